@@ -1,0 +1,94 @@
+"""Shared fixtures: the reference model and tiny URDFs written on the fly."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pinocchio as pin
+import pytest
+
+import uvms_pin as up
+
+ROOT = Path(__file__).resolve().parents[1]
+REFERENCE_URDF = ROOT / "models" / "uvms_lbv150.urdf"
+RHO = 1025.0
+G = 9.81
+
+
+def body_urdf(
+    *,
+    mass: float = 10.0,
+    inertia: tuple[float, float, float] = (0.1, 0.2, 0.3),
+    com: tuple[float, float, float] = (0.0, 0.0, 0.0),
+    hydro: str | None = None,
+    collision: str | None = None,
+) -> str:
+    """A one-link robot named 'body' (also used as its own end-effector frame)."""
+    parts = [
+        '<robot name="one">',
+        '  <link name="body">',
+        f'    <inertial><origin xyz="{com[0]} {com[1]} {com[2]}"/><mass value="{mass}"/>'
+        f'<inertia ixx="{inertia[0]}" iyy="{inertia[1]}" izz="{inertia[2]}" ixy="0" ixz="0" iyz="0"/></inertial>',
+    ]
+    if collision:
+        parts.append(f"    <collision><geometry>{collision}</geometry></collision>")
+    if hydro:
+        parts.append(f"    <hydrodynamics>{hydro}</hydrodynamics>")
+    parts += ["  </link>", "</robot>"]
+    return "\n".join(parts)
+
+
+def hydro_xml(volume: float, cob=(0, 0, 0), added=(0,) * 6, lin=(0,) * 6, quad=(0,) * 6) -> str:
+    def s(x):
+        return " ".join(str(v) for v in x)
+
+    return (
+        f'<volume value="{volume}"/><center_of_buoyancy xyz="{s(cob)}"/>'
+        f'<added_mass diagonal="{s(added)}"/><linear_damping diagonal="{s(lin)}"/>'
+        f'<quadratic_damping diagonal="{s(quad)}"/>'
+    )
+
+
+@pytest.fixture
+def write_urdf(tmp_path: Path):
+    """Write URDF text to a file and return its path."""
+
+    def _write(text: str, name: str = "robot.urdf") -> Path:
+        path = tmp_path / name
+        path.write_text(text)
+        return path
+
+    return _write
+
+
+@pytest.fixture
+def load_body(write_urdf):
+    """Load a one-link URDF as a UVMS whose end-effector and sensor frames are the body."""
+
+    def _load(text: str, **kw) -> up.UVMS:
+        return up.load_uvms(write_urdf(text), ee_frame="body", sensor_frame="body", **kw)
+
+    return _load
+
+
+@pytest.fixture(scope="session")
+def reference_uvms() -> up.UVMS:
+    return up.load_uvms(REFERENCE_URDF)
+
+
+def random_configuration(uvms: up.UVMS, rng: np.random.Generator) -> np.ndarray:
+    """A random q: position in a 2 m box, uniform random orientation, joints within limits."""
+    model = uvms.model
+    q = np.empty(model.nq)
+    q[:3] = rng.uniform(-1.0, 1.0, 3)
+    quat = rng.normal(size=4)
+    q[3:7] = quat / np.linalg.norm(quat)
+    lo = np.maximum(model.lowerPositionLimit[7:], -np.pi)
+    hi = np.minimum(model.upperPositionLimit[7:], np.pi)
+    q[7:] = rng.uniform(lo, hi)
+    return q
+
+
+def free_body_state(uvms: up.UVMS) -> np.ndarray:
+    return pin.neutral(uvms.model)

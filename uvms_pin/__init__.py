@@ -1,0 +1,43 @@
+"""uvms-pin: Underwater Vehicle-Manipulator Systems on Pinocchio."""
+
+from uvms_pin.dynamics import (
+    bias_forces,
+    forward_dynamics,
+    frame_wrench_to_generalized,
+    kinetic_energy,
+    mass_matrix,
+    potential_energy,
+)
+from uvms_pin.errors import (
+    FunnelViolation,
+    ModelError,
+    ParameterError,
+    ScenarioError,
+    SimulationError,
+    UvmsPinError,
+)
+from uvms_pin.hydro.params import HydroParams
+from uvms_pin.measurement import Measurement
+from uvms_pin.model import UVMS, HydroBody, load_uvms
+
+__version__ = "0.1.0"
+
+__all__ = [
+    "UVMS",
+    "FunnelViolation",
+    "HydroBody",
+    "HydroParams",
+    "Measurement",
+    "ModelError",
+    "ParameterError",
+    "ScenarioError",
+    "SimulationError",
+    "UvmsPinError",
+    "bias_forces",
+    "forward_dynamics",
+    "frame_wrench_to_generalized",
+    "kinetic_energy",
+    "load_uvms",
+    "mass_matrix",
+    "potential_energy",
+]

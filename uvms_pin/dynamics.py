@@ -1,0 +1,185 @@
+"""Underwater dynamics of a UVMS (DESIGN.md section 5, after Schjolberg & Fossen 1994).
+
+    M(q) zeta_dot + h(q, zeta) = tau + tau_ext
+
+    M(q)      = M_RB(q) + sum_i J_i^T M_A,i J_i                    (added mass inside M)
+    h(q,zeta) = C_RB zeta + g_RB
+              - sum_i J_i^T [ -M_A,i (a_i^bias - nu_c_dot,i) - C_A,i(nu_r,i) nu_r,i
+                              - D_i(nu_r,i) nu_r,i + w_buoy,i ]
+
+with J_i the LOCAL body Jacobian of joint i, nu_r,i = nu_i - nu_c,i the current-relative
+body velocity and a_i^bias the body acceleration at zero joint acceleration. tau_ext is the
+generalized force of external wrenches (contact, disturbances): for a wrench w applied at a
+frame, tau_ext = J_frame^T w.
+
+Every function works in the UVMS's Pinocchio data buffer; none allocates a model.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pinocchio as pin
+from scipy.linalg import cho_factor, cho_solve
+
+from uvms_pin.errors import ParameterError, SimulationError
+from uvms_pin.hydro.added_mass import kirchhoff_wrench
+from uvms_pin.hydro.current import current_acceleration_body, current_velocity_body
+from uvms_pin.hydro.damping import damping_wrench
+from uvms_pin.hydro.restoring import buoyancy_potential_energy, buoyancy_wrench
+from uvms_pin.model import UVMS
+
+_NO_CURRENT = np.zeros(3)
+
+
+def _check(name: str, x: np.ndarray, n: int) -> np.ndarray:
+    x = np.asarray(x, dtype=float)
+    if x.shape != (n,):
+        raise ParameterError(f"{name} must have shape ({n},), got {x.shape}")
+    if not np.all(np.isfinite(x)):
+        raise ParameterError(f"{name} contains a non-finite value: {x}")
+    return x
+
+
+def _fluid_wrenches(uvms: UVMS, current_world_m_s: np.ndarray) -> list[pin.Force]:
+    """Wrench of the water on each joint body (LOCAL frame), all terms but M_A zeta_dot.
+
+    Needs ``forwardKinematics(model, data, q, v, 0)`` in ``uvms.data`` (placements, body
+    velocities and bias accelerations).
+    """
+    model, data = uvms.model, uvms.data
+    rho = uvms.water_density_kg_m3
+    gravity = model.gravity.linear
+    fext = [pin.Force.Zero() for _ in range(model.njoints)]
+    for j in uvms.joints_with_added_mass:
+        rotation = data.oMi[j].rotation
+        nu = data.v[j].vector
+        nu_c = current_velocity_body(rotation, current_world_m_s)
+        nu_c_dot = current_acceleration_body(nu[3:], nu_c[:3])
+        added = uvms.added_mass_per_joint[j]
+        wrench = -(added @ (data.a[j].vector - nu_c_dot)) - kirchhoff_wrench(added, nu - nu_c)
+        fext[j].vector += wrench
+    for j in uvms.joints_with_volume:
+        fext[j].vector += buoyancy_wrench(
+            uvms.volume_per_joint_m3[j],
+            uvms.center_of_buoyancy_per_joint_m[j],
+            data.oMi[j].rotation,
+            rho,
+            gravity,
+        )
+    for body in uvms.hydro_bodies_with_damping:
+        j = body.joint_id
+        placement = body.placement_in_joint
+        rotation = data.oMi[j].rotation @ placement.rotation
+        nu_body = placement.actInv(data.v[j]).vector
+        nu_r = nu_body - current_velocity_body(rotation, current_world_m_s)
+        wrench_body = damping_wrench(
+            body.params.linear_damping, body.params.quadratic_damping, nu_r
+        )
+        fext[j] += placement.act(pin.Force(wrench_body))
+    return fext
+
+
+def mass_matrix(uvms: UVMS, q: np.ndarray) -> np.ndarray:
+    """M(q) = M_RB(q) + sum_i J_i^T M_A,i J_i (nv x nv, symmetric positive definite)."""
+    q = _check("q", q, uvms.nq)
+    return _mass_matrix(uvms, q)
+
+
+def _mass_matrix(uvms: UVMS, q: np.ndarray) -> np.ndarray:
+    model, data = uvms.model, uvms.data
+    pin.crba(model, data, q)
+    mass = np.triu(data.M)
+    mass = mass + np.triu(mass, 1).T  # crba fills the upper triangle only
+    if uvms.joints_with_added_mass:
+        pin.computeJointJacobians(model, data, q)
+        for j in uvms.joints_with_added_mass:
+            jac = pin.getJointJacobian(model, data, j, pin.LOCAL)
+            mass += jac.T @ uvms.added_mass_per_joint[j] @ jac
+    return mass
+
+
+def bias_forces(
+    uvms: UVMS, q: np.ndarray, v: np.ndarray, current_world: np.ndarray = _NO_CURRENT
+) -> np.ndarray:
+    """h(q, zeta): rigid Coriolis and gravity, added-mass bias and Coriolis, damping, buoyancy.
+
+    Args:
+        q: configuration (nq,). v: generalized velocity zeta (nv,).
+        current_world: constant, uniform current velocity in the world frame [m/s].
+    """
+    q = _check("q", q, uvms.nq)
+    v = _check("v", v, uvms.nv)
+    current = _check("current_world", current_world, 3)
+    return _bias_forces(uvms, q, v, current)
+
+
+def _bias_forces(uvms: UVMS, q: np.ndarray, v: np.ndarray, current: np.ndarray) -> np.ndarray:
+    model, data = uvms.model, uvms.data
+    zero = np.zeros(model.nv)
+    pin.forwardKinematics(model, data, q, v, zero)
+    fext = _fluid_wrenches(uvms, current)
+    # rnea(q, v, 0, fext) = C_RB v + g_RB - sum_i J_i^T fext_i
+    return pin.rnea(model, data, q, v, zero, fext).copy()
+
+
+def forward_dynamics(
+    uvms: UVMS,
+    q: np.ndarray,
+    v: np.ndarray,
+    tau: np.ndarray,
+    current_world: np.ndarray = _NO_CURRENT,
+    tau_ext: np.ndarray | None = None,
+) -> np.ndarray:
+    """zeta_dot = M(q)^-1 (tau + tau_ext - h(q, zeta)), by a Cholesky solve (no inverse).
+
+    Args:
+        tau: generalized input (nv,): body wrench on the vehicle [N; N m], joint torques.
+        tau_ext: generalized force of external wrenches (nv,), e.g. from
+            `frame_wrench_to_generalized`; None for none.
+
+    Raises:
+        ParameterError: wrong shape or non-finite input.
+        SimulationError: M not positive definite (e.g. a degenerate model).
+    """
+    q = _check("q", q, uvms.nq)
+    v = _check("v", v, uvms.nv)
+    tau = _check("tau", tau, uvms.nv)
+    current = _check("current_world", current_world, 3)
+    rhs = tau - _bias_forces(uvms, q, v, current)
+    if tau_ext is not None:
+        rhs += _check("tau_ext", tau_ext, uvms.nv)
+    mass = _mass_matrix(uvms, q)
+    try:
+        factor = cho_factor(mass, lower=False, check_finite=False)
+    except np.linalg.LinAlgError as exc:
+        raise SimulationError(f"mass matrix is not positive definite at q = {q}") from exc
+    return cho_solve(factor, rhs, check_finite=False)
+
+
+def frame_wrench_to_generalized(
+    uvms: UVMS, q: np.ndarray, frame_id: int, wrench_world_aligned: np.ndarray
+) -> np.ndarray:
+    """tau_ext = J^T w for a wrench at a frame origin, in world-aligned axes [N; N m]."""
+    model, data = uvms.model, uvms.data
+    jac = pin.computeFrameJacobian(model, data, q, frame_id, pin.LOCAL_WORLD_ALIGNED)
+    return jac.T @ wrench_world_aligned
+
+
+def kinetic_energy(uvms: UVMS, q: np.ndarray, v: np.ndarray) -> float:
+    """T = 1/2 zeta^T M(q) zeta [J], added mass (the entrained fluid) included."""
+    v = _check("v", v, uvms.nv)
+    return float(0.5 * v @ mass_matrix(uvms, q) @ v)
+
+
+def potential_energy(uvms: UVMS, q: np.ndarray) -> float:
+    """U = U_gravity + U_buoyancy [J] (zero at z = 0)."""
+    q = _check("q", q, uvms.nq)
+    model, data = uvms.model, uvms.data
+    pin.forwardKinematics(model, data, q)
+    energy = float(pin.computePotentialEnergy(model, data, q))
+    for j in uvms.joints_with_volume:
+        cob_world = data.oMi[j].act(uvms.center_of_buoyancy_per_joint_m[j])
+        energy += buoyancy_potential_energy(
+            uvms.volume_per_joint_m3[j], cob_world, uvms.water_density_kg_m3, model.gravity.linear
+        )
+    return energy

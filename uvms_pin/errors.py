@@ -1,0 +1,55 @@
+"""The project's exception hierarchy: every failure the user can cause has a type here."""
+
+from __future__ import annotations
+
+
+class UvmsPinError(Exception):
+    """Base class of every error raised on purpose by uvms-pin."""
+
+
+class ModelError(UvmsPinError):
+    """A model file (URDF, hydrodynamic extension) is malformed or physically invalid.
+
+    The message names the file, the link and what is wrong.
+    """
+
+    def __init__(self, message: str, *, path: str | None = None, link: str | None = None):
+        prefix = ""
+        if path is not None:
+            prefix += f"{path}: "
+        if link is not None:
+            prefix += f"link '{link}': "
+        super().__init__(prefix + message)
+        self.path = path
+        self.link = link
+
+
+class ParameterError(UvmsPinError, ValueError):
+    """An argument has the wrong shape, a non-finite value or is out of its valid range."""
+
+
+class ScenarioError(UvmsPinError):
+    """A scenario or study file is malformed: unknown key, wrong type, missing entry."""
+
+
+class SimulationError(UvmsPinError):
+    """The simulation cannot continue (non-finite state, integrator failure)."""
+
+
+class FunnelViolation(SimulationError):
+    """A prescribed-performance error left its funnel: |e(t)| >= rho(t).
+
+    Attributes name the level, component, time, error and bound so that callers can
+    report it without parsing the message.
+    """
+
+    def __init__(self, *, level: str, component: str, time_s: float, error: float, bound: float):
+        super().__init__(
+            f"funnel violated at t = {time_s:.6f} s: {level} error '{component}' = {error:.6g} "
+            f"reached its bound rho = {bound:.6g} (|xi| = {abs(error) / bound:.6f} >= 1)"
+        )
+        self.level = level
+        self.component = component
+        self.time_s = time_s
+        self.error = error
+        self.bound = bound

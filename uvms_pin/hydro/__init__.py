@@ -1,0 +1,1 @@
+"""Hydrodynamics as small pure functions returning body-frame wrenches."""

@@ -1,0 +1,36 @@
+"""Buoyancy: the hydrostatic restoring wrench (gravity itself is Pinocchio's)."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from uvms_pin.hydro.vector import cross3
+
+
+def buoyancy_wrench(
+    volume_m3: float,
+    center_of_buoyancy_body_m: np.ndarray,
+    rotation_world_body: np.ndarray,
+    water_density_kg_m3: float,
+    gravity_world_m_s2: np.ndarray,
+) -> np.ndarray:
+    """Body-frame wrench of the buoyancy force -rho V g acting at the centre of buoyancy.
+
+    f_b = R^T (-rho V g_world) (up for g pointing down); moment r_b x f_b about the body
+    origin. Returns [f_b (N); r_b x f_b (N m)].
+    """
+    force_body = rotation_world_body.T @ (-water_density_kg_m3 * volume_m3 * gravity_world_m_s2)
+    out = np.empty(6)
+    out[:3] = force_body
+    out[3:] = cross3(center_of_buoyancy_body_m, force_body)
+    return out
+
+
+def buoyancy_potential_energy(
+    volume_m3: float,
+    center_of_buoyancy_world_m: np.ndarray,
+    water_density_kg_m3: float,
+    gravity_world_m_s2: np.ndarray,
+) -> float:
+    """U_b = rho V g_world . p_b [J]: the potential whose negative gradient is the buoyancy force."""
+    return float(water_density_kg_m3 * volume_m3 * gravity_world_m_s2 @ center_of_buoyancy_world_m)

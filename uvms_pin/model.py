@@ -1,0 +1,403 @@
+"""URDF -> UVMS: the static model (Pinocchio model, per-body hydrodynamics, frames).
+
+Pinocchio builds the rigid multibody with a free-flyer root and merges links attached by
+fixed joints into their parent joint's body. The hydrodynamic extension (DESIGN.md section 4)
+is read here from the same file; each link's coefficients become a `HydroBody` attached to
+the Pinocchio joint that carries the link, with the link's placement in that joint's frame,
+so nothing is approximated when links are merged.
+"""
+
+from __future__ import annotations
+
+import xml.etree.ElementTree as ET
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+import pinocchio as pin
+
+from uvms_pin.errors import ModelError, ParameterError
+from uvms_pin.hydro import geometry
+from uvms_pin.hydro.added_mass import added_mass_in_parent
+from uvms_pin.hydro.params import HydroParams
+
+DEFAULT_WATER_DENSITY_KG_M3 = 1025.0  # sea water; a parameter of load_uvms, never hidden
+
+_HYDRO_TAGS = {"volume", "center_of_buoyancy", "added_mass", "linear_damping", "quadratic_damping"}
+
+
+@dataclass(frozen=True)
+class HydroBody:
+    """Hydrodynamic parameters of one link attached to one Pinocchio joint.
+
+    Attributes:
+        name: the URDF link (or ``link/collision[k]`` for a derived primitive).
+        joint_id: index of the Pinocchio joint whose body carries this link.
+        placement_in_joint: SE3 of the hydro frame (where the coefficients are given)
+            relative to the joint frame.
+        params: coefficients in the hydro frame.
+    """
+
+    name: str
+    joint_id: int
+    placement_in_joint: pin.SE3
+    params: HydroParams
+
+    @property
+    def action_joint_to_body(self) -> np.ndarray:
+        """X (6x6) with nu_body = X nu_joint."""
+        return self.placement_in_joint.inverse().action
+
+
+@dataclass
+class UVMS:
+    """A loaded underwater vehicle-manipulator system (static model plus a work buffer).
+
+    Attributes:
+        model: Pinocchio model, free-flyer root (joint 1) = the vehicle.
+        data: Pinocchio data used as a work buffer by the dynamics functions (not
+            thread-safe; use `copy()` for one UVMS per thread or process).
+        hydro_bodies: every link's hydrodynamic parameters with its joint and placement.
+        water_density_kg_m3: rho used for buoyancy and derived coefficients.
+        ee_frame_id, sensor_frame_id: Pinocchio frame indices of the end-effector and of
+            the wrist force/torque sensor.
+        source: path of the URDF file.
+    """
+
+    model: pin.Model
+    hydro_bodies: tuple[HydroBody, ...]
+    water_density_kg_m3: float
+    ee_frame_id: int
+    sensor_frame_id: int
+    source: str = ""
+    data: pin.Data = field(init=False, repr=False)
+    added_mass_per_joint: np.ndarray = field(init=False, repr=False)
+    hydro_bodies_with_damping: tuple[HydroBody, ...] = field(init=False, repr=False)
+    volume_per_joint_m3: np.ndarray = field(init=False, repr=False)
+    center_of_buoyancy_per_joint_m: np.ndarray = field(init=False, repr=False)
+
+    def __post_init__(self) -> None:
+        self.data = self.model.createData()
+        nj = self.model.njoints
+        added = np.zeros((nj, 6, 6))
+        volume = np.zeros(nj)
+        moment = np.zeros((nj, 3))
+        for body in self.hydro_bodies:
+            p = body.params
+            added[body.joint_id] += added_mass_in_parent(p.added_mass, body.action_joint_to_body)
+            volume[body.joint_id] += p.volume_m3
+            moment[body.joint_id] += p.volume_m3 * body.placement_in_joint.act(
+                p.center_of_buoyancy_m
+            )
+        cob = np.zeros((nj, 3))
+        nz = volume > 0.0
+        cob[nz] = moment[nz] / volume[nz, None]
+        self.added_mass_per_joint = added
+        self.volume_per_joint_m3 = volume
+        self.center_of_buoyancy_per_joint_m = cob
+        self.hydro_bodies_with_damping = tuple(
+            b
+            for b in self.hydro_bodies
+            if np.any(b.params.linear_damping) or np.any(b.params.quadratic_damping)
+        )
+        # joints that carry added mass: the only ones the mass matrix must visit
+        self.joints_with_added_mass = tuple(
+            int(j) for j in np.flatnonzero(np.any(added, axis=(1, 2)))
+        )
+        self.joints_with_volume = tuple(int(j) for j in np.flatnonzero(volume))
+
+    # ---- sizes and aggregates -------------------------------------------------------
+    @property
+    def nq(self) -> int:
+        return self.model.nq
+
+    @property
+    def nv(self) -> int:
+        return self.model.nv
+
+    @property
+    def n_arm_joints(self) -> int:
+        return self.model.nv - 6
+
+    @property
+    def mass_kg(self) -> float:
+        """Rigid-body mass in air [kg]."""
+        return float(sum(inertia.mass for inertia in self.model.inertias))
+
+    @property
+    def volume_m3(self) -> float:
+        """Total displaced volume [m^3]."""
+        return float(self.volume_per_joint_m3.sum())
+
+    @property
+    def net_buoyancy_N(self) -> float:
+        """Buoyancy minus weight [N]: > 0 floats up, < 0 sinks."""
+        g = float(np.linalg.norm(self.model.gravity.linear))
+        return (self.water_density_kg_m3 * self.volume_m3 - self.mass_kg) * g
+
+    @property
+    def arm_joint_names(self) -> list[str]:
+        return list(self.model.names[2:])
+
+    def neutral_configuration(self) -> np.ndarray:
+        """q at the origin, level, arm at zero (clipped into the joint limits)."""
+        q = pin.neutral(self.model)
+        lo = self.model.lowerPositionLimit[7:]
+        hi = self.model.upperPositionLimit[7:]
+        q[7:] = np.clip(q[7:], lo, hi)
+        return q
+
+    def copy(self) -> UVMS:
+        """An independent UVMS sharing the static parts but with its own work buffer."""
+        return UVMS(
+            model=self.model,
+            hydro_bodies=self.hydro_bodies,
+            water_density_kg_m3=self.water_density_kg_m3,
+            ee_frame_id=self.ee_frame_id,
+            sensor_frame_id=self.sensor_frame_id,
+            source=self.source,
+        )
+
+    def with_hydro(self, transform: Callable[[HydroBody], HydroParams]) -> UVMS:
+        """A UVMS whose every body's params are replaced by ``transform(body)``."""
+        bodies = tuple(
+            HydroBody(b.name, b.joint_id, b.placement_in_joint, transform(b))
+            for b in self.hydro_bodies
+        )
+        return UVMS(
+            model=self.model,
+            hydro_bodies=bodies,
+            water_density_kg_m3=self.water_density_kg_m3,
+            ee_frame_id=self.ee_frame_id,
+            sensor_frame_id=self.sensor_frame_id,
+            source=self.source,
+        )
+
+
+# ---- loading ----------------------------------------------------------------------------
+
+
+def load_uvms(
+    urdf_path: str | Path,
+    *,
+    water_density_kg_m3: float = DEFAULT_WATER_DENSITY_KG_M3,
+    ee_frame: str = "ee",
+    sensor_frame: str = "ft_sensor",
+    derive_missing: bool = True,
+    allow_dry_links: bool = False,
+) -> UVMS:
+    """Load a UVMS from a URDF with the hydrodynamic extension.
+
+    Args:
+        urdf_path: the URDF file. Its root link becomes the free-flying vehicle.
+        water_density_kg_m3: rho [kg/m^3] for buoyancy and derived coefficients.
+        ee_frame, sensor_frame: names of the end-effector and force/torque sensor frames.
+        derive_missing: links without a <hydrodynamics> element get coefficients derived
+            from their collision primitives (marked ``derived``).
+        allow_dry_links: accept links with mass but neither hydrodynamics nor collision
+            geometry (they get no hydrodynamic effect) instead of raising.
+
+    Raises:
+        ModelError: naming the file, the link and what is wrong.
+    """
+    path = Path(urdf_path)
+    where = str(path)
+    if not np.isfinite(water_density_kg_m3) or water_density_kg_m3 <= 0.0:
+        raise ParameterError(f"water_density_kg_m3 must be positive, got {water_density_kg_m3}")
+    if not path.is_file():
+        raise ModelError("file not found", path=where)
+    try:
+        root = ET.parse(path).getroot()
+    except ET.ParseError as exc:
+        raise ModelError(f"not well-formed XML ({exc})", path=where) from exc
+    if root.tag != "robot":
+        raise ModelError(f"root element is <{root.tag}>, expected <robot>", path=where)
+    links = {link.get("name"): link for link in root.findall("link")}
+    if not links:
+        raise ModelError("no <link> elements", path=where)
+    hydro_elements = _collect_hydro_elements(root, links, where)
+    try:
+        model = pin.buildModelFromUrdf(str(path), pin.JointModelFreeFlyer())
+    except Exception as exc:  # Pinocchio raises ValueError/RuntimeError for bad URDFs
+        raise ModelError(f"Pinocchio could not build the model: {exc}", path=where) from exc
+
+    bodies: list[HydroBody] = []
+    for name, link in links.items():
+        has_inertial = link.find("inertial") is not None
+        collisions = link.findall("collision")
+        hydro = hydro_elements.get(name)
+        if hydro is not None and not has_inertial:
+            raise ModelError("has <hydrodynamics> but no <inertial>", path=where, link=name)
+        if collisions and not has_inertial:
+            raise ModelError("has <collision> geometry but no <inertial>", path=where, link=name)
+        if not has_inertial:
+            continue  # a frame-only link: no body, no hydrodynamics
+        frame_id = model.getFrameId(name, pin.BODY)
+        if frame_id >= len(model.frames):
+            raise ModelError("not found in the Pinocchio model", path=where, link=name)
+        frame = model.frames[frame_id]
+        joint_id = int(frame.parentJoint)
+        if hydro is not None:
+            params = _parse_hydro(hydro, where, name)
+            bodies.append(HydroBody(name, joint_id, frame.placement, params))
+        elif collisions and derive_missing:
+            for k, collision in enumerate(collisions):
+                origin, params = _derive_from_collision(collision, water_density_kg_m3, where, name)
+                bodies.append(
+                    HydroBody(f"{name}/collision[{k}]", joint_id, frame.placement * origin, params)
+                )
+        elif not allow_dry_links:
+            raise ModelError(
+                "has mass but no <hydrodynamics> element and no collision primitive to derive "
+                "coefficients from (pass allow_dry_links=True to accept a dry link)",
+                path=where,
+                link=name,
+            )
+
+    return UVMS(
+        model=model,
+        hydro_bodies=tuple(bodies),
+        water_density_kg_m3=float(water_density_kg_m3),
+        ee_frame_id=_frame_id(model, ee_frame, where),
+        sensor_frame_id=_frame_id(model, sensor_frame, where),
+        source=where,
+    )
+
+
+def _frame_id(model: pin.Model, name: str, where: str) -> int:
+    if not model.existFrame(name):
+        names = sorted({f.name for f in model.frames})
+        raise ModelError(f"frame '{name}' not found; frames are: {', '.join(names)}", path=where)
+    return int(model.getFrameId(name))
+
+
+def _collect_hydro_elements(root: ET.Element, links: dict, where: str) -> dict[str, ET.Element]:
+    found: dict[str, ET.Element] = {}
+    for name, link in links.items():
+        elements = link.findall("hydrodynamics")
+        if len(elements) > 1:
+            raise ModelError("has more than one <hydrodynamics> element", path=where, link=name)
+        if elements:
+            found[name] = elements[0]
+    for element in root.findall("hydrodynamics"):
+        name = element.get("link")
+        if name is None:
+            raise ModelError('top-level <hydrodynamics> needs a link="NAME" attribute', path=where)
+        if name not in links:
+            raise ModelError(
+                "top-level <hydrodynamics> names a link that does not exist", path=where, link=name
+            )
+        if name in found:
+            raise ModelError("has more than one <hydrodynamics> element", path=where, link=name)
+        found[name] = element
+    return found
+
+
+def _numbers(text: str | None, count: int, what: str, where: str, link: str) -> np.ndarray:
+    if text is None:
+        raise ModelError(f"{what} is missing its value", path=where, link=link)
+    try:
+        values = np.array([float(tok) for tok in text.split()])
+    except ValueError as exc:
+        raise ModelError(f"{what} has a non-numeric value '{text}'", path=where, link=link) from exc
+    if values.size != count:
+        raise ModelError(f"{what} needs {count} numbers, got {values.size}", path=where, link=link)
+    if not np.all(np.isfinite(values)):
+        raise ModelError(f"{what} has a non-finite value", path=where, link=link)
+    return values
+
+
+def _matrix_6x6(element: ET.Element | None, what: str, where: str, link: str) -> np.ndarray:
+    if element is None:
+        return np.zeros((6, 6))
+    diagonal, matrix = element.get("diagonal"), element.get("matrix")
+    if (diagonal is None) == (matrix is None):
+        raise ModelError(
+            f'<{what}> needs exactly one of diagonal="6 numbers" or matrix="36 numbers"',
+            path=where,
+            link=link,
+        )
+    if diagonal is not None:
+        values = _numbers(diagonal, 6, f"<{what} diagonal>", where, link)
+        if np.any(values < 0.0):
+            raise ModelError(
+                f"<{what}> diagonal must be >= 0 (magnitudes), got {values.tolist()}",
+                path=where,
+                link=link,
+            )
+        return np.diag(values)
+    return _numbers(matrix, 36, f"<{what} matrix>", where, link).reshape(6, 6)
+
+
+def _parse_hydro(element: ET.Element, where: str, link: str) -> HydroParams:
+    for child in element:
+        if child.tag not in _HYDRO_TAGS:
+            raise ModelError(
+                f"unknown tag <{child.tag}> in <hydrodynamics>; known: {', '.join(sorted(_HYDRO_TAGS))}",
+                path=where,
+                link=link,
+            )
+    volume_el = element.find("volume")
+    if volume_el is None:
+        raise ModelError("<hydrodynamics> has no <volume>", path=where, link=link)
+    volume = float(_numbers(volume_el.get("value"), 1, "<volume value>", where, link)[0])
+    if volume < 0.0:
+        raise ModelError(f"negative volume {volume} m^3", path=where, link=link)
+    cob_el = element.find("center_of_buoyancy")
+    cob = (
+        np.zeros(3)
+        if cob_el is None
+        else _numbers(cob_el.get("xyz"), 3, "<center_of_buoyancy xyz>", where, link)
+    )
+    added = _matrix_6x6(element.find("added_mass"), "added_mass", where, link)
+    linear = _matrix_6x6(element.find("linear_damping"), "linear_damping", where, link)
+    quad_el = element.find("quadratic_damping")
+    quadratic = np.zeros(6)
+    if quad_el is not None:
+        quadratic = _numbers(
+            quad_el.get("diagonal"), 6, "<quadratic_damping diagonal>", where, link
+        )
+    try:
+        return HydroParams(volume, cob, added, linear, quadratic, derived=False, origin="URDF")
+    except ParameterError as exc:
+        raise ModelError(str(exc), path=where, link=link) from exc
+
+
+def _origin(element: ET.Element | None, where: str, link: str) -> pin.SE3:
+    if element is None:
+        return pin.SE3.Identity()
+    xyz = _numbers(element.get("xyz", "0 0 0"), 3, "<origin xyz>", where, link)
+    rpy = _numbers(element.get("rpy", "0 0 0"), 3, "<origin rpy>", where, link)
+    return pin.SE3(pin.rpy.rpyToMatrix(*rpy), xyz)
+
+
+def _derive_from_collision(
+    collision: ET.Element, water_density_kg_m3: float, where: str, link: str
+) -> tuple[pin.SE3, HydroParams]:
+    origin = _origin(collision.find("origin"), where, link)
+    geom = collision.find("geometry")
+    shape = None if geom is None or len(geom) == 0 else geom[0]
+    if shape is None:
+        raise ModelError("<collision> has no <geometry> shape", path=where, link=link)
+    try:
+        if shape.tag == "box":
+            size = _numbers(shape.get("size"), 3, "<box size>", where, link)
+            return origin, geometry.box_hydro(size, water_density_kg_m3)
+        if shape.tag == "cylinder":
+            radius = _numbers(shape.get("radius"), 1, "<cylinder radius>", where, link)[0]
+            length = _numbers(shape.get("length"), 1, "<cylinder length>", where, link)[0]
+            return origin, geometry.cylinder_hydro(radius, length, water_density_kg_m3)
+        if shape.tag == "sphere":
+            radius = _numbers(shape.get("radius"), 1, "<sphere radius>", where, link)[0]
+            return origin, geometry.sphere_hydro(radius, water_density_kg_m3)
+    except ParameterError as exc:
+        raise ModelError(
+            f"cannot derive hydrodynamics from <{shape.tag}>: {exc}", path=where, link=link
+        ) from exc
+    raise ModelError(
+        f"cannot derive hydrodynamics from collision <{shape.tag}> (box, cylinder and sphere are "
+        "supported); add a <hydrodynamics> element",
+        path=where,
+        link=link,
+    )

@@ -1,0 +1,129 @@
+"""Sensors with bounded, seeded noise; they produce the controller's `Measurement`.
+
+Noise is drawn once, on a fixed sample grid, from a seeded generator and held between
+samples, so a measurement is a deterministic function of time: the same run gives the same
+numbers whatever the integrator, and adaptive integrators see a well-defined system.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+import pinocchio as pin
+
+from uvms_pin.errors import ParameterError
+from uvms_pin.measurement import Measurement
+
+
+@dataclass(frozen=True)
+class NoiseSpec:
+    """Bounded noise: ``uniform`` in [-bound, bound] or ``gaussian`` clipped at +-bound.
+
+    For ``gaussian`` the standard deviation is bound / 3.
+    """
+
+    bound: float = 0.0
+    distribution: str = "uniform"
+
+    def __post_init__(self) -> None:
+        if not (self.bound >= 0.0 and math.isfinite(self.bound)):
+            raise ParameterError(f"noise bound must be >= 0, got {self.bound}")
+        if self.distribution not in ("uniform", "gaussian"):
+            raise ParameterError(
+                f"noise distribution must be 'uniform' or 'gaussian', got '{self.distribution}'"
+            )
+
+    def draw(self, rng: np.random.Generator, shape: tuple[int, ...]) -> np.ndarray:
+        if self.bound == 0.0:
+            return np.zeros(shape)
+        if self.distribution == "uniform":
+            return rng.uniform(-self.bound, self.bound, size=shape)
+        return np.clip(rng.normal(0.0, self.bound / 3.0, size=shape), -self.bound, self.bound)
+
+
+class HeldNoise:
+    """A noise signal sampled every ``period_s`` and held: n(t) = table[floor(t / T)]."""
+
+    def __init__(
+        self,
+        spec: NoiseSpec,
+        width: int,
+        period_s: float,
+        duration_s: float,
+        rng: np.random.Generator,
+    ):
+        if not (period_s > 0.0 and math.isfinite(period_s)):
+            raise ParameterError(f"noise sample period must be positive, got {period_s}")
+        self.period_s = period_s
+        self._table = spec.draw(rng, (math.ceil(duration_s / period_s) + 2, width))
+
+    def __call__(self, time_s: float) -> np.ndarray:
+        k = min(int(time_s / self.period_s + 1e-9), len(self._table) - 1)
+        return self._table[k]
+
+
+@dataclass(frozen=True)
+class SensorConfig:
+    """Noise of the force/torque sensor and of the state estimate.
+
+    Attributes:
+        force_noise: on each force component [N]. torque_noise: [N m].
+        position_noise: vehicle position [m]; orientation_noise: rotation vector [rad];
+        joint_noise: [rad]; velocity_noise: every component of zeta [m/s, rad/s].
+        sample_period_s: sensor rate (noise held between samples).
+    """
+
+    force_noise: NoiseSpec = NoiseSpec()
+    torque_noise: NoiseSpec = NoiseSpec()
+    position_noise: NoiseSpec = NoiseSpec()
+    orientation_noise: NoiseSpec = NoiseSpec()
+    joint_noise: NoiseSpec = NoiseSpec()
+    velocity_noise: NoiseSpec = NoiseSpec()
+    sample_period_s: float = 1e-3
+
+
+class SensorSuite:
+    """Turns the true state and contact wrench into a noisy `Measurement`."""
+
+    def __init__(self, model: pin.Model, config: SensorConfig, duration_s: float, seed: int):
+        self.model = model
+        self.config = config
+        rng = np.random.default_rng(seed)
+        nj = model.nv - 6
+        period = config.sample_period_s
+        self._force = HeldNoise(config.force_noise, 3, period, duration_s, rng)
+        self._torque = HeldNoise(config.torque_noise, 3, period, duration_s, rng)
+        self._position = HeldNoise(config.position_noise, 3, period, duration_s, rng)
+        self._orientation = HeldNoise(config.orientation_noise, 3, period, duration_s, rng)
+        self._joints = HeldNoise(config.joint_noise, nj, period, duration_s, rng)
+        self._velocity = HeldNoise(config.velocity_noise, model.nv, period, duration_s, rng)
+        self._state_noisy = any(
+            s.bound > 0.0
+            for s in (
+                config.position_noise,
+                config.orientation_noise,
+                config.joint_noise,
+                config.velocity_noise,
+            )
+        )
+
+    def force_noise(self, time_s: float) -> np.ndarray:
+        return np.concatenate([self._force(time_s), self._torque(time_s)])
+
+    def measure(
+        self, time_s: float, q: np.ndarray, v: np.ndarray, wrench_world: np.ndarray
+    ) -> Measurement:
+        wrench = wrench_world + self.force_noise(time_s)
+        if not self._state_noisy:
+            return Measurement(time_s, q, v, wrench)
+        dq = np.zeros(self.model.nv)
+        dq[:3] = self._position(time_s)
+        dq[3:6] = self._orientation(time_s)
+        dq[6:] = self._joints(time_s)
+        # position noise is a world offset: rotate it into the body frame pin.integrate uses
+        rotation = pin.Quaternion(q[3:7]).toRotationMatrix()
+        dq[:3] = rotation.T @ dq[:3]
+        q_meas = pin.integrate(self.model, q, dq)
+        return Measurement(time_s, q_meas, v + self._velocity(time_s), wrench)
