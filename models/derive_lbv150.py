@@ -255,12 +255,16 @@ def _cylinder_link_xml(link: CylinderLink, material: str) -> str:
     )
 
 
-# (name, parent, child, axis, lower, upper, effort N m, velocity rad/s)
+# (name, parent, child, axis, lower, upper, effort N m, velocity rad/s, armature kg m^2)
+# armature = reflected rotor inertia J_rotor N^2 of a geared joint motor: a small DC motor
+# rotor of ~1e-6 kg m^2 behind a ~100:1 gearbox gives ~0.01 kg m^2 (shoulder, elbow);
+# the wrist's smaller motor (~2e-7 kg m^2, 100:1) ~0.002 kg m^2. Estimates: replace with
+# the data of the actual drives.
 _ARM_JOINTS = (
-    ("arm_joint1", "base_link", "arm_link1", "0 0 1", -1.6, 1.6, 10.0, 1.5),
-    ("arm_joint2", "arm_link1", "arm_link2", "0 1 0", -0.3, 2.0, 10.0, 1.5),
-    ("arm_joint3", "arm_link2", "arm_link3", "0 1 0", -1.5, 1.5, 6.0, 2.0),
-    ("arm_joint4", "arm_link3", "arm_link4", "1 0 0", -2.6, 2.6, 3.0, 2.0),
+    ("arm_joint1", "base_link", "arm_link1", "0 0 1", -1.6, 1.6, 10.0, 1.5, 0.01),
+    ("arm_joint2", "arm_link1", "arm_link2", "0 1 0", -0.3, 2.0, 10.0, 1.5, 0.01),
+    ("arm_joint3", "arm_link2", "arm_link3", "0 1 0", -1.5, 1.5, 6.0, 2.0, 0.005),
+    ("arm_joint4", "arm_link3", "arm_link4", "1 0 0", -2.6, 2.6, 3.0, 2.0, 0.002),
 )
 
 
@@ -335,7 +339,7 @@ def render_urdf() -> str:
     ]
     for link in ARM_LINKS:
         out.append(_cylinder_link_xml(link, "arm_gray"))
-    for name, parent, child, axis, lower, upper, effort, velocity in _ARM_JOINTS:
+    for name, parent, child, axis, lower, upper, effort, velocity, armature in _ARM_JOINTS:
         out += [
             f'  <joint name="{name}" type="revolute">',
             f'    <parent link="{parent}"/>',
@@ -344,6 +348,7 @@ def render_urdf() -> str:
             f'    <axis xyz="{axis}"/>',
             f'    <limit lower="{_num(lower)}" upper="{_num(upper)}" effort="{_num(effort)}" '
             f'velocity="{_num(velocity)}"/>',
+            f'    <armature value="{_num(armature)}"/>',
             "  </joint>",
         ]
     out += [

@@ -50,6 +50,7 @@ class _ProgressLine:
 
 def write_outputs(rollout: Rollout, out: Path) -> list[Path]:
     """Rollout, metrics.json and figures into ``out``."""
+    from uvms_pin.viz.paper_figures import paper_figures
     from uvms_pin.viz.plots import standard_figures
 
     out.mkdir(parents=True, exist_ok=True)
@@ -64,7 +65,7 @@ def write_outputs(rollout: Rollout, out: Path) -> list[Path]:
             **metrics,
         },
     )
-    return standard_figures(rollout, out)
+    return paper_figures(rollout, out) + standard_figures(rollout, out)
 
 
 def _cmd_run(args: argparse.Namespace) -> int:

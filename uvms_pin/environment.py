@@ -64,6 +64,8 @@ class LinearSpring(ContactModel):
         self._anchor = np.array(position_world_m if given is None else given, dtype=float)
 
     def wrench_on_environment_world(self, position_world_m, velocity_world_m_s):
+        if self._anchor is None:
+            raise ParameterError("LinearSpring has no anchor: call attach() or give anchor_world_m")
         out = np.zeros(6)
         out[:3] = self.stiffness_N_m * (position_world_m - self._anchor)
         return out
@@ -106,6 +108,8 @@ class CompliantPlane(ContactModel):
         self._point = np.array(position_world_m if given is None else given, dtype=float)
 
     def wrench_on_environment_world(self, position_world_m, velocity_world_m_s):
+        if self._point is None:
+            raise ParameterError("CompliantPlane has no surface point: call attach() or give point_world_m")
         depth = float((self._point - position_world_m) @ self.normal_world)
         out = np.zeros(6)
         if depth <= 0.0:
@@ -134,6 +138,8 @@ class SinusoidalDisturbance:
         object.__setattr__(self, "amplitude", _vector("disturbance amplitude", self.amplitude, 6))
         if not (self.period_s > 0.0 and math.isfinite(self.period_s)):
             raise ParameterError(f"disturbance period_s must be positive, got {self.period_s}")
+        if not math.isfinite(self.phase_rad):
+            raise ParameterError(f"disturbance phase_rad must be finite, got {self.phase_rad}")
 
     def __call__(self, time_s: float) -> np.ndarray:
         return self.amplitude * math.sin(2.0 * math.pi * time_s / self.period_s + self.phase_rad)

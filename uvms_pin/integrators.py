@@ -23,6 +23,8 @@ from scipy.integrate import solve_ivp
 from uvms_pin.errors import ParameterError, SimulationError
 
 Rhs = Callable[[float, np.ndarray, np.ndarray], np.ndarray]
+Event = Callable[[float, np.ndarray, np.ndarray], float]
+"""A function of (t, q, v) whose downward zero crossing stops an adaptive integration."""
 
 
 class Integrator(ABC):
@@ -33,6 +35,29 @@ class Integrator(ABC):
         self, model: pin.Model, rhs: Rhs, t0: float, q0: np.ndarray, v0: np.ndarray, t1: float
     ) -> tuple[np.ndarray, np.ndarray]:
         """Return (q, v) at t1."""
+
+    def advance_through(
+        self,
+        model: pin.Model,
+        rhs: Rhs,
+        t0: float,
+        q0: np.ndarray,
+        v0: np.ndarray,
+        times: np.ndarray,
+        event: Event | None = None,
+    ) -> list[tuple[float, np.ndarray, np.ndarray]]:
+        """(t, q, v) at each of the increasing ``times`` (> t0), in one pass.
+
+        With an ``event`` (adaptive integrators only; fixed-step ones ignore it), the pass
+        stops where the event crosses zero downwards: the last entry is then that state.
+        """
+        out = []
+        t, q, v = t0, q0, v0
+        for t_next in times:
+            q, v = self.advance(model, rhs, t, q, v, float(t_next))
+            t = float(t_next)
+            out.append((t, q, v))
+        return out
 
 
 def _chart_rate(model: pin.Model, q0: np.ndarray, delta: np.ndarray, v: np.ndarray) -> np.ndarray:
@@ -134,7 +159,24 @@ class Adaptive(Integrator):
             raise ParameterError("adaptive rtol, atol and max_step_s must be positive")
 
     def advance(self, model, rhs, t0, q0, v0, t1):
+        _, q, v = self.advance_through(model, rhs, t0, q0, v0, np.array([t1]))[-1]
+        return q, v
+
+    def advance_through(self, model, rhs, t0, q0, v0, times, event=None):
+        """One solve_ivp call from t0 to times[-1] in the chart at q0 (keeps the step size
+        and Jacobian history across output times; re-base by calling again). The event,
+        if any, is checked on every accepted step and located by root finding."""
         nv = model.nv
+        times = np.asarray(times, dtype=float)
+        events = None
+        if event is not None:
+
+            def chart_event(t: float, y: np.ndarray) -> float:
+                return event(t, pin.integrate(model, q0, y[:nv]), y[nv:])
+
+            chart_event.terminal = True
+            chart_event.direction = -1.0
+            events = [chart_event]
 
         def chart_rhs(t: float, y: np.ndarray) -> np.ndarray:
             delta, v = y[:nv], y[nv:]
@@ -147,17 +189,24 @@ class Adaptive(Integrator):
         y0 = np.concatenate([np.zeros(nv), v0])
         sol = solve_ivp(
             chart_rhs,
-            (t0, t1),
+            (t0, float(times[-1])),
             y0,
             method=self.method,
             rtol=self.rtol,
             atol=self.atol,
             max_step=self.max_step_s,
-            t_eval=[t1],
+            t_eval=times,
+            events=events,
         )
         if not sol.success:
             raise SimulationError(
-                f"{self.method} failed between t = {t0:.6g} s and {t1:.6g} s: {sol.message}"
+                f"{self.method} failed between t = {t0:.6g} s and {times[-1]:.6g} s: {sol.message}"
             )
-        y1 = sol.y[:, -1]
-        return pin.integrate(model, q0, y1[:nv]), y1[nv:].copy()
+        out = [
+            (float(t), pin.integrate(model, q0, y[:nv]), y[nv:].copy())
+            for t, y in zip(sol.t, sol.y.T, strict=True)
+        ]
+        if sol.status == 1:  # stopped by the event
+            t_event, y_event = float(sol.t_events[0][0]), sol.y_events[0][0]
+            out.append((t_event, pin.integrate(model, q0, y_event[:nv]), y_event[nv:].copy()))
+        return out

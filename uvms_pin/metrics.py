@@ -54,4 +54,66 @@ def compute_metrics(rollout: Rollout) -> dict[str, float]:
         joint_torque_peak_Nm=float(joints.max()) if joints.size else 0.0,
         joint_torque_rms_Nm=_rms(joints),
     )
+    out.update(force_tracking_metrics(rollout))
+    return out
+
+
+def transient_end_s(rollout: Rollout, fraction: float = 0.05) -> float:
+    """First time the force funnels have decayed to within ``fraction`` of their final width:
+    rho(t) - rho_inf <= fraction (rho0 - rho_inf). NaN without a force funnel."""
+    rho = rollout.signals.get("rho_x")
+    if rho is None or len(rho) < 2:
+        return math.nan
+    rho_force = rho[:, 0]
+    span = rho_force[0] - rho_force[-1]
+    if span <= 0.0:
+        return float(rollout.time_s[0])
+    settled = np.flatnonzero(rho_force - rho_force[-1] <= fraction * span)
+    return float(rollout.time_s[settled[0]])
+
+
+def force_tracking_metrics(rollout: Rollout) -> dict[str, float]:
+    """Force-control metrics from a run that logged the controller's signals.
+
+    Force error is the TRUE one, f_e - f_d (the sensor's noise excluded), per component;
+    "after transient" starts at `transient_end_s`. Overshoot: the largest error of the
+    opposite sign to the initial error, over every force component [N]. Funnel margin:
+    min over time and components of 1 - |xi| per level (> 0 means the funnel held).
+    """
+    signals = rollout.signals
+    if "force_desired_world_N" not in signals or len(rollout) == 0:
+        return {}
+    desired = signals["force_desired_world_N"]
+    error = rollout.wrench_contact_world[:, :3] - desired
+    norm = np.linalg.norm(error, axis=1)
+    t_transient = transient_end_s(rollout)
+    after = rollout.time_s >= t_transient
+    initial_sign = np.sign(error[0])
+    overshoot = np.where(initial_sign != 0.0, -initial_sign * error, np.abs(error))
+    out = {
+        "force_error_rms_N": _rms(norm),
+        "force_error_max_N": float(norm.max()),
+        "transient_end_s": t_transient,
+        "force_error_rms_after_transient_N": _rms(norm[after]),
+        "force_error_max_after_transient_N": float(norm[after].max())
+        if np.any(after)
+        else math.nan,
+        "force_overshoot_N": float(max(0.0, np.max(overshoot[1:]) if len(overshoot) > 1 else 0.0)),
+    }
+    for level, key in (("first", "xi_x"), ("second", "xi_zeta")):
+        if key in signals:
+            out[f"funnel_margin_min_{level}"] = float(np.min(1.0 - np.abs(signals[key])))
+    if "e_x" in signals:
+        out["orientation_error_final_rad"] = float(np.linalg.norm(signals["e_x"][-1, 3:6]))
+    commanded = signals.get("tau_commanded")
+    if commanded is not None:
+        out["commanded_vehicle_force_peak_N"] = float(
+            np.linalg.norm(commanded[:, :3], axis=1).max()
+        )
+        out["commanded_vehicle_torque_peak_Nm"] = float(
+            np.linalg.norm(commanded[:, 3:6], axis=1).max()
+        )
+        out["commanded_joint_torque_peak_Nm"] = (
+            float(np.abs(commanded[:, 6:]).max()) if commanded.shape[1] > 6 else 0.0
+        )
     return out

@@ -222,6 +222,7 @@ def load_uvms(
     except Exception as exc:  # Pinocchio raises ValueError/RuntimeError for bad URDFs
         raise ModelError(f"Pinocchio could not build the model: {exc}", path=where) from exc
 
+    _read_armature(root, model, where)
     bodies: list[HydroBody] = []
     for name, link in links.items():
         has_inertial = link.find("inertial") is not None
@@ -233,6 +234,7 @@ def load_uvms(
             raise ModelError("has <collision> geometry but no <inertial>", path=where, link=name)
         if not has_inertial:
             continue  # a frame-only link: no body, no hydrodynamics
+        _check_inertial(link.find("inertial"), where, name)
         frame_id = model.getFrameId(name, pin.BODY)
         if frame_id >= len(model.frames):
             raise ModelError("not found in the Pinocchio model", path=where, link=name)
@@ -263,6 +265,48 @@ def load_uvms(
         sensor_frame_id=_frame_id(model, sensor_frame, where),
         source=where,
     )
+
+
+def _check_inertial(inertial: ET.Element, where: str, link: str) -> None:
+    """Validate <inertial> ourselves.
+
+    Fix: urdfdom only prints to stderr when <mass> or <inertia> is missing or non-numeric,
+    and Pinocchio then builds the link with zero mass and/or zero rotational inertia, which
+    silently changes the dynamics (or makes M singular). Origin xyz/rpy are checked too.
+    """
+    _origin(inertial.find("origin"), where, link)
+    mass_el = inertial.find("mass")
+    if mass_el is None:
+        raise ModelError("<inertial> has no <mass>", path=where, link=link)
+    mass = _numbers(mass_el.get("value"), 1, "<mass value>", where, link)[0]
+    if mass < 0.0:
+        raise ModelError(f"negative mass {mass} kg", path=where, link=link)
+    inertia_el = inertial.find("inertia")
+    if inertia_el is None:
+        raise ModelError("<inertial> has no <inertia>", path=where, link=link)
+    for key in ("ixx", "ixy", "ixz", "iyy", "iyz", "izz"):
+        _numbers(inertia_el.get(key), 1, f"<inertia {key}>", where, link)
+
+
+def _read_armature(root: ET.Element, model: pin.Model, where: str) -> None:
+    """``<joint><armature value="kg m^2"/></joint>``: reflected rotor inertia of a joint's
+    drive (J_rotor N^2), added to the diagonal of M (Pinocchio's ``model.armature``)."""
+    for joint in root.findall("joint"):
+        element = joint.find("armature")
+        if element is None:
+            continue
+        name = joint.get("name", "?")
+        value = float(
+            _numbers(element.get("value"), 1, "<armature value>", where, f"joint {name}")[0]
+        )
+        if value < 0.0:
+            raise ModelError(f"joint '{name}': negative armature {value} kg m^2", path=where)
+        if not model.existJointName(name):
+            raise ModelError(
+                f"joint '{name}' with <armature> is not a moving joint of the model", path=where
+            )
+        joint_model = model.joints[model.getJointId(name)]
+        model.armature[joint_model.idx_v : joint_model.idx_v + joint_model.nv] = value
 
 
 def _frame_id(model: pin.Model, name: str, where: str) -> int:

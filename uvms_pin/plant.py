@@ -11,6 +11,7 @@ from dataclasses import dataclass, field
 import numpy as np
 import pinocchio as pin
 
+from uvms_pin.actuation import Actuation, Unlimited
 from uvms_pin.dynamics import forward_dynamics
 from uvms_pin.environment import ContactModel, Disturbance
 from uvms_pin.errors import ParameterError
@@ -26,12 +27,14 @@ class Plant:
         current_world_m_s: constant uniform current (3,) [m/s].
         contact: compliant environment at the end-effector, or None.
         disturbance: body wrench on the vehicle as a function of time, or None.
+        actuation: thrusters and joint limits between the commanded and applied tau.
     """
 
     uvms: UVMS
     current_world_m_s: np.ndarray = field(default_factory=lambda: np.zeros(3))
     contact: ContactModel | None = None
     disturbance: Disturbance | None = None
+    actuation: Actuation = field(default_factory=Unlimited)
 
     def __post_init__(self) -> None:
         c = np.asarray(self.current_world_m_s, dtype=float).reshape(-1)

@@ -101,10 +101,13 @@ class Rollout:
         """Write ``rollout.npz`` and ``rollout.json`` into ``directory`` atomically."""
         out = Path(directory)
         out.mkdir(parents=True, exist_ok=True)
+        # Fix: serialise the metadata before writing anything; it used to be serialised
+        # after rollout.npz was replaced, so unserialisable metadata left a new .npz next
+        # to no (or a previous run's) rollout.json.
+        text = json.dumps(self.metadata, indent=2, sort_keys=True, default=_json_default)
         arrays = {name: getattr(self, name) for name in self._BASE}
         arrays.update({f"signal__{k}": a for k, a in self.signals.items()})
         _atomic_write(out / ARRAY_FILE, lambda f: np.savez_compressed(f, **arrays), binary=True)
-        text = json.dumps(self.metadata, indent=2, sort_keys=True, default=_json_default)
         _atomic_write(out / META_FILE, lambda f: f.write(text), binary=False)
         return out
 

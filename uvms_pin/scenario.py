@@ -20,7 +20,9 @@ import numpy as np
 import pinocchio as pin
 import tomllib
 
+from uvms_pin.actuation import Actuation, Thruster, ThrustersAndJointLimits, Unlimited
 from uvms_pin.controllers.base import Controller, ZeroController
+from uvms_pin.controllers.ppc import PPCParams, PrescribedPerformanceController
 from uvms_pin.environment import CompliantPlane, ContactModel, LinearSpring, SinusoidalDisturbance
 from uvms_pin.errors import ParameterError, ScenarioError, UvmsPinError
 from uvms_pin.integrators import RK4, Adaptive, Integrator, SemiImplicitEuler
@@ -44,7 +46,8 @@ class _Table:
         self._source = source
 
     def _err(self, key: str, msg: str) -> ScenarioError:
-        return ScenarioError(f"{self._source}: {self._where}.{key}: {msg}")
+        where = f"{self._where}.{key}" if self._where else key
+        return ScenarioError(f"{self._source}: {where}: {msg}")
 
     def has(self, key: str) -> bool:
         return key in self._data
@@ -220,7 +223,8 @@ def _build(raw: dict[str, Any], path: Path, source: str) -> Scenario:
     q0, v0 = _initial_state(top.table("initial") or _Table({}, "initial", source), uvms)
     contact = _environment(top.table("environment"))
     disturbance = _disturbance(top.table("disturbance"))
-    plant = Plant(uvms, current_world_m_s=current, contact=contact, disturbance=disturbance)
+    actuation = _actuation(top.table("actuation"), uvms)
+    plant = Plant(uvms, current, contact, disturbance, actuation)
     sensor_config = _sensors(top.table("sensors") or _Table({}, "sensors", source))
     integrator = _integrator(top.table("integrator") or _Table({}, "integrator", source))
 
@@ -313,6 +317,33 @@ def _sensors(t: _Table) -> SensorConfig:
     return config
 
 
+def _actuation(t: _Table | None, uvms: UVMS) -> Actuation:
+    if t is None:
+        return Unlimited()
+    limit_joints = t.pop_raw("limit_joint_torques", True)
+    if not isinstance(limit_joints, bool):
+        raise ScenarioError(f"{t._source}: actuation.limit_joint_torques must be true or false")
+    entries = t.pop_raw("thruster", [])
+    if not isinstance(entries, list) or not entries:
+        raise ScenarioError(f"{t._source}: [actuation] needs at least one [[actuation.thruster]]")
+    thrusters = []
+    for k, entry in enumerate(entries):
+        e = _Table(entry, f"actuation.thruster[{k}]", t._source)
+        thrusters.append(
+            Thruster(
+                name=e.string("name", f"thruster{k}"),
+                position_body_m=e.vector("position_body_m", 3),
+                direction_body=e.vector("direction_body", 3),
+                max_forward_N=e.number("max_forward_N", nonneg=True),
+                max_reverse_N=e.number("max_reverse_N", nonneg=True),
+            )
+        )
+        e.finish()
+    t.finish()
+    limits = uvms.model.effortLimit[6:].copy() if limit_joints else None
+    return ThrustersAndJointLimits(thrusters, limits)
+
+
 _FIXED_STEP = {"rk4": RK4, "semi_implicit_euler": SemiImplicitEuler}
 
 
@@ -343,8 +374,49 @@ def _zero_controller(t: _Table, uvms: UVMS) -> ControllerFactory:
     return lambda u: ZeroController(u.nv)
 
 
+def _sine_profile(t: _Table | None, size: int) -> Callable[[float], np.ndarray]:
+    """offset + amplitude sin(2 pi t / period + phase), component-wise."""
+    if t is None:
+        zero = np.zeros(size)
+        return lambda time_s: zero
+    offset = t.vector("offset", size, np.zeros(size))
+    amplitude = t.vector("amplitude", size, np.zeros(size))
+    period = t.number("period_s", 1.0, positive=True)
+    phase = t.number("phase_rad", 0.0)
+    t.finish()
+    omega = 2.0 * math.pi / period
+    return lambda time_s: offset + amplitude * math.sin(omega * time_s + phase)
+
+
+_PPC_FIRST_LEVEL_KEYS = ("k_x", "rho0_x", "rho_inf_x", "l_x_per_s")  # 6 components
+_PPC_SECOND_LEVEL_KEYS = ("k_zeta", "rho0_zeta", "rho_inf_zeta", "l_zeta_per_s", "velocity_weights")
+
+
+def _ppc_controller(t: _Table, uvms: UVMS) -> ControllerFactory:
+    """[controller] type = "ppc": the paper's law; omitted keys keep the paper's values."""
+    ee_frame = t.string("ee_frame", uvms.model.frames[uvms.ee_frame_id].name)
+    fields: dict[str, Any] = {}
+    for keys, size in ((_PPC_FIRST_LEVEL_KEYS, 6), (_PPC_SECOND_LEVEL_KEYS, uvms.nv)):
+        for key in keys:
+            if t.has(key):
+                fields[key] = t.vector(key, size)
+    for key in ("null_space_gain_per_s", "pinv_relative_cutoff"):
+        if t.has(key):
+            fields[key] = t.number(key, nonneg=True)
+    desired_rpy = t.vector("desired_rpy", 3, [0.0, 0.0, 0.0])
+    desired_force = _sine_profile(t.table("desired_force"), 3)
+    t.finish()
+    try:
+        params = PPCParams(desired_rpy=desired_rpy, **fields).sized(uvms.nv)
+        PrescribedPerformanceController(uvms.model, ee_frame, params, desired_force)
+    except ParameterError as exc:
+        raise ScenarioError(f"{t._source}: [controller]: {exc}") from exc
+    return lambda u: PrescribedPerformanceController(u.model, ee_frame, params, desired_force)
+
+
 _CONTROLLER_BUILDERS: dict[str, Callable[[_Table, UVMS], ControllerFactory]] = {
-    "none": _zero_controller
+    "none": _zero_controller,
+    "ppc": _ppc_controller,
 }
 
 

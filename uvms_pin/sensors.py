@@ -1,8 +1,12 @@
 """Sensors with bounded, seeded noise; they produce the controller's `Measurement`.
 
-Noise is drawn once, on a fixed sample grid, from a seeded generator and held between
-samples, so a measurement is a deterministic function of time: the same run gives the same
-numbers whatever the integrator, and adaptive integrators see a well-defined system.
+Noise is drawn once, on a fixed sample grid, from a seeded generator, so a measurement is a
+deterministic function of time: the same run gives the same numbers whatever the
+integrator. Between grid points the noise is blended with a smoothstep, n(t) = n_k +
+(n_k+1 - n_k)(3 s^2 - 2 s^3), s = t / T - k: it equals the drawn samples at the grid points
+(where a sampled controller reads it), never leaves their bounds, and is continuously
+differentiable, so a continuous-time closed loop stays smooth enough for stiff adaptive
+integrators (a held, stepwise noise makes them restart at every sample).
 """
 
 from __future__ import annotations
@@ -43,8 +47,8 @@ class NoiseSpec:
         return np.clip(rng.normal(0.0, self.bound / 3.0, size=shape), -self.bound, self.bound)
 
 
-class HeldNoise:
-    """A noise signal sampled every ``period_s`` and held: n(t) = table[floor(t / T)]."""
+class SampledNoise:
+    """A noise signal drawn every ``period_s`` and smoothstep-blended between draws."""
 
     def __init__(
         self,
@@ -60,8 +64,13 @@ class HeldNoise:
         self._table = spec.draw(rng, (math.ceil(duration_s / period_s) + 2, width))
 
     def __call__(self, time_s: float) -> np.ndarray:
-        k = min(int(time_s / self.period_s + 1e-9), len(self._table) - 1)
-        return self._table[k]
+        position = max(time_s, 0.0) / self.period_s
+        k = min(int(position + 1e-9), len(self._table) - 2)
+        s = min(max(position - k, 0.0), 1.0)
+        if s < 1e-9:
+            return self._table[k]
+        blend = s * s * (3.0 - 2.0 * s)
+        return self._table[k] + blend * (self._table[k + 1] - self._table[k])
 
 
 @dataclass(frozen=True)
@@ -72,7 +81,7 @@ class SensorConfig:
         force_noise: on each force component [N]. torque_noise: [N m].
         position_noise: vehicle position [m]; orientation_noise: rotation vector [rad];
         joint_noise: [rad]; velocity_noise: every component of zeta [m/s, rad/s].
-        sample_period_s: sensor rate (noise held between samples).
+        sample_period_s: sensor rate: a new noise value is drawn every sample period.
     """
 
     force_noise: NoiseSpec = NoiseSpec()
@@ -93,12 +102,12 @@ class SensorSuite:
         rng = np.random.default_rng(seed)
         nj = model.nv - 6
         period = config.sample_period_s
-        self._force = HeldNoise(config.force_noise, 3, period, duration_s, rng)
-        self._torque = HeldNoise(config.torque_noise, 3, period, duration_s, rng)
-        self._position = HeldNoise(config.position_noise, 3, period, duration_s, rng)
-        self._orientation = HeldNoise(config.orientation_noise, 3, period, duration_s, rng)
-        self._joints = HeldNoise(config.joint_noise, nj, period, duration_s, rng)
-        self._velocity = HeldNoise(config.velocity_noise, model.nv, period, duration_s, rng)
+        self._force = SampledNoise(config.force_noise, 3, period, duration_s, rng)
+        self._torque = SampledNoise(config.torque_noise, 3, period, duration_s, rng)
+        self._position = SampledNoise(config.position_noise, 3, period, duration_s, rng)
+        self._orientation = SampledNoise(config.orientation_noise, 3, period, duration_s, rng)
+        self._joints = SampledNoise(config.joint_noise, nj, period, duration_s, rng)
+        self._velocity = SampledNoise(config.velocity_noise, model.nv, period, duration_s, rng)
         self._state_noisy = any(
             s.bound > 0.0
             for s in (
@@ -118,12 +127,14 @@ class SensorSuite:
         wrench = wrench_world + self.force_noise(time_s)
         if not self._state_noisy:
             return Measurement(time_s, q, v, wrench)
+        # Fix: the position noise used to go through pin.integrate together with the
+        # orientation noise; the SE(3) exponential then maps it by R V(w) R^T (V the left
+        # Jacobian of SO(3)), so the world offset exceeded its bound by up to |w|/2. Now:
+        # orientation and joints by integrate (zero linear part: the position is untouched),
+        # then the position noise added as a plain world offset.
         dq = np.zeros(self.model.nv)
-        dq[:3] = self._position(time_s)
         dq[3:6] = self._orientation(time_s)
         dq[6:] = self._joints(time_s)
-        # position noise is a world offset: rotate it into the body frame pin.integrate uses
-        rotation = pin.Quaternion(q[3:7]).toRotationMatrix()
-        dq[:3] = rotation.T @ dq[:3]
         q_meas = pin.integrate(self.model, q, dq)
+        q_meas[:3] = q[:3] + self._position(time_s)
         return Measurement(time_s, q_meas, v + self._velocity(time_s), wrench)

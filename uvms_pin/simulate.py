@@ -13,7 +13,7 @@ import math
 import platform
 import time
 from collections.abc import Callable
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
 from importlib import metadata as importlib_metadata
 from typing import Any
 
@@ -31,9 +31,9 @@ Progress = Callable[[float, float], None]
 
 # A speed this large [m/s or rad/s] only comes out of a blown-up integration.
 _DIVERGED_SPEED = 1e4
-# Retries of an adaptive interval, each with a 4x smaller max step, when a trial stage
-# (not an accepted state) lands outside a funnel.
-_ADAPTIVE_RETRIES = 4
+# The funnel event fires when the margin min(1 - |xi|) reaches -this: just outside, so
+# that the controller, evaluated at the located event state, reports the violation.
+_EVENT_OVERSHOOT = 1e-6
 
 
 @dataclass(frozen=True)
@@ -46,6 +46,8 @@ class SimulationSettings:
         log_period_s: logging interval [s]; a multiple of the control period if sampled.
         control_period_s: controller period [s] (zero-order hold) or None = continuous.
         seed: master seed of every random draw in the run (recorded in the rollout).
+        rebase_period_s: continuous mode only: length of one adaptive-integrator pass
+            (the local chart of the free-flyer is re-based at its start).
     """
 
     duration_s: float
@@ -53,6 +55,7 @@ class SimulationSettings:
     log_period_s: float = 0.01
     control_period_s: float | None = None
     seed: int = 0
+    rebase_period_s: float = 0.5
 
     def __post_init__(self) -> None:
         if not (self.duration_s > 0.0 and math.isfinite(self.duration_s)):
@@ -148,53 +151,103 @@ def simulate_closed_loop(
     def held_rhs(tau: np.ndarray) -> Callable:
         return lambda t, q, v: plant.acceleration(t, q, v, tau)
 
+    def command(t: float, measurement) -> tuple[np.ndarray, np.ndarray]:
+        tau = np.asarray(controller.compute(t, measurement), dtype=float)
+        if tau.shape != (model.nv,) or not np.all(np.isfinite(tau)):
+            raise SimulationError(f"controller returned an invalid tau at t = {t:.6g} s: {tau}")
+        return tau, plant.actuation.apply(tau)
+
     def continuous_rhs(t: float, q: np.ndarray, v: np.ndarray) -> np.ndarray:
         measurement, contact = measure(t, q, v)
-        tau = controller.compute(t, measurement)
-        return plant.acceleration(t, q, v, tau, contact)
+        _, tau_applied = command(t, measurement)
+        return plant.acceleration(t, q, v, tau_applied, contact)
 
-    def log(k: int, t: float, q, v, tau, contact, measured) -> None:
+    def log(k: int, t: float, q, v, tau, tau_applied, contact, measured) -> None:
         rollout.time_s[k] = t
         rollout.q[k] = q
         rollout.v[k] = v
-        rollout.tau[k] = tau
+        rollout.tau[k] = tau_applied
+        rollout.signal("tau_commanded", model.nv)[k] = tau
         rollout.wrench_contact_world[k] = contact
         rollout.wrench_measured_world[k] = measured
         rollout.wrench_disturbance_body[k] = plant.disturbance_wrench(t)
         rollout.kinetic_energy_J[k] = kinetic_energy(uvms, q, v)
         rollout.potential_energy_J[k] = potential_energy(uvms, q)
-        for name, values in getattr(controller, "last_signals", {}).items():
-            values = np.atleast_1d(values)
+        for name, values in controller.signals().items():
             rollout.signal(name, values.size)[k] = values
 
+    def check_finite(t0: float, t1: float, q: np.ndarray, v: np.ndarray) -> None:
+        if (
+            not (np.all(np.isfinite(q)) and np.all(np.isfinite(v)))
+            or np.max(np.abs(v)) > _DIVERGED_SPEED
+        ):
+            raise SimulationError(f"simulation diverged between t = {t0:.6g} s and {t1:.6g} s")
+
+    def sample(k: int, t: float, q: np.ndarray, v: np.ndarray) -> np.ndarray:
+        """Measure and command at an accepted state; log it if k is a log index."""
+        measurement, contact = measure(t, q, v)
+        tau, tau_applied = command(t, measurement)
+        if k >= 0:
+            log(k, t, q, v, tau, tau_applied, contact, measurement.wrench_world)
+            if progress is not None:
+                progress(t, settings.duration_s)
+        return tau_applied
+
     wall_start = time.perf_counter()
-    q, v = q0, v0
+    log_times = np.arange(settings.n_log) * settings.log_period_s
     logged = 0
-    n_ticks = (settings.n_log - 1) * settings.ticks_per_log
-    tick_s = settings.log_period_s / settings.ticks_per_log
     try:
-        for tick in range(n_ticks + 1):
-            t = tick * tick_s
-            measurement, contact = measure(t, q, v)
-            tau = np.array(controller.compute(t, measurement), dtype=float)
-            if tau.shape != (model.nv,) or not np.all(np.isfinite(tau)):
-                raise SimulationError(f"controller returned an invalid tau at t = {t:.6g} s: {tau}")
-            if tick % settings.ticks_per_log == 0:
-                log(logged, t, q, v, tau, contact, measurement.wrench_world)
-                logged += 1
-                if progress is not None:
-                    progress(t, settings.duration_s)
-            if tick == n_ticks:
-                break
-            rhs = continuous_rhs if settings.control_period_s is None else held_rhs(tau)
-            q, v = _advance(settings.integrator, model, rhs, t, q, v, t + tick_s)
-            if (
-                not (np.all(np.isfinite(q)) and np.all(np.isfinite(v)))
-                or np.max(np.abs(v)) > _DIVERGED_SPEED
-            ):
-                raise SimulationError(
-                    f"simulation diverged between t = {t:.6g} s and {t + tick_s:.6g} s"
+        q, v = q0, v0
+        if settings.control_period_s is None:
+            # continuous control: one integrator pass per re-basing segment, states at the
+            # log times; the controller is evaluated inside the right-hand side. With an
+            # adaptive integrator the controller's barrier is extended beyond its funnels
+            # for trial stages, and the funnel margin is an event on accepted steps.
+            adaptive = isinstance(settings.integrator, Adaptive)
+
+            def margin_event(t: float, q: np.ndarray, v: np.ndarray) -> float:
+                measurement, _ = measure(t, q, v)
+                controller.compute(t, measurement)
+                return controller.funnel_margin() + _EVENT_OVERSHOOT
+
+            sample(0, 0.0, q, v)
+            logged = 1
+            per_segment = max(1, round(settings.rebase_period_s / settings.log_period_s))
+            while logged < settings.n_log:
+                t0 = log_times[logged - 1]
+                times = log_times[logged : logged + per_segment]
+                controller.set_funnel_extension(adaptive)
+                try:
+                    states = settings.integrator.advance_through(
+                        model, continuous_rhs, t0, q, v, times, margin_event if adaptive else None
+                    )
+                finally:
+                    controller.set_funnel_extension(False)
+                for t, q, v in states:
+                    check_finite(t0, t, q, v)
+                    on_log = logged < settings.n_log and abs(t - log_times[logged]) < 1e-9
+                    # an event stop is not a log time: sampling there raises the violation
+                    sample(logged if on_log else -1, t, q, v)
+                    if not on_log:
+                        raise SimulationError(
+                            f"funnel event at t = {t:.6g} s but the controller found no violation"
+                        )
+                    logged += 1
+        else:
+            ticks_per_log = settings.ticks_per_log
+            tick_s = settings.control_period_s
+            n_ticks = (settings.n_log - 1) * ticks_per_log
+            for tick in range(n_ticks + 1):
+                t = tick * tick_s
+                on_log = tick % ticks_per_log == 0
+                tau_applied = sample(logged if on_log else -1, t, q, v)
+                logged += on_log
+                if tick == n_ticks:
+                    break
+                q, v = settings.integrator.advance(
+                    model, held_rhs(tau_applied), t, q, v, t + tick_s
                 )
+                check_finite(t, t + tick_s, q, v)
     except (FunnelViolation, SimulationError) as exc:
         rollout.truncate(logged)
         _finish(rollout, wall_start, settings, type(exc).__name__, str(exc))
@@ -202,19 +255,6 @@ def simulate_closed_loop(
         raise
     _finish(rollout, wall_start, settings, "ok", "")
     return rollout
-
-
-def _advance(integrator: Integrator, model, rhs, t0, q0, v0, t1):
-    """One interval; adaptive trial stages outside a funnel are retried with smaller steps."""
-    for attempt in range(_ADAPTIVE_RETRIES + 1):
-        try:
-            return integrator.advance(model, rhs, t0, q0, v0, t1)
-        except FunnelViolation:
-            if not isinstance(integrator, Adaptive) or attempt == _ADAPTIVE_RETRIES:
-                raise
-            max_step = min(integrator.max_step_s, t1 - t0) / 4.0
-            integrator = replace(integrator, max_step_s=max_step)
-    raise AssertionError("unreachable")
 
 
 def _finish(

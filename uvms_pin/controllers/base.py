@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import math
 from abc import ABC, abstractmethod
 
 import numpy as np
@@ -22,6 +23,23 @@ class Controller(ABC):
 
     def reset(self) -> None:  # noqa: B027 - optional hook, stateless controllers skip it
         """Forget any internal state before a new run."""
+
+    def signals(self) -> dict[str, np.ndarray]:
+        """Internal signals of the last ``compute`` worth logging (name -> 1-D array)."""
+        return {}
+
+    def funnel_margin(self) -> float:
+        """min over funnel components of 1 - |xi| at the last ``compute`` (inf: no funnels)."""
+        return math.inf
+
+    def set_funnel_extension(self, enabled: bool) -> None:  # noqa: B027 - optional hook
+        """For continuous-time simulation with an adaptive integrator only.
+
+        When enabled, ``compute`` evaluates its barrier (clamped) outside a funnel instead
+        of raising, so that a trial stage the integrator will reject does not end the run;
+        the simulator watches ``funnel_margin()`` on accepted steps instead and reports a
+        genuine violation. Controllers without funnels ignore it.
+        """
 
 
 class ZeroController(Controller):

@@ -196,3 +196,27 @@ def check_funnel(
             bound=float(bound[j]),
         )
     return xi
+
+
+def transformed_error_extended(xi: ArrayLike, clamp: float) -> np.ndarray:
+    """eps(xi) inside |xi| <= clamp, continued linearly (slope r(clamp)) beyond it.
+
+    Only for integrating a continuous-time closed loop: a trial stage outside the funnel
+    then sees a transformed error that keeps growing, so an implicit integrator's stage
+    equations have no solution out there (a flat, clamped extension would give one).
+    """
+    xi = np.asarray(xi, dtype=float)
+    inside = np.clip(xi, -clamp, clamp)
+    return 2.0 * np.arctanh(inside) + (2.0 / (1.0 - clamp * clamp)) * (xi - inside)
+
+
+def barrier_extended(xi: ArrayLike, clamp: float) -> np.ndarray:
+    """b(xi) = r(xi) eps(xi) inside |xi| <= clamp, continued linearly beyond it (see
+    `transformed_error_extended`); b'(xi) = 4 xi eps / (1 - xi^2)^2 + r^2."""
+    xi = np.asarray(xi, dtype=float)
+    inside = np.clip(xi, -clamp, clamp)
+    one_minus = 1.0 - inside * inside
+    eps = 2.0 * np.arctanh(inside)
+    r = 2.0 / one_minus
+    slope = 4.0 * inside * eps / (one_minus * one_minus) + r * r
+    return r * eps + slope * (xi - inside)

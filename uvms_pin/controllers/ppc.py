@@ -37,9 +37,12 @@ from numpy.typing import ArrayLike
 from uvms_pin.controllers.base import Controller
 from uvms_pin.controllers.performance import (
     PerformanceFunction,
+    barrier_extended,
     check_funnel,
+    normalized_error,
     transformation_gain,
     transformed_error,
+    transformed_error_extended,
 )
 from uvms_pin.errors import ParameterError
 from uvms_pin.kinematics import analytical_jacobian, end_effector_pose, frame_id_from_name
@@ -52,6 +55,9 @@ FIRST_LEVEL_NAMES: tuple[str, ...] = ("f_x", "f_y", "f_z", "roll", "pitch", "yaw
 VEHICLE_VELOCITY_NAMES: tuple[str, ...] = ("u", "v", "w", "p", "q", "r")
 
 _N_VEHICLE = 6
+#: With the funnel extension on (continuous-time simulation), the barrier is continued
+#: linearly beyond |xi| = this (where eps ~ 14.5, r ~ 1e6): it keeps growing outside.
+_XI_CLAMP = 1.0 - 1e-6
 #: Joint position limits at or beyond this magnitude are treated as absent (Pinocchio marks
 #: "no limit" with +-max double).
 _NO_LIMIT_THRESHOLD = 1e10
@@ -93,6 +99,10 @@ class PPCParams:
             pseudo-inverse, eq. (9).
         pinv_relative_cutoff: singular values of J below this fraction of the largest are
             treated as zero in J^+ (numerical rank only, no damping).
+        velocity_weights: positive weights W (nv,) of the generalized pseudo-inverse of the
+            paper's remark, J^# = W^-1 J^T (J W^-1 J^T)^+, which minimises zeta^T W zeta:
+            a large weight keeps that DoF out of the task (e.g. an unactuated vehicle roll).
+            1 (default) = the Moore-Penrose pseudo-inverse of eq. (9).
     """
 
     k_x: ArrayLike = 0.2
@@ -106,6 +116,7 @@ class PPCParams:
     desired_rpy: ArrayLike = (0.0, 0.0, 0.0)
     null_space_gain_per_s: float = 0.0
     pinv_relative_cutoff: float = 1e-12
+    velocity_weights: ArrayLike = 1.0
 
     @classmethod
     def for_uvms(cls, n_joints: int, **overrides) -> PPCParams:
@@ -140,8 +151,9 @@ class PPCParams:
             "rho0_zeta": _vector("rho0_zeta", self.rho0_zeta, nv),
             "rho_inf_zeta": _vector("rho_inf_zeta", rho_inf_zeta, nv),
             "l_zeta_per_s": _vector("l_zeta_per_s", self.l_zeta_per_s, nv),
+            "velocity_weights": _vector("velocity_weights", self.velocity_weights, nv),
         }
-        for name in ("k_x", "k_zeta"):
+        for name in ("k_x", "k_zeta", "velocity_weights"):
             bad = np.flatnonzero(~(sized[name] > 0.0))
             if bad.size:
                 raise ParameterError(
@@ -212,12 +224,19 @@ def _as_function(value, name: str, size: int) -> Callable[[float], np.ndarray]:
     return lambda time_s: constant
 
 
-def pseudo_inverse(matrix: np.ndarray, relative_cutoff: float) -> np.ndarray:
-    """Moore-Penrose pseudo-inverse through the SVD.
+def pseudo_inverse(
+    matrix: np.ndarray, relative_cutoff: float, weights: np.ndarray | None = None
+) -> np.ndarray:
+    """Moore-Penrose pseudo-inverse through the SVD, or its weighted form.
 
     Singular values ``s_i <= relative_cutoff * s_max`` are treated as zero (numerical
     rank); the others are inverted exactly (no damping), as in the paper's eq. (9).
+    With ``weights`` w (columns), J^# = W^-1/2 (J W^-1/2)^+, i.e. the minimum of
+    x^T W x among the least-squares solutions of J x = b.
     """
+    if weights is not None:
+        scale = 1.0 / np.sqrt(weights)
+        return scale[:, None] * pseudo_inverse(matrix * scale[None, :], relative_cutoff)
     u, s, vt = np.linalg.svd(matrix, full_matrices=False)
     if s.size == 0 or s[0] == 0.0:
         return np.zeros(matrix.shape[::-1])
@@ -294,6 +313,10 @@ class PrescribedPerformanceController(Controller):
             self._joint_limits()
         )
         self.last_signals: PPCSignals | None = None
+        self._extend_beyond_funnels = False
+        self._margin = np.inf
+        weighted = np.any(self.params.velocity_weights != 1.0)
+        self._weights = self.params.velocity_weights if weighted else None
 
     # ------------------------------------------------------------------ model helpers
     def _arm_velocity_names(self) -> list[str]:
@@ -379,10 +402,12 @@ class PrescribedPerformanceController(Controller):
         e_orientation = np.mod(rpy_ee - rpy_desired + np.pi, 2.0 * np.pi) - np.pi
         e_x = np.r_[e_force, e_orientation]
         rho_x = self.performance_x.value(time_s)
-        xi_x = check_funnel(
-            level="first", names=self.first_level_names, time_s=time_s, error=e_x, bound=rho_x
+        xi_x = self._normalize("first", self.first_level_names, time_s, e_x, rho_x)
+        eps_x = (
+            transformed_error_extended(xi_x, _XI_CLAMP)
+            if self._extend_beyond_funnels
+            else transformed_error(xi_x)
         )
-        eps_x = transformed_error(xi_x)
         # eq. (13), erratum: k_x > 0 (the paper's simulation prints -0.2). The force rows
         # are end-effector linear velocities [m/s]: with f_e = K_f (p - p0), K_f > 0, a
         # force above the desired one (e_f > 0) asks the end-effector to back off.
@@ -390,7 +415,7 @@ class PrescribedPerformanceController(Controller):
 
         # ---- task space -> generalized velocities, eq. (9) (+ the remark's null space)
         jacobian = analytical_jacobian(self.model, self.data, q, self.ee_frame_id)
-        jacobian_pinv = pseudo_inverse(jacobian, params.pinv_relative_cutoff)
+        jacobian_pinv = pseudo_inverse(jacobian, params.pinv_relative_cutoff, self._weights)
         zeta_r = jacobian_pinv @ xdot_r
         if params.null_space_gain_per_s > 0.0:
             zeta_0 = self.null_space_velocity(q)
@@ -399,16 +424,15 @@ class PrescribedPerformanceController(Controller):
         # ---- second level, eq. (14)-(19); erratum: rho_v == rho_zeta, P == P_zeta
         e_zeta = v - zeta_r
         rho_zeta = self.performance_zeta.value(time_s)
-        xi_zeta = check_funnel(
-            level="second",
-            names=self.second_level_names,
-            time_s=time_s,
-            error=e_zeta,
-            bound=rho_zeta,
-        )
-        eps_zeta = transformed_error(xi_zeta)
+        xi_zeta = self._normalize("second", self.second_level_names, time_s, e_zeta, rho_zeta)
         # eq. (19), erratum: K_zeta > 0 (the paper's simulation prints k_v = -5).
-        tau = -params.k_zeta * transformation_gain(xi_zeta) * eps_zeta / rho_zeta
+        if self._extend_beyond_funnels:
+            eps_zeta = transformed_error_extended(xi_zeta, _XI_CLAMP)
+            tau = -params.k_zeta * barrier_extended(xi_zeta, _XI_CLAMP) / rho_zeta
+        else:
+            eps_zeta = transformed_error(xi_zeta)
+            tau = -params.k_zeta * transformation_gain(xi_zeta) * eps_zeta / rho_zeta
+        self._margin = float(min(np.min(1.0 - np.abs(xi_x)), np.min(1.0 - np.abs(xi_zeta))))
 
         self.last_signals = PPCSignals(
             time_s=time_s,
@@ -429,6 +453,33 @@ class PrescribedPerformanceController(Controller):
         )
         return tau
 
+    def _normalize(self, level, names, time_s, error, bound) -> np.ndarray:
+        """xi = e / rho; raises FunnelViolation at |xi| >= 1 unless the extension is on."""
+        if self._extend_beyond_funnels:
+            xi = normalized_error(error, bound)
+            if not np.all(np.isfinite(xi)):
+                check_funnel(level=level, names=names, time_s=time_s, error=error, bound=bound)
+            return xi
+        return check_funnel(level=level, names=names, time_s=time_s, error=error, bound=bound)
+
+    def funnel_margin(self) -> float:
+        """min(1 - |xi|) over both levels at the last ``compute`` (> 0: inside)."""
+        return self._margin
+
+    def set_funnel_extension(self, enabled: bool) -> None:
+        self._extend_beyond_funnels = bool(enabled)
+
     def reset(self) -> None:
         """Forget the logged signals (the law itself has no state)."""
         self.last_signals = None
+        self._margin = np.inf
+
+    def signals(self) -> dict[str, np.ndarray]:
+        """The last call's internal signals as arrays, for logging (empty before a call)."""
+        if self.last_signals is None:
+            return {}
+        return {
+            f.name: np.atleast_1d(getattr(self.last_signals, f.name))
+            for f in dataclasses.fields(self.last_signals)
+            if f.name != "time_s"
+        }

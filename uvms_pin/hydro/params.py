@@ -80,6 +80,21 @@ class HydroParams:
         object.__setattr__(self, "quadratic_damping", dq)
         object.__setattr__(self, "volume_m3", float(self.volume_m3))
 
+    def __eq__(self, other: object) -> bool:
+        # Fix: the dataclass-generated __eq__ compares the array fields with `==` inside a
+        # tuple comparison and raised "truth value of an array is ambiguous". Compare the
+        # values instead (``origin`` is a note and, as declared, not compared).
+        if not isinstance(other, HydroParams):
+            return NotImplemented
+        return (
+            self.volume_m3 == other.volume_m3
+            and self.derived == other.derived
+            and np.array_equal(self.center_of_buoyancy_m, other.center_of_buoyancy_m)
+            and np.array_equal(self.added_mass, other.added_mass)
+            and np.array_equal(self.linear_damping, other.linear_damping)
+            and np.array_equal(self.quadratic_damping, other.quadratic_damping)
+        )
+
     @staticmethod
     def dry() -> HydroParams:
         """A body with no volume and no hydrodynamic effect (e.g. a frame-only link)."""

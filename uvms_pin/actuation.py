@@ -1,0 +1,129 @@
+"""Actuators: what part of a commanded tau the vehicle and the arm can actually apply.
+
+The vehicle's body wrench comes from thrusters, tau_v = B f, with B (6 x m) built from
+each thruster's position r_i and unit direction d_i in the body frame, column
+[d_i; r_i x d_i]. A command is allocated by the pseudo-inverse, f = B^+ tau_v, each thrust
+is clipped to its limits, and B f is applied: directions no thruster can push (e.g. an
+LBV150's roll and pitch) are simply not applied. Arm torques are clipped to the joints'
+effort limits. `Unlimited` applies the command as it is (the paper's assumption).
+"""
+
+from __future__ import annotations
+
+import math
+from abc import ABC, abstractmethod
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import numpy as np
+
+from uvms_pin.errors import ParameterError
+from uvms_pin.hydro.vector import cross3
+
+
+class Actuation(ABC):
+    """Maps a commanded generalized input to the applied one."""
+
+    @abstractmethod
+    def apply(self, tau_commanded: np.ndarray) -> np.ndarray:
+        """The applied tau (nv,) [N, N m]."""
+
+
+class Unlimited(Actuation):
+    """Every DoF actuated without limit: tau_applied = tau_commanded."""
+
+    def apply(self, tau_commanded):
+        return tau_commanded
+
+
+@dataclass(frozen=True)
+class Thruster:
+    """One fixed thruster on the vehicle body.
+
+    Attributes:
+        name: label for reports.
+        position_body_m: point of application r (3,) in the vehicle body frame [m].
+        direction_body: thrust direction d (3,) for positive thrust (normalised here).
+        max_forward_N, max_reverse_N: thrust limits, f in [-max_reverse, max_forward] [N].
+    """
+
+    name: str
+    position_body_m: np.ndarray
+    direction_body: np.ndarray
+    max_forward_N: float
+    max_reverse_N: float
+
+    def __post_init__(self) -> None:
+        r = np.asarray(self.position_body_m, dtype=float).reshape(-1)
+        d = np.asarray(self.direction_body, dtype=float).reshape(-1)
+        if (
+            r.shape != (3,)
+            or d.shape != (3,)
+            or not (np.all(np.isfinite(r)) and np.all(np.isfinite(d)))
+        ):
+            raise ParameterError(
+                f"thruster '{self.name}': position and direction need 3 finite numbers"
+            )
+        norm = float(np.linalg.norm(d))
+        if norm == 0.0:
+            raise ParameterError(f"thruster '{self.name}': direction must be non-zero")
+        for label, value in (
+            ("max_forward_N", self.max_forward_N),
+            ("max_reverse_N", self.max_reverse_N),
+        ):
+            if not (value >= 0.0 and math.isfinite(value)):
+                raise ParameterError(
+                    f"thruster '{self.name}': {label} must be finite and >= 0, got {value}"
+                )
+        object.__setattr__(self, "position_body_m", r)
+        object.__setattr__(self, "direction_body", d / norm)
+
+    @property
+    def wrench_column(self) -> np.ndarray:
+        """[d; r x d]: the body wrench of a unit thrust."""
+        return np.r_[self.direction_body, cross3(self.position_body_m, self.direction_body)]
+
+
+class ThrustersAndJointLimits(Actuation):
+    """Thruster allocation with saturation for the vehicle, effort limits for the joints.
+
+    Args:
+        thrusters: the vehicle's thrusters (at least one).
+        joint_effort_limits_Nm: |tau_j| limits (n_joints,), e.g. the URDF's effort limits;
+            None = arm torques unlimited.
+    """
+
+    def __init__(self, thrusters: Sequence[Thruster], joint_effort_limits_Nm: np.ndarray | None):
+        if not thrusters:
+            raise ParameterError("at least one thruster is needed")
+        self.thrusters = tuple(thrusters)
+        self.allocation = np.column_stack([t.wrench_column for t in self.thrusters])  # B, 6 x m
+        self._allocation_pinv = np.linalg.pinv(self.allocation)
+        self._lower = -np.array([t.max_reverse_N for t in self.thrusters])
+        self._upper = np.array([t.max_forward_N for t in self.thrusters])
+        if joint_effort_limits_Nm is not None:
+            limits = np.asarray(joint_effort_limits_Nm, dtype=float)
+            if np.any(~(limits > 0.0)) or not np.all(np.isfinite(limits)):
+                raise ParameterError(
+                    f"joint effort limits must be positive and finite, got {limits}"
+                )
+            joint_effort_limits_Nm = limits
+        self.joint_effort_limits_Nm = joint_effort_limits_Nm
+
+    def thrusts(self, tau_commanded: np.ndarray) -> np.ndarray:
+        """Per-thruster thrust f (m,) [N] after allocation and saturation."""
+        return np.clip(self._allocation_pinv @ tau_commanded[:6], self._lower, self._upper)
+
+    def apply(self, tau_commanded):
+        out = np.empty_like(tau_commanded)
+        out[:6] = self.allocation @ self.thrusts(tau_commanded)
+        arm = tau_commanded[6:]
+        if self.joint_effort_limits_Nm is None:
+            out[6:] = arm
+        else:
+            if arm.shape != self.joint_effort_limits_Nm.shape:
+                raise ParameterError(
+                    f"{arm.size} arm torques for {self.joint_effort_limits_Nm.size} effort limits"
+                )
+            out[6:] = np.clip(arm, -self.joint_effort_limits_Nm, self.joint_effort_limits_Nm)
+        return out

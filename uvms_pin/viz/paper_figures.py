@@ -1,0 +1,115 @@
+"""The paper's three figures (Figs. 3-5) from a rollout of the PPC controller."""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+from uvms_pin.rollout import Rollout
+from uvms_pin.viz.plots import new_figure, save_figure
+
+FIRST_LEVEL_LABELS = (
+    "$e_{f_x}$ [N]",
+    "$e_{f_y}$ [N]",
+    "$e_{f_z}$ [N]",
+    "$e_\\phi$ [rad]",
+    "$e_\\theta$ [rad]",
+    "$e_\\psi$ [rad]",
+)
+
+
+def _funnel_axes(ax, t, error, rho, label):
+    ax.fill_between(t, -rho, rho, color="tab:red", alpha=0.08, linewidth=0)
+    ax.plot(t, rho, color="tab:red", linewidth=1.0)
+    ax.plot(t, -rho, color="tab:red", linewidth=1.0)
+    ax.plot(t, error, color="tab:blue", linewidth=1.0)
+    ax.set_ylabel(label, fontsize=8)
+    ax.grid(True, alpha=0.3)
+    ax.tick_params(labelsize=7)
+
+
+def plot_force(rollout: Rollout, path: Path) -> Path:
+    """Fig. 3: desired (green), measured (gray) and true (red) contact force per axis."""
+    t = rollout.time_s
+    desired = rollout.signals["force_desired_world_N"]
+    fig, axes = new_figure(3, 1, figsize=(8, 7), sharex=True)
+    for i, axis in enumerate("xyz"):
+        ax = axes[i]
+        ax.plot(
+            t,
+            rollout.wrench_measured_world[:, i],
+            color="0.6",
+            linewidth=0.6,
+            label="measured $f_e + \\Delta f_e$",
+        )
+        ax.plot(
+            t,
+            rollout.wrench_contact_world[:, i],
+            color="tab:red",
+            linewidth=1.4,
+            label="true $f_e$",
+        )
+        ax.plot(
+            t,
+            desired[:, i],
+            color="tab:green",
+            linewidth=1.4,
+            linestyle="--",
+            label="desired $f_e^d$",
+        )
+        ax.set_ylabel(f"$f_{axis}$ [N]")
+        ax.grid(True, alpha=0.3)
+    axes[0].legend(loc="upper right", fontsize=8)
+    axes[-1].set_xlabel("time [s]")
+    fig.suptitle(f"{rollout.metadata.get('scenario', '')}: contact force")
+    return save_figure(fig, path)
+
+
+def plot_first_level(rollout: Rollout, path: Path) -> Path:
+    """Fig. 4: the six first-level errors (blue) inside their funnels +-rho_x (red)."""
+    t = rollout.time_s
+    e, rho = rollout.signals["e_x"], rollout.signals["rho_x"]
+    fig, axes = new_figure(3, 2, figsize=(10, 7), sharex=True)
+    for j in range(6):
+        _funnel_axes(axes[j % 3, j // 3], t, e[:, j], rho[:, j], FIRST_LEVEL_LABELS[j])
+    for ax in axes[-1]:
+        ax.set_xlabel("time [s]")
+    fig.suptitle(f"{rollout.metadata.get('scenario', '')}: first-level errors and funnels")
+    return save_figure(fig, path)
+
+
+def plot_second_level(rollout: Rollout, path: Path, names: list[str] | None = None) -> Path:
+    """Fig. 5: the n second-level velocity errors (blue) inside +-rho_zeta (red)."""
+    t = rollout.time_s
+    e, rho = rollout.signals["e_zeta"], rollout.signals["rho_zeta"]
+    n = e.shape[1]
+    if names is None:
+        names = ["u [m/s]", "v [m/s]", "w [m/s]", "p [rad/s]", "q [rad/s]", "r [rad/s]"] + [
+            f"joint {k + 1} [rad/s]" for k in range(n - 6)
+        ]
+    cols = 2
+    rows = math.ceil(n / cols)
+    fig, axes = new_figure(rows, cols, figsize=(10, 1.6 * rows + 1), sharex=True, squeeze=False)
+    for j in range(n):
+        _funnel_axes(axes[j % rows, j // rows], t, e[:, j], rho[:, j], f"$e_\\zeta$ {names[j]}")
+    for k in range(n, rows * cols):
+        axes[k % rows, k // rows].set_visible(False)
+    for ax in axes[-1]:
+        ax.set_xlabel("time [s]")
+    fig.suptitle(
+        f"{rollout.metadata.get('scenario', '')}: second-level velocity errors and funnels"
+    )
+    return save_figure(fig, path)
+
+
+def paper_figures(rollout: Rollout, directory: Path) -> list[Path]:
+    """Figs. 3-5 when the rollout carries the PPC signals; nothing otherwise."""
+    needed = ("force_desired_world_N", "e_x", "rho_x", "e_zeta", "rho_zeta")
+    if len(rollout) < 2 or not all(k in rollout.signals for k in needed):
+        return []
+    directory = Path(directory)
+    return [
+        plot_force(rollout, directory / "force.png"),
+        plot_first_level(rollout, directory / "first_level_errors.png"),
+        plot_second_level(rollout, directory / "second_level_errors.png"),
+    ]
