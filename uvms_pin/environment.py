@@ -109,7 +109,9 @@ class CompliantPlane(ContactModel):
 
     def wrench_on_environment_world(self, position_world_m, velocity_world_m_s):
         if self._point is None:
-            raise ParameterError("CompliantPlane has no surface point: call attach() or give point_world_m")
+            raise ParameterError(
+                "CompliantPlane has no surface point: call attach() or give point_world_m"
+            )
         depth = float((self._point - position_world_m) @ self.normal_world)
         out = np.zeros(6)
         if depth <= 0.0:
