@@ -26,6 +26,7 @@ from uvms_pin.hydro.added_mass import kirchhoff_wrench
 from uvms_pin.hydro.current import current_acceleration_body, current_velocity_body
 from uvms_pin.hydro.damping import damping_wrench
 from uvms_pin.hydro.restoring import buoyancy_potential_energy, buoyancy_wrench
+from uvms_pin.hydro.vector import mat_t_vec, mat_vec
 from uvms_pin.model import UVMS
 
 _NO_CURRENT = np.zeros(3)
@@ -44,39 +45,47 @@ def _fluid_wrenches(uvms: UVMS, current_world_m_s: np.ndarray) -> list[pin.Force
     """Wrench of the water on each joint body (LOCAL frame), all terms but M_A zeta_dot.
 
     Needs ``forwardKinematics(model, data, q, v, 0)`` in ``uvms.data`` (placements, body
-    velocities and bias accelerations).
+    velocities and bias accelerations). Vectorized over bodies: the per-body physics is the
+    pure functions of `uvms_pin.hydro`, called once on stacks.
     """
     model, data = uvms.model, uvms.data
-    rho = uvms.water_density_kg_m3
-    gravity = model.gravity.linear
-    fext = [pin.Force.Zero() for _ in range(model.njoints)]
-    for j in uvms.joints_with_added_mass:
-        rotation = data.oMi[j].rotation
-        nu = data.v[j].vector
-        nu_c = current_velocity_body(rotation, current_world_m_s)
-        nu_c_dot = current_acceleration_body(nu[3:], nu_c[:3])
-        added = uvms.added_mass_per_joint[j]
-        wrench = -(added @ (data.a[j].vector - nu_c_dot)) - kirchhoff_wrench(added, nu - nu_c)
-        fext[j].vector += wrench
-    for j in uvms.joints_with_volume:
-        fext[j].vector += buoyancy_wrench(
-            uvms.volume_per_joint_m3[j],
-            uvms.center_of_buoyancy_per_joint_m[j],
-            data.oMi[j].rotation,
-            rho,
-            gravity,
+    nj = model.njoints
+    rotation = np.array([data.oMi[j].rotation for j in range(nj)])  # (nj, 3, 3)
+    velocity = np.array([data.v[j].vector for j in range(nj)])  # (nj, 6), LOCAL
+    has_current = bool(np.any(current_world_m_s))
+    wrench = np.zeros((nj, 6))
+
+    joints = uvms.joints_with_added_mass
+    if joints:
+        nu = velocity[list(joints)]
+        acc = np.array([data.a[j].vector for j in joints])
+        if has_current:
+            nu_c = current_velocity_body(rotation[list(joints)], current_world_m_s)
+            acc = acc - current_acceleration_body(nu[:, 3:], nu_c[:, :3])
+            nu = nu - nu_c
+        added = uvms.added_mass_per_joint[list(joints)]
+        wrench[list(joints)] -= mat_vec(added, acc) + kirchhoff_wrench(added, nu)
+
+    joints = uvms.joints_with_volume
+    if joints:
+        wrench[list(joints)] += buoyancy_wrench(
+            uvms.volume_per_joint_m3[list(joints)],
+            uvms.center_of_buoyancy_per_joint_m[list(joints)],
+            rotation[list(joints)],
+            uvms.water_density_kg_m3,
+            model.gravity.linear,
         )
-    for body in uvms.hydro_bodies_with_damping:
-        j = body.joint_id
-        placement = body.placement_in_joint
-        rotation = data.oMi[j].rotation @ placement.rotation
-        nu_body = placement.actInv(data.v[j]).vector
-        nu_r = nu_body - current_velocity_body(rotation, current_world_m_s)
-        wrench_body = damping_wrench(
-            body.params.linear_damping, body.params.quadratic_damping, nu_r
-        )
-        fext[j] += placement.act(pin.Force(wrench_body))
-    return fext
+
+    ids = uvms.damping_joint_ids
+    if ids.size:
+        nu_r = mat_vec(uvms.damping_action, velocity[ids])  # body velocity of each link
+        if has_current:
+            body_rotation = np.matmul(rotation[ids], uvms.damping_rotation_in_joint)
+            nu_r = nu_r - current_velocity_body(body_rotation, current_world_m_s)
+        wrench_body = damping_wrench(uvms.damping_linear, uvms.damping_quadratic, nu_r)
+        # back to the joint frame: f_joint = X^T f_body
+        np.add.at(wrench, ids, mat_t_vec(uvms.damping_action, wrench_body))
+    return [pin.Force(w) for w in wrench]
 
 
 def mass_matrix(uvms: UVMS, q: np.ndarray) -> np.ndarray:

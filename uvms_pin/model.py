@@ -106,6 +106,17 @@ class UVMS:
             int(j) for j in np.flatnonzero(np.any(added, axis=(1, 2)))
         )
         self.joints_with_volume = tuple(int(j) for j in np.flatnonzero(volume))
+        # stacked per-body constants for the vectorized hot path (dynamics._fluid_wrenches)
+        damped = self.hydro_bodies_with_damping
+        self.damping_joint_ids = np.array([b.joint_id for b in damped], dtype=int)
+        self.damping_action = np.array([b.action_joint_to_body for b in damped]).reshape(-1, 6, 6)
+        self.damping_rotation_in_joint = np.array(
+            [b.placement_in_joint.rotation for b in damped]
+        ).reshape(-1, 3, 3)
+        self.damping_linear = np.array([b.params.linear_damping for b in damped]).reshape(-1, 6, 6)
+        self.damping_quadratic = np.array([b.params.quadratic_damping for b in damped]).reshape(
+            -1, 6
+        )
 
     # ---- sizes and aggregates -------------------------------------------------------
     @property

@@ -258,9 +258,7 @@ def _initial_state(t: _Table, uvms: UVMS) -> tuple[np.ndarray, np.ndarray]:
     outside = (joints < lo) | (joints > hi)
     if np.any(outside):
         names = [n for n, o in zip(uvms.arm_joint_names, outside, strict=True) if o]
-        raise ScenarioError(
-            f"initial.joint_positions_rad: outside the joint limits for {', '.join(names)}"
-        )
+        raise t._err("joint_positions_rad", f"outside the joint limits for {', '.join(names)}")
     q0 = np.empty(uvms.nq)
     q0[:3] = position
     q0[3:7] = pin.Quaternion(pin.rpy.rpyToMatrix(*rpy)).coeffs()

@@ -99,15 +99,17 @@ class SensorSuite:
     def __init__(self, model: pin.Model, config: SensorConfig, duration_s: float, seed: int):
         self.model = model
         self.config = config
-        rng = np.random.default_rng(seed)
+        # one independent stream per channel: a channel's draws do not depend on the
+        # others' sizes, and a longer run extends a shorter one with the same seed
+        rngs = [np.random.default_rng(child) for child in np.random.SeedSequence(seed).spawn(6)]
         nj = model.nv - 6
         period = config.sample_period_s
-        self._force = SampledNoise(config.force_noise, 3, period, duration_s, rng)
-        self._torque = SampledNoise(config.torque_noise, 3, period, duration_s, rng)
-        self._position = SampledNoise(config.position_noise, 3, period, duration_s, rng)
-        self._orientation = SampledNoise(config.orientation_noise, 3, period, duration_s, rng)
-        self._joints = SampledNoise(config.joint_noise, nj, period, duration_s, rng)
-        self._velocity = SampledNoise(config.velocity_noise, model.nv, period, duration_s, rng)
+        self._force = SampledNoise(config.force_noise, 3, period, duration_s, rngs[0])
+        self._torque = SampledNoise(config.torque_noise, 3, period, duration_s, rngs[1])
+        self._position = SampledNoise(config.position_noise, 3, period, duration_s, rngs[2])
+        self._orientation = SampledNoise(config.orientation_noise, 3, period, duration_s, rngs[3])
+        self._joints = SampledNoise(config.joint_noise, nj, period, duration_s, rngs[4])
+        self._velocity = SampledNoise(config.velocity_noise, model.nv, period, duration_s, rngs[5])
         self._state_noisy = any(
             s.bound > 0.0
             for s in (

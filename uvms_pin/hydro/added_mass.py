@@ -6,33 +6,32 @@ kinetic energy T_A = 1/2 nu^T M_A nu. Its reaction on the body is
     w_A = -(M_A nu_dot + C_A(nu) nu),   C_A(nu) nu = nu x* (M_A nu)
 
 so M_A enters the mass matrix and C_A(nu) nu is a velocity-product wrench that does no work
-(nu^T (nu x* p) = 0).
+(nu^T (nu x* p) = 0). Functions take single bodies or stacks (leading axes broadcast).
 """
 
 from __future__ import annotations
 
 import numpy as np
 
-from uvms_pin.hydro.vector import cross3
+from uvms_pin.hydro.vector import cross3, mat_vec
 
 
 def kirchhoff_wrench(added_mass: np.ndarray, velocity_body: np.ndarray) -> np.ndarray:
     """C_A(nu) nu = [w x p1; w x p2 + v x p1] with p = M_A nu (Pinocchio order).
 
     Args:
-        added_mass: M_A (6x6) in the body frame [kg, kg m, kg m^2].
-        velocity_body: nu = [v (m/s); w (rad/s)] in the body frame.
+        added_mass: M_A (..., 6, 6) in the body frame [kg, kg m, kg m^2].
+        velocity_body: nu = [v (m/s); w (rad/s)] (..., 6) in the body frame.
 
     Returns:
-        The wrench C_A(nu) nu [N; N m] (the fluid exerts its negative on the body).
+        The wrench C_A(nu) nu (..., 6) [N; N m] (the fluid exerts its negative on the body).
     """
-    p = added_mass @ velocity_body
-    v = velocity_body[:3]
-    w = velocity_body[3:]
-    out = np.empty(6)
-    out[:3] = cross3(w, p[:3])
-    out[3:] = cross3(w, p[3:]) + cross3(v, p[:3])
-    return out
+    p = mat_vec(added_mass, velocity_body)
+    v = velocity_body[..., :3]
+    w = velocity_body[..., 3:]
+    return np.concatenate(
+        [cross3(w, p[..., :3]), cross3(w, p[..., 3:]) + cross3(v, p[..., :3])], axis=-1
+    )
 
 
 def added_mass_in_parent(

@@ -4,11 +4,11 @@ from __future__ import annotations
 
 import numpy as np
 
-from uvms_pin.hydro.vector import cross3
+from uvms_pin.hydro.vector import cross3, mat_t_vec
 
 
 def buoyancy_wrench(
-    volume_m3: float,
+    volume_m3: float | np.ndarray,
     center_of_buoyancy_body_m: np.ndarray,
     rotation_world_body: np.ndarray,
     water_density_kg_m3: float,
@@ -17,13 +17,13 @@ def buoyancy_wrench(
     """Body-frame wrench of the buoyancy force -rho V g acting at the centre of buoyancy.
 
     f_b = R^T (-rho V g_world) (up for g pointing down); moment r_b x f_b about the body
-    origin. Returns [f_b (N); r_b x f_b (N m)].
+    origin. Returns [f_b (N); r_b x f_b (N m)], shape (..., 6) for stacked inputs
+    (volume (...), r_b (..., 3), R (..., 3, 3)).
     """
-    force_body = rotation_world_body.T @ (-water_density_kg_m3 * volume_m3 * gravity_world_m_s2)
-    out = np.empty(6)
-    out[:3] = force_body
-    out[3:] = cross3(center_of_buoyancy_body_m, force_body)
-    return out
+    volume = np.asarray(volume_m3, dtype=float)[..., None]
+    force_world = -water_density_kg_m3 * volume * gravity_world_m_s2
+    force_body = mat_t_vec(rotation_world_body, force_world)
+    return np.concatenate([force_body, cross3(center_of_buoyancy_body_m, force_body)], axis=-1)
 
 
 def buoyancy_potential_energy(

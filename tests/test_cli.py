@@ -1,0 +1,104 @@
+"""The command line as a new user runs it (the installed ``uvms-pin`` entry point)."""
+
+from __future__ import annotations
+
+import json
+import shutil
+import subprocess
+import sys
+import textwrap
+from pathlib import Path
+
+import pytest
+from conftest import REFERENCE_URDF, ROOT
+
+
+def uvms_pin_command() -> list[str]:
+    exe = Path(sys.executable).with_name("uvms-pin")
+    if exe.exists():
+        return [str(exe)]
+    found = shutil.which("uvms-pin")
+    if found is None:
+        pytest.fail("the uvms-pin console script is not installed (pip install -e .)")
+    return [found]
+
+
+def run(*args: str, cwd: Path = ROOT) -> subprocess.CompletedProcess:
+    return subprocess.run(
+        [*uvms_pin_command(), *args],
+        cwd=cwd,
+        capture_output=True,
+        text=True,
+        timeout=600,
+        check=False,
+    )
+
+
+def test_info_prints_the_model_summary():
+    result = run("info", str(REFERENCE_URDF))
+    assert result.returncode == 0, result.stderr
+    out = result.stdout
+    for needle in (
+        "nq = 11, nv = 10",
+        "base_link",
+        "arm_joint4",
+        "net buoyancy",
+        "added mass",
+        "effort",
+        "tool",
+    ):
+        assert needle in out
+    assert "uvms_lbv150.urdf" in out
+
+
+def test_info_on_a_bad_file_is_a_clear_error(tmp_path):
+    bad = tmp_path / "bad.urdf"
+    bad.write_text("<robot name='x'><link name='a'>")
+    result = run("info", str(bad))
+    assert result.returncode == 2
+    assert "bad.urdf" in result.stderr and "not well-formed XML" in result.stderr
+    assert "Traceback" not in result.stderr
+
+
+def test_run_passive_scenario_writes_rollout_metrics_and_figures(tmp_path):
+    scenario = tmp_path / "short.toml"
+    scenario.write_text(
+        (ROOT / "scenarios" / "passive_current.toml")
+        .read_text()
+        .replace("../models/uvms_lbv150.urdf", str(REFERENCE_URDF))
+        .replace("duration_s = 20.0", "duration_s = 0.5")
+    )
+    out = tmp_path / "out"
+    result = run("run", str(scenario), "--out", str(out))
+    assert result.returncode == 0, result.stderr
+    for name in (
+        "rollout.npz",
+        "rollout.json",
+        "metrics.json",
+        "pose.png",
+        "velocities.png",
+        "energy.png",
+    ):
+        assert (out / name).stat().st_size > 0, name
+    metrics = json.loads((out / "metrics.json").read_text())
+    assert metrics["status"] == "ok"
+    assert metrics["simulated_time_s"] == pytest.approx(0.5)
+    assert metrics["seed"] == 1
+
+
+def test_run_with_a_bad_scenario_writes_nothing(tmp_path):
+    scenario = tmp_path / "bad.toml"
+    scenario.write_text(
+        textwrap.dedent(f"""
+        [scenario]
+        model = "{REFERENCE_URDF}"
+        duration_s = 1.0
+        [water]
+        current = [1, 2, 3]
+    """)
+    )
+    out = tmp_path / "out"
+    result = run("run", str(scenario), "--out", str(out))
+    assert result.returncode == 2
+    assert "unknown key(s): current" in result.stderr
+    assert not out.exists()
