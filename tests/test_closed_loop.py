@@ -201,10 +201,7 @@ def test_cli_saves_and_plots_the_partial_rollout(tmp_path):
         "../models/uvms_lbv150.urdf", str(ROOT / "models" / "uvms_lbv150.urdf")
     )
     text = text.replace("duration_s = 10.0", "duration_s = 3.0")
-    scenario.write_text(text + "\n")
-    # tighten the force funnel below the noise via the file itself
-    import re
-
+    # tighten the force funnel below the noise in the file itself
     scenario.write_text(
         re.sub(r"rho_inf_x = \[[^\]]*\]", "rho_inf_x = [0.01, 0.01, 0.01, 0.2, 0.2, 0.2]", text)
     )
