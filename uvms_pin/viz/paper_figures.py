@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import math
 from pathlib import Path
 
 from uvms_pin.rollout import Rollout
@@ -87,15 +86,23 @@ def plot_second_level(rollout: Rollout, path: Path, names: list[str] | None = No
         names = ["u [m/s]", "v [m/s]", "w [m/s]", "p [rad/s]", "q [rad/s]", "r [rad/s]"] + [
             f"joint {k + 1} [rad/s]" for k in range(n - 6)
         ]
-    cols = 2
-    rows = math.ceil(n / cols)
-    fig, axes = new_figure(rows, cols, figsize=(10, 1.6 * rows + 1), sharex=True, squeeze=False)
+    # left column: the 6 vehicle velocities; right column: the arm joints
+    n_arm = n - 6
+    rows = max(6, n_arm)
+    cols = 2 if n_arm else 1
+    fig, axes = new_figure(rows, cols, figsize=(10, 1.5 * rows + 1), sharex=True, squeeze=False)
     for j in range(n):
-        _funnel_axes(axes[j % rows, j // rows], t, e[:, j], rho[:, j], f"$e_\\zeta$ {names[j]}")
-    for k in range(n, rows * cols):
-        axes[k % rows, k // rows].set_visible(False)
+        row, col = (j, 0) if j < 6 else (j - 6, 1)
+        _funnel_axes(axes[row, col], t, e[:, j], rho[:, j], f"$e_\\zeta$ {names[j]}")
+    for row in range(rows):
+        for col in range(cols):
+            if (col == 0 and row >= 6) or (col == 1 and row >= n_arm):
+                axes[row, col].set_visible(False)
     for ax in axes[-1]:
         ax.set_xlabel("time [s]")
+    if 0 < n_arm < rows:
+        axes[n_arm - 1, 1].xaxis.set_tick_params(labelbottom=True)
+        axes[n_arm - 1, 1].set_xlabel("time [s]")
     fig.suptitle(
         f"{rollout.metadata.get('scenario', '')}: second-level velocity errors and funnels"
     )
