@@ -91,14 +91,36 @@ class ThrustersAndJointLimits(Actuation):
         thrusters: the vehicle's thrusters (at least one).
         joint_effort_limits_Nm: |tau_j| limits (n_joints,), e.g. the URDF's effort limits;
             None = arm torques unlimited.
+        allocated_components: indices (0-5: surge, sway, heave, roll, pitch, yaw) of the
+            commanded body wrench the allocation tries to produce, f = B_s^+ tau_s; the
+            others are ignored (e.g. the roll and pitch of a vehicle whose thrusters cannot
+            produce them on purpose). The applied wrench is always B f, side effects
+            included. Default: all six.
     """
 
-    def __init__(self, thrusters: Sequence[Thruster], joint_effort_limits_Nm: np.ndarray | None):
+    def __init__(
+        self,
+        thrusters: Sequence[Thruster],
+        joint_effort_limits_Nm: np.ndarray | None,
+        allocated_components: Sequence[int] = (0, 1, 2, 3, 4, 5),
+    ):
         if not thrusters:
             raise ParameterError("at least one thruster is needed")
+        components = np.asarray(allocated_components, dtype=int)
+        if (
+            components.size == 0
+            or np.any((components < 0) | (components > 5))
+            or len(set(components.tolist())) != components.size
+        ):
+            raise ParameterError(
+                f"allocated_components must be distinct indices in 0..5, got {list(allocated_components)}"
+            )
         self.thrusters = tuple(thrusters)
         self.allocation = np.column_stack([t.wrench_column for t in self.thrusters])  # B, 6 x m
-        self._allocation_pinv = np.linalg.pinv(self.allocation)
+        self.allocated_components = components
+        # f = B_s^+ tau[s]: written as a 6-column map that ignores the other components
+        self._allocation_pinv = np.zeros((len(self.thrusters), 6))
+        self._allocation_pinv[:, components] = np.linalg.pinv(self.allocation[components])
         self._lower = -np.array([t.max_reverse_N for t in self.thrusters])
         self._upper = np.array([t.max_forward_N for t in self.thrusters])
         if joint_effort_limits_Nm is not None:

@@ -126,7 +126,8 @@ class _Table:
     def table(self, key: str) -> _Table | None:
         if key not in self._data:
             return None
-        return _Table(self._data.pop(key), f"{self._where}.{key}", self._source)
+        where = f"{self._where}.{key}" if self._where else key
+        return _Table(self._data.pop(key), where, self._source)
 
     def pop_raw(self, key: str, default: Any = None) -> Any:
         return self._data.pop(key, default)
@@ -337,9 +338,13 @@ def _actuation(t: _Table | None, uvms: UVMS) -> Actuation:
             )
         )
         e.finish()
+    components = t.vector("allocated_components", None, [0, 1, 2, 3, 4, 5])
     t.finish()
     limits = uvms.model.effortLimit[6:].copy() if limit_joints else None
-    return ThrustersAndJointLimits(thrusters, limits)
+    try:
+        return ThrustersAndJointLimits(thrusters, limits, components.astype(int).tolist())
+    except ParameterError as exc:
+        raise ScenarioError(f"{t._source}: [actuation]: {exc}") from exc
 
 
 _FIXED_STEP = {"rk4": RK4, "semi_implicit_euler": SemiImplicitEuler}
@@ -401,6 +406,8 @@ def _ppc_controller(t: _Table, uvms: UVMS) -> ControllerFactory:
     for key in ("null_space_gain_per_s", "pinv_relative_cutoff"):
         if t.has(key):
             fields[key] = t.number(key, nonneg=True)
+    if t.has("null_space_target"):
+        fields["null_space_target"] = t.vector("null_space_target", uvms.n_arm_joints)
     desired_rpy = t.vector("desired_rpy", 3, [0.0, 0.0, 0.0])
     desired_force = _sine_profile(t.table("desired_force"), 3)
     t.finish()

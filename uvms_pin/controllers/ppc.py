@@ -99,6 +99,8 @@ class PPCParams:
             pseudo-inverse, eq. (9).
         pinv_relative_cutoff: singular values of J below this fraction of the largest are
             treated as zero in J^+ (numerical rank only, no damping).
+        null_space_target: arm joint positions (n_joints,) [rad] the secondary task pulls
+            toward (e.g. a pose with reach in the task direction); None = mid-range.
         velocity_weights: positive weights W (nv,) of the generalized pseudo-inverse of the
             paper's remark, J^# = W^-1 J^T (J W^-1 J^T)^+, which minimises zeta^T W zeta:
             a large weight keeps that DoF out of the task (e.g. an unactuated vehicle roll).
@@ -117,6 +119,7 @@ class PPCParams:
     null_space_gain_per_s: float = 0.0
     pinv_relative_cutoff: float = 1e-12
     velocity_weights: ArrayLike = 1.0
+    null_space_target: ArrayLike | None = None
 
     @classmethod
     def for_uvms(cls, n_joints: int, **overrides) -> PPCParams:
@@ -153,6 +156,10 @@ class PPCParams:
             "l_zeta_per_s": _vector("l_zeta_per_s", self.l_zeta_per_s, nv),
             "velocity_weights": _vector("velocity_weights", self.velocity_weights, nv),
         }
+        if self.null_space_target is not None:
+            sized["null_space_target"] = _vector(
+                "null_space_target", self.null_space_target, nv - _N_VEHICLE
+            )
         for name in ("k_x", "k_zeta", "velocity_weights"):
             bad = np.flatnonzero(~(sized[name] > 0.0))
             if bad.size:
@@ -312,6 +319,9 @@ class PrescribedPerformanceController(Controller):
         self._limited_q_index, self._limited_v_index, self._mid, self._half_range = (
             self._joint_limits()
         )
+        self._target = self._mid
+        if self.params.null_space_target is not None:
+            self._target = self.params.null_space_target[self._limited_v_index - _N_VEHICLE]
         self.last_signals: PPCSignals | None = None
         self._extend_beyond_funnels = False
         self._margin = np.inf
@@ -346,15 +356,18 @@ class PrescribedPerformanceController(Controller):
     def null_space_velocity(self, q: np.ndarray) -> np.ndarray:
         """Secondary-task velocity zeta_0 (nv,) for joint-limit avoidance.
 
-        zeta_0 = -k_0 grad H(q) with H(q) = sum_j (q_j - q_mid_j)^2 / (2 h_j), h_j the
-        half-range of arm joint j, so zeta_0_j = -k_0 (q_j - q_mid_j) / h_j [rad/s]: each
-        limited arm joint is pushed toward mid-range, at k_0 rad/s when at a limit. It is
-        zero on the 6 vehicle DoFs and on joints without (finite) position limits.
+        zeta_0 = -k_0 grad H(q) with H(q) = sum_j (q_j - q_0j)^2 / (2 h_j), h_j the
+        half-range of arm joint j and q_0 the target (mid-range by default), so
+        zeta_0_j = -k_0 (q_j - q_0j) / h_j [rad/s]: each limited arm joint is pushed toward
+        its target. It is zero on the 6 vehicle DoFs and on joints without (finite)
+        position limits. Projected on the null space of J it moves the vehicle and the arm
+        together without moving the end-effector: the vehicle slowly takes over what the
+        arm is holding.
         """
         zeta_0 = np.zeros(self.model.nv)
         gain = float(self.params.null_space_gain_per_s)
         if gain > 0.0 and self._limited_q_index.size:
-            offset = np.asarray(q)[self._limited_q_index] - self._mid
+            offset = np.asarray(q)[self._limited_q_index] - self._target
             zeta_0[self._limited_v_index] = -gain * offset / self._half_range
         return zeta_0
 
