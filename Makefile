@@ -24,6 +24,12 @@ lint: $(STAMP)
 	$(BIN)/ruff format --check .
 
 test: $(STAMP) lint
+	@# the replay tests open replay.html in a real headless browser: Debian's chromium,
+	@# installed here when possible (root with apt-get); otherwise those tests skip
+	@command -v chromium >/dev/null 2>&1 || { \
+	  if [ "$$(id -u)" = 0 ] && command -v apt-get >/dev/null 2>&1; then \
+	    apt-get update && DEBIAN_FRONTEND=noninteractive apt-get install -y chromium; \
+	  else echo "chromium missing and not installable here (needs root + apt-get): browser tests will skip"; fi; }
 	$(BIN)/python -m pytest -q
 
 bench: $(STAMP)

@@ -11,10 +11,12 @@ from uvms_pin.errors import FunnelViolation, SimulationError, UvmsPinError
 from uvms_pin.model import load_uvms
 from uvms_pin.rollout import Rollout, write_json_atomic
 from uvms_pin.scenario import load_scenario, simulate
+from uvms_pin.study.command import register as register_study_commands
 from uvms_pin.summary import model_summary
 
 EXIT_BAD_INPUT = 2
 EXIT_RUN_STOPPED = 3
+EXIT_INTERRUPTED = 130  # as a shell reports a process stopped by Ctrl-C
 
 
 class _ProgressLine:
@@ -68,13 +70,28 @@ def write_outputs(rollout: Rollout, out: Path) -> list[Path]:
     return paper_figures(rollout, out) + standard_figures(rollout, out)
 
 
+def _simulate(scenario, args: argparse.Namespace, progress) -> Rollout:
+    if not args.live:
+        return simulate(scenario, progress=progress)
+    from uvms_pin.viz.live import run_live
+
+    return run_live(scenario, port=args.port, speed=args.speed, progress=progress)
+
+
+def _write_replay(rollout: Rollout, path: Path, **kw) -> Path:
+    from uvms_pin.viz.replay import write_replay
+
+    return write_replay(rollout, path, **kw)
+
+
 def _cmd_run(args: argparse.Namespace) -> int:
+    _check_view_options(args)
     scenario = load_scenario(args.scenario)
     out = Path(args.out)
     progress = None if args.quiet else _ProgressLine(scenario.name)
     status = 0
     try:
-        rollout = simulate(scenario, progress=progress)
+        rollout = _simulate(scenario, args, progress)
     except (FunnelViolation, SimulationError) as exc:
         rollout = exc.rollout
         status = EXIT_RUN_STOPPED
@@ -83,6 +100,8 @@ def _cmd_run(args: argparse.Namespace) -> int:
         if progress is not None:
             progress.close()
     figures = write_outputs(rollout, out)
+    if args.html:
+        figures.append(_write_replay(rollout, out / "replay.html"))
     metrics = rollout.metrics()
     print(
         f"scenario {scenario.name}: {rollout.metadata['status']}, simulated {metrics['simulated_time_s']:.3f} s in {metrics['wall_time_s']:.2f} s (real-time factor {metrics['real_time_factor']:.2f})"
@@ -94,6 +113,46 @@ def _cmd_run(args: argparse.Namespace) -> int:
     if status:
         print(message, file=sys.stderr)
     return status
+
+
+def _check_view_options(args: argparse.Namespace) -> None:
+    if not args.speed > 0.0:
+        raise UvmsPinError(f"--speed must be positive, got {args.speed}")
+    if not 0 <= args.port <= 65535:
+        raise UvmsPinError(f"--port must be in 0..65535, got {args.port}")
+
+
+def _cmd_replay(args: argparse.Namespace) -> int:
+    _check_view_options(args)
+    if not (args.html or args.live):
+        raise UvmsPinError("replay: nothing to do, give --html and/or --live")
+    if not args.fps > 0.0:
+        raise UvmsPinError(f"--fps must be positive, got {args.fps}")
+    rollout = Rollout.load(args.rollout)
+    if args.html:
+        path = Path(args.out) if args.out else Path(args.rollout) / "replay.html"
+        _write_replay(rollout, path, urdf=args.urdf, max_fps=args.fps)
+        size_mb = path.stat().st_size / 1e6
+        print(f"wrote {path} ({size_mb:.1f} MB, {len(rollout)} samples)")
+    if args.live:
+        from uvms_pin.viz.live import replay_live
+        from uvms_pin.viz.replay import scene_for_rollout
+
+        scene = scene_for_rollout(rollout, urdf=args.urdf)
+        replay_live(rollout, scene, port=args.port, speed=args.speed)
+    return 0
+
+
+def _add_view_options(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument(
+        "--live", action="store_true", help="show the run in meshcat (server on 127.0.0.1)"
+    )
+    parser.add_argument(
+        "--port", type=int, default=7000, help="live view port (default 7000; 0: any free)"
+    )
+    parser.add_argument(
+        "--speed", type=float, default=1.0, help="live playback speed-up over real time"
+    )
 
 
 def _cmd_info(args: argparse.Namespace) -> int:
@@ -111,13 +170,28 @@ def build_parser() -> argparse.ArgumentParser:
     run.add_argument("scenario", help="scenario TOML file")
     run.add_argument("--out", required=True, help="output directory")
     run.add_argument("--quiet", action="store_true", help="no progress line")
+    run.add_argument(
+        "--html", action="store_true", help="also write replay.html (self-contained, offline)"
+    )
+    _add_view_options(run)
     run.set_defaults(func=_cmd_run)
+    replay = sub.add_parser("replay", help="show a saved rollout: replay.html and/or live")
+    replay.add_argument("rollout", help="directory holding rollout.npz and rollout.json")
+    replay.add_argument("--html", action="store_true", help="write ROLLOUT/replay.html")
+    replay.add_argument("--out", help="write the page here instead of ROLLOUT/replay.html")
+    replay.add_argument("--urdf", help="the model's URDF, if it moved since the run")
+    replay.add_argument(
+        "--fps", type=float, default=30.0, help="replay frames per simulated second (max)"
+    )
+    _add_view_options(replay)
+    replay.set_defaults(func=_cmd_replay)
     info = sub.add_parser("info", help="print a summary of a UVMS URDF")
     info.add_argument("urdf", help="URDF file with the hydrodynamic extension")
     info.add_argument(
         "--water-density", type=float, default=1025.0, help="kg/m^3 (default: sea water)"
     )
     info.set_defaults(func=_cmd_info)
+    register_study_commands(sub)
     return parser
 
 
@@ -128,6 +202,9 @@ def main(argv: list[str] | None = None) -> int:
     except UvmsPinError as exc:
         print(f"uvms-pin: error: {exc}", file=sys.stderr)
         return EXIT_BAD_INPUT
+    except KeyboardInterrupt:
+        print("uvms-pin: interrupted", file=sys.stderr)
+        return EXIT_INTERRUPTED
 
 
 if __name__ == "__main__":

@@ -1,0 +1,79 @@
+"""Plant factors a scenario file does not carry: inertia, added mass, damping, buoyancy.
+
+`modify_plant` returns the scenario with its UVMS replaced by a scaled copy. The
+controller is built from the scenario's UVMS but uses only its kinematics (model-free),
+so the factors change the plant, not the controller.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+
+import pinocchio as pin
+
+from uvms_pin.hydro.params import HydroParams
+from uvms_pin.model import UVMS, HydroBody
+from uvms_pin.scenario import Scenario
+
+
+def scaled_uvms(
+    uvms: UVMS,
+    *,
+    mass_scale: float = 1.0,
+    added_mass_scale: float = 1.0,
+    damping_scale: float = 1.0,
+    buoyancy_scale: float = 1.0,
+) -> UVMS:
+    """A copy of ``uvms`` with scaled parameters.
+
+    - ``mass_scale``: every body's mass and rotational inertia (about its CoM, which
+      stays put) and the joint armature;
+    - ``added_mass_scale``: every body's added-mass matrix M_A;
+    - ``damping_scale``: linear and quadratic damping;
+    - ``buoyancy_scale``: every displaced volume (buoyancy rho g V; centres unchanged).
+
+    Mass and volume are scaled independently: a mass_scale of 1.2 with buoyancy_scale 1
+    leaves the vehicle 20 % of its weight heavy in water.
+    """
+    model = uvms.model
+    if mass_scale != 1.0:
+        model = pin.Model(model)
+        for j in range(1, model.njoints):
+            inertia = model.inertias[j]
+            model.inertias[j] = pin.Inertia(
+                inertia.mass * mass_scale, inertia.lever, inertia.inertia * mass_scale
+            )
+        model.armature = uvms.model.armature * mass_scale
+    out = UVMS(
+        model,
+        uvms.hydro_bodies,
+        uvms.water_density_kg_m3,
+        uvms.ee_frame_id,
+        uvms.sensor_frame_id,
+        uvms.source,
+    )
+    if (added_mass_scale, damping_scale, buoyancy_scale) == (1.0, 1.0, 1.0):
+        return out
+
+    def hydro(body: HydroBody) -> HydroParams:
+        p = body.params
+        return HydroParams(
+            p.volume_m3 * buoyancy_scale,
+            p.center_of_buoyancy_m,
+            p.added_mass * added_mass_scale,
+            p.linear_damping * damping_scale,
+            p.quadratic_damping * damping_scale,
+            derived=p.derived,
+            origin=p.origin,
+        )
+
+    return out.with_hydro(hydro)
+
+
+def modify_plant(scenario: Scenario, factors: dict[str, float]) -> Scenario:
+    """The scenario with its plant's UVMS scaled by ``factors`` (names of `scaled_uvms`)."""
+    if all(v == 1.0 for v in factors.values()):
+        return scenario
+    uvms = scaled_uvms(scenario.uvms, **factors)
+    plant = dataclasses.replace(scenario.plant, uvms=uvms)
+    return dataclasses.replace(scenario, plant=plant)
