@@ -19,6 +19,9 @@ from uvms_pin.errors import (
 from uvms_pin.hydro.params import HydroParams
 from uvms_pin.measurement import Measurement
 from uvms_pin.model import UVMS, HydroBody, load_uvms
+from uvms_pin.mount import mount_arm
+from uvms_pin.rollout import Rollout
+from uvms_pin.scenario import load_scenario, simulate
 
 __version__ = "0.1.0"
 
@@ -30,6 +33,7 @@ __all__ = [
     "Measurement",
     "ModelError",
     "ParameterError",
+    "Rollout",
     "ScenarioError",
     "SimulationError",
     "UvmsPinError",
@@ -37,7 +41,10 @@ __all__ = [
     "forward_dynamics",
     "frame_wrench_to_generalized",
     "kinetic_energy",
+    "load_scenario",
     "load_uvms",
     "mass_matrix",
+    "mount_arm",
     "potential_energy",
+    "simulate",
 ]

@@ -7,6 +7,7 @@ import sys
 import time
 from pathlib import Path
 
+from uvms_pin.arms.command import register as register_compare_arms
 from uvms_pin.errors import FunnelViolation, SimulationError, UvmsPinError
 from uvms_pin.model import load_uvms
 from uvms_pin.rollout import Rollout, write_json_atomic
@@ -192,6 +193,7 @@ def build_parser() -> argparse.ArgumentParser:
     )
     info.set_defaults(func=_cmd_info)
     register_study_commands(sub)
+    register_compare_arms(sub)
     return parser
 
 

@@ -10,7 +10,7 @@ so nothing is approximated when links are merged.
 from __future__ import annotations
 
 import xml.etree.ElementTree as ET
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -20,7 +20,9 @@ import pinocchio as pin
 from uvms_pin.errors import ModelError, ParameterError
 from uvms_pin.hydro import geometry
 from uvms_pin.hydro.added_mass import added_mass_in_parent
+from uvms_pin.hydro.mesh import load_mesh_geometry, mesh_hydro
 from uvms_pin.hydro.params import HydroParams
+from uvms_pin.resources import package_search_path, resolve_resource
 
 DEFAULT_WATER_DENSITY_KG_M3 = 1025.0  # sea water; a parameter of load_uvms, never hidden
 
@@ -197,6 +199,7 @@ def load_uvms(
     sensor_frame: str = "ft_sensor",
     derive_missing: bool = True,
     allow_dry_links: bool = False,
+    package_dirs: Sequence[str | Path] = (),
 ) -> UVMS:
     """Load a UVMS from a URDF with the hydrodynamic extension.
 
@@ -208,6 +211,10 @@ def load_uvms(
             from their collision primitives (marked ``derived``).
         allow_dry_links: accept links with mass but neither hydrodynamics nor collision
             geometry (they get no hydrodynamic effect) instead of raising.
+        package_dirs: directories containing packages, searched first for the
+            ``package://`` mesh paths of collision meshes (then the installed
+            example-robot-data; see `uvms_pin.resources`). Relative mesh paths are relative
+            to the URDF's directory.
 
     Raises:
         ModelError: naming the file, the link and what is wrong.
@@ -256,7 +263,9 @@ def load_uvms(
             bodies.append(HydroBody(name, joint_id, frame.placement, params))
         elif collisions and derive_missing:
             for k, collision in enumerate(collisions):
-                origin, params = _derive_from_collision(collision, water_density_kg_m3, where, name)
+                origin, params = _derive_from_collision(
+                    collision, water_density_kg_m3, where, name, path.parent, package_dirs
+                )
                 bodies.append(
                     HydroBody(f"{name}/collision[{k}]", joint_id, frame.placement * origin, params)
                 )
@@ -428,7 +437,12 @@ def _origin(element: ET.Element | None, where: str, link: str) -> pin.SE3:
 
 
 def _derive_from_collision(
-    collision: ET.Element, water_density_kg_m3: float, where: str, link: str
+    collision: ET.Element,
+    water_density_kg_m3: float,
+    where: str,
+    link: str,
+    base_dir: Path = Path("."),
+    package_dirs: Sequence[str | Path] = (),
 ) -> tuple[pin.SE3, HydroParams]:
     origin = _origin(collision.find("origin"), where, link)
     geom = collision.find("geometry")
@@ -446,13 +460,31 @@ def _derive_from_collision(
         if shape.tag == "sphere":
             radius = _numbers(shape.get("radius"), 1, "<sphere radius>", where, link)[0]
             return origin, geometry.sphere_hydro(radius, water_density_kg_m3)
+        if shape.tag == "mesh":
+            # volume and bounding primitive of the mesh (uvms_pin.hydro.mesh)
+            filename = shape.get("filename")
+            if not filename:
+                raise ModelError("<mesh> has no filename", path=where, link=link)
+            resolved = resolve_resource(filename, base_dir, package_dirs)
+            if resolved is None:
+                searched = ", ".join(str(d) for d in package_search_path(package_dirs))
+                raise ModelError(
+                    f"cannot derive hydrodynamics from collision <mesh>: file '{filename}' not "
+                    f"found (relative paths from {base_dir}; package:// searched in: "
+                    f"{searched or 'none'}); fix the path, pass package_dirs, or add a "
+                    "<hydrodynamics> element",
+                    path=where,
+                    link=link,
+                )
+            scale = _numbers(shape.get("scale", "1 1 1"), 3, "<mesh scale>", where, link)
+            return origin, mesh_hydro(load_mesh_geometry(resolved, scale), water_density_kg_m3)
     except ParameterError as exc:
         raise ModelError(
             f"cannot derive hydrodynamics from <{shape.tag}>: {exc}", path=where, link=link
         ) from exc
     raise ModelError(
-        f"cannot derive hydrodynamics from collision <{shape.tag}> (box, cylinder and sphere are "
-        "supported); add a <hydrodynamics> element",
+        f"cannot derive hydrodynamics from collision <{shape.tag}> (box, cylinder, sphere and "
+        "mesh are supported); add a <hydrodynamics> element",
         path=where,
         link=link,
     )

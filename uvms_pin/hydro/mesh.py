@@ -1,0 +1,174 @@
+"""Hydrodynamic coefficients of a link whose collision geometry is a mesh.
+
+A mesh is reduced to two things (DESIGN.md section 4, "a mesh through its bounding primitive
+or volume"):
+
+- its **volume and centre of buoyancy**: the enclosed volume and centroid of the mesh if it is
+  watertight, else of its convex hull (an upper estimate: a hull fills the concave parts);
+- a **bounding primitive** for added mass and drag: the oriented bounding box (OBB, trimesh's
+  ``bounding_box_oriented`` of the convex hull). When two of its sides differ by less than
+  ``cylinder_aspect_tolerance`` the link is treated as a cylinder along the third side
+  (diameter = the mean of the two), which is what most arm links and motor housings are;
+  otherwise as a box. The primitive's coefficients come from
+  :func:`uvms_pin.hydro.geometry.cylinder_hydro` / :func:`~uvms_pin.hydro.geometry.box_hydro`.
+
+The primitive encloses the mesh, so its volume V_p exceeds the mesh's V. Added mass scales
+with the displaced volume at a fixed shape (potential flow: M_A = rho V k(aspect ratios)), so
+it is multiplied by V / V_p: the primitive's shape with the mesh's volume. Drag scales with
+the projected area, which the enclosing primitive over-estimates only a little for compact
+links: it is kept (an upper estimate of the drag of a bluff link).
+
+Every number is returned at the mesh origin (the ``<collision><origin>`` frame), in its
+axes, marked ``derived``, with a note of the method in ``origin``.
+"""
+
+from __future__ import annotations
+
+import functools
+import math
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from uvms_pin.errors import ParameterError
+from uvms_pin.hydro import geometry
+from uvms_pin.hydro.params import HydroParams
+
+__all__ = ["MeshGeometry", "load_mesh_geometry", "mesh_hydro"]
+
+#: Two OBB sides within this relative difference make the bounding primitive a cylinder.
+DEFAULT_CYLINDER_ASPECT_TOLERANCE = 0.15
+#: Smallest side of a bounding primitive [m] (a flat mesh still gets a finite thickness).
+_MIN_SIDE_M = 1e-4
+
+
+@dataclass(frozen=True)
+class MeshGeometry:
+    """What the hydrodynamics need from a mesh, in the mesh frame (after scaling) [m].
+
+    Attributes:
+        volume_m3: enclosed volume (of the mesh if watertight, else of its convex hull).
+        centroid_m: centre of that volume (centre of buoyancy).
+        watertight: whether the mesh itself was used (False: its convex hull).
+        obb_rotation: mesh_R_obb (3x3), the axes of the oriented bounding box.
+        obb_center_m: mesh_p_obb (3,).
+        obb_extents_m: the box's full side lengths (3,).
+    """
+
+    volume_m3: float
+    centroid_m: np.ndarray
+    watertight: bool
+    obb_rotation: np.ndarray
+    obb_center_m: np.ndarray
+    obb_extents_m: np.ndarray
+
+
+@functools.lru_cache(maxsize=256)
+def _load_cached(path: str, mtime_ns: int, scale: tuple[float, float, float]) -> MeshGeometry:
+    import trimesh  # optional at import time: only meshes need it
+
+    try:
+        mesh = trimesh.load(path, force="mesh", process=True)
+    except Exception as exc:  # trimesh raises many types for unreadable files
+        raise ParameterError(f"cannot read mesh '{path}': {exc}") from exc
+    if not isinstance(mesh, trimesh.Trimesh) or len(mesh.faces) == 0:
+        raise ParameterError(f"mesh '{path}' has no triangles")
+    mesh.apply_scale(np.asarray(scale, dtype=float))
+    if mesh.is_watertight and abs(mesh.volume) > 0.0:
+        body, watertight = mesh, True
+    else:
+        body, watertight = mesh.convex_hull, False
+    volume = abs(float(body.volume))
+    if not (math.isfinite(volume) and volume > 0.0):
+        raise ParameterError(f"mesh '{path}' encloses no volume (flat or degenerate)")
+    centroid = np.asarray(body.center_mass, dtype=float)
+    obb = mesh.convex_hull.bounding_box_oriented.primitive
+    transform = np.asarray(obb.transform, dtype=float)
+    rotation = transform[:3, :3].copy()
+    if np.linalg.det(rotation) < 0.0:  # keep a proper rotation (flip one box axis)
+        rotation[:, 2] *= -1.0
+    return MeshGeometry(
+        volume_m3=volume,
+        centroid_m=centroid,
+        watertight=watertight,
+        obb_rotation=rotation,
+        obb_center_m=transform[:3, 3].copy(),
+        obb_extents_m=np.maximum(np.asarray(obb.extents, dtype=float), _MIN_SIDE_M),
+    )
+
+
+def load_mesh_geometry(path: str | Path, scale=(1.0, 1.0, 1.0)) -> MeshGeometry:
+    """Read a mesh file (STL, OBJ, DAE, ... anything trimesh reads) and reduce it.
+
+    Results are cached on (path, modification time, scale).
+
+    Raises:
+        ParameterError: the file does not exist, cannot be read, or encloses no volume.
+    """
+    p = Path(path)
+    if not p.is_file():
+        raise ParameterError(f"mesh file not found: '{p}'")
+    s = np.broadcast_to(np.asarray(scale, dtype=float).reshape(-1), (3,))
+    if not np.all(np.isfinite(s)) or np.any(s == 0.0):
+        raise ParameterError(f"mesh scale must be finite and non-zero, got {scale!r}")
+    return _load_cached(str(p.resolve()), p.stat().st_mtime_ns, tuple(float(x) for x in np.abs(s)))
+
+
+def mesh_hydro(
+    geometry_: MeshGeometry,
+    water_density_kg_m3: float,
+    *,
+    cylinder_aspect_tolerance: float = DEFAULT_CYLINDER_ASPECT_TOLERANCE,
+) -> HydroParams:
+    """Coefficients of a mesh at its origin, in its frame (see the module docstring).
+
+    Args:
+        geometry_: from :func:`load_mesh_geometry`.
+        water_density_kg_m3: rho [kg/m^3] > 0.
+        cylinder_aspect_tolerance: relative difference under which two OBB sides make a
+            cylinder (0 = always a box).
+    """
+    ext = geometry_.obb_extents_m
+    rotation = geometry_.obb_rotation
+    order = np.argsort(ext)
+    pairs = ((order[0], order[1], order[2]), (order[1], order[2], order[0]))
+    primitive = None
+    for i, j, axis in pairs:
+        if abs(ext[i] - ext[j]) <= cylinder_aspect_tolerance * max(ext[i], ext[j]):
+            radius = 0.25 * (ext[i] + ext[j])
+            length = float(ext[axis])
+            base = geometry.cylinder_hydro(radius, length, water_density_kg_m3)
+            # the cylinder's z axis along OBB axis `axis`: a proper rotation with that column
+            z = rotation[:, axis]
+            x = rotation[:, i]
+            rot = np.column_stack([x, np.cross(z, x), z])
+            primitive = (base, rot, f"cylinder r={radius:.4g} m L={length:.4g} m")
+            break
+    if primitive is None:
+        base = geometry.box_hydro(ext, water_density_kg_m3)
+        primitive = (base, rotation, "box {:.4g}x{:.4g}x{:.4g} m".format(*ext))
+    base, rot, label = primitive
+    ratio = geometry_.volume_m3 / base.volume_m3
+    scaled = HydroParams(
+        volume_m3=geometry_.volume_m3,
+        center_of_buoyancy_m=np.zeros(3),
+        added_mass=base.added_mass * ratio,
+        linear_damping=base.linear_damping,
+        quadratic_damping=base.quadratic_damping,
+        derived=True,
+    )
+    moved = geometry.hydro_in_frame(scaled, rot, geometry_.obb_center_m)
+    source = "mesh" if geometry_.watertight else "convex hull"
+    return HydroParams(
+        volume_m3=geometry_.volume_m3,
+        center_of_buoyancy_m=geometry_.centroid_m,
+        added_mass=moved.added_mass,
+        linear_damping=moved.linear_damping,
+        quadratic_damping=moved.quadratic_damping,
+        derived=True,
+        origin=(
+            f"mesh: V={geometry_.volume_m3:.4g} m^3 from the {source}; bounding {label}, "
+            f"added mass scaled by V/V_primitive={ratio:.3f}"
+        ),
+    )

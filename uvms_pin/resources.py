@@ -1,0 +1,77 @@
+"""Finding files a URDF refers to: ``package://`` and relative mesh paths.
+
+``package://NAME/rest`` resolves to ``DIR/NAME/rest`` for the first directory DIR of the
+search path that has it (ROS and Pinocchio's ``package_dirs`` convention: a directory that
+*contains* packages). The search path is the caller's ``package_dirs`` followed by the
+``share`` directory of the installed ``example-robot-data`` distribution, so its robots load
+without arguments (its wheel ships URDFs and meshes under
+``site-packages/cmeel.prefix/share/example-robot-data`` but no Python loader). ``file://``
+URLs and absolute paths are taken as they are; other paths are relative to the URDF's
+directory.
+"""
+
+from __future__ import annotations
+
+import functools
+from collections.abc import Iterable
+from importlib import metadata
+from pathlib import Path
+
+__all__ = ["example_robot_data_dir", "package_search_path", "resolve_resource"]
+
+_ERD_DISTRIBUTION = "example-robot-data"
+_ERD_SHARE = ("cmeel.prefix", "share")
+
+
+@functools.lru_cache(maxsize=1)
+def _example_robot_data_share() -> Path | None:
+    try:
+        dist = metadata.distribution(_ERD_DISTRIBUTION)
+    except metadata.PackageNotFoundError:
+        return None
+    share = Path(str(dist.locate_file(Path(*_ERD_SHARE))))
+    return share if (share / _ERD_DISTRIBUTION).is_dir() else None
+
+
+def example_robot_data_dir() -> Path | None:
+    """``.../share/example-robot-data`` of the installed distribution, or None."""
+    share = _example_robot_data_share()
+    return None if share is None else share / _ERD_DISTRIBUTION
+
+
+def package_search_path(package_dirs: Iterable[str | Path] = ()) -> list[Path]:
+    """The directories searched for ``package://`` names, in order."""
+    dirs = [Path(d) for d in package_dirs]
+    share = _example_robot_data_share()
+    if share is not None:
+        dirs.append(share)
+    return dirs
+
+
+def resolve_resource(
+    filename: str, base_dir: str | Path, package_dirs: Iterable[str | Path] = ()
+) -> Path | None:
+    """The file a URDF ``filename`` attribute points to, or None if it does not exist.
+
+    Args:
+        filename: ``package://NAME/rest``, ``file:///abs``, an absolute or a relative path.
+        base_dir: the URDF's directory (for relative paths).
+        package_dirs: extra directories containing packages, searched first.
+    """
+    if filename.startswith("package://"):
+        rest = filename[len("package://") :]
+        for directory in package_search_path(package_dirs):
+            candidate = directory / rest
+            if candidate.is_file():
+                return candidate
+            # a directory that IS the package: drop the package name
+            _, _, inner = rest.partition("/")
+            if inner and (directory / inner).is_file() and directory.name == rest.split("/")[0]:
+                return directory / inner
+        return None
+    if filename.startswith("file://"):
+        filename = filename[len("file://") :]
+    path = Path(filename)
+    if not path.is_absolute():
+        path = Path(base_dir) / path
+    return path if path.is_file() else None
