@@ -28,6 +28,10 @@ class Actuation(ABC):
     def apply(self, tau_commanded: np.ndarray) -> np.ndarray:
         """The applied tau (nv,) [N, N m]."""
 
+    def saturated(self, tau_commanded: np.ndarray) -> bool:
+        """True when an actuator cannot give what the command asks."""
+        return False
+
 
 class Unlimited(Actuation):
     """Every DoF actuated without limit: tau_applied = tau_commanded."""
@@ -135,6 +139,14 @@ class ThrustersAndJointLimits(Actuation):
     def thrusts(self, tau_commanded: np.ndarray) -> np.ndarray:
         """Per-thruster thrust f (m,) [N] after allocation and saturation."""
         return np.clip(self._allocation_pinv @ tau_commanded[:6], self._lower, self._upper)
+
+    def saturated(self, tau_commanded: np.ndarray) -> bool:
+        """True when a thruster or a joint cannot give what the command asks."""
+        raw = self._allocation_pinv @ tau_commanded[:6]
+        if np.any(raw < self._lower) or np.any(raw > self._upper):
+            return True
+        limits = self.joint_effort_limits_Nm
+        return limits is not None and bool(np.any(np.abs(tau_commanded[6:]) > limits))
 
     def apply(self, tau_commanded):
         out = np.empty_like(tau_commanded)
