@@ -17,7 +17,7 @@ $(STAMP): pyproject.toml
 	touch $(STAMP)
 
 demo: $(STAMP)
-	$(BIN)/uvms-pin run $(DEMO_SCENARIO) --out $(DEMO_OUT)
+	$(BIN)/uvms-pin run $(DEMO_SCENARIO) --out $(DEMO_OUT) --html
 
 lint: $(STAMP)
 	$(BIN)/ruff check .

@@ -99,6 +99,8 @@ def run_case(args: tuple[str, dict, float, float]) -> dict:
 
 
 def markdown(rows: list[dict]) -> str:
+    """One row per case. For a run that stopped, the margins are those of the samples logged
+    before the stop and the force RMS is not given (no full steady state)."""
     head = (
         "| case | funnels hold | min margin 1st / 2nd | force RMS after transient [N] | "
         "peak vehicle force applied / commanded [N] | peak joint torque [N m] | "
@@ -107,10 +109,11 @@ def markdown(rows: list[dict]) -> str:
     lines = []
     for r in rows:
         failure = r["failure"].replace("funnel violated at ", "").split(" (|xi|")[0]
+        rms = f"{r['force_error_rms_after_transient_N']:.3f}" if r["holds"] else "-"
         lines.append(
             f"| {r['case']} | {'yes' if r['holds'] else 'no'} "
             f"| {r['funnel_margin_min_first']:.3f} / {r['funnel_margin_min_second']:.3f} "
-            f"| {r['force_error_rms_after_transient_N']:.3f} "
+            f"| {rms} "
             f"| {r['vehicle_force_peak_N']:.0f} / {r['commanded_vehicle_force_peak_N']:.0f} "
             f"| {r['joint_torque_peak_Nm']:.2f} | {100 * r['saturation_fraction']:.0f} % "
             f"| {failure} |"

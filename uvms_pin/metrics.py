@@ -55,7 +55,27 @@ def compute_metrics(rollout: Rollout) -> dict[str, float]:
         joint_torque_rms_Nm=_rms(joints),
     )
     out.update(force_tracking_metrics(rollout))
+    out.update(joint_limit_metrics(rollout))
     return out
+
+
+def joint_limit_metrics(rollout: Rollout) -> dict[str, float]:
+    """How far the arm went past its position limits [rad] (0: never), and the time share.
+
+    The simulator does not stop a joint at its limit (no hard stops are modelled), so a
+    controller that drives a joint past it shows up here, not as a crash.
+    """
+    meta = rollout.metadata
+    if "arm_position_lower_rad" not in meta or len(rollout) == 0 or rollout.q.shape[1] <= 7:
+        return {}
+    q = rollout.q[:, 7:]
+    lower = np.asarray(meta["arm_position_lower_rad"], dtype=float)
+    upper = np.asarray(meta["arm_position_upper_rad"], dtype=float)
+    excess = np.maximum(lower - q, 0.0) + np.maximum(q - upper, 0.0)
+    return {
+        "joint_limit_excess_max_rad": float(excess.max()),
+        "joint_limit_excess_time_fraction": float(np.mean(np.any(excess > 0.0, axis=1))),
+    }
 
 
 def transient_end_s(rollout: Rollout, fraction: float = 0.05) -> float:

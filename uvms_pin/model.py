@@ -191,6 +191,20 @@ class UVMS:
 # ---- loading ----------------------------------------------------------------------------
 
 
+def read_urdf_root(path: Path) -> ET.Element:
+    """The <robot> element of a URDF file; ModelError naming the file otherwise."""
+    where = str(path)
+    if not path.is_file():
+        raise ModelError("file not found", path=where)
+    try:
+        root = ET.parse(path).getroot()
+    except ET.ParseError as exc:
+        raise ModelError(f"not well-formed XML ({exc})", path=where) from exc
+    if root.tag != "robot":
+        raise ModelError(f"root element is <{root.tag}>, expected <robot>", path=where)
+    return root
+
+
 def load_uvms(
     urdf_path: str | Path,
     *,
@@ -223,14 +237,7 @@ def load_uvms(
     where = str(path)
     if not np.isfinite(water_density_kg_m3) or water_density_kg_m3 <= 0.0:
         raise ParameterError(f"water_density_kg_m3 must be positive, got {water_density_kg_m3}")
-    if not path.is_file():
-        raise ModelError("file not found", path=where)
-    try:
-        root = ET.parse(path).getroot()
-    except ET.ParseError as exc:
-        raise ModelError(f"not well-formed XML ({exc})", path=where) from exc
-    if root.tag != "robot":
-        raise ModelError(f"root element is <{root.tag}>, expected <robot>", path=where)
+    root = read_urdf_root(path)
     links = {link.get("name"): link for link in root.findall("link")}
     if not links:
         raise ModelError("no <link> elements", path=where)

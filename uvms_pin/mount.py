@@ -46,7 +46,7 @@ import numpy as np
 import pinocchio as pin
 
 from uvms_pin.errors import ModelError, ParameterError
-from uvms_pin.model import DEFAULT_WATER_DENSITY_KG_M3, UVMS, load_uvms
+from uvms_pin.model import DEFAULT_WATER_DENSITY_KG_M3, UVMS, load_uvms, read_urdf_root
 from uvms_pin.resources import resolve_resource
 
 __all__ = [
@@ -602,16 +602,7 @@ class _Tree:
 
     @classmethod
     def read(cls, path: Path) -> _Tree:
-        where = str(path)
-        if not path.is_file():
-            raise ModelError("file not found", path=where)
-        try:
-            root = ET.parse(path).getroot()
-        except ET.ParseError as exc:
-            raise ModelError(f"not well-formed XML ({exc})", path=where) from exc
-        if root.tag != "robot":
-            raise ModelError(f"root element is <{root.tag}>, expected <robot>", path=where)
-        return cls(root, path)
+        return cls(read_urdf_root(path), path)
 
     def require_link(self, name: str, role: str) -> str:
         if name not in self.links:

@@ -139,6 +139,9 @@ def simulate_closed_loop(
         integrator_settings=dict(vars(settings.integrator)),
         versions=package_versions(),
         model_source=uvms.source,
+        arm_joint_names=uvms.arm_joint_names,
+        arm_position_lower_rad=model.lowerPositionLimit[7:].tolist(),
+        arm_position_upper_rad=model.upperPositionLimit[7:].tolist(),
     )
     rollout = Rollout.allocate(settings.n_log, model.nq, model.nv, meta)
     controller.reset()

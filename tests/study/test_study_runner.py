@@ -90,7 +90,7 @@ def test_killing_the_sweep_process_and_rerunning_finishes_the_study(tmp_path, se
     command = [
         sys.executable,
         "-m",
-        "uvms_pin.study.command",
+        "uvms_pin.cli",
         "sweep",
         str(path),
         "--out",

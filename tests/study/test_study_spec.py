@@ -6,9 +6,9 @@ import numpy as np
 import pytest
 from study_helpers import STUDY, write_study
 
+from uvms_pin.cli import main
 from uvms_pin.errors import UvmsPinError
 from uvms_pin.study import StudyError, load_study
-from uvms_pin.study.command import main
 
 
 def test_runs_are_the_grid_times_the_samples_with_derived_seeds(tmp_path):

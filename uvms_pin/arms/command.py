@@ -13,7 +13,6 @@ from pathlib import Path
 
 from uvms_pin.arms.catalog import available_arms
 from uvms_pin.arms.compare import CompareSettings, compare_arms
-from uvms_pin.errors import UvmsPinError
 from uvms_pin.trim import TrimSpec
 
 EXIT_BAD_INPUT = 2
@@ -93,18 +92,3 @@ def register(subparsers) -> argparse.ArgumentParser:
     parser.add_argument("--list", action="store_true", help="list the arm names available and exit")
     parser.set_defaults(func=_cmd_compare_arms)
     return parser
-
-
-def main(argv: list[str] | None = None) -> int:
-    parser = argparse.ArgumentParser(prog="uvms-pin")
-    register(parser.add_subparsers(dest="command", required=True))
-    args = parser.parse_args(["compare-arms", *(sys.argv[1:] if argv is None else argv)])
-    try:
-        return args.func(args)
-    except UvmsPinError as exc:
-        print(f"uvms-pin: error: {exc}", file=sys.stderr)
-        return EXIT_BAD_INPUT
-
-
-if __name__ == "__main__":
-    sys.exit(main())

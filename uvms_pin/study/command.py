@@ -12,8 +12,6 @@ import argparse
 import sys
 from pathlib import Path
 
-from uvms_pin.errors import UvmsPinError
-
 EXIT_BAD_INPUT = 2
 EXIT_INTERRUPTED = 130
 
@@ -103,18 +101,3 @@ def register(subparsers) -> None:
     )
     report.add_argument("directory", help="output directory of 'sweep'")
     report.set_defaults(func=_cmd_report)
-
-
-def main(argv: list[str] | None = None) -> int:
-    parser = argparse.ArgumentParser(prog="uvms-pin", description="uvms-pin studies")
-    register(parser.add_subparsers(dest="command", required=True))
-    args = parser.parse_args(argv)
-    try:
-        return args.func(args)
-    except UvmsPinError as exc:
-        print(f"uvms-pin: error: {exc}", file=sys.stderr)
-        return EXIT_BAD_INPUT
-
-
-if __name__ == "__main__":
-    sys.exit(main())
