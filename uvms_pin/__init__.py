@@ -20,6 +20,7 @@ from uvms_pin.hydro.params import HydroParams
 from uvms_pin.measurement import Measurement
 from uvms_pin.model import UVMS, HydroBody, load_uvms
 from uvms_pin.mount import mount_arm
+from uvms_pin.resources import shipped_path
 from uvms_pin.rollout import Rollout
 from uvms_pin.scenario import load_scenario, simulate
 
@@ -46,5 +47,6 @@ __all__ = [
     "mass_matrix",
     "mount_arm",
     "potential_energy",
+    "shipped_path",
     "simulate",
 ]

@@ -13,11 +13,12 @@ directory.
 from __future__ import annotations
 
 import functools
+import sys
 from collections.abc import Iterable
 from importlib import metadata
 from pathlib import Path
 
-__all__ = ["example_robot_data_dir", "package_search_path", "resolve_resource"]
+__all__ = ["example_robot_data_dir", "package_search_path", "resolve_resource", "shipped_path"]
 
 _ERD_DISTRIBUTION = "example-robot-data"
 _ERD_SHARE = ("cmeel.prefix", "share")
@@ -75,3 +76,23 @@ def resolve_resource(
     if not path.is_absolute():
         path = Path(base_dir) / path
     return path if path.is_file() else None
+
+
+def shipped_path(relative: str | Path) -> Path:
+    """A file shipped with uvms-pin: ``models/uvms_lbv150.urdf``, ``scenarios/...``, ...
+
+    From a source checkout (editable install) it is the repository's file; from a wheel it
+    is the copy installed in ``<prefix>/share/uvms-pin/``.
+
+    Raises:
+        FileNotFoundError: neither exists.
+    """
+    relative = Path(relative)
+    candidates = [
+        Path(__file__).resolve().parents[1] / relative,
+        Path(sys.prefix) / "share" / "uvms-pin" / relative,
+    ]
+    for candidate in candidates:
+        if candidate.exists():
+            return candidate
+    raise FileNotFoundError(f"{relative} is not shipped with this install (looked in {candidates})")
