@@ -125,6 +125,9 @@ def controller_overrides(
         else:
             arm = [_median_arm(value, n_ref)] * n
         out[f"controller.{key}"] = vehicle + arm
+    if "null_space_target" in raw_controller:
+        # the reference design pulls the arm back to its working pose: each arm's own
+        out["controller.null_space_target"] = [float(x) for x in q0[7:]]
     return out
 
 
