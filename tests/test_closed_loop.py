@@ -47,9 +47,12 @@ def _assert_inside_funnels(rollout: up.Rollout, force_rms_fraction: float) -> No
     # strictly inside, every component, every logged sample
     assert np.all(np.abs(s["e_x"]) < s["rho_x"])
     assert np.all(np.abs(s["e_zeta"]) < s["rho_zeta"])
-    metrics = rollout.metrics()
-    rho_inf_force = s["rho_x"][-1, :3].min()
-    assert metrics["force_error_rms_after_transient_N"] < force_rms_fraction * rho_inf_force
+    # per force component: the true error's RMS after the transient vs that component's
+    # final funnel width
+    after = rollout.time_s >= rollout.metrics()["transient_end_s"]
+    error = rollout.wrench_contact_world[after, :3] - s["force_desired_world_N"][after]
+    rms = np.sqrt(np.mean(error**2, axis=0))
+    assert np.all(rms < force_rms_fraction * s["rho_x"][-1, :3]), (rms, s["rho_x"][-1, :3])
 
 
 def test_paper_scenario_holds_its_funnels(paper_rollout):
@@ -197,7 +200,9 @@ def test_cli_saves_and_plots_the_partial_rollout(tmp_path):
         "../models/uvms_lbv150.urdf", str(ROOT / "models" / "uvms_lbv150.urdf")
     )
     text = text.replace("duration_s = 10.0", "duration_s = 3.0")
-    # tighten the force funnel below the noise in the file itself
+    # tighten the force funnel below the noise in the file itself, shrinking within ~1.5 s
+    text = re.sub(r"l_x_per_s = \[[^\]]*\]", "l_x_per_s = [3.0, 3.0, 3.0, 1.0, 1.0, 1.0]", text)
+    text = re.sub(r"rho0_x = \[[^\]]*\]", "rho0_x = [1.0, 1.0, 1.0, 0.9, 0.9, 0.9]", text)
     scenario.write_text(
         re.sub(r"rho_inf_x = \[[^\]]*\]", "rho_inf_x = [0.01, 0.01, 0.01, 0.2, 0.2, 0.2]", text)
     )
