@@ -159,6 +159,9 @@ def test_cli_ctrl_c_during_a_live_run_shuts_the_server_down(tmp_path):
         [*CLI, "run", str(scenario), "--out", str(tmp_path / "o"), "--quiet", "--live",
          "--port", str(port), "--speed", "0.5"],
         stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+        # a runner started in the background passes SIGINT on as ignored (and Python
+        # keeps an inherited SIG_IGN): give the child the default Ctrl-C behaviour
+        preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL),
     )  # fmt: skip
     try:
         line = proc.stdout.readline()
@@ -167,17 +170,8 @@ def test_cli_ctrl_c_during_a_live_run_shuts_the_server_down(tmp_path):
         with urllib.request.urlopen(f"http://127.0.0.1:{port}/static/", timeout=10) as r:
             assert r.status == 200
         time.sleep(0.5)  # streaming
-        # Ctrl-C; repeated if it was lost (seen once on a loaded machine: the run then
-        # completed with exit 0 and no message; cause not found yet, see the issue notes)
-        for _ in range(20):
-            proc.send_signal(signal.SIGINT)
-            try:
-                _, err = proc.communicate(timeout=1.0)
-                break
-            except subprocess.TimeoutExpired:
-                continue
-        else:
-            _, err = proc.communicate(timeout=30)
+        proc.send_signal(signal.SIGINT)
+        _, err = proc.communicate(timeout=30)
     finally:
         if proc.poll() is None:
             proc.kill()
