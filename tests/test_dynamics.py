@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import dataclasses
+
 import numpy as np
 import pinocchio as pin
 import pytest
@@ -139,14 +141,7 @@ def _balanced_undamped(uvms: UVMS) -> UVMS:
             np.zeros(6),
         )
         bodies.append(HydroBody(model.names[j], j, pin.SE3.Identity(), params))
-    return UVMS(
-        model,
-        tuple(bodies),
-        uvms.water_density_kg_m3,
-        uvms.ee_frame_id,
-        uvms.sensor_frame_id,
-        uvms.source,
-    )
+    return dataclasses.replace(uvms, hydro_bodies=tuple(bodies))
 
 
 def _integrate(uvms, q, v, duration, dt, current=None, tau=None, samples=100):

@@ -9,6 +9,7 @@ so nothing is approximated when links are merged.
 
 from __future__ import annotations
 
+import dataclasses
 import xml.etree.ElementTree as ET
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
@@ -163,29 +164,16 @@ class UVMS:
 
     def copy(self) -> UVMS:
         """An independent UVMS sharing the static parts but with its own work buffer."""
-        return UVMS(
-            model=self.model,
-            hydro_bodies=self.hydro_bodies,
-            water_density_kg_m3=self.water_density_kg_m3,
-            ee_frame_id=self.ee_frame_id,
-            sensor_frame_id=self.sensor_frame_id,
-            source=self.source,
-        )
+        return dataclasses.replace(self)
+
+    def with_model(self, model: pin.Model) -> UVMS:
+        """The same hydrodynamics and frames on another (e.g. re-scaled) Pinocchio model."""
+        return dataclasses.replace(self, model=model)
 
     def with_hydro(self, transform: Callable[[HydroBody], HydroParams]) -> UVMS:
         """A UVMS whose every body's params are replaced by ``transform(body)``."""
-        bodies = tuple(
-            HydroBody(b.name, b.joint_id, b.placement_in_joint, transform(b))
-            for b in self.hydro_bodies
-        )
-        return UVMS(
-            model=self.model,
-            hydro_bodies=bodies,
-            water_density_kg_m3=self.water_density_kg_m3,
-            ee_frame_id=self.ee_frame_id,
-            sensor_frame_id=self.sensor_frame_id,
-            source=self.source,
-        )
+        bodies = tuple(dataclasses.replace(b, params=transform(b)) for b in self.hydro_bodies)
+        return dataclasses.replace(self, hydro_bodies=bodies)
 
 
 # ---- loading ----------------------------------------------------------------------------

@@ -44,14 +44,7 @@ def scaled_uvms(
                 inertia.mass * mass_scale, inertia.lever, inertia.inertia * mass_scale
             )
         model.armature = uvms.model.armature * mass_scale
-    out = UVMS(
-        model,
-        uvms.hydro_bodies,
-        uvms.water_density_kg_m3,
-        uvms.ee_frame_id,
-        uvms.sensor_frame_id,
-        uvms.source,
-    )
+    out = uvms.with_model(model)
     if (added_mass_scale, damping_scale, buoyancy_scale) == (1.0, 1.0, 1.0):
         return out
 
