@@ -7,11 +7,15 @@ import os
 import tempfile
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 from uvms_pin.errors import ParameterError
+
+if TYPE_CHECKING:
+    import pandas as pd
+    from matplotlib.figure import Figure
 
 ARRAY_FILE = "rollout.npz"
 META_FILE = "rollout.json"
@@ -95,6 +99,23 @@ class Rollout:
         from uvms_pin.metrics import compute_metrics
 
         return compute_metrics(self)
+
+    def to_dataframe(self) -> pd.DataFrame:
+        """One row per sample, index ``time_s``, columns ``<array>.<component>_<unit>``
+        (e.g. ``q.vehicle.x_m``, ``v.arm_joint1_rad_s``, ``tau.vehicle.fx_N``,
+        ``wrench_contact_world.fx_N``, ``e_x.fx_N``); ``attrs["units"]`` maps each column
+        to its unit. The scheme is in `uvms_pin.rollout_table` and docs/api.md."""
+        from uvms_pin.rollout_table import to_dataframe
+
+        return to_dataframe(self)
+
+    def plot(self, kind: str | None = None) -> Figure | dict[str, Figure]:
+        """A matplotlib Figure of this rollout: ``kind`` one of `uvms_pin.viz.figures.KINDS`
+        ("pose", "velocities", "energy", "force", "first_level", "second_level"); without
+        ``kind`` every figure the rollout has data for, as a dict by kind."""
+        from uvms_pin.viz.figures import plot_rollout
+
+        return plot_rollout(self, kind)
 
     # ---- persistence ------------------------------------------------------------------
     def save(self, directory: str | Path) -> Path:

@@ -28,6 +28,7 @@ from uvms_pin.errors import ParameterError, ScenarioError, UvmsPinError
 from uvms_pin.integrators import RK4, Adaptive, Integrator, SemiImplicitEuler
 from uvms_pin.model import UVMS, load_uvms
 from uvms_pin.plant import Plant
+from uvms_pin.progress import ProgressBar, callback_or_none
 from uvms_pin.rollout import Rollout
 from uvms_pin.sensors import NoiseSpec, SensorConfig, SensorSuite
 from uvms_pin.simulate import Progress, SimulationSettings, simulate_closed_loop
@@ -425,12 +426,24 @@ _CONTROLLER_BUILDERS: dict[str, Callable[[_Table, UVMS], ControllerFactory]] = {
 }
 
 
-def simulate(scenario: Scenario, *, progress: Progress | None = None) -> Rollout:
+def simulate(scenario: Scenario, *, progress: bool | Progress | None = True) -> Rollout:
     """Run a scenario: fresh sensors (seeded) and controller, closed loop, rollout.
+
+    ``progress``: True (default) shows a tqdm bar (notebook widget in Jupyter) once the
+    run has lasted `uvms_pin.progress.BAR_DELAY_S` of wall time, so short runs print
+    nothing; False or None: silent; a callable ``(t_s, duration_s)`` is called after
+    every logged sample.
 
     Raises FunnelViolation / SimulationError with the partial rollout attached as
     ``exc.rollout`` (see `simulate_closed_loop`).
     """
+    if progress is True:
+        with ProgressBar(scenario.name, scenario.settings.duration_s) as bar:
+            return _simulate(scenario, bar)
+    return _simulate(scenario, callback_or_none(progress))
+
+
+def _simulate(scenario: Scenario, progress: Progress | None) -> Rollout:
     settings = scenario.settings
     sensors = SensorSuite(
         scenario.uvms.model, scenario.sensor_config, settings.duration_s, settings.seed

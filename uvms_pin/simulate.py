@@ -140,6 +140,7 @@ def simulate_closed_loop(
         versions=package_versions(),
         model_source=uvms.source,
         arm_joint_names=uvms.arm_joint_names,
+        arm_joint_kinds=[_joint_kind(model, name) for name in uvms.arm_joint_names],
         arm_position_lower_rad=model.lowerPositionLimit[7:].tolist(),
         arm_position_upper_rad=model.upperPositionLimit[7:].tolist(),
     )
@@ -258,6 +259,13 @@ def simulate_closed_loop(
         raise
     _finish(rollout, wall_start, settings, "ok", "")
     return rollout
+
+
+def _joint_kind(model, joint_name: str) -> str:
+    """'prismatic' or 'revolute' (names the units of the joint's columns in a table)."""
+    shortname = model.joints[model.getJointId(joint_name)].shortname()
+    prismatic = ("JointModelPX", "JointModelPY", "JointModelPZ", "JointModelPrismatic")
+    return "prismatic" if shortname.startswith(prismatic) else "revolute"
 
 
 def _finish(

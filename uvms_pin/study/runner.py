@@ -70,7 +70,7 @@ def execute_run(base: str, run: Run, rollout_dir: str | None = None) -> dict[str
         scenario = modify_plant(load_scenario(base, run.overrides), run.plant)
         row["net_buoyancy_N"] = scenario.uvms.net_buoyancy_N
         try:
-            rollout = simulate(scenario)
+            rollout = simulate(scenario, progress=False)
         except FunnelViolation as exc:
             rollout = getattr(exc, "rollout", None)
             row.update(

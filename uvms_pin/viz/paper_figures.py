@@ -1,11 +1,19 @@
-"""The paper's three figures (Figs. 3-5) from a rollout of the PPC controller."""
+"""The paper's three figures (Figs. 3-5) from a rollout of the PPC controller.
+
+Each returns the `Figure` when no ``path`` is given, else saves it and returns the path.
+"""
 
 from __future__ import annotations
 
 from pathlib import Path
 
+from matplotlib.figure import Figure
+
 from uvms_pin.rollout import Rollout
 from uvms_pin.viz.plots import new_figure, save_figure
+
+#: The signals Figs. 3-5 need (logged by the PPC controller).
+PPC_SIGNALS = ("force_desired_world_N", "e_x", "rho_x", "e_zeta", "rho_zeta")
 
 FIRST_LEVEL_LABELS = (
     "$e_{f_x}$ [N]",
@@ -27,7 +35,7 @@ def _funnel_axes(ax, t, error, rho, label):
     ax.tick_params(labelsize=7)
 
 
-def plot_force(rollout: Rollout, path: Path) -> Path:
+def plot_force(rollout: Rollout, path: Path | None = None) -> Figure | Path:
     """Fig. 3: desired (green), measured (gray) and true (red) contact force per axis."""
     t = rollout.time_s
     desired = rollout.signals["force_desired_world_N"]
@@ -64,7 +72,7 @@ def plot_force(rollout: Rollout, path: Path) -> Path:
     return save_figure(fig, path)
 
 
-def plot_first_level(rollout: Rollout, path: Path) -> Path:
+def plot_first_level(rollout: Rollout, path: Path | None = None) -> Figure | Path:
     """Fig. 4: the six first-level errors (blue) inside their funnels +-rho_x (red)."""
     t = rollout.time_s
     e, rho = rollout.signals["e_x"], rollout.signals["rho_x"]
@@ -77,7 +85,9 @@ def plot_first_level(rollout: Rollout, path: Path) -> Path:
     return save_figure(fig, path)
 
 
-def plot_second_level(rollout: Rollout, path: Path, names: list[str] | None = None) -> Path:
+def plot_second_level(
+    rollout: Rollout, path: Path | None = None, names: list[str] | None = None
+) -> Figure | Path:
     """Fig. 5: the n second-level velocity errors (blue) inside +-rho_zeta (red)."""
     t = rollout.time_s
     e, rho = rollout.signals["e_zeta"], rollout.signals["rho_zeta"]
@@ -111,8 +121,7 @@ def plot_second_level(rollout: Rollout, path: Path, names: list[str] | None = No
 
 def paper_figures(rollout: Rollout, directory: Path) -> list[Path]:
     """Figs. 3-5 when the rollout carries the PPC signals; nothing otherwise."""
-    needed = ("force_desired_world_N", "e_x", "rho_x", "e_zeta", "rho_zeta")
-    if len(rollout) < 2 or not all(k in rollout.signals for k in needed):
+    if len(rollout) < 2 or not all(k in rollout.signals for k in PPC_SIGNALS):
         return []
     directory = Path(directory)
     return [

@@ -1,4 +1,8 @@
-"""Figures of a rollout (matplotlib, headless Agg backend)."""
+"""Figures of a rollout (matplotlib, headless Agg backend).
+
+Every ``plot_*`` function returns the `Figure` when no ``path`` is given (for notebooks)
+and saves it and returns the path when one is.
+"""
 
 from __future__ import annotations
 
@@ -22,13 +26,16 @@ def _rpy(q: np.ndarray) -> np.ndarray:
     return np.array([pin.rpy.matrixToRpy(pin.Quaternion(row[3:7]).toRotationMatrix()) for row in q])
 
 
-def save_figure(fig: Figure, path: Path) -> Path:
+def save_figure(fig: Figure, path: Path | None) -> Figure | Path:
+    """Lay out ``fig``; save it to ``path`` and return the path, or return the figure."""
     fig.tight_layout()
+    if path is None:
+        return fig
     fig.savefig(path, dpi=120)
     return path
 
 
-def plot_pose(rollout: Rollout, path: Path) -> Path:
+def plot_pose(rollout: Rollout, path: Path | None = None) -> Figure | Path:
     """Vehicle position (world) and roll/pitch/yaw over time."""
     t = rollout.time_s
     fig, (ax_p, ax_o) = new_figure(2, 1, figsize=(8, 6), sharex=True)
@@ -48,7 +55,7 @@ def plot_pose(rollout: Rollout, path: Path) -> Path:
     return save_figure(fig, path)
 
 
-def plot_velocities(rollout: Rollout, path: Path) -> Path:
+def plot_velocities(rollout: Rollout, path: Path | None = None) -> Figure | Path:
     """Body linear and angular velocity of the vehicle and the arm joint rates."""
     t = rollout.time_s
     fig, axes = new_figure(3, 1, figsize=(8, 8), sharex=True)
@@ -69,7 +76,7 @@ def plot_velocities(rollout: Rollout, path: Path) -> Path:
     return save_figure(fig, path)
 
 
-def plot_energy(rollout: Rollout, path: Path) -> Path:
+def plot_energy(rollout: Rollout, path: Path | None = None) -> Figure | Path:
     """Kinetic (added mass included), potential and total energy."""
     t = rollout.time_s
     fig, ax = new_figure(figsize=(8, 4))
