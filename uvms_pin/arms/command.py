@@ -33,6 +33,7 @@ def _cmd_compare_arms(args: argparse.Namespace) -> int:
         trim=trim,
         mount_rpy=tuple(args.mount_rpy),
         ik_starts=args.ik_starts,
+        keep_rollouts=args.keep_rollouts,
     )
     rows = compare_arms(
         args.scenario,
@@ -48,6 +49,8 @@ def _cmd_compare_arms(args: argparse.Namespace) -> int:
         err_text = "" if math.isnan(err) else f"force error RMS {err:.3f} N"
         print(f"{r['arm']:<{width}}  {r['status']:<16} {err_text}")
     print(f"wrote {args.out}/comparison.csv, comparison.md, comparison.png")
+    if args.keep_rollouts:
+        print(f"per arm: {args.out}/<arm>/row.json, rollout, metrics.json and figures")
     return 0
 
 
@@ -88,6 +91,11 @@ def register(subparsers) -> argparse.ArgumentParser:
     )
     parser.add_argument(
         "--ik-starts", type=int, default=24, help="initial-configuration search starts"
+    )
+    parser.add_argument(
+        "--keep-rollouts",
+        action="store_true",
+        help="also write each arm's row, rollout, metrics and figures into OUT/<arm>/",
     )
     parser.add_argument("--list", action="store_true", help="list the arm names available and exit")
     parser.set_defaults(func=_cmd_compare_arms)

@@ -23,6 +23,9 @@ For a scenario (e.g. ``scenarios/realistic_force_tracking.toml``) whose model is
    median of the reference arm's entries.
 6. The run's status is "ok", the exception that stopped it (FunnelViolation,
    SimulationError) or "joint limits" if a joint left its limits during the run.
+7. With ``keep_rollouts``, each arm's row (``row.json``: status, reason, trim) and, when it
+   ran, its rollout, ``metrics.json`` and figures (the paper's funnel figures show which
+   error left its funnel, and when) go to ``OUT/<arm>/``, as ``uvms-pin run`` writes them.
 
 The reference row is the scenario itself, unchanged.
 """
@@ -32,6 +35,7 @@ from __future__ import annotations
 import csv
 import io
 import math
+import sys
 import tempfile
 import time
 import traceback
@@ -50,6 +54,7 @@ from uvms_pin.dynamics import mass_matrix
 from uvms_pin.errors import FunnelViolation, ScenarioError, SimulationError, UvmsPinError
 from uvms_pin.model import UVMS
 from uvms_pin.mount import hull_box, mount_arm_detailed, write_text_atomic
+from uvms_pin.rollout import write_json_atomic
 from uvms_pin.scenario import load_scenario, simulate
 from uvms_pin.trim import TrimSpec
 
@@ -90,6 +95,7 @@ class CompareSettings:
     mount_rpy: tuple[float, float, float] = (math.pi, 0.0, 0.0)
     ik_starts: int = 24
     seed: int = 0
+    keep_rollouts: bool = False
 
 
 def _nan_row(name: str) -> dict:
@@ -146,10 +152,37 @@ def _joint_limit_violation(rollout, uvms: UVMS) -> str:
     )
 
 
-def _run(scenario, row: dict) -> None:
-    """Simulate, fill the metrics and the status into ``row``."""
+class ArmProgress:
+    """Progress of one arm's run as text lines, one per tenth of the simulated duration.
+
+    Picklable (worker processes get one); ``emit`` receives each line.
+    """
+
+    def __init__(self, arm: str, emit: Callable[[str], None]):
+        self.arm = arm
+        self.emit = emit
+        self.start = time.perf_counter()
+        self.next_fraction = 0.1
+
+    def __call__(self, t_s: float, duration_s: float) -> None:
+        fraction = t_s / duration_s if duration_s > 0 else 1.0
+        if fraction + 1e-9 < self.next_fraction:
+            return
+        while self.next_fraction <= fraction + 1e-9:
+            self.next_fraction += 0.1
+        elapsed = time.perf_counter() - self.start
+        self.emit(f"  {self.arm}: t = {t_s:.3g}/{duration_s:g} s ({elapsed:.0f} s)")
+
+
+def print_to_stderr(line: str) -> None:
+    """Default line sink of worker processes (a module function: picklable)."""
+    print(line, file=sys.stderr, flush=True)
+
+
+def _run(scenario, row: dict, keep_dir: Path | None = None, progress=None) -> None:
+    """Simulate, fill the metrics and the status into ``row``; keep the outputs if asked."""
     try:
-        rollout = simulate(scenario)
+        rollout = simulate(scenario, progress=progress)
         status, reason = "ok", ""
     except FunnelViolation as exc:
         rollout, status, reason = exc.rollout, "FunnelViolation", str(exc)
@@ -173,6 +206,22 @@ def _run(scenario, row: dict) -> None:
     ):
         row[key] = float(metrics.get(key, math.nan))
     row["status"], row["reason"] = status, reason
+    if keep_dir is not None:
+        from uvms_pin.cli import write_outputs
+
+        write_outputs(rollout, keep_dir)
+
+
+def _keep_dir(out_dir: str, arm: str, settings: CompareSettings) -> Path | None:
+    return Path(out_dir) / arm if settings.keep_rollouts else None
+
+
+def _write_row(row: dict, keep_dir: Path | None) -> None:
+    if keep_dir is not None:
+        keep_dir.mkdir(parents=True, exist_ok=True)
+        # NaN (a metric the arm never got) as JSON null
+        clean = {k: None if isinstance(v, float) and math.isnan(v) else v for k, v in row.items()}
+        write_json_atomic(keep_dir / "row.json", clean)
 
 
 def _ee_rpy_error_deg(uvms: UVMS, q: np.ndarray, target: pin.SE3) -> float:
@@ -190,106 +239,19 @@ def run_one_arm(
     mount_xyz: tuple[float, float, float],
     hull: tuple[np.ndarray, np.ndarray] | None,
     settings: CompareSettings,
+    emit: Callable[[str], None] | None = None,
 ) -> dict:
-    """One row of the comparison (never raises for a per-arm failure)."""
+    """One row of the comparison (never raises for a per-arm failure).
+
+    ``emit`` receives progress lines while the arm's run goes (none if None).
+    """
     entry = None if name == REFERENCE else resolve_arm(name)
     row = _nan_row(name if entry is None else entry.name)
-    overrides = {} if settings.duration_s is None else {"scenario.duration_s": settings.duration_s}
-    vehicle_mass = _vehicle_mass(Path(vehicle_urdf))
+    keep_dir = _keep_dir(out_dir, row["arm"], settings)
+    progress = ArmProgress(row["arm"], emit) if emit is not None else False
     try:
-        base = load_scenario(scenario_path, overrides)
-        reference = base.uvms
-        data = reference.model.createData()
-        pin.framesForwardKinematics(reference.model, data, base.q0)
-        target = data.oMf[reference.ee_frame_id].copy()
-        if name == REFERENCE:
-            row.update(
-                n_joints=reference.n_arm_joints,
-                arm_mass_kg=reference.mass_kg - vehicle_mass,
-                system_mass_kg=reference.mass_kg,
-                net_buoyancy_before_N=reference.net_buoyancy_N,
-                net_buoyancy_after_N=reference.net_buoyancy_N,
-                foam_volume_L=0.0,
-                ballast_kg=0.0,
-                initial_orientation_error_deg=0.0,
-                derived_hydro_bodies=sum(b.params.derived for b in reference.hydro_bodies),
-            )
-            _run(base, row)
-            row["reason"] = ("the scenario as it is; " + row["reason"]).rstrip("; ")
-            return row
-        mount_kw = dict(
-            ee_link=entry.ee_link,
-            arm_base_link=entry.arm_base_link,
-            water_density_kg_m3=reference.water_density_kg_m3,
-            allow_dry_links=True,
-        )
-        pose = (np.asarray(mount_xyz), np.asarray(settings.mount_rpy))
-        mounted = mount_arm_detailed(vehicle_urdf, entry.urdf, pose, **mount_kw)
-        uvms = mounted.uvms
-        row.update(
-            n_joints=uvms.n_arm_joints,
-            arm_mass_kg=uvms.mass_kg - vehicle_mass,
-            system_mass_kg=uvms.mass_kg,
-            net_buoyancy_before_N=uvms.net_buoyancy_N,
-            net_buoyancy_after_N=uvms.net_buoyancy_N,
-            foam_volume_L=0.0,
-            ballast_kg=0.0,
-            derived_hydro_bodies=len(mounted.derived_bodies),
-            dry_links=" ".join(mounted.dry_links),
-        )
-        ik = solve_initial_configuration(
-            uvms, base.q0[:7], target, hull=hull, starts=settings.ik_starts, seed=settings.seed
-        )
-        row["initial_orientation_error_deg"] = math.degrees(ik.orientation_error_rad)
-        if not ik.reachable:
-            row.update(status="unreachable", reason=ik.reason)
-            return row
-        q_arm = ik.q[7:]
-        model_path = Path(out_dir) / "models" / f"{entry.name}.urdf"
-        if settings.trim is not None:
-            mounted = mount_arm_detailed(
-                vehicle_urdf,
-                entry.urdf,
-                pose,
-                trim=settings.trim,
-                trim_joint_positions=q_arm,
-                save_urdf=model_path,
-                **mount_kw,
-            )
-            report = mounted.trim
-            row.update(
-                net_buoyancy_after_N=mounted.uvms.net_buoyancy_N,
-                system_mass_kg=mounted.uvms.mass_kg,
-                foam_volume_L=report.foam_volume_m3 * 1e3,
-                ballast_kg=report.ballast_mass_kg,
-                bg_cm=report.bg_after_m * 100.0,
-            )
-            trim_notes = "; ".join(report.notes)
-        else:
-            trim_notes = ""
-            write_text_atomic(model_path, mounted.urdf_text)
-        uvms = mounted.uvms
-        scenario_overrides = dict(overrides)
-        scenario_overrides.update(
-            {
-                "scenario.model": str(model_path.resolve()),
-                "initial.joint_positions_rad": q_arm.tolist(),
-                "initial.velocity": [0.0] * uvms.nv,
-            }
-        )
-        scenario_overrides.update(
-            controller_overrides(base.raw.get("controller", {}), reference, base.q0, uvms, ik.q)
-        )
-        scenario = load_scenario(scenario_path, scenario_overrides)
-        _run(scenario, row)
-        if ik.orientation_error_rad > 1e-3:
-            note = (
-                f"initial tool orientation {math.degrees(ik.orientation_error_rad):.1f} deg "
-                "from the paper's (the arm cannot match it at the contact point)"
-            )
-            row["reason"] = f"{note}; {row['reason']}" if row["reason"] else note
-        if trim_notes:
-            row["reason"] = f"{row['reason']}; trim: {trim_notes}".lstrip("; ")
+        _fill_row(name, entry, row, scenario_path, out_dir, vehicle_urdf, mount_xyz, hull,
+                  settings, keep_dir=keep_dir, progress=progress)  # fmt: skip
     except (UvmsPinError, ScenarioError) as exc:
         row.update(status="model error", reason=f"{type(exc).__name__}: {exc}")
     except Exception as exc:  # a per-arm bug must not lose the other rows
@@ -297,7 +259,110 @@ def run_one_arm(
             status="error",
             reason=f"{type(exc).__name__}: {exc} | {traceback.format_exc(limit=2)!r}",
         )
+    _write_row(row, keep_dir)
     return row
+
+
+def _fill_row(
+    name, entry, row, scenario_path, out_dir, vehicle_urdf, mount_xyz, hull, settings,
+    *, keep_dir, progress,
+) -> None:  # fmt: skip
+    """Mount, solve, trim and run one arm, filling ``row`` (raises on a model error)."""
+    overrides = {} if settings.duration_s is None else {"scenario.duration_s": settings.duration_s}
+    vehicle_mass = _vehicle_mass(Path(vehicle_urdf))
+    base = load_scenario(scenario_path, overrides)
+    reference = base.uvms
+    data = reference.model.createData()
+    pin.framesForwardKinematics(reference.model, data, base.q0)
+    target = data.oMf[reference.ee_frame_id].copy()
+    if name == REFERENCE:
+        row.update(
+            n_joints=reference.n_arm_joints,
+            arm_mass_kg=reference.mass_kg - vehicle_mass,
+            system_mass_kg=reference.mass_kg,
+            net_buoyancy_before_N=reference.net_buoyancy_N,
+            net_buoyancy_after_N=reference.net_buoyancy_N,
+            foam_volume_L=0.0,
+            ballast_kg=0.0,
+            initial_orientation_error_deg=0.0,
+            derived_hydro_bodies=sum(b.params.derived for b in reference.hydro_bodies),
+        )
+        _run(base, row, keep_dir, progress)
+        row["reason"] = ("the scenario as it is; " + row["reason"]).rstrip("; ")
+        return
+    mount_kw = dict(
+        ee_link=entry.ee_link,
+        arm_base_link=entry.arm_base_link,
+        water_density_kg_m3=reference.water_density_kg_m3,
+        allow_dry_links=True,
+    )
+    pose = (np.asarray(mount_xyz), np.asarray(settings.mount_rpy))
+    mounted = mount_arm_detailed(vehicle_urdf, entry.urdf, pose, **mount_kw)
+    uvms = mounted.uvms
+    row.update(
+        n_joints=uvms.n_arm_joints,
+        arm_mass_kg=uvms.mass_kg - vehicle_mass,
+        system_mass_kg=uvms.mass_kg,
+        net_buoyancy_before_N=uvms.net_buoyancy_N,
+        net_buoyancy_after_N=uvms.net_buoyancy_N,
+        foam_volume_L=0.0,
+        ballast_kg=0.0,
+        derived_hydro_bodies=len(mounted.derived_bodies),
+        dry_links=" ".join(mounted.dry_links),
+    )
+    ik = solve_initial_configuration(
+        uvms, base.q0[:7], target, hull=hull, starts=settings.ik_starts, seed=settings.seed
+    )
+    row["initial_orientation_error_deg"] = math.degrees(ik.orientation_error_rad)
+    if not ik.reachable:
+        row.update(status="unreachable", reason=ik.reason)
+        return
+    q_arm = ik.q[7:]
+    model_path = Path(out_dir) / "models" / f"{entry.name}.urdf"
+    if settings.trim is not None:
+        mounted = mount_arm_detailed(
+            vehicle_urdf,
+            entry.urdf,
+            pose,
+            trim=settings.trim,
+            trim_joint_positions=q_arm,
+            save_urdf=model_path,
+            **mount_kw,
+        )
+        report = mounted.trim
+        row.update(
+            net_buoyancy_after_N=mounted.uvms.net_buoyancy_N,
+            system_mass_kg=mounted.uvms.mass_kg,
+            foam_volume_L=report.foam_volume_m3 * 1e3,
+            ballast_kg=report.ballast_mass_kg,
+            bg_cm=report.bg_after_m * 100.0,
+        )
+        trim_notes = "; ".join(report.notes)
+    else:
+        trim_notes = ""
+        write_text_atomic(model_path, mounted.urdf_text)
+    uvms = mounted.uvms
+    scenario_overrides = dict(overrides)
+    scenario_overrides.update(
+        {
+            "scenario.model": str(model_path.resolve()),
+            "initial.joint_positions_rad": q_arm.tolist(),
+            "initial.velocity": [0.0] * uvms.nv,
+        }
+    )
+    scenario_overrides.update(
+        controller_overrides(base.raw.get("controller", {}), reference, base.q0, uvms, ik.q)
+    )
+    scenario = load_scenario(scenario_path, scenario_overrides)
+    _run(scenario, row, keep_dir, progress)
+    if ik.orientation_error_rad > 1e-3:
+        note = (
+            f"initial tool orientation {math.degrees(ik.orientation_error_rad):.1f} deg "
+            "from the paper's (the arm cannot match it at the contact point)"
+        )
+        row["reason"] = f"{note}; {row['reason']}" if row["reason"] else note
+    if trim_notes:
+        row["reason"] = f"{row['reason']}; trim: {trim_notes}".lstrip("; ")
 
 
 def compare_arms(
@@ -314,6 +379,8 @@ def compare_arms(
     ``arms``: "reference" (the scenario as it is), catalogue names, URDF paths or
     :class:`~uvms_pin.arms.catalog.ArmEntry` objects (a user arm with its ``ee_link``).
     Returns the rows (dicts keyed by :data:`COLUMNS`), in the order of ``arms``.
+    ``progress`` receives a line when an arm starts, every tenth of its run and when it is
+    done (from worker processes, with ``jobs > 1``, the lines during a run go to stderr).
     """
     scenario_path = Path(scenario_path)
     out = Path(out_dir)
@@ -341,15 +408,19 @@ def compare_arms(
         rows: list[dict] = []
         start = time.perf_counter()
         if jobs > 1 and len(arms) > 1:
+            emit = print_to_stderr if progress else None
             with ProcessPoolExecutor(max_workers=jobs) as pool:
-                futures = [pool.submit(run_one_arm, *a) for a in args]
+                futures = [pool.submit(run_one_arm, *a, emit) for a in args]
                 for future in futures:
                     rows.append(future.result())
                     if progress:
                         progress(_progress_line(rows[-1], start))
         else:
             for a in args:
-                rows.append(run_one_arm(*a))
+                if progress:
+                    label = a[0].name if isinstance(a[0], ArmEntry) else a[0]
+                    progress(f"{label}: running ({time.perf_counter() - start:.0f} s elapsed)")
+                rows.append(run_one_arm(*a, progress))
                 if progress:
                     progress(_progress_line(rows[-1], start))
     write_comparison(rows, out, scenario=str(scenario_path), settings=settings)
