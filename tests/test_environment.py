@@ -29,7 +29,7 @@ def test_spring_anchors_at_attach_and_gives_k_times_displacement():
     wrench = spring.wrench_on_environment_world(p, np.zeros(3))
     np.testing.assert_allclose(wrench[:3], K * (p - p0), rtol=1e-15)
     np.testing.assert_array_equal(wrench[3:], np.zeros(3))  # a point contact: no torque
-    # pushing along +x raises f_x (DESIGN.md section 7): K positive definite
+    # pushing along +x raises f_x (docs/controller.md, errata): K positive definite
     assert spring.wrench_on_environment_world(p0 + np.array([0.01, 0, 0]), np.zeros(3))[0] > 0
 
 

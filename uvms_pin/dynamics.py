@@ -1,4 +1,4 @@
-"""Underwater dynamics of a UVMS (DESIGN.md section 5, after Schjolberg & Fossen 1994).
+"""Underwater dynamics of a UVMS (docs/physics.md, after Schjolberg & Fossen 1994).
 
     M(q) zeta_dot + h(q, zeta) = tau + tau_ext
 

@@ -1,7 +1,7 @@
 """What the robot touches and what pushes it: compliant contact and disturbances.
 
 Contact models return lambda, the wrench the end-effector exerts ON the environment
-(DESIGN.md section 5), at the end-effector point in world-aligned axes; the robot receives
+(docs/physics.md), at the end-effector point in world-aligned axes; the robot receives
 -lambda through the contact-point Jacobian. The controller never sees these objects.
 """
 

@@ -1,7 +1,7 @@
 """URDF -> UVMS: the static model (Pinocchio model, per-body hydrodynamics, frames).
 
 Pinocchio builds the rigid multibody with a free-flyer root and merges links attached by
-fixed joints into their parent joint's body. The hydrodynamic extension (DESIGN.md section 4)
+fixed joints into their parent joint's body. The hydrodynamic extension (docs/physics.md)
 is read here from the same file; each link's coefficients become a `HydroBody` attached to
 the Pinocchio joint that carries the link, with the link's placement in that joint's frame,
 so nothing is approximated when links are merged.

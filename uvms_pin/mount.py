@@ -1,4 +1,4 @@
-"""Mount any arm URDF on a vehicle URDF: one UVMS from two files (DESIGN.md section 9).
+"""Mount any arm URDF on a vehicle URDF: one UVMS from two files (docs/api.md).
 
 The two files are merged into one URDF, written to a temporary directory and loaded with
 :func:`uvms_pin.model.load_uvms`, so the hydrodynamic extension, the derivation of missing

@@ -81,7 +81,7 @@ class Plant:
         tau: np.ndarray,
         contact_world: np.ndarray | None = None,
     ) -> np.ndarray:
-        """zeta_dot of  M zeta_dot + h + J_c^T lambda + delta = tau  (DESIGN.md section 5)."""
+        """zeta_dot of  M zeta_dot + h + J_c^T lambda + delta = tau  (docs/physics.md)."""
         model = self.uvms.model
         tau_ext = np.zeros(model.nv)
         if self.contact is not None:

@@ -1,7 +1,7 @@
 """Hydrodynamic coefficients of a link whose collision geometry is a mesh.
 
-A mesh is reduced to two things (DESIGN.md section 4, "a mesh through its bounding primitive
-or volume"):
+A mesh is reduced to two things (docs/physics.md, "coefficients derived from the
+collision geometry"):
 
 - its **volume and centre of buoyancy**: the enclosed volume and centroid of the mesh if it is
   watertight, else of its convex hull (an upper estimate: a hull fills the concave parts);

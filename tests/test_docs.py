@@ -1,0 +1,127 @@
+"""The repository documents itself: docs/ covers every scenario key, and nothing points
+outside the repository."""
+
+from __future__ import annotations
+
+import re
+from pathlib import Path
+
+import pytest
+from conftest import ROOT
+
+from uvms_pin import scenario as scenario_module
+from uvms_pin.scenario import load_scenario
+
+DOCS = ROOT / "docs"
+SCENARIOS = ROOT / "scenarios"
+
+# variants that make the reader visit every branch: both contact models, a fixed-step and
+# an adaptive integrator, no controller and the PPC with every optional key asked for
+_VARIANTS = [
+    ("paper_force_tracking.toml", {}),
+    ("realistic_force_tracking.toml", {}),
+    ("passive_current.toml", {}),
+    (
+        "passive_still_water.toml",
+        {
+            "environment": {"type": "plane", "stiffness_N_m": 100.0},
+            "controller": {"type": "none"},
+            "control": {"period_s": 0.002},
+            "integrator.method": "semi_implicit_euler",
+        },
+    ),
+]
+
+_READERS = ("number", "optional_number", "integer", "string", "vector", "table", "has", "pop_raw")
+
+
+def scenario_keys_read() -> set[str]:
+    """Every dotted key the scenario reader asks for while loading the variants
+    (``actuation.thruster[i].name`` for entries of an array of tables)."""
+    seen: set[str] = set()
+    table_class = scenario_module._Table
+    originals = {name: getattr(table_class, name) for name in _READERS}
+
+    def recording(name):
+        original = originals[name]
+
+        def method(self, key, *args, **kwargs):
+            where = re.sub(r"\[\d+\]", "[i]", self._where)
+            seen.add(f"{where}.{key}" if where else key)
+            return original(self, key, *args, **kwargs)
+
+        return method
+
+    with pytest.MonkeyPatch.context() as patch:
+        for name in _READERS:
+            patch.setattr(table_class, name, recording(name))
+        for file, overrides in _VARIANTS:
+            load_scenario(SCENARIOS / file, overrides)  # a dict value replaces a table
+    return seen
+
+
+def _documented_rows(text: str) -> set[str]:
+    """Keys in the first column of the Markdown tables: ``| `key` | ...``."""
+    return set(re.findall(r"^\| `([\w.\[\]]+)` \|", text, flags=re.MULTILINE))
+
+
+def test_every_scenario_key_the_reader_accepts_is_documented():
+    text = (DOCS / "scenarios.md").read_text()
+    keys = scenario_keys_read()
+    assert len(keys) > 60  # the variants reach every table and key
+    missing = sorted(k for k in keys if f"`{k}`" not in text and f"`[{k}]`" not in text)
+    assert not missing, f"docs/scenarios.md does not document: {missing}"
+
+
+def test_scenarios_doc_lists_no_key_the_reader_does_not_know():
+    rows = _documented_rows((DOCS / "scenarios.md").read_text())
+    assert rows, "no key table found in docs/scenarios.md"
+    unknown = sorted(rows - scenario_keys_read())
+    assert not unknown, f"docs/scenarios.md documents keys the reader never reads: {unknown}"
+
+
+def test_studies_doc_names_every_factor_distribution_and_mode():
+    from uvms_pin.study.spec import APPLY_MODES, DISTRIBUTIONS, PLANT_FACTORS, PLANT_PREFIX
+
+    text = (DOCS / "studies.md").read_text()
+    names = [PLANT_PREFIX + f for f in PLANT_FACTORS] + list(DISTRIBUTIONS) + list(APPLY_MODES)
+    assert not [n for n in names if f"`{n}`" not in text and f'"{n}"' not in text]
+
+
+# ---- the repository is self-contained --------------------------------------------------
+
+# built from pieces so that this file does not match itself
+_OUTSIDE = re.compile("|".join(re.escape(p) for p in ("../" + "shared", "DESIGN" + ".md", "/work/" + "shared")))  # fmt: skip
+_TEXT_SUFFIXES = {".md", ".py", ".toml", ".ipynb", ".urdf", ".txt", ".cfg", ".yml", ".yaml"}
+
+
+def _repository_text_files() -> list[Path]:
+    skip = {".git", ".venv", "out", "build", "node_modules", "__pycache__"}
+    files = []
+    for path in ROOT.rglob("*"):
+        parts = set(path.relative_to(ROOT).parts)
+        if path.is_file() and path.suffix in _TEXT_SUFFIXES and not parts & skip:
+            if not any(p.endswith(".egg-info") for p in parts):
+                files.append(path)
+    files.append(ROOT / "Makefile")
+    return files
+
+
+def test_nothing_points_to_notes_outside_the_repository():
+    hits = []
+    for path in _repository_text_files():
+        for number, line in enumerate(path.read_text(errors="replace").splitlines(), 1):
+            if _OUTSIDE.search(line):
+                hits.append(f"{path.relative_to(ROOT)}:{number}: {line.strip()}")
+    assert not hits, "point to docs/ instead:\n" + "\n".join(hits)
+
+
+def test_relative_links_in_the_docs_resolve():
+    broken = []
+    for doc in [ROOT / "README.md", *sorted(DOCS.glob("*.md"))]:
+        for target in re.findall(r"\]\(([^)#\s]+)(?:#[^)]*)?\)", doc.read_text()):
+            if "://" in target:
+                continue
+            if not (doc.parent / target).exists():
+                broken.append(f"{doc.relative_to(ROOT)} -> {target}")
+    assert not broken, broken
