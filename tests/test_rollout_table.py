@@ -8,7 +8,7 @@ from conftest import ROOT
 
 import uvms_pin as up
 from uvms_pin.rollout import Rollout
-from uvms_pin.rollout_table import column_layout
+from uvms_pin.rollout_table import UNIT_TEXT, column_layout
 
 JOINTS = ["shoulder", "slide", "wrist"]
 
@@ -65,10 +65,13 @@ def test_every_column_has_a_unit_matching_its_name_and_nothing_is_lost():
     widths = sum(getattr(r, name).reshape(len(r), -1).shape[1] for name in Rollout._BASE[1:])
     widths += sum(a.shape[1] for a in r.signals.values())
     assert df.shape == (len(r), widths)
+    suffix = {text: code for code, text in UNIT_TEXT.items()}
     for column, unit in units.items():
         if unit:
-            assert column.endswith(f"_{unit}"), column
+            assert column.endswith(f"_{suffix.get(unit, unit)}"), column
     assert units["q.vehicle.qx"] == "" and units["e_x.fx_N"] == "N"
+    assert units["v.vehicle.vx_m_s"] == "m/s" and units["tau.vehicle.mz_Nm"] == "N m"
+    assert units["v.wrist_rad_s"] == "rad/s" and units["q.slide_m"] == "m"
     assert df.attrs["metadata"]["scenario"] == "x"
 
 

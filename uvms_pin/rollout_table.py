@@ -15,7 +15,8 @@ Column names are ``<array>.<component>_<unit>``:
   dimensionless columns (quaternion, normalized errors) have none.
 
 The time ``time_s`` is the index. ``DataFrame.attrs["units"]`` maps every column to its
-unit ("" when dimensionless) and ``attrs["metadata"]`` holds the rollout's metadata.
+unit as text ("m/s", "N m"; "" when dimensionless) and ``attrs["metadata"]`` holds the
+rollout's metadata.
 """
 
 from __future__ import annotations
@@ -94,12 +95,16 @@ def _labels(
     return out
 
 
+#: unit suffix in a column name -> the unit as text in ``attrs["units"]``
+UNIT_TEXT = {"m_s": "m/s", "rad_s": "rad/s", "Nm": "N m"}
+
+
 def _column_name(label: str, unit: str) -> str:
     return f"{label}_{unit}" if unit else label
 
 
 def column_layout(rollout: Rollout) -> list[tuple[str, str, np.ndarray]]:
-    """(column name, unit, values) for every column of `to_dataframe`, in order."""
+    """(column name, unit suffix, values) for every column of `to_dataframe`, in order."""
     blocks: list[tuple[list[tuple[str, str]], np.ndarray]] = [
         (_labels(rollout, "q", _POSE, "configuration", rollout.q.shape[1]), rollout.q),
         (_labels(rollout, "v", _TWIST, "velocity", rollout.v.shape[1]), rollout.v),
@@ -135,6 +140,6 @@ def to_dataframe(rollout: Rollout) -> pd.DataFrame:
         {name: values for name, _, values in layout},
         index=pd.Index(rollout.time_s, name="time_s"),
     )
-    frame.attrs["units"] = {name: unit for name, unit, _ in layout}
+    frame.attrs["units"] = {name: UNIT_TEXT.get(unit, unit) for name, unit, _ in layout}
     frame.attrs["metadata"] = dict(rollout.metadata)
     return frame
