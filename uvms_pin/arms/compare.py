@@ -231,6 +231,21 @@ def _ee_rpy_error_deg(uvms: UVMS, q: np.ndarray, target: pin.SE3) -> float:
     return math.degrees(float(np.linalg.norm(pin.log3(rot.T @ target.rotation))))
 
 
+@dataclass(frozen=True)
+class _ArmJob:
+    """What one arm's run needs besides its row (``entry`` None: the reference arm)."""
+
+    entry: ArmEntry | None
+    scenario_path: str
+    out_dir: str
+    vehicle_urdf: str
+    mount_xyz: tuple[float, float, float]
+    hull: tuple[np.ndarray, np.ndarray] | None
+    settings: CompareSettings
+    keep_dir: Path | None
+    progress: ArmProgress | bool
+
+
 def run_one_arm(
     name: str | ArmEntry,
     scenario_path: str,
@@ -249,9 +264,11 @@ def run_one_arm(
     row = _nan_row(name if entry is None else entry.name)
     keep_dir = _keep_dir(out_dir, row["arm"], settings)
     progress = ArmProgress(row["arm"], emit) if emit is not None else False
+    job = _ArmJob(
+        entry, scenario_path, out_dir, vehicle_urdf, mount_xyz, hull, settings, keep_dir, progress
+    )
     try:
-        _fill_row(name, entry, row, scenario_path, out_dir, vehicle_urdf, mount_xyz, hull,
-                  settings, keep_dir=keep_dir, progress=progress)  # fmt: skip
+        _fill_row(row, job)
     except (UvmsPinError, ScenarioError) as exc:
         row.update(status="model error", reason=f"{type(exc).__name__}: {exc}")
     except Exception as exc:  # a per-arm bug must not lose the other rows
@@ -263,19 +280,17 @@ def run_one_arm(
     return row
 
 
-def _fill_row(
-    name, entry, row, scenario_path, out_dir, vehicle_urdf, mount_xyz, hull, settings,
-    *, keep_dir, progress,
-) -> None:  # fmt: skip
+def _fill_row(row: dict, job: _ArmJob) -> None:
     """Mount, solve, trim and run one arm, filling ``row`` (raises on a model error)."""
+    entry, settings = job.entry, job.settings
     overrides = {} if settings.duration_s is None else {"scenario.duration_s": settings.duration_s}
-    vehicle_mass = _vehicle_mass(Path(vehicle_urdf))
-    base = load_scenario(scenario_path, overrides)
+    vehicle_mass = _vehicle_mass(Path(job.vehicle_urdf))
+    base = load_scenario(job.scenario_path, overrides)
     reference = base.uvms
     data = reference.model.createData()
     pin.framesForwardKinematics(reference.model, data, base.q0)
     target = data.oMf[reference.ee_frame_id].copy()
-    if name == REFERENCE:
+    if entry is None:
         row.update(
             n_joints=reference.n_arm_joints,
             arm_mass_kg=reference.mass_kg - vehicle_mass,
@@ -287,7 +302,7 @@ def _fill_row(
             initial_orientation_error_deg=0.0,
             derived_hydro_bodies=sum(b.params.derived for b in reference.hydro_bodies),
         )
-        _run(base, row, keep_dir, progress)
+        _run(base, row, job.keep_dir, job.progress)
         row["reason"] = ("the scenario as it is; " + row["reason"]).rstrip("; ")
         return
     mount_kw = dict(
@@ -296,8 +311,8 @@ def _fill_row(
         water_density_kg_m3=reference.water_density_kg_m3,
         allow_dry_links=True,
     )
-    pose = (np.asarray(mount_xyz), np.asarray(settings.mount_rpy))
-    mounted = mount_arm_detailed(vehicle_urdf, entry.urdf, pose, **mount_kw)
+    pose = (np.asarray(job.mount_xyz), np.asarray(settings.mount_rpy))
+    mounted = mount_arm_detailed(job.vehicle_urdf, entry.urdf, pose, **mount_kw)
     uvms = mounted.uvms
     row.update(
         n_joints=uvms.n_arm_joints,
@@ -311,17 +326,17 @@ def _fill_row(
         dry_links=" ".join(mounted.dry_links),
     )
     ik = solve_initial_configuration(
-        uvms, base.q0[:7], target, hull=hull, starts=settings.ik_starts, seed=settings.seed
+        uvms, base.q0[:7], target, hull=job.hull, starts=settings.ik_starts, seed=settings.seed
     )
     row["initial_orientation_error_deg"] = math.degrees(ik.orientation_error_rad)
     if not ik.reachable:
         row.update(status="unreachable", reason=ik.reason)
         return
     q_arm = ik.q[7:]
-    model_path = Path(out_dir) / "models" / f"{entry.name}.urdf"
+    model_path = Path(job.out_dir) / "models" / f"{entry.name}.urdf"
     if settings.trim is not None:
         mounted = mount_arm_detailed(
-            vehicle_urdf,
+            job.vehicle_urdf,
             entry.urdf,
             pose,
             trim=settings.trim,
@@ -353,8 +368,8 @@ def _fill_row(
     scenario_overrides.update(
         controller_overrides(base.raw.get("controller", {}), reference, base.q0, uvms, ik.q)
     )
-    scenario = load_scenario(scenario_path, scenario_overrides)
-    _run(scenario, row, keep_dir, progress)
+    scenario = load_scenario(job.scenario_path, scenario_overrides)
+    _run(scenario, row, job.keep_dir, job.progress)
     if ik.orientation_error_rad > 1e-3:
         note = (
             f"initial tool orientation {math.degrees(ik.orientation_error_rad):.1f} deg "
