@@ -116,12 +116,22 @@ def test_nothing_points_to_notes_outside_the_repository():
     assert not hits, "point to docs/ instead:\n" + "\n".join(hits)
 
 
+def _anchors(markdown: Path) -> set[str]:
+    """GitHub's heading anchors: lower case, punctuation dropped, spaces -> hyphens."""
+    headings = re.findall(r"^#+ (.+)$", markdown.read_text(), flags=re.MULTILINE)
+    return {re.sub(r"[^\w\- ]", "", h.strip().lower()).replace(" ", "-") for h in headings}
+
+
 def test_relative_links_in_the_docs_resolve():
     broken = []
     for doc in [ROOT / "README.md", *sorted(DOCS.glob("*.md"))]:
-        for target in re.findall(r"\]\(([^)#\s]+)(?:#[^)]*)?\)", doc.read_text()):
+        links = re.findall(r"\]\(([^)#\s]+)(?:#([^)]*))?\)", doc.read_text())
+        for target, anchor in links:
+            path = doc.parent / target
             if "://" in target:
                 continue
-            if not (doc.parent / target).exists():
+            if not path.exists():
                 broken.append(f"{doc.relative_to(ROOT)} -> {target}")
+            elif anchor and anchor not in _anchors(path):
+                broken.append(f"{doc.relative_to(ROOT)} -> {target}#{anchor}")
     assert not broken, broken
