@@ -46,7 +46,7 @@ from pathlib import Path
 import numpy as np
 import pinocchio as pin
 
-from uvms_pin.arms.catalog import CATALOG, ArmEntry
+from uvms_pin.arms.catalog import ArmEntry, resolve_arm
 from uvms_pin.errors import ModelError, ParameterError
 from uvms_pin.model import DEFAULT_WATER_DENSITY_KG_M3, UVMS, load_uvms, read_urdf_root
 from uvms_pin.resources import find_model, resolve_resource
@@ -567,9 +567,9 @@ def _moving_above(tree: _Tree, joint: str) -> bool:
 def _catalog_entry(arm: str | Path | ArmEntry) -> ArmEntry | None:
     """The catalogue entry ``arm`` names (an ArmEntry, or a name that is not a file)."""
     if isinstance(arm, ArmEntry):
-        return arm
-    if isinstance(arm, str) and arm in CATALOG and not Path(arm).is_file():
-        return CATALOG[arm]
+        return resolve_arm(arm)
+    if isinstance(arm, str) and not Path(arm).is_file() and Path(arm).suffix.lower() != ".urdf":
+        return resolve_arm(arm)  # a catalogue name, else a ParameterError listing them
     return None
 
 
