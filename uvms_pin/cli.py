@@ -181,8 +181,8 @@ def build_parser() -> argparse.ArgumentParser:
         default=[],
         metavar="KEY=VALUE",
         help="override a scenario entry (repeatable): a dotted key, optionally [i]-indexed, "
-        "and a TOML value, e.g. --set environment.stiffness_N_m=[20,20,20] "
-        "--set initial.joint_positions_rad[3]=0.5",
+        "and a TOML value, e.g. --set 'environment.stiffness_N_m=[20,20,20]' "
+        "--set 'initial.joint_positions_rad[3]=0.5'",
     )
     run.add_argument(
         "--html", action="store_true", help="also write replay.html (self-contained, offline)"
