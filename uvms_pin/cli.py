@@ -10,6 +10,8 @@ from pathlib import Path
 from uvms_pin.arms.command import register as register_compare_arms
 from uvms_pin.errors import FunnelViolation, SimulationError, UvmsPinError
 from uvms_pin.model import load_uvms
+from uvms_pin.overrides import parse_assignment
+from uvms_pin.resources import find_model
 from uvms_pin.rollout import Rollout, write_json_atomic
 from uvms_pin.scenario import load_scenario, simulate
 from uvms_pin.study.command import register as register_study_commands
@@ -87,7 +89,8 @@ def _write_replay(rollout: Rollout, path: Path, **kw) -> Path:
 
 def _cmd_run(args: argparse.Namespace) -> int:
     _check_view_options(args)
-    scenario = load_scenario(args.scenario)
+    overrides = dict(parse_assignment(text) for text in args.set)
+    scenario = load_scenario(args.scenario, overrides)
     out = Path(args.out)
     progress = None if args.quiet else _ProgressLine(scenario.name)
     status = 0
@@ -157,7 +160,8 @@ def _add_view_options(parser: argparse.ArgumentParser) -> None:
 
 
 def _cmd_info(args: argparse.Namespace) -> int:
-    uvms = load_uvms(args.urdf, water_density_kg_m3=args.water_density)
+    path = find_model(args.urdf) or args.urdf  # a file, else a shipped model name
+    uvms = load_uvms(path, water_density_kg_m3=args.water_density)
     print(model_summary(uvms))
     return 0
 
@@ -171,6 +175,15 @@ def build_parser() -> argparse.ArgumentParser:
     run.add_argument("scenario", help="scenario TOML file")
     run.add_argument("--out", required=True, help="output directory")
     run.add_argument("--quiet", action="store_true", help="no progress line")
+    run.add_argument(
+        "--set",
+        action="append",
+        default=[],
+        metavar="KEY=VALUE",
+        help="override a scenario entry (repeatable): a dotted key, optionally [i]-indexed, "
+        "and a TOML value, e.g. --set 'environment.stiffness_N_m=[20,20,20]' "
+        "--set 'initial.joint_positions_rad[3]=0.5'",
+    )
     run.add_argument(
         "--html", action="store_true", help="also write replay.html (self-contained, offline)"
     )
@@ -187,7 +200,9 @@ def build_parser() -> argparse.ArgumentParser:
     _add_view_options(replay)
     replay.set_defaults(func=_cmd_replay)
     info = sub.add_parser("info", help="print a summary of a UVMS URDF")
-    info.add_argument("urdf", help="URDF file with the hydrodynamic extension")
+    info.add_argument(
+        "urdf", help="URDF file with the hydrodynamic extension, or a shipped model name"
+    )
     info.add_argument(
         "--water-density", type=float, default=1025.0, help="kg/m^3 (default: sea water)"
     )

@@ -26,6 +26,8 @@ from uvms_pin.hydro.params import HydroParams
 from uvms_pin.resources import package_search_path, resolve_resource
 
 DEFAULT_WATER_DENSITY_KG_M3 = 1025.0  # sea water; a parameter of load_uvms, never hidden
+DEFAULT_EE_FRAME = "ee"
+DEFAULT_SENSOR_FRAME = "ft_sensor"
 
 _HYDRO_TAGS = {"volume", "center_of_buoyancy", "added_mass", "linear_damping", "quadratic_damping"}
 
@@ -64,15 +66,16 @@ class UVMS:
         hydro_bodies: every link's hydrodynamic parameters with its joint and placement.
         water_density_kg_m3: rho used for buoyancy and derived coefficients.
         ee_frame_id, sensor_frame_id: Pinocchio frame indices of the end-effector and of
-            the wrist force/torque sensor.
+            the wrist force/torque sensor, or None for a model without them (a vehicle
+            alone): what needs them asks through `require_ee_frame`.
         source: path of the URDF file.
     """
 
     model: pin.Model
     hydro_bodies: tuple[HydroBody, ...]
     water_density_kg_m3: float
-    ee_frame_id: int
-    sensor_frame_id: int
+    ee_frame_id: int | None
+    sensor_frame_id: int | None
     source: str = ""
     data: pin.Data = field(init=False, repr=False)
     added_mass_per_joint: np.ndarray = field(init=False, repr=False)
@@ -154,6 +157,21 @@ class UVMS:
     def arm_joint_names(self) -> list[str]:
         return list(self.model.names[2:])
 
+    @property
+    def has_end_effector(self) -> bool:
+        return self.ee_frame_id is not None
+
+    def require_ee_frame(self, needed_by: str) -> int:
+        """The end-effector frame index; ModelError naming ``needed_by`` when there is none."""
+        if self.ee_frame_id is None:
+            raise ModelError(
+                f"{needed_by} needs an end-effector frame, and this model has none (a vehicle "
+                "without an arm? mount one with uvms_pin.mount_arm, or name the frame with "
+                "load_uvms(..., ee_frame=NAME))",
+                path=self.source or None,
+            )
+        return self.ee_frame_id
+
     def neutral_configuration(self) -> np.ndarray:
         """q at the origin, level, arm at zero (clipped into the joint limits)."""
         q = pin.neutral(self.model)
@@ -197,8 +215,8 @@ def load_uvms(
     urdf_path: str | Path,
     *,
     water_density_kg_m3: float = DEFAULT_WATER_DENSITY_KG_M3,
-    ee_frame: str = "ee",
-    sensor_frame: str = "ft_sensor",
+    ee_frame: str | None = None,
+    sensor_frame: str | None = None,
     derive_missing: bool = True,
     allow_dry_links: bool = False,
     package_dirs: Sequence[str | Path] = (),
@@ -208,7 +226,10 @@ def load_uvms(
     Args:
         urdf_path: the URDF file. Its root link becomes the free-flying vehicle.
         water_density_kg_m3: rho [kg/m^3] for buoyancy and derived coefficients.
-        ee_frame, sensor_frame: names of the end-effector and force/torque sensor frames.
+        ee_frame, sensor_frame: names of the end-effector and force/torque sensor frames;
+            a name given must exist. None (default): ``ee`` and ``ft_sensor`` when the file
+            has them, else no such frame (a vehicle without an arm loads; a controller or
+            environment that needs the end-effector raises, see `UVMS.require_ee_frame`).
         derive_missing: links without a <hydrodynamics> element get coefficients derived
             from their collision primitives (marked ``derived``).
         allow_dry_links: accept links with mass but neither hydrodynamics nor collision
@@ -276,8 +297,8 @@ def load_uvms(
         model=model,
         hydro_bodies=tuple(bodies),
         water_density_kg_m3=float(water_density_kg_m3),
-        ee_frame_id=_frame_id(model, ee_frame, where),
-        sensor_frame_id=_frame_id(model, sensor_frame, where),
+        ee_frame_id=_optional_frame_id(model, ee_frame, DEFAULT_EE_FRAME, where),
+        sensor_frame_id=_optional_frame_id(model, sensor_frame, DEFAULT_SENSOR_FRAME, where),
         source=where,
     )
 
@@ -322,6 +343,13 @@ def _read_armature(root: ET.Element, model: pin.Model, where: str) -> None:
             )
         joint_model = model.joints[model.getJointId(name)]
         model.armature[joint_model.idx_v : joint_model.idx_v + joint_model.nv] = value
+
+
+def _optional_frame_id(model: pin.Model, name: str | None, default: str, where: str) -> int | None:
+    """The frame ``name`` (must exist), or with None the frame ``default`` if it exists."""
+    if name is None:
+        return int(model.getFrameId(default)) if model.existFrame(default) else None
+    return _frame_id(model, name, where)
 
 
 def _frame_id(model: pin.Model, name: str, where: str) -> int:

@@ -37,6 +37,7 @@ import copy
 import math
 import os
 import tempfile
+import warnings
 import xml.etree.ElementTree as ET
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
@@ -45,9 +46,10 @@ from pathlib import Path
 import numpy as np
 import pinocchio as pin
 
+from uvms_pin.arms.catalog import ArmEntry, resolve_arm
 from uvms_pin.errors import ModelError, ParameterError
 from uvms_pin.model import DEFAULT_WATER_DENSITY_KG_M3, UVMS, load_uvms, read_urdf_root
-from uvms_pin.resources import resolve_resource
+from uvms_pin.resources import find_model, resolve_resource
 
 __all__ = [
     "MountResult",
@@ -107,6 +109,8 @@ class MountResult:
         tool_axis_in_ee_link: unit vector of the tool axis in ``ee_link``'s frame.
         dry_links: arm links with mass but neither hydrodynamics nor collision geometry.
         trim: the trim report, or None.
+        removed_links, removed_joints: the arm the vehicle file carried, replaced (empty
+            for a vehicle alone or with ``keep_existing_arm=True``).
     """
 
     uvms: UVMS
@@ -119,6 +123,8 @@ class MountResult:
     tool_axis_in_ee_link: np.ndarray
     dry_links: list[str] = field(default_factory=list)
     trim: object | None = None
+    removed_links: list[str] = field(default_factory=list)
+    removed_joints: list[str] = field(default_factory=list)
 
     @property
     def derived_bodies(self) -> list[str]:
@@ -131,7 +137,7 @@ class MountResult:
 
 def mount_arm(
     vehicle_urdf: str | Path,
-    arm_urdf: str | Path,
+    arm_urdf: str | Path | ArmEntry,
     mount_pose,
     *,
     arm_base_link: str | None = None,
@@ -140,9 +146,18 @@ def mount_arm(
 ) -> UVMS:
     """Mount an arm on a vehicle: one UVMS (the vehicle is the free-flying root).
 
+    When the vehicle file already carries an arm (``models/uvms_lbv150.urdf``), that arm
+    is replaced: everything from its first moving joint down, with its ``ft_sensor``,
+    ``tool`` and ``ee`` frames, is removed (a ``UserWarning`` and
+    `MountResult.removed_links` say what); ``keep_existing_arm=True`` keeps it (two arms,
+    the new one's names prefixed ``arm_`` where they clash; ``ee`` is the new arm's).
+
     Args:
-        vehicle_urdf: vehicle URDF (with the hydrodynamic extension or collision geometry).
-        arm_urdf: arm URDF; ``package://`` and relative mesh paths are resolved.
+        vehicle_urdf: vehicle URDF (with the hydrodynamic extension or collision geometry),
+            or a shipped model name (``"lbv150"``).
+        arm_urdf: arm URDF (``package://`` and relative mesh paths are resolved), or a
+            catalogue entry: a name (``"ur5"``) or `uvms_pin.arms.catalog.ArmEntry` (its
+            ``ee_link`` and ``arm_base_link`` are the defaults).
         mount_pose: pose of the arm base in ``vehicle_link``: a ``pin.SE3``, a 4x4
             homogeneous matrix, or ``(xyz, rpy)`` [m, rad].
         arm_base_link: the arm link bolted to the vehicle (default: the arm's root).
@@ -161,7 +176,7 @@ def mount_arm(
 
 def mount_arm_detailed(
     vehicle_urdf: str | Path,
-    arm_urdf: str | Path,
+    arm_urdf: str | Path | ArmEntry,
     mount_pose,
     *,
     arm_base_link: str | None = None,
@@ -177,6 +192,7 @@ def mount_arm_detailed(
     trim=None,
     trim_joint_positions: Sequence[float] | None = None,
     save_urdf: str | Path | None = None,
+    keep_existing_arm: bool = False,
 ) -> MountResult:
     """:func:`mount_arm` with every option, returning the UVMS and what was done.
 
@@ -194,7 +210,14 @@ def mount_arm_detailed(
             add foam and ballast for neutral buoyancy and the chosen BG.
         trim_joint_positions: arm configuration at which to trim (default: neutral).
         save_urdf: also write the merged URDF there (atomically).
+        keep_existing_arm: keep an arm the vehicle file already carries (default: replace it).
     """
+    vehicle_urdf = find_model(vehicle_urdf) or vehicle_urdf
+    entry = _catalog_entry(arm_urdf)
+    if entry is not None:
+        arm_urdf = entry.urdf
+        arm_base_link = arm_base_link if arm_base_link is not None else entry.arm_base_link
+        ee_link = ee_link if ee_link is not None else entry.ee_link
     merged = merge_urdf(
         vehicle_urdf,
         arm_urdf,
@@ -208,7 +231,16 @@ def mount_arm_detailed(
         lock_positions=lock_positions,
         package_dirs=package_dirs,
         allow_dry_links=allow_dry_links,
+        keep_existing_arm=keep_existing_arm,
     )
+    if merged.removed_links:
+        warnings.warn(
+            f"mount_arm: replaced the arm {vehicle_urdf} carried: removed joints "
+            f"{', '.join(merged.removed_joints)} and links {', '.join(merged.removed_links)} "
+            "(keep_existing_arm=True keeps it)",
+            UserWarning,
+            stacklevel=3,
+        )
     load_kw = dict(
         water_density_kg_m3=water_density_kg_m3,
         ee_frame=merged.ee_frame,
@@ -247,6 +279,8 @@ def mount_arm_detailed(
         tool_axis_in_ee_link=merged.tool_axis,
         dry_links=merged.dry_links,
         trim=report,
+        removed_links=merged.removed_links,
+        removed_joints=merged.removed_joints,
     )
 
 
@@ -266,6 +300,8 @@ class MergedURDF:
     tool_axis: np.ndarray
     dry_links: list[str]
     hull_box: tuple[np.ndarray, np.ndarray] | None
+    removed_links: list[str] = field(default_factory=list)
+    removed_joints: list[str] = field(default_factory=list)
 
 
 def merge_urdf(
@@ -282,17 +318,26 @@ def merge_urdf(
     lock_positions: Mapping[str, float] | None = None,
     package_dirs: Sequence[str | Path] = (),
     allow_dry_links: bool = False,
+    keep_existing_arm: bool = False,
 ) -> MergedURDF:
     """Build the merged URDF tree (steps 1-6 of the module docstring); nothing is written."""
     placement = parse_mount_pose(mount_pose)
     vpath, apath = Path(vehicle_urdf), Path(arm_urdf)
     vehicle = _Tree.read(vpath)
     arm = _Tree.read(apath)
+    removed_links, removed_joints = ([], []) if keep_existing_arm else _existing_arm(vehicle)
     vlink = (
         vehicle.root_link
         if vehicle_link is None
         else vehicle.require_link(vehicle_link, "vehicle_link")
     )
+    if vlink in removed_links:
+        raise ModelError(
+            f"vehicle_link '{vlink}' belongs to the arm the vehicle file already carries, which "
+            "is replaced (pass keep_existing_arm=True to mount on it)",
+            path=str(vpath),
+            link=vlink,
+        )
     base = (
         arm.root_link if arm_base_link is None else arm.require_link(arm_base_link, "arm_base_link")
     )
@@ -365,7 +410,8 @@ def merge_urdf(
             locked[name] = _lock(joint, locks.get(name), apath)
 
     # ---- renaming clashes, mesh paths
-    vehicle_names = set(vehicle.links) | set(vehicle.joints)
+    vehicle_names = (set(vehicle.links) | set(vehicle.joints)) - set(removed_links + removed_joints)
+    frames = _unique_frame_names(vehicle_names)
     added_names = {"arm_mount_joint", "trim_foam", "trim_foam_joint"}
     added_names |= {"trim_ballast", "trim_ballast_joint"}
     if sensor_link is None:
@@ -397,7 +443,10 @@ def merge_urdf(
         "robot", {"name": f"{vehicle.root.get('name', 'vehicle')}+{arm.root.get('name', 'arm')}"}
     )
     materials: set[str] = set()
+    dropped = set(removed_links) | set(removed_joints)
     for element in vehicle.root:
+        if element.get("name") in dropped or element.get("link") in dropped:
+            continue  # the replaced arm (top-level <hydrodynamics link=...> included)
         if element.tag in _KEEP_TOP_LEVEL:
             item = copy.deepcopy(element)
             if item.tag == "material":
@@ -431,30 +480,28 @@ def merge_urdf(
     out.extend(arm_joints)
     base_new = renamed.get(base, base)
     ee_new = renamed.get(ee, ee)
-    _add_fixed(out, "arm_mount_joint", vlink, base_new, placement)
+    _add_fixed(out, frames["arm_mount_joint"], vlink, base_new, placement)
 
     # ---- sensor, tool and end-effector frames
     rot_tool = _rotation_with_x(axis)
     if sensor_link is None:
-        sensor_frame = "ft_sensor"
+        sensor_frame = frames["ft_sensor"]
         out.append(ET.Element("link", {"name": sensor_frame}))
-        _add_fixed(out, "ft_sensor_joint", ee_new, sensor_frame, pin.SE3(rot_tool, np.zeros(3)))
+        _add_fixed(
+            out, frames["ft_sensor_joint"], ee_new, sensor_frame, pin.SE3(rot_tool, np.zeros(3))
+        )
     else:
         sensor_frame = renamed.get(sensor_link, sensor_link)
+    ee_frame = frames["ee"]
     if tool is not None:
-        out.append(_probe_link("tool", tool))
-        _add_fixed(out, "tool_joint", sensor_frame, "tool", pin.SE3.Identity())
-        out.append(ET.Element("link", {"name": "ee"}))
-        _add_fixed(
-            out, "ee_joint", "tool", "ee", pin.SE3(np.eye(3), np.array([tool.length_m, 0, 0]))
-        )
-        ee_frame = "ee"
-    elif ee_new == "ee":
-        ee_frame = "ee"
-    else:
-        out.append(ET.Element("link", {"name": "ee"}))
-        _add_fixed(out, "ee_joint", sensor_frame, "ee", pin.SE3.Identity())
-        ee_frame = "ee"
+        out.append(_probe_link(frames["tool"], tool))
+        _add_fixed(out, frames["tool_joint"], sensor_frame, frames["tool"], pin.SE3.Identity())
+        out.append(ET.Element("link", {"name": ee_frame}))
+        tip = pin.SE3(np.eye(3), np.array([tool.length_m, 0, 0]))
+        _add_fixed(out, frames["ee_joint"], frames["tool"], ee_frame, tip)
+    elif ee_new != ee_frame:
+        out.append(ET.Element("link", {"name": ee_frame}))
+        _add_fixed(out, frames["ee_joint"], sensor_frame, ee_frame, pin.SE3.Identity())
 
     return MergedURDF(
         root=out,
@@ -469,7 +516,61 @@ def merge_urdf(
         tool_axis=axis,
         dry_links=dry,
         hull_box=_box_of(vehicle.links[vlink]),
+        removed_links=removed_links,
+        removed_joints=removed_joints,
     )
+
+
+_ADDED_FRAMES = ("arm_mount_joint", "ft_sensor", "ft_sensor_joint", "tool", "tool_joint", "ee")
+_ADDED_FRAMES += ("ee_joint",)
+
+
+def _unique_frame_names(taken: set[str]) -> dict[str, str]:
+    """The names of the frames the mount adds (``ee``, ``ft_sensor``, ...), prefixed with
+    ``arm_`` while the vehicle already uses them (a kept arm has its own)."""
+    out = {}
+    for name in _ADDED_FRAMES:
+        new = name
+        while new in taken:
+            new = _RENAME_PREFIX + new
+        out[name] = new
+    return out
+
+
+def _existing_arm(vehicle: _Tree) -> tuple[list[str], list[str]]:
+    """(links, joints) of the arm a vehicle file already carries: everything below each
+    first moving joint (one without a moving joint above it), and the ``ft_sensor``,
+    ``tool`` and ``ee`` frames wherever they hang; empty for a vehicle alone."""
+    starts = []
+    for name in vehicle.joint_order:
+        if vehicle.joints[name].get("type") in _MOVING and not _moving_above(vehicle, name):
+            starts.append(vehicle.child_of(name))
+    starts += [f for f in ("ft_sensor", "tool", "ee") if f in vehicle.parent_joint]
+    links: set[str] = set()
+    for start in starts:
+        links.update(vehicle.subtree(start))
+    ordered_links = [n for n in vehicle.link_order if n in links]
+    joints = [n for n in vehicle.joint_order if vehicle.child_of(n) in links]
+    return ordered_links, joints
+
+
+def _moving_above(tree: _Tree, joint: str) -> bool:
+    link = tree.joints[joint].find("parent").get("link")
+    while link in tree.parent_joint:
+        above = tree.parent_joint[link]
+        if tree.joints[above].get("type") in _MOVING:
+            return True
+        link = tree.joints[above].find("parent").get("link")
+    return False
+
+
+def _catalog_entry(arm: str | Path | ArmEntry) -> ArmEntry | None:
+    """The catalogue entry ``arm`` names (an ArmEntry, or a name that is not a file)."""
+    if isinstance(arm, ArmEntry):
+        return resolve_arm(arm)
+    if isinstance(arm, str) and not Path(arm).is_file() and Path(arm).suffix.lower() != ".urdf":
+        return resolve_arm(arm)  # a catalogue name, else a ParameterError listing them
+    return None
 
 
 def hull_box(urdf: str | Path, link: str | None = None) -> tuple[np.ndarray, np.ndarray] | None:

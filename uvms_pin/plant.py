@@ -43,6 +43,8 @@ class Plant:
                 f"current_world_m_s must be 3 finite numbers, got {self.current_world_m_s}"
             )
         self.current_world_m_s = c
+        if self.contact is not None:
+            self.uvms.require_ee_frame("a contact environment (at the end-effector)")
         self._ee_data = self.uvms.model.createData()
 
     def ee_state(self, q: np.ndarray, v: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:

@@ -18,7 +18,14 @@ from collections.abc import Iterable
 from importlib import metadata
 from pathlib import Path
 
-__all__ = ["example_robot_data_dir", "package_search_path", "resolve_resource", "shipped_path"]
+__all__ = [
+    "example_robot_data_dir",
+    "find_model",
+    "package_search_path",
+    "resolve_resource",
+    "shipped_models",
+    "shipped_path",
+]
 
 _ERD_DISTRIBUTION = "example-robot-data"
 _ERD_SHARE = ("cmeel.prefix", "share")
@@ -96,3 +103,23 @@ def shipped_path(relative: str | Path) -> Path:
         if candidate.exists():
             return candidate
     raise FileNotFoundError(f"{relative} is not shipped with this install (looked in {candidates})")
+
+
+def shipped_models() -> list[str]:
+    """Names of the shipped models (``models/NAME.urdf``), e.g. ``lbv150``, ``uvms_lbv150``."""
+    try:
+        return sorted(p.stem for p in shipped_path("models").glob("*.urdf"))
+    except FileNotFoundError:
+        return []
+
+
+def find_model(entry: str | Path, base_dir: str | Path = ".") -> Path | None:
+    """A model file: ``entry`` as a path (relative to ``base_dir``) if that file exists,
+    else a shipped model name (``"uvms_lbv150"`` or ``"uvms_lbv150.urdf"``), else None."""
+    path = Path(entry)
+    candidate = path if path.is_absolute() else Path(base_dir) / path
+    if candidate.is_file():
+        return candidate.resolve()
+    if len(path.parts) == 1 and path.stem in shipped_models() and path.suffix in ("", ".urdf"):
+        return shipped_path(Path("models") / f"{path.stem}.urdf")
+    return None

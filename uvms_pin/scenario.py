@@ -1,15 +1,19 @@
 """Scenario files (TOML) -> the objects of one run; ``simulate(scenario)`` runs it.
 
 A scenario is read in two stages: the TOML becomes a plain dict (on which dotted
-``overrides`` such as ``{"environment.stiffness_N_m": [20, 20, 20]}`` are applied, which is
-how sweeps and robustness tables vary it), then every table is checked and turned into
-objects. Unknown keys, wrong types and bad values raise `ScenarioError` naming the file and
-the key. See ``scenarios/*.toml`` for documented examples.
+``overrides`` such as ``{"environment.stiffness_N_m": [20, 20, 20]}`` or
+``{"initial.joint_positions_rad[3]": 0.5}`` are applied, see `uvms_pin.overrides`; that is
+how ``uvms-pin run --set``, sweeps and robustness tables vary it), then every table is
+checked and turned into objects. Unknown keys, wrong types and bad values raise
+`ScenarioError` naming the file and the key, or the override when an override set it, with
+the closest known key. ``model`` is a path relative to the scenario file or the name of a
+shipped model (``"uvms_lbv150"``, ``"lbv150"``). See ``scenarios/*.toml`` for documented
+examples.
 """
 
 from __future__ import annotations
 
-import copy
+import dataclasses
 import math
 from collections.abc import Callable
 from dataclasses import dataclass
@@ -22,35 +26,54 @@ import tomllib
 
 from uvms_pin.actuation import Actuation, Thruster, ThrustersAndJointLimits, Unlimited
 from uvms_pin.controllers.base import Controller, ZeroController
+from uvms_pin.controllers.custom import ControllerSpec, class_path, custom_controller
 from uvms_pin.controllers.ppc import PPCParams, PrescribedPerformanceController
 from uvms_pin.environment import CompliantPlane, ContactModel, LinearSpring, SinusoidalDisturbance
 from uvms_pin.errors import ParameterError, ScenarioError, UvmsPinError
 from uvms_pin.integrators import RK4, Adaptive, Integrator, SemiImplicitEuler
 from uvms_pin.model import UVMS, load_uvms
+from uvms_pin.overrides import apply_overrides, closest, parse_key_path
 from uvms_pin.plant import Plant
 from uvms_pin.progress import ProgressBar, callback_or_none
+from uvms_pin.resources import find_model, shipped_models
 from uvms_pin.rollout import Rollout
 from uvms_pin.sensors import NoiseSpec, SensorConfig, SensorSuite
 from uvms_pin.simulate import Progress, SimulationSettings, simulate_closed_loop
 
 ControllerFactory = Callable[[UVMS], Controller]
 
+__all__ = ["Scenario", "apply_overrides", "load_scenario", "simulate"]
+
 
 class _Table:
-    """One TOML table, read key by key; leftovers are reported as unknown keys."""
+    """One TOML table, read key by key; leftovers are reported as unknown keys.
 
-    def __init__(self, data: Any, where: str, source: str):
+    ``overridden`` maps each overridden dotted key (without index) to the override's text,
+    so an error about a value an override set names the override instead of the file.
+    """
+
+    def __init__(
+        self, data: Any, where: str, source: str, overridden: dict[str, str] | None = None
+    ):
         if not isinstance(data, dict):
             raise ScenarioError(f"{source}: [{where}] must be a table, got {type(data).__name__}")
         self._data = dict(data)
         self._where = where
         self._source = source
+        self._overridden = overridden or {}
+        self._asked: set[str] = set()  # every key the reader knows, for suggestions
+
+    def _full(self, key: str) -> str:
+        return f"{self._where}.{key}" if self._where else key
 
     def _err(self, key: str, msg: str) -> ScenarioError:
-        where = f"{self._where}.{key}" if self._where else key
+        where = self._full(key)
+        if where in self._overridden:
+            return ScenarioError(f"override '{self._overridden[where]}': {msg}")
         return ScenarioError(f"{self._source}: {where}: {msg}")
 
     def has(self, key: str) -> bool:
+        self._asked.add(key)
         return key in self._data
 
     def number(
@@ -61,6 +84,7 @@ class _Table:
         positive: bool = False,
         nonneg: bool = False,
     ) -> float:
+        self._asked.add(key)
         if key not in self._data:
             if default is None:
                 raise self._err(key, "is required")
@@ -82,6 +106,7 @@ class _Table:
         return self.number(key, **kw) if key in self._data else None
 
     def integer(self, key: str, default: int) -> int:
+        self._asked.add(key)
         value = self._data.pop(key, default)
         if isinstance(value, bool) or not isinstance(value, int):
             raise self._err(key, f"must be an integer, got {value!r}")
@@ -90,6 +115,7 @@ class _Table:
     def string(
         self, key: str, default: str | None = None, choices: tuple[str, ...] | None = None
     ) -> str:
+        self._asked.add(key)
         if key not in self._data:
             if default is None:
                 raise self._err(key, "is required")
@@ -104,6 +130,7 @@ class _Table:
     def vector(
         self, key: str, size: int | None, default=None, *, nonneg: bool = False
     ) -> np.ndarray:
+        self._asked.add(key)
         if key not in self._data:
             if default is None:
                 raise self._err(key, "is required")
@@ -125,18 +152,42 @@ class _Table:
         return arr
 
     def table(self, key: str) -> _Table | None:
+        self._asked.add(key)
         if key not in self._data:
             return None
-        where = f"{self._where}.{key}" if self._where else key
-        return _Table(self._data.pop(key), where, self._source)
+        return _Table(self._data.pop(key), self._full(key), self._source, self._overridden)
 
     def pop_raw(self, key: str, default: Any = None) -> Any:
+        self._asked.add(key)
         return self._data.pop(key, default)
 
+    def rest(self) -> dict[str, Any]:
+        """Every key not read yet (and the table is then finished)."""
+        out, self._data = self._data, {}
+        return out
+
     def finish(self) -> None:
-        if self._data:
-            keys = ", ".join(sorted(self._data))
-            raise ScenarioError(f"{self._source}: [{self._where}] has unknown key(s): {keys}")
+        """ScenarioError for keys nobody read, naming the override that set one if any,
+        with the closest known key."""
+        if not self._data:
+            return
+        unknown = sorted(self._data)
+        known = self._asked - set(unknown)
+        for key in unknown:
+            full = self._full(key)
+            for dotted, text in self._overridden.items():
+                if dotted == full or dotted.startswith(full + "."):
+                    hint = closest(key, known)
+                    fixed = (self._full(hint) + text[len(full) :]) if hint else None
+                    raise ScenarioError(
+                        f"override '{text}': unknown key '{full}'"
+                        + (f"; did you mean '{fixed}'?" if fixed else "")
+                    )
+        hints = [f"'{k}' -> '{closest(k, known)}'" for k in unknown if closest(k, known)]
+        raise ScenarioError(
+            f"{self._source}: [{self._where}] has unknown key(s): {', '.join(unknown)}"
+            + (f" (did you mean {', '.join(hints)}?)" if hints else "")
+        )
 
 
 @dataclass
@@ -147,7 +198,9 @@ class Scenario:
         name, description: from [scenario].
         path: the file it came from. raw: the dict after overrides (recorded in rollouts).
         plant: UVMS + water + environment + disturbance.
-        controller_factory: builds a fresh controller for the plant's UVMS.
+        controller_factory: builds a fresh controller for the plant's UVMS (a
+            `ControllerSpec` for the [controller] table: its type and parameters are
+            recorded in the rollout with the class that actually ran).
         sensor_config: noise of the measurements.
         q0, v0: initial state. settings: integrator, periods, duration, seed.
     """
@@ -168,25 +221,18 @@ class Scenario:
         return self.plant.uvms
 
 
-def apply_overrides(
-    raw: dict[str, Any], overrides: dict[str, Any] | None, source: str = "<overrides>"
-) -> dict[str, Any]:
-    """A deep copy of ``raw`` with dotted keys set, e.g. ``{"water.current_world_m_s": [0.2, 0, 0]}``."""
-    out = copy.deepcopy(raw)
-    for dotted, value in (overrides or {}).items():
-        parts = dotted.split(".")
-        node = out
-        for part in parts[:-1]:
-            child = node.setdefault(part, {})
-            if not isinstance(child, dict):
-                raise ScenarioError(f"{source}: override '{dotted}': '{part}' is not a table")
-            node = child
-        node[parts[-1]] = copy.deepcopy(value)
-    return out
-
-
 def load_scenario(path: str | Path, overrides: dict[str, Any] | None = None) -> Scenario:
-    """Read a scenario TOML file, apply dotted overrides and build the objects."""
+    """Read a scenario TOML file, apply dotted overrides and build the objects.
+
+    Args:
+        path: the scenario file.
+        overrides: dotted key (optionally ``[i]``-indexed) -> value, e.g.
+            ``{"environment.stiffness_N_m": [20, 20, 20], "initial.joint_positions_rad[3]":
+            0.5}`` (`uvms_pin.overrides`).
+
+    Raises:
+        ScenarioError: naming the file and the key, or the override that set a bad value.
+    """
     path = Path(path)
     source = str(path)
     if not path.is_file():
@@ -195,17 +241,18 @@ def load_scenario(path: str | Path, overrides: dict[str, Any] | None = None) -> 
         raw = tomllib.loads(path.read_text())
     except tomllib.TOMLDecodeError as exc:
         raise ScenarioError(f"{source}: not valid TOML ({exc})") from exc
-    raw = apply_overrides(raw, overrides, source)
+    raw = apply_overrides(raw, overrides)
+    overridden = {parse_key_path(text).key: text for text in overrides or {}}
     try:
-        return _build(raw, path, source)
+        return _build(raw, path, source, overridden)
     except ScenarioError:
         raise
     except UvmsPinError as exc:
         raise ScenarioError(f"{source}: {exc}") from exc
 
 
-def _build(raw: dict[str, Any], path: Path, source: str) -> Scenario:
-    top = _Table(raw, "", source)
+def _build(raw: dict[str, Any], path: Path, source: str, overridden: dict[str, str]) -> Scenario:
+    top = _Table(raw, "", source, overridden)
     head = top.table("scenario") or _Table({}, "scenario", source)
     name = head.string("name", path.stem)
     description = head.string("description", "")
@@ -219,11 +266,18 @@ def _build(raw: dict[str, Any], path: Path, source: str) -> Scenario:
     current = water.vector("current_world_m_s", 3, [0.0, 0.0, 0.0])
     water.finish()
 
-    model_path = (path.parent / model_entry).resolve()
+    model_path = find_model(model_entry, path.parent)
+    if model_path is None:
+        raise head._err(
+            "model",
+            f"'{model_entry}' is neither a file relative to the scenario "
+            f"({path.parent.resolve() / model_entry}) nor a shipped model "
+            f"({', '.join(shipped_models())})",
+        )
     uvms = load_uvms(model_path, water_density_kg_m3=density)
 
     q0, v0 = _initial_state(top.table("initial") or _Table({}, "initial", source), uvms)
-    contact = _environment(top.table("environment"))
+    contact = _environment(top.table("environment"), uvms)
     disturbance = _disturbance(top.table("disturbance"))
     actuation = _actuation(top.table("actuation"), uvms)
     plant = Plant(uvms, current, contact, disturbance, actuation)
@@ -238,7 +292,7 @@ def _build(raw: dict[str, Any], path: Path, source: str) -> Scenario:
     output.finish()
 
     controller_table = top.table("controller")
-    controller_factory = _controller(controller_table, uvms)
+    controller_factory = _controller(controller_table, uvms, path.parent)
     top.finish()
     try:
         settings = SimulationSettings(duration, integrator, log_period, control_period, seed)
@@ -268,9 +322,10 @@ def _initial_state(t: _Table, uvms: UVMS) -> tuple[np.ndarray, np.ndarray]:
     return q0, velocity
 
 
-def _environment(t: _Table | None) -> ContactModel | None:
+def _environment(t: _Table | None, uvms: UVMS) -> ContactModel | None:
     if t is None:
         return None
+    uvms.require_ee_frame("[environment] (a contact at the end-effector)")
     kind = t.string("type", choices=("spring", "plane"))
     anchor = t.vector("anchor_world_m", 3) if t.has("anchor_world_m") else None
     if kind == "spring":
@@ -366,16 +421,34 @@ def _integrator(t: _Table) -> Integrator:
     return out
 
 
-def _controller(t: _Table | None, uvms: UVMS) -> ControllerFactory:
+def _controller(t: _Table | None, uvms: UVMS, scenario_dir: Path) -> ControllerSpec:
+    """[controller]: "none", "ppc" or "package.module:ClassName" (`uvms_pin.controllers.custom`)."""
     if t is None:
-        return lambda u: ZeroController(u.nv)
-    kind = t.string("type", choices=tuple(_CONTROLLER_BUILDERS))
+        return ControllerSpec("none", {}, _zero)
+    kind = t.string("type")
+    if ":" in kind:
+        params = t.rest()
+        try:
+            spec = custom_controller(kind, params, scenario_dir)
+            spec(uvms)  # built once now, so a bad parameter is found before the run
+        except ParameterError as exc:
+            raise ScenarioError(f"{t._source}: [controller]: {exc}") from exc
+        return spec
+    if kind not in _CONTROLLER_BUILDERS:
+        choices = ", ".join(_CONTROLLER_BUILDERS)
+        raise t._err(
+            "type", f"must be one of {choices} or 'package.module:ClassName', got '{kind}'"
+        )
     return _CONTROLLER_BUILDERS[kind](t, uvms)
 
 
-def _zero_controller(t: _Table, uvms: UVMS) -> ControllerFactory:
+def _zero(uvms: UVMS) -> Controller:
+    return ZeroController(uvms.nv)
+
+
+def _zero_controller(t: _Table, uvms: UVMS) -> ControllerSpec:
     t.finish()
-    return lambda u: ZeroController(u.nv)
+    return ControllerSpec("none", {}, _zero)
 
 
 def _sine_profile(t: _Table | None, size: int) -> Callable[[float], np.ndarray]:
@@ -396,9 +469,13 @@ _PPC_FIRST_LEVEL_KEYS = ("k_x", "rho0_x", "rho_inf_x", "l_x_per_s")  # 6 compone
 _PPC_SECOND_LEVEL_KEYS = ("k_zeta", "rho0_zeta", "rho_inf_zeta", "l_zeta_per_s", "velocity_weights")
 
 
-def _ppc_controller(t: _Table, uvms: UVMS) -> ControllerFactory:
+def _ppc_controller(t: _Table, uvms: UVMS) -> ControllerSpec:
     """[controller] type = "ppc": the paper's law; omitted keys keep the paper's values."""
-    ee_frame = t.string("ee_frame", uvms.model.frames[uvms.ee_frame_id].name)
+    if t.has("ee_frame"):
+        ee_frame = t.string("ee_frame")
+    else:
+        ee_id = uvms.require_ee_frame("[controller] type = 'ppc'")
+        ee_frame = uvms.model.frames[ee_id].name
     fields: dict[str, Any] = {}
     for keys, size in ((_PPC_FIRST_LEVEL_KEYS, 6), (_PPC_SECOND_LEVEL_KEYS, uvms.nv)):
         for key in keys:
@@ -410,17 +487,35 @@ def _ppc_controller(t: _Table, uvms: UVMS) -> ControllerFactory:
     if t.has("null_space_target"):
         fields["null_space_target"] = t.vector("null_space_target", uvms.n_arm_joints)
     desired_rpy = t.vector("desired_rpy", 3, [0.0, 0.0, 0.0])
-    desired_force = _sine_profile(t.table("desired_force"), 3)
+    force_table = t.table("desired_force")
+    force_raw = {} if force_table is None else dict(force_table._data)
+    desired_force = _sine_profile(force_table, 3)
     t.finish()
     try:
         params = PPCParams(desired_rpy=desired_rpy, **fields).sized(uvms.nv)
         PrescribedPerformanceController(uvms.model, ee_frame, params, desired_force)
     except ParameterError as exc:
         raise ScenarioError(f"{t._source}: [controller]: {exc}") from exc
-    return lambda u: PrescribedPerformanceController(u.model, ee_frame, params, desired_force)
+    recorded = {
+        "ee_frame": ee_frame,
+        "desired_force": force_raw,
+        **{k: _plain(v) for k, v in dataclasses.asdict(params).items()},
+    }
+    return ControllerSpec(
+        "ppc",
+        recorded,
+        lambda u: PrescribedPerformanceController(u.model, ee_frame, params, desired_force),
+    )
 
 
-_CONTROLLER_BUILDERS: dict[str, Callable[[_Table, UVMS], ControllerFactory]] = {
+def _plain(value: Any) -> Any:
+    """numpy arrays and scalars as lists and floats (for the rollout's JSON)."""
+    if isinstance(value, np.ndarray):
+        return value.tolist()
+    return value.item() if isinstance(value, np.generic) else value
+
+
+_CONTROLLER_BUILDERS: dict[str, Callable[[_Table, UVMS], ControllerSpec]] = {
     "none": _zero_controller,
     "ppc": _ppc_controller,
 }
@@ -454,6 +549,7 @@ def _simulate(scenario: Scenario, progress: Progress | None) -> Rollout:
         "scenario_path": str(scenario.path),
         "description": scenario.description,
         "parameters": scenario.raw,
+        "controller": controller_record(scenario.controller_factory, controller),
     }
     return simulate_closed_loop(
         scenario.plant,
@@ -465,3 +561,15 @@ def _simulate(scenario: Scenario, progress: Progress | None) -> Rollout:
         metadata=metadata,
         progress=progress,
     )
+
+
+def controller_record(factory: ControllerFactory, controller: Controller) -> dict[str, Any]:
+    """What ran: the class of ``controller`` (``module:QualifiedName``) and, when the
+    factory is a `ControllerSpec`, its type and parameters (else None: unknown)."""
+    inner = getattr(controller, "wrapped_controller", controller)  # a viewer's tap
+    spec = factory if isinstance(factory, ControllerSpec) else None
+    return {
+        "class": class_path(inner),
+        "type": None if spec is None else spec.type,
+        "params": None if spec is None else spec.params,
+    }

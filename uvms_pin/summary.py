@@ -11,6 +11,10 @@ def _fmt(values: np.ndarray, precision: int = 4) -> str:
     return " ".join(f"{x:.{precision}g}" for x in values)
 
 
+def _frame_name(uvms: UVMS, frame_id: int | None) -> str:
+    return "none (vehicle only)" if frame_id is None else uvms.model.frames[frame_id].name
+
+
 def model_summary(uvms: UVMS) -> str:
     """Bodies, masses, volumes, net buoyancy, hydro coefficients (derived marked), limits."""
     model = uvms.model
@@ -20,8 +24,8 @@ def model_summary(uvms: UVMS) -> str:
         f"model: {uvms.source}",
         f"nq = {uvms.nq}, nv = {uvms.nv} (6 vehicle + {uvms.n_arm_joints} arm joints)",
         f"water density: {rho:g} kg/m^3, gravity: {g:g} m/s^2",
-        f"end-effector frame: {model.frames[uvms.ee_frame_id].name}, "
-        f"F/T sensor frame: {model.frames[uvms.sensor_frame_id].name}",
+        f"end-effector frame: {_frame_name(uvms, uvms.ee_frame_id)}, "
+        f"F/T sensor frame: {_frame_name(uvms, uvms.sensor_frame_id)}",
         "",
         "bodies (Pinocchio joints; fixed links merged):",
         f"  {'joint':<16}{'mass [kg]':>11}{'volume [m^3]':>14}{'weight-buoyancy [N]':>21}",
@@ -47,6 +51,8 @@ def model_summary(uvms: UVMS) -> str:
         lines.append(f"     added mass diag   [{_fmt(np.diag(p.added_mass))}]")
         lines.append(f"     linear damping    [{_fmt(np.diag(p.linear_damping))}]")
         lines.append(f"     quadratic damping [{_fmt(p.quadratic_damping)}]")
+    if not uvms.n_arm_joints:
+        return "\n".join([*lines, "", "arm joints: none (vehicle only)"])
     lines += [
         "",
         "arm joints:",

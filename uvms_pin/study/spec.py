@@ -30,7 +30,6 @@ import hashlib
 import itertools
 import json
 import math
-import re
 import zlib
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -40,13 +39,13 @@ import numpy as np
 import tomllib
 
 from uvms_pin.errors import ScenarioError, UvmsPinError
+from uvms_pin.overrides import KEY_PATH, parse_key_path
 
 SEED_KEY = 0x5EED  # spawn-key component of a sample's scenario seed
 PLANT_PREFIX = "plant."
 PLANT_FACTORS = ("mass_scale", "added_mass_scale", "damping_scale", "buoyancy_scale")
 DISTRIBUTIONS = ("uniform", "normal", "log-uniform")
 APPLY_MODES = ("set", "scale", "add")
-_PATH = re.compile(r"^([A-Za-z_][\w-]*(?:\.[A-Za-z_][\w-]*)+)(?:\[(\d+)\])?$")
 
 
 class StudyError(UvmsPinError):
@@ -80,12 +79,11 @@ class Parameter:
     @property
     def key(self) -> str:
         """The scenario key without the element index."""
-        return _PATH.match(self.path).group(1)
+        return parse_key_path(self.path).key
 
     @property
     def index(self) -> int | None:
-        m = _PATH.match(self.path).group(2)
-        return None if m is None else int(m)
+        return parse_key_path(self.path).index
 
     def draw(self, master_seed: int, sample: int) -> float:
         """This parameter's value in sample ``sample`` (independent of every other draw)."""
@@ -360,10 +358,9 @@ def _parameter(
     def fail(msg: str) -> StudyError:
         return StudyError(f"{where}: {msg}")
 
-    match = _PATH.match(path)
-    if match is None:
+    if KEY_PATH.match(path) is None:
         raise fail("not a dotted key like 'environment.stiffness_N_m' or 'a.b[2]'")
-    key, index = match.group(1), match.group(2)
+    key, index = parse_key_path(path).key, parse_key_path(path).index
     apply = entry.pop("apply", "set")
     if apply not in APPLY_MODES:
         raise fail(f"apply must be one of {', '.join(APPLY_MODES)}, got {apply!r}")

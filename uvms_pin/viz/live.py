@@ -33,6 +33,7 @@ import numpy as np
 import zmq
 from meshcat.visualizer import ViewerWindow
 
+from uvms_pin.controllers.custom import ControllerSpec
 from uvms_pin.errors import SimulationError
 from uvms_pin.rollout import Rollout
 from uvms_pin.scenario import Scenario, simulate
@@ -369,6 +370,7 @@ class _ControllerTap:
 
     def __init__(self, controller):
         self._controller = controller
+        self.wrapped_controller = controller  # what the rollout records as the class that ran
         self.measurement = None
         self.last_signals: dict[str, np.ndarray] = {}
 
@@ -424,6 +426,9 @@ def simulate_live(
         if progress is not None:
             progress(t, duration)
 
+    spec = scenario.controller_factory
+    if isinstance(spec, ControllerSpec):  # keep its type and parameters for the record
+        controller_factory = dataclasses.replace(spec, build=controller_factory)
     tapped = dataclasses.replace(scenario, plant=plant, controller_factory=controller_factory)
     return simulate(tapped, progress=on_sample)
 

@@ -330,7 +330,13 @@ class UvmsScene:
 
     # ---- per instant -------------------------------------------------------------------
     def ee_position(self, q: np.ndarray) -> np.ndarray:
+        """The end-effector position (the vehicle origin for a model without one) [m]."""
         pin.forwardKinematics(self.uvms.model, self.data, q)
+        return self._tip_after_kinematics()
+
+    def _tip_after_kinematics(self) -> np.ndarray:
+        if self.uvms.ee_frame_id is None:
+            return self.data.oMi[1].translation.copy()  # a vehicle alone: trace its origin
         return pin.updateFramePlacement(
             self.uvms.model, self.data, self.uvms.ee_frame_id
         ).translation.copy()
@@ -350,7 +356,7 @@ class UvmsScene:
                 quat,
                 np.asarray(obj.meshScale, dtype=float).copy(),
             )
-        tip = pin.updateFramePlacement(model, data, self.uvms.ee_frame_id).translation.copy()
+        tip = self._tip_after_kinematics()
         base = q[:3]
         if self.environment is not None and self.environment.kind == "spring":
             span = tip - self.environment.point_world_m

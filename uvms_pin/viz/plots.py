@@ -58,17 +58,20 @@ def plot_pose(rollout: Rollout, path: Path | None = None) -> Figure | Path:
 def plot_velocities(rollout: Rollout, path: Path | None = None) -> Figure | Path:
     """Body linear and angular velocity of the vehicle and the arm joint rates."""
     t = rollout.time_s
-    fig, axes = new_figure(3, 1, figsize=(8, 8), sharex=True)
+    n_joints = rollout.v.shape[1] - 6
+    rows = 3 if n_joints else 2  # a vehicle alone has no joint rates
+    fig, axes = new_figure(rows, 1, figsize=(8, 8 * rows / 3), sharex=True)
     for i, label in enumerate(("u", "v", "w")):
         axes[0].plot(t, rollout.v[:, i], label=label)
     axes[0].set_ylabel("body linear [m/s]")
     for i, label in enumerate(("p", "q", "r")):
         axes[1].plot(t, rollout.v[:, 3 + i], label=label)
     axes[1].set_ylabel("body angular [rad/s]")
-    for j in range(rollout.v.shape[1] - 6):
+    for j in range(n_joints):
         axes[2].plot(t, rollout.v[:, 6 + j], label=f"joint {j + 1}")
-    axes[2].set_ylabel("joint rates [rad/s]")
-    axes[2].set_xlabel("time [s]")
+    if n_joints:
+        axes[2].set_ylabel("joint rates [rad/s]")
+    axes[-1].set_xlabel("time [s]")
     for ax in axes:
         ax.legend(loc="best", fontsize=8)
         ax.grid(True, alpha=0.3)
