@@ -15,7 +15,7 @@ if __name__ == "__main__":
         str(ROOT / "scripts" / "robustness_table.py"),
         "--paper-gains",
         "--jobs",
-        "1",
+        "2",
         "--out",
         str(out),
     ]
