@@ -1,6 +1,8 @@
 # Two commands do all the set-up on a fresh machine with Python 3.11 and pip:
 #   make demo   - create .venv, install uvms-pin, run the main scenario into out/demo
 #   make test   - create .venv, install uvms-pin with dev tools, lint and run the test suite
+#   make results - regenerate every table (docs/results/*.md) and figure the README quotes
+#                  (RESULTS="paper robustness" for some; the list is scripts/make_results.py)
 PYTHON ?= python3
 VENV := .venv
 BIN := $(VENV)/bin
@@ -8,7 +10,7 @@ STAMP := $(VENV)/.installed
 DEMO_SCENARIO ?= scenarios/realistic_force_tracking.toml
 DEMO_OUT ?= out/demo
 
-.PHONY: demo test lint bench clean
+.PHONY: demo test lint bench results clean
 
 $(STAMP): pyproject.toml
 	$(PYTHON) -m venv $(VENV)
@@ -34,6 +36,9 @@ test: $(STAMP) lint
 
 bench: $(STAMP)
 	$(BIN)/python benchmarks/bench_dynamics.py
+
+results: $(STAMP)
+	$(BIN)/python scripts/make_results.py $(if $(RESULTS),--only $(RESULTS))
 
 clean:
 	rm -rf $(VENV) out build *.egg-info

@@ -102,3 +102,38 @@ def test_run_with_a_bad_scenario_writes_nothing(tmp_path):
     assert result.returncode == 2
     assert "unknown key(s): current" in result.stderr
     assert not out.exists()
+
+
+_SUSPICIOUS_URDF = """<robot name="r">
+<link name="body"><inertial><mass value="2"/>
+<inertia ixx="0.01" iyy="0.02" izz="0.03" ixy="0" ixz="0" iyz="0"/></inertial>
+<hydrodynamics><volume value="0.002"/></hydrodynamics></link>
+<link name="fin"><inertial><mass value="0"/>
+<inertia ixx="0" iyy="0" izz="0" ixy="0" ixz="0" iyz="0"/></inertial>
+<hydrodynamics><volume value="0.001"/></hydrodynamics></link>
+<link name="ee"/><link name="ft_sensor"/>
+<joint name="j1" type="fixed"><parent link="body"/><child link="fin"/></joint>
+<joint name="j2" type="fixed"><parent link="body"/><child link="ee"/></joint>
+<joint name="j3" type="fixed"><parent link="body"/><child link="ft_sensor"/></joint>
+</robot>
+"""
+
+
+def test_a_model_warning_is_one_line_and_the_command_succeeds(tmp_path):
+    path = tmp_path / "fin.urdf"
+    path.write_text(_SUSPICIOUS_URDF)
+    result = run("info", str(path))
+    assert result.returncode == 0, result.stderr
+    lines = result.stderr.strip().splitlines()
+    assert lines == [
+        f"uvms-pin: warning: {path}: link 'fin': displaces 0.001 m^3 of water but has zero mass"
+    ]
+
+
+def test_an_impossible_inertia_is_exit_2_naming_file_link_and_cause(tmp_path):
+    path = tmp_path / "tri.urdf"
+    path.write_text(_SUSPICIOUS_URDF.replace('izz="0.03"', 'izz="0.05"'))
+    result = run("info", str(path))
+    assert result.returncode == 2
+    assert f"{path}: link 'body': inertia violates the triangle inequality" in result.stderr
+    assert "Traceback" not in result.stderr

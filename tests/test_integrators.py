@@ -235,3 +235,47 @@ def test_fixed_step_substep_count(free_body, integrator, t1, calls):
     assert min(times) == 0.0 and max(times) == pytest.approx(
         t1 if isinstance(integrator, RK4) else t1 - t1 / calls, rel=1e-12
     )
+
+
+def test_adaptive_failure_carries_the_states_it_reached(free_body):
+    """A finite-time blow-up (v_x' = 1 / (0.05 - t)^2) makes RK45's step vanish near
+    t = 0.05 s: the SimulationError carries the states at the output times before it, which
+    are the exact solution v_x = 1 / (0.05 - t) - 20 (1e-4 relative), and no later ones."""
+    model = free_body.model
+
+    def rhs(t, q, v):
+        a = np.zeros(model.nv)
+        a[0] = 1.0 / (0.05 - t) ** 2
+        return a
+
+    times = np.arange(1, 11) * 0.01
+    with pytest.raises(up.SimulationError, match="RK45 failed") as info:
+        Adaptive("RK45", rtol=1e-8, atol=1e-10).advance_through(
+            model, rhs, 0.0, pin.neutral(model), np.zeros(model.nv), times
+        )
+    states = info.value.states
+    reached = [t for t, _, _ in states]
+    np.testing.assert_allclose(reached, times[: len(reached)])
+    assert 4 <= len(reached) <= 5  # 0.01 ... 0.04 (0.05 itself is the singularity)
+    for t, _, v in states:
+        assert v[0] == pytest.approx(1.0 / (0.05 - t) - 20.0, rel=1e-4)
+
+
+def test_adaptive_event_before_the_first_output_time(free_body):
+    """An event that fires before the first output time returns just the event state (the
+    solver then has no output rows: it used to fail on them)."""
+    model = free_body.model
+    v0 = np.zeros(model.nv)
+    v0[0] = 1.0
+    states = Adaptive("RK45").advance_through(
+        model,
+        lambda t, q, v: np.zeros(model.nv),
+        0.0,
+        pin.neutral(model),
+        v0,
+        np.array([0.1, 0.2]),
+        event=lambda t, q, v: 0.05 - q[0],  # crosses zero downwards at x = 0.05 m
+    )
+    assert len(states) == 1
+    t, q, _ = states[0]
+    assert t == pytest.approx(0.05, rel=1e-6) and q[0] == pytest.approx(0.05, rel=1e-6)

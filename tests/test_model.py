@@ -247,6 +247,34 @@ BAD_INERTIAL = {
         '<inertia ixx="0.01" iyy="0.02" izz="0.03" ixy="0" ixz="0"/></inertial>',
         "<inertia iyz> is missing",
     ),
+    "negative principal moment": (
+        '<inertial><mass value="2"/>'
+        '<inertia ixx="-0.01" iyy="0.02" izz="0.03" ixy="0" ixz="0" iyz="0"/></inertial>',
+        "not positive semi-definite",
+    ),
+    # positive diagonal, but the products of inertia make it indefinite: eigenvalues of
+    # [[0.01, 0.02], [0.02, 0.01]] are 0.03 and -0.01
+    "indefinite through the products": (
+        '<inertial><mass value="2"/>'
+        '<inertia ixx="0.01" iyy="0.01" izz="0.015" ixy="0.02" ixz="0" iyz="0"/></inertial>',
+        "not positive semi-definite",
+    ),
+    "triangle inequality": (
+        '<inertial><mass value="2"/>'
+        '<inertia ixx="0.01" iyy="0.02" izz="0.05" ixy="0" ixz="0" iyz="0"/></inertial>',
+        "triangle inequality",
+    ),
+    # a rotated frame: the diagonal alone satisfies I1 + I2 >= I3, the principal moments
+    # (0.005, 0.01, 0.02) do not
+    "triangle inequality in principal axes": (
+        '<inertial><mass value="2"/>'
+        '<inertia ixx="0.0125" iyy="0.0125" izz="0.01" ixy="0.0075" ixz="0" iyz="0"/></inertial>',
+        "triangle inequality",
+    ),
+    "rotational inertia without mass": (
+        f'<inertial><mass value="0"/>{_INERTIA}</inertial>',
+        "zero mass but a rotational inertia",
+    ),
 }
 
 
@@ -261,6 +289,97 @@ def test_bad_inertial_raises_model_error(write_urdf, case):
     message = str(info.value)
     assert str(path) in message and "link 'body'" in message
     assert expected in message, message
+
+
+@pytest.mark.parametrize(
+    "inertia",
+    [
+        (0.0, 0.0, 0.0, 0.0, 0.0, 0.0),  # a point mass
+        (0.01, 0.02, 0.03, 0.0, 0.0, 0.0),
+        (0.01, 0.02, 0.03, 0.0, 0.0, 0.0),
+        (0.0, 1 / 12, 1 / 12, 0.0, 0.0, 0.0),  # a thin rod along x: I1 = 0
+        (0.25, 0.5, 0.75, 0.0, 0.0, 0.0),  # a flat plate: I3 = I1 + I2 exactly
+        (0.025, 0.05, 0.0749, 0.0, 0.0, 0.0),  # the plate printed with 3 digits
+    ],
+)
+def test_physical_inertias_load(write_urdf, inertia):
+    """The limits of the admissible set (PSD, I1 + I2 = I3) load, and the loaded rigid
+    mass matrix carries exactly the URDF's inertia."""
+    ixx, iyy, izz, ixy, ixz, iyz = inertia
+    path = write_urdf(
+        _robot(
+            _link(
+                "body",
+                '<inertial><mass value="2"/>'
+                f'<inertia ixx="{ixx!r}" iyy="{iyy!r}" izz="{izz!r}" ixy="{ixy!r}" '
+                f'ixz="{ixz!r}" iyz="{iyz!r}"/></inertial>'
+                f"<hydrodynamics>{GOOD_HYDRO}</hydrodynamics>",
+            )
+        )
+    )
+    uvms = up.load_uvms(path, ee_frame="body", sensor_frame="body")
+    np.testing.assert_allclose(uvms.model.inertias[1].inertia, np.diag([ixx, iyy, izz]), atol=1e-15)
+
+
+def _two_joint_robot(lower: float, upper: float) -> str:
+    return _robot(
+        _link("body", INERTIAL + f"<hydrodynamics>{GOOD_HYDRO}</hydrodynamics>"),
+        _link("arm", INERTIAL + f"<hydrodynamics>{GOOD_HYDRO}</hydrodynamics>"),
+        '<joint name="shoulder" type="revolute"><parent link="body"/><child link="arm"/>'
+        f'<axis xyz="0 0 1"/><limit lower="{lower}" upper="{upper}" effort="1" velocity="1"/>'
+        "</joint>",
+    )
+
+
+def test_inverted_joint_limits_raise_model_error(write_urdf):
+    path = write_urdf(_two_joint_robot(1.0, -1.0))
+    with pytest.raises(up.ModelError) as info:
+        up.load_uvms(path, ee_frame="arm", sensor_frame="arm")
+    message = str(info.value)
+    assert str(path) in message and "joint 'shoulder'" in message
+    assert "lower = 1.0 > upper = -1.0" in message
+
+
+def test_equal_joint_limits_load(write_urdf):
+    uvms = up.load_uvms(write_urdf(_two_joint_robot(0.5, 0.5)), ee_frame="arm", sensor_frame="arm")
+    assert uvms.model.lowerPositionLimit[7] == uvms.model.upperPositionLimit[7] == 0.5
+
+
+MASS_VOLUME_WARNINGS = {
+    "volume without mass": (
+        '<inertial><mass value="0"/>'
+        '<inertia ixx="0" iyy="0" izz="0" ixy="0" ixz="0" iyz="0"/></inertial>'
+        f"<hydrodynamics>{GOOD_HYDRO}</hydrodynamics>",
+        "displaces 0.002 m^3 of water but has zero mass",
+    ),
+    "mass without volume": (
+        INERTIAL + f"<hydrodynamics>{hydro_xml(0.0)}</hydrodynamics>",
+        "has 2 kg of mass but displaces no water",
+    ),
+}
+
+
+@pytest.mark.parametrize("case", list(MASS_VOLUME_WARNINGS), ids=list(MASS_VOLUME_WARNINGS))
+def test_mass_volume_mismatch_warns_naming_file_and_link(write_urdf, case):
+    body, expected = MASS_VOLUME_WARNINGS[case]
+    path = write_urdf(
+        _robot(
+            _link("body", INERTIAL + f"<hydrodynamics>{GOOD_HYDRO}</hydrodynamics>"),
+            _link("fin", body),
+            _fixed("body", "fin"),
+        )
+    )
+    with pytest.warns(up.ModelWarning) as record:
+        up.load_uvms(path, ee_frame="body", sensor_frame="body")
+    messages = [str(w.message) for w in record]
+    assert len(messages) == 1, messages
+    assert str(path) in messages[0] and "link 'fin'" in messages[0]
+    assert expected in messages[0], messages[0]
+
+
+def test_reference_model_loads_without_warnings(recwarn):
+    up.load_uvms(REFERENCE_URDF)
+    assert not [w for w in recwarn if issubclass(w.category, up.UvmsPinWarning)]
 
 
 def test_top_level_hydrodynamics_without_link_attribute(write_urdf):

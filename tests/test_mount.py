@@ -148,6 +148,25 @@ def test_example_robot_data_arm_mounts_with_mesh_hydro(split, name):
     assert "*" in model_summary(uvms)  # derived bodies are marked
 
 
+@needs_erd
+@pytest.mark.parametrize("name", ["ur3", "ur5", "ur10", "panda", "z1", "kinova", "xarm7", "so100"])
+def test_every_arm_the_project_uses_passes_the_model_checks(split, name):
+    """The inertia, joint-limit and hydrodynamics checks accept every arm compare-arms
+    mounts (their massless frame links have zero inertia; point masses are allowed)."""
+    entry = CATALOG[name]
+    uvms = up.mount_arm(
+        split.vehicle_urdf,
+        entry.urdf,
+        _mount_pose(split),
+        ee_link=entry.ee_link,
+        arm_base_link=entry.arm_base_link,
+        allow_dry_links=True,
+    )
+    assert uvms.n_arm_joints >= 5
+    assert np.all(uvms.model.lowerPositionLimit[7:] <= uvms.model.upperPositionLimit[7:])
+    assert np.all(np.linalg.eigvalsh(up.mass_matrix(uvms, uvms.neutral_configuration())) > 0)
+
+
 def test_available_arms_lists_installed_example_robot_data_arms():
     names = available_arms()
     assert names[0] == "reference"

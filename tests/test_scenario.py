@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import importlib
 import textwrap
 from pathlib import Path
 
@@ -63,6 +64,19 @@ def test_minimal_scenario_defaults(tmp_path):
         ("[control]\nperiod_s = 0.003\n[output]\nlog_period_s = 0.01\n", "integer multiple"),
         ("[actuation]\nlimit_joint_torques = true\n", "at least one [[actuation.thruster]]"),
         ("[sensors]\nforce_noise_N = 'loud'\n", "sensors.force_noise_N: must be a finite number"),
+        # nothing silently changed: the run must be exactly the one the rollout records
+        ("[integrator]\nstep_s = 5.0\n", "of step_s (integrator.step_s) = 5 s"),
+        ("[integrator]\nstep_s = 0.003\n", "of step_s (integrator.step_s) = 0.003 s"),
+        (
+            "[control]\nperiod_s = 0.002\n[integrator]\nstep_s = 0.003\n",
+            "control_period_s (control.period_s) = 0.002 s must be an integer multiple",
+        ),
+        ("[output]\nlog_period_s = 100.0\n", "of log_period_s (output.log_period_s) = 100 s"),
+        ("[output]\nlog_period_s = 0.03\n", "duration_s (scenario.duration_s) = 0.1 s must"),
+        (
+            "[initial]\nvelocity = [1e6, 0, 0, 0, 0, 0, 0, 0, 0, 0]\n",
+            "initial.velocity: 1e+06 is not a physical speed",
+        ),
     ],
 )
 def test_bad_entries_are_named(tmp_path, extra, needle):
@@ -105,3 +119,31 @@ def test_shipped_scenarios_load(name):
     if name.startswith("realistic"):
         assert isinstance(scenario.plant.actuation, ThrustersAndJointLimits)
         assert scenario.settings.control_period_s is not None
+
+
+def test_a_log_that_would_not_fit_in_memory_is_refused_before_allocating(tmp_path, monkeypatch):
+    """1e6 s logged every 10 ms is 1e8 samples (~170 GB): refused at load time, naming the
+    keys, from an estimate (nothing is allocated: the test would not survive otherwise)."""
+    text = MINIMAL.replace("duration_s = 0.1", "duration_s = 1e9")
+    with pytest.raises(up.ScenarioError) as info:
+        load_scenario(write(tmp_path, text))
+    message = str(info.value)
+    assert "GiB" in message and "scenario.duration_s" in message
+    assert "output.log_period_s" in message
+    # the same limit with 1 GiB available: 10 s (1001 samples) loads, 1e6 s does not
+    # (the package re-exports a function named simulate: reach the module itself)
+    module = importlib.import_module("uvms_pin.simulate")
+    monkeypatch.setattr(module, "available_memory_bytes", lambda: 2**30)
+    load_scenario(write(tmp_path, MINIMAL.replace("duration_s = 0.1", "duration_s = 10.0")))
+    with pytest.raises(up.ScenarioError, match="more than half of the 1 GiB available"):
+        load_scenario(write(tmp_path, MINIMAL.replace("duration_s = 0.1", "duration_s = 1e6")))
+
+
+def test_the_recorded_settings_are_the_simulated_ones(tmp_path):
+    """Log period, step and duration that divide each other: the rollout's time axis is
+    exactly 0, log_period, ..., duration, and the metadata records what ran."""
+    text = MINIMAL + "[integrator]\nstep_s = 0.005\n[output]\nlog_period_s = 0.02\n"
+    rollout = up.simulate(load_scenario(write(tmp_path, text)))
+    np.testing.assert_allclose(rollout.time_s, np.arange(6) * 0.02, atol=1e-12)
+    assert rollout.metadata["simulated_time_s"] == pytest.approx(0.1)
+    assert rollout.metadata["integrator_settings"]["step_s"] == 0.005

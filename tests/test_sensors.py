@@ -68,6 +68,35 @@ def test_sampled_noise_rejects_bad_period():
             SampledNoise(NoiseSpec(0.1), 3, period, 1.0, np.random.default_rng(0))
 
 
+@pytest.mark.parametrize("distribution", ["uniform", "gaussian"])
+@pytest.mark.parametrize("chunk_rows", [2, 7, 4096])
+def test_lazy_noise_equals_one_draw_of_the_whole_table(distribution, chunk_rows):
+    """Drawn chunk by chunk as time advances, the noise is bitwise the noise of one draw of
+    the whole table, the same generator state, at the grid points and between them; going
+    back in time (replayed from the seed) gives the same values again."""
+    spec = NoiseSpec(0.02, distribution)
+    duration, period = 0.2, 1e-3
+    table = spec.draw(np.random.default_rng(3), (round(duration / period) + 2, 3))
+    noise = SampledNoise(spec, 3, period, duration, np.random.default_rng(3), chunk_rows=chunk_rows)
+    grid = np.arange(round(duration / period) + 1)
+    for k in grid:
+        np.testing.assert_array_equal(noise(k * period), table[k])
+    s = 0.3
+    blend = s * s * (3.0 - 2.0 * s)
+    for k in grid[::-1][1:]:  # backwards: replays the stream from the seed
+        expected = table[k] + blend * (table[k + 1] - table[k])
+        np.testing.assert_allclose(noise((k + s) * period), expected, rtol=0, atol=1e-15)
+
+
+def test_lazy_noise_memory_does_not_grow_with_the_duration():
+    """A 1e6 s run at 1 kHz would be a 24 GB table; lazily, only two chunks are held."""
+    noise = SampledNoise(NoiseSpec(0.1), 3, 1e-3, 1e6, np.random.default_rng(0), chunk_rows=64)
+    for t in np.linspace(0.0, 2.0, 50):
+        noise(float(t))
+    assert noise._window.nbytes <= 2 * 64 * 3 * 8
+    assert np.all(np.abs(noise(1.999)) <= 0.1)
+
+
 def _config(bound: float = 0.02, distribution: str = "uniform") -> SensorConfig:
     spec = NoiseSpec(bound, distribution)
     return SensorConfig(

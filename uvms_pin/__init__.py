@@ -11,10 +11,12 @@ from uvms_pin.dynamics import (
 from uvms_pin.errors import (
     FunnelViolation,
     ModelError,
+    ModelWarning,
     ParameterError,
     ScenarioError,
     SimulationError,
     UvmsPinError,
+    UvmsPinWarning,
 )
 from uvms_pin.hydro.params import HydroParams
 from uvms_pin.measurement import Measurement
@@ -33,11 +35,13 @@ __all__ = [
     "HydroParams",
     "Measurement",
     "ModelError",
+    "ModelWarning",
     "ParameterError",
     "Rollout",
     "ScenarioError",
     "SimulationError",
     "UvmsPinError",
+    "UvmsPinWarning",
     "bias_forces",
     "forward_dynamics",
     "frame_wrench_to_generalized",

@@ -5,10 +5,11 @@ from __future__ import annotations
 import argparse
 import sys
 import time
+import warnings
 from pathlib import Path
 
 from uvms_pin.arms.command import register as register_compare_arms
-from uvms_pin.errors import FunnelViolation, SimulationError, UvmsPinError
+from uvms_pin.errors import FunnelViolation, SimulationError, UvmsPinError, UvmsPinWarning
 from uvms_pin.model import load_uvms
 from uvms_pin.overrides import parse_assignment
 from uvms_pin.resources import find_model
@@ -212,8 +213,23 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
+def _show_warning(message, category, filename, lineno, file=None, line=None) -> None:
+    """The project's warnings as one line each, like its errors (no source location)."""
+    if issubclass(category, UvmsPinWarning):
+        print(f"uvms-pin: warning: {message}", file=sys.stderr)
+    else:
+        sys.stderr.write(warnings.formatwarning(message, category, filename, lineno, line))
+
+
 def main(argv: list[str] | None = None) -> int:
     args = build_parser().parse_args(argv)
+    with warnings.catch_warnings():
+        warnings.simplefilter("always", UvmsPinWarning)
+        warnings.showwarning = _show_warning
+        return _dispatch(args)
+
+
+def _dispatch(args: argparse.Namespace) -> int:
     try:
         return args.func(args)
     except UvmsPinError as exc:

@@ -24,6 +24,17 @@ class ModelError(UvmsPinError):
         self.link = link
 
 
+class UvmsPinWarning(UserWarning):
+    """Base class of every warning issued by uvms-pin (the CLI prints them as warnings)."""
+
+
+class ModelWarning(UvmsPinWarning):
+    """A model loads but looks physically suspicious (e.g. a link with volume and no mass).
+
+    The message names the file, the link and what is suspicious.
+    """
+
+
 class ParameterError(UvmsPinError, ValueError):
     """An argument has the wrong shape, a non-finite value or is out of its valid range."""
 

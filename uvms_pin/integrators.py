@@ -198,14 +198,18 @@ class Adaptive(Integrator):
             t_eval=times,
             events=events,
         )
-        if not sol.success:
-            raise SimulationError(
-                f"{self.method} failed between t = {t0:.6g} s and {times[-1]:.6g} s: {sol.message}"
-            )
+        # sol.y is an empty list, not an array, when no output time was reached
+        ys = np.reshape(sol.y, (2 * nv, len(sol.t))).T
         out = [
             (float(t), pin.integrate(model, q0, y[:nv]), y[nv:].copy())
-            for t, y in zip(sol.t, sol.y.T, strict=True)
+            for t, y in zip(sol.t, ys, strict=True)
         ]
+        if not sol.success:
+            error = SimulationError(
+                f"{self.method} failed between t = {t0:.6g} s and {times[-1]:.6g} s: {sol.message}"
+            )
+            error.states = out  # the output times reached before the failure
+            raise error
         if sol.status == 1:  # stopped by the event
             t_event, y_event = float(sol.t_events[0][0]), sol.y_events[0][0]
             out.append((t_event, pin.integrate(model, q0, y_event[:nv]), y_event[nv:].copy()))

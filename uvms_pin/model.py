@@ -10,6 +10,7 @@ so nothing is approximated when links are merged.
 from __future__ import annotations
 
 import dataclasses
+import warnings
 import xml.etree.ElementTree as ET
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
@@ -18,7 +19,7 @@ from pathlib import Path
 import numpy as np
 import pinocchio as pin
 
-from uvms_pin.errors import ModelError, ParameterError
+from uvms_pin.errors import ModelError, ModelWarning, ParameterError
 from uvms_pin.hydro import geometry
 from uvms_pin.hydro.added_mass import added_mass_in_parent
 from uvms_pin.hydro.mesh import load_mesh_geometry, mesh_hydro
@@ -256,6 +257,7 @@ def load_uvms(
     except Exception as exc:  # Pinocchio raises ValueError/RuntimeError for bad URDFs
         raise ModelError(f"Pinocchio could not build the model: {exc}", path=where) from exc
 
+    _check_joint_limits(root, where)
     _read_armature(root, model, where)
     bodies: list[HydroBody] = []
     for name, link in links.items():
@@ -268,7 +270,8 @@ def load_uvms(
             raise ModelError("has <collision> geometry but no <inertial>", path=where, link=name)
         if not has_inertial:
             continue  # a frame-only link: no body, no hydrodynamics
-        _check_inertial(link.find("inertial"), where, name)
+        mass_kg = _check_inertial(link.find("inertial"), where, name)
+        n_bodies = len(bodies)
         frame_id = model.getFrameId(name, pin.BODY)
         if frame_id >= len(model.frames):
             raise ModelError("not found in the Pinocchio model", path=where, link=name)
@@ -292,6 +295,9 @@ def load_uvms(
                 path=where,
                 link=name,
             )
+        if len(bodies) > n_bodies:  # a dry link accepted by allow_dry_links is no surprise
+            volume_m3 = sum(b.params.volume_m3 for b in bodies[n_bodies:])
+            _warn_on_mass_volume_mismatch(mass_kg, volume_m3, where, name)
 
     return UVMS(
         model=model,
@@ -303,8 +309,8 @@ def load_uvms(
     )
 
 
-def _check_inertial(inertial: ET.Element, where: str, link: str) -> None:
-    """Validate <inertial> ourselves.
+def _check_inertial(inertial: ET.Element, where: str, link: str) -> float:
+    """Validate <inertial> ourselves; return the mass [kg].
 
     Fix: urdfdom only prints to stderr when <mass> or <inertia> is missing or non-numeric,
     and Pinocchio then builds the link with zero mass and/or zero rotational inertia, which
@@ -320,8 +326,95 @@ def _check_inertial(inertial: ET.Element, where: str, link: str) -> None:
     inertia_el = inertial.find("inertia")
     if inertia_el is None:
         raise ModelError("<inertial> has no <inertia>", path=where, link=link)
-    for key in ("ixx", "ixy", "ixz", "iyy", "iyz", "izz"):
-        _numbers(inertia_el.get(key), 1, f"<inertia {key}>", where, link)
+    entries = {
+        key: float(_numbers(inertia_el.get(key), 1, f"<inertia {key}>", where, link)[0])
+        for key in ("ixx", "ixy", "ixz", "iyy", "iyz", "izz")
+    }
+    _check_rotational_inertia(entries, mass, where, link)
+    return mass
+
+
+# Relative slack of the inertia checks: URDF inertias are often printed with 3-4 digits,
+# and a flat plate (I3 = I1 + I2 exactly) must not fail on its rounding.
+_INERTIA_RELATIVE_TOLERANCE = 1e-3
+
+
+def _check_rotational_inertia(entries: dict[str, float], mass_kg: float, where: str, link: str):
+    """The rotational inertia of a body [kg m^2] must be one a mass distribution can have.
+
+    I = sum m_k (|r_k|^2 1 - r_k r_k^T) gives: principal moments I1 <= I2 <= I3 all >= 0
+    (positive semi-definite: zero for a point mass), the triangle inequality
+    I1 + I2 >= I3 (I1 + I2 - I3 = 2 sum m_k z_k^2 in the principal frame), and I = 0 when
+    the mass is zero. Negative diagonal entries are refused outright.
+    """
+    matrix = np.array(
+        [
+            [entries["ixx"], entries["ixy"], entries["ixz"]],
+            [entries["ixy"], entries["iyy"], entries["iyz"]],
+            [entries["ixz"], entries["iyz"], entries["izz"]],
+        ]
+    )
+    principal = np.linalg.eigvalsh(matrix)
+    scale = float(np.max(np.abs(principal)))
+    if scale == 0.0:
+        return
+    if mass_kg == 0.0:
+        raise ModelError(
+            f"zero mass but a rotational inertia (principal moments {_fmt(principal)} kg m^2)",
+            path=where,
+            link=link,
+        )
+    negative = [k for k in ("ixx", "iyy", "izz") if entries[k] < 0.0]
+    if negative or principal[0] < -_INERTIA_RELATIVE_TOLERANCE * scale:
+        raise ModelError(
+            f"inertia is not positive semi-definite: principal moments {_fmt(principal)} "
+            f"kg m^2{' (negative ' + ', '.join(negative) + ')' if negative else ''}",
+            path=where,
+            link=link,
+        )
+    if principal[0] + principal[1] < principal[2] * (1.0 - _INERTIA_RELATIVE_TOLERANCE):
+        raise ModelError(
+            f"inertia violates the triangle inequality I1 + I2 >= I3: principal moments "
+            f"{_fmt(principal)} kg m^2 (no mass distribution has them)",
+            path=where,
+            link=link,
+        )
+
+
+def _fmt(values: np.ndarray) -> str:
+    return "(" + ", ".join(f"{x:.6g}" for x in values) + ")"
+
+
+def _check_joint_limits(root: ET.Element, where: str) -> None:
+    """<limit lower upper> of every revolute and prismatic joint: lower <= upper.
+
+    Pinocchio keeps an inverted interval, and clipping into it (initial state, null-space
+    target) then gives a configuration outside both bounds.
+    """
+    for joint in root.findall("joint"):
+        limit = joint.find("limit")
+        if limit is None or joint.get("type") not in ("revolute", "prismatic"):
+            continue
+        name = f"joint {joint.get('name', '?')}"
+        lower = float(_numbers(limit.get("lower", "0"), 1, "<limit lower>", where, name)[0])
+        upper = float(_numbers(limit.get("upper", "0"), 1, "<limit upper>", where, name)[0])
+        if lower > upper:
+            raise ModelError(
+                f"joint '{joint.get('name', '?')}': <limit> lower = {lower} > upper = {upper}",
+                path=where,
+            )
+
+
+def _warn_on_mass_volume_mismatch(mass_kg: float, volume_m3: float, where: str, link: str):
+    """A link that displaces water but weighs nothing (or the reverse) is legal but rarely
+    meant: buoyancy without weight (or weight without buoyancy) on that link."""
+    if volume_m3 > 0.0 and mass_kg == 0.0:
+        cause = f"displaces {volume_m3:.6g} m^3 of water but has zero mass"
+    elif mass_kg > 0.0 and volume_m3 == 0.0:
+        cause = f"has {mass_kg:.6g} kg of mass but displaces no water (zero volume)"
+    else:
+        return
+    warnings.warn(f"{where}: link '{link}': {cause}", ModelWarning, stacklevel=3)
 
 
 def _read_armature(root: ET.Element, model: pin.Model, where: str) -> None:

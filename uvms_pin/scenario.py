@@ -38,7 +38,13 @@ from uvms_pin.progress import ProgressBar, callback_or_none
 from uvms_pin.resources import find_model, shipped_models
 from uvms_pin.rollout import Rollout
 from uvms_pin.sensors import NoiseSpec, SensorConfig, SensorSuite
-from uvms_pin.simulate import Progress, SimulationSettings, simulate_closed_loop
+from uvms_pin.simulate import (
+    DIVERGED_SPEED,
+    Progress,
+    SimulationSettings,
+    check_log_fits,
+    simulate_closed_loop,
+)
 
 ControllerFactory = Callable[[UVMS], Controller]
 
@@ -296,6 +302,7 @@ def _build(raw: dict[str, Any], path: Path, source: str, overridden: dict[str, s
     top.finish()
     try:
         settings = SimulationSettings(duration, integrator, log_period, control_period, seed)
+        check_log_fits(settings, uvms.nq, uvms.nv)
     except ParameterError as exc:
         raise ScenarioError(f"{source}: {exc}") from exc
     return Scenario(
@@ -310,6 +317,12 @@ def _initial_state(t: _Table, uvms: UVMS) -> tuple[np.ndarray, np.ndarray]:
     joints = t.vector("joint_positions_rad", n_arm, uvms.neutral_configuration()[7:])
     velocity = t.vector("velocity", uvms.nv, np.zeros(uvms.nv))
     t.finish()
+    if np.max(np.abs(velocity)) >= DIVERGED_SPEED:
+        raise t._err(
+            "velocity",
+            f"{np.max(np.abs(velocity)):g} is not a physical speed (the simulator treats "
+            f"|v| >= {DIVERGED_SPEED:g} m/s or rad/s as diverged)",
+        )
     lo, hi = uvms.model.lowerPositionLimit[7:], uvms.model.upperPositionLimit[7:]
     outside = (joints < lo) | (joints > hi)
     if np.any(outside):

@@ -1,7 +1,7 @@
 """Sensors with bounded, seeded noise; they produce the controller's `Measurement`.
 
-Noise is drawn once, on a fixed sample grid, from a seeded generator, so a measurement is a
-deterministic function of time: the same run gives the same numbers whatever the
+Noise is drawn on a fixed sample grid (lazily, in chunks) from a seeded generator, so a
+measurement is a deterministic function of time: the same run gives the same numbers whatever the
 integrator. Between grid points the noise is blended with a smoothstep, n(t) = n_k +
 (n_k+1 - n_k)(3 s^2 - 2 s^3), s = t / T - k: it equals the drawn samples at the grid points
 (where a sampled controller reads it), never leaves their bounds, and is continuously
@@ -48,7 +48,15 @@ class NoiseSpec:
 
 
 class SampledNoise:
-    """A noise signal drawn every ``period_s`` and smoothstep-blended between draws."""
+    """A noise signal drawn every ``period_s`` and smoothstep-blended between draws.
+
+    The samples are drawn lazily, ``chunk_rows`` at a time, as time advances: memory stays
+    bounded whatever the duration. Drawing a stream in chunks gives exactly the numbers of
+    one draw of the whole table (numpy's generators fill arrays value by value), so the
+    signal does not depend on the chunk size. Only the current and the previous chunk are
+    kept; an earlier time replays the stream from the seed (never needed by the closed loop,
+    whose integrators go back at most one output interval).
+    """
 
     def __init__(
         self,
@@ -57,20 +65,48 @@ class SampledNoise:
         period_s: float,
         duration_s: float,
         rng: np.random.Generator,
+        *,
+        chunk_rows: int = 4096,
     ):
         if not (period_s > 0.0 and math.isfinite(period_s)):
             raise ParameterError(f"noise sample period must be positive, got {period_s}")
+        if chunk_rows < 2:
+            raise ParameterError(f"chunk_rows must be >= 2, got {chunk_rows}")
         self.period_s = period_s
-        self._table = spec.draw(rng, (math.ceil(duration_s / period_s) + 2, width))
+        self._spec = spec
+        self._width = width
+        self._rows = math.ceil(duration_s / period_s) + 2
+        self._chunk_rows = chunk_rows
+        self._start_state = rng.bit_generator.state
+        self._rng = rng
+        self._rewind()
+
+    def _rewind(self) -> None:
+        self._rng.bit_generator.state = self._start_state
+        self._first = 0  # row index of self._window[0]
+        self._window = np.empty((0, self._width))
+
+    def _rows_from(self, k: int) -> np.ndarray:
+        """Rows k and k + 1 of the (virtual) table."""
+        if k < self._first:
+            self._rewind()
+        while k + 1 >= self._first + len(self._window):
+            # keep the last chunk (rows k - 1, k may straddle two chunks), append the next
+            keep = self._window[-self._chunk_rows :]
+            self._first += len(self._window) - len(keep)
+            fresh = self._spec.draw(self._rng, (self._chunk_rows, self._width))
+            self._window = np.concatenate([keep, fresh])
+        return self._window[k - self._first : k - self._first + 2]
 
     def __call__(self, time_s: float) -> np.ndarray:
         position = max(time_s, 0.0) / self.period_s
-        k = min(int(position + 1e-9), len(self._table) - 2)
+        k = min(int(position + 1e-9), self._rows - 2)
         s = min(max(position - k, 0.0), 1.0)
+        here, after = self._rows_from(k)
         if s < 1e-9:
-            return self._table[k]
+            return here
         blend = s * s * (3.0 - 2.0 * s)
-        return self._table[k] + blend * (self._table[k + 1] - self._table[k])
+        return here + blend * (after - here)
 
 
 @dataclass(frozen=True)

@@ -10,6 +10,7 @@ Two control modes:
 from __future__ import annotations
 
 import math
+import os
 import platform
 import time
 from collections.abc import Callable
@@ -30,7 +31,10 @@ from uvms_pin.sensors import SensorSuite
 Progress = Callable[[float, float], None]
 
 # A speed this large [m/s or rad/s] only comes out of a blown-up integration.
-_DIVERGED_SPEED = 1e4
+DIVERGED_SPEED = 1e4
+# What numerical code raises on a blown-up state (a singular chart Jacobian or mass
+# matrix, an overflow): reported as a SimulationError with the partial rollout kept.
+_NUMERICAL_FAILURES = (np.linalg.LinAlgError, FloatingPointError, OverflowError, ZeroDivisionError)
 # The funnel event fires when the margin min(1 - |xi|) reaches -this: just outside, so
 # that the controller, evaluated at the located event state, reports the violation.
 _EVENT_OVERSHOOT = 1e-6
@@ -62,17 +66,38 @@ class SimulationSettings:
             raise ParameterError(f"duration_s must be positive, got {self.duration_s}")
         if not (self.log_period_s > 0.0 and math.isfinite(self.log_period_s)):
             raise ParameterError(f"log_period_s must be positive, got {self.log_period_s}")
+        # Nothing is silently rounded or capped: the run is exactly the one recorded.
+        _require_multiple(
+            self.duration_s,
+            self.log_period_s,
+            "duration_s (scenario.duration_s)",
+            "log_period_s (output.log_period_s)",
+        )
         if self.control_period_s is not None:
             if not (self.control_period_s > 0.0 and math.isfinite(self.control_period_s)):
                 raise ParameterError(
                     f"control_period_s must be positive, got {self.control_period_s}"
                 )
-            ratio = self.log_period_s / self.control_period_s
-            if ratio < 1.0 - 1e-9 or abs(ratio - round(ratio)) > 1e-6:
-                raise ParameterError(
-                    f"log_period_s ({self.log_period_s}) must be an integer multiple of "
-                    f"control_period_s ({self.control_period_s})"
-                )
+            _require_multiple(
+                self.log_period_s,
+                self.control_period_s,
+                "log_period_s (output.log_period_s)",
+                "control_period_s (control.period_s)",
+            )
+        step_s = getattr(self.integrator, "step_s", None)
+        if step_s is not None:
+            # a fixed-step integrator takes equal substeps of each control (or output)
+            # interval: a step that does not divide it would be shortened without a trace
+            interval, name = (
+                (self.control_period_s, "control_period_s (control.period_s)")
+                if self.control_period_s is not None
+                else (self.log_period_s, "log_period_s (output.log_period_s)")
+            )
+            _require_multiple(interval, step_s, name, "step_s (integrator.step_s)")
+
+    def log_bytes(self, nq: int, nv: int) -> int:
+        """Memory the rollout of this run takes [bytes] (float64 arrays, every sample)."""
+        return self.n_log * 8 * _log_width(nq, nv)
 
     @property
     def n_log(self) -> int:
@@ -83,6 +108,53 @@ class SimulationSettings:
         if self.control_period_s is None:
             return 1
         return round(self.log_period_s / self.control_period_s)
+
+
+def _require_multiple(whole: float, part: float, whole_name: str, part_name: str) -> None:
+    """ParameterError unless whole = n part for an integer n >= 1 (relative slack 1e-6)."""
+    ratio = whole / part
+    if ratio < 1.0 - 1e-9 or abs(ratio - round(ratio)) > 1e-6 * max(1.0, ratio):
+        raise ParameterError(
+            f"{whole_name} = {whole:g} s must be an integer multiple (>= 1) of "
+            f"{part_name} = {part:g} s: the run would not be the one recorded"
+        )
+
+
+def _log_width(nq: int, nv: int) -> int:
+    """Float64 values logged per sample: the base arrays (`Rollout.allocate`) and the
+    controller's signals, bounded by 10 (6 + nv) (the PPC logs 3 x 3 + 5 x 6 + 7 nv: its
+    references, errors, funnels and commanded tau)."""
+    base = 1 + nq + 2 * nv + 3 * 6 + 2
+    return base + 10 * (6 + nv)
+
+
+def available_memory_bytes() -> int | None:
+    """Memory the system can give this process now [bytes], or None if unknown."""
+    try:
+        with open("/proc/meminfo") as f:
+            for line in f:
+                if line.startswith("MemAvailable:"):
+                    return int(line.split()[1]) * 1024
+    except OSError:
+        pass
+    try:
+        return os.sysconf("SC_AVPHYS_PAGES") * os.sysconf("SC_PAGE_SIZE")
+    except (ValueError, OSError, AttributeError):
+        return None
+
+
+def check_log_fits(settings: SimulationSettings, nq: int, nv: int) -> None:
+    """ParameterError, before anything is allocated, if the rollout would take more than half
+    of the available memory (the other half: figures, the saved copy, the rest of the run)."""
+    needed = settings.log_bytes(nq, nv)
+    available = available_memory_bytes()
+    if available is not None and needed > available // 2:
+        raise ParameterError(
+            f"the log of this run would take {needed / 2**30:.3g} GiB "
+            f"({settings.n_log} samples: duration_s {settings.duration_s:g} s / log_period_s "
+            f"{settings.log_period_s:g} s), more than half of the {available / 2**30:.3g} GiB "
+            "available: shorten scenario.duration_s or lengthen output.log_period_s"
+        )
 
 
 def package_versions() -> dict[str, str]:
@@ -144,6 +216,7 @@ def simulate_closed_loop(
         arm_position_lower_rad=model.lowerPositionLimit[7:].tolist(),
         arm_position_upper_rad=model.upperPositionLimit[7:].tolist(),
     )
+    check_log_fits(settings, model.nq, model.nv)
     rollout = Rollout.allocate(settings.n_log, model.nq, model.nv, meta)
     controller.reset()
     plant.attach(q0)
@@ -164,7 +237,12 @@ def simulate_closed_loop(
     def continuous_rhs(t: float, q: np.ndarray, v: np.ndarray) -> np.ndarray:
         measurement, contact = measure(t, q, v)
         _, tau_applied = command(t, measurement)
-        return plant.acceleration(t, q, v, tau_applied, contact)
+        acceleration = plant.acceleration(t, q, v, tau_applied, contact)
+        # an adaptive solver would shrink its step on a non-finite stage until it gives up
+        # with a message that does not say why: stop at once instead
+        if not np.all(np.isfinite(acceleration)):
+            raise SimulationError(f"simulation diverged: non-finite acceleration at t = {t:.6g} s")
+        return acceleration
 
     def log(k: int, t: float, q, v, tau, tau_applied, contact, measured) -> None:
         rollout.time_s[k] = t
@@ -183,7 +261,7 @@ def simulate_closed_loop(
     def check_finite(t0: float, t1: float, q: np.ndarray, v: np.ndarray) -> None:
         if (
             not (np.all(np.isfinite(q)) and np.all(np.isfinite(v)))
-            or np.max(np.abs(v)) > _DIVERGED_SPEED
+            or np.max(np.abs(v)) > DIVERGED_SPEED
         ):
             raise SimulationError(f"simulation diverged between t = {t0:.6g} s and {t1:.6g} s")
 
@@ -200,6 +278,7 @@ def simulate_closed_loop(
     wall_start = time.perf_counter()
     log_times = np.arange(settings.n_log) * settings.log_period_s
     logged = 0
+    span = [0.0, 0.0]  # the interval being integrated, for a divergence message
     try:
         q, v = q0, v0
         if settings.control_period_s is None:
@@ -221,10 +300,14 @@ def simulate_closed_loop(
                 t0 = log_times[logged - 1]
                 times = log_times[logged : logged + per_segment]
                 controller.set_funnel_extension(adaptive)
+                span[:] = t0, times[-1]
+                failure = None
                 try:
                     states = settings.integrator.advance_through(
                         model, continuous_rhs, t0, q, v, times, margin_event if adaptive else None
                     )
+                except SimulationError as exc:  # log the states reached before the failure
+                    states, failure = getattr(exc, "states", []), exc
                 finally:
                     controller.set_funnel_extension(False)
                 for t, q, v in states:
@@ -237,6 +320,8 @@ def simulate_closed_loop(
                             f"funnel event at t = {t:.6g} s but the controller found no violation"
                         )
                     logged += 1
+                if failure is not None:
+                    raise failure
         else:
             ticks_per_log = settings.ticks_per_log
             tick_s = settings.control_period_s
@@ -248,14 +333,20 @@ def simulate_closed_loop(
                 logged += on_log
                 if tick == n_ticks:
                     break
+                span[:] = t, t + tick_s
                 q, v = settings.integrator.advance(
                     model, held_rhs(tau_applied), t, q, v, t + tick_s
                 )
                 check_finite(t, t + tick_s, q, v)
-    except (FunnelViolation, SimulationError) as exc:
-        rollout.truncate(logged)
-        _finish(rollout, wall_start, settings, type(exc).__name__, str(exc))
-        exc.rollout = rollout
+    except _NUMERICAL_FAILURES as exc:
+        error = SimulationError(
+            f"simulation diverged between t = {span[0]:.6g} s and {span[1]:.6g} s "
+            f"({type(exc).__name__}: {exc})"
+        )
+        _stopped(rollout, logged, wall_start, settings, error)
+        raise error from exc
+    except SimulationError as exc:  # FunnelViolation included
+        _stopped(rollout, logged, wall_start, settings, exc)
         raise
     _finish(rollout, wall_start, settings, "ok", "")
     return rollout
@@ -266,6 +357,27 @@ def _joint_kind(model, joint_name: str) -> str:
     shortname = model.joints[model.getJointId(joint_name)].shortname()
     prismatic = ("JointModelPX", "JointModelPY", "JointModelPZ", "JointModelPrismatic")
     return "prismatic" if shortname.startswith(prismatic) else "revolute"
+
+
+def _stopped(
+    rollout: Rollout,
+    logged: int,
+    wall_start: float,
+    settings: SimulationSettings,
+    exc: SimulationError,
+) -> None:
+    """Keep the samples logged before the stop and attach the rollout to the exception."""
+    rollout.truncate(logged)
+    _finish(rollout, wall_start, settings, type(exc).__name__, str(exc))
+    if isinstance(exc, FunnelViolation):
+        rollout.metadata["violation"] = {
+            "level": exc.level,
+            "component": exc.component,
+            "time_s": exc.time_s,
+            "error": exc.error,
+            "bound": exc.bound,
+        }
+    exc.rollout = rollout
 
 
 def _finish(

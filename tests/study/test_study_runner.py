@@ -175,3 +175,15 @@ def test_report_writes_markdown_and_figures(tmp_path, serial_table):
     assert "violation_rate.png" in names and any(n.startswith("heatmap_") for n in names)
     assert any(n.startswith("scatter_") for n in names) and any(n.startswith("box_") for n in names)
     assert all(p.stat().st_size > 1000 for p in written)
+
+
+def test_a_scaled_parameter_column_holds_the_factor(serial_table):
+    """disturbance.amplitude is varied with apply = "scale": its column is named as a
+    factor on the base amplitude (0.15 N), and holds the factor, not newtons."""
+    study, serial = serial_table
+    assert "disturbance.amplitude" not in serial.columns
+    factors = serial["disturbance.amplitude [x base]"]
+    assert factors.between(0.5, 2.0).all()
+    for run in study.runs():
+        row = serial[serial["run_id"] == run.run_id].iloc[0]
+        assert row["disturbance.amplitude [x base]"] == run.values["disturbance.amplitude"]

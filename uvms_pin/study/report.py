@@ -20,7 +20,7 @@ import tomllib
 from matplotlib.figure import Figure
 
 from uvms_pin.study.runner import STATUSES, STUDY_COPY, load_results
-from uvms_pin.study.spec import StudyError
+from uvms_pin.study.spec import StudyError, column_name
 
 REPORT_FILE = "report.md"
 FIGURES_DIR = "figures"
@@ -56,7 +56,7 @@ def _parameters(table: pd.DataFrame, info: dict[str, Any]) -> list[dict[str, Any
     entries = info.get("parameter") or [{"path": c} for c in table.columns if "." in c]
     out = []
     for entry in entries:
-        path = entry.get("path")
+        path = column_name(entry.get("path"), entry.get("apply", "set"))
         if path not in table.columns:
             continue
         column = table[path]
@@ -271,6 +271,29 @@ def _rank_correlation(x: pd.Series, y: pd.Series) -> float:
     return float(x[ok].rank().corr(y[ok].astype(float).rank()))
 
 
+def exclude_unfinished_transients(table: pd.DataFrame) -> tuple[pd.DataFrame, int, float]:
+    """The table with the "after transient" metrics blanked (NaN) for runs that stopped
+    before the force funnel's transient ended, how many, and that transient end [s].
+
+    A run stopped at t = 0.01 s has no "after the transient": its partial rollout's last
+    funnel value is not rho_inf, so its after-transient metrics describe the transient
+    itself. The transient end is the median ``transient_end_s`` of the runs that finished
+    (their funnel was logged to the end); with no finished run, every stopped run is
+    excluded.
+    """
+    columns = [c for c in table.columns if "after_transient" in c]
+    if not columns or "simulated_time_s" not in table.columns:
+        return table, 0, math.nan
+    finished = table["status"] == "ok"
+    ends = table.loc[finished, "transient_end_s"] if "transient_end_s" in table else []
+    end = float(np.nanmedian(ends)) if len(ends) and np.isfinite(ends).any() else math.nan
+    simulated = table["simulated_time_s"].astype(float)
+    excluded = ~finished & ~(simulated >= end)  # NaN end: every stopped run
+    out = table.copy()
+    out.loc[excluded, columns] = math.nan
+    return out, int(excluded.sum()), end
+
+
 def write_report(directory: str | Path) -> list[Path]:
     """Write ``report.md`` and its figures (``figures/*.png``) into a study directory.
 
@@ -281,6 +304,7 @@ def write_report(directory: str | Path) -> list[Path]:
     table = load_results(directory)
     if not len(table):
         raise StudyError(f"{directory}: the study table is empty (no run finished yet)")
+    table, excluded, transient_end = exclude_unfinished_transients(table)
     info = _study_info(directory)
     head = info.get("study", {})
     options = info.get("report", {})
@@ -308,11 +332,30 @@ def write_report(directory: str | Path) -> list[Path]:
         figures.append(violations)
 
     text = _markdown(table, head, params, metrics, heatmaps, figures, directory)
+    text = text.replace(_EXCLUSION_MARK, _exclusion_note(excluded, transient_end))
     report = directory / REPORT_FILE
     tmp = report.with_suffix(".md.tmp")
     tmp.write_text(text)
     tmp.replace(report)
     return [report, *figures]
+
+
+_EXCLUSION_MARK = "<!-- excluded runs -->"
+
+
+def _exclusion_note(excluded: int, transient_end_s: float) -> str:
+    if not excluded:
+        return ""
+    when = (
+        f"before the force funnel's transient ended (t = {transient_end_s:.3g} s, the median "
+        "over the finished runs)"
+        if math.isfinite(transient_end_s)
+        else "and no run finished to say when the transient ends"
+    )
+    return (
+        f"\n{excluded} run(s) stopped {when}: they are excluded from the after-transient "
+        "metrics, here and in the figures."
+    )
 
 
 def _heatmap_pairs(table, params, options) -> list[tuple[str, str]]:
@@ -427,6 +470,7 @@ def _markdown(table, head, params, metrics, heatmaps, figures, directory) -> str
             "## Metrics",
             "",
             "Over all runs (a stopped run's metrics cover its partial rollout) and over the runs that finished ok.",
+            _EXCLUSION_MARK,
             "",
         ]
         rows = []

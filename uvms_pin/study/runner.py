@@ -110,7 +110,9 @@ def base_row(run: Run) -> dict[str, Any]:
         "host": socket.gethostname(),
     }
     for path, value in run.values.items():
-        row[path] = value if not isinstance(value, list) else json.dumps(value)
+        row[run.columns.get(path, path)] = (
+            value if not isinstance(value, list) else json.dumps(value)
+        )
     return row
 
 

@@ -77,6 +77,11 @@ class Parameter:
         return self.path.startswith(PLANT_PREFIX)
 
     @property
+    def column(self) -> str:
+        """The study table's column of this parameter (see `column_name`)."""
+        return column_name(self.path, self.apply)
+
+    @property
     def key(self) -> str:
         """The scenario key without the element index."""
         return parse_key_path(self.path).key
@@ -98,6 +103,13 @@ class Parameter:
         return float(np.clip(value, a.get("low", -math.inf), a.get("high", math.inf)))
 
 
+def column_name(path: str, apply: str = "set") -> str:
+    """What a table column of a varied parameter holds: the value set (``path``), a factor
+    on the base value (``path [x base]``) or an increment to it (``path [+ base]``): the
+    column of a scaled 0.15 N amplitude holds 2.0, not newtons."""
+    return {"set": path, "scale": f"{path} [x base]", "add": f"{path} [+ base]"}[apply]
+
+
 @dataclass(frozen=True)
 class Run:
     """One simulation of a study.
@@ -109,6 +121,7 @@ class Run:
         values: parameter path -> value, as varied (what the table records).
         overrides: dotted scenario keys -> values, ready for `load_scenario`.
         plant: plant factor name -> value (``mass_scale``, ...), 1.0 when not varied.
+        columns: parameter path -> its table column (`column_name`).
     """
 
     run_id: str
@@ -118,6 +131,7 @@ class Run:
     values: dict[str, Any]
     overrides: dict[str, Any]
     plant: dict[str, float]
+    columns: dict[str, str] = field(default_factory=dict)
 
 
 @dataclass
@@ -164,8 +178,18 @@ class Study:
                 seed = sample_seed(self.seed, sample)
                 overrides, plant = self.resolve(values)
                 overrides["scenario.seed"] = seed
+                columns = {p.path: p.column for p in self.parameters}
                 out.append(
-                    Run(run_id(values, seed), len(out), sample, seed, values, overrides, plant)
+                    Run(
+                        run_id(values, seed),
+                        len(out),
+                        sample,
+                        seed,
+                        values,
+                        overrides,
+                        plant,
+                        columns,
+                    )
                 )
         return out
 

@@ -9,8 +9,9 @@ from pathlib import Path
 
 from matplotlib.figure import Figure
 
+from uvms_pin.controllers.ppc import FIRST_LEVEL_NAMES, VEHICLE_VELOCITY_NAMES
 from uvms_pin.rollout import Rollout
-from uvms_pin.viz.plots import new_figure, save_figure
+from uvms_pin.viz.plots import mark_stop, new_figure, save_figure
 
 #: The signals Figs. 3-5 need (logged by the PPC controller).
 PPC_SIGNALS = ("force_desired_world_N", "e_x", "rho_x", "e_zeta", "rho_zeta")
@@ -33,6 +34,17 @@ def _funnel_axes(ax, t, error, rho, label):
     ax.set_ylabel(label, fontsize=8)
     ax.grid(True, alpha=0.3)
     ax.tick_params(labelsize=7)
+
+
+def _mark_violation(axes_of_component: dict[str, object], rollout: Rollout, level: str) -> None:
+    """The violating error at the violation time (red x) and its bounds +-rho (red bars):
+    the state is not a logged sample, so without this the curve ends inside the funnel."""
+    v = rollout.metadata.get("violation")
+    if not v or v["level"] != level or v["component"] not in axes_of_component:
+        return
+    ax = axes_of_component[v["component"]]
+    ax.plot([v["time_s"]] * 2, [v["bound"], -v["bound"]], "_", color="tab:red", markersize=14)
+    ax.plot(v["time_s"], v["error"], "x", color="tab:red", markersize=9, markeredgewidth=2)
 
 
 def plot_force(rollout: Rollout, path: Path | None = None) -> Figure | Path:
@@ -68,7 +80,7 @@ def plot_force(rollout: Rollout, path: Path | None = None) -> Figure | Path:
         ax.grid(True, alpha=0.3)
     axes[0].legend(loc="upper right", fontsize=8)
     axes[-1].set_xlabel("time [s]")
-    fig.suptitle(f"{rollout.metadata.get('scenario', '')}: contact force")
+    mark_stop(fig, axes, rollout, f"{rollout.metadata.get('scenario', '')}: contact force")
     return save_figure(fig, path)
 
 
@@ -81,7 +93,10 @@ def plot_first_level(rollout: Rollout, path: Path | None = None) -> Figure | Pat
         _funnel_axes(axes[j % 3, j // 3], t, e[:, j], rho[:, j], FIRST_LEVEL_LABELS[j])
     for ax in axes[-1]:
         ax.set_xlabel("time [s]")
-    fig.suptitle(f"{rollout.metadata.get('scenario', '')}: first-level errors and funnels")
+    by_name = {name: axes[j % 3, j // 3] for j, name in enumerate(FIRST_LEVEL_NAMES)}
+    _mark_violation(by_name, rollout, "first")
+    title = f"{rollout.metadata.get('scenario', '')}: first-level errors and funnels"
+    mark_stop(fig, axes, rollout, title)
     return save_figure(fig, path)
 
 
@@ -113,9 +128,15 @@ def plot_second_level(
     if 0 < n_arm < rows:
         axes[n_arm - 1, 1].xaxis.set_tick_params(labelbottom=True)
         axes[n_arm - 1, 1].set_xlabel("time [s]")
-    fig.suptitle(
-        f"{rollout.metadata.get('scenario', '')}: second-level velocity errors and funnels"
+    component_names = list(VEHICLE_VELOCITY_NAMES) + list(
+        rollout.metadata.get("arm_joint_names", [])
     )
+    by_name = {
+        name: axes[j, 0] if j < 6 else axes[j - 6, 1] for j, name in enumerate(component_names[:n])
+    }
+    _mark_violation(by_name, rollout, "second")
+    title = f"{rollout.metadata.get('scenario', '')}: second-level velocity errors and funnels"
+    mark_stop(fig, axes, rollout, title)
     return save_figure(fig, path)
 
 

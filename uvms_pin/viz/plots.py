@@ -13,6 +13,7 @@ import pinocchio as pin
 from matplotlib.figure import Figure
 
 from uvms_pin.rollout import Rollout
+from uvms_pin.viz.stop import stop_summary, stop_time_s
 
 
 def new_figure(rows: int = 1, cols: int = 1, figsize=(8, 6), **kw):
@@ -35,6 +36,23 @@ def save_figure(fig: Figure, path: Path | None) -> Figure | Path:
     return path
 
 
+# ---- a stopped run: where and why, in every figure ------------------------------------------
+
+
+def mark_stop(fig: Figure, axes, rollout: Rollout, title: str) -> None:
+    """Title the figure; for a stopped run add the reason under the title and a dashed red
+    line at the stop time in every axes."""
+    summary = stop_summary(rollout)
+    if summary is None:
+        fig.suptitle(title)
+        return
+    fig.suptitle(f"{title}\n{summary}", color="tab:red")
+    t_stop = stop_time_s(rollout)
+    for ax in np.ravel(axes):
+        if ax.get_visible():
+            ax.axvline(t_stop, color="tab:red", linestyle="--", linewidth=1.0)
+
+
 def plot_pose(rollout: Rollout, path: Path | None = None) -> Figure | Path:
     """Vehicle position (world) and roll/pitch/yaw over time."""
     t = rollout.time_s
@@ -51,7 +69,7 @@ def plot_pose(rollout: Rollout, path: Path | None = None) -> Figure | Path:
     ax_o.set_xlabel("time [s]")
     ax_o.legend(loc="best")
     ax_o.grid(True, alpha=0.3)
-    fig.suptitle(f"{rollout.metadata.get('scenario', '')}: vehicle pose")
+    mark_stop(fig, (ax_p, ax_o), rollout, f"{rollout.metadata.get('scenario', '')}: vehicle pose")
     return save_figure(fig, path)
 
 
@@ -75,7 +93,7 @@ def plot_velocities(rollout: Rollout, path: Path | None = None) -> Figure | Path
     for ax in axes:
         ax.legend(loc="best", fontsize=8)
         ax.grid(True, alpha=0.3)
-    fig.suptitle(f"{rollout.metadata.get('scenario', '')}: velocities")
+    mark_stop(fig, axes, rollout, f"{rollout.metadata.get('scenario', '')}: velocities")
     return save_figure(fig, path)
 
 
@@ -92,7 +110,7 @@ def plot_energy(rollout: Rollout, path: Path | None = None) -> Figure | Path:
     ax.set_ylabel("energy [J]")
     ax.legend(loc="best")
     ax.grid(True, alpha=0.3)
-    ax.set_title(f"{rollout.metadata.get('scenario', '')}: energy")
+    mark_stop(fig, ax, rollout, f"{rollout.metadata.get('scenario', '')}: energy")
     return save_figure(fig, path)
 
 

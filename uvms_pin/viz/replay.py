@@ -34,6 +34,7 @@ from uvms_pin.viz.meshcat_scene import (
     UvmsScene,
     recording_visualizer,
 )
+from uvms_pin.viz.stop import stop_summary
 
 REPLAY_FILE = "replay.html"
 _TRAIL_CHUNKS = 60
@@ -142,6 +143,7 @@ def replay_html(
         "title": f"uvms-pin replay: {meta.get('scenario', 'rollout')}",
         "description": meta.get("description", ""),
         "status": meta.get("status", ""),
+        "stopped": stop_summary(rollout) or "",
         "t0": t0,
         "duration": float(time_s[-1] - t0),
         "fps": fps,
@@ -221,6 +223,7 @@ body { margin: 0; background: #04162e; font: 13px/1.35 sans-serif; }
 #uvms-info { position: absolute; left: 8px; top: 8px; max-width: 46vw; color: #e8f2ff;
   background: rgba(0, 20, 40, 0.55); padding: 6px 9px; border-radius: 4px; }
 #uvms-info b { font-size: 14px; }
+#uvms-info .uvms-stopped { color: #ff8a80; }
 #uvms-bar { position: absolute; left: 0; right: 0; bottom: 0; display: flex; gap: 10px;
   align-items: center; padding: 6px 12px; background: rgba(0, 20, 40, 0.6); color: #e8f2ff; }
 #uvms-bar button { width: 72px; }
@@ -284,6 +287,8 @@ def _page(commands: list[bytes], info: dict[str, Any]) -> str:
     if info["duration"] > 0:
         frames = f"<br>{info['frames']} frames at {info['fps']:.3g} per simulated second"
     status = f" ({esc(info['status'])})" if info["status"] else ""
+    if info.get("stopped"):
+        status += f'<br><span class="uvms-stopped">{esc(info["stopped"])}</span>'
     return f"""<!DOCTYPE html>
 <html>
 <head>

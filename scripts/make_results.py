@@ -1,0 +1,57 @@
+"""Regenerate every table and figure the README quotes (``make results``).
+
+    python scripts/make_results.py [--only NAME ...] [--skip NAME ...] [--list]
+
+Each result is one script in scripts/results/ writing docs/results/<name>.md (and its
+figures into docs/). To add a result, add its script there and its name to PRODUCERS.
+"""
+
+from __future__ import annotations
+
+import argparse
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[1]
+
+# name -> what it regenerates (the script is scripts/results/<name>.py); in run order
+PRODUCERS = {
+    "paper": "the paper's scenario: docs/results/paper.md, docs/paper_force.png",
+    "realistic": "the realistic scenario: docs/results/realistic.md, docs/realistic_force.png",
+    "robustness": "robustness table: docs/results/robustness.md",
+    "bench": "benchmark table: docs/results/bench.md",
+    "compare_arms": "arm comparison: docs/results/compare_arms.md, docs/arm_comparison.png",
+    "study_model_uncertainty": "study summary: docs/results/study_model_uncertainty.md",
+    "study_paper_claims": "study summary: docs/results/study_paper_claims.md",
+}
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--only", nargs="+", choices=list(PRODUCERS), default=None)
+    parser.add_argument("--skip", nargs="+", choices=list(PRODUCERS), default=[])
+    parser.add_argument("--list", action="store_true", help="list the results and exit")
+    args = parser.parse_args(argv)
+    if args.list:
+        for name, what in PRODUCERS.items():
+            print(f"{name:<26} {what}")
+        return 0
+    names = [n for n in (args.only or PRODUCERS) if n not in args.skip]
+    failed = []
+    for name in names:
+        start = time.perf_counter()
+        print(f"== {name}: {PRODUCERS[name]}", flush=True)
+        script = ROOT / "scripts" / "results" / f"{name}.py"
+        if subprocess.run([sys.executable, str(script)], cwd=ROOT, check=False).returncode:
+            failed.append(name)
+        print(f"== {name}: {time.perf_counter() - start:.0f} s", flush=True)
+    if failed:
+        print(f"make results: failed: {', '.join(failed)}", file=sys.stderr)
+        return 1
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

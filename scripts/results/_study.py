@@ -1,0 +1,23 @@
+"""A study as a result: sweep, report, and the report's text (figures stay in out/)."""
+
+from __future__ import annotations
+
+import re
+
+from _common import scratch, uvms_pin, write_result
+
+
+def produce(name: str, study: str, title: str) -> None:
+    out = scratch(name)
+    uvms_pin("sweep", study, "--out", str(out), "--workers", "2", "--quiet")
+    uvms_pin("report", str(out))
+    report = (out / "report.md").read_text()
+    # the summary only: figures are many and large; they stay in out/results/<name>/
+    report = report.split("\n## Figures")[0]
+    report = re.sub(r"!\[[^\]]*\]\([^)]*\)\n?", "", report)
+    report = re.sub(r"^# .*\n", "", report, count=1)
+    body = (
+        f"`uvms-pin sweep {study} --out out/results/{name} --workers 2` then "
+        f"`uvms-pin report out/results/{name}` (figures there):\n\n{report}"
+    )
+    write_result(name, title, f"python scripts/results/{name}.py", body)

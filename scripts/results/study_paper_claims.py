@@ -1,0 +1,6 @@
+"""The paper_claims study (240 runs): its report's summary."""
+
+from _study import produce
+
+if __name__ == "__main__":
+    produce("study_paper_claims", "studies/paper_claims.toml", "Study: the paper's claims")
