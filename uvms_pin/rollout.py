@@ -3,14 +3,13 @@
 from __future__ import annotations
 
 import json
-import os
-import tempfile
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
+from uvms_pin.atomic import atomic_write
 from uvms_pin.errors import ParameterError
 
 ARRAY_FILE = "rollout.npz"
@@ -107,8 +106,8 @@ class Rollout:
         text = json.dumps(self.metadata, indent=2, sort_keys=True, default=_json_default)
         arrays = {name: getattr(self, name) for name in self._BASE}
         arrays.update({f"signal__{k}": a for k, a in self.signals.items()})
-        _atomic_write(out / ARRAY_FILE, lambda f: np.savez_compressed(f, **arrays), binary=True)
-        _atomic_write(out / META_FILE, lambda f: f.write(text), binary=False)
+        atomic_write(out / ARRAY_FILE, lambda f: np.savez_compressed(f, **arrays), binary=True)
+        atomic_write(out / META_FILE, lambda f: f.write(text), binary=False)
         return out
 
     @classmethod
@@ -138,16 +137,4 @@ def _json_default(obj: Any) -> Any:
 def write_json_atomic(path: Path, payload: dict[str, Any]) -> None:
     """Write a JSON file so that a crash never leaves it half-written."""
     text = json.dumps(payload, indent=2, sort_keys=True, default=_json_default)
-    _atomic_write(path, lambda f: f.write(text), binary=False)
-
-
-def _atomic_write(path: Path, writer, *, binary: bool) -> None:
-    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
-    try:
-        with os.fdopen(fd, "wb" if binary else "w") as f:
-            writer(f)
-        os.replace(tmp, path)
-    except BaseException:
-        if os.path.exists(tmp):
-            os.unlink(tmp)
-        raise
+    atomic_write(path, lambda f: f.write(text), binary=False)

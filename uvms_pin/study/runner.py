@@ -21,7 +21,6 @@ saturation), every metric of `Rollout.metrics`, the run's wall time and host.
 
 from __future__ import annotations
 
-import contextlib
 import hashlib
 import json
 import logging
@@ -30,7 +29,6 @@ import os
 import shutil
 import socket
 import sys
-import tempfile
 import time
 import traceback
 from collections.abc import Callable
@@ -40,6 +38,7 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
+from uvms_pin.atomic import atomic_path
 from uvms_pin.errors import FunnelViolation, SimulationError
 from uvms_pin.study.spec import Run, Study
 
@@ -147,15 +146,8 @@ def error_row(run: Run, exc: BaseException) -> dict[str, Any]:
 
 
 def _atomic_parquet(frame: pd.DataFrame, path: Path) -> None:
-    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
-    os.close(fd)
-    try:
+    with atomic_path(path) as tmp:
         frame.to_parquet(tmp, index=False)
-        os.replace(tmp, path)
-    except BaseException:
-        with contextlib.suppress(FileNotFoundError):
-            os.unlink(tmp)
-        raise
 
 
 class ResultStore:

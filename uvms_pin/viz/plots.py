@@ -8,6 +8,7 @@ import numpy as np
 import pinocchio as pin
 from matplotlib.figure import Figure
 
+from uvms_pin.atomic import atomic_path
 from uvms_pin.rollout import Rollout
 
 
@@ -24,7 +25,8 @@ def _rpy(q: np.ndarray) -> np.ndarray:
 
 def save_figure(fig: Figure, path: Path) -> Path:
     fig.tight_layout()
-    fig.savefig(path, dpi=120)
+    with atomic_path(path) as tmp:
+        fig.savefig(tmp, dpi=120, format=Path(path).suffix[1:])
     return path
 
 
