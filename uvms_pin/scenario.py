@@ -18,7 +18,6 @@ from typing import Any
 
 import numpy as np
 import pinocchio as pin
-import tomllib
 
 from uvms_pin.actuation import Actuation, Thruster, ThrustersAndJointLimits, Unlimited
 from uvms_pin.controllers.base import Controller, ZeroController
@@ -31,6 +30,7 @@ from uvms_pin.plant import Plant
 from uvms_pin.rollout import Rollout
 from uvms_pin.sensors import NoiseSpec, SensorConfig, SensorSuite
 from uvms_pin.simulate import Progress, SimulationSettings, simulate_closed_loop
+from uvms_pin.tomlfile import read_toml
 
 ControllerFactory = Callable[[UVMS], Controller]
 
@@ -188,12 +188,7 @@ def load_scenario(path: str | Path, overrides: dict[str, Any] | None = None) -> 
     """Read a scenario TOML file, apply dotted overrides and build the objects."""
     path = Path(path)
     source = str(path)
-    if not path.is_file():
-        raise ScenarioError(f"{source}: file not found")
-    try:
-        raw = tomllib.loads(path.read_text())
-    except tomllib.TOMLDecodeError as exc:
-        raise ScenarioError(f"{source}: not valid TOML ({exc})") from exc
+    raw = read_toml(path, ScenarioError)
     raw = apply_overrides(raw, overrides, source)
     try:
         return _build(raw, path, source)

@@ -20,7 +20,8 @@ import tomllib
 from matplotlib.figure import Figure
 
 from uvms_pin.atomic import atomic_path, write_text_atomic
-from uvms_pin.study.runner import STATUSES, STUDY_COPY, load_results
+from uvms_pin.study.identity import STUDY_COPY
+from uvms_pin.study.runner import STATUSES, load_results
 from uvms_pin.study.spec import StudyError
 
 REPORT_FILE = "report.md"
