@@ -8,10 +8,13 @@ import time
 from pathlib import Path
 
 from uvms_pin.arms.command import register as register_compare_arms
+from uvms_pin.cli_types import positive
 from uvms_pin.errors import FunnelViolation, SimulationError, UvmsPinError
 from uvms_pin.model import load_uvms
+from uvms_pin.outdir import OVERWRITE_HELP, RUN, check_writable, claim, claim_file
 from uvms_pin.rollout import Rollout, write_json_atomic
 from uvms_pin.scenario import load_scenario, simulate
+from uvms_pin.simulate import package_versions
 from uvms_pin.study.command import register as register_study_commands
 from uvms_pin.summary import model_summary
 
@@ -88,21 +91,15 @@ def _write_replay(rollout: Rollout, path: Path, **kw) -> Path:
 def _cmd_run(args: argparse.Namespace) -> int:
     _check_view_options(args)
     scenario = load_scenario(args.scenario)
-    out = Path(args.out)
-    progress = None if args.quiet else _ProgressLine(scenario.name)
-    status = 0
-    try:
-        rollout = _simulate(scenario, args, progress)
-    except (FunnelViolation, SimulationError) as exc:
-        rollout = exc.rollout
-        status = EXIT_RUN_STOPPED
-        message = f"run stopped: {exc}"
-    finally:
-        if progress is not None:
-            progress.close()
-    figures = write_outputs(rollout, out)
-    if args.html:
-        figures.append(_write_replay(rollout, out / "replay.html"))
+    out = check_writable(args.out)  # before simulating, not after
+    with claim(out, RUN, overwrite=args.overwrite):
+        rollout, status, message = _simulate_to_end(scenario, args)
+        if rollout is None:
+            print(message, file=sys.stderr)
+            return status
+        figures = write_outputs(rollout, out)
+        if args.html:
+            figures.append(_write_replay(rollout, out / "replay.html"))
     metrics = rollout.metrics()
     print(
         f"scenario {scenario.name}: {rollout.metadata['status']}, simulated {metrics['simulated_time_s']:.3f} s in {metrics['wall_time_s']:.2f} s (real-time factor {metrics['real_time_factor']:.2f})"
@@ -116,9 +113,26 @@ def _cmd_run(args: argparse.Namespace) -> int:
     return status
 
 
+def _simulate_to_end(scenario, args: argparse.Namespace) -> tuple[Rollout | None, int, str]:
+    """(rollout, exit status, message): a stopped or interrupted run keeps its rollout."""
+    progress = None if args.quiet else _ProgressLine(scenario.name)
+    try:
+        return _simulate(scenario, args, progress), 0, ""
+    except (FunnelViolation, SimulationError) as exc:
+        return getattr(exc, "rollout", None), EXIT_RUN_STOPPED, f"run stopped: {exc}"
+    except KeyboardInterrupt as exc:
+        rollout = getattr(exc, "rollout", None)
+        if rollout is None or not len(rollout):
+            return None, EXIT_INTERRUPTED, "uvms-pin: interrupted before the first sample"
+        t_s = float(rollout.time_s[-1])
+        kept = f"the partial rollout (t = 0 to {t_s:.3f} s) is kept in {args.out}"
+        return rollout, EXIT_INTERRUPTED, f"uvms-pin: interrupted: {kept}"
+    finally:
+        if progress is not None:
+            progress.close()
+
+
 def _check_view_options(args: argparse.Namespace) -> None:
-    if not args.speed > 0.0:
-        raise UvmsPinError(f"--speed must be positive, got {args.speed}")
     if not 0 <= args.port <= 65535:
         raise UvmsPinError(f"--port must be in 0..65535, got {args.port}")
 
@@ -127,12 +141,11 @@ def _cmd_replay(args: argparse.Namespace) -> int:
     _check_view_options(args)
     if not (args.html or args.live):
         raise UvmsPinError("replay: nothing to do, give --html and/or --live")
-    if not args.fps > 0.0:
-        raise UvmsPinError(f"--fps must be positive, got {args.fps}")
     rollout = Rollout.load(args.rollout)
     if args.html:
         path = Path(args.out) if args.out else Path(args.rollout) / "replay.html"
-        _write_replay(rollout, path, urdf=args.urdf, max_fps=args.fps)
+        with claim_file(path, overwrite=args.overwrite):
+            _write_replay(rollout, path, urdf=args.urdf, max_fps=args.fps)
         size_mb = path.stat().st_size / 1e6
         print(f"wrote {path} ({size_mb:.1f} MB, {len(rollout)} samples)")
     if args.live:
@@ -152,7 +165,7 @@ def _add_view_options(parser: argparse.ArgumentParser) -> None:
         "--port", type=int, default=7000, help="live view port (default 7000; 0: any free)"
     )
     parser.add_argument(
-        "--speed", type=float, default=1.0, help="live playback speed-up over real time"
+        "--speed", type=positive, default=1.0, help="live playback speed-up over real time"
     )
 
 
@@ -166,11 +179,13 @@ def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(
         prog="uvms-pin", description="Underwater vehicle-manipulator simulation on Pinocchio."
     )
+    parser.add_argument("--version", action="version", version=version_text())
     sub = parser.add_subparsers(dest="command", required=True)
     run = sub.add_parser("run", help="run a scenario file and write rollout, metrics and figures")
     run.add_argument("scenario", help="scenario TOML file")
     run.add_argument("--out", required=True, help="output directory")
     run.add_argument("--quiet", action="store_true", help="no progress line")
+    run.add_argument("--overwrite", action="store_true", help=OVERWRITE_HELP)
     run.add_argument(
         "--html", action="store_true", help="also write replay.html (self-contained, offline)"
     )
@@ -181,20 +196,27 @@ def build_parser() -> argparse.ArgumentParser:
     replay.add_argument("--html", action="store_true", help="write ROLLOUT/replay.html")
     replay.add_argument("--out", help="write the page here instead of ROLLOUT/replay.html")
     replay.add_argument("--urdf", help="the model's URDF, if it moved since the run")
+    replay.add_argument("--overwrite", action="store_true", help="replace an existing page")
     replay.add_argument(
-        "--fps", type=float, default=30.0, help="replay frames per simulated second (max)"
+        "--fps", type=positive, default=30.0, help="replay frames per simulated second (max)"
     )
     _add_view_options(replay)
     replay.set_defaults(func=_cmd_replay)
     info = sub.add_parser("info", help="print a summary of a UVMS URDF")
     info.add_argument("urdf", help="URDF file with the hydrodynamic extension")
     info.add_argument(
-        "--water-density", type=float, default=1025.0, help="kg/m^3 (default: sea water)"
+        "--water-density", type=positive, default=1025.0, help="kg/m^3 (default: sea water)"
     )
     info.set_defaults(func=_cmd_info)
     register_study_commands(sub)
     register_compare_arms(sub)
     return parser
+
+
+def version_text() -> str:
+    """``uvms-pin X (pinocchio Y, Python Z)``: what a bug report needs."""
+    versions = package_versions()
+    return f"uvms-pin {versions['uvms-pin']} (pinocchio {versions['pin']}, Python {versions['python']})"
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -207,6 +229,10 @@ def main(argv: list[str] | None = None) -> int:
     except KeyboardInterrupt:
         print("uvms-pin: interrupted", file=sys.stderr)
         return EXIT_INTERRUPTED
+    except OSError as exc:  # a disk full, a file removed under us: not a bug to trace
+        where = f"{exc.filename}: " if exc.filename else ""
+        print(f"uvms-pin: error: {where}{exc.strerror or exc}", file=sys.stderr)
+        return EXIT_BAD_INPUT
 
 
 if __name__ == "__main__":

@@ -87,6 +87,9 @@ COMPARISON = OutputKind(
     ("comparison.csv", "comparison.md", "comparison.png", "models/*.urdf"),
 )
 KINDS = (RUN, STUDY, COMPARISON)
+OVERWRITE_HELP = (
+    "replace the results an earlier run left in --out (only files uvms-pin writes are removed)"
+)
 
 
 def check_writable(path: str | Path, option: str = "--out") -> Path:
@@ -133,22 +136,26 @@ def claim(
     are removed first). ``kind = STUDY`` accepts its own results (a sweep resumes).
     """
     directory = check_writable(directory, option)
+    created = not directory.exists()
     try:
         directory.mkdir(parents=True, exist_ok=True)
     except OSError as exc:
         raise OutputError(f"{option} {directory}: cannot create it ({exc.strerror})") from exc
-    with _locked(directory, option):
-        _refuse_other_kinds(directory, kind, option)
-        if kind is not STUDY and kind.holds(directory):
-            if not overwrite:
+    try:
+        with _locked(directory, option):
+            _refuse_other_kinds(directory, kind, option)
+            if kind is not STUDY and kind.holds(directory) and not overwrite:
                 raise OutputError(
                     f"{option} {directory} already holds {kind.name} "
                     f"({', '.join(p.name for p in kind.present(directory)[:4])}...); "
                     "pass --overwrite to replace them, or choose another directory"
                 )
-        if overwrite:
-            remove_outputs(directory, kind)
-        yield directory
+            if overwrite:
+                remove_outputs(directory, kind)
+            yield directory
+    finally:  # a run that wrote nothing leaves no directory behind
+        if created and directory.is_dir() and not any(directory.iterdir()):
+            directory.rmdir()
 
 
 def _refuse_other_kinds(directory: Path, kind: OutputKind, option: str) -> None:

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import zipfile
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -115,12 +116,19 @@ class Rollout:
         src = Path(directory)
         if not (src / ARRAY_FILE).is_file() or not (src / META_FILE).is_file():
             raise ParameterError(f"{src} holds no rollout ({ARRAY_FILE} and {META_FILE} expected)")
-        with np.load(src / ARRAY_FILE) as data:
-            base = {name: data[name] for name in cls._BASE}
-            signals = {
-                k[len("signal__") :]: data[k] for k in data.files if k.startswith("signal__")
-            }
-        metadata = json.loads((src / META_FILE).read_text())
+        try:
+            with np.load(src / ARRAY_FILE) as data:
+                base = {name: data[name] for name in cls._BASE}
+                signals = {
+                    k[len("signal__") :]: data[k] for k in data.files if k.startswith("signal__")
+                }
+            metadata = json.loads((src / META_FILE).read_text(encoding="utf-8"))
+        except (OSError, ValueError, KeyError, zipfile.BadZipFile) as exc:  # JSON errors too
+            raise ParameterError(
+                f"{src} holds a damaged rollout ({type(exc).__name__}: {exc}); rerun the scenario"
+            ) from exc
+        if not isinstance(metadata, dict):
+            raise ParameterError(f"{src / META_FILE}: a JSON object expected")
         return cls(**base, signals=signals, metadata=metadata)
 
 

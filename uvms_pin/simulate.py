@@ -115,6 +115,7 @@ def simulate_closed_loop(
         FunnelViolation, SimulationError: the run stopped early; the exception's
             ``rollout`` attribute holds the rollout up to the last logged sample with
             ``metadata['status']`` and ``metadata['error']`` set.
+        KeyboardInterrupt: likewise, with status ``interrupted``.
     """
     uvms = plant.uvms
     model = uvms.model
@@ -254,6 +255,11 @@ def simulate_closed_loop(
     except (FunnelViolation, SimulationError) as exc:
         rollout.truncate(logged)
         _finish(rollout, wall_start, settings, type(exc).__name__, str(exc))
+        exc.rollout = rollout
+        raise
+    except KeyboardInterrupt as exc:  # Ctrl-C: the caller may keep what was simulated
+        rollout.truncate(logged)
+        _finish(rollout, wall_start, settings, "interrupted", "interrupted by the user")
         exc.rollout = rollout
         raise
     _finish(rollout, wall_start, settings, "ok", "")

@@ -221,7 +221,13 @@ def _client(workers: int | None, scheduler: str | None):
     from dask.distributed import Client, LocalCluster
 
     if scheduler is not None:
-        return Client(scheduler), None
+        try:
+            return Client(scheduler, timeout=30), None
+        except (OSError, TimeoutError, ValueError) as exc:
+            raise StudyError(
+                f"--scheduler {scheduler}: cannot connect ({type(exc).__name__}: {exc}); "
+                "is the scheduler running at that address?"
+            ) from exc
     cluster = LocalCluster(
         n_workers=workers or os.cpu_count() or 1,
         threads_per_worker=1,
