@@ -22,12 +22,15 @@ saturation), every metric of `Rollout.metrics`, the run's wall time and host.
 
 from __future__ import annotations
 
+import contextlib
 import json
 import logging
 import math
 import os
+import signal
 import socket
 import sys
+import threading
 import time
 import traceback
 from collections.abc import Callable
@@ -228,14 +231,31 @@ def _client(workers: int | None, scheduler: str | None):
                 f"--scheduler {scheduler}: cannot connect ({type(exc).__name__}: {exc}); "
                 "is the scheduler running at that address?"
             ) from exc
-    cluster = LocalCluster(
-        n_workers=workers or os.cpu_count() or 1,
-        threads_per_worker=1,
-        processes=True,
-        dashboard_address=":0",
-        silence_logs=logging.ERROR,
-    )
+    with _sigint_ignored_by_children():
+        cluster = LocalCluster(
+            n_workers=workers or os.cpu_count() or 1,
+            threads_per_worker=1,
+            processes=True,
+            dashboard_address=":0",
+            silence_logs=logging.ERROR,
+        )
     return Client(cluster), cluster
+
+
+@contextlib.contextmanager
+def _sigint_ignored_by_children():
+    """Start worker processes with Ctrl-C ignored (inherited, and Python keeps an ignored
+    SIGINT): a terminal's Ctrl-C reaches the whole process group, and each worker would
+    print its own KeyboardInterrupt traceback; this process alone handles it and closes
+    the cluster."""
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    previous = signal.signal(signal.SIGINT, signal.SIG_IGN)
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGINT, previous)
 
 
 def run_study(
