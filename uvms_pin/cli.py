@@ -6,17 +6,19 @@ import argparse
 import sys
 import time
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from uvms_pin.arms.command import register as register_compare_arms
 from uvms_pin.cli_types import positive
 from uvms_pin.errors import FunnelViolation, SimulationError, UvmsPinError
-from uvms_pin.model import load_uvms
 from uvms_pin.outdir import OVERWRITE_HELP, RUN, check_writable, claim, claim_file
-from uvms_pin.rollout import Rollout, write_json_atomic
-from uvms_pin.scenario import load_scenario, simulate
-from uvms_pin.simulate import package_versions
 from uvms_pin.study.command import register as register_study_commands
-from uvms_pin.summary import model_summary
+
+if TYPE_CHECKING:
+    from uvms_pin.rollout import Rollout
+
+# The simulation stack (Pinocchio, SciPy, matplotlib) is imported by the commands that
+# need it: --help, --version and argument errors answer at once.
 
 EXIT_BAD_INPUT = 2
 EXIT_RUN_STOPPED = 3
@@ -56,6 +58,7 @@ class _ProgressLine:
 
 def write_outputs(rollout: Rollout, out: Path) -> list[Path]:
     """Rollout, metrics.json and figures into ``out``."""
+    from uvms_pin.rollout import write_json_atomic
     from uvms_pin.viz.paper_figures import paper_figures
     from uvms_pin.viz.plots import standard_figures
 
@@ -75,6 +78,8 @@ def write_outputs(rollout: Rollout, out: Path) -> list[Path]:
 
 
 def _simulate(scenario, args: argparse.Namespace, progress) -> Rollout:
+    from uvms_pin.scenario import simulate
+
     if not args.live:
         return simulate(scenario, progress=progress)
     from uvms_pin.viz.live import run_live
@@ -89,6 +94,8 @@ def _write_replay(rollout: Rollout, path: Path, **kw) -> Path:
 
 
 def _cmd_run(args: argparse.Namespace) -> int:
+    from uvms_pin.scenario import load_scenario
+
     _check_view_options(args)
     scenario = load_scenario(args.scenario)
     out = check_writable(args.out)  # before simulating, not after
@@ -141,6 +148,8 @@ def _cmd_replay(args: argparse.Namespace) -> int:
     _check_view_options(args)
     if not (args.html or args.live):
         raise UvmsPinError("replay: nothing to do, give --html and/or --live")
+    from uvms_pin.rollout import Rollout
+
     rollout = Rollout.load(args.rollout)
     if args.html:
         path = Path(args.out) if args.out else Path(args.rollout) / "replay.html"
@@ -170,6 +179,9 @@ def _add_view_options(parser: argparse.ArgumentParser) -> None:
 
 
 def _cmd_info(args: argparse.Namespace) -> int:
+    from uvms_pin.model import load_uvms
+    from uvms_pin.summary import model_summary
+
     uvms = load_uvms(args.urdf, water_density_kg_m3=args.water_density)
     print(model_summary(uvms))
     return 0
@@ -179,7 +191,7 @@ def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(
         prog="uvms-pin", description="Underwater vehicle-manipulator simulation on Pinocchio."
     )
-    parser.add_argument("--version", action="version", version=version_text())
+    parser.add_argument("--version", action=_Version)
     sub = parser.add_subparsers(dest="command", required=True)
     run = sub.add_parser("run", help="run a scenario file and write rollout, metrics and figures")
     run.add_argument("scenario", help="scenario TOML file")
@@ -213,8 +225,22 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
+class _Version(argparse.Action):
+    """``--version``: the text is made only when asked (it imports Pinocchio)."""
+
+    def __init__(self, option_strings, dest, **kw):
+        kw.update(nargs=0, help="print the versions of uvms-pin, Pinocchio and Python, and exit")
+        super().__init__(option_strings, dest, **kw)
+
+    def __call__(self, parser, namespace, values, option_string=None):
+        print(version_text())
+        parser.exit()
+
+
 def version_text() -> str:
     """``uvms-pin X (pinocchio Y, Python Z)``: what a bug report needs."""
+    from uvms_pin.simulate import package_versions
+
     versions = package_versions()
     return f"uvms-pin {versions['uvms-pin']} (pinocchio {versions['pin']}, Python {versions['python']})"
 

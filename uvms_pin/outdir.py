@@ -92,25 +92,25 @@ OVERWRITE_HELP = (
 )
 
 
-def check_writable(path: str | Path, option: str = "--out") -> Path:
+def check_writable(path: str | Path, option: str = "--out", shown: str | None = None) -> Path:
     """``path`` as a directory uvms-pin can create or write into; OutputError otherwise.
 
     Nothing is created: the first existing ancestor must be a directory we may write in.
+    ``shown``: how messages name the argument (default ``path``).
     """
     path = Path(path)
+    option = f"{option} {path if shown is None else shown}"
     target = path.absolute()
     existing = target
     while not existing.exists():
         if existing.is_symlink():  # a dangling link: mkdir would fail on it
-            raise OutputError(f"{option} {path}: {existing} is a broken symbolic link")
+            raise OutputError(f"{option}: {existing} is a broken symbolic link")
         existing = existing.parent
     if not existing.is_dir():
         where = "is a file" if existing == target else f"is under a file ({existing})"
-        raise OutputError(f"{option} {path}: {where}; give a directory")
+        raise OutputError(f"{option}: {where}; give a directory")
     if not _may_write(existing):
-        raise OutputError(
-            f"{option} {path}: cannot write in {existing} (permission denied or read-only)"
-        )
+        raise OutputError(f"{option}: cannot write in {existing} (permission denied or read-only)")
     return path
 
 
@@ -196,7 +196,7 @@ def claim_file(
     path = Path(path)
     if path.is_dir():
         raise OutputError(f"{option} {path}: is a directory; give a file name (replay.html)")
-    directory = check_writable(path.parent, option)
+    directory = check_writable(path.parent, option, shown=str(path))
     directory.mkdir(parents=True, exist_ok=True)
     with _locked(directory, option):
         if path.exists() and not overwrite:

@@ -11,11 +11,9 @@ import math
 import sys
 
 from uvms_pin.arms.catalog import available_arms
-from uvms_pin.arms.compare import CompareSettings, compare_arms
 from uvms_pin.cli_types import count, finite, positive
 from uvms_pin.errors import ParameterError
 from uvms_pin.outdir import COMPARISON, OVERWRITE_HELP, check_writable, claim
-from uvms_pin.trim import TrimSpec
 
 EXIT_BAD_INPUT = 2
 DEFAULT_ARMS = "reference,so100,z1,kinova,ur3,ur5,panda"
@@ -28,6 +26,9 @@ def _cmd_compare_arms(args: argparse.Namespace) -> int:
     if args.scenario is None:
         print("uvms-pin compare-arms: error: SCENARIO is required", file=sys.stderr)
         return EXIT_BAD_INPUT
+    from uvms_pin.arms.compare import CompareSettings, compare_arms
+    from uvms_pin.trim import TrimSpec
+
     arms = _arm_names(args.arms)
     trim = None if args.no_trim else TrimSpec(bg_m=args.bg, foam_density_kg_m3=args.foam_density)
     settings = CompareSettings(
