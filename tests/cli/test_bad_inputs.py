@@ -153,7 +153,7 @@ def workspace(tmp_path_factory) -> Path:
     (ws / "good.toml").write_text(passive_scenario(0.1))
     write_outputs(simulate(load_scenario(ws / "good.toml")), ws / "prior_run")
     (ws / "study").mkdir()
-    (ws / "study" / "base.toml").write_text(passive_scenario(0.05))
+    (ws / "study" / "base.toml").write_text(passive_scenario(0.04))
     (ws / "study" / "study.toml").write_text(STUDY)
     run_study(
         load_study(ws / "study" / "study.toml"), ws / "prior_study", workers=0, progress=False
