@@ -40,9 +40,11 @@ def test_a_claim_that_wrote_nothing_leaves_no_directory(tmp_path):
 def test_outputs_are_refused_and_overwrite_removes_only_uvms_pin_files(tmp_path):
     out = tmp_path / "out"
     out.mkdir()
-    for name in ("rollout.npz", "rollout.json", "replay.html", "force.png", ".x.json.1a.tmp"):
+    for name in ("rollout.npz", "rollout.json", "replay.html", "force.png"):
         (out / name).write_text("earlier run")
+    (out / ".rollout.json.1a2b3c4d.tmp").write_text("an interrupted write")
     (out / "notes.txt").write_text("mine")
+    (out / ".notes.txt.swp.tmp").write_text("my editor's")
     (out / "photo.png").write_text("mine too")
     with pytest.raises(OutputError, match=r"already holds a run's outputs.*--overwrite"):
         with claim(out, RUN):
@@ -50,7 +52,7 @@ def test_outputs_are_refused_and_overwrite_removes_only_uvms_pin_files(tmp_path)
     assert (out / "rollout.npz").exists()
     with claim(out, RUN, overwrite=True):
         pass
-    assert sorted(p.name for p in out.iterdir()) == ["notes.txt", "photo.png"]
+    assert sorted(p.name for p in out.iterdir()) == [".notes.txt.swp.tmp", "notes.txt", "photo.png"]
 
 
 def test_another_commands_results_are_refused_even_with_overwrite(tmp_path):

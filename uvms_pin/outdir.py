@@ -96,7 +96,7 @@ def check_writable(path: str | Path, option: str = "--out", shown: str | None = 
     """``path`` as a directory uvms-pin can create or write into; OutputError otherwise.
 
     Nothing is created: the first existing ancestor must be a directory we may write in.
-    ``shown``: how messages name the argument (default ``path``).
+    ``shown``: the file the user named, when ``path`` is its directory (messages name it).
     """
     path = Path(path)
     option = f"{option} {path if shown is None else shown}"
@@ -107,7 +107,9 @@ def check_writable(path: str | Path, option: str = "--out", shown: str | None = 
             raise OutputError(f"{option}: {existing} is a broken symbolic link")
         existing = existing.parent
     if not existing.is_dir():
-        where = "is a file" if existing == target else f"is under a file ({existing})"
+        # with ``shown``, ``path`` is the directory of the file the user named
+        itself = existing == target and shown is None
+        where = "is a file" if itself else f"is under a file ({existing})"
         raise OutputError(f"{option}: {where}; give a directory")
     if not _may_write(existing):
         raise OutputError(f"{option}: cannot write in {existing} (permission denied or read-only)")
@@ -173,7 +175,10 @@ def remove_outputs(directory: Path, kind: OutputKind) -> list[Path]:
     Sub-directories the kind created are removed only once empty.
     """
     removed = kind.present(directory)
-    removed += sorted(directory.rglob(f".*{TEMP_SUFFIX}"))
+    for pattern in kind.patterns:  # temporary files of an interrupted write (atomic.py)
+        head, _, name = pattern.rpartition("/")
+        temporary = f".{name}.*{TEMP_SUFFIX}"
+        removed += sorted(directory.glob(f"{head}/{temporary}" if head else temporary))
     for path in removed:
         path.unlink(missing_ok=True)
     subdirs = {p.parent for pattern in kind.patterns for p in directory.glob(pattern)}
