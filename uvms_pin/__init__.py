@@ -1,13 +1,8 @@
 """uvms-pin: Underwater Vehicle-Manipulator Systems on Pinocchio."""
 
-from uvms_pin.dynamics import (
-    bias_forces,
-    forward_dynamics,
-    frame_wrench_to_generalized,
-    kinetic_energy,
-    mass_matrix,
-    potential_energy,
-)
+from importlib import import_module
+from typing import Any
+
 from uvms_pin.errors import (
     FunnelViolation,
     ModelError,
@@ -18,13 +13,41 @@ from uvms_pin.errors import (
     UvmsPinError,
     UvmsPinWarning,
 )
-from uvms_pin.hydro.params import HydroParams
-from uvms_pin.measurement import Measurement
-from uvms_pin.model import UVMS, HydroBody, load_uvms
-from uvms_pin.mount import mount_arm
-from uvms_pin.resources import shipped_path
-from uvms_pin.rollout import Rollout
-from uvms_pin.scenario import load_scenario, simulate
+
+# The rest is imported on first use (PEP 562): ``uvms-pin --help`` and argument errors
+# then answer without loading Pinocchio and SciPy.
+_LAZY = {
+    "bias_forces": "uvms_pin.dynamics",
+    "forward_dynamics": "uvms_pin.dynamics",
+    "frame_wrench_to_generalized": "uvms_pin.dynamics",
+    "kinetic_energy": "uvms_pin.dynamics",
+    "mass_matrix": "uvms_pin.dynamics",
+    "potential_energy": "uvms_pin.dynamics",
+    "HydroParams": "uvms_pin.hydro.params",
+    "Measurement": "uvms_pin.measurement",
+    "UVMS": "uvms_pin.model",
+    "HydroBody": "uvms_pin.model",
+    "load_uvms": "uvms_pin.model",
+    "mount_arm": "uvms_pin.mount",
+    "shipped_path": "uvms_pin.resources",
+    "Rollout": "uvms_pin.rollout",
+    "load_scenario": "uvms_pin.scenario",
+    "simulate": "uvms_pin.scenario",
+}
+
+
+def __getattr__(name: str) -> Any:
+    module = _LAZY.get(name)
+    if module is None:
+        raise AttributeError(f"module 'uvms_pin' has no attribute '{name}'")
+    value = getattr(import_module(module), name)
+    globals()[name] = value
+    return value
+
+
+def __dir__() -> list[str]:
+    return sorted({*globals(), *_LAZY})
+
 
 __version__ = "0.1.0"
 

@@ -7,16 +7,21 @@ import sys
 import time
 import warnings
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from uvms_pin.arms.command import register as register_compare_arms
+from uvms_pin.cli_types import positive
 from uvms_pin.errors import FunnelViolation, SimulationError, UvmsPinError, UvmsPinWarning
-from uvms_pin.model import load_uvms
+from uvms_pin.outdir import OVERWRITE_HELP, RUN, check_writable, claim, claim_file
 from uvms_pin.overrides import parse_assignment
 from uvms_pin.resources import find_model
-from uvms_pin.rollout import Rollout, write_json_atomic
-from uvms_pin.scenario import load_scenario, simulate
 from uvms_pin.study.command import register as register_study_commands
-from uvms_pin.summary import model_summary
+
+if TYPE_CHECKING:
+    from uvms_pin.rollout import Rollout
+
+# The simulation stack (Pinocchio, SciPy, matplotlib) is imported by the commands that
+# need it: --help, --version and argument errors answer at once.
 
 EXIT_BAD_INPUT = 2
 EXIT_RUN_STOPPED = 3
@@ -56,6 +61,7 @@ class _ProgressLine:
 
 def write_outputs(rollout: Rollout, out: Path) -> list[Path]:
     """Rollout, metrics.json and figures into ``out``."""
+    from uvms_pin.rollout import write_json_atomic
     from uvms_pin.viz.paper_figures import paper_figures
     from uvms_pin.viz.plots import standard_figures
 
@@ -75,6 +81,8 @@ def write_outputs(rollout: Rollout, out: Path) -> list[Path]:
 
 
 def _simulate(scenario, args: argparse.Namespace, progress) -> Rollout:
+    from uvms_pin.scenario import simulate
+
     if not args.live:
         return simulate(scenario, progress=progress)
     from uvms_pin.viz.live import run_live
@@ -89,24 +97,20 @@ def _write_replay(rollout: Rollout, path: Path, **kw) -> Path:
 
 
 def _cmd_run(args: argparse.Namespace) -> int:
+    from uvms_pin.scenario import load_scenario
+
     _check_view_options(args)
     overrides = dict(parse_assignment(text) for text in args.set)
     scenario = load_scenario(args.scenario, overrides)
-    out = Path(args.out)
-    progress = None if args.quiet else _ProgressLine(scenario.name)
-    status = 0
-    try:
-        rollout = _simulate(scenario, args, progress)
-    except (FunnelViolation, SimulationError) as exc:
-        rollout = exc.rollout
-        status = EXIT_RUN_STOPPED
-        message = f"run stopped: {exc}"
-    finally:
-        if progress is not None:
-            progress.close()
-    figures = write_outputs(rollout, out)
-    if args.html:
-        figures.append(_write_replay(rollout, out / "replay.html"))
+    out = check_writable(args.out)  # before simulating, not after
+    with claim(out, RUN, overwrite=args.overwrite):
+        rollout, status, message = _simulate_to_end(scenario, args)
+        if rollout is None:
+            print(message, file=sys.stderr)
+            return status
+        figures = write_outputs(rollout, out)
+        if args.html:
+            figures.append(_write_replay(rollout, out / "replay.html"))
     metrics = rollout.metrics()
     print(
         f"scenario {scenario.name}: {rollout.metadata['status']}, simulated {metrics['simulated_time_s']:.3f} s in {metrics['wall_time_s']:.2f} s (real-time factor {metrics['real_time_factor']:.2f})"
@@ -120,9 +124,26 @@ def _cmd_run(args: argparse.Namespace) -> int:
     return status
 
 
+def _simulate_to_end(scenario, args: argparse.Namespace) -> tuple[Rollout | None, int, str]:
+    """(rollout, exit status, message): a stopped or interrupted run keeps its rollout."""
+    progress = None if args.quiet else _ProgressLine(scenario.name)
+    try:
+        return _simulate(scenario, args, progress), 0, ""
+    except (FunnelViolation, SimulationError) as exc:
+        return getattr(exc, "rollout", None), EXIT_RUN_STOPPED, f"run stopped: {exc}"
+    except KeyboardInterrupt as exc:
+        rollout = getattr(exc, "rollout", None)
+        if rollout is None or not len(rollout):
+            return None, EXIT_INTERRUPTED, "uvms-pin: interrupted before the first sample"
+        t_s = float(rollout.time_s[-1])
+        kept = f"the partial rollout (t = 0 to {t_s:.3f} s) is kept in {args.out}"
+        return rollout, EXIT_INTERRUPTED, f"uvms-pin: interrupted: {kept}"
+    finally:
+        if progress is not None:
+            progress.close()
+
+
 def _check_view_options(args: argparse.Namespace) -> None:
-    if not args.speed > 0.0:
-        raise UvmsPinError(f"--speed must be positive, got {args.speed}")
     if not 0 <= args.port <= 65535:
         raise UvmsPinError(f"--port must be in 0..65535, got {args.port}")
 
@@ -131,12 +152,13 @@ def _cmd_replay(args: argparse.Namespace) -> int:
     _check_view_options(args)
     if not (args.html or args.live):
         raise UvmsPinError("replay: nothing to do, give --html and/or --live")
-    if not args.fps > 0.0:
-        raise UvmsPinError(f"--fps must be positive, got {args.fps}")
+    from uvms_pin.rollout import Rollout
+
     rollout = Rollout.load(args.rollout)
     if args.html:
         path = Path(args.out) if args.out else Path(args.rollout) / "replay.html"
-        _write_replay(rollout, path, urdf=args.urdf, max_fps=args.fps)
+        with claim_file(path, overwrite=args.overwrite):
+            _write_replay(rollout, path, urdf=args.urdf, max_fps=args.fps)
         size_mb = path.stat().st_size / 1e6
         print(f"wrote {path} ({size_mb:.1f} MB, {len(rollout)} samples)")
     if args.live:
@@ -156,13 +178,15 @@ def _add_view_options(parser: argparse.ArgumentParser) -> None:
         "--port", type=int, default=7000, help="live view port (default 7000; 0: any free)"
     )
     parser.add_argument(
-        "--speed", type=float, default=1.0, help="live playback speed-up over real time"
+        "--speed", type=positive, default=1.0, help="live playback speed-up over real time"
     )
 
 
 def _cmd_info(args: argparse.Namespace) -> int:
-    path = find_model(args.urdf) or args.urdf  # a file, else a shipped model name
-    uvms = load_uvms(path, water_density_kg_m3=args.water_density)
+    from uvms_pin.model import load_uvms
+    from uvms_pin.summary import model_summary
+
+    uvms = load_uvms(find_model(args.urdf) or args.urdf, water_density_kg_m3=args.water_density)
     print(model_summary(uvms))
     return 0
 
@@ -171,11 +195,13 @@ def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(
         prog="uvms-pin", description="Underwater vehicle-manipulator simulation on Pinocchio."
     )
+    parser.add_argument("--version", action=_Version)
     sub = parser.add_subparsers(dest="command", required=True)
     run = sub.add_parser("run", help="run a scenario file and write rollout, metrics and figures")
     run.add_argument("scenario", help="scenario TOML file")
     run.add_argument("--out", required=True, help="output directory")
     run.add_argument("--quiet", action="store_true", help="no progress line")
+    run.add_argument("--overwrite", action="store_true", help=OVERWRITE_HELP)
     run.add_argument(
         "--set",
         action="append",
@@ -195,8 +221,9 @@ def build_parser() -> argparse.ArgumentParser:
     replay.add_argument("--html", action="store_true", help="write ROLLOUT/replay.html")
     replay.add_argument("--out", help="write the page here instead of ROLLOUT/replay.html")
     replay.add_argument("--urdf", help="the model's URDF, if it moved since the run")
+    replay.add_argument("--overwrite", action="store_true", help="replace an existing page")
     replay.add_argument(
-        "--fps", type=float, default=30.0, help="replay frames per simulated second (max)"
+        "--fps", type=positive, default=30.0, help="replay frames per simulated second (max)"
     )
     _add_view_options(replay)
     replay.set_defaults(func=_cmd_replay)
@@ -205,7 +232,7 @@ def build_parser() -> argparse.ArgumentParser:
         "urdf", help="URDF file with the hydrodynamic extension, or a shipped model name"
     )
     info.add_argument(
-        "--water-density", type=float, default=1025.0, help="kg/m^3 (default: sea water)"
+        "--water-density", type=positive, default=1025.0, help="kg/m^3 (default: sea water)"
     )
     info.set_defaults(func=_cmd_info)
     register_study_commands(sub)
@@ -219,6 +246,26 @@ def _show_warning(message, category, filename, lineno, file=None, line=None) -> 
         print(f"uvms-pin: warning: {message}", file=sys.stderr)
     else:
         sys.stderr.write(warnings.formatwarning(message, category, filename, lineno, line))
+
+
+class _Version(argparse.Action):
+    """``--version``: the text is made only when asked (it imports Pinocchio)."""
+
+    def __init__(self, option_strings, dest, **kw):
+        kw.update(nargs=0, help="print the versions of uvms-pin, Pinocchio and Python, and exit")
+        super().__init__(option_strings, dest, **kw)
+
+    def __call__(self, parser, namespace, values, option_string=None):
+        print(version_text())
+        parser.exit()
+
+
+def version_text() -> str:
+    """``uvms-pin X (pinocchio Y, Python Z)``: what a bug report needs."""
+    from uvms_pin.simulate import package_versions
+
+    versions = package_versions()
+    return f"uvms-pin {versions['uvms-pin']} (pinocchio {versions['pin']}, Python {versions['python']})"
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -238,6 +285,10 @@ def _dispatch(args: argparse.Namespace) -> int:
     except KeyboardInterrupt:
         print("uvms-pin: interrupted", file=sys.stderr)
         return EXIT_INTERRUPTED
+    except OSError as exc:  # a disk full, a file removed under us: not a bug to trace
+        where = f"{exc.filename}: " if exc.filename else ""
+        print(f"uvms-pin: error: {where}{exc.strerror or exc}", file=sys.stderr)
+        return EXIT_BAD_INPUT
 
 
 if __name__ == "__main__":

@@ -43,6 +43,10 @@ class ScenarioError(UvmsPinError):
     """A scenario or study file is malformed: unknown key, wrong type, missing entry."""
 
 
+class OutputError(UvmsPinError):
+    """An output path cannot be written, is in use, or holds results that are not this run's."""
+
+
 class SimulationError(UvmsPinError):
     """The simulation cannot continue (non-finite state, integrator failure)."""
 

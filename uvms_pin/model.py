@@ -24,6 +24,7 @@ from uvms_pin.hydro import geometry
 from uvms_pin.hydro.added_mass import added_mass_in_parent
 from uvms_pin.hydro.mesh import load_mesh_geometry, mesh_hydro
 from uvms_pin.hydro.params import HydroParams
+from uvms_pin.native_stderr import captured_native_stderr
 from uvms_pin.resources import package_search_path, resolve_resource
 
 DEFAULT_WATER_DENSITY_KG_M3 = 1025.0  # sea water; a parameter of load_uvms, never hidden
@@ -253,9 +254,11 @@ def load_uvms(
         raise ModelError("no <link> elements", path=where)
     hydro_elements = _collect_hydro_elements(root, links, where)
     try:
-        model = pin.buildModelFromUrdf(str(path), pin.JointModelFreeFlyer())
+        with captured_native_stderr() as urdfdom:  # its errors go into our message
+            model = pin.buildModelFromUrdf(str(path), pin.JointModelFreeFlyer())
     except Exception as exc:  # Pinocchio raises ValueError/RuntimeError for bad URDFs
-        raise ModelError(f"Pinocchio could not build the model: {exc}", path=where) from exc
+        detail = f" (urdfdom: {urdfdom.text})" if urdfdom.text else ""
+        raise ModelError(f"Pinocchio could not build the model: {exc}{detail}", path=where) from exc
 
     _check_joint_limits(root, where)
     _read_armature(root, model, where)

@@ -35,7 +35,6 @@ from __future__ import annotations
 
 import copy
 import math
-import os
 import tempfile
 import warnings
 import xml.etree.ElementTree as ET
@@ -46,6 +45,7 @@ from pathlib import Path
 import numpy as np
 import pinocchio as pin
 
+from uvms_pin import atomic
 from uvms_pin.arms.catalog import ArmEntry, resolve_arm
 from uvms_pin.errors import ModelError, ParameterError
 from uvms_pin.model import DEFAULT_WATER_DENSITY_KG_M3, UVMS, load_uvms, read_urdf_root
@@ -628,14 +628,7 @@ def parse_mount_pose(mount_pose) -> pin.SE3:
 def write_text_atomic(path: Path, text: str) -> None:
     """Write ``text`` to ``path`` through a temporary file in the same directory."""
     path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
-    try:
-        with os.fdopen(fd, "w") as handle:
-            handle.write(text)
-        os.replace(tmp, path)
-    except BaseException:
-        Path(tmp).unlink(missing_ok=True)
-        raise
+    atomic.write_text_atomic(path, text)
 
 
 # ---------------------------------------------------------------------- the URDF tree

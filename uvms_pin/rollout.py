@@ -3,14 +3,14 @@
 from __future__ import annotations
 
 import json
-import os
-import tempfile
+import zipfile
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from uvms_pin.atomic import atomic_write
 from uvms_pin.errors import ParameterError
 
 if TYPE_CHECKING:
@@ -128,8 +128,8 @@ class Rollout:
         text = json.dumps(self.metadata, indent=2, sort_keys=True, default=_json_default)
         arrays = {name: getattr(self, name) for name in self._BASE}
         arrays.update({f"signal__{k}": a for k, a in self.signals.items()})
-        _atomic_write(out / ARRAY_FILE, lambda f: np.savez_compressed(f, **arrays), binary=True)
-        _atomic_write(out / META_FILE, lambda f: f.write(text), binary=False)
+        atomic_write(out / ARRAY_FILE, lambda f: np.savez_compressed(f, **arrays), binary=True)
+        atomic_write(out / META_FILE, lambda f: f.write(text), binary=False)
         return out
 
     @classmethod
@@ -137,12 +137,19 @@ class Rollout:
         src = Path(directory)
         if not (src / ARRAY_FILE).is_file() or not (src / META_FILE).is_file():
             raise ParameterError(f"{src} holds no rollout ({ARRAY_FILE} and {META_FILE} expected)")
-        with np.load(src / ARRAY_FILE) as data:
-            base = {name: data[name] for name in cls._BASE}
-            signals = {
-                k[len("signal__") :]: data[k] for k in data.files if k.startswith("signal__")
-            }
-        metadata = json.loads((src / META_FILE).read_text())
+        try:
+            with np.load(src / ARRAY_FILE) as data:
+                base = {name: data[name] for name in cls._BASE}
+                signals = {
+                    k[len("signal__") :]: data[k] for k in data.files if k.startswith("signal__")
+                }
+            metadata = json.loads((src / META_FILE).read_text(encoding="utf-8"))
+        except (OSError, ValueError, KeyError, zipfile.BadZipFile) as exc:  # JSON errors too
+            raise ParameterError(
+                f"{src} holds a damaged rollout ({type(exc).__name__}: {exc}); rerun the scenario"
+            ) from exc
+        if not isinstance(metadata, dict):
+            raise ParameterError(f"{src / META_FILE}: a JSON object expected")
         return cls(**base, signals=signals, metadata=metadata)
 
 
@@ -159,16 +166,4 @@ def _json_default(obj: Any) -> Any:
 def write_json_atomic(path: Path, payload: dict[str, Any]) -> None:
     """Write a JSON file so that a crash never leaves it half-written."""
     text = json.dumps(payload, indent=2, sort_keys=True, default=_json_default)
-    _atomic_write(path, lambda f: f.write(text), binary=False)
-
-
-def _atomic_write(path: Path, writer, *, binary: bool) -> None:
-    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
-    try:
-        with os.fdopen(fd, "wb" if binary else "w") as f:
-            writer(f)
-        os.replace(tmp, path)
-    except BaseException:
-        if os.path.exists(tmp):
-            os.unlink(tmp)
-        raise
+    atomic_write(path, lambda f: f.write(text), binary=False)

@@ -22,7 +22,6 @@ from typing import Any
 
 import numpy as np
 import pinocchio as pin
-import tomllib
 
 from uvms_pin.actuation import Actuation, Thruster, ThrustersAndJointLimits, Unlimited
 from uvms_pin.controllers.base import Controller, ZeroController
@@ -45,6 +44,7 @@ from uvms_pin.simulate import (
     check_log_fits,
     simulate_closed_loop,
 )
+from uvms_pin.tomlfile import read_toml
 
 ControllerFactory = Callable[[UVMS], Controller]
 
@@ -241,12 +241,7 @@ def load_scenario(path: str | Path, overrides: dict[str, Any] | None = None) -> 
     """
     path = Path(path)
     source = str(path)
-    if not path.is_file():
-        raise ScenarioError(f"{source}: file not found")
-    try:
-        raw = tomllib.loads(path.read_text())
-    except tomllib.TOMLDecodeError as exc:
-        raise ScenarioError(f"{source}: not valid TOML ({exc})") from exc
+    raw = read_toml(path, ScenarioError)
     raw = apply_overrides(raw, overrides)
     overridden = {parse_key_path(text).key: text for text in overrides or {}}
     try:

@@ -187,6 +187,7 @@ def simulate_closed_loop(
         FunnelViolation, SimulationError: the run stopped early; the exception's
             ``rollout`` attribute holds the rollout up to the last logged sample with
             ``metadata['status']`` and ``metadata['error']`` set.
+        KeyboardInterrupt: likewise, with status ``interrupted``.
     """
     uvms = plant.uvms
     model = uvms.model
@@ -347,6 +348,11 @@ def simulate_closed_loop(
         raise error from exc
     except SimulationError as exc:  # FunnelViolation included
         _stopped(rollout, logged, wall_start, settings, exc)
+        raise
+    except KeyboardInterrupt as exc:  # Ctrl-C: the caller may keep what was simulated
+        rollout.truncate(logged)
+        _finish(rollout, wall_start, settings, "interrupted", "interrupted by the user")
+        exc.rollout = rollout
         raise
     _finish(rollout, wall_start, settings, "ok", "")
     return rollout

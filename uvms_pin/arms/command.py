@@ -9,11 +9,11 @@ from __future__ import annotations
 import argparse
 import math
 import sys
-from pathlib import Path
 
 from uvms_pin.arms.catalog import available_arms
-from uvms_pin.arms.compare import CompareSettings, compare_arms
-from uvms_pin.trim import TrimSpec
+from uvms_pin.cli_types import count, finite, positive
+from uvms_pin.errors import ParameterError
+from uvms_pin.outdir import COMPARISON, OVERWRITE_HELP, check_writable, claim
 
 EXIT_BAD_INPUT = 2
 DEFAULT_ARMS = "reference,so100,z1,kinova,ur3,ur5,panda"
@@ -26,7 +26,10 @@ def _cmd_compare_arms(args: argparse.Namespace) -> int:
     if args.scenario is None:
         print("uvms-pin compare-arms: error: SCENARIO is required", file=sys.stderr)
         return EXIT_BAD_INPUT
-    arms = [a.strip() for a in args.arms.split(",") if a.strip()]
+    from uvms_pin.arms.compare import CompareSettings, compare_arms
+    from uvms_pin.trim import TrimSpec
+
+    arms = _arm_names(args.arms)
     trim = None if args.no_trim else TrimSpec(bg_m=args.bg, foam_density_kg_m3=args.foam_density)
     settings = CompareSettings(
         duration_s=args.duration,
@@ -35,14 +38,16 @@ def _cmd_compare_arms(args: argparse.Namespace) -> int:
         ik_starts=args.ik_starts,
         keep_rollouts=args.keep_rollouts,
     )
-    rows = compare_arms(
-        args.scenario,
-        arms,
-        Path(args.out),
-        settings,
-        jobs=args.jobs,
-        progress=lambda line: print(line, file=sys.stderr, flush=True),
-    )
+    out = check_writable(args.out)
+    with claim(out, COMPARISON, overwrite=args.overwrite):
+        rows = compare_arms(
+            args.scenario,
+            arms,
+            out,
+            settings,
+            jobs=args.jobs,
+            progress=lambda line: print(line, file=sys.stderr, flush=True),
+        )
     width = max(len(r["arm"]) for r in rows)
     for r in rows:
         err = r["force_error_rms_N"]
@@ -52,6 +57,17 @@ def _cmd_compare_arms(args: argparse.Namespace) -> int:
     if args.keep_rollouts:
         print(f"per arm: {args.out}/<arm>/row.json, rollout, metrics.json and figures")
     return 0
+
+
+def _arm_names(text: str) -> list[str]:
+    """The comma-separated names of ``--arms``: at least one, none twice."""
+    names = [a.strip() for a in text.split(",")]
+    if not any(names) or "" in names:
+        raise ParameterError(f"--arms {text!r}: give comma-separated arm names, none empty")
+    twice = sorted({n for n in names if names.count(n) > 1})
+    if twice:
+        raise ParameterError(f"--arms {text!r}: {', '.join(twice)} given twice")
+    return names
 
 
 def register(subparsers) -> argparse.ArgumentParser:
@@ -72,25 +88,26 @@ def register(subparsers) -> argparse.ArgumentParser:
         help=f"comma-separated arm names or URDF paths (default {DEFAULT_ARMS})",
     )
     parser.add_argument("--out", default="out/compare_arms", help="output directory")
-    parser.add_argument("--duration", type=float, default=None, help="override the duration [s]")
-    parser.add_argument("--jobs", type=int, default=1, help="arms run in parallel processes")
+    parser.add_argument("--duration", type=positive, default=None, help="override the duration [s]")
+    parser.add_argument("--jobs", type=count(1), default=1, help="arms run in parallel processes")
     parser.add_argument("--no-trim", action="store_true", help="do not add foam and ballast")
+    parser.add_argument("--overwrite", action="store_true", help=OVERWRITE_HELP)
     parser.add_argument(
-        "--bg", type=float, default=0.02, help="metacentric height BG after trim [m]"
+        "--bg", type=finite, default=0.02, help="metacentric height BG after trim [m]"
     )
     parser.add_argument(
-        "--foam-density", type=float, default=350.0, help="trim foam density [kg/m^3]"
+        "--foam-density", type=positive, default=350.0, help="trim foam density [kg/m^3]"
     )
     parser.add_argument(
         "--mount-rpy",
-        type=float,
+        type=finite,
         nargs=3,
         default=(math.pi, 0.0, 0.0),
         metavar=("R", "P", "Y"),
         help="arm base orientation on the vehicle [rad] (default: upside down)",
     )
     parser.add_argument(
-        "--ik-starts", type=int, default=24, help="initial-configuration search starts"
+        "--ik-starts", type=count(1), default=24, help="initial-configuration search starts"
     )
     parser.add_argument(
         "--keep-rollouts",

@@ -50,6 +50,7 @@ import pinocchio as pin
 from uvms_pin.arms.catalog import REFERENCE, ArmEntry, resolve_arm
 from uvms_pin.arms.initial import solve_initial_configuration
 from uvms_pin.arms.reference import split_urdf
+from uvms_pin.atomic import atomic_path
 from uvms_pin.dynamics import mass_matrix
 from uvms_pin.errors import FunnelViolation, ScenarioError, SimulationError, UvmsPinError
 from uvms_pin.model import UVMS
@@ -559,8 +560,7 @@ def _figure(rows: list[dict], out: Path) -> Path:
     fig.suptitle("Arms compared (green: task completed, red: failed, gray: unreachable)")
     fig.tight_layout()
     path = out / "comparison.png"
-    tmp = out / ".comparison.png.tmp.png"
-    fig.savefig(tmp, dpi=110)
+    with atomic_path(path) as tmp:
+        fig.savefig(tmp, dpi=110, format="png")
     plt.close(fig)
-    tmp.replace(path)
     return path

@@ -12,6 +12,9 @@ import argparse
 import sys
 from pathlib import Path
 
+from uvms_pin.cli_types import count
+from uvms_pin.outdir import STUDY, check_writable, claim
+
 EXIT_BAD_INPUT = 2
 EXIT_INTERRUPTED = 130
 
@@ -22,26 +25,28 @@ def _cmd_sweep(args: argparse.Namespace) -> int:
 
     study = load_study(args.study)  # every check happens here, before any run
     runs = study.runs()
-    where = f"scheduler {args.scheduler}" if args.scheduler else _workers_text(args.workers)
-    print(f"study {study.name}: {len(runs)} runs of {study.base} on {where}, results in {args.out}")
-    try:
-        summary = run_study(
-            study,
-            args.out,
-            workers=args.workers,
-            scheduler=args.scheduler,
-            keep_rollouts=args.keep_rollouts,
-            progress=not args.quiet,
-            retry_errors=args.retry_errors,
-        )
-    except KeyboardInterrupt:
-        recorded = len(load_results(args.out))
-        print(
-            f"\ninterrupted: {recorded} of {len(runs)} runs recorded in {args.out}; "
-            "rerun the same command to finish",
-            file=sys.stderr,
-        )
-        return EXIT_INTERRUPTED
+    out = check_writable(args.out)
+    with claim(out, STUDY, overwrite=args.overwrite):
+        where = f"scheduler {args.scheduler}" if args.scheduler else _workers_text(args.workers)
+        print(f"study {study.name}: {len(runs)} runs of {study.base} on {where}, results in {out}")
+        try:
+            summary = run_study(
+                study,
+                out,
+                workers=args.workers,
+                scheduler=args.scheduler,
+                keep_rollouts=args.keep_rollouts,
+                progress=not args.quiet,
+                retry_errors=args.retry_errors,
+            )
+        except KeyboardInterrupt:
+            recorded = len(load_results(out))
+            print(
+                f"\ninterrupted: {recorded} of {len(runs)} runs recorded in {out}; "
+                "rerun the same command to finish",
+                file=sys.stderr,
+            )
+            return EXIT_INTERRUPTED
     print(
         f"{summary['run']} run now, {summary['skipped']} already recorded; "
         + ", ".join(
@@ -78,7 +83,7 @@ def register(subparsers) -> None:
     where = sweep.add_mutually_exclusive_group()
     where.add_argument(
         "--workers",
-        type=int,
+        type=count(0),
         default=None,
         help="local cluster worker processes (1 thread each; default: CPU count; 0 = serial, no Dask)",
     )
@@ -92,6 +97,11 @@ def register(subparsers) -> None:
         help="rerun recorded runs whose status is 'error' (crashes, not funnel violations)",
     )
     sweep.add_argument("--quiet", action="store_true", help="no progress bar")
+    sweep.add_argument(
+        "--overwrite",
+        action="store_true",
+        help="discard the study results in --out first (to rerun a changed study there)",
+    )
     sweep.set_defaults(func=_cmd_sweep)
 
     report = subparsers.add_parser(

@@ -19,7 +19,9 @@ import pandas as pd
 import tomllib
 from matplotlib.figure import Figure
 
-from uvms_pin.study.runner import STATUSES, STUDY_COPY, load_results
+from uvms_pin.atomic import atomic_path, write_text_atomic
+from uvms_pin.study.identity import STUDY_COPY
+from uvms_pin.study.runner import STATUSES, load_results
 from uvms_pin.study.spec import StudyError, column_name
 
 REPORT_FILE = "report.md"
@@ -101,7 +103,8 @@ def _failed(table: pd.DataFrame) -> pd.Series:
 
 def _save(fig: Figure, path: Path) -> Path:
     fig.tight_layout()
-    fig.savefig(path, dpi=110)
+    with atomic_path(path) as tmp:
+        fig.savefig(tmp, dpi=110, format=path.suffix[1:])
     return path
 
 
@@ -334,9 +337,7 @@ def write_report(directory: str | Path) -> list[Path]:
     text = _markdown(table, head, params, metrics, heatmaps, figures, directory)
     text = text.replace(_EXCLUSION_MARK, _exclusion_note(excluded, transient_end))
     report = directory / REPORT_FILE
-    tmp = report.with_suffix(".md.tmp")
-    tmp.write_text(text)
-    tmp.replace(report)
+    write_text_atomic(report, text)
     return [report, *figures]
 
 

@@ -3,6 +3,7 @@
 Layout of an output directory::
 
     study.toml          a copy of the study file (what was asked)
+    study_inputs.json   the study settings and the digests of its base scenario and model
     results.parquet     THE table: one row per finished run, sorted by run index
     parts/<id>.parquet  rows finished since the last compaction (one file per run)
     rollouts/<id>/      rollouts, only with keep_rollouts
@@ -22,15 +23,14 @@ saturation), every metric of `Rollout.metrics`, the run's wall time and host.
 from __future__ import annotations
 
 import contextlib
-import hashlib
 import json
 import logging
 import math
 import os
-import shutil
+import signal
 import socket
 import sys
-import tempfile
+import threading
 import time
 import traceback
 from collections.abc import Callable
@@ -40,13 +40,14 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
+from uvms_pin.atomic import atomic_path
 from uvms_pin.errors import FunnelViolation, SimulationError
-from uvms_pin.study.spec import Run, Study
+from uvms_pin.study.identity import check_same_study, file_sha256, record_study_inputs
+from uvms_pin.study.spec import Run, Study, StudyError
 
 RESULTS_FILE = "results.parquet"
 PARTS_DIR = "parts"
 ROLLOUTS_DIR = "rollouts"
-STUDY_COPY = "study.toml"
 STATUSES = ("ok", "FunnelViolation", "diverged", "error")
 
 RunFunction = Callable[[str, Run, "str | None"], dict[str, Any]]
@@ -149,15 +150,18 @@ def error_row(run: Run, exc: BaseException) -> dict[str, Any]:
 
 
 def _atomic_parquet(frame: pd.DataFrame, path: Path) -> None:
-    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
-    os.close(fd)
-    try:
+    with atomic_path(path) as tmp:
         frame.to_parquet(tmp, index=False)
-        os.replace(tmp, path)
-    except BaseException:
-        with contextlib.suppress(FileNotFoundError):
-            os.unlink(tmp)
-        raise
+
+
+def _read_parquet(path: Path) -> pd.DataFrame:
+    try:
+        return pd.read_parquet(path)
+    except Exception as exc:  # pyarrow raises several types for a damaged file
+        raise StudyError(
+            f"{path}: not a readable Parquet table ({type(exc).__name__}: {exc}); "
+            "it was not written by uvms-pin or was damaged: move it away and rerun"
+        ) from exc
 
 
 class ResultStore:
@@ -178,8 +182,8 @@ class ResultStore:
         """Every recorded row (table and parts), one per run id, sorted by run index."""
         frames = []
         if self.table_path.is_file():
-            frames.append(pd.read_parquet(self.table_path))
-        frames += [pd.read_parquet(p) for p in self._part_files()]
+            frames.append(_read_parquet(self.table_path))
+        frames += [_read_parquet(p) for p in self._part_files()]
         frames = [f for f in frames if len(f)]
         if not frames:
             return pd.DataFrame()
@@ -207,8 +211,6 @@ def load_results(out: str | Path) -> pd.DataFrame:
     """The study table of an output directory (parts not yet compacted included)."""
     out = Path(out)
     if not (out / RESULTS_FILE).is_file() and not (out / PARTS_DIR).is_dir():
-        from uvms_pin.study.spec import StudyError
-
         raise StudyError(f"{out}: no {RESULTS_FILE}: not a study output directory")
     return ResultStore(out).load()
 
@@ -220,23 +222,42 @@ class Summary(dict):
     """Counts of a sweep: total, skipped (already recorded), run now, and per status."""
 
 
-def _file_sha256(path: Path) -> str:
-    return hashlib.sha256(path.read_bytes()).hexdigest()[:16]
-
-
 def _client(workers: int | None, scheduler: str | None):
     from dask.distributed import Client, LocalCluster
 
     if scheduler is not None:
-        return Client(scheduler), None
-    cluster = LocalCluster(
-        n_workers=workers or os.cpu_count() or 1,
-        threads_per_worker=1,
-        processes=True,
-        dashboard_address=":0",
-        silence_logs=logging.ERROR,
-    )
+        try:
+            return Client(scheduler, timeout=30), None
+        except (OSError, TimeoutError, ValueError) as exc:
+            raise StudyError(
+                f"--scheduler {scheduler}: cannot connect ({type(exc).__name__}: {exc}); "
+                "is the scheduler running at that address?"
+            ) from exc
+    with _sigint_ignored_by_children():
+        cluster = LocalCluster(
+            n_workers=workers or os.cpu_count() or 1,
+            threads_per_worker=1,
+            processes=True,
+            dashboard_address=":0",
+            silence_logs=logging.ERROR,
+        )
     return Client(cluster), cluster
+
+
+@contextlib.contextmanager
+def _sigint_ignored_by_children():
+    """Start worker processes with Ctrl-C ignored (inherited, and Python keeps an ignored
+    SIGINT): a terminal's Ctrl-C reaches the whole process group, and each worker would
+    print its own KeyboardInterrupt traceback; this process alone handles it and closes
+    the cluster."""
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    previous = signal.signal(signal.SIGINT, signal.SIG_IGN)
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGINT, previous)
 
 
 def run_study(
@@ -271,9 +292,11 @@ def run_study(
 
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
-    if study.path.resolve() != (out / STUDY_COPY).resolve():
-        shutil.copyfile(study.path, out / STUDY_COPY)
     store = ResultStore(out)
+    recorded = store.load()
+    base_hashes = recorded.get("base_sha256", pd.Series(dtype=object)).dropna()
+    check_same_study(out, study, set(base_hashes))  # before anything is written
+    record_study_inputs(out, study)
     recorded = store.compact()
     runs = study.runs()
     done_ids: set[str] = set()
@@ -286,7 +309,7 @@ def run_study(
         for status in keep["status"]:
             counts[status] = counts.get(status, 0) + 1
     todo = [r for r in runs if r.run_id not in done_ids]
-    base_sha = _file_sha256(study.base)
+    base_sha = file_sha256(study.base)
     rollout_dir = str(out / ROLLOUTS_DIR) if keep_rollouts else None
     summary = Summary(total=len(runs), skipped=len(runs) - len(todo), run=0, **counts)
     if not todo:

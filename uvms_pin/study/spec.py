@@ -36,10 +36,10 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
-import tomllib
 
 from uvms_pin.errors import ScenarioError, UvmsPinError
 from uvms_pin.overrides import KEY_PATH, parse_key_path
+from uvms_pin.tomlfile import read_toml
 
 SEED_KEY = 0x5EED  # spawn-key component of a sample's scenario seed
 PLANT_PREFIX = "plant."
@@ -270,12 +270,7 @@ def load_study(path: str | Path) -> Study:
     """
     path = Path(path)
     source = str(path)
-    if not path.is_file():
-        raise StudyError(f"{source}: file not found")
-    try:
-        raw = tomllib.loads(path.read_text())
-    except tomllib.TOMLDecodeError as exc:
-        raise StudyError(f"{source}: not valid TOML ({exc})") from exc
+    raw = read_toml(path, StudyError)
 
     unknown = set(raw) - {"study", "fixed", "parameter", "report"}
     if unknown:
@@ -306,10 +301,7 @@ def load_study(path: str | Path) -> Study:
     base = (path.parent / base_entry).resolve()
     if not base.is_file():
         raise StudyError(f"{source}: study.base: scenario '{base_entry}' not found ({base})")
-    try:
-        base_raw = tomllib.loads(base.read_text())
-    except tomllib.TOMLDecodeError as exc:
-        raise StudyError(f"{source}: study.base: '{base_entry}' is not valid TOML ({exc})") from exc
+    base_raw = read_toml(base, StudyError, f"{source}: study.base: '{base_entry}'")
 
     fixed = raw.get("fixed", {})
     if not isinstance(fixed, dict):

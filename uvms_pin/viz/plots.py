@@ -12,6 +12,7 @@ import numpy as np
 import pinocchio as pin
 from matplotlib.figure import Figure
 
+from uvms_pin.atomic import atomic_path
 from uvms_pin.rollout import Rollout
 from uvms_pin.viz.stop import stop_summary, stop_time_s
 
@@ -32,7 +33,8 @@ def save_figure(fig: Figure, path: Path | None) -> Figure | Path:
     fig.tight_layout()
     if path is None:
         return fig
-    fig.savefig(path, dpi=120)
+    with atomic_path(path) as tmp:
+        fig.savefig(tmp, dpi=120, format=Path(path).suffix[1:])
     return path
 
 

@@ -14,8 +14,6 @@ import base64
 import html
 import json
 import math
-import os
-import tempfile
 from pathlib import Path
 from typing import Any
 
@@ -23,6 +21,7 @@ import meshcat
 import meshcat.animation
 import numpy as np
 
+from uvms_pin.atomic import write_text_atomic
 from uvms_pin.model import load_uvms
 from uvms_pin.rollout import Rollout
 from uvms_pin.viz.errors import VizError
@@ -200,16 +199,7 @@ def write_page(text: str, path: str | Path) -> Path:
     """Write an HTML page atomically (never a half-written file); returns the path."""
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
-    try:
-        with os.fdopen(fd, "w", encoding="utf-8") as f:
-            f.write(text)
-        os.chmod(tmp, 0o644)  # a page to share (mkstemp creates 0600)
-        os.replace(tmp, path)
-    except BaseException:
-        Path(tmp).unlink(missing_ok=True)
-        raise
-    return path
+    return write_text_atomic(path, text)
 
 
 _CSP = (

@@ -1,0 +1,76 @@
+"""A study directory holds one study: ``uvms-pin sweep`` resumes into it, refuses another
+study or a changed base scenario (exit 2, nothing touched), replaces it only with
+--overwrite; Ctrl-C on a Dask sweep prints one message and the rerun finishes it."""
+
+from __future__ import annotations
+
+import glob
+import time
+
+import pandas as pd
+import pytest
+from cli_support import STUDY, interrupt, passive_scenario, run_cli, start_cli, tree_digest
+
+
+def _sweep(tmp_path, *extra: str):
+    return run_cli(["sweep", "study.toml", "--out", "out", "--quiet", *extra], cwd=tmp_path)
+
+
+def test_a_study_directory_refuses_another_study_and_a_changed_base(tmp_path):
+    (tmp_path / "base.toml").write_text(passive_scenario(0.04))
+    (tmp_path / "study.toml").write_text(STUDY)
+    first = _sweep(tmp_path, "--workers", "0")
+    assert first.returncode == 0, first.stderr
+    assert "2 run now, 0 already recorded" in first.stdout
+
+    (tmp_path / "study.toml").write_text("# same study, a comment added\n" + STUDY)
+    again = _sweep(tmp_path, "--workers", "0")
+    assert again.returncode == 0, again.stderr
+    assert "0 run now, 2 already recorded" in again.stdout
+
+    recorded = tree_digest(tmp_path / "out")
+    (tmp_path / "study.toml").write_text(STUDY.replace("[0.0, 0.1]", "[0.0, 0.2]"))
+    other = _sweep(tmp_path, "--workers", "0")
+    assert other.returncode == 2
+    assert "out holds the results of another study" in other.stderr
+    assert "--overwrite" in other.stderr and "Traceback" not in other.stderr
+    assert tree_digest(tmp_path / "out") == recorded
+
+    (tmp_path / "study.toml").write_text(STUDY)
+    (tmp_path / "base.toml").write_text(passive_scenario(0.06))
+    changed = _sweep(tmp_path, "--workers", "0")
+    assert changed.returncode == 2
+    assert "the base scenario" in changed.stderr and "base.toml changed" in changed.stderr
+    assert tree_digest(tmp_path / "out") == recorded
+
+    (tmp_path / "study.toml").write_text(STUDY.replace("[0.0, 0.1]", "[0.0, 0.2]"))
+    replaced = _sweep(tmp_path, "--workers", "0", "--overwrite")
+    assert replaced.returncode == 0, replaced.stderr
+    table = pd.read_parquet(tmp_path / "out" / "results.parquet")
+    assert sorted(table["water.current_world_m_s[0]"]) == [0.0, 0.2]
+    assert table["simulated_time_s"].tolist() == pytest.approx([0.06, 0.06])  # the new base only
+
+
+def test_ctrl_c_on_a_dask_sweep_prints_one_message_and_the_rerun_finishes(tmp_path):
+    (tmp_path / "base.toml").write_text(passive_scenario(0.5))
+    (tmp_path / "study.toml").write_text(STUDY.replace("seed = 3", "seed = 3\nsamples = 15"))
+    proc = start_cli(["sweep", "study.toml", "--out", "out", "--workers", "1"], cwd=tmp_path)
+    try:
+        deadline = time.monotonic() + 240
+        while not glob.glob(str(tmp_path / "out" / "parts" / "*.parquet")):
+            assert proc.poll() is None and time.monotonic() < deadline, "no run recorded"
+            time.sleep(0.2)
+        _, err = interrupt(proc)
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+            proc.wait()
+    assert proc.returncode == 130, err
+    assert "Traceback" not in err and "KeyboardInterrupt" not in err, err
+    assert "interrupted:" in err and "rerun the same command to finish" in err
+    assert len([line for line in err.splitlines() if "interrupted" in line]) == 1, err
+
+    rerun = _sweep(tmp_path, "--workers", "0")
+    assert rerun.returncode == 0, rerun.stderr
+    table = pd.read_parquet(tmp_path / "out" / "results.parquet")
+    assert len(table) == 30 and table["run_id"].is_unique
