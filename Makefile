@@ -32,8 +32,11 @@ test: $(STAMP) lint
 	  else echo "chromium missing and not installable here (needs root + apt-get): browser tests will skip"; fi; }
 	$(BIN)/python -m pytest -q
 
+# every benchmarks/bench_*.py, one after the other (ratios only; tables in out/bench/);
+# the dev install includes the bench extra (mujoco)
 bench: $(STAMP)
-	$(BIN)/python benchmarks/bench_dynamics.py
+	@set -e; for script in benchmarks/bench_*.py; do \
+	  echo "== $$script"; $(BIN)/python $$script; done
 
 clean:
 	rm -rf $(VENV) out build *.egg-info
