@@ -7,6 +7,7 @@ from pathlib import Path
 import numpy as np
 import pinocchio as pin
 import pytest
+from conftest import body_urdf, hydro_xml
 
 import uvms_pin as up
 from uvms_pin.arms.catalog import resolve_arm
@@ -232,3 +233,52 @@ def test_bad_input_raises_clear_errors():
     assert "capsule" in text
     with pytest.raises(ModelError, match="capsule"):
         uvms_to_mjcf(uvms, text)
+
+
+def test_a_body_with_volume_but_no_mass_is_refused(write_urdf):
+    text = body_urdf(mass=0.0, inertia=(0.0, 0.0, 0.0), hydro=hydro_xml(0.01))
+    uvms = up.load_uvms(write_urdf(text), ee_frame="body", sensor_frame="body")
+    with pytest.raises(ModelError, match=r"'body' displaces .* but has no mass"):
+        uvms_to_mjcf(uvms, text)
+
+
+def _hydrostatics_only(uvms: up.UVMS) -> up.UVMS:
+    """The same bodies and volumes with no added mass and no damping."""
+    return uvms.with_hydro(
+        lambda body: up.HydroParams(
+            body.params.volume_m3,
+            body.params.center_of_buoyancy_m,
+            np.zeros((6, 6)),
+            np.zeros((6, 6)),
+            np.zeros(6),
+        )
+    )
+
+
+def test_same_motion_when_the_water_only_buoys(system):
+    """With MuJoCo's fluid off and uvms-pin's added mass and damping off, the two simulators
+    have the same rigid dynamics plus buoyancy: the accelerations at random moving states
+    agree (MuJoCo's free-joint qacc is d/dt of the WORLD linear velocity: R (a + w x v))."""
+    uvms, model, data = system
+    dry = _hydrostatics_only(uvms)
+    model.opt.density, model.opt.viscosity = 0.0, 0.0
+    rng = np.random.default_rng(16)
+    try:
+        for _ in range(5):
+            q = _random_q(uvms, rng)
+            v = rng.normal(scale=0.5, size=uvms.nv)
+            tau = rng.normal(size=uvms.nv)
+            data.qpos[:], data.qvel[:] = qpos_from_q(q), qvel_from_v(q, v)
+            data.qfrc_applied[:] = qfrc_from_tau(q, tau)
+            mujoco.mj_forward(model, data)
+            zeta_dot = up.forward_dynamics(dry, q, v, tau)
+            expected = qvel_from_v(q, zeta_dot)
+            expected[:3] += qvel_from_v(q, np.concatenate([np.cross(v[3:6], v[:3]), v[3:]]))[:3]
+            scale = max(1.0, np.abs(expected).max())
+            np.testing.assert_allclose(data.qacc, expected, rtol=0, atol=1e-8 * scale)
+    finally:
+        data.qfrc_applied[:] = 0.0
+        model.opt.density, model.opt.viscosity = (
+            uvms.water_density_kg_m3,
+            MjcfOptions().viscosity_Pa_s,
+        )
