@@ -143,13 +143,11 @@ def uvms_to_mjcf(
     )
     ET.SubElement(option, "flag", contact="disable")
     world = ET.SubElement(root, "worldbody")
-    geoms = _fluid_geoms(uvms, urdf, options, Path(base_dir), package_dirs)
     axes = _joint_axes(model)
     bodies = {0: world}
     for j in range(1, model.njoints):
-        body = _joint_body(uvms, j, bodies[model.parents[j]], axes[j], options)
-        body.extend(geoms.get(j, []))
-        bodies[j] = body
+        bodies[j] = _joint_body(uvms, j, bodies[model.parents[j]], axes[j], options)
+    _add_fluid_geoms(uvms, urdf, bodies, options, Path(base_dir), package_dirs)
     for frame_id in dict.fromkeys((uvms.ee_frame_id, uvms.sensor_frame_id)):
         frame = model.frames[frame_id]
         _placed(bodies[frame.parentJoint], "site", frame.placement, name=frame.name)
@@ -276,16 +274,16 @@ def _inertial(body: ET.Element, inertia: pin.Inertia) -> None:
 # ---- fluid geoms from the collision shapes ----------------------------------------------
 
 
-def _fluid_geoms(
+def _add_fluid_geoms(
     uvms: UVMS,
     urdf: ET.Element,
+    bodies: dict[int, ET.Element],
     options: MjcfOptions,
     base_dir: Path,
     package_dirs: Sequence[str | Path],
-) -> dict[int, list[ET.Element]]:
-    """One ellipsoid-fluid geom per collision shape, grouped by the joint carrying it."""
+) -> None:
+    """One ellipsoid-fluid geom per collision shape, in the body of the joint carrying it."""
     model = uvms.model
-    out: dict[int, list[ET.Element]] = {}
     for link in urdf.findall("link"):
         name = link.get("name", "")
         collisions = link.findall("collision")
@@ -295,8 +293,8 @@ def _fluid_geoms(
         for k, collision in enumerate(collisions):
             placement = frame.placement * _origin(collision.find("origin"), "urdf_text", name)
             kind, size, local = _shape(collision, name, base_dir, package_dirs)
-            geom = _placed(
-                ET.Element("dummy"),
+            _placed(
+                bodies[frame.parentJoint],
                 "geom",
                 placement * local,
                 name=f"{name}/collision[{k}]",
@@ -307,8 +305,6 @@ def _fluid_geoms(
                 contype="0",
                 conaffinity="0",
             )
-            out.setdefault(int(frame.parentJoint), []).append(geom)
-    return out
 
 
 def _shape(
