@@ -182,8 +182,10 @@ def mounted_system(arm: str, tmp: Path) -> System:
     mounted = mount_arm_detailed(
         split.vehicle_urdf, entry.urdf, pose, ee_link=entry.ee_link, allow_dry_links=True
     )
+    model = mounted.uvms.model
     q0 = mounted.uvms.neutral_configuration()
-    q0[7:] += 0.3  # away from singular straight-arm poses
+    # away from singular straight-arm poses, inside the joint limits
+    q0[7:] = np.clip(q0[7:] + 0.3, model.lowerPositionLimit[7:], model.upperPositionLimit[7:])
     return build_system(arm, mounted.uvms, mounted.urdf_text, q0)
 
 
