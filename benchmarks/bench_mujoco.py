@@ -70,15 +70,18 @@ ABA = "pin.aba (rigid, no water)"
 MJ_FORWARD, MJ_PLANT, MJ_LOOP = "MuJoCo mj_forward", "MuJoCo plant", "MuJoCo closed-loop tick"
 
 
-def best_times(cases: dict[Hashable, Callable[[], object]], repeat: int) -> dict[Hashable, float]:
+def best_times(
+    cases: dict[Hashable, Callable[[], object]], repeat: int, batch_s: float = 0.05
+) -> dict[Hashable, float]:
     """Best time per call [s] of each case over ``repeat`` rounds.
 
-    Times are this process's CPU time (``time.process_time``: time other processes take
-    from a shared machine is not counted); each batch lasts >= 0.2 s (timeit's autorange),
-    and the cases are interleaved round by round, so what load remains hits all alike.
+    Times are this process's CPU time (``time.process_time``: what other processes take
+    from a shared machine is not counted). Each round times every case once, in a batch of
+    about ``batch_s``: short batches interleaved over many rounds let the minimum find the
+    machine's quiet moments for every case alike.
     """
     timers = {name: timeit.Timer(fn, timer=time.process_time) for name, fn in cases.items()}
-    numbers = {name: timer.autorange()[0] for name, timer in timers.items()}
+    numbers = {name: max(1, round(batch_s / timer.timeit(1))) for name, timer in timers.items()}
     best = dict.fromkeys(cases, math.inf)
     for _ in range(repeat):
         for name, timer in timers.items():
@@ -390,8 +393,8 @@ def markdown(sections: list[dict], arms: list[dict]) -> str:
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--repeat", type=int, default=7, help="rounds; the best is kept")
-    parser.add_argument("--ticks", type=int, default=100, help="closed-loop ticks per run")
+    parser.add_argument("--repeat", type=int, default=25, help="rounds; the best is kept")
+    parser.add_argument("--ticks", type=int, default=25, help="closed-loop ticks per run")
     parser.add_argument("--out", type=Path, default=ROOT / "out" / "bench" / "mujoco.md")
     args = parser.parse_args()
     if min(args.repeat, args.ticks) < 1:
