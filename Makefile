@@ -34,8 +34,11 @@ test: $(STAMP) lint
 	  else echo "chromium missing and not installable here (needs root + apt-get): browser tests will skip"; fi; }
 	$(BIN)/python -m pytest -q
 
+# every benchmarks/bench_*.py, one after the other (ratios only; tables in out/bench/);
+# the dev install includes the bench extra (mujoco)
 bench: $(STAMP)
-	$(BIN)/python benchmarks/bench_dynamics.py
+	@set -e; for script in benchmarks/bench_*.py; do \
+	  echo "== $$script"; $(BIN)/python $$script; done
 
 results: $(STAMP)
 	$(BIN)/python scripts/make_results.py $(if $(RESULTS),--only $(RESULTS))

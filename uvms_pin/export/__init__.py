@@ -1,0 +1,1 @@
+"""Export a UVMS to other simulators' formats (MJCF for MuJoCo)."""
