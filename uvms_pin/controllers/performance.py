@@ -201,14 +201,14 @@ def check_funnel(
     return xi
 
 
-def max_abs(values: np.ndarray) -> float:
-    """max_j |values_j| of a 1-D array; NaN if any value is NaN.
+def max_abs(values: np.ndarray | list[float]) -> float:
+    """max_j |values_j| of a 1-D array or list of floats; NaN if any value is NaN.
 
     A NaN must never pass a funnel check (``max_abs(xi) < 1``), and Python's ``max`` may skip
     one, so a NaN sum turns the answer into NaN. Python floats: for the 6 to ~20 components
     of a funnel level this costs less than numpy's reductions.
     """
-    items = values.tolist()
+    items = values.tolist() if isinstance(values, np.ndarray) else values
     largest = max(map(abs, items))
     total = sum(items)
     return largest if total == total else math.nan

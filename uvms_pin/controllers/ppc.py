@@ -279,8 +279,8 @@ def _first_level_error(
     force_desired: np.ndarray,
     rpy_ee: np.ndarray,
     rpy_desired: np.ndarray,
-) -> np.ndarray:
-    """e_x (6,) = [f_meas - f_d (3) N; wrap(rpy_ee - rpy_d) (3) rad].
+) -> list[float]:
+    """e_x (6 floats) = [f_meas - f_d (3) N; wrap(rpy_ee - rpy_d) (3) rad].
 
     e_f = f_e + Delta f_e - f_d; e_o = rpy - rpy_d as in the paper, wrapped to [-pi, pi) so
     that a roll or yaw crossing +-pi (where matrixToRpy jumps by 2 pi) is not read as a huge
@@ -288,16 +288,14 @@ def _first_level_error(
     """
     f, fd = wrench_world.tolist(), force_desired.tolist()
     r, rd = rpy_ee.tolist(), rpy_desired.tolist()
-    return np.array(
-        (
-            f[0] - fd[0],
-            f[1] - fd[1],
-            f[2] - fd[2],
-            (r[0] - rd[0] + math.pi) % _TWO_PI - math.pi,
-            (r[1] - rd[1] + math.pi) % _TWO_PI - math.pi,
-            (r[2] - rd[2] + math.pi) % _TWO_PI - math.pi,
-        )
-    )
+    return [
+        f[0] - fd[0],
+        f[1] - fd[1],
+        f[2] - fd[2],
+        (r[0] - rd[0] + math.pi) % _TWO_PI - math.pi,
+        (r[1] - rd[1] + math.pi) % _TWO_PI - math.pi,
+        (r[2] - rd[2] + math.pi) % _TWO_PI - math.pi,
+    ]
 
 
 class PrescribedPerformanceController(Controller):
@@ -383,7 +381,7 @@ class PrescribedPerformanceController(Controller):
             self.first_level_names + self.second_level_names,
         )
         # -k_x eps = (-2 k_x) artanh(xi) and -k r eps / rho = (-4 k) artanh(xi) / ((1 - xi^2) rho)
-        self._neg_two_k_x = -2.0 * self.params.k_x
+        self._neg_two_k_x = (-2.0 * self.params.k_x).tolist()
         self._neg_four_k_zeta = -4.0 * self.params.k_zeta
         self._solver = MinimumNormSolver(self._weights, self.params.pinv_relative_cutoff)
         self._nq, self._nv = self.model.nq, self.model.nv
@@ -494,16 +492,18 @@ class PrescribedPerformanceController(Controller):
         e_x = _first_level_error(wrench_world, force_desired, rpy_ee, rpy_desired)
         rho = self._performance_both.value(time_s)
         rho_x, rho_zeta = rho[:6], rho[6:]
-        xi_x = e_x / rho_x
+        # eq. (13), erratum: k_x > 0 (the paper's simulation prints -0.2). The force rows
+        # are end-effector linear velocities [m/s]: with f_e = K_f (p - p0), K_f > 0, a
+        # force above the desired one (e_f > 0) asks the end-effector to back off.
+        # Six components: Python floats (-k_x eps = -2 k_x artanh(xi)).
+        xi_x = [e / r for e, r in zip(e_x, rho_x.tolist(), strict=True)]
         max_xi_x = max_abs(xi_x)
         if max_xi_x < (_XI_CLAMP if extended else 1.0):
-            # eq. (13), erratum: k_x > 0 (the paper's simulation prints -0.2). The force rows
-            # are end-effector linear velocities [m/s]: with f_e = K_f (p - p0), K_f > 0, a
-            # force above the desired one (e_f > 0) asks the end-effector to back off.
-            xdot_r = self._neg_two_k_x * np.arctanh(xi_x)
+            xdot_r = [k * math.atanh(x) for k, x in zip(self._neg_two_k_x, xi_x, strict=True)]
         else:  # outside (raises), or beyond the clamp of the funnel extension
+            e_x = np.array(e_x)
             xi_x = self._normalize("first", self.first_level_names, time_s, e_x, rho_x)
-            xdot_r = -self.params.k_x * transformed_error_extended(xi_x, _XI_CLAMP)
+            xdot_r = (-self.params.k_x * transformed_error_extended(xi_x, _XI_CLAMP)).tolist()
         check_euler_singularity(self.model, self.ee_frame_id, rpy_ee)
 
         # ---- task space -> generalized velocities, eq. (9) (+ the remark's null space)
@@ -543,7 +543,7 @@ class PrescribedPerformanceController(Controller):
         return tau
 
     def _reference_velocity(
-        self, q: np.ndarray, rpy_ee: np.ndarray, jacobian_lwa: np.ndarray, xdot_r: np.ndarray
+        self, q: np.ndarray, rpy_ee: np.ndarray, jacobian_lwa: np.ndarray, xdot_r: list[float]
     ) -> np.ndarray:
         """zeta_r = J^# xdot_r + (I - J^# J) zeta_0 (nv,) [m/s, rad/s].
 
@@ -551,8 +551,7 @@ class PrescribedPerformanceController(Controller):
         b = [xdot_p; E xdot_o], and zeta_0 + J^# (xdot_r - J zeta_0) = zeta_0 + (J^lwa)^#
         (b - J^lwa zeta_0). The exact SVD route on J itself when the solver declines.
         """
-        rates = xdot_r.tolist()
-        b = np.array(rates[:3] + list(angular_velocity_world_from_euler_rates(rpy_ee, rates[3:])))
+        b = np.array([*xdot_r[:3], *angular_velocity_world_from_euler_rates(rpy_ee, xdot_r[3:])])
         if self._null_space_scale is not None:
             zeta_0 = self.null_space_velocity(q)
             solution = self._solver.solve(jacobian_lwa, b - np.dot(jacobian_lwa, zeta_0))
@@ -565,7 +564,7 @@ class PrescribedPerformanceController(Controller):
                 return solution
         jacobian = analytical_jacobian(self.model, self.data, q, self.ee_frame_id)
         jacobian_pinv = pseudo_inverse(jacobian, self.params.pinv_relative_cutoff, self._weights)
-        zeta_r = jacobian_pinv @ xdot_r
+        zeta_r = jacobian_pinv @ np.array(xdot_r)
         if zeta_0 is not None:
             zeta_r = zeta_r + zeta_0 - jacobian_pinv @ (jacobian @ zeta_0)
         return zeta_r
@@ -596,11 +595,11 @@ class PrescribedPerformanceController(Controller):
             force_desired_world_N=force_desired,
             rpy_desired=rpy_desired,
             rpy_ee=rpy_ee,
-            e_x=e_x,
+            e_x=np.array(e_x),
             rho_x=rho_x,
-            xi_x=xi_x,
-            eps_x=transform(xi_x),
-            xdot_r=xdot_r,
+            xi_x=np.array(xi_x),
+            eps_x=transform(np.array(xi_x)),
+            xdot_r=np.array(xdot_r),
             zeta_r=zeta_r,
             e_zeta=e_zeta,
             rho_zeta=rho_zeta,

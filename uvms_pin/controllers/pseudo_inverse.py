@@ -27,8 +27,9 @@ from scipy.linalg import lapack
 #: normal equations' error ~cond^2 * 1e-16 is already ~1e-13 or less.
 REFINE_ABOVE_CONDITION_BOUND = 1e3
 #: Largest certified bound of cond(J W^-1/2)^2 for which the Cholesky route is used. The
-#: refined solution's error grows like cond * 1e-16 (measured: <= 2e-13 relative to the SVD
-#: at cond = 1e3); the bound is at most m = 6 times cond^2, so this admits cond <~ 1.3e3.
+#: bound lies between cond(G) and m^2 cond(G) = 36 cond(G) (G = J W^-1 J^T): this admits every
+#: cond(J W^-1/2) below ~530 and none above ~3200. The refined solution's error grows like
+#: cond * 1e-16 (measured against the SVD: <= 2e-13 relative at cond = 1e3).
 MAX_GRAM_CONDITION_BOUND = 1e7
 
 
@@ -85,7 +86,7 @@ class MinimumNormSolver:
         :data:`REFINE_ABOVE_CONDITION_BOUND`) turns the normal equations' error ~cond^2 eps
         into ~cond eps.
         The rank and accuracy check is certified, not estimated: lambda_max(G) <= tr G and
-        1 / lambda_min(G) <= tr G^-1 = ||L^-1||_F^2, so cond(G) <= tr G tr G^-1 <= m cond(G);
+        1 / lambda_min(G) <= tr G^-1 = ||L^-1||_F^2, so cond(G) <= tr G tr G^-1 <= m^2 cond(G);
         None when that bound exceeds :data:`MAX_GRAM_CONDITION_BOUND` (or 1 / cutoff^2),
         or when G is not numerically positive definite.
         """
