@@ -66,7 +66,8 @@ class MinimumNormSolver:
     """
 
     def __init__(self, weights: np.ndarray | None, relative_cutoff: float):
-        self._inverse_weights = None if weights is None else 1.0 / np.asarray(weights, float)
+        self._weights = None if weights is None else np.asarray(weights, float)
+        self._inverse_weights = None if weights is None else 1.0 / self._weights
         # the SVD keeps every singular value iff cond < 1 / cutoff, i.e. cond^2 < cutoff^-2
         cutoff_squared = float(relative_cutoff) ** 2
         self._max_bound = (
@@ -78,7 +79,8 @@ class MinimumNormSolver:
     def solve(self, jacobian: np.ndarray, rhs: np.ndarray) -> np.ndarray | None:
         """The minimum W-norm solution x (n,) of J x = b, or None (use the SVD instead).
 
-        With G = J W^-1 J^T = L L^T (Cholesky) and G^-1 = L^-T L^-1:
+        With G = J W^-1 J^T = L L^T (Cholesky) and Y = G^-1 J W^-1 (two triangular solves
+        with n right-hand sides), J^# = Y^T:
 
             x1 = W^-1 J^T G^-1 b;  r = b - J x1,  x = x1 + W^-1 J^T G^-1 r.
 
@@ -86,7 +88,7 @@ class MinimumNormSolver:
         :data:`REFINE_ABOVE_CONDITION_BOUND`) turns the normal equations' error ~cond^2 eps
         into ~cond eps.
         The rank and accuracy check is certified, not estimated: lambda_max(G) <= tr G and
-        1 / lambda_min(G) <= tr G^-1 = ||L^-1||_F^2, so cond(G) <= tr G tr G^-1 <= m^2 cond(G);
+        1 / lambda_min(G) <= tr G^-1 = tr(Y W Y^T), so cond(G) <= tr G tr G^-1 <= m^2 cond(G);
         None when that bound exceeds :data:`MAX_GRAM_CONDITION_BOUND` (or 1 / cutoff^2),
         or when G is not numerically positive definite.
         """
@@ -96,12 +98,13 @@ class MinimumNormSolver:
         factor, info = lapack.dpotrf(gram, lower=1, overwrite_a=1)
         if info != 0:
             return None
-        factor_inverse, info = lapack.dtrtri(factor, lower=1, overwrite_c=1)
-        bound = np.vdot(weighted, jacobian) * np.vdot(factor_inverse, factor_inverse)
+        # Y = G^-1 J W^-1 (6 x n), so J^# = W^-1 J^T G^-1 = Y^T and G^-1 = Y W Y^T
+        solved, info = lapack.dpotrs(factor, weighted, lower=1)
+        inverse_trace = np.vdot(solved if self._weights is None else solved * self._weights, solved)
+        bound = np.vdot(weighted, jacobian) * inverse_trace
         if info != 0 or not bound <= self._max_bound:
             return None
-        # J^# = W^-1 J^T G^-1 (n x 6), G^-1 = L^-T L^-1
-        pseudo = np.dot(weighted.T, np.dot(factor_inverse.T, factor_inverse))
+        pseudo = solved.T
         x = np.dot(pseudo, rhs)
         if bound > REFINE_ABOVE_CONDITION_BOUND:
             x += np.dot(pseudo, rhs - np.dot(jacobian, x))
