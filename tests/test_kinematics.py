@@ -24,10 +24,12 @@ from uvms_pin.errors import ParameterError
 from uvms_pin.kinematics import (
     EULER_SINGULARITY_MIN_ABS_COS_PITCH,
     analytical_jacobian,
+    angular_velocity_world_from_euler_rates,
     end_effector_pose,
     euler_rate_matrix_body,
     euler_rpy_from_rotation,
     frame_id_from_name,
+    frame_rotation_and_jacobian,
 )
 
 REFERENCE_URDF = Path(__file__).resolve().parents[1] / "models" / "uvms_lbv150.urdf"
@@ -240,3 +242,47 @@ def test_bad_q_raises():
     q[0] = np.nan
     with pytest.raises(ParameterError):
         analytical_jacobian(model, data, q, frame_id)
+
+
+def test_world_euler_rate_matrix_is_r_times_j_body_and_the_rotation_rate():
+    """E rpy_dot = R J'' rpy_dot, and [omega_world]_x = R_dot R^T by central differences."""
+    rng = np.random.default_rng(12)
+    for _ in range(20):
+        rpy = rng.uniform([-3.0, -1.4, -3.0], [3.0, 1.4, 3.0])
+        rates = rng.normal(size=3)
+        omega = np.array(angular_velocity_world_from_euler_rates(tuple(rpy), tuple(rates)))
+        rotation = pin.rpy.rpyToMatrix(rpy)
+        np.testing.assert_allclose(
+            omega, rotation @ euler_rate_matrix_body(rpy) @ rates, rtol=0, atol=1e-14
+        )
+        h = 1e-6
+        rotation_dot = (
+            pin.rpy.rpyToMatrix(rpy + h * rates) - pin.rpy.rpyToMatrix(rpy - h * rates)
+        ) / (2 * h)
+        np.testing.assert_allclose(pin.skew(omega), rotation_dot @ rotation.T, atol=1e-8)
+
+
+def test_one_pass_rotation_and_jacobian(model):
+    """frame_rotation_and_jacobian = the frame rotation and LOCAL_WORLD_ALIGNED Jacobian of
+    the full passes, and diag(I, E^-1) J^lwa is the analytical Jacobian."""
+    frame_id = frame_id_from_name(model, "ee")
+    data, reference = model.createData(), model.createData()
+    for q in well_conditioned_configurations(model, frame_id, 10, seed=4):
+        rotation, jacobian_lwa = frame_rotation_and_jacobian(model, data, q, frame_id)
+        pin.computeJointJacobians(model, reference, q)
+        pin.updateFramePlacements(model, reference)
+        np.testing.assert_allclose(rotation, reference.oMf[frame_id].rotation, atol=1e-15)
+        expected = pin.getFrameJacobian(
+            model, reference, frame_id, pin.ReferenceFrame.LOCAL_WORLD_ALIGNED
+        )
+        np.testing.assert_allclose(jacobian_lwa, expected, atol=1e-14)
+        rpy = euler_rpy_from_rotation(rotation)
+        world_rate_matrix = np.column_stack(
+            [angular_velocity_world_from_euler_rates(tuple(rpy), tuple(e)) for e in np.eye(3)]
+        )
+        analytical = np.vstack(
+            [jacobian_lwa[:3], np.linalg.solve(world_rate_matrix, jacobian_lwa[3:])]
+        )
+        np.testing.assert_allclose(
+            analytical, analytical_jacobian(model, reference, q, frame_id), atol=1e-13
+        )

@@ -16,6 +16,8 @@ Conventions (docs/physics.md):
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 import pinocchio as pin
 
@@ -79,6 +81,67 @@ def euler_rate_matrix_body(rpy: np.ndarray) -> np.ndarray:
             [0.0, -s_roll, c_pitch * c_roll],
         ]
     )
+
+
+def angular_velocity_world_from_euler_rates(
+    rpy: tuple[float, float, float], euler_rates: tuple[float, float, float]
+) -> tuple[float, float, float]:
+    """omega_world = E(rpy) rpy_dot [rad/s]: the world-axes angular velocity of ZYX rates.
+
+    With R = Rz(psi) Ry(theta) Rx(phi), omega = psi_dot e_z + theta_dot Rz e_y +
+    phi_dot Rz Ry e_x, i.e. E = R J'' (:func:`euler_rate_matrix_body`)::
+
+        E = [[cos(psi) cos(theta), -sin(psi), 0],
+             [sin(psi) cos(theta),  cos(psi), 0],
+             [-sin(theta),          0,        1]]
+
+    It depends on pitch and yaw only and needs no inverse (det E = cos(theta)). Scalar
+    ``math`` on 3 floats: this runs once per control tick.
+    """
+    _, pitch, yaw = rpy
+    roll_rate, pitch_rate, yaw_rate = euler_rates
+    c_pitch, s_pitch = math.cos(pitch), math.sin(pitch)
+    c_yaw, s_yaw = math.cos(yaw), math.sin(yaw)
+    return (
+        c_yaw * c_pitch * roll_rate - s_yaw * pitch_rate,
+        s_yaw * c_pitch * roll_rate + c_yaw * pitch_rate,
+        yaw_rate - s_pitch * roll_rate,
+    )
+
+
+def frame_rotation_and_jacobian(
+    model: pin.Model, data: pin.Data, q: np.ndarray, frame_id: int
+) -> tuple[np.ndarray, np.ndarray]:
+    """One Pinocchio pass: world_R_frame (3, 3) and the frame's LOCAL_WORLD_ALIGNED Jacobian.
+
+    ``pin.computeFrameJacobian`` runs forward kinematics on the frame's support only and
+    leaves the frame placement in ``data.oMf``. The Jacobian J^lwa (6, nv) maps zeta to
+    [p_dot_world (3) m/s; omega_world (3) rad/s]: with E of
+    :func:`angular_velocity_world_from_euler_rates`, the analytical Jacobian of
+    :func:`analytical_jacobian` is J = diag(I, E^-1) J^lwa.
+
+    No input checks: for callers that validated ``q`` (shape (nq,), finite) and
+    ``frame_id`` once.
+    """
+    jacobian = pin.computeFrameJacobian(model, data, q, frame_id, pin.LOCAL_WORLD_ALIGNED)
+    return data.oMf[frame_id].rotation, jacobian
+
+
+def check_euler_singularity(
+    model: pin.Model,
+    frame_id: int,
+    rpy: np.ndarray,
+    min_abs_cos_pitch: float = EULER_SINGULARITY_MIN_ABS_COS_PITCH,
+) -> None:
+    """Raise ParameterError if |cos(pitch)| < ``min_abs_cos_pitch`` (see
+    :func:`analytical_jacobian`)."""
+    cos_pitch = math.cos(rpy[1])
+    if abs(cos_pitch) < min_abs_cos_pitch:
+        raise ParameterError(
+            f"frame '{model.frames[frame_id].name}' is at the ZYX Euler singularity: "
+            f"pitch = {rpy[1]:.6f} rad, |cos(pitch)| = {abs(cos_pitch):.3g} < "
+            f"{min_abs_cos_pitch:.3g}; the analytical Jacobian is undefined there"
+        )
 
 
 def _check_q(model: pin.Model, q: np.ndarray) -> np.ndarray:
@@ -145,13 +208,7 @@ def analytical_jacobian(
     pin.computeJointJacobians(model, data, q)  # also runs forward kinematics
     placement_world = pin.updateFramePlacement(model, data, frame_id)
     rpy = euler_rpy_from_rotation(placement_world.rotation)
-    cos_pitch = float(np.cos(rpy[1]))
-    if abs(cos_pitch) < min_abs_cos_pitch:
-        raise ParameterError(
-            f"frame '{model.frames[frame_id].name}' is at the ZYX Euler singularity: "
-            f"pitch = {rpy[1]:.6f} rad, |cos(pitch)| = {abs(cos_pitch):.3g} < "
-            f"{min_abs_cos_pitch:.3g}; the analytical Jacobian is undefined there"
-        )
+    check_euler_singularity(model, frame_id, rpy, min_abs_cos_pitch)
     jacobian_world_aligned = pin.getFrameJacobian(
         model, data, frame_id, pin.ReferenceFrame.LOCAL_WORLD_ALIGNED
     )

@@ -12,6 +12,7 @@ import pytest
 from uvms_pin.controllers.performance import (
     PerformanceFunction,
     check_funnel,
+    max_abs,
     normalized_error,
     transformation_gain,
     transformed_error,
@@ -165,3 +166,15 @@ def test_check_funnel_reports_the_worst_component_and_nan():
 def test_check_funnel_rejects_mismatched_names():
     with pytest.raises(ParameterError):
         check_funnel(level="first", names=["a"], time_s=0.0, error=[0.1, 0.2], bound=[1, 1])
+
+
+def test_max_abs_and_nan_anywhere():
+    """max |x| of arrays and lists; a NaN in any position gives NaN (never passes < 1)."""
+    assert max_abs(np.array([0.2, -0.7, 0.5])) == 0.7
+    assert max_abs([0.1, -0.05]) == 0.1
+    assert max_abs(np.array([-np.inf, 0.0])) == np.inf
+    for position in range(4):
+        values = np.array([0.1, -0.3, 0.2, 0.0])
+        values[position] = np.nan
+        assert np.isnan(max_abs(values))
+        assert not max_abs(values) < 1.0

@@ -22,11 +22,28 @@ Second level (generalized velocity, n = nv components):
 
 The controller is model-free: it uses only frame placements and frame Jacobians of the
 model (kinematics), never its inertias, gravity or hydrodynamics, nor the environment.
+
+How ``compute`` is evaluated (it runs once per control tick, or once per integrator stage,
+so it avoids per-call overhead; the results agree with the direct evaluation of the
+equations above to ~1e-13, see tests/controllers/test_ppc_oracle.py):
+
+- one Pinocchio pass gives the end-effector rotation and its LOCAL_WORLD_ALIGNED Jacobian
+  J^lwa; the analytical Jacobian is J = diag(I, E^-1) J^lwa with E the Euler-rate matrix
+  in world axes, and since J has full row rank, J^# xdot = (J^lwa)^# [xdot_p; E xdot_o]:
+  E is applied in closed form and never inverted;
+- J^# is applied by a Cholesky solve of the 6 x 6 J W^-1 J^T with one refinement step
+  (:class:`~uvms_pin.controllers.pseudo_inverse.MinimumNormSolver`); when its certified
+  condition bound is too large, the exact SVD route of the definition is used instead;
+- both funnels are evaluated in one vector, and a funnel check is one max |xi| < 1; the
+  detailed checks (which component, which exception) only run when that fails;
+- scalar ``math`` on the 3- and 6-element quantities; ``last_signals`` is assembled only
+  when read.
 """
 
 from __future__ import annotations
 
 import dataclasses
+import math
 from collections.abc import Callable
 from dataclasses import dataclass
 
@@ -39,14 +56,30 @@ from uvms_pin.controllers.performance import (
     PerformanceFunction,
     barrier_extended,
     check_funnel,
+    max_abs,
     normalized_error,
-    transformation_gain,
     transformed_error,
     transformed_error_extended,
 )
+from uvms_pin.controllers.pseudo_inverse import MinimumNormSolver, pseudo_inverse
 from uvms_pin.errors import ParameterError
-from uvms_pin.kinematics import analytical_jacobian, end_effector_pose, frame_id_from_name
+from uvms_pin.kinematics import (
+    analytical_jacobian,
+    angular_velocity_world_from_euler_rates,
+    check_euler_singularity,
+    frame_id_from_name,
+    frame_rotation_and_jacobian,
+)
 from uvms_pin.measurement import Measurement
+
+__all__ = [
+    "FIRST_LEVEL_NAMES",
+    "VEHICLE_VELOCITY_NAMES",
+    "PPCParams",
+    "PPCSignals",
+    "PrescribedPerformanceController",
+    "pseudo_inverse",
+]
 
 #: Names of the first-level (task-space) error components.
 FIRST_LEVEL_NAMES: tuple[str, ...] = ("f_x", "f_y", "f_z", "roll", "pitch", "yaw")
@@ -58,6 +91,7 @@ _N_VEHICLE = 6
 #: With the funnel extension on (continuous-time simulation), the barrier is continued
 #: linearly beyond |xi| = this (where eps ~ 14.5, r ~ 1e6): it keeps growing outside.
 _XI_CLAMP = 1.0 - 1e-6
+_TWO_PI = 2.0 * math.pi
 #: Joint position limits at or beyond this magnitude are treated as absent (Pinocchio marks
 #: "no limit" with +-max double).
 _NO_LIMIT_THRESHOLD = 1e10
@@ -220,6 +254,8 @@ def _as_function(value, name: str, size: int) -> Callable[[float], np.ndarray]:
 
         def evaluate(time_s: float) -> np.ndarray:
             out = np.asarray(value(time_s), dtype=float)
+            if out.shape == (size,) and math.isfinite(sum(out.tolist())):
+                return out  # the exact check below also admits sums beyond 1e308
             if out.shape != (size,) or not np.all(np.isfinite(out)):
                 raise ParameterError(
                     f"{name}({time_s}) must return {size} finite values, got {out!r}"
@@ -231,26 +267,35 @@ def _as_function(value, name: str, size: int) -> Callable[[float], np.ndarray]:
     return lambda time_s: constant
 
 
-def pseudo_inverse(
-    matrix: np.ndarray, relative_cutoff: float, weights: np.ndarray | None = None
-) -> np.ndarray:
-    """Moore-Penrose pseudo-inverse through the SVD, or its weighted form.
+def _as_slice(index: np.ndarray) -> slice | np.ndarray:
+    """``index`` as a slice if it is a contiguous increasing range (cheaper to index)."""
+    if index.size and np.array_equal(index, np.arange(index[0], index[0] + index.size)):
+        return slice(int(index[0]), int(index[0]) + index.size)
+    return index
 
-    Singular values ``s_i <= relative_cutoff * s_max`` are treated as zero (numerical
-    rank); the others are inverted exactly (no damping), as in the paper's eq. (9).
-    With ``weights`` w (columns), J^# = W^-1/2 (J W^-1/2)^+, i.e. the minimum of
-    x^T W x among the least-squares solutions of J x = b.
+
+def _first_level_error(
+    wrench_world: np.ndarray,
+    force_desired: np.ndarray,
+    rpy_ee: np.ndarray,
+    rpy_desired: np.ndarray,
+) -> list[float]:
+    """e_x (6 floats) = [f_meas - f_d (3) N; wrap(rpy_ee - rpy_d) (3) rad].
+
+    e_f = f_e + Delta f_e - f_d; e_o = rpy - rpy_d as in the paper, wrapped to [-pi, pi) so
+    that a roll or yaw crossing +-pi (where matrixToRpy jumps by 2 pi) is not read as a huge
+    error. Scalar ``math`` on 3 + 3 floats (Python's float % is numpy's mod).
     """
-    if weights is not None:
-        scale = 1.0 / np.sqrt(weights)
-        return scale[:, None] * pseudo_inverse(matrix * scale[None, :], relative_cutoff)
-    u, s, vt = np.linalg.svd(matrix, full_matrices=False)
-    if s.size == 0 or s[0] == 0.0:
-        return np.zeros(matrix.shape[::-1])
-    keep = s > relative_cutoff * s[0]
-    s_inv = np.zeros_like(s)
-    s_inv[keep] = 1.0 / s[keep]
-    return (vt.T * s_inv) @ u.T
+    f, fd = wrench_world.tolist(), force_desired.tolist()
+    r, rd = rpy_ee.tolist(), rpy_desired.tolist()
+    return [
+        f[0] - fd[0],
+        f[1] - fd[1],
+        f[2] - fd[2],
+        (r[0] - rd[0] + math.pi) % _TWO_PI - math.pi,
+        (r[1] - rd[1] + math.pi) % _TWO_PI - math.pi,
+        (r[2] - rd[2] + math.pi) % _TWO_PI - math.pi,
+    ]
 
 
 class PrescribedPerformanceController(Controller):
@@ -322,11 +367,35 @@ class PrescribedPerformanceController(Controller):
         self._target = self._mid
         if self.params.null_space_target is not None:
             self._target = self.params.null_space_target[self._limited_v_index - _N_VEHICLE]
-        self.last_signals: PPCSignals | None = None
         self._extend_beyond_funnels = False
         self._margin = np.inf
         weighted = np.any(self.params.velocity_weights != 1.0)
         self._weights = self.params.velocity_weights if weighted else None
+
+        # ---- constants of the fast evaluation (see the module docstring)
+        # both levels' funnels in one vector: rho = [rho_x (6); rho_zeta (nv)]
+        self._performance_both = PerformanceFunction(
+            np.r_[self.performance_x.rho0, self.performance_zeta.rho0],
+            np.r_[self.performance_x.rho_inf, self.performance_zeta.rho_inf],
+            np.r_[self.performance_x.decay_rate_per_s, self.performance_zeta.decay_rate_per_s],
+            self.first_level_names + self.second_level_names,
+        )
+        # -k_x eps = (-2 k_x) artanh(xi) and -k r eps / rho = (-4 k) artanh(xi) / ((1 - xi^2) rho)
+        self._neg_two_k_x = (-2.0 * self.params.k_x).tolist()
+        self._neg_four_k_zeta = -4.0 * self.params.k_zeta
+        self._solver = MinimumNormSolver(self._weights, self.params.pinv_relative_cutoff)
+        self._nq, self._nv = self.model.nq, self.model.nv
+        # zeta_0 = (q - q_0) (-k_0 / h) on the limited joints, indexed by slices when they
+        # are contiguous (the usual arm); None when there is no secondary task
+        gain = float(self.params.null_space_gain_per_s)
+        self._null_space_scale = (
+            -gain / self._half_range if gain > 0.0 and self._limited_q_index.size else None
+        )
+        self._limited_q = _as_slice(self._limited_q_index)
+        self._limited_v = _as_slice(self._limited_v_index)
+        # the last successful call's raw signals, and the PPCSignals built from them on demand
+        self._last: tuple | None = None
+        self._last_signals: PPCSignals | None = None
 
     # ------------------------------------------------------------------ model helpers
     def _arm_velocity_names(self) -> list[str]:
@@ -364,11 +433,10 @@ class PrescribedPerformanceController(Controller):
         together without moving the end-effector: the vehicle slowly takes over what the
         arm is holding.
         """
-        zeta_0 = np.zeros(self.model.nv)
-        gain = float(self.params.null_space_gain_per_s)
-        if gain > 0.0 and self._limited_q_index.size:
-            offset = np.asarray(q)[self._limited_q_index] - self._target
-            zeta_0[self._limited_v_index] = -gain * offset / self._half_range
+        zeta_0 = np.zeros(self._nv)
+        if self._null_space_scale is not None:
+            offset = np.asarray(q)[self._limited_q] - self._target
+            zeta_0[self._limited_v] = offset * self._null_space_scale
         return zeta_0
 
     # ------------------------------------------------------------------ the law
@@ -376,9 +444,18 @@ class PrescribedPerformanceController(Controller):
         q = np.asarray(measurement.q, dtype=float)
         v = np.asarray(measurement.v, dtype=float)
         wrench = np.asarray(measurement.wrench_world, dtype=float)
+        if (
+            q.shape == (self._nq,)
+            and v.shape == (self._nv,)
+            and wrench.shape == (6,)
+            # one finiteness test for all three: a sum is NaN or inf if any entry is (Python
+            # floats: no overflow warning); the exact check below admits sums beyond 1e308
+            and math.isfinite(sum(q.tolist()) + sum(v.tolist()) + sum(wrench.tolist()))
+        ):
+            return q, v, wrench
         for label, array, size in (
-            ("q", q, self.model.nq),
-            ("v", v, self.model.nv),
+            ("q", q, self._nq),
+            ("v", v, self._nv),
             ("wrench_world", wrench, 6),
         ):
             if array.shape != (size,):
@@ -403,68 +480,94 @@ class PrescribedPerformanceController(Controller):
         """
         time_s = float(time_s)
         q, v, wrench_world = self._check_measurement(measurement)
-        params = self.params
+        extended = self._extend_beyond_funnels
 
         # ---- first level: force and orientation errors, eq. (8)-(12)
         force_desired = self._desired_force(time_s)
         rpy_desired = self._desired_rpy(time_s)
-        _, rpy_ee = end_effector_pose(self.model, self.data, q, self.ee_frame_id)
-        e_force = wrench_world[:3] - force_desired  # e_f = f_e + Delta f_e - f_d
-        # e_o = rpy - rpy_d as in the paper, wrapped to [-pi, pi) so that a roll or yaw
-        # crossing +-pi (where matrixToRpy jumps by 2 pi) is not read as a huge error.
-        e_orientation = np.mod(rpy_ee - rpy_desired + np.pi, 2.0 * np.pi) - np.pi
-        e_x = np.r_[e_force, e_orientation]
-        rho_x = self.performance_x.value(time_s)
-        xi_x = self._normalize("first", self.first_level_names, time_s, e_x, rho_x)
-        eps_x = (
-            transformed_error_extended(xi_x, _XI_CLAMP)
-            if self._extend_beyond_funnels
-            else transformed_error(xi_x)
+        rotation, jacobian_lwa = frame_rotation_and_jacobian(
+            self.model, self.data, q, self.ee_frame_id
         )
+        rpy_ee = pin.rpy.matrixToRpy(rotation)
+        e_x = _first_level_error(wrench_world, force_desired, rpy_ee, rpy_desired)
+        rho = self._performance_both.value(time_s)
+        rho_x, rho_zeta = rho[:6], rho[6:]
         # eq. (13), erratum: k_x > 0 (the paper's simulation prints -0.2). The force rows
         # are end-effector linear velocities [m/s]: with f_e = K_f (p - p0), K_f > 0, a
         # force above the desired one (e_f > 0) asks the end-effector to back off.
-        xdot_r = -params.k_x * eps_x
+        # Six components: Python floats (-k_x eps = -2 k_x artanh(xi)).
+        xi_x = [e / r for e, r in zip(e_x, rho_x.tolist(), strict=True)]
+        max_xi_x = max_abs(xi_x)
+        if max_xi_x < (_XI_CLAMP if extended else 1.0):
+            xdot_r = [k * math.atanh(x) for k, x in zip(self._neg_two_k_x, xi_x, strict=True)]
+        else:  # outside (raises), or beyond the clamp of the funnel extension
+            e_x = np.array(e_x)
+            xi_x = self._normalize("first", self.first_level_names, time_s, e_x, rho_x)
+            xdot_r = (-self.params.k_x * transformed_error_extended(xi_x, _XI_CLAMP)).tolist()
+        check_euler_singularity(self.model, self.ee_frame_id, rpy_ee)
 
         # ---- task space -> generalized velocities, eq. (9) (+ the remark's null space)
-        jacobian = analytical_jacobian(self.model, self.data, q, self.ee_frame_id)
-        jacobian_pinv = pseudo_inverse(jacobian, params.pinv_relative_cutoff, self._weights)
-        zeta_r = jacobian_pinv @ xdot_r
-        if params.null_space_gain_per_s > 0.0:
-            zeta_0 = self.null_space_velocity(q)
-            zeta_r = zeta_r + zeta_0 - jacobian_pinv @ (jacobian @ zeta_0)
+        zeta_r = self._reference_velocity(q, rpy_ee, jacobian_lwa, xdot_r)
 
         # ---- second level, eq. (14)-(19); erratum: rho_v == rho_zeta, P == P_zeta
         e_zeta = v - zeta_r
-        rho_zeta = self.performance_zeta.value(time_s)
-        xi_zeta = self._normalize("second", self.second_level_names, time_s, e_zeta, rho_zeta)
+        xi_zeta = e_zeta / rho_zeta
+        max_xi_zeta = max_abs(xi_zeta)
         # eq. (19), erratum: K_zeta > 0 (the paper's simulation prints k_v = -5).
-        if self._extend_beyond_funnels:
-            eps_zeta = transformed_error_extended(xi_zeta, _XI_CLAMP)
-            tau = -params.k_zeta * barrier_extended(xi_zeta, _XI_CLAMP) / rho_zeta
+        if max_xi_zeta < (_XI_CLAMP if extended else 1.0):
+            # -K_zeta P^-1 r(xi) eps(xi) with r eps = 4 artanh(xi) / (1 - xi^2), and
+            # (1 - xi^2) rho = rho - xi e
+            tau = self._neg_four_k_zeta * np.arctanh(xi_zeta) / (rho_zeta - xi_zeta * e_zeta)
         else:
-            eps_zeta = transformed_error(xi_zeta)
-            tau = -params.k_zeta * transformation_gain(xi_zeta) * eps_zeta / rho_zeta
-        self._margin = float(min(np.min(1.0 - np.abs(xi_x)), np.min(1.0 - np.abs(xi_zeta))))
-
-        self.last_signals = PPCSignals(
-            time_s=time_s,
-            force_desired_world_N=force_desired,
-            rpy_desired=rpy_desired,
-            rpy_ee=rpy_ee,
-            e_x=e_x,
-            rho_x=rho_x,
-            xi_x=xi_x,
-            eps_x=eps_x,
-            xdot_r=xdot_r,
-            zeta_r=zeta_r,
-            e_zeta=e_zeta,
-            rho_zeta=rho_zeta,
-            xi_zeta=xi_zeta,
-            eps_zeta=eps_zeta,
-            tau=tau.copy(),
+            xi_zeta = self._normalize("second", self.second_level_names, time_s, e_zeta, rho_zeta)
+            tau = -self.params.k_zeta * barrier_extended(xi_zeta, _XI_CLAMP) / rho_zeta
+        # min(1 - |xi|) = 1 - max |xi| exactly (1 - x rounds monotonically)
+        self._margin = 1.0 - max(max_xi_x, max_xi_zeta)
+        self._last = (
+            time_s,
+            force_desired,
+            rpy_desired,
+            rpy_ee,
+            e_x,
+            rho_x,
+            xi_x,
+            xdot_r,
+            zeta_r,
+            e_zeta,
+            rho_zeta,
+            xi_zeta,
+            tau.copy(),
+            extended,
         )
+        self._last_signals = None
         return tau
+
+    def _reference_velocity(
+        self, q: np.ndarray, rpy_ee: np.ndarray, jacobian_lwa: np.ndarray, xdot_r: list[float]
+    ) -> np.ndarray:
+        """zeta_r = J^# xdot_r + (I - J^# J) zeta_0 (nv,) [m/s, rad/s].
+
+        With J = diag(I, E^-1) J^lwa of full row rank, J^# xdot_r = (J^lwa)^# b with
+        b = [xdot_p; E xdot_o], and zeta_0 + J^# (xdot_r - J zeta_0) = zeta_0 + (J^lwa)^#
+        (b - J^lwa zeta_0). The exact SVD route on J itself when the solver declines.
+        """
+        b = np.array([*xdot_r[:3], *angular_velocity_world_from_euler_rates(rpy_ee, xdot_r[3:])])
+        if self._null_space_scale is not None:
+            zeta_0 = self.null_space_velocity(q)
+            solution = self._solver.solve(jacobian_lwa, b - np.dot(jacobian_lwa, zeta_0))
+            if solution is not None:
+                return solution + zeta_0
+        else:
+            zeta_0 = None
+            solution = self._solver.solve(jacobian_lwa, b)
+            if solution is not None:
+                return solution
+        jacobian = analytical_jacobian(self.model, self.data, q, self.ee_frame_id)
+        jacobian_pinv = pseudo_inverse(jacobian, self.params.pinv_relative_cutoff, self._weights)
+        zeta_r = jacobian_pinv @ np.array(xdot_r)
+        if zeta_0 is not None:
+            zeta_r = zeta_r + zeta_0 - jacobian_pinv @ (jacobian @ zeta_0)
+        return zeta_r
 
     def _normalize(self, level, names, time_s, error, bound) -> np.ndarray:
         """xi = e / rho; raises FunnelViolation at |xi| >= 1 unless the extension is on."""
@@ -475,6 +578,37 @@ class PrescribedPerformanceController(Controller):
             return xi
         return check_funnel(level=level, names=names, time_s=time_s, error=error, bound=bound)
 
+    @property
+    def last_signals(self) -> PPCSignals | None:
+        """:class:`PPCSignals` of the last successful ``compute`` (None before one)."""
+        if self._last is None or self._last_signals is not None:
+            return self._last_signals
+        (time_s, force_desired, rpy_desired, rpy_ee, e_x, rho_x, xi_x, xdot_r, zeta_r,
+         e_zeta, rho_zeta, xi_zeta, tau, extended) = self._last  # fmt: skip
+        transform = (
+            (lambda xi: transformed_error_extended(xi, _XI_CLAMP))
+            if extended
+            else transformed_error
+        )
+        self._last_signals = PPCSignals(
+            time_s=time_s,
+            force_desired_world_N=force_desired,
+            rpy_desired=rpy_desired,
+            rpy_ee=rpy_ee,
+            e_x=np.array(e_x),
+            rho_x=rho_x,
+            xi_x=np.array(xi_x),
+            eps_x=transform(np.array(xi_x)),
+            xdot_r=np.array(xdot_r),
+            zeta_r=zeta_r,
+            e_zeta=e_zeta,
+            rho_zeta=rho_zeta,
+            xi_zeta=xi_zeta,
+            eps_zeta=transform(xi_zeta),
+            tau=tau,
+        )
+        return self._last_signals
+
     def funnel_margin(self) -> float:
         """min(1 - |xi|) over both levels at the last ``compute`` (> 0: inside)."""
         return self._margin
@@ -484,15 +618,17 @@ class PrescribedPerformanceController(Controller):
 
     def reset(self) -> None:
         """Forget the logged signals (the law itself has no state)."""
-        self.last_signals = None
+        self._last = None
+        self._last_signals = None
         self._margin = np.inf
 
     def signals(self) -> dict[str, np.ndarray]:
         """The last call's internal signals as arrays, for logging (empty before a call)."""
-        if self.last_signals is None:
+        signals = self.last_signals
+        if signals is None:
             return {}
         return {
-            f.name: np.atleast_1d(getattr(self.last_signals, f.name))
-            for f in dataclasses.fields(self.last_signals)
+            f.name: np.atleast_1d(getattr(signals, f.name))
+            for f in dataclasses.fields(signals)
             if f.name != "time_s"
         }

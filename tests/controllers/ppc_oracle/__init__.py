@@ -1,0 +1,7 @@
+"""A frozen copy of the prescribed-performance controller as it was before it was optimized.
+
+``ppc.py``, ``performance.py`` and ``kinematics.py`` are uvms_pin's files of commit 1c81485,
+verbatim except for their imports of each other. They are the oracle of
+``test_ppc_oracle.py``: the fast controller must give the same outputs (tau, signals, funnel
+margin, exceptions) to 1e-12. Do not edit them; do not import them from the package.
+"""
