@@ -82,6 +82,10 @@ class AiryWave(FlowField):
     def velocity_gradient(self, time_s, points_world):
         return self.components.velocity_gradient(time_s, as_points(points_world))
 
+    @property
+    def has_free_surface(self) -> bool:
+        return True
+
     def surface_elevation(self, time_s, xy_world):
         return self.components.elevation(time_s, np.asarray(xy_world, dtype=float).reshape(-1, 2))
 

@@ -51,6 +51,11 @@ class FlowField(ABC):
         grad = self.velocity_gradient(time_s, points)
         return self.local_acceleration(time_s, points) + np.einsum("kij,kj->ki", grad, u)
 
+    @property
+    def has_free_surface(self) -> bool:
+        """True for fields that move the free surface (waves): bodies must stay below it."""
+        return False
+
     def surface_elevation(self, time_s: float, xy_world: np.ndarray) -> np.ndarray:
         """Free-surface elevation eta (n,) [m] above z = 0 at horizontal points (n, 2)."""
         xy = np.asarray(xy_world, dtype=float).reshape(-1, 2)
@@ -85,6 +90,10 @@ class SumFlow(FlowField):
     def velocity_gradient(self, time_s, points_world):
         points = as_points(points_world)
         return sum(f.velocity_gradient(time_s, points) for f in self.fields)
+
+    @property
+    def has_free_surface(self) -> bool:
+        return any(f.has_free_surface for f in self.fields)
 
     def surface_elevation(self, time_s, xy_world):
         return sum(f.surface_elevation(time_s, xy_world) for f in self.fields)
