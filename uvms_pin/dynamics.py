@@ -85,8 +85,9 @@ def _fluid_wrenches(uvms: UVMS, flow: FlowField | None, time_s: float) -> list[p
         cob_world = np.array(
             [data.oMi[j].act(uvms.center_of_buoyancy_per_joint_m[j]) for j in range(nj)]
         )
-        flow_velocity_world = flow.velocity(time_s, cob_world)
-        flow_acceleration_world = flow.acceleration(time_s, cob_world)
+        flow_velocity_world, flow_acceleration_world = flow.velocity_and_acceleration(
+            time_s, cob_world
+        )
 
     joints = list(uvms.joints_with_added_mass)
     if joints:

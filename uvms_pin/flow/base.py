@@ -46,10 +46,25 @@ class FlowField(ABC):
 
     def acceleration(self, time_s: float, points_world: np.ndarray) -> np.ndarray:
         """Du/Dt = du/dt + (grad u) u (n, 3) [m/s^2]: the material acceleration."""
+        return self.velocity_and_acceleration(time_s, points_world)[1]
+
+    def kinematics(
+        self, time_s: float, points_world: np.ndarray
+    ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """(u, du/dt, grad u) at once; fields override it to share work between the three."""
         points = as_points(points_world)
-        u = self.velocity(time_s, points)
-        grad = self.velocity_gradient(time_s, points)
-        return self.local_acceleration(time_s, points) + np.einsum("kij,kj->ki", grad, u)
+        return (
+            self.velocity(time_s, points),
+            self.local_acceleration(time_s, points),
+            self.velocity_gradient(time_s, points),
+        )
+
+    def velocity_and_acceleration(
+        self, time_s: float, points_world: np.ndarray
+    ) -> tuple[np.ndarray, np.ndarray]:
+        """(u, Du/Dt) (n, 3) each, from one `kinematics` evaluation."""
+        u, du_dt, grad = self.kinematics(time_s, points_world)
+        return u, du_dt + np.einsum("kij,kj->ki", grad, u)
 
     @property
     def has_free_surface(self) -> bool:
@@ -90,6 +105,11 @@ class SumFlow(FlowField):
     def velocity_gradient(self, time_s, points_world):
         points = as_points(points_world)
         return sum(f.velocity_gradient(time_s, points) for f in self.fields)
+
+    def kinematics(self, time_s, points_world):
+        points = as_points(points_world)
+        parts = [f.kinematics(time_s, points) for f in self.fields]
+        return tuple(sum(p[i] for p in parts) for i in range(3))
 
     @property
     def has_free_surface(self) -> bool:

@@ -102,12 +102,29 @@ class WaveComponents:
         horizontal = ch * np.sin(theta) * aww
         return np.column_stack([horizontal @ ex, horizontal @ ey, -(sh * np.cos(theta)) @ aww])
 
+    def kinematics(
+        self, time_s: float, points: np.ndarray
+    ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """(u, du/dt, grad u) from one evaluation of the phases and depth profiles."""
+        theta, ch, sh, ex, ey = self._phase_and_profiles(time_s, points)
+        cos, sin = np.cos(theta), np.sin(theta)
+        a, w, k = self.amplitude_m, self.angular_frequency_rad_s, self.wavenumber_rad_m
+        c_cos, c_sin, s_cos, s_sin = ch * cos, ch * sin, sh * cos, sh * sin
+        aw, aww = a * w, a * w * w
+        velocity = np.column_stack([c_cos @ (aw * ex), c_cos @ (aw * ey), s_sin @ aw])
+        local = np.column_stack([c_sin @ (aww * ex), c_sin @ (aww * ey), -(s_cos @ aww)])
+        return velocity, local, self._gradient(c_sin, s_cos, ex, ey, aw * k)
+
     def velocity_gradient(self, time_s: float, points: np.ndarray) -> np.ndarray:
         theta, ch, sh, ex, ey = self._phase_and_profiles(time_s, points)
         awk = self.amplitude_m * self.angular_frequency_rad_s * self.wavenumber_rad_m
-        c_sin = ch * np.sin(theta) * awk  # (n, m)
-        s_cos = sh * np.cos(theta) * awk
-        grad = np.empty((len(points), 3, 3))
+        return self._gradient(ch * np.sin(theta), sh * np.cos(theta), ex, ey, awk)
+
+    @staticmethod
+    def _gradient(c_sin, s_cos, ex, ey, awk) -> np.ndarray:
+        """grad u from C sin(theta), S cos(theta) (n, m) and A w k (m,)."""
+        c_sin, s_cos = c_sin * awk, s_cos * awk  # (n, m)
+        grad = np.empty((len(c_sin), 3, 3))
         e = (ex, ey)
         for i in range(2):
             for j in range(2):

@@ -108,6 +108,9 @@ class IrregularSea(FlowField):
     def velocity_gradient(self, time_s, points_world):
         return self.components.velocity_gradient(time_s, as_points(points_world))
 
+    def kinematics(self, time_s, points_world):
+        return self.components.kinematics(time_s, as_points(points_world))
+
     @property
     def has_free_surface(self) -> bool:
         return True
