@@ -77,7 +77,23 @@ def write_outputs(rollout: Rollout, out: Path) -> list[Path]:
             **metrics,
         },
     )
-    return paper_figures(rollout, out) + standard_figures(rollout, out)
+    return paper_figures(rollout, out) + standard_figures(rollout, out) + _flow_figure(rollout, out)
+
+
+def _flow_figure(rollout: Rollout, out: Path) -> list[Path]:
+    """flow.png when the run had waves or a varying current (not for a uniform current)."""
+    from uvms_pin.flow import UniformCurrent
+    from uvms_pin.model import load_uvms
+    from uvms_pin.scenario import water_flow_of
+    from uvms_pin.viz.flow_plots import FLOW_FIGURE, plot_flow_seen
+
+    parameters = rollout.metadata.get("parameters") or {}
+    flow = water_flow_of(parameters)
+    if flow is None or isinstance(flow, UniformCurrent) or len(rollout) == 0:
+        return []
+    density = float(parameters.get("water", {}).get("density_kg_m3", 1025.0))
+    uvms = load_uvms(rollout.metadata["model_source"], water_density_kg_m3=density)
+    return [plot_flow_seen(rollout, uvms, flow, out / FLOW_FIGURE)]
 
 
 def _simulate(scenario, args: argparse.Namespace, progress) -> Rollout:

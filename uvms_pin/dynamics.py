@@ -22,10 +22,15 @@ import pinocchio as pin
 from scipy.linalg import cho_factor, cho_solve
 
 from uvms_pin.errors import ParameterError, SimulationError
+from uvms_pin.flow import FlowField, UniformCurrent
 from uvms_pin.hydro.added_mass import kirchhoff_wrench
-from uvms_pin.hydro.current import current_acceleration_body, current_velocity_body
+from uvms_pin.hydro.current import current_velocity_body, flow_twist_rate_body
 from uvms_pin.hydro.damping import damping_wrench
-from uvms_pin.hydro.restoring import buoyancy_potential_energy, buoyancy_wrench
+from uvms_pin.hydro.restoring import (
+    buoyancy_potential_energy,
+    buoyancy_wrench,
+    froude_krylov_wrench,
+)
 from uvms_pin.hydro.vector import mat_t_vec, mat_vec
 from uvms_pin.model import UVMS
 
@@ -41,47 +46,86 @@ def _check(name: str, x: np.ndarray, n: int) -> np.ndarray:
     return x
 
 
-def _fluid_wrenches(uvms: UVMS, current_world_m_s: np.ndarray) -> list[pin.Force]:
+def _resolve_flow(current_world: np.ndarray, flow: FlowField | None) -> FlowField | None:
+    """The flow a call asked for: ``current_world`` is the shorthand for a UniformCurrent."""
+    current = _check("current_world", current_world, 3)
+    if flow is not None:
+        if not isinstance(flow, FlowField):
+            raise ParameterError(
+                f"flow must be a uvms_pin.flow.FlowField, got {type(flow).__name__}"
+            )
+        if np.any(current):
+            raise ParameterError("give either current_world or flow, not both (add the fields)")
+        return flow
+    return UniformCurrent(current) if np.any(current) else None
+
+
+def _check_time(time_s: float) -> float:
+    time_s = float(time_s)
+    if not np.isfinite(time_s):
+        raise ParameterError(f"time_s must be finite, got {time_s}")
+    return time_s
+
+
+def _fluid_wrenches(uvms: UVMS, flow: FlowField | None, time_s: float) -> list[pin.Force]:
     """Wrench of the water on each joint body (LOCAL frame), all terms but M_A zeta_dot.
 
     Needs ``forwardKinematics(model, data, q, v, 0)`` in ``uvms.data`` (placements, body
-    velocities and bias accelerations). Vectorized over bodies: the per-body physics is the
+    velocities and bias accelerations). The flow is sampled at each joint body's centre of
+    buoyancy (its origin if it has no volume) for added mass and Froude-Krylov, and at each
+    damped link's origin for damping. Vectorized over bodies: the per-body physics is the
     pure functions of `uvms_pin.hydro`, called once on stacks.
     """
     model, data = uvms.model, uvms.data
     nj = model.njoints
     rotation = np.array([data.oMi[j].rotation for j in range(nj)])  # (nj, 3, 3)
     velocity = np.array([data.v[j].vector for j in range(nj)])  # (nj, 6), LOCAL
-    has_current = bool(np.any(current_world_m_s))
     wrench = np.zeros((nj, 6))
-
-    joints = uvms.joints_with_added_mass
-    if joints:
-        nu = velocity[list(joints)]
-        acc = np.array([data.a[j].vector for j in joints])
-        if has_current:
-            nu_c = current_velocity_body(rotation[list(joints)], current_world_m_s)
-            acc = acc - current_acceleration_body(nu[:, 3:], nu_c[:, :3])
-            nu = nu - nu_c
-        added = uvms.added_mass_per_joint[list(joints)]
-        wrench[list(joints)] -= mat_vec(added, acc) + kirchhoff_wrench(added, nu)
-
-    joints = uvms.joints_with_volume
-    if joints:
-        wrench[list(joints)] += buoyancy_wrench(
-            uvms.volume_per_joint_m3[list(joints)],
-            uvms.center_of_buoyancy_per_joint_m[list(joints)],
-            rotation[list(joints)],
-            uvms.water_density_kg_m3,
-            model.gravity.linear,
+    if flow is not None:
+        cob_world = np.array(
+            [data.oMi[j].act(uvms.center_of_buoyancy_per_joint_m[j]) for j in range(nj)]
         )
+        flow_velocity_world, flow_acceleration_world = flow.velocity_and_acceleration(
+            time_s, cob_world
+        )
+
+    joints = list(uvms.joints_with_added_mass)
+    if joints:
+        nu = velocity[joints]
+        acc = np.array([data.a[j].vector for j in joints])
+        if flow is not None:
+            nu_c = current_velocity_body(rotation[joints], flow_velocity_world[joints])
+            acc = acc - flow_twist_rate_body(
+                rotation[joints], nu[:, 3:], nu_c[:, :3], flow_acceleration_world[joints]
+            )
+            nu = nu - nu_c
+        added = uvms.added_mass_per_joint[joints]
+        wrench[joints] -= mat_vec(added, acc) + kirchhoff_wrench(added, nu)
+
+    joints = list(uvms.joints_with_volume)
+    if joints:
+        volume, cob = uvms.volume_per_joint_m3[joints], uvms.center_of_buoyancy_per_joint_m[joints]
+        wrench[joints] += buoyancy_wrench(
+            volume, cob, rotation[joints], uvms.water_density_kg_m3, model.gravity.linear
+        )
+        if flow is not None:
+            wrench[joints] += froude_krylov_wrench(
+                volume,
+                cob,
+                rotation[joints],
+                uvms.water_density_kg_m3,
+                flow_acceleration_world[joints],
+            )
 
     ids = uvms.damping_joint_ids
     if ids.size:
         nu_r = mat_vec(uvms.damping_action, velocity[ids])  # body velocity of each link
-        if has_current:
+        if flow is not None:
             body_rotation = np.matmul(rotation[ids], uvms.damping_rotation_in_joint)
-            nu_r = nu_r - current_velocity_body(body_rotation, current_world_m_s)
+            origin_world = np.einsum(
+                "kij,kj->ki", rotation[ids], uvms.damping_origin_in_joint_m
+            ) + np.array([data.oMi[int(j)].translation for j in ids])
+            nu_r = nu_r - current_velocity_body(body_rotation, flow.velocity(time_s, origin_world))
         wrench_body = damping_wrench(uvms.damping_linear, uvms.damping_quadratic, nu_r)
         # back to the joint frame: f_joint = X^T f_body
         np.add.at(wrench, ids, mat_t_vec(uvms.damping_action, wrench_body))
@@ -108,25 +152,36 @@ def _mass_matrix(uvms: UVMS, q: np.ndarray) -> np.ndarray:
 
 
 def bias_forces(
-    uvms: UVMS, q: np.ndarray, v: np.ndarray, current_world: np.ndarray = _NO_CURRENT
+    uvms: UVMS,
+    q: np.ndarray,
+    v: np.ndarray,
+    current_world: np.ndarray = _NO_CURRENT,
+    *,
+    flow: FlowField | None = None,
+    time_s: float = 0.0,
 ) -> np.ndarray:
-    """h(q, zeta): rigid Coriolis and gravity, added-mass bias and Coriolis, damping, buoyancy.
+    """h(q, zeta): rigid Coriolis and gravity, added-mass bias and Coriolis, damping, buoyancy,
+    and, in an accelerating flow, the Froude-Krylov and added-mass loads of the flow.
 
     Args:
         q: configuration (nq,). v: generalized velocity zeta (nv,).
-        current_world: constant, uniform current velocity in the world frame [m/s].
+        current_world: constant, uniform current velocity in the world frame [m/s]
+            (shorthand for ``flow=UniformCurrent(current_world)``).
+        flow: any `uvms_pin.flow.FlowField` (waves, sea states, varying currents).
+        time_s: the time at which the flow is evaluated [s].
     """
     q = _check("q", q, uvms.nq)
     v = _check("v", v, uvms.nv)
-    current = _check("current_world", current_world, 3)
-    return _bias_forces(uvms, q, v, current)
+    return _bias_forces(uvms, q, v, _resolve_flow(current_world, flow), _check_time(time_s))
 
 
-def _bias_forces(uvms: UVMS, q: np.ndarray, v: np.ndarray, current: np.ndarray) -> np.ndarray:
+def _bias_forces(
+    uvms: UVMS, q: np.ndarray, v: np.ndarray, flow: FlowField | None, time_s: float
+) -> np.ndarray:
     model, data = uvms.model, uvms.data
     zero = np.zeros(model.nv)
     pin.forwardKinematics(model, data, q, v, zero)
-    fext = _fluid_wrenches(uvms, current)
+    fext = _fluid_wrenches(uvms, flow, time_s)
     # rnea(q, v, 0, fext) = C_RB v + g_RB - sum_i J_i^T fext_i
     return pin.rnea(model, data, q, v, zero, fext).copy()
 
@@ -138,13 +193,18 @@ def forward_dynamics(
     tau: np.ndarray,
     current_world: np.ndarray = _NO_CURRENT,
     tau_ext: np.ndarray | None = None,
+    *,
+    flow: FlowField | None = None,
+    time_s: float = 0.0,
 ) -> np.ndarray:
     """zeta_dot = M(q)^-1 (tau + tau_ext - h(q, zeta)), by a Cholesky solve (no inverse).
 
     Args:
         tau: generalized input (nv,): body wrench on the vehicle [N; N m], joint torques.
+        current_world: uniform constant current [m/s] (shorthand for a UniformCurrent).
         tau_ext: generalized force of external wrenches (nv,), e.g. from
             `frame_wrench_to_generalized`; None for none.
+        flow, time_s: a `uvms_pin.flow.FlowField` and the time it is evaluated at [s].
 
     Raises:
         ParameterError: wrong shape or non-finite input.
@@ -153,8 +213,7 @@ def forward_dynamics(
     q = _check("q", q, uvms.nq)
     v = _check("v", v, uvms.nv)
     tau = _check("tau", tau, uvms.nv)
-    current = _check("current_world", current_world, 3)
-    rhs = tau - _bias_forces(uvms, q, v, current)
+    rhs = tau - _bias_forces(uvms, q, v, _resolve_flow(current_world, flow), _check_time(time_s))
     if tau_ext is not None:
         rhs += _check("tau_ext", tau_ext, uvms.nv)
     mass = _mass_matrix(uvms, q)

@@ -121,6 +121,9 @@ class UVMS:
         self.damping_rotation_in_joint = np.array(
             [b.placement_in_joint.rotation for b in damped]
         ).reshape(-1, 3, 3)
+        self.damping_origin_in_joint_m = np.array(
+            [b.placement_in_joint.translation for b in damped]
+        ).reshape(-1, 3)
         self.damping_linear = np.array([b.params.linear_damping for b in damped]).reshape(-1, 6, 6)
         self.damping_quadratic = np.array([b.params.quadratic_damping for b in damped]).reshape(
             -1, 6

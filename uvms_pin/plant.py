@@ -14,7 +14,8 @@ import pinocchio as pin
 from uvms_pin.actuation import Actuation, Unlimited
 from uvms_pin.dynamics import forward_dynamics
 from uvms_pin.environment import ContactModel, Disturbance
-from uvms_pin.errors import ParameterError
+from uvms_pin.errors import ParameterError, SimulationError
+from uvms_pin.flow import FlowField, SumFlow, UniformCurrent
 from uvms_pin.model import UVMS
 
 
@@ -28,6 +29,8 @@ class Plant:
         contact: compliant environment at the end-effector, or None.
         disturbance: body wrench on the vehicle as a function of time, or None.
         actuation: thrusters and joint limits between the commanded and applied tau.
+        flow: waves, sea states or varying currents (`uvms_pin.flow`), added to the
+            uniform current; None for none.
     """
 
     uvms: UVMS
@@ -35,6 +38,7 @@ class Plant:
     contact: ContactModel | None = None
     disturbance: Disturbance | None = None
     actuation: Actuation = field(default_factory=Unlimited)
+    flow: FlowField | None = None
 
     def __post_init__(self) -> None:
         c = np.asarray(self.current_world_m_s, dtype=float).reshape(-1)
@@ -45,7 +49,44 @@ class Plant:
         self.current_world_m_s = c
         if self.contact is not None:
             self.uvms.require_ee_frame("a contact environment (at the end-effector)")
+        if self.flow is not None and not isinstance(self.flow, FlowField):
+            raise ParameterError(f"flow must be a FlowField, got {type(self.flow).__name__}")
         self._ee_data = self.uvms.model.createData()
+        self._flow = self.water_flow
+
+    @property
+    def water_flow(self) -> FlowField | None:
+        """The whole flow the bodies see: the uniform current plus ``flow``."""
+        fields = [UniformCurrent(self.current_world_m_s)] if np.any(self.current_world_m_s) else []
+        if self.flow is not None:
+            fields.append(self.flow)
+        if not fields:
+            return None
+        return fields[0] if len(fields) == 1 else SumFlow(tuple(fields))
+
+    def check_submerged(self, time_s: float, q: np.ndarray) -> None:
+        """Raise SimulationError when a body's centre of buoyancy is above the wave surface.
+
+        Only for flows with a moving free surface (waves): the hydrodynamics here are those
+        of a fully submerged body, so a body reaching the surface ends the run, reported.
+        """
+        if self.flow is None or not self.flow.has_free_surface:
+            return
+        model, data = self.uvms.model, self._ee_data
+        pin.forwardKinematics(model, data, q)
+        for body in self.uvms.hydro_bodies:
+            if body.params.volume_m3 <= 0.0:
+                continue
+            cob = data.oMi[body.joint_id].act(
+                body.placement_in_joint.act(body.params.center_of_buoyancy_m)
+            )
+            eta = float(self.flow.surface_elevation(time_s, cob[None, :2])[0])
+            if cob[2] > eta:
+                raise SimulationError(
+                    f"link '{body.name}' reached the free surface at t = {time_s:.6g} s: its "
+                    f"centre of buoyancy is {cob[2] - eta:.3g} m above the wave surface "
+                    f"(eta = {eta:.3g} m); the model holds for submerged bodies only"
+                )
 
     def ee_state(self, q: np.ndarray, v: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """End-effector position, linear velocity (world) and its LOCAL_WORLD_ALIGNED Jacobian."""
@@ -96,4 +137,6 @@ class Plant:
         if self.disturbance is not None:
             # the free-flyer's LOCAL Jacobian is [I 0]: a body wrench maps to tau[:6] directly
             tau_ext[:6] -= self.disturbance_wrench(time_s)
-        return forward_dynamics(self.uvms, q, v, tau, self.current_world_m_s, tau_ext)
+        return forward_dynamics(
+            self.uvms, q, v, tau, tau_ext=tau_ext, flow=self._flow, time_s=time_s
+        )

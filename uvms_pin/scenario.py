@@ -13,6 +13,7 @@ examples.
 
 from __future__ import annotations
 
+import copy
 import dataclasses
 import math
 from collections.abc import Callable
@@ -29,6 +30,15 @@ from uvms_pin.controllers.custom import ControllerSpec, class_path, custom_contr
 from uvms_pin.controllers.ppc import PPCParams, PrescribedPerformanceController
 from uvms_pin.environment import CompliantPlane, ContactModel, LinearSpring, SinusoidalDisturbance
 from uvms_pin.errors import ParameterError, ScenarioError, UvmsPinError
+from uvms_pin.flow import (
+    AiryWave,
+    DepthProfileCurrent,
+    FlowField,
+    GaussMarkovCurrent,
+    IrregularSea,
+    SumFlow,
+    UniformCurrent,
+)
 from uvms_pin.integrators import RK4, Adaptive, Integrator, SemiImplicitEuler
 from uvms_pin.model import UVMS, load_uvms
 from uvms_pin.overrides import apply_overrides, closest, parse_key_path
@@ -265,6 +275,7 @@ def _build(raw: dict[str, Any], path: Path, source: str, overridden: dict[str, s
     water = top.table("water") or _Table({}, "water", source)
     density = water.number("density_kg_m3", 1025.0, positive=True)
     current = water.vector("current_world_m_s", 3, [0.0, 0.0, 0.0])
+    flow = _water_flow(water, seed)
     water.finish()
 
     model_path = find_model(model_entry, path.parent)
@@ -281,7 +292,7 @@ def _build(raw: dict[str, Any], path: Path, source: str, overridden: dict[str, s
     contact = _environment(top.table("environment"), uvms)
     disturbance = _disturbance(top.table("disturbance"))
     actuation = _actuation(top.table("actuation"), uvms)
-    plant = Plant(uvms, current, contact, disturbance, actuation)
+    plant = Plant(uvms, current, contact, disturbance, actuation, flow)
     sensor_config = _sensors(top.table("sensors") or _Table({}, "sensors", source))
     integrator = _integrator(top.table("integrator") or _Table({}, "integrator", source))
 
@@ -328,6 +339,101 @@ def _initial_state(t: _Table, uvms: UVMS) -> tuple[np.ndarray, np.ndarray]:
     q0[3:7] = pin.Quaternion(pin.rpy.rpyToMatrix(*rpy)).coeffs()
     q0[7:] = joints
     return q0, velocity
+
+
+def water_flow_of(parameters: dict[str, Any], source: str = "<parameters>") -> FlowField | None:
+    """The whole flow of a scenario's raw parameters (e.g. a rollout's
+    ``metadata['parameters']``): the uniform current plus [water.current/waves/sea]."""
+    water = _Table(copy.deepcopy(parameters.get("water", {})), "water", source)
+    water.pop_raw("density_kg_m3")
+    current = water.vector("current_world_m_s", 3, [0.0, 0.0, 0.0])
+    seed = (parameters.get("scenario") or {}).get("seed", 0)
+    flow = _water_flow(water, seed)
+    water.finish()
+    fields = [UniformCurrent(current)] if np.any(current) else []
+    fields += [flow] if flow is not None else []
+    if not fields:
+        return None
+    return fields[0] if len(fields) == 1 else SumFlow(tuple(fields))
+
+
+def _water_flow(water: _Table, seed: int) -> FlowField | None:
+    """[water.current], [water.waves] and [water.sea]: the flow beyond the uniform
+    ``current_world_m_s``, summed. Seeds default to the scenario's seed."""
+    fields: list[FlowField] = []
+    current = water.table("current")
+    if current is not None:
+        fields.append(_current_field(current, seed))
+    waves = water.table("waves")
+    if waves is not None:
+        fields.append(
+            _flow_field(
+                waves,
+                lambda: AiryWave(
+                    amplitude_m=waves.number("amplitude_m", nonneg=True),
+                    period_s=waves.number("period_s", positive=True),
+                    heading_rad=waves.number("heading_rad", 0.0),
+                    water_depth_m=waves.number("water_depth_m", math.inf, positive=True),
+                    phase_rad=waves.number("phase_rad", 0.0),
+                ),
+            )
+        )
+    sea = water.table("sea")
+    if sea is not None:
+        fields.append(
+            _flow_field(
+                sea,
+                lambda: IrregularSea(
+                    significant_height_m=sea.number("significant_height_m", nonneg=True),
+                    peak_period_s=sea.number("peak_period_s", positive=True),
+                    peak_enhancement=sea.number("peak_enhancement", 3.3, positive=True),
+                    heading_rad=sea.number("heading_rad", 0.0),
+                    spreading_exponent=sea.optional_number("spreading_exponent", positive=True),
+                    n_components=sea.integer("n_components", 100),
+                    seed=sea.integer("seed", seed),
+                    water_depth_m=sea.number("water_depth_m", math.inf, positive=True),
+                ),
+            )
+        )
+    if not fields:
+        return None
+    return fields[0] if len(fields) == 1 else SumFlow(tuple(fields))
+
+
+def _current_field(t: _Table, seed: int) -> FlowField:
+    kind = t.string("type", "uniform", ("uniform", "gauss_markov", "profile"))
+    if kind == "uniform":
+        return _flow_field(t, lambda: UniformCurrent(t.vector("velocity_world_m_s", 3)))
+    if kind == "profile":
+        return _flow_field(
+            t,
+            lambda: DepthProfileCurrent(
+                t.vector("velocity_world_m_s", 3),
+                t.vector("depths_m", None),
+                t.vector("factors", None),
+            ),
+        )
+    return _flow_field(
+        t,
+        lambda: GaussMarkovCurrent(
+            mean_velocity_world_m_s=t.vector("mean_velocity_world_m_s", 3),
+            std_m_s=t.number("std_m_s", nonneg=True),
+            time_constant_s=t.number("time_constant_s", positive=True),
+            bound_m_s=t.number("bound_m_s", positive=True),
+            seed=t.integer("seed", seed),
+            sample_period_s=t.number("sample_period_s", 0.5, positive=True),
+        ),
+    )
+
+
+def _flow_field(t: _Table, build: Callable[[], FlowField]) -> FlowField:
+    """Build a flow field from a table; its own ParameterErrors name the table."""
+    try:
+        field = build()
+    except ParameterError as exc:
+        raise ScenarioError(f"{t._source}: [{t._where}]: {exc}") from exc
+    t.finish()
+    return field
 
 
 def _environment(t: _Table | None, uvms: UVMS) -> ContactModel | None:

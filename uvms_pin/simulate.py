@@ -268,6 +268,7 @@ def simulate_closed_loop(
 
     def sample(k: int, t: float, q: np.ndarray, v: np.ndarray) -> np.ndarray:
         """Measure and command at an accepted state; log it if k is a log index."""
+        plant.check_submerged(t, q)
         measurement, contact = measure(t, q, v)
         tau, tau_applied = command(t, measurement)
         if k >= 0:

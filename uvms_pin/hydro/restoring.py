@@ -1,4 +1,10 @@
-"""Buoyancy: the hydrostatic restoring wrench (gravity itself is Pinocchio's)."""
+"""Buoyancy and the Froude-Krylov load: the undisturbed pressure field on the displaced volume.
+
+The pressure of the undisturbed flow pushes a submerged body with -grad p integrated over
+its volume: rho V (Du/Dt - g) at the centre of buoyancy. Its -rho V g part is buoyancy
+(gravity itself is Pinocchio's); its rho V Du/Dt part is the Froude-Krylov force of an
+accelerating flow (waves), zero in still water or a uniform constant current.
+"""
 
 from __future__ import annotations
 
@@ -23,6 +29,24 @@ def buoyancy_wrench(
     volume = np.asarray(volume_m3, dtype=float)[..., None]
     force_world = -water_density_kg_m3 * volume * gravity_world_m_s2
     force_body = mat_t_vec(rotation_world_body, force_world)
+    return np.concatenate([force_body, cross3(center_of_buoyancy_body_m, force_body)], axis=-1)
+
+
+def froude_krylov_wrench(
+    volume_m3: float | np.ndarray,
+    center_of_buoyancy_body_m: np.ndarray,
+    rotation_world_body: np.ndarray,
+    water_density_kg_m3: float,
+    flow_acceleration_world_m_s2: np.ndarray,
+) -> np.ndarray:
+    """Body-frame wrench of rho V Du/Dt acting at the centre of buoyancy (..., 6) [N; N m].
+
+    Du/Dt (world, (..., 3)) is the flow's material acceleration at the centre of buoyancy.
+    """
+    volume = np.asarray(volume_m3, dtype=float)[..., None]
+    force_body = mat_t_vec(
+        rotation_world_body, water_density_kg_m3 * volume * flow_acceleration_world_m_s2
+    )
     return np.concatenate([force_body, cross3(center_of_buoyancy_body_m, force_body)], axis=-1)
 
 

@@ -40,6 +40,7 @@ from uvms_pin.scenario import Scenario, simulate
 from uvms_pin.simulate import Progress
 from uvms_pin.viz.errors import LiveServerError, PortInUseError
 from uvms_pin.viz.meshcat_scene import EnvironmentView, Frame, SceneStyle, UvmsScene
+from uvms_pin.viz.surface import SurfaceView
 
 LOOPBACK = "127.0.0.1"
 DEFAULT_PORT = 7000
@@ -391,13 +392,20 @@ def scene_for_scenario(scenario: Scenario, style: SceneStyle | None = None) -> U
     probe = UvmsScene(scenario.uvms)
     tip0 = probe.ee_position(scenario.q0)
     controller = scenario.raw.get("controller") or {}
+    extent = np.vstack([scenario.q0[:3], tip0])
+    flow = scenario.plant.flow
+    surface = None
+    if flow is not None and flow.has_free_surface:
+        surface = SurfaceView(flow, scenario.q0[:2])
+        extent = np.vstack([extent, [*scenario.q0[:2], 0.0]])
     return UvmsScene(
         scenario.uvms,
         environment=EnvironmentView.from_parameters(scenario.raw, tip0),
         current_world_m_s=scenario.plant.current_world_m_s,
         show_desired=controller.get("type") == "ppc",
-        extent_world_m=np.vstack([scenario.q0[:3], tip0]),
+        extent_world_m=extent,
         style=style,
+        surface=surface,
     )
 
 

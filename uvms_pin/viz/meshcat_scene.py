@@ -35,6 +35,7 @@ import umsgpack
 
 from uvms_pin.model import UVMS
 from uvms_pin.viz.errors import VizError
+from uvms_pin.viz.surface import SurfaceView
 
 ROOT = "uvms_pin"
 _Y = np.array([0.0, 1.0, 0.0])
@@ -175,6 +176,7 @@ class UvmsScene:
         style: scales and sizes.
         visual_model: the geometry to draw; default: the visual elements of the URDF
             ``uvms.source`` (meshes found through ``package_dirs``).
+        surface: the animated wave surface, or None (still water: not drawn).
     """
 
     def __init__(
@@ -188,8 +190,10 @@ class UvmsScene:
         style: SceneStyle | None = None,
         visual_model: pin.GeometryModel | None = None,
         package_dirs: tuple[str, ...] = (),
+        surface: SurfaceView | None = None,
     ):
         self.uvms = uvms
+        self.surface = surface
         self.environment = environment
         self.current_world_m_s = np.asarray(current_world_m_s, dtype=float).reshape(3)
         self.show_forces = environment is not None or show_desired
@@ -235,6 +239,8 @@ class UvmsScene:
                 if self.environment.kind == "spring"
                 else "compliant plane (grey)"
             )
+        if self.surface is not None:
+            parts.append("wave surface (translucent blue tiles)")
         parts.append("tip trail (yellow); sea floor 0.5 m grid")
         return "; ".join(parts)
 
@@ -257,6 +263,8 @@ class UvmsScene:
         self._build_robot(root)
         self._build_floor(root)
         self._build_environment(root)
+        if self.surface is not None:
+            self.surface.build(root)
         if self.show_forces:
             # measured: wide and translucent, so that the desired one shows inside it
             self._build_arrow(root["forces/measured"], _RED, radius_factor=1.8, opacity=0.55)
@@ -377,6 +385,8 @@ class UvmsScene:
             out.update(self._arrow("current", above, self.current_world_m_s, scale))
         depth = max(float(base[2] - self.floor_z_m), _TINY)
         out["plumb"] = (base.copy(), np.array([0.0, 0.0, 0.0, 1.0]), np.array([1.0, 1.0, depth]))
+        if self.surface is not None:
+            out.update(self.surface.poses(frame.time_s))
         return out
 
     def _arrow(self, path: str, tail, vector, scale: float) -> dict[str, Pose]:

@@ -34,6 +34,7 @@ from uvms_pin.viz.meshcat_scene import (
     recording_visualizer,
 )
 from uvms_pin.viz.stop import stop_summary
+from uvms_pin.viz.surface import SurfaceView
 
 REPLAY_FILE = "replay.html"
 _TRAIL_CHUNKS = 60
@@ -65,6 +66,9 @@ def scene_for_rollout(
     scene0 = UvmsScene(uvms)  # for forward kinematics only
     tips = np.array([scene0.ee_position(q) for q in _every(rollout.q, 400)])
     extent = np.vstack([tips, rollout.q[:, :3]])
+    surface = _surface_view(params, extent)
+    if surface is not None:  # keep the mean surface above the vehicle in view
+        extent = np.vstack([extent, [*rollout.q[0, :2], 0.0]])
     return UvmsScene(
         uvms,
         environment=EnvironmentView.from_parameters(params, tips[0]),
@@ -72,7 +76,18 @@ def scene_for_rollout(
         show_desired="force_desired_world_N" in rollout.signals,
         extent_world_m=extent,
         style=style,
+        surface=surface,
     )
+
+
+def _surface_view(parameters: dict[str, Any], extent_world_m: np.ndarray) -> SurfaceView | None:
+    """The animated wave surface of a run with waves, else None."""
+    from uvms_pin.scenario import water_flow_of
+
+    flow = water_flow_of(parameters)
+    if flow is None or not flow.has_free_surface:
+        return None
+    return SurfaceView(flow, extent_world_m.mean(axis=0)[:2])
 
 
 def _every(rows: np.ndarray, at_most: int) -> np.ndarray:

@@ -1,0 +1,99 @@
+"""A regular linear (Airy) wave."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from uvms_pin.errors import ParameterError
+from uvms_pin.flow.base import FlowField, as_points
+from uvms_pin.flow.components import STANDARD_GRAVITY_M_S2, WaveComponents, wavenumber
+
+__all__ = ["AiryWave", "wavenumber"]
+
+
+def _finite(value: float, name: str, *, positive: bool = False) -> float:
+    value = float(value)
+    if not math.isfinite(value) or (positive and value <= 0.0):
+        raise ParameterError(
+            f"{name} must be {'positive and ' if positive else ''}finite, got {value}"
+        )
+    return value
+
+
+class AiryWave(FlowField):
+    """eta = A cos(k e.p - w t + phi): linear wave theory in finite or infinite depth.
+
+    Args:
+        amplitude_m: A (half the wave height) [m].
+        period_s: T = 2 pi / w [s].
+        heading_rad: direction the wave travels, world, from +x towards +y [rad].
+        water_depth_m: d [m] (the sea floor at z = -d); inf for deep water.
+        phase_rad: phi [rad].
+        gravity_m_s2: g in the dispersion relation [m/s^2].
+    """
+
+    def __init__(
+        self,
+        amplitude_m: float,
+        period_s: float,
+        heading_rad: float = 0.0,
+        water_depth_m: float = math.inf,
+        phase_rad: float = 0.0,
+        gravity_m_s2: float = STANDARD_GRAVITY_M_S2,
+    ):
+        amplitude = _finite(amplitude_m, "amplitude_m")
+        if amplitude < 0.0:
+            raise ParameterError(f"amplitude_m must be >= 0, got {amplitude}")
+        period = _finite(period_s, "period_s", positive=True)
+        heading = _finite(heading_rad, "heading_rad")
+        phase = _finite(phase_rad, "phase_rad")
+        depth = float(water_depth_m)
+        if not depth > 0.0:
+            raise ParameterError(f"water_depth_m must be positive (or inf), got {water_depth_m}")
+        omega = 2.0 * math.pi / period
+        k = wavenumber(omega, depth, gravity_m_s2)
+        self.amplitude_m, self.period_s, self.heading_rad = amplitude, period, heading
+        self.water_depth_m, self.phase_rad = depth, phase
+        self.components = WaveComponents(
+            np.array([amplitude]),
+            np.array([omega]),
+            np.array([k]),
+            np.array([heading]),
+            np.array([phase]),
+            depth,
+        )
+
+    @property
+    def wavenumber_rad_m(self) -> float:
+        return float(self.components.wavenumber_rad_m[0])
+
+    @property
+    def wavelength_m(self) -> float:
+        return 2.0 * math.pi / self.wavenumber_rad_m
+
+    def velocity(self, time_s, points_world):
+        return self.components.velocity(time_s, as_points(points_world))
+
+    def local_acceleration(self, time_s, points_world):
+        return self.components.local_acceleration(time_s, as_points(points_world))
+
+    def velocity_gradient(self, time_s, points_world):
+        return self.components.velocity_gradient(time_s, as_points(points_world))
+
+    def kinematics(self, time_s, points_world):
+        return self.components.kinematics(time_s, as_points(points_world))
+
+    @property
+    def has_free_surface(self) -> bool:
+        return True
+
+    def surface_elevation(self, time_s, xy_world):
+        return self.components.elevation(time_s, np.asarray(xy_world, dtype=float).reshape(-1, 2))
+
+    def __repr__(self) -> str:
+        return (
+            f"AiryWave(amplitude_m={self.amplitude_m}, period_s={self.period_s}, "
+            f"heading_rad={self.heading_rad}, water_depth_m={self.water_depth_m})"
+        )

@@ -1,0 +1,122 @@
+"""The flow-field interface and the superposition of fields."""
+
+from __future__ import annotations
+
+from abc import ABC, abstractmethod
+
+import numpy as np
+
+from uvms_pin.errors import ParameterError
+
+
+def as_points(points_world: np.ndarray) -> np.ndarray:
+    """Points as a float (n, 3) array; a single (3,) point becomes (1, 3)."""
+    points = np.asarray(points_world, dtype=float)
+    if points.ndim == 1:
+        points = points[None, :]
+    if points.ndim != 2 or points.shape[1] != 3:
+        raise ParameterError(f"points_world must have shape (n, 3), got {points.shape}")
+    return points
+
+
+class FlowField(ABC):
+    """An undisturbed water flow u(t, p) in the world frame (waves: irrotational; a sheared
+    current has vorticity, which bodies do not feel: the fluid twist has no angular part).
+
+    Subclasses give the velocity, its local time derivative du/dt and its spatial gradient
+    grad u (J_ij = du_i / dx_j); the material acceleration follows:
+
+        Du/Dt = du/dt + (grad u) u                                  [m/s^2]
+
+    which is what the inertial loads on a body need (the pressure gradient of the
+    undisturbed flow is -grad p = rho (Du/Dt - g)).
+    """
+
+    @abstractmethod
+    def velocity(self, time_s: float, points_world: np.ndarray) -> np.ndarray:
+        """u (n, 3) [m/s] at the world points (n, 3) [m]."""
+
+    @abstractmethod
+    def local_acceleration(self, time_s: float, points_world: np.ndarray) -> np.ndarray:
+        """du/dt (n, 3) [m/s^2] at fixed world points."""
+
+    @abstractmethod
+    def velocity_gradient(self, time_s: float, points_world: np.ndarray) -> np.ndarray:
+        """grad u (n, 3, 3) [1/s]: entry [k, i, j] = du_i / dx_j at point k."""
+
+    def acceleration(self, time_s: float, points_world: np.ndarray) -> np.ndarray:
+        """Du/Dt = du/dt + (grad u) u (n, 3) [m/s^2]: the material acceleration."""
+        return self.velocity_and_acceleration(time_s, points_world)[1]
+
+    def kinematics(
+        self, time_s: float, points_world: np.ndarray
+    ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """(u, du/dt, grad u) at once; fields override it to share work between the three."""
+        points = as_points(points_world)
+        return (
+            self.velocity(time_s, points),
+            self.local_acceleration(time_s, points),
+            self.velocity_gradient(time_s, points),
+        )
+
+    def velocity_and_acceleration(
+        self, time_s: float, points_world: np.ndarray
+    ) -> tuple[np.ndarray, np.ndarray]:
+        """(u, Du/Dt) (n, 3) each, from one `kinematics` evaluation."""
+        u, du_dt, grad = self.kinematics(time_s, points_world)
+        return u, du_dt + np.einsum("kij,kj->ki", grad, u)
+
+    @property
+    def has_free_surface(self) -> bool:
+        """True for fields that move the free surface (waves): bodies must stay below it."""
+        return False
+
+    def surface_elevation(self, time_s: float, xy_world: np.ndarray) -> np.ndarray:
+        """Free-surface elevation eta (n,) [m] above z = 0 at horizontal points (n, 2)."""
+        xy = np.asarray(xy_world, dtype=float).reshape(-1, 2)
+        return np.zeros(len(xy))
+
+    def __add__(self, other: FlowField) -> SumFlow:
+        if not isinstance(other, FlowField):
+            return NotImplemented
+        return SumFlow((self, other))
+
+
+class SumFlow(FlowField):
+    """The superposition of flow fields (linear: velocities, their time derivatives and
+    gradients add; the material acceleration is formed from the sums, not summed)."""
+
+    def __init__(self, fields: tuple[FlowField, ...]):
+        flat: list[FlowField] = []
+        for f in fields:
+            flat.extend(f.fields if isinstance(f, SumFlow) else (f,))
+        if not flat:
+            raise ParameterError("SumFlow needs at least one field")
+        self.fields = tuple(flat)
+
+    def velocity(self, time_s, points_world):
+        points = as_points(points_world)
+        return sum(f.velocity(time_s, points) for f in self.fields)
+
+    def local_acceleration(self, time_s, points_world):
+        points = as_points(points_world)
+        return sum(f.local_acceleration(time_s, points) for f in self.fields)
+
+    def velocity_gradient(self, time_s, points_world):
+        points = as_points(points_world)
+        return sum(f.velocity_gradient(time_s, points) for f in self.fields)
+
+    def kinematics(self, time_s, points_world):
+        points = as_points(points_world)
+        parts = [f.kinematics(time_s, points) for f in self.fields]
+        return tuple(sum(p[i] for p in parts) for i in range(3))
+
+    @property
+    def has_free_surface(self) -> bool:
+        return any(f.has_free_surface for f in self.fields)
+
+    def surface_elevation(self, time_s, xy_world):
+        return sum(f.surface_elevation(time_s, xy_world) for f in self.fields)
+
+    def __repr__(self) -> str:
+        return " + ".join(repr(f) for f in self.fields)
