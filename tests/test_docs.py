@@ -22,11 +22,49 @@ _VARIANTS = [
     ("realistic_force_tracking.toml", {}),
     ("passive_current.toml", {}),
     (
+        "sea_state_force_tracking.toml",
+        {"water.sea.spreading_exponent": 4.0, "water.sea.seed": 3, "water.sea.water_depth_m": 30.0},
+    ),
+    (
+        "passive_current.toml",
+        {
+            "water.waves": {"amplitude_m": 0.1, "period_s": 4.0},
+            "water.current": {
+                "type": "gauss_markov",
+                "mean_velocity_world_m_s": [0.1, 0, 0],
+                "std_m_s": 0.05,
+                "time_constant_s": 10.0,
+                "bound_m_s": 0.1,
+                "seed": 1,
+                "sample_period_s": 0.5,
+            },
+        },
+    ),
+    (
+        "passive_current.toml",
+        {
+            "water.waves": {
+                "amplitude_m": 0.1,
+                "period_s": 4.0,
+                "heading_rad": 0.2,
+                "water_depth_m": 20.0,
+                "phase_rad": 0.1,
+            },
+            "water.current": {
+                "type": "profile",
+                "velocity_world_m_s": [0.2, 0, 0],
+                "depths_m": [0, 10],
+                "factors": [1, 0.5],
+            },
+        },
+    ),
+    (
         "passive_still_water.toml",
         {
-            "environment": {"type": "plane", "stiffness_N_m": 100.0},
-            "controller": {"type": "none"},
-            "control": {"period_s": 0.002},
+            "environment.type": "plane",
+            "environment.stiffness_N_m": 100.0,
+            "controller.type": "none",
+            "control.period_s": 0.002,
             "integrator.method": "semi_implicit_euler",
         },
     ),
@@ -56,7 +94,7 @@ def scenario_keys_read() -> set[str]:
         for name in _READERS:
             patch.setattr(table_class, name, recording(name))
         for file, overrides in _VARIANTS:
-            load_scenario(SCENARIOS / file, overrides)  # a dict value replaces a table
+            load_scenario(SCENARIOS / file, overrides)
     return seen
 
 

@@ -1,6 +1,8 @@
 """uvms-pin: Underwater Vehicle-Manipulator Systems on Pinocchio."""
 
+import sys
 from importlib import import_module
+from types import ModuleType
 from typing import Any
 
 from uvms_pin.errors import (
@@ -47,6 +49,19 @@ def __getattr__(name: str) -> Any:
 
 def __dir__() -> list[str]:
     return sorted({*globals(), *_LAZY})
+
+
+class _Package(ModuleType):
+    """The package module: importing the submodule ``uvms_pin.simulate`` must not hide the
+    function ``uvms_pin.simulate`` (the import system binds a submodule onto its package)."""
+
+    def __setattr__(self, name: str, value: Any) -> None:
+        if name in _LAZY and isinstance(value, ModuleType):
+            return  # the submodule stays reachable through sys.modules
+        super().__setattr__(name, value)
+
+
+sys.modules[__name__].__class__ = _Package
 
 
 __version__ = "0.1.0"

@@ -4,7 +4,7 @@ Pure functions on Pinocchio's Model / Data split, ``f(model, data, q, frame_id)`
 only frame placements and frame Jacobians (no inertias, no dynamics), so a model-free
 controller may call them.
 
-Conventions (DESIGN.md section 3):
+Conventions (docs/physics.md):
 
 - q (nq,) is Pinocchio's free-flyer configuration [p (3) m, quaternion xyzw (4), joints];
 - zeta = Pinocchio's v (nv,) = [body-frame linear velocity (3) m/s, body-frame angular

@@ -1,7 +1,7 @@
 """The paper's model-free prescribed-performance force/orientation controller (Section 4).
 
 Heshmati-alamdari, Nikou, Kyriakopoulos, Dimarogonas, "A Robust Force Control Approach for
-Underwater Vehicle Manipulator Systems" (IFAC 2017). Two levels (DESIGN.md section 7):
+Underwater Vehicle Manipulator Systems" (IFAC 2017). Two levels (docs/controller.md):
 
 First level (task space, 6 components j = f_x, f_y, f_z, roll, pitch, yaw):
 
@@ -73,7 +73,7 @@ class PPCParams:
     joint rates [rad/s]). :meth:`for_uvms` returns fully sized arrays; :meth:`sized`
     validates and sizes any instance.
 
-    Defaults are the paper's simulation values (Section 5) with the DESIGN.md section 7
+    Defaults are the paper's simulation values (Section 5) with the docs/controller.md
     errata fixed:
 
     - ``k_x = 0.2`` and ``k_zeta = 5``: the paper prints k_x = -0.2 and k_v = -5, but its
