@@ -65,7 +65,6 @@ def test_run_passive_scenario_writes_rollout_metrics_and_figures(tmp_path):
     scenario.write_text(
         (ROOT / "scenarios" / "passive_current.toml")
         .read_text()
-        .replace("../models/uvms_lbv150.urdf", str(REFERENCE_URDF))
         .replace("duration_s = 20.0", "duration_s = 0.5")
     )
     out = tmp_path / "out"
