@@ -14,6 +14,7 @@ from uvms_pin.rollout import Rollout, write_json_atomic
 from uvms_pin.scenario import load_scenario, simulate
 from uvms_pin.study.command import register as register_study_commands
 from uvms_pin.summary import model_summary
+from uvms_pin.validation.command import register as register_validate
 
 EXIT_BAD_INPUT = 2
 EXIT_RUN_STOPPED = 3
@@ -194,6 +195,7 @@ def build_parser() -> argparse.ArgumentParser:
     info.set_defaults(func=_cmd_info)
     register_study_commands(sub)
     register_compare_arms(sub)
+    register_validate(sub)
     return parser
 
 

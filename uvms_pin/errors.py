@@ -32,6 +32,10 @@ class ScenarioError(UvmsPinError):
     """A scenario or study file is malformed: unknown key, wrong type, missing entry."""
 
 
+class DataError(UvmsPinError):
+    """A measurement data set is missing, malformed or unusable; the message names the file."""
+
+
 class SimulationError(UvmsPinError):
     """The simulation cannot continue (non-finite state, integrator failure)."""
 
