@@ -45,6 +45,10 @@ BLUEROV_BOX_M = (0.457, 0.575, 0.254)
 TRIAL_MASS_KG = 13.17  # weight 13.17 * 9.81 N applied at the origin
 TRIAL_BUOYANCY_KG = 13.082  # buoyancy 13.082 * 9.81 N ...
 TRIAL_COB_M = (0.0074, 0.0, 0.02)  # ... at this point
+# Identified here, not in K23: shift of the hull's centre of buoyancy fitted on the
+# identification trials (families 001, 008) by `python -m uvms_pin.validation.identify
+# data/hinsdale2023` run on the file without it (models/README.md section 9)
+TRIAL_COB_CORRECTION_M = (0.000306, 0.000546, 0.004211)
 # net weights in water [N] of the trim items, at their positions [m]
 TRIAL_WEIGHTS = (  # lead: counter-arm weight, bottom-left, bottom-right
     ("ballast_counter_arm", 3.24, (-0.20, 0.165, -0.075)),
@@ -260,9 +264,10 @@ def lead_for_net_weight(net_weight_N: float, rho: float = FRESH_WATER_KG_M3) -> 
 
 def trial_vehicle_urdf() -> str:
     """The BlueROV2 Heavy as configured in the 2023 pool trials (K23), fresh water."""
+    cob = tuple(a + b for a, b in zip(TRIAL_COB_M, TRIAL_COB_CORRECTION_M, strict=True))
     hydro = _hydro(
         TRIAL_BUOYANCY_KG / FRESH_WATER_KG_M3,
-        TRIAL_COB_M,
+        cob,
         BLUEROV_ADDED_MASS,
         BLUEROV_LINEAR_DAMPING,
         BLUEROV_QUADRATIC_DAMPING,

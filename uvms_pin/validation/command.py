@@ -54,7 +54,7 @@ def register(subparsers) -> argparse.ArgumentParser:
     )
     pool.add_argument("--out", required=True, help="output directory")
     pool.add_argument("--trials", help="comma-separated trial names (default: all)")
-    pool.add_argument("--step", type=float, default=0.02, help="RK4 step [s] (default 0.02)")
+    pool.add_argument("--step", type=float, default=0.05, help="RK4 step [s] (default 0.05)")
     pool.add_argument("--no-figures", action="store_true", help="skip the per-trial figures")
     pool.add_argument("--quiet", action="store_true", help="no per-trial progress lines")
     pool.set_defaults(func=_cmd_validate_pool)
