@@ -8,7 +8,7 @@ STAMP := $(VENV)/.installed
 DEMO_SCENARIO ?= scenarios/realistic_force_tracking.toml
 DEMO_OUT ?= out/demo
 
-.PHONY: demo test lint bench clean
+.PHONY: demo test lint bench results clean
 
 $(STAMP): pyproject.toml
 	$(PYTHON) -m venv $(VENV)
@@ -34,6 +34,11 @@ test: $(STAMP) lint
 
 bench: $(STAMP)
 	$(BIN)/python benchmarks/bench_dynamics.py
+
+# the pool trials of a real BlueROV2 Heavy + Alpha 5 against the simulator (README "Validated
+# against a real vehicle"): out/pool/pool_validation.json, .csv and one figure per trial
+results: $(STAMP)
+	$(BIN)/uvms-pin validate pool data/hinsdale2023 --out out/pool
 
 clean:
 	rm -rf $(VENV) out build *.egg-info

@@ -112,10 +112,10 @@ def _errors(uvms: UVMS, data) -> np.ndarray:
     return np.array(out)
 
 
-def rms_deg(errors: np.ndarray) -> tuple[float, float]:
-    """(roll, pitch) RMS [deg] of (n, 2) errors [rad]."""
+def rms_deg(errors: np.ndarray) -> str:
+    """'roll, pitch' RMS [deg] of (n, 2) errors [rad], 3 decimals."""
     roll, pitch = np.degrees(np.sqrt(np.mean(errors**2, axis=0)))
-    return float(roll), float(pitch)
+    return f"{roll:.3f}, {pitch:.3f}"
 
 
 def fit_centre_of_buoyancy(
