@@ -10,6 +10,7 @@ import pytest
 
 import uvms_pin as up
 from uvms_pin.errors import ParameterError
+from uvms_pin.validation.identify import quasi_static_roll_pitch
 from uvms_pin.validation.pool import trial_uvms
 from uvms_pin.validation.prescribed import (
     JointTrajectory,
@@ -17,6 +18,7 @@ from uvms_pin.validation.prescribed import (
     simulate_prescribed_arm,
     vehicle_acceleration,
 )
+from uvms_pin.validation.trials import roll_pitch_rad
 
 
 @pytest.fixture(scope="module")
@@ -77,6 +79,10 @@ def test_arm_held_still_vehicle_settles_with_g_below_b(uvms):
     )
     np.testing.assert_allclose(com[:2], cob[:2], atol=2e-5)
     assert cob[2] > com[2]  # stable: B above G
+    # the quasi-static solver of the identification finds the same attitude
+    settled = roll_pitch_rad(q_vehicle[-1:, 3:7])[0]
+    found = quasi_static_roll_pitch(model, q_arm, np.zeros(2))
+    np.testing.assert_allclose(found, settled, atol=2e-5)
 
 
 def test_times_outside_the_trajectory_are_refused(uvms):
