@@ -131,3 +131,12 @@ def test_alpha5_is_in_the_arm_catalog():
     assert entry is CATALOG["alpha5"]
     assert entry.urdf.is_file()
     assert entry.urdf.name == "reach_alpha5.urdf"
+
+
+def test_force_task_model_is_trimmed_neutral_with_probe():
+    uvms = up.load_uvms(MODELS / "uvms_bluerov2_alpha5.urdf")
+    assert uvms.nv == 10
+    assert abs(uvms.net_buoyancy_N) < 1e-3
+    assert uvms.model.frames[uvms.ee_frame_id].name == "ee"
+    assert uvms.model.frames[uvms.sensor_frame_id].name == "ft_sensor"
+    assert uvms.mass_kg > _vehicle(BLUEROV).mass_kg + 1.462  # + probe, foam and ballast
