@@ -16,6 +16,7 @@ from uvms_pin.outdir import OVERWRITE_HELP, RUN, check_writable, claim, claim_fi
 from uvms_pin.overrides import parse_assignment
 from uvms_pin.resources import find_model
 from uvms_pin.study.command import register as register_study_commands
+from uvms_pin.validation.command import register as register_validate
 
 if TYPE_CHECKING:
     from uvms_pin.rollout import Rollout
@@ -253,6 +254,7 @@ def build_parser() -> argparse.ArgumentParser:
     info.set_defaults(func=_cmd_info)
     register_study_commands(sub)
     register_compare_arms(sub)
+    register_validate(sub)
     return parser
 
 

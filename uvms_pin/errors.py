@@ -47,6 +47,10 @@ class OutputError(UvmsPinError):
     """An output path cannot be written, is in use, or holds results that are not this run's."""
 
 
+class DataError(UvmsPinError):
+    """A measurement data set is missing, malformed or unusable; the message names the file."""
+
+
 class SimulationError(UvmsPinError):
     """The simulation cannot continue (non-finite state, integrator failure)."""
 

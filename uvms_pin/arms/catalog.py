@@ -13,7 +13,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from uvms_pin.errors import ParameterError
-from uvms_pin.resources import example_robot_data_dir
+from uvms_pin.resources import example_robot_data_dir, shipped_path
 
 __all__ = ["CATALOG", "REFERENCE", "ArmEntry", "available_arms", "resolve_arm"]
 
@@ -31,6 +31,7 @@ class ArmEntry:
         ee_link: the link carrying the sensor and probe (None: chosen by the mount).
         arm_base_link: the link bolted to the vehicle (None: the URDF's root).
         description: a few words for the report.
+        shipped: the URDF ships with uvms-pin (``relative_path`` under its ``models/``).
     """
 
     name: str
@@ -38,12 +39,15 @@ class ArmEntry:
     ee_link: str | None = None
     arm_base_link: str | None = None
     description: str = ""
+    shipped: bool = False
 
     @property
     def urdf(self) -> Path:
         path = Path(self.relative_path)
         if path.is_absolute():
             return path
+        if self.shipped:
+            return shipped_path(Path("models") / path)
         root = example_robot_data_dir()
         if root is None:
             raise ParameterError(
@@ -80,15 +84,23 @@ CATALOG: dict[str, ArmEntry] = {
         ArmEntry(
             "xarm7", "xarm_description/urdf/xarm7.urdf", "link_eef", None, "UFactory xArm7, 7 DoF"
         ),
+        ArmEntry(
+            "alpha5",
+            "reach_alpha5.urdf",
+            "alpha_wrist_link",
+            None,
+            "Reach Alpha 5, 4 DoF + locked jaw (shipped)",
+            shipped=True,
+        ),
     )
 }
 
 
 def available_arms() -> list[str]:
     """Names accepted by ``compare-arms`` whose files are installed (reference first)."""
-    names = [REFERENCE]
+    names = [REFERENCE] + [n for n, e in CATALOG.items() if e.shipped]
     if example_robot_data_dir() is not None:
-        names += [n for n, e in CATALOG.items() if e.urdf.is_file()]
+        names += [n for n, e in CATALOG.items() if not e.shipped and e.urdf.is_file()]
     return names
 
 

@@ -1,0 +1,392 @@
+"""Write the BlueROV2 Heavy, the Reach Alpha 5 and the Hinsdale-2023 trial vehicle URDFs.
+
+Every number below is an input with its source (models/README.md, sections 7-9, says more):
+
+- vB22: von Benzon, Sorensen, Uth, Jouffroy, Liniger, Pedersen, "An Open-Source Benchmark
+  Simulator: Control of a BlueROV2 Underwater Robot", J. Mar. Sci. Eng. 10(12) 1898, 2022,
+  Table A1 (coefficients published in NED; the diagonal magnitudes carry over to FLU).
+- K23: Hannah Kolano, github.com/hkolano/UVMS-SysID-with-EAs (MIT, (c) 2023 Hannah Kolano),
+  commit 18d9b2f5: ``src/julia-sim/ConfigFiles/MagicNumAlpha.jl`` (arm link volumes,
+  centres of buoyancy and mass, masses, drag, joint limits),
+  ``MagicNumBlueROVHardware.jl`` (the vehicle as configured in the 2023 pool trials:
+  buoyancy, centre of buoyancy, ballast, DVL, foam), ``ConstMagicNums.jl`` (rho = 997) and
+  ``urdf/blue_rov_hardware_fixedjaw.urdf`` (Alpha 5 kinematics, derived from Reach
+  Robotics' public r5m description, link inertia tensors, effort and velocity limits, the
+  arm's mount on the vehicle).
+
+Run ``python models/derive_bluerov_alpha5.py --write`` to regenerate the three files,
+``--check`` to exit 1 if a file differs from what this script writes.
+"""
+
+from __future__ import annotations
+
+import argparse
+import math
+import sys
+from pathlib import Path
+
+HERE = Path(__file__).resolve().parent
+G_M_S2 = 9.81
+FRESH_WATER_KG_M3 = 997.0  # K23 ConstMagicNums.jl
+LEAD_KG_M3 = 11340.0
+
+# ---- BlueROV2 Heavy, vB22 Table A1 (FLU; CoG at the origin, CoB 0.01 m above it) ----
+BLUEROV_MASS_KG = 13.5
+BLUEROV_VOLUME_M3 = 0.0134
+BLUEROV_INERTIA_KG_M2 = (0.26, 0.23, 0.37)
+BLUEROV_COB_M = (0.0, 0.0, 0.01)
+BLUEROV_ADDED_MASS = (6.36, 7.12, 18.68, 0.189, 0.135, 0.222)
+BLUEROV_LINEAR_DAMPING = (13.7, 0.0, 33.0, 0.0, 0.8, 0.0)
+BLUEROV_QUADRATIC_DAMPING = (141.0, 217.0, 190.0, 1.19, 0.47, 1.5)
+# Blue Robotics BlueROV2 Heavy envelope 457 x 575 x 254 mm (L x W x H), for drawing and trim
+BLUEROV_BOX_M = (0.457, 0.575, 0.254)
+
+# ---- the trial vehicle (K23 MagicNumBlueROVHardware.jl), FLU, vehicle frame ----------
+TRIAL_MASS_KG = 13.17  # weight 13.17 * 9.81 N applied at the origin
+TRIAL_BUOYANCY_KG = 13.082  # buoyancy 13.082 * 9.81 N ...
+TRIAL_COB_M = (0.0074, 0.0, 0.02)  # ... at this point
+# Identified here, not in K23: shift of the hull's centre of buoyancy fitted on the
+# identification trials (families 001, 008) by `python -m uvms_pin.validation.identify
+# data/hinsdale2023` run on the file without it (models/README.md section 9)
+TRIAL_COB_CORRECTION_M = (0.000306, 0.000546, 0.004211)
+# net weights in water [N] of the trim items, at their positions [m]
+TRIAL_WEIGHTS = (  # lead: counter-arm weight, bottom-left, bottom-right
+    ("ballast_counter_arm", 3.24, (-0.20, 0.165, -0.075)),
+    ("ballast_bottom_left", 1.62, (-0.0975, 0.1275, -0.1325)),
+    ("ballast_bottom_right", 1.62, (-0.0975, -0.1275, -0.1325)),
+)
+TRIAL_NET_WEIGHTS = (  # DVL and its bracket: only their net weight is published
+    ("dvl", 0.69, (-0.1887, 0.0439, -0.1095 + 0.05)),
+    ("dvl_bracket", 1.01, (-0.1887 + 0.0345, 0.0439, -0.1295 + 0.05)),
+)
+TRIAL_FOAM = (  # net lift [N] of the two foam blocks (the final values of the file)
+    ("foam_left", 8.46, (0.0, 0.11, 0.027)),
+    ("foam_right", 8.66 + 0.2, (0.0, -0.11, 0.027)),
+)
+
+# ---- Reach Alpha 5 (K23): kinematics, masses, CoM, CoB, volumes, drag -----------------
+ALPHA_MOUNT_XYZ_M = (0.25, -0.10965, 0.005)  # arm base in the vehicle frame (K23 URDF)
+# name, mass [kg], CoM [m], inertia (ixx ixy ixz iyy iyz izz) [kg m^2], volume [L],
+# CoB [m], quadratic drag on the CoB velocity per link axis [N/(m/s)^2],
+# added mass lumped into the link mass by K23 ("actual + added" - "actual") [kg]
+ALPHA_LINKS = (
+    (
+        "alpha_base_link",
+        0.341,
+        (-0.075, -0.006, -0.003),
+        (0.000099, 0.000139, 0.000115, 0.004334, 0.000003, 0.004348),
+        0.202,
+        (-0.075, -0.006, -0.003),
+        (0.0, 0.0, 0.0),
+        0.53 - 0.341,
+    ),
+    (
+        "alpha_shoulder_link",
+        0.194,
+        (0.005, -0.001, 0.016),
+        (0.000196, 0.000005, 0.000054, 0.000220, 0.000003, 0.000067),
+        0.018,
+        (-0.001, -0.003, 0.032),
+        (0.26, 0.26, 0.3),
+        0.226 - 0.194,
+    ),
+    (
+        "alpha_upper_arm_link",
+        0.429,
+        (0.073, 0.0, 0.0),
+        (0.000087, -0.000076, -0.000010, 0.004906, 0.0, 0.004929),
+        0.203,
+        (0.073, 0.0, -0.002),
+        (0.3, 1.6, 1.6),
+        0.630 - 0.429,
+    ),
+    (
+        "alpha_forearm_link",
+        0.115,
+        (0.017, -0.026, -0.002),
+        (0.000127, -0.000061, -0.000001, 0.000062, 0.0, 0.000163),
+        0.025,
+        (0.003, 0.001, -0.017),
+        (0.26, 0.3, 0.26),
+        0.147 - 0.115,
+    ),
+    (
+        "alpha_wrist_link",
+        0.333,
+        (0.0, 0.0, -0.098),
+        (0.006152, -0.000002, -0.000004, 0.006177, 0.0, 0.000079),
+        0.155,
+        (0.0, 0.0, -0.098),
+        (1.8, 1.8, 0.3),
+        0.559 - 0.333,
+    ),
+)
+ALPHA_JAW = ("alpha_jaw_link", 0.05, (0.0, 0.0, -0.190), 0.020, (0.05, 0.05, 0.05))
+HALF_PI = math.pi / 2
+# joint, parent, child, xyz, rpy, lower, upper [rad], effort [N m], velocity [rad/s]
+# Angles are K23's: raw Reach encoder minus 3.07 rad (axis E) and 2.879 rad (axis B).
+ALPHA_JOINTS = (
+    (
+        "alpha_axis_e",
+        "alpha_base_link",
+        "alpha_shoulder_link",
+        (0.0, 0.0, 0.0),
+        (0.0, 0.0, 0.0),
+        -math.radians(175),
+        math.radians(175),
+        9.0,
+        0.5,
+    ),
+    (
+        "alpha_axis_d",
+        "alpha_shoulder_link",
+        "alpha_upper_arm_link",
+        (0.020, 0.0, 0.046),
+        (HALF_PI, 1.3, 0.0),
+        0.0,
+        math.radians(200),
+        9.0,
+        0.5,
+    ),
+    (
+        "alpha_axis_c",
+        "alpha_upper_arm_link",
+        "alpha_forearm_link",
+        (0.15, 0.0, 0.0),
+        (math.pi, 0.0, 1.3),
+        0.0,
+        math.radians(200),
+        9.0,
+        0.5,
+    ),
+    (
+        "alpha_axis_b",
+        "alpha_forearm_link",
+        "alpha_wrist_link",
+        (0.020, 0.0, 0.0),
+        (-HALF_PI, 0.0, 0.0),
+        -math.radians(165),
+        math.radians(165),
+        5.0,
+        1.0,
+    ),
+)
+ALPHA_ENCODER_OFFSETS_RAD = {"alpha_axis_e": 3.07, "alpha_axis_b": 2.879}
+
+
+def _f(values) -> str:
+    return " ".join(f"{v:.9g}" for v in values)
+
+
+def _inertial(mass: float, com=(0.0, 0.0, 0.0), inertia=(0, 0, 0, 0, 0, 0)) -> str:
+    ixx, ixy, ixz, iyy, iyz, izz = inertia
+    return (
+        f'    <inertial>\n      <origin xyz="{_f(com)}" rpy="0 0 0"/>\n'
+        f'      <mass value="{mass:.9g}"/>\n'
+        f'      <inertia ixx="{ixx:.9g}" ixy="{ixy:.9g}" ixz="{ixz:.9g}" iyy="{iyy:.9g}" '
+        f'iyz="{iyz:.9g}" izz="{izz:.9g}"/>\n    </inertial>\n'
+    )
+
+
+def _hydro(volume_m3: float, cob=(0.0, 0.0, 0.0), added=None, linear=None, quadratic=None):
+    lines = [
+        "    <hydrodynamics>",
+        f'      <volume value="{volume_m3:.9g}"/>',
+        f'      <center_of_buoyancy xyz="{_f(cob)}"/>',
+    ]
+    if added is not None:
+        lines.append(f'      <added_mass diagonal="{_f(added)}"/>')
+    if linear is not None:
+        lines.append(f'      <linear_damping diagonal="{_f(linear)}"/>')
+    if quadratic is not None:
+        lines.append(f'      <quadratic_damping diagonal="{_f(quadratic)}"/>')
+    lines.append("    </hydrodynamics>")
+    return "\n".join(lines) + "\n"
+
+
+def _fixed(name: str, parent: str, child: str, xyz, rpy=(0.0, 0.0, 0.0)) -> str:
+    return (
+        f'  <joint name="{name}" type="fixed">\n    <parent link="{parent}"/>\n'
+        f'    <child link="{child}"/>\n    <origin xyz="{_f(xyz)}" rpy="{_f(rpy)}"/>\n'
+        "  </joint>\n"
+    )
+
+
+def _point_link(name: str, mass: float, hydro: str, comment: str) -> str:
+    return f'  <!-- {comment} -->\n  <link name="{name}">\n{_inertial(mass)}{hydro}  </link>\n'
+
+
+def _header(name: str, what: str) -> str:
+    return (
+        '<?xml version="1.0"?>\n'
+        f"<!-- GENERATED by models/derive_bluerov_alpha5.py: {what}\n"
+        "     Sources of every number: models/README.md. Do not edit by hand. -->\n"
+        f'<robot name="{name}">\n'
+    )
+
+
+def _hull_link(mass, inertia, hydro: str) -> str:
+    ixx, iyy, izz = inertia
+    box = _f(BLUEROV_BOX_M)
+    return (
+        '  <link name="base_link">\n'
+        + _inertial(mass, (0.0, 0.0, 0.0), (ixx, 0, 0, iyy, 0, izz))
+        + hydro
+        + f'    <visual>\n      <geometry><box size="{box}"/></geometry>\n'
+        '      <material name="bluerov_blue"><color rgba="0.2 0.4 0.7 0.6"/></material>\n'
+        "    </visual>\n"
+        f'    <collision>\n      <geometry><box size="{box}"/></geometry>\n    </collision>\n'
+        "  </link>\n"
+    )
+
+
+def bluerov2_heavy_urdf() -> str:
+    """The catalogue vehicle: vB22 Table A1, sea water by default at load time."""
+    hydro = _hydro(
+        BLUEROV_VOLUME_M3,
+        BLUEROV_COB_M,
+        BLUEROV_ADDED_MASS,
+        BLUEROV_LINEAR_DAMPING,
+        BLUEROV_QUADRATIC_DAMPING,
+    )
+    return (
+        _header("bluerov2_heavy", "BlueROV2 Heavy, von Benzon et al. 2022 Table A1")
+        + _hull_link(BLUEROV_MASS_KG, BLUEROV_INERTIA_KG_M2, hydro)
+        + "</robot>\n"
+    )
+
+
+def lead_for_net_weight(net_weight_N: float, rho: float = FRESH_WATER_KG_M3) -> tuple[float, float]:
+    """(mass [kg], volume [m^3]) of lead whose weight in water of density rho is net_weight_N."""
+    mass = net_weight_N / (G_M_S2 * (1.0 - rho / LEAD_KG_M3))
+    return mass, mass / LEAD_KG_M3
+
+
+def trial_vehicle_urdf() -> str:
+    """The BlueROV2 Heavy as configured in the 2023 pool trials (K23), fresh water."""
+    cob = tuple(a + b for a, b in zip(TRIAL_COB_M, TRIAL_COB_CORRECTION_M, strict=True))
+    hydro = _hydro(
+        TRIAL_BUOYANCY_KG / FRESH_WATER_KG_M3,
+        cob,
+        BLUEROV_ADDED_MASS,
+        BLUEROV_LINEAR_DAMPING,
+        BLUEROV_QUADRATIC_DAMPING,
+    )
+    out = _header(
+        "bluerov2_heavy_hinsdale2023",
+        "BlueROV2 Heavy as trimmed for the Hinsdale 2023 pool trials (Kolano), rho = 997",
+    ) + _hull_link(TRIAL_MASS_KG, BLUEROV_INERTIA_KG_M2, hydro)
+    for name, net_N, xyz in TRIAL_WEIGHTS:
+        mass, volume = lead_for_net_weight(net_N)
+        out += _point_link(name, mass, _hydro(volume), f"lead, {net_N} N in fresh water")
+        out += _fixed(f"{name}_joint", "base_link", name, xyz)
+    for name, net_N, xyz in TRIAL_NET_WEIGHTS:
+        out += _point_link(
+            name,
+            net_N / G_M_S2,
+            _hydro(0.0),
+            f"net weight {net_N} N only (mass m = W/g, no volume)",
+        )
+        out += _fixed(f"{name}_joint", "base_link", name, xyz)
+    for name, lift_N, xyz in TRIAL_FOAM:
+        volume = lift_N / (FRESH_WATER_KG_M3 * G_M_S2)
+        out += _point_link(
+            name, 0.0, _hydro(volume), f"foam, net lift {lift_N:.4g} N (massless volume)"
+        )
+        out += _fixed(f"{name}_joint", "base_link", name, xyz)
+    return out + "</robot>\n"
+
+
+def alpha5_urdf() -> str:
+    """Reach Alpha 5, arm only (root alpha_base_link), jaw fixed (K23 kinematics)."""
+    out = _header("reach_alpha5", "Reach Alpha 5 (arm only), jaw locked; Kolano's identification")
+    for name, mass, com, inertia, volume_L, cob, drag, added in ALPHA_LINKS:
+        # volume 0 here: this link's buoyancy, added mass and drag sit on its _cob frame
+        out += f'  <link name="{name}">\n{_inertial(mass, com, inertia)}{_hydro(0.0)}'
+        out += (
+            '    <visual>\n      <origin xyz="' + _f(com) + '" rpy="0 0 0"/>\n'
+            '      <geometry><sphere radius="0.02"/></geometry>\n'
+            '      <material name="alpha_grey"><color rgba="0.3 0.3 0.3 1"/></material>\n'
+            "    </visual>\n  </link>\n"
+        )
+        # the hydrodynamics act at the centre of buoyancy (K23 applies buoyancy and the
+        # quadratic drag of the CoB's velocity there): a massless frame at the CoB carries them
+        hydro = _hydro(
+            volume_L * 1e-3, (0.0, 0.0, 0.0), (added, added, added, 0, 0, 0), None, (*drag, 0, 0, 0)
+        )
+        out += _point_link(f"{name}_cob", 0.0, hydro, f"{name}: buoyancy, added mass, drag")
+        out += _fixed(f"{name}_cob_joint", name, f"{name}_cob", cob)
+    for joint, parent, child, xyz, rpy, lower, upper, effort, velocity in ALPHA_JOINTS:
+        out += (
+            f'  <joint name="{joint}" type="revolute">\n    <parent link="{parent}"/>\n'
+            f'    <child link="{child}"/>\n    <origin xyz="{_f(xyz)}" rpy="{_f(rpy)}"/>\n'
+            '    <axis xyz="0 0 1"/>\n'
+            f'    <limit lower="{lower:.9g}" upper="{upper:.9g}" effort="{effort:.9g}" '
+            f'velocity="{velocity:.9g}"/>\n  </joint>\n'
+        )
+    name, mass, xyz, volume_L, drag = ALPHA_JAW
+    hydro = _hydro(volume_L * 1e-3, quadratic=(*drag, 0, 0, 0))
+    out += _point_link(name, mass, hydro, "jaw, locked closed: a point mass with its volume")
+    out += _fixed("alpha_jaw_joint", "alpha_wrist_link", name, xyz)
+    return out + "</robot>\n"
+
+
+# the force-task UVMS (scenarios/bluerov_alpha5_force_tracking.toml): the catalogue vehicle
+# with the Alpha 5 at K23's mount, uvms-pin's default probe on the wrist, trimmed by
+# uvms_pin.trim (foam on top, lead below; BG 2 cm) at the scenario's initial arm pose, sea water
+FORCE_TASK_ARM_POSE_RAD = (-0.2, 0.8, 2.2, 0.2)
+
+
+def force_task_urdf() -> str:
+    """bluerov2_heavy.urdf + reach_alpha5.urdf + probe, trimmed (needs both files written)."""
+    from uvms_pin.mount import mount_arm_detailed  # the installed uvms-pin does the merge
+
+    result = mount_arm_detailed(
+        HERE / "bluerov2_heavy.urdf",
+        HERE / "reach_alpha5.urdf",
+        (ALPHA_MOUNT_XYZ_M, (0.0, 0.0, 0.0)),
+        trim=True,
+        trim_joint_positions=FORCE_TASK_ARM_POSE_RAD,
+    )
+    comment = (
+        "<!-- GENERATED by models/derive_bluerov_alpha5.py: BlueROV2 Heavy + Reach Alpha 5 + "
+        "probe, trimmed with uvms_pin.mount (trim: "
+        + result.trim.summary().replace("\n", "; ").replace("--", "-")
+        + ") -->\n"
+    )
+    text = result.urdf_text
+    if text.startswith("<?xml"):
+        declaration, _, rest = text.partition("\n")
+        return f"{declaration}\n{comment}{rest}"
+    return comment + text
+
+
+FILES = {
+    "bluerov2_heavy.urdf": bluerov2_heavy_urdf,
+    "bluerov2_heavy_hinsdale2023.urdf": trial_vehicle_urdf,
+    "reach_alpha5.urdf": alpha5_urdf,
+    "uvms_bluerov2_alpha5.urdf": force_task_urdf,
+}
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--write", action="store_true", help="write the URDF files")
+    parser.add_argument("--check", action="store_true", help="exit 1 if a file is out of date")
+    args = parser.parse_args(argv)
+    stale = []
+    for filename, make in FILES.items():
+        path = HERE / filename
+        text = make()  # in order: the force-task file is made from the files written before
+        if args.write:
+            path.write_text(text)
+            print(f"wrote {path}")
+        elif not path.is_file() or path.read_text() != text:
+            stale.append(filename)
+    for filename in stale:
+        print(f"{filename} is out of date: run with --write")
+    return 1 if (args.check and stale) else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

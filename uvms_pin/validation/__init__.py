@@ -1,0 +1,1 @@
+"""Validation against measurements: the Hinsdale 2023 pool trials (``uvms-pin validate pool``)."""

@@ -1,0 +1,1 @@
+"""Vehicles shipped with uvms-pin beyond their URDF: thruster layouts and thrust models."""
