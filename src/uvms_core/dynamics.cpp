@@ -56,13 +56,15 @@ void Dynamics::prepare() {
   jacobian_ = Eigen::Matrix<double, 6, Eigen::Dynamic>::Zero(6, nv);
   added_times_jacobian_ = Eigen::Matrix<double, 6, Eigen::Dynamic>::Zero(6, nv);
   cholesky_ = Eigen::LLT<Eigen::MatrixXd>(nv);
+  prepare_articulated();
 }
 
 void Dynamics::kinematics(const ConstVec& q, const ConstVec& v) {
   pinocchio::forwardKinematics(model_, data_, q, v, ConstVec(zero_));
 }
 
-void Dynamics::fluid_wrenches(double time_s, const FlowField& flow) {
+void Dynamics::fluid_wrenches(double time_s, const FlowField& flow,
+                              bool with_bias_acceleration) {
   for (auto& f : fext_) f.setZero();
   const Vec3 gravity = model_.gravity.linear();
   for (int j : joints_with_added_mass_) {
@@ -70,8 +72,9 @@ void Dynamics::fluid_wrenches(double time_s, const FlowField& flow) {
     const Vec6 velocity = data_.v[j].toVector();
     const FlowInBody seen = flow_in_body(flow.at(time_s, placement.translation()),
                                          placement.rotation(), velocity.tail<3>());
-    fext_[j].toVector() += added_mass_wrench(hydro_.added_mass_per_joint[j],
-                                             data_.a[j].toVector(), velocity, seen);
+    const Vec6 bias = with_bias_acceleration ? data_.a[j].toVector() : Vec6::Zero();
+    fext_[j].toVector() +=
+        added_mass_wrench(hydro_.added_mass_per_joint[j], bias, velocity, seen);
   }
   for (int j : joints_with_volume_) {
     fext_[j].toVector() += buoyancy_wrench(
@@ -151,8 +154,24 @@ const Eigen::VectorXd& Dynamics::solve(const ConstVec& q, const ConstVec& rhs) {
 const Eigen::VectorXd& Dynamics::bias_forces(const ConstVec& q, const ConstVec& v,
                                              const FlowField& flow) {
   kinematics(q, v);
-  fluid_wrenches(0.0, flow);
+  fluid_wrenches(0.0, flow, true);
   return bias_from_wrenches(q, v);
+}
+
+const Eigen::VectorXd& Dynamics::accelerations(const ConstVec& q, const ConstVec& v,
+                                               const ConstVec& tau, const ConstVec* tau_ext) {
+  if (articulated_) {
+    if (tau_ext == nullptr) {
+      articulated_body_pass(tau);
+    } else {
+      rhs_ = tau + *tau_ext;
+      articulated_body_pass(rhs_);
+    }
+    return acceleration_;
+  }
+  rhs_ = tau - bias_from_wrenches(q, v);
+  if (tau_ext != nullptr) rhs_ += *tau_ext;
+  return solve(q, rhs_);
 }
 
 const Eigen::VectorXd& Dynamics::forward_dynamics(const ConstVec& q,
@@ -160,9 +179,9 @@ const Eigen::VectorXd& Dynamics::forward_dynamics(const ConstVec& q,
                                                   const ConstVec& tau,
                                                   const FlowField& flow,
                                                   const ConstVec* tau_ext) {
-  rhs_ = tau - bias_forces(q, v, flow);
-  if (tau_ext != nullptr) rhs_ += *tau_ext;
-  return solve(q, rhs_);
+  kinematics(q, v);
+  fluid_wrenches(0.0, flow, needs_bias_acceleration());
+  return accelerations(q, v, tau, tau_ext);
 }
 
 }  // namespace uvms

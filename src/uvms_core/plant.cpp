@@ -6,7 +6,7 @@
 namespace uvms {
 
 Plant::Plant(const Dynamics& dynamics, int ee_frame_id)
-    : dynamics_(dynamics), stepper_(dynamics_.model()), rhs_(dynamics_.nv()) {
+    : dynamics_(dynamics), stepper_(dynamics_.model()) {
   const auto& model = dynamics_.model();
   if (ee_frame_id < 0 || ee_frame_id >= static_cast<int>(model.nframes)) {
     throw InputError("end-effector frame " + std::to_string(ee_frame_id) +
@@ -38,7 +38,7 @@ Vec6 Plant::contact_wrench(const ConstVec& q, const ConstVec& v) {
 const Eigen::VectorXd& Plant::acceleration(double time_s, const ConstVec& q, const ConstVec& v,
                                            const ConstVec& tau, const Vec6* contact_world) {
   dynamics_.kinematics(q, v);
-  dynamics_.fluid_wrenches(time_s, flow);
+  dynamics_.fluid_wrenches(time_s, flow, dynamics_.needs_bias_acceleration());
   if (has_contact(contact)) {
     const auto [position, velocity] =
         tip_state(dynamics_.model(), dynamics_.data(), ee_frame_id_);
@@ -52,8 +52,7 @@ const Eigen::VectorXd& Plant::acceleration(double time_s, const ConstVec& q, con
     // delta acts against tau on the vehicle body (joint 1, free-flyer: LOCAL Jacobian [I 0])
     dynamics_.add_local_wrench(1, -disturbance->at(time_s));
   }
-  rhs_ = tau - dynamics_.bias_from_wrenches(q, v);
-  return dynamics_.solve(q, rhs_);
+  return dynamics_.accelerations(q, v, tau, nullptr);
 }
 
 std::pair<Eigen::VectorXd, Eigen::VectorXd> Plant::advance(double t0, const ConstVec& q0,

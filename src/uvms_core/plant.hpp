@@ -40,7 +40,6 @@ class Plant {
   pinocchio::FrameIndex ee_frame_id_;
   pinocchio::JointIndex ee_joint_id_;
   ManifoldStepper stepper_;
-  Eigen::VectorXd rhs_;
 };
 
 }  // namespace uvms
