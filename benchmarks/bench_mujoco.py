@@ -12,7 +12,7 @@ measured here, to one ``pin.aba`` call on the same model or to MuJoCo doing the 
 
 1. forward dynamics (with a current), x pin.aba;
 2. the plant over one 2 ms control period, RK4 at 0.5 ms (uvms-pin: the simulator's
-   per-tick call, ``integrator.advance`` on ``Plant.acceleration`` with the input held;
+   per-tick call, ``Plant.advance`` with the input held (one compiled call on the core);
    MuJoCo: 4 ``mj_step`` with ``opt.integrator = RK4``);
 3. one closed-loop tick of scenarios/realistic_force_tracking.toml: the same Python PPC,
    sensors and thruster allocation compute tau from a `Measurement` of each simulator's
@@ -235,10 +235,17 @@ def uvms_plant_case(system: System, backend: str | None) -> Callable[[], object]
         disturbance=SinusoidalDisturbance(),
     )
     plant.attach(system.q0)
-    rhs = plant_rhs(plant, np.zeros(uvms.nv), backend)
-    integrator, model = RK4(STEP_S), uvms.model
-    q, v = system.q0, system.v0
-    return lambda: integrator.advance(model, rhs, 0.0, q, v, CONTROL_PERIOD_S)
+    integrator = RK4(STEP_S)
+    q, v, tau = system.q0, system.v0, np.zeros(uvms.nv)
+    return lambda: advance(plant, integrator, backend, 0.0, q, v, tau, CONTROL_PERIOD_S)
+
+
+def advance(plant, integrator, backend, t0, q, v, tau, t1):
+    """The simulator's per-tick call: ``Plant.advance`` (one compiled call for the whole
+    period on the core), or the integrator's loop over ``Plant.acceleration``."""
+    if hasattr(plant, "advance"):
+        return plant.advance(integrator, t0, q, v, tau, t1)
+    return integrator.advance(plant.uvms.model, plant_rhs(plant, tau, backend), t0, q, v, t1)
 
 
 def mujoco_plant_case(system: System) -> Callable[[], object]:
@@ -306,13 +313,12 @@ def _fresh(scenario) -> tuple:
 def _uvms_loop(scenario, plant: Plant, backend: str | None, ticks: int) -> None:
     controller, sensors = _fresh(scenario)
     plant.attach(scenario.q0)
-    integrator, model = scenario.settings.integrator, scenario.uvms.model
+    integrator = scenario.settings.integrator
     q, v = scenario.q0, scenario.v0
     for k in range(ticks):
         t = k * CONTROL_PERIOD_S
         tau = _controller_tick(plant, controller, sensors, t, q, v)
-        rhs = plant_rhs(plant, tau, backend)
-        q, v = integrator.advance(model, rhs, t, q, v, t + CONTROL_PERIOD_S)
+        q, v = advance(plant, integrator, backend, t, q, v, tau, t + CONTROL_PERIOD_S)
 
 
 def _mujoco_loop(scenario, system: System, ticks: int) -> None:

@@ -22,6 +22,7 @@ PRODUCERS = {
     "realistic": "the realistic scenario: docs/results/realistic.md, docs/realistic_force.png",
     "robustness": "robustness table: docs/results/robustness.md",
     "bench": "benchmark table: docs/results/bench.md",
+    "bench_mujoco": "uvms-pin vs MuJoCo: docs/results/bench_mujoco.md",
     "compare_arms": "arm comparison: docs/results/compare_arms.md, docs/arm_comparison.png",
     "study_model_uncertainty": "study summary: docs/results/study_model_uncertainty.md",
     "study_paper_claims": "study summary: docs/results/study_paper_claims.md",
