@@ -143,7 +143,10 @@ class Plant:
                 stacklevel=3,
             )
             return None
-        compiled = core_module().Plant(dynamics_of(self.uvms), self.uvms.ee_frame_id)
+        # the compiled plant uses the end-effector frame for contact only, which a model
+        # without one cannot have (checked above): frame 0 (the world) stands in
+        ee_frame_id = self.uvms.ee_frame_id if self.uvms.has_end_effector else 0
+        compiled = core_module().Plant(dynamics_of(self.uvms), ee_frame_id)
         compiled.set_flow(*compiled_flow(self._flow))  # the current plus any waves
         contact = self.contact
         if isinstance(contact, LinearSpring):
