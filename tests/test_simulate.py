@@ -28,7 +28,8 @@ BLOW_UPS = {
     "stiffness 1e7, no controller, RK4 at 0.5 ms": (
         PASSIVE,
         {
-            "environment": {"type": "spring", "stiffness_N_m": [1e7] * 3},
+            "environment.type": "spring",
+            "environment.stiffness_N_m": [1e7] * 3,
             "integrator.step_s": 0.0005,
         },
     ),
@@ -83,7 +84,7 @@ def test_cli_exits_3_and_saves_the_partial_rollout_of_a_blow_up(tmp_path):
     result = run("run", str(scenario), "--out", str(out), "--quiet")
     assert result.returncode == 3, result.stderr
     assert "Traceback" not in result.stderr
-    assert "simulation diverged between t = 0 s and 0.002 s (LinAlgError" in result.stderr
+    assert "simulation diverged between t = 0 s and 0.002 s (" in result.stderr
     metrics = json.loads((out / "metrics.json").read_text())
     assert metrics["status"] == "SimulationError"
     assert len(up.Rollout.load(out)) == 1

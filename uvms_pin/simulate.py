@@ -32,9 +32,21 @@ Progress = Callable[[float, float], None]
 
 # A speed this large [m/s or rad/s] only comes out of a blown-up integration.
 DIVERGED_SPEED = 1e4
+
+
 # What numerical code raises on a blown-up state (a singular chart Jacobian or mass
 # matrix, an overflow): reported as a SimulationError with the partial rollout kept.
-_NUMERICAL_FAILURES = (np.linalg.LinAlgError, FloatingPointError, OverflowError, ZeroDivisionError)
+class CompiledCoreFailure(ArithmeticError):
+    """A numerical failure reported by the compiled core (e.g. M not positive definite)."""
+
+
+_NUMERICAL_FAILURES = (
+    np.linalg.LinAlgError,
+    FloatingPointError,
+    OverflowError,
+    ZeroDivisionError,
+    CompiledCoreFailure,
+)
 # The funnel event fires when the margin min(1 - |xi|) reaches -this: just outside, so
 # that the controller, evaluated at the located event state, reports the violation.
 _EVENT_OVERSHOOT = 1e-6
@@ -333,7 +345,10 @@ def simulate_closed_loop(
                 if tick == n_ticks:
                     break
                 span[:] = t, t + tick_s
-                q, v = plant.advance(settings.integrator, t, q, v, tau_applied, t + tick_s)
+                try:
+                    q, v = plant.advance(settings.integrator, t, q, v, tau_applied, t + tick_s)
+                except SimulationError as exc:  # a failed solve inside the compiled core
+                    raise CompiledCoreFailure(str(exc)) from exc
                 check_finite(t, t + tick_s, q, v)
     except _NUMERICAL_FAILURES as exc:
         error = SimulationError(
