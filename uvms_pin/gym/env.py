@@ -83,7 +83,7 @@ class UvmsEnv(gym.Env):
             if not (np.isfinite(value) and value >= 0.0):
                 raise ParameterError(f"{label} must be finite and >= 0, got {value}")
         self.render_mode = render_mode
-        self.scenario_path = _scenario_path(scenario)
+        self.scenario_path = scenario_path(scenario)
         self.overrides = dict(overrides or {})
         if model is not None:
             self.overrides["scenario.model"] = model
@@ -270,7 +270,7 @@ def _layout(nq: int, nv: int, goal_size: int) -> dict[str, slice]:
     return out
 
 
-def _scenario_path(scenario: str | Path) -> Path:
+def scenario_path(scenario: str | Path) -> Path:
     """A scenario file, or the name of a shipped one (``realistic_force_tracking``)."""
     path = Path(scenario)
     if path.is_file():
