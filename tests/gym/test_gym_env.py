@@ -198,3 +198,17 @@ def test_bad_actions_are_clear_errors():
         env.step(np.zeros(3))
     with pytest.raises(ParameterError, match="10 finite numbers"):
         env.step(np.full(10, np.nan))
+
+
+def test_sea_state_is_drawn_from_the_episode_seed():
+    env = _make(FORCE, scenario="sea_state_force_tracking").unwrapped
+    point = np.array([[0.0, 0.0, -2.0]])
+
+    def flow_at_seed(seed: int) -> np.ndarray:
+        env.reset(seed=seed)
+        assert env.scenario.raw["scenario"]["seed"] == seed
+        return env.scenario.plant.flow.velocity(1.0, point)
+
+    first, other, again = flow_at_seed(1), flow_at_seed(2), flow_at_seed(1)
+    assert not np.allclose(first, other)  # another seed: another sea
+    np.testing.assert_array_equal(first, again)
