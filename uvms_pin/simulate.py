@@ -34,7 +34,7 @@ Progress = Callable[[float, float], None]
 DIVERGED_SPEED = 1e4
 # What numerical code raises on a blown-up state (a singular chart Jacobian or mass
 # matrix, an overflow): reported as a SimulationError with the partial rollout kept.
-_NUMERICAL_FAILURES = (np.linalg.LinAlgError, FloatingPointError, OverflowError, ZeroDivisionError)
+NUMERICAL_FAILURES = (np.linalg.LinAlgError, FloatingPointError, OverflowError, ZeroDivisionError)
 # The funnel event fires when the margin min(1 - |xi|) reaches -this: just outside, so
 # that the controller, evaluated at the located event state, reports the violation.
 _EVENT_OVERSHOOT = 1e-6
@@ -108,6 +108,14 @@ class SimulationSettings:
         if self.control_period_s is None:
             return 1
         return round(self.log_period_s / self.control_period_s)
+
+
+def diverged(q: np.ndarray, v: np.ndarray) -> bool:
+    """True for a state only a blown-up integration gives: non-finite, or a speed above
+    `DIVERGED_SPEED`."""
+    return not (np.all(np.isfinite(q)) and np.all(np.isfinite(v))) or bool(
+        np.max(np.abs(v)) > DIVERGED_SPEED
+    )
 
 
 def _require_multiple(whole: float, part: float, whole_name: str, part_name: str) -> None:
@@ -260,10 +268,7 @@ def simulate_closed_loop(
             rollout.signal(name, values.size)[k] = values
 
     def check_finite(t0: float, t1: float, q: np.ndarray, v: np.ndarray) -> None:
-        if (
-            not (np.all(np.isfinite(q)) and np.all(np.isfinite(v)))
-            or np.max(np.abs(v)) > DIVERGED_SPEED
-        ):
+        if diverged(q, v):
             raise SimulationError(f"simulation diverged between t = {t0:.6g} s and {t1:.6g} s")
 
     def sample(k: int, t: float, q: np.ndarray, v: np.ndarray) -> np.ndarray:
@@ -340,7 +345,7 @@ def simulate_closed_loop(
                     model, held_rhs(tau_applied), t, q, v, t + tick_s
                 )
                 check_finite(t, t + tick_s, q, v)
-    except _NUMERICAL_FAILURES as exc:
+    except NUMERICAL_FAILURES as exc:
         error = SimulationError(
             f"simulation diverged between t = {span[0]:.6g} s and {span[1]:.6g} s "
             f"({type(exc).__name__}: {exc})"

@@ -212,3 +212,26 @@ def test_sea_state_is_drawn_from_the_episode_seed():
     first, other, again = flow_at_seed(1), flow_at_seed(2), flow_at_seed(1)
     assert not np.allclose(first, other)  # another seed: another sea
     np.testing.assert_array_equal(first, again)
+
+
+def test_divergence_ends_the_episode_cleanly():
+    # unlimited actuation with an absurd scale: the vehicle blows up within a step or two
+    env = gym.make(
+        STATION,
+        scenario="passive_still_water",
+        overrides={"control.period_s": 0.002},
+        action_scale=np.full(10, 1e12),
+    ).unwrapped
+    observation, _ = env.reset(seed=0)
+    for _ in range(5):
+        observation, reward, terminated, truncated, info = env.step(np.ones(10))
+        if terminated:
+            break
+    assert terminated and not truncated
+    assert "diverged" in info["error"]
+    assert reward == -100.0
+    assert np.all(np.isfinite(observation))
+    with pytest.raises(ParameterError, match="reset"):
+        env.step(np.ones(10))
+    rollout = env.episode_rollout()  # the states reached before the failure, all finite
+    assert np.all(np.isfinite(rollout.q)) and np.all(np.diff(rollout.time_s) > 0)

@@ -155,29 +155,28 @@ class UvmsEnv(gym.Env):
             raise ParameterError("call reset() before step()")
         if self.clip_actions:
             a = np.clip(a, -1.0, 1.0)
-        stepper = self._stepper
+        stepper, plant = self._stepper, self.scenario.plant
         tau = self.action_scale * a
-        t, q, v, measured = stepper.time_s, stepper.q, stepper.v, self._measurement
+        t, measured = stepper.time_s, self._measurement
+        self._record.add(
+            t,
+            stepper.q,
+            stepper.v,
+            plant.actuation.apply(tau),
+            tau,
+            self._contact,
+            measured.wrench_world,
+            plant.disturbance_wrench(t),
+        )
         info: dict[str, Any] = {"seed": self.episode_seed}
         try:
-            tau_applied = stepper.advance(tau)
+            stepper.advance(tau)
             self._measurement, self._contact = stepper.measure()
         except SimulationError as exc:
             self._measurement = None  # the episode is over: reset() before stepping again
             info.update(time_s=t, error=str(exc))
-            self._record.add(t, q, v, tau, tau, np.zeros(6), measured.wrench_world, np.zeros(6))
             obs = _observation_of(measured, self.task.goal(t))
             return obs, -self.failure_penalty, True, False, info
-        self._record.add(
-            t,
-            q,
-            v,
-            tau_applied,
-            tau,
-            self.scenario.plant.contact_wrench(q, v),
-            measured.wrench_world,
-            self.scenario.plant.disturbance_wrench(t),
-        )
         self._steps += 1
         outcome = self.task.outcome(stepper.time_s, stepper.q, self._contact, a)
         truncated = self._steps >= self.max_steps and not outcome.terminated
@@ -203,16 +202,18 @@ class UvmsEnv(gym.Env):
         record = EpisodeRecord()
         record.rows = list(self._record.rows)
         stepper = self._stepper
-        last_tau = record.rows[-1][3:5] if record.rows else (np.zeros(self.scenario.uvms.nv),) * 2
-        record.add(
-            stepper.time_s,
-            stepper.q,
-            stepper.v,
-            *last_tau,
-            self._contact,
-            self._measurement.wrench_world if self._measurement is not None else self._contact,
-            self.scenario.plant.disturbance_wrench(stepper.time_s),
-        )
+        if not record.rows or record.rows[-1][0] != stepper.time_s:  # the state reached
+            held = record.rows[-1][3:5] if record.rows else (np.zeros(stepper.v.size),) * 2
+            measured = self._contact if self._measurement is None else self._measurement
+            record.add(
+                stepper.time_s,
+                stepper.q,
+                stepper.v,
+                *held,
+                self._contact,
+                getattr(measured, "wrench_world", measured),
+                self.scenario.plant.disturbance_wrench(stepper.time_s),
+            )
         scenario = self.scenario
         metadata = {
             "scenario": scenario.name,

@@ -15,10 +15,7 @@ from uvms_pin.errors import SimulationError
 from uvms_pin.measurement import Measurement
 from uvms_pin.plant import Plant
 from uvms_pin.sensors import SensorConfig, SensorSuite
-from uvms_pin.simulate import DIVERGED_SPEED, SimulationSettings
-
-# what numerical code raises on a blown-up state (as in uvms_pin.simulate)
-NUMERICAL_FAILURES = (np.linalg.LinAlgError, FloatingPointError, OverflowError, ZeroDivisionError)
+from uvms_pin.simulate import NUMERICAL_FAILURES, SimulationSettings, diverged
 
 
 class PlantStepper:
@@ -77,9 +74,7 @@ class PlantStepper:
                 f"simulation diverged between t = {t0:.6g} s and {t1:.6g} s "
                 f"({type(exc).__name__}: {exc})"
             ) from exc
-        if not (np.all(np.isfinite(q)) and np.all(np.isfinite(v))) or (
-            np.max(np.abs(v)) > DIVERGED_SPEED
-        ):
+        if diverged(q, v):
             raise SimulationError(f"simulation diverged between t = {t0:.6g} s and {t1:.6g} s")
         self.q, self.v = q, v
         # the simulator's tick time, tick * period: no accumulated rounding
