@@ -12,7 +12,9 @@ DEMO_OUT ?= out/demo
 
 .PHONY: demo test lint bench results clean
 
-$(STAMP): pyproject.toml
+# pip builds the compiled core (src/uvms_core, CMakeLists.txt) while installing: a changed
+# C++ source re-runs the install
+$(STAMP): pyproject.toml CMakeLists.txt $(wildcard src/uvms_core/*.cpp src/uvms_core/*.hpp)
 	$(PYTHON) -m venv $(VENV)
 	$(BIN)/python -m pip install --quiet --upgrade pip
 	$(BIN)/python -m pip install --quiet -e '.[dev]'
@@ -43,10 +45,6 @@ bench: $(STAMP)
 results: $(STAMP)
 	$(BIN)/python scripts/make_results.py $(if $(RESULTS),--only $(RESULTS))
 
-# the pool trials of a real BlueROV2 Heavy + Alpha 5 against the simulator (README "Validated
-# against a real vehicle"): out/pool/pool_validation.json, .csv and one figure per trial
-results: $(STAMP)
-	$(BIN)/uvms-pin validate pool data/hinsdale2023 --out out/pool
 
 clean:
 	rm -rf $(VENV) out build *.egg-info
