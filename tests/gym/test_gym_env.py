@@ -235,3 +235,14 @@ def test_divergence_ends_the_episode_cleanly():
         env.step(np.ones(10))
     rollout = env.episode_rollout()  # the states reached before the failure, all finite
     assert np.all(np.isfinite(rollout.q)) and np.all(np.diff(rollout.time_s) > 0)
+
+
+def test_any_scenario_or_model():
+    bluerov = _make(FORCE, scenario="bluerov_alpha5_force_tracking").unwrapped
+    uvms = bluerov.scenario.uvms
+    assert bluerov.observation_space.shape == (uvms.nq + uvms.nv + 6 + 3,)
+    assert bluerov.action_space.shape == (uvms.nv,)
+    urdf = ROOT / "models" / "uvms_lbv150.urdf"
+    lbv = _make(FORCE, model=str(urdf)).unwrapped
+    assert lbv.scenario.uvms.source == str(urdf.resolve()) or lbv.scenario.uvms.source == str(urdf)
+    assert lbv.observation_space.shape == (30,)

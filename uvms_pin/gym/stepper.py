@@ -2,8 +2,8 @@
 `uvms_pin.simulate.simulate_closed_loop`, opened at the controller.
 
 The calls and their order are those of the simulator's sampled mode (measure at the tick,
-apply the held input through the actuation, advance the integrator by one control
-period, check the state), so a policy that returns what a controller returns gives the
+apply the held input through the actuation, advance the plant by one control period
+with `Plant.advance`, one compiled call when the core is built, check the state), so a policy that returns what a controller returns gives the
 trajectory of ``uvms-pin run`` with the same seed.
 """
 
@@ -61,14 +61,7 @@ class PlantStepper:
         t0, t1 = self.time_s, self.time_s + self.period_s
         plant = self.plant
         try:
-            q, v = self.settings.integrator.advance(
-                plant.uvms.model,
-                lambda t, q, v: plant.acceleration(t, q, v, tau_applied),
-                t0,
-                self.q,
-                self.v,
-                t1,
-            )
+            q, v = plant.advance(self.settings.integrator, t0, self.q, self.v, tau_applied, t1)
         except NUMERICAL_FAILURES as exc:
             raise SimulationError(
                 f"simulation diverged between t = {t0:.6g} s and {t1:.6g} s "
