@@ -177,6 +177,7 @@ def test_render_and_replay_export(tmp_path):
         ({"funnel": "tight"}, "funnel must be"),
         ({"desired_force_N": [1.0, 2.0]}, "desired_force_N"),
         ({"initial_position_noise_m": -1.0}, "initial_position_noise_m"),
+        ({"effort_weight": "high"}, "effort_weight must be a finite number"),
     ],
 )
 def test_bad_options_are_clear_errors(kw, match):

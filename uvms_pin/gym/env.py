@@ -15,6 +15,7 @@ at the scenario's duration_s.
 
 from __future__ import annotations
 
+import numbers
 from pathlib import Path
 from typing import Any, ClassVar
 
@@ -80,8 +81,8 @@ class UvmsEnv(gym.Env):
             ("effort_weight", effort_weight),
             ("failure_penalty", failure_penalty),
         ):
-            if not (np.isfinite(value) and value >= 0.0):
-                raise ParameterError(f"{label} must be finite and >= 0, got {value}")
+            if not (isinstance(value, numbers.Real) and np.isfinite(value) and value >= 0.0):
+                raise ParameterError(f"{label} must be a finite number >= 0, got {value!r}")
         self.render_mode = render_mode
         self.scenario_path = scenario_path(scenario)
         self.overrides = dict(overrides or {})
