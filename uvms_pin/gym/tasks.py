@@ -37,7 +37,7 @@ class StepOutcome:
 
 
 def effort_penalty(action: np.ndarray, weight: float) -> float:
-    return weight * float(np.mean(np.square(action)))
+    return weight * float(action @ action) / action.size  # w mean(a^2)
 
 
 class ForceTrackingTask:
