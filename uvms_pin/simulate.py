@@ -40,7 +40,7 @@ class CompiledCoreFailure(ArithmeticError):
     """A numerical failure reported by the compiled core (e.g. M not positive definite)."""
 
 
-_NUMERICAL_FAILURES = (
+NUMERICAL_FAILURES = (
     np.linalg.LinAlgError,
     FloatingPointError,
     OverflowError,
@@ -120,6 +120,14 @@ class SimulationSettings:
         if self.control_period_s is None:
             return 1
         return round(self.log_period_s / self.control_period_s)
+
+
+def diverged(q: np.ndarray, v: np.ndarray) -> bool:
+    """True for a state only a blown-up integration gives: non-finite, or a speed above
+    `DIVERGED_SPEED`."""
+    return not (np.all(np.isfinite(q)) and np.all(np.isfinite(v))) or bool(
+        np.max(np.abs(v)) > DIVERGED_SPEED
+    )
 
 
 def _require_multiple(whole: float, part: float, whole_name: str, part_name: str) -> None:
@@ -269,10 +277,7 @@ def simulate_closed_loop(
             rollout.signal(name, values.size)[k] = values
 
     def check_finite(t0: float, t1: float, q: np.ndarray, v: np.ndarray) -> None:
-        if (
-            not (np.all(np.isfinite(q)) and np.all(np.isfinite(v)))
-            or np.max(np.abs(v)) > DIVERGED_SPEED
-        ):
+        if diverged(q, v):
             raise SimulationError(f"simulation diverged between t = {t0:.6g} s and {t1:.6g} s")
 
     def sample(k: int, t: float, q: np.ndarray, v: np.ndarray) -> np.ndarray:
@@ -350,7 +355,7 @@ def simulate_closed_loop(
                 except SimulationError as exc:  # a failed solve inside the compiled core
                     raise CompiledCoreFailure(str(exc)) from exc
                 check_finite(t, t + tick_s, q, v)
-    except _NUMERICAL_FAILURES as exc:
+    except NUMERICAL_FAILURES as exc:
         error = SimulationError(
             f"simulation diverged between t = {span[0]:.6g} s and {span[1]:.6g} s "
             f"({type(exc).__name__}: {exc})"

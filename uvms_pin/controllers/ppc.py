@@ -609,6 +609,10 @@ class PrescribedPerformanceController(Controller):
         )
         return self._last_signals
 
+    def desired_force_world_N(self, time_s: float) -> np.ndarray:
+        """f_d(t) (3,) [N], world axes: the force this controller tracks."""
+        return np.asarray(self._desired_force(time_s), dtype=float)
+
     def funnel_margin(self) -> float:
         """min(1 - |xi|) over both levels at the last ``compute`` (> 0: inside)."""
         return self._margin
