@@ -314,6 +314,16 @@ def _build(raw: dict[str, Any], path: Path, source: str, overridden: dict[str, s
 
     controller_table = top.table("controller")
     controller_factory = _controller(controller_table, uvms, path.parent)
+    baselines = top.table("baselines")
+    if baselines is not None:
+        for kind in baselines.rest():
+            if kind not in BASELINE_KINDS or (raw.get("controller") or {}).get("type") == kind:
+                raise ScenarioError(
+                    f"{source}: [baselines.{kind}]: a baseline is one of "
+                    f"{', '.join(BASELINE_KINDS)} other than the scenario's [controller] type"
+                )
+            table = _Table(baseline_controller_table(raw, kind), f"baselines.{kind}", source)
+            _controller(table, uvms, path.parent)  # checked now, not when compared
     top.finish()
     try:
         settings = SimulationSettings(duration, integrator, log_period, control_period, seed)
@@ -564,6 +574,39 @@ def _controller(t: _Table | None, uvms: UVMS, scenario_dir: Path) -> ControllerS
             "type", f"must be one of {choices} or 'package.module:ClassName', got '{kind}'"
         )
     return _CONTROLLER_BUILDERS[kind](t, uvms)
+
+
+#: Controllers whose tuning a scenario may carry in [baselines.<kind>] for comparisons.
+BASELINE_KINDS = ("pi_force", "impedance", "computed_torque")
+#: Keys of a PPC [controller] table a baseline of the same task inherits (the same task,
+#: and for the J^# baselines the same pseudo-inverse and null-space pull).
+_TASK_KEYS = ("ee_frame", "desired_rpy", "desired_force")
+_PSEUDO_INVERSE_INHERITED = ("velocity_weights", "null_space_gain_per_s", "null_space_target")
+
+
+def baseline_controller_table(raw: dict[str, Any], kind: str) -> dict[str, Any]:
+    """The [controller] table that runs the scenario ``raw``'s task with controller ``kind``.
+
+    The scenario's own [controller] when its type is ``kind``; else a baseline's table: the
+    task (``ee_frame``, ``desired_rpy``, ``desired_force``; for "pi_force" and
+    "computed_torque" also the PPC's ``velocity_weights`` and null-space keys) taken from
+    [controller], then the gains of ``[baselines.<kind>]`` (defaults if absent).
+
+    Raises:
+        ScenarioError: ``kind`` is not the scenario's controller nor a baseline.
+    """
+    controller = raw.get("controller") or {}
+    if controller.get("type") == kind:
+        return copy.deepcopy(controller)
+    if kind not in BASELINE_KINDS:
+        choices = ", ".join((controller.get("type", "none"), *BASELINE_KINDS))
+        raise ScenarioError(f"controller '{kind}': this scenario can run {choices}")
+    inherited = _TASK_KEYS + (_PSEUDO_INVERSE_INHERITED if kind != "impedance" else ())
+    table = {"type": kind, **{k: controller[k] for k in inherited if k in controller}}
+    tuning = (raw.get("baselines") or {}).get(kind) or {}
+    if not isinstance(tuning, dict):
+        raise ScenarioError(f"[baselines.{kind}] must be a table, got {tuning!r}")
+    return copy.deepcopy({**table, **tuning})
 
 
 def _zero(uvms: UVMS) -> Controller:
