@@ -322,8 +322,12 @@ def _build(raw: dict[str, Any], path: Path, source: str, overridden: dict[str, s
                     f"{source}: [baselines.{kind}]: a baseline is one of "
                     f"{', '.join(BASELINE_KINDS)} other than the scenario's [controller] type"
                 )
-            table = _Table(baseline_controller_table(raw, kind), f"baselines.{kind}", source)
-            _controller(table, uvms, path.parent)  # checked now, not when compared
+            # read as the [controller] it becomes (same keys, same docs); checked now
+            table = _Table(baseline_controller_table(raw, kind), "controller", source)
+            try:
+                _controller(table, uvms, path.parent)
+            except ScenarioError as exc:
+                raise ScenarioError(f"[baselines.{kind}] (run as [controller]): {exc}") from exc
     top.finish()
     try:
         settings = SimulationSettings(duration, integrator, log_period, control_period, seed)
