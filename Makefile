@@ -12,7 +12,9 @@ DEMO_OUT ?= out/demo
 
 .PHONY: demo test lint bench results clean
 
-$(STAMP): pyproject.toml
+# pip builds the compiled core (src/uvms_core, CMakeLists.txt) while installing: a changed
+# C++ source re-runs the install
+$(STAMP): pyproject.toml CMakeLists.txt $(wildcard src/uvms_core/*.cpp src/uvms_core/*.hpp)
 	$(PYTHON) -m venv $(VENV)
 	$(BIN)/python -m pip install --quiet --upgrade pip
 	$(BIN)/python -m pip install --quiet -e '.[dev]'

@@ -1,17 +1,24 @@
-"""Cost of the underwater dynamics and of one integrator step, as ratios to pin.aba.
+"""Cost of the underwater dynamics, the plant and the closed loop: compiled core vs Python.
 
-    .venv/bin/python benchmarks/bench_dynamics.py [--repeat N] [--json FILE]
+    .venv/bin/python benchmarks/bench_dynamics.py [--repeat N] [--number N] [--loop-s T] [--json FILE]
 
 Every figure is measured in this process, on the reference model, and reported as a ratio
 to one rigid-body ``pin.aba`` call (the floor: Pinocchio's forward dynamics with no water)
-timed in the same run, so the numbers compare across machines. Absolute times are printed
-for information only.
+timed in the same run, so the numbers compare across machines. Times are the CPU time of
+this process (``time.process_time``): on a machine shared with other jobs, wall-clock time
+measures the neighbours. Absolute times are printed for information only. "core" is the compiled backend (the default), "python" the reference.
+
+The plant rows advance the plant of the realistic scenario (2 N/m spring, sinusoidal
+disturbance, a 0.3 m/s current) over one 2 ms control period with RK4 at 0.5 ms (4 steps, 16
+right-hand sides). The closed-loop rows run the shipped scenarios for ``--loop-s`` simulated
+seconds and report the real-time factor (simulated / wall time) and the cost per control tick.
 """
 
 from __future__ import annotations
 
 import argparse
 import json
+import time
 import timeit
 from pathlib import Path
 
@@ -19,57 +26,122 @@ import numpy as np
 import pinocchio as pin
 
 import uvms_pin as up
-from uvms_pin.integrators import RK4, SemiImplicitEuler
+from uvms_pin.core import dynamics_of
+from uvms_pin.environment import LinearSpring, SinusoidalDisturbance
+from uvms_pin.integrators import RK4
+from uvms_pin.plant import Plant
 
 ROOT = Path(__file__).resolve().parents[1]
+BACKENDS = ("core", "python")
 
 
 def best_time(fn, number: int, repeat: int) -> float:
     """Best mean time per call over ``repeat`` batches of ``number`` calls [s]."""
-    return min(timeit.repeat(fn, number=number, repeat=repeat)) / number
+    return min(timeit.repeat(fn, number=number, repeat=repeat, timer=time.process_time)) / number
 
 
-def main() -> None:
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--repeat", type=int, default=5)
-    parser.add_argument("--number", type=int, default=2000)
-    parser.add_argument("--json", type=Path, default=None, help="also write the results here")
-    args = parser.parse_args()
-
-    uvms = up.load_uvms(ROOT / "models" / "uvms_lbv150.urdf")
-    model = uvms.model
-    data = model.createData()
+def call_rows(uvms: up.UVMS, number: int, repeat: int) -> dict[str, float]:
+    """Seconds per call of each dynamics function and of the plant over a control period."""
+    model, data = uvms.model, uvms.model.createData()
     rng = np.random.default_rng(0)
     q = uvms.neutral_configuration()
     q[7:] = [0.1, 0.6, -0.5, 0.2]
     v = rng.normal(scale=0.3, size=model.nv)
     tau = rng.normal(size=model.nv)
     current = np.array([0.3, 0.1, 0.0])
-
-    def rhs(t, qq, vv):
-        return up.forward_dynamics(uvms, qq, vv, tau, current)
-
-    rk4, euler = RK4(1e-3), SemiImplicitEuler(1e-3)
+    compiled = dynamics_of(uvms)
     cases = {
-        "pin.aba (rigid floor)": lambda: pin.aba(model, data, q, v, tau),
-        "mass_matrix": lambda: up.mass_matrix(uvms, q),
-        "bias_forces (with current)": lambda: up.bias_forces(uvms, q, v, current),
-        "forward_dynamics (with current)": lambda: up.forward_dynamics(uvms, q, v, tau, current),
-        "RK4 step (4 forward_dynamics)": lambda: rk4.advance(model, rhs, 0.0, q, v, 1e-3),
-        "semi-implicit Euler step": lambda: euler.advance(model, rhs, 0.0, q, v, 1e-3),
+        "pin.aba (rigid floor)": (lambda: pin.aba(model, data, q, v, tau), number),
+        "core Dynamics.forward_dynamics (direct)": (
+            lambda: compiled.forward_dynamics(q, v, tau, current),
+            number,
+        ),
     }
-    results = {}
-    floor = None
-    for name, fn in cases.items():
-        number = args.number if "step" not in name else max(1, args.number // 4)
-        seconds = best_time(fn, number, args.repeat)
-        floor = seconds if floor is None else floor
-        results[name] = {"seconds": seconds, "ratio_to_aba": seconds / floor}
-    width = max(len(n) for n in results)
+    for b in BACKENDS:
+        cases[f"{b}: mass_matrix"] = (lambda b=b: up.mass_matrix(uvms, q, backend=b), number)
+        cases[f"{b}: bias_forces (current)"] = (
+            lambda b=b: up.bias_forces(uvms, q, v, current, backend=b),
+            number,
+        )
+        cases[f"{b}: forward_dynamics (current)"] = (
+            lambda b=b: up.forward_dynamics(uvms, q, v, tau, current, backend=b),
+            number,
+        )
+    rk4 = RK4(5e-4)
+    for b in BACKENDS:
+        plant = Plant(
+            uvms,
+            current,
+            LinearSpring(np.full(3, 2.0)),
+            SinusoidalDisturbance(),
+            backend=b,
+        )
+        plant.attach(q)
+        cases[f"{b}: plant over 2 ms (RK4 0.5 ms)"] = (
+            lambda p=plant: p.advance(rk4, 0.0, q, v, tau, 0.002),
+            max(1, number // 20),
+        )
+    return {name: best_time(fn, n, repeat) for name, (fn, n) in cases.items()}
+
+
+def closed_loop_rows(duration_s: float) -> dict[str, dict[str, float]]:
+    """Real-time factor and wall time per control tick of the shipped scenarios."""
+    out = {}
+    for name in ("realistic_force_tracking", "paper_force_tracking"):
+        for b in BACKENDS:
+            scenario = up.load_scenario(
+                ROOT / "scenarios" / f"{name}.toml",
+                {"scenario.duration_s": duration_s, "integrator.backend": b},
+            )
+            start = time.process_time()
+            rollout = up.simulate(scenario)
+            wall = time.process_time() - start
+            period = scenario.settings.control_period_s
+            ticks = duration_s / period if period else float("nan")
+            out[f"{name} [{b}]"] = {
+                "real_time_factor": duration_s / wall,
+                "wall_s": wall,
+                "seconds_per_tick": wall / ticks,
+                "status": rollout.metadata["status"],
+            }
+    return out
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--repeat", type=int, default=5)
+    parser.add_argument("--number", type=int, default=2000)
+    parser.add_argument("--loop-s", type=float, default=1.0, help="simulated seconds per loop")
+    parser.add_argument("--json", type=Path, default=None, help="also write the results here")
+    args = parser.parse_args()
+
+    uvms = up.load_uvms(ROOT / "models" / "uvms_lbv150.urdf")
+    calls = call_rows(uvms, args.number, args.repeat)
+    floor = calls["pin.aba (rigid floor)"]
+    width = max(len(n) for n in calls)
     print(f"{'case':<{width}}  {'x pin.aba':>10}  {'us/call':>10}")
-    for name, r in results.items():
-        print(f"{name:<{width}}  {r['ratio_to_aba']:>10.1f}  {r['seconds'] * 1e6:>10.2f}")
+    for name, seconds in calls.items():
+        print(f"{name:<{width}}  {seconds / floor:>10.1f}  {seconds * 1e6:>10.2f}")
+    for what in ("forward_dynamics (current)", "plant over 2 ms (RK4 0.5 ms)"):
+        speedup = calls[f"python: {what}"] / calls[f"core: {what}"]
+        print(f"speed-up core / python, {what}: {speedup:.1f}x")
+
+    loops = closed_loop_rows(args.loop_s)
+    width = max(len(n) for n in loops)
+    print(f"\n{'closed loop (' + str(args.loop_s) + ' s)':<{width}}  {'RTF':>7}  {'us/tick':>9}")
+    for name, r in loops.items():
+        print(
+            f"{name:<{width}}  {r['real_time_factor']:>7.2f}  "
+            f"{r['seconds_per_tick'] * 1e6:>9.0f}  {r['status']}"
+        )
+    for name in ("realistic_force_tracking", "paper_force_tracking"):
+        speedup = loops[f"{name} [python]"]["wall_s"] / loops[f"{name} [core]"]["wall_s"]
+        print(f"speed-up core / python, {name} closed loop: {speedup:.1f}x")
     if args.json is not None:
+        results = {
+            "calls": {n: {"seconds": s, "ratio_to_aba": s / floor} for n, s in calls.items()},
+            "closed_loop": loops,
+        }
         args.json.write_text(json.dumps(results, indent=2))
 
 

@@ -93,13 +93,20 @@ def test_run_with_a_bad_scenario_writes_nothing(tmp_path):
         model = "{REFERENCE_URDF}"
         duration_s = 1.0
         [water]
-        current = [1, 2, 3]
+        current_velocity = [1, 2, 3]
     """)
     )
     out = tmp_path / "out"
     result = run("run", str(scenario), "--out", str(out))
     assert result.returncode == 2
-    assert "unknown key(s): current" in result.stderr
+    assert "unknown key(s): current_velocity" in result.stderr
+    assert not out.exists()
+    # [water.current] is a table: a list there is named as such
+    scenario.write_text(scenario.read_text().replace("current_velocity", "current"))
+    result = run("run", str(scenario), "--out", str(out))
+    assert result.returncode == 2
+    assert "water.current] must be a table" in result.stderr
+    assert "Traceback" not in result.stderr
     assert not out.exists()
 
 

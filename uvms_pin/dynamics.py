@@ -13,6 +13,10 @@ generalized force of external wrenches (contact, disturbances): for a wrench w a
 frame, tau_ext = J_frame^T w.
 
 Every function works in the UVMS's Pinocchio data buffer; none allocates a model.
+
+Two implementations: this module's Python code is the readable reference
+(``backend="python"``); the compiled core (`uvms_pin.core`, ``backend="core"``, the default)
+computes the same quantities in one C++ call and is held to this reference by the tests.
 """
 
 from __future__ import annotations
@@ -21,6 +25,7 @@ import numpy as np
 import pinocchio as pin
 from scipy.linalg import cho_factor, cho_solve
 
+from uvms_pin.core import check_backend, dynamics_of
 from uvms_pin.errors import ParameterError, SimulationError
 from uvms_pin.flow import FlowField, UniformCurrent
 from uvms_pin.hydro.added_mass import kirchhoff_wrench
@@ -132,8 +137,26 @@ def _fluid_wrenches(uvms: UVMS, flow: FlowField | None, time_s: float) -> list[p
     return [pin.Force(w) for w in wrench]
 
 
-def mass_matrix(uvms: UVMS, q: np.ndarray) -> np.ndarray:
-    """M(q) = M_RB(q) + sum_i J_i^T M_A,i J_i (nv x nv, symmetric positive definite)."""
+def _core_inputs(uvms: UVMS, **arrays) -> dict[str, np.ndarray]:
+    """The arguments as float arrays, or ParameterError naming the bad one (the core's
+    binding takes float arrays only: this runs only when it refused an argument)."""
+    sizes = {"q": uvms.nq, "current_world": 3}
+    return {
+        name: x if x is None else _check(name, x, sizes.get(name, uvms.nv))
+        for name, x in arrays.items()
+    }
+
+
+def mass_matrix(uvms: UVMS, q: np.ndarray, *, backend: str = "core") -> np.ndarray:
+    """M(q) = M_RB(q) + sum_i J_i^T M_A,i J_i (nv x nv, symmetric positive definite).
+
+    ``backend``: "core" (compiled, default) or "python" (the reference)."""
+    if backend == "core":
+        try:
+            return dynamics_of(uvms).mass_matrix(q)
+        except TypeError:
+            return dynamics_of(uvms).mass_matrix(**_core_inputs(uvms, q=q))
+    check_backend(backend)
     q = _check("q", q, uvms.nq)
     return _mass_matrix(uvms, q)
 
@@ -159,6 +182,7 @@ def bias_forces(
     *,
     flow: FlowField | None = None,
     time_s: float = 0.0,
+    backend: str = "core",
 ) -> np.ndarray:
     """h(q, zeta): rigid Coriolis and gravity, added-mass bias and Coriolis, damping, buoyancy,
     and, in an accelerating flow, the Froude-Krylov and added-mass loads of the flow.
@@ -169,7 +193,15 @@ def bias_forces(
             (shorthand for ``flow=UniformCurrent(current_world)``).
         flow: any `uvms_pin.flow.FlowField` (waves, sea states, varying currents).
         time_s: the time at which the flow is evaluated [s].
+        backend: "core" (compiled, default) or "python" (the reference).
     """
+    if backend == "core" and flow is None:
+        try:
+            return dynamics_of(uvms).bias_forces(q, v, current_world)
+        except TypeError:
+            args = _core_inputs(uvms, q=q, v=v, current_world=current_world)
+            return dynamics_of(uvms).bias_forces(**args)
+    check_backend(backend)
     q = _check("q", q, uvms.nq)
     v = _check("v", v, uvms.nv)
     return _bias_forces(uvms, q, v, _resolve_flow(current_world, flow), _check_time(time_s))
@@ -196,6 +228,7 @@ def forward_dynamics(
     *,
     flow: FlowField | None = None,
     time_s: float = 0.0,
+    backend: str = "core",
 ) -> np.ndarray:
     """zeta_dot = M(q)^-1 (tau + tau_ext - h(q, zeta)), by a Cholesky solve (no inverse).
 
@@ -205,11 +238,21 @@ def forward_dynamics(
         tau_ext: generalized force of external wrenches (nv,), e.g. from
             `frame_wrench_to_generalized`; None for none.
         flow, time_s: a `uvms_pin.flow.FlowField` and the time it is evaluated at [s].
+        backend: "core" (compiled, default) or "python" (the reference).
 
     Raises:
         ParameterError: wrong shape or non-finite input.
         SimulationError: M not positive definite (e.g. a degenerate model).
     """
+    if backend == "core" and flow is None:
+        try:
+            return dynamics_of(uvms).forward_dynamics(q, v, tau, current_world, tau_ext)
+        except TypeError:
+            args = _core_inputs(
+                uvms, q=q, v=v, tau=tau, current_world=current_world, tau_ext=tau_ext
+            )
+            return dynamics_of(uvms).forward_dynamics(**args)
+    check_backend(backend)
     q = _check("q", q, uvms.nq)
     v = _check("v", v, uvms.nv)
     tau = _check("tau", tau, uvms.nv)
@@ -233,10 +276,10 @@ def frame_wrench_to_generalized(
     return jac.T @ wrench_world_aligned
 
 
-def kinetic_energy(uvms: UVMS, q: np.ndarray, v: np.ndarray) -> float:
+def kinetic_energy(uvms: UVMS, q: np.ndarray, v: np.ndarray, *, backend: str = "core") -> float:
     """T = 1/2 zeta^T M(q) zeta [J], added mass (the entrained fluid) included."""
     v = _check("v", v, uvms.nv)
-    return float(0.5 * v @ mass_matrix(uvms, q) @ v)
+    return float(0.5 * v @ mass_matrix(uvms, q, backend=backend) @ v)
 
 
 def potential_energy(uvms: UVMS, q: np.ndarray) -> float:

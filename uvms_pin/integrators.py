@@ -36,6 +36,13 @@ class Integrator(ABC):
     ) -> tuple[np.ndarray, np.ndarray]:
         """Return (q, v) at t1."""
 
+    def advance_held(
+        self, compiled_plant, t0: float, q0: np.ndarray, v0: np.ndarray, tau: np.ndarray, t1: float
+    ) -> tuple[np.ndarray, np.ndarray] | None:
+        """(q, v) at t1 computed by the compiled plant with tau held, in one call; None when
+        this integrator has no compiled counterpart (then `advance` runs)."""
+        return None
+
     def advance_through(
         self,
         model: pin.Model,
@@ -91,6 +98,9 @@ class RK4(Integrator):
             q, v = self._step(model, rhs, t0 + k * h, q, v, h)
         return q, v
 
+    def advance_held(self, compiled_plant, t0, q0, v0, tau, t1):
+        return compiled_plant.advance(t0, q0, v0, tau, t1, self.step_s, True)
+
     @staticmethod
     def _step(model, rhs, t, q0, v0, h):
         a1 = rhs(t, q0, v0)
@@ -132,6 +142,9 @@ class SemiImplicitEuler(Integrator):
             v = v + h * rhs(t0 + k * h, q, v)
             q = pin.integrate(model, q, h * v)
         return q, v
+
+    def advance_held(self, compiled_plant, t0, q0, v0, tau, t1):
+        return compiled_plant.advance(t0, q0, v0, tau, t1, self.step_s, False)
 
 
 @dataclass(frozen=True)

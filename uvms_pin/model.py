@@ -129,6 +129,11 @@ class UVMS:
             -1, 6
         )
 
+    def __getstate__(self) -> dict:
+        state = dict(self.__dict__)
+        state.pop("_core_dynamics", None)  # the compiled core (C++): rebuilt on first use
+        return state
+
     # ---- sizes and aggregates -------------------------------------------------------
     @property
     def nq(self) -> int:

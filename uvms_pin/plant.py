@@ -1,22 +1,43 @@
 """The simulated world: a UVMS in water, with an environment and disturbances.
 
 `Plant.acceleration` is the right-hand side of the closed loop; the controller is not part
-of it (it sees only a `Measurement`).
+of it (it sees only a `Measurement`). `Plant.advance` moves the plant over one control period
+with the input held.
+
+With ``backend="core"`` (default) both run in the compiled core (`uvms_pin.core`): the whole
+period (every integrator stage, contact, disturbance, held tau) is one C++ call. The core
+knows the current, `LinearSpring`, `CompliantPlane` and `SinusoidalDisturbance`; a plant with
+anything else (e.g. a disturbance written in Python) runs on the Python reference, and says
+so once with a `CoreFallbackWarning`. The compiled plant reads the current, contact and
+disturbance when it is built: at `attach` (the start of every simulation) or first use.
 """
 
 from __future__ import annotations
 
+import warnings
 from dataclasses import dataclass, field
 
 import numpy as np
 import pinocchio as pin
 
 from uvms_pin.actuation import Actuation, Unlimited
+from uvms_pin.core import check_backend, core_module, dynamics_of
 from uvms_pin.dynamics import forward_dynamics
-from uvms_pin.environment import ContactModel, Disturbance
+from uvms_pin.environment import (
+    CompliantPlane,
+    ContactModel,
+    Disturbance,
+    LinearSpring,
+    SinusoidalDisturbance,
+)
 from uvms_pin.errors import ParameterError, SimulationError
 from uvms_pin.flow import FlowField, SumFlow, UniformCurrent
+from uvms_pin.integrators import Integrator
 from uvms_pin.model import UVMS
+
+
+class CoreFallbackWarning(UserWarning):
+    """A plant the compiled core cannot represent runs on the (slower) Python reference."""
 
 
 @dataclass
@@ -31,6 +52,7 @@ class Plant:
         actuation: thrusters and joint limits between the commanded and applied tau.
         flow: waves, sea states or varying currents (`uvms_pin.flow`), added to the
             uniform current; None for none.
+        backend: "core" (compiled, default) or "python" (the reference implementation).
     """
 
     uvms: UVMS
@@ -39,6 +61,7 @@ class Plant:
     disturbance: Disturbance | None = None
     actuation: Actuation = field(default_factory=Unlimited)
     flow: FlowField | None = None
+    backend: str = "core"
 
     def __post_init__(self) -> None:
         c = np.asarray(self.current_world_m_s, dtype=float).reshape(-1)
@@ -51,6 +74,7 @@ class Plant:
             self.uvms.require_ee_frame("a contact environment (at the end-effector)")
         if self.flow is not None and not isinstance(self.flow, FlowField):
             raise ParameterError(f"flow must be a FlowField, got {type(self.flow).__name__}")
+        check_backend(self.backend)
         self._ee_data = self.uvms.model.createData()
         self._flow = self.water_flow
 
@@ -88,6 +112,62 @@ class Plant:
                     f"(eta = {eta:.3g} m); the model holds for submerged bodies only"
                 )
 
+    def __getstate__(self) -> dict:
+        state = dict(self.__dict__)
+        state.pop("_compiled", None)  # a C++ object: rebuilt on first use after unpickling
+        return state
+
+    # ---- the compiled plant -----------------------------------------------------------
+    def _unsupported(self) -> str | None:
+        """What the core cannot represent, or None."""
+        if self.contact is not None and type(self.contact) not in (LinearSpring, CompliantPlane):
+            return f"contact model {type(self.contact).__name__}"
+        if self.disturbance is not None and type(self.disturbance) is not SinusoidalDisturbance:
+            return f"disturbance {self.disturbance!r}"
+        if self.flow is not None:
+            return f"flow {self.flow!r}"
+        return None
+
+    def _build_compiled(self):
+        """The compiled plant mirroring this one, or None (Python path)."""
+        if self.backend != "core":
+            return None
+        unsupported = self._unsupported()
+        if unsupported is not None:
+            warnings.warn(
+                f"the compiled core does not support the {unsupported}: this plant runs on "
+                "the Python reference (slower)",
+                CoreFallbackWarning,
+                stacklevel=3,
+            )
+            return None
+        compiled = core_module().Plant(dynamics_of(self.uvms), self.uvms.ee_frame_id)
+        compiled.set_current(self.current_world_m_s)
+        contact = self.contact
+        if isinstance(contact, LinearSpring):
+            if contact._anchor is None:
+                return None  # not attached: the Python path raises the error
+            compiled.set_spring(contact.stiffness_N_m, contact._anchor)
+        elif isinstance(contact, CompliantPlane):
+            if contact._point is None:
+                return None
+            compiled.set_plane(
+                contact.normal_world,
+                contact._point,
+                float(contact.stiffness_N_m),
+                float(contact.damping_N_s_m),
+            )
+        if self.disturbance is not None:
+            d = self.disturbance
+            compiled.set_sinusoidal_disturbance(d.amplitude, float(d.period_s), float(d.phase_rad))
+        return compiled
+
+    def _core(self):
+        if "_compiled" not in self.__dict__:
+            self._compiled = self._build_compiled()
+        return self._compiled
+
+    # ---- kinematics of the tip ----------------------------------------------------------
     def ee_state(self, q: np.ndarray, v: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """End-effector position, linear velocity (world) and its LOCAL_WORLD_ALIGNED Jacobian."""
         model, data, fid = self.uvms.model, self._ee_data, self.uvms.ee_frame_id
@@ -97,15 +177,20 @@ class Plant:
         return position, velocity, data
 
     def attach(self, q0: np.ndarray) -> None:
-        """Anchor the environment at the initial end-effector position."""
+        """Anchor the environment at the initial end-effector position (and (re)build the
+        compiled plant from the current fields)."""
         if self.contact is not None:
             position, _, _ = self.ee_state(q0, np.zeros(self.uvms.nv))
             self.contact.attach(position)
+        self.__dict__.pop("_compiled", None)
 
     def contact_wrench(self, q: np.ndarray, v: np.ndarray) -> np.ndarray:
         """lambda (6,): the wrench the end-effector exerts on the environment, world axes."""
         if self.contact is None:
             return np.zeros(6)
+        compiled = self._core()
+        if compiled is not None:
+            return compiled.contact_wrench(q, v)
         position, velocity, _ = self.ee_state(q, v)
         return self.contact.wrench_on_environment_world(position, velocity)
 
@@ -116,6 +201,7 @@ class Plant:
             else np.asarray(self.disturbance(time_s), dtype=float)
         )
 
+    # ---- dynamics -----------------------------------------------------------------------
     def acceleration(
         self,
         time_s: float,
@@ -125,6 +211,9 @@ class Plant:
         contact_world: np.ndarray | None = None,
     ) -> np.ndarray:
         """zeta_dot of  M zeta_dot + h + J_c^T lambda + delta = tau  (docs/physics.md)."""
+        compiled = self._core()
+        if compiled is not None:
+            return compiled.acceleration(time_s, q, v, tau, contact_world)
         model = self.uvms.model
         tau_ext = np.zeros(model.nv)
         if self.contact is not None:
@@ -138,5 +227,27 @@ class Plant:
             # the free-flyer's LOCAL Jacobian is [I 0]: a body wrench maps to tau[:6] directly
             tau_ext[:6] -= self.disturbance_wrench(time_s)
         return forward_dynamics(
-            self.uvms, q, v, tau, tau_ext=tau_ext, flow=self._flow, time_s=time_s
+            self.uvms, q, v, tau, tau_ext=tau_ext, flow=self._flow, time_s=time_s, backend=self.backend
+        )
+
+    def advance(
+        self,
+        integrator: Integrator,
+        t0: float,
+        q0: np.ndarray,
+        v0: np.ndarray,
+        tau: np.ndarray,
+        t1: float,
+    ) -> tuple[np.ndarray, np.ndarray]:
+        """(q, v) at t1 from (q0, v0) at t0 with the input tau held (zero-order hold).
+
+        One compiled call for the whole interval when the integrator has a compiled
+        counterpart (RK4, semi-implicit Euler); the integrator's Python loop otherwise."""
+        compiled = self._core()
+        if compiled is not None:
+            out = integrator.advance_held(compiled, t0, q0, v0, tau, t1)
+            if out is not None:
+                return out
+        return integrator.advance(
+            self.uvms.model, lambda t, q, v: self.acceleration(t, q, v, tau), t0, q0, v0, t1
         )

@@ -29,6 +29,7 @@ from uvms_pin.actuation import Actuation, Thruster, ThrustersAndJointLimits, Unl
 from uvms_pin.controllers.base import Controller, ZeroController
 from uvms_pin.controllers.custom import ControllerSpec, class_path, custom_controller
 from uvms_pin.controllers.ppc import PPCParams, PrescribedPerformanceController
+from uvms_pin.core import BACKENDS
 from uvms_pin.environment import CompliantPlane, ContactModel, LinearSpring, SinusoidalDisturbance
 from uvms_pin.errors import ParameterError, ScenarioError, UvmsPinError
 from uvms_pin.flow import (
@@ -301,9 +302,9 @@ def _build(raw: dict[str, Any], path: Path, source: str, overridden: dict[str, s
     contact = _environment(top.table("environment"), uvms)
     disturbance = _disturbance(top.table("disturbance"))
     actuation = _actuation(top.table("actuation"), uvms)
-    plant = Plant(uvms, current, contact, disturbance, actuation, flow)
     sensor_config = _sensors(top.table("sensors") or _Table({}, "sensors", source))
-    integrator = _integrator(top.table("integrator") or _Table({}, "integrator", source))
+    integrator, backend = _integrator(top.table("integrator") or _Table({}, "integrator", source))
+    plant = Plant(uvms, current, contact, disturbance, actuation, flow=flow, backend=backend)
 
     control = top.table("control") or _Table({}, "control", source)
     control_period = control.optional_number("period_s", positive=True)
@@ -543,7 +544,9 @@ def _actuation(t: _Table | None, uvms: UVMS) -> Actuation:
 _FIXED_STEP = {"rk4": RK4, "semi_implicit_euler": SemiImplicitEuler}
 
 
-def _integrator(t: _Table) -> Integrator:
+def _integrator(t: _Table) -> tuple[Integrator, str]:
+    """The integrator and the plant's backend ("core": compiled, "python": the reference)."""
+    backend = t.string("backend", "core", BACKENDS)
     method = t.string("method", "rk4", (*_FIXED_STEP, *Adaptive._METHODS))
     if method in _FIXED_STEP:
         out = _FIXED_STEP[method](t.number("step_s", 1e-3, positive=True))
@@ -555,7 +558,7 @@ def _integrator(t: _Table) -> Integrator:
             max_step_s=t.number("max_step_s", math.inf, positive=True),
         )
     t.finish()
-    return out
+    return out, backend
 
 
 def _controller(t: _Table | None, uvms: UVMS, scenario_dir: Path) -> ControllerSpec:

@@ -226,9 +226,6 @@ def simulate_closed_loop(
         contact = plant.contact_wrench(q, v)
         return sensors.measure(t, q, v, contact), contact
 
-    def held_rhs(tau: np.ndarray) -> Callable:
-        return lambda t, q, v: plant.acceleration(t, q, v, tau)
-
     def command(t: float, measurement) -> tuple[np.ndarray, np.ndarray]:
         tau = np.asarray(controller.compute(t, measurement), dtype=float)
         if tau.shape != (model.nv,) or not np.all(np.isfinite(tau)):
@@ -254,7 +251,7 @@ def simulate_closed_loop(
         rollout.wrench_contact_world[k] = contact
         rollout.wrench_measured_world[k] = measured
         rollout.wrench_disturbance_body[k] = plant.disturbance_wrench(t)
-        rollout.kinetic_energy_J[k] = kinetic_energy(uvms, q, v)
+        rollout.kinetic_energy_J[k] = kinetic_energy(uvms, q, v, backend=plant.backend)
         rollout.potential_energy_J[k] = potential_energy(uvms, q)
         for name, values in controller.signals().items():
             rollout.signal(name, values.size)[k] = values
@@ -336,9 +333,7 @@ def simulate_closed_loop(
                 if tick == n_ticks:
                     break
                 span[:] = t, t + tick_s
-                q, v = settings.integrator.advance(
-                    model, held_rhs(tau_applied), t, q, v, t + tick_s
-                )
+                q, v = plant.advance(settings.integrator, t, q, v, tau_applied, t + tick_s)
                 check_finite(t, t + tick_s, q, v)
     except _NUMERICAL_FAILURES as exc:
         error = SimulationError(

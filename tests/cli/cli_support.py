@@ -66,7 +66,7 @@ def passive_scenario(duration_s: float = 0.1, **replace: str) -> str:
     text = (
         (ROOT / "scenarios" / "passive_current.toml")
         .read_text()
-        .replace("../models/uvms_lbv150.urdf", str(URDF))
+        .replace('"uvms_lbv150"', f'"{URDF}"')
         .replace("duration_s = 20.0", f"duration_s = {duration_s}")
     )
     for old, new in replace.items():

@@ -80,10 +80,10 @@ CASES = [
     Case("run-missing-scenario", ("run", "nope.toml", "--out", "prior"), ("nope.toml", "file not found")),
     Case("run-not-utf8", ("run", "s.toml", "--out", "prior"), ("s.toml", "not UTF-8"), _write("s.toml", b"\xff\xfe[scenario]\n")),
     Case("run-invalid-toml", ("run", "s.toml", "--out", "prior"), ("s.toml", "not valid TOML"), _write("s.toml", "[scenario\n")),
-    Case("run-unknown-key", ("run", "s.toml", "--out", "prior"), ("s.toml", "[water]", "unknown key(s): current"), _write("s.toml", GOOD_BUT(**{"[water]\n": "[water]\ncurrent = [1, 2, 3]\n"}))),
+    Case("run-unknown-key", ("run", "s.toml", "--out", "prior"), ("s.toml", "[water]", "unknown key(s): current_velocity"), _write("s.toml", GOOD_BUT(**{"[water]\n": "[water]\ncurrent_velocity = [1, 2, 3]\n"}))),
     Case("run-scenario-is-a-directory", ("run", "sdir", "--out", "prior"), ("sdir", "is a directory"), _mkdir("sdir")),
     Case("run-negative-duration", ("run", "s.toml", "--out", "prior"), ("s.toml", "duration_s", "must be positive"), _write("s.toml", GOOD_BUT(-1.0))),
-    Case("run-missing-model", ("run", "s.toml", "--out", "prior"), ("missing.urdf", "file not found"), _write("s.toml", GOOD_BUT(**{str(URDF): "missing.urdf"}))),
+    Case("run-missing-model", ("run", "s.toml", "--out", "prior"), ("missing.urdf", "neither a file relative to the scenario"), _write("s.toml", GOOD_BUT(**{str(URDF): "missing.urdf"}))),
     Case("run-urdfdom-error", ("run", "s.toml", "--out", "prior"), ("bad.urdf", "does not specify limits"), _steps(_write("bad.urdf", BAD_URDF), _write("s.toml", GOOD_BUT(**{str(URDF): "bad.urdf"})))),
     Case("run-bad-overwrite-keeps-results", ("run", "nope.toml", "--out", "prior", "--overwrite"), ("nope.toml", "file not found")),
     # ---- run: the output directory and options ---------------------------------------

@@ -1,0 +1,187 @@
+#include "dynamics.hpp"
+
+#include <pinocchio/algorithm/crba.hpp>
+#include <pinocchio/algorithm/kinematics.hpp>
+#include <pinocchio/algorithm/rnea.hpp>
+
+#include "added_mass.hpp"
+#include "damping.hpp"
+#include "restoring.hpp"
+
+namespace uvms {
+
+Dynamics::Dynamics(Model model, HydroBodies hydro)
+    : model_(std::move(model)), data_(model_), hydro_(std::move(hydro)) {
+  const auto nj = static_cast<std::size_t>(model_.njoints);
+  if (hydro_.added_mass_per_joint.size() != nj || hydro_.volume_per_joint_m3.size() != nj ||
+      hydro_.center_of_buoyancy_per_joint_m.size() != nj) {
+    throw InputError("per-joint hydrodynamic arrays must have njoints = " +
+                     std::to_string(nj) + " entries");
+  }
+  for (const auto& body : hydro_.damped_bodies) {
+    if (body.joint_id < 0 || body.joint_id >= model_.njoints) {
+      throw InputError("damped body on joint " + std::to_string(body.joint_id) +
+                       ", which the model does not have");
+    }
+  }
+  prepare();
+}
+
+Dynamics::Dynamics(const Dynamics& other)
+    : model_(other.model_), data_(other.model_), hydro_(other.hydro_) {
+  prepare();
+}
+
+void Dynamics::prepare() {
+  const int nj = model_.njoints, nv = model_.nv;
+  joints_with_added_mass_.clear();
+  joints_with_volume_.clear();
+  support_width_.assign(nj, -1);
+  for (int j = 1; j < nj; ++j) {
+    if (!hydro_.added_mass_per_joint[j].isZero(0.0)) joints_with_added_mass_.push_back(j);
+    if (hydro_.volume_per_joint_m3[j] != 0.0) joints_with_volume_.push_back(j);
+    // the support of a joint in a chain is the leading block of columns: J^T M_A J touches
+    // only that block
+    int count = 0;
+    for (auto k : model_.supports[j]) count += k == 0 ? 0 : model_.joints[k].nv();
+    const int width = model_.joints[j].idx_v() + model_.joints[j].nv();
+    if (count == width) support_width_[j] = width;
+  }
+  fext_.assign(nj, pinocchio::Force::Zero());
+  zero_ = Eigen::VectorXd::Zero(nv);
+  h_ = Eigen::VectorXd::Zero(nv);
+  rhs_ = Eigen::VectorXd::Zero(nv);
+  acceleration_ = Eigen::VectorXd::Zero(nv);
+  mass_ = Eigen::MatrixXd::Zero(nv, nv);
+  jacobian_ = Eigen::Matrix<double, 6, Eigen::Dynamic>::Zero(6, nv);
+  added_times_jacobian_ = Eigen::Matrix<double, 6, Eigen::Dynamic>::Zero(6, nv);
+  cholesky_ = Eigen::LLT<Eigen::MatrixXd>(nv);
+  prepare_articulated();
+}
+
+void Dynamics::kinematics(const ConstVec& q, const ConstVec& v) {
+  pinocchio::forwardKinematics(model_, data_, q, v, ConstVec(zero_));
+}
+
+void Dynamics::fluid_wrenches(double time_s, const FlowField& flow,
+                              bool with_bias_acceleration) {
+  for (auto& f : fext_) f.setZero();
+  const Vec3 gravity = model_.gravity.linear();
+  for (int j : joints_with_added_mass_) {
+    const auto& placement = data_.oMi[j];
+    const Vec6 velocity = data_.v[j].toVector();
+    const FlowInBody seen = flow_in_body(flow.at(time_s, placement.translation()),
+                                         placement.rotation(), velocity.tail<3>());
+    const Vec6 bias = with_bias_acceleration ? data_.a[j].toVector() : Vec6::Zero();
+    fext_[j].toVector() +=
+        added_mass_wrench(hydro_.added_mass_per_joint[j], bias, velocity, seen);
+  }
+  for (int j : joints_with_volume_) {
+    fext_[j].toVector() += buoyancy_wrench(
+        hydro_.volume_per_joint_m3[j], hydro_.center_of_buoyancy_per_joint_m[j],
+        data_.oMi[j].rotation(), hydro_.water_density_kg_m3, gravity);
+  }
+  for (const auto& body : hydro_.damped_bodies) {
+    const auto& placement = data_.oMi[body.joint_id];
+    const Mat3 rotation = placement.rotation() * body.rotation_in_joint;
+    const Vec3 point = placement.act(body.position_in_joint_m);
+    const Vec6 nu_r = body.action_joint_to_body * data_.v[body.joint_id].toVector() -
+                      flow_velocity_in_body(flow.at(time_s, point), rotation);
+    const Vec6 wrench_body =
+        damping_wrench(body.linear_damping, body.quadratic_damping, nu_r);
+    fext_[body.joint_id].toVector() += body.action_joint_to_body.transpose() * wrench_body;
+  }
+}
+
+void Dynamics::add_world_wrench(int joint_id, const Vec3& point_world_m,
+                                const Vec6& wrench_world) {
+  // the same wrench about the world origin, then into the joint frame
+  const pinocchio::Force about_origin(
+      wrench_world.head<3>(),
+      wrench_world.tail<3>() + point_world_m.cross(Vec3(wrench_world.head<3>())));
+  fext_[joint_id] += data_.oMi[joint_id].actInv(about_origin);
+}
+
+void Dynamics::add_local_wrench(int joint_id, const Vec6& wrench_local) {
+  fext_[joint_id].toVector() += wrench_local;
+}
+
+const Eigen::VectorXd& Dynamics::bias_from_wrenches(const ConstVec& q,
+                                                    const ConstVec& v) {
+  h_ = pinocchio::rnea(model_, data_, q, v, ConstVec(zero_), fext_);
+  return h_;
+}
+
+const Eigen::MatrixXd& Dynamics::mass_matrix(const ConstVec& q) {
+  pinocchio::crba(model_, data_, q, pinocchio::Convention::WORLD);
+  mass_ = data_.M;
+  mass_.triangularView<Eigen::StrictlyLower>() = mass_.transpose();  // crba fills the upper
+  for (int j : joints_with_added_mass_) {
+    const int width = support_width_[j] > 0 ? support_width_[j] : model_.nv;
+    const auto& placement = data_.oMi[j];
+    // LOCAL Jacobian of joint j from crba's world-frame columns (zero outside the support)
+    for (int c = 0; c < width; ++c) {
+      jacobian_.col(c) = placement.actInv(pinocchio::Motion(data_.J.col(c))).toVector();
+    }
+    if (support_width_[j] < 0) {
+      jacobian_.setZero();
+      for (auto k : model_.supports[j]) {
+        if (k == 0) continue;
+        const auto& joint = model_.joints[k];
+        for (int c = joint.idx_v(); c < joint.idx_v() + joint.nv(); ++c) {
+          jacobian_.col(c) = placement.actInv(pinocchio::Motion(data_.J.col(c))).toVector();
+        }
+      }
+    }
+    auto block = jacobian_.leftCols(width);
+    added_times_jacobian_.leftCols(width).noalias() = hydro_.added_mass_per_joint[j] * block;
+    mass_.topLeftCorner(width, width).noalias() +=
+        block.transpose() * added_times_jacobian_.leftCols(width);
+  }
+  return mass_;
+}
+
+const Eigen::VectorXd& Dynamics::solve(const ConstVec& q, const ConstVec& rhs) {
+  cholesky_.compute(mass_matrix(q));
+  if (cholesky_.info() != Eigen::Success) {
+    throw SimulationFailure("mass matrix is not positive definite");
+  }
+  acceleration_ = rhs;
+  cholesky_.solveInPlace(acceleration_);
+  return acceleration_;
+}
+
+const Eigen::VectorXd& Dynamics::bias_forces(const ConstVec& q, const ConstVec& v,
+                                             const FlowField& flow) {
+  kinematics(q, v);
+  fluid_wrenches(0.0, flow, true);
+  return bias_from_wrenches(q, v);
+}
+
+const Eigen::VectorXd& Dynamics::accelerations(const ConstVec& q, const ConstVec& v,
+                                               const ConstVec& tau, const ConstVec* tau_ext) {
+  if (articulated_) {
+    if (tau_ext == nullptr) {
+      articulated_body_pass(tau);
+    } else {
+      rhs_ = tau + *tau_ext;
+      articulated_body_pass(rhs_);
+    }
+    return acceleration_;
+  }
+  rhs_ = tau - bias_from_wrenches(q, v);
+  if (tau_ext != nullptr) rhs_ += *tau_ext;
+  return solve(q, rhs_);
+}
+
+const Eigen::VectorXd& Dynamics::forward_dynamics(const ConstVec& q,
+                                                  const ConstVec& v,
+                                                  const ConstVec& tau,
+                                                  const FlowField& flow,
+                                                  const ConstVec* tau_ext) {
+  kinematics(q, v);
+  fluid_wrenches(0.0, flow, needs_bias_acceleration());
+  return accelerations(q, v, tau, tau_ext);
+}
+
+}  // namespace uvms

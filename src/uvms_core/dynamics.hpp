@@ -1,0 +1,106 @@
+// Underwater dynamics of a UVMS (mirror of uvms_pin/dynamics.py):
+//
+//   M(q) zeta_dot + h(q, zeta) = tau + tau_ext
+//   M = M_RB + sum_i J_i^T M_A,i J_i
+//   h = C_RB zeta + g_RB - sum_i J_i^T [ -M_A,i (a_i - nu_c_dot,i) - C_A,i(nu_r,i) nu_r,i
+//                                         - D_i(nu_r,i) nu_r,i + w_buoy,i ]
+//
+// Forward dynamics runs an articulated-body pass (articulated_body.cpp) in which each body's
+// inertia is the generalized spatial inertia I_i + M_A,i: the added mass is exact and inside
+// M, in O(n), after one kinematics pass. Models with a joint whose motion subspace depends on
+// q (none in the shipped ones) use M by CRBA and h by RNEA, then a Cholesky solve.
+//
+// One object per model: the Pinocchio model (static) plus its work buffers (no allocation
+// per call). Not thread-safe, like uvms.data.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include <Eigen/Cholesky>
+#include <pinocchio/multibody/data.hpp>
+#include <pinocchio/multibody/model.hpp>
+
+#include "flow.hpp"
+#include "hydro_bodies.hpp"
+
+namespace uvms {
+
+using Model = pinocchio::Model;
+using Data = pinocchio::Data;
+using ForceVector = pinocchio::container::aligned_vector<pinocchio::Force>;
+// read-only vectors, passed without copies (and the types libpinocchio_default instantiates)
+using ConstVec = Eigen::Ref<const Eigen::VectorXd>;
+
+class Dynamics {
+ public:
+  Dynamics(Model model, HydroBodies hydro);
+  Dynamics(const Dynamics& other);
+
+  const Model& model() const { return model_; }
+  int nq() const { return model_.nq; }
+  int nv() const { return model_.nv; }
+
+  // Kinematics at (q, zeta, zeta_dot = 0): placements, body velocities, bias accelerations.
+  void kinematics(const ConstVec& q, const ConstVec& v);
+  // After kinematics(): the wrench of the water on each joint body (LOCAL), all but M_A zeta_dot
+  // (with_bias_acceleration: also -M_A a_bias, as h needs; the articulated pass does not).
+  void fluid_wrenches(double time_s, const FlowField& flow, bool with_bias_acceleration);
+  // After kinematics() and the wrenches: zeta_dot for tau (+ tau_ext), by the articulated
+  // pass when the model allows it, else h, M and Cholesky.
+  const Eigen::VectorXd& accelerations(const ConstVec& q, const ConstVec& v, const ConstVec& tau,
+                                       const ConstVec* tau_ext);
+  // Whether fluid_wrenches must include -M_A a_bias before accelerations().
+  bool needs_bias_acceleration() const { return !articulated_; }
+  // After fluid_wrenches(): add a wrench given at a world point in world axes to joint j.
+  void add_world_wrench(int joint_id, const Vec3& point_world_m, const Vec6& wrench_world);
+  // Add a wrench given in joint j's own frame (e.g. a body wrench on the vehicle).
+  void add_local_wrench(int joint_id, const Vec6& wrench_local);
+  // h(q, zeta) - sum_i J_i^T fext_i from the wrenches accumulated above.
+  const Eigen::VectorXd& bias_from_wrenches(const ConstVec& q, const ConstVec& v);
+  // M(q), symmetric, added mass included.
+  const Eigen::MatrixXd& mass_matrix(const ConstVec& q);
+  // zeta_dot = M^-1 rhs, by Cholesky (throws SimulationFailure if M is not SPD).
+  const Eigen::VectorXd& solve(const ConstVec& q, const ConstVec& rhs);
+
+  // The public operations of uvms_pin.dynamics.
+  const Eigen::VectorXd& bias_forces(const ConstVec& q, const ConstVec& v,
+                                     const FlowField& flow);
+  const Eigen::VectorXd& forward_dynamics(const ConstVec& q, const ConstVec& v,
+                                          const ConstVec& tau, const FlowField& flow,
+                                          const ConstVec* tau_ext);
+
+  Data& data() { return data_; }
+
+ private:
+  void prepare();
+  void prepare_articulated();                        // articulated_body.cpp
+  void articulated_body_pass(const ConstVec& tau);  // articulated_body.cpp
+
+  Model model_;
+  Data data_;
+  HydroBodies hydro_;
+  std::vector<int> joints_with_added_mass_;
+  std::vector<int> joints_with_volume_;
+  std::vector<int> support_width_;  // columns 0..w-1 hold joint j's support (a chain); -1: tree
+  ForceVector fext_;
+  Eigen::VectorXd zero_, h_, rhs_, acceleration_;
+  Eigen::MatrixXd mass_;
+  Eigen::Matrix<double, 6, Eigen::Dynamic> jacobian_, added_times_jacobian_;
+  Eigen::LLT<Eigen::MatrixXd> cholesky_;
+
+  // articulated-body pass: constant motion subspaces and per-joint buffers
+  using Subspace = Eigen::Matrix<double, 6, Eigen::Dynamic, 0, 6, 6>;
+  using Small = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, 6, 6>;
+  bool articulated_ = false;
+  std::vector<Subspace, Eigen::aligned_allocator<Subspace>> subspace_, u_mat_, u_dinv_;
+  std::vector<Small, Eigen::aligned_allocator<Small>> dinv_;
+  aligned_vector<Mat6> inertia_a_;
+  aligned_vector<Vec6> bias_a_, bias_acc_, acc_;
+  std::vector<Eigen::Matrix<double, Eigen::Dynamic, 1, 0, 6, 1>> u_vec_;
+};
+
+// Model from the text archive of Python's pin.Model.saveToString() (model_io.cpp).
+Model model_from_text(const std::string& text);
+
+}  // namespace uvms

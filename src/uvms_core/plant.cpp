@@ -1,0 +1,72 @@
+#include "plant.hpp"
+
+#include <pinocchio/algorithm/frames.hpp>
+#include <pinocchio/algorithm/kinematics.hpp>
+
+namespace uvms {
+
+Plant::Plant(const Dynamics& dynamics, int ee_frame_id)
+    : dynamics_(dynamics), stepper_(dynamics_.model()) {
+  const auto& model = dynamics_.model();
+  if (ee_frame_id < 0 || ee_frame_id >= static_cast<int>(model.nframes)) {
+    throw InputError("end-effector frame " + std::to_string(ee_frame_id) +
+                     " is not a frame of the model");
+  }
+  ee_frame_id_ = static_cast<pinocchio::FrameIndex>(ee_frame_id);
+  ee_joint_id_ = model.frames[ee_frame_id_].parentJoint;
+}
+
+namespace {
+
+// Tip position and linear velocity (world) after the dynamics' kinematics pass.
+std::pair<Vec3, Vec3> tip_state(const Model& model, Data& data, pinocchio::FrameIndex frame) {
+  const Vec3 position = pinocchio::updateFramePlacement(model, data, frame).translation();
+  const Vec3 velocity =
+      pinocchio::getFrameVelocity(model, data, frame, pinocchio::LOCAL_WORLD_ALIGNED).linear();
+  return {position, velocity};
+}
+
+}  // namespace
+
+Vec6 Plant::contact_wrench(const ConstVec& q, const ConstVec& v) {
+  if (!has_contact(contact)) return Vec6::Zero();
+  dynamics_.kinematics(q, v);
+  const auto [position, velocity] = tip_state(dynamics_.model(), dynamics_.data(), ee_frame_id_);
+  return contact_wrench_world(contact, position, velocity);
+}
+
+const Eigen::VectorXd& Plant::acceleration(double time_s, const ConstVec& q, const ConstVec& v,
+                                           const ConstVec& tau, const Vec6* contact_world) {
+  dynamics_.kinematics(q, v);
+  dynamics_.fluid_wrenches(time_s, flow, dynamics_.needs_bias_acceleration());
+  if (has_contact(contact)) {
+    const auto [position, velocity] =
+        tip_state(dynamics_.model(), dynamics_.data(), ee_frame_id_);
+    const Vec6 lambda = contact_world != nullptr
+                            ? *contact_world
+                            : contact_wrench_world(contact, position, velocity);
+    // the robot receives -lambda at the tip
+    dynamics_.add_world_wrench(static_cast<int>(ee_joint_id_), position, -lambda);
+  }
+  if (disturbance) {
+    // delta acts against tau on the vehicle body (joint 1, free-flyer: LOCAL Jacobian [I 0])
+    dynamics_.add_local_wrench(1, -disturbance->at(time_s));
+  }
+  return dynamics_.accelerations(q, v, tau, nullptr);
+}
+
+std::pair<Eigen::VectorXd, Eigen::VectorXd> Plant::advance(double t0, const ConstVec& q0,
+                                                           const ConstVec& v0,
+                                                           const ConstVec& tau, double t1,
+                                                           double max_step_s, bool rk4) {
+  stepper_.q = q0;
+  stepper_.v = v0;
+  auto rhs = [&](double t, const Eigen::VectorXd& q,
+                 const Eigen::VectorXd& v) -> const Eigen::VectorXd& {
+    return acceleration(t, q, v, tau);
+  };
+  stepper_.advance(rhs, t0, t1, max_step_s, rk4);
+  return {stepper_.q, stepper_.v};
+}
+
+}  // namespace uvms

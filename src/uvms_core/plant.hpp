@@ -1,0 +1,45 @@
+// The simulated world (mirror of uvms_pin/plant.py): a UVMS in a flow, touching a compliant
+// environment at its end-effector and pushed by a disturbance:
+//   M zeta_dot + h + J_c^T lambda + [delta; 0] = tau.
+// It advances the plant over one control period with the input held, in one call.
+#pragma once
+
+#include <utility>
+
+#include "contact.hpp"
+#include "disturbance.hpp"
+#include "dynamics.hpp"
+#include "integrators.hpp"
+
+namespace uvms {
+
+class Plant {
+ public:
+  Plant(const Dynamics& dynamics, int ee_frame_id);
+  Plant(const Plant&) = delete;
+  Plant& operator=(const Plant&) = delete;
+
+  FlowField flow;
+  Contact contact;
+  Disturbance disturbance;
+
+  // lambda at (q, v): what the end-effector exerts on the environment [N; N m], world axes.
+  Vec6 contact_wrench(const ConstVec& q, const ConstVec& v);
+  // zeta_dot; contact_world given = use it instead of the contact model (continuous loop).
+  const Eigen::VectorXd& acceleration(double time_s, const ConstVec& q, const ConstVec& v,
+                                      const ConstVec& tau, const Vec6* contact_world = nullptr);
+  // (q, v) at t1 from (q0, v0) at t0 with tau held; rk4 or semi-implicit Euler substeps.
+  std::pair<Eigen::VectorXd, Eigen::VectorXd> advance(double t0, const ConstVec& q0,
+                                                      const ConstVec& v0, const ConstVec& tau,
+                                                      double t1, double max_step_s, bool rk4);
+
+  Dynamics& dynamics() { return dynamics_; }
+
+ private:
+  Dynamics dynamics_;
+  pinocchio::FrameIndex ee_frame_id_;
+  pinocchio::JointIndex ee_joint_id_;
+  ManifoldStepper stepper_;
+};
+
+}  // namespace uvms

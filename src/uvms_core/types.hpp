@@ -1,0 +1,25 @@
+// Fixed-size spatial types shared by the core's units (Pinocchio order: [linear; angular]).
+#pragma once
+
+#include <Eigen/Core>
+#include <stdexcept>
+#include <string>
+
+namespace uvms {
+
+using Vec3 = Eigen::Vector3d;
+using Vec6 = Eigen::Matrix<double, 6, 1>;
+using Mat3 = Eigen::Matrix3d;
+using Mat6 = Eigen::Matrix<double, 6, 6>;
+
+// Bad input from the caller (shape, non-finite value): ParameterError on the Python side.
+struct InputError : std::invalid_argument {
+  using std::invalid_argument::invalid_argument;
+};
+
+// The simulation cannot continue (e.g. M not positive definite): SimulationError in Python.
+struct SimulationFailure : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
+}  // namespace uvms

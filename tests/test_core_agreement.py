@@ -1,0 +1,158 @@
+"""The compiled core against the Python reference (its oracle): 1e-12 relative on random states.
+
+Reference model and three mounted example-robot-data arms; with and without a current; with
+external generalized forces, the spring and plane contacts and the sinusoidal disturbance; the
+plant advanced over a control period by RK4 and semi-implicit Euler.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from conftest import REFERENCE_URDF, random_configuration
+
+import uvms_pin as up
+from uvms_pin.arms.catalog import CATALOG
+from uvms_pin.arms.reference import split_urdf
+from uvms_pin.environment import CompliantPlane, LinearSpring, SinusoidalDisturbance
+from uvms_pin.integrators import RK4, SemiImplicitEuler
+from uvms_pin.plant import Plant
+from uvms_pin.resources import example_robot_data_dir
+
+REL = 1e-12
+ERD_ARMS = ("ur5", "panda", "z1")
+
+
+def assert_rel(actual: np.ndarray, expected: np.ndarray, rel: float = REL) -> None:
+    """max |a - e| <= rel * max |e| (relative to the size of the whole quantity)."""
+    scale = max(float(np.max(np.abs(expected))), 1e-300)
+    err = float(np.max(np.abs(actual - expected)))
+    assert err <= rel * scale, f"relative error {err / scale:.3g} > {rel:g}"
+
+
+@pytest.fixture(scope="module")
+def mounted_arms(tmp_path_factory):
+    if example_robot_data_dir() is None:
+        pytest.skip("example-robot-data is not installed")
+    split = split_urdf(REFERENCE_URDF, tmp_path_factory.mktemp("split"))
+    pose = (split.mount_pose.translation, (np.pi, 0.0, 0.0))
+    return {
+        name: up.mount_arm(
+            split.vehicle_urdf,
+            CATALOG[name].urdf,
+            pose,
+            ee_link=CATALOG[name].ee_link,
+            allow_dry_links=True,
+        )
+        for name in ERD_ARMS
+    }
+
+
+def _models(reference_uvms, mounted_arms):
+    return {"reference": reference_uvms, **mounted_arms}
+
+
+@pytest.mark.parametrize("current", [(0.0, 0.0, 0.0), (0.3, -0.2, 0.1)])
+def test_dynamics_match_the_reference(reference_uvms, mounted_arms, current):
+    rng = np.random.default_rng(9)
+    current = np.array(current)
+    for name, uvms in _models(reference_uvms, mounted_arms).items():
+        assert uvms.nv >= (10 if name == "reference" else 12), name
+        for _ in range(5):
+            q = random_configuration(uvms, rng)
+            v = rng.normal(scale=0.5, size=uvms.nv)
+            tau = rng.normal(scale=5.0, size=uvms.nv)
+            tau_ext = rng.normal(scale=2.0, size=uvms.nv)
+            assert_rel(up.mass_matrix(uvms, q), up.mass_matrix(uvms, q, backend="python"))
+            assert_rel(
+                up.bias_forces(uvms, q, v, current),
+                up.bias_forces(uvms, q, v, current, backend="python"),
+            )
+            for ext in (None, tau_ext):
+                assert_rel(
+                    up.forward_dynamics(uvms, q, v, tau, current, ext),
+                    up.forward_dynamics(uvms, q, v, tau, current, ext, backend="python"),
+                )
+
+
+def _plants(uvms, rng):
+    """Plant pairs (core, python) with each contact kind, a current and a disturbance."""
+    current = np.array([0.2, -0.1, 0.05])
+    disturbance = SinusoidalDisturbance(rng.normal(size=6), period_s=3.0, phase_rad=0.4)
+    contacts = [
+        None,
+        lambda: LinearSpring(np.array([2.0, 3.0, 5.0])),
+        # the tip starts 1 cm inside a tilted plane: pushed back
+        lambda: CompliantPlane(np.array([0.3, 0.2, 1.0]), 200.0, 5.0),
+    ]
+    for make in contacts:
+        pair = []
+        for backend in ("core", "python"):
+            plant = Plant(
+                uvms,
+                current,
+                None if make is None else make(),
+                disturbance,
+                backend=backend,
+            )
+            pair.append(plant)
+        yield pair
+
+
+def _attach_inside(plant: Plant, q0: np.ndarray) -> None:
+    plant.attach(q0)
+    if isinstance(plant.contact, CompliantPlane):
+        plant.contact._point = plant.contact._point + 0.01 * plant.contact.normal_world
+        plant.__dict__.pop("_compiled", None)
+
+
+def test_plant_right_hand_side_matches_the_reference(reference_uvms, mounted_arms):
+    rng = np.random.default_rng(3)
+    for uvms in _models(reference_uvms, mounted_arms).values():
+        q0 = uvms.neutral_configuration()
+        for core, python in _plants(uvms, rng):
+            for plant in (core, python):
+                _attach_inside(plant, q0)
+            for _ in range(3):
+                q = q0.copy()
+                q[7:] += rng.normal(scale=0.01, size=uvms.nv - 6)
+                v = rng.normal(scale=0.3, size=uvms.nv)
+                tau = rng.normal(scale=5.0, size=uvms.nv)
+                t = float(rng.uniform(0.0, 5.0))
+                lam = python.contact_wrench(q, v)
+                np.testing.assert_allclose(core.contact_wrench(q, v), lam, rtol=REL, atol=0.0)
+                assert_rel(core.acceleration(t, q, v, tau), python.acceleration(t, q, v, tau))
+                given = rng.normal(size=6)
+                assert_rel(
+                    core.acceleration(t, q, v, tau, given),
+                    python.acceleration(t, q, v, tau, given),
+                )
+
+
+def test_plane_pushes_only_inside(reference_uvms):
+    q0 = reference_uvms.neutral_configuration()
+    plant = Plant(reference_uvms, contact=CompliantPlane(np.array([0.0, 0.0, 1.0]), 100.0))
+    plant.attach(q0)
+    v = np.zeros(reference_uvms.nv)
+    assert not np.any(plant.contact_wrench(q0, v))  # on the surface: depth 0
+    _attach_inside(plant, q0)
+    lam = plant.contact_wrench(q0, v)
+    np.testing.assert_allclose(lam, [0.0, 0.0, -1.0, 0.0, 0.0, 0.0], rtol=1e-12)
+
+
+@pytest.mark.parametrize("integrator", [RK4(5e-4), SemiImplicitEuler(5e-4)])
+def test_advance_over_a_control_period_matches_the_reference(
+    reference_uvms, mounted_arms, integrator
+):
+    rng = np.random.default_rng(4)
+    for uvms in _models(reference_uvms, mounted_arms).values():
+        q0 = uvms.neutral_configuration()
+        for core, python in _plants(uvms, rng):
+            for plant in (core, python):
+                _attach_inside(plant, q0)
+            v0 = rng.normal(scale=0.3, size=uvms.nv)
+            tau = rng.normal(scale=5.0, size=uvms.nv)
+            q_c, v_c = core.advance(integrator, 0.1, q0, v0, tau, 0.102)
+            q_p, v_p = python.advance(integrator, 0.1, q0, v0, tau, 0.102)
+            assert_rel(q_c, q_p)
+            assert_rel(v_c, v_p)
