@@ -23,6 +23,9 @@ PRODUCERS = {
     "robustness": "robustness table: docs/results/robustness.md",
     "bench": "benchmark table: docs/results/bench.md",
     "compare_arms": "arm comparison: docs/results/compare_arms.md, docs/arm_comparison.png",
+    "compare_controllers": (
+        "controller comparison: docs/results/compare_controllers.md, docs/controllers_force.png"
+    ),
     "study_model_uncertainty": "study summary: docs/results/study_model_uncertainty.md",
     "study_paper_claims": "study summary: docs/results/study_paper_claims.md",
 }
