@@ -227,7 +227,14 @@ class Plant:
             # the free-flyer's LOCAL Jacobian is [I 0]: a body wrench maps to tau[:6] directly
             tau_ext[:6] -= self.disturbance_wrench(time_s)
         return forward_dynamics(
-            self.uvms, q, v, tau, tau_ext=tau_ext, flow=self._flow, time_s=time_s, backend=self.backend
+            self.uvms,
+            q,
+            v,
+            tau,
+            tau_ext=tau_ext,
+            flow=self._flow,
+            time_s=time_s,
+            backend=self.backend,
         )
 
     def advance(

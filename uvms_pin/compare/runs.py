@@ -8,6 +8,7 @@ from typing import Any
 
 from uvms_pin.compare.metrics import Criteria, comparison_row
 from uvms_pin.errors import FunnelViolation, ScenarioError, SimulationError
+from uvms_pin.overrides import apply_overrides
 from uvms_pin.rollout import Rollout
 from uvms_pin.scenario import Scenario, baseline_controller_table, scenario_from_raw, simulate
 from uvms_pin.tomlfile import read_toml
@@ -25,13 +26,14 @@ def controller_scenarios(
         ScenarioError: a bad file, override or controller name.
     """
     path = Path(path)
-    raw = read_toml(path, ScenarioError)
+    # overrides first: they may set a baseline's tuning ("baselines.pi_force.damping=...")
+    raw = apply_overrides(read_toml(path, ScenarioError), overrides)
     out = {}
     for name in controllers:
         # the controller table that runs; the other tunings are not this run's
         variant = {k: v for k, v in raw.items() if k != "baselines"}
         variant["controller"] = baseline_controller_table(raw, name)
-        out[name] = scenario_from_raw(variant, path, overrides)
+        out[name] = scenario_from_raw(variant, path)
     return out
 
 
