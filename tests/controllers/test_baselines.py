@@ -112,6 +112,7 @@ def test_computed_torque_uses_its_model(reference_uvms):
 def _with_controller(table: dict):
     """The realistic scenario (0.1 s) with its [controller] table replaced."""
     raw = read_toml(REALISTIC, ScenarioError)
+    raw.pop("baselines")  # the tunings compare-controllers uses; not this table's
     raw["controller"] = {"desired_force": raw["controller"]["desired_force"], **table}
     raw["scenario"]["duration_s"] = 0.1
     return scenario_from_raw(raw, REALISTIC)
