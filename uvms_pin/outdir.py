@@ -88,7 +88,19 @@ COMPARISON = OutputKind(
 )
 CONTROLLER_COMPARISON = OutputKind(
     "a controller comparison",
-    ("controllers.csv", "controllers.md", "controllers_force.png", "controllers_metrics.png"),
+    (
+        "controllers.csv",
+        "controllers.md",
+        "controllers_force.png",
+        "controllers_metrics.png",
+        "robustness.csv",
+        "robustness.md",
+        "robustness/robustness.toml",
+        "robustness/study.toml",
+        "robustness/study_inputs.json",
+        "robustness/results.parquet",
+        "robustness/parts/*.parquet",
+    ),
     ("controllers.csv", "controllers.md"),
 )
 KINDS = (RUN, STUDY, COMPARISON, CONTROLLER_COMPARISON)

@@ -55,3 +55,43 @@ def test_compare_controllers_bad_input(tmp_path, args, message):
     assert result.returncode == 2, result.stderr
     assert message in result.stderr and "Traceback" not in result.stderr
     assert not out.exists()
+
+
+def test_robustness_set_through_the_study_runner(tmp_path):
+    out = tmp_path / "robust"
+    result = run_cli(
+        [
+            "compare-controllers", str(REALISTIC), "--controllers", "pi_force",
+            "--set", "scenario.duration_s=0.1", "--robustness", "--jobs", "0",
+            "--no-figures", "--quiet", "--out", str(out),
+        ],
+        tmp_path,
+    )  # fmt: skip
+    assert result.returncode == 0, result.stderr
+    main = next(csv.DictReader((out / "controllers.csv").open()))
+    rows = {r["case"]: r for r in csv.DictReader((out / "robustness.csv").open())}
+    assert set(rows) == {
+        "nominal", "stiffness_x10", "plant_x1.3", "plant_x0.7", "noise_x5", "disturbance_x5",
+    }  # fmt: skip
+    # the nominal case is the comparison's own run (same seed, same everything)
+    assert float(rows["nominal"]["force_error_rms_N"]) == pytest.approx(
+        float(main["force_error_rms_N"]), rel=1e-12
+    )
+    # a stiffer environment changes the force the same motion produces
+    assert rows["stiffness_x10"]["force_error_rms_N"] != rows["nominal"]["force_error_rms_N"]
+    assert (out / "robustness" / "results.parquet").is_file()
+
+
+def test_robustness_cases_scale_what_the_scenario_sets():
+    from uvms_pin.compare.robustness import robustness_cases
+
+    raw = {
+        "environment": {"stiffness_N_m": [2.0, 2.0, 2.0]},
+        "sensors": {"force_noise_N": 0.02, "distribution": "uniform"},
+        "disturbance": {"amplitude": [0.15, 0.0, 0.0, 0.0, 0.0, 0.0]},
+    }
+    cases = robustness_cases(raw)
+    assert cases["stiffness_x10"][0] == {"environment.stiffness_N_m": [20.0, 20.0, 20.0]}
+    assert cases["noise_x5"][0] == {"sensors.force_noise_N": pytest.approx(0.1)}
+    assert cases["disturbance_x5"][0]["disturbance.amplitude"][0] == pytest.approx(0.75)
+    assert set(cases["plant_x0.7"][1].values()) == {0.7}

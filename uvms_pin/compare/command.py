@@ -5,7 +5,7 @@ from __future__ import annotations
 import argparse
 import sys
 
-from uvms_pin.cli_types import positive
+from uvms_pin.cli_types import count, positive
 from uvms_pin.errors import ParameterError
 from uvms_pin.outdir import CONTROLLER_COMPARISON, OVERWRITE_HELP, check_writable, claim
 from uvms_pin.overrides import parse_assignment
@@ -53,6 +53,15 @@ def _cmd_compare_controllers(args: argparse.Namespace) -> int:
             from uvms_pin.viz.controller_comparison import write_comparison_figures
 
             written += write_comparison_figures(rows, rollouts, out, after_s)
+        if args.robustness:
+            from uvms_pin.compare.robustness import run_robustness, write_robustness
+
+            if say is not None:
+                say("robustness set: every controller x 6 cases, through the study runner ...")
+            robust = run_robustness(
+                args.scenario, names, out / "robustness", criteria, args.jobs, overrides
+            )
+            written += write_robustness(robust, out)
     for row in rows:
         verdict = "holds the task" if row["success"] else f"fails: {row['reason']}"
         print(
@@ -100,6 +109,17 @@ def register(subparsers) -> argparse.ArgumentParser:
         help="largest peak force error after the transient that holds the task [N]",
     )  # fmt: skip
     parser.add_argument("--no-figures", action="store_true", help="tables only")
+    parser.add_argument(
+        "--robustness",
+        action="store_true",
+        help="also run every controller on 6 cases (nominal, environment stiffness x10, "
+        "plant x1.3 and x0.7, noise x5, disturbance x5) through the study runner: "
+        "robustness.csv, robustness.md, OUT/robustness/ (a study directory)",
+    )
+    parser.add_argument(
+        "--jobs", type=count(0), default=1,
+        help="Dask worker processes for --robustness (0: serial, in this process)",
+    )  # fmt: skip
     parser.add_argument("--quiet", action="store_true", help="no progress lines")
     parser.set_defaults(func=_cmd_compare_controllers)
     return parser
