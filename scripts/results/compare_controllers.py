@@ -1,4 +1,5 @@
-"""The controller comparison: the realistic task with the PPC and the three baselines."""
+"""The controller comparison: the realistic task with the PPC and the three baselines,
+nominal and over the robustness set."""
 
 from _common import publish_figure, scratch, uvms_pin, write_result
 
@@ -12,12 +13,15 @@ if __name__ == "__main__":
         "--controllers",
         CONTROLLERS,
     )
-    uvms_pin(*args, "--out", str(out), "--quiet")
+    uvms_pin(*args, "--robustness", "--jobs", "2", "--out", str(out), "--quiet")
     publish_figure(out / "controllers_force.png", "controllers_force.png")
     body = (
         f"`uvms-pin {' '.join(args)}`:\n\n"
         + (out / "controllers.md").read_text()
         + "\n![force tracking per controller](../controllers_force.png)\n"
+        + "\nWith `--robustness --jobs 2`: force error RMS after the transient per case, and "
+        + "whether the task held (stopped: a funnel of the PPC broke):\n\n"
+        + (out / "robustness.md").read_text()
     )
     write_result(
         "compare_controllers",

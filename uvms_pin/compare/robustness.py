@@ -139,8 +139,8 @@ def robustness_table(rows: list[dict[str, Any]]) -> str:
         cells = []
         for case in cases:
             r = next(x for x in rows if x["controller"] == name and x["case"] == case)
-            if r["status"] == "error":
-                cells.append("error")
+            if r["status"] in ("error", "stopped"):
+                cells.append(r["status"])  # the CSV's reason / error column says why
                 continue
             verdict = "holds" if r.get("success") else "fails"
             cells.append(f"{_text(float(r['force_error_rms_N']))} N, {verdict}")
