@@ -45,10 +45,6 @@ bench: $(STAMP)
 results: $(STAMP)
 	$(BIN)/python scripts/make_results.py $(if $(RESULTS),--only $(RESULTS))
 
-# the pool trials of a real BlueROV2 Heavy + Alpha 5 against the simulator (README "Validated
-# against a real vehicle"): out/pool/pool_validation.json, .csv and one figure per trial
-results: $(STAMP)
-	$(BIN)/uvms-pin validate pool data/hinsdale2023 --out out/pool
 
 clean:
 	rm -rf $(VENV) out build *.egg-info

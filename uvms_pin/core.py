@@ -13,6 +13,7 @@ missing or was built from other sources or against another Pinocchio, `core_modu
 from __future__ import annotations
 
 import hashlib
+import math
 from pathlib import Path
 from types import ModuleType
 
@@ -20,12 +21,17 @@ import numpy as np
 import pinocchio as pin  # loads libpinocchio_default before the extension needs it
 
 from uvms_pin.errors import ParameterError, UvmsPinError
+from uvms_pin.flow import AiryWave, FlowField, IrregularSea, SumFlow, UniformCurrent
 from uvms_pin.model import UVMS
 
 BACKENDS = ("core", "python")
 API_VERSION = 1
 REBUILD = "rebuild it with `pip install -e .` (or `make clean test`) in the uvms-pin checkout"
 _SOURCE_DIR = Path(__file__).resolve().parents[1] / "src" / "uvms_core"
+
+
+class CoreFallbackWarning(UserWarning):
+    """Something the compiled core cannot represent runs on the (slower) Python reference."""
 
 
 class CoreUnavailableError(UvmsPinError, ImportError):
@@ -120,3 +126,35 @@ def dynamics_of(uvms: UVMS):
         cached = build_dynamics(uvms)
         uvms.__dict__["_core_dynamics"] = cached
     return cached
+
+
+def compiled_flow(flow: FlowField | None) -> tuple[np.ndarray, np.ndarray, float] | None:
+    """The core's form of a flow: (uniform current (3,), wave components (m, 5), depth), or
+    None when the core cannot represent it (a varying or sheared current, waves in
+    different depths). Rows: amplitude, angular frequency, wavenumber, heading, phase, as in
+    `uvms_pin.flow.components.WaveComponents`."""
+    current = np.zeros(3)
+    tables, depths = [], set()
+    for field in flow.fields if isinstance(flow, SumFlow) else (() if flow is None else (flow,)):
+        if isinstance(field, UniformCurrent):
+            current = current + field.velocity_world_m_s
+        elif isinstance(field, AiryWave | IrregularSea):
+            c = field.components
+            tables.append(
+                np.column_stack(
+                    [
+                        c.amplitude_m,
+                        c.angular_frequency_rad_s,
+                        c.wavenumber_rad_m,
+                        c.heading_rad,
+                        c.phase_rad,
+                    ]
+                )
+            )
+            depths.add(c.water_depth_m)
+        else:
+            return None
+    if len(depths) > 1:
+        return None
+    waves = np.vstack(tables) if tables else np.zeros((0, 5))
+    return current, waves, depths.pop() if depths else math.inf

@@ -21,11 +21,13 @@ computes the same quantities in one C++ call and is held to this reference by th
 
 from __future__ import annotations
 
+import warnings
+
 import numpy as np
 import pinocchio as pin
 from scipy.linalg import cho_factor, cho_solve
 
-from uvms_pin.core import check_backend, dynamics_of
+from uvms_pin.core import CoreFallbackWarning, check_backend, compiled_flow, dynamics_of
 from uvms_pin.errors import ParameterError, SimulationError
 from uvms_pin.flow import FlowField, UniformCurrent
 from uvms_pin.hydro.added_mass import kirchhoff_wrench
@@ -63,6 +65,15 @@ def _resolve_flow(current_world: np.ndarray, flow: FlowField | None) -> FlowFiel
             raise ParameterError("give either current_world or flow, not both (add the fields)")
         return flow
     return UniformCurrent(current) if np.any(current) else None
+
+
+def _warn_python_flow(flow: FlowField) -> None:
+    warnings.warn(
+        f"the compiled core does not support the flow {flow!r}: the Python reference "
+        "computes these dynamics (slower)",
+        CoreFallbackWarning,
+        stacklevel=3,
+    )
 
 
 def _check_time(time_s: float) -> float:
@@ -195,7 +206,12 @@ def bias_forces(
         time_s: the time at which the flow is evaluated [s].
         backend: "core" (compiled, default) or "python" (the reference).
     """
-    if backend == "core" and flow is None:
+    if backend == "core" and flow is not None:
+        spec = compiled_flow(_resolve_flow(current_world, flow))
+        if spec is not None:
+            return dynamics_of(uvms).bias_forces_in_waves(q, v, *spec, _check_time(time_s))
+        _warn_python_flow(flow)
+    elif backend == "core":
         try:
             return dynamics_of(uvms).bias_forces(q, v, current_world)
         except TypeError:
@@ -244,7 +260,14 @@ def forward_dynamics(
         ParameterError: wrong shape or non-finite input.
         SimulationError: M not positive definite (e.g. a degenerate model).
     """
-    if backend == "core" and flow is None:
+    if backend == "core" and flow is not None:
+        spec = compiled_flow(_resolve_flow(current_world, flow))
+        if spec is not None:
+            return dynamics_of(uvms).forward_dynamics_in_waves(
+                q, v, tau, *spec, _check_time(time_s), tau_ext
+            )
+        _warn_python_flow(flow)
+    elif backend == "core":
         try:
             return dynamics_of(uvms).forward_dynamics(q, v, tau, current_world, tau_ext)
         except TypeError:

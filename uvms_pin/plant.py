@@ -21,7 +21,13 @@ import numpy as np
 import pinocchio as pin
 
 from uvms_pin.actuation import Actuation, Unlimited
-from uvms_pin.core import check_backend, core_module, dynamics_of
+from uvms_pin.core import (
+    CoreFallbackWarning,
+    check_backend,
+    compiled_flow,
+    core_module,
+    dynamics_of,
+)
 from uvms_pin.dynamics import forward_dynamics
 from uvms_pin.environment import (
     CompliantPlane,
@@ -34,10 +40,6 @@ from uvms_pin.errors import ParameterError, SimulationError
 from uvms_pin.flow import FlowField, SumFlow, UniformCurrent
 from uvms_pin.integrators import Integrator
 from uvms_pin.model import UVMS
-
-
-class CoreFallbackWarning(UserWarning):
-    """A plant the compiled core cannot represent runs on the (slower) Python reference."""
 
 
 @dataclass
@@ -124,7 +126,7 @@ class Plant:
             return f"contact model {type(self.contact).__name__}"
         if self.disturbance is not None and type(self.disturbance) is not SinusoidalDisturbance:
             return f"disturbance {self.disturbance!r}"
-        if self.flow is not None:
+        if self.flow is not None and compiled_flow(self.flow) is None:
             return f"flow {self.flow!r}"
         return None
 
@@ -142,7 +144,7 @@ class Plant:
             )
             return None
         compiled = core_module().Plant(dynamics_of(self.uvms), self.uvms.ee_frame_id)
-        compiled.set_current(self.current_world_m_s)
+        compiled.set_flow(*compiled_flow(self._flow))  # the current plus any waves
         contact = self.contact
         if isinstance(contact, LinearSpring):
             if contact._anchor is None:

@@ -89,6 +89,25 @@ uvms::FlowField current_flow(const ConstVec& current_world) {
   return flow;
 }
 
+// A uniform current plus wave components: rows [amplitude_m, angular_frequency_rad_s,
+// wavenumber_rad_m, heading_rad, phase_rad] of ``waves`` (m x 5), all in water of depth d.
+uvms::FlowField wave_flow(const ConstVec& current_world, const Eigen::MatrixXd& waves,
+                          double water_depth_m) {
+  uvms::FlowField flow = current_flow(current_world);
+  if (waves.size() != 0 && waves.cols() != 5) {
+    throw uvms::InputError("waves must have 5 columns (amplitude, angular frequency, "
+                           "wavenumber, heading, phase), got " + std::to_string(waves.cols()));
+  }
+  if (!waves.allFinite() || !(water_depth_m > 0.0)) {
+    throw uvms::InputError("waves must be finite and water_depth_m positive");
+  }
+  for (Eigen::Index i = 0; i < waves.rows(); ++i) {
+    flow.waves.push_back({waves(i, 0), waves(i, 1), waves(i, 2), waves(i, 3), waves(i, 4)});
+  }
+  flow.water_depth_m = water_depth_m;
+  return flow;
+}
+
 void check_state(uvms::Dynamics& d, const ConstVec& q, const ConstVec& v) {
   check_vector("q", q, d.nq());
   check_vector("v", v, d.nv());
@@ -153,6 +172,30 @@ NB_MODULE(_core, m) {
           },
           "q"_a, "v"_a, "current_world"_a)
       .def(
+          "bias_forces_in_waves",
+          [](uvms::Dynamics& d, const ConstVec& q, const ConstVec& v,
+             const ConstVec& current_world, const Eigen::MatrixXd& waves, double water_depth_m,
+             double time_s) -> Eigen::VectorXd {
+            check_state(d, q, v);
+            return d.bias_forces(q, v, wave_flow(current_world, waves, water_depth_m), time_s);
+          },
+          "q"_a, "v"_a, "current_world"_a, "waves"_a, "water_depth_m"_a, "time_s"_a)
+      .def(
+          "forward_dynamics_in_waves",
+          [](uvms::Dynamics& d, const ConstVec& q, const ConstVec& v, const ConstVec& tau,
+             const ConstVec& current_world, const Eigen::MatrixXd& waves, double water_depth_m,
+             double time_s, std::optional<Eigen::VectorXd> tau_ext) -> Eigen::VectorXd {
+            check_state(d, q, v);
+            check_vector("tau", tau, d.nv());
+            const uvms::FlowField flow = wave_flow(current_world, waves, water_depth_m);
+            if (!tau_ext) return d.forward_dynamics(q, v, tau, flow, nullptr, time_s);
+            check_vector("tau_ext", *tau_ext, d.nv());
+            const ConstVec ext(*tau_ext);
+            return d.forward_dynamics(q, v, tau, flow, &ext, time_s);
+          },
+          "q"_a, "v"_a, "tau"_a, "current_world"_a, "waves"_a, "water_depth_m"_a, "time_s"_a,
+          "tau_ext"_a = nb::none())
+      .def(
           "forward_dynamics",
           [](uvms::Dynamics& d, const ConstVec& q, const ConstVec& v, const ConstVec& tau,
              const ConstVec& current_world,
@@ -172,6 +215,12 @@ NB_MODULE(_core, m) {
       .def(
           "set_current",
           [](uvms::Plant& p, const ConstVec& c) { p.flow = current_flow(c); }, "current_world"_a)
+      .def(
+          "set_flow",
+          [](uvms::Plant& p, const ConstVec& c, const Eigen::MatrixXd& waves, double depth) {
+            p.flow = wave_flow(c, waves, depth);
+          },
+          "current_world"_a, "waves"_a, "water_depth_m"_a)
       .def("clear_contact", [](uvms::Plant& p) { p.contact = uvms::NoContact{}; })
       .def(
           "set_spring",

@@ -67,19 +67,29 @@ void Dynamics::fluid_wrenches(double time_s, const FlowField& flow,
                               bool with_bias_acceleration) {
   for (auto& f : fext_) f.setZero();
   const Vec3 gravity = model_.gravity.linear();
+  // the flow is sampled at each joint body's centre of buoyancy (its origin without volume)
   for (int j : joints_with_added_mass_) {
     const auto& placement = data_.oMi[j];
     const Vec6 velocity = data_.v[j].toVector();
-    const FlowInBody seen = flow_in_body(flow.at(time_s, placement.translation()),
-                                         placement.rotation(), velocity.tail<3>());
+    const FlowInBody seen = flow_in_body(
+        flow.at(time_s, placement.act(hydro_.center_of_buoyancy_per_joint_m[j])),
+        placement.rotation(), velocity.tail<3>());
     const Vec6 bias = with_bias_acceleration ? data_.a[j].toVector() : Vec6::Zero();
     fext_[j].toVector() +=
         added_mass_wrench(hydro_.added_mass_per_joint[j], bias, velocity, seen);
   }
+  const bool accelerating = !flow.waves.empty();  // else Du/Dt = 0: no Froude-Krylov
   for (int j : joints_with_volume_) {
-    fext_[j].toVector() += buoyancy_wrench(
-        hydro_.volume_per_joint_m3[j], hydro_.center_of_buoyancy_per_joint_m[j],
-        data_.oMi[j].rotation(), hydro_.water_density_kg_m3, gravity);
+    const auto& placement = data_.oMi[j];
+    const Vec3& cob = hydro_.center_of_buoyancy_per_joint_m[j];
+    fext_[j].toVector() += buoyancy_wrench(hydro_.volume_per_joint_m3[j], cob,
+                                           placement.rotation(), hydro_.water_density_kg_m3,
+                                           gravity);
+    if (accelerating) {
+      fext_[j].toVector() += froude_krylov_wrench(
+          hydro_.volume_per_joint_m3[j], cob, placement.rotation(), hydro_.water_density_kg_m3,
+          flow.at(time_s, placement.act(cob)).acceleration_world);
+    }
   }
   for (const auto& body : hydro_.damped_bodies) {
     const auto& placement = data_.oMi[body.joint_id];
@@ -152,9 +162,9 @@ const Eigen::VectorXd& Dynamics::solve(const ConstVec& q, const ConstVec& rhs) {
 }
 
 const Eigen::VectorXd& Dynamics::bias_forces(const ConstVec& q, const ConstVec& v,
-                                             const FlowField& flow) {
+                                             const FlowField& flow, double time_s) {
   kinematics(q, v);
-  fluid_wrenches(0.0, flow, true);
+  fluid_wrenches(time_s, flow, true);
   return bias_from_wrenches(q, v);
 }
 
@@ -178,9 +188,9 @@ const Eigen::VectorXd& Dynamics::forward_dynamics(const ConstVec& q,
                                                   const ConstVec& v,
                                                   const ConstVec& tau,
                                                   const FlowField& flow,
-                                                  const ConstVec* tau_ext) {
+                                                  const ConstVec* tau_ext, double time_s) {
   kinematics(q, v);
-  fluid_wrenches(0.0, flow, needs_bias_acceleration());
+  fluid_wrenches(time_s, flow, needs_bias_acceleration());
   return accelerations(q, v, tau, tau_ext);
 }
 

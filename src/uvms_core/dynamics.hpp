@@ -65,10 +65,10 @@ class Dynamics {
 
   // The public operations of uvms_pin.dynamics.
   const Eigen::VectorXd& bias_forces(const ConstVec& q, const ConstVec& v,
-                                     const FlowField& flow);
+                                     const FlowField& flow, double time_s = 0.0);
   const Eigen::VectorXd& forward_dynamics(const ConstVec& q, const ConstVec& v,
                                           const ConstVec& tau, const FlowField& flow,
-                                          const ConstVec* tau_ext);
+                                          const ConstVec* tau_ext, double time_s = 0.0);
 
   Data& data() { return data_; }
 

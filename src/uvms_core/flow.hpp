@@ -1,9 +1,13 @@
 // The water's motion as each body sees it (mirror of uvms_pin/hydro/current.py).
 //
 // A flow gives the undisturbed water velocity u(t, p) and its material acceleration Du/Dt at a
-// world point. Today: a uniform, constant current (u = const, Du/Dt = 0). Other flows (waves)
-// grow here: they only change FlowField::at; the per-body terms already take a_c.
+// world point (mirror of uvms_pin/flow/: UniformCurrent, and AiryWave / IrregularSea as a sum
+// of linear wave components, uvms_pin/flow/components.py). Du/Dt = du/dt + (grad u) u is
+// formed from the sums, as SumFlow does.
 #pragma once
+
+#include <cmath>
+#include <vector>
 
 #include "types.hpp"
 
@@ -22,11 +26,53 @@ struct FlowInBody {
   Vec6 acceleration;
 };
 
+// One regular linear wave (uvms_pin.flow.components.WaveComponents, one column).
+struct WaveComponent {
+  double amplitude_m;
+  double angular_frequency_rad_s;
+  double wavenumber_rad_m;
+  double heading_rad;
+  double phase_rad;
+};
+
 struct FlowField {
   Vec3 current_world_m_s = Vec3::Zero();
+  std::vector<WaveComponent> waves;         // empty: no waves
+  double water_depth_m = INFINITY;          // d of every wave component (inf: deep water)
 
-  FlowAtPoint at(double /*time_s*/, const Vec3& /*point_world_m*/) const {
-    return {current_world_m_s, Vec3::Zero()};
+  // theta = k e.p - w t + phi; C, S = (e^{kz} +- e^{-k(z+2d)}) / (1 - e^{-2kd});
+  // u = sum A w [C cos(theta) e + S sin(theta) z],
+  // du/dt = sum A w^2 [C sin(theta) e - S cos(theta) z],
+  // grad u: xy block -A w k C sin(theta) e e^T, xz = zx = A w k S cos(theta) e,
+  // zz = A w k C sin(theta).
+  FlowAtPoint at(double time_s, const Vec3& point_world_m) const {
+    if (waves.empty()) return {current_world_m_s, Vec3::Zero()};
+    Vec3 velocity = current_world_m_s;
+    Vec3 local = Vec3::Zero();
+    Mat3 gradient = Mat3::Zero();
+    const double x = point_world_m.x(), y = point_world_m.y(), z = point_world_m.z();
+    for (const auto& w : waves) {
+      const double k = w.wavenumber_rad_m, omega = w.angular_frequency_rad_s;
+      const double ex = std::cos(w.heading_rad), ey = std::sin(w.heading_rad);
+      const double theta = k * (x * ex + y * ey) - omega * time_s + w.phase_rad;
+      const double below = std::exp(-(z + 2.0 * water_depth_m) * k);
+      const double denominator = 1.0 - std::exp(-2.0 * k * water_depth_m);
+      const double grow = std::exp(k * z);
+      const double c = (grow + below) / denominator, s = (grow - below) / denominator;
+      const double cos_t = std::cos(theta), sin_t = std::sin(theta);
+      const double aw = w.amplitude_m * omega, aww = aw * omega, awk = aw * k;
+      velocity += Vec3(aw * c * cos_t * ex, aw * c * cos_t * ey, aw * s * sin_t);
+      local += Vec3(aww * c * sin_t * ex, aww * c * sin_t * ey, -aww * s * cos_t);
+      const double c_sin = awk * c * sin_t, s_cos = awk * s * cos_t;
+      const double e[2] = {ex, ey};
+      for (int i = 0; i < 2; ++i) {
+        for (int j = 0; j < 2; ++j) gradient(i, j) -= c_sin * e[i] * e[j];
+        gradient(i, 2) += s_cos * e[i];
+        gradient(2, i) += s_cos * e[i];
+      }
+      gradient(2, 2) += c_sin;
+    }
+    return {velocity, local + gradient * velocity};
   }
 };
 

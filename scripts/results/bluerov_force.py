@@ -1,0 +1,11 @@
+"""The force task on the BlueROV2 Heavy + Reach Alpha 5: metrics table and force figure."""
+
+from _scenario_run import produce
+
+if __name__ == "__main__":
+    produce(
+        "bluerov_force",
+        "scenarios/bluerov_alpha5_force_tracking.toml",
+        "The force task on a BlueROV2 Heavy + Reach Alpha 5 (T200 thrust, Alpha 5 torques)",
+        "bluerov_alpha5_force.png",
+    )

@@ -1,0 +1,11 @@
+"""The realistic task under a JONSWAP sea (Hs 0.5 m, Tp 5 s, 2 m deep): metrics and force figure."""
+
+from _scenario_run import produce
+
+if __name__ == "__main__":
+    produce(
+        "sea_state",
+        "scenarios/sea_state_force_tracking.toml",
+        "The realistic task under a sea state (JONSWAP Hs 0.5 m, Tp 5 s, LBV150 at 2 m)",
+        "sea_state_force.png",
+    )
