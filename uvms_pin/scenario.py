@@ -315,20 +315,16 @@ def _build(raw: dict[str, Any], path: Path, source: str, overridden: dict[str, s
 
     controller_table = top.table("controller")
     controller_factory = _controller(controller_table, uvms, path.parent)
+    # [baselines.<kind>]: tunings for `compare-controllers`, which builds (and so checks)
+    # each one before any run; here only their names (a model with another arm, e.g. in
+    # compare-arms, must not be refused for a comparison it is not running)
     baselines = top.table("baselines")
-    if baselines is not None:
-        for kind in baselines.rest():
-            if kind not in BASELINE_KINDS or (raw.get("controller") or {}).get("type") == kind:
-                raise ScenarioError(
-                    f"{source}: [baselines.{kind}]: a baseline is one of "
-                    f"{', '.join(BASELINE_KINDS)} other than the scenario's [controller] type"
-                )
-            # read as the [controller] it becomes (same keys, same docs); checked now
-            table = _Table(baseline_controller_table(raw, kind), "controller", source)
-            try:
-                _controller(table, uvms, path.parent)
-            except ScenarioError as exc:
-                raise ScenarioError(f"[baselines.{kind}] (run as [controller]): {exc}") from exc
+    for kind in baselines.rest() if baselines is not None else {}:
+        if kind not in BASELINE_KINDS or (raw.get("controller") or {}).get("type") == kind:
+            raise ScenarioError(
+                f"{source}: [baselines.{kind}]: a baseline is one of "
+                f"{', '.join(BASELINE_KINDS)} other than the scenario's [controller] type"
+            )
     top.finish()
     try:
         settings = SimulationSettings(duration, integrator, log_period, control_period, seed)

@@ -33,7 +33,10 @@ def controller_scenarios(
         # the controller table that runs; the other tunings are not this run's
         variant = {k: v for k, v in raw.items() if k != "baselines"}
         variant["controller"] = baseline_controller_table(raw, name)
-        out[name] = scenario_from_raw(variant, path)
+        try:
+            out[name] = scenario_from_raw(variant, path)
+        except ScenarioError as exc:
+            raise ScenarioError(f"controller '{name}' ([baselines.{name}]): {exc}") from exc
     return out
 
 
