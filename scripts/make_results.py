@@ -24,6 +24,9 @@ PRODUCERS = {
     "bench": "benchmark table: docs/results/bench.md",
     "bench_mujoco": "uvms-pin vs MuJoCo: docs/results/bench_mujoco.md",
     "compare_arms": "arm comparison: docs/results/compare_arms.md, docs/arm_comparison.png",
+    "compare_controllers": (
+        "controller comparison: docs/results/compare_controllers.md, docs/controllers_force.png"
+    ),
     "study_model_uncertainty": "study summary: docs/results/study_model_uncertainty.md",
     "study_paper_claims": "study summary: docs/results/study_paper_claims.md",
     "bluerov_force": "BlueROV2 + Alpha 5 force task: docs/results/bluerov_force.md, docs/bluerov_alpha5_force.png",

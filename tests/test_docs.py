@@ -20,6 +20,20 @@ SCENARIOS = ROOT / "scenarios"
 _VARIANTS = [
     ("paper_force_tracking.toml", {}),
     ("realistic_force_tracking.toml", {}),
+    ("passive_still_water.toml", {"controller.type": "pi_force"}),
+    ("passive_still_water.toml", {"controller.type": "impedance"}),
+    (
+        "passive_still_water.toml",
+        {
+            "controller.type": "computed_torque",
+            "controller.model_error": {
+                "mass_scale": 1.3,
+                "added_mass_scale": 1.3,
+                "damping_scale": 0.7,
+                "buoyancy_scale": 1.0,
+            },
+        },
+    ),
     ("passive_current.toml", {}),
     (
         "sea_state_force_tracking.toml",

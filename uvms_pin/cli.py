@@ -11,6 +11,7 @@ from typing import TYPE_CHECKING
 
 from uvms_pin.arms.command import register as register_compare_arms
 from uvms_pin.cli_types import positive
+from uvms_pin.compare.command import register as register_compare_controllers
 from uvms_pin.errors import FunnelViolation, SimulationError, UvmsPinError, UvmsPinWarning
 from uvms_pin.outdir import OVERWRITE_HELP, RUN, check_writable, claim, claim_file
 from uvms_pin.overrides import parse_assignment
@@ -254,6 +255,7 @@ def build_parser() -> argparse.ArgumentParser:
     info.set_defaults(func=_cmd_info)
     register_study_commands(sub)
     register_compare_arms(sub)
+    register_compare_controllers(sub)
     register_validate(sub)
     return parser
 

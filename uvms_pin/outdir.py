@@ -86,7 +86,24 @@ COMPARISON = OutputKind(
     ("comparison.csv", "comparison.md", "comparison.png", "models/*.urdf"),
     ("comparison.csv", "comparison.md", "comparison.png", "models/*.urdf"),
 )
-KINDS = (RUN, STUDY, COMPARISON)
+CONTROLLER_COMPARISON = OutputKind(
+    "a controller comparison",
+    (
+        "controllers.csv",
+        "controllers.md",
+        "controllers_force.png",
+        "controllers_metrics.png",
+        "robustness.csv",
+        "robustness.md",
+        "robustness/robustness.toml",
+        "robustness/study.toml",
+        "robustness/study_inputs.json",
+        "robustness/results.parquet",
+        "robustness/parts/*.parquet",
+    ),
+    ("controllers.csv", "controllers.md"),
+)
+KINDS = (RUN, STUDY, COMPARISON, CONTROLLER_COMPARISON)
 OVERWRITE_HELP = (
     "replace the results an earlier run left in --out (only files uvms-pin writes are removed)"
 )

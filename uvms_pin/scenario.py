@@ -15,6 +15,7 @@ from __future__ import annotations
 
 import copy
 import dataclasses
+import functools
 import math
 from collections.abc import Callable
 from dataclasses import dataclass
@@ -251,8 +252,16 @@ def load_scenario(path: str | Path, overrides: dict[str, Any] | None = None) -> 
         ScenarioError: naming the file and the key, or the override that set a bad value.
     """
     path = Path(path)
+    return scenario_from_raw(read_toml(path, ScenarioError), path, overrides)
+
+
+def scenario_from_raw(
+    raw: dict[str, Any], path: str | Path, overrides: dict[str, Any] | None = None
+) -> Scenario:
+    """`load_scenario` of an already-read document ``raw`` (as if read from ``path``:
+    relative model paths and custom controllers resolve next to it)."""
+    path = Path(path)
     source = str(path)
-    raw = read_toml(path, ScenarioError)
     raw = apply_overrides(raw, overrides)
     overridden = {parse_key_path(text).key: text for text in overrides or {}}
     try:
@@ -306,6 +315,16 @@ def _build(raw: dict[str, Any], path: Path, source: str, overridden: dict[str, s
 
     controller_table = top.table("controller")
     controller_factory = _controller(controller_table, uvms, path.parent)
+    # [baselines.<kind>]: tunings for `compare-controllers`, which builds (and so checks)
+    # each one before any run; here only their names (a model with another arm, e.g. in
+    # compare-arms, must not be refused for a comparison it is not running)
+    baselines = top.table("baselines")
+    for kind in baselines.rest() if baselines is not None else {}:
+        if kind not in BASELINE_KINDS or (raw.get("controller") or {}).get("type") == kind:
+            raise ScenarioError(
+                f"{source}: [baselines.{kind}]: a baseline is one of "
+                f"{', '.join(BASELINE_KINDS)} other than the scenario's [controller] type"
+            )
     top.finish()
     try:
         settings = SimulationSettings(duration, integrator, log_period, control_period, seed)
@@ -539,7 +558,8 @@ def _integrator(t: _Table) -> tuple[Integrator, str]:
 
 
 def _controller(t: _Table | None, uvms: UVMS, scenario_dir: Path) -> ControllerSpec:
-    """[controller]: "none", "ppc" or "package.module:ClassName" (`uvms_pin.controllers.custom`)."""
+    """[controller]: "none", "ppc", a baseline ("pi_force", "impedance", "computed_torque")
+    or "package.module:ClassName" (`uvms_pin.controllers.custom`)."""
     if t is None:
         return ControllerSpec("none", {}, _zero)
     kind = t.string("type")
@@ -557,6 +577,39 @@ def _controller(t: _Table | None, uvms: UVMS, scenario_dir: Path) -> ControllerS
             "type", f"must be one of {choices} or 'package.module:ClassName', got '{kind}'"
         )
     return _CONTROLLER_BUILDERS[kind](t, uvms)
+
+
+#: Controllers whose tuning a scenario may carry in [baselines.<kind>] for comparisons.
+BASELINE_KINDS = ("pi_force", "impedance", "computed_torque")
+#: Keys of a PPC [controller] table a baseline of the same task inherits (the same task,
+#: and for the J^# baselines the same pseudo-inverse and null-space pull).
+_TASK_KEYS = ("ee_frame", "desired_rpy", "desired_force")
+_PSEUDO_INVERSE_INHERITED = ("velocity_weights", "null_space_gain_per_s", "null_space_target")
+
+
+def baseline_controller_table(raw: dict[str, Any], kind: str) -> dict[str, Any]:
+    """The [controller] table that runs the scenario ``raw``'s task with controller ``kind``.
+
+    The scenario's own [controller] when its type is ``kind``; else a baseline's table: the
+    task (``ee_frame``, ``desired_rpy``, ``desired_force``; for "pi_force" and
+    "computed_torque" also the PPC's ``velocity_weights`` and null-space keys) taken from
+    [controller], then the gains of ``[baselines.<kind>]`` (defaults if absent).
+
+    Raises:
+        ScenarioError: ``kind`` is not the scenario's controller nor a baseline.
+    """
+    controller = raw.get("controller") or {}
+    if controller.get("type") == kind:
+        return copy.deepcopy(controller)
+    if kind not in BASELINE_KINDS:
+        choices = ", ".join((controller.get("type", "none"), *BASELINE_KINDS))
+        raise ScenarioError(f"controller '{kind}': this scenario can run {choices}")
+    inherited = _TASK_KEYS + (_PSEUDO_INVERSE_INHERITED if kind != "impedance" else ())
+    table = {"type": kind, **{k: controller[k] for k in inherited if k in controller}}
+    tuning = (raw.get("baselines") or {}).get(kind) or {}
+    if not isinstance(tuning, dict):
+        raise ScenarioError(f"[baselines.{kind}] must be a table, got {tuning!r}")
+    return copy.deepcopy({**table, **tuning})
 
 
 def _zero(uvms: UVMS) -> Controller:
@@ -632,9 +685,89 @@ def _plain(value: Any) -> Any:
     return value.item() if isinstance(value, np.generic) else value
 
 
+def _ee_frame(t: _Table, uvms: UVMS, kind: str) -> str:
+    if t.has("ee_frame"):
+        return t.string("ee_frame")
+    ee_id = uvms.require_ee_frame(f"[controller] type = '{kind}'")
+    return uvms.model.frames[ee_id].name
+
+
+#: The keys of the baseline controllers' tables: name -> size ("nv", "arm" or a number).
+_FORCE_LOOP_KEYS = {
+    "kp_force_m_s_per_N": 3,
+    "ki_force_m_s2_per_N": 3,
+    "k_orientation_per_s": 3,
+    "integral_limit_Ns": 3,
+}
+_PSEUDO_INVERSE_KEYS = {"velocity_weights": "nv", "null_space_target": "arm"}
+_BASELINE_KEYS: dict[str, dict[str, int | str]] = {
+    "pi_force": {**_FORCE_LOOP_KEYS, "damping": "nv", **_PSEUDO_INVERSE_KEYS},
+    "impedance": {
+        "stiffness_N_m": 3,
+        "damping_N_s_m": 3,
+        "stiffness_Nm_rad": 3,
+        "damping_Nm_s_rad": 3,
+        "velocity_damping": "nv",
+        "posture_stiffness_Nm_rad": "arm",
+    },
+    "computed_torque": {**_FORCE_LOOP_KEYS, "velocity_gain_per_s": "nv", **_PSEUDO_INVERSE_KEYS},
+}
+_MODEL_ERROR_KEYS = ("mass_scale", "added_mass_scale", "damping_scale", "buoyancy_scale")
+
+
+def _baseline_controller(t: _Table, uvms: UVMS, kind: str) -> ControllerSpec:
+    """[controller] type = "pi_force" | "impedance" | "computed_torque" (docs/controllers.md)."""
+    from uvms_pin.controllers.computed_torque import ComputedTorqueController
+    from uvms_pin.controllers.impedance import ImpedanceController
+    from uvms_pin.controllers.pi_force import PIForceController
+
+    ee_frame = _ee_frame(t, uvms, kind)
+    sizes = {"nv": uvms.nv, "arm": uvms.n_arm_joints}
+    fields: dict[str, Any] = {}
+    for key, size in _BASELINE_KEYS[kind].items():
+        if t.has(key):
+            fields[key] = t.vector(key, sizes.get(size, size))
+    if kind != "impedance" and t.has("null_space_gain_per_s"):
+        fields["null_space_gain_per_s"] = t.number("null_space_gain_per_s", nonneg=True)
+    fields["desired_rpy"] = t.vector("desired_rpy", 3, [0.0, 0.0, 0.0])
+    force_table = t.table("desired_force")
+    force_raw = {} if force_table is None else dict(force_table._data)
+    fields["desired_force_world_N"] = _sine_profile(force_table, 3)
+    factors: dict[str, float] = {}
+    error_table = t.table("model_error") if kind == "computed_torque" else None
+    if error_table is not None:
+        factors = {k: error_table.number(k, 1.0, positive=True) for k in _MODEL_ERROR_KEYS}
+        error_table.finish()
+    t.finish()
+
+    def build(u: UVMS) -> Controller:
+        if kind == "computed_torque":
+            from uvms_pin.study.plant import scaled_uvms
+
+            return ComputedTorqueController(scaled_uvms(u, **factors), ee_frame, **fields)
+        cls = PIForceController if kind == "pi_force" else ImpedanceController
+        return cls(u.model, ee_frame, **fields)
+
+    try:
+        build(uvms)
+    except ParameterError as exc:
+        raise ScenarioError(f"{t._source}: [controller]: {exc}") from exc
+    recorded = {
+        "ee_frame": ee_frame,
+        "desired_force": force_raw,
+        "model_error": factors,
+        **{k: _plain(v) for k, v in fields.items() if k != "desired_force_world_N"},
+    }
+    return ControllerSpec(kind, recorded, build)
+
+
 _CONTROLLER_BUILDERS: dict[str, Callable[[_Table, UVMS], ControllerSpec]] = {
     "none": _zero_controller,
     "ppc": _ppc_controller,
+    **{
+        kind: functools.partial(_baseline_controller, kind=kind)
+        for kind in ("pi_force", "impedance", "computed_torque")
+    },
 }
 
 

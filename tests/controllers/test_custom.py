@@ -142,7 +142,10 @@ def test_ppc_records_its_resolved_parameters():
         ('type = "my_ctrl_c:NotAController"', "derived from uvms_pin.controllers.base.Controller"),
         ('type = "my_ctrl_c:ConstantWrench"\nwrong = 1', "rejected its parameters (wrong)"),
         ('type = "my_ctrl_c:"', "expected 'package.module:ClassName'"),
-        ('type = "pcc"', "must be one of none, ppc or 'package.module:ClassName'"),
+        (
+            'type = "pcc"',
+            "must be one of none, ppc, pi_force, impedance, computed_torque or 'package.module:ClassName'",
+        ),
     ],
 )
 def test_bad_controllers_are_named(tmp_path, controller, needle):
