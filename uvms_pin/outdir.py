@@ -64,6 +64,7 @@ RUN = OutputKind(
         "force.png",
         "first_level_errors.png",
         "second_level_errors.png",
+        "flow.png",  # runs with waves or a varying current
     ),
     ("rollout.npz", "rollout.json", "metrics.json", "replay.html"),
 )
