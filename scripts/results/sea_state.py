@@ -1,5 +1,7 @@
-"""The realistic task under a JONSWAP sea (Hs 0.5 m, Tp 5 s, 2 m deep): metrics and force figure."""
+"""The realistic task under a JONSWAP sea (Hs 0.5 m, Tp 5 s, 2 m deep): metrics, force and
+flow figures."""
 
+from _common import SCRATCH, publish_figure
 from _scenario_run import produce
 
 if __name__ == "__main__":
@@ -9,3 +11,4 @@ if __name__ == "__main__":
         "The realistic task under a sea state (JONSWAP Hs 0.5 m, Tp 5 s, LBV150 at 2 m)",
         "sea_state_force.png",
     )
+    publish_figure(SCRATCH / "sea_state" / "flow.png", "sea_state_flow.png")
