@@ -10,6 +10,7 @@ missing transpose or misplaced lever arm (those are O(1) relative errors).
 from __future__ import annotations
 
 import math
+import warnings
 
 import numpy as np
 import pinocchio as pin
@@ -361,12 +362,15 @@ MASS_VOLUME_WARNINGS = {
 
 @pytest.mark.parametrize("case", list(MASS_VOLUME_WARNINGS), ids=list(MASS_VOLUME_WARNINGS))
 def test_mass_volume_mismatch_warns_naming_file_and_link(write_urdf, case):
+    """A rigid body (here the fin, on its own revolute joint) with buoyancy but no weight,
+    or the reverse."""
     body, expected = MASS_VOLUME_WARNINGS[case]
     path = write_urdf(
         _robot(
             _link("body", INERTIAL + f"<hydrodynamics>{GOOD_HYDRO}</hydrodynamics>"),
             _link("fin", body),
-            _fixed("body", "fin"),
+            '<joint name="hinge" type="revolute"><parent link="body"/><child link="fin"/>'
+            '<axis xyz="0 0 1"/><limit lower="-1" upper="1" effort="1" velocity="1"/></joint>',
         )
     )
     with pytest.warns(up.ModelWarning) as record:
@@ -375,6 +379,23 @@ def test_mass_volume_mismatch_warns_naming_file_and_link(write_urdf, case):
     assert len(messages) == 1, messages
     assert str(path) in messages[0] and "link 'fin'" in messages[0]
     assert expected in messages[0], messages[0]
+
+
+@pytest.mark.parametrize("case", list(MASS_VOLUME_WARNINGS), ids=list(MASS_VOLUME_WARNINGS))
+def test_a_buoyancy_link_fixed_to_a_mass_link_is_one_body_and_no_surprise(write_urdf, case):
+    """Links merged by a fixed joint are one rigid body: a volume-only link (e.g. a centre of
+    buoyancy of its own) on a link with mass warns only if the body as a whole mismatches."""
+    body, _ = MASS_VOLUME_WARNINGS[case]
+    path = write_urdf(
+        _robot(
+            _link("body", INERTIAL + f"<hydrodynamics>{GOOD_HYDRO}</hydrodynamics>"),
+            _link("fin", body),
+            _fixed("body", "fin"),
+        )
+    )
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", up.ModelWarning)
+        up.load_uvms(path, ee_frame="body", sensor_frame="body")
 
 
 def test_reference_model_loads_without_warnings(recwarn):

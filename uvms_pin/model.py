@@ -271,6 +271,7 @@ def load_uvms(
     _check_joint_limits(root, where)
     _read_armature(root, model, where)
     bodies: list[HydroBody] = []
+    checked: dict[int, list] = {}  # joint -> [mass kg, volume m^3, link names] of wet links
     for name, link in links.items():
         has_inertial = link.find("inertial") is not None
         collisions = link.findall("collision")
@@ -307,8 +308,13 @@ def load_uvms(
                 link=name,
             )
         if len(bodies) > n_bodies:  # a dry link accepted by allow_dry_links is no surprise
-            volume_m3 = sum(b.params.volume_m3 for b in bodies[n_bodies:])
-            _warn_on_mass_volume_mismatch(mass_kg, volume_m3, where, name)
+            entry = checked.setdefault(joint_id, [0.0, 0.0, []])
+            entry[0] += mass_kg
+            entry[1] += sum(b.params.volume_m3 for b in bodies[n_bodies:])
+            entry[2].append(name)
+    # per rigid body (links merged by fixed joints): a buoyancy link beside a mass link is fine
+    for mass_kg, volume_m3, names in checked.values():
+        _warn_on_mass_volume_mismatch(mass_kg, volume_m3, where, "', '".join(names))
 
     return UVMS(
         model=model,
