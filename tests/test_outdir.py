@@ -83,11 +83,11 @@ def test_the_comparison_overwrite_removes_its_models_directory_once_empty(tmp_pa
 
 def test_run_outputs_are_exactly_the_files_a_run_writes(tmp_path):
     """RUN lists the outputs by name: a new figure must be added there (or --overwrite
-    would leave it stale)."""
+    would leave it stale). The sea-state scenario writes every figure (flow.png too)."""
     from uvms_pin.cli import write_outputs
     from uvms_pin.scenario import load_scenario, simulate
 
-    text = (ROOT / "scenarios" / "realistic_force_tracking.toml").read_text()
+    text = (ROOT / "scenarios" / "sea_state_force_tracking.toml").read_text()
     text = text.replace("../models/", f"{ROOT}/models/").replace(
         "duration_s = 10.0", "duration_s = 0.04"
     )
