@@ -21,7 +21,8 @@ import numpy as np
 import pinocchio as pin  # loads libpinocchio_default before the extension needs it
 
 from uvms_pin.errors import ParameterError, UvmsPinError
-from uvms_pin.flow import AiryWave, FlowField, IrregularSea, SumFlow, UniformCurrent
+from uvms_pin.flow import FlowField, SumFlow, UniformCurrent
+from uvms_pin.flow.components import WaveField
 from uvms_pin.model import UVMS
 
 BACKENDS = ("core", "python")
@@ -138,7 +139,7 @@ def compiled_flow(flow: FlowField | None) -> tuple[np.ndarray, np.ndarray, float
     for field in flow.fields if isinstance(flow, SumFlow) else (() if flow is None else (flow,)):
         if isinstance(field, UniformCurrent):
             current = current + field.velocity_world_m_s
-        elif isinstance(field, AiryWave | IrregularSea):
+        elif isinstance(field, WaveField):
             c = field.components
             tables.append(
                 np.column_stack(

@@ -7,8 +7,12 @@ import math
 import numpy as np
 
 from uvms_pin.errors import ParameterError
-from uvms_pin.flow.base import FlowField, as_points
-from uvms_pin.flow.components import STANDARD_GRAVITY_M_S2, WaveComponents, wavenumber
+from uvms_pin.flow.components import (
+    STANDARD_GRAVITY_M_S2,
+    WaveComponents,
+    WaveField,
+    wavenumber,
+)
 
 __all__ = ["AiryWave", "wavenumber"]
 
@@ -22,7 +26,7 @@ def _finite(value: float, name: str, *, positive: bool = False) -> float:
     return value
 
 
-class AiryWave(FlowField):
+class AiryWave(WaveField):
     """eta = A cos(k e.p - w t + phi): linear wave theory in finite or infinite depth.
 
     Args:
@@ -72,25 +76,6 @@ class AiryWave(FlowField):
     @property
     def wavelength_m(self) -> float:
         return 2.0 * math.pi / self.wavenumber_rad_m
-
-    def velocity(self, time_s, points_world):
-        return self.components.velocity(time_s, as_points(points_world))
-
-    def local_acceleration(self, time_s, points_world):
-        return self.components.local_acceleration(time_s, as_points(points_world))
-
-    def velocity_gradient(self, time_s, points_world):
-        return self.components.velocity_gradient(time_s, as_points(points_world))
-
-    def kinematics(self, time_s, points_world):
-        return self.components.kinematics(time_s, as_points(points_world))
-
-    @property
-    def has_free_surface(self) -> bool:
-        return True
-
-    def surface_elevation(self, time_s, xy_world):
-        return self.components.elevation(time_s, np.asarray(xy_world, dtype=float).reshape(-1, 2))
 
     def __repr__(self) -> str:
         return (

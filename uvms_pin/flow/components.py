@@ -23,6 +23,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from uvms_pin.errors import ParameterError
+from uvms_pin.flow.base import FlowField, as_points
 
 STANDARD_GRAVITY_M_S2 = 9.81
 
@@ -133,3 +134,29 @@ class WaveComponents:
             grad[:, 2, i] = grad[:, i, 2]  # irrotational: grad u is symmetric
         grad[:, 2, 2] = c_sin.sum(axis=1)
         return grad
+
+
+class WaveField(FlowField):
+    """A flow made of linear wave components (``self.components``, set by the subclass):
+    it has a moving free surface, and its kinematics are those of `WaveComponents`."""
+
+    components: WaveComponents
+
+    def velocity(self, time_s, points_world):
+        return self.components.velocity(time_s, as_points(points_world))
+
+    def local_acceleration(self, time_s, points_world):
+        return self.components.local_acceleration(time_s, as_points(points_world))
+
+    def velocity_gradient(self, time_s, points_world):
+        return self.components.velocity_gradient(time_s, as_points(points_world))
+
+    def kinematics(self, time_s, points_world):
+        return self.components.kinematics(time_s, as_points(points_world))
+
+    @property
+    def has_free_surface(self) -> bool:
+        return True
+
+    def surface_elevation(self, time_s, xy_world):
+        return self.components.elevation(time_s, np.asarray(xy_world, dtype=float).reshape(-1, 2))

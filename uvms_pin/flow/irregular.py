@@ -16,8 +16,12 @@ import math
 import numpy as np
 
 from uvms_pin.errors import ParameterError
-from uvms_pin.flow.base import FlowField, as_points
-from uvms_pin.flow.components import STANDARD_GRAVITY_M_S2, WaveComponents, wavenumber
+from uvms_pin.flow.components import (
+    STANDARD_GRAVITY_M_S2,
+    WaveComponents,
+    WaveField,
+    wavenumber,
+)
 from uvms_pin.flow.spectrum import jonswap_spectrum
 
 
@@ -35,7 +39,7 @@ def _spread_headings(
     return mean_rad + np.interp(rng.uniform(size=count), cdf, grid)
 
 
-class IrregularSea(FlowField):
+class IrregularSea(WaveField):
     """A seeded realisation of a JONSWAP sea (gamma = 1: Pierson-Moskowitz).
 
     Args:
@@ -98,25 +102,6 @@ class IrregularSea(FlowField):
     def components_significant_height_m(self) -> float:
         """4 sqrt(sum A_j^2 / 2): the significant height the drawn components carry."""
         return 4.0 * math.sqrt(0.5 * float(np.sum(self.components.amplitude_m**2)))
-
-    def velocity(self, time_s, points_world):
-        return self.components.velocity(time_s, as_points(points_world))
-
-    def local_acceleration(self, time_s, points_world):
-        return self.components.local_acceleration(time_s, as_points(points_world))
-
-    def velocity_gradient(self, time_s, points_world):
-        return self.components.velocity_gradient(time_s, as_points(points_world))
-
-    def kinematics(self, time_s, points_world):
-        return self.components.kinematics(time_s, as_points(points_world))
-
-    @property
-    def has_free_surface(self) -> bool:
-        return True
-
-    def surface_elevation(self, time_s, xy_world):
-        return self.components.elevation(time_s, np.asarray(xy_world, dtype=float).reshape(-1, 2))
 
     def __repr__(self) -> str:
         return (
