@@ -118,7 +118,8 @@ _SUSPICIOUS_URDF = """<robot name="r">
 <inertia ixx="0" iyy="0" izz="0" ixy="0" ixz="0" iyz="0"/></inertial>
 <hydrodynamics><volume value="0.001"/></hydrodynamics></link>
 <link name="ee"/><link name="ft_sensor"/>
-<joint name="j1" type="fixed"><parent link="body"/><child link="fin"/></joint>
+<joint name="j1" type="revolute"><parent link="body"/><child link="fin"/>
+<axis xyz="0 0 1"/><limit lower="-1" upper="1" effort="1" velocity="1"/></joint>
 <joint name="j2" type="fixed"><parent link="body"/><child link="ee"/></joint>
 <joint name="j3" type="fixed"><parent link="body"/><child link="ft_sensor"/></joint>
 </robot>
