@@ -187,6 +187,7 @@ class Plant:
         if self.contact is not None:
             position, _, _ = self.ee_state(q0, np.zeros(self.uvms.nv))
             self.contact.attach(position)
+        self._flow = self.water_flow  # the current and flow as they are now, like the core
         self.__dict__.pop("_compiled", None)
 
     def contact_wrench(self, q: np.ndarray, v: np.ndarray) -> np.ndarray:
