@@ -74,8 +74,12 @@ class Dynamics {
 
  private:
   void prepare();
-  void prepare_articulated();                        // articulated_body.cpp
-  void articulated_body_pass(const ConstVec& tau);  // articulated_body.cpp
+  // articulated_body.cpp
+  void prepare_articulated();
+  void articulated_body_pass(const ConstVec& tau);
+  void articulated_bodies();  // each body's own inertia and bias wrench
+  void articulated_backward(int joint, const ConstVec& tau, Mat6& inertia_art, Vec6& bias_art);
+  void articulated_forward(int joint, const Vec6& parent_acceleration);
 
   Model model_;
   Data data_;
@@ -89,15 +93,28 @@ class Dynamics {
   Eigen::Matrix<double, 6, Eigen::Dynamic> jacobian_, added_times_jacobian_;
   Eigen::LLT<Eigen::MatrixXd> cholesky_;
 
-  // articulated-body pass: constant motion subspaces and per-joint buffers
+  // articulated-body pass (articulated_body.cpp). Each joint's motion subspace S is constant
+  // in its frame; the pass is specialised by its kind: a free-flyer (S = I, 6x6 LLT), a
+  // one-DoF joint (S a 6-vector: scalar D, rank-one update) or any other (n <= 6, generic).
+  enum class JointKind { kFree, kOneDof, kGeneric };
   using Subspace = Eigen::Matrix<double, 6, Eigen::Dynamic, 0, 6, 6>;
   using Small = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, 6, 6>;
+  using SmallVec = Eigen::Matrix<double, Eigen::Dynamic, 1, 0, 6, 1>;
   bool articulated_ = false;
+  std::vector<JointKind> kind_;
+  aligned_vector<Mat6> body_inertia_;  // I_i + M_A,i in joint i's frame (constant)
+  aligned_vector<Mat6> inertia_a_;     // articulated inertia I^A_i
+  aligned_vector<Vec6> bias_a_, bias_acc_, acc_;
+  // one-DoF joints: S, U = I^A S, 1 / D, u = tau - S^T p^A
+  aligned_vector<Vec6> axis_, u_axis_;
+  std::vector<double> d_inv_, u_scalar_;
+  // free-flyers: D = I^A (+ armature) factored, u = tau - p^A
+  std::vector<Eigen::LLT<Mat6>, Eigen::aligned_allocator<Eigen::LLT<Mat6>>> d_free_;
+  aligned_vector<Vec6> u_free_;
+  // other joints
   std::vector<Subspace, Eigen::aligned_allocator<Subspace>> subspace_, u_mat_, u_dinv_;
   std::vector<Small, Eigen::aligned_allocator<Small>> dinv_;
-  aligned_vector<Mat6> inertia_a_;
-  aligned_vector<Vec6> bias_a_, bias_acc_, acc_;
-  std::vector<Eigen::Matrix<double, Eigen::Dynamic, 1, 0, 6, 1>> u_vec_;
+  std::vector<SmallVec, Eigen::aligned_allocator<SmallVec>> u_vec_;
 };
 
 // Model from the text archive of Python's pin.Model.saveToString() (model_io.cpp).
