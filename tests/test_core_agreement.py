@@ -8,6 +8,7 @@ plant advanced over a control period by RK4 and semi-implicit Euler.
 from __future__ import annotations
 
 import numpy as np
+import pinocchio as pin
 import pytest
 from conftest import REFERENCE_URDF, random_configuration
 
@@ -15,7 +16,7 @@ import uvms_pin as up
 from uvms_pin.arms.catalog import CATALOG
 from uvms_pin.arms.reference import split_urdf
 from uvms_pin.environment import CompliantPlane, LinearSpring, SinusoidalDisturbance
-from uvms_pin.integrators import RK4, SemiImplicitEuler
+from uvms_pin.integrators import RK4, SemiImplicitEuler, python_chart
 from uvms_pin.plant import Plant
 from uvms_pin.resources import example_robot_data_dir
 
@@ -156,3 +157,52 @@ def test_advance_over_a_control_period_matches_the_reference(
             q_p, v_p = python.advance(integrator, 0.1, q0, v0, tau, 0.102)
             assert_rel(q_c, q_p)
             assert_rel(v_c, v_p)
+
+
+def test_compiled_chart_matches_pinocchio_from_python(reference_uvms, mounted_arms):
+    rng = np.random.default_rng(11)
+    for uvms in _models(reference_uvms, mounted_arms).values():
+        chart = Plant(uvms).chart()
+        reference = python_chart(uvms.model)
+        for _ in range(5):
+            q0 = random_configuration(uvms, rng)
+            delta = rng.normal(scale=0.3, size=uvms.nv)
+            v = rng.normal(size=uvms.nv)
+            for got, expected in zip(chart(q0, delta, v), reference(q0, delta, v), strict=True):
+                assert_rel(got, expected)
+
+
+def _with_spherical_joint(uvms: up.UVMS, joint_id: int) -> up.UVMS:
+    """The same bodies and frames, joint ``joint_id`` (a revolute) made a ball joint."""
+    old = uvms.model
+    new = pin.Model()
+    new.name, new.gravity = old.name, old.gravity
+    for j in range(1, old.njoints):
+        joint = pin.JointModelSpherical() if j == joint_id else old.joints[j]
+        added = new.addJoint(old.parents[j], joint, old.jointPlacements[j], old.names[j])
+        new.appendBodyToJoint(added, old.inertias[j], pin.SE3.Identity())
+        new.armature[new.joints[added].idx_v : new.joints[added].idx_v + joint.nv] = (
+            old.armature[old.joints[j].idx_v] if joint.nv == 1 else 1e-3
+        )
+    for f in list(old.frames)[1:]:
+        new.addFrame(
+            pin.Frame(f.name, f.parentJoint, f.parentFrame, f.placement, f.type, f.inertia),
+            False,
+        )
+    return uvms.with_model(new)
+
+
+def test_generic_joints_in_the_articulated_pass_match_the_reference(reference_uvms):
+    """A 3-DoF (spherical) joint takes the pass's generic route: same answer as M and h."""
+    uvms = _with_spherical_joint(reference_uvms, 3)
+    assert uvms.model.joints[3].shortname() == "JointModelSpherical"
+    rng = np.random.default_rng(12)
+    for _ in range(5):
+        q = pin.randomConfiguration(uvms.model, -np.ones(uvms.model.nq), np.ones(uvms.model.nq))
+        v = rng.normal(scale=0.5, size=uvms.nv)
+        tau = rng.normal(scale=5.0, size=uvms.nv)
+        current = np.array([0.3, -0.2, 0.1])
+        assert_rel(
+            up.forward_dynamics(uvms, q, v, tau, current),
+            up.forward_dynamics(uvms, q, v, tau, current, backend="python"),
+        )

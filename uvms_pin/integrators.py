@@ -25,6 +25,9 @@ from uvms_pin.errors import ParameterError, SimulationError
 Rhs = Callable[[float, np.ndarray, np.ndarray], np.ndarray]
 Event = Callable[[float, np.ndarray, np.ndarray], float]
 """A function of (t, q, v) whose downward zero crossing stops an adaptive integration."""
+Chart = Callable[[np.ndarray, np.ndarray, np.ndarray], tuple[np.ndarray, np.ndarray]]
+"""(q0, delta, v) -> (integrate(q0, delta), Jint(q0, delta)^-1 v): the local chart, e.g. the
+compiled plant's ``chart`` (default: `python_chart`)."""
 
 
 class Integrator(ABC):
@@ -52,11 +55,14 @@ class Integrator(ABC):
         v0: np.ndarray,
         times: np.ndarray,
         event: Event | None = None,
+        chart: Chart | None = None,
     ) -> list[tuple[float, np.ndarray, np.ndarray]]:
         """(t, q, v) at each of the increasing ``times`` (> t0), in one pass.
 
         With an ``event`` (adaptive integrators only; fixed-step ones ignore it), the pass
         stops where the event crosses zero downwards: the last entry is then that state.
+        ``chart`` (adaptive integrators only) evaluates the local chart; None: Pinocchio's
+        integrate and dIntegrate from Python (`python_chart`).
         """
         out = []
         t, q, v = t0, q0, v0
@@ -71,6 +77,15 @@ def _chart_rate(model: pin.Model, q0: np.ndarray, delta: np.ndarray, v: np.ndarr
     """delta_dot with integrate(q0, delta)'s velocity equal to v (body-frame zeta)."""
     jac = pin.dIntegrate(model, q0, delta, pin.ARG1)
     return np.linalg.solve(jac, v)
+
+
+def python_chart(model: pin.Model) -> Chart:
+    """The local chart of ``model`` evaluated from Python (the reference of the core's)."""
+
+    def chart(q0: np.ndarray, delta: np.ndarray, v: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        return pin.integrate(model, q0, delta), _chart_rate(model, q0, delta, v)
+
+    return chart
 
 
 def _substeps(t0: float, t1: float, max_step_s: float) -> tuple[int, float]:
@@ -175,11 +190,12 @@ class Adaptive(Integrator):
         _, q, v = self.advance_through(model, rhs, t0, q0, v0, np.array([t1]))[-1]
         return q, v
 
-    def advance_through(self, model, rhs, t0, q0, v0, times, event=None):
+    def advance_through(self, model, rhs, t0, q0, v0, times, event=None, chart=None):
         """One solve_ivp call from t0 to times[-1] in the chart at q0 (keeps the step size
         and Jacobian history across output times; re-base by calling again). The event,
         if any, is checked on every accepted step and located by root finding."""
         nv = model.nv
+        chart = python_chart(model) if chart is None else chart
         times = np.asarray(times, dtype=float)
         events = None
         if event is not None:
@@ -193,9 +209,9 @@ class Adaptive(Integrator):
 
         def chart_rhs(t: float, y: np.ndarray) -> np.ndarray:
             delta, v = y[:nv], y[nv:]
-            q = pin.integrate(model, q0, delta)
+            q, delta_dot = chart(q0, delta, v)
             out = np.empty(2 * nv)
-            out[:nv] = _chart_rate(model, q0, delta, v)
+            out[:nv] = delta_dot
             out[nv:] = rhs(t, q, v)
             return out
 

@@ -38,7 +38,7 @@ from uvms_pin.environment import (
 )
 from uvms_pin.errors import ParameterError, SimulationError
 from uvms_pin.flow import FlowField, SumFlow, UniformCurrent
-from uvms_pin.integrators import Integrator
+from uvms_pin.integrators import Chart, Integrator
 from uvms_pin.model import UVMS
 
 
@@ -242,6 +242,11 @@ class Plant:
             time_s=time_s,
             backend=self.backend,
         )
+
+    def chart(self) -> Chart | None:
+        """The compiled local chart of the adaptive integrators, or None (Python path)."""
+        compiled = self._core()
+        return None if compiled is None else compiled.chart
 
     def advance(
         self,

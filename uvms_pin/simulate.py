@@ -320,7 +320,14 @@ def simulate_closed_loop(
                 failure = None
                 try:
                     states = settings.integrator.advance_through(
-                        model, continuous_rhs, t0, q, v, times, margin_event if adaptive else None
+                        model,
+                        continuous_rhs,
+                        t0,
+                        q,
+                        v,
+                        times,
+                        margin_event if adaptive else None,
+                        chart=plant.chart(),
                     )
                 except SimulationError as exc:  # log the states reached before the failure
                     states, failure = getattr(exc, "states", []), exc

@@ -273,5 +273,14 @@ NB_MODULE(_core, m) {
             }
             return p.advance(t0, q0, v0, tau, t1, max_step_s, rk4);
           },
-          "t0"_a, "q0"_a, "v0"_a, "tau"_a, "t1"_a, "max_step_s"_a, "rk4"_a);
+          "t0"_a, "q0"_a, "v0"_a, "tau"_a, "t1"_a, "max_step_s"_a, "rk4"_a)
+      .def(
+          "chart",
+          [](uvms::Plant& p, const ConstVec& q0, const ConstVec& delta, const ConstVec& v) {
+            check_vector("q0", q0, p.dynamics().nq());
+            check_vector("delta", delta, p.dynamics().nv());
+            check_vector("v", v, p.dynamics().nv());
+            return p.chart(q0, delta, v);
+          },
+          "q0"_a, "delta"_a, "v"_a);
 }

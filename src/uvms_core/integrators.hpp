@@ -13,6 +13,8 @@
 #include <pinocchio/algorithm/joint-configuration.hpp>
 #include <pinocchio/multibody/model.hpp>
 
+#include "types.hpp"
+
 namespace uvms {
 
 // n equal substeps no longer than max_step_s between t0 and t1, and their length.
@@ -27,15 +29,25 @@ struct ManifoldStepper {
       : model(model),
         q(model.nq), v(model.nv), q_stage(model.nq), v_stage(model.nv), delta(model.nv),
         a1(model.nv), a2(model.nv), a3(model.nv), a4(model.nv), d1(model.nv), d2(model.nv),
-        d3(model.nv), d4(model.nv), jac(Eigen::MatrixXd::Zero(model.nv, model.nv)), lu(model.nv) {}
+        d3(model.nv), d4(model.nv), jac(Eigen::MatrixXd::Zero(model.nv, model.nv)) {}
 
-  // delta_dot with integrate(q0, delta)'s velocity equal to velocity (dIntegrate writes the
-  // joints' diagonal blocks only: jac starts at zero)
+  // delta_dot with integrate(q0, delta)'s velocity equal to velocity. dIntegrate is block
+  // diagonal (each joint's own block; jac starts at zero), so each joint's block is solved
+  // on its own: 1 for a one-DoF joint, a 6x6 LU for a free-flyer.
   void chart_rate(const Eigen::VectorXd& q0, const Eigen::VectorXd& delta_in,
                   const Eigen::VectorXd& velocity, Eigen::VectorXd& out) {
     pinocchio::dIntegrate(model, q0, delta_in, jac, pinocchio::ARG1);
-    lu.compute(jac);
-    out = lu.solve(velocity);
+    for (int j = 1; j < model.njoints; ++j) {
+      const int idx = model.joints[j].idx_v(), n = model.joints[j].nv();
+      if (n == 1) {
+        out[idx] = velocity[idx] / jac(idx, idx);
+      } else if (n == 6) {
+        out.segment<6>(idx) =
+            Eigen::PartialPivLU<Mat6>(jac.block<6, 6>(idx, idx)).solve(velocity.segment<6>(idx));
+      } else {
+        out.segment(idx, n) = jac.block(idx, idx, n, n).partialPivLu().solve(velocity.segment(idx, n));
+      }
+    }
   }
 
   template <class Rhs>
@@ -87,7 +99,6 @@ struct ManifoldStepper {
   const pinocchio::Model& model;
   Eigen::VectorXd q, v, q_stage, v_stage, delta, a1, a2, a3, a4, d1, d2, d3, d4;
   Eigen::MatrixXd jac;
-  Eigen::PartialPivLU<Eigen::MatrixXd> lu;
 };
 
 }  // namespace uvms

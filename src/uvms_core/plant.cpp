@@ -69,4 +69,15 @@ std::pair<Eigen::VectorXd, Eigen::VectorXd> Plant::advance(double t0, const Cons
   return {stepper_.q, stepper_.v};
 }
 
+std::pair<Eigen::VectorXd, Eigen::VectorXd> Plant::chart(const ConstVec& q0,
+                                                         const ConstVec& delta,
+                                                         const ConstVec& v) {
+  stepper_.q = q0;
+  stepper_.delta = delta;
+  stepper_.v = v;
+  pinocchio::integrate(dynamics_.model(), stepper_.q, stepper_.delta, stepper_.q_stage);
+  stepper_.chart_rate(stepper_.q, stepper_.delta, stepper_.v, stepper_.d1);
+  return {stepper_.q_stage, stepper_.d1};
+}
+
 }  // namespace uvms

@@ -33,6 +33,11 @@ class Plant {
                                                       const ConstVec& v0, const ConstVec& tau,
                                                       double t1, double max_step_s, bool rk4);
 
+  // The local chart of the adaptive integrators (integrators.py, Adaptive): the
+  // configuration q = integrate(q0, delta) and delta_dot = Jint(q0, delta)^-1 v.
+  std::pair<Eigen::VectorXd, Eigen::VectorXd> chart(const ConstVec& q0, const ConstVec& delta,
+                                                    const ConstVec& v);
+
   Dynamics& dynamics() { return dynamics_; }
 
  private:
