@@ -138,7 +138,10 @@ class ThrustersAndJointLimits(Actuation):
 
     def thrusts(self, tau_commanded: np.ndarray) -> np.ndarray:
         """Per-thruster thrust f (m,) [N] after allocation and saturation."""
-        return np.clip(self._allocation_pinv @ tau_commanded[:6], self._lower, self._upper)
+        # minimum(maximum()) is np.clip without its per-call dispatch cost
+        return np.minimum(
+            np.maximum(self._allocation_pinv @ tau_commanded[:6], self._lower), self._upper
+        )
 
     def saturated(self, tau_commanded: np.ndarray) -> bool:
         """True when a thruster or a joint cannot give what the command asks."""
@@ -159,5 +162,6 @@ class ThrustersAndJointLimits(Actuation):
                 raise ParameterError(
                     f"{arm.size} arm torques for {self.joint_effort_limits_Nm.size} effort limits"
                 )
-            out[6:] = np.clip(arm, -self.joint_effort_limits_Nm, self.joint_effort_limits_Nm)
+            limits = self.joint_effort_limits_Nm
+            out[6:] = np.minimum(np.maximum(arm, -limits), limits)
         return out

@@ -98,6 +98,11 @@ class SampledNoise:
             self._window = np.concatenate([keep, fresh])
         return self._window[k - self._first : k - self._first + 2]
 
+    @property
+    def silent(self) -> bool:
+        """True when the noise is identically zero (bound 0)."""
+        return self._spec.bound == 0.0
+
     def __call__(self, time_s: float) -> np.ndarray:
         position = max(time_s, 0.0) / self.period_s
         k = min(int(position + 1e-9), self._rows - 2)
@@ -157,7 +162,14 @@ class SensorSuite:
         )
 
     def force_noise(self, time_s: float) -> np.ndarray:
-        return np.concatenate([self._force(time_s), self._torque(time_s)])
+        """[force noise (3) N; torque noise (3) N m] at time_s."""
+        out = np.zeros(6)
+        # a silent channel is zero by construction: nothing to draw or blend
+        if not self._force.silent:
+            out[:3] = self._force(time_s)
+        if not self._torque.silent:
+            out[3:] = self._torque(time_s)
+        return out
 
     def measure(
         self, time_s: float, q: np.ndarray, v: np.ndarray, wrench_world: np.ndarray
