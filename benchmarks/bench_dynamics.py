@@ -81,6 +81,15 @@ def call_rows(uvms: up.UVMS, number: int, repeat: int) -> dict[str, float]:
             lambda p=plant: p.advance(rk4, 0.0, q, v, tau, 0.002),
             max(1, number // 20),
         )
+    # the marginal cost of hydrodynamic bodies: the same plant with the arm links dry (only
+    # the vehicle in water), against every body in water as above
+    dry_arm = uvms.with_hydro(lambda b: b.params if b.joint_id == 1 else up.HydroParams.dry())
+    plant = Plant(dry_arm, current, LinearSpring(np.full(3, 2.0)), SinusoidalDisturbance())
+    plant.attach(q)
+    cases["core: plant over 2 ms, arm links dry"] = (
+        lambda p=plant: p.advance(rk4, 0.0, q, v, tau, 0.002),
+        max(1, number // 20),
+    )
     return {name: best_time(fn, n, repeat) for name, (fn, n) in cases.items()}
 
 
@@ -125,6 +134,10 @@ def main() -> None:
     for what in ("forward_dynamics (current)", "plant over 2 ms (RK4 0.5 ms)"):
         speedup = calls[f"python: {what}"] / calls[f"core: {what}"]
         print(f"speed-up core / python, {what}: {speedup:.1f}x")
+    wet = (
+        calls["core: plant over 2 ms (RK4 0.5 ms)"] / calls["core: plant over 2 ms, arm links dry"]
+    )
+    print(f"core plant, every body in water / only the vehicle in water: {wet:.2f}x")
 
     loops = closed_loop_rows(args.loop_s)
     width = max(len(n) for n in loops)
