@@ -81,6 +81,8 @@ def best_times(
     machine's quiet moments for every case alike.
     """
     timers = {name: timeit.Timer(fn, timer=time.process_time) for name, fn in cases.items()}
+    for fn in cases.values():
+        fn()  # warm up first: a first call that builds caches would shrink the batch size
     numbers = {name: max(1, round(batch_s / timer.timeit(1))) for name, timer in timers.items()}
     best = dict.fromkeys(cases, math.inf)
     for _ in range(repeat):
