@@ -150,11 +150,13 @@ def count_svd_fallbacks(monkeypatch):
 
 @pytest.mark.parametrize("stem", SCENARIOS)
 def test_oracle_still_gives_the_recorded_outputs(stem):
-    """Guards the oracle itself: it reproduces, bit for bit, what it gave when recorded."""
+    """Guards the oracle itself: it reproduces what it gave when recorded, to 1e-12 (not bit
+    for bit: its SVD's last bits move with the numpy / LAPACK build)."""
     _, oracle = scenario_pair(stem)
     for measurement, extended, tau in recorded(stem):
         oracle.set_funnel_extension(extended)
-        np.testing.assert_array_equal(oracle.compute(measurement.time_s, measurement), tau)
+        got = oracle.compute(measurement.time_s, measurement)
+        np.testing.assert_allclose(got, tau, rtol=1e-12, atol=1e-12 * np.max(np.abs(tau)))
 
 
 @pytest.mark.parametrize("stem", SCENARIOS)
