@@ -11,6 +11,7 @@ to the reference on exactly the calls the reference raises for or extends beyond
 
 from __future__ import annotations
 
+import copy
 import math
 
 import numpy as np
@@ -515,6 +516,23 @@ def test_signals_margin_and_reset_follow_the_last_successful_call(reference_pair
     assert len(calls) == 2  # the violation and the extension beyond the clamp
     core.reset()
     assert core.last_signals is None and core.signals() == {} and core.funnel_margin() == np.inf
+
+
+@pytest.mark.parametrize("backend", ["core", "python"])
+def test_a_copy_computes_the_same_and_keeps_the_last_signals(reference_pair, backend):
+    model, q, build = reference_pair
+    controller = build()[0 if backend == "core" else 1]
+    measurement = Measurement(0.1, q, np.full(model.nv, 0.05), np.r_[0.3, 0, 0, 0, 0, 0])
+    tau = controller.compute(0.1, measurement)
+    clone = copy.deepcopy(controller)
+    assert clone.backend == backend and (clone._kernel is None) == (backend == "python")
+    assert clone.funnel_margin() == controller.funnel_margin()
+    for name, value in controller.signals().items():
+        np.testing.assert_array_equal(clone.signals()[name], value)
+    np.testing.assert_array_equal(clone.compute(0.1, measurement), tau)
+    other = Measurement(0.2, q, np.full(model.nv, -0.05), np.r_[0.1, 0, 0, 0, 0, 0])
+    clone.compute(0.2, other)  # the clone's buffers are its own
+    assert controller.last_signals.time_s == 0.1 and clone.last_signals.time_s == 0.2
 
 
 # ---------------------------------------------------------------- closed loop

@@ -454,6 +454,20 @@ class PrescribedPerformanceController(Controller):
         self._core_margin = packed[kernel.margin_offset() :]
         return kernel
 
+    _KERNEL_ATTRIBUTES = ("_kernel", "_core_signals", "_core_tau", "_core_margin")
+
+    def __getstate__(self) -> dict:
+        """For copy and pickle: the compiled kernel is rebuilt, the last signals kept."""
+        self.last_signals  # noqa: B018 - builds the PPCSignals (from the kernel's buffers)
+        state = {k: v for k, v in self.__dict__.items() if k not in self._KERNEL_ATTRIBUTES}
+        state["_margin"] = self.funnel_margin()
+        state["_core_last"] = None
+        return state
+
+    def __setstate__(self, state: dict) -> None:
+        self.__dict__.update(state)
+        self._kernel = self._build_kernel() if self.backend == "core" else None
+
     # ------------------------------------------------------------------ model helpers
     def _arm_velocity_names(self) -> list[str]:
         names = []
