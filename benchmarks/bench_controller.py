@@ -11,13 +11,17 @@ Cases, each on a measurement near the scenario's initial state:
   realistic-style controller (weights and null-space task), if example-robot-data is
   installed.
 
-Each is timed for the package's controller and for the frozen pre-optimization copy kept
-as the test oracle (``tests/controllers/ppc_oracle``), and reported as a ratio to one
+Each is timed for the package's controller on its two backends, the compiled law
+(``backend="core"``, the default, src/uvms_core/ppc.hpp) and the Python reference
+(``backend="python"``), and for the frozen pre-optimization copy kept as the test oracle
+(``tests/controllers/ppc_oracle``), and reported as a ratio to one
 rigid-body ``pin.aba`` call on the reference model timed in the same process, so that the
 figures compare across machines. Times are this process's CPU time (``time.process_time``),
 best batch of ``--repeat``: on a shared machine the wait for a core does not count.
 Absolute times are printed for information only. ``--breakdown`` also times the stages of
-the realistic case's ``compute`` separately (where the rest of the cost goes).
+the realistic case's Python ``compute`` separately (where its cost goes), and the compiled
+kernel's call alone (what the core's ``compute`` adds in Python: f_d(t), the call, the copy of
+tau).
 """
 
 from __future__ import annotations
@@ -46,9 +50,11 @@ from uvms_pin.scenario import load_scenario
 
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT / "tests" / "controllers"))
+from ppc_oracle import in_place_of_the_package_ppc  # noqa: E402
 from ppc_oracle.ppc import PrescribedPerformanceController as OraclePPC  # noqa: E402
 
-Case = tuple[Callable[[], object], Callable[[], object]]  # (package, oracle) compute calls
+#: the compute calls of one case: compiled law, Python reference, pre-optimization oracle
+Case = tuple[Callable[[], object], Callable[[], object], Callable[[], object]]
 
 
 def best_time(fn: Callable[[], object], number: int, repeat: int) -> float:
@@ -62,16 +68,25 @@ def _measurement(uvms: up.UVMS, q: np.ndarray, time_s: float = 0.3) -> Measureme
     return Measurement(time_s, q, v, np.array([0.3, 0.05, -0.05, 0.0, 0.0, 0.0]))
 
 
+def _calls(measurement: Measurement, *controllers) -> Case:
+    def call(controller):
+        controller.compute(measurement.time_s, measurement)  # inside the funnels
+        return lambda: controller.compute(measurement.time_s, measurement)
+
+    return tuple(call(c) for c in controllers)
+
+
 def scenario_case(stem: str) -> Case:
-    scenario = load_scenario(ROOT / "scenarios" / f"{stem}.toml")
-    fast = scenario.controller_factory(scenario.uvms)
-    with mock.patch("uvms_pin.scenario.PrescribedPerformanceController", OraclePPC):
+    path = ROOT / "scenarios" / f"{stem}.toml"
+    scenario = load_scenario(path)
+    core = scenario.controller_factory(scenario.uvms)
+    python = load_scenario(path, {"controller.backend": "python"}).controller_factory(scenario.uvms)
+    assert (core.backend, python.backend) == ("core", "python")
+    with mock.patch(
+        "uvms_pin.scenario.PrescribedPerformanceController", in_place_of_the_package_ppc
+    ):
         oracle = scenario.controller_factory(scenario.uvms)
-    measurement = _measurement(scenario.uvms, scenario.q0)
-    return (
-        lambda: fast.compute(measurement.time_s, measurement),
-        lambda: oracle.compute(measurement.time_s, measurement),
-    )
+    return _calls(_measurement(scenario.uvms, scenario.q0), core, python, oracle)
 
 
 def mounted_arm_case(arm: str) -> Case | None:
@@ -99,22 +114,25 @@ def mounted_arm_case(arm: str) -> Case | None:
         desired_rpy=rpy + 0.05,
     )
     frame = uvms.model.frames[uvms.ee_frame_id].name
-    fast = PrescribedPerformanceController(uvms.model, frame, params, (0.4, 0.0, 0.0))
-    oracle = OraclePPC(uvms.model, frame, params, (0.4, 0.0, 0.0))
-    measurement = _measurement(uvms, q)
-    return (
-        lambda: fast.compute(measurement.time_s, measurement),
-        lambda: oracle.compute(measurement.time_s, measurement),
+    force = (0.4, 0.0, 0.0)
+    return _calls(
+        _measurement(uvms, q),
+        PrescribedPerformanceController(uvms.model, frame, params, force),
+        PrescribedPerformanceController(uvms.model, frame, params, force, backend="python"),
+        OraclePPC(uvms.model, frame, params, force),
     )
 
 
 def breakdown() -> dict[str, Callable[[], object]]:
-    """The stages of the realistic scenario's ``compute``, each callable on its own."""
+    """The stages of the realistic scenario's Python ``compute``, each callable on its own,
+    and the compiled kernel's call."""
     from uvms_pin.controllers import ppc
     from uvms_pin.kinematics import frame_rotation_and_jacobian
 
-    scenario = load_scenario(ROOT / "scenarios" / "realistic_force_tracking.toml")
+    path = ROOT / "scenarios" / "realistic_force_tracking.toml"
+    scenario = load_scenario(path, {"controller.backend": "python"})
     c = scenario.controller_factory(scenario.uvms)
+    compiled = load_scenario(path).controller_factory(scenario.uvms)
     m = _measurement(scenario.uvms, scenario.q0)
     t, q = m.time_s, m.q
     rotation, jacobian = frame_rotation_and_jacobian(c.model, c.data, q, c.ee_frame_id)
@@ -133,8 +151,14 @@ def breakdown() -> dict[str, Callable[[], object]]:
         ppc.max_abs(xi)
         return (c._neg_four_k_zeta * np.arctanh(xi) / (rho_zeta - xi * e)).copy()
 
+    kernel = compiled._kernel
+    kernel_args = (t, m.q, m.v, m.wrench_world, force, rpy_desired, False)
+    assert kernel.compute(*kernel_args) == 0
+
     return {
-        "compute (whole)": lambda: c.compute(t, m),
+        "core: compute (whole)": lambda: compiled.compute(t, m),
+        "core: the kernel's call alone": lambda: kernel.compute(*kernel_args),
+        "python: compute (whole)": lambda: c.compute(t, m),
         "measurement check": lambda: c._check_measurement(m),
         "f_d(t), rpy_d(t)": lambda: (c._desired_force(t), c._desired_rpy(t)),
         "Pinocchio pass + rpy": lambda: pin.rpy.matrixToRpy(
@@ -178,19 +202,29 @@ def main() -> None:
     floor = best_time(lambda: pin.aba(model, data, q, v, tau), args.number * 5, args.repeat)
     results = {"pin.aba [s]": floor}
     print(f"pin.aba on the reference model: {floor * 1e6:.2f} us")
-    print(f"{'case':<28}  {'x pin.aba':>9}  {'us/call':>8}  {'before x aba':>12}  {'speed-up':>8}")
+    print(f"{'':<28}  {'compiled (core)':^18}  {'Python reference':^18}  {'pre-optimization':^16}")
+    print(
+        f"{'case':<28}  {'x pin.aba':>9}  {'us/call':>7}  {'x pin.aba':>9}  {'us/call':>7}"
+        f"  {'x pin.aba':>16}"
+    )
     for name, case in cases.items():
         if case is None:
             print(f"{name:<28}  skipped: example-robot-data is not installed")
             continue
-        fast, oracle = (best_time(fn, args.number, args.repeat) for fn in case)
-        results[name] = {"seconds": fast, "ratio_to_aba": fast / floor, "before_seconds": oracle}
+        core, python, oracle = (best_time(fn, args.number, args.repeat) for fn in case)
+        results[name] = {
+            "seconds": core,
+            "ratio_to_aba": core / floor,
+            "python_seconds": python,
+            "python_ratio_to_aba": python / floor,
+            "before_seconds": oracle,
+        }
         print(
-            f"{name:<28}  {fast / floor:>9.1f}  {fast * 1e6:>8.2f}  {oracle / floor:>12.1f}"
-            f"  {oracle / fast:>8.1f}"
+            f"{name:<28}  {core / floor:>9.1f}  {core * 1e6:>7.2f}  {python / floor:>9.1f}"
+            f"  {python * 1e6:>7.2f}  {oracle / floor:>16.1f}"
         )
     if args.breakdown:
-        print("\nrealistic compute, stage by stage (x pin.aba):")
+        print("\nrealistic compute, stage by stage (x pin.aba; 'python' stages: the reference):")
         for name, fn in breakdown().items():
             seconds = best_time(fn, args.number, args.repeat)
             results[f"stage: {name}"] = {"seconds": seconds, "ratio_to_aba": seconds / floor}

@@ -27,7 +27,7 @@ from uvms_pin.scenario import Scenario, load_scenario, simulate
 
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT / "tests" / "controllers"))
-from ppc_oracle.ppc import PrescribedPerformanceController as OraclePPC  # noqa: E402
+from ppc_oracle import in_place_of_the_package_ppc  # noqa: E402
 
 #: scenario file stem -> simulated duration [s]
 RUNS = {"paper_force_tracking": 1.0, "realistic_force_tracking": 2.0}
@@ -61,7 +61,9 @@ class _Recorder(Controller):
 
 def oracle_controller(scenario: Scenario) -> Controller:
     """The scenario's controller, built with the same arguments by the frozen oracle."""
-    with mock.patch("uvms_pin.scenario.PrescribedPerformanceController", OraclePPC):
+    with mock.patch(
+        "uvms_pin.scenario.PrescribedPerformanceController", in_place_of_the_package_ppc
+    ):
         return scenario.controller_factory(scenario.uvms)
 
 

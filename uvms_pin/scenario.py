@@ -657,24 +657,31 @@ def _ppc_controller(t: _Table, uvms: UVMS) -> ControllerSpec:
     if t.has("null_space_target"):
         fields["null_space_target"] = t.vector("null_space_target", uvms.n_arm_joints)
     desired_rpy = t.vector("desired_rpy", 3, [0.0, 0.0, 0.0])
+    # "core": the compiled law (Python reference on the calls it declines); "python": the reference
+    backend = t.string("backend", "core", BACKENDS)
     force_table = t.table("desired_force")
     force_raw = {} if force_table is None else dict(force_table._data)
     desired_force = _sine_profile(force_table, 3)
     t.finish()
     try:
         params = PPCParams(desired_rpy=desired_rpy, **fields).sized(uvms.nv)
-        PrescribedPerformanceController(uvms.model, ee_frame, params, desired_force)
+        PrescribedPerformanceController(
+            uvms.model, ee_frame, params, desired_force, backend=backend
+        )
     except ParameterError as exc:
         raise ScenarioError(f"{t._source}: [controller]: {exc}") from exc
     recorded = {
         "ee_frame": ee_frame,
         "desired_force": force_raw,
+        "backend": backend,
         **{k: _plain(v) for k, v in dataclasses.asdict(params).items()},
     }
     return ControllerSpec(
         "ppc",
         recorded,
-        lambda u: PrescribedPerformanceController(u.model, ee_frame, params, desired_force),
+        lambda u: PrescribedPerformanceController(
+            u.model, ee_frame, params, desired_force, backend=backend
+        ),
     )
 
 

@@ -11,6 +11,7 @@
 #include <pinocchio/config.hpp>
 
 #include "plant.hpp"
+#include "ppc.hpp"
 
 namespace nb = nanobind;
 using namespace nb::literals;
@@ -283,4 +284,75 @@ NB_MODULE(_core, m) {
             return p.chart(q0, delta, v);
           },
           "q0"_a, "delta"_a, "v"_a);
+
+  // the prescribed-performance controller's law (ppc.hpp); the Python controller validates
+  // and sizes its parameters and runs its reference for every call not returned as ok (0)
+  using Ppc = uvms::PrescribedPerformanceController;
+  using Vector1 = nb::ndarray<const double, nb::ndim<1>, nb::c_contig, nb::device::cpu>;
+  m.attr("PPC_STATUS") = nb::make_tuple("ok", "first-level funnel", "second-level funnel",
+                                        "solver declined", "Euler singularity", "bad input");
+  nb::class_<Ppc>(m, "PrescribedPerformanceController")
+      .def(
+          "__init__",
+          [](Ppc* self, const std::string& model_text, int ee_frame_id, const ConstVec& k_x,
+             const ConstVec& rho0_x, const ConstVec& rho_inf_x, const ConstVec& l_x_per_s,
+             const Eigen::VectorXd& k_zeta, const Eigen::VectorXd& rho0_zeta,
+             const Eigen::VectorXd& rho_inf_zeta, const Eigen::VectorXd& l_zeta_per_s,
+             const Eigen::VectorXd& velocity_weights, double null_space_gain_per_s,
+             const std::vector<int>& limited_q_index, const std::vector<int>& limited_v_index,
+             const Eigen::VectorXd& null_space_target, const Eigen::VectorXd& half_range,
+             double max_condition_bound, double refine_above_condition_bound, double xi_clamp,
+             double min_abs_cos_pitch) {
+            uvms::PpcSettings s;
+            s.ee_frame_id = ee_frame_id;
+            s.k_x = vec6("k_x", k_x);
+            s.rho0_x = vec6("rho0_x", rho0_x);
+            s.rho_inf_x = vec6("rho_inf_x", rho_inf_x);
+            s.l_x_per_s = vec6("l_x_per_s", l_x_per_s);
+            s.k_zeta = k_zeta;
+            s.rho0_zeta = rho0_zeta;
+            s.rho_inf_zeta = rho_inf_zeta;
+            s.l_zeta_per_s = l_zeta_per_s;
+            s.velocity_weights = velocity_weights;
+            s.null_space_gain_per_s = null_space_gain_per_s;
+            s.limited_q_index = limited_q_index;
+            s.limited_v_index = limited_v_index;
+            s.null_space_target = null_space_target;
+            s.half_range = half_range;
+            s.max_condition_bound = max_condition_bound;
+            s.refine_above_condition_bound = refine_above_condition_bound;
+            s.xi_clamp = xi_clamp;
+            s.min_abs_cos_pitch = min_abs_cos_pitch;
+            new (self) Ppc(uvms::model_from_text(model_text), std::move(s));
+          },
+          "model_text"_a, "ee_frame_id"_a, "k_x"_a, "rho0_x"_a, "rho_inf_x"_a, "l_x_per_s"_a,
+          "k_zeta"_a, "rho0_zeta"_a, "rho_inf_zeta"_a, "l_zeta_per_s"_a, "velocity_weights"_a,
+          "null_space_gain_per_s"_a, "limited_q_index"_a, "limited_v_index"_a,
+          "null_space_target"_a, "half_range"_a, "max_condition_bound"_a,
+          "refine_above_condition_bound"_a, "xi_clamp"_a, "min_abs_cos_pitch"_a)
+      .def_prop_ro("nq", &Ppc::nq)
+      .def_prop_ro("nv", &Ppc::nv)
+      .def(
+          "compute",
+          [](Ppc& c, double time_s, const Vector1& q, const Vector1& v, const Vector1& wrench,
+             const Vector1& force_desired, const Vector1& rpy_desired, bool extended) {
+            const auto size = [](const Vector1& a) { return Eigen::Index(a.shape(0)); };
+            return static_cast<int>(c.compute(time_s, q.data(), size(q), v.data(), size(v),
+                                              wrench.data(), size(wrench), force_desired.data(),
+                                              size(force_desired), rpy_desired.data(),
+                                              size(rpy_desired), extended));
+          },
+          "time_s"_a, "q"_a, "v"_a, "wrench_world"_a, "force_desired"_a, "rpy_desired"_a,
+          "extended"_a)
+      .def(
+          "signals",
+          [](Ppc& c) {
+            // a read-only view of the last ok call's packed signals (it lives with c)
+            const Eigen::VectorXd& s = c.signals();
+            return nb::ndarray<nb::numpy, const double, nb::ndim<1>>(
+                s.data(), {static_cast<std::size_t>(s.size())}, nb::handle());
+          },
+          nb::rv_policy::reference_internal)
+      .def("zeta_offset", &Ppc::zeta_offset, "k"_a)
+      .def("margin_offset", &Ppc::margin_offset);
 }

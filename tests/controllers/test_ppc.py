@@ -6,9 +6,12 @@ Models are built in code (free-flyer + n revolute joints with axes Z, Y, Y, X, .
 
 from __future__ import annotations
 
+import re
+
 import numpy as np
 import pinocchio as pin
 import pytest
+from conftest import ROOT
 
 from uvms_pin.controllers.performance import transformation_gain, transformed_error
 from uvms_pin.controllers.ppc import (
@@ -335,18 +338,30 @@ def test_output_is_a_deterministic_function_of_the_measurement(model, q_bent):
     assert controller.last_signals is None
 
 
-def test_model_free_inertias_do_not_matter(q_bent):
+@pytest.mark.parametrize("backend", ["core", "python"])
+def test_model_free_inertias_do_not_matter(q_bent, backend):
     """Same kinematics, inertias scaled by 7: identical tau for the same measurement."""
     light, heavy = build_test_uvms(mass_scale=1.0), build_test_uvms(mass_scale=7.0)
     measurement = make_measurement(light, q_bent, v=0.01 * np.ones(light.nv), force=(0.2, 0, 0))
     rpy = ee_rpy(light, q_bent)
-    tau_light = PrescribedPerformanceController(light, "ee", desired_rpy=rpy).compute(
-        0.1, measurement
-    )
-    tau_heavy = PrescribedPerformanceController(heavy, "ee", desired_rpy=rpy).compute(
-        0.1, measurement
-    )
+    tau_light = PrescribedPerformanceController(
+        light, "ee", desired_rpy=rpy, backend=backend
+    ).compute(0.1, measurement)
+    tau_heavy = PrescribedPerformanceController(
+        heavy, "ee", desired_rpy=rpy, backend=backend
+    ).compute(0.1, measurement)
     np.testing.assert_array_equal(tau_light, tau_heavy)
+
+
+def test_model_free_the_compiled_law_uses_only_frame_kinematics():
+    """The compiled law (src/uvms_core/ppc.cpp) includes one Pinocchio algorithm, the frame
+    Jacobian, and calls no other (the Python test below cannot patch C++ calls)."""
+    source = (ROOT / "src" / "uvms_core" / "ppc.cpp").read_text()
+    header = (ROOT / "src" / "uvms_core" / "ppc.hpp").read_text()
+    algorithms = re.findall(r"#include <pinocchio/algorithm/([\w-]+)\.hpp>", source + header)
+    assert algorithms == ["frames"]
+    calls = set(re.findall(r"pinocchio::(\w+)\(", source))
+    assert calls == {"computeFrameJacobian"}, calls
 
 
 def test_model_free_no_dynamics_algorithm_is_called(model, q_bent, monkeypatch):
@@ -368,7 +383,7 @@ def test_model_free_no_dynamics_algorithm_is_called(model, q_bent, monkeypatch):
         "centerOfMass",
     ):
         monkeypatch.setattr(pin, name, forbidden)
-    controller = controller_holding_orientation(model, q_bent)
+    controller = controller_holding_orientation(model, q_bent, backend="python")
     tau = controller.compute(0.1, make_measurement(model, q_bent, force=(0.2, 0.0, 0.0)))
     assert np.all(np.isfinite(tau))
 

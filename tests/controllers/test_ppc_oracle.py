@@ -20,6 +20,7 @@ import numpy as np
 import pinocchio as pin
 import pytest
 from conftest import ROOT, random_configuration
+from ppc_oracle import in_place_of_the_package_ppc
 from ppc_oracle import performance as oracle_performance
 from ppc_oracle.ppc import PrescribedPerformanceController as OraclePPC
 from test_ppc import build_test_uvms
@@ -112,7 +113,9 @@ def assert_same_outcome(
 def scenario_pair(stem: str):
     scenario = load_scenario(ROOT / "scenarios" / f"{stem}.toml")
     fast = scenario.controller_factory(scenario.uvms)
-    with mock.patch("uvms_pin.scenario.PrescribedPerformanceController", OraclePPC):
+    with mock.patch(
+        "uvms_pin.scenario.PrescribedPerformanceController", in_place_of_the_package_ppc
+    ):
         oracle = scenario.controller_factory(scenario.uvms)
     assert isinstance(fast, PrescribedPerformanceController)
     assert isinstance(oracle, OraclePPC)

@@ -38,6 +38,13 @@ equations above to ~1e-13, see tests/controllers/test_ppc_oracle.py):
   detailed checks (which component, which exception) only run when that fails;
 - scalar ``math`` on the 3- and 6-element quantities; ``last_signals`` is assembled only
   when read.
+
+With ``backend="core"`` (the default) the same steps run compiled in one call
+(``src/uvms_core/ppc.hpp``, the names there are the ones here): f_d(t) and rpy_d(t) are
+still evaluated in Python (user code), and every call the kernel does not return as ok (a
+funnel left or the extension's clamp passed, the solver declining, the Euler singularity, a
+malformed or non-finite input) is evaluated by the Python code below, so the exceptions and
+the SVD and extension routes are this module's own.
 """
 
 from __future__ import annotations
@@ -61,9 +68,15 @@ from uvms_pin.controllers.performance import (
     transformed_error,
     transformed_error_extended,
 )
-from uvms_pin.controllers.pseudo_inverse import MinimumNormSolver, pseudo_inverse
+from uvms_pin.controllers.pseudo_inverse import (
+    REFINE_ABOVE_CONDITION_BOUND,
+    MinimumNormSolver,
+    pseudo_inverse,
+)
+from uvms_pin.core import check_backend, core_module
 from uvms_pin.errors import ParameterError
 from uvms_pin.kinematics import (
+    EULER_SINGULARITY_MIN_ABS_COS_PITCH,
     analytical_jacobian,
     angular_velocity_world_from_euler_rates,
     check_euler_singularity,
@@ -312,6 +325,10 @@ class PrescribedPerformanceController(Controller):
             constant. Default zero.
         desired_rpy: desired end-effector Euler angles (roll, pitch, yaw) [rad], a
             function of time or a constant. Default ``params.desired_rpy``.
+        backend: ``"core"`` (default): the compiled law (``src/uvms_core/ppc.hpp``) with
+            this Python code as its fallback on every call it declines; ``"python"``: this
+            code only, the reference. Both give the same tau to ~1e-13 and raise the same
+            errors (tests/controllers/test_ppc_core.py).
 
     The measured force is ``measurement.wrench_world[:3]`` (sensor noise included, the
     paper's f_e + Delta f_e).
@@ -334,7 +351,10 @@ class PrescribedPerformanceController(Controller):
         params: PPCParams | None = None,
         desired_force_world_N: Callable[[float], ArrayLike] | ArrayLike = (0.0, 0.0, 0.0),
         desired_rpy: Callable[[float], ArrayLike] | ArrayLike | None = None,
+        *,
+        backend: str = "core",
     ):
+        self.backend = check_backend(backend)
         if model.njoints < 2 or model.joints[1].shortname() != "JointModelFreeFlyer":
             raise ParameterError(
                 "the UVMS model must have a free-flyer root joint (joint 1); build it with "
@@ -394,8 +414,59 @@ class PrescribedPerformanceController(Controller):
         self._limited_q = _as_slice(self._limited_q_index)
         self._limited_v = _as_slice(self._limited_v_index)
         # the last successful call's raw signals, and the PPCSignals built from them on demand
+        # (_last is None when they are the compiled kernel's, see _core_last)
         self._last: tuple | None = None
         self._last_signals: PPCSignals | None = None
+        self._core_last: tuple | None = None
+        self._kernel = self._build_kernel() if self.backend == "core" else None
+
+    def _build_kernel(self):
+        """The compiled law (src/uvms_core/ppc.hpp) with this controller's constants, and
+        read-only views of its packed signals (those of its last ok call)."""
+        params, solver = self.params, self._solver
+        kernel = core_module().PrescribedPerformanceController(
+            self.model.saveToString(),
+            self.ee_frame_id,
+            params.k_x,
+            params.rho0_x,
+            params.rho_inf_x,
+            params.l_x_per_s,
+            params.k_zeta,
+            self.performance_zeta.rho0,
+            self.performance_zeta.rho_inf,
+            self.performance_zeta.decay_rate_per_s,
+            params.velocity_weights,
+            float(params.null_space_gain_per_s),
+            self._limited_q_index.tolist(),
+            self._limited_v_index.tolist(),
+            np.asarray(self._target, dtype=float),
+            self._half_range,
+            solver.max_condition_bound,
+            REFINE_ABOVE_CONDITION_BOUND,
+            _XI_CLAMP,
+            EULER_SINGULARITY_MIN_ABS_COS_PITCH,
+        )
+        packed, nv = kernel.signals(), self._nv
+        zeta = [packed[kernel.zeta_offset(k) : kernel.zeta_offset(k) + nv] for k in range(5)]
+        self._core_signals = (packed[0:3], packed[3:9], packed[9:15], packed[15:21],
+                              packed[21:27], *zeta)  # fmt: skip
+        self._core_tau = zeta[4]
+        self._core_margin = packed[kernel.margin_offset() :]
+        return kernel
+
+    _KERNEL_ATTRIBUTES = ("_kernel", "_core_signals", "_core_tau", "_core_margin")
+
+    def __getstate__(self) -> dict:
+        """For copy and pickle: the compiled kernel is rebuilt, the last signals kept."""
+        self.last_signals  # noqa: B018 - builds the PPCSignals (from the kernel's buffers)
+        state = {k: v for k, v in self.__dict__.items() if k not in self._KERNEL_ATTRIBUTES}
+        state["_margin"] = self.funnel_margin()
+        state["_core_last"] = None
+        return state
+
+    def __setstate__(self, state: dict) -> None:
+        self.__dict__.update(state)
+        self._kernel = self._build_kernel() if self.backend == "core" else None
 
     # ------------------------------------------------------------------ model helpers
     def _arm_velocity_names(self) -> list[str]:
@@ -472,19 +543,64 @@ class PrescribedPerformanceController(Controller):
         A pure function of ``(time_s, measurement)`` (``time_s`` is the funnels' time,
         t = 0 at the start of the run); only ``last_signals`` is updated.
 
+        With ``backend="core"`` the compiled kernel evaluates the law; every call it does not
+        return as ok (a funnel left, the solver declining, the Euler singularity, a malformed
+        or non-finite input) is evaluated by the Python reference below, which raises, or
+        takes the SVD route or the funnel extension, exactly as with ``backend="python"``.
+
         Raises:
             FunnelViolation: a first-level (``level="first"``) or second-level
                 (``level="second"``) error reached its bound, |xi| >= 1.
             ParameterError: malformed measurement, or the end-effector at the Euler
                 singularity (pitch = +-90 deg).
         """
+        kernel = self._kernel
         time_s = float(time_s)
+        if kernel is None:
+            return self._compute_reference(time_s, measurement)
+        try:
+            force_desired = self._desired_force(time_s)
+            rpy_desired = self._desired_rpy(time_s)
+        except Exception:
+            self._check_measurement(measurement)  # the reference checks the measurement first
+            raise
+        extended = self._extend_beyond_funnels
+        try:
+            status = kernel.compute(
+                time_s,
+                measurement.q,
+                measurement.v,
+                measurement.wrench_world,
+                force_desired,
+                rpy_desired,
+                extended,
+            )
+        except TypeError:  # not convertible to 1-D float arrays: the reference says why
+            status = -1
+        if status:
+            return self._compute_reference(time_s, measurement, force_desired, rpy_desired)
+        self._core_last = (time_s, force_desired, rpy_desired, extended)
+        self._last = None
+        self._last_signals = None
+        self._margin = None
+        return self._core_tau.copy()
+
+    def _compute_reference(
+        self,
+        time_s: float,
+        measurement: Measurement,
+        force_desired: np.ndarray | None = None,
+        rpy_desired: np.ndarray | None = None,
+    ) -> np.ndarray:
+        """The Python evaluation of :meth:`compute` (``backend="python"``, and the calls the
+        compiled kernel declines); f_d(t) and rpy_d(t) are evaluated here unless given."""
         q, v, wrench_world = self._check_measurement(measurement)
         extended = self._extend_beyond_funnels
 
         # ---- first level: force and orientation errors, eq. (8)-(12)
-        force_desired = self._desired_force(time_s)
-        rpy_desired = self._desired_rpy(time_s)
+        if force_desired is None:
+            force_desired = self._desired_force(time_s)
+            rpy_desired = self._desired_rpy(time_s)
         rotation, jacobian_lwa = frame_rotation_and_jacobian(
             self.model, self.data, q, self.ee_frame_id
         )
@@ -539,6 +655,7 @@ class PrescribedPerformanceController(Controller):
             tau.copy(),
             extended,
         )
+        self._core_last = None
         self._last_signals = None
         return tau
 
@@ -581,10 +698,17 @@ class PrescribedPerformanceController(Controller):
     @property
     def last_signals(self) -> PPCSignals | None:
         """:class:`PPCSignals` of the last successful ``compute`` (None before one)."""
-        if self._last is None or self._last_signals is not None:
+        if self._last_signals is not None:
             return self._last_signals
-        (time_s, force_desired, rpy_desired, rpy_ee, e_x, rho_x, xi_x, xdot_r, zeta_r,
-         e_zeta, rho_zeta, xi_zeta, tau, extended) = self._last  # fmt: skip
+        if self._core_last is not None:  # copies: the kernel's buffer is rewritten
+            time_s, force_desired, rpy_desired, extended = self._core_last
+            (rpy_ee, e_x, rho_x, xi_x, xdot_r, zeta_r, e_zeta, rho_zeta, xi_zeta,
+             tau) = (a.copy() for a in self._core_signals)  # fmt: skip
+        elif self._last is not None:
+            (time_s, force_desired, rpy_desired, rpy_ee, e_x, rho_x, xi_x, xdot_r, zeta_r,
+             e_zeta, rho_zeta, xi_zeta, tau, extended) = self._last  # fmt: skip
+        else:
+            return None
         transform = (
             (lambda xi: transformed_error_extended(xi, _XI_CLAMP))
             if extended
@@ -615,7 +739,8 @@ class PrescribedPerformanceController(Controller):
 
     def funnel_margin(self) -> float:
         """min(1 - |xi|) over both levels at the last ``compute`` (> 0: inside)."""
-        return self._margin
+        margin = self._margin
+        return float(self._core_margin[0]) if margin is None else margin
 
     def set_funnel_extension(self, enabled: bool) -> None:
         self._extend_beyond_funnels = bool(enabled)
@@ -623,6 +748,7 @@ class PrescribedPerformanceController(Controller):
     def reset(self) -> None:
         """Forget the logged signals (the law itself has no state)."""
         self._last = None
+        self._core_last = None
         self._last_signals = None
         self._margin = np.inf
 

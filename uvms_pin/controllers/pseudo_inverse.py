@@ -76,6 +76,11 @@ class MinimumNormSolver:
             else min(MAX_GRAM_CONDITION_BOUND, 1.0 / cutoff_squared)
         )
 
+    @property
+    def max_condition_bound(self) -> float:
+        """The largest certified bound of cond(J W^-1/2)^2 for which :meth:`solve` answers."""
+        return self._max_bound
+
     def solve(self, jacobian: np.ndarray, rhs: np.ndarray) -> np.ndarray | None:
         """The minimum W-norm solution x (n,) of J x = b, or None (use the SVD instead).
 

@@ -111,8 +111,9 @@ class EndEffectorTask:
             null_space_gain_per_s=null_space_gain_per_s,
             null_space_target=null_space_target,
         )
+        # only the Python pieces of the PPC are used here (checks, J^#): no compiled kernel
         self._ppc = PrescribedPerformanceController(
-            model, ee_frame_name, params, desired_force_world_N, desired_rpy
+            model, ee_frame_name, params, desired_force_world_N, desired_rpy, backend="python"
         )
         self.model, self.data = self._ppc.model, self._ppc.data
         self.ee_frame_id = self._ppc.ee_frame_id
