@@ -1,6 +1,6 @@
 """Cost of one prescribed-performance ``compute``, as a ratio to one ``pin.aba`` call.
 
-    .venv/bin/python benchmarks/bench_controller.py [--repeat N] [--number N] [--json FILE]
+    .venv/bin/python benchmarks/bench_controller.py [--repeat N] [--json FILE] [--breakdown]
 
 Cases, each on a measurement near the scenario's initial state:
 
@@ -17,7 +17,8 @@ Each is timed for the package's controller on its two backends, the compiled law
 (``tests/controllers/ppc_oracle``), and reported as a ratio to one
 rigid-body ``pin.aba`` call on the reference model timed in the same process, so that the
 figures compare across machines. Times are this process's CPU time (``time.process_time``),
-best batch of ``--repeat``: on a shared machine the wait for a core does not count.
+best of ``--repeat`` interleaved rounds (`timing.py`): on a shared machine the wait for a core
+does not count.
 Absolute times are printed for information only. ``--breakdown`` also times the stages of
 the realistic case's Python ``compute`` separately (where its cost goes), and the compiled
 kernel's call alone (what the core's ``compute`` adds in Python: f_d(t), the call, the copy of
@@ -31,14 +32,13 @@ import json
 import math
 import sys
 import tempfile
-import time
-import timeit
 from collections.abc import Callable
 from pathlib import Path
 from unittest import mock
 
 import numpy as np
 import pinocchio as pin
+from timing import best_times, one_blas_thread
 
 import uvms_pin as up
 from uvms_pin.arms.catalog import CATALOG
@@ -55,11 +55,6 @@ from ppc_oracle.ppc import PrescribedPerformanceController as OraclePPC  # noqa:
 
 #: the compute calls of one case: compiled law, Python reference, pre-optimization oracle
 Case = tuple[Callable[[], object], Callable[[], object], Callable[[], object]]
-
-
-def best_time(fn: Callable[[], object], number: int, repeat: int) -> float:
-    """Best mean time per call over ``repeat`` batches of ``number`` calls [s]."""
-    return min(timeit.repeat(fn, number=number, repeat=repeat, timer=time.process_time)) / number
 
 
 def _measurement(uvms: up.UVMS, q: np.ndarray, time_s: float = 0.3) -> Measurement:
@@ -182,8 +177,9 @@ def breakdown() -> dict[str, Callable[[], object]]:
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--repeat", type=int, default=7)
-    parser.add_argument("--number", type=int, default=2000)
+    parser.add_argument(
+        "--repeat", type=int, default=20, help="interleaved rounds; the best is kept"
+    )
     parser.add_argument("--json", type=Path, default=None, help="also write the results here")
     parser.add_argument("--breakdown", action="store_true", help="time the stages too")
     args = parser.parse_args()
@@ -199,7 +195,14 @@ def main() -> None:
         "realistic (reference model)": scenario_case("realistic_force_tracking"),
         "7-joint arm (Panda)": mounted_arm_case("panda"),
     }
-    floor = best_time(lambda: pin.aba(model, data, q, v, tau), args.number * 5, args.repeat)
+    one_blas_thread()
+    # every case and the aba floor timed in the same interleaved rounds
+    timed_cases = {"aba": lambda: pin.aba(model, data, q, v, tau)}
+    for name, case in cases.items():
+        for backend, fn in zip(("core", "python", "oracle"), case or (), strict=False):
+            timed_cases[name, backend] = fn
+    timed = best_times(timed_cases, args.repeat)
+    floor = timed["aba"]
     results = {"pin.aba [s]": floor}
     print(f"pin.aba on the reference model: {floor * 1e6:.2f} us")
     print(f"{'':<28}  {'compiled (core)':^18}  {'Python reference':^18}  {'pre-optimization':^16}")
@@ -211,7 +214,7 @@ def main() -> None:
         if case is None:
             print(f"{name:<28}  skipped: example-robot-data is not installed")
             continue
-        core, python, oracle = (best_time(fn, args.number, args.repeat) for fn in case)
+        core, python, oracle = (timed[name, b] for b in ("core", "python", "oracle"))
         results[name] = {
             "seconds": core,
             "ratio_to_aba": core / floor,
@@ -226,7 +229,7 @@ def main() -> None:
     if args.breakdown:
         print("\nrealistic compute, stage by stage (x pin.aba; 'python' stages: the reference):")
         for name, fn in breakdown().items():
-            seconds = best_time(fn, args.number, args.repeat)
+            seconds = best_times({name: fn}, args.repeat)[name]
             results[f"stage: {name}"] = {"seconds": seconds, "ratio_to_aba": seconds / floor}
             print(f"  {name:<30}  {seconds / floor:>6.2f}  {seconds * 1e6:>7.2f} us")
     if args.json is not None:

@@ -1,12 +1,12 @@
 """Cost of the underwater dynamics, the plant and the closed loop: compiled core vs Python.
 
-    .venv/bin/python benchmarks/bench_dynamics.py [--repeat N] [--number N] [--loop-s T] [--json FILE]
+    .venv/bin/python benchmarks/bench_dynamics.py [--repeat N] [--loop-s T] [--json FILE]
 
 Every figure is measured in this process, on the reference model, and reported as a ratio
 to one rigid-body ``pin.aba`` call (the floor: Pinocchio's forward dynamics with no water)
 timed in the same run, so the numbers compare across machines. Times are the CPU time of
-this process (``time.process_time``): on a machine shared with other jobs, wall-clock time
-measures the neighbours. Absolute times are printed for information only. "core" is the compiled backend (the default), "python" the reference.
+this process (``time.process_time``), best of interleaved rounds, with one BLAS thread
+(`timing.py`): on a machine shared with other jobs, wall-clock time measures the neighbours. Absolute times are printed for information only. "core" is the compiled backend (the default), "python" the reference.
 
 The plant rows advance the plant of the realistic scenario (2 N/m spring, sinusoidal
 disturbance, a 0.3 m/s current) over one 2 ms control period with RK4 at 0.5 ms (4 steps, 16
@@ -19,11 +19,11 @@ from __future__ import annotations
 import argparse
 import json
 import time
-import timeit
 from pathlib import Path
 
 import numpy as np
 import pinocchio as pin
+from timing import best_times, one_blas_thread
 
 import uvms_pin as up
 from uvms_pin.core import dynamics_of
@@ -35,12 +35,7 @@ ROOT = Path(__file__).resolve().parents[1]
 BACKENDS = ("core", "python")
 
 
-def best_time(fn, number: int, repeat: int) -> float:
-    """Best mean time per call over ``repeat`` batches of ``number`` calls [s]."""
-    return min(timeit.repeat(fn, number=number, repeat=repeat, timer=time.process_time)) / number
-
-
-def call_rows(uvms: up.UVMS, number: int, repeat: int) -> dict[str, float]:
+def call_rows(uvms: up.UVMS, repeat: int) -> dict[str, float]:
     """Seconds per call of each dynamics function and of the plant over a control period."""
     model, data = uvms.model, uvms.model.createData()
     rng = np.random.default_rng(0)
@@ -51,46 +46,37 @@ def call_rows(uvms: up.UVMS, number: int, repeat: int) -> dict[str, float]:
     current = np.array([0.3, 0.1, 0.0])
     compiled = dynamics_of(uvms)
     cases = {
-        "pin.aba (rigid floor)": (lambda: pin.aba(model, data, q, v, tau), number),
-        "core Dynamics.forward_dynamics (direct)": (
-            lambda: compiled.forward_dynamics(q, v, tau, current),
-            number,
+        "pin.aba (rigid floor)": lambda: pin.aba(model, data, q, v, tau),
+        "core Dynamics.forward_dynamics (direct)": lambda: compiled.forward_dynamics(
+            q, v, tau, current
         ),
     }
     for b in BACKENDS:
-        cases[f"{b}: mass_matrix"] = (lambda b=b: up.mass_matrix(uvms, q, backend=b), number)
-        cases[f"{b}: bias_forces (current)"] = (
-            lambda b=b: up.bias_forces(uvms, q, v, current, backend=b),
-            number,
+        cases[f"{b}: mass_matrix"] = lambda b=b: up.mass_matrix(uvms, q, backend=b)
+        cases[f"{b}: bias_forces (current)"] = lambda b=b: up.bias_forces(
+            uvms, q, v, current, backend=b
         )
-        cases[f"{b}: forward_dynamics (current)"] = (
-            lambda b=b: up.forward_dynamics(uvms, q, v, tau, current, backend=b),
-            number,
+        cases[f"{b}: forward_dynamics (current)"] = lambda b=b: up.forward_dynamics(
+            uvms, q, v, tau, current, backend=b
         )
     rk4 = RK4(5e-4)
     for b in BACKENDS:
         plant = Plant(
-            uvms,
-            current,
-            LinearSpring(np.full(3, 2.0)),
-            SinusoidalDisturbance(),
-            backend=b,
+            uvms, current, LinearSpring(np.full(3, 2.0)), SinusoidalDisturbance(), backend=b
         )
         plant.attach(q)
-        cases[f"{b}: plant over 2 ms (RK4 0.5 ms)"] = (
-            lambda p=plant: p.advance(rk4, 0.0, q, v, tau, 0.002),
-            max(1, number // 20),
+        cases[f"{b}: plant over 2 ms (RK4 0.5 ms)"] = lambda p=plant: p.advance(
+            rk4, 0.0, q, v, tau, 0.002
         )
     # the marginal cost of hydrodynamic bodies: the same plant with the arm links dry (only
     # the vehicle in water), against every body in water as above
     dry_arm = uvms.with_hydro(lambda b: b.params if b.joint_id == 1 else up.HydroParams.dry())
     plant = Plant(dry_arm, current, LinearSpring(np.full(3, 2.0)), SinusoidalDisturbance())
     plant.attach(q)
-    cases["core: plant over 2 ms, arm links dry"] = (
-        lambda p=plant: p.advance(rk4, 0.0, q, v, tau, 0.002),
-        max(1, number // 20),
+    cases["core: plant over 2 ms, arm links dry"] = lambda p=plant: p.advance(
+        rk4, 0.0, q, v, tau, 0.002
     )
-    return {name: best_time(fn, n, repeat) for name, (fn, n) in cases.items()}
+    return best_times(cases, repeat)
 
 
 def closed_loop_rows(duration_s: float) -> dict[str, dict[str, float]]:
@@ -122,14 +108,16 @@ def closed_loop_rows(duration_s: float) -> dict[str, dict[str, float]]:
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--repeat", type=int, default=5)
-    parser.add_argument("--number", type=int, default=2000)
+    parser.add_argument(
+        "--repeat", type=int, default=20, help="interleaved rounds; the best is kept"
+    )
     parser.add_argument("--loop-s", type=float, default=2.0, help="simulated seconds per loop")
     parser.add_argument("--json", type=Path, default=None, help="also write the results here")
     args = parser.parse_args()
+    one_blas_thread()
 
     uvms = up.load_uvms(ROOT / "models" / "uvms_lbv150.urdf")
-    calls = call_rows(uvms, args.number, args.repeat)
+    calls = call_rows(uvms, args.repeat)
     floor = calls["pin.aba (rigid floor)"]
     width = max(len(n) for n in calls)
     print(f"{'case':<{width}}  {'x pin.aba':>10}  {'us/call':>10}")

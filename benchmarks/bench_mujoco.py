@@ -31,15 +31,14 @@ import inspect
 import json
 import math
 import tempfile
-import time
-import timeit
-from collections.abc import Callable, Hashable
+from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 
 import mujoco
 import numpy as np
 import pinocchio as pin
+from timing import best_times, one_blas_thread
 
 import uvms_pin as up
 from uvms_pin.arms.catalog import resolve_arm
@@ -68,28 +67,6 @@ CURRENT_WORLD_M_S = np.array([0.3, 0.1, 0.0])
 ARMS = ("reference", "ur5", "panda")  # 4, 6 and 7 arm joints
 ABA = "pin.aba (rigid, no water)"
 MJ_FORWARD, MJ_PLANT, MJ_LOOP = "MuJoCo mj_forward", "MuJoCo plant", "MuJoCo closed-loop tick"
-
-
-def best_times(
-    cases: dict[Hashable, Callable[[], object]], repeat: int, batch_s: float = 0.05
-) -> dict[Hashable, float]:
-    """Best time per call [s] of each case over ``repeat`` rounds.
-
-    Times are this process's CPU time (``time.process_time``: what other processes take
-    from a shared machine is not counted). Each round times every case once, in a batch of
-    about ``batch_s``: short batches interleaved over many rounds let the minimum find the
-    machine's quiet moments for every case alike.
-    """
-    timers = {name: timeit.Timer(fn, timer=time.process_time) for name, fn in cases.items()}
-    for fn in cases.values():
-        fn()  # warm up first: a first call that builds caches would shrink the batch size
-    numbers = {name: max(1, round(batch_s / timer.timeit(1))) for name, timer in timers.items()}
-    best = dict.fromkeys(cases, math.inf)
-    for _ in range(repeat):
-        for name, timer in timers.items():
-            seconds = timer.timeit(numbers[name]) / numbers[name]
-            best[name] = min(best[name], seconds)
-    return best
 
 
 # ---- backends ---------------------------------------------------------------------------
@@ -407,6 +384,7 @@ def main() -> None:
     args = parser.parse_args()
     if min(args.repeat, args.ticks) < 1:
         parser.error("--repeat and --ticks must be >= 1")
+    one_blas_thread()
 
     reference = reference_system()
     sections = [

@@ -23,6 +23,7 @@ PRODUCERS = {
     "robustness": "robustness table: docs/results/robustness.md",
     "bench": "benchmark table: docs/results/bench.md",
     "bench_mujoco": "uvms-pin vs MuJoCo: docs/results/bench_mujoco.md",
+    "bench_controller": "controller benchmark: docs/results/bench_controller.md",
     "bench_gym": "Gymnasium step rate: docs/results/bench_gym.md",
     "compare_arms": "arm comparison: docs/results/compare_arms.md, docs/arm_comparison.png",
     "compare_controllers": (

@@ -22,7 +22,7 @@ ROWS = (
     ("joint_torque_peak_Nm", "peak joint torque [N m]", "{:.3g}"),
     ("joint_limit_excess_max_rad", "largest joint-limit excess [rad]", "{:.3g}"),
     ("orientation_error_final_rad", "final orientation error [rad]", "{:.3g}"),
-    ("wall_time_s", "wall time [s] (machine-dependent)", "{:.0f}"),
+    ("wall_time_s", "wall time [s] (machine-dependent)", "{:.2g}"),
 )
 
 
