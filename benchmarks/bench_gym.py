@@ -26,6 +26,7 @@ import timeit
 import gymnasium as gym
 import numpy as np
 import pinocchio as pin
+from timing import one_blas_thread
 
 import uvms_pin.gym  # noqa: F401 - registers the environments
 
@@ -92,6 +93,7 @@ def main() -> None:
     parser.add_argument("--repeat", type=int, default=3)
     parser.add_argument("--json", help="also write the results to this file")
     args = parser.parse_args()
+    one_blas_thread()
     results = run(args.steps, args.repeat)
     for env_id, r in results.items():
         print(
