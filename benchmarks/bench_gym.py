@@ -21,12 +21,11 @@ from __future__ import annotations
 import argparse
 import json
 import time
-import timeit
 
 import gymnasium as gym
 import numpy as np
 import pinocchio as pin
-from timing import one_blas_thread
+from timing import best_times, one_blas_thread
 
 import uvms_pin.gym  # noqa: F401 - registers the environments
 
@@ -39,10 +38,7 @@ def aba_time(model: pin.Model, repeat: int) -> float:
     rng = np.random.default_rng(0)
     q = pin.randomConfiguration(model, -np.ones(model.nq), np.ones(model.nq))
     v, tau = rng.standard_normal(model.nv), rng.standard_normal(model.nv)
-    times = timeit.repeat(
-        lambda: pin.aba(model, data, q, v, tau), number=2000, repeat=repeat, timer=time.process_time
-    )
-    return min(times) / 2000
+    return best_times({"aba": lambda: pin.aba(model, data, q, v, tau)}, max(repeat, 20))["aba"]
 
 
 def step_time(env: gym.Env, steps: int, repeat: int) -> float:
