@@ -1,11 +1,14 @@
 """The compiled core against the Python reference (its oracle): 1e-12 relative on random states.
 
-Reference model and three mounted example-robot-data arms; with and without a current; with
+Reference model, every shipped model file, three mounted example-robot-data arms and a
+ball-jointed arm; with and without a current; with
 external generalized forces, the spring and plane contacts and the sinusoidal disturbance; the
 plant advanced over a control period by RK4 and semi-implicit Euler.
 """
 
 from __future__ import annotations
+
+import warnings
 
 import numpy as np
 import pinocchio as pin
@@ -18,7 +21,7 @@ from uvms_pin.arms.reference import split_urdf
 from uvms_pin.environment import CompliantPlane, LinearSpring, SinusoidalDisturbance
 from uvms_pin.integrators import RK4, SemiImplicitEuler, python_chart
 from uvms_pin.plant import Plant
-from uvms_pin.resources import example_robot_data_dir
+from uvms_pin.resources import example_robot_data_dir, shipped_models, shipped_path
 
 REL = 1e-12
 ERD_ARMS = ("ur5", "panda", "z1")
@@ -206,3 +209,46 @@ def test_generic_joints_in_the_articulated_pass_match_the_reference(reference_uv
             up.forward_dynamics(uvms, q, v, tau, current),
             up.forward_dynamics(uvms, q, v, tau, current, backend="python"),
         )
+
+
+@pytest.mark.parametrize("name", shipped_models())
+def test_every_shipped_model_matches_the_reference(name):
+    """Each model file uvms-pin ships (vehicles, arm, mounted systems): M, h and forward
+    dynamics with and without a current, and the plant with its disturbance (and the spring
+    when the model has an end-effector)."""
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", up.ModelWarning)  # e.g. the arm file's dry links
+        uvms = up.load_uvms(shipped_path(f"models/{name}.urdf"))
+    rng = np.random.default_rng(13)
+    for current in (np.zeros(3), np.array([0.3, -0.2, 0.1])):
+        for _ in range(3):
+            q = random_configuration(uvms, rng)
+            v = rng.normal(scale=0.5, size=uvms.nv)
+            tau = rng.normal(scale=5.0, size=uvms.nv)
+            assert_rel(up.mass_matrix(uvms, q), up.mass_matrix(uvms, q, backend="python"))
+            assert_rel(
+                up.bias_forces(uvms, q, v, current),
+                up.bias_forces(uvms, q, v, current, backend="python"),
+            )
+            assert_rel(
+                up.forward_dynamics(uvms, q, v, tau, current),
+                up.forward_dynamics(uvms, q, v, tau, current, backend="python"),
+            )
+    contact = (lambda: LinearSpring(np.full(3, 2.0))) if uvms.has_end_effector else lambda: None
+    disturbance = SinusoidalDisturbance(rng.normal(size=6), period_s=3.0)
+    current = np.array([0.2, -0.1, 0.05])
+    core, python = (
+        Plant(uvms, current, contact(), disturbance, backend=b) for b in ("core", "python")
+    )
+    q0 = uvms.neutral_configuration()
+    for plant in (core, python):
+        plant.attach(q0)
+    v0 = rng.normal(scale=0.3, size=uvms.nv)
+    tau = rng.normal(scale=5.0, size=uvms.nv)
+    assert_rel(core.acceleration(0.3, q0, v0, tau), python.acceleration(0.3, q0, v0, tau))
+    for got, expected in zip(
+        core.advance(RK4(5e-4), 0.1, q0, v0, tau, 0.102),
+        python.advance(RK4(5e-4), 0.1, q0, v0, tau, 0.102),
+        strict=True,
+    ):
+        assert_rel(got, expected)
