@@ -67,16 +67,21 @@ def test_dynamics_match_the_reference(reference_uvms, mounted_arms, current):
             v = rng.normal(scale=0.5, size=uvms.nv)
             tau = rng.normal(scale=5.0, size=uvms.nv)
             tau_ext = rng.normal(scale=2.0, size=uvms.nv)
-            assert_rel(up.mass_matrix(uvms, q), up.mass_matrix(uvms, q, backend="python"))
-            assert_rel(
-                up.bias_forces(uvms, q, v, current),
-                up.bias_forces(uvms, q, v, current, backend="python"),
-            )
             for ext in (None, tau_ext):
-                assert_rel(
-                    up.forward_dynamics(uvms, q, v, tau, current, ext),
-                    up.forward_dynamics(uvms, q, v, tau, current, ext, backend="python"),
-                )
+                _assert_dynamics_match(uvms, q, v, tau, current, ext)
+
+
+def _assert_dynamics_match(uvms, q, v, tau, current, tau_ext=None) -> None:
+    """M, h and forward dynamics of the core equal the reference's at (q, v, tau)."""
+    assert_rel(up.mass_matrix(uvms, q), up.mass_matrix(uvms, q, backend="python"))
+    assert_rel(
+        up.bias_forces(uvms, q, v, current),
+        up.bias_forces(uvms, q, v, current, backend="python"),
+    )
+    assert_rel(
+        up.forward_dynamics(uvms, q, v, tau, current, tau_ext),
+        up.forward_dynamics(uvms, q, v, tau, current, tau_ext, backend="python"),
+    )
 
 
 def _plants(uvms, rng):
@@ -225,15 +230,7 @@ def test_every_shipped_model_matches_the_reference(name):
             q = random_configuration(uvms, rng)
             v = rng.normal(scale=0.5, size=uvms.nv)
             tau = rng.normal(scale=5.0, size=uvms.nv)
-            assert_rel(up.mass_matrix(uvms, q), up.mass_matrix(uvms, q, backend="python"))
-            assert_rel(
-                up.bias_forces(uvms, q, v, current),
-                up.bias_forces(uvms, q, v, current, backend="python"),
-            )
-            assert_rel(
-                up.forward_dynamics(uvms, q, v, tau, current),
-                up.forward_dynamics(uvms, q, v, tau, current, backend="python"),
-            )
+            _assert_dynamics_match(uvms, q, v, tau, current)
     contact = (lambda: LinearSpring(np.full(3, 2.0))) if uvms.has_end_effector else lambda: None
     disturbance = SinusoidalDisturbance(rng.normal(size=6), period_s=3.0)
     current = np.array([0.2, -0.1, 0.05])

@@ -7,6 +7,7 @@ Scratch output (rollouts, study tables) goes to out/results/<name>/.
 
 from __future__ import annotations
 
+import json
 import os
 import platform
 import shutil
@@ -67,3 +68,15 @@ def publish_figure(source: Path, name: str) -> Path:
     shutil.copyfile(source, target)
     print(f"wrote {target.relative_to(ROOT)}", flush=True)
     return target
+
+
+def benchmark_result(name: str, title: str, script: str, args: list[str], preface: str) -> Path:
+    """Run ``benchmarks/<script> <args> --json FILE`` and publish what it printed as the
+    result ``name`` (a code block after ``preface``)."""
+    out = scratch(name) / f"{name}.json"
+    command = [sys.executable, str(ROOT / "benchmarks" / script), *args, "--json", str(out)]
+    print("$ " + " ".join(command[1:]), flush=True)
+    printed = subprocess.run(command, cwd=ROOT, check=True, capture_output=True, text=True)
+    json.loads(out.read_text())  # the benchmark wrote its results
+    body = preface + "\n\n```\n" + printed.stdout.strip() + "\n```\n"
+    return write_result(name, title, f"python scripts/results/{name}.py", body)
