@@ -56,6 +56,27 @@ class HeadlessPage:
     def __init__(self, width: int = 900, height: int = 640):
         self.binary = chromium_or_skip()
         self.width, self.height = width, height
+        self.requests: list[str] = []
+        self.websockets: list[str] = []
+        # a headless Chromium on a loaded machine now and then exits while starting (seen
+        # once in ~900 CI tests): start it again, with a fresh profile, up to three times
+        for _ in range(3):
+            port_file = self._launch()
+            if port_file is not None:
+                break
+            self.close()
+        else:
+            pytest.fail("chromium did not start its DevTools endpoint (3 attempts)")
+        port = int(port_file.read_text().split()[0])
+        with urllib.request.urlopen(f"http://127.0.0.1:{port}/json/list", timeout=10) as r:
+            targets = json.load(r)
+        self.ws_url = next(t for t in targets if t["type"] == "page")["webSocketDebuggerUrl"]
+        self.loop = asyncio.new_event_loop()
+        self.loop.run_until_complete(self._connect())
+
+    def _launch(self) -> Path | None:
+        """Start Chromium with a new profile; its DevTools port file, or None if it exited or
+        did not write it within 30 s."""
         self.profile = tempfile.TemporaryDirectory(
             prefix="uvms-chromium-", ignore_cleanup_errors=True
         )
@@ -72,7 +93,7 @@ class HeadlessPage:
                 "--disable-sync",
                 "--enable-unsafe-swiftshader",
                 f"--user-data-dir={self.profile.name}",
-                f"--window-size={width},{height}",
+                f"--window-size={self.width},{self.height}",
                 "--remote-debugging-address=127.0.0.1",
                 "--remote-debugging-port=0",
                 "about:blank",
@@ -81,21 +102,13 @@ class HeadlessPage:
             stderr=subprocess.DEVNULL,
             start_new_session=True,
         )
-        self.requests: list[str] = []
-        self.websockets: list[str] = []
         port_file = Path(self.profile.name) / "DevToolsActivePort"
         deadline = time.monotonic() + 30
         while not port_file.is_file() or len(port_file.read_text().split()) < 2:
             if time.monotonic() > deadline or self.proc.poll() is not None:
-                self.close()
-                pytest.fail("chromium did not start its DevTools endpoint")
+                return None
             time.sleep(0.05)
-        port = int(port_file.read_text().split()[0])
-        with urllib.request.urlopen(f"http://127.0.0.1:{port}/json/list", timeout=10) as r:
-            targets = json.load(r)
-        self.ws_url = next(t for t in targets if t["type"] == "page")["webSocketDebuggerUrl"]
-        self.loop = asyncio.new_event_loop()
-        self.loop.run_until_complete(self._connect())
+        return port_file
 
     async def _connect(self) -> None:
         from tornado.websocket import websocket_connect
