@@ -16,6 +16,23 @@ RHO = 1025.0
 G = 9.81
 
 
+def mount_on_reference_vehicle(arm: str, tmp_dir: Path) -> up.UVMS:
+    """A catalog arm (e.g. ``"panda"``) on the reference vehicle, at the reference arm's
+    mount turned upside down, as compare-arms mounts it (its dry links allowed)."""
+    from uvms_pin.arms.catalog import CATALOG
+    from uvms_pin.arms.reference import split_urdf
+
+    split = split_urdf(REFERENCE_URDF, tmp_dir)
+    entry = CATALOG[arm]
+    return up.mount_arm(
+        split.vehicle_urdf,
+        entry.urdf,
+        (split.mount_pose.translation, (np.pi, 0.0, 0.0)),
+        ee_link=entry.ee_link,
+        allow_dry_links=True,
+    )
+
+
 def body_urdf(
     *,
     mass: float = 10.0,

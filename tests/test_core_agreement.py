@@ -13,11 +13,9 @@ import warnings
 import numpy as np
 import pinocchio as pin
 import pytest
-from conftest import REFERENCE_URDF, random_configuration
+from conftest import mount_on_reference_vehicle, random_configuration
 
 import uvms_pin as up
-from uvms_pin.arms.catalog import CATALOG
-from uvms_pin.arms.reference import split_urdf
 from uvms_pin.environment import CompliantPlane, LinearSpring, SinusoidalDisturbance
 from uvms_pin.integrators import RK4, SemiImplicitEuler, python_chart
 from uvms_pin.plant import Plant
@@ -38,17 +36,8 @@ def assert_rel(actual: np.ndarray, expected: np.ndarray, rel: float = REL) -> No
 def mounted_arms(tmp_path_factory):
     if example_robot_data_dir() is None:
         pytest.skip("example-robot-data is not installed")
-    split = split_urdf(REFERENCE_URDF, tmp_path_factory.mktemp("split"))
-    pose = (split.mount_pose.translation, (np.pi, 0.0, 0.0))
     return {
-        name: up.mount_arm(
-            split.vehicle_urdf,
-            CATALOG[name].urdf,
-            pose,
-            ee_link=CATALOG[name].ee_link,
-            allow_dry_links=True,
-        )
-        for name in ERD_ARMS
+        name: mount_on_reference_vehicle(name, tmp_path_factory.mktemp(name)) for name in ERD_ARMS
     }
 
 

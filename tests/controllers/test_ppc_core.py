@@ -17,7 +17,7 @@ import math
 import numpy as np
 import pinocchio as pin
 import pytest
-from conftest import ROOT, random_configuration
+from conftest import ROOT, mount_on_reference_vehicle, random_configuration
 from test_ppc_oracle import (
     CLAMP,
     REALISTIC_WEIGHTS,
@@ -274,18 +274,7 @@ def test_random_states_on_the_reference_model(reference_uvms, variant):
 def panda_uvms(tmp_path_factory):
     if example_robot_data_dir() is None:
         pytest.skip("needs example-robot-data")
-    from uvms_pin.arms.catalog import CATALOG
-    from uvms_pin.arms.reference import split_urdf
-
-    split = split_urdf(ROOT / "models" / "uvms_lbv150.urdf", tmp_path_factory.mktemp("panda"))
-    entry = CATALOG["panda"]
-    uvms = up.mount_arm(
-        split.vehicle_urdf,
-        entry.urdf,
-        (split.mount_pose.translation, (math.pi, 0.0, 0.0)),
-        ee_link=entry.ee_link,
-        allow_dry_links=True,
-    )
+    uvms = mount_on_reference_vehicle("panda", tmp_path_factory.mktemp("panda"))
     assert uvms.n_arm_joints == 7
     return uvms
 

@@ -19,7 +19,7 @@ from unittest import mock
 import numpy as np
 import pinocchio as pin
 import pytest
-from conftest import ROOT, random_configuration
+from conftest import ROOT, mount_on_reference_vehicle, random_configuration
 from ppc_oracle import in_place_of_the_package_ppc
 from ppc_oracle import performance as oracle_performance
 from ppc_oracle.ppc import PrescribedPerformanceController as OraclePPC
@@ -272,18 +272,7 @@ def test_random_states_on_arms_of_any_size(n_joints):
 
 @pytest.mark.skipif(example_robot_data_dir() is None, reason="needs example-robot-data")
 def test_random_states_on_a_mounted_7_joint_panda(tmp_path):
-    from uvms_pin.arms.catalog import CATALOG
-    from uvms_pin.arms.reference import split_urdf
-
-    split = split_urdf(ROOT / "models" / "uvms_lbv150.urdf", tmp_path)
-    entry = CATALOG["panda"]
-    uvms = up.mount_arm(
-        split.vehicle_urdf,
-        entry.urdf,
-        (split.mount_pose.translation, (math.pi, 0.0, 0.0)),
-        ee_link=entry.ee_link,
-        allow_dry_links=True,
-    )
+    uvms = mount_on_reference_vehicle("panda", tmp_path)
     assert uvms.n_arm_joints == 7
     params = PPCParams(velocity_weights=[*REALISTIC_WEIGHTS, *[1.0] * 7], null_space_gain_per_s=3.0)
     frame = uvms.model.frames[uvms.ee_frame_id].name
