@@ -41,12 +41,12 @@ import pinocchio as pin
 from timing import best_times, one_blas_thread
 
 import uvms_pin as up
-from uvms_pin.arms.catalog import CATALOG
-from uvms_pin.arms.reference import split_urdf
-from uvms_pin.controllers.ppc import PPCParams, PrescribedPerformanceController
-from uvms_pin.measurement import Measurement
-from uvms_pin.resources import example_robot_data_dir
-from uvms_pin.scenario import load_scenario
+from uvms_pin.control.measurement import Measurement
+from uvms_pin.control.ppc import PPCParams, PrescribedPerformanceController
+from uvms_pin.model.mount.catalog import CATALOG
+from uvms_pin.model.mount.split import split_urdf
+from uvms_pin.model.resources import example_robot_data_dir
+from uvms_pin.scenario.scenario import load_scenario
 
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT / "tests" / "controllers"))
@@ -78,7 +78,7 @@ def scenario_case(stem: str) -> Case:
     python = load_scenario(path, {"controller.backend": "python"}).controller_factory(scenario.uvms)
     assert (core.backend, python.backend) == ("core", "python")
     with mock.patch(
-        "uvms_pin.scenario.PrescribedPerformanceController", in_place_of_the_package_ppc
+        "uvms_pin.scenario.scenario.PrescribedPerformanceController", in_place_of_the_package_ppc
     ):
         oracle = scenario.controller_factory(scenario.uvms)
     return _calls(_measurement(scenario.uvms, scenario.q0), core, python, oracle)
@@ -121,8 +121,8 @@ def mounted_arm_case(arm: str) -> Case | None:
 def breakdown() -> dict[str, Callable[[], object]]:
     """The stages of the realistic scenario's Python ``compute``, each callable on its own,
     and the compiled kernel's call."""
-    from uvms_pin.controllers import ppc
-    from uvms_pin.kinematics import frame_rotation_and_jacobian
+    from uvms_pin.control import ppc
+    from uvms_pin.physics.kinematics import frame_rotation_and_jacobian
 
     path = ROOT / "scenarios" / "realistic_force_tracking.toml"
     scenario = load_scenario(path, {"controller.backend": "python"})

@@ -26,10 +26,10 @@ import pinocchio as pin
 from timing import best_times, one_blas_thread
 
 import uvms_pin as up
-from uvms_pin.core import dynamics_of
-from uvms_pin.environment import LinearSpring, SinusoidalDisturbance
-from uvms_pin.integrators import RK4
-from uvms_pin.plant import Plant
+from uvms_pin.physics.compiled import dynamics_of
+from uvms_pin.physics.environment import LinearSpring, SinusoidalDisturbance
+from uvms_pin.sim.integrators import RK4
+from uvms_pin.sim.plant import Plant
 
 ROOT = Path(__file__).resolve().parents[1]
 BACKENDS = ("core", "python")

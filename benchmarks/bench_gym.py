@@ -27,7 +27,7 @@ import numpy as np
 import pinocchio as pin
 from timing import best_times, one_blas_thread
 
-import uvms_pin.gym  # noqa: F401 - registers the environments
+import uvms_pin.apps.gym  # noqa: F401 - registers the environments
 
 ENVS = ("uvms_pin/ForceTracking-v0", "uvms_pin/StationKeeping-v0")
 

@@ -2,7 +2,7 @@
 
     .venv/bin/python benchmarks/bench_mujoco.py [--repeat N] [--out out/bench/mujoco.md]
 
-The MuJoCo model is generated from the uvms-pin one (`uvms_pin.export.mjcf`: same masses,
+The MuJoCo model is generated from the uvms-pin one (`uvms_pin.apps.export.mjcf`: same masses,
 inertias, joint placements, axes and armature; buoyancy by gravity-compensated carriers;
 MuJoCo's ellipsoid fluid model on the collision shapes; the paper's 2 N/m spring as a
 tendon), so both simulators move the same rigid bodies. The water differs: uvms-pin puts
@@ -41,21 +41,21 @@ import pinocchio as pin
 from timing import best_times, one_blas_thread
 
 import uvms_pin as up
-from uvms_pin.arms.catalog import resolve_arm
-from uvms_pin.arms.reference import split_urdf
-from uvms_pin.environment import LinearSpring, SinusoidalDisturbance
-from uvms_pin.export.mjcf import MjcfOptions, uvms_to_mjcf
-from uvms_pin.export.mujoco_state import (
+from uvms_pin.apps.export.mjcf import MjcfOptions, uvms_to_mjcf
+from uvms_pin.apps.export.mujoco_state import (
     q_from_qpos,
     qfrc_from_tau,
     qpos_from_q,
     qvel_from_v,
     v_from_qvel,
 )
-from uvms_pin.integrators import RK4
-from uvms_pin.mount import mount_arm_detailed
-from uvms_pin.plant import Plant
-from uvms_pin.sensors import SensorSuite
+from uvms_pin.model.mount.catalog import resolve_arm
+from uvms_pin.model.mount.mount import mount_arm_detailed
+from uvms_pin.model.mount.split import split_urdf
+from uvms_pin.physics.environment import LinearSpring, SinusoidalDisturbance
+from uvms_pin.sim.integrators import RK4
+from uvms_pin.sim.plant import Plant
+from uvms_pin.sim.sensors import SensorSuite
 
 ROOT = Path(__file__).resolve().parents[1]
 REFERENCE_URDF = ROOT / "models" / "uvms_lbv150.urdf"

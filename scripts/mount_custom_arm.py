@@ -101,14 +101,14 @@ def write_example_arm(directory: Path) -> Path:
 
 
 def main(argv: list[str] | None = None) -> int:
-    from uvms_pin.arms.catalog import ArmEntry
-    from uvms_pin.arms.compare import CompareSettings, compare_arms
-    from uvms_pin.arms.reference import split_urdf
+    from uvms_pin.apps.arms.compare import CompareSettings, compare_arms
     from uvms_pin.errors import UvmsPinError
-    from uvms_pin.mount import mount_arm_detailed
-    from uvms_pin.scenario import load_scenario
-    from uvms_pin.summary import model_summary
-    from uvms_pin.trim import TrimSpec
+    from uvms_pin.model.mount.catalog import ArmEntry
+    from uvms_pin.model.mount.mount import mount_arm_detailed
+    from uvms_pin.model.mount.split import split_urdf
+    from uvms_pin.model.summary import model_summary
+    from uvms_pin.model.trim import TrimSpec
+    from uvms_pin.scenario.scenario import load_scenario
 
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--arm", help="your arm URDF (default: a built-in example arm)")

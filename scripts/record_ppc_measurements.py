@@ -21,9 +21,9 @@ from unittest import mock
 
 import numpy as np
 
-from uvms_pin.controllers.base import Controller
-from uvms_pin.measurement import Measurement
-from uvms_pin.scenario import Scenario, load_scenario, simulate
+from uvms_pin.control.base import Controller
+from uvms_pin.control.measurement import Measurement
+from uvms_pin.scenario.scenario import Scenario, load_scenario, simulate
 
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT / "tests" / "controllers"))
@@ -62,7 +62,7 @@ class _Recorder(Controller):
 def oracle_controller(scenario: Scenario) -> Controller:
     """The scenario's controller, built with the same arguments by the frozen oracle."""
     with mock.patch(
-        "uvms_pin.scenario.PrescribedPerformanceController", in_place_of_the_package_ppc
+        "uvms_pin.scenario.scenario.PrescribedPerformanceController", in_place_of_the_package_ppc
     ):
         return scenario.controller_factory(scenario.uvms)
 

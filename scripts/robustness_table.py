@@ -17,8 +17,8 @@ from pathlib import Path
 import numpy as np
 
 from uvms_pin.errors import FunnelViolation, SimulationError
-from uvms_pin.scenario import load_scenario, simulate
-from uvms_pin.study.plant import scaled_uvms
+from uvms_pin.model.scaled import scaled_uvms
+from uvms_pin.scenario.scenario import load_scenario, simulate
 
 ROOT = Path(__file__).resolve().parents[1]
 SCENARIO = ROOT / "scenarios" / "realistic_force_tracking.toml"

@@ -17,9 +17,9 @@ from pathlib import Path
 import numpy as np
 
 import uvms_pin as up
-from uvms_pin.viz.live import LiveView
-from uvms_pin.viz.meshcat_scene import Frame, UvmsScene
-from uvms_pin.viz.replay import scene_html, write_page
+from uvms_pin.apps.viz.live import LiveView
+from uvms_pin.apps.viz.meshcat_scene import Frame, UvmsScene
+from uvms_pin.apps.viz.replay import scene_html, write_page
 
 ROOT = Path(__file__).resolve().parents[1]
 

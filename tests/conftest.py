@@ -2,6 +2,9 @@
 
 from __future__ import annotations
 
+import shutil
+import subprocess
+import sys
 from pathlib import Path
 
 import numpy as np
@@ -14,13 +17,15 @@ ROOT = Path(__file__).resolve().parents[1]
 REFERENCE_URDF = ROOT / "models" / "uvms_lbv150.urdf"
 RHO = 1025.0
 G = 9.81
+#: relative agreement of the compiled core with the Python reference
+REL = 1e-12
 
 
 def mount_on_reference_vehicle(arm: str, tmp_dir: Path) -> up.UVMS:
     """A catalog arm (e.g. ``"panda"``) on the reference vehicle, at the reference arm's
     mount turned upside down, as compare-arms mounts it (its dry links allowed)."""
-    from uvms_pin.arms.catalog import CATALOG
-    from uvms_pin.arms.reference import split_urdf
+    from uvms_pin.model.mount.catalog import CATALOG
+    from uvms_pin.model.mount.split import split_urdf
 
     split = split_urdf(REFERENCE_URDF, tmp_dir)
     entry = CATALOG[arm]
@@ -109,3 +114,32 @@ def random_configuration(uvms: up.UVMS, rng: np.random.Generator) -> np.ndarray:
 
 def free_body_state(uvms: up.UVMS) -> np.ndarray:
     return pin.neutral(uvms.model)
+
+
+# ---- the command line as a user runs it, and relative comparisons (used across folders)
+def uvms_pin_command() -> list[str]:
+    exe = Path(sys.executable).with_name("uvms-pin")
+    if exe.exists():
+        return [str(exe)]
+    found = shutil.which("uvms-pin")
+    if found is None:
+        pytest.fail("the uvms-pin console script is not installed (pip install -e .)")
+    return [found]
+
+
+def run(*args: str, cwd: Path = ROOT) -> subprocess.CompletedProcess:
+    return subprocess.run(
+        [*uvms_pin_command(), *args],
+        cwd=cwd,
+        capture_output=True,
+        text=True,
+        timeout=600,
+        check=False,
+    )
+
+
+def assert_rel(actual: np.ndarray, expected: np.ndarray, rel: float = REL) -> None:
+    """max |a - e| <= rel * max |e| (relative to the size of the whole quantity)."""
+    scale = max(float(np.max(np.abs(expected))), 1e-300)
+    err = float(np.max(np.abs(actual - expected)))
+    assert err <= rel * scale, f"relative error {err / scale:.3g} > {rel:g}"

@@ -9,8 +9,8 @@ from pathlib import Path
 import pytest
 from conftest import ROOT
 
-from uvms_pin import scenario as scenario_module
-from uvms_pin.scenario import load_scenario
+from uvms_pin.scenario import scenario as scenario_module
+from uvms_pin.scenario.scenario import load_scenario
 
 DOCS = ROOT / "docs"
 SCENARIOS = ROOT / "scenarios"
@@ -133,7 +133,7 @@ def test_scenarios_doc_lists_no_key_the_reader_does_not_know():
 
 
 def test_studies_doc_names_every_factor_distribution_and_mode():
-    from uvms_pin.study.spec import APPLY_MODES, DISTRIBUTIONS, PLANT_FACTORS, PLANT_PREFIX
+    from uvms_pin.apps.study.spec import APPLY_MODES, DISTRIBUTIONS, PLANT_FACTORS, PLANT_PREFIX
 
     text = (DOCS / "studies.md").read_text()
     names = [PLANT_PREFIX + f for f in PLANT_FACTORS] + list(DISTRIBUTIONS) + list(APPLY_MODES)

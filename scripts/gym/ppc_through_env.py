@@ -11,10 +11,10 @@ import argparse
 import gymnasium as gym
 import numpy as np
 
-import uvms_pin.gym  # noqa: F401 - registers the environments
-from uvms_pin.gym.env import scenario_path
-from uvms_pin.gym.policy import ControllerPolicy
-from uvms_pin.scenario import load_scenario, simulate
+import uvms_pin.apps.gym  # noqa: F401 - registers the environments
+from uvms_pin.apps.gym.env import scenario_path
+from uvms_pin.apps.gym.policy import ControllerPolicy
+from uvms_pin.scenario.scenario import load_scenario, simulate
 
 
 def random_episode(scenario: str, seed: int, steps: int) -> float:

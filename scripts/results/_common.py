@@ -33,7 +33,7 @@ def scratch(name: str) -> Path:
 
 def uvms_pin(*args: str) -> subprocess.CompletedProcess:
     """Run the ``uvms-pin`` command of this interpreter (exit 0 or 3 are results)."""
-    command = [sys.executable, "-m", "uvms_pin.cli", *args]
+    command = [sys.executable, "-m", "uvms_pin.apps.cli.main", *args]
     print("$ uvms-pin " + " ".join(args), flush=True)
     result = subprocess.run(command, cwd=ROOT, check=False)
     if result.returncode not in (0, 3):

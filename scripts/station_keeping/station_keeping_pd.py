@@ -9,7 +9,7 @@ The scenario next to this file (``station_keeping.toml``) names it as
 
 and uvms-pin imports this module from the scenario's directory and builds the controller
 as ``StationKeepingPD(uvms, **params)`` (the other keys of [controller]). A controller
-subclasses `uvms_pin.controllers.base.Controller` and sees only a `Measurement`.
+subclasses `uvms_pin.control.base.Controller` and sees only a `Measurement`.
 
 The law, with p and R the measured vehicle position (world) and attitude, nu = (v, w) the
 measured body velocity and (p_d, R_d) the pose held:
@@ -26,10 +26,10 @@ from __future__ import annotations
 import numpy as np
 import pinocchio as pin
 
-from uvms_pin.controllers.base import Controller
+from uvms_pin.control.base import Controller
+from uvms_pin.control.measurement import Measurement
 from uvms_pin.errors import ParameterError
-from uvms_pin.measurement import Measurement
-from uvms_pin.model import UVMS
+from uvms_pin.model.uvms import UVMS
 
 
 class StationKeepingPD(Controller):

@@ -1,4 +1,4 @@
-// Underwater dynamics of a UVMS (mirror of uvms_pin/dynamics.py):
+// Underwater dynamics of a UVMS (mirror of uvms_pin/physics/dynamics.py):
 //
 //   M(q) zeta_dot + h(q, zeta) = tau + tau_ext
 //   M = M_RB + sum_i J_i^T M_A,i J_i
@@ -63,7 +63,7 @@ class Dynamics {
   // zeta_dot = M^-1 rhs, by Cholesky (throws SimulationFailure if M is not SPD).
   const Eigen::VectorXd& solve(const ConstVec& q, const ConstVec& rhs);
 
-  // The public operations of uvms_pin.dynamics.
+  // The public operations of uvms_pin.physics.dynamics.
   const Eigen::VectorXd& bias_forces(const ConstVec& q, const ConstVec& v,
                                      const FlowField& flow, double time_s = 0.0);
   const Eigen::VectorXd& forward_dynamics(const ConstVec& q, const ConstVec& v,

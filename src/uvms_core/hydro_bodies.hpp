@@ -1,5 +1,5 @@
 // The static hydrodynamic parameters of a UVMS, stacked per Pinocchio joint (the arrays that
-// uvms_pin/model.py builds: added_mass_per_joint, volume_per_joint_m3, ...).
+// uvms_pin/model/uvms.py builds: added_mass_per_joint, volume_per_joint_m3, ...).
 #pragma once
 
 #include <vector>

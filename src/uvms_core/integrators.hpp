@@ -1,4 +1,4 @@
-// Fixed-step integrators on the configuration manifold (mirror of uvms_pin/integrators.py).
+// Fixed-step integrators on the configuration manifold (mirror of uvms_pin/sim/integrators.py).
 //
 // RK4 works in the local chart q = integrate(q0, delta) of the step's start, where
 // delta_dot = Jint(q0, delta)^-1 zeta (Jint = dIntegrate wrt delta); the result is mapped back

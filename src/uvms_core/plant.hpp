@@ -1,4 +1,4 @@
-// The simulated world (mirror of uvms_pin/plant.py): a UVMS in a flow, touching a compliant
+// The simulated world (mirror of uvms_pin/sim/plant.py): a UVMS in a flow, touching a compliant
 // environment at its end-effector and pushed by a disturbance:
 //   M zeta_dot + h + J_c^T lambda + [delta; 0] = tau.
 // It advances the plant over one control period with the input held, in one call.

@@ -1,5 +1,5 @@
 // The paper's prescribed-performance force/orientation controller, one `compute` in one call
-// (mirror of uvms_pin/controllers/ppc.py, PrescribedPerformanceController.compute; the names
+// (mirror of uvms_pin/control/ppc.py, PrescribedPerformanceController.compute; the names
 // below are the Python ones). Heshmati-alamdari et al., IFAC 2017, Section 4:
 //
 // First level (6 components f_x, f_y, f_z [N]; roll, pitch, yaw [rad]):

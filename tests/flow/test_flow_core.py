@@ -8,13 +8,12 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from conftest import random_configuration
-from test_core_agreement import assert_rel
+from conftest import assert_rel, random_configuration
 
 import uvms_pin as up
-from uvms_pin.core import CoreFallbackWarning, compiled_flow
 from uvms_pin.flow import AiryWave, GaussMarkovCurrent, IrregularSea, UniformCurrent
-from uvms_pin.scenario import load_scenario, simulate
+from uvms_pin.physics.compiled import CoreFallbackWarning, compiled_flow
+from uvms_pin.scenario.scenario import load_scenario, simulate
 
 ROOT = Path(__file__).resolve().parents[2]
 FLOWS = {

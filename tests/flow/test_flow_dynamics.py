@@ -9,7 +9,7 @@ from conftest import RHO, body_urdf, hydro_xml, random_configuration
 
 import uvms_pin as up
 from uvms_pin.flow import AiryWave, GaussMarkovCurrent, UniformCurrent
-from uvms_pin.integrators import RK4
+from uvms_pin.sim.integrators import RK4
 
 RADIUS = 0.1
 VOLUME = 4.0 / 3.0 * np.pi * RADIUS**3

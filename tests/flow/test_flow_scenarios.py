@@ -9,7 +9,7 @@ import pytest
 
 import uvms_pin as up
 from uvms_pin.flow import AiryWave, GaussMarkovCurrent, IrregularSea, SumFlow
-from uvms_pin.scenario import load_scenario, simulate, water_flow_of
+from uvms_pin.scenario.scenario import load_scenario, simulate, water_flow_of
 
 ROOT = Path(__file__).resolve().parents[2]
 REALISTIC = ROOT / "scenarios" / "realistic_force_tracking.toml"

@@ -1,0 +1,63 @@
+"""compare-arms keeps each arm's outputs (--keep-rollouts) and reports progress per arm."""
+
+from __future__ import annotations
+
+import json
+
+import pytest
+from conftest import ROOT
+
+from uvms_pin.apps.arms.compare import ArmProgress, CompareSettings, compare_arms
+from uvms_pin.apps.cli.main import main
+from uvms_pin.model.resources import example_robot_data_dir
+from uvms_pin.results.rollout import Rollout
+
+SCENARIO = ROOT / "scenarios" / "realistic_force_tracking.toml"
+
+
+def test_arm_progress_emits_one_line_per_tenth():
+    lines: list[str] = []
+    progress = ArmProgress("ur5", lines.append)
+    for k in range(101):
+        progress(k * 0.02, 2.0)
+    assert len(lines) == 10  # t = 0.2, 0.4, ..., 2.0
+    assert lines[0].startswith("  ur5: t = 0.2/2 s") and lines[-1].startswith("  ur5: t = 2/2 s")
+
+
+def test_keep_rollouts_writes_each_arms_outputs(tmp_path):
+    lines: list[str] = []
+    settings = CompareSettings(duration_s=0.1, keep_rollouts=True)
+    rows = compare_arms(SCENARIO, ["reference"], tmp_path, settings, progress=lines.append)
+    arm_dir = tmp_path / "reference"
+    row = json.loads((arm_dir / "row.json").read_text())
+    assert row["status"] == rows[0]["status"] == "ok"
+    rollout = Rollout.load(arm_dir)
+    assert rollout.metadata["status"] == "ok"
+    assert rollout.time_s[-1] == pytest.approx(0.1)
+    assert row["simulated_time_s"] == pytest.approx(0.1)
+    for name in ("metrics.json", "force.png", "first_level_errors.png", "pose.png"):
+        assert (arm_dir / name).is_file(), name
+    assert lines[0].startswith("reference: running")
+    assert any(line.startswith("  reference: t = 0.1/0.1 s") for line in lines)
+    assert lines[-1].startswith("reference: ok")
+
+
+def test_without_keep_rollouts_only_the_table_is_written(tmp_path):
+    compare_arms(SCENARIO, ["reference"], tmp_path, CompareSettings(duration_s=0.02))
+    assert sorted(p.name for p in tmp_path.iterdir()) == [
+        "comparison.csv",
+        "comparison.md",
+        "comparison.png",
+    ]
+
+
+@pytest.mark.skipif(example_robot_data_dir() is None, reason="example-robot-data not installed")
+def test_cli_keeps_the_reason_of_an_arm_that_never_ran(tmp_path, capsys):
+    out = tmp_path / "arms"
+    argv = ["compare-arms", str(SCENARIO), "--arms", "so100", "--duration", "0.02"]
+    assert main([*argv, "--ik-starts", "4", "--out", str(out), "--keep-rollouts"]) == 0
+    row = json.loads((out / "so100" / "row.json").read_text())
+    assert row["status"] == "unreachable" and "out of reach" in row["reason"]
+    assert row["force_error_rms_N"] is None  # never ran: null, not NaN
+    assert not (out / "so100" / "rollout.npz").exists()
+    assert "per arm:" in capsys.readouterr().out

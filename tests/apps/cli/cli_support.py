@@ -1,0 +1,90 @@
+"""Shared by the command-line tests: the installed ``uvms-pin``, tiny inputs, directory digests."""
+
+from __future__ import annotations
+
+import hashlib
+import os
+import signal
+import subprocess
+from pathlib import Path
+
+from conftest import ROOT, uvms_pin_command
+
+__all__ = ["ROOT", "uvms_pin_command"]
+URDF = ROOT / "models" / "uvms_lbv150.urdf"
+
+
+def run_cli(args: list[str], cwd: Path, timeout_s: float = 300.0) -> subprocess.CompletedProcess:
+    """``uvms-pin ARGS`` as a user types it, in ``cwd``; output captured as text."""
+    return subprocess.run(
+        [*uvms_pin_command(), *args],
+        cwd=cwd,
+        capture_output=True,
+        text=True,
+        timeout=timeout_s,
+        check=False,
+    )
+
+
+def start_cli(args: list[str], cwd: Path) -> subprocess.Popen:
+    """``uvms-pin ARGS`` in the background, in its own session (a terminal's process group),
+    with the default Ctrl-C behaviour whatever the test runner passed on."""
+    return subprocess.Popen(
+        [*uvms_pin_command(), *args],
+        cwd=cwd,
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+        start_new_session=True,
+        preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL),
+    )
+
+
+def tree_digest(path: Path) -> dict[str, str]:
+    """Relative path -> SHA-256 of every file under ``path`` ({} if it does not exist)."""
+    if not path.exists():
+        return {}
+    if path.is_file():
+        return {".": hashlib.sha256(path.read_bytes()).hexdigest()}
+    return {
+        str(p.relative_to(path)): hashlib.sha256(p.read_bytes()).hexdigest()
+        for p in sorted(path.rglob("*"))
+        if p.is_file()
+    }
+
+
+def passive_scenario(duration_s: float = 0.1, **replace: str) -> str:
+    """The passive-current scenario, ``duration_s`` long, its model by absolute path."""
+    text = (
+        (ROOT / "scenarios" / "passive_current.toml")
+        .read_text()
+        .replace('"uvms_lbv150"', f'"{URDF}"')
+        .replace("duration_s = 20.0", f"duration_s = {duration_s}")
+    )
+    for old, new in replace.items():
+        assert old in text, old
+        text = text.replace(old, new)
+    return text
+
+
+STUDY = """
+[study]
+name = "tiny_passive"
+base = "base.toml"
+seed = 3
+
+[[parameter]]
+path = "water.current_world_m_s[0]"
+values = [0.0, 0.1]
+"""
+
+
+def interrupt(proc: subprocess.Popen, timeout_s: float = 120.0) -> tuple[str, str]:
+    """Ctrl-C as a terminal sends it (to the whole process group); the remaining output."""
+    os.killpg(proc.pid, signal.SIGINT)
+    try:
+        return proc.communicate(timeout=timeout_s)
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+            proc.wait()

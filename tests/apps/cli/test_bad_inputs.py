@@ -1,0 +1,219 @@
+"""Bad inputs and misuses, typed at the installed ``uvms-pin`` as a user would.
+
+Every case must exit with its status (2: bad input), print only the project's message (or
+argparse's usage and message) naming the input and what is wrong, no traceback, and leave
+the results already on disk as they were (their files hashed before and after); an
+``--out`` that did not exist must still not exist. All cases run concurrently (each is a
+process that spends most of its time importing), so the corpus takes a few import times.
+"""
+
+from __future__ import annotations
+
+import os
+import shutil
+from collections.abc import Callable
+from concurrent.futures import ThreadPoolExecutor
+from dataclasses import dataclass
+from pathlib import Path
+
+import pytest
+from cli_support import STUDY, URDF, passive_scenario, run_cli, tree_digest
+
+BAD_URDF = """<robot name="bad">
+  <link name="a"><inertial><mass value="1"/>
+    <inertia ixx="1" iyy="1" izz="1" ixy="0" ixz="0" iyz="0"/></inertial></link>
+  <link name="b"/>
+  <joint name="j" type="revolute"><parent link="a"/><child link="b"/></joint>
+</robot>
+"""
+
+
+def _write(name: str, content: str | bytes) -> Callable[[Path], None]:
+    def setup(case_dir: Path) -> None:
+        path = case_dir / name
+        path.parent.mkdir(parents=True, exist_ok=True)
+        if isinstance(content, bytes):
+            path.write_bytes(content)
+        else:
+            path.write_text(content)
+
+    return setup
+
+
+def _mkdir(name: str) -> Callable[[Path], None]:
+    return lambda case_dir: (case_dir / name).mkdir()
+
+
+def _steps(*setups: Callable[[Path], None]) -> Callable[[Path], None]:
+    def setup(case_dir: Path) -> None:
+        for s in setups:
+            s(case_dir)
+
+    return setup
+
+
+def _copy_study_inputs(case_dir: Path) -> None:
+    for name in ("base.toml", "study.toml"):
+        shutil.copy(case_dir.parent.parent / "study" / name, case_dir / name)
+
+
+@dataclass(frozen=True)
+class Case:
+    """``uvms-pin ARGS`` in a directory holding ``prior`` (a run's outputs) and
+    ``study_out`` (a study's results); ``{good}``, ``{study}``, ``{urdf}``, ``{ro}`` in
+    ARGS are a valid scenario, a valid study, the reference URDF and a directory that
+    cannot be written. ``watch``: results that must not change, or an --out that must
+    not appear."""
+
+    name: str
+    args: tuple[str, ...]
+    needles: tuple[str, ...]
+    setup: Callable[[Path], None] | None = None
+    watch: str = "prior"
+    code: int = 2
+
+
+GOOD_BUT = passive_scenario  # the valid scenario with a replacement (what is wrong)
+
+CASES = [
+    # ---- run: the scenario -----------------------------------------------------------
+    Case("run-missing-scenario", ("run", "nope.toml", "--out", "prior"), ("nope.toml", "file not found")),
+    Case("run-not-utf8", ("run", "s.toml", "--out", "prior"), ("s.toml", "not UTF-8"), _write("s.toml", b"\xff\xfe[scenario]\n")),
+    Case("run-invalid-toml", ("run", "s.toml", "--out", "prior"), ("s.toml", "not valid TOML"), _write("s.toml", "[scenario\n")),
+    Case("run-unknown-key", ("run", "s.toml", "--out", "prior"), ("s.toml", "[water]", "unknown key(s): current_velocity"), _write("s.toml", GOOD_BUT(**{"[water]\n": "[water]\ncurrent_velocity = [1, 2, 3]\n"}))),
+    Case("run-scenario-is-a-directory", ("run", "sdir", "--out", "prior"), ("sdir", "is a directory"), _mkdir("sdir")),
+    Case("run-negative-duration", ("run", "s.toml", "--out", "prior"), ("s.toml", "duration_s", "must be positive"), _write("s.toml", GOOD_BUT(-1.0))),
+    Case("run-missing-model", ("run", "s.toml", "--out", "prior"), ("missing.urdf", "neither a file relative to the scenario"), _write("s.toml", GOOD_BUT(**{str(URDF): "missing.urdf"}))),
+    Case("run-urdfdom-error", ("run", "s.toml", "--out", "prior"), ("bad.urdf", "does not specify limits"), _steps(_write("bad.urdf", BAD_URDF), _write("s.toml", GOOD_BUT(**{str(URDF): "bad.urdf"})))),
+    Case("run-bad-overwrite-keeps-results", ("run", "nope.toml", "--out", "prior", "--overwrite"), ("nope.toml", "file not found")),
+    # ---- run: the output directory and options ---------------------------------------
+    Case("run-out-is-a-file", ("run", "{good}", "--out", "f"), ("--out f", "is a file"), _write("f", "mine"), watch="f"),
+    Case("run-out-under-a-file", ("run", "{good}", "--out", "f/sub"), ("f/sub", "under a file"), _write("f", "mine"), watch="f"),
+    Case("run-out-not-writable", ("run", "{good}", "--out", "{ro}/out"), ("/out", "cannot write")),
+    Case("run-out-holds-results", ("run", "{good}", "--out", "prior"), ("--out prior", "already holds a run's outputs", "--overwrite")),
+    Case("run-out-holds-a-study", ("run", "{good}", "--out", "study_out", "--overwrite"), ("study_out", "holds a study's results"), watch="study_out"),
+    Case("run-out-holds-a-comparison", ("run", "{good}", "--out", "cmp", "--overwrite"), ("cmp", "holds an arm comparison"), _write("cmp/comparison.csv", "arm\n"), watch="cmp"),
+    Case("run-speed-zero", ("run", "{good}", "--out", "new", "--speed", "0"), ("--speed", "must be positive"), watch="new"),
+    Case("run-speed-nan", ("run", "{good}", "--out", "new", "--speed", "nan"), ("--speed", "finite"), watch="new"),
+    Case("run-port-out-of-range", ("run", "{good}", "--out", "new", "--port", "70000"), ("--port", "0..65535"), watch="new"),
+    Case("run-no-out", ("run", "{good}"), ("--out", "required")),
+    # ---- replay ------------------------------------------------------------------------
+    Case("replay-missing-rollout", ("replay", "nodir", "--html"), ("nodir", "holds no rollout"), watch="nodir"),
+    Case("replay-nothing-to-do", ("replay", "prior"), ("replay", "nothing to do", "--html")),
+    Case("replay-fps-zero", ("replay", "prior", "--html", "--fps", "0"), ("--fps", "must be positive")),
+    Case("replay-damaged-arrays", ("replay", "prior", "--html"), ("prior", "damaged rollout"), _write("prior/rollout.npz", b"not a zip")),
+    Case("replay-damaged-metadata", ("replay", "prior", "--html"), ("prior", "damaged rollout"), _write("prior/rollout.json", b"{\xff")),
+    Case("replay-page-exists", ("replay", "prior", "--html"), ("replay.html", "already exists", "--overwrite"), _write("prior/replay.html", "<html>earlier</html>")),
+    Case("replay-out-is-a-directory", ("replay", "prior", "--html", "--out", "pagedir"), ("pagedir", "is a directory"), _mkdir("pagedir"), watch="pagedir"),
+    Case("replay-out-under-a-file", ("replay", "prior", "--html", "--out", "f/page.html"), ("--out f/page.html", "under a file"), _write("f", "mine"), watch="f"),
+    # ---- info --------------------------------------------------------------------------
+    Case("info-missing", ("info", "nope.urdf"), ("nope.urdf", "file not found")),
+    Case("info-not-xml", ("info", "x.urdf"), ("x.urdf", "not well-formed XML"), _write("x.urdf", "<robot")),
+    Case("info-wrong-root", ("info", "x.urdf"), ("x.urdf", "expected <robot>"), _write("x.urdf", "<model/>")),
+    Case("info-negative-density", ("info", "{urdf}", "--water-density", "-1"), ("--water-density", "must be positive")),
+    # ---- sweep and report --------------------------------------------------------------
+    Case("sweep-missing-study", ("sweep", "nope.toml", "--out", "study_out"), ("nope.toml", "file not found"), watch="study_out"),
+    Case("sweep-study-not-utf8", ("sweep", "st.toml", "--out", "study_out"), ("st.toml", "not UTF-8"), _write("st.toml", b"[study]\nname = \"\xe9\"\n"), watch="study_out"),
+    Case("sweep-negative-workers", ("sweep", "{study}", "--out", "study_out", "--workers", "-2"), ("--workers", ">= 0", "-2"), watch="study_out"),
+    Case("sweep-workers-not-a-number", ("sweep", "{study}", "--out", "study_out", "--workers", "two"), ("--workers", "integer", "two"), watch="study_out"),
+    Case("sweep-workers-and-scheduler", ("sweep", "{study}", "--out", "study_out", "--workers", "1", "--scheduler", "tcp://127.0.0.1:1"), ("--scheduler", "not allowed with", "--workers"), watch="study_out"),
+    Case("sweep-another-study", ("sweep", "study.toml", "--out", "study_out", "--workers", "0"), ("study_out", "another study", "--overwrite"), _steps(_copy_study_inputs, _write("study.toml", STUDY.replace("[0.0, 0.1]", "[0.0, 0.2]"))), watch="study_out"),
+    Case("sweep-base-changed", ("sweep", "study.toml", "--out", "study_out", "--workers", "0"), ("base.toml", "changed", "restore it"), _steps(_copy_study_inputs, _write("base.toml", passive_scenario(0.06))), watch="study_out"),
+    Case("sweep-missing-base", ("sweep", "st.toml", "--out", "new"), ("st.toml", "study.base", "not found"), _write("st.toml", STUDY.replace("base.toml", "gone.toml")), watch="new"),
+    Case("sweep-into-a-run", ("sweep", "{study}", "--out", "prior", "--workers", "0"), ("prior", "holds a run's outputs")),
+    Case("sweep-out-is-a-file", ("sweep", "{study}", "--out", "f", "--workers", "0"), ("--out f", "is a file"), _write("f", "mine"), watch="f"),
+    Case("sweep-damaged-table", ("sweep", "{study}", "--out", "study_out", "--workers", "0"), ("results.parquet", "not a readable Parquet table"), _write("study_out/results.parquet", b"PAR1 garbage"), watch="study_out"),
+    Case("report-not-a-study", ("report", "prior"), ("prior", "not a study output directory")),
+    # ---- compare-arms ------------------------------------------------------------------
+    Case("arms-empty", ("compare-arms", "{good}", "--arms", "", "--out", "new"), ("--arms", "none empty"), watch="new"),
+    Case("arms-twice", ("compare-arms", "{good}", "--arms", "reference,reference", "--out", "new"), ("reference", "given twice"), watch="new"),
+    Case("arms-negative-jobs", ("compare-arms", "{good}", "--jobs", "-1", "--out", "new"), ("--jobs", ">= 1", "-1"), watch="new"),
+    Case("arms-zero-jobs", ("compare-arms", "{good}", "--jobs", "0", "--out", "new"), ("--jobs", ">= 1"), watch="new"),
+    Case("arms-zero-ik-starts", ("compare-arms", "{good}", "--ik-starts", "0", "--out", "new"), ("--ik-starts", ">= 1"), watch="new"),
+    Case("arms-negative-duration", ("compare-arms", "{good}", "--duration", "-1", "--out", "new"), ("--duration", "must be positive"), watch="new"),
+    Case("arms-infinite-rpy", ("compare-arms", "{good}", "--mount-rpy", "0", "inf", "0", "--out", "new"), ("--mount-rpy", "finite"), watch="new"),
+    Case("arms-unknown-arm", ("compare-arms", "{good}", "--arms", "nosucharm", "--out", "new"), ("nosucharm", "unknown arm"), watch="new"),
+    Case("arms-into-a-run", ("compare-arms", "{good}", "--arms", "reference", "--out", "prior"), ("prior", "holds a run's outputs")),
+    Case("arms-no-scenario", ("compare-arms", "--out", "new"), ("SCENARIO", "required"), watch="new"),
+    # ---- the command itself ------------------------------------------------------------
+    Case("no-command", (), ("command", "required")),
+    Case("unknown-command", ("frobnicate",), ("frobnicate", "invalid choice")),
+]  # fmt: skip
+
+
+@pytest.fixture(scope="module")
+def workspace(tmp_path_factory) -> Path:
+    """A valid scenario, a run's outputs and a study's results, made in-process."""
+    from uvms_pin.apps.outputs import write_outputs
+    from uvms_pin.apps.study import load_study
+    from uvms_pin.apps.study.runner import run_study
+    from uvms_pin.scenario.scenario import load_scenario, simulate
+
+    ws = tmp_path_factory.mktemp("corpus")
+    (ws / "good.toml").write_text(passive_scenario(0.1))
+    write_outputs(simulate(load_scenario(ws / "good.toml")), ws / "prior_run")
+    (ws / "study").mkdir()
+    (ws / "study" / "base.toml").write_text(passive_scenario(0.04))
+    (ws / "study" / "study.toml").write_text(STUDY)
+    run_study(
+        load_study(ws / "study" / "study.toml"), ws / "prior_study", workers=0, progress=False
+    )
+    return ws
+
+
+def _not_writable(ws: Path) -> Path:
+    """A directory this process cannot create files in (root may write a 0555 one)."""
+    if os.geteuid() == 0:
+        return Path("/sys")  # sysfs: not even root creates files there
+    ro = ws / "read_only"
+    ro.mkdir(exist_ok=True)
+    ro.chmod(0o555)
+    return ro
+
+
+@pytest.fixture(scope="module")
+def outcomes(workspace) -> dict[str, tuple]:
+    """Each case run once, all concurrently: name -> (result, watched before, after, existed)."""
+    values = {
+        "good": str(workspace / "good.toml"),
+        "study": str(workspace / "study" / "study.toml"),
+        "urdf": str(URDF),
+        "ro": str(_not_writable(workspace)),
+    }
+
+    def one(case: Case):
+        case_dir = workspace / "cases" / case.name
+        case_dir.mkdir(parents=True)
+        shutil.copytree(workspace / "prior_run", case_dir / "prior")
+        shutil.copytree(workspace / "prior_study", case_dir / "study_out")
+        if case.setup is not None:
+            case.setup(case_dir)
+        watched = case_dir / case.watch
+        existed, before = watched.exists(), tree_digest(watched)
+        result = run_cli([a.format(**values) for a in case.args], cwd=case_dir)
+        return result, before, tree_digest(watched), existed, watched.exists()
+
+    with ThreadPoolExecutor(max_workers=2 * (os.cpu_count() or 1)) as pool:
+        results = pool.map(one, CASES)
+        return {case.name: r for case, r in zip(CASES, results, strict=True)}
+
+
+def test_the_corpus_is_large_and_its_names_unique():
+    assert len(CASES) >= 40
+    assert len({c.name for c in CASES}) == len(CASES)
+
+
+@pytest.mark.parametrize("case", CASES, ids=[c.name for c in CASES])
+def test_a_bad_input_is_refused_cleanly(case: Case, outcomes):
+    result, before, after, existed, exists = outcomes[case.name]
+    err = result.stderr
+    assert result.returncode == case.code, err
+    assert "Traceback" not in err, err
+    lines = err.strip().splitlines()
+    # only the project's message (after argparse's usage, for argument errors)
+    assert lines[-1].startswith("uvms-pin"), err
+    assert all(line.startswith(("usage:", " ")) for line in lines[:-1]), err
+    for needle in case.needles:
+        assert needle in lines[-1], f"{needle!r} not in {lines[-1]!r}"
+    assert after == before, f"{case.watch} was modified"
+    assert exists == existed, f"{case.watch} was {'created' if exists else 'removed'}"

@@ -1,0 +1,97 @@
+"""``uvms-pin compare-controllers`` on a short run, and its bad inputs (exit 2, nothing written)."""
+
+from __future__ import annotations
+
+import csv
+import math
+
+import pytest
+from cli_support import ROOT, run_cli
+
+REALISTIC = ROOT / "scenarios" / "realistic_force_tracking.toml"
+
+
+def test_compare_controllers_short_run(tmp_path):
+    out = tmp_path / "cmp"
+    result = run_cli(
+        [
+            "compare-controllers", str(REALISTIC), "--controllers", "ppc,pi_force,computed_torque",
+            "--set", "scenario.duration_s=0.1", "--out", str(out), "--quiet",
+        ],
+        tmp_path,
+    )  # fmt: skip
+    assert result.returncode == 0, result.stderr
+    rows = list(csv.DictReader((out / "controllers.csv").open()))
+    assert [r["controller"] for r in rows] == ["ppc", "pi_force", "computed_torque"]
+    for row in rows:
+        assert math.isfinite(float(row["force_error_rms_N"]))
+        assert row["success"] in ("True", "False")
+    # funnel margins only where there are funnels
+    assert float(rows[0]["funnel_margin_first"]) > 0.0
+    assert math.isnan(float(rows[1]["funnel_margin_first"]))
+    for name in ("controllers.md", "controllers_force.png", "controllers_metrics.png"):
+        assert (out / name).is_file()
+    # a second run into the same directory needs --overwrite
+    again = run_cli(
+        ["compare-controllers", str(REALISTIC), "--controllers", "pi_force",
+         "--set", "scenario.duration_s=0.1", "--out", str(out), "--no-figures"],
+        tmp_path,
+    )  # fmt: skip
+    assert again.returncode == 2 and "--overwrite" in again.stderr
+
+
+@pytest.mark.parametrize(
+    "args, message",
+    [
+        (["--controllers", "ppc,lqr"], "lqr"),
+        (["--controllers", "ppc,ppc"], "twice"),
+        (["--set", "baselines.pi_force.damping=-1"], "damping"),
+        (["--after", "100"], "--after"),
+    ],
+)
+def test_compare_controllers_bad_input(tmp_path, args, message):
+    out = tmp_path / "never"
+    result = run_cli(["compare-controllers", str(REALISTIC), "--out", str(out), *args], tmp_path)
+    assert result.returncode == 2, result.stderr
+    assert message in result.stderr and "Traceback" not in result.stderr
+    assert not out.exists()
+
+
+def test_robustness_set_through_the_study_runner(tmp_path):
+    out = tmp_path / "robust"
+    result = run_cli(
+        [
+            "compare-controllers", str(REALISTIC), "--controllers", "pi_force",
+            "--set", "scenario.duration_s=0.1", "--robustness", "--jobs", "0",
+            "--no-figures", "--quiet", "--out", str(out),
+        ],
+        tmp_path,
+    )  # fmt: skip
+    assert result.returncode == 0, result.stderr
+    main = next(csv.DictReader((out / "controllers.csv").open()))
+    rows = {r["case"]: r for r in csv.DictReader((out / "robustness.csv").open())}
+    assert set(rows) == {
+        "nominal", "stiffness_x10", "plant_x1.3", "plant_x0.7", "noise_x5", "disturbance_x5",
+    }  # fmt: skip
+    # the nominal case is the comparison's own run (same seed, same everything)
+    assert float(rows["nominal"]["force_error_rms_N"]) == pytest.approx(
+        float(main["force_error_rms_N"]), rel=1e-12
+    )
+    # a stiffer environment changes the force the same motion produces
+    assert rows["stiffness_x10"]["force_error_rms_N"] != rows["nominal"]["force_error_rms_N"]
+    assert (out / "robustness" / "results.parquet").is_file()
+
+
+def test_robustness_cases_scale_what_the_scenario_sets():
+    from uvms_pin.apps.compare.robustness import robustness_cases
+
+    raw = {
+        "environment": {"stiffness_N_m": [2.0, 2.0, 2.0]},
+        "sensors": {"force_noise_N": 0.02, "distribution": "uniform"},
+        "disturbance": {"amplitude": [0.15, 0.0, 0.0, 0.0, 0.0, 0.0]},
+    }
+    cases = robustness_cases(raw)
+    assert cases["stiffness_x10"][0] == {"environment.stiffness_N_m": [20.0, 20.0, 20.0]}
+    assert cases["noise_x5"][0] == {"sensors.force_noise_N": pytest.approx(0.1)}
+    assert cases["disturbance_x5"][0]["disturbance.amplitude"][0] == pytest.approx(0.75)
+    assert set(cases["plant_x0.7"][1].values()) == {0.7}

@@ -1,0 +1,79 @@
+"""``uvms-pin run`` and its output directory as a user meets them: a run in progress locks
+its --out, Ctrl-C keeps what was simulated, --overwrite replaces only uvms-pin's files,
+result files follow the umask, and --version answers."""
+
+from __future__ import annotations
+
+import json
+import os
+import stat
+import subprocess
+from importlib import metadata
+
+import numpy as np
+from cli_support import interrupt, passive_scenario, run_cli, start_cli, uvms_pin_command
+
+from uvms_pin.results.rollout import Rollout
+
+
+def test_ctrl_c_keeps_the_partial_rollout_and_a_second_run_into_its_out_is_refused(tmp_path):
+    (tmp_path / "long.toml").write_text(passive_scenario(60.0))
+    (tmp_path / "short.toml").write_text(passive_scenario(0.1))
+    proc = start_cli(["run", "long.toml", "--out", "o"], cwd=tmp_path)
+    try:
+        first = proc.stderr.readline()  # the progress line: the run is simulating
+        assert first.startswith("passive_current ["), first
+        second = run_cli(["run", "short.toml", "--out", "o"], cwd=tmp_path)
+        out, err = interrupt(proc)
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+            proc.wait()
+    assert second.returncode == 2, second.stderr
+    assert "--out o is being written by another uvms-pin process" in second.stderr
+    assert "Traceback" not in second.stderr
+
+    assert proc.returncode == 130, err
+    assert "Traceback" not in err
+    assert "interrupted: the partial rollout (t = 0 to" in err and "is kept in o" in err
+    assert "scenario passive_current: interrupted" in out
+    rollout = Rollout.load(tmp_path / "o")
+    metrics = json.loads((tmp_path / "o" / "metrics.json").read_text())
+    assert rollout.metadata["status"] == metrics["status"] == "interrupted"
+    assert len(rollout) >= 2 and np.all(np.diff(rollout.time_s) > 0)
+    assert np.all(np.isfinite(rollout.q)) and np.all(np.isfinite(rollout.v))
+    assert 0.0 < rollout.time_s[-1] < 60.0
+    assert metrics["simulated_time_s"] == rollout.time_s[-1]
+    assert (tmp_path / "o" / "pose.png").stat().st_size > 0
+
+
+def test_overwrite_replaces_a_runs_outputs_keeps_the_users_files_and_follows_the_umask(tmp_path):
+    (tmp_path / "s.toml").write_text(passive_scenario(0.1))
+    out = tmp_path / "o"
+    out.mkdir()
+    for stale in ("rollout.npz", "replay.html", "force.png"):  # an earlier PPC run's
+        (out / stale).write_text("stale")
+    (out / "notes.txt").write_text("mine")
+    result = subprocess.run(
+        [*uvms_pin_command(), "run", "s.toml", "--out", "o", "--quiet", "--overwrite"],
+        cwd=tmp_path,
+        capture_output=True,
+        text=True,
+        timeout=300,
+        preexec_fn=lambda: os.umask(0o027),
+    )
+    assert result.returncode == 0, result.stderr
+    names = sorted(p.name for p in out.iterdir())
+    run_files = ["rollout.npz", "rollout.json", "metrics.json", "pose.png", "velocities.png"]
+    assert names == sorted([*run_files, "energy.png", "notes.txt"])
+    assert (out / "notes.txt").read_text() == "mine"
+    assert Rollout.load(out).metadata["status"] == "ok"
+    for name in names:
+        if name != "notes.txt":
+            assert stat.S_IMODE((out / name).stat().st_mode) == 0o640, name
+
+
+def test_version_names_the_installed_package(tmp_path):
+    result = run_cli(["--version"], cwd=tmp_path)
+    assert result.returncode == 0, result.stderr
+    assert result.stdout.startswith(f"uvms-pin {metadata.version('uvms-pin')} (pinocchio ")

@@ -1,0 +1,249 @@
+"""uvms_pin.apps.gym: the Gymnasium API contract, seeding, the PPC through the environment."""
+
+from __future__ import annotations
+
+import importlib.util
+
+import gymnasium as gym
+import numpy as np
+import pytest
+from conftest import ROOT
+from gymnasium.utils.env_checker import check_env
+
+import uvms_pin.apps.gym  # noqa: F401 - registers the environments
+from uvms_pin.errors import ParameterError
+
+FORCE = "uvms_pin/ForceTracking-v0"
+STATION = "uvms_pin/StationKeeping-v0"
+SHORT = {"scenario.duration_s": 0.1}
+
+
+def _make(env_id: str, **kw):
+    kw.setdefault("overrides", SHORT)
+    return gym.make(env_id, **kw)
+
+
+def _rollout(env, seed: int, steps: int) -> tuple[np.ndarray, list[float]]:
+    observation, _ = env.reset(seed=seed)
+    env.action_space.seed(seed)
+    observations, rewards = [observation], []
+    for _ in range(steps):
+        observation, reward, terminated, truncated, _ = env.step(env.action_space.sample())
+        observations.append(observation)
+        rewards.append(reward)
+        if terminated or truncated:
+            break
+    return np.array(observations), rewards
+
+
+@pytest.mark.parametrize("env_id", [FORCE, STATION])
+def test_check_env_passes(env_id):
+    env = _make(env_id, render_mode="rgb_array")
+    check_env(env.unwrapped)  # raises on any violation of the API contract
+
+
+@pytest.mark.parametrize("env_id", [FORCE, STATION])
+def test_seeded_resets_are_reproducible(env_id):
+    first = _rollout(_make(env_id), seed=5, steps=20)
+    second = _rollout(_make(env_id), seed=5, steps=20)
+    np.testing.assert_array_equal(first[0], second[0])
+    assert first[1] == second[1]
+    other = _rollout(_make(env_id), seed=6, steps=20)
+    # another seed: another initial perturbation and other sensor noise
+    assert not np.allclose(first[0][0], other[0][0])
+
+
+def test_unseeded_resets_follow_the_last_seed():
+    def seeds(env):
+        env.reset(seed=9)
+        return [env.reset()[1]["seed"] for _ in range(3)]
+
+    a, b = seeds(_make(FORCE)), seeds(_make(FORCE))
+    assert a == b
+    assert len(set(a)) == 3
+
+
+def test_observation_layout_is_the_measurement():
+    env = _make(FORCE, initial_position_noise_m=0.0, initial_joint_noise_rad=0.0).unwrapped
+    observation, _ = env.reset(seed=env.scenario.settings.seed)
+    layout = env.observation_layout
+    q0 = env.scenario.q0
+    # the realistic scenario measures the state exactly, the wrench with +-0.02 N noise
+    np.testing.assert_allclose(
+        observation[layout["q"]],
+        q0 / np.r_[1, 1, 1, [np.linalg.norm(q0[3:7])] * 4, np.ones(q0.size - 7)],
+    )
+    np.testing.assert_array_equal(observation[layout["v"]], env.scenario.v0)
+    assert np.all(np.abs(observation[layout["wrench"]][:3]) <= 0.02)  # anchored: f(0) = 0
+    # f_d(0) = 0.4 N on x (the scenario's [controller.desired_force])
+    np.testing.assert_allclose(observation[layout["goal"]], [0.4, 0.0, 0.0], atol=1e-12)
+
+
+def _ppc_script():
+    spec = importlib.util.spec_from_file_location(
+        "ppc_through_env", ROOT / "scripts" / "gym" / "ppc_through_env.py"
+    )
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+def test_ppc_through_the_environment_is_uvms_pin_run():
+    q_env, q_run = _ppc_script().ppc_through_env("realistic_force_tracking", 0.3)
+    assert q_env.shape == q_run.shape == (31, q_run.shape[1])
+    assert np.max(np.abs(q_run[-1] - q_run[0])) > 1e-3  # the run moves
+    np.testing.assert_allclose(q_env, q_run, rtol=0, atol=1e-9)
+
+
+def test_funnel_ends_the_episode():
+    # f(0) = 0, f_d(0) = 0.4 N: outside a 0.1 N funnel at once
+    env = _make(FORCE, funnel=(0.1, 0.05, 1.0))
+    env.reset(seed=0)
+    _, _, terminated, truncated, info = env.step(np.zeros(env.action_space.shape))
+    assert terminated and not truncated
+    assert info["force_error_N"] > 0.1
+
+
+def test_time_limit_truncates():
+    env = _make(STATION, overrides={"scenario.duration_s": 0.05})
+    env.reset(seed=0)
+    flags = [env.step(np.zeros(env.action_space.shape))[2:4] for _ in range(5)]
+    assert flags == [(False, False)] * 4 + [(False, True)]
+
+
+def test_station_keeping_reward_is_the_pose_error():
+    env = _make(STATION).unwrapped
+    env.reset(seed=2)
+    _, reward, _, _, info = env.step(np.zeros(env.action_space.shape))
+    expected = -((info["position_error_m"] / 0.1) ** 2) - (info["angle_error_rad"] / 0.1) ** 2
+    assert reward == pytest.approx(expected)
+    assert 0.0 < info["position_error_m"] <= np.sqrt(3) * 0.1  # the reset perturbation
+
+
+def test_vector_envs():
+    sync = gym.make_vec(FORCE, num_envs=2, vectorization_mode="sync", overrides=SHORT)
+    observations, _ = sync.reset(seed=[3, 4])
+    single, _ = _make(FORCE).reset(seed=4)
+    np.testing.assert_array_equal(observations[1], single)
+    actions = np.zeros((2, sync.single_action_space.shape[0]))
+    observations, rewards, *_ = sync.step(actions)
+    assert observations.shape == (2, *sync.single_observation_space.shape)
+    assert np.all(np.isfinite(rewards))
+    sync.close()
+
+
+def test_async_vector_env():
+    envs = gym.make_vec(FORCE, num_envs=2, vectorization_mode="async", overrides=SHORT)
+    try:
+        observations, _ = envs.reset(seed=[3, 4])
+        single, _ = _make(FORCE).reset(seed=3)
+        np.testing.assert_array_equal(observations[0], single)
+        envs.step(np.zeros((2, envs.single_action_space.shape[0])))
+    finally:
+        envs.close()
+
+
+def test_render_and_replay_export(tmp_path):
+    env = _make(FORCE, render_mode="rgb_array").unwrapped
+    env.reset(seed=0)
+    first = env.render()
+    for _ in range(10):
+        env.step(np.ones(env.action_space.shape))
+    assert first.dtype == np.uint8 and first.shape == (360, 480, 3)
+    assert np.any(env.render() != first)  # the image follows the state
+    rollout = env.episode_rollout()
+    assert len(rollout) == 11
+    np.testing.assert_allclose(np.diff(rollout.time_s), 0.002, rtol=1e-9)
+    from uvms_pin.apps.viz.replay import write_replay
+    from uvms_pin.results.rollout import Rollout
+
+    loaded = Rollout.load(rollout.save(tmp_path / "episode"))
+    np.testing.assert_array_equal(loaded.q, rollout.q)
+    page = write_replay(loaded, tmp_path / "replay.html")
+    assert page.stat().st_size > 1000
+
+
+@pytest.mark.parametrize(
+    ("kw", "match"),
+    [
+        ({"scenario": "no_such_scenario"}, "no such file nor shipped scenario"),
+        ({"scenario": "paper_force_tracking"}, "control.period_s"),
+        (
+            {"scenario": "passive_still_water", "overrides": {"control.period_s": 0.002}},
+            "action_scale",
+        ),
+        ({"render_mode": "ansi"}, "render_mode"),
+        ({"action_scale": [1.0, 2.0]}, "action_scale must be 10"),
+        ({"funnel": "tight"}, "funnel must be"),
+        ({"desired_force_N": [1.0, 2.0]}, "desired_force_N"),
+        ({"initial_position_noise_m": -1.0}, "initial_position_noise_m"),
+        ({"effort_weight": "high"}, "effort_weight must be a finite number"),
+    ],
+)
+def test_bad_options_are_clear_errors(kw, match):
+    with pytest.raises(ParameterError, match=match):
+        gym.make(FORCE, **kw)
+
+
+def test_force_tracking_needs_a_contact_environment():
+    with pytest.raises(ParameterError, match="contact"):
+        gym.make(FORCE, scenario="gym_station_keeping")
+
+
+def test_bad_actions_are_clear_errors():
+    env = _make(FORCE).unwrapped
+    with pytest.raises(ParameterError, match="reset"):
+        env.step(np.zeros(10))
+    env.reset(seed=0)
+    with pytest.raises(ParameterError, match="10 finite numbers"):
+        env.step(np.zeros(3))
+    with pytest.raises(ParameterError, match="10 finite numbers"):
+        env.step(np.full(10, np.nan))
+
+
+def test_sea_state_is_drawn_from_the_episode_seed():
+    env = _make(FORCE, scenario="sea_state_force_tracking").unwrapped
+    point = np.array([[0.0, 0.0, -2.0]])
+
+    def flow_at_seed(seed: int) -> np.ndarray:
+        env.reset(seed=seed)
+        assert env.scenario.raw["scenario"]["seed"] == seed
+        return env.scenario.plant.flow.velocity(1.0, point)
+
+    first, other, again = flow_at_seed(1), flow_at_seed(2), flow_at_seed(1)
+    assert not np.allclose(first, other)  # another seed: another sea
+    np.testing.assert_array_equal(first, again)
+
+
+def test_divergence_ends_the_episode_cleanly():
+    # unlimited actuation with an absurd scale: the vehicle blows up within a step or two
+    env = gym.make(
+        STATION,
+        scenario="passive_still_water",
+        overrides={"control.period_s": 0.002},
+        action_scale=np.full(10, 1e12),
+    ).unwrapped
+    observation, _ = env.reset(seed=0)
+    for _ in range(5):
+        observation, reward, terminated, truncated, info = env.step(np.ones(10))
+        if terminated:
+            break
+    assert terminated and not truncated
+    assert "diverged" in info["error"]
+    assert reward == -100.0
+    assert np.all(np.isfinite(observation))
+    with pytest.raises(ParameterError, match="reset"):
+        env.step(np.ones(10))
+    rollout = env.episode_rollout()  # the states reached before the failure, all finite
+    assert np.all(np.isfinite(rollout.q)) and np.all(np.diff(rollout.time_s) > 0)
+
+
+def test_any_scenario_or_model():
+    bluerov = _make(FORCE, scenario="bluerov_alpha5_force_tracking").unwrapped
+    uvms = bluerov.scenario.uvms
+    assert bluerov.observation_space.shape == (uvms.nq + uvms.nv + 6 + 3,)
+    assert bluerov.action_space.shape == (uvms.nv,)
+    urdf = ROOT / "models" / "uvms_lbv150.urdf"
+    lbv = _make(FORCE, model=str(urdf)).unwrapped
+    assert lbv.scenario.uvms.source == str(urdf.resolve()) or lbv.scenario.uvms.source == str(urdf)
+    assert lbv.observation_space.shape == (30,)

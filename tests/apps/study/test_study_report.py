@@ -1,0 +1,72 @@
+"""The study report: stopped runs kept out of the after-transient statistics, parameter
+columns named for what they hold."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pandas as pd
+import pytest
+
+from uvms_pin.apps.study.report import exclude_unfinished_transients, write_report
+from uvms_pin.apps.study.runner import RESULTS_FILE
+from uvms_pin.apps.study.spec import column_name
+
+RMS = "force_error_rms_after_transient_N"
+
+
+def _table() -> pd.DataFrame:
+    """Four finished runs (transient ends 5.8-6.0 s, RMS ~0.3 N), one run that stopped at
+    0.01 s (its 'after transient' is the transient: RMS 1.9 N) and one that stopped at
+    7 s, after the transient (kept)."""
+    status = ["ok"] * 4 + ["FunnelViolation", "FunnelViolation"]
+    return pd.DataFrame(
+        {
+            "run_id": [f"r{k}" for k in range(6)],
+            "run_index": list(range(6)),
+            "status": status,
+            "error": [""] * 4 + ["funnel violated", "funnel violated"],
+            "violation_level": [""] * 4 + ["second", "second"],
+            "violation_component": [""] * 4 + ["u", "v"],
+            "violation_time_s": [math.nan] * 4 + [0.01, 7.0],
+            "simulated_time_s": [10.0] * 4 + [0.01, 7.0],
+            "transient_end_s": [5.8, 5.9, 6.0, 5.9, 0.0, 5.9],
+            RMS: [0.28, 0.30, 0.29, 0.31, 1.9, 0.35],
+            "run_wall_time_s": [1.0] * 6,
+            "disturbance.amplitude [x base]": [0.5, 1.0, 1.5, 2.0, 2.5, 3.0],
+        }
+    )
+
+
+def test_runs_stopped_before_the_transient_ended_are_excluded():
+    table, excluded, end = exclude_unfinished_transients(_table())
+    assert excluded == 1 and end == pytest.approx(5.9)
+    assert math.isnan(table.loc[4, RMS])  # stopped at 0.01 s
+    assert table.loc[5, RMS] == 0.35  # stopped at 7 s > 5.9 s: its RMS is after the transient
+    np.testing.assert_array_equal(table[RMS].to_numpy()[:4], _table()[RMS].to_numpy()[:4])
+    assert table.loc[4, "simulated_time_s"] == 0.01  # other metrics untouched
+
+
+def test_with_no_finished_run_every_stopped_run_is_excluded():
+    stopped = _table().iloc[4:].reset_index(drop=True)
+    table, excluded, end = exclude_unfinished_transients(stopped)
+    assert excluded == 2 and math.isnan(end)
+    assert table[RMS].isna().all()
+
+
+def test_report_states_the_exclusion_and_leaves_the_run_out_of_the_statistics(tmp_path):
+    _table().to_parquet(tmp_path / RESULTS_FILE)
+    report = write_report(tmp_path)[0].read_text()
+    assert "1 run(s) stopped before the force funnel's transient ended (t = 5.9 s" in report
+    row = next(line for line in report.splitlines() if line.startswith(f"| {RMS} | all"))
+    # all (5): the four finished runs and the one stopped at 7 s; max 0.35, not 1.9
+    assert "all (5)" in row and "| 0.35 |" in row and "1.9" not in row
+
+
+def test_scaled_and_added_parameters_are_named_for_what_they_hold():
+    assert column_name("disturbance.amplitude", "scale") == "disturbance.amplitude [x base]"
+    assert column_name("initial.joint_positions_rad[1]", "add") == (
+        "initial.joint_positions_rad[1] [+ base]"
+    )
+    assert column_name("environment.stiffness_N_m") == "environment.stiffness_N_m"

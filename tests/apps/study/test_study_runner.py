@@ -1,0 +1,195 @@
+"""Running studies: Dask vs serial, resume after a kill or a crash, failing runs recorded."""
+
+from __future__ import annotations
+
+import os
+import signal
+import subprocess
+import sys
+import time
+
+import cloudpickle
+import pandas as pd
+import pytest
+from study_helpers import ROOT, write_study
+
+from uvms_pin.apps.study import load_study
+from uvms_pin.apps.study.report import write_report
+from uvms_pin.apps.study.runner import (
+    RESULTS_FILE,
+    ResultStore,
+    execute_run,
+    load_results,
+    run_study,
+)
+
+# columns that legitimately differ between two executions of the same run
+VOLATILE = ("run_wall_time_s", "wall_time_s", "real_time_factor", "host")
+
+cloudpickle.register_pickle_by_value(sys.modules[__name__])  # workers cannot import tests
+
+
+def _stable(table: pd.DataFrame) -> pd.DataFrame:
+    return table.drop(columns=[c for c in VOLATILE if c in table.columns]).reset_index(drop=True)
+
+
+@pytest.fixture(scope="module")
+def serial_table(tmp_path_factory):
+    directory = tmp_path_factory.mktemp("serial")
+    study = load_study(write_study(directory))
+    run_study(study, directory / "out", workers=0, progress=False)
+    return study, pd.read_parquet(directory / "out" / RESULTS_FILE)
+
+
+def test_local_cluster_gives_the_serial_table(tmp_path, serial_table):
+    study, serial = serial_table
+    summary = run_study(
+        load_study(write_study(tmp_path)), tmp_path / "out", workers=2, progress=False
+    )
+    assert summary["run"] == 6 and summary["skipped"] == 0
+    table = pd.read_parquet(tmp_path / "out" / RESULTS_FILE)
+    assert list(table["run_id"]) == [r.run_id for r in study.runs()]
+    assert set(table["status"]) <= {"ok", "FunnelViolation"} and len(set(table["status"])) == 2
+    assert table["force_error_rms_N"].notna().all()
+    pd.testing.assert_frame_equal(_stable(table), _stable(serial))
+    # a second sweep finds everything recorded and runs nothing
+    again = run_study(
+        load_study(write_study(tmp_path)), tmp_path / "out", workers=2, progress=False
+    )
+    assert again["run"] == 0 and again["skipped"] == 6
+
+
+def test_a_crash_midway_leaves_a_valid_table_and_the_rerun_only_finishes_it(tmp_path, serial_table):
+    _, serial = serial_table
+    study = load_study(write_study(tmp_path))
+    out = tmp_path / "out"
+    seen = []
+
+    def crash_after_two(row):
+        seen.append(row["run_id"])
+        if len(seen) == 2:
+            raise RuntimeError("simulated crash")
+
+    with pytest.raises(RuntimeError, match="simulated crash"):
+        run_study(
+            study, out, workers=0, progress=False, compact_every=100, on_result=crash_after_two
+        )
+    before = pd.read_parquet(out / RESULTS_FILE)  # compacted on the way out, readable
+    assert list(before["run_id"]) == seen
+    rerun = []
+    summary = run_study(
+        study, out, workers=0, progress=False, on_result=lambda r: rerun.append(r["run_id"])
+    )
+    assert summary["skipped"] == 2 and summary["run"] == 4
+    assert not set(rerun) & set(seen)
+    after = pd.read_parquet(out / RESULTS_FILE)
+    assert after["run_id"].is_unique and len(after) == 6
+    # the two first rows were not redone (same wall time) and the whole matches the serial run
+    pd.testing.assert_frame_equal(after.iloc[:2].reset_index(drop=True), before)
+    pd.testing.assert_frame_equal(_stable(after), _stable(serial))
+
+
+def test_killing_the_sweep_process_and_rerunning_finishes_the_study(tmp_path, serial_table):
+    _, serial = serial_table
+    path = write_study(tmp_path)
+    out = tmp_path / "out"
+    command = [
+        sys.executable,
+        "-m",
+        "uvms_pin.apps.cli.main",
+        "sweep",
+        str(path),
+        "--out",
+        str(out),
+        "--workers",
+        "0",
+        "--quiet",
+    ]
+    process = subprocess.Popen(command, cwd=ROOT, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
+    store = ResultStore(out) if out.exists() else None
+    deadline = time.monotonic() + 60
+    while time.monotonic() < deadline:
+        if out.exists():
+            store = store or ResultStore(out)
+            if len(list(store.parts.glob("*.parquet"))) >= 2:
+                break
+        time.sleep(0.02)
+    os.kill(process.pid, signal.SIGKILL)
+    process.wait()
+    killed = load_results(out)
+    assert 2 <= len(killed) < 6, "the sweep finished before it could be killed"
+    result = subprocess.run(command, cwd=ROOT, capture_output=True, text=True, timeout=120)
+    assert result.returncode == 0, result.stderr
+    assert f"{6 - len(killed)} run now, {len(killed)} already recorded" in result.stdout
+    after = pd.read_parquet(out / RESULTS_FILE)
+    assert after["run_id"].is_unique and len(after) == 6
+    kept = after.set_index("run_id").loc[killed["run_id"], "run_wall_time_s"]
+    assert list(kept) == list(killed["run_wall_time_s"])  # not repeated
+    pd.testing.assert_frame_equal(_stable(after), _stable(serial))
+    assert not list((out / "parts").glob("*"))
+
+
+def flaky_run(base, run, rollout_dir):
+    """Raises inside the worker for the second run; the others run normally."""
+    if run.index == 1:
+        raise RuntimeError(f"injected failure in run {run.run_id}")
+    return execute_run(base, run, rollout_dir)
+
+
+def test_a_run_raising_in_a_worker_is_recorded_and_the_study_goes_on(tmp_path):
+    study = load_study(write_study(tmp_path))
+    out = tmp_path / "out"
+    summary = run_study(study, out, workers=2, progress=False, run_fn=flaky_run, keep_rollouts=True)
+    assert summary["run"] == 6 and summary["error"] == 1
+    table = pd.read_parquet(out / RESULTS_FILE)
+    assert len(table) == 6
+    failed = table[table["status"] == "error"]
+    assert list(failed["run_index"]) == [1]
+    assert "RuntimeError: injected failure in run" in failed["error"].iloc[0]
+    others = table[table["status"] != "error"]
+    assert others["force_error_rms_N"].notna().all()
+    assert all((out / "rollouts" / rid / "rollout.npz").is_file() for rid in others["run_id"])
+    # --retry-errors reruns only the failed run (now healthy)
+    retry = run_study(study, out, workers=0, progress=False, retry_errors=True)
+    assert retry["run"] == 1
+    table = pd.read_parquet(out / RESULTS_FILE)
+    assert len(table) == 6 and (table["status"] != "error").all()
+
+
+def test_a_run_whose_scenario_fails_is_an_error_row_not_an_exception(tmp_path):
+    study = load_study(write_study(tmp_path))
+    run = study.runs()[0]
+    broken = type(run)(
+        **{**run.__dict__, "overrides": {**run.overrides, "sensors.distribution": "cauchy"}}
+    )
+    row = execute_run(str(study.base), broken)
+    assert row["status"] == "error" and "cauchy" in row["error"] and row["run_id"] == run.run_id
+
+
+def test_report_writes_markdown_and_figures(tmp_path, serial_table):
+    study, serial = serial_table
+    out = tmp_path / "out"
+    out.mkdir()
+    serial.to_parquet(out / RESULTS_FILE)
+    (out / "study.toml").write_text(study.path.read_text())
+    written = write_report(out)
+    report = written[0].read_text()
+    ok = int((serial["status"] == "ok").sum())
+    assert f"in **{ok} of 6 runs" in report
+    assert "heatmap" in report and "environment.stiffness_N_m" in report
+    names = {p.name for p in written[1:]}
+    assert "violation_rate.png" in names and any(n.startswith("heatmap_") for n in names)
+    assert any(n.startswith("scatter_") for n in names) and any(n.startswith("box_") for n in names)
+    assert all(p.stat().st_size > 1000 for p in written)
+
+
+def test_a_scaled_parameter_column_holds_the_factor(serial_table):
+    """disturbance.amplitude is varied with apply = "scale": its column is named as a
+    factor on the base amplitude (0.15 N), and holds the factor, not newtons."""
+    study, serial = serial_table
+    assert "disturbance.amplitude" not in serial.columns
+    factors = serial["disturbance.amplitude [x base]"]
+    assert factors.between(0.5, 2.0).all()
+    for run in study.runs():
+        row = serial[serial["run_id"] == run.run_id].iloc[0]
+        assert row["disturbance.amplitude [x base]"] == run.values["disturbance.amplitude"]

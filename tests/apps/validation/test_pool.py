@@ -1,0 +1,90 @@
+"""``uvms-pin validate pool`` on shipped trials: its outputs, its targets and bad input."""
+
+from __future__ import annotations
+
+import csv
+import json
+import shutil
+from pathlib import Path
+
+import numpy as np
+import pytest
+from conftest import run
+
+DATA = Path(__file__).resolve().parents[3] / "data" / "hinsdale2023"
+# the two shortest trials (17 s each), both held out of the identification (models/README.md)
+SHORT_TRIALS = ("_alt_011-1", "_alt_011-2")
+
+
+@pytest.fixture(scope="module")
+def short_run(tmp_path_factory):
+    out = tmp_path_factory.mktemp("pool")
+    result = run(
+        "validate", "pool", str(DATA), "--out", str(out), "--trials", ",".join(SHORT_TRIALS)
+    )
+    assert result.returncode == 0, result.stderr
+    return out, result
+
+
+def test_writes_json_exactly_as_specified_csv_and_figures(short_run):
+    out, result = short_run
+    summary = json.loads((out / "pool_validation.json").read_text())
+    assert set(summary) == {"trials", "mean_pitch_rmse_deg", "mean_roll_rmse_deg"}
+    assert set(summary["trials"]) == set(SHORT_TRIALS)
+    for entry in summary["trials"].values():
+        assert set(entry) == {"pitch_rmse_deg", "roll_rmse_deg"}
+    pitches = [e["pitch_rmse_deg"] for e in summary["trials"].values()]
+    assert summary["mean_pitch_rmse_deg"] == pytest.approx(np.mean(pitches))
+    rows = list(csv.DictReader((out / "pool_validation.csv").open()))
+    assert [r["trial"] for r in rows] == list(SHORT_TRIALS)
+    for name in SHORT_TRIALS:
+        assert (out / f"{name}.png").stat().st_size > 10_000
+    assert "mean roll RMSE" in result.stdout
+
+
+def test_short_trials_meet_the_targets(short_run):
+    """Mean roll and pitch RMSE <= 1 deg, every trial <= 2 deg, each below the published
+    simulator's RMSE on the same samples, and far below the attitude held at its start."""
+    out, _ = short_run
+    summary = json.loads((out / "pool_validation.json").read_text())
+    assert summary["mean_roll_rmse_deg"] <= 1.0
+    assert summary["mean_pitch_rmse_deg"] <= 1.0
+    for row in csv.DictReader((out / "pool_validation.csv").open()):
+        roll, pitch = float(row["roll_rmse_deg"]), float(row["pitch_rmse_deg"])
+        assert roll <= 2.0 and pitch <= 2.0, row
+        assert roll < float(row["published_roll_rmse_deg"]), row
+        assert pitch < float(row["published_pitch_rmse_deg"]), row
+        assert roll < 0.5 * float(row["held_roll_rmse_deg"]), row
+        assert pitch < 0.5 * float(row["held_pitch_rmse_deg"]), row
+
+
+def test_missing_data_directory_is_exit_2_and_writes_nothing(tmp_path):
+    out = tmp_path / "out"
+    result = run("validate", "pool", str(tmp_path / "nope"), "--out", str(out))
+    assert result.returncode == 2
+    assert "not a directory" in result.stderr and "Traceback" not in result.stderr
+    assert not out.exists()
+
+
+def test_directory_without_trials_is_exit_2(tmp_path):
+    out = tmp_path / "out"
+    result = run("validate", "pool", str(tmp_path), "--out", str(out))
+    assert result.returncode == 2
+    assert "no trial files" in result.stderr
+    assert not out.exists()
+
+
+def test_one_bad_file_stops_before_anything_is_written(tmp_path):
+    shutil.copy(DATA / "_alt_011-1.npz", tmp_path)
+    (tmp_path / "_zz_broken.npz").write_bytes(b"PK\x03\x04 truncated")
+    out = tmp_path / "out"
+    result = run("validate", "pool", str(tmp_path), "--out", str(out))
+    assert result.returncode == 2
+    assert "_zz_broken.npz" in result.stderr and "Traceback" not in result.stderr
+    assert not out.exists()
+
+
+def test_unknown_trial_name_is_exit_2(tmp_path):
+    result = run("validate", "pool", str(DATA), "--out", str(tmp_path / "o"), "--trials", "x")
+    assert result.returncode == 2
+    assert "no trial named x" in result.stderr

@@ -1,0 +1,167 @@
+"""The baseline controllers (issue 14.1): computed torque tracks exactly with the exact model,
+the model-free ones ignore the plant's parameters, and scenario files select them."""
+
+from __future__ import annotations
+
+import numpy as np
+import pinocchio as pin
+import pytest
+from conftest import ROOT
+
+from uvms_pin.control.baselines.computed_torque import ComputedTorqueController
+from uvms_pin.control.baselines.impedance import ImpedanceController
+from uvms_pin.control.baselines.pi_force import PIForceController
+from uvms_pin.control.measurement import Measurement
+from uvms_pin.errors import ScenarioError
+from uvms_pin.model.scaled import scaled_uvms
+from uvms_pin.scenario.scenario import load_scenario, scenario_from_raw
+from uvms_pin.scenario.toml import read_toml
+from uvms_pin.sim.closed_loop import SimulationSettings, simulate_closed_loop
+from uvms_pin.sim.integrators import RK4
+from uvms_pin.sim.plant import Plant
+from uvms_pin.sim.sensors import SensorConfig, SensorSuite
+
+REALISTIC = ROOT / "scenarios" / "realistic_force_tracking.toml"
+
+
+def _ee_name(uvms) -> str:
+    return uvms.model.frames[uvms.require_ee_frame("test")].name
+
+
+def _motion_reference(uvms, q0):
+    """Constant body twist of the vehicle and sinusoidal joints: exact q_r, zeta_r, a_r."""
+    n_arm = uvms.nv - 6
+    twist = np.array([0.2, -0.1, 0.05, 0.1, -0.05, 0.2])
+    amplitude, omega = np.full(n_arm, 0.3), 2.0 * np.pi * 0.5
+
+    def reference(time_s):
+        s, c = np.sin(omega * time_s), np.cos(omega * time_s)
+        q_r = pin.integrate(uvms.model, q0, np.r_[twist * time_s, amplitude * s])
+        return (
+            q_r,
+            np.r_[twist, amplitude * omega * c],
+            np.r_[np.zeros(6), -amplitude * omega**2 * s],
+        )
+
+    return reference
+
+
+def _track(reference_uvms, model_uvms) -> float:
+    q0 = pin.neutral(reference_uvms.model)
+    q0[2] = -2.0
+    reference = _motion_reference(reference_uvms, q0)
+    controller = ComputedTorqueController(
+        model_uvms, _ee_name(reference_uvms), reference=reference,
+        velocity_gain_per_s=10.0, position_gain_per_s2=25.0,
+    )  # fmt: skip
+    settings = SimulationSettings(1.0, RK4(step_s=1e-3), log_period_s=0.01)  # continuous control
+    sensors = SensorSuite(reference_uvms.model, SensorConfig(), 1.0, 0)
+    rollout = simulate_closed_loop(
+        Plant(reference_uvms), controller, sensors, q0, reference(0.0)[1], settings
+    )
+    errors = [
+        np.linalg.norm(pin.difference(reference_uvms.model, q, reference(t)[0]))
+        for t, q in zip(rollout.time_s, rollout.q, strict=True)
+    ]
+    return float(max(errors))
+
+
+def test_computed_torque_with_the_exact_model_tracks_to_numerical_precision(reference_uvms):
+    exact = _track(reference_uvms, reference_uvms)
+    assert exact < 1e-9
+    # what model error costs: 30 % more mass and added mass in the controller's model
+    wrong = _track(
+        reference_uvms, scaled_uvms(reference_uvms, mass_scale=1.3, added_mass_scale=1.3)
+    )
+    assert wrong > 1e3 * max(exact, 1e-12)
+
+
+def _measurement(uvms, rng) -> Measurement:
+    q = pin.neutral(uvms.model)
+    q[7:] = [-0.2, 1.0, -0.8, 0.2][: uvms.nv - 6]
+    return Measurement(0.3, q, rng.normal(0.0, 0.1, uvms.nv), np.r_[rng.normal(0, 0.5, 3), 0, 0, 0])
+
+
+@pytest.mark.parametrize("cls", [PIForceController, ImpedanceController])
+def test_model_free_controllers_ignore_the_plant_parameters(reference_uvms, cls):
+    """Built on a plant with every inertial and hydrodynamic parameter x1.3 or x0.7, the
+    same measurement gives the same tau, bit for bit."""
+    measurement = _measurement(reference_uvms, np.random.default_rng(14))
+    taus = []
+    for scale in (1.0, 0.7, 1.3):
+        uvms = scaled_uvms(
+            reference_uvms, mass_scale=scale, added_mass_scale=scale, damping_scale=scale,
+            buoyancy_scale=scale,
+        )  # fmt: skip
+        controller = cls(uvms.model, _ee_name(uvms), desired_force_world_N=(0.4, 0.0, 0.0))
+        controller.compute(0.29, measurement)  # (the PI's integral advances on the second call)
+        taus.append(controller.compute(0.3, measurement))
+    assert np.any(taus[0] != 0.0)
+    for tau in taus[1:]:
+        np.testing.assert_array_equal(tau, taus[0])
+
+
+def test_computed_torque_uses_its_model(reference_uvms):
+    measurement = _measurement(reference_uvms, np.random.default_rng(3))
+    ee = _ee_name(reference_uvms)
+    exact = ComputedTorqueController(reference_uvms, ee).compute(0.3, measurement)
+    heavier = ComputedTorqueController(scaled_uvms(reference_uvms, mass_scale=1.3), ee)
+    assert not np.allclose(heavier.compute(0.3, measurement), exact)
+
+
+def _with_controller(table: dict):
+    """The realistic scenario (0.1 s) with its [controller] table replaced."""
+    raw = read_toml(REALISTIC, ScenarioError)
+    raw.pop("baselines")  # the tunings compare-controllers uses; not this table's
+    raw["controller"] = {"desired_force": raw["controller"]["desired_force"], **table}
+    raw["scenario"]["duration_s"] = 0.1
+    return scenario_from_raw(raw, REALISTIC)
+
+
+@pytest.mark.parametrize(
+    "kind, cls",
+    [
+        ("pi_force", PIForceController),
+        ("impedance", ImpedanceController),
+        ("computed_torque", ComputedTorqueController),
+    ],
+)
+def test_scenario_selects_the_baseline(kind, cls):
+    scenario = _with_controller({"type": kind})
+    assert isinstance(scenario.controller_factory(scenario.uvms), cls)
+    assert scenario.controller_factory.type == kind
+    assert scenario.controller_factory.params["desired_force"]["offset"] == [0.4, 0.0, 0.0]
+
+
+def test_baseline_rejects_a_ppc_key_and_a_bad_gain():
+    with pytest.raises(ScenarioError, match="k_zeta"):
+        load_scenario(REALISTIC, {"controller.type": "pi_force"})
+    with pytest.raises(ScenarioError, match="damping"):
+        _with_controller({"type": "pi_force", "damping": -1.0})
+
+
+def test_model_error_table():
+    table = {"type": "computed_torque", "model_error": {"mass_scale": 1.3}}
+    scenario = _with_controller(table)
+    controller = scenario.controller_factory(scenario.uvms)
+    assert controller.uvms.model.inertias[1].mass == pytest.approx(
+        1.3 * scenario.uvms.model.inertias[1].mass
+    )
+    with pytest.raises(ScenarioError, match="mass_scale"):
+        _with_controller({"type": "computed_torque", "model_error": {"mass_scale": -1.0}})
+
+
+def test_each_baseline_on_the_nominal_realistic_task():
+    """The shipped tunings over the full 10 s: pi_force and computed_torque hold the task
+    (peak force error after t = 5 s <= 0.5 N, joints within limits); the impedance
+    controller, which has no force feedback, does not, and says why."""
+    from uvms_pin.apps.compare.metrics import Criteria
+    from uvms_pin.apps.compare.runs import compare_controllers, controller_scenarios
+
+    names = ["pi_force", "impedance", "computed_torque"]
+    rows, _ = compare_controllers(controller_scenarios(REALISTIC, names), Criteria(5.0))
+    verdict = {row["controller"]: row for row in rows}
+    assert verdict["pi_force"]["success"] and verdict["computed_torque"]["success"]
+    assert verdict["computed_torque"]["orientation_error_peak_rad"] < 0.1
+    assert not verdict["impedance"]["success"]
+    assert "force error after t = 5 s" in verdict["impedance"]["reason"]

@@ -1,0 +1,59 @@
+"""BlueROV2 Heavy thrusters: published geometry, full 6-DoF allocation, T200 limits."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from uvms_pin.errors import ParameterError
+from uvms_pin.model.vehicles.bluerov2_heavy import T200_16V, thrusters
+from uvms_pin.sim.actuation import ThrustersAndJointLimits
+
+
+def test_geometry_matches_von_benzon_layout():
+    ts = thrusters()
+    assert len(ts) == 8
+    horizontal = [t for t in ts if "horizontal" in t.name]
+    vertical = [t for t in ts if "vertical" in t.name]
+    np.testing.assert_allclose(
+        sorted(np.abs(t.position_body_m).tolist() for t in horizontal), [[0.156, 0.111, 0.085]] * 4
+    )
+    np.testing.assert_allclose(
+        sorted(np.abs(t.position_body_m).tolist() for t in vertical), [[0.120, 0.218, 0.0]] * 4
+    )
+    for t in horizontal:  # 45 deg off surge, in the horizontal plane
+        assert t.direction_body[2] == 0.0
+        assert abs(t.direction_body[0]) == pytest.approx(abs(t.direction_body[1]))
+    for t in vertical:
+        np.testing.assert_allclose(t.direction_body, [0, 0, 1])
+
+
+def test_t200_limits_at_16_volts():
+    assert T200_16V.max_forward_N == pytest.approx(5.25 * 9.80665)
+    assert T200_16V.max_reverse_N == pytest.approx(4.1 * 9.80665)
+    assert T200_16V.thrust_N(1.0) == pytest.approx(T200_16V.max_forward_N)
+    assert T200_16V.thrust_N(-1.0) == pytest.approx(-T200_16V.max_reverse_N)
+    assert T200_16V.thrust_N(0.5) == pytest.approx(0.25 * T200_16V.max_forward_N)
+    with pytest.raises(ParameterError, match=r"\[-1, 1\]"):
+        T200_16V.thrust_N(1.5)
+
+
+def test_every_body_wrench_is_allocated_exactly_below_saturation():
+    actuation = ThrustersAndJointLimits(thrusters(), None)
+    assert np.linalg.matrix_rank(actuation.allocation) == 6
+    rng = np.random.default_rng(8)
+    for _ in range(20):
+        wrench = rng.normal(scale=[10, 10, 10, 1, 1, 1])
+        np.testing.assert_allclose(actuation.apply(wrench), wrench, atol=1e-9)
+        assert not actuation.saturated(wrench)
+
+
+def test_saturation_caps_each_thruster_at_its_t200_limit():
+    actuation = ThrustersAndJointLimits(thrusters(), None)
+    command = np.array([1000.0, 0, 0, 0, 0, 0])
+    assert actuation.saturated(command)
+    f = actuation.thrusts(command)
+    assert np.all(f <= T200_16V.max_forward_N + 1e-12)
+    assert np.all(f >= -T200_16V.max_reverse_N - 1e-12)
+    # four horizontal thrusters at 45 deg: at most 4 F cos(45 deg) of surge
+    assert actuation.apply(command)[0] <= 4 * T200_16V.max_forward_N * np.sqrt(0.5) + 1e-9

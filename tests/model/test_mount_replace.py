@@ -1,0 +1,126 @@
+"""Swapping the arm of the shipped model (issue 11.2): mount_arm replaces the arm a vehicle
+file carries, keeps it on request, and takes catalogue names and entries."""
+
+from __future__ import annotations
+
+import math
+import warnings
+
+import numpy as np
+import pinocchio as pin
+import pytest
+from conftest import REFERENCE_URDF, ROOT, random_configuration
+
+import uvms_pin as up
+from uvms_pin.model.mount.catalog import CATALOG
+from uvms_pin.model.mount.mount import mount_arm_detailed
+from uvms_pin.model.mount.split import split_urdf
+from uvms_pin.model.resources import example_robot_data_dir
+
+VEHICLE_URDF = ROOT / "models" / "lbv150.urdf"
+POSE = ((0.2, 0.0, -0.18), (math.pi, 0.0, 0.0))  # under the hull, upside down
+REFERENCE_ARM = [f"arm_joint{k}" for k in range(1, 5)]
+REFERENCE_ARM_LINKS = [f"arm_link{k}" for k in range(1, 5)]
+needs_erd = pytest.mark.skipif(
+    example_robot_data_dir() is None, reason="example-robot-data is not installed"
+)
+
+
+def assert_same_dynamics(a: up.UVMS, b: up.UVMS, seed: int = 3) -> None:
+    rng = np.random.default_rng(seed)
+    for _ in range(5):
+        q = random_configuration(a, rng)
+        v = rng.normal(size=a.nv)
+        current = rng.normal(size=3) * 0.3
+        np.testing.assert_allclose(up.mass_matrix(a, q), up.mass_matrix(b, q), atol=1e-12)
+        np.testing.assert_allclose(
+            up.bias_forces(a, q, v, current), up.bias_forces(b, q, v, current), atol=1e-10
+        )
+
+
+@needs_erd
+def test_an_erd_arm_on_the_shipped_uvms_replaces_its_arm():
+    """uvms_lbv150 + UR5 = lbv150 + UR5: the vehicle plus the new arm only."""
+    with pytest.warns(UserWarning, match="replaced the arm") as record:
+        on_uvms = mount_arm_detailed(REFERENCE_URDF, "ur5", POSE)
+    message = next(str(w.message) for w in record if "replaced the arm" in str(w.message))
+    for name in (*REFERENCE_ARM, "ft_sensor", "tool", "ee"):
+        assert name in message
+    with warnings.catch_warnings(record=True) as quiet:
+        warnings.simplefilter("always")  # a vehicle alone: nothing replaced, nothing said
+        on_vehicle = mount_arm_detailed(VEHICLE_URDF, "ur5", POSE)
+    assert not [w for w in quiet if "replaced the arm" in str(w.message)]
+    assert on_uvms.removed_joints == [
+        *REFERENCE_ARM,
+        "ft_sensor_joint",
+        "tool_joint",
+        "ee_joint",
+    ]
+    assert on_uvms.removed_links == [*REFERENCE_ARM_LINKS, "ft_sensor", "tool", "ee"]
+    assert on_vehicle.removed_links == [] and on_vehicle.removed_joints == []
+    a, b = on_uvms.uvms, on_vehicle.uvms
+    assert a.nv == 6 + 6 and b.nv == a.nv
+    assert a.arm_joint_names == b.arm_joint_names
+    assert not set(a.arm_joint_names) & set(REFERENCE_ARM)
+    assert a.mass_kg == pytest.approx(b.mass_kg, rel=1e-14)
+    assert_same_dynamics(a, b)
+
+
+def test_the_reference_arm_mounted_back_on_the_shipped_uvms_is_the_reference(
+    tmp_path, reference_uvms
+):
+    """Replacing the arm by itself gives the reference model: exactly the arm was removed."""
+    split = split_urdf(REFERENCE_URDF, tmp_path)
+    with pytest.warns(UserWarning, match="replaced the arm"):
+        mounted = up.mount_arm(
+            REFERENCE_URDF,
+            split.arm_urdf,
+            split.mount_pose,
+            ee_link="ee",
+            sensor_link="ft_sensor",
+            tool=None,
+        )
+    assert mounted.arm_joint_names == reference_uvms.arm_joint_names  # no renaming needed
+    assert mounted.volume_m3 == pytest.approx(reference_uvms.volume_m3, rel=1e-12)
+    assert_same_dynamics(mounted, reference_uvms)
+
+
+@needs_erd
+def test_keep_existing_arm_gives_two_arms_with_distinct_names():
+    result = mount_arm_detailed(REFERENCE_URDF, CATALOG["ur3"], POSE, keep_existing_arm=True)
+    uvms = result.uvms
+    assert result.removed_links == []
+    assert uvms.nv == 6 + 4 + 6
+    names = uvms.arm_joint_names
+    assert len(set(names)) == len(names) and set(REFERENCE_ARM) <= set(names)
+    model = uvms.model
+    frames = {f.name for f in model.frames}
+    assert {"ee", "ft_sensor", "arm_ee", "arm_ft_sensor"} <= frames
+    # the UVMS's end-effector is the new arm's: it moves with a UR3 joint, not arm_joint1
+    assert model.frames[uvms.ee_frame_id].name == "arm_ee"
+    q = uvms.neutral_configuration()
+    data = model.createData()
+    pin.framesForwardKinematics(model, data, q)
+    before = data.oMf[uvms.ee_frame_id].translation.copy()
+    old_ee = data.oMf[model.getFrameId("ee")].translation.copy()
+    q[model.joints[model.getJointId("arm_joint1")].idx_q] += 0.3
+    pin.framesForwardKinematics(model, data, q)
+    np.testing.assert_allclose(data.oMf[uvms.ee_frame_id].translation, before, atol=1e-12)
+    assert np.linalg.norm(data.oMf[model.getFrameId("ee")].translation - old_ee) > 0.01
+
+
+@needs_erd
+def test_catalogue_names_and_entries_are_arms():
+    by_name = up.mount_arm(VEHICLE_URDF, "ur3", POSE)
+    by_entry = up.mount_arm(VEHICLE_URDF, CATALOG["ur3"], POSE)
+    by_path = up.mount_arm(VEHICLE_URDF, CATALOG["ur3"].urdf, POSE, ee_link="tool0")
+    by_shipped_name = up.mount_arm("lbv150", "ur3", POSE)
+    for other in (by_entry, by_path, by_shipped_name):
+        assert other.arm_joint_names == by_name.arm_joint_names
+        assert_same_dynamics(other, by_name)
+
+
+@needs_erd
+def test_an_unknown_arm_name_lists_the_catalogue():
+    with pytest.raises(up.ParameterError, match=r"unknown arm 'ur55'.*ur5"):
+        up.mount_arm(VEHICLE_URDF, "ur55", POSE)

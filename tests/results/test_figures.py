@@ -1,0 +1,55 @@
+"""Figures as objects (notebooks) or files (CLI); Rollout.plot by kind."""
+
+from __future__ import annotations
+
+import pytest
+from conftest import ROOT
+from matplotlib.figure import Figure
+
+import uvms_pin as up
+from uvms_pin.errors import ParameterError
+from uvms_pin.results.figures.kinds import KINDS
+from uvms_pin.results.figures.paper import plot_force
+from uvms_pin.results.figures.standard import plot_pose
+
+
+@pytest.fixture(scope="module")
+def passive():
+    scenario = up.load_scenario(
+        ROOT / "scenarios" / "passive_still_water.toml", {"scenario.duration_s": 0.1}
+    )
+    return up.simulate(scenario, progress=False)
+
+
+@pytest.fixture(scope="module")
+def ppc():
+    scenario = up.load_scenario(
+        ROOT / "scenarios" / "realistic_force_tracking.toml", {"scenario.duration_s": 0.05}
+    )
+    return up.simulate(scenario, progress=False)
+
+
+def test_plot_helpers_return_the_figure_without_a_path(passive, ppc, tmp_path):
+    fig = plot_pose(passive)
+    assert isinstance(fig, Figure) and len(fig.axes) == 2
+    assert isinstance(plot_force(ppc), Figure)
+    path = plot_pose(passive, tmp_path / "pose.png")
+    assert path == tmp_path / "pose.png" and path.stat().st_size > 1000
+
+
+def test_plot_all_gives_the_figures_the_rollout_has_data_for(passive, ppc):
+    assert set(passive.plot()) == {"pose", "velocities", "energy"}
+    figures = ppc.plot()
+    assert set(figures) == set(KINDS)
+    assert all(isinstance(f, Figure) for f in figures.values())
+    # one panel per first-level error; one per velocity error (vehicle 6 + arm, hidden spares)
+    assert len(figures["first_level"].axes) == 6
+    visible = [ax for ax in figures["second_level"].axes if ax.get_visible()]
+    assert len(visible) == ppc.v.shape[1]
+
+
+def test_plot_kind_errors_name_the_problem(passive):
+    with pytest.raises(ParameterError, match=r"unknown plot kind 'forces'.*force"):
+        passive.plot("forces")
+    with pytest.raises(ParameterError, match=r"cannot plot 'first_level'.*e_x"):
+        passive.plot("first_level")

@@ -1,0 +1,100 @@
+"""Output directories: checked before work, locked while written, never mixed."""
+
+from __future__ import annotations
+
+import pytest
+from conftest import ROOT
+
+from uvms_pin.errors import OutputError
+from uvms_pin.results.outdir import COMPARISON, RUN, STUDY, check_writable, claim, claim_file
+
+
+def test_check_writable_refuses_files_and_paths_under_them_and_creates_nothing(tmp_path):
+    (tmp_path / "f").write_text("mine")
+    with pytest.raises(OutputError, match="is a file"):
+        check_writable(tmp_path / "f")
+    with pytest.raises(OutputError, match=r"is under a file \(.*f\)"):
+        check_writable(tmp_path / "f" / "a" / "b")
+    assert check_writable(tmp_path / "new" / "deeper") == tmp_path / "new" / "deeper"
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["f"]
+
+
+def test_a_claimed_directory_is_locked_against_a_second_writer(tmp_path):
+    with claim(tmp_path / "out", RUN) as out:
+        with pytest.raises(OutputError, match="being written by another uvms-pin process"):
+            with claim(out, RUN):
+                pass
+        with pytest.raises(OutputError, match="being written"):
+            with claim_file(out / "replay.html"):
+                pass
+    with claim(tmp_path / "out", RUN):  # released at the end of the block
+        (tmp_path / "out" / "rollout.json").write_text("{}")
+
+
+def test_a_claim_that_wrote_nothing_leaves_no_directory(tmp_path):
+    with pytest.raises(RuntimeError), claim(tmp_path / "out", RUN):
+        raise RuntimeError("the scenario failed")
+    assert not (tmp_path / "out").exists()
+
+
+def test_outputs_are_refused_and_overwrite_removes_only_uvms_pin_files(tmp_path):
+    out = tmp_path / "out"
+    out.mkdir()
+    for name in ("rollout.npz", "rollout.json", "replay.html", "force.png"):
+        (out / name).write_text("earlier run")
+    (out / ".rollout.json.1a2b3c4d.tmp").write_text("an interrupted write")
+    (out / "notes.txt").write_text("mine")
+    (out / ".notes.txt.swp.tmp").write_text("my editor's")
+    (out / "photo.png").write_text("mine too")
+    with pytest.raises(OutputError, match=r"already holds a run's outputs.*--overwrite"):
+        with claim(out, RUN):
+            pass
+    assert (out / "rollout.npz").exists()
+    with claim(out, RUN, overwrite=True):
+        pass
+    assert sorted(p.name for p in out.iterdir()) == [".notes.txt.swp.tmp", "notes.txt", "photo.png"]
+
+
+def test_another_commands_results_are_refused_even_with_overwrite(tmp_path):
+    study = tmp_path / "study"
+    (study / "parts").mkdir(parents=True)
+    (study / "results.parquet").write_text("table")
+    for kind in (RUN, COMPARISON):
+        with pytest.raises(OutputError, match="holds a study's results"):
+            with claim(study, kind, overwrite=True):
+                pass
+    assert (study / "results.parquet").read_text() == "table"
+    with claim(study, STUDY):  # a sweep resumes into its own directory
+        pass
+    with claim(study, STUDY, overwrite=True):
+        pass
+    assert not (study / "results.parquet").exists() and not (study / "parts").exists()
+
+
+def test_the_comparison_overwrite_removes_its_models_directory_once_empty(tmp_path):
+    out = tmp_path / "arms"
+    (out / "models").mkdir(parents=True)
+    (out / "models" / "ur5.urdf").write_text("<robot/>")
+    (out / "comparison.csv").write_text("arm\n")
+    with claim(out, COMPARISON, overwrite=True):
+        pass
+    assert list(out.iterdir()) == []
+
+
+def test_run_outputs_are_exactly_the_files_a_run_writes(tmp_path):
+    """RUN lists the outputs by name: a new figure must be added there (or --overwrite
+    would leave it stale). The sea-state scenario writes every figure (flow.png too)."""
+    from uvms_pin.apps.outputs import write_outputs
+    from uvms_pin.scenario.scenario import load_scenario, simulate
+
+    text = (ROOT / "scenarios" / "sea_state_force_tracking.toml").read_text()
+    text = text.replace("../models/", f"{ROOT}/models/").replace(
+        "duration_s = 10.0", "duration_s = 0.04"
+    )
+    (tmp_path / "s.toml").write_text(text)
+    out = tmp_path / "out"
+    out.mkdir()
+    figures = write_outputs(simulate(load_scenario(tmp_path / "s.toml")), out)
+    assert any(p.name == "force.png" for p in figures)  # the paper figures are there too
+    written = {p.name for p in out.iterdir()}
+    assert written | {"replay.html"} == set(RUN.patterns)  # replay.html: with --html

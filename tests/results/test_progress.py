@@ -1,0 +1,50 @@
+"""Progress of a simulation: callable, tqdm bar, or silence."""
+
+from __future__ import annotations
+
+import pytest
+from conftest import ROOT
+
+import uvms_pin as up
+from uvms_pin.errors import ParameterError
+from uvms_pin.results.progress import ProgressBar, callback_or_none
+
+SCENARIO = ROOT / "scenarios" / "passive_still_water.toml"
+
+
+def _short(duration_s: float = 0.1):
+    return up.load_scenario(SCENARIO, {"scenario.duration_s": duration_s})
+
+
+def test_callable_sees_every_logged_time_up_to_the_duration():
+    seen = []
+    rollout = up.simulate(_short(), progress=lambda t, total: seen.append((t, total)))
+    assert [t for t, _ in seen] == pytest.approx(list(rollout.time_s))
+    assert {total for _, total in seen} == {0.1}
+
+
+def test_false_and_none_are_silent(capsys):
+    for off in (False, None):
+        up.simulate(_short(0.04), progress=off)
+    captured = capsys.readouterr()
+    assert captured.err == "" and captured.out == ""
+
+
+def test_default_bar_stays_silent_for_a_short_run(capsys):
+    up.simulate(_short(0.04))  # far below the 2 s delay
+    assert capsys.readouterr().err == ""
+
+
+def test_bar_reports_simulated_seconds(capsys):
+    with ProgressBar("demo", 2.0, delay_s=0.0) as bar:
+        bar(0.5, 2.0)
+        bar(2.0, 2.0)
+    err = capsys.readouterr().err
+    assert "demo" in err and "2/2 s" in err and "100%" in err
+
+
+def test_bad_progress_value_is_a_parameter_error():
+    with pytest.raises(ParameterError, match="progress must be"):
+        callback_or_none("yes")
+    with pytest.raises(ParameterError, match="progress must be"):
+        up.simulate(_short(0.04), progress=1)

@@ -1,0 +1,146 @@
+"""Overrides (issue 11.3): one parser for --set, load_scenario and study paths; errors
+name the override and suggest the closest key; ``model`` resolves from anywhere."""
+
+from __future__ import annotations
+
+import shutil
+
+import numpy as np
+import pytest
+from conftest import ROOT, run
+
+import uvms_pin as up
+from uvms_pin.scenario.overrides import apply_overrides, parse_assignment, parse_key_path
+from uvms_pin.scenario.scenario import load_scenario
+
+PASSIVE = ROOT / "scenarios" / "passive_current.toml"
+PAPER = ROOT / "scenarios" / "paper_force_tracking.toml"
+
+
+@pytest.mark.parametrize(
+    ("text", "key", "value"),
+    [
+        ("scenario.duration_s=2", "scenario.duration_s", 2),
+        ("water.current_world_m_s=[0.2, 0, 0]", "water.current_world_m_s", [0.2, 0, 0]),
+        ("initial.joint_positions_rad[3]=-0.5", "initial.joint_positions_rad[3]", -0.5),
+        ('integrator.method="Radau"', "integrator.method", "Radau"),
+        ("integrator.method=Radau", "integrator.method", "Radau"),  # bare word: a string
+        ("actuation.limit_joint_torques=false", "actuation.limit_joint_torques", False),
+        ("controller.desired_force.period_s = 2.5", "controller.desired_force.period_s", 2.5),
+    ],
+)
+def test_assignments_parse_as_toml_values(text, key, value):
+    assert parse_assignment(text) == (key, value)
+
+
+@pytest.mark.parametrize("text", ["duration_s=2", "scenario.duration_s", "a.b[x]=1", "=3"])
+def test_bad_assignments_are_named(text):
+    with pytest.raises(up.ScenarioError, match="override"):
+        parse_assignment(text)
+
+
+def test_the_study_files_use_the_same_parser():
+    from uvms_pin.apps.study import spec
+
+    parameter = spec.Parameter("initial.joint_positions_rad[2]", "parameter[0]")
+    assert (parameter.key, parameter.index) == ("initial.joint_positions_rad", 2)
+    assert spec.KEY_PATH is parse_key_path.__globals__["KEY_PATH"]
+
+
+def test_indexed_override_sets_one_element_and_leaves_the_input_alone():
+    raw = {"initial": {"joint_positions_rad": [0.0, 0.5, -0.5, 0.0]}}
+    out = apply_overrides(raw, {"initial.joint_positions_rad[2]": 0.25})
+    assert out["initial"]["joint_positions_rad"] == [0.0, 0.5, 0.25, 0.0]
+    assert raw["initial"]["joint_positions_rad"][2] == -0.5
+    with pytest.raises(up.ScenarioError, match=r"override 'initial.joint_positions_rad\[4\]'"):
+        apply_overrides(raw, {"initial.joint_positions_rad[4]": 0.0})
+    with pytest.raises(up.ScenarioError, match="cannot be indexed"):
+        apply_overrides(raw, {"water.current_world_m_s[0]": 0.1})
+
+
+def test_load_scenario_accepts_the_indexed_syntax():
+    scenario = load_scenario(PASSIVE, {"initial.joint_positions_rad[1]": 0.7})
+    np.testing.assert_array_equal(scenario.q0[7:], [0.0, 0.7, -0.5, 0.0])
+    assert scenario.raw["initial"]["joint_positions_rad"] == [0.0, 0.7, -0.5, 0.0]
+
+
+@pytest.mark.parametrize(
+    ("overrides", "needle"),
+    [
+        (
+            {"enviroment.stiffness_N_m": [1, 1, 1]},
+            "override 'enviroment.stiffness_N_m': unknown key 'enviroment'; "
+            "did you mean 'environment.stiffness_N_m'?",
+        ),
+        (
+            {"environment.stifness_N_m": [1, 1, 1]},
+            "did you mean 'environment.stiffness_N_m'?",
+        ),
+        ({"controller.k_xx": 0.3}, "did you mean 'controller.k_x'?"),
+        ({"scenario.duraton_s": 1.0}, "did you mean 'scenario.duration_s'?"),
+        (
+            {"environment.stiffness_N_m": [-1, 1, 1]},
+            "override 'environment.stiffness_N_m': must be >= 0",
+        ),
+        ({"scenario.duration_s": "long"}, "override 'scenario.duration_s': must be a finite"),
+    ],
+)
+def test_override_errors_name_the_override_and_suggest(overrides, needle):
+    with pytest.raises(up.ScenarioError) as info:
+        load_scenario(PAPER, overrides)
+    message = str(info.value)
+    assert needle in message
+    assert "paper_force_tracking.toml" not in message  # the override, not the file
+
+
+def test_a_typo_in_the_file_gets_a_suggestion_too(tmp_path):
+    text = PASSIVE.read_text().replace("current_world_m_s", "curent_world_m_s")
+    path = tmp_path / "typo.toml"
+    path.write_text(text)
+    with pytest.raises(up.ScenarioError, match=r"typo.toml.*curent_world_m_s.*current_world_m_s"):
+        load_scenario(path)
+
+
+def test_a_copied_scenario_finds_its_shipped_model(tmp_path):
+    copy = tmp_path / "elsewhere" / "mine.toml"
+    copy.parent.mkdir()
+    shutil.copy(PASSIVE, copy)
+    scenario = load_scenario(copy)
+    assert scenario.uvms.source == str(ROOT / "models" / "uvms_lbv150.urdf")
+    # a relative path next to the scenario wins over a shipped name
+    shutil.copy(ROOT / "models" / "uvms_lbv150.urdf", copy.parent / "uvms_lbv150")
+    assert load_scenario(copy).uvms.source == str(copy.parent / "uvms_lbv150")
+    with pytest.raises(up.ScenarioError, match=r"'nope' is neither a file.*lbv150.*uvms_lbv150"):
+        load_scenario(copy, {"scenario.model": "nope"})
+
+
+def test_run_set_from_the_command_line(tmp_path):
+    out = tmp_path / "out"
+    result = run(
+        "run",
+        str(PASSIVE),
+        "--out",
+        str(out),
+        "--quiet",
+        "--set",
+        "scenario.duration_s=0.1",
+        "--set",
+        "water.current_world_m_s=[0.0, 0.4, 0.0]",
+        "--set",
+        "initial.joint_positions_rad[0]=0.3",
+    )
+    assert result.returncode == 0, result.stderr
+    rollout = up.Rollout.load(out)
+    assert rollout.time_s[-1] == pytest.approx(0.1)
+    assert rollout.metadata["parameters"]["water"]["current_world_m_s"] == [0.0, 0.4, 0.0]
+    assert rollout.q[0, 7] == pytest.approx(0.3)
+
+
+def test_run_set_typo_exits_2_with_a_suggestion_and_writes_nothing(tmp_path):
+    out = tmp_path / "out"
+    result = run("run", str(PASSIVE), "--out", str(out), "--set", "water.curent_world_m_s=[0,0,0]")
+    assert result.returncode == 2
+    assert "override 'water.curent_world_m_s'" in result.stderr
+    assert "did you mean 'water.current_world_m_s'?" in result.stderr
+    assert "Traceback" not in result.stderr
+    assert not out.exists()

@@ -1,0 +1,119 @@
+"""``uvms-pin compare-arms SCENARIO --arms reference,ur5,panda --out DIR``.
+
+Wire it into `uvms_pin.apps.cli.main.build_parser` with ``register(sub)``; meanwhile run it as
+``python -m uvms_pin.apps.arms.command SCENARIO ...``.
+"""
+
+from __future__ import annotations
+
+import argparse
+import math
+import sys
+
+from uvms_pin.apps.arguments import count, finite, positive
+from uvms_pin.errors import ParameterError
+from uvms_pin.model.mount.catalog import available_arms
+from uvms_pin.results.outdir import COMPARISON, OVERWRITE_HELP, check_writable, claim
+
+EXIT_BAD_INPUT = 2
+DEFAULT_ARMS = "reference,so100,z1,kinova,ur3,ur5,panda"
+
+
+def _cmd_compare_arms(args: argparse.Namespace) -> int:
+    if args.list:
+        print("\n".join(available_arms()))
+        return 0
+    if args.scenario is None:
+        print("uvms-pin compare-arms: error: SCENARIO is required", file=sys.stderr)
+        return EXIT_BAD_INPUT
+    from uvms_pin.apps.arms.compare import CompareSettings, compare_arms
+    from uvms_pin.model.trim import TrimSpec
+
+    arms = _arm_names(args.arms)
+    trim = None if args.no_trim else TrimSpec(bg_m=args.bg, foam_density_kg_m3=args.foam_density)
+    settings = CompareSettings(
+        duration_s=args.duration,
+        trim=trim,
+        mount_rpy=tuple(args.mount_rpy),
+        ik_starts=args.ik_starts,
+        keep_rollouts=args.keep_rollouts,
+    )
+    out = check_writable(args.out)
+    with claim(out, COMPARISON, overwrite=args.overwrite):
+        rows = compare_arms(
+            args.scenario,
+            arms,
+            out,
+            settings,
+            jobs=args.jobs,
+            progress=lambda line: print(line, file=sys.stderr, flush=True),
+        )
+    width = max(len(r["arm"]) for r in rows)
+    for r in rows:
+        err = r["force_error_rms_N"]
+        err_text = "" if math.isnan(err) else f"force error RMS {err:.3f} N"
+        print(f"{r['arm']:<{width}}  {r['status']:<16} {err_text}")
+    print(f"wrote {args.out}/comparison.csv, comparison.md, comparison.png")
+    if args.keep_rollouts:
+        print(f"per arm: {args.out}/<arm>/row.json, rollout, metrics.json and figures")
+    return 0
+
+
+def _arm_names(text: str) -> list[str]:
+    """The comma-separated names of ``--arms``: at least one, none twice."""
+    names = [a.strip() for a in text.split(",")]
+    if not any(names) or "" in names:
+        raise ParameterError(f"--arms {text!r}: give comma-separated arm names, none empty")
+    twice = sorted({n for n in names if names.count(n) > 1})
+    if twice:
+        raise ParameterError(f"--arms {text!r}: {', '.join(twice)} given twice")
+    return names
+
+
+def register(subparsers) -> argparse.ArgumentParser:
+    """Add the ``compare-arms`` subcommand to the ``uvms-pin`` parser's subparsers."""
+    parser = subparsers.add_parser(
+        "compare-arms",
+        help="run a scenario's task with several arms mounted on its vehicle and compare them",
+        description=(
+            "Mount each arm (a name from example-robot-data, 'reference' or a URDF path) on the "
+            "scenario's vehicle, solve the initial configuration, trim, run the task and write "
+            "comparison.csv, comparison.md and comparison.png."
+        ),
+    )
+    parser.add_argument("scenario", nargs="?", help="scenario TOML file")
+    parser.add_argument(
+        "--arms",
+        default=DEFAULT_ARMS,
+        help=f"comma-separated arm names or URDF paths (default {DEFAULT_ARMS})",
+    )
+    parser.add_argument("--out", default="out/compare_arms", help="output directory")
+    parser.add_argument("--duration", type=positive, default=None, help="override the duration [s]")
+    parser.add_argument("--jobs", type=count(1), default=1, help="arms run in parallel processes")
+    parser.add_argument("--no-trim", action="store_true", help="do not add foam and ballast")
+    parser.add_argument("--overwrite", action="store_true", help=OVERWRITE_HELP)
+    parser.add_argument(
+        "--bg", type=finite, default=0.02, help="metacentric height BG after trim [m]"
+    )
+    parser.add_argument(
+        "--foam-density", type=positive, default=350.0, help="trim foam density [kg/m^3]"
+    )
+    parser.add_argument(
+        "--mount-rpy",
+        type=finite,
+        nargs=3,
+        default=(math.pi, 0.0, 0.0),
+        metavar=("R", "P", "Y"),
+        help="arm base orientation on the vehicle [rad] (default: upside down)",
+    )
+    parser.add_argument(
+        "--ik-starts", type=count(1), default=24, help="initial-configuration search starts"
+    )
+    parser.add_argument(
+        "--keep-rollouts",
+        action="store_true",
+        help="also write each arm's row, rollout, metrics and figures into OUT/<arm>/",
+    )
+    parser.add_argument("--list", action="store_true", help="list the arm names available and exit")
+    parser.set_defaults(func=_cmd_compare_arms)
+    return parser

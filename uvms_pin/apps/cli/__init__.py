@@ -1,0 +1,1 @@
+"""The `uvms-pin` command."""

@@ -1,0 +1,279 @@
+"""The ``uvms-pin`` command."""
+
+from __future__ import annotations
+
+import argparse
+import sys
+import time
+import warnings
+from pathlib import Path
+from typing import TYPE_CHECKING
+
+from uvms_pin.apps.arguments import positive
+from uvms_pin.apps.arms.command import register as register_compare_arms
+from uvms_pin.apps.compare.command import register as register_compare_controllers
+from uvms_pin.apps.outputs import write_outputs
+from uvms_pin.apps.study.command import register as register_study_commands
+from uvms_pin.apps.validation.command import register as register_validate
+from uvms_pin.errors import FunnelViolation, SimulationError, UvmsPinError, UvmsPinWarning
+from uvms_pin.model.resources import find_model
+from uvms_pin.results.outdir import OVERWRITE_HELP, RUN, check_writable, claim, claim_file
+from uvms_pin.scenario.overrides import parse_assignment
+
+if TYPE_CHECKING:
+    from uvms_pin.results.rollout import Rollout
+
+# The simulation stack (Pinocchio, SciPy, matplotlib) is imported by the commands that
+# need it: --help, --version and argument errors answer at once.
+
+EXIT_BAD_INPUT = 2
+EXIT_RUN_STOPPED = 3
+EXIT_INTERRUPTED = 130  # as a shell reports a process stopped by Ctrl-C
+
+
+class _ProgressLine:
+    """A single updating progress line on stderr, at most a few times per second."""
+
+    def __init__(self, label: str, stream=sys.stderr, min_interval_s: float = 0.5):
+        self.label = label
+        self.stream = stream
+        self.tty = stream.isatty()
+        # on a terminal the line is redrawn; in a log file one line every 10 s of wall time
+        self.min_interval_s = min_interval_s if self.tty else 10.0
+        self.start = time.perf_counter()
+        self.last = -1.0
+
+    def __call__(self, t: float, duration: float) -> None:
+        now = time.perf_counter()
+        if now - self.last < self.min_interval_s and t < duration:
+            return
+        self.last = now
+        elapsed = now - self.start
+        frac = t / duration if duration > 0 else 1.0
+        eta = elapsed * (1.0 - frac) / frac if frac > 0 else float("nan")
+        bar = "#" * int(30 * frac)
+        line = f"{self.label} [{bar:<30}] t = {t:7.3f}/{duration:g} s  elapsed {elapsed:6.1f} s  left ~{eta:6.1f} s"
+        self.stream.write(f"\r{line}" if self.tty else f"{line}\n")
+        self.stream.flush()
+
+    def close(self) -> None:
+        if self.tty:
+            self.stream.write("\n")
+        self.stream.flush()
+
+
+def _simulate(scenario, args: argparse.Namespace, progress) -> Rollout:
+    from uvms_pin.scenario.scenario import simulate
+
+    if not args.live:
+        return simulate(scenario, progress=progress)
+    from uvms_pin.apps.viz.live import run_live
+
+    return run_live(scenario, port=args.port, speed=args.speed, progress=progress)
+
+
+def _write_replay(rollout: Rollout, path: Path, **kw) -> Path:
+    from uvms_pin.apps.viz.replay import write_replay
+
+    return write_replay(rollout, path, **kw)
+
+
+def _cmd_run(args: argparse.Namespace) -> int:
+    from uvms_pin.scenario.scenario import load_scenario
+
+    _check_view_options(args)
+    overrides = dict(parse_assignment(text) for text in args.set)
+    scenario = load_scenario(args.scenario, overrides)
+    out = check_writable(args.out)  # before simulating, not after
+    with claim(out, RUN, overwrite=args.overwrite):
+        rollout, status, message = _simulate_to_end(scenario, args)
+        if rollout is None:
+            print(message, file=sys.stderr)
+            return status
+        figures = write_outputs(rollout, out)
+        if args.html:
+            figures.append(_write_replay(rollout, out / "replay.html"))
+    metrics = rollout.metrics()
+    print(
+        f"scenario {scenario.name}: {rollout.metadata['status']}, simulated {metrics['simulated_time_s']:.3f} s in {metrics['wall_time_s']:.2f} s (real-time factor {metrics['real_time_factor']:.2f})"
+    )
+    print(
+        f"wrote {out}/rollout.npz, rollout.json, metrics.json, "
+        + ", ".join(p.name for p in figures)
+    )
+    if status:
+        print(message, file=sys.stderr)
+    return status
+
+
+def _simulate_to_end(scenario, args: argparse.Namespace) -> tuple[Rollout | None, int, str]:
+    """(rollout, exit status, message): a stopped or interrupted run keeps its rollout."""
+    progress = None if args.quiet else _ProgressLine(scenario.name)
+    try:
+        return _simulate(scenario, args, progress), 0, ""
+    except (FunnelViolation, SimulationError) as exc:
+        return getattr(exc, "rollout", None), EXIT_RUN_STOPPED, f"run stopped: {exc}"
+    except KeyboardInterrupt as exc:
+        rollout = getattr(exc, "rollout", None)
+        if rollout is None or not len(rollout):
+            return None, EXIT_INTERRUPTED, "uvms-pin: interrupted before the first sample"
+        t_s = float(rollout.time_s[-1])
+        kept = f"the partial rollout (t = 0 to {t_s:.3f} s) is kept in {args.out}"
+        return rollout, EXIT_INTERRUPTED, f"uvms-pin: interrupted: {kept}"
+    finally:
+        if progress is not None:
+            progress.close()
+
+
+def _check_view_options(args: argparse.Namespace) -> None:
+    if not 0 <= args.port <= 65535:
+        raise UvmsPinError(f"--port must be in 0..65535, got {args.port}")
+
+
+def _cmd_replay(args: argparse.Namespace) -> int:
+    _check_view_options(args)
+    if not (args.html or args.live):
+        raise UvmsPinError("replay: nothing to do, give --html and/or --live")
+    from uvms_pin.results.rollout import Rollout
+
+    rollout = Rollout.load(args.rollout)
+    if args.html:
+        path = Path(args.out) if args.out else Path(args.rollout) / "replay.html"
+        with claim_file(path, overwrite=args.overwrite):
+            _write_replay(rollout, path, urdf=args.urdf, max_fps=args.fps)
+        size_mb = path.stat().st_size / 1e6
+        print(f"wrote {path} ({size_mb:.1f} MB, {len(rollout)} samples)")
+    if args.live:
+        from uvms_pin.apps.viz.live import replay_live
+        from uvms_pin.apps.viz.replay import scene_for_rollout
+
+        scene = scene_for_rollout(rollout, urdf=args.urdf)
+        replay_live(rollout, scene, port=args.port, speed=args.speed)
+    return 0
+
+
+def _add_view_options(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument(
+        "--live", action="store_true", help="show the run in meshcat (server on 127.0.0.1)"
+    )
+    parser.add_argument(
+        "--port", type=int, default=7000, help="live view port (default 7000; 0: any free)"
+    )
+    parser.add_argument(
+        "--speed", type=positive, default=1.0, help="live playback speed-up over real time"
+    )
+
+
+def _cmd_info(args: argparse.Namespace) -> int:
+    from uvms_pin.model.summary import model_summary
+    from uvms_pin.model.uvms import load_uvms
+
+    uvms = load_uvms(find_model(args.urdf) or args.urdf, water_density_kg_m3=args.water_density)
+    print(model_summary(uvms))
+    return 0
+
+
+def build_parser() -> argparse.ArgumentParser:
+    parser = argparse.ArgumentParser(
+        prog="uvms-pin", description="Underwater vehicle-manipulator simulation on Pinocchio."
+    )
+    parser.add_argument("--version", action=_Version)
+    sub = parser.add_subparsers(dest="command", required=True)
+    run = sub.add_parser("run", help="run a scenario file and write rollout, metrics and figures")
+    run.add_argument("scenario", help="scenario TOML file")
+    run.add_argument("--out", required=True, help="output directory")
+    run.add_argument("--quiet", action="store_true", help="no progress line")
+    run.add_argument("--overwrite", action="store_true", help=OVERWRITE_HELP)
+    run.add_argument(
+        "--set",
+        action="append",
+        default=[],
+        metavar="KEY=VALUE",
+        help="override a scenario entry (repeatable): a dotted key, optionally [i]-indexed, "
+        "and a TOML value, e.g. --set 'environment.stiffness_N_m=[20,20,20]' "
+        "--set 'initial.joint_positions_rad[3]=0.5'",
+    )
+    run.add_argument(
+        "--html", action="store_true", help="also write replay.html (self-contained, offline)"
+    )
+    _add_view_options(run)
+    run.set_defaults(func=_cmd_run)
+    replay = sub.add_parser("replay", help="show a saved rollout: replay.html and/or live")
+    replay.add_argument("rollout", help="directory holding rollout.npz and rollout.json")
+    replay.add_argument("--html", action="store_true", help="write ROLLOUT/replay.html")
+    replay.add_argument("--out", help="write the page here instead of ROLLOUT/replay.html")
+    replay.add_argument("--urdf", help="the model's URDF, if it moved since the run")
+    replay.add_argument("--overwrite", action="store_true", help="replace an existing page")
+    replay.add_argument(
+        "--fps", type=positive, default=30.0, help="replay frames per simulated second (max)"
+    )
+    _add_view_options(replay)
+    replay.set_defaults(func=_cmd_replay)
+    info = sub.add_parser("info", help="print a summary of a UVMS URDF")
+    info.add_argument(
+        "urdf", help="URDF file with the hydrodynamic extension, or a shipped model name"
+    )
+    info.add_argument(
+        "--water-density", type=positive, default=1025.0, help="kg/m^3 (default: sea water)"
+    )
+    info.set_defaults(func=_cmd_info)
+    register_study_commands(sub)
+    register_compare_arms(sub)
+    register_compare_controllers(sub)
+    register_validate(sub)
+    return parser
+
+
+def _show_warning(message, category, filename, lineno, file=None, line=None) -> None:
+    """The project's warnings as one line each, like its errors (no source location)."""
+    if issubclass(category, UvmsPinWarning):
+        print(f"uvms-pin: warning: {message}", file=sys.stderr)
+    else:
+        sys.stderr.write(warnings.formatwarning(message, category, filename, lineno, line))
+
+
+class _Version(argparse.Action):
+    """``--version``: the text is made only when asked (it imports Pinocchio)."""
+
+    def __init__(self, option_strings, dest, **kw):
+        kw.update(nargs=0, help="print the versions of uvms-pin, Pinocchio and Python, and exit")
+        super().__init__(option_strings, dest, **kw)
+
+    def __call__(self, parser, namespace, values, option_string=None):
+        print(version_text())
+        parser.exit()
+
+
+def version_text() -> str:
+    """``uvms-pin X (pinocchio Y, Python Z)``: what a bug report needs."""
+    from uvms_pin.sim.closed_loop import package_versions
+
+    versions = package_versions()
+    return f"uvms-pin {versions['uvms-pin']} (pinocchio {versions['pin']}, Python {versions['python']})"
+
+
+def main(argv: list[str] | None = None) -> int:
+    args = build_parser().parse_args(argv)
+    with warnings.catch_warnings():
+        warnings.simplefilter("always", UvmsPinWarning)
+        warnings.showwarning = _show_warning
+        return _dispatch(args)
+
+
+def _dispatch(args: argparse.Namespace) -> int:
+    try:
+        return args.func(args)
+    except UvmsPinError as exc:
+        print(f"uvms-pin: error: {exc}", file=sys.stderr)
+        return EXIT_BAD_INPUT
+    except KeyboardInterrupt:
+        print("uvms-pin: interrupted", file=sys.stderr)
+        return EXIT_INTERRUPTED
+    except OSError as exc:  # a disk full, a file removed under us: not a bug to trace
+        where = f"{exc.filename}: " if exc.filename else ""
+        print(f"uvms-pin: error: {where}{exc.strerror or exc}", file=sys.stderr)
+        return EXIT_BAD_INPUT
+
+
+if __name__ == "__main__":
+    sys.exit(main())

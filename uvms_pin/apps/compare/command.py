@@ -1,0 +1,125 @@
+"""``uvms-pin compare-controllers SCENARIO --controllers ppc,pi_force,... --out DIR``."""
+
+from __future__ import annotations
+
+import argparse
+import sys
+
+from uvms_pin.apps.arguments import count, positive
+from uvms_pin.errors import ParameterError
+from uvms_pin.results.outdir import CONTROLLER_COMPARISON, OVERWRITE_HELP, check_writable, claim
+from uvms_pin.scenario.overrides import parse_assignment
+
+DEFAULT_CONTROLLERS = "ppc,pi_force,impedance,computed_torque"
+
+
+def _names(text: str) -> list[str]:
+    """The comma-separated names of ``--controllers``: at least one, none empty or twice."""
+    names = [n.strip() for n in text.split(",")]
+    if "" in names:
+        raise ParameterError(f"--controllers {text!r}: give comma-separated names, none empty")
+    twice = sorted({n for n in names if names.count(n) > 1})
+    if twice:
+        raise ParameterError(f"--controllers {text!r}: {', '.join(twice)} given twice")
+    return names
+
+
+def _cmd_compare_controllers(args: argparse.Namespace) -> int:
+    from uvms_pin.apps.compare.metrics import Criteria
+    from uvms_pin.apps.compare.runs import compare_controllers, controller_scenarios
+    from uvms_pin.apps.compare.table import write_table
+
+    names = _names(args.controllers)
+    overrides = dict(parse_assignment(text) for text in args.set)
+    scenarios = controller_scenarios(args.scenario, names, overrides)
+    duration = next(iter(scenarios.values())).settings.duration_s
+    after_s = 0.5 * duration if args.after is None else args.after
+    if not after_s < duration:
+        raise ParameterError(
+            f"--after {after_s:g} s must be before the end of the run ({duration:g} s)"
+        )
+    criteria = Criteria(after_s, args.band, args.tolerance)
+    out = check_writable(args.out)
+    with claim(out, CONTROLLER_COMPARISON, overwrite=args.overwrite):
+        say = None if args.quiet else (lambda line: print(line, file=sys.stderr, flush=True))
+        rows, rollouts = compare_controllers(scenarios, criteria, say)
+        header = (
+            f"Scenario {args.scenario}; force and orientation errors after t = {after_s:g} s, "
+            f"settling band {args.band:g} N, success: peak force error after the transient "
+            f"<= {args.tolerance:g} N, no joint past its limits."
+        )
+        written = write_table(rows, out, header)
+        if not args.no_figures:
+            from uvms_pin.apps.compare.figures import write_comparison_figures
+
+            written += write_comparison_figures(rows, rollouts, out, after_s)
+        if args.robustness:
+            from uvms_pin.apps.compare.robustness import run_robustness, write_robustness
+
+            if say is not None:
+                say("robustness set: every controller x 6 cases, through the study runner ...")
+            robust = run_robustness(
+                args.scenario, names, out / "robustness", criteria, args.jobs, overrides
+            )
+            written += write_robustness(robust, out)
+    for row in rows:
+        verdict = "holds the task" if row["success"] else f"fails: {row['reason']}"
+        print(
+            f"{row['controller']:<16} force error RMS {row['force_error_rms_N']:.3f} N, "
+            f"peak {row['force_error_peak_N']:.3f} N: {verdict}"
+        )
+    print("wrote " + ", ".join(str(p) for p in written))
+    return 0
+
+
+def register(subparsers) -> argparse.ArgumentParser:
+    """Add the ``compare-controllers`` subcommand to the ``uvms-pin`` parser."""
+    parser = subparsers.add_parser(
+        "compare-controllers",
+        help="run a scenario's task with several controllers and compare them",
+        description=(
+            "Run the scenario once per controller (its own [controller] for its type, the "
+            "[baselines.<name>] tuning for the others, defaults if absent) and write "
+            "controllers.csv, controllers.md and figures."
+        ),
+    )
+    parser.add_argument("scenario", help="scenario TOML file")
+    parser.add_argument(
+        "--controllers",
+        default=DEFAULT_CONTROLLERS,
+        help=f"comma-separated: the scenario's own type and/or pi_force, impedance, "
+        f"computed_torque (default {DEFAULT_CONTROLLERS})",
+    )
+    parser.add_argument("--out", required=True, help="output directory")
+    parser.add_argument("--overwrite", action="store_true", help=OVERWRITE_HELP)
+    parser.add_argument(
+        "--set",
+        action="append",
+        default=[],
+        metavar="KEY=VALUE",
+        help="override a scenario entry for every controller (repeatable), as in 'run'",
+    )
+    parser.add_argument(
+        "--after", type=positive, default=None, help="start of the after-transient window [s] "
+        "(default: half the duration)"
+    )  # fmt: skip
+    parser.add_argument("--band", type=positive, default=0.25, help="settling band [N]")
+    parser.add_argument(
+        "--tolerance", type=positive, default=0.5,
+        help="largest peak force error after the transient that holds the task [N]",
+    )  # fmt: skip
+    parser.add_argument("--no-figures", action="store_true", help="tables only")
+    parser.add_argument(
+        "--robustness",
+        action="store_true",
+        help="also run every controller on 6 cases (nominal, environment stiffness x10, "
+        "plant x1.3 and x0.7, noise x5, disturbance x5) through the study runner: "
+        "robustness.csv, robustness.md, OUT/robustness/ (a study directory)",
+    )
+    parser.add_argument(
+        "--jobs", type=count(0), default=1,
+        help="Dask worker processes for --robustness (0: serial, in this process)",
+    )  # fmt: skip
+    parser.add_argument("--quiet", action="store_true", help="no progress lines")
+    parser.set_defaults(func=_cmd_compare_controllers)
+    return parser

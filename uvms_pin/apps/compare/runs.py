@@ -1,0 +1,71 @@
+"""Run one scenario's task with each controller and collect the comparison's rows."""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from pathlib import Path
+from typing import Any
+
+from uvms_pin.apps.compare.metrics import Criteria, comparison_row
+from uvms_pin.errors import FunnelViolation, ScenarioError, SimulationError
+from uvms_pin.results.rollout import Rollout
+from uvms_pin.scenario.overrides import apply_overrides
+from uvms_pin.scenario.scenario import (
+    Scenario,
+    baseline_controller_table,
+    scenario_from_raw,
+    simulate,
+)
+from uvms_pin.scenario.toml import read_toml
+
+__all__ = ["compare_controllers", "controller_scenarios", "run_controller"]
+
+
+def controller_scenarios(
+    path: str | Path, controllers: list[str], overrides: dict[str, Any] | None = None
+) -> dict[str, Scenario]:
+    """The scenario at ``path`` once per controller (its [controller] replaced by
+    `baseline_controller_table`), every one built and checked before any run.
+
+    Raises:
+        ScenarioError: a bad file, override or controller name.
+    """
+    path = Path(path)
+    # overrides first: they may set a baseline's tuning ("baselines.pi_force.damping=...")
+    raw = apply_overrides(read_toml(path, ScenarioError), overrides)
+    out = {}
+    for name in controllers:
+        # the controller table that runs; the other tunings are not this run's
+        variant = {k: v for k, v in raw.items() if k != "baselines"}
+        variant["controller"] = baseline_controller_table(raw, name)
+        try:
+            out[name] = scenario_from_raw(variant, path)
+        except ScenarioError as exc:
+            raise ScenarioError(f"controller '{name}' ([baselines.{name}]): {exc}") from exc
+    return out
+
+
+def run_controller(name: str, scenario: Scenario, criteria: Criteria) -> tuple[dict, Rollout]:
+    """(row, rollout) of one controller; a run the simulator stops is a row, not an error."""
+    try:
+        rollout, stopped = simulate(scenario, progress=False), ""
+    except (FunnelViolation, SimulationError) as exc:
+        rollout, stopped = getattr(exc, "rollout", None), f"run stopped: {exc}"
+    if rollout is None or len(rollout) == 0:
+        raise SimulationError(f"controller '{name}': {stopped or 'no samples'}")
+    return comparison_row(name, rollout, scenario.plant.actuation, criteria, stopped), rollout
+
+
+def compare_controllers(
+    scenarios: dict[str, Scenario],
+    criteria: Criteria,
+    progress: Callable[[str], None] | None = None,
+) -> tuple[list[dict], dict[str, Rollout]]:
+    """Rows (in the given order) and rollouts of every controller's run."""
+    rows, rollouts = [], {}
+    for name, scenario in scenarios.items():
+        if progress is not None:
+            progress(f"running {name} ...")
+        row, rollouts[name] = run_controller(name, scenario, criteria)
+        rows.append(row)
+    return rows, rollouts

@@ -1,0 +1,286 @@
+"""Gymnasium environments on a scenario: the sampled closed loop of ``uvms-pin run`` with
+the controller replaced by the policy (docs/gym.md).
+
+Observation (float64), what a controller may measure, in this order (``observation_layout``):
+    q_measured (nq): vehicle position [m] (3), quaternion xyzw (4), arm joints [rad];
+    v_measured (nv): body linear [m/s] (3), body angular [rad/s] (3), joint rates [rad/s];
+    wrench_measured (6): F/T force [N] (3), torque [N m] (3), world axes, with noise;
+    goal: the task's goal (force tracking: f_d(t) [N] (3); station keeping: p_d [m] (3),
+    quaternion xyzw (4)).
+Action (nv,) in [-1, 1]: tau_commanded = action_scale * action (`uvms_pin.apps.gym.actions`),
+then the plant's actuation (thruster allocation and saturation, joint torque limits).
+One step = one control period (the scenario's control.period_s); the episode is truncated
+at the scenario's duration_s.
+"""
+
+from __future__ import annotations
+
+import numbers
+from pathlib import Path
+from typing import Any, ClassVar
+
+import gymnasium as gym
+import numpy as np
+
+from uvms_pin.apps.gym.actions import action_scale as make_action_scale
+from uvms_pin.apps.gym.episode import EpisodeRecord
+from uvms_pin.apps.gym.stepper import PlantStepper
+from uvms_pin.errors import ParameterError, SimulationError
+from uvms_pin.model.resources import shipped_path
+from uvms_pin.results.rollout import Rollout
+from uvms_pin.scenario.scenario import Scenario, load_scenario
+from uvms_pin.sim.closed_loop import package_versions
+
+# spawn key of the initial-perturbation stream: apart from the sensors' children 0..5
+_PERTURBATION_STREAM = 1 << 16
+
+
+def _episode_seed(np_random: np.random.Generator) -> int:
+    return int(np_random.integers(0, 2**31 - 1))
+
+
+class UvmsEnv(gym.Env):
+    """Base of the uvms-pin environments: a scenario stepped one control period at a time.
+
+    Args:
+        scenario: scenario file (path, or the name of a shipped scenario).
+        model: replaces the scenario's model (a shipped model name or a URDF path).
+        overrides: dotted scenario overrides, as ``uvms-pin run --set`` (e.g.
+            ``{"control.period_s": 0.01}``).
+        action_scale: scale of the normalized action (nv,) [N, N m]; default: the
+            actuation limits (required when the scenario's actuation is unlimited).
+        clip_actions: clip the action to [-1, 1] (False: pass it on; the actuation still
+            saturates).
+        initial_position_noise_m, initial_joint_noise_rad: bound of the uniform
+            perturbation of the vehicle position and of the arm joints at reset.
+        effort_weight: w_effort of the reward. failure_penalty: reward of a diverged step.
+        render_mode: None or "rgb_array".
+    """
+
+    metadata: ClassVar[dict[str, Any]] = {"render_modes": ["rgb_array"], "render_fps": 30}
+
+    def __init__(
+        self,
+        scenario: str | Path,
+        *,
+        model: str | None = None,
+        overrides: dict[str, Any] | None = None,
+        action_scale: Any = None,
+        clip_actions: bool = True,
+        initial_position_noise_m: float = 0.0,
+        initial_joint_noise_rad: float = 0.0,
+        effort_weight: float = 0.01,
+        failure_penalty: float = 100.0,
+        render_mode: str | None = None,
+    ):
+        if render_mode is not None and render_mode not in self.metadata["render_modes"]:
+            raise ParameterError(f"render_mode must be None or 'rgb_array', got {render_mode!r}")
+        for label, value in (
+            ("initial_position_noise_m", initial_position_noise_m),
+            ("initial_joint_noise_rad", initial_joint_noise_rad),
+            ("effort_weight", effort_weight),
+            ("failure_penalty", failure_penalty),
+        ):
+            if not (isinstance(value, numbers.Real) and np.isfinite(value) and value >= 0.0):
+                raise ParameterError(f"{label} must be a finite number >= 0, got {value!r}")
+        self.render_mode = render_mode
+        self.scenario_path = scenario_path(scenario)
+        self.overrides = dict(overrides or {})
+        if model is not None:
+            self.overrides["scenario.model"] = model
+        self.scenario = load_scenario(self.scenario_path, self.overrides)
+        if self.scenario.settings.control_period_s is None:
+            raise ParameterError(
+                f"{self.scenario_path}: the environment steps one control period at a time, "
+                "and the scenario's control is continuous: set control.period_s "
+                '(overrides={"control.period_s": 0.002})'
+            )
+        self._stepper = PlantStepper(
+            self.scenario.plant, self.scenario.sensor_config, self.scenario.settings
+        )
+        uvms = self.scenario.uvms
+        self.action_scale = make_action_scale(self.scenario.plant.actuation, uvms.nv, action_scale)
+        self.clip_actions = bool(clip_actions)
+        self.initial_position_noise_m = float(initial_position_noise_m)
+        self.initial_joint_noise_rad = float(initial_joint_noise_rad)
+        self.effort_weight = float(effort_weight)
+        self.failure_penalty = float(failure_penalty)
+        settings = self.scenario.settings
+        self.max_steps = round(settings.duration_s / settings.control_period_s)
+        self.task = self._make_task(self.scenario)
+        self.observation_layout = _layout(uvms.nq, uvms.nv, self.task.goal_size)
+        size = self.observation_layout["goal"].stop
+        self.observation_space = gym.spaces.Box(-np.inf, np.inf, (size,), np.float64)
+        self.action_space = gym.spaces.Box(-1.0, 1.0, (uvms.nv,), np.float64)
+        self.episode_seed: int | None = None
+        self._steps = 0
+        self._record = EpisodeRecord()
+        self._measurement = None
+        self._contact = np.zeros(6)
+        self._anchor: np.ndarray | None = None
+        self._render_data = uvms.model.createData()
+        self._flow_seed = self.scenario.settings.seed
+
+    # -- to be given by a task environment ---------------------------------------------
+    def _make_task(self, scenario: Scenario):
+        raise NotImplementedError
+
+    # -- gymnasium API -------------------------------------------------------------------
+    def reset(self, *, seed: int | None = None, options: dict[str, Any] | None = None):
+        """Start an episode. Every random draw (sensor noise, initial perturbation, sea
+        state) comes from the episode seed: ``seed`` when given, else drawn from the
+        environment's generator (itself seeded by the last given seed); ``info['seed']``."""
+        super().reset(seed=seed)
+        if options:
+            raise ParameterError(f"reset takes no options, got {sorted(options)}")
+        episode_seed = int(seed) if seed is not None else _episode_seed(self.np_random)
+        self._reseed_flow(episode_seed)
+        self.episode_seed = episode_seed
+        q0, v0 = self._initial_state(episode_seed)
+        self._stepper.reset(q0, v0, episode_seed)
+        self._steps = 0
+        self._record = EpisodeRecord()
+        self._anchor = None
+        if self.scenario.plant.contact is not None:
+            self._anchor = self.scenario.plant.ee_state(self._stepper.q, self._stepper.v)[0]
+        self._measurement, self._contact = self._stepper.measure()
+        return self._observation(), {"seed": episode_seed, "time_s": 0.0}
+
+    def step(self, action):
+        a = np.asarray(action, dtype=float)
+        if a.shape != self.action_space.shape or not np.all(np.isfinite(a)):
+            raise ParameterError(
+                f"action must be {self.action_space.shape[0]} finite numbers, got {action!r}"
+            )
+        if self._measurement is None:
+            raise ParameterError("call reset() before step()")
+        if self.clip_actions:
+            a = np.clip(a, -1.0, 1.0)
+        stepper, plant = self._stepper, self.scenario.plant
+        tau = self.action_scale * a
+        t, measured = stepper.time_s, self._measurement
+        self._record.add(
+            t,
+            stepper.q,
+            stepper.v,
+            plant.actuation.apply(tau),
+            tau,
+            self._contact,
+            measured.wrench_world,
+            plant.disturbance_wrench(t),
+        )
+        info: dict[str, Any] = {"seed": self.episode_seed}
+        try:
+            stepper.advance(tau)
+            self._measurement, self._contact = stepper.measure()
+        except SimulationError as exc:
+            self._measurement = None  # the episode is over: reset() before stepping again
+            info.update(time_s=t, error=str(exc))
+            obs = _observation_of(measured, self.task.goal(t))
+            return obs, -self.failure_penalty, True, False, info
+        self._steps += 1
+        outcome = self.task.outcome(stepper.time_s, stepper.q, self._contact, a)
+        truncated = self._steps >= self.max_steps and not outcome.terminated
+        info.update(time_s=stepper.time_s, **outcome.terms)
+        return self._observation(), outcome.reward, outcome.terminated, truncated, info
+
+    def render(self):
+        if self.render_mode != "rgb_array":
+            return None
+        from uvms_pin.apps.gym.render import side_view_rgb
+
+        stepper = self._stepper
+        return side_view_rgb(
+            self.scenario.uvms, self._render_data, stepper.q, stepper.time_s, self._anchor
+        )
+
+    # -- replay export -------------------------------------------------------------------
+    def episode_rollout(self) -> Rollout:
+        """The episode so far as a Rollout (``save`` it, then ``uvms-pin replay`` it):
+        one sample per control tick up to the current state."""
+        if self.episode_seed is None:
+            raise ParameterError("no episode yet: call reset() first")
+        record = EpisodeRecord()
+        record.rows = list(self._record.rows)
+        stepper = self._stepper
+        if not record.rows or record.rows[-1][0] != stepper.time_s:  # the state reached
+            held = record.rows[-1][3:5] if record.rows else (np.zeros(stepper.v.size),) * 2
+            measured = self._contact if self._measurement is None else self._measurement
+            record.add(
+                stepper.time_s,
+                stepper.q,
+                stepper.v,
+                *held,
+                self._contact,
+                getattr(measured, "wrench_world", measured),
+                self.scenario.plant.disturbance_wrench(stepper.time_s),
+            )
+        scenario = self.scenario
+        metadata = {
+            "scenario": scenario.name,
+            "scenario_path": str(scenario.path),
+            "description": f"{scenario.description} (gymnasium {self.spec.id if self.spec else type(self).__name__})",
+            "parameters": scenario.raw,
+            "seed": self.episode_seed,
+            "control_period_s": scenario.settings.control_period_s,
+            "log_period_s": scenario.settings.control_period_s,
+            "model_source": scenario.uvms.source,
+            "arm_joint_names": scenario.uvms.arm_joint_names,
+            "versions": package_versions(),
+            "status": "ok",
+            "error": "",
+        }
+        return record.to_rollout(scenario.uvms, metadata)
+
+    # -- helpers -------------------------------------------------------------------------
+    def _observation(self) -> np.ndarray:
+        return _observation_of(self._measurement, self.task.goal(self._stepper.time_s))
+
+    def _initial_state(self, episode_seed: int) -> tuple[np.ndarray, np.ndarray]:
+        rng = np.random.default_rng(
+            np.random.SeedSequence(episode_seed, spawn_key=(_PERTURBATION_STREAM,))
+        )
+        q0 = self.scenario.q0.copy()
+        q0[:3] += rng.uniform(-1.0, 1.0, 3) * self.initial_position_noise_m
+        q0[7:] += rng.uniform(-1.0, 1.0, q0.size - 7) * self.initial_joint_noise_rad
+        return q0, self.scenario.v0.copy()
+
+    def _reseed_flow(self, episode_seed: int) -> None:
+        """A seeded flow (waves, sea state, varying current) is drawn again from the episode
+        seed: the scenario is rebuilt with scenario.seed = the episode seed."""
+        if self.scenario.plant.flow is None or episode_seed == self._flow_seed:
+            return
+        self.scenario = load_scenario(
+            self.scenario_path, {**self.overrides, "scenario.seed": episode_seed}
+        )
+        self._stepper = PlantStepper(
+            self.scenario.plant, self.scenario.sensor_config, self.scenario.settings
+        )
+        self._flow_seed = episode_seed
+
+
+def _observation_of(measurement, goal: np.ndarray) -> np.ndarray:
+    return np.concatenate([measurement.q, measurement.v, measurement.wrench_world, goal])
+
+
+def _layout(nq: int, nv: int, goal_size: int) -> dict[str, slice]:
+    """Slices of the observation vector by name (module docstring)."""
+    out, start = {}, 0
+    for name, size in (("q", nq), ("v", nv), ("wrench", 6), ("goal", goal_size)):
+        out[name] = slice(start, start + size)
+        start += size
+    return out
+
+
+def scenario_path(scenario: str | Path) -> Path:
+    """A scenario file, or the name of a shipped one (``realistic_force_tracking``)."""
+    path = Path(scenario)
+    if path.is_file():
+        return path
+    name = path.name if path.suffix == ".toml" else f"{path.name}.toml"
+    if str(scenario) == path.name:
+        try:
+            return shipped_path(Path("scenarios") / name)
+        except FileNotFoundError:
+            pass
+    raise ParameterError(f"scenario {str(scenario)!r}: no such file nor shipped scenario")

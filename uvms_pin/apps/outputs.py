@@ -1,0 +1,44 @@
+"""What a run leaves in its output directory: the rollout, ``metrics.json``, its figures."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from uvms_pin.results.rollout import Rollout
+
+
+def write_outputs(rollout: Rollout, out: Path) -> list[Path]:
+    """Rollout, metrics.json and figures into ``out``."""
+    from uvms_pin.results.atomic import write_json_atomic
+    from uvms_pin.results.figures.paper import paper_figures
+    from uvms_pin.results.figures.standard import standard_figures
+
+    out.mkdir(parents=True, exist_ok=True)
+    rollout.save(out)
+    metrics = rollout.metrics()
+    write_json_atomic(
+        out / "metrics.json",
+        {
+            "status": rollout.metadata.get("status"),
+            "error": rollout.metadata.get("error", ""),
+            "seed": rollout.metadata.get("seed"),
+            **metrics,
+        },
+    )
+    return paper_figures(rollout, out) + standard_figures(rollout, out) + _flow_figure(rollout, out)
+
+
+def _flow_figure(rollout: Rollout, out: Path) -> list[Path]:
+    """flow.png when the run had waves or a varying current (not for a uniform current)."""
+    from uvms_pin.apps.viz.flow_plots import FLOW_FIGURE, plot_flow_seen
+    from uvms_pin.flow import UniformCurrent
+    from uvms_pin.model.uvms import load_uvms
+    from uvms_pin.scenario.scenario import water_flow_of
+
+    parameters = rollout.metadata.get("parameters") or {}
+    flow = water_flow_of(parameters)
+    if flow is None or isinstance(flow, UniformCurrent) or len(rollout) == 0:
+        return []
+    density = float(parameters.get("water", {}).get("density_kg_m3", 1025.0))
+    uvms = load_uvms(rollout.metadata["model_source"], water_density_kg_m3=density)
+    return [plot_flow_seen(rollout, uvms, flow, out / FLOW_FIGURE)]

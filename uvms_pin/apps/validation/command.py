@@ -1,0 +1,61 @@
+"""``uvms-pin validate pool DATA_DIR --out DIR``: the pool trials against the simulator.
+
+Wired into `uvms_pin.apps.cli.main.build_parser` with ``register(sub)``.
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+
+from uvms_pin.errors import ParameterError
+
+
+def _cmd_validate_pool(args: argparse.Namespace) -> int:
+    from uvms_pin.apps.validation.run import run_pool_validation
+
+    if not args.step > 0.0:
+        raise ParameterError(f"--step must be positive, got {args.step}")
+    names = [n.strip() for n in args.trials.split(",") if n.strip()] if args.trials else None
+    result = run_pool_validation(
+        args.data_dir,
+        args.out,
+        trial_names=names,
+        step_s=args.step,
+        figures=not args.no_figures,
+        progress=None if args.quiet else lambda line: print(line, file=sys.stderr, flush=True),
+    )
+    print(
+        f"{len(result['trials'])} trials: mean roll RMSE {result['mean_roll_rmse_deg']:.3f} deg, "
+        f"mean pitch RMSE {result['mean_pitch_rmse_deg']:.3f} deg"
+    )
+    print(f"wrote {args.out}/pool_validation.json, pool_validation.csv and one figure per trial")
+    return 0
+
+
+def register(subparsers) -> argparse.ArgumentParser:
+    """Add ``validate pool`` to the ``uvms-pin`` parser's subparsers."""
+    parser = subparsers.add_parser(
+        "validate", help="compare the simulator with measurements (pool trials)"
+    )
+    kinds = parser.add_subparsers(dest="validation", required=True)
+    pool = kinds.add_parser(
+        "pool",
+        help="BlueROV2 Heavy + Alpha 5 pool trials: simulated vs measured roll and pitch",
+        description=(
+            "For every trial (<name>.npz) in DATA_DIR, prescribe the arm joints from the "
+            "encoders, leave the vehicle free from its measured initial state and compare the "
+            "simulated roll and pitch with the IMU. Writes DIR/pool_validation.json, "
+            "pool_validation.csv and <trial>.png."
+        ),
+    )
+    pool.add_argument(
+        "data_dir", help="directory of trial files, e.g. the shipped data/hinsdale2023"
+    )
+    pool.add_argument("--out", required=True, help="output directory")
+    pool.add_argument("--trials", help="comma-separated trial names (default: all)")
+    pool.add_argument("--step", type=float, default=0.05, help="RK4 step [s] (default 0.05)")
+    pool.add_argument("--no-figures", action="store_true", help="skip the per-trial figures")
+    pool.add_argument("--quiet", action="store_true", help="no per-trial progress lines")
+    pool.set_defaults(func=_cmd_validate_pool)
+    return parser

@@ -1,0 +1,162 @@
+"""Identify the trial vehicle's centre of buoyancy from the pool trials' quasi-static attitude.
+
+The arm moves slowly, so the vehicle stays close to its hydrostatic equilibrium: at each
+instant, the roll and pitch where the restoring moment of gravity and buoyancy balances
+the arm's (the roll and pitch rows of h(q, 0) vanish). The equilibrium depends on where
+the hull's centre of buoyancy is; a shift dr_B of a fraction of a centimetre moves it by
+degrees (roll stiffness ~ W BG ~ 3 N m/rad for ~150 N of buoyancy). This module fits dr_B
+(3 numbers) by least squares of equilibrium minus measured roll and pitch on a set of
+trials, and reports the fit on the others:
+
+    python -m uvms_pin.apps.validation.identify data/hinsdale2023
+
+Identification trials: the trajectory families 001 and 008 (6 trials); the families 002,
+009 and 011 (6 trials) are held out for validation (`IDENTIFICATION_TRIALS`).
+"""
+
+from __future__ import annotations
+
+import argparse
+import dataclasses
+import sys
+from collections.abc import Sequence
+from pathlib import Path
+
+import numpy as np
+from scipy.optimize import least_squares
+from scipy.spatial.transform import Rotation
+
+from uvms_pin.apps.validation.pool import (
+    IDENTIFICATION_TRIALS,
+    JOINT_CUTOFF_HZ,
+    joint_angles_rad,
+    trial_uvms,
+)
+from uvms_pin.apps.validation.prescribed import JointTrajectory
+from uvms_pin.apps.validation.trials import find_trials, load_trial, roll_pitch_rad
+from uvms_pin.errors import SimulationError
+from uvms_pin.model.uvms import UVMS
+from uvms_pin.physics.dynamics import bias_forces
+
+__all__ = [
+    "IDENTIFICATION_TRIALS",
+    "fit_centre_of_buoyancy",
+    "quasi_static_roll_pitch",
+    "with_cob_offset",
+]
+
+HULL = "base_link"
+
+
+def with_cob_offset(uvms: UVMS, offset_m: np.ndarray, link: str = HULL) -> UVMS:
+    """The same system with ``link``'s centre of buoyancy moved by offset_m (link frame)."""
+
+    def moved(body):
+        if body.name != link:
+            return body.params
+        cob = body.params.center_of_buoyancy_m + np.asarray(offset_m, dtype=float)
+        return dataclasses.replace(body.params, center_of_buoyancy_m=cob)
+
+    return uvms.with_hydro(moved)
+
+
+def _restoring_roll_pitch(uvms: UVMS, roll_pitch: np.ndarray, q_arm: np.ndarray) -> np.ndarray:
+    quat = Rotation.from_euler("ZYX", [0.0, roll_pitch[1], roll_pitch[0]]).as_quat()
+    q = np.concatenate([np.zeros(3), quat, q_arm])
+    return bias_forces(uvms, q, np.zeros(uvms.nv))[3:5]
+
+
+def quasi_static_roll_pitch(
+    uvms: UVMS, q_arm: np.ndarray, guess_rad: np.ndarray, tol_rad: float = 1e-8
+) -> np.ndarray:
+    """Roll and pitch [rad] (yaw 0) where the roll and pitch moments of h(q, 0) vanish.
+
+    Newton's method with a finite-difference Jacobian, from ``guess_rad``.
+
+    Raises:
+        SimulationError: no convergence in 20 iterations (e.g. an unstable trim).
+    """
+    x = np.asarray(guess_rad, dtype=float).copy()
+    eps = 1e-6
+    for _ in range(20):
+        f0 = _restoring_roll_pitch(uvms, x, q_arm)
+        jac = np.column_stack(
+            [(_restoring_roll_pitch(uvms, x + eps * e, q_arm) - f0) / eps for e in np.eye(2)]
+        )
+        step = np.linalg.solve(jac, -f0)
+        x += step
+        if np.max(np.abs(step)) < tol_rad:
+            return x
+    raise SimulationError(f"no hydrostatic equilibrium found near {guess_rad} for q_arm {q_arm}")
+
+
+def _samples(path: Path, every: int) -> tuple[list[np.ndarray], np.ndarray]:
+    """Prescribed arm angles and measured roll/pitch at every ``every``-th IMU sample."""
+    trial = load_trial(path)
+    arm = JointTrajectory.from_samples(
+        trial.encoder_time_s, joint_angles_rad(trial.encoder_rad), JOINT_CUTOFF_HZ
+    )
+    start, end = trial.common_span_s
+    arm_start, arm_end = arm.span_s
+    inside = (trial.imu_time_s >= max(start, arm_start)) & (trial.imu_time_s <= min(end, arm_end))
+    times = trial.imu_time_s[inside][::every]
+    measured = roll_pitch_rad(trial.imu_quat_xyzw[inside][::every])
+    return [arm(t)[0] for t in times], measured
+
+
+def _errors(uvms: UVMS, data) -> np.ndarray:
+    out = []
+    for arm_angles, measured in data:
+        for q_arm, rp in zip(arm_angles, measured, strict=True):
+            out.append(quasi_static_roll_pitch(uvms, q_arm, rp) - rp)
+    return np.array(out)
+
+
+def rms_deg(errors: np.ndarray) -> str:
+    """'roll, pitch' RMS [deg] of (n, 2) errors [rad], 3 decimals."""
+    roll, pitch = np.degrees(np.sqrt(np.mean(errors**2, axis=0)))
+    return f"{roll:.3f}, {pitch:.3f}"
+
+
+def fit_centre_of_buoyancy(
+    uvms: UVMS, trial_files: Sequence[Path], every: int = 10
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Least-squares dr_B [m] of the hull; also the errors [rad] before and after."""
+    data = [_samples(p, every) for p in trial_files]
+    result = least_squares(
+        lambda p: _errors(with_cob_offset(uvms, p), data).ravel(),
+        np.zeros(3),
+        diff_step=1e-3,
+        x_scale=0.005,
+    )
+    before = _errors(uvms, data)
+    return result.x, before, result.fun.reshape(-1, 2)
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("data_dir", help="the pool trials, e.g. data/hinsdale2023")
+    parser.add_argument("--every", type=int, default=10, help="use every n-th IMU sample")
+    args = parser.parse_args(argv)
+    files = {p.stem: p for p in find_trials(args.data_dir)}
+    training = [files[n] for n in IDENTIFICATION_TRIALS]
+    held_out = [p for n, p in files.items() if n not in IDENTIFICATION_TRIALS]
+    # the shipped trial model may already hold a correction: fit the one relative to the file
+    uvms = trial_uvms()
+    offset, before, after = fit_centre_of_buoyancy(uvms, training, args.every)
+    print(f"identification trials: {', '.join(IDENTIFICATION_TRIALS)}")
+    print(f"hull centre of buoyancy offset dr_B = {np.array2string(offset, precision=6)} m")
+    print(
+        "quasi-static roll, pitch RMS [deg] on identification trials: "
+        f"{rms_deg(before)} -> {rms_deg(after)}"
+    )
+    data = [_samples(p, args.every) for p in held_out]
+    print(
+        "quasi-static roll, pitch RMS [deg] on held-out trials: "
+        f"{rms_deg(_errors(uvms, data))} -> {rms_deg(_errors(with_cob_offset(uvms, offset), data))}"
+    )
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

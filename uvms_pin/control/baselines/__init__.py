@@ -1,0 +1,1 @@
+"""The controllers the PPC is compared with: PI force, impedance, computed torque."""

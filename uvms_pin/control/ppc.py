@@ -1,0 +1,759 @@
+"""The paper's model-free prescribed-performance force/orientation controller (Section 4).
+
+Heshmati-alamdari, Nikou, Kyriakopoulos, Dimarogonas, "A Robust Force Control Approach for
+Underwater Vehicle Manipulator Systems" (IFAC 2017). Two levels (docs/controller.md):
+
+First level (task space, 6 components j = f_x, f_y, f_z, roll, pitch, yaw):
+
+    e_x      = [f_meas - f_d(t) (3) N;  rpy_ee(q) - rpy_d(t) (3) rad]
+    xi_x     = e_x / rho_x(t)                      (must stay in (-1, 1))
+    eps_x    = ln((1 + xi_x) / (1 - xi_x))
+    xdot_r   = -k_x eps_x                          ([m/s (3); rad/s Euler rates (3)])
+    zeta_r   = J(q)^+ xdot_r  [+ (I - J^+ J) zeta_0]
+
+with J = J'^-1 J^g the analytical Jacobian of the end-effector
+(:func:`uvms_pin.physics.kinematics.analytical_jacobian`).
+
+Second level (generalized velocity, n = nv components):
+
+    e_zeta   = zeta_meas - zeta_r
+    xi_zeta  = P_zeta(t)^-1 e_zeta,   P_zeta = diag(rho_zeta_j(t))
+    tau      = -K_zeta P_zeta^-1 R(xi_zeta) eps_zeta,   R = diag(2 / (1 - xi_zeta_j^2))
+
+The controller is model-free: it uses only frame placements and frame Jacobians of the
+model (kinematics), never its inertias, gravity or hydrodynamics, nor the environment.
+
+How ``compute`` is evaluated (it runs once per control tick, or once per integrator stage,
+so it avoids per-call overhead; the results agree with the direct evaluation of the
+equations above to ~1e-13, see tests/controllers/test_ppc_oracle.py):
+
+- one Pinocchio pass gives the end-effector rotation and its LOCAL_WORLD_ALIGNED Jacobian
+  J^lwa; the analytical Jacobian is J = diag(I, E^-1) J^lwa with E the Euler-rate matrix
+  in world axes, and since J has full row rank, J^# xdot = (J^lwa)^# [xdot_p; E xdot_o]:
+  E is applied in closed form and never inverted;
+- J^# is applied by a Cholesky solve of the 6 x 6 J W^-1 J^T with one refinement step
+  (:class:`~uvms_pin.control.pseudo_inverse.MinimumNormSolver`); when its certified
+  condition bound is too large, the exact SVD route of the definition is used instead;
+- both funnels are evaluated in one vector, and a funnel check is one max |xi| < 1; the
+  detailed checks (which component, which exception) only run when that fails;
+- scalar ``math`` on the 3- and 6-element quantities; ``last_signals`` is assembled only
+  when read.
+
+With ``backend="core"`` (the default) the same steps run compiled in one call
+(``src/uvms_core/ppc.hpp``, the names there are the ones here): f_d(t) and rpy_d(t) are
+still evaluated in Python (user code), and every call the kernel does not return as ok (a
+funnel left or the extension's clamp passed, the solver declining, the Euler singularity, a
+malformed or non-finite input) is evaluated by the Python code below, so the exceptions and
+the SVD and extension routes are this module's own.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from collections.abc import Callable
+from dataclasses import dataclass
+
+import numpy as np
+import pinocchio as pin
+from numpy.typing import ArrayLike
+
+from uvms_pin.control.base import Controller
+from uvms_pin.control.measurement import Measurement
+from uvms_pin.control.performance import (
+    PerformanceFunction,
+    barrier_extended,
+    check_funnel,
+    max_abs,
+    normalized_error,
+    transformed_error,
+    transformed_error_extended,
+)
+from uvms_pin.control.pseudo_inverse import (
+    REFINE_ABOVE_CONDITION_BOUND,
+    MinimumNormSolver,
+    pseudo_inverse,
+)
+from uvms_pin.errors import ParameterError
+from uvms_pin.physics.compiled import check_backend, core_module
+from uvms_pin.physics.kinematics import (
+    EULER_SINGULARITY_MIN_ABS_COS_PITCH,
+    analytical_jacobian,
+    angular_velocity_world_from_euler_rates,
+    check_euler_singularity,
+    frame_id_from_name,
+    frame_rotation_and_jacobian,
+)
+from uvms_pin.results.components import FIRST_LEVEL_NAMES, VEHICLE_VELOCITY_NAMES
+
+__all__ = [
+    "FIRST_LEVEL_NAMES",
+    "VEHICLE_VELOCITY_NAMES",
+    "PPCParams",
+    "PPCSignals",
+    "PrescribedPerformanceController",
+    "pseudo_inverse",
+]
+
+_N_VEHICLE = 6
+#: With the funnel extension on (continuous-time simulation), the barrier is continued
+#: linearly beyond |xi| = this (where eps ~ 14.5, r ~ 1e6): it keeps growing outside.
+_XI_CLAMP = 1.0 - 1e-6
+_TWO_PI = 2.0 * math.pi
+#: Joint position limits at or beyond this magnitude are treated as absent (Pinocchio marks
+#: "no limit" with +-max double).
+_NO_LIMIT_THRESHOLD = 1e10
+
+
+@dataclass(frozen=True, eq=False)
+class PPCParams:
+    """Gains and funnels of :class:`PrescribedPerformanceController`.
+
+    Every array field accepts a scalar (broadcast to all components) or one value per
+    component: 6 for the first level (``_x``: f_x, f_y, f_z [N]; roll, pitch, yaw [rad]),
+    nv = 6 + n_joints for the second level (``_zeta``: u, v, w [m/s]; p, q, r [rad/s];
+    joint rates [rad/s]). :meth:`for_uvms` returns fully sized arrays; :meth:`sized`
+    validates and sizes any instance.
+
+    Defaults are the paper's simulation values (Section 5) with its errata fixed
+    (docs/controller.md):
+
+    - ``k_x = 0.2`` and ``k_zeta = 5``: the paper prints k_x = -0.2 and k_v = -5, but its
+      law (eq. 13, 18) already carries the minus sign and requires k > 0; negative gains
+      would push every error out of its funnel.
+    - The paper's rho_v / rho_zeta and P(t) / P_zeta(t) are the same thing: here ``_zeta``.
+    - ``l_x = 3`` for all six: the paper gives l_x only for j = 1..3 (forces); we use 3 for
+      the orientation components too.
+    - ``rho_inf_zeta``: 0.2 for the 6 vehicle components and 0.4 for the arm joints (the
+      paper's second "j in {1..6}" line is the vehicle). ``None`` means this split.
+
+    Attributes:
+        k_x: first-level gains k_x [m/s or rad/s per unit of eps], > 0, (6,).
+        k_zeta: diagonal of K_zeta [N, N m per unit of eps rho^-1], > 0, (nv,).
+        rho0_x, rho_inf_x: first-level funnel bounds [N (3); rad (3)].
+        l_x_per_s: first-level decay rates [1/s].
+        rho0_zeta, rho_inf_zeta: second-level funnel bounds [m/s (3); rad/s (3 + n)].
+        l_zeta_per_s: second-level decay rates [1/s].
+        desired_rpy: constant desired end-effector Euler angles (roll, pitch, yaw) [rad],
+            used when the controller is given no ``desired_rpy``.
+        null_space_gain_per_s: gain k_0 >= 0 [rad/s] of the optional secondary task
+            (joint-limit avoidance in the null space of J). 0 (default) = the paper's plain
+            pseudo-inverse, eq. (9).
+        pinv_relative_cutoff: singular values of J below this fraction of the largest are
+            treated as zero in J^+ (numerical rank only, no damping).
+        null_space_target: arm joint positions (n_joints,) [rad] the secondary task pulls
+            toward (e.g. a pose with reach in the task direction); None = mid-range.
+        velocity_weights: positive weights W (nv,) of the generalized pseudo-inverse of the
+            paper's remark, J^# = W^-1 J^T (J W^-1 J^T)^+, which minimises zeta^T W zeta:
+            a large weight keeps that DoF out of the task (e.g. an unactuated vehicle roll).
+            1 (default) = the Moore-Penrose pseudo-inverse of eq. (9).
+    """
+
+    k_x: ArrayLike = 0.2
+    k_zeta: ArrayLike = 5.0
+    rho0_x: ArrayLike = (1.0, 1.0, 1.0, 0.9, 0.9, 0.9)
+    rho_inf_x: ArrayLike = 0.2
+    l_x_per_s: ArrayLike = 3.0
+    rho0_zeta: ArrayLike = 1.0
+    rho_inf_zeta: ArrayLike | None = None
+    l_zeta_per_s: ArrayLike = 2.2
+    desired_rpy: ArrayLike = (0.0, 0.0, 0.0)
+    null_space_gain_per_s: float = 0.0
+    pinv_relative_cutoff: float = 1e-12
+    velocity_weights: ArrayLike = 1.0
+    null_space_target: ArrayLike | None = None
+
+    @classmethod
+    def for_uvms(cls, n_joints: int, **overrides) -> PPCParams:
+        """The paper's parameters sized for a vehicle with ``n_joints`` arm DoFs.
+
+        ``overrides`` replace fields before sizing (e.g. ``k_zeta=2.0``).
+        """
+        if int(n_joints) != n_joints or n_joints < 0:
+            raise ParameterError(f"n_joints must be a non-negative integer, got {n_joints}")
+        return cls(**overrides).sized(_N_VEHICLE + int(n_joints))
+
+    def sized(self, nv: int) -> PPCParams:
+        """A copy whose array fields have 6 (first level) or ``nv`` (second level) entries.
+
+        Raises:
+            ParameterError: a field has the wrong size or a non-finite value, a gain is
+                not > 0, or ``null_space_gain_per_s`` / ``pinv_relative_cutoff`` < 0.
+        """
+        nv = int(nv)
+        if nv < _N_VEHICLE:
+            raise ParameterError(f"nv = {nv}: a UVMS has at least the 6 vehicle velocities")
+        rho_inf_zeta = self.rho_inf_zeta
+        if rho_inf_zeta is None:
+            rho_inf_zeta = np.r_[np.full(_N_VEHICLE, 0.2), np.full(nv - _N_VEHICLE, 0.4)]
+        sized = {
+            "k_x": _vector("k_x", self.k_x, 6),
+            "rho0_x": _vector("rho0_x", self.rho0_x, 6),
+            "rho_inf_x": _vector("rho_inf_x", self.rho_inf_x, 6),
+            "l_x_per_s": _vector("l_x_per_s", self.l_x_per_s, 6),
+            "desired_rpy": _vector("desired_rpy", self.desired_rpy, 3),
+            "k_zeta": _vector("k_zeta", self.k_zeta, nv),
+            "rho0_zeta": _vector("rho0_zeta", self.rho0_zeta, nv),
+            "rho_inf_zeta": _vector("rho_inf_zeta", rho_inf_zeta, nv),
+            "l_zeta_per_s": _vector("l_zeta_per_s", self.l_zeta_per_s, nv),
+            "velocity_weights": _vector("velocity_weights", self.velocity_weights, nv),
+        }
+        if self.null_space_target is not None:
+            sized["null_space_target"] = _vector(
+                "null_space_target", self.null_space_target, nv - _N_VEHICLE
+            )
+        for name in ("k_x", "k_zeta", "velocity_weights"):
+            bad = np.flatnonzero(~(sized[name] > 0.0))
+            if bad.size:
+                raise ParameterError(
+                    f"{name} must be > 0 (the law already has the minus sign; the paper's "
+                    f"printed negative gains are an erratum), got {sized[name][bad]} at "
+                    f"indices {bad.tolist()}"
+                )
+        for name in ("null_space_gain_per_s", "pinv_relative_cutoff"):
+            value = float(getattr(self, name))
+            if not (np.isfinite(value) and value >= 0.0):
+                raise ParameterError(f"{name} must be finite and >= 0, got {value}")
+        return dataclasses.replace(self, **sized)
+
+
+def _vector(name: str, value: ArrayLike, size: int) -> np.ndarray:
+    array = np.asarray(value, dtype=float)
+    if array.ndim == 0:
+        array = np.full(size, float(array))
+    if array.shape != (size,):
+        raise ParameterError(f"{name} must be a scalar or have {size} entries, got {array.shape}")
+    if not np.all(np.isfinite(array)):
+        raise ParameterError(f"{name} has non-finite entries: {array}")
+    array = array.copy()
+    array.flags.writeable = False
+    return array
+
+
+@dataclass(frozen=True, eq=False)
+class PPCSignals:
+    """Internal signals of one :meth:`PrescribedPerformanceController.compute` call.
+
+    First level (6,): ``e_x`` [N (3); rad (3)], ``rho_x`` (same units), ``xi_x``, ``eps_x``,
+    ``xdot_r`` [m/s (3); rad/s (3)]. Second level (nv,): ``zeta_r`` and ``e_zeta``
+    [m/s, rad/s], ``rho_zeta``, ``xi_zeta``, ``eps_zeta``, ``tau`` [N, N m].
+    """
+
+    time_s: float
+    force_desired_world_N: np.ndarray
+    rpy_desired: np.ndarray
+    rpy_ee: np.ndarray
+    e_x: np.ndarray
+    rho_x: np.ndarray
+    xi_x: np.ndarray
+    eps_x: np.ndarray
+    xdot_r: np.ndarray
+    zeta_r: np.ndarray
+    e_zeta: np.ndarray
+    rho_zeta: np.ndarray
+    xi_zeta: np.ndarray
+    eps_zeta: np.ndarray
+    tau: np.ndarray
+
+
+def _as_function(value, name: str, size: int) -> Callable[[float], np.ndarray]:
+    """Wrap a constant into a function of time; check a callable's output when called."""
+    if callable(value):
+
+        def evaluate(time_s: float) -> np.ndarray:
+            out = np.asarray(value(time_s), dtype=float)
+            if out.shape == (size,) and math.isfinite(sum(out.tolist())):
+                return out  # the exact check below also admits sums beyond 1e308
+            if out.shape != (size,) or not np.all(np.isfinite(out)):
+                raise ParameterError(
+                    f"{name}({time_s}) must return {size} finite values, got {out!r}"
+                )
+            return out
+
+        return evaluate
+    constant = _vector(name, value, size)
+    return lambda time_s: constant
+
+
+def _as_slice(index: np.ndarray) -> slice | np.ndarray:
+    """``index`` as a slice if it is a contiguous increasing range (cheaper to index)."""
+    if index.size and np.array_equal(index, np.arange(index[0], index[0] + index.size)):
+        return slice(int(index[0]), int(index[0]) + index.size)
+    return index
+
+
+def _first_level_error(
+    wrench_world: np.ndarray,
+    force_desired: np.ndarray,
+    rpy_ee: np.ndarray,
+    rpy_desired: np.ndarray,
+) -> list[float]:
+    """e_x (6 floats) = [f_meas - f_d (3) N; wrap(rpy_ee - rpy_d) (3) rad].
+
+    e_f = f_e + Delta f_e - f_d; e_o = rpy - rpy_d as in the paper, wrapped to [-pi, pi) so
+    that a roll or yaw crossing +-pi (where matrixToRpy jumps by 2 pi) is not read as a huge
+    error. Scalar ``math`` on 3 + 3 floats (Python's float % is numpy's mod).
+    """
+    f, fd = wrench_world.tolist(), force_desired.tolist()
+    r, rd = rpy_ee.tolist(), rpy_desired.tolist()
+    return [
+        f[0] - fd[0],
+        f[1] - fd[1],
+        f[2] - fd[2],
+        (r[0] - rd[0] + math.pi) % _TWO_PI - math.pi,
+        (r[1] - rd[1] + math.pi) % _TWO_PI - math.pi,
+        (r[2] - rd[2] + math.pi) % _TWO_PI - math.pi,
+    ]
+
+
+class PrescribedPerformanceController(Controller):
+    """The paper's two-level prescribed-performance force/orientation controller.
+
+    Args:
+        model: the UVMS kinematic model: Pinocchio model whose joint 1 is the vehicle's
+            free-flyer root; any number nv - 6 of arm DoFs. Only frame placements and
+            Jacobians are used (a private copy is kept).
+        ee_frame_name: name of the end-effector frame whose Euler angles are controlled.
+        params: gains and funnels; scalars broadcast. Default: the paper's values.
+        desired_force_world_N: f_d(t), the force [N] the end-effector should exert on the
+            environment in world axes: a function of time [s] returning (3,), or a
+            constant. Default zero.
+        desired_rpy: desired end-effector Euler angles (roll, pitch, yaw) [rad], a
+            function of time or a constant. Default ``params.desired_rpy``.
+        backend: ``"core"`` (default): the compiled law (``src/uvms_core/ppc.hpp``) with
+            this Python code as its fallback on every call it declines; ``"python"``: this
+            code only, the reference. Both give the same tau to ~1e-13 and raise the same
+            errors (tests/controllers/test_ppc_core.py).
+
+    The measured force is ``measurement.wrench_world[:3]`` (sensor noise included, the
+    paper's f_e + Delta f_e).
+
+    Attributes:
+        performance_x: first-level funnels rho_x(t) (6 components).
+        performance_zeta: second-level funnels rho_zeta(t) (nv components).
+        first_level_names, second_level_names: component names used in errors and logs.
+        last_signals: :class:`PPCSignals` of the last successful ``compute`` (None before).
+
+    Raises:
+        ParameterError: unknown frame (the message lists the frames), root joint not a
+            free-flyer, or invalid parameters.
+    """
+
+    def __init__(
+        self,
+        model: pin.Model,
+        ee_frame_name: str,
+        params: PPCParams | None = None,
+        desired_force_world_N: Callable[[float], ArrayLike] | ArrayLike = (0.0, 0.0, 0.0),
+        desired_rpy: Callable[[float], ArrayLike] | ArrayLike | None = None,
+        *,
+        backend: str = "core",
+    ):
+        self.backend = check_backend(backend)
+        if model.njoints < 2 or model.joints[1].shortname() != "JointModelFreeFlyer":
+            raise ParameterError(
+                "the UVMS model must have a free-flyer root joint (joint 1); build it with "
+                "pin.buildModelFromUrdf(path, pin.JointModelFreeFlyer())"
+            )
+        self.model = pin.Model(model)  # private copy: later edits of `model` do not leak in
+        self.data = self.model.createData()
+        self.ee_frame_name = ee_frame_name
+        self.ee_frame_id = frame_id_from_name(self.model, ee_frame_name)
+        self.params = (params if params is not None else PPCParams()).sized(self.model.nv)
+        self._desired_force = _as_function(desired_force_world_N, "desired_force_world_N", 3)
+        self._desired_rpy = _as_function(
+            self.params.desired_rpy if desired_rpy is None else desired_rpy, "desired_rpy", 3
+        )
+
+        self.first_level_names = FIRST_LEVEL_NAMES
+        self.second_level_names = VEHICLE_VELOCITY_NAMES + tuple(self._arm_velocity_names())
+        self.performance_x = PerformanceFunction(
+            self.params.rho0_x, self.params.rho_inf_x, self.params.l_x_per_s, self.first_level_names
+        )
+        self.performance_zeta = PerformanceFunction(
+            self.params.rho0_zeta,
+            self.params.rho_inf_zeta,
+            self.params.l_zeta_per_s,
+            self.second_level_names,
+        )
+        self._limited_q_index, self._limited_v_index, self._mid, self._half_range = (
+            self._joint_limits()
+        )
+        self._target = self._mid
+        if self.params.null_space_target is not None:
+            self._target = self.params.null_space_target[self._limited_v_index - _N_VEHICLE]
+        self._extend_beyond_funnels = False
+        self._margin = np.inf
+        weighted = np.any(self.params.velocity_weights != 1.0)
+        self._weights = self.params.velocity_weights if weighted else None
+
+        # ---- constants of the fast evaluation (see the module docstring)
+        # both levels' funnels in one vector: rho = [rho_x (6); rho_zeta (nv)]
+        self._performance_both = PerformanceFunction(
+            np.r_[self.performance_x.rho0, self.performance_zeta.rho0],
+            np.r_[self.performance_x.rho_inf, self.performance_zeta.rho_inf],
+            np.r_[self.performance_x.decay_rate_per_s, self.performance_zeta.decay_rate_per_s],
+            self.first_level_names + self.second_level_names,
+        )
+        # -k_x eps = (-2 k_x) artanh(xi) and -k r eps / rho = (-4 k) artanh(xi) / ((1 - xi^2) rho)
+        self._neg_two_k_x = (-2.0 * self.params.k_x).tolist()
+        self._neg_four_k_zeta = -4.0 * self.params.k_zeta
+        self._solver = MinimumNormSolver(self._weights, self.params.pinv_relative_cutoff)
+        self._nq, self._nv = self.model.nq, self.model.nv
+        # zeta_0 = (q - q_0) (-k_0 / h) on the limited joints, indexed by slices when they
+        # are contiguous (the usual arm); None when there is no secondary task
+        gain = float(self.params.null_space_gain_per_s)
+        self._null_space_scale = (
+            -gain / self._half_range if gain > 0.0 and self._limited_q_index.size else None
+        )
+        self._limited_q = _as_slice(self._limited_q_index)
+        self._limited_v = _as_slice(self._limited_v_index)
+        # the last successful call's raw signals, and the PPCSignals built from them on demand
+        # (_last is None when they are the compiled kernel's, see _core_last)
+        self._last: tuple | None = None
+        self._last_signals: PPCSignals | None = None
+        self._core_last: tuple | None = None
+        self._kernel = self._build_kernel() if self.backend == "core" else None
+
+    def _build_kernel(self):
+        """The compiled law (src/uvms_core/ppc.hpp) with this controller's constants, and
+        read-only views of its packed signals (those of its last ok call)."""
+        params, solver = self.params, self._solver
+        kernel = core_module().PrescribedPerformanceController(
+            self.model.saveToString(),
+            self.ee_frame_id,
+            params.k_x,
+            params.rho0_x,
+            params.rho_inf_x,
+            params.l_x_per_s,
+            params.k_zeta,
+            self.performance_zeta.rho0,
+            self.performance_zeta.rho_inf,
+            self.performance_zeta.decay_rate_per_s,
+            params.velocity_weights,
+            float(params.null_space_gain_per_s),
+            self._limited_q_index.tolist(),
+            self._limited_v_index.tolist(),
+            np.asarray(self._target, dtype=float),
+            self._half_range,
+            solver.max_condition_bound,
+            REFINE_ABOVE_CONDITION_BOUND,
+            _XI_CLAMP,
+            EULER_SINGULARITY_MIN_ABS_COS_PITCH,
+        )
+        packed, nv = kernel.signals(), self._nv
+        zeta = [packed[kernel.zeta_offset(k) : kernel.zeta_offset(k) + nv] for k in range(5)]
+        self._core_signals = (packed[0:3], packed[3:9], packed[9:15], packed[15:21],
+                              packed[21:27], *zeta)  # fmt: skip
+        self._core_tau = zeta[4]
+        self._core_margin = packed[kernel.margin_offset() :]
+        return kernel
+
+    _KERNEL_ATTRIBUTES = ("_kernel", "_core_signals", "_core_tau", "_core_margin")
+
+    def __getstate__(self) -> dict:
+        """For copy and pickle: the compiled kernel is rebuilt, the last signals kept."""
+        self.last_signals  # noqa: B018 - builds the PPCSignals (from the kernel's buffers)
+        state = {k: v for k, v in self.__dict__.items() if k not in self._KERNEL_ATTRIBUTES}
+        state["_margin"] = self.funnel_margin()
+        state["_core_last"] = None
+        return state
+
+    def __setstate__(self, state: dict) -> None:
+        self.__dict__.update(state)
+        self._kernel = self._build_kernel() if self.backend == "core" else None
+
+    # ------------------------------------------------------------------ model helpers
+    def _arm_velocity_names(self) -> list[str]:
+        names = []
+        for joint_id in range(2, self.model.njoints):
+            joint, name = self.model.joints[joint_id], self.model.names[joint_id]
+            names += [name] if joint.nv == 1 else [f"{name}[{k}]" for k in range(joint.nv)]
+        return names
+
+    def _joint_limits(self):
+        """Arm DoFs with one position coordinate per velocity and finite limits."""
+        q_index, v_index, mid, half_range = [], [], [], []
+        for joint_id in range(2, self.model.njoints):
+            joint = self.model.joints[joint_id]
+            if joint.nq != 1 or joint.nv != 1:
+                continue  # e.g. continuous joints (cos, sin): no position limits
+            lower = float(self.model.lowerPositionLimit[joint.idx_q])
+            upper = float(self.model.upperPositionLimit[joint.idx_q])
+            if max(abs(lower), abs(upper)) >= _NO_LIMIT_THRESHOLD or not upper > lower:
+                continue
+            q_index.append(joint.idx_q)
+            v_index.append(joint.idx_v)
+            mid.append(0.5 * (upper + lower))
+            half_range.append(0.5 * (upper - lower))
+        return (np.array(q_index, int), np.array(v_index, int), np.array(mid), np.array(half_range))
+
+    def null_space_velocity(self, q: np.ndarray) -> np.ndarray:
+        """Secondary-task velocity zeta_0 (nv,) for joint-limit avoidance.
+
+        zeta_0 = -k_0 grad H(q) with H(q) = sum_j (q_j - q_0j)^2 / (2 h_j), h_j the
+        half-range of arm joint j and q_0 the target (mid-range by default), so
+        zeta_0_j = -k_0 (q_j - q_0j) / h_j [rad/s]: each limited arm joint is pushed toward
+        its target. It is zero on the 6 vehicle DoFs and on joints without (finite)
+        position limits. Projected on the null space of J it moves the vehicle and the arm
+        together without moving the end-effector: the vehicle slowly takes over what the
+        arm is holding.
+        """
+        zeta_0 = np.zeros(self._nv)
+        if self._null_space_scale is not None:
+            offset = np.asarray(q)[self._limited_q] - self._target
+            zeta_0[self._limited_v] = offset * self._null_space_scale
+        return zeta_0
+
+    # ------------------------------------------------------------------ the law
+    def _check_measurement(self, measurement: Measurement) -> tuple[np.ndarray, ...]:
+        q = np.asarray(measurement.q, dtype=float)
+        v = np.asarray(measurement.v, dtype=float)
+        wrench = np.asarray(measurement.wrench_world, dtype=float)
+        if (
+            q.shape == (self._nq,)
+            and v.shape == (self._nv,)
+            and wrench.shape == (6,)
+            # one finiteness test for all three: a sum is NaN or inf if any entry is (Python
+            # floats: no overflow warning); the exact check below admits sums beyond 1e308
+            and math.isfinite(sum(q.tolist()) + sum(v.tolist()) + sum(wrench.tolist()))
+        ):
+            return q, v, wrench
+        for label, array, size in (
+            ("q", q, self._nq),
+            ("v", v, self._nv),
+            ("wrench_world", wrench, 6),
+        ):
+            if array.shape != (size,):
+                raise ParameterError(
+                    f"measurement.{label} must have shape ({size},), got {array.shape}"
+                )
+            if not np.all(np.isfinite(array)):
+                raise ParameterError(f"measurement.{label} has non-finite entries: {array}")
+        return q, v, wrench
+
+    def compute(self, time_s: float, measurement: Measurement) -> np.ndarray:
+        """tau (nv,) [N, N m]: body wrench on the vehicle, then arm joint torques.
+
+        A pure function of ``(time_s, measurement)`` (``time_s`` is the funnels' time,
+        t = 0 at the start of the run); only ``last_signals`` is updated.
+
+        With ``backend="core"`` the compiled kernel evaluates the law; every call it does not
+        return as ok (a funnel left, the solver declining, the Euler singularity, a malformed
+        or non-finite input) is evaluated by the Python reference below, which raises, or
+        takes the SVD route or the funnel extension, exactly as with ``backend="python"``.
+
+        Raises:
+            FunnelViolation: a first-level (``level="first"``) or second-level
+                (``level="second"``) error reached its bound, |xi| >= 1.
+            ParameterError: malformed measurement, or the end-effector at the Euler
+                singularity (pitch = +-90 deg).
+        """
+        kernel = self._kernel
+        time_s = float(time_s)
+        if kernel is None:
+            return self._compute_reference(time_s, measurement)
+        try:
+            force_desired = self._desired_force(time_s)
+            rpy_desired = self._desired_rpy(time_s)
+        except Exception:
+            self._check_measurement(measurement)  # the reference checks the measurement first
+            raise
+        extended = self._extend_beyond_funnels
+        try:
+            status = kernel.compute(
+                time_s,
+                measurement.q,
+                measurement.v,
+                measurement.wrench_world,
+                force_desired,
+                rpy_desired,
+                extended,
+            )
+        except TypeError:  # not convertible to 1-D float arrays: the reference says why
+            status = -1
+        if status:
+            return self._compute_reference(time_s, measurement, force_desired, rpy_desired)
+        self._core_last = (time_s, force_desired, rpy_desired, extended)
+        self._last = None
+        self._last_signals = None
+        self._margin = None
+        return self._core_tau.copy()
+
+    def _compute_reference(
+        self,
+        time_s: float,
+        measurement: Measurement,
+        force_desired: np.ndarray | None = None,
+        rpy_desired: np.ndarray | None = None,
+    ) -> np.ndarray:
+        """The Python evaluation of :meth:`compute` (``backend="python"``, and the calls the
+        compiled kernel declines); f_d(t) and rpy_d(t) are evaluated here unless given."""
+        q, v, wrench_world = self._check_measurement(measurement)
+        extended = self._extend_beyond_funnels
+
+        # ---- first level: force and orientation errors, eq. (8)-(12)
+        if force_desired is None:
+            force_desired = self._desired_force(time_s)
+            rpy_desired = self._desired_rpy(time_s)
+        rotation, jacobian_lwa = frame_rotation_and_jacobian(
+            self.model, self.data, q, self.ee_frame_id
+        )
+        rpy_ee = pin.rpy.matrixToRpy(rotation)
+        e_x = _first_level_error(wrench_world, force_desired, rpy_ee, rpy_desired)
+        rho = self._performance_both.value(time_s)
+        rho_x, rho_zeta = rho[:6], rho[6:]
+        # eq. (13), erratum: k_x > 0 (the paper's simulation prints -0.2). The force rows
+        # are end-effector linear velocities [m/s]: with f_e = K_f (p - p0), K_f > 0, a
+        # force above the desired one (e_f > 0) asks the end-effector to back off.
+        # Six components: Python floats (-k_x eps = -2 k_x artanh(xi)).
+        xi_x = [e / r for e, r in zip(e_x, rho_x.tolist(), strict=True)]
+        max_xi_x = max_abs(xi_x)
+        if max_xi_x < (_XI_CLAMP if extended else 1.0):
+            xdot_r = [k * math.atanh(x) for k, x in zip(self._neg_two_k_x, xi_x, strict=True)]
+        else:  # outside (raises), or beyond the clamp of the funnel extension
+            e_x = np.array(e_x)
+            xi_x = self._normalize("first", self.first_level_names, time_s, e_x, rho_x)
+            xdot_r = (-self.params.k_x * transformed_error_extended(xi_x, _XI_CLAMP)).tolist()
+        check_euler_singularity(self.model, self.ee_frame_id, rpy_ee)
+
+        # ---- task space -> generalized velocities, eq. (9) (+ the remark's null space)
+        zeta_r = self._reference_velocity(q, rpy_ee, jacobian_lwa, xdot_r)
+
+        # ---- second level, eq. (14)-(19); erratum: rho_v == rho_zeta, P == P_zeta
+        e_zeta = v - zeta_r
+        xi_zeta = e_zeta / rho_zeta
+        max_xi_zeta = max_abs(xi_zeta)
+        # eq. (19), erratum: K_zeta > 0 (the paper's simulation prints k_v = -5).
+        if max_xi_zeta < (_XI_CLAMP if extended else 1.0):
+            # -K_zeta P^-1 r(xi) eps(xi) with r eps = 4 artanh(xi) / (1 - xi^2), and
+            # (1 - xi^2) rho = rho - xi e
+            tau = self._neg_four_k_zeta * np.arctanh(xi_zeta) / (rho_zeta - xi_zeta * e_zeta)
+        else:
+            xi_zeta = self._normalize("second", self.second_level_names, time_s, e_zeta, rho_zeta)
+            tau = -self.params.k_zeta * barrier_extended(xi_zeta, _XI_CLAMP) / rho_zeta
+        # min(1 - |xi|) = 1 - max |xi| exactly (1 - x rounds monotonically)
+        self._margin = 1.0 - max(max_xi_x, max_xi_zeta)
+        self._last = (
+            time_s,
+            force_desired,
+            rpy_desired,
+            rpy_ee,
+            e_x,
+            rho_x,
+            xi_x,
+            xdot_r,
+            zeta_r,
+            e_zeta,
+            rho_zeta,
+            xi_zeta,
+            tau.copy(),
+            extended,
+        )
+        self._core_last = None
+        self._last_signals = None
+        return tau
+
+    def _reference_velocity(
+        self, q: np.ndarray, rpy_ee: np.ndarray, jacobian_lwa: np.ndarray, xdot_r: list[float]
+    ) -> np.ndarray:
+        """zeta_r = J^# xdot_r + (I - J^# J) zeta_0 (nv,) [m/s, rad/s].
+
+        With J = diag(I, E^-1) J^lwa of full row rank, J^# xdot_r = (J^lwa)^# b with
+        b = [xdot_p; E xdot_o], and zeta_0 + J^# (xdot_r - J zeta_0) = zeta_0 + (J^lwa)^#
+        (b - J^lwa zeta_0). The exact SVD route on J itself when the solver declines.
+        """
+        b = np.array([*xdot_r[:3], *angular_velocity_world_from_euler_rates(rpy_ee, xdot_r[3:])])
+        if self._null_space_scale is not None:
+            zeta_0 = self.null_space_velocity(q)
+            solution = self._solver.solve(jacobian_lwa, b - np.dot(jacobian_lwa, zeta_0))
+            if solution is not None:
+                return solution + zeta_0
+        else:
+            zeta_0 = None
+            solution = self._solver.solve(jacobian_lwa, b)
+            if solution is not None:
+                return solution
+        jacobian = analytical_jacobian(self.model, self.data, q, self.ee_frame_id)
+        jacobian_pinv = pseudo_inverse(jacobian, self.params.pinv_relative_cutoff, self._weights)
+        zeta_r = jacobian_pinv @ np.array(xdot_r)
+        if zeta_0 is not None:
+            zeta_r = zeta_r + zeta_0 - jacobian_pinv @ (jacobian @ zeta_0)
+        return zeta_r
+
+    def _normalize(self, level, names, time_s, error, bound) -> np.ndarray:
+        """xi = e / rho; raises FunnelViolation at |xi| >= 1 unless the extension is on."""
+        if self._extend_beyond_funnels:
+            xi = normalized_error(error, bound)
+            if not np.all(np.isfinite(xi)):
+                check_funnel(level=level, names=names, time_s=time_s, error=error, bound=bound)
+            return xi
+        return check_funnel(level=level, names=names, time_s=time_s, error=error, bound=bound)
+
+    @property
+    def last_signals(self) -> PPCSignals | None:
+        """:class:`PPCSignals` of the last successful ``compute`` (None before one)."""
+        if self._last_signals is not None:
+            return self._last_signals
+        if self._core_last is not None:  # copies: the kernel's buffer is rewritten
+            time_s, force_desired, rpy_desired, extended = self._core_last
+            (rpy_ee, e_x, rho_x, xi_x, xdot_r, zeta_r, e_zeta, rho_zeta, xi_zeta,
+             tau) = (a.copy() for a in self._core_signals)  # fmt: skip
+        elif self._last is not None:
+            (time_s, force_desired, rpy_desired, rpy_ee, e_x, rho_x, xi_x, xdot_r, zeta_r,
+             e_zeta, rho_zeta, xi_zeta, tau, extended) = self._last  # fmt: skip
+        else:
+            return None
+        transform = (
+            (lambda xi: transformed_error_extended(xi, _XI_CLAMP))
+            if extended
+            else transformed_error
+        )
+        self._last_signals = PPCSignals(
+            time_s=time_s,
+            force_desired_world_N=force_desired,
+            rpy_desired=rpy_desired,
+            rpy_ee=rpy_ee,
+            e_x=np.array(e_x),
+            rho_x=rho_x,
+            xi_x=np.array(xi_x),
+            eps_x=transform(np.array(xi_x)),
+            xdot_r=np.array(xdot_r),
+            zeta_r=zeta_r,
+            e_zeta=e_zeta,
+            rho_zeta=rho_zeta,
+            xi_zeta=xi_zeta,
+            eps_zeta=transform(xi_zeta),
+            tau=tau,
+        )
+        return self._last_signals
+
+    def desired_force_world_N(self, time_s: float) -> np.ndarray:
+        """f_d(t) (3,) [N], world axes: the force this controller tracks."""
+        return np.asarray(self._desired_force(time_s), dtype=float)
+
+    def funnel_margin(self) -> float:
+        """min(1 - |xi|) over both levels at the last ``compute`` (> 0: inside)."""
+        margin = self._margin
+        return float(self._core_margin[0]) if margin is None else margin
+
+    def set_funnel_extension(self, enabled: bool) -> None:
+        self._extend_beyond_funnels = bool(enabled)
+
+    def reset(self) -> None:
+        """Forget the logged signals (the law itself has no state)."""
+        self._last = None
+        self._core_last = None
+        self._last_signals = None
+        self._margin = np.inf
+
+    def signals(self) -> dict[str, np.ndarray]:
+        """The last call's internal signals as arrays, for logging (empty before a call)."""
+        signals = self.last_signals
+        if signals is None:
+            return {}
+        return {
+            f.name: np.atleast_1d(getattr(signals, f.name))
+            for f in dataclasses.fields(signals)
+            if f.name != "time_s"
+        }

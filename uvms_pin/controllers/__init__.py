@@ -1,5 +1,0 @@
-"""Controllers: one small interface (`Controller`), one file per law."""
-
-from uvms_pin.controllers.base import Controller, ZeroController
-
-__all__ = ["Controller", "ZeroController"]

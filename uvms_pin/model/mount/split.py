@@ -1,0 +1,90 @@
+"""Split a UVMS URDF into a vehicle URDF and an arm URDF (the inverse of `mount_arm`).
+
+Used to mount other arms on the reference vehicle (the LBV150 without its arm) and to check
+that mounting the reference arm back gives the reference model.
+"""
+
+from __future__ import annotations
+
+import copy
+import xml.etree.ElementTree as ET
+from dataclasses import dataclass
+from pathlib import Path
+
+import pinocchio as pin
+
+from uvms_pin.errors import ModelError
+from uvms_pin.model.mount.mount import _origin_of, _Tree, write_text_atomic
+
+__all__ = ["SplitURDF", "split_urdf"]
+
+#: The reference model's first arm joint.
+REFERENCE_FIRST_ARM_JOINT = "arm_joint1"
+ARM_MOUNT_LINK = "arm_mount"
+
+
+@dataclass(frozen=True)
+class SplitURDF:
+    """Paths of the two files and the arm's mount pose in the vehicle link."""
+
+    vehicle_urdf: Path
+    arm_urdf: Path
+    vehicle_link: str
+    mount_pose: pin.SE3
+
+
+def split_urdf(
+    urdf: str | Path,
+    out_dir: str | Path,
+    first_arm_joint: str = REFERENCE_FIRST_ARM_JOINT,
+) -> SplitURDF:
+    """Write ``vehicle.urdf`` (everything but the arm) and ``arm.urdf`` into ``out_dir``.
+
+    The arm file's root is an empty link ``arm_mount`` at the first arm joint's origin, so
+    mounting it at ``mount_pose`` rebuilds the same kinematics. Top-level ``<hydrodynamics
+    link=...>`` elements follow their link. Mesh paths are made absolute.
+    """
+    path = Path(urdf)
+    tree = _Tree.read(path)
+    if first_arm_joint not in tree.joints:
+        raise ModelError(f"joint '{first_arm_joint}' not found", path=str(path))
+    joint = tree.joints[first_arm_joint]
+    vehicle_link = joint.find("parent").get("link")
+    arm_links = set(tree.subtree(tree.child_of(first_arm_joint)))
+    mount = _origin_of(joint, path)
+
+    vehicle = ET.Element("robot", {"name": tree.root.get("name", "robot") + "_vehicle"})
+    arm = ET.Element("robot", {"name": tree.root.get("name", "robot") + "_arm"})
+    ET.SubElement(arm, "link", {"name": ARM_MOUNT_LINK})
+    for element in tree.root:
+        item = copy.deepcopy(element)
+        for mesh in item.iter("mesh"):
+            filename = mesh.get("filename", "")
+            if filename and "://" not in filename and not Path(filename).is_absolute():
+                mesh.set("filename", str((path.parent / filename).resolve()))
+        if element.tag == "link":
+            (arm if element.get("name") in arm_links else vehicle).append(item)
+        elif element.tag == "joint":
+            child = element.find("child").get("link")
+            if element.get("name") == first_arm_joint:
+                item.find("parent").set("link", ARM_MOUNT_LINK)
+                origin = item.find("origin")
+                if origin is not None:
+                    item.remove(origin)
+                arm.append(item)
+            else:
+                (arm if child in arm_links else vehicle).append(item)
+        elif element.tag == "hydrodynamics":
+            (arm if element.get("link") in arm_links else vehicle).append(item)
+        else:
+            vehicle.append(item)
+            if element.tag == "material":
+                arm.append(copy.deepcopy(element))
+    out = Path(out_dir)
+    vehicle_path, arm_path = out / "vehicle.urdf", out / "arm.urdf"
+    for root, target in ((vehicle, vehicle_path), (arm, arm_path)):
+        ET.indent(root, "  ")
+        write_text_atomic(
+            target, '<?xml version="1.0"?>\n' + ET.tostring(root, encoding="unicode") + "\n"
+        )
+    return SplitURDF(vehicle_path, arm_path, vehicle_link, mount)

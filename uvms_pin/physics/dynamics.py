@@ -1,0 +1,319 @@
+"""Underwater dynamics of a UVMS (docs/physics.md, after Schjolberg & Fossen 1994).
+
+    M(q) zeta_dot + h(q, zeta) = tau + tau_ext
+
+    M(q)      = M_RB(q) + sum_i J_i^T M_A,i J_i                    (added mass inside M)
+    h(q,zeta) = C_RB zeta + g_RB
+              - sum_i J_i^T [ -M_A,i (a_i^bias - nu_c_dot,i) - C_A,i(nu_r,i) nu_r,i
+                              - D_i(nu_r,i) nu_r,i + w_buoy,i ]
+
+with J_i the LOCAL body Jacobian of joint i, nu_r,i = nu_i - nu_c,i the current-relative
+body velocity and a_i^bias the body acceleration at zero joint acceleration. tau_ext is the
+generalized force of external wrenches (contact, disturbances): for a wrench w applied at a
+frame, tau_ext = J_frame^T w.
+
+Every function works in the UVMS's Pinocchio data buffer; none allocates a model.
+
+Two implementations: this module's Python code is the readable reference
+(``backend="python"``); the compiled core (`uvms_pin.physics.compiled`, ``backend="core"``, the default)
+computes the same quantities in one C++ call and is held to this reference by the tests.
+"""
+
+from __future__ import annotations
+
+import warnings
+
+import numpy as np
+import pinocchio as pin
+from scipy.linalg import cho_factor, cho_solve
+
+from uvms_pin.errors import ParameterError, SimulationError
+from uvms_pin.flow import FlowField, UniformCurrent
+from uvms_pin.hydro.added_mass import kirchhoff_wrench
+from uvms_pin.hydro.current import current_velocity_body, flow_twist_rate_body
+from uvms_pin.hydro.damping import damping_wrench
+from uvms_pin.hydro.restoring import (
+    buoyancy_potential_energy,
+    buoyancy_wrench,
+    froude_krylov_wrench,
+)
+from uvms_pin.hydro.vector import mat_t_vec, mat_vec
+from uvms_pin.model.uvms import UVMS
+from uvms_pin.physics.compiled import CoreFallbackWarning, check_backend, compiled_flow, dynamics_of
+
+_NO_CURRENT = np.zeros(3)
+
+
+def _check(name: str, x: np.ndarray, n: int) -> np.ndarray:
+    x = np.asarray(x, dtype=float)
+    if x.shape != (n,):
+        raise ParameterError(f"{name} must have shape ({n},), got {x.shape}")
+    if not np.all(np.isfinite(x)):
+        raise ParameterError(f"{name} contains a non-finite value: {x}")
+    return x
+
+
+def _resolve_flow(current_world: np.ndarray, flow: FlowField | None) -> FlowField | None:
+    """The flow a call asked for: ``current_world`` is the shorthand for a UniformCurrent."""
+    current = _check("current_world", current_world, 3)
+    if flow is not None:
+        if not isinstance(flow, FlowField):
+            raise ParameterError(
+                f"flow must be a uvms_pin.flow.FlowField, got {type(flow).__name__}"
+            )
+        if np.any(current):
+            raise ParameterError("give either current_world or flow, not both (add the fields)")
+        return flow
+    return UniformCurrent(current) if np.any(current) else None
+
+
+def _warn_python_flow(flow: FlowField) -> None:
+    warnings.warn(
+        f"the compiled core does not support the flow {flow!r}: the Python reference "
+        "computes these dynamics (slower)",
+        CoreFallbackWarning,
+        stacklevel=3,
+    )
+
+
+def _check_time(time_s: float) -> float:
+    time_s = float(time_s)
+    if not np.isfinite(time_s):
+        raise ParameterError(f"time_s must be finite, got {time_s}")
+    return time_s
+
+
+def _fluid_wrenches(uvms: UVMS, flow: FlowField | None, time_s: float) -> list[pin.Force]:
+    """Wrench of the water on each joint body (LOCAL frame), all terms but M_A zeta_dot.
+
+    Needs ``forwardKinematics(model, data, q, v, 0)`` in ``uvms.data`` (placements, body
+    velocities and bias accelerations). The flow is sampled at each joint body's centre of
+    buoyancy (its origin if it has no volume) for added mass and Froude-Krylov, and at each
+    damped link's origin for damping. Vectorized over bodies: the per-body physics is the
+    pure functions of `uvms_pin.hydro`, called once on stacks.
+    """
+    model, data = uvms.model, uvms.data
+    nj = model.njoints
+    rotation = np.array([data.oMi[j].rotation for j in range(nj)])  # (nj, 3, 3)
+    velocity = np.array([data.v[j].vector for j in range(nj)])  # (nj, 6), LOCAL
+    wrench = np.zeros((nj, 6))
+    if flow is not None:
+        cob_world = np.array(
+            [data.oMi[j].act(uvms.center_of_buoyancy_per_joint_m[j]) for j in range(nj)]
+        )
+        flow_velocity_world, flow_acceleration_world = flow.velocity_and_acceleration(
+            time_s, cob_world
+        )
+
+    joints = list(uvms.joints_with_added_mass)
+    if joints:
+        nu = velocity[joints]
+        acc = np.array([data.a[j].vector for j in joints])
+        if flow is not None:
+            nu_c = current_velocity_body(rotation[joints], flow_velocity_world[joints])
+            acc = acc - flow_twist_rate_body(
+                rotation[joints], nu[:, 3:], nu_c[:, :3], flow_acceleration_world[joints]
+            )
+            nu = nu - nu_c
+        added = uvms.added_mass_per_joint[joints]
+        wrench[joints] -= mat_vec(added, acc) + kirchhoff_wrench(added, nu)
+
+    joints = list(uvms.joints_with_volume)
+    if joints:
+        volume, cob = uvms.volume_per_joint_m3[joints], uvms.center_of_buoyancy_per_joint_m[joints]
+        wrench[joints] += buoyancy_wrench(
+            volume, cob, rotation[joints], uvms.water_density_kg_m3, model.gravity.linear
+        )
+        if flow is not None:
+            wrench[joints] += froude_krylov_wrench(
+                volume,
+                cob,
+                rotation[joints],
+                uvms.water_density_kg_m3,
+                flow_acceleration_world[joints],
+            )
+
+    ids = uvms.damping_joint_ids
+    if ids.size:
+        nu_r = mat_vec(uvms.damping_action, velocity[ids])  # body velocity of each link
+        if flow is not None:
+            body_rotation = np.matmul(rotation[ids], uvms.damping_rotation_in_joint)
+            origin_world = np.einsum(
+                "kij,kj->ki", rotation[ids], uvms.damping_origin_in_joint_m
+            ) + np.array([data.oMi[int(j)].translation for j in ids])
+            nu_r = nu_r - current_velocity_body(body_rotation, flow.velocity(time_s, origin_world))
+        wrench_body = damping_wrench(uvms.damping_linear, uvms.damping_quadratic, nu_r)
+        # back to the joint frame: f_joint = X^T f_body
+        np.add.at(wrench, ids, mat_t_vec(uvms.damping_action, wrench_body))
+    return [pin.Force(w) for w in wrench]
+
+
+def _core_inputs(uvms: UVMS, **arrays) -> dict[str, np.ndarray]:
+    """The arguments as float arrays, or ParameterError naming the bad one (the core's
+    binding takes float arrays only: this runs only when it refused an argument)."""
+    sizes = {"q": uvms.nq, "current_world": 3}
+    return {
+        name: x if x is None else _check(name, x, sizes.get(name, uvms.nv))
+        for name, x in arrays.items()
+    }
+
+
+def mass_matrix(uvms: UVMS, q: np.ndarray, *, backend: str = "core") -> np.ndarray:
+    """M(q) = M_RB(q) + sum_i J_i^T M_A,i J_i (nv x nv, symmetric positive definite).
+
+    ``backend``: "core" (compiled, default) or "python" (the reference)."""
+    if backend == "core":
+        try:
+            return dynamics_of(uvms).mass_matrix(q)
+        except TypeError:
+            return dynamics_of(uvms).mass_matrix(**_core_inputs(uvms, q=q))
+    check_backend(backend)
+    q = _check("q", q, uvms.nq)
+    return _mass_matrix(uvms, q)
+
+
+def _mass_matrix(uvms: UVMS, q: np.ndarray) -> np.ndarray:
+    model, data = uvms.model, uvms.data
+    pin.crba(model, data, q)
+    mass = np.triu(data.M)
+    mass = mass + np.triu(mass, 1).T  # crba fills the upper triangle only
+    if uvms.joints_with_added_mass:
+        pin.computeJointJacobians(model, data, q)
+        for j in uvms.joints_with_added_mass:
+            jac = pin.getJointJacobian(model, data, j, pin.LOCAL)
+            mass += jac.T @ uvms.added_mass_per_joint[j] @ jac
+    return mass
+
+
+def bias_forces(
+    uvms: UVMS,
+    q: np.ndarray,
+    v: np.ndarray,
+    current_world: np.ndarray = _NO_CURRENT,
+    *,
+    flow: FlowField | None = None,
+    time_s: float = 0.0,
+    backend: str = "core",
+) -> np.ndarray:
+    """h(q, zeta): rigid Coriolis and gravity, added-mass bias and Coriolis, damping, buoyancy,
+    and, in an accelerating flow, the Froude-Krylov and added-mass loads of the flow.
+
+    Args:
+        q: configuration (nq,). v: generalized velocity zeta (nv,).
+        current_world: constant, uniform current velocity in the world frame [m/s]
+            (shorthand for ``flow=UniformCurrent(current_world)``).
+        flow: any `uvms_pin.flow.FlowField` (waves, sea states, varying currents).
+        time_s: the time at which the flow is evaluated [s].
+        backend: "core" (compiled, default) or "python" (the reference).
+    """
+    if backend == "core" and flow is not None:
+        spec = compiled_flow(_resolve_flow(current_world, flow))
+        if spec is not None:
+            return dynamics_of(uvms).bias_forces_in_waves(q, v, *spec, _check_time(time_s))
+        _warn_python_flow(flow)
+    elif backend == "core":
+        try:
+            return dynamics_of(uvms).bias_forces(q, v, current_world)
+        except TypeError:
+            args = _core_inputs(uvms, q=q, v=v, current_world=current_world)
+            return dynamics_of(uvms).bias_forces(**args)
+    check_backend(backend)
+    q = _check("q", q, uvms.nq)
+    v = _check("v", v, uvms.nv)
+    return _bias_forces(uvms, q, v, _resolve_flow(current_world, flow), _check_time(time_s))
+
+
+def _bias_forces(
+    uvms: UVMS, q: np.ndarray, v: np.ndarray, flow: FlowField | None, time_s: float
+) -> np.ndarray:
+    model, data = uvms.model, uvms.data
+    zero = np.zeros(model.nv)
+    pin.forwardKinematics(model, data, q, v, zero)
+    fext = _fluid_wrenches(uvms, flow, time_s)
+    # rnea(q, v, 0, fext) = C_RB v + g_RB - sum_i J_i^T fext_i
+    return pin.rnea(model, data, q, v, zero, fext).copy()
+
+
+def forward_dynamics(
+    uvms: UVMS,
+    q: np.ndarray,
+    v: np.ndarray,
+    tau: np.ndarray,
+    current_world: np.ndarray = _NO_CURRENT,
+    tau_ext: np.ndarray | None = None,
+    *,
+    flow: FlowField | None = None,
+    time_s: float = 0.0,
+    backend: str = "core",
+) -> np.ndarray:
+    """zeta_dot = M(q)^-1 (tau + tau_ext - h(q, zeta)), by a Cholesky solve (no inverse).
+
+    Args:
+        tau: generalized input (nv,): body wrench on the vehicle [N; N m], joint torques.
+        current_world: uniform constant current [m/s] (shorthand for a UniformCurrent).
+        tau_ext: generalized force of external wrenches (nv,), e.g. from
+            `frame_wrench_to_generalized`; None for none.
+        flow, time_s: a `uvms_pin.flow.FlowField` and the time it is evaluated at [s].
+        backend: "core" (compiled, default) or "python" (the reference).
+
+    Raises:
+        ParameterError: wrong shape or non-finite input.
+        SimulationError: M not positive definite (e.g. a degenerate model).
+    """
+    if backend == "core" and flow is not None:
+        spec = compiled_flow(_resolve_flow(current_world, flow))
+        if spec is not None:
+            return dynamics_of(uvms).forward_dynamics_in_waves(
+                q, v, tau, *spec, _check_time(time_s), tau_ext
+            )
+        _warn_python_flow(flow)
+    elif backend == "core":
+        try:
+            return dynamics_of(uvms).forward_dynamics(q, v, tau, current_world, tau_ext)
+        except TypeError:
+            args = _core_inputs(
+                uvms, q=q, v=v, tau=tau, current_world=current_world, tau_ext=tau_ext
+            )
+            return dynamics_of(uvms).forward_dynamics(**args)
+    check_backend(backend)
+    q = _check("q", q, uvms.nq)
+    v = _check("v", v, uvms.nv)
+    tau = _check("tau", tau, uvms.nv)
+    rhs = tau - _bias_forces(uvms, q, v, _resolve_flow(current_world, flow), _check_time(time_s))
+    if tau_ext is not None:
+        rhs += _check("tau_ext", tau_ext, uvms.nv)
+    mass = _mass_matrix(uvms, q)
+    try:
+        factor = cho_factor(mass, lower=False, check_finite=False)
+    except np.linalg.LinAlgError as exc:
+        raise SimulationError(f"mass matrix is not positive definite at q = {q}") from exc
+    return cho_solve(factor, rhs, check_finite=False)
+
+
+def frame_wrench_to_generalized(
+    uvms: UVMS, q: np.ndarray, frame_id: int, wrench_world_aligned: np.ndarray
+) -> np.ndarray:
+    """tau_ext = J^T w for a wrench at a frame origin, in world-aligned axes [N; N m]."""
+    model, data = uvms.model, uvms.data
+    jac = pin.computeFrameJacobian(model, data, q, frame_id, pin.LOCAL_WORLD_ALIGNED)
+    return jac.T @ wrench_world_aligned
+
+
+def kinetic_energy(uvms: UVMS, q: np.ndarray, v: np.ndarray, *, backend: str = "core") -> float:
+    """T = 1/2 zeta^T M(q) zeta [J], added mass (the entrained fluid) included."""
+    v = _check("v", v, uvms.nv)
+    return float(0.5 * v @ mass_matrix(uvms, q, backend=backend) @ v)
+
+
+def potential_energy(uvms: UVMS, q: np.ndarray) -> float:
+    """U = U_gravity + U_buoyancy [J] (zero at z = 0)."""
+    q = _check("q", q, uvms.nq)
+    model, data = uvms.model, uvms.data
+    pin.forwardKinematics(model, data, q)
+    energy = float(pin.computePotentialEnergy(model, data, q))
+    for j in uvms.joints_with_volume:
+        cob_world = data.oMi[j].act(uvms.center_of_buoyancy_per_joint_m[j])
+        energy += buoyancy_potential_energy(
+            uvms.volume_per_joint_m3[j], cob_world, uvms.water_density_kg_m3, model.gravity.linear
+        )
+    return energy

@@ -1,0 +1,139 @@
+"""Scalar summaries of a rollout (what `metrics.json` holds)."""
+
+from __future__ import annotations
+
+import math
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+if TYPE_CHECKING:
+    from uvms_pin.results.rollout_data import RolloutData
+
+
+def _rms(x: np.ndarray) -> float:
+    return float(np.sqrt(np.mean(np.square(x)))) if x.size else math.nan
+
+
+def compute_metrics(rollout: RolloutData) -> dict[str, float]:
+    """Metrics of any run: timing, energy, motion and effort.
+
+    Energy drift is max |E(t) - E(0)| / max(|E(0)|, K(0)) over the run (E = T + U), the
+    number an energy-conservation check looks at. Efforts: vehicle force = |tau[0:3]|,
+    vehicle torque = |tau[3:6]|, joint torques = max over joints of |tau_j|.
+    """
+    meta = rollout.metadata
+    out: dict[str, float] = {
+        "simulated_time_s": float(meta.get("simulated_time_s", math.nan)),
+        "wall_time_s": float(meta.get("wall_time_s", math.nan)),
+        "real_time_factor": float(meta.get("real_time_factor", math.nan)),
+        "n_samples": float(len(rollout)),
+    }
+    if len(rollout) == 0:
+        return out
+    kinetic = rollout.kinetic_energy_J
+    total = rollout.total_energy_J
+    scale = max(abs(total[0]), kinetic[0], 1e-12)
+    out.update(
+        kinetic_energy_initial_J=float(kinetic[0]),
+        kinetic_energy_final_J=float(kinetic[-1]),
+        energy_relative_drift_max=float(np.max(np.abs(total - total[0])) / scale),
+        energy_max_increase_J=float(np.max(np.diff(total))) if len(total) > 1 else 0.0,
+        vehicle_displacement_m=float(np.linalg.norm(rollout.q[-1, :3] - rollout.q[0, :3])),
+        vehicle_speed_final_m_s=float(np.linalg.norm(rollout.v[-1, :3])),
+        vehicle_angular_speed_final_rad_s=float(np.linalg.norm(rollout.v[-1, 3:6])),
+    )
+    force = np.linalg.norm(rollout.tau[:, :3], axis=1)
+    torque = np.linalg.norm(rollout.tau[:, 3:6], axis=1)
+    joints = np.abs(rollout.tau[:, 6:])
+    out.update(
+        vehicle_force_peak_N=float(force.max()),
+        vehicle_force_rms_N=_rms(force),
+        vehicle_torque_peak_Nm=float(torque.max()),
+        vehicle_torque_rms_Nm=_rms(torque),
+        joint_torque_peak_Nm=float(joints.max()) if joints.size else 0.0,
+        joint_torque_rms_Nm=_rms(joints),
+    )
+    out.update(force_tracking_metrics(rollout))
+    out.update(joint_limit_metrics(rollout))
+    return out
+
+
+def joint_limit_metrics(rollout: RolloutData) -> dict[str, float]:
+    """How far the arm went past its position limits [rad] (0: never), and the time share.
+
+    The simulator does not stop a joint at its limit (no hard stops are modelled), so a
+    controller that drives a joint past it shows up here, not as a crash.
+    """
+    meta = rollout.metadata
+    if "arm_position_lower_rad" not in meta or len(rollout) == 0 or rollout.q.shape[1] <= 7:
+        return {}
+    q = rollout.q[:, 7:]
+    lower = np.asarray(meta["arm_position_lower_rad"], dtype=float)
+    upper = np.asarray(meta["arm_position_upper_rad"], dtype=float)
+    excess = np.maximum(lower - q, 0.0) + np.maximum(q - upper, 0.0)
+    return {
+        "joint_limit_excess_max_rad": float(excess.max()),
+        "joint_limit_excess_time_fraction": float(np.mean(np.any(excess > 0.0, axis=1))),
+    }
+
+
+def transient_end_s(rollout: RolloutData, fraction: float = 0.05) -> float:
+    """First time the force funnels have decayed to within ``fraction`` of their final width:
+    rho(t) - rho_inf <= fraction (rho0 - rho_inf). NaN without a force funnel."""
+    rho = rollout.signals.get("rho_x")
+    if rho is None or len(rho) < 2:
+        return math.nan
+    rho_force = rho[:, 0]
+    span = rho_force[0] - rho_force[-1]
+    if span <= 0.0:
+        return float(rollout.time_s[0])
+    settled = np.flatnonzero(rho_force - rho_force[-1] <= fraction * span)
+    return float(rollout.time_s[settled[0]])
+
+
+def force_tracking_metrics(rollout: RolloutData) -> dict[str, float]:
+    """Force-control metrics from a run that logged the controller's signals.
+
+    Force error is the TRUE one, f_e - f_d (the sensor's noise excluded), per component;
+    "after transient" starts at `transient_end_s`. Overshoot: the largest error of the
+    opposite sign to the initial error, over every force component [N]. Funnel margin:
+    min over time and components of 1 - |xi| per level (> 0 means the funnel held).
+    """
+    signals = rollout.signals
+    if "force_desired_world_N" not in signals or len(rollout) == 0:
+        return {}
+    desired = signals["force_desired_world_N"]
+    error = rollout.wrench_contact_world[:, :3] - desired
+    norm = np.linalg.norm(error, axis=1)
+    t_transient = transient_end_s(rollout)
+    after = rollout.time_s >= t_transient
+    initial_sign = np.sign(error[0])
+    overshoot = np.where(initial_sign != 0.0, -initial_sign * error, np.abs(error))
+    out = {
+        "force_error_rms_N": _rms(norm),
+        "force_error_max_N": float(norm.max()),
+        "transient_end_s": t_transient,
+        "force_error_rms_after_transient_N": _rms(norm[after]),
+        "force_error_max_after_transient_N": float(norm[after].max())
+        if np.any(after)
+        else math.nan,
+        "force_overshoot_N": float(max(0.0, np.max(overshoot[1:]) if len(overshoot) > 1 else 0.0)),
+    }
+    for level, key in (("first", "xi_x"), ("second", "xi_zeta")):
+        if key in signals:
+            out[f"funnel_margin_min_{level}"] = float(np.min(1.0 - np.abs(signals[key])))
+    if "e_x" in signals:
+        out["orientation_error_final_rad"] = float(np.linalg.norm(signals["e_x"][-1, 3:6]))
+    commanded = signals.get("tau_commanded")
+    if commanded is not None:
+        out["commanded_vehicle_force_peak_N"] = float(
+            np.linalg.norm(commanded[:, :3], axis=1).max()
+        )
+        out["commanded_vehicle_torque_peak_Nm"] = float(
+            np.linalg.norm(commanded[:, 3:6], axis=1).max()
+        )
+        out["commanded_joint_torque_peak_Nm"] = (
+            float(np.abs(commanded[:, 6:]).max()) if commanded.shape[1] > 6 else 0.0
+        )
+    return out

@@ -1,0 +1,90 @@
+"""A simulation's result: preallocated arrays plus metadata; saves as .npz + JSON."""
+
+from __future__ import annotations
+
+import json
+import zipfile
+from pathlib import Path
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+from uvms_pin.errors import ParameterError
+from uvms_pin.results.atomic import atomic_write, json_text
+from uvms_pin.results.rollout_data import RolloutData
+
+if TYPE_CHECKING:
+    import pandas as pd
+    from matplotlib.figure import Figure
+
+ARRAY_FILE = "rollout.npz"
+META_FILE = "rollout.json"
+
+
+class Rollout(RolloutData):
+    """Logged trajectory of one run, with its views (metrics, pandas table, figures) and
+    its files (``rollout.npz`` + ``rollout.json``, saved and loaded).
+
+    Arrays have one row per logged sample (``len(time_s)``); ``signals`` holds extra
+    per-sample arrays (controller errors and funnels, ...) by name. ``metadata`` is
+    JSON-serialisable: seed, scenario parameters, package versions, status, wall time;
+    ``status`` reads how the run ended as a `RunStatus`.
+    """
+
+    def metrics(self) -> dict[str, float]:
+        """Scalar summary (see `uvms_pin.results.metrics.compute_metrics`)."""
+        from uvms_pin.results.metrics import compute_metrics
+
+        return compute_metrics(self)
+
+    def to_dataframe(self) -> pd.DataFrame:
+        """One row per sample, index ``time_s``, columns ``<array>.<component>_<unit>``
+        (e.g. ``q.vehicle.x_m``, ``v.arm_joint1_rad_s``, ``tau.vehicle.fx_N``,
+        ``wrench_contact_world.fx_N``, ``e_x.fx_N``); ``attrs["units"]`` maps each column
+        to its unit. The scheme is in `uvms_pin.results.table` and docs/api.md."""
+        from uvms_pin.results.table import to_dataframe
+
+        return to_dataframe(self)
+
+    def plot(self, kind: str | None = None) -> Figure | dict[str, Figure]:
+        """A matplotlib Figure of this rollout: ``kind`` one of `uvms_pin.results.figures.kinds.KINDS`
+        ("pose", "velocities", "energy", "force", "first_level", "second_level"); without
+        ``kind`` every figure the rollout has data for, as a dict by kind."""
+        from uvms_pin.results.figures.kinds import plot_rollout
+
+        return plot_rollout(self, kind)
+
+    # ---- persistence ------------------------------------------------------------------
+    def save(self, directory: str | Path) -> Path:
+        """Write ``rollout.npz`` and ``rollout.json`` into ``directory`` atomically."""
+        out = Path(directory)
+        out.mkdir(parents=True, exist_ok=True)
+        # Fix: serialise the metadata before writing anything; it used to be serialised
+        # after rollout.npz was replaced, so unserialisable metadata left a new .npz next
+        # to no (or a previous run's) rollout.json.
+        text = json_text(self.metadata)
+        arrays = {name: getattr(self, name) for name in self._BASE}
+        arrays.update({f"signal__{k}": a for k, a in self.signals.items()})
+        atomic_write(out / ARRAY_FILE, lambda f: np.savez_compressed(f, **arrays), binary=True)
+        atomic_write(out / META_FILE, lambda f: f.write(text), binary=False)
+        return out
+
+    @classmethod
+    def load(cls, directory: str | Path) -> Rollout:
+        src = Path(directory)
+        if not (src / ARRAY_FILE).is_file() or not (src / META_FILE).is_file():
+            raise ParameterError(f"{src} holds no rollout ({ARRAY_FILE} and {META_FILE} expected)")
+        try:
+            with np.load(src / ARRAY_FILE) as data:
+                base = {name: data[name] for name in cls._BASE}
+                signals = {
+                    k[len("signal__") :]: data[k] for k in data.files if k.startswith("signal__")
+                }
+            metadata = json.loads((src / META_FILE).read_text(encoding="utf-8"))
+        except (OSError, ValueError, KeyError, zipfile.BadZipFile) as exc:  # JSON errors too
+            raise ParameterError(
+                f"{src} holds a damaged rollout ({type(exc).__name__}: {exc}); rerun the scenario"
+            ) from exc
+        if not isinstance(metadata, dict):
+            raise ParameterError(f"{src / META_FILE}: a JSON object expected")
+        return cls(**base, signals=signals, metadata=metadata)

@@ -1,0 +1,1 @@
+"""Simulation: the plant, integrators, sensors, actuation and the one closed-loop engine."""

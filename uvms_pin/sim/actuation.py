@@ -1,0 +1,117 @@
+"""Actuators: what part of a commanded tau the vehicle and the arm can actually apply.
+
+The vehicle's body wrench comes from thrusters, tau_v = B f, with B (6 x m) built from
+each thruster's position r_i and unit direction d_i in the body frame, column
+[d_i; r_i x d_i]. A command is allocated by the pseudo-inverse, f = B^+ tau_v, each thrust
+is clipped to its limits, and B f is applied: directions no thruster can push (e.g. an
+LBV150's roll and pitch) are simply not applied. Arm torques are clipped to the joints'
+effort limits. `Unlimited` applies the command as it is (the paper's assumption).
+"""
+
+from __future__ import annotations
+
+from abc import ABC, abstractmethod
+from collections.abc import Sequence
+
+import numpy as np
+
+from uvms_pin.errors import ParameterError
+from uvms_pin.model.thruster import Thruster
+
+
+class Actuation(ABC):
+    """Maps a commanded generalized input to the applied one."""
+
+    @abstractmethod
+    def apply(self, tau_commanded: np.ndarray) -> np.ndarray:
+        """The applied tau (nv,) [N, N m]."""
+
+    def saturated(self, tau_commanded: np.ndarray) -> bool:
+        """True when an actuator cannot give what the command asks."""
+        return False
+
+
+class Unlimited(Actuation):
+    """Every DoF actuated without limit: tau_applied = tau_commanded."""
+
+    def apply(self, tau_commanded):
+        return tau_commanded
+
+
+class ThrustersAndJointLimits(Actuation):
+    """Thruster allocation with saturation for the vehicle, effort limits for the joints.
+
+    Args:
+        thrusters: the vehicle's thrusters (at least one).
+        joint_effort_limits_Nm: |tau_j| limits (n_joints,), e.g. the URDF's effort limits;
+            None = arm torques unlimited.
+        allocated_components: indices (0-5: surge, sway, heave, roll, pitch, yaw) of the
+            commanded body wrench the allocation tries to produce, f = B_s^+ tau_s; the
+            others are ignored (e.g. the roll and pitch of a vehicle whose thrusters cannot
+            produce them on purpose). The applied wrench is always B f, side effects
+            included. Default: all six.
+    """
+
+    def __init__(
+        self,
+        thrusters: Sequence[Thruster],
+        joint_effort_limits_Nm: np.ndarray | None,
+        allocated_components: Sequence[int] = (0, 1, 2, 3, 4, 5),
+    ):
+        if not thrusters:
+            raise ParameterError("at least one thruster is needed")
+        components = np.asarray(allocated_components, dtype=int)
+        if (
+            components.size == 0
+            or np.any((components < 0) | (components > 5))
+            or len(set(components.tolist())) != components.size
+        ):
+            raise ParameterError(
+                f"allocated_components must be distinct indices in 0..5, got {list(allocated_components)}"
+            )
+        self.thrusters = tuple(thrusters)
+        self.allocation = np.column_stack([t.wrench_column for t in self.thrusters])  # B, 6 x m
+        self.allocated_components = components
+        # f = B_s^+ tau[s]: written as a 6-column map that ignores the other components
+        self._allocation_pinv = np.zeros((len(self.thrusters), 6))
+        self._allocation_pinv[:, components] = np.linalg.pinv(self.allocation[components])
+        self._lower = -np.array([t.max_reverse_N for t in self.thrusters])
+        self._upper = np.array([t.max_forward_N for t in self.thrusters])
+        if joint_effort_limits_Nm is not None:
+            limits = np.asarray(joint_effort_limits_Nm, dtype=float)
+            if np.any(~(limits > 0.0)) or not np.all(np.isfinite(limits)):
+                raise ParameterError(
+                    f"joint effort limits must be positive and finite, got {limits}"
+                )
+            joint_effort_limits_Nm = limits
+        self.joint_effort_limits_Nm = joint_effort_limits_Nm
+
+    def thrusts(self, tau_commanded: np.ndarray) -> np.ndarray:
+        """Per-thruster thrust f (m,) [N] after allocation and saturation."""
+        # minimum(maximum()) is np.clip without its per-call dispatch cost
+        return np.minimum(
+            np.maximum(self._allocation_pinv @ tau_commanded[:6], self._lower), self._upper
+        )
+
+    def saturated(self, tau_commanded: np.ndarray) -> bool:
+        """True when a thruster or a joint cannot give what the command asks."""
+        raw = self._allocation_pinv @ tau_commanded[:6]
+        if np.any(raw < self._lower) or np.any(raw > self._upper):
+            return True
+        limits = self.joint_effort_limits_Nm
+        return limits is not None and bool(np.any(np.abs(tau_commanded[6:]) > limits))
+
+    def apply(self, tau_commanded):
+        out = np.empty_like(tau_commanded)
+        out[:6] = self.allocation @ self.thrusts(tau_commanded)
+        arm = tau_commanded[6:]
+        if self.joint_effort_limits_Nm is None:
+            out[6:] = arm
+        else:
+            if arm.shape != self.joint_effort_limits_Nm.shape:
+                raise ParameterError(
+                    f"{arm.size} arm torques for {self.joint_effort_limits_Nm.size} effort limits"
+                )
+            limits = self.joint_effort_limits_Nm
+            out[6:] = np.minimum(np.maximum(arm, -limits), limits)
+        return out
