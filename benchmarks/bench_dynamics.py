@@ -26,8 +26,9 @@ import pinocchio as pin
 from timing import best_times, one_blas_thread
 
 import uvms_pin as up
-from uvms_pin.physics.compiled import dynamics_of
-from uvms_pin.physics.environment import LinearSpring, SinusoidalDisturbance
+from uvms_pin.physics.contact import LinearSpring
+from uvms_pin.physics.disturbance import SinusoidalDisturbance
+from uvms_pin.physics.dynamics import dynamics_of
 from uvms_pin.sim.integrators import RK4
 from uvms_pin.sim.plant import Plant
 
@@ -44,7 +45,7 @@ def call_rows(uvms: up.UVMS, repeat: int) -> dict[str, float]:
     v = rng.normal(scale=0.3, size=model.nv)
     tau = rng.normal(size=model.nv)
     current = np.array([0.3, 0.1, 0.0])
-    compiled = dynamics_of(uvms)
+    compiled = dynamics_of(uvms).core
     cases = {
         "pin.aba (rigid floor)": lambda: pin.aba(model, data, q, v, tau),
         "core Dynamics.forward_dynamics (direct)": lambda: compiled.forward_dynamics(

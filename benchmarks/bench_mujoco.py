@@ -52,7 +52,8 @@ from uvms_pin.apps.export.mujoco_state import (
 from uvms_pin.model.mount.catalog import resolve_arm
 from uvms_pin.model.mount.mount import mount_arm_detailed
 from uvms_pin.model.mount.split import split_urdf
-from uvms_pin.physics.environment import LinearSpring, SinusoidalDisturbance
+from uvms_pin.physics.contact import LinearSpring
+from uvms_pin.physics.disturbance import SinusoidalDisturbance
 from uvms_pin.sim.integrators import RK4
 from uvms_pin.sim.plant import Plant
 from uvms_pin.sim.sensors import SensorSuite

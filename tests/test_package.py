@@ -8,9 +8,9 @@ import sys
 
 def test_simulate_is_the_function_even_after_its_module_is_imported():
     code = (
-        "import uvms_pin.sim.closed_loop, uvms_pin.scenario.scenario, uvms_pin as up\n"
-        "assert callable(up.simulate) and up.simulate.__module__ == 'uvms_pin.scenario.scenario'\n"
-        "from uvms_pin.sim.closed_loop import SimulationSettings\n"
+        "import uvms_pin.sim.run, uvms_pin.scenario.scenario, uvms_pin as up\n"
+        "assert callable(up.simulate) and up.simulate.__module__ == 'uvms_pin.sim.run'\n"
+        "from uvms_pin.sim.settings import SimulationSettings\n"
     )
     result = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
     assert result.returncode == 0, result.stderr

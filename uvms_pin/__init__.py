@@ -30,8 +30,8 @@ _LAZY = {
     "mount_arm": "uvms_pin.model.mount.mount",
     "shipped_path": "uvms_pin.model.resources",
     "Rollout": "uvms_pin.results.rollout",
-    "load_scenario": "uvms_pin.scenario",
-    "simulate": "uvms_pin.scenario",
+    "load_scenario": "uvms_pin.scenario.scenario",
+    "simulate": "uvms_pin.sim.run",
 }
 
 

@@ -16,15 +16,16 @@ import sys
 import warnings
 from types import ModuleType
 
-#: old path (below ``uvms_pin.``) -> new path; a package's entry covers its modules.
-MOVED: dict[str, str] = {
+#: old path (below ``uvms_pin.``) -> new path; a package's entry covers its modules. A module
+#: that was split maps to its parts (a tuple): its names are found in them, in order.
+MOVED: dict[str, str | tuple[str, ...]] = {
     "actuation": "sim.actuation",
     "atomic": "results.atomic",
     "cli": "apps.cli.main",
     "cli_types": "apps.arguments",
-    "core": "physics.compiled",
+    "core": ("physics.compiled.extension", "physics.compiled.backend", "physics.dynamics"),
     "dynamics": "physics.dynamics",
-    "environment": "physics.environment",
+    "environment": ("physics.contact", "physics.disturbance"),
     "integrators": "sim.integrators",
     "kinematics": "physics.kinematics",
     "measurement": "control.measurement",
@@ -68,38 +69,61 @@ MOVED: dict[str, str] = {
 _PREFIX = "uvms_pin."
 
 
-def new_path(old: str) -> str | None:
-    """The new full path of the old full module path ``old``, or None if it did not move."""
+def new_path(old: str) -> str | tuple[str, ...] | None:
+    """The new full path (or paths, for a split module) of the old full module path
+    ``old``, or None if it did not move."""
     if not old.startswith(_PREFIX):
         return None
     parts = old[len(_PREFIX) :].split(".")
     for k in range(len(parts), 0, -1):
         moved = MOVED.get(".".join(parts[:k]))
+        if isinstance(moved, tuple):
+            return tuple(_PREFIX + m for m in moved) if k == len(parts) else None
         if moved is not None:
             return _PREFIX + ".".join([moved, *parts[k:]])
     return None
 
 
+class _SplitModule(ModuleType):
+    """An old module that was split: its names, looked up in the parts in order."""
+
+    def __init__(self, name: str, parts: tuple[ModuleType, ...]):
+        super().__init__(
+            name, f"moved: its names are now in {', '.join(p.__name__ for p in parts)}"
+        )
+        self._parts = parts
+
+    def __getattr__(self, attribute: str):
+        for part in self._parts:
+            if hasattr(part, attribute):
+                return getattr(part, attribute)
+        raise AttributeError(f"module '{self.__name__}' has no attribute '{attribute}'")
+
+
 class _Alias(importlib.abc.Loader):
     """Loads an old path as the module at its new place (the same object)."""
 
-    def __init__(self, new: str):
+    def __init__(self, new: str | tuple[str, ...]):
         self.new = new
         self._spec = None
 
     def create_module(self, spec) -> ModuleType:
-        module = importlib.import_module(self.new)
-        self._spec = module.__spec__  # the import system sets the alias's; put it back below
+        where = self.new if isinstance(self.new, str) else " and ".join(self.new)
         warnings.warn(
-            f"{spec.name} moved to {self.new}; import it from there",
+            f"{spec.name} moved to {where}; import it from there",
             DeprecationWarning,
             stacklevel=2,
         )
+        if not isinstance(self.new, str):
+            return _SplitModule(spec.name, tuple(map(importlib.import_module, self.new)))
+        module = importlib.import_module(self.new)
+        self._spec = module.__spec__  # the import system sets the alias's; put it back below
         return module
 
     def exec_module(self, module: ModuleType) -> None:
         """Nothing to run (the module was imported at its new place): its own spec back."""
-        module.__spec__ = self._spec
+        if self._spec is not None:
+            module.__spec__ = self._spec
 
 
 class MovedModuleFinder(importlib.abc.MetaPathFinder):
@@ -109,8 +133,9 @@ class MovedModuleFinder(importlib.abc.MetaPathFinder):
         new = new_path(fullname)
         if new is None or fullname in sys.modules:
             return None
-        if importlib.util.find_spec(new) is None:
-            return None
+        for path in (new,) if isinstance(new, str) else new:
+            if importlib.util.find_spec(path) is None:
+                return None
         return importlib.util.spec_from_loader(fullname, _Alias(new))
 
 

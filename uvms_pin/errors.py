@@ -51,6 +51,16 @@ class DataError(UvmsPinError):
     """A measurement data set is missing, malformed or unusable; the message names the file."""
 
 
+class CoreUnavailableError(UvmsPinError, ImportError):
+    """The compiled core is missing, stale or built against another Pinocchio; the message
+    says how to rebuild it."""
+
+
+class CoreFallbackWarning(UvmsPinWarning):
+    """Something the compiled core has no counterpart of runs on the (slower) Python
+    reference; the message says what and why."""
+
+
 class SimulationError(UvmsPinError):
     """The simulation cannot continue (non-finite state, integrator failure)."""
 

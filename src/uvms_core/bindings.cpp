@@ -1,4 +1,6 @@
-// nanobind module uvms_pin._core: the compiled Dynamics and Plant.
+// nanobind module uvms_pin._core: the compiled counterparts of uvms-pin's concepts, one
+// section per concept, each a struct with named fields (the Python side that fills them is
+// uvms_pin/physics/compiled/, uvms_pin/sim/compiled.py and uvms_pin/control/ppc_kernel.py).
 // Bad input raises uvms_pin.errors.ParameterError, a failed solve SimulationError.
 #include <nanobind/eigen/dense.h>
 #include <nanobind/nanobind.h>
@@ -6,6 +8,7 @@
 #include <nanobind/stl/optional.h>
 #include <nanobind/stl/pair.h>
 #include <nanobind/stl/string.h>
+#include <nanobind/stl/variant.h>
 #include <nanobind/stl/vector.h>
 
 #include <pinocchio/config.hpp>
@@ -21,104 +24,343 @@ namespace {
 using uvms::ConstVec;
 using uvms::InputError;
 
-template <int... Shape>
-using Array = nb::ndarray<const double, nb::shape<Shape...>, nb::c_contig, nb::device::cpu>;
+// ---- vectors from Python ---------------------------------------------------------------
 
-void check_vector(const char* name, const ConstVec& x, Eigen::Index n) {
-  if (x.size() != n) {
+using Array1 = nb::ndarray<const double, nb::ndim<1>, nb::c_contig, nb::device::cpu>;
+
+std::string shape_of(nb::handle x) {
+  if (nb::hasattr(x, "shape")) return nb::repr(x.attr("shape")).c_str();
+  return std::string("a ") + nb::type_name(x.type()).c_str();
+}
+
+// A vector argument, read without a copy when it is a contiguous float64 array and converted
+// once otherwise (numpy.asarray: a list, another dtype); `ok` is false when it is not a 1-D
+// array of numbers. Nothing is raised here: the caller decides what bad input means.
+struct VectorArg {
+  Array1 array;
+  bool ok = false;
+
+  explicit VectorArg(nb::handle x) {
+    ok = nb::try_cast(x, array, true);
+    if (ok || x.is_none()) return;
+    try {
+      nb::object converted = nb::module_::import_("numpy").attr("asarray")(x, "dtype"_a = "float64");
+      ok = nb::try_cast(converted, array, false);
+    } catch (const nb::python_error&) {  // not numbers at all (a string, a dict): not ok
+      ok = false;
+    }
+  }
+  Eigen::Index size() const { return ok ? Eigen::Index(array.shape(0)) : -1; }
+  Eigen::Map<const Eigen::VectorXd> map() const { return {array.data(), size()}; }
+};
+
+// The vector ``name`` of n finite numbers, or InputError saying what it is instead.
+Eigen::Map<const Eigen::VectorXd> vector(const char* name, nb::handle x, const VectorArg& arg,
+                                         Eigen::Index n) {
+  if (!arg.ok || arg.size() != n) {
     throw InputError(std::string(name) + " must have shape (" + std::to_string(n) +
-                     ",), got (" + std::to_string(x.size()) + ",)");
+                     ",), got " + (arg.ok ? "(" + std::to_string(arg.size()) + ",)" : shape_of(x)));
   }
-  if (!x.allFinite()) throw InputError(std::string(name) + " contains a non-finite value");
+  if (!arg.map().allFinite()) throw InputError(std::string(name) + " contains a non-finite value");
+  return arg.map();
 }
 
-uvms::Vec3 vec3(const char* name, const ConstVec& x) {
-  check_vector(name, x, 3);
-  return x;
+// Declares `name` (a Map) from the Python argument `name_obj` with n entries.
+#define UVMS_VECTOR(name, n)            \
+  const VectorArg name##_arg(name##_obj); \
+  const auto name = vector(#name, name##_obj, name##_arg, (n))
+
+template <typename Struct>
+void check_finite(const char* name, const Struct& values) {
+  if (!values.allFinite()) throw InputError(std::string(name) + " contains a non-finite value");
 }
 
-uvms::Vec6 vec6(const char* name, const ConstVec& x) {
-  check_vector(name, x, 6);
-  return x;
+// ---- the dynamics (dynamics.hpp) ---------------------------------------------------------
+
+void bind_hydro_bodies(nb::module_& m) {
+  nb::class_<uvms::DampedBody>(m, "DampedBody",
+                               "One damped link on a joint (hydro_bodies.hpp, DampedBody).")
+      .def(nb::init<>())
+      .def_rw("joint_id", &uvms::DampedBody::joint_id)
+      .def_rw("action_joint_to_body", &uvms::DampedBody::action_joint_to_body)
+      .def_rw("rotation_in_joint", &uvms::DampedBody::rotation_in_joint)
+      .def_rw("position_in_joint_m", &uvms::DampedBody::position_in_joint_m)
+      .def_rw("linear_damping", &uvms::DampedBody::linear_damping)
+      .def_rw("quadratic_damping", &uvms::DampedBody::quadratic_damping);
+  nb::class_<uvms::HydroBodies>(m, "HydroBodies",
+                                "The hydrodynamic parameters per joint (hydro_bodies.hpp).")
+      .def(nb::init<>())
+      .def_rw("water_density_kg_m3", &uvms::HydroBodies::water_density_kg_m3)
+      .def_rw("added_mass_per_joint", &uvms::HydroBodies::added_mass_per_joint)
+      .def_rw("volume_per_joint_m3", &uvms::HydroBodies::volume_per_joint_m3)
+      .def_rw("center_of_buoyancy_per_joint_m",
+              &uvms::HydroBodies::center_of_buoyancy_per_joint_m)
+      .def_rw("damped_bodies", &uvms::HydroBodies::damped_bodies);
 }
 
-template <int R, int C, typename Arr>
-Eigen::Matrix<double, R, C> matrix_at(const Arr& a, std::size_t k) {
-  // numpy stacks are row-major
-  return Eigen::Map<const Eigen::Matrix<double, R, C, (C > 1 ? Eigen::RowMajor : Eigen::ColMajor)>>(
-      a.data() + k * R * C);
+void bind_flow(nb::module_& m) {
+  nb::class_<uvms::WaveComponent>(m, "WaveComponent", "One linear wave (flow.hpp).")
+      .def(nb::init<>())
+      .def_rw("amplitude_m", &uvms::WaveComponent::amplitude_m)
+      .def_rw("angular_frequency_rad_s", &uvms::WaveComponent::angular_frequency_rad_s)
+      .def_rw("wavenumber_rad_m", &uvms::WaveComponent::wavenumber_rad_m)
+      .def_rw("heading_rad", &uvms::WaveComponent::heading_rad)
+      .def_rw("phase_rad", &uvms::WaveComponent::phase_rad);
+  nb::class_<uvms::FlowField>(m, "FlowField",
+                              "A uniform current plus linear waves in one depth (flow.hpp).")
+      .def(nb::init<>())
+      .def_rw("current_world_m_s", &uvms::FlowField::current_world_m_s)
+      .def_rw("waves", &uvms::FlowField::waves)
+      .def_rw("water_depth_m", &uvms::FlowField::water_depth_m);
 }
 
-uvms::HydroBodies hydro_bodies(double rho, const Array<-1, 6, 6>& added,
-                               const Array<-1>& volume, const Array<-1, 3>& cob,
-                               const std::vector<int>& damped_joint,
-                               const Array<-1, 6, 6>& damped_action,
-                               const Array<-1, 3, 3>& damped_rotation,
-                               const Array<-1, 3>& damped_position,
-                               const Array<-1, 6, 6>& damped_linear,
-                               const Array<-1, 6>& damped_quadratic) {
-  uvms::HydroBodies out;
-  out.water_density_kg_m3 = rho;
-  const std::size_t nj = added.shape(0);
-  if (volume.shape(0) != nj || cob.shape(0) != nj) {
-    throw InputError("added_mass, volume and center_of_buoyancy need one entry per joint");
-  }
-  for (std::size_t j = 0; j < nj; ++j) {
-    out.added_mass_per_joint.push_back(matrix_at<6, 6>(added, j));
-    out.volume_per_joint_m3.push_back(volume.data()[j]);
-    out.center_of_buoyancy_per_joint_m.push_back(matrix_at<3, 1>(cob, j));
-  }
-  const std::size_t nd = damped_joint.size();
-  if (damped_action.shape(0) != nd || damped_rotation.shape(0) != nd ||
-      damped_position.shape(0) != nd || damped_linear.shape(0) != nd ||
-      damped_quadratic.shape(0) != nd) {
-    throw InputError("damped-body arrays need one entry per damped body");
-  }
-  for (std::size_t k = 0; k < nd; ++k) {
-    out.damped_bodies.push_back({damped_joint[k], matrix_at<6, 6>(damped_action, k),
-                                 matrix_at<3, 3>(damped_rotation, k),
-                                 matrix_at<3, 1>(damped_position, k),
-                                 matrix_at<6, 6>(damped_linear, k),
-                                 matrix_at<6, 1>(damped_quadratic, k)});
-  }
-  return out;
+// The flow of a call: None (still water) or a FlowField.
+uvms::FlowField flow_or_still(const std::optional<uvms::FlowField>& flow) {
+  return flow ? *flow : uvms::FlowField{};
 }
 
-uvms::FlowField current_flow(const ConstVec& current_world) {
+uvms::FlowField current_only(nb::handle current_world_obj) {
+  UVMS_VECTOR(current_world, 3);
   uvms::FlowField flow;
-  flow.current_world_m_s = vec3("current_world", current_world);
+  flow.current_world_m_s = current_world;
   return flow;
 }
 
-// A uniform current plus wave components: rows [amplitude_m, angular_frequency_rad_s,
-// wavenumber_rad_m, heading_rad, phase_rad] of ``waves`` (m x 5), all in water of depth d.
-uvms::FlowField wave_flow(const ConstVec& current_world, const Eigen::MatrixXd& waves,
-                          double water_depth_m) {
-  uvms::FlowField flow = current_flow(current_world);
-  if (waves.size() != 0 && waves.cols() != 5) {
-    throw uvms::InputError("waves must have 5 columns (amplitude, angular frequency, "
-                           "wavenumber, heading, phase), got " + std::to_string(waves.cols()));
-  }
-  if (!waves.allFinite() || !(water_depth_m > 0.0)) {
-    throw uvms::InputError("waves must be finite and water_depth_m positive");
-  }
-  for (Eigen::Index i = 0; i < waves.rows(); ++i) {
-    flow.waves.push_back({waves(i, 0), waves(i, 1), waves(i, 2), waves(i, 3), waves(i, 4)});
-  }
-  flow.water_depth_m = water_depth_m;
-  return flow;
+void bind_dynamics(nb::module_& m) {
+  using uvms::Dynamics;
+  nb::class_<Dynamics>(m, "Dynamics", "M, h and forward dynamics of one UVMS (dynamics.hpp).")
+      .def(
+          "__init__",
+          [](Dynamics* self, const std::string& model_text, const uvms::HydroBodies& hydro) {
+            new (self) Dynamics(uvms::model_from_text(model_text), hydro);
+          },
+          "model_text"_a, "hydro_bodies"_a)
+      .def_prop_ro("nq", &Dynamics::nq)
+      .def_prop_ro("nv", &Dynamics::nv)
+      .def(
+          "mass_matrix",
+          [](Dynamics& d, nb::handle q_obj) -> Eigen::MatrixXd {
+            UVMS_VECTOR(q, d.nq());
+            return d.mass_matrix(q);
+          },
+          "q"_a.none())
+      .def(
+          "bias_forces",
+          [](Dynamics& d, nb::handle q_obj, nb::handle v_obj,
+             nb::handle current_world_obj) -> Eigen::VectorXd {
+            UVMS_VECTOR(q, d.nq());
+            UVMS_VECTOR(v, d.nv());
+            return d.bias_forces(q, v, current_only(current_world_obj));
+          },
+          "q"_a.none(), "v"_a.none(), "current_world"_a.none())
+      .def(
+          "bias_forces_in",
+          [](Dynamics& d, nb::handle q_obj, nb::handle v_obj,
+             const std::optional<uvms::FlowField>& flow, double time_s) -> Eigen::VectorXd {
+            UVMS_VECTOR(q, d.nq());
+            UVMS_VECTOR(v, d.nv());
+            return d.bias_forces(q, v, flow_or_still(flow), time_s);
+          },
+          "q"_a.none(), "v"_a.none(), "flow"_a.none(), "time_s"_a)
+      .def(
+          "forward_dynamics",
+          [](Dynamics& d, nb::handle q_obj, nb::handle v_obj, nb::handle tau_obj,
+             nb::handle current_world_obj, nb::handle tau_ext_obj) -> Eigen::VectorXd {
+            UVMS_VECTOR(q, d.nq());
+            UVMS_VECTOR(v, d.nv());
+            UVMS_VECTOR(tau, d.nv());
+            const uvms::FlowField flow = current_only(current_world_obj);
+            if (tau_ext_obj.is_none()) return d.forward_dynamics(q, v, tau, flow, nullptr);
+            UVMS_VECTOR(tau_ext, d.nv());
+            const ConstVec ext(tau_ext);
+            return d.forward_dynamics(q, v, tau, flow, &ext);
+          },
+          "q"_a.none(), "v"_a.none(), "tau"_a.none(), "current_world"_a.none(), "tau_ext"_a.none() = nb::none())
+      .def(
+          "forward_dynamics_in",
+          [](Dynamics& d, nb::handle q_obj, nb::handle v_obj, nb::handle tau_obj,
+             const std::optional<uvms::FlowField>& flow, double time_s,
+             nb::handle tau_ext_obj) -> Eigen::VectorXd {
+            UVMS_VECTOR(q, d.nq());
+            UVMS_VECTOR(v, d.nv());
+            UVMS_VECTOR(tau, d.nv());
+            if (tau_ext_obj.is_none()) {
+              return d.forward_dynamics(q, v, tau, flow_or_still(flow), nullptr, time_s);
+            }
+            UVMS_VECTOR(tau_ext, d.nv());
+            const ConstVec ext(tau_ext);
+            return d.forward_dynamics(q, v, tau, flow_or_still(flow), &ext, time_s);
+          },
+          "q"_a.none(), "v"_a.none(), "tau"_a.none(), "flow"_a.none(), "time_s"_a, "tau_ext"_a.none() = nb::none());
 }
 
-void check_state(uvms::Dynamics& d, const ConstVec& q, const ConstVec& v) {
-  check_vector("q", q, d.nq());
-  check_vector("v", v, d.nv());
+// ---- the environment (contact.hpp, disturbance.hpp) and the integrators -----------------
+
+void bind_environment(nb::module_& m) {
+  nb::class_<uvms::NoContact>(m, "NoContact", "No contact (contact.hpp).").def(nb::init<>());
+  nb::class_<uvms::LinearSpring>(m, "LinearSpring", "f_e = K_f (p - p_0) (contact.hpp).")
+      .def(nb::init<>())
+      .def_rw("stiffness_N_m", &uvms::LinearSpring::stiffness_N_m)
+      .def_rw("anchor_world_m", &uvms::LinearSpring::anchor_world_m);
+  nb::class_<uvms::CompliantPlane>(m, "CompliantPlane",
+                                   "A unilateral Kelvin-Voigt plane (contact.hpp).")
+      .def(nb::init<>())
+      .def_rw("normal_world", &uvms::CompliantPlane::normal_world)
+      .def_rw("point_world_m", &uvms::CompliantPlane::point_world_m)
+      .def_rw("stiffness_N_m", &uvms::CompliantPlane::stiffness_N_m)
+      .def_rw("damping_N_s_m", &uvms::CompliantPlane::damping_N_s_m);
+  nb::class_<uvms::SinusoidalDisturbance>(m, "SinusoidalDisturbance",
+                                          "delta(t) = a sin(2 pi t / T + phi) (disturbance.hpp).")
+      .def(nb::init<>())
+      .def_rw("amplitude", &uvms::SinusoidalDisturbance::amplitude)
+      .def_rw("period_s", &uvms::SinusoidalDisturbance::period_s)
+      .def_rw("phase_rad", &uvms::SinusoidalDisturbance::phase_rad);
+  nb::enum_<uvms::Method>(m, "Method", "A fixed-step method (integrators.hpp).")
+      .value("rk4", uvms::Method::rk4)
+      .value("semi_implicit_euler", uvms::Method::semi_implicit_euler);
+  nb::class_<uvms::FixedStep>(m, "FixedStep", "A fixed-step integrator (integrators.hpp).")
+      .def(nb::init<>())
+      .def_rw("method", &uvms::FixedStep::method)
+      .def_rw("step_s", &uvms::FixedStep::step_s);
+}
+
+// ---- the plant (plant.hpp) -----------------------------------------------------------------
+
+void bind_plant(nb::module_& m) {
+  using uvms::Plant;
+  nb::class_<Plant>(m, "Plant", "A UVMS in water, touching and pushed (plant.hpp).")
+      .def(nb::init<const uvms::Dynamics&, int>(), "dynamics"_a, "ee_frame_id"_a)
+      .def_rw("flow", &Plant::flow)
+      .def_rw("contact", &Plant::contact)
+      .def_rw("disturbance", &Plant::disturbance)
+      .def(
+          "contact_wrench",
+          [](Plant& p, nb::handle q_obj, nb::handle v_obj) -> Eigen::VectorXd {
+            UVMS_VECTOR(q, p.dynamics().nq());
+            UVMS_VECTOR(v, p.dynamics().nv());
+            return p.contact_wrench(q, v);
+          },
+          "q"_a.none(), "v"_a.none())
+      .def(
+          "acceleration",
+          [](Plant& p, double t, nb::handle q_obj, nb::handle v_obj, nb::handle tau_obj,
+             nb::handle contact_world_obj) -> Eigen::VectorXd {
+            UVMS_VECTOR(q, p.dynamics().nq());
+            UVMS_VECTOR(v, p.dynamics().nv());
+            UVMS_VECTOR(tau, p.dynamics().nv());
+            if (contact_world_obj.is_none()) return p.acceleration(t, q, v, tau);
+            UVMS_VECTOR(contact_world, 6);
+            const uvms::Vec6 lambda = contact_world;
+            return p.acceleration(t, q, v, tau, &lambda);
+          },
+          "time_s"_a, "q"_a.none(), "v"_a.none(), "tau"_a.none(), "contact_world"_a.none() = nb::none())
+      .def(
+          "advance",
+          [](Plant& p, double t0, nb::handle q0_obj, nb::handle v0_obj, nb::handle tau_obj,
+             double t1, const uvms::FixedStep& integrator) {
+            UVMS_VECTOR(q0, p.dynamics().nq());
+            UVMS_VECTOR(v0, p.dynamics().nv());
+            UVMS_VECTOR(tau, p.dynamics().nv());
+            if (!(t1 > t0) || !(integrator.step_s > 0.0)) {
+              throw InputError("advance needs t1 > t0 and a positive step");
+            }
+            return p.advance(t0, q0, v0, tau, t1, integrator);
+          },
+          "t0"_a, "q0"_a.none(), "v0"_a.none(), "tau"_a.none(), "t1"_a, "integrator"_a)
+      .def(
+          "chart",
+          [](Plant& p, nb::handle q0_obj, nb::handle delta_obj, nb::handle v_obj) {
+            UVMS_VECTOR(q0, p.dynamics().nq());
+            UVMS_VECTOR(delta, p.dynamics().nv());
+            UVMS_VECTOR(v, p.dynamics().nv());
+            return p.chart(q0, delta, v);
+          },
+          "q0"_a.none(), "delta"_a.none(), "v"_a.none());
+}
+
+// ---- the prescribed-performance controller (ppc.hpp) ---------------------------------------
+
+void bind_ppc(nb::module_& m) {
+  using Ppc = uvms::PrescribedPerformanceController;
+  using Settings = uvms::PpcSettings;
+  m.attr("PPC_STATUS") = nb::make_tuple("ok", "first-level funnel", "second-level funnel",
+                                        "solver declined", "Euler singularity", "bad input");
+  nb::class_<Settings>(m, "PpcSettings", "Gains, funnels and solver settings (ppc.hpp).")
+      .def(nb::init<>())
+      .def_rw("ee_frame_id", &Settings::ee_frame_id)
+      .def_rw("k_x", &Settings::k_x)
+      .def_rw("rho0_x", &Settings::rho0_x)
+      .def_rw("rho_inf_x", &Settings::rho_inf_x)
+      .def_rw("l_x_per_s", &Settings::l_x_per_s)
+      .def_rw("k_zeta", &Settings::k_zeta)
+      .def_rw("rho0_zeta", &Settings::rho0_zeta)
+      .def_rw("rho_inf_zeta", &Settings::rho_inf_zeta)
+      .def_rw("l_zeta_per_s", &Settings::l_zeta_per_s)
+      .def_rw("velocity_weights", &Settings::velocity_weights)
+      .def_rw("null_space_gain_per_s", &Settings::null_space_gain_per_s)
+      .def_rw("limited_q_index", &Settings::limited_q_index)
+      .def_rw("limited_v_index", &Settings::limited_v_index)
+      .def_rw("null_space_target", &Settings::null_space_target)
+      .def_rw("half_range", &Settings::half_range)
+      .def_rw("max_condition_bound", &Settings::max_condition_bound)
+      .def_rw("refine_above_condition_bound", &Settings::refine_above_condition_bound)
+      .def_rw("xi_clamp", &Settings::xi_clamp)
+      .def_rw("min_abs_cos_pitch", &Settings::min_abs_cos_pitch);
+  nb::class_<Ppc>(m, "PrescribedPerformanceController", "The paper's law (ppc.hpp).")
+      .def(
+          "__init__",
+          [](Ppc* self, const std::string& model_text, const Settings& settings) {
+            check_finite("k_x", settings.k_x);
+            check_finite("k_zeta", settings.k_zeta);
+            new (self) Ppc(uvms::model_from_text(model_text), settings);
+          },
+          "model_text"_a, "settings"_a)
+      .def_prop_ro("nq", &Ppc::nq)
+      .def_prop_ro("nv", &Ppc::nv)
+      .def(
+          "compute",
+          // the status says what the caller must do; bad input is a status too (the Python
+          // reference then raises its own, precise error)
+          [](Ppc& c, double time_s, nb::handle q, nb::handle v, nb::handle wrench,
+             nb::handle force_desired, nb::handle rpy_desired, bool extended) {
+            const VectorArg a[5] = {VectorArg(q), VectorArg(v), VectorArg(wrench),
+                                    VectorArg(force_desired), VectorArg(rpy_desired)};
+            for (const auto& arg : a) {
+              if (!arg.ok) return static_cast<int>(uvms::PpcStatus::bad_input);
+            }
+            return static_cast<int>(c.compute(
+                time_s, a[0].array.data(), a[0].size(), a[1].array.data(), a[1].size(),
+                a[2].array.data(), a[2].size(), a[3].array.data(), a[3].size(),
+                a[4].array.data(), a[4].size(), extended));
+          },
+          "time_s"_a, "q"_a.none(), "v"_a.none(), "wrench_world"_a.none(), "force_desired"_a.none(), "rpy_desired"_a.none(),
+          "extended"_a)
+      .def(
+          "signals",
+          [](Ppc& c) {
+            // a read-only view of the last ok call's packed signals (it lives with c)
+            const Eigen::VectorXd& s = c.signals();
+            return nb::ndarray<nb::numpy, const double, nb::ndim<1>>(
+                s.data(), {static_cast<std::size_t>(s.size())}, nb::handle());
+          },
+          nb::rv_policy::reference_internal)
+      .def(
+          "signal_layout",
+          [](Ppc& c) {
+            nb::dict out;
+            for (const auto& slot : c.signal_layout()) {
+              out[slot.name] = nb::make_tuple(slot.offset, slot.offset + slot.size);
+            }
+            return out;
+          },
+          "{name: (start, stop)} of each signal in signals(), in order");
 }
 
 }  // namespace
 
 NB_MODULE(_core, m) {
-  m.doc() = "Compiled dynamics and plant of uvms-pin (C++ on Pinocchio's C++ API).";
-  m.attr("API_VERSION") = 1;
+  m.doc() = "Compiled dynamics, plant and controller of uvms-pin (C++ on Pinocchio's C++ API).";
+  m.attr("API_VERSION") = uvms::kApiVersion;
   m.attr("PINOCCHIO_VERSION") = PINOCCHIO_VERSION;
   m.attr("SOURCE_HASH") = UVMS_CORE_SOURCE_HASH;
 
@@ -137,222 +379,10 @@ NB_MODULE(_core, m) {
     }
   });
 
-  nb::class_<uvms::Dynamics>(m, "Dynamics")
-      .def(
-          "__init__",
-          [](uvms::Dynamics* self, const std::string& model_text, double rho,
-             const Array<-1, 6, 6>& added, const Array<-1>& volume, const Array<-1, 3>& cob,
-             const std::vector<int>& damped_joint, const Array<-1, 6, 6>& damped_action,
-             const Array<-1, 3, 3>& damped_rotation, const Array<-1, 3>& damped_position,
-             const Array<-1, 6, 6>& damped_linear, const Array<-1, 6>& damped_quadratic) {
-            new (self) uvms::Dynamics(
-                uvms::model_from_text(model_text),
-                hydro_bodies(rho, added, volume, cob, damped_joint, damped_action,
-                             damped_rotation, damped_position, damped_linear,
-                             damped_quadratic));
-          },
-          "model_text"_a, "water_density_kg_m3"_a, "added_mass_per_joint"_a,
-          "volume_per_joint_m3"_a, "center_of_buoyancy_per_joint_m"_a, "damped_joint"_a,
-          "damped_action"_a, "damped_rotation"_a, "damped_position"_a, "damped_linear"_a,
-          "damped_quadratic"_a)
-      .def_prop_ro("nq", &uvms::Dynamics::nq)
-      .def_prop_ro("nv", &uvms::Dynamics::nv)
-      .def(
-          "mass_matrix",
-          [](uvms::Dynamics& d, const ConstVec& q) -> Eigen::MatrixXd {
-            check_vector("q", q, d.nq());
-            return d.mass_matrix(q);
-          },
-          "q"_a)
-      .def(
-          "bias_forces",
-          [](uvms::Dynamics& d, const ConstVec& q, const ConstVec& v,
-             const ConstVec& current_world) -> Eigen::VectorXd {
-            check_state(d, q, v);
-            return d.bias_forces(q, v, current_flow(current_world));
-          },
-          "q"_a, "v"_a, "current_world"_a)
-      .def(
-          "bias_forces_in_waves",
-          [](uvms::Dynamics& d, const ConstVec& q, const ConstVec& v,
-             const ConstVec& current_world, const Eigen::MatrixXd& waves, double water_depth_m,
-             double time_s) -> Eigen::VectorXd {
-            check_state(d, q, v);
-            return d.bias_forces(q, v, wave_flow(current_world, waves, water_depth_m), time_s);
-          },
-          "q"_a, "v"_a, "current_world"_a, "waves"_a, "water_depth_m"_a, "time_s"_a)
-      .def(
-          "forward_dynamics_in_waves",
-          [](uvms::Dynamics& d, const ConstVec& q, const ConstVec& v, const ConstVec& tau,
-             const ConstVec& current_world, const Eigen::MatrixXd& waves, double water_depth_m,
-             double time_s, std::optional<Eigen::VectorXd> tau_ext) -> Eigen::VectorXd {
-            check_state(d, q, v);
-            check_vector("tau", tau, d.nv());
-            const uvms::FlowField flow = wave_flow(current_world, waves, water_depth_m);
-            if (!tau_ext) return d.forward_dynamics(q, v, tau, flow, nullptr, time_s);
-            check_vector("tau_ext", *tau_ext, d.nv());
-            const ConstVec ext(*tau_ext);
-            return d.forward_dynamics(q, v, tau, flow, &ext, time_s);
-          },
-          "q"_a, "v"_a, "tau"_a, "current_world"_a, "waves"_a, "water_depth_m"_a, "time_s"_a,
-          "tau_ext"_a = nb::none())
-      .def(
-          "forward_dynamics",
-          [](uvms::Dynamics& d, const ConstVec& q, const ConstVec& v, const ConstVec& tau,
-             const ConstVec& current_world,
-             std::optional<Eigen::VectorXd> tau_ext) -> Eigen::VectorXd {
-            check_state(d, q, v);
-            check_vector("tau", tau, d.nv());
-            const uvms::FlowField flow = current_flow(current_world);
-            if (!tau_ext) return d.forward_dynamics(q, v, tau, flow, nullptr);
-            check_vector("tau_ext", *tau_ext, d.nv());
-            const ConstVec ext(*tau_ext);
-            return d.forward_dynamics(q, v, tau, flow, &ext);
-          },
-          "q"_a, "v"_a, "tau"_a, "current_world"_a, "tau_ext"_a = nb::none());
-
-  nb::class_<uvms::Plant>(m, "Plant")
-      .def(nb::init<const uvms::Dynamics&, int>(), "dynamics"_a, "ee_frame_id"_a)
-      .def(
-          "set_current",
-          [](uvms::Plant& p, const ConstVec& c) { p.flow = current_flow(c); }, "current_world"_a)
-      .def(
-          "set_flow",
-          [](uvms::Plant& p, const ConstVec& c, const Eigen::MatrixXd& waves, double depth) {
-            p.flow = wave_flow(c, waves, depth);
-          },
-          "current_world"_a, "waves"_a, "water_depth_m"_a)
-      .def("clear_contact", [](uvms::Plant& p) { p.contact = uvms::NoContact{}; })
-      .def(
-          "set_spring",
-          [](uvms::Plant& p, const ConstVec& stiffness, const ConstVec& anchor) {
-            p.contact = uvms::LinearSpring{vec3("stiffness_N_m", stiffness),
-                                           vec3("anchor_world_m", anchor)};
-          },
-          "stiffness_N_m"_a, "anchor_world_m"_a)
-      .def(
-          "set_plane",
-          [](uvms::Plant& p, const ConstVec& normal, const ConstVec& point, double k, double c) {
-            p.contact = uvms::CompliantPlane{vec3("normal_world", normal),
-                                             vec3("point_world_m", point), k, c};
-          },
-          "normal_world"_a, "point_world_m"_a, "stiffness_N_m"_a, "damping_N_s_m"_a)
-      .def("clear_disturbance", [](uvms::Plant& p) { p.disturbance.reset(); })
-      .def(
-          "set_sinusoidal_disturbance",
-          [](uvms::Plant& p, const ConstVec& amplitude, double period_s, double phase_rad) {
-            p.disturbance = uvms::SinusoidalDisturbance{vec6("amplitude", amplitude), period_s,
-                                                        phase_rad};
-          },
-          "amplitude"_a, "period_s"_a, "phase_rad"_a)
-      .def(
-          "contact_wrench",
-          [](uvms::Plant& p, const ConstVec& q, const ConstVec& v) -> Eigen::VectorXd {
-            check_state(p.dynamics(), q, v);
-            return p.contact_wrench(q, v);
-          },
-          "q"_a, "v"_a)
-      .def(
-          "acceleration",
-          [](uvms::Plant& p, double t, const ConstVec& q, const ConstVec& v, const ConstVec& tau,
-             std::optional<Eigen::VectorXd> contact_world) -> Eigen::VectorXd {
-            check_state(p.dynamics(), q, v);
-            check_vector("tau", tau, p.dynamics().nv());
-            if (!contact_world) return p.acceleration(t, q, v, tau);
-            const uvms::Vec6 lambda = vec6("contact_world", *contact_world);
-            return p.acceleration(t, q, v, tau, &lambda);
-          },
-          "time_s"_a, "q"_a, "v"_a, "tau"_a, "contact_world"_a = nb::none())
-      .def(
-          "advance",
-          [](uvms::Plant& p, double t0, const ConstVec& q0, const ConstVec& v0,
-             const ConstVec& tau, double t1, double max_step_s, bool rk4) {
-            check_state(p.dynamics(), q0, v0);
-            check_vector("tau", tau, p.dynamics().nv());
-            if (!(t1 > t0) || !(max_step_s > 0.0)) {
-              throw InputError("advance needs t1 > t0 and a positive step");
-            }
-            return p.advance(t0, q0, v0, tau, t1, max_step_s, rk4);
-          },
-          "t0"_a, "q0"_a, "v0"_a, "tau"_a, "t1"_a, "max_step_s"_a, "rk4"_a)
-      .def(
-          "chart",
-          [](uvms::Plant& p, const ConstVec& q0, const ConstVec& delta, const ConstVec& v) {
-            check_vector("q0", q0, p.dynamics().nq());
-            check_vector("delta", delta, p.dynamics().nv());
-            check_vector("v", v, p.dynamics().nv());
-            return p.chart(q0, delta, v);
-          },
-          "q0"_a, "delta"_a, "v"_a);
-
-  // the prescribed-performance controller's law (ppc.hpp); the Python controller validates
-  // and sizes its parameters and runs its reference for every call not returned as ok (0)
-  using Ppc = uvms::PrescribedPerformanceController;
-  using Vector1 = nb::ndarray<const double, nb::ndim<1>, nb::c_contig, nb::device::cpu>;
-  m.attr("PPC_STATUS") = nb::make_tuple("ok", "first-level funnel", "second-level funnel",
-                                        "solver declined", "Euler singularity", "bad input");
-  nb::class_<Ppc>(m, "PrescribedPerformanceController")
-      .def(
-          "__init__",
-          [](Ppc* self, const std::string& model_text, int ee_frame_id, const ConstVec& k_x,
-             const ConstVec& rho0_x, const ConstVec& rho_inf_x, const ConstVec& l_x_per_s,
-             const Eigen::VectorXd& k_zeta, const Eigen::VectorXd& rho0_zeta,
-             const Eigen::VectorXd& rho_inf_zeta, const Eigen::VectorXd& l_zeta_per_s,
-             const Eigen::VectorXd& velocity_weights, double null_space_gain_per_s,
-             const std::vector<int>& limited_q_index, const std::vector<int>& limited_v_index,
-             const Eigen::VectorXd& null_space_target, const Eigen::VectorXd& half_range,
-             double max_condition_bound, double refine_above_condition_bound, double xi_clamp,
-             double min_abs_cos_pitch) {
-            uvms::PpcSettings s;
-            s.ee_frame_id = ee_frame_id;
-            s.k_x = vec6("k_x", k_x);
-            s.rho0_x = vec6("rho0_x", rho0_x);
-            s.rho_inf_x = vec6("rho_inf_x", rho_inf_x);
-            s.l_x_per_s = vec6("l_x_per_s", l_x_per_s);
-            s.k_zeta = k_zeta;
-            s.rho0_zeta = rho0_zeta;
-            s.rho_inf_zeta = rho_inf_zeta;
-            s.l_zeta_per_s = l_zeta_per_s;
-            s.velocity_weights = velocity_weights;
-            s.null_space_gain_per_s = null_space_gain_per_s;
-            s.limited_q_index = limited_q_index;
-            s.limited_v_index = limited_v_index;
-            s.null_space_target = null_space_target;
-            s.half_range = half_range;
-            s.max_condition_bound = max_condition_bound;
-            s.refine_above_condition_bound = refine_above_condition_bound;
-            s.xi_clamp = xi_clamp;
-            s.min_abs_cos_pitch = min_abs_cos_pitch;
-            new (self) Ppc(uvms::model_from_text(model_text), std::move(s));
-          },
-          "model_text"_a, "ee_frame_id"_a, "k_x"_a, "rho0_x"_a, "rho_inf_x"_a, "l_x_per_s"_a,
-          "k_zeta"_a, "rho0_zeta"_a, "rho_inf_zeta"_a, "l_zeta_per_s"_a, "velocity_weights"_a,
-          "null_space_gain_per_s"_a, "limited_q_index"_a, "limited_v_index"_a,
-          "null_space_target"_a, "half_range"_a, "max_condition_bound"_a,
-          "refine_above_condition_bound"_a, "xi_clamp"_a, "min_abs_cos_pitch"_a)
-      .def_prop_ro("nq", &Ppc::nq)
-      .def_prop_ro("nv", &Ppc::nv)
-      .def(
-          "compute",
-          [](Ppc& c, double time_s, const Vector1& q, const Vector1& v, const Vector1& wrench,
-             const Vector1& force_desired, const Vector1& rpy_desired, bool extended) {
-            const auto size = [](const Vector1& a) { return Eigen::Index(a.shape(0)); };
-            return static_cast<int>(c.compute(time_s, q.data(), size(q), v.data(), size(v),
-                                              wrench.data(), size(wrench), force_desired.data(),
-                                              size(force_desired), rpy_desired.data(),
-                                              size(rpy_desired), extended));
-          },
-          "time_s"_a, "q"_a, "v"_a, "wrench_world"_a, "force_desired"_a, "rpy_desired"_a,
-          "extended"_a)
-      .def(
-          "signals",
-          [](Ppc& c) {
-            // a read-only view of the last ok call's packed signals (it lives with c)
-            const Eigen::VectorXd& s = c.signals();
-            return nb::ndarray<nb::numpy, const double, nb::ndim<1>>(
-                s.data(), {static_cast<std::size_t>(s.size())}, nb::handle());
-          },
-          nb::rv_policy::reference_internal)
-      .def("zeta_offset", &Ppc::zeta_offset, "k"_a)
-      .def("margin_offset", &Ppc::margin_offset);
+  bind_hydro_bodies(m);
+  bind_flow(m);
+  bind_dynamics(m);
+  bind_environment(m);
+  bind_plant(m);
+  bind_ppc(m);
 }

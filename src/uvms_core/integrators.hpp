@@ -17,6 +17,14 @@
 
 namespace uvms {
 
+// A fixed-step integrator (mirror of uvms_pin/sim/integrators.py, RK4 and SemiImplicitEuler):
+// its method and the longest substep [s] it takes between two times.
+enum class Method : int { rk4 = 0, semi_implicit_euler = 1 };
+struct FixedStep {
+  Method method = Method::rk4;
+  double step_s = 1e-3;
+};
+
 // n equal substeps no longer than max_step_s between t0 and t1, and their length.
 inline std::pair<int, double> substeps(double t0, double t1, double max_step_s) {
   const int n = std::max(1, static_cast<int>(std::ceil((t1 - t0) / max_step_s - 1e-9)));
@@ -83,12 +91,12 @@ struct ManifoldStepper {
     q = q_stage;
   }
 
-  // Advance (q, v) from t0 to t1 in equal substeps (RK4 if rk4, else semi-implicit Euler).
+  // Advance (q, v) from t0 to t1 in equal substeps of the integrator's method.
   template <class Rhs>
-  void advance(Rhs& rhs, double t0, double t1, double max_step_s, bool rk4) {
-    const auto [n, h] = substeps(t0, t1, max_step_s);
+  void advance(Rhs& rhs, double t0, double t1, const FixedStep& integrator) {
+    const auto [n, h] = substeps(t0, t1, integrator.step_s);
     for (int k = 0; k < n; ++k) {
-      if (rk4) {
+      if (integrator.method == Method::rk4) {
         rk4_step(rhs, t0 + k * h, h);
       } else {
         semi_implicit_euler_step(rhs, t0 + k * h, h);

@@ -58,14 +58,14 @@ const Eigen::VectorXd& Plant::acceleration(double time_s, const ConstVec& q, con
 std::pair<Eigen::VectorXd, Eigen::VectorXd> Plant::advance(double t0, const ConstVec& q0,
                                                            const ConstVec& v0,
                                                            const ConstVec& tau, double t1,
-                                                           double max_step_s, bool rk4) {
+                                                           const FixedStep& integrator) {
   stepper_.q = q0;
   stepper_.v = v0;
   auto rhs = [&](double t, const Eigen::VectorXd& q,
                  const Eigen::VectorXd& v) -> const Eigen::VectorXd& {
     return acceleration(t, q, v, tau);
   };
-  stepper_.advance(rhs, t0, t1, max_step_s, rk4);
+  stepper_.advance(rhs, t0, t1, integrator);
   return {stepper_.q, stepper_.v};
 }
 

@@ -28,10 +28,10 @@ class Plant {
   // zeta_dot; contact_world given = use it instead of the contact model (continuous loop).
   const Eigen::VectorXd& acceleration(double time_s, const ConstVec& q, const ConstVec& v,
                                       const ConstVec& tau, const Vec6* contact_world = nullptr);
-  // (q, v) at t1 from (q0, v0) at t0 with tau held; rk4 or semi-implicit Euler substeps.
+  // (q, v) at t1 from (q0, v0) at t0 with tau held, in the integrator's substeps.
   std::pair<Eigen::VectorXd, Eigen::VectorXd> advance(double t0, const ConstVec& q0,
                                                       const ConstVec& v0, const ConstVec& tau,
-                                                      double t1, double max_step_s, bool rk4);
+                                                      double t1, const FixedStep& integrator);
 
   // The local chart of the adaptive integrators (integrators.py, Adaptive): the
   // configuration q = integrate(q0, delta) and delta_dot = Jint(q0, delta)^-1 v.

@@ -85,6 +85,17 @@ PrescribedPerformanceController::PrescribedPerformanceController(pinocchio::Mode
   committed_ = working_;
 }
 
+std::vector<PrescribedPerformanceController::SignalSlot>
+PrescribedPerformanceController::signal_layout() const {
+  const Eigen::Index nv = model_.nv;
+  return {{"rpy_ee", kRpyEe, 3},          {"e_x", kEx, 6},
+          {"rho_x", kRhoX, 6},            {"xi_x", kXiX, 6},
+          {"xdot_r", kXdotR, 6},          {"zeta_r", zeta_offset(0), nv},
+          {"e_zeta", zeta_offset(1), nv}, {"rho_zeta", zeta_offset(2), nv},
+          {"xi_zeta", zeta_offset(3), nv}, {"tau", zeta_offset(4), nv},
+          {"margin", margin_offset(), 1}};
+}
+
 const Eigen::VectorXd& PrescribedPerformanceController::null_space_velocity(
     const Eigen::VectorXd& q) {
   zeta_0_.setZero();

@@ -92,6 +92,13 @@ class PrescribedPerformanceController {
                                 kZetaR = 27;
   Eigen::Index zeta_offset(int k) const { return kZetaR + k * model_.nv; }  // 0 zeta_r .. 4 tau
   Eigen::Index margin_offset() const { return kZetaR + 5 * model_.nv; }
+  // Where each signal sits in signals(): (name, offset, size), in this order; the only place
+  // the layout is written (the Python controller reads its views from it).
+  struct SignalSlot {
+    const char* name;
+    Eigen::Index offset, size;
+  };
+  std::vector<SignalSlot> signal_layout() const;
 
   // zeta_0 (nv) of the null-space task at q: the Python null_space_velocity (for tests).
   const Eigen::VectorXd& null_space_velocity(const Eigen::VectorXd& q);

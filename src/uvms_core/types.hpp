@@ -7,6 +7,10 @@
 
 namespace uvms {
 
+// The version of the interface the Python seam (uvms_pin/physics/compiled/) is written
+// against: the only place it is defined (Python reads _core.API_VERSION).
+constexpr int kApiVersion = 2;
+
 using Vec3 = Eigen::Vector3d;
 using Vec6 = Eigen::Matrix<double, 6, 1>;
 using Mat3 = Eigen::Matrix3d;

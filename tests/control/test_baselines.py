@@ -16,10 +16,11 @@ from uvms_pin.errors import ScenarioError
 from uvms_pin.model.scaled import scaled_uvms
 from uvms_pin.scenario.scenario import load_scenario, scenario_from_raw
 from uvms_pin.scenario.toml import read_toml
-from uvms_pin.sim.closed_loop import SimulationSettings, simulate_closed_loop
+from uvms_pin.sim.closed_loop import simulate_closed_loop
 from uvms_pin.sim.integrators import RK4
 from uvms_pin.sim.plant import Plant
 from uvms_pin.sim.sensors import SensorConfig, SensorSuite
+from uvms_pin.sim.settings import SimulationSettings
 
 REALISTIC = ROOT / "scenarios" / "realistic_force_tracking.toml"
 

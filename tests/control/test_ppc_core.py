@@ -34,7 +34,7 @@ from uvms_pin.control.measurement import Measurement
 from uvms_pin.control.ppc import PPCParams, PrescribedPerformanceController
 from uvms_pin.errors import FunnelViolation, ParameterError, ScenarioError
 from uvms_pin.model.resources import example_robot_data_dir
-from uvms_pin.physics.compiled import core_module
+from uvms_pin.physics.compiled.extension import core_module
 from uvms_pin.scenario.scenario import load_scenario
 
 STATUS = core_module().PPC_STATUS
@@ -121,13 +121,12 @@ def test_the_kernel_reports_each_status(reference_uvms):
     assert status(v=np.full(model.nv, 3.0), extended=True) == "second-level funnel"
     # xi_zeta of one component between the extension's clamp and 1: the plain law holds
     # (ok), the extension is the reference's
-    packed = kernel.signals()
-    zeta_r = packed[kernel.zeta_offset(0) : kernel.zeta_offset(0) + model.nv].copy()
-    rho_zeta = packed[kernel.zeta_offset(2) : kernel.zeta_offset(2) + model.nv].copy()
+    zeta_r = kernel.views["zeta_r"].copy()
+    rho_zeta = kernel.views["rho_zeta"].copy()
     v_edge = v.copy()
     v_edge[7] = zeta_r[7] + (1.0 - 3e-7) * rho_zeta[7]
     assert status(v=v_edge) == "ok"
-    assert np.abs(kernel.signals()[kernel.zeta_offset(3) + 7] - (1.0 - 3e-7)) < 1e-12
+    assert np.abs(kernel.views["xi_zeta"][7] - (1.0 - 3e-7)) < 1e-12
     assert status(v=v_edge, extended=True) == "second-level funnel"
     assert status(q=np.r_[q[:-1], np.nan]) == "bad input"
     assert status(v=v[:-1]) == "bad input"
@@ -147,9 +146,9 @@ def test_the_kernel_reports_each_status(reference_uvms):
     assert status(q=q_singular, rpy=singular_rpy) == "Euler singularity"
     # a failed call leaves the last ok call's signals
     assert status() == "ok"
-    packed = kernel.signals().copy()
+    packed = kernel.packed.copy()
     assert status(force=np.array([5.0, 0.0, 0.0])) != "ok"
-    np.testing.assert_array_equal(kernel.signals(), packed)
+    np.testing.assert_array_equal(kernel.packed, packed)
 
 
 # ---------------------------------------------------------------- recorded runs

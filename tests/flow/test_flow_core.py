@@ -11,8 +11,11 @@ import pytest
 from conftest import assert_rel, random_configuration
 
 import uvms_pin as up
+from uvms_pin.errors import CoreFallbackWarning
 from uvms_pin.flow import AiryWave, GaussMarkovCurrent, IrregularSea, UniformCurrent
-from uvms_pin.physics.compiled import CoreFallbackWarning, compiled_flow
+from uvms_pin.physics.compiled.backend import Fallback
+from uvms_pin.physics.compiled.extension import core_module
+from uvms_pin.physics.compiled.flow import flow_to_core
 from uvms_pin.scenario.scenario import load_scenario, simulate
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -65,9 +68,11 @@ def test_the_sea_state_closed_loop_is_the_same_on_both_backends():
 
 def test_a_flow_the_core_cannot_represent_runs_on_the_reference(reference_uvms):
     gm = GaussMarkovCurrent([0.2, 0, 0], 0.05, 10.0, 0.1, seed=3)
-    assert compiled_flow(gm) is None
-    assert compiled_flow(AiryWave(0.1, 3.0, water_depth_m=5.0) + AiryWave(0.1, 4.0)) is None
-    assert compiled_flow(None)[1].shape == (0, 5)
+    core = core_module()
+    assert isinstance(flow_to_core(gm, core), Fallback)
+    mixed_depths = AiryWave(0.1, 3.0, water_depth_m=5.0) + AiryWave(0.1, 4.0)
+    assert isinstance(flow_to_core(mixed_depths, core), Fallback)
+    assert flow_to_core(None, core).waves == []
     q = reference_uvms.neutral_configuration()
     q[2] = -2.0
     v = np.full(reference_uvms.nv, 0.1)
@@ -76,4 +81,4 @@ def test_a_flow_the_core_cannot_represent_runs_on_the_reference(reference_uvms):
     np.testing.assert_array_equal(
         h, up.bias_forces(reference_uvms, q, v, flow=gm, time_s=1.0, backend="python")
     )
-    assert math.isinf(compiled_flow(IrregularSea(0.5, 5.0))[2])
+    assert math.isinf(flow_to_core(IrregularSea(0.5, 5.0), core).water_depth_m)

@@ -2,14 +2,15 @@
 
 from __future__ import annotations
 
+import json
 from pathlib import Path
 
 import numpy as np
 import pytest
 
 import uvms_pin as up
-from uvms_pin.flow import AiryWave, GaussMarkovCurrent, IrregularSea, SumFlow
-from uvms_pin.scenario.scenario import load_scenario, simulate, water_flow_of
+from uvms_pin.flow import AiryWave, GaussMarkovCurrent, IrregularSea, SumFlow, flow_from_record
+from uvms_pin.scenario.scenario import load_scenario, simulate
 
 ROOT = Path(__file__).resolve().parents[2]
 REALISTIC = ROOT / "scenarios" / "realistic_force_tracking.toml"
@@ -42,11 +43,11 @@ def test_flow_tables_add_up_and_are_recorded():
     flow = scenario.plant.flow
     assert isinstance(flow, SumFlow)
     assert [type(f) for f in flow.fields] == [GaussMarkovCurrent, AiryWave]
-    # the rollout's recorded parameters rebuild the same whole flow (current included)
-    rebuilt = water_flow_of(scenario.raw)
+    # what a rollout records (JSON) rebuilds the same whole flow (current included)
+    rebuilt = flow_from_record(json.loads(json.dumps(scenario.plant.record()))["flow"])
     p = np.array([[0.3, 0.1, -2.0]])
     np.testing.assert_allclose(
-        rebuilt.velocity(1.3, p), scenario.plant.water_flow.velocity(1.3, p), rtol=1e-14
+        rebuilt.velocity(1.3, p), scenario.plant.water.velocity(1.3, p), rtol=1e-14
     )
 
 

@@ -10,11 +10,11 @@ import pytest
 from conftest import ROOT
 
 import uvms_pin as up
-from uvms_pin.errors import ParameterError, SimulationError
-from uvms_pin.physics import compiled as core
-from uvms_pin.physics.environment import SinusoidalDisturbance
+from uvms_pin.errors import CoreFallbackWarning, ParameterError, SimulationError
+from uvms_pin.physics.compiled import extension as core
+from uvms_pin.physics.disturbance import SinusoidalDisturbance
 from uvms_pin.sim.integrators import RK4
-from uvms_pin.sim.plant import CoreFallbackWarning, Plant
+from uvms_pin.sim.plant import Plant
 
 SCENARIO = ROOT / "scenarios" / "realistic_force_tracking.toml"
 

@@ -17,7 +17,8 @@ from conftest import REL, assert_rel, mount_on_reference_vehicle, random_configu
 
 import uvms_pin as up
 from uvms_pin.model.resources import example_robot_data_dir, shipped_models, shipped_path
-from uvms_pin.physics.environment import CompliantPlane, LinearSpring, SinusoidalDisturbance
+from uvms_pin.physics.contact import CompliantPlane, LinearSpring
+from uvms_pin.physics.disturbance import SinusoidalDisturbance
 from uvms_pin.sim.integrators import RK4, SemiImplicitEuler, python_chart
 from uvms_pin.sim.plant import Plant
 

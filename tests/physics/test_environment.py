@@ -11,7 +11,8 @@ import pytest
 from conftest import REFERENCE_URDF
 
 import uvms_pin as up
-from uvms_pin.physics.environment import CompliantPlane, LinearSpring, SinusoidalDisturbance
+from uvms_pin.physics.contact import CompliantPlane, LinearSpring
+from uvms_pin.physics.disturbance import SinusoidalDisturbance
 from uvms_pin.scenario.scenario import load_scenario, simulate
 
 K = np.array([2.0, 3.0, 5.0])

@@ -160,7 +160,7 @@ def test_what_needs_an_end_effector_says_so(tmp_path, extra, needle):
 
 
 def test_a_contact_plant_needs_an_end_effector():
-    from uvms_pin.physics.environment import LinearSpring
+    from uvms_pin.physics.contact import LinearSpring
     from uvms_pin.sim.plant import Plant
 
     with pytest.raises(up.ModelError, match="needs an end-effector frame"):

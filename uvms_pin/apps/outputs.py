@@ -31,14 +31,13 @@ def write_outputs(rollout: Rollout, out: Path) -> list[Path]:
 def _flow_figure(rollout: Rollout, out: Path) -> list[Path]:
     """flow.png when the run had waves or a varying current (not for a uniform current)."""
     from uvms_pin.apps.viz.flow_plots import FLOW_FIGURE, plot_flow_seen
-    from uvms_pin.flow import UniformCurrent
+    from uvms_pin.flow import UniformCurrent, flow_from_record
     from uvms_pin.model.uvms import load_uvms
-    from uvms_pin.scenario.scenario import water_flow_of
 
-    parameters = rollout.metadata.get("parameters") or {}
-    flow = water_flow_of(parameters)
+    world = rollout.metadata.get("world") or {}
+    flow = flow_from_record(world.get("flow"))
     if flow is None or isinstance(flow, UniformCurrent) or len(rollout) == 0:
         return []
-    density = float(parameters.get("water", {}).get("density_kg_m3", 1025.0))
+    density = float(world["water_density_kg_m3"])
     uvms = load_uvms(rollout.metadata["model_source"], water_density_kg_m3=density)
     return [plot_flow_seen(rollout, uvms, flow, out / FLOW_FIGURE)]

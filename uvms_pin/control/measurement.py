@@ -1,4 +1,4 @@
-"""What a controller is allowed to see: one sample of the (possibly noisy) sensors."""
+"""What a controller is allowed to see: one sample of the (possibly noisy) sensors, read-only."""
 
 from __future__ import annotations
 
@@ -7,9 +7,15 @@ from dataclasses import dataclass
 import numpy as np
 
 
+def read_only(array: np.ndarray) -> np.ndarray:
+    """``array`` itself, marked read-only: whoever holds it can no longer write into it."""
+    array.flags.writeable = False
+    return array
+
+
 @dataclass(frozen=True)
 class Measurement:
-    """One sensor sample; the only input of a controller.
+    """One sensor sample; the only input of a controller. Its arrays are read-only.
 
     Attributes:
         time_s: sample time t [s].
@@ -25,6 +31,18 @@ class Measurement:
     q: np.ndarray
     v: np.ndarray
     wrench_world: np.ndarray
+
+    def __post_init__(self) -> None:
+        # a measurement never aliases anything writable (the plant's state): arrays that are
+        # not already read-only float arrays are copied, and the copies frozen
+        for name in ("q", "v", "wrench_world"):
+            value = getattr(self, name)
+            if not (
+                isinstance(value, np.ndarray)
+                and value.dtype == np.float64
+                and not value.flags.writeable
+            ):
+                object.__setattr__(self, name, read_only(np.array(value, dtype=float)))
 
     @property
     def force_world_N(self) -> np.ndarray:

@@ -69,15 +69,14 @@ from uvms_pin.control.performance import (
     transformed_error,
     transformed_error_extended,
 )
+from uvms_pin.control.ppc_kernel import PpcKernel
 from uvms_pin.control.pseudo_inverse import (
-    REFINE_ABOVE_CONDITION_BOUND,
     MinimumNormSolver,
     pseudo_inverse,
 )
 from uvms_pin.errors import ParameterError
-from uvms_pin.physics.compiled import check_backend, core_module
+from uvms_pin.physics.compiled.backend import Fallback, backend_named
 from uvms_pin.physics.kinematics import (
-    EULER_SINGULARITY_MIN_ABS_COS_PITCH,
     analytical_jacobian,
     angular_velocity_world_from_euler_rates,
     check_euler_singularity,
@@ -349,7 +348,7 @@ class PrescribedPerformanceController(Controller):
         *,
         backend: str = "core",
     ):
-        self.backend = check_backend(backend)
+        self.backend = backend_named(backend).name
         if model.njoints < 2 or model.joints[1].shortname() != "JointModelFreeFlyer":
             raise ParameterError(
                 "the UVMS model must have a free-flyer root joint (joint 1); build it with "
@@ -413,43 +412,35 @@ class PrescribedPerformanceController(Controller):
         self._last: tuple | None = None
         self._last_signals: PPCSignals | None = None
         self._core_last: tuple | None = None
-        self._kernel = self._build_kernel() if self.backend == "core" else None
+        self._kernel = self._build_kernel()
 
-    def _build_kernel(self):
-        """The compiled law (src/uvms_core/ppc.hpp) with this controller's constants, and
-        read-only views of its packed signals (those of its last ok call)."""
-        params, solver = self.params, self._solver
-        kernel = core_module().PrescribedPerformanceController(
-            self.model.saveToString(),
-            self.ee_frame_id,
-            params.k_x,
-            params.rho0_x,
-            params.rho_inf_x,
-            params.l_x_per_s,
-            params.k_zeta,
-            self.performance_zeta.rho0,
-            self.performance_zeta.rho_inf,
-            self.performance_zeta.decay_rate_per_s,
-            params.velocity_weights,
-            float(params.null_space_gain_per_s),
-            self._limited_q_index.tolist(),
-            self._limited_v_index.tolist(),
-            np.asarray(self._target, dtype=float),
-            self._half_range,
-            solver.max_condition_bound,
-            REFINE_ABOVE_CONDITION_BOUND,
-            _XI_CLAMP,
-            EULER_SINGULARITY_MIN_ABS_COS_PITCH,
+    def _build_kernel(self) -> PpcKernel | None:
+        """The compiled law with this controller's constants (None with the Python backend)."""
+        params, zeta = self.params, self.performance_zeta
+        kernel = PpcKernel.build(
+            backend_named(self.backend),
+            self.model,
+            ee_frame_id=self.ee_frame_id,
+            k_x=params.k_x,
+            rho0_x=params.rho0_x,
+            rho_inf_x=params.rho_inf_x,
+            l_x_per_s=params.l_x_per_s,
+            k_zeta=params.k_zeta,
+            rho0_zeta=zeta.rho0,
+            rho_inf_zeta=zeta.rho_inf,
+            l_zeta_per_s=zeta.decay_rate_per_s,
+            velocity_weights=params.velocity_weights,
+            null_space_gain_per_s=float(params.null_space_gain_per_s),
+            limited_q_index=self._limited_q_index.tolist(),
+            limited_v_index=self._limited_v_index.tolist(),
+            null_space_target=np.asarray(self._target, dtype=float),
+            half_range=self._half_range,
+            max_condition_bound=self._solver.max_condition_bound,
+            xi_clamp=_XI_CLAMP,
         )
-        packed, nv = kernel.signals(), self._nv
-        zeta = [packed[kernel.zeta_offset(k) : kernel.zeta_offset(k) + nv] for k in range(5)]
-        self._core_signals = (packed[0:3], packed[3:9], packed[9:15], packed[15:21],
-                              packed[21:27], *zeta)  # fmt: skip
-        self._core_tau = zeta[4]
-        self._core_margin = packed[kernel.margin_offset() :]
-        return kernel
+        return None if isinstance(kernel, Fallback) else kernel
 
-    _KERNEL_ATTRIBUTES = ("_kernel", "_core_signals", "_core_tau", "_core_margin")
+    _KERNEL_ATTRIBUTES = ("_kernel",)
 
     def __getstate__(self) -> dict:
         """For copy and pickle: the compiled kernel is rebuilt, the last signals kept."""
@@ -461,7 +452,7 @@ class PrescribedPerformanceController(Controller):
 
     def __setstate__(self, state: dict) -> None:
         self.__dict__.update(state)
-        self._kernel = self._build_kernel() if self.backend == "core" else None
+        self._kernel = self._build_kernel()
 
     # ------------------------------------------------------------------ model helpers
     def _arm_velocity_names(self) -> list[str]:
@@ -560,25 +551,23 @@ class PrescribedPerformanceController(Controller):
             self._check_measurement(measurement)  # the reference checks the measurement first
             raise
         extended = self._extend_beyond_funnels
-        try:
-            status = kernel.compute(
-                time_s,
-                measurement.q,
-                measurement.v,
-                measurement.wrench_world,
-                force_desired,
-                rpy_desired,
-                extended,
-            )
-        except TypeError:  # not convertible to 1-D float arrays: the reference says why
-            status = -1
+        # any status but ok (0), bad input included: the reference evaluates, raises or says why
+        status = kernel.compute(
+            time_s,
+            measurement.q,
+            measurement.v,
+            measurement.wrench_world,
+            force_desired,
+            rpy_desired,
+            extended,
+        )
         if status:
             return self._compute_reference(time_s, measurement, force_desired, rpy_desired)
         self._core_last = (time_s, force_desired, rpy_desired, extended)
         self._last = None
         self._last_signals = None
         self._margin = None
-        return self._core_tau.copy()
+        return kernel.tau.copy()
 
     def _compute_reference(
         self,
@@ -698,7 +687,7 @@ class PrescribedPerformanceController(Controller):
         if self._core_last is not None:  # copies: the kernel's buffer is rewritten
             time_s, force_desired, rpy_desired, extended = self._core_last
             (rpy_ee, e_x, rho_x, xi_x, xdot_r, zeta_r, e_zeta, rho_zeta, xi_zeta,
-             tau) = (a.copy() for a in self._core_signals)  # fmt: skip
+             tau) = self._kernel.copies()  # fmt: skip
         elif self._last is not None:
             (time_s, force_desired, rpy_desired, rpy_ee, e_x, rho_x, xi_x, xdot_r, zeta_r,
              e_zeta, rho_zeta, xi_zeta, tau, extended) = self._last  # fmt: skip
@@ -735,7 +724,7 @@ class PrescribedPerformanceController(Controller):
     def funnel_margin(self) -> float:
         """min(1 - |xi|) over both levels at the last ``compute`` (> 0: inside)."""
         margin = self._margin
-        return float(self._core_margin[0]) if margin is None else margin
+        return self._kernel.margin if margin is None else margin
 
     def set_funnel_extension(self, enabled: bool) -> None:
         self._extend_beyond_funnels = bool(enabled)

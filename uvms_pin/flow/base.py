@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 from abc import ABC, abstractmethod
+from typing import Any
 
 import numpy as np
 
@@ -76,6 +77,12 @@ class FlowField(ABC):
         xy = np.asarray(xy_world, dtype=float).reshape(-1, 2)
         return np.zeros(len(xy))
 
+    def record(self) -> dict[str, Any]:
+        """This field as plain data (JSON: a rollout saves it), which
+        `uvms_pin.flow.record.flow_from_record` turns back into the same field. A field
+        defined outside uvms-pin records its type and repr only (it cannot be rebuilt)."""
+        return {"type": type(self).__name__, "repr": repr(self)}
+
     def __add__(self, other: FlowField) -> SumFlow:
         if not isinstance(other, FlowField):
             return NotImplemented
@@ -117,6 +124,9 @@ class SumFlow(FlowField):
 
     def surface_elevation(self, time_s, xy_world):
         return sum(f.surface_elevation(time_s, xy_world) for f in self.fields)
+
+    def record(self) -> dict[str, Any]:
+        return {"type": "sum", "fields": [f.record() for f in self.fields]}
 
     def __repr__(self) -> str:
         return " + ".join(repr(f) for f in self.fields)

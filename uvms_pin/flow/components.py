@@ -160,3 +160,28 @@ class WaveField(FlowField):
 
     def surface_elevation(self, time_s, xy_world):
         return self.components.elevation(time_s, np.asarray(xy_world, dtype=float).reshape(-1, 2))
+
+    def record(self) -> dict:
+        """Its components, exactly (a sea state is not drawn again)."""
+        c = self.components
+        return {
+            "type": "waves",
+            "repr": repr(self),
+            "amplitude_m": c.amplitude_m.tolist(),
+            "angular_frequency_rad_s": c.angular_frequency_rad_s.tolist(),
+            "wavenumber_rad_m": c.wavenumber_rad_m.tolist(),
+            "heading_rad": c.heading_rad.tolist(),
+            "phase_rad": c.phase_rad.tolist(),
+            "water_depth_m": float(c.water_depth_m),
+        }
+
+
+class Waves(WaveField):
+    """Linear waves given by their components (a recorded `AiryWave` or `IrregularSea`)."""
+
+    def __init__(self, components: WaveComponents, label: str = "Waves"):
+        self.components = components
+        self._label = label
+
+    def __repr__(self) -> str:
+        return self._label

@@ -19,9 +19,9 @@ import math
 
 import numpy as np
 
+from uvms_pin.checks import finite_vector
 from uvms_pin.errors import ParameterError
 from uvms_pin.flow.base import FlowField, as_points
-from uvms_pin.flow.uniform import finite_vector3
 
 _CHUNK = 1024
 
@@ -66,8 +66,8 @@ class GaussMarkovCurrent(FlowField):
         seed: int = 0,
         sample_period_s: float = 0.5,
     ):
-        self.mean_velocity_world_m_s = finite_vector3(
-            mean_velocity_world_m_s, "mean_velocity_world_m_s"
+        self.mean_velocity_world_m_s = finite_vector(
+            "mean_velocity_world_m_s", mean_velocity_world_m_s, 3
         )
         self.std_m_s = float(std_m_s)
         if not (self.std_m_s >= 0.0 and math.isfinite(self.std_m_s)):
@@ -130,6 +130,18 @@ class GaussMarkovCurrent(FlowField):
 
     def velocity_gradient(self, time_s, points_world):
         return np.zeros((len(as_points(points_world)), 3, 3))
+
+    def record(self) -> dict:
+        """Its parameters and seed: the same realisation is drawn again."""
+        return {
+            "type": "gauss_markov_current",
+            "mean_velocity_world_m_s": self.mean_velocity_world_m_s.tolist(),
+            "std_m_s": self.std_m_s,
+            "time_constant_s": self.time_constant_s,
+            "bound_m_s": self.bound_m_s,
+            "seed": self.seed,
+            "sample_period_s": self.sample_period_s,
+        }
 
     def __repr__(self) -> str:
         return (

@@ -4,9 +4,9 @@ from __future__ import annotations
 
 import numpy as np
 
+from uvms_pin.checks import finite_vector
 from uvms_pin.errors import ParameterError
 from uvms_pin.flow.base import FlowField, as_points
-from uvms_pin.flow.uniform import finite_vector3
 
 
 class DepthProfileCurrent(FlowField):
@@ -20,7 +20,7 @@ class DepthProfileCurrent(FlowField):
     """
 
     def __init__(self, velocity_world_m_s, depths_m, factors):
-        self.velocity_world_m_s = finite_vector3(velocity_world_m_s, "velocity_world_m_s")
+        self.velocity_world_m_s = finite_vector("velocity_world_m_s", velocity_world_m_s, 3)
         depths = np.asarray(depths_m, dtype=float).reshape(-1)
         factors_ = np.asarray(factors, dtype=float).reshape(-1)
         if depths.shape != factors_.shape or depths.size < 2:
@@ -70,6 +70,14 @@ class DepthProfileCurrent(FlowField):
         grad = np.zeros((len(slope_z), 3, 3))
         grad[:, :, 2] = slope_z[:, None] * self.velocity_world_m_s
         return grad
+
+    def record(self) -> dict:
+        return {
+            "type": "depth_profile_current",
+            "velocity_world_m_s": self.velocity_world_m_s.tolist(),
+            "depths_m": self.depths_m.tolist(),
+            "factors": self.factors.tolist(),
+        }
 
     def __repr__(self) -> str:
         return (

@@ -4,23 +4,15 @@ from __future__ import annotations
 
 import numpy as np
 
-from uvms_pin.errors import ParameterError
+from uvms_pin.checks import finite_vector
 from uvms_pin.flow.base import FlowField, as_points
-
-
-def finite_vector3(value, name: str) -> np.ndarray:
-    """A finite (3,) float vector, or ParameterError naming ``name``."""
-    vector = np.asarray(value, dtype=float).reshape(-1)
-    if vector.shape != (3,) or not np.all(np.isfinite(vector)):
-        raise ParameterError(f"{name} must be 3 finite numbers, got {value!r}")
-    return vector
 
 
 class UniformCurrent(FlowField):
     """u(t, p) = U, the same everywhere and always (world frame) [m/s]."""
 
     def __init__(self, velocity_world_m_s):
-        self.velocity_world_m_s = finite_vector3(velocity_world_m_s, "velocity_world_m_s")
+        self.velocity_world_m_s = finite_vector("velocity_world_m_s", velocity_world_m_s, 3)
 
     def velocity(self, time_s, points_world):
         return np.tile(self.velocity_world_m_s, (len(as_points(points_world)), 1))
@@ -33,6 +25,9 @@ class UniformCurrent(FlowField):
 
     def acceleration(self, time_s, points_world):
         return np.zeros((len(as_points(points_world)), 3))
+
+    def record(self) -> dict:
+        return {"type": "uniform_current", "velocity_world_m_s": self.velocity_world_m_s.tolist()}
 
     def __repr__(self) -> str:
         return f"UniformCurrent({self.velocity_world_m_s.tolist()})"

@@ -84,9 +84,13 @@ class UVMS:
     hydro_bodies_with_damping: tuple[HydroBody, ...] = field(init=False, repr=False)
     volume_per_joint_m3: np.ndarray = field(init=False, repr=False)
     center_of_buoyancy_per_joint_m: np.ndarray = field(init=False, repr=False)
+    #: What the layers above build from this model once and keep with it (the compiled
+    #: dynamics): derived, so neither compared, copied nor pickled.
+    cache: dict = field(init=False, repr=False, compare=False)
 
     def __post_init__(self) -> None:
         self.data = self.model.createData()
+        self.cache = {}
         nj = self.model.njoints
         added = np.zeros((nj, 6, 6))
         volume = np.zeros(nj)
@@ -130,9 +134,7 @@ class UVMS:
         )
 
     def __getstate__(self) -> dict:
-        state = dict(self.__dict__)
-        state.pop("_core_dynamics", None)  # the compiled core (C++): rebuilt on first use
-        return state
+        return {**self.__dict__, "cache": {}}  # e.g. C++ objects: rebuilt on first use
 
     # ---- sizes and aggregates -------------------------------------------------------
     @property

@@ -21,12 +21,11 @@ computes the same quantities in one C++ call and is held to this reference by th
 
 from __future__ import annotations
 
-import warnings
-
 import numpy as np
 import pinocchio as pin
 from scipy.linalg import cho_factor, cho_solve
 
+from uvms_pin.checks import finite_vector
 from uvms_pin.errors import ParameterError, SimulationError
 from uvms_pin.flow import FlowField, UniformCurrent
 from uvms_pin.hydro.added_mass import kirchhoff_wrench
@@ -39,41 +38,10 @@ from uvms_pin.hydro.restoring import (
 )
 from uvms_pin.hydro.vector import mat_t_vec, mat_vec
 from uvms_pin.model.uvms import UVMS
-from uvms_pin.physics.compiled import CoreFallbackWarning, check_backend, compiled_flow, dynamics_of
+from uvms_pin.physics.compiled.backend import backend_named
+from uvms_pin.physics.compiled.dynamics import CompiledDynamics
 
 _NO_CURRENT = np.zeros(3)
-
-
-def _check(name: str, x: np.ndarray, n: int) -> np.ndarray:
-    x = np.asarray(x, dtype=float)
-    if x.shape != (n,):
-        raise ParameterError(f"{name} must have shape ({n},), got {x.shape}")
-    if not np.all(np.isfinite(x)):
-        raise ParameterError(f"{name} contains a non-finite value: {x}")
-    return x
-
-
-def _resolve_flow(current_world: np.ndarray, flow: FlowField | None) -> FlowField | None:
-    """The flow a call asked for: ``current_world`` is the shorthand for a UniformCurrent."""
-    current = _check("current_world", current_world, 3)
-    if flow is not None:
-        if not isinstance(flow, FlowField):
-            raise ParameterError(
-                f"flow must be a uvms_pin.flow.FlowField, got {type(flow).__name__}"
-            )
-        if np.any(current):
-            raise ParameterError("give either current_world or flow, not both (add the fields)")
-        return flow
-    return UniformCurrent(current) if np.any(current) else None
-
-
-def _warn_python_flow(flow: FlowField) -> None:
-    warnings.warn(
-        f"the compiled core does not support the flow {flow!r}: the Python reference "
-        "computes these dynamics (slower)",
-        CoreFallbackWarning,
-        stacklevel=3,
-    )
 
 
 def _check_time(time_s: float) -> float:
@@ -148,30 +116,6 @@ def _fluid_wrenches(uvms: UVMS, flow: FlowField | None, time_s: float) -> list[p
     return [pin.Force(w) for w in wrench]
 
 
-def _core_inputs(uvms: UVMS, **arrays) -> dict[str, np.ndarray]:
-    """The arguments as float arrays, or ParameterError naming the bad one (the core's
-    binding takes float arrays only: this runs only when it refused an argument)."""
-    sizes = {"q": uvms.nq, "current_world": 3}
-    return {
-        name: x if x is None else _check(name, x, sizes.get(name, uvms.nv))
-        for name, x in arrays.items()
-    }
-
-
-def mass_matrix(uvms: UVMS, q: np.ndarray, *, backend: str = "core") -> np.ndarray:
-    """M(q) = M_RB(q) + sum_i J_i^T M_A,i J_i (nv x nv, symmetric positive definite).
-
-    ``backend``: "core" (compiled, default) or "python" (the reference)."""
-    if backend == "core":
-        try:
-            return dynamics_of(uvms).mass_matrix(q)
-        except TypeError:
-            return dynamics_of(uvms).mass_matrix(**_core_inputs(uvms, q=q))
-    check_backend(backend)
-    q = _check("q", q, uvms.nq)
-    return _mass_matrix(uvms, q)
-
-
 def _mass_matrix(uvms: UVMS, q: np.ndarray) -> np.ndarray:
     model, data = uvms.model, uvms.data
     pin.crba(model, data, q)
@@ -183,6 +127,117 @@ def _mass_matrix(uvms: UVMS, q: np.ndarray) -> np.ndarray:
             jac = pin.getJointJacobian(model, data, j, pin.LOCAL)
             mass += jac.T @ uvms.added_mass_per_joint[j] @ jac
     return mass
+
+
+def _bias_forces(
+    uvms: UVMS, q: np.ndarray, v: np.ndarray, flow: FlowField | None, time_s: float
+) -> np.ndarray:
+    model, data = uvms.model, uvms.data
+    zero = np.zeros(model.nv)
+    pin.forwardKinematics(model, data, q, v, zero)
+    fext = _fluid_wrenches(uvms, flow, time_s)
+    # rnea(q, v, 0, fext) = C_RB v + g_RB - sum_i J_i^T fext_i
+    return pin.rnea(model, data, q, v, zero, fext).copy()
+
+
+def _solve(uvms: UVMS, q: np.ndarray, rhs: np.ndarray) -> np.ndarray:
+    """M(q)^-1 rhs by a Cholesky factorisation (no inverse)."""
+    mass = _mass_matrix(uvms, q)
+    try:
+        factor = cho_factor(mass, lower=False, check_finite=False)
+    except np.linalg.LinAlgError as exc:
+        raise SimulationError(f"mass matrix is not positive definite at q = {q}") from exc
+    return cho_solve(factor, rhs, check_finite=False)
+
+
+class ReferenceDynamics:
+    """M, h and the forward dynamics of one UVMS, in Python: the readable reference.
+
+    The ``*_in`` methods take any `uvms_pin.flow.FlowField` evaluated at ``time_s``; the
+    others a uniform, constant current (3,) [m/s] in the world frame.
+    """
+
+    def __init__(self, uvms: UVMS):
+        self.uvms = uvms
+
+    def _state(self, q, v=None) -> tuple[np.ndarray, np.ndarray | None]:
+        q = finite_vector("q", q, self.uvms.nq)
+        return q, None if v is None else finite_vector("v", v, self.uvms.nv)
+
+    def mass_matrix(self, q: np.ndarray) -> np.ndarray:
+        q, _ = self._state(q)
+        return _mass_matrix(self.uvms, q)
+
+    def bias_forces(self, q: np.ndarray, v: np.ndarray, current_world: np.ndarray) -> np.ndarray:
+        return self.bias_forces_in(q, v, _uniform(current_world), 0.0)
+
+    def bias_forces_in(
+        self, q: np.ndarray, v: np.ndarray, flow: FlowField | None, time_s: float
+    ) -> np.ndarray:
+        q, v = self._state(q, v)
+        return _bias_forces(self.uvms, q, v, flow, _check_time(time_s))
+
+    def forward_dynamics(
+        self,
+        q: np.ndarray,
+        v: np.ndarray,
+        tau: np.ndarray,
+        current_world: np.ndarray,
+        tau_ext: np.ndarray | None = None,
+    ) -> np.ndarray:
+        return self.forward_dynamics_in(q, v, tau, _uniform(current_world), 0.0, tau_ext)
+
+    def forward_dynamics_in(
+        self,
+        q: np.ndarray,
+        v: np.ndarray,
+        tau: np.ndarray,
+        flow: FlowField | None,
+        time_s: float,
+        tau_ext: np.ndarray | None = None,
+    ) -> np.ndarray:
+        q, v = self._state(q, v)
+        rhs = finite_vector("tau", tau, self.uvms.nv) - _bias_forces(
+            self.uvms, q, v, flow, _check_time(time_s)
+        )
+        if tau_ext is not None:
+            rhs += finite_vector("tau_ext", tau_ext, self.uvms.nv)
+        return _solve(self.uvms, q, rhs)
+
+
+def _uniform(current_world: np.ndarray) -> UniformCurrent | None:
+    """The flow of a uniform current (None in still water)."""
+    current = finite_vector("current_world", current_world, 3)
+    return UniformCurrent(current) if np.any(current) else None
+
+
+def dynamics_of(uvms: UVMS, backend: str = "core") -> CompiledDynamics | ReferenceDynamics:
+    """The dynamics of ``uvms`` in ``backend`` ("core": compiled, "python": the reference),
+    built on first use and kept with it (``uvms.cache``)."""
+    compiled = backend_named(backend).compiled
+    key = "compiled_dynamics" if compiled else "reference_dynamics"
+    dynamics = uvms.cache.get(key)
+    if dynamics is None:
+        reference = ReferenceDynamics(uvms)
+        dynamics = CompiledDynamics(uvms, reference) if compiled else reference
+        uvms.cache[key] = dynamics
+    return dynamics
+
+
+def _flow_of_call(current_world: np.ndarray, flow: FlowField) -> FlowField:
+    """``flow`` when a call gives one: the current is then one of its fields, not an extra."""
+    if not isinstance(flow, FlowField):
+        raise ParameterError(f"flow must be a uvms_pin.flow.FlowField, got {type(flow).__name__}")
+    if np.any(finite_vector("current_world", current_world, 3)):
+        raise ParameterError("give either current_world or flow, not both (add the fields)")
+    return flow
+
+
+def mass_matrix(uvms: UVMS, q: np.ndarray, *, backend: str = "core") -> np.ndarray:
+    """M(q) = M_RB(q) + sum_i J_i^T M_A,i J_i (nv x nv, symmetric positive definite).
+
+    ``backend``: "core" (compiled, default) or "python" (the reference)."""
+    return dynamics_of(uvms, backend).mass_matrix(q)
 
 
 def bias_forces(
@@ -206,32 +261,11 @@ def bias_forces(
         time_s: the time at which the flow is evaluated [s].
         backend: "core" (compiled, default) or "python" (the reference).
     """
-    if backend == "core" and flow is not None:
-        spec = compiled_flow(_resolve_flow(current_world, flow))
-        if spec is not None:
-            return dynamics_of(uvms).bias_forces_in_waves(q, v, *spec, _check_time(time_s))
-        _warn_python_flow(flow)
-    elif backend == "core":
-        try:
-            return dynamics_of(uvms).bias_forces(q, v, current_world)
-        except TypeError:
-            args = _core_inputs(uvms, q=q, v=v, current_world=current_world)
-            return dynamics_of(uvms).bias_forces(**args)
-    check_backend(backend)
-    q = _check("q", q, uvms.nq)
-    v = _check("v", v, uvms.nv)
-    return _bias_forces(uvms, q, v, _resolve_flow(current_world, flow), _check_time(time_s))
-
-
-def _bias_forces(
-    uvms: UVMS, q: np.ndarray, v: np.ndarray, flow: FlowField | None, time_s: float
-) -> np.ndarray:
-    model, data = uvms.model, uvms.data
-    zero = np.zeros(model.nv)
-    pin.forwardKinematics(model, data, q, v, zero)
-    fext = _fluid_wrenches(uvms, flow, time_s)
-    # rnea(q, v, 0, fext) = C_RB v + g_RB - sum_i J_i^T fext_i
-    return pin.rnea(model, data, q, v, zero, fext).copy()
+    dynamics = dynamics_of(uvms, backend)
+    if flow is None:
+        return dynamics.bias_forces(q, v, current_world)
+    flow = _flow_of_call(current_world, flow)
+    return dynamics.bias_forces_in(q, v, flow, _check_time(time_s))
 
 
 def forward_dynamics(
@@ -260,34 +294,11 @@ def forward_dynamics(
         ParameterError: wrong shape or non-finite input.
         SimulationError: M not positive definite (e.g. a degenerate model).
     """
-    if backend == "core" and flow is not None:
-        spec = compiled_flow(_resolve_flow(current_world, flow))
-        if spec is not None:
-            return dynamics_of(uvms).forward_dynamics_in_waves(
-                q, v, tau, *spec, _check_time(time_s), tau_ext
-            )
-        _warn_python_flow(flow)
-    elif backend == "core":
-        try:
-            return dynamics_of(uvms).forward_dynamics(q, v, tau, current_world, tau_ext)
-        except TypeError:
-            args = _core_inputs(
-                uvms, q=q, v=v, tau=tau, current_world=current_world, tau_ext=tau_ext
-            )
-            return dynamics_of(uvms).forward_dynamics(**args)
-    check_backend(backend)
-    q = _check("q", q, uvms.nq)
-    v = _check("v", v, uvms.nv)
-    tau = _check("tau", tau, uvms.nv)
-    rhs = tau - _bias_forces(uvms, q, v, _resolve_flow(current_world, flow), _check_time(time_s))
-    if tau_ext is not None:
-        rhs += _check("tau_ext", tau_ext, uvms.nv)
-    mass = _mass_matrix(uvms, q)
-    try:
-        factor = cho_factor(mass, lower=False, check_finite=False)
-    except np.linalg.LinAlgError as exc:
-        raise SimulationError(f"mass matrix is not positive definite at q = {q}") from exc
-    return cho_solve(factor, rhs, check_finite=False)
+    dynamics = dynamics_of(uvms, backend)
+    if flow is None:
+        return dynamics.forward_dynamics(q, v, tau, current_world, tau_ext)
+    flow = _flow_of_call(current_world, flow)
+    return dynamics.forward_dynamics_in(q, v, tau, flow, _check_time(time_s), tau_ext)
 
 
 def frame_wrench_to_generalized(
@@ -301,13 +312,13 @@ def frame_wrench_to_generalized(
 
 def kinetic_energy(uvms: UVMS, q: np.ndarray, v: np.ndarray, *, backend: str = "core") -> float:
     """T = 1/2 zeta^T M(q) zeta [J], added mass (the entrained fluid) included."""
-    v = _check("v", v, uvms.nv)
+    v = finite_vector("v", v, uvms.nv)
     return float(0.5 * v @ mass_matrix(uvms, q, backend=backend) @ v)
 
 
 def potential_energy(uvms: UVMS, q: np.ndarray) -> float:
     """U = U_gravity + U_buoyancy [J] (zero at z = 0)."""
-    q = _check("q", q, uvms.nq)
+    q = finite_vector("q", q, uvms.nq)
     model, data = uvms.model, uvms.data
     pin.forwardKinematics(model, data, q)
     energy = float(pin.computePotentialEnergy(model, data, q))

@@ -20,8 +20,7 @@ from __future__ import annotations
 import importlib
 import keyword
 import sys
-from collections.abc import Callable, Mapping
-from dataclasses import dataclass, field
+from collections.abc import Mapping
 from pathlib import Path
 from typing import Any
 
@@ -29,33 +28,9 @@ from uvms_pin.control.base import Controller
 from uvms_pin.errors import ParameterError
 from uvms_pin.model.uvms import UVMS
 from uvms_pin.scenario.overrides import closest
+from uvms_pin.sim.run import ControllerSpec
 
-__all__ = ["ControllerSpec", "class_path", "custom_controller", "load_controller_class"]
-
-
-@dataclass(frozen=True)
-class ControllerSpec:
-    """What a scenario's ``[controller]`` builds: callable as ``spec(uvms) -> Controller``.
-
-    Attributes:
-        type: the table's ``type`` ("none", "ppc" or "package.module:ClassName").
-        params: the parameters the controller is built with, as recorded in rollouts
-            (for "ppc": every gain and funnel after defaults and broadcasting).
-        build: makes a fresh controller for a loaded model.
-    """
-
-    type: str
-    params: dict[str, Any] = field(default_factory=dict)
-    build: Callable[[UVMS], Controller] = field(default=None, repr=False)
-
-    def __call__(self, uvms: UVMS) -> Controller:
-        return self.build(uvms)
-
-
-def class_path(controller: object) -> str:
-    """``module:QualifiedName`` of an object's class (what a scenario's ``type`` names)."""
-    cls = type(controller)
-    return f"{cls.__module__}:{cls.__qualname__}"
+__all__ = ["custom_controller", "load_controller_class"]
 
 
 def load_controller_class(type_path: str, search_dir: str | Path | None = None) -> type:

@@ -18,7 +18,6 @@ import dataclasses
 import functools
 import math
 from collections.abc import Callable
-from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
@@ -40,31 +39,19 @@ from uvms_pin.flow import (
 from uvms_pin.model.resources import find_model, shipped_models
 from uvms_pin.model.thruster import Thruster
 from uvms_pin.model.uvms import UVMS, load_uvms
-from uvms_pin.physics.compiled import BACKENDS
-from uvms_pin.physics.environment import (
-    CompliantPlane,
-    ContactModel,
-    LinearSpring,
-    SinusoidalDisturbance,
-)
-from uvms_pin.results.progress import ProgressBar, callback_or_none
-from uvms_pin.results.rollout import Rollout
-from uvms_pin.scenario.custom_controller import ControllerSpec, class_path, custom_controller
+from uvms_pin.physics.compiled.backend import BACKENDS
+from uvms_pin.physics.contact import CompliantPlane, ContactModel, LinearSpring
+from uvms_pin.physics.disturbance import SinusoidalDisturbance
+from uvms_pin.scenario.custom_controller import custom_controller
 from uvms_pin.scenario.overrides import apply_overrides, closest, parse_key_path
 from uvms_pin.scenario.toml import read_toml
 from uvms_pin.sim.actuation import Actuation, ThrustersAndJointLimits, Unlimited
-from uvms_pin.sim.closed_loop import (
-    DIVERGED_SPEED,
-    Progress,
-    SimulationSettings,
-    check_log_fits,
-    simulate_closed_loop,
-)
+from uvms_pin.sim.divergence import DIVERGED_SPEED
 from uvms_pin.sim.integrators import RK4, Adaptive, Integrator, SemiImplicitEuler
 from uvms_pin.sim.plant import Plant
-from uvms_pin.sim.sensors import NoiseSpec, SensorConfig, SensorSuite
-
-ControllerFactory = Callable[[UVMS], Controller]
+from uvms_pin.sim.run import ControllerSpec, Scenario, simulate
+from uvms_pin.sim.sensors import NoiseSpec, SensorConfig
+from uvms_pin.sim.settings import SimulationSettings, check_log_fits
 
 __all__ = ["Scenario", "apply_overrides", "load_scenario", "simulate"]
 
@@ -214,37 +201,6 @@ class _Table:
         )
 
 
-@dataclass
-class Scenario:
-    """Everything one run needs, built from a scenario file.
-
-    Attributes:
-        name, description: from [scenario].
-        path: the file it came from. raw: the dict after overrides (recorded in rollouts).
-        plant: UVMS + water + environment + disturbance.
-        controller_factory: builds a fresh controller for the plant's UVMS (a
-            `ControllerSpec` for the [controller] table: its type and parameters are
-            recorded in the rollout with the class that actually ran).
-        sensor_config: noise of the measurements.
-        q0, v0: initial state. settings: integrator, periods, duration, seed.
-    """
-
-    name: str
-    description: str
-    path: Path
-    raw: dict[str, Any]
-    plant: Plant
-    controller_factory: ControllerFactory
-    sensor_config: SensorConfig
-    q0: np.ndarray
-    v0: np.ndarray
-    settings: SimulationSettings
-
-    @property
-    def uvms(self) -> UVMS:
-        return self.plant.uvms
-
-
 def load_scenario(path: str | Path, overrides: dict[str, Any] | None = None) -> Scenario:
     """Read a scenario TOML file, apply dotted overrides and build the objects.
 
@@ -365,22 +321,6 @@ def _initial_state(t: _Table, uvms: UVMS) -> tuple[np.ndarray, np.ndarray]:
     q0[3:7] = pin.Quaternion(pin.rpy.rpyToMatrix(*rpy)).coeffs()
     q0[7:] = joints
     return q0, velocity
-
-
-def water_flow_of(parameters: dict[str, Any], source: str = "<parameters>") -> FlowField | None:
-    """The whole flow of a scenario's raw parameters (e.g. a rollout's
-    ``metadata['parameters']``): the uniform current plus [water.current/waves/sea]."""
-    water = _Table(copy.deepcopy(parameters.get("water", {})), "water", source)
-    water.pop_raw("density_kg_m3")
-    current = water.vector("current_world_m_s", 3, [0.0, 0.0, 0.0])
-    seed = (parameters.get("scenario") or {}).get("seed", 0)
-    flow = _water_flow(water, seed)
-    water.finish()
-    fields = [UniformCurrent(current)] if np.any(current) else []
-    fields += [flow] if flow is not None else []
-    if not fields:
-        return None
-    return fields[0] if len(fields) == 1 else SumFlow(tuple(fields))
 
 
 def _water_flow(water: _Table, seed: int) -> FlowField | None:
@@ -782,57 +722,3 @@ _CONTROLLER_BUILDERS: dict[str, Callable[[_Table, UVMS], ControllerSpec]] = {
         for kind in ("pi_force", "impedance", "computed_torque")
     },
 }
-
-
-def simulate(scenario: Scenario, *, progress: bool | Progress | None = True) -> Rollout:
-    """Run a scenario: fresh sensors (seeded) and controller, closed loop, rollout.
-
-    ``progress``: True (default) shows a tqdm bar (notebook widget in Jupyter) once the
-    run has lasted `uvms_pin.results.progress.BAR_DELAY_S` of wall time, so short runs print
-    nothing; False or None: silent; a callable ``(t_s, duration_s)`` is called after
-    every logged sample.
-
-    Raises FunnelViolation / SimulationError with the partial rollout attached as
-    ``exc.rollout`` (see `simulate_closed_loop`).
-    """
-    if progress is True:
-        with ProgressBar(scenario.name, scenario.settings.duration_s) as bar:
-            return _simulate(scenario, bar)
-    return _simulate(scenario, callback_or_none(progress))
-
-
-def _simulate(scenario: Scenario, progress: Progress | None) -> Rollout:
-    settings = scenario.settings
-    sensors = SensorSuite(
-        scenario.uvms.model, scenario.sensor_config, settings.duration_s, settings.seed
-    )
-    controller = scenario.controller_factory(scenario.uvms)
-    metadata = {
-        "scenario": scenario.name,
-        "scenario_path": str(scenario.path),
-        "description": scenario.description,
-        "parameters": scenario.raw,
-        "controller": controller_record(scenario.controller_factory, controller),
-    }
-    return simulate_closed_loop(
-        scenario.plant,
-        controller,
-        sensors,
-        scenario.q0,
-        scenario.v0,
-        settings,
-        metadata=metadata,
-        progress=progress,
-    )
-
-
-def controller_record(factory: ControllerFactory, controller: Controller) -> dict[str, Any]:
-    """What ran: the class of ``controller`` (``module:QualifiedName``) and, when the
-    factory is a `ControllerSpec`, its type and parameters (else None: unknown)."""
-    inner = getattr(controller, "wrapped_controller", controller)  # a viewer's tap
-    spec = factory if isinstance(factory, ControllerSpec) else None
-    return {
-        "class": class_path(inner),
-        "type": None if spec is None else spec.type,
-        "params": None if spec is None else spec.params,
-    }

@@ -15,12 +15,14 @@ import math
 from abc import ABC, abstractmethod
 from collections.abc import Callable
 from dataclasses import dataclass
+from types import ModuleType
 
 import numpy as np
 import pinocchio as pin
 from scipy.integrate import solve_ivp
 
 from uvms_pin.errors import ParameterError, SimulationError
+from uvms_pin.physics.compiled.backend import Backend, Fallback
 
 Rhs = Callable[[float, np.ndarray, np.ndarray], np.ndarray]
 Event = Callable[[float, np.ndarray, np.ndarray], float]
@@ -39,12 +41,11 @@ class Integrator(ABC):
     ) -> tuple[np.ndarray, np.ndarray]:
         """Return (q, v) at t1."""
 
-    def advance_held(
-        self, compiled_plant, t0: float, q0: np.ndarray, v0: np.ndarray, tau: np.ndarray, t1: float
-    ) -> tuple[np.ndarray, np.ndarray] | None:
-        """(q, v) at t1 computed by the compiled plant with tau held, in one call; None when
-        this integrator has no compiled counterpart (then `advance` runs)."""
-        return None
+    def to_core(self, backend: Backend):
+        """The core's counterpart of this integrator (src/uvms_core/integrators.hpp), with
+        which the compiled plant advances a whole period in one call, or the Fallback saying
+        why not (then `advance` runs, on the plant's right-hand side)."""
+        return Fallback(f"the integrator {type(self).__name__}")
 
     def advance_through(
         self,
@@ -88,6 +89,14 @@ def python_chart(model: pin.Model) -> Chart:
     return chart
 
 
+def _fixed_step(core: ModuleType, method, step_s: float):
+    """The core's FixedStep: ``method`` in substeps no longer than ``step_s`` [s]."""
+    out = core.FixedStep()
+    out.method = method
+    out.step_s = float(step_s)
+    return out
+
+
 def _substeps(t0: float, t1: float, max_step_s: float) -> tuple[int, float]:
     n = max(1, math.ceil((t1 - t0) / max_step_s - 1e-9))
     return n, (t1 - t0) / n
@@ -113,8 +122,8 @@ class RK4(Integrator):
             q, v = self._step(model, rhs, t0 + k * h, q, v, h)
         return q, v
 
-    def advance_held(self, compiled_plant, t0, q0, v0, tau, t1):
-        return compiled_plant.advance(t0, q0, v0, tau, t1, self.step_s, True)
+    def to_core(self, backend):
+        return backend.counterpart(lambda core: _fixed_step(core, core.Method.rk4, self.step_s))
 
     @staticmethod
     def _step(model, rhs, t, q0, v0, h):
@@ -158,8 +167,10 @@ class SemiImplicitEuler(Integrator):
             q = pin.integrate(model, q, h * v)
         return q, v
 
-    def advance_held(self, compiled_plant, t0, q0, v0, tau, t1):
-        return compiled_plant.advance(t0, q0, v0, tau, t1, self.step_s, False)
+    def to_core(self, backend):
+        return backend.counterpart(
+            lambda core: _fixed_step(core, core.Method.semi_implicit_euler, self.step_s)
+        )
 
 
 @dataclass(frozen=True)

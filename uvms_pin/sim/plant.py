@@ -4,40 +4,34 @@
 of it (it sees only a `Measurement`). `Plant.advance` moves the plant over one control period
 with the input held.
 
-With ``backend="core"`` (default) both run in the compiled core (`uvms_pin.physics.compiled`): the whole
-period (every integrator stage, contact, disturbance, held tau) is one C++ call. The core
-knows the current, `LinearSpring`, `CompliantPlane` and `SinusoidalDisturbance`; a plant with
-anything else (e.g. a disturbance written in Python) runs on the Python reference, and says
-so once with a `CoreFallbackWarning`. The compiled plant reads the current, contact and
-disturbance when it is built: at `attach` (the start of every simulation) or first use.
+With ``backend="core"`` (default) both run in the compiled core: the whole period (every
+integrator stage, contact, disturbance, held tau) is one C++ call. The plant's compiled
+counterpart (`src/uvms_core/plant.hpp`) is built from its flow, contact and disturbance when
+a run starts (`attach`) or on first use; when one of them has no counterpart (e.g. a
+disturbance written in Python) the plant runs on the Python reference and says so once with a
+`CoreFallbackWarning`.
 """
 
 from __future__ import annotations
 
-import warnings
 from dataclasses import dataclass, field
+from types import ModuleType
+from typing import Any
 
 import numpy as np
 import pinocchio as pin
 
+from uvms_pin.checks import finite_vector
 from uvms_pin.errors import ParameterError, SimulationError
 from uvms_pin.flow import FlowField, SumFlow, UniformCurrent
 from uvms_pin.model.uvms import UVMS
-from uvms_pin.physics.compiled import (
-    CoreFallbackWarning,
-    check_backend,
-    compiled_flow,
-    core_module,
-    dynamics_of,
-)
-from uvms_pin.physics.dynamics import forward_dynamics
-from uvms_pin.physics.environment import (
-    CompliantPlane,
-    ContactModel,
-    Disturbance,
-    LinearSpring,
-    SinusoidalDisturbance,
-)
+from uvms_pin.physics.compiled.backend import Backend, Fallback, backend_named
+from uvms_pin.physics.compiled.contact import contact_to_core
+from uvms_pin.physics.compiled.disturbance import disturbance_to_core
+from uvms_pin.physics.compiled.flow import flow_to_core
+from uvms_pin.physics.contact import ContactModel
+from uvms_pin.physics.disturbance import Disturbance
+from uvms_pin.physics.dynamics import dynamics_of, forward_dynamics
 from uvms_pin.sim.actuation import Actuation, Unlimited
 from uvms_pin.sim.integrators import Chart, Integrator
 
@@ -66,29 +60,33 @@ class Plant:
     backend: str = "core"
 
     def __post_init__(self) -> None:
-        c = np.asarray(self.current_world_m_s, dtype=float).reshape(-1)
-        if c.shape != (3,) or not np.all(np.isfinite(c)):
-            raise ParameterError(
-                f"current_world_m_s must be 3 finite numbers, got {self.current_world_m_s}"
-            )
-        self.current_world_m_s = c
+        self.current_world_m_s = finite_vector("current_world_m_s", self.current_world_m_s, 3)
         if self.contact is not None:
             self.uvms.require_ee_frame("a contact environment (at the end-effector)")
         if self.flow is not None and not isinstance(self.flow, FlowField):
             raise ParameterError(f"flow must be a FlowField, got {type(self.flow).__name__}")
-        check_backend(self.backend)
+        self._backend: Backend = backend_named(self.backend)
         self._ee_data = self.uvms.model.createData()
-        self._flow = self.water_flow
+        self.water = self._water()
 
-    @property
-    def water_flow(self) -> FlowField | None:
-        """The whole flow the bodies see: the uniform current plus ``flow``."""
+    def _water(self) -> FlowField | None:
+        """The one flow the bodies see: the uniform current and ``flow`` (None: still water)."""
         fields = [UniformCurrent(self.current_world_m_s)] if np.any(self.current_world_m_s) else []
-        if self.flow is not None:
-            fields.append(self.flow)
+        fields += [self.flow] if self.flow is not None else []
         if not fields:
             return None
         return fields[0] if len(fields) == 1 else SumFlow(tuple(fields))
+
+    def record(self) -> dict[str, Any]:
+        """The world this plant simulates, as plain data (a rollout saves it; figures and
+        replays draw it): water density, the uniform current, the whole flow and the
+        contact (as attached)."""
+        return {
+            "water_density_kg_m3": float(self.uvms.water_density_kg_m3),
+            "current_world_m_s": self.current_world_m_s.tolist(),
+            "flow": None if self.water is None else self.water.record(),
+            "contact": None if self.contact is None else self.contact.record(),
+        }
 
     def check_submerged(self, time_s: float, q: np.ndarray) -> None:
         """Raise SimulationError when a body's centre of buoyancy is above the wave surface.
@@ -116,60 +114,38 @@ class Plant:
 
     def __getstate__(self) -> dict:
         state = dict(self.__dict__)
-        state.pop("_compiled", None)  # a C++ object: rebuilt on first use after unpickling
+        # C++ objects: rebuilt on first use after unpickling
+        state.pop("_compiled", None)
+        state.pop("_step", None)
         return state
 
     # ---- the compiled plant -----------------------------------------------------------
-    def _unsupported(self) -> str | None:
-        """What the core cannot represent, or None."""
-        if self.contact is not None and type(self.contact) not in (LinearSpring, CompliantPlane):
-            return f"contact model {type(self.contact).__name__}"
-        if self.disturbance is not None and type(self.disturbance) is not SinusoidalDisturbance:
-            return f"disturbance {self.disturbance!r}"
-        if self.flow is not None and compiled_flow(self.flow) is None:
-            return f"flow {self.flow!r}"
-        return None
-
-    def _build_compiled(self):
-        """The compiled plant mirroring this one, or None (Python path)."""
-        if self.backend != "core":
-            return None
-        unsupported = self._unsupported()
-        if unsupported is not None:
-            warnings.warn(
-                f"the compiled core does not support the {unsupported}: this plant runs on "
-                "the Python reference (slower)",
-                CoreFallbackWarning,
-                stacklevel=3,
-            )
-            return None
+    def _to_core(self, core: ModuleType):
+        """The compiled plant mirroring this one, or the Fallback of the first part the core
+        has no counterpart of."""
+        parts = (
+            flow_to_core(self.water, core),
+            contact_to_core(self.contact, core),
+            disturbance_to_core(self.disturbance, core),
+        )
+        fallback = next((p for p in parts if isinstance(p, Fallback)), None)
+        if fallback is not None:
+            return fallback
         # the compiled plant uses the end-effector frame for contact only, which a model
-        # without one cannot have (checked above): frame 0 (the world) stands in
+        # without one cannot have (checked in __post_init__): frame 0 (the world) stands in
         ee_frame_id = self.uvms.ee_frame_id if self.uvms.has_end_effector else 0
-        compiled = core_module().Plant(dynamics_of(self.uvms), ee_frame_id)
-        compiled.set_flow(*compiled_flow(self._flow))  # the current plus any waves
-        contact = self.contact
-        if isinstance(contact, LinearSpring):
-            if contact._anchor is None:
-                return None  # not attached: the Python path raises the error
-            compiled.set_spring(contact.stiffness_N_m, contact._anchor)
-        elif isinstance(contact, CompliantPlane):
-            if contact._point is None:
-                return None
-            compiled.set_plane(
-                contact.normal_world,
-                contact._point,
-                float(contact.stiffness_N_m),
-                float(contact.damping_N_s_m),
-            )
-        if self.disturbance is not None:
-            d = self.disturbance
-            compiled.set_sinusoidal_disturbance(d.amplitude, float(d.period_s), float(d.phase_rad))
+        compiled = core.Plant(dynamics_of(self.uvms).core, ee_frame_id)
+        compiled.flow, compiled.contact, compiled.disturbance = parts
         return compiled
 
     def _core(self):
+        """The compiled plant, or None: the Python reference computes (warned once)."""
         if "_compiled" not in self.__dict__:
-            self._compiled = self._build_compiled()
+            compiled = self._backend.counterpart(self._to_core)
+            if isinstance(compiled, Fallback):
+                compiled.warn("this plant", stacklevel=4)
+                compiled = None
+            self._compiled = compiled
         return self._compiled
 
     # ---- kinematics of the tip ----------------------------------------------------------
@@ -182,12 +158,12 @@ class Plant:
         return position, velocity, data
 
     def attach(self, q0: np.ndarray) -> None:
-        """Anchor the environment at the initial end-effector position (and (re)build the
-        compiled plant from the current fields)."""
+        """Anchor the environment at the initial end-effector position, and take the current
+        and flow as they are now (the compiled plant is rebuilt from them)."""
         if self.contact is not None:
             position, _, _ = self.ee_state(q0, np.zeros(self.uvms.nv))
             self.contact.attach(position)
-        self._flow = self.water_flow  # the current and flow as they are now, like the core
+        self.water = self._water()
         self.__dict__.pop("_compiled", None)
 
     def contact_wrench(self, q: np.ndarray, v: np.ndarray) -> np.ndarray:
@@ -238,7 +214,7 @@ class Plant:
             v,
             tau,
             tau_ext=tau_ext,
-            flow=self._flow,
+            flow=self.water,
             time_s=time_s,
             backend=self.backend,
         )
@@ -247,6 +223,14 @@ class Plant:
         """The compiled local chart of the adaptive integrators, or None (Python path)."""
         compiled = self._core()
         return None if compiled is None else compiled.chart
+
+    def _compiled_step(self, integrator: Integrator):
+        """The core's counterpart of ``integrator`` (kept for the next period), or None."""
+        step = self.__dict__.get("_step")
+        if step is None or step[0] is not integrator:
+            compiled = integrator.to_core(self._backend)
+            step = self._step = (integrator, None if isinstance(compiled, Fallback) else compiled)
+        return step[1]
 
     def advance(
         self,
@@ -263,9 +247,9 @@ class Plant:
         counterpart (RK4, semi-implicit Euler); the integrator's Python loop otherwise."""
         compiled = self._core()
         if compiled is not None:
-            out = integrator.advance_held(compiled, t0, q0, v0, tau, t1)
-            if out is not None:
-                return out
+            step = self._compiled_step(integrator)
+            if step is not None:
+                return compiled.advance(t0, q0, v0, tau, t1, step)
         return integrator.advance(
             self.uvms.model, lambda t, q, v: self.acceleration(t, q, v, tau), t0, q0, v0, t1
         )

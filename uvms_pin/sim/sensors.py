@@ -17,7 +17,7 @@ from dataclasses import dataclass
 import numpy as np
 import pinocchio as pin
 
-from uvms_pin.control.measurement import Measurement
+from uvms_pin.control.measurement import Measurement, read_only
 from uvms_pin.errors import ParameterError
 
 
@@ -174,7 +174,7 @@ class SensorSuite:
     def measure(
         self, time_s: float, q: np.ndarray, v: np.ndarray, wrench_world: np.ndarray
     ) -> Measurement:
-        wrench = wrench_world + self.force_noise(time_s)
+        wrench = read_only(wrench_world + self.force_noise(time_s))
         if not self._state_noisy:
             return Measurement(time_s, q, v, wrench)
         # Fix: the position noise used to go through pin.integrate together with the
@@ -187,4 +187,4 @@ class SensorSuite:
         dq[6:] = self._joints(time_s)
         q_meas = pin.integrate(self.model, q, dq)
         q_meas[:3] = q[:3] + self._position(time_s)
-        return Measurement(time_s, q_meas, v + self._velocity(time_s), wrench)
+        return Measurement(time_s, read_only(q_meas), read_only(v + self._velocity(time_s)), wrench)

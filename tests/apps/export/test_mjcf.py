@@ -17,7 +17,7 @@ from uvms_pin.model.mount.catalog import resolve_arm
 from uvms_pin.model.mount.mount import mount_arm_detailed
 from uvms_pin.model.mount.split import split_urdf
 from uvms_pin.model.resources import example_robot_data_dir
-from uvms_pin.physics.environment import LinearSpring
+from uvms_pin.physics.contact import LinearSpring
 from uvms_pin.sim.plant import Plant
 
 mujoco = pytest.importorskip("mujoco")

@@ -26,7 +26,7 @@ from uvms_pin.apps.viz.meshcat_scene import (
 def scene(reference_uvms):
     q = reference_uvms.neutral_configuration()
     tip = UvmsScene(reference_uvms).ee_position(q)
-    env = EnvironmentView.from_parameters({"environment": {"type": "spring"}}, tip)
+    env = EnvironmentView.from_record({"type": "spring", "anchor_world_m": None}, tip)
     return UvmsScene(
         reference_uvms,
         environment=env,

@@ -246,7 +246,7 @@ class _Version(argparse.Action):
 
 def version_text() -> str:
     """``uvms-pin X (pinocchio Y, Python Z)``: what a bug report needs."""
-    from uvms_pin.sim.closed_loop import package_versions
+    from uvms_pin.results.provenance import package_versions
 
     versions = package_versions()
     return f"uvms-pin {versions['uvms-pin']} (pinocchio {versions['pin']}, Python {versions['python']})"

@@ -23,13 +23,16 @@ import gymnasium as gym
 import numpy as np
 
 from uvms_pin.apps.gym.actions import action_scale as make_action_scale
-from uvms_pin.apps.gym.episode import EpisodeRecord
-from uvms_pin.apps.gym.stepper import PlantStepper
+from uvms_pin.control.measurement import Measurement
 from uvms_pin.errors import ParameterError, SimulationError
 from uvms_pin.model.resources import shipped_path
 from uvms_pin.results.rollout import Rollout
-from uvms_pin.scenario.scenario import Scenario, load_scenario
-from uvms_pin.sim.closed_loop import package_versions
+from uvms_pin.results.status import OK, RunStatus
+from uvms_pin.scenario.scenario import load_scenario
+from uvms_pin.sim.closed_loop import ClosedLoop, run_metadata
+from uvms_pin.sim.log import RolloutLog
+from uvms_pin.sim.run import Scenario
+from uvms_pin.sim.sensors import SensorSuite
 
 # spawn key of the initial-perturbation stream: apart from the sensors' children 0..5
 _PERTURBATION_STREAM = 1 << 16
@@ -95,9 +98,7 @@ class UvmsEnv(gym.Env):
                 "and the scenario's control is continuous: set control.period_s "
                 '(overrides={"control.period_s": 0.002})'
             )
-        self._stepper = PlantStepper(
-            self.scenario.plant, self.scenario.sensor_config, self.scenario.settings
-        )
+        self._loop = ClosedLoop(self.scenario.plant, self.scenario.settings)
         uvms = self.scenario.uvms
         self.action_scale = make_action_scale(self.scenario.plant.actuation, uvms.nv, action_scale)
         self.clip_actions = bool(clip_actions)
@@ -114,7 +115,8 @@ class UvmsEnv(gym.Env):
         self.action_space = gym.spaces.Box(-1.0, 1.0, (uvms.nv,), np.float64)
         self.episode_seed: int | None = None
         self._steps = 0
-        self._record = EpisodeRecord()
+        self._log: RolloutLog | None = None
+        self._failure: SimulationError | None = None
         self._measurement = None
         self._contact = np.zeros(6)
         self._anchor: np.ndarray | None = None
@@ -137,13 +139,21 @@ class UvmsEnv(gym.Env):
         self._reseed_flow(episode_seed)
         self.episode_seed = episode_seed
         q0, v0 = self._initial_state(episode_seed)
-        self._stepper.reset(q0, v0, episode_seed)
+        scenario, loop = self.scenario, self._loop
+        settings = scenario.settings
+        sensors = SensorSuite(
+            scenario.uvms.model, scenario.sensor_config, settings.duration_s, episode_seed
+        )
+        loop.start(q0, v0, sensors)
         self._steps = 0
-        self._record = EpisodeRecord()
+        self._log = RolloutLog(
+            scenario.uvms, self.max_steps + 1, self._episode_metadata(), scenario.plant.backend
+        )
+        self._failure = None
         self._anchor = None
-        if self.scenario.plant.contact is not None:
-            self._anchor = self.scenario.plant.ee_state(self._stepper.q, self._stepper.v)[0]
-        self._measurement, self._contact = self._stepper.measure()
+        if scenario.plant.contact is not None:
+            self._anchor = scenario.plant.ee_state(loop.q, loop.v)[0]
+        self._measurement, self._contact = loop.measure()
         return self._observation(), {"seed": episode_seed, "time_s": 0.0}
 
     def step(self, action):
@@ -156,32 +166,25 @@ class UvmsEnv(gym.Env):
             raise ParameterError("call reset() before step()")
         if self.clip_actions:
             a = np.clip(a, -1.0, 1.0)
-        stepper, plant = self._stepper, self.scenario.plant
+        loop = self._loop
         tau = self.action_scale * a
-        t, measured = stepper.time_s, self._measurement
-        self._record.add(
-            t,
-            stepper.q,
-            stepper.v,
-            plant.actuation.apply(tau),
-            tau,
-            self._contact,
-            measured.wrench_world,
-            plant.disturbance_wrench(t),
-        )
+        tau_applied = loop.actuate(tau)
+        t, measured = loop.time_s, self._measurement
+        self._log.on_sample(loop.sample(measured, self._contact, tau, tau_applied))
         info: dict[str, Any] = {"seed": self.episode_seed}
         try:
-            stepper.advance(tau)
-            self._measurement, self._contact = stepper.measure()
+            loop.step(tau_applied)
+            self._measurement, self._contact = loop.measure()
         except SimulationError as exc:
             self._measurement = None  # the episode is over: reset() before stepping again
+            self._failure = exc
             info.update(time_s=t, error=str(exc))
             obs = _observation_of(measured, self.task.goal(t))
             return obs, -self.failure_penalty, True, False, info
         self._steps += 1
-        outcome = self.task.outcome(stepper.time_s, stepper.q, self._contact, a)
+        outcome = self.task.outcome(loop.time_s, loop.q, self._contact, a)
         truncated = self._steps >= self.max_steps and not outcome.terminated
-        info.update(time_s=stepper.time_s, **outcome.terms)
+        info.update(time_s=loop.time_s, **outcome.terms)
         return self._observation(), outcome.reward, outcome.terminated, truncated, info
 
     def render(self):
@@ -189,52 +192,55 @@ class UvmsEnv(gym.Env):
             return None
         from uvms_pin.apps.gym.render import side_view_rgb
 
-        stepper = self._stepper
+        loop = self._loop
         return side_view_rgb(
-            self.scenario.uvms, self._render_data, stepper.q, stepper.time_s, self._anchor
+            self.scenario.uvms, self._render_data, loop.q, loop.time_s, self._anchor
         )
 
     # -- replay export -------------------------------------------------------------------
     def episode_rollout(self) -> Rollout:
         """The episode so far as a Rollout (``save`` it, then ``uvms-pin replay`` it):
-        one sample per control tick up to the current state."""
+        one sample per control tick up to the current state (where the last input is shown
+        held), its status saying whether the plant diverged."""
         if self.episode_seed is None:
             raise ParameterError("no episode yet: call reset() first")
-        record = EpisodeRecord()
-        record.rows = list(self._record.rows)
-        stepper = self._stepper
-        if not record.rows or record.rows[-1][0] != stepper.time_s:  # the state reached
-            held = record.rows[-1][3:5] if record.rows else (np.zeros(stepper.v.size),) * 2
-            measured = self._contact if self._measurement is None else self._measurement
-            record.add(
-                stepper.time_s,
-                stepper.q,
-                stepper.v,
-                *held,
-                self._contact,
-                getattr(measured, "wrench_world", measured),
-                self.scenario.plant.disturbance_wrench(stepper.time_s),
-            )
+        loop, log = self._loop, self._log.copy()
+        rollout = log.rollout
+        if log.count == 0 or rollout.time_s[log.count - 1] != loop.time_s:  # the state reached
+            k = log.count - 1
+            held = (rollout.signals["tau_commanded"][k], rollout.tau[k]) if k >= 0 else None
+            tau, tau_applied = held if held else (np.zeros(loop.v.size),) * 2
+            measured = self._measurement
+            if measured is None:  # diverged: the true contact stands in for the reading
+                measured = Measurement(loop.time_s, loop.q, loop.v, self._contact)
+            log.on_sample(loop.sample(measured, self._contact, tau, tau_applied))
+        rollout = log.finish()
+        failure = self._failure
+        rollout.set_status(
+            RunStatus(OK)
+            if failure is None
+            else RunStatus(type(failure).__name__, str(failure), float(rollout.time_s[-1]))
+        )
+        return rollout
+
+    def _episode_metadata(self) -> dict[str, Any]:
         scenario = self.scenario
-        metadata = {
+        settings = scenario.settings
+        env_id = self.spec.id if self.spec else type(self).__name__
+        return {
             "scenario": scenario.name,
             "scenario_path": str(scenario.path),
-            "description": f"{scenario.description} (gymnasium {self.spec.id if self.spec else type(self).__name__})",
+            "description": f"{scenario.description} (gymnasium {env_id})",
             "parameters": scenario.raw,
+            **run_metadata(scenario.plant, settings),
             "seed": self.episode_seed,
-            "control_period_s": scenario.settings.control_period_s,
-            "log_period_s": scenario.settings.control_period_s,
-            "model_source": scenario.uvms.source,
-            "arm_joint_names": scenario.uvms.arm_joint_names,
-            "versions": package_versions(),
-            "status": "ok",
-            "error": "",
+            "log_period_s": settings.control_period_s,
+            "world": scenario.plant.record(),
         }
-        return record.to_rollout(scenario.uvms, metadata)
 
     # -- helpers -------------------------------------------------------------------------
     def _observation(self) -> np.ndarray:
-        return _observation_of(self._measurement, self.task.goal(self._stepper.time_s))
+        return _observation_of(self._measurement, self.task.goal(self._loop.time_s))
 
     def _initial_state(self, episode_seed: int) -> tuple[np.ndarray, np.ndarray]:
         rng = np.random.default_rng(
@@ -253,9 +259,7 @@ class UvmsEnv(gym.Env):
         self.scenario = load_scenario(
             self.scenario_path, {**self.overrides, "scenario.seed": episode_seed}
         )
-        self._stepper = PlantStepper(
-            self.scenario.plant, self.scenario.sensor_config, self.scenario.settings
-        )
+        self._loop = ClosedLoop(self.scenario.plant, self.scenario.settings)
         self._flow_seed = episode_seed
 
 

@@ -7,16 +7,13 @@ that connects gets the current frame). When the run ends the display plays what 
 to a connected browser, then the server is shut down; on Ctrl-C (KeyboardInterrupt) it is
 shut down at once.
 
-The logged samples are picked up without touching the simulator: the plant and the
-controller are wrapped in pass-through taps that remember the last state, contact wrench,
-measurement and controller signals; ``simulate_closed_loop`` calls ``progress`` right after
-logging a sample, when those are exactly the logged ones.
+The logged samples reach the view as an observer of the closed loop (`LiveFeed`): the
+simulation is the same with or without it.
 """
 
 from __future__ import annotations
 
 import bisect
-import dataclasses
 import os
 import selectors
 import socket
@@ -26,7 +23,7 @@ import tempfile
 import threading
 import time
 from pathlib import Path
-from typing import Any, TextIO
+from typing import TextIO
 
 import meshcat
 import numpy as np
@@ -39,8 +36,8 @@ from uvms_pin.apps.viz.surface import SurfaceView
 from uvms_pin.errors import SimulationError
 from uvms_pin.results.progress import Progress
 from uvms_pin.results.rollout import Rollout
-from uvms_pin.scenario.custom_controller import ControllerSpec
-from uvms_pin.scenario.scenario import Scenario, simulate
+from uvms_pin.sim.run import Scenario, simulate
+from uvms_pin.sim.sample import Sample
 
 LOOPBACK = "127.0.0.1"
 DEFAULT_PORT = 7000
@@ -350,41 +347,22 @@ class LiveView:
 # ---- feeding a live view from a simulation -----------------------------------------------
 
 
-class _PlantTap:
-    """The plant, unchanged, remembering the last (q, contact wrench) it was asked for."""
+class LiveFeed:
+    """An observer of the closed loop pushing every logged sample to a live view."""
 
-    def __init__(self, plant):
-        self._plant = plant
-        self.q = None
+    def __init__(self, live: LiveView):
+        self.live = live
 
-    def __getattr__(self, name: str) -> Any:
-        return getattr(self._plant, name)
-
-    def contact_wrench(self, q, v):
-        wrench = self._plant.contact_wrench(q, v)
-        self.q = q
-        return wrench
-
-
-class _ControllerTap:
-    """The controller, unchanged, remembering its last measurement and signals."""
-
-    def __init__(self, controller):
-        self._controller = controller
-        self.wrapped_controller = controller  # what the rollout records as the class that ran
-        self.measurement = None
-        self.last_signals: dict[str, np.ndarray] = {}
-
-    def __getattr__(self, name: str) -> Any:
-        return getattr(self._controller, name)
-
-    def compute(self, time_s, measurement):
-        self.measurement = measurement
-        return self._controller.compute(time_s, measurement)
-
-    def signals(self):
-        self.last_signals = self._controller.signals()
-        return self.last_signals
+    def on_sample(self, sample: Sample) -> None:
+        desired = sample.signals.get("force_desired_world_N")
+        self.live.push(
+            Frame(
+                sample.time_s,
+                np.array(sample.q),
+                sample.measurement.wrench_world[:3].copy(),
+                None if desired is None else desired.copy(),
+            )
+        )
 
 
 def scene_for_scenario(scenario: Scenario, style: SceneStyle | None = None) -> UvmsScene:
@@ -400,7 +378,9 @@ def scene_for_scenario(scenario: Scenario, style: SceneStyle | None = None) -> U
         extent = np.vstack([extent, [*scenario.q0[:2], 0.0]])
     return UvmsScene(
         scenario.uvms,
-        environment=EnvironmentView.from_parameters(scenario.raw, tip0),
+        environment=EnvironmentView.from_record(
+            None if scenario.plant.contact is None else scenario.plant.contact.record(), tip0
+        ),
         current_world_m_s=scenario.plant.current_world_m_s,
         show_desired=controller.get("type") == "ppc",
         extent_world_m=extent,
@@ -412,33 +392,9 @@ def scene_for_scenario(scenario: Scenario, style: SceneStyle | None = None) -> U
 def simulate_live(
     scenario: Scenario, live: LiveView, *, progress: Progress | None = None
 ) -> Rollout:
-    """`uvms_pin.scenario.scenario.simulate`, with every logged sample pushed to ``live``.
-
-    The rollout is the same as without the view (the taps only read).
-    """
-    plant = _PlantTap(scenario.plant)
-    controllers: list[_ControllerTap] = []
-
-    def controller_factory(uvms):
-        tap = _ControllerTap(scenario.controller_factory(uvms))
-        controllers.append(tap)
-        return tap
-
-    def on_sample(t: float, duration: float) -> None:
-        ctrl = controllers[-1]
-        measured = ctrl.measurement.wrench_world[:3].copy() if ctrl.measurement else None
-        desired = ctrl.last_signals.get("force_desired_world_N")
-        live.push(
-            Frame(t, np.array(plant.q), measured, None if desired is None else desired.copy())
-        )
-        if progress is not None:
-            progress(t, duration)
-
-    spec = scenario.controller_factory
-    if isinstance(spec, ControllerSpec):  # keep its type and parameters for the record
-        controller_factory = dataclasses.replace(spec, build=controller_factory)
-    tapped = dataclasses.replace(scenario, plant=plant, controller_factory=controller_factory)
-    return simulate(tapped, progress=on_sample)
+    """`uvms_pin.sim.run.simulate`, with every logged sample pushed to ``live`` (an observer:
+    the rollout is the same as without the view)."""
+    return simulate(scenario, progress=progress, observers=[LiveFeed(live)])
 
 
 def run_live(

@@ -76,22 +76,21 @@ class EnvironmentView:
     normal_world: np.ndarray | None = None  # plane only: outward unit normal
 
     @classmethod
-    def from_parameters(
-        cls, parameters: Mapping[str, Any] | None, ee_position0_world_m: np.ndarray
+    def from_record(
+        cls, record: Mapping[str, Any] | None, ee_position0_world_m: np.ndarray
     ) -> EnvironmentView | None:
-        """From a scenario's raw parameters (``rollout.metadata['parameters']``).
-
-        As in `uvms_pin.physics.environment`, a missing ``anchor_world_m`` means the tip at t = 0.
-        """
-        env = (parameters or {}).get("environment")
-        if not env:
+        """From a contact model's record (`ContactModel.record`, ``metadata['world']`` of a
+        rollout). As in `uvms_pin.physics.contact`, a spring or plane not attached yet (no
+        anchor or point) is where the tip is at t = 0."""
+        if not record:
             return None
-        point = np.asarray(env.get("anchor_world_m", ee_position0_world_m), dtype=float)
-        kind = env.get("type")
+        kind = record.get("type")
+        where = record.get("anchor_world_m" if kind == "spring" else "point_world_m")
+        point = np.asarray(ee_position0_world_m if where is None else where, dtype=float)
         if kind == "spring":
             return cls("spring", point)
         if kind == "plane":
-            normal = np.asarray(env.get("normal_world", [-1.0, 0.0, 0.0]), dtype=float)
+            normal = np.asarray(record["normal_world"], dtype=float)
             return cls("plane", point, normal / np.linalg.norm(normal))
         raise VizError(f"cannot draw an environment of type {kind!r}")
 

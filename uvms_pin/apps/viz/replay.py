@@ -31,7 +31,8 @@ from uvms_pin.apps.viz.meshcat_scene import (
     recording_visualizer,
 )
 from uvms_pin.apps.viz.surface import SurfaceView
-from uvms_pin.model.uvms import load_uvms
+from uvms_pin.flow import FlowField, flow_from_record
+from uvms_pin.model.uvms import DEFAULT_WATER_DENSITY_KG_M3, load_uvms
 from uvms_pin.results.atomic import write_text_atomic
 from uvms_pin.results.rollout import Rollout
 
@@ -49,29 +50,29 @@ def scene_for_rollout(
     rollout: Rollout, *, urdf: str | Path | None = None, style: SceneStyle | None = None
 ) -> UvmsScene:
     """The scene of a rollout: its model (``metadata['model_source']`` or ``urdf``), the
-    environment and current of its scenario parameters, its extent."""
+    world it recorded (``metadata['world']``: contact, current, waves), its extent."""
     if len(rollout) == 0:
         raise VizError("the rollout has no sample to show")
     meta = rollout.metadata
-    params = meta.get("parameters") or {}
+    world = meta.get("world") or {}
     source = Path(urdf) if urdf is not None else meta.get("model_source")
     if not source or not Path(source).is_file():
         raise VizError(
             f"model file {source!r} of the rollout not found; pass the URDF explicitly "
             "(uvms-pin replay DIR --urdf FILE)"
         )
-    water = params.get("water", {})
-    uvms = load_uvms(source, water_density_kg_m3=float(water.get("density_kg_m3", 1025.0)))
+    density = float(world.get("water_density_kg_m3", DEFAULT_WATER_DENSITY_KG_M3))
+    uvms = load_uvms(source, water_density_kg_m3=density)
     scene0 = UvmsScene(uvms)  # for forward kinematics only
     tips = np.array([scene0.ee_position(q) for q in _every(rollout.q, 400)])
     extent = np.vstack([tips, rollout.q[:, :3]])
-    surface = _surface_view(params, extent)
+    surface = _surface_view(flow_from_record(world.get("flow")), extent)
     if surface is not None:  # keep the mean surface above the vehicle in view
         extent = np.vstack([extent, [*rollout.q[0, :2], 0.0]])
     return UvmsScene(
         uvms,
-        environment=EnvironmentView.from_parameters(params, tips[0]),
-        current_world_m_s=water.get("current_world_m_s", [0.0, 0.0, 0.0]),
+        environment=EnvironmentView.from_record(world.get("contact"), tips[0]),
+        current_world_m_s=world.get("current_world_m_s", [0.0, 0.0, 0.0]),
         show_desired="force_desired_world_N" in rollout.signals,
         extent_world_m=extent,
         style=style,
@@ -79,11 +80,8 @@ def scene_for_rollout(
     )
 
 
-def _surface_view(parameters: dict[str, Any], extent_world_m: np.ndarray) -> SurfaceView | None:
+def _surface_view(flow: FlowField | None, extent_world_m: np.ndarray) -> SurfaceView | None:
     """The animated wave surface of a run with waves, else None."""
-    from uvms_pin.scenario.scenario import water_flow_of
-
-    flow = water_flow_of(parameters)
     if flow is None or not flow.has_free_surface:
         return None
     return SurfaceView(flow, extent_world_m.mean(axis=0)[:2])

@@ -1,6 +1,6 @@
-"""What the robot touches and what pushes it: compliant contact and disturbances.
+"""What the end-effector touches: compliant contact models.
 
-Contact models return lambda, the wrench the end-effector exerts ON the environment
+A contact model returns lambda, the wrench the end-effector exerts ON the environment
 (docs/physics.md), at the end-effector point in world-aligned axes; the robot receives
 -lambda through the contact-point Jacobian. The controller never sees these objects.
 """
@@ -9,21 +9,13 @@ from __future__ import annotations
 
 import math
 from abc import ABC, abstractmethod
-from collections.abc import Callable
-from dataclasses import dataclass, field
+from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 
+from uvms_pin.checks import finite_vector
 from uvms_pin.errors import ParameterError
-
-
-def _vector(name: str, x, n: int) -> np.ndarray:
-    arr = np.asarray(x, dtype=float).reshape(-1)
-    if arr.shape != (n,):
-        raise ParameterError(f"{name} must have {n} numbers, got {arr.size}")
-    if not np.all(np.isfinite(arr)):
-        raise ParameterError(f"{name} has a non-finite value: {arr}")
-    return arr
 
 
 class ContactModel(ABC):
@@ -37,6 +29,11 @@ class ContactModel(ABC):
         self, position_world_m: np.ndarray, velocity_world_m_s: np.ndarray
     ) -> np.ndarray:
         """lambda = [force N; torque N m] exerted by the end-effector, world axes."""
+
+    def record(self) -> dict[str, Any]:
+        """What the environment is, as plain data (a rollout saves it, views draw it): its
+        type and, once attached, where it is."""
+        return {"type": type(self).__name__}
 
 
 @dataclass
@@ -52,12 +49,26 @@ class LinearSpring(ContactModel):
     anchor_world_m: np.ndarray | None = None
 
     def __post_init__(self) -> None:
-        self.stiffness_N_m = _vector("spring stiffness_N_m", self.stiffness_N_m, 3)
+        self.stiffness_N_m = finite_vector("spring stiffness_N_m", self.stiffness_N_m, 3)
         if np.any(self.stiffness_N_m < 0.0):
             raise ParameterError(f"spring stiffness must be >= 0, got {self.stiffness_N_m}")
         if self.anchor_world_m is not None:
-            self.anchor_world_m = _vector("spring anchor_world_m", self.anchor_world_m, 3)
+            self.anchor_world_m = finite_vector("spring anchor_world_m", self.anchor_world_m, 3)
         self._anchor = self.anchor_world_m  # the effective anchor, set again by attach()
+
+    @property
+    def anchor(self) -> np.ndarray | None:
+        """The effective anchor p_0 (3,) [m]: the given one, or the one `attach` set; None
+        before a run."""
+        return self._anchor
+
+    def record(self) -> dict[str, Any]:
+        anchor = self.anchor
+        return {
+            "type": "spring",
+            "stiffness_N_m": self.stiffness_N_m.tolist(),
+            "anchor_world_m": None if anchor is None else anchor.tolist(),
+        }
 
     def attach(self, position_world_m):
         given = self.anchor_world_m
@@ -90,7 +101,7 @@ class CompliantPlane(ContactModel):
     point_world_m: np.ndarray | None = None
 
     def __post_init__(self) -> None:
-        n = _vector("plane normal_world", self.normal_world, 3)
+        n = finite_vector("plane normal_world", self.normal_world, 3)
         norm = float(np.linalg.norm(n))
         if norm == 0.0:
             raise ParameterError("plane normal_world must be non-zero")
@@ -100,8 +111,24 @@ class CompliantPlane(ContactModel):
         if not (self.damping_N_s_m >= 0.0 and math.isfinite(self.damping_N_s_m)):
             raise ParameterError(f"plane damping_N_s_m must be >= 0, got {self.damping_N_s_m}")
         if self.point_world_m is not None:
-            self.point_world_m = _vector("plane point_world_m", self.point_world_m, 3)
+            self.point_world_m = finite_vector("plane point_world_m", self.point_world_m, 3)
         self._point = self.point_world_m  # the effective surface point, set again by attach()
+
+    @property
+    def point(self) -> np.ndarray | None:
+        """The effective surface point (3,) [m]: the given one, or the one `attach` set;
+        None before a run."""
+        return self._point
+
+    def record(self) -> dict[str, Any]:
+        point = self.point
+        return {
+            "type": "plane",
+            "normal_world": self.normal_world.tolist(),
+            "point_world_m": None if point is None else point.tolist(),
+            "stiffness_N_m": float(self.stiffness_N_m),
+            "damping_N_s_m": float(self.damping_N_s_m),
+        }
 
     def attach(self, position_world_m):
         given = self.point_world_m
@@ -120,32 +147,3 @@ class CompliantPlane(ContactModel):
         push = max(0.0, self.stiffness_N_m * depth + self.damping_N_s_m * rate)
         out[:3] = -push * self.normal_world
         return out
-
-
-# ---- disturbances: wrenches on the vehicle body -----------------------------------------
-
-
-@dataclass(frozen=True)
-class SinusoidalDisturbance:
-    """delta(t) = amplitude sin(2 pi t / period + phase), a body wrench on the vehicle.
-
-    The paper's: amplitude 0.15 N on x, y, z, period 7 s.
-    """
-
-    amplitude: np.ndarray = field(default_factory=lambda: np.array([0.15, 0.15, 0.15, 0, 0, 0]))
-    period_s: float = 7.0
-    phase_rad: float = 0.0
-
-    def __post_init__(self) -> None:
-        object.__setattr__(self, "amplitude", _vector("disturbance amplitude", self.amplitude, 6))
-        if not (self.period_s > 0.0 and math.isfinite(self.period_s)):
-            raise ParameterError(f"disturbance period_s must be positive, got {self.period_s}")
-        if not math.isfinite(self.phase_rad):
-            raise ParameterError(f"disturbance phase_rad must be finite, got {self.phase_rad}")
-
-    def __call__(self, time_s: float) -> np.ndarray:
-        return self.amplitude * math.sin(2.0 * math.pi * time_s / self.period_s + self.phase_rad)
-
-
-Disturbance = Callable[[float], np.ndarray]
-"""Any function of time returning a (6,) body wrench [N; N m] on the vehicle."""

@@ -1,0 +1,107 @@
+"""The compiled dynamics of a UVMS: its hydrodynamic bodies as the core's `HydroBodies`
+(src/uvms_core/hydro_bodies.hpp) and the `Dynamics` built from them (dynamics.hpp).
+
+`CompiledDynamics` has the interface of `uvms_pin.physics.dynamics.ReferenceDynamics`: the
+calls in a uniform current go straight to C++; a call in a flow the core has no counterpart of
+(a varying or sheared current) runs on the reference, with a `CoreFallbackWarning`.
+"""
+
+from __future__ import annotations
+
+from types import ModuleType
+from typing import Protocol
+
+import numpy as np
+
+from uvms_pin.flow import FlowField
+from uvms_pin.model.uvms import UVMS
+from uvms_pin.physics.compiled.backend import Fallback
+from uvms_pin.physics.compiled.extension import core_module
+from uvms_pin.physics.compiled.flow import flow_to_core
+
+
+class FlowDynamics(Protocol):
+    """What computes the dynamics in a flow the core has no counterpart of (the reference)."""
+
+    def bias_forces_in(
+        self, q: np.ndarray, v: np.ndarray, flow: FlowField, time_s: float
+    ) -> np.ndarray: ...
+
+    def forward_dynamics_in(
+        self,
+        q: np.ndarray,
+        v: np.ndarray,
+        tau: np.ndarray,
+        flow: FlowField,
+        time_s: float,
+        tau_ext: np.ndarray | None = None,
+    ) -> np.ndarray: ...
+
+
+def hydro_bodies_to_core(uvms: UVMS, core: ModuleType):
+    """The core's `HydroBodies` of ``uvms``: per-joint added mass (at the joint origin, joint
+    axes), volume and centre of buoyancy, and every damped link's placement and damping."""
+    bodies = core.HydroBodies()
+    bodies.water_density_kg_m3 = float(uvms.water_density_kg_m3)
+    bodies.added_mass_per_joint = list(uvms.added_mass_per_joint)
+    bodies.volume_per_joint_m3 = [float(v) for v in uvms.volume_per_joint_m3]
+    bodies.center_of_buoyancy_per_joint_m = list(uvms.center_of_buoyancy_per_joint_m)
+    damped = []
+    for body in uvms.hydro_bodies_with_damping:
+        entry = core.DampedBody()
+        entry.joint_id = int(body.joint_id)
+        entry.action_joint_to_body = body.action_joint_to_body
+        entry.rotation_in_joint = body.placement_in_joint.rotation
+        entry.position_in_joint_m = body.placement_in_joint.translation
+        entry.linear_damping = body.params.linear_damping
+        entry.quadratic_damping = body.params.quadratic_damping
+        damped.append(entry)
+    bodies.damped_bodies = damped
+    return bodies
+
+
+class CompiledDynamics:
+    """M, h and the forward dynamics of one UVMS in the compiled core.
+
+    Like ``uvms.data`` it reads the model when built: a UVMS changed in place afterwards
+    needs ``uvms.copy()`` (or `with_model` / `with_hydro`), which builds a new one.
+    """
+
+    def __init__(self, uvms: UVMS, reference: FlowDynamics):
+        core = core_module()
+        self.core = core.Dynamics(uvms.model.saveToString(), hydro_bodies_to_core(uvms, core))
+        self._reference = reference
+        self._flow: tuple[FlowField | None, object] = (None, None)  # the last flow converted
+        # the calls in a uniform current: the C++ methods themselves (no Python in between)
+        self.mass_matrix = self.core.mass_matrix
+        self.bias_forces = self.core.bias_forces
+        self.forward_dynamics = self.core.forward_dynamics
+
+    def _flow_struct(self, flow: FlowField):
+        """The core's FlowField of ``flow`` (the last one is kept: a flow is immutable), or
+        its Fallback."""
+        if self._flow[0] is not flow:
+            self._flow = (flow, flow_to_core(flow, core_module()))
+        return self._flow[1]
+
+    def bias_forces_in(self, q: np.ndarray, v: np.ndarray, flow: FlowField, time_s: float):
+        compiled = self._flow_struct(flow)
+        if isinstance(compiled, Fallback):
+            compiled.warn("these dynamics", stacklevel=4)
+            return self._reference.bias_forces_in(q, v, flow, time_s)
+        return self.core.bias_forces_in(q, v, compiled, time_s)
+
+    def forward_dynamics_in(
+        self,
+        q: np.ndarray,
+        v: np.ndarray,
+        tau: np.ndarray,
+        flow: FlowField,
+        time_s: float,
+        tau_ext: np.ndarray | None = None,
+    ):
+        compiled = self._flow_struct(flow)
+        if isinstance(compiled, Fallback):
+            compiled.warn("these dynamics", stacklevel=4)
+            return self._reference.forward_dynamics_in(q, v, tau, flow, time_s, tau_ext)
+        return self.core.forward_dynamics_in(q, v, tau, compiled, time_s, tau_ext)

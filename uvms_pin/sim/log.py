@@ -1,0 +1,74 @@
+"""The rollout of a run, written sample by sample: the observer every run has.
+
+Rows are preallocated (the run's number of logged samples, or a first guess that doubles when
+full, for an episode of unknown length); the energies are computed once, for the rows
+written, when the log is finished (they are functions of the state alone).
+"""
+
+from __future__ import annotations
+
+import copy
+from typing import Any
+
+from uvms_pin.model.uvms import UVMS
+from uvms_pin.physics.dynamics import kinetic_energy, potential_energy
+from uvms_pin.results.rollout import Rollout
+from uvms_pin.sim.sample import Sample
+
+
+class RolloutLog:
+    """Writes the loop's samples into a `Rollout` (an `Observer`).
+
+    Args:
+        uvms: the model (sizes, energies). backend: the dynamics' backend for the energies.
+        capacity: rows to allocate first. metadata: the rollout's metadata.
+    """
+
+    def __init__(self, uvms: UVMS, capacity: int, metadata: dict[str, Any], backend: str = "core"):
+        self.uvms = uvms
+        self.backend = backend
+        self.rollout = Rollout.allocate(max(int(capacity), 1), uvms.nq, uvms.nv, metadata)
+        self.count = 0
+
+    def on_sample(self, sample: Sample) -> None:
+        if self.count == len(self.rollout):
+            self._grow()
+        k, rollout = self.count, self.rollout
+        rollout.time_s[k] = sample.time_s
+        rollout.q[k] = sample.q
+        rollout.v[k] = sample.v
+        rollout.tau[k] = sample.tau_applied
+        rollout.signal("tau_commanded", self.uvms.nv)[k] = sample.tau_commanded
+        rollout.wrench_contact_world[k] = sample.contact_world
+        rollout.wrench_measured_world[k] = sample.measurement.wrench_world
+        rollout.wrench_disturbance_body[k] = sample.disturbance_body
+        for name, values in sample.signals.items():
+            rollout.signal(name, values.size)[k] = values
+        self.count += 1
+
+    def _grow(self) -> None:
+        old, n = self.rollout, len(self.rollout)
+        grown = Rollout.allocate(2 * n, self.uvms.nq, self.uvms.nv, old.metadata)
+        for name in Rollout._BASE:
+            getattr(grown, name)[:n] = getattr(old, name)
+        for name, values in old.signals.items():
+            grown.signal(name, values.shape[1])[:n] = values
+        self.rollout = grown
+
+    def copy(self) -> RolloutLog:
+        """An independent log holding the same samples (the model is shared)."""
+        out = RolloutLog.__new__(RolloutLog)
+        out.uvms, out.backend, out.count = self.uvms, self.backend, self.count
+        out.rollout = copy.deepcopy(self.rollout)
+        return out
+
+    def finish(self) -> Rollout:
+        """The rollout of the samples written so far, with their energies."""
+        rollout = self.rollout
+        rollout.truncate(self.count)
+        for k in range(self.count):
+            rollout.kinetic_energy_J[k] = kinetic_energy(
+                self.uvms, rollout.q[k], rollout.v[k], backend=self.backend
+            )
+            rollout.potential_energy_J[k] = potential_energy(self.uvms, rollout.q[k])
+        return rollout

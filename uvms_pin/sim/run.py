@@ -1,0 +1,145 @@
+"""A run: everything one simulation needs (a `Scenario`), and ``simulate(scenario)``.
+
+A scenario is usually read from a TOML file (`uvms_pin.scenario.load_scenario`); it can as
+well be built in code from its parts. `simulate` builds a fresh controller and seeded
+sensors, runs the closed loop and returns the rollout.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from uvms_pin.control.base import Controller
+from uvms_pin.model.uvms import UVMS
+from uvms_pin.results.progress import Progress, ProgressBar, callback_or_none
+from uvms_pin.results.rollout import Rollout
+from uvms_pin.sim.closed_loop import simulate_closed_loop
+from uvms_pin.sim.plant import Plant
+from uvms_pin.sim.sample import Observer, ProgressReport
+from uvms_pin.sim.sensors import SensorConfig, SensorSuite
+from uvms_pin.sim.settings import SimulationSettings
+
+ControllerFactory = Callable[[UVMS], Controller]
+
+
+@dataclass(frozen=True)
+class ControllerSpec:
+    """A controller factory that says what it builds: ``spec(uvms) -> Controller``.
+
+    Attributes:
+        type: what it is ("none", "ppc", a baseline or "package.module:ClassName").
+        params: the parameters the controller is built with, as recorded in rollouts
+            (for "ppc": every gain and funnel after defaults and broadcasting).
+        build: makes a fresh controller for a loaded model.
+    """
+
+    type: str
+    params: dict[str, Any] = field(default_factory=dict)
+    build: ControllerFactory = field(default=None, repr=False)
+
+    def __call__(self, uvms: UVMS) -> Controller:
+        return self.build(uvms)
+
+
+@dataclass
+class Scenario:
+    """Everything one run needs.
+
+    Attributes:
+        name, description: what the run is.
+        path: the file it came from (relative model paths and custom controllers resolve
+            next to it). raw: the scenario's parameters (recorded in rollouts).
+        plant: UVMS + water + environment + disturbance + actuation.
+        controller_factory: builds a fresh controller for the plant's UVMS (a
+            `ControllerSpec` records its type and parameters in the rollout).
+        sensor_config: noise of the measurements.
+        q0, v0: initial state. settings: integrator, periods, duration, seed.
+    """
+
+    name: str
+    description: str
+    path: Path
+    raw: dict[str, Any]
+    plant: Plant
+    controller_factory: ControllerFactory
+    sensor_config: SensorConfig
+    q0: np.ndarray
+    v0: np.ndarray
+    settings: SimulationSettings
+
+    @property
+    def uvms(self) -> UVMS:
+        return self.plant.uvms
+
+
+def simulate(
+    scenario: Scenario,
+    *,
+    progress: bool | Progress | None = True,
+    observers: Sequence[Observer] = (),
+) -> Rollout:
+    """Run a scenario: fresh sensors (seeded) and controller, closed loop, rollout.
+
+    ``progress``: True (default) shows a tqdm bar (notebook widget in Jupyter) once the
+    run has lasted `uvms_pin.results.progress.BAR_DELAY_S` of wall time, so short runs print
+    nothing; False or None: silent; a callable ``(t_s, duration_s)`` is called after
+    every logged sample. ``observers``: called with every logged sample (`Observer`), e.g.
+    a live view.
+
+    Raises FunnelViolation / SimulationError with the partial rollout attached as
+    ``exc.rollout`` (see `uvms_pin.sim.closed_loop.ClosedLoop.run`).
+    """
+    duration_s = scenario.settings.duration_s
+    if progress is True:
+        with ProgressBar(scenario.name, duration_s) as bar:
+            return _simulate(scenario, [*observers, ProgressReport(bar, duration_s)])
+    callback = callback_or_none(progress)
+    reports = [] if callback is None else [ProgressReport(callback, duration_s)]
+    return _simulate(scenario, [*observers, *reports])
+
+
+def _simulate(scenario: Scenario, observers: list[Observer]) -> Rollout:
+    settings = scenario.settings
+    sensors = SensorSuite(
+        scenario.uvms.model, scenario.sensor_config, settings.duration_s, settings.seed
+    )
+    controller = scenario.controller_factory(scenario.uvms)
+    metadata = {
+        "scenario": scenario.name,
+        "scenario_path": str(scenario.path),
+        "description": scenario.description,
+        "parameters": scenario.raw,
+        "controller": controller_record(scenario.controller_factory, controller),
+    }
+    return simulate_closed_loop(
+        scenario.plant,
+        controller,
+        sensors,
+        scenario.q0,
+        scenario.v0,
+        settings,
+        metadata=metadata,
+        observers=observers,
+    )
+
+
+def class_path(controller: object) -> str:
+    """``module:QualifiedName`` of an object's class (what a scenario's ``type`` names)."""
+    cls = type(controller)
+    return f"{cls.__module__}:{cls.__qualname__}"
+
+
+def controller_record(factory: ControllerFactory, controller: Controller) -> dict[str, Any]:
+    """What ran: the class of ``controller`` (``module:QualifiedName``) and, when the
+    factory is a `ControllerSpec`, its type and parameters (else None: unknown)."""
+    spec = factory if isinstance(factory, ControllerSpec) else None
+    return {
+        "class": class_path(controller),
+        "type": None if spec is None else spec.type,
+        "params": None if spec is None else spec.params,
+    }
