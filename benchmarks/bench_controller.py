@@ -46,7 +46,7 @@ from uvms_pin.control.ppc import PPCParams, PrescribedPerformanceController
 from uvms_pin.model.mount.catalog import CATALOG
 from uvms_pin.model.mount.split import split_urdf
 from uvms_pin.model.resources import example_robot_data_dir
-from uvms_pin.scenario.scenario import load_scenario
+from uvms_pin.scenario.load import load_scenario
 
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT / "tests" / "controllers"))
@@ -78,7 +78,7 @@ def scenario_case(stem: str) -> Case:
     python = load_scenario(path, {"controller.backend": "python"}).controller_factory(scenario.uvms)
     assert (core.backend, python.backend) == ("core", "python")
     with mock.patch(
-        "uvms_pin.scenario.scenario.PrescribedPerformanceController", in_place_of_the_package_ppc
+        "uvms_pin.scenario.ppc.PrescribedPerformanceController", in_place_of_the_package_ppc
     ):
         oracle = scenario.controller_factory(scenario.uvms)
     return _calls(_measurement(scenario.uvms, scenario.q0), core, python, oracle)

@@ -108,7 +108,7 @@ def main(argv: list[str] | None = None) -> int:
     from uvms_pin.model.mount.split import split_urdf
     from uvms_pin.model.summary import model_summary
     from uvms_pin.model.trim import TrimSpec
-    from uvms_pin.scenario.scenario import load_scenario
+    from uvms_pin.scenario.load import load_scenario
 
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--arm", help="your arm URDF (default: a built-in example arm)")

@@ -23,7 +23,8 @@ import numpy as np
 
 from uvms_pin.control.base import Controller
 from uvms_pin.control.measurement import Measurement
-from uvms_pin.scenario.scenario import Scenario, load_scenario, simulate
+from uvms_pin.scenario.load import load_scenario
+from uvms_pin.sim.run import Scenario, simulate
 
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT / "tests" / "controllers"))
@@ -62,7 +63,7 @@ class _Recorder(Controller):
 def oracle_controller(scenario: Scenario) -> Controller:
     """The scenario's controller, built with the same arguments by the frozen oracle."""
     with mock.patch(
-        "uvms_pin.scenario.scenario.PrescribedPerformanceController", in_place_of_the_package_ppc
+        "uvms_pin.scenario.ppc.PrescribedPerformanceController", in_place_of_the_package_ppc
     ):
         return scenario.controller_factory(scenario.uvms)
 

@@ -18,7 +18,8 @@ import numpy as np
 
 from uvms_pin.errors import FunnelViolation, SimulationError
 from uvms_pin.model.scaled import scaled_uvms
-from uvms_pin.scenario.scenario import load_scenario, simulate
+from uvms_pin.scenario.load import load_scenario
+from uvms_pin.sim.run import simulate
 
 ROOT = Path(__file__).resolve().parents[1]
 SCENARIO = ROOT / "scenarios" / "realistic_force_tracking.toml"

@@ -9,8 +9,8 @@ from pathlib import Path
 import pytest
 from conftest import ROOT
 
-from uvms_pin.scenario import scenario as scenario_module
-from uvms_pin.scenario.scenario import load_scenario
+from uvms_pin.scenario.load import load_scenario
+from uvms_pin.scenario.schema import Table
 
 DOCS = ROOT / "docs"
 SCENARIOS = ROOT / "scenarios"
@@ -84,21 +84,32 @@ _VARIANTS = [
     ),
 ]
 
-_READERS = ("number", "optional_number", "integer", "string", "vector", "table", "has", "pop_raw")
+_READERS = (
+    "number",
+    "optional_number",
+    "integer",
+    "string",
+    "boolean",
+    "vector",
+    "table",
+    "tables",
+    "has",
+    "pop_raw",
+)
 
 
 def scenario_keys_read() -> set[str]:
     """Every dotted key the scenario reader asks for while loading the variants
     (``actuation.thruster[i].name`` for entries of an array of tables)."""
     seen: set[str] = set()
-    table_class = scenario_module._Table
+    table_class = Table
     originals = {name: getattr(table_class, name) for name in _READERS}
 
     def recording(name):
         original = originals[name]
 
         def method(self, key, *args, **kwargs):
-            where = re.sub(r"\[\d+\]", "[i]", self._where)
+            where = re.sub(r"\[\d+\]", "[i]", self.where)
             seen.add(f"{where}.{key}" if where else key)
             return original(self, key, *args, **kwargs)
 

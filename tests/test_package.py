@@ -8,7 +8,7 @@ import sys
 
 def test_simulate_is_the_function_even_after_its_module_is_imported():
     code = (
-        "import uvms_pin.sim.run, uvms_pin.scenario.scenario, uvms_pin as up\n"
+        "import uvms_pin.sim.run, uvms_pin.scenario.load, uvms_pin as up\n"
         "assert callable(up.simulate) and up.simulate.__module__ == 'uvms_pin.sim.run'\n"
         "from uvms_pin.sim.settings import SimulationSettings\n"
     )

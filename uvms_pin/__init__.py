@@ -30,7 +30,7 @@ _LAZY = {
     "mount_arm": "uvms_pin.model.mount.mount",
     "shipped_path": "uvms_pin.model.resources",
     "Rollout": "uvms_pin.results.rollout",
-    "load_scenario": "uvms_pin.scenario.scenario",
+    "load_scenario": "uvms_pin.scenario.load",
     "simulate": "uvms_pin.sim.run",
 }
 

@@ -14,7 +14,8 @@ import numpy as np
 import uvms_pin.apps.gym  # noqa: F401 - registers the environments
 from uvms_pin.apps.gym.env import scenario_path
 from uvms_pin.apps.gym.policy import ControllerPolicy
-from uvms_pin.scenario.scenario import load_scenario, simulate
+from uvms_pin.scenario.load import load_scenario
+from uvms_pin.sim.run import simulate
 
 
 def random_episode(scenario: str, seed: int, steps: int) -> float:

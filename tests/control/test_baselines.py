@@ -14,7 +14,7 @@ from uvms_pin.control.baselines.pi_force import PIForceController
 from uvms_pin.control.measurement import Measurement
 from uvms_pin.errors import ScenarioError
 from uvms_pin.model.scaled import scaled_uvms
-from uvms_pin.scenario.scenario import load_scenario, scenario_from_raw
+from uvms_pin.scenario.load import load_scenario, scenario_from_raw
 from uvms_pin.scenario.toml import read_toml
 from uvms_pin.sim.closed_loop import simulate_closed_loop
 from uvms_pin.sim.integrators import RK4

@@ -15,7 +15,8 @@ import uvms_pin as up
 from uvms_pin.apps.cli.main import main
 from uvms_pin.control.base import ZeroController
 from uvms_pin.scenario.custom_controller import ControllerSpec, load_controller_class
-from uvms_pin.scenario.scenario import load_scenario, simulate
+from uvms_pin.scenario.load import load_scenario
+from uvms_pin.sim.run import simulate
 
 EXAMPLE = ROOT / "scripts" / "station_keeping" / "station_keeping.toml"
 

@@ -35,7 +35,7 @@ from uvms_pin.control.ppc import PPCParams, PrescribedPerformanceController
 from uvms_pin.errors import FunnelViolation, ParameterError, ScenarioError
 from uvms_pin.model.resources import example_robot_data_dir
 from uvms_pin.physics.compiled.extension import core_module
-from uvms_pin.scenario.scenario import load_scenario
+from uvms_pin.scenario.load import load_scenario
 
 STATUS = core_module().PPC_STATUS
 

@@ -32,7 +32,7 @@ from uvms_pin.control.ppc import PPCParams, PrescribedPerformanceController
 from uvms_pin.errors import FunnelViolation, UvmsPinError
 from uvms_pin.model.resources import example_robot_data_dir
 from uvms_pin.physics.kinematics import frame_rotation_and_jacobian
-from uvms_pin.scenario.scenario import load_scenario
+from uvms_pin.scenario.load import load_scenario
 
 RECORDED = Path(__file__).resolve().parent / "data" / "ppc_runs.npz"
 SCENARIOS = ("paper_force_tracking", "realistic_force_tracking")
@@ -114,7 +114,7 @@ def scenario_pair(stem: str):
     scenario = load_scenario(ROOT / "scenarios" / f"{stem}.toml")
     fast = scenario.controller_factory(scenario.uvms)
     with mock.patch(
-        "uvms_pin.scenario.scenario.PrescribedPerformanceController", in_place_of_the_package_ppc
+        "uvms_pin.scenario.ppc.PrescribedPerformanceController", in_place_of_the_package_ppc
     ):
         oracle = scenario.controller_factory(scenario.uvms)
     assert isinstance(fast, PrescribedPerformanceController)

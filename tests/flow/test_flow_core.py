@@ -16,7 +16,8 @@ from uvms_pin.flow import AiryWave, GaussMarkovCurrent, IrregularSea, UniformCur
 from uvms_pin.physics.compiled.backend import Fallback
 from uvms_pin.physics.compiled.extension import core_module
 from uvms_pin.physics.compiled.flow import flow_to_core
-from uvms_pin.scenario.scenario import load_scenario, simulate
+from uvms_pin.scenario.load import load_scenario
+from uvms_pin.sim.run import simulate
 
 ROOT = Path(__file__).resolve().parents[2]
 FLOWS = {

@@ -10,7 +10,8 @@ import pytest
 
 import uvms_pin as up
 from uvms_pin.flow import AiryWave, GaussMarkovCurrent, IrregularSea, SumFlow, flow_from_record
-from uvms_pin.scenario.scenario import load_scenario, simulate
+from uvms_pin.scenario.load import load_scenario
+from uvms_pin.sim.run import simulate
 
 ROOT = Path(__file__).resolve().parents[2]
 REALISTIC = ROOT / "scenarios" / "realistic_force_tracking.toml"

@@ -13,7 +13,8 @@ from conftest import REFERENCE_URDF
 import uvms_pin as up
 from uvms_pin.physics.contact import CompliantPlane, LinearSpring
 from uvms_pin.physics.disturbance import SinusoidalDisturbance
-from uvms_pin.scenario.scenario import load_scenario, simulate
+from uvms_pin.scenario.load import load_scenario
+from uvms_pin.sim.run import simulate
 
 K = np.array([2.0, 3.0, 5.0])
 

@@ -85,7 +85,8 @@ def test_run_outputs_are_exactly_the_files_a_run_writes(tmp_path):
     """RUN lists the outputs by name: a new figure must be added there (or --overwrite
     would leave it stale). The sea-state scenario writes every figure (flow.png too)."""
     from uvms_pin.apps.outputs import write_outputs
-    from uvms_pin.scenario.scenario import load_scenario, simulate
+    from uvms_pin.scenario.load import load_scenario
+    from uvms_pin.sim.run import simulate
 
     text = (ROOT / "scenarios" / "sea_state_force_tracking.toml").read_text()
     text = text.replace("../models/", f"{ROOT}/models/").replace(

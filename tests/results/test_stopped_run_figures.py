@@ -11,7 +11,8 @@ import uvms_pin as up
 from uvms_pin.apps.viz.replay import write_replay
 from uvms_pin.results.figures import paper as paper_figures
 from uvms_pin.results.figures import standard as plots
-from uvms_pin.scenario.scenario import load_scenario, simulate
+from uvms_pin.scenario.load import load_scenario
+from uvms_pin.sim.run import simulate
 
 REALISTIC = ROOT / "scenarios" / "realistic_force_tracking.toml"
 

@@ -6,8 +6,9 @@ from pathlib import Path
 
 import numpy as np
 
-from uvms_pin.scenario.scenario import load_scenario, simulate
+from uvms_pin.scenario.load import load_scenario
 from uvms_pin.sim.actuation import ThrustersAndJointLimits
+from uvms_pin.sim.run import simulate
 
 SCENARIO = Path(__file__).resolve().parents[2] / "scenarios" / "bluerov_alpha5_force_tracking.toml"
 

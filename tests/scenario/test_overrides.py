@@ -10,8 +10,8 @@ import pytest
 from conftest import ROOT, run
 
 import uvms_pin as up
+from uvms_pin.scenario.load import load_scenario
 from uvms_pin.scenario.overrides import apply_overrides, parse_assignment, parse_key_path
-from uvms_pin.scenario.scenario import load_scenario
 
 PASSIVE = ROOT / "scenarios" / "passive_current.toml"
 PAPER = ROOT / "scenarios" / "paper_force_tracking.toml"

@@ -12,7 +12,8 @@ from conftest import REFERENCE_URDF, ROOT
 
 import uvms_pin as up
 from uvms_pin.control.ppc import PrescribedPerformanceController
-from uvms_pin.scenario.scenario import apply_overrides, load_scenario
+from uvms_pin.scenario.load import load_scenario
+from uvms_pin.scenario.overrides import apply_overrides
 from uvms_pin.sim.actuation import ThrustersAndJointLimits, Unlimited
 
 MINIMAL = f"""

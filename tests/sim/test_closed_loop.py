@@ -19,8 +19,9 @@ from uvms_pin.control.measurement import Measurement
 from uvms_pin.control.ppc import PrescribedPerformanceController
 from uvms_pin.model.scaled import scaled_uvms
 from uvms_pin.model.uvms import UVMS
-from uvms_pin.scenario.scenario import Scenario, load_scenario, simulate
+from uvms_pin.scenario.load import load_scenario
 from uvms_pin.sim.actuation import ThrustersAndJointLimits
+from uvms_pin.sim.run import Scenario, simulate
 
 PAPER = ROOT / "scenarios" / "paper_force_tracking.toml"
 REALISTIC = ROOT / "scenarios" / "realistic_force_tracking.toml"

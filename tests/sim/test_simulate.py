@@ -10,7 +10,8 @@ import pytest
 from conftest import ROOT
 
 import uvms_pin as up
-from uvms_pin.scenario.scenario import load_scenario, simulate
+from uvms_pin.scenario.load import load_scenario
+from uvms_pin.sim.run import simulate
 
 PAPER = ROOT / "scenarios" / "paper_force_tracking.toml"
 REALISTIC = ROOT / "scenarios" / "realistic_force_tracking.toml"

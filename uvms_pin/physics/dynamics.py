@@ -214,13 +214,16 @@ def _uniform(current_world: np.ndarray) -> UniformCurrent | None:
 def dynamics_of(uvms: UVMS, backend: str = "core") -> CompiledDynamics | ReferenceDynamics:
     """The dynamics of ``uvms`` in ``backend`` ("core": compiled, "python": the reference),
     built on first use and kept with it (``uvms.cache``)."""
-    compiled = backend_named(backend).compiled
-    key = "compiled_dynamics" if compiled else "reference_dynamics"
-    dynamics = uvms.cache.get(key)
-    if dynamics is None:
-        reference = ReferenceDynamics(uvms)
-        dynamics = CompiledDynamics(uvms, reference) if compiled else reference
-        uvms.cache[key] = dynamics
+    built = uvms.cache.get("dynamics")
+    dynamics = None if built is None else built.get(backend)
+    return _build_dynamics(uvms, backend) if dynamics is None else dynamics
+
+
+def _build_dynamics(uvms: UVMS, backend: str) -> CompiledDynamics | ReferenceDynamics:
+    compiled = backend_named(backend).compiled  # ParameterError for an unknown name
+    reference = ReferenceDynamics(uvms)
+    dynamics = CompiledDynamics(uvms, reference) if compiled else reference
+    uvms.cache.setdefault("dynamics", {})[backend] = dynamics
     return dynamics
 
 

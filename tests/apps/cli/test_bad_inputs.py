@@ -147,7 +147,8 @@ def workspace(tmp_path_factory) -> Path:
     from uvms_pin.apps.outputs import write_outputs
     from uvms_pin.apps.study import load_study
     from uvms_pin.apps.study.runner import run_study
-    from uvms_pin.scenario.scenario import load_scenario, simulate
+    from uvms_pin.scenario.load import load_scenario
+    from uvms_pin.sim.run import simulate
 
     ws = tmp_path_factory.mktemp("corpus")
     (ws / "good.toml").write_text(passive_scenario(0.1))

@@ -11,7 +11,8 @@ from PIL import Image
 from viz_support import SPRING, HeadlessPage, short_scenario
 
 from uvms_pin.apps.viz.replay import REPLAY_FILE, write_replay
-from uvms_pin.scenario.scenario import load_scenario, simulate
+from uvms_pin.scenario.load import load_scenario
+from uvms_pin.sim.run import simulate
 
 DURATION_S = 1.0
 

@@ -9,7 +9,7 @@ margin, exceptions) to 1e-12. Do not edit them; do not import them from the pack
 
 def in_place_of_the_package_ppc(*args, backend: str = "core", **kwargs):
     """The oracle, built with the arguments a scenario gives the package's controller
-    (``mock.patch("uvms_pin.scenario.scenario.PrescribedPerformanceController", ...)``): the
+    (``mock.patch("uvms_pin.scenario.ppc.PrescribedPerformanceController", ...)``): the
     ``backend`` keyword, newer than the oracle, is dropped (the oracle has one backend)."""
     from ppc_oracle.ppc import PrescribedPerformanceController
 

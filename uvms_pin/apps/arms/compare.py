@@ -56,7 +56,8 @@ from uvms_pin.model.trim import TrimSpec
 from uvms_pin.model.uvms import UVMS
 from uvms_pin.physics.dynamics import mass_matrix
 from uvms_pin.results.atomic import atomic_path, write_json_atomic
-from uvms_pin.scenario.scenario import load_scenario, simulate
+from uvms_pin.scenario.load import load_scenario
+from uvms_pin.sim.run import simulate
 
 __all__ = ["COLUMNS", "CompareSettings", "compare_arms", "write_comparison"]
 

@@ -63,7 +63,7 @@ class _ProgressLine:
 
 
 def _simulate(scenario, args: argparse.Namespace, progress) -> Rollout:
-    from uvms_pin.scenario.scenario import simulate
+    from uvms_pin.sim.run import simulate
 
     if not args.live:
         return simulate(scenario, progress=progress)
@@ -79,7 +79,7 @@ def _write_replay(rollout: Rollout, path: Path, **kw) -> Path:
 
 
 def _cmd_run(args: argparse.Namespace) -> int:
-    from uvms_pin.scenario.scenario import load_scenario
+    from uvms_pin.scenario.load import load_scenario
 
     _check_view_options(args)
     overrides = dict(parse_assignment(text) for text in args.set)

@@ -73,7 +73,8 @@ class _CaseStudy(Study):
 def execute_case(base: str, run: Run, rollout_dir: str | None, criteria: Criteria) -> dict:
     """One controller on one case: the comparison row (never raises; errors go in the row)."""
     from uvms_pin.apps.compare.runs import run_controller
-    from uvms_pin.scenario.scenario import baseline_controller_table, scenario_from_raw
+    from uvms_pin.scenario.baselines import baseline_controller_table
+    from uvms_pin.scenario.load import scenario_from_raw
 
     start = time.perf_counter()
     row = base_row(run)

@@ -9,14 +9,11 @@ from typing import Any
 from uvms_pin.apps.compare.metrics import Criteria, comparison_row
 from uvms_pin.errors import FunnelViolation, ScenarioError, SimulationError
 from uvms_pin.results.rollout import Rollout
+from uvms_pin.scenario.baselines import baseline_controller_table
+from uvms_pin.scenario.load import scenario_from_raw
 from uvms_pin.scenario.overrides import apply_overrides
-from uvms_pin.scenario.scenario import (
-    Scenario,
-    baseline_controller_table,
-    scenario_from_raw,
-    simulate,
-)
 from uvms_pin.scenario.toml import read_toml
+from uvms_pin.sim.run import Scenario, simulate
 
 __all__ = ["compare_controllers", "controller_scenarios", "run_controller"]
 

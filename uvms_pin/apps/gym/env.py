@@ -28,7 +28,7 @@ from uvms_pin.errors import ParameterError, SimulationError
 from uvms_pin.model.resources import shipped_path
 from uvms_pin.results.rollout import Rollout
 from uvms_pin.results.status import OK, RunStatus
-from uvms_pin.scenario.scenario import load_scenario
+from uvms_pin.scenario.load import load_scenario
 from uvms_pin.sim.closed_loop import ClosedLoop, run_metadata
 from uvms_pin.sim.log import RolloutLog
 from uvms_pin.sim.run import Scenario

@@ -13,7 +13,7 @@ from uvms_pin.apps.gym.tasks import ForceTrackingTask
 from uvms_pin.control.performance import PerformanceFunction
 from uvms_pin.control.ppc import PrescribedPerformanceController
 from uvms_pin.errors import ParameterError
-from uvms_pin.scenario.scenario import Scenario
+from uvms_pin.sim.run import Scenario
 
 DEFAULT_SCENARIO = "realistic_force_tracking"
 # (rho0 [N], rho_inf [N], l [1/s]) when the scenario has no PPC to take the funnel from

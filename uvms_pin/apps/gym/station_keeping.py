@@ -7,7 +7,7 @@ from typing import Any
 
 from uvms_pin.apps.gym.env import UvmsEnv
 from uvms_pin.apps.gym.tasks import StationKeepingTask
-from uvms_pin.scenario.scenario import Scenario
+from uvms_pin.sim.run import Scenario
 
 DEFAULT_SCENARIO = "gym_station_keeping"
 

@@ -11,7 +11,7 @@ from __future__ import annotations
 import dataclasses
 
 from uvms_pin.model.scaled import scaled_uvms
-from uvms_pin.scenario.scenario import Scenario
+from uvms_pin.sim.run import Scenario
 
 
 def modify_plant(scenario: Scenario, factors: dict[str, float]) -> Scenario:

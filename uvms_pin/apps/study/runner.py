@@ -62,7 +62,8 @@ def execute_run(base: str, run: Run, rollout_dir: str | None = None) -> dict[str
     Never raises for a failed run: the status and message go in the row.
     """
     from uvms_pin.apps.study.plant import modify_plant
-    from uvms_pin.scenario.scenario import load_scenario, simulate
+    from uvms_pin.scenario.load import load_scenario
+    from uvms_pin.sim.run import simulate
 
     start = time.perf_counter()
     row = base_row(run)

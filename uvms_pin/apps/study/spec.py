@@ -39,6 +39,7 @@ import numpy as np
 
 from uvms_pin.errors import ScenarioError, UvmsPinError
 from uvms_pin.scenario.overrides import KEY_PATH, parse_key_path
+from uvms_pin.scenario.schema import Table, is_number
 from uvms_pin.scenario.toml import read_toml
 
 SEED_KEY = 0x5EED  # spawn-key component of a sample's scenario seed
@@ -271,77 +272,49 @@ def load_study(path: str | Path) -> Study:
     path = Path(path)
     source = str(path)
     raw = read_toml(path, StudyError)
-
     unknown = set(raw) - {"study", "fixed", "parameter", "report"}
     if unknown:
         raise StudyError(f"{source}: unknown table(s): {', '.join(sorted(unknown))}")
-    head = dict(raw.get("study", {}))
-
-    def pop(key, kind, default=_MISSING):
-        if key not in head:
-            if default is _MISSING:
-                raise StudyError(f"{source}: study.{key}: is required")
-            return default
-        value = head.pop(key)
-        if isinstance(value, bool) or not isinstance(value, kind):
-            raise StudyError(f"{source}: study.{key}: must be {kind.__name__}, got {value!r}")
-        return value
-
-    name = pop("name", str, path.stem)
-    description = pop("description", str, "")
-    base_entry = pop("base", str)
-    seed = pop("seed", int)
-    samples = pop("samples", int, 1)
-    if head:
-        raise StudyError(f"{source}: [study] has unknown key(s): {', '.join(sorted(head))}")
-    if seed < 0:
-        raise StudyError(f"{source}: study.seed: must be >= 0, got {seed}")
-    if samples < 1:
-        raise StudyError(f"{source}: study.samples: must be >= 1, got {samples}")
+    top = Table(raw, "", source, error=StudyError)
+    head = top.table_or_empty("study")
+    name = head.string("name", path.stem)
+    description = head.string("description", "")
+    base_entry = head.string("base")
+    seed = head.integer("seed", minimum=0)
+    samples = head.integer("samples", 1, minimum=1)
+    head.finish()
     base = (path.parent / base_entry).resolve()
     if not base.is_file():
-        raise StudyError(f"{source}: study.base: scenario '{base_entry}' not found ({base})")
+        raise head.error("base", f"scenario '{base_entry}' not found ({base})")
     base_raw = read_toml(base, StudyError, f"{source}: study.base: '{base_entry}'")
-
-    fixed = raw.get("fixed", {})
-    if not isinstance(fixed, dict):
-        raise StudyError(f"{source}: [fixed] must be a table of dotted keys")
-    fixed = _flatten(fixed)
-    for key in fixed:
-        if key.startswith(PLANT_PREFIX):
-            raise StudyError(f"{source}: fixed.{key}: plant factors go in a [[parameter]]")
-
-    entries = raw.get("parameter", [])
-    if not isinstance(entries, list) or not entries:
+    fixed = _fixed(raw.get("fixed", {}), source)
+    entries = top.tables("parameter")
+    if not entries:
         raise StudyError(f"{source}: needs at least one [[parameter]]")
-    parameters = []
-    for k, entry in enumerate(entries):
-        parameters.append(_parameter(entry, k, source, base_raw, fixed))
+    parameters = tuple(_parameter(entry, k, base_raw, fixed) for k, entry in enumerate(entries))
     seen = set()
     for p in parameters:
         if p.path in seen:
             raise StudyError(f"{source}: {p.entry}: the path is given twice")
         seen.add(p.path)
-
     report = raw.get("report", {})
     if not isinstance(report, dict):
         raise StudyError(f"{source}: [report] must be a table")
     _check_report(report, source, {p.path for p in parameters})
-
-    study = Study(
-        name,
-        description,
-        path,
-        base,
-        seed,
-        samples,
-        fixed,
-        tuple(parameters),
-        report,
-        base_raw,
-    )
+    study = Study(name, description, path, base, seed, samples, fixed, parameters, report, base_raw)
     _check_against_base(study, source)
     return study
+
+
+def _fixed(table: Any, source: str) -> dict[str, Any]:
+    """[fixed]: dotted scenario keys applied to every run (no plant factor)."""
+    if not isinstance(table, dict):
+        raise StudyError(f"{source}: [fixed] must be a table of dotted keys")
+    fixed = _flatten(table)
+    for key in fixed:
+        if key.startswith(PLANT_PREFIX):
+            raise StudyError(f"{source}: fixed.{key}: plant factors go in a [[parameter]]")
+    return fixed
 
 
 def _flatten(table: dict[str, Any], prefix: str = "") -> dict[str, Any]:
@@ -355,113 +328,108 @@ def _flatten(table: dict[str, Any], prefix: str = "") -> dict[str, Any]:
     return out
 
 
-def _number(x: Any) -> bool:
-    return isinstance(x, int | float) and not isinstance(x, bool) and math.isfinite(x)
-
-
-def _parameter(
-    entry: Any, k: int, source: str, base_raw: dict[str, Any], fixed: dict[str, Any]
-) -> Parameter:
-    if not isinstance(entry, dict):
-        raise StudyError(f"{source}: parameter[{k}]: must be a table")
-    entry = dict(entry)
-    path = entry.pop("path", None)
-    if not isinstance(path, str):
-        raise StudyError(f"{source}: parameter[{k}]: 'path' (a dotted key) is required")
-    where = f"{source}: parameter[{k}] '{path}'"
-    label = f"parameter[{k}] '{path}'"
-
-    def fail(msg: str) -> StudyError:
-        return StudyError(f"{where}: {msg}")
-
+def _parameter(t: Table, k: int, base_raw: dict[str, Any], fixed: dict[str, Any]) -> Parameter:
+    """One [[parameter]]: where it goes, how it is applied, its grid or its distribution."""
+    path = t.string("path")
+    t.label = f"parameter[{k}] '{path}'"
     if KEY_PATH.match(path) is None:
-        raise fail("not a dotted key like 'environment.stiffness_N_m' or 'a.b[2]'")
-    key, index = parse_key_path(path).key, parse_key_path(path).index
-    apply = entry.pop("apply", "set")
-    if apply not in APPLY_MODES:
-        raise fail(f"apply must be one of {', '.join(APPLY_MODES)}, got {apply!r}")
-
-    if path.startswith(PLANT_PREFIX):
-        factor = path[len(PLANT_PREFIX) :]
-        if factor not in PLANT_FACTORS or index is not None:
-            raise fail(
-                f"unknown plant factor; known: {', '.join(PLANT_PREFIX + f for f in PLANT_FACTORS)}"
-            )
-    else:
-        base_value = fixed.get(key, _lookup(base_raw, key, None))
-        if index is not None:
-            if not isinstance(base_value, list):
-                raise fail(f"'{key}' is not a list in the base scenario, it cannot be indexed")
-            if int(index) >= len(base_value):
-                raise fail(f"index {index} out of range: '{key}' has {len(base_value)} entries")
-        elif apply != "set" and base_value is None:
-            raise fail(f"apply = '{apply}' needs a value of '{key}' in the base scenario")
-
-    kinds = [name for name in ("values", "linspace", "logspace", "distribution") if name in entry]
+        raise t.fail("not a dotted key like 'environment.stiffness_N_m' or 'a.b[2]'")
+    apply = t.string("apply", "set", APPLY_MODES)
+    _check_target(t, path, apply, base_raw, fixed)
+    kinds = [name for name in (*_GRIDS, "distribution") if t.has(name)]
     if len(kinds) != 1:
-        raise fail("give exactly one of values, linspace, logspace, distribution")
-    kind = kinds[0]
-    grid = None
-    distribution = None
-    args: dict[str, float] = {}
-    if kind == "values":
-        values = entry.pop("values")
-        if not isinstance(values, list) or not values:
-            raise fail("values: the list is empty")
-        for v in values:
-            ok = _number(v) or (isinstance(v, list) and v and all(_number(x) for x in v))
-            if not ok:
-                raise fail(f"values: {v!r} is not a finite number or list of numbers")
-        grid = tuple(values)
-    elif kind in ("linspace", "logspace"):
-        spec = entry.pop(kind)
+        raise t.fail("give exactly one of values, linspace, logspace, distribution")
+    if kinds[0] == "distribution":
+        distribution, args = _distribution(t)
+        grid = None
+    else:
+        distribution, args = None, {}
+        grid = _GRIDS[kinds[0]](t)
+    t.finish()
+    return Parameter(path, t.label, apply, grid, distribution, args)
+
+
+def _check_target(
+    t: Table, path: str, apply: str, base_raw: dict[str, Any], fixed: dict[str, Any]
+) -> None:
+    """A plant factor uvms-pin knows, or a scenario key whose base value fits ``apply``."""
+    key, index = parse_key_path(path).key, parse_key_path(path).index
+    if path.startswith(PLANT_PREFIX):
+        if path[len(PLANT_PREFIX) :] not in PLANT_FACTORS or index is not None:
+            known = ", ".join(PLANT_PREFIX + f for f in PLANT_FACTORS)
+            raise t.fail(f"unknown plant factor; known: {known}")
+        return
+    base_value = fixed.get(key, _lookup(base_raw, key, None))
+    if index is not None:
+        if not isinstance(base_value, list):
+            raise t.fail(f"'{key}' is not a list in the base scenario, it cannot be indexed")
+        if int(index) >= len(base_value):
+            raise t.fail(f"index {index} out of range: '{key}' has {len(base_value)} entries")
+    elif apply != "set" and base_value is None:
+        raise t.fail(f"apply = '{apply}' needs a value of '{key}' in the base scenario")
+
+
+def _values(t: Table) -> tuple[Any, ...]:
+    values = t.pop_raw("values")
+    if not isinstance(values, list) or not values:
+        raise t.fail("values: the list is empty")
+    for v in values:
+        if not (is_number(v) or (isinstance(v, list) and v and all(is_number(x) for x in v))):
+            raise t.fail(f"values: {v!r} is not a finite number or list of numbers")
+    return tuple(values)
+
+
+def _spaced(kind: str):
+    """A grid of ``count`` points from ``start`` to ``stop``, evenly (linspace) or
+    geometrically (logspace) spaced: ``[start, stop, count]``."""
+
+    def read(t: Table) -> tuple[float, ...]:
+        spec = t.pop_raw(kind)
         if (
             not isinstance(spec, list)
             or len(spec) != 3
-            or not all(_number(x) for x in spec[:2])
+            or not all(is_number(x) for x in spec[:2])
             or isinstance(spec[2], bool)
             or not isinstance(spec[2], int)
         ):
-            raise fail(f"{kind}: must be [start, stop, count], got {spec!r}")
+            raise t.fail(f"{kind}: must be [start, stop, count], got {spec!r}")
         start, stop, count = spec
         if count < 1:
-            raise fail(f"{kind}: empty range (count = {count})")
+            raise t.fail(f"{kind}: empty range (count = {count})")
         if count > 1 and start == stop:
-            raise fail(f"{kind}: empty range (start = stop = {start})")
-        if kind == "logspace":
-            if start <= 0 or stop <= 0:
-                raise fail(f"logspace: start and stop must be > 0, got {start}, {stop}")
-            points = np.geomspace(start, stop, count)
-        else:
-            points = np.linspace(start, stop, count)
-        grid = tuple(float(x) for x in points)
-    else:
-        distribution = entry.pop("distribution")
-        if distribution not in DISTRIBUTIONS:
-            raise fail(f"unknown distribution {distribution!r}; known: {', '.join(DISTRIBUTIONS)}")
-        needed = ("mean", "std") if distribution == "normal" else ("low", "high")
-        optional = ("low", "high") if distribution == "normal" else ()
-        for name in (*needed, *optional):
-            if name in entry:
-                value = entry.pop(name)
-                if not _number(value):
-                    raise fail(f"{name}: must be a finite number, got {value!r}")
-                args[name] = float(value)
-            elif name in needed:
-                raise fail(f"distribution '{distribution}' needs '{name}'")
-        if distribution == "normal":
-            if args["std"] <= 0:
-                raise fail(f"std must be > 0, got {args['std']}")
-            if args.get("low", -math.inf) >= args.get("high", math.inf):
-                raise fail(f"empty range: low = {args['low']} >= high = {args['high']}")
-        else:
-            if args["low"] >= args["high"]:
-                raise fail(f"empty range: low = {args['low']} >= high = {args['high']}")
-            if distribution == "log-uniform" and args["low"] <= 0:
-                raise fail(f"log-uniform needs low > 0, got {args['low']}")
-    if entry:
-        raise fail(f"unknown key(s): {', '.join(sorted(entry))}")
-    return Parameter(path, label, apply, grid, distribution, args)
+            raise t.fail(f"{kind}: empty range (start = stop = {start})")
+        if kind == "logspace" and (start <= 0 or stop <= 0):
+            raise t.fail(f"logspace: start and stop must be > 0, got {start}, {stop}")
+        space = np.geomspace if kind == "logspace" else np.linspace
+        return tuple(float(x) for x in space(start, stop, count))
+
+    return read
+
+
+#: grid key -> how the grid is read from a [[parameter]]
+_GRIDS = {"values": _values, "linspace": _spaced("linspace"), "logspace": _spaced("logspace")}
+
+
+def _distribution(t: Table) -> tuple[str, dict[str, float]]:
+    """The random law of a [[parameter]] and its arguments, checked."""
+    distribution = t.pop_raw("distribution")
+    if distribution not in DISTRIBUTIONS:
+        raise t.fail(f"unknown distribution {distribution!r}; known: {', '.join(DISTRIBUTIONS)}")
+    normal = distribution == "normal"
+    needed = ("mean", "std") if normal else ("low", "high")
+    args: dict[str, float] = {}
+    for name in (*needed, *(("low", "high") if normal else ())):
+        if t.has(name):
+            args[name] = t.number(name)
+        elif name in needed:
+            raise t.fail(f"distribution '{distribution}' needs '{name}'")
+    if normal and args["std"] <= 0:
+        raise t.fail(f"std must be > 0, got {args['std']}")
+    if args.get("low", -math.inf) >= args.get("high", math.inf):
+        raise t.fail(f"empty range: low = {args['low']} >= high = {args['high']}")
+    if distribution == "log-uniform" and args["low"] <= 0:
+        raise t.fail(f"log-uniform needs low > 0, got {args['low']}")
+    return distribution, args
 
 
 def _check_report(report: dict[str, Any], source: str, paths: set[str]) -> None:
@@ -487,7 +455,7 @@ def _extremes(study: Study, runs: list[Run]) -> dict[str, list[Any]]:
     out: dict[str, list[Any]] = {}
     for p in study.parameters:
         values = [r.values[p.path] for r in runs]
-        if all(_number(v) for v in values):
+        if all(is_number(v) for v in values):
             bounds = [p.args[k] for k in ("low", "high") if k in p.args]  # the support
             out[p.path] = sorted({min(values), max(values), *bounds})
         else:
@@ -500,7 +468,7 @@ def _check_against_base(study: Study, source: str) -> None:
     """Load the base scenario with the fixed overrides; then with each parameter alone at
     each of its extremes over the runs (so a failure names its entry); then with the first
     run's overrides as a whole. Plant factors are checked for sign."""
-    from uvms_pin.scenario.scenario import load_scenario
+    from uvms_pin.scenario.load import load_scenario
 
     try:
         load_scenario(study.base, study.fixed)

@@ -1,0 +1,139 @@
+"""Scenario files (TOML) -> a `Scenario`, ready for ``simulate``.
+
+A scenario is read in two stages: the TOML becomes a plain dict (on which dotted
+``overrides`` such as ``{"environment.stiffness_N_m": [20, 20, 20]}`` or
+``{"initial.joint_positions_rad[3]": 0.5}`` are applied, see `uvms_pin.scenario.overrides`;
+that is how ``uvms-pin run --set``, sweeps and robustness tables vary it), then every table
+is checked and built by the module of its concept: ``[water]`` (`water`), ``[initial]``
+(`initial`), ``[environment]`` and ``[disturbance]`` (`world`), ``[actuation]``,
+``[sensors]``, ``[integrator]``, ``[control]`` and ``[output]`` (`timing`), ``[controller]``
+(`controller`) and ``[baselines]`` (`baselines`). Unknown keys, wrong types and bad values
+raise `ScenarioError` naming the file and the key, or the override when an override set it,
+with the closest known key. ``model`` is a path relative to the scenario file or the name of
+a shipped model (``"uvms_lbv150"``, ``"lbv150"``). See ``scenarios/*.toml`` for documented
+examples.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+from uvms_pin.errors import ParameterError, ScenarioError, UvmsPinError
+from uvms_pin.model.resources import find_model, shipped_models
+from uvms_pin.model.uvms import UVMS, load_uvms
+from uvms_pin.scenario.actuation import build_actuation
+from uvms_pin.scenario.baselines import check_baselines
+from uvms_pin.scenario.controller import build_controller
+from uvms_pin.scenario.initial import build_initial_state
+from uvms_pin.scenario.overrides import apply_overrides, parse_key_path
+from uvms_pin.scenario.schema import Table
+from uvms_pin.scenario.sensors import build_sensors
+from uvms_pin.scenario.timing import build_control_period, build_integrator, build_log_period
+from uvms_pin.scenario.toml import read_toml
+from uvms_pin.scenario.water import Water, build_water
+from uvms_pin.scenario.world import build_disturbance, build_environment
+from uvms_pin.sim.plant import Plant
+from uvms_pin.sim.run import Scenario
+from uvms_pin.sim.settings import SimulationSettings, check_log_fits
+
+
+@dataclass(frozen=True)
+class Head:
+    """``[scenario]``: name, description, model entry, duration [s], master seed."""
+
+    name: str
+    description: str
+    model: str
+    duration_s: float
+    seed: int
+
+
+def load_scenario(path: str | Path, overrides: dict[str, Any] | None = None) -> Scenario:
+    """Read a scenario TOML file, apply dotted overrides and build the objects.
+
+    Args:
+        path: the scenario file.
+        overrides: dotted key (optionally ``[i]``-indexed) -> value, e.g.
+            ``{"environment.stiffness_N_m": [20, 20, 20], "initial.joint_positions_rad[3]":
+            0.5}`` (`uvms_pin.scenario.overrides`).
+
+    Raises:
+        ScenarioError: naming the file and the key, or the override that set a bad value.
+    """
+    path = Path(path)
+    return scenario_from_raw(read_toml(path, ScenarioError), path, overrides)
+
+
+def scenario_from_raw(
+    raw: dict[str, Any], path: str | Path, overrides: dict[str, Any] | None = None
+) -> Scenario:
+    """`load_scenario` of an already-read document ``raw`` (as if read from ``path``:
+    relative model paths and custom controllers resolve next to it)."""
+    path = Path(path)
+    source = str(path)
+    raw = apply_overrides(raw, overrides)
+    overridden = {parse_key_path(text).key: text for text in overrides or {}}
+    try:
+        return _build(raw, path, Table(raw, "", source, overridden))
+    except ScenarioError:
+        raise
+    except UvmsPinError as exc:
+        raise ScenarioError(f"{source}: {exc}") from exc
+
+
+def _build(raw: dict[str, Any], path: Path, top: Table) -> Scenario:
+    scenario = top.table_or_empty("scenario")
+    head = _head(scenario, path)
+    water = build_water(top.table_or_empty("water"), head.seed)
+    uvms = _model(head, water, path, scenario)
+    q0, v0 = build_initial_state(top.table_or_empty("initial"), uvms)
+    contact = build_environment(top.table("environment"), uvms)
+    disturbance = build_disturbance(top.table("disturbance"))
+    actuation = build_actuation(top.table("actuation"), uvms)
+    sensor_config = build_sensors(top.table_or_empty("sensors"))
+    integrator, backend = build_integrator(top.table_or_empty("integrator"))
+    control_period = build_control_period(top.table_or_empty("control"))
+    log_period = build_log_period(top.table_or_empty("output"))
+    controller = build_controller(top.table("controller"), uvms, path.parent)
+    check_baselines(top.table("baselines"), (raw.get("controller") or {}).get("type"))
+    top.finish()
+    plant = Plant(
+        uvms, water.current_world_m_s, contact, disturbance, actuation, water.flow, backend
+    )
+    try:
+        settings = SimulationSettings(
+            head.duration_s, integrator, log_period, control_period, head.seed
+        )
+        check_log_fits(settings, uvms.nq, uvms.nv)
+    except ParameterError as exc:
+        raise ScenarioError(f"{top.source}: {exc}") from exc
+    return Scenario(
+        head.name, head.description, path, raw, plant, controller, sensor_config, q0, v0, settings
+    )
+
+
+def _head(t: Table, path: Path) -> Head:
+    head = Head(
+        name=t.string("name", path.stem),
+        description=t.string("description", ""),
+        model=t.string("model"),
+        duration_s=t.number("duration_s", positive=True),
+        seed=t.integer("seed", 0),
+    )
+    t.finish()
+    return head
+
+
+def _model(head: Head, water: Water, path: Path, scenario: Table) -> UVMS:
+    """The model ``[scenario] model`` names, in water of ``[water]``'s density."""
+    model_path = find_model(head.model, path.parent)
+    if model_path is None:
+        raise scenario.error(
+            "model",
+            f"'{head.model}' is neither a file relative to the scenario "
+            f"({path.parent.resolve() / head.model}) nor a shipped model "
+            f"({', '.join(shipped_models())})",
+        )
+    return load_uvms(model_path, water_density_kg_m3=water.density_kg_m3)

@@ -1,0 +1,55 @@
+"""``[integrator]``, ``[control]`` and ``[output]``: how the run is integrated (and on which
+backend), how often the controller runs, how often the state is logged."""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable
+
+from uvms_pin.physics.compiled.backend import BACKENDS
+from uvms_pin.scenario.schema import Table
+from uvms_pin.sim.integrators import RK4, Adaptive, Integrator, SemiImplicitEuler
+
+
+def _fixed_step(kind: type[Integrator]) -> Callable[[Table], Integrator]:
+    return lambda t: kind(t.number("step_s", 1e-3, positive=True))
+
+
+def _adaptive(method: str) -> Callable[[Table], Integrator]:
+    return lambda t: Adaptive(
+        method,
+        rtol=t.number("rtol", 1e-6, positive=True),
+        atol=t.number("atol", 1e-8, positive=True),
+        max_step_s=t.number("max_step_s", math.inf, positive=True),
+    )
+
+
+#: [integrator] method -> how the integrator is built from the table
+INTEGRATORS: dict[str, Callable[[Table], Integrator]] = {
+    "rk4": _fixed_step(RK4),
+    "semi_implicit_euler": _fixed_step(SemiImplicitEuler),
+    **{method: _adaptive(method) for method in Adaptive._METHODS},
+}
+
+
+def build_integrator(t: Table) -> tuple[Integrator, str]:
+    """The integrator and the plant's backend ("core": compiled, "python": the reference)."""
+    backend = t.string("backend", "core", BACKENDS)
+    method = t.string("method", "rk4", tuple(INTEGRATORS))
+    out = INTEGRATORS[method](t)
+    t.finish()
+    return out, backend
+
+
+def build_control_period(t: Table) -> float | None:
+    """[control] period_s: the controller's period [s]; None = continuous control."""
+    period = t.optional_number("period_s", positive=True)
+    t.finish()
+    return period
+
+
+def build_log_period(t: Table) -> float:
+    """[output] log_period_s [s] (default 0.01)."""
+    period = t.number("log_period_s", 0.01, positive=True)
+    t.finish()
+    return period

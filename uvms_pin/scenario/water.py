@@ -1,0 +1,118 @@
+"""``[water]``: the density, the uniform current and the flow fields of ``[water.current]``,
+``[water.waves]`` and ``[water.sea]`` (their sum). Seeds default to the scenario's seed."""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable
+from dataclasses import dataclass
+
+import numpy as np
+
+from uvms_pin.errors import ParameterError
+from uvms_pin.flow import (
+    AiryWave,
+    DepthProfileCurrent,
+    FlowField,
+    GaussMarkovCurrent,
+    IrregularSea,
+    SumFlow,
+    UniformCurrent,
+)
+from uvms_pin.scenario.schema import Table
+
+
+@dataclass(frozen=True)
+class Water:
+    """What ``[water]`` gives: rho [kg/m^3], the uniform current [m/s] (world) and the flow
+    beyond it (None for none)."""
+
+    density_kg_m3: float
+    current_world_m_s: np.ndarray
+    flow: FlowField | None
+
+
+def build_water(t: Table, seed: int) -> Water:
+    density = t.number("density_kg_m3", 1025.0, positive=True)
+    current = t.vector("current_world_m_s", 3, [0.0, 0.0, 0.0])
+    fields = []
+    for key, build in FLOW_TABLES.items():
+        table = t.table(key)
+        if table is not None:
+            fields.append(_flow_field(table, build, seed))
+    t.finish()
+    flow = None if not fields else fields[0] if len(fields) == 1 else SumFlow(tuple(fields))
+    return Water(density, current, flow)
+
+
+def _waves(t: Table, seed: int) -> AiryWave:
+    return AiryWave(
+        amplitude_m=t.number("amplitude_m", nonneg=True),
+        period_s=t.number("period_s", positive=True),
+        heading_rad=t.number("heading_rad", 0.0),
+        water_depth_m=t.number("water_depth_m", math.inf, positive=True),
+        phase_rad=t.number("phase_rad", 0.0),
+    )
+
+
+def _sea(t: Table, seed: int) -> IrregularSea:
+    return IrregularSea(
+        significant_height_m=t.number("significant_height_m", nonneg=True),
+        peak_period_s=t.number("peak_period_s", positive=True),
+        peak_enhancement=t.number("peak_enhancement", 3.3, positive=True),
+        heading_rad=t.number("heading_rad", 0.0),
+        spreading_exponent=t.optional_number("spreading_exponent", positive=True),
+        n_components=t.integer("n_components", 100),
+        seed=t.integer("seed", seed),
+        water_depth_m=t.number("water_depth_m", math.inf, positive=True),
+    )
+
+
+def _current(t: Table, seed: int) -> FlowField:
+    kind = t.string("type", "uniform", tuple(CURRENTS))
+    return CURRENTS[kind](t, seed)
+
+
+def _uniform_current(t: Table, seed: int) -> UniformCurrent:
+    return UniformCurrent(t.vector("velocity_world_m_s", 3))
+
+
+def _profile_current(t: Table, seed: int) -> DepthProfileCurrent:
+    return DepthProfileCurrent(
+        t.vector("velocity_world_m_s", 3), t.vector("depths_m", None), t.vector("factors", None)
+    )
+
+
+def _gauss_markov_current(t: Table, seed: int) -> GaussMarkovCurrent:
+    return GaussMarkovCurrent(
+        mean_velocity_world_m_s=t.vector("mean_velocity_world_m_s", 3),
+        std_m_s=t.number("std_m_s", nonneg=True),
+        time_constant_s=t.number("time_constant_s", positive=True),
+        bound_m_s=t.number("bound_m_s", positive=True),
+        seed=t.integer("seed", seed),
+        sample_period_s=t.number("sample_period_s", 0.5, positive=True),
+    )
+
+
+#: [water.current] type -> how the current is built from its table
+CURRENTS: dict[str, Callable[[Table, int], FlowField]] = {
+    "uniform": _uniform_current,
+    "gauss_markov": _gauss_markov_current,
+    "profile": _profile_current,
+}
+#: the flow tables of [water], in the order their fields are summed
+FLOW_TABLES: dict[str, Callable[[Table, int], FlowField]] = {
+    "current": _current,
+    "waves": _waves,
+    "sea": _sea,
+}
+
+
+def _flow_field(t: Table, build: Callable[[Table, int], FlowField], seed: int) -> FlowField:
+    """Build a flow field from its table; the field's own ParameterErrors name the table."""
+    try:
+        field = build(t, seed)
+    except ParameterError as exc:
+        raise t.fail(str(exc)) from exc
+    t.finish()
+    return field
