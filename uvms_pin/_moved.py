@@ -60,6 +60,7 @@ MOVED: dict[str, str | tuple[str, ...]] = {
     "vehicles": "model.vehicles",
     "viz": "apps.viz",
     "viz.controller_comparison": "apps.compare.figures",
+    "viz.errors": "errors",
     "viz.figures": "results.figures.kinds",
     "viz.paper_figures": "results.figures.paper",
     "viz.plots": "results.figures.standard",

@@ -43,6 +43,10 @@ class ScenarioError(UvmsPinError):
     """A scenario or study file is malformed: unknown key, wrong type, missing entry."""
 
 
+class StudyError(UvmsPinError):
+    """A study file is malformed or names something the base scenario does not have."""
+
+
 class OutputError(UvmsPinError):
     """An output path cannot be written, is in use, or holds results that are not this run's."""
 
@@ -82,3 +86,23 @@ class FunnelViolation(SimulationError):
         self.time_s = time_s
         self.error = error
         self.bound = bound
+
+
+class VizError(UvmsPinError):
+    """A scene, a replay or a live view cannot be built (missing model file, bad rollout)."""
+
+
+class LiveServerError(VizError):
+    """The live meshcat server cannot be started or stopped."""
+
+
+class PortInUseError(LiveServerError):
+    """The requested port on the loopback interface is already taken."""
+
+    def __init__(self, host: str, port: int):
+        super().__init__(
+            f"port {port} on {host} is already in use: choose another with --port "
+            "(or --port 0 for any free port)"
+        )
+        self.host = host
+        self.port = port

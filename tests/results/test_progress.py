@@ -48,3 +48,25 @@ def test_bad_progress_value_is_a_parameter_error():
         callback_or_none("yes")
     with pytest.raises(ParameterError, match="progress must be"):
         up.simulate(_short(0.04), progress=1)
+
+
+def test_lines_in_a_log_after_the_delay_then_every_interval_and_at_the_end():
+    import io
+
+    from uvms_pin.results.progress import ProgressLines, progress_printer
+
+    log = io.StringIO()
+    lines = ProgressLines("run", 10.0, log, delay_s=0.0, interval_s=3600.0)
+    for t in (0.0, 5.0, 10.0):
+        lines(t, 10.0)
+    text = log.getvalue().splitlines()
+    assert len(text) == 2  # the first call, then the end (the interval is an hour)
+    assert text[0].startswith("run [") and "t =   0.000/10 s" in text[0]
+    assert "#" * 30 in text[1] and "t =  10.000/10 s" in text[1]
+    quiet = io.StringIO()
+    silent = ProgressLines("run", 10.0, quiet, delay_s=3600.0)
+    for t in (0.0, 10.0):
+        silent(t, 10.0)
+    assert quiet.getvalue() == ""  # shorter than the delay: nothing, not even the end
+    with progress_printer("run", 10.0, stream=io.StringIO()) as printer:
+        assert isinstance(printer, ProgressLines)  # a file: lines, not a bar

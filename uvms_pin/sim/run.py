@@ -16,7 +16,7 @@ import numpy as np
 
 from uvms_pin.control.base import Controller
 from uvms_pin.model.uvms import UVMS
-from uvms_pin.results.progress import Progress, ProgressBar, callback_or_none
+from uvms_pin.results.progress import Progress, callback_or_none, progress_printer
 from uvms_pin.results.rollout import Rollout
 from uvms_pin.sim.closed_loop import simulate_closed_loop
 from uvms_pin.sim.plant import Plant
@@ -85,9 +85,9 @@ def simulate(
 ) -> Rollout:
     """Run a scenario: fresh sensors (seeded) and controller, closed loop, rollout.
 
-    ``progress``: True (default) shows a tqdm bar (notebook widget in Jupyter) once the
-    run has lasted `uvms_pin.results.progress.BAR_DELAY_S` of wall time, so short runs print
-    nothing; False or None: silent; a callable ``(t_s, duration_s)`` is called after
+    ``progress``: True (default) shows a tqdm bar (notebook widget in Jupyter; text lines
+    when stderr is a file) once the run has lasted `uvms_pin.results.progress.BAR_DELAY_S` of
+    wall time, so short runs print nothing; False or None: silent; a callable ``(t_s, duration_s)`` is called after
     every logged sample. ``observers``: called with every logged sample (`Observer`), e.g.
     a live view.
 
@@ -96,8 +96,8 @@ def simulate(
     """
     duration_s = scenario.settings.duration_s
     if progress is True:
-        with ProgressBar(scenario.name, duration_s) as bar:
-            return _simulate(scenario, [*observers, ProgressReport(bar, duration_s)])
+        with progress_printer(scenario.name, duration_s) as printer:
+            return _simulate(scenario, [*observers, ProgressReport(printer, duration_s)])
     callback = callback_or_none(progress)
     reports = [] if callback is None else [ProgressReport(callback, duration_s)]
     return _simulate(scenario, [*observers, *reports])

@@ -17,9 +17,9 @@ import numpy as np
 import pytest
 from viz_support import SPRING, short_scenario
 
-from uvms_pin.apps.viz.errors import PortInUseError
 from uvms_pin.apps.viz.live import LiveView, MeshcatServer, port_is_free, run_live
 from uvms_pin.apps.viz.meshcat_scene import Frame
+from uvms_pin.errors import PortInUseError
 from uvms_pin.results.rollout import Rollout
 from uvms_pin.scenario.load import load_scenario
 from uvms_pin.sim.run import simulate

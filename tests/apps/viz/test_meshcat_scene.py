@@ -11,7 +11,6 @@ import pinocchio as pin
 import pytest
 from viz_support import ROOT
 
-from uvms_pin.apps.viz.errors import VizError
 from uvms_pin.apps.viz.meshcat_scene import (
     EnvironmentView,
     Frame,
@@ -20,6 +19,7 @@ from uvms_pin.apps.viz.meshcat_scene import (
     pose_matrix,
     recording_visualizer,
 )
+from uvms_pin.errors import VizError
 
 
 @pytest.fixture(scope="module")

@@ -4,8 +4,8 @@ from __future__ import annotations
 
 import argparse
 import sys
-import time
 import warnings
+from contextlib import nullcontext
 from pathlib import Path
 from typing import TYPE_CHECKING
 
@@ -18,6 +18,7 @@ from uvms_pin.apps.validation.command import register as register_validate
 from uvms_pin.errors import FunnelViolation, SimulationError, UvmsPinError, UvmsPinWarning
 from uvms_pin.model.resources import find_model
 from uvms_pin.results.outdir import OVERWRITE_HELP, RUN, check_writable, claim, claim_file
+from uvms_pin.results.progress import progress_printer
 from uvms_pin.scenario.overrides import parse_assignment
 
 if TYPE_CHECKING:
@@ -29,37 +30,6 @@ if TYPE_CHECKING:
 EXIT_BAD_INPUT = 2
 EXIT_RUN_STOPPED = 3
 EXIT_INTERRUPTED = 130  # as a shell reports a process stopped by Ctrl-C
-
-
-class _ProgressLine:
-    """A single updating progress line on stderr, at most a few times per second."""
-
-    def __init__(self, label: str, stream=sys.stderr, min_interval_s: float = 0.5):
-        self.label = label
-        self.stream = stream
-        self.tty = stream.isatty()
-        # on a terminal the line is redrawn; in a log file one line every 10 s of wall time
-        self.min_interval_s = min_interval_s if self.tty else 10.0
-        self.start = time.perf_counter()
-        self.last = -1.0
-
-    def __call__(self, t: float, duration: float) -> None:
-        now = time.perf_counter()
-        if now - self.last < self.min_interval_s and t < duration:
-            return
-        self.last = now
-        elapsed = now - self.start
-        frac = t / duration if duration > 0 else 1.0
-        eta = elapsed * (1.0 - frac) / frac if frac > 0 else float("nan")
-        bar = "#" * int(30 * frac)
-        line = f"{self.label} [{bar:<30}] t = {t:7.3f}/{duration:g} s  elapsed {elapsed:6.1f} s  left ~{eta:6.1f} s"
-        self.stream.write(f"\r{line}" if self.tty else f"{line}\n")
-        self.stream.flush()
-
-    def close(self) -> None:
-        if self.tty:
-            self.stream.write("\n")
-        self.stream.flush()
 
 
 def _simulate(scenario, args: argparse.Namespace, progress) -> Rollout:
@@ -108,7 +78,15 @@ def _cmd_run(args: argparse.Namespace) -> int:
 
 def _simulate_to_end(scenario, args: argparse.Namespace) -> tuple[Rollout | None, int, str]:
     """(rollout, exit status, message): a stopped or interrupted run keeps its rollout."""
-    progress = None if args.quiet else _ProgressLine(scenario.name)
+    duration_s = scenario.settings.duration_s
+    printer = (
+        nullcontext() if args.quiet else progress_printer(scenario.name, duration_s, delay_s=0.0)
+    )
+    with printer as progress:
+        return _run_or_stop(scenario, args, progress)
+
+
+def _run_or_stop(scenario, args: argparse.Namespace, progress) -> tuple[Rollout | None, int, str]:
     try:
         return _simulate(scenario, args, progress), 0, ""
     except (FunnelViolation, SimulationError) as exc:
@@ -120,9 +98,6 @@ def _simulate_to_end(scenario, args: argparse.Namespace) -> tuple[Rollout | None
         t_s = float(rollout.time_s[-1])
         kept = f"the partial rollout (t = 0 to {t_s:.3f} s) is kept in {args.out}"
         return rollout, EXIT_INTERRUPTED, f"uvms-pin: interrupted: {kept}"
-    finally:
-        if progress is not None:
-            progress.close()
 
 
 def _check_view_options(args: argparse.Namespace) -> None:

@@ -37,7 +37,7 @@ from typing import Any
 
 import numpy as np
 
-from uvms_pin.errors import ScenarioError, UvmsPinError
+from uvms_pin.errors import ScenarioError, StudyError
 from uvms_pin.scenario.overrides import KEY_PATH, parse_key_path
 from uvms_pin.scenario.schema import Table, is_number
 from uvms_pin.scenario.toml import read_toml
@@ -47,10 +47,6 @@ PLANT_PREFIX = "plant."
 PLANT_FACTORS = ("mass_scale", "added_mass_scale", "damping_scale", "buoyancy_scale")
 DISTRIBUTIONS = ("uniform", "normal", "log-uniform")
 APPLY_MODES = ("set", "scale", "add")
-
-
-class StudyError(UvmsPinError):
-    """A study file is malformed or names something the base scenario does not have."""
 
 
 @dataclass(frozen=True)

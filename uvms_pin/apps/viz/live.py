@@ -30,10 +30,9 @@ import numpy as np
 import zmq
 from meshcat.visualizer import ViewerWindow
 
-from uvms_pin.apps.viz.errors import LiveServerError, PortInUseError
 from uvms_pin.apps.viz.meshcat_scene import EnvironmentView, Frame, SceneStyle, UvmsScene
 from uvms_pin.apps.viz.surface import SurfaceView
-from uvms_pin.errors import SimulationError
+from uvms_pin.errors import LiveServerError, PortInUseError, SimulationError
 from uvms_pin.results.progress import Progress
 from uvms_pin.results.rollout import Rollout
 from uvms_pin.sim.run import Scenario, simulate

@@ -33,8 +33,8 @@ import numpy as np
 import pinocchio as pin
 import umsgpack
 
-from uvms_pin.apps.viz.errors import VizError
 from uvms_pin.apps.viz.surface import SurfaceView
+from uvms_pin.errors import VizError
 from uvms_pin.model.uvms import UVMS
 
 ROOT = "uvms_pin"

@@ -21,7 +21,6 @@ import meshcat
 import meshcat.animation
 import numpy as np
 
-from uvms_pin.apps.viz.errors import VizError
 from uvms_pin.apps.viz.meshcat_scene import (
     ROOT,
     EnvironmentView,
@@ -31,6 +30,7 @@ from uvms_pin.apps.viz.meshcat_scene import (
     recording_visualizer,
 )
 from uvms_pin.apps.viz.surface import SurfaceView
+from uvms_pin.errors import VizError
 from uvms_pin.flow import FlowField, flow_from_record
 from uvms_pin.model.uvms import DEFAULT_WATER_DENSITY_KG_M3, load_uvms
 from uvms_pin.results.atomic import write_text_atomic
