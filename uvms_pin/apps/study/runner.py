@@ -34,6 +34,7 @@ import threading
 import time
 import traceback
 from collections.abc import Callable
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
@@ -288,17 +289,56 @@ def run_study(
         run_fn: what each task executes (tests inject failures through it).
         on_result: called with each new row after it is recorded.
     """
-    from tqdm.auto import tqdm
-
     out = Path(out)
+    store, recorded = _open_store(study, out)
+    runs = study.runs()
+    done_ids, counts = _recorded_runs(recorded, retry_errors)
+    todo = [r for r in runs if r.run_id not in done_ids]
+    base_sha = file_sha256(study.base)
+    rollout_dir = str(out / ROLLOUTS_DIR) if keep_rollouts else None
+    summary = Summary(total=len(runs), skipped=len(runs) - len(todo), run=0, **counts)
+    if not todo:
+        return summary
+
+    bar = _progress_bar(study.name, len(runs), len(runs) - len(todo), progress, counts)
+    recorder = _Recorder(
+        store=store,
+        summary=summary,
+        counts=counts,
+        base_sha256=base_sha,
+        bar=bar,
+        compact_every=compact_every,
+        compact_interval_s=compact_interval_s,
+        on_result=on_result,
+    )
+    base = str(study.base)
+    try:
+        if workers == 0 and scheduler is None:
+            for run in todo:
+                recorder.record(run_fn(base, run, rollout_dir))
+        else:
+            _run_on_dask(todo, base, rollout_dir, run_fn, recorder.record, workers, scheduler)
+    finally:
+        bar.close()
+        store.compact()
+    return summary
+
+
+def _open_store(study: Study, out: Path) -> tuple[ResultStore, pd.DataFrame]:
+    """The output directory's store and its rows, compacted, after checking that they are
+    rows of this study (before anything is written) and recording the study's inputs."""
     out.mkdir(parents=True, exist_ok=True)
     store = ResultStore(out)
     recorded = store.load()
     base_hashes = recorded.get("base_sha256", pd.Series(dtype=object)).dropna()
     check_same_study(out, study, set(base_hashes))  # before anything is written
     record_study_inputs(out, study)
-    recorded = store.compact()
-    runs = study.runs()
+    return store, store.compact()
+
+
+def _recorded_runs(recorded: pd.DataFrame, retry_errors: bool) -> tuple[set[str], dict[str, int]]:
+    """The ids of the recorded runs not to run again (with ``retry_errors``, the errors
+    are run again), and their counts per status (every status of `STATUSES` included)."""
     done_ids: set[str] = set()
     counts = dict.fromkeys(STATUSES, 0)
     if len(recorded):
@@ -308,59 +348,67 @@ def run_study(
         done_ids = set(keep["run_id"])
         for status in keep["status"]:
             counts[status] = counts.get(status, 0) + 1
-    todo = [r for r in runs if r.run_id not in done_ids]
-    base_sha = file_sha256(study.base)
-    rollout_dir = str(out / ROLLOUTS_DIR) if keep_rollouts else None
-    summary = Summary(total=len(runs), skipped=len(runs) - len(todo), run=0, **counts)
-    if not todo:
-        return summary
+    return done_ids, counts
+
+
+def _failures(counts: dict[str, int]) -> str:
+    """The progress bar's postfix: the count of each status other than ok."""
+    return " ".join(f"{k}={counts[k]}" for k in STATUSES[1:])
+
+
+def _progress_bar(name: str, total: int, done: int, progress: bool, counts: dict[str, int]):
+    """A tqdm bar over the runs (disabled without ``progress``), the recorded ones done."""
+    from tqdm.auto import tqdm
 
     bar = tqdm(
-        total=len(runs),
-        initial=len(runs) - len(todo),
+        total=total,
+        initial=done,
         unit="run",
-        desc=study.name,
+        desc=name,
         disable=not progress,
         dynamic_ncols=True,
         # in a log file (nohup) one line every 30 s rather than a redraw per run
         mininterval=0.5 if sys.stderr.isatty() else 30.0,
     )
+    bar.set_postfix_str(_failures(counts), refresh=False)
+    return bar
 
-    def failures() -> str:
-        return " ".join(f"{k}={counts[k]}" for k in STATUSES[1:])
 
-    bar.set_postfix_str(failures(), refresh=False)
-    since_compact = 0
-    last_compact = time.monotonic()
+@dataclass
+class _Recorder:
+    """Takes each finished run's row: stamps the base scenario's digest, stores it, counts
+    it (``counts``, ``summary``, the progress bar), compacts the table after
+    ``compact_every`` rows or ``compact_interval_s`` seconds, then calls ``on_result``."""
 
-    def finished(row: dict[str, Any]) -> None:
-        nonlocal since_compact, last_compact
-        row["base_sha256"] = base_sha
-        store.record(row)
+    store: ResultStore
+    summary: Summary
+    counts: dict[str, int]
+    base_sha256: str
+    bar: Any
+    compact_every: int
+    compact_interval_s: float
+    on_result: Callable[[dict[str, Any]], None] | None
+    since_compact: int = 0
+    last_compact: float = field(default_factory=time.monotonic)
+
+    def record(self, row: dict[str, Any]) -> None:
+        """Record one finished run's row (see the class)."""
+        row["base_sha256"] = self.base_sha256
+        self.store.record(row)
+        counts = self.counts
         counts[row["status"]] = counts.get(row["status"], 0) + 1
-        summary["run"] += 1
-        summary[row["status"]] = counts[row["status"]]
-        since_compact += 1
-        bar.update(1)
-        bar.set_postfix_str(failures(), refresh=False)
-        if since_compact >= compact_every or time.monotonic() - last_compact > compact_interval_s:
-            store.compact()
-            since_compact = 0
-            last_compact = time.monotonic()
-        if on_result is not None:
-            on_result(row)
-
-    base = str(study.base)
-    try:
-        if workers == 0 and scheduler is None:
-            for run in todo:
-                finished(run_fn(base, run, rollout_dir))
-        else:
-            _run_on_dask(todo, base, rollout_dir, run_fn, finished, workers, scheduler)
-    finally:
-        bar.close()
-        store.compact()
-    return summary
+        self.summary["run"] += 1
+        self.summary[row["status"]] = counts[row["status"]]
+        self.since_compact += 1
+        self.bar.update(1)
+        self.bar.set_postfix_str(_failures(counts), refresh=False)
+        overdue = time.monotonic() - self.last_compact > self.compact_interval_s
+        if self.since_compact >= self.compact_every or overdue:
+            self.store.compact()
+            self.since_compact = 0
+            self.last_compact = time.monotonic()
+        if self.on_result is not None:
+            self.on_result(row)
 
 
 def _run_on_dask(todo, base, rollout_dir, run_fn, finished, workers, scheduler) -> None:
