@@ -301,16 +301,8 @@ def run_study(
         return summary
 
     bar = _progress_bar(study.name, len(runs), len(runs) - len(todo), progress, counts)
-    recorder = _Recorder(
-        store=store,
-        summary=summary,
-        counts=counts,
-        base_sha256=base_sha,
-        bar=bar,
-        compact_every=compact_every,
-        compact_interval_s=compact_interval_s,
-        on_result=on_result,
-    )
+    compaction = _Compaction(store, compact_every, compact_interval_s)
+    recorder = _Recorder(base_sha, counts, summary, bar, compaction, on_result)
     base = str(study.base)
     try:
         if workers == 0 and scheduler is None:
@@ -375,38 +367,49 @@ def _progress_bar(name: str, total: int, done: int, progress: bool, counts: dict
 
 
 @dataclass
-class _Recorder:
-    """Takes each finished run's row: stamps the base scenario's digest, stores it, counts
-    it (``counts``, ``summary``, the progress bar), compacts the table after
-    ``compact_every`` rows or ``compact_interval_s`` seconds, then calls ``on_result``."""
+class _Compaction:
+    """Rewrites the table after ``every`` new rows or ``interval_s`` seconds since the
+    last rewrite, whichever comes first."""
 
     store: ResultStore
-    summary: Summary
-    counts: dict[str, int]
+    every: int
+    interval_s: float
+    since: int = 0
+    last: float = field(default_factory=time.monotonic)
+
+    def row_added(self) -> None:
+        """Count one new row; rewrite the table if it is due."""
+        self.since += 1
+        if self.since >= self.every or time.monotonic() - self.last > self.interval_s:
+            self.store.compact()
+            self.since = 0
+            self.last = time.monotonic()
+
+
+@dataclass
+class _Recorder:
+    """Takes each finished run's row: stamps the base scenario's digest, stores it, counts
+    it (``counts``, ``summary``, the progress bar), lets the table be compacted, then
+    calls ``on_result``."""
+
     base_sha256: str
+    counts: dict[str, int]
+    summary: Summary
     bar: Any
-    compact_every: int
-    compact_interval_s: float
+    compaction: _Compaction
     on_result: Callable[[dict[str, Any]], None] | None
-    since_compact: int = 0
-    last_compact: float = field(default_factory=time.monotonic)
 
     def record(self, row: dict[str, Any]) -> None:
         """Record one finished run's row (see the class)."""
         row["base_sha256"] = self.base_sha256
-        self.store.record(row)
+        self.compaction.store.record(row)
         counts = self.counts
         counts[row["status"]] = counts.get(row["status"], 0) + 1
         self.summary["run"] += 1
         self.summary[row["status"]] = counts[row["status"]]
-        self.since_compact += 1
         self.bar.update(1)
         self.bar.set_postfix_str(_failures(counts), refresh=False)
-        overdue = time.monotonic() - self.last_compact > self.compact_interval_s
-        if self.since_compact >= self.compact_every or overdue:
-            self.store.compact()
-            self.since_compact = 0
-            self.last_compact = time.monotonic()
+        self.compaction.row_added()
         if self.on_result is not None:
             self.on_result(row)
 
