@@ -12,7 +12,7 @@ from uvms_pin.control.baselines.computed_torque import ComputedTorqueController
 from uvms_pin.control.baselines.impedance import ImpedanceController
 from uvms_pin.control.baselines.pi_force import PIForceController
 from uvms_pin.control.measurement import Measurement
-from uvms_pin.errors import ScenarioError
+from uvms_pin.errors import ParameterError, ScenarioError
 from uvms_pin.model.scaled import scaled_uvms
 from uvms_pin.scenario.load import load_scenario, scenario_from_raw
 from uvms_pin.scenario.toml import read_toml
@@ -108,6 +108,28 @@ def test_computed_torque_uses_its_model(reference_uvms):
     exact = ComputedTorqueController(reference_uvms, ee).compute(0.3, measurement)
     heavier = ComputedTorqueController(scaled_uvms(reference_uvms, mass_scale=1.3), ee)
     assert not np.allclose(heavier.compute(0.3, measurement), exact)
+
+
+def test_pi_force_and_computed_torque_share_the_force_task(reference_uvms):
+    """The same `ForceTaskOptions` keywords give both the same reference velocity; an
+    unknown keyword or a bad gain is refused by name."""
+    ee = _ee_name(reference_uvms)
+    options = {
+        "kp_force_m_s_per_N": 0.3,
+        "null_space_gain_per_s": 0.5,
+        "desired_force_world_N": (0.4, 0.0, 0.0),
+    }
+    measurement = _measurement(reference_uvms, np.random.default_rng(7))
+    pi = PIForceController(reference_uvms.model, ee, **options)
+    computed = ComputedTorqueController(reference_uvms, ee, **options)
+    for controller in (pi, computed):
+        controller.compute(0.29, measurement)
+        controller.compute(0.3, measurement)
+    np.testing.assert_array_equal(pi.signals()["zeta_r"], computed.signals()["zeta_r"])
+    with pytest.raises(TypeError, match="stiffness_N_m"):
+        PIForceController(reference_uvms.model, ee, stiffness_N_m=1.0)
+    with pytest.raises(ParameterError, match="ki_force_m_s2_per_N"):
+        ComputedTorqueController(reference_uvms, ee, ki_force_m_s2_per_N=-1.0)
 
 
 def _with_controller(table: dict):

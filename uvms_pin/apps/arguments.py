@@ -2,6 +2,9 @@
 
 ``argparse`` turns the ``ArgumentTypeError`` into ``uvms-pin CMD: error: argument
 --workers: must be an integer >= 0, got -2`` and exit status 2, before any work.
+
+Also what several commands share: the ``--set KEY=VALUE`` option (`add_set_option`) and
+comma-separated name lists (`comma_names`, checked by the command: a `ParameterError`).
 """
 
 from __future__ import annotations
@@ -9,6 +12,8 @@ from __future__ import annotations
 import argparse
 import math
 from collections.abc import Callable
+
+from uvms_pin.errors import ParameterError
 
 
 def count(minimum: int) -> Callable[[str], int]:
@@ -43,3 +48,26 @@ def positive(text: str) -> float:
     if value <= 0.0:
         raise argparse.ArgumentTypeError(f"must be positive, got {text!r}")
     return value
+
+
+def add_set_option(parser: argparse.ArgumentParser, help_text: str) -> None:
+    """``--set KEY=VALUE``, repeatable: scenario entries to override (the command parses
+    each with `uvms_pin.scenario.overrides.parse_assignment`); [] if not given."""
+    parser.add_argument("--set", action="append", default=[], metavar="KEY=VALUE", help=help_text)
+
+
+def comma_names(option: str, text: str, what: str = "names") -> list[str]:
+    """The comma-separated names ``text`` of ``option`` (e.g. ``--arms``), stripped: at
+    least one, none empty, none twice.
+
+    Raises:
+        ParameterError: naming the option and ``what`` it lists: an empty name, or the
+            names given twice.
+    """
+    names = [n.strip() for n in text.split(",")]
+    if "" in names:
+        raise ParameterError(f"{option} {text!r}: give comma-separated {what}, none empty")
+    twice = sorted({n for n in names if names.count(n) > 1})
+    if twice:
+        raise ParameterError(f"{option} {text!r}: {', '.join(twice)} given twice")
+    return names

@@ -7,7 +7,8 @@ import json
 import pytest
 from conftest import ROOT
 
-from uvms_pin.apps.arms.compare import ArmProgress, CompareSettings, compare_arms
+from uvms_pin.apps.arms.compare import CompareSettings, compare_arms
+from uvms_pin.apps.arms.progress import ArmProgress
 from uvms_pin.apps.cli.main import main
 from uvms_pin.model.resources import example_robot_data_dir
 from uvms_pin.results.rollout import Rollout

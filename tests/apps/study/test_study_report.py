@@ -9,9 +9,10 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from uvms_pin.apps.study.report import exclude_unfinished_transients, write_report
+from uvms_pin.apps.study.report import write_report
 from uvms_pin.apps.study.runner import RESULTS_FILE
 from uvms_pin.apps.study.spec import column_name
+from uvms_pin.apps.study.statistics import exclude_unfinished_transients
 
 RMS = "force_error_rms_after_transient_N"
 

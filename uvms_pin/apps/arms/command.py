@@ -10,8 +10,7 @@ import argparse
 import math
 import sys
 
-from uvms_pin.apps.arguments import count, finite, positive
-from uvms_pin.errors import ParameterError
+from uvms_pin.apps.arguments import comma_names, count, finite, positive
 from uvms_pin.model.mount.catalog import available_arms
 from uvms_pin.results.outdir import COMPARISON, OVERWRITE_HELP, check_writable, claim
 
@@ -29,7 +28,7 @@ def _cmd_compare_arms(args: argparse.Namespace) -> int:
     from uvms_pin.apps.arms.compare import CompareSettings, compare_arms
     from uvms_pin.model.trim import TrimSpec
 
-    arms = _arm_names(args.arms)
+    arms = comma_names("--arms", args.arms, "arm names")
     trim = None if args.no_trim else TrimSpec(bg_m=args.bg, foam_density_kg_m3=args.foam_density)
     settings = CompareSettings(
         duration_s=args.duration,
@@ -57,17 +56,6 @@ def _cmd_compare_arms(args: argparse.Namespace) -> int:
     if args.keep_rollouts:
         print(f"per arm: {args.out}/<arm>/row.json, rollout, metrics.json and figures")
     return 0
-
-
-def _arm_names(text: str) -> list[str]:
-    """The comma-separated names of ``--arms``: at least one, none twice."""
-    names = [a.strip() for a in text.split(",")]
-    if not any(names) or "" in names:
-        raise ParameterError(f"--arms {text!r}: give comma-separated arm names, none empty")
-    twice = sorted({n for n in names if names.count(n) > 1})
-    if twice:
-        raise ParameterError(f"--arms {text!r}: {', '.join(twice)} given twice")
-    return names
 
 
 def register(subparsers) -> argparse.ArgumentParser:

@@ -9,7 +9,7 @@ from contextlib import nullcontext
 from pathlib import Path
 from typing import TYPE_CHECKING
 
-from uvms_pin.apps.arguments import positive
+from uvms_pin.apps.arguments import add_set_option, positive
 from uvms_pin.apps.arms.command import register as register_compare_arms
 from uvms_pin.apps.compare.command import register as register_compare_controllers
 from uvms_pin.apps.outputs import write_outputs
@@ -159,12 +159,9 @@ def build_parser() -> argparse.ArgumentParser:
     run.add_argument("--out", required=True, help="output directory")
     run.add_argument("--quiet", action="store_true", help="no progress line")
     run.add_argument("--overwrite", action="store_true", help=OVERWRITE_HELP)
-    run.add_argument(
-        "--set",
-        action="append",
-        default=[],
-        metavar="KEY=VALUE",
-        help="override a scenario entry (repeatable): a dotted key, optionally [i]-indexed, "
+    add_set_option(
+        run,
+        "override a scenario entry (repeatable): a dotted key, optionally [i]-indexed, "
         "and a TOML value, e.g. --set 'environment.stiffness_N_m=[20,20,20]' "
         "--set 'initial.joint_positions_rad[3]=0.5'",
     )

@@ -5,7 +5,7 @@ from __future__ import annotations
 import argparse
 import sys
 
-from uvms_pin.apps.arguments import count, positive
+from uvms_pin.apps.arguments import add_set_option, comma_names, count, positive
 from uvms_pin.errors import ParameterError
 from uvms_pin.results.outdir import CONTROLLER_COMPARISON, OVERWRITE_HELP, check_writable, claim
 from uvms_pin.scenario.overrides import parse_assignment
@@ -13,23 +13,12 @@ from uvms_pin.scenario.overrides import parse_assignment
 DEFAULT_CONTROLLERS = "ppc,pi_force,impedance,computed_torque"
 
 
-def _names(text: str) -> list[str]:
-    """The comma-separated names of ``--controllers``: at least one, none empty or twice."""
-    names = [n.strip() for n in text.split(",")]
-    if "" in names:
-        raise ParameterError(f"--controllers {text!r}: give comma-separated names, none empty")
-    twice = sorted({n for n in names if names.count(n) > 1})
-    if twice:
-        raise ParameterError(f"--controllers {text!r}: {', '.join(twice)} given twice")
-    return names
-
-
 def _cmd_compare_controllers(args: argparse.Namespace) -> int:
     from uvms_pin.apps.compare.metrics import Criteria
     from uvms_pin.apps.compare.runs import compare_controllers, controller_scenarios
     from uvms_pin.apps.compare.table import write_table
 
-    names = _names(args.controllers)
+    names = comma_names("--controllers", args.controllers)
     overrides = dict(parse_assignment(text) for text in args.set)
     scenarios = controller_scenarios(args.scenario, names, overrides)
     duration = next(iter(scenarios.values())).settings.duration_s
@@ -92,12 +81,8 @@ def register(subparsers) -> argparse.ArgumentParser:
     )
     parser.add_argument("--out", required=True, help="output directory")
     parser.add_argument("--overwrite", action="store_true", help=OVERWRITE_HELP)
-    parser.add_argument(
-        "--set",
-        action="append",
-        default=[],
-        metavar="KEY=VALUE",
-        help="override a scenario entry for every controller (repeatable), as in 'run'",
+    add_set_option(
+        parser, "override a scenario entry for every controller (repeatable), as in 'run'"
     )
     parser.add_argument(
         "--after", type=positive, default=None, help="start of the after-transient window [s] "

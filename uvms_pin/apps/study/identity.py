@@ -17,7 +17,8 @@ from typing import Any
 
 import tomllib
 
-from uvms_pin.apps.study.spec import Study, StudyError
+from uvms_pin.apps.study.spec import Study
+from uvms_pin.errors import StudyError
 from uvms_pin.results.atomic import write_text_atomic
 
 INPUTS_FILE = "study_inputs.json"

@@ -34,6 +34,7 @@ import threading
 import time
 import traceback
 from collections.abc import Callable
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
@@ -41,8 +42,8 @@ import numpy as np
 import pandas as pd
 
 from uvms_pin.apps.study.identity import check_same_study, file_sha256, record_study_inputs
-from uvms_pin.apps.study.spec import Run, Study, StudyError
-from uvms_pin.errors import FunnelViolation, SimulationError
+from uvms_pin.apps.study.spec import Run, Study
+from uvms_pin.errors import FunnelViolation, SimulationError, StudyError
 from uvms_pin.results.atomic import atomic_path
 
 RESULTS_FILE = "results.parquet"
@@ -289,17 +290,48 @@ def run_study(
         run_fn: what each task executes (tests inject failures through it).
         on_result: called with each new row after it is recorded.
     """
-    from tqdm.auto import tqdm
-
     out = Path(out)
+    store, recorded = _open_store(study, out)
+    runs = study.runs()
+    done_ids, counts = _recorded_runs(recorded, retry_errors)
+    todo = [r for r in runs if r.run_id not in done_ids]
+    base_sha = file_sha256(study.base)
+    rollout_dir = str(out / ROLLOUTS_DIR) if keep_rollouts else None
+    summary = Summary(total=len(runs), skipped=len(runs) - len(todo), run=0, **counts)
+    if not todo:
+        return summary
+
+    bar = _progress_bar(study.name, len(runs), len(runs) - len(todo), progress, counts)
+    compaction = _Compaction(store, compact_every, compact_interval_s)
+    recorder = _Recorder(base_sha, counts, summary, bar, compaction, on_result)
+    base = str(study.base)
+    try:
+        if workers == 0 and scheduler is None:
+            for run in todo:
+                recorder.record(run_fn(base, run, rollout_dir))
+        else:
+            _run_on_dask(todo, base, rollout_dir, run_fn, recorder.record, workers, scheduler)
+    finally:
+        bar.close()
+        store.compact()
+    return summary
+
+
+def _open_store(study: Study, out: Path) -> tuple[ResultStore, pd.DataFrame]:
+    """The output directory's store and its rows, compacted, after checking that they are
+    rows of this study (before anything is written) and recording the study's inputs."""
     out.mkdir(parents=True, exist_ok=True)
     store = ResultStore(out)
     recorded = store.load()
     base_hashes = recorded.get("base_sha256", pd.Series(dtype=object)).dropna()
     check_same_study(out, study, set(base_hashes))  # before anything is written
     record_study_inputs(out, study)
-    recorded = store.compact()
-    runs = study.runs()
+    return store, store.compact()
+
+
+def _recorded_runs(recorded: pd.DataFrame, retry_errors: bool) -> tuple[set[str], dict[str, int]]:
+    """The ids of the recorded runs not to run again (with ``retry_errors``, the errors
+    are run again), and their counts per status (every status of `STATUSES` included)."""
     done_ids: set[str] = set()
     counts = dict.fromkeys(STATUSES, 0)
     if len(recorded):
@@ -309,59 +341,78 @@ def run_study(
         done_ids = set(keep["run_id"])
         for status in keep["status"]:
             counts[status] = counts.get(status, 0) + 1
-    todo = [r for r in runs if r.run_id not in done_ids]
-    base_sha = file_sha256(study.base)
-    rollout_dir = str(out / ROLLOUTS_DIR) if keep_rollouts else None
-    summary = Summary(total=len(runs), skipped=len(runs) - len(todo), run=0, **counts)
-    if not todo:
-        return summary
+    return done_ids, counts
+
+
+def _failures(counts: dict[str, int]) -> str:
+    """The progress bar's postfix: the count of each status other than ok."""
+    return " ".join(f"{k}={counts[k]}" for k in STATUSES[1:])
+
+
+def _progress_bar(name: str, total: int, done: int, progress: bool, counts: dict[str, int]):
+    """A tqdm bar over the runs (disabled without ``progress``), the recorded ones done."""
+    from tqdm.auto import tqdm
 
     bar = tqdm(
-        total=len(runs),
-        initial=len(runs) - len(todo),
+        total=total,
+        initial=done,
         unit="run",
-        desc=study.name,
+        desc=name,
         disable=not progress,
         dynamic_ncols=True,
         # in a log file (nohup) one line every 30 s rather than a redraw per run
         mininterval=0.5 if sys.stderr.isatty() else 30.0,
     )
+    bar.set_postfix_str(_failures(counts), refresh=False)
+    return bar
 
-    def failures() -> str:
-        return " ".join(f"{k}={counts[k]}" for k in STATUSES[1:])
 
-    bar.set_postfix_str(failures(), refresh=False)
-    since_compact = 0
-    last_compact = time.monotonic()
+@dataclass
+class _Compaction:
+    """Rewrites the table after ``every`` new rows or ``interval_s`` seconds since the
+    last rewrite, whichever comes first."""
 
-    def finished(row: dict[str, Any]) -> None:
-        nonlocal since_compact, last_compact
-        row["base_sha256"] = base_sha
-        store.record(row)
+    store: ResultStore
+    every: int
+    interval_s: float
+    since: int = 0
+    last: float = field(default_factory=time.monotonic)
+
+    def row_added(self) -> None:
+        """Count one new row; rewrite the table if it is due."""
+        self.since += 1
+        if self.since >= self.every or time.monotonic() - self.last > self.interval_s:
+            self.store.compact()
+            self.since = 0
+            self.last = time.monotonic()
+
+
+@dataclass
+class _Recorder:
+    """Takes each finished run's row: stamps the base scenario's digest, stores it, counts
+    it (``counts``, ``summary``, the progress bar), lets the table be compacted, then
+    calls ``on_result``."""
+
+    base_sha256: str
+    counts: dict[str, int]
+    summary: Summary
+    bar: Any
+    compaction: _Compaction
+    on_result: Callable[[dict[str, Any]], None] | None
+
+    def record(self, row: dict[str, Any]) -> None:
+        """Record one finished run's row (see the class)."""
+        row["base_sha256"] = self.base_sha256
+        self.compaction.store.record(row)
+        counts = self.counts
         counts[row["status"]] = counts.get(row["status"], 0) + 1
-        summary["run"] += 1
-        summary[row["status"]] = counts[row["status"]]
-        since_compact += 1
-        bar.update(1)
-        bar.set_postfix_str(failures(), refresh=False)
-        if since_compact >= compact_every or time.monotonic() - last_compact > compact_interval_s:
-            store.compact()
-            since_compact = 0
-            last_compact = time.monotonic()
-        if on_result is not None:
-            on_result(row)
-
-    base = str(study.base)
-    try:
-        if workers == 0 and scheduler is None:
-            for run in todo:
-                finished(run_fn(base, run, rollout_dir))
-        else:
-            _run_on_dask(todo, base, rollout_dir, run_fn, finished, workers, scheduler)
-    finally:
-        bar.close()
-        store.compact()
-    return summary
+        self.summary["run"] += 1
+        self.summary[row["status"]] = counts[row["status"]]
+        self.bar.update(1)
+        self.bar.set_postfix_str(_failures(counts), refresh=False)
+        self.compaction.row_added()
+        if self.on_result is not None:
+            self.on_result(row)
 
 
 def _run_on_dask(todo, base, rollout_dir, run_fn, finished, workers, scheduler) -> None:

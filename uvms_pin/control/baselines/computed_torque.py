@@ -22,13 +22,14 @@ It does not know the current or the waves (h is evaluated in still water).
 from __future__ import annotations
 
 from collections.abc import Callable
+from typing import Any
 
 import numpy as np
 import pinocchio as pin
 from numpy.typing import ArrayLike
 
 from uvms_pin.control.base import Controller
-from uvms_pin.control.baselines.task import EndEffectorTask, ForceOrientationLoop, gain_vector
+from uvms_pin.control.baselines.task import ForceTaskOptions, gain_vector
 from uvms_pin.control.measurement import Measurement
 from uvms_pin.model.uvms import UVMS
 from uvms_pin.physics.dynamics import bias_forces, mass_matrix
@@ -49,9 +50,10 @@ class ComputedTorqueController(Controller):
         velocity_gain_per_s: K_v (nv,) > 0 [1/s].
         position_gain_per_s2: K_q (nv,) >= 0 [1/s^2] (motion task only).
         reference: a `MotionReference` for a motion task; None = force/orientation task.
-        kp_force_m_s_per_N, ki_force_m_s2_per_N, k_orientation_per_s, integral_limit_Ns,
-            desired_force_world_N, desired_rpy, velocity_weights, null_space_gain_per_s,
-            null_space_target: the force task, as `PIForceController`.
+        **force_task: the force task, keywords of `ForceTaskOptions` as for
+            `PIForceController` (kp_force_m_s_per_N, ki_force_m_s2_per_N,
+            k_orientation_per_s, integral_limit_Ns, desired_force_world_N, desired_rpy,
+            velocity_weights, null_space_gain_per_s, null_space_target).
     """
 
     def __init__(
@@ -62,33 +64,16 @@ class ComputedTorqueController(Controller):
         velocity_gain_per_s: ArrayLike = 5.0,
         position_gain_per_s2: ArrayLike = 25.0,
         reference: MotionReference | None = None,
-        kp_force_m_s_per_N: ArrayLike = 0.1,
-        ki_force_m_s2_per_N: ArrayLike = 0.05,
-        k_orientation_per_s: ArrayLike = 1.0,
-        integral_limit_Ns: ArrayLike = 5.0,
-        desired_force_world_N: Callable[[float], ArrayLike] | ArrayLike = (0.0, 0.0, 0.0),
-        desired_rpy: Callable[[float], ArrayLike] | ArrayLike = (0.0, 0.0, 0.0),
-        velocity_weights: ArrayLike = 1.0,
-        null_space_gain_per_s: float = 0.0,
-        null_space_target: ArrayLike | None = None,
+        **force_task: Any,
     ):
+        options = ForceTaskOptions(**force_task)
         self.uvms = uvms.with_model(pin.Model(uvms.model))
-        self.task = EndEffectorTask(
-            self.uvms.model,
-            ee_frame_name,
-            desired_force_world_N,
-            desired_rpy,
-            velocity_weights=velocity_weights,
-            null_space_gain_per_s=null_space_gain_per_s,
-            null_space_target=null_space_target,
-        )
+        self.task = options.task(self.uvms.model, ee_frame_name)
         nv = self.task.nv
         self.k_v = gain_vector("velocity_gain_per_s", velocity_gain_per_s, nv, positive=True)
         self.k_q = gain_vector("position_gain_per_s2", position_gain_per_s2, nv)
         self.reference = reference
-        self.loop = ForceOrientationLoop(
-            kp_force_m_s_per_N, ki_force_m_s2_per_N, k_orientation_per_s, integral_limit_Ns
-        )
+        self.loop = options.loop()
         self._signals: dict[str, np.ndarray] = {}
 
     def reset(self) -> None:

@@ -15,14 +15,14 @@ tracking shows in the metrics.
 
 from __future__ import annotations
 
-from collections.abc import Callable
+from typing import Any
 
 import numpy as np
 import pinocchio as pin
 from numpy.typing import ArrayLike
 
 from uvms_pin.control.base import Controller
-from uvms_pin.control.baselines.task import EndEffectorTask, ForceOrientationLoop, gain_vector
+from uvms_pin.control.baselines.task import ForceTaskOptions, gain_vector
 from uvms_pin.control.measurement import Measurement
 
 __all__ = ["PIForceController"]
@@ -32,41 +32,21 @@ class PIForceController(Controller):
     """Explicit PI force / P orientation control through J^# and velocity damping.
 
     Args:
-        model, ee_frame_name, desired_force_world_N, desired_rpy, velocity_weights,
-            null_space_gain_per_s, null_space_target: as `EndEffectorTask`.
-        kp_force_m_s_per_N, ki_force_m_s2_per_N, k_orientation_per_s, integral_limit_Ns:
-            the outer loop (`ForceOrientationLoop`), per component (a scalar broadcasts).
+        model: the UVMS kinematic model (free-flyer root).
+        ee_frame_name: the end-effector frame.
         damping: k_d (nv,) > 0 [N per m/s (3); N m per rad/s (3 + n_joints)].
+        **force_task: the task and its outer loop, keywords of `ForceTaskOptions`
+            (kp_force_m_s_per_N, ki_force_m_s2_per_N, k_orientation_per_s,
+            integral_limit_Ns, desired_force_world_N, desired_rpy, velocity_weights,
+            null_space_gain_per_s, null_space_target; defaults there).
     """
 
     def __init__(
-        self,
-        model: pin.Model,
-        ee_frame_name: str,
-        *,
-        kp_force_m_s_per_N: ArrayLike = 0.1,
-        ki_force_m_s2_per_N: ArrayLike = 0.05,
-        k_orientation_per_s: ArrayLike = 1.0,
-        integral_limit_Ns: ArrayLike = 5.0,
-        damping: ArrayLike = 20.0,
-        desired_force_world_N: Callable[[float], ArrayLike] | ArrayLike = (0.0, 0.0, 0.0),
-        desired_rpy: Callable[[float], ArrayLike] | ArrayLike = (0.0, 0.0, 0.0),
-        velocity_weights: ArrayLike = 1.0,
-        null_space_gain_per_s: float = 0.0,
-        null_space_target: ArrayLike | None = None,
+        self, model: pin.Model, ee_frame_name: str, *, damping: ArrayLike = 20.0, **force_task: Any
     ):
-        self.task = EndEffectorTask(
-            model,
-            ee_frame_name,
-            desired_force_world_N,
-            desired_rpy,
-            velocity_weights=velocity_weights,
-            null_space_gain_per_s=null_space_gain_per_s,
-            null_space_target=null_space_target,
-        )
-        self.loop = ForceOrientationLoop(
-            kp_force_m_s_per_N, ki_force_m_s2_per_N, k_orientation_per_s, integral_limit_Ns
-        )
+        options = ForceTaskOptions(**force_task)
+        self.task = options.task(model, ee_frame_name)
+        self.loop = options.loop()
         self.damping = gain_vector("damping", damping, self.task.nv, positive=True)
         self._signals: dict[str, np.ndarray] = {}
 

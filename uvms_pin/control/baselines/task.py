@@ -17,6 +17,7 @@ Only kinematics (frame placements and Jacobians of a private copy of the model) 
 from __future__ import annotations
 
 from collections.abc import Callable
+from dataclasses import dataclass
 
 import numpy as np
 import pinocchio as pin
@@ -27,7 +28,13 @@ from uvms_pin.control.ppc import PPCParams, PrescribedPerformanceController
 from uvms_pin.errors import ParameterError
 from uvms_pin.physics.kinematics import angular_velocity_world_from_euler_rates
 
-__all__ = ["EndEffectorTask", "ForceOrientationLoop", "TaskState", "gain_vector"]
+__all__ = [
+    "EndEffectorTask",
+    "ForceOrientationLoop",
+    "ForceTaskOptions",
+    "TaskState",
+    "gain_vector",
+]
 
 
 def gain_vector(name: str, value: ArrayLike, size: int, *, positive: bool = False) -> np.ndarray:
@@ -190,3 +197,50 @@ class ForceOrientationLoop:
             self._last = (time_s, error[:3].copy())
         force_rate = -(self.kp * error[:3] + self.ki * self.integral_Ns)
         return np.r_[force_rate, -self.k_o * error[3:]]
+
+
+@dataclass(frozen=True)
+class ForceTaskOptions:
+    """The tuning of the explicit force task the PI force and the computed-torque
+    controllers share: the task (`EndEffectorTask`) and its outer loop
+    (`ForceOrientationLoop`). The controllers take these as keywords (``**force_task``);
+    an unknown keyword is a TypeError here, before anything is built.
+
+    Attributes:
+        kp_force_m_s_per_N, ki_force_m_s2_per_N, k_orientation_per_s, integral_limit_Ns:
+            the outer loop's gains (3,) [m/s per N, m/s per N s, 1/s, N s], per component
+            (a scalar broadcasts).
+        desired_force_world_N, desired_rpy, velocity_weights, null_space_gain_per_s,
+            null_space_target: the task's, as `EndEffectorTask`.
+    """
+
+    kp_force_m_s_per_N: ArrayLike = 0.1
+    ki_force_m_s2_per_N: ArrayLike = 0.05
+    k_orientation_per_s: ArrayLike = 1.0
+    integral_limit_Ns: ArrayLike = 5.0
+    desired_force_world_N: Callable[[float], ArrayLike] | ArrayLike = (0.0, 0.0, 0.0)
+    desired_rpy: Callable[[float], ArrayLike] | ArrayLike = (0.0, 0.0, 0.0)
+    velocity_weights: ArrayLike = 1.0
+    null_space_gain_per_s: float = 0.0
+    null_space_target: ArrayLike | None = None
+
+    def task(self, model: pin.Model, ee_frame_name: str) -> EndEffectorTask:
+        """The task on ``model`` for ``ee_frame_name`` (checks the task's options)."""
+        return EndEffectorTask(
+            model,
+            ee_frame_name,
+            self.desired_force_world_N,
+            self.desired_rpy,
+            velocity_weights=self.velocity_weights,
+            null_space_gain_per_s=self.null_space_gain_per_s,
+            null_space_target=self.null_space_target,
+        )
+
+    def loop(self) -> ForceOrientationLoop:
+        """The outer loop (checks its gains)."""
+        return ForceOrientationLoop(
+            self.kp_force_m_s_per_N,
+            self.ki_force_m_s2_per_N,
+            self.k_orientation_per_s,
+            self.integral_limit_Ns,
+        )

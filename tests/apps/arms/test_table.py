@@ -1,0 +1,52 @@
+"""The comparison's CSV and Markdown: 4 significant digits, NaN as an empty cell, the long
+columns as notes per arm."""
+
+from __future__ import annotations
+
+import csv
+import math
+
+from uvms_pin.apps.arms.row import COLUMNS, nan_row
+from uvms_pin.apps.arms.settings import CompareSettings
+from uvms_pin.apps.arms.table import write_comparison
+
+
+def _rows() -> list[dict]:
+    ok = nan_row("reference")
+    ok.update(status="ok", n_joints=4, arm_mass_kg=0.99000001, force_error_rms_N=0.123456)
+    far = nan_row("so100")
+    far.update(status="unreachable", reason="out of reach", dry_links="jaw")
+    return [ok, far]
+
+
+def test_csv_has_every_column_and_blank_nan(tmp_path):
+    paths = write_comparison(_rows(), tmp_path)
+    assert [p.name for p in paths] == ["comparison.csv", "comparison.md", "comparison.png"]
+    with open(paths[0], newline="") as f:
+        table = list(csv.DictReader(f))
+    assert list(table[0]) == [key for key, _ in COLUMNS]
+    assert table[0]["arm_mass_kg"] == "0.99" and table[0]["force_error_rms_N"] == "0.1235"
+    assert table[0]["n_joints"] == "4" and table[1]["force_error_rms_N"] == ""
+    assert table[1]["reason"] == "out of reach"
+
+
+def test_markdown_table_and_notes(tmp_path):
+    settings = CompareSettings(duration_s=2.0, trim=None, mount_rpy=(math.pi, 0.0, 0.0))
+    write_comparison(_rows(), tmp_path, scenario="s.toml", settings=settings)
+    lines = (tmp_path / "comparison.md").read_text().splitlines()
+    assert lines[0] == "# Arm comparison: s.toml"
+    assert lines[3] == "Duration: 2 s; mount rpy (3.1416, 0.0, 0.0) rad; trim: none."
+    header = lines[5]
+    assert header.startswith("| arm | joints | status |") and "why" not in header
+    assert lines[7].startswith("| reference | 4 | ok | 0.99 |")
+    assert lines[-2:] == [
+        "- **reference** (ok): completed",
+        "- **so100** (unreachable): out of reach (links with mass but no geometry, no "
+        "buoyancy: jaw)",
+    ]
+
+
+def test_without_settings_no_settings_line(tmp_path):
+    write_comparison(_rows(), tmp_path)
+    lines = (tmp_path / "comparison.md").read_text().splitlines()
+    assert lines[3] == "" and lines[4].startswith("| arm |")

@@ -1,0 +1,29 @@
+"""The options of an arm comparison (`uvms_pin.apps.arms.compare.compare_arms`)."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+from uvms_pin.model.trim import TrimSpec
+
+
+@dataclass(frozen=True)
+class CompareSettings:
+    """Options of :func:`~uvms_pin.apps.arms.compare.compare_arms` (picklable: they go to
+    worker processes).
+
+    Attributes:
+        duration_s: simulated duration [s]; None keeps the scenario's.
+        trim: foam and ballast added for the arm at its initial configuration; None: none.
+        mount_rpy: arm base orientation on the vehicle [rad] (default upside down).
+        ik_starts: starts of the initial-configuration search; seed: its random seed.
+        keep_rollouts: write each arm's row, rollout, metrics and figures to OUT/<arm>/.
+    """
+
+    duration_s: float | None = None
+    trim: TrimSpec | None = TrimSpec()  # noqa: RUF009 - frozen, immutable default
+    mount_rpy: tuple[float, float, float] = (math.pi, 0.0, 0.0)
+    ik_starts: int = 24
+    seed: int = 0
+    keep_rollouts: bool = False
