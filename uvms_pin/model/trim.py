@@ -47,6 +47,7 @@ import pinocchio as pin
 
 from uvms_pin.errors import ParameterError
 from uvms_pin.model.uvms import UVMS
+from uvms_pin.results.format import numbers_text
 
 __all__ = ["TrimReport", "TrimSpec", "add_trim_links", "mass_properties", "plan_trim"]
 
@@ -320,10 +321,6 @@ def plan_trim(
     )
 
 
-def _fmt(values) -> str:
-    return " ".join(repr(float(x)) for x in values)
-
-
 def _slab_link(
     name: str, mass: float, size: tuple[float, float, float], hydro: ET.Element
 ) -> ET.Element:
@@ -351,7 +348,7 @@ def _slab_link(
     )
     visual = ET.SubElement(link, "visual")
     geom = ET.SubElement(visual, "geometry")
-    ET.SubElement(geom, "box", {"size": _fmt([lx, ly, max(lz, 1e-4)])})
+    ET.SubElement(geom, "box", {"size": numbers_text([lx, ly, max(lz, 1e-4)])})
     link.append(hydro)
     return link
 
@@ -391,4 +388,4 @@ def add_trim_links(root: ET.Element, vehicle_link: str, report: TrimReport) -> N
         joint = ET.SubElement(root, "joint", {"name": f"{name}_joint", "type": "fixed"})
         ET.SubElement(joint, "parent", {"link": vehicle_link})
         ET.SubElement(joint, "child", {"link": name})
-        ET.SubElement(joint, "origin", {"xyz": _fmt(position), "rpy": "0 0 0"})
+        ET.SubElement(joint, "origin", {"xyz": numbers_text(position), "rpy": "0 0 0"})

@@ -26,6 +26,7 @@ from uvms_pin.hydro.mesh import load_mesh_geometry, mesh_hydro
 from uvms_pin.hydro.params import HydroParams
 from uvms_pin.model.native_stderr import captured_native_stderr
 from uvms_pin.model.resources import package_search_path, resolve_resource
+from uvms_pin.results.format import numbers_text
 
 DEFAULT_WATER_DENSITY_KG_M3 = 1025.0  # sea water; a parameter of load_uvms, never hidden
 DEFAULT_EE_FRAME = "ee"
@@ -375,16 +376,17 @@ def _check_rotational_inertia(entries: dict[str, float], mass_kg: float, where: 
     scale = float(np.max(np.abs(principal)))
     if scale == 0.0:
         return
+    moments = "(" + numbers_text(principal, 6, ", ") + ")"
     if mass_kg == 0.0:
         raise ModelError(
-            f"zero mass but a rotational inertia (principal moments {_fmt(principal)} kg m^2)",
+            f"zero mass but a rotational inertia (principal moments {moments} kg m^2)",
             path=where,
             link=link,
         )
     negative = [k for k in ("ixx", "iyy", "izz") if entries[k] < 0.0]
     if negative or principal[0] < -_INERTIA_RELATIVE_TOLERANCE * scale:
         raise ModelError(
-            f"inertia is not positive semi-definite: principal moments {_fmt(principal)} "
+            f"inertia is not positive semi-definite: principal moments {moments} "
             f"kg m^2{' (negative ' + ', '.join(negative) + ')' if negative else ''}",
             path=where,
             link=link,
@@ -392,14 +394,10 @@ def _check_rotational_inertia(entries: dict[str, float], mass_kg: float, where: 
     if principal[0] + principal[1] < principal[2] * (1.0 - _INERTIA_RELATIVE_TOLERANCE):
         raise ModelError(
             f"inertia violates the triangle inequality I1 + I2 >= I3: principal moments "
-            f"{_fmt(principal)} kg m^2 (no mass distribution has them)",
+            f"{moments} kg m^2 (no mass distribution has them)",
             path=where,
             link=link,
         )
-
-
-def _fmt(values: np.ndarray) -> str:
-    return "(" + ", ".join(f"{x:.6g}" for x in values) + ")"
 
 
 def _check_joint_limits(root: ET.Element, where: str) -> None:

@@ -50,6 +50,7 @@ from uvms_pin.model.mount.catalog import ArmEntry, resolve_arm
 from uvms_pin.model.resources import find_model, resolve_resource
 from uvms_pin.model.uvms import DEFAULT_WATER_DENSITY_KG_M3, UVMS, load_uvms, read_urdf_root
 from uvms_pin.results import atomic
+from uvms_pin.results.format import numbers_text
 
 __all__ = [
     "MountResult",
@@ -814,17 +815,13 @@ def _origin_of(element: ET.Element, path: Path) -> pin.SE3:
     return pin.SE3(pin.rpy.rpyToMatrix(*rpy), xyz)
 
 
-def _fmt(values) -> str:
-    return " ".join(repr(float(x)) for x in values)
-
-
 def _set_origin(element: ET.Element, placement: pin.SE3) -> None:
     origin = element.find("origin")
     if origin is None:
         origin = ET.Element("origin")
         element.insert(0, origin)
-    origin.set("xyz", _fmt(placement.translation))
-    origin.set("rpy", _fmt(pin.rpy.matrixToRpy(placement.rotation)))
+    origin.set("xyz", numbers_text(placement.translation))
+    origin.set("rpy", numbers_text(pin.rpy.matrixToRpy(placement.rotation)))
 
 
 def _add_fixed(out: ET.Element, name: str, parent: str, child: str, placement: pin.SE3) -> None:
@@ -841,7 +838,7 @@ def _probe_link(name: str, tool: ProbeTool) -> ET.Element:
     iyy = m * (3.0 * r * r + length * length) / 12.0
     link = ET.Element("link", {"name": name})
     inertial = ET.SubElement(link, "inertial")
-    ET.SubElement(inertial, "origin", {"xyz": _fmt([length / 2, 0, 0]), "rpy": "0 0 0"})
+    ET.SubElement(inertial, "origin", {"xyz": numbers_text([length / 2, 0, 0]), "rpy": "0 0 0"})
     ET.SubElement(inertial, "mass", {"value": repr(m)})
     ET.SubElement(
         inertial,
@@ -851,7 +848,9 @@ def _probe_link(name: str, tool: ProbeTool) -> ET.Element:
     for tag in ("visual", "collision"):
         el = ET.SubElement(link, tag)
         ET.SubElement(
-            el, "origin", {"xyz": _fmt([length / 2, 0, 0]), "rpy": _fmt([0, math.pi / 2, 0])}
+            el,
+            "origin",
+            {"xyz": numbers_text([length / 2, 0, 0]), "rpy": numbers_text([0, math.pi / 2, 0])},
         )
         geom = ET.SubElement(el, "geometry")
         ET.SubElement(geom, "cylinder", {"radius": repr(r), "length": repr(length)})
