@@ -39,7 +39,8 @@ from uvms_pin.flow import (
 )
 from uvms_pin.model.resources import find_model, shipped_models
 from uvms_pin.model.thruster import Thruster
-from uvms_pin.model.uvms import UVMS, load_uvms
+from uvms_pin.model.urdf.load import load_uvms
+from uvms_pin.model.uvms import UVMS
 from uvms_pin.physics.compiled import BACKENDS
 from uvms_pin.physics.environment import (
     CompliantPlane,

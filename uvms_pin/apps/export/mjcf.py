@@ -43,7 +43,8 @@ import pinocchio as pin
 from uvms_pin.errors import ModelError, ParameterError
 from uvms_pin.hydro.mesh import load_mesh_geometry
 from uvms_pin.model.resources import resolve_resource
-from uvms_pin.model.uvms import UVMS, _numbers, _origin
+from uvms_pin.model.urdf.read import read_numbers, read_origin
+from uvms_pin.model.uvms import UVMS
 from uvms_pin.results.format import numbers_text
 
 __all__ = ["MUJOCO_DEFAULT_FLUID_COEFFICIENTS", "MjcfOptions", "uvms_to_mjcf"]
@@ -306,7 +307,7 @@ def _add_fluid_geoms(
             continue
         frame = model.frames[model.getFrameId(name, pin.FrameType.BODY)]
         for k, collision in enumerate(collisions):
-            placement = frame.placement * _origin(collision.find("origin"), "urdf_text", name)
+            placement = frame.placement * read_origin(collision.find("origin"), "urdf_text", name)
             kind, size, local = _shape(collision, name, base_dir, package_dirs)
             _placed(
                 bodies[frame.parentJoint],
@@ -332,19 +333,19 @@ def _shape(
     if shape is None:
         raise ModelError("<collision> has no <geometry> shape", path=where, link=link)
     if shape.tag == "box":
-        return "box", 0.5 * _numbers(shape.get("size"), 3, "<box size>", where, link), _EYE
+        return "box", 0.5 * read_numbers(shape.get("size"), 3, "<box size>", where, link), _EYE
     if shape.tag == "cylinder":
-        radius = _numbers(shape.get("radius"), 1, "<cylinder radius>", where, link)[0]
-        length = _numbers(shape.get("length"), 1, "<cylinder length>", where, link)[0]
+        radius = read_numbers(shape.get("radius"), 1, "<cylinder radius>", where, link)[0]
+        length = read_numbers(shape.get("length"), 1, "<cylinder length>", where, link)[0]
         return "cylinder", np.array([radius, 0.5 * length]), _EYE
     if shape.tag == "sphere":
-        return "sphere", _numbers(shape.get("radius"), 1, "<sphere radius>", where, link), _EYE
+        return "sphere", read_numbers(shape.get("radius"), 1, "<sphere radius>", where, link), _EYE
     if shape.tag == "mesh":
         filename = shape.get("filename", "")
         resolved = resolve_resource(filename, base_dir, package_dirs)
         if resolved is None:
             raise ModelError(f"collision mesh '{filename}' not found", path=where, link=link)
-        scale = _numbers(shape.get("scale", "1 1 1"), 3, "<mesh scale>", where, link)
+        scale = read_numbers(shape.get("scale", "1 1 1"), 3, "<mesh scale>", where, link)
         mesh = load_mesh_geometry(resolved, scale)
         half = np.maximum(0.5 * mesh.obb_extents_m, 5e-5)
         return "box", half, pin.SE3(mesh.obb_rotation, mesh.obb_center_m)

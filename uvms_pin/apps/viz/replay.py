@@ -31,7 +31,7 @@ from uvms_pin.apps.viz.meshcat_scene import (
     recording_visualizer,
 )
 from uvms_pin.apps.viz.surface import SurfaceView
-from uvms_pin.model.uvms import load_uvms
+from uvms_pin.model.urdf.load import load_uvms
 from uvms_pin.results.atomic import write_text_atomic
 from uvms_pin.results.rollout import Rollout
 

@@ -1,7 +1,7 @@
 """Mount any arm URDF on a vehicle URDF: one UVMS from two files (docs/api.md).
 
 The two files are merged into one URDF, written to a temporary directory and loaded with
-:func:`uvms_pin.model.uvms.load_uvms`, so the hydrodynamic extension, the derivation of missing
+:func:`uvms_pin.model.urdf.load.load_uvms`, so the hydrodynamic extension, the derivation of missing
 coefficients from collision geometry (meshes included) and every check of the loader apply
 unchanged; the temporary file is removed before returning.
 
@@ -48,7 +48,9 @@ import pinocchio as pin
 from uvms_pin.errors import ModelError, ParameterError
 from uvms_pin.model.mount.catalog import ArmEntry, resolve_arm
 from uvms_pin.model.resources import find_model, resolve_resource
-from uvms_pin.model.uvms import DEFAULT_WATER_DENSITY_KG_M3, UVMS, load_uvms, read_urdf_root
+from uvms_pin.model.urdf.load import load_uvms
+from uvms_pin.model.urdf.read import read_urdf_root
+from uvms_pin.model.uvms import DEFAULT_WATER_DENSITY_KG_M3, UVMS
 from uvms_pin.results import atomic
 from uvms_pin.results.format import numbers_text
 
