@@ -254,7 +254,8 @@ def mount_arm_detailed(
     uvms = _load_text(merged.root, source, **load_kw)
     report = None
     if trim:
-        from uvms_pin.model.trim import TrimSpec, add_trim_links, plan_trim
+        from uvms_pin.model.trim import TrimSpec, plan_trim
+        from uvms_pin.model.trim_urdf import add_trim_links
 
         spec = trim if isinstance(trim, TrimSpec) else TrimSpec()
         q = uvms.neutral_configuration()
