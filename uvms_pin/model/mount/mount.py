@@ -47,11 +47,12 @@ import pinocchio as pin
 
 from uvms_pin.errors import ModelError, ParameterError
 from uvms_pin.model.mount.catalog import ArmEntry, resolve_arm
+from uvms_pin.model.mount.origin import add_fixed_joint, origin_of, set_origin, vector_attribute
+from uvms_pin.model.mount.text import urdf_text, write_text_file
+from uvms_pin.model.mount.tree import MOVING_JOINT_TYPES, URDFTree
 from uvms_pin.model.resources import find_model, resolve_resource
 from uvms_pin.model.urdf.load import load_uvms
-from uvms_pin.model.urdf.read import read_urdf_root
 from uvms_pin.model.uvms import DEFAULT_WATER_DENSITY_KG_M3, UVMS
-from uvms_pin.results import atomic
 from uvms_pin.results.format import numbers_text
 
 __all__ = [
@@ -64,7 +65,6 @@ __all__ = [
     "parse_mount_pose",
 ]
 
-_MOVING = ("revolute", "continuous", "prismatic")
 _GRIPPER_WORDS = ("finger", "gripper", "jaw", "hand")
 _KEEP_TOP_LEVEL = ("link", "joint", "material", "hydrodynamics")
 _CONTINUOUS_LIMIT_RAD = 2.0 * math.pi
@@ -269,9 +269,9 @@ def mount_arm_detailed(
         report = plan_trim(uvms, q, spec, hull=merged.hull_box)
         add_trim_links(merged.root, merged.vehicle_link, report)
         uvms = _load_text(merged.root, source, **load_kw)
-    text = _to_text(merged.root)
+    text = urdf_text(merged.root)
     if save_urdf is not None:
-        write_text_atomic(Path(save_urdf), text)
+        write_text_file(save_urdf, text)
     return MountResult(
         uvms=uvms,
         urdf_text=text,
@@ -327,8 +327,8 @@ def merge_urdf(
     """Build the merged URDF tree (steps 1-6 of the module docstring); nothing is written."""
     placement = parse_mount_pose(mount_pose)
     vpath, apath = Path(vehicle_urdf), Path(arm_urdf)
-    vehicle = _Tree.read(vpath)
-    arm = _Tree.read(apath)
+    vehicle = URDFTree.read(vpath)
+    arm = URDFTree.read(apath)
     removed_links, removed_joints = ([], []) if keep_existing_arm else _existing_arm(vehicle)
     vlink = (
         vehicle.root_link
@@ -347,7 +347,7 @@ def merge_urdf(
     )
     subtree = arm.subtree(base)
     if ee_link is None:
-        ee = arm.choose_ee_link(base)
+        ee = _choose_ee_link(arm, base)
     else:
         ee = arm.require_link(ee_link, "ee_link")
         if ee not in subtree:
@@ -355,7 +355,7 @@ def merge_urdf(
                 f"ee_link '{ee}' is not below arm_base_link '{base}'", path=str(apath), link=ee
             )
     path_joints = arm.path_joints(base, ee)
-    chain = [j for j in path_joints if arm.joints[j].get("type") in _MOVING]
+    chain = [j for j in path_joints if arm.joints[j].get("type") in MOVING_JOINT_TYPES]
     if not chain:
         raise ModelError(
             f"no moving joint between arm_base_link '{base}' and ee_link '{ee}'", path=str(apath)
@@ -395,7 +395,7 @@ def merge_urdf(
                 "prismatic and fixed joints",
                 path=str(apath),
             )
-        if kind not in _MOVING and kind != "fixed":
+        if kind not in MOVING_JOINT_TYPES and kind != "fixed":
             raise ModelError(f"joint '{name}' has unknown type '{kind}'", path=str(apath))
         if name in chain:
             if joint.find("mimic") is not None:
@@ -410,7 +410,7 @@ def merge_urdf(
                     )
                 limit.set("lower", repr(-_CONTINUOUS_LIMIT_RAD))
                 limit.set("upper", repr(_CONTINUOUS_LIMIT_RAD))
-        elif kind in _MOVING:
+        elif kind in MOVING_JOINT_TYPES:
             locked[name] = _lock(joint, locks.get(name), apath)
 
     # ---- renaming clashes, mesh paths
@@ -484,14 +484,14 @@ def merge_urdf(
     out.extend(arm_joints)
     base_new = renamed.get(base, base)
     ee_new = renamed.get(ee, ee)
-    _add_fixed(out, frames["arm_mount_joint"], vlink, base_new, placement)
+    add_fixed_joint(out, frames["arm_mount_joint"], vlink, base_new, placement)
 
     # ---- sensor, tool and end-effector frames
     rot_tool = _rotation_with_x(axis)
     if sensor_link is None:
         sensor_frame = frames["ft_sensor"]
         out.append(ET.Element("link", {"name": sensor_frame}))
-        _add_fixed(
+        add_fixed_joint(
             out, frames["ft_sensor_joint"], ee_new, sensor_frame, pin.SE3(rot_tool, np.zeros(3))
         )
     else:
@@ -499,13 +499,13 @@ def merge_urdf(
     ee_frame = frames["ee"]
     if tool is not None:
         out.append(_probe_link(frames["tool"], tool))
-        _add_fixed(out, frames["tool_joint"], sensor_frame, frames["tool"], pin.SE3.Identity())
+        add_fixed_joint(out, frames["tool_joint"], sensor_frame, frames["tool"], pin.SE3.Identity())
         out.append(ET.Element("link", {"name": ee_frame}))
         tip = pin.SE3(np.eye(3), np.array([tool.length_m, 0, 0]))
-        _add_fixed(out, frames["ee_joint"], frames["tool"], ee_frame, tip)
+        add_fixed_joint(out, frames["ee_joint"], frames["tool"], ee_frame, tip)
     elif ee_new != ee_frame:
         out.append(ET.Element("link", {"name": ee_frame}))
-        _add_fixed(out, frames["ee_joint"], sensor_frame, ee_frame, pin.SE3.Identity())
+        add_fixed_joint(out, frames["ee_joint"], sensor_frame, ee_frame, pin.SE3.Identity())
 
     return MergedURDF(
         root=out,
@@ -541,13 +541,15 @@ def _unique_frame_names(taken: set[str]) -> dict[str, str]:
     return out
 
 
-def _existing_arm(vehicle: _Tree) -> tuple[list[str], list[str]]:
+def _existing_arm(vehicle: URDFTree) -> tuple[list[str], list[str]]:
     """(links, joints) of the arm a vehicle file already carries: everything below each
     first moving joint (one without a moving joint above it), and the ``ft_sensor``,
     ``tool`` and ``ee`` frames wherever they hang; empty for a vehicle alone."""
     starts = []
     for name in vehicle.joint_order:
-        if vehicle.joints[name].get("type") in _MOVING and not _moving_above(vehicle, name):
+        if vehicle.joints[name].get("type") in MOVING_JOINT_TYPES and not vehicle.moving_above(
+            name
+        ):
             starts.append(vehicle.child_of(name))
     starts += [f for f in ("ft_sensor", "tool", "ee") if f in vehicle.parent_joint]
     links: set[str] = set()
@@ -556,16 +558,6 @@ def _existing_arm(vehicle: _Tree) -> tuple[list[str], list[str]]:
     ordered_links = [n for n in vehicle.link_order if n in links]
     joints = [n for n in vehicle.joint_order if vehicle.child_of(n) in links]
     return ordered_links, joints
-
-
-def _moving_above(tree: _Tree, joint: str) -> bool:
-    link = tree.joints[joint].find("parent").get("link")
-    while link in tree.parent_joint:
-        above = tree.parent_joint[link]
-        if tree.joints[above].get("type") in _MOVING:
-            return True
-        link = tree.joints[above].find("parent").get("link")
-    return False
 
 
 def _catalog_entry(arm: str | Path | ArmEntry) -> ArmEntry | None:
@@ -580,7 +572,7 @@ def _catalog_entry(arm: str | Path | ArmEntry) -> ArmEntry | None:
 def hull_box(urdf: str | Path, link: str | None = None) -> tuple[np.ndarray, np.ndarray] | None:
     """(centre, full size) [m] of the first box collision of ``link`` (default: the root) in
     that link's frame, or None: the hull envelope used by the trim and the reach check."""
-    tree = _Tree.read(Path(urdf))
+    tree = URDFTree.read(Path(urdf))
     name = tree.root_link if link is None else tree.require_link(link, "link")
     return _box_of(tree.links[name])
 
@@ -629,139 +621,27 @@ def parse_mount_pose(mount_pose) -> pin.SE3:
     return pin.SE3(rotation, translation)
 
 
-def write_text_atomic(path: Path, text: str) -> None:
-    """Write ``text`` to ``path`` through a temporary file in the same directory."""
-    path.parent.mkdir(parents=True, exist_ok=True)
-    atomic.write_text_atomic(path, text)
-
-
-# ---------------------------------------------------------------------- the URDF tree
-
-
-class _Tree:
-    """A parsed URDF with its kinematic tree checked (links, joints, parents, root)."""
-
-    def __init__(self, root: ET.Element, path: Path):
-        self.root = root
-        self.path = path
-        where = str(path)
-        self.links: dict[str, ET.Element] = {}
-        self.link_order: list[str] = []
-        for link in root.findall("link"):
-            name = link.get("name")
-            if not name:
-                raise ModelError("a <link> has no name", path=where)
-            if name in self.links:
-                raise ModelError("is defined twice", path=where, link=name)
-            self.links[name] = link
-            self.link_order.append(name)
-        if not self.links:
-            raise ModelError("no <link> elements", path=where)
-        self.joints: dict[str, ET.Element] = {}
-        self.joint_order: list[str] = []
-        self.parent_joint: dict[str, str] = {}
-        self.children: dict[str, list[str]] = {n: [] for n in self.links}
-        for joint in root.findall("joint"):
-            name = joint.get("name")
-            if not name:
-                raise ModelError("a <joint> has no name", path=where)
-            if name in self.joints:
-                raise ModelError(f"joint '{name}' is defined twice", path=where)
-            parent_el, child_el = joint.find("parent"), joint.find("child")
-            if parent_el is None or child_el is None:
-                raise ModelError(f"joint '{name}' needs <parent> and <child>", path=where)
-            parent, child = parent_el.get("link"), child_el.get("link")
-            for role, link in (("parent", parent), ("child", child)):
-                if link not in self.links:
-                    raise ModelError(
-                        f"joint '{name}': unknown {role} link '{link}'", path=where, link=link
-                    )
-            if child in self.parent_joint:
-                raise ModelError(
-                    f"closed chain: the link has two parents (joints '{self.parent_joint[child]}' "
-                    f"and '{name}'); URDF and Pinocchio need a tree",
-                    path=where,
-                    link=child,
-                )
-            self.joints[name] = joint
-            self.joint_order.append(name)
-            self.parent_joint[child] = name
-            self.children[parent].append(name)
-        roots = [n for n in self.link_order if n not in self.parent_joint]
-        if len(roots) != 1:
-            raise ModelError(
-                f"expected one root link, found {len(roots)}: {', '.join(roots) or 'none'} "
-                "(a cycle or a disconnected part)",
-                path=where,
-            )
-        self.root_link = roots[0]
-        if len(self.subtree(self.root_link)) != len(self.links):
-            raise ModelError("the joints form a cycle", path=where)
-
-    @classmethod
-    def read(cls, path: Path) -> _Tree:
-        return cls(read_urdf_root(path), path)
-
-    def require_link(self, name: str, role: str) -> str:
-        if name not in self.links:
-            raise ModelError(
-                f"{role} '{name}' is not a link of this file; links are: "
-                + ", ".join(self.link_order),
-                path=str(self.path),
-                link=name,
-            )
-        return name
-
-    def child_of(self, joint: str) -> str:
-        return self.joints[joint].find("child").get("link")
-
-    def subtree(self, link: str) -> list[str]:
-        out, stack = [], [link]
-        while stack:
-            current = stack.pop()
-            out.append(current)
-            stack.extend(self.child_of(j) for j in self.children[current])
-        return out
-
-    def path_joints(self, base: str, tip: str) -> list[str]:
-        joints = []
-        current = tip
-        while current != base:
-            joint = self.parent_joint[current]
-            joints.append(joint)
-            current = self.joints[joint].find("parent").get("link")
-        return joints[::-1]
-
-    def _moving_below(self, link: str) -> int:
-        return sum(
-            1
-            for n in self.subtree(link)
-            if n in self.parent_joint
-            and n != link
-            and self.joints[self.parent_joint[n]].get("type") in _MOVING
-        )
-
-    def choose_ee_link(self, base: str) -> str:
-        """Follow the single branch that carries moving joints; stop before grippers."""
-        current, last_moving_child = base, None
-        while True:
-            branches = []
-            for joint in self.children[current]:
-                child = self.child_of(joint)
-                moving = self.joints[joint].get("type") in _MOVING
-                if moving or self._moving_below(child):
-                    branches.append((joint, child, moving))
-            if len(branches) != 1:
-                break
-            joint, child, moving = branches[0]
-            if moving and any(w in joint.lower() for w in _GRIPPER_WORDS):
-                break
-            current = child
-            if moving:
-                last_moving_child = child
-        if last_moving_child is None:
-            raise ModelError(f"no moving joint below arm_base_link '{base}'", path=str(self.path))
-        return last_moving_child
+def _choose_ee_link(arm: URDFTree, base: str) -> str:
+    """Follow the single branch that carries moving joints; stop before grippers."""
+    current, last_moving_child = base, None
+    while True:
+        branches = []
+        for joint in arm.children[current]:
+            child = arm.child_of(joint)
+            moving = arm.is_moving(joint)
+            if moving or arm.moving_below(child):
+                branches.append((joint, child, moving))
+        if len(branches) != 1:
+            break
+        joint, child, moving = branches[0]
+        if moving and any(w in joint.lower() for w in _GRIPPER_WORDS):
+            break
+        current = child
+        if moving:
+            last_moving_child = child
+    if last_moving_child is None:
+        raise ModelError(f"no moving joint below arm_base_link '{base}'", path=str(arm.path))
+    return last_moving_child
 
 
 def _original(name: str, renamed: dict[str, str]) -> str:
@@ -784,54 +664,19 @@ def _lock(joint: ET.Element, position: float | None, path: Path) -> float:
         raise ParameterError(
             f"lock position {position} of joint '{name}' is outside its limits [{lower}, {upper}]"
         )
-    axis = _numbers_attr(joint.find("axis"), "xyz", "1 0 0", path, name)
+    axis = vector_attribute(joint.find("axis"), "xyz", "1 0 0", path, name)
     axis = axis / np.linalg.norm(axis)
-    origin = _origin_of(joint, path)
+    origin = origin_of(joint, path)
     if joint.get("type") == "prismatic":
         motion = pin.SE3(np.eye(3), axis * value)
     else:
         motion = pin.SE3(pin.exp3(axis * value), np.zeros(3))
-    _set_origin(joint, origin * motion)
+    set_origin(joint, origin * motion)
     joint.set("type", "fixed")
     for tag in ("limit", "mimic", "dynamics", "safety_controller", "calibration", "axis"):
         for element in joint.findall(tag):
             joint.remove(element)
     return value
-
-
-def _numbers_attr(element: ET.Element | None, key: str, default: str, path: Path, what: str):
-    text = default if element is None else element.get(key, default)
-    try:
-        values = np.array([float(t) for t in text.split()])
-    except ValueError as exc:
-        raise ModelError(f"'{what}': non-numeric {key} '{text}'", path=str(path)) from exc
-    if values.shape != (3,) or not np.all(np.isfinite(values)):
-        raise ModelError(f"'{what}': {key} needs 3 finite numbers, got '{text}'", path=str(path))
-    return values
-
-
-def _origin_of(element: ET.Element, path: Path) -> pin.SE3:
-    origin = element.find("origin")
-    name = element.get("name", element.tag)
-    xyz = _numbers_attr(origin, "xyz", "0 0 0", path, name)
-    rpy = _numbers_attr(origin, "rpy", "0 0 0", path, name)
-    return pin.SE3(pin.rpy.rpyToMatrix(*rpy), xyz)
-
-
-def _set_origin(element: ET.Element, placement: pin.SE3) -> None:
-    origin = element.find("origin")
-    if origin is None:
-        origin = ET.Element("origin")
-        element.insert(0, origin)
-    origin.set("xyz", numbers_text(placement.translation))
-    origin.set("rpy", numbers_text(pin.rpy.matrixToRpy(placement.rotation)))
-
-
-def _add_fixed(out: ET.Element, name: str, parent: str, child: str, placement: pin.SE3) -> None:
-    joint = ET.SubElement(out, "joint", {"name": name, "type": "fixed"})
-    ET.SubElement(joint, "parent", {"link": parent})
-    ET.SubElement(joint, "child", {"link": child})
-    _set_origin(joint, placement)
 
 
 def _probe_link(name: str, tool: ProbeTool) -> ET.Element:
@@ -860,7 +705,7 @@ def _probe_link(name: str, tool: ProbeTool) -> ET.Element:
     return link
 
 
-def _tool_axis(arm: _Tree, tool_axis, chain: list[str], ee: str, path: Path) -> np.ndarray:
+def _tool_axis(arm: URDFTree, tool_axis, chain: list[str], ee: str, path: Path) -> np.ndarray:
     if isinstance(tool_axis, str):
         if tool_axis in _AXES:
             return np.array(_AXES[tool_axis])
@@ -876,17 +721,17 @@ def _tool_axis(arm: _Tree, tool_axis, chain: list[str], ee: str, path: Path) -> 
     return axis / norm
 
 
-def _placement_in(arm: _Tree, link: str, joints: list[str], path: Path) -> dict[str, pin.SE3]:
+def _placement_in(arm: URDFTree, link: str, joints: list[str], path: Path) -> dict[str, pin.SE3]:
     """Placements (zero configuration) of every link on the path, relative to its start."""
     out = {}
     current = pin.SE3.Identity()
     for joint in joints:
-        current = current * _origin_of(arm.joints[joint], path)
+        current = current * origin_of(arm.joints[joint], path)
         out[arm.child_of(joint)] = current
     return out
 
 
-def _auto_tool_axis(arm: _Tree, chain: list[str], ee: str, path: Path) -> np.ndarray:
+def _auto_tool_axis(arm: URDFTree, chain: list[str], ee: str, path: Path) -> np.ndarray:
     """The last chain joint's axis in ``ee``'s frame, pointing away from the arm."""
     last = chain[-1]
     base = arm.joints[chain[0]].find("parent").get("link")
@@ -894,7 +739,7 @@ def _auto_tool_axis(arm: _Tree, chain: list[str], ee: str, path: Path) -> np.nda
     placements = _placement_in(arm, ee, joints, path)
     joint_frame = placements[arm.child_of(last)]  # the last joint's frame (zero position)
     ee_frame = placements[ee]
-    axis_joint = _numbers_attr(arm.joints[last].find("axis"), "xyz", "1 0 0", path, last)
+    axis_joint = vector_attribute(arm.joints[last].find("axis"), "xyz", "1 0 0", path, last)
     axis_world = joint_frame.rotation @ (axis_joint / np.linalg.norm(axis_joint))
     if len(chain) > 1:
         prev = placements[arm.child_of(chain[-2])].translation
@@ -971,7 +816,7 @@ def _box_of(link: ET.Element) -> tuple[np.ndarray, np.ndarray] | None:
 
 
 def _mark_dry_links(
-    links: list[ET.Element], arm: _Tree, renamed: dict[str, str], allow_dry_links: bool
+    links: list[ET.Element], arm: URDFTree, renamed: dict[str, str], allow_dry_links: bool
 ) -> list[str]:
     """Give links with an <inertial> but no geometry and no hydrodynamics an explicit empty
     ``<hydrodynamics>`` (volume 0): always for massless frame links, and for links with mass
@@ -1001,17 +846,11 @@ def _mark_dry_links(
     return dry
 
 
-def _to_text(root: ET.Element) -> str:
-    tree = copy.deepcopy(root)
-    ET.indent(tree, "  ")
-    return '<?xml version="1.0"?>\n' + ET.tostring(tree, encoding="unicode") + "\n"
-
-
 def _load_text(root: ET.Element, source: str, **load_kw) -> UVMS:
     """Write the merged tree to a private temporary directory, load it, remove it."""
     with tempfile.TemporaryDirectory(prefix="uvms_pin_mount_") as tmp:
         path = Path(tmp) / "merged.urdf"
-        path.write_text(_to_text(root))
+        path.write_text(urdf_text(root))
         try:
             uvms = load_uvms(path, **load_kw)
         except ModelError as exc:
