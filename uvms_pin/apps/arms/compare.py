@@ -50,7 +50,8 @@ import pinocchio as pin
 from uvms_pin.apps.arms.initial import solve_initial_configuration
 from uvms_pin.errors import FunnelViolation, ScenarioError, SimulationError, UvmsPinError
 from uvms_pin.model.mount.catalog import REFERENCE, ArmEntry, resolve_arm
-from uvms_pin.model.mount.mount import hull_box, mount_arm_detailed
+from uvms_pin.model.mount.hull import hull_box
+from uvms_pin.model.mount.mount import mount_arm_detailed
 from uvms_pin.model.mount.split import split_urdf
 from uvms_pin.model.mount.text import write_text_file as write_text_atomic
 from uvms_pin.model.trim import TrimSpec
