@@ -77,10 +77,8 @@ def merge_urdf(
     allow_dry_links: bool = False,
     keep_existing_arm: bool = False,
 ) -> MergedURDF:
-    """Build the merged URDF tree (steps 1-6 of the module docstring); nothing is written.
-
-    The options are :func:`uvms_pin.model.mount.mount.mount_arm_detailed`'s.
-    """
+    """Build the merged URDF tree (steps 1-6 of `uvms_pin.model.mount.mount`); nothing is
+    written. The options are :func:`uvms_pin.model.mount.mount.mount_arm_detailed`'s."""
     placement = parse_mount_pose(mount_pose)
     vehicle = URDFTree.read(Path(vehicle_urdf))
     arm = URDFTree.read(Path(arm_urdf))
