@@ -26,7 +26,7 @@ _LAZY = {
     "Measurement": "uvms_pin.control.measurement",
     "UVMS": "uvms_pin.model.uvms",
     "HydroBody": "uvms_pin.model.uvms",
-    "load_uvms": "uvms_pin.model.uvms",
+    "load_uvms": "uvms_pin.model.urdf.load",
     "mount_arm": "uvms_pin.model.mount.mount",
     "shipped_path": "uvms_pin.model.resources",
     "Rollout": "uvms_pin.results.rollout",

@@ -14,8 +14,9 @@ import uvms_pin as up
 from uvms_pin.apps.arms.compare import CompareSettings, compare_arms
 from uvms_pin.errors import ModelError, ParameterError
 from uvms_pin.model.mount.catalog import CATALOG, available_arms
-from uvms_pin.model.mount.mount import ProbeTool, mount_arm, mount_arm_detailed
+from uvms_pin.model.mount.mount import mount_arm, mount_arm_detailed
 from uvms_pin.model.mount.split import split_urdf
+from uvms_pin.model.mount.tool import ProbeTool
 from uvms_pin.model.resources import example_robot_data_dir
 from uvms_pin.model.trim import TrimSpec, mass_properties
 

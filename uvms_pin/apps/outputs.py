@@ -32,7 +32,7 @@ def _flow_figure(rollout: Rollout, out: Path) -> list[Path]:
     """flow.png when the run had waves or a varying current (not for a uniform current)."""
     from uvms_pin.apps.viz.flow_plots import FLOW_FIGURE, plot_flow_seen
     from uvms_pin.flow import UniformCurrent, flow_from_record
-    from uvms_pin.model.uvms import load_uvms
+    from uvms_pin.model.urdf.load import load_uvms
 
     world = rollout.metadata.get("world") or {}
     flow = flow_from_record(world.get("flow"))

@@ -62,12 +62,17 @@ _DEFAULT_SKIN_FRICTION = 0.0047
 # --------------------------------------------------------------------------- validation
 
 
-def _positive(name: str, value: float) -> float:
-    """Return ``value`` as a float if it is finite and > 0, else raise ParameterError."""
+def _number(name: str, value: float) -> float:
+    """``value`` as a float, else ParameterError naming ``name``."""
     try:
-        x = float(value)
+        return float(value)
     except (TypeError, ValueError) as exc:
         raise ParameterError(f"{name} must be a number, got {value!r}") from exc
+
+
+def _positive(name: str, value: float) -> float:
+    """Return ``value`` as a float if it is finite and > 0, else raise ParameterError."""
+    x = _number(name, value)
     if not math.isfinite(x) or x <= 0.0:
         raise ParameterError(f"{name} must be finite and > 0, got {value!r}")
     return x
@@ -75,10 +80,7 @@ def _positive(name: str, value: float) -> float:
 
 def _non_negative(name: str, value: float) -> float:
     """Return ``value`` as a float if it is finite and >= 0, else raise ParameterError."""
-    try:
-        x = float(value)
-    except (TypeError, ValueError) as exc:
-        raise ParameterError(f"{name} must be a number, got {value!r}") from exc
+    x = _number(name, value)
     if not math.isfinite(x) or x < 0.0:
         raise ParameterError(f"{name} must be finite and >= 0, got {value!r}")
     return x
@@ -91,6 +93,29 @@ def _linear_from_quadratic(
     u = _non_negative("linear_damping_reference_speed_m_s", reference_speed_m_s)
     w = _non_negative("linear_damping_reference_rate_rad_s", reference_rate_rad_s)
     return np.diag(quadratic * np.array([u, u, u, w, w, w]))
+
+
+def _at_centre(
+    volume_m3: float,
+    added_mass: np.ndarray,
+    quadratic_damping: np.ndarray,
+    reference_speed_m_s: float,
+    reference_rate_rad_s: float,
+    origin: str,
+) -> HydroParams:
+    """A primitive's coefficients at its centre (its centre of buoyancy, by symmetry), the
+    linear damping from the quadratic one at the reference speed and rate, marked derived."""
+    return HydroParams(
+        volume_m3=volume_m3,
+        center_of_buoyancy_m=np.zeros(3),
+        added_mass=added_mass,
+        linear_damping=_linear_from_quadratic(
+            quadratic_damping, reference_speed_m_s, reference_rate_rad_s
+        ),
+        quadratic_damping=quadratic_damping,
+        derived=True,
+        origin=origin,
+    )
 
 
 # --------------------------------------------------------------------------- ellipsoid
@@ -234,16 +259,13 @@ def sphere_hydro(
     d_lin = 0.5 * rho * cd * math.pi * r * r
     d_rot = 3.0 * math.pi**2 / 8.0 * rho * cf * r**5
     quadratic = np.array([d_lin, d_lin, d_lin, d_rot, d_rot, d_rot])
-    return HydroParams(
-        volume_m3=volume,
-        center_of_buoyancy_m=np.zeros(3),
-        added_mass=added,
-        linear_damping=_linear_from_quadratic(
-            quadratic, linear_damping_reference_speed_m_s, linear_damping_reference_rate_rad_s
-        ),
-        quadratic_damping=quadratic,
-        derived=True,
-        origin=f"sphere r={r:g} m: potential-flow added mass, Cd={cd:g}",
+    return _at_centre(
+        volume,
+        added,
+        quadratic,
+        linear_damping_reference_speed_m_s,
+        linear_damping_reference_rate_rad_s,
+        f"sphere r={r:g} m: potential-flow added mass, Cd={cd:g}",
     )
 
 
@@ -319,19 +341,14 @@ def cylinder_hydro(
     d_tumble = rho * cd_x * r * length**4 / 32.0 + 4.0 / 15.0 * rho * cd_a * r**5
     d_roll = math.pi * rho * cf * r**4 * (length + 0.4 * r)
     quadratic = np.array([d_cross, d_cross, d_axial, d_tumble, d_tumble, d_roll])
-    return HydroParams(
-        volume_m3=volume,
-        center_of_buoyancy_m=np.zeros(3),
-        added_mass=added,
-        linear_damping=_linear_from_quadratic(
-            quadratic, linear_damping_reference_speed_m_s, linear_damping_reference_rate_rad_s
-        ),
-        quadratic_damping=quadratic,
-        derived=True,
-        origin=(
-            f"cylinder r={r:g} m L={length:g} m: strip-theory added mass (Ca=1), "
-            f"axial k1={k_axial:.3f}, Cd={cd_x:g}/{cd_a:g}"
-        ),
+    return _at_centre(
+        volume,
+        added,
+        quadratic,
+        linear_damping_reference_speed_m_s,
+        linear_damping_reference_rate_rad_s,
+        f"cylinder r={r:g} m L={length:g} m: strip-theory added mass (Ca=1), "
+        f"axial k1={k_axial:.3f}, Cd={cd_x:g}/{cd_a:g}",
     )
 
 
@@ -392,16 +409,13 @@ def box_hydro(
             rho * cd * lz * (lx**4 + ly**4) / 64.0,
         ]
     )
-    return HydroParams(
-        volume_m3=volume,
-        center_of_buoyancy_m=np.zeros(3),
-        added_mass=added,
-        linear_damping=_linear_from_quadratic(
-            quadratic, linear_damping_reference_speed_m_s, linear_damping_reference_rate_rad_s
-        ),
-        quadratic_damping=quadratic,
-        derived=True,
-        origin=(f"box {lx:g}x{ly:g}x{lz:g} m: equal-volume ellipsoid added mass (Lamb), Cd={cd:g}"),
+    return _at_centre(
+        volume,
+        added,
+        quadratic,
+        linear_damping_reference_speed_m_s,
+        linear_damping_reference_rate_rad_s,
+        f"box {lx:g}x{ly:g}x{lz:g} m: equal-volume ellipsoid added mass (Lamb), Cd={cd:g}",
     )
 
 

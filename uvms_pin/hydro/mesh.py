@@ -24,6 +24,7 @@ axes, marked ``derived``, with a note of the method in ``origin``.
 
 from __future__ import annotations
 
+import dataclasses
 import functools
 import math
 from dataclasses import dataclass
@@ -150,23 +151,16 @@ def mesh_hydro(
         primitive = (base, rotation, "box {:.4g}x{:.4g}x{:.4g} m".format(*ext))
     base, rot, label = primitive
     ratio = geometry_.volume_m3 / base.volume_m3
-    scaled = HydroParams(
-        volume_m3=geometry_.volume_m3,
-        center_of_buoyancy_m=np.zeros(3),
-        added_mass=base.added_mass * ratio,
-        linear_damping=base.linear_damping,
-        quadratic_damping=base.quadratic_damping,
-        derived=True,
+    # the primitive's shape with the mesh's volume: added mass scaled, drag kept
+    scaled = dataclasses.replace(
+        base, volume_m3=geometry_.volume_m3, added_mass=base.added_mass * ratio
     )
     moved = geometry.hydro_in_frame(scaled, rot, geometry_.obb_center_m)
     source = "mesh" if geometry_.watertight else "convex hull"
-    return HydroParams(
-        volume_m3=geometry_.volume_m3,
+    # buoyancy acts at the mesh's own centroid, not at the primitive's centre
+    return dataclasses.replace(
+        moved,
         center_of_buoyancy_m=geometry_.centroid_m,
-        added_mass=moved.added_mass,
-        linear_damping=moved.linear_damping,
-        quadratic_damping=moved.quadratic_damping,
-        derived=True,
         origin=(
             f"mesh: V={geometry_.volume_m3:.4g} m^3 from the {source}; bounding {label}, "
             f"added mass scaled by V/V_primitive={ratio:.3f}"

@@ -5,10 +5,7 @@ from __future__ import annotations
 import numpy as np
 
 from uvms_pin.model.uvms import UVMS
-
-
-def _fmt(values: np.ndarray, precision: int = 4) -> str:
-    return " ".join(f"{x:.{precision}g}" for x in values)
+from uvms_pin.results.format import numbers_text
 
 
 def _frame_name(uvms: UVMS, frame_id: int | None) -> str:
@@ -46,11 +43,11 @@ def model_summary(uvms: UVMS) -> str:
         p = body.params
         mark = "*" if p.derived else " "
         lines.append(
-            f" {mark}{body.name} (on joint {model.names[body.joint_id]}): V = {p.volume_m3:.6g} m^3, r_b = [{_fmt(p.center_of_buoyancy_m)}] m"
+            f" {mark}{body.name} (on joint {model.names[body.joint_id]}): V = {p.volume_m3:.6g} m^3, r_b = [{numbers_text(p.center_of_buoyancy_m, 4)}] m"
         )
-        lines.append(f"     added mass diag   [{_fmt(np.diag(p.added_mass))}]")
-        lines.append(f"     linear damping    [{_fmt(np.diag(p.linear_damping))}]")
-        lines.append(f"     quadratic damping [{_fmt(p.quadratic_damping)}]")
+        lines.append(f"     added mass diag   [{numbers_text(np.diag(p.added_mass), 4)}]")
+        lines.append(f"     linear damping    [{numbers_text(np.diag(p.linear_damping), 4)}]")
+        lines.append(f"     quadratic damping [{numbers_text(p.quadratic_damping, 4)}]")
     if not uvms.n_arm_joints:
         return "\n".join([*lines, "", "arm joints: none (vehicle only)"])
     lines += [

@@ -29,17 +29,17 @@ foam's net lift and N_b = m_b (1 - rho / rho_b) the ballast's net weight, clippe
 hull footprint; what the clipping leaves is reported as a residual moment and the static
 angle it causes (moment / (W BG)).
 
-Only the volumes and masses of the foam and ballast are added (their ``<hydrodynamics>``
-hold the volume): the foam slab enlarges the vehicle's envelope, whose added mass and drag
-grow a little, but a slab on top of the hull is not a free plate (``box_hydro`` of a thin
-slab would add a flat plate's large heave added mass): the change is neglected. Re-derive
-the hull's coefficients for the new envelope if the foam is thick.
+`uvms_pin.model.trim_urdf.add_trim_links` writes them into the URDF. Only the volumes and
+masses of the foam and ballast are added (their ``<hydrodynamics>`` hold the volume): the
+foam slab enlarges the vehicle's envelope, whose added mass and drag grow a little, but a
+slab on top of the hull is not a free plate (``box_hydro`` of a thin slab would add a flat
+plate's large heave added mass): the change is neglected. Re-derive the hull's
+coefficients for the new envelope if the foam is thick.
 """
 
 from __future__ import annotations
 
 import math
-import xml.etree.ElementTree as ET
 from dataclasses import asdict, dataclass, field
 
 import numpy as np
@@ -48,7 +48,7 @@ import pinocchio as pin
 from uvms_pin.errors import ParameterError
 from uvms_pin.model.uvms import UVMS
 
-__all__ = ["TrimReport", "TrimSpec", "add_trim_links", "mass_properties", "plan_trim"]
+__all__ = ["TrimReport", "TrimSpec", "mass_properties", "plan_trim"]
 
 LEAD_DENSITY_KG_M3 = 11340.0
 _FIXED_POINT_PASSES = 8
@@ -188,6 +188,88 @@ def plan_trim(
             f"foam ({rho_f} kg/m^3) must be lighter and ballast ({rho_b} kg/m^3) denser than "
             f"the water ({rho} kg/m^3)"
         )
+    footprint = _footprint(spec, hull)
+    before = _MassProperties(*mass_properties(uvms, q))
+    foam_v, ballast_m = _foam_and_ballast(before, spec, rho, footprint)
+    foam_m = rho_f * foam_v
+    ballast_v = ballast_m / rho_b
+    z_f, z_b, notes = _heights(before, spec, rho, footprint, foam_v, ballast_m)
+    lift = (rho - rho_f) * foam_v
+    sink = ballast_m - rho * ballast_v
+    foam_xy, ballast_xy, residual = _level(before, rho, footprint, lift, sink)
+    foam_pos = np.array([foam_xy[0], foam_xy[1], z_f])
+    ballast_pos = np.array([ballast_xy[0], ballast_xy[1], z_b])
+
+    mass, com, volume, cob = before.mass_kg, before.com_m, before.volume_m3, before.cob_m
+    mass_after = mass + foam_m + ballast_m
+    volume_after = volume + foam_v + ballast_v
+    com_after = (mass * com + foam_m * foam_pos + ballast_m * ballast_pos) / mass_after
+    cob_after = (volume * cob + foam_v * foam_pos + ballast_v * ballast_pos) / volume_after
+    bg_after = float(cob_after[2] - com_after[2])
+    if abs(bg_after - spec.bg_m) > 1e-4:
+        side = "more" if bg_after > spec.bg_m else "less"
+        notes.append(
+            f"BG target {spec.bg_m * 100:.2f} cm not reachable with foam and ballast within the "
+            f"hull's height: BG = {bg_after * 100:.2f} cm ({side} stable than asked)"
+        )
+    moment, tilt = _residual_tilt(residual, mass_after * g, bg_after, g)
+    if np.any(np.abs(residual) > 1e-9):
+        notes.append(
+            "foam/ballast offsets clipped to the hull footprint: the vehicle rests at roll "
+            f"{math.degrees(tilt[0]):.1f} deg, pitch {math.degrees(tilt[1]):.1f} deg"
+        )
+    return TrimReport(
+        foam_volume_m3=foam_v,
+        foam_mass_kg=foam_m,
+        foam_size_m=(float(footprint.lx_m), float(footprint.ly_m), foam_v / footprint.area_m2),
+        foam_position_m=foam_pos,
+        ballast_mass_kg=ballast_m,
+        ballast_volume_m3=ballast_v,
+        ballast_size_m=(
+            float(footprint.lx_m),
+            float(footprint.ly_m),
+            ballast_v / footprint.area_m2,
+        ),
+        ballast_position_m=ballast_pos,
+        mass_before_kg=mass,
+        mass_after_kg=mass_after,
+        net_buoyancy_before_N=(rho * volume - mass) * g,
+        net_buoyancy_after_N=(rho * volume_after - mass_after) * g,
+        bg_before_m=float(cob[2] - com[2]),
+        bg_target_m=spec.bg_m,
+        bg_after_m=bg_after,
+        residual_moment_Nm=moment,
+        residual_tilt_rad=tilt,
+        notes=notes,
+    )
+
+
+@dataclass(frozen=True)
+class _MassProperties:
+    """The system before trim, in the vehicle frame (`mass_properties`)."""
+
+    mass_kg: float
+    com_m: np.ndarray
+    volume_m3: float
+    cob_m: np.ndarray
+
+
+@dataclass(frozen=True)
+class _Footprint:
+    """Where the slabs go, in the vehicle frame: their (lx, ly) and its centre (x, y), the
+    hull's top (foam on it) and bottom (ballast under it) [m]."""
+
+    lx_m: float
+    ly_m: float
+    center_x_m: float
+    center_y_m: float
+    top_z_m: float
+    bottom_z_m: float
+    area_m2: float
+
+
+def _footprint(spec: TrimSpec, hull: tuple[np.ndarray, np.ndarray] | None) -> _Footprint:
+    """``spec``'s footprint and heights, the hull box's where ``spec`` leaves them None."""
     if hull is None and (
         spec.footprint_m is None or spec.top_z_m is None or spec.bottom_z_m is None
     ):
@@ -203,15 +285,21 @@ def plan_trim(
     area = lx * ly
     if not (area > 0.0 and math.isfinite(area)):
         raise ParameterError(f"trim footprint must be positive, got {lx} x {ly} m")
+    return _Footprint(lx, ly, cx, cy, top, bottom, area)
 
-    mass, com, volume, cob = mass_properties(uvms, q)
-    bg = spec.bg_m
-    notes: list[str] = []
+
+def _foam_and_ballast(
+    before: _MassProperties, spec: TrimSpec, rho: float, footprint: _Footprint
+) -> tuple[float, float]:
+    """(V_f [m^3], m_b [kg]) solving the neutral and BG equations (module docstring); the
+    slab heights move the centroids, hence the fixed-point passes. A negative solution:
+    the one material that keeps the system neutral alone."""
+    mass, com, volume, cob = before.mass_kg, before.com_m, before.volume_m3, before.cob_m
+    rho_f, rho_b, bg = spec.foam_density_kg_m3, spec.ballast_density_kg_m3, spec.bg_m
     foam_v, ballast_m = 0.0, 0.0
-    z_f, z_b = top, bottom
     for _ in range(_FIXED_POINT_PASSES):
-        z_f = top + 0.5 * foam_v / area
-        z_b = bottom - 0.5 * (ballast_m / rho_b) / area
+        z_f = footprint.top_z_m + 0.5 * foam_v / footprint.area_m2
+        z_b = footprint.bottom_z_m - 0.5 * (ballast_m / rho_b) / footprint.area_m2
         a = np.array(
             [
                 [rho - rho_f, rho / rho_b - 1.0],
@@ -225,12 +313,28 @@ def plan_trim(
                 foam_v, ballast_m = (mass - rho * volume) / (rho - rho_f), 0.0
             else:  # floats: ballast only
                 foam_v, ballast_m = 0.0, (mass - rho * volume) / (rho / rho_b - 1.0)
-    foam_v, ballast_m = float(max(foam_v, 0.0)), float(max(ballast_m, 0.0))
+    return float(max(foam_v, 0.0)), float(max(ballast_m, 0.0))
+
+
+def _heights(
+    before: _MassProperties,
+    spec: TrimSpec,
+    rho: float,
+    footprint: _Footprint,
+    foam_v: float,
+    ballast_m: float,
+) -> tuple[float, float, list[str]]:
+    """(z_f, z_b [m], notes): the slabs' centroids on top of and under the hull; with one
+    material only, its height is the free parameter left to reach the BG target (clipped
+    to the hull's height)."""
+    mass, com, volume, cob = before.mass_kg, before.com_m, before.volume_m3, before.cob_m
+    rho_f, bg = spec.foam_density_kg_m3, spec.bg_m
+    top, bottom, area = footprint.top_z_m, footprint.bottom_z_m, footprint.area_m2
     foam_m = rho_f * foam_v
-    ballast_v = ballast_m / rho_b
+    ballast_v = ballast_m / spec.ballast_density_kg_m3
     z_f = top + 0.5 * foam_v / area
     z_b = bottom - 0.5 * ballast_v / area
-    # one material only: its height is the free parameter left to reach the BG target
+    notes: list[str] = []
     weight_bg = bg * (mass + foam_m + ballast_m) - rho * volume * cob[2] + mass * com[2]
     if foam_v > 0.0 and ballast_m == 0.0:
         t = foam_v / area
@@ -246,14 +350,22 @@ def plan_trim(
         z_b = float(np.clip(wanted, bottom - t / 2, top - t / 2))
         if z_b > bottom:
             notes.append(f"ballast raised to z = {z_b:.3f} m (inside the frame) for the BG target")
+    return z_f, z_b, notes
 
-    # level: least-norm horizontal offsets, clipped to the footprint
-    lift = (rho - rho_f) * foam_v
-    sink = ballast_m - rho * ballast_v
+
+def _level(
+    before: _MassProperties, rho: float, footprint: _Footprint, lift: float, sink: float
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(foam (x, y), ballast (x, y) [m], residual [kg m]): the least-norm horizontal offsets
+    that leave no pitch or roll moment, L_f x_f - N_b x_b = M x_G - rho V x_B (``lift``
+    L_f, ``sink`` N_b as masses), clipped to the footprint; the residual is the moment
+    (as mass * m, about y for x, about x for y) the clipping leaves."""
+    mass, com, volume, cob = before.mass_kg, before.com_m, before.volume_m3, before.cob_m
+    cx, cy = footprint.center_x_m, footprint.center_y_m
     foam_xy = np.array([cx, cy], dtype=float)
     ballast_xy = np.array([cx, cy], dtype=float)
-    residual = np.zeros(2)  # moments about y (x offsets) and x (y offsets), as mass * m
-    half = np.array([lx, ly]) / 2
+    residual = np.zeros(2)
+    half = np.array([footprint.lx_m, footprint.ly_m]) / 2
     center = np.array([cx, cy])
     for k in range(2):
         # about the footprint centre: L (x_f - c) - N (x_b - c) = D - (L - N) c
@@ -267,128 +379,23 @@ def plan_trim(
         foam_xy[k] = center[k] + df
         ballast_xy[k] = center[k] + db
         residual[k] = demand - (lift * df - sink * db)
-    foam_pos = np.array([foam_xy[0], foam_xy[1], z_f])
-    ballast_pos = np.array([ballast_xy[0], ballast_xy[1], z_b])
+    return foam_xy, ballast_xy, residual
 
-    mass_after = mass + foam_m + ballast_m
-    volume_after = volume + foam_v + ballast_v
-    com_after = (mass * com + foam_m * foam_pos + ballast_m * ballast_pos) / mass_after
-    cob_after = (volume * cob + foam_v * foam_pos + ballast_v * ballast_pos) / volume_after
-    bg_after = float(cob_after[2] - com_after[2])
-    if abs(bg_after - bg) > 1e-4:
-        side = "more" if bg_after > bg else "less"
-        notes.append(
-            f"BG target {bg * 100:.2f} cm not reachable with foam and ballast within the hull's "
-            f"height: BG = {bg_after * 100:.2f} cm ({side} stable than asked)"
-        )
-    weight = mass_after * g
-    # residual weight moment [kg m]: excess weight at +x pitches the nose down (+ about y),
-    # at +y rolls to the left side down (- about x): r x (0, 0, -W)
-    moment_roll = -residual[1] * g
-    moment_pitch = residual[0] * g
-    stiffness = weight * max(bg_after, 1e-9)
+
+def _residual_tilt(
+    residual_kg_m: np.ndarray, weight_N: float, bg_m: float, g: float
+) -> tuple[np.ndarray, np.ndarray]:
+    """(roll, pitch) moment [N m] the clipped offsets leave, and the static tilt [rad] it
+    causes against the righting stiffness W BG."""
+    # excess weight at +x pitches the nose down (+ about y), at +y rolls to the left side
+    # down (- about x): r x (0, 0, -W)
+    moment_roll = -residual_kg_m[1] * g
+    moment_pitch = residual_kg_m[0] * g
+    stiffness = weight_N * max(bg_m, 1e-9)
     tilt = np.array(
         [
             math.asin(max(-1.0, min(1.0, moment_roll / stiffness))),
             math.asin(max(-1.0, min(1.0, moment_pitch / stiffness))),
         ]
     )
-    if np.any(np.abs(residual) > 1e-9):
-        notes.append(
-            "foam/ballast offsets clipped to the hull footprint: the vehicle rests at roll "
-            f"{math.degrees(tilt[0]):.1f} deg, pitch {math.degrees(tilt[1]):.1f} deg"
-        )
-    return TrimReport(
-        foam_volume_m3=foam_v,
-        foam_mass_kg=foam_m,
-        foam_size_m=(float(lx), float(ly), foam_v / area),
-        foam_position_m=foam_pos,
-        ballast_mass_kg=ballast_m,
-        ballast_volume_m3=ballast_v,
-        ballast_size_m=(float(lx), float(ly), ballast_v / area),
-        ballast_position_m=ballast_pos,
-        mass_before_kg=mass,
-        mass_after_kg=mass_after,
-        net_buoyancy_before_N=(rho * volume - mass) * g,
-        net_buoyancy_after_N=(rho * volume_after - mass_after) * g,
-        bg_before_m=float(cob[2] - com[2]),
-        bg_target_m=bg,
-        bg_after_m=bg_after,
-        residual_moment_Nm=np.array([moment_roll, moment_pitch]),
-        residual_tilt_rad=tilt,
-        notes=notes,
-    )
-
-
-def _fmt(values) -> str:
-    return " ".join(repr(float(x)) for x in values)
-
-
-def _slab_link(
-    name: str, mass: float, size: tuple[float, float, float], hydro: ET.Element
-) -> ET.Element:
-    lx, ly, lz = size
-    link = ET.Element("link", {"name": name})
-    inertial = ET.SubElement(link, "inertial")
-    ET.SubElement(inertial, "origin", {"xyz": "0 0 0", "rpy": "0 0 0"})
-    ET.SubElement(inertial, "mass", {"value": repr(float(mass))})
-    ixx, iyy, izz = (
-        mass * (ly * ly + lz * lz) / 12.0,
-        mass * (lx * lx + lz * lz) / 12.0,
-        mass * (lx * lx + ly * ly) / 12.0,
-    )
-    ET.SubElement(
-        inertial,
-        "inertia",
-        {
-            "ixx": repr(float(ixx)),
-            "iyy": repr(float(iyy)),
-            "izz": repr(float(izz)),
-            "ixy": "0",
-            "ixz": "0",
-            "iyz": "0",
-        },
-    )
-    visual = ET.SubElement(link, "visual")
-    geom = ET.SubElement(visual, "geometry")
-    ET.SubElement(geom, "box", {"size": _fmt([lx, ly, max(lz, 1e-4)])})
-    link.append(hydro)
-    return link
-
-
-def _hydro_element(volume: float) -> ET.Element:
-    element = ET.Element("hydrodynamics")
-    ET.SubElement(element, "volume", {"value": repr(float(volume))})
-    ET.SubElement(element, "center_of_buoyancy", {"xyz": "0 0 0"})
-    return element
-
-
-def add_trim_links(root: ET.Element, vehicle_link: str, report: TrimReport) -> None:
-    """Append the foam and ballast as fixed links of ``vehicle_link`` to a URDF tree."""
-    items = []
-    if report.foam_volume_m3 > 0.0:
-        items.append(
-            (
-                "trim_foam",
-                report.foam_mass_kg,
-                report.foam_size_m,
-                report.foam_position_m,
-                _hydro_element(report.foam_volume_m3),
-            )
-        )
-    if report.ballast_mass_kg > 0.0:
-        items.append(
-            (
-                "trim_ballast",
-                report.ballast_mass_kg,
-                report.ballast_size_m,
-                report.ballast_position_m,
-                _hydro_element(report.ballast_volume_m3),
-            )
-        )
-    for name, mass, size, position, hydro in items:
-        root.append(_slab_link(name, mass, size, hydro))
-        joint = ET.SubElement(root, "joint", {"name": f"{name}_joint", "type": "fixed"})
-        ET.SubElement(joint, "parent", {"link": vehicle_link})
-        ET.SubElement(joint, "child", {"link": name})
-        ET.SubElement(joint, "origin", {"xyz": _fmt(position), "rpy": "0 0 0"})
+    return np.array([moment_roll, moment_pitch]), tilt

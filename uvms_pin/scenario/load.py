@@ -22,7 +22,8 @@ from typing import Any
 
 from uvms_pin.errors import ParameterError, ScenarioError, UvmsPinError
 from uvms_pin.model.resources import find_model, shipped_models
-from uvms_pin.model.uvms import UVMS, load_uvms
+from uvms_pin.model.urdf.load import load_uvms
+from uvms_pin.model.uvms import UVMS
 from uvms_pin.scenario.actuation import build_actuation
 from uvms_pin.scenario.baselines import check_baselines
 from uvms_pin.scenario.controller import build_controller

@@ -44,7 +44,7 @@ from uvms_pin.apps.arms.row import COLUMNS
 from uvms_pin.apps.arms.settings import CompareSettings
 from uvms_pin.apps.arms.table import write_comparison
 from uvms_pin.model.mount.catalog import REFERENCE, ArmEntry, resolve_arm
-from uvms_pin.model.mount.mount import hull_box
+from uvms_pin.model.mount.hull import hull_box
 from uvms_pin.model.mount.split import split_urdf
 from uvms_pin.scenario.load import load_scenario
 

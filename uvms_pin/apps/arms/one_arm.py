@@ -29,8 +29,9 @@ from uvms_pin.apps.arms.row import nan_row, write_row
 from uvms_pin.apps.arms.settings import CompareSettings
 from uvms_pin.errors import ScenarioError, UvmsPinError
 from uvms_pin.model.mount.catalog import REFERENCE, ArmEntry, resolve_arm
-from uvms_pin.model.mount.mount import MountResult, mount_arm_detailed, write_text_atomic
+from uvms_pin.model.mount.mount import MountResult, mount_arm_detailed
 from uvms_pin.model.uvms import UVMS
+from uvms_pin.results.atomic import write_text_atomic
 from uvms_pin.scenario.load import load_scenario
 from uvms_pin.sim.run import Scenario
 
@@ -204,6 +205,7 @@ def _trimmed(
     into ``row``), its model saved at ``model_path``, and the trim's notes; without
     ``settings.trim``, ``mounted`` as it is (its model saved) and no notes."""
     if job.settings.trim is None:
+        model_path.parent.mkdir(parents=True, exist_ok=True)
         write_text_atomic(model_path, mounted.urdf_text)
         return mounted, ""
     trimmed = _mount(

@@ -14,7 +14,7 @@ from pathlib import Path
 from uvms_pin.apps.arms.figure import comparison_figure
 from uvms_pin.apps.arms.row import COLUMNS
 from uvms_pin.apps.arms.settings import CompareSettings
-from uvms_pin.model.mount.mount import write_text_atomic
+from uvms_pin.results.atomic import write_text_atomic
 from uvms_pin.results.format import cell_text
 
 
@@ -23,6 +23,7 @@ def write_comparison(
 ) -> list[Path]:
     """``comparison.csv``, ``comparison.md`` and ``comparison.png`` (atomically)."""
     out = Path(out_dir)
+    out.mkdir(parents=True, exist_ok=True)
     write_text_atomic(out / "comparison.csv", _csv_text(rows))
     write_text_atomic(out / "comparison.md", _markdown(rows, scenario, settings))
     return [out / "comparison.csv", out / "comparison.md", comparison_figure(rows, out)]

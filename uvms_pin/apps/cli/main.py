@@ -141,7 +141,7 @@ def _add_view_options(parser: argparse.ArgumentParser) -> None:
 
 def _cmd_info(args: argparse.Namespace) -> int:
     from uvms_pin.model.summary import model_summary
-    from uvms_pin.model.uvms import load_uvms
+    from uvms_pin.model.urdf.load import load_uvms
 
     uvms = load_uvms(find_model(args.urdf) or args.urdf, water_density_kg_m3=args.water_density)
     print(model_summary(uvms))

@@ -43,7 +43,9 @@ import pinocchio as pin
 from uvms_pin.errors import ModelError, ParameterError
 from uvms_pin.hydro.mesh import load_mesh_geometry
 from uvms_pin.model.resources import resolve_resource
-from uvms_pin.model.uvms import UVMS, _numbers, _origin
+from uvms_pin.model.urdf.read import read_numbers, read_origin
+from uvms_pin.model.uvms import UVMS
+from uvms_pin.results.format import numbers_text
 
 __all__ = ["MUJOCO_DEFAULT_FLUID_COEFFICIENTS", "MjcfOptions", "uvms_to_mjcf"]
 
@@ -55,6 +57,8 @@ SEA_WATER_VISCOSITY_PA_S = 1.08e-3
 SPRING_ANCHOR_SITE = "spring_anchor"
 SPRING_TENDON = "spring"
 _CARRIER_SUFFIX = "/buoyancy"
+#: Significant digits of every number written: 17 make any double round-trip exactly.
+_EXACT_DIGITS = 17
 
 
 @dataclass(frozen=True)
@@ -135,11 +139,11 @@ def uvms_to_mjcf(
     option = ET.SubElement(
         root,
         "option",
-        timestep=_fmt(options.timestep_s),
+        timestep=numbers_text(options.timestep_s, _EXACT_DIGITS),
         integrator=options.integrator,
-        density=_fmt(uvms.water_density_kg_m3),
-        viscosity=_fmt(options.viscosity_Pa_s),
-        gravity=_fmt(model.gravity.linear),
+        density=numbers_text(uvms.water_density_kg_m3, _EXACT_DIGITS),
+        viscosity=numbers_text(options.viscosity_Pa_s, _EXACT_DIGITS),
+        gravity=numbers_text(model.gravity.linear, _EXACT_DIGITS),
     )
     ET.SubElement(option, "flag", contact="disable")
     world = ET.SubElement(root, "worldbody")
@@ -209,9 +213,11 @@ def _joint_body(
             "joint",
             name=model.names[j],
             type=kind,
-            axis=_fmt(direction),
-            armature=_fmt(model.armature[idx]),
-            range=_fmt([model.lowerPositionLimit[idx_q], model.upperPositionLimit[idx_q]]),
+            axis=numbers_text(direction, _EXACT_DIGITS),
+            armature=numbers_text(model.armature[idx], _EXACT_DIGITS),
+            range=numbers_text(
+                [model.lowerPositionLimit[idx_q], model.upperPositionLimit[idx_q]], _EXACT_DIGITS
+            ),
             limited="false",
         )
     inertia = model.inertias[j]
@@ -250,10 +256,16 @@ def _add_carrier(
         body,
         "body",
         name=name + _CARRIER_SUFFIX,
-        pos=_fmt(center),
-        gravcomp=_fmt(buoyancy_kg / carrier_kg),
+        pos=numbers_text(center, _EXACT_DIGITS),
+        gravcomp=numbers_text(buoyancy_kg / carrier_kg, _EXACT_DIGITS),
     )
-    ET.SubElement(carrier, "inertial", pos="0 0 0", mass=_fmt(carrier_kg), diaginertia="0 0 0")
+    ET.SubElement(
+        carrier,
+        "inertial",
+        pos="0 0 0",
+        mass=numbers_text(carrier_kg, _EXACT_DIGITS),
+        diaginertia="0 0 0",
+    )
     return kept
 
 
@@ -267,7 +279,11 @@ def _inertial(body: ET.Element, inertia: pin.Inertia) -> None:
     i = inertia.inertia
     full = [i[0, 0], i[1, 1], i[2, 2], i[0, 1], i[0, 2], i[1, 2]]
     ET.SubElement(
-        body, "inertial", pos=_fmt(inertia.lever), mass=_fmt(inertia.mass), fullinertia=_fmt(full)
+        body,
+        "inertial",
+        pos=numbers_text(inertia.lever, _EXACT_DIGITS),
+        mass=numbers_text(inertia.mass, _EXACT_DIGITS),
+        fullinertia=numbers_text(full, _EXACT_DIGITS),
     )
 
 
@@ -291,7 +307,7 @@ def _add_fluid_geoms(
             continue
         frame = model.frames[model.getFrameId(name, pin.FrameType.BODY)]
         for k, collision in enumerate(collisions):
-            placement = frame.placement * _origin(collision.find("origin"), "urdf_text", name)
+            placement = frame.placement * read_origin(collision.find("origin"), "urdf_text", name)
             kind, size, local = _shape(collision, name, base_dir, package_dirs)
             _placed(
                 bodies[frame.parentJoint],
@@ -299,9 +315,9 @@ def _add_fluid_geoms(
                 placement * local,
                 name=f"{name}/collision[{k}]",
                 type=kind,
-                size=_fmt(size),
+                size=numbers_text(size, _EXACT_DIGITS),
                 fluidshape="ellipsoid",
-                fluidcoef=_fmt(options.fluid_coefficients),
+                fluidcoef=numbers_text(options.fluid_coefficients, _EXACT_DIGITS),
                 contype="0",
                 conaffinity="0",
             )
@@ -317,19 +333,19 @@ def _shape(
     if shape is None:
         raise ModelError("<collision> has no <geometry> shape", path=where, link=link)
     if shape.tag == "box":
-        return "box", 0.5 * _numbers(shape.get("size"), 3, "<box size>", where, link), _EYE
+        return "box", 0.5 * read_numbers(shape.get("size"), 3, "<box size>", where, link), _EYE
     if shape.tag == "cylinder":
-        radius = _numbers(shape.get("radius"), 1, "<cylinder radius>", where, link)[0]
-        length = _numbers(shape.get("length"), 1, "<cylinder length>", where, link)[0]
+        radius = read_numbers(shape.get("radius"), 1, "<cylinder radius>", where, link)[0]
+        length = read_numbers(shape.get("length"), 1, "<cylinder length>", where, link)[0]
         return "cylinder", np.array([radius, 0.5 * length]), _EYE
     if shape.tag == "sphere":
-        return "sphere", _numbers(shape.get("radius"), 1, "<sphere radius>", where, link), _EYE
+        return "sphere", read_numbers(shape.get("radius"), 1, "<sphere radius>", where, link), _EYE
     if shape.tag == "mesh":
         filename = shape.get("filename", "")
         resolved = resolve_resource(filename, base_dir, package_dirs)
         if resolved is None:
             raise ModelError(f"collision mesh '{filename}' not found", path=where, link=link)
-        scale = _numbers(shape.get("scale", "1 1 1"), 3, "<mesh scale>", where, link)
+        scale = read_numbers(shape.get("scale", "1 1 1"), 3, "<mesh scale>", where, link)
         mesh = load_mesh_geometry(resolved, scale)
         half = np.maximum(0.5 * mesh.obb_extents_m, 5e-5)
         return "box", half, pin.SE3(mesh.obb_rotation, mesh.obb_center_m)
@@ -343,10 +359,17 @@ _EYE = pin.SE3.Identity()
 
 
 def _spring(root: ET.Element, world: ET.Element, ee_site: str, options: MjcfOptions) -> None:
-    ET.SubElement(world, "site", name=SPRING_ANCHOR_SITE, pos=_fmt(options.spring_anchor_world_m))
+    ET.SubElement(
+        world,
+        "site",
+        name=SPRING_ANCHOR_SITE,
+        pos=numbers_text(options.spring_anchor_world_m, _EXACT_DIGITS),
+    )
     tendon = ET.SubElement(ET.SubElement(root, "tendon"), "spatial")
     tendon.attrib.update(
-        name=SPRING_TENDON, stiffness=_fmt(options.spring_stiffness_N_m), springlength="0 0"
+        name=SPRING_TENDON,
+        stiffness=numbers_text(options.spring_stiffness_N_m, _EXACT_DIGITS),
+        springlength="0 0",
     )
     ET.SubElement(tendon, "site", site=ee_site)
     ET.SubElement(tendon, "site", site=SPRING_ANCHOR_SITE)
@@ -356,11 +379,6 @@ def _placed(parent: ET.Element, tag: str, placement: pin.SE3, **attrib: str) -> 
     """A child element at ``placement`` (pos, and quat w x y z) in its parent's frame."""
     xyzw = pin.Quaternion(placement.rotation).coeffs()
     element = ET.SubElement(parent, tag, **attrib)
-    element.set("pos", _fmt(placement.translation))
-    element.set("quat", _fmt([xyzw[3], xyzw[0], xyzw[1], xyzw[2]]))
+    element.set("pos", numbers_text(placement.translation, _EXACT_DIGITS))
+    element.set("quat", numbers_text([xyzw[3], xyzw[0], xyzw[1], xyzw[2]], _EXACT_DIGITS))
     return element
-
-
-def _fmt(values) -> str:
-    """Numbers as text, round-trip exact (17 significant digits)."""
-    return " ".join(f"{float(x):.17g}" for x in np.atleast_1d(np.asarray(values, dtype=float)))

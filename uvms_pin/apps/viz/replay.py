@@ -32,7 +32,8 @@ from uvms_pin.apps.viz.meshcat_scene import (
 from uvms_pin.apps.viz.surface import SurfaceView
 from uvms_pin.errors import VizError
 from uvms_pin.flow import FlowField, flow_from_record
-from uvms_pin.model.uvms import DEFAULT_WATER_DENSITY_KG_M3, load_uvms
+from uvms_pin.model.urdf.load import load_uvms
+from uvms_pin.model.uvms import DEFAULT_WATER_DENSITY_KG_M3
 from uvms_pin.results.atomic import write_text_atomic
 from uvms_pin.results.rollout import Rollout
 

@@ -1,40 +1,41 @@
 """Mount any arm URDF on a vehicle URDF: one UVMS from two files (docs/api.md).
 
 The two files are merged into one URDF, written to a temporary directory and loaded with
-:func:`uvms_pin.model.uvms.load_uvms`, so the hydrodynamic extension, the derivation of missing
-coefficients from collision geometry (meshes included) and every check of the loader apply
-unchanged; the temporary file is removed before returning.
+:func:`uvms_pin.model.urdf.load.load_uvms`, so the hydrodynamic extension, the derivation of
+missing coefficients from collision geometry (meshes included) and every check of the loader
+apply unchanged; the temporary file is removed before returning.
 
-What the merge does, in order:
+What the merge does, in order (`uvms_pin.model.mount.merge`; the module doing each step in
+brackets):
 
 1. Checks both trees: every joint names existing links, no link has two parents (a closed
-   chain), one root per file. Errors name the file, the link or joint, and what is wrong.
+   chain), one root per file. Errors name the file, the link or joint, and what is wrong
+   (``tree``).
 2. Keeps the arm's subtree below ``arm_base_link`` (default: the arm's root) and chooses the
    end-effector (wrist) link ``ee_link`` if not given: follow the arm from its base while one
    single branch carries moving joints, stop before a branch or a gripper joint (a name with
-   finger, gripper, jaw or hand).
+   finger, gripper, jaw or hand) (``selection``).
 3. The arm's moving joints on the path base -> ``ee_link`` are the UVMS joints; every other
    moving joint (gripper fingers, a second branch) is locked (made fixed) at
    ``lock_positions[name]``, default 0 clipped into its limits. Continuous joints on the path
    become revolute with limits +-2 pi (so q has one angle per joint, as the rest of uvms-pin
-   assumes).
-4. Renames the arm's links and joints that clash with the vehicle's (prefix ``arm_``),
-   resolves every mesh path (``package://``, relative, ``file://``; see
-   :mod:`uvms_pin.model.resources`) to an absolute path, and drops the arm's ``<transmission>``,
-   ``<gazebo>`` and other non-kinematic elements.
+   assumes) (``joints``).
+4. Renames the arm's links and joints that clash with the vehicle's (prefix ``arm_``)
+   (``names``), resolves every mesh path (``package://``, relative, ``file://``; see
+   :mod:`uvms_pin.model.resources`) to an absolute path (``links``), and drops the arm's
+   ``<transmission>``, ``<gazebo>`` and other non-kinematic elements.
 5. Attaches the arm base to ``vehicle_link`` (default: the vehicle's root) with a fixed joint
-   at ``mount_pose``.
+   at ``mount_pose`` (``pose``).
 6. Adds a fixed F/T sensor frame ``ft_sensor`` at ``ee_link``, its x axis along the tool axis,
    then the tool (a probe like the reference arm's: link ``tool`` with inertial and collision
    cylinder, coefficients derived) and the end-effector frame ``ee`` at its tip, x forward
-   along the probe. With ``tool=None`` the ``ee`` frame is the sensor frame.
-7. Optionally trims the system (:mod:`uvms_pin.model.trim`): foam and ballast links on the vehicle.
+   along the probe. With ``tool=None`` the ``ee`` frame is the sensor frame (``tool``).
+7. Optionally trims the system (:mod:`uvms_pin.model.trim`): foam and ballast links on the
+   vehicle (:mod:`uvms_pin.model.trim_urdf`).
 """
 
 from __future__ import annotations
 
-import copy
-import math
 import tempfile
 import warnings
 import xml.etree.ElementTree as ET
@@ -43,56 +44,19 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
-import pinocchio as pin
 
 from uvms_pin.errors import ModelError, ParameterError
 from uvms_pin.model.mount.catalog import ArmEntry, resolve_arm
-from uvms_pin.model.resources import find_model, resolve_resource
-from uvms_pin.model.uvms import DEFAULT_WATER_DENSITY_KG_M3, UVMS, load_uvms, read_urdf_root
-from uvms_pin.results import atomic
+from uvms_pin.model.mount.merge import MergedURDF, merge_urdf
+from uvms_pin.model.mount.text import urdf_text, write_text_file
+from uvms_pin.model.mount.tool import REFERENCE_PROBE, ProbeTool
+from uvms_pin.model.resources import find_model
+from uvms_pin.model.trim import TrimReport, TrimSpec, plan_trim
+from uvms_pin.model.trim_urdf import add_trim_links
+from uvms_pin.model.urdf.load import load_uvms
+from uvms_pin.model.uvms import DEFAULT_WATER_DENSITY_KG_M3, UVMS
 
-__all__ = [
-    "MountResult",
-    "ProbeTool",
-    "hull_box",
-    "merge_urdf",
-    "mount_arm",
-    "mount_arm_detailed",
-    "parse_mount_pose",
-]
-
-_MOVING = ("revolute", "continuous", "prismatic")
-_GRIPPER_WORDS = ("finger", "gripper", "jaw", "hand")
-_KEEP_TOP_LEVEL = ("link", "joint", "material", "hydrodynamics")
-_CONTINUOUS_LIMIT_RAD = 2.0 * math.pi
-_RENAME_PREFIX = "arm_"
-_AXES = {
-    "x": (1.0, 0.0, 0.0),
-    "y": (0.0, 1.0, 0.0),
-    "z": (0.0, 0.0, 1.0),
-    "-x": (-1.0, 0.0, 0.0),
-    "-y": (0.0, -1.0, 0.0),
-    "-z": (0.0, 0.0, -1.0),
-}
-
-
-@dataclass(frozen=True)
-class ProbeTool:
-    """A rigid probe on the wrist: a solid cylinder along the tool axis, tip = ``ee``.
-
-    Defaults are the reference arm's probe (models/README.md section 3): 0.08 m long,
-    radius 8 mm, 50 g (steel-tipped, slightly heavier than the water it displaces).
-    """
-
-    length_m: float = 0.08
-    radius_m: float = 0.008
-    mass_kg: float = 0.05
-
-    def __post_init__(self) -> None:
-        for name in ("length_m", "radius_m", "mass_kg"):
-            value = getattr(self, name)
-            if not (math.isfinite(value) and value > 0.0):
-                raise ParameterError(f"ProbeTool.{name} must be finite and > 0, got {value}")
+__all__ = ["MountResult", "mount_arm", "mount_arm_detailed"]
 
 
 @dataclass
@@ -184,7 +148,7 @@ def mount_arm_detailed(
     vehicle_link: str | None = None,
     sensor_link: str | None = None,
     tool_axis: str | Sequence[float] = "auto",
-    tool: ProbeTool | None = ProbeTool(),
+    tool: ProbeTool | None = REFERENCE_PROBE,
     lock_positions: Mapping[str, float] | None = None,
     water_density_kg_m3: float = DEFAULT_WATER_DENSITY_KG_M3,
     package_dirs: Sequence[str | Path] = (),
@@ -248,26 +212,64 @@ def mount_arm_detailed(
         package_dirs=package_dirs,
     )
     source = f"mount_arm({vehicle_urdf} + {arm_urdf})"
-    uvms = _load_text(merged.root, source, **load_kw)
+    uvms = _load_merged(merged.root, source, **load_kw)
     report = None
     if trim:
-        from uvms_pin.model.trim import TrimSpec, add_trim_links, plan_trim
-
         spec = trim if isinstance(trim, TrimSpec) else TrimSpec()
-        q = uvms.neutral_configuration()
-        if trim_joint_positions is not None:
-            joints = np.asarray(trim_joint_positions, dtype=float).reshape(-1)
-            if joints.shape != (uvms.n_arm_joints,) or not np.all(np.isfinite(joints)):
-                raise ParameterError(
-                    f"trim_joint_positions needs {uvms.n_arm_joints} finite numbers, got {joints}"
-                )
-            q[7:] = joints
-        report = plan_trim(uvms, q, spec, hull=merged.hull_box)
-        add_trim_links(merged.root, merged.vehicle_link, report)
-        uvms = _load_text(merged.root, source, **load_kw)
-    text = _to_text(merged.root)
+        report = _add_trim(uvms, merged, spec, trim_joint_positions)
+        uvms = _load_merged(merged.root, source, **load_kw)
+    text = urdf_text(merged.root)
     if save_urdf is not None:
-        write_text_atomic(Path(save_urdf), text)
+        write_text_file(save_urdf, text)
+    return _result(merged, uvms, text, report)
+
+
+def _catalog_entry(arm: str | Path | ArmEntry) -> ArmEntry | None:
+    """The catalogue entry ``arm`` names (an ArmEntry, or a name that is not a file)."""
+    if isinstance(arm, ArmEntry):
+        return resolve_arm(arm)
+    if isinstance(arm, str) and not Path(arm).is_file() and Path(arm).suffix.lower() != ".urdf":
+        return resolve_arm(arm)  # a catalogue name, else a ParameterError listing them
+    return None
+
+
+def _load_merged(root: ET.Element, source: str, **load_kw) -> UVMS:
+    """Write the merged tree to a private temporary directory, load it, remove it; errors
+    name ``source`` (the two files), not the temporary file."""
+    with tempfile.TemporaryDirectory(prefix="uvms_pin_mount_") as tmp:
+        path = Path(tmp) / "merged.urdf"
+        path.write_text(urdf_text(root))
+        try:
+            uvms = load_uvms(path, **load_kw)
+        except ModelError as exc:
+            raise ModelError(str(exc).replace(str(path), source)) from exc
+    uvms.source = source
+    return uvms
+
+
+def _add_trim(
+    uvms: UVMS,
+    merged: MergedURDF,
+    spec: TrimSpec,
+    trim_joint_positions: Sequence[float] | None,
+) -> TrimReport:
+    """Plan the trim of ``uvms`` with the arm at ``trim_joint_positions`` [rad or m]
+    (default: neutral) and add the foam and ballast links to the merged tree."""
+    q = uvms.neutral_configuration()
+    if trim_joint_positions is not None:
+        joints = np.asarray(trim_joint_positions, dtype=float).reshape(-1)
+        if joints.shape != (uvms.n_arm_joints,) or not np.all(np.isfinite(joints)):
+            raise ParameterError(
+                f"trim_joint_positions needs {uvms.n_arm_joints} finite numbers, got {joints}"
+            )
+        q[7:] = joints
+    report = plan_trim(uvms, q, spec, hull=merged.hull_box)
+    add_trim_links(merged.root, merged.vehicle_link, report)
+    return report
+
+
+def _result(merged: MergedURDF, uvms: UVMS, text: str, report: TrimReport | None) -> MountResult:
+    """The `MountResult` of a merge, the system loaded from it, its text and trim report."""
     return MountResult(
         uvms=uvms,
         urdf_text=text,
@@ -282,737 +284,3 @@ def mount_arm_detailed(
         removed_links=merged.removed_links,
         removed_joints=merged.removed_joints,
     )
-
-
-@dataclass
-class MergedURDF:
-    """The merged tree and what :func:`mount_arm_detailed` needs to load it."""
-
-    root: ET.Element
-    ee_frame: str
-    sensor_frame: str
-    vehicle_link: str
-    arm_joints: list[str]
-    locked: dict[str, float]
-    renamed: dict[str, str]
-    arm_base_link: str
-    ee_link: str
-    tool_axis: np.ndarray
-    dry_links: list[str]
-    hull_box: tuple[np.ndarray, np.ndarray] | None
-    removed_links: list[str] = field(default_factory=list)
-    removed_joints: list[str] = field(default_factory=list)
-
-
-def merge_urdf(
-    vehicle_urdf: str | Path,
-    arm_urdf: str | Path,
-    mount_pose,
-    *,
-    arm_base_link: str | None = None,
-    ee_link: str | None = None,
-    vehicle_link: str | None = None,
-    sensor_link: str | None = None,
-    tool_axis: str | Sequence[float] = "auto",
-    tool: ProbeTool | None = ProbeTool(),
-    lock_positions: Mapping[str, float] | None = None,
-    package_dirs: Sequence[str | Path] = (),
-    allow_dry_links: bool = False,
-    keep_existing_arm: bool = False,
-) -> MergedURDF:
-    """Build the merged URDF tree (steps 1-6 of the module docstring); nothing is written."""
-    placement = parse_mount_pose(mount_pose)
-    vpath, apath = Path(vehicle_urdf), Path(arm_urdf)
-    vehicle = _Tree.read(vpath)
-    arm = _Tree.read(apath)
-    removed_links, removed_joints = ([], []) if keep_existing_arm else _existing_arm(vehicle)
-    vlink = (
-        vehicle.root_link
-        if vehicle_link is None
-        else vehicle.require_link(vehicle_link, "vehicle_link")
-    )
-    if vlink in removed_links:
-        raise ModelError(
-            f"vehicle_link '{vlink}' belongs to the arm the vehicle file already carries, which "
-            "is replaced (pass keep_existing_arm=True to mount on it)",
-            path=str(vpath),
-            link=vlink,
-        )
-    base = (
-        arm.root_link if arm_base_link is None else arm.require_link(arm_base_link, "arm_base_link")
-    )
-    subtree = arm.subtree(base)
-    if ee_link is None:
-        ee = arm.choose_ee_link(base)
-    else:
-        ee = arm.require_link(ee_link, "ee_link")
-        if ee not in subtree:
-            raise ModelError(
-                f"ee_link '{ee}' is not below arm_base_link '{base}'", path=str(apath), link=ee
-            )
-    path_joints = arm.path_joints(base, ee)
-    chain = [j for j in path_joints if arm.joints[j].get("type") in _MOVING]
-    if not chain:
-        raise ModelError(
-            f"no moving joint between arm_base_link '{base}' and ee_link '{ee}'", path=str(apath)
-        )
-    if sensor_link is not None:
-        sensor_link = arm.require_link(sensor_link, "sensor_link")
-        if sensor_link not in subtree:
-            raise ModelError(
-                f"sensor_link '{sensor_link}' is not below arm_base_link '{base}'",
-                path=str(apath),
-                link=sensor_link,
-            )
-
-    axis = _tool_axis(arm, tool_axis, chain, ee, apath)
-
-    # ---- the arm's elements, restricted to the subtree, joints converted
-    locks = dict(lock_positions or {})
-    unknown = sorted(set(locks) - set(arm.joints))
-    if unknown:
-        raise ModelError(
-            f"lock_positions names unknown joint(s): {', '.join(unknown)}", path=str(apath)
-        )
-    arm_links = [copy.deepcopy(arm.links[n]) for n in arm.link_order if n in subtree]
-    arm_joints = [
-        copy.deepcopy(arm.joints[n])
-        for n in arm.joint_order
-        if arm.joints[n].find("child").get("link") in subtree
-        and arm.joints[n].find("child").get("link") != base
-    ]
-    locked: dict[str, float] = {}
-    for joint in arm_joints:
-        name = joint.get("name")
-        kind = joint.get("type")
-        if kind in ("floating", "planar"):
-            raise ModelError(
-                f"joint '{name}' is {kind}: an arm may only have revolute, continuous, "
-                "prismatic and fixed joints",
-                path=str(apath),
-            )
-        if kind not in _MOVING and kind != "fixed":
-            raise ModelError(f"joint '{name}' has unknown type '{kind}'", path=str(apath))
-        if name in chain:
-            if joint.find("mimic") is not None:
-                joint.remove(joint.find("mimic"))
-            if kind == "continuous":
-                joint.set("type", "revolute")
-                limit = joint.find("limit")
-                if limit is None:
-                    raise ModelError(
-                        f"continuous joint '{name}' has no <limit effort velocity>",
-                        path=str(apath),
-                    )
-                limit.set("lower", repr(-_CONTINUOUS_LIMIT_RAD))
-                limit.set("upper", repr(_CONTINUOUS_LIMIT_RAD))
-        elif kind in _MOVING:
-            locked[name] = _lock(joint, locks.get(name), apath)
-
-    # ---- renaming clashes, mesh paths
-    vehicle_names = (set(vehicle.links) | set(vehicle.joints)) - set(removed_links + removed_joints)
-    frames = _unique_frame_names(vehicle_names)
-    added_names = {"arm_mount_joint", "trim_foam", "trim_foam_joint"}
-    added_names |= {"trim_ballast", "trim_ballast_joint"}
-    if sensor_link is None:
-        added_names |= {"ft_sensor", "ft_sensor_joint"}
-    if tool is not None:
-        added_names |= {"tool", "tool_joint", "ee", "ee_joint"}
-    elif ee != "ee":
-        added_names |= {"ee", "ee_joint"}
-    renamed: dict[str, str] = {}
-    for element in arm_links + arm_joints:
-        name = element.get("name")
-        if name in vehicle_names or name in added_names:
-            new = _RENAME_PREFIX + name
-            while new in vehicle_names or new in arm.links or new in arm.joints:
-                new = _RENAME_PREFIX + new
-            renamed[name] = new
-    for element in arm_links + arm_joints:
-        if element.get("name") in renamed:
-            element.set("name", renamed[element.get("name")])
-    for joint in arm_joints:
-        for tag in ("parent", "child"):
-            el = joint.find(tag)
-            el.set("link", renamed.get(el.get("link"), el.get("link")))
-        mimic = joint.find("mimic")
-        if mimic is not None and mimic.get("joint") in renamed:
-            mimic.set("joint", renamed[mimic.get("joint")])
-
-    out = ET.Element(
-        "robot", {"name": f"{vehicle.root.get('name', 'vehicle')}+{arm.root.get('name', 'arm')}"}
-    )
-    materials: set[str] = set()
-    dropped = set(removed_links) | set(removed_joints)
-    for element in vehicle.root:
-        if element.get("name") in dropped or element.get("link") in dropped:
-            continue  # the replaced arm (top-level <hydrodynamics link=...> included)
-        if element.tag in _KEEP_TOP_LEVEL:
-            item = copy.deepcopy(element)
-            if item.tag == "material":
-                materials.add(item.get("name"))
-            _resolve_meshes(item, vpath, package_dirs, needs_collision=False)
-            out.append(item)
-    for element in arm.root:
-        if element.tag == "material" and element.get("name") not in materials:
-            out.append(copy.deepcopy(element))
-            materials.add(element.get("name"))
-    for link in arm_links:
-        has_hydro = link.find("hydrodynamics") is not None or any(
-            h.get("link") == _original(link.get("name"), renamed)
-            for h in arm.root.findall("hydrodynamics")
-        )
-        _resolve_meshes(
-            link,
-            apath,
-            package_dirs,
-            needs_collision=not has_hydro,
-            link_name=_original(link.get("name"), renamed),
-        )
-        _strip_undefined_materials(link, materials)
-        out.append(link)
-    dry = _mark_dry_links(arm_links, arm, renamed, allow_dry_links)
-    for element in arm.root.findall("hydrodynamics"):
-        if element.get("link") in subtree:
-            item = copy.deepcopy(element)
-            item.set("link", renamed.get(item.get("link"), item.get("link")))
-            out.append(item)
-    out.extend(arm_joints)
-    base_new = renamed.get(base, base)
-    ee_new = renamed.get(ee, ee)
-    _add_fixed(out, frames["arm_mount_joint"], vlink, base_new, placement)
-
-    # ---- sensor, tool and end-effector frames
-    rot_tool = _rotation_with_x(axis)
-    if sensor_link is None:
-        sensor_frame = frames["ft_sensor"]
-        out.append(ET.Element("link", {"name": sensor_frame}))
-        _add_fixed(
-            out, frames["ft_sensor_joint"], ee_new, sensor_frame, pin.SE3(rot_tool, np.zeros(3))
-        )
-    else:
-        sensor_frame = renamed.get(sensor_link, sensor_link)
-    ee_frame = frames["ee"]
-    if tool is not None:
-        out.append(_probe_link(frames["tool"], tool))
-        _add_fixed(out, frames["tool_joint"], sensor_frame, frames["tool"], pin.SE3.Identity())
-        out.append(ET.Element("link", {"name": ee_frame}))
-        tip = pin.SE3(np.eye(3), np.array([tool.length_m, 0, 0]))
-        _add_fixed(out, frames["ee_joint"], frames["tool"], ee_frame, tip)
-    elif ee_new != ee_frame:
-        out.append(ET.Element("link", {"name": ee_frame}))
-        _add_fixed(out, frames["ee_joint"], sensor_frame, ee_frame, pin.SE3.Identity())
-
-    return MergedURDF(
-        root=out,
-        ee_frame=ee_frame,
-        sensor_frame=sensor_frame,
-        vehicle_link=vlink,
-        arm_joints=[renamed.get(j, j) for j in chain],
-        locked={renamed.get(k, k): v for k, v in locked.items()},
-        renamed=renamed,
-        arm_base_link=base,
-        ee_link=ee,
-        tool_axis=axis,
-        dry_links=dry,
-        hull_box=_box_of(vehicle.links[vlink]),
-        removed_links=removed_links,
-        removed_joints=removed_joints,
-    )
-
-
-_ADDED_FRAMES = ("arm_mount_joint", "ft_sensor", "ft_sensor_joint", "tool", "tool_joint", "ee")
-_ADDED_FRAMES += ("ee_joint",)
-
-
-def _unique_frame_names(taken: set[str]) -> dict[str, str]:
-    """The names of the frames the mount adds (``ee``, ``ft_sensor``, ...), prefixed with
-    ``arm_`` while the vehicle already uses them (a kept arm has its own)."""
-    out = {}
-    for name in _ADDED_FRAMES:
-        new = name
-        while new in taken:
-            new = _RENAME_PREFIX + new
-        out[name] = new
-    return out
-
-
-def _existing_arm(vehicle: _Tree) -> tuple[list[str], list[str]]:
-    """(links, joints) of the arm a vehicle file already carries: everything below each
-    first moving joint (one without a moving joint above it), and the ``ft_sensor``,
-    ``tool`` and ``ee`` frames wherever they hang; empty for a vehicle alone."""
-    starts = []
-    for name in vehicle.joint_order:
-        if vehicle.joints[name].get("type") in _MOVING and not _moving_above(vehicle, name):
-            starts.append(vehicle.child_of(name))
-    starts += [f for f in ("ft_sensor", "tool", "ee") if f in vehicle.parent_joint]
-    links: set[str] = set()
-    for start in starts:
-        links.update(vehicle.subtree(start))
-    ordered_links = [n for n in vehicle.link_order if n in links]
-    joints = [n for n in vehicle.joint_order if vehicle.child_of(n) in links]
-    return ordered_links, joints
-
-
-def _moving_above(tree: _Tree, joint: str) -> bool:
-    link = tree.joints[joint].find("parent").get("link")
-    while link in tree.parent_joint:
-        above = tree.parent_joint[link]
-        if tree.joints[above].get("type") in _MOVING:
-            return True
-        link = tree.joints[above].find("parent").get("link")
-    return False
-
-
-def _catalog_entry(arm: str | Path | ArmEntry) -> ArmEntry | None:
-    """The catalogue entry ``arm`` names (an ArmEntry, or a name that is not a file)."""
-    if isinstance(arm, ArmEntry):
-        return resolve_arm(arm)
-    if isinstance(arm, str) and not Path(arm).is_file() and Path(arm).suffix.lower() != ".urdf":
-        return resolve_arm(arm)  # a catalogue name, else a ParameterError listing them
-    return None
-
-
-def hull_box(urdf: str | Path, link: str | None = None) -> tuple[np.ndarray, np.ndarray] | None:
-    """(centre, full size) [m] of the first box collision of ``link`` (default: the root) in
-    that link's frame, or None: the hull envelope used by the trim and the reach check."""
-    tree = _Tree.read(Path(urdf))
-    name = tree.root_link if link is None else tree.require_link(link, "link")
-    return _box_of(tree.links[name])
-
-
-def parse_mount_pose(mount_pose) -> pin.SE3:
-    """A ``pin.SE3`` from an SE3, a 4x4 matrix or ``(xyz, rpy)``.
-
-    Raises:
-        ParameterError: non-finite numbers, wrong shapes, or a rotation that is not
-            orthonormal with determinant +1.
-    """
-    if isinstance(mount_pose, pin.SE3):
-        rotation, translation = np.array(mount_pose.rotation), np.array(mount_pose.translation)
-    else:
-        try:
-            if isinstance(mount_pose, tuple | list) and len(mount_pose) == 2:
-                xyz = np.asarray(mount_pose[0], dtype=float).reshape(-1)
-                rpy = np.asarray(mount_pose[1], dtype=float).reshape(-1)
-                if xyz.shape != (3,) or rpy.shape != (3,):
-                    raise ParameterError(
-                        f"mount_pose (xyz, rpy) needs 3 + 3 numbers, got {xyz.size} + {rpy.size}"
-                    )
-                if not (np.all(np.isfinite(xyz)) and np.all(np.isfinite(rpy))):
-                    raise ParameterError(f"mount_pose has a non-finite value: {xyz}, {rpy}")
-                return pin.SE3(pin.rpy.rpyToMatrix(*rpy), xyz)
-            matrix = np.asarray(mount_pose, dtype=float)
-        except ParameterError:
-            raise
-        except (TypeError, ValueError) as exc:
-            raise ParameterError(f"mount_pose is not a pose: {mount_pose!r}") from exc
-        if matrix.shape != (4, 4):
-            raise ParameterError(
-                f"mount_pose must be a pin.SE3, a 4x4 matrix or (xyz, rpy), got shape {matrix.shape}"
-            )
-        if not np.allclose(matrix[3], [0.0, 0.0, 0.0, 1.0]) and np.all(np.isfinite(matrix)):
-            raise ParameterError(f"mount_pose last row must be [0 0 0 1], got {matrix[3]}")
-        rotation, translation = matrix[:3, :3], matrix[:3, 3]
-    if not (np.all(np.isfinite(rotation)) and np.all(np.isfinite(translation))):
-        raise ParameterError("mount_pose has a non-finite value")
-    deviation = float(np.max(np.abs(rotation.T @ rotation - np.eye(3))))
-    if deviation > 1e-6 or np.linalg.det(rotation) < 0.0:
-        raise ParameterError(
-            "mount_pose rotation is not a rotation matrix (orthonormal, det +1): "
-            f"max |R^T R - I| = {deviation:.3g}, det = {np.linalg.det(rotation):.6g}"
-        )
-    return pin.SE3(rotation, translation)
-
-
-def write_text_atomic(path: Path, text: str) -> None:
-    """Write ``text`` to ``path`` through a temporary file in the same directory."""
-    path.parent.mkdir(parents=True, exist_ok=True)
-    atomic.write_text_atomic(path, text)
-
-
-# ---------------------------------------------------------------------- the URDF tree
-
-
-class _Tree:
-    """A parsed URDF with its kinematic tree checked (links, joints, parents, root)."""
-
-    def __init__(self, root: ET.Element, path: Path):
-        self.root = root
-        self.path = path
-        where = str(path)
-        self.links: dict[str, ET.Element] = {}
-        self.link_order: list[str] = []
-        for link in root.findall("link"):
-            name = link.get("name")
-            if not name:
-                raise ModelError("a <link> has no name", path=where)
-            if name in self.links:
-                raise ModelError("is defined twice", path=where, link=name)
-            self.links[name] = link
-            self.link_order.append(name)
-        if not self.links:
-            raise ModelError("no <link> elements", path=where)
-        self.joints: dict[str, ET.Element] = {}
-        self.joint_order: list[str] = []
-        self.parent_joint: dict[str, str] = {}
-        self.children: dict[str, list[str]] = {n: [] for n in self.links}
-        for joint in root.findall("joint"):
-            name = joint.get("name")
-            if not name:
-                raise ModelError("a <joint> has no name", path=where)
-            if name in self.joints:
-                raise ModelError(f"joint '{name}' is defined twice", path=where)
-            parent_el, child_el = joint.find("parent"), joint.find("child")
-            if parent_el is None or child_el is None:
-                raise ModelError(f"joint '{name}' needs <parent> and <child>", path=where)
-            parent, child = parent_el.get("link"), child_el.get("link")
-            for role, link in (("parent", parent), ("child", child)):
-                if link not in self.links:
-                    raise ModelError(
-                        f"joint '{name}': unknown {role} link '{link}'", path=where, link=link
-                    )
-            if child in self.parent_joint:
-                raise ModelError(
-                    f"closed chain: the link has two parents (joints '{self.parent_joint[child]}' "
-                    f"and '{name}'); URDF and Pinocchio need a tree",
-                    path=where,
-                    link=child,
-                )
-            self.joints[name] = joint
-            self.joint_order.append(name)
-            self.parent_joint[child] = name
-            self.children[parent].append(name)
-        roots = [n for n in self.link_order if n not in self.parent_joint]
-        if len(roots) != 1:
-            raise ModelError(
-                f"expected one root link, found {len(roots)}: {', '.join(roots) or 'none'} "
-                "(a cycle or a disconnected part)",
-                path=where,
-            )
-        self.root_link = roots[0]
-        if len(self.subtree(self.root_link)) != len(self.links):
-            raise ModelError("the joints form a cycle", path=where)
-
-    @classmethod
-    def read(cls, path: Path) -> _Tree:
-        return cls(read_urdf_root(path), path)
-
-    def require_link(self, name: str, role: str) -> str:
-        if name not in self.links:
-            raise ModelError(
-                f"{role} '{name}' is not a link of this file; links are: "
-                + ", ".join(self.link_order),
-                path=str(self.path),
-                link=name,
-            )
-        return name
-
-    def child_of(self, joint: str) -> str:
-        return self.joints[joint].find("child").get("link")
-
-    def subtree(self, link: str) -> list[str]:
-        out, stack = [], [link]
-        while stack:
-            current = stack.pop()
-            out.append(current)
-            stack.extend(self.child_of(j) for j in self.children[current])
-        return out
-
-    def path_joints(self, base: str, tip: str) -> list[str]:
-        joints = []
-        current = tip
-        while current != base:
-            joint = self.parent_joint[current]
-            joints.append(joint)
-            current = self.joints[joint].find("parent").get("link")
-        return joints[::-1]
-
-    def _moving_below(self, link: str) -> int:
-        return sum(
-            1
-            for n in self.subtree(link)
-            if n in self.parent_joint
-            and n != link
-            and self.joints[self.parent_joint[n]].get("type") in _MOVING
-        )
-
-    def choose_ee_link(self, base: str) -> str:
-        """Follow the single branch that carries moving joints; stop before grippers."""
-        current, last_moving_child = base, None
-        while True:
-            branches = []
-            for joint in self.children[current]:
-                child = self.child_of(joint)
-                moving = self.joints[joint].get("type") in _MOVING
-                if moving or self._moving_below(child):
-                    branches.append((joint, child, moving))
-            if len(branches) != 1:
-                break
-            joint, child, moving = branches[0]
-            if moving and any(w in joint.lower() for w in _GRIPPER_WORDS):
-                break
-            current = child
-            if moving:
-                last_moving_child = child
-        if last_moving_child is None:
-            raise ModelError(f"no moving joint below arm_base_link '{base}'", path=str(self.path))
-        return last_moving_child
-
-
-def _original(name: str, renamed: dict[str, str]) -> str:
-    for old, new in renamed.items():
-        if new == name:
-            return old
-    return name
-
-
-def _lock(joint: ET.Element, position: float | None, path: Path) -> float:
-    """Make a moving joint fixed at ``position`` (default 0 clipped into its limits)."""
-    name = joint.get("name")
-    limit = joint.find("limit")
-    lower = -math.inf if limit is None else float(limit.get("lower", "-inf"))
-    upper = math.inf if limit is None else float(limit.get("upper", "inf"))
-    if joint.get("type") == "continuous":
-        lower, upper = -math.inf, math.inf
-    value = float(np.clip(0.0 if position is None else position, lower, upper))
-    if position is not None and not (math.isfinite(position) and lower <= position <= upper):
-        raise ParameterError(
-            f"lock position {position} of joint '{name}' is outside its limits [{lower}, {upper}]"
-        )
-    axis = _numbers_attr(joint.find("axis"), "xyz", "1 0 0", path, name)
-    axis = axis / np.linalg.norm(axis)
-    origin = _origin_of(joint, path)
-    if joint.get("type") == "prismatic":
-        motion = pin.SE3(np.eye(3), axis * value)
-    else:
-        motion = pin.SE3(pin.exp3(axis * value), np.zeros(3))
-    _set_origin(joint, origin * motion)
-    joint.set("type", "fixed")
-    for tag in ("limit", "mimic", "dynamics", "safety_controller", "calibration", "axis"):
-        for element in joint.findall(tag):
-            joint.remove(element)
-    return value
-
-
-def _numbers_attr(element: ET.Element | None, key: str, default: str, path: Path, what: str):
-    text = default if element is None else element.get(key, default)
-    try:
-        values = np.array([float(t) for t in text.split()])
-    except ValueError as exc:
-        raise ModelError(f"'{what}': non-numeric {key} '{text}'", path=str(path)) from exc
-    if values.shape != (3,) or not np.all(np.isfinite(values)):
-        raise ModelError(f"'{what}': {key} needs 3 finite numbers, got '{text}'", path=str(path))
-    return values
-
-
-def _origin_of(element: ET.Element, path: Path) -> pin.SE3:
-    origin = element.find("origin")
-    name = element.get("name", element.tag)
-    xyz = _numbers_attr(origin, "xyz", "0 0 0", path, name)
-    rpy = _numbers_attr(origin, "rpy", "0 0 0", path, name)
-    return pin.SE3(pin.rpy.rpyToMatrix(*rpy), xyz)
-
-
-def _fmt(values) -> str:
-    return " ".join(repr(float(x)) for x in values)
-
-
-def _set_origin(element: ET.Element, placement: pin.SE3) -> None:
-    origin = element.find("origin")
-    if origin is None:
-        origin = ET.Element("origin")
-        element.insert(0, origin)
-    origin.set("xyz", _fmt(placement.translation))
-    origin.set("rpy", _fmt(pin.rpy.matrixToRpy(placement.rotation)))
-
-
-def _add_fixed(out: ET.Element, name: str, parent: str, child: str, placement: pin.SE3) -> None:
-    joint = ET.SubElement(out, "joint", {"name": name, "type": "fixed"})
-    ET.SubElement(joint, "parent", {"link": parent})
-    ET.SubElement(joint, "child", {"link": child})
-    _set_origin(joint, placement)
-
-
-def _probe_link(name: str, tool: ProbeTool) -> ET.Element:
-    """A solid cylinder along x from the origin: inertial and collision (hydro derived)."""
-    r, length, m = tool.radius_m, tool.length_m, tool.mass_kg
-    ixx = 0.5 * m * r * r
-    iyy = m * (3.0 * r * r + length * length) / 12.0
-    link = ET.Element("link", {"name": name})
-    inertial = ET.SubElement(link, "inertial")
-    ET.SubElement(inertial, "origin", {"xyz": _fmt([length / 2, 0, 0]), "rpy": "0 0 0"})
-    ET.SubElement(inertial, "mass", {"value": repr(m)})
-    ET.SubElement(
-        inertial,
-        "inertia",
-        {"ixx": repr(ixx), "iyy": repr(iyy), "izz": repr(iyy), "ixy": "0", "ixz": "0", "iyz": "0"},
-    )
-    for tag in ("visual", "collision"):
-        el = ET.SubElement(link, tag)
-        ET.SubElement(
-            el, "origin", {"xyz": _fmt([length / 2, 0, 0]), "rpy": _fmt([0, math.pi / 2, 0])}
-        )
-        geom = ET.SubElement(el, "geometry")
-        ET.SubElement(geom, "cylinder", {"radius": repr(r), "length": repr(length)})
-    return link
-
-
-def _tool_axis(arm: _Tree, tool_axis, chain: list[str], ee: str, path: Path) -> np.ndarray:
-    if isinstance(tool_axis, str):
-        if tool_axis in _AXES:
-            return np.array(_AXES[tool_axis])
-        if tool_axis != "auto":
-            raise ParameterError(
-                f"tool_axis must be 'auto', one of {', '.join(_AXES)} or a 3-vector, got {tool_axis!r}"
-            )
-        return _auto_tool_axis(arm, chain, ee, path)
-    axis = np.asarray(tool_axis, dtype=float).reshape(-1)
-    norm = float(np.linalg.norm(axis)) if axis.shape == (3,) else 0.0
-    if axis.shape != (3,) or not np.all(np.isfinite(axis)) or norm == 0.0:
-        raise ParameterError(f"tool_axis must be a non-zero finite 3-vector, got {tool_axis!r}")
-    return axis / norm
-
-
-def _placement_in(arm: _Tree, link: str, joints: list[str], path: Path) -> dict[str, pin.SE3]:
-    """Placements (zero configuration) of every link on the path, relative to its start."""
-    out = {}
-    current = pin.SE3.Identity()
-    for joint in joints:
-        current = current * _origin_of(arm.joints[joint], path)
-        out[arm.child_of(joint)] = current
-    return out
-
-
-def _auto_tool_axis(arm: _Tree, chain: list[str], ee: str, path: Path) -> np.ndarray:
-    """The last chain joint's axis in ``ee``'s frame, pointing away from the arm."""
-    last = chain[-1]
-    base = arm.joints[chain[0]].find("parent").get("link")
-    joints = arm.path_joints(base, ee)
-    placements = _placement_in(arm, ee, joints, path)
-    joint_frame = placements[arm.child_of(last)]  # the last joint's frame (zero position)
-    ee_frame = placements[ee]
-    axis_joint = _numbers_attr(arm.joints[last].find("axis"), "xyz", "1 0 0", path, last)
-    axis_world = joint_frame.rotation @ (axis_joint / np.linalg.norm(axis_joint))
-    if len(chain) > 1:
-        prev = placements[arm.child_of(chain[-2])].translation
-    else:
-        prev = np.zeros(3)
-    away = ee_frame.translation - prev
-    if float(axis_world @ away) < 0.0:
-        axis_world = -axis_world
-    axis = ee_frame.rotation.T @ axis_world
-    return axis / np.linalg.norm(axis)
-
-
-def _rotation_with_x(axis: np.ndarray) -> np.ndarray:
-    """A rotation whose x column is ``axis`` (the y column as close to the link's y as it can)."""
-    x = axis / np.linalg.norm(axis)
-    helper = np.array([0.0, 1.0, 0.0]) if abs(x[1]) < 0.9 else np.array([0.0, 0.0, 1.0])
-    y = helper - (helper @ x) * x
-    y /= np.linalg.norm(y)
-    return np.column_stack([x, y, np.cross(x, y)])
-
-
-def _resolve_meshes(
-    link: ET.Element,
-    urdf: Path,
-    package_dirs: Sequence[str | Path],
-    *,
-    needs_collision: bool,
-    link_name: str | None = None,
-) -> None:
-    """Make mesh paths absolute; a missing collision mesh that is needed is an error;
-    a missing visual mesh is dropped (it only matters for drawing)."""
-    for tag in ("visual", "collision"):
-        for element in list(link.findall(tag)):
-            mesh = element.find("geometry/mesh")
-            if mesh is None:
-                continue
-            filename = mesh.get("filename", "")
-            resolved = resolve_resource(filename, urdf.parent, package_dirs)
-            if resolved is not None:
-                mesh.set("filename", str(resolved.resolve()))
-            elif tag == "collision" and needs_collision:
-                raise ModelError(
-                    f"collision mesh '{filename}' not found (relative paths from {urdf.parent}; "
-                    "package:// in package_dirs and the installed example-robot-data)",
-                    path=str(urdf),
-                    link=link_name or link.get("name"),
-                )
-            else:
-                link.remove(element)
-
-
-def _strip_undefined_materials(link: ET.Element, materials: set[str]) -> None:
-    for visual in link.findall("visual"):
-        material = visual.find("material")
-        if material is not None and len(material) == 0 and material.get("name") not in materials:
-            visual.remove(material)
-
-
-def _box_of(link: ET.Element) -> tuple[np.ndarray, np.ndarray] | None:
-    """(centre, full size) of the first box collision of a link, or None."""
-    for collision in link.findall("collision"):
-        box = collision.find("geometry/box")
-        if box is None:
-            continue
-        origin = collision.find("origin")
-        xyz = (
-            np.zeros(3)
-            if origin is None
-            else np.array([float(t) for t in origin.get("xyz", "0 0 0").split()])
-        )
-        size = np.array([float(t) for t in box.get("size").split()])
-        return xyz, size
-    return None
-
-
-def _mark_dry_links(
-    links: list[ET.Element], arm: _Tree, renamed: dict[str, str], allow_dry_links: bool
-) -> list[str]:
-    """Give links with an <inertial> but no geometry and no hydrodynamics an explicit empty
-    ``<hydrodynamics>`` (volume 0): always for massless frame links, and for links with mass
-    when ``allow_dry_links`` (returned: they weigh but displace nothing). Links with mass
-    are otherwise left for `load_uvms` to reject, naming them."""
-    top_level = {h.get("link") for h in arm.root.findall("hydrodynamics")}
-    dry = []
-    for link in links:
-        name = link.get("name")
-        inertial = link.find("inertial")
-        if (
-            inertial is None
-            or link.find("collision") is not None
-            or link.find("hydrodynamics") is not None
-            or _original(name, renamed) in top_level
-        ):
-            continue
-        mass_el = inertial.find("mass")
-        try:
-            mass = float(mass_el.get("value")) if mass_el is not None else math.nan
-        except (TypeError, ValueError):
-            continue  # load_uvms reports the bad <mass>
-        if mass == 0.0 or (allow_dry_links and math.isfinite(mass)):
-            ET.SubElement(link, "hydrodynamics").append(ET.Element("volume", {"value": "0"}))
-            if mass > 0.0:
-                dry.append(name)
-    return dry
-
-
-def _to_text(root: ET.Element) -> str:
-    tree = copy.deepcopy(root)
-    ET.indent(tree, "  ")
-    return '<?xml version="1.0"?>\n' + ET.tostring(tree, encoding="unicode") + "\n"
-
-
-def _load_text(root: ET.Element, source: str, **load_kw) -> UVMS:
-    """Write the merged tree to a private temporary directory, load it, remove it."""
-    with tempfile.TemporaryDirectory(prefix="uvms_pin_mount_") as tmp:
-        path = Path(tmp) / "merged.urdf"
-        path.write_text(_to_text(root))
-        try:
-            uvms = load_uvms(path, **load_kw)
-        except ModelError as exc:
-            raise ModelError(str(exc).replace(str(path), source)) from exc
-    uvms.source = source
-    return uvms

@@ -14,7 +14,9 @@ from pathlib import Path
 import pinocchio as pin
 
 from uvms_pin.errors import ModelError
-from uvms_pin.model.mount.mount import _origin_of, _Tree, write_text_atomic
+from uvms_pin.model.mount.origin import origin_of
+from uvms_pin.model.mount.text import urdf_text, write_text_file
+from uvms_pin.model.mount.tree import URDFTree
 
 __all__ = ["SplitURDF", "split_urdf"]
 
@@ -45,13 +47,13 @@ def split_urdf(
     link=...>`` elements follow their link. Mesh paths are made absolute.
     """
     path = Path(urdf)
-    tree = _Tree.read(path)
+    tree = URDFTree.read(path)
     if first_arm_joint not in tree.joints:
         raise ModelError(f"joint '{first_arm_joint}' not found", path=str(path))
     joint = tree.joints[first_arm_joint]
     vehicle_link = joint.find("parent").get("link")
     arm_links = set(tree.subtree(tree.child_of(first_arm_joint)))
-    mount = _origin_of(joint, path)
+    mount = origin_of(joint, path)
 
     vehicle = ET.Element("robot", {"name": tree.root.get("name", "robot") + "_vehicle"})
     arm = ET.Element("robot", {"name": tree.root.get("name", "robot") + "_arm"})
@@ -83,8 +85,5 @@ def split_urdf(
     out = Path(out_dir)
     vehicle_path, arm_path = out / "vehicle.urdf", out / "arm.urdf"
     for root, target in ((vehicle, vehicle_path), (arm, arm_path)):
-        ET.indent(root, "  ")
-        write_text_atomic(
-            target, '<?xml version="1.0"?>\n' + ET.tostring(root, encoding="unicode") + "\n"
-        )
+        write_text_file(target, urdf_text(root))
     return SplitURDF(vehicle_path, arm_path, vehicle_link, mount)

@@ -1,0 +1,29 @@
+"""The arm a vehicle file already carries (``models/uvms_lbv150.urdf``), which a mount
+replaces unless asked to keep it."""
+
+from __future__ import annotations
+
+from uvms_pin.model.mount.tree import URDFTree
+
+__all__ = ["existing_arm"]
+
+#: Frames of a mounted arm that hang where the tool is, whatever the arm.
+_MOUNT_FRAMES = ("ft_sensor", "tool", "ee")
+
+
+def existing_arm(vehicle: URDFTree) -> tuple[list[str], list[str]]:
+    """(links, joints) of the arm a vehicle file already carries: everything below each
+    first moving joint (one without a moving joint above it), and the ``ft_sensor``,
+    ``tool`` and ``ee`` frames wherever they hang; empty for a vehicle alone."""
+    starts = [
+        vehicle.child_of(name)
+        for name in vehicle.joint_order
+        if vehicle.is_moving(name) and not vehicle.moving_above(name)
+    ]
+    starts += [f for f in _MOUNT_FRAMES if f in vehicle.parent_joint]
+    links: set[str] = set()
+    for start in starts:
+        links.update(vehicle.subtree(start))
+    ordered_links = [n for n in vehicle.link_order if n in links]
+    joints = [n for n in vehicle.joint_order if vehicle.child_of(n) in links]
+    return ordered_links, joints

@@ -1,0 +1,98 @@
+"""Coefficients derived from a link's collision geometry (docs/physics.md): a box, cylinder or
+sphere through `uvms_pin.hydro.geometry`, a mesh through `uvms_pin.hydro.mesh` (its volume and
+bounding primitive); each at the ``<collision><origin>`` frame."""
+
+from __future__ import annotations
+
+import xml.etree.ElementTree as ET
+from collections.abc import Sequence
+from pathlib import Path
+
+import pinocchio as pin
+
+from uvms_pin.errors import ModelError, ParameterError
+from uvms_pin.hydro import geometry
+from uvms_pin.hydro.mesh import load_mesh_geometry, mesh_hydro
+from uvms_pin.hydro.params import HydroParams
+from uvms_pin.model.resources import package_search_path, resolve_resource
+from uvms_pin.model.urdf.read import read_numbers, read_origin
+
+__all__ = ["collision_hydro"]
+
+
+def collision_hydro(
+    collision: ET.Element,
+    water_density_kg_m3: float,
+    where: str,
+    link: str,
+    base_dir: Path = Path("."),
+    package_dirs: Sequence[str | Path] = (),
+) -> tuple[pin.SE3, HydroParams]:
+    """(placement of the collision frame in the link frame, its coefficients there).
+
+    Args:
+        collision: the ``<collision>`` element.
+        water_density_kg_m3: rho [kg/m^3].
+        where, link: the file and link, for error messages.
+        base_dir, package_dirs: where relative and ``package://`` mesh paths are found.
+
+    Raises:
+        ModelError: no shape, an unsupported shape, bad sizes, a mesh not found.
+    """
+    origin = read_origin(collision.find("origin"), where, link)
+    geom = collision.find("geometry")
+    shape = None if geom is None or len(geom) == 0 else geom[0]
+    if shape is None:
+        raise ModelError("<collision> has no <geometry> shape", path=where, link=link)
+    try:
+        if shape.tag == "box":
+            size = read_numbers(shape.get("size"), 3, "<box size>", where, link)
+            return origin, geometry.box_hydro(size, water_density_kg_m3)
+        if shape.tag == "cylinder":
+            radius = read_numbers(shape.get("radius"), 1, "<cylinder radius>", where, link)[0]
+            length = read_numbers(shape.get("length"), 1, "<cylinder length>", where, link)[0]
+            return origin, geometry.cylinder_hydro(radius, length, water_density_kg_m3)
+        if shape.tag == "sphere":
+            radius = read_numbers(shape.get("radius"), 1, "<sphere radius>", where, link)[0]
+            return origin, geometry.sphere_hydro(radius, water_density_kg_m3)
+        if shape.tag == "mesh":
+            return origin, _mesh_hydro(
+                shape, water_density_kg_m3, where, link, base_dir, package_dirs
+            )
+    except ParameterError as exc:
+        raise ModelError(
+            f"cannot derive hydrodynamics from <{shape.tag}>: {exc}", path=where, link=link
+        ) from exc
+    raise ModelError(
+        f"cannot derive hydrodynamics from collision <{shape.tag}> (box, cylinder, sphere and "
+        "mesh are supported); add a <hydrodynamics> element",
+        path=where,
+        link=link,
+    )
+
+
+def _mesh_hydro(
+    shape: ET.Element,
+    water_density_kg_m3: float,
+    where: str,
+    link: str,
+    base_dir: Path,
+    package_dirs: Sequence[str | Path],
+) -> HydroParams:
+    """Volume and bounding primitive of the mesh file (`uvms_pin.hydro.mesh`), scaled."""
+    filename = shape.get("filename")
+    if not filename:
+        raise ModelError("<mesh> has no filename", path=where, link=link)
+    resolved = resolve_resource(filename, base_dir, package_dirs)
+    if resolved is None:
+        searched = ", ".join(str(d) for d in package_search_path(package_dirs))
+        raise ModelError(
+            f"cannot derive hydrodynamics from collision <mesh>: file '{filename}' not "
+            f"found (relative paths from {base_dir}; package:// searched in: "
+            f"{searched or 'none'}); fix the path, pass package_dirs, or add a "
+            "<hydrodynamics> element",
+            path=where,
+            link=link,
+        )
+    scale = read_numbers(shape.get("scale", "1 1 1"), 3, "<mesh scale>", where, link)
+    return mesh_hydro(load_mesh_geometry(resolved, scale), water_density_kg_m3)

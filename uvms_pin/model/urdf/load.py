@@ -1,0 +1,155 @@
+"""URDF -> `UVMS`: Pinocchio builds the rigid multibody with a free-flyer root, the
+hydrodynamic extension is read from the same file (`uvms_pin.model.urdf.bodies`), and what
+urdfdom and Pinocchio accept silently is checked here (joint limits, armature, frames)."""
+
+from __future__ import annotations
+
+import xml.etree.ElementTree as ET
+from collections.abc import Sequence
+from pathlib import Path
+
+import numpy as np
+import pinocchio as pin
+
+from uvms_pin.errors import ModelError, ParameterError
+from uvms_pin.model.native_stderr import captured_native_stderr
+from uvms_pin.model.urdf.bodies import hydro_bodies
+from uvms_pin.model.urdf.hydrodynamics import hydro_elements_by_link
+from uvms_pin.model.urdf.read import read_numbers, read_urdf_root
+from uvms_pin.model.uvms import DEFAULT_WATER_DENSITY_KG_M3, UVMS
+
+__all__ = ["DEFAULT_EE_FRAME", "DEFAULT_SENSOR_FRAME", "load_uvms"]
+
+DEFAULT_EE_FRAME = "ee"
+DEFAULT_SENSOR_FRAME = "ft_sensor"
+
+
+def load_uvms(
+    urdf_path: str | Path,
+    *,
+    water_density_kg_m3: float = DEFAULT_WATER_DENSITY_KG_M3,
+    ee_frame: str | None = None,
+    sensor_frame: str | None = None,
+    derive_missing: bool = True,
+    allow_dry_links: bool = False,
+    package_dirs: Sequence[str | Path] = (),
+) -> UVMS:
+    """Load a UVMS from a URDF with the hydrodynamic extension.
+
+    Args:
+        urdf_path: the URDF file. Its root link becomes the free-flying vehicle.
+        water_density_kg_m3: rho [kg/m^3] for buoyancy and derived coefficients.
+        ee_frame, sensor_frame: names of the end-effector and force/torque sensor frames;
+            a name given must exist. None (default): ``ee`` and ``ft_sensor`` when the file
+            has them, else no such frame (a vehicle without an arm loads; a controller or
+            environment that needs the end-effector raises, see `UVMS.require_ee_frame`).
+        derive_missing: links without a <hydrodynamics> element get coefficients derived
+            from their collision primitives (marked ``derived``).
+        allow_dry_links: accept links with mass but neither hydrodynamics nor collision
+            geometry (they get no hydrodynamic effect) instead of raising.
+        package_dirs: directories containing packages, searched first for the
+            ``package://`` mesh paths of collision meshes (then the installed
+            example-robot-data; see `uvms_pin.model.resources`). Relative mesh paths are relative
+            to the URDF's directory.
+
+    Raises:
+        ModelError: naming the file, the link and what is wrong.
+    """
+    path = Path(urdf_path)
+    where = str(path)
+    if not np.isfinite(water_density_kg_m3) or water_density_kg_m3 <= 0.0:
+        raise ParameterError(f"water_density_kg_m3 must be positive, got {water_density_kg_m3}")
+    root = read_urdf_root(path)
+    links = {link.get("name"): link for link in root.findall("link")}
+    if not links:
+        raise ModelError("no <link> elements", path=where)
+    hydro_elements = hydro_elements_by_link(root, links, where)
+    model = _build_model(path)
+    _check_joint_limits(root, where)
+    _read_armature(root, model, where)
+    bodies = hydro_bodies(
+        model,
+        links,
+        hydro_elements,
+        water_density_kg_m3,
+        where,
+        derive_missing=derive_missing,
+        allow_dry_links=allow_dry_links,
+        base_dir=path.parent,
+        package_dirs=package_dirs,
+    )
+    return UVMS(
+        model=model,
+        hydro_bodies=tuple(bodies),
+        water_density_kg_m3=float(water_density_kg_m3),
+        ee_frame_id=_optional_frame_id(model, ee_frame, DEFAULT_EE_FRAME, where),
+        sensor_frame_id=_optional_frame_id(model, sensor_frame, DEFAULT_SENSOR_FRAME, where),
+        source=where,
+    )
+
+
+def _build_model(path: Path) -> pin.Model:
+    """Pinocchio's model of the file, free-flyer root; urdfdom's complaints in the error."""
+    try:
+        with captured_native_stderr() as urdfdom:  # its errors go into our message
+            return pin.buildModelFromUrdf(str(path), pin.JointModelFreeFlyer())
+    except Exception as exc:  # Pinocchio raises ValueError/RuntimeError for bad URDFs
+        detail = f" (urdfdom: {urdfdom.text})" if urdfdom.text else ""
+        raise ModelError(
+            f"Pinocchio could not build the model: {exc}{detail}", path=str(path)
+        ) from exc
+
+
+def _check_joint_limits(root: ET.Element, where: str) -> None:
+    """<limit lower upper> of every revolute and prismatic joint: lower <= upper.
+
+    Pinocchio keeps an inverted interval, and clipping into it (initial state, null-space
+    target) then gives a configuration outside both bounds.
+    """
+    for joint in root.findall("joint"):
+        limit = joint.find("limit")
+        if limit is None or joint.get("type") not in ("revolute", "prismatic"):
+            continue
+        name = f"joint {joint.get('name', '?')}"
+        lower = float(read_numbers(limit.get("lower", "0"), 1, "<limit lower>", where, name)[0])
+        upper = float(read_numbers(limit.get("upper", "0"), 1, "<limit upper>", where, name)[0])
+        if lower > upper:
+            raise ModelError(
+                f"joint '{joint.get('name', '?')}': <limit> lower = {lower} > upper = {upper}",
+                path=where,
+            )
+
+
+def _read_armature(root: ET.Element, model: pin.Model, where: str) -> None:
+    """``<joint><armature value="kg m^2"/></joint>``: reflected rotor inertia of a joint's
+    drive (J_rotor N^2), added to the diagonal of M (Pinocchio's ``model.armature``)."""
+    for joint in root.findall("joint"):
+        element = joint.find("armature")
+        if element is None:
+            continue
+        name = joint.get("name", "?")
+        value = float(
+            read_numbers(element.get("value"), 1, "<armature value>", where, f"joint {name}")[0]
+        )
+        if value < 0.0:
+            raise ModelError(f"joint '{name}': negative armature {value} kg m^2", path=where)
+        if not model.existJointName(name):
+            raise ModelError(
+                f"joint '{name}' with <armature> is not a moving joint of the model", path=where
+            )
+        joint_model = model.joints[model.getJointId(name)]
+        model.armature[joint_model.idx_v : joint_model.idx_v + joint_model.nv] = value
+
+
+def _optional_frame_id(model: pin.Model, name: str | None, default: str, where: str) -> int | None:
+    """The frame ``name`` (must exist), or with None the frame ``default`` if it exists."""
+    if name is None:
+        return int(model.getFrameId(default)) if model.existFrame(default) else None
+    return _frame_id(model, name, where)
+
+
+def _frame_id(model: pin.Model, name: str, where: str) -> int:
+    if not model.existFrame(name):
+        names = sorted({f.name for f in model.frames})
+        raise ModelError(f"frame '{name}' not found; frames are: {', '.join(names)}", path=where)
+    return int(model.getFrameId(name))

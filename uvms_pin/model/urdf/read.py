@@ -1,0 +1,52 @@
+"""Reading URDF text: the ``<robot>`` root of a file, numbers and ``<origin>`` placements of
+attributes, with a `ModelError` naming the file, the link and what is wrong."""
+
+from __future__ import annotations
+
+import xml.etree.ElementTree as ET
+from pathlib import Path
+
+import numpy as np
+import pinocchio as pin
+
+from uvms_pin.errors import ModelError
+
+__all__ = ["read_numbers", "read_origin", "read_urdf_root"]
+
+
+def read_urdf_root(path: Path) -> ET.Element:
+    """The <robot> element of a URDF file; ModelError naming the file otherwise."""
+    where = str(path)
+    if not path.is_file():
+        raise ModelError("file not found", path=where)
+    try:
+        root = ET.parse(path).getroot()
+    except ET.ParseError as exc:
+        raise ModelError(f"not well-formed XML ({exc})", path=where) from exc
+    if root.tag != "robot":
+        raise ModelError(f"root element is <{root.tag}>, expected <robot>", path=where)
+    return root
+
+
+def read_numbers(text: str | None, count: int, what: str, where: str, link: str) -> np.ndarray:
+    """``count`` finite numbers from an attribute's text (``what`` names it in errors)."""
+    if text is None:
+        raise ModelError(f"{what} is missing its value", path=where, link=link)
+    try:
+        values = np.array([float(tok) for tok in text.split()])
+    except ValueError as exc:
+        raise ModelError(f"{what} has a non-numeric value '{text}'", path=where, link=link) from exc
+    if values.size != count:
+        raise ModelError(f"{what} needs {count} numbers, got {values.size}", path=where, link=link)
+    if not np.all(np.isfinite(values)):
+        raise ModelError(f"{what} has a non-finite value", path=where, link=link)
+    return values
+
+
+def read_origin(element: ET.Element | None, where: str, link: str) -> pin.SE3:
+    """The placement an ``<origin xyz rpy>`` element gives [m, rad] (identity when absent)."""
+    if element is None:
+        return pin.SE3.Identity()
+    xyz = read_numbers(element.get("xyz", "0 0 0"), 3, "<origin xyz>", where, link)
+    rpy = read_numbers(element.get("rpy", "0 0 0"), 3, "<origin rpy>", where, link)
+    return pin.SE3(pin.rpy.rpyToMatrix(*rpy), xyz)
