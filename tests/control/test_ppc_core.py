@@ -29,7 +29,7 @@ from test_ppc_oracle import (
 )
 
 import uvms_pin as up
-from uvms_pin.control import ppc as ppc_module
+from uvms_pin.control import task_space
 from uvms_pin.control.measurement import Measurement
 from uvms_pin.control.ppc import PPCParams, PrescribedPerformanceController
 from uvms_pin.errors import FunnelViolation, ParameterError, ScenarioError
@@ -432,9 +432,9 @@ def test_the_svd_route_when_the_solver_declines(
 ):
     model, q, build = reference_pair
     svd_calls = []
-    original = ppc_module.pseudo_inverse
+    original = task_space.pseudo_inverse  # the exact SVD route of J^# (the PPC's reference)
     monkeypatch.setattr(
-        ppc_module, "pseudo_inverse", lambda *a, **k: svd_calls.append(1) or original(*a, **k)
+        task_space, "pseudo_inverse", lambda *a, **k: svd_calls.append(1) or original(*a, **k)
     )
     params = PPCParams(velocity_weights=[vehicle_weight] * 6 + [1.0] * 4, null_space_gain_per_s=1)
     core, python, calls = build(params)

@@ -26,7 +26,7 @@ from ppc_oracle.ppc import PrescribedPerformanceController as OraclePPC
 from test_ppc import build_test_uvms
 
 import uvms_pin as up
-from uvms_pin.control import ppc as ppc_module
+from uvms_pin.control import task_space
 from uvms_pin.control.measurement import Measurement
 from uvms_pin.control.ppc import PPCParams, PrescribedPerformanceController
 from uvms_pin.errors import FunnelViolation, UvmsPinError
@@ -138,13 +138,13 @@ def recorded(stem: str):
 def count_svd_fallbacks(monkeypatch):
     """Counts the fast controller's calls of the exact SVD route."""
     calls = []
-    original = ppc_module.pseudo_inverse
+    original = task_space.pseudo_inverse  # the exact SVD route of J^#
 
     def counting(*args, **kwargs):
         calls.append(1)
         return original(*args, **kwargs)
 
-    monkeypatch.setattr(ppc_module, "pseudo_inverse", counting)
+    monkeypatch.setattr(task_space, "pseudo_inverse", counting)
     return calls
 
 

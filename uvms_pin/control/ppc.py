@@ -70,15 +70,19 @@ from uvms_pin.control.performance import (
     transformed_error_extended,
 )
 from uvms_pin.control.ppc_kernel import PpcKernel
-from uvms_pin.control.pseudo_inverse import (
-    MinimumNormSolver,
-    pseudo_inverse,
+from uvms_pin.control.ppc_params import PPCParams
+from uvms_pin.control.pseudo_inverse import pseudo_inverse
+from uvms_pin.control.task_space import (
+    JointLimitPull,
+    ReferenceVelocity,
+    arm_velocity_names,
+    check_measurement,
+    first_level_error,
+    require_free_flyer,
+    signal_of_time,
 )
-from uvms_pin.errors import ParameterError
 from uvms_pin.physics.compiled.backend import Fallback, backend_named
 from uvms_pin.physics.kinematics import (
-    analytical_jacobian,
-    angular_velocity_world_from_euler_rates,
     check_euler_singularity,
     frame_id_from_name,
     frame_rotation_and_jacobian,
@@ -94,139 +98,9 @@ __all__ = [
     "pseudo_inverse",
 ]
 
-_N_VEHICLE = 6
 #: With the funnel extension on (continuous-time simulation), the barrier is continued
 #: linearly beyond |xi| = this (where eps ~ 14.5, r ~ 1e6): it keeps growing outside.
 _XI_CLAMP = 1.0 - 1e-6
-_TWO_PI = 2.0 * math.pi
-#: Joint position limits at or beyond this magnitude are treated as absent (Pinocchio marks
-#: "no limit" with +-max double).
-_NO_LIMIT_THRESHOLD = 1e10
-
-
-@dataclass(frozen=True, eq=False)
-class PPCParams:
-    """Gains and funnels of :class:`PrescribedPerformanceController`.
-
-    Every array field accepts a scalar (broadcast to all components) or one value per
-    component: 6 for the first level (``_x``: f_x, f_y, f_z [N]; roll, pitch, yaw [rad]),
-    nv = 6 + n_joints for the second level (``_zeta``: u, v, w [m/s]; p, q, r [rad/s];
-    joint rates [rad/s]). :meth:`for_uvms` returns fully sized arrays; :meth:`sized`
-    validates and sizes any instance.
-
-    Defaults are the paper's simulation values (Section 5) with its errata fixed
-    (docs/controller.md):
-
-    - ``k_x = 0.2`` and ``k_zeta = 5``: the paper prints k_x = -0.2 and k_v = -5, but its
-      law (eq. 13, 18) already carries the minus sign and requires k > 0; negative gains
-      would push every error out of its funnel.
-    - The paper's rho_v / rho_zeta and P(t) / P_zeta(t) are the same thing: here ``_zeta``.
-    - ``l_x = 3`` for all six: the paper gives l_x only for j = 1..3 (forces); we use 3 for
-      the orientation components too.
-    - ``rho_inf_zeta``: 0.2 for the 6 vehicle components and 0.4 for the arm joints (the
-      paper's second "j in {1..6}" line is the vehicle). ``None`` means this split.
-
-    Attributes:
-        k_x: first-level gains k_x [m/s or rad/s per unit of eps], > 0, (6,).
-        k_zeta: diagonal of K_zeta [N, N m per unit of eps rho^-1], > 0, (nv,).
-        rho0_x, rho_inf_x: first-level funnel bounds [N (3); rad (3)].
-        l_x_per_s: first-level decay rates [1/s].
-        rho0_zeta, rho_inf_zeta: second-level funnel bounds [m/s (3); rad/s (3 + n)].
-        l_zeta_per_s: second-level decay rates [1/s].
-        desired_rpy: constant desired end-effector Euler angles (roll, pitch, yaw) [rad],
-            used when the controller is given no ``desired_rpy``.
-        null_space_gain_per_s: gain k_0 >= 0 [rad/s] of the optional secondary task
-            (joint-limit avoidance in the null space of J). 0 (default) = the paper's plain
-            pseudo-inverse, eq. (9).
-        pinv_relative_cutoff: singular values of J below this fraction of the largest are
-            treated as zero in J^+ (numerical rank only, no damping).
-        null_space_target: arm joint positions (n_joints,) [rad] the secondary task pulls
-            toward (e.g. a pose with reach in the task direction); None = mid-range.
-        velocity_weights: positive weights W (nv,) of the generalized pseudo-inverse of the
-            paper's remark, J^# = W^-1 J^T (J W^-1 J^T)^+, which minimises zeta^T W zeta:
-            a large weight keeps that DoF out of the task (e.g. an unactuated vehicle roll).
-            1 (default) = the Moore-Penrose pseudo-inverse of eq. (9).
-    """
-
-    k_x: ArrayLike = 0.2
-    k_zeta: ArrayLike = 5.0
-    rho0_x: ArrayLike = (1.0, 1.0, 1.0, 0.9, 0.9, 0.9)
-    rho_inf_x: ArrayLike = 0.2
-    l_x_per_s: ArrayLike = 3.0
-    rho0_zeta: ArrayLike = 1.0
-    rho_inf_zeta: ArrayLike | None = None
-    l_zeta_per_s: ArrayLike = 2.2
-    desired_rpy: ArrayLike = (0.0, 0.0, 0.0)
-    null_space_gain_per_s: float = 0.0
-    pinv_relative_cutoff: float = 1e-12
-    velocity_weights: ArrayLike = 1.0
-    null_space_target: ArrayLike | None = None
-
-    @classmethod
-    def for_uvms(cls, n_joints: int, **overrides) -> PPCParams:
-        """The paper's parameters sized for a vehicle with ``n_joints`` arm DoFs.
-
-        ``overrides`` replace fields before sizing (e.g. ``k_zeta=2.0``).
-        """
-        if int(n_joints) != n_joints or n_joints < 0:
-            raise ParameterError(f"n_joints must be a non-negative integer, got {n_joints}")
-        return cls(**overrides).sized(_N_VEHICLE + int(n_joints))
-
-    def sized(self, nv: int) -> PPCParams:
-        """A copy whose array fields have 6 (first level) or ``nv`` (second level) entries.
-
-        Raises:
-            ParameterError: a field has the wrong size or a non-finite value, a gain is
-                not > 0, or ``null_space_gain_per_s`` / ``pinv_relative_cutoff`` < 0.
-        """
-        nv = int(nv)
-        if nv < _N_VEHICLE:
-            raise ParameterError(f"nv = {nv}: a UVMS has at least the 6 vehicle velocities")
-        rho_inf_zeta = self.rho_inf_zeta
-        if rho_inf_zeta is None:
-            rho_inf_zeta = np.r_[np.full(_N_VEHICLE, 0.2), np.full(nv - _N_VEHICLE, 0.4)]
-        sized = {
-            "k_x": _vector("k_x", self.k_x, 6),
-            "rho0_x": _vector("rho0_x", self.rho0_x, 6),
-            "rho_inf_x": _vector("rho_inf_x", self.rho_inf_x, 6),
-            "l_x_per_s": _vector("l_x_per_s", self.l_x_per_s, 6),
-            "desired_rpy": _vector("desired_rpy", self.desired_rpy, 3),
-            "k_zeta": _vector("k_zeta", self.k_zeta, nv),
-            "rho0_zeta": _vector("rho0_zeta", self.rho0_zeta, nv),
-            "rho_inf_zeta": _vector("rho_inf_zeta", rho_inf_zeta, nv),
-            "l_zeta_per_s": _vector("l_zeta_per_s", self.l_zeta_per_s, nv),
-            "velocity_weights": _vector("velocity_weights", self.velocity_weights, nv),
-        }
-        if self.null_space_target is not None:
-            sized["null_space_target"] = _vector(
-                "null_space_target", self.null_space_target, nv - _N_VEHICLE
-            )
-        for name in ("k_x", "k_zeta", "velocity_weights"):
-            bad = np.flatnonzero(~(sized[name] > 0.0))
-            if bad.size:
-                raise ParameterError(
-                    f"{name} must be > 0 (the law already has the minus sign; the paper's "
-                    f"printed negative gains are an erratum), got {sized[name][bad]} at "
-                    f"indices {bad.tolist()}"
-                )
-        for name in ("null_space_gain_per_s", "pinv_relative_cutoff"):
-            value = float(getattr(self, name))
-            if not (np.isfinite(value) and value >= 0.0):
-                raise ParameterError(f"{name} must be finite and >= 0, got {value}")
-        return dataclasses.replace(self, **sized)
-
-
-def _vector(name: str, value: ArrayLike, size: int) -> np.ndarray:
-    array = np.asarray(value, dtype=float)
-    if array.ndim == 0:
-        array = np.full(size, float(array))
-    if array.shape != (size,):
-        raise ParameterError(f"{name} must be a scalar or have {size} entries, got {array.shape}")
-    if not np.all(np.isfinite(array)):
-        raise ParameterError(f"{name} has non-finite entries: {array}")
-    array = array.copy()
-    array.flags.writeable = False
-    return array
 
 
 @dataclass(frozen=True, eq=False)
@@ -253,56 +127,6 @@ class PPCSignals:
     xi_zeta: np.ndarray
     eps_zeta: np.ndarray
     tau: np.ndarray
-
-
-def _as_function(value, name: str, size: int) -> Callable[[float], np.ndarray]:
-    """Wrap a constant into a function of time; check a callable's output when called."""
-    if callable(value):
-
-        def evaluate(time_s: float) -> np.ndarray:
-            out = np.asarray(value(time_s), dtype=float)
-            if out.shape == (size,) and math.isfinite(sum(out.tolist())):
-                return out  # the exact check below also admits sums beyond 1e308
-            if out.shape != (size,) or not np.all(np.isfinite(out)):
-                raise ParameterError(
-                    f"{name}({time_s}) must return {size} finite values, got {out!r}"
-                )
-            return out
-
-        return evaluate
-    constant = _vector(name, value, size)
-    return lambda time_s: constant
-
-
-def _as_slice(index: np.ndarray) -> slice | np.ndarray:
-    """``index`` as a slice if it is a contiguous increasing range (cheaper to index)."""
-    if index.size and np.array_equal(index, np.arange(index[0], index[0] + index.size)):
-        return slice(int(index[0]), int(index[0]) + index.size)
-    return index
-
-
-def _first_level_error(
-    wrench_world: np.ndarray,
-    force_desired: np.ndarray,
-    rpy_ee: np.ndarray,
-    rpy_desired: np.ndarray,
-) -> list[float]:
-    """e_x (6 floats) = [f_meas - f_d (3) N; wrap(rpy_ee - rpy_d) (3) rad].
-
-    e_f = f_e + Delta f_e - f_d; e_o = rpy - rpy_d as in the paper, wrapped to [-pi, pi) so
-    that a roll or yaw crossing +-pi (where matrixToRpy jumps by 2 pi) is not read as a huge
-    error. Scalar ``math`` on 3 + 3 floats (Python's float % is numpy's mod).
-    """
-    f, fd = wrench_world.tolist(), force_desired.tolist()
-    r, rd = rpy_ee.tolist(), rpy_desired.tolist()
-    return [
-        f[0] - fd[0],
-        f[1] - fd[1],
-        f[2] - fd[2],
-        (r[0] - rd[0] + math.pi) % _TWO_PI - math.pi,
-        (r[1] - rd[1] + math.pi) % _TWO_PI - math.pi,
-        (r[2] - rd[2] + math.pi) % _TWO_PI - math.pi,
-    ]
 
 
 class PrescribedPerformanceController(Controller):
@@ -349,23 +173,19 @@ class PrescribedPerformanceController(Controller):
         backend: str = "core",
     ):
         self.backend = backend_named(backend).name
-        if model.njoints < 2 or model.joints[1].shortname() != "JointModelFreeFlyer":
-            raise ParameterError(
-                "the UVMS model must have a free-flyer root joint (joint 1); build it with "
-                "pin.buildModelFromUrdf(path, pin.JointModelFreeFlyer())"
-            )
+        require_free_flyer(model)
         self.model = pin.Model(model)  # private copy: later edits of `model` do not leak in
         self.data = self.model.createData()
         self.ee_frame_name = ee_frame_name
         self.ee_frame_id = frame_id_from_name(self.model, ee_frame_name)
         self.params = (params if params is not None else PPCParams()).sized(self.model.nv)
-        self._desired_force = _as_function(desired_force_world_N, "desired_force_world_N", 3)
-        self._desired_rpy = _as_function(
+        self._desired_force = signal_of_time(desired_force_world_N, "desired_force_world_N", 3)
+        self._desired_rpy = signal_of_time(
             self.params.desired_rpy if desired_rpy is None else desired_rpy, "desired_rpy", 3
         )
 
         self.first_level_names = FIRST_LEVEL_NAMES
-        self.second_level_names = VEHICLE_VELOCITY_NAMES + tuple(self._arm_velocity_names())
+        self.second_level_names = VEHICLE_VELOCITY_NAMES + tuple(arm_velocity_names(self.model))
         self.performance_x = PerformanceFunction(
             self.params.rho0_x, self.params.rho_inf_x, self.params.l_x_per_s, self.first_level_names
         )
@@ -375,16 +195,19 @@ class PrescribedPerformanceController(Controller):
             self.params.l_zeta_per_s,
             self.second_level_names,
         )
-        self._limited_q_index, self._limited_v_index, self._mid, self._half_range = (
-            self._joint_limits()
+        self._pull = JointLimitPull(
+            self.model, self.params.null_space_gain_per_s, self.params.null_space_target
         )
-        self._target = self._mid
-        if self.params.null_space_target is not None:
-            self._target = self.params.null_space_target[self._limited_v_index - _N_VEHICLE]
+        self._reference = ReferenceVelocity(
+            self.model,
+            self.data,
+            self.ee_frame_id,
+            self.params.velocity_weights,
+            self.params.pinv_relative_cutoff,
+            self._pull,
+        )
         self._extend_beyond_funnels = False
         self._margin = np.inf
-        weighted = np.any(self.params.velocity_weights != 1.0)
-        self._weights = self.params.velocity_weights if weighted else None
 
         # ---- constants of the fast evaluation (see the module docstring)
         # both levels' funnels in one vector: rho = [rho_x (6); rho_zeta (nv)]
@@ -397,16 +220,7 @@ class PrescribedPerformanceController(Controller):
         # -k_x eps = (-2 k_x) artanh(xi) and -k r eps / rho = (-4 k) artanh(xi) / ((1 - xi^2) rho)
         self._neg_two_k_x = (-2.0 * self.params.k_x).tolist()
         self._neg_four_k_zeta = -4.0 * self.params.k_zeta
-        self._solver = MinimumNormSolver(self._weights, self.params.pinv_relative_cutoff)
         self._nq, self._nv = self.model.nq, self.model.nv
-        # zeta_0 = (q - q_0) (-k_0 / h) on the limited joints, indexed by slices when they
-        # are contiguous (the usual arm); None when there is no secondary task
-        gain = float(self.params.null_space_gain_per_s)
-        self._null_space_scale = (
-            -gain / self._half_range if gain > 0.0 and self._limited_q_index.size else None
-        )
-        self._limited_q = _as_slice(self._limited_q_index)
-        self._limited_v = _as_slice(self._limited_v_index)
         # the last successful call's raw signals, and the PPCSignals built from them on demand
         # (_last is None when they are the compiled kernel's, see _core_last)
         self._last: tuple | None = None
@@ -416,29 +230,31 @@ class PrescribedPerformanceController(Controller):
 
     def _build_kernel(self) -> PpcKernel | None:
         """The compiled law with this controller's constants (None with the Python backend)."""
-        params, zeta = self.params, self.performance_zeta
-        kernel = PpcKernel.build(
-            backend_named(self.backend),
-            self.model,
-            ee_frame_id=self.ee_frame_id,
-            k_x=params.k_x,
-            rho0_x=params.rho0_x,
-            rho_inf_x=params.rho_inf_x,
-            l_x_per_s=params.l_x_per_s,
-            k_zeta=params.k_zeta,
-            rho0_zeta=zeta.rho0,
-            rho_inf_zeta=zeta.rho_inf,
-            l_zeta_per_s=zeta.decay_rate_per_s,
-            velocity_weights=params.velocity_weights,
-            null_space_gain_per_s=float(params.null_space_gain_per_s),
-            limited_q_index=self._limited_q_index.tolist(),
-            limited_v_index=self._limited_v_index.tolist(),
-            null_space_target=np.asarray(self._target, dtype=float),
-            half_range=self._half_range,
-            max_condition_bound=self._solver.max_condition_bound,
-            xi_clamp=_XI_CLAMP,
-        )
+        kernel = PpcKernel.build(backend_named(self.backend), self.model, self.kernel_settings())
         return None if isinstance(kernel, Fallback) else kernel
+
+    def kernel_settings(self) -> dict[str, object]:
+        """The compiled law's settings (the fields of the core's PpcSettings, by name)."""
+        params, zeta, pull = self.params, self.performance_zeta, self._pull
+        return {
+            "ee_frame_id": self.ee_frame_id,
+            "k_x": params.k_x,
+            "rho0_x": params.rho0_x,
+            "rho_inf_x": params.rho_inf_x,
+            "l_x_per_s": params.l_x_per_s,
+            "k_zeta": params.k_zeta,
+            "rho0_zeta": zeta.rho0,
+            "rho_inf_zeta": zeta.rho_inf,
+            "l_zeta_per_s": zeta.decay_rate_per_s,
+            "velocity_weights": params.velocity_weights,
+            "null_space_gain_per_s": float(params.null_space_gain_per_s),
+            "limited_q_index": pull.limited_q_index.tolist(),
+            "limited_v_index": pull.limited_v_index.tolist(),
+            "null_space_target": np.asarray(pull.target, dtype=float),
+            "half_range": pull.half_range,
+            "max_condition_bound": self._reference.solver.max_condition_bound,
+            "xi_clamp": _XI_CLAMP,
+        }
 
     _KERNEL_ATTRIBUTES = ("_kernel",)
 
@@ -454,74 +270,13 @@ class PrescribedPerformanceController(Controller):
         self.__dict__.update(state)
         self._kernel = self._build_kernel()
 
-    # ------------------------------------------------------------------ model helpers
-    def _arm_velocity_names(self) -> list[str]:
-        names = []
-        for joint_id in range(2, self.model.njoints):
-            joint, name = self.model.joints[joint_id], self.model.names[joint_id]
-            names += [name] if joint.nv == 1 else [f"{name}[{k}]" for k in range(joint.nv)]
-        return names
-
-    def _joint_limits(self):
-        """Arm DoFs with one position coordinate per velocity and finite limits."""
-        q_index, v_index, mid, half_range = [], [], [], []
-        for joint_id in range(2, self.model.njoints):
-            joint = self.model.joints[joint_id]
-            if joint.nq != 1 or joint.nv != 1:
-                continue  # e.g. continuous joints (cos, sin): no position limits
-            lower = float(self.model.lowerPositionLimit[joint.idx_q])
-            upper = float(self.model.upperPositionLimit[joint.idx_q])
-            if max(abs(lower), abs(upper)) >= _NO_LIMIT_THRESHOLD or not upper > lower:
-                continue
-            q_index.append(joint.idx_q)
-            v_index.append(joint.idx_v)
-            mid.append(0.5 * (upper + lower))
-            half_range.append(0.5 * (upper - lower))
-        return (np.array(q_index, int), np.array(v_index, int), np.array(mid), np.array(half_range))
-
     def null_space_velocity(self, q: np.ndarray) -> np.ndarray:
-        """Secondary-task velocity zeta_0 (nv,) for joint-limit avoidance.
-
-        zeta_0 = -k_0 grad H(q) with H(q) = sum_j (q_j - q_0j)^2 / (2 h_j), h_j the
-        half-range of arm joint j and q_0 the target (mid-range by default), so
-        zeta_0_j = -k_0 (q_j - q_0j) / h_j [rad/s]: each limited arm joint is pushed toward
-        its target. It is zero on the 6 vehicle DoFs and on joints without (finite)
-        position limits. Projected on the null space of J it moves the vehicle and the arm
-        together without moving the end-effector: the vehicle slowly takes over what the
-        arm is holding.
-        """
-        zeta_0 = np.zeros(self._nv)
-        if self._null_space_scale is not None:
-            offset = np.asarray(q)[self._limited_q] - self._target
-            zeta_0[self._limited_v] = offset * self._null_space_scale
-        return zeta_0
+        """The secondary task's velocity zeta_0 (nv,) at q (`JointLimitPull`)."""
+        return self._pull.velocity(q)
 
     # ------------------------------------------------------------------ the law
     def _check_measurement(self, measurement: Measurement) -> tuple[np.ndarray, ...]:
-        q = np.asarray(measurement.q, dtype=float)
-        v = np.asarray(measurement.v, dtype=float)
-        wrench = np.asarray(measurement.wrench_world, dtype=float)
-        if (
-            q.shape == (self._nq,)
-            and v.shape == (self._nv,)
-            and wrench.shape == (6,)
-            # one finiteness test for all three: a sum is NaN or inf if any entry is (Python
-            # floats: no overflow warning); the exact check below admits sums beyond 1e308
-            and math.isfinite(sum(q.tolist()) + sum(v.tolist()) + sum(wrench.tolist()))
-        ):
-            return q, v, wrench
-        for label, array, size in (
-            ("q", q, self._nq),
-            ("v", v, self._nv),
-            ("wrench_world", wrench, 6),
-        ):
-            if array.shape != (size,):
-                raise ParameterError(
-                    f"measurement.{label} must have shape ({size},), got {array.shape}"
-                )
-            if not np.all(np.isfinite(array)):
-                raise ParameterError(f"measurement.{label} has non-finite entries: {array}")
-        return q, v, wrench
+        return check_measurement(measurement, self._nq, self._nv)
 
     def compute(self, time_s: float, measurement: Measurement) -> np.ndarray:
         """tau (nv,) [N, N m]: body wrench on the vehicle, then arm joint torques.
@@ -589,7 +344,7 @@ class PrescribedPerformanceController(Controller):
             self.model, self.data, q, self.ee_frame_id
         )
         rpy_ee = pin.rpy.matrixToRpy(rotation)
-        e_x = _first_level_error(wrench_world, force_desired, rpy_ee, rpy_desired)
+        e_x = first_level_error(wrench_world, force_desired, rpy_ee, rpy_desired)
         rho = self._performance_both.value(time_s)
         rho_x, rho_zeta = rho[:6], rho[6:]
         # eq. (13), erratum: k_x > 0 (the paper's simulation prints -0.2). The force rows
@@ -646,29 +401,8 @@ class PrescribedPerformanceController(Controller):
     def _reference_velocity(
         self, q: np.ndarray, rpy_ee: np.ndarray, jacobian_lwa: np.ndarray, xdot_r: list[float]
     ) -> np.ndarray:
-        """zeta_r = J^# xdot_r + (I - J^# J) zeta_0 (nv,) [m/s, rad/s].
-
-        With J = diag(I, E^-1) J^lwa of full row rank, J^# xdot_r = (J^lwa)^# b with
-        b = [xdot_p; E xdot_o], and zeta_0 + J^# (xdot_r - J zeta_0) = zeta_0 + (J^lwa)^#
-        (b - J^lwa zeta_0). The exact SVD route on J itself when the solver declines.
-        """
-        b = np.array([*xdot_r[:3], *angular_velocity_world_from_euler_rates(rpy_ee, xdot_r[3:])])
-        if self._null_space_scale is not None:
-            zeta_0 = self.null_space_velocity(q)
-            solution = self._solver.solve(jacobian_lwa, b - np.dot(jacobian_lwa, zeta_0))
-            if solution is not None:
-                return solution + zeta_0
-        else:
-            zeta_0 = None
-            solution = self._solver.solve(jacobian_lwa, b)
-            if solution is not None:
-                return solution
-        jacobian = analytical_jacobian(self.model, self.data, q, self.ee_frame_id)
-        jacobian_pinv = pseudo_inverse(jacobian, self.params.pinv_relative_cutoff, self._weights)
-        zeta_r = jacobian_pinv @ np.array(xdot_r)
-        if zeta_0 is not None:
-            zeta_r = zeta_r + zeta_0 - jacobian_pinv @ (jacobian @ zeta_0)
-        return zeta_r
+        """zeta_r = J^# xdot_r + (I - J^# J) zeta_0 (nv,) [m/s, rad/s] (`ReferenceVelocity`)."""
+        return self._reference(q, rpy_ee, jacobian_lwa, xdot_r)
 
     def _normalize(self, level, names, time_s, error, bound) -> np.ndarray:
         """xi = e / rho; raises FunnelViolation at |xi| >= 1 unless the extension is on."""

@@ -37,7 +37,9 @@ class PpcKernel:
         self.compute = self.kernel.compute  # the C++ method itself: nothing in between
 
     @classmethod
-    def build(cls, backend: Backend, model: pin.Model, **settings) -> PpcKernel | Fallback:
+    def build(
+        cls, backend: Backend, model: pin.Model, settings: dict[str, object]
+    ) -> PpcKernel | Fallback:
         """The kernel of ``model`` with ``settings`` (the fields of the core's PpcSettings,
         by name), or the backend's Fallback (the Python reference was asked for)."""
 

@@ -24,9 +24,24 @@ import pinocchio as pin
 from numpy.typing import ArrayLike
 
 from uvms_pin.control.measurement import Measurement
-from uvms_pin.control.ppc import PPCParams, PrescribedPerformanceController
+from uvms_pin.control.ppc_params import PPCParams
+from uvms_pin.control.task_space import (
+    JointLimitPull,
+    ReferenceVelocity,
+    arm_velocity_names,
+    check_measurement,
+    first_level_error,
+    require_free_flyer,
+    signal_of_time,
+)
 from uvms_pin.errors import ParameterError
-from uvms_pin.physics.kinematics import angular_velocity_world_from_euler_rates
+from uvms_pin.physics.kinematics import (
+    angular_velocity_world_from_euler_rates,
+    check_euler_singularity,
+    frame_id_from_name,
+    frame_rotation_and_jacobian,
+)
+from uvms_pin.results.components import VEHICLE_VELOCITY_NAMES
 
 __all__ = [
     "EndEffectorTask",
@@ -88,9 +103,9 @@ class TaskState:
 class EndEffectorTask:
     """Task errors, Jacobian and the pseudo-inverse of the PPC for one end-effector.
 
-    It is built on a PPC (whose first-level gains it ignores) so that the checks of the
-    measurement, the Euler singularity, J^#, its weights and the null-space term are the
-    PPC's own code: a baseline differs from the PPC only in its feedback law.
+    The checks of the measurement, the Euler singularity, J^#, its weights and the
+    null-space term are the PPC's own pieces (`uvms_pin.control.task_space`): a baseline
+    differs from the PPC only in its feedback law.
 
     Args:
         model: the UVMS kinematic model (free-flyer root).
@@ -113,19 +128,28 @@ class EndEffectorTask:
         null_space_gain_per_s: float = 0.0,
         null_space_target: ArrayLike | None = None,
     ):
+        require_free_flyer(model)
+        self.model = pin.Model(model)  # private copy: later edits of `model` do not leak in
+        self.data = self.model.createData()
+        self.ee_frame_id = frame_id_from_name(self.model, ee_frame_name)
+        self.nv = self.model.nv
         params = PPCParams(
             velocity_weights=velocity_weights,
             null_space_gain_per_s=null_space_gain_per_s,
             null_space_target=null_space_target,
+        ).sized(self.nv)
+        self._desired_force = signal_of_time(desired_force_world_N, "desired_force_world_N", 3)
+        self._desired_rpy = signal_of_time(desired_rpy, "desired_rpy", 3)
+        self.velocity_names = VEHICLE_VELOCITY_NAMES + tuple(arm_velocity_names(self.model))
+        pull = JointLimitPull(self.model, params.null_space_gain_per_s, params.null_space_target)
+        self._reference = ReferenceVelocity(
+            self.model,
+            self.data,
+            self.ee_frame_id,
+            params.velocity_weights,
+            params.pinv_relative_cutoff,
+            pull,
         )
-        # only the Python pieces of the PPC are used here (checks, J^#): no compiled kernel
-        self._ppc = PrescribedPerformanceController(
-            model, ee_frame_name, params, desired_force_world_N, desired_rpy, backend="python"
-        )
-        self.model, self.data = self._ppc.model, self._ppc.data
-        self.ee_frame_id = self._ppc.ee_frame_id
-        self.nv = self.model.nv
-        self.velocity_names = self._ppc.second_level_names
 
     def evaluate(self, time_s: float, measurement: Measurement) -> TaskState:
         """The task at ``measurement``: errors, rotation and J^lwa (checks the input).
@@ -134,22 +158,18 @@ class EndEffectorTask:
             ParameterError: malformed measurement, or the end-effector at the Euler
                 singularity (pitch = +-90 deg).
         """
-        from uvms_pin.control.ppc import _first_level_error
-        from uvms_pin.physics.kinematics import check_euler_singularity, frame_rotation_and_jacobian
-
-        ppc = self._ppc
-        q, v, wrench = ppc._check_measurement(measurement)
-        force_desired = ppc._desired_force(float(time_s))
-        rpy_desired = ppc._desired_rpy(float(time_s))
+        q, v, wrench = check_measurement(measurement, self.model.nq, self.nv)
+        force_desired = self._desired_force(float(time_s))
+        rpy_desired = self._desired_rpy(float(time_s))
         rotation, jacobian = frame_rotation_and_jacobian(self.model, self.data, q, self.ee_frame_id)
         rpy_ee = pin.rpy.matrixToRpy(rotation)
         check_euler_singularity(self.model, self.ee_frame_id, rpy_ee)
-        error = np.array(_first_level_error(wrench, force_desired, rpy_ee, rpy_desired))
+        error = np.array(first_level_error(wrench, force_desired, rpy_ee, rpy_desired))
         return TaskState(q, v, error, force_desired, rpy_desired, rpy_ee, rotation, jacobian)
 
     def reference_velocity(self, state: TaskState, xdot_r: np.ndarray) -> np.ndarray:
         """zeta_r (nv,) = J^# xdot_r + (I - J^# J) zeta_0 [m/s, rad/s], the PPC's eq. (9)."""
-        return self._ppc._reference_velocity(
+        return self._reference(
             state.q, state.rpy_ee, state.jacobian_lwa, [float(x) for x in xdot_r]
         )
 

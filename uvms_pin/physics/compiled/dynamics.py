@@ -1,7 +1,7 @@
 """The compiled dynamics of a UVMS: its hydrodynamic bodies as the core's `HydroBodies`
 (src/uvms_core/hydro_bodies.hpp) and the `Dynamics` built from them (dynamics.hpp).
 
-`CompiledDynamics` has the interface of `uvms_pin.physics.dynamics.ReferenceDynamics`: the
+`CompiledDynamics` has the interface of `uvms_pin.physics.reference.ReferenceDynamics`: the
 calls in a uniform current go straight to C++; a call in a flow the core has no counterpart of
 (a varying or sheared current) runs on the reference, with a `CoreFallbackWarning`.
 """
@@ -9,7 +9,6 @@ calls in a uniform current go straight to C++; a call in a flow the core has no 
 from __future__ import annotations
 
 from types import ModuleType
-from typing import Protocol
 
 import numpy as np
 
@@ -18,24 +17,7 @@ from uvms_pin.model.uvms import UVMS
 from uvms_pin.physics.compiled.backend import Fallback
 from uvms_pin.physics.compiled.extension import core_module
 from uvms_pin.physics.compiled.flow import flow_to_core
-
-
-class FlowDynamics(Protocol):
-    """What computes the dynamics in a flow the core has no counterpart of (the reference)."""
-
-    def bias_forces_in(
-        self, q: np.ndarray, v: np.ndarray, flow: FlowField, time_s: float
-    ) -> np.ndarray: ...
-
-    def forward_dynamics_in(
-        self,
-        q: np.ndarray,
-        v: np.ndarray,
-        tau: np.ndarray,
-        flow: FlowField,
-        time_s: float,
-        tau_ext: np.ndarray | None = None,
-    ) -> np.ndarray: ...
+from uvms_pin.physics.reference import ReferenceDynamics
 
 
 def hydro_bodies_to_core(uvms: UVMS, core: ModuleType):
@@ -67,7 +49,7 @@ class CompiledDynamics:
     needs ``uvms.copy()`` (or `with_model` / `with_hydro`), which builds a new one.
     """
 
-    def __init__(self, uvms: UVMS, reference: FlowDynamics):
+    def __init__(self, uvms: UVMS, reference: ReferenceDynamics):
         core = core_module()
         self.core = core.Dynamics(uvms.model.saveToString(), hydro_bodies_to_core(uvms, core))
         self._reference = reference

@@ -1,0 +1,197 @@
+"""The Python reference of the underwater dynamics: M, h and the forward dynamics of a UVMS
+written out term by term, the readable specification the compiled core is held to
+(docs/physics.md, after Schjolberg & Fossen 1994):
+
+    M(q)      = M_RB(q) + sum_i J_i^T M_A,i J_i                    (added mass inside M)
+    h(q,zeta) = C_RB zeta + g_RB
+              - sum_i J_i^T [ -M_A,i (a_i^bias - nu_c_dot,i) - C_A,i(nu_r,i) nu_r,i
+                              - D_i(nu_r,i) nu_r,i + w_buoy,i ]
+
+with J_i the LOCAL body Jacobian of joint i, nu_r,i = nu_i - nu_c,i the current-relative
+body velocity and a_i^bias the body acceleration at zero joint acceleration. Every function
+works in the UVMS's Pinocchio data buffer; none allocates a model.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pinocchio as pin
+from scipy.linalg import cho_factor, cho_solve
+
+from uvms_pin.checks import finite_vector
+from uvms_pin.errors import ParameterError, SimulationError
+from uvms_pin.flow import FlowField, UniformCurrent
+from uvms_pin.hydro.added_mass import kirchhoff_wrench
+from uvms_pin.hydro.current import current_velocity_body, flow_twist_rate_body
+from uvms_pin.hydro.damping import damping_wrench
+from uvms_pin.hydro.restoring import buoyancy_wrench, froude_krylov_wrench
+from uvms_pin.hydro.vector import mat_t_vec, mat_vec
+from uvms_pin.model.uvms import UVMS
+
+
+def check_time(time_s: float) -> float:
+    """``time_s`` as a float, or ParameterError if it is not finite."""
+    time_s = float(time_s)
+    if not np.isfinite(time_s):
+        raise ParameterError(f"time_s must be finite, got {time_s}")
+    return time_s
+
+
+def _fluid_wrenches(uvms: UVMS, flow: FlowField | None, time_s: float) -> list[pin.Force]:
+    """Wrench of the water on each joint body (LOCAL frame), all terms but M_A zeta_dot.
+
+    Needs ``forwardKinematics(model, data, q, v, 0)`` in ``uvms.data`` (placements, body
+    velocities and bias accelerations). The flow is sampled at each joint body's centre of
+    buoyancy (its origin if it has no volume) for added mass and Froude-Krylov, and at each
+    damped link's origin for damping. Vectorized over bodies: the per-body physics is the
+    pure functions of `uvms_pin.hydro`, called once on stacks.
+    """
+    model, data = uvms.model, uvms.data
+    nj = model.njoints
+    rotation = np.array([data.oMi[j].rotation for j in range(nj)])  # (nj, 3, 3)
+    velocity = np.array([data.v[j].vector for j in range(nj)])  # (nj, 6), LOCAL
+    wrench = np.zeros((nj, 6))
+    if flow is not None:
+        cob_world = np.array(
+            [data.oMi[j].act(uvms.center_of_buoyancy_per_joint_m[j]) for j in range(nj)]
+        )
+        flow_velocity_world, flow_acceleration_world = flow.velocity_and_acceleration(
+            time_s, cob_world
+        )
+
+    joints = list(uvms.joints_with_added_mass)
+    if joints:
+        nu = velocity[joints]
+        acc = np.array([data.a[j].vector for j in joints])
+        if flow is not None:
+            nu_c = current_velocity_body(rotation[joints], flow_velocity_world[joints])
+            acc = acc - flow_twist_rate_body(
+                rotation[joints], nu[:, 3:], nu_c[:, :3], flow_acceleration_world[joints]
+            )
+            nu = nu - nu_c
+        added = uvms.added_mass_per_joint[joints]
+        wrench[joints] -= mat_vec(added, acc) + kirchhoff_wrench(added, nu)
+
+    joints = list(uvms.joints_with_volume)
+    if joints:
+        volume, cob = uvms.volume_per_joint_m3[joints], uvms.center_of_buoyancy_per_joint_m[joints]
+        wrench[joints] += buoyancy_wrench(
+            volume, cob, rotation[joints], uvms.water_density_kg_m3, model.gravity.linear
+        )
+        if flow is not None:
+            wrench[joints] += froude_krylov_wrench(
+                volume,
+                cob,
+                rotation[joints],
+                uvms.water_density_kg_m3,
+                flow_acceleration_world[joints],
+            )
+
+    ids = uvms.damping_joint_ids
+    if ids.size:
+        nu_r = mat_vec(uvms.damping_action, velocity[ids])  # body velocity of each link
+        if flow is not None:
+            body_rotation = np.matmul(rotation[ids], uvms.damping_rotation_in_joint)
+            origin_world = np.einsum(
+                "kij,kj->ki", rotation[ids], uvms.damping_origin_in_joint_m
+            ) + np.array([data.oMi[int(j)].translation for j in ids])
+            nu_r = nu_r - current_velocity_body(body_rotation, flow.velocity(time_s, origin_world))
+        wrench_body = damping_wrench(uvms.damping_linear, uvms.damping_quadratic, nu_r)
+        # back to the joint frame: f_joint = X^T f_body
+        np.add.at(wrench, ids, mat_t_vec(uvms.damping_action, wrench_body))
+    return [pin.Force(w) for w in wrench]
+
+
+def _mass_matrix(uvms: UVMS, q: np.ndarray) -> np.ndarray:
+    model, data = uvms.model, uvms.data
+    pin.crba(model, data, q)
+    mass = np.triu(data.M)
+    mass = mass + np.triu(mass, 1).T  # crba fills the upper triangle only
+    if uvms.joints_with_added_mass:
+        pin.computeJointJacobians(model, data, q)
+        for j in uvms.joints_with_added_mass:
+            jac = pin.getJointJacobian(model, data, j, pin.LOCAL)
+            mass += jac.T @ uvms.added_mass_per_joint[j] @ jac
+    return mass
+
+
+def _bias_forces(
+    uvms: UVMS, q: np.ndarray, v: np.ndarray, flow: FlowField | None, time_s: float
+) -> np.ndarray:
+    model, data = uvms.model, uvms.data
+    zero = np.zeros(model.nv)
+    pin.forwardKinematics(model, data, q, v, zero)
+    fext = _fluid_wrenches(uvms, flow, time_s)
+    # rnea(q, v, 0, fext) = C_RB v + g_RB - sum_i J_i^T fext_i
+    return pin.rnea(model, data, q, v, zero, fext).copy()
+
+
+def _solve(uvms: UVMS, q: np.ndarray, rhs: np.ndarray) -> np.ndarray:
+    """M(q)^-1 rhs by a Cholesky factorisation (no inverse)."""
+    mass = _mass_matrix(uvms, q)
+    try:
+        factor = cho_factor(mass, lower=False, check_finite=False)
+    except np.linalg.LinAlgError as exc:
+        raise SimulationError(f"mass matrix is not positive definite at q = {q}") from exc
+    return cho_solve(factor, rhs, check_finite=False)
+
+
+class ReferenceDynamics:
+    """M, h and the forward dynamics of one UVMS, in Python: the readable reference.
+
+    The ``*_in`` methods take any `uvms_pin.flow.FlowField` evaluated at ``time_s``; the
+    others a uniform, constant current (3,) [m/s] in the world frame.
+    """
+
+    def __init__(self, uvms: UVMS):
+        self.uvms = uvms
+
+    def _state(self, q, v=None) -> tuple[np.ndarray, np.ndarray | None]:
+        q = finite_vector("q", q, self.uvms.nq)
+        return q, None if v is None else finite_vector("v", v, self.uvms.nv)
+
+    def mass_matrix(self, q: np.ndarray) -> np.ndarray:
+        q, _ = self._state(q)
+        return _mass_matrix(self.uvms, q)
+
+    def bias_forces(self, q: np.ndarray, v: np.ndarray, current_world: np.ndarray) -> np.ndarray:
+        return self.bias_forces_in(q, v, _uniform(current_world), 0.0)
+
+    def bias_forces_in(
+        self, q: np.ndarray, v: np.ndarray, flow: FlowField | None, time_s: float
+    ) -> np.ndarray:
+        q, v = self._state(q, v)
+        return _bias_forces(self.uvms, q, v, flow, check_time(time_s))
+
+    def forward_dynamics(
+        self,
+        q: np.ndarray,
+        v: np.ndarray,
+        tau: np.ndarray,
+        current_world: np.ndarray,
+        tau_ext: np.ndarray | None = None,
+    ) -> np.ndarray:
+        return self.forward_dynamics_in(q, v, tau, _uniform(current_world), 0.0, tau_ext)
+
+    def forward_dynamics_in(
+        self,
+        q: np.ndarray,
+        v: np.ndarray,
+        tau: np.ndarray,
+        flow: FlowField | None,
+        time_s: float,
+        tau_ext: np.ndarray | None = None,
+    ) -> np.ndarray:
+        q, v = self._state(q, v)
+        rhs = finite_vector("tau", tau, self.uvms.nv) - _bias_forces(
+            self.uvms, q, v, flow, check_time(time_s)
+        )
+        if tau_ext is not None:
+            rhs += finite_vector("tau_ext", tau_ext, self.uvms.nv)
+        return _solve(self.uvms, q, rhs)
+
+
+def _uniform(current_world: np.ndarray) -> UniformCurrent | None:
+    """The flow of a uniform current (None in still water)."""
+    current = finite_vector("current_world", current_world, 3)
+    return UniformCurrent(current) if np.any(current) else None
