@@ -15,27 +15,30 @@ from uvms_pin.errors import (
 
 # The rest is imported on first use (PEP 562): ``uvms-pin --help`` and argument errors
 # then answer without loading Pinocchio and SciPy.
-_LAZY = {
-    "bias_forces": "uvms_pin.physics.dynamics",
-    "forward_dynamics": "uvms_pin.physics.dynamics",
-    "frame_wrench_to_generalized": "uvms_pin.physics.dynamics",
-    "kinetic_energy": "uvms_pin.physics.dynamics",
-    "mass_matrix": "uvms_pin.physics.dynamics",
-    "potential_energy": "uvms_pin.physics.dynamics",
-    "HydroParams": "uvms_pin.hydro.params",
-    "Measurement": "uvms_pin.control.measurement",
-    "UVMS": "uvms_pin.model.uvms",
-    "HydroBody": "uvms_pin.model.uvms",
-    "load_uvms": "uvms_pin.model.urdf.load",
-    "mount_arm": "uvms_pin.model.mount.mount",
-    "shipped_path": "uvms_pin.model.resources",
-    "Rollout": "uvms_pin.results.rollout",
-    "load_scenario": "uvms_pin.scenario.load",
-    "simulate": "uvms_pin.sim.run",
-}
-
-
-__getattr__, __dir__ = lazy_exports(__name__, _LAZY)
+__getattr__, __dir__, _lazy_names = lazy_exports(
+    __name__,
+    {
+        "uvms_pin.physics.dynamics": (
+            "bias_forces",
+            "forward_dynamics",
+            "frame_wrench_to_generalized",
+            "kinetic_energy",
+            "mass_matrix",
+            "potential_energy",
+        ),
+        "uvms_pin.hydro.params": ("HydroParams",),
+        "uvms_pin.control.base": ("Controller",),
+        "uvms_pin.control.measurement": ("Measurement",),
+        "uvms_pin.model.uvms": ("UVMS", "HydroBody"),
+        "uvms_pin.model.urdf.load": ("load_uvms",),
+        "uvms_pin.model.mount.mount": ("mount_arm",),
+        "uvms_pin.model.resources": ("shipped_path",),
+        "uvms_pin.results.rollout": ("Rollout",),
+        "uvms_pin.results.status": ("RunStatus",),
+        "uvms_pin.scenario.load": ("load_scenario",),
+        "uvms_pin.sim.run": ("Scenario", "simulate"),
+    },
+)
 
 _moved.install()
 
@@ -43,6 +46,7 @@ __version__ = "0.1.0"
 
 __all__ = [
     "UVMS",
+    "Controller",
     "FunnelViolation",
     "HydroBody",
     "HydroParams",
@@ -51,6 +55,8 @@ __all__ = [
     "ModelWarning",
     "ParameterError",
     "Rollout",
+    "RunStatus",
+    "Scenario",
     "ScenarioError",
     "SimulationError",
     "UvmsPinError",

@@ -9,11 +9,13 @@ from typing import Any
 
 
 def lazy_exports(
-    package: str, exports: dict[str, str]
-) -> tuple[Callable[[str], Any], Callable[[], list[str]]]:
-    """``(__getattr__, __dir__)`` for ``package``: each name of ``exports`` is taken from its
-    module (name -> full module path) when first asked for, then kept in the package."""
+    package: str, names_by_module: dict[str, tuple[str, ...]]
+) -> tuple[Callable[[str], Any], Callable[[], list[str]], list[str]]:
+    """``(__getattr__, __dir__, __all__)`` for ``package``: each name of ``names_by_module``
+    (full module path -> the names it gives) is taken from its module when first asked for,
+    then kept in the package."""
     namespace = import_module(package).__dict__
+    exports = {name: module for module, names in names_by_module.items() for name in names}
 
     def __getattr__(name: str) -> Any:
         module = exports.get(name)
@@ -26,4 +28,4 @@ def lazy_exports(
     def __dir__() -> list[str]:
         return sorted({*namespace, *exports})
 
-    return __getattr__, __dir__
+    return __getattr__, __dir__, sorted(exports)

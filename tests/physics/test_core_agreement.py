@@ -93,7 +93,7 @@ def _plants(uvms, rng):
 def _attach_inside(plant: Plant, q0: np.ndarray) -> None:
     plant.attach(q0)
     if isinstance(plant.contact, CompliantPlane):
-        plant.contact._point = plant.contact._point + 0.01 * plant.contact.normal_world
+        plant.contact._at = plant.contact._at + 0.01 * plant.contact.normal_world
         plant.__dict__.pop("_compiled", None)
 
 

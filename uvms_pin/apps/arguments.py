@@ -71,3 +71,28 @@ def comma_names(option: str, text: str, what: str = "names") -> list[str]:
     if twice:
         raise ParameterError(f"{option} {text!r}: {', '.join(twice)} given twice")
     return names
+
+
+def add_comparison_command(
+    subparsers,
+    name: str,
+    summary: str,
+    description: str,
+    *,
+    scenario_required: bool = True,
+    out_default: str | None = None,
+) -> argparse.ArgumentParser:
+    """A command that runs one scenario's task several ways and writes a comparison into an
+    output directory: its parser with the ``scenario`` argument, ``--out`` (required unless
+    ``out_default``) and ``--overwrite``."""
+    from uvms_pin.results.outdir import OVERWRITE_HELP
+
+    parser = subparsers.add_parser(name, help=summary, description=description)
+    parser.add_argument(
+        "scenario", nargs=None if scenario_required else "?", help="scenario TOML file"
+    )
+    parser.add_argument(
+        "--out", required=out_default is None, default=out_default, help="output directory"
+    )
+    parser.add_argument("--overwrite", action="store_true", help=OVERWRITE_HELP)
+    return parser

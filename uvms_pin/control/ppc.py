@@ -73,18 +73,13 @@ from uvms_pin.control.ppc_kernel import PpcKernel
 from uvms_pin.control.ppc_params import PPCParams
 from uvms_pin.control.pseudo_inverse import pseudo_inverse
 from uvms_pin.control.task_space import (
-    JointLimitPull,
-    ReferenceVelocity,
-    arm_velocity_names,
+    ForceOrientationTask,
     check_measurement,
     first_level_error,
-    require_free_flyer,
-    signal_of_time,
 )
 from uvms_pin.physics.compiled.backend import Fallback, backend_named
 from uvms_pin.physics.kinematics import (
     check_euler_singularity,
-    frame_id_from_name,
     frame_rotation_and_jacobian,
 )
 from uvms_pin.results.components import FIRST_LEVEL_NAMES, VEHICLE_VELOCITY_NAMES
@@ -173,19 +168,17 @@ class PrescribedPerformanceController(Controller):
         backend: str = "core",
     ):
         self.backend = backend_named(backend).name
-        require_free_flyer(model)
-        self.model = pin.Model(model)  # private copy: later edits of `model` do not leak in
-        self.data = self.model.createData()
-        self.ee_frame_name = ee_frame_name
-        self.ee_frame_id = frame_id_from_name(self.model, ee_frame_name)
-        self.params = (params if params is not None else PPCParams()).sized(self.model.nv)
-        self._desired_force = signal_of_time(desired_force_world_N, "desired_force_world_N", 3)
-        self._desired_rpy = signal_of_time(
-            self.params.desired_rpy if desired_rpy is None else desired_rpy, "desired_rpy", 3
+        task = ForceOrientationTask(
+            model, ee_frame_name, params or PPCParams(), desired_force_world_N, desired_rpy
         )
-
+        self.task = task
+        self.model, self.data, self.ee_frame_id = task.model, task.data, task.ee_frame_id
+        self.ee_frame_name = ee_frame_name
+        self.params = task.params
+        self._desired_force, self._desired_rpy = task.desired_force, task.desired_rpy
+        self._pull, self._reference = task.pull, task.reference
         self.first_level_names = FIRST_LEVEL_NAMES
-        self.second_level_names = VEHICLE_VELOCITY_NAMES + tuple(arm_velocity_names(self.model))
+        self.second_level_names = task.velocity_names
         self.performance_x = PerformanceFunction(
             self.params.rho0_x, self.params.rho_inf_x, self.params.l_x_per_s, self.first_level_names
         )
@@ -194,17 +187,6 @@ class PrescribedPerformanceController(Controller):
             self.params.rho_inf_zeta,
             self.params.l_zeta_per_s,
             self.second_level_names,
-        )
-        self._pull = JointLimitPull(
-            self.model, self.params.null_space_gain_per_s, self.params.null_space_target
-        )
-        self._reference = ReferenceVelocity(
-            self.model,
-            self.data,
-            self.ee_frame_id,
-            self.params.velocity_weights,
-            self.params.pinv_relative_cutoff,
-            self._pull,
         )
         self._extend_beyond_funnels = False
         self._margin = np.inf

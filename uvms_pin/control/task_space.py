@@ -16,13 +16,15 @@ import pinocchio as pin
 from numpy.typing import ArrayLike
 
 from uvms_pin.control.measurement import Measurement
-from uvms_pin.control.ppc_params import N_VEHICLE, sized_vector
+from uvms_pin.control.ppc_params import N_VEHICLE, PPCParams, sized_vector
 from uvms_pin.control.pseudo_inverse import MinimumNormSolver, pseudo_inverse
 from uvms_pin.errors import ParameterError
 from uvms_pin.physics.kinematics import (
     analytical_jacobian,
     angular_velocity_world_from_euler_rates,
+    frame_id_from_name,
 )
+from uvms_pin.results.components import VEHICLE_VELOCITY_NAMES
 
 _TWO_PI = 2.0 * math.pi
 #: Joint position limits at or beyond this magnitude are treated as absent (Pinocchio marks
@@ -220,3 +222,48 @@ class ReferenceVelocity:
         if zeta_0 is not None:
             zeta_r = zeta_r + zeta_0 - jacobian_pinv @ (jacobian @ zeta_0)
         return zeta_r
+
+
+class ForceOrientationTask:
+    """The force/orientation task of one end-effector: a private copy of the model, the
+    frame, the (sized) parameters, the desired signals f_d(t) [N] and rpy_d(t) [rad], the
+    names of the generalized velocities, the null-space pull and the reference velocity.
+
+    Args:
+        model: the UVMS kinematic model (free-flyer root; copied: later edits do not leak in).
+        ee_frame_name: the end-effector frame.
+        params: the PPC's parameters (the baselines use its J^# and null-space ones).
+        desired_force_world_N, desired_rpy: constants or functions of time; ``desired_rpy``
+            None: ``params.desired_rpy``.
+
+    Raises:
+        ParameterError: not a free-flyer root, an unknown frame, invalid parameters.
+    """
+
+    def __init__(
+        self,
+        model: pin.Model,
+        ee_frame_name: str,
+        params: PPCParams,
+        desired_force_world_N: Callable[[float], ArrayLike] | ArrayLike,
+        desired_rpy: Callable[[float], ArrayLike] | ArrayLike | None,
+    ):
+        require_free_flyer(model)
+        self.model = pin.Model(model)
+        self.data = self.model.createData()
+        self.ee_frame_id = frame_id_from_name(self.model, ee_frame_name)
+        self.params = params.sized(self.model.nv)
+        self.desired_force = signal_of_time(desired_force_world_N, "desired_force_world_N", 3)
+        rpy = self.params.desired_rpy if desired_rpy is None else desired_rpy
+        self.desired_rpy = signal_of_time(rpy, "desired_rpy", 3)
+        self.velocity_names = VEHICLE_VELOCITY_NAMES + tuple(arm_velocity_names(self.model))
+        p = self.params
+        self.pull = JointLimitPull(self.model, p.null_space_gain_per_s, p.null_space_target)
+        self.reference = ReferenceVelocity(
+            self.model,
+            self.data,
+            self.ee_frame_id,
+            p.velocity_weights,
+            p.pinv_relative_cutoff,
+            self.pull,
+        )

@@ -6,12 +6,11 @@ mounted on vehicles, trim, thruster layouts, shipped files.
 
 from uvms_pin._lazy import lazy_exports
 
-_EXPORTS = {
-    "DEFAULT_WATER_DENSITY_KG_M3": "uvms_pin.model.uvms",
-    "HydroBody": "uvms_pin.model.uvms",
-    "UVMS": "uvms_pin.model.uvms",
-    "load_uvms": "uvms_pin.model.urdf.load",
-    "read_urdf_root": "uvms_pin.model.urdf.read",
-}
-__all__ = sorted(_EXPORTS)
-__getattr__, __dir__ = lazy_exports(__name__, _EXPORTS)
+__getattr__, __dir__, __all__ = lazy_exports(
+    __name__,
+    {
+        "uvms_pin.model.uvms": ("DEFAULT_WATER_DENSITY_KG_M3", "HydroBody", "UVMS"),
+        "uvms_pin.model.urdf.load": ("load_uvms",),
+        "uvms_pin.model.urdf.read": ("read_urdf_root",),
+    },
+)

@@ -36,8 +36,29 @@ class ContactModel(ABC):
         return {"type": type(self).__name__}
 
 
+class PlacedContact(ContactModel):
+    """A contact placed at a given world point, or where the tip is when the run starts
+    (`attach`)."""
+
+    _given: np.ndarray | None = None  # the point given (None: the tip's at t = 0)
+    _at: np.ndarray | None = None  # the effective point, set by attach() when not given
+
+    def _place(self, label: str, point) -> np.ndarray | None:
+        """``point`` checked (or None): the point given, where the model stays."""
+        self._given = self._at = None if point is None else finite_vector(label, point, 3)
+        return self._given
+
+    def attach(self, position_world_m):
+        given = self._given
+        self._at = np.array(position_world_m if given is None else given, dtype=float)
+
+    def placed_at(self) -> list[float] | None:
+        """The effective point as a list (for records), None before a run."""
+        return None if self._at is None else self._at.tolist()
+
+
 @dataclass
-class LinearSpring(ContactModel):
+class LinearSpring(PlacedContact):
     """The paper's environment: f_e = K_f (p - p_0), anchored where the tip is at t = 0.
 
     Attributes:
@@ -52,38 +73,28 @@ class LinearSpring(ContactModel):
         self.stiffness_N_m = finite_vector("spring stiffness_N_m", self.stiffness_N_m, 3)
         if np.any(self.stiffness_N_m < 0.0):
             raise ParameterError(f"spring stiffness must be >= 0, got {self.stiffness_N_m}")
-        if self.anchor_world_m is not None:
-            self.anchor_world_m = finite_vector("spring anchor_world_m", self.anchor_world_m, 3)
-        self._anchor = self.anchor_world_m  # the effective anchor, set again by attach()
+        self.anchor_world_m = self._place("spring anchor_world_m", self.anchor_world_m)
 
     @property
     def anchor(self) -> np.ndarray | None:
         """The effective anchor p_0 (3,) [m]: the given one, or the one `attach` set; None
         before a run."""
-        return self._anchor
+        return self._at
 
     def record(self) -> dict[str, Any]:
-        anchor = self.anchor
-        return {
-            "type": "spring",
-            "stiffness_N_m": self.stiffness_N_m.tolist(),
-            "anchor_world_m": None if anchor is None else anchor.tolist(),
-        }
-
-    def attach(self, position_world_m):
-        given = self.anchor_world_m
-        self._anchor = np.array(position_world_m if given is None else given, dtype=float)
+        stiffness = self.stiffness_N_m.tolist()
+        return {"type": "spring", "stiffness_N_m": stiffness, "anchor_world_m": self.placed_at()}
 
     def wrench_on_environment_world(self, position_world_m, velocity_world_m_s):
-        if self._anchor is None:
+        if self._at is None:
             raise ParameterError("LinearSpring has no anchor: call attach() or give anchor_world_m")
         out = np.zeros(6)
-        out[:3] = self.stiffness_N_m * (position_world_m - self._anchor)
+        out[:3] = self.stiffness_N_m * (position_world_m - self._at)
         return out
 
 
 @dataclass
-class CompliantPlane(ContactModel):
+class CompliantPlane(PlacedContact):
     """A unilateral Kelvin-Voigt surface: pushes back only while the tip is inside it.
 
     With penetration d = (p_s - p) . n (n: outward normal, towards the robot),
@@ -110,36 +121,29 @@ class CompliantPlane(ContactModel):
             raise ParameterError(f"plane stiffness_N_m must be positive, got {self.stiffness_N_m}")
         if not (self.damping_N_s_m >= 0.0 and math.isfinite(self.damping_N_s_m)):
             raise ParameterError(f"plane damping_N_s_m must be >= 0, got {self.damping_N_s_m}")
-        if self.point_world_m is not None:
-            self.point_world_m = finite_vector("plane point_world_m", self.point_world_m, 3)
-        self._point = self.point_world_m  # the effective surface point, set again by attach()
+        self.point_world_m = self._place("plane point_world_m", self.point_world_m)
 
     @property
     def point(self) -> np.ndarray | None:
         """The effective surface point (3,) [m]: the given one, or the one `attach` set;
         None before a run."""
-        return self._point
+        return self._at
 
     def record(self) -> dict[str, Any]:
-        point = self.point
         return {
             "type": "plane",
             "normal_world": self.normal_world.tolist(),
-            "point_world_m": None if point is None else point.tolist(),
+            "point_world_m": self.placed_at(),
             "stiffness_N_m": float(self.stiffness_N_m),
             "damping_N_s_m": float(self.damping_N_s_m),
         }
 
-    def attach(self, position_world_m):
-        given = self.point_world_m
-        self._point = np.array(position_world_m if given is None else given, dtype=float)
-
     def wrench_on_environment_world(self, position_world_m, velocity_world_m_s):
-        if self._point is None:
+        if self._at is None:
             raise ParameterError(
                 "CompliantPlane has no surface point: call attach() or give point_world_m"
             )
-        depth = float((self._point - position_world_m) @ self.normal_world)
+        depth = float((self._at - position_world_m) @ self.normal_world)
         out = np.zeros(6)
         if depth <= 0.0:
             return out

@@ -12,6 +12,7 @@ import sys
 import time
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager
+from dataclasses import dataclass
 from typing import TextIO
 
 from uvms_pin.errors import ParameterError
@@ -53,6 +54,7 @@ class ProgressBar:
         self._bar.close()
 
 
+@dataclass
 class ProgressLines:
     """Progress as text lines on ``stream`` (a log file or a pipe: no redrawing), one when
     ``delay_s`` of wall time has passed, then one every ``interval_s``, and the last one::
@@ -60,19 +62,15 @@ class ProgressLines:
         realistic_force_tracking [#########                     ] t =   3.000/10 s  elapsed    4.1 s  left ~    9.6 s
     """
 
-    def __init__(
-        self,
-        label: str,
-        duration_s: float,
-        stream: TextIO,
-        delay_s: float = 0.0,
-        interval_s: float = 10.0,
-    ):
-        self.label = label
-        self.stream = stream
-        self.interval_s = interval_s
+    label: str
+    duration_s: float
+    stream: TextIO
+    delay_s: float = 0.0
+    interval_s: float = 10.0
+
+    def __post_init__(self) -> None:
         self.start = time.perf_counter()
-        self.next_s = delay_s  # wall time of the next line, from the start
+        self.next_s = self.delay_s  # wall time of the next line, from the start
         self.printed = False
 
     def __call__(self, t_s: float, duration_s: float) -> None:

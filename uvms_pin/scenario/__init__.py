@@ -10,13 +10,12 @@ table builds its concept (`water`, `initial`, `world`, `actuation`, `sensors`, `
 
 from uvms_pin._lazy import lazy_exports
 
-_EXPORTS = {
-    "Scenario": "uvms_pin.sim.run",
-    "apply_overrides": "uvms_pin.scenario.overrides",
-    "baseline_controller_table": "uvms_pin.scenario.baselines",
-    "load_scenario": "uvms_pin.scenario.load",
-    "scenario_from_raw": "uvms_pin.scenario.load",
-    "simulate": "uvms_pin.sim.run",
-}
-__all__ = sorted(_EXPORTS)
-__getattr__, __dir__ = lazy_exports(__name__, _EXPORTS)
+__getattr__, __dir__, __all__ = lazy_exports(
+    __name__,
+    {
+        "uvms_pin.sim.run": ("Scenario", "simulate"),
+        "uvms_pin.scenario.load": ("load_scenario", "scenario_from_raw"),
+        "uvms_pin.scenario.overrides": ("apply_overrides",),
+        "uvms_pin.scenario.baselines": ("baseline_controller_table",),
+    },
+)

@@ -13,11 +13,15 @@ from uvms_pin.control.base import Controller
 from uvms_pin.control.baselines.computed_torque import ComputedTorqueController
 from uvms_pin.control.baselines.impedance import ImpedanceController
 from uvms_pin.control.baselines.pi_force import PIForceController
-from uvms_pin.errors import ParameterError, ScenarioError
+from uvms_pin.errors import ScenarioError
 from uvms_pin.model.scaled import scaled_uvms
 from uvms_pin.model.uvms import UVMS
-from uvms_pin.scenario.ppc import ee_frame_name
-from uvms_pin.scenario.profiles import plain, sine_profile
+from uvms_pin.scenario.controller_parts import (
+    checked_spec,
+    desired_force_profile,
+    ee_frame_name,
+    plain,
+)
 from uvms_pin.scenario.schema import Table
 from uvms_pin.sim.run import ControllerSpec
 
@@ -100,26 +104,16 @@ def build_baseline(t: Table, uvms: UVMS, kind: str) -> ControllerSpec:
     if baseline.pseudo_inverse and t.has("null_space_gain_per_s"):
         fields["null_space_gain_per_s"] = t.number("null_space_gain_per_s", nonneg=True)
     fields["desired_rpy"] = t.vector("desired_rpy", 3, [0.0, 0.0, 0.0])
-    force_table = t.table("desired_force")
-    force_raw = {} if force_table is None else force_table.data
-    fields["desired_force_world_N"] = sine_profile(force_table, 3)
+    fields["desired_force_world_N"], force_raw = desired_force_profile(t)
     factors = _model_error(t.table("model_error") if baseline.model_error else None)
     t.finish()
 
     def build(u: UVMS) -> Controller:
         return baseline.build(u, ee_frame, fields, factors)
 
-    try:
-        build(uvms)  # built once now, so a bad parameter is found before the run
-    except ParameterError as exc:
-        raise t.fail(str(exc)) from exc
-    recorded = {
-        "ee_frame": ee_frame,
-        "desired_force": force_raw,
-        "model_error": factors,
-        **{k: plain(v) for k, v in fields.items() if k != "desired_force_world_N"},
-    }
-    return ControllerSpec(kind, recorded, build)
+    parameters = {k: plain(v) for k, v in fields.items() if k != "desired_force_world_N"}
+    recorded = {"ee_frame": ee_frame, "desired_force": force_raw, "model_error": factors}
+    return checked_spec(t, uvms, kind, {**recorded, **parameters}, build)
 
 
 def _model_error(t: Table | None) -> dict[str, float]:

@@ -16,6 +16,7 @@ from abc import ABC, abstractmethod
 from collections.abc import Callable
 from dataclasses import dataclass
 from types import ModuleType
+from typing import ClassVar
 
 import numpy as np
 import pinocchio as pin
@@ -89,44 +90,54 @@ def python_chart(model: pin.Model) -> Chart:
     return chart
 
 
-def _fixed_step(core: ModuleType, method, step_s: float):
-    """The core's FixedStep: ``method`` in substeps no longer than ``step_s`` [s]."""
-    out = core.FixedStep()
-    out.method = method
-    out.step_s = float(step_s)
-    return out
-
-
 def _substeps(t0: float, t1: float, max_step_s: float) -> tuple[int, float]:
     n = max(1, math.ceil((t1 - t0) / max_step_s - 1e-9))
     return n, (t1 - t0) / n
 
 
 @dataclass(frozen=True)
-class RK4(Integrator):
-    """Classical 4th-order Runge-Kutta in the local chart (Runge-Kutta-Munthe-Kaas).
-
-    Takes equal substeps no longer than ``step_s`` [s] between t0 and t1.
-    """
+class FixedStep(Integrator):
+    """An integrator taking equal substeps no longer than ``step_s`` [s] between t0 and t1,
+    in one compiled call per interval when the plant runs in the core (``core_method``: the
+    name of its counterpart in src/uvms_core/integrators.hpp)."""
 
     step_s: float = 1e-3
+    core_method: ClassVar[str] = ""
 
     def __post_init__(self) -> None:
         if not (self.step_s > 0.0 and math.isfinite(self.step_s)):
-            raise ParameterError(f"RK4 step_s must be positive, got {self.step_s}")
+            raise ParameterError(
+                f"{type(self).__name__} step_s must be positive, got {self.step_s}"
+            )
 
     def advance(self, model, rhs, t0, q0, v0, t1):
         n, h = _substeps(t0, t1, self.step_s)
         q, v = q0, v0
         for k in range(n):
-            q, v = self._step(model, rhs, t0 + k * h, q, v, h)
+            q, v = self.step(model, rhs, t0 + k * h, q, v, h)
         return q, v
 
-    def to_core(self, backend):
-        return backend.counterpart(lambda core: _fixed_step(core, core.Method.rk4, self.step_s))
+    @abstractmethod
+    def step(self, model, rhs, t, q, v, h):
+        """(q, v) one substep h [s] after (q, v) at t."""
 
-    @staticmethod
-    def _step(model, rhs, t, q0, v0, h):
+    def to_core(self, backend):
+        def build(core: ModuleType):
+            out = core.FixedStep()
+            out.method = getattr(core.Method, self.core_method)
+            out.step_s = float(self.step_s)
+            return out
+
+        return backend.counterpart(build)
+
+
+@dataclass(frozen=True)
+class RK4(FixedStep):
+    """Classical 4th-order Runge-Kutta in the local chart (Runge-Kutta-Munthe-Kaas)."""
+
+    core_method: ClassVar[str] = "rk4"
+
+    def step(self, model, rhs, t, q0, v0, h):
         a1 = rhs(t, q0, v0)
         d1 = v0  # Jint(q0, 0) = identity
         delta2 = 0.5 * h * d1
@@ -150,27 +161,15 @@ class RK4(Integrator):
 
 
 @dataclass(frozen=True)
-class SemiImplicitEuler(Integrator):
+class SemiImplicitEuler(FixedStep):
     """Symplectic Euler: v+ = v + h a(q, v); q+ = integrate(q, h v+). One rhs call per step."""
 
     step_s: float = 1e-4
+    core_method: ClassVar[str] = "semi_implicit_euler"
 
-    def __post_init__(self) -> None:
-        if not (self.step_s > 0.0 and math.isfinite(self.step_s)):
-            raise ParameterError(f"SemiImplicitEuler step_s must be positive, got {self.step_s}")
-
-    def advance(self, model, rhs, t0, q0, v0, t1):
-        n, h = _substeps(t0, t1, self.step_s)
-        q, v = q0, v0
-        for k in range(n):
-            v = v + h * rhs(t0 + k * h, q, v)
-            q = pin.integrate(model, q, h * v)
-        return q, v
-
-    def to_core(self, backend):
-        return backend.counterpart(
-            lambda core: _fixed_step(core, core.Method.semi_implicit_euler, self.step_s)
-        )
+    def step(self, model, rhs, t, q, v, h):
+        v = v + h * rhs(t, q, v)
+        return pin.integrate(model, q, h * v), v
 
 
 @dataclass(frozen=True)

@@ -10,9 +10,9 @@ import argparse
 import math
 import sys
 
-from uvms_pin.apps.arguments import comma_names, count, finite, positive
+from uvms_pin.apps.arguments import add_comparison_command, comma_names, count, finite, positive
 from uvms_pin.model.mount.catalog import available_arms
-from uvms_pin.results.outdir import COMPARISON, OVERWRITE_HELP, check_writable, claim
+from uvms_pin.results.outdir import COMPARISON, check_writable, claim
 
 EXIT_BAD_INPUT = 2
 DEFAULT_ARMS = "reference,so100,z1,kinova,ur3,ur5,panda"
@@ -60,26 +60,24 @@ def _cmd_compare_arms(args: argparse.Namespace) -> int:
 
 def register(subparsers) -> argparse.ArgumentParser:
     """Add the ``compare-arms`` subcommand to the ``uvms-pin`` parser's subparsers."""
-    parser = subparsers.add_parser(
+    parser = add_comparison_command(
+        subparsers,
         "compare-arms",
-        help="run a scenario's task with several arms mounted on its vehicle and compare them",
-        description=(
-            "Mount each arm (a name from example-robot-data, 'reference' or a URDF path) on the "
-            "scenario's vehicle, solve the initial configuration, trim, run the task and write "
-            "comparison.csv, comparison.md and comparison.png."
-        ),
+        "run a scenario's task with several arms mounted on its vehicle and compare them",
+        "Mount each arm (a name from example-robot-data, 'reference' or a URDF path) on the "
+        "scenario's vehicle, solve the initial configuration, trim, run the task and write "
+        "comparison.csv, comparison.md and comparison.png.",
+        scenario_required=False,
+        out_default="out/compare_arms",
     )
-    parser.add_argument("scenario", nargs="?", help="scenario TOML file")
     parser.add_argument(
         "--arms",
         default=DEFAULT_ARMS,
         help=f"comma-separated arm names or URDF paths (default {DEFAULT_ARMS})",
     )
-    parser.add_argument("--out", default="out/compare_arms", help="output directory")
     parser.add_argument("--duration", type=positive, default=None, help="override the duration [s]")
     parser.add_argument("--jobs", type=count(1), default=1, help="arms run in parallel processes")
     parser.add_argument("--no-trim", action="store_true", help="do not add foam and ballast")
-    parser.add_argument("--overwrite", action="store_true", help=OVERWRITE_HELP)
     parser.add_argument(
         "--bg", type=finite, default=0.02, help="metacentric height BG after trim [m]"
     )

@@ -5,9 +5,15 @@ from __future__ import annotations
 import argparse
 import sys
 
-from uvms_pin.apps.arguments import add_set_option, comma_names, count, positive
+from uvms_pin.apps.arguments import (
+    add_comparison_command,
+    add_set_option,
+    comma_names,
+    count,
+    positive,
+)
 from uvms_pin.errors import ParameterError
-from uvms_pin.results.outdir import CONTROLLER_COMPARISON, OVERWRITE_HELP, check_writable, claim
+from uvms_pin.results.outdir import CONTROLLER_COMPARISON, check_writable, claim
 from uvms_pin.scenario.overrides import parse_assignment
 
 DEFAULT_CONTROLLERS = "ppc,pi_force,impedance,computed_torque"
@@ -63,24 +69,20 @@ def _cmd_compare_controllers(args: argparse.Namespace) -> int:
 
 def register(subparsers) -> argparse.ArgumentParser:
     """Add the ``compare-controllers`` subcommand to the ``uvms-pin`` parser."""
-    parser = subparsers.add_parser(
+    parser = add_comparison_command(
+        subparsers,
         "compare-controllers",
-        help="run a scenario's task with several controllers and compare them",
-        description=(
-            "Run the scenario once per controller (its own [controller] for its type, the "
-            "[baselines.<name>] tuning for the others, defaults if absent) and write "
-            "controllers.csv, controllers.md and figures."
-        ),
+        "run a scenario's task with several controllers and compare them",
+        "Run the scenario once per controller (its own [controller] for its type, the "
+        "[baselines.<name>] tuning for the others, defaults if absent) and write "
+        "controllers.csv, controllers.md and figures.",
     )
-    parser.add_argument("scenario", help="scenario TOML file")
     parser.add_argument(
         "--controllers",
         default=DEFAULT_CONTROLLERS,
         help=f"comma-separated: the scenario's own type and/or pi_force, impedance, "
         f"computed_torque (default {DEFAULT_CONTROLLERS})",
     )
-    parser.add_argument("--out", required=True, help="output directory")
-    parser.add_argument("--overwrite", action="store_true", help=OVERWRITE_HELP)
     add_set_option(
         parser, "override a scenario entry for every controller (repeatable), as in 'run'"
     )

@@ -55,12 +55,16 @@ class UvmsEnv(gym.Env):
         clip_actions: clip the action to [-1, 1] (False: pass it on; the actuation still
             saturates).
         initial_position_noise_m, initial_joint_noise_rad: bound of the uniform
-            perturbation of the vehicle position and of the arm joints at reset.
+            perturbation of the vehicle position [m] and of the arm joints [rad] at reset;
+            None: the environment's ``initial_noise`` (force tracking 0.02, 0.02; station
+            keeping 0.1, 0.05).
         effort_weight: w_effort of the reward. failure_penalty: reward of a diverged step.
         render_mode: None or "rgb_array".
     """
 
     metadata: ClassVar[dict[str, Any]] = {"render_modes": ["rgb_array"], "render_fps": 30}
+    #: bounds of the initial perturbation when not given: position [m], arm joints [rad]
+    initial_noise: ClassVar[tuple[float, float]] = (0.0, 0.0)
 
     def __init__(
         self,
@@ -70,14 +74,18 @@ class UvmsEnv(gym.Env):
         overrides: dict[str, Any] | None = None,
         action_scale: Any = None,
         clip_actions: bool = True,
-        initial_position_noise_m: float = 0.0,
-        initial_joint_noise_rad: float = 0.0,
+        initial_position_noise_m: float | None = None,
+        initial_joint_noise_rad: float | None = None,
         effort_weight: float = 0.01,
         failure_penalty: float = 100.0,
         render_mode: str | None = None,
     ):
         if render_mode is not None and render_mode not in self.metadata["render_modes"]:
             raise ParameterError(f"render_mode must be None or 'rgb_array', got {render_mode!r}")
+        if initial_position_noise_m is None:
+            initial_position_noise_m = self.initial_noise[0]
+        if initial_joint_noise_rad is None:
+            initial_joint_noise_rad = self.initial_noise[1]
         for label, value in (
             ("initial_position_noise_m", initial_position_noise_m),
             ("initial_joint_noise_rad", initial_joint_noise_rad),

@@ -31,24 +31,19 @@ class ForceTrackingEnv(UvmsEnv):
             (else `DEFAULT_FUNNEL`); False: no funnel termination.
     """
 
+    initial_noise = (0.02, 0.02)
+
     def __init__(
         self,
         scenario: str | Path = DEFAULT_SCENARIO,
         *,
         desired_force_N: Any = None,
         funnel: Any = None,
-        initial_position_noise_m: float = 0.02,
-        initial_joint_noise_rad: float = 0.02,
         **kwargs: Any,
     ):
         self._desired_force_option = desired_force_N
         self._funnel_option = funnel
-        super().__init__(
-            scenario,
-            initial_position_noise_m=initial_position_noise_m,
-            initial_joint_noise_rad=initial_joint_noise_rad,
-            **kwargs,
-        )
+        super().__init__(scenario, **kwargs)
 
     def _make_task(self, scenario: Scenario) -> ForceTrackingTask:
         if scenario.plant.contact is None:

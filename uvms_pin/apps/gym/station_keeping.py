@@ -19,22 +19,17 @@ class StationKeepingEnv(UvmsEnv):
         max_position_error_m: the episode ends when |p - p_d| exceeds it [m].
     """
 
+    initial_noise = (0.1, 0.05)
+
     def __init__(
         self,
         scenario: str | Path = DEFAULT_SCENARIO,
         *,
         max_position_error_m: float = 1.0,
-        initial_position_noise_m: float = 0.1,
-        initial_joint_noise_rad: float = 0.05,
         **kwargs: Any,
     ):
         self._max_position_error_m = max_position_error_m
-        super().__init__(
-            scenario,
-            initial_position_noise_m=initial_position_noise_m,
-            initial_joint_noise_rad=initial_joint_noise_rad,
-            **kwargs,
-        )
+        super().__init__(scenario, **kwargs)
 
     def _make_task(self, scenario: Scenario) -> StationKeepingTask:
         return StationKeepingTask(scenario.q0, self._max_position_error_m, self.effort_weight)

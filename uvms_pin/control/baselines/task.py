@@ -26,22 +26,16 @@ from numpy.typing import ArrayLike
 from uvms_pin.control.measurement import Measurement
 from uvms_pin.control.ppc_params import PPCParams
 from uvms_pin.control.task_space import (
-    JointLimitPull,
-    ReferenceVelocity,
-    arm_velocity_names,
+    ForceOrientationTask,
     check_measurement,
     first_level_error,
-    require_free_flyer,
-    signal_of_time,
 )
 from uvms_pin.errors import ParameterError
 from uvms_pin.physics.kinematics import (
     angular_velocity_world_from_euler_rates,
     check_euler_singularity,
-    frame_id_from_name,
     frame_rotation_and_jacobian,
 )
-from uvms_pin.results.components import VEHICLE_VELOCITY_NAMES
 
 __all__ = [
     "EndEffectorTask",
@@ -128,28 +122,19 @@ class EndEffectorTask:
         null_space_gain_per_s: float = 0.0,
         null_space_target: ArrayLike | None = None,
     ):
-        require_free_flyer(model)
-        self.model = pin.Model(model)  # private copy: later edits of `model` do not leak in
-        self.data = self.model.createData()
-        self.ee_frame_id = frame_id_from_name(self.model, ee_frame_name)
-        self.nv = self.model.nv
         params = PPCParams(
             velocity_weights=velocity_weights,
             null_space_gain_per_s=null_space_gain_per_s,
             null_space_target=null_space_target,
-        ).sized(self.nv)
-        self._desired_force = signal_of_time(desired_force_world_N, "desired_force_world_N", 3)
-        self._desired_rpy = signal_of_time(desired_rpy, "desired_rpy", 3)
-        self.velocity_names = VEHICLE_VELOCITY_NAMES + tuple(arm_velocity_names(self.model))
-        pull = JointLimitPull(self.model, params.null_space_gain_per_s, params.null_space_target)
-        self._reference = ReferenceVelocity(
-            self.model,
-            self.data,
-            self.ee_frame_id,
-            params.velocity_weights,
-            params.pinv_relative_cutoff,
-            pull,
         )
+        task = ForceOrientationTask(
+            model, ee_frame_name, params, desired_force_world_N, desired_rpy
+        )
+        self.model, self.data, self.ee_frame_id = task.model, task.data, task.ee_frame_id
+        self.nv = self.model.nv
+        self.velocity_names = task.velocity_names
+        self._desired_force, self._desired_rpy = task.desired_force, task.desired_rpy
+        self._reference = task.reference
 
     def evaluate(self, time_s: float, measurement: Measurement) -> TaskState:
         """The task at ``measurement``: errors, rotation and J^lwa (checks the input).

@@ -100,13 +100,7 @@ class MountResult:
 
 
 def mount_arm(
-    vehicle_urdf: str | Path,
-    arm_urdf: str | Path | ArmEntry,
-    mount_pose,
-    *,
-    arm_base_link: str | None = None,
-    ee_link: str | None = None,
-    **kwargs,
+    vehicle_urdf: str | Path, arm_urdf: str | Path | ArmEntry, mount_pose, **options
 ) -> UVMS:
     """Mount an arm on a vehicle: one UVMS (the vehicle is the free-flying root).
 
@@ -124,18 +118,16 @@ def mount_arm(
             ``ee_link`` and ``arm_base_link`` are the defaults).
         mount_pose: pose of the arm base in ``vehicle_link``: a ``pin.SE3``, a 4x4
             homogeneous matrix, or ``(xyz, rpy)`` [m, rad].
-        arm_base_link: the arm link bolted to the vehicle (default: the arm's root).
-        ee_link: the wrist/flange link carrying the F/T sensor (default: chosen, see the
-            module docstring).
-        **kwargs: see :func:`mount_arm_detailed`.
+        options: keywords of :func:`mount_arm_detailed`, e.g. ``arm_base_link`` (the arm
+            link bolted to the vehicle; default: the arm's root) and ``ee_link`` (the
+            wrist/flange link carrying the F/T sensor; default: chosen, see the module
+            docstring).
 
     Raises:
         ModelError: a file is malformed, a link is unknown, a closed chain, a missing mesh.
         ParameterError: a bad mount pose or tool.
     """
-    return mount_arm_detailed(
-        vehicle_urdf, arm_urdf, mount_pose, arm_base_link=arm_base_link, ee_link=ee_link, **kwargs
-    ).uvms
+    return mount_arm_detailed(vehicle_urdf, arm_urdf, mount_pose, **options).uvms
 
 
 def mount_arm_detailed(
@@ -161,6 +153,9 @@ def mount_arm_detailed(
     """:func:`mount_arm` with every option, returning the UVMS and what was done.
 
     Args (beyond :func:`mount_arm`'s):
+        arm_base_link: the arm link bolted to the vehicle (default: the arm's root).
+        ee_link: the wrist/flange link carrying the F/T sensor (default: chosen, see the
+            module docstring).
         vehicle_link: vehicle link the arm is bolted to (default: the vehicle's root).
         sensor_link: an existing arm link to use as the F/T sensor frame (then no
             ``ft_sensor`` frame is added; with ``tool=None`` and an ``ee_link`` named as

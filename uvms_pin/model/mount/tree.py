@@ -5,6 +5,7 @@ what is wrong."""
 from __future__ import annotations
 
 import xml.etree.ElementTree as ET
+from collections.abc import Iterator
 from pathlib import Path
 
 from uvms_pin.errors import ModelError
@@ -46,26 +47,27 @@ class URDFTree:
         """The checked tree of the URDF file at ``path``."""
         return cls(read_urdf_root(path), path)
 
-    def _read_links(self) -> None:
-        where = str(self.path)
-        for link in self.root.findall("link"):
-            name = link.get("name")
+    def _named(self, tag: str) -> Iterator[tuple[str, ET.Element]]:
+        """(name, element) of every ``<tag>`` of the file (ModelError for one with no name)."""
+        for element in self.root.findall(tag):
+            name = element.get("name")
             if not name:
-                raise ModelError("a <link> has no name", path=where)
+                raise ModelError(f"a <{tag}> has no name", path=str(self.path))
+            yield name, element
+
+    def _read_links(self) -> None:
+        for name, link in self._named("link"):
             if name in self.links:
-                raise ModelError("is defined twice", path=where, link=name)
+                raise ModelError("is defined twice", path=str(self.path), link=name)
             self.links[name] = link
             self.link_order.append(name)
         if not self.links:
-            raise ModelError("no <link> elements", path=where)
+            raise ModelError("no <link> elements", path=str(self.path))
         self.children = {n: [] for n in self.links}
 
     def _read_joints(self) -> None:
         where = str(self.path)
-        for joint in self.root.findall("joint"):
-            name = joint.get("name")
-            if not name:
-                raise ModelError("a <joint> has no name", path=where)
+        for name, joint in self._named("joint"):
             if name in self.joints:
                 raise ModelError(f"joint '{name}' is defined twice", path=where)
             parent, child = self._ends(joint, name)

@@ -7,7 +7,7 @@ from functools import singledispatch
 from types import ModuleType
 
 from uvms_pin.physics.compiled.backend import Fallback
-from uvms_pin.physics.contact import CompliantPlane, ContactModel, LinearSpring
+from uvms_pin.physics.contact import CompliantPlane, ContactModel, LinearSpring, PlacedContact
 
 
 @singledispatch
@@ -23,21 +23,23 @@ def _(contact: None, core: ModuleType):
 
 @contact_to_core.register
 def _(contact: LinearSpring, core: ModuleType):
-    if contact.anchor is None:
-        return Fallback("a spring with no anchor yet (it is set when the run starts)")
-    out = core.LinearSpring()
-    out.stiffness_N_m = contact.stiffness_N_m
-    out.anchor_world_m = contact.anchor
-    return out
+    fields = {"stiffness_N_m": contact.stiffness_N_m, "anchor_world_m": contact.anchor}
+    return _placed(contact, core.LinearSpring, fields)
 
 
 @contact_to_core.register
 def _(contact: CompliantPlane, core: ModuleType):
-    if contact.point is None:
-        return Fallback("a plane with no surface point yet (it is set when the run starts)")
-    out = core.CompliantPlane()
-    out.normal_world = contact.normal_world
-    out.point_world_m = contact.point
-    out.stiffness_N_m = float(contact.stiffness_N_m)
-    out.damping_N_s_m = float(contact.damping_N_s_m)
+    fields = {"normal_world": contact.normal_world, "point_world_m": contact.point}
+    fields.update(stiffness_N_m=contact.stiffness_N_m, damping_N_s_m=contact.damping_N_s_m)
+    return _placed(contact, core.CompliantPlane, fields)
+
+
+def _placed(contact: PlacedContact, struct: type, fields: dict):
+    """The core's ``struct`` with ``fields``, or a Fallback while the contact has no point
+    (it is placed when the run starts: `attach`)."""
+    if contact.placed_at() is None:
+        return Fallback(f"a {type(contact).__name__} not placed yet (a run places it)")
+    out = struct()
+    for name, value in fields.items():
+        setattr(out, name, value)
     return out
