@@ -6,7 +6,8 @@ turns the table into figures and a Markdown summary (`report`). The ``sweep`` an
 ``report`` subcommands live in `command`.
 """
 
-from uvms_pin.apps.study.spec import Parameter, Run, Study, load_study
+from uvms_pin.apps.study.reader import load_study
+from uvms_pin.apps.study.spec import Parameter, Run, Study
 from uvms_pin.errors import StudyError
 
 __all__ = ["Parameter", "Run", "Study", "StudyError", "load_study"]

@@ -20,8 +20,8 @@ EXIT_INTERRUPTED = 130
 
 
 def _cmd_sweep(args: argparse.Namespace) -> int:
+    from uvms_pin.apps.study.reader import load_study
     from uvms_pin.apps.study.runner import load_results, run_study
-    from uvms_pin.apps.study.spec import load_study
 
     study = load_study(args.study)  # every check happens here, before any run
     runs = study.runs()
