@@ -9,8 +9,13 @@ import numpy as np
 
 def read_only(array: np.ndarray) -> np.ndarray:
     """``array`` itself, marked read-only: whoever holds it can no longer write into it."""
-    array.flags.writeable = False
+    array.setflags(write=False)
     return array
+
+
+def _frozen(value) -> bool:
+    """A read-only float64 array (nobody can write into it)."""
+    return type(value) is np.ndarray and value.dtype.char == "d" and not value.flags.writeable
 
 
 @dataclass(frozen=True)
@@ -35,13 +40,16 @@ class Measurement:
     def __post_init__(self) -> None:
         # a measurement never aliases anything writable (the plant's state): arrays that are
         # not already read-only float arrays are copied, and the copies frozen
+        q, v, w = self.q, self.v, self.wrench_world
+        if (  # the engine's case, inline: three read-only float arrays
+            type(q) is type(v) is type(w) is np.ndarray
+            and not (q.flags.writeable or v.flags.writeable or w.flags.writeable)
+            and q.dtype.char == v.dtype.char == w.dtype.char == "d"
+        ):
+            return
         for name in ("q", "v", "wrench_world"):
             value = getattr(self, name)
-            if not (
-                isinstance(value, np.ndarray)
-                and value.dtype == np.float64
-                and not value.flags.writeable
-            ):
+            if not _frozen(value):
                 object.__setattr__(self, name, read_only(np.array(value, dtype=float)))
 
     @property

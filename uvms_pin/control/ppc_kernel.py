@@ -35,6 +35,8 @@ class PpcKernel:
             name: packed[start:stop] for name, (start, stop) in self.kernel.signal_layout().items()
         }
         self.compute = self.kernel.compute  # the C++ method itself: nothing in between
+        #: tau (nv,) of the last ok call (a view: copy it to keep it)
+        self.tau = self.views["tau"]
 
     @classmethod
     def build(
@@ -56,11 +58,6 @@ class PpcKernel:
     def copies(self) -> tuple[np.ndarray, ...]:
         """Copies of the last ok call's signals, in the order of `SIGNALS`."""
         return tuple(self.views[name].copy() for name in SIGNALS)
-
-    @property
-    def tau(self) -> np.ndarray:
-        """tau (nv,) of the last ok call (a view: copy it to keep it)."""
-        return self.views["tau"]
 
     @property
     def margin(self) -> float:

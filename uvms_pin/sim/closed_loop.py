@@ -99,7 +99,7 @@ class ClosedLoop:
         Raises SimulationError when a body reached the free surface (waves)."""
         self.plant.check_submerged(self.time_s, self.q)
         contact = self.plant.contact_wrench(self.q, self.v)
-        return self.sensors.measure(self.time_s, self.q, self.v, contact), read_only(contact)
+        return self.sensors.measure(self.time_s, self.q, self.v, contact), contact
 
     def command(self, measurement: Measurement) -> np.ndarray:
         """The controller's tau (nv,) for ``measurement`` (SimulationError if it is not nv
@@ -114,7 +114,7 @@ class ClosedLoop:
 
     def actuate(self, tau_commanded: np.ndarray) -> np.ndarray:
         """What the thrusters and joints apply of ``tau_commanded`` (nv,)."""
-        return read_only(self.plant.actuation.apply(tau_commanded))
+        return self.plant.actuation.apply(tau_commanded)
 
     def step(self, tau_applied: np.ndarray) -> None:
         """Advance one control period with ``tau_applied`` held.
@@ -128,7 +128,9 @@ class ClosedLoop:
             raise _diverged(t0, t1, exc) from exc
         if diverged(q, v):
             raise SimulationError(f"simulation diverged between t = {t0:.6g} s and {t1:.6g} s")
-        self.q, self.v = read_only(q), read_only(v)
+        q.setflags(write=False)  # new arrays of the plant's: frozen, not copied
+        v.setflags(write=False)
+        self.q, self.v = q, v
         # the tick's time, tick * period: no accumulated rounding
         self.time_s = round(t1 / period) * period
 
@@ -221,17 +223,24 @@ class ClosedLoop:
         adaptive = isinstance(settings.integrator, Adaptive)
         log_times = np.arange(settings.n_log) * settings.log_period_s
 
+        sensors, actuation, command = self.sensors, plant.actuation, self.command
+
         def at(t: float, q: np.ndarray, v: np.ndarray) -> tuple[Measurement, np.ndarray]:
+            # q is the chart's, new at every stage; v is a view of the solver's state: a copy
+            q.setflags(write=False)
+            v = v.copy()
+            v.setflags(write=False)
             contact = plant.contact_wrench(q, v)
-            return self.sensors.measure(t, q, v, contact), contact
+            return sensors.measure(t, q, v, contact), contact
 
         def rhs(t: float, q: np.ndarray, v: np.ndarray) -> np.ndarray:
             measurement, contact = at(t, q, v)
-            tau_applied = self.actuate(self.command(measurement))
+            tau_applied = actuation.apply(command(measurement))
             acceleration = plant.acceleration(t, q, v, tau_applied, contact)
             # an adaptive solver would shrink its step on a non-finite stage until it gives
-            # up with a message that does not say why: stop at once instead
-            if not np.all(np.isfinite(acceleration)):
+            # up with a message that does not say why: stop at once instead (a sum is NaN or
+            # inf if any entry is; the exact test only when it is)
+            if not math.isfinite(acceleration.sum()) and not np.all(np.isfinite(acceleration)):
                 raise SimulationError(
                     f"simulation diverged: non-finite acceleration at t = {t:.6g} s"
                 )
