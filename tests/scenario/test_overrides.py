@@ -40,11 +40,11 @@ def test_bad_assignments_are_named(text):
 
 
 def test_the_study_files_use_the_same_parser():
-    from uvms_pin.apps.study import spec
+    from uvms_pin.apps.study import reader, spec
 
     parameter = spec.Parameter("initial.joint_positions_rad[2]", "parameter[0]")
     assert (parameter.key, parameter.index) == ("initial.joint_positions_rad", 2)
-    assert spec.KEY_PATH is parse_key_path.__globals__["KEY_PATH"]
+    assert reader.KEY_PATH is parse_key_path.__globals__["KEY_PATH"]
 
 
 def test_indexed_override_sets_one_element_and_leaves_the_input_alone():
