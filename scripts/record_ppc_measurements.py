@@ -7,7 +7,7 @@ extension on) and ``realistic_force_tracking`` (500 Hz, generalized pseudo-inver
 null-space task) for a short time, captures every ``Measurement`` the controller is given
 (and whether the funnel extension was on), keeps an evenly spaced subset, and stores it
 with the outputs of the frozen pre-optimization controller (``tests/controllers/
-ppc_oracle``): tau and the funnel margin. ``tests/controllers/test_ppc_oracle.py`` replays
+ppc_oracle``): tau and the funnel margin. ``tests/control/test_ppc_oracle.py`` replays
 the measurements through the package's controller and through the oracle.
 """
 

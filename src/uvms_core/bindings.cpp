@@ -1,6 +1,7 @@
 // nanobind module uvms_pin._core: the compiled counterparts of uvms-pin's concepts, one
 // section per concept, each a struct with named fields (the Python side that fills them is
-// uvms_pin/physics/compiled/, uvms_pin/sim/compiled.py and uvms_pin/control/ppc_kernel.py).
+// uvms_pin/physics/compiled/, the integrators' and the plant's in uvms_pin/sim/, and
+// uvms_pin/control/ppc_kernel.py).
 // Bad input raises uvms_pin.errors.ParameterError, a failed solve SimulationError.
 #include <nanobind/eigen/dense.h>
 #include <nanobind/nanobind.h>

@@ -1,4 +1,4 @@
-// Compliant contact at the end-effector (mirror of uvms_pin/physics/environment.py).
+// Compliant contact at the end-effector (mirror of uvms_pin/physics/contact.py).
 // Each model returns lambda: the wrench the end-effector exerts ON the environment, at the
 // end-effector point, world axes [N; N m].
 #pragma once

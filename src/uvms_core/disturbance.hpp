@@ -1,4 +1,4 @@
-// Disturbances: body wrenches on the vehicle (mirror of uvms_pin/physics/environment.py).
+// Disturbances: body wrenches on the vehicle (mirror of uvms_pin/physics/disturbance.py).
 #pragma once
 
 #include <cmath>

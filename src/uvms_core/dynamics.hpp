@@ -1,4 +1,4 @@
-// Underwater dynamics of a UVMS (mirror of uvms_pin/physics/dynamics.py):
+// Underwater dynamics of a UVMS (mirror of uvms_pin/physics/reference.py):
 //
 //   M(q) zeta_dot + h(q, zeta) = tau + tau_ext
 //   M = M_RB + sum_i J_i^T M_A,i J_i

@@ -19,7 +19,7 @@ PASSIVE = ROOT / "scenarios" / "passive_still_water.toml"
 
 # the blow-ups of issue 10, each in its first steps (0.2 s runs). (Density 1e9 under LSODA
 # is not one: it integrates, very stiffly, for 0.15 s before LSODA gives up, ~90 s of wall
-# time; tests/test_integrators.py checks that a failed adaptive pass keeps its states.)
+# time; tests/sim/test_integrators.py checks that a failed adaptive pass keeps its states.)
 BLOW_UPS = {
     "stiffness 1e12, sampled RK4": (REALISTIC, {"environment.stiffness_N_m": [1e12] * 3}),
     "stiffness 1e12, continuous LSODA": (PAPER, {"environment.stiffness_N_m": [1e12] * 3}),

@@ -25,7 +25,7 @@ model (kinematics), never its inertias, gravity or hydrodynamics, nor the enviro
 
 How ``compute`` is evaluated (it runs once per control tick, or once per integrator stage,
 so it avoids per-call overhead; the results agree with the direct evaluation of the
-equations above to ~1e-13, see tests/controllers/test_ppc_oracle.py):
+equations above to ~1e-13, see tests/control/test_ppc_oracle.py):
 
 - one Pinocchio pass gives the end-effector rotation and its LOCAL_WORLD_ALIGNED Jacobian
   J^lwa; the analytical Jacobian is J = diag(I, E^-1) J^lwa with E the Euler-rate matrix
@@ -141,7 +141,7 @@ class PrescribedPerformanceController(Controller):
         backend: ``"core"`` (default): the compiled law (``src/uvms_core/ppc.hpp``) with
             this Python code as its fallback on every call it declines; ``"python"``: this
             code only, the reference. Both give the same tau to ~1e-13 and raise the same
-            errors (tests/controllers/test_ppc_core.py).
+            errors (tests/control/test_ppc_core.py).
 
     The measured force is ``measurement.wrench_world[:3]`` (sensor noise included, the
     paper's f_e + Delta f_e).

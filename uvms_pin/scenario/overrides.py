@@ -11,10 +11,9 @@ from __future__ import annotations
 import copy
 import difflib
 import re
+import tomllib
 from dataclasses import dataclass
 from typing import Any
-
-import tomllib
 
 from uvms_pin.errors import ScenarioError
 

@@ -1,6 +1,6 @@
 """MJCF (MuJoCo's XML) of a UVMS: the same rigid multibody, MuJoCo's fluid model, buoyancy.
 
-What is the same as in uvms-pin (tests/export/test_mjcf.py checks it against Pinocchio):
+What is the same as in uvms-pin (tests/apps/export/test_mjcf.py checks it against Pinocchio):
 
 - one MuJoCo body per Pinocchio joint, at the joint placement, with the joint's axis, its
   armature and its (merged) spatial inertia; the free-flyer root becomes a ``<freejoint>``;

@@ -12,10 +12,9 @@ from __future__ import annotations
 
 import hashlib
 import json
+import tomllib
 from pathlib import Path
 from typing import Any
-
-import tomllib
 
 from uvms_pin.apps.study.spec import Study
 from uvms_pin.errors import StudyError

@@ -8,10 +8,9 @@ are parameters, how they were sampled, and the optional [report] metrics and hea
 
 from __future__ import annotations
 
+import tomllib
 from pathlib import Path
 from typing import Any
-
-import tomllib
 
 from uvms_pin.apps.study.bins import report_parameters
 from uvms_pin.apps.study.figures import write_figures
