@@ -14,7 +14,7 @@ Cases, each on a measurement near the scenario's initial state:
 Each is timed for the package's controller on its two backends, the compiled law
 (``backend="core"``, the default, src/uvms_core/ppc.hpp) and the Python reference
 (``backend="python"``), and for the frozen pre-optimization copy kept as the test oracle
-(``tests/controllers/ppc_oracle``), and reported as a ratio to one
+(``tests/control/ppc_oracle``), and reported as a ratio to one
 rigid-body ``pin.aba`` call on the reference model timed in the same process, so that the
 figures compare across machines. Times are this process's CPU time (``time.process_time``),
 best of ``--repeat`` interleaved rounds (`timing.py`): on a shared machine the wait for a core
@@ -49,7 +49,7 @@ from uvms_pin.model.resources import example_robot_data_dir
 from uvms_pin.scenario.load import load_scenario
 
 ROOT = Path(__file__).resolve().parents[1]
-sys.path.insert(0, str(ROOT / "tests" / "controllers"))
+sys.path.insert(0, str(ROOT / "tests" / "control"))
 from ppc_oracle import in_place_of_the_package_ppc  # noqa: E402
 from ppc_oracle.ppc import PrescribedPerformanceController as OraclePPC  # noqa: E402
 

@@ -1,12 +1,12 @@
 """Record controller inputs from real runs of both shipped scenarios, and the oracle's outputs.
 
-    .venv/bin/python scripts/record_ppc_measurements.py [--out tests/controllers/data/...]
+    .venv/bin/python scripts/record_ppc_measurements.py [--out tests/control/data/...]
 
 Runs ``paper_force_tracking`` (LSODA, continuous control: many calls with the funnel
 extension on) and ``realistic_force_tracking`` (500 Hz, generalized pseudo-inverse and
 null-space task) for a short time, captures every ``Measurement`` the controller is given
 (and whether the funnel extension was on), keeps an evenly spaced subset, and stores it
-with the outputs of the frozen pre-optimization controller (``tests/controllers/
+with the outputs of the frozen pre-optimization controller (``tests/control/
 ppc_oracle``): tau and the funnel margin. ``tests/control/test_ppc_oracle.py`` replays
 the measurements through the package's controller and through the oracle.
 """
@@ -27,7 +27,7 @@ from uvms_pin.scenario.load import load_scenario
 from uvms_pin.sim.run import Scenario, simulate
 
 ROOT = Path(__file__).resolve().parents[1]
-sys.path.insert(0, str(ROOT / "tests" / "controllers"))
+sys.path.insert(0, str(ROOT / "tests" / "control"))
 from ppc_oracle import in_place_of_the_package_ppc  # noqa: E402
 
 #: scenario file stem -> simulated duration [s]
@@ -101,7 +101,7 @@ def record(stem: str, duration_s: float, keep: int) -> dict[str, np.ndarray]:
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument(
-        "--out", type=Path, default=ROOT / "tests" / "controllers" / "data" / "ppc_runs.npz"
+        "--out", type=Path, default=ROOT / "tests" / "control" / "data" / "ppc_runs.npz"
     )
     parser.add_argument("--keep", type=int, default=300, help="measurements kept per scenario")
     args = parser.parse_args()

@@ -5,6 +5,8 @@ from __future__ import annotations
 import subprocess
 import sys
 
+import pytest
+
 from conftest import ROOT
 
 sys.path.insert(0, str(ROOT / "scripts"))
@@ -29,3 +31,27 @@ def test_list_and_bad_names():
     assert [line.split()[0] for line in listed.stdout.splitlines()] == list(PRODUCERS)
     bad = subprocess.run([sys.executable, script, "--only", "nope"], capture_output=True, text=True)
     assert bad.returncode == 2 and "invalid choice: 'nope'" in bad.stderr
+
+
+def _runnable_scripts() -> list:
+    """Every script a user or `make results` runs: benchmarks/ and scripts/, helpers aside."""
+    found = [*(ROOT / "benchmarks").glob("*.py"), *(ROOT / "scripts").rglob("*.py")]
+    return sorted(p for p in found if '__name__ == "__main__"' in p.read_text())
+
+
+def test_the_runnable_scripts_are_found():
+    names = {p.relative_to(ROOT).as_posix() for p in _runnable_scripts()}
+    assert {"benchmarks/bench_controller.py", "scripts/results/paper.py"} <= names
+    assert "benchmarks/timing.py" not in names
+
+
+@pytest.mark.parametrize(
+    "script", _runnable_scripts(), ids=lambda p: p.relative_to(ROOT).as_posix()
+)
+def test_every_script_starts_and_answers_help_without_running(script):
+    """Imports resolve after a move (sys.path included), and --help runs nothing."""
+    started = subprocess.run(
+        [sys.executable, str(script), "--help"], cwd=ROOT, capture_output=True, text=True
+    )
+    assert started.returncode == 0, started.stderr[-2000:]
+    assert started.stdout.startswith("usage:"), started.stdout[:500]

@@ -7,6 +7,7 @@ Scratch output (rollouts, study tables) goes to out/results/<name>/.
 
 from __future__ import annotations
 
+import argparse
 import json
 import os
 import platform
@@ -20,6 +21,14 @@ ROOT = Path(__file__).resolve().parents[2]
 DOCS = ROOT / "docs"
 RESULTS = DOCS / "results"
 SCRATCH = ROOT / "out" / "results"
+
+
+def producer_cli(doc: str | None) -> None:
+    """Answer ``--help`` (and refuse any other argument) before a producer runs anything."""
+    parser = argparse.ArgumentParser(
+        description=doc, epilog="Run by `make results` (scripts/make_results.py); no arguments."
+    )
+    parser.parse_args()
 
 
 def scratch(name: str) -> Path:

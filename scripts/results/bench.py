@@ -2,9 +2,10 @@
 
 from __future__ import annotations
 
-from _common import benchmark_result
+from _common import benchmark_result, producer_cli
 
 if __name__ == "__main__":
+    producer_cli(__doc__)
     benchmark_result(
         "bench",
         "Dynamics benchmark",

@@ -5,9 +5,10 @@ from __future__ import annotations
 import subprocess
 import sys
 
-from _common import ROOT, scratch, write_result
+from _common import ROOT, producer_cli, scratch, write_result
 
 if __name__ == "__main__":
+    producer_cli(__doc__)
     out = scratch("bench_mujoco") / "mujoco.md"
     command = [sys.executable, str(ROOT / "benchmarks" / "bench_mujoco.py"), "--out", str(out)]
     print("$ " + " ".join(command[1:]), flush=True)

@@ -1,10 +1,11 @@
 """The arm comparison: the realistic task with every catalogue arm (table and figure)."""
 
-from _common import publish_figure, scratch, uvms_pin, write_result
+from _common import producer_cli, publish_figure, scratch, uvms_pin, write_result
 
 ARMS = "reference,so100,z1,kinova,ur3,ur5,ur10,panda,xarm7"
 
 if __name__ == "__main__":
+    producer_cli(__doc__)
     out = scratch("compare_arms")
     args = ("compare-arms", "scenarios/realistic_force_tracking.toml", "--arms", ARMS)
     uvms_pin(*args, "--out", str(out), "--jobs", "1")

@@ -1,11 +1,12 @@
 """The controller comparison: the realistic task with the PPC and the three baselines,
 nominal and over the robustness set."""
 
-from _common import publish_figure, scratch, uvms_pin, write_result
+from _common import producer_cli, publish_figure, scratch, uvms_pin, write_result
 
 CONTROLLERS = "ppc,pi_force,impedance,computed_torque"
 
 if __name__ == "__main__":
+    producer_cli(__doc__)
     out = scratch("compare_controllers")
     args = (
         "compare-controllers",

@@ -5,11 +5,12 @@ from __future__ import annotations
 import csv
 import json
 
-from _common import publish_figure, scratch, uvms_pin, write_result
+from _common import producer_cli, publish_figure, scratch, uvms_pin, write_result
 
 FIGURES = ("_alt_011-2", "_alt_002-0")  # the README shows these two
 
 if __name__ == "__main__":
+    producer_cli(__doc__)
     out = scratch("pool_validation")
     uvms_pin("validate", "pool", "data/hinsdale2023", "--out", str(out))
     summary = json.loads((out / "pool_validation.json").read_text())

@@ -6,9 +6,10 @@ import json
 import subprocess
 import sys
 
-from _common import ROOT, scratch, write_result
+from _common import ROOT, producer_cli, scratch, write_result
 
 if __name__ == "__main__":
+    producer_cli(__doc__)
     out = scratch("robustness")
     command = [
         sys.executable,

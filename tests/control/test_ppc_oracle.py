@@ -1,7 +1,7 @@
 """The fast PPC gives the pre-optimization controller's outputs to 1e-12 (the oracle).
 
 The oracle is a frozen copy of the controller before it was optimized
-(``tests/controllers/ppc_oracle``). Compared on each call: tau (relative to max |tau|), the
+(``tests/control/ppc_oracle``). Compared on each call: tau (relative to max |tau|), the
 funnel margin, every logged signal, and the exception (type, level, component, values)
 when the oracle raises. Inputs: measurements recorded from real runs of both shipped
 scenarios (``scripts/record_ppc_measurements.py``), random states on the reference model,

@@ -5,7 +5,9 @@
 
 `load` reads a file (`schema` checks every table, `overrides` varies it); one module per
 table builds its concept (`water`, `initial`, `world`, `actuation`, `sensors`, `timing`,
-`controller`, `ppc`, `baselines`, `custom_controller`).
+`controller`, `ppc`, `baselines`, `custom_controller`); `controller_parts` holds the
+pieces several controller tables share (profiles, end-effector frame) and `toml` reads
+TOML files with errors that name them.
 """
 
 from uvms_pin._lazy import lazy_exports
