@@ -62,6 +62,7 @@ def test_lines_in_a_log_after_the_delay_then_every_interval_and_at_the_end():
     text = log.getvalue().splitlines()
     assert len(text) == 2  # the first call, then the end (the interval is an hour)
     assert text[0].startswith("run [") and "t =   0.000/10 s" in text[0]
+    assert text[0].endswith("left ~     ? s")  # no rate yet: unknown, not nan
     assert "#" * 30 in text[1] and "t =  10.000/10 s" in text[1]
     quiet = io.StringIO()
     silent = ProgressLines("run", 10.0, quiet, delay_s=3600.0)

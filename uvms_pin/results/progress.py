@@ -80,11 +80,12 @@ class ProgressLines:
             return
         self.next_s, self.printed = elapsed + self.interval_s, True
         fraction = t_s / duration_s if duration_s > 0 else 1.0
-        left = elapsed * (1.0 - fraction) / fraction if fraction > 0 else float("nan")
+        # nothing simulated yet: no rate to extrapolate from
+        left = f"{elapsed * (1.0 - fraction) / fraction:6.1f}" if fraction > 0 else "     ?"
         bar = "#" * int(30 * fraction)
         self.stream.write(
             f"{self.label} [{bar:<30}] t = {t_s:7.3f}/{duration_s:g} s  elapsed "
-            f"{elapsed:6.1f} s  left ~{left:6.1f} s\n"
+            f"{elapsed:6.1f} s  left ~{left} s\n"
         )
         self.stream.flush()
 
