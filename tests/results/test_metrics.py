@@ -69,7 +69,20 @@ def test_effort_rms_and_peak_of_known_sines():
     assert m["vehicle_force_peak_N"] == pytest.approx(3.0, rel=1e-12)
     assert m["vehicle_torque_rms_Nm"] == pytest.approx(math.sqrt(3.0), rel=1e-12)
     assert m["vehicle_torque_peak_Nm"] == pytest.approx(math.sqrt(5.0), rel=1e-12)
+    # "joint torques = max over joints of |tau_j|", its peak and RMS over time
     assert m["joint_torque_peak_Nm"] == pytest.approx(1.5, rel=1e-12)
+    assert m["joint_torque_rms_Nm"] == pytest.approx(1.5, rel=1e-12)
+
+
+def test_joint_torque_rms_follows_the_largest_joint_sample_by_sample():
+    """|tau_1| = |2 sin|, |tau_2| = 1: the largest is 2 |sin| where |sin| > 1/2 (two
+    thirds of the period), so mean(max^2) = 5/3 + 3^0.5 / pi (integrating 4 sin^2 there)."""
+    r = rollout()
+    r.tau[:, 6] = sine(2.0)
+    r.tau[:, 7] = 1.0
+    expected = math.sqrt(5.0 / 3.0 + math.sqrt(3.0) / math.pi)
+    # the grid's 100 samples per period sum the kinked square to ~1e-4
+    assert compute_metrics(r)["joint_torque_rms_Nm"] == pytest.approx(expected, rel=1e-3)
 
 
 def test_energy_drift_and_largest_increase():
