@@ -45,7 +45,11 @@ def compute_metrics(rollout: RolloutData) -> dict[str, float]:
     )
     force = np.linalg.norm(rollout.tau[:, :3], axis=1)
     torque = np.linalg.norm(rollout.tau[:, 3:6], axis=1)
-    joints = np.abs(rollout.tau[:, 6:])
+    # Fix: the RMS was taken over every joint and sample, so idle joints diluted it (a
+    # 4-joint arm with one joint working reported half its torque); it is now the RMS of
+    # max_j |tau_j|, the quantity the docstring names (the peak was already its maximum)
+    arm = np.abs(rollout.tau[:, 6:])
+    joints = arm.max(axis=1) if arm.shape[1] else np.empty(0)  # no arm: peak 0, RMS NaN
     out.update(
         vehicle_force_peak_N=float(force.max()),
         vehicle_force_rms_N=_rms(force),

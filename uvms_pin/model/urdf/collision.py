@@ -1,6 +1,7 @@
 """Coefficients derived from a link's collision geometry (docs/physics.md): a box, cylinder or
-sphere through `uvms_pin.hydro.geometry`, a mesh through `uvms_pin.hydro.mesh` (its volume and
-bounding primitive); each at the ``<collision><origin>`` frame."""
+sphere through `uvms_pin.hydro.geometry`, at the ``<collision><origin>`` frame; a mesh
+through `uvms_pin.hydro.mesh` (its volume and bounding primitive), at that primitive's frame
+inside the mesh's (so that its drag is the primitive's own, as for a primitive in the URDF)."""
 
 from __future__ import annotations
 
@@ -12,7 +13,7 @@ import pinocchio as pin
 
 from uvms_pin.errors import ModelError, ParameterError
 from uvms_pin.hydro import geometry
-from uvms_pin.hydro.mesh import load_mesh_geometry, mesh_hydro
+from uvms_pin.hydro.mesh import load_mesh_geometry, mesh_primitive
 from uvms_pin.hydro.params import HydroParams
 from uvms_pin.model.resources import package_search_path, resolve_resource
 from uvms_pin.model.urdf.read import read_numbers, read_origin
@@ -28,7 +29,8 @@ def collision_hydro(
     base_dir: Path = Path("."),
     package_dirs: Sequence[str | Path] = (),
 ) -> tuple[pin.SE3, HydroParams]:
-    """(placement of the collision frame in the link frame, its coefficients there).
+    """(placement of the body's frame in the link frame, its coefficients there): the
+    ``<collision><origin>`` frame, or for a mesh its bounding primitive's frame.
 
     Args:
         collision: the ``<collision>`` element.
@@ -56,9 +58,10 @@ def collision_hydro(
             radius = read_numbers(shape.get("radius"), 1, "<sphere radius>", where, link)[0]
             return origin, geometry.sphere_hydro(radius, water_density_kg_m3)
         if shape.tag == "mesh":
-            return origin, _mesh_hydro(
+            placement, params = _mesh_hydro(
                 shape, water_density_kg_m3, where, link, base_dir, package_dirs
             )
+            return origin * placement, params
     except ParameterError as exc:
         raise ModelError(
             f"cannot derive hydrodynamics from <{shape.tag}>: {exc}", path=where, link=link
@@ -78,8 +81,9 @@ def _mesh_hydro(
     link: str,
     base_dir: Path,
     package_dirs: Sequence[str | Path],
-) -> HydroParams:
-    """Volume and bounding primitive of the mesh file (`uvms_pin.hydro.mesh`), scaled."""
+) -> tuple[pin.SE3, HydroParams]:
+    """Volume and bounding primitive of the mesh file (`uvms_pin.hydro.mesh`), scaled: the
+    primitive's placement in the mesh frame, its coefficients there."""
     filename = shape.get("filename")
     if not filename:
         raise ModelError("<mesh> has no filename", path=where, link=link)
@@ -95,4 +99,11 @@ def _mesh_hydro(
             link=link,
         )
     scale = read_numbers(shape.get("scale", "1 1 1"), 3, "<mesh scale>", where, link)
-    return mesh_hydro(load_mesh_geometry(resolved, scale), water_density_kg_m3)
+    # Fix: the coefficients used to be moved to the mesh origin, where the quadratic drag of
+    # a primitive off the origin or turned can only be a diagonal estimate (40-50 % off the
+    # drag wrench of the same box given as a URDF primitive); the body now sits at the
+    # primitive's own frame, as a URDF primitive does
+    rotation, center, params = mesh_primitive(
+        load_mesh_geometry(resolved, scale), water_density_kg_m3
+    )
+    return pin.SE3(rotation, center), params
