@@ -21,6 +21,7 @@ __getattr__, __dir__, _lazy_names = lazy_exports(
         "uvms_pin.physics.dynamics": (
             "bias_forces",
             "forward_dynamics",
+            "forward_dynamics_derivatives",
             "frame_wrench_to_generalized",
             "kinetic_energy",
             "mass_matrix",
@@ -63,6 +64,7 @@ __all__ = [
     "UvmsPinWarning",
     "bias_forces",
     "forward_dynamics",
+    "forward_dynamics_derivatives",
     "frame_wrench_to_generalized",
     "kinetic_energy",
     "load_scenario",

@@ -73,6 +73,7 @@ class Dynamics {
   Data& data() { return data_; }
 
  private:
+  friend class Derivatives;  // derivatives.hpp: reads the model, hydro and work buffers
   void prepare();
   // articulated_body.cpp
   void prepare_articulated();

@@ -1,0 +1,189 @@
+"""The derivatives of the forward dynamics against finite differences of the dynamics.
+
+`up.forward_dynamics_derivatives` (the Python reference, backend="python") against 4-point
+central differences of `up.forward_dynamics` (the reference), q moved along the tangent
+(pin.integrate), on random states of every shipped model, three mounted example-robot-data
+arms and a ball-jointed arm, in still water, a current, regular and irregular waves, and a
+sheared current. Steps: 1e-5 on q (m, rad) and on v, tau scaled by their size (the
+quadratic damping |x| x is C1: a relative velocity within 2 steps of zero would show it).
+"""
+
+from __future__ import annotations
+
+import math
+import warnings
+
+import numpy as np
+import pinocchio as pin
+import pytest
+from conftest import (
+    central_difference,
+    mount_on_reference_vehicle,
+    with_spherical_joint,
+)
+
+import uvms_pin as up
+from uvms_pin.errors import ParameterError
+from uvms_pin.flow import AiryWave, DepthProfileCurrent, FlowField, IrregularSea, UniformCurrent
+from uvms_pin.model.resources import shipped_models, shipped_path
+
+#: relative agreement with the finite differences (max |error| / max |entry| per matrix)
+FD_REL = 1e-7
+STEP = 1e-5
+
+FLOWS = {
+    "still": None,
+    "current": UniformCurrent([0.3, -0.2, 0.1]),
+    "airy+current": AiryWave(0.4, 5.0, heading_rad=0.5, water_depth_m=15.0)
+    + UniformCurrent([0.2, 0.0, 0.0]),
+    "irregular": IrregularSea(1.5, 7.0, n_components=30, seed=4, spreading_exponent=3.0),
+    "sheared": DepthProfileCurrent([0.4, 0.1, 0.05], [0.0, 10.0], [1.0, 0.2]),
+}
+
+
+def random_state(uvms: up.UVMS, rng: np.random.Generator):
+    """A random (q, v, tau): joints within their limits (any joint type: ball, continuous),
+    the vehicle 2.5-3.5 m deep (wave kinematics grow towards the surface)."""
+    model = uvms.model
+    lower = np.maximum(model.lowerPositionLimit, -np.pi)
+    upper = np.minimum(model.upperPositionLimit, np.pi)
+    pin.seed(int(rng.integers(2**31)))  # pin.randomConfiguration draws from its own generator
+    q = pin.randomConfiguration(model, lower, upper)
+    q[2] = -3.0 + rng.uniform(-0.5, 0.5)
+    return q, rng.normal(scale=0.5, size=uvms.nv), rng.normal(scale=5.0, size=uvms.nv)
+
+
+def _relative_error(got: np.ndarray, expected: np.ndarray) -> float:
+    return float(np.max(np.abs(got - expected)) / max(np.max(np.abs(expected)), 1e-300))
+
+
+def assert_matches_finite_differences(uvms, q, v, tau, flow, time_s=0.4, tau_ext=None):
+    """The three derivatives of the reference against central differences of its dynamics."""
+    kw = {"flow": flow, "time_s": time_s, "backend": "python"}
+
+    def accel(qq, vv, tt):
+        return up.forward_dynamics(uvms, qq, vv, tt, tau_ext=tau_ext, **kw)
+
+    da_dq, da_dv, da_dtau = up.forward_dynamics_derivatives(
+        uvms, q, v, tau, tau_ext=tau_ext, **kw
+    )
+    nv = uvms.nv
+    integrate = lambda x, dx: pin.integrate(uvms.model, x, dx)  # noqa: E731
+    fd_q = central_difference(lambda x: accel(x, v, tau), q, nv, STEP, integrate)
+    fd_v = central_difference(lambda x: accel(q, x, tau), v, nv, STEP * max(1, np.abs(v).max()))
+    fd_tau = central_difference(lambda x: accel(q, v, x), tau, nv, 1e-3 * np.abs(tau).max())
+    errors = [_relative_error(*p) for p in ((da_dq, fd_q), (da_dv, fd_v), (da_dtau, fd_tau))]
+    assert max(errors) < FD_REL, f"relative errors (dq, dv, dtau): {errors}"
+    assert da_dq.shape == da_dv.shape == da_dtau.shape == (nv, nv)
+    return errors
+
+
+@pytest.fixture(scope="module", params=["reference", "ur5", "panda", "z1", "ball"])
+def system(request, reference_uvms, tmp_path_factory) -> up.UVMS:
+    if request.param == "reference":
+        return reference_uvms
+    if request.param == "ball":
+        return with_spherical_joint(reference_uvms, 3)
+    return mount_on_reference_vehicle(request.param, tmp_path_factory.mktemp(request.param))
+
+
+@pytest.mark.parametrize("flow", list(FLOWS), ids=list(FLOWS))
+def test_derivatives_match_finite_differences(system, flow):
+    rng = np.random.default_rng(24)
+    for _ in range(2):
+        q, v, tau = random_state(system, rng)
+        assert_matches_finite_differences(system, q, v, tau, FLOWS[flow])
+
+
+@pytest.mark.parametrize("name", shipped_models())
+def test_every_shipped_model_matches_finite_differences(name):
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", up.ModelWarning)
+        uvms = up.load_uvms(shipped_path(f"models/{name}.urdf"))
+    rng = np.random.default_rng(25)
+    for flow in (None, FLOWS["airy+current"]):
+        q, v, tau = random_state(uvms, rng)
+        assert_matches_finite_differences(uvms, q, v, tau, flow)
+
+
+def test_a_held_generalized_force_moves_only_the_point_of_linearisation(reference_uvms):
+    """tau_ext is held fixed: the derivatives are those at the acceleration it produces."""
+    rng = np.random.default_rng(26)
+    q, v, tau = random_state(reference_uvms, rng)
+    tau_ext = rng.normal(scale=3.0, size=reference_uvms.nv)
+    assert_matches_finite_differences(reference_uvms, q, v, tau, FLOWS["current"], tau_ext=tau_ext)
+    _, _, with_ext = up.forward_dynamics_derivatives(
+        reference_uvms, q, v, tau, tau_ext=tau_ext, backend="python"
+    )
+    np.testing.assert_allclose(
+        with_ext @ up.mass_matrix(reference_uvms, q, backend="python"),
+        np.eye(reference_uvms.nv),
+        atol=1e-9,
+    )
+
+
+def test_rigid_body_in_air_matches_pinocchio_aba_derivatives(load_body):
+    """With no water (no volume, no added mass, no damping) the derivatives are Pinocchio's
+    own computeABADerivatives."""
+    from conftest import body_urdf, hydro_xml
+
+    uvms = load_body(body_urdf(com=(0.01, -0.02, 0.03), hydro=hydro_xml(0.0)))
+    rng = np.random.default_rng(27)
+    q, v, tau = random_state(uvms, rng)
+    data = uvms.model.createData()  # the results are views into it: keep it alive
+    expected = [np.array(m) for m in pin.computeABADerivatives(uvms.model, data, q, v, tau)]
+    expected[2] = np.triu(expected[2]) + np.triu(expected[2], 1).T  # Minv: upper triangle
+    got = up.forward_dynamics_derivatives(uvms, q, v, tau, backend="python")
+    for g, e in zip(got, expected, strict=True):
+        np.testing.assert_allclose(g, e, rtol=0, atol=1e-10 * np.abs(e).max())
+
+
+def test_still_water_derivatives_do_not_depend_on_position(reference_uvms):
+    """In still (or uniformly flowing) water nothing depends on where the vehicle is: the
+    columns of da/dq along the vehicle's translation are zero (a physics check that finite
+    differences share, here exactly)."""
+    rng = np.random.default_rng(28)
+    q, v, tau = random_state(reference_uvms, rng)
+    for flow in (None, FLOWS["current"]):
+        da_dq, _, _ = up.forward_dynamics_derivatives(
+            reference_uvms, q, v, tau, flow=flow, backend="python"
+        )
+        assert np.abs(da_dq[:, :3]).max() < 1e-12 * np.abs(da_dq).max()
+    # in waves the flow varies in space: the same columns are not zero
+    da_dq, _, _ = up.forward_dynamics_derivatives(
+        reference_uvms, q, v, tau, flow=FLOWS["airy+current"], backend="python"
+    )
+    assert np.abs(da_dq[:, :3]).max() > 1e-3 * np.abs(da_dq).max()
+
+
+def test_a_flow_without_second_order_kinematics_is_refused(reference_uvms):
+    class Swirl(FlowField):
+        def velocity(self, time_s, points_world):
+            return np.zeros((len(points_world), 3))
+
+        def local_acceleration(self, time_s, points_world):
+            return np.zeros((len(points_world), 3))
+
+        def velocity_gradient(self, time_s, points_world):
+            return np.zeros((len(points_world), 3, 3))
+
+        def __repr__(self):
+            return "Swirl()"
+
+    q = reference_uvms.neutral_configuration()
+    zero = np.zeros(reference_uvms.nv)
+    with pytest.raises(ParameterError, match=r"Swirl\(\).*gradient_kinematics"):
+        up.forward_dynamics_derivatives(reference_uvms, q, zero, zero, flow=Swirl())
+
+
+def test_bad_arguments_name_what_is_wrong(reference_uvms):
+    q = reference_uvms.neutral_configuration()
+    zero = np.zeros(reference_uvms.nv)
+    with pytest.raises(ParameterError, match="v must have shape"):
+        up.forward_dynamics_derivatives(reference_uvms, q, zero[:3], zero)
+    with pytest.raises(ParameterError, match="either current_world or flow"):
+        up.forward_dynamics_derivatives(
+            reference_uvms, q, zero, zero, current_world=np.ones(3), flow=FLOWS["current"]
+        )
+    with pytest.raises(ParameterError, match="time_s"):
+        up.forward_dynamics_derivatives(reference_uvms, q, zero, zero, time_s=math.nan)
