@@ -1,6 +1,7 @@
 """Coefficients derived from a link's collision geometry (docs/physics.md): a box, cylinder or
 sphere through `uvms_pin.hydro.geometry`, a mesh through `uvms_pin.hydro.mesh` (its volume and
-bounding primitive); each at the ``<collision><origin>`` frame."""
+bounding primitive); each at the ``<collision><origin>`` frame. The same shapes, as hull
+pieces (`uvms_pin.hydro.hull`), are what the free surface cuts."""
 
 from __future__ import annotations
 
@@ -12,12 +13,15 @@ import pinocchio as pin
 
 from uvms_pin.errors import ModelError, ParameterError
 from uvms_pin.hydro import geometry
+from uvms_pin.hydro.hull import HullPiece
 from uvms_pin.hydro.mesh import load_mesh_geometry, mesh_hydro
 from uvms_pin.hydro.params import HydroParams
+from uvms_pin.hydro.submerged import Polyhedron, Sphere
+from uvms_pin.hydro.submerged_cylinder import Cylinder
 from uvms_pin.model.resources import package_search_path, resolve_resource
 from uvms_pin.model.urdf.read import read_numbers, read_origin
 
-__all__ = ["collision_hydro"]
+__all__ = ["collision_hydro", "collision_piece"]
 
 
 def collision_hydro(
@@ -71,6 +75,60 @@ def collision_hydro(
     )
 
 
+def collision_piece(
+    collision: ET.Element,
+    where: str,
+    link: str,
+    base_dir: Path = Path("."),
+    package_dirs: Sequence[str | Path] = (),
+    *,
+    placed: bool = True,
+) -> HullPiece:
+    """The ``<collision>`` shape as a hull piece, at its ``<origin>`` in the link frame
+    (``placed``) or at the collision frame itself.
+
+    Raises:
+        ModelError: as `collision_hydro`.
+    """
+    origin = read_origin(collision.find("origin"), where, link)
+    geom = collision.find("geometry")
+    shape = None if geom is None or len(geom) == 0 else geom[0]
+    if shape is None:
+        raise ModelError("<collision> has no <geometry> shape", path=where, link=link)
+    try:
+        solid = _solid(shape, where, link, base_dir, package_dirs)
+    except ParameterError as exc:
+        raise ModelError(
+            f"cannot use <{shape.tag}> as a hull: {exc}", path=where, link=link
+        ) from exc
+    if not placed:
+        return HullPiece(solid)
+    return HullPiece(solid, origin.rotation, origin.translation)
+
+
+def _solid(
+    shape: ET.Element, where: str, link: str, base_dir: Path, package_dirs: Sequence[str | Path]
+) -> Sphere | Polyhedron | Cylinder:
+    """The shape of a <box>, <cylinder>, <sphere> or <mesh> element."""
+    if shape.tag == "box":
+        return Polyhedron.box(read_numbers(shape.get("size"), 3, "<box size>", where, link))
+    if shape.tag == "cylinder":
+        radius = read_numbers(shape.get("radius"), 1, "<cylinder radius>", where, link)[0]
+        length = read_numbers(shape.get("length"), 1, "<cylinder length>", where, link)[0]
+        return Cylinder(radius, length)
+    if shape.tag == "sphere":
+        return Sphere(read_numbers(shape.get("radius"), 1, "<sphere radius>", where, link)[0])
+    if shape.tag == "mesh":
+        mesh = _mesh_geometry(shape, where, link, base_dir, package_dirs)
+        return Polyhedron(mesh.vertices_m, mesh.triangles)
+    raise ModelError(
+        f"cannot use collision <{shape.tag}> as a hull (box, cylinder, sphere and mesh are "
+        "supported)",
+        path=where,
+        link=link,
+    )
+
+
 def _mesh_hydro(
     shape: ET.Element,
     water_density_kg_m3: float,
@@ -80,6 +138,18 @@ def _mesh_hydro(
     package_dirs: Sequence[str | Path],
 ) -> HydroParams:
     """Volume and bounding primitive of the mesh file (`uvms_pin.hydro.mesh`), scaled."""
+    mesh = _mesh_geometry(shape, where, link, base_dir, package_dirs)
+    return mesh_hydro(mesh, water_density_kg_m3)
+
+
+def _mesh_geometry(
+    shape: ET.Element,
+    where: str,
+    link: str,
+    base_dir: Path,
+    package_dirs: Sequence[str | Path],
+):
+    """The mesh file of a <mesh> element, read and scaled (`uvms_pin.hydro.mesh`)."""
     filename = shape.get("filename")
     if not filename:
         raise ModelError("<mesh> has no filename", path=where, link=link)
@@ -95,4 +165,4 @@ def _mesh_hydro(
             link=link,
         )
     scale = read_numbers(shape.get("scale", "1 1 1"), 3, "<mesh scale>", where, link)
-    return mesh_hydro(load_mesh_geometry(resolved, scale), water_density_kg_m3)
+    return load_mesh_geometry(resolved, scale)
