@@ -45,7 +45,7 @@ def _run(uvms, q, v, duration_s, step_s=1e-3, flow=None, every=10):
     tau = np.zeros(uvms.nv)
     period = step_s * every
     out = [(0.0, q, v)]
-    for k in range(int(round(duration_s / period))):
+    for k in range(round(duration_s / period)):
         q, v = plant.advance(RK4(step_s), k * period, q, v, tau, (k + 1) * period)
         out.append(((k + 1) * period, q, v))
     return out
@@ -166,7 +166,7 @@ def test_energy_is_conserved_without_damping_and_never_grows_with_it(load_body):
     kinetic0 = up.kinetic_energy(uvms, q0, v0, free_surface=True)
     drift = []
     for step in (2e-3, 1e-3):
-        samples = _run(uvms, q0, v0, 3.0, step_s=step, every=int(round(0.02 / step)))
+        samples = _run(uvms, q0, v0, 3.0, step_s=step, every=round(0.02 / step))
         drift.append(max(abs(_energy(uvms, q, v) - e0) for _, q, v in samples))
     assert drift[1] < 1e-5 * kinetic0
     assert drift[1] < drift[0] / 3  # an integration error, not a model's
