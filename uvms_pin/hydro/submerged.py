@@ -27,7 +27,7 @@ derivative needs (`uvms_pin.hydro.hull`).
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -123,6 +123,10 @@ class Sphere:
     def bounding_radius_m(self) -> float:
         return self.radius_m
 
+    @property
+    def label(self) -> str:
+        return "sphere"
+
     def below(self, normal: np.ndarray, depth_m: float) -> WetPart:
         r = self.radius_m
         volume, centroid, area = unit_sphere_cap(depth_m / r)
@@ -155,6 +159,10 @@ class Ellipsoid:
     def bounding_radius_m(self) -> float:
         return max(self.semi_axes_m)
 
+    @property
+    def label(self) -> str:
+        return "ellipsoid"
+
     def below(self, normal: np.ndarray, depth_m: float) -> WetPart:
         axes = np.asarray(self.semi_axes_m)
         det = float(np.prod(axes))
@@ -179,11 +187,12 @@ class Polyhedron:
 
     Attributes:
         vertices_m: (n, 3). triangles: (m, 3) vertex indices, counter-clockwise seen from
-        outside.
+        outside. label: what it is, for people ("box", "mesh").
     """
 
     vertices_m: np.ndarray
     triangles: np.ndarray
+    label: str = field(default="mesh", compare=False)
 
     def __post_init__(self) -> None:
         vertices = np.ascontiguousarray(self.vertices_m, dtype=float)
@@ -213,7 +222,7 @@ class Polyhedron:
             (0, 4, 5), (0, 5, 1), (2, 3, 7), (2, 7, 6),  # y = -b/2, +b/2
             (0, 2, 6), (0, 6, 4), (1, 5, 7), (1, 7, 3),  # z = -c/2, +c/2
         ]  # fmt: skip
-        return Polyhedron(corners * half, np.array(faces))
+        return Polyhedron(corners * half, np.array(faces), label="box")
 
     @property
     def volume_m3(self) -> float:

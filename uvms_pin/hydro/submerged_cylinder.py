@@ -77,6 +77,10 @@ class Cylinder:
     def bounding_radius_m(self) -> float:
         return math.hypot(self.radius_m, 0.5 * self.length_m)
 
+    @property
+    def label(self) -> str:
+        return "cylinder"
+
     def below(self, normal: np.ndarray, depth_m: float) -> WetPart:
         n_p = math.hypot(normal[0], normal[1])
         if n_p <= AXIAL_TOLERANCE:
