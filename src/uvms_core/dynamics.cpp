@@ -62,6 +62,7 @@ void Dynamics::prepare() {
   relative_velocity_.assign(nj, Vec6::Zero());
   deep_.assign(n_hulls, 0);
   dry_.assign(n_hulls, 0);
+  surface_.assign(n_hulls, SurfaceAt{});
   fraction_.assign(n_hulls, 1.0);
   fraction_rate_.assign(n_hulls, 0.0);
   hull_volume_.assign(n_hulls, 0.0);

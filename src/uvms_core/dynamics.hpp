@@ -132,6 +132,7 @@ class Dynamics {
   aligned_vector<Mat6> wet_added_mass_;
   std::vector<char> wet_touched_;  // joints with a hull not deep
   std::vector<char> deep_, dry_;
+  std::vector<SurfaceAt> surface_;  // over each hull the bound check leaves undecided
   std::vector<int> cut_;           // hulls the surface cuts
   std::vector<double> fraction_, fraction_rate_, hull_volume_;
   aligned_vector<Vec6> fraction_gradient_;

@@ -1,9 +1,9 @@
 // The free surface as the bodies see it (mirror of uvms_pin/physics/surface.py).
 //
 // Each hull whose bounding sphere lies below -max|eta| is wet (f = 1), above +max|eta| dry
-// (f = 0): one bound check per body, and nothing more when every body is deep. The others are
-// cut by the surface, level over each hull at the elevation under its bounding sphere's
-// centre (hull.hpp). Per joint touched:
+// (f = 0): one bound check per body, and nothing more when every body is deep. Over any other
+// hull the surface is level at the elevation eta under its bounding sphere's centre: the hull
+// is deep (dry) when the sphere lies below (above) it, else cut (hull.hpp). Per joint touched:
 //   V_j = sum V_sub,i,  r_j = sum V_sub,i r_sub,i / V_j,  M_A,j = sum f_i M_A,i + M_A(no hull),
 // and the added mass that changes with f adds, per cut body (Lagrange's equations of
 // T_i = f_i 1/2 nu_r^T M_A,i nu_r; see uvms_pin/physics/reference.py, wet_fraction_wrenches):
@@ -47,9 +47,15 @@ void Dynamics::update_wet_state(double time_s, const FlowField& flow, bool free_
   bool all_deep = true;
   for (std::size_t h = 0; h < bodies.size(); ++h) {
     const auto& hull = bodies[h].hull;
-    const double height = data_.oMi[bodies[h].joint_id].act(hull.bound_center_m).z();
-    deep_[h] = height + hull.bound_radius_m <= -bound;
-    dry_[h] = height - hull.bound_radius_m >= bound;
+    const Vec3 center = data_.oMi[bodies[h].joint_id].act(hull.bound_center_m);
+    const double top = center.z() + hull.bound_radius_m, bottom = center.z() - hull.bound_radius_m;
+    deep_[h] = top <= -bound;
+    dry_[h] = bottom >= bound;
+    if (!deep_[h] && !dry_[h]) {  // the level surface over this hull decides
+      surface_[h] = flow.surface_at(time_s, center.x(), center.y());
+      deep_[h] = top <= surface_[h].elevation_m;
+      dry_[h] = bottom >= surface_[h].elevation_m;
+    }
     all_deep = all_deep && deep_[h];
   }
   if (all_deep) return;
@@ -64,9 +70,8 @@ void Dynamics::update_wet_state(double time_s, const FlowField& flow, bool free_
     hull_moment_[h] = hull_volume_[h] * body.center_of_buoyancy_in_joint_m;
     if (deep_[h] || dry_[h]) continue;
     const auto& placement = data_.oMi[body.joint_id];
-    const Vec3 center = placement.act(body.hull.bound_center_m);
-    const Wetting wetting = body.hull.wet(placement.rotation(), placement.translation(),
-                                          flow.surface_at(time_s, center.x(), center.y()));
+    const Wetting wetting =
+        body.hull.wet(placement.rotation(), placement.translation(), surface_[h]);
     hull_volume_[h] = wetting.volume_m3;
     hull_moment_[h] = wetting.moment_m4;
     fraction_[h] = wetting.fraction;

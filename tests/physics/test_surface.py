@@ -127,6 +127,38 @@ def test_deep_bodies_are_exactly_as_without_a_surface(models, flow):
             )
 
 
+def test_bodies_under_the_local_surface_are_exactly_as_without_one(reference_uvms):
+    """In a sea whose crests could reach them (sum |A| above the hull's top) but whose
+    surface over each body is above it now: bit for bit the numbers without a surface."""
+    sea = IrregularSea(0.5, 5.0, seed=1)
+    uvms = reference_uvms
+    q = uvms.neutral_configuration()
+    q[2] = -1.0
+    v = np.random.default_rng(2).normal(scale=0.3, size=uvms.nv)
+    data = uvms.model.createData()
+    pin.forwardKinematics(uvms.model, data, q)
+    bodies = uvms.surface_bodies
+    centers = np.array(
+        [
+            data.oMi[int(j)].act(c)
+            for j, c in zip(bodies.joint_ids, bodies.bound_center_in_joint_m, strict=True)
+        ]
+    )
+    assert np.max(centers[:, 2] + bodies.bound_radius_m) > -sea.elevation_bound_m
+    checked = 0
+    for t in np.linspace(0.0, 20.0, 41):
+        if np.any(sea.surface_elevation(t, centers[:, :2]) < centers[:, 2] + bodies.bound_radius_m):
+            continue
+        for backend in ("core", "python"):
+            kw = {"flow": sea, "time_s": t, "backend": backend}
+            np.testing.assert_array_equal(
+                up.bias_forces(uvms, q, v, free_surface=True, **kw),
+                up.bias_forces(uvms, q, v, **kw),
+            )
+        checked += 1
+    assert checked > 10
+
+
 def test_above_the_water_a_body_feels_gravity_only(models):
     """High above the waves: the rigid-body dynamics, no buoyancy, added mass or drag."""
     rng = np.random.default_rng(3)

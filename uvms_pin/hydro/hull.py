@@ -40,7 +40,7 @@ __all__ = ["Hull", "HullPiece", "SurfaceAt", "Wetting"]
 Shape = Sphere | Ellipsoid | Polyhedron | Cylinder
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)
 class HullPiece:
     """One shape, placed in the body's frame: x_body = rotation x_shape + translation_m."""
 
@@ -59,6 +59,17 @@ class HullPiece:
             )
         object.__setattr__(self, "rotation", rotation)
         object.__setattr__(self, "translation_m", translation)
+
+    def __eq__(self, other: object) -> bool:
+        if not isinstance(other, HullPiece):
+            return NotImplemented
+        return (
+            self.shape == other.shape
+            and np.array_equal(self.rotation, other.rotation)
+            and np.array_equal(self.translation_m, other.translation_m)
+        )
+
+    __hash__ = None  # type: ignore[assignment]  # equal by value, like the arrays it holds
 
     def placed(self, rotation: np.ndarray, translation_m: np.ndarray) -> HullPiece:
         """This piece in a frame where the body frame has the pose (rotation, translation)."""

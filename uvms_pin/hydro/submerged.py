@@ -181,7 +181,7 @@ class Ellipsoid:
         )
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)
 class Polyhedron:
     """A closed triangle mesh with outward-facing triangles [m] (a box, a collision mesh).
 
@@ -211,6 +211,15 @@ class Polyhedron:
             raise ParameterError(
                 "the mesh encloses no positive volume (not closed, or triangles inward)"
             )
+
+    def __eq__(self, other: object) -> bool:
+        if not isinstance(other, Polyhedron):
+            return NotImplemented
+        return np.array_equal(self.vertices_m, other.vertices_m) and np.array_equal(
+            self.triangles, other.triangles
+        )
+
+    __hash__ = None  # type: ignore[assignment]  # equal by value, like the arrays it holds
 
     @staticmethod
     def box(size_m) -> Polyhedron:

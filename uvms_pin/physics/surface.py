@@ -9,9 +9,10 @@ volume and its wet fraction f_i = V_sub,i / V_i (`uvms_pin.hydro.hull`). Per joi
 
 and each damped body's damping is scaled by its f_i. A hull whose bounding sphere lies
 below -max|eta| is wet whatever the waves do (f = 1: one bound check per body); one above
-+max|eta| is dry (f = 0); only the others are cut by the surface, level over each hull at
-the elevation under the centre of its bounding sphere. When every hull is deep nothing is
-computed: the model's constant per-joint arrays apply (`wet_state` gives None).
++max|eta| is dry (f = 0). The surface over any other hull is level at the elevation eta
+under the centre of its bounding sphere: the hull is deep (dry) when that sphere lies below
+(above) it, else it is cut. When every hull is deep nothing is computed: the model's
+constant per-joint arrays apply (`wet_state` gives None).
 """
 
 from __future__ import annotations
@@ -22,10 +23,10 @@ import numpy as np
 import pinocchio as pin
 
 from uvms_pin.flow import FlowField
-from uvms_pin.hydro.hull import SurfaceAt, Wetting
+from uvms_pin.hydro.hull import SurfaceAt
 from uvms_pin.model.uvms import UVMS
 
-__all__ = ["WetState", "wet_state", "wettings"]
+__all__ = ["WetState", "wet_state"]
 
 
 @dataclass(frozen=True)
@@ -42,44 +43,40 @@ class WetState:
     fraction_rate: np.ndarray
 
 
-def _deep_and_dry(
-    uvms: UVMS, data: pin.Data, flow: FlowField | None
-) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """(deep (h,), dry (h,), bound centres in the world (h, 3)) of every hull."""
+def _bound_centers(uvms: UVMS, data: pin.Data) -> np.ndarray:
+    """The centre of every hull's bounding sphere in the world (h, 3)."""
     bodies = uvms.surface_bodies
-    centers = np.array(
+    return np.array(
         [
             data.oMi[int(j)].act(c)
             for j, c in zip(bodies.joint_ids, bodies.bound_center_in_joint_m, strict=True)
         ]
     ).reshape(-1, 3)
-    bound = 0.0 if flow is None else flow.elevation_bound_m
-    heights = centers[:, 2]
-    return (
-        heights + bodies.bound_radius_m <= -bound,
-        heights - bodies.bound_radius_m >= bound,
-        centers,
-    )
 
 
-def wettings(
-    uvms: UVMS, data: pin.Data, flow: FlowField | None, time_s: float, which: np.ndarray
-) -> list[Wetting]:
-    """The wetting of the hulls ``which`` (indices), after forward kinematics in ``data``."""
+def _classify(
+    uvms: UVMS, data: pin.Data, flow: FlowField | None, time_s: float
+) -> tuple[np.ndarray, np.ndarray, dict[int, SurfaceAt]]:
+    """(deep (h,), dry (h,), the surface over each hull the surface may cut).
+
+    First the bound check against max|eta|; a hull it leaves undecided is deep (dry) when
+    its bounding sphere lies below (above) the level surface over it, eta at its centre."""
     bodies = uvms.surface_bodies
-    _, _, centers = _deep_and_dry(uvms, data, flow)
-    if flow is None:
-        surfaces = [SurfaceAt()] * len(which)
-    else:
-        eta, rate, slope = flow.surface_kinematics(time_s, centers[which, :2])
-        surfaces = [
-            SurfaceAt(*row) for row in zip(eta, rate, slope[:, 0], slope[:, 1], strict=True)
-        ]
-    out = []
-    for h, surface in zip(which, surfaces, strict=True):
-        placement = data.oMi[int(bodies.joint_ids[h])]
-        out.append(bodies.hulls[h].wet(placement.rotation, placement.translation, surface))
-    return out
+    centers = _bound_centers(uvms, data)
+    bound = 0.0 if flow is None else flow.elevation_bound_m
+    top, bottom = centers[:, 2] + bodies.bound_radius_m, centers[:, 2] - bodies.bound_radius_m
+    deep, dry = top <= -bound, bottom >= bound
+    undecided = np.flatnonzero(~deep & ~dry)
+    surfaces: dict[int, SurfaceAt] = {}
+    if undecided.size:
+        if flow is None:
+            kinematics = (np.zeros(undecided.size), np.zeros(undecided.size), np.zeros((undecided.size, 2)))
+        else:
+            kinematics = flow.surface_kinematics(time_s, centers[undecided, :2])
+        for k, (eta, rate, slope) in zip(undecided, zip(*kinematics, strict=True), strict=True):
+            deep[k], dry[k] = top[k] <= eta, bottom[k] >= eta
+            surfaces[int(k)] = SurfaceAt(float(eta), float(rate), float(slope[0]), float(slope[1]))
+    return deep, dry, surfaces
 
 
 def wet_state(uvms: UVMS, data: pin.Data, flow: FlowField | None, time_s: float) -> WetState | None:
@@ -88,7 +85,7 @@ def wet_state(uvms: UVMS, data: pin.Data, flow: FlowField | None, time_s: float)
     bodies = uvms.surface_bodies
     if len(bodies) == 0:
         return None
-    deep, dry, _ = _deep_and_dry(uvms, data, flow)
+    deep, dry, surfaces = _classify(uvms, data, flow, time_s)
     if np.all(deep):
         return None
     n = len(bodies)
@@ -96,8 +93,9 @@ def wet_state(uvms: UVMS, data: pin.Data, flow: FlowField | None, time_s: float)
     gradient, rate = np.zeros((n, 6)), np.zeros(n)
     volume = np.where(deep, bodies.volume_m3, 0.0)
     moment = volume[:, None] * bodies.center_of_buoyancy_in_joint_m
-    cut = np.flatnonzero(~deep & ~dry)
-    for h, wetting in zip(cut, wettings(uvms, data, flow, time_s, cut), strict=True):
+    for h in np.flatnonzero(~deep & ~dry):
+        placement = data.oMi[int(bodies.joint_ids[h])]
+        wetting = bodies.hulls[h].wet(placement.rotation, placement.translation, surfaces[int(h)])
         volume[h], moment[h] = wetting.volume_m3, wetting.moment_m4
         fraction[h], gradient[h], rate[h] = (
             wetting.fraction,
