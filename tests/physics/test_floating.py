@@ -193,3 +193,14 @@ def test_a_floating_body_follows_long_waves(load_body):
     assert math.hypot(*coefficients[:2]) / amplitude == pytest.approx(1.0, abs=1e-2)
     # in phase with eta = A cos(k x - w t) at the body (x stays near 0)
     assert coefficients[0] / amplitude == pytest.approx(1.0, abs=2e-2)
+
+
+def test_a_body_heavier_than_its_water_does_not_float(load_body):
+    """floating_equilibrium says so instead of returning a depth."""
+    uvms = load_body(
+        body_urdf(
+            mass=2.0 * RHO * 0.001, hydro=hydro_xml(0.001), collision='<sphere radius="0.062"/>'
+        )
+    )
+    with pytest.raises(up.SimulationError, match="does not float"):
+        floating_equilibrium(uvms, _at(uvms))

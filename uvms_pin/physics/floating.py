@@ -77,9 +77,8 @@ def floating_equilibrium(
     z = brentq(lift, -span, span, xtol=1e-14, rtol=4 * np.finfo(float).eps, maxiter=200)
     if not free_attitude:
         return _with(q, z, roll, pitch, yaw)
-    scale = np.array(
-        [uvms.mass_kg * 9.81, uvms.mass_kg * 9.81 * reach, uvms.mass_kg * 9.81 * reach]
-    )
+    weight = uvms.mass_kg * float(np.linalg.norm(uvms.model.gravity.linear))
+    scale = np.array([weight, weight * reach, weight * reach])  # the equations made O(1)
     solved = root(
         lambda x: net_hydrostatic_load(uvms, _with(q, x[0], x[1], x[2], yaw), backend) / scale,
         np.array([z, roll, pitch]),

@@ -70,7 +70,11 @@ def _classify(
     surfaces: dict[int, SurfaceAt] = {}
     if undecided.size:
         if flow is None:
-            kinematics = (np.zeros(undecided.size), np.zeros(undecided.size), np.zeros((undecided.size, 2)))
+            kinematics = (
+                np.zeros(undecided.size),
+                np.zeros(undecided.size),
+                np.zeros((undecided.size, 2)),
+            )
         else:
             kinematics = flow.surface_kinematics(time_s, centers[undecided, :2])
         for k, (eta, rate, slope) in zip(undecided, zip(*kinematics, strict=True), strict=True):
