@@ -94,3 +94,24 @@ def test_the_wet_fraction_changes_as_its_gradient_and_rate_say():
         )
         checked += 1
     assert checked > 20
+
+
+def test_a_mesh_away_from_its_origin_is_fitted_by_its_own_centroid():
+    """A mesh whose volume lies off its frame's origin (as collision meshes do): the fitted
+    hull's wet centroid, deep, is the model's centre of buoyancy; the bound holds it."""
+    box = Polyhedron.box((0.4, 0.2, 0.1))
+    offset = Polyhedron(box.vertices_m + np.array([0.3, -0.1, 0.2]), box.triangles)
+    np.testing.assert_allclose(offset.centroid_m, [0.3, -0.1, 0.2], atol=1e-15)
+    piece = HullPiece(offset, _random_rotation(), np.array([0.1, 0.0, 0.0]))
+    hull = Hull.fitted((piece,), 0.004, np.array([0.4, -0.2, 0.1]))
+    deep = hull.wet(np.eye(3), np.array([0.0, 0.0, -5.0]), SurfaceAt())
+    np.testing.assert_allclose(deep.center_of_buoyancy_m, [0.4, -0.2, 0.1], atol=1e-14)
+    assert deep.volume_m3 == pytest.approx(0.004)
+    for _ in range(20):
+        rotation = _random_rotation()
+        below = -(rotation @ hull.bound_center_m)[2] - hull.bound_radius_m
+        assert hull.wet(
+            rotation, np.array([0.0, 0.0, below]), SurfaceAt()
+        ).fraction == pytest.approx(1.0, abs=1e-12)
+        above = -(rotation @ hull.bound_center_m)[2] + hull.bound_radius_m
+        assert hull.wet(rotation, np.array([0.0, 0.0, above]), SurfaceAt()).fraction == 0.0

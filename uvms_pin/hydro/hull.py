@@ -84,7 +84,8 @@ class HullPiece:
 
     @property
     def centroid_m(self) -> np.ndarray:
-        return self.translation_m  # every shape is centred on its origin
+        """The centroid of the piece's volume, body frame."""
+        return self.rotation @ self.shape.centroid_m + self.translation_m
 
 
 @dataclass(frozen=True)
@@ -155,10 +156,12 @@ class Hull:
             centroid = volumes @ np.array([p.centroid_m for p in pieces]) / geometric
             shift = np.asarray(center_of_buoyancy_m, dtype=float) - centroid
             pieces = tuple(replace(p, translation_m=p.translation_m + shift) for p in pieces)
-        centers = np.array([p.centroid_m for p in pieces])
-        center = 0.5 * (centers.min(axis=0) + centers.max(axis=0))
+        # each shape lies within its bounding radius of its own origin
+        origins = np.array([p.translation_m for p in pieces])
+        center = 0.5 * (origins.min(axis=0) + origins.max(axis=0))
         radius = max(
-            float(np.linalg.norm(p.centroid_m - center)) + p.shape.bounding_radius_m for p in pieces
+            float(np.linalg.norm(p.translation_m - center)) + p.shape.bounding_radius_m
+            for p in pieces
         )
         return Hull(tuple(pieces), volume_m3 / geometric, geometric, center, radius)
 

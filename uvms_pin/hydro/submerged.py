@@ -127,6 +127,10 @@ class Sphere:
     def label(self) -> str:
         return "sphere"
 
+    @property
+    def centroid_m(self) -> np.ndarray:
+        return np.zeros(3)
+
     def below(self, normal: np.ndarray, depth_m: float) -> WetPart:
         r = self.radius_m
         volume, centroid, area = unit_sphere_cap(depth_m / r)
@@ -162,6 +166,10 @@ class Ellipsoid:
     @property
     def label(self) -> str:
         return "ellipsoid"
+
+    @property
+    def centroid_m(self) -> np.ndarray:
+        return np.zeros(3)
 
     def below(self, normal: np.ndarray, depth_m: float) -> WetPart:
         axes = np.asarray(self.semi_axes_m)
@@ -239,7 +247,15 @@ class Polyhedron:
         return float(np.einsum("ij,ij->", a, np.cross(b, c))) / 6.0
 
     @property
+    def centroid_m(self) -> np.ndarray:
+        """The centroid of the enclosed volume, in the mesh's frame (anywhere for a mesh)."""
+        a, b, c = (self.vertices_m[self.triangles[:, k]] for k in range(3))
+        six_volumes = np.einsum("ij,ij->i", a, np.cross(b, c))
+        return (six_volumes @ (a + b + c)) / (4.0 * six_volumes.sum())
+
+    @property
     def bounding_radius_m(self) -> float:
+        """The radius of a sphere about the mesh's origin that holds it."""
         return float(np.max(np.linalg.norm(self.vertices_m, axis=1)))
 
     def below(self, normal: np.ndarray, depth_m: float) -> WetPart:

@@ -81,6 +81,10 @@ class Cylinder:
     def label(self) -> str:
         return "cylinder"
 
+    @property
+    def centroid_m(self) -> np.ndarray:
+        return np.zeros(3)
+
     def below(self, normal: np.ndarray, depth_m: float) -> WetPart:
         n_p = math.hypot(normal[0], normal[1])
         if n_p <= AXIAL_TOLERANCE:
