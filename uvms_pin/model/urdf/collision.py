@@ -14,7 +14,7 @@ import pinocchio as pin
 from uvms_pin.errors import ModelError, ParameterError
 from uvms_pin.hydro import geometry
 from uvms_pin.hydro.hull import HullPiece
-from uvms_pin.hydro.mesh import load_mesh_geometry, mesh_hydro
+from uvms_pin.hydro.mesh import MeshGeometry, load_mesh_geometry, mesh_hydro
 from uvms_pin.hydro.params import HydroParams
 from uvms_pin.hydro.submerged import Polyhedron, Sphere
 from uvms_pin.hydro.submerged_cylinder import Cylinder
@@ -148,7 +148,7 @@ def _mesh_geometry(
     link: str,
     base_dir: Path,
     package_dirs: Sequence[str | Path],
-):
+) -> MeshGeometry:
     """The mesh file of a <mesh> element, read and scaled (`uvms_pin.hydro.mesh`)."""
     filename = shape.get("filename")
     if not filename:
