@@ -52,7 +52,7 @@ class Plant:
         backend: "core" (compiled, default) or "python" (the reference implementation).
         free_surface: the water has a top, z = 0 or the waves' elevation, and each body is
             cut by it (`uvms_pin.physics.surface`): it floats, surfaces, leaves the water.
-            False: water without a top (every body wholly wet wherever it is).
+            The default. False: water without a top (every body wholly wet wherever it is).
         stop_at_surface: end the run (SimulationError) when a body's centre of buoyancy
             rises above the surface: for models meant for submerged bodies only.
     """
@@ -64,7 +64,7 @@ class Plant:
     actuation: Actuation = field(default_factory=Unlimited)
     flow: FlowField | None = None
     backend: str = "core"
-    free_surface: bool = False
+    free_surface: bool = True
     stop_at_surface: bool = False
 
     def __post_init__(self) -> None:
