@@ -1,6 +1,5 @@
 #include "derivatives.hpp"
 
-#include <cstdio>
 #include <set>
 
 #include <pinocchio/algorithm/kinematics-derivatives.hpp>
@@ -35,7 +34,8 @@ Matrix3x JointMotion::point_dq(const Vec3& point_in_joint_m) const {
   return rotation * (jacobian.topRows<3>() - skew(point_in_joint_m) * jacobian.bottomRows<3>());
 }
 
-Derivatives::Derivatives(const Dynamics& dynamics) : dynamics_(dynamics) {
+Derivatives::Derivatives(const Dynamics& dynamics)
+    : dynamics_(dynamics), data_(dynamics_.model()) {
   const auto& model = dynamics_.model();
   const int nj = model.njoints, nv = model.nv;
   std::set<int> joints(dynamics_.joints_with_added_mass_.begin(),
@@ -52,7 +52,6 @@ Derivatives::Derivatives(const Dynamics& dynamics) : dynamics_(dynamics) {
   dw_dv_.assign(nj, Matrix6x::Zero(6, nv));
   fext_.assign(nj, pinocchio::Force::Zero());
   acceleration_ = Eigen::VectorXd::Zero(nv);
-  scratch_ = Matrix6x::Zero(6, nv);
   did_dq_ = did_dv_ = mass_ = Eigen::MatrixXd::Zero(nv, nv);
   cholesky_ = Eigen::LLT<Eigen::MatrixXd>(nv);
   out_.da_dq = out_.da_dv = out_.da_dtau = Eigen::MatrixXd::Zero(nv, nv);
@@ -78,13 +77,14 @@ void Derivatives::wrenches_at(const ConstVec& q, const ConstVec& v, const Eigen:
 
 void Derivatives::joint_motions() {
   const auto& model = dynamics_.model_;
-  const auto& data = dynamics_.data_;
+  const auto& data = data_;
   for (int j : hydro_joints_) {
     auto& m = motion_[j];
-    // (d a / d qdd equals d nu / dv: the copy in scratch_ is not needed)
+    // d a / d qdd = d nu / dv = J, written straight into m.jacobian. Pinocchio writes the
+    // columns of the joint's support only: the others stay the zeros each joint's own
+    // matrices were built with (a buffer shared by joints would carry another joint's columns)
     pinocchio::getJointAccelerationDerivatives(model, data, j, pinocchio::LOCAL, m.velocity_dq,
-                                               m.jacobian, m.acceleration_dq, m.acceleration_dv,
-                                               scratch_);
+                                               m.acceleration_dq, m.acceleration_dv, m.jacobian);
     m.rotation = data.oMi[j].rotation();
     m.translation = data.oMi[j].translation();
     m.velocity = data.v[j].toVector();
@@ -191,15 +191,12 @@ const ForwardDynamicsDerivatives& Derivatives::forward_dynamics_derivatives(
   did_dv_.setZero();
   // M into data.M, as Pinocchio's own bindings do: the version with external forces adds
   // the armature to data.M, not to its dtau/da argument (Pinocchio 4.1)
-  d.data_.M.setZero();
-  pinocchio::computeRNEADerivatives(d.model_, d.data_, q, v, ConstVec(acceleration_), fext_,
-                                    did_dq_, did_dv_, d.data_.M);
-  mass_ = d.data_.M;
-  std::fprintf(stderr, "massRB %.17g\n", mass_.norm());
+  data_.M.setZero();
+  pinocchio::computeRNEADerivatives(d.model_, data_, q, v, ConstVec(acceleration_), fext_,
+                                    did_dq_, did_dv_, data_.M);
+  mass_ = data_.M;
   joint_motions();
-  Eigen::MatrixXd before = motion_[3].jacobian;
   fluid_jacobians(flow, time_s);
-  std::fprintf(stderr, "jac change %g\n", (before - motion_[3].jacobian).norm());
   for (int j : hydro_joints_) {
     const auto& jac = motion_[j].jacobian;
     did_dq_.noalias() -= jac.transpose() * dw_dq_[j];
@@ -208,10 +205,8 @@ const ForwardDynamicsDerivatives& Derivatives::forward_dynamics_derivatives(
   mass_.triangularView<Eigen::StrictlyLower>() = mass_.transpose();  // filled: upper triangle
   for (int j : d.joints_with_added_mass_) {
     const auto& jac = motion_[j].jacobian;
-    std::fprintf(stderr, "joint %d jac %.17g added %.17g\n", j, jac.norm(), d.hydro_.added_mass_per_joint[j].norm());
     mass_.noalias() += jac.transpose() * (d.hydro_.added_mass_per_joint[j] * jac);
   }
-  std::fprintf(stderr, "mass %.17g %.17g\n", mass_.norm(), d.data_.M.norm());
   cholesky_.compute(mass_);
   if (cholesky_.info() != Eigen::Success) {
     throw SimulationFailure("mass matrix is not positive definite");

@@ -10,8 +10,10 @@
 // Jacobians are each hydro unit's (added_mass.hpp, damping.hpp, restoring.hpp), chained here
 // one function per term as in fluid.py.
 //
-// A Derivatives owns a copy of the Dynamics it differentiates (its own Pinocchio data), like
-// Plant: not thread-safe, no allocation per call.
+// A Derivatives owns a copy of the Dynamics it differentiates, like Plant, and a Pinocchio
+// data of its own for the RNEA derivatives (they overwrite buffers, e.g. data.M and the
+// composite inertias, that the dynamics' articulated pass keeps between calls): not
+// thread-safe, no allocation per call.
 #pragma once
 
 #include <vector>
@@ -80,10 +82,10 @@ class Derivatives {
   void damping_jacobians(const DampedBody& body, const FlowGradientsAtPoint& flow);
 
   Dynamics dynamics_;
+  Data data_;  // the RNEA derivatives' and the joint motions' (not the dynamics')
   std::vector<int> hydro_joints_;
   std::vector<JointMotion> motion_;  // per joint id (only hydro joints filled)
   std::vector<Matrix6x> dw_dq_, dw_dv_;
-  Matrix6x scratch_;
   ForceVector fext_;
   Eigen::VectorXd acceleration_;
   Eigen::MatrixXd did_dq_, did_dv_, mass_;

@@ -163,3 +163,35 @@ def test_a_wedge_is_buoyed_at_its_centroid_not_its_bounding_box_centre(load_body
     assert view["volume"][0] == pytest.approx(0.5 * a * b * length, rel=1e-12)
     centroid = OFFSET_M + ROTATION @ np.array([a / 3.0, b / 3.0, length / 2.0])
     np.testing.assert_allclose(view["centre of buoyancy"], centroid, rtol=0, atol=1e-15)
+
+
+def test_the_surface_cuts_a_box_mesh_where_the_box_is(load_body, tmp_path):
+    """The hull of a body derived from a mesh sits where the mesh is: a rotated, offset box
+    mesh and the box primitive at that pose leave the same wet volume and moment, at random
+    heights and tilts of the link (the body frame of the mesh is its bounding box's, so a
+    hull left in the mesh frame would be turned and shifted)."""
+    from uvms_pin.hydro.hull import SurfaceAt
+
+    sides = (0.3, 0.2, 0.12)
+    box = trimesh.creation.box(extents=sides)
+    box.apply_transform(_pose(ROTATION, OFFSET_M))
+
+    def hull(collision: str):
+        text = body_urdf().replace(
+            "  </link>", f"    <collision>{collision}</collision>\n  </link>"
+        )
+        (only,) = load_body(text).surface_bodies.hulls
+        return only
+
+    from_mesh = hull(_write(box, tmp_path / "box.obj"))
+    from_box = hull(
+        f'{_origin(ROTATION, OFFSET_M)}<geometry><box size="{_numbers(sides)}"/></geometry>'
+    )
+    rng = np.random.default_rng(3)
+    for _ in range(40):
+        rotation = pin.rpy.rpyToMatrix(*rng.uniform(-math.pi, math.pi, 3))
+        position = np.array([0.0, 0.0, rng.uniform(-0.25, 0.25)])
+        cut_mesh = from_mesh.wet(rotation, position, SurfaceAt())
+        cut_box = from_box.wet(rotation, position, SurfaceAt())
+        assert cut_mesh.volume_m3 == pytest.approx(cut_box.volume_m3, rel=1e-12, abs=1e-15)
+        np.testing.assert_allclose(cut_mesh.moment_m4, cut_box.moment_m4, rtol=0, atol=1e-14)

@@ -64,9 +64,7 @@ def assert_matches_finite_differences(uvms, q, v, tau, flow, time_s=0.4, tau_ext
     def accel(qq, vv, tt):
         return up.forward_dynamics(uvms, qq, vv, tt, tau_ext=tau_ext, **kw)
 
-    da_dq, da_dv, da_dtau = up.forward_dynamics_derivatives(
-        uvms, q, v, tau, tau_ext=tau_ext, **kw
-    )
+    da_dq, da_dv, da_dtau = up.forward_dynamics_derivatives(uvms, q, v, tau, tau_ext=tau_ext, **kw)
     nv = uvms.nv
     integrate = lambda x, dx: pin.integrate(uvms.model, x, dx)  # noqa: E731
     fd_q = central_difference(lambda x: accel(x, v, tau), q, nv, STEP, integrate)
@@ -187,3 +185,149 @@ def test_bad_arguments_name_what_is_wrong(reference_uvms):
         )
     with pytest.raises(ParameterError, match="time_s"):
         up.forward_dynamics_derivatives(reference_uvms, q, zero, zero, time_s=math.nan)
+
+
+# ---- the compiled core against the reference ---------------------------------------------
+
+#: compiled against Python: the same formulas summed in another order
+CORE_REL = 1e-10
+
+
+@pytest.mark.parametrize("flow", ["still", "current", "airy+current", "irregular"])
+def test_compiled_derivatives_match_the_reference(system, flow):
+    rng = np.random.default_rng(29)
+    for _ in range(3):
+        q, v, tau = random_state(system, rng)
+        tau_ext = rng.normal(size=system.nv)
+        kw = {"flow": FLOWS[flow], "time_s": 0.7, "tau_ext": tau_ext}
+        expected = up.forward_dynamics_derivatives(system, q, v, tau, backend="python", **kw)
+        got = up.forward_dynamics_derivatives(system, q, v, tau, backend="core", **kw)
+        for g, e, name in zip(got, expected, ("da_dq", "da_dv", "da_dtau"), strict=True):
+            assert _relative_error(g, e) < CORE_REL, name
+
+
+def test_compiled_derivatives_in_a_flow_without_core_counterpart_fall_back(reference_uvms):
+    rng = np.random.default_rng(30)
+    q, v, tau = random_state(reference_uvms, rng)
+    kw = {"flow": FLOWS["sheared"], "time_s": 0.2}
+    with pytest.warns(up.errors.CoreFallbackWarning, match="derivatives"):
+        got = up.forward_dynamics_derivatives(reference_uvms, q, v, tau, **kw)
+    expected = up.forward_dynamics_derivatives(reference_uvms, q, v, tau, backend="python", **kw)
+    for g, e in zip(got, expected, strict=True):
+        np.testing.assert_array_equal(g, e)
+
+
+# ---- the free surface ------------------------------------------------------------------------
+
+
+@pytest.mark.parametrize("backend", ["python", "core"])
+def test_free_surface_deep_bodies_have_the_deep_derivatives(reference_uvms, backend):
+    """Every body deep under the surface: the dynamics are those without a top, and so are
+    the derivatives (with waves too: the surface is far above)."""
+    rng = np.random.default_rng(31)
+    q, v, tau = random_state(reference_uvms, rng)
+    q[2] = -6.0
+    for flow in (None, FLOWS["airy+current"]):
+        kw = {"flow": flow, "time_s": 0.3, "backend": backend}
+        with_top = up.forward_dynamics_derivatives(
+            reference_uvms, q, v, tau, free_surface=True, **kw
+        )
+        without = up.forward_dynamics_derivatives(reference_uvms, q, v, tau, **kw)
+        for a, b in zip(with_top, without, strict=True):
+            np.testing.assert_array_equal(a, b)
+
+
+@pytest.mark.parametrize("depth_m", [0.0, 0.1, 5.0])
+def test_free_surface_cutting_a_body_is_refused(reference_uvms, depth_m):
+    """At or near the surface (or out of the water) the wet-fraction terms would need
+    differentiating: refused with a message naming the joints, never a silent wrong answer."""
+    q = reference_uvms.neutral_configuration()
+    q[2] = depth_m
+    zero = np.zeros(reference_uvms.nv)
+    with pytest.raises(ParameterError, match=r"free_surface=True.*surface cuts or leaves dry"):
+        up.forward_dynamics_derivatives(reference_uvms, q, zero, zero, free_surface=True)
+
+
+# ---- one control period ----------------------------------------------------------------------
+
+
+def _euler_period(uvms, q, v, tau, period_s, step_s, flow, time_s):
+    """The plant's semi-implicit Euler over a period (uvms_pin.sim.integrators)."""
+    from uvms_pin.sim.integrators import SemiImplicitEuler
+
+    def rhs(t, qq, vv):
+        return up.forward_dynamics(uvms, qq, vv, tau, flow=flow, time_s=t, backend="python")
+
+    return SemiImplicitEuler(step_s=step_s).advance(
+        uvms.model, rhs, time_s, q, v, time_s + period_s
+    )
+
+
+@pytest.mark.parametrize("flow", ["current", "airy+current"])
+def test_step_derivatives_match_finite_differences_of_the_period(reference_uvms, flow):
+    uvms, water = reference_uvms, FLOWS[flow]
+    rng = np.random.default_rng(32)
+    q, v, tau = random_state(uvms, rng)
+    period, step, t0 = 0.02, 0.005, 0.4
+    got = up.step_derivatives(
+        uvms, q, v, tau, period, step_s=step, flow=water, time_s=t0, backend="python"
+    )
+    q1, v1 = _euler_period(uvms, q, v, tau, period, step, water, t0)
+    # the plant's integrator, to rounding (the same formulas, the flow summed differently)
+    np.testing.assert_allclose(got.q, q1, rtol=1e-13, atol=1e-13)
+    np.testing.assert_allclose(got.v, v1, rtol=1e-13, atol=1e-13)
+    nv, model = uvms.nv, uvms.model
+
+    def end_state(x):  # x = (dq, v, tau) -> (q+ - q1 in the tangent at q1, v+)
+        dq, vv, tt = x[:nv], x[nv : 2 * nv], x[2 * nv :]
+        qe, ve = _euler_period(uvms, pin.integrate(model, q, dq), vv, tt, period, step, water, t0)
+        return np.r_[pin.difference(model, q1, qe), ve]
+
+    x0 = np.r_[np.zeros(nv), v, tau]
+    fd = central_difference(end_state, x0, 3 * nv, STEP)
+    fd_tau = central_difference(
+        lambda t: end_state(np.r_[np.zeros(nv), v, t]), tau, nv, 1e-3 * np.abs(tau).max()
+    )
+    # d(q+ (-) q1)/d(q+) is the identity at q1: the columns are the tangent Jacobians
+    assert _relative_error(got.dx_dx, fd[:, : 2 * nv]) < FD_REL
+    assert _relative_error(got.dx_dtau, fd_tau) < FD_REL
+
+
+def test_input_matrix_chains_the_thrusters_into_the_step(reference_uvms):
+    """dx+/du = dx+/dtau B_u for u = (thrust forces, joint torques): against finite
+    differences in u, with tau = B_u u; B_u's vehicle block is the allocation matrix."""
+    from uvms_pin.model.thruster import Thruster
+
+    uvms = reference_uvms
+    thrusters = [
+        Thruster(
+            f"t{k}", np.r_[np.cos(k), np.sin(k), 0.1 * k], np.r_[np.sin(k), 1.0, k % 2], 80, 60
+        )
+        for k in range(8)
+    ]
+    b_u = up.input_matrix(thrusters, uvms.nv)
+    assert b_u.shape == (uvms.nv, 8 + uvms.nv - 6)
+    np.testing.assert_array_equal(
+        b_u[:6, :8], np.column_stack([t.wrench_column for t in thrusters])
+    )
+    rng = np.random.default_rng(33)
+    q, v, _ = random_state(uvms, rng)
+    u = rng.normal(scale=5.0, size=b_u.shape[1])
+    got = up.step_derivatives(uvms, q, v, b_u @ u, 0.01, step_s=0.005, backend="python")
+
+    def end_velocity(uu):
+        return up.step_derivatives(uvms, q, v, b_u @ uu, 0.01, step_s=0.005, backend="python").v
+
+    fd = central_difference(end_velocity, u, len(u), 1e-3 * np.abs(u).max())
+    assert _relative_error(got.dx_du(b_u)[uvms.nv :], fd) < FD_REL
+    with pytest.raises(ParameterError, match="at least one thruster"):
+        up.input_matrix([], uvms.nv)
+
+
+def test_step_derivatives_refuse_a_bad_period(reference_uvms):
+    q = reference_uvms.neutral_configuration()
+    zero = np.zeros(reference_uvms.nv)
+    with pytest.raises(ParameterError, match="period_s"):
+        up.step_derivatives(reference_uvms, q, zero, zero, 0.0)
+    with pytest.raises(ParameterError, match="step_s"):
+        up.step_derivatives(reference_uvms, q, zero, zero, 0.1, step_s=-1.0)

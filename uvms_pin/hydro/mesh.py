@@ -60,6 +60,8 @@ class MeshGeometry:
         obb_rotation: mesh_R_obb (3x3), the axes of the oriented bounding box.
         obb_center_m: mesh_p_obb (3,).
         obb_extents_m: the box's full side lengths (3,).
+        vertices_m, triangles: the closed surface the volume is of (the mesh, or its convex
+            hull), outward triangles (n, 3) and (m, 3): what the free surface cuts.
     """
 
     volume_m3: float
@@ -68,6 +70,8 @@ class MeshGeometry:
     obb_rotation: np.ndarray
     obb_center_m: np.ndarray
     obb_extents_m: np.ndarray
+    vertices_m: np.ndarray | None = None
+    triangles: np.ndarray | None = None
 
 
 @functools.lru_cache(maxsize=256)
@@ -85,6 +89,9 @@ def _load_cached(path: str, mtime_ns: int, scale: tuple[float, float, float]) ->
         body, watertight = mesh, True
     else:
         body, watertight = mesh.convex_hull, False
+    triangles = np.asarray(body.faces, dtype=np.int64)
+    if float(body.volume) < 0.0:  # inward triangles: turn them out
+        triangles = triangles[:, ::-1].copy()
     volume = abs(float(body.volume))
     if not (math.isfinite(volume) and volume > 0.0):
         raise ParameterError(f"mesh '{path}' encloses no volume (flat or degenerate)")
@@ -101,6 +108,8 @@ def _load_cached(path: str, mtime_ns: int, scale: tuple[float, float, float]) ->
         obb_rotation=rotation,
         obb_center_m=transform[:3, 3].copy(),
         obb_extents_m=np.maximum(np.asarray(obb.extents, dtype=float), _MIN_SIDE_M),
+        vertices_m=np.asarray(body.vertices, dtype=float).copy(),
+        triangles=triangles,
     )
 
 

@@ -20,13 +20,14 @@ import numpy as np
 import pinocchio as pin
 from scipy.linalg import cho_factor, cho_solve
 
-from uvms_pin.errors import SimulationError
+from uvms_pin.errors import ParameterError, SimulationError
 from uvms_pin.flow import FlowField
 from uvms_pin.model.uvms import UVMS
 from uvms_pin.physics.derivatives.fluid import fluid_wrench_jacobians
 from uvms_pin.physics.derivatives.motion import JointMotion, joint_motions
 from uvms_pin.physics.reference import ReferenceDynamics
 from uvms_pin.physics.reference import _fluid_wrenches as fluid_wrenches
+from uvms_pin.physics.surface import wet_state
 
 
 def hydro_joints(uvms: UVMS) -> list[int]:
@@ -85,3 +86,23 @@ def forward_dynamics_derivatives(
     did_dq, did_dv, mass, _ = inverse_dynamics_derivatives(uvms, q, v, a, flow, time_s)
     inverse = inverse_of_mass(mass, q)
     return -inverse @ did_dq, -inverse @ did_dv, inverse
+
+
+def require_deep(uvms: UVMS, q: np.ndarray, flow: FlowField | None, time_s: float) -> None:
+    """ParameterError unless every hull is deep under the free surface at (q, t): there
+    the dynamics are those of water without a top (`uvms_pin.physics.surface`), and so are
+    their derivatives. The wet-fraction terms of a body the surface cuts are not
+    differentiated (nor is the jump in them where a body starts touching it)."""
+    data = uvms.model.createData()
+    pin.forwardKinematics(uvms.model, data, q)
+    wet = wet_state(uvms, data, flow, time_s)
+    if wet is None:
+        return
+    bodies = uvms.surface_bodies
+    names = [uvms.model.names[int(bodies.joint_ids[h])] for h in np.flatnonzero(wet.fraction < 1)]
+    raise ParameterError(
+        "forward_dynamics_derivatives with free_surface=True needs every body deep under the "
+        f"surface; at t = {time_s:.6g} s the surface cuts or leaves dry the hull(s) on joint(s) "
+        f"{sorted(set(names))} (wet fractions {np.round(wet.fraction, 4).tolist()}): the "
+        "derivatives of the wet-fraction terms are not implemented"
+    )
