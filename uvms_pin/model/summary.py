@@ -55,10 +55,16 @@ def model_summary(uvms: UVMS) -> str:
         "arm joints:",
         f"  {'joint':<16}{'lower [rad]':>12}{'upper [rad]':>12}{'effort':>10}{'velocity':>10}",
     ]
-    for k, name in enumerate(uvms.arm_joint_names):
-        idx_q, idx_v = 7 + k, 6 + k
+    arm = uvms.arm_joints
+    for k, name in enumerate(arm.names):
+        idx_v = 6 + k
+        lower, upper = (
+            f"{x:>12.3f}" if np.isfinite(x) else f"{'none':>12}"
+            for x in (arm.lower[k], arm.upper[k])
+        )
         lines.append(
-            f"  {name:<16}{model.lowerPositionLimit[idx_q]:>12.3f}{model.upperPositionLimit[idx_q]:>12.3f}"
+            f"  {name:<16}{lower}{upper}"
             f"{model.effortLimit[idx_v]:>10.3g}{model.velocityLimit[idx_v]:>10.3g}"
+            + ("  continuous: q holds (cos, sin)" if arm.kinds[k] == "continuous" else "")
         )
     return "\n".join(lines)

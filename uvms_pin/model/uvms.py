@@ -19,6 +19,7 @@ import pinocchio as pin
 from uvms_pin.errors import ModelError
 from uvms_pin.hydro.added_mass import added_mass_in_parent
 from uvms_pin.hydro.params import HydroParams
+from uvms_pin.model.arm_joints import ArmJoints
 
 __all__ = ["DEFAULT_WATER_DENSITY_KG_M3", "UVMS", "HydroBody"]
 
@@ -157,6 +158,17 @@ class UVMS:
         return (self.water_density_kg_m3 * self.volume_m3 - self.mass_kg) * g
 
     @property
+    def arm_joints(self) -> ArmJoints:
+        """The arm's joints: names, kinds, limits; q <-> one position per joint.
+
+        Raises ModelError for an arm joint of more than one degree of freedom (a ball joint
+        built in code: the dynamics take it, a scenario's one-angle-per-joint keys do not).
+        """
+        if "arm_joints" not in self.cache:
+            self.cache["arm_joints"] = ArmJoints.of(self.model, self.source)
+        return self.cache["arm_joints"]
+
+    @property
     def arm_joint_names(self) -> list[str]:
         return list(self.model.names[2:])
 
@@ -176,11 +188,10 @@ class UVMS:
         return self.ee_frame_id
 
     def neutral_configuration(self) -> np.ndarray:
-        """q at the origin, level, arm at zero (clipped into the joint limits)."""
+        """q at the origin, level, every arm joint at zero (clipped into its limits)."""
         q = pin.neutral(self.model)
-        lo = self.model.lowerPositionLimit[7:]
-        hi = self.model.upperPositionLimit[7:]
-        q[7:] = np.clip(q[7:], lo, hi)
+        arm = self.arm_joints
+        q[7:] = arm.configuration(arm.clip(np.zeros(arm.count)))
         return q
 
     def copy(self) -> UVMS:

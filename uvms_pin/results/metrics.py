@@ -7,6 +7,8 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from uvms_pin.results.joint_positions import KINDS, REVOLUTE, arm_positions, configuration_width
+
 if TYPE_CHECKING:
     from uvms_pin.results.rollout_data import RolloutData
 
@@ -60,7 +62,8 @@ def compute_metrics(rollout: RolloutData) -> dict[str, float]:
 
 
 def joint_limit_metrics(rollout: RolloutData) -> dict[str, float]:
-    """How far the arm went past its position limits [rad] (0: never), and the time share.
+    """How far the arm went past its position limits [rad] (0: never), and the time share,
+    over the joints that have limits (a continuous joint has none; {} if no joint has).
 
     The simulator does not stop a joint at its limit (no hard stops are modelled), so a
     controller that drives a joint past it shows up here, not as a crash.
@@ -68,10 +71,19 @@ def joint_limit_metrics(rollout: RolloutData) -> dict[str, float]:
     meta = rollout.metadata
     if "arm_position_lower_rad" not in meta or len(rollout) == 0 or rollout.q.shape[1] <= 7:
         return {}
-    q = rollout.q[:, 7:]
-    lower = np.asarray(meta["arm_position_lower_rad"], dtype=float)
-    upper = np.asarray(meta["arm_position_upper_rad"], dtype=float)
-    excess = np.maximum(lower - q, 0.0) + np.maximum(q - upper, 0.0)
+    lower = np.array([-math.inf if x is None else x for x in meta["arm_position_lower_rad"]])
+    upper = np.array([math.inf if x is None else x for x in meta["arm_position_upper_rad"]])
+    kinds = meta.get("arm_joint_kinds") or [REVOLUTE] * lower.size
+    limited = np.isfinite(lower) & np.isfinite(upper)
+    if (  # metadata that does not describe these columns (written by hand, or damaged)
+        not np.any(limited)
+        or not lower.size == upper.size == len(kinds)
+        or not set(kinds) <= set(KINDS)
+        or configuration_width(kinds) != rollout.q.shape[1] - 7
+    ):
+        return {}
+    q = arm_positions(rollout.q[:, 7:], kinds)[:, limited]
+    excess = np.maximum(lower[limited] - q, 0.0) + np.maximum(q - upper[limited], 0.0)
     return {
         "joint_limit_excess_max_rad": float(excess.max()),
         "joint_limit_excess_time_fraction": float(np.mean(np.any(excess > 0.0, axis=1))),

@@ -326,11 +326,13 @@ def _stopped(log: RolloutLog, wall_start: float, exc: SimulationError) -> Simula
 
 
 def run_metadata(plant: Plant, settings: SimulationSettings) -> dict[str, Any]:
-    """What a rollout records of the run: settings, seed, versions, model and arm joints."""
+    """What a rollout records of the run: settings, seed, versions, model and arm joints
+    (their kinds and position limits, None where a joint has none)."""
     from uvms_pin.results.provenance import package_versions
 
     uvms = plant.uvms
-    model = uvms.model
+    arm = uvms.arm_joints
+    lower, upper = arm.limits_record()
     return {
         "seed": settings.seed,
         "duration_s": settings.duration_s,
@@ -340,18 +342,11 @@ def run_metadata(plant: Plant, settings: SimulationSettings) -> dict[str, Any]:
         "integrator_settings": dict(vars(settings.integrator)),
         "versions": package_versions(),
         "model_source": uvms.source,
-        "arm_joint_names": uvms.arm_joint_names,
-        "arm_joint_kinds": [_joint_kind(model, name) for name in uvms.arm_joint_names],
-        "arm_position_lower_rad": model.lowerPositionLimit[7:].tolist(),
-        "arm_position_upper_rad": model.upperPositionLimit[7:].tolist(),
+        "arm_joint_names": list(arm.names),
+        "arm_joint_kinds": list(arm.kinds),
+        "arm_position_lower_rad": lower,
+        "arm_position_upper_rad": upper,
     }
-
-
-def _joint_kind(model, joint_name: str) -> str:
-    """'prismatic' or 'revolute' (names the units of the joint's columns in a table)."""
-    shortname = model.joints[model.getJointId(joint_name)].shortname()
-    prismatic = ("JointModelPX", "JointModelPY", "JointModelPZ", "JointModelPrismatic")
-    return "prismatic" if shortname.startswith(prismatic) else "revolute"
 
 
 def simulate_closed_loop(

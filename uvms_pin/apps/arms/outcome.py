@@ -33,8 +33,9 @@ def joint_limit_violation(rollout, uvms: UVMS) -> str:
     """The first arm joint past its limits (1e-6 rad tolerance) and when; "" if none."""
     if len(rollout) == 0:
         return ""
-    q = rollout.q[:, 7:]
-    lo, hi = uvms.model.lowerPositionLimit[7:], uvms.model.upperPositionLimit[7:]
+    arm = uvms.arm_joints  # a continuous joint has no limits: never past them
+    q = arm.positions(rollout.q)
+    lo, hi = arm.lower, arm.upper
     bad = (q < lo - 1e-6) | (q > hi + 1e-6)
     if not np.any(bad):
         return ""

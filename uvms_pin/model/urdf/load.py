@@ -78,7 +78,7 @@ def load_uvms(
         base_dir=path.parent,
         package_dirs=package_dirs,
     )
-    return UVMS(
+    uvms = UVMS(
         model=model,
         hydro_bodies=tuple(bodies),
         water_density_kg_m3=float(water_density_kg_m3),
@@ -86,6 +86,8 @@ def load_uvms(
         sensor_frame_id=_optional_frame_id(model, sensor_frame, DEFAULT_SENSOR_FRAME, where),
         source=where,
     )
+    uvms.arm_joints  # noqa: B018 - refuses a planar or floating arm joint now, naming it
+    return uvms
 
 
 def _build_model(path: Path) -> pin.Model:
