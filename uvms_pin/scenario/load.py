@@ -81,7 +81,9 @@ def scenario_from_raw(
     except ScenarioError:
         raise
     except UvmsPinError as exc:
-        raise ScenarioError(f"{source}: {exc}") from exc
+        error = ScenarioError(f"{source}: {exc}")
+        error.user_traceback = exc.user_traceback
+        raise error from exc
 
 
 def _build(raw: dict[str, Any], path: Path, top: Table) -> Scenario:

@@ -18,16 +18,17 @@ from __future__ import annotations
 
 import math
 import time
-from collections.abc import Sequence
+from collections.abc import Iterator, Sequence
+from contextlib import contextmanager
 from typing import Any
 
 import numpy as np
 
 from uvms_pin.control.base import Controller
 from uvms_pin.control.measurement import Measurement, read_only
-from uvms_pin.errors import FunnelViolation, ParameterError, SimulationError
+from uvms_pin.errors import ControllerError, FunnelViolation, ParameterError, SimulationError
 from uvms_pin.results.rollout import Rollout
-from uvms_pin.results.status import INTERRUPTED, OK, RunStatus, Violation
+from uvms_pin.results.status import ERROR, INTERRUPTED, OK, RunStatus, Violation
 from uvms_pin.sim.divergence import NUMERICAL_FAILURES, diverged
 from uvms_pin.sim.integrators import Adaptive
 from uvms_pin.sim.log import RolloutLog
@@ -90,7 +91,8 @@ class ClosedLoop:
         self.time_s, self.q, self.v = 0.0, read_only(q0), read_only(v0)
         self.sensors = sensors
         if self.controller is not None:
-            self.controller.reset()
+            with self._controller_code("reset"):
+                self.controller.reset()
         self.plant.attach(self.q)
 
     def measure(self) -> tuple[Measurement, np.ndarray]:
@@ -105,7 +107,12 @@ class ClosedLoop:
         """The controller's tau (nv,) for ``measurement`` (SimulationError if it is not nv
         finite numbers)."""
         t = measurement.time_s
-        tau = np.asarray(self.controller.compute(t, measurement), dtype=float)
+        try:  # inline, not the context manager: this is the hot path
+            tau = np.asarray(self.controller.compute(t, measurement), dtype=float)
+        except SimulationError:  # a funnel violation is the law's own verdict
+            raise
+        except Exception as exc:
+            raise _controller_failed(self.controller, "compute", t, exc) from exc
         if tau.shape != (self.plant.uvms.nv,) or not (
             math.isfinite(float(tau.sum())) or np.all(np.isfinite(tau))  # exact if in doubt
         ):
@@ -143,6 +150,11 @@ class ClosedLoop:
     ) -> Sample:
         """The loop now, as its observers see it."""
         controller = self.controller
+        if controller is None:
+            signals = _NO_SIGNALS
+        else:
+            with self._controller_code("signals"):
+                signals = controller.signals()
         return Sample(
             self.time_s,
             self.q,
@@ -152,8 +164,19 @@ class ClosedLoop:
             self.plant.disturbance_wrench(self.time_s),
             tau_commanded,
             tau_applied,
-            _NO_SIGNALS if controller is None else controller.signals(),
+            signals,
         )
+
+    @contextmanager
+    def _controller_code(self, method: str) -> Iterator[None]:
+        """The controller's ``method`` runs in the block: what it raises (a funnel violation
+        aside) stops the run as a `ControllerError` naming the method and the time."""
+        try:
+            yield
+        except SimulationError:
+            raise
+        except Exception as exc:
+            raise _controller_failed(self.controller, method, self.time_s, exc) from exc
 
     def notify(self, sample: Sample) -> None:
         for observer in self.observers:
@@ -171,11 +194,11 @@ class ClosedLoop:
             KeyboardInterrupt: likewise, with status ``interrupted``.
         """
         self.observers.insert(0, log)
-        self.start(q0, v0, sensors)
-        log.rollout.metadata["world"] = self.plant.record()  # as simulated: anchored
         wall_start = time.perf_counter()
         span = [0.0, 0.0]  # the interval being integrated, for a divergence message
         try:
+            self.start(q0, v0, sensors)
+            log.rollout.metadata["world"] = self.plant.record()  # as simulated: anchored
             if self.settings.control_period_s is None:
                 self._run_continuous(span)
             else:
@@ -184,7 +207,7 @@ class ClosedLoop:
             error = _diverged(*span, exc)
             raise _stopped(log, wall_start, error) from exc
         except SimulationError as exc:  # FunnelViolation included
-            raise _stopped(log, wall_start, exc) from None
+            raise _stopped(log, wall_start, exc) from exc.__cause__  # e.g. the controller's
         except KeyboardInterrupt as exc:  # Ctrl-C: the caller may keep what was simulated
             exc.rollout = _finished(
                 log, wall_start, RunStatus(INTERRUPTED, "interrupted by the user")
@@ -247,8 +270,9 @@ class ClosedLoop:
             return acceleration
 
         def margin_event(t: float, q: np.ndarray, v: np.ndarray) -> float:
-            controller.compute(t, at(t, q, v)[0])
-            return controller.funnel_margin() + _EVENT_OVERSHOOT
+            command(at(t, q, v)[0])
+            with self._controller_code("funnel_margin"):
+                return controller.funnel_margin() + _EVENT_OVERSHOOT
 
         self._tick(True)
         logged = 1
@@ -278,7 +302,8 @@ class ClosedLoop:
     def _integrate(self, rhs, t0: float, times: np.ndarray, event):
         """(states reached, the failure that stopped the pass or None)."""
         controller = self.controller
-        controller.set_funnel_extension(event is not None)
+        with self._controller_code("set_funnel_extension"):
+            controller.set_funnel_extension(event is not None)
         try:
             states = self.settings.integrator.advance_through(
                 self.plant.uvms.model, rhs, t0, self.q, self.v, times, event,
@@ -289,6 +314,15 @@ class ClosedLoop:
         finally:
             controller.set_funnel_extension(False)
         return states, None
+
+
+def _controller_failed(
+    controller: Controller, method: str, time_s: float, exc: Exception
+) -> ControllerError:
+    """The `ControllerError` of ``exc``, raised by ``controller.method`` at ``time_s``; with
+    the frames of the user's code when the controller is not one of uvms-pin's."""
+    users = not type(controller).__module__.startswith("uvms_pin.")
+    return ControllerError(method, time_s, exc, users=users)
 
 
 def _diverged(t0: float, t1: float, exc: BaseException) -> SimulationError:
@@ -319,9 +353,12 @@ def _stopped(log: RolloutLog, wall_start: float, exc: SimulationError) -> Simula
     if isinstance(exc, FunnelViolation):
         violation = Violation(exc.level, exc.component, exc.time_s, exc.error, exc.bound)
     time_s = violation.time_s if violation is not None else None
-    exc.rollout = _finished(
-        log, wall_start, RunStatus(type(exc).__name__, str(exc), time_s, violation)
-    )
+    kind = type(exc).__name__
+    if isinstance(exc, ControllerError):
+        kind, time_s = ERROR, exc.time_s
+    if exc.user_traceback:
+        log.rollout.metadata["error_traceback"] = exc.user_traceback
+    exc.rollout = _finished(log, wall_start, RunStatus(kind, str(exc), time_s, violation))
     return exc
 
 

@@ -11,10 +11,10 @@ import math
 import sys
 
 from uvms_pin.apps.arguments import add_comparison_command, comma_names, count, finite, positive
+from uvms_pin.apps.exit_codes import EXIT_BAD_INPUT
 from uvms_pin.model.mount.catalog import available_arms
 from uvms_pin.results.outdir import COMPARISON, check_writable, claim
 
-EXIT_BAD_INPUT = 2
 DEFAULT_ARMS = "reference,so100,z1,kinova,ur3,ur5,panda"
 
 

@@ -22,7 +22,7 @@ For a scenario (e.g. ``scenarios/realistic_force_tracking.toml``) whose model is
    is what the sampled controller's stability depends on), and the other arrays take the
    median of the reference arm's entries.
 6. The run's status is "ok", the exception that stopped it (FunnelViolation,
-   SimulationError) or "joint limits" if a joint left its limits during the run.
+   SimulationError), "error" (the controller raised) or "joint limits" if a joint left its limits during the run.
 7. With ``keep_rollouts``, each arm's row (``row.json``: status, reason, trim) and, when it
    ran, its rollout, ``metrics.json`` and figures (the paper's funnel figures show which
    error left its funnel, and when) go to ``OUT/<arm>/``, as ``uvms-pin run`` writes them.

@@ -5,41 +5,25 @@ from __future__ import annotations
 import argparse
 import sys
 import warnings
-from contextlib import nullcontext
 from pathlib import Path
 from typing import TYPE_CHECKING
 
 from uvms_pin.apps.arguments import add_set_option, positive
 from uvms_pin.apps.arms.command import register as register_compare_arms
+from uvms_pin.apps.cli.run import check_view_options, cmd_run
 from uvms_pin.apps.compare.command import register as register_compare_controllers
-from uvms_pin.apps.outputs import write_outputs
+from uvms_pin.apps.exit_codes import EXIT_BAD_INPUT, EXIT_ENVIRONMENT, EXIT_INTERRUPTED
 from uvms_pin.apps.study.command import register as register_study_commands
 from uvms_pin.apps.validation.command import register as register_validate
-from uvms_pin.errors import FunnelViolation, SimulationError, UvmsPinError, UvmsPinWarning
+from uvms_pin.errors import UvmsPinError, UvmsPinWarning
 from uvms_pin.model.resources import find_model
-from uvms_pin.results.outdir import OVERWRITE_HELP, RUN, check_writable, claim, claim_file
-from uvms_pin.results.progress import progress_printer
-from uvms_pin.scenario.overrides import parse_assignment
+from uvms_pin.results.outdir import OVERWRITE_HELP, claim_file
 
 if TYPE_CHECKING:
     from uvms_pin.results.rollout import Rollout
 
 # The simulation stack (Pinocchio, SciPy, matplotlib) is imported by the commands that
 # need it: --help, --version and argument errors answer at once.
-
-EXIT_BAD_INPUT = 2
-EXIT_RUN_STOPPED = 3
-EXIT_INTERRUPTED = 130  # as a shell reports a process stopped by Ctrl-C
-
-
-def _simulate(scenario, args: argparse.Namespace, progress) -> Rollout:
-    from uvms_pin.sim.run import simulate
-
-    if not args.live:
-        return simulate(scenario, progress=progress)
-    from uvms_pin.apps.viz.live import run_live
-
-    return run_live(scenario, port=args.port, speed=args.speed, progress=progress)
 
 
 def _write_replay(rollout: Rollout, path: Path, **kw) -> Path:
@@ -48,65 +32,8 @@ def _write_replay(rollout: Rollout, path: Path, **kw) -> Path:
     return write_replay(rollout, path, **kw)
 
 
-def _cmd_run(args: argparse.Namespace) -> int:
-    from uvms_pin.scenario.load import load_scenario
-
-    _check_view_options(args)
-    overrides = dict(parse_assignment(text) for text in args.set)
-    scenario = load_scenario(args.scenario, overrides)
-    out = check_writable(args.out)  # before simulating, not after
-    with claim(out, RUN, overwrite=args.overwrite):
-        rollout, status, message = _simulate_to_end(scenario, args)
-        if rollout is None:
-            print(message, file=sys.stderr)
-            return status
-        figures = write_outputs(rollout, out)
-        if args.html:
-            figures.append(_write_replay(rollout, out / "replay.html"))
-    metrics = rollout.metrics()
-    print(
-        f"scenario {scenario.name}: {rollout.metadata['status']}, simulated {metrics['simulated_time_s']:.3f} s in {metrics['wall_time_s']:.2f} s (real-time factor {metrics['real_time_factor']:.2f})"
-    )
-    print(
-        f"wrote {out}/rollout.npz, rollout.json, metrics.json, "
-        + ", ".join(p.name for p in figures)
-    )
-    if status:
-        print(message, file=sys.stderr)
-    return status
-
-
-def _simulate_to_end(scenario, args: argparse.Namespace) -> tuple[Rollout | None, int, str]:
-    """(rollout, exit status, message): a stopped or interrupted run keeps its rollout."""
-    duration_s = scenario.settings.duration_s
-    printer = (
-        nullcontext() if args.quiet else progress_printer(scenario.name, duration_s, delay_s=0.0)
-    )
-    with printer as progress:
-        return _run_or_stop(scenario, args, progress)
-
-
-def _run_or_stop(scenario, args: argparse.Namespace, progress) -> tuple[Rollout | None, int, str]:
-    try:
-        return _simulate(scenario, args, progress), 0, ""
-    except (FunnelViolation, SimulationError) as exc:
-        return getattr(exc, "rollout", None), EXIT_RUN_STOPPED, f"run stopped: {exc}"
-    except KeyboardInterrupt as exc:
-        rollout = getattr(exc, "rollout", None)
-        if rollout is None or not len(rollout):
-            return None, EXIT_INTERRUPTED, "uvms-pin: interrupted before the first sample"
-        t_s = float(rollout.time_s[-1])
-        kept = f"the partial rollout (t = 0 to {t_s:.3f} s) is kept in {args.out}"
-        return rollout, EXIT_INTERRUPTED, f"uvms-pin: interrupted: {kept}"
-
-
-def _check_view_options(args: argparse.Namespace) -> None:
-    if not 0 <= args.port <= 65535:
-        raise UvmsPinError(f"--port must be in 0..65535, got {args.port}")
-
-
 def _cmd_replay(args: argparse.Namespace) -> int:
-    _check_view_options(args)
+    check_view_options(args)
     if not (args.html or args.live):
         raise UvmsPinError("replay: nothing to do, give --html and/or --live")
     from uvms_pin.results.rollout import Rollout
@@ -169,7 +96,7 @@ def build_parser() -> argparse.ArgumentParser:
         "--html", action="store_true", help="also write replay.html (self-contained, offline)"
     )
     _add_view_options(run)
-    run.set_defaults(func=_cmd_run)
+    run.set_defaults(func=cmd_run)
     replay = sub.add_parser("replay", help="show a saved rollout: replay.html and/or live")
     replay.add_argument("rollout", help="directory holding rollout.npz and rollout.json")
     replay.add_argument("--html", action="store_true", help="write ROLLOUT/replay.html")
@@ -235,16 +162,21 @@ def main(argv: list[str] | None = None) -> int:
 def _dispatch(args: argparse.Namespace) -> int:
     try:
         return args.func(args)
+    except OSError as exc:  # a disk full, a file removed under us: not a bug to trace
+        where = f"{exc.filename}: " if exc.filename else ""
+        print(f"uvms-pin: error: {where}{exc.strerror or exc}", file=sys.stderr)
+        return EXIT_ENVIRONMENT
     except UvmsPinError as exc:
+        if exc.user_traceback:  # the user's own code failed: its frames, shown as such
+            print(
+                "uvms-pin: your code raised; its traceback:\n" + exc.user_traceback.rstrip("\n"),
+                file=sys.stderr,
+            )
         print(f"uvms-pin: error: {exc}", file=sys.stderr)
         return EXIT_BAD_INPUT
     except KeyboardInterrupt:
         print("uvms-pin: interrupted", file=sys.stderr)
         return EXIT_INTERRUPTED
-    except OSError as exc:  # a disk full, a file removed under us: not a bug to trace
-        where = f"{exc.filename}: " if exc.filename else ""
-        print(f"uvms-pin: error: {where}{exc.strerror or exc}", file=sys.stderr)
-        return EXIT_BAD_INPUT
 
 
 if __name__ == "__main__":

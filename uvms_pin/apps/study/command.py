@@ -13,10 +13,8 @@ import sys
 from pathlib import Path
 
 from uvms_pin.apps.arguments import count
+from uvms_pin.apps.exit_codes import EXIT_INTERRUPTED
 from uvms_pin.results.outdir import STUDY, check_writable, claim
-
-EXIT_BAD_INPUT = 2
-EXIT_INTERRUPTED = 130
 
 
 def _cmd_sweep(args: argparse.Namespace) -> int:

@@ -43,7 +43,7 @@ import pandas as pd
 
 from uvms_pin.apps.study.identity import check_same_study, file_sha256, record_study_inputs
 from uvms_pin.apps.study.spec import Run, Study
-from uvms_pin.errors import FunnelViolation, SimulationError, StudyError
+from uvms_pin.errors import ControllerError, FunnelViolation, SimulationError, StudyError
 from uvms_pin.results.atomic import atomic_path
 
 RESULTS_FILE = "results.parquet"
@@ -82,6 +82,13 @@ def execute_run(base: str, run: Run, rollout_dir: str | None = None) -> dict[str
                 violation_level=exc.level,
                 violation_component=exc.component,
                 violation_time_s=float(exc.time_s),
+            )
+        except ControllerError as exc:  # the controller raised: not a result, an error
+            rollout = getattr(exc, "rollout", None)
+            row.update(status="error", error=str(exc))
+            cause = exc.__cause__
+            row["traceback"] = exc.user_traceback or "".join(
+                traceback.format_exception(cause, limit=8) if cause else ()
             )
         except SimulationError as exc:
             rollout = getattr(exc, "rollout", None)
