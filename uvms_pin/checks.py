@@ -1,6 +1,10 @@
-"""Checks of arguments that raise `ParameterError` naming the argument and what is wrong."""
+"""Checks of arguments that raise `ParameterError` naming the argument and what is wrong,
+and of what a command is about to allocate (`check_memory`)."""
 
 from __future__ import annotations
+
+import os
+from collections.abc import Callable
 
 import numpy as np
 
@@ -18,3 +22,41 @@ def finite_vector(name: str, value, size: int) -> np.ndarray:
     if not np.all(np.isfinite(array)):
         raise ParameterError(f"{name} contains a non-finite value: {array}")
     return array
+
+
+def available_memory_bytes() -> int | None:
+    """Memory the system can give this process now [bytes], or None if unknown."""
+    try:
+        with open("/proc/meminfo") as f:
+            for line in f:
+                if line.startswith("MemAvailable:"):
+                    return int(line.split()[1]) * 1024
+    except OSError:
+        pass
+    try:
+        return os.sysconf("SC_AVPHYS_PAGES") * os.sysconf("SC_PAGE_SIZE")
+    except (ValueError, OSError, AttributeError):
+        return None
+
+
+def check_memory(
+    needed_bytes: float,
+    what: str,
+    remedy: str,
+    error: Callable[[str], Exception] = ParameterError,
+) -> None:
+    """Raise ``error(message)`` before anything is allocated if ``what`` would take more than
+    half of the memory available (the other half: what the command allocates besides).
+
+    Args:
+        needed_bytes: the estimate [bytes]. what: the thing and its size, for the message
+            ("the log of this run (500001 samples: ...)"). remedy: what to change.
+        error: makes the exception from the message (an exception type, or a function
+            that names the file and the entry).
+    """
+    available = available_memory_bytes()
+    if available is not None and needed_bytes > available // 2:
+        raise error(
+            f"{what} would take {needed_bytes / 2**30:.3g} GiB, more than half of the "
+            f"{available / 2**30:.3g} GiB available: {remedy}"
+        )

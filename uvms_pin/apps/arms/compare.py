@@ -43,6 +43,8 @@ from uvms_pin.apps.arms.progress import done_line, print_to_stderr
 from uvms_pin.apps.arms.row import COLUMNS
 from uvms_pin.apps.arms.settings import CompareSettings
 from uvms_pin.apps.arms.table import write_comparison
+from uvms_pin.checks import check_memory
+from uvms_pin.errors import ScenarioError
 from uvms_pin.model.mount.catalog import REFERENCE, ArmEntry, resolve_arm
 from uvms_pin.model.mount.hull import hull_box
 from uvms_pin.model.mount.split import split_urdf
@@ -73,7 +75,9 @@ def compare_arms(
     scenario_path = Path(scenario_path)
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
-    base = load_scenario(scenario_path)
+    duration = {} if settings.duration_s is None else {"scenario.duration_s": settings.duration_s}
+    base = load_scenario(scenario_path, duration)
+    _check_runs_fit(base, min(jobs, len(arms)))
     model_path = Path(base.uvms.source)
     for name in arms:  # fail early on names that are neither known nor files
         if name != REFERENCE:
@@ -99,6 +103,22 @@ def compare_arms(
             rows = _run_in_turn(args, progress)
     write_comparison(rows, out, scenario=str(scenario_path), settings=settings)
     return rows
+
+
+#: configuration and velocity entries an arm of the catalogue may add to the scenario's
+#: (a 7-joint arm replacing a 4-joint one, continuous joints counted twice)
+_MORE_ARM_ENTRIES = 16
+
+
+def _check_runs_fit(base, parallel: int) -> None:
+    """ScenarioError before any arm runs if ``parallel`` runs' logs would not fit."""
+    uvms, settings = base.uvms, base.settings
+    check_memory(
+        parallel * settings.log_bytes(uvms.nq + _MORE_ARM_ENTRIES, uvms.nv + _MORE_ARM_ENTRIES),
+        f"the logs of {parallel} arm runs at a time ({settings.n_log} samples each)",
+        "shorten --duration, lengthen output.log_period_s or lower --jobs",
+        ScenarioError,
+    )
 
 
 def _run_in_processes(

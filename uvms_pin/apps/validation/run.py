@@ -13,7 +13,7 @@ from uvms_pin.apps.validation.pool import (
     summary_csv,
     trial_uvms,
 )
-from uvms_pin.apps.validation.trials import find_trials, load_trial
+from uvms_pin.apps.validation.trials import check_trials_fit, find_trials, load_trial
 from uvms_pin.errors import DataError
 from uvms_pin.results.atomic import write_json_atomic, write_text_atomic
 
@@ -45,6 +45,7 @@ def run_pool_validation(
                 f"{data_dir}: no trial named {', '.join(unknown)} (have {', '.join(by_name)})"
             )
         files = [by_name[n] for n in trial_names]
+    check_trials_fit(files)
     trials = [load_trial(p) for p in files]
     uvms = trial_uvms()
     comparisons = []
