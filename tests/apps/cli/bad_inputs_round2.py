@@ -1,0 +1,96 @@
+"""The bad-input corpus, second round (issue 22): what a new user broke in an afternoon, and
+the rest of each class. One block per issue item; the runner is ``test_bad_inputs.py``."""
+
+from __future__ import annotations
+
+from corpus import (
+    Case,
+    realistic_with,
+    rollout_kept,
+    scenario_with,
+    steps,
+    urdf_with,
+    write,
+)
+
+ARM_JOINTS = ("arm_joint1", "arm_joint2", "arm_joint3", "arm_joint4")
+
+
+def _joint_type(kind: str, *names: str) -> str:
+    """The reference URDF with joints ``names`` of type ``kind``."""
+    return urdf_with(
+        **{
+            f'<joint name="{n}" type="revolute">': f'<joint name="{n}" type="{kind}">'
+            for n in names
+        }
+    )
+
+
+def _controller(body: str, init: str = "self.nv = uvms.nv") -> str:
+    """A user's controller module ``ctrl.py`` with class ``C``."""
+    return (
+        "import numpy as np\n"
+        "from uvms_pin.control.base import Controller\n\n"
+        "class C(Controller):\n"
+        "    def __init__(self, uvms, **params):\n"
+        f"        {init}\n\n"
+        "    def compute(self, t, m):\n"
+        + "".join(f"        {line}\n" for line in body.splitlines())
+    )
+
+
+def _with_controller(module: str, params: str = "") -> object:
+    """Setup: ``ctrl.py`` and a passive scenario ``s.toml`` run by its controller ``C``."""
+    extra = f'\n[controller]\ntype = "ctrl:C"\n{params}'
+    return steps(write("ctrl.py", module), write("s.toml", scenario_with(_URDF, 0.2, extra)))
+
+
+_URDF = str(__import__("cli_support").URDF)
+
+#: ``python diskfull.py NAME uvms-pin-args``: uvms-pin on a disk that refuses file NAME
+DISK_FULL = """import errno, os, sys
+from uvms_pin.apps.cli.main import main
+full = sys.argv.pop(1)
+real = os.replace
+def replace(src, dst, *args, **kw):
+    if os.path.basename(dst) == full:
+        raise OSError(errno.ENOSPC, os.strerror(errno.ENOSPC), str(src))
+    return real(src, dst, *args, **kw)
+os.replace = replace
+sys.exit(main())
+"""
+_RUN_NEW = ("run", "s.toml", "--out", "new", "--quiet")
+
+ROUND_TWO = [
+    # ---- 1. a controller cannot change the simulation through its measurement ----------
+    Case("run-controller-freezes-the-vehicle", _RUN_NEW, ("run stopped", "compute() raised at t = 0 s", "ValueError: assignment destination is read-only"), _with_controller(_controller("m.v[:] = 0\nreturn np.zeros(self.nv)")), code=3, traceback_of="ctrl.py", after=rollout_kept("new", "error")),
+    Case("run-controller-teleports-the-vehicle", _RUN_NEW, ("compute() raised", "read-only"), _with_controller(_controller("m.q[0] = 99.0\nreturn np.zeros(self.nv)")), code=3, traceback_of="ctrl.py", after=rollout_kept("new", "error")),
+    Case("run-controller-writes-the-wrench", _RUN_NEW, ("compute() raised", "read-only"), _with_controller(_controller("m.force_world_N[:] = 1.0\nreturn np.zeros(self.nv)")), code=3, traceback_of="ctrl.py", after=rollout_kept("new", "error")),
+    # ---- 2. continuous joints: one position per joint, no limits -----------------------
+    Case("run-continuous-joints-given-cos-and-sin", ("run", "s.toml", "--out", "new", "--set", "initial.joint_positions_rad=[1,0,1,0,1,0,1,0]"), ("initial.joint_positions_rad", "needs 4 numbers, got 8"), steps(write("c.urdf", _joint_type("continuous", *ARM_JOINTS)), write("s.toml", scenario_with("c.urdf"))), watch="new"),
+    Case("run-continuous-beside-a-limited-joint-outside", ("run", "s.toml", "--out", "new", "--set", "initial.joint_positions_rad=[3.0, 2.5, 0, 0]"), ("outside the joint limits for arm_joint2",), steps(write("c.urdf", _joint_type("continuous", "arm_joint1")), write("s.toml", scenario_with("c.urdf"))), watch="new"),
+    Case("info-planar-arm-joint", ("info", "p.urdf"), ("p.urdf", "joint 'arm_joint2' (JointModelPlanar) has 3 degrees of freedom", "revolute, continuous or prismatic"), write("p.urdf", _joint_type("planar", "arm_joint2"))),
+    Case("info-floating-arm-joint", ("info", "f.urdf"), ("f.urdf", "joint 'arm_joint3' (JointModelFreeFlyer) has 6 degrees of freedom"), write("f.urdf", _joint_type("floating", "arm_joint3"))),
+    # ---- 3. what a command allocates is checked first ------------------------------------
+    Case("sweep-linspace-of-a-billion", ("sweep", "st.toml", "--out", "new"), ("st.toml", "parameter[0]", "linspace: 1000000000000 points", "GiB", "give fewer"), steps(write("base.toml", scenario_with(_URDF)), write("st.toml", '[study]\nbase = "base.toml"\nseed = 1\n[[parameter]]\npath = "water.current_world_m_s[0]"\nlinspace = [1, 1000, 1000000000000]\n')), watch="new"),
+    Case("sweep-logspace-of-a-billion", ("sweep", "st.toml", "--out", "new"), ("logspace: 1000000000000 points",), steps(write("base.toml", scenario_with(_URDF)), write("st.toml", '[study]\nbase = "base.toml"\nseed = 1\n[[parameter]]\npath = "water.density_kg_m3"\nlogspace = [1000, 1030, 1000000000000]\n')), watch="new"),
+    Case("sweep-too-many-samples", ("sweep", "st.toml", "--out", "new"), ("the study's 20000000000000 runs (2 points x 10000000000000 samples)", "split the study"), steps(write("base.toml", scenario_with(_URDF)), write("st.toml", '[study]\nbase = "base.toml"\nseed = 1\nsamples = 10000000000000\n[[parameter]]\npath = "water.current_world_m_s[0]"\nvalues = [0.0, 0.1]\n')), watch="new"),
+    Case("compare-controllers-log-too-large", ("compare-controllers", "r.toml", "--out", "new", "--set", "scenario.duration_s=1e9", "--controllers", "ppc"), ("the log of this run", "GiB", "scenario.duration_s"), write("r.toml", realistic_with()), watch="new"),
+    Case("compare-arms-duration-too-long", ("compare-arms", "r.toml", "--out", "new", "--duration", "1e9", "--arms", "reference"), ("the log of this run", "GiB"), write("r.toml", realistic_with()), watch="new"),
+    # ---- 4. a controller that raises: the rollout kept, its traceback shown -------------
+    Case("run-controller-raises-later", _RUN_NEW, ("run stopped", "compute() raised at t = 0.1", "ZeroDivisionError", "partial rollout (t = 0 to 0.1"), _with_controller(_controller("if t > 0.1:\n    return 1 / 0\nreturn np.zeros(self.nv)")), code=3, traceback_of="ctrl.py", after=rollout_kept("new", "error", error="ZeroDivisionError", error_traceback="ctrl.py")),
+    Case("run-controller-reset-raises", _RUN_NEW, ("run stopped", "reset() raised at t = 0 s", "RuntimeError: no hardware"), _with_controller(_controller("return np.zeros(self.nv)") + "\n    def reset(self):\n        raise RuntimeError('no hardware')\n"), code=3, traceback_of="ctrl.py", after=rollout_kept("new", "error")),
+    Case("run-controller-signals-raise", _RUN_NEW, ("signals() raised", "KeyError"), _with_controller(_controller("return np.zeros(self.nv)") + "\n    def signals(self):\n        return {}['e_x']\n"), code=3, traceback_of="ctrl.py", after=rollout_kept("new", "error")),
+    Case("run-controller-returns-a-wrong-size", _RUN_NEW, ("run stopped", "controller returned an invalid tau"), _with_controller(_controller("return np.zeros(3)")), code=3, after=rollout_kept("new", "SimulationError")),
+    Case("run-controller-constructor-raises", _RUN_NEW, ("s.toml", "[controller]", "rejected its parameters (gain)", "KeyError"), _with_controller(_controller("return None", init="self.gain = {}['gain']"), "gain = 2.0\n"), traceback_of="ctrl.py", watch="new"),
+    Case("run-controller-module-fails-to-import", _RUN_NEW, ("importing 'ctrl' failed", "NameError"), _with_controller("import numpy as np\nundefined_name\n"), traceback_of="ctrl.py", watch="new"),
+    # ---- 5. a second Ctrl-C while the first is handled -----------------------------------
+    Case("run-second-ctrl-c-while-saving", ("run", "long.toml", "--out", "new", "--quiet"), ("interrupted", "the partial rollout (t = 0 to"), write("long.toml", scenario_with(_URDF, 600.0)), code=130, interrupts=(0.02,), after=rollout_kept("new", "interrupted")),
+    Case("run-three-ctrl-c-in-a-row", ("run", "long.toml", "--out", "new", "--quiet"), ("interrupted",), write("long.toml", scenario_with(_URDF, 600.0)), code=130, interrupts=(0.01, 0.05), after=rollout_kept("new", "interrupted")),
+    # ---- 14. a full disk: exit 4, the file named, what was kept said --------------------
+    Case("run-disk-full-at-a-figure", ("velocities.png", "run", "s.toml", "--out", "new", "--quiet"), ("cannot write new/velocities.png: No space left on device", "kept in new: rollout.npz, rollout.json, metrics.json, pose.png"), steps(write("diskfull.py", DISK_FULL), write("s.toml", scenario_with(_URDF))), code=4, script="diskfull.py", after=rollout_kept("new", "ok")),
+    Case("run-disk-full-at-the-rollout", ("rollout.npz", "run", "s.toml", "--out", "new", "--quiet"), ("cannot write new/rollout.npz: No space left on device", "nothing of this run was kept in new"), steps(write("diskfull.py", DISK_FULL), write("s.toml", scenario_with(_URDF))), code=4, script="diskfull.py", watch="new"),
+    Case("run-disk-full-at-the-metadata", ("rollout.json", "run", "s.toml", "--out", "new", "--quiet"), ("cannot write new/rollout.json", "nothing of this run was kept"), steps(write("diskfull.py", DISK_FULL), write("s.toml", scenario_with(_URDF))), code=4, script="diskfull.py", watch="new"),
+    Case("replay-disk-full", ("replay.html", "replay", "prior", "--html"), ("prior/replay.html: No space left on device",), write("diskfull.py", DISK_FULL), code=4, script="diskfull.py"),
+    Case("sweep-disk-full", ("results.parquet", "sweep", "{study}", "--out", "new", "--workers", "0", "--quiet"), ("new/results.parquet: No space left on device",), write("diskfull.py", DISK_FULL), code=4, script="diskfull.py", watch="prior"),
+]  # fmt: skip
