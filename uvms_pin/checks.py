@@ -24,6 +24,20 @@ def finite_vector(name: str, value, size: int) -> np.ndarray:
     return array
 
 
+#: seeds are recorded in rollouts, JSON and the study table's int64 column
+MAX_SEED = 2**63 - 1
+
+
+def seed_value(name: str, value) -> int:
+    """``value`` as a seed: an integer in [0, 2^63 - 1] (numpy's generators take no negative
+    seed, and a study table stores seeds as int64); ParameterError naming ``name`` else."""
+    if isinstance(value, bool) or not isinstance(value, int | np.integer):
+        raise ParameterError(f"{name} must be an integer in [0, 2^63 - 1], got {value!r}")
+    if not 0 <= int(value) <= MAX_SEED:
+        raise ParameterError(f"{name} must be an integer in [0, 2^63 - 1], got {value}")
+    return int(value)
+
+
 def available_memory_bytes() -> int | None:
     """Memory the system can give this process now [bytes], or None if unknown."""
     try:

@@ -89,3 +89,17 @@ def test_cli_exits_3_and_saves_the_partial_rollout_of_a_blow_up(tmp_path):
     metrics = json.loads((out / "metrics.json").read_text())
     assert metrics["status"] == "SimulationError"
     assert len(up.Rollout.load(out)) == 1
+
+
+@pytest.mark.parametrize("seed", [-1, 2**63, 1.5])
+def test_a_seed_no_generator_takes_is_refused_where_it_is_given(seed):
+    from uvms_pin.flow import GaussMarkovCurrent, IrregularSea
+    from uvms_pin.sim.integrators import RK4
+    from uvms_pin.sim.settings import SimulationSettings
+
+    with pytest.raises(up.ParameterError, match="seed must be an integer in"):
+        SimulationSettings(1.0, RK4(0.01), seed=seed)
+    with pytest.raises(up.ParameterError, match="seed must be an integer in"):
+        IrregularSea(0.5, 6.0, seed=seed)
+    with pytest.raises(up.ParameterError, match="seed must be an integer in"):
+        GaussMarkovCurrent([0.1, 0, 0], 0.05, 10.0, 0.2, seed=seed)

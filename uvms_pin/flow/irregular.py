@@ -15,6 +15,7 @@ import math
 
 import numpy as np
 
+from uvms_pin.checks import seed_value
 from uvms_pin.errors import ParameterError
 from uvms_pin.flow.components import (
     STANDARD_GRAVITY_M_S2,
@@ -82,7 +83,7 @@ class IrregularSea(WaveField):
         self.significant_height_m = float(significant_height_m)
         self.peak_period_s = float(peak_period_s)
         self.peak_enhancement = float(peak_enhancement)
-        self.seed = int(seed)
+        self.seed = seed_value("seed", seed)
         self.water_depth_m = float(water_depth_m)
         rng = np.random.default_rng(self.seed)
         wp = 2.0 * math.pi / self.peak_period_s

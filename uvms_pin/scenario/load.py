@@ -123,7 +123,7 @@ def _head(t: Table, path: Path) -> Head:
         description=t.string("description", ""),
         model=t.string("model"),
         duration_s=t.number("duration_s", positive=True),
-        seed=t.integer("seed", 0),
+        seed=t.seed("seed", 0),
     )
     t.finish()
     return head

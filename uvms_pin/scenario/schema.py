@@ -14,7 +14,8 @@ from typing import Any
 
 import numpy as np
 
-from uvms_pin.errors import ScenarioError, UvmsPinError
+from uvms_pin.checks import seed_value
+from uvms_pin.errors import ParameterError, ScenarioError, UvmsPinError
 from uvms_pin.scenario.overrides import closest
 
 
@@ -121,6 +122,14 @@ class Table:
         if minimum is not None and value < minimum:
             raise self.error(key, f"must be >= {minimum}, got {value}")
         return value
+
+    def seed(self, key: str, default: int) -> int:
+        """A seed: an integer in [0, 2^63 - 1] (`uvms_pin.checks.seed_value`)."""
+        value = self.integer(key, default)
+        try:
+            return seed_value(self.full(key), value)
+        except ParameterError as exc:
+            raise self.error(key, str(exc).removeprefix(f"{self.full(key)} ")) from None
 
     def string(
         self, key: str, default: str | None = None, choices: tuple[str, ...] | None = None

@@ -63,7 +63,7 @@ def _sea(t: Table, seed: int) -> IrregularSea:
         heading_rad=t.number("heading_rad", 0.0),
         spreading_exponent=t.optional_number("spreading_exponent", positive=True),
         n_components=t.integer("n_components", 100),
-        seed=t.integer("seed", seed),
+        seed=t.seed("seed", seed),
         water_depth_m=t.number("water_depth_m", math.inf, positive=True),
     )
 
@@ -89,7 +89,7 @@ def _gauss_markov_current(t: Table, seed: int) -> GaussMarkovCurrent:
         std_m_s=t.number("std_m_s", nonneg=True),
         time_constant_s=t.number("time_constant_s", positive=True),
         bound_m_s=t.number("bound_m_s", positive=True),
-        seed=t.integer("seed", seed),
+        seed=t.seed("seed", seed),
         sample_period_s=t.number("sample_period_s", 0.5, positive=True),
     )
 

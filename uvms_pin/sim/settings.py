@@ -6,7 +6,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-from uvms_pin.checks import check_memory
+from uvms_pin.checks import check_memory, seed_value
 from uvms_pin.errors import ParameterError
 from uvms_pin.sim.integrators import Integrator
 
@@ -33,6 +33,7 @@ class SimulationSettings:
     rebase_period_s: float = 0.5
 
     def __post_init__(self) -> None:
+        seed_value("seed", self.seed)
         if not (self.duration_s > 0.0 and math.isfinite(self.duration_s)):
             raise ParameterError(f"duration_s must be positive, got {self.duration_s}")
         if not (self.log_period_s > 0.0 and math.isfinite(self.log_period_s)):

@@ -3,6 +3,7 @@ the rest of each class. One block per issue item; the runner is ``test_bad_input
 
 from __future__ import annotations
 
+from cli_support import ROOT, URDF
 from corpus import (
     Case,
     realistic_with,
@@ -45,7 +46,7 @@ def _with_controller(module: str, params: str = "") -> object:
     return steps(write("ctrl.py", module), write("s.toml", scenario_with(_URDF, 0.2, extra)))
 
 
-_URDF = str(__import__("cli_support").URDF)
+_URDF = str(URDF)
 
 #: ``python diskfull.py NAME uvms-pin-args``: uvms-pin on a disk that refuses file NAME
 DISK_FULL = """import errno, os, sys
@@ -87,6 +88,14 @@ ROUND_TWO = [
     # ---- 5. a second Ctrl-C while the first is handled -----------------------------------
     Case("run-second-ctrl-c-while-saving", ("run", "long.toml", "--out", "new", "--quiet"), ("interrupted", "the partial rollout (t = 0 to"), write("long.toml", scenario_with(_URDF, 600.0)), code=130, interrupts=(0.02,), after=rollout_kept("new", "interrupted")),
     Case("run-three-ctrl-c-in-a-row", ("run", "long.toml", "--out", "new", "--quiet"), ("interrupted",), write("long.toml", scenario_with(_URDF, 600.0)), code=130, interrupts=(0.01, 0.05), after=rollout_kept("new", "interrupted")),
+    # ---- 6. seeds numpy would refuse: named where they are given -------------------------
+    Case("run-negative-seed", ("run", "{good}", "--out", "new", "--set", "scenario.seed=-5"), ("override 'scenario.seed'", "must be an integer in [0, 2^63 - 1], got -5"), watch="new"),
+    Case("run-seed-beyond-int64", ("run", "{good}", "--out", "new", "--set", "scenario.seed=9223372036854775808"), ("scenario.seed", "[0, 2^63 - 1]"), watch="new"),
+    Case("run-fractional-seed", ("run", "{good}", "--out", "new", "--set", "scenario.seed=1.5"), ("scenario.seed", "must be an integer, got 1.5"), watch="new"),
+    Case("run-negative-sea-seed", ("run", "sea.toml", "--out", "new", "--set", "water.sea.seed=-1"), ("override 'water.sea.seed'", "got -1"), write("sea.toml", (ROOT / "scenarios" / "sea_state_force_tracking.toml").read_text().replace('"uvms_lbv150"', f'"{_URDF}"')), watch="new"),
+    Case("run-negative-seed-in-the-file", ("run", "s.toml", "--out", "new"), ("s.toml: scenario.seed", "got -3"), write("s.toml", scenario_with(_URDF).replace("seed = 1", "seed = -3")), watch="new"),
+    Case("sweep-negative-study-seed", ("sweep", "st.toml", "--out", "new"), ("st.toml: study.seed", "got -1"), steps(write("base.toml", scenario_with(_URDF)), write("st.toml", '[study]\nbase = "base.toml"\nseed = -1\n[[parameter]]\npath = "water.current_world_m_s[0]"\nvalues = [0.0, 0.1]\n')), watch="new"),
+    Case("sweep-negative-fixed-seed", ("sweep", "st.toml", "--out", "new"), ("st.toml", "study.base with [fixed]", "scenario.seed", "got -2"), steps(write("base.toml", scenario_with(_URDF)), write("st.toml", '[study]\nbase = "base.toml"\nseed = 1\n[fixed]\n"scenario.seed" = -2\n[[parameter]]\npath = "water.current_world_m_s[0]"\nvalues = [0.0, 0.1]\n')), watch="new"),
     # ---- 14. a full disk: exit 4, the file named, what was kept said --------------------
     Case("run-disk-full-at-a-figure", ("velocities.png", "run", "s.toml", "--out", "new", "--quiet"), ("cannot write new/velocities.png: No space left on device", "kept in new: rollout.npz, rollout.json, metrics.json, pose.png"), steps(write("diskfull.py", DISK_FULL), write("s.toml", scenario_with(_URDF))), code=4, script="diskfull.py", after=rollout_kept("new", "ok")),
     Case("run-disk-full-at-the-rollout", ("rollout.npz", "run", "s.toml", "--out", "new", "--quiet"), ("cannot write new/rollout.npz: No space left on device", "nothing of this run was kept in new"), steps(write("diskfull.py", DISK_FULL), write("s.toml", scenario_with(_URDF))), code=4, script="diskfull.py", watch="new"),

@@ -49,7 +49,7 @@ def load_study(path: str | Path) -> Study:
     name = head.string("name", path.stem)
     description = head.string("description", "")
     base_entry = head.string("base")
-    seed = head.integer("seed", minimum=0)
+    seed = head.seed("seed", None)
     samples = head.integer("samples", 1, minimum=1)
     head.finish()
     base = (path.parent / base_entry).resolve()
