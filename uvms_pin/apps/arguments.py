@@ -11,13 +11,15 @@ from __future__ import annotations
 
 import argparse
 import math
+import os
 from collections.abc import Callable
 
 from uvms_pin.errors import ParameterError
 
 
-def count(minimum: int) -> Callable[[str], int]:
-    """An integer >= ``minimum`` (process, job and start counts)."""
+def count(minimum: int, maximum: int | None = None, why: str = "") -> Callable[[str], int]:
+    """An integer in ``minimum..maximum`` (process, job and start counts); ``why``: what the
+    maximum is, for the message."""
 
     def parse(text: str) -> int:
         try:
@@ -26,9 +28,20 @@ def count(minimum: int) -> Callable[[str], int]:
             raise argparse.ArgumentTypeError(f"must be an integer, got {text!r}") from None
         if value < minimum:
             raise argparse.ArgumentTypeError(f"must be an integer >= {minimum}, got {value}")
+        if maximum is not None and value > maximum:
+            raise argparse.ArgumentTypeError(
+                f"must be an integer <= {maximum}{f' ({why})' if why else ''}, got {value}"
+            )
         return value
 
     return parse
+
+
+def process_count(minimum: int) -> Callable[[str], int]:
+    """A count of worker processes on this machine: at most 4 per CPU (more only wait for
+    the CPUs, each with its own copy of the model and its memory)."""
+    cpus = os.cpu_count() or 1
+    return count(minimum, 4 * cpus, f"4 per CPU, {cpus} CPUs here")
 
 
 def finite(text: str) -> float:

@@ -40,6 +40,12 @@ def _spread_headings(
     return mean_rad + np.interp(rng.uniform(size=count), cdf, grid)
 
 
+#: More components than any sea needs (tens to hundreds resolve a JONSWAP spectrum); each
+#: is summed at every body at every integrator stage, so the bound keeps a run's time (and
+#: the time between two checks for Ctrl-C) in proportion.
+MAX_COMPONENTS = 2000
+
+
 class IrregularSea(WaveField):
     """A seeded realisation of a JONSWAP sea (gamma = 1: Pierson-Moskowitz).
 
@@ -68,8 +74,15 @@ class IrregularSea(WaveField):
         frequency_range: tuple[float, float] = (0.5, 3.5),
         gravity_m_s2: float = STANDARD_GRAVITY_M_S2,
     ):
-        if isinstance(n_components, bool) or not isinstance(n_components, int) or n_components < 1:
-            raise ParameterError(f"n_components must be a positive integer, got {n_components!r}")
+        if (
+            isinstance(n_components, bool)
+            or not isinstance(n_components, int)
+            or not 1 <= n_components <= MAX_COMPONENTS
+        ):
+            raise ParameterError(
+                f"n_components must be an integer in 1..{MAX_COMPONENTS}, got {n_components!r}"
+                " (each component is summed at every body at every integrator stage)"
+            )
         low, high = (float(x) for x in frequency_range)
         if not (0.0 < low < 1.0 < high and math.isfinite(high)):
             raise ParameterError(

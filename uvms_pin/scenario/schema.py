@@ -112,7 +112,14 @@ class Table:
     def optional_number(self, key: str, **kw) -> float | None:
         return self.number(key, **kw) if key in self._data else None
 
-    def integer(self, key: str, default: int | None = None, *, minimum: int | None = None) -> int:
+    def integer(
+        self,
+        key: str,
+        default: int | None = None,
+        *,
+        minimum: int | None = None,
+        maximum: int | None = None,
+    ) -> int:
         self._asked.add(key)
         if key not in self._data and default is None:
             raise self.error(key, "is required")
@@ -121,6 +128,8 @@ class Table:
             raise self.error(key, f"must be an integer, got {value!r}")
         if minimum is not None and value < minimum:
             raise self.error(key, f"must be >= {minimum}, got {value}")
+        if maximum is not None and value > maximum:
+            raise self.error(key, f"must be <= {maximum}, got {value}")
         return value
 
     def seed(self, key: str, default: int) -> int:

@@ -19,6 +19,7 @@ from uvms_pin.flow import (
     SumFlow,
     UniformCurrent,
 )
+from uvms_pin.flow.irregular import MAX_COMPONENTS
 from uvms_pin.scenario.schema import Table
 
 
@@ -62,7 +63,7 @@ def _sea(t: Table, seed: int) -> IrregularSea:
         peak_enhancement=t.number("peak_enhancement", 3.3, positive=True),
         heading_rad=t.number("heading_rad", 0.0),
         spreading_exponent=t.optional_number("spreading_exponent", positive=True),
-        n_components=t.integer("n_components", 100),
+        n_components=t.integer("n_components", 100, minimum=1, maximum=MAX_COMPONENTS),
         seed=t.seed("seed", seed),
         water_depth_m=t.number("water_depth_m", math.inf, positive=True),
     )

@@ -61,6 +61,11 @@ os.replace = replace
 sys.exit(main())
 """
 _RUN_NEW = ("run", "s.toml", "--out", "new", "--quiet")
+_SEA = (
+    (ROOT / "scenarios" / "sea_state_force_tracking.toml")
+    .read_text()
+    .replace('"../models/uvms_lbv150.urdf"', f'"{URDF}"')
+)
 
 ROUND_TWO = [
     # ---- 1. a controller cannot change the simulation through its measurement ----------
@@ -92,10 +97,17 @@ ROUND_TWO = [
     Case("run-negative-seed", ("run", "{good}", "--out", "new", "--set", "scenario.seed=-5"), ("override 'scenario.seed'", "must be an integer in [0, 2^63 - 1], got -5"), watch="new"),
     Case("run-seed-beyond-int64", ("run", "{good}", "--out", "new", "--set", "scenario.seed=9223372036854775808"), ("scenario.seed", "[0, 2^63 - 1]"), watch="new"),
     Case("run-fractional-seed", ("run", "{good}", "--out", "new", "--set", "scenario.seed=1.5"), ("scenario.seed", "must be an integer, got 1.5"), watch="new"),
-    Case("run-negative-sea-seed", ("run", "sea.toml", "--out", "new", "--set", "water.sea.seed=-1"), ("override 'water.sea.seed'", "got -1"), write("sea.toml", (ROOT / "scenarios" / "sea_state_force_tracking.toml").read_text().replace('"uvms_lbv150"', f'"{_URDF}"')), watch="new"),
+    Case("run-negative-sea-seed", ("run", "sea.toml", "--out", "new", "--set", "water.sea.seed=-1"), ("override 'water.sea.seed'", "got -1"), write("sea.toml", _SEA), watch="new"),
     Case("run-negative-seed-in-the-file", ("run", "s.toml", "--out", "new"), ("s.toml: scenario.seed", "got -3"), write("s.toml", scenario_with(_URDF).replace("seed = 1", "seed = -3")), watch="new"),
     Case("sweep-negative-study-seed", ("sweep", "st.toml", "--out", "new"), ("st.toml: study.seed", "got -1"), steps(write("base.toml", scenario_with(_URDF)), write("st.toml", '[study]\nbase = "base.toml"\nseed = -1\n[[parameter]]\npath = "water.current_world_m_s[0]"\nvalues = [0.0, 0.1]\n')), watch="new"),
     Case("sweep-negative-fixed-seed", ("sweep", "st.toml", "--out", "new"), ("st.toml", "study.base with [fixed]", "scenario.seed", "got -2"), steps(write("base.toml", scenario_with(_URDF)), write("st.toml", '[study]\nbase = "base.toml"\nseed = 1\n[fixed]\n"scenario.seed" = -2\n[[parameter]]\npath = "water.current_world_m_s[0]"\nvalues = [0.0, 0.1]\n')), watch="new"),
+    # ---- 7. every count bounded --------------------------------------------------------
+    Case("run-sea-of-ten-million-components", ("run", "sea.toml", "--out", "new", "--set", "water.sea.n_components=10000000"), ("override 'water.sea.n_components'", "must be <= 2000, got 10000000"), write("sea.toml", _SEA), watch="new"),
+    Case("run-sea-of-no-component", ("run", "sea.toml", "--out", "new", "--set", "water.sea.n_components=0"), ("water.sea.n_components", "must be >= 1, got 0"), write("sea.toml", _SEA), watch="new"),
+    Case("sweep-workers-beyond-the-machine", ("sweep", "{study}", "--out", "study_out", "--workers", "100000"), ("--workers", "must be an integer <=", "per CPU", "100000"), watch="study_out"),
+    Case("compare-controllers-jobs-beyond-the-machine", ("compare-controllers", "{good}", "--out", "new", "--jobs", "100000"), ("--jobs", "per CPU"), watch="new"),
+    Case("compare-arms-jobs-beyond-the-machine", ("compare-arms", "{good}", "--out", "new", "--jobs", "100000"), ("--jobs", "per CPU"), watch="new"),
+    Case("compare-arms-ik-starts-beyond-reason", ("compare-arms", "{good}", "--out", "new", "--ik-starts", "100000000"), ("--ik-starts", "must be an integer <= 10000"), watch="new"),
     # ---- 14. a full disk: exit 4, the file named, what was kept said --------------------
     Case("run-disk-full-at-a-figure", ("velocities.png", "run", "s.toml", "--out", "new", "--quiet"), ("cannot write new/velocities.png: No space left on device", "kept in new: rollout.npz, rollout.json, metrics.json, pose.png"), steps(write("diskfull.py", DISK_FULL), write("s.toml", scenario_with(_URDF))), code=4, script="diskfull.py", after=rollout_kept("new", "ok")),
     Case("run-disk-full-at-the-rollout", ("rollout.npz", "run", "s.toml", "--out", "new", "--quiet"), ("cannot write new/rollout.npz: No space left on device", "nothing of this run was kept in new"), steps(write("diskfull.py", DISK_FULL), write("s.toml", scenario_with(_URDF))), code=4, script="diskfull.py", watch="new"),

@@ -10,7 +10,14 @@ import argparse
 import math
 import sys
 
-from uvms_pin.apps.arguments import add_comparison_command, comma_names, count, finite, positive
+from uvms_pin.apps.arguments import (
+    add_comparison_command,
+    comma_names,
+    count,
+    finite,
+    positive,
+    process_count,
+)
 from uvms_pin.apps.exit_codes import EXIT_BAD_INPUT
 from uvms_pin.model.mount.catalog import available_arms
 from uvms_pin.results.outdir import COMPARISON, check_writable, claim
@@ -76,7 +83,9 @@ def register(subparsers) -> argparse.ArgumentParser:
         help=f"comma-separated arm names or URDF paths (default {DEFAULT_ARMS})",
     )
     parser.add_argument("--duration", type=positive, default=None, help="override the duration [s]")
-    parser.add_argument("--jobs", type=count(1), default=1, help="arms run in parallel processes")
+    parser.add_argument(
+        "--jobs", type=process_count(1), default=1, help="arms run in parallel processes"
+    )
     parser.add_argument("--no-trim", action="store_true", help="do not add foam and ballast")
     parser.add_argument(
         "--bg", type=finite, default=0.02, help="metacentric height BG after trim [m]"
@@ -93,7 +102,10 @@ def register(subparsers) -> argparse.ArgumentParser:
         help="arm base orientation on the vehicle [rad] (default: upside down)",
     )
     parser.add_argument(
-        "--ik-starts", type=count(1), default=24, help="initial-configuration search starts"
+        "--ik-starts",
+        type=count(1, 10_000, "a few dozen suffice"),
+        default=24,
+        help="initial-configuration search starts",
     )
     parser.add_argument(
         "--keep-rollouts",

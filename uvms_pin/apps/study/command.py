@@ -12,7 +12,7 @@ import argparse
 import sys
 from pathlib import Path
 
-from uvms_pin.apps.arguments import count
+from uvms_pin.apps.arguments import process_count
 from uvms_pin.apps.exit_codes import EXIT_INTERRUPTED
 from uvms_pin.results.outdir import STUDY, check_writable, claim
 
@@ -81,7 +81,7 @@ def register(subparsers) -> None:
     where = sweep.add_mutually_exclusive_group()
     where.add_argument(
         "--workers",
-        type=count(0),
+        type=process_count(0),
         default=None,
         help="local cluster worker processes (1 thread each; default: CPU count; 0 = serial, no Dask)",
     )
