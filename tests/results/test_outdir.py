@@ -99,3 +99,13 @@ def test_run_outputs_are_exactly_the_files_a_run_writes(tmp_path):
     assert any(p.name == "force.png" for p in figures)  # the paper figures are there too
     written = {p.name for p in out.iterdir()}
     assert written | {"replay.html"} == set(RUN.patterns)  # replay.html: with --html
+
+
+@pytest.mark.parametrize("empty", ["", "  "])
+def test_an_empty_out_is_not_the_current_directory(tmp_path, monkeypatch, empty):
+    monkeypatch.chdir(tmp_path)
+    with pytest.raises(OutputError, match="an empty path; give a directory"):
+        check_writable(empty)
+    with pytest.raises(OutputError, match="an empty path"), claim(empty, RUN):
+        pass
+    assert list(tmp_path.iterdir()) == []

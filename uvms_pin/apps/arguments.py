@@ -63,6 +63,22 @@ def positive(text: str) -> float:
     return value
 
 
+def nonempty(what: str) -> Callable[[str], str]:
+    """Text that is not empty nor blank, ``what`` naming it for the message (``--out ""`` is
+    not the current directory: it is a missing value, most often an unset shell variable)."""
+
+    def parse(text: str) -> str:
+        if not text.strip():
+            raise argparse.ArgumentTypeError(f"must be {what}, got {text!r}")
+        return text
+
+    return parse
+
+
+#: a file or directory given on the command line
+path_text = nonempty("a path")
+
+
 def add_set_option(parser: argparse.ArgumentParser, help_text: str) -> None:
     """``--set KEY=VALUE``, repeatable: scenario entries to override (the command parses
     each with `uvms_pin.scenario.overrides.parse_assignment`); [] if not given."""
@@ -102,10 +118,17 @@ def add_comparison_command(
 
     parser = subparsers.add_parser(name, help=summary, description=description)
     parser.add_argument(
-        "scenario", nargs=None if scenario_required else "?", help="scenario TOML file"
+        "scenario",
+        nargs=None if scenario_required else "?",
+        type=path_text,
+        help="scenario TOML file",
     )
     parser.add_argument(
-        "--out", required=out_default is None, default=out_default, help="output directory"
+        "--out",
+        required=out_default is None,
+        default=out_default,
+        type=path_text,
+        help="output directory",
     )
     parser.add_argument("--overwrite", action="store_true", help=OVERWRITE_HELP)
     return parser

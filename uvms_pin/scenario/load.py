@@ -131,6 +131,11 @@ def _head(t: Table, path: Path) -> Head:
 
 def _model(head: Head, water: Water, path: Path, scenario: Table) -> UVMS:
     """The model ``[scenario] model`` names, in water of ``[water]``'s density."""
+    if not head.model.strip():
+        raise scenario.error(
+            "model",
+            f"is empty; give a URDF file or a shipped model ({', '.join(shipped_models())})",
+        )
     model_path = find_model(head.model, path.parent)
     if model_path is None:
         raise scenario.error(

@@ -8,7 +8,7 @@ import warnings
 from pathlib import Path
 from typing import TYPE_CHECKING
 
-from uvms_pin.apps.arguments import add_set_option, positive
+from uvms_pin.apps.arguments import add_set_option, path_text, positive
 from uvms_pin.apps.arms.command import register as register_compare_arms
 from uvms_pin.apps.cli.run import check_view_options, cmd_run
 from uvms_pin.apps.compare.command import register as register_compare_controllers
@@ -82,8 +82,8 @@ def build_parser() -> argparse.ArgumentParser:
     parser.add_argument("--version", action=_Version)
     sub = parser.add_subparsers(dest="command", required=True)
     run = sub.add_parser("run", help="run a scenario file and write rollout, metrics and figures")
-    run.add_argument("scenario", help="scenario TOML file")
-    run.add_argument("--out", required=True, help="output directory")
+    run.add_argument("scenario", type=path_text, help="scenario TOML file")
+    run.add_argument("--out", required=True, type=path_text, help="output directory")
     run.add_argument("--quiet", action="store_true", help="no progress line")
     run.add_argument("--overwrite", action="store_true", help=OVERWRITE_HELP)
     add_set_option(
@@ -98,10 +98,16 @@ def build_parser() -> argparse.ArgumentParser:
     _add_view_options(run)
     run.set_defaults(func=cmd_run)
     replay = sub.add_parser("replay", help="show a saved rollout: replay.html and/or live")
-    replay.add_argument("rollout", help="directory holding rollout.npz and rollout.json")
+    replay.add_argument(
+        "rollout", type=path_text, help="directory holding rollout.npz and rollout.json"
+    )
     replay.add_argument("--html", action="store_true", help="write ROLLOUT/replay.html")
-    replay.add_argument("--out", help="write the page here instead of ROLLOUT/replay.html")
-    replay.add_argument("--urdf", help="the model's URDF, if it moved since the run")
+    replay.add_argument(
+        "--out", type=path_text, help="write the page here instead of ROLLOUT/replay.html"
+    )
+    replay.add_argument(
+        "--urdf", type=path_text, help="the model's URDF, if it moved since the run"
+    )
     replay.add_argument("--overwrite", action="store_true", help="replace an existing page")
     replay.add_argument(
         "--fps", type=positive, default=30.0, help="replay frames per simulated second (max)"
@@ -110,7 +116,9 @@ def build_parser() -> argparse.ArgumentParser:
     replay.set_defaults(func=_cmd_replay)
     info = sub.add_parser("info", help="print a summary of a UVMS URDF")
     info.add_argument(
-        "urdf", help="URDF file with the hydrodynamic extension, or a shipped model name"
+        "urdf",
+        type=path_text,
+        help="URDF file with the hydrodynamic extension, or a shipped model name",
     )
     info.add_argument(
         "--water-density", type=positive, default=1025.0, help="kg/m^3 (default: sea water)"

@@ -52,6 +52,8 @@ def load_study(path: str | Path) -> Study:
     seed = head.seed("seed", None)
     samples = head.integer("samples", 1, minimum=1)
     head.finish()
+    if not base_entry.strip():
+        raise head.error("base", "is empty; give the base scenario's file")
     base = (path.parent / base_entry).resolve()
     if not base.is_file():
         raise head.error("base", f"scenario '{base_entry}' not found ({base})")

@@ -8,6 +8,7 @@ from __future__ import annotations
 import argparse
 import sys
 
+from uvms_pin.apps.arguments import comma_names, nonempty, path_text
 from uvms_pin.errors import ParameterError
 
 
@@ -16,7 +17,7 @@ def _cmd_validate_pool(args: argparse.Namespace) -> int:
 
     if not args.step > 0.0:
         raise ParameterError(f"--step must be positive, got {args.step}")
-    names = [n.strip() for n in args.trials.split(",") if n.strip()] if args.trials else None
+    names = None if args.trials is None else comma_names("--trials", args.trials, "trial names")
     result = run_pool_validation(
         args.data_dir,
         args.out,
@@ -50,10 +51,14 @@ def register(subparsers) -> argparse.ArgumentParser:
         ),
     )
     pool.add_argument(
-        "data_dir", help="directory of trial files, e.g. the shipped data/hinsdale2023"
+        "data_dir",
+        type=path_text,
+        help="directory of trial files, e.g. the shipped data/hinsdale2023",
     )
-    pool.add_argument("--out", required=True, help="output directory")
-    pool.add_argument("--trials", help="comma-separated trial names (default: all)")
+    pool.add_argument("--out", required=True, type=path_text, help="output directory")
+    pool.add_argument(
+        "--trials", type=nonempty("trial names"), help="comma-separated trial names (default: all)"
+    )
     pool.add_argument("--step", type=float, default=0.05, help="RK4 step [s] (default 0.05)")
     pool.add_argument("--no-figures", action="store_true", help="skip the per-trial figures")
     pool.add_argument("--quiet", action="store_true", help="no per-trial progress lines")
