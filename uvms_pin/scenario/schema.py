@@ -66,16 +66,33 @@ class Table:
         """The table as messages name it: its label, else ``[dotted.name]``."""
         return self.label if self.label is not None else f"[{self.where}]"
 
+    def _override_of(self, where: str) -> str | None:
+        """The override that set ``where`` (a dotted name in the file): the key itself, or
+        a table (or list element) holding it that an override replaced whole."""
+        if where in self._overridden:
+            return self._overridden[where]
+        for text in self._overridden.values():
+            if where.startswith((f"{text}.", f"{text}[")):
+                return text
+        return None
+
     def error(self, key: str, msg: str) -> UvmsPinError:
-        """The error about ``key``: naming the override that set it, else the file."""
+        """The error about ``key``: naming the override that set it (and the key, when the
+        override set a whole table holding it), else the file."""
         where = self.full(key)
         if where in self._overridden:
             return self._error(f"override '{self._overridden[where]}': {msg}")
+        override = self._override_of(where)
+        if override is not None:
+            return self._error(f"override '{override}': {where}: {msg}")
         named = where if self.label is None else f"{self.label}: {key}"
         return self._error(f"{self.source}: {named}: {msg}")
 
     def fail(self, msg: str) -> UvmsPinError:
-        """An error about the table as a whole."""
+        """An error about the table as a whole (naming the override that replaced it)."""
+        override = self._override_of(self.where) if self.label is None else None
+        if override is not None:
+            return self._error(f"override '{override}': {self.title}: {msg}")
         return self._error(f"{self.source}: {self.title}: {msg}")
 
     @property
@@ -231,6 +248,13 @@ class Table:
         known = self._asked - set(unknown)
         for key in unknown:
             full = self.full(key)
+            whole = self._override_of(self.where) if self.where else None
+            if whole is not None and full not in self._overridden:  # it replaced this table
+                hint = closest(key, known)
+                raise self._error(
+                    f"override '{whole}': unknown key '{full}'"
+                    + (f"; did you mean '{self.full(hint)}'?" if hint else "")
+                )
             for dotted, text in self._overridden.items():
                 if dotted == full or dotted.startswith(full + "."):
                     hint = closest(key, known)

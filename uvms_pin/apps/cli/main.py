@@ -88,9 +88,11 @@ def build_parser() -> argparse.ArgumentParser:
     run.add_argument("--overwrite", action="store_true", help=OVERWRITE_HELP)
     add_set_option(
         run,
-        "override a scenario entry (repeatable): a dotted key, optionally [i]-indexed, "
-        "and a TOML value, e.g. --set 'environment.stiffness_N_m=[20,20,20]' "
-        "--set 'initial.joint_positions_rad[3]=0.5'",
+        "override a scenario entry (repeatable): a dotted key, its parts optionally "
+        "[i]-indexed, and a TOML value, e.g. --set 'environment.stiffness_N_m=[20,20,20]' "
+        "--set 'initial.joint_positions_rad[3]=0.5' "
+        "--set 'actuation.thruster[0].max_forward_N=10'; a table value replaces a whole "
+        "table: --set 'controller={type=\"none\"}'",
     )
     run.add_argument(
         "--html", action="store_true", help="also write replay.html (self-contained, offline)"
