@@ -61,6 +61,7 @@ os.replace = replace
 sys.exit(main())
 """
 _RUN_NEW = ("run", "s.toml", "--out", "new", "--quiet")
+_DATA = str(ROOT / "data" / "hinsdale2023")
 _SEA = (
     (ROOT / "scenarios" / "sea_state_force_tracking.toml")
     .read_text()
@@ -115,9 +116,9 @@ ROUND_TWO = [
     Case("sweep-empty-out", ("sweep", "{study}", "--out", ""), ("--out", "must be a path"), watch="."),
     Case("compare-controllers-empty-out", ("compare-controllers", "{good}", "--out", ""), ("--out", "must be a path"), watch="."),
     Case("compare-arms-empty-out", ("compare-arms", "{good}", "--out", ""), ("--out", "must be a path"), watch="."),
-    Case("validate-empty-out", ("validate", "pool", str(ROOT / "data" / "hinsdale2023"), "--out", ""), ("--out", "must be a path"), watch="."),
-    Case("validate-empty-trials", ("validate", "pool", str(ROOT / "data" / "hinsdale2023"), "--out", "new", "--trials", ""), ("--trials", "must be trial names"), watch="new"),
-    Case("validate-an-empty-trial-name", ("validate", "pool", str(ROOT / "data" / "hinsdale2023"), "--out", "new", "--trials", "_alt_011-1,"), ("--trials", "none empty"), watch="new"),
+    Case("validate-empty-out", ("validate", "pool", _DATA, "--out", ""), ("--out", "must be a path"), watch="."),
+    Case("validate-empty-trials", ("validate", "pool", _DATA, "--out", "new", "--trials", ""), ("--trials", "must be trial names"), watch="new"),
+    Case("validate-an-empty-trial-name", ("validate", "pool", _DATA, "--out", "new", "--trials", "_alt_011-1,"), ("--trials", "none empty"), watch="new"),
     Case("replay-empty-out", ("replay", "prior", "--html", "--out", ""), ("--out", "must be a path"), watch="."),
     Case("replay-empty-urdf", ("replay", "prior", "--html", "--urdf", ""), ("--urdf", "must be a path"), watch="."),
     Case("info-empty", ("info", ""), ("argument urdf", "must be a path"), watch="."),
@@ -135,6 +136,13 @@ ROUND_TWO = [
     Case("run-whole-thruster-table-incomplete", ("run", "r.toml", "--out", "new", "--set", 'actuation.thruster[0]={name="x"}'), ("override 'actuation.thruster[0]'", "position_body_m: is required"), write("r.toml", realistic_with()), watch="new"),
     Case("run-index-into-a-table", ("run", "{good}", "--out", "new", "--set", "water[0].density_kg_m3=1000"), ("'water' is not a list in the file",), watch="new"),
     Case("sweep-thruster-path-out-of-range", ("sweep", "st.toml", "--out", "new"), ("st.toml", "parameter[0] 'actuation.thruster[7].max_forward_N'", "index 7 out of range"), steps(write("base.toml", realistic_with()), write("st.toml", '[study]\nbase = "base.toml"\nseed = 1\n[[parameter]]\npath = "actuation.thruster[7].max_forward_N"\nvalues = [1.0, 2.0]\n')), watch="new"),
+    # ---- 10. nothing silently capped: validate's --step ------------------------------------
+    Case("validate-step-longer-than-every-interval", ("validate", "pool", _DATA, "--out", "new", "--trials", "_alt_011-1", "--step", "10"), ("--step 10 s is longer than the longest IMU interval", "a single step of its own length"), watch="new"),
+    Case("validate-step-absurdly-small", ("validate", "pool", _DATA, "--out", "new", "--trials", "_alt_011-1", "--step", "1e-9"), ("RK4 steps over the 1 trials", "more than 1e+07"), watch="new"),
+    Case("validate-step-zero", ("validate", "pool", _DATA, "--out", "new", "--step", "0"), ("argument --step", "must be positive"), watch="new"),
+    Case("validate-step-nan", ("validate", "pool", _DATA, "--out", "new", "--step", "nan"), ("argument --step", "finite"), watch="new"),
+    Case("validate-out-is-a-file", ("validate", "pool", _DATA, "--out", "f", "--trials", "_alt_011-1"), ("--out f", "is a file"), write("f", "mine"), watch="f"),
+    Case("validate-unknown-trial", ("validate", "pool", _DATA, "--out", "new", "--trials", "_alt_999-9"), ("no trial named _alt_999-9",), watch="new"),
     # ---- 14. a full disk: exit 4, the file named, what was kept said --------------------
     Case("run-disk-full-at-a-figure", ("velocities.png", "run", "s.toml", "--out", "new", "--quiet"), ("cannot write new/velocities.png: No space left on device", "kept in new: rollout.npz, rollout.json, metrics.json, pose.png"), steps(write("diskfull.py", DISK_FULL), write("s.toml", scenario_with(_URDF))), code=4, script="diskfull.py", after=rollout_kept("new", "ok")),
     Case("run-disk-full-at-the-rollout", ("rollout.npz", "run", "s.toml", "--out", "new", "--quiet"), ("cannot write new/rollout.npz: No space left on device", "nothing of this run was kept in new"), steps(write("diskfull.py", DISK_FULL), write("s.toml", scenario_with(_URDF))), code=4, script="diskfull.py", watch="new"),
