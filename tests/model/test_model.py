@@ -341,6 +341,18 @@ def test_inverted_joint_limits_raise_model_error(write_urdf):
     assert "lower = 1.0 > upper = -1.0" in message
 
 
+@pytest.mark.parametrize("kind", ["revolute", "continuous", "prismatic"])
+def test_a_zero_joint_axis_is_refused_naming_the_joint(write_urdf, kind):
+    """It loaded, and the run then 'diverged at t = 0' on a singular articulated inertia."""
+    text = _two_joint_robot(-1.0, 1.0).replace('<axis xyz="0 0 1"/>', '<axis xyz="0 0 0"/>')
+    text = text.replace('type="revolute"', f'type="{kind}"')
+    path = write_urdf(text)
+    with pytest.raises(up.ModelError) as info:
+        up.load_uvms(path, ee_frame="arm", sensor_frame="arm")
+    assert str(path) in str(info.value)
+    assert "joint 'shoulder': <axis xyz=\"0 0 0\"> is zero" in str(info.value)
+
+
 def test_equal_joint_limits_load(write_urdf):
     uvms = up.load_uvms(write_urdf(_two_joint_robot(0.5, 0.5)), ee_frame="arm", sensor_frame="arm")
     assert uvms.model.lowerPositionLimit[7] == uvms.model.upperPositionLimit[7] == 0.5

@@ -29,7 +29,7 @@ from uvms_pin.control.measurement import Measurement, read_only
 from uvms_pin.errors import ControllerError, FunnelViolation, ParameterError, SimulationError
 from uvms_pin.results.rollout import Rollout
 from uvms_pin.results.status import ERROR, INTERRUPTED, OK, RunStatus, Violation
-from uvms_pin.sim.divergence import NUMERICAL_FAILURES, diverged
+from uvms_pin.sim.divergence import NUMERICAL_FAILURES, diverged, divergence_context
 from uvms_pin.sim.integrators import Adaptive
 from uvms_pin.sim.log import RolloutLog
 from uvms_pin.sim.plant import Plant
@@ -69,6 +69,7 @@ class ClosedLoop:
         self.q = read_only(np.zeros(plant.uvms.nq))
         self.v = read_only(np.zeros(plant.uvms.nv))
         self.sensors: SensorSuite | None = None
+        self._last_tau_applied: np.ndarray | None = None  # continuous loop: the last stage's
 
     # ---- the steps of the loop ------------------------------------------------------------
     def start(self, q0: np.ndarray, v0: np.ndarray, sensors: SensorSuite) -> None:
@@ -132,9 +133,9 @@ class ClosedLoop:
         try:
             q, v = self.plant.advance(self.settings.integrator, t0, self.q, self.v, tau_applied, t1)
         except (SimulationError, *NUMERICAL_FAILURES) as exc:
-            raise _diverged(t0, t1, exc) from exc
+            raise _diverged(t0, t1, exc, self._context((t0, t1), tau_applied)) from exc
         if diverged(q, v):
-            raise SimulationError(f"simulation diverged between t = {t0:.6g} s and {t1:.6g} s")
+            raise _diverged(t0, t1, None, self._context((t0, t1), tau_applied))
         q.setflags(write=False)  # new arrays of the plant's: frozen, not copied
         v.setflags(write=False)
         self.q, self.v = q, v
@@ -166,6 +167,10 @@ class ClosedLoop:
             tau_applied,
             signals,
         )
+
+    def _context(self, span_s: tuple[float, float], tau_applied: np.ndarray | None) -> str:
+        """What stood out over ``span_s`` from the current state (`divergence_context`)."""
+        return divergence_context(self.plant, span_s, self.q, self.v, tau_applied)
 
     @contextmanager
     def _controller_code(self, method: str) -> Iterator[None]:
@@ -204,7 +209,7 @@ class ClosedLoop:
             else:
                 self._run_sampled(span)
         except NUMERICAL_FAILURES as exc:
-            error = _diverged(*span, exc)
+            error = _diverged(*span, exc, self._context(tuple(span), self._last_tau_applied))
             raise _stopped(log, wall_start, error) from exc
         except SimulationError as exc:  # FunnelViolation included
             raise _stopped(log, wall_start, exc) from exc.__cause__  # e.g. the controller's
@@ -259,13 +264,15 @@ class ClosedLoop:
         def rhs(t: float, q: np.ndarray, v: np.ndarray) -> np.ndarray:
             measurement, contact = at(t, q, v)
             tau_applied = actuation.apply(command(measurement))
+            self._last_tau_applied = tau_applied  # for a divergence message
             acceleration = plant.acceleration(t, q, v, tau_applied, contact)
             # an adaptive solver would shrink its step on a non-finite stage until it gives
             # up with a message that does not say why: stop at once instead (a sum is NaN or
             # inf if any entry is; the exact test only when it is)
             if not math.isfinite(acceleration.sum()) and not np.all(np.isfinite(acceleration)):
+                context = divergence_context(plant, (t, t), q, v, tau_applied)
                 raise SimulationError(
-                    f"simulation diverged: non-finite acceleration at t = {t:.6g} s"
+                    f"simulation diverged: non-finite acceleration at t = {t:.6g} s; {context}"
                 )
             return acceleration
 
@@ -284,9 +291,7 @@ class ClosedLoop:
             states, failure = self._integrate(rhs, t0, times, margin_event if adaptive else None)
             for t, q, v in states:
                 if diverged(q, v):
-                    raise SimulationError(
-                        f"simulation diverged between t = {t0:.6g} s and {t:.6g} s"
-                    )
+                    raise _diverged(t0, t, None, self._context((t0, t), self._last_tau_applied))
                 self.time_s, self.q, self.v = float(t), read_only(q), read_only(v)
                 on_log = abs(t - log_times[logged]) < 1e-9
                 # an event stop is not a log time: the controller raises the violation there
@@ -325,9 +330,12 @@ def _controller_failed(
     return ControllerError(method, time_s, exc, users=users)
 
 
-def _diverged(t0: float, t1: float, exc: BaseException) -> SimulationError:
+def _diverged(t0: float, t1: float, exc: BaseException | None, context: str) -> SimulationError:
+    """The divergence between t0 and t1 (``exc``: what the solve raised, None if the state
+    came back non-finite or absurd), with ``context``: what stood out at t0."""
+    cause = "" if exc is None else f" ({type(exc).__name__}: {exc})"
     return SimulationError(
-        f"simulation diverged between t = {t0:.6g} s and {t1:.6g} s ({type(exc).__name__}: {exc})"
+        f"simulation diverged between t = {t0:.6g} s and {t1:.6g} s{cause}; {context}"
     )
 
 

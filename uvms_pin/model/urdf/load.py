@@ -66,6 +66,7 @@ def load_uvms(
     hydro_elements = hydro_elements_by_link(root, links, where)
     model = _build_model(path)
     _check_joint_limits(root, where)
+    _check_joint_axes(root, where)
     _read_armature(root, model, where)
     bodies = hydro_bodies(
         model,
@@ -118,6 +119,23 @@ def _check_joint_limits(root: ET.Element, where: str) -> None:
         if lower > upper:
             raise ModelError(
                 f"joint '{joint.get('name', '?')}': <limit> lower = {lower} > upper = {upper}",
+                path=where,
+            )
+
+
+def _check_joint_axes(root: ET.Element, where: str) -> None:
+    """<axis xyz> of every moving joint: finite and not zero (Pinocchio normalises it; a
+    zero axis gives a joint that moves nothing, and a mass matrix singular on it)."""
+    for joint in root.findall("joint"):
+        axis = joint.find("axis")
+        if axis is None or joint.get("type") not in ("revolute", "continuous", "prismatic"):
+            continue
+        name = joint.get("name", "?")
+        xyz = read_numbers(axis.get("xyz", "1 0 0"), 3, "<axis xyz>", where, f"joint {name}")
+        if not np.linalg.norm(xyz) > 1e-12:
+            raise ModelError(
+                f"joint '{name}': <axis xyz=\"{axis.get('xyz')}\"> is zero; give the direction "
+                "the joint turns about (revolute, continuous) or slides along (prismatic)",
                 path=where,
             )
 
