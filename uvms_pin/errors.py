@@ -62,6 +62,12 @@ class ModelWarning(UvmsPinWarning):
     """
 
 
+class PlausibilityWarning(UvmsPinWarning):
+    """A value far outside what any vehicle, water or sea has (a volume in litres, a period
+    in milliseconds?): the message names it, gives the number and the usual range. A value
+    that cannot be physical at all is refused instead."""
+
+
 class ParameterError(UvmsPinError, ValueError):
     """An argument has the wrong shape, a non-finite value or is out of its valid range."""
 

@@ -17,6 +17,7 @@ import numpy as np
 
 from uvms_pin.checks import seed_value
 from uvms_pin.errors import ParameterError
+from uvms_pin.flow.airy import WAVE_PERIOD
 from uvms_pin.flow.components import (
     STANDARD_GRAVITY_M_S2,
     WaveComponents,
@@ -83,6 +84,9 @@ class IrregularSea(WaveField):
                 f"n_components must be an integer in 1..{MAX_COMPONENTS}, got {n_components!r}"
                 " (each component is summed at every body at every integrator stage)"
             )
+        refusal = WAVE_PERIOD.refusal(float(peak_period_s))  # a scenario warns of unusual
+        if refusal is not None:
+            raise ParameterError(f"peak_period_s = {refusal}")
         low, high = (float(x) for x in frequency_range)
         if not (0.0 < low < 1.0 < high and math.isfinite(high)):
             raise ParameterError(

@@ -16,6 +16,7 @@ from dataclasses import dataclass, field
 import numpy as np
 import pinocchio as pin
 
+from uvms_pin.checks import Plausible
 from uvms_pin.errors import ModelError
 from uvms_pin.hydro.added_mass import added_mass_in_parent
 from uvms_pin.hydro.params import HydroParams
@@ -24,6 +25,26 @@ from uvms_pin.model.arm_joints import ArmJoints
 __all__ = ["DEFAULT_WATER_DENSITY_KG_M3", "UVMS", "HydroBody"]
 
 DEFAULT_WATER_DENSITY_KG_M3 = 1025.0  # sea water; a parameter of load_uvms, never hidden
+
+#: What water's density is [kg/m^3]
+WATER_DENSITY = Plausible(
+    "kg/m^3",
+    usual=(990.0, 1050.0),
+    possible=(500.0, 15000.0),
+    usual_text="fresh to sea water",
+    impossible_text="no liquid is that light or dense (mercury: 13534 kg/m^3)",
+    hints=("sea water is 1025 kg/m^3 (1.025 g/cm^3)",) * 2,
+)
+#: What a body of a UVMS is, on average: its mass over the water it displaces [kg/m^3]
+BODY_DENSITY = Plausible(
+    "kg/m^3",
+    usual=(50.0, 15000.0),
+    possible=(1.2, 22600.0),
+    usual_text="what vehicles and arms are made of, foam to tungsten",
+    impossible_text="no body in water is lighter than air (1.2 kg/m^3) or denser than osmium "
+    "(22590 kg/m^3)",
+    hints=("a <volume> in litres?", "a <mass> in grams?"),
+)
 
 
 @dataclass(frozen=True)

@@ -16,11 +16,12 @@ examples.
 
 from __future__ import annotations
 
+import warnings
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-from uvms_pin.errors import ParameterError, ScenarioError, UvmsPinError
+from uvms_pin.errors import ParameterError, PlausibilityWarning, ScenarioError, UvmsPinError
 from uvms_pin.model.resources import find_model, shipped_models
 from uvms_pin.model.urdf.load import load_uvms
 from uvms_pin.model.uvms import UVMS
@@ -144,4 +145,6 @@ def _model(head: Head, water: Water, path: Path, scenario: Table) -> UVMS:
             f"({path.parent.resolve() / head.model}) nor a shipped model "
             f"({', '.join(shipped_models())})",
         )
-    return load_uvms(model_path, water_density_kg_m3=water.density_kg_m3)
+    with warnings.catch_warnings():  # the density was judged as [water] density_kg_m3
+        warnings.simplefilter("ignore", PlausibilityWarning)
+        return load_uvms(model_path, water_density_kg_m3=water.density_kg_m3)

@@ -10,12 +10,13 @@ read are reported by `Table.finish` with the closest known key.
 from __future__ import annotations
 
 import math
+import warnings
 from typing import Any
 
 import numpy as np
 
-from uvms_pin.checks import seed_value
-from uvms_pin.errors import ParameterError, ScenarioError, UvmsPinError
+from uvms_pin.checks import Plausible, seed_value
+from uvms_pin.errors import ParameterError, PlausibilityWarning, ScenarioError, UvmsPinError
 from uvms_pin.scenario.overrides import closest
 
 
@@ -87,6 +88,25 @@ class Table:
             return self._error(f"override '{override}': {where}: {msg}")
         named = where if self.label is None else f"{self.label}: {key}"
         return self._error(f"{self.source}: {named}: {msg}")
+
+    def plausible(self, key: str, value: float, law: Plausible) -> float:
+        """``value`` of ``key`` judged by ``law``: refused (an error naming the key, or the
+        override that set it) if it cannot be physical, warned if far from usual."""
+        refusal = law.refusal(value)
+        if refusal is not None:
+            raise self.error(key, refusal)
+        warning = law.warning(value)
+        if warning is not None:
+            where = self.full(key)
+            override = self._override_of(where)
+            if override is not None and where in self._overridden:
+                message = f"override '{override}': {warning}"
+            elif override is not None:
+                message = f"override '{override}': {where} = {warning}"
+            else:
+                message = f"{self.source}: {where} = {warning}"
+            warnings.warn(message, PlausibilityWarning, stacklevel=2)
+        return value
 
     def fail(self, msg: str) -> UvmsPinError:
         """An error about the table as a whole (naming the override that replaced it)."""

@@ -9,6 +9,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from uvms_pin.checks import Plausible
 from uvms_pin.errors import ParameterError
 from uvms_pin.flow import (
     AiryWave,
@@ -19,8 +20,35 @@ from uvms_pin.flow import (
     SumFlow,
     UniformCurrent,
 )
+from uvms_pin.flow.airy import WAVE_PERIOD
 from uvms_pin.flow.irregular import MAX_COMPONENTS
+from uvms_pin.model.uvms import WATER_DENSITY
 from uvms_pin.scenario.schema import Table
+
+#: The speed of the water [m/s]: the fastest tidal races run at ~5 m/s; faster than sound in
+#: water, the incompressible model means nothing
+CURRENT_SPEED = Plausible(
+    "m/s",
+    usual=(0.0, 5.0),
+    possible=(0.0, 1480.0),
+    usual_text="sea and tidal currents",
+    impossible_text="no water flows faster than sound in it (~1480 m/s)",
+)
+#: A regular wave's amplitude, half its height [m]
+AMPLITUDE = Plausible(
+    "m",
+    usual=(0.0, 10.0),
+    possible=(0.0, 50.0),
+    usual_text="sea waves (the highest measured: ~30 m crest to trough)",
+    impossible_text="no sea wave is that high",
+)
+SIGNIFICANT_HEIGHT = Plausible(
+    "m",
+    usual=(0.0, 15.0),
+    possible=(0.0, 40.0),
+    usual_text="sea states (the highest measured: ~19 m)",
+    impossible_text="no sea state is that high",
+)
 
 
 @dataclass(frozen=True)
@@ -34,8 +62,11 @@ class Water:
 
 
 def build_water(t: Table, seed: int) -> Water:
-    density = t.number("density_kg_m3", 1025.0, positive=True)
+    density = t.plausible(
+        "density_kg_m3", t.number("density_kg_m3", 1025.0, positive=True), WATER_DENSITY
+    )
     current = t.vector("current_world_m_s", 3, [0.0, 0.0, 0.0])
+    t.plausible("current_world_m_s", float(np.linalg.norm(current)), CURRENT_SPEED)
     fields = []
     for key, build in FLOW_TABLES.items():
         table = t.table(key)
@@ -48,8 +79,8 @@ def build_water(t: Table, seed: int) -> Water:
 
 def _waves(t: Table, seed: int) -> AiryWave:
     return AiryWave(
-        amplitude_m=t.number("amplitude_m", nonneg=True),
-        period_s=t.number("period_s", positive=True),
+        amplitude_m=t.plausible("amplitude_m", t.number("amplitude_m", nonneg=True), AMPLITUDE),
+        period_s=t.plausible("period_s", t.number("period_s", positive=True), WAVE_PERIOD),
         heading_rad=t.number("heading_rad", 0.0),
         water_depth_m=t.number("water_depth_m", math.inf, positive=True),
         phase_rad=t.number("phase_rad", 0.0),
@@ -58,8 +89,14 @@ def _waves(t: Table, seed: int) -> AiryWave:
 
 def _sea(t: Table, seed: int) -> IrregularSea:
     return IrregularSea(
-        significant_height_m=t.number("significant_height_m", nonneg=True),
-        peak_period_s=t.number("peak_period_s", positive=True),
+        significant_height_m=t.plausible(
+            "significant_height_m",
+            t.number("significant_height_m", nonneg=True),
+            SIGNIFICANT_HEIGHT,
+        ),
+        peak_period_s=t.plausible(
+            "peak_period_s", t.number("peak_period_s", positive=True), WAVE_PERIOD
+        ),
         peak_enhancement=t.number("peak_enhancement", 3.3, positive=True),
         heading_rad=t.number("heading_rad", 0.0),
         spreading_exponent=t.optional_number("spreading_exponent", positive=True),
