@@ -136,8 +136,8 @@ def test_missing_file(tmp_path):
     with pytest.raises(up.ModelError, match="file not found") as info:
         up.load_uvms(path)
     assert str(path) in str(info.value)
-    with pytest.raises(up.ModelError, match="file not found"):
-        up.load_uvms(tmp_path)  # a directory is not a URDF file either
+    with pytest.raises(up.ModelError, match="is a directory, not a URDF file"):
+        up.load_uvms(tmp_path)
 
 
 def test_malformed_xml(write_urdf):

@@ -22,7 +22,7 @@ from pathlib import Path
 from typing import Any
 
 from uvms_pin.errors import ParameterError, PlausibilityWarning, ScenarioError, UvmsPinError
-from uvms_pin.model.resources import find_model, shipped_models
+from uvms_pin.model.resources import resolve_model
 from uvms_pin.model.urdf.load import load_uvms
 from uvms_pin.model.uvms import UVMS
 from uvms_pin.scenario.actuation import build_actuation
@@ -132,19 +132,10 @@ def _head(t: Table, path: Path) -> Head:
 
 def _model(head: Head, water: Water, path: Path, scenario: Table) -> UVMS:
     """The model ``[scenario] model`` names, in water of ``[water]``'s density."""
-    if not head.model.strip():
-        raise scenario.error(
-            "model",
-            f"is empty; give a URDF file or a shipped model ({', '.join(shipped_models())})",
-        )
-    model_path = find_model(head.model, path.parent)
-    if model_path is None:
-        raise scenario.error(
-            "model",
-            f"'{head.model}' is neither a file relative to the scenario "
-            f"({path.parent.resolve() / head.model}) nor a shipped model "
-            f"({', '.join(shipped_models())})",
-        )
+    try:
+        model_path = resolve_model(head.model, path.parent)
+    except ParameterError as exc:
+        raise scenario.error("model", str(exc)) from None
     with warnings.catch_warnings():  # the density was judged as [water] density_kg_m3
         warnings.simplefilter("ignore", PlausibilityWarning)
         return load_uvms(model_path, water_density_kg_m3=water.density_kg_m3)

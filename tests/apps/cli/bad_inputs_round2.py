@@ -161,6 +161,13 @@ ROUND_TWO = [
     Case("run-current-faster-than-sound", ("run", "{good}", "--out", "new", "--set", "water.current_world_m_s=[2000, 0, 0]"), ("override 'water.current_world_m_s'", "2000 m/s cannot be physical"), watch="new"),
     Case("run-integrator-step-of-a-nanosecond", ("run", "{good}", "--out", "new", "--quiet", "--set", "integrator.step_s=1e-9", "--set", "scenario.duration_s=1e-6", "--set", "output.log_period_s=1e-6"), ("warning: override 'integrator.step_s': 1e-09 s is far outside",), code=0, after=rollout_kept("new", "ok")),
     Case("run-fresh-water-density-warned", ("run", "{good}", "--out", "new", "--quiet", "--set", "water.density_kg_m3=1240"), ("warning: override 'water.density_kg_m3': 1240 kg/m^3 is far outside fresh to sea water",), code=0, after=rollout_kept("new", "ok")),
+    # ---- 13. a model entry that names no model says why ------------------------------
+    Case("info-a-directory", ("info", "adir"), ("'adir' is a directory", "not a URDF file"), steps(lambda d: (d / "adir").mkdir())),
+    Case("info-a-near-miss-of-a-shipped-name", ("info", "bluerov3"), ("'bluerov3' is neither a file", "nor a shipped model (bluerov2_heavy,", "did you mean 'bluerov2_heavy'?")),
+    Case("info-not-a-urdf-file", ("info", "notes.txt"), ("notes.txt", "not well-formed XML"), write("notes.txt", "my notes\n")),
+    Case("run-model-is-a-directory", ("run", "s.toml", "--out", "new"), ("s.toml: scenario.model", "'adir' is a directory"), steps(lambda d: (d / "adir").mkdir(), write("s.toml", scenario_with("adir"))), watch="new"),
+    Case("run-model-is-not-a-urdf-file", ("run", "s.toml", "--out", "new"), ("notes.txt", "not well-formed XML"), steps(write("notes.txt", "my notes\n"), write("s.toml", scenario_with("notes.txt"))), watch="new"),
+    Case("run-model-near-miss", ("run", "s.toml", "--out", "new"), ("scenario.model", "'uvms_lbv15' is neither a file", "did you mean 'uvms_lbv150'?"), write("s.toml", scenario_with("uvms_lbv15")), watch="new"),
     # ---- 14. a full disk: exit 4, the file named, what was kept said --------------------
     Case("run-disk-full-at-a-figure", ("velocities.png", "run", "s.toml", "--out", "new", "--quiet"), ("cannot write new/velocities.png: No space left on device", "kept in new: rollout.npz, rollout.json, metrics.json, pose.png"), steps(write("diskfull.py", DISK_FULL), write("s.toml", scenario_with(_URDF))), code=4, script="diskfull.py", after=rollout_kept("new", "ok")),
     Case("run-disk-full-at-the-rollout", ("rollout.npz", "run", "s.toml", "--out", "new", "--quiet"), ("cannot write new/rollout.npz: No space left on device", "nothing of this run was kept in new"), steps(write("diskfull.py", DISK_FULL), write("s.toml", scenario_with(_URDF))), code=4, script="diskfull.py", watch="new"),

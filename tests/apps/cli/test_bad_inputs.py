@@ -37,7 +37,7 @@ CASES = [
     Case("run-unknown-key", ("run", "s.toml", "--out", "prior"), ("s.toml", "[water]", "unknown key(s): current_velocity"), _write("s.toml", GOOD_BUT(**{"[water]\n": "[water]\ncurrent_velocity = [1, 2, 3]\n"}))),
     Case("run-scenario-is-a-directory", ("run", "sdir", "--out", "prior"), ("sdir", "is a directory"), _mkdir("sdir")),
     Case("run-negative-duration", ("run", "s.toml", "--out", "prior"), ("s.toml", "duration_s", "must be positive"), _write("s.toml", GOOD_BUT(-1.0))),
-    Case("run-missing-model", ("run", "s.toml", "--out", "prior"), ("missing.urdf", "neither a file relative to the scenario"), _write("s.toml", GOOD_BUT(**{str(URDF): "missing.urdf"}))),
+    Case("run-missing-model", ("run", "s.toml", "--out", "prior"), ("scenario.model", "'missing.urdf' is neither a file", "nor a shipped model"), _write("s.toml", GOOD_BUT(**{str(URDF): "missing.urdf"}))),
     Case("run-urdfdom-error", ("run", "s.toml", "--out", "prior"), ("bad.urdf", "does not specify limits"), _steps(_write("bad.urdf", BAD_URDF), _write("s.toml", GOOD_BUT(**{str(URDF): "bad.urdf"})))),
     Case("run-bad-overwrite-keeps-results", ("run", "nope.toml", "--out", "prior", "--overwrite"), ("nope.toml", "file not found")),
     # ---- run: the output directory and options ---------------------------------------
@@ -61,7 +61,7 @@ CASES = [
     Case("replay-out-is-a-directory", ("replay", "prior", "--html", "--out", "pagedir"), ("pagedir", "is a directory"), _mkdir("pagedir"), watch="pagedir"),
     Case("replay-out-under-a-file", ("replay", "prior", "--html", "--out", "f/page.html"), ("--out f/page.html", "under a file"), _write("f", "mine"), watch="f"),
     # ---- info --------------------------------------------------------------------------
-    Case("info-missing", ("info", "nope.urdf"), ("nope.urdf", "file not found")),
+    Case("info-missing", ("info", "nope.urdf"), ("'nope.urdf' is neither a file", "nor a shipped model (")),
     Case("info-not-xml", ("info", "x.urdf"), ("x.urdf", "not well-formed XML"), _write("x.urdf", "<robot")),
     Case("info-wrong-root", ("info", "x.urdf"), ("x.urdf", "expected <robot>"), _write("x.urdf", "<model/>")),
     Case("info-negative-density", ("info", "{urdf}", "--water-density", "-1"), ("--water-density", "must be positive")),

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+import os
 import sys
 import warnings
 from pathlib import Path
@@ -12,11 +13,16 @@ from uvms_pin.apps.arguments import add_set_option, path_text, positive
 from uvms_pin.apps.arms.command import register as register_compare_arms
 from uvms_pin.apps.cli.run import check_view_options, cmd_run
 from uvms_pin.apps.compare.command import register as register_compare_controllers
-from uvms_pin.apps.exit_codes import EXIT_BAD_INPUT, EXIT_ENVIRONMENT, EXIT_INTERRUPTED
+from uvms_pin.apps.exit_codes import (
+    EXIT_BAD_INPUT,
+    EXIT_BROKEN_PIPE,
+    EXIT_ENVIRONMENT,
+    EXIT_INTERRUPTED,
+)
 from uvms_pin.apps.study.command import register as register_study_commands
 from uvms_pin.apps.validation.command import register as register_validate
 from uvms_pin.errors import UvmsPinError, UvmsPinWarning
-from uvms_pin.model.resources import find_model
+from uvms_pin.model.resources import resolve_model
 from uvms_pin.results.outdir import OVERWRITE_HELP, claim_file
 
 if TYPE_CHECKING:
@@ -70,7 +76,7 @@ def _cmd_info(args: argparse.Namespace) -> int:
     from uvms_pin.model.summary import model_summary
     from uvms_pin.model.urdf.load import load_uvms
 
-    uvms = load_uvms(find_model(args.urdf) or args.urdf, water_density_kg_m3=args.water_density)
+    uvms = load_uvms(resolve_model(args.urdf), water_density_kg_m3=args.water_density)
     print(model_summary(uvms))
     return 0
 
@@ -172,6 +178,9 @@ def main(argv: list[str] | None = None) -> int:
 def _dispatch(args: argparse.Namespace) -> int:
     try:
         return args.func(args)
+    except BrokenPipeError:  # the reader of stdout stopped (| head): nothing more to say
+        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+        return EXIT_BROKEN_PIPE
     except OSError as exc:  # a disk full, a file removed under us: not a bug to trace
         where = f"{exc.filename}: " if exc.filename else ""
         print(f"uvms-pin: error: {where}{exc.strerror or exc}", file=sys.stderr)

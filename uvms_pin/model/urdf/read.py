@@ -17,6 +17,8 @@ __all__ = ["read_numbers", "read_origin", "read_urdf_root"]
 def read_urdf_root(path: Path) -> ET.Element:
     """The <robot> element of a URDF file; ModelError naming the file otherwise."""
     where = str(path)
+    if path.is_dir():
+        raise ModelError("is a directory, not a URDF file", path=where)
     if not path.is_file():
         raise ModelError("file not found", path=where)
     try:
