@@ -61,6 +61,18 @@ os.replace = replace
 sys.exit(main())
 """
 _RUN_NEW = ("run", "s.toml", "--out", "new", "--quiet")
+
+
+def _first_row_is(table: str, start: str):
+    """After: the first data row of the CSV file ``table`` starts with ``start``."""
+
+    def check(case_dir) -> None:
+        row = (case_dir / table).read_text().splitlines()[1]
+        assert row.startswith(start), row
+
+    return check
+
+
 _DATA = str(ROOT / "data" / "hinsdale2023")
 _SEA = (
     (ROOT / "scenarios" / "sea_state_force_tracking.toml")
@@ -124,7 +136,7 @@ ROUND_TWO = [
     Case("info-empty", ("info", ""), ("argument urdf", "must be a path"), watch="."),
     Case("report-empty", ("report", ""), ("argument directory", "must be a path"), watch="."),
     Case("sweep-empty-scheduler", ("sweep", "{study}", "--out", "new", "--scheduler", ""), ("--scheduler", "must be an address"), watch="new"),
-    Case("run-empty-model", ("run", "s.toml", "--out", "new"), ("s.toml: scenario.model: is empty",), write("s.toml", scenario_with("")), watch="new"),
+    Case("run-empty-model", ("run", "s.toml", "--out", "new"), ("s.toml: scenario.model: the model is empty",), write("s.toml", scenario_with("")), watch="new"),
     Case("sweep-empty-base", ("sweep", "st.toml", "--out", "new"), ("st.toml: study.base: is empty",), write("st.toml", '[study]\nbase = ""\nseed = 1\n[[parameter]]\npath = "water.current_world_m_s[0]"\nvalues = [0.0, 0.1]\n'), watch="new"),
     # ---- 9. keys inside arrays of tables; a table value replaces a whole table ----------
     Case("run-thruster-index-out-of-range", ("run", "r.toml", "--out", "new", "--set", "actuation.thruster[9].max_forward_N=0"), ("override 'actuation.thruster[9].max_forward_N'", "index 9 out of range, 'actuation.thruster' has 4 entries"), write("r.toml", realistic_with()), watch="new"),
@@ -168,6 +180,11 @@ ROUND_TWO = [
     Case("run-model-is-a-directory", ("run", "s.toml", "--out", "new"), ("s.toml: scenario.model", "'adir' is a directory"), steps(lambda d: (d / "adir").mkdir(), write("s.toml", scenario_with("adir"))), watch="new"),
     Case("run-model-is-not-a-urdf-file", ("run", "s.toml", "--out", "new"), ("notes.txt", "not well-formed XML"), steps(write("notes.txt", "my notes\n"), write("s.toml", scenario_with("notes.txt"))), watch="new"),
     Case("run-model-near-miss", ("run", "s.toml", "--out", "new"), ("scenario.model", "'uvms_lbv15' is neither a file", "did you mean 'uvms_lbv150'?"), write("s.toml", scenario_with("uvms_lbv15")), watch="new"),
+    # ---- 15. compare-arms: --set and --quiet, nothing ran, a vehicle without an arm -------
+    Case("compare-arms-vehicle-without-an-arm", ("compare-arms", "v.toml", "--out", "new"), ("v.toml", "is a vehicle without an arm", "give a scenario whose model carries an arm"), write("v.toml", scenario_with("lbv150").replace("joint_positions_rad = [0.0, 0.5, -0.5, 0.0]", "").replace("velocity = [0.2, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0]", "")), watch="new"),
+    Case("compare-arms-no-arm-ran", ("compare-arms", "{good}", "--out", "new", "--quiet", "--arms", "notarm.urdf"), ("compare-arms: no arm ran, nothing is compared", "notarm: model error"), write("notarm.urdf", '<robot name="x"><link name="a"/></robot>'), code=3, after=_first_row_is("new/comparison.csv", "notarm,")),
+    Case("compare-arms-bad-set", ("compare-arms", "{good}", "--out", "new", "--set", "water.curent_world_m_s=[0,0,0]"), ("override 'water.curent_world_m_s'", "did you mean 'water.current_world_m_s'?"), watch="new"),
+    Case("compare-arms-set-not-an-assignment", ("compare-arms", "{good}", "--out", "new", "--set", "scenario.duration_s"), ("override 'scenario.duration_s': expected KEY=VALUE",), watch="new"),
     # ---- 14. a full disk: exit 4, the file named, what was kept said --------------------
     Case("run-disk-full-at-a-figure", ("velocities.png", "run", "s.toml", "--out", "new", "--quiet"), ("cannot write new/velocities.png: No space left on device", "kept in new: rollout.npz, rollout.json, metrics.json, pose.png"), steps(write("diskfull.py", DISK_FULL), write("s.toml", scenario_with(_URDF))), code=4, script="diskfull.py", after=rollout_kept("new", "ok")),
     Case("run-disk-full-at-the-rollout", ("rollout.npz", "run", "s.toml", "--out", "new", "--quiet"), ("cannot write new/rollout.npz: No space left on device", "nothing of this run was kept in new"), steps(write("diskfull.py", DISK_FULL), write("s.toml", scenario_with(_URDF))), code=4, script="diskfull.py", watch="new"),

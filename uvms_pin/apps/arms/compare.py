@@ -75,15 +75,20 @@ def compare_arms(
     scenario_path = Path(scenario_path)
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
-    duration = {} if settings.duration_s is None else {"scenario.duration_s": settings.duration_s}
-    base = load_scenario(scenario_path, duration)
+    base = load_scenario(scenario_path, settings.scenario_overrides)
+    if not base.uvms.n_arm_joints:
+        raise ScenarioError(
+            f"{scenario_path}: its model ({base.uvms.source}) is a vehicle without an arm: "
+            "compare-arms mounts each arm where the scenario's arm is and runs the "
+            "scenario's task with it; give a scenario whose model carries an arm"
+        )
     _check_runs_fit(base, min(jobs, len(arms)))
     model_path = Path(base.uvms.source)
     for name in arms:  # fail early on names that are neither known nor files
         if name != REFERENCE:
             resolve_arm(name)
     with tempfile.TemporaryDirectory(prefix="uvms_pin_arms_") as tmp:
-        split = split_urdf(model_path, tmp)
+        split = split_urdf(model_path, tmp, first_arm_joint=base.uvms.arm_joint_names[0])
         hull = hull_box(split.vehicle_urdf, split.vehicle_link)
         args = [
             (

@@ -88,7 +88,7 @@ def run_one_arm(
 def _fill_row(row: dict, job: _ArmJob) -> None:
     """Mount, solve, trim and run one arm, filling ``row`` (raises on a model error)."""
     settings = job.settings
-    overrides = {} if settings.duration_s is None else {"scenario.duration_s": settings.duration_s}
+    overrides = settings.scenario_overrides
     vehicle_mass = _vehicle_mass(Path(job.vehicle_urdf))
     base = load_scenario(job.scenario_path, overrides)
     target = _start_tool_placement(base)
