@@ -68,6 +68,12 @@ class PlausibilityWarning(UvmsPinWarning):
     that cannot be physical at all is refused instead."""
 
 
+class ActuationWarning(UvmsPinWarning):
+    """The actuators left out part of what the controller commanded for a reason the
+    scenario does not state (a wrench component no thruster can produce): the message names
+    the components and the largest value dropped."""
+
+
 class ParameterError(UvmsPinError, ValueError):
     """An argument has the wrong shape, a non-finite value or is out of its valid range."""
 

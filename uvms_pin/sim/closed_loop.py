@@ -18,6 +18,7 @@ from __future__ import annotations
 
 import math
 import time
+import warnings
 from collections.abc import Iterator, Sequence
 from contextlib import contextmanager
 from typing import Any
@@ -26,7 +27,13 @@ import numpy as np
 
 from uvms_pin.control.base import Controller
 from uvms_pin.control.measurement import Measurement, read_only
-from uvms_pin.errors import ControllerError, FunnelViolation, ParameterError, SimulationError
+from uvms_pin.errors import (
+    ActuationWarning,
+    ControllerError,
+    FunnelViolation,
+    ParameterError,
+    SimulationError,
+)
 from uvms_pin.results.rollout import Rollout
 from uvms_pin.results.status import ERROR, INTERRUPTED, OK, RunStatus, Violation
 from uvms_pin.sim.divergence import NUMERICAL_FAILURES, diverged, divergence_context
@@ -91,6 +98,7 @@ class ClosedLoop:
         q0[3:7] /= np.linalg.norm(q0[3:7])
         self.time_s, self.q, self.v = 0.0, read_only(q0), read_only(v0)
         self.sensors = sensors
+        self.plant.actuation.start()
         if self.controller is not None:
             with self._controller_code("reset"):
                 self.controller.reset()
@@ -220,6 +228,9 @@ class ClosedLoop:
             raise
         finally:
             self.observers.remove(log)
+            dropped = self.plant.actuation.dropped()
+            if dropped is not None:
+                warnings.warn(dropped, ActuationWarning, stacklevel=2)
         return _finished(log, wall_start, RunStatus(OK))
 
     def _tick(self, logged: bool) -> np.ndarray:
@@ -262,6 +273,12 @@ class ClosedLoop:
             return sensors.measure(t, q, v, contact), contact
 
         def rhs(t: float, q: np.ndarray, v: np.ndarray) -> np.ndarray:
+            # a stage of a blown-up step: a divergence, not a bad argument to the dynamics
+            if not (math.isfinite(q.sum()) and math.isfinite(v.sum())):
+                context = divergence_context(plant, (t, t), self.q, self.v, self._last_tau_applied)
+                raise SimulationError(
+                    f"simulation diverged: a non-finite state at t = {t:.6g} s; {context}"
+                )
             measurement, contact = at(t, q, v)
             tau_applied = actuation.apply(command(measurement))
             self._last_tau_applied = tau_applied  # for a divergence message

@@ -175,7 +175,8 @@ def _interrupted(args: list[str], cwd: Path, delays: tuple[float, ...]):
         time.sleep(1.0)
         for delay_s in (0.0, *delays):
             time.sleep(delay_s)
-            os.killpg(proc.pid, signal.SIGINT)
+            if proc.poll() is None:  # (one that ended early fails on its exit status)
+                os.killpg(proc.pid, signal.SIGINT)
         out, err = proc.communicate(timeout=120)
     finally:
         if proc.poll() is None:
