@@ -187,6 +187,8 @@ ROUND_TWO = [
     Case("compare-arms-set-not-an-assignment", ("compare-arms", "{good}", "--out", "new", "--set", "scenario.duration_s"), ("override 'scenario.duration_s': expected KEY=VALUE",), watch="new"),
     # ---- 16. wrench components no thruster produces: said once, with what was dropped ----
     Case("run-allocation-drops-roll-and-pitch", ("run", "r.toml", "--out", "new", "--quiet"), ("warning: the thrusters cannot produce every wrench component", "of pitch moment my", "actuation.allocated_components = [0, 1, 2, 5]"), write("r.toml", realistic_with().replace("allocated_components = [0, 1, 2, 5]\n", "")), code=0, after=rollout_kept("new", "ok")),
+    # ---- 17. a rerun into the same directory (make demo's) replaces the outputs -----------
+    Case("run-again-into-the-same-directory", ("run", "{good}", "--out", "prior", "--quiet", "--html", "--overwrite"), (), code=0, watch="study_out", after=rollout_kept("prior", "ok")),
     # ---- 14. a full disk: exit 4, the file named, what was kept said --------------------
     Case("run-disk-full-at-a-figure", ("velocities.png", "run", "s.toml", "--out", "new", "--quiet"), ("cannot write new/velocities.png: No space left on device", "kept in new: rollout.npz, rollout.json, metrics.json, pose.png"), steps(write("diskfull.py", DISK_FULL), write("s.toml", scenario_with(_URDF))), code=4, script="diskfull.py", after=rollout_kept("new", "ok")),
     Case("run-disk-full-at-the-rollout", ("rollout.npz", "run", "s.toml", "--out", "new", "--quiet"), ("cannot write new/rollout.npz: No space left on device", "nothing of this run was kept in new"), steps(write("diskfull.py", DISK_FULL), write("s.toml", scenario_with(_URDF))), code=4, script="diskfull.py", watch="new"),
