@@ -17,7 +17,7 @@ examples.
 from __future__ import annotations
 
 import warnings
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any
 
@@ -100,7 +100,9 @@ def _build(raw: dict[str, Any], path: Path, top: Table) -> Scenario:
     integrator, backend = build_integrator(top.table_or_empty("integrator"))
     control_period = build_control_period(top.table_or_empty("control"))
     log_period = build_log_period(top.table_or_empty("output"))
-    controller = build_controller(top.table("controller"), uvms, path.parent)
+    controller = replace(
+        build_controller(top.table("controller"), uvms, path.parent), from_file=True
+    )
     check_baselines(top.table("baselines"), (raw.get("controller") or {}).get("type"))
     top.finish()
     plant = Plant(
