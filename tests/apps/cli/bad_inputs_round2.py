@@ -48,6 +48,51 @@ def _with_controller(module: str, params: str = "") -> object:
 
 _URDF = str(URDF)
 
+#: ``python api.py SCENARIO OUT``: a run whose controller is replaced in code, saved
+_SET_IN_CODE = """import sys
+import numpy as np
+from uvms_pin.apps.outputs import write_results
+from uvms_pin.control.base import Controller
+from uvms_pin.scenario.load import load_scenario
+from uvms_pin.sim.run import simulate
+class Hold(Controller):
+    def __init__(self, nv):
+        self.nv, self.gain = nv, 3.0
+    def compute(self, t, m):
+        return np.zeros(self.nv)
+scenario = load_scenario(sys.argv[1], {"controller.type": "none"})
+scenario.controller_factory = lambda uvms: Hold(uvms.nv)
+write_results(simulate(scenario, progress=False), __import__("pathlib").Path(sys.argv[2]))
+"""
+
+
+def _recorded_as_set_in_code(case_dir) -> None:
+    import json
+
+    metadata = json.loads((case_dir / "new" / "rollout.json").read_text())
+    assert metadata["controller"] == {
+        "class": "__main__:Hold",
+        "type": "__main__:Hold",
+        "params": {"nv": 10, "gain": 3.0},
+    }
+    assert metadata["parameters"]["controller"]["set_in_code"] is True
+
+
+#: a policy writing into its observations: the episode is the one of a policy that did not
+_GYM_MEDDLER = """import gymnasium as gym, numpy as np, uvms_pin.apps.gym
+def episode(meddle):
+    env = gym.make("uvms_pin/ForceTracking-v0", overrides={"scenario.duration_s": 0.02}).unwrapped
+    obs, _ = env.reset(seed=1)
+    seen = [obs.copy()]
+    for _ in range(5):
+        if meddle:
+            obs[:] = 99.0
+        obs, *_ = env.step(np.zeros(env.action_space.shape))
+        seen.append(obs.copy())
+    return np.array(seen)
+assert np.array_equal(episode(True), episode(False))
+"""
+
 #: ``python diskfull.py NAME uvms-pin-args``: uvms-pin on a disk that refuses file NAME
 DISK_FULL = """import errno, os, sys
 from uvms_pin.apps.cli.main import main
@@ -189,6 +234,10 @@ ROUND_TWO = [
     Case("run-allocation-drops-roll-and-pitch", ("run", "r.toml", "--out", "new", "--quiet"), ("warning: the thrusters cannot produce every wrench component", "of pitch moment my", "actuation.allocated_components = [0, 1, 2, 5]"), write("r.toml", realistic_with().replace("allocated_components = [0, 1, 2, 5]\n", "")), code=0, after=rollout_kept("new", "ok")),
     # ---- 17. a rerun into the same directory (make demo's) replaces the outputs -----------
     Case("run-again-into-the-same-directory", ("run", "{good}", "--out", "prior", "--quiet", "--html", "--overwrite"), (), code=0, watch="study_out", after=rollout_kept("prior", "ok")),
+    # ---- 18. a controller set in code is recorded as what ran (the Python API) ----------
+    Case("api-controller-set-in-code-is-recorded", ("s.toml", "new"), (), steps(write("api.py", _SET_IN_CODE), write("s.toml", scenario_with(_URDF))), code=0, script="api.py", watch="prior", after=_recorded_as_set_in_code),
+    # ---- 1. the Gymnasium observation is the policy's own array (the Python API) -------
+    Case("api-gym-observation-written-by-the-policy", (), (), write("gym_meddler.py", _GYM_MEDDLER), code=0, script="gym_meddler.py", watch="prior"),
     # ---- 14. a full disk: exit 4, the file named, what was kept said --------------------
     Case("run-disk-full-at-a-figure", ("velocities.png", "run", "s.toml", "--out", "new", "--quiet"), ("cannot write new/velocities.png: No space left on device", "kept in new: rollout.npz, rollout.json, metrics.json, pose.png"), steps(write("diskfull.py", DISK_FULL), write("s.toml", scenario_with(_URDF))), code=4, script="diskfull.py", after=rollout_kept("new", "ok")),
     Case("run-disk-full-at-the-rollout", ("rollout.npz", "run", "s.toml", "--out", "new", "--quiet"), ("cannot write new/rollout.npz: No space left on device", "nothing of this run was kept in new"), steps(write("diskfull.py", DISK_FULL), write("s.toml", scenario_with(_URDF))), code=4, script="diskfull.py", watch="new"),
