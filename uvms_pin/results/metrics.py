@@ -18,10 +18,8 @@ def _rms(x: np.ndarray) -> float:
 
 
 def compute_metrics(rollout: RolloutData) -> dict[str, float]:
-    """Metrics of any run: timing, energy, motion and effort.
-
-    Energy drift is max |E(t) - E(0)| / max(|E(0)|, K(0)) over the run (E = T + U), the
-    number an energy-conservation check looks at. Efforts: vehicle force = |tau[0:3]|,
+    """Metrics of any run: timing, energy (`energy_metrics`: a balance when driven), motion
+    and effort. Efforts: vehicle force = |tau[0:3]|,
     vehicle torque = |tau[3:6]|, joint torques = max over joints of |tau_j|.
     """
     meta = rollout.metadata
@@ -35,11 +33,10 @@ def compute_metrics(rollout: RolloutData) -> dict[str, float]:
         return out
     kinetic = rollout.kinetic_energy_J
     total = rollout.total_energy_J
-    scale = max(abs(total[0]), kinetic[0], 1e-12)
     out.update(
         kinetic_energy_initial_J=float(kinetic[0]),
         kinetic_energy_final_J=float(kinetic[-1]),
-        energy_relative_drift_max=float(np.max(np.abs(total - total[0])) / scale),
+        **energy_metrics(rollout),
         energy_max_increase_J=float(np.max(np.diff(total))) if len(total) > 1 else 0.0,
         vehicle_displacement_m=float(np.linalg.norm(rollout.q[-1, :3] - rollout.q[0, :3])),
         vehicle_speed_final_m_s=float(np.linalg.norm(rollout.v[-1, :3])),
@@ -59,6 +56,48 @@ def compute_metrics(rollout: RolloutData) -> dict[str, float]:
     out.update(force_tracking_metrics(rollout))
     out.update(joint_limit_metrics(rollout))
     return out
+
+
+def driven(rollout: RolloutData) -> bool:
+    """Whether anything did work on the system: a generalized force, a contact, a
+    disturbance (the water's own forces aside)."""
+    return bool(
+        np.any(rollout.tau)
+        or np.any(rollout.wrench_contact_world)
+        or np.any(rollout.wrench_disturbance_body)
+    )
+
+
+def work_of_tau_J(rollout: RolloutData) -> np.ndarray:
+    """W(t) = int_0^t tau . zeta dt [J]: the work of the applied generalized force, by the
+    trapezoid rule over the logged samples (tau is held between control ticks, so this is
+    exact only as the log period goes to the control period)."""
+    power = np.einsum("ij,ij->i", rollout.tau, rollout.v)  # tau is conjugate to zeta [W]
+    steps = 0.5 * (power[1:] + power[:-1]) * np.diff(rollout.time_s)
+    return np.concatenate([[0.0], np.cumsum(steps)])
+
+
+def energy_metrics(rollout: RolloutData) -> dict[str, float]:
+    """The energy of a run. Driven (a force, contact or disturbance did work): its balance,
+    E(T) - E(0) = W_tau + W_rest, with W_tau the work of the applied generalized force
+    (`work_of_tau_J`) and W_rest the work of the water (damping, currents: dissipation),
+    the contact and the disturbance, what the energy change leaves. Not driven: the largest
+    relative change of E = T + U, max |E(t) - E(0)| / max(|E(0)|, T(0)) (the water's
+    damping dissipates; without it, the integration's error)."""
+    total = rollout.total_energy_J
+    change = float(total[-1] - total[0])
+    if not driven(rollout):
+        scale = max(abs(total[0]), rollout.kinetic_energy_J[0], 1e-12)
+        return {
+            "energy_change_J": change,
+            "energy_relative_drift_max": float(np.max(np.abs(total - total[0])) / scale),
+        }
+    work = float(work_of_tau_J(rollout)[-1])
+    return {
+        "energy_change_J": change,
+        "work_of_tau_J": work,
+        "work_of_water_contact_disturbance_J": change - work,
+    }
 
 
 def joint_limit_metrics(rollout: RolloutData) -> dict[str, float]:

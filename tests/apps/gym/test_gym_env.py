@@ -288,3 +288,25 @@ def test_continuous_arm_joints(tmp_path):
     assert np.all(np.abs(turned) <= 0.3) and np.any(np.abs(turned) > 0.01)
     observation, *_ = env.step(np.zeros(10))
     assert np.all(np.isfinite(observation))
+
+
+def test_the_render_draws_the_vehicle_at_its_size_and_attitude():
+    """Its hull box (the first box collision of the root link), turned with the vehicle; not a
+    0.1 m square for every vehicle."""
+    import pinocchio as pin
+
+    from uvms_pin.apps.gym.render import _outline_xz, vehicle_box
+
+    env = _make(FORCE, scenario="bluerov_alpha5_force_tracking").unwrapped
+    centre, size = vehicle_box(env.scenario.uvms)
+    np.testing.assert_allclose(size, [0.457, 0.575, 0.254])  # the BlueROV2 Heavy's hull
+    pitch = 0.3
+    data = env.scenario.uvms.model.createData()
+    q = env.scenario.q0.copy()
+    q[3:7] = pin.Quaternion(pin.rpy.rpyToMatrix(0.0, pitch, 0.0)).coeffs()
+    pin.forwardKinematics(env.scenario.uvms.model, data, q)
+    outline = _outline_xz(data, (centre, size))
+    width = np.ptp(outline[:, 0])
+    assert width == pytest.approx(size[0] * np.cos(pitch) + size[2] * np.sin(pitch))
+    lbv = _make(FORCE).unwrapped
+    np.testing.assert_allclose(vehicle_box(lbv.scenario.uvms)[1], [0.53, 0.245, 0.254])

@@ -130,6 +130,7 @@ class UvmsEnv(gym.Env):
         self._contact = np.zeros(6)
         self._anchor: np.ndarray | None = None
         self._render_data = uvms.model.createData()
+        self._vehicle_box = None  # (centre, size) [m], found on the first render
         self._flow_seed = self.scenario.settings.seed
 
     # -- to be given by a task environment ---------------------------------------------
@@ -199,12 +200,15 @@ class UvmsEnv(gym.Env):
     def render(self):
         if self.render_mode != "rgb_array":
             return None
-        from uvms_pin.apps.gym.render import side_view_rgb
+        from uvms_pin.apps.gym.render import side_view_rgb, vehicle_box
 
+        if self._vehicle_box is None:
+            self._vehicle_box = vehicle_box(self.scenario.uvms)
         loop = self._loop
         return side_view_rgb(
-            self.scenario.uvms, self._render_data, loop.q, loop.time_s, self._anchor
-        )
+            self.scenario.uvms, self._render_data, loop.q, loop.time_s, self._anchor,
+            box=self._vehicle_box,
+        )  # fmt: skip
 
     # -- replay export -------------------------------------------------------------------
     def episode_rollout(self) -> Rollout:
