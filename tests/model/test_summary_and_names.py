@@ -24,7 +24,8 @@ def test_derived_bodies_are_said_to_be_in_their_collision_shape_frame():
     )
     # a body read from a <hydrodynamics> element has no such line: its frame is its link's
     k = next(i for i, line in enumerate(lines) if line.startswith("  base_link"))
-    assert lines[k + 1].strip().startswith("added mass diag")
+    assert lines[k + 1].strip().startswith("free surface cuts")
+    assert lines[k + 2].strip().startswith("added mass diag")
 
 
 def test_a_model_entry_that_names_no_model_says_why(tmp_path):

@@ -5,6 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pinocchio as pin
 
+from uvms_pin.hydro.hull import Hull
 from uvms_pin.model.uvms import UVMS
 from uvms_pin.results.format import numbers_text
 
@@ -17,9 +18,10 @@ def _shape_frame(uvms: UVMS, body) -> str:
     """Where a derived body's frame (its collision shape's) is in its link's frame."""
     model = uvms.model
     link = body.name.split("/")[0]
-    if not model.existFrame(link):
+    # a link's own frame (a fixed joint may carry its name too)
+    if not model.existFrame(link, pin.FrameType.BODY):
         return f"the collision shape's, [{numbers_text(body.placement_in_joint.translation, 4)}] m in the joint frame"
-    link_in_joint = model.frames[model.getFrameId(link)].placement
+    link_in_joint = model.frames[model.getFrameId(link, pin.FrameType.BODY)].placement
     shape_in_link = link_in_joint.inverse() * body.placement_in_joint
     xyz, rpy = (
         np.where(np.abs(x) < 1e-12, 0.0, x)  # round-off of the composed placements
@@ -60,7 +62,8 @@ def model_summary(uvms: UVMS) -> str:
         "the link frame for a <hydrodynamics> element, the collision shape's frame for "
         "coefficients derived from geometry, marked *):",
     ]
-    for body in uvms.hydro_bodies:
+    hulls = dict(zip(uvms.surface_bodies.body_index, uvms.surface_bodies.hulls, strict=True))
+    for k, body in enumerate(uvms.hydro_bodies):
         p = body.params
         mark = "*" if p.derived else " "
         lines.append(
@@ -68,6 +71,7 @@ def model_summary(uvms: UVMS) -> str:
         )
         if p.derived:
             lines.append(f"     frame             {_shape_frame(uvms, body)}")
+        lines.append(f"     free surface cuts {hull_text(hulls.get(k))}")
         lines.append(f"     added mass diag   [{numbers_text(np.diag(p.added_mass), 4)}]")
         lines.append(f"     linear damping    [{numbers_text(np.diag(p.linear_damping), 4)}]")
         lines.append(f"     quadratic damping [{numbers_text(p.quadratic_damping, 4)}]")
@@ -91,3 +95,14 @@ def model_summary(uvms: UVMS) -> str:
             + ("  continuous: q holds (cos, sin)" if arm.kinds[k] == "continuous" else "")
         )
     return "\n".join(lines)
+
+
+def hull_text(hull: Hull | None) -> str:
+    """What the free surface cuts of a body: its hull's shapes and volume scale."""
+    if hull is None:
+        return "nothing (no volume, no geometry: always wet)"
+    if hull.equivalent_sphere:
+        radius = hull.pieces[0].shape.radius_m
+        return f"a sphere of its volume at r_b, r = {radius:.4g} m (no collision geometry)"
+    shapes = ", ".join(piece.shape.label for piece in hull.pieces)
+    return f"its collision {shapes}, volume scaled by {hull.volume_scale:.4g} to V"

@@ -20,9 +20,10 @@ import time
 from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
 
+import paused_cli
 import pytest
 from bad_inputs_round2 import ROUND_TWO
-from cli_support import STUDY, URDF, passive_scenario, run_cli, start_cli, tree_digest
+from cli_support import STUDY, URDF, passive_scenario, run_cli, tree_digest
 from corpus import BAD_URDF, GOOD_BUT, Case, check_case
 from corpus import copy_study_inputs as _copy_study_inputs
 from corpus import mkdir as _mkdir
@@ -164,15 +165,12 @@ def outcomes(workspace) -> dict[str, tuple]:
 
 
 def _interrupted(args: list[str], cwd: Path, delays: tuple[float, ...]):
-    """``uvms-pin ARGS`` (quiet) with Ctrl-C 1 s after its --out appeared (it simulates by
-    then), then again after each delay."""
-    proc = start_cli(args, cwd)
+    """``uvms-pin ARGS`` with Ctrl-C while its 500th sample is being logged (the run paused
+    there by a test hook, tests/paused_cli.py: the same point however fast the machine),
+    then again after each delay [s] (a user pressing again while the first is handled)."""
+    proc = paused_cli.start(["--pause-at-sample", "500"], args, cwd)
     try:
-        out_dir = cwd / args[args.index("--out") + 1]
-        deadline = time.monotonic() + 120.0
-        while not out_dir.exists() and proc.poll() is None and time.monotonic() < deadline:
-            time.sleep(0.05)
-        time.sleep(1.0)
+        paused_cli.wait_until_paused(proc)
         for delay_s in (0.0, *delays):
             time.sleep(delay_s)
             if proc.poll() is None:  # (one that ended early fails on its exit status)

@@ -13,19 +13,23 @@ import time
 from importlib import metadata
 
 import numpy as np
+import paused_cli
 import pytest
-from cli_support import interrupt, passive_scenario, run_cli, start_cli, uvms_pin_command
+from cli_support import interrupt, passive_scenario, run_cli, uvms_pin_command
 
 from uvms_pin.results.rollout import Rollout
 
 
 def test_ctrl_c_keeps_the_partial_rollout_and_a_second_run_into_its_out_is_refused(tmp_path):
+    """Ctrl-C while the 51st sample of a 60 s run is being logged (the run paused there by
+    a test hook: the outcome does not depend on how fast the machine simulates)."""
     (tmp_path / "long.toml").write_text(passive_scenario(60.0))
     (tmp_path / "short.toml").write_text(passive_scenario(0.1))
-    proc = start_cli(["run", "long.toml", "--out", "o"], cwd=tmp_path)
+    proc = paused_cli.start(
+        ["--pause-at-sample", "51"], ["run", "long.toml", "--out", "o"], tmp_path
+    )
     try:
-        first = proc.stderr.readline()  # the progress line: the run is simulating
-        assert first.startswith("passive_current ["), first
+        paused_cli.wait_until_paused(proc)
         second = run_cli(["run", "short.toml", "--out", "o"], cwd=tmp_path)
         out, err = interrupt(proc)
     finally:
@@ -43,9 +47,9 @@ def test_ctrl_c_keeps_the_partial_rollout_and_a_second_run_into_its_out_is_refus
     rollout = Rollout.load(tmp_path / "o")
     metrics = json.loads((tmp_path / "o" / "metrics.json").read_text())
     assert rollout.metadata["status"] == metrics["status"] == "interrupted"
-    assert len(rollout) >= 2 and np.all(np.diff(rollout.time_s) > 0)
+    # every sample logged up to the interruption, at the scenario's 0.02 s log period
+    np.testing.assert_allclose(rollout.time_s, 0.02 * np.arange(51), rtol=0, atol=1e-12)
     assert np.all(np.isfinite(rollout.q)) and np.all(np.isfinite(rollout.v))
-    assert 0.0 < rollout.time_s[-1] < 60.0
     assert metrics["simulated_time_s"] == rollout.time_s[-1]
     assert (tmp_path / "o" / "pose.png").stat().st_size > 0
 
@@ -56,10 +60,12 @@ def test_a_second_ctrl_c_while_saving_does_not_lose_the_rollout(tmp_path, delay_
     while the partial rollout is being saved) waits for the save: the rollout, its metadata
     and metrics.json are whole and agree, no temporary file is left."""
     (tmp_path / "long.toml").write_text(passive_scenario(600.0))
-    proc = start_cli(["run", "long.toml", "--out", "o"], cwd=tmp_path)
+    # paused at a known sample (a test hook): enough simulated for a save that takes a while
+    proc = paused_cli.start(
+        ["--pause-at-sample", "2000"], ["run", "long.toml", "--out", "o"], tmp_path
+    )
     try:
-        assert proc.stderr.readline().startswith("passive_current [")
-        time.sleep(1.0)  # enough simulated for a save that takes a while
+        paused_cli.wait_until_paused(proc)
         os.killpg(proc.pid, signal.SIGINT)
         time.sleep(delay_s)
         _out, err = interrupt(proc)
