@@ -65,6 +65,7 @@ RUN = OutputKind(
         "first_level_errors.png",
         "second_level_errors.png",
         "flow.png",  # runs with waves or a varying current
+        "surface.png",  # runs in which a body left the water in part
     ),
     ("rollout.npz", "rollout.json", "metrics.json", "replay.html"),
 )
