@@ -3,6 +3,9 @@ the rest of each class. One block per issue item; the runner is ``test_bad_input
 
 from __future__ import annotations
 
+import re
+import struct
+
 from cli_support import ROOT, URDF
 from corpus import (
     Case,
@@ -125,6 +128,31 @@ _SEA = (
     .replace('"../models/uvms_lbv150.urdf"', f'"{URDF}"')
 )
 
+_SURFACING = str(ROOT / "scenarios" / "surfacing.toml")
+#: a binary STL of one triangle: a surface enclosing no volume
+_FLAT_STL = (
+    b"\0" * 80
+    + struct.pack("<I", 1)
+    + struct.pack("<12f", 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 1, 0)
+    + b"\0\0"
+)
+_BASE_BOX = '<geometry><box size="0.53 0.245 0.254"/></geometry>'
+_FLAT_MESH = '<geometry><mesh filename="flat.stl"/></geometry>'
+
+
+def _arm_link1_derived_from(collision: str) -> str:
+    """The reference URDF with arm_link1's <hydrodynamics> removed (derived from its
+    collision shape) and that shape replaced by ``collision``."""
+    text = URDF.read_text()
+    start = text.index('<link name="arm_link1">')
+    end = text.index("</link>", start)
+    link = re.sub(r"<hydrodynamics>.*?</hydrodynamics>", "", text[start:end], flags=re.S)
+    link = re.sub(
+        r"<collision>.*?</collision>", f"<collision>{collision}</collision>", link, flags=re.S
+    )
+    return text[:start] + link + text[end:]
+
+
 ROUND_TWO = [
     # ---- 1. a controller cannot change the simulation through its measurement ----------
     Case("run-controller-freezes-the-vehicle", _RUN_NEW, ("run stopped", "compute() raised at t = 0 s", "ValueError: assignment destination is read-only"), _with_controller(_controller("m.v[:] = 0\nreturn np.zeros(self.nv)")), code=3, traceback_of="ctrl.py", after=rollout_kept("new", "error")),
@@ -244,4 +272,14 @@ ROUND_TWO = [
     Case("run-disk-full-at-the-metadata", ("rollout.json", "run", "s.toml", "--out", "new", "--quiet"), ("cannot write new/rollout.json", "nothing of this run was kept"), steps(write("diskfull.py", DISK_FULL), write("s.toml", scenario_with(_URDF))), code=4, script="diskfull.py", watch="new"),
     Case("replay-disk-full", ("replay.html", "replay", "prior", "--html"), ("prior/replay.html: No space left on device",), write("diskfull.py", DISK_FULL), code=4, script="diskfull.py"),
     Case("sweep-disk-full", ("results.parquet", "sweep", "{study}", "--out", "new", "--workers", "0", "--quiet"), ("new/results.parquet: No space left on device",), write("diskfull.py", DISK_FULL), code=4, script="diskfull.py", watch="prior"),
+    # ---- the free surface (issue 21): its keys, its stop, a hull that cannot be built ---
+    Case("run-free-surface-not-a-boolean", ("run", _SURFACING, "--out", "new", "--set", "water.free_surface=1"), ("override 'water.free_surface'", "must be true or false, got 1"), watch="new"),
+    Case("run-stop-at-surface-a-string-in-the-file", ("run", "s.toml", "--out", "new"), ("s.toml", "water.stop_at_surface", "must be true or false, got 'yes'"), write("s.toml", scenario_with(_URDF).replace("[water]\n", '[water]\nstop_at_surface = "yes"\n')), watch="new"),
+    Case("run-free-surface-key-misspelled", ("run", _SURFACING, "--out", "new", "--set", "water.free_surfce=true"), ("unknown key 'water.free_surfce'", "did you mean 'water.free_surface'?"), watch="new"),
+    Case("run-stop-at-surface-reached", ("run", _SURFACING, "--out", "new", "--quiet", "--set", "water.stop_at_surface=true", "--set", "initial.position_world_m=[0, 0, -0.3]"), ("run stopped: link 'base_link' reached the free surface at t =", "([water] stop_at_surface)", "the partial rollout (t = 0 to"), code=3, after=rollout_kept("new", "SimulationError")),
+    Case("run-stop-at-surface-above-it-at-the-start", ("run", _SURFACING, "--out", "new", "--quiet", "--set", "water.stop_at_surface=true", "--set", "initial.position_world_m=[0, 0, 1]"), ("reached the free surface at t = 0 s", "1 m above the surface", "nothing was simulated"), code=3, after=rollout_kept("new", "SimulationError")),
+    Case("info-flat-mesh-as-a-hull", ("info", "h.urdf"), ("h.urdf", "link 'base_link'", "cannot use <mesh> as a hull", "flat.stl' encloses no volume", "a sphere of the link's volume instead"), steps(write("flat.stl", _FLAT_STL), write("h.urdf", urdf_with(**{_BASE_BOX: _FLAT_MESH}))), code=0),
+    Case("info-zero-box-as-a-hull", ("info", "h.urdf"), ("h.urdf", "link 'base_link'", "cannot use <box> as a hull", "got 0.0"), write("h.urdf", urdf_with(**{_BASE_BOX: '<geometry><box size="0.53 0.245 0"/></geometry>'})), code=0),
+    Case("info-derived-body-of-a-flat-mesh", ("info", "d.urdf"), ("d.urdf", "link 'arm_link1'", "cannot derive hydrodynamics from <mesh>", "encloses no volume"), steps(write("flat.stl", _FLAT_STL), write("d.urdf", _arm_link1_derived_from(_FLAT_MESH)))),
+    Case("run-derived-body-of-a-flat-mesh", ("run", "s.toml", "--out", "new"), ("d.urdf", "link 'arm_link1'", "encloses no volume"), steps(write("flat.stl", _FLAT_STL), write("d.urdf", _arm_link1_derived_from(_FLAT_MESH)), write("s.toml", scenario_with("d.urdf"))), watch="new"),
 ]  # fmt: skip
