@@ -74,6 +74,23 @@ def test_backends_agree_on_a_continuous_run(tmp_path):
     assert np.max(np.abs(runs[0].q - runs[1].q)) <= 1e-9 * scale
 
 
+def test_backends_agree_on_a_continuous_run_through_the_free_surface(tmp_path):
+    """At the waterline (the hull and the arm's links cut by the surface, their wet parts
+    changing): the core's wet-state dynamics with (cos, sin) joint coordinates agree with
+    the reference's."""
+    urdf = continuous_joint_urdf(tmp_path, ("arm_joint1", "arm_joint3"))
+    at_surface = {"initial.position_world_m": [0.0, 0.0, -0.05], "water.free_surface": True}
+    runs = [
+        simulate(_scenario(urdf, **{"integrator.backend": b, **at_surface}), progress=False)
+        for b in ("core", "python")
+    ]
+    wet = runs[1].signals["wet_fraction"]
+    assert np.any(wet < 1.0 - 1e-6) and np.ptp(wet, axis=0).max() > 0.0  # cut, and moving
+    scale = np.max(np.abs(runs[1].q))
+    assert np.max(np.abs(runs[0].q - runs[1].q)) <= 1e-9 * scale
+    np.testing.assert_allclose(runs[0].signals["wet_fraction"], wet, rtol=0, atol=1e-9)
+
+
 def test_joint_limit_metrics_skip_continuous_joints():
     """Joint 1 continuous at 3 rad, joint 2 revolute 0.5 rad past its upper limit."""
     n = 4
