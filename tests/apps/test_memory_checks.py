@@ -86,7 +86,7 @@ def test_a_comparison_keeps_every_log_so_all_must_fit(monkeypatch):
 
     path = ROOT / "scenarios" / "realistic_force_tracking.toml"
     one = controller_scenarios(path, ["ppc"])["ppc"]
-    log = one.settings.log_bytes(one.uvms.nq, one.uvms.nv)
+    log = one.settings.log_bytes(one.uvms.nq, one.uvms.nv, one.plant.n_logged_hulls)
     _available(monkeypatch, 2 * log + 10)  # one log fits, two do not
     controller_scenarios(path, ["ppc"])
     with pytest.raises(ScenarioError, match="the logs of the 2 runs"):
@@ -113,3 +113,31 @@ def test_trials_are_checked_before_they_are_loaded(tmp_path, monkeypatch):
     with pytest.raises(DataError, match=r"the 1 trial files .*\(--trials\)"):
         run_pool_validation(DATA, tmp_path / "o", trial_names=["_alt_011-1"])
     assert not (tmp_path / "o").exists()
+
+
+def test_a_runs_log_counts_the_wet_fractions_a_free_surface_adds(monkeypatch):
+    """Under a free surface every sample logs one wet fraction per hull: the estimate holds
+    them (the arrays a run really logs fit in it), and a memory that fits the log without
+    them but not with them refuses the scenario before it runs."""
+    import numpy as np
+
+    from uvms_pin.scenario.load import load_scenario
+    from uvms_pin.sim.run import simulate
+
+    path = ROOT / "scenarios" / "surfacing.toml"
+    short = {"scenario.duration_s": 0.5, "initial.position_world_m": [0.0, 0.0, -0.05]}
+    scenario = load_scenario(path, short)
+    nq, nv, hulls = scenario.uvms.nq, scenario.uvms.nv, len(scenario.uvms.surface_bodies)
+    assert hulls > 0
+    settings = scenario.settings
+    with_hulls = settings.log_bytes(nq, nv, hulls)
+    assert with_hulls - settings.log_bytes(nq, nv) == settings.n_log * 8 * hulls
+    rollout = simulate(scenario, progress=False)
+    assert rollout.signals["wet_fraction"].shape == (settings.n_log, hulls)
+    logged = sum(a.nbytes for a in (rollout.time_s, rollout.q, rollout.v, rollout.tau))
+    logged += sum(np.asarray(a).nbytes for a in rollout.signals.values())
+    assert logged <= with_hulls
+    _available(monkeypatch, 2 * with_hulls - 2)  # the log without the hulls fits
+    with pytest.raises(ScenarioError, match="the log of this run"):
+        load_scenario(path, short)
+    load_scenario(path, {**short, "water.free_surface": False})  # no wet fractions logged

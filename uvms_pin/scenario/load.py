@@ -120,7 +120,7 @@ def _build(raw: dict[str, Any], path: Path, top: Table) -> Scenario:
         settings = SimulationSettings(
             head.duration_s, integrator, log_period, control_period, head.seed
         )
-        check_log_fits(settings, uvms.nq, uvms.nv)
+        check_log_fits(settings, uvms.nq, uvms.nv, plant.n_logged_hulls)
     except ParameterError as exc:
         raise ScenarioError(f"{top.source}: {exc}") from exc
     return Scenario(

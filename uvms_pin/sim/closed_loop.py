@@ -430,7 +430,7 @@ def simulate_closed_loop(
     """
     from uvms_pin.sim.settings import check_log_fits
 
-    check_log_fits(settings, plant.uvms.nq, plant.uvms.nv)
+    check_log_fits(settings, plant.uvms.nq, plant.uvms.nv, plant.n_logged_hulls)
     meta = {**(metadata or {}), **run_metadata(plant, settings)}
     log = RolloutLog(plant.uvms, settings.n_log, meta, backend=plant.backend, plant=plant)
     loop = ClosedLoop(plant, settings, controller, observers)

@@ -67,9 +67,10 @@ class SimulationSettings:
             )
             _require_multiple(interval, step_s, name, "step_s (integrator.step_s)")
 
-    def log_bytes(self, nq: int, nv: int) -> int:
-        """Memory the rollout of this run takes [bytes] (float64 arrays, every sample)."""
-        return self.n_log * 8 * _log_width(nq, nv)
+    def log_bytes(self, nq: int, nv: int, n_hulls: int = 0) -> int:
+        """Memory the rollout of this run takes [bytes] (float64 arrays, every sample;
+        ``n_hulls``: the wet fractions logged under a free surface)."""
+        return self.n_log * 8 * (_log_width(nq, nv) + n_hulls)
 
     @property
     def n_log(self) -> int:
@@ -100,11 +101,11 @@ def _log_width(nq: int, nv: int) -> int:
     return base + 10 * (6 + nv)
 
 
-def check_log_fits(settings: SimulationSettings, nq: int, nv: int) -> None:
+def check_log_fits(settings: SimulationSettings, nq: int, nv: int, n_hulls: int = 0) -> None:
     """ParameterError, before anything is allocated, if the rollout would take more than half
     of the available memory (the other half: figures, the saved copy, the rest of the run)."""
     check_memory(
-        settings.log_bytes(nq, nv),
+        settings.log_bytes(nq, nv, n_hulls),
         f"the log of this run ({settings.n_log} samples: duration_s {settings.duration_s:g} s "
         f"/ log_period_s {settings.log_period_s:g} s)",
         "shorten scenario.duration_s or lengthen output.log_period_s",

@@ -111,15 +111,22 @@ def compare_arms(
 
 
 #: configuration and velocity entries an arm of the catalogue may add to the scenario's
-#: (a 7-joint arm replacing a 4-joint one, continuous joints counted twice)
+#: (a 7-joint arm replacing a 4-joint one, continuous joints counted twice), and hulls (the
+#: wet fractions logged: panda's 18 derived bodies against the reference arm's 5)
 _MORE_ARM_ENTRIES = 16
+_MORE_HULLS = 16
 
 
 def _check_runs_fit(base, parallel: int) -> None:
     """ScenarioError before any arm runs if ``parallel`` runs' logs would not fit."""
     uvms, settings = base.uvms, base.settings
     check_memory(
-        parallel * settings.log_bytes(uvms.nq + _MORE_ARM_ENTRIES, uvms.nv + _MORE_ARM_ENTRIES),
+        parallel
+        * settings.log_bytes(
+            uvms.nq + _MORE_ARM_ENTRIES,
+            uvms.nv + _MORE_ARM_ENTRIES,
+            base.plant.n_logged_hulls + _MORE_HULLS if base.plant.free_surface else 0,
+        ),
         f"the logs of {parallel} arm runs at a time ({settings.n_log} samples each)",
         "shorten --duration, lengthen output.log_period_s or lower --jobs",
         ScenarioError,
