@@ -91,7 +91,10 @@ def _load_cached(path: str, mtime_ns: int, scale: tuple[float, float, float]) ->
         raise ParameterError(
             f"mesh '{path}' encloses no volume (flat or degenerate: {type(exc).__name__})"
         ) from exc
-    if mesh.is_watertight and abs(mesh.volume) > 0.0:
+    # a flat surface's centre of mass is 0/0 to trimesh: its volume is refused below
+    with np.errstate(invalid="ignore", divide="ignore"):
+        closed = mesh.is_watertight and abs(mesh.volume) > 0.0
+    if closed:
         body, watertight = mesh, True
     else:
         body, watertight = hull, False
