@@ -48,15 +48,15 @@ def compute_metrics(rollout: RolloutData) -> dict[str, float]:
     # 4-joint arm with one joint working reported half its torque); it is now the RMS of
     # max_j |tau_j|, the quantity the docstring names (the peak was already its maximum)
     arm = np.abs(rollout.tau[:, 6:])
-    joints = arm.max(axis=1) if arm.shape[1] else np.empty(0)  # no arm: peak 0, RMS NaN
     out.update(
         vehicle_force_peak_N=float(force.max()),
         vehicle_force_rms_N=_rms(force),
         vehicle_torque_peak_Nm=float(torque.max()),
         vehicle_torque_rms_Nm=_rms(torque),
-        joint_torque_peak_Nm=float(joints.max()) if joints.size else 0.0,
-        joint_torque_rms_Nm=_rms(joints),
     )
+    if arm.shape[1]:  # a vehicle without an arm has no joint torque metrics (not NaN, not 0)
+        joints = arm.max(axis=1)
+        out.update(joint_torque_peak_Nm=float(joints.max()), joint_torque_rms_Nm=_rms(joints))
     out.update(force_tracking_metrics(rollout))
     out.update(joint_limit_metrics(rollout))
     out.update(surface_metrics(rollout))
