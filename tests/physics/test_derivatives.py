@@ -174,11 +174,33 @@ def test_a_flow_without_second_order_kinematics_is_refused(reference_uvms):
         up.forward_dynamics_derivatives(reference_uvms, q, zero, zero, flow=Swirl())
 
 
+@pytest.mark.parametrize("backend", ["core", "python"])
+def test_bad_vectors_name_what_is_wrong(reference_uvms, backend):
+    """Shapes and values are checked by the reference and by the core alike (and through
+    the core's fallback to the reference in a flow it has no counterpart of)."""
+    q = reference_uvms.neutral_configuration()
+    zero = np.zeros(reference_uvms.nv)
+    bad = zero.copy()
+    bad[2] = math.nan
+    for flow in (None, FLOWS["sheared"]):
+        kw = {"backend": backend, "flow": flow}
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", up.errors.CoreFallbackWarning)
+            with pytest.raises(ParameterError, match="v must have shape"):
+                up.forward_dynamics_derivatives(reference_uvms, q, zero[:3], zero, **kw)
+            with pytest.raises(ParameterError, match=r"tau.*non-finite"):
+                up.forward_dynamics_derivatives(reference_uvms, q, zero, bad, **kw)
+            with pytest.raises(ParameterError, match="tau_ext must have shape"):
+                up.forward_dynamics_derivatives(
+                    reference_uvms, q, zero, zero, tau_ext=zero[:4], **kw
+                )
+            with pytest.raises(ParameterError, match="q must have shape"):
+                up.forward_dynamics_derivatives(reference_uvms, q[:5], zero, zero, **kw)
+
+
 def test_bad_arguments_name_what_is_wrong(reference_uvms):
     q = reference_uvms.neutral_configuration()
     zero = np.zeros(reference_uvms.nv)
-    with pytest.raises(ParameterError, match="v must have shape"):
-        up.forward_dynamics_derivatives(reference_uvms, q, zero[:3], zero)
     with pytest.raises(ParameterError, match="either current_world or flow"):
         up.forward_dynamics_derivatives(
             reference_uvms, q, zero, zero, current_world=np.ones(3), flow=FLOWS["current"]

@@ -195,15 +195,11 @@ def forward_dynamics_derivatives(
             dry) raises ParameterError (the wet-fraction terms are not differentiated).
     """
     dynamics = dynamics_of(uvms, backend)
-    current = _NO_CURRENT if current_world is None else current_world
-    water = _uniform_or(current, flow)
-    q, v = finite_vector("q", q, uvms.nq), finite_vector("v", v, uvms.nv)
-    tau = finite_vector("tau", tau, uvms.nv)
-    if tau_ext is not None:
-        tau_ext = finite_vector("tau_ext", tau_ext, uvms.nv)
+    water = _checked_flow(flow) if current_world is None else _uniform_or(current_world, flow)
     time_s = check_time(time_s)
     if free_surface:
-        require_deep(uvms, q, water, time_s)
+        require_deep(uvms, finite_vector("q", q, uvms.nq), water, time_s)
+    # q, v, tau and tau_ext are checked (shape, finite) by the reference and by the core
     if isinstance(dynamics, ReferenceDynamics):
         return reference_derivatives(uvms, q, v, tau, water, time_s, tau_ext)
     return dynamics.forward_dynamics_derivatives(q, v, tau, water, time_s, tau_ext)

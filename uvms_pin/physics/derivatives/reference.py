@@ -20,6 +20,7 @@ import numpy as np
 import pinocchio as pin
 from scipy.linalg import cho_factor, cho_solve
 
+from uvms_pin.checks import finite_vector
 from uvms_pin.errors import ParameterError, SimulationError
 from uvms_pin.flow import FlowField
 from uvms_pin.model.uvms import UVMS
@@ -81,7 +82,12 @@ def forward_dynamics_derivatives(
     tau_ext: np.ndarray | None = None,
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """(da/dq, da/dv, da/dtau) (nv x nv each) of the forward dynamics, q along the tangent;
-    ``tau_ext`` (a generalized force, nv) is held fixed."""
+    ``tau_ext`` (a generalized force, nv) is held fixed. ParameterError for a vector of the
+    wrong shape or with a non-finite entry."""
+    q, v = finite_vector("q", q, uvms.nq), finite_vector("v", v, uvms.nv)
+    tau = finite_vector("tau", tau, uvms.nv)
+    if tau_ext is not None:
+        tau_ext = finite_vector("tau_ext", tau_ext, uvms.nv)
     a = ReferenceDynamics(uvms).forward_dynamics_in(q, v, tau, flow, time_s, tau_ext)
     did_dq, did_dv, mass, _ = inverse_dynamics_derivatives(uvms, q, v, a, flow, time_s)
     inverse = inverse_of_mass(mass, q)
