@@ -48,6 +48,10 @@ def main(argv: list[str] | None = None) -> int:
         for name, what in PRODUCERS.items():
             print(f"{name:<26} {what}")
         return 0
+    sys.path.insert(0, str(ROOT / "scripts" / "results"))
+    from _common import refuse_shortened_runs
+
+    refuse_shortened_runs()
     names = [n for n in (args.only or PRODUCERS) if n not in args.skip]
     failed = []
     for name in names:

@@ -35,6 +35,11 @@ class ModelWarning(UvmsPinWarning):
     """
 
 
+class ShortenedRunWarning(UvmsPinWarning):
+    """A scenario runs shorter than its ``duration_s`` because ``UVMS_PIN_MAX_DURATION_S``
+    is set (`uvms_pin.sim.shortened`); the message names the file and both durations."""
+
+
 class ParameterError(UvmsPinError, ValueError):
     """An argument has the wrong shape, a non-finite value or is out of its valid range."""
 

@@ -66,6 +66,7 @@ def _cmd_run(args: argparse.Namespace) -> int:
     metrics = rollout.metrics()
     print(
         f"scenario {scenario.name}: {rollout.metadata['status']}, simulated {metrics['simulated_time_s']:.3f} s in {metrics['wall_time_s']:.2f} s (real-time factor {metrics['real_time_factor']:.2f})"
+        + _shortened_note(scenario)
     )
     print(
         f"wrote {out}/rollout.npz, rollout.json, metrics.json, "
@@ -74,6 +75,15 @@ def _cmd_run(args: argparse.Namespace) -> int:
     if status:
         print(message, file=sys.stderr)
     return status
+
+
+def _shortened_note(scenario) -> str:
+    """What the run line adds for a run `UVMS_PIN_MAX_DURATION_S` shortened."""
+    if scenario.shortened_from_s is None:
+        return ""
+    from uvms_pin.sim.shortened import MAX_DURATION_ENV
+
+    return f", SHORTENED from {scenario.shortened_from_s:g} s by {MAX_DURATION_ENV}"
 
 
 def _simulate_to_end(scenario, args: argparse.Namespace) -> tuple[Rollout | None, int, str]:
