@@ -21,6 +21,7 @@ PRODUCERS = {
     "paper": "the paper's scenario: docs/results/paper.md, docs/paper_force.png",
     "realistic": "the realistic scenario: docs/results/realistic.md, docs/realistic_force.png",
     "robustness": "robustness table: docs/results/robustness.md",
+    "station_keeping": "your own controller (a PD): docs/results/station_keeping.md",
     "bench": "benchmark table: docs/results/bench.md",
     "bench_mujoco": "uvms-pin vs MuJoCo: docs/results/bench_mujoco.md",
     "bench_controller": "controller benchmark: docs/results/bench_controller.md",

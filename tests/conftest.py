@@ -120,6 +120,18 @@ def free_body_state(uvms: up.UVMS) -> np.ndarray:
     return pin.neutral(uvms.model)
 
 
+# ---- the documentation's snippets (tests/test_docs_run.py): what ran, what was skipped
+DOCS_RUN_SUMMARY = pytest.StashKey[list]()
+
+
+def pytest_terminal_summary(terminalreporter, exitstatus, config):
+    lines = config.stash.get(DOCS_RUN_SUMMARY, None)
+    if lines:
+        terminalreporter.section("documentation snippets")
+        for line in lines:
+            terminalreporter.write_line(line)
+
+
 # ---- the command line as a user runs it, and relative comparisons (used across folders)
 def uvms_pin_command() -> list[str]:
     exe = Path(sys.executable).with_name("uvms-pin")

@@ -133,4 +133,3 @@ def test_published_results_refuse_shortened_runs(script, tmp_path):
 
 def _environment() -> dict[str, str]:
     return {k: v for k, v in os.environ.items() if k != MAX_DURATION_ENV}
-
