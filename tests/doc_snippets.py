@@ -50,7 +50,7 @@ NEEDS = ("chromium", "network")
 
 _FENCE = re.compile(r"^(?P<indent> {0,3})(?P<fence>`{3,}|~{3,})\s*(?P<info>[^`\s]*)")
 _DIRECTIVE = re.compile(r"^\s*<!--\s*doc-test:\s*(?P<kind>[\w-]+)\s*:\s*(?P<value>.*?)\s*-->\s*$")
-_ANY_DIRECTIVE = re.compile(r"<!--\s*doc-test\b")
+_ANY_DIRECTIVE = re.compile(r"^\s*<!--\s*doc-test\b")
 
 
 @dataclass(frozen=True)

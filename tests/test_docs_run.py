@@ -11,11 +11,13 @@ from __future__ import annotations
 
 import json
 import os
+import re
 import shlex
 import shutil
 import socket
 import subprocess
 import sys
+from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
 
 import pytest
@@ -121,15 +123,17 @@ def run_document(doc: str, snippets: list[Snippet], copy: Path, work: Path) -> d
     return found
 
 
-@pytest.fixture(scope="session")
-def doc_run(tmp_path_factory, pytestconfig) -> dict[str, dict]:
-    """Every document's snippets, run once: snippet id -> result (or skip reason)."""
-    base = tmp_path_factory.mktemp("docs_run")
+def lanes(docs: list[str]) -> list[list[str]]:
+    """The README, and the other documents after one another: two lanes that run side by
+    side, each in its own working copy (the suite is serial: this uses the second core).
+    Blocks of different lanes never share an output (`test_no_two_blocks_write_one_output`)."""
+    return [docs[:1], docs[1:]]
+
+
+def run_lane(docs: list[str], base: Path, available: dict[str, bool]) -> dict[str, dict]:
     copy = working_copy(base / "repository")
-    available = {"chromium": bool(shutil.which("chromium") or shutil.which("chromium-browser"))}
-    available["network"] = any("network" in s.needs for s in SNIPPETS) and _network()
     results: dict[str, dict] = {}
-    for doc in documents(ROOT):
+    for doc in docs:
         runnable = []
         for snippet in (s for s in SNIPPETS if s.doc == doc):
             reason = skip_reason(snippet, copy, available)
@@ -139,6 +143,21 @@ def doc_run(tmp_path_factory, pytestconfig) -> dict[str, dict]:
                 runnable.append(snippet)
         if runnable:
             results.update(run_document(doc, runnable, copy, base))
+    return results
+
+
+@pytest.fixture(scope="session")
+def doc_run(tmp_path_factory, pytestconfig) -> dict[str, dict]:
+    """Every document's snippets, run once: snippet id -> result (or skip reason)."""
+    available = {"chromium": bool(shutil.which("chromium") or shutil.which("chromium-browser"))}
+    available["network"] = any("network" in s.needs for s in SNIPPETS) and _network()
+    groups = lanes(documents(ROOT))
+    with ThreadPoolExecutor(len(groups)) as pool:
+        runs = [
+            pool.submit(run_lane, docs, tmp_path_factory.mktemp("docs_run"), available)
+            for docs in groups
+        ]
+        results = {k: v for run in runs for k, v in run.result().items()}
     pytestconfig.stash[DOCS_RUN_SUMMARY] = _summary(results)
     return results
 
@@ -153,6 +172,11 @@ def _summary(results: dict[str, dict]) -> list[str]:
         result = results[snippet.id]
         if result["status"] == "skipped":
             lines.append(f"  skipped {snippet.id} ({snippet.language}): {result['reason']}")
+        else:
+            took = "not run"
+            if "seconds" in result:
+                took = f"{result['seconds']:.1f} s ({result['cpu_seconds']:.1f} s CPU)"
+            lines.append(f"  {result['status']} {snippet.id} ({snippet.language}): {took}")
         if snippet.placeholders:
             names = ", ".join(f"{name} (stand-in: {stand_in})" for name, stand_in in snippet.placeholders)  # fmt: skip
             lines.append(f"  placeholders {snippet.id}: {names}")
@@ -184,8 +208,6 @@ def test_the_documents_have_runnable_blocks():
 def _inline_commands() -> list[tuple[str, str]]:
     """(document, command) for every inline ``uvms-pin ...`` naming a repository path (a
     command to copy, not a mention such as `uvms-pin run`)."""
-    import re
-
     found = []
     for doc in documents(ROOT):
         for command in re.findall(r"`(uvms-pin [^`]+)`", (ROOT / doc).read_text()):
@@ -202,3 +224,39 @@ def test_inline_commands_are_complete(doc, command, capsys):
         build_parser().parse_args(shlex.split(command)[1:])
     except SystemExit:
         pytest.fail(f"{doc}: `{command}` does not parse: {capsys.readouterr().err.strip()}")
+
+
+# ---- outputs: no two blocks write the same place -----------------------------------------
+def outputs_written(snippet: Snippet) -> list[str]:
+    """Where a block writes, in order: ``--out DIR`` (and DIR/replay.html with ``--html``),
+    ``replay DIR --html`` (DIR/replay.html), ``.save("DIR")``; commands with --overwrite
+    aside."""
+    if snippet.language == "python":
+        return re.findall(r"\.save\(\s*[\"']([^\"']+)[\"']", snippet.code)
+    written = []
+    for line in snippet.code.replace("\\\n", " ").splitlines():
+        words = shlex.split(line.removeprefix("$ "), comments=True)
+        if "--overwrite" in words:
+            continue
+        out = words[words.index("--out") + 1].rstrip("/") if "--out" in words else None
+        if out:
+            written.append(out)
+        if "--html" in words and out and words[1:2] == ["run"]:
+            written.append(f"{out}/replay.html")
+        if words[:2] == ["uvms-pin", "replay"] and "--html" in words and not out:
+            written.append(f"{words[2].rstrip('/')}/replay.html")
+    return written
+
+
+def test_no_two_blocks_write_one_output():
+    """A reader runs the README and then the docs in one clone: no block may write where an
+    earlier one did (`uvms-pin` refuses a directory holding a run, and says so)."""
+    first: dict[str, str] = {}
+    clashes = []
+    for snippet in (s for s in SNIPPETS if not s.skip):
+        for path in outputs_written(snippet):
+            if path in first:
+                clashes.append(f"{snippet.id} writes {path}, as {first[path]} does")
+            first.setdefault(path, snippet.id)
+    assert len(first) >= 15, sorted(first)  # the outputs are found
+    assert not clashes, clashes
