@@ -4,8 +4,11 @@ snippet's failure, a false assert or a missing output is reported as a failure."
 
 from __future__ import annotations
 
+import sys
+
 import pytest
 from doc_snippets import (
+    OLD_PATHS_ARE_ERRORS,
     DirectiveError,
     Snippet,
     console_commands,
@@ -156,3 +159,13 @@ def test_a_console_block_must_print_what_it_shows(tmp_path, monkeypatch):
     )
     wrong = run_snippet(_snippet("console", "$ echo 4.44e-16\n2.22e-16\n"), {})
     assert wrong["status"] == "failed" and "but it printed" in wrong["stderr"]
+
+
+def test_an_old_module_path_fails_a_block(tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    monkeypatch.setenv("PYTHONWARNINGS", OLD_PATHS_ARE_ERRORS)
+    python = sys.executable
+    new = run_snippet(_snippet("bash", f"{python} -c 'import uvms_pin.apps.gym'\n"), {})
+    assert new["status"] == "passed", new
+    old = run_snippet(_snippet("bash", f"{python} -c 'import uvms_pin.gym'\n"), {})
+    assert old["status"] == "failed" and "moved to uvms_pin.apps.gym" in old["stderr"]

@@ -22,7 +22,7 @@ from pathlib import Path
 
 import pytest
 from conftest import DOCS_RUN_SUMMARY, ROOT
-from doc_snippets import CAP_S, Snippet, all_snippets, documents
+from doc_snippets import CAP_S, OLD_PATHS_ARE_ERRORS, Snippet, all_snippets, documents
 
 from uvms_pin.apps.cli.main import build_parser
 from uvms_pin.sim.shortened import MAX_DURATION_ENV
@@ -58,10 +58,12 @@ def working_copy(destination: Path) -> Path:
 
 
 def environment() -> dict[str, str]:
-    """This interpreter's scripts first on PATH, figures without a display, runs capped."""
+    """This interpreter's scripts first on PATH, figures without a display, runs capped,
+    old module paths refused."""
     env = dict(os.environ)
     env["PATH"] = os.pathsep.join([str(Path(sys.executable).parent), env.get("PATH", "")])
     env.update({MAX_DURATION_ENV: CAP_S, "MPLBACKEND": "Agg", "PYTHONUNBUFFERED": "1"})
+    env["PYTHONWARNINGS"] = OLD_PATHS_ARE_ERRORS
     env.pop("PYTHONPATH", None)
     return env
 
