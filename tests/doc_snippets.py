@@ -24,6 +24,8 @@ on GitHub, visible in the source), one per line:
     <!-- doc-test: output: TEXT -->                 TEXT appears in what the block prints
     <!-- doc-test: assert: EXPRESSION -->           python: true in the block's namespace
                                                     after it ran (a number the text quotes)
+    <!-- doc-test: same-as: DOC -->                 not run: a block of DOC runs the same
+                                                    commands (comments aside; checked)
 
 An unknown directive, or one that is not right above a runnable block, is an error.
 """
@@ -31,6 +33,7 @@ An unknown directive, or one that is not right above a runnable block, is an err
 from __future__ import annotations
 
 import re
+import shlex
 from dataclasses import asdict, dataclass
 from pathlib import Path
 
@@ -48,7 +51,7 @@ LANGUAGES = {
     "shell": "bash",
     "console": "console",
 }
-DIRECTIVES = ("skip", "needs", "placeholder", "output", "assert")
+DIRECTIVES = ("skip", "needs", "placeholder", "output", "assert", "same-as")
 NEEDS = ("chromium", "network")
 
 _FENCE = re.compile(r"^(?P<indent> {0,3})(?P<fence>`{3,}|~{3,})\s*(?P<info>[^`\s]*)")
@@ -66,6 +69,7 @@ class Snippet:
         skip: why it is not run (None: it runs). needs: "chromium" / "network".
         placeholders: (file the reader supplies, the repository file standing in for it).
         outputs: texts its output contains. asserts: python expressions that hold after it.
+        same_as: a document with a block of the same commands, run instead of this one.
     """
 
     doc: str
@@ -77,6 +81,7 @@ class Snippet:
     placeholders: tuple[tuple[str, str], ...] = ()
     outputs: tuple[str, ...] = ()
     asserts: tuple[str, ...] = ()
+    same_as: str | None = None
 
     @property
     def id(self) -> str:
@@ -168,8 +173,8 @@ def _snippet(doc: str, line: int, language: str, code: str, directives: list[tup
         where = f"{doc}:{at}"
         if not value:
             raise DirectiveError(f"{where}: doc-test {kind} needs a value")
-        if kind == "skip":
-            fields["skip"] = value
+        if kind in ("skip", "same-as"):
+            fields[kind.replace("-", "_")] = value
         elif kind == "needs":
             if value not in NEEDS:
                 raise DirectiveError(f"{where}: needs: one of {', '.join(NEEDS)}, got {value!r}")
@@ -214,3 +219,14 @@ def output_matches(shown: str, printed: str) -> bool:
 
     pattern = ".*?".join(re.escape(part) for part in tidy(shown).split("..."))
     return re.fullmatch(pattern, tidy(printed), flags=re.DOTALL) is not None
+
+
+def commands(snippet: Snippet) -> list[list[str]]:
+    """A shell or console block's commands as words: comments, prompts, the output a
+    console block shows and line continuations aside."""
+    if snippet.language == "console":
+        texts = [command for command, _ in console_commands(snippet.code)]
+    else:
+        texts = [snippet.code]
+    lines = (line for text in texts for line in text.replace("\\\n", " ").splitlines())
+    return [words for words in (shlex.split(line, comments=True) for line in lines) if words]

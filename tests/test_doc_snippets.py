@@ -11,6 +11,7 @@ from doc_snippets import (
     OLD_PATHS_ARE_ERRORS,
     DirectiveError,
     Snippet,
+    commands,
     console_commands,
     output_matches,
     parse_markdown,
@@ -169,3 +170,15 @@ def test_an_old_module_path_fails_a_block(tmp_path, monkeypatch):
     assert new["status"] == "passed", new
     old = run_snippet(_snippet("bash", f"{python} -c 'import uvms_pin.gym'\n"), {})
     assert old["status"] == "failed" and "moved to uvms_pin.apps.gym" in old["stderr"]
+
+
+def test_commands_leave_out_comments_prompts_and_shown_output():
+    bash = _snippet(
+        "bash", "uvms-pin sweep a.toml \\\n    --out out/a   # or: --scheduler X\n\n# note\n"
+    )
+    same = _snippet("bash", "uvms-pin sweep a.toml --out out/a\n")
+    assert commands(bash) == commands(same) == [["uvms-pin", "sweep", "a.toml", "--out", "out/a"]]
+    console = _snippet("console", "$ echo 'a b'  # says a b\na b (it's printed)\n")
+    assert commands(console) == [["echo", "a b"]]
+    found = parse_markdown("<!-- doc-test: same-as: docs/x.md -->\n```bash\ntrue\n```\n", "d.md")
+    assert found[0].same_as == "docs/x.md" and found[0].skip is None

@@ -22,7 +22,14 @@ from pathlib import Path
 
 import pytest
 from conftest import DOCS_RUN_SUMMARY, ROOT
-from doc_snippets import CAP_S, OLD_PATHS_ARE_ERRORS, Snippet, all_snippets, documents
+from doc_snippets import (
+    CAP_S,
+    OLD_PATHS_ARE_ERRORS,
+    Snippet,
+    all_snippets,
+    commands,
+    documents,
+)
 
 from uvms_pin.apps.cli.main import build_parser
 from uvms_pin.sim.shortened import MAX_DURATION_ENV
@@ -90,6 +97,8 @@ def _install_is_current(copy: Path) -> str | None:
 def skip_reason(snippet: Snippet, copy: Path, available: dict[str, bool]) -> str | None:
     if snippet.skip:
         return snippet.skip
+    if snippet.same_as:
+        return f"the same commands as {same_block(snippet).id}, which runs them"
     for need in snippet.needs:
         if not available[need]:
             return f"needs {need}, not available here"
@@ -228,6 +237,20 @@ def test_inline_commands_are_complete(doc, command, capsys):
         pytest.fail(f"{doc}: `{command}` does not parse: {capsys.readouterr().err.strip()}")
 
 
+def same_block(snippet: Snippet) -> Snippet:
+    """The runnable block of ``snippet.same_as`` with ``snippet``'s commands."""
+    for other in SNIPPETS:
+        runs = not (other.skip or other.same_as) and other.language != "python"
+        if other.doc == snippet.same_as and runs and commands(other) == commands(snippet):
+            return other
+    raise AssertionError(f"{snippet.id}: no block of {snippet.same_as} runs its commands")
+
+
+def test_a_block_said_to_be_the_same_as_another_is():
+    for snippet in (s for s in SNIPPETS if s.same_as):
+        assert same_block(snippet).id.startswith(snippet.same_as)
+
+
 # ---- outputs: no two blocks write the same place -----------------------------------------
 def outputs_written(snippet: Snippet) -> list[str]:
     """Where a block writes, in order: ``--out DIR`` (and DIR/replay.html with ``--html``),
@@ -236,8 +259,7 @@ def outputs_written(snippet: Snippet) -> list[str]:
     if snippet.language == "python":
         return re.findall(r"\.save\(\s*[\"']([^\"']+)[\"']", snippet.code)
     written = []
-    for line in snippet.code.replace("\\\n", " ").splitlines():
-        words = shlex.split(line.removeprefix("$ "), comments=True)
+    for words in commands(snippet):
         if "--overwrite" in words:
             continue
         out = words[words.index("--out") + 1].rstrip("/") if "--out" in words else None
@@ -255,7 +277,7 @@ def test_no_two_blocks_write_one_output():
     earlier one did (`uvms-pin` refuses a directory holding a run, and says so)."""
     first: dict[str, str] = {}
     clashes = []
-    for snippet in (s for s in SNIPPETS if not s.skip):
+    for snippet in (s for s in SNIPPETS if not (s.skip or s.same_as)):
         for path in outputs_written(snippet):
             if path in first:
                 clashes.append(f"{snippet.id} writes {path}, as {first[path]} does")
