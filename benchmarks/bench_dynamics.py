@@ -80,6 +80,37 @@ def call_rows(uvms: up.UVMS, repeat: int) -> dict[str, float]:
     return best_times(cases, repeat)
 
 
+def surface_rows(uvms: up.UVMS, repeat: int) -> dict[str, float]:
+    """Seconds per control period of the compiled plant with and without a free surface,
+    every body deep (the vehicle 3 m down) and the vehicle at the surface (its origin at
+    z = 0: the hull and the arm's first links cut by it)."""
+    rng = np.random.default_rng(0)
+    q = uvms.neutral_configuration()
+    q[7:] = [0.1, 0.6, -0.5, 0.2]
+    v = rng.normal(scale=0.3, size=uvms.nv)
+    tau = rng.normal(size=uvms.nv)
+    current = np.array([0.3, 0.1, 0.0])
+    rk4 = RK4(5e-4)
+    cases = {}
+    for where, z in (("deep", -3.0), ("at the surface", 0.0)):
+        at = q.copy()
+        at[2] = z
+        for surface in (False, True):
+            plant = Plant(
+                uvms,
+                current,
+                LinearSpring(np.full(3, 2.0)),
+                SinusoidalDisturbance(),
+                free_surface=surface,
+            )
+            plant.attach(at)
+            label = "free surface" if surface else "no surface"
+            cases[f"core: plant over 2 ms, {where}, {label}"] = lambda p=plant, a=at: p.advance(
+                rk4, 0.0, a, v, tau, 0.002
+            )
+    return best_times(cases, repeat)
+
+
 def closed_loop_rows(duration_s: float) -> dict[str, dict[str, float]]:
     """Real-time factor and wall time per control tick of the shipped scenarios."""
     out = {}
@@ -118,7 +149,7 @@ def main() -> None:
     one_blas_thread()
 
     uvms = up.load_uvms(ROOT / "models" / "uvms_lbv150.urdf")
-    calls = call_rows(uvms, args.repeat)
+    calls = {**call_rows(uvms, args.repeat), **surface_rows(uvms, args.repeat)}
     floor = calls["pin.aba (rigid floor)"]
     width = max(len(n) for n in calls)
     print(f"{'case':<{width}}  {'x pin.aba':>10}  {'us/call':>10}")
@@ -131,6 +162,12 @@ def main() -> None:
         calls["core: plant over 2 ms (RK4 0.5 ms)"] / calls["core: plant over 2 ms, arm links dry"]
     )
     print(f"core plant, every body in water / only the vehicle in water: {wet:.2f}x")
+    for where in ("deep", "at the surface"):
+        ratio = (
+            calls[f"core: plant over 2 ms, {where}, free surface"]
+            / calls[f"core: plant over 2 ms, {where}, no surface"]
+        )
+        print(f"core plant {where}, with a free surface / without: {ratio:.2f}x")
 
     loops = closed_loop_rows(args.loop_s)
     width = max(len(n) for n in loops)

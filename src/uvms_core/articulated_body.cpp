@@ -125,7 +125,10 @@ void Dynamics::articulated_bodies() {
     const auto& inertia = model_.inertias[i];
     const pinocchio::Motion& velocity = data_.v[i];
     const pinocchio::Motion gravity_local = data_.oMi[i].actInv(model_.gravity);
-    inertia_a_[i] = body_inertia_[i];
+    // under a free surface, the body's wet added mass
+    inertia_a_[i] = wet_active_ && wet_touched_[i]
+                        ? Mat6(model_.inertias[i].matrix() + wet_added_mass_[i])
+                        : body_inertia_[i];
     bias_a_[i] = velocity.cross(inertia * velocity).toVector() -
                  (inertia * gravity_local).toVector() - fext_[i].toVector();
     // velocity-product acceleration of joint i: a_bias,i - X_i a_bias,parent

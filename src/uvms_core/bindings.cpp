@@ -78,11 +78,51 @@ void check_finite(const char* name, const Struct& values) {
 
 // ---- the dynamics (dynamics.hpp) ---------------------------------------------------------
 
+void bind_hulls(nb::module_& m) {
+  nb::enum_<uvms::ShapeKind>(m, "ShapeKind", "The shape of a hull piece (hull.hpp).")
+      .value("sphere", uvms::ShapeKind::sphere)
+      .value("ellipsoid", uvms::ShapeKind::ellipsoid)
+      .value("cylinder", uvms::ShapeKind::cylinder)
+      .value("polyhedron", uvms::ShapeKind::polyhedron);
+  nb::class_<uvms::HullPiece>(m, "HullPiece", "One shape placed in a body frame (hull.hpp).")
+      .def(nb::init<>())
+      .def_rw("kind", &uvms::HullPiece::kind)
+      .def_rw("size", &uvms::HullPiece::size)
+      .def_rw("vertices", &uvms::HullPiece::vertices)
+      .def_rw("triangles", &uvms::HullPiece::triangles)
+      .def_rw("rotation", &uvms::HullPiece::rotation)
+      .def_rw("translation_m", &uvms::HullPiece::translation_m)
+      .def(
+          "below",
+          [](const uvms::HullPiece& piece, const uvms::Vec3& normal, double depth) {
+            const uvms::WetPart part = piece.below(normal, depth);
+            return nb::make_tuple(part.volume_m3, uvms::Vec3(part.moment_m4),
+                                  part.waterplane_area_m2, uvms::Vec3(part.waterplane_moment_m3));
+          },
+          "normal"_a, "depth_m"_a,
+          "(V, M, A, M_A) of the part below n . x = d, body frame (submerged.hpp)");
+  nb::class_<uvms::Hull>(m, "Hull", "The shapes of one body, fitted to its volume (hull.hpp).")
+      .def(nb::init<>())
+      .def_rw("pieces", &uvms::Hull::pieces)
+      .def_rw("volume_scale", &uvms::Hull::volume_scale)
+      .def_rw("geometric_volume_m3", &uvms::Hull::geometric_volume_m3)
+      .def_rw("bound_center_m", &uvms::Hull::bound_center_m)
+      .def_rw("bound_radius_m", &uvms::Hull::bound_radius_m);
+  nb::class_<uvms::SurfaceBody>(m, "SurfaceBody", "A hull on a joint (hydro_bodies.hpp).")
+      .def(nb::init<>())
+      .def_rw("joint_id", &uvms::SurfaceBody::joint_id)
+      .def_rw("hull", &uvms::SurfaceBody::hull)
+      .def_rw("volume_m3", &uvms::SurfaceBody::volume_m3)
+      .def_rw("center_of_buoyancy_in_joint_m", &uvms::SurfaceBody::center_of_buoyancy_in_joint_m)
+      .def_rw("added_mass_in_joint", &uvms::SurfaceBody::added_mass_in_joint);
+}
+
 void bind_hydro_bodies(nb::module_& m) {
   nb::class_<uvms::DampedBody>(m, "DampedBody",
                                "One damped link on a joint (hydro_bodies.hpp, DampedBody).")
       .def(nb::init<>())
       .def_rw("joint_id", &uvms::DampedBody::joint_id)
+      .def_rw("hull_index", &uvms::DampedBody::hull_index)
       .def_rw("action_joint_to_body", &uvms::DampedBody::action_joint_to_body)
       .def_rw("rotation_in_joint", &uvms::DampedBody::rotation_in_joint)
       .def_rw("position_in_joint_m", &uvms::DampedBody::position_in_joint_m)
@@ -96,7 +136,10 @@ void bind_hydro_bodies(nb::module_& m) {
       .def_rw("volume_per_joint_m3", &uvms::HydroBodies::volume_per_joint_m3)
       .def_rw("center_of_buoyancy_per_joint_m",
               &uvms::HydroBodies::center_of_buoyancy_per_joint_m)
-      .def_rw("damped_bodies", &uvms::HydroBodies::damped_bodies);
+      .def_rw("damped_bodies", &uvms::HydroBodies::damped_bodies)
+      .def_rw("surface_bodies", &uvms::HydroBodies::surface_bodies)
+      .def_rw("added_mass_without_hull_per_joint",
+              &uvms::HydroBodies::added_mass_without_hull_per_joint);
 }
 
 void bind_flow(nb::module_& m) {
@@ -146,6 +189,14 @@ void bind_dynamics(nb::module_& m) {
           },
           "q"_a.none())
       .def(
+          "mass_matrix_in",
+          [](Dynamics& d, nb::handle q_obj, const std::optional<uvms::FlowField>& flow,
+             double time_s, bool free_surface) -> Eigen::MatrixXd {
+            UVMS_VECTOR(q, d.nq());
+            return d.mass_matrix_in(q, flow_or_still(flow), time_s, free_surface);
+          },
+          "q"_a.none(), "flow"_a.none(), "time_s"_a, "free_surface"_a = false)
+      .def(
           "bias_forces",
           [](Dynamics& d, nb::handle q_obj, nb::handle v_obj,
              nb::handle current_world_obj) -> Eigen::VectorXd {
@@ -157,12 +208,13 @@ void bind_dynamics(nb::module_& m) {
       .def(
           "bias_forces_in",
           [](Dynamics& d, nb::handle q_obj, nb::handle v_obj,
-             const std::optional<uvms::FlowField>& flow, double time_s) -> Eigen::VectorXd {
+             const std::optional<uvms::FlowField>& flow, double time_s,
+             bool free_surface) -> Eigen::VectorXd {
             UVMS_VECTOR(q, d.nq());
             UVMS_VECTOR(v, d.nv());
-            return d.bias_forces(q, v, flow_or_still(flow), time_s);
+            return d.bias_forces(q, v, flow_or_still(flow), time_s, free_surface);
           },
-          "q"_a.none(), "v"_a.none(), "flow"_a.none(), "time_s"_a)
+          "q"_a.none(), "v"_a.none(), "flow"_a.none(), "time_s"_a, "free_surface"_a = false)
       .def(
           "forward_dynamics",
           [](Dynamics& d, nb::handle q_obj, nb::handle v_obj, nb::handle tau_obj,
@@ -181,18 +233,20 @@ void bind_dynamics(nb::module_& m) {
           "forward_dynamics_in",
           [](Dynamics& d, nb::handle q_obj, nb::handle v_obj, nb::handle tau_obj,
              const std::optional<uvms::FlowField>& flow, double time_s,
-             nb::handle tau_ext_obj) -> Eigen::VectorXd {
+             nb::handle tau_ext_obj, bool free_surface) -> Eigen::VectorXd {
             UVMS_VECTOR(q, d.nq());
             UVMS_VECTOR(v, d.nv());
             UVMS_VECTOR(tau, d.nv());
             if (tau_ext_obj.is_none()) {
-              return d.forward_dynamics(q, v, tau, flow_or_still(flow), nullptr, time_s);
+              return d.forward_dynamics(q, v, tau, flow_or_still(flow), nullptr, time_s,
+                                        free_surface);
             }
             UVMS_VECTOR(tau_ext, d.nv());
             const ConstVec ext(tau_ext);
-            return d.forward_dynamics(q, v, tau, flow_or_still(flow), &ext, time_s);
+            return d.forward_dynamics(q, v, tau, flow_or_still(flow), &ext, time_s, free_surface);
           },
-          "q"_a.none(), "v"_a.none(), "tau"_a.none(), "flow"_a.none(), "time_s"_a, "tau_ext"_a.none() = nb::none());
+          "q"_a.none(), "v"_a.none(), "tau"_a.none(), "flow"_a.none(), "time_s"_a, "tau_ext"_a.none() = nb::none(),
+          "free_surface"_a = false);
 }
 
 // ---- the environment (contact.hpp, disturbance.hpp) and the integrators -----------------
@@ -232,6 +286,7 @@ void bind_plant(nb::module_& m) {
   nb::class_<Plant>(m, "Plant", "A UVMS in water, touching and pushed (plant.hpp).")
       .def(nb::init<const uvms::Dynamics&, int>(), "dynamics"_a, "ee_frame_id"_a)
       .def_rw("flow", &Plant::flow)
+      .def_rw("free_surface", &Plant::free_surface)
       .def_rw("contact", &Plant::contact)
       .def_rw("disturbance", &Plant::disturbance)
       .def(
@@ -380,6 +435,7 @@ NB_MODULE(_core, m) {
     }
   });
 
+  bind_hulls(m);
   bind_hydro_bodies(m);
   bind_flow(m);
   bind_dynamics(m);

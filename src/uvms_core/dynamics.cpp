@@ -23,7 +23,13 @@ Dynamics::Dynamics(Model model, HydroBodies hydro)
       throw InputError("damped body on joint " + std::to_string(body.joint_id) +
                        ", which the model does not have");
     }
+    if (body.hull_index < -1 ||
+        body.hull_index >= static_cast<int>(hydro_.surface_bodies.size())) {
+      throw InputError("damped body with hull " + std::to_string(body.hull_index) +
+                       ", which the bodies do not have");
+    }
   }
+  check_surface_bodies();
   prepare();
 }
 
@@ -48,6 +54,21 @@ void Dynamics::prepare() {
     if (count == width) support_width_[j] = width;
   }
   fext_.assign(nj, pinocchio::Force::Zero());
+  const std::size_t n_hulls = hydro_.surface_bodies.size();
+  wet_volume_.assign(nj, 0.0);
+  wet_cob_.assign(nj, Vec3::Zero());
+  wet_added_mass_.assign(nj, Mat6::Zero());
+  wet_touched_.assign(nj, 0);
+  relative_velocity_.assign(nj, Vec6::Zero());
+  deep_.assign(n_hulls, 0);
+  dry_.assign(n_hulls, 0);
+  surface_.assign(n_hulls, SurfaceAt{});
+  fraction_.assign(n_hulls, 1.0);
+  fraction_rate_.assign(n_hulls, 0.0);
+  hull_volume_.assign(n_hulls, 0.0);
+  fraction_gradient_.assign(n_hulls, Vec6::Zero());
+  hull_moment_.assign(n_hulls, Vec3::Zero());
+  cut_.reserve(n_hulls);
   zero_ = Eigen::VectorXd::Zero(nv);
   h_ = Eigen::VectorXd::Zero(nv);
   rhs_ = Eigen::VectorXd::Zero(nv);
@@ -64,30 +85,36 @@ void Dynamics::kinematics(const ConstVec& q, const ConstVec& v) {
 }
 
 void Dynamics::fluid_wrenches(double time_s, const FlowField& flow,
-                              bool with_bias_acceleration) {
+                              bool with_bias_acceleration, bool free_surface) {
   for (auto& f : fext_) f.setZero();
+  update_wet_state(time_s, flow, free_surface);
   const Vec3 gravity = model_.gravity.linear();
+  if (wet_active_) {
+    for (int h : cut_) {
+      const int j = hydro_.surface_bodies[h].joint_id;
+      relative_velocity_[j] = data_.v[j].toVector();
+    }
+  }
   // the flow is sampled at each joint body's centre of buoyancy (its origin without volume)
   for (int j : joints_with_added_mass_) {
     const auto& placement = data_.oMi[j];
     const Vec6 velocity = data_.v[j].toVector();
-    const FlowInBody seen = flow_in_body(
-        flow.at(time_s, placement.act(hydro_.center_of_buoyancy_per_joint_m[j])),
-        placement.rotation(), velocity.tail<3>());
+    const FlowInBody seen = flow_in_body(flow.at(time_s, placement.act(center_of_buoyancy(j))),
+                                         placement.rotation(), velocity.tail<3>());
     const Vec6 bias = with_bias_acceleration ? data_.a[j].toVector() : Vec6::Zero();
-    fext_[j].toVector() +=
-        added_mass_wrench(hydro_.added_mass_per_joint[j], bias, velocity, seen);
+    fext_[j].toVector() += added_mass_wrench(added_mass(j), bias, velocity, seen);
+    relative_velocity_[j] = velocity - seen.velocity;
   }
+  if (wet_active_) add_wet_fraction_wrenches();
   const bool accelerating = !flow.waves.empty();  // else Du/Dt = 0: no Froude-Krylov
   for (int j : joints_with_volume_) {
     const auto& placement = data_.oMi[j];
-    const Vec3& cob = hydro_.center_of_buoyancy_per_joint_m[j];
-    fext_[j].toVector() += buoyancy_wrench(hydro_.volume_per_joint_m3[j], cob,
-                                           placement.rotation(), hydro_.water_density_kg_m3,
-                                           gravity);
+    const Vec3& cob = center_of_buoyancy(j);
+    fext_[j].toVector() += buoyancy_wrench(volume(j), cob, placement.rotation(),
+                                           hydro_.water_density_kg_m3, gravity);
     if (accelerating) {
       fext_[j].toVector() += froude_krylov_wrench(
-          hydro_.volume_per_joint_m3[j], cob, placement.rotation(), hydro_.water_density_kg_m3,
+          volume(j), cob, placement.rotation(), hydro_.water_density_kg_m3,
           flow.at(time_s, placement.act(cob)).acceleration_world);
     }
   }
@@ -97,8 +124,8 @@ void Dynamics::fluid_wrenches(double time_s, const FlowField& flow,
     const Vec3 point = placement.act(body.position_in_joint_m);
     const Vec6 nu_r = body.action_joint_to_body * data_.v[body.joint_id].toVector() -
                       flow_velocity_in_body(flow.at(time_s, point), rotation);
-    const Vec6 wrench_body =
-        damping_wrench(body.linear_damping, body.quadratic_damping, nu_r);
+    Vec6 wrench_body = damping_wrench(body.linear_damping, body.quadratic_damping, nu_r);
+    if (wet_active_) wrench_body *= damping_fraction(body);  // drag of the wet part
     fext_[body.joint_id].toVector() += body.action_joint_to_body.transpose() * wrench_body;
   }
 }
@@ -123,6 +150,18 @@ const Eigen::VectorXd& Dynamics::bias_from_wrenches(const ConstVec& q,
 }
 
 const Eigen::MatrixXd& Dynamics::mass_matrix(const ConstVec& q) {
+  wet_active_ = false;
+  return assemble_mass_matrix(q);
+}
+
+const Eigen::MatrixXd& Dynamics::mass_matrix_in(const ConstVec& q, const FlowField& flow,
+                                                double time_s, bool free_surface) {
+  pinocchio::forwardKinematics(model_, data_, q);
+  update_wet_state(time_s, flow, free_surface);
+  return assemble_mass_matrix(q);
+}
+
+const Eigen::MatrixXd& Dynamics::assemble_mass_matrix(const ConstVec& q) {
   pinocchio::crba(model_, data_, q, pinocchio::Convention::WORLD);
   mass_ = data_.M;
   mass_.triangularView<Eigen::StrictlyLower>() = mass_.transpose();  // crba fills the upper
@@ -144,7 +183,7 @@ const Eigen::MatrixXd& Dynamics::mass_matrix(const ConstVec& q) {
       }
     }
     auto block = jacobian_.leftCols(width);
-    added_times_jacobian_.leftCols(width).noalias() = hydro_.added_mass_per_joint[j] * block;
+    added_times_jacobian_.leftCols(width).noalias() = added_mass(j) * block;
     mass_.topLeftCorner(width, width).noalias() +=
         block.transpose() * added_times_jacobian_.leftCols(width);
   }
@@ -152,7 +191,7 @@ const Eigen::MatrixXd& Dynamics::mass_matrix(const ConstVec& q) {
 }
 
 const Eigen::VectorXd& Dynamics::solve(const ConstVec& q, const ConstVec& rhs) {
-  cholesky_.compute(mass_matrix(q));
+  cholesky_.compute(assemble_mass_matrix(q));
   if (cholesky_.info() != Eigen::Success) {
     throw SimulationFailure("mass matrix is not positive definite");
   }
@@ -162,9 +201,10 @@ const Eigen::VectorXd& Dynamics::solve(const ConstVec& q, const ConstVec& rhs) {
 }
 
 const Eigen::VectorXd& Dynamics::bias_forces(const ConstVec& q, const ConstVec& v,
-                                             const FlowField& flow, double time_s) {
+                                             const FlowField& flow, double time_s,
+                                             bool free_surface) {
   kinematics(q, v);
-  fluid_wrenches(time_s, flow, true);
+  fluid_wrenches(time_s, flow, true, free_surface);
   return bias_from_wrenches(q, v);
 }
 
@@ -188,9 +228,10 @@ const Eigen::VectorXd& Dynamics::forward_dynamics(const ConstVec& q,
                                                   const ConstVec& v,
                                                   const ConstVec& tau,
                                                   const FlowField& flow,
-                                                  const ConstVec* tau_ext, double time_s) {
+                                                  const ConstVec* tau_ext, double time_s,
+                                                  bool free_surface) {
   kinematics(q, v);
-  fluid_wrenches(time_s, flow, needs_bias_acceleration());
+  fluid_wrenches(time_s, flow, needs_bias_acceleration(), free_surface);
   return accelerations(q, v, tau, tau_ext);
 }
 

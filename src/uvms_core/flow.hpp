@@ -9,6 +9,7 @@
 #include <cmath>
 #include <vector>
 
+#include "hull.hpp"
 #include "types.hpp"
 
 namespace uvms {
@@ -45,6 +46,30 @@ struct FlowField {
   // du/dt = sum A w^2 [C sin(theta) e - S cos(theta) z],
   // grad u: xy block -A w k C sin(theta) e e^T, xz = zx = A w k S cos(theta) e,
   // zz = A w k C sin(theta).
+  // sum |A|: no point of the surface is farther from z = 0 (0: a level surface).
+  double elevation_bound_m() const {
+    double bound = 0.0;
+    for (const auto& w : waves) bound += std::abs(w.amplitude_m);
+    return bound;
+  }
+
+  // eta = sum A cos(theta), d eta / dt = sum A w sin(theta),
+  // grad eta = -sum A k sin(theta) (cos beta, sin beta), at a horizontal point.
+  SurfaceAt surface_at(double time_s, double x, double y) const {
+    SurfaceAt out;
+    for (const auto& w : waves) {
+      const double k = w.wavenumber_rad_m;
+      const double ex = std::cos(w.heading_rad), ey = std::sin(w.heading_rad);
+      const double theta = k * (x * ex + y * ey) - w.angular_frequency_rad_s * time_s + w.phase_rad;
+      const double sin_t = std::sin(theta);
+      out.elevation_m += w.amplitude_m * std::cos(theta);
+      out.rate_m_s += w.amplitude_m * w.angular_frequency_rad_s * sin_t;
+      out.slope_x -= w.amplitude_m * k * ex * sin_t;
+      out.slope_y -= w.amplitude_m * k * ey * sin_t;
+    }
+    return out;
+  }
+
   FlowAtPoint at(double time_s, const Vec3& point_world_m) const {
     if (waves.empty()) return {current_world_m_s, Vec3::Zero()};
     Vec3 velocity = current_world_m_s;

@@ -1,11 +1,13 @@
 // The static hydrodynamic parameters of a UVMS, stacked per Pinocchio joint (the arrays that
-// uvms_pin/model/uvms.py builds: added_mass_per_joint, volume_per_joint_m3, ...).
+// uvms_pin/model/uvms.py builds: added_mass_per_joint, volume_per_joint_m3, ...), and the
+// hulls a free surface cuts (uvms_pin/model/hulls.py).
 #pragma once
 
 #include <vector>
 
 #include <Eigen/StdVector>
 
+#include "hull.hpp"
 #include "types.hpp"
 
 namespace uvms {
@@ -21,6 +23,16 @@ struct DampedBody {
   Vec3 position_in_joint_m;   // where the flow is sampled: the body origin
   Mat6 linear_damping;        // D_lin
   Vec6 quadratic_damping;     // diag(D_quad)
+  int hull_index = -1;        // its hull in HydroBodies::surface_bodies (-1: none, always wet)
+};
+
+// A body a free surface can leave partly dry (uvms_pin/model/hulls.py, SurfaceBodies).
+struct SurfaceBody {
+  int joint_id = 0;
+  Hull hull;                              // in the joint's frame
+  double volume_m3 = 0.0;                 // V
+  Vec3 center_of_buoyancy_in_joint_m = Vec3::Zero();
+  Mat6 added_mass_in_joint = Mat6::Zero();
 };
 
 struct HydroBodies {
@@ -29,6 +41,8 @@ struct HydroBodies {
   std::vector<double> volume_per_joint_m3;        // V
   aligned_vector<Vec3> center_of_buoyancy_per_joint_m;
   aligned_vector<DampedBody> damped_bodies;
+  aligned_vector<SurfaceBody> surface_bodies;     // the hulls
+  aligned_vector<Mat6> added_mass_without_hull_per_joint;  // always wet
 };
 
 }  // namespace uvms

@@ -38,7 +38,7 @@ Vec6 Plant::contact_wrench(const ConstVec& q, const ConstVec& v) {
 const Eigen::VectorXd& Plant::acceleration(double time_s, const ConstVec& q, const ConstVec& v,
                                            const ConstVec& tau, const Vec6* contact_world) {
   dynamics_.kinematics(q, v);
-  dynamics_.fluid_wrenches(time_s, flow, dynamics_.needs_bias_acceleration());
+  dynamics_.fluid_wrenches(time_s, flow, dynamics_.needs_bias_acceleration(), free_surface);
   if (has_contact(contact)) {
     const auto [position, velocity] =
         tip_state(dynamics_.model(), dynamics_.data(), ee_frame_id_);

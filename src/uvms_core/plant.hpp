@@ -20,6 +20,7 @@ class Plant {
   Plant& operator=(const Plant&) = delete;
 
   FlowField flow;
+  bool free_surface = false;  // the bodies are cut by the flow's free surface
   Contact contact;
   Disturbance disturbance;
 

@@ -33,7 +33,6 @@ from uvms_pin.control import task_space
 from uvms_pin.control.measurement import Measurement
 from uvms_pin.control.ppc import PPCParams, PrescribedPerformanceController
 from uvms_pin.errors import FunnelViolation, ParameterError, ScenarioError
-from uvms_pin.model.resources import example_robot_data_dir
 from uvms_pin.physics.compiled.extension import core_module
 from uvms_pin.scenario.load import load_scenario
 
@@ -271,8 +270,6 @@ def test_random_states_on_the_reference_model(reference_uvms, variant):
 
 @pytest.fixture(scope="module")
 def panda_uvms(tmp_path_factory):
-    if example_robot_data_dir() is None:
-        pytest.skip("needs example-robot-data")
     uvms = mount_on_reference_vehicle("panda", tmp_path_factory.mktemp("panda"))
     assert uvms.n_arm_joints == 7
     return uvms

@@ -30,7 +30,6 @@ from uvms_pin.control import task_space
 from uvms_pin.control.measurement import Measurement
 from uvms_pin.control.ppc import PPCParams, PrescribedPerformanceController
 from uvms_pin.errors import FunnelViolation, UvmsPinError
-from uvms_pin.model.resources import example_robot_data_dir
 from uvms_pin.physics.kinematics import frame_rotation_and_jacobian
 from uvms_pin.scenario.load import load_scenario
 
@@ -270,7 +269,6 @@ def test_random_states_on_arms_of_any_size(n_joints):
     assert outcomes["ok"] >= 40
 
 
-@pytest.mark.skipif(example_robot_data_dir() is None, reason="needs example-robot-data")
 def test_random_states_on_a_mounted_7_joint_panda(tmp_path):
     uvms = mount_on_reference_vehicle("panda", tmp_path)
     assert uvms.n_arm_joints == 7

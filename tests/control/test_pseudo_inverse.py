@@ -81,3 +81,74 @@ def test_declines_when_the_svd_would_cut_a_singular_value():
     jacobian = matrix_with_condition(rng, 300.0)
     assert MinimumNormSolver(None, 1e-12).solve(jacobian, np.ones(6)) is not None
     assert MinimumNormSolver(None, 1e-2).solve(jacobian, np.ones(6)) is None
+
+
+# ---- the SVD reference itself, against numpy's pinv ------------------------------------------
+
+
+def matrix_with_singular_values(rng, singular_values, shape=(6, 10)) -> np.ndarray:
+    m, n = shape
+    u, _ = np.linalg.qr(rng.normal(size=(m, m)))
+    v, _ = np.linalg.qr(rng.normal(size=(n, m)))
+    return (u * np.asarray(singular_values, dtype=float)) @ v.T
+
+
+@pytest.mark.parametrize("shape", [(6, 10), (6, 6), (3, 7), (8, 5)])
+def test_the_reference_is_numpys_pinv_at_full_rank(shape):
+    rng = np.random.default_rng(shape[0] * 10 + shape[1])
+    for _ in range(20):
+        matrix = rng.normal(size=shape)
+        expected = np.linalg.pinv(matrix, rcond=1e-12)
+        np.testing.assert_allclose(
+            pseudo_inverse(matrix, 1e-12), expected, rtol=0, atol=1e-12 * np.abs(expected).max()
+        )
+
+
+def test_the_cutoff_drops_the_same_singular_values_as_numpys_rcond():
+    """Singular values 40 x (1, 0.5, 1e-3, 1e-7, 1e-13, 0): a cutoff (relative to the largest)
+    between two of them keeps those above it; numpy's rcond (s > rcond s_max) draws the same
+    line."""
+    rng = np.random.default_rng(21)
+    sigma = 40.0 * np.array([1.0, 0.5, 1e-3, 1e-7, 1e-13, 0.0])
+    matrix = matrix_with_singular_values(rng, sigma)
+    for cutoff, kept in ((0.7, 1), (1e-2, 2), (1e-5, 3), (1e-10, 4)):
+        mine = pseudo_inverse(matrix, cutoff)
+        expected = np.linalg.pinv(matrix, rcond=cutoff)
+        np.testing.assert_allclose(mine, expected, rtol=0, atol=1e-9 * np.abs(expected).max())
+        # the kept rank: J^# J projects onto a space of that dimension
+        assert np.trace(mine @ matrix) == pytest.approx(kept, abs=1e-6)
+        # what a dropped direction would have given: its 1/s dwarfs everything kept
+        assert np.abs(mine).max() < 2.0 / sigma[kept - 1]
+
+
+def test_a_singular_value_at_the_cutoff_is_dropped():
+    """s_i = cutoff x s_max exactly (a diagonal matrix: its SVD is exact) is not above the
+    cutoff: dropped, as numpy's pinv drops it."""
+    matrix = np.zeros((3, 4))
+    matrix[range(3), range(3)] = [4.0, 2.0, 1.0]
+    mine = pseudo_inverse(matrix, 0.5)
+    np.testing.assert_array_equal(mine, np.linalg.pinv(matrix, rcond=0.5))
+    np.testing.assert_array_equal(np.diag(mine), [0.25, 0.0, 0.0])
+
+
+def test_the_weighted_reference_is_the_minimum_weighted_norm_least_squares_solution():
+    """J^# = W^-1/2 (J W^-1/2)^+: for a rank-deficient J, x = J^# b minimises |J x - b|, and
+    among the minimisers x^T W x (checked against numpy's pinv of J W^-1/2)."""
+    rng = np.random.default_rng(22)
+    weights = rng.uniform(0.2, 5.0, 10)
+    matrix = matrix_with_singular_values(rng, [3.0, 1.0, 0.2, 0.05, 0.0, 0.0])  # rank 4
+    half = 1.0 / np.sqrt(weights)
+    expected = half[:, None] * np.linalg.pinv(matrix * half, rcond=1e-12)
+    mine = pseudo_inverse(matrix, 1e-12, weights)
+    np.testing.assert_allclose(mine, expected, rtol=0, atol=1e-11 * np.abs(expected).max())
+    rhs = rng.normal(size=6)
+    x = mine @ rhs
+    residual = matrix @ x - rhs
+    np.testing.assert_allclose(matrix.T @ residual, 0.0, atol=1e-12)  # least squares
+    null_basis = np.linalg.svd(matrix)[2][4:]  # J z = 0
+    for z in rng.normal(size=(20, 6)) @ null_basis:
+        assert (x + z) @ (weights * (x + z)) > x @ (weights * x)
+
+
+def test_the_zero_matrix_has_a_zero_pseudo_inverse():
+    np.testing.assert_array_equal(pseudo_inverse(np.zeros((6, 10)), 1e-12), np.zeros((10, 6)))

@@ -88,10 +88,12 @@ def test_bad_flow_tables_name_the_table(overrides, message):
 
 
 def test_body_reaching_the_surface_stops_the_run_with_its_rollout():
-    """A passive vehicle made buoyant (denser water) rises from 0.5 m under small waves: the
-    run stops when a link reaches the surface, says which and when, and keeps the rollout.
-    (A neutral vehicle would not: it rides the orbits of the water around it.)"""
+    """A passive vehicle made buoyant (denser water) rises from 0.5 m under small waves: with
+    ``stop_at_surface`` (off by default since the free surface is simulated) the run stops
+    when a link reaches the surface, says which and when, and keeps the rollout. (A neutral
+    vehicle would not: it rides the orbits of the water around it.)"""
     overrides = {
+        "water.stop_at_surface": True,
         "water.density_kg_m3": 1150.0,
         "initial.position_world_m": [0.0, 0.0, -0.5],
         "water.waves": {"amplitude_m": 0.1, "period_s": 4.0},

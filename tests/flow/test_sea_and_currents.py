@@ -36,16 +36,54 @@ def test_jonswap_with_gamma_one_is_pierson_moskowitz():
     )
 
 
+def _band_limited_m0_and_its_spread(sea: IrregularSea, low=0.5, high=3.5) -> tuple[float, float]:
+    """m0 of the spectrum over the drawn band [low, high] wp, and the standard deviation of
+    the components' sum_j S(w_j) dw about it (one frequency uniform in each of the
+    n equal bins: a stratified sum, variance sum_j dw^2 Var_bin S)."""
+    n = len(sea.components.angular_frequency_rad_s)
+    wp = 2 * math.pi / sea.peak_period_s
+    edges = np.linspace(low * wp, high * wp, n + 1)
+    width = edges[1] - edges[0]
+    inside = np.linspace(edges[:-1], edges[1:], 201)  # (201, n): points across each bin
+    s = jonswap_spectrum(inside, sea.significant_height_m, sea.peak_period_s, sea.peak_enhancement)
+    m0 = float(np.sum(np.trapezoid(s, inside, axis=0)))
+    return m0, float(width * np.sqrt(np.sum(np.var(s, axis=0))))
+
+
+def _record_m0_spread(sea: IrregularSea, duration_s: float) -> float:
+    """Standard deviation of a record's mean square about the components' m0 = sum A^2 / 2,
+    over the random phases: each pair (i, j) adds A_i A_j times the record's mean of
+    cos((w_i - w_j) t + phase), of mean square 2 sin^2(D T / 2) / (D T)^2 (D = w_i - w_j),
+    and the pairs are uncorrelated."""
+    c = sea.components
+    a2, w = c.amplitude_m**2, c.angular_frequency_rad_s
+    i, j = np.triu_indices(len(w), 1)
+    x = (w[i] - w[j]) * duration_s
+    return float(np.sqrt(np.sum(a2[i] * a2[j] * 2.0 * np.sin(x / 2) ** 2 / x**2)))
+
+
 def test_irregular_sea_reproduces_hs_and_tp_in_a_record():
-    """A 3-hour record at one point: Hs = 4 std(eta) and the periodogram's peak period."""
+    """A 3-hour record at one point: Hs = 4 std(eta) and the periodogram's peak period.
+
+    Tolerances are 4 standard deviations of what is random in each (Hs = 4 sqrt(m0), so a
+    relative spread of m0 is halved in Hs): the drawn frequencies make the components' Hs
+    differ from the band-limited spectrum's by ~0.24 % (sd); the record's finite length
+    makes its Hs differ from the components' by ~0.1 % (sd, this draw): 4 sd, ~0.4 %, where
+    it used to be held to 5 %. (Over 60 seeds the two normalised errors have sd 0.86 and
+    0.89 and never exceed 2.5.)"""
     sea = IrregularSea(0.5, 5.0, peak_enhancement=3.3, n_components=200, seed=4)
-    assert sea.components_significant_height_m == pytest.approx(0.5, rel=0.02)
+    hs = sea.components_significant_height_m
+    m0_band, m0_band_sd = _band_limited_m0_and_its_spread(sea)
+    assert 4.0 * math.sqrt(m0_band) == pytest.approx(0.5, rel=0.005)  # the band holds 99.5 %
+    assert (hs / 4.0) ** 2 == pytest.approx(m0_band, abs=4.0 * m0_band_sd)
     fs = 4.0
     t = np.arange(0.0, 3 * 3600.0, 1.0 / fs)
     # vectorised over time: one point, many times
     c = sea.components
     eta = np.cos(np.outer(-t, c.angular_frequency_rad_s) + c.phase_rad) @ c.amplitude_m
-    assert 4.0 * np.std(eta) == pytest.approx(0.5, rel=0.05)
+    record_sd = _record_m0_spread(sea, t[-1] + 1.0 / fs) / (hs / 4.0) ** 2 / 2.0  # of Hs
+    assert 0.0005 < record_sd < 0.003
+    assert 4.0 * np.std(eta) == pytest.approx(hs, rel=4.0 * record_sd)
     f, p = welch(eta, fs=fs, nperseg=8192)
     assert 1.0 / f[np.argmax(p)] == pytest.approx(5.0, rel=0.06)
     # the record from surface_elevation agrees with the vectorised one
@@ -86,7 +124,7 @@ def test_gauss_markov_current_is_seeded_bounded_smooth_and_order_independent():
     times = np.linspace(0.0, 2000.0, 4001)
     v = np.array([gm.velocity(t, [0, 0, 0])[0] for t in times])
     assert np.all(np.abs(v - [0.2, 0.0, 0.0]) <= 0.15 + 1e-12)
-    assert 0.05 < np.std(v[:, 1]) < 0.15
+    assert np.abs(v - [0.2, 0.0, 0.0]).max() > 0.14  # the bound is reached (1.5 sigma)
     other = GaussMarkovCurrent(
         [0.2, 0.0, 0.0], std_m_s=0.1, time_constant_s=20.0, bound_m_s=0.15, seed=7
     )
@@ -97,6 +135,31 @@ def test_gauss_markov_current_is_seeded_bounded_smooth_and_order_independent():
         np.testing.assert_allclose(gm.acceleration(t, [0, 0, 0]), fd, atol=1e-8)
     with pytest.raises(ParameterError, match="t >= 0"):
         gm.velocity(-1.0, [0, 0, 0])
+
+
+def test_gauss_markov_current_has_its_stationary_statistics():
+    """Sampled on its grid (dt = 0.5 s) the process is AR(1): deviations of mean 0, standard
+    deviation sigma, lag-one correlation rho = exp(-dt / T), per component. With the bound
+    at 6 sigma (clipping nothing that matters) and N = 3 x 20000 samples, the sampling
+    errors of an AR(1) (Bartlett) are sd(mean) = sigma sqrt((1 + rho) / ((1 - rho) n)) for a
+    component of n samples, sd(s / sigma) = sqrt((1 + rho^2) / ((1 - rho^2) 2 N)) and
+    sd(r1) = sqrt((1 - rho^2) / N) pooled: 2 % of sigma, 0.58 % and 0.26 % here; each is held
+    to 4 of them (over 40 seeds the pooled errors, normalised, have sd 1.06-1.11 and never
+    exceed 2.7). The old check (std within +-50 %) held the standard deviation to ~7 sd of a
+    shorter record."""
+    sigma, time_constant_s, dt, n = 0.1, 2.0, 0.5, 20000
+    mean = np.array([0.2, -0.1, 0.0])
+    gm = GaussMarkovCurrent(mean, sigma, time_constant_s, 6.0 * sigma, seed=11, sample_period_s=dt)
+    deviation = np.array([gm.velocity(k * dt, [0, 0, 0])[0] for k in range(n)]) - mean
+    rho = math.exp(-dt / time_constant_s)
+    count = deviation.size  # pooled over the three components
+    sd_mean = sigma * math.sqrt((1 + rho) / ((1 - rho) * n))
+    sd_std = math.sqrt((1 + rho**2) / ((1 - rho**2) * 2 * count))
+    sd_r1 = math.sqrt((1 - rho**2) / count)
+    assert np.all(np.abs(deviation.mean(axis=0)) < 4 * sd_mean)
+    assert math.sqrt(np.mean(deviation**2)) / sigma == pytest.approx(1.0, abs=4 * sd_std)
+    r1 = np.sum(deviation[1:] * deviation[:-1]) / np.sum(deviation**2)
+    assert r1 == pytest.approx(rho, abs=4 * sd_r1)
 
 
 def test_depth_profile_current():

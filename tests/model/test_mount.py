@@ -17,13 +17,9 @@ from uvms_pin.model.mount.catalog import CATALOG, available_arms
 from uvms_pin.model.mount.mount import mount_arm, mount_arm_detailed
 from uvms_pin.model.mount.split import split_urdf
 from uvms_pin.model.mount.tool import ProbeTool
-from uvms_pin.model.resources import example_robot_data_dir
 from uvms_pin.model.trim import TrimSpec, mass_properties
 
 SCENARIO = ROOT / "scenarios" / "realistic_force_tracking.toml"
-needs_erd = pytest.mark.skipif(
-    example_robot_data_dir() is None, reason="example-robot-data is not installed"
-)
 UPSIDE_DOWN = (math.pi, 0.0, 0.0)
 
 
@@ -118,7 +114,6 @@ def test_added_probe_and_frames_match_the_reference_tool(split, reference_uvms):
 ERD_ARMS = ("z1", "kinova", "ur3", "panda")
 
 
-@needs_erd
 @pytest.mark.parametrize("name", ERD_ARMS)
 def test_example_robot_data_arm_mounts_with_mesh_hydro(split, name):
     entry = CATALOG[name]
@@ -149,7 +144,6 @@ def test_example_robot_data_arm_mounts_with_mesh_hydro(split, name):
     assert "*" in model_summary(uvms)  # derived bodies are marked
 
 
-@needs_erd
 @pytest.mark.parametrize("name", ["ur3", "ur5", "ur10", "panda", "z1", "kinova", "xarm7", "so100"])
 def test_every_arm_the_project_uses_passes_the_model_checks(split, name):
     """The inertia, joint-limit and hydrodynamics checks accept every arm compare-arms
@@ -171,11 +165,9 @@ def test_every_arm_the_project_uses_passes_the_model_checks(split, name):
 def test_available_arms_lists_installed_example_robot_data_arms():
     names = available_arms()
     assert names[0] == "reference"
-    if example_robot_data_dir() is not None:
-        assert {"ur5", "panda", "z1", "kinova", "so100"} <= set(names)
+    assert {"ur5", "panda", "z1", "kinova", "so100"} <= set(names)
 
 
-@needs_erd
 def test_trim_makes_a_heavy_arm_neutral_and_stable(split):
     entry = CATALOG["ur3"]
     spec = TrimSpec(bg_m=0.03)
@@ -194,7 +186,6 @@ def test_trim_makes_a_heavy_arm_neutral_and_stable(split):
     assert "foam" in report.summary()
 
 
-@needs_erd
 def test_compare_arms_runs_the_force_task(tmp_path):
     arms = ["reference", "ur3", "z1", "panda", "so100"]
     rows = compare_arms(

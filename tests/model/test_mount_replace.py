@@ -15,15 +15,11 @@ import uvms_pin as up
 from uvms_pin.model.mount.catalog import CATALOG
 from uvms_pin.model.mount.mount import mount_arm_detailed
 from uvms_pin.model.mount.split import split_urdf
-from uvms_pin.model.resources import example_robot_data_dir
 
 VEHICLE_URDF = ROOT / "models" / "lbv150.urdf"
 POSE = ((0.2, 0.0, -0.18), (math.pi, 0.0, 0.0))  # under the hull, upside down
 REFERENCE_ARM = [f"arm_joint{k}" for k in range(1, 5)]
 REFERENCE_ARM_LINKS = [f"arm_link{k}" for k in range(1, 5)]
-needs_erd = pytest.mark.skipif(
-    example_robot_data_dir() is None, reason="example-robot-data is not installed"
-)
 
 
 def assert_same_dynamics(a: up.UVMS, b: up.UVMS, seed: int = 3) -> None:
@@ -38,7 +34,6 @@ def assert_same_dynamics(a: up.UVMS, b: up.UVMS, seed: int = 3) -> None:
         )
 
 
-@needs_erd
 def test_an_erd_arm_on_the_shipped_uvms_replaces_its_arm():
     """uvms_lbv150 + UR5 = lbv150 + UR5: the vehicle plus the new arm only."""
     with pytest.warns(UserWarning, match="replaced the arm") as record:
@@ -85,7 +80,6 @@ def test_the_reference_arm_mounted_back_on_the_shipped_uvms_is_the_reference(
     assert_same_dynamics(mounted, reference_uvms)
 
 
-@needs_erd
 def test_keep_existing_arm_gives_two_arms_with_distinct_names():
     result = mount_arm_detailed(REFERENCE_URDF, CATALOG["ur3"], POSE, keep_existing_arm=True)
     uvms = result.uvms
@@ -109,7 +103,6 @@ def test_keep_existing_arm_gives_two_arms_with_distinct_names():
     assert np.linalg.norm(data.oMf[model.getFrameId("ee")].translation - old_ee) > 0.01
 
 
-@needs_erd
 def test_catalogue_names_and_entries_are_arms():
     by_name = up.mount_arm(VEHICLE_URDF, "ur3", POSE)
     by_entry = up.mount_arm(VEHICLE_URDF, CATALOG["ur3"], POSE)
@@ -120,7 +113,6 @@ def test_catalogue_names_and_entries_are_arms():
         assert_same_dynamics(other, by_name)
 
 
-@needs_erd
 def test_an_unknown_arm_name_lists_the_catalogue():
     with pytest.raises(up.ParameterError, match=r"unknown arm 'ur55'.*ur5"):
         up.mount_arm(VEHICLE_URDF, "ur55", POSE)

@@ -77,8 +77,6 @@ def build_test_uvms(n_joints: int = 4) -> pin.Model:
 def model(request) -> pin.Model:
     if request.param == "programmatic":
         return build_test_uvms()
-    if not REFERENCE_URDF.exists():
-        pytest.skip(f"{REFERENCE_URDF} not written yet")
     return pin.buildModelFromUrdf(str(REFERENCE_URDF), pin.JointModelFreeFlyer())
 
 

@@ -2,11 +2,14 @@
 
 from __future__ import annotations
 
+import time
+
 import pytest
 from conftest import ROOT
 
 import uvms_pin as up
 from uvms_pin.errors import ParameterError
+from uvms_pin.results import progress as progress_module
 from uvms_pin.results.progress import ProgressBar, callback_or_none
 
 SCENARIO = ROOT / "scenarios" / "passive_still_water.toml"
@@ -30,9 +33,36 @@ def test_false_and_none_are_silent(capsys):
     assert captured.err == "" and captured.out == ""
 
 
-def test_default_bar_stays_silent_for_a_short_run(capsys):
-    up.simulate(_short(0.04))  # far below the 2 s delay
+class SteppedClock:
+    """The progress module's ``time``: each ``perf_counter`` reading is ``step_s`` later
+    than the previous one (0: held still); everything else is the real ``time``."""
+
+    def __init__(self, step_s: float = 0.0) -> None:
+        self.now_s, self.step_s = 1000.0, step_s
+
+    def perf_counter(self) -> float:
+        self.now_s += self.step_s
+        return self.now_s
+
+    def __getattr__(self, name: str):
+        return getattr(time, name)
+
+
+def test_default_progress_is_silent_until_its_delay_has_passed(capsys, monkeypatch):
+    """Wall time as the test sets it, not as the machine runs: held still, a run never
+    reaches the 2 s delay and prints nothing; 1 s per reading, the second sample (t = 0.02
+    s, read 2 s after the start) is past it: a line; then only the end gets one (the next
+    is due 10 s later)."""
+    clock = SteppedClock()
+    monkeypatch.setattr(progress_module, "time", clock)
+    up.simulate(_short(0.04))
     assert capsys.readouterr().err == ""
+    clock.step_s = 1.0
+    up.simulate(_short(0.1))
+    lines = capsys.readouterr().err.splitlines()
+    assert len(lines) == 2, lines
+    assert "t =   0.020/0.1 s" in lines[0] and "elapsed    2.0 s" in lines[0]
+    assert "t =   0.100/0.1 s" in lines[1]
 
 
 def test_bar_reports_simulated_seconds(capsys):

@@ -16,9 +16,11 @@ from conftest import ROOT
 
 import uvms_pin as up
 from uvms_pin.control.measurement import Measurement
+from uvms_pin.control.performance import transformation_gain, transformed_error
 from uvms_pin.control.ppc import PrescribedPerformanceController
 from uvms_pin.model.scaled import scaled_uvms
 from uvms_pin.model.uvms import UVMS
+from uvms_pin.physics.kinematics import analytical_jacobian, end_effector_pose, frame_id_from_name
 from uvms_pin.scenario.load import load_scenario
 from uvms_pin.sim.actuation import ThrustersAndJointLimits
 from uvms_pin.sim.run import Scenario, simulate
@@ -245,15 +247,37 @@ def test_realistic_force_trajectory_converges_with_the_step():
 
 
 def test_controller_runs_for_any_arm_and_frame():
-    """The law is sized by the model: a 2-joint arm and another end-effector frame."""
+    """The law is sized by the model (a 2-joint arm, the sensor frame as its end-effector)
+    and is the paper's there, recomputed from its signals and the reduced model's own
+    Jacobian: xdot_r = -k_x eps(e_x / rho_x), zeta_r = J^+ xdot_r (unit weights, no
+    null-space task), tau = -K_zeta P^-1 R(xi_zeta) eps(xi_zeta) / rho_zeta."""
     base = load_scenario(REALISTIC)
     model = base.uvms.model
     reduced = pin.buildReducedModel(
         model, [model.getJointId("arm_joint3"), model.getJointId("arm_joint4")], base.q0
     )
-    controller = PrescribedPerformanceController(
-        reduced, "ft_sensor", desired_force_world_N=[0.4, 0, 0]
-    )
     q = np.delete(base.q0, [9, 10])
-    tau = controller.compute(0.0, Measurement(0.0, q, np.zeros(8), np.zeros(6)))
-    assert tau.shape == (8,) and np.all(np.isfinite(tau))
+    frame = frame_id_from_name(reduced, "ft_sensor")
+    rpy_now = end_effector_pose(reduced, reduced.createData(), q, frame)[1]
+    controller = PrescribedPerformanceController(
+        reduced, "ft_sensor", desired_force_world_N=[0.4, 0, 0], desired_rpy=rpy_now + 0.05
+    )
+    time_s = 0.3
+    v = 0.02 * np.random.default_rng(5).normal(size=8)
+    force = np.array([0.1, -0.05, 0.2])
+    tau = controller.compute(time_s, Measurement(time_s, q, v, np.r_[force, 0.0, 0.0, 0.0]))
+    assert tau.shape == (8,)
+    assert controller.second_level_names[6:] == ("arm_joint1", "arm_joint2")
+    s, p = controller.last_signals, controller.params
+    rho_x = (p.rho0_x - p.rho_inf_x) * np.exp(-p.l_x_per_s * time_s) + p.rho_inf_x
+    np.testing.assert_allclose(s.rho_x, rho_x, rtol=1e-14)
+    np.testing.assert_allclose(s.e_x, np.r_[force - [0.4, 0.0, 0.0], [-0.05] * 3], atol=1e-12)
+    np.testing.assert_allclose(s.xdot_r, -p.k_x * transformed_error(s.e_x / rho_x), rtol=1e-14)
+    jacobian = analytical_jacobian(reduced, reduced.createData(), q, frame)
+    np.testing.assert_allclose(s.zeta_r, np.linalg.pinv(jacobian) @ s.xdot_r, atol=1e-12)
+    np.testing.assert_allclose(s.e_zeta, v - s.zeta_r, atol=1e-15)
+    rho_zeta = (p.rho0_zeta - p.rho_inf_zeta) * np.exp(-p.l_zeta_per_s * time_s) + p.rho_inf_zeta
+    np.testing.assert_allclose(s.rho_zeta, rho_zeta, rtol=1e-14)
+    xi = s.e_zeta / rho_zeta
+    expected = -p.k_zeta * transformation_gain(xi) * transformed_error(xi) / rho_zeta
+    np.testing.assert_allclose(tau, expected, rtol=1e-12, atol=1e-14)

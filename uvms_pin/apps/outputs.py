@@ -4,6 +4,8 @@ from __future__ import annotations
 
 from pathlib import Path
 
+import numpy as np
+
 from uvms_pin.results.rollout import Rollout
 
 
@@ -25,7 +27,12 @@ def write_outputs(rollout: Rollout, out: Path) -> list[Path]:
             **metrics,
         },
     )
-    return paper_figures(rollout, out) + standard_figures(rollout, out) + _flow_figure(rollout, out)
+    return (
+        paper_figures(rollout, out)
+        + standard_figures(rollout, out)
+        + _flow_figure(rollout, out)
+        + _surface_figure(rollout, out)
+    )
 
 
 def _flow_figure(rollout: Rollout, out: Path) -> list[Path]:
@@ -41,3 +48,21 @@ def _flow_figure(rollout: Rollout, out: Path) -> list[Path]:
     density = float(world["water_density_kg_m3"])
     uvms = load_uvms(rollout.metadata["model_source"], water_density_kg_m3=density)
     return [plot_flow_seen(rollout, uvms, flow, out / FLOW_FIGURE)]
+
+
+def _surface_figure(rollout: Rollout, out: Path) -> list[Path]:
+    """surface.png when the run had a free surface and some body left the water in part."""
+    from uvms_pin.apps.viz.surface_plots import SURFACE_FIGURE, plot_waterline
+    from uvms_pin.flow import flow_from_record
+    from uvms_pin.model.urdf.load import load_uvms
+
+    world = rollout.metadata.get("world") or {}
+    fractions = rollout.signals.get("wet_fraction")
+    if not world.get("free_surface") or fractions is None or len(rollout) == 0:
+        return []
+    if np.all(fractions >= 1.0 - 1e-9):
+        return []
+    density = float(world["water_density_kg_m3"])
+    uvms = load_uvms(rollout.metadata["model_source"], water_density_kg_m3=density)
+    flow = flow_from_record(world.get("flow"))
+    return [plot_waterline(rollout, uvms, flow, out / SURFACE_FIGURE)]

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import math
 from abc import ABC, abstractmethod
 from typing import Any
 
@@ -77,6 +78,21 @@ class FlowField(ABC):
         xy = np.asarray(xy_world, dtype=float).reshape(-1, 2)
         return np.zeros(len(xy))
 
+    def surface_kinematics(
+        self, time_s: float, xy_world: np.ndarray
+    ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """(eta (n,) [m], d eta / dt (n,) [m/s], (d eta / dx, d eta / dy) (n, 2)) at
+        horizontal points (n, 2): the free surface and how it moves (level and still here)."""
+        xy = np.asarray(xy_world, dtype=float).reshape(-1, 2)
+        return self.surface_elevation(time_s, xy), np.zeros(len(xy)), np.zeros((len(xy), 2))
+
+    @property
+    def elevation_bound_m(self) -> float:
+        """A bound on |eta| [m] over all times and places (0 for a level surface; infinite
+        for a field with a free surface that does not say): a body deeper than it is wet
+        whatever the waves do."""
+        return math.inf if self.has_free_surface else 0.0
+
     def record(self) -> dict[str, Any]:
         """This field as plain data (JSON: a rollout saves it), which
         `uvms_pin.flow.record.flow_from_record` turns back into the same field. A field
@@ -124,6 +140,14 @@ class SumFlow(FlowField):
 
     def surface_elevation(self, time_s, xy_world):
         return sum(f.surface_elevation(time_s, xy_world) for f in self.fields)
+
+    def surface_kinematics(self, time_s, xy_world):
+        parts = [f.surface_kinematics(time_s, xy_world) for f in self.fields]
+        return tuple(sum(p[i] for p in parts) for i in range(3))
+
+    @property
+    def elevation_bound_m(self) -> float:
+        return sum(f.elevation_bound_m for f in self.fields)
 
     def record(self) -> dict[str, Any]:
         return {"type": "sum", "fields": [f.record() for f in self.fields]}

@@ -91,6 +91,18 @@ class WaveComponents:
         theta, *_ = self._phase_and_profiles(time_s, points)
         return np.cos(theta) @ self.amplitude_m
 
+    def surface_kinematics(
+        self, time_s: float, xy: np.ndarray
+    ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """eta = sum A cos(theta), d eta / dt = sum A w sin(theta),
+        grad eta = -sum A k sin(theta) (cos beta, sin beta)."""
+        points = np.column_stack([xy, np.zeros(len(xy))])
+        theta, _, _, ex, ey = self._phase_and_profiles(time_s, points)
+        sin = np.sin(theta)
+        a, w, k = self.amplitude_m, self.angular_frequency_rad_s, self.wavenumber_rad_m
+        akx, aky = a * k * ex, a * k * ey
+        return np.cos(theta) @ a, sin @ (a * w), -np.column_stack([sin @ akx, sin @ aky])
+
     def velocity(self, time_s: float, points: np.ndarray) -> np.ndarray:
         theta, ch, sh, ex, ey = self._phase_and_profiles(time_s, points)
         aw = self.amplitude_m * self.angular_frequency_rad_s
@@ -160,6 +172,15 @@ class WaveField(FlowField):
 
     def surface_elevation(self, time_s, xy_world):
         return self.components.elevation(time_s, np.asarray(xy_world, dtype=float).reshape(-1, 2))
+
+    def surface_kinematics(self, time_s, xy_world):
+        xy = np.asarray(xy_world, dtype=float).reshape(-1, 2)
+        return self.components.surface_kinematics(time_s, xy)
+
+    @property
+    def elevation_bound_m(self) -> float:
+        """sum |A|: no point of the surface is farther from z = 0."""
+        return float(np.sum(np.abs(self.components.amplitude_m)))
 
     def record(self) -> dict:
         """Its components, exactly (a sea state is not drawn again)."""

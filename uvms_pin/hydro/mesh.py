@@ -18,8 +18,13 @@ it is multiplied by V / V_p: the primitive's shape with the mesh's volume. Drag 
 the projected area, which the enclosing primitive over-estimates only a little for compact
 links: it is kept (an upper estimate of the drag of a bluff link).
 
-Every number is returned at the mesh origin (the ``<collision><origin>`` frame), in its
-axes, marked ``derived``, with a note of the method in ``origin``.
+`mesh_primitive` returns the coefficients at the bounding primitive's own centre and axes,
+with the pose of that frame in the mesh frame: there the quadratic drag is the primitive's
+own, exactly as for the same primitive given in a URDF (the URDF reader uses it).
+`mesh_hydro` returns them at the mesh origin (the ``<collision><origin>`` frame), in its
+axes, where the quadratic drag can only be a diagonal estimate
+(:func:`uvms_pin.hydro.geometry.hydro_in_frame`). Both mark them ``derived``, with a note of
+the method in ``origin``.
 """
 
 from __future__ import annotations
@@ -36,7 +41,7 @@ from uvms_pin.errors import ParameterError
 from uvms_pin.hydro import geometry
 from uvms_pin.hydro.params import HydroParams
 
-__all__ = ["MeshGeometry", "load_mesh_geometry", "mesh_hydro"]
+__all__ = ["MeshGeometry", "load_mesh_geometry", "mesh_hydro", "mesh_primitive"]
 
 #: Two OBB sides within this relative difference make the bounding primitive a cylinder.
 DEFAULT_CYLINDER_ASPECT_TOLERANCE = 0.15
@@ -55,6 +60,8 @@ class MeshGeometry:
         obb_rotation: mesh_R_obb (3x3), the axes of the oriented bounding box.
         obb_center_m: mesh_p_obb (3,).
         obb_extents_m: the box's full side lengths (3,).
+        vertices_m, triangles: the closed surface the volume is of (the mesh, or its convex
+            hull), outward triangles (n, 3) and (m, 3): what the free surface cuts.
     """
 
     volume_m3: float
@@ -63,6 +70,8 @@ class MeshGeometry:
     obb_rotation: np.ndarray
     obb_center_m: np.ndarray
     obb_extents_m: np.ndarray
+    vertices_m: np.ndarray | None = None
+    triangles: np.ndarray | None = None
 
 
 @functools.lru_cache(maxsize=256)
@@ -80,6 +89,9 @@ def _load_cached(path: str, mtime_ns: int, scale: tuple[float, float, float]) ->
         body, watertight = mesh, True
     else:
         body, watertight = mesh.convex_hull, False
+    triangles = np.asarray(body.faces, dtype=np.int64)
+    if float(body.volume) < 0.0:  # inward triangles: turn them out
+        triangles = triangles[:, ::-1].copy()
     volume = abs(float(body.volume))
     if not (math.isfinite(volume) and volume > 0.0):
         raise ParameterError(f"mesh '{path}' encloses no volume (flat or degenerate)")
@@ -96,6 +108,8 @@ def _load_cached(path: str, mtime_ns: int, scale: tuple[float, float, float]) ->
         obb_rotation=rotation,
         obb_center_m=transform[:3, 3].copy(),
         obb_extents_m=np.maximum(np.asarray(obb.extents, dtype=float), _MIN_SIDE_M),
+        vertices_m=np.asarray(body.vertices, dtype=float).copy(),
+        triangles=triangles,
     )
 
 
@@ -116,13 +130,17 @@ def load_mesh_geometry(path: str | Path, scale=(1.0, 1.0, 1.0)) -> MeshGeometry:
     return _load_cached(str(p.resolve()), p.stat().st_mtime_ns, tuple(float(x) for x in np.abs(s)))
 
 
-def mesh_hydro(
+def mesh_primitive(
     geometry_: MeshGeometry,
     water_density_kg_m3: float,
     *,
     cylinder_aspect_tolerance: float = DEFAULT_CYLINDER_ASPECT_TOLERANCE,
-) -> HydroParams:
-    """Coefficients of a mesh at its origin, in its frame (see the module docstring).
+) -> tuple[np.ndarray, np.ndarray, HydroParams]:
+    """The bounding primitive of a mesh: (mesh_R_p, mesh_p_p, its coefficients in frame p).
+
+    Frame p is the primitive's centre and axes (a cylinder's axis is its z); the
+    coefficients are the primitive's, its added mass scaled to the mesh's volume, with the
+    centre of buoyancy at the mesh's centroid (see the module docstring).
 
     Args:
         geometry_: from :func:`load_mesh_geometry`.
@@ -151,18 +169,42 @@ def mesh_hydro(
         primitive = (base, rotation, "box {:.4g}x{:.4g}x{:.4g} m".format(*ext))
     base, rot, label = primitive
     ratio = geometry_.volume_m3 / base.volume_m3
-    # the primitive's shape with the mesh's volume: added mass scaled, drag kept
-    scaled = dataclasses.replace(
-        base, volume_m3=geometry_.volume_m3, added_mass=base.added_mass * ratio
-    )
-    moved = geometry.hydro_in_frame(scaled, rot, geometry_.obb_center_m)
     source = "mesh" if geometry_.watertight else "convex hull"
-    # buoyancy acts at the mesh's own centroid, not at the primitive's centre
-    return dataclasses.replace(
-        moved,
-        center_of_buoyancy_m=geometry_.centroid_m,
+    center = geometry_.obb_center_m
+    # the primitive's shape with the mesh's volume: added mass scaled, drag kept; buoyancy
+    # acts at the mesh's own centroid, not at the primitive's centre
+    params = dataclasses.replace(
+        base,
+        volume_m3=geometry_.volume_m3,
+        added_mass=base.added_mass * ratio,
+        center_of_buoyancy_m=rot.T @ (geometry_.centroid_m - center),
         origin=(
             f"mesh: V={geometry_.volume_m3:.4g} m^3 from the {source}; bounding {label}, "
             f"added mass scaled by V/V_primitive={ratio:.3f}"
         ),
+    )
+    return rot, center.copy(), params
+
+
+def mesh_hydro(
+    geometry_: MeshGeometry,
+    water_density_kg_m3: float,
+    *,
+    cylinder_aspect_tolerance: float = DEFAULT_CYLINDER_ASPECT_TOLERANCE,
+) -> HydroParams:
+    """Coefficients of a mesh at its origin, in its frame: those of :func:`mesh_primitive`
+    moved there (the quadratic drag becomes a diagonal estimate; see the module docstring).
+
+    Args:
+        geometry_: from :func:`load_mesh_geometry`.
+        water_density_kg_m3: rho [kg/m^3] > 0.
+        cylinder_aspect_tolerance: relative difference under which two OBB sides make a
+            cylinder (0 = always a box).
+    """
+    rot, center, params = mesh_primitive(
+        geometry_, water_density_kg_m3, cylinder_aspect_tolerance=cylinder_aspect_tolerance
+    )
+    moved = geometry.hydro_in_frame(params, rot, center)
+    return dataclasses.replace(
+        moved, center_of_buoyancy_m=geometry_.centroid_m, origin=params.origin
     )

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from uvms_pin.hydro.hull import Hull
 from uvms_pin.model.uvms import UVMS
 from uvms_pin.results.format import numbers_text
 
@@ -39,12 +40,14 @@ def model_summary(uvms: UVMS) -> str:
         "",
         "hydrodynamic bodies (coefficients at the link origin, link frame; * = derived from geometry):",
     ]
-    for body in uvms.hydro_bodies:
+    hulls = dict(zip(uvms.surface_bodies.body_index, uvms.surface_bodies.hulls, strict=True))
+    for k, body in enumerate(uvms.hydro_bodies):
         p = body.params
         mark = "*" if p.derived else " "
         lines.append(
             f" {mark}{body.name} (on joint {model.names[body.joint_id]}): V = {p.volume_m3:.6g} m^3, r_b = [{numbers_text(p.center_of_buoyancy_m, 4)}] m"
         )
+        lines.append(f"     free surface cuts {hull_text(hulls.get(k))}")
         lines.append(f"     added mass diag   [{numbers_text(np.diag(p.added_mass), 4)}]")
         lines.append(f"     linear damping    [{numbers_text(np.diag(p.linear_damping), 4)}]")
         lines.append(f"     quadratic damping [{numbers_text(p.quadratic_damping, 4)}]")
@@ -62,3 +65,14 @@ def model_summary(uvms: UVMS) -> str:
             f"{model.effortLimit[idx_v]:>10.3g}{model.velocityLimit[idx_v]:>10.3g}"
         )
     return "\n".join(lines)
+
+
+def hull_text(hull: Hull | None) -> str:
+    """What the free surface cuts of a body: its hull's shapes and volume scale."""
+    if hull is None:
+        return "nothing (no volume, no geometry: always wet)"
+    if hull.equivalent_sphere:
+        radius = hull.pieces[0].shape.radius_m
+        return f"a sphere of its volume at r_b, r = {radius:.4g} m (no collision geometry)"
+    shapes = ", ".join(piece.shape.label for piece in hull.pieces)
+    return f"its collision {shapes}, volume scaled by {hull.volume_scale:.4g} to V"

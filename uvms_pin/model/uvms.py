@@ -18,7 +18,9 @@ import pinocchio as pin
 
 from uvms_pin.errors import ModelError
 from uvms_pin.hydro.added_mass import added_mass_in_parent
+from uvms_pin.hydro.hull import HullPiece
 from uvms_pin.hydro.params import HydroParams
+from uvms_pin.model.hulls import SurfaceBodies
 
 __all__ = ["DEFAULT_WATER_DENSITY_KG_M3", "UVMS", "HydroBody"]
 
@@ -35,12 +37,16 @@ class HydroBody:
         placement_in_joint: SE3 of the hydro frame (where the coefficients are given)
             relative to the joint frame.
         params: coefficients in the hydro frame.
+        geometry: the shapes that displace the body's water, placed in the hydro frame (its
+            collision geometry; the free surface cuts them). Empty: a body with volume is
+            taken as a sphere of that volume at its centre of buoyancy.
     """
 
     name: str
     joint_id: int
     placement_in_joint: pin.SE3
     params: HydroParams
+    geometry: tuple[HullPiece, ...] = ()
 
     @property
     def action_joint_to_body(self) -> np.ndarray:
@@ -123,6 +129,8 @@ class UVMS:
         self.damping_quadratic = np.array([b.params.quadratic_damping for b in damped]).reshape(
             -1, 6
         )
+        #: the bodies' hulls in their joints' frames, for a free surface
+        self.surface_bodies = SurfaceBodies.of(self.hydro_bodies, damped, nj)
 
     def __getstate__(self) -> dict:
         return {**self.__dict__, "cache": {}}  # e.g. C++ objects: rebuilt on first use

@@ -26,12 +26,13 @@ import pinocchio as pin
 
 from uvms_pin.checks import finite_vector
 from uvms_pin.errors import ParameterError
-from uvms_pin.flow import FlowField
+from uvms_pin.flow import FlowField, UniformCurrent
 from uvms_pin.hydro.restoring import buoyancy_potential_energy
 from uvms_pin.model.uvms import UVMS
 from uvms_pin.physics.compiled.backend import backend_named
 from uvms_pin.physics.compiled.dynamics import CompiledDynamics
 from uvms_pin.physics.reference import ReferenceDynamics, check_time
+from uvms_pin.physics.surface import wet_state
 
 _NO_CURRENT = np.zeros(3)
 
@@ -52,20 +53,42 @@ def _build_dynamics(uvms: UVMS, backend: str) -> CompiledDynamics | ReferenceDyn
     return dynamics
 
 
-def _flow_of_call(current_world: np.ndarray, flow: FlowField) -> FlowField:
-    """``flow`` when a call gives one: the current is then one of its fields, not an extra."""
-    if not isinstance(flow, FlowField):
+def _checked_flow(flow: FlowField | None) -> FlowField | None:
+    if flow is not None and not isinstance(flow, FlowField):
         raise ParameterError(f"flow must be a uvms_pin.flow.FlowField, got {type(flow).__name__}")
-    if np.any(finite_vector("current_world", current_world, 3)):
+    return flow
+
+
+def _flow_of_call(current_world: np.ndarray, flow: FlowField | None) -> FlowField | None:
+    """``flow`` when a call gives one: the current is then one of its fields, not an extra;
+    without one, the uniform current (None: still water)."""
+    current = finite_vector("current_world", current_world, 3)
+    if flow is None:
+        return UniformCurrent(current) if np.any(current) else None
+    _checked_flow(flow)
+    if np.any(current):
         raise ParameterError("give either current_world or flow, not both (add the fields)")
     return flow
 
 
-def mass_matrix(uvms: UVMS, q: np.ndarray, *, backend: str = "core") -> np.ndarray:
+def mass_matrix(
+    uvms: UVMS,
+    q: np.ndarray,
+    *,
+    backend: str = "core",
+    free_surface: bool = False,
+    flow: FlowField | None = None,
+    time_s: float = 0.0,
+) -> np.ndarray:
     """M(q) = M_RB(q) + sum_i J_i^T M_A,i J_i (nv x nv, symmetric positive definite).
 
-    ``backend``: "core" (compiled, default) or "python" (the reference)."""
-    return dynamics_of(uvms, backend).mass_matrix(q)
+    ``backend``: "core" (compiled, default) or "python" (the reference). ``free_surface``:
+    each body's added mass scaled by its wet fraction under the surface of ``flow`` (z = 0
+    in still water) at ``time_s``."""
+    dynamics = dynamics_of(uvms, backend)
+    if not free_surface:
+        return dynamics.mass_matrix(q)
+    return dynamics.mass_matrix_in(q, _checked_flow(flow), check_time(time_s), True)
 
 
 def bias_forces(
@@ -77,6 +100,7 @@ def bias_forces(
     flow: FlowField | None = None,
     time_s: float = 0.0,
     backend: str = "core",
+    free_surface: bool = False,
 ) -> np.ndarray:
     """h(q, zeta): rigid Coriolis and gravity, added-mass bias and Coriolis, damping, buoyancy,
     and, in an accelerating flow, the Froude-Krylov and added-mass loads of the flow.
@@ -88,12 +112,15 @@ def bias_forces(
         flow: any `uvms_pin.flow.FlowField` (waves, sea states, varying currents).
         time_s: the time at which the flow is evaluated [s].
         backend: "core" (compiled, default) or "python" (the reference).
+        free_surface: cut the bodies by the free surface (z = 0, or the waves' elevation):
+            buoyancy and Froude-Krylov of the wet part, added mass and damping scaled by the
+            wet fraction (`uvms_pin.physics.surface`). False: water without a top.
     """
     dynamics = dynamics_of(uvms, backend)
-    if flow is None:
+    if flow is None and not free_surface:
         return dynamics.bias_forces(q, v, current_world)
     flow = _flow_of_call(current_world, flow)
-    return dynamics.bias_forces_in(q, v, flow, check_time(time_s))
+    return dynamics.bias_forces_in(q, v, flow, check_time(time_s), free_surface)
 
 
 def forward_dynamics(
@@ -107,6 +134,7 @@ def forward_dynamics(
     flow: FlowField | None = None,
     time_s: float = 0.0,
     backend: str = "core",
+    free_surface: bool = False,
 ) -> np.ndarray:
     """zeta_dot = M(q)^-1 (tau + tau_ext - h(q, zeta)), by a Cholesky solve (no inverse).
 
@@ -117,16 +145,17 @@ def forward_dynamics(
             `frame_wrench_to_generalized`; None for none.
         flow, time_s: a `uvms_pin.flow.FlowField` and the time it is evaluated at [s].
         backend: "core" (compiled, default) or "python" (the reference).
+        free_surface: cut the bodies by the free surface (see `bias_forces`).
 
     Raises:
         ParameterError: wrong shape or non-finite input.
         SimulationError: M not positive definite (e.g. a degenerate model).
     """
     dynamics = dynamics_of(uvms, backend)
-    if flow is None:
+    if flow is None and not free_surface:
         return dynamics.forward_dynamics(q, v, tau, current_world, tau_ext)
     flow = _flow_of_call(current_world, flow)
-    return dynamics.forward_dynamics_in(q, v, tau, flow, check_time(time_s), tau_ext)
+    return dynamics.forward_dynamics_in(q, v, tau, flow, check_time(time_s), tau_ext, free_surface)
 
 
 def frame_wrench_to_generalized(
@@ -138,21 +167,50 @@ def frame_wrench_to_generalized(
     return jac.T @ wrench_world_aligned
 
 
-def kinetic_energy(uvms: UVMS, q: np.ndarray, v: np.ndarray, *, backend: str = "core") -> float:
-    """T = 1/2 zeta^T M(q) zeta [J], added mass (the entrained fluid) included."""
+def kinetic_energy(
+    uvms: UVMS,
+    q: np.ndarray,
+    v: np.ndarray,
+    *,
+    backend: str = "core",
+    free_surface: bool = False,
+    flow: FlowField | None = None,
+    time_s: float = 0.0,
+) -> float:
+    """T = 1/2 zeta^T M(q) zeta [J], added mass (the entrained fluid) included (scaled by
+    the wet fractions with ``free_surface``)."""
     v = finite_vector("v", v, uvms.nv)
-    return float(0.5 * v @ mass_matrix(uvms, q, backend=backend) @ v)
+    mass = mass_matrix(
+        uvms, q, backend=backend, free_surface=free_surface, flow=flow, time_s=time_s
+    )
+    return float(0.5 * v @ mass @ v)
 
 
-def potential_energy(uvms: UVMS, q: np.ndarray) -> float:
-    """U = U_gravity + U_buoyancy [J] (zero at z = 0)."""
+def potential_energy(
+    uvms: UVMS,
+    q: np.ndarray,
+    *,
+    free_surface: bool = False,
+    flow: FlowField | None = None,
+    time_s: float = 0.0,
+) -> float:
+    """U = U_gravity + U_buoyancy [J] (zero at z = 0): U_buoyancy = rho g . (V r_b) summed
+    over the joints, with the wet volumes and centroids under a ``free_surface`` (then, in
+    still water, U is the potential of the exact hydrostatic load: its negative gradient is
+    rho g V_sub at r_sub; under waves the water does work and U is the same formula at
+    ``time_s``)."""
     q = finite_vector("q", q, uvms.nq)
     model, data = uvms.model, uvms.data
     pin.forwardKinematics(model, data, q)
     energy = float(pin.computePotentialEnergy(model, data, q))
+    wet = wet_state(uvms, data, _checked_flow(flow), check_time(time_s)) if free_surface else None
+    volumes = uvms.volume_per_joint_m3 if wet is None else wet.volume_per_joint_m3
+    cobs = (
+        uvms.center_of_buoyancy_per_joint_m if wet is None else wet.center_of_buoyancy_per_joint_m
+    )
     for j in uvms.joints_with_volume:
-        cob_world = data.oMi[j].act(uvms.center_of_buoyancy_per_joint_m[j])
+        cob_world = data.oMi[j].act(cobs[j])
         energy += buoyancy_potential_energy(
-            uvms.volume_per_joint_m3[j], cob_world, uvms.water_density_kg_m3, model.gravity.linear
+            volumes[j], cob_world, uvms.water_density_kg_m3, model.gravity.linear
         )
     return energy

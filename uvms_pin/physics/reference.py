@@ -26,7 +26,9 @@ from uvms_pin.hydro.current import current_velocity_body, flow_twist_rate_body
 from uvms_pin.hydro.damping import damping_wrench
 from uvms_pin.hydro.restoring import buoyancy_wrench, froude_krylov_wrench
 from uvms_pin.hydro.vector import mat_t_vec, mat_vec
+from uvms_pin.model.hulls import SurfaceBodies
 from uvms_pin.model.uvms import UVMS
+from uvms_pin.physics.surface import WetState, wet_state
 
 
 def check_time(time_s: float) -> float:
@@ -37,24 +39,31 @@ def check_time(time_s: float) -> float:
     return time_s
 
 
-def _fluid_wrenches(uvms: UVMS, flow: FlowField | None, time_s: float) -> list[pin.Force]:
+def _fluid_wrenches(
+    uvms: UVMS, flow: FlowField | None, time_s: float, wet: WetState | None = None
+) -> list[pin.Force]:
     """Wrench of the water on each joint body (LOCAL frame), all terms but M_A zeta_dot.
 
     Needs ``forwardKinematics(model, data, q, v, 0)`` in ``uvms.data`` (placements, body
     velocities and bias accelerations). The flow is sampled at each joint body's centre of
     buoyancy (its origin if it has no volume) for added mass and Froude-Krylov, and at each
-    damped link's origin for damping. Vectorized over bodies: the per-body physics is the
-    pure functions of `uvms_pin.hydro`, called once on stacks.
+    damped link's origin for damping. Under a free surface (``wet``, `physics.surface`) the
+    volumes, centres of buoyancy and added masses are the wet ones, damping is scaled by the
+    wet fraction and the added mass's change with it adds `wet_fraction_wrenches`. Vectorized
+    over bodies: the per-body physics is the pure functions of `uvms_pin.hydro`, called once
+    on stacks.
     """
     model, data = uvms.model, uvms.data
     nj = model.njoints
     rotation = np.array([data.oMi[j].rotation for j in range(nj)])  # (nj, 3, 3)
     velocity = np.array([data.v[j].vector for j in range(nj)])  # (nj, 6), LOCAL
     wrench = np.zeros((nj, 6))
+    volumes = uvms.volume_per_joint_m3 if wet is None else wet.volume_per_joint_m3
+    cobs = (
+        uvms.center_of_buoyancy_per_joint_m if wet is None else wet.center_of_buoyancy_per_joint_m
+    )
     if flow is not None:
-        cob_world = np.array(
-            [data.oMi[j].act(uvms.center_of_buoyancy_per_joint_m[j]) for j in range(nj)]
-        )
+        cob_world = np.array([data.oMi[j].act(cobs[j]) for j in range(nj)])
         flow_velocity_world, flow_acceleration_world = flow.velocity_and_acceleration(
             time_s, cob_world
         )
@@ -69,12 +78,16 @@ def _fluid_wrenches(uvms: UVMS, flow: FlowField | None, time_s: float) -> list[p
                 rotation[joints], nu[:, 3:], nu_c[:, :3], flow_acceleration_world[joints]
             )
             nu = nu - nu_c
-        added = uvms.added_mass_per_joint[joints]
+        added = (uvms.added_mass_per_joint if wet is None else wet.added_mass_per_joint)[joints]
         wrench[joints] -= mat_vec(added, acc) + kirchhoff_wrench(added, nu)
+        if wet is not None:
+            relative = velocity.copy()
+            relative[joints] = nu
+            wrench += wet_fraction_wrenches(uvms.surface_bodies, wet, velocity, relative)
 
     joints = list(uvms.joints_with_volume)
     if joints:
-        volume, cob = uvms.volume_per_joint_m3[joints], uvms.center_of_buoyancy_per_joint_m[joints]
+        volume, cob = volumes[joints], cobs[joints]
         wrench[joints] += buoyancy_wrench(
             volume, cob, rotation[joints], uvms.water_density_kg_m3, model.gravity.linear
         )
@@ -97,38 +110,78 @@ def _fluid_wrenches(uvms: UVMS, flow: FlowField | None, time_s: float) -> list[p
             ) + np.array([data.oMi[int(j)].translation for j in ids])
             nu_r = nu_r - current_velocity_body(body_rotation, flow.velocity(time_s, origin_world))
         wrench_body = damping_wrench(uvms.damping_linear, uvms.damping_quadratic, nu_r)
+        if wet is not None:  # drag of the wet part: scaled by the wet fraction
+            hull = uvms.surface_bodies.hull_of_damped
+            wrench_body *= np.where(hull >= 0, wet.fraction[hull], 1.0)[:, None]
         # back to the joint frame: f_joint = X^T f_body
         np.add.at(wrench, ids, mat_t_vec(uvms.damping_action, wrench_body))
     return [pin.Force(w) for w in wrench]
 
 
-def _mass_matrix(uvms: UVMS, q: np.ndarray) -> np.ndarray:
+def wet_fraction_wrenches(
+    bodies: SurfaceBodies, wet: WetState, velocity: np.ndarray, relative_velocity: np.ndarray
+) -> np.ndarray:
+    """The wrench (nj, 6) on each joint of an added mass that changes with the wet fraction.
+
+    Body i's fluid kinetic energy is T_i = f_i(q, t) 1/2 nu_r^T M_A,i nu_r; the Kirchhoff
+    terms are those of the constant M_A,i, scaled by f_i. Lagrange's equations add, per body,
+
+        w_i = -(df_i/dt) M_A,i nu_r + (1/2 nu_r^T M_A,i nu_r) g_i,   df_i/dt = g_i . nu + f_t,i
+
+    (g_i = df_i / d(pose) over the joint's twist), which makes the exchange of energy with
+    the entrained water exact: with the surface at rest and no damping, kinetic + potential
+    energy is conserved. ``velocity`` and ``relative_velocity`` (nj, 6): each joint's twist
+    nu and nu_r = nu - nu_c (LOCAL).
+    """
+    j = bodies.joint_ids
+    momentum = mat_vec(bodies.added_mass_in_joint, relative_velocity[j])
+    energy = 0.5 * np.einsum("hi,hi->h", relative_velocity[j], momentum)
+    rate = np.einsum("hi,hi->h", wet.fraction_gradient, velocity[j]) + wet.fraction_rate
+    out = np.zeros((len(velocity), 6))
+    np.add.at(out, j, energy[:, None] * wet.fraction_gradient - rate[:, None] * momentum)
+    return out
+
+
+def _mass_matrix(uvms: UVMS, q: np.ndarray, wet: WetState | None = None) -> np.ndarray:
     model, data = uvms.model, uvms.data
     pin.crba(model, data, q)
     mass = np.triu(data.M)
     mass = mass + np.triu(mass, 1).T  # crba fills the upper triangle only
+    added = uvms.added_mass_per_joint if wet is None else wet.added_mass_per_joint
     if uvms.joints_with_added_mass:
         pin.computeJointJacobians(model, data, q)
         for j in uvms.joints_with_added_mass:
             jac = pin.getJointJacobian(model, data, j, pin.LOCAL)
-            mass += jac.T @ uvms.added_mass_per_joint[j] @ jac
+            mass += jac.T @ added[j] @ jac
     return mass
 
 
+def _wet(uvms: UVMS, flow: FlowField | None, time_s: float, free_surface: bool) -> WetState | None:
+    """The wet state after forward kinematics (None without a free surface or all deep)."""
+    return wet_state(uvms, uvms.data, flow, time_s) if free_surface else None
+
+
 def _bias_forces(
-    uvms: UVMS, q: np.ndarray, v: np.ndarray, flow: FlowField | None, time_s: float
-) -> np.ndarray:
+    uvms: UVMS,
+    q: np.ndarray,
+    v: np.ndarray,
+    flow: FlowField | None,
+    time_s: float,
+    free_surface: bool = False,
+) -> tuple[np.ndarray, WetState | None]:
+    """(h, the wet state it was computed in)."""
     model, data = uvms.model, uvms.data
     zero = np.zeros(model.nv)
     pin.forwardKinematics(model, data, q, v, zero)
-    fext = _fluid_wrenches(uvms, flow, time_s)
+    wet = _wet(uvms, flow, time_s, free_surface)
+    fext = _fluid_wrenches(uvms, flow, time_s, wet)
     # rnea(q, v, 0, fext) = C_RB v + g_RB - sum_i J_i^T fext_i
-    return pin.rnea(model, data, q, v, zero, fext).copy()
+    return pin.rnea(model, data, q, v, zero, fext).copy(), wet
 
 
-def _solve(uvms: UVMS, q: np.ndarray, rhs: np.ndarray) -> np.ndarray:
+def _solve(uvms: UVMS, q: np.ndarray, rhs: np.ndarray, wet: WetState | None) -> np.ndarray:
     """M(q)^-1 rhs by a Cholesky factorisation (no inverse)."""
-    mass = _mass_matrix(uvms, q)
+    mass = _mass_matrix(uvms, q, wet)
     try:
         factor = cho_factor(mass, lower=False, check_finite=False)
     except np.linalg.LinAlgError as exc:
@@ -140,7 +193,9 @@ class ReferenceDynamics:
     """M, h and the forward dynamics of one UVMS, in Python: the readable reference.
 
     The ``*_in`` methods take any `uvms_pin.flow.FlowField` evaluated at ``time_s``; the
-    others a uniform, constant current (3,) [m/s] in the world frame.
+    others a uniform, constant current (3,) [m/s] in the world frame. ``free_surface``:
+    the bodies are cut by the free surface (`uvms_pin.physics.surface`); without it the
+    water has no top (every body is wholly wet).
     """
 
     def __init__(self, uvms: UVMS):
@@ -154,14 +209,27 @@ class ReferenceDynamics:
         q, _ = self._state(q)
         return _mass_matrix(self.uvms, q)
 
+    def mass_matrix_in(
+        self, q: np.ndarray, flow: FlowField | None, time_s: float, free_surface: bool = False
+    ) -> np.ndarray:
+        q, _ = self._state(q)
+        pin.forwardKinematics(self.uvms.model, self.uvms.data, q)
+        wet = _wet(self.uvms, flow, check_time(time_s), free_surface)
+        return _mass_matrix(self.uvms, q, wet)
+
     def bias_forces(self, q: np.ndarray, v: np.ndarray, current_world: np.ndarray) -> np.ndarray:
         return self.bias_forces_in(q, v, _uniform(current_world), 0.0)
 
     def bias_forces_in(
-        self, q: np.ndarray, v: np.ndarray, flow: FlowField | None, time_s: float
+        self,
+        q: np.ndarray,
+        v: np.ndarray,
+        flow: FlowField | None,
+        time_s: float,
+        free_surface: bool = False,
     ) -> np.ndarray:
         q, v = self._state(q, v)
-        return _bias_forces(self.uvms, q, v, flow, check_time(time_s))
+        return _bias_forces(self.uvms, q, v, flow, check_time(time_s), free_surface)[0]
 
     def forward_dynamics(
         self,
@@ -181,14 +249,14 @@ class ReferenceDynamics:
         flow: FlowField | None,
         time_s: float,
         tau_ext: np.ndarray | None = None,
+        free_surface: bool = False,
     ) -> np.ndarray:
         q, v = self._state(q, v)
-        rhs = finite_vector("tau", tau, self.uvms.nv) - _bias_forces(
-            self.uvms, q, v, flow, check_time(time_s)
-        )
+        bias, wet = _bias_forces(self.uvms, q, v, flow, check_time(time_s), free_surface)
+        rhs = finite_vector("tau", tau, self.uvms.nv) - bias
         if tau_ext is not None:
             rhs += finite_vector("tau_ext", tau_ext, self.uvms.nv)
-        return _solve(self.uvms, q, rhs)
+        return _solve(self.uvms, q, rhs, wet)
 
 
 def _uniform(current_world: np.ndarray) -> UniformCurrent | None:

@@ -45,7 +45,11 @@ def compute_metrics(rollout: RolloutData) -> dict[str, float]:
     )
     force = np.linalg.norm(rollout.tau[:, :3], axis=1)
     torque = np.linalg.norm(rollout.tau[:, 3:6], axis=1)
-    joints = np.abs(rollout.tau[:, 6:])
+    # Fix: the RMS was taken over every joint and sample, so idle joints diluted it (a
+    # 4-joint arm with one joint working reported half its torque); it is now the RMS of
+    # max_j |tau_j|, the quantity the docstring names (the peak was already its maximum)
+    arm = np.abs(rollout.tau[:, 6:])
+    joints = arm.max(axis=1) if arm.shape[1] else np.empty(0)  # no arm: peak 0, RMS NaN
     out.update(
         vehicle_force_peak_N=float(force.max()),
         vehicle_force_rms_N=_rms(force),
@@ -56,7 +60,31 @@ def compute_metrics(rollout: RolloutData) -> dict[str, float]:
     )
     out.update(force_tracking_metrics(rollout))
     out.update(joint_limit_metrics(rollout))
+    out.update(surface_metrics(rollout))
     return out
+
+
+#: A wet fraction this far below 1 counts as partly out of the water (rounding aside).
+_WET = 1.0 - 1e-9
+
+
+def surface_metrics(rollout: RolloutData) -> dict[str, float]:
+    """How long some body was out of the water, in part or whole [s], from the logged wet
+    fractions (a run under a free surface): each sample counts until the next one.
+
+    ``time_partly_out_of_water_s``: some body had 0 <= f < 1 (part of it, or all, above
+    the surface); ``time_wholly_out_of_water_s``: some body had f = 0; and the smallest
+    wet fraction of any body over the run.
+    """
+    fractions = rollout.signals.get("wet_fraction")
+    if fractions is None or len(rollout) == 0 or fractions.shape[1] == 0:
+        return {}
+    held = np.diff(rollout.time_s, append=rollout.time_s[-1])
+    return {
+        "time_partly_out_of_water_s": float(held @ np.any(fractions < _WET, axis=1)),
+        "time_wholly_out_of_water_s": float(held @ np.any(fractions <= 0.0, axis=1)),
+        "wet_fraction_min": float(fractions.min()),
+    }
 
 
 def joint_limit_metrics(rollout: RolloutData) -> dict[str, float]:

@@ -104,7 +104,15 @@ def _build(raw: dict[str, Any], path: Path, top: Table) -> Scenario:
     check_baselines(top.table("baselines"), (raw.get("controller") or {}).get("type"))
     top.finish()
     plant = Plant(
-        uvms, water.current_world_m_s, contact, disturbance, actuation, water.flow, backend
+        uvms,
+        water.current_world_m_s,
+        contact,
+        disturbance,
+        actuation,
+        water.flow,
+        backend,
+        free_surface=water.free_surface,
+        stop_at_surface=water.stop_at_surface,
     )
     try:
         settings = SimulationSettings(

@@ -24,17 +24,25 @@ from uvms_pin.scenario.schema import Table
 
 @dataclass(frozen=True)
 class Water:
-    """What ``[water]`` gives: rho [kg/m^3], the uniform current [m/s] (world) and the flow
-    beyond it (None for none)."""
+    """What ``[water]`` gives: rho [kg/m^3], the uniform current [m/s] (world), the flow
+    beyond it (None for none), whether the water has a free surface (z = 0, or the waves'
+    elevation) that cuts the bodies, and whether a run stops when a body's centre of
+    buoyancy reaches it."""
 
     density_kg_m3: float
     current_world_m_s: np.ndarray
     flow: FlowField | None
+    free_surface: bool = True
+    stop_at_surface: bool = False
 
 
 def build_water(t: Table, seed: int) -> Water:
     density = t.number("density_kg_m3", 1025.0, positive=True)
     current = t.vector("current_world_m_s", 3, [0.0, 0.0, 0.0])
+    stop_at_surface = t.boolean("stop_at_surface", False)
+    # stopping at the surface is the model of submerged bodies: no surface in the dynamics
+    # unless asked for as well
+    free_surface = t.boolean("free_surface", not stop_at_surface)
     fields = []
     for key, build in FLOW_TABLES.items():
         table = t.table(key)
@@ -42,7 +50,7 @@ def build_water(t: Table, seed: int) -> Water:
             fields.append(_flow_field(table, build, seed))
     t.finish()
     flow = None if not fields else fields[0] if len(fields) == 1 else SumFlow(tuple(fields))
-    return Water(density, current, flow)
+    return Water(density, current, flow, free_surface, stop_at_surface)
 
 
 def _waves(t: Table, seed: int) -> AiryWave:

@@ -96,7 +96,8 @@ class ClosedLoop:
     def measure(self) -> tuple[Measurement, np.ndarray]:
         """(what the sensors give now, the true contact wrench (6,) [N; N m] world axes).
 
-        Raises SimulationError when a body reached the free surface (waves)."""
+        Raises SimulationError when a body reached the free surface and the plant stops
+        there (``stop_at_surface``)."""
         self.plant.check_submerged(self.time_s, self.q)
         contact = self.plant.contact_wrench(self.q, self.v)
         return self.sensors.measure(self.time_s, self.q, self.v, contact), contact
@@ -374,6 +375,6 @@ def simulate_closed_loop(
 
     check_log_fits(settings, plant.uvms.nq, plant.uvms.nv)
     meta = {**(metadata or {}), **run_metadata(plant, settings)}
-    log = RolloutLog(plant.uvms, settings.n_log, meta, backend=plant.backend)
+    log = RolloutLog(plant.uvms, settings.n_log, meta, backend=plant.backend, plant=plant)
     loop = ClosedLoop(plant, settings, controller, observers)
     return loop.run(q0, v0, sensors, log)

@@ -2,7 +2,9 @@
 
 Rows are preallocated (the run's number of logged samples, or a first guess that doubles when
 full, for an episode of unknown length); the energies are computed once, for the rows
-written, when the log is finished (they are functions of the state alone).
+written, when the log is finished (they are functions of the state alone), and so, under a
+free surface, is each hull's wet fraction (the signal ``wet_fraction``, one column per hull
+named in the metadata's ``hull_names``: 1 deep, 0 out of the water).
 """
 
 from __future__ import annotations
@@ -13,6 +15,7 @@ from typing import Any
 from uvms_pin.model.uvms import UVMS
 from uvms_pin.physics.dynamics import kinetic_energy, potential_energy
 from uvms_pin.results.rollout import Rollout
+from uvms_pin.sim.plant import Plant
 from uvms_pin.sim.sample import Sample
 
 
@@ -22,11 +25,23 @@ class RolloutLog:
     Args:
         uvms: the model (sizes, energies). backend: the dynamics' backend for the energies.
         capacity: rows to allocate first. metadata: the rollout's metadata.
+        plant: the world run in, when it has a free surface (energies and wet fractions
+            under it); None: water without a top.
     """
 
-    def __init__(self, uvms: UVMS, capacity: int, metadata: dict[str, Any], backend: str = "core"):
+    def __init__(
+        self,
+        uvms: UVMS,
+        capacity: int,
+        metadata: dict[str, Any],
+        backend: str = "core",
+        plant: Plant | None = None,
+    ):
         self.uvms = uvms
         self.backend = backend
+        self.plant = plant if plant is not None and plant.free_surface else None
+        if self.plant is not None:
+            metadata = {**metadata, "hull_names": hull_names(uvms)}
         self.rollout = Rollout.allocate(max(int(capacity), 1), uvms.nq, uvms.nv, metadata)
         self.count = 0
 
@@ -59,6 +74,7 @@ class RolloutLog:
         """An independent log holding the same samples (the model is shared)."""
         out = RolloutLog.__new__(RolloutLog)
         out.uvms, out.backend, out.count = self.uvms, self.backend, self.count
+        out.plant = self.plant
         out.rollout = copy.deepcopy(self.rollout)
         return out
 
@@ -66,9 +82,22 @@ class RolloutLog:
         """The rollout of the samples written so far, with their energies."""
         rollout = self.rollout
         rollout.truncate(self.count)
+        plant = self.plant
+        surface = {} if plant is None else {"free_surface": True, "flow": plant.water}
         for k in range(self.count):
+            if plant is not None:
+                surface["time_s"] = float(rollout.time_s[k])
+                width = len(self.uvms.surface_bodies)
+                rollout.signal("wet_fraction", width)[k] = plant.wet_fractions(
+                    surface["time_s"], rollout.q[k]
+                )
             rollout.kinetic_energy_J[k] = kinetic_energy(
-                self.uvms, rollout.q[k], rollout.v[k], backend=self.backend
+                self.uvms, rollout.q[k], rollout.v[k], backend=self.backend, **surface
             )
-            rollout.potential_energy_J[k] = potential_energy(self.uvms, rollout.q[k])
+            rollout.potential_energy_J[k] = potential_energy(self.uvms, rollout.q[k], **surface)
         return rollout
+
+
+def hull_names(uvms: UVMS) -> list[str]:
+    """The name of each hull's body (the columns of the ``wet_fraction`` signal)."""
+    return [uvms.hydro_bodies[int(k)].name for k in uvms.surface_bodies.body_index]

@@ -32,6 +32,7 @@ from uvms_pin.physics.compiled.flow import flow_to_core
 from uvms_pin.physics.contact import ContactModel
 from uvms_pin.physics.disturbance import Disturbance
 from uvms_pin.physics.dynamics import dynamics_of, forward_dynamics
+from uvms_pin.physics.surface import wet_state
 from uvms_pin.sim.actuation import Actuation, Unlimited
 from uvms_pin.sim.integrators import Chart, Integrator
 
@@ -49,6 +50,11 @@ class Plant:
         flow: waves, sea states or varying currents (`uvms_pin.flow`), added to the
             uniform current; None for none.
         backend: "core" (compiled, default) or "python" (the reference implementation).
+        free_surface: the water has a top, z = 0 or the waves' elevation, and each body is
+            cut by it (`uvms_pin.physics.surface`): it floats, surfaces, leaves the water.
+            The default. False: water without a top (every body wholly wet wherever it is).
+        stop_at_surface: end the run (SimulationError) when a body's centre of buoyancy
+            rises above the surface: for models meant for submerged bodies only.
     """
 
     uvms: UVMS
@@ -58,6 +64,8 @@ class Plant:
     actuation: Actuation = field(default_factory=Unlimited)
     flow: FlowField | None = None
     backend: str = "core"
+    free_surface: bool = True
+    stop_at_surface: bool = False
 
     def __post_init__(self) -> None:
         self.current_world_m_s = finite_vector("current_world_m_s", self.current_world_m_s, 3)
@@ -86,15 +94,13 @@ class Plant:
             "current_world_m_s": self.current_world_m_s.tolist(),
             "flow": None if self.water is None else self.water.record(),
             "contact": None if self.contact is None else self.contact.record(),
+            "free_surface": bool(self.free_surface),
         }
 
     def check_submerged(self, time_s: float, q: np.ndarray) -> None:
-        """Raise SimulationError when a body's centre of buoyancy is above the wave surface.
-
-        Only for flows with a moving free surface (waves): the hydrodynamics here are those
-        of a fully submerged body, so a body reaching the surface ends the run, reported.
-        """
-        if self.flow is None or not self.flow.has_free_surface:
+        """With ``stop_at_surface``: raise SimulationError when a body's centre of buoyancy
+        is above the free surface (z = 0, or the waves' elevation there)."""
+        if not self.stop_at_surface:
             return
         model, data = self.uvms.model, self._ee_data
         pin.forwardKinematics(model, data, q)
@@ -104,13 +110,25 @@ class Plant:
             cob = data.oMi[body.joint_id].act(
                 body.placement_in_joint.act(body.params.center_of_buoyancy_m)
             )
-            eta = float(self.flow.surface_elevation(time_s, cob[None, :2])[0])
+            eta = 0.0 if self.water is None else self.water.surface_elevation(time_s, cob[:2])
+            eta = float(np.asarray(eta).reshape(-1)[0])
             if cob[2] > eta:
                 raise SimulationError(
                     f"link '{body.name}' reached the free surface at t = {time_s:.6g} s: its "
-                    f"centre of buoyancy is {cob[2] - eta:.3g} m above the wave surface "
-                    f"(eta = {eta:.3g} m); the model holds for submerged bodies only"
+                    f"centre of buoyancy is {cob[2] - eta:.3g} m above the surface "
+                    f"(eta = {eta:.3g} m) and the run stops there ([water] stop_at_surface)"
                 )
+
+    def wet_fractions(self, time_s: float, q: np.ndarray) -> np.ndarray:
+        """Each hull's wet fraction f in [0, 1] at (t, q) (``uvms.surface_bodies`` order):
+        1 deep, 0 out of the water; all 1 without a free surface."""
+        bodies = self.uvms.surface_bodies
+        if not self.free_surface:
+            return np.ones(len(bodies))
+        data = self._ee_data
+        pin.forwardKinematics(self.uvms.model, data, q)
+        state = wet_state(self.uvms, data, self.water, time_s)
+        return np.ones(len(bodies)) if state is None else state.fraction.copy()
 
     def __getstate__(self) -> dict:
         state = dict(self.__dict__)
@@ -136,6 +154,7 @@ class Plant:
         ee_frame_id = self.uvms.ee_frame_id if self.uvms.has_end_effector else 0
         compiled = core.Plant(dynamics_of(self.uvms).core, ee_frame_id)
         compiled.flow, compiled.contact, compiled.disturbance = parts
+        compiled.free_surface = bool(self.free_surface)
         return compiled
 
     def _core(self):
@@ -217,6 +236,7 @@ class Plant:
             flow=self.water,
             time_s=time_s,
             backend=self.backend,
+            free_surface=self.free_surface,
         )
 
     def chart(self) -> Chart | None:

@@ -10,7 +10,6 @@ from conftest import ROOT
 from uvms_pin.apps.arms.compare import CompareSettings, compare_arms
 from uvms_pin.apps.arms.progress import ArmProgress
 from uvms_pin.apps.cli.main import main
-from uvms_pin.model.resources import example_robot_data_dir
 from uvms_pin.results.rollout import Rollout
 
 SCENARIO = ROOT / "scenarios" / "realistic_force_tracking.toml"
@@ -52,7 +51,6 @@ def test_without_keep_rollouts_only_the_table_is_written(tmp_path):
     ]
 
 
-@pytest.mark.skipif(example_robot_data_dir() is None, reason="example-robot-data not installed")
 def test_cli_keeps_the_reason_of_an_arm_that_never_ran(tmp_path, capsys):
     out = tmp_path / "arms"
     argv = ["compare-arms", str(SCENARIO), "--arms", "so100", "--duration", "0.02"]

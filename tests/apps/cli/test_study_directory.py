@@ -4,12 +4,12 @@ study or a changed base scenario (exit 2, nothing touched), replaces it only wit
 
 from __future__ import annotations
 
-import glob
-import time
-
 import pandas as pd
+import paused_cli
 import pytest
-from cli_support import STUDY, interrupt, passive_scenario, run_cli, start_cli, tree_digest
+from cli_support import STUDY, interrupt, passive_scenario, run_cli, tree_digest
+
+from uvms_pin.apps.study.runner import load_results
 
 
 def _sweep(tmp_path, *extra: str):
@@ -52,14 +52,14 @@ def test_a_study_directory_refuses_another_study_and_a_changed_base(tmp_path):
 
 
 def test_ctrl_c_on_a_dask_sweep_prints_one_message_and_the_rerun_finishes(tmp_path):
+    """Ctrl-C once the sweep has recorded its first row (it waits there, held by a test
+    hook: however fast the runs, the sweep is in the middle when interrupted)."""
     (tmp_path / "base.toml").write_text(passive_scenario(0.5))
     (tmp_path / "study.toml").write_text(STUDY.replace("seed = 3", "seed = 3\nsamples = 15"))
-    proc = start_cli(["sweep", "study.toml", "--out", "out", "--workers", "1"], cwd=tmp_path)
+    command = ["sweep", "study.toml", "--out", "out", "--workers", "1"]
+    proc = paused_cli.start(["--pause-after-rows", "1"], command, tmp_path)
     try:
-        deadline = time.monotonic() + 240
-        while not glob.glob(str(tmp_path / "out" / "parts" / "*.parquet")):
-            assert proc.poll() is None and time.monotonic() < deadline, "no run recorded"
-            time.sleep(0.2)
+        paused_cli.wait_until_paused(proc)
         _, err = interrupt(proc)
     finally:
         if proc.poll() is None:
@@ -69,8 +69,10 @@ def test_ctrl_c_on_a_dask_sweep_prints_one_message_and_the_rerun_finishes(tmp_pa
     assert "Traceback" not in err and "KeyboardInterrupt" not in err, err
     assert "interrupted:" in err and "rerun the same command to finish" in err
     assert len([line for line in err.splitlines() if "interrupted" in line]) == 1, err
+    assert len(load_results(tmp_path / "out")) == 1  # what was recorded before Ctrl-C
 
     rerun = _sweep(tmp_path, "--workers", "0")
     assert rerun.returncode == 0, rerun.stderr
+    assert "29 run now, 1 already recorded" in rerun.stdout
     table = pd.read_parquet(tmp_path / "out" / "results.parquet")
     assert len(table) == 30 and table["run_id"].is_unique

@@ -16,7 +16,6 @@ from uvms_pin.errors import ModelError, ParameterError
 from uvms_pin.model.mount.catalog import resolve_arm
 from uvms_pin.model.mount.mount import mount_arm_detailed
 from uvms_pin.model.mount.split import split_urdf
-from uvms_pin.model.resources import example_robot_data_dir
 from uvms_pin.physics.contact import LinearSpring
 from uvms_pin.sim.plant import Plant
 
@@ -31,8 +30,6 @@ def _mounted(name: str, tmp: Path) -> tuple[up.UVMS, str]:
     """The reference system, or an example-robot-data arm on the reference vehicle."""
     if name == "reference":
         return up.load_uvms(REFERENCE_URDF), REFERENCE_URDF.read_text()
-    if example_robot_data_dir() is None:
-        pytest.skip("example-robot-data is not installed")
     split = split_urdf(REFERENCE_URDF, tmp)
     entry = resolve_arm(name)
     pose = (split.mount_pose.translation, np.array([np.pi, 0.0, 0.0]))  # as compare-arms

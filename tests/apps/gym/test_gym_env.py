@@ -7,6 +7,7 @@ import re
 
 import gymnasium as gym
 import numpy as np
+import pinocchio as pin
 import pytest
 from conftest import ROOT
 from gymnasium.utils.env_checker import check_env
@@ -113,12 +114,26 @@ def test_time_limit_truncates():
 
 
 def test_station_keeping_reward_is_the_pose_error():
+    """The errors are those of the true state reached (the episode's rollout, not the
+    measurement) to the goal pose (the scenario's initial pose, in the observation), and
+    the reward is -(|p - p_d| / 0.1 m)^2 - (angle / 0.1 rad)^2 (no effort at zero action)."""
     env = _make(STATION).unwrapped
-    env.reset(seed=2)
-    _, reward, _, _, info = env.step(np.zeros(env.action_space.shape))
-    expected = -((info["position_error_m"] / 0.1) ** 2) - (info["angle_error_rad"] / 0.1) ** 2
-    assert reward == pytest.approx(expected)
-    assert 0.0 < info["position_error_m"] <= np.sqrt(3) * 0.1  # the reset perturbation
+    observation, _ = env.reset(seed=2)
+    goal = observation[env.observation_layout["goal"]]
+    np.testing.assert_array_equal(goal, env.scenario.q0[:7])
+    for _ in range(3):
+        _, reward, _, _, info = env.step(np.zeros(env.action_space.shape))
+    q = env.episode_rollout().q[-1]
+    position_error = np.linalg.norm(q[:3] - goal[:3])
+    rotation = pin.Quaternion(q[3:7]).toRotationMatrix()
+    goal_rotation = pin.Quaternion(goal[3:7]).toRotationMatrix()
+    angle_error = np.linalg.norm(pin.log3(goal_rotation.T @ rotation))
+    assert info["position_error_m"] == pytest.approx(position_error, rel=1e-12)
+    assert info["angle_error_rad"] == pytest.approx(angle_error, rel=1e-9, abs=1e-12)
+    expected = -((position_error / 0.1) ** 2) - (angle_error / 0.1) ** 2
+    assert reward == pytest.approx(expected, rel=1e-12)
+    # the reset moved the vehicle up to 0.1 m per axis from the goal; 3 steps barely move it
+    assert 0.0 < position_error <= np.sqrt(3) * 0.1
 
 
 def test_vector_envs():

@@ -2,14 +2,12 @@
 
 from __future__ import annotations
 
-import os
-import signal
 import subprocess
 import sys
-import time
 
 import cloudpickle
 import pandas as pd
+import paused_cli
 import pytest
 from study_helpers import ROOT, write_study
 
@@ -17,7 +15,6 @@ from uvms_pin.apps.study import load_study
 from uvms_pin.apps.study.report import write_report
 from uvms_pin.apps.study.runner import (
     RESULTS_FILE,
-    ResultStore,
     execute_run,
     load_results,
     run_study,
@@ -90,37 +87,29 @@ def test_a_crash_midway_leaves_a_valid_table_and_the_rerun_only_finishes_it(tmp_
 
 
 def test_killing_the_sweep_process_and_rerunning_finishes_the_study(tmp_path, serial_table):
+    """SIGKILL once two rows are recorded (the sweep held there by a test hook, so the kill
+    comes mid-sweep on any machine): the rerun runs the four others only."""
     _, serial = serial_table
     path = write_study(tmp_path)
     out = tmp_path / "out"
-    command = [
-        sys.executable,
-        "-m",
-        "uvms_pin.apps.cli.main",
-        "sweep",
-        str(path),
-        "--out",
-        str(out),
-        "--workers",
-        "0",
-        "--quiet",
-    ]
-    process = subprocess.Popen(command, cwd=ROOT, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
-    store = ResultStore(out) if out.exists() else None
-    deadline = time.monotonic() + 60
-    while time.monotonic() < deadline:
-        if out.exists():
-            store = store or ResultStore(out)
-            if len(list(store.parts.glob("*.parquet"))) >= 2:
-                break
-        time.sleep(0.02)
-    os.kill(process.pid, signal.SIGKILL)
-    process.wait()
+    command = ["sweep", str(path), "--out", str(out), "--workers", "0", "--quiet"]
+    process = paused_cli.start(["--pause-after-rows", "2"], command, ROOT)
+    try:
+        paused_cli.wait_until_paused(process)
+    finally:
+        process.kill()
+        process.wait()
     killed = load_results(out)
-    assert 2 <= len(killed) < 6, "the sweep finished before it could be killed"
-    result = subprocess.run(command, cwd=ROOT, capture_output=True, text=True, timeout=120)
+    assert len(killed) == 2
+    result = subprocess.run(
+        [sys.executable, "-m", "uvms_pin.apps.cli.main", *command],
+        cwd=ROOT,
+        capture_output=True,
+        text=True,
+        timeout=120,
+    )
     assert result.returncode == 0, result.stderr
-    assert f"{6 - len(killed)} run now, {len(killed)} already recorded" in result.stdout
+    assert "4 run now, 2 already recorded" in result.stdout
     after = pd.read_parquet(out / RESULTS_FILE)
     assert after["run_id"].is_unique and len(after) == 6
     kept = after.set_index("run_id").loc[killed["run_id"], "run_wall_time_s"]

@@ -14,6 +14,7 @@ import urllib.request
 from pathlib import Path
 
 import numpy as np
+import paused_cli
 import pytest
 from viz_support import SPRING, short_scenario
 
@@ -154,23 +155,19 @@ def test_cli_busy_port_exits_with_a_clear_message(tmp_path):
 
 
 def test_cli_ctrl_c_during_a_live_run_shuts_the_server_down(tmp_path):
+    """Ctrl-C while the live run is simulating (held at its 20th sample by a test hook, the
+    view streaming): the server is gone when the command returns."""
     scenario = short_scenario(tmp_path, 20.0)
     port = _free_port()
-    proc = subprocess.Popen(
-        [*CLI, "run", str(scenario), "--out", str(tmp_path / "o"), "--quiet", "--live",
-         "--port", str(port), "--speed", "0.5"],
-        stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
-        # a runner started in the background passes SIGINT on as ignored (and Python
-        # keeps an inherited SIG_IGN): give the child the default Ctrl-C behaviour
-        preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL),
-    )  # fmt: skip
+    command = ["run", str(scenario), "--out", str(tmp_path / "o"), "--quiet", "--live",
+               "--port", str(port), "--speed", "0.5"]  # fmt: skip
+    proc = paused_cli.start(["--pause-at-sample", "20"], command, tmp_path)
     try:
-        line = proc.stdout.readline()
-        assert line.startswith(f"live view: http://127.0.0.1:{port}/static/"), line
+        lines = paused_cli.wait_until_paused(proc)
+        assert lines[0].startswith(f"live view: http://127.0.0.1:{port}/static/"), lines
         assert _server_processes(port)
         with urllib.request.urlopen(f"http://127.0.0.1:{port}/static/", timeout=10) as r:
             assert r.status == 200
-        time.sleep(0.5)  # streaming
         proc.send_signal(signal.SIGINT)
         _, err = proc.communicate(timeout=30)
     finally:
@@ -180,33 +177,53 @@ def test_cli_ctrl_c_during_a_live_run_shuts_the_server_down(tmp_path):
     assert proc.returncode == 130, err
     assert "interrupted" in err and "Traceback" not in err
     assert port_is_free(port)
-    deadline = time.monotonic() + 5
-    while _server_processes(port) and time.monotonic() < deadline:
-        time.sleep(0.1)
-    assert _server_processes(port) == []
+    assert _server_processes(port) == []  # terminated and reaped before the command returned
 
 
-def test_a_browser_receives_the_stream(reference_uvms):
-    """A page on the live URL shows the frames as they are played (the vehicle moves)."""
+class ManualClock:
+    """The live view's clock (its module's ``time``), advanced by the test alone:
+    ``perf_counter`` reads it; everything else is the real ``time``."""
+
+    def __init__(self) -> None:
+        self.now_s = 0.0
+
+    def perf_counter(self) -> float:
+        return self.now_s
+
+    def __getattr__(self, name: str):
+        return getattr(time, name)
+
+
+def test_a_browser_receives_the_stream_paced_by_the_clock(reference_uvms, monkeypatch):
+    """A page on the live URL shows the frames as the view's clock plays them: at twice
+    real time, 0.5525 s of clock show the frame of t = 1.105 s (x = 0.110 m), 0.4 s more
+    the one of t = 1.905 s (x = 0.190 m), not the last one pushed (x = 0.299 m)."""
     from viz_support import HeadlessPage
 
+    from uvms_pin.apps.viz import live as live_module
     from uvms_pin.apps.viz.meshcat_scene import UvmsScene
 
+    clock = ManualClock()
+    monkeypatch.setattr(live_module, "time", clock)
     page = HeadlessPage()  # skips without chromium
     base = "viewer.scene_tree.find(['meshcat', 'uvms_pin', 'robot', 'visuals', 'base_link_0'])"
+    x = f"{base}.object.position.x"
     try:
-        with LiveView(UvmsScene(reference_uvms), port=0, speed=1.0) as live:
+        with LiveView(UvmsScene(reference_uvms), port=0, speed=2.0) as live:
             q = reference_uvms.neutral_configuration()
             for k in range(300):  # 3 s moving at 0.1 m/s along x
                 q_k = q.copy()
                 q_k[0] = 0.001 * k
                 live.push(Frame(0.01 * k, q_k))
-            page.open(live.url, f"{base}.object.position.x > 0")
-            x0 = page.evaluate(f"{base}.object.position.x")
-            time.sleep(0.5)
-            x1 = page.evaluate(f"{base}.object.position.x")
-            assert x1 > x0  # still streaming, paced
-            assert live.watched and live.shown > 1
+            page.open(live.url, f"{x} === 0")  # the first frame, which the server keeps
+            # more than the view's 0.5 s between two looks for a browser: it finds this one
+            clock.now_s += 0.5525
+            page.wait_until(f"{x} > 0.1")
+            assert page.evaluate(x) == pytest.approx(0.110, abs=1e-9)
+            clock.now_s += 0.4
+            page.wait_until(f"{x} > 0.15")
+            assert page.evaluate(x) == pytest.approx(0.190, abs=1e-9)
+            assert live.watched and live.shown == 3  # the first frame, then one per advance
             assert page.websockets == [f"ws://127.0.0.1:{live.server.port}/"]
             port = live.server.port
     finally:

@@ -165,12 +165,17 @@ class HeadlessPage:
     def open(self, url: str, ready: str, timeout_s: float = 30.0) -> None:
         """Navigate and wait until the JS expression ``ready`` is true."""
         self.call("Page.navigate", {"url": url})
+        self.wait_until(ready, timeout_s, url)
+
+    def wait_until(self, ready: str, timeout_s: float = 30.0, where: str = "the page") -> None:
+        """Wait until the JS expression ``ready`` is true (the timeout only ends a test
+        that would otherwise hang: nothing waits for a time to pass)."""
         deadline = time.monotonic() + timeout_s
         while not self.evaluate(
             f"(() => {{ try {{ return !!({ready}); }} catch (e) {{ return false; }} }})()"
         ):
             if time.monotonic() > deadline:
-                raise TimeoutError(f"{url}: {ready} never became true")
+                raise TimeoutError(f"{where}: {ready} never became true")
             time.sleep(0.1)
 
     def next_frames(self, n: int = 3) -> None:

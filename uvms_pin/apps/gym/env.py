@@ -175,7 +175,11 @@ class UvmsEnv(gym.Env):
         loop.start(q0, v0, sensors)
         self._steps = 0
         self._log = RolloutLog(
-            scenario.uvms, self.max_steps + 1, self._episode_metadata(), scenario.plant.backend
+            scenario.uvms,
+            self.max_steps + 1,
+            self._episode_metadata(),
+            scenario.plant.backend,
+            plant=scenario.plant,
         )
         self._failure = None
         self._anchor = None

@@ -31,7 +31,7 @@ import zmq
 from meshcat.visualizer import ViewerWindow
 
 from uvms_pin.apps.viz.meshcat_scene import EnvironmentView, Frame, SceneStyle, UvmsScene
-from uvms_pin.apps.viz.surface import SurfaceView
+from uvms_pin.apps.viz.surface import surface_view_of
 from uvms_pin.errors import LiveServerError, PortInUseError, SimulationError
 from uvms_pin.results.progress import Progress
 from uvms_pin.results.rollout import Rollout
@@ -370,10 +370,8 @@ def scene_for_scenario(scenario: Scenario, style: SceneStyle | None = None) -> U
     tip0 = probe.ee_position(scenario.q0)
     controller = scenario.raw.get("controller") or {}
     extent = np.vstack([scenario.q0[:3], tip0])
-    flow = scenario.plant.flow
-    surface = None
-    if flow is not None and flow.has_free_surface:
-        surface = SurfaceView(flow, scenario.q0[:2])
+    surface = surface_view_of(scenario.plant.flow, scenario.plant.free_surface, scenario.q0[:2])
+    if surface is not None:  # keep the surface above the vehicle in view
         extent = np.vstack([extent, [*scenario.q0[:2], 0.0]])
     return UvmsScene(
         scenario.uvms,

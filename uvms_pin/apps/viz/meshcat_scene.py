@@ -175,7 +175,8 @@ class UvmsScene:
         style: scales and sizes.
         visual_model: the geometry to draw; default: the visual elements of the URDF
             ``uvms.source`` (meshes found through ``package_dirs``).
-        surface: the animated wave surface, or None (still water: not drawn).
+        surface: the free surface (animated waves, or the level z = 0 of still water), or
+            None (water without a top: not drawn).
     """
 
     def __init__(
@@ -239,7 +240,7 @@ class UvmsScene:
                 else "compliant plane (grey)"
             )
         if self.surface is not None:
-            parts.append("wave surface (translucent blue tiles)")
+            parts.append("free surface (translucent blue tiles)")
         parts.append("tip trail (yellow); sea floor 0.5 m grid")
         return "; ".join(parts)
 

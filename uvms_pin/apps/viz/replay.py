@@ -29,9 +29,9 @@ from uvms_pin.apps.viz.meshcat_scene import (
     UvmsScene,
     recording_visualizer,
 )
-from uvms_pin.apps.viz.surface import SurfaceView
+from uvms_pin.apps.viz.surface import surface_view_of
 from uvms_pin.errors import VizError
-from uvms_pin.flow import FlowField, flow_from_record
+from uvms_pin.flow import flow_from_record
 from uvms_pin.model.urdf.load import load_uvms
 from uvms_pin.model.uvms import DEFAULT_WATER_DENSITY_KG_M3
 from uvms_pin.results.atomic import write_text_atomic
@@ -67,7 +67,11 @@ def scene_for_rollout(
     scene0 = UvmsScene(uvms)  # for forward kinematics only
     tips = np.array([scene0.ee_position(q) for q in _every(rollout.q, 400)])
     extent = np.vstack([tips, rollout.q[:, :3]])
-    surface = _surface_view(flow_from_record(world.get("flow")), extent)
+    surface = surface_view_of(
+        flow_from_record(world.get("flow")),
+        bool(world.get("free_surface")),
+        extent.mean(axis=0)[:2],
+    )
     if surface is not None:  # keep the mean surface above the vehicle in view
         extent = np.vstack([extent, [*rollout.q[0, :2], 0.0]])
     return UvmsScene(
@@ -79,13 +83,6 @@ def scene_for_rollout(
         style=style,
         surface=surface,
     )
-
-
-def _surface_view(flow: FlowField | None, extent_world_m: np.ndarray) -> SurfaceView | None:
-    """The animated wave surface of a run with waves, else None."""
-    if flow is None or not flow.has_free_surface:
-        return None
-    return SurfaceView(flow, extent_world_m.mean(axis=0)[:2])
 
 
 def _every(rows: np.ndarray, at_most: int) -> np.ndarray:

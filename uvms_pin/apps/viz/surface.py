@@ -1,4 +1,5 @@
-"""The wave surface drawn in meshcat: translucent tiles that follow eta(t, x, y).
+"""The free surface drawn in meshcat: translucent tiles that follow eta(t, x, y) (level at
+z = 0 in still water).
 
 Meshcat animates transforms, not vertices, so the surface is a grid of thin tiles, each
 placed at the elevation of its centre and tilted to the local slope (normal
@@ -27,13 +28,23 @@ def _quaternion_z_to(normals: np.ndarray) -> np.ndarray:
     return quat / np.linalg.norm(quat, axis=1, keepdims=True)
 
 
+def surface_view_of(
+    flow: FlowField | None, free_surface: bool, center_xy_m: np.ndarray
+) -> SurfaceView | None:
+    """The surface a scene shows: the waves of a flow that has them, the level water line
+    z = 0 of a run with a free surface in still water, else None."""
+    if flow is not None and flow.has_free_surface:
+        return SurfaceView(flow, center_xy_m)
+    return SurfaceView(None, center_xy_m) if free_surface else None
+
+
 class SurfaceView:
     """Tiles over a square of ``half_width_m`` around ``center_xy_m`` showing the free surface
-    of ``flow`` (a field with ``has_free_surface``)."""
+    of ``flow`` (a field with ``has_free_surface``; None: the level surface z = 0)."""
 
     def __init__(
         self,
-        flow: FlowField,
+        flow: FlowField | None,
         center_xy_m: np.ndarray,
         half_width_m: float = 3.0,
         tiles_per_side: int = 12,
@@ -54,6 +65,8 @@ class SurfaceView:
     def elevation_and_normal(self, time_s: float) -> tuple[np.ndarray, np.ndarray]:
         """eta (n,) [m] at the tile centres and the unit surface normals (n, 3)."""
         xy, h = self.centers_xy_m, _SLOPE_STEP_M
+        if self.flow is None:
+            return np.zeros(len(xy)), np.tile(_Z, (len(xy), 1))
         eta = self.flow.surface_elevation(time_s, xy)
         dx = (
             self.flow.surface_elevation(time_s, xy + np.array([h, 0.0]))

@@ -17,7 +17,8 @@ from pathlib import Path
 import pinocchio as pin
 
 from uvms_pin.errors import ModelError, ModelWarning
-from uvms_pin.model.urdf.collision import collision_hydro
+from uvms_pin.hydro.hull import HullPiece
+from uvms_pin.model.urdf.collision import collision_hydro, collision_piece
 from uvms_pin.model.urdf.hydrodynamics import parse_hydro
 from uvms_pin.model.urdf.inertial import check_inertial
 from uvms_pin.model.uvms import HydroBody
@@ -63,15 +64,25 @@ def hydro_bodies(
         hydro = hydro_elements.get(name)
         collisions = link.findall("collision")
         if hydro is not None:
-            own = [HydroBody(name, joint_id, placement, parse_hydro(hydro, where, name))]
+            params = parse_hydro(hydro, where, name)
+            hull = _hull_pieces(collisions, where, name, base_dir, package_dirs)
+            own = [HydroBody(name, joint_id, placement, params, hull)]
         elif collisions and derive_missing:
             own = []
             for k, collision in enumerate(collisions):
                 origin, params = collision_hydro(
                     collision, water_density_kg_m3, where, name, base_dir, package_dirs
                 )
+                # the shape in the body's frame: a mesh's body sits at its bounding
+                # primitive's frame, not at the collision origin
+                to_body = origin.inverse()
+                piece = collision_piece(collision, where, name, base_dir, package_dirs).placed(
+                    to_body.rotation, to_body.translation
+                )
                 own.append(
-                    HydroBody(f"{name}/collision[{k}]", joint_id, placement * origin, params)
+                    HydroBody(
+                        f"{name}/collision[{k}]", joint_id, placement * origin, params, (piece,)
+                    )
                 )
         elif not allow_dry_links:
             raise ModelError(
@@ -91,6 +102,30 @@ def hydro_bodies(
     for body in wet.values():
         _warn_on_mass_volume_mismatch(body.mass_kg, body.volume_m3, where, "', '".join(body.links))
     return bodies
+
+
+def _hull_pieces(
+    collisions: list[ET.Element],
+    where: str,
+    link: str,
+    base_dir: Path,
+    package_dirs: Sequence[str | Path],
+) -> tuple[HullPiece, ...]:
+    """The link's collision shapes as hull pieces (link frame). A shape that cannot be read
+    (a mesh not found) is left out with a `ModelWarning`: the body then floats as a sphere
+    of its volume (its coefficients come from <hydrodynamics>, so it loads as before)."""
+    pieces = []
+    for collision in collisions:
+        try:
+            pieces.append(collision_piece(collision, where, link, base_dir, package_dirs))
+        except ModelError as exc:
+            warnings.warn(
+                f"{exc}; the free surface cuts a sphere of the link's volume instead",
+                ModelWarning,
+                stacklevel=4,
+            )
+            return ()
+    return tuple(pieces)
 
 
 def _has_inertial(link: ET.Element, has_hydro: bool, where: str, name: str) -> bool:

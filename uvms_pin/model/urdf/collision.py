@@ -1,6 +1,8 @@
 """Coefficients derived from a link's collision geometry (docs/physics.md): a box, cylinder or
-sphere through `uvms_pin.hydro.geometry`, a mesh through `uvms_pin.hydro.mesh` (its volume and
-bounding primitive); each at the ``<collision><origin>`` frame."""
+sphere through `uvms_pin.hydro.geometry`, at the ``<collision><origin>`` frame; a mesh
+through `uvms_pin.hydro.mesh` (its volume and bounding primitive), at that primitive's frame
+inside the mesh's (so that its drag is the primitive's own, as for a primitive in the URDF).
+The same shapes, as hull pieces (`uvms_pin.hydro.hull`), are what the free surface cuts."""
 
 from __future__ import annotations
 
@@ -12,12 +14,15 @@ import pinocchio as pin
 
 from uvms_pin.errors import ModelError, ParameterError
 from uvms_pin.hydro import geometry
-from uvms_pin.hydro.mesh import load_mesh_geometry, mesh_hydro
+from uvms_pin.hydro.hull import HullPiece
+from uvms_pin.hydro.mesh import MeshGeometry, load_mesh_geometry, mesh_primitive
 from uvms_pin.hydro.params import HydroParams
+from uvms_pin.hydro.submerged import Polyhedron, Sphere
+from uvms_pin.hydro.submerged_cylinder import Cylinder
 from uvms_pin.model.resources import package_search_path, resolve_resource
 from uvms_pin.model.urdf.read import read_numbers, read_origin
 
-__all__ = ["collision_hydro"]
+__all__ = ["collision_hydro", "collision_piece"]
 
 
 def collision_hydro(
@@ -28,7 +33,8 @@ def collision_hydro(
     base_dir: Path = Path("."),
     package_dirs: Sequence[str | Path] = (),
 ) -> tuple[pin.SE3, HydroParams]:
-    """(placement of the collision frame in the link frame, its coefficients there).
+    """(placement of the body's frame in the link frame, its coefficients there): the
+    ``<collision><origin>`` frame, or for a mesh its bounding primitive's frame.
 
     Args:
         collision: the ``<collision>`` element.
@@ -56,9 +62,10 @@ def collision_hydro(
             radius = read_numbers(shape.get("radius"), 1, "<sphere radius>", where, link)[0]
             return origin, geometry.sphere_hydro(radius, water_density_kg_m3)
         if shape.tag == "mesh":
-            return origin, _mesh_hydro(
+            placement, params = _mesh_hydro(
                 shape, water_density_kg_m3, where, link, base_dir, package_dirs
             )
+            return origin * placement, params
     except ParameterError as exc:
         raise ModelError(
             f"cannot derive hydrodynamics from <{shape.tag}>: {exc}", path=where, link=link
@@ -71,6 +78,55 @@ def collision_hydro(
     )
 
 
+def collision_piece(
+    collision: ET.Element,
+    where: str,
+    link: str,
+    base_dir: Path = Path("."),
+    package_dirs: Sequence[str | Path] = (),
+) -> HullPiece:
+    """The ``<collision>`` shape as a hull piece, at its ``<origin>`` in the link frame.
+
+    Raises:
+        ModelError: as `collision_hydro`.
+    """
+    origin = read_origin(collision.find("origin"), where, link)
+    geom = collision.find("geometry")
+    shape = None if geom is None or len(geom) == 0 else geom[0]
+    if shape is None:
+        raise ModelError("<collision> has no <geometry> shape", path=where, link=link)
+    try:
+        solid = _solid(shape, where, link, base_dir, package_dirs)
+    except ParameterError as exc:
+        raise ModelError(
+            f"cannot use <{shape.tag}> as a hull: {exc}", path=where, link=link
+        ) from exc
+    return HullPiece(solid, origin.rotation, origin.translation)
+
+
+def _solid(
+    shape: ET.Element, where: str, link: str, base_dir: Path, package_dirs: Sequence[str | Path]
+) -> Sphere | Polyhedron | Cylinder:
+    """The shape of a <box>, <cylinder>, <sphere> or <mesh> element."""
+    if shape.tag == "box":
+        return Polyhedron.box(read_numbers(shape.get("size"), 3, "<box size>", where, link))
+    if shape.tag == "cylinder":
+        radius = read_numbers(shape.get("radius"), 1, "<cylinder radius>", where, link)[0]
+        length = read_numbers(shape.get("length"), 1, "<cylinder length>", where, link)[0]
+        return Cylinder(radius, length)
+    if shape.tag == "sphere":
+        return Sphere(read_numbers(shape.get("radius"), 1, "<sphere radius>", where, link)[0])
+    if shape.tag == "mesh":
+        mesh = _mesh_geometry(shape, where, link, base_dir, package_dirs)
+        return Polyhedron(mesh.vertices_m, mesh.triangles)
+    raise ModelError(
+        f"cannot use collision <{shape.tag}> as a hull (box, cylinder, sphere and mesh are "
+        "supported)",
+        path=where,
+        link=link,
+    )
+
+
 def _mesh_hydro(
     shape: ET.Element,
     water_density_kg_m3: float,
@@ -78,8 +134,25 @@ def _mesh_hydro(
     link: str,
     base_dir: Path,
     package_dirs: Sequence[str | Path],
-) -> HydroParams:
-    """Volume and bounding primitive of the mesh file (`uvms_pin.hydro.mesh`), scaled."""
+) -> tuple[pin.SE3, HydroParams]:
+    """Volume and bounding primitive of the mesh file (`uvms_pin.hydro.mesh`), scaled: the
+    primitive's placement in the mesh frame, its coefficients there."""
+    # the body sits at the primitive's own frame, as a URDF primitive does: moved to the mesh
+    # origin, the quadratic drag of a primitive off the origin or turned could only be a
+    # diagonal estimate (40-50 % off the drag wrench of the same box given as a primitive)
+    mesh = _mesh_geometry(shape, where, link, base_dir, package_dirs)
+    rotation, center, params = mesh_primitive(mesh, water_density_kg_m3)
+    return pin.SE3(rotation, center), params
+
+
+def _mesh_geometry(
+    shape: ET.Element,
+    where: str,
+    link: str,
+    base_dir: Path,
+    package_dirs: Sequence[str | Path],
+) -> MeshGeometry:
+    """The mesh file of a <mesh> element, read and scaled (`uvms_pin.hydro.mesh`)."""
     filename = shape.get("filename")
     if not filename:
         raise ModelError("<mesh> has no filename", path=where, link=link)
@@ -95,4 +168,4 @@ def _mesh_hydro(
             link=link,
         )
     scale = read_numbers(shape.get("scale", "1 1 1"), 3, "<mesh scale>", where, link)
-    return mesh_hydro(load_mesh_geometry(resolved, scale), water_density_kg_m3)
+    return load_mesh_geometry(resolved, scale)

@@ -17,6 +17,7 @@ from uvms_pin.model.uvms import UVMS
 from uvms_pin.physics.compiled.backend import Fallback
 from uvms_pin.physics.compiled.extension import core_module
 from uvms_pin.physics.compiled.flow import flow_to_core
+from uvms_pin.physics.compiled.hull import surface_bodies_to_core
 from uvms_pin.physics.reference import ReferenceDynamics
 
 
@@ -29,8 +30,10 @@ def hydro_bodies_to_core(uvms: UVMS, core: ModuleType):
     bodies.volume_per_joint_m3 = [float(v) for v in uvms.volume_per_joint_m3]
     bodies.center_of_buoyancy_per_joint_m = list(uvms.center_of_buoyancy_per_joint_m)
     damped = []
-    for body in uvms.hydro_bodies_with_damping:
+    hull_of_damped = uvms.surface_bodies.hull_of_damped
+    for k, body in enumerate(uvms.hydro_bodies_with_damping):
         entry = core.DampedBody()
+        entry.hull_index = int(hull_of_damped[k])
         entry.joint_id = int(body.joint_id)
         entry.action_joint_to_body = body.action_joint_to_body
         entry.rotation_in_joint = body.placement_in_joint.rotation
@@ -39,6 +42,10 @@ def hydro_bodies_to_core(uvms: UVMS, core: ModuleType):
         entry.quadratic_damping = body.params.quadratic_damping
         damped.append(entry)
     bodies.damped_bodies = damped
+    bodies.surface_bodies = surface_bodies_to_core(uvms.surface_bodies, core)
+    bodies.added_mass_without_hull_per_joint = list(
+        uvms.surface_bodies.added_mass_without_hull_per_joint
+    )
     return bodies
 
 
@@ -59,31 +66,50 @@ class CompiledDynamics:
         self.bias_forces = self.core.bias_forces
         self.forward_dynamics = self.core.forward_dynamics
 
-    def _flow_struct(self, flow: FlowField):
+    def _flow_struct(self, flow: FlowField | None):
         """The core's FlowField of ``flow`` (the last one is kept: a flow is immutable), or
         its Fallback."""
-        if self._flow[0] is not flow:
+        if self._flow[0] is not flow or self._flow[1] is None:
             self._flow = (flow, flow_to_core(flow, core_module()))
         return self._flow[1]
 
-    def bias_forces_in(self, q: np.ndarray, v: np.ndarray, flow: FlowField, time_s: float):
+    def mass_matrix_in(
+        self, q: np.ndarray, flow: FlowField | None, time_s: float, free_surface: bool = False
+    ):
         compiled = self._flow_struct(flow)
         if isinstance(compiled, Fallback):
             compiled.warn("these dynamics", stacklevel=4)
-            return self._reference.bias_forces_in(q, v, flow, time_s)
-        return self.core.bias_forces_in(q, v, compiled, time_s)
+            return self._reference.mass_matrix_in(q, flow, time_s, free_surface)
+        return self.core.mass_matrix_in(q, compiled, time_s, free_surface)
+
+    def bias_forces_in(
+        self,
+        q: np.ndarray,
+        v: np.ndarray,
+        flow: FlowField | None,
+        time_s: float,
+        free_surface: bool = False,
+    ):
+        compiled = self._flow_struct(flow)
+        if isinstance(compiled, Fallback):
+            compiled.warn("these dynamics", stacklevel=4)
+            return self._reference.bias_forces_in(q, v, flow, time_s, free_surface)
+        return self.core.bias_forces_in(q, v, compiled, time_s, free_surface)
 
     def forward_dynamics_in(
         self,
         q: np.ndarray,
         v: np.ndarray,
         tau: np.ndarray,
-        flow: FlowField,
+        flow: FlowField | None,
         time_s: float,
         tau_ext: np.ndarray | None = None,
+        free_surface: bool = False,
     ):
         compiled = self._flow_struct(flow)
         if isinstance(compiled, Fallback):
             compiled.warn("these dynamics", stacklevel=4)
-            return self._reference.forward_dynamics_in(q, v, tau, flow, time_s, tau_ext)
-        return self.core.forward_dynamics_in(q, v, tau, compiled, time_s, tau_ext)
+            return self._reference.forward_dynamics_in(
+                q, v, tau, flow, time_s, tau_ext, free_surface
+            )
+        return self.core.forward_dynamics_in(q, v, tau, compiled, time_s, tau_ext, free_surface)
