@@ -1,9 +1,9 @@
 """The code blocks of the documentation as the doc test runs them (tests/test_docs_run.py).
 
-Every fenced block of README.md, docs/*.md and models/README.md whose language is
-``python``, ``bash`` (``sh``, ``shell``) or ``console`` is a snippet: it runs as written,
-in document order, the documents one after the other, in one fresh working copy of the
-repository (its outputs never meet a developer's ``out/``). The python blocks of one
+Every fenced block of README.md, docs/*.md and the other Markdown files (`documents`)
+whose language is ``python``, ``bash`` (``sh``, ``shell``) or ``console`` is a snippet: it
+runs as written, in document order, the documents one after the other, in one fresh working
+copy of the repository (its outputs never meet a developer's ``out/``). The python blocks of one
 document share one namespace, as in one interpreter session. A ``console`` block shows
 commands (``$ ...``) and what they print: the printed text must match, ``...`` standing
 for any text.
@@ -32,6 +32,7 @@ An unknown directive, or one that is not right above a runnable block, is an err
 
 from __future__ import annotations
 
+import os
 import re
 import shlex
 from dataclasses import asdict, dataclass
@@ -103,10 +104,29 @@ class DirectiveError(ValueError):
     """A doc-test directive that is unknown, malformed or not above a runnable block."""
 
 
+#: folders whose Markdown is not documentation a reader follows: generated results (their
+#: numbers come from `make results`), environments, outputs, build trees
+NOT_DOCUMENTS = ("docs/results", ".venv", "out", "build", "node_modules")
+
+
 def documents(root: Path) -> list[str]:
-    """The documents, in the order they run: README.md, docs/*.md, models/README.md."""
-    docs = sorted(p.relative_to(root).as_posix() for p in (root / "docs").glob("*.md"))
-    return ["README.md", *docs, "models/README.md"]
+    """The documents, in the order they run: README.md, docs/*.md, then every other
+    Markdown file of the repository (models/README.md, and whatever a later change adds),
+    each group sorted; hidden folders and `NOT_DOCUMENTS` aside."""
+    found = []
+    for folder, subfolders, files in os.walk(root):
+        here = Path(folder).relative_to(root).as_posix()
+        subfolders[:] = sorted(
+            name
+            for name in subfolders
+            if not name.startswith(".")
+            and not name.endswith(".egg-info")
+            and (Path(here) / name).as_posix().removeprefix("./") not in NOT_DOCUMENTS
+        )
+        found += [(Path(here) / name).as_posix().removeprefix("./") for name in files if name.endswith(".md")]  # fmt: skip
+    docs = sorted(name for name in found if name.startswith("docs/") and name.count("/") == 1)
+    others = sorted(name for name in found if name != "README.md" and name not in docs)
+    return ["README.md", *docs, *others]
 
 
 def all_snippets(root: Path) -> list[Snippet]:

@@ -13,6 +13,7 @@ from doc_snippets import (
     Snippet,
     commands,
     console_commands,
+    documents,
     output_matches,
     parse_markdown,
 )
@@ -182,3 +183,19 @@ def test_commands_leave_out_comments_prompts_and_shown_output():
     assert commands(console) == [["echo", "a b"]]
     found = parse_markdown("<!-- doc-test: same-as: docs/x.md -->\n```bash\ntrue\n```\n", "d.md")
     assert found[0].same_as == "docs/x.md" and found[0].skip is None
+
+
+def test_every_markdown_file_of_the_repository_is_a_document(tmp_path):
+    """A Markdown file a later change adds anywhere is run too (README first, then docs/,
+    then the rest); generated results, hidden folders, environments and outputs are not."""
+    for name in [
+        "README.md", "docs/b.md", "docs/a.md", "models/README.md", "benchmarks/NOTES.md",
+        "docs/results/paper.md", "docs/deeper/c.md", ".github/x.md", ".venv/lib/y.md",
+        "out/run/z.md", "pkg.egg-info/w.md", "src/uvms_core/notes.txt",
+    ]:  # fmt: skip
+        (tmp_path / name).parent.mkdir(parents=True, exist_ok=True)
+        (tmp_path / name).write_text("# x\n")
+    assert documents(tmp_path) == [
+        "README.md", "docs/a.md", "docs/b.md",
+        "benchmarks/NOTES.md", "docs/deeper/c.md", "models/README.md",
+    ]  # fmt: skip

@@ -1,5 +1,5 @@
 """Documentation that runs: every python, bash and console block of README.md, docs/*.md
-and models/README.md runs as written, in document order, in a fresh working copy of the
+and the repository's other Markdown files (models/README.md, ...) runs as written, in document order, in a fresh working copy of the
 repository, with scenario runs shortened (and saying so) by UVMS_PIN_MAX_DURATION_S.
 
 How blocks are found and what the ``<!-- doc-test: ... -->`` directives mean:
