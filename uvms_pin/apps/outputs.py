@@ -15,9 +15,10 @@ def write_outputs(rollout: Rollout, out: Path) -> list[Path]:
     from uvms_pin.results.figures.paper import paper_figures
     from uvms_pin.results.figures.standard import standard_figures
 
+    # the metrics first: one of your own that fails (an input error) leaves nothing written
+    metrics = rollout.metrics()
     out.mkdir(parents=True, exist_ok=True)
     rollout.save(out)
-    metrics = rollout.metrics()
     write_json_atomic(
         out / "metrics.json",
         {

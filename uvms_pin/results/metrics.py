@@ -7,6 +7,9 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from uvms_pin.results.extra_metrics import extra_metrics
+from uvms_pin.results.task_metrics import task_metrics
+
 if TYPE_CHECKING:
     from uvms_pin.results.rollout_data import RolloutData
 
@@ -17,6 +20,9 @@ def _rms(x: np.ndarray) -> float:
 
 def compute_metrics(rollout: RolloutData) -> dict[str, float]:
     """Metrics of any run: timing, energy, motion and effort.
+
+    Then your own metrics, the functions the rollout's metadata names
+    (`uvms_pin.results.extra_metrics`, a scenario's ``[metrics] extra``).
 
     Energy drift is max |E(t) - E(0)| / max(|E(0)|, K(0)) over the run (E = T + U), the
     number an energy-conservation check looks at. Efforts: vehicle force = |tau[0:3]|,
@@ -61,6 +67,8 @@ def compute_metrics(rollout: RolloutData) -> dict[str, float]:
     out.update(force_tracking_metrics(rollout))
     out.update(joint_limit_metrics(rollout))
     out.update(surface_metrics(rollout))
+    out.update(task_metrics(rollout))
+    out.update(extra_metrics(rollout, out))
     return out
 
 

@@ -17,9 +17,6 @@ of the same name share the first one imported.
 
 from __future__ import annotations
 
-import importlib
-import keyword
-import sys
 from collections.abc import Mapping
 from pathlib import Path
 from typing import Any
@@ -27,7 +24,7 @@ from typing import Any
 from uvms_pin.control.base import Controller
 from uvms_pin.errors import ParameterError
 from uvms_pin.model.uvms import UVMS
-from uvms_pin.scenario.overrides import closest
+from uvms_pin.results.named import resolve_reference
 from uvms_pin.sim.run import ControllerSpec
 
 __all__ = ["custom_controller", "load_controller_class"]
@@ -40,20 +37,7 @@ def load_controller_class(type_path: str, search_dir: str | Path | None = None) 
         ParameterError: a malformed name, a module that is not found or fails to import, a
             missing attribute (with the closest name), or not a `Controller` subclass.
     """
-    module_name, _, class_name = type_path.partition(":")
-    if not (_dotted_identifier(module_name) and _dotted_identifier(class_name)):
-        raise ParameterError(f"controller type '{type_path}': expected 'package.module:ClassName'")
-    module = _import(module_name, type_path, search_dir)
-    obj: Any = module
-    for part in class_name.split("."):
-        if not hasattr(obj, part):
-            names = [n for n in dir(obj) if not n.startswith("_")]
-            hint = closest(part, names)
-            raise ParameterError(
-                f"controller type '{type_path}': module '{module_name}' has no '{class_name}'"
-                + (f"; did you mean '{hint}'?" if hint else "")
-            )
-        obj = getattr(obj, part)
+    obj = resolve_reference(type_path, search_dir, what="controller type")
     if not (isinstance(obj, type) and issubclass(obj, Controller)):
         raise ParameterError(
             f"controller type '{type_path}': must be a class derived from "
@@ -88,35 +72,3 @@ def custom_controller(
         return controller
 
     return ControllerSpec(type_path, frozen, build)
-
-
-def _dotted_identifier(text: str) -> bool:
-    parts = text.split(".")
-    return bool(text) and all(p.isidentifier() and not keyword.iskeyword(p) for p in parts)
-
-
-def _import(module_name: str, type_path: str, search_dir: str | Path | None):
-    added = None
-    if search_dir is not None:
-        added = str(Path(search_dir).resolve())
-        sys.path.insert(0, added)
-    try:
-        return importlib.import_module(module_name)
-    except ModuleNotFoundError as exc:
-        if exc.name is not None and (module_name + ".").startswith(exc.name + "."):
-            where = f" or in {added}" if added else ""
-            raise ParameterError(
-                f"controller type '{type_path}': module '{module_name}' not found on "
-                f"sys.path{where}"
-            ) from exc
-        raise ParameterError(
-            f"controller type '{type_path}': importing '{module_name}' failed: {exc}"
-        ) from exc
-    except Exception as exc:  # the user's module raised while importing: name it
-        raise ParameterError(
-            f"controller type '{type_path}': importing '{module_name}' failed: "
-            f"{type(exc).__name__}: {exc}"
-        ) from exc
-    finally:
-        if added is not None:
-            sys.path.remove(added)

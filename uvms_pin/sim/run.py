@@ -7,6 +7,8 @@ sensors, runs the closed loop and returns the rollout.
 
 from __future__ import annotations
 
+import copy
+import importlib
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -15,7 +17,10 @@ from typing import Any
 import numpy as np
 
 from uvms_pin.control.base import Controller
+from uvms_pin.control.tracking.task import TrackingTask
+from uvms_pin.errors import ParameterError, SimulationError
 from uvms_pin.model.uvms import UVMS
+from uvms_pin.results.extra_metrics import DIRECTORY_KEY, REFERENCES_KEY
 from uvms_pin.results.progress import Progress, callback_or_none, progress_printer
 from uvms_pin.results.rollout import Rollout
 from uvms_pin.sim.closed_loop import simulate_closed_loop
@@ -23,6 +28,7 @@ from uvms_pin.sim.plant import Plant
 from uvms_pin.sim.sample import Observer, ProgressReport
 from uvms_pin.sim.sensors import SensorConfig, SensorSuite
 from uvms_pin.sim.settings import SimulationSettings
+from uvms_pin.sim.task_record import record_task
 
 ControllerFactory = Callable[[UVMS], Controller]
 
@@ -59,6 +65,10 @@ class Scenario:
             `ControllerSpec` records its type and parameters in the rollout).
         sensor_config: noise of the measurements.
         q0, v0: initial state. settings: integrator, periods, duration, seed.
+        extra_metrics: your own metric functions, ``"package.module:function"``
+            (`uvms_pin.results.extra_metrics`), resolved next to ``path``.
+        task: a tracking task (``[task]``): its reference and true pose are added to the
+            rollout (`uvms_pin.sim.task_record`), and its metrics to ``metrics()``.
     """
 
     name: str
@@ -71,10 +81,34 @@ class Scenario:
     q0: np.ndarray
     v0: np.ndarray
     settings: SimulationSettings
+    extra_metrics: tuple[str, ...] = ()
+    task: TrackingTask | None = None
 
     @property
     def uvms(self) -> UVMS:
         return self.plant.uvms
+
+    @classmethod
+    def from_dict(
+        cls,
+        data: dict[str, Any],
+        path: str | Path = "<dict>",
+        overrides: dict[str, Any] | None = None,
+    ) -> Scenario:
+        """A scenario built in code: ``data`` is what the TOML file would hold, as nested
+        dicts (``{"scenario": {"model": "uvms_lbv150", "duration_s": 5}, "water": {...}}``),
+        checked key by key exactly as a file is (`uvms_pin.scenario.load`). ``path``: as if
+        read from this file (relative model paths, your own controllers and metrics resolve
+        in its directory: the working directory by default). ``overrides``: dotted keys, as
+        ``uvms-pin run --set``.
+
+        Raises:
+            ScenarioError: naming the key (and ``path``) of a bad value.
+        """
+        # the reader is the layer above this one (it builds Scenarios): reached by name at
+        # call time, so that this layer does not depend on it
+        reader = importlib.import_module("uvms_pin.scenario.load")
+        return reader.scenario_from_raw(copy.deepcopy(dict(data)), path, overrides)
 
 
 def simulate(
@@ -82,6 +116,7 @@ def simulate(
     *,
     progress: bool | Progress | None = True,
     observers: Sequence[Observer] = (),
+    controller: Controller | None = None,
 ) -> Rollout:
     """Run a scenario: fresh sensors (seeded) and controller, closed loop, rollout.
 
@@ -89,7 +124,8 @@ def simulate(
     when stderr is a file) once the run has lasted `uvms_pin.results.progress.BAR_DELAY_S` of
     wall time, so short runs print nothing; False or None: silent; a callable ``(t_s, duration_s)`` is called after
     every logged sample. ``observers``: called with every logged sample (`Observer`), e.g.
-    a live view.
+    a live view. ``controller``: an instance to run instead of the one the scenario builds
+    (it is reset first; the rollout records its class, with type and parameters None).
 
     Raises FunnelViolation / SimulationError with the partial rollout attached as
     ``exc.rollout`` (see `uvms_pin.sim.closed_loop.ClosedLoop.run`).
@@ -97,35 +133,54 @@ def simulate(
     duration_s = scenario.settings.duration_s
     if progress is True:
         with progress_printer(scenario.name, duration_s) as printer:
-            return _simulate(scenario, [*observers, ProgressReport(printer, duration_s)])
+            reports = [ProgressReport(printer, duration_s)]
+            return _simulate(scenario, [*observers, *reports], controller)
     callback = callback_or_none(progress)
     reports = [] if callback is None else [ProgressReport(callback, duration_s)]
-    return _simulate(scenario, [*observers, *reports])
+    return _simulate(scenario, [*observers, *reports], controller)
 
 
-def _simulate(scenario: Scenario, observers: list[Observer]) -> Rollout:
+def _simulate(
+    scenario: Scenario, observers: list[Observer], given: Controller | None
+) -> Rollout:
     settings = scenario.settings
     sensors = SensorSuite(
         scenario.uvms.model, scenario.sensor_config, settings.duration_s, settings.seed
     )
-    controller = scenario.controller_factory(scenario.uvms)
+    if given is not None and not isinstance(given, Controller):
+        raise ParameterError(
+            f"controller must be a uvms_pin Controller instance, got {type(given).__name__}"
+        )
+    controller = scenario.controller_factory(scenario.uvms) if given is None else given
+    factory = scenario.controller_factory if given is None else None
     metadata = {
         "scenario": scenario.name,
         "scenario_path": str(scenario.path),
         "description": scenario.description,
         "parameters": scenario.raw,
-        "controller": controller_record(scenario.controller_factory, controller),
+        "controller": controller_record(factory, controller),
+        REFERENCES_KEY: list(scenario.extra_metrics),
+        DIRECTORY_KEY: str(Path(scenario.path).parent.resolve()),
     }
-    return simulate_closed_loop(
-        scenario.plant,
-        controller,
-        sensors,
-        scenario.q0,
-        scenario.v0,
-        settings,
-        metadata=metadata,
-        observers=observers,
-    )
+    try:
+        rollout = simulate_closed_loop(
+            scenario.plant,
+            controller,
+            sensors,
+            scenario.q0,
+            scenario.v0,
+            settings,
+            metadata=metadata,
+            observers=observers,
+        )
+    except (SimulationError, KeyboardInterrupt) as exc:  # the partial rollout too
+        partial = getattr(exc, "rollout", None)
+        if scenario.task is not None and partial is not None:
+            record_task(partial, scenario.task, scenario.uvms)
+        raise
+    if scenario.task is not None:
+        record_task(rollout, scenario.task, scenario.uvms)
+    return rollout
 
 
 def class_path(controller: object) -> str:
@@ -134,7 +189,9 @@ def class_path(controller: object) -> str:
     return f"{cls.__module__}:{cls.__qualname__}"
 
 
-def controller_record(factory: ControllerFactory, controller: Controller) -> dict[str, Any]:
+def controller_record(
+    factory: ControllerFactory | None, controller: Controller
+) -> dict[str, Any]:
     """What ran: the class of ``controller`` (``module:QualifiedName``) and, when the
     factory is a `ControllerSpec`, its type and parameters (else None: unknown)."""
     spec = factory if isinstance(factory, ControllerSpec) else None

@@ -1,0 +1,108 @@
+"""Tracking tasks and task-priority control: the task Jacobians are the derivatives of the
+task poses, the priorities hold, set-based tasks act only where they should, and with the
+exact model the controllers track (still water, no noise, unlimited actuation)."""
+
+from __future__ import annotations
+
+import numpy as np
+import pinocchio as pin
+import pytest
+from conftest import ROOT
+
+from uvms_pin.control.pseudo_inverse import pseudo_inverse
+from uvms_pin.control.tracking.task import TrackingTask, orientation_error
+from uvms_pin.control.tracking.task_priority import (
+    KinematicGains,
+    KinematicLevel,
+    prioritized_velocity,
+)
+from uvms_pin.control.tracking.trajectory import Hold
+from uvms_pin.errors import ParameterError
+from uvms_pin.model.urdf.load import load_uvms
+
+UVMS_PATH = ROOT / "models" / "uvms_lbv150.urdf"
+
+
+@pytest.fixture(scope="module")
+def uvms():
+    return load_uvms(UVMS_PATH)
+
+
+def _q(uvms, rng):
+    q = pin.randomConfiguration(uvms.model, uvms.model.lowerPositionLimit.clip(-2, 2),
+                                uvms.model.upperPositionLimit.clip(-2, 2))  # fmt: skip
+    q[7:] = rng.uniform(uvms.model.lowerPositionLimit[7:], uvms.model.upperPositionLimit[7:])
+    return q
+
+
+def _task(uvms, target="end_effector", frame="world"):
+    name = "" if target == "vehicle" else uvms.model.frames[uvms.ee_frame_id].name
+    return TrackingTask("hold", target, frame, name, Hold(np.zeros(3)), np.eye(3))
+
+
+@pytest.mark.parametrize("target, frame", [("end_effector", "world"), ("end_effector", "vehicle"), ("vehicle", "world")])
+def test_task_jacobian_is_the_derivative_of_the_pose(uvms, target, frame):
+    task, model = _task(uvms, target, frame), uvms.model
+    data = model.createData()
+    rng = np.random.default_rng(3)
+    for _ in range(5):
+        q = _q(uvms, rng)
+        v = rng.normal(size=model.nv)
+        p, rotation, jac = task.pose_and_jacobian(model, data, q)
+        h = 1e-6
+        p_plus, r_plus = task.pose(model, data, pin.integrate(model, q, h * v))
+        p_minus, r_minus = task.pose(model, data, pin.integrate(model, q, -h * v))
+        np.testing.assert_allclose((p_plus - p_minus) / (2 * h), jac[:3] @ v, atol=1e-6)
+        omega = pin.log3(r_plus @ r_minus.T) / (2 * h)  # task-frame axes
+        np.testing.assert_allclose(omega, jac[3:] @ v, atol=1e-6)
+        if frame == "vehicle":
+            assert not jac[:, :6].any()  # the vehicle's motion does not move it
+
+
+def test_vehicle_frame_task_of_the_vehicle_is_refused(uvms):
+    with pytest.raises(ParameterError, match="vehicle in the vehicle frame"):
+        _task(uvms, "vehicle", "vehicle")
+
+
+def test_orientation_error_is_the_rotation_to_the_reference():
+    rotation = pin.utils.rpyToMatrix(0.1, -0.2, 0.3)
+    error = orientation_error(np.eye(3), rotation)
+    np.testing.assert_allclose(pin.exp3(error) @ rotation, np.eye(3), atol=1e-14)
+
+
+def test_priorities_hold_and_a_single_task_is_the_weighted_pseudo_inverse():
+    rng = np.random.default_rng(0)
+    weights = rng.uniform(0.5, 5.0, 7)
+    j1, x1 = rng.normal(size=(3, 7)), rng.normal(size=3)
+    j2, x2 = rng.normal(size=(6, 7)), rng.normal(size=6)  # 3 + 6 > 7: they conflict
+    single = prioritized_velocity([(j1, x1)], weights, 1e-9)
+    np.testing.assert_allclose(single, pseudo_inverse(j1, 1e-12, weights) @ x1, atol=1e-9)
+    both = prioritized_velocity([(j1, x1), (j2, x2)], weights, 1e-9)
+    np.testing.assert_allclose(j1 @ both, x1, atol=1e-8)  # the first is exact
+    swapped = prioritized_velocity([(j2, x2), (j1, x1)], weights, 1e-9)
+    np.testing.assert_allclose(j2 @ swapped, x2, atol=1e-8)
+    assert np.linalg.norm(j1 @ swapped - x1) > 1e-3  # the conflict is real
+    # a lower task compatible with the upper one is met too
+    j3 = rng.normal(size=(3, 7))
+    x3 = rng.normal(size=3)
+    three = prioritized_velocity([(j1, x1), (j3, x3)], weights, 1e-9)
+    np.testing.assert_allclose(j3 @ three, x3, atol=1e-7)
+
+
+def test_kinematic_level_meets_the_pose_task_and_the_limit_task(uvms):
+    task = _task(uvms)
+    model = uvms.model
+    level = KinematicLevel(model, task, KinematicGains(attitude_gain_per_s=0.0, damping=1e-8))
+    q = uvms.neutral_configuration()
+    q[7:] = [-0.2, 1.0, -0.8, 0.2]
+    zeta_r, errors = level.reference(0.0, q)
+    _, _, jac = task.pose_and_jacobian(model, model.createData(), q)
+    rate = np.concatenate([errors["position_error"], errors["orientation_error"]])
+    assert not errors["active_limits"].any()
+    np.testing.assert_allclose(jac @ zeta_r, rate, atol=1e-6)
+    # joint 2 inside its lower margin: its rate is the limit task's, whatever the pose asks
+    lower = model.lowerPositionLimit[8]
+    q[8] = lower + 0.02
+    zeta_r, errors = level.reference(0.0, q)
+    assert errors["active_limits"].tolist() == [0.0, 1.0, 0.0, 0.0]
+    assert zeta_r[7] == pytest.approx(2.0 * 0.08, rel=1e-6)  # k_l (q_b - q), pushed inside

@@ -1,0 +1,200 @@
+"""The task-priority kinematic level: prioritized tasks -> a generalized velocity reference.
+
+Tasks, highest priority first (Antonelli's null-space-based behavioural control; the
+set-based activation of Simetti and Casalino for the inequality tasks):
+
+1. joint limits (set-based): a joint closer than ``joint_limit_margin_rad`` to a limit
+   gets the row q_dot_j = k_l (q_b - q_j), q_b the margin's inner edge (the rate is zero on
+   that edge, so activation is continuous); a joint inside its safe band has no row;
+2. the tracking task (`uvms_pin.control.tracking.task.TrackingTask`), 6 rows:
+   x_dot_r = [p_dot_r + K_p (p_r - p); K_o e_o], e_o = log3(R_r R^T) [m/s; rad/s];
+3. vehicle roll and pitch (an end-effector task only): the body angular rates
+   w_x, w_y = k_a e_a, e_a the first two components of log3(R_v^T R_level), R_level the
+   vehicle's yaw alone (the attitude a vehicle floats at);
+4. manipulability (set-based: active while w(q) = sqrt(det(J_a J_a^T)) < w_min): the arm
+   rates k_m grad w [rad/s] (grad by central differences), J_a the arm's columns of the
+   end-effector Jacobian.
+
+Each task k with Jacobian J_k and desired rate x_k is solved in the null space of the
+ones above (in the metric W of ``velocity_weights``, zeta = W^-1/2 u):
+
+    u_k = u_{k-1} + (J_k N_{k-1})^+ (x_k - J_k u_{k-1}),  N_k = N_{k-1} - (J_k N_{k-1})^+ J_k N_{k-1}
+
+with the damped inverse A^+ = A^T (A A^T + lambda^2 I)^-1 (lambda = ``damping``; the
+directions the tasks above took away, singular values at rounding level, left out), so
+that a lower task losing rank against the ones above does not ask for unbounded rates. The result
+is zeta_r = W^-1/2 u_K (nv,) [m/s, rad/s body; joint rates], the reference a dynamic level
+follows (`uvms_pin.control.tracking.dynamic_level`).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+import pinocchio as pin
+
+from uvms_pin.checks import finite_vector
+from uvms_pin.control.tracking.task import TrackingTask, orientation_error, vehicle_rotation
+from uvms_pin.errors import ParameterError
+
+__all__ = ["KinematicLevel", "KinematicGains", "prioritized_velocity"]
+
+
+@dataclass(frozen=True)
+class KinematicGains:
+    """The kinematic level's gains (defaults: the LBV150 and Alpha 5 tracking scenarios).
+
+    Attributes:
+        position_gain_per_s: K_p [1/s]. orientation_gain_per_s: K_o [1/s].
+        attitude_gain_per_s: k_a, vehicle roll/pitch [1/s] (0: no attitude task).
+        joint_limit_margin_rad: the band inside each limit where the limit task acts [rad].
+        joint_limit_gain_per_s: k_l [1/s].
+        manipulability_threshold: w_min (0: no manipulability task).
+        manipulability_gain: k_m [rad/s per unit of w].
+        velocity_weights: W's diagonal (nv,) (a larger weight: that velocity is used less);
+            None: all ones.
+        damping: lambda of the damped inverse.
+    """
+
+    position_gain_per_s: float = 1.0
+    orientation_gain_per_s: float = 1.0
+    attitude_gain_per_s: float = 1.0
+    joint_limit_margin_rad: float = 0.1
+    joint_limit_gain_per_s: float = 2.0
+    manipulability_threshold: float = 0.0
+    manipulability_gain: float = 1.0
+    velocity_weights: np.ndarray | None = field(default=None)
+    damping: float = 1e-3
+
+    def __post_init__(self) -> None:
+        for name in ("position_gain_per_s", "orientation_gain_per_s", "joint_limit_margin_rad",
+                     "joint_limit_gain_per_s", "damping"):  # fmt: skip
+            value = getattr(self, name)
+            if not (math.isfinite(value) and value > 0):
+                raise ParameterError(f"{name} must be positive, got {value}")
+        for name in ("attitude_gain_per_s", "manipulability_threshold", "manipulability_gain"):
+            value = getattr(self, name)
+            if not (math.isfinite(value) and value >= 0):
+                raise ParameterError(f"{name} must be >= 0, got {value}")
+
+
+#: Singular values below this fraction of the largest are rounding (a direction the tasks
+#: above took away): they are dropped, not damped.
+RANK_CUTOFF = 1e-10
+
+
+def _damped_inverse(matrix: np.ndarray, damping: float) -> np.ndarray:
+    """A^T (A A^T + lambda^2 I)^-1 through the SVD, V diag(s / (s^2 + lambda^2)) U^T, with
+    the directions A has lost (s <= `RANK_CUTOFF` s_max) left out exactly."""
+    u, s, vt = np.linalg.svd(matrix, full_matrices=False)
+    if s.size == 0 or s[0] == 0.0:
+        return np.zeros(matrix.shape[::-1])
+    inverse = np.where(s > RANK_CUTOFF * s[0], s / (s * s + damping * damping), 0.0)
+    return (vt.T * inverse) @ u.T
+
+
+def prioritized_velocity(
+    tasks: list[tuple[np.ndarray, np.ndarray]], weights: np.ndarray, damping: float
+) -> np.ndarray:
+    """zeta solving ``tasks`` [(J_k (m_k, n), x_k (m_k,)), ...] in priority order (the
+    recursion of the module docstring, in the metric W = diag(weights))."""
+    scale = 1.0 / np.sqrt(weights)
+    n = scale.size
+    u, null = np.zeros(n), np.eye(n)
+    for jacobian, rate in tasks:
+        if jacobian.shape[0] == 0:
+            continue
+        scaled = jacobian * scale
+        projected = scaled @ null
+        inverse = _damped_inverse(projected, damping)
+        u = u + inverse @ (rate - scaled @ u)
+        null = null - inverse @ projected
+    return scale * u
+
+
+class KinematicLevel:
+    """zeta_r(t, q) for a tracking task on a model (kinematics only: frame placements and
+    Jacobians).
+
+    Args:
+        model: the UVMS's Pinocchio model (a private Data is made). task: what to track.
+        gains: `KinematicGains`.
+    """
+
+    def __init__(self, model: pin.Model, task: TrackingTask, gains: KinematicGains):
+        self.model, self.data, self.task, self.gains = model, model.createData(), task, gains
+        nv = model.nv
+        weights = gains.velocity_weights
+        self.weights = np.ones(nv) if weights is None else finite_vector("velocity_weights", weights, nv)
+        if np.any(self.weights <= 0):
+            raise ParameterError(f"velocity_weights must be positive, got {self.weights}")
+        self.lower = np.asarray(model.lowerPositionLimit[7:], dtype=float)
+        self.upper = np.asarray(model.upperPositionLimit[7:], dtype=float)
+        self.task.frame_id(model)  # the frame exists
+        self._ee_id = -1 if task.target == "vehicle" else task.frame_id(model)
+
+    def reference(self, time_s: float, q: np.ndarray) -> tuple[np.ndarray, dict[str, np.ndarray]]:
+        """(zeta_r (nv,), the task's errors: ``position_error`` [m], ``orientation_error``
+        [rad], ``active_limits`` (one 0/1 per arm joint))."""
+        task, gains = self.task, self.gains
+        position, rotation, jacobian = task.pose_and_jacobian(self.model, self.data, q)
+        p_r, v_r, _ = task.path.at(time_s)
+        e_p = p_r - position
+        e_o = orientation_error(task.rotation_reference, rotation)
+        rate = np.concatenate([v_r + gains.position_gain_per_s * e_p, gains.orientation_gain_per_s * e_o])
+        limits, active = self._joint_limit_task(q)
+        tasks = [limits, (jacobian, rate)]
+        if task.target == "end_effector" and gains.attitude_gain_per_s > 0:
+            tasks.append(self._attitude_task(q))
+        if task.target == "end_effector" and gains.manipulability_threshold > 0:
+            tasks.append(self._manipulability_task(q))
+        zeta_r = prioritized_velocity(tasks, self.weights, gains.damping)
+        return zeta_r, {"position_error": e_p, "orientation_error": e_o, "active_limits": active}
+
+    def _joint_limit_task(self, q: np.ndarray) -> tuple[tuple[np.ndarray, np.ndarray], np.ndarray]:
+        margin, gain = self.gains.joint_limit_margin_rad, self.gains.joint_limit_gain_per_s
+        joints = q[7:]
+        low_edge, high_edge = self.lower + margin, self.upper - margin
+        below, above = joints < low_edge, joints > high_edge
+        active = below | above
+        target = np.where(below, low_edge, high_edge)
+        rows = np.flatnonzero(active)
+        jacobian = np.zeros((rows.size, self.model.nv))
+        jacobian[np.arange(rows.size), 6 + rows] = 1.0
+        return (jacobian, gain * (target[rows] - joints[rows])), active.astype(float)
+
+    def _attitude_task(self, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        rotation = vehicle_rotation(q)
+        yaw = math.atan2(rotation[1, 0], rotation[0, 0])
+        level = pin.utils.rpyToMatrix(0.0, 0.0, yaw)
+        error = np.asarray(pin.log3(rotation.T @ level))[:2]  # body axes
+        jacobian = np.zeros((2, self.model.nv))
+        jacobian[0, 3] = jacobian[1, 4] = 1.0
+        return jacobian, self.gains.attitude_gain_per_s * error
+
+    def manipulability(self, q: np.ndarray) -> float:
+        """w(q) = sqrt(det(J_a J_a^T)), J_a the arm's columns of the frame Jacobian."""
+        pin.computeJointJacobians(self.model, self.data, q)
+        pin.updateFramePlacements(self.model, self.data)
+        jac = pin.getFrameJacobian(self.model, self.data, self._ee_id, pin.LOCAL_WORLD_ALIGNED)
+        arm = jac[:, 6:]
+        rows = min(arm.shape)
+        gram = arm @ arm.T if arm.shape[0] <= arm.shape[1] else arm.T @ arm
+        return math.sqrt(max(np.linalg.det(gram), 0.0)) if rows else 0.0
+
+    def _manipulability_task(self, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        n_arm = q.size - 7
+        if self.manipulability(q) >= self.gains.manipulability_threshold:
+            return np.zeros((0, self.model.nv)), np.zeros(0)
+        step = 1e-6
+        gradient = np.zeros(n_arm)
+        for j in range(n_arm):
+            plus, minus = q.copy(), q.copy()
+            plus[7 + j] += step
+            minus[7 + j] -= step
+            gradient[j] = (self.manipulability(plus) - self.manipulability(minus)) / (2 * step)
+        jacobian = np.zeros((n_arm, self.model.nv))
+        jacobian[:, 6:] = np.eye(n_arm)
+        return jacobian, self.gains.manipulability_gain * gradient
