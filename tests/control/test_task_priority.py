@@ -95,7 +95,7 @@ def test_kinematic_level_meets_the_pose_task_and_the_limit_task(uvms):
     level = KinematicLevel(model, task, KinematicGains(attitude_gain_per_s=0.0, damping=1e-8))
     q = uvms.neutral_configuration()
     q[7:] = [-0.2, 1.0, -0.8, 0.2]
-    zeta_r, errors = level.reference(0.0, q)
+    zeta_r, errors = level.reference(0.0, q, np.zeros(model.nv))
     _, _, jac = task.pose_and_jacobian(model, model.createData(), q)
     rate = np.concatenate([errors["position_error"], errors["orientation_error"]])
     assert not errors["active_limits"].any()
@@ -103,6 +103,6 @@ def test_kinematic_level_meets_the_pose_task_and_the_limit_task(uvms):
     # joint 2 inside its lower margin: its rate is the limit task's, whatever the pose asks
     lower = model.lowerPositionLimit[8]
     q[8] = lower + 0.02
-    zeta_r, errors = level.reference(0.0, q)
+    zeta_r, errors = level.reference(0.0, q, np.zeros(model.nv))
     assert errors["active_limits"].tolist() == [0.0, 1.0, 0.0, 0.0]
     assert zeta_r[7] == pytest.approx(2.0 * 0.08, rel=1e-6)  # k_l (q_b - q), pushed inside

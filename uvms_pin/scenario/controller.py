@@ -22,6 +22,7 @@ from uvms_pin.scenario.custom_controller import custom_controller
 from uvms_pin.scenario.ppc import build_ppc
 from uvms_pin.scenario.schema import Table
 from uvms_pin.scenario.tracking_controllers import TRACKING_CONTROLLERS
+from uvms_pin.sim.actuation import Actuation, Unlimited
 from uvms_pin.sim.run import ControllerSpec
 
 
@@ -46,17 +47,22 @@ CONTROLLERS: dict[str, Callable[[Table, UVMS], ControllerSpec]] = {
 
 
 def build_controller(
-    t: Table | None, uvms: UVMS, scenario_dir: Path, task: TrackingTask | None = None
+    t: Table | None,
+    uvms: UVMS,
+    scenario_dir: Path,
+    task: TrackingTask | None = None,
+    actuation: Actuation | None = None,
 ) -> ControllerSpec:
     """The [controller] table's controller (none without the table); the tracking
-    controllers (`TRACKING_CONTROLLERS`) follow the scenario's ``task``."""
+    controllers (`TRACKING_CONTROLLERS`) follow the scenario's ``task`` and leave alone the
+    velocities ``actuation`` does not drive."""
     if t is None:
         return NO_CONTROLLER
     kind = t.string("type")
     if kind in TRACKING_CONTROLLERS:
         if task is None:
             raise t.error("type", f"'{kind}' follows a tracking task: the scenario needs a [task]")
-        return TRACKING_CONTROLLERS[kind](t, uvms, task)
+        return TRACKING_CONTROLLERS[kind](t, uvms, task, actuation or Unlimited())
     if ":" in kind:
         try:
             spec = custom_controller(kind, t.rest(), scenario_dir)

@@ -101,7 +101,7 @@ def _build(raw: dict[str, Any], path: Path, top: Table) -> Scenario:
     integrator, backend = build_integrator(top.table_or_empty("integrator"))
     control_period = build_control_period(top.table_or_empty("control"))
     log_period = build_log_period(top.table_or_empty("output"))
-    controller = build_controller(top.table("controller"), uvms, path.parent, task)
+    controller = build_controller(top.table("controller"), uvms, path.parent, task, actuation)
     extra_metrics = build_metrics(top.table("metrics"), path.parent)
     check_baselines(top.table("baselines"), (raw.get("controller") or {}).get("type"))
     top.finish()

@@ -25,11 +25,12 @@ from uvms_pin.results.components import VEHICLE_VELOCITY_NAMES
 from uvms_pin.scenario.baselines import model_error_factors
 from uvms_pin.scenario.controller_parts import checked_spec, plain
 from uvms_pin.scenario.schema import Table
+from uvms_pin.sim.actuation import Actuation
 from uvms_pin.sim.run import ControllerSpec
 
 __all__ = ["TRACKING_CONTROLLERS"]
 
-def _kinematic_gains(t: Table, nv: int) -> KinematicGains:
+def _kinematic_gains(t: Table, nv: int, passive: tuple[int, ...]) -> KinematicGains:
     defaults = KinematicGains()
     numbers = {
         name: t.number(name, getattr(defaults, name))
@@ -39,7 +40,15 @@ def _kinematic_gains(t: Table, nv: int) -> KinematicGains:
     }  # fmt: skip
     weights = t.vector("velocity_weights", nv) if t.has("velocity_weights") else None
     damping = t.number("pinv_damping", defaults.damping, positive=True)
-    return KinematicGains(**numbers, velocity_weights=weights, damping=damping)
+    passive_table = t.vector("passive_velocities", None, list(passive))
+    if any(k not in range(6) for k in passive_table) or len(set(passive_table)) != len(passive_table):
+        raise t.error("passive_velocities", f"must be distinct indices in 0..5, got {passive_table.tolist()}")
+    return KinematicGains(
+        **numbers,
+        velocity_weights=weights,
+        damping=damping,
+        passive_velocities=tuple(int(k) for k in passive_table),
+    )
 
 
 def _dynamic_level(t: Table, uvms: UVMS) -> tuple[Callable[[UVMS], Any], dict[str, Any]]:
@@ -70,9 +79,11 @@ def _dynamic_level(t: Table, uvms: UVMS) -> tuple[Callable[[UVMS], Any], dict[st
     )
 
 
-def build_task_priority(t: Table, uvms: UVMS, task: TrackingTask) -> ControllerSpec:
+def build_task_priority(
+    t: Table, uvms: UVMS, task: TrackingTask, actuation: Actuation
+) -> ControllerSpec:
     """[controller] type = "task_priority"."""
-    gains = _kinematic_gains(t, uvms.nv)
+    gains = _kinematic_gains(t, uvms.nv, passive_velocities(actuation))
     dynamic, recorded = _dynamic_level(t, uvms)
     t.finish()
 
@@ -84,7 +95,9 @@ def build_task_priority(t: Table, uvms: UVMS, task: TrackingTask) -> ControllerS
     return checked_spec(t, uvms, "task_priority", params, build)
 
 
-def build_resolved_acceleration(t: Table, uvms: UVMS, task: TrackingTask) -> ControllerSpec:
+def build_resolved_acceleration(
+    t: Table, uvms: UVMS, task: TrackingTask, actuation: Actuation
+) -> ControllerSpec:
     """[controller] type = "resolved_acceleration"."""
     fields = {
         "position_gain_per_s2": t.vector("position_gain_per_s2", 6, [4.0] * 6),
@@ -102,8 +115,18 @@ def build_resolved_acceleration(t: Table, uvms: UVMS, task: TrackingTask) -> Con
     return checked_spec(t, uvms, "resolved_acceleration", params, build)
 
 
-#: [controller] type -> its builder (the table, the model, the scenario's [task])
-TRACKING_CONTROLLERS: dict[str, Callable[[Table, UVMS, TrackingTask], ControllerSpec]] = {
+def passive_velocities(actuation: Actuation) -> tuple[int, ...]:
+    """The vehicle's body velocities the thrusters are not asked to drive (0-5): those
+    outside ``[actuation] allocated_components``; none with unlimited actuation."""
+    allocated = getattr(actuation, "allocated_components", range(6))
+    return tuple(k for k in range(6) if k not in allocated)
+
+
+#: [controller] type -> its builder (the table, the model, the scenario's [task], the
+#: plant's actuation)
+TRACKING_CONTROLLERS: dict[
+    str, Callable[[Table, UVMS, TrackingTask, Actuation], ControllerSpec]
+] = {
     "task_priority": build_task_priority,
     "resolved_acceleration": build_resolved_acceleration,
 }

@@ -68,7 +68,7 @@ class TaskPriorityController(Controller):
 
     def compute(self, time_s: float, measurement: Measurement) -> np.ndarray:
         q, v = measurement.q, measurement.v
-        zeta_r, errors = self.kinematics.reference(time_s, q)
+        zeta_r, errors = self.kinematics.reference(time_s, q, v)
         tau = self.dynamic.torque(time_s, q, v, zeta_r)
         self._signals = {
             **task_signals(self.task, errors["position_error"], errors["orientation_error"]),

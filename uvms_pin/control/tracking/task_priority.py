@@ -25,6 +25,12 @@ directions the tasks above took away, singular values at rounding level, left ou
 that a lower task losing rank against the ones above does not ask for unbounded rates. The result
 is zeta_r = W^-1/2 u_K (nv,) [m/s, rad/s body; joint rates], the reference a dynamic level
 follows (`uvms_pin.control.tracking.dynamic_level`).
+
+Velocities no actuator can drive (``passive_velocities``: an LBV150's roll and pitch rates,
+left to its metacentric restoring moment) are not unknowns of the recursion: their
+measured values zeta_P move the tasks, x_k - J_k,P zeta_P is what the others must give, and
+zeta_r,P = zeta_P (the dynamic level has nothing to correct there). A task whose rows only
+such velocities can move (the attitude task of such a vehicle) then asks nothing.
 """
 
 from __future__ import annotations
@@ -56,6 +62,8 @@ class KinematicGains:
         velocity_weights: W's diagonal (nv,) (a larger weight: that velocity is used less);
             None: all ones.
         damping: lambda of the damped inverse.
+        passive_velocities: indices of the velocities no actuator drives (0-5: the
+            vehicle's body velocities u, v, w, p, q, r).
     """
 
     position_gain_per_s: float = 1.0
@@ -67,6 +75,7 @@ class KinematicGains:
     manipulability_gain: float = 1.0
     velocity_weights: np.ndarray | None = field(default=None)
     damping: float = 1e-3
+    passive_velocities: tuple[int, ...] = ()
 
     def __post_init__(self) -> None:
         for name in ("position_gain_per_s", "orientation_gain_per_s", "joint_limit_margin_rad",
@@ -132,11 +141,28 @@ class KinematicLevel:
             raise ParameterError(f"velocity_weights must be positive, got {self.weights}")
         self.lower = np.asarray(model.lowerPositionLimit[7:], dtype=float)
         self.upper = np.asarray(model.upperPositionLimit[7:], dtype=float)
+        passive = sorted(set(int(k) for k in gains.passive_velocities))
+        if any(not 0 <= k < 6 for k in passive):
+            raise ParameterError(f"passive_velocities must be in 0..5, got {passive}")
+        self.passive = np.array(passive, dtype=int)
+        self.active = np.setdiff1d(np.arange(nv), self.passive)
         self.task.frame_id(model)  # the frame exists
         self._ee_id = -1 if task.target == "vehicle" else task.frame_id(model)
 
-    def reference(self, time_s: float, q: np.ndarray) -> tuple[np.ndarray, dict[str, np.ndarray]]:
-        """(zeta_r (nv,), the task's errors: ``position_error`` [m], ``orientation_error``
+    def _solve(self, tasks: list, v: np.ndarray) -> np.ndarray:
+        """The recursion over the driven velocities, the passive ones at their measured v."""
+        if self.passive.size == 0:
+            return prioritized_velocity(tasks, self.weights, self.gains.damping)
+        active, passive = self.active, self.passive
+        moved = [(j[:, active], x - j[:, passive] @ v[passive]) for j, x in tasks]
+        zeta_r = np.array(v, dtype=float)
+        zeta_r[active] = prioritized_velocity(moved, self.weights[active], self.gains.damping)
+        return zeta_r
+
+    def reference(
+        self, time_s: float, q: np.ndarray, v: np.ndarray
+    ) -> tuple[np.ndarray, dict[str, np.ndarray]]:
+        """(zeta_r (nv,) at the measured (q, v), the task's errors: ``position_error`` [m], ``orientation_error``
         [rad], ``active_limits`` (one 0/1 per arm joint))."""
         task, gains = self.task, self.gains
         position, rotation, jacobian = task.pose_and_jacobian(self.model, self.data, q)
@@ -150,7 +176,7 @@ class KinematicLevel:
             tasks.append(self._attitude_task(q))
         if task.target == "end_effector" and gains.manipulability_threshold > 0:
             tasks.append(self._manipulability_task(q))
-        zeta_r = prioritized_velocity(tasks, self.weights, gains.damping)
+        zeta_r = self._solve(tasks, v)
         return zeta_r, {"position_error": e_p, "orientation_error": e_o, "active_limits": active}
 
     def _joint_limit_task(self, q: np.ndarray) -> tuple[tuple[np.ndarray, np.ndarray], np.ndarray]:
