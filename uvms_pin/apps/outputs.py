@@ -14,6 +14,7 @@ def write_outputs(rollout: Rollout, out: Path) -> list[Path]:
     from uvms_pin.results.atomic import write_json_atomic
     from uvms_pin.results.figures.paper import paper_figures
     from uvms_pin.results.figures.standard import standard_figures
+    from uvms_pin.results.figures.tracking import tracking_figures
 
     # the metrics first: one of your own that fails (an input error) leaves nothing written
     metrics = rollout.metrics()
@@ -31,6 +32,7 @@ def write_outputs(rollout: Rollout, out: Path) -> list[Path]:
     return (
         paper_figures(rollout, out)
         + standard_figures(rollout, out)
+        + tracking_figures(rollout, out)
         + _flow_figure(rollout, out)
         + _surface_figure(rollout, out)
     )
