@@ -3,9 +3,12 @@
 Tasks, highest priority first (Antonelli's null-space-based behavioural control; the
 set-based activation of Simetti and Casalino for the inequality tasks):
 
-1. joint limits (set-based): a joint closer than ``joint_limit_margin_rad`` to a limit
-   gets the row q_dot_j = k_l (q_b - q_j), q_b the margin's inner edge (the rate is zero on
-   that edge, so activation is continuous); a joint inside its safe band has no row;
+1. joint limits (set-based): each joint's rate must stay within
+   k_l (q_lo + m - q_j) <= q_dot_j <= k_l (q_hi - m - q_j), m = ``joint_limit_margin_rad``
+   (a joint slows down as it nears the band of width m inside a limit, and is driven back
+   out of it); a joint whose rate the other tasks would take past a bound gets the row
+   q_dot_j = that bound, and the tasks are solved again (the active set grows until no
+   rate is out of bounds); a joint within its bounds has no row;
 2. the tracking task (`uvms_pin.control.tracking.task.TrackingTask`), 6 rows:
    x_dot_r = [p_dot_r + K_p (p_r - p); K_o e_o], e_o = log3(R_r R^T) [m/s; rad/s];
 3. vehicle roll and pitch (an end-effector task only): the body angular rates
@@ -91,24 +94,32 @@ class KinematicGains:
 
 #: Singular values below this fraction of the largest are rounding (a direction the tasks
 #: above took away): they are dropped, not damped.
-RANK_CUTOFF = 1e-10
+RANK_CUTOFF = 1e-9
 
 
-def _damped_inverse(matrix: np.ndarray, damping: float) -> np.ndarray:
-    """A^T (A A^T + lambda^2 I)^-1 through the SVD, V diag(s / (s^2 + lambda^2)) U^T, with
-    the directions A has lost (s <= `RANK_CUTOFF` s_max) left out exactly."""
+def _damped_inverse_and_rows(matrix: np.ndarray, damping: float) -> tuple[np.ndarray, np.ndarray]:
+    """(A^T (A A^T + lambda^2 I)^-1, an orthonormal basis of A's row space (rows)) through
+    the SVD: V diag(s / (s^2 + lambda^2)) U^T, the directions A has lost (s <=
+    `RANK_CUTOFF` s_max) left out exactly."""
     u, s, vt = np.linalg.svd(matrix, full_matrices=False)
     if s.size == 0 or s[0] == 0.0:
-        return np.zeros(matrix.shape[::-1])
-    inverse = np.where(s > RANK_CUTOFF * s[0], s / (s * s + damping * damping), 0.0)
-    return (vt.T * inverse) @ u.T
+        return np.zeros(matrix.shape[::-1]), np.zeros((0, matrix.shape[1]))
+    keep = s > RANK_CUTOFF * s[0]
+    inverse = (vt[keep].T * (s[keep] / (s[keep] ** 2 + damping * damping))) @ u[:, keep].T
+    return inverse, vt[keep]
 
 
 def prioritized_velocity(
     tasks: list[tuple[np.ndarray, np.ndarray]], weights: np.ndarray, damping: float
 ) -> np.ndarray:
     """zeta solving ``tasks`` [(J_k (m_k, n), x_k (m_k,)), ...] in priority order (the
-    recursion of the module docstring, in the metric W = diag(weights))."""
+    recursion of the module docstring, in the metric W = diag(weights)).
+
+    The null-space projector is updated with the exact projector on each task's row space,
+    N_k = N_{k-1} - V_k V_k^T (V_k: the right singular vectors of J_k N_{k-1} kept), not
+    with the damped inverse: a damped N would leave a small part of an upper task's
+    directions free, which a lower task, inverting that small part, would use at full size.
+    """
     scale = 1.0 / np.sqrt(weights)
     n = scale.size
     u, null = np.zeros(n), np.eye(n)
@@ -116,10 +127,9 @@ def prioritized_velocity(
         if jacobian.shape[0] == 0:
             continue
         scaled = jacobian * scale
-        projected = scaled @ null
-        inverse = _damped_inverse(projected, damping)
+        inverse, rows = _damped_inverse_and_rows(scaled @ null, damping)
         u = u + inverse @ (rate - scaled @ u)
-        null = null - inverse @ projected
+        null = null - rows.T @ rows
     return scale * u
 
 
@@ -170,26 +180,37 @@ class KinematicLevel:
         e_p = p_r - position
         e_o = orientation_error(task.rotation_reference, rotation)
         rate = np.concatenate([v_r + gains.position_gain_per_s * e_p, gains.orientation_gain_per_s * e_o])
-        limits, active = self._joint_limit_task(q)
-        tasks = [limits, (jacobian, rate)]
+        tasks = [(jacobian, rate)]
         if task.target == "end_effector" and gains.attitude_gain_per_s > 0:
             tasks.append(self._attitude_task(q))
         if task.target == "end_effector" and gains.manipulability_threshold > 0:
             tasks.append(self._manipulability_task(q))
-        zeta_r = self._solve(tasks, v)
+        zeta_r, active = self._solve_within_limits(tasks, q, v)
         return zeta_r, {"position_error": e_p, "orientation_error": e_o, "active_limits": active}
 
-    def _joint_limit_task(self, q: np.ndarray) -> tuple[tuple[np.ndarray, np.ndarray], np.ndarray]:
+    def _solve_within_limits(
+        self, tasks: list, q: np.ndarray, v: np.ndarray
+    ) -> tuple[np.ndarray, np.ndarray]:
+        """zeta_r with every joint rate inside its bounds (module docstring, task 1), and
+        which joints' bound is a task (1.0) or not (0.0)."""
         margin, gain = self.gains.joint_limit_margin_rad, self.gains.joint_limit_gain_per_s
         joints = q[7:]
-        low_edge, high_edge = self.lower + margin, self.upper - margin
-        below, above = joints < low_edge, joints > high_edge
-        active = below | above
-        target = np.where(below, low_edge, high_edge)
-        rows = np.flatnonzero(active)
-        jacobian = np.zeros((rows.size, self.model.nv))
-        jacobian[np.arange(rows.size), 6 + rows] = 1.0
-        return (jacobian, gain * (target[rows] - joints[rows])), active.astype(float)
+        lowest = gain * (self.lower + margin - joints)  # q_dot_j >= this
+        highest = gain * (self.upper - margin - joints)  # q_dot_j <= this
+        bound = np.zeros(joints.size)  # the rate a bounded joint is held at
+        held = np.zeros(joints.size, dtype=bool)
+        for _ in range(joints.size + 1):
+            rows = np.flatnonzero(held)
+            limit_jacobian = np.zeros((rows.size, self.model.nv))
+            limit_jacobian[np.arange(rows.size), 6 + rows] = 1.0
+            zeta_r = self._solve([(limit_jacobian, bound[rows]), *tasks], v)
+            rates = zeta_r[6:]
+            over = ~held & ((rates > highest + 1e-12) | (rates < lowest - 1e-12))
+            if not over.any():
+                return zeta_r, held.astype(float)
+            bound = np.where(over, np.clip(rates, lowest, highest), bound)
+            held |= over
+        return zeta_r, held.astype(float)
 
     def _attitude_task(self, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         rotation = vehicle_rotation(q)
