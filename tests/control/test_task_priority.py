@@ -100,9 +100,26 @@ def test_kinematic_level_meets_the_pose_task_and_the_limit_task(uvms):
     rate = np.concatenate([errors["position_error"], errors["orientation_error"]])
     assert not errors["active_limits"].any()
     np.testing.assert_allclose(jac @ zeta_r, rate, atol=1e-6)
-    # joint 2 inside its lower margin: its rate is the limit task's, whatever the pose asks
-    lower = model.lowerPositionLimit[8]
-    q[8] = lower + 0.02
-    zeta_r, errors = level.reference(0.0, q, np.zeros(model.nv))
-    assert errors["active_limits"].tolist() == [0.0, 1.0, 0.0, 0.0]
-    assert zeta_r[7] == pytest.approx(2.0 * 0.08, rel=1e-6)  # k_l (q_b - q), pushed inside
+    # the rate bounds k_l (q_lo + m - q) <= q_dot <= k_l (q_hi - m - q) hold wherever the
+    # joints are (inside a margin: driven back out), and only bounded joints are held
+    rng = np.random.default_rng(5)
+    lower, upper = model.lowerPositionLimit[7:], model.upperPositionLimit[7:]
+    held_somewhere = 0
+    for _ in range(40):
+        q[7:] = rng.uniform(lower - 0.05, upper + 0.05)
+        zeta_r, errors = level.reference(0.0, q, np.zeros(model.nv))
+        rates = zeta_r[6:]
+        assert np.all(rates >= 2.0 * (lower + 0.1 - q[7:]) - 1e-9)
+        assert np.all(rates <= 2.0 * (upper - 0.1 - q[7:]) + 1e-9)
+        held_somewhere += errors["active_limits"].sum()
+    assert held_somewhere > 0
+
+def test_a_lower_task_cannot_move_what_an_upper_task_holds_even_damped():
+    # regression: with the projector built from the damped inverse, 1e-6 of a held joint's
+    # direction stayed free and an arm-only task below used it at full size
+    held = np.zeros((2, 10))
+    held[0, 7] = held[1, 8] = 1.0
+    arm = np.random.default_rng(0).normal(size=(6, 10))
+    arm[:, :6] = 0.0
+    zeta = prioritized_velocity([(held, np.array([2.04, 2.2])), (arm, np.ones(6))], np.ones(10), 1e-3)
+    np.testing.assert_allclose(zeta[7:9], [2.04, 2.2], rtol=1e-5)
