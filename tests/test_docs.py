@@ -11,8 +11,8 @@ from conftest import ROOT
 
 from uvms_pin.errors import ScenarioError
 from uvms_pin.scenario.load import load_scenario, scenario_from_raw
-from uvms_pin.scenario.toml import read_toml
 from uvms_pin.scenario.schema import Table
+from uvms_pin.scenario.toml import read_toml
 
 DOCS = ROOT / "docs"
 SCENARIOS = ROOT / "scenarios"

@@ -52,9 +52,7 @@ def test_scripting_executes(tmp_path):
     client.execute()
     outputs = [o for c in nb.cells if c.cell_type == "code" for o in c.outputs]
     assert not [o for o in outputs if o.output_type == "error"]
-    text = "\n".join(
-        o.get("text", "") or o.get("data", {}).get("text/plain", "") for o in outputs
-    )
+    text = "\n".join(o.get("text", "") or o.get("data", {}).get("text/plain", "") for o in outputs)
     assert "task_position_error_rms_m" in text and "vehicle_excursion_max_m" in text
     assert "[task] has unknown key(s): radius" in text  # the misspelt key, named
     assert "'hold_error.x_m': 'm'" in text and "'arm_rates.j1_rad_s': 'rad/s'" in text

@@ -62,7 +62,9 @@ if __name__ == "__main__":
         "poses (the controllers see noisy measurements: 1 mm, 1 mrad, 0.5 mrad, 2 mm/s); "
         "100 Hz control with zero-order hold, thrust and joint-torque limits. Task held: "
         "the run ends with every joint inside its limits and the position error within "
-        "1 cm.\n\n" + "\n".join(table) + "\n\nCommands:\n\n"
+        "1 cm.\n\n"
+        + "\n".join(table)
+        + "\n\nCommands:\n\n"
         + "\n".join(f"- {c}" for c in commands)
         + "\n\n![LBV150 circle, task priority, still water](../tracking_lbv150_circle.png)\n"
         + "\n![LBV150 circle in a 0.2 m/s current, per controller](../tracking_lbv150_current.png)\n"

@@ -40,7 +40,9 @@ def _task(uvms, target="end_effector", frame="world"):
     return TrackingTask("hold", target, frame, name, Hold(np.zeros(3)), np.eye(3))
 
 
-@pytest.mark.parametrize("target, frame", [("end_effector", "world"), ("end_effector", "vehicle"), ("vehicle", "world")])
+@pytest.mark.parametrize(
+    "target, frame", [("end_effector", "world"), ("end_effector", "vehicle"), ("vehicle", "world")]
+)
 def test_task_jacobian_is_the_derivative_of_the_pose(uvms, target, frame):
     task, model = _task(uvms, target, frame), uvms.model
     data = model.createData()
@@ -48,7 +50,7 @@ def test_task_jacobian_is_the_derivative_of_the_pose(uvms, target, frame):
     for _ in range(5):
         q = _q(uvms, rng)
         v = rng.normal(size=model.nv)
-        p, rotation, jac = task.pose_and_jacobian(model, data, q)
+        _, _, jac = task.pose_and_jacobian(model, data, q)
         h = 1e-6
         p_plus, r_plus = task.pose(model, data, pin.integrate(model, q, h * v))
         p_minus, r_minus = task.pose(model, data, pin.integrate(model, q, -h * v))
@@ -114,6 +116,7 @@ def test_kinematic_level_meets_the_pose_task_and_the_limit_task(uvms):
         held_somewhere += errors["active_limits"].sum()
     assert held_somewhere > 0
 
+
 def test_a_lower_task_cannot_move_what_an_upper_task_holds_even_damped():
     # regression: with the projector built from the damped inverse, 1e-6 of a held joint's
     # direction stayed free and an arm-only task below used it at full size
@@ -121,5 +124,7 @@ def test_a_lower_task_cannot_move_what_an_upper_task_holds_even_damped():
     held[0, 7] = held[1, 8] = 1.0
     arm = np.random.default_rng(0).normal(size=(6, 10))
     arm[:, :6] = 0.0
-    zeta = prioritized_velocity([(held, np.array([2.04, 2.2])), (arm, np.ones(6))], np.ones(10), 1e-3)
+    zeta = prioritized_velocity(
+        [(held, np.array([2.04, 2.2])), (arm, np.ones(6))], np.ones(10), 1e-3
+    )
     np.testing.assert_allclose(zeta[7:9], [2.04, 2.2], rtol=1e-5)

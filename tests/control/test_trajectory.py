@@ -26,8 +26,10 @@ PATHS = {
     "circle_tilted": Circle(START, 0.25, 7.0, normal=[1.0, 1.0, 0.5], ramp_s=1.5),
     "helix": Helix(START, 0.1, 10.0, 0.05, normal=[0, 1, 0], ramp_s=3.0),
     "lemniscate": Lemniscate(START, 0.2, 12.0, ramp_s=2.0),
-    "min_jerk": MinimumJerk(START, START + [0.2, -0.1, 0.3], 4.0, start_s=1.0),
-    "waypoints": Waypoints(START + np.array([[0, 0, 0], [0.1, 0, 0], [0.1, 0.2, -0.1]]), [0.5, 3.0, 6.0]),
+    "min_jerk": MinimumJerk(START, START + np.array([0.2, -0.1, 0.3]), 4.0, start_s=1.0),
+    "waypoints": Waypoints(
+        START + np.array([[0, 0, 0], [0.1, 0, 0], [0.1, 0.2, -0.1]]), [0.5, 3.0, 6.0]
+    ),
 }
 
 
@@ -60,13 +62,15 @@ def test_minimum_jerk_boundary_conditions():
         assert abs(s - target) < 1e-12 and abs(ds) < 1e-9 and abs(dds) < 1e-4
     assert minimum_jerk(0.5) == pytest.approx((0.5, 1.875, 0.0))  # symmetric, peak speed 15/8
     path = PATHS["min_jerk"]
-    np.testing.assert_allclose(path.at(5.0)[0], START + [0.2, -0.1, 0.3], atol=1e-15)
+    np.testing.assert_allclose(path.at(5.0)[0], START + np.array([0.2, -0.1, 0.3]), atol=1e-15)
     np.testing.assert_allclose(path.at(3.0)[0], START + 0.5 * np.array([0.2, -0.1, 0.3]))
 
 
 def test_waypoints_reached_at_their_times_at_rest():
     path = PATHS["waypoints"]
-    for point, time_s in zip(START + np.array([[0, 0, 0], [0.1, 0, 0], [0.1, 0.2, -0.1]]), [0.5, 3.0, 6.0], strict=True):
+    for point, time_s in zip(
+        START + np.array([[0, 0, 0], [0.1, 0, 0], [0.1, 0.2, -0.1]]), [0.5, 3.0, 6.0], strict=True
+    ):
         p, v, a = path.at(time_s)
         np.testing.assert_allclose(p, point, atol=1e-14)
         np.testing.assert_allclose(v, 0.0, atol=1e-14)
@@ -91,7 +95,7 @@ def test_circle_radius_speed_and_closure():
 
 def test_helix_rises_one_pitch_per_turn_and_lemniscate_closes():
     helix = Helix(START, 0.1, 10.0, 0.05, ramp_s=0.0)
-    np.testing.assert_allclose(helix.at(10.0)[0], START + [0, 0, 0.05], atol=1e-12)
+    np.testing.assert_allclose(helix.at(10.0)[0], START + np.array([0, 0, 0.05]), atol=1e-12)
     eight = Lemniscate(START, 0.2, 12.0)
     np.testing.assert_allclose(eight.at(6.0)[0], START, atol=1e-12)  # crossing point
     np.testing.assert_allclose(eight.at(12.0)[0], START, atol=1e-12)

@@ -85,7 +85,7 @@ def test_bad_references_are_scenario_errors(scenario_dir, reference, match):
         load_scenario(scenario_dir / "bad.toml")
     with pytest.raises(ScenarioError, match=rf"override 'metrics.extra': .*{match}"):
         load_scenario(scenario_dir / "run.toml", {"metrics.extra": [reference]})
-    with pytest.raises(ScenarioError, match="override .metrics.extra.: must be a list"):
+    with pytest.raises(ScenarioError, match=r"override 'metrics\.extra': must be a list"):
         load_scenario(scenario_dir / "run.toml", {"metrics.extra": "my_metrics:arm_travel"})
 
 
@@ -99,7 +99,9 @@ def test_bad_references_are_scenario_errors(scenario_dir, reference, match):
     ],
 )
 def test_bad_results_name_the_function(scenario_dir, reference, match):
-    scenario = load_scenario(scenario_dir / "run.toml", {"metrics.extra": [f"my_metrics:{reference}"]})
+    scenario = load_scenario(
+        scenario_dir / "run.toml", {"metrics.extra": [f"my_metrics:{reference}"]}
+    )
     rollout = simulate(scenario, progress=False)
     with pytest.raises(ParameterError, match=f"metric 'my_metrics:{reference}'.*{match}"):
         rollout.metrics()

@@ -13,7 +13,9 @@ from uvms_pin.results.task_metrics import settling_time, task_metrics
 
 def _rollout(error_m: np.ndarray, rotation_rad: np.ndarray, transient_s: float) -> RolloutData:
     n = len(error_m)
-    r = RolloutData.allocate(n, 11, 10, {"task": {"transient_s": transient_s, "settle_tolerance_m": 0.01}})
+    r = RolloutData.allocate(
+        n, 11, 10, {"task": {"transient_s": transient_s, "settle_tolerance_m": 0.01}}
+    )
     r.time_s[:] = np.arange(n) * 0.1
     r.q[:] = 0.0
     r.v[:] = 1.0

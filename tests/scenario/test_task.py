@@ -53,7 +53,10 @@ def test_the_reference_starts_at_the_target():
         ({"type": "circle", "radius_m": 0.1, "period_s": 20.0, "radiu_m": 1}, "did you mean"),
         ({"type": "hold", "target": "vehicle", "frame": "vehicle"}, "vehicle in the vehicle frame"),
         ({"type": "waypoints", "offsets_m": [[0, 0]], "times_s": [1.0]}, "task.offsets_m: must be"),
-        ({"type": "waypoints", "offsets_m": [[0, 0, 0], [1, 0, 0]], "times_s": [1.0, 0.5]}, "increase"),
+        (
+            {"type": "waypoints", "offsets_m": [[0, 0, 0], [1, 0, 0]], "times_s": [1.0, 0.5]},
+            "increase",
+        ),
         ({"type": "circle", "radius_m": 0.1, "period_s": 20.0, "normal": [0, 0, 0]}, "normal"),
     ],
 )

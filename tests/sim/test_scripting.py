@@ -65,9 +65,11 @@ def test_from_dict_equals_the_file(tmp_path):
 def test_from_dict_checks_keys_as_a_file_is():
     raw = _passive()
     raw["water"]["densty_kg_m3"] = 1000.0
-    with pytest.raises(ScenarioError, match=r"<dict>: \[water\] has unknown key\(s\): densty_kg_m3"):
+    with pytest.raises(
+        ScenarioError, match=r"<dict>: \[water\] has unknown key\(s\): densty_kg_m3"
+    ):
         Scenario.from_dict(raw)
-    with pytest.raises(ScenarioError, match="override 'scenario.duration_s': must be positive"):
+    with pytest.raises(ScenarioError, match=r"override 'scenario\.duration_s': must be positive"):
         Scenario.from_dict(_passive(), overrides={"scenario.duration_s": -1.0})
 
 

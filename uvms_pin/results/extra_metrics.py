@@ -73,9 +73,7 @@ def _checked(reference: str, values: Any, taken: Mapping[str, Any]) -> dict[str,
         if not isinstance(name, str) or not name:
             raise ParameterError(f"metric '{reference}': a metric name must be text, got {name!r}")
         if name in taken:
-            raise ParameterError(
-                f"metric '{reference}': '{name}' is already a metric (rename it)"
-            )
+            raise ParameterError(f"metric '{reference}': '{name}' is already a metric (rename it)")
         if isinstance(value, bool) or not isinstance(value, numbers.Real):
             raise ParameterError(
                 f"metric '{reference}': '{name}' must be a real number, got {value!r}"

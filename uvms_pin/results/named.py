@@ -66,7 +66,9 @@ def _import(module_name: str, reference: str, search_dir: str | Path | None, wha
             raise ParameterError(
                 f"{what} '{reference}': module '{module_name}' not found on sys.path{where}"
             ) from exc
-        raise ParameterError(f"{what} '{reference}': importing '{module_name}' failed: {exc}") from exc
+        raise ParameterError(
+            f"{what} '{reference}': importing '{module_name}' failed: {exc}"
+        ) from exc
     except Exception as exc:  # the user's module raised while importing: name it
         raise ParameterError(
             f"{what} '{reference}': importing '{module_name}' failed: {type(exc).__name__}: {exc}"

@@ -50,7 +50,9 @@ def task_metrics(rollout: RolloutData) -> dict[str, float]:
     if not task or "task_position" not in signals or len(rollout) == 0:
         return {}
     time_s = rollout.time_s
-    position_error = np.linalg.norm(signals["task_reference_position"] - signals["task_position"], axis=1)
+    position_error = np.linalg.norm(
+        signals["task_reference_position"] - signals["task_position"], axis=1
+    )
     rotation_error = np.linalg.norm(signals["task_rotation_error"], axis=1)
     after = time_s >= float(task.get("transient_s", 0.0))
     settled = settling_time(time_s, position_error, float(task.get("settle_tolerance_m", 0.01)))
@@ -58,10 +60,14 @@ def task_metrics(rollout: RolloutData) -> dict[str, float]:
     power = np.abs(rollout.tau * rollout.v).sum(axis=1)
     return {
         "task_position_error_rms_m": _rms(position_error[after]),
-        "task_position_error_max_m": float(position_error[after].max()) if after.any() else math.nan,
+        "task_position_error_max_m": float(position_error[after].max())
+        if after.any()
+        else math.nan,
         "task_position_error_final_m": float(position_error[-1]),
         "task_orientation_error_rms_rad": _rms(rotation_error[after]),
-        "task_orientation_error_max_rad": float(rotation_error[after].max()) if after.any() else math.nan,
+        "task_orientation_error_max_rad": float(rotation_error[after].max())
+        if after.any()
+        else math.nan,
         "task_settling_time_s": settled,
         "task_settled": 0.0 if math.isnan(settled) else 1.0,
         "task_path_length_m": _path_length(signals["task_position"]),

@@ -148,7 +148,11 @@ def baseline_controller_table(raw: dict[str, Any], kind: str) -> dict[str, Any]:
     if "type" in tuning:
         return copy.deepcopy(tuning)
     if kind not in BASELINES:
-        variants = [k for k, v in (raw.get("baselines") or {}).items() if isinstance(v, dict) and "type" in v]
+        variants = [
+            k
+            for k, v in (raw.get("baselines") or {}).items()
+            if isinstance(v, dict) and "type" in v
+        ]
         choices = ", ".join((controller.get("type", "none"), *BASELINE_KINDS, *variants))
         raise ScenarioError(f"controller '{kind}': this scenario can run {choices}")
     inherited = _TASK_KEYS + (_PSEUDO_INVERSE_INHERITED if BASELINES[kind].pseudo_inverse else ())

@@ -33,8 +33,8 @@ from uvms_pin.scenario.metrics import build_metrics
 from uvms_pin.scenario.overrides import apply_overrides, parse_key_path
 from uvms_pin.scenario.schema import Table
 from uvms_pin.scenario.sensors import build_sensors
-from uvms_pin.scenario.timing import build_control_period, build_integrator, build_log_period
 from uvms_pin.scenario.task import build_task
+from uvms_pin.scenario.timing import build_control_period, build_integrator, build_log_period
 from uvms_pin.scenario.toml import read_toml
 from uvms_pin.scenario.water import Water, build_water
 from uvms_pin.scenario.world import build_disturbance, build_environment

@@ -30,6 +30,7 @@ from uvms_pin.sim.run import ControllerSpec
 
 __all__ = ["TRACKING_CONTROLLERS"]
 
+
 def _kinematic_gains(t: Table, nv: int, passive: tuple[int, ...]) -> KinematicGains:
     defaults = KinematicGains()
     numbers = {
@@ -41,8 +42,12 @@ def _kinematic_gains(t: Table, nv: int, passive: tuple[int, ...]) -> KinematicGa
     weights = t.vector("velocity_weights", nv) if t.has("velocity_weights") else None
     damping = t.number("pinv_damping", defaults.damping, positive=True)
     passive_table = t.vector("passive_velocities", None, list(passive))
-    if any(k not in range(6) for k in passive_table) or len(set(passive_table)) != len(passive_table):
-        raise t.error("passive_velocities", f"must be distinct indices in 0..5, got {passive_table.tolist()}")
+    if any(k not in range(6) for k in passive_table) or len(set(passive_table)) != len(
+        passive_table
+    ):
+        raise t.error(
+            "passive_velocities", f"must be distinct indices in 0..5, got {passive_table.tolist()}"
+        )
     return KinematicGains(
         **numbers,
         velocity_weights=weights,
@@ -74,7 +79,9 @@ def _dynamic_level(t: Table, uvms: UVMS) -> tuple[Callable[[UVMS], Any], dict[st
     recorded = {"k_zeta": gain, "rho0_zeta": rho0, "rho_inf_zeta": rho_inf,
                 "l_zeta_per_s": decay}  # fmt: skip
     return (
-        lambda u: PpcVelocityLevel(nv, gain, PerformanceFunction(rho0, rho_inf, decay, names), names),
+        lambda u: PpcVelocityLevel(
+            nv, gain, PerformanceFunction(rho0, rho_inf, decay, names), names
+        ),
         {"dynamic_level": kind, **recorded},
     )
 

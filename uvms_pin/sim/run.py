@@ -140,9 +140,7 @@ def simulate(
     return _simulate(scenario, [*observers, *reports], controller)
 
 
-def _simulate(
-    scenario: Scenario, observers: list[Observer], given: Controller | None
-) -> Rollout:
+def _simulate(scenario: Scenario, observers: list[Observer], given: Controller | None) -> Rollout:
     settings = scenario.settings
     sensors = SensorSuite(
         scenario.uvms.model, scenario.sensor_config, settings.duration_s, settings.seed
@@ -189,9 +187,7 @@ def class_path(controller: object) -> str:
     return f"{cls.__module__}:{cls.__qualname__}"
 
 
-def controller_record(
-    factory: ControllerFactory | None, controller: Controller
-) -> dict[str, Any]:
+def controller_record(factory: ControllerFactory | None, controller: Controller) -> dict[str, Any]:
     """What ran: the class of ``controller`` (``module:QualifiedName``) and, when the
     factory is a `ControllerSpec`, its type and parameters (else None: unknown)."""
     spec = factory if isinstance(factory, ControllerSpec) else None

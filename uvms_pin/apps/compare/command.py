@@ -78,7 +78,7 @@ def _compare_tracking(args: argparse.Namespace, scenarios, criteria, out) -> int
 
     if args.robustness:
         raise ParameterError("--robustness runs the force-tracking cases: not for a [task]")
-    task = (next(iter(scenarios.values())).task)
+    task = next(iter(scenarios.values())).task
     with claim(out, CONTROLLER_COMPARISON, overwrite=args.overwrite):
         say = None if args.quiet else (lambda line: print(line, file=sys.stderr, flush=True))
         rows, rollouts = compare_controllers(scenarios, criteria, say)

@@ -25,7 +25,6 @@ from uvms_pin.control.base import Controller
 from uvms_pin.control.baselines.task import gain_vector
 from uvms_pin.control.measurement import Measurement
 from uvms_pin.control.pseudo_inverse import pseudo_inverse
-from uvms_pin.control.tracking.dynamic_level import InverseDynamicsLevel, PpcVelocityLevel
 from uvms_pin.control.tracking.task import TrackingTask, orientation_error, vehicle_rotation
 from uvms_pin.control.tracking.task_priority import KinematicGains, KinematicLevel
 from uvms_pin.errors import ParameterError
@@ -117,8 +116,10 @@ class ResolvedAccelerationController(Controller):
         self.k_d = gain_vector("velocity_gain_per_s", velocity_gain_per_s, 6, positive=True)
         self.k_n = float(gain_vector("null_space_damping_per_s", null_space_damping_per_s, 1)[0])
         nv = self.model.nv
-        self.weights = np.ones(nv) if velocity_weights is None else gain_vector(
-            "velocity_weights", velocity_weights, nv, positive=True
+        self.weights = (
+            np.ones(nv)
+            if velocity_weights is None
+            else gain_vector("velocity_weights", velocity_weights, nv, positive=True)
         )
         self._frame_id = task.frame_id(self.model)
         self._signals: dict = {}
@@ -134,7 +135,9 @@ class ResolvedAccelerationController(Controller):
         model, data = self.model, self.data
         pin.forwardKinematics(model, data, q, v, np.zeros(model.nv))
         pin.updateFramePlacements(model, data)
-        acc = pin.getFrameClassicalAcceleration(model, data, self._frame_id, pin.LOCAL_WORLD_ALIGNED)
+        acc = pin.getFrameClassicalAcceleration(
+            model, data, self._frame_id, pin.LOCAL_WORLD_ALIGNED
+        )
         return np.concatenate([acc.linear, acc.angular])
 
     def compute(self, time_s: float, measurement: Measurement) -> np.ndarray:
@@ -145,9 +148,11 @@ class ResolvedAccelerationController(Controller):
         e_p = p_r - position
         e_o = orientation_error(task.rotation_reference, rotation)
         rate = jacobian @ v
-        a_task = np.concatenate([a_r, np.zeros(3)]) + self.k_d * (
-            np.concatenate([v_r, np.zeros(3)]) - rate
-        ) + self.k_p * np.concatenate([e_p, e_o])
+        a_task = (
+            np.concatenate([a_r, np.zeros(3)])
+            + self.k_d * (np.concatenate([v_r, np.zeros(3)]) - rate)
+            + self.k_p * np.concatenate([e_p, e_o])
+        )
         inverse = pseudo_inverse(jacobian, 1e-9, self.weights)
         null = np.eye(self.model.nv) - inverse @ jacobian
         acceleration = inverse @ (a_task - self._bias_acceleration(q, v)) - self.k_n * (null @ v)

@@ -43,7 +43,9 @@ class InverseDynamicsLevel:
         [1/s^2]. integral_limit: |int e dt| per component [m, rad] (anti-windup).
     """
 
-    def __init__(self, uvms: UVMS, velocity_gain_per_s=4.0, integral_gain_per_s2=4.0, integral_limit=0.5):
+    def __init__(
+        self, uvms: UVMS, velocity_gain_per_s=4.0, integral_gain_per_s2=4.0, integral_limit=0.5
+    ):
         self.uvms = uvms.with_model(pin.Model(uvms.model))
         nv = self.uvms.nv
         self.k_v = gain_vector("velocity_gain_per_s", velocity_gain_per_s, nv, positive=True)
@@ -86,5 +88,7 @@ class PpcVelocityLevel:
 
     def torque(self, time_s: float, q: np.ndarray, v: np.ndarray, zeta_r: np.ndarray) -> np.ndarray:
         bound = self.funnel.value(time_s)
-        xi = check_funnel(level="second", names=self.names, time_s=time_s, error=v - zeta_r, bound=bound)
+        xi = check_funnel(
+            level="second", names=self.names, time_s=time_s, error=v - zeta_r, bound=bound
+        )
         return -self.k / bound * transformation_gain(xi) * transformed_error(xi)

@@ -93,7 +93,9 @@ class TrackingTask:
             raise ParameterError(f"task frame '{self.frame_name}' is not a frame of the model")
         return int(model.getFrameId(self.frame_name))
 
-    def pose(self, model: pin.Model, data: pin.Data, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    def pose(
+        self, model: pin.Model, data: pin.Data, q: np.ndarray
+    ) -> tuple[np.ndarray, np.ndarray]:
         """(position [m], rotation (3, 3)) of the tracked frame in the task frame."""
         return self.pose_and_jacobian(model, data, q, jacobian=False)[:2]
 

@@ -48,7 +48,7 @@ from uvms_pin.checks import finite_vector
 from uvms_pin.control.tracking.task import TrackingTask, orientation_error, vehicle_rotation
 from uvms_pin.errors import ParameterError
 
-__all__ = ["KinematicLevel", "KinematicGains", "prioritized_velocity"]
+__all__ = ["KinematicGains", "KinematicLevel", "prioritized_velocity"]
 
 
 @dataclass(frozen=True)
@@ -146,7 +146,9 @@ class KinematicLevel:
         self.model, self.data, self.task, self.gains = model, model.createData(), task, gains
         nv = model.nv
         weights = gains.velocity_weights
-        self.weights = np.ones(nv) if weights is None else finite_vector("velocity_weights", weights, nv)
+        self.weights = (
+            np.ones(nv) if weights is None else finite_vector("velocity_weights", weights, nv)
+        )
         if np.any(self.weights <= 0):
             raise ParameterError(f"velocity_weights must be positive, got {self.weights}")
         self.lower = np.asarray(model.lowerPositionLimit[7:], dtype=float)
@@ -179,7 +181,9 @@ class KinematicLevel:
         p_r, v_r, _ = task.path.at(time_s)
         e_p = p_r - position
         e_o = orientation_error(task.rotation_reference, rotation)
-        rate = np.concatenate([v_r + gains.position_gain_per_s * e_p, gains.orientation_gain_per_s * e_o])
+        rate = np.concatenate(
+            [v_r + gains.position_gain_per_s * e_p, gains.orientation_gain_per_s * e_o]
+        )
         tasks = [(jacobian, rate)]
         if task.target == "end_effector" and gains.attitude_gain_per_s > 0:
             tasks.append(self._attitude_task(q))

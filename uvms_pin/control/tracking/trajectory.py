@@ -213,8 +213,14 @@ class Waypoints:
         pts = np.asarray(points, dtype=float)
         times = np.asarray(times_s, dtype=float)
         if pts.ndim != 2 or pts.shape[1] != 3 or len(pts) < 2:
-            raise ParameterError(f"waypoints must be >= 2 points of 3 numbers, got shape {pts.shape}")
-        if times.shape != (len(pts),) or not np.all(np.isfinite(times)) or not np.all(np.isfinite(pts)):
+            raise ParameterError(
+                f"waypoints must be >= 2 points of 3 numbers, got shape {pts.shape}"
+            )
+        if (
+            times.shape != (len(pts),)
+            or not np.all(np.isfinite(times))
+            or not np.all(np.isfinite(pts))
+        ):
             raise ParameterError(
                 f"waypoints need one finite time per point: {len(pts)} points, times {times.tolist()}"
             )

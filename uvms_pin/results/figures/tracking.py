@@ -48,7 +48,9 @@ def plot_tracking(rollout: RolloutData, path: Path | None = None) -> Figure | Pa
         (axes[1, 1], rotation_deg, "orientation error [deg]"),
     ):
         ax.plot(t, values)
-        ax.axvline(float(task.get("transient_s", 0.0)), color="0.5", linestyle=":", label="transient end")
+        ax.axvline(
+            float(task.get("transient_s", 0.0)), color="0.5", linestyle=":", label="transient end"
+        )
         ax.set_xlabel("t [s]")
         ax.set_ylabel(label)
         ax.legend(fontsize=8)
