@@ -112,3 +112,4 @@ def test_bad_results_are_cli_input_errors(scenario_dir, capsys):
                  "--quiet", "--set", 'metrics.extra=["my_metrics:raising"]'])  # fmt: skip
     assert code == 2
     assert "raised RuntimeError" in capsys.readouterr().err
+    assert not (scenario_dir / "o").exists() or not any((scenario_dir / "o").iterdir())
