@@ -74,7 +74,7 @@ def test_extra_metrics_enter_metrics_json(scenario_dir, capsys):
     [
         ("my_metrics:arm_travl", "has no 'arm_travl'; did you mean 'arm_travel'"),
         ("no_such_module:f", "module 'no_such_module' not found"),
-        ("my_metrics", "expected 'package.module:Name'"),
+        ("my_metrics", "expected 'package.module:function'"),
         ("my_metrics:NOT_CALLABLE", "not a function"),
     ],
 )

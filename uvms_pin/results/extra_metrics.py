@@ -31,7 +31,7 @@ DIRECTORY_KEY = "extra_metrics_dir"
 
 def metric_function(reference: str, search_dir: str | Path | None = None) -> Callable:
     """The callable ``"package.module:function"`` names (ParameterError if it is none)."""
-    function = resolve_reference(reference, search_dir, what="metric")
+    function = resolve_reference(reference, search_dir, what="metric", form="function")
     if not callable(function):
         raise ParameterError(
             f"metric '{reference}': is a {type(function).__name__}, not a function of the rollout"

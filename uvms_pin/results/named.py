@@ -20,13 +20,16 @@ from uvms_pin.errors import ParameterError
 __all__ = ["resolve_reference"]
 
 
-def resolve_reference(reference: str, search_dir: str | Path | None = None, *, what: str) -> Any:
+def resolve_reference(
+    reference: str, search_dir: str | Path | None = None, *, what: str, form: str = "Name"
+) -> Any:
     """The object ``"package.module:Name"`` names (``Name`` may be dotted: ``Class.method``).
 
     Args:
         reference: the text. search_dir: a directory put in front of ``sys.path`` while
             importing (None: ``sys.path`` as it is). what: how messages name the reference
-            ("controller type", "metric").
+            ("controller type", "metric"). form: what the part after the colon names, in
+            the message about a malformed reference ("ClassName", "function").
 
     Raises:
         ParameterError: a malformed name, a module not found or failing to import, a
@@ -34,7 +37,7 @@ def resolve_reference(reference: str, search_dir: str | Path | None = None, *, w
     """
     module_name, _, attribute = str(reference).partition(":")
     if not (_dotted_identifier(module_name) and _dotted_identifier(attribute)):
-        raise ParameterError(f"{what} '{reference}': expected 'package.module:Name'")
+        raise ParameterError(f"{what} '{reference}': expected 'package.module:{form}'")
     obj: Any = _import(module_name, reference, search_dir, what)
     for part in attribute.split("."):
         if not hasattr(obj, part):

@@ -37,7 +37,7 @@ def load_controller_class(type_path: str, search_dir: str | Path | None = None) 
         ParameterError: a malformed name, a module that is not found or fails to import, a
             missing attribute (with the closest name), or not a `Controller` subclass.
     """
-    obj = resolve_reference(type_path, search_dir, what="controller type")
+    obj = resolve_reference(type_path, search_dir, what="controller type", form="ClassName")
     if not (isinstance(obj, type) and issubclass(obj, Controller)):
         raise ParameterError(
             f"controller type '{type_path}': must be a class derived from "
