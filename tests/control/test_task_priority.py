@@ -128,3 +128,40 @@ def test_a_lower_task_cannot_move_what_an_upper_task_holds_even_damped():
         [(held, np.array([2.04, 2.2])), (arm, np.ones(6))], np.ones(10), 1e-3
     )
     np.testing.assert_allclose(zeta[7:9], [2.04, 2.2], rtol=1e-5)
+
+
+def test_the_manipulability_task_climbs_its_gradient_in_the_pose_tasks_null_space(uvms):
+    task, model = _task(uvms), uvms.model
+    plain = KinematicLevel(model, task, KinematicGains(attitude_gain_per_s=0.0, damping=1e-9))
+    q = uvms.neutral_configuration()
+    q[7:] = [0.3, 0.4, -0.6, 0.5]
+    w = plain.manipulability(q)
+    climbing = KinematicLevel(
+        model,
+        task,
+        KinematicGains(
+            attitude_gain_per_s=0.0,
+            damping=1e-9,
+            manipulability_threshold=2.0 * w,  # active here
+            manipulability_gain=1.0,
+        ),
+    )
+    zero = np.zeros(model.nv)
+    without, _ = plain.reference(0.0, q, zero)
+    with_task, _ = climbing.reference(0.0, q, zero)
+    _, _, jac = task.pose_and_jacobian(model, model.createData(), q)
+    change = with_task - without
+    np.testing.assert_allclose(jac @ change, 0.0, atol=1e-7)  # the pose task is untouched
+    h = 1e-6
+    gradient = np.array([
+        (climbing.manipulability(q + h * np.eye(model.nq)[7 + j])
+         - climbing.manipulability(q - h * np.eye(model.nq)[7 + j])) / (2 * h)
+        for j in range(4)
+    ])  # fmt: skip
+    assert np.linalg.norm(change[6:]) > 1e-6 and change[6:] @ gradient > 0.0  # uphill
+    # above the threshold the set-based task is absent
+    relaxed = KinematicLevel(
+        model, task, KinematicGains(attitude_gain_per_s=0.0, damping=1e-9,
+                                    manipulability_threshold=0.5 * w)
+    )  # fmt: skip
+    np.testing.assert_allclose(relaxed.reference(0.0, q, zero)[0], without, atol=1e-12)

@@ -113,3 +113,44 @@ def test_compare_controllers_on_a_tracking_task(tmp_path, capsys):
     assert "task_position_error_rms_m" in text and "computed_torque_task" in text
     assert (out / "controllers_tracking.png").is_file()
     assert "position error RMS" in capsys.readouterr().out
+
+
+@pytest.mark.parametrize(
+    "task",
+    [
+        {"type": "circle", "target": "vehicle", "radius_m": 0.2, "period_s": 20.0, "ramp_s": 2.0},
+        # the arm alone (4 joints) follows the position (a whole pose would be 6 equations),
+        # on a circle in the vehicle's y-z plane its joints reach (in the x-y plane joint 3
+        # would need to pass its limit, and the limit task, above, stops it)
+        {
+            "type": "circle",
+            "frame": "vehicle",
+            "radius_m": 0.05,
+            "period_s": 10.0,
+            "ramp_s": 2.0,
+            "track_orientation": False,
+            "normal": [1.0, 0.0, 0.0],
+        },
+    ],
+    ids=["vehicle path", "end effector in the vehicle frame"],
+)
+def test_task_priority_tracks_vehicle_paths_and_vehicle_frame_tasks(task):
+    # default gains, no acceleration feed-forward: the velocity level lags a_r / K_v behind
+    # (vehicle path: 0.02 m/s^2 / 4 1/s = 5 mm/s), which K_p = 1 1/s turns into ~5 mm
+    raw = _raw(6.0, task=task, controller={"type": "task_priority"})
+    metrics = simulate(Scenario.from_dict(raw, CIRCLE), progress=False).metrics()
+    assert metrics["task_position_error_max_m"] < 1e-2
+    if task.get("track_orientation", True):
+        assert metrics["task_orientation_error_max_rad"] < 0.01
+    assert metrics["joint_limit_excess_max_rad"] == 0.0
+
+
+def test_the_integral_takes_up_the_current_the_model_does_not_know():
+    def final_error(integral_gain: float) -> float:
+        controller = {"type": "task_priority", "integral_gain_per_s2": [integral_gain] * 10}
+        raw = _raw(10.0, controller=controller, water={"current_world_m_s": [0.2, 0.0, 0.0]})
+        rollout = simulate(Scenario.from_dict(raw, CIRCLE), progress=False)
+        return rollout.metrics()["task_position_error_final_m"]
+
+    with_integral, without = final_error(4.0), final_error(0.0)
+    assert with_integral < 0.2 * without and without > 5e-3

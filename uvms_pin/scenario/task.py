@@ -108,6 +108,7 @@ def build_task(t: Table | None, uvms: UVMS, q0: np.ndarray) -> TrackingTask | No
     frame_name = "" if target == "vehicle" else _ee_frame(t, uvms)
     transient = t.number("transient_s", 0.0, nonneg=True)
     tolerance = t.number("settle_tolerance_m", 0.01, positive=True)
+    track_orientation = t.boolean("track_orientation", True)
     try:
         at_start = TrackingTask(kind, target, frame, frame_name, Hold(np.zeros(3)), np.eye(3))
         position, rotation = at_start.pose(uvms.model, uvms.model.createData(), q0)
@@ -124,5 +125,5 @@ def build_task(t: Table | None, uvms: UVMS, q0: np.ndarray) -> TrackingTask | No
     recorded = {k: plain(v) for k, v in record.items()}
     return TrackingTask(
         kind, target, frame, frame_name, path, np.asarray(rotation), transient, tolerance,
-        {**recorded, "start_m": start.tolist(), "frame_name": frame_name},
+        {**recorded, "start_m": start.tolist(), "frame_name": frame_name}, track_orientation,
     )  # fmt: skip

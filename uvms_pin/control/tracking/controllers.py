@@ -153,9 +153,12 @@ class ResolvedAccelerationController(Controller):
             + self.k_d * (np.concatenate([v_r, np.zeros(3)]) - rate)
             + self.k_p * np.concatenate([e_p, e_o])
         )
+        rows = task.rows
+        jacobian = jacobian[rows]
         inverse = pseudo_inverse(jacobian, 1e-9, self.weights)
         null = np.eye(self.model.nv) - inverse @ jacobian
-        acceleration = inverse @ (a_task - self._bias_acceleration(q, v)) - self.k_n * (null @ v)
+        wanted = (a_task - self._bias_acceleration(q, v))[rows]
+        acceleration = inverse @ wanted - self.k_n * (null @ v)
         self._signals = task_signals(task, e_p, e_o)
         return mass_matrix(self.uvms, q) @ acceleration + bias_forces(self.uvms, q, v)
 

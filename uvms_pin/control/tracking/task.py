@@ -57,6 +57,9 @@ class TrackingTask:
         transient_s: the metrics "after the transient" start here [s].
         settle_tolerance_m: the position error the settling time waits for [m].
         record: the task as written (what rollouts keep).
+        track_orientation: False: the controllers follow the position alone (an arm with
+            fewer than 6 joints in the vehicle frame); the orientation error is still
+            measured against R_r.
     """
 
     kind: str
@@ -68,6 +71,12 @@ class TrackingTask:
     transient_s: float = 0.0
     settle_tolerance_m: float = 0.01
     record: dict[str, Any] = field(default_factory=dict)
+    track_orientation: bool = True
+
+    @property
+    def rows(self) -> slice:
+        """The rows of [p_dot; omega] the controllers follow (all 6, or the position's)."""
+        return slice(0, 6 if self.track_orientation else 3)
 
     def __post_init__(self) -> None:
         if (self.target, self.frame) not in TARGETS:

@@ -15,8 +15,9 @@ set-based activation of Simetti and Casalino for the inequality tasks):
    w_x, w_y = k_a e_a, e_a the first two components of log3(R_v^T R_level), R_level the
    vehicle's yaw alone (the attitude a vehicle floats at);
 4. manipulability (set-based: active while w(q) = sqrt(det(J_a J_a^T)) < w_min): the arm
-   rates k_m grad w [rad/s] (grad by central differences), J_a the arm's columns of the
-   end-effector Jacobian.
+   climbs k_m grad w [rad/s] (grad by central differences) in the null space of every task
+   above (gradient projection, zeta += W^-1/2 N_K W^1/2 [0; k_m grad w]), J_a the arm's
+   columns of the end-effector Jacobian.
 
 Each task k with Jacobian J_k and desired rate x_k is solved in the null space of the
 ones above (in the metric W of ``velocity_weights``, zeta = W^-1/2 u):
@@ -110,10 +111,15 @@ def _damped_inverse_and_rows(matrix: np.ndarray, damping: float) -> tuple[np.nda
 
 
 def prioritized_velocity(
-    tasks: list[tuple[np.ndarray, np.ndarray]], weights: np.ndarray, damping: float
+    tasks: list[tuple[np.ndarray, np.ndarray]],
+    weights: np.ndarray,
+    damping: float,
+    secondary: np.ndarray | None = None,
 ) -> np.ndarray:
     """zeta solving ``tasks`` [(J_k (m_k, n), x_k (m_k,)), ...] in priority order (the
-    recursion of the module docstring, in the metric W = diag(weights)).
+    recursion of the module docstring, in the metric W = diag(weights)), plus the velocity
+    ``secondary`` (n,) projected into the null space of them all (gradient projection:
+    u += N_K W^1/2 secondary), if given.
 
     The null-space projector is updated with the exact projector on each task's row space,
     N_k = N_{k-1} - V_k V_k^T (V_k: the right singular vectors of J_k N_{k-1} kept), not
@@ -130,6 +136,8 @@ def prioritized_velocity(
         inverse, rows = _damped_inverse_and_rows(scaled @ null, damping)
         u = u + inverse @ (rate - scaled @ u)
         null = null - rows.T @ rows
+    if secondary is not None:
+        u = u + null @ (secondary / scale)
     return scale * u
 
 
@@ -161,14 +169,17 @@ class KinematicLevel:
         self.task.frame_id(model)  # the frame exists
         self._ee_id = -1 if task.target == "vehicle" else task.frame_id(model)
 
-    def _solve(self, tasks: list, v: np.ndarray) -> np.ndarray:
+    def _solve(self, tasks: list, v: np.ndarray, secondary: np.ndarray | None) -> np.ndarray:
         """The recursion over the driven velocities, the passive ones at their measured v."""
+        damping = self.gains.damping
         if self.passive.size == 0:
-            return prioritized_velocity(tasks, self.weights, self.gains.damping)
+            return prioritized_velocity(tasks, self.weights, damping, secondary)
         active, passive = self.active, self.passive
         moved = [(j[:, active], x - j[:, passive] @ v[passive]) for j, x in tasks]
         zeta_r = np.array(v, dtype=float)
-        zeta_r[active] = prioritized_velocity(moved, self.weights[active], self.gains.damping)
+        zeta_r[active] = prioritized_velocity(
+            moved, self.weights[active], damping, None if secondary is None else secondary[active]
+        )
         return zeta_r
 
     def reference(
@@ -184,16 +195,17 @@ class KinematicLevel:
         rate = np.concatenate(
             [v_r + gains.position_gain_per_s * e_p, gains.orientation_gain_per_s * e_o]
         )
-        tasks = [(jacobian, rate)]
+        tasks = [(jacobian[task.rows], rate[task.rows])]
         if task.target == "end_effector" and gains.attitude_gain_per_s > 0:
             tasks.append(self._attitude_task(q))
+        secondary = None
         if task.target == "end_effector" and gains.manipulability_threshold > 0:
-            tasks.append(self._manipulability_task(q))
-        zeta_r, active = self._solve_within_limits(tasks, q, v)
+            secondary = self._manipulability_velocity(q)
+        zeta_r, active = self._solve_within_limits(tasks, q, v, secondary)
         return zeta_r, {"position_error": e_p, "orientation_error": e_o, "active_limits": active}
 
     def _solve_within_limits(
-        self, tasks: list, q: np.ndarray, v: np.ndarray
+        self, tasks: list, q: np.ndarray, v: np.ndarray, secondary: np.ndarray | None
     ) -> tuple[np.ndarray, np.ndarray]:
         """zeta_r with every joint rate inside its bounds (module docstring, task 1), and
         which joints' bound is a task (1.0) or not (0.0)."""
@@ -207,7 +219,7 @@ class KinematicLevel:
             rows = np.flatnonzero(held)
             limit_jacobian = np.zeros((rows.size, self.model.nv))
             limit_jacobian[np.arange(rows.size), 6 + rows] = 1.0
-            zeta_r = self._solve([(limit_jacobian, bound[rows]), *tasks], v)
+            zeta_r = self._solve([(limit_jacobian, bound[rows]), *tasks], v, secondary)
             rates = zeta_r[6:]
             over = ~held & ((rates > highest + 1e-12) | (rates < lowest - 1e-12))
             if not over.any():
@@ -235,10 +247,11 @@ class KinematicLevel:
         gram = arm @ arm.T if arm.shape[0] <= arm.shape[1] else arm.T @ arm
         return math.sqrt(max(np.linalg.det(gram), 0.0)) if rows else 0.0
 
-    def _manipulability_task(self, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    def _manipulability_velocity(self, q: np.ndarray) -> np.ndarray | None:
+        """[0 (6); k_m grad w] while w(q) < w_min (grad by central differences), else None."""
         n_arm = q.size - 7
         if self.manipulability(q) >= self.gains.manipulability_threshold:
-            return np.zeros((0, self.model.nv)), np.zeros(0)
+            return None
         step = 1e-6
         gradient = np.zeros(n_arm)
         for j in range(n_arm):
@@ -246,6 +259,4 @@ class KinematicLevel:
             plus[7 + j] += step
             minus[7 + j] -= step
             gradient[j] = (self.manipulability(plus) - self.manipulability(minus)) / (2 * step)
-        jacobian = np.zeros((n_arm, self.model.nv))
-        jacobian[:, 6:] = np.eye(n_arm)
-        return jacobian, self.gains.manipulability_gain * gradient
+        return np.concatenate([np.zeros(6), self.gains.manipulability_gain * gradient])
