@@ -17,7 +17,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from uvms_pin.errors import ParameterError
-from uvms_pin.results.named import resolve_reference
+from uvms_pin.results.named import resolve_reference, users_code_failed
 
 if TYPE_CHECKING:
     from uvms_pin.results.rollout_data import RolloutData
@@ -54,9 +54,9 @@ def extra_metrics(rollout: RolloutData, built_in: Mapping[str, Any]) -> dict[str
         function = metric_function(reference, search_dir)
         try:
             values = function(rollout)
-        except Exception as exc:  # the user's function: name it, never a bare traceback
-            raise ParameterError(
-                f"metric '{reference}' raised {type(exc).__name__}: {exc}"
+        except Exception as exc:  # the user's function: named, with its own frames
+            raise users_code_failed(
+                f"metric '{reference}' raised {type(exc).__name__}: {exc}", exc
             ) from exc
         out.update(_checked(reference, values, {**built_in, **out}))
     return out

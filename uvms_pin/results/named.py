@@ -15,9 +15,9 @@ import sys
 from pathlib import Path
 from typing import Any
 
-from uvms_pin.errors import ParameterError
+from uvms_pin.errors import ParameterError, user_traceback
 
-__all__ = ["resolve_reference"]
+__all__ = ["resolve_reference", "users_code_failed"]
 
 
 def resolve_reference(
@@ -51,6 +51,14 @@ def resolve_reference(
     return obj
 
 
+def users_code_failed(message: str, exc: BaseException) -> ParameterError:
+    """A ParameterError saying ``message``, with the frames of the user's code that raised
+    ``exc`` (`uvms_pin.errors.user_traceback`) for the command line to show."""
+    error = ParameterError(message)
+    error.user_traceback = user_traceback(exc)
+    return error
+
+
 def _dotted_identifier(text: str) -> bool:
     parts = text.split(".")
     return bool(text) and all(p.isidentifier() and not keyword.iskeyword(p) for p in parts)
@@ -73,8 +81,9 @@ def _import(module_name: str, reference: str, search_dir: str | Path | None, wha
             f"{what} '{reference}': importing '{module_name}' failed: {exc}"
         ) from exc
     except Exception as exc:  # the user's module raised while importing: name it
-        raise ParameterError(
-            f"{what} '{reference}': importing '{module_name}' failed: {type(exc).__name__}: {exc}"
+        raise users_code_failed(
+            f"{what} '{reference}': importing '{module_name}' failed: {type(exc).__name__}: {exc}",
+            exc,
         ) from exc
     finally:
         if added is not None:

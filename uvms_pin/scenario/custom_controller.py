@@ -24,7 +24,7 @@ from typing import Any
 from uvms_pin.control.base import Controller
 from uvms_pin.errors import ParameterError
 from uvms_pin.model.uvms import UVMS
-from uvms_pin.results.named import resolve_reference
+from uvms_pin.results.named import resolve_reference, users_code_failed
 from uvms_pin.sim.run import ControllerSpec
 
 __all__ = ["custom_controller", "load_controller_class"]
@@ -59,10 +59,11 @@ def custom_controller(
                 controller = cls.from_params(uvms, dict(frozen))
             else:
                 controller = cls(uvms, **frozen)
-        except (TypeError, ValueError, KeyError) as exc:
-            raise ParameterError(
+        except Exception as exc:  # the user's constructor: its traceback goes with it
+            raise users_code_failed(
                 f"controller '{type_path}' rejected its parameters "
-                f"({', '.join(sorted(frozen)) or 'none'}): {exc}"
+                f"({', '.join(sorted(frozen)) or 'none'}): {type(exc).__name__}: {exc}",
+                exc,
             ) from exc
         if not isinstance(controller, Controller):
             raise ParameterError(

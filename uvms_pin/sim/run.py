@@ -47,6 +47,8 @@ class ControllerSpec:
     type: str
     params: dict[str, Any] = field(default_factory=dict)
     build: ControllerFactory = field(default=None, repr=False)
+    #: built from the scenario file's [controller] table (its ``raw`` then records it)
+    from_file: bool = field(default=False, compare=False)
 
     def __call__(self, uvms: UVMS) -> Controller:
         return self.build(uvms)
@@ -150,13 +152,13 @@ def _simulate(scenario: Scenario, observers: list[Observer], given: Controller |
             f"controller must be a uvms_pin Controller instance, got {type(given).__name__}"
         )
     controller = scenario.controller_factory(scenario.uvms) if given is None else given
-    factory = scenario.controller_factory if given is None else None
+    record = controller_record(scenario.controller_factory if given is None else None, controller)
     metadata = {
         "scenario": scenario.name,
         "scenario_path": str(scenario.path),
         "description": scenario.description,
-        "parameters": scenario.raw,
-        "controller": controller_record(factory, controller),
+        "parameters": recorded_parameters(scenario, record, instance=given is not None),
+        "controller": record,
         REFERENCES_KEY: list(scenario.extra_metrics),
         DIRECTORY_KEY: str(Path(scenario.path).parent.resolve()),
     }
@@ -188,11 +190,42 @@ def class_path(controller: object) -> str:
 
 
 def controller_record(factory: ControllerFactory | None, controller: Controller) -> dict[str, Any]:
-    """What ran: the class of ``controller`` (``module:QualifiedName``) and, when the
-    factory is a `ControllerSpec`, its type and parameters (else None: unknown)."""
-    spec = factory if isinstance(factory, ControllerSpec) else None
+    """What ran: the class of ``controller`` (``module:QualifiedName``), its type and its
+    parameters: a `ControllerSpec`'s, else (another factory, or an instance given to
+    `simulate`: ``factory`` None) the class path (what a scenario's ``type`` would name)
+    and the controller's public numbers, strings and small arrays (`public_parameters`)."""
+    if isinstance(factory, ControllerSpec):
+        return {"class": class_path(controller), "type": factory.type, "params": factory.params}
     return {
         "class": class_path(controller),
-        "type": None if spec is None else spec.type,
-        "params": None if spec is None else spec.params,
+        "type": class_path(controller),
+        "params": public_parameters(controller),
     }
+
+
+def public_parameters(controller: object) -> dict[str, Any]:
+    """The controller's public attributes that are numbers, strings, booleans or numeric
+    arrays of at most 64 entries (as lists): what can be recorded of a controller built in
+    code."""
+    out: dict[str, Any] = {}
+    for name, value in vars(controller).items():
+        if name.startswith("_"):
+            continue
+        if isinstance(value, bool | int | float | str):
+            out[name] = value
+        elif isinstance(value, np.ndarray) and value.dtype.kind in "biuf" and value.size <= 64:
+            out[name] = value.tolist()
+    return out
+
+
+def recorded_parameters(
+    scenario: Scenario, record: dict[str, Any], *, instance: bool = False
+) -> dict[str, Any]:
+    """The scenario's parameters as they ran: its ``raw`` document, whose [controller] table
+    says what the run's controller is when it was not built from that table (a
+    ``controller_factory`` set in code, or an ``instance`` given to `simulate`)."""
+    factory = scenario.controller_factory
+    if isinstance(factory, ControllerSpec) and factory.from_file and not instance:
+        return scenario.raw
+    table = {"type": record["type"], "set_in_code": True, **(record["params"] or {})}
+    return {**scenario.raw, "controller": table}

@@ -159,8 +159,13 @@ class KinematicLevel:
         )
         if np.any(self.weights <= 0):
             raise ParameterError(f"velocity_weights must be positive, got {self.weights}")
-        self.lower = np.asarray(model.lowerPositionLimit[7:], dtype=float)
-        self.upper = np.asarray(model.upperPositionLimit[7:], dtype=float)
+        # the joints with limits (one configuration entry: revolute, prismatic); a
+        # continuous joint (cos, sin) has none: (its q index, its v index)
+        bounded = [(j.idx_q, j.idx_v) for j in list(model.joints)[2:] if j.nq == 1]
+        self.bounded_q = np.array([i for i, _ in bounded], dtype=int)
+        self.bounded_v = np.array([i for _, i in bounded], dtype=int)
+        self.lower = np.asarray(model.lowerPositionLimit[self.bounded_q], dtype=float)
+        self.upper = np.asarray(model.upperPositionLimit[self.bounded_q], dtype=float)
         passive = sorted(set(int(k) for k in gains.passive_velocities))
         if any(not 0 <= k < 6 for k in passive):
             raise ParameterError(f"passive_velocities must be in 0..5, got {passive}")
@@ -186,7 +191,7 @@ class KinematicLevel:
         self, time_s: float, q: np.ndarray, v: np.ndarray
     ) -> tuple[np.ndarray, dict[str, np.ndarray]]:
         """(zeta_r (nv,) at the measured (q, v), the task's errors: ``position_error`` [m], ``orientation_error``
-        [rad], ``active_limits`` (one 0/1 per arm joint))."""
+        [rad], ``active_limits`` (one 0/1 per arm joint with limits, in order))."""
         task, gains = self.task, self.gains
         position, rotation, jacobian = task.pose_and_jacobian(self.model, self.data, q)
         p_r, v_r, _ = task.path.at(time_s)
@@ -210,7 +215,7 @@ class KinematicLevel:
         """zeta_r with every joint rate inside its bounds (module docstring, task 1), and
         which joints' bound is a task (1.0) or not (0.0)."""
         margin, gain = self.gains.joint_limit_margin_rad, self.gains.joint_limit_gain_per_s
-        joints = q[7:]
+        joints = q[self.bounded_q]
         lowest = gain * (self.lower + margin - joints)  # q_dot_j >= this
         highest = gain * (self.upper - margin - joints)  # q_dot_j <= this
         bound = np.zeros(joints.size)  # the rate a bounded joint is held at
@@ -218,9 +223,9 @@ class KinematicLevel:
         for _ in range(joints.size + 1):
             rows = np.flatnonzero(held)
             limit_jacobian = np.zeros((rows.size, self.model.nv))
-            limit_jacobian[np.arange(rows.size), 6 + rows] = 1.0
+            limit_jacobian[np.arange(rows.size), self.bounded_v[rows]] = 1.0
             zeta_r = self._solve([(limit_jacobian, bound[rows]), *tasks], v, secondary)
-            rates = zeta_r[6:]
+            rates = zeta_r[self.bounded_v]
             over = ~held & ((rates > highest + 1e-12) | (rates < lowest - 1e-12))
             if not over.any():
                 return zeta_r, held.astype(float)
@@ -249,14 +254,14 @@ class KinematicLevel:
 
     def _manipulability_velocity(self, q: np.ndarray) -> np.ndarray | None:
         """[0 (6); k_m grad w] while w(q) < w_min (grad by central differences), else None."""
-        n_arm = q.size - 7
         if self.manipulability(q) >= self.gains.manipulability_threshold:
             return None
-        step = 1e-6
-        gradient = np.zeros(n_arm)
-        for j in range(n_arm):
-            plus, minus = q.copy(), q.copy()
-            plus[7 + j] += step
-            minus[7 + j] -= step
+        nv, step = self.model.nv, 1e-6
+        gradient = np.zeros(nv - 6)
+        for j in range(nv - 6):  # along each joint's velocity (continuous joints too)
+            direction = np.zeros(nv)
+            direction[6 + j] = step
+            plus = pin.integrate(self.model, q, direction)
+            minus = pin.integrate(self.model, q, -direction)
             gradient[j] = (self.manipulability(plus) - self.manipulability(minus)) / (2 * step)
         return np.concatenate([np.zeros(6), self.gains.manipulability_gain * gradient])
