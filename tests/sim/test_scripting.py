@@ -83,9 +83,12 @@ def test_a_controller_instance_runs_and_is_recorded():
     again = simulate(scenario, progress=False, controller=braking)
     assert braking.calls == calls  # reset at the start of every run
     np.testing.assert_array_equal(again.q, rollout.q)
-    assert rollout.metadata["controller"] == {
-        "class": f"{Braking.__module__}:Braking", "type": None, "params": None,
-    }  # fmt: skip
+    # recorded as a controller set in code: its class, and its public numbers
+    path = f"{Braking.__module__}:Braking"
+    record = rollout.metadata["controller"]
+    assert record["class"] == record["type"] == path and record["params"]["damping"] == 30.0
+    table = rollout.metadata["parameters"]["controller"]
+    assert table["type"] == path and table["set_in_code"] is True
     # the damping slows the vehicle and the arm down compared with the passive run
     assert rollout.kinetic_energy_J[-1] < 0.8 * passive.kinetic_energy_J[-1]
     with pytest.raises(ParameterError, match="Controller instance"):
