@@ -38,6 +38,7 @@ PRODUCERS = {
     "study_sea_state": "study summary: docs/results/study_sea_state.md",
     "surface": "the free surface, analytic cases and surfacing: docs/results/surface.md, docs/surfacing.png",
     "derivatives": "cost of the dynamics' derivatives and of an MPC re-plan: docs/results/derivatives.md",
+    "tracking": "end-effector tracking, controller x task x conditions: docs/results/tracking.md, docs/tracking_*.png",
 }
 
 

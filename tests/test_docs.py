@@ -9,8 +9,10 @@ from pathlib import Path
 import pytest
 from conftest import ROOT
 
-from uvms_pin.scenario.load import load_scenario
+from uvms_pin.errors import ScenarioError
+from uvms_pin.scenario.load import load_scenario, scenario_from_raw
 from uvms_pin.scenario.schema import Table
+from uvms_pin.scenario.toml import read_toml
 
 DOCS = ROOT / "docs"
 SCENARIOS = ROOT / "scenarios"
@@ -85,6 +87,70 @@ _VARIANTS = [
     ),
 ]
 
+_PPC_LEVEL = {
+    "type": "task_priority",
+    "dynamic_level": "ppc",
+    "position_gain_per_s": 1.0,
+    "orientation_gain_per_s": 1.0,
+    "attitude_gain_per_s": 1.0,
+    "joint_limit_margin_rad": 0.1,
+    "joint_limit_gain_per_s": 2.0,
+    "manipulability_threshold": 0.01,
+    "manipulability_gain": 1.0,
+    "pinv_damping": 0.001,
+    "passive_velocities": [3, 4],
+    "velocity_weights": [1.0] * 10,
+    "k_zeta": [1.0] * 10,
+    "rho0_zeta": [2.0] * 10,
+    "rho_inf_zeta": [1.0] * 10,
+    "l_zeta_per_s": [1.0] * 10,
+}
+_RESOLVED_ACCELERATION = {
+    "type": "resolved_acceleration",
+    "position_gain_per_s2": [4.0] * 6,
+    "velocity_gain_per_s": [4.0] * 6,
+    "null_space_damping_per_s": 2.0,
+    "velocity_weights": [1.0] * 10,
+    "model_error": {"mass_scale": 1.1},
+}
+# the tracking tasks: every path, both targets and frames, both tracking controllers
+_VARIANTS += [
+    ("lbv150_ee_circle.toml", {"metrics.extra": []}),
+    (
+        "lbv150_ee_circle.toml",
+        {
+            "task": {"type": "helix", "radius_m": 0.1, "period_s": 20.0, "rise_per_turn_m": 0.05,
+                     "ee_frame": "ee", "start_m": [0.5, 0.0, -0.4], "rpy_rad": [0.0, 0.0, 0.0],
+                     "frame": "vehicle"},
+            "controller": _PPC_LEVEL,
+            "baselines": {},
+        },
+        True,
+    ),
+    (
+        "lbv150_ee_circle.toml",
+        {
+            "task": {"type": "lemniscate", "half_width_m": 0.1, "period_s": 20.0},
+            "controller": _RESOLVED_ACCELERATION,
+        },
+        True,
+    ),
+    (
+        "lbv150_ee_circle.toml",
+        {"task": {"type": "min_jerk", "displacement_m": [0.1, 0, 0], "duration_s": 5.0,
+                  "start_s": 1.0}},
+        True,
+    ),
+    (
+        "lbv150_ee_circle.toml",
+        {"task": {"type": "waypoints", "offsets_m": [[0, 0, 0], [0.1, 0, 0]], "times_s": [0, 4],
+                  "target": "vehicle", "transient_s": 1.0, "settle_tolerance_m": 0.02}},
+        True,
+    ),
+    ("lbv150_ee_circle.toml", {"task": {"type": "hold", "target": "vehicle"}}, True),
+]  # fmt: skip
+# (file, overrides[, True: the dict's tables replace the file's whole tables instead])
+
 _READERS = (
     "number",
     "optional_number",
@@ -119,8 +185,12 @@ def scenario_keys_read() -> set[str]:
     with pytest.MonkeyPatch.context() as patch:
         for name in _READERS:
             patch.setattr(table_class, name, recording(name))
-        for file, overrides in _VARIANTS:
-            load_scenario(SCENARIOS / file, overrides)
+        for file, overrides, *replace in _VARIANTS:
+            if replace:
+                raw = {**read_toml(SCENARIOS / file, ScenarioError), **overrides}
+                scenario_from_raw(raw, SCENARIOS / file)
+            else:
+                load_scenario(SCENARIOS / file, overrides)
     return seen
 
 

@@ -23,9 +23,10 @@ def write_results(rollout: Rollout, out: Path) -> list[str]:
     from uvms_pin.results.atomic import write_json_atomic
     from uvms_pin.results.rollout import ARRAY_FILE, META_FILE
 
+    # the metrics first: one of your own that fails (an input error) leaves nothing written
+    metrics = rollout.metrics()
     out.mkdir(parents=True, exist_ok=True)
     rollout.save(out)
-    metrics = rollout.metrics()
     write_json_atomic(
         out / METRICS_FILE,
         {
@@ -42,10 +43,12 @@ def write_figures(rollout: Rollout, out: Path) -> list[Path]:
     """Every figure the rollout has data for (none below two samples) into ``out``."""
     from uvms_pin.results.figures.paper import paper_figures
     from uvms_pin.results.figures.standard import standard_figures
+    from uvms_pin.results.figures.tracking import tracking_figures
 
     return (
         paper_figures(rollout, out)
         + standard_figures(rollout, out)
+        + tracking_figures(rollout, out)
         + _flow_figure(rollout, out)
         + _surface_figure(rollout, out)
     )

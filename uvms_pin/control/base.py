@@ -8,6 +8,7 @@ from abc import ABC, abstractmethod
 import numpy as np
 
 from uvms_pin.control.measurement import Measurement
+from uvms_pin.results.signal import Signal
 
 
 class Controller(ABC):
@@ -24,8 +25,10 @@ class Controller(ABC):
     def reset(self) -> None:  # noqa: B027 - optional hook, stateless controllers skip it
         """Forget any internal state before a new run."""
 
-    def signals(self) -> dict[str, np.ndarray]:
-        """Internal signals of the last ``compute`` worth logging (name -> 1-D array)."""
+    def signals(self) -> dict[str, np.ndarray | Signal]:
+        """Internal signals of the last ``compute`` worth logging, by name: a 1-D array
+        (table columns ``<name>.0``, ``<name>.1``, ...) or a `Signal` carrying a name and a
+        unit per component (columns ``<name>.<component>_<unit>``)."""
         return {}
 
     def funnel_margin(self) -> float:

@@ -7,7 +7,9 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from uvms_pin.results.extra_metrics import extra_metrics
 from uvms_pin.results.joint_positions import KINDS, REVOLUTE, arm_positions, configuration_width
+from uvms_pin.results.task_metrics import task_metrics
 
 if TYPE_CHECKING:
     from uvms_pin.results.rollout_data import RolloutData
@@ -19,7 +21,9 @@ def _rms(x: np.ndarray) -> float:
 
 def compute_metrics(rollout: RolloutData) -> dict[str, float]:
     """Metrics of any run: timing, energy (`energy_metrics`: a balance when driven), motion
-    and effort. Efforts: vehicle force = |tau[0:3]|,
+    and effort; a tracking task's (`uvms_pin.results.task_metrics`); then your own, the
+    functions the rollout's metadata names (`uvms_pin.results.extra_metrics`, a scenario's
+    ``[metrics] extra``). Efforts: vehicle force = |tau[0:3]|,
     vehicle torque = |tau[3:6]|, joint torques = max over joints of |tau_j|.
     """
     meta = rollout.metadata
@@ -60,6 +64,8 @@ def compute_metrics(rollout: RolloutData) -> dict[str, float]:
     out.update(force_tracking_metrics(rollout))
     out.update(joint_limit_metrics(rollout))
     out.update(surface_metrics(rollout))
+    out.update(task_metrics(rollout))
+    out.update(extra_metrics(rollout, out))
     return out
 
 

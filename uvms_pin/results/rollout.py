@@ -48,7 +48,8 @@ class Rollout(RolloutData):
 
     def plot(self, kind: str | None = None) -> Figure | dict[str, Figure]:
         """A matplotlib Figure of this rollout: ``kind`` one of `uvms_pin.results.figures.kinds.KINDS`
-        ("pose", "velocities", "energy", "force", "first_level", "second_level"); without
+        ("pose", "velocities", "energy", "force", "first_level", "second_level", "tracking");
+        without
         ``kind`` every figure the rollout has data for, as a dict by kind."""
         from uvms_pin.results.figures.kinds import plot_rollout
 

@@ -14,6 +14,8 @@ Column names are ``<array>.<component>_<unit>``:
   ``fx fy fz roll pitch yaw``; a signal this module does not know uses its index.
 - ``_<unit>`` is the SI unit (``m``, ``rad``, ``m_s``, ``rad_s``, ``N``, ``Nm``, ``J``);
   dimensionless columns (quaternion, normalized errors) have none.
+- a signal a controller logged as a `uvms_pin.results.signal.Signal` has its own names and
+  units: ``<signal>.<component>_<unit>`` (unit ``"m/s"`` -> suffix ``m_s``).
 
 The time ``time_s`` is the index. ``DataFrame.attrs["units"]`` maps every column to its
 unit as text ("m/s", "N m"; "" when dimensionless) and ``attrs["metadata"]`` holds the
@@ -27,6 +29,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from uvms_pin.results.joint_positions import CONTINUOUS, KINDS, configuration_width
+from uvms_pin.results.signal import unit_suffix
 
 if TYPE_CHECKING:
     import pandas as pd
@@ -118,8 +121,21 @@ def _labels(
 UNIT_TEXT = {"m_s": "m/s", "rad_s": "rad/s", "Nm": "N m"}
 
 
+def _named_labels(prefix: str, described, width: int) -> list[tuple[str, str]] | None:
+    """(column, unit text) of a signal logged as a `Signal` (its component names and
+    units, kept in the metadata's ``signal_units``); None when it was not, or the record
+    does not fit its width."""
+    if not isinstance(described, dict):
+        return None
+    components, units = described.get("components") or [], described.get("units") or []
+    if len(components) != width or len(units) != width:
+        return None
+    return [(f"{prefix}.{c}", u) for c, u in zip(components, units, strict=True)]
+
+
 def _column_name(label: str, unit: str) -> str:
-    return f"{label}_{unit}" if unit else label
+    suffix = unit_suffix(unit)
+    return f"{label}_{suffix}" if suffix else label
 
 
 def column_layout(rollout: RolloutData) -> list[tuple[str, str, np.ndarray]]:
@@ -133,12 +149,16 @@ def column_layout(rollout: RolloutData) -> list[tuple[str, str, np.ndarray]]:
         blocks.append((_labels(rollout, name, _WRENCH, None, 6), getattr(rollout, name)))
     blocks.append(([("kinetic_energy", "J")], rollout.kinetic_energy_J[:, None]))
     blocks.append(([("potential_energy", "J")], rollout.potential_energy_J[:, None]))
+    described = rollout.metadata.get("signal_units") or {}
     for name, values in rollout.signals.items():
         values = values.reshape(len(values), -1)
         prefix, vehicle, joint_layout = SIGNAL_LAYOUTS.get(name, (name, [], None))
         if prefix in _BASE_ARRAYS:
             prefix = f"signal.{prefix}"
-        if not vehicle:
+        named = _named_labels(prefix, described.get(name), values.shape[1])
+        if named is not None:
+            labels = named
+        elif not vehicle:
             labels = [(f"{prefix}.{k}", "") for k in range(values.shape[1])]
         else:
             labels = _labels(rollout, prefix, vehicle, joint_layout, values.shape[1])

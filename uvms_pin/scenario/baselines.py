@@ -128,35 +128,49 @@ def model_error_factors(t: Table | None) -> dict[str, float]:
 def baseline_controller_table(raw: dict[str, Any], kind: str) -> dict[str, Any]:
     """The [controller] table that runs the scenario ``raw``'s task with controller ``kind``.
 
-    The scenario's own [controller] when its type is ``kind``; else a baseline's table: the
+    The scenario's own [controller] when its type is ``kind``; a named variant
+    ``[baselines.<kind>]`` that has its own ``type`` (any controller type, e.g. a tracking
+    controller with other gains): that table as it is; else a baseline's table: the
     task (``ee_frame``, ``desired_rpy``, ``desired_force``; for "pi_force" and
     "computed_torque" also the PPC's ``velocity_weights`` and null-space keys) taken from
     [controller], then the gains of ``[baselines.<kind>]`` (defaults if absent).
 
     Raises:
-        ScenarioError: ``kind`` is not the scenario's controller nor a baseline.
+        ScenarioError: ``kind`` is not the scenario's controller, a named variant nor a
+            baseline.
     """
     controller = raw.get("controller") or {}
     if controller.get("type") == kind:
         return copy.deepcopy(controller)
-    if kind not in BASELINES:
-        choices = ", ".join((controller.get("type", "none"), *BASELINE_KINDS))
-        raise ScenarioError(f"controller '{kind}': this scenario can run {choices}")
-    inherited = _TASK_KEYS + (_PSEUDO_INVERSE_INHERITED if BASELINES[kind].pseudo_inverse else ())
-    table = {"type": kind, **{k: controller[k] for k in inherited if k in controller}}
     tuning = (raw.get("baselines") or {}).get(kind) or {}
     if not isinstance(tuning, dict):
         raise ScenarioError(f"[baselines.{kind}] must be a table, got {tuning!r}")
+    if "type" in tuning:
+        return copy.deepcopy(tuning)
+    if kind not in BASELINES:
+        variants = [
+            k
+            for k, v in (raw.get("baselines") or {}).items()
+            if isinstance(v, dict) and "type" in v
+        ]
+        choices = ", ".join((controller.get("type", "none"), *BASELINE_KINDS, *variants))
+        raise ScenarioError(f"controller '{kind}': this scenario can run {choices}")
+    inherited = _TASK_KEYS + (_PSEUDO_INVERSE_INHERITED if BASELINES[kind].pseudo_inverse else ())
+    table = {"type": kind, **{k: controller[k] for k in inherited if k in controller}}
     return copy.deepcopy({**table, **tuning})
 
 
 def check_baselines(t: Table | None, controller_type: str | None) -> None:
-    """[baselines.<kind>]: tunings for `compare-controllers`, which builds (and so checks)
+    """[baselines.<name>]: tunings for `compare-controllers`, which builds (and so checks)
     each one before any run; here only their names (a model with another arm, e.g. in
-    compare-arms, must not be refused for a comparison it is not running)."""
-    for kind in t.rest() if t is not None else {}:
+    compare-arms, must not be refused for a comparison it is not running). A table with
+    its own ``type`` is a named variant and may have any name."""
+    for kind, table in (t.rest() if t is not None else {}).items():
+        if isinstance(table, dict) and isinstance(table.get("type"), str):
+            continue
         if kind not in BASELINES or controller_type == kind:
             raise ScenarioError(
                 f"{t.source}: [baselines.{kind}]: a baseline is one of "
-                f"{', '.join(BASELINE_KINDS)} other than the scenario's [controller] type"
+                f"{', '.join(BASELINE_KINDS)} other than the scenario's [controller] type, "
+                "or a named variant with its own 'type'"
             )

@@ -4,7 +4,8 @@ and what the rollout records).
 ``type`` is "none" (zero input), "ppc" (the paper's law, `uvms_pin.scenario.ppc`), a baseline
 ("pi_force", "impedance", "computed_torque": `uvms_pin.scenario.baselines`), "mpc"
 (model-predictive control, `uvms_pin.scenario.mpc`) or
-"package.module:ClassName", your own (`uvms_pin.scenario.custom_controller`).
+"package.module:ClassName", your own (`uvms_pin.scenario.custom_controller`); with a
+``[task]``, "task_priority" or "resolved_acceleration" (`uvms_pin.scenario.tracking_controllers`).
 """
 
 from __future__ import annotations
@@ -14,6 +15,7 @@ from collections.abc import Callable
 from pathlib import Path
 
 from uvms_pin.control.base import Controller, ZeroController
+from uvms_pin.control.tracking.task import TrackingTask
 from uvms_pin.errors import ParameterError
 from uvms_pin.model.uvms import UVMS
 from uvms_pin.scenario.baselines import BASELINES, build_baseline
@@ -21,6 +23,8 @@ from uvms_pin.scenario.custom_controller import custom_controller
 from uvms_pin.scenario.mpc import build_mpc
 from uvms_pin.scenario.ppc import build_ppc
 from uvms_pin.scenario.schema import Table
+from uvms_pin.scenario.tracking_controllers import TRACKING_CONTROLLERS
+from uvms_pin.sim.actuation import Actuation, Unlimited
 from uvms_pin.sim.run import ControllerSpec
 
 
@@ -45,11 +49,23 @@ CONTROLLERS: dict[str, Callable[[Table, UVMS], ControllerSpec]] = {
 }
 
 
-def build_controller(t: Table | None, uvms: UVMS, scenario_dir: Path) -> ControllerSpec:
-    """The [controller] table's controller (none without the table)."""
+def build_controller(
+    t: Table | None,
+    uvms: UVMS,
+    scenario_dir: Path,
+    task: TrackingTask | None = None,
+    actuation: Actuation | None = None,
+) -> ControllerSpec:
+    """The [controller] table's controller (none without the table); the tracking
+    controllers (`TRACKING_CONTROLLERS`) follow the scenario's ``task`` and leave alone the
+    velocities ``actuation`` does not drive."""
     if t is None:
         return NO_CONTROLLER
     kind = t.string("type")
+    if kind in TRACKING_CONTROLLERS:
+        if task is None:
+            raise t.error("type", f"'{kind}' follows a tracking task: the scenario needs a [task]")
+        return TRACKING_CONTROLLERS[kind](t, uvms, task, actuation or Unlimited())
     if ":" in kind:
         try:
             spec = custom_controller(kind, t.rest(), scenario_dir)
@@ -60,7 +76,7 @@ def build_controller(t: Table | None, uvms: UVMS, scenario_dir: Path) -> Control
             raise error from exc
         return spec
     if kind not in CONTROLLERS:
-        choices = ", ".join(CONTROLLERS)
+        choices = ", ".join([*CONTROLLERS, *TRACKING_CONTROLLERS])
         raise t.error(
             "type", f"must be one of {choices} or 'package.module:ClassName', got '{kind}'"
         )

@@ -7,7 +7,8 @@ that is how ``uvms-pin run --set``, sweeps and robustness tables vary it), then 
 is checked and built by the module of its concept: ``[water]`` (`water`), ``[initial]``
 (`initial`), ``[environment]`` and ``[disturbance]`` (`world`), ``[actuation]``,
 ``[sensors]``, ``[integrator]``, ``[control]`` and ``[output]`` (`timing`), ``[controller]``
-(`controller`) and ``[baselines]`` (`baselines`). Unknown keys, wrong types and bad values
+(`controller`), ``[baselines]`` (`baselines`), ``[task]`` (`task`) and ``[metrics]``
+(`metrics`). Unknown keys, wrong types and bad values
 raise `ScenarioError` naming the file and the key, or the override when an override set it,
 with the closest known key. ``model`` is a path relative to the scenario file or the name of
 a shipped model (``"uvms_lbv150"``, ``"lbv150"``). See ``scenarios/*.toml`` for documented
@@ -29,9 +30,11 @@ from uvms_pin.scenario.actuation import build_actuation
 from uvms_pin.scenario.baselines import check_baselines
 from uvms_pin.scenario.controller import build_controller
 from uvms_pin.scenario.initial import build_initial_state
+from uvms_pin.scenario.metrics import build_metrics
 from uvms_pin.scenario.overrides import apply_overrides, parse_key_path
 from uvms_pin.scenario.schema import Table
 from uvms_pin.scenario.sensors import build_sensors
+from uvms_pin.scenario.task import build_task
 from uvms_pin.scenario.timing import build_control_period, build_integrator, build_log_period
 from uvms_pin.scenario.toml import read_toml
 from uvms_pin.scenario.water import Water, build_water
@@ -96,6 +99,7 @@ def _build(raw: dict[str, Any], path: Path, top: Table) -> Scenario:
     water = build_water(top.table_or_empty("water"), head.seed)
     uvms = _model(head, water, path, scenario)
     q0, v0 = build_initial_state(top.table_or_empty("initial"), uvms)
+    task = build_task(top.table("task"), uvms, q0)
     contact = build_environment(top.table("environment"), uvms)
     disturbance = build_disturbance(top.table("disturbance"))
     actuation = build_actuation(top.table("actuation"), uvms)
@@ -104,8 +108,10 @@ def _build(raw: dict[str, Any], path: Path, top: Table) -> Scenario:
     control_period = build_control_period(top.table_or_empty("control"))
     log_period = build_log_period(top.table_or_empty("output"))
     controller = replace(
-        build_controller(top.table("controller"), uvms, path.parent), from_file=True
+        build_controller(top.table("controller"), uvms, path.parent, task, actuation),
+        from_file=True,
     )
+    extra_metrics = build_metrics(top.table("metrics"), path.parent)
     check_baselines(top.table("baselines"), (raw.get("controller") or {}).get("type"))
     top.finish()
     plant = Plant(
@@ -127,7 +133,18 @@ def _build(raw: dict[str, Any], path: Path, top: Table) -> Scenario:
     except ParameterError as exc:
         raise ScenarioError(f"{top.source}: {exc}") from exc
     return Scenario(
-        head.name, head.description, path, raw, plant, controller, sensor_config, q0, v0, settings
+        head.name,
+        head.description,
+        path,
+        raw,
+        plant,
+        controller,
+        sensor_config,
+        q0,
+        v0,
+        settings,
+        extra_metrics=extra_metrics,
+        task=task,
     )
 
 

@@ -15,6 +15,7 @@ from typing import Any
 from uvms_pin.model.uvms import UVMS
 from uvms_pin.physics.dynamics import kinetic_energy, potential_energy
 from uvms_pin.results.rollout import Rollout
+from uvms_pin.results.signal import Signal
 from uvms_pin.sim.plant import Plant
 from uvms_pin.sim.sample import Sample
 
@@ -44,6 +45,7 @@ class RolloutLog:
             metadata = {**metadata, "hull_names": hull_names(uvms)}
         self.rollout = Rollout.allocate(max(int(capacity), 1), uvms.nq, uvms.nv, metadata)
         self.count = 0
+        self.described: set[str] = set()  # the named signals (`Signal`) already described
 
     def on_sample(self, sample: Sample) -> None:
         if self.count == len(self.rollout):
@@ -58,8 +60,19 @@ class RolloutLog:
         rollout.wrench_measured_world[k] = sample.measurement.wrench_world
         rollout.wrench_disturbance_body[k] = sample.disturbance_body
         for name, values in sample.signals.items():
+            if isinstance(values, Signal):
+                if name not in self.described:
+                    self._describe(name, values)
+                values = values.values
             rollout.signal(name, values.size)[k] = values
         self.count += 1
+
+    def _describe(self, name: str, signal: Signal) -> None:
+        """Keep a named signal's component names and units in the metadata
+        (``signal_units``: name -> {"components": [...], "units": [...]})."""
+        described = self.rollout.metadata.setdefault("signal_units", {})
+        described[name] = signal.describe()
+        self.described.add(name)
 
     def _grow(self) -> None:
         old, n = self.rollout, len(self.rollout)
@@ -75,6 +88,7 @@ class RolloutLog:
         out = RolloutLog.__new__(RolloutLog)
         out.uvms, out.backend, out.count = self.uvms, self.backend, self.count
         out.plant = self.plant
+        out.described = set(self.described)
         out.rollout = copy.deepcopy(self.rollout)
         return out
 

@@ -7,7 +7,9 @@ sensors, runs the closed loop and returns the rollout.
 
 from __future__ import annotations
 
+import copy
 import dataclasses
+import importlib
 import warnings
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
@@ -17,8 +19,10 @@ from typing import Any
 import numpy as np
 
 from uvms_pin.control.base import Controller
-from uvms_pin.errors import ShortenedRunWarning
+from uvms_pin.control.tracking.task import TrackingTask
+from uvms_pin.errors import ParameterError, ShortenedRunWarning, SimulationError
 from uvms_pin.model.uvms import UVMS
+from uvms_pin.results.extra_metrics import DIRECTORY_KEY, REFERENCES_KEY
 from uvms_pin.results.progress import Progress, callback_or_none, progress_printer
 from uvms_pin.results.rollout import Rollout
 from uvms_pin.sim.closed_loop import simulate_closed_loop
@@ -27,6 +31,7 @@ from uvms_pin.sim.sample import Observer, ProgressReport
 from uvms_pin.sim.sensors import SensorConfig, SensorSuite
 from uvms_pin.sim.settings import SimulationSettings
 from uvms_pin.sim.shortened import max_duration_s, shortened_duration_s, shortened_message
+from uvms_pin.sim.task_record import record_task
 
 ControllerFactory = Callable[[UVMS], Controller]
 
@@ -65,6 +70,10 @@ class Scenario:
             `ControllerSpec` records its type and parameters in the rollout).
         sensor_config: noise of the measurements.
         q0, v0: initial state. settings: integrator, periods, duration, seed.
+        extra_metrics: your own metric functions, ``"package.module:function"``
+            (`uvms_pin.results.extra_metrics`), resolved next to ``path``.
+        task: a tracking task (``[task]``): its reference and true pose are added to the
+            rollout (`uvms_pin.sim.task_record`), and its metrics to ``metrics()``.
         shortened_from_s: the scenario's own duration [s] when ``UVMS_PIN_MAX_DURATION_S``
             shortened this run (`shortened`), else None.
     """
@@ -79,11 +88,35 @@ class Scenario:
     q0: np.ndarray
     v0: np.ndarray
     settings: SimulationSettings
+    extra_metrics: tuple[str, ...] = ()
+    task: TrackingTask | None = None
     shortened_from_s: float | None = None
 
     @property
     def uvms(self) -> UVMS:
         return self.plant.uvms
+
+    @classmethod
+    def from_dict(
+        cls,
+        data: dict[str, Any],
+        path: str | Path = "<dict>",
+        overrides: dict[str, Any] | None = None,
+    ) -> Scenario:
+        """A scenario built in code: ``data`` is what the TOML file would hold, as nested
+        dicts (``{"scenario": {"model": "uvms_lbv150", "duration_s": 5}, "water": {...}}``),
+        checked key by key exactly as a file is (`uvms_pin.scenario.load`). ``path``: as if
+        read from this file (relative model paths, your own controllers and metrics resolve
+        in its directory: the working directory by default). ``overrides``: dotted keys, as
+        ``uvms-pin run --set``.
+
+        Raises:
+            ScenarioError: naming the key (and ``path``) of a bad value.
+        """
+        # the reader is the layer above this one (it builds Scenarios): reached by name at
+        # call time, so that this layer does not depend on it
+        reader = importlib.import_module("uvms_pin.scenario.load")
+        return reader.scenario_from_raw(copy.deepcopy(dict(data)), path, overrides)
 
 
 def simulate(
@@ -91,6 +124,7 @@ def simulate(
     *,
     progress: bool | Progress | None = True,
     observers: Sequence[Observer] = (),
+    controller: Controller | None = None,
 ) -> Rollout:
     """Run a scenario: fresh sensors (seeded) and controller, closed loop, rollout.
 
@@ -98,7 +132,8 @@ def simulate(
     when stderr is a file) once the run has lasted `uvms_pin.results.progress.BAR_DELAY_S` of
     wall time, so short runs print nothing; False or None: silent; a callable ``(t_s, duration_s)`` is called after
     every logged sample. ``observers``: called with every logged sample (`Observer`), e.g.
-    a live view.
+    a live view. ``controller``: an instance to run instead of the one the scenario builds
+    (it is reset first; the rollout records its class, with type and parameters None).
 
     Raises FunnelViolation / SimulationError with the partial rollout attached as
     ``exc.rollout`` (see `uvms_pin.sim.closed_loop.ClosedLoop.run`). With
@@ -108,38 +143,54 @@ def simulate(
     duration_s = scenario.settings.duration_s
     if progress is True:
         with progress_printer(scenario.name, duration_s) as printer:
-            return _simulate(scenario, [*observers, ProgressReport(printer, duration_s)])
+            reports = [ProgressReport(printer, duration_s)]
+            return _simulate(scenario, [*observers, *reports], controller)
     callback = callback_or_none(progress)
     reports = [] if callback is None else [ProgressReport(callback, duration_s)]
-    return _simulate(scenario, [*observers, *reports])
+    return _simulate(scenario, [*observers, *reports], controller)
 
 
-def _simulate(scenario: Scenario, observers: list[Observer]) -> Rollout:
+def _simulate(scenario: Scenario, observers: list[Observer], given: Controller | None) -> Rollout:
     settings = scenario.settings
     sensors = SensorSuite(
         scenario.uvms.model, scenario.sensor_config, settings.duration_s, settings.seed
     )
-    controller = scenario.controller_factory(scenario.uvms)
-    record = controller_record(scenario.controller_factory, controller)
+    if given is not None and not isinstance(given, Controller):
+        raise ParameterError(
+            f"controller must be a uvms_pin Controller instance, got {type(given).__name__}"
+        )
+    controller = scenario.controller_factory(scenario.uvms) if given is None else given
+    record = controller_record(scenario.controller_factory if given is None else None, controller)
     metadata = {
         "scenario": scenario.name,
         "scenario_path": str(scenario.path),
         "description": scenario.description,
-        "parameters": recorded_parameters(scenario, record),
+        "parameters": recorded_parameters(scenario, record, instance=given is not None),
         "controller": record,
+        REFERENCES_KEY: list(scenario.extra_metrics),
+        DIRECTORY_KEY: str(Path(scenario.path).parent.resolve()),
     }
     if scenario.shortened_from_s is not None:
         metadata["shortened_from_s"] = scenario.shortened_from_s
-    return simulate_closed_loop(
-        scenario.plant,
-        controller,
-        sensors,
-        scenario.q0,
-        scenario.v0,
-        settings,
-        metadata=metadata,
-        observers=observers,
-    )
+    try:
+        rollout = simulate_closed_loop(
+            scenario.plant,
+            controller,
+            sensors,
+            scenario.q0,
+            scenario.v0,
+            settings,
+            metadata=metadata,
+            observers=observers,
+        )
+    except (SimulationError, KeyboardInterrupt) as exc:  # the partial rollout too
+        partial = getattr(exc, "rollout", None)
+        if scenario.task is not None and partial is not None:
+            record_task(partial, scenario.task, scenario.uvms)
+        raise
+    if scenario.task is not None:
+        record_task(rollout, scenario.task, scenario.uvms)
+    return rollout
 
 
 def class_path(controller: object) -> str:
@@ -148,10 +199,11 @@ def class_path(controller: object) -> str:
     return f"{cls.__module__}:{cls.__qualname__}"
 
 
-def controller_record(factory: ControllerFactory, controller: Controller) -> dict[str, Any]:
+def controller_record(factory: ControllerFactory | None, controller: Controller) -> dict[str, Any]:
     """What ran: the class of ``controller`` (``module:QualifiedName``), its type and its
-    parameters: a `ControllerSpec`'s, else the class path (what a scenario's ``type`` would
-    name) and the controller's public numbers, strings and small arrays (`public_parameters`)."""
+    parameters: a `ControllerSpec`'s, else (another factory, or an instance given to
+    `simulate`: ``factory`` None) the class path (what a scenario's ``type`` would name)
+    and the controller's public numbers, strings and small arrays (`public_parameters`)."""
     if isinstance(factory, ControllerSpec):
         return {"class": class_path(controller), "type": factory.type, "params": factory.params}
     return {
@@ -208,12 +260,14 @@ def public_parameters(controller: object) -> dict[str, Any]:
     return out
 
 
-def recorded_parameters(scenario: Scenario, record: dict[str, Any]) -> dict[str, Any]:
+def recorded_parameters(
+    scenario: Scenario, record: dict[str, Any], *, instance: bool = False
+) -> dict[str, Any]:
     """The scenario's parameters as they ran: its ``raw`` document, whose [controller] table
     says what the run's controller is when it was not built from that table (a
-    ``controller_factory`` set in code)."""
+    ``controller_factory`` set in code, or an ``instance`` given to `simulate`)."""
     factory = scenario.controller_factory
-    if isinstance(factory, ControllerSpec) and factory.from_file:
+    if isinstance(factory, ControllerSpec) and factory.from_file and not instance:
         return scenario.raw
     table = {"type": record["type"], "set_in_code": True, **(record["params"] or {})}
     return {**scenario.raw, "controller": table}

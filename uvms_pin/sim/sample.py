@@ -9,6 +9,7 @@ from typing import Protocol
 import numpy as np
 
 from uvms_pin.control.measurement import Measurement
+from uvms_pin.results.signal import Signal
 
 
 @dataclass(frozen=True)
@@ -24,7 +25,8 @@ class Sample:
         disturbance_body: delta(t), the disturbance wrench on the vehicle [N; N m], body axes.
         tau_commanded: the controller's output (nv,) [N, N m]; tau_applied: what the
             actuation made of it (held over the next control period).
-        signals: the controller's internal signals after this call, by name.
+        signals: the controller's internal signals after this call, by name (arrays, or
+            `Signal` records with component names and units).
     """
 
     time_s: float
@@ -35,7 +37,7 @@ class Sample:
     disturbance_body: np.ndarray
     tau_commanded: np.ndarray
     tau_applied: np.ndarray
-    signals: dict[str, np.ndarray]
+    signals: dict[str, np.ndarray | Signal]
 
 
 class Observer(Protocol):

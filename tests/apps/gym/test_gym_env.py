@@ -287,6 +287,46 @@ def test_any_scenario_or_model():
     assert lbv.observation_space.shape == (30,)
 
 
+POSE = "uvms_pin/PoseTracking-v0"
+
+
+def test_pose_tracking_env_api_and_goal():
+    env = _make(POSE, render_mode="rgb_array")
+    check_env(env.unwrapped)
+    env = env.unwrapped
+    observation, _ = env.reset(seed=1)
+    goal = observation[env.observation_layout["goal"]]
+    p0, v0, _ = env.scenario.task.path.at(0.0)
+    np.testing.assert_allclose(goal[:3], p0)
+    np.testing.assert_allclose(goal[3:6], v0)
+    rotation = pin.Quaternion(goal[6:10]).toRotationMatrix()  # xyzw
+    np.testing.assert_allclose(rotation, env.scenario.task.rotation_reference, atol=1e-12)
+
+
+def test_the_task_priority_controller_tracks_through_the_pose_env():
+    """The scenario's controller as a policy: the rewards are its true pose errors, small."""
+    from uvms_pin.apps.gym.policy import ControllerPolicy
+
+    env = gym.make(POSE, overrides={"scenario.duration_s": 3.0}, clip_actions=False).unwrapped
+    controller = env.scenario.controller_factory(env.scenario.uvms)
+    policy = ControllerPolicy(controller, env)
+    observation, info = env.reset(seed=3)
+    info = {**info, "time_s": 0.0}
+    errors = []
+    while True:
+        observation, reward, terminated, truncated, info = env.step(policy(observation, info))
+        errors.append(info["position_error_m"])
+        expected = -((info["position_error_m"] / 0.1) ** 2) - (info["angle_error_rad"] / 0.1) ** 2
+        assert reward <= expected + 1e-12  # the effort term only lowers it
+        if terminated or truncated:
+            break
+    assert truncated and not terminated and len(errors) == 300
+    # the reset moved the vehicle by up to 1 cm per axis; the controller takes it back
+    assert max(errors[-50:]) < 0.01
+    with pytest.raises(ParameterError, match="PoseTracking needs a \\[task\\]"):
+        gym.make(POSE, scenario="gym_station_keeping")
+
+
 def test_an_observation_never_aliases_the_plant_state():
     """A policy that writes into its observation (or into the episode's rollout) changes
     nothing in the environment: the next observations are those of an untouched run."""

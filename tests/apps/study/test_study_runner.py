@@ -206,3 +206,16 @@ def test_a_scaled_parameter_column_holds_the_factor(serial_table):
     for run in study.runs():
         row = serial[serial["run_id"] == run.run_id].iloc[0]
         assert row["disturbance.amplitude [x base]"] == run.values["disturbance.amplitude"]
+
+
+def test_your_own_metrics_are_study_columns(tmp_path):
+    study = load_study(write_study(tmp_path))
+    (tmp_path / "study_metrics.py").write_text(
+        "def peak_heave(rollout):\n"
+        "    return {'heave_speed_peak_m_s': float(abs(rollout.v[:, 2]).max())}\n"
+    )
+    with (tmp_path / "scenario.toml").open("a") as f:
+        f.write('\n[metrics]\nextra = ["study_metrics:peak_heave"]\n')
+    row = execute_run(str(study.base), study.runs()[0])
+    assert row["status"] == "ok", row["error"]
+    assert 0.0 < row["heave_speed_peak_m_s"] < 1.0

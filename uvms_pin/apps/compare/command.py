@@ -35,6 +35,8 @@ def _cmd_compare_controllers(args: argparse.Namespace) -> int:
         )
     criteria = Criteria(after_s, args.band, args.tolerance)
     out = check_writable(args.out)
+    if next(iter(scenarios.values())).task is not None:
+        return _compare_tracking(args, scenarios, criteria, out)
     with claim(out, CONTROLLER_COMPARISON, overwrite=args.overwrite):
         say = None if args.quiet else (lambda line: print(line, file=sys.stderr, flush=True))
         rows, rollouts = compare_controllers(scenarios, criteria, say)
@@ -62,6 +64,37 @@ def _cmd_compare_controllers(args: argparse.Namespace) -> int:
         print(
             f"{row['controller']:<16} force error RMS {row['force_error_rms_N']:.3f} N, "
             f"peak {row['force_error_peak_N']:.3f} N: {verdict}"
+        )
+    print("wrote " + ", ".join(str(p) for p in written))
+    return 0
+
+
+def _compare_tracking(args: argparse.Namespace, scenarios, criteria, out) -> int:
+    """The comparison on a tracking task (`uvms_pin.apps.compare.tracking`): its table and
+    ``controllers_tracking.png``; ``--robustness`` is for the force task only."""
+    from uvms_pin.apps.compare.runs import compare_controllers
+    from uvms_pin.apps.compare.table import write_table
+    from uvms_pin.apps.compare.tracking import TRACKING_COLUMNS, write_tracking_figure
+
+    if args.robustness:
+        raise ParameterError("--robustness runs the force-tracking cases: not for a [task]")
+    task = next(iter(scenarios.values())).task
+    with claim(out, CONTROLLER_COMPARISON, overwrite=args.overwrite):
+        say = None if args.quiet else (lambda line: print(line, file=sys.stderr, flush=True))
+        rows, rollouts = compare_controllers(scenarios, criteria, say)
+        header = (
+            f"Scenario {args.scenario}; {task.kind} of the {task.target} ({task.frame} frame); "
+            f"errors after t = {task.transient_s:g} s; success: the run ends with every joint "
+            f"inside its limits and the position error within {task.settle_tolerance_m:g} m."
+        )
+        written = write_table(rows, out, header, TRACKING_COLUMNS)
+        if not args.no_figures:
+            written.append(write_tracking_figure(rollouts, out))
+    for row in rows:
+        verdict = "holds the task" if row["success"] else f"fails: {row['reason']}"
+        print(
+            f"{row['controller']:<22} position error RMS {1000 * row['task_position_error_rms_m']:.2f} mm, "
+            f"orientation {row['task_orientation_error_rms_rad']:.4f} rad: {verdict}"
         )
     print("wrote " + ", ".join(str(p) for p in written))
     return 0

@@ -7,6 +7,7 @@ from pathlib import Path
 from typing import Any
 
 from uvms_pin.apps.compare.metrics import Criteria, comparison_row
+from uvms_pin.apps.compare.tracking import tracking_row
 from uvms_pin.checks import check_memory
 from uvms_pin.errors import FunnelViolation, ScenarioError, SimulationError
 from uvms_pin.results.rollout import Rollout
@@ -53,13 +54,16 @@ def controller_scenarios(
 
 
 def run_controller(name: str, scenario: Scenario, criteria: Criteria) -> tuple[dict, Rollout]:
-    """(row, rollout) of one controller; a run the simulator stops is a row, not an error."""
+    """(row, rollout) of one controller; a run the simulator stops is a row, not an error.
+    On a tracking task (``scenario.task``) the row is `tracking_row`'s."""
     try:
         rollout, stopped = simulate(scenario, progress=False), ""
     except (FunnelViolation, SimulationError) as exc:
         rollout, stopped = getattr(exc, "rollout", None), f"run stopped: {exc}"
     if rollout is None or len(rollout) == 0:
         raise SimulationError(f"controller '{name}': {stopped or 'no samples'}")
+    if scenario.task is not None:
+        return tracking_row(name, rollout, scenario.plant.actuation, stopped), rollout
     return comparison_row(name, rollout, scenario.plant.actuation, criteria, stopped), rollout
 
 

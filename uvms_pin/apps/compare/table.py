@@ -22,22 +22,24 @@ def _text(value: Any) -> str:
     return str(value)
 
 
-def markdown_table(rows: list[dict[str, Any]]) -> str:
-    """One line per controller, the columns of `COLUMNS` (NaN shown as '-')."""
-    lines = ["| " + " | ".join(COLUMNS) + " |", "|" + "---|" * len(COLUMNS)]
+def markdown_table(rows: list[dict[str, Any]], columns: tuple[str, ...] = COLUMNS) -> str:
+    """One line per controller, the ``columns`` (`COLUMNS` by default; NaN shown as '-')."""
+    lines = ["| " + " | ".join(columns) + " |", "|" + "---|" * len(columns)]
     for row in rows:
-        cells = [_text(row[c]).replace("|", "/") for c in COLUMNS]
+        cells = [_text(row[c]).replace("|", "/") for c in columns]
         lines.append("| " + " | ".join(cells) + " |")
     return "\n".join(lines) + "\n"
 
 
-def write_table(rows: list[dict[str, Any]], out: Path, header: str) -> list[Path]:
+def write_table(
+    rows: list[dict[str, Any]], out: Path, header: str, columns: tuple[str, ...] = COLUMNS
+) -> list[Path]:
     """``controllers.csv`` and ``controllers.md`` (``header`` above the Markdown table)."""
     buffer = io.StringIO()
-    writer = csv.DictWriter(buffer, fieldnames=COLUMNS, extrasaction="ignore")
+    writer = csv.DictWriter(buffer, fieldnames=columns, extrasaction="ignore")
     writer.writeheader()
     writer.writerows(rows)
     return [
         write_text_atomic(out / "controllers.csv", buffer.getvalue()),
-        write_text_atomic(out / "controllers.md", header + "\n\n" + markdown_table(rows)),
+        write_text_atomic(out / "controllers.md", header + "\n\n" + markdown_table(rows, columns)),
     ]

@@ -10,6 +10,9 @@ not rewarded for sensor noise. Per step, with a = the normalized action (nv,):
 - station keeping: r = -|p - p_d|^2 / (0.1 m)^2 - |log(R_d^T R)|^2 / (0.1 rad)^2
   - w_effort mean(a^2), p, R the true vehicle position and attitude; terminated when
   |p - p_d| > ``max_position_error_m``.
+- pose tracking (a scenario's ``[task]``): r = -|p_r(t) - p|^2 / (0.1 m)^2
+  - |log3(R_r R^T)|^2 / (0.1 rad)^2 - w_effort mean(a^2), p, R the tracked frame's true
+  pose in the task frame; terminated when |p_r(t) - p| > ``max_position_error_m``.
 """
 
 from __future__ import annotations
@@ -21,6 +24,7 @@ import numpy as np
 import pinocchio as pin
 
 from uvms_pin.control.performance import PerformanceFunction
+from uvms_pin.control.tracking.task import TrackingTask, orientation_error
 from uvms_pin.errors import ParameterError
 
 POSITION_SCALE_M = 0.1
@@ -108,6 +112,56 @@ class StationKeepingTask:
         position_error = float(np.linalg.norm(q[:3] - self.target_position_m))
         rotation = pin.Quaternion(q[3:7]).toRotationMatrix()
         angle_error = float(np.linalg.norm(pin.log3(self._target_rotation.T @ rotation)))
+        effort = effort_penalty(action, self.effort_weight)
+        reward = -((position_error / POSITION_SCALE_M) ** 2) - (angle_error / ANGLE_SCALE_RAD) ** 2
+        terms = {
+            "position_error_m": position_error,
+            "angle_error_rad": angle_error,
+            "effort_penalty": effort,
+        }
+        return StepOutcome(reward - effort, position_error > self.max_position_error_m, terms)
+
+
+class PoseTrackingTask:
+    """Follow a tracking task's reference pose (`uvms_pin.control.tracking.task`).
+
+    The goal is [p_r(t) [m] (3), p_dot_r(t) [m/s] (3), quaternion of R_r xyzw (4)], task
+    frame.
+    """
+
+    name = "pose_tracking"
+    goal_size = 10
+    goal_names = ("p_r_x_m", "p_r_y_m", "p_r_z_m", "v_r_x_m_s", "v_r_y_m_s", "v_r_z_m_s",
+                  "quat_r_x", "quat_r_y", "quat_r_z", "quat_r_w")  # fmt: skip
+
+    def __init__(
+        self,
+        task: TrackingTask,
+        model: pin.Model,
+        max_position_error_m: float,
+        effort_weight: float,
+    ):
+        if not (max_position_error_m > 0.0 and np.isfinite(max_position_error_m)):
+            raise ParameterError(
+                f"max_position_error_m must be positive, got {max_position_error_m}"
+            )
+        self.task, self.model, self.data = task, model, model.createData()
+        self._quaternion = pin.Quaternion(task.rotation_reference).coeffs().copy()
+        self.max_position_error_m = max_position_error_m
+        self.effort_weight = effort_weight
+
+    def goal(self, time_s: float) -> np.ndarray:
+        position, velocity, _ = self.task.path.at(time_s)
+        return np.concatenate([position, velocity, self._quaternion])
+
+    def outcome(
+        self, time_s: float, q: np.ndarray, contact_world: np.ndarray, action: np.ndarray
+    ) -> StepOutcome:
+        position, rotation = self.task.pose(self.model, self.data, q)
+        position_error = float(np.linalg.norm(self.task.path.at(time_s)[0] - position))
+        angle_error = float(
+            np.linalg.norm(orientation_error(self.task.rotation_reference, rotation))
+        )
         effort = effort_penalty(action, self.effort_weight)
         reward = -((position_error / POSITION_SCALE_M) ** 2) - (angle_error / ANGLE_SCALE_RAD) ** 2
         terms = {

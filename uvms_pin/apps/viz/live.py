@@ -354,6 +354,7 @@ class LiveFeed:
 
     def on_sample(self, sample: Sample) -> None:
         desired = sample.signals.get("force_desired_world_N")
+        desired = getattr(desired, "values", desired)  # an array, or a named `Signal`
         self.live.push(
             Frame(
                 sample.time_s,

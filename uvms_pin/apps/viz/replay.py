@@ -19,7 +19,9 @@ from typing import Any
 
 import meshcat
 import meshcat.animation
+import meshcat.geometry as mg
 import numpy as np
+import pinocchio as pin
 
 from uvms_pin.apps.viz.meshcat_scene import (
     ROOT,
@@ -39,6 +41,7 @@ from uvms_pin.results.rollout import Rollout
 
 REPLAY_FILE = "replay.html"
 _TRAIL_CHUNKS = 60
+_REFERENCE_COLOR = 0xFF40FF
 _TRAIL_POINTS = 4000
 
 
@@ -145,6 +148,11 @@ def replay_html(
             node.set_property("quaternion", "quaternion", quat.tolist())
             node.set_property("scale", "vector3", scale.tolist())
     _add_trail(scene, root, anim, time_s, q, t0, fps, float(keys[-1]))
+    reference = reference_path_world(rollout)
+    legend = scene.legend()
+    if reference is not None:
+        root["reference"].set_object(_reference_object(reference[good]))
+        legend += "; the task's reference path (magenta)"
     vis.set_animation(anim, play=True, repetitions=math.inf)
 
     meta = rollout.metadata
@@ -157,9 +165,30 @@ def replay_html(
         "duration": float(time_s[-1] - t0),
         "fps": fps,
         "frames": len(idx),
-        "legend": scene.legend(),
+        "legend": legend,
     }
     return _page(window.commands, info)
+
+
+def reference_path_world(rollout: Rollout) -> np.ndarray | None:
+    """A tracking task's reference positions (n, 3) in the world frame [m] (a reference
+    given in the vehicle frame moved with the vehicle's logged pose); None without a task."""
+    reference = rollout.signals.get("task_reference_position")
+    task = rollout.metadata.get("task") or {}
+    if reference is None:
+        return None
+    if task.get("frame") != "vehicle":
+        return np.array(reference, dtype=float)
+    out = np.empty_like(reference)
+    for k, (row, point) in enumerate(zip(rollout.q, reference, strict=True)):
+        rotation = pin.Quaternion(row[6], row[3], row[4], row[5]).normalized().toRotationMatrix()
+        out[k] = row[:3] + rotation @ point
+    return out
+
+
+def _reference_object(points_world_m: np.ndarray) -> mg.Line:
+    pts = np.asarray(points_world_m, dtype=np.float32).reshape(-1, 3)
+    return mg.Line(mg.PointsGeometry(pts.T), mg.LineBasicMaterial(color=_REFERENCE_COLOR))
 
 
 def scene_html(scene: UvmsScene, frame: Frame, *, title: str, description: str = "") -> str:

@@ -14,6 +14,7 @@ from uvms_pin.results.figures.paper import (
     plot_second_level,
 )
 from uvms_pin.results.figures.standard import plot_energy, plot_pose, plot_velocities
+from uvms_pin.results.figures.tracking import TRACKING_SIGNALS, plot_tracking
 from uvms_pin.results.rollout_data import RolloutData
 
 #: kind -> (figure function, signals it needs)
@@ -24,6 +25,7 @@ KINDS: dict[str, tuple[Callable[..., Figure], tuple[str, ...]]] = {
     "force": (plot_force, ("force_desired_world_N",)),
     "first_level": (plot_first_level, PPC_SIGNALS),
     "second_level": (plot_second_level, PPC_SIGNALS),
+    "tracking": (plot_tracking, TRACKING_SIGNALS),
 }
 
 

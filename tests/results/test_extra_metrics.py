@@ -1,0 +1,115 @@
+"""Your own metrics: ``[metrics] extra = ["module:function"]`` reach metrics.json and study
+tables; bad references and bad results are clear errors naming the function."""
+
+from __future__ import annotations
+
+import json
+import textwrap
+
+import numpy as np
+import pytest
+from conftest import ROOT
+
+from uvms_pin.apps.cli.main import main
+from uvms_pin.errors import ParameterError, ScenarioError
+from uvms_pin.results.rollout import Rollout
+from uvms_pin.scenario.load import load_scenario
+from uvms_pin.sim.run import simulate
+
+PASSIVE = ROOT / "scenarios" / "passive_still_water.toml"
+
+MODULE = '''
+import numpy as np
+
+
+def arm_travel(rollout):
+    """The arm joints' total travel [rad] and the vehicle's lowest z [m]."""
+    travel = np.abs(np.diff(rollout.q[:, 7:], axis=0)).sum()
+    return {"arm_travel_rad": float(travel), "vehicle_z_min_m": float(rollout.q[:, 2].min())}
+
+
+def clashing(rollout):
+    return {"n_samples": 3.0}
+
+
+def not_a_mapping(rollout):
+    return [1.0]
+
+
+def nan_valued(rollout):
+    return {"broken": float("nan")}
+
+
+def raising(rollout):
+    raise RuntimeError("no data")
+
+
+NOT_CALLABLE = 3
+'''
+
+
+@pytest.fixture
+def scenario_dir(tmp_path):
+    (tmp_path / "my_metrics.py").write_text(textwrap.dedent(MODULE))
+    text = PASSIVE.read_text().replace('model = "uvms_lbv150"', 'model = "uvms_lbv150"', 1)
+    text = text.replace("duration_s = 10.0", "duration_s = 0.2")
+    (tmp_path / "run.toml").write_text(text + '\n[metrics]\nextra = ["my_metrics:arm_travel"]\n')
+    return tmp_path
+
+
+def test_extra_metrics_enter_metrics_json(scenario_dir, capsys):
+    out = scenario_dir / "out"
+    assert main(["run", str(scenario_dir / "run.toml"), "--out", str(out), "--quiet"]) == 0
+    metrics = json.loads((out / "metrics.json").read_text())
+    rollout = Rollout.load(out)
+    travel = np.abs(np.diff(rollout.q[:, 7:], axis=0)).sum()
+    assert metrics["arm_travel_rad"] == pytest.approx(travel) and travel > 0.01
+    assert metrics["vehicle_z_min_m"] == pytest.approx(rollout.q[:, 2].min())
+    # a loaded rollout computes them again, the same way
+    assert rollout.metrics()["arm_travel_rad"] == pytest.approx(travel)
+
+
+@pytest.mark.parametrize(
+    "reference, match",
+    [
+        ("my_metrics:arm_travl", "has no 'arm_travl'; did you mean 'arm_travel'"),
+        ("no_such_module:f", "module 'no_such_module' not found"),
+        ("my_metrics", "expected 'package.module:function'"),
+        ("my_metrics:NOT_CALLABLE", "not a function"),
+    ],
+)
+def test_bad_references_are_scenario_errors(scenario_dir, reference, match):
+    text = (scenario_dir / "run.toml").read_text().replace("my_metrics:arm_travel", reference)
+    (scenario_dir / "bad.toml").write_text(text)
+    with pytest.raises(ScenarioError, match=rf"bad.toml: metrics.extra: .*{match}"):
+        load_scenario(scenario_dir / "bad.toml")
+    with pytest.raises(ScenarioError, match=rf"override 'metrics.extra': .*{match}"):
+        load_scenario(scenario_dir / "run.toml", {"metrics.extra": [reference]})
+    with pytest.raises(ScenarioError, match=r"override 'metrics\.extra': must be a list"):
+        load_scenario(scenario_dir / "run.toml", {"metrics.extra": "my_metrics:arm_travel"})
+
+
+@pytest.mark.parametrize(
+    "reference, match",
+    [
+        ("clashing", "'n_samples' is already a metric"),
+        ("not_a_mapping", "must return a mapping"),
+        ("nan_valued", "'broken' is NaN"),
+        ("raising", "raised RuntimeError: no data"),
+    ],
+)
+def test_bad_results_name_the_function(scenario_dir, reference, match):
+    scenario = load_scenario(
+        scenario_dir / "run.toml", {"metrics.extra": [f"my_metrics:{reference}"]}
+    )
+    rollout = simulate(scenario, progress=False)
+    with pytest.raises(ParameterError, match=f"metric 'my_metrics:{reference}'.*{match}"):
+        rollout.metrics()
+
+
+def test_bad_results_are_cli_input_errors(scenario_dir, capsys):
+    code = main(["run", str(scenario_dir / "run.toml"), "--out", str(scenario_dir / "o"),
+                 "--quiet", "--set", 'metrics.extra=["my_metrics:raising"]'])  # fmt: skip
+    assert code == 2
+    assert "raised RuntimeError" in capsys.readouterr().err
+    assert not (scenario_dir / "o").exists() or not any((scenario_dir / "o").iterdir())
