@@ -119,7 +119,10 @@ def column_layout(rollout: RolloutData) -> list[tuple[str, str, np.ndarray]]:
         prefix, vehicle, joint_layout = SIGNAL_LAYOUTS.get(name, (name, [], None))
         if prefix in _BASE_ARRAYS:
             prefix = f"signal.{prefix}"
-        if not vehicle:
+        named = _named_columns(rollout, name, prefix, values.shape[1])
+        if named is not None:
+            labels = named
+        elif not vehicle:
             labels = [(f"{prefix}.{k}", "") for k in range(values.shape[1])]
         else:
             labels = _labels(rollout, prefix, vehicle, joint_layout, values.shape[1])
@@ -129,6 +132,17 @@ def column_layout(rollout: RolloutData) -> list[tuple[str, str, np.ndarray]]:
         for labels, values in blocks
         for k, (label, unit) in enumerate(labels)
     ]
+
+
+def _named_columns(
+    rollout: RolloutData, name: str, prefix: str, width: int
+) -> list[tuple[str, str]] | None:
+    """The (column, unit) a producer declared for signal ``name`` in the metadata's
+    ``signal_columns`` (per thruster, per sensor), None when it declared none."""
+    declared = rollout.metadata.get("signal_columns", {}).get(name)
+    if declared is None or len(declared) != width:
+        return None
+    return [(f"{prefix}.{component}", unit) for component, unit in declared]
 
 
 def to_dataframe(rollout: RolloutData) -> pd.DataFrame:

@@ -89,6 +89,7 @@ class ClosedLoop:
         q0[3:7] /= np.linalg.norm(q0[3:7])
         self.time_s, self.q, self.v = 0.0, read_only(q0), read_only(v0)
         self.sensors = sensors
+        self.plant.actuation.start(self.settings.control_period_s)
         if self.controller is not None:
             self.controller.reset()
         self.plant.attach(self.q)
@@ -144,6 +145,9 @@ class ClosedLoop:
     ) -> Sample:
         """The loop now, as its observers see it."""
         controller = self.controller
+        signals = self.plant.actuation.signals()
+        if controller is not None:
+            signals = {**controller.signals(), **signals}
         return Sample(
             self.time_s,
             self.q,
@@ -153,7 +157,7 @@ class ClosedLoop:
             self.plant.disturbance_wrench(self.time_s),
             tau_commanded,
             tau_applied,
-            _NO_SIGNALS if controller is None else controller.signals(),
+            signals or _NO_SIGNALS,
         )
 
     def notify(self, sample: Sample) -> None:
@@ -345,6 +349,10 @@ def run_metadata(plant: Plant, settings: SimulationSettings) -> dict[str, Any]:
         "arm_joint_kinds": [_joint_kind(model, name) for name in uvms.arm_joint_names],
         "arm_position_lower_rad": model.lowerPositionLimit[7:].tolist(),
         "arm_position_upper_rad": model.upperPositionLimit[7:].tolist(),
+        "signal_columns": {
+            name: [list(column) for column in columns]
+            for name, columns in plant.actuation.signal_columns().items()
+        },
     }
 
 
