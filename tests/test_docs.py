@@ -20,6 +20,23 @@ SCENARIOS = ROOT / "scenarios"
 _VARIANTS = [
     ("paper_force_tracking.toml", {}),
     ("realistic_force_tracking.toml", {}),
+    (
+        "realistic_force_tracking.toml",
+        {
+            "actuation.thruster": [
+                {
+                    "position_body_m": [0.0, 0.0, 0.0],
+                    "direction_body": [1.0, 0.0, 0.0],
+                    "curve": "quadratic",
+                    "max_forward_N": 20.0,
+                    "max_reverse_N": 15.0,
+                    "deadband": 0.05,
+                    "time_constant_s": 0.05,
+                    "rate_limit_N_s": 200.0,
+                }
+            ]
+        },
+    ),
     ("passive_still_water.toml", {"controller.type": "pi_force"}),
     ("passive_still_water.toml", {"controller.type": "impedance"}),
     (

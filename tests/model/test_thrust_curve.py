@@ -51,7 +51,9 @@ def test_the_driver_command_gives_the_thrust_asked_within_the_limits(curve):
 
 def test_quadratic_law():
     curve = QuadraticThrustCurve(40.0, 25.0, deadband=0.2)
-    np.testing.assert_array_equal(curve.thrust_N(np.array([1.0, -1.0, 0.2, -0.15])), [40, -25, 0, 0])
+    np.testing.assert_array_equal(
+        curve.thrust_N(np.array([1.0, -1.0, 0.2, -0.15])), [40, -25, 0, 0]
+    )
     # half-way through the live range: a quarter of the thrust (T ~ n^2)
     assert curve.thrust_N(np.array([0.6]))[0] == pytest.approx(10.0, rel=1e-14)
     assert curve.thrust_N(np.array([-0.6]))[0] == pytest.approx(-6.25, rel=1e-14)

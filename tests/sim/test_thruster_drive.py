@@ -39,7 +39,12 @@ def test_63_percent_of_a_step_at_the_time_constant(period_s):
 
 @pytest.mark.parametrize(
     ("f0", "steady", "tau", "rate"),
-    [(0.0, 10.0, 0.05, math.inf), (0.0, 10.0, 0.05, 60.0), (5.0, -8.0, 0.02, 300.0), (0.0, 10.0, 0.0, 250.0)],
+    [
+        (0.0, 10.0, 0.05, math.inf),
+        (0.0, 10.0, 0.05, 60.0),
+        (5.0, -8.0, 0.02, 300.0),
+        (0.0, 10.0, 0.0, 250.0),
+    ],
 )
 def test_one_period_matches_the_ode(f0, steady, tau, rate):
     dt = 0.04
@@ -52,7 +57,9 @@ def test_one_period_matches_the_ode(f0, steady, tau, rate):
 
 
 def test_rate_limit_is_the_slope():
-    end, mean = first_order_step(np.zeros(1), np.array([100.0]), np.array([0.01]), np.array([50.0]), 0.1)
+    end, mean = first_order_step(
+        np.zeros(1), np.array([100.0]), np.array([0.01]), np.array([50.0]), 0.1
+    )
     assert end[0] == pytest.approx(5.0, rel=1e-14)
     assert mean[0] == pytest.approx(2.5, rel=1e-14)
 

@@ -61,7 +61,11 @@ class QuadraticThrustCurve(ThrustCurve):
                 raise ParameterError(f"{label} must be finite and >= 0, got {value}")
         if not (0.0 <= deadband < 1.0):
             raise ParameterError(f"deadband must be in [0, 1), got {deadband}")
-        self.forward_N, self.reverse_N, self.deadband = float(max_forward_N), float(max_reverse_N), float(deadband)
+        self.forward_N, self.reverse_N, self.deadband = (
+            float(max_forward_N),
+            float(max_reverse_N),
+            float(deadband),
+        )
         self.name = "quadratic"
 
     def thrust_N(self, command):
@@ -91,8 +95,14 @@ class TabulatedThrustCurve(ThrustCurve):
     def __init__(self, command: np.ndarray, thrust_N: np.ndarray, name: str = "table"):
         u = np.asarray(command, dtype=float).reshape(-1)
         t = np.asarray(thrust_N, dtype=float).reshape(-1)
-        if u.shape != t.shape or u.size < 2 or not (np.all(np.isfinite(u)) and np.all(np.isfinite(t))):
-            raise ParameterError(f"thrust table needs matching finite command and thrust arrays, got {u.shape}, {t.shape}")
+        if (
+            u.shape != t.shape
+            or u.size < 2
+            or not (np.all(np.isfinite(u)) and np.all(np.isfinite(t)))
+        ):
+            raise ParameterError(
+                f"thrust table needs matching finite command and thrust arrays, got {u.shape}, {t.shape}"
+            )
         if not (np.all(np.diff(u) > 0.0) and u[0] == -1.0 and u[-1] == 1.0):
             raise ParameterError("thrust table commands must increase strictly from -1 to 1")
         if np.any(np.diff(t) < 0.0):
@@ -102,7 +112,9 @@ class TabulatedThrustCurve(ThrustCurve):
         self.command, self.thrust, self.name = u, t, name
 
     def thrust_N(self, command):
-        return np.interp(np.clip(np.asarray(command, dtype=float), -1.0, 1.0), self.command, self.thrust)
+        return np.interp(
+            np.clip(np.asarray(command, dtype=float), -1.0, 1.0), self.command, self.thrust
+        )
 
     def command_for(self, thrust_N):
         t = np.clip(np.asarray(thrust_N, dtype=float), self.thrust[0], self.thrust[-1])

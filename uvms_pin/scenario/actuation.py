@@ -47,8 +47,12 @@ def _thruster(t: Table, k: int) -> tuple[Thruster, ThrustCurve, float, float]:
     kind = t.string("curve", "linear", CURVES)
     table_curve = t200_16v_curve() if kind == "t200_16v" else None
     # a tabulated curve brings its own limits; lower ones may be given
-    forward = t.number("max_forward_N", table_curve.max_forward_N if table_curve else None, nonneg=True)
-    reverse = t.number("max_reverse_N", table_curve.max_reverse_N if table_curve else None, nonneg=True)
+    forward = t.number(
+        "max_forward_N", table_curve.max_forward_N if table_curve else None, nonneg=True
+    )
+    reverse = t.number(
+        "max_reverse_N", table_curve.max_reverse_N if table_curve else None, nonneg=True
+    )
     try:
         thruster = Thruster(
             name=t.string("name", f"thruster{k}"),
@@ -59,7 +63,9 @@ def _thruster(t: Table, k: int) -> tuple[Thruster, ThrustCurve, float, float]:
         )
         deadband = t.number("deadband", 0.0, nonneg=True)
         if deadband and kind != "quadratic":
-            raise t.error("deadband", f'applies to curve = "quadratic" (curve "{kind}" has its own)')
+            raise t.error(
+                "deadband", f'applies to curve = "quadratic" (curve "{kind}" has its own)'
+            )
         if kind == "quadratic":
             curve: ThrustCurve = QuadraticThrustCurve(forward, reverse, deadband)
         else:

@@ -40,7 +40,8 @@ class Actuation(ABC):
 
     def start(self, period_s: float | None) -> None:
         """A run starts: actuator states to rest; ``period_s`` the control period (None:
-        the controller is evaluated continuously)."""
+        the controller is evaluated continuously). Stateless actuators have nothing to do."""
+        return
 
     def signals(self) -> dict[str, np.ndarray]:
         """The actuators' signals after the last `apply`, by name."""

@@ -76,7 +76,9 @@ class ThrusterDrives:
         if self.time_constant_s.shape != (m,) or self.rate_limit_N_s.shape != (m,):
             raise ParameterError(f"one time constant and one rate limit per thruster ({m}) needed")
         if np.any(~np.isfinite(self.time_constant_s)) or np.any(self.time_constant_s < 0.0):
-            raise ParameterError(f"time constants must be finite and >= 0, got {self.time_constant_s}")
+            raise ParameterError(
+                f"time constants must be finite and >= 0, got {self.time_constant_s}"
+            )
         if np.any(np.isnan(self.rate_limit_N_s)) or np.any(self.rate_limit_N_s <= 0.0):
             raise ParameterError(f"rate limits must be > 0 (inf: none), got {self.rate_limit_N_s}")
         self.thrust_N = np.zeros(m)
@@ -99,10 +101,14 @@ class ThrusterDrives:
 
     def commands(self, desired_N: np.ndarray) -> np.ndarray:
         """The command u (m,) each driver sends for the thrusts ``desired_N``."""
-        return np.array([c.command_for(np.array([f]))[0] for c, f in zip(self.curves, desired_N, strict=True)])
+        return np.array(
+            [c.command_for(np.array([f]))[0] for c, f in zip(self.curves, desired_N, strict=True)]
+        )
 
     def steady_thrust_N(self, command: np.ndarray) -> np.ndarray:
-        return np.array([c.thrust_N(np.array([u]))[0] for c, u in zip(self.curves, command, strict=True)])
+        return np.array(
+            [c.thrust_N(np.array([u]))[0] for c, u in zip(self.curves, command, strict=True)]
+        )
 
     def advance(self, command: np.ndarray) -> np.ndarray:
         """Hold ``command`` for one period: the mean thrust over it (m,) [N]; the state moves

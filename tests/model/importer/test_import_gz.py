@@ -47,7 +47,7 @@ def test_buoyancy_is_the_collision_boxs_volume_in_the_worlds_density(imported):
 
 
 def test_the_model_loads_and_its_mass_matrix_has_the_added_mass(imported):
-    result, out = imported
+    _result, out = imported
     uvms = load_uvms(out, water_density_kg_m3=1000.0)
     # the propeller joint became the thruster; the two fin joints stay
     assert uvms.nv == 8
@@ -85,7 +85,7 @@ def test_cross_terms_are_reported_not_dropped_silently():
 
     plugin = ET.fromstring(
         "<plugin><link_name>b</link_name><xUabsU>-2</xUabsU><xUabsV>-3</xUabsV>"
-        "<nRR>-1</nRR><xDotR>-0.5</xDotR><foo>1</foo></plugin>"
+        "<nRR>-1</nRR><xDotU>-2</xDotU><nDotR>-1</nDotR><xDotR>-0.5</xDotR><foo>1</foo></plugin>"
     )
     notes: list[str] = []
     params = gz_hydrodynamics(plugin, 0.0, np.zeros(3), "f.sdf", notes)

@@ -70,7 +70,7 @@ def test_the_one_asymmetric_entry_is_reported(imported):
 
 
 def test_buoyancy_and_density_are_the_plugins(imported):
-    result, out = imported
+    result, _out = imported
     params = result.hydro["rexrov/base_link"]
     assert params.volume_m3 == 1.83826
     np.testing.assert_array_equal(params.center_of_buoyancy_m, [0.0, 0.0, 0.3])
@@ -130,7 +130,7 @@ def test_the_written_urdf_reads_back_the_same_coefficients(imported):
 
 
 def test_the_writer_says_what_it_did_not_map(imported):
-    result, out = imported
+    _result, out = imported
     text = out.read_text()
     assert "<flow_velocity_topic> not mapped" in text
     assert "<box> not mapped" in text
@@ -153,7 +153,11 @@ def test_unexpanded_xacro_is_refused(tmp_path):
         ("<type>fossen</type>", "<type>sphere</type>", 'type "sphere" cannot be imported'),
         ("-74.82 -69.48", "74.82 -69.48", "positive semi-definite"),
         ("<volume>1.83826</volume>", "<volume>x</volume>", "non-numeric"),
-        ('<link name="rexrov/base_link">\n        <neutrally', '<link name="nope">\n        <neutrally', "'nope'"),
+        (
+            '<link name="rexrov/base_link">\n        <neutrally',
+            '<link name="nope">\n        <neutrally',
+            "'nope'",
+        ),
     ],
 )
 def test_bad_plugin_blocks_are_named(tmp_path, old, new, match):
@@ -169,8 +173,6 @@ def test_bad_plugin_blocks_are_named(tmp_path, old, new, match):
 
 def test_neutrally_buoyant_gives_volume_m_over_rho(tmp_path):
     source = tmp_path / "n.urdf"
-    source.write_text(
-        REXROV.read_text().replace("<neutrally_buoyant>0<", "<neutrally_buoyant>1<")
-    )
+    source.write_text(REXROV.read_text().replace("<neutrally_buoyant>0<", "<neutrally_buoyant>1<"))
     result = import_model(source)
     assert result.hydro["rexrov/base_link"].volume_m3 == pytest.approx(1862.87 / 1028.0, rel=1e-15)

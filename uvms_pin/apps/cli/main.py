@@ -168,7 +168,9 @@ def _cmd_import(args: argparse.Namespace) -> int:
     if result.thrusters:
         print(f"wrote {table} ({len(result.thrusters)} thrusters)")
     if result.fluid_density_kg_m3 is not None:
-        print(f"fluid density in the source: {result.fluid_density_kg_m3:g} kg/m^3 ([water] density_kg_m3)")
+        print(
+            f"fluid density in the source: {result.fluid_density_kg_m3:g} kg/m^3 ([water] density_kg_m3)"
+        )
     for note in result.not_mapped:
         print(f"not mapped: {note}")
     return 0

@@ -39,7 +39,9 @@ def collision_volume(link: ET.Element, where: str, notes: list[str]) -> tuple[fl
         geometry = collision.find("geometry")
         volume = None if geometry is None else _shape_volume(geometry, where, name)
         if volume is None:
-            notes.append(f"link '{name}': a collision shape without a primitive volume left out of its buoyancy")
+            notes.append(
+                f"link '{name}': a collision shape without a primitive volume left out of its buoyancy"
+            )
             continue
         centre = read_origin(collision.find("origin"), where, name).translation
         total += volume

@@ -12,8 +12,8 @@ links (a thruster plugin's propeller) leave the tree and become the thruster tab
 from __future__ import annotations
 
 import copy
-from contextlib import nullcontext
 import xml.etree.ElementTree as ET
+from contextlib import nullcontext
 from pathlib import Path
 
 import numpy as np
@@ -62,10 +62,15 @@ def import_model(
         out = Path(out)
         table = None if not thrusters else Path(thrusters_out or out.with_suffix(".thrusters.toml"))
         # both files appear together or neither does
-        with atomic_path(out) as urdf_tmp, (nullcontext() if table is None else atomic_path(table)) as table_tmp:
+        with (
+            atomic_path(out) as urdf_tmp,
+            nullcontext() if table is None else atomic_path(table) as table_tmp,
+        ):
             urdf_tmp.write_text(result.urdf_text, encoding="utf-8")
             if table_tmp is not None:
-                table_tmp.write_text(thruster_table_text(thrusters, where, density), encoding="utf-8")
+                table_tmp.write_text(
+                    thruster_table_text(thrusters, where, density), encoding="utf-8"
+                )
     return result
 
 
@@ -82,7 +87,9 @@ def _read_source(path: Path, notes: list[str]) -> tuple[ET.Element, list[ET.Elem
         robot = sdf_to_urdf(sdf_model(root, where), where, notes)
         return robot, list(root.iter("plugin")), "sdf"
     if root.tag != "robot":
-        raise ModelError(f"root element is <{root.tag}>, expected <robot> (URDF) or <sdf>", path=where)
+        raise ModelError(
+            f"root element is <{root.tag}>, expected <robot> (URDF) or <sdf>", path=where
+        )
     for element in root.iter():
         if element.tag.startswith(_XACRO_NAMESPACE) or "${" in "".join(element.attrib.values()):
             raise ModelError(
@@ -134,14 +141,18 @@ def _hydro(links, plugins, where, notes) -> tuple[float | None, dict[str, HydroP
         for name, link in links.items():
             if name not in hydro and link.find("inertial") is not None:
                 volume, centre = collision_volume(link, where, notes)
-                hydro[name] = HydroParams(volume, centre, np.zeros((6, 6)), np.zeros((6, 6)), np.zeros(6))
+                hydro[name] = HydroParams(
+                    volume, centre, np.zeros((6, 6)), np.zeros((6, 6)), np.zeros(6)
+                )
     return density, hydro
 
 
 def _gz_buoyancy(link, buoyancy: bool, where: str, notes: list[str]) -> tuple[float, np.ndarray]:
     if buoyancy:
         return collision_volume(link, where, notes)
-    notes.append(f"link '{link.get('name')}': no Buoyancy system in the file: written without buoyancy")
+    notes.append(
+        f"link '{link.get('name')}': no Buoyancy system in the file: written without buoyancy"
+    )
     return 0.0, np.zeros(3)
 
 
@@ -165,11 +176,14 @@ def _drop_thruster_links(robot: ET.Element, plugins: list[ET.Element], notes: li
         robot.remove(by_child[link])
         notes.append(
             f"thruster link '{link}' ({_mass(links[link]):g} kg) and joint "
-            f"'{by_child[link].get('name')}' removed: the thruster is in the thruster table"
+            f"'{by_child[link].get('name')}' removed from the tree: the thruster is in the "
+            "thruster table"
         )
 
 
-def _finish_links(robot: ET.Element, hydro: dict[str, HydroParams], where: str, notes: list[str]) -> None:
+def _finish_links(
+    robot: ET.Element, hydro: dict[str, HydroParams], where: str, notes: list[str]
+) -> None:
     """Each link with mass gets its ``<hydrodynamics>`` (zero volume: dry, as in the
     source); a link without mass loses its collision shapes (uvms-pin needs mass there)."""
     for link in robot.findall("link"):
@@ -189,7 +203,9 @@ def _finish_links(robot: ET.Element, hydro: dict[str, HydroParams], where: str, 
 
 def _known_link(name: str | None, links: dict[str, ET.Element], where: str) -> str:
     if name not in links:
-        raise ModelError(f"a hydrodynamics plugin names link {name!r}, which is not in the model", path=where)
+        raise ModelError(
+            f"a hydrodynamics plugin names link {name!r}, which is not in the model", path=where
+        )
     if links[name].find("inertial") is None:
         raise ModelError("has hydrodynamics but no <inertial>", path=where, link=name)
     return name

@@ -28,7 +28,7 @@ from uvms_pin.errors import ModelError, ParameterError
 from uvms_pin.hydro.params import HydroParams
 from uvms_pin.model.importer.xml import child_numbers, child_text
 
-__all__ = ["LINK_FROM_SNAME", "fossen_hydro"]
+__all__ = ["LINK_FROM_SNAME", "fossen_hydro", "note_asymmetry"]
 
 #: T: link frame (x fwd, y left, z up) <-> the plugin's SNAME frame (x fwd, y stbd, z down);
 #: a rotation by pi about x, its own inverse, applied to [linear; angular].
@@ -53,7 +53,9 @@ def fossen_hydro(
     link = block.get("name", "?")
     model = block.find("hydrodynamic_model")
     if model is None:
-        raise ModelError("uuv_simulator link block has no <hydrodynamic_model>", path=where, link=link)
+        raise ModelError(
+            "uuv_simulator link block has no <hydrodynamic_model>", path=where, link=link
+        )
     kind = child_text(model, "type")
     if kind != "fossen":
         raise ModelError(
@@ -69,18 +71,20 @@ def fossen_hydro(
     linear = -_sname_to_link(_matrix(model, "linear_damping", where, link, diagonal_ok=True))
     quadratic = -np.diag(_matrix(model, "quadratic_damping", where, link, diagonal_ok=True))
     _note_off_diagonal_quadratic(model, where, link, notes)
-    _note_asymmetry(added, link, notes)
+    note_asymmetry(added, link, notes)
     try:
         return HydroParams(
             volume_m3,
             np.zeros(3) if cob is None else cob,
-            added,
+            0.5 * (added + added.T),
             linear,
             quadratic,
             origin=f"uuv_simulator fossen model ({where})",
         )
     except ParameterError as exc:
-        raise ModelError(f"{exc} (after the SNAME -> link frame change)", path=where, link=link) from exc
+        raise ModelError(
+            f"{exc} (after the SNAME -> link frame change)", path=where, link=link
+        ) from exc
 
 
 def _sname_to_link(matrix_sname: np.ndarray) -> np.ndarray:
@@ -120,10 +124,14 @@ def _note_unmapped(
 ) -> None:
     for child in element:
         if child.tag not in mapped:
-            notes.append(f"link '{link}': <{prefix}{child.tag}> not mapped (no uvms-pin counterpart)")
+            notes.append(
+                f"link '{link}': <{prefix}{child.tag}> not mapped (no uvms-pin counterpart)"
+            )
 
 
-def _note_off_diagonal_quadratic(model: ET.Element, where: str, link: str, notes: list[str]) -> None:
+def _note_off_diagonal_quadratic(
+    model: ET.Element, where: str, link: str, notes: list[str]
+) -> None:
     """The plugin reads a 36-number quadratic_damping but uses only its diagonal; so do we."""
     full = _matrix(model, "quadratic_damping", where, link, diagonal_ok=True)
     if np.any(full - np.diag(np.diag(full))):
@@ -133,7 +141,7 @@ def _note_off_diagonal_quadratic(model: ET.Element, where: str, link: str, notes
         )
 
 
-def _note_asymmetry(added: np.ndarray, link: str, notes: list[str]) -> None:
+def note_asymmetry(added: np.ndarray, link: str, notes: list[str]) -> None:
     asymmetry = float(np.max(np.abs(added - added.T)))
     if asymmetry > _SYMMETRY_NOTE_RELATIVE * max(1.0, float(np.max(np.abs(added)))):
         notes.append(

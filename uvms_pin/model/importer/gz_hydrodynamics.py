@@ -23,6 +23,7 @@ import numpy as np
 
 from uvms_pin.errors import ModelError, ParameterError
 from uvms_pin.hydro.params import HydroParams
+from uvms_pin.model.importer.fossen import note_asymmetry
 from uvms_pin.model.importer.xml import element_numbers
 
 __all__ = ["FORCE_AXES", "VELOCITIES", "gz_hydrodynamics"]
@@ -72,11 +73,12 @@ def gz_hydrodynamics(
             f"link '{link}': off-diagonal added mass: gz-sim's Coriolis uses only the "
             "diagonal, uvms-pin's the whole matrix"
         )
+    note_asymmetry(added, link, notes)
     try:
         return HydroParams(
             volume_m3,
             center_of_buoyancy_m,
-            added,
+            0.5 * (added + added.T),
             linear,
             quadratic,
             origin=f"gz-sim Hydrodynamics ({where})",

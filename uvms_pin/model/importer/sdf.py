@@ -60,9 +60,7 @@ def sdf_pose(element: ET.Element | None, where: str, what: str) -> pin.SE3:
 
 def _origin(parent: ET.Element, placement: pin.SE3) -> None:
     rpy = pin.rpy.matrixToRpy(placement.rotation)
-    ET.SubElement(
-        parent, "origin", xyz=numbers_text(placement.translation), rpy=numbers_text(rpy)
-    )
+    ET.SubElement(parent, "origin", xyz=numbers_text(placement.translation), rpy=numbers_text(rpy))
 
 
 def sdf_to_urdf(model: ET.Element, where: str, notes: list[str]) -> ET.Element:
@@ -88,10 +86,14 @@ def _link(link: ET.Element, where: str, notes: list[str]) -> ET.Element:
         ET.SubElement(element, "mass", value=(inertial.findtext("mass") or "1").strip())
         inertia = inertial.find("inertia")
         keys = ("ixx", "ixy", "ixz", "iyy", "iyz", "izz")
-        values = {k: (inertia.findtext(k) or "0").strip() if inertia is not None else "0" for k in keys}
+        values = {
+            k: (inertia.findtext(k) or "0").strip() if inertia is not None else "0" for k in keys
+        }
         ET.SubElement(element, "inertia", **values)
         if inertial.find("fluid_added_mass") is not None:
-            notes.append(f"link '{name}': <fluid_added_mass> not mapped (use the Hydrodynamics system)")
+            notes.append(
+                f"link '{name}': <fluid_added_mass> not mapped (use the Hydrodynamics system)"
+            )
     for collision in link.findall("collision"):
         geometry = _geometry(collision.find("geometry"), where, name, notes)
         if geometry is not None:
@@ -101,7 +103,9 @@ def _link(link: ET.Element, where: str, notes: list[str]) -> ET.Element:
     return out
 
 
-def _geometry(geometry: ET.Element | None, where: str, link: str, notes: list[str]) -> ET.Element | None:
+def _geometry(
+    geometry: ET.Element | None, where: str, link: str, notes: list[str]
+) -> ET.Element | None:
     """A URDF ``<geometry>`` of an SDF box, sphere, cylinder or mesh; None (noted) otherwise."""
     out = ET.Element("geometry")
     shape = None if geometry is None else next(iter(geometry), None)
@@ -125,13 +129,20 @@ def _geometry(geometry: ET.Element | None, where: str, link: str, notes: list[st
     return out
 
 
-def _joint(joint: ET.Element, link_poses: dict[str, pin.SE3], where: str, notes: list[str]) -> ET.Element:
+def _joint(
+    joint: ET.Element, link_poses: dict[str, pin.SE3], where: str, notes: list[str]
+) -> ET.Element:
     name, kind = joint.get("name"), joint.get("type")
     if kind not in _JOINT_TYPES:
         raise ModelError(f"joint '{name}': type '{kind}' has no URDF counterpart", path=where)
     if not sdf_pose(joint, where, f"joint '{name}'").isIdentity():
-        raise ModelError(f"joint '{name}': a <pose> off its child link is not supported", path=where)
-    parent, child = (joint.findtext("parent") or "").strip(), (joint.findtext("child") or "").strip()
+        raise ModelError(
+            f"joint '{name}': a <pose> off its child link is not supported", path=where
+        )
+    parent, child = (
+        (joint.findtext("parent") or "").strip(),
+        (joint.findtext("child") or "").strip(),
+    )
     for end in (parent, child):
         if end not in link_poses:
             raise ModelError(f"joint '{name}': no link '{end}' in the model", path=where)
@@ -145,7 +156,9 @@ def _joint(joint: ET.Element, link_poses: dict[str, pin.SE3], where: str, notes:
     return out
 
 
-def _axis(out: ET.Element, axis: ET.Element, child_pose: pin.SE3, where: str, name: str, notes: list[str]) -> None:
+def _axis(
+    out: ET.Element, axis: ET.Element, child_pose: pin.SE3, where: str, name: str, notes: list[str]
+) -> None:
     xyz = axis.find("xyz")
     if xyz is not None and xyz.get("expressed_in"):
         raise ModelError(f"joint '{name}': <xyz expressed_in> is not supported", path=where)
@@ -157,11 +170,18 @@ def _axis(out: ET.Element, axis: ET.Element, child_pose: pin.SE3, where: str, na
     if limit is None:
         return
     values = {}
-    for key, default in (("lower", -math.pi), ("upper", math.pi), ("effort", UNLIMITED), ("velocity", UNLIMITED)):
+    for key, default in (
+        ("lower", -math.pi),
+        ("upper", math.pi),
+        ("effort", UNLIMITED),
+        ("velocity", UNLIMITED),
+    ):
         text = limit.findtext(key)
         value = default if text is None else float(text)
         if key in ("effort", "velocity") and value < 0.0:
-            notes.append(f"joint '{name}': {key} limit {value:g} (unlimited) written as {UNLIMITED:g}")
+            notes.append(
+                f"joint '{name}': {key} limit {value:g} (unlimited) written as {UNLIMITED:g}"
+            )
             value = UNLIMITED
         values[key] = repr(value)
     ET.SubElement(out, "limit", **values)

@@ -37,7 +37,9 @@ def _number(parent: ET.Element, tag: str, where: str, name: str) -> float | None
     try:
         value = float(text)
     except ValueError as exc:
-        raise ModelError(f"thruster '{name}': <{tag}> is not a number: '{text}'", path=where) from exc
+        raise ModelError(
+            f"thruster '{name}': <{tag}> is not a number: '{text}'", path=where
+        ) from exc
     if not np.isfinite(value):
         raise ModelError(f"thruster '{name}': <{tag}> is not finite", path=where)
     return value
@@ -57,7 +59,9 @@ def uuv_thruster(
     if dynamics is not None and child_text(dynamics, "type") == "FirstOrder":
         time_constant = _number(dynamics, "timeConstant", where, link)
     elif dynamics is not None:
-        notes.append(f"thruster '{link}': dynamics type {child_text(dynamics, 'type')!r} not mapped")
+        notes.append(
+            f"thruster '{link}': dynamics type {child_text(dynamics, 'type')!r} not mapped"
+        )
     law, coefficient = "quadratic", None
     if conversion is not None and child_text(conversion, "type") == "Basic":
         coefficient = _number(conversion, "rotorConstant", where, link)
@@ -102,7 +106,14 @@ def gz_thruster(
         coefficient = k_t * rho * diameter**4
     upper = _number(plugin, "max_thrust_cmd", where, name)
     lower = _number(plugin, "min_thrust_cmd", where, name)
-    for tag in ("use_angvel_cmd", "velocity_control", "deadband", "wake_fraction", "alpha_1", "alpha_2"):
+    for tag in (
+        "use_angvel_cmd",
+        "velocity_control",
+        "deadband",
+        "wake_fraction",
+        "alpha_1",
+        "alpha_2",
+    ):
         if plugin.find(tag) is not None:
             notes.append(f"thruster '{name}': <{tag}> not mapped")
     return ImportedThruster(

@@ -15,7 +15,9 @@ __all__ = ["link_placements", "root_link"]
 
 def root_link(robot: ET.Element, where: str) -> str:
     """The one link that is no joint's child."""
-    children = {j.find("child").get("link") for j in robot.findall("joint") if j.find("child") is not None}
+    children = {
+        j.find("child").get("link") for j in robot.findall("joint") if j.find("child") is not None
+    }
     roots = [link.get("name") for link in robot.findall("link") if link.get("name") not in children]
     if len(roots) != 1:
         raise ModelError(f"needs exactly one root link, found {roots}", path=where)
@@ -47,5 +49,7 @@ def link_placements(robot: ET.Element, where: str) -> dict[str, pin.SE3]:
 def axis_of(joint: ET.Element) -> np.ndarray:
     """A joint's unit axis in its (child link's) frame; URDF's default is x."""
     axis = joint.find("axis")
-    values = np.array([float(v) for v in (axis.get("xyz", "1 0 0") if axis is not None else "1 0 0").split()])
+    values = np.array(
+        [float(v) for v in (axis.get("xyz", "1 0 0") if axis is not None else "1 0 0").split()]
+    )
     return values / np.linalg.norm(values)

@@ -30,7 +30,9 @@ def urdf_text(robot: ET.Element, source: str, not_mapped: Sequence[str]) -> str:
     """The URDF file: a comment naming the source and what was not mapped, then the robot."""
     ET.indent(robot, space="  ")
     lines = [f"Imported by uvms-pin import from {source}."]
-    lines += ["Not mapped:"] + [f"  - {n}" for n in not_mapped] if not_mapped else ["Everything mapped."]
+    lines += (
+        ["Not mapped:"] + [f"  - {n}" for n in not_mapped] if not_mapped else ["Everything mapped."]
+    )
     comment = "\n".join(line.replace("--", "- -") for line in lines)
     body = ET.tostring(robot, encoding="unicode")
     return f'<?xml version="1.0"?>\n<!--\n{comment}\n-->\n{body}\n'
@@ -57,10 +59,21 @@ def thruster_table_text(
             f"position_body_m = {_toml_vector(thruster.position_body_m)}",
             f"direction_body = {_toml_vector(thruster.direction_body)}",
         ]
-        for key, value in (("max_forward_N", thruster.max_forward_N), ("max_reverse_N", thruster.max_reverse_N)):
-            lines.append(f"{key} = {value!r}" if value is not None else f"# {key} = ?  (not in the source: set it)")
+        for key, value in (
+            ("max_forward_N", thruster.max_forward_N),
+            ("max_reverse_N", thruster.max_reverse_N),
+        ):
+            lines.append(
+                f"{key} = {value!r}"
+                if value is not None
+                else f"# {key} = ?  (not in the source: set it)"
+            )
         if thruster.time_constant_s is not None:
-            lines.append(f"# rotor time constant in the source: {thruster.time_constant_s!r} s")
+            lines.append(
+                f"time_constant_s = {thruster.time_constant_s!r}  # the source lags the rotor speed"
+            )
         if thruster.thrust_coefficient is not None:
-            lines.append(f"# {thruster.thrust_law} thrust coefficient in the source: {thruster.thrust_coefficient!r}")
+            lines.append(
+                f"# {thruster.thrust_law} thrust coefficient in the source: {thruster.thrust_coefficient!r}"
+            )
     return "\n".join(lines) + "\n"
