@@ -92,6 +92,35 @@ _VARIANTS = [
     (
         "passive_still_water.toml",
         {
+            "joints.viscous_Nms": [0.1, 0.1, 0.1, 0.1],
+            "joints.coulomb_Nm": [0.05, 0.05, 0.05, 0.05],
+            "joints.coulomb_velocity_rad_s": 0.02,
+            "joints.torque_time_constant_s": [0.01, 0.01, 0.01, 0.01],
+            "sensors.imu": {
+                "gyro_noise_rad_s_rthz": 1e-3,
+                "gyro_bias_walk_rad_s2_rthz": 1e-5,
+                "accel_noise_m_s2_rthz": 1e-2,
+                "accel_bias_walk_m_s3_rthz": 1e-4,
+            },
+            "sensors.depth": {"noise_Pa": 50.0},
+            "sensors.dvl": {
+                "noise_m_s": 0.01,
+                "min_altitude_m": 0.3,
+                "max_altitude_m": 50.0,
+                "dropout_probability": 0.05,
+                "seabed_depth_m": 30.0,
+            },
+            "sensors.usbl": {
+                "noise_m": 0.1,
+                "period_s": 1.0,
+                "latency_s": 0.5,
+                "dropout_probability": 0.1,
+            },
+        },
+    ),
+    (
+        "passive_still_water.toml",
+        {
             "environment.type": "plane",
             "environment.stiffness_N_m": 100.0,
             "controller.type": "none",

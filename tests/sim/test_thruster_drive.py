@@ -80,3 +80,23 @@ def test_dynamics_need_a_sampled_loop():
 def test_bad_parameters_are_refused(tau, rate):
     with pytest.raises(ParameterError):
         ThrusterDrives([QuadraticThrustCurve(1.0, 1.0)], [tau], [rate])
+
+
+def test_the_direct_path_equals_linear_drives():
+    from uvms_pin.model.thruster import Thruster
+    from uvms_pin.sim.actuation import ThrustersAndJointLimits, ideal_drives
+
+    thrusters = [
+        Thruster("a", np.array([0.1, 0.2, 0.0]), np.array([1.0, 0.0, 0.0]), 20.0, 15.0),
+        Thruster("b", np.array([0.0, -0.2, 0.1]), np.array([0.0, 1.0, 0.2]), 10.0, 0.0),
+        Thruster("c", np.array([-0.3, 0.0, 0.0]), np.array([0.0, 0.0, 1.0]), 12.0, 12.0),
+    ]
+    direct = ThrustersAndJointLimits(thrusters, None)
+    explicit = ThrustersAndJointLimits(thrusters, None, drives=ideal_drives(thrusters))
+    for actuation in (direct, explicit):
+        actuation.start(0.01)
+    rng = np.random.default_rng(0)
+    for tau in rng.normal(scale=20.0, size=(50, 6)):
+        np.testing.assert_allclose(direct.apply(tau), explicit.apply(tau), rtol=1e-12, atol=1e-12)
+        for name in ("thrust", "thruster_command"):
+            np.testing.assert_allclose(direct.signals()[name], explicit.signals()[name], atol=1e-12)

@@ -33,6 +33,8 @@ def build_actuation(t: Table | None, uvms: UVMS) -> Actuation:
     parts = [_thruster(e, k) for k, e in enumerate(entries)]
     thrusters = [p[0] for p in parts]
     drives = ThrusterDrives([p[1] for p in parts], [p[2] for p in parts], [p[3] for p in parts])
+    if all(c.name == "linear" for c in drives.curves) and not drives.has_dynamics:
+        drives = None  # the allocated thrust at once: the actuation's direct path
     components = t.vector("allocated_components", None, [0, 1, 2, 3, 4, 5])
     t.finish()
     limits = uvms.model.effortLimit[6:].copy() if limit_joints else None

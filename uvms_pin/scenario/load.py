@@ -28,6 +28,7 @@ from uvms_pin.scenario.actuation import build_actuation
 from uvms_pin.scenario.baselines import check_baselines
 from uvms_pin.scenario.controller import build_controller
 from uvms_pin.scenario.initial import build_initial_state
+from uvms_pin.scenario.joints import build_joint_friction, with_joint_lag
 from uvms_pin.scenario.overrides import apply_overrides, parse_key_path
 from uvms_pin.scenario.schema import Table
 from uvms_pin.scenario.sensors import build_sensors
@@ -92,8 +93,11 @@ def _build(raw: dict[str, Any], path: Path, top: Table) -> Scenario:
     q0, v0 = build_initial_state(top.table_or_empty("initial"), uvms)
     contact = build_environment(top.table("environment"), uvms)
     disturbance = build_disturbance(top.table("disturbance"))
-    actuation = build_actuation(top.table("actuation"), uvms)
-    sensor_config = build_sensors(top.table_or_empty("sensors"))
+    joints = top.table_or_empty("joints")
+    friction = build_joint_friction(joints, uvms)
+    actuation = with_joint_lag(joints, build_actuation(top.table("actuation"), uvms), uvms)
+    joints.finish()
+    sensor_config = build_sensors(top.table_or_empty("sensors"), water.density_kg_m3)
     integrator, backend = build_integrator(top.table_or_empty("integrator"))
     control_period = build_control_period(top.table_or_empty("control"))
     log_period = build_log_period(top.table_or_empty("output"))
@@ -110,6 +114,7 @@ def _build(raw: dict[str, Any], path: Path, top: Table) -> Scenario:
         backend,
         free_surface=water.free_surface,
         stop_at_surface=water.stop_at_surface,
+        joint_friction=friction,
     )
     try:
         settings = SimulationSettings(

@@ -101,6 +101,8 @@ class ThrustersAndJointLimits(Actuation):
         self._allocation_pinv[:, components] = np.linalg.pinv(self.allocation[components])
         self._lower = -np.array([t.max_reverse_N for t in self.thrusters])
         self._upper = np.array([t.max_forward_N for t in self.thrusters])
+        # the default drives give the allocated thrust at once: computed directly (fast path)
+        self._ideal = drives is None
         if drives is None:
             drives = ideal_drives(self.thrusters)
         if len(drives.curves) != len(self.thrusters):
@@ -108,6 +110,9 @@ class ThrustersAndJointLimits(Actuation):
         self.drives = drives
         self._command = np.zeros(len(self.thrusters))
         self._thrust = np.zeros(len(self.thrusters))
+        # the linear curve's command u = f / limit (a zero limit: u = 0, f = 0)
+        self._full_forward = np.where(self._upper > 0.0, self._upper, np.inf)
+        self._full_reverse = np.where(self._lower < 0.0, -self._lower, np.inf)
         if joint_effort_limits_Nm is not None:
             limits = np.asarray(joint_effort_limits_Nm, dtype=float)
             if np.any(~(limits > 0.0)) or not np.all(np.isfinite(limits)):
@@ -149,8 +154,14 @@ class ThrustersAndJointLimits(Actuation):
 
     def apply(self, tau_commanded):
         out = np.empty_like(tau_commanded)
-        self._command = self.drives.commands(self.thrusts(tau_commanded))
-        self._thrust = self.drives.advance(self._command)
+        if self._ideal:
+            self._thrust = self.thrusts(tau_commanded)
+            self._command = self._thrust / np.where(
+                self._thrust >= 0.0, self._full_forward, self._full_reverse
+            )
+        else:
+            self._command = self.drives.commands(self.thrusts(tau_commanded))
+            self._thrust = self.drives.advance(self._command)
         out[:6] = self.allocation @ self._thrust
         arm = tau_commanded[6:]
         if self.joint_effort_limits_Nm is None:

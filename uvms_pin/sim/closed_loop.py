@@ -90,6 +90,8 @@ class ClosedLoop:
         self.time_s, self.q, self.v = 0.0, read_only(q0), read_only(v0)
         self.sensors = sensors
         self.plant.actuation.start(self.settings.control_period_s)
+        if sensors.navigation is not None:
+            sensors.navigation.start(self.settings.control_period_s)
         if self.controller is not None:
             self.controller.reset()
         self.plant.attach(self.q)
@@ -146,6 +148,8 @@ class ClosedLoop:
         """The loop now, as its observers see it."""
         controller = self.controller
         signals = self.plant.actuation.signals()
+        if self.sensors.navigation is not None:
+            signals.update(self.sensors.navigation.signals())
         if controller is not None:
             signals = {**controller.signals(), **signals}
         return Sample(
@@ -202,6 +206,8 @@ class ClosedLoop:
     def _tick(self, logged: bool) -> np.ndarray:
         """Measure, command and actuate at the current state; log if ``logged``."""
         measurement, contact = self.measure()
+        if self.sensors.navigation is not None:  # stateful: once per tick
+            self.sensors.navigation.update(self.time_s, self.q, self.v)
         tau = self.command(measurement)
         tau_applied = self.actuate(tau)
         if logged:
@@ -383,6 +389,10 @@ def simulate_closed_loop(
 
     check_log_fits(settings, plant.uvms.nq, plant.uvms.nv)
     meta = {**(metadata or {}), **run_metadata(plant, settings)}
+    if sensors.navigation is not None:
+        meta["signal_columns"].update(
+            {k: [list(c) for c in cols] for k, cols in sensors.navigation.signal_columns().items()}
+        )
     log = RolloutLog(plant.uvms, settings.n_log, meta, backend=plant.backend, plant=plant)
     loop = ClosedLoop(plant, settings, controller, observers)
     return loop.run(q0, v0, sensors, log)
