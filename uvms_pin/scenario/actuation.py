@@ -31,6 +31,7 @@ def build_actuation(t: Table | None, uvms: UVMS) -> Actuation:
     if not entries:
         raise t.fail("needs at least one [[actuation.thruster]]")
     parts = [_thruster(e, k) for k, e in enumerate(entries)]
+    parts = _shared_curves(parts)
     thrusters = [p[0] for p in parts]
     drives = ThrusterDrives([p[1] for p in parts], [p[2] for p in parts], [p[3] for p in parts])
     if all(c.name == "linear" for c in drives.curves) and not drives.has_dynamics:
@@ -78,3 +79,15 @@ def _thruster(t: Table, k: int) -> tuple[Thruster, ThrustCurve, float, float]:
     rate = t.optional_number("rate_limit_N_s", positive=True)
     t.finish()
     return thruster, curve, time_constant, math.inf if rate is None else rate
+
+
+def _shared_curves(parts: list) -> list:
+    """Equal quadratic curves as one object: the drives evaluate a shared curve at once."""
+    shared: dict[tuple[float, float, float], ThrustCurve] = {}
+    out = []
+    for thruster, curve, tau, rate in parts:
+        if isinstance(curve, QuadraticThrustCurve):
+            key = (curve.forward_N, curve.reverse_N, curve.deadband)
+            curve = shared.setdefault(key, curve)
+        out.append((thruster, curve, tau, rate))
+    return out

@@ -14,6 +14,7 @@ solution itself (63.2 % of a step at t = tau). tau = 0 and r = inf: f = T_ss at 
 
 from __future__ import annotations
 
+import math
 from collections.abc import Sequence
 
 import numpy as np
@@ -33,25 +34,38 @@ def first_order_step(
 ) -> tuple[np.ndarray, np.ndarray]:
     """(f(dt), the mean of f over [0, dt]) for df/dt = clip((T_ss - f)/tau, -r, r), f(0) =
     ``thrust_N`` (element-wise; tau = 0 is an instant lag, r = inf no rate limit)."""
-    # inf * 0 (no rate limit, no time constant) is resolved by the np.where's below
-    with np.errstate(invalid="ignore", divide="ignore", over="ignore"):
-        error = steady_N - thrust_N
-        band = rate_limit_N_s * time_constant_s  # the ramp lasts until |error| = r tau
-        ramp_s = np.where(np.abs(error) > band, (np.abs(error) - band) / rate_limit_N_s, 0.0)
-        ramp_s = np.minimum(np.nan_to_num(ramp_s, nan=0.0), dt_s)
-        ramping = ramp_s > 0.0
-        ramped = np.where(ramping, thrust_N + np.sign(error) * rate_limit_N_s * ramp_s, thrust_N)
-        integral = np.where(ramping, 0.5 * (thrust_N + ramped) * ramp_s, 0.0)
-        rest_s = dt_s - ramp_s
-        remaining = steady_N - ramped
-        # no lag: the rest of the period (if any) is at T_ss at once
-        instant = np.where(rest_s > 0.0, 0.0, 1.0)
-        decay = np.where(time_constant_s > 0.0, np.exp(-rest_s / time_constant_s), instant)
-        # the integral of T_ss - e exp(-t/tau) over the rest h: T_ss h - e tau (1 - exp(-h/tau))
-        lag = np.where(time_constant_s > 0.0, remaining * time_constant_s * (1.0 - decay), 0.0)
-        tail = steady_N * rest_s - lag
-    end = steady_N - remaining * decay
-    return end, (integral + tail) / dt_s
+    # a handful of drives per vehicle: scalar arithmetic beats numpy's per-call overhead
+    ends, means = np.empty(len(thrust_N)), np.empty(len(thrust_N))
+    for k, (f, ss, tau, rate) in enumerate(
+        zip(
+            thrust_N.tolist(),
+            steady_N.tolist(),
+            time_constant_s.tolist(),
+            rate_limit_N_s.tolist(),
+            strict=True,
+        )
+    ):
+        ends[k], means[k] = _step_one(f, ss, tau, rate, dt_s)
+    return ends, means
+
+
+def _step_one(f: float, steady: float, tau: float, rate: float, dt: float) -> tuple[float, float]:
+    """One drive over one period: a ramp at the rate limit while |T_ss - f| > r tau, then
+    the exponential approach T_ss - e exp(-t / tau); (the end value, the mean)."""
+    error = steady - f
+    band = rate * tau if math.isfinite(rate) else math.inf  # r tau; no rate limit: never ramp
+    ramp = min((abs(error) - band) / rate, dt) if abs(error) > band else 0.0
+    ramped = f + math.copysign(rate * ramp, error) if ramp > 0.0 else f
+    integral = 0.5 * (f + ramped) * ramp
+    rest = dt - ramp
+    remaining = steady - ramped
+    if tau > 0.0:
+        decay = math.exp(-rest / tau)
+        tail = steady * rest - remaining * tau * (1.0 - decay)
+    else:  # no lag: the rest of the period (if any) is at T_ss at once
+        decay = 0.0 if rest > 0.0 else 1.0
+        tail = steady * rest
+    return steady - remaining * decay, (integral + tail) / dt
 
 
 class ThrusterDrives:
@@ -70,6 +84,11 @@ class ThrusterDrives:
         rate_limit_N_s: Sequence[float],
     ):
         self.curves = tuple(curves)
+        # thrusters sharing one curve object are evaluated together
+        by_curve: dict[int, list[int]] = {}
+        for k, curve in enumerate(self.curves):
+            by_curve.setdefault(id(curve), []).append(k)
+        self._groups = [(self.curves[ks[0]], np.array(ks)) for ks in by_curve.values()]
         self.time_constant_s = np.asarray(time_constant_s, dtype=float)
         self.rate_limit_N_s = np.asarray(rate_limit_N_s, dtype=float)
         m = len(self.curves)
@@ -101,14 +120,16 @@ class ThrusterDrives:
 
     def commands(self, desired_N: np.ndarray) -> np.ndarray:
         """The command u (m,) each driver sends for the thrusts ``desired_N``."""
-        return np.array(
-            [c.command_for(np.array([f]))[0] for c, f in zip(self.curves, desired_N, strict=True)]
-        )
+        out = np.empty(len(self.curves))
+        for curve, index in self._groups:
+            out[index] = curve.command_for(desired_N[index])
+        return out
 
     def steady_thrust_N(self, command: np.ndarray) -> np.ndarray:
-        return np.array(
-            [c.thrust_N(np.array([u]))[0] for c, u in zip(self.curves, command, strict=True)]
-        )
+        out = np.empty(len(self.curves))
+        for curve, index in self._groups:
+            out[index] = curve.thrust_N(command[index])
+        return out
 
     def advance(self, command: np.ndarray) -> np.ndarray:
         """Hold ``command`` for one period: the mean thrust over it (m,) [N]; the state moves

@@ -11,6 +11,8 @@ command u of uvms-pin is (PWM - 1500 us) / 400 us, in [-1, 1].
 
 from __future__ import annotations
 
+from functools import cache
+
 import numpy as np
 
 from uvms_pin.model.thrust_curve import TabulatedThrustCurve
@@ -231,9 +233,11 @@ T200_16V_THRUST_KGF = np.array(
 )
 
 
+@cache
 def t200_16v_curve() -> TabulatedThrustCurve:
     """The T200's thrust [N] against the command u = (PWM - 1500) / 400, at 16 V:
-    5.25 kgf (51.5 N) forward and 4.07 kgf (39.9 N) reverse at full command."""
+    5.25 kgf (51.5 N) forward and 4.07 kgf (39.9 N) reverse at full command. One shared
+    (immutable) curve, so that a vehicle's T200s are evaluated together."""
     return TabulatedThrustCurve(
         (T200_16V_PWM_US - 1500.0) / 400.0,
         T200_16V_THRUST_KGF * STANDARD_GRAVITY_M_S2,
