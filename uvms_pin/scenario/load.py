@@ -101,6 +101,10 @@ def _build(raw: dict[str, Any], path: Path, top: Table) -> Scenario:
     integrator, backend = build_integrator(top.table_or_empty("integrator"))
     control_period = build_control_period(top.table_or_empty("control"))
     log_period = build_log_period(top.table_or_empty("output"))
+    if control_period is None and sensor_config.navigation.fitted:
+        raise top.error(
+            "sensors", "navigation sensors sample at the control ticks: set [control] period_s"
+        )
     controller = build_controller(top.table("controller"), uvms, path.parent)
     check_baselines(top.table("baselines"), (raw.get("controller") or {}).get("type"))
     top.finish()

@@ -78,3 +78,12 @@ def test_noise_is_seeded_and_the_table_names_the_columns():
     frame = one.to_dataframe()
     assert frame.attrs["units"]["imu_accel.fz_m_s2"] == "m_s2"
     assert "dvl.lock" in frame.columns and "usbl.age_s" in frame.columns
+
+
+def test_navigation_sensors_in_a_continuous_loop_are_refused_at_load(tmp_path):
+    from uvms_pin.errors import ScenarioError
+
+    with pytest.raises(ScenarioError, match=r"\[control\] period_s"):
+        load_scenario(
+            ROOT / "scenarios" / "passive_still_water.toml", {"sensors.depth": {"noise_Pa": 1.0}}
+        )
