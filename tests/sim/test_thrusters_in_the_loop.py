@@ -98,3 +98,13 @@ def test_the_table_names_each_thrusters_columns(run):
     frame = rollout.to_dataframe()
     assert frame.attrs["units"]["thrust.lagged_N"] == "N"
     assert "thruster_command.vertical" in frame.columns
+
+
+def test_a_limit_above_the_tabulated_curve_is_refused():
+    from uvms_pin.errors import ScenarioError
+
+    thruster = {**THRUSTERS[1], "max_forward_N": 60.0}
+    with pytest.raises(
+        ScenarioError, match=r"max_forward_N: 60.0 N is more than the t200_16v curve gives \(51.48"
+    ):
+        load_scenario(ROOT / SCENARIO, {"actuation.thruster": [thruster]})

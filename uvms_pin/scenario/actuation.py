@@ -56,6 +56,13 @@ def _thruster(t: Table, k: int) -> tuple[Thruster, ThrustCurve, float, float]:
     reverse = t.number(
         "max_reverse_N", table_curve.max_reverse_N if table_curve else None, nonneg=True
     )
+    if table_curve is not None:
+        for key, value, most in (
+            ("max_forward_N", forward, table_curve.max_forward_N),
+            ("max_reverse_N", reverse, table_curve.max_reverse_N),
+        ):
+            if value > most:
+                raise t.error(key, f"{value} N is more than the {kind} curve gives ({most:.6g} N)")
     try:
         thruster = Thruster(
             name=t.string("name", f"thruster{k}"),
