@@ -38,6 +38,21 @@ def mount_on_reference_vehicle(arm: str, tmp_dir: Path) -> up.UVMS:
     )
 
 
+def continuous_joint_urdf(
+    tmp_path: Path, joints=("arm_joint1", "arm_joint2", "arm_joint3", "arm_joint4")
+) -> Path:
+    """The reference URDF with ``joints`` made ``continuous`` (q then holds their cos and
+    sin, nq != nv; their <limit> stays, urdfdom reads only effort and velocity of it)."""
+    text = REFERENCE_URDF.read_text()
+    for name in joints:
+        old = f'<joint name="{name}" type="revolute">'
+        assert old in text, name
+        text = text.replace(old, f'<joint name="{name}" type="continuous">')
+    path = tmp_path / "continuous.urdf"
+    path.write_text(text)
+    return path
+
+
 def body_urdf(
     *,
     mass: float = 10.0,
@@ -100,15 +115,16 @@ def reference_uvms() -> up.UVMS:
 
 
 def random_configuration(uvms: up.UVMS, rng: np.random.Generator) -> np.ndarray:
-    """A random q: position in a 2 m box, uniform random orientation, joints within limits."""
-    model = uvms.model
+    """A random q: position in a 2 m box, uniform random orientation, joints within limits
+    (a continuous joint anywhere in [-pi, pi])."""
+    model, arm = uvms.model, uvms.arm_joints
     q = np.empty(model.nq)
     q[:3] = rng.uniform(-1.0, 1.0, 3)
     quat = rng.normal(size=4)
     q[3:7] = quat / np.linalg.norm(quat)
-    lo = np.maximum(model.lowerPositionLimit[7:], -np.pi)
-    hi = np.minimum(model.upperPositionLimit[7:], np.pi)
-    q[7:] = rng.uniform(lo, hi)
+    lo = np.maximum(arm.lower, -np.pi)
+    hi = np.minimum(arm.upper, np.pi)
+    q[7:] = arm.configuration(rng.uniform(lo, hi))
     return q
 
 

@@ -16,12 +16,13 @@ examples.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+import warnings
+from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any
 
-from uvms_pin.errors import ParameterError, ScenarioError, UvmsPinError
-from uvms_pin.model.resources import find_model, shipped_models
+from uvms_pin.errors import ParameterError, PlausibilityWarning, ScenarioError, UvmsPinError
+from uvms_pin.model.resources import resolve_model
 from uvms_pin.model.urdf.load import load_uvms
 from uvms_pin.model.uvms import UVMS
 from uvms_pin.scenario.actuation import build_actuation
@@ -82,7 +83,9 @@ def scenario_from_raw(
     except ScenarioError:
         raise
     except UvmsPinError as exc:
-        raise ScenarioError(f"{source}: {exc}") from exc
+        error = ScenarioError(f"{source}: {exc}")
+        error.user_traceback = exc.user_traceback
+        raise error from exc
 
 
 def _build(raw: dict[str, Any], path: Path, top: Table) -> Scenario:
@@ -105,7 +108,9 @@ def _build(raw: dict[str, Any], path: Path, top: Table) -> Scenario:
         raise top.error(
             "sensors", "navigation sensors sample at the control ticks: set [control] period_s"
         )
-    controller = build_controller(top.table("controller"), uvms, path.parent)
+    controller = replace(
+        build_controller(top.table("controller"), uvms, path.parent), from_file=True
+    )
     check_baselines(top.table("baselines"), (raw.get("controller") or {}).get("type"))
     top.finish()
     plant = Plant(
@@ -124,7 +129,7 @@ def _build(raw: dict[str, Any], path: Path, top: Table) -> Scenario:
         settings = SimulationSettings(
             head.duration_s, integrator, log_period, control_period, head.seed
         )
-        check_log_fits(settings, uvms.nq, uvms.nv)
+        check_log_fits(settings, uvms.nq, uvms.nv, plant.n_logged_hulls)
     except ParameterError as exc:
         raise ScenarioError(f"{top.source}: {exc}") from exc
     return Scenario(
@@ -138,7 +143,7 @@ def _head(t: Table, path: Path) -> Head:
         description=t.string("description", ""),
         model=t.string("model"),
         duration_s=t.number("duration_s", positive=True),
-        seed=t.integer("seed", 0),
+        seed=t.seed("seed", 0),
     )
     t.finish()
     return head
@@ -146,12 +151,10 @@ def _head(t: Table, path: Path) -> Head:
 
 def _model(head: Head, water: Water, path: Path, scenario: Table) -> UVMS:
     """The model ``[scenario] model`` names, in water of ``[water]``'s density."""
-    model_path = find_model(head.model, path.parent)
-    if model_path is None:
-        raise scenario.error(
-            "model",
-            f"'{head.model}' is neither a file relative to the scenario "
-            f"({path.parent.resolve() / head.model}) nor a shipped model "
-            f"({', '.join(shipped_models())})",
-        )
-    return load_uvms(model_path, water_density_kg_m3=water.density_kg_m3)
+    try:
+        model_path = resolve_model(head.model, path.parent)
+    except ParameterError as exc:
+        raise scenario.error("model", str(exc)) from None
+    with warnings.catch_warnings():  # the density was judged as [water] density_kg_m3
+        warnings.simplefilter("ignore", PlausibilityWarning)
+        return load_uvms(model_path, water_density_kg_m3=water.density_kg_m3)

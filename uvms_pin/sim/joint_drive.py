@@ -32,7 +32,7 @@ class LaggedJointTorques(Actuation):
         self._torque = np.zeros(tau.size)
         self._period_s: float | None = None
 
-    def start(self, period_s: float | None) -> None:
+    def start(self, period_s: float | None = None) -> None:
         if period_s is None and np.any(self.time_constant_s > 0.0):
             raise ParameterError("a joint torque lag needs a sampled loop: set [control] period_s")
         self.inner.start(period_s)
@@ -53,6 +53,9 @@ class LaggedJointTorques(Actuation):
 
     def saturated(self, tau_commanded: np.ndarray) -> bool:
         return self.inner.saturated(tau_commanded)
+
+    def dropped(self) -> str | None:
+        return self.inner.dropped()
 
     def signals(self) -> dict[str, np.ndarray]:
         return self.inner.signals()

@@ -89,6 +89,12 @@ class Plant:
         self._ee_data = self.uvms.model.createData()
         self.water = self._water()
 
+    @property
+    def n_logged_hulls(self) -> int:
+        """Wet fractions a run of this plant logs per sample (one per hull under a free
+        surface, none without)."""
+        return len(self.uvms.surface_bodies) if self.free_surface else 0
+
     def _water(self) -> FlowField | None:
         """The one flow the bodies see: the uniform current and ``flow`` (None: still water)."""
         fields = [UniformCurrent(self.current_world_m_s)] if np.any(self.current_world_m_s) else []

@@ -41,6 +41,8 @@ class ControllerSpec:
     type: str
     params: dict[str, Any] = field(default_factory=dict)
     build: ControllerFactory = field(default=None, repr=False)
+    #: built from the scenario file's [controller] table (its ``raw`` then records it)
+    from_file: bool = field(default=False, compare=False)
 
     def __call__(self, uvms: UVMS) -> Controller:
         return self.build(uvms)
@@ -109,12 +111,13 @@ def _simulate(scenario: Scenario, observers: list[Observer]) -> Rollout:
         scenario.uvms.model, scenario.sensor_config, settings.duration_s, settings.seed
     )
     controller = scenario.controller_factory(scenario.uvms)
+    record = controller_record(scenario.controller_factory, controller)
     metadata = {
         "scenario": scenario.name,
         "scenario_path": str(scenario.path),
         "description": scenario.description,
-        "parameters": scenario.raw,
-        "controller": controller_record(scenario.controller_factory, controller),
+        "parameters": recorded_parameters(scenario, record),
+        "controller": record,
     }
     return simulate_closed_loop(
         scenario.plant,
@@ -135,11 +138,39 @@ def class_path(controller: object) -> str:
 
 
 def controller_record(factory: ControllerFactory, controller: Controller) -> dict[str, Any]:
-    """What ran: the class of ``controller`` (``module:QualifiedName``) and, when the
-    factory is a `ControllerSpec`, its type and parameters (else None: unknown)."""
-    spec = factory if isinstance(factory, ControllerSpec) else None
+    """What ran: the class of ``controller`` (``module:QualifiedName``), its type and its
+    parameters: a `ControllerSpec`'s, else the class path (what a scenario's ``type`` would
+    name) and the controller's public numbers, strings and small arrays (`public_parameters`)."""
+    if isinstance(factory, ControllerSpec):
+        return {"class": class_path(controller), "type": factory.type, "params": factory.params}
     return {
         "class": class_path(controller),
-        "type": None if spec is None else spec.type,
-        "params": None if spec is None else spec.params,
+        "type": class_path(controller),
+        "params": public_parameters(controller),
     }
+
+
+def public_parameters(controller: object) -> dict[str, Any]:
+    """The controller's public attributes that are numbers, strings, booleans or numeric
+    arrays of at most 64 entries (as lists): what can be recorded of a controller built in
+    code."""
+    out: dict[str, Any] = {}
+    for name, value in vars(controller).items():
+        if name.startswith("_"):
+            continue
+        if isinstance(value, bool | int | float | str):
+            out[name] = value
+        elif isinstance(value, np.ndarray) and value.dtype.kind in "biuf" and value.size <= 64:
+            out[name] = value.tolist()
+    return out
+
+
+def recorded_parameters(scenario: Scenario, record: dict[str, Any]) -> dict[str, Any]:
+    """The scenario's parameters as they ran: its ``raw`` document, whose [controller] table
+    says what the run's controller is when it was not built from that table (a
+    ``controller_factory`` set in code)."""
+    factory = scenario.controller_factory
+    if isinstance(factory, ControllerSpec) and factory.from_file:
+        return scenario.raw
+    table = {"type": record["type"], "set_in_code": True, **(record["params"] or {})}
+    return {**scenario.raw, "controller": table}

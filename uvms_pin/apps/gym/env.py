@@ -21,6 +21,7 @@ from typing import Any, ClassVar
 
 import gymnasium as gym
 import numpy as np
+import pinocchio as pin
 
 from uvms_pin.apps.gym.actions import action_scale as make_action_scale
 from uvms_pin.control.measurement import Measurement
@@ -129,6 +130,7 @@ class UvmsEnv(gym.Env):
         self._contact = np.zeros(6)
         self._anchor: np.ndarray | None = None
         self._render_data = uvms.model.createData()
+        self._vehicle_box = None  # (centre, size) [m], found on the first render
         self._flow_seed = self.scenario.settings.seed
 
     # -- to be given by a task environment ---------------------------------------------
@@ -202,12 +204,15 @@ class UvmsEnv(gym.Env):
     def render(self):
         if self.render_mode != "rgb_array":
             return None
-        from uvms_pin.apps.gym.render import side_view_rgb
+        from uvms_pin.apps.gym.render import side_view_rgb, vehicle_box
 
+        if self._vehicle_box is None:
+            self._vehicle_box = vehicle_box(self.scenario.uvms)
         loop = self._loop
         return side_view_rgb(
-            self.scenario.uvms, self._render_data, loop.q, loop.time_s, self._anchor
-        )
+            self.scenario.uvms, self._render_data, loop.q, loop.time_s, self._anchor,
+            box=self._vehicle_box,
+        )  # fmt: skip
 
     # -- replay export -------------------------------------------------------------------
     def episode_rollout(self) -> Rollout:
@@ -258,9 +263,13 @@ class UvmsEnv(gym.Env):
         rng = np.random.default_rng(
             np.random.SeedSequence(episode_seed, spawn_key=(_PERTURBATION_STREAM,))
         )
+        uvms = self.scenario.uvms
         q0 = self.scenario.q0.copy()
         q0[:3] += rng.uniform(-1.0, 1.0, 3) * self.initial_position_noise_m
-        q0[7:] += rng.uniform(-1.0, 1.0, q0.size - 7) * self.initial_joint_noise_rad
+        # each arm joint moved by its own angle (a continuous joint's q is (cos, sin))
+        dq = np.zeros(uvms.nv)
+        dq[6:] = rng.uniform(-1.0, 1.0, uvms.nv - 6) * self.initial_joint_noise_rad
+        q0[7:] = pin.integrate(uvms.model, q0, dq)[7:]
         return q0, self.scenario.v0.copy()
 
     def _reseed_flow(self, episode_seed: int) -> None:
