@@ -47,6 +47,9 @@ def build_actuation(t: Table | None, uvms: UVMS) -> Actuation:
 
 def _thruster(t: Table, k: int) -> tuple[Thruster, ThrustCurve, float, float]:
     """(the thruster, its curve, its time constant [s], its rate limit [N/s])."""
+    name = t.string("name", f"thruster{k}")
+    position = t.vector("position_body_m", 3)
+    direction = t.vector("direction_body", 3)
     kind = t.string("curve", "linear", CURVES)
     table_curve = t200_16v_curve() if kind == "t200_16v" else None
     # a tabulated curve brings its own limits; lower ones may be given
@@ -65,9 +68,9 @@ def _thruster(t: Table, k: int) -> tuple[Thruster, ThrustCurve, float, float]:
                 raise t.error(key, f"{value} N is more than the {kind} curve gives ({most:.6g} N)")
     try:
         thruster = Thruster(
-            name=t.string("name", f"thruster{k}"),
-            position_body_m=t.vector("position_body_m", 3),
-            direction_body=t.vector("direction_body", 3),
+            name=name,
+            position_body_m=position,
+            direction_body=direction,
             max_forward_N=forward,
             max_reverse_N=reverse,
         )
