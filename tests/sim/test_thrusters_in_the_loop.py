@@ -108,3 +108,20 @@ def test_a_limit_above_the_tabulated_curve_is_refused():
         ScenarioError, match=r"max_forward_N: 60.0 N is more than the t200_16v curve gives \(51.48"
     ):
         load_scenario(ROOT / SCENARIO, {"actuation.thruster": [thruster]})
+
+
+def test_each_drive_key_of_an_entry_can_be_overridden():
+    """``--set 'actuation.thruster[i].key=...'`` and study paths of the same form."""
+    scenario = load_scenario(
+        ROOT / SCENARIO,
+        {
+            "actuation.thruster[0].time_constant_s": 0.05,
+            "actuation.thruster[1].curve": "quadratic",
+            "actuation.thruster[1].deadband": 0.1,
+            "actuation.thruster[2].rate_limit_N_s": 100.0,
+        },
+    )
+    drives = scenario.plant.actuation.drives
+    np.testing.assert_array_equal(drives.time_constant_s, [0.05, 0.0, 0.0, 0.0])
+    np.testing.assert_array_equal(drives.rate_limit_N_s, [np.inf, np.inf, 100.0, np.inf])
+    assert drives.curves[1].deadband == 0.1
