@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import os
 import shutil
 import subprocess
 import sys
@@ -14,6 +15,9 @@ import pytest
 import uvms_pin as up
 
 ROOT = Path(__file__).resolve().parents[1]
+# the tests check full-length runs: a cap on durations in the developer's shell (README:
+# UVMS_PIN_MAX_DURATION_S) does not apply to them (the doc test sets its own per snippet)
+os.environ.pop("UVMS_PIN_MAX_DURATION_S", None)
 REFERENCE_URDF = ROOT / "models" / "uvms_lbv150.urdf"
 RHO = 1025.0
 G = 9.81
@@ -130,6 +134,18 @@ def random_configuration(uvms: up.UVMS, rng: np.random.Generator) -> np.ndarray:
 
 def free_body_state(uvms: up.UVMS) -> np.ndarray:
     return pin.neutral(uvms.model)
+
+
+# ---- the documentation's snippets (tests/test_docs_run.py): what ran, what was skipped
+DOCS_RUN_SUMMARY = pytest.StashKey[list]()
+
+
+def pytest_terminal_summary(terminalreporter, exitstatus, config):
+    lines = config.stash.get(DOCS_RUN_SUMMARY, None)
+    if lines:
+        terminalreporter.section("documentation snippets")
+        for line in lines:
+            terminalreporter.write_line(line)
 
 
 # ---- the command line as a user runs it, and relative comparisons (used across folders)

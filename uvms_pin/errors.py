@@ -62,6 +62,11 @@ class ModelWarning(UvmsPinWarning):
     """
 
 
+class ShortenedRunWarning(UvmsPinWarning):
+    """A scenario runs shorter than its ``duration_s`` because ``UVMS_PIN_MAX_DURATION_S``
+    is set (`uvms_pin.sim.shortened`); the message names the file and both durations."""
+
+
 class PlausibilityWarning(UvmsPinWarning):
     """A value far outside what any vehicle, water or sea has (a volume in litres, a period
     in milliseconds?): the message names it, gives the number and the usual range. A value

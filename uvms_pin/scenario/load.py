@@ -38,7 +38,7 @@ from uvms_pin.scenario.toml import read_toml
 from uvms_pin.scenario.water import Water, build_water
 from uvms_pin.scenario.world import build_disturbance, build_environment
 from uvms_pin.sim.plant import Plant
-from uvms_pin.sim.run import Scenario
+from uvms_pin.sim.run import Scenario, shortened
 from uvms_pin.sim.settings import SimulationSettings, check_log_fits
 
 
@@ -62,6 +62,9 @@ def load_scenario(path: str | Path, overrides: dict[str, Any] | None = None) -> 
             ``{"environment.stiffness_N_m": [20, 20, 20], "initial.joint_positions_rad[3]":
             0.5}`` (`uvms_pin.scenario.overrides`).
 
+    With the environment variable ``UVMS_PIN_MAX_DURATION_S`` set, a longer scenario is
+    shortened to it, with a warning (`uvms_pin.sim.shortened`).
+
     Raises:
         ScenarioError: naming the file and the key, or the override that set a bad value.
     """
@@ -79,7 +82,7 @@ def scenario_from_raw(
     raw = apply_overrides(raw, overrides)
     overridden = {parse_key_path(text).key: text for text in overrides or {}}
     try:
-        return _build(raw, path, Table(raw, "", source, overridden))
+        return shortened(_build(raw, path, Table(raw, "", source, overridden)))
     except ScenarioError:
         raise
     except UvmsPinError as exc:

@@ -7,7 +7,9 @@ sensors, runs the closed loop and returns the rollout.
 
 from __future__ import annotations
 
-from collections.abc import Callable, Sequence
+import dataclasses
+import warnings
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -15,6 +17,7 @@ from typing import Any
 import numpy as np
 
 from uvms_pin.control.base import Controller
+from uvms_pin.errors import ShortenedRunWarning
 from uvms_pin.model.uvms import UVMS
 from uvms_pin.results.progress import Progress, callback_or_none, progress_printer
 from uvms_pin.results.rollout import Rollout
@@ -23,6 +26,7 @@ from uvms_pin.sim.plant import Plant
 from uvms_pin.sim.sample import Observer, ProgressReport
 from uvms_pin.sim.sensors import SensorConfig, SensorSuite
 from uvms_pin.sim.settings import SimulationSettings
+from uvms_pin.sim.shortened import max_duration_s, shortened_duration_s, shortened_message
 
 ControllerFactory = Callable[[UVMS], Controller]
 
@@ -61,6 +65,8 @@ class Scenario:
             `ControllerSpec` records its type and parameters in the rollout).
         sensor_config: noise of the measurements.
         q0, v0: initial state. settings: integrator, periods, duration, seed.
+        shortened_from_s: the scenario's own duration [s] when ``UVMS_PIN_MAX_DURATION_S``
+            shortened this run (`shortened`), else None.
     """
 
     name: str
@@ -73,6 +79,7 @@ class Scenario:
     q0: np.ndarray
     v0: np.ndarray
     settings: SimulationSettings
+    shortened_from_s: float | None = None
 
     @property
     def uvms(self) -> UVMS:
@@ -94,8 +101,10 @@ def simulate(
     a live view.
 
     Raises FunnelViolation / SimulationError with the partial rollout attached as
-    ``exc.rollout`` (see `uvms_pin.sim.closed_loop.ClosedLoop.run`).
+    ``exc.rollout`` (see `uvms_pin.sim.closed_loop.ClosedLoop.run`). With
+    ``UVMS_PIN_MAX_DURATION_S`` set, the run is shortened, and says so (`shortened`).
     """
+    scenario = shortened(scenario)
     duration_s = scenario.settings.duration_s
     if progress is True:
         with progress_printer(scenario.name, duration_s) as printer:
@@ -119,6 +128,8 @@ def _simulate(scenario: Scenario, observers: list[Observer]) -> Rollout:
         "parameters": recorded_parameters(scenario, record),
         "controller": record,
     }
+    if scenario.shortened_from_s is not None:
+        metadata["shortened_from_s"] = scenario.shortened_from_s
     return simulate_closed_loop(
         scenario.plant,
         controller,
@@ -148,6 +159,38 @@ def controller_record(factory: ControllerFactory, controller: Controller) -> dic
         "type": class_path(controller),
         "params": public_parameters(controller),
     }
+
+
+def shortened(scenario: Scenario, environ: Mapping[str, str] | None = None) -> Scenario:
+    """``scenario``, or a copy shortened to the cap ``UVMS_PIN_MAX_DURATION_S`` sets in
+    ``environ`` (default: the process's environment; `uvms_pin.sim.shortened`).
+
+    A shortened copy has the new duration in its settings and parameters, its own duration
+    in ``shortened_from_s``, and a `ShortenedRunWarning` says so. A scenario that is not
+    longer than the cap comes back unchanged, without a warning.
+
+    Raises:
+        ParameterError: the variable holds no positive number.
+    """
+    cap_s = max_duration_s(environ)
+    settings = scenario.settings
+    if cap_s is None:
+        return scenario
+    duration_s = shortened_duration_s(settings.duration_s, settings.log_period_s, cap_s)
+    if duration_s is None:
+        return scenario
+    own_s = scenario.shortened_from_s or settings.duration_s
+    warnings.warn(
+        ShortenedRunWarning(shortened_message(str(scenario.path), own_s, duration_s, cap_s)),
+        stacklevel=2,
+    )
+    head = {**scenario.raw.get("scenario", {}), "duration_s": duration_s}
+    return dataclasses.replace(
+        scenario,
+        raw={**scenario.raw, "scenario": head},
+        settings=dataclasses.replace(settings, duration_s=duration_s),
+        shortened_from_s=own_s,
+    )
 
 
 def public_parameters(controller: object) -> dict[str, Any]:

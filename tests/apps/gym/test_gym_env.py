@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import importlib.util
+import re
 
 import gymnasium as gym
 import numpy as np
@@ -198,6 +199,28 @@ def test_render_and_replay_export(tmp_path):
 def test_bad_options_are_clear_errors(kw, match):
     with pytest.raises(ParameterError, match=match):
         gym.make(FORCE, **kw)
+
+
+def test_the_continuous_control_advice_works_as_given():
+    """The refusal of a continuous-control scenario names a control period and, for one
+    without actuation limits, action_scale: doing exactly that gives a working env."""
+    with pytest.raises(ParameterError) as refused:
+        gym.make(FORCE, scenario="paper_force_tracking")
+    message = str(refused.value)
+    period = re.search(r'overrides=\{"control\.period_s": ([0-9.e-]+)\}', message)
+    assert period and "action_scale=<10 numbers" in message, message
+    env = gym.make(
+        FORCE,
+        scenario="paper_force_tracking",
+        overrides={"control.period_s": float(period.group(1))},
+        action_scale=np.full(10, 5.0),
+    )
+    env.reset(seed=0)
+    _, _, terminated, truncated, info = env.step(np.zeros(10))
+    assert not (terminated or truncated) and info["time_s"] == pytest.approx(0.005)
+    with pytest.raises(ParameterError) as refused:
+        gym.make(FORCE, scenario="paper_force_tracking", action_scale=np.full(10, 5.0))
+    assert "action_scale" not in str(refused.value)  # given already: not asked again
 
 
 def test_force_tracking_needs_a_contact_environment():

@@ -168,6 +168,16 @@ def _write_failure(exc: OSError, out: Path, written: list[str]) -> str:
     return f"uvms-pin: error: cannot write {where}: {exc.strerror or exc}; {kept}"
 
 
+def _shortened_note(rollout: Rollout) -> str:
+    """What the run line adds for a run `UVMS_PIN_MAX_DURATION_S` shortened."""
+    own_s = rollout.metadata.get("shortened_from_s")
+    if own_s is None:
+        return ""
+    from uvms_pin.sim.shortened import MAX_DURATION_ENV
+
+    return f", SHORTENED from {own_s:g} s by {MAX_DURATION_ENV}"
+
+
 def _report(name: str, ending: Ending, out: Path, written: list[str]) -> None:
     """The run's line (status, simulated and wall time) and the files written."""
     rollout = ending.rollout
@@ -175,7 +185,7 @@ def _report(name: str, ending: Ending, out: Path, written: list[str]) -> None:
     print(
         f"scenario {name}: {rollout.metadata['status']}, simulated "
         f"{metrics['simulated_time_s']:.3f} s in {metrics['wall_time_s']:.2f} s "
-        f"(real-time factor {metrics['real_time_factor']:.2f})"
+        f"(real-time factor {metrics['real_time_factor']:.2f})" + _shortened_note(rollout)
     )
     if not written:
         return

@@ -39,6 +39,30 @@ from uvms_pin.sim.sensors import SensorSuite
 _PERTURBATION_STREAM = 1 << 16
 
 
+def _continuous_control_message(scenario: Scenario, action_scale: Any) -> str:
+    """Why a continuous-control scenario is refused, and the options that make it run: a
+    control period that divides the log period (the log period itself does), and
+    ``action_scale`` when the scenario has no actuation limits to normalize by."""
+    log_period_s = scenario.settings.log_period_s
+    fix = f'overrides={{"control.period_s": {log_period_s:g}}}'
+    try:
+        make_action_scale(scenario.plant.actuation, scenario.uvms.nv, action_scale)
+    except ParameterError:
+        fix += f", action_scale=<{scenario.uvms.nv} numbers [N, N m]> (no [actuation] limits)"
+    return (
+        f"{scenario.path}: the environment steps one control period at a time, and the "
+        "scenario's control is continuous: give it a control period that divides "
+        f"output.log_period_s = {log_period_s:g} s, e.g. {fix}"
+    )
+
+
+def _shortened_record(scenario: Scenario) -> dict[str, Any]:
+    """``{"shortened_from_s": T}`` for a scenario UVMS_PIN_MAX_DURATION_S shortened."""
+    if scenario.shortened_from_s is None:
+        return {}
+    return {"shortened_from_s": scenario.shortened_from_s}
+
+
 def _episode_seed(np_random: np.random.Generator) -> int:
     return int(np_random.integers(0, 2**31 - 1))
 
@@ -102,11 +126,7 @@ class UvmsEnv(gym.Env):
             self.overrides["scenario.model"] = model
         self.scenario = load_scenario(self.scenario_path, self.overrides)
         if self.scenario.settings.control_period_s is None:
-            raise ParameterError(
-                f"{self.scenario_path}: the environment steps one control period at a time, "
-                "and the scenario's control is continuous: set control.period_s "
-                '(overrides={"control.period_s": 0.002})'
-            )
+            raise ParameterError(_continuous_control_message(self.scenario, action_scale))
         self._loop = ClosedLoop(self.scenario.plant, self.scenario.settings)
         uvms = self.scenario.uvms
         self.action_scale = make_action_scale(self.scenario.plant.actuation, uvms.nv, action_scale)
@@ -253,7 +273,7 @@ class UvmsEnv(gym.Env):
             "seed": self.episode_seed,
             "log_period_s": settings.control_period_s,
             "world": scenario.plant.record(),
-        }
+        } | _shortened_record(scenario)
 
     # -- helpers -------------------------------------------------------------------------
     def _observation(self) -> np.ndarray:
