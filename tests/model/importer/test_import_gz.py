@@ -108,3 +108,11 @@ def test_a_joint_with_its_own_pose_is_refused(tmp_path):
     source.write_text(text)
     with pytest.raises(ModelError, match="horizontal_fins_joint"):
         import_model(source)
+
+
+def test_notes_about_the_removed_propeller_joint_are_dropped(imported):
+    result, _ = imported
+    assert not any(n.startswith("joint 'propeller_joint':") for n in result.not_mapped)
+    assert any(
+        n.startswith("joint 'vertical_fins_joint': effort limit -1") for n in result.not_mapped
+    )

@@ -174,6 +174,8 @@ def _drop_thruster_links(robot: ET.Element, plugins: list[ET.Element], notes: li
             raise ModelError(f"thruster link '{link}' carries other links; cannot remove it")
         robot.remove(links[link])
         robot.remove(by_child[link])
+        # what was said of the removed joint no longer applies to the written model
+        notes[:] = [n for n in notes if not n.startswith(f"joint '{by_child[link].get('name')}':")]
         notes.append(
             f"thruster link '{link}' ({_mass(links[link]):g} kg) and joint "
             f"'{by_child[link].get('name')}' removed from the tree: the thruster is in the "
