@@ -93,6 +93,7 @@ _VARIANTS = [
         "passive_still_water.toml",
         {
             "control.period_s": 0.002,
+            "joints.use_model_friction": True,
             "joints.viscous_Nms": [0.1, 0.1, 0.1, 0.1],
             "joints.coulomb_Nm": [0.05, 0.05, 0.05, 0.05],
             "joints.coulomb_velocity_rad_s": 0.02,

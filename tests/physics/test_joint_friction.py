@@ -87,3 +87,22 @@ def test_bad_friction_is_refused(b, c, s, match):
 def test_friction_for_the_wrong_number_of_joints_is_refused(uvms):
     with pytest.raises(ParameterError, match="joint friction for 1 joints"):
         Plant(uvms, joint_friction=JointFriction(np.ones(1), np.ones(1), np.ones(1)))
+
+
+def test_the_urdfs_dynamics_friction_is_used_only_when_asked(tmp_path):
+    from conftest import ROOT
+
+    from uvms_pin.scenario.load import load_scenario
+
+    text = REFERENCE_URDF.read_text()
+    marked = text.replace("</joint>", '<dynamics damping="0.5" friction="0.2"/></joint>')
+    (tmp_path / "model.urdf").write_text(marked)
+    scenario = (ROOT / "scenarios" / "passive_still_water.toml").read_text()
+    scenario = scenario.replace('model = "uvms_lbv150"', 'model = "model.urdf"')
+    (tmp_path / "run.toml").write_text(scenario)
+    assert load_scenario(tmp_path / "run.toml").plant.joint_friction is None
+    friction = load_scenario(
+        tmp_path / "run.toml", {"joints.use_model_friction": True}
+    ).plant.joint_friction
+    np.testing.assert_array_equal(friction.viscous_Nms, [0.5] * 4)
+    np.testing.assert_array_equal(friction.coulomb_Nm, [0.2] * 4)

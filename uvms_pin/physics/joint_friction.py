@@ -5,8 +5,9 @@
 b [N m s/rad] viscous, c [N m] Coulomb, s [rad/s] the velocity over which the Coulomb term
 rises to c (tanh keeps it smooth for the integrators). Its power tau_f . v <= 0 for every v
 (dissipative). A generalized force on the joints, added to tau inside the plant's dynamics
-(compiled: src/uvms_core/joint_friction.hpp); in a URDF it is ``<dynamics damping="b"
-friction="c"/>`` of each joint (Pinocchio's ``model.damping``, ``model.friction``).
+(compiled: src/uvms_core/joint_friction.hpp). A scenario gives b and c in ``[joints]``, or
+takes a URDF's ``<dynamics damping="b" friction="c"/>`` (Pinocchio's ``model.damping``,
+``model.friction``) with ``joints.use_model_friction``.
 """
 
 from __future__ import annotations

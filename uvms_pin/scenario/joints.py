@@ -1,6 +1,6 @@
 """``[joints]``: the arm's joint drives: friction (viscous, regularized Coulomb) and the
-torque bandwidth. Without the table, friction is the model's (URDF ``<dynamics damping
-friction>``, zero when absent) and the torque follows its command at once."""
+torque bandwidth. Without the table there is no friction (``use_model_friction = true``
+takes the URDF's ``<dynamics damping friction>``) and the torque follows its command at once."""
 
 from __future__ import annotations
 
@@ -20,8 +20,14 @@ def build_joint_friction(t: Table, uvms: UVMS) -> JointFriction | None:
     if n == 0:
         return None
     model = uvms.model
-    viscous = t.vector("viscous_Nms", n, model.damping[6:].copy(), nonneg=True)
-    coulomb = t.vector("coulomb_Nm", n, model.friction[6:].copy(), nonneg=True)
+    # opt-in: arm files often carry <dynamics> values tuned for another simulator
+    from_model = t.boolean("use_model_friction", False)
+    viscous = t.vector(
+        "viscous_Nms", n, model.damping[6:].copy() if from_model else np.zeros(n), nonneg=True
+    )
+    coulomb = t.vector(
+        "coulomb_Nm", n, model.friction[6:].copy() if from_model else np.zeros(n), nonneg=True
+    )
     scale = t.number("coulomb_velocity_rad_s", DEFAULT_COULOMB_VELOCITY_RAD_S, positive=True)
     try:
         friction = JointFriction(viscous, coulomb, np.full(n, scale))
