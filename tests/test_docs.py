@@ -22,6 +22,23 @@ SCENARIOS = ROOT / "scenarios"
 _VARIANTS = [
     ("paper_force_tracking.toml", {}),
     ("realistic_force_tracking.toml", {}),
+    (
+        "realistic_force_tracking.toml",
+        {
+            "actuation.thruster": [
+                {
+                    "position_body_m": [0.0, 0.0, 0.0],
+                    "direction_body": [1.0, 0.0, 0.0],
+                    "curve": "quadratic",
+                    "max_forward_N": 20.0,
+                    "max_reverse_N": 15.0,
+                    "deadband": 0.05,
+                    "time_constant_s": 0.05,
+                    "rate_limit_N_s": 200.0,
+                }
+            ]
+        },
+    ),
     ("passive_still_water.toml", {"controller.type": "pi_force"}),
     ("passive_still_water.toml", {"controller.type": "impedance"}),
     (
@@ -72,6 +89,37 @@ _VARIANTS = [
                 "velocity_world_m_s": [0.2, 0, 0],
                 "depths_m": [0, 10],
                 "factors": [1, 0.5],
+            },
+        },
+    ),
+    (
+        "passive_still_water.toml",
+        {
+            "control.period_s": 0.002,
+            "joints.use_model_friction": True,
+            "joints.viscous_Nms": [0.1, 0.1, 0.1, 0.1],
+            "joints.coulomb_Nm": [0.05, 0.05, 0.05, 0.05],
+            "joints.coulomb_velocity_rad_s": 0.02,
+            "joints.torque_time_constant_s": [0.01, 0.01, 0.01, 0.01],
+            "sensors.imu": {
+                "gyro_noise_rad_s_rthz": 1e-3,
+                "gyro_bias_walk_rad_s2_rthz": 1e-5,
+                "accel_noise_m_s2_rthz": 1e-2,
+                "accel_bias_walk_m_s3_rthz": 1e-4,
+            },
+            "sensors.depth": {"noise_Pa": 50.0},
+            "sensors.dvl": {
+                "noise_m_s": 0.01,
+                "min_altitude_m": 0.3,
+                "max_altitude_m": 50.0,
+                "dropout_probability": 0.05,
+                "seabed_depth_m": 30.0,
+            },
+            "sensors.usbl": {
+                "noise_m": 0.1,
+                "period_s": 1.0,
+                "latency_s": 0.5,
+                "dropout_probability": 0.1,
             },
         },
     ),

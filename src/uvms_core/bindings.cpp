@@ -306,6 +306,12 @@ void bind_environment(nb::module_& m) {
       .def_rw("amplitude", &uvms::SinusoidalDisturbance::amplitude)
       .def_rw("period_s", &uvms::SinusoidalDisturbance::period_s)
       .def_rw("phase_rad", &uvms::SinusoidalDisturbance::phase_rad);
+  nb::class_<uvms::JointFriction>(
+      m, "JointFriction", "-(b v + c tanh(v / s)) on each arm joint (joint_friction.hpp).")
+      .def(nb::init<>())
+      .def_rw("viscous_Nms", &uvms::JointFriction::viscous_Nms)
+      .def_rw("coulomb_Nm", &uvms::JointFriction::coulomb_Nm)
+      .def_rw("velocity_scale_rad_s", &uvms::JointFriction::velocity_scale_rad_s);
   nb::enum_<uvms::Method>(m, "Method", "A fixed-step method (integrators.hpp).")
       .value("rk4", uvms::Method::rk4)
       .value("semi_implicit_euler", uvms::Method::semi_implicit_euler);
@@ -325,6 +331,7 @@ void bind_plant(nb::module_& m) {
       .def_rw("free_surface", &Plant::free_surface)
       .def_rw("contact", &Plant::contact)
       .def_rw("disturbance", &Plant::disturbance)
+      .def_rw("joint_friction", &Plant::joint_friction)
       .def(
           "contact_wrench",
           [](Plant& p, nb::handle q_obj, nb::handle v_obj) -> Eigen::VectorXd {

@@ -1,6 +1,7 @@
 // The simulated world (mirror of uvms_pin/sim/plant.py): a UVMS in a flow, touching a compliant
 // environment at its end-effector and pushed by a disturbance:
-//   M zeta_dot + h + J_c^T lambda + [delta; 0] = tau.
+//   M zeta_dot + h + J_c^T lambda + [delta; 0] = tau + [0; tau_f(v)],
+// tau_f the friction of the arm's joint drives (joint_friction.hpp).
 // It advances the plant over one control period with the input held, in one call.
 #pragma once
 
@@ -10,6 +11,7 @@
 #include "disturbance.hpp"
 #include "dynamics.hpp"
 #include "integrators.hpp"
+#include "joint_friction.hpp"
 
 namespace uvms {
 
@@ -23,6 +25,7 @@ class Plant {
   bool free_surface = false;  // the bodies are cut by the flow's free surface
   Contact contact;
   Disturbance disturbance;
+  JointFriction joint_friction;
 
   // lambda at (q, v): what the end-effector exerts on the environment [N; N m], world axes.
   Vec6 contact_wrench(const ConstVec& q, const ConstVec& v);
@@ -46,6 +49,7 @@ class Plant {
   pinocchio::FrameIndex ee_frame_id_;
   pinocchio::JointIndex ee_joint_id_;
   ManifoldStepper stepper_;
+  Eigen::VectorXd tau_with_friction_;
 };
 
 }  // namespace uvms

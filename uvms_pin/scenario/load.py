@@ -31,6 +31,7 @@ from uvms_pin.scenario.baselines import check_baselines
 from uvms_pin.scenario.controller import build_controller
 from uvms_pin.scenario.initial import build_initial_state
 from uvms_pin.scenario.metrics import build_metrics
+from uvms_pin.scenario.joints import build_joint_friction, with_joint_lag
 from uvms_pin.scenario.overrides import apply_overrides, parse_key_path
 from uvms_pin.scenario.schema import Table
 from uvms_pin.scenario.sensors import build_sensors
@@ -102,11 +103,18 @@ def _build(raw: dict[str, Any], path: Path, top: Table) -> Scenario:
     task = build_task(top.table("task"), uvms, q0)
     contact = build_environment(top.table("environment"), uvms)
     disturbance = build_disturbance(top.table("disturbance"))
-    actuation = build_actuation(top.table("actuation"), uvms)
-    sensor_config = build_sensors(top.table_or_empty("sensors"))
+    joints = top.table_or_empty("joints")
+    friction = build_joint_friction(joints, uvms)
+    actuation = with_joint_lag(joints, build_actuation(top.table("actuation"), uvms), uvms)
+    joints.finish()
+    sensor_config = build_sensors(top.table_or_empty("sensors"), water.density_kg_m3)
     integrator, backend = build_integrator(top.table_or_empty("integrator"))
     control_period = build_control_period(top.table_or_empty("control"))
     log_period = build_log_period(top.table_or_empty("output"))
+    if control_period is None and sensor_config.navigation.fitted:
+        raise top.error(
+            "sensors", "navigation sensors sample at the control ticks: set [control] period_s"
+        )
     controller = replace(
         build_controller(top.table("controller"), uvms, path.parent, task, actuation),
         from_file=True,
@@ -124,6 +132,7 @@ def _build(raw: dict[str, Any], path: Path, top: Table) -> Scenario:
         backend,
         free_surface=water.free_surface,
         stop_at_surface=water.stop_at_surface,
+        joint_friction=friction,
     )
     try:
         settings = SimulationSettings(

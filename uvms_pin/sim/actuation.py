@@ -6,6 +6,12 @@ each thruster's position r_i and unit direction d_i in the body frame, column
 is clipped to its limits, and B f is applied: directions no thruster can push (e.g. an
 LBV150's roll and pitch) are simply not applied. Arm torques are clipped to the joints'
 effort limits. `Unlimited` applies the command as it is (the paper's assumption).
+
+Each thruster is a drive (`uvms_pin.sim.thruster_drive`): its driver sends the command u on
+its thrust curve that gives the allocated thrust, and the thrust follows with first-order
+dynamics and a rate limit; by default the curve is linear up to the limits and the lag is
+none, so the allocated thrust is applied at once. The commands and thrusts are logged as the
+signals ``thruster_command`` (u, dimensionless) and ``thrust`` (N), a column per thruster.
 """
 
 from __future__ import annotations
@@ -16,7 +22,9 @@ from collections.abc import Sequence
 import numpy as np
 
 from uvms_pin.errors import ParameterError
+from uvms_pin.model.thrust_curve import TabulatedThrustCurve
 from uvms_pin.model.thruster import Thruster
+from uvms_pin.sim.thruster_drive import ThrusterDrives
 
 
 class Actuation(ABC):
@@ -30,13 +38,22 @@ class Actuation(ABC):
         """True when an actuator cannot give what the command asks."""
         return False
 
-    def start(self) -> None:  # noqa: B027 - optional hook
-        """A run starts: forget what earlier runs dropped."""
+    def start(self, period_s: float | None = None) -> None:  # noqa: B027 - optional hook
+        """A run starts: actuator states to rest, and what earlier runs dropped forgotten;
+        ``period_s`` the control period (None: the controller is evaluated continuously)."""
 
     def dropped(self) -> str | None:
         """What the run so far asked that the actuators cannot produce at all (not a
         saturation: a direction), for a warning; None if nothing."""
         return None
+
+    def signals(self) -> dict[str, np.ndarray]:
+        """The actuators' signals after the last `apply`, by name."""
+        return {}
+
+    def signal_columns(self) -> dict[str, list[tuple[str, str]]]:
+        """Per signal of `signals`: (column name, unit suffix) of each entry."""
+        return {}
 
 
 class Unlimited(Actuation):
@@ -58,6 +75,8 @@ class ThrustersAndJointLimits(Actuation):
             others are ignored (e.g. the roll and pitch of a vehicle whose thrusters cannot
             produce them on purpose). The applied wrench is always B f, side effects
             included. Default: all six.
+        drives: the thrusters' curves and dynamics (default: linear curves to the limits,
+            no lag).
     """
 
     def __init__(
@@ -65,6 +84,7 @@ class ThrustersAndJointLimits(Actuation):
         thrusters: Sequence[Thruster],
         joint_effort_limits_Nm: np.ndarray | None,
         allocated_components: Sequence[int] = (0, 1, 2, 3, 4, 5),
+        drives: ThrusterDrives | None = None,
     ):
         if not thrusters:
             raise ParameterError("at least one thruster is needed")
@@ -91,6 +111,18 @@ class ThrustersAndJointLimits(Actuation):
         self._dropped_max = np.zeros(components.size)
         self._lower = -np.array([t.max_reverse_N for t in self.thrusters])
         self._upper = np.array([t.max_forward_N for t in self.thrusters])
+        # the default drives give the allocated thrust at once: computed directly (fast path)
+        self._ideal = drives is None
+        if drives is None:
+            drives = ideal_drives(self.thrusters)
+        if len(drives.curves) != len(self.thrusters):
+            raise ParameterError(f"{len(drives.curves)} drives for {len(self.thrusters)} thrusters")
+        self.drives = drives
+        self._command = np.zeros(len(self.thrusters))
+        self._thrust = np.zeros(len(self.thrusters))
+        # the linear curve's command u = f / limit (a zero limit: u = 0, f = 0)
+        self._full_forward = np.where(self._upper > 0.0, self._upper, np.inf)
+        self._full_reverse = np.where(self._lower < 0.0, -self._lower, np.inf)
         if joint_effort_limits_Nm is not None:
             limits = np.asarray(joint_effort_limits_Nm, dtype=float)
             if np.any(~(limits > 0.0)) or not np.all(np.isfinite(limits)):
@@ -115,8 +147,21 @@ class ThrustersAndJointLimits(Actuation):
         limits = self.joint_effort_limits_Nm
         return limits is not None and bool(np.any(np.abs(tau_commanded[6:]) > limits))
 
-    def start(self) -> None:
+    def start(self, period_s: float | None = None) -> None:
         self._dropped_max[:] = 0.0
+        self.drives.start(period_s)
+        self._command = np.zeros(len(self.thrusters))
+        self._thrust = np.zeros(len(self.thrusters))
+
+    def signals(self) -> dict[str, np.ndarray]:
+        return {"thruster_command": self._command.copy(), "thrust": self._thrust.copy()}
+
+    def signal_columns(self) -> dict[str, list[tuple[str, str]]]:
+        names = [t.name for t in self.thrusters]
+        return {
+            "thruster_command": [(name, "") for name in names],
+            "thrust": [(name, "N") for name in names],
+        }
 
     def _unproducible(self) -> list[int]:
         """Positions (in the allocated components) of those the thrusters cannot produce: as
@@ -153,7 +198,15 @@ class ThrustersAndJointLimits(Actuation):
             lost = np.abs(self._residual @ tau_commanded[self.allocated_components])
             np.maximum(self._dropped_max, lost, out=self._dropped_max)
         out = np.empty_like(tau_commanded)
-        out[:6] = self.allocation @ self.thrusts(tau_commanded)
+        if self._ideal:
+            self._thrust = self.thrusts(tau_commanded)
+            self._command = self._thrust / np.where(
+                self._thrust >= 0.0, self._full_forward, self._full_reverse
+            )
+        else:
+            self._command = self.drives.commands(self.thrusts(tau_commanded))
+            self._thrust = self.drives.advance(self._command)
+        out[:6] = self.allocation @ self._thrust
         arm = tau_commanded[6:]
         if self.joint_effort_limits_Nm is None:
             out[6:] = arm
@@ -165,3 +218,19 @@ class ThrustersAndJointLimits(Actuation):
             limits = self.joint_effort_limits_Nm
             out[6:] = np.minimum(np.maximum(arm, -limits), limits)
         return out
+
+
+def linear_curve(thruster: Thruster) -> TabulatedThrustCurve:
+    """T = u max_forward_N (u > 0), u max_reverse_N (u < 0): a driver that gives the thrust
+    asked for, up to the limits."""
+    return TabulatedThrustCurve(
+        np.array([-1.0, 0.0, 1.0]),
+        np.array([-thruster.max_reverse_N, 0.0, thruster.max_forward_N]),
+        name="linear",
+    )
+
+
+def ideal_drives(thrusters: Sequence[Thruster]) -> ThrusterDrives:
+    """Linear curves, no lag, no rate limit: the allocated thrust at once."""
+    m = len(thrusters)
+    return ThrusterDrives([linear_curve(t) for t in thrusters], [0.0] * m, [np.inf] * m)

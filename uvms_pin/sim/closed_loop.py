@@ -98,7 +98,9 @@ class ClosedLoop:
         q0[3:7] /= np.linalg.norm(q0[3:7])
         self.time_s, self.q, self.v = 0.0, read_only(q0), read_only(v0)
         self.sensors = sensors
-        self.plant.actuation.start()
+        self.plant.actuation.start(self.settings.control_period_s)
+        if sensors.navigation is not None:
+            sensors.navigation.start(self.settings.control_period_s)
         if self.controller is not None:
             with self._controller_code("reset"):
                 self.controller.reset()
@@ -160,11 +162,12 @@ class ClosedLoop:
     ) -> Sample:
         """The loop now, as its observers see it."""
         controller = self.controller
-        if controller is None:
-            signals = _NO_SIGNALS
-        else:
+        signals = self.plant.actuation.signals()
+        if self.sensors.navigation is not None:
+            signals.update(self.sensors.navigation.signals())
+        if controller is not None:
             with self._controller_code("signals"):
-                signals = controller.signals()
+                signals = {**controller.signals(), **signals}
         return Sample(
             self.time_s,
             self.q,
@@ -174,7 +177,7 @@ class ClosedLoop:
             self.plant.disturbance_wrench(self.time_s),
             tau_commanded,
             tau_applied,
-            signals,
+            signals or _NO_SIGNALS,
         )
 
     def _context(self, span_s: tuple[float, float], tau_applied: np.ndarray | None) -> str:
@@ -237,6 +240,8 @@ class ClosedLoop:
     def _tick(self, logged: bool) -> np.ndarray:
         """Measure, command and actuate at the current state; log if ``logged``."""
         measurement, contact = self.measure()
+        if self.sensors.navigation is not None:  # stateful: once per tick
+            self.sensors.navigation.update(self.time_s, self.q, self.v)
         tau = self.command(measurement)
         tau_applied = self.actuate(tau)
         if logged:
@@ -409,6 +414,16 @@ def run_metadata(plant: Plant, settings: SimulationSettings) -> dict[str, Any]:
         "arm_joint_kinds": list(arm.kinds),
         "arm_position_lower_rad": lower,
         "arm_position_upper_rad": upper,
+        "signal_units": _described(plant.actuation.signal_columns()),
+    }
+
+
+def _described(columns: dict[str, list[tuple[str, str]]]) -> dict[str, dict[str, list[str]]]:
+    """Producers' (component, unit) columns per signal in the rollout's ``signal_units``
+    record, the one a controller's `Signal` is described by (`uvms_pin.sim.log`)."""
+    return {
+        name: {"components": [c for c, _ in cols], "units": [u for _, u in cols]}
+        for name, cols in columns.items()
     }
 
 
@@ -432,6 +447,8 @@ def simulate_closed_loop(
 
     check_log_fits(settings, plant.uvms.nq, plant.uvms.nv, plant.n_logged_hulls)
     meta = {**(metadata or {}), **run_metadata(plant, settings)}
+    if sensors.navigation is not None:
+        meta["signal_units"].update(_described(sensors.navigation.signal_columns()))
     log = RolloutLog(plant.uvms, settings.n_log, meta, backend=plant.backend, plant=plant)
     loop = ClosedLoop(plant, settings, controller, observers)
     return loop.run(q0, v0, sensors, log)

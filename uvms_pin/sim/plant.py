@@ -29,9 +29,11 @@ from uvms_pin.physics.compiled.backend import Backend, Fallback, backend_named
 from uvms_pin.physics.compiled.contact import contact_to_core
 from uvms_pin.physics.compiled.disturbance import disturbance_to_core
 from uvms_pin.physics.compiled.flow import flow_to_core
+from uvms_pin.physics.compiled.joint_friction import joint_friction_to_core
 from uvms_pin.physics.contact import ContactModel
 from uvms_pin.physics.disturbance import Disturbance
 from uvms_pin.physics.dynamics import dynamics_of, forward_dynamics
+from uvms_pin.physics.joint_friction import JointFriction
 from uvms_pin.physics.surface import wet_state
 from uvms_pin.sim.actuation import Actuation, Unlimited
 from uvms_pin.sim.integrators import Chart, Integrator
@@ -55,6 +57,8 @@ class Plant:
             The default. False: water without a top (every body wholly wet wherever it is).
         stop_at_surface: end the run (SimulationError) when a body's centre of buoyancy
             rises above the surface: for models meant for submerged bodies only.
+        joint_friction: viscous and Coulomb friction of the arm's joint drives, a
+            generalized force in the dynamics (`uvms_pin.physics.joint_friction`); None: none.
     """
 
     uvms: UVMS
@@ -66,6 +70,7 @@ class Plant:
     backend: str = "core"
     free_surface: bool = True
     stop_at_surface: bool = False
+    joint_friction: JointFriction | None = None
 
     def __post_init__(self) -> None:
         self.current_world_m_s = finite_vector("current_world_m_s", self.current_world_m_s, 3)
@@ -73,6 +78,13 @@ class Plant:
             self.uvms.require_ee_frame("a contact environment (at the end-effector)")
         if self.flow is not None and not isinstance(self.flow, FlowField):
             raise ParameterError(f"flow must be a FlowField, got {type(self.flow).__name__}")
+        if (
+            self.joint_friction is not None
+            and self.joint_friction.viscous_Nms.size != self.uvms.nv - 6
+        ):
+            raise ParameterError(
+                f"joint friction for {self.joint_friction.viscous_Nms.size} joints, the model has {self.uvms.nv - 6}"
+            )
         self._backend: Backend = backend_named(self.backend)
         self._ee_data = self.uvms.model.createData()
         self.water = self._water()
@@ -160,6 +172,7 @@ class Plant:
         ee_frame_id = self.uvms.ee_frame_id if self.uvms.has_end_effector else 0
         compiled = core.Plant(dynamics_of(self.uvms).core, ee_frame_id)
         compiled.flow, compiled.contact, compiled.disturbance = parts
+        compiled.joint_friction = joint_friction_to_core(self.joint_friction, core)
         compiled.free_surface = bool(self.free_surface)
         return compiled
 
@@ -217,12 +230,15 @@ class Plant:
         tau: np.ndarray,
         contact_world: np.ndarray | None = None,
     ) -> np.ndarray:
-        """zeta_dot of  M zeta_dot + h + J_c^T lambda + delta = tau  (docs/physics.md)."""
+        """zeta_dot of  M zeta_dot + h + J_c^T lambda + delta = tau + [0; tau_f(v)]
+        (docs/physics.md; tau_f the joint drives' friction)."""
         compiled = self._core()
         if compiled is not None:
             return compiled.acceleration(time_s, q, v, tau, contact_world)
         model = self.uvms.model
         tau_ext = np.zeros(model.nv)
+        if self.joint_friction is not None:
+            tau_ext[6:] += self.joint_friction.torque_Nm(v[6:])
         if self.contact is not None:
             if contact_world is None:
                 contact_world = self.contact_wrench(q, v)

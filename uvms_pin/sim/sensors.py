@@ -12,13 +12,14 @@ integrators (a held, stepwise noise makes them restart at every sample).
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 import pinocchio as pin
 
 from uvms_pin.control.measurement import Measurement, read_only
 from uvms_pin.errors import ParameterError
+from uvms_pin.sim.navigation.suite import NavigationSpec, NavigationSuite
 
 
 @dataclass(frozen=True)
@@ -123,6 +124,8 @@ class SensorConfig:
         position_noise: vehicle position [m]; orientation_noise: rotation vector [rad];
         joint_noise: [rad]; velocity_noise: every component of zeta [m/s, rad/s].
         sample_period_s: sensor rate: a new noise value is drawn every sample period.
+        navigation: the vehicle's navigation sensors (IMU, depth, DVL, USBL), logged as
+            signals; what a controller measures is unchanged by them.
     """
 
     force_noise: NoiseSpec = NoiseSpec()
@@ -132,6 +135,7 @@ class SensorConfig:
     joint_noise: NoiseSpec = NoiseSpec()
     velocity_noise: NoiseSpec = NoiseSpec()
     sample_period_s: float = 1e-3
+    navigation: NavigationSpec = field(default_factory=NavigationSpec)
 
 
 class SensorSuite:
@@ -151,6 +155,8 @@ class SensorSuite:
         self._orientation = SampledNoise(config.orientation_noise, 3, period, duration_s, rngs[3])
         self._joints = SampledNoise(config.joint_noise, nj, period, duration_s, rngs[4])
         self._velocity = SampledNoise(config.velocity_noise, model.nv, period, duration_s, rngs[5])
+        nav = config.navigation
+        self.navigation = NavigationSuite(nav, seed) if nav.fitted else None
         self._state_noisy = any(
             s.bound > 0.0
             for s in (

@@ -21,9 +21,9 @@ from uvms_pin.apps.exit_codes import (
 )
 from uvms_pin.apps.study.command import register as register_study_commands
 from uvms_pin.apps.validation.command import register as register_validate
-from uvms_pin.errors import UvmsPinError, UvmsPinWarning
+from uvms_pin.errors import OutputError, UvmsPinError, UvmsPinWarning
 from uvms_pin.model.resources import resolve_model
-from uvms_pin.results.outdir import OVERWRITE_HELP, claim_file
+from uvms_pin.results.outdir import OVERWRITE_HELP, check_writable, claim_file
 
 if TYPE_CHECKING:
     from uvms_pin.results.rollout import Rollout
@@ -81,6 +81,43 @@ def _cmd_info(args: argparse.Namespace) -> int:
     return 0
 
 
+def _cmd_import(args: argparse.Namespace) -> int:
+    from uvms_pin.model.importer.convert import import_model
+
+    out = Path(args.out)
+    table = Path(args.thrusters) if args.thrusters else out.with_suffix(".thrusters.toml")
+    with claim_file(out, overwrite=args.overwrite, option="--out"):
+        if table.exists() and not args.overwrite:
+            raise OutputError(f"--thrusters {table}: exists; pass --overwrite to replace it")
+        check_writable(table.parent, "--thrusters", shown=str(table))
+        result = import_model(args.file, out, thrusters_out=table)
+    print(f"wrote {out}")
+    if result.thrusters:
+        print(f"wrote {table} ({len(result.thrusters)} thrusters)")
+    if result.fluid_density_kg_m3 is not None:
+        print(
+            f"fluid density in the source: {result.fluid_density_kg_m3:g} kg/m^3 ([water] density_kg_m3)"
+        )
+    for note in result.not_mapped:
+        print(f"not mapped: {note}")
+    return 0
+
+
+def _add_import(sub) -> None:
+    parser = sub.add_parser(
+        "import",
+        help="read a Gazebo vehicle (uuv_simulator or gz-sim plugins; URDF or SDF) into a "
+        "uvms-pin URDF and a thruster table",
+    )
+    parser.add_argument("file", help="URDF (xacro-expanded) or SDF file")
+    parser.add_argument("--out", required=True, help="the uvms-pin URDF to write")
+    parser.add_argument(
+        "--thrusters", help="the thruster table to write (default: OUT with .thrusters.toml)"
+    )
+    parser.add_argument("--overwrite", action="store_true", help="replace existing files")
+    parser.set_defaults(func=_cmd_import)
+
+
 def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(
         prog="uvms-pin", description="Underwater vehicle-manipulator simulation on Pinocchio."
@@ -132,6 +169,7 @@ def build_parser() -> argparse.ArgumentParser:
         "--water-density", type=positive, default=1025.0, help="kg/m^3 (default: sea water)"
     )
     info.set_defaults(func=_cmd_info)
+    _add_import(sub)
     register_study_commands(sub)
     register_compare_arms(sub)
     register_compare_controllers(sub)

@@ -1,0 +1,60 @@
+"""The IMU's noise: its Allan deviation is the configured one; gravity in the accelerometer."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from uvms_pin.errors import ParameterError
+from uvms_pin.sim.navigation.imu import Imu, ImuSpec, NoisyChannel, allan_deviation
+
+N, K = 0.004, 2e-4  # rad/s/sqrt(Hz), rad/s^2/sqrt(Hz)
+
+
+def test_a_record_is_the_same_numbers_as_sample_by_sample():
+    one = NoisyChannel(N, K, np.random.default_rng(5))
+    other = NoisyChannel(N, K, np.random.default_rng(5))
+    truth = np.arange(30.0).reshape(10, 3)
+    step = np.array([one.sample(row, 0.01) for row in truth])
+    np.testing.assert_allclose(other.record(truth, 0.01), step, rtol=1e-13, atol=1e-15)
+    np.testing.assert_allclose(one.bias, other.bias, rtol=1e-13)
+
+
+@pytest.mark.parametrize("tau_s", [1.0, 100.0])
+def test_allan_deviation_is_the_configured_one(tau_s):
+    """sigma(tau)^2 = N^2 / tau + K^2 tau / 3, over a 20 h record at 10 Hz, every axis."""
+    dt = 0.1
+    channel = NoisyChannel(N, K, np.random.default_rng(2017))
+    record = channel.record(np.zeros((720_000, 3)), dt)
+    expected = math.sqrt(N**2 / tau_s + K**2 * tau_s / 3.0)
+    for axis in range(3):
+        got = allan_deviation(record[:, axis], dt, tau_s)
+        assert got == pytest.approx(expected, rel=0.10)
+
+
+def test_allan_deviation_of_white_noise_alone_falls_as_one_over_sqrt_tau():
+    channel = NoisyChannel(N, 0.0, np.random.default_rng(3))
+    record = channel.record(np.zeros((200_000, 3)), 0.01)[:, 0]
+    ratio = allan_deviation(record, 0.01, 0.1) / allan_deviation(record, 0.01, 10.0)
+    assert ratio == pytest.approx(10.0, rel=0.1)
+
+
+def test_accelerometer_reads_gravity_at_rest_in_body_axes():
+    imu = Imu(ImuSpec(), np.random.default_rng(0), np.random.default_rng(1))
+    # rolled by 90 degrees about x: the body's y axis points up
+    rotation = np.array([[1.0, 0.0, 0.0], [0.0, 0.0, -1.0], [0.0, 1.0, 0.0]])
+    gyro, accel = imu.measure(np.array([0.1, 0.2, 0.3]), np.zeros(3), rotation, 0.01)
+    np.testing.assert_allclose(accel, [0.0, 9.81, 0.0], atol=1e-15)
+    np.testing.assert_array_equal(gyro, [0.1, 0.2, 0.3])
+    # in free fall it reads nothing
+    _, falling = imu.measure(np.zeros(3), np.array([0.0, 0.0, -9.81]), rotation, 0.01)
+    np.testing.assert_allclose(falling, 0.0, atol=1e-15)
+
+
+def test_bad_specs_are_refused():
+    with pytest.raises(ParameterError, match="gyro_noise"):
+        ImuSpec(gyro_noise_rad_s_rthz=-1.0)
+    with pytest.raises(ParameterError, match="tau"):
+        allan_deviation(np.zeros(10), 0.1, 1.0)

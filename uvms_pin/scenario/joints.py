@@ -1,0 +1,48 @@
+"""``[joints]``: the arm's joint drives: friction (viscous, regularized Coulomb) and the
+torque bandwidth. Without the table there is no friction (``use_model_friction = true``
+takes the URDF's ``<dynamics damping friction>``) and the torque follows its command at once."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from uvms_pin.errors import ParameterError
+from uvms_pin.model.uvms import UVMS
+from uvms_pin.physics.joint_friction import DEFAULT_COULOMB_VELOCITY_RAD_S, JointFriction
+from uvms_pin.scenario.schema import Table
+from uvms_pin.sim.actuation import Actuation
+from uvms_pin.sim.joint_drive import LaggedJointTorques
+
+
+def build_joint_friction(t: Table, uvms: UVMS) -> JointFriction | None:
+    """The drives' friction (None when the model has no joint or no friction)."""
+    n = uvms.nv - 6
+    if n == 0:
+        return None
+    model = uvms.model
+    # opt-in: arm files often carry <dynamics> values tuned for another simulator
+    from_model = t.boolean("use_model_friction", False)
+    viscous = t.vector(
+        "viscous_Nms", n, model.damping[6:].copy() if from_model else np.zeros(n), nonneg=True
+    )
+    coulomb = t.vector(
+        "coulomb_Nm", n, model.friction[6:].copy() if from_model else np.zeros(n), nonneg=True
+    )
+    scale = t.number("coulomb_velocity_rad_s", DEFAULT_COULOMB_VELOCITY_RAD_S, positive=True)
+    try:
+        friction = JointFriction(viscous, coulomb, np.full(n, scale))
+    except ParameterError as exc:
+        raise t.fail(str(exc)) from exc
+    return friction if friction.active else None
+
+
+def with_joint_lag(t: Table, actuation: Actuation, uvms: UVMS) -> Actuation:
+    """``actuation`` with the joints' torque lag ``torque_time_constant_s`` (all zero: as is)."""
+    n = uvms.nv - 6
+    lag = t.vector("torque_time_constant_s", n, np.zeros(n), nonneg=True)
+    if n == 0 or not np.any(lag):
+        return actuation
+    try:
+        return LaggedJointTorques(actuation, lag)
+    except ParameterError as exc:
+        raise t.error("torque_time_constant_s", str(exc)) from exc
