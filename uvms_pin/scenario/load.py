@@ -30,8 +30,8 @@ from uvms_pin.scenario.actuation import build_actuation
 from uvms_pin.scenario.baselines import check_baselines
 from uvms_pin.scenario.controller import build_controller
 from uvms_pin.scenario.initial import build_initial_state
-from uvms_pin.scenario.metrics import build_metrics
 from uvms_pin.scenario.joints import build_joint_friction, with_joint_lag
+from uvms_pin.scenario.metrics import build_metrics
 from uvms_pin.scenario.overrides import apply_overrides, parse_key_path
 from uvms_pin.scenario.schema import Table
 from uvms_pin.scenario.sensors import build_sensors
