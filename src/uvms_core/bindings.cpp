@@ -270,6 +270,13 @@ void bind_environment(nb::module_& m) {
       .def_rw("amplitude", &uvms::SinusoidalDisturbance::amplitude)
       .def_rw("period_s", &uvms::SinusoidalDisturbance::period_s)
       .def_rw("phase_rad", &uvms::SinusoidalDisturbance::phase_rad);
+  nb::class_<uvms::JointStopsModel>(m, "JointStops",
+                                    "Compliant stops at the joint limits (joint_stops.hpp).")
+      .def(nb::init<>())
+      .def_rw("lower_rad", &uvms::JointStopsModel::lower_rad)
+      .def_rw("upper_rad", &uvms::JointStopsModel::upper_rad)
+      .def_rw("stiffness_Nm_rad", &uvms::JointStopsModel::stiffness_Nm_rad)
+      .def_rw("damping_Nm_s_rad", &uvms::JointStopsModel::damping_Nm_s_rad);
   nb::enum_<uvms::Method>(m, "Method", "A fixed-step method (integrators.hpp).")
       .value("rk4", uvms::Method::rk4)
       .value("semi_implicit_euler", uvms::Method::semi_implicit_euler);
@@ -289,6 +296,7 @@ void bind_plant(nb::module_& m) {
       .def_rw("free_surface", &Plant::free_surface)
       .def_rw("contact", &Plant::contact)
       .def_rw("disturbance", &Plant::disturbance)
+      .def_rw("joint_stops", &Plant::joint_stops)
       .def(
           "contact_wrench",
           [](Plant& p, nb::handle q_obj, nb::handle v_obj) -> Eigen::VectorXd {

@@ -52,6 +52,11 @@ const Eigen::VectorXd& Plant::acceleration(double time_s, const ConstVec& q, con
     // delta acts against tau on the vehicle body (joint 1, free-flyer: LOCAL Jacobian [I 0])
     dynamics_.add_local_wrench(1, -disturbance->at(time_s));
   }
+  if (joint_stops) {
+    tau_total_ = tau;
+    joint_stops->add_torque(q, v, tau_total_);
+    return dynamics_.accelerations(q, v, tau_total_, nullptr);
+  }
   return dynamics_.accelerations(q, v, tau, nullptr);
 }
 

@@ -1,6 +1,6 @@
 // The simulated world (mirror of uvms_pin/sim/plant.py): a UVMS in a flow, touching a compliant
 // environment at its end-effector and pushed by a disturbance:
-//   M zeta_dot + h + J_c^T lambda + [delta; 0] = tau.
+//   M zeta_dot + h + J_c^T lambda + [delta; 0] = tau + tau_stop.
 // It advances the plant over one control period with the input held, in one call.
 #pragma once
 
@@ -10,6 +10,7 @@
 #include "disturbance.hpp"
 #include "dynamics.hpp"
 #include "integrators.hpp"
+#include "joint_stops.hpp"
 
 namespace uvms {
 
@@ -23,6 +24,7 @@ class Plant {
   bool free_surface = false;  // the bodies are cut by the flow's free surface
   Contact contact;
   Disturbance disturbance;
+  JointStops joint_stops;  // compliant stops at the arm joints' limits, or none
 
   // lambda at (q, v): what the end-effector exerts on the environment [N; N m], world axes.
   Vec6 contact_wrench(const ConstVec& q, const ConstVec& v);
@@ -46,6 +48,7 @@ class Plant {
   pinocchio::FrameIndex ee_frame_id_;
   pinocchio::JointIndex ee_joint_id_;
   ManifoldStepper stepper_;
+  Eigen::VectorXd tau_total_;  // tau + the joint stops' torque
 };
 
 }  // namespace uvms

@@ -5,7 +5,8 @@ A scenario is read in two stages: the TOML becomes a plain dict (on which dotted
 ``{"initial.joint_positions_rad[3]": 0.5}`` are applied, see `uvms_pin.scenario.overrides`;
 that is how ``uvms-pin run --set``, sweeps and robustness tables vary it), then every table
 is checked and built by the module of its concept: ``[water]`` (`water`), ``[initial]``
-(`initial`), ``[environment]`` and ``[disturbance]`` (`world`), ``[actuation]``,
+(`initial`), ``[environment]`` and ``[disturbance]`` (`world`), ``[world]`` and ``[joints]``
+(`objects`), ``[actuation]``,
 ``[sensors]``, ``[integrator]``, ``[control]`` and ``[output]`` (`timing`), ``[controller]``
 (`controller`) and ``[baselines]`` (`baselines`). Unknown keys, wrong types and bad values
 raise `ScenarioError` naming the file and the key, or the override when an override set it,
@@ -28,6 +29,7 @@ from uvms_pin.scenario.actuation import build_actuation
 from uvms_pin.scenario.baselines import check_baselines
 from uvms_pin.scenario.controller import build_controller
 from uvms_pin.scenario.initial import build_initial_state
+from uvms_pin.scenario.objects import build_joint_stops, build_world
 from uvms_pin.scenario.overrides import apply_overrides, parse_key_path
 from uvms_pin.scenario.schema import Table
 from uvms_pin.scenario.sensors import build_sensors
@@ -91,6 +93,8 @@ def _build(raw: dict[str, Any], path: Path, top: Table) -> Scenario:
     uvms = _model(head, water, path, scenario)
     q0, v0 = build_initial_state(top.table_or_empty("initial"), uvms)
     contact = build_environment(top.table("environment"), uvms)
+    world = build_world(top.table("world"), uvms, path.parent)
+    joint_stops = build_joint_stops(top.table_or_empty("joints"), uvms)
     disturbance = build_disturbance(top.table("disturbance"))
     actuation = build_actuation(top.table("actuation"), uvms)
     sensor_config = build_sensors(top.table_or_empty("sensors"))
@@ -110,6 +114,8 @@ def _build(raw: dict[str, Any], path: Path, top: Table) -> Scenario:
         backend,
         free_surface=water.free_surface,
         stop_at_surface=water.stop_at_surface,
+        world=world,
+        joint_stops=joint_stops,
     )
     try:
         settings = SimulationSettings(

@@ -265,6 +265,7 @@ class ClosedLoop:
                         f"simulation diverged between t = {t0:.6g} s and {t:.6g} s"
                     )
                 self.time_s, self.q, self.v = float(t), read_only(q), read_only(v)
+                plant.settle(self.q, self.v)  # the friction's anchors move at the log times
                 on_log = abs(t - log_times[logged]) < 1e-9
                 # an event stop is not a log time: the controller raises the violation there
                 self._tick(on_log)
