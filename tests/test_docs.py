@@ -120,11 +120,9 @@ _VARIANTS = [
                 "tangential_stiffness_N_m": 1e4,
                 "tangential_damping_N_s_m": 20.0,
             },
-            "joints": {
-                "hard_stops": True,
-                "stop_stiffness_Nm_rad": 500.0,
-                "stop_damping_Nm_s_rad": 2.0,
-            },
+            "joints.hard_stops": True,
+            "joints.stop_stiffness_Nm_rad": 500.0,
+            "joints.stop_damping_Nm_s_rad": 2.0,
         },
     ),
 ]

@@ -10,11 +10,11 @@ import sys
 import matplotlib
 
 matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
-import numpy as np  # noqa: E402
-from _common import ROOT, producer_cli, publish_figure, scratch, uvms_pin, write_result  # noqa: E402
+import matplotlib.pyplot as plt
+import numpy as np
+from _common import ROOT, producer_cli, publish_figure, scratch, uvms_pin, write_result
 
-from uvms_pin.results.rollout import Rollout  # noqa: E402
+from uvms_pin.results.rollout import Rollout
 
 SCENARIO = "scenarios/seabed_landing.toml"
 METRICS = (
@@ -76,9 +76,7 @@ def main() -> None:
         + "\n\n![seabed landing](../seabed_landing.png)\n\n"
         + "The cost of the world (`python benchmarks/bench_world.py`): the reference UVMS's "
         "plant over one 2 ms control period, compiled core, as a ratio to the plant "
-        "without a world:\n\n"
-        + printed.stdout.strip()
-        + "\n"
+        "without a world:\n\n" + printed.stdout.strip() + "\n"
     )
     write_result("world", "A world to work in", "python scripts/results/world.py", body)
 

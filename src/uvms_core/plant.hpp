@@ -11,6 +11,7 @@
 #include "dynamics.hpp"
 #include "integrators.hpp"
 #include "joint_stops.hpp"
+#include "world_bounds.hpp"
 
 namespace uvms {
 
@@ -31,6 +32,11 @@ class Plant {
   // zeta_dot; contact_world given = use it instead of the contact model (continuous loop).
   const Eigen::VectorXd& acceleration(double time_s, const ConstVec& q, const ConstVec& v,
                                       const ConstVec& tau, const Vec6* contact_world = nullptr);
+  // Whether no piece can reach a world object within horizon_s from (q, v)
+  // (world_bounds.hpp); true without bounds.
+  bool world_clear(const ConstVec& q, const ConstVec& v, double horizon_s);
+  WorldBoundsModel world_bounds;
+
   // (q, v) at t1 from (q0, v0) at t0 with tau held, in the integrator's substeps.
   std::pair<Eigen::VectorXd, Eigen::VectorXd> advance(double t0, const ConstVec& q0,
                                                       const ConstVec& v0, const ConstVec& tau,

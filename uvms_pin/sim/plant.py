@@ -32,6 +32,7 @@ from uvms_pin.physics.compiled.contact import contact_to_core
 from uvms_pin.physics.compiled.disturbance import disturbance_to_core
 from uvms_pin.physics.compiled.flow import flow_to_core
 from uvms_pin.physics.compiled.joint_stops import joint_stops_to_core
+from uvms_pin.physics.compiled.world import world_bounds_to_core
 from uvms_pin.physics.contact import ContactModel
 from uvms_pin.physics.disturbance import Disturbance
 from uvms_pin.physics.dynamics import dynamics_of, forward_dynamics
@@ -172,6 +173,9 @@ class Plant:
         compiled.flow, compiled.contact, compiled.disturbance = parts
         compiled.free_surface = bool(self.free_surface)
         compiled.joint_stops = joint_stops_to_core(self.joint_stops, core)
+        bounds = world_bounds_to_core(self.world, core)
+        if bounds is not None:
+            compiled.world_bounds = bounds
         return compiled
 
     def _core(self):
@@ -245,8 +249,12 @@ class Plant:
         persists: the friction forgets its anchors)."""
         if self.world is None:
             return True
-        pin.forwardKinematics(self.uvms.model, self._world_data, q, v)
-        clear = self.world.clear(self._world_data, horizon_s)
+        compiled = self._core()
+        if compiled is not None:
+            clear = compiled.world_clear(q, v, horizon_s)
+        else:
+            pin.forwardKinematics(self.uvms.model, self._world_data, q, v)
+            clear = self.world.clear(self._world_data, horizon_s)
         if clear:
             self.friction.clear()
         return clear

@@ -251,7 +251,8 @@ class UvmsScene:
         if self.world is not None:
             scale = self.style.world_force_scale_m_per_N
             parts.append(f"world contact forces (orange), {scale:g} m per N")
-        parts.append("tip trail (yellow); sea floor 0.5 m grid")
+        floor = self.world is None or not self.world.has_plane
+        parts.append("tip trail (yellow)" + ("; sea floor 0.5 m grid" if floor else ""))
         return "; ".join(parts)
 
     # ---- static geometry ---------------------------------------------------------------

@@ -18,7 +18,7 @@ import pinocchio as pin
 from uvms_pin.physics.world.objects import WorldObject
 from uvms_pin.physics.world.robot_geometry import RobotPiece
 
-__all__ = ["Touch", "clear_of", "touch"]
+__all__ = ["Bounds", "Touch", "clear_of", "touch"]
 
 _REQUEST = coal.CollisionRequest()  # one contact, depth and normal: what a pair needs
 
@@ -93,81 +93,109 @@ CLEARANCE_M = 0.05
 
 
 def clear_of(
-    data: pin.Data,
-    pieces: Sequence[RobotPiece],
-    objects: Sequence[WorldObject],
-    horizon_s: float,
+    data: pin.Data, pieces: Sequence[RobotPiece], bounds: Bounds, horizon_s: float
 ) -> bool:
     """Whether no piece can reach any object within ``horizon_s`` (after
     ``pin.forwardKinematics(model, data, q, v)``): every piece's bounding sphere, grown by
     twice the distance its fastest point covers at the current speed plus `CLEARANCE_M`,
     misses every object's bound. Then a whole control period runs without the world."""
+    centers, reach = [], []
     for piece in pieces:
-        joint = data.oMi[piece.joint_id]
-        center = joint.act(piece.placement_in_joint.translation)
+        local = piece.placement_in_joint.translation
         twist = data.v[piece.joint_id]
-        offset = float(np.linalg.norm(piece.placement_in_joint.translation))
         speed = float(np.linalg.norm(twist.linear)) + float(np.linalg.norm(twist.angular)) * (
-            offset + piece.bound_radius_m
+            float(np.linalg.norm(local)) + piece.bound_radius_m
         )
-        reach = piece.bound_radius_m + 2.0 * speed * horizon_s + CLEARANCE_M
-        for obj in objects:
-            if _near_within(center, reach, obj):
-                return False
-    return True
+        centers.append(data.oMi[piece.joint_id].act(local))
+        reach.append(piece.bound_radius_m + 2.0 * speed * horizon_s + CLEARANCE_M)
+    centers_m = np.array(centers).reshape(-1, 3)
+    return not bounds.near(centers_m, np.array(reach, dtype=float))
 
 
-def _near_within(center: np.ndarray, radius_m: float, obj: WorldObject) -> bool:
-    if obj.is_plane:
-        return float((center - obj.placement.translation) @ obj.normal_world) < radius_m
-    gap = float(np.linalg.norm(center - obj.placement.translation))
-    return gap < radius_m + obj.bound_radius_m
+@dataclass(frozen=True)
+class Bounds:
+    """The objects' bounds, stacked: planes (outward normals (k, 3), offsets n . p0 (k,))
+    and the other objects' bounding spheres (centres (l, 3), radii (l,)), with their
+    indices among the objects."""
+
+    plane_index: np.ndarray
+    plane_normals: np.ndarray
+    plane_offsets_m: np.ndarray
+    solid_index: np.ndarray
+    solid_centers_m: np.ndarray
+    solid_radii_m: np.ndarray
+
+    @staticmethod
+    def of(objects: Sequence[WorldObject]) -> Bounds:
+        planes = [k for k, o in enumerate(objects) if o.is_plane]
+        solids = [k for k, o in enumerate(objects) if not o.is_plane]
+        normals = np.array([objects[k].normal_world for k in planes]).reshape(-1, 3)
+        points = np.array([objects[k].placement.translation for k in planes]).reshape(-1, 3)
+        return Bounds(
+            np.array(planes, dtype=int),
+            normals,
+            np.einsum("ij,ij->i", normals, points),
+            np.array(solids, dtype=int),
+            np.array([objects[k].placement.translation for k in solids]).reshape(-1, 3),
+            np.array([objects[k].bound_radius_m for k in solids], dtype=float),
+        )
+
+    def near(self, centers_m: np.ndarray, radii_m: np.ndarray) -> list[tuple[int, int]]:
+        """(piece, object) of every sphere (centres (p, 3), radii (p,)) that reaches an
+        object's bound."""
+        out = []
+        heights = centers_m @ self.plane_normals.T - self.plane_offsets_m  # (p, k)
+        for p, k in zip(*np.nonzero(heights < radii_m[:, None]), strict=True):
+            out.append((int(p), int(self.plane_index[k])))
+        gaps = np.linalg.norm(centers_m[:, None, :] - self.solid_centers_m[None], axis=2)
+        for p, k in zip(*np.nonzero(gaps < radii_m[:, None] + self.solid_radii_m), strict=True):
+            out.append((int(p), int(self.solid_index[k])))
+        return out
 
 
 def touch(
-    model: pin.Model, data: pin.Data, pieces: Sequence[RobotPiece], objects: Sequence[WorldObject]
+    data: pin.Data,
+    pieces: Sequence[RobotPiece],
+    objects: Sequence[WorldObject],
+    bounds: Bounds,
 ) -> Touch:
     """The contact points after ``pin.forwardKinematics(model, data, q, v)``."""
-    rows: list[tuple] = []
-    for p, piece in enumerate(pieces):
-        joint = data.oMi[piece.joint_id]
-        where = joint * piece.placement_in_joint
-        for o, obj in enumerate(objects):
-            if not _near_within(where.translation, piece.bound_radius_m, obj):
-                continue
-            if obj.is_plane and piece.corners_m is not None:
-                corners, points, depths = _corners_below(piece, where, obj)
-                normal = obj.normal_world
-                rows += [
-                    (p, o, int(c), x, normal, d)
-                    for c, x, d in zip(corners, points, depths, strict=True)
-                ]
-                continue
-            found = _coal_point(piece, where, obj)
-            if found is not None:
-                rows.append((p, o, -1, *found))
-    return _stacked(model, data, pieces, rows)
+    where = [data.oMi[piece.joint_id] * piece.placement_in_joint for piece in pieces]
+    centers = np.array([w.translation for w in where]).reshape(-1, 3)
+    radii = np.array([piece.bound_radius_m for piece in pieces], dtype=float)
+    chunks: list[tuple] = []
+    for p, o in bounds.near(centers, radii):
+        piece, obj = pieces[p], objects[o]
+        if obj.is_plane and piece.corners_m is not None:
+            corners, points, depths = _corners_below(piece, where[p], obj)
+            if len(corners):
+                normals = np.broadcast_to(obj.normal_world, points.shape)
+                count = len(corners)
+                chunks.append(
+                    (np.full(count, p), np.full(count, o), corners, points, normals, depths)
+                )
+            continue
+        found = _coal_point(piece, where[p], obj)
+        if found is not None:
+            point, normal, depth = found
+            chunks.append(
+                ([p], [o], [-1], point[None], normal[None], np.array([depth], dtype=float))
+            )
+    return _stacked(data, pieces, chunks)
 
 
-def _stacked(model: pin.Model, data: pin.Data, pieces: Sequence[RobotPiece], rows: list) -> Touch:
-    if not rows:
+def _stacked(data: pin.Data, pieces: Sequence[RobotPiece], chunks: list) -> Touch:
+    if not chunks:
         empty3 = np.zeros((0, 3))
         none = np.zeros(0, dtype=int)
         return Touch(none, none, none, empty3, empty3, np.zeros(0), empty3)
-    piece, obj, corner, point, normal, depth = (list(c) for c in zip(*rows, strict=True))
-    points = np.array(point, dtype=float)
+    columns = [np.concatenate(c) for c in zip(*chunks, strict=True)]
+    piece, obj, corner = (c.astype(int) for c in columns[:3])
+    points, normals, depth = columns[3:]
     joints = [pieces[p].joint_id for p in piece]
     rotation = np.array([data.oMi[j].rotation for j in joints])
     origin = np.array([data.oMi[j].translation for j in joints])
     linear = np.einsum("kij,kj->ki", rotation, np.array([data.v[j].linear for j in joints]))
     angular = np.einsum("kij,kj->ki", rotation, np.array([data.v[j].angular for j in joints]))
     velocity = linear + cross(angular, points - origin)
-    return Touch(
-        np.array(piece, dtype=int),
-        np.array(obj, dtype=int),
-        np.array(corner, dtype=int),
-        points,
-        np.array(normal, dtype=float),
-        np.array(depth, dtype=float),
-        velocity,
-    )
+    return Touch(piece, obj, corner, points, normals, depth, velocity)

@@ -26,7 +26,7 @@ from uvms_pin.model.uvms import UVMS
 from uvms_pin.physics.world.contact_law import ContactLaw, friction_force_N, normal_force_N
 from uvms_pin.physics.world.objects import WorldObject
 from uvms_pin.physics.world.robot_geometry import RobotPiece, robot_pieces
-from uvms_pin.physics.world.touch import Touch, clear_of, cross, touch
+from uvms_pin.physics.world.touch import Bounds, Touch, clear_of, cross, touch
 
 __all__ = ["ContactForces", "FrictionMemory", "World"]
 
@@ -84,6 +84,7 @@ class World:
         names = [o.name for o in self.objects]
         if len(set(names)) != len(names):
             raise ParameterError(f"world objects need distinct names, got {names}")
+        self.bounds = Bounds.of(self.objects)
         self._mu = np.array(
             [[o.friction_static, o.friction_kinetic] for o in self.objects], dtype=float
         ).reshape(-1, 2)
@@ -104,13 +105,13 @@ class World:
     def clear(self, data: pin.Data, horizon_s: float) -> bool:
         """Nothing can touch within ``horizon_s`` (`uvms_pin.physics.world.touch.clear_of`),
         after ``pin.forwardKinematics(model, data, q, v)``."""
-        return clear_of(data, self.pieces, self.objects, horizon_s)
+        return clear_of(data, self.pieces, self.bounds, horizon_s)
 
     # ---- forces ---------------------------------------------------------------------
     def forces(self, data: pin.Data, memory: FrictionMemory) -> ContactForces:
         """The force at each contact point after ``pin.forwardKinematics(model, data, q,
         v)``, with the anchors of ``memory`` (read only)."""
-        found = touch(self.uvms.model, data, self.pieces, self.objects)
+        found = touch(data, self.pieces, self.objects, self.bounds)
         normal = found.normal_world
         velocity = found.velocity_world_m_s
         rate = -np.einsum("ij,ij->i", velocity, normal)
