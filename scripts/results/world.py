@@ -45,7 +45,7 @@ def figure(rollout: Rollout, path) -> dict[str, float]:
         mine = [k for k, p in enumerate(pairs) if p.endswith("|" + name)]
         force = np.linalg.norm(contacts[:, mine, :3].sum(axis=1), axis=1)
         axes[1].plot(t, force, label=f"on the UVMS from the {name}")
-        out[f"{name}_force_final_N"] = float(force[-1])
+        out[f"contact force from the {name} at the end [N]"] = float(force[-1])
     axes[1].set_ylabel("contact force [N]")
     axes[1].set_xlabel("time [s]")
     axes[1].legend()
@@ -66,7 +66,7 @@ def main() -> None:
     publish_figure(out / "seabed_landing.png", "seabed_landing.png")
     lines = ["| metric | value |", "|---|---|"]
     lines += [f"| {lab} | {fmt.format(metrics[k])} |" for k, lab, fmt in METRICS if k in metrics]
-    lines += [f"| final {k.replace('_', ' ')} | {v:.4g} |" for k, v in numbers.items()]
+    lines += [f"| {label} | {value:.4g} |" for label, value in numbers.items()]
     bench = out / "bench_world.json"
     command = [sys.executable, "benchmarks/bench_world.py", "--json", str(bench)]
     printed = subprocess.run(command, cwd=ROOT, check=True, capture_output=True, text=True)
@@ -74,9 +74,9 @@ def main() -> None:
         f"`uvms-pin run {SCENARIO}` (exit code {result.returncode}):\n\n"
         + "\n".join(lines)
         + "\n\n![seabed landing](../seabed_landing.png)\n\n"
-        + "The cost of the world (`python benchmarks/bench_world.py`): the reference UVMS's "
-        "plant over one 2 ms control period, compiled core, as a ratio to the plant "
-        "without a world:\n\n" + printed.stdout.strip() + "\n"
+        + "The cost of the world (`python benchmarks/bench_world.py`): the plant over one "
+        "2 ms control period, compiled core, as a ratio to the same model's plant without a "
+        "world:\n\n" + printed.stdout.strip() + "\n"
     )
     write_result("world", "A world to work in", "python scripts/results/world.py", body)
 

@@ -36,7 +36,7 @@ def test_the_scene_draws_every_object_and_no_floor_of_its_own(reference_uvms, wo
     blob = b"".join(window.commands)
     for name in (b"seabed", b"crate", b"pipe", b"rock"):
         assert b"uvms_pin/world/objects/" + name in blob
-    assert b"uvms_pin/world/contacts/0" in blob
+    assert b"uvms_pin/world/contacts/pair0" in blob
     assert b"uvms_pin/floor" not in blob  # the seabed is the floor
     assert "world contact forces (orange)" in scene.legend()
 
@@ -50,10 +50,10 @@ def test_a_pair_arrow_starts_at_its_point_and_is_scale_times_force_long(referenc
     contacts[k, :3] = [0.0, 30.0, 40.0]  # 50 N
     contacts[k, 3:6] = [0.5, -0.2, -2.9]
     poses = scene.poses(Frame(0.0, reference_uvms.neutral_configuration(), None, None, contacts))
-    position, quat, _ = poses[f"world/contacts/{k}"]
+    position, quat, _ = poses[f"world/contacts/pair{k}"]
     assert np.allclose(position, contacts[k, 3:6])
-    shaft = poses[f"world/contacts/{k}/shaft"][2][1]
+    shaft = poses[f"world/contacts/pair{k}/shaft"][2][1]
     head = 4.0 * style.arrow_radius_m
     assert shaft + head == pytest.approx(0.02 * 50.0)
     # the other pairs carry no force: their arrows are hidden
-    assert np.all(poses["world/contacts/0"][2] < 1e-5)
+    assert np.all(poses["world/contacts/pair0"][2] < 1e-5)

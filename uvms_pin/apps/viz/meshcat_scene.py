@@ -65,7 +65,7 @@ class SceneStyle:
     """
 
     force_scale_m_per_N: float = 0.5
-    world_force_scale_m_per_N: float = 0.01
+    world_force_scale_m_per_N: float = 0.02
     current_scale_m_per_m_s: float = 1.0
     floor_clearance_m: float = 1.0
     arrow_radius_m: float = 0.008

@@ -1,9 +1,10 @@
 """The world's objects and contact forces as drawn (`uvms_pin.physics.world`).
 
 Paths under the scene root: ``world/objects/<name>`` (the seafloor a sandy slab, solids
-grey-brown, meshes as their file's triangles) and ``world/contacts/<k>`` (orange arrows, one
+grey-brown, meshes as their file's triangles) and ``world/contacts/pair<k>`` (orange arrows, one
 per (body, object) pair, at the pair's contact point along the force on the body,
-``SceneStyle.world_force_scale_m_per_N`` long per newton).
+``SceneStyle.world_force_scale_m_per_N`` long per newton). A node's name is never a bare
+number: three.js's animation tracks would read it as an index, and the arrow not move.
 """
 
 from __future__ import annotations
@@ -66,7 +67,7 @@ class WorldView:
         for obj in self.objects:
             self._build_object(node[f"objects/{obj['name']}"], obj)
         for k in range(len(self.pairs)):
-            build_arrow(node[f"contacts/{k}"], _ARROW)
+            build_arrow(node[f"contacts/pair{k}"], _ARROW)
 
     def _build_object(self, node: meshcat.Visualizer, obj: dict[str, Any]) -> None:
         rotation = np.asarray(obj["rotation_world"], dtype=float)
@@ -94,7 +95,7 @@ class WorldView:
         for k in range(len(self.pairs)):
             force = None if rows is None else rows[k, :3]
             tail = np.zeros(3) if rows is None else rows[k, 3:6]
-            out.update(arrow(f"world/contacts/{k}", tail, force))
+            out.update(arrow(f"world/contacts/pair{k}", tail, force))
         return out
 
 
