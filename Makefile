@@ -21,7 +21,8 @@ $(STAMP): pyproject.toml CMakeLists.txt $(wildcard src/uvms_core/*.cpp src/uvms_
 	touch $(STAMP)
 
 demo: $(STAMP)
-	$(BIN)/uvms-pin run $(DEMO_SCENARIO) --out $(DEMO_OUT) --html
+	@# --overwrite: the demo reruns into the same directory (only uvms-pin's files are replaced)
+	$(BIN)/uvms-pin run $(DEMO_SCENARIO) --out $(DEMO_OUT) --html --overwrite
 
 lint: $(STAMP)
 	$(BIN)/ruff check .

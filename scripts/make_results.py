@@ -21,6 +21,7 @@ PRODUCERS = {
     "paper": "the paper's scenario: docs/results/paper.md, docs/paper_force.png",
     "realistic": "the realistic scenario: docs/results/realistic.md, docs/realistic_force.png",
     "robustness": "robustness table: docs/results/robustness.md",
+    "station_keeping": "your own controller (a PD): docs/results/station_keeping.md",
     "bench": "benchmark table: docs/results/bench.md",
     "bench_mujoco": "uvms-pin vs MuJoCo: docs/results/bench_mujoco.md",
     "bench_controller": "controller benchmark: docs/results/bench_controller.md",
@@ -50,6 +51,10 @@ def main(argv: list[str] | None = None) -> int:
         for name, what in PRODUCERS.items():
             print(f"{name:<26} {what}")
         return 0
+    sys.path.insert(0, str(ROOT / "scripts" / "results"))
+    from _common import refuse_shortened_runs
+
+    refuse_shortened_runs()
     names = [n for n in (args.only or PRODUCERS) if n not in args.skip]
     failed = []
     for name in names:

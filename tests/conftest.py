@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import os
 import shutil
 import subprocess
 import sys
@@ -14,6 +15,9 @@ import pytest
 import uvms_pin as up
 
 ROOT = Path(__file__).resolve().parents[1]
+# the tests check full-length runs: a cap on durations in the developer's shell (README:
+# UVMS_PIN_MAX_DURATION_S) does not apply to them (the doc test sets its own per snippet)
+os.environ.pop("UVMS_PIN_MAX_DURATION_S", None)
 REFERENCE_URDF = ROOT / "models" / "uvms_lbv150.urdf"
 RHO = 1025.0
 G = 9.81
@@ -36,6 +40,21 @@ def mount_on_reference_vehicle(arm: str, tmp_dir: Path) -> up.UVMS:
         ee_link=entry.ee_link,
         allow_dry_links=True,
     )
+
+
+def continuous_joint_urdf(
+    tmp_path: Path, joints=("arm_joint1", "arm_joint2", "arm_joint3", "arm_joint4")
+) -> Path:
+    """The reference URDF with ``joints`` made ``continuous`` (q then holds their cos and
+    sin, nq != nv; their <limit> stays, urdfdom reads only effort and velocity of it)."""
+    text = REFERENCE_URDF.read_text()
+    for name in joints:
+        old = f'<joint name="{name}" type="revolute">'
+        assert old in text, name
+        text = text.replace(old, f'<joint name="{name}" type="continuous">')
+    path = tmp_path / "continuous.urdf"
+    path.write_text(text)
+    return path
 
 
 def body_urdf(
@@ -100,20 +119,33 @@ def reference_uvms() -> up.UVMS:
 
 
 def random_configuration(uvms: up.UVMS, rng: np.random.Generator) -> np.ndarray:
-    """A random q: position in a 2 m box, uniform random orientation, joints within limits."""
-    model = uvms.model
+    """A random q: position in a 2 m box, uniform random orientation, joints within limits
+    (a continuous joint anywhere in [-pi, pi])."""
+    model, arm = uvms.model, uvms.arm_joints
     q = np.empty(model.nq)
     q[:3] = rng.uniform(-1.0, 1.0, 3)
     quat = rng.normal(size=4)
     q[3:7] = quat / np.linalg.norm(quat)
-    lo = np.maximum(model.lowerPositionLimit[7:], -np.pi)
-    hi = np.minimum(model.upperPositionLimit[7:], np.pi)
-    q[7:] = rng.uniform(lo, hi)
+    lo = np.maximum(arm.lower, -np.pi)
+    hi = np.minimum(arm.upper, np.pi)
+    q[7:] = arm.configuration(rng.uniform(lo, hi))
     return q
 
 
 def free_body_state(uvms: up.UVMS) -> np.ndarray:
     return pin.neutral(uvms.model)
+
+
+# ---- the documentation's snippets (tests/test_docs_run.py): what ran, what was skipped
+DOCS_RUN_SUMMARY = pytest.StashKey[list]()
+
+
+def pytest_terminal_summary(terminalreporter, exitstatus, config):
+    lines = config.stash.get(DOCS_RUN_SUMMARY, None)
+    if lines:
+        terminalreporter.section("documentation snippets")
+        for line in lines:
+            terminalreporter.write_line(line)
 
 
 # ---- the command line as a user runs it, and relative comparisons (used across folders)

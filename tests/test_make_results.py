@@ -54,3 +54,27 @@ def test_every_script_starts_and_answers_help_without_running(script):
     )
     assert started.returncode == 0, started.stderr[-2000:]
     assert started.stdout.startswith("usage:"), started.stdout[:500]
+
+
+def test_make_demo_runs_twice(tmp_path):
+    """The second ``make demo`` replaces the first's outputs (it refused the directory)."""
+    import shutil
+
+    if shutil.which("make") is None:
+        pytest.skip("make is not installed")
+    scenario = tmp_path / "short.toml"
+    scenario.write_text(
+        (ROOT / "scenarios" / "passive_current.toml")
+        .read_text()
+        .replace('"uvms_lbv150"', f'"{ROOT / "models" / "uvms_lbv150.urdf"}"')
+        .replace("duration_s = 20.0", "duration_s = 0.1")
+    )
+    out = tmp_path / "demo"
+    command = [
+        "make", "-C", str(ROOT), "-o", ".venv/.installed", "demo",
+        f"DEMO_SCENARIO={scenario}", f"DEMO_OUT={out}",
+    ]  # fmt: skip
+    for _ in range(2):
+        result = subprocess.run(command, capture_output=True, text=True, timeout=600)
+        assert result.returncode == 0, result.stderr
+    assert (out / "replay.html").is_file() and (out / "rollout.npz").is_file()

@@ -1,10 +1,17 @@
-"""Checks of arguments that raise `ParameterError` naming the argument and what is wrong."""
+"""Checks of arguments that raise `ParameterError` naming the argument and what is wrong,
+of what a command is about to allocate (`check_memory`), and of what is physical
+(`Plausible`)."""
 
 from __future__ import annotations
 
+import os
+import warnings
+from collections.abc import Callable
+from dataclasses import dataclass
+
 import numpy as np
 
-from uvms_pin.errors import ParameterError
+from uvms_pin.errors import ParameterError, PlausibilityWarning
 
 
 def finite_vector(name: str, value, size: int) -> np.ndarray:
@@ -18,3 +25,108 @@ def finite_vector(name: str, value, size: int) -> np.ndarray:
     if not np.all(np.isfinite(array)):
         raise ParameterError(f"{name} contains a non-finite value: {array}")
     return array
+
+
+@dataclass(frozen=True)
+class Plausible:
+    """What a physical quantity can be (``possible``: beyond, it is refused) and what it
+    usually is (``usual``: beyond, a `PlausibilityWarning`), in ``unit``.
+
+    ``usual_text`` says what the usual range is ("fresh to sea water"); ``impossible_text``
+    why the possible one ends ("no liquid is that dense"); ``hints``: the likely slip below
+    the range and above it ("a <volume> in litres?", "a <mass> in grams?").
+    """
+
+    unit: str
+    usual: tuple[float, float]
+    possible: tuple[float, float]
+    usual_text: str
+    impossible_text: str
+    hints: tuple[str, str] = ("", "")
+
+    def _hint(self, value: float) -> str:
+        hint = self.hints[0] if value < self.usual[0] else self.hints[1]
+        return f"; {hint}" if hint else ""
+
+    def refusal(self, value: float) -> str | None:
+        """Why ``value`` cannot be (for an error naming it), or None."""
+        low, high = self.possible
+        if low <= value <= high:
+            return None
+        return (
+            f"{value:g} {self.unit} cannot be physical: {self.impossible_text} "
+            f"(possible: {low:g} to {high:g} {self.unit}){self._hint(value)}"
+        )
+
+    def warning(self, value: float) -> str | None:
+        """Why ``value`` is suspicious (for a warning naming it), or None."""
+        low, high = self.usual
+        if low <= value <= high:
+            return None
+        return (
+            f"{value:g} {self.unit} is far outside {self.usual_text} "
+            f"({low:g} to {high:g} {self.unit}){self._hint(value)}"
+        )
+
+    def check(self, name: str, value: float) -> float:
+        """``value``; ParameterError naming ``name`` if it cannot be physical, a
+        `PlausibilityWarning` if it is far from usual."""
+        refusal = self.refusal(value)
+        if refusal is not None:
+            raise ParameterError(f"{name} = {refusal}")
+        warning = self.warning(value)
+        if warning is not None:
+            warnings.warn(f"{name} = {warning}", PlausibilityWarning, stacklevel=3)
+        return value
+
+
+#: seeds are recorded in rollouts, JSON and the study table's int64 column
+MAX_SEED = 2**63 - 1
+
+
+def seed_value(name: str, value) -> int:
+    """``value`` as a seed: an integer in [0, 2^63 - 1] (numpy's generators take no negative
+    seed, and a study table stores seeds as int64); ParameterError naming ``name`` else."""
+    if isinstance(value, bool) or not isinstance(value, int | np.integer):
+        raise ParameterError(f"{name} must be an integer in [0, 2^63 - 1], got {value!r}")
+    if not 0 <= int(value) <= MAX_SEED:
+        raise ParameterError(f"{name} must be an integer in [0, 2^63 - 1], got {value}")
+    return int(value)
+
+
+def available_memory_bytes() -> int | None:
+    """Memory the system can give this process now [bytes], or None if unknown."""
+    try:
+        with open("/proc/meminfo") as f:
+            for line in f:
+                if line.startswith("MemAvailable:"):
+                    return int(line.split()[1]) * 1024
+    except OSError:
+        pass
+    try:
+        return os.sysconf("SC_AVPHYS_PAGES") * os.sysconf("SC_PAGE_SIZE")
+    except (ValueError, OSError, AttributeError):
+        return None
+
+
+def check_memory(
+    needed_bytes: float,
+    what: str,
+    remedy: str,
+    error: Callable[[str], Exception] = ParameterError,
+) -> None:
+    """Raise ``error(message)`` before anything is allocated if ``what`` would take more than
+    half of the memory available (the other half: what the command allocates besides).
+
+    Args:
+        needed_bytes: the estimate [bytes]. what: the thing and its size, for the message
+            ("the log of this run (500001 samples: ...)"). remedy: what to change.
+        error: makes the exception from the message (an exception type, or a function
+            that names the file and the entry).
+    """
+    available = available_memory_bytes()
+    if available is not None and needed_bytes > available // 2:
+        raise error(
+            f"{what} would take {needed_bytes / 2**30:.3g} GiB, more than half of the "
+            f"{available / 2**30:.3g} GiB available: {remedy}"
+        )

@@ -2,9 +2,36 @@
 
 from __future__ import annotations
 
+import traceback
+from pathlib import Path
+
+_PACKAGE_DIR = str(Path(__file__).resolve().parent)
+
 
 class UvmsPinError(Exception):
-    """Base class of every error raised on purpose by uvms-pin."""
+    """Base class of every error raised on purpose by uvms-pin.
+
+    ``user_traceback``: when the error is an exception of the user's own code (a custom
+    controller), the frames of that code as text (`user_traceback`), shown as such by the
+    command line; "" otherwise.
+    """
+
+    user_traceback: str = ""
+
+
+def user_traceback(exc: BaseException) -> str:
+    """The traceback of ``exc`` without uvms-pin's own outer frames: from the first frame of
+    the user's code (a file outside the package) to the exception; "" if none is."""
+    frames = traceback.extract_tb(exc.__traceback__)
+    first = next(
+        (k for k, frame in enumerate(frames) if not frame.filename.startswith(_PACKAGE_DIR)),
+        None,
+    )
+    if first is None:
+        return ""
+    lines = traceback.format_list(frames[first:])
+    lines += traceback.format_exception_only(type(exc), exc)
+    return "Traceback (most recent call last):\n" + "".join(lines)
 
 
 class ModelError(UvmsPinError):
@@ -35,6 +62,23 @@ class ModelWarning(UvmsPinWarning):
     """
 
 
+class ShortenedRunWarning(UvmsPinWarning):
+    """A scenario runs shorter than its ``duration_s`` because ``UVMS_PIN_MAX_DURATION_S``
+    is set (`uvms_pin.sim.shortened`); the message names the file and both durations."""
+
+
+class PlausibilityWarning(UvmsPinWarning):
+    """A value far outside what any vehicle, water or sea has (a volume in litres, a period
+    in milliseconds?): the message names it, gives the number and the usual range. A value
+    that cannot be physical at all is refused instead."""
+
+
+class ActuationWarning(UvmsPinWarning):
+    """The actuators left out part of what the controller commanded for a reason the
+    scenario does not state (a wrench component no thruster can produce): the message names
+    the components and the largest value dropped."""
+
+
 class ParameterError(UvmsPinError, ValueError):
     """An argument has the wrong shape, a non-finite value or is out of its valid range."""
 
@@ -49,6 +93,13 @@ class StudyError(UvmsPinError):
 
 class OutputError(UvmsPinError):
     """An output path cannot be written, is in use, or holds results that are not this run's."""
+
+
+class ResourceError(UvmsPinError, OSError):
+    """The system refused what a command needed after its inputs were checked: a full disk,
+    a directory removed meanwhile. An `OSError` whose ``filename`` is the file uvms-pin was
+    writing (not its temporary name); the command line exits with status 4 for it.
+    """
 
 
 class DataError(UvmsPinError):
@@ -67,6 +118,25 @@ class CoreFallbackWarning(UvmsPinWarning):
 
 class SimulationError(UvmsPinError):
     """The simulation cannot continue (non-finite state, integrator failure)."""
+
+
+class ControllerError(SimulationError):
+    """The controller raised while the run was going (``compute``, ``reset``, ``signals``):
+    the run stops there with status ``error``, its rollout kept (``exc.rollout``).
+
+    Attributes name the method and the time; ``__cause__`` is the controller's exception and
+    ``user_traceback`` its frames when the controller is the user's own code.
+    """
+
+    def __init__(self, method: str, time_s: float, cause: BaseException, *, users: bool):
+        super().__init__(
+            f"the controller's {method}() raised at t = {time_s:.6g} s: "
+            f"{type(cause).__name__}: {cause}"
+        )
+        self.method = method
+        self.time_s = time_s
+        if users:
+            self.user_traceback = user_traceback(cause)
 
 
 class FunnelViolation(SimulationError):

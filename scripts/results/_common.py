@@ -29,6 +29,21 @@ def producer_cli(doc: str | None) -> None:
         description=doc, epilog="Run by `make results` (scripts/make_results.py); no arguments."
     )
     parser.parse_args()
+    refuse_shortened_runs()
+
+
+def refuse_shortened_runs() -> None:
+    """Exit 2 if ``UVMS_PIN_MAX_DURATION_S`` is set: published results come from full runs
+    only (a shortened run would write a shortened table)."""
+    from uvms_pin.sim.shortened import MAX_DURATION_ENV
+
+    if os.environ.get(MAX_DURATION_ENV, "").strip():
+        print(
+            f"make results: {MAX_DURATION_ENV} is set ({os.environ[MAX_DURATION_ENV]!r}): the "
+            "published results come from full-length runs only; unset it",
+            file=sys.stderr,
+        )
+        raise SystemExit(2)
 
 
 def scratch(name: str) -> Path:

@@ -6,6 +6,8 @@ import json
 
 from _common import ROOT, publish_figure, scratch, uvms_pin, write_result
 
+from uvms_pin.results.rollout import Rollout
+
 # (metrics.json key, label, format)
 ROWS = (
     ("status", "status", "{}"),
@@ -26,20 +28,45 @@ ROWS = (
 )
 
 
-def produce(name: str, scenario: str, title: str, figure: str) -> None:
+def produce(
+    name: str, scenario: str, title: str, figure: str, replay: bool = False, extra: str = ""
+) -> None:
+    """Run ``scenario`` with the CLI and write its metrics table (with the vertical contact
+    force after the transient; with ``replay``, also the size of its replay.html), then
+    ``extra`` (more Markdown)."""
     out = scratch(name)
-    result = uvms_pin("run", scenario, "--out", str(out), "--quiet")
+    result = uvms_pin("run", scenario, "--out", str(out), "--quiet", *(["--html"] * replay))
     metrics = json.loads((out / "metrics.json").read_text())
     lines = ["| metric | value |", "|---|---|"]
     lines += [
         f"| {label} | {fmt.format(metrics[key])} |" for key, label, fmt in ROWS if key in metrics
     ]
+    lines += _vertical_contact_force_row(out, metrics.get("transient_end_s"))
+    if replay:
+        size_mb = (out / "replay.html").stat().st_size / 1e6
+        lines.append(f"| replay.html (uvms-pin run --html) [MB] | {size_mb:.1f} |")
     if metrics.get("error"):
         lines.append(f"| stopped because | {metrics['error']} |")
     body = (
         f"`uvms-pin run {scenario}` (exit code {result.returncode}), seed "
-        f"{metrics['seed']}:\n\n" + "\n".join(lines) + f"\n\n![force](../{figure})\n"
+        f"{metrics['seed']}:\n\n" + "\n".join(lines) + f"\n\n![force](../{figure})\n" + extra
     )
     publish_figure(out / "force.png", figure)
     write_result(name, title, f"python scripts/results/{name}.py", body)
     assert (ROOT / "docs" / figure).is_file()
+
+
+def _vertical_contact_force_row(out, transient_end_s: float | None) -> list[str]:
+    """The contact force along world z after the transient, min / mean / max [N] (the
+    force no controller asks for: what waves and the vehicle's motion leave)."""
+    if transient_end_s is None:
+        return []
+    rollout = Rollout.load(out)
+    after = rollout.time_s > transient_end_s
+    fz = rollout.wrench_contact_world[after, 2]
+    if not fz.size:
+        return []
+    return [
+        f"| vertical contact force f_z after the transient, min / mean / max [N] | "
+        f"{fz.min():.3f} / {fz.mean():.3f} / {fz.max():.3f} |"
+    ]

@@ -273,6 +273,8 @@ void bind_environment(nb::module_& m) {
   nb::class_<uvms::JointStopsModel>(m, "JointStops",
                                     "Compliant stops at the joint limits (joint_stops.hpp).")
       .def(nb::init<>())
+      .def_rw("q_index", &uvms::JointStopsModel::q_index)
+      .def_rw("v_index", &uvms::JointStopsModel::v_index)
       .def_rw("lower_rad", &uvms::JointStopsModel::lower_rad)
       .def_rw("upper_rad", &uvms::JointStopsModel::upper_rad)
       .def_rw("stiffness_Nm_rad", &uvms::JointStopsModel::stiffness_Nm_rad)

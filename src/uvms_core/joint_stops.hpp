@@ -5,13 +5,16 @@
 #include <algorithm>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "types.hpp"
 
 namespace uvms {
 
 struct JointStopsModel {
-  Eigen::VectorXd lower_rad;  // arm joints q[7:], +-inf: no stop
+  std::vector<int> q_index;   // each stopped joint's coordinate in q (one coordinate each)
+  std::vector<int> v_index;   // and in zeta
+  Eigen::VectorXd lower_rad;  // its limits, +-inf: no stop
   Eigen::VectorXd upper_rad;
   double stiffness_Nm_rad = 1.0e3;
   double damping_Nm_s_rad = 5.0;
@@ -20,18 +23,22 @@ struct JointStopsModel {
   void add_torque(const Eigen::Ref<const Eigen::VectorXd>& q,
                   const Eigen::Ref<const Eigen::VectorXd>& v, Eigen::VectorXd& out) const {
     const Eigen::Index n = lower_rad.size();
-    if (upper_rad.size() != n || v.size() != n + 6 || q.size() != n + 7) {
-      throw InputError("joint stops of " + std::to_string(n) + " joints for a model of nv = " +
-                       std::to_string(v.size()));
+    const auto count = static_cast<std::size_t>(n);
+    if (upper_rad.size() != n || q_index.size() != count || v_index.size() != count) {
+      throw InputError("joint stops: one q index, v index and pair of limits per joint");
     }
-    for (Eigen::Index i = 0; i < n; ++i) {
-      const double over = q[7 + i] - upper_rad[i];
-      const double under = lower_rad[i] - q[7 + i];
-      const double rate = v[6 + i];
+    for (std::size_t i = 0; i < count; ++i) {
+      const int iq = q_index[i], iv = v_index[i];
+      if (iq < 0 || iq >= q.size() || iv < 0 || iv >= v.size()) {
+        throw InputError("joint stops: a joint index is outside the model's q or v");
+      }
+      const auto k = static_cast<Eigen::Index>(i);
+      const double over = q[iq] - upper_rad[k];
+      const double under = lower_rad[k] - q[iq];
       if (over > 0.0) {
-        out[6 + i] -= std::max(0.0, stiffness_Nm_rad * over + damping_Nm_s_rad * rate);
+        out[iv] -= std::max(0.0, stiffness_Nm_rad * over + damping_Nm_s_rad * v[iv]);
       } else if (under > 0.0) {
-        out[6 + i] += std::max(0.0, stiffness_Nm_rad * under - damping_Nm_s_rad * rate);
+        out[iv] += std::max(0.0, stiffness_Nm_rad * under - damping_Nm_s_rad * v[iv]);
       }
     }
   }

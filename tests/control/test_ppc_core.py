@@ -17,7 +17,12 @@ import math
 import numpy as np
 import pinocchio as pin
 import pytest
-from conftest import ROOT, mount_on_reference_vehicle, random_configuration
+from conftest import (
+    ROOT,
+    continuous_joint_urdf,
+    mount_on_reference_vehicle,
+    random_configuration,
+)
 from test_ppc_oracle import (
     CLAMP,
     REALISTIC_WEIGHTS,
@@ -33,6 +38,7 @@ from uvms_pin.control import task_space
 from uvms_pin.control.measurement import Measurement
 from uvms_pin.control.ppc import PPCParams, PrescribedPerformanceController
 from uvms_pin.errors import FunnelViolation, ParameterError, ScenarioError
+from uvms_pin.model.arm_joints import ArmJoints
 from uvms_pin.physics.compiled.extension import core_module
 from uvms_pin.scenario.load import load_scenario
 
@@ -208,8 +214,9 @@ def variant_params(name: str, model: pin.Model) -> PPCParams:
     fields = dict(VARIANTS[name])
     if "velocity_weights" in fields:
         fields["velocity_weights"] = [*fields["velocity_weights"], *[1.0] * n_joints]
-    if fields.get("null_space_target") == "mid+0.2":
-        lower, upper = model.lowerPositionLimit[7:], model.upperPositionLimit[7:]
+    if fields.get("null_space_target") == "mid+0.2":  # 0.2 for a joint without limits
+        arm = ArmJoints.of(model)
+        lower, upper = (np.where(arm.limited, x, 0.0) for x in (arm.lower, arm.upper))
         fields["null_space_target"] = 0.5 * (lower + upper) + 0.2
     return PPCParams(**fields)
 
@@ -287,6 +294,25 @@ def test_random_states_on_a_mounted_7_joint_panda(panda_uvms, variant):
         lambda r: random_configuration(panda_uvms, r),
     )
     assert outcomes["ok"] >= 25  # of 60 calls
+
+
+@pytest.mark.parametrize("variant", ["paper", "weights+null-space+target+gains"])
+def test_random_states_with_continuous_joints(tmp_path, variant):
+    """Joints 1 and 3 continuous (q holds their cos and sin, nq = 12 + 1 != nv = 10); the
+    null-space pull acts on the limited joints 2 and 4 only."""
+    path = continuous_joint_urdf(tmp_path, ("arm_joint1", "arm_joint3"))
+    uvms = up.load_uvms(path)
+    model = uvms.model
+    assert (model.nq, model.nv) == (13, 10)
+    outcomes = compare_random_states(
+        model,
+        model.frames[uvms.ee_frame_id].name,
+        variant_params(variant, model),
+        np.random.default_rng(19),
+        40,
+        lambda r: random_configuration(uvms, r),
+    )
+    assert outcomes["ok"] >= 30  # of 80 calls
 
 
 def test_beyond_the_funnels_the_same_errors_and_extension(reference_uvms):

@@ -174,3 +174,11 @@ def test_depth_profile_current():
     assert law.velocity(0.0, [[0, 0, -20.0]])[0, 0] == pytest.approx(0.0)
     with pytest.raises(ParameterError, match="increasing"):
         DepthProfileCurrent([1, 0, 0], [0.0, 0.0], [1, 1])
+
+
+@pytest.mark.parametrize("n", [0, 2001, 10_000_000, 2.5, True])
+def test_a_sea_has_a_bounded_number_of_components(n):
+    """Refused before anything is drawn: 1e7 components took GBs and minutes (deaf to Ctrl-C)."""
+    with pytest.raises(ParameterError, match=r"n_components must be an integer in 1\.\.2000"):
+        IrregularSea(0.5, 5.0, n_components=n)
+    assert IrregularSea(0.5, 5.0, n_components=2000).components.amplitude_m.size == 2000

@@ -195,3 +195,27 @@ def test_the_surface_cuts_a_box_mesh_where_the_box_is(load_body, tmp_path):
         cut_box = from_box.wet(rotation, position, SurfaceAt())
         assert cut_mesh.volume_m3 == pytest.approx(cut_box.volume_m3, rel=1e-12, abs=1e-15)
         np.testing.assert_allclose(cut_mesh.moment_m4, cut_box.moment_m4, rtol=0, atol=1e-14)
+
+
+@pytest.mark.parametrize(
+    "vertices",
+    [
+        [[0, 0, 0], [1, 0, 0], [0, 1, 0]],  # one triangle: qhull needs 4 points
+        [[0, 0, 0], [1, 0, 0], [0, 1, 0], [1, 1, 0]],  # every point in one plane
+    ],
+    ids=["one-triangle", "flat"],
+)
+def test_a_mesh_enclosing_no_volume_is_refused_naming_the_file(load_body, tmp_path, vertices):
+    """A flat mesh has no convex hull: ParameterError naming the file (qhull's own error was
+    raised through), and the link's derived body refuses it as a ModelError naming the link."""
+    from uvms_pin.errors import ModelError, ParameterError
+    from uvms_pin.hydro.mesh import load_mesh_geometry
+
+    faces = [[0, 1, 2]] if len(vertices) == 3 else [[0, 1, 2], [1, 3, 2]]
+    path = tmp_path / "flat.stl"
+    trimesh.Trimesh(vertices, faces, process=False).export(path)
+    with pytest.raises(ParameterError, match=r"flat\.stl' encloses no volume"):
+        load_mesh_geometry(path)
+    text = body_urdf(mass=1.0, collision=f'<mesh filename="{path}"/>')
+    with pytest.raises(ModelError, match=r"link 'body'.*encloses no volume"):
+        load_body(text)

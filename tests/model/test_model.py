@@ -136,8 +136,8 @@ def test_missing_file(tmp_path):
     with pytest.raises(up.ModelError, match="file not found") as info:
         up.load_uvms(path)
     assert str(path) in str(info.value)
-    with pytest.raises(up.ModelError, match="file not found"):
-        up.load_uvms(tmp_path)  # a directory is not a URDF file either
+    with pytest.raises(up.ModelError, match="is a directory, not a URDF file"):
+        up.load_uvms(tmp_path)
 
 
 def test_malformed_xml(write_urdf):
@@ -339,6 +339,18 @@ def test_inverted_joint_limits_raise_model_error(write_urdf):
     message = str(info.value)
     assert str(path) in message and "joint 'shoulder'" in message
     assert "lower = 1.0 > upper = -1.0" in message
+
+
+@pytest.mark.parametrize("kind", ["revolute", "continuous", "prismatic"])
+def test_a_zero_joint_axis_is_refused_naming_the_joint(write_urdf, kind):
+    """It loaded, and the run then 'diverged at t = 0' on a singular articulated inertia."""
+    text = _two_joint_robot(-1.0, 1.0).replace('<axis xyz="0 0 1"/>', '<axis xyz="0 0 0"/>')
+    text = text.replace('type="revolute"', f'type="{kind}"')
+    path = write_urdf(text)
+    with pytest.raises(up.ModelError) as info:
+        up.load_uvms(path, ee_frame="arm", sensor_frame="arm")
+    assert str(path) in str(info.value)
+    assert "joint 'shoulder': <axis xyz=\"0 0 0\"> is zero" in str(info.value)
 
 
 def test_equal_joint_limits_load(write_urdf):

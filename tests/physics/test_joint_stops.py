@@ -6,8 +6,9 @@ from __future__ import annotations
 import numpy as np
 import pinocchio as pin
 import pytest
-from conftest import REL
+from conftest import REL, continuous_joint_urdf
 
+import uvms_pin as up
 from uvms_pin.physics.joint_stops import JointStops
 from uvms_pin.sim.integrators import RK4
 from uvms_pin.sim.plant import Plant
@@ -80,3 +81,24 @@ def test_the_core_stops_equal_the_reference(reference_uvms):
     q = uvms.neutral_configuration()
     v, tau = rng.normal(size=uvms.nv), rng.normal(size=uvms.nv)
     assert np.array_equal(core.acceleration(0.0, q, v, tau), bare.acceleration(0.0, q, v, tau))
+
+
+def test_a_continuous_joint_has_no_stop_and_the_others_keep_theirs(tmp_path):
+    """arm_joint1 continuous: q holds its cos and sin, so the stops of joints 2-4 sit at
+    shifted coordinates; core and reference agree, and only those joints are pushed."""
+
+    uvms = up.load_uvms(continuous_joint_urdf(tmp_path, ("arm_joint1",)))
+    stops = JointStops.of_model(uvms.model, 300.0, 3.0)
+    assert stops.names == ("arm_joint2", "arm_joint3", "arm_joint4")
+    assert stops.q_index.tolist() == [9, 10, 11] and stops.v_index.tolist() == [7, 8, 9]
+    core = Plant(uvms, joint_stops=stops, free_surface=False, backend="core")
+    python = Plant(uvms, joint_stops=stops, free_surface=False, backend="python")
+    assert core._core() is not None
+    q = uvms.neutral_configuration()
+    q[stops.q_index] = stops.upper_rad + 0.1  # every stopped joint 0.1 rad past its limit
+    v, tau = np.zeros(uvms.nv), np.zeros(uvms.nv)
+    torque = stops.torque(q, v)
+    assert torque[6] == 0.0 and np.allclose(torque[7:], -30.0)
+    a_core = core.acceleration(0.0, q, v, tau)
+    a_python = python.acceleration(0.0, q, v, tau)
+    assert np.allclose(a_core, a_python, rtol=REL, atol=REL * np.abs(a_python).max())

@@ -41,3 +41,40 @@ def test_native_stderr_is_captured_and_restored(capfd):
     os.write(2, b"after\n")
     assert captured.text == "Error: joint [j]"
     assert capfd.readouterr().err == "after\n"
+
+
+def test_files_written_together_are_replaced_together_or_not_at_all(tmp_path, monkeypatch):
+    import errno
+
+    from uvms_pin.errors import ResourceError
+    from uvms_pin.results.atomic import atomic_paths
+
+    a, b = tmp_path / "a.npz", tmp_path / "a.json"
+    a.write_text("old a")
+    b.write_text("old b")
+    real = os.replace
+
+    def replace(src, dst, *args, **kw):  # the second rename fails as on a full disk
+        if str(dst) == str(b):
+            raise OSError(errno.ENOSPC, "No space left on device", str(src))
+        return real(src, dst, *args, **kw)
+
+    monkeypatch.setattr(os, "replace", replace)
+    with pytest.raises(ResourceError) as info, atomic_paths(a, b) as (ta, tb):
+        ta.write_text("new a")
+        tb.write_text("new b")
+    assert info.value.filename == str(b) and info.value.errno == errno.ENOSPC
+    assert (a.read_text(), b.read_text()) == ("old a", "old b")  # the first put back
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["a.json", "a.npz"]  # no temporary
+    monkeypatch.setattr(os, "replace", real)
+    # a write failing without a file name (ENOSPC in the middle of a write) names both
+    with pytest.raises(ResourceError, match=r"a.npz and .*a.json"), atomic_paths(a, b) as (ta, _):
+        raise OSError(errno.ENOSPC, "No space left on device")
+    assert (a.read_text(), b.read_text()) == ("old a", "old b")
+    # a writer failing to read some other file keeps its own error
+    with pytest.raises(FileNotFoundError), atomic_paths(a) as (ta,):
+        (tmp_path / "elsewhere.txt").read_text()
+    with atomic_paths(a, b) as (ta, tb):
+        ta.write_text("new a")
+        tb.write_text("new b")
+    assert (a.read_text(), b.read_text()) == ("new a", "new b")

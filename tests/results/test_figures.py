@@ -53,3 +53,23 @@ def test_plot_kind_errors_name_the_problem(passive):
         passive.plot("forces")
     with pytest.raises(ParameterError, match=r"cannot plot 'first_level'.*e_x"):
         passive.plot("first_level")
+
+
+def test_the_pose_figure_shows_the_motion_not_the_depth(passive):
+    """z ~ -2 m on the axis of x and y flattened them: the start is taken out (and titled)."""
+    fig = plot_pose(passive)
+    ax_p = fig.axes[0]
+    start = passive.q[0, :3]
+    for line, k in zip(ax_p.get_lines(), range(3), strict=True):
+        assert line.get_ydata()[0] == 0.0
+        assert line.get_ydata()[-1] == pytest.approx(passive.q[-1, k] - start[k])
+    assert f"z = {start[2]:.3g} m" in ax_p.get_title()
+
+
+def test_the_energy_figure_of_a_driven_run_shows_the_balance(passive, ppc):
+    from uvms_pin.results.figures.standard import plot_energy
+
+    labels = [line.get_label() for line in plot_energy(ppc).axes[0].get_lines()]
+    assert "work of tau" in labels and any(label.startswith("work of water") for label in labels)
+    labels = [line.get_label() for line in plot_energy(passive).axes[0].get_lines()]
+    assert "work of tau" not in labels  # nothing drives a passive run

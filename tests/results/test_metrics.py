@@ -74,6 +74,22 @@ def test_effort_rms_and_peak_of_known_sines():
     assert m["joint_torque_rms_Nm"] == pytest.approx(1.5, rel=1e-12)
 
 
+def test_a_vehicle_without_an_arm_has_no_joint_torque_metrics_and_no_nan():
+    """A bare vehicle: the joint metrics do not apply, so they are absent (they were a NaN
+    RMS beside a 0 peak in metrics.json); every metric left is a finite number."""
+    r = Rollout.allocate(
+        N, 7, 6, {"simulated_time_s": 9.99, "wall_time_s": 1.0, "real_time_factor": 9.99}
+    )
+    r.time_s[:] = DT * np.arange(N)
+    for name in Rollout._BASE[1:]:
+        getattr(r, name)[...] = 0.0
+    r.q[:, 6] = 1.0
+    r.tau[:, 2] = sine(1.0)
+    m = compute_metrics(r)
+    assert "joint_torque_rms_Nm" not in m and "joint_torque_peak_Nm" not in m
+    assert all(math.isfinite(value) for value in m.values()), m
+
+
 def test_joint_torque_rms_follows_the_largest_joint_sample_by_sample():
     """|tau_1| = |2 sin|, |tau_2| = 1: the largest is 2 |sin| where |sin| > 1/2 (two
     thirds of the period), so mean(max^2) = 5/3 + 3^0.5 / pi (integrating 4 sin^2 there)."""

@@ -83,7 +83,8 @@ def test_the_comparison_overwrite_removes_its_models_directory_once_empty(tmp_pa
 
 def test_run_outputs_are_exactly_the_files_a_run_writes(tmp_path):
     """RUN lists the outputs by name: a new figure must be added there (or --overwrite
-    would leave it stale). The sea-state scenario writes every figure (flow.png too)."""
+    would leave it stale). The sea-state scenario writes every figure but one (flow.png
+    too); the surfacing scenario started at the waterline writes surface.png."""
     from uvms_pin.apps.outputs import write_outputs
     from uvms_pin.scenario.load import load_scenario
     from uvms_pin.sim.run import simulate
@@ -97,5 +98,22 @@ def test_run_outputs_are_exactly_the_files_a_run_writes(tmp_path):
     out.mkdir()
     figures = write_outputs(simulate(load_scenario(tmp_path / "s.toml")), out)
     assert any(p.name == "force.png" for p in figures)  # the paper figures are there too
-    written = {p.name for p in out.iterdir()}
+    at_the_surface = load_scenario(
+        ROOT / "scenarios" / "surfacing.toml",
+        {"scenario.duration_s": 0.2, "initial.position_world_m": [0.0, 0.0, -0.05]},
+    )
+    figures = write_outputs(simulate(at_the_surface), out / "surfacing")
+    assert "surface.png" in {p.name for p in figures}
+    written = {p.name for p in out.iterdir() if p.is_file()}
+    written |= {p.name for p in (out / "surfacing").iterdir()}
     assert written | {"replay.html"} == set(RUN.patterns)  # replay.html: with --html
+
+
+@pytest.mark.parametrize("empty", ["", "  "])
+def test_an_empty_out_is_not_the_current_directory(tmp_path, monkeypatch, empty):
+    monkeypatch.chdir(tmp_path)
+    with pytest.raises(OutputError, match="an empty path; give a directory"):
+        check_writable(empty)
+    with pytest.raises(OutputError, match="an empty path"), claim(empty, RUN):
+        pass
+    assert list(tmp_path.iterdir()) == []

@@ -144,3 +144,67 @@ def test_run_set_typo_exits_2_with_a_suggestion_and_writes_nothing(tmp_path):
     assert "did you mean 'water.current_world_m_s'?" in result.stderr
     assert "Traceback" not in result.stderr
     assert not out.exists()
+
+
+REALISTIC = ROOT / "scenarios" / "realistic_force_tracking.toml"
+
+
+def test_a_key_inside_an_array_of_tables_is_overridden():
+    """docs/scenarios.md lists ``actuation.thruster[i].max_forward_N``: --set reaches it."""
+    scenario = load_scenario(
+        REALISTIC,
+        {"actuation.thruster[0].max_forward_N": 0.0, "actuation.thruster[3].name": "up"},
+    )
+    thrusters = scenario.plant.actuation.thrusters
+    assert thrusters[0].max_forward_N == 0.0 and thrusters[1].max_forward_N == 21.6
+    assert thrusters[3].name == "up"
+    assert parse_assignment("actuation.thruster[0].max_forward_N=0") == (
+        "actuation.thruster[0].max_forward_N",
+        0,
+    )
+
+
+def test_a_table_value_replaces_the_whole_table():
+    raw = {"controller": {"type": "ppc", "k_x": 1.0}, "water": {"density_kg_m3": 1000.0}}
+    out = apply_overrides(raw, {"controller": {"type": "none"}})
+    assert out["controller"] == {"type": "none"} and raw["controller"]["k_x"] == 1.0
+    scenario = load_scenario(REALISTIC, {"controller": {"type": "none"}})
+    assert scenario.controller_factory.type == "none"
+    assert parse_assignment('controller={type="none"}') == ("controller", {"type": "none"})
+
+
+@pytest.mark.parametrize(
+    ("overrides", "message"),
+    [
+        ({"controller": 3}, "override 'controller': 'controller' is a whole table; give a table value"),
+        ({"controller": {"type": "nope"}}, "override 'controller': controller.type: must be one of"),
+        ({"controller": {"type": "none", "tpe": 1}}, "override 'controller': unknown key 'controller.tpe'; did you mean 'controller.type'?"),
+        ({"actuation.thruster[9].max_forward_N": 0}, "index 9 out of range, 'actuation.thruster' has 4 entries"),
+        ({"actuation.thruster[0]": {"name": "x"}}, "override 'actuation.thruster[0]': actuation.thruster[0].position_body_m: is required"),
+        ({"actuation.thruster[0].max_forward_N": -1}, "override 'actuation.thruster[0].max_forward_N': must be >= 0"),
+        ({"water[0].density_kg_m3": 1}, "'water' is not a list in the file"),
+        ({"actuation.thruster[0].name[1]": "x"}, "'actuation.thruster[0].name' is not a list"),
+    ],
+)  # fmt: skip
+def test_bad_table_and_element_overrides_name_the_override(overrides, message):
+    with pytest.raises(up.ScenarioError) as info:
+        load_scenario(REALISTIC, overrides)
+    assert message in str(info.value)
+
+
+def test_a_study_varies_a_thrusters_limit(tmp_path):
+    from uvms_pin.apps.study import load_study
+
+    (tmp_path / "base.toml").write_text(
+        REALISTIC.read_text().replace('"uvms_lbv150"', f'"{ROOT / "models" / "uvms_lbv150.urdf"}"')
+    )
+    (tmp_path / "s.toml").write_text(
+        '[study]\nbase = "base.toml"\nseed = 1\n[[parameter]]\n'
+        'path = "actuation.thruster[1].max_reverse_N"\napply = "scale"\nvalues = [0.5, 2.0]\n'
+    )
+    runs = load_study(tmp_path / "s.toml").runs()
+    limits = [
+        load_scenario(tmp_path / "base.toml", r.overrides).plant.actuation.thrusters[1]
+        for r in runs
+    ]
+    assert [t.max_reverse_N for t in limits] == [7.5, 30.0]  # 15 N x 0.5, x 2

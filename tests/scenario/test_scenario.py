@@ -133,7 +133,7 @@ def test_a_log_that_would_not_fit_in_memory_is_refused_before_allocating(tmp_pat
     assert "output.log_period_s" in message
     # the same limit with 1 GiB available: 10 s (1001 samples) loads, 1e6 s does not
     # (the package re-exports a function named simulate: reach the module itself)
-    module = importlib.import_module("uvms_pin.sim.settings")
+    module = importlib.import_module("uvms_pin.checks")
     monkeypatch.setattr(module, "available_memory_bytes", lambda: 2**30)
     load_scenario(write(tmp_path, MINIMAL.replace("duration_s = 0.1", "duration_s = 10.0")))
     with pytest.raises(up.ScenarioError, match="more than half of the 1 GiB available"):

@@ -38,6 +38,17 @@ def test_values_are_read_checked_and_defaulted():
         ({"b": 1}, lambda t: t.boolean("b", True), "water.b: must be true or false, got 1"),
         ({"n": 0}, lambda t: t.integer("n", minimum=1), "water.n: must be >= 1, got 0"),
         ({}, lambda t: t.number("k"), "water.k: is required"),
+        (
+            {"seed": -5},
+            lambda t: t.seed("seed", 0),
+            "water.seed: must be an integer in [0, 2^63 - 1], got -5",
+        ),
+        (
+            {"seed": 2**63},
+            lambda t: t.seed("seed", 0),
+            "water.seed: must be an integer in [0, 2^63 - 1]",
+        ),
+        ({"seed": 1.0}, lambda t: t.seed("seed", 0), "water.seed: must be an integer, got 1.0"),
         ({"e": 3}, lambda t: t.tables("e"), "water.e: must be an array of tables"),
     ],
 )

@@ -17,15 +17,16 @@ PAPER = ROOT / "scenarios" / "paper_force_tracking.toml"
 REALISTIC = ROOT / "scenarios" / "realistic_force_tracking.toml"
 PASSIVE = ROOT / "scenarios" / "passive_still_water.toml"
 
-# the blow-ups of issue 10, each in its first steps (0.2 s runs). (Density 1e9 under LSODA
-# is not one: it integrates, very stiffly, for 0.15 s before LSODA gives up, ~90 s of wall
-# time; tests/sim/test_integrators.py checks that a failed adaptive pass keeps its states.)
+# the blow-ups of issue 10, each in its first steps (0.2 s runs). (Its water density of 1e9
+# kg/m^3 and current of 1e5 m/s are refused at load now, as no water can be that:
+# tests/scenario/test_plausibility.py; tests/sim/test_integrators.py checks that a failed
+# adaptive pass keeps its states.)
 BLOW_UPS = {
     "stiffness 1e12, sampled RK4": (REALISTIC, {"environment.stiffness_N_m": [1e12] * 3}),
     "stiffness 1e12, continuous LSODA": (PAPER, {"environment.stiffness_N_m": [1e12] * 3}),
-    "water density 1e9, sampled RK4": (REALISTIC, {"water.density_kg_m3": 1e9}),
-    "current 1e5 m/s": (REALISTIC, {"water.current_world_m_s": [1e5, 0.0, 0.0]}),
-    "current 1e5 m/s, continuous LSODA": (PAPER, {"water.current_world_m_s": [1e5, 0.0, 0.0]}),
+    "water density 15000, sampled RK4": (REALISTIC, {"water.density_kg_m3": 15000.0}),
+    "current 1400 m/s": (REALISTIC, {"water.current_world_m_s": [1400.0, 0.0, 0.0]}),
+    "current 1400 m/s, no controller": (PASSIVE, {"water.current_world_m_s": [1400.0, 0.0, 0.0]}),
     "stiffness 1e7, no controller, RK4 at 0.5 ms": (
         PASSIVE,
         {
@@ -89,3 +90,17 @@ def test_cli_exits_3_and_saves_the_partial_rollout_of_a_blow_up(tmp_path):
     metrics = json.loads((out / "metrics.json").read_text())
     assert metrics["status"] == "SimulationError"
     assert len(up.Rollout.load(out)) == 1
+
+
+@pytest.mark.parametrize("seed", [-1, 2**63, 1.5])
+def test_a_seed_no_generator_takes_is_refused_where_it_is_given(seed):
+    from uvms_pin.flow import GaussMarkovCurrent, IrregularSea
+    from uvms_pin.sim.integrators import RK4
+    from uvms_pin.sim.settings import SimulationSettings
+
+    with pytest.raises(up.ParameterError, match="seed must be an integer in"):
+        SimulationSettings(1.0, RK4(0.01), seed=seed)
+    with pytest.raises(up.ParameterError, match="seed must be an integer in"):
+        IrregularSea(0.5, 6.0, seed=seed)
+    with pytest.raises(up.ParameterError, match="seed must be an integer in"):
+        GaussMarkovCurrent([0.1, 0, 0], 0.05, 10.0, 0.2, seed=seed)

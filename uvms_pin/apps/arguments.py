@@ -11,13 +11,15 @@ from __future__ import annotations
 
 import argparse
 import math
+import os
 from collections.abc import Callable
 
 from uvms_pin.errors import ParameterError
 
 
-def count(minimum: int) -> Callable[[str], int]:
-    """An integer >= ``minimum`` (process, job and start counts)."""
+def count(minimum: int, maximum: int | None = None, why: str = "") -> Callable[[str], int]:
+    """An integer in ``minimum..maximum`` (process, job and start counts); ``why``: what the
+    maximum is, for the message."""
 
     def parse(text: str) -> int:
         try:
@@ -26,9 +28,20 @@ def count(minimum: int) -> Callable[[str], int]:
             raise argparse.ArgumentTypeError(f"must be an integer, got {text!r}") from None
         if value < minimum:
             raise argparse.ArgumentTypeError(f"must be an integer >= {minimum}, got {value}")
+        if maximum is not None and value > maximum:
+            raise argparse.ArgumentTypeError(
+                f"must be an integer <= {maximum}{f' ({why})' if why else ''}, got {value}"
+            )
         return value
 
     return parse
+
+
+def process_count(minimum: int) -> Callable[[str], int]:
+    """A count of worker processes on this machine: at most 4 per CPU (more only wait for
+    the CPUs, each with its own copy of the model and its memory)."""
+    cpus = os.cpu_count() or 1
+    return count(minimum, 4 * cpus, f"4 per CPU, {cpus} CPUs here")
 
 
 def finite(text: str) -> float:
@@ -48,6 +61,22 @@ def positive(text: str) -> float:
     if value <= 0.0:
         raise argparse.ArgumentTypeError(f"must be positive, got {text!r}")
     return value
+
+
+def nonempty(what: str) -> Callable[[str], str]:
+    """Text that is not empty nor blank, ``what`` naming it for the message (``--out ""`` is
+    not the current directory: it is a missing value, most often an unset shell variable)."""
+
+    def parse(text: str) -> str:
+        if not text.strip():
+            raise argparse.ArgumentTypeError(f"must be {what}, got {text!r}")
+        return text
+
+    return parse
+
+
+#: a file or directory given on the command line
+path_text = nonempty("a path")
 
 
 def add_set_option(parser: argparse.ArgumentParser, help_text: str) -> None:
@@ -89,10 +118,17 @@ def add_comparison_command(
 
     parser = subparsers.add_parser(name, help=summary, description=description)
     parser.add_argument(
-        "scenario", nargs=None if scenario_required else "?", help="scenario TOML file"
+        "scenario",
+        nargs=None if scenario_required else "?",
+        type=path_text,
+        help="scenario TOML file",
     )
     parser.add_argument(
-        "--out", required=out_default is None, default=out_default, help="output directory"
+        "--out",
+        required=out_default is None,
+        default=out_default,
+        type=path_text,
+        help="output directory",
     )
     parser.add_argument("--overwrite", action="store_true", help=OVERWRITE_HELP)
     return parser

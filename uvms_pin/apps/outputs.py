@@ -8,18 +8,26 @@ import numpy as np
 
 from uvms_pin.results.rollout import Rollout
 
+METRICS_FILE = "metrics.json"
+
 
 def write_outputs(rollout: Rollout, out: Path) -> list[Path]:
-    """Rollout, metrics.json and figures into ``out``."""
+    """Rollout, metrics.json and figures into ``out``; the figures' paths."""
+    write_results(rollout, out)
+    return write_figures(rollout, out)
+
+
+def write_results(rollout: Rollout, out: Path) -> list[str]:
+    """``rollout.npz``, ``rollout.json`` and ``metrics.json`` into ``out`` (each written
+    whole or not at all); their names."""
     from uvms_pin.results.atomic import write_json_atomic
-    from uvms_pin.results.figures.paper import paper_figures
-    from uvms_pin.results.figures.standard import standard_figures
+    from uvms_pin.results.rollout import ARRAY_FILE, META_FILE
 
     out.mkdir(parents=True, exist_ok=True)
     rollout.save(out)
     metrics = rollout.metrics()
     write_json_atomic(
-        out / "metrics.json",
+        out / METRICS_FILE,
         {
             "status": rollout.metadata.get("status"),
             "error": rollout.metadata.get("error", ""),
@@ -27,6 +35,14 @@ def write_outputs(rollout: Rollout, out: Path) -> list[Path]:
             **metrics,
         },
     )
+    return [ARRAY_FILE, META_FILE, METRICS_FILE]
+
+
+def write_figures(rollout: Rollout, out: Path) -> list[Path]:
+    """Every figure the rollout has data for (none below two samples) into ``out``."""
+    from uvms_pin.results.figures.paper import paper_figures
+    from uvms_pin.results.figures.standard import standard_figures
+
     return (
         paper_figures(rollout, out)
         + standard_figures(rollout, out)

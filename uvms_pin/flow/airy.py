@@ -6,6 +6,7 @@ import math
 
 import numpy as np
 
+from uvms_pin.checks import Plausible
 from uvms_pin.errors import ParameterError
 from uvms_pin.flow.components import (
     STANDARD_GRAVITY_M_S2,
@@ -24,6 +25,21 @@ def _finite(value: float, name: str, *, positive: bool = False) -> float:
             f"{name} must be {'positive and ' if positive else ''}finite, got {value}"
         )
     return value
+
+
+#: A gravity wave's period [s]: below ~0.1 s waves are capillary ripples (surface tension,
+#: not gravity, restores them), beyond an hour they are tides
+WAVE_PERIOD = Plausible(
+    "s",
+    usual=(1.0, 30.0),
+    possible=(0.1, 3600.0),
+    usual_text="sea waves (swell: up to ~25 s)",
+    impossible_text="Airy theory is of gravity waves: shorter ones are capillary ripples, "
+    "longer ones tides",
+    hints=("a period in milliseconds?", ""),
+)
+#: Waves steeper than this break (Michell's limit of height over wavelength)
+MAX_STEEPNESS = 1.0 / 7.0
 
 
 class AiryWave(WaveField):
@@ -56,8 +72,17 @@ class AiryWave(WaveField):
         depth = float(water_depth_m)
         if not depth > 0.0:
             raise ParameterError(f"water_depth_m must be positive (or inf), got {water_depth_m}")
+        refusal = WAVE_PERIOD.refusal(period)  # (a scenario warns of unusual ones)
+        if refusal is not None:
+            raise ParameterError(f"period_s = {refusal}")
         omega = 2.0 * math.pi / period
         k = wavenumber(omega, depth, gravity_m_s2)
+        if 2.0 * amplitude * k / (2.0 * math.pi) > MAX_STEEPNESS:
+            raise ParameterError(
+                f"a wave of height 2 amplitude_m = {2.0 * amplitude:g} m over its wavelength "
+                f"{2.0 * math.pi / k:.4g} m (period {period:g} s) is steeper than 1/7: it "
+                "breaks, and Airy theory holds for gentle waves"
+            )
         self.amplitude_m, self.period_s, self.heading_rad = amplitude, period, heading
         self.water_depth_m, self.phase_rad = depth, phase
         self.components = WaveComponents(

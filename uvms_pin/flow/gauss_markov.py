@@ -19,7 +19,7 @@ import math
 
 import numpy as np
 
-from uvms_pin.checks import finite_vector
+from uvms_pin.checks import finite_vector, seed_value
 from uvms_pin.errors import ParameterError
 from uvms_pin.flow.base import FlowField, as_points
 
@@ -75,7 +75,7 @@ class GaussMarkovCurrent(FlowField):
         self.time_constant_s = _positive(time_constant_s, "time_constant_s")
         self.bound_m_s = _positive(bound_m_s, "bound_m_s")
         self.sample_period_s = _positive(sample_period_s, "sample_period_s")
-        self.seed = int(seed)
+        self.seed = seed_value("seed", seed)
         self._rng = np.random.default_rng(self.seed)
         self._samples = np.tile(self.mean_velocity_world_m_s, (1, 1))
         self._decay = math.exp(-self.sample_period_s / self.time_constant_s)

@@ -15,7 +15,9 @@ import math
 
 import numpy as np
 
+from uvms_pin.checks import seed_value
 from uvms_pin.errors import ParameterError
+from uvms_pin.flow.airy import WAVE_PERIOD
 from uvms_pin.flow.components import (
     STANDARD_GRAVITY_M_S2,
     WaveComponents,
@@ -37,6 +39,12 @@ def _spread_headings(
     cdf = np.concatenate([[0.0], np.cumsum(0.5 * (density[1:] + density[:-1]) * np.diff(grid))])
     cdf /= cdf[-1]
     return mean_rad + np.interp(rng.uniform(size=count), cdf, grid)
+
+
+#: More components than any sea needs (tens to hundreds resolve a JONSWAP spectrum); each
+#: is summed at every body at every integrator stage, so the bound keeps a run's time (and
+#: the time between two checks for Ctrl-C) in proportion.
+MAX_COMPONENTS = 2000
 
 
 class IrregularSea(WaveField):
@@ -67,8 +75,18 @@ class IrregularSea(WaveField):
         frequency_range: tuple[float, float] = (0.5, 3.5),
         gravity_m_s2: float = STANDARD_GRAVITY_M_S2,
     ):
-        if isinstance(n_components, bool) or not isinstance(n_components, int) or n_components < 1:
-            raise ParameterError(f"n_components must be a positive integer, got {n_components!r}")
+        if (
+            isinstance(n_components, bool)
+            or not isinstance(n_components, int)
+            or not 1 <= n_components <= MAX_COMPONENTS
+        ):
+            raise ParameterError(
+                f"n_components must be an integer in 1..{MAX_COMPONENTS}, got {n_components!r}"
+                " (each component is summed at every body at every integrator stage)"
+            )
+        refusal = WAVE_PERIOD.refusal(float(peak_period_s))  # a scenario warns of unusual
+        if refusal is not None:
+            raise ParameterError(f"peak_period_s = {refusal}")
         low, high = (float(x) for x in frequency_range)
         if not (0.0 < low < 1.0 < high and math.isfinite(high)):
             raise ParameterError(
@@ -82,7 +100,7 @@ class IrregularSea(WaveField):
         self.significant_height_m = float(significant_height_m)
         self.peak_period_s = float(peak_period_s)
         self.peak_enhancement = float(peak_enhancement)
-        self.seed = int(seed)
+        self.seed = seed_value("seed", seed)
         self.water_depth_m = float(water_depth_m)
         rng = np.random.default_rng(self.seed)
         wp = 2.0 * math.pi / self.peak_period_s

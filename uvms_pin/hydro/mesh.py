@@ -85,10 +85,19 @@ def _load_cached(path: str, mtime_ns: int, scale: tuple[float, float, float]) ->
     if not isinstance(mesh, trimesh.Trimesh) or len(mesh.faces) == 0:
         raise ParameterError(f"mesh '{path}' has no triangles")
     mesh.apply_scale(np.asarray(scale, dtype=float))
-    if mesh.is_watertight and abs(mesh.volume) > 0.0:
+    try:
+        hull = mesh.convex_hull
+    except Exception as exc:  # qhull refuses points in a plane or a line (its own error types)
+        raise ParameterError(
+            f"mesh '{path}' encloses no volume (flat or degenerate: {type(exc).__name__})"
+        ) from exc
+    # a flat surface's centre of mass is 0/0 to trimesh: its volume is refused below
+    with np.errstate(invalid="ignore", divide="ignore"):
+        closed = mesh.is_watertight and abs(mesh.volume) > 0.0
+    if closed:
         body, watertight = mesh, True
     else:
-        body, watertight = mesh.convex_hull, False
+        body, watertight = hull, False
     triangles = np.asarray(body.faces, dtype=np.int64)
     if float(body.volume) < 0.0:  # inward triangles: turn them out
         triangles = triangles[:, ::-1].copy()
@@ -96,7 +105,7 @@ def _load_cached(path: str, mtime_ns: int, scale: tuple[float, float, float]) ->
     if not (math.isfinite(volume) and volume > 0.0):
         raise ParameterError(f"mesh '{path}' encloses no volume (flat or degenerate)")
     centroid = np.asarray(body.center_mass, dtype=float)
-    obb = mesh.convex_hull.bounding_box_oriented.primitive
+    obb = hull.bounding_box_oriented.primitive
     transform = np.asarray(obb.transform, dtype=float)
     rotation = transform[:3, :3].copy()
     if np.linalg.det(rotation) < 0.0:  # keep a proper rotation (flip one box axis)

@@ -12,16 +12,20 @@ directory.
 
 from __future__ import annotations
 
+import difflib
 import functools
 import sys
 from collections.abc import Iterable
 from importlib import metadata
 from pathlib import Path
 
+from uvms_pin.errors import ParameterError
+
 __all__ = [
     "example_robot_data_dir",
     "find_model",
     "package_search_path",
+    "resolve_model",
     "resolve_resource",
     "shipped_models",
     "shipped_path",
@@ -123,3 +127,28 @@ def find_model(entry: str | Path, base_dir: str | Path = ".") -> Path | None:
     if len(path.parts) == 1 and path.stem in shipped_models() and path.suffix in ("", ".urdf"):
         return shipped_path(Path("models") / f"{path.stem}.urdf")
     return None
+
+
+def resolve_model(entry: str | Path, base_dir: str | Path = ".") -> Path:
+    """The model file ``entry`` names (`find_model`), or a ParameterError saying why there
+    is none: an empty entry, a directory, or neither a file nor a shipped model (the shipped
+    names listed, the closest first)."""
+    text = str(entry)
+    if not text.strip():
+        raise ParameterError(
+            f"the model is empty; give a URDF file or a shipped model ({', '.join(shipped_models())})"
+        )
+    found = find_model(entry, base_dir)
+    if found is not None:
+        return found
+    path = Path(entry)
+    candidate = path if path.is_absolute() else Path(base_dir) / path
+    if candidate.is_dir():
+        raise ParameterError(f"'{text}' is a directory ({candidate.resolve()}), not a URDF file")
+    names = shipped_models()
+    close = difflib.get_close_matches(path.stem, names, n=1, cutoff=0.6)
+    hint = f"; did you mean '{close[0]}'?" if close else ""
+    raise ParameterError(
+        f"'{text}' is neither a file ({candidate.resolve()}) nor a shipped model "
+        f"({', '.join(names)}){hint}"
+    )

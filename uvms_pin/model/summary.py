@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import numpy as np
+import pinocchio as pin
 
 from uvms_pin.hydro.hull import Hull
 from uvms_pin.model.uvms import UVMS
@@ -11,6 +12,25 @@ from uvms_pin.results.format import numbers_text
 
 def _frame_name(uvms: UVMS, frame_id: int | None) -> str:
     return "none (vehicle only)" if frame_id is None else uvms.model.frames[frame_id].name
+
+
+def _shape_frame(uvms: UVMS, body) -> str:
+    """Where a derived body's frame (its collision shape's) is in its link's frame."""
+    model = uvms.model
+    link = body.name.split("/")[0]
+    # a link's own frame (a fixed joint may carry its name too)
+    if not model.existFrame(link, pin.FrameType.BODY):
+        return f"the collision shape's, [{numbers_text(body.placement_in_joint.translation, 4)}] m in the joint frame"
+    link_in_joint = model.frames[model.getFrameId(link, pin.FrameType.BODY)].placement
+    shape_in_link = link_in_joint.inverse() * body.placement_in_joint
+    xyz, rpy = (
+        np.where(np.abs(x) < 1e-12, 0.0, x)  # round-off of the composed placements
+        for x in (shape_in_link.translation, pin.rpy.matrixToRpy(shape_in_link.rotation))
+    )
+    return (
+        f"the collision shape's: origin [{numbers_text(xyz, 4)}] m, "
+        f"rpy [{numbers_text(rpy, 4)}] rad in link {link}'s frame"
+    )
 
 
 def model_summary(uvms: UVMS) -> str:
@@ -38,7 +58,9 @@ def model_summary(uvms: UVMS) -> str:
         f"  {'total':<16}{uvms.mass_kg:>11.4f}{uvms.volume_m3:>14.6f}{-uvms.net_buoyancy_N:>21.4f}",
         f"net buoyancy: {uvms.net_buoyancy_N:+.4f} N ({'floats' if uvms.net_buoyancy_N > 0 else 'sinks' if uvms.net_buoyancy_N < 0 else 'neutral'})",
         "",
-        "hydrodynamic bodies (coefficients at the link origin, link frame; * = derived from geometry):",
+        "hydrodynamic bodies (coefficients at the origin of each body's frame, in that frame: "
+        "the link frame for a <hydrodynamics> element, the collision shape's frame for "
+        "coefficients derived from geometry, marked *):",
     ]
     hulls = dict(zip(uvms.surface_bodies.body_index, uvms.surface_bodies.hulls, strict=True))
     for k, body in enumerate(uvms.hydro_bodies):
@@ -47,6 +69,8 @@ def model_summary(uvms: UVMS) -> str:
         lines.append(
             f" {mark}{body.name} (on joint {model.names[body.joint_id]}): V = {p.volume_m3:.6g} m^3, r_b = [{numbers_text(p.center_of_buoyancy_m, 4)}] m"
         )
+        if p.derived:
+            lines.append(f"     frame             {_shape_frame(uvms, body)}")
         lines.append(f"     free surface cuts {hull_text(hulls.get(k))}")
         lines.append(f"     added mass diag   [{numbers_text(np.diag(p.added_mass), 4)}]")
         lines.append(f"     linear damping    [{numbers_text(np.diag(p.linear_damping), 4)}]")
@@ -58,11 +82,17 @@ def model_summary(uvms: UVMS) -> str:
         "arm joints:",
         f"  {'joint':<16}{'lower [rad]':>12}{'upper [rad]':>12}{'effort':>10}{'velocity':>10}",
     ]
-    for k, name in enumerate(uvms.arm_joint_names):
-        idx_q, idx_v = 7 + k, 6 + k
+    arm = uvms.arm_joints
+    for k, name in enumerate(arm.names):
+        idx_v = 6 + k
+        lower, upper = (
+            f"{x:>12.3f}" if np.isfinite(x) else f"{'none':>12}"
+            for x in (arm.lower[k], arm.upper[k])
+        )
         lines.append(
-            f"  {name:<16}{model.lowerPositionLimit[idx_q]:>12.3f}{model.upperPositionLimit[idx_q]:>12.3f}"
+            f"  {name:<16}{lower}{upper}"
             f"{model.effortLimit[idx_v]:>10.3g}{model.velocityLimit[idx_v]:>10.3g}"
+            + ("  continuous: q holds (cos, sin)" if arm.kinds[k] == "continuous" else "")
         )
     return "\n".join(lines)
 

@@ -16,15 +16,37 @@ from dataclasses import dataclass, field
 import numpy as np
 import pinocchio as pin
 
+from uvms_pin.checks import Plausible
 from uvms_pin.errors import ModelError
 from uvms_pin.hydro.added_mass import added_mass_in_parent
 from uvms_pin.hydro.hull import HullPiece
 from uvms_pin.hydro.params import HydroParams
+from uvms_pin.model.arm_joints import ArmJoints
 from uvms_pin.model.hulls import SurfaceBodies
 
 __all__ = ["DEFAULT_WATER_DENSITY_KG_M3", "UVMS", "HydroBody"]
 
 DEFAULT_WATER_DENSITY_KG_M3 = 1025.0  # sea water; a parameter of load_uvms, never hidden
+
+#: What water's density is [kg/m^3]
+WATER_DENSITY = Plausible(
+    "kg/m^3",
+    usual=(990.0, 1050.0),
+    possible=(500.0, 15000.0),
+    usual_text="fresh to sea water",
+    impossible_text="no liquid is that light or dense (mercury: 13534 kg/m^3)",
+    hints=("sea water is 1025 kg/m^3 (1.025 g/cm^3)",) * 2,
+)
+#: What a body of a UVMS is, on average: its mass over the water it displaces [kg/m^3]
+BODY_DENSITY = Plausible(
+    "kg/m^3",
+    usual=(50.0, 15000.0),
+    possible=(1.2, 22600.0),
+    usual_text="what vehicles and arms are made of, foam to tungsten",
+    impossible_text="no body in water is lighter than air (1.2 kg/m^3) or denser than osmium "
+    "(22590 kg/m^3)",
+    hints=("a <volume> in litres?", "a <mass> in grams?"),
+)
 
 
 @dataclass(frozen=True)
@@ -165,6 +187,17 @@ class UVMS:
         return (self.water_density_kg_m3 * self.volume_m3 - self.mass_kg) * g
 
     @property
+    def arm_joints(self) -> ArmJoints:
+        """The arm's joints: names, kinds, limits; q <-> one position per joint.
+
+        Raises ModelError for an arm joint of more than one degree of freedom (a ball joint
+        built in code: the dynamics take it, a scenario's one-angle-per-joint keys do not).
+        """
+        if "arm_joints" not in self.cache:
+            self.cache["arm_joints"] = ArmJoints.of(self.model, self.source)
+        return self.cache["arm_joints"]
+
+    @property
     def arm_joint_names(self) -> list[str]:
         return list(self.model.names[2:])
 
@@ -184,11 +217,10 @@ class UVMS:
         return self.ee_frame_id
 
     def neutral_configuration(self) -> np.ndarray:
-        """q at the origin, level, arm at zero (clipped into the joint limits)."""
+        """q at the origin, level, every arm joint at zero (clipped into its limits)."""
         q = pin.neutral(self.model)
-        lo = self.model.lowerPositionLimit[7:]
-        hi = self.model.upperPositionLimit[7:]
-        q[7:] = np.clip(q[7:], lo, hi)
+        arm = self.arm_joints
+        q[7:] = arm.configuration(arm.clip(np.zeros(arm.count)))
         return q
 
     def copy(self) -> UVMS:

@@ -29,9 +29,11 @@ class JointStops:
     """Compliant stops at the arm joints' limits.
 
     Attributes:
-        lower_rad, upper_rad: each arm joint's limits (n,) [rad or m] (+-inf: no stop).
+        lower_rad, upper_rad: each stopped joint's limits (n,) [rad or m] (+-inf: no stop).
         stiffness_Nm_rad: k_s [N m/rad] (> 0). damping_Nm_s_rad: c_s [N m s/rad] (>= 0).
         names: the joints, for messages and metrics.
+        q_index, v_index: each joint's coordinate in q and in zeta (n,); None: the arm's
+            joints in order, one coordinate each (q[7:], zeta[6:]).
     """
 
     lower_rad: np.ndarray
@@ -39,6 +41,8 @@ class JointStops:
     stiffness_Nm_rad: float = 1.0e3
     damping_Nm_s_rad: float = 5.0
     names: tuple[str, ...] = ()
+    q_index: np.ndarray | None = None
+    v_index: np.ndarray | None = None
 
     def __post_init__(self) -> None:
         if not (math.isfinite(self.stiffness_Nm_rad) and self.stiffness_Nm_rad > 0.0):
@@ -47,38 +51,43 @@ class JointStops:
             raise ParameterError(f"stop damping must be >= 0, got {self.damping_Nm_s_rad}")
         if np.any(self.lower_rad > self.upper_rad):
             raise ParameterError("a joint's lower limit is above its upper limit")
+        n = len(self.lower_rad)
+        if self.q_index is None:
+            object.__setattr__(self, "q_index", 7 + np.arange(n))
+        if self.v_index is None:
+            object.__setattr__(self, "v_index", 6 + np.arange(n))
 
     @staticmethod
     def of_model(model: pin.Model, stiffness_Nm_rad: float = 1.0e3, damping_Nm_s_rad: float = 5.0):
-        """The stops of a UVMS model's arm joints (one coordinate each, after the
-        free-flyer: q[7:], zeta[6:]), from its position limits."""
-        if model.nq - 7 != model.nv - 6:
-            raise ParameterError(
-                "joint stops need one coordinate per arm joint (no continuous or spherical joint)"
-            )
+        """The stops of a UVMS model's arm joints with one coordinate (revolute,
+        prismatic), from its position limits; a continuous joint has none."""
+        joints = [j for j in range(2, model.njoints) if model.joints[j].nq == 1]
+        q_index = np.array([model.joints[j].idx_q for j in joints], dtype=int)
         return JointStops(
-            np.array(model.lowerPositionLimit[7:], dtype=float),
-            np.array(model.upperPositionLimit[7:], dtype=float),
+            np.array(model.lowerPositionLimit[q_index], dtype=float),
+            np.array(model.upperPositionLimit[q_index], dtype=float),
             float(stiffness_Nm_rad),
             float(damping_Nm_s_rad),
-            tuple(model.names[2:]),
+            tuple(model.names[j] for j in joints),
+            q_index,
+            np.array([model.joints[j].idx_v for j in joints], dtype=int),
         )
 
     def torque(self, q: np.ndarray, v: np.ndarray) -> np.ndarray:
         """tau_stop (nv,): zero on the vehicle and on every joint inside its range."""
         out = np.zeros(v.shape[0])
-        joints, rates = q[7:], v[6:]
+        joints, rates = q[self.q_index], v[self.v_index]
         k, c = self.stiffness_Nm_rad, self.damping_Nm_s_rad
         over = np.maximum(joints - self.upper_rad, 0.0)
         under = np.maximum(self.lower_rad - joints, 0.0)
         push_down = np.where(over > 0.0, np.maximum(0.0, k * over + c * rates), 0.0)
         push_up = np.where(under > 0.0, np.maximum(0.0, k * under - c * rates), 0.0)
-        out[6:] = push_up - push_down
+        out[self.v_index] = push_up - push_down
         return out
 
     def at_stop(self, q: np.ndarray) -> np.ndarray:
         """Which joints are past a limit (n,) bool, at q (nq,) or a trajectory (T, nq)."""
-        joints = np.asarray(q)[..., 7:]
+        joints = np.asarray(q)[..., self.q_index]
         return (joints > self.upper_rad) | (joints < self.lower_rad)
 
     def record(self) -> dict[str, Any]:

@@ -2,6 +2,8 @@
 
 A file is written under a temporary name in its own directory and renamed over its target
 (atomic on POSIX): a crash or Ctrl-C leaves the previous file or none, never half of one.
+When the system refuses the write (a full disk), the error is a `ResourceError` naming the
+file that was being written, not its temporary name.
 The temporary file is created with mode 0666 filtered by the umask, as ``open()`` does
 (``tempfile.mkstemp`` would make every result 0600, unlike the figures beside it).
 """
@@ -18,6 +20,8 @@ from typing import IO, Any
 
 import numpy as np
 
+from uvms_pin.errors import ResourceError
+
 TEMP_SUFFIX = ".tmp"
 
 
@@ -29,15 +33,93 @@ def atomic_path(path: str | Path) -> Iterator[Path]:
     (``.fig.png.1a2b3c4d.png.tmp``) so that writers choosing a format by suffix still
     can be told it explicitly; it starts with a dot so that listings skip it.
     """
-    path = Path(path)
-    tmp = path.with_name(f".{path.name}.{secrets.token_hex(4)}{TEMP_SUFFIX}")
-    os.close(os.open(tmp, os.O_WRONLY | os.O_CREAT | os.O_EXCL, 0o666))
-    try:
+    with atomic_paths(path) as (tmp,):
         yield tmp
-        os.replace(tmp, path)
-    except BaseException:
-        tmp.unlink(missing_ok=True)
+
+
+@contextmanager
+def atomic_paths(*paths: str | Path) -> Iterator[list[Path]]:
+    """Temporary paths for files that go together (a rollout's arrays and metadata): all
+    renamed into place when the block ends without error, or none of them.
+
+    The renames come after every file is written; if one fails, the files renamed before it
+    are put back as they were (their previous versions kept as hard links meanwhile).
+    """
+    targets = [Path(p) for p in paths]
+    temps: list[Path] = []
+    try:
+        for path in targets:
+            temps.append(_temporary(path, ""))
+            os.close(os.open(temps[-1], os.O_WRONLY | os.O_CREAT | os.O_EXCL, 0o666))
+        yield temps
+        _replace_together(targets, temps)
+    except ResourceError:
+        _remove(temps)
         raise
+    except OSError as exc:
+        _remove(temps)
+        ours = {str(t): str(t) for t in targets} | {
+            str(tmp): str(t) for tmp, t in zip(temps, targets, strict=False)
+        }
+        if exc.filename is not None and str(exc.filename) not in ours:
+            raise  # the writer failed to read another file: its own error
+        # the disk (full, the directory removed...): say which file, not its temporary
+        where = (
+            " and ".join(str(t) for t in targets)
+            if exc.filename is None
+            else ours[str(exc.filename)]
+        )
+        raise _not_written(where, exc) from exc
+    except BaseException:
+        _remove(temps)
+        raise
+
+
+def _temporary(path: Path, kind: str) -> Path:
+    return path.with_name(f".{path.name}.{secrets.token_hex(4)}{kind}{TEMP_SUFFIX}")
+
+
+def _replace_together(targets: list[Path], temps: list[Path]) -> None:
+    """Rename each temporary onto its target; on a failure, undo the renames done."""
+    backups: list[Path | None] = []
+    for path in targets:
+        backup = None
+        if len(targets) > 1 and path.exists():
+            backup = _temporary(path, ".old")
+            try:
+                os.link(path, backup)
+            except OSError:  # no hard links here: this file cannot be put back
+                backup = None
+        backups.append(backup)
+    done = 0
+    try:
+        for tmp, path in zip(temps, targets, strict=True):
+            try:
+                os.replace(tmp, path)
+            except OSError as exc:
+                raise ResourceError(exc.errno, exc.strerror or str(exc), str(path)) from exc
+            done += 1
+    except OSError:
+        for path, backup in zip(targets[:done], backups[:done], strict=True):
+            if backup is not None:
+                os.replace(backup, path)
+            else:
+                path.unlink(missing_ok=True)
+        raise
+    finally:
+        _remove([b for b in backups if b is not None])
+
+
+def _remove(paths: list[Path]) -> None:
+    for path in paths:
+        path.unlink(missing_ok=True)
+
+
+def _not_written(path: str, exc: OSError) -> ResourceError:
+    """``exc`` (a full disk, a directory removed...) as the failure to write ``path``."""
+    if isinstance(exc, ResourceError):
+        return exc
+    return ResourceError(exc.errno, exc.strerror or str(exc), path)
 
 
 def atomic_write(path: str | Path, writer: Callable[[IO], object], *, binary: bool) -> Path:

@@ -7,6 +7,8 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from uvms_pin.results.joint_positions import KINDS, REVOLUTE, arm_positions, configuration_width
+
 if TYPE_CHECKING:
     from uvms_pin.results.rollout_data import RolloutData
 
@@ -16,10 +18,8 @@ def _rms(x: np.ndarray) -> float:
 
 
 def compute_metrics(rollout: RolloutData) -> dict[str, float]:
-    """Metrics of any run: timing, energy, motion and effort.
-
-    Energy drift is max |E(t) - E(0)| / max(|E(0)|, K(0)) over the run (E = T + U), the
-    number an energy-conservation check looks at. Efforts: vehicle force = |tau[0:3]|,
+    """Metrics of any run: timing, energy (`energy_metrics`: a balance when driven), motion
+    and effort. Efforts: vehicle force = |tau[0:3]|,
     vehicle torque = |tau[3:6]|, joint torques = max over joints of |tau_j|.
     """
     meta = rollout.metadata
@@ -33,11 +33,10 @@ def compute_metrics(rollout: RolloutData) -> dict[str, float]:
         return out
     kinetic = rollout.kinetic_energy_J
     total = rollout.total_energy_J
-    scale = max(abs(total[0]), kinetic[0], 1e-12)
     out.update(
         kinetic_energy_initial_J=float(kinetic[0]),
         kinetic_energy_final_J=float(kinetic[-1]),
-        energy_relative_drift_max=float(np.max(np.abs(total - total[0])) / scale),
+        **energy_metrics(rollout),
         energy_max_increase_J=float(np.max(np.diff(total))) if len(total) > 1 else 0.0,
         vehicle_displacement_m=float(np.linalg.norm(rollout.q[-1, :3] - rollout.q[0, :3])),
         vehicle_speed_final_m_s=float(np.linalg.norm(rollout.v[-1, :3])),
@@ -49,20 +48,63 @@ def compute_metrics(rollout: RolloutData) -> dict[str, float]:
     # 4-joint arm with one joint working reported half its torque); it is now the RMS of
     # max_j |tau_j|, the quantity the docstring names (the peak was already its maximum)
     arm = np.abs(rollout.tau[:, 6:])
-    joints = arm.max(axis=1) if arm.shape[1] else np.empty(0)  # no arm: peak 0, RMS NaN
     out.update(
         vehicle_force_peak_N=float(force.max()),
         vehicle_force_rms_N=_rms(force),
         vehicle_torque_peak_Nm=float(torque.max()),
         vehicle_torque_rms_Nm=_rms(torque),
-        joint_torque_peak_Nm=float(joints.max()) if joints.size else 0.0,
-        joint_torque_rms_Nm=_rms(joints),
     )
+    if arm.shape[1]:  # a vehicle without an arm has no joint torque metrics (not NaN, not 0)
+        joints = arm.max(axis=1)
+        out.update(joint_torque_peak_Nm=float(joints.max()), joint_torque_rms_Nm=_rms(joints))
     out.update(force_tracking_metrics(rollout))
     out.update(joint_limit_metrics(rollout))
     out.update(surface_metrics(rollout))
     out.update(world_contact_metrics(rollout))
     return out
+
+
+def driven(rollout: RolloutData) -> bool:
+    """Whether anything did work on the system: a generalized force, a contact, a
+    disturbance (the water's own forces aside)."""
+    return bool(
+        np.any(rollout.tau)
+        or np.any(rollout.wrench_contact_world)
+        or np.any(rollout.wrench_disturbance_body)
+    )
+
+
+def work_of_tau_J(rollout: RolloutData) -> np.ndarray:
+    """W(t) = int_0^t tau . zeta dt [J]: the work of the applied generalized force, by the
+    trapezoid rule over the logged samples (tau is held between control ticks, so this is
+    exact only as the log period goes to the control period)."""
+    power = np.einsum("ij,ij->i", rollout.tau, rollout.v)  # tau is conjugate to zeta [W]
+    steps = 0.5 * (power[1:] + power[:-1]) * np.diff(rollout.time_s)
+    return np.concatenate([[0.0], np.cumsum(steps)])
+
+
+def energy_metrics(rollout: RolloutData) -> dict[str, float]:
+    """The energy of a run. Driven (a force, contact or disturbance did work): its balance,
+    E(T) - E(0) = W_tau + W_rest, with W_tau the work of the applied generalized force
+    (`work_of_tau_J`) and W_rest the work of the water (damping, currents: dissipation),
+    the contact (the end-effector's, the world's) and the joint stops (their springs hold
+    energy while pressed), and the disturbance, what the energy change leaves. Not driven: the largest
+    relative change of E = T + U, max |E(t) - E(0)| / max(|E(0)|, T(0)) (the water's
+    damping dissipates; without it, the integration's error)."""
+    total = rollout.total_energy_J
+    change = float(total[-1] - total[0])
+    if not driven(rollout):
+        scale = max(abs(total[0]), rollout.kinetic_energy_J[0], 1e-12)
+        return {
+            "energy_change_J": change,
+            "energy_relative_drift_max": float(np.max(np.abs(total - total[0])) / scale),
+        }
+    work = float(work_of_tau_J(rollout)[-1])
+    return {
+        "energy_change_J": change,
+        "work_of_tau_J": work,
+        "work_of_water_contact_disturbance_J": change - work,
+    }
 
 
 #: A wet fraction this far below 1 counts as partly out of the water (rounding aside).
@@ -90,7 +132,8 @@ def surface_metrics(rollout: RolloutData) -> dict[str, float]:
 
 def joint_limit_metrics(rollout: RolloutData) -> dict[str, float]:
     """How far the arm went past its position limits [rad] (0: never), the time share, and
-    the time at a stop [s] (some joint past a limit; each sample counts until the next).
+    the time at a stop [s] (some joint past a limit; each sample counts until the next),
+    over the joints that have limits (a continuous joint has none; {} if no joint has).
 
     With joint stops (``[joints] hard_stops``, the default) a joint past its limit is
     pressing on its compliant stop, by tau / k_s; without them nothing stops it, and a
@@ -99,10 +142,19 @@ def joint_limit_metrics(rollout: RolloutData) -> dict[str, float]:
     meta = rollout.metadata
     if "arm_position_lower_rad" not in meta or len(rollout) == 0 or rollout.q.shape[1] <= 7:
         return {}
-    q = rollout.q[:, 7:]
-    lower = np.asarray(meta["arm_position_lower_rad"], dtype=float)
-    upper = np.asarray(meta["arm_position_upper_rad"], dtype=float)
-    excess = np.maximum(lower - q, 0.0) + np.maximum(q - upper, 0.0)
+    lower = np.array([-math.inf if x is None else x for x in meta["arm_position_lower_rad"]])
+    upper = np.array([math.inf if x is None else x for x in meta["arm_position_upper_rad"]])
+    kinds = meta.get("arm_joint_kinds") or [REVOLUTE] * lower.size
+    limited = np.isfinite(lower) & np.isfinite(upper)
+    if (  # metadata that does not describe these columns (written by hand, or damaged)
+        not np.any(limited)
+        or not lower.size == upper.size == len(kinds)
+        or not set(kinds) <= set(KINDS)
+        or configuration_width(kinds) != rollout.q.shape[1] - 7
+    ):
+        return {}
+    q = arm_positions(rollout.q[:, 7:], kinds)[:, limited]
+    excess = np.maximum(lower[limited] - q, 0.0) + np.maximum(q - upper[limited], 0.0)
     held = np.diff(rollout.time_s, append=rollout.time_s[-1])
     past = np.any(excess > 0.0, axis=1)
     return {

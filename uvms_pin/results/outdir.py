@@ -65,6 +65,7 @@ RUN = OutputKind(
         "first_level_errors.png",
         "second_level_errors.png",
         "flow.png",  # runs with waves or a varying current
+        "surface.png",  # runs in which a body left the water in part
     ),
     ("rollout.npz", "rollout.json", "metrics.json", "replay.html"),
 )
@@ -116,6 +117,8 @@ def check_writable(path: str | Path, option: str = "--out", shown: str | None = 
     Nothing is created: the first existing ancestor must be a directory we may write in.
     ``shown``: the file the user named, when ``path`` is its directory (messages name it).
     """
+    if not str(path).strip():  # Path("") is ".": an empty --out is a missing value
+        raise OutputError(f"{option} {str(path)!r}: an empty path; give a directory")
     path = Path(path)
     option = f"{option} {path if shown is None else shown}"
     target = path.absolute()

@@ -10,7 +10,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from uvms_pin.errors import ParameterError
-from uvms_pin.results.atomic import atomic_write, json_text
+from uvms_pin.results.atomic import atomic_paths, json_text
 from uvms_pin.results.rollout_data import RolloutData
 
 if TYPE_CHECKING:
@@ -65,8 +65,12 @@ class Rollout(RolloutData):
         text = json_text(self.metadata)
         arrays = {name: getattr(self, name) for name in self._BASE}
         arrays.update({f"signal__{k}": a for k, a in self.signals.items()})
-        atomic_write(out / ARRAY_FILE, lambda f: np.savez_compressed(f, **arrays), binary=True)
-        atomic_write(out / META_FILE, lambda f: f.write(text), binary=False)
+        # both written to temporary files first, then renamed: a full disk (or Ctrl-C) while
+        # writing either leaves the previous pair, never a new array file beside old metadata
+        with atomic_paths(out / ARRAY_FILE, out / META_FILE) as (arrays_tmp, meta_tmp):
+            with open(arrays_tmp, "wb") as f:
+                np.savez_compressed(f, **arrays)
+            meta_tmp.write_text(text, encoding="utf-8")
         return out
 
     @classmethod

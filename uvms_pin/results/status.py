@@ -1,9 +1,10 @@
 """How a run ended: a typed status, saved in the rollout's metadata and read back from it.
 
 The kinds are the names runs have always recorded (``rollout.json``'s ``status``): ``"ok"``
-(it ran to the end), ``"interrupted"`` (Ctrl-C), or the type of the error that stopped it,
-``"FunnelViolation"`` or ``"SimulationError"`` (a diverged state, a failed solve, a body at
-the free surface, a controller that raised).
+(it ran to the end), ``"interrupted"`` (Ctrl-C), ``"error"`` (the controller raised: the
+message names its method, the time and the exception; ``error_traceback`` holds the frames
+of a user's own controller), or the type of the error that stopped it, ``"FunnelViolation"``
+or ``"SimulationError"`` (a diverged state, a failed solve, a body at the free surface).
 """
 
 from __future__ import annotations
@@ -13,6 +14,7 @@ from typing import Any
 
 OK = "ok"
 INTERRUPTED = "interrupted"
+ERROR = "error"  # the controller raised (its message and, for the user's own, traceback)
 
 
 @dataclass(frozen=True)

@@ -9,7 +9,8 @@ Column names are ``<array>.<component>_<unit>``:
   velocities and generalized forces are in the vehicle body frame.
 - ``<component>`` is ``vehicle.<axis>`` for the free-flyer part (``x y z qx qy qz qw`` of
   q; ``vx vy vz wx wy wz`` of v; ``fx fy fz mx my mz`` of a wrench or generalized force)
-  and the joint's URDF name for the arm; a task-space (first-level) quantity uses
+  and the joint's URDF name for the arm (a continuous joint's configuration is two
+  columns, ``q.<joint>.cos`` and ``q.<joint>.sin``); a task-space (first-level) quantity uses
   ``fx fy fz roll pitch yaw``; the world's contacts (signal ``world_contact``) use
   ``<body>|<object>.fx fy fz`` (force on the body, N), ``.x y z`` (its point, m) and
   ``.mx my mz`` (moment about it, N m); a signal this module does not know uses its index.
@@ -26,6 +27,8 @@ from __future__ import annotations
 from typing import TYPE_CHECKING
 
 import numpy as np
+
+from uvms_pin.results.joint_positions import CONTINUOUS, KINDS, configuration_width
 
 if TYPE_CHECKING:
     import pandas as pd
@@ -83,6 +86,17 @@ def _joints(rollout: RolloutData, width: int) -> list[tuple[str, str]]:
     return list(zip(names, kinds, strict=True))
 
 
+def _configuration_joints(rollout: RolloutData, width: int) -> list[tuple[str, str]] | None:
+    """(name, kind) of the arm joints whose configuration takes ``width`` entries of q (a
+    continuous joint two), from the metadata; None when it does not say."""
+    names = list(rollout.metadata.get("arm_joint_names") or [])
+    kinds = list(rollout.metadata.get("arm_joint_kinds") or [])
+    if len(names) == len(kinds) and set(kinds) <= set(KINDS):
+        if configuration_width(kinds) == width:
+            return list(zip(names, kinds, strict=True))
+    return None
+
+
 def _labels(
     rollout: RolloutData, prefix: str, vehicle: list, joint_layout: str | None, width: int
 ) -> list[tuple[str, str]]:
@@ -92,8 +106,13 @@ def _labels(
         return [(f"{prefix}.{k}", "") for k in range(width)]
     out = [(f"{prefix}.vehicle.{c}" if joint_layout else f"{prefix}.{c}", u) for c, u in vehicle]
     revolute_unit, prismatic_unit = _JOINT_UNITS[joint_layout] if joint_layout else ("", "")
-    for name, kind in _joints(rollout, n_joint):
-        out.append((f"{prefix}.{name}", prismatic_unit if kind == "prismatic" else revolute_unit))
+    joints = _configuration_joints(rollout, n_joint) if joint_layout == "configuration" else None
+    for name, kind in joints or _joints(rollout, n_joint):
+        if kind == CONTINUOUS and joints is not None:  # (cos, sin) of the angle
+            out += [(f"{prefix}.{name}.cos", ""), (f"{prefix}.{name}.sin", "")]
+        else:
+            unit = prismatic_unit if kind == "prismatic" else revolute_unit
+            out.append((f"{prefix}.{name}", unit))
     return out
 
 

@@ -52,7 +52,9 @@ def build_controller(t: Table | None, uvms: UVMS, scenario_dir: Path) -> Control
             spec = custom_controller(kind, t.rest(), scenario_dir)
             spec(uvms)  # built once now, so a bad parameter is found before the run
         except ParameterError as exc:
-            raise t.fail(str(exc)) from exc
+            error = t.fail(str(exc))
+            error.user_traceback = exc.user_traceback  # the user's module or class raised
+            raise error from exc
         return spec
     if kind not in CONTROLLERS:
         choices = ", ".join(CONTROLLERS)

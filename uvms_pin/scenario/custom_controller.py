@@ -25,7 +25,7 @@ from pathlib import Path
 from typing import Any
 
 from uvms_pin.control.base import Controller
-from uvms_pin.errors import ParameterError
+from uvms_pin.errors import ParameterError, user_traceback
 from uvms_pin.model.uvms import UVMS
 from uvms_pin.scenario.overrides import closest
 from uvms_pin.sim.run import ControllerSpec
@@ -75,10 +75,11 @@ def custom_controller(
                 controller = cls.from_params(uvms, dict(frozen))
             else:
                 controller = cls(uvms, **frozen)
-        except (TypeError, ValueError, KeyError) as exc:
-            raise ParameterError(
+        except Exception as exc:  # the user's constructor: its traceback goes with it
+            raise _users_code_failed(
                 f"controller '{type_path}' rejected its parameters "
-                f"({', '.join(sorted(frozen)) or 'none'}): {exc}"
+                f"({', '.join(sorted(frozen)) or 'none'}): {type(exc).__name__}: {exc}",
+                exc,
             ) from exc
         if not isinstance(controller, Controller):
             raise ParameterError(
@@ -88,6 +89,14 @@ def custom_controller(
         return controller
 
     return ControllerSpec(type_path, frozen, build)
+
+
+def _users_code_failed(message: str, exc: BaseException) -> ParameterError:
+    """A ParameterError saying ``message``, with the frames of the user's code that raised
+    ``exc`` (`uvms_pin.errors.user_traceback`) for the command line to show."""
+    error = ParameterError(message)
+    error.user_traceback = user_traceback(exc)
+    return error
 
 
 def _dotted_identifier(text: str) -> bool:
@@ -113,9 +122,10 @@ def _import(module_name: str, type_path: str, search_dir: str | Path | None):
             f"controller type '{type_path}': importing '{module_name}' failed: {exc}"
         ) from exc
     except Exception as exc:  # the user's module raised while importing: name it
-        raise ParameterError(
+        raise _users_code_failed(
             f"controller type '{type_path}': importing '{module_name}' failed: "
-            f"{type(exc).__name__}: {exc}"
+            f"{type(exc).__name__}: {exc}",
+            exc,
         ) from exc
     finally:
         if added is not None:

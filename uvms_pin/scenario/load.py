@@ -17,12 +17,13 @@ examples.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+import warnings
+from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any
 
-from uvms_pin.errors import ParameterError, ScenarioError, UvmsPinError
-from uvms_pin.model.resources import find_model, shipped_models
+from uvms_pin.errors import ParameterError, PlausibilityWarning, ScenarioError, UvmsPinError
+from uvms_pin.model.resources import resolve_model
 from uvms_pin.model.urdf.load import load_uvms
 from uvms_pin.model.uvms import UVMS
 from uvms_pin.scenario.actuation import build_actuation
@@ -38,7 +39,7 @@ from uvms_pin.scenario.toml import read_toml
 from uvms_pin.scenario.water import Water, build_water
 from uvms_pin.scenario.world import build_disturbance, build_environment
 from uvms_pin.sim.plant import Plant
-from uvms_pin.sim.run import Scenario
+from uvms_pin.sim.run import Scenario, shortened
 from uvms_pin.sim.settings import SimulationSettings, check_log_fits
 
 
@@ -62,6 +63,9 @@ def load_scenario(path: str | Path, overrides: dict[str, Any] | None = None) -> 
             ``{"environment.stiffness_N_m": [20, 20, 20], "initial.joint_positions_rad[3]":
             0.5}`` (`uvms_pin.scenario.overrides`).
 
+    With the environment variable ``UVMS_PIN_MAX_DURATION_S`` set, a longer scenario is
+    shortened to it, with a warning (`uvms_pin.sim.shortened`).
+
     Raises:
         ScenarioError: naming the file and the key, or the override that set a bad value.
     """
@@ -79,11 +83,13 @@ def scenario_from_raw(
     raw = apply_overrides(raw, overrides)
     overridden = {parse_key_path(text).key: text for text in overrides or {}}
     try:
-        return _build(raw, path, Table(raw, "", source, overridden))
+        return shortened(_build(raw, path, Table(raw, "", source, overridden)))
     except ScenarioError:
         raise
     except UvmsPinError as exc:
-        raise ScenarioError(f"{source}: {exc}") from exc
+        error = ScenarioError(f"{source}: {exc}")
+        error.user_traceback = exc.user_traceback
+        raise error from exc
 
 
 def _build(raw: dict[str, Any], path: Path, top: Table) -> Scenario:
@@ -101,7 +107,9 @@ def _build(raw: dict[str, Any], path: Path, top: Table) -> Scenario:
     integrator, backend = build_integrator(top.table_or_empty("integrator"))
     control_period = build_control_period(top.table_or_empty("control"))
     log_period = build_log_period(top.table_or_empty("output"))
-    controller = build_controller(top.table("controller"), uvms, path.parent)
+    controller = replace(
+        build_controller(top.table("controller"), uvms, path.parent), from_file=True
+    )
     check_baselines(top.table("baselines"), (raw.get("controller") or {}).get("type"))
     top.finish()
     plant = Plant(
@@ -121,7 +129,7 @@ def _build(raw: dict[str, Any], path: Path, top: Table) -> Scenario:
         settings = SimulationSettings(
             head.duration_s, integrator, log_period, control_period, head.seed
         )
-        check_log_fits(settings, uvms.nq, uvms.nv)
+        check_log_fits(settings, uvms.nq, uvms.nv, plant.n_logged_columns)
     except ParameterError as exc:
         raise ScenarioError(f"{top.source}: {exc}") from exc
     return Scenario(
@@ -135,7 +143,7 @@ def _head(t: Table, path: Path) -> Head:
         description=t.string("description", ""),
         model=t.string("model"),
         duration_s=t.number("duration_s", positive=True),
-        seed=t.integer("seed", 0),
+        seed=t.seed("seed", 0),
     )
     t.finish()
     return head
@@ -143,12 +151,10 @@ def _head(t: Table, path: Path) -> Head:
 
 def _model(head: Head, water: Water, path: Path, scenario: Table) -> UVMS:
     """The model ``[scenario] model`` names, in water of ``[water]``'s density."""
-    model_path = find_model(head.model, path.parent)
-    if model_path is None:
-        raise scenario.error(
-            "model",
-            f"'{head.model}' is neither a file relative to the scenario "
-            f"({path.parent.resolve() / head.model}) nor a shipped model "
-            f"({', '.join(shipped_models())})",
-        )
-    return load_uvms(model_path, water_density_kg_m3=water.density_kg_m3)
+    try:
+        model_path = resolve_model(head.model, path.parent)
+    except ParameterError as exc:
+        raise scenario.error("model", str(exc)) from None
+    with warnings.catch_warnings():  # the density was judged as [water] density_kg_m3
+        warnings.simplefilter("ignore", PlausibilityWarning)
+        return load_uvms(model_path, water_density_kg_m3=water.density_kg_m3)

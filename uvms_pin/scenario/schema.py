@@ -10,11 +10,13 @@ read are reported by `Table.finish` with the closest known key.
 from __future__ import annotations
 
 import math
+import warnings
 from typing import Any
 
 import numpy as np
 
-from uvms_pin.errors import ScenarioError, UvmsPinError
+from uvms_pin.checks import Plausible, seed_value
+from uvms_pin.errors import ParameterError, PlausibilityWarning, ScenarioError, UvmsPinError
 from uvms_pin.scenario.overrides import closest
 
 
@@ -65,16 +67,52 @@ class Table:
         """The table as messages name it: its label, else ``[dotted.name]``."""
         return self.label if self.label is not None else f"[{self.where}]"
 
+    def _override_of(self, where: str) -> str | None:
+        """The override that set ``where`` (a dotted name in the file): the key itself, or
+        a table (or list element) holding it that an override replaced whole."""
+        if where in self._overridden:
+            return self._overridden[where]
+        for text in self._overridden.values():
+            if where.startswith((f"{text}.", f"{text}[")):
+                return text
+        return None
+
     def error(self, key: str, msg: str) -> UvmsPinError:
-        """The error about ``key``: naming the override that set it, else the file."""
+        """The error about ``key``: naming the override that set it (and the key, when the
+        override set a whole table holding it), else the file."""
         where = self.full(key)
         if where in self._overridden:
             return self._error(f"override '{self._overridden[where]}': {msg}")
+        override = self._override_of(where)
+        if override is not None:
+            return self._error(f"override '{override}': {where}: {msg}")
         named = where if self.label is None else f"{self.label}: {key}"
         return self._error(f"{self.source}: {named}: {msg}")
 
+    def plausible(self, key: str, value: float, law: Plausible) -> float:
+        """``value`` of ``key`` judged by ``law``: refused (an error naming the key, or the
+        override that set it) if it cannot be physical, warned if far from usual."""
+        refusal = law.refusal(value)
+        if refusal is not None:
+            raise self.error(key, refusal)
+        warning = law.warning(value)
+        if warning is not None:
+            where = self.full(key)
+            override = self._override_of(where)
+            if override is not None and where in self._overridden:
+                message = f"override '{override}': {warning}"
+            elif override is not None:
+                message = f"override '{override}': {where} = {warning}"
+            else:
+                message = f"{self.source}: {where} = {warning}"
+            warnings.warn(message, PlausibilityWarning, stacklevel=2)
+        return value
+
     def fail(self, msg: str) -> UvmsPinError:
-        """An error about the table as a whole."""
+        """An error about the table as a whole (naming the override that replaced it)."""
+        override = self._override_of(self.where) if self.label is None else None
+        if override is not None:
+            return self._error(f"override '{override}': {self.title}: {msg}")
         return self._error(f"{self.source}: {self.title}: {msg}")
 
     @property
@@ -111,7 +149,14 @@ class Table:
     def optional_number(self, key: str, **kw) -> float | None:
         return self.number(key, **kw) if key in self._data else None
 
-    def integer(self, key: str, default: int | None = None, *, minimum: int | None = None) -> int:
+    def integer(
+        self,
+        key: str,
+        default: int | None = None,
+        *,
+        minimum: int | None = None,
+        maximum: int | None = None,
+    ) -> int:
         self._asked.add(key)
         if key not in self._data and default is None:
             raise self.error(key, "is required")
@@ -120,7 +165,17 @@ class Table:
             raise self.error(key, f"must be an integer, got {value!r}")
         if minimum is not None and value < minimum:
             raise self.error(key, f"must be >= {minimum}, got {value}")
+        if maximum is not None and value > maximum:
+            raise self.error(key, f"must be <= {maximum}, got {value}")
         return value
+
+    def seed(self, key: str, default: int) -> int:
+        """A seed: an integer in [0, 2^63 - 1] (`uvms_pin.checks.seed_value`)."""
+        value = self.integer(key, default)
+        try:
+            return seed_value(self.full(key), value)
+        except ParameterError as exc:
+            raise self.error(key, str(exc).removeprefix(f"{self.full(key)} ")) from None
 
     def string(
         self, key: str, default: str | None = None, choices: tuple[str, ...] | None = None
@@ -213,6 +268,13 @@ class Table:
         known = self._asked - set(unknown)
         for key in unknown:
             full = self.full(key)
+            whole = self._override_of(self.where) if self.where else None
+            if whole is not None and full not in self._overridden:  # it replaced this table
+                hint = closest(key, known)
+                raise self._error(
+                    f"override '{whole}': unknown key '{full}'"
+                    + (f"; did you mean '{self.full(hint)}'?" if hint else "")
+                )
             for dotted, text in self._overridden.items():
                 if dotted == full or dotted.startswith(full + "."):
                     hint = closest(key, known)

@@ -6,13 +6,34 @@ from __future__ import annotations
 import math
 from collections.abc import Callable
 
+from uvms_pin.checks import Plausible
 from uvms_pin.physics.compiled.backend import BACKENDS
 from uvms_pin.scenario.schema import Table
 from uvms_pin.sim.integrators import RK4, Adaptive, Integrator, SemiImplicitEuler
 
+#: A fixed integrator step [s]: a UVMS's fastest dynamics (a stiff contact, the joint
+#: drives) want ~1e-4 s, its slowest are seconds; below 1e-5 s a run takes 1e5 steps per
+#: simulated second, above 0.05 s RK4 steps over the joints' dynamics
+STEP = Plausible(
+    "s",
+    usual=(1e-5, 0.05),
+    possible=(0.0, math.inf),
+    usual_text="the steps a UVMS run needs",
+    impossible_text="",
+    hints=("every simulated second takes 1/step steps", ""),
+)
+#: A controller's period [s]: real controllers run at 10 Hz to 10 kHz
+CONTROL_PERIOD = Plausible(
+    "s",
+    usual=(1e-4, 0.1),
+    possible=(0.0, math.inf),
+    usual_text="controller rates of 10 Hz to 10 kHz",
+    impossible_text="",
+)
+
 
 def _fixed_step(kind: type[Integrator]) -> Callable[[Table], Integrator]:
-    return lambda t: kind(t.number("step_s", 1e-3, positive=True))
+    return lambda t: kind(t.plausible("step_s", t.number("step_s", 1e-3, positive=True), STEP))
 
 
 def _adaptive(method: str) -> Callable[[Table], Integrator]:
@@ -44,6 +65,8 @@ def build_integrator(t: Table) -> tuple[Integrator, str]:
 def build_control_period(t: Table) -> float | None:
     """[control] period_s: the controller's period [s]; None = continuous control."""
     period = t.optional_number("period_s", positive=True)
+    if period is not None:
+        t.plausible("period_s", period, CONTROL_PERIOD)
     t.finish()
     return period
 

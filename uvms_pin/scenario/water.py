@@ -9,6 +9,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from uvms_pin.checks import Plausible
 from uvms_pin.errors import ParameterError
 from uvms_pin.flow import (
     AiryWave,
@@ -19,7 +20,35 @@ from uvms_pin.flow import (
     SumFlow,
     UniformCurrent,
 )
+from uvms_pin.flow.airy import WAVE_PERIOD
+from uvms_pin.flow.irregular import MAX_COMPONENTS
+from uvms_pin.model.uvms import WATER_DENSITY
 from uvms_pin.scenario.schema import Table
+
+#: The speed of the water [m/s]: the fastest tidal races run at ~5 m/s; faster than sound in
+#: water, the incompressible model means nothing
+CURRENT_SPEED = Plausible(
+    "m/s",
+    usual=(0.0, 5.0),
+    possible=(0.0, 1480.0),
+    usual_text="sea and tidal currents",
+    impossible_text="no water flows faster than sound in it (~1480 m/s)",
+)
+#: A regular wave's amplitude, half its height [m]
+AMPLITUDE = Plausible(
+    "m",
+    usual=(0.0, 10.0),
+    possible=(0.0, 50.0),
+    usual_text="sea waves (the highest measured: ~30 m crest to trough)",
+    impossible_text="no sea wave is that high",
+)
+SIGNIFICANT_HEIGHT = Plausible(
+    "m",
+    usual=(0.0, 15.0),
+    possible=(0.0, 40.0),
+    usual_text="sea states (the highest measured: ~19 m)",
+    impossible_text="no sea state is that high",
+)
 
 
 @dataclass(frozen=True)
@@ -37,8 +66,11 @@ class Water:
 
 
 def build_water(t: Table, seed: int) -> Water:
-    density = t.number("density_kg_m3", 1025.0, positive=True)
+    density = t.plausible(
+        "density_kg_m3", t.number("density_kg_m3", 1025.0, positive=True), WATER_DENSITY
+    )
     current = t.vector("current_world_m_s", 3, [0.0, 0.0, 0.0])
+    t.plausible("current_world_m_s", float(np.linalg.norm(current)), CURRENT_SPEED)
     stop_at_surface = t.boolean("stop_at_surface", False)
     # stopping at the surface is the model of submerged bodies: no surface in the dynamics
     # unless asked for as well
@@ -55,8 +87,8 @@ def build_water(t: Table, seed: int) -> Water:
 
 def _waves(t: Table, seed: int) -> AiryWave:
     return AiryWave(
-        amplitude_m=t.number("amplitude_m", nonneg=True),
-        period_s=t.number("period_s", positive=True),
+        amplitude_m=t.plausible("amplitude_m", t.number("amplitude_m", nonneg=True), AMPLITUDE),
+        period_s=t.plausible("period_s", t.number("period_s", positive=True), WAVE_PERIOD),
         heading_rad=t.number("heading_rad", 0.0),
         water_depth_m=t.number("water_depth_m", math.inf, positive=True),
         phase_rad=t.number("phase_rad", 0.0),
@@ -65,13 +97,19 @@ def _waves(t: Table, seed: int) -> AiryWave:
 
 def _sea(t: Table, seed: int) -> IrregularSea:
     return IrregularSea(
-        significant_height_m=t.number("significant_height_m", nonneg=True),
-        peak_period_s=t.number("peak_period_s", positive=True),
+        significant_height_m=t.plausible(
+            "significant_height_m",
+            t.number("significant_height_m", nonneg=True),
+            SIGNIFICANT_HEIGHT,
+        ),
+        peak_period_s=t.plausible(
+            "peak_period_s", t.number("peak_period_s", positive=True), WAVE_PERIOD
+        ),
         peak_enhancement=t.number("peak_enhancement", 3.3, positive=True),
         heading_rad=t.number("heading_rad", 0.0),
         spreading_exponent=t.optional_number("spreading_exponent", positive=True),
-        n_components=t.integer("n_components", 100),
-        seed=t.integer("seed", seed),
+        n_components=t.integer("n_components", 100, minimum=1, maximum=MAX_COMPONENTS),
+        seed=t.seed("seed", seed),
         water_depth_m=t.number("water_depth_m", math.inf, positive=True),
     )
 
@@ -97,7 +135,7 @@ def _gauss_markov_current(t: Table, seed: int) -> GaussMarkovCurrent:
         std_m_s=t.number("std_m_s", nonneg=True),
         time_constant_s=t.number("time_constant_s", positive=True),
         bound_m_s=t.number("bound_m_s", positive=True),
-        seed=t.integer("seed", seed),
+        seed=t.seed("seed", seed),
         sample_period_s=t.number("sample_period_s", 0.5, positive=True),
     )
 

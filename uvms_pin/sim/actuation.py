@@ -30,6 +30,14 @@ class Actuation(ABC):
         """True when an actuator cannot give what the command asks."""
         return False
 
+    def start(self) -> None:  # noqa: B027 - optional hook
+        """A run starts: forget what earlier runs dropped."""
+
+    def dropped(self) -> str | None:
+        """What the run so far asked that the actuators cannot produce at all (not a
+        saturation: a direction), for a warning; None if nothing."""
+        return None
+
 
 class Unlimited(Actuation):
     """Every DoF actuated without limit: tau_applied = tau_commanded."""
@@ -75,6 +83,12 @@ class ThrustersAndJointLimits(Actuation):
         # f = B_s^+ tau[s]: written as a 6-column map that ignores the other components
         self._allocation_pinv = np.zeros((len(self.thrusters), 6))
         self._allocation_pinv[:, components] = np.linalg.pinv(self.allocation[components])
+        # what of an allocated command no thrust can produce: (I - B_s B_s^+) tau_s, tracked
+        # only when the thrusters do not span the allocated components
+        chosen = self.allocation[components]
+        residual = np.eye(components.size) - chosen @ np.linalg.pinv(chosen)
+        self._residual = residual if np.max(np.abs(residual)) > 1e-9 else None
+        self._dropped_max = np.zeros(components.size)
         self._lower = -np.array([t.max_reverse_N for t in self.thrusters])
         self._upper = np.array([t.max_forward_N for t in self.thrusters])
         if joint_effort_limits_Nm is not None:
@@ -101,7 +115,43 @@ class ThrustersAndJointLimits(Actuation):
         limits = self.joint_effort_limits_Nm
         return limits is not None and bool(np.any(np.abs(tau_commanded[6:]) > limits))
 
+    def start(self) -> None:
+        self._dropped_max[:] = 0.0
+
+    def _unproducible(self) -> list[int]:
+        """Positions (in the allocated components) of those the thrusters cannot produce: as
+        many as the thrusters' rank lacks, those weighing most in what no thrust reaches."""
+        chosen = self.allocation[self.allocated_components]
+        missing = self.allocated_components.size - np.linalg.matrix_rank(chosen, tol=1e-9)
+        weight = np.abs(np.diag(self._residual))  # each axis's share no thrust reaches
+        return sorted(int(k) for k in np.argsort(-weight, kind="stable")[:missing])
+
+    def dropped(self) -> str | None:
+        """The allocated components no thrust can produce and the largest part of a command
+        dropped on each (the allocation is least squares: it leaves them out silently)."""
+        if self._residual is None or not np.any(self._dropped_max > 1e-6):
+            return None
+        names = ("surge force fx", "sway force fy", "heave force fz", "roll moment mx",
+                 "pitch moment my", "yaw moment mz")  # fmt: skip
+        units = ("N", "N", "N", "N m", "N m", "N m")
+        lost = self._unproducible()
+        components = self.allocated_components
+        parts = [
+            f"{self._dropped_max[k]:.3g} {units[components[k]]} of {names[components[k]]}"
+            for k in lost
+            if self._dropped_max[k] > 1e-6
+        ] or [f"{np.max(self._dropped_max):.3g} N or N m"]  # coupled: no one axis stands out
+        kept = [int(c) for k, c in enumerate(components) if k not in lost]
+        return (
+            "the thrusters cannot produce every wrench component the controller commands: "
+            f"the allocation dropped up to {' and '.join(parts)}; if that is meant, say so "
+            f"with actuation.allocated_components = {kept} (what they can produce)"
+        )
+
     def apply(self, tau_commanded):
+        if self._residual is not None:  # what no thrust can produce: the largest so far
+            lost = np.abs(self._residual @ tau_commanded[self.allocated_components])
+            np.maximum(self._dropped_max, lost, out=self._dropped_max)
         out = np.empty_like(tau_commanded)
         out[:6] = self.allocation @ self.thrusts(tau_commanded)
         arm = tau_commanded[6:]

@@ -18,17 +18,25 @@ from __future__ import annotations
 
 import math
 import time
-from collections.abc import Sequence
+import warnings
+from collections.abc import Iterator, Sequence
+from contextlib import contextmanager
 from typing import Any
 
 import numpy as np
 
 from uvms_pin.control.base import Controller
 from uvms_pin.control.measurement import Measurement, read_only
-from uvms_pin.errors import FunnelViolation, ParameterError, SimulationError
+from uvms_pin.errors import (
+    ActuationWarning,
+    ControllerError,
+    FunnelViolation,
+    ParameterError,
+    SimulationError,
+)
 from uvms_pin.results.rollout import Rollout
-from uvms_pin.results.status import INTERRUPTED, OK, RunStatus, Violation
-from uvms_pin.sim.divergence import NUMERICAL_FAILURES, diverged
+from uvms_pin.results.status import ERROR, INTERRUPTED, OK, RunStatus, Violation
+from uvms_pin.sim.divergence import NUMERICAL_FAILURES, diverged, divergence_context
 from uvms_pin.sim.integrators import Adaptive
 from uvms_pin.sim.log import RolloutLog
 from uvms_pin.sim.plant import Plant
@@ -68,6 +76,7 @@ class ClosedLoop:
         self.q = read_only(np.zeros(plant.uvms.nq))
         self.v = read_only(np.zeros(plant.uvms.nv))
         self.sensors: SensorSuite | None = None
+        self._last_tau_applied: np.ndarray | None = None  # continuous loop: the last stage's
 
     # ---- the steps of the loop ------------------------------------------------------------
     def start(self, q0: np.ndarray, v0: np.ndarray, sensors: SensorSuite) -> None:
@@ -89,8 +98,10 @@ class ClosedLoop:
         q0[3:7] /= np.linalg.norm(q0[3:7])
         self.time_s, self.q, self.v = 0.0, read_only(q0), read_only(v0)
         self.sensors = sensors
+        self.plant.actuation.start()
         if self.controller is not None:
-            self.controller.reset()
+            with self._controller_code("reset"):
+                self.controller.reset()
         self.plant.attach(self.q)
 
     def measure(self) -> tuple[Measurement, np.ndarray]:
@@ -106,7 +117,12 @@ class ClosedLoop:
         """The controller's tau (nv,) for ``measurement`` (SimulationError if it is not nv
         finite numbers)."""
         t = measurement.time_s
-        tau = np.asarray(self.controller.compute(t, measurement), dtype=float)
+        try:  # inline, not the context manager: this is the hot path
+            tau = np.asarray(self.controller.compute(t, measurement), dtype=float)
+        except SimulationError:  # a funnel violation is the law's own verdict
+            raise
+        except Exception as exc:
+            raise _controller_failed(self.controller, "compute", t, exc) from exc
         if tau.shape != (self.plant.uvms.nv,) or not (
             math.isfinite(float(tau.sum())) or np.all(np.isfinite(tau))  # exact if in doubt
         ):
@@ -126,9 +142,9 @@ class ClosedLoop:
         try:
             q, v = self.plant.advance(self.settings.integrator, t0, self.q, self.v, tau_applied, t1)
         except (SimulationError, *NUMERICAL_FAILURES) as exc:
-            raise _diverged(t0, t1, exc) from exc
+            raise _diverged(t0, t1, exc, self._context((t0, t1), tau_applied)) from exc
         if diverged(q, v):
-            raise SimulationError(f"simulation diverged between t = {t0:.6g} s and {t1:.6g} s")
+            raise _diverged(t0, t1, None, self._context((t0, t1), tau_applied))
         q.setflags(write=False)  # new arrays of the plant's: frozen, not copied
         v.setflags(write=False)
         self.q, self.v = q, v
@@ -144,6 +160,11 @@ class ClosedLoop:
     ) -> Sample:
         """The loop now, as its observers see it."""
         controller = self.controller
+        if controller is None:
+            signals = _NO_SIGNALS
+        else:
+            with self._controller_code("signals"):
+                signals = controller.signals()
         return Sample(
             self.time_s,
             self.q,
@@ -153,8 +174,23 @@ class ClosedLoop:
             self.plant.disturbance_wrench(self.time_s),
             tau_commanded,
             tau_applied,
-            _NO_SIGNALS if controller is None else controller.signals(),
+            signals,
         )
+
+    def _context(self, span_s: tuple[float, float], tau_applied: np.ndarray | None) -> str:
+        """What stood out over ``span_s`` from the current state (`divergence_context`)."""
+        return divergence_context(self.plant, span_s, self.q, self.v, tau_applied)
+
+    @contextmanager
+    def _controller_code(self, method: str) -> Iterator[None]:
+        """The controller's ``method`` runs in the block: what it raises (a funnel violation
+        aside) stops the run as a `ControllerError` naming the method and the time."""
+        try:
+            yield
+        except SimulationError:
+            raise
+        except Exception as exc:
+            raise _controller_failed(self.controller, method, self.time_s, exc) from exc
 
     def notify(self, sample: Sample) -> None:
         for observer in self.observers:
@@ -172,20 +208,20 @@ class ClosedLoop:
             KeyboardInterrupt: likewise, with status ``interrupted``.
         """
         self.observers.insert(0, log)
-        self.start(q0, v0, sensors)
-        log.rollout.metadata["world"] = self.plant.record()  # as simulated: anchored
         wall_start = time.perf_counter()
         span = [0.0, 0.0]  # the interval being integrated, for a divergence message
         try:
+            self.start(q0, v0, sensors)
+            log.rollout.metadata["world"] = self.plant.record()  # as simulated: anchored
             if self.settings.control_period_s is None:
                 self._run_continuous(span)
             else:
                 self._run_sampled(span)
         except NUMERICAL_FAILURES as exc:
-            error = _diverged(*span, exc)
+            error = _diverged(*span, exc, self._context(tuple(span), self._last_tau_applied))
             raise _stopped(log, wall_start, error) from exc
         except SimulationError as exc:  # FunnelViolation included
-            raise _stopped(log, wall_start, exc) from None
+            raise _stopped(log, wall_start, exc) from exc.__cause__  # e.g. the controller's
         except KeyboardInterrupt as exc:  # Ctrl-C: the caller may keep what was simulated
             exc.rollout = _finished(
                 log, wall_start, RunStatus(INTERRUPTED, "interrupted by the user")
@@ -193,6 +229,9 @@ class ClosedLoop:
             raise
         finally:
             self.observers.remove(log)
+            dropped = self.plant.actuation.dropped()
+            if dropped is not None:
+                warnings.warn(dropped, ActuationWarning, stacklevel=2)
         return _finished(log, wall_start, RunStatus(OK))
 
     def _tick(self, logged: bool) -> np.ndarray:
@@ -235,21 +274,30 @@ class ClosedLoop:
             return sensors.measure(t, q, v, contact), contact
 
         def rhs(t: float, q: np.ndarray, v: np.ndarray) -> np.ndarray:
+            # a stage of a blown-up step: a divergence, not a bad argument to the dynamics
+            if not (math.isfinite(q.sum()) and math.isfinite(v.sum())):
+                context = divergence_context(plant, (t, t), self.q, self.v, self._last_tau_applied)
+                raise SimulationError(
+                    f"simulation diverged: a non-finite state at t = {t:.6g} s; {context}"
+                )
             measurement, contact = at(t, q, v)
             tau_applied = actuation.apply(command(measurement))
+            self._last_tau_applied = tau_applied  # for a divergence message
             acceleration = plant.acceleration(t, q, v, tau_applied, contact)
             # an adaptive solver would shrink its step on a non-finite stage until it gives
             # up with a message that does not say why: stop at once instead (a sum is NaN or
             # inf if any entry is; the exact test only when it is)
             if not math.isfinite(acceleration.sum()) and not np.all(np.isfinite(acceleration)):
+                context = divergence_context(plant, (t, t), q, v, tau_applied)
                 raise SimulationError(
-                    f"simulation diverged: non-finite acceleration at t = {t:.6g} s"
+                    f"simulation diverged: non-finite acceleration at t = {t:.6g} s; {context}"
                 )
             return acceleration
 
         def margin_event(t: float, q: np.ndarray, v: np.ndarray) -> float:
-            controller.compute(t, at(t, q, v)[0])
-            return controller.funnel_margin() + _EVENT_OVERSHOOT
+            command(at(t, q, v)[0])
+            with self._controller_code("funnel_margin"):
+                return controller.funnel_margin() + _EVENT_OVERSHOOT
 
         self._tick(True)
         logged = 1
@@ -261,9 +309,7 @@ class ClosedLoop:
             states, failure = self._integrate(rhs, t0, times, margin_event if adaptive else None)
             for t, q, v in states:
                 if diverged(q, v):
-                    raise SimulationError(
-                        f"simulation diverged between t = {t0:.6g} s and {t:.6g} s"
-                    )
+                    raise _diverged(t0, t, None, self._context((t0, t), self._last_tau_applied))
                 self.time_s, self.q, self.v = float(t), read_only(q), read_only(v)
                 plant.settle(self.q, self.v)  # the friction's anchors move at the log times
                 on_log = abs(t - log_times[logged]) < 1e-9
@@ -280,7 +326,8 @@ class ClosedLoop:
     def _integrate(self, rhs, t0: float, times: np.ndarray, event):
         """(states reached, the failure that stopped the pass or None)."""
         controller = self.controller
-        controller.set_funnel_extension(event is not None)
+        with self._controller_code("set_funnel_extension"):
+            controller.set_funnel_extension(event is not None)
         try:
             states = self.settings.integrator.advance_through(
                 self.plant.uvms.model, rhs, t0, self.q, self.v, times, event,
@@ -293,9 +340,21 @@ class ClosedLoop:
         return states, None
 
 
-def _diverged(t0: float, t1: float, exc: BaseException) -> SimulationError:
+def _controller_failed(
+    controller: Controller, method: str, time_s: float, exc: Exception
+) -> ControllerError:
+    """The `ControllerError` of ``exc``, raised by ``controller.method`` at ``time_s``; with
+    the frames of the user's code when the controller is not one of uvms-pin's."""
+    users = not type(controller).__module__.startswith("uvms_pin.")
+    return ControllerError(method, time_s, exc, users=users)
+
+
+def _diverged(t0: float, t1: float, exc: BaseException | None, context: str) -> SimulationError:
+    """The divergence between t0 and t1 (``exc``: what the solve raised, None if the state
+    came back non-finite or absurd), with ``context``: what stood out at t0."""
+    cause = "" if exc is None else f" ({type(exc).__name__}: {exc})"
     return SimulationError(
-        f"simulation diverged between t = {t0:.6g} s and {t1:.6g} s ({type(exc).__name__}: {exc})"
+        f"simulation diverged between t = {t0:.6g} s and {t1:.6g} s{cause}; {context}"
     )
 
 
@@ -321,18 +380,23 @@ def _stopped(log: RolloutLog, wall_start: float, exc: SimulationError) -> Simula
     if isinstance(exc, FunnelViolation):
         violation = Violation(exc.level, exc.component, exc.time_s, exc.error, exc.bound)
     time_s = violation.time_s if violation is not None else None
-    exc.rollout = _finished(
-        log, wall_start, RunStatus(type(exc).__name__, str(exc), time_s, violation)
-    )
+    kind = type(exc).__name__
+    if isinstance(exc, ControllerError):
+        kind, time_s = ERROR, exc.time_s
+    if exc.user_traceback:
+        log.rollout.metadata["error_traceback"] = exc.user_traceback
+    exc.rollout = _finished(log, wall_start, RunStatus(kind, str(exc), time_s, violation))
     return exc
 
 
 def run_metadata(plant: Plant, settings: SimulationSettings) -> dict[str, Any]:
-    """What a rollout records of the run: settings, seed, versions, model and arm joints."""
+    """What a rollout records of the run: settings, seed, versions, model and arm joints
+    (their kinds and position limits, None where a joint has none)."""
     from uvms_pin.results.provenance import package_versions
 
     uvms = plant.uvms
-    model = uvms.model
+    arm = uvms.arm_joints
+    lower, upper = arm.limits_record()
     return {
         "seed": settings.seed,
         "duration_s": settings.duration_s,
@@ -342,18 +406,11 @@ def run_metadata(plant: Plant, settings: SimulationSettings) -> dict[str, Any]:
         "integrator_settings": dict(vars(settings.integrator)),
         "versions": package_versions(),
         "model_source": uvms.source,
-        "arm_joint_names": uvms.arm_joint_names,
-        "arm_joint_kinds": [_joint_kind(model, name) for name in uvms.arm_joint_names],
-        "arm_position_lower_rad": model.lowerPositionLimit[7:].tolist(),
-        "arm_position_upper_rad": model.upperPositionLimit[7:].tolist(),
+        "arm_joint_names": list(arm.names),
+        "arm_joint_kinds": list(arm.kinds),
+        "arm_position_lower_rad": lower,
+        "arm_position_upper_rad": upper,
     }
-
-
-def _joint_kind(model, joint_name: str) -> str:
-    """'prismatic' or 'revolute' (names the units of the joint's columns in a table)."""
-    shortname = model.joints[model.getJointId(joint_name)].shortname()
-    prismatic = ("JointModelPX", "JointModelPY", "JointModelPZ", "JointModelPrismatic")
-    return "prismatic" if shortname.startswith(prismatic) else "revolute"
 
 
 def simulate_closed_loop(
@@ -374,7 +431,7 @@ def simulate_closed_loop(
     """
     from uvms_pin.sim.settings import check_log_fits
 
-    check_log_fits(settings, plant.uvms.nq, plant.uvms.nv)
+    check_log_fits(settings, plant.uvms.nq, plant.uvms.nv, plant.n_logged_columns)
     meta = {**(metadata or {}), **run_metadata(plant, settings)}
     log = RolloutLog(plant.uvms, settings.n_log, meta, backend=plant.backend, plant=plant)
     loop = ClosedLoop(plant, settings, controller, observers)

@@ -1,5 +1,6 @@
 """What only a blown-up integration gives: a non-finite state or an absurd speed, and the
-numerical errors that mean the same."""
+numerical errors that mean the same; and what a divergence message says about where it
+came from (`divergence_context`)."""
 
 from __future__ import annotations
 
@@ -25,4 +26,91 @@ def diverged(q: np.ndarray, v: np.ndarray) -> bool:
         return False
     return not (np.all(np.isfinite(q)) and np.all(np.isfinite(v))) or bool(
         np.max(np.abs(v)) > DIVERGED_SPEED
+    )
+
+
+#: What no UVMS meets, per quantity: a water speed [m/s], a force or moment [N, N m] (its
+#: thrusters make tens to hundreds), a speed [m/s or rad/s]. Past these, a quantity is named
+#: as the likely cause of a divergence.
+_IMPLAUSIBLE = {"water": 20.0, "wrench": 1e5, "speed": 100.0}
+_VEHICLE_WRENCH = (("fx", "N"), ("fy", "N"), ("fz", "N"), ("mx", "N m"), ("my", "N m"), ("mz", "N m"))  # fmt: skip
+
+
+def _labels(uvms) -> tuple[list[tuple[str, str]], list[tuple[str, str]]]:
+    """(name, unit) of each velocity and each generalized force component."""
+    arm = uvms.arm_joints
+    linear = [arm_kind == "prismatic" for arm_kind in arm.kinds]
+    velocity = [("vehicle u", "m/s"), ("vehicle v", "m/s"), ("vehicle w", "m/s"),
+                ("vehicle p", "rad/s"), ("vehicle q", "rad/s"), ("vehicle r", "rad/s")]  # fmt: skip
+    velocity += [(n, "m/s" if lin else "rad/s") for n, lin in zip(arm.names, linear, strict=True)]
+    force = [(f"vehicle {n}", u) for n, u in _VEHICLE_WRENCH]
+    force += [(n, "N" if lin else "N m") for n, lin in zip(arm.names, linear, strict=True)]
+    return velocity, force
+
+
+def divergence_context(
+    plant, span_s: tuple[float, float], q: np.ndarray, v: np.ndarray, tau
+) -> str:
+    """What stands out in the state and inputs of a diverged interval ``span_s`` (the state
+    at its start): each quantity far outside what any vehicle meets (the water's speed at
+    the vehicle, the applied generalized force, the disturbance, the contact wrench, a
+    velocity; the time-varying ones over the interval), with its value and where; else the
+    largest velocity component. One clause, for the divergence message."""
+    velocity_labels, force_labels = _labels(plant.uvms)
+    found: list[tuple[float, str]] = []
+
+    def largest(values, labels, scale: float, what: str) -> None:
+        values = np.atleast_2d(np.asarray(values, dtype=float))  # (times, components)
+        if values.size == 0:
+            return
+        row, k = np.unravel_index(
+            int(np.argmax(np.abs(np.nan_to_num(values, nan=np.inf)))), values.shape
+        )
+        value = values[row, k]
+        if not abs(value) <= scale:  # NaN included
+            name, unit = labels[k]
+            found.append((abs(value) / scale, f"{what} {name} = {value:.3g} {unit}"))
+
+    times = (span_s[0], 0.5 * (span_s[0] + span_s[1]), span_s[1])
+    if plant.water is not None:
+        at = np.asarray(q[:3], dtype=float)[None]
+        speeds = [[float(np.linalg.norm(plant.water.velocity(t, at)[0]))] for t in times]
+        largest(speeds, [("at the vehicle", "m/s")], _IMPLAUSIBLE["water"], "water speed")
+    if tau is not None:
+        largest(tau, force_labels, _IMPLAUSIBLE["wrench"], "applied generalized force")
+    disturbance = [plant.disturbance_wrench(t) for t in times]
+    largest(disturbance, force_labels, _IMPLAUSIBLE["wrench"], "disturbance")
+    if plant.contact is not None:
+        wrench_labels = [(n.removeprefix("vehicle "), u) for n, u in force_labels[:6]]
+        largest(plant.contact_wrench(q, v), wrench_labels, _IMPLAUSIBLE["wrench"],
+                "contact wrench (world)")  # fmt: skip
+    largest(v, velocity_labels, _IMPLAUSIBLE["speed"], "velocity")
+    t0 = span_s[0]
+    if found:
+        found.sort(reverse=True)
+        return f"from t = {t0:.6g} s: " + ", ".join(text for _, text in found[:3])
+    singular = _singular_mass(plant.uvms, q, velocity_labels)
+    if singular:
+        return f"at t = {t0:.6g} s {singular}"
+    k = int(np.argmax(np.abs(v)))
+    name, unit = velocity_labels[k]
+    return (
+        f"at t = {t0:.6g} s every input was in a physical range; the largest velocity "
+        f"was {name} = {v[k]:.3g} {unit}"
+    )
+
+
+def _singular_mass(uvms, q: np.ndarray, labels) -> str:
+    """ "the mass matrix is singular ..." naming the least-massive degree of freedom, or ""."""
+    from uvms_pin.physics.dynamics import mass_matrix
+
+    mass = mass_matrix(uvms, q, backend="python")  # q: the last state reached, finite
+    eigenvalues, vectors = np.linalg.eigh(mass)
+    if eigenvalues[0] > 1e-12 * max(eigenvalues[-1], 1e-300):
+        return ""
+    k = int(np.argmax(np.abs(vectors[:, 0])))
+    return (
+        f"the mass matrix is singular (smallest eigenvalue {eigenvalues[0]:.3g}), along "
+        f"{labels[k][0]} mostly: a body without inertia about that motion (a link with no "
+        "mass, added mass or armature)"
     )

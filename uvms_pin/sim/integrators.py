@@ -68,10 +68,14 @@ class Integrator(ABC):
         """
         out = []
         t, q, v = t0, q0, v0
-        for t_next in times:
-            q, v = self.advance(model, rhs, t, q, v, float(t_next))
-            t = float(t_next)
-            out.append((t, q, v))
+        try:
+            for t_next in times:
+                q, v = self.advance(model, rhs, t, q, v, float(t_next))
+                t = float(t_next)
+                out.append((t, q, v))
+        except SimulationError as error:  # e.g. the controller raised inside rhs
+            error.states = out  # the output times reached before the failure
+            raise
         return out
 
 

@@ -92,6 +92,19 @@ class Plant:
         if self.world is not None and self.world.uvms is not self.uvms:
             raise ParameterError("the plant's world was built for another UVMS")
 
+    @property
+    def n_logged_hulls(self) -> int:
+        """Wet fractions a run of this plant logs per sample (one per hull under a free
+        surface, none without)."""
+        return len(self.uvms.surface_bodies) if self.free_surface else 0
+
+    @property
+    def n_logged_columns(self) -> int:
+        """Values a run of this plant logs per sample beyond the base arrays: the wet
+        fractions and, with a world, 9 per (body, object) pair (``world_contact``)."""
+        pairs = 0 if self.world is None else len(self.world.pair_names)
+        return self.n_logged_hulls + 9 * pairs
+
     def _water(self) -> FlowField | None:
         """The one flow the bodies see: the uniform current and ``flow`` (None: still water)."""
         fields = [UniformCurrent(self.current_world_m_s)] if np.any(self.current_world_m_s) else []
@@ -162,6 +175,7 @@ class Plant:
             flow_to_core(self.water, core),
             contact_to_core(self.contact, core),
             disturbance_to_core(self.disturbance, core),
+            joint_stops_to_core(self.joint_stops, core),
         )
         fallback = next((p for p in parts if isinstance(p, Fallback)), None)
         if fallback is not None:
@@ -170,9 +184,8 @@ class Plant:
         # without one cannot have (checked in __post_init__): frame 0 (the world) stands in
         ee_frame_id = self.uvms.ee_frame_id if self.uvms.has_end_effector else 0
         compiled = core.Plant(dynamics_of(self.uvms).core, ee_frame_id)
-        compiled.flow, compiled.contact, compiled.disturbance = parts
+        compiled.flow, compiled.contact, compiled.disturbance, compiled.joint_stops = parts
         compiled.free_surface = bool(self.free_surface)
-        compiled.joint_stops = joint_stops_to_core(self.joint_stops, core)
         bounds = world_bounds_to_core(self.world, core)
         if bounds is not None:
             compiled.world_bounds = bounds

@@ -7,7 +7,9 @@ sensors, runs the closed loop and returns the rollout.
 
 from __future__ import annotations
 
-from collections.abc import Callable, Sequence
+import dataclasses
+import warnings
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -15,6 +17,7 @@ from typing import Any
 import numpy as np
 
 from uvms_pin.control.base import Controller
+from uvms_pin.errors import ShortenedRunWarning
 from uvms_pin.model.uvms import UVMS
 from uvms_pin.results.progress import Progress, callback_or_none, progress_printer
 from uvms_pin.results.rollout import Rollout
@@ -23,6 +26,7 @@ from uvms_pin.sim.plant import Plant
 from uvms_pin.sim.sample import Observer, ProgressReport
 from uvms_pin.sim.sensors import SensorConfig, SensorSuite
 from uvms_pin.sim.settings import SimulationSettings
+from uvms_pin.sim.shortened import max_duration_s, shortened_duration_s, shortened_message
 
 ControllerFactory = Callable[[UVMS], Controller]
 
@@ -41,6 +45,8 @@ class ControllerSpec:
     type: str
     params: dict[str, Any] = field(default_factory=dict)
     build: ControllerFactory = field(default=None, repr=False)
+    #: built from the scenario file's [controller] table (its ``raw`` then records it)
+    from_file: bool = field(default=False, compare=False)
 
     def __call__(self, uvms: UVMS) -> Controller:
         return self.build(uvms)
@@ -59,6 +65,8 @@ class Scenario:
             `ControllerSpec` records its type and parameters in the rollout).
         sensor_config: noise of the measurements.
         q0, v0: initial state. settings: integrator, periods, duration, seed.
+        shortened_from_s: the scenario's own duration [s] when ``UVMS_PIN_MAX_DURATION_S``
+            shortened this run (`shortened`), else None.
     """
 
     name: str
@@ -71,6 +79,7 @@ class Scenario:
     q0: np.ndarray
     v0: np.ndarray
     settings: SimulationSettings
+    shortened_from_s: float | None = None
 
     @property
     def uvms(self) -> UVMS:
@@ -92,8 +101,10 @@ def simulate(
     a live view.
 
     Raises FunnelViolation / SimulationError with the partial rollout attached as
-    ``exc.rollout`` (see `uvms_pin.sim.closed_loop.ClosedLoop.run`).
+    ``exc.rollout`` (see `uvms_pin.sim.closed_loop.ClosedLoop.run`). With
+    ``UVMS_PIN_MAX_DURATION_S`` set, the run is shortened, and says so (`shortened`).
     """
+    scenario = shortened(scenario)
     duration_s = scenario.settings.duration_s
     if progress is True:
         with progress_printer(scenario.name, duration_s) as printer:
@@ -109,13 +120,16 @@ def _simulate(scenario: Scenario, observers: list[Observer]) -> Rollout:
         scenario.uvms.model, scenario.sensor_config, settings.duration_s, settings.seed
     )
     controller = scenario.controller_factory(scenario.uvms)
+    record = controller_record(scenario.controller_factory, controller)
     metadata = {
         "scenario": scenario.name,
         "scenario_path": str(scenario.path),
         "description": scenario.description,
-        "parameters": scenario.raw,
-        "controller": controller_record(scenario.controller_factory, controller),
+        "parameters": recorded_parameters(scenario, record),
+        "controller": record,
     }
+    if scenario.shortened_from_s is not None:
+        metadata["shortened_from_s"] = scenario.shortened_from_s
     return simulate_closed_loop(
         scenario.plant,
         controller,
@@ -135,11 +149,71 @@ def class_path(controller: object) -> str:
 
 
 def controller_record(factory: ControllerFactory, controller: Controller) -> dict[str, Any]:
-    """What ran: the class of ``controller`` (``module:QualifiedName``) and, when the
-    factory is a `ControllerSpec`, its type and parameters (else None: unknown)."""
-    spec = factory if isinstance(factory, ControllerSpec) else None
+    """What ran: the class of ``controller`` (``module:QualifiedName``), its type and its
+    parameters: a `ControllerSpec`'s, else the class path (what a scenario's ``type`` would
+    name) and the controller's public numbers, strings and small arrays (`public_parameters`)."""
+    if isinstance(factory, ControllerSpec):
+        return {"class": class_path(controller), "type": factory.type, "params": factory.params}
     return {
         "class": class_path(controller),
-        "type": None if spec is None else spec.type,
-        "params": None if spec is None else spec.params,
+        "type": class_path(controller),
+        "params": public_parameters(controller),
     }
+
+
+def shortened(scenario: Scenario, environ: Mapping[str, str] | None = None) -> Scenario:
+    """``scenario``, or a copy shortened to the cap ``UVMS_PIN_MAX_DURATION_S`` sets in
+    ``environ`` (default: the process's environment; `uvms_pin.sim.shortened`).
+
+    A shortened copy has the new duration in its settings and parameters, its own duration
+    in ``shortened_from_s``, and a `ShortenedRunWarning` says so. A scenario that is not
+    longer than the cap comes back unchanged, without a warning.
+
+    Raises:
+        ParameterError: the variable holds no positive number.
+    """
+    cap_s = max_duration_s(environ)
+    settings = scenario.settings
+    if cap_s is None:
+        return scenario
+    duration_s = shortened_duration_s(settings.duration_s, settings.log_period_s, cap_s)
+    if duration_s is None:
+        return scenario
+    own_s = scenario.shortened_from_s or settings.duration_s
+    warnings.warn(
+        ShortenedRunWarning(shortened_message(str(scenario.path), own_s, duration_s, cap_s)),
+        stacklevel=2,
+    )
+    head = {**scenario.raw.get("scenario", {}), "duration_s": duration_s}
+    return dataclasses.replace(
+        scenario,
+        raw={**scenario.raw, "scenario": head},
+        settings=dataclasses.replace(settings, duration_s=duration_s),
+        shortened_from_s=own_s,
+    )
+
+
+def public_parameters(controller: object) -> dict[str, Any]:
+    """The controller's public attributes that are numbers, strings, booleans or numeric
+    arrays of at most 64 entries (as lists): what can be recorded of a controller built in
+    code."""
+    out: dict[str, Any] = {}
+    for name, value in vars(controller).items():
+        if name.startswith("_"):
+            continue
+        if isinstance(value, bool | int | float | str):
+            out[name] = value
+        elif isinstance(value, np.ndarray) and value.dtype.kind in "biuf" and value.size <= 64:
+            out[name] = value.tolist()
+    return out
+
+
+def recorded_parameters(scenario: Scenario, record: dict[str, Any]) -> dict[str, Any]:
+    """The scenario's parameters as they ran: its ``raw`` document, whose [controller] table
+    says what the run's controller is when it was not built from that table (a
+    ``controller_factory`` set in code)."""
+    factory = scenario.controller_factory
+    if isinstance(factory, ControllerSpec) and factory.from_file:
+        return scenario.raw
+    table = {"type": record["type"], "set_in_code": True, **(record["params"] or {})}
+    return {**scenario.raw, "controller": table}

@@ -4,9 +4,9 @@ other (nothing is silently rounded) and a log that fits in memory."""
 from __future__ import annotations
 
 import math
-import os
 from dataclasses import dataclass
 
+from uvms_pin.checks import check_memory, seed_value
 from uvms_pin.errors import ParameterError
 from uvms_pin.sim.integrators import Integrator
 
@@ -33,6 +33,7 @@ class SimulationSettings:
     rebase_period_s: float = 0.5
 
     def __post_init__(self) -> None:
+        seed_value("seed", self.seed)
         if not (self.duration_s > 0.0 and math.isfinite(self.duration_s)):
             raise ParameterError(f"duration_s must be positive, got {self.duration_s}")
         if not (self.log_period_s > 0.0 and math.isfinite(self.log_period_s)):
@@ -66,9 +67,10 @@ class SimulationSettings:
             )
             _require_multiple(interval, step_s, name, "step_s (integrator.step_s)")
 
-    def log_bytes(self, nq: int, nv: int) -> int:
-        """Memory the rollout of this run takes [bytes] (float64 arrays, every sample)."""
-        return self.n_log * 8 * _log_width(nq, nv)
+    def log_bytes(self, nq: int, nv: int, n_hulls: int = 0) -> int:
+        """Memory the rollout of this run takes [bytes] (float64 arrays, every sample;
+        ``n_hulls``: the wet fractions logged under a free surface)."""
+        return self.n_log * 8 * (_log_width(nq, nv) + n_hulls)
 
     @property
     def n_log(self) -> int:
@@ -99,30 +101,12 @@ def _log_width(nq: int, nv: int) -> int:
     return base + 10 * (6 + nv)
 
 
-def available_memory_bytes() -> int | None:
-    """Memory the system can give this process now [bytes], or None if unknown."""
-    try:
-        with open("/proc/meminfo") as f:
-            for line in f:
-                if line.startswith("MemAvailable:"):
-                    return int(line.split()[1]) * 1024
-    except OSError:
-        pass
-    try:
-        return os.sysconf("SC_AVPHYS_PAGES") * os.sysconf("SC_PAGE_SIZE")
-    except (ValueError, OSError, AttributeError):
-        return None
-
-
-def check_log_fits(settings: SimulationSettings, nq: int, nv: int) -> None:
+def check_log_fits(settings: SimulationSettings, nq: int, nv: int, n_hulls: int = 0) -> None:
     """ParameterError, before anything is allocated, if the rollout would take more than half
     of the available memory (the other half: figures, the saved copy, the rest of the run)."""
-    needed = settings.log_bytes(nq, nv)
-    available = available_memory_bytes()
-    if available is not None and needed > available // 2:
-        raise ParameterError(
-            f"the log of this run would take {needed / 2**30:.3g} GiB "
-            f"({settings.n_log} samples: duration_s {settings.duration_s:g} s / log_period_s "
-            f"{settings.log_period_s:g} s), more than half of the {available / 2**30:.3g} GiB "
-            "available: shorten scenario.duration_s or lengthen output.log_period_s"
-        )
+    check_memory(
+        settings.log_bytes(nq, nv, n_hulls),
+        f"the log of this run ({settings.n_log} samples: duration_s {settings.duration_s:g} s "
+        f"/ log_period_s {settings.log_period_s:g} s)",
+        "shorten scenario.duration_s or lengthen output.log_period_s",
+    )

@@ -54,9 +54,42 @@ def test_without_keep_rollouts_only_the_table_is_written(tmp_path):
 def test_cli_keeps_the_reason_of_an_arm_that_never_ran(tmp_path, capsys):
     out = tmp_path / "arms"
     argv = ["compare-arms", str(SCENARIO), "--arms", "so100", "--duration", "0.02"]
-    assert main([*argv, "--ik-starts", "4", "--out", str(out), "--keep-rollouts"]) == 0
+    # the only arm never ran: the table says why, and the exit status says nothing ran
+    assert main([*argv, "--ik-starts", "4", "--out", str(out), "--keep-rollouts"]) == 3
     row = json.loads((out / "so100" / "row.json").read_text())
     assert row["status"] == "unreachable" and "out of reach" in row["reason"]
     assert row["force_error_rms_N"] is None  # never ran: null, not NaN
     assert not (out / "so100" / "rollout.npz").exists()
-    assert "per arm:" in capsys.readouterr().out
+    captured = capsys.readouterr()
+    assert "per arm:" in captured.out
+    assert (
+        captured.err.strip()
+        .splitlines()[-1]
+        .startswith("uvms-pin: compare-arms: no arm ran, nothing is compared: so100: unreachable")
+    )
+
+
+def test_set_applies_to_every_arm_and_quiet_silences_progress(tmp_path, capsys):
+    out = tmp_path / "arms"
+    argv = ["compare-arms", str(SCENARIO), "--arms", "reference", "--out", str(out), "--quiet"]
+    assert (
+        main([*argv, "--set", "scenario.duration_s=0.04", "--set", "output.log_period_s=0.02"]) == 0
+    )
+    table = (out / "comparison.csv").read_text().splitlines()
+    header, row = table[0].split(","), table[1].split(",")
+    assert float(row[header.index("simulated_time_s")]) == pytest.approx(0.04)
+    assert capsys.readouterr().err == ""
+
+
+def test_a_vehicle_without_an_arm_is_refused_saying_so(tmp_path, capsys):
+    scenario = tmp_path / "vehicle.toml"
+    scenario.write_text(
+        (ROOT / "scenarios" / "passive_current.toml")
+        .read_text()
+        .replace('"uvms_lbv150"', '"lbv150"')
+        .replace("joint_positions_rad = [0.0, 0.5, -0.5, 0.0]", "")
+        .replace("velocity = [0.2, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0]", "")
+    )
+    assert main(["compare-arms", str(scenario), "--out", str(tmp_path / "o")]) == 2
+    assert "is a vehicle without an arm" in capsys.readouterr().err
+    assert not (tmp_path / "o").exists()

@@ -95,3 +95,25 @@ def test_robustness_cases_scale_what_the_scenario_sets():
     assert cases["noise_x5"][0] == {"sensors.force_noise_N": pytest.approx(0.1)}
     assert cases["disturbance_x5"][0]["disturbance.amplitude"][0] == pytest.approx(0.75)
     assert set(cases["plant_x0.7"][1].values()) == {0.7}
+
+
+def test_the_force_figure_is_titled_and_its_window_line_labelled(tmp_path):
+    """It had no title, and a vertical line nothing named (issue 22, 19)."""
+    from uvms_pin.apps.compare.figures import write_comparison_figures
+    from uvms_pin.apps.compare.metrics import Criteria
+    from uvms_pin.apps.compare.runs import compare_controllers, controller_scenarios
+
+    scenarios = controller_scenarios(REALISTIC, ["ppc"], {"scenario.duration_s": 0.1})
+    rows, rollouts = compare_controllers(scenarios, Criteria(0.05, 0.25, 0.5))
+    written = write_comparison_figures(rows, rollouts, tmp_path, 0.05)
+    assert [p.name for p in written] == ["controllers_force.png", "controllers_metrics.png"]
+    assert not [p for p in tmp_path.iterdir() if p.name.startswith(".")]  # written whole
+
+    from uvms_pin.apps.compare.figures import force_figure
+
+    fig = force_figure(rollouts, 0.05)
+    assert fig._suptitle.get_text().startswith("realistic_force_tracking: contact force f_x")
+    lower = fig.axes[1]
+    assert [t.get_text() for t in lower.get_legend().get_texts()] == [
+        "after-transient window from t = 0.05 s (errors measured there)"
+    ]

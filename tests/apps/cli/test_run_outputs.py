@@ -6,12 +6,15 @@ from __future__ import annotations
 
 import json
 import os
+import signal
 import stat
 import subprocess
+import time
 from importlib import metadata
 
 import numpy as np
 import paused_cli
+import pytest
 from cli_support import interrupt, passive_scenario, run_cli, uvms_pin_command
 
 from uvms_pin.results.rollout import Rollout
@@ -49,6 +52,34 @@ def test_ctrl_c_keeps_the_partial_rollout_and_a_second_run_into_its_out_is_refus
     assert np.all(np.isfinite(rollout.q)) and np.all(np.isfinite(rollout.v))
     assert metrics["simulated_time_s"] == rollout.time_s[-1]
     assert (tmp_path / "o" / "pose.png").stat().st_size > 0
+
+
+@pytest.mark.parametrize("delay_s", [0.02, 0.08, 0.15, 0.3])
+def test_a_second_ctrl_c_while_saving_does_not_lose_the_rollout(tmp_path, delay_s):
+    """The first Ctrl-C stops the run; a second one ``delay_s`` later (an impatient user,
+    while the partial rollout is being saved) waits for the save: the rollout, its metadata
+    and metrics.json are whole and agree, no temporary file is left."""
+    (tmp_path / "long.toml").write_text(passive_scenario(600.0))
+    # paused at a known sample (a test hook): enough simulated for a save that takes a while
+    proc = paused_cli.start(
+        ["--pause-at-sample", "2000"], ["run", "long.toml", "--out", "o"], tmp_path
+    )
+    try:
+        paused_cli.wait_until_paused(proc)
+        os.killpg(proc.pid, signal.SIGINT)
+        time.sleep(delay_s)
+        _out, err = interrupt(proc)
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+            proc.wait()
+    assert proc.returncode == 130, err
+    assert "Traceback" not in err
+    rollout = Rollout.load(tmp_path / "o")
+    metrics = json.loads((tmp_path / "o" / "metrics.json").read_text())
+    assert rollout.metadata["status"] == metrics["status"] == "interrupted"
+    assert metrics["simulated_time_s"] == rollout.time_s[-1] > 0.0
+    assert not [p.name for p in (tmp_path / "o").iterdir() if p.name.startswith(".")]
 
 
 def test_overwrite_replaces_a_runs_outputs_keeps_the_users_files_and_follows_the_umask(tmp_path):

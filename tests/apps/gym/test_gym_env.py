@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import importlib.util
+import re
 
 import gymnasium as gym
 import numpy as np
@@ -200,6 +201,28 @@ def test_bad_options_are_clear_errors(kw, match):
         gym.make(FORCE, **kw)
 
 
+def test_the_continuous_control_advice_works_as_given():
+    """The refusal of a continuous-control scenario names a control period and, for one
+    without actuation limits, action_scale: doing exactly that gives a working env."""
+    with pytest.raises(ParameterError) as refused:
+        gym.make(FORCE, scenario="paper_force_tracking")
+    message = str(refused.value)
+    period = re.search(r'overrides=\{"control\.period_s": ([0-9.e-]+)\}', message)
+    assert period and "action_scale=<10 numbers" in message, message
+    env = gym.make(
+        FORCE,
+        scenario="paper_force_tracking",
+        overrides={"control.period_s": float(period.group(1))},
+        action_scale=np.full(10, 5.0),
+    )
+    env.reset(seed=0)
+    _, _, terminated, truncated, info = env.step(np.zeros(10))
+    assert not (terminated or truncated) and info["time_s"] == pytest.approx(0.005)
+    with pytest.raises(ParameterError) as refused:
+        gym.make(FORCE, scenario="paper_force_tracking", action_scale=np.full(10, 5.0))
+    assert "action_scale" not in str(refused.value)  # given already: not asked again
+
+
 def test_force_tracking_needs_a_contact_environment():
     with pytest.raises(ParameterError, match="contact"):
         gym.make(FORCE, scenario="gym_station_keeping")
@@ -262,3 +285,66 @@ def test_any_scenario_or_model():
     lbv = _make(FORCE, model=str(urdf)).unwrapped
     assert lbv.scenario.uvms.source == str(urdf.resolve()) or lbv.scenario.uvms.source == str(urdf)
     assert lbv.observation_space.shape == (30,)
+
+
+def test_an_observation_never_aliases_the_plant_state():
+    """A policy that writes into its observation (or into the episode's rollout) changes
+    nothing in the environment: the next observations are those of an untouched run."""
+
+    def run(meddle: bool) -> np.ndarray:
+        env = _make(FORCE).unwrapped
+        observation, _ = env.reset(seed=5)
+        seen = [observation.copy()]
+        for _ in range(5):
+            if meddle:
+                assert not np.shares_memory(observation, env._loop.q)
+                observation[:] = 99.0  # it is the policy's own array
+                rollout = env.episode_rollout()
+                rollout.q[:] = 99.0
+                rollout.v[:] = 99.0
+            observation, *_ = env.step(np.zeros(env.action_space.shape))
+            seen.append(observation.copy())
+        return np.array(seen)
+
+    np.testing.assert_array_equal(run(meddle=True), run(meddle=False))
+
+
+def test_continuous_arm_joints(tmp_path):
+    """A model whose arm joints are continuous: q holds (cos, sin) of each (nq = 15 for
+    nv = 10); the initial joint perturbation turns each joint by an angle, staying on the
+    circle."""
+    from conftest import continuous_joint_urdf
+
+    urdf = continuous_joint_urdf(tmp_path)
+    env = _make(FORCE, model=str(urdf), initial_joint_noise_rad=0.3).unwrapped
+    assert env.observation_space.shape == (15 + 10 + 6 + 3,)
+    observation, _ = env.reset(seed=3)
+    q = observation[env.observation_layout["q"]]
+    cos, sin = q[7::2], q[8::2]
+    np.testing.assert_allclose(np.hypot(cos, sin), 1.0, rtol=0, atol=1e-14)
+    turned = np.arctan2(sin, cos) - env.scenario.uvms.arm_joints.positions(env.scenario.q0)
+    assert np.all(np.abs(turned) <= 0.3) and np.any(np.abs(turned) > 0.01)
+    observation, *_ = env.step(np.zeros(10))
+    assert np.all(np.isfinite(observation))
+
+
+def test_the_render_draws_the_vehicle_at_its_size_and_attitude():
+    """Its hull box (the first box collision of the root link), turned with the vehicle; not a
+    0.1 m square for every vehicle."""
+    import pinocchio as pin
+
+    from uvms_pin.apps.gym.render import _outline_xz, vehicle_box
+
+    env = _make(FORCE, scenario="bluerov_alpha5_force_tracking").unwrapped
+    centre, size = vehicle_box(env.scenario.uvms)
+    np.testing.assert_allclose(size, [0.457, 0.575, 0.254])  # the BlueROV2 Heavy's hull
+    pitch = 0.3
+    data = env.scenario.uvms.model.createData()
+    q = env.scenario.q0.copy()
+    q[3:7] = pin.Quaternion(pin.rpy.rpyToMatrix(0.0, pitch, 0.0)).coeffs()
+    pin.forwardKinematics(env.scenario.uvms.model, data, q)
+    outline = _outline_xz(data, (centre, size))
+    width = np.ptp(outline[:, 0])
+    assert width == pytest.approx(size[0] * np.cos(pitch) + size[2] * np.sin(pitch))
+    lbv = _make(FORCE).unwrapped
+    np.testing.assert_allclose(vehicle_box(lbv.scenario.uvms)[1], [0.53, 0.245, 0.254])

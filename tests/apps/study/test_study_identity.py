@@ -63,3 +63,19 @@ def test_a_directory_without_the_record_is_checked_against_its_copy_and_rows(tmp
     study_path.write_text(study_path.read_text().replace("seed = 11", "seed = 12"))
     with pytest.raises(StudyError, match="holds the results of another study"):
         _sweep(study_path, out)
+
+
+def test_shortened_and_full_runs_never_share_a_table(tmp_path, monkeypatch):
+    """UVMS_PIN_MAX_DURATION_S is part of what the rows come from: a resume with another
+    cap (or none) is refused, before anything is written."""
+    study_path = write_study(tmp_path)
+    out = tmp_path / "out"
+    monkeypatch.setenv("UVMS_PIN_MAX_DURATION_S", "0.1")
+    _sweep(study_path, out)
+    before = _files(out)
+    monkeypatch.delenv("UVMS_PIN_MAX_DURATION_S")
+    with pytest.raises(StudyError, match=r"UVMS_PIN_MAX_DURATION_S=0.1 .* None now"):
+        _sweep(study_path, out)
+    assert _files(out) == before
+    monkeypatch.setenv("UVMS_PIN_MAX_DURATION_S", "0.1")
+    _sweep(study_path, out)  # the same cap: resumes

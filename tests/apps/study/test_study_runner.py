@@ -155,6 +155,30 @@ def test_a_run_whose_scenario_fails_is_an_error_row_not_an_exception(tmp_path):
     assert row["status"] == "error" and "cauchy" in row["error"] and row["run_id"] == run.run_id
 
 
+def test_a_controller_raising_is_an_error_row_with_its_traceback_not_a_divergence(tmp_path):
+    study = load_study(write_study(tmp_path))
+    (tmp_path / "raising_ctrl.py").write_text(
+        "import numpy as np\n"
+        "from uvms_pin.control.base import Controller\n"
+        "class Late(Controller):\n"
+        "    def __init__(self, uvms):\n"
+        "        self.nv = uvms.nv\n"
+        "    def compute(self, t, m):\n"
+        "        if t > 0.05:\n"
+        "            raise RuntimeError('sensor lost')\n"
+        "        return np.zeros(self.nv)\n"
+    )
+    text = study.base.read_text()
+    start, end = text.index("[controller]"), text.index("[control]")
+    base = tmp_path / "raising.toml"
+    base.write_text(text[:start] + '[controller]\ntype = "raising_ctrl:Late"\n\n' + text[end:])
+    row = execute_run(str(base), study.runs()[0])
+    assert row["status"] == "error", row
+    assert "compute() raised at t = 0.052 s: RuntimeError: sensor lost" in row["error"]
+    assert "raising_ctrl.py" in row["traceback"] and "sensor lost" in row["traceback"]
+    assert row["simulated_time_s"] == pytest.approx(0.05)  # the rollout up to the stop
+
+
 def test_report_writes_markdown_and_figures(tmp_path, serial_table):
     study, serial = serial_table
     out = tmp_path / "out"

@@ -88,3 +88,34 @@ def test_unknown_trial_name_is_exit_2(tmp_path):
     result = run("validate", "pool", str(DATA), "--out", str(tmp_path / "o"), "--trials", "x")
     assert result.returncode == 2
     assert "no trial named x" in result.stderr
+
+
+@pytest.mark.parametrize(
+    ("step", "message"),
+    [
+        ("10", "--step 10 s is longer than the longest IMU interval"),
+        ("1e-9", "RK4 steps over the 1 trials, more than 1e+07"),
+        ("0", "argument --step: must be positive"),
+    ],
+)
+def test_a_step_that_would_not_be_the_step_used_is_refused(tmp_path, step, message):
+    """--step is the largest step of each IMU interval: one longer than every interval
+    would silently be each interval's length; one so short it takes hours is refused too."""
+    out = tmp_path / "o"
+    result = run(
+        "validate", "pool", str(DATA), "--out", str(out), "--trials", "_alt_011-1", "--step", step
+    )
+    assert result.returncode == 2, result.stderr
+    assert message in result.stderr and "Traceback" not in result.stderr
+    assert not out.exists()
+
+
+def test_no_figures_says_so(tmp_path):
+    out = tmp_path / "o"
+    result = run(
+        "validate", "pool", str(DATA), "--out", str(out), "--trials", "_alt_011-1",
+        "--no-figures", "--quiet",
+    )  # fmt: skip
+    assert result.returncode == 0, result.stderr
+    assert result.stdout.strip().endswith(f"wrote {out}/pool_validation.json, pool_validation.csv")
+    assert sorted(p.name for p in out.iterdir()) == ["pool_validation.csv", "pool_validation.json"]

@@ -4,6 +4,7 @@ from the pair's contact point along the force, as long as the stated scale."""
 from __future__ import annotations
 
 import numpy as np
+import pinocchio as pin
 import pytest
 from viz_support import ROOT
 
@@ -52,6 +53,8 @@ def test_a_pair_arrow_starts_at_its_point_and_is_scale_times_force_long(referenc
     poses = scene.poses(Frame(0.0, reference_uvms.neutral_configuration(), None, None, contacts))
     position, quat, _ = poses[f"world/contacts/pair{k}"]
     assert np.allclose(position, contacts[k, 3:6])
+    along = pin.Quaternion(np.asarray(quat, dtype=float)).matrix() @ np.array([0.0, 1.0, 0.0])
+    assert np.allclose(along, [0.0, 0.6, 0.8])  # the arrow points along the force
     shaft = poses[f"world/contacts/pair{k}/shaft"][2][1]
     head = 4.0 * style.arrow_radius_m
     assert shaft + head == pytest.approx(0.02 * 50.0)

@@ -10,11 +10,20 @@ import argparse
 import math
 import sys
 
-from uvms_pin.apps.arguments import add_comparison_command, comma_names, count, finite, positive
+from uvms_pin.apps.arguments import (
+    add_comparison_command,
+    add_set_option,
+    comma_names,
+    count,
+    finite,
+    positive,
+    process_count,
+)
+from uvms_pin.apps.exit_codes import EXIT_BAD_INPUT, EXIT_RUN_STOPPED
 from uvms_pin.model.mount.catalog import available_arms
 from uvms_pin.results.outdir import COMPARISON, check_writable, claim
+from uvms_pin.scenario.overrides import parse_assignment
 
-EXIT_BAD_INPUT = 2
 DEFAULT_ARMS = "reference,so100,z1,kinova,ur3,ur5,panda"
 
 
@@ -36,17 +45,12 @@ def _cmd_compare_arms(args: argparse.Namespace) -> int:
         mount_rpy=tuple(args.mount_rpy),
         ik_starts=args.ik_starts,
         keep_rollouts=args.keep_rollouts,
+        overrides=tuple(parse_assignment(text) for text in args.set),
     )
     out = check_writable(args.out)
+    say = None if args.quiet else (lambda line: print(line, file=sys.stderr, flush=True))
     with claim(out, COMPARISON, overwrite=args.overwrite):
-        rows = compare_arms(
-            args.scenario,
-            arms,
-            out,
-            settings,
-            jobs=args.jobs,
-            progress=lambda line: print(line, file=sys.stderr, flush=True),
-        )
+        rows = compare_arms(args.scenario, arms, out, settings, jobs=args.jobs, progress=say)
     width = max(len(r["arm"]) for r in rows)
     for r in rows:
         err = r["force_error_rms_N"]
@@ -55,6 +59,13 @@ def _cmd_compare_arms(args: argparse.Namespace) -> int:
     print(f"wrote {args.out}/comparison.csv, comparison.md, comparison.png")
     if args.keep_rollouts:
         print(f"per arm: {args.out}/<arm>/row.json, rollout, metrics.json and figures")
+    ran = [r for r in rows if r["simulated_time_s"] > 0.0]  # NaN: it never ran
+    if not ran:
+        reasons = "; ".join(f"{r['arm']}: {r['status']} ({r['reason']})" for r in rows)
+        print(
+            f"uvms-pin: compare-arms: no arm ran, nothing is compared: {reasons}", file=sys.stderr
+        )
+        return EXIT_RUN_STOPPED
     return 0
 
 
@@ -76,7 +87,9 @@ def register(subparsers) -> argparse.ArgumentParser:
         help=f"comma-separated arm names or URDF paths (default {DEFAULT_ARMS})",
     )
     parser.add_argument("--duration", type=positive, default=None, help="override the duration [s]")
-    parser.add_argument("--jobs", type=count(1), default=1, help="arms run in parallel processes")
+    parser.add_argument(
+        "--jobs", type=process_count(1), default=1, help="arms run in parallel processes"
+    )
     parser.add_argument("--no-trim", action="store_true", help="do not add foam and ballast")
     parser.add_argument(
         "--bg", type=finite, default=0.02, help="metacentric height BG after trim [m]"
@@ -93,13 +106,22 @@ def register(subparsers) -> argparse.ArgumentParser:
         help="arm base orientation on the vehicle [rad] (default: upside down)",
     )
     parser.add_argument(
-        "--ik-starts", type=count(1), default=24, help="initial-configuration search starts"
+        "--ik-starts",
+        type=count(1, 10_000, "a few dozen suffice"),
+        default=24,
+        help="initial-configuration search starts",
     )
     parser.add_argument(
         "--keep-rollouts",
         action="store_true",
         help="also write each arm's row, rollout, metrics and figures into OUT/<arm>/",
     )
+    add_set_option(
+        parser,
+        "override a scenario entry for every arm (repeatable), as in 'run'; each arm's model, "
+        "initial joint positions and per-joint controller entries are set per arm",
+    )
+    parser.add_argument("--quiet", action="store_true", help="no progress lines")
     parser.add_argument("--list", action="store_true", help="list the arm names available and exit")
     parser.set_defaults(func=_cmd_compare_arms)
     return parser

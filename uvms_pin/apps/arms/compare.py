@@ -22,7 +22,7 @@ For a scenario (e.g. ``scenarios/realistic_force_tracking.toml``) whose model is
    is what the sampled controller's stability depends on), and the other arrays take the
    median of the reference arm's entries.
 6. The run's status is "ok", the exception that stopped it (FunnelViolation,
-   SimulationError) or "joint limits" if a joint left its limits during the run.
+   SimulationError), "error" (the controller raised) or "joint limits" if a joint left its limits during the run.
 7. With ``keep_rollouts``, each arm's row (``row.json``: status, reason, trim) and, when it
    ran, its rollout, ``metrics.json`` and figures (the paper's funnel figures show which
    error left its funnel, and when) go to ``OUT/<arm>/``, as ``uvms-pin run`` writes them.
@@ -43,6 +43,8 @@ from uvms_pin.apps.arms.progress import done_line, print_to_stderr
 from uvms_pin.apps.arms.row import COLUMNS
 from uvms_pin.apps.arms.settings import CompareSettings
 from uvms_pin.apps.arms.table import write_comparison
+from uvms_pin.checks import check_memory
+from uvms_pin.errors import ScenarioError
 from uvms_pin.model.mount.catalog import REFERENCE, ArmEntry, resolve_arm
 from uvms_pin.model.mount.hull import hull_box
 from uvms_pin.model.mount.split import split_urdf
@@ -73,13 +75,20 @@ def compare_arms(
     scenario_path = Path(scenario_path)
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
-    base = load_scenario(scenario_path)
+    base = load_scenario(scenario_path, settings.scenario_overrides)
+    if not base.uvms.n_arm_joints:
+        raise ScenarioError(
+            f"{scenario_path}: its model ({base.uvms.source}) is a vehicle without an arm: "
+            "compare-arms mounts each arm where the scenario's arm is and runs the "
+            "scenario's task with it; give a scenario whose model carries an arm"
+        )
+    _check_runs_fit(base, min(jobs, len(arms)))
     model_path = Path(base.uvms.source)
     for name in arms:  # fail early on names that are neither known nor files
         if name != REFERENCE:
             resolve_arm(name)
     with tempfile.TemporaryDirectory(prefix="uvms_pin_arms_") as tmp:
-        split = split_urdf(model_path, tmp)
+        split = split_urdf(model_path, tmp, first_arm_joint=base.uvms.arm_joint_names[0])
         hull = hull_box(split.vehicle_urdf, split.vehicle_link)
         args = [
             (
@@ -99,6 +108,29 @@ def compare_arms(
             rows = _run_in_turn(args, progress)
     write_comparison(rows, out, scenario=str(scenario_path), settings=settings)
     return rows
+
+
+#: configuration and velocity entries an arm of the catalogue may add to the scenario's
+#: (a 7-joint arm replacing a 4-joint one, continuous joints counted twice), and hulls (the
+#: wet fractions logged: panda's 18 derived bodies against the reference arm's 5)
+_MORE_ARM_ENTRIES = 16
+_MORE_HULLS = 16
+
+
+def _check_runs_fit(base, parallel: int) -> None:
+    """ScenarioError before any arm runs if ``parallel`` runs' logs would not fit."""
+    uvms, settings = base.uvms, base.settings
+    check_memory(
+        parallel
+        * settings.log_bytes(
+            uvms.nq + _MORE_ARM_ENTRIES,
+            uvms.nv + _MORE_ARM_ENTRIES,
+            base.plant.n_logged_hulls + _MORE_HULLS if base.plant.free_surface else 0,
+        ),
+        f"the logs of {parallel} arm runs at a time ({settings.n_log} samples each)",
+        "shorten --duration, lengthen output.log_period_s or lower --jobs",
+        ScenarioError,
+    )
 
 
 def _run_in_processes(

@@ -45,5 +45,5 @@ def controller_overrides(
         out[f"controller.{key}"] = vehicle + arm
     if "null_space_target" in raw_controller:
         # the reference design pulls the arm back to its working pose: each arm's own
-        out["controller.null_space_target"] = [float(x) for x in q0[7:]]
+        out["controller.null_space_target"] = uvms.arm_joints.positions(q0).tolist()
     return out

@@ -24,6 +24,7 @@ from dataclasses import dataclass
 import numpy as np
 import pinocchio as pin
 
+from uvms_pin.errors import ModelError
 from uvms_pin.model.uvms import UVMS
 
 #: Position-only iterations after the prioritized ones (converge the contact point).
@@ -55,9 +56,20 @@ class InitialConfiguration:
 
 
 def _arm_bounds(uvms: UVMS) -> tuple[np.ndarray, np.ndarray]:
-    """Joint limits shrunk by a margin (the task must start off the limits)."""
-    lo = np.maximum(uvms.model.lowerPositionLimit[7:], -2.0 * np.pi)
-    hi = np.minimum(uvms.model.upperPositionLimit[7:], 2.0 * np.pi)
+    """Joint limits shrunk by a margin (the task must start off the limits).
+
+    Raises ModelError for a continuous joint: the search moves q[7:] as one angle per
+    joint, as `uvms_pin.mount_arm` makes them (a continuous joint becomes revolute)."""
+    arm = uvms.arm_joints
+    if "continuous" in arm.kinds:
+        raise ModelError(
+            "the initial-configuration search needs one configuration entry per arm joint; "
+            f"joints {[n for n, k in zip(arm.names, arm.kinds, strict=True) if k == 'continuous']} "
+            "are continuous (mount the arm with uvms_pin.mount_arm, which makes them revolute)",
+            path=uvms.source or None,
+        )
+    lo = np.maximum(arm.lower, -2.0 * np.pi)
+    hi = np.minimum(arm.upper, 2.0 * np.pi)
     margin = np.minimum(_LIMIT_MARGIN_RAD, _LIMIT_MARGIN_FRACTION * (hi - lo))
     return lo + margin, hi - margin
 

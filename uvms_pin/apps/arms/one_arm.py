@@ -88,7 +88,7 @@ def run_one_arm(
 def _fill_row(row: dict, job: _ArmJob) -> None:
     """Mount, solve, trim and run one arm, filling ``row`` (raises on a model error)."""
     settings = job.settings
-    overrides = {} if settings.duration_s is None else {"scenario.duration_s": settings.duration_s}
+    overrides = settings.scenario_overrides
     vehicle_mass = _vehicle_mass(Path(job.vehicle_urdf))
     base = load_scenario(job.scenario_path, overrides)
     target = _start_tool_placement(base)
@@ -179,11 +179,12 @@ def _run_mounted(
         row.update(status="unreachable", reason=ik.reason)
         return
     model_path = Path(job.out_dir) / "models" / f"{job.entry.name}.urdf"
-    mounted, trim_notes = _trimmed(row, job, mounted, ik.q[7:], model_path, density)
+    joints = mounted.uvms.arm_joints.positions(ik.q)
+    mounted, trim_notes = _trimmed(row, job, mounted, joints, model_path, density)
     arm_overrides = {
         **overrides,
         "scenario.model": str(model_path.resolve()),
-        "initial.joint_positions_rad": ik.q[7:].tolist(),
+        "initial.joint_positions_rad": joints.tolist(),
         "initial.velocity": [0.0] * mounted.uvms.nv,
         **controller_overrides(
             base.raw.get("controller", {}), base.uvms, base.q0, mounted.uvms, ik.q

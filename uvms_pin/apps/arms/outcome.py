@@ -1,8 +1,9 @@
 """One arm's run: simulate its scenario, put the metrics and the outcome in its row.
 
 The status is "ok", the exception that stopped the run (FunnelViolation,
-SimulationError) or "joint limits" if a joint left its limits during an otherwise
-complete run; the reason says what happened (the joint, its limits, when).
+SimulationError), "error" (the controller raised) or "joint limits" if a joint left its
+limits during an otherwise complete run; the reason says what happened (the joint, its
+limits, when).
 """
 
 from __future__ import annotations
@@ -33,8 +34,9 @@ def joint_limit_violation(rollout, uvms: UVMS) -> str:
     """The first arm joint past its limits (1e-6 rad tolerance) and when; "" if none."""
     if len(rollout) == 0:
         return ""
-    q = rollout.q[:, 7:]
-    lo, hi = uvms.model.lowerPositionLimit[7:], uvms.model.upperPositionLimit[7:]
+    arm = uvms.arm_joints  # a continuous joint has no limits: never past them
+    q = arm.positions(rollout.q)
+    lo, hi = arm.lower, arm.upper
     bad = (q < lo - 1e-6) | (q > hi + 1e-6)
     if not np.any(bad):
         return ""
@@ -55,8 +57,9 @@ def run_scenario(
         status, reason = "ok", ""
     except FunnelViolation as exc:
         rollout, status, reason = exc.rollout, "FunnelViolation", str(exc)
-    except SimulationError as exc:
-        rollout, status, reason = exc.rollout, "SimulationError", str(exc)
+    except SimulationError as exc:  # a divergence, or "error": the controller raised
+        rollout, reason = exc.rollout, str(exc)
+        status = rollout.status.kind
     limits = joint_limit_violation(rollout, scenario.uvms)
     if limits:
         reason = f"{limits}; {reason}" if reason else limits

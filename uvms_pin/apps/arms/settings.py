@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import Any
 
 from uvms_pin.model.trim import TrimSpec
 
@@ -19,6 +20,8 @@ class CompareSettings:
         mount_rpy: arm base orientation on the vehicle [rad] (default upside down).
         ik_starts: starts of the initial-configuration search; seed: its random seed.
         keep_rollouts: write each arm's row, rollout, metrics and figures to OUT/<arm>/.
+        overrides: scenario overrides for every arm (``--set``), as (dotted key, value)
+            pairs.
     """
 
     duration_s: float | None = None
@@ -27,3 +30,12 @@ class CompareSettings:
     ik_starts: int = 24
     seed: int = 0
     keep_rollouts: bool = False
+    overrides: tuple[tuple[str, Any], ...] = ()
+
+    @property
+    def scenario_overrides(self) -> dict[str, Any]:
+        """The overrides every arm's scenario is loaded with (``--set``, then --duration)."""
+        out = dict(self.overrides)
+        if self.duration_s is not None:
+            out["scenario.duration_s"] = self.duration_s
+        return out

@@ -3,43 +3,33 @@
 from __future__ import annotations
 
 import argparse
+import os
 import sys
 import warnings
-from contextlib import nullcontext
 from pathlib import Path
 from typing import TYPE_CHECKING
 
-from uvms_pin.apps.arguments import add_set_option, positive
+from uvms_pin.apps.arguments import add_set_option, path_text, positive
 from uvms_pin.apps.arms.command import register as register_compare_arms
+from uvms_pin.apps.cli.run import check_view_options, cmd_run
 from uvms_pin.apps.compare.command import register as register_compare_controllers
-from uvms_pin.apps.outputs import write_outputs
+from uvms_pin.apps.exit_codes import (
+    EXIT_BAD_INPUT,
+    EXIT_BROKEN_PIPE,
+    EXIT_ENVIRONMENT,
+    EXIT_INTERRUPTED,
+)
 from uvms_pin.apps.study.command import register as register_study_commands
 from uvms_pin.apps.validation.command import register as register_validate
-from uvms_pin.errors import FunnelViolation, SimulationError, UvmsPinError, UvmsPinWarning
-from uvms_pin.model.resources import find_model
-from uvms_pin.results.outdir import OVERWRITE_HELP, RUN, check_writable, claim, claim_file
-from uvms_pin.results.progress import progress_printer
-from uvms_pin.scenario.overrides import parse_assignment
+from uvms_pin.errors import UvmsPinError, UvmsPinWarning
+from uvms_pin.model.resources import resolve_model
+from uvms_pin.results.outdir import OVERWRITE_HELP, claim_file
 
 if TYPE_CHECKING:
     from uvms_pin.results.rollout import Rollout
 
 # The simulation stack (Pinocchio, SciPy, matplotlib) is imported by the commands that
 # need it: --help, --version and argument errors answer at once.
-
-EXIT_BAD_INPUT = 2
-EXIT_RUN_STOPPED = 3
-EXIT_INTERRUPTED = 130  # as a shell reports a process stopped by Ctrl-C
-
-
-def _simulate(scenario, args: argparse.Namespace, progress) -> Rollout:
-    from uvms_pin.sim.run import simulate
-
-    if not args.live:
-        return simulate(scenario, progress=progress)
-    from uvms_pin.apps.viz.live import run_live
-
-    return run_live(scenario, port=args.port, speed=args.speed, progress=progress)
 
 
 def _write_replay(rollout: Rollout, path: Path, **kw) -> Path:
@@ -48,65 +38,8 @@ def _write_replay(rollout: Rollout, path: Path, **kw) -> Path:
     return write_replay(rollout, path, **kw)
 
 
-def _cmd_run(args: argparse.Namespace) -> int:
-    from uvms_pin.scenario.load import load_scenario
-
-    _check_view_options(args)
-    overrides = dict(parse_assignment(text) for text in args.set)
-    scenario = load_scenario(args.scenario, overrides)
-    out = check_writable(args.out)  # before simulating, not after
-    with claim(out, RUN, overwrite=args.overwrite):
-        rollout, status, message = _simulate_to_end(scenario, args)
-        if rollout is None:
-            print(message, file=sys.stderr)
-            return status
-        figures = write_outputs(rollout, out)
-        if args.html:
-            figures.append(_write_replay(rollout, out / "replay.html"))
-    metrics = rollout.metrics()
-    print(
-        f"scenario {scenario.name}: {rollout.metadata['status']}, simulated {metrics['simulated_time_s']:.3f} s in {metrics['wall_time_s']:.2f} s (real-time factor {metrics['real_time_factor']:.2f})"
-    )
-    print(
-        f"wrote {out}/rollout.npz, rollout.json, metrics.json, "
-        + ", ".join(p.name for p in figures)
-    )
-    if status:
-        print(message, file=sys.stderr)
-    return status
-
-
-def _simulate_to_end(scenario, args: argparse.Namespace) -> tuple[Rollout | None, int, str]:
-    """(rollout, exit status, message): a stopped or interrupted run keeps its rollout."""
-    duration_s = scenario.settings.duration_s
-    printer = (
-        nullcontext() if args.quiet else progress_printer(scenario.name, duration_s, delay_s=0.0)
-    )
-    with printer as progress:
-        return _run_or_stop(scenario, args, progress)
-
-
-def _run_or_stop(scenario, args: argparse.Namespace, progress) -> tuple[Rollout | None, int, str]:
-    try:
-        return _simulate(scenario, args, progress), 0, ""
-    except (FunnelViolation, SimulationError) as exc:
-        return getattr(exc, "rollout", None), EXIT_RUN_STOPPED, f"run stopped: {exc}"
-    except KeyboardInterrupt as exc:
-        rollout = getattr(exc, "rollout", None)
-        if rollout is None or not len(rollout):
-            return None, EXIT_INTERRUPTED, "uvms-pin: interrupted before the first sample"
-        t_s = float(rollout.time_s[-1])
-        kept = f"the partial rollout (t = 0 to {t_s:.3f} s) is kept in {args.out}"
-        return rollout, EXIT_INTERRUPTED, f"uvms-pin: interrupted: {kept}"
-
-
-def _check_view_options(args: argparse.Namespace) -> None:
-    if not 0 <= args.port <= 65535:
-        raise UvmsPinError(f"--port must be in 0..65535, got {args.port}")
-
-
 def _cmd_replay(args: argparse.Namespace) -> int:
-    _check_view_options(args)
+    check_view_options(args)
     if not (args.html or args.live):
         raise UvmsPinError("replay: nothing to do, give --html and/or --live")
     from uvms_pin.results.rollout import Rollout
@@ -143,7 +76,7 @@ def _cmd_info(args: argparse.Namespace) -> int:
     from uvms_pin.model.summary import model_summary
     from uvms_pin.model.urdf.load import load_uvms
 
-    uvms = load_uvms(find_model(args.urdf) or args.urdf, water_density_kg_m3=args.water_density)
+    uvms = load_uvms(resolve_model(args.urdf), water_density_kg_m3=args.water_density)
     print(model_summary(uvms))
     return 0
 
@@ -155,26 +88,34 @@ def build_parser() -> argparse.ArgumentParser:
     parser.add_argument("--version", action=_Version)
     sub = parser.add_subparsers(dest="command", required=True)
     run = sub.add_parser("run", help="run a scenario file and write rollout, metrics and figures")
-    run.add_argument("scenario", help="scenario TOML file")
-    run.add_argument("--out", required=True, help="output directory")
+    run.add_argument("scenario", type=path_text, help="scenario TOML file")
+    run.add_argument("--out", required=True, type=path_text, help="output directory")
     run.add_argument("--quiet", action="store_true", help="no progress line")
     run.add_argument("--overwrite", action="store_true", help=OVERWRITE_HELP)
     add_set_option(
         run,
-        "override a scenario entry (repeatable): a dotted key, optionally [i]-indexed, "
-        "and a TOML value, e.g. --set 'environment.stiffness_N_m=[20,20,20]' "
-        "--set 'initial.joint_positions_rad[3]=0.5'",
+        "override a scenario entry (repeatable): a dotted key, its parts optionally "
+        "[i]-indexed, and a TOML value, e.g. --set 'environment.stiffness_N_m=[20,20,20]' "
+        "--set 'initial.joint_positions_rad[3]=0.5' "
+        "--set 'actuation.thruster[0].max_forward_N=10'; a table value replaces a whole "
+        "table: --set 'controller={type=\"none\"}'",
     )
     run.add_argument(
         "--html", action="store_true", help="also write replay.html (self-contained, offline)"
     )
     _add_view_options(run)
-    run.set_defaults(func=_cmd_run)
+    run.set_defaults(func=cmd_run)
     replay = sub.add_parser("replay", help="show a saved rollout: replay.html and/or live")
-    replay.add_argument("rollout", help="directory holding rollout.npz and rollout.json")
+    replay.add_argument(
+        "rollout", type=path_text, help="directory holding rollout.npz and rollout.json"
+    )
     replay.add_argument("--html", action="store_true", help="write ROLLOUT/replay.html")
-    replay.add_argument("--out", help="write the page here instead of ROLLOUT/replay.html")
-    replay.add_argument("--urdf", help="the model's URDF, if it moved since the run")
+    replay.add_argument(
+        "--out", type=path_text, help="write the page here instead of ROLLOUT/replay.html"
+    )
+    replay.add_argument(
+        "--urdf", type=path_text, help="the model's URDF, if it moved since the run"
+    )
     replay.add_argument("--overwrite", action="store_true", help="replace an existing page")
     replay.add_argument(
         "--fps", type=positive, default=30.0, help="replay frames per simulated second (max)"
@@ -183,7 +124,9 @@ def build_parser() -> argparse.ArgumentParser:
     replay.set_defaults(func=_cmd_replay)
     info = sub.add_parser("info", help="print a summary of a UVMS URDF")
     info.add_argument(
-        "urdf", help="URDF file with the hydrodynamic extension, or a shipped model name"
+        "urdf",
+        type=path_text,
+        help="URDF file with the hydrodynamic extension, or a shipped model name",
     )
     info.add_argument(
         "--water-density", type=positive, default=1025.0, help="kg/m^3 (default: sea water)"
@@ -235,16 +178,24 @@ def main(argv: list[str] | None = None) -> int:
 def _dispatch(args: argparse.Namespace) -> int:
     try:
         return args.func(args)
+    except BrokenPipeError:  # the reader of stdout stopped (| head): nothing more to say
+        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+        return EXIT_BROKEN_PIPE
+    except OSError as exc:  # a disk full, a file removed under us: not a bug to trace
+        where = f"{exc.filename}: " if exc.filename else ""
+        print(f"uvms-pin: error: {where}{exc.strerror or exc}", file=sys.stderr)
+        return EXIT_ENVIRONMENT
     except UvmsPinError as exc:
+        if exc.user_traceback:  # the user's own code failed: its frames, shown as such
+            print(
+                "uvms-pin: your code raised; its traceback:\n" + exc.user_traceback.rstrip("\n"),
+                file=sys.stderr,
+            )
         print(f"uvms-pin: error: {exc}", file=sys.stderr)
         return EXIT_BAD_INPUT
     except KeyboardInterrupt:
         print("uvms-pin: interrupted", file=sys.stderr)
         return EXIT_INTERRUPTED
-    except OSError as exc:  # a disk full, a file removed under us: not a bug to trace
-        where = f"{exc.filename}: " if exc.filename else ""
-        print(f"uvms-pin: error: {where}{exc.strerror or exc}", file=sys.stderr)
-        return EXIT_BAD_INPUT
 
 
 if __name__ == "__main__":

@@ -9,8 +9,8 @@ from uvms_pin.apps.arguments import (
     add_comparison_command,
     add_set_option,
     comma_names,
-    count,
     positive,
+    process_count,
 )
 from uvms_pin.errors import ParameterError
 from uvms_pin.results.outdir import CONTROLLER_COMPARISON, check_writable, claim
@@ -104,7 +104,7 @@ def register(subparsers) -> argparse.ArgumentParser:
         "robustness.csv, robustness.md, OUT/robustness/ (a study directory)",
     )
     parser.add_argument(
-        "--jobs", type=count(0), default=1,
+        "--jobs", type=process_count(0), default=1,
         help="Dask worker processes for --robustness (0: serial, in this process)",
     )  # fmt: skip
     parser.add_argument("--quiet", action="store_true", help="no progress lines")

@@ -7,6 +7,7 @@ from pathlib import Path
 from typing import Any
 
 from uvms_pin.apps.compare.metrics import Criteria, comparison_row
+from uvms_pin.checks import check_memory
 from uvms_pin.errors import FunnelViolation, ScenarioError, SimulationError
 from uvms_pin.results.rollout import Rollout
 from uvms_pin.scenario.baselines import baseline_controller_table
@@ -39,6 +40,16 @@ def controller_scenarios(
             out[name] = scenario_from_raw(variant, path)
         except ScenarioError as exc:
             raise ScenarioError(f"controller '{name}' ([baselines.{name}]): {exc}") from exc
+    # every controller's rollout is kept until the figures are drawn: all of them must fit
+    check_memory(
+        sum(
+            s.settings.log_bytes(s.uvms.nq, s.uvms.nv, s.plant.n_logged_columns)
+            for s in out.values()
+        ),
+        f"the logs of the {len(out)} runs ({next(iter(out.values())).settings.n_log} samples each)",
+        "shorten scenario.duration_s, lengthen output.log_period_s or compare fewer controllers",
+        ScenarioError,
+    )
     return out
 
 

@@ -208,18 +208,18 @@ def _joint_body(
     else:
         idx = model.joints[j].idx_v
         idx_q = model.joints[j].idx_q
-        ET.SubElement(
+        joint = ET.SubElement(
             body,
             "joint",
             name=model.names[j],
             type=kind,
             axis=numbers_text(direction, _EXACT_DIGITS),
             armature=numbers_text(model.armature[idx], _EXACT_DIGITS),
-            range=numbers_text(
-                [model.lowerPositionLimit[idx_q], model.upperPositionLimit[idx_q]], _EXACT_DIGITS
-            ),
             limited="false",
         )
+        if model.joints[j].nq == 1:  # a continuous joint (cos, sin) has no range
+            limits = [model.lowerPositionLimit[idx_q], model.upperPositionLimit[idx_q]]
+            joint.set("range", numbers_text(limits, _EXACT_DIGITS))
     inertia = model.inertias[j]
     volume = float(uvms.volume_per_joint_m3[j])
     if volume > 0.0:

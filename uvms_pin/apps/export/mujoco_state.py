@@ -1,6 +1,7 @@
 """uvms-pin's state and generalized forces in MuJoCo's conventions and back.
 
-For the free-flyer root the two differ in two ways (arm joints are the same numbers):
+For the free-flyer root the two differ in two ways (arm joints are the same numbers, but
+for a continuous joint's configuration: (cos, sin) here, the angle in MuJoCo):
 
 - configuration: Pinocchio's quaternion is (x, y, z, w), MuJoCo's ``qpos`` is (w, x, y, z);
 - velocity: Pinocchio's zeta = [v_body; w_body] (linear velocity in the BODY frame),
@@ -12,8 +13,12 @@ For the free-flyer root the two differ in two ways (arm joints are the same numb
 
 from __future__ import annotations
 
+from collections.abc import Sequence
+
 import numpy as np
 import pinocchio as pin
+
+from uvms_pin.results.joint_positions import arm_configuration, arm_positions
 
 
 def base_rotation(q: np.ndarray) -> np.ndarray:
@@ -21,16 +26,25 @@ def base_rotation(q: np.ndarray) -> np.ndarray:
     return pin.Quaternion(q[6], q[3], q[4], q[5]).normalized().toRotationMatrix()
 
 
-def qpos_from_q(q: np.ndarray) -> np.ndarray:
-    """MuJoCo ``qpos`` of a uvms-pin configuration q (quaternion reordered to w x y z)."""
-    qpos = np.array(q, dtype=float)
+def qpos_from_q(q: np.ndarray, kinds: Sequence[str] | None = None) -> np.ndarray:
+    """MuJoCo ``qpos`` of a uvms-pin configuration q (quaternion reordered to w x y z).
+
+    ``kinds``: the arm joints' kinds (`UVMS.arm_joints`), needed when one is continuous:
+    its (cos, sin) becomes MuJoCo's hinge angle. None: every arm joint has one entry.
+    """
+    q = np.asarray(q, dtype=float)
+    arm = q[7:] if kinds is None else arm_positions(q[7:], kinds)
+    qpos = np.concatenate([q[:7], arm])
     qpos[3], qpos[4:7] = q[6], q[3:6]
     return qpos
 
 
-def q_from_qpos(qpos: np.ndarray) -> np.ndarray:
-    """uvms-pin configuration of a MuJoCo ``qpos`` (quaternion reordered to x y z w)."""
-    q = np.array(qpos, dtype=float)
+def q_from_qpos(qpos: np.ndarray, kinds: Sequence[str] | None = None) -> np.ndarray:
+    """uvms-pin configuration of a MuJoCo ``qpos`` (quaternion reordered to x y z w; a
+    continuous joint's angle to (cos, sin) when ``kinds`` says so, as `qpos_from_q`)."""
+    qpos = np.asarray(qpos, dtype=float)
+    arm = qpos[7:] if kinds is None else arm_configuration(qpos[7:], kinds)
+    q = np.concatenate([qpos[:7], arm])
     q[3:6], q[6] = qpos[4:7], qpos[3]
     return q
 

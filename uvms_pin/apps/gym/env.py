@@ -21,6 +21,7 @@ from typing import Any, ClassVar
 
 import gymnasium as gym
 import numpy as np
+import pinocchio as pin
 
 from uvms_pin.apps.gym.actions import action_scale as make_action_scale
 from uvms_pin.control.measurement import Measurement
@@ -36,6 +37,30 @@ from uvms_pin.sim.sensors import SensorSuite
 
 # spawn key of the initial-perturbation stream: apart from the sensors' children 0..5
 _PERTURBATION_STREAM = 1 << 16
+
+
+def _continuous_control_message(scenario: Scenario, action_scale: Any) -> str:
+    """Why a continuous-control scenario is refused, and the options that make it run: a
+    control period that divides the log period (the log period itself does), and
+    ``action_scale`` when the scenario has no actuation limits to normalize by."""
+    log_period_s = scenario.settings.log_period_s
+    fix = f'overrides={{"control.period_s": {log_period_s:g}}}'
+    try:
+        make_action_scale(scenario.plant.actuation, scenario.uvms.nv, action_scale)
+    except ParameterError:
+        fix += f", action_scale=<{scenario.uvms.nv} numbers [N, N m]> (no [actuation] limits)"
+    return (
+        f"{scenario.path}: the environment steps one control period at a time, and the "
+        "scenario's control is continuous: give it a control period that divides "
+        f"output.log_period_s = {log_period_s:g} s, e.g. {fix}"
+    )
+
+
+def _shortened_record(scenario: Scenario) -> dict[str, Any]:
+    """``{"shortened_from_s": T}`` for a scenario UVMS_PIN_MAX_DURATION_S shortened."""
+    if scenario.shortened_from_s is None:
+        return {}
+    return {"shortened_from_s": scenario.shortened_from_s}
 
 
 def _episode_seed(np_random: np.random.Generator) -> int:
@@ -101,11 +126,7 @@ class UvmsEnv(gym.Env):
             self.overrides["scenario.model"] = model
         self.scenario = load_scenario(self.scenario_path, self.overrides)
         if self.scenario.settings.control_period_s is None:
-            raise ParameterError(
-                f"{self.scenario_path}: the environment steps one control period at a time, "
-                "and the scenario's control is continuous: set control.period_s "
-                '(overrides={"control.period_s": 0.002})'
-            )
+            raise ParameterError(_continuous_control_message(self.scenario, action_scale))
         self._loop = ClosedLoop(self.scenario.plant, self.scenario.settings)
         uvms = self.scenario.uvms
         self.action_scale = make_action_scale(self.scenario.plant.actuation, uvms.nv, action_scale)
@@ -129,6 +150,7 @@ class UvmsEnv(gym.Env):
         self._contact = np.zeros(6)
         self._anchor: np.ndarray | None = None
         self._render_data = uvms.model.createData()
+        self._vehicle_box = None  # (centre, size) [m], found on the first render
         self._flow_seed = self.scenario.settings.seed
 
     # -- to be given by a task environment ---------------------------------------------
@@ -202,12 +224,15 @@ class UvmsEnv(gym.Env):
     def render(self):
         if self.render_mode != "rgb_array":
             return None
-        from uvms_pin.apps.gym.render import side_view_rgb
+        from uvms_pin.apps.gym.render import side_view_rgb, vehicle_box
 
+        if self._vehicle_box is None:
+            self._vehicle_box = vehicle_box(self.scenario.uvms)
         loop = self._loop
         return side_view_rgb(
-            self.scenario.uvms, self._render_data, loop.q, loop.time_s, self._anchor
-        )
+            self.scenario.uvms, self._render_data, loop.q, loop.time_s, self._anchor,
+            box=self._vehicle_box,
+        )  # fmt: skip
 
     # -- replay export -------------------------------------------------------------------
     def episode_rollout(self) -> Rollout:
@@ -248,7 +273,7 @@ class UvmsEnv(gym.Env):
             "seed": self.episode_seed,
             "log_period_s": settings.control_period_s,
             "world": scenario.plant.record(),
-        }
+        } | _shortened_record(scenario)
 
     # -- helpers -------------------------------------------------------------------------
     def _observation(self) -> np.ndarray:
@@ -258,9 +283,13 @@ class UvmsEnv(gym.Env):
         rng = np.random.default_rng(
             np.random.SeedSequence(episode_seed, spawn_key=(_PERTURBATION_STREAM,))
         )
+        uvms = self.scenario.uvms
         q0 = self.scenario.q0.copy()
         q0[:3] += rng.uniform(-1.0, 1.0, 3) * self.initial_position_noise_m
-        q0[7:] += rng.uniform(-1.0, 1.0, q0.size - 7) * self.initial_joint_noise_rad
+        # each arm joint moved by its own angle (a continuous joint's q is (cos, sin))
+        dq = np.zeros(uvms.nv)
+        dq[6:] = rng.uniform(-1.0, 1.0, uvms.nv - 6) * self.initial_joint_noise_rad
+        q0[7:] = pin.integrate(uvms.model, q0, dq)[7:]
         return q0, self.scenario.v0.copy()
 
     def _reseed_flow(self, episode_seed: int) -> None:

@@ -12,11 +12,9 @@ import argparse
 import sys
 from pathlib import Path
 
-from uvms_pin.apps.arguments import count
+from uvms_pin.apps.arguments import nonempty, path_text, process_count
+from uvms_pin.apps.exit_codes import EXIT_INTERRUPTED
 from uvms_pin.results.outdir import STUDY, check_writable, claim
-
-EXIT_BAD_INPUT = 2
-EXIT_INTERRUPTED = 130
 
 
 def _cmd_sweep(args: argparse.Namespace) -> int:
@@ -78,16 +76,22 @@ def register(subparsers) -> None:
         help="run a study (parameter sweep / Monte Carlo) on Dask into a Parquet table",
         description="Run every run of a study file not yet recorded in --out (rerun to resume).",
     )
-    sweep.add_argument("study", help="study TOML file")
-    sweep.add_argument("--out", required=True, help="output directory (table, parts, rollouts)")
+    sweep.add_argument("study", type=path_text, help="study TOML file")
+    sweep.add_argument(
+        "--out", required=True, type=path_text, help="output directory (table, parts, rollouts)"
+    )
     where = sweep.add_mutually_exclusive_group()
     where.add_argument(
         "--workers",
-        type=count(0),
+        type=process_count(0),
         default=None,
         help="local cluster worker processes (1 thread each; default: CPU count; 0 = serial, no Dask)",
     )
-    where.add_argument("--scheduler", help="address of a running Dask scheduler (tcp://host:8786)")
+    where.add_argument(
+        "--scheduler",
+        type=nonempty("an address"),
+        help="address of a running Dask scheduler (tcp://host:8786)",
+    )
     sweep.add_argument(
         "--keep-rollouts", action="store_true", help="save every rollout in DIR/rollouts/<run id>/"
     )
@@ -109,5 +113,5 @@ def register(subparsers) -> None:
         help="figures and a Markdown summary (report.md) of a study's results",
         description="Scatter and box plots of metrics vs parameters, funnel-violation heatmaps, report.md.",
     )
-    report.add_argument("directory", help="output directory of 'sweep'")
+    report.add_argument("directory", type=path_text, help="output directory of 'sweep'")
     report.set_defaults(func=_cmd_report)

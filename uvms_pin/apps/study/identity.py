@@ -3,7 +3,8 @@
 ``study_inputs.json`` records what the rows were computed from: the study file's settings
 (its parsed TOML, so that a comment or whitespace edit is not a different study), and
 SHA-256 digests of the base scenario and of its model file (their bytes: any edit can
-change a result). A sweep into a directory whose record differs is refused: resuming would
+change a result), and the cap ``UVMS_PIN_MAX_DURATION_S`` put on its runs (None: full
+length; `uvms_pin.sim.shortened`). A sweep into a directory whose record differs is refused: resuming would
 put rows of two different studies into one table. Directories written before the record
 existed are checked against their ``study.toml`` copy and the rows' ``base_sha256``.
 """
@@ -19,6 +20,7 @@ from typing import Any
 from uvms_pin.apps.study.spec import Study
 from uvms_pin.errors import StudyError
 from uvms_pin.results.atomic import write_text_atomic
+from uvms_pin.sim.shortened import MAX_DURATION_ENV, max_duration_s
 
 INPUTS_FILE = "study_inputs.json"
 STUDY_COPY = "study.toml"
@@ -51,6 +53,7 @@ def study_inputs(study: Study) -> dict[str, Any]:
         "base_sha256": file_sha256(study.base),
         "model": None if model is None else str(model),
         "model_sha256": file_sha256(model) if model is not None and model.is_file() else None,
+        "max_duration_s": max_duration_s(),
     }
 
 
@@ -85,6 +88,12 @@ def check_same_study(out: Path, study: Study, recorded_base_sha256: set[str]) ->
             f"{out}: the base scenario {study.base} changed since its results were recorded "
             f"(sha256 {', '.join(sorted(stale))} then, {now['base_sha256']} now); restore it, "
             f"or {WHAT_TO_DO}"
+        )
+    if then and then.get("max_duration_s") != now["max_duration_s"]:  # older records: None
+        raise StudyError(
+            f"{out}: its runs were made with {MAX_DURATION_ENV}={then.get('max_duration_s')} "
+            f"(None: full length), and it is {now['max_duration_s']} now: a table must not mix "
+            f"shortened and full runs; set it back, or {WHAT_TO_DO}"
         )
     if then.get("model_sha256") not in (None, now["model_sha256"]):
         raise StudyError(

@@ -22,6 +22,7 @@ from uvms_pin.apps.study.spec import (
     Study,
     lookup,
 )
+from uvms_pin.checks import check_memory
 from uvms_pin.errors import ScenarioError, StudyError
 from uvms_pin.scenario.overrides import KEY_PATH, parse_key_path
 from uvms_pin.scenario.schema import Table, is_number
@@ -48,9 +49,11 @@ def load_study(path: str | Path) -> Study:
     name = head.string("name", path.stem)
     description = head.string("description", "")
     base_entry = head.string("base")
-    seed = head.integer("seed", minimum=0)
+    seed = head.seed("seed", None)
     samples = head.integer("samples", 1, minimum=1)
     head.finish()
+    if not base_entry.strip():
+        raise head.error("base", "is empty; give the base scenario's file")
     base = (path.parent / base_entry).resolve()
     if not base.is_file():
         raise head.error("base", f"scenario '{base_entry}' not found ({base})")
@@ -65,6 +68,7 @@ def load_study(path: str | Path) -> Study:
         if p.path in seen:
             raise StudyError(f"{source}: {p.entry}: the path is given twice")
         seen.add(p.path)
+    _check_size(source, parameters, samples, fixed)
     report = raw.get("report", {})
     if not isinstance(report, dict):
         raise StudyError(f"{source}: [report] must be a table")
@@ -72,6 +76,29 @@ def load_study(path: str | Path) -> Study:
     study = Study(name, description, path, base, seed, samples, fixed, parameters, report, base_raw)
     _check_against_base(study, source)
     return study
+
+
+#: memory of one grid value (a float in a tuple, and the array it came from) [bytes]
+_GRID_POINT_BYTES = 48
+#: memory of one run of a study (its `Run` of a few dicts, its table row, the scheduler's
+#: record of it) [bytes], plus per parameter or fixed entry: estimates on the high side
+_RUN_BYTES = 8192
+_RUN_ENTRY_BYTES = 512
+
+
+def _check_size(
+    source: str, parameters: tuple[Parameter, ...], samples: int, fixed: dict[str, Any]
+) -> None:
+    """StudyError before the run list is made if the study's runs would not fit in memory."""
+    grids = [len(p.grid) for p in parameters if p.grid is not None]
+    n_runs = math.prod(grids) * samples
+    shape = " x ".join([*(f"{n} points" for n in grids), f"{samples} samples"])
+    check_memory(
+        n_runs * (_RUN_BYTES + _RUN_ENTRY_BYTES * (len(parameters) + len(fixed))),
+        f"{source}: the study's {n_runs} runs ({shape}), their list and table,",
+        "give fewer grid points or samples, or split the study",
+        StudyError,
+    )
 
 
 def _fixed(table: Any, source: str) -> dict[str, Any]:
@@ -164,6 +191,7 @@ def _spaced(kind: str):
         start, stop, count = spec
         if count < 1:
             raise t.fail(f"{kind}: empty range (count = {count})")
+        check_memory(count * _GRID_POINT_BYTES, f"{kind}: {count} points", "give fewer", t.fail)
         if count > 1 and start == stop:
             raise t.fail(f"{kind}: empty range (start = stop = {start})")
         if kind == "logspace" and (start <= 0 or stop <= 0):

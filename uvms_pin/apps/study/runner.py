@@ -43,7 +43,8 @@ import pandas as pd
 
 from uvms_pin.apps.study.identity import check_same_study, file_sha256, record_study_inputs
 from uvms_pin.apps.study.spec import Run, Study
-from uvms_pin.errors import FunnelViolation, SimulationError, StudyError
+from uvms_pin.checks import check_memory
+from uvms_pin.errors import ControllerError, FunnelViolation, SimulationError, StudyError
 from uvms_pin.results.atomic import atomic_path
 
 RESULTS_FILE = "results.parquet"
@@ -82,6 +83,13 @@ def execute_run(base: str, run: Run, rollout_dir: str | None = None) -> dict[str
                 violation_level=exc.level,
                 violation_component=exc.component,
                 violation_time_s=float(exc.time_s),
+            )
+        except ControllerError as exc:  # the controller raised: not a result, an error
+            rollout = getattr(exc, "rollout", None)
+            row.update(status="error", error=str(exc))
+            cause = exc.__cause__
+            row["traceback"] = exc.user_traceback or "".join(
+                traceback.format_exception(cause, limit=8) if cause else ()
             )
         except SimulationError as exc:
             rollout = getattr(exc, "rollout", None)
@@ -156,9 +164,26 @@ def _atomic_parquet(frame: pd.DataFrame, path: Path) -> None:
         frame.to_parquet(tmp, index=False)
 
 
+#: memory of a table read into pandas per byte of its columns in the file (uncompressed):
+#: the columns, their object strings and the copies concat and sorting make
+_TABLE_EXPANSION = 4
+
+
 def _read_parquet(path: Path) -> pd.DataFrame:
+    import pyarrow.parquet as pq
+
     try:
+        metadata = pq.ParquetFile(path).metadata
+        size = sum(metadata.row_group(k).total_byte_size for k in range(metadata.num_row_groups))
+        check_memory(
+            _TABLE_EXPANSION * size,
+            f"{path} ({metadata.num_rows} rows, {metadata.num_columns} columns) read into memory",
+            "report on a machine with more memory, or split the study",
+            StudyError,
+        )
         return pd.read_parquet(path)
+    except StudyError:
+        raise
     except Exception as exc:  # pyarrow raises several types for a damaged file
         raise StudyError(
             f"{path}: not a readable Parquet table ({type(exc).__name__}: {exc}); "

@@ -16,8 +16,9 @@ Parameter paths:
 - ``plant.mass_scale``, ``plant.added_mass_scale``, ``plant.damping_scale``,
   ``plant.buoyancy_scale``: factors applied to the loaded model (see `modify_plant`);
 - any dotted key of the scenario TOML (``environment.stiffness_N_m``, ``controller.k_x``,
-  ...), optionally with an element index (``initial.joint_positions_rad[3]``), optionally
-  ``apply = "scale"`` (times the base value) or ``"add"`` (plus the base value).
+  ...), optionally with element indices (``initial.joint_positions_rad[3]``,
+  ``actuation.thruster[0].max_forward_N``), optionally ``apply = "scale"`` (times the base
+  value) or ``"add"`` (plus the base value).
 
 Study files are read by `uvms_pin.apps.study.reader.load_study`.
 """
@@ -36,7 +37,7 @@ from typing import Any
 
 import numpy as np
 
-from uvms_pin.scenario.overrides import parse_key_path
+from uvms_pin.scenario.overrides import KeyPath, parse_key_path
 
 SEED_KEY = 0x5EED  # spawn-key component of a sample's scenario seed
 PLANT_PREFIX = "plant."
@@ -241,12 +242,21 @@ _MISSING = object()
 
 
 def lookup(raw: dict[str, Any], key: str, default: Any = _MISSING) -> Any:
-    """The value of the dotted ``key`` in ``raw`` (``default``, else KeyError, if absent)."""
+    """The value of the dotted ``key`` in ``raw``, its parts indexed or not
+    (``actuation.thruster[0].max_forward_N``); ``default``, else KeyError, if absent."""
     node: Any = raw
-    for part in key.split("."):
-        if not isinstance(node, dict) or part not in node:
-            if default is _MISSING:
-                raise KeyError(key)
-            return default
-        node = node[part]
+    for name, index in KeyPath(key, key, None).parts:
+        if not isinstance(node, dict) or name not in node:
+            return _absent(key, default)
+        node = node[name]
+        if index is not None:
+            if not isinstance(node, list) or index >= len(node):
+                return _absent(key, default)
+            node = node[index]
     return node
+
+
+def _absent(key: str, default: Any) -> Any:
+    if default is _MISSING:
+        raise KeyError(key)
+    return default

@@ -8,15 +8,15 @@ from __future__ import annotations
 import argparse
 import sys
 
-from uvms_pin.errors import ParameterError
+from uvms_pin.apps.arguments import comma_names, nonempty, path_text, positive
+from uvms_pin.results.outdir import check_writable
 
 
 def _cmd_validate_pool(args: argparse.Namespace) -> int:
     from uvms_pin.apps.validation.run import run_pool_validation
 
-    if not args.step > 0.0:
-        raise ParameterError(f"--step must be positive, got {args.step}")
-    names = [n.strip() for n in args.trials.split(",") if n.strip()] if args.trials else None
+    names = None if args.trials is None else comma_names("--trials", args.trials, "trial names")
+    check_writable(args.out)  # before minutes of simulation, not after
     result = run_pool_validation(
         args.data_dir,
         args.out,
@@ -29,7 +29,8 @@ def _cmd_validate_pool(args: argparse.Namespace) -> int:
         f"{len(result['trials'])} trials: mean roll RMSE {result['mean_roll_rmse_deg']:.3f} deg, "
         f"mean pitch RMSE {result['mean_pitch_rmse_deg']:.3f} deg"
     )
-    print(f"wrote {args.out}/pool_validation.json, pool_validation.csv and one figure per trial")
+    figures = "" if args.no_figures else " and one figure per trial"
+    print(f"wrote {args.out}/pool_validation.json, pool_validation.csv{figures}")
     return 0
 
 
@@ -50,11 +51,21 @@ def register(subparsers) -> argparse.ArgumentParser:
         ),
     )
     pool.add_argument(
-        "data_dir", help="directory of trial files, e.g. the shipped data/hinsdale2023"
+        "data_dir",
+        type=path_text,
+        help="directory of trial files, e.g. the shipped data/hinsdale2023",
     )
-    pool.add_argument("--out", required=True, help="output directory")
-    pool.add_argument("--trials", help="comma-separated trial names (default: all)")
-    pool.add_argument("--step", type=float, default=0.05, help="RK4 step [s] (default 0.05)")
+    pool.add_argument("--out", required=True, type=path_text, help="output directory")
+    pool.add_argument(
+        "--trials", type=nonempty("trial names"), help="comma-separated trial names (default: all)"
+    )
+    pool.add_argument(
+        "--step",
+        type=positive,
+        default=0.05,
+        help="largest RK4 step [s]: each IMU interval is split into equal steps no longer than "
+        "this; at most the longest IMU interval (default 0.05, the median interval)",
+    )
     pool.add_argument("--no-figures", action="store_true", help="skip the per-trial figures")
     pool.add_argument("--quiet", action="store_true", help="no per-trial progress lines")
     pool.set_defaults(func=_cmd_validate_pool)

@@ -9,6 +9,11 @@ degrees (roll stiffness ~ W BG ~ 3 N m/rad for ~150 N of buoyancy). This module 
 trials, and reports the fit on the others:
 
     python -m uvms_pin.apps.validation.identify data/hinsdale2023
+    python -m uvms_pin.apps.validation.identify data/hinsdale2023 --cob 0.0074 0 0.02
+
+The fit is relative to the model it starts from: the shipped trial model already carries
+the correction (an offset of ~0 comes out); ``--cob`` starts from another hull centre of
+buoyancy, e.g. Kolano's own (0.0074, 0, 0.02) m, from which the correction is found.
 
 Identification trials: the trajectory families 001 and 008 (6 trials); the families 002,
 009 and 011 (6 trials) are held out for validation (`IDENTIFICATION_TRIALS`).
@@ -42,6 +47,7 @@ __all__ = [
     "IDENTIFICATION_TRIALS",
     "fit_centre_of_buoyancy",
     "quasi_static_roll_pitch",
+    "with_cob",
     "with_cob_offset",
 ]
 
@@ -58,6 +64,14 @@ def with_cob_offset(uvms: UVMS, offset_m: np.ndarray, link: str = HULL) -> UVMS:
         return dataclasses.replace(body.params, center_of_buoyancy_m=cob)
 
     return uvms.with_hydro(moved)
+
+
+def with_cob(uvms: UVMS, cob_m: Sequence[float], link: str = HULL) -> UVMS:
+    """The same system with ``link``'s centre of buoyancy at cob_m (link frame) [m]."""
+    (body,) = [b for b in uvms.hydro_bodies if b.name == link]
+    return with_cob_offset(
+        uvms, np.asarray(cob_m, dtype=float) - body.params.center_of_buoyancy_m, link
+    )
 
 
 def _restoring_roll_pitch(uvms: UVMS, roll_pitch: np.ndarray, q_arm: np.ndarray) -> np.ndarray:
@@ -137,15 +151,27 @@ def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("data_dir", help="the pool trials, e.g. data/hinsdale2023")
     parser.add_argument("--every", type=int, default=10, help="use every n-th IMU sample")
+    parser.add_argument(
+        "--cob",
+        nargs=3,
+        type=float,
+        metavar=("X", "Y", "Z"),
+        help="start from this hull centre of buoyancy [m] (base_link frame) instead of the "
+        "shipped model's, e.g. Kolano's 0.0074 0 0.02",
+    )
     args = parser.parse_args(argv)
     files = {p.stem: p for p in find_trials(args.data_dir)}
     training = [files[n] for n in IDENTIFICATION_TRIALS]
     held_out = [p for n, p in files.items() if n not in IDENTIFICATION_TRIALS]
     # the shipped trial model may already hold a correction: fit the one relative to the file
-    uvms = trial_uvms()
+    uvms = trial_uvms() if args.cob is None else with_cob(trial_uvms(), args.cob)
     offset, before, after = fit_centre_of_buoyancy(uvms, training, args.every)
     print(f"identification trials: {', '.join(IDENTIFICATION_TRIALS)}")
-    print(f"hull centre of buoyancy offset dr_B = {np.array2string(offset, precision=6)} m")
+    millimetres = ", ".join(f"{round(1e3 * x, 2) + 0.0:.2f}" for x in offset)  # no -0.00
+    print(
+        f"hull centre of buoyancy offset dr_B = {np.array2string(offset, precision=6)} m "
+        f"= ({millimetres}) mm"
+    )
     print(
         "quasi-static roll, pitch RMS [deg] on identification trials: "
         f"{rms_deg(before)} -> {rms_deg(after)}"

@@ -2,8 +2,11 @@
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable, Sequence
 from pathlib import Path
+
+import numpy as np
 
 from uvms_pin.apps.validation.figures import trial_figure
 from uvms_pin.apps.validation.pool import (
@@ -13,9 +16,39 @@ from uvms_pin.apps.validation.pool import (
     summary_csv,
     trial_uvms,
 )
-from uvms_pin.apps.validation.trials import find_trials, load_trial
-from uvms_pin.errors import DataError
+from uvms_pin.apps.validation.trials import check_trials_fit, find_trials, load_trial
+from uvms_pin.errors import DataError, ParameterError
 from uvms_pin.results.atomic import write_json_atomic, write_text_atomic
+
+#: RK4 steps a validation may take over all its trials (~0.2 ms each in pure Python: ~30 min)
+MAX_STEPS = 10**7
+
+
+def check_step(step_s: float, trials) -> None:
+    """``step_s`` is the largest RK4 step: each IMU interval (they jitter, ~0.001-0.12 s) is
+    split into equal steps no longer than it. A step longer than every interval would
+    silently be each interval's own length, whatever it is.
+
+    Raises:
+        ParameterError: a step that is not positive and finite, longer than the longest
+            IMU interval of the trials, or so short the trials take more than `MAX_STEPS`.
+    """
+    if not (math.isfinite(step_s) and step_s > 0.0):
+        raise ParameterError(f"--step must be a positive number of seconds, got {step_s}")
+    longest = max(float(np.max(np.diff(t.imu_time_s))) for t in trials)
+    if step_s > longest:
+        raise ParameterError(
+            f"--step {step_s:g} s is longer than the longest IMU interval ({longest:.4g} s): "
+            "each interval is integrated in steps no longer than --step, so every one would "
+            f"be a single step of its own length, as with --step {longest:.4g}; give at most that"
+        )
+    steps = sum(math.ceil((t.imu_time_s[-1] - t.imu_time_s[0]) / step_s) for t in trials)
+    if steps > MAX_STEPS:
+        raise ParameterError(
+            f"--step {step_s:g} s: {steps:.3g} RK4 steps over the {len(trials)} trials, more "
+            f"than {MAX_STEPS:.0e} (half an hour or more); {STEP_S:g} s (the default) is "
+            "within 0.002 deg of 0.02 s"
+        )
 
 
 def run_pool_validation(
@@ -45,7 +78,9 @@ def run_pool_validation(
                 f"{data_dir}: no trial named {', '.join(unknown)} (have {', '.join(by_name)})"
             )
         files = [by_name[n] for n in trial_names]
+    check_trials_fit(files)
     trials = [load_trial(p) for p in files]
+    check_step(step_s, trials)
     uvms = trial_uvms()
     comparisons = []
     for trial in trials:

@@ -9,12 +9,14 @@ Loading checks every key, shape and time vector and raises `DataError` naming th
 
 from __future__ import annotations
 
+import zipfile
 from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 from scipy.spatial.transform import Rotation
 
+from uvms_pin.checks import check_memory
 from uvms_pin.errors import DataError
 
 __all__ = ["PoolTrial", "PublishedSimulation", "find_trials", "load_trial", "roll_pitch_rad"]
@@ -91,6 +93,28 @@ def find_trials(data_dir: str | Path) -> list[Path]:
     if not files:
         raise DataError(f"{directory}: no trial files (*.npz) found")
     return files
+
+
+#: memory of a trial in use per byte of its arrays (float copies, filtered streams)
+_TRIAL_EXPANSION = 4
+
+
+def check_trials_fit(files: list[Path]) -> None:
+    """DataError before any trial is read if all of them (they are all loaded before the
+    first is simulated) would not fit in memory; from the sizes the NPZ files declare."""
+    total = 0
+    for path in files:
+        try:
+            with zipfile.ZipFile(path) as archive:
+                total += sum(info.file_size for info in archive.infolist())
+        except (OSError, zipfile.BadZipFile) as exc:
+            raise DataError(f"{path}: not a readable NPZ file ({exc})") from exc
+    check_memory(
+        _TRIAL_EXPANSION * total,
+        f"the {len(files)} trial files (their arrays: {total / 2**20:.3g} MiB)",
+        "validate fewer trials at a time (--trials)",
+        DataError,
+    )
 
 
 def _arrays(path: Path, keys: dict[str, int]) -> dict[str, np.ndarray]:

@@ -67,7 +67,7 @@ class ImpedanceController(Controller):
 
     def reset(self) -> None:
         self._anchor_world_m: np.ndarray | None = None
-        self._posture_rad: np.ndarray | None = None
+        self._posture_q: np.ndarray | None = None
         self._signals: dict[str, np.ndarray] = {}
 
     def compute(self, time_s: float, measurement: Measurement) -> np.ndarray:
@@ -75,7 +75,7 @@ class ImpedanceController(Controller):
         position = self.task.data.oMf[self.task.ee_frame_id].translation.copy()
         if self._anchor_world_m is None:
             self._anchor_world_m = position
-            self._posture_rad = state.q[7:].copy()
+            self._posture_q = np.array(state.q)  # the whole q: held by its arm part
         twist = state.jacobian_lwa @ state.v  # [p_dot; omega] world axes
         rotation_desired = pin.rpy.rpyToMatrix(*state.rpy_desired)
         rotation_error = pin.log3(rotation_desired @ state.rotation.T)  # world axes [rad]
@@ -86,7 +86,10 @@ class ImpedanceController(Controller):
             self.k_o * rotation_error - self.d_o * twist[3:],
         ]
         tau = state.jacobian_lwa.T @ wrench - self.d_zeta * state.v
-        tau[6:] -= self.k_q * (state.q[7:] - self._posture_rad)
+        # the arm's posture error on the joints' own manifold (a continuous joint's q is
+        # (cos, sin)): pin.difference gives one angle or length per joint
+        posture_error = pin.difference(self.task.model, self._posture_q, state.q)[6:]
+        tau[6:] -= self.k_q * posture_error
         self._signals = {
             "force_desired_world_N": state.force_desired_world_N,
             "e_x": state.error,

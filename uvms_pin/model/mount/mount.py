@@ -257,7 +257,7 @@ def _add_trim(
             raise ParameterError(
                 f"trim_joint_positions needs {uvms.n_arm_joints} finite numbers, got {joints}"
             )
-        q[7:] = joints
+        q[7:] = uvms.arm_joints.configuration(joints)
     report = plan_trim(uvms, q, spec, hull=merged.hull_box)
     add_trim_links(merged.root, merged.vehicle_link, report)
     return report

@@ -49,7 +49,10 @@ def split_urdf(
     path = Path(urdf)
     tree = URDFTree.read(path)
     if first_arm_joint not in tree.joints:
-        raise ModelError(f"joint '{first_arm_joint}' not found", path=str(path))
+        raise ModelError(
+            f"joint '{first_arm_joint}' not found (joints: {', '.join(tree.joints) or 'none'})",
+            path=str(path),
+        )
     joint = tree.joints[first_arm_joint]
     vehicle_link = joint.find("parent").get("link")
     arm_links = set(tree.subtree(tree.child_of(first_arm_joint)))

@@ -21,6 +21,7 @@ from uvms_pin.hydro.hull import HullPiece
 from uvms_pin.model.urdf.collision import collision_hydro, collision_piece
 from uvms_pin.model.urdf.hydrodynamics import parse_hydro
 from uvms_pin.model.urdf.inertial import check_inertial
+from uvms_pin.model.urdf.read import single
 from uvms_pin.model.uvms import HydroBody
 
 __all__ = ["hydro_bodies"]
@@ -59,7 +60,7 @@ def hydro_bodies(
     for name, link in links.items():
         if not _has_inertial(link, name in hydro_elements, where, name):
             continue  # a frame-only link: no body, no hydrodynamics
-        mass_kg = check_inertial(link.find("inertial"), where, name)
+        mass_kg = check_inertial(single(link, "inertial", where, name), where, name)
         joint_id, placement = _carrier(model, name, where)
         hydro = hydro_elements.get(name)
         collisions = link.findall("collision")

@@ -20,7 +20,7 @@ from uvms_pin.hydro.params import HydroParams
 from uvms_pin.hydro.submerged import Polyhedron, Sphere
 from uvms_pin.hydro.submerged_cylinder import Cylinder
 from uvms_pin.model.resources import package_search_path, resolve_resource
-from uvms_pin.model.urdf.read import read_numbers, read_origin
+from uvms_pin.model.urdf.read import read_numbers, read_origin, single
 
 __all__ = ["collision_hydro", "collision_piece"]
 
@@ -45,8 +45,8 @@ def collision_hydro(
     Raises:
         ModelError: no shape, an unsupported shape, bad sizes, a mesh not found.
     """
-    origin = read_origin(collision.find("origin"), where, link)
-    geom = collision.find("geometry")
+    origin = read_origin(single(collision, "origin", where, link), where, link)
+    geom = single(collision, "geometry", where, link)
     shape = None if geom is None or len(geom) == 0 else geom[0]
     if shape is None:
         raise ModelError("<collision> has no <geometry> shape", path=where, link=link)

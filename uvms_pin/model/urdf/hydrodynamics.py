@@ -20,7 +20,7 @@ import numpy as np
 
 from uvms_pin.errors import ModelError, ParameterError
 from uvms_pin.hydro.params import HydroParams
-from uvms_pin.model.urdf.read import read_numbers
+from uvms_pin.model.urdf.read import read_numbers, single
 
 __all__ = ["HYDRO_TAGS", "hydro_elements_by_link", "parse_hydro"]
 
@@ -62,21 +62,23 @@ def parse_hydro(element: ET.Element, where: str, link: str) -> HydroParams:
                 path=where,
                 link=link,
             )
-    volume_el = element.find("volume")
+    volume_el = single(element, "volume", where, link)
     if volume_el is None:
         raise ModelError("<hydrodynamics> has no <volume>", path=where, link=link)
     volume = float(read_numbers(volume_el.get("value"), 1, "<volume value>", where, link)[0])
     if volume < 0.0:
         raise ModelError(f"negative volume {volume} m^3", path=where, link=link)
-    cob_el = element.find("center_of_buoyancy")
+    cob_el = single(element, "center_of_buoyancy", where, link)
     cob = (
         np.zeros(3)
         if cob_el is None
         else read_numbers(cob_el.get("xyz"), 3, "<center_of_buoyancy xyz>", where, link)
     )
-    added = _matrix_6x6(element.find("added_mass"), "added_mass", where, link)
-    linear = _matrix_6x6(element.find("linear_damping"), "linear_damping", where, link)
-    quad_el = element.find("quadratic_damping")
+    added = _matrix_6x6(single(element, "added_mass", where, link), "added_mass", where, link)
+    linear = _matrix_6x6(
+        single(element, "linear_damping", where, link), "linear_damping", where, link
+    )
+    quad_el = single(element, "quadratic_damping", where, link)
     quadratic = np.zeros(6)
     if quad_el is not None:
         quadratic = read_numbers(

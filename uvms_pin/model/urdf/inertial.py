@@ -7,7 +7,7 @@ import xml.etree.ElementTree as ET
 import numpy as np
 
 from uvms_pin.errors import ModelError
-from uvms_pin.model.urdf.read import read_numbers, read_origin
+from uvms_pin.model.urdf.read import read_numbers, read_origin, single
 from uvms_pin.results.format import numbers_text
 
 __all__ = ["check_inertial"]
@@ -24,14 +24,14 @@ def check_inertial(inertial: ET.Element, where: str, link: str) -> float:
     and Pinocchio then builds the link with zero mass and/or zero rotational inertia, which
     silently changes the dynamics (or makes M singular). Origin xyz/rpy are checked too.
     """
-    read_origin(inertial.find("origin"), where, link)
-    mass_el = inertial.find("mass")
+    read_origin(single(inertial, "origin", where, link), where, link)
+    mass_el = single(inertial, "mass", where, link)
     if mass_el is None:
         raise ModelError("<inertial> has no <mass>", path=where, link=link)
     mass = read_numbers(mass_el.get("value"), 1, "<mass value>", where, link)[0]
     if mass < 0.0:
         raise ModelError(f"negative mass {mass} kg", path=where, link=link)
-    inertia_el = inertial.find("inertia")
+    inertia_el = single(inertial, "inertia", where, link)
     if inertia_el is None:
         raise ModelError("<inertial> has no <inertia>", path=where, link=link)
     entries = {

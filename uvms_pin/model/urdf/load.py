@@ -4,6 +4,7 @@ urdfdom and Pinocchio accept silently is checked here (joint limits, armature, f
 
 from __future__ import annotations
 
+import warnings
 import xml.etree.ElementTree as ET
 from collections.abc import Sequence
 from pathlib import Path
@@ -11,12 +12,12 @@ from pathlib import Path
 import numpy as np
 import pinocchio as pin
 
-from uvms_pin.errors import ModelError, ParameterError
+from uvms_pin.errors import ModelError, ModelWarning, ParameterError
 from uvms_pin.model.native_stderr import captured_native_stderr
 from uvms_pin.model.urdf.bodies import hydro_bodies
 from uvms_pin.model.urdf.hydrodynamics import hydro_elements_by_link
-from uvms_pin.model.urdf.read import read_numbers, read_urdf_root
-from uvms_pin.model.uvms import DEFAULT_WATER_DENSITY_KG_M3, UVMS
+from uvms_pin.model.urdf.read import read_numbers, read_urdf_root, single
+from uvms_pin.model.uvms import BODY_DENSITY, DEFAULT_WATER_DENSITY_KG_M3, UVMS, WATER_DENSITY
 
 __all__ = ["DEFAULT_EE_FRAME", "DEFAULT_SENSOR_FRAME", "load_uvms"]
 
@@ -59,6 +60,7 @@ def load_uvms(
     where = str(path)
     if not np.isfinite(water_density_kg_m3) or water_density_kg_m3 <= 0.0:
         raise ParameterError(f"water_density_kg_m3 must be positive, got {water_density_kg_m3}")
+    WATER_DENSITY.check("water_density_kg_m3", water_density_kg_m3)
     root = read_urdf_root(path)
     links = {link.get("name"): link for link in root.findall("link")}
     if not links:
@@ -66,6 +68,7 @@ def load_uvms(
     hydro_elements = hydro_elements_by_link(root, links, where)
     model = _build_model(path)
     _check_joint_limits(root, where)
+    _check_joint_axes(root, where)
     _read_armature(root, model, where)
     bodies = hydro_bodies(
         model,
@@ -78,7 +81,7 @@ def load_uvms(
         base_dir=path.parent,
         package_dirs=package_dirs,
     )
-    return UVMS(
+    uvms = UVMS(
         model=model,
         hydro_bodies=tuple(bodies),
         water_density_kg_m3=float(water_density_kg_m3),
@@ -86,6 +89,31 @@ def load_uvms(
         sensor_frame_id=_optional_frame_id(model, sensor_frame, DEFAULT_SENSOR_FRAME, where),
         source=where,
     )
+    uvms.arm_joints  # noqa: B018 - refuses a planar or floating arm joint now, naming it
+    _check_densities(uvms, where)
+    return uvms
+
+
+def _check_densities(uvms: UVMS, where: str) -> None:
+    """Each body's mass over the water it displaces (links merged onto one joint together):
+    refused if no body can be that light or dense, warned if far from usual (`BODY_DENSITY`)."""
+    model = uvms.model
+    for joint_id in range(1, model.njoints):
+        mass, volume = model.inertias[joint_id].mass, uvms.volume_per_joint_m3[joint_id]
+        if mass <= 0.0 or volume <= 0.0:
+            continue  # a body without mass or volume: warned about where its links are read
+        links = [b.name for b in uvms.hydro_bodies if b.joint_id == joint_id]
+        what = (
+            f"the body on joint '{model.names[joint_id]}' (links {', '.join(links)}): "
+            f"{mass:.4g} kg displacing {volume:.4g} m^3, a mean density of"
+        )
+        density = mass / volume
+        refusal = BODY_DENSITY.refusal(density)
+        if refusal is not None:
+            raise ModelError(f"{what} {refusal}", path=where)
+        warning = BODY_DENSITY.warning(density)
+        if warning is not None:
+            warnings.warn(f"{where}: {what} {warning}", ModelWarning, stacklevel=3)
 
 
 def _build_model(path: Path) -> pin.Model:
@@ -107,7 +135,7 @@ def _check_joint_limits(root: ET.Element, where: str) -> None:
     target) then gives a configuration outside both bounds.
     """
     for joint in root.findall("joint"):
-        limit = joint.find("limit")
+        limit = single(joint, "limit", where, f"joint {joint.get('name', '?')}")
         if limit is None or joint.get("type") not in ("revolute", "prismatic"):
             continue
         name = f"joint {joint.get('name', '?')}"
@@ -120,11 +148,28 @@ def _check_joint_limits(root: ET.Element, where: str) -> None:
             )
 
 
+def _check_joint_axes(root: ET.Element, where: str) -> None:
+    """<axis xyz> of every moving joint: finite and not zero (Pinocchio normalises it; a
+    zero axis gives a joint that moves nothing, and a mass matrix singular on it)."""
+    for joint in root.findall("joint"):
+        axis = single(joint, "axis", where, f"joint {joint.get('name', '?')}")
+        if axis is None or joint.get("type") not in ("revolute", "continuous", "prismatic"):
+            continue
+        name = joint.get("name", "?")
+        xyz = read_numbers(axis.get("xyz", "1 0 0"), 3, "<axis xyz>", where, f"joint {name}")
+        if not np.linalg.norm(xyz) > 1e-12:
+            raise ModelError(
+                f"joint '{name}': <axis xyz=\"{axis.get('xyz')}\"> is zero; give the direction "
+                "the joint turns about (revolute, continuous) or slides along (prismatic)",
+                path=where,
+            )
+
+
 def _read_armature(root: ET.Element, model: pin.Model, where: str) -> None:
     """``<joint><armature value="kg m^2"/></joint>``: reflected rotor inertia of a joint's
     drive (J_rotor N^2), added to the diagonal of M (Pinocchio's ``model.armature``)."""
     for joint in root.findall("joint"):
-        element = joint.find("armature")
+        element = single(joint, "armature", where, f"joint {joint.get('name', '?')}")
         if element is None:
             continue
         name = joint.get("name", "?")

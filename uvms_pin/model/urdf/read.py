@@ -17,6 +17,8 @@ __all__ = ["read_numbers", "read_origin", "read_urdf_root"]
 def read_urdf_root(path: Path) -> ET.Element:
     """The <robot> element of a URDF file; ModelError naming the file otherwise."""
     where = str(path)
+    if path.is_dir():
+        raise ModelError("is a directory, not a URDF file", path=where)
     if not path.is_file():
         raise ModelError("file not found", path=where)
     try:
@@ -50,3 +52,17 @@ def read_origin(element: ET.Element | None, where: str, link: str) -> pin.SE3:
     xyz = read_numbers(element.get("xyz", "0 0 0"), 3, "<origin xyz>", where, link)
     rpy = read_numbers(element.get("rpy", "0 0 0"), 3, "<origin rpy>", where, link)
     return pin.SE3(pin.rpy.rpyToMatrix(*rpy), xyz)
+
+
+def single(element: ET.Element, tag: str, where: str, link: str) -> ET.Element | None:
+    """The one ``<tag>`` child of ``element`` (None without one).
+
+    Raises:
+        ModelError: more than one (a reader taking the first would silently drop the rest).
+    """
+    found = element.findall(tag)
+    if len(found) > 1:
+        raise ModelError(
+            f"<{element.tag}> has {len(found)} <{tag}> elements; give one", path=where, link=link
+        )
+    return found[0] if found else None

@@ -12,6 +12,8 @@ def joint_stops_to_core(stops: JointStops | None, core: ModuleType):
     if stops is None:
         return None
     out = core.JointStops()
+    out.q_index = [int(i) for i in stops.q_index]
+    out.v_index = [int(i) for i in stops.v_index]
     out.lower_rad = stops.lower_rad
     out.upper_rad = stops.upper_rad
     out.stiffness_Nm_rad = float(stops.stiffness_Nm_rad)

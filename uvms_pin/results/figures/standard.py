@@ -13,6 +13,7 @@ import pinocchio as pin
 from matplotlib.figure import Figure
 
 from uvms_pin.results.atomic import atomic_path
+from uvms_pin.results.metrics import driven, work_of_tau_J
 from uvms_pin.results.rollout_data import RolloutData
 
 
@@ -56,12 +57,20 @@ def mark_stop(fig: Figure, axes, rollout: RolloutData, title: str) -> None:
 
 
 def plot_pose(rollout: RolloutData, path: Path | None = None) -> Figure | Path:
-    """Vehicle position (world) and roll/pitch/yaw over time."""
+    """Vehicle position (world) relative to where it started, and roll/pitch/yaw over time.
+
+    The start is taken out (it is in the title): the depth of a vehicle at z = -2 m would
+    otherwise flatten the few centimetres it moves on one shared axis."""
     t = rollout.time_s
     fig, (ax_p, ax_o) = new_figure(2, 1, figsize=(8, 6), sharex=True)
+    start = rollout.q[0, :3]
     for i, label in enumerate("xyz"):
-        ax_p.plot(t, rollout.q[:, i], label=label)
-    ax_p.set_ylabel("position [m]")
+        ax_p.plot(t, rollout.q[:, i] - start[i], label=f"{label} - {label}(0)")
+    ax_p.set_ylabel("position - start [m]")
+    ax_p.set_title(
+        f"start (world): x = {start[0]:.3g} m, y = {start[1]:.3g} m, z = {start[2]:.3g} m",
+        fontsize=9,
+    )
     ax_p.legend(loc="best")
     ax_p.grid(True, alpha=0.3)
     rpy = _rpy(rollout.q)
@@ -100,17 +109,34 @@ def plot_velocities(rollout: RolloutData, path: Path | None = None) -> Figure | 
 
 
 def plot_energy(rollout: RolloutData, path: Path | None = None) -> Figure | Path:
-    """Kinetic (added mass included), potential and total energy."""
+    """Kinetic (added mass included), potential and total energy; for a driven run the
+    balance too (`uvms_pin.results.metrics.energy_metrics`): the work of tau, and what the
+    water, the contact and the disturbance did (the rest)."""
     t = rollout.time_s
-    fig, ax = new_figure(figsize=(8, 4))
-    ax.plot(t, rollout.kinetic_energy_J, label="kinetic 1/2 zeta^T M zeta")
-    ax.plot(t, rollout.potential_energy_J - rollout.potential_energy_J[0], label="potential - U(0)")
+    balance = driven(rollout)
+    fig, ax = new_figure(figsize=(10, 4) if balance else (8, 4))
+    ax.plot(t, rollout.kinetic_energy_J, label="kinetic T = 1/2 zeta^T M zeta")
     ax.plot(
-        t, rollout.total_energy_J - rollout.potential_energy_J[0], label="total - U(0)", color="k"
+        t, rollout.potential_energy_J - rollout.potential_energy_J[0], label="potential U - U(0)"
     )
+    change = rollout.total_energy_J - rollout.total_energy_J[0]
+    ax.plot(t, change, label="total E - E(0)", color="k")
+    if balance:  # E(t) - E(0) = W_tau(t) + W_rest(t)
+        work = work_of_tau_J(rollout)
+        ax.plot(t, work, "--", color="tab:red", label="work of tau")
+        ax.plot(
+            t,
+            change - work,
+            ":",
+            color="tab:green",
+            label="work of water, contact,\ndisturbance (the rest)",
+        )
     ax.set_xlabel("time [s]")
     ax.set_ylabel("energy [J]")
-    ax.legend(loc="best")
+    if balance:  # beside the axes: five curves leave no free corner
+        ax.legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize=8)
+    else:
+        ax.legend(loc="best")
     ax.grid(True, alpha=0.3)
     mark_stop(fig, ax, rollout, f"{rollout.metadata.get('scenario', '')}: energy")
     return save_figure(fig, path)

@@ -1,0 +1,46 @@
+"""The Ctrl-C guard of commands that save what they ran (SIGINT sent to this process)."""
+
+from __future__ import annotations
+
+import os
+import signal
+
+import pytest
+
+from uvms_pin.apps.interrupts import InterruptGuard
+
+
+def _ctrl_c() -> None:
+    os.kill(os.getpid(), signal.SIGINT)
+
+
+def test_the_first_ctrl_c_raises_the_next_wait_for_the_save(capsys):
+    with InterruptGuard() as guard:
+        with pytest.raises(KeyboardInterrupt):
+            _ctrl_c()
+        with guard.saving():
+            _ctrl_c()  # noted, not raised: the save goes on
+            _ctrl_c()
+            saved = True
+        assert saved and guard.pending
+        guard.release()
+        with pytest.raises(KeyboardInterrupt):  # after the save: raises again
+            _ctrl_c()
+    assert capsys.readouterr().err.count("saving first, please wait") == 1
+
+
+def test_a_ctrl_c_during_a_save_raises_when_the_save_is_done():
+    with InterruptGuard() as guard:
+        done = []
+        with pytest.raises(KeyboardInterrupt):
+            with guard.saving():
+                _ctrl_c()
+                done.append("saved")
+        assert done == ["saved"]
+
+
+def test_the_previous_handler_is_back_afterwards():
+    before = signal.getsignal(signal.SIGINT)
+    with InterruptGuard():
+        assert signal.getsignal(signal.SIGINT) is not before
+    assert signal.getsignal(signal.SIGINT) is before

@@ -1,0 +1,143 @@
+"""What a command allocates is checked against the memory available before it is allocated:
+a study's grids and run list, a study table read back, the logs a comparison keeps, the trials
+a validation loads (as ``run`` checks its log). The available memory is set by monkeypatching
+`uvms_pin.checks.available_memory_bytes`, so each limit is tested exactly where it falls."""
+
+from __future__ import annotations
+
+import textwrap
+from pathlib import Path
+
+import pytest
+from conftest import ROOT
+
+import uvms_pin.checks as checks
+from uvms_pin.errors import DataError, ScenarioError, StudyError
+
+URDF = ROOT / "models" / "uvms_lbv150.urdf"
+DATA = ROOT / "data" / "hinsdale2023"
+
+
+def _available(monkeypatch, n_bytes: int) -> None:
+    monkeypatch.setattr(checks, "available_memory_bytes", lambda: n_bytes)
+
+
+def _study(tmp_path: Path, grid: str, samples: int = 1) -> Path:
+    text = (ROOT / "scenarios" / "passive_current.toml").read_text()
+    (tmp_path / "base.toml").write_text(text.replace('"uvms_lbv150"', f'"{URDF}"'))
+    path = tmp_path / "study.toml"
+    path.write_text(
+        textwrap.dedent(f"""
+        [study]
+        base = "base.toml"
+        seed = 1
+        samples = {samples}
+        [[parameter]]
+        path = "water.current_world_m_s[0]"
+        {grid}
+        """)
+    )
+    return path
+
+
+def test_a_grid_is_checked_before_its_points_are_made(tmp_path):
+    """1e12 points (48 TB): refused from the count, whatever the machine."""
+    from uvms_pin.apps.study import load_study
+
+    with pytest.raises(StudyError) as info:
+        load_study(_study(tmp_path, "linspace = [1, 1000, 1000000000000]"))
+    message = str(info.value)
+    assert (
+        "study.toml: parameter[0] 'water.current_world_m_s[0]': linspace: 1000000000000 points"
+        in message
+    )
+    assert "GiB" in message and "give fewer" in message
+
+
+def test_the_run_list_is_checked_before_it_is_made(tmp_path, monkeypatch):
+    from uvms_pin.apps.study import load_study
+
+    # 100 points x 50 samples = 5000 runs x (8192 + 512) bytes = 43.5 MB
+    path = _study(tmp_path, "linspace = [0.0, 0.1, 100]", samples=50)
+    _available(monkeypatch, 2 * 44 * 10**6)
+    load_study(path)
+    _available(monkeypatch, 2 * 43 * 10**6)
+    with pytest.raises(StudyError, match=r"the study's 5000 runs \(100 points x 50 samples\)"):
+        load_study(path)
+
+
+def test_a_study_table_is_checked_before_it_is_read(tmp_path, monkeypatch):
+    import pandas as pd
+
+    from uvms_pin.apps.study.runner import load_results
+
+    out = tmp_path / "out"
+    (out / "parts").mkdir(parents=True)
+    table = pd.DataFrame({"run_id": [f"{k:016x}" for k in range(1000)], "run_index": range(1000)})
+    table.to_parquet(out / "results.parquet")
+    assert len(load_results(out)) == 1000
+    _available(monkeypatch, 10_000)
+    with pytest.raises(StudyError, match=r"results.parquet \(1000 rows, 2 columns\) read into"):
+        load_results(out)
+
+
+def test_a_comparison_keeps_every_log_so_all_must_fit(monkeypatch):
+    from uvms_pin.apps.compare.runs import controller_scenarios
+
+    path = ROOT / "scenarios" / "realistic_force_tracking.toml"
+    one = controller_scenarios(path, ["ppc"])["ppc"]
+    log = one.settings.log_bytes(one.uvms.nq, one.uvms.nv, one.plant.n_logged_hulls)
+    _available(monkeypatch, 2 * log + 10)  # one log fits, two do not
+    controller_scenarios(path, ["ppc"])
+    with pytest.raises(ScenarioError, match="the logs of the 2 runs"):
+        controller_scenarios(path, ["ppc", "pi_force"])
+
+
+def test_arms_run_in_parallel_must_fit_together(tmp_path, monkeypatch):
+    from uvms_pin.apps.arms.compare import CompareSettings, compare_arms
+    from uvms_pin.scenario.load import load_scenario
+
+    path = ROOT / "scenarios" / "realistic_force_tracking.toml"
+    base = load_scenario(path)
+    log = base.settings.log_bytes(base.uvms.nq, base.uvms.nv)
+    _available(monkeypatch, 3 * log)  # one run's log fits, two arms' at a time do not
+    with pytest.raises(ScenarioError, match=r"the logs of 2 arm runs at a time .* lower --jobs"):
+        compare_arms(path, ["reference", "ur3"], tmp_path / "o", CompareSettings(), jobs=2)
+    assert not any((tmp_path / "o").iterdir())  # refused before any arm ran
+
+
+def test_trials_are_checked_before_they_are_loaded(tmp_path, monkeypatch):
+    from uvms_pin.apps.validation.run import run_pool_validation
+
+    _available(monkeypatch, 4 * 72_824)  # the trial's arrays: 72824 bytes, x4 in use
+    with pytest.raises(DataError, match=r"the 1 trial files .*\(--trials\)"):
+        run_pool_validation(DATA, tmp_path / "o", trial_names=["_alt_011-1"])
+    assert not (tmp_path / "o").exists()
+
+
+def test_a_runs_log_counts_the_wet_fractions_a_free_surface_adds(monkeypatch):
+    """Under a free surface every sample logs one wet fraction per hull: the estimate holds
+    them (the arrays a run really logs fit in it), and a memory that fits the log without
+    them but not with them refuses the scenario before it runs."""
+    import numpy as np
+
+    from uvms_pin.scenario.load import load_scenario
+    from uvms_pin.sim.run import simulate
+
+    path = ROOT / "scenarios" / "surfacing.toml"
+    short = {"scenario.duration_s": 0.5, "initial.position_world_m": [0.0, 0.0, -0.05]}
+    scenario = load_scenario(path, short)
+    nq, nv, hulls = scenario.uvms.nq, scenario.uvms.nv, len(scenario.uvms.surface_bodies)
+    assert hulls > 0
+    settings = scenario.settings
+    with_hulls = settings.log_bytes(nq, nv, hulls)
+    assert with_hulls - settings.log_bytes(nq, nv) == settings.n_log * 8 * hulls
+    rollout = simulate(scenario, progress=False)
+    assert rollout.signals["wet_fraction"].shape == (settings.n_log, hulls)
+    logged = sum(a.nbytes for a in (rollout.time_s, rollout.q, rollout.v, rollout.tau))
+    logged += sum(np.asarray(a).nbytes for a in rollout.signals.values())
+    assert logged <= with_hulls
+    _available(monkeypatch, 2 * with_hulls - 2)  # the log without the hulls fits
+    with pytest.raises(ScenarioError, match="the log of this run"):
+        load_scenario(path, short)
+    load_scenario(path, {**short, "water.free_surface": False})  # no wet fractions logged

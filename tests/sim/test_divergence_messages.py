@@ -1,0 +1,90 @@
+"""A divergence says what diverged and where: the quantity far outside any vehicle's range
+that started it (the water's speed, a disturbance, an applied force, a velocity) with its
+value and component, or a mass matrix singular along a named degree of freedom."""
+
+from __future__ import annotations
+
+import dataclasses
+
+import numpy as np
+import pinocchio as pin
+import pytest
+from conftest import ROOT
+
+import uvms_pin as up
+from uvms_pin.control.base import Controller
+from uvms_pin.scenario.load import load_scenario
+from uvms_pin.sim.divergence import divergence_context
+from uvms_pin.sim.plant import Plant
+from uvms_pin.sim.run import simulate
+
+REALISTIC = ROOT / "scenarios" / "realistic_force_tracking.toml"
+PASSIVE = ROOT / "scenarios" / "passive_current.toml"
+
+
+def _stopped(path, **overrides) -> str:
+    scenario = load_scenario(path, {"scenario.duration_s": 0.1, **overrides})
+    with pytest.raises(up.SimulationError) as info:
+        simulate(scenario, progress=False)
+    return str(info.value)
+
+
+def test_a_current_no_sea_has_is_named():
+    # 1400 m/s: possible (below the speed of sound in water), warned, and it diverges
+    with pytest.warns(up.UvmsPinWarning, match="1400 m/s is far outside sea and tidal currents"):
+        message = _stopped(PASSIVE, **{"water.current_world_m_s": [1400.0, 0.0, 0.0]})
+    assert message.startswith("simulation diverged between t = 0 s and")
+    assert "water speed at the vehicle = 1.4e+03 m/s" in message
+
+
+def test_a_disturbance_no_sea_has_is_named_even_when_it_starts_at_zero():
+    # A sin(2 pi t / T): zero at t = 0, 1.8e27 N one step later
+    message = _stopped(REALISTIC, **{"disturbance.amplitude": [1e30, 0, 0, 0, 0, 0]})
+    assert "disturbance vehicle fx = 1.8e+27 N" in message
+
+
+class Huge(Controller):
+    def __init__(self, nv):
+        self.nv = nv
+
+    def compute(self, time_s, measurement):
+        tau = np.zeros(self.nv)
+        tau[7] = 1e30
+        return tau
+
+
+def test_an_applied_force_no_actuator_makes_is_named():
+    scenario = load_scenario(PASSIVE, {"scenario.duration_s": 0.1})
+    scenario.controller_factory = lambda uvms: Huge(uvms.nv)
+    with pytest.raises(up.SimulationError) as info:
+        simulate(scenario, progress=False)
+    assert "applied generalized force arm_joint2 = 1e+30 N m" in str(info.value)
+
+
+def test_a_mass_matrix_singular_along_a_joint_names_the_joint(reference_uvms):
+    model = reference_uvms.model.copy()
+    model.inertias[5] = pin.Inertia.Zero()  # arm_joint4's link, and no armature, no added mass
+    model.armature[9] = 0.0
+    uvms = reference_uvms.with_model(model).with_hydro(
+        lambda b: (
+            b.params
+            if b.joint_id != 5
+            else dataclasses.replace(b.params, added_mass=np.zeros((6, 6)))
+        )
+    )
+    context = divergence_context(
+        Plant(uvms), (0.0, 0.01), uvms.neutral_configuration(), np.zeros(10), np.zeros(10)
+    )
+    assert "the mass matrix is singular" in context and "along arm_joint4" in context
+
+
+def test_a_physical_state_says_so_with_its_largest_velocity(reference_uvms):
+    v = np.zeros(10)
+    v[4] = -0.3
+    context = divergence_context(
+        Plant(reference_uvms), (1.0, 1.01), reference_uvms.neutral_configuration(), v, None
+    )
+    assert context == (
+        "at t = 1 s every input was in a physical range; the largest velocity was "
+        "vehicle q = -0.3 rad/s"
+    )

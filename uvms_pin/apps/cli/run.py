@@ -1,0 +1,196 @@
+"""``uvms-pin run``: simulate a scenario, save what was simulated, say how it ended.
+
+Whatever ends the run (its end, a funnel violation, a divergence, the controller raising,
+Ctrl-C), what was simulated is saved first (rollout.npz, rollout.json, metrics.json, under
+`InterruptGuard.saving`: a second Ctrl-C does not cut it), then the figures. Exit status:
+0 the run reached its end; 3 it stopped early (the rollout kept); 130 Ctrl-C; 4 the
+system failed us while saving (a full disk...), the message naming the file and what was
+kept.
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+from contextlib import nullcontext
+from dataclasses import dataclass
+from pathlib import Path
+from typing import TYPE_CHECKING
+
+from uvms_pin.apps.exit_codes import EXIT_ENVIRONMENT, EXIT_INTERRUPTED, EXIT_RUN_STOPPED
+from uvms_pin.apps.interrupts import InterruptGuard
+from uvms_pin.errors import ParameterError, SimulationError
+from uvms_pin.results.outdir import RUN, check_writable, claim
+from uvms_pin.results.progress import progress_printer
+from uvms_pin.scenario.overrides import parse_assignment
+
+if TYPE_CHECKING:
+    from uvms_pin.results.rollout import Rollout
+
+
+@dataclass
+class Ending:
+    """How a run ended, for the command's output: its rollout (None: nothing simulated),
+    the exit status and what to say; ``user_traceback``: the frames of the user's code
+    that stopped it."""
+
+    rollout: Rollout | None
+    status: int = 0
+    message: str = ""
+    user_traceback: str = ""
+
+
+def check_view_options(args: argparse.Namespace) -> None:
+    """--port in range (run, replay)."""
+    if not 0 <= args.port <= 65535:
+        raise ParameterError(f"--port must be in 0..65535, got {args.port}")
+
+
+def cmd_run(args: argparse.Namespace) -> int:
+    from uvms_pin.scenario.load import load_scenario
+
+    check_view_options(args)
+    overrides = dict(parse_assignment(text) for text in args.set)
+    scenario = load_scenario(args.scenario, overrides)
+    out = check_writable(args.out)  # before simulating, not after
+    with InterruptGuard() as guard, claim(out, RUN, overwrite=args.overwrite):
+        ending = _simulate_to_end(scenario, args)
+        if ending.user_traceback:
+            print(
+                "uvms-pin: the run stopped in your controller's code; its traceback:\n"
+                + ending.user_traceback.rstrip("\n"),
+                file=sys.stderr,
+            )
+        if ending.rollout is None:
+            print(ending.message, file=sys.stderr)
+            return ending.status
+        written, failure = _save(ending, out, args, guard)
+    _report(scenario.name, ending, out, written)
+    if failure is not None:
+        print(failure.message, file=sys.stderr)
+        return failure.status
+    if ending.status:
+        print(ending.message, file=sys.stderr)
+    return ending.status
+
+
+def _simulate(scenario, args: argparse.Namespace, progress) -> Rollout:
+    from uvms_pin.sim.run import simulate
+
+    if not args.live:
+        return simulate(scenario, progress=progress)
+    from uvms_pin.apps.viz.live import run_live
+
+    return run_live(scenario, port=args.port, speed=args.speed, progress=progress)
+
+
+def _simulate_to_end(scenario, args: argparse.Namespace) -> Ending:
+    """The run's `Ending`: a stopped or interrupted run keeps its rollout."""
+    duration_s = scenario.settings.duration_s
+    printer = (
+        nullcontext() if args.quiet else progress_printer(scenario.name, duration_s, delay_s=0.0)
+    )
+    with printer as progress:
+        return _run_or_stop(scenario, args, progress)
+
+
+def _run_or_stop(scenario, args: argparse.Namespace, progress) -> Ending:
+    try:
+        return Ending(_simulate(scenario, args, progress))
+    except SimulationError as exc:  # FunnelViolation, ControllerError included
+        rollout = getattr(exc, "rollout", None)
+        return Ending(
+            rollout,
+            EXIT_RUN_STOPPED,
+            f"uvms-pin: run stopped: {exc}; {_kept(rollout, args.out)}",
+            exc.user_traceback,
+        )
+    except KeyboardInterrupt as exc:
+        rollout = getattr(exc, "rollout", None)
+        if rollout is None or not len(rollout):
+            return Ending(None, EXIT_INTERRUPTED, "uvms-pin: interrupted before the first sample")
+        return Ending(
+            rollout, EXIT_INTERRUPTED, f"uvms-pin: interrupted: {_kept(rollout, args.out)}"
+        )
+
+
+def _kept(rollout: Rollout | None, out: str) -> str:
+    """``the partial rollout (t = 0 to T s) is kept in OUT`` (what was simulated)."""
+    if rollout is None:
+        return "nothing was simulated"
+    if not len(rollout):
+        return f"nothing was simulated (the rollout saved in {out} says why, and is empty)"
+    t_s = float(rollout.time_s[-1])
+    return f"the partial rollout (t = 0 to {t_s:.3f} s) is kept in {out}"
+
+
+def _save(
+    ending: Ending, out: Path, args: argparse.Namespace, guard: InterruptGuard
+) -> tuple[list[str], Ending | None]:
+    """(the file names written, a failure to report or None): the rollout and metrics.json
+    whole or not at all, then the figures (and replay.html)."""
+    from uvms_pin.apps.outputs import write_figures, write_results
+
+    rollout = ending.rollout
+    try:
+        with guard.saving():
+            write_results(rollout, out)
+        guard.release()
+        write_figures(rollout, out)
+        if args.html:
+            from uvms_pin.apps.viz.replay import write_replay
+
+            write_replay(rollout, out / "replay.html")
+    except KeyboardInterrupt:
+        kept = ", ".join(_files_of_the_run(out)) or "nothing"
+        return _files_of_the_run(out), Ending(
+            rollout, EXIT_INTERRUPTED, f"uvms-pin: interrupted while saving; kept in {out}: {kept}"
+        )
+    except OSError as exc:  # a full disk, a directory removed meanwhile (ResourceError too)
+        written = _files_of_the_run(out)
+        return written, Ending(rollout, EXIT_ENVIRONMENT, _write_failure(exc, out, written))
+    return _files_of_the_run(out), None
+
+
+def _files_of_the_run(out: Path) -> list[str]:
+    """The run's files in ``out`` (`claim` left none of an earlier run's there)."""
+    return [name for name in RUN.patterns if (out / name).is_file()]
+
+
+def _write_failure(exc: OSError, out: Path, written: list[str]) -> str:
+    """What could not be written and what was kept (the run itself went as reported)."""
+    where = exc.filename or out
+    kept = (
+        f"kept in {out}: {', '.join(written)}"
+        if written
+        else f"nothing of this run was kept in {out}"
+    )
+    return f"uvms-pin: error: cannot write {where}: {exc.strerror or exc}; {kept}"
+
+
+def _shortened_note(rollout: Rollout) -> str:
+    """What the run line adds for a run `UVMS_PIN_MAX_DURATION_S` shortened."""
+    own_s = rollout.metadata.get("shortened_from_s")
+    if own_s is None:
+        return ""
+    from uvms_pin.sim.shortened import MAX_DURATION_ENV
+
+    return f", SHORTENED from {own_s:g} s by {MAX_DURATION_ENV}"
+
+
+def _report(name: str, ending: Ending, out: Path, written: list[str]) -> None:
+    """The run's line (status, simulated and wall time) and the files written."""
+    rollout = ending.rollout
+    metrics = rollout.metrics()
+    print(
+        f"scenario {name}: {rollout.metadata['status']}, simulated "
+        f"{metrics['simulated_time_s']:.3f} s in {metrics['wall_time_s']:.2f} s "
+        f"(real-time factor {metrics['real_time_factor']:.2f})" + _shortened_note(rollout)
+    )
+    if not written:
+        return
+    line = f"wrote {out}/{written[0]}" + "".join(f", {n}" for n in written[1:])
+    if len(rollout) < 2:
+        samples = "one" if len(rollout) == 1 else "none"
+        line += f"; no figures (a figure needs two samples, the run has {samples})"
+    print(line)
