@@ -3,7 +3,9 @@
 from __future__ import annotations
 
 import numpy as np
+import umsgpack
 
+from uvms_pin.apps.viz.meshcat_scene import recording_visualizer
 from uvms_pin.apps.viz.surface import SurfaceView
 from uvms_pin.flow import AiryWave, UniformCurrent
 
@@ -34,3 +36,18 @@ def test_tiles_follow_the_elevation_and_slope_of_the_wave():
 def test_still_water_has_no_surface_to_draw():
     assert not UniformCurrent([0.2, 0, 0]).has_free_surface
     assert (UniformCurrent([0.2, 0, 0]) + AiryWave(0.1, 3.0)).has_free_surface
+
+
+def test_still_water_tiles_are_placed_once_at_z0_and_not_animated():
+    view = SurfaceView(None, np.array([1.0, -2.0]), half_width_m=3.0, tiles_per_side=4)
+    assert view.poses(0.0) == {} and view.poses(5.0) == {}
+    vis, window = recording_visualizer()
+    view.build(vis)
+    commands = [umsgpack.unpackb(c) for c in window.commands]
+    placed = {c["path"]: c["matrix"] for c in commands if c["type"] == "set_transform"}
+    for name, (x, y) in zip(view.names, view.centers_xy_m, strict=True):
+        path = next(p for p in placed if p.endswith(name))
+        # column-major 4x4: the translation is the last column
+        matrix = np.asarray(placed[path], dtype=float).reshape(4, 4).T
+        np.testing.assert_allclose(matrix[:3, 3], [x, y, 0.0], atol=1e-6)
+        np.testing.assert_allclose(matrix[:3, :3], np.eye(3))

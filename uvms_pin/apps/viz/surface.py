@@ -57,10 +57,20 @@ class SurfaceView:
         self.cell_m = cell
         self.names = [f"surface/tile{k:03d}" for k in range(len(self.centers_xy_m))]
 
+    @property
+    def still(self) -> bool:
+        """Level water (no waves): the tiles are placed once and never animated (animating
+        144 motionless tiles made a still-water replay four times larger)."""
+        return self.flow is None
+
     def build(self, root: meshcat.Visualizer) -> None:
         material = mg.MeshPhongMaterial(color=_SURFACE_BLUE, transparent=True, opacity=0.45)
-        for name in self.names:
+        for name, (x, y) in zip(self.names, self.centers_xy_m, strict=True):
             root[name].set_object(mg.Box([self.cell_m, self.cell_m, 0.004]), material)
+            if self.still:
+                at_z0 = np.eye(4)
+                at_z0[:2, 3] = (x, y)
+                root[name].set_transform(at_z0)
 
     def elevation_and_normal(self, time_s: float) -> tuple[np.ndarray, np.ndarray]:
         """eta (n,) [m] at the tile centres and the unit surface normals (n, 3)."""
@@ -80,6 +90,9 @@ class SurfaceView:
         return eta, normal / np.linalg.norm(normal, axis=1, keepdims=True)
 
     def poses(self, time_s: float) -> dict[str, tuple[np.ndarray, np.ndarray, np.ndarray]]:
+        """The tiles' poses at ``time_s``; none in still water (placed once by `build`)."""
+        if self.still:
+            return {}
         eta, normal = self.elevation_and_normal(time_s)
         quats = _quaternion_z_to(normal)
         one = np.ones(3)
