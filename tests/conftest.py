@@ -132,6 +132,41 @@ def random_configuration(uvms: up.UVMS, rng: np.random.Generator) -> np.ndarray:
     return q
 
 
+def with_spherical_joint(uvms: up.UVMS, joint_id: int) -> up.UVMS:
+    """The same bodies and frames, joint ``joint_id`` (a revolute) made a ball joint."""
+    old = uvms.model
+    new = pin.Model()
+    new.name, new.gravity = old.name, old.gravity
+    for j in range(1, old.njoints):
+        joint = pin.JointModelSpherical() if j == joint_id else old.joints[j]
+        added = new.addJoint(old.parents[j], joint, old.jointPlacements[j], old.names[j])
+        new.appendBodyToJoint(added, old.inertias[j], pin.SE3.Identity())
+        new.armature[new.joints[added].idx_v : new.joints[added].idx_v + joint.nv] = (
+            old.armature[old.joints[j].idx_v] if joint.nv == 1 else 1e-3
+        )
+    for f in list(old.frames)[1:]:
+        new.addFrame(
+            pin.Frame(f.name, f.parentJoint, f.parentFrame, f.placement, f.type, f.inertia),
+            False,
+        )
+    return uvms.with_model(new)
+
+
+def central_difference(function, x: np.ndarray, n: int, step: float, plus=None) -> np.ndarray:
+    """d function / dx along n tangent directions, by the 4-point central difference (error
+    O(step^4)): (8 (f(h) - f(-h)) - (f(2h) - f(-2h))) / (12 h) per column. ``plus(x, dx)``
+    moves x (default x + dx; ``pin.integrate`` for a configuration: the tangent convention)."""
+    plus = (lambda x0, dx: x0 + dx) if plus is None else plus
+    columns = []
+    for k in range(n):
+        e = np.zeros(n)
+        e[k] = step
+        near = np.asarray(function(plus(x, e))) - np.asarray(function(plus(x, -e)))
+        far = np.asarray(function(plus(x, 2 * e))) - np.asarray(function(plus(x, -2 * e)))
+        columns.append((8.0 * near - far) / (12.0 * step))
+    return np.stack(columns, axis=-1)
+
+
 def free_body_state(uvms: up.UVMS) -> np.ndarray:
     return pin.neutral(uvms.model)
 

@@ -30,6 +30,7 @@ TOP_LEVEL = {
     "flow",
     "hydro",
     "model",
+    "ocp",
     "physics",
     "results",
     "scenario",

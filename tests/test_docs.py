@@ -35,6 +35,7 @@ _VARIANTS = [
         },
     ),
     ("passive_current.toml", {}),
+    ("mpc_station_keeping.toml", {"controller.model_error": {"damping_scale": 1.2}}),
     (
         "sea_state_force_tracking.toml",
         {"water.sea.spreading_exponent": 4.0, "water.sea.seed": 3, "water.sea.water_depth_m": 30.0},

@@ -111,6 +111,11 @@ class CoreUnavailableError(UvmsPinError, ImportError):
     says how to rebuild it."""
 
 
+class OptionalDependencyError(UvmsPinError, ImportError):
+    """A feature needs a package of an optional extra that is not installed; the message
+    says which extra to install."""
+
+
 class CoreFallbackWarning(UvmsPinWarning):
     """Something the compiled core has no counterpart of runs on the (slower) Python
     reference; the message says what and why."""

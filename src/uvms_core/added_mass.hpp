@@ -15,6 +15,23 @@ inline Vec6 kirchhoff_wrench(const Mat6& added_mass, const Vec6& velocity_body) 
   return out;
 }
 
+// d(C_A(nu) nu)/d nu = (nu x*) M_A - (p xbar), p = M_A nu, with (nu x*) = [[w]x 0; [v]x [w]x]
+// and (p xbar) = [0 [p1]x; [p1]x [p2]x] (dnu x* p = -(p xbar) dnu).
+inline Mat6 kirchhoff_jacobian(const Mat6& added_mass, const Vec6& velocity_body) {
+  const Vec6 p = added_mass * velocity_body;
+  Mat6 cross_star = Mat6::Zero();
+  const Mat3 w_hat = skew(velocity_body.tail<3>());
+  cross_star.topLeftCorner<3, 3>() = w_hat;
+  cross_star.bottomLeftCorner<3, 3>() = skew(velocity_body.head<3>());
+  cross_star.bottomRightCorner<3, 3>() = w_hat;
+  Mat6 out = cross_star * added_mass;
+  const Mat3 p1_hat = skew(p.head<3>());
+  out.topRightCorner<3, 3>() -= p1_hat;
+  out.bottomLeftCorner<3, 3>() -= p1_hat;
+  out.bottomRightCorner<3, 3>() -= skew(p.tail<3>());
+  return out;
+}
+
 // Added-mass wrench on the body, all but the -M_A zeta_dot part that sits inside M:
 //   -M_A (a_bias - nu_c_dot) - C_A(nu_r) nu_r,  nu_r = nu - nu_c  [N; N m], body frame.
 inline Vec6 added_mass_wrench(const Mat6& added_mass, const Vec6& bias_acceleration_body,

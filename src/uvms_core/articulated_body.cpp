@@ -31,12 +31,6 @@ namespace uvms {
 
 namespace {
 
-Mat3 skew(const Vec3& t) {
-  Mat3 out;
-  out << 0.0, -t.z(), t.y(), t.z(), 0.0, -t.x(), -t.y(), t.x(), 0.0;
-  return out;
-}
-
 // parent += X* child X*^T for the child-to-parent force transform X* = [R 0; [t]x R  R] of
 // the placement (R, t) of the child in the parent, on 3x3 blocks (child symmetric):
 //   [A B; B^T C] -> [Ar, Br - Ar P; P Ar + Br^T, Cr + P Br + (P Br)^T - P Ar P],

@@ -14,6 +14,7 @@
 
 #include <pinocchio/config.hpp>
 
+#include "derivatives.hpp"
 #include "plant.hpp"
 #include "ppc.hpp"
 
@@ -249,6 +250,41 @@ void bind_dynamics(nb::module_& m) {
           "free_surface"_a = false);
 }
 
+// ---- the derivatives of the dynamics (derivatives.hpp) --------------------------------------
+
+void bind_derivatives(nb::module_& m) {
+  using uvms::Derivatives;
+  using uvms::ForwardDynamicsDerivatives;
+  nb::class_<ForwardDynamicsDerivatives>(
+      m, "ForwardDynamicsDerivatives",
+      "da/dq (along the tangent), da/dv and da/dtau, nv x nv each (derivatives.hpp).")
+      .def_ro("da_dq", &ForwardDynamicsDerivatives::da_dq)
+      .def_ro("da_dv", &ForwardDynamicsDerivatives::da_dv)
+      .def_ro("da_dtau", &ForwardDynamicsDerivatives::da_dtau);
+  nb::class_<Derivatives>(m, "Derivatives",
+                          "The derivatives of one UVMS's forward dynamics (derivatives.hpp).")
+      .def(nb::init<const uvms::Dynamics&>(), "dynamics"_a)
+      .def(
+          "forward_dynamics_derivatives",
+          [](Derivatives& d, nb::handle q_obj, nb::handle v_obj, nb::handle tau_obj,
+             const std::optional<uvms::FlowField>& flow, double time_s,
+             nb::handle tau_ext_obj) -> ForwardDynamicsDerivatives {
+            const int nq = d.dynamics().nq(), nv = d.dynamics().nv();
+            UVMS_VECTOR(q, nq);
+            UVMS_VECTOR(v, nv);
+            UVMS_VECTOR(tau, nv);
+            if (tau_ext_obj.is_none()) {
+              return d.forward_dynamics_derivatives(q, v, tau, flow_or_still(flow), nullptr,
+                                                    time_s);
+            }
+            UVMS_VECTOR(tau_ext, nv);
+            const ConstVec ext(tau_ext);
+            return d.forward_dynamics_derivatives(q, v, tau, flow_or_still(flow), &ext, time_s);
+          },
+          "q"_a.none(), "v"_a.none(), "tau"_a.none(), "flow"_a.none(), "time_s"_a,
+          "tau_ext"_a.none() = nb::none());
+}
+
 // ---- the environment (contact.hpp, disturbance.hpp) and the integrators -----------------
 
 void bind_environment(nb::module_& m) {
@@ -470,6 +506,7 @@ NB_MODULE(_core, m) {
   bind_hydro_bodies(m);
   bind_flow(m);
   bind_dynamics(m);
+  bind_derivatives(m);
   bind_environment(m);
   bind_plant(m);
   bind_ppc(m);

@@ -85,6 +85,7 @@ class Dynamics {
   Data& data() { return data_; }
 
  private:
+  friend class Derivatives;  // derivatives.hpp: reads the model, hydro and work buffers
   void prepare();
   // M(q) with the added masses of the current wet state.
   const Eigen::MatrixXd& assemble_mass_matrix(const ConstVec& q);

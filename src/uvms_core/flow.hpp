@@ -20,6 +20,16 @@ struct FlowAtPoint {
   Vec3 acceleration_world;
 };
 
+// What the derivatives of the dynamics read from the flow at a point (world axes): u [m/s],
+// G = grad u [1/s], Du/Dt [m/s^2] and grad Du/Dt [1/s^2] (mirror of
+// FlowField.material_gradients).
+struct FlowGradientsAtPoint {
+  Vec3 velocity_world = Vec3::Zero();
+  Mat3 gradient = Mat3::Zero();
+  Vec3 acceleration_world = Vec3::Zero();
+  Mat3 acceleration_gradient = Mat3::Zero();
+};
+
 // The fluid twist nu_c and its body-frame rate nu_c_dot at a body's reference point [m/s;
 // rad/s] and [m/s^2; rad/s^2] (irrotational flow: no angular part).
 struct FlowInBody {
@@ -98,6 +108,51 @@ struct FlowField {
       gradient(2, 2) += c_sin;
     }
     return {velocity, local + gradient * velocity};
+  }
+
+  // u, G, Du/Dt and grad Du/Dt = dG/dt + sum_l (dG/dx_l) u e_l^T + G G. One wave component's
+  // G is A w k (C sin(theta) P + S cos(theta) Q), P = z z^T - e e^T, Q = e z^T + z e^T, so
+  //   dG/dt   = A w^2 k (-C cos(theta) P + S sin(theta) Q),
+  //   dG/dx_l = A w k^2 [(S sin(theta) z_l + C cos(theta) e_l) P
+  //                      + (C cos(theta) z_l - S sin(theta) e_l) Q]
+  // (grad theta = k e, dC/dz = k S, dS/dz = k C; uvms_pin/flow/components.py).
+  FlowGradientsAtPoint gradients_at(double time_s, const Vec3& point_world_m) const {
+    FlowGradientsAtPoint out;
+    out.velocity_world = current_world_m_s;
+    if (waves.empty()) return out;
+    Vec3 local = Vec3::Zero();
+    Mat3 rate = Mat3::Zero();
+    Mat3 curvature[3] = {Mat3::Zero(), Mat3::Zero(), Mat3::Zero()};  // dG/dx_l
+    const Vec3 up = Vec3::UnitZ();
+    const double x = point_world_m.x(), y = point_world_m.y(), z = point_world_m.z();
+    for (const auto& w : waves) {
+      const double k = w.wavenumber_rad_m, omega = w.angular_frequency_rad_s;
+      const Vec3 e(std::cos(w.heading_rad), std::sin(w.heading_rad), 0.0);
+      const double theta = k * (x * e.x() + y * e.y()) - omega * time_s + w.phase_rad;
+      const double below = std::exp(-(z + 2.0 * water_depth_m) * k);
+      const double denominator = 1.0 - std::exp(-2.0 * k * water_depth_m);
+      const double grow = std::exp(k * z);
+      const double c = (grow + below) / denominator, s = (grow - below) / denominator;
+      const double cos_t = std::cos(theta), sin_t = std::sin(theta);
+      const double aw = w.amplitude_m * omega, awk = aw * k;
+      const Mat3 p = up * up.transpose() - e * e.transpose();
+      const Mat3 q = e * up.transpose() + up * e.transpose();
+      out.velocity_world += aw * (c * cos_t * e + s * sin_t * up);
+      local += aw * omega * (c * sin_t * e - s * cos_t * up);
+      out.gradient += awk * (c * sin_t * p + s * cos_t * q);
+      rate += awk * omega * (-c * cos_t * p + s * sin_t * q);
+      for (int l = 0; l < 3; ++l) {
+        curvature[l] += awk * k *
+                        ((s * sin_t * up[l] + c * cos_t * e[l]) * p +
+                         (c * cos_t * up[l] - s * sin_t * e[l]) * q);
+      }
+    }
+    out.acceleration_world = local + out.gradient * out.velocity_world;
+    out.acceleration_gradient = rate + out.gradient * out.gradient;
+    for (int l = 0; l < 3; ++l) {
+      out.acceleration_gradient.col(l) += curvature[l] * out.velocity_world;
+    }
+    return out;
   }
 };
 

@@ -28,4 +28,23 @@ inline Vec6 froude_krylov_wrench(double volume_m3, const Vec3& center_of_buoyanc
   return out;
 }
 
+// Derivatives of the body wrench [f; r x f] of a world force F at a body point r, f = R^T F,
+// with the body rotation perturbed in its own axes (R -> R exp([theta]x)):
+//   d/d theta = [[f]x; [r]x [f]x],   d/dF = [R^T; [r]x R^T].
+using Mat63 = Eigen::Matrix<double, 6, 3>;
+struct PointForceJacobians {
+  Mat63 by_rotation;
+  Mat63 by_force;
+};
+
+inline PointForceJacobians point_force_jacobians(const Vec3& force_body_N,
+                                                 const Vec3& point_body_m,
+                                                 const Mat3& rotation_world_body) {
+  const Mat3 f_hat = skew(force_body_N), r_hat = skew(point_body_m);
+  PointForceJacobians out;
+  out.by_rotation << f_hat, r_hat * f_hat;
+  out.by_force << rotation_world_body.transpose(), r_hat * rotation_world_body.transpose();
+  return out;
+}
+
 }  // namespace uvms

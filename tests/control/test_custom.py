@@ -146,7 +146,7 @@ def test_ppc_records_its_resolved_parameters():
         ('type = "my_ctrl_c:"', "expected 'package.module:ClassName'"),
         (
             'type = "pcc"',
-            "must be one of none, ppc, pi_force, impedance, computed_torque or 'package.module:ClassName'",
+            "must be one of none, ppc, mpc, pi_force, impedance, computed_torque or 'package.module:ClassName'",
         ),
     ],
 )

@@ -13,7 +13,13 @@ import warnings
 import numpy as np
 import pinocchio as pin
 import pytest
-from conftest import REL, assert_rel, mount_on_reference_vehicle, random_configuration
+from conftest import (
+    REL,
+    assert_rel,
+    mount_on_reference_vehicle,
+    random_configuration,
+    with_spherical_joint,
+)
 
 import uvms_pin as up
 from uvms_pin.model.resources import shipped_models, shipped_path
@@ -158,29 +164,9 @@ def test_compiled_chart_matches_pinocchio_from_python(system):
             assert_rel(got, expected)
 
 
-def _with_spherical_joint(uvms: up.UVMS, joint_id: int) -> up.UVMS:
-    """The same bodies and frames, joint ``joint_id`` (a revolute) made a ball joint."""
-    old = uvms.model
-    new = pin.Model()
-    new.name, new.gravity = old.name, old.gravity
-    for j in range(1, old.njoints):
-        joint = pin.JointModelSpherical() if j == joint_id else old.joints[j]
-        added = new.addJoint(old.parents[j], joint, old.jointPlacements[j], old.names[j])
-        new.appendBodyToJoint(added, old.inertias[j], pin.SE3.Identity())
-        new.armature[new.joints[added].idx_v : new.joints[added].idx_v + joint.nv] = (
-            old.armature[old.joints[j].idx_v] if joint.nv == 1 else 1e-3
-        )
-    for f in list(old.frames)[1:]:
-        new.addFrame(
-            pin.Frame(f.name, f.parentJoint, f.parentFrame, f.placement, f.type, f.inertia),
-            False,
-        )
-    return uvms.with_model(new)
-
-
 def test_generic_joints_in_the_articulated_pass_match_the_reference(reference_uvms):
     """A 3-DoF (spherical) joint takes the pass's generic route: same answer as M and h."""
-    uvms = _with_spherical_joint(reference_uvms, 3)
+    uvms = with_spherical_joint(reference_uvms, 3)
     assert uvms.model.joints[3].shortname() == "JointModelSpherical"
     rng = np.random.default_rng(12)
     for _ in range(5):

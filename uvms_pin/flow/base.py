@@ -68,6 +68,33 @@ class FlowField(ABC):
         u, du_dt, grad = self.kinematics(time_s, points_world)
         return u, du_dt + np.einsum("kij,kj->ki", grad, u)
 
+    def gradient_kinematics(
+        self, time_s: float, points_world: np.ndarray
+    ) -> tuple[np.ndarray, np.ndarray]:
+        """(grad du/dt (n, 3, 3) [1/s^2], the Hessian of u (n, 3, 3, 3) [1/(m s)], entry
+        [k, i, j, l] = d2 u_i / dx_j dx_l at point k): the second-order kinematics that the
+        derivatives of the dynamics need (`material_gradients`). A field defined outside
+        uvms-pin gives them by overriding this method."""
+        raise ParameterError(
+            f"the flow {self!r} does not give its second-order kinematics (override "
+            "FlowField.gradient_kinematics): the derivatives of the dynamics need them"
+        )
+
+    def material_gradients(
+        self, time_s: float, points_world: np.ndarray
+    ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+        """(u, grad u, Du/Dt, grad Du/Dt) at the points: what a body's hydrodynamic loads and
+        their derivatives read from the flow. With G = grad u and H the Hessian,
+
+            grad(Du/Dt)_ij = d(du_i/dt)/dx_j + sum_k H_ikj u_k + sum_k G_ik G_kj.
+        """
+        points = as_points(points_world)
+        u, du_dt, grad = self.kinematics(time_s, points)
+        grad_du_dt, hessian = self.gradient_kinematics(time_s, points)
+        material = du_dt + np.einsum("kij,kj->ki", grad, u)
+        material_grad = grad_du_dt + np.einsum("kimj,km->kij", hessian, u) + np.matmul(grad, grad)
+        return u, grad, material, material_grad
+
     @property
     def has_free_surface(self) -> bool:
         """True for fields that move the free surface (waves): bodies must stay below it."""
@@ -133,6 +160,11 @@ class SumFlow(FlowField):
         points = as_points(points_world)
         parts = [f.kinematics(time_s, points) for f in self.fields]
         return tuple(sum(p[i] for p in parts) for i in range(3))
+
+    def gradient_kinematics(self, time_s, points_world):
+        points = as_points(points_world)
+        parts = [f.gradient_kinematics(time_s, points) for f in self.fields]
+        return tuple(sum(p[i] for p in parts) for i in range(2))
 
     @property
     def has_free_surface(self) -> bool:

@@ -133,6 +133,39 @@ class WaveComponents:
         awk = self.amplitude_m * self.angular_frequency_rad_s * self.wavenumber_rad_m
         return self._gradient(ch * np.sin(theta), sh * np.cos(theta), ex, ey, awk)
 
+    def gradient_kinematics(
+        self, time_s: float, points: np.ndarray
+    ) -> tuple[np.ndarray, np.ndarray]:
+        """(grad du/dt (n, 3, 3), Hessian of u (n, 3, 3, 3), [k, i, j, l] = d2 u_i/dx_j dx_l).
+
+        One component's velocity gradient is A w k (C sin(theta) P + S cos(theta) Q) with
+        P = z z^T - e e^T and Q = e z^T + z e^T; with grad theta = k e, dC/dz = k S and
+        dS/dz = k C, its time and space derivatives are
+
+            d/dt    = A w^2 k (-C cos(theta) P + S sin(theta) Q)
+            d/dx_l  = A w k^2 [(S sin(theta) z_l + C cos(theta) e_l) P
+                               + (C cos(theta) z_l - S sin(theta) e_l) Q].
+        """
+        theta, ch, sh, ex, ey = self._phase_and_profiles(time_s, points)
+        cos, sin = np.cos(theta), np.sin(theta)
+        a, w, k = self.amplitude_m, self.angular_frequency_rad_s, self.wavenumber_rad_m
+        e = np.column_stack([ex, ey, np.zeros_like(ex)])  # (m, 3)
+        up = np.array([0.0, 0.0, 1.0])
+        p = up[None, :, None] * up[None, None, :] - e[:, :, None] * e[:, None, :]
+        q = e[:, :, None] * up[None, None, :] + up[None, :, None] * e[:, None, :]
+        awwk, awkk = a * w * w * k, a * w * k * k
+        grad_rate = np.einsum("nm,mij->nij", -ch * cos * awwk, p) + np.einsum(
+            "nm,mij->nij", sh * sin * awwk, q
+        )
+        s_sin, c_cos = sh * sin * awkk, ch * cos * awkk  # (n, m)
+        hessian = (
+            np.einsum("nm,mij,l->nijl", s_sin, p, up)
+            + np.einsum("nm,mij,ml->nijl", c_cos, p, e)
+            + np.einsum("nm,mij,l->nijl", c_cos, q, up)
+            - np.einsum("nm,mij,ml->nijl", s_sin, q, e)
+        )
+        return grad_rate, hessian
+
     @staticmethod
     def _gradient(c_sin, s_cos, ex, ey, awk) -> np.ndarray:
         """grad u from C sin(theta), S cos(theta) (n, m) and A w k (m,)."""
@@ -165,6 +198,9 @@ class WaveField(FlowField):
 
     def kinematics(self, time_s, points_world):
         return self.components.kinematics(time_s, as_points(points_world))
+
+    def gradient_kinematics(self, time_s, points_world):
+        return self.components.gradient_kinematics(time_s, as_points(points_world))
 
     @property
     def has_free_surface(self) -> bool:

@@ -71,6 +71,12 @@ class DepthProfileCurrent(FlowField):
         grad[:, :, 2] = slope_z[:, None] * self.velocity_world_m_s
         return grad
 
+    def gradient_kinematics(self, time_s, points_world):
+        # steady, and linear in depth between the tabulated depths: no curvature (the kinks
+        # at the tabulated depths are a set of measure zero)
+        n = len(as_points(points_world))
+        return np.zeros((n, 3, 3)), np.zeros((n, 3, 3, 3))
+
     def record(self) -> dict:
         return {
             "type": "depth_profile_current",

@@ -23,6 +23,11 @@ class UniformCurrent(FlowField):
     def velocity_gradient(self, time_s, points_world):
         return np.zeros((len(as_points(points_world)), 3, 3))
 
+    def gradient_kinematics(self, time_s, points_world):
+        # uniform in space: no gradient of du/dt, no curvature
+        n = len(as_points(points_world))
+        return np.zeros((n, 3, 3)), np.zeros((n, 3, 3, 3))
+
     def acceleration(self, time_s, points_world):
         return np.zeros((len(as_points(points_world)), 3))
 

@@ -13,7 +13,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from uvms_pin.hydro.vector import cross3, mat_vec
+from uvms_pin.hydro.vector import cross3, mat_vec, skew
 
 
 def kirchhoff_wrench(added_mass: np.ndarray, velocity_body: np.ndarray) -> np.ndarray:
@@ -32,6 +32,29 @@ def kirchhoff_wrench(added_mass: np.ndarray, velocity_body: np.ndarray) -> np.nd
     return np.concatenate(
         [cross3(w, p[..., :3]), cross3(w, p[..., 3:]) + cross3(v, p[..., :3])], axis=-1
     )
+
+
+def kirchhoff_jacobian(added_mass: np.ndarray, velocity_body: np.ndarray) -> np.ndarray:
+    """d(C_A(nu) nu)/d nu (..., 6, 6): the Kirchhoff wrench linearised about nu.
+
+    C_A(nu) nu = nu x* p with p = M_A nu is bilinear in (nu, p):
+    d(nu x* p) = (nu x*) M_A dnu + (dnu x* p), and dnu x* p = -(p xbar) dnu with
+    (p xbar) = [0, [p1]x; [p1]x, [p2]x] (columns: linear, angular), so
+
+        d(C_A nu)/d nu = (nu x*) M_A - (p xbar),   (nu x*) = [[w]x, 0; [v]x, [w]x].
+    """
+    p = mat_vec(added_mass, velocity_body)
+    cross_star = np.zeros((*velocity_body.shape[:-1], 6, 6))
+    w_hat, v_hat = skew(velocity_body[..., 3:]), skew(velocity_body[..., :3])
+    cross_star[..., :3, :3] = w_hat
+    cross_star[..., 3:, :3] = v_hat
+    cross_star[..., 3:, 3:] = w_hat
+    bar = np.zeros_like(cross_star)
+    p1_hat = skew(p[..., :3])
+    bar[..., :3, 3:] = p1_hat
+    bar[..., 3:, :3] = p1_hat
+    bar[..., 3:, 3:] = skew(p[..., 3:])
+    return np.matmul(cross_star, added_mass) - bar
 
 
 def added_mass_in_parent(

@@ -23,3 +23,15 @@ def damping_wrench(
     """
     nu_r = relative_velocity_body
     return -mat_vec(linear_damping, nu_r) - quadratic_damping * np.abs(nu_r) * nu_r
+
+
+def damping_jacobian(
+    linear_damping: np.ndarray, quadratic_damping: np.ndarray, relative_velocity_body: np.ndarray
+) -> np.ndarray:
+    """d(damping wrench)/d nu_r (..., 6, 6) = -(D_lin + diag(2 D_quad |nu_r|)).
+
+    d(|x| x)/dx = 2 |x|: the quadratic law is continuously differentiable (its second
+    derivative jumps at x = 0).
+    """
+    diagonal = 2.0 * quadratic_damping * np.abs(relative_velocity_body)
+    return -(linear_damping + diagonal[..., :, None] * np.eye(6))

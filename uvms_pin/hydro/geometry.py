@@ -42,6 +42,7 @@ from scipy.integrate import quad
 
 from uvms_pin.errors import ParameterError
 from uvms_pin.hydro.params import HydroParams
+from uvms_pin.hydro.vector import skew
 
 __all__ = [
     "box_hydro",
@@ -422,10 +423,6 @@ def box_hydro(
 # --------------------------------------------------------------------------- change of frame
 
 
-def _skew(p: np.ndarray) -> np.ndarray:
-    return np.array([[0.0, -p[2], p[1]], [p[2], 0.0, -p[0]], [-p[1], p[0], 0.0]])
-
-
 def _drop_roundoff(m: np.ndarray) -> np.ndarray:
     """Zero the entries below 1e-12 of the largest one (products with cos(pi/2) ~ 6e-17)."""
     scale = float(np.max(np.abs(m))) if m.size else 0.0
@@ -478,7 +475,7 @@ def hydro_in_frame(params: HydroParams, rotation, translation_m) -> HydroParams:
 
     x = np.zeros((6, 6))
     x[:3, :3] = rot.T
-    x[:3, 3:] = -rot.T @ _skew(p)
+    x[:3, 3:] = -rot.T @ skew(np.asarray(p, dtype=float))
     x[3:, 3:] = rot.T
     added = _drop_roundoff(x.T @ params.added_mass @ x)
     linear = _drop_roundoff(x.T @ params.linear_damping @ x)

@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from uvms_pin.hydro.vector import cross3, mat_t_vec
+from uvms_pin.hydro.vector import cross3, mat_t_vec, skew
 
 
 def buoyancy_wrench(
@@ -48,6 +48,24 @@ def froude_krylov_wrench(
         rotation_world_body, water_density_kg_m3 * volume * flow_acceleration_world_m_s2
     )
     return np.concatenate([force_body, cross3(center_of_buoyancy_body_m, force_body)], axis=-1)
+
+
+def point_force_jacobians(
+    force_body_N: np.ndarray, center_of_buoyancy_body_m: np.ndarray, rotation_world_body: np.ndarray
+) -> tuple[np.ndarray, np.ndarray]:
+    """Derivatives of a body wrench [f; r x f] of a world force F at a body point r, f = R^T F
+    (buoyancy, Froude-Krylov): (d/d theta (..., 6, 3), d/dF (..., 6, 3)).
+
+    theta is the body's rotation perturbation in its own axes, R -> R exp([theta]x), under
+    which d(R^T F) = [R^T F]x dtheta:
+
+        d/d theta = [[f]x; [r]x [f]x],   d/dF = [R^T; [r]x R^T].
+    """
+    f_hat, r_hat = skew(force_body_N), skew(center_of_buoyancy_body_m)
+    rotation_t = np.swapaxes(rotation_world_body, -1, -2)
+    by_rotation = np.concatenate([f_hat, np.matmul(r_hat, f_hat)], axis=-2)
+    by_force = np.concatenate([rotation_t, np.matmul(r_hat, rotation_t)], axis=-2)
+    return by_rotation, by_force
 
 
 def buoyancy_potential_energy(

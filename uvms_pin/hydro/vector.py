@@ -20,3 +20,11 @@ def mat_vec(matrices: np.ndarray, vectors: np.ndarray) -> np.ndarray:
 def mat_t_vec(matrices: np.ndarray, vectors: np.ndarray) -> np.ndarray:
     """M^T v over the last axes: (..., n, m) x (..., n) -> (..., m)."""
     return np.matmul(vectors[..., None, :], matrices)[..., 0, :]
+
+
+def skew(vectors: np.ndarray) -> np.ndarray:
+    """[a]x (..., 3, 3) with [a]x b = a x b, for a (..., 3)."""
+    a0, a1, a2 = vectors[..., 0], vectors[..., 1], vectors[..., 2]
+    zero = np.zeros_like(a0)
+    rows = [[zero, -a2, a1], [a2, zero, -a0], [-a1, a0, zero]]
+    return np.stack([np.stack(r, axis=-1) for r in rows], axis=-2)

@@ -31,6 +31,10 @@ from uvms_pin.hydro.restoring import buoyancy_potential_energy
 from uvms_pin.model.uvms import UVMS
 from uvms_pin.physics.compiled.backend import backend_named
 from uvms_pin.physics.compiled.dynamics import CompiledDynamics
+from uvms_pin.physics.derivatives.reference import (
+    forward_dynamics_derivatives as reference_derivatives,
+)
+from uvms_pin.physics.derivatives.reference import require_deep
 from uvms_pin.physics.reference import ReferenceDynamics, check_time
 from uvms_pin.physics.surface import wet_state
 
@@ -156,6 +160,57 @@ def forward_dynamics(
         return dynamics.forward_dynamics(q, v, tau, current_world, tau_ext)
     flow = _flow_of_call(current_world, flow)
     return dynamics.forward_dynamics_in(q, v, tau, flow, check_time(time_s), tau_ext, free_surface)
+
+
+def forward_dynamics_derivatives(
+    uvms: UVMS,
+    q: np.ndarray,
+    v: np.ndarray,
+    tau: np.ndarray,
+    *,
+    current_world: np.ndarray | None = None,
+    flow: FlowField | None = None,
+    time_s: float = 0.0,
+    tau_ext: np.ndarray | None = None,
+    backend: str = "core",
+    free_surface: bool = False,
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(da/dq, da/dv, da/dtau) of zeta_dot = forward_dynamics(q, v, tau), each nv x nv.
+
+    da/dq is taken along the tangent of the configuration manifold, a(q (+) dq) with
+    ``pin.integrate`` (Pinocchio's `computeABADerivatives` convention), so it is nv x nv
+    also when nq != nv. Every term is differentiated: added mass (inside M and in the bias
+    accelerations), Kirchhoff C_A, linear and quadratic damping on the relative velocity,
+    weight and buoyancy, the Froude-Krylov and added-mass loads of an accelerating flow, the
+    flow sampled where the dynamics sample it (docs/derivatives.md). ``tau_ext`` (a
+    generalized force) is held fixed; da/dtau = M^-1 is also d a / d tau_ext.
+
+    Args:
+        current_world: uniform constant current [m/s] (shorthand for a UniformCurrent).
+        flow, time_s: a `uvms_pin.flow.FlowField` (it must give `gradient_kinematics`) and
+            the time it is evaluated at [s].
+        backend: "core" (compiled, default) or "python" (the reference).
+        free_surface: the water has a top (see `bias_forces`). The derivatives are those of
+            bodies wholly under it: a state where the surface cuts a hull (or leaves it
+            dry) raises ParameterError (the wet-fraction terms are not differentiated).
+    """
+    dynamics = dynamics_of(uvms, backend)
+    water = _checked_flow(flow) if current_world is None else _uniform_or(current_world, flow)
+    time_s = check_time(time_s)
+    if free_surface:
+        require_deep(uvms, finite_vector("q", q, uvms.nq), water, time_s)
+    # q, v, tau and tau_ext are checked (shape, finite) by the reference and by the core
+    if isinstance(dynamics, ReferenceDynamics):
+        return reference_derivatives(uvms, q, v, tau, water, time_s, tau_ext)
+    return dynamics.forward_dynamics_derivatives(q, v, tau, water, time_s, tau_ext)
+
+
+def _uniform_or(current_world: np.ndarray, flow: FlowField | None) -> FlowField | None:
+    """The flow of a call: ``flow``, or the uniform current (None in still water)."""
+    if flow is not None:
+        return _flow_of_call(current_world, flow)
+    current = finite_vector("current_world", current_world, 3)
+    return UniformCurrent(current) if np.any(current) else None
 
 
 def frame_wrench_to_generalized(

@@ -105,7 +105,7 @@ def build_baseline(t: Table, uvms: UVMS, kind: str) -> ControllerSpec:
         fields["null_space_gain_per_s"] = t.number("null_space_gain_per_s", nonneg=True)
     fields["desired_rpy"] = t.vector("desired_rpy", 3, [0.0, 0.0, 0.0])
     fields["desired_force_world_N"], force_raw = desired_force_profile(t)
-    factors = _model_error(t.table("model_error") if baseline.model_error else None)
+    factors = model_error_factors(t.table("model_error") if baseline.model_error else None)
     t.finish()
 
     def build(u: UVMS) -> Controller:
@@ -116,7 +116,7 @@ def build_baseline(t: Table, uvms: UVMS, kind: str) -> ControllerSpec:
     return checked_spec(t, uvms, kind, {**recorded, **parameters}, build)
 
 
-def _model_error(t: Table | None) -> dict[str, float]:
+def model_error_factors(t: Table | None) -> dict[str, float]:
     """[controller.model_error]: the factors of the controller's own model (1: exact)."""
     if t is None:
         return {}

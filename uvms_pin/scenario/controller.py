@@ -2,7 +2,8 @@
 and what the rollout records).
 
 ``type`` is "none" (zero input), "ppc" (the paper's law, `uvms_pin.scenario.ppc`), a baseline
-("pi_force", "impedance", "computed_torque": `uvms_pin.scenario.baselines`) or
+("pi_force", "impedance", "computed_torque": `uvms_pin.scenario.baselines`), "mpc"
+(model-predictive control, `uvms_pin.scenario.mpc`) or
 "package.module:ClassName", your own (`uvms_pin.scenario.custom_controller`).
 """
 
@@ -17,6 +18,7 @@ from uvms_pin.errors import ParameterError
 from uvms_pin.model.uvms import UVMS
 from uvms_pin.scenario.baselines import BASELINES, build_baseline
 from uvms_pin.scenario.custom_controller import custom_controller
+from uvms_pin.scenario.mpc import build_mpc
 from uvms_pin.scenario.ppc import build_ppc
 from uvms_pin.scenario.schema import Table
 from uvms_pin.sim.run import ControllerSpec
@@ -38,6 +40,7 @@ def _none(t: Table, uvms: UVMS) -> ControllerSpec:
 CONTROLLERS: dict[str, Callable[[Table, UVMS], ControllerSpec]] = {
     "none": _none,
     "ppc": build_ppc,
+    "mpc": build_mpc,
     **{kind: functools.partial(build_baseline, kind=kind) for kind in BASELINES},
 }
 

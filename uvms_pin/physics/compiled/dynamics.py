@@ -18,6 +18,9 @@ from uvms_pin.physics.compiled.backend import Fallback
 from uvms_pin.physics.compiled.extension import core_module
 from uvms_pin.physics.compiled.flow import flow_to_core
 from uvms_pin.physics.compiled.hull import surface_bodies_to_core
+from uvms_pin.physics.derivatives.reference import (
+    forward_dynamics_derivatives as reference_derivatives,
+)
 from uvms_pin.physics.reference import ReferenceDynamics
 
 
@@ -61,6 +64,7 @@ class CompiledDynamics:
         self.core = core.Dynamics(uvms.model.saveToString(), hydro_bodies_to_core(uvms, core))
         self._reference = reference
         self._flow: tuple[FlowField | None, object] = (None, None)  # the last flow converted
+        self._derivatives = None  # core.Derivatives, built on first use
         # the calls in a uniform current: the C++ methods themselves (no Python in between)
         self.mass_matrix = self.core.mass_matrix
         self.bias_forces = self.core.bias_forces
@@ -113,3 +117,24 @@ class CompiledDynamics:
                 q, v, tau, flow, time_s, tau_ext, free_surface
             )
         return self.core.forward_dynamics_in(q, v, tau, compiled, time_s, tau_ext, free_surface)
+
+    def forward_dynamics_derivatives(
+        self,
+        q: np.ndarray,
+        v: np.ndarray,
+        tau: np.ndarray,
+        flow: FlowField | None,
+        time_s: float,
+        tau_ext: np.ndarray | None = None,
+    ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """(da/dq, da/dv, da/dtau) in the core (src/uvms_core/derivatives.hpp): its own copy
+        of these dynamics, built on first use; a flow the core has no counterpart of runs on
+        the reference (`uvms_pin.physics.derivatives.reference`), with a warning."""
+        compiled = core_module().FlowField() if flow is None else self._flow_struct(flow)
+        if isinstance(compiled, Fallback):
+            compiled.warn("these derivatives", stacklevel=4)
+            return reference_derivatives(self._reference.uvms, q, v, tau, flow, time_s, tau_ext)
+        if self._derivatives is None:
+            self._derivatives = core_module().Derivatives(self.core)
+        out = self._derivatives.forward_dynamics_derivatives(q, v, tau, compiled, time_s, tau_ext)
+        return out.da_dq, out.da_dv, out.da_dtau

@@ -1,0 +1,187 @@
+"""Cost of the derivatives of the underwater forward dynamics, as ratios to ``pin.aba``.
+
+    .venv/bin/python benchmarks/bench_derivatives.py [--repeat N] [--out out/bench/derivatives.md]
+
+On the reference model in a 0.3 m/s current, every figure is a best-of-``repeat`` CPU time
+measured in this process (`timing.py`, one BLAS thread) divided by one rigid-body
+``pin.aba`` call timed in the same run:
+
+- Pinocchio's own rigid-body derivatives (``pin.computeABADerivatives``, no water);
+- ``up.forward_dynamics_derivatives`` (analytical, added mass, C_A, damping, buoyancy and
+  the current), compiled and Python reference, and the compiled call alone (the core's
+  ``Derivatives`` object without the Python argument checks);
+- the same Jacobians by central finite differences of the compiled forward dynamics
+  (2 (2 nv) + ... calls; what a user without the derivatives would do);
+- MuJoCo's ``mjd_transitionFD`` on the MuJoCo twin (benchmarks/bench_mujoco.py): the
+  discrete-transition Jacobians by finite differences, Euler and implicitfast, centred.
+  MuJoCo's fluid model has no added-mass acceleration term: the job differs, the cost is
+  what a MuJoCo user pays for the Jacobians of one step.
+
+A second table times one re-plan of the MPC controller (`uvms_pin.control.mpc`, station
+keeping in the current with the BlueROV2 Heavy's eight bounded thrusters, a 1 s horizon of
+50 nodes, 50 Hz, warm-started BoxFDDP) and gives its real-time factor (the 20 ms period over
+the CPU time of a re-plan; > 1: faster than real time on one core).
+"""
+
+from __future__ import annotations
+
+import argparse
+import itertools
+from pathlib import Path
+
+import mujoco
+import numpy as np
+import pinocchio as pin
+from bench_mujoco import CURRENT_WORLD_M_S, reference_system
+from timing import best_times, one_blas_thread
+
+import uvms_pin as up
+from uvms_pin.physics.compiled.extension import core_module
+from uvms_pin.physics.dynamics import dynamics_of
+
+ROOT = Path(__file__).resolve().parents[1]
+
+
+def central_differences(uvms: up.UVMS, q, v, tau, step: float = 1e-6):
+    """da/dq, da/dv, da/dtau by central differences of the compiled forward dynamics."""
+    fd = dynamics_of(uvms).core.forward_dynamics
+    nv, model = uvms.nv, uvms.model
+    out = np.empty((nv, 3 * nv))
+    for k in range(nv):
+        e = np.zeros(nv)
+        e[k] = step
+        qp, qm = pin.integrate(model, q, e), pin.integrate(model, q, -e)
+        out[:, k] = fd(qp, v, tau, CURRENT_WORLD_M_S) - fd(qm, v, tau, CURRENT_WORLD_M_S)
+        out[:, nv + k] = fd(q, v + e, tau, CURRENT_WORLD_M_S) - fd(q, v - e, tau, CURRENT_WORLD_M_S)
+        out[:, 2 * nv + k] = fd(q, v, tau + e, CURRENT_WORLD_M_S) - fd(
+            q, v, tau - e, CURRENT_WORLD_M_S
+        )
+    return out / (2 * step)
+
+
+def mujoco_transition_case(system, integrator: int):
+    """mjd_transitionFD (centred) of one step of the twin with ``integrator``."""
+    model = system.mj_model
+    model.opt.integrator = integrator
+    data = mujoco.MjData(model)
+    from uvms_pin.apps.export.mujoco_state import qpos_from_q, qvel_from_v
+
+    data.qpos[:] = qpos_from_q(system.q0)
+    data.qvel[:] = qvel_from_v(system.q0, system.v0)
+    mujoco.mj_forward(model, data)
+    nx, nu = 2 * model.nv + model.na, model.nu
+    a, b = np.zeros((nx, nx)), np.zeros((nx, nu))
+    return lambda: mujoco.mjd_transitionFD(model, data, 1e-6, 1, a, b, None, None)
+
+
+def cases_of(system) -> dict[str, object]:
+    uvms, q, v = system.uvms, system.q0, system.v0
+    tau = np.random.default_rng(1).normal(size=uvms.nv)
+    model, data = uvms.model, uvms.model.createData()
+    current = up.flow.UniformCurrent(CURRENT_WORLD_M_S)
+    derivatives = core_module().Derivatives(dynamics_of(uvms).core)
+    flow_struct = core_module().FlowField()
+    flow_struct.current_world_m_s = CURRENT_WORLD_M_S
+    cases = {
+        "pin.aba (rigid, the unit)": lambda: pin.aba(model, data, q, v, tau),
+        "pin.computeABADerivatives (rigid)": lambda: pin.computeABADerivatives(
+            model, data, q, v, tau
+        ),
+        "core forward_dynamics (current)": lambda: up.forward_dynamics(
+            uvms, q, v, tau, CURRENT_WORLD_M_S
+        ),
+        "core forward_dynamics_derivatives (current)": lambda: up.forward_dynamics_derivatives(
+            uvms, q, v, tau, flow=current
+        ),
+        "core Derivatives object alone (current)": lambda: derivatives.forward_dynamics_derivatives(
+            q, v, tau, flow_struct, 0.0
+        ),
+        "python forward_dynamics_derivatives (current)": lambda: up.forward_dynamics_derivatives(
+            uvms, q, v, tau, flow=current, backend="python"
+        ),
+        "central differences of core forward_dynamics": lambda: central_differences(
+            uvms, q, v, tau
+        ),
+    }
+    for name, integrator in (
+        ("Euler", mujoco.mjtIntegrator.mjINT_EULER),
+        ("implicitfast", mujoco.mjtIntegrator.mjINT_IMPLICITFAST),
+    ):
+        cases[f"MuJoCo mjd_transitionFD ({name}, centred)"] = mujoco_transition_case(
+            system, integrator
+        )
+    return cases
+
+
+def mpc_cases(system) -> dict[str, object]:
+    """One warm-started re-plan of a station-keeping MPC per call, at 1 and 3 iterations."""
+    import pinocchio as pin_
+
+    from uvms_pin.control.measurement import Measurement
+    from uvms_pin.control.mpc import MpcController
+    from uvms_pin.model.vehicles import bluerov2_heavy
+    from uvms_pin.ocp.problems import Actuators
+
+    uvms, q0 = system.uvms, system.q0.copy()
+    thrusters = bluerov2_heavy.thrusters()
+    effort = uvms.model.effortLimit[6:]
+    bounds = (
+        np.r_[[-t.max_reverse_N for t in thrusters], -effort],
+        np.r_[[t.max_forward_N for t in thrusters], effort],
+    )
+    actuators = Actuators(up.input_matrix(thrusters, uvms.nv), bounds)
+    measurement = Measurement(0.0, q0, system.v0, np.zeros(6))
+    cases = {}
+    for iterations in (1, 3):
+        controller = MpcController(
+            uvms,
+            task="station",
+            target=pin_.SE3(np.eye(3), q0[:3].copy()),
+            posture=q0,
+            horizon_s=1.0,
+            dt_s=0.02,
+            rate_hz=50.0,
+            iterations=iterations,
+            actuators=actuators,
+            flow=up.flow.UniformCurrent(CURRENT_WORLD_M_S),
+        )
+        clock = itertools.count()
+        cases[f"MPC re-plan, 50 nodes, {iterations} iteration(s)"] = lambda c=controller, k=clock: (
+            c.compute(0.02 * next(k), measurement)
+        )
+    return cases
+
+
+def mpc_table(times: dict[str, float], unit: float) -> str:
+    rows = [
+        "| MPC (station, 1 s horizon, 50 Hz) | x pin.aba | real-time factor |",
+        "|---|---:|---:|",
+    ]
+    rows += [f"| {name} | {t / unit:.0f} | {0.02 / t:.1f} |" for name, t in times.items()]
+    return "\n".join(rows) + "\n"
+
+
+def table(times: dict[str, float]) -> str:
+    unit = times["pin.aba (rigid, the unit)"]
+    rows = ["| call | x pin.aba |", "|---|---:|"]
+    rows += [f"| {name} | {t / unit:.1f} |" for name, t in times.items()]
+    return "\n".join(rows) + "\n"
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--repeat", type=int, default=30)
+    parser.add_argument("--out", type=Path, default=ROOT / "out" / "bench" / "derivatives.md")
+    args = parser.parse_args()
+    with one_blas_thread():
+        system = reference_system()
+        times = best_times(cases_of(system), args.repeat)
+        mpc = best_times(mpc_cases(system), max(3, args.repeat // 10), batch_s=0.0)
+    text = table(times) + "\n" + mpc_table(mpc, times["pin.aba (rigid, the unit)"])
+    print(text)
+    args.out.parent.mkdir(parents=True, exist_ok=True)
+    args.out.write_text(text)
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,96 @@
+// Derivatives of the underwater forward dynamics (mirror of uvms_pin/physics/derivatives/).
+//
+// a(q, v, tau) solves ID(q, v, a) = tau + tau_ext, ID the RNEA with each joint body's fluid
+// wrench w_j(q, v, a) as an external force (w_j holds -M_A,j a_j). Along the tangent:
+//   dID/dq = dRNEA/dq |_(w fixed) - sum_j J_j^T dw_j/dq         (likewise d/dv)
+//   M = dID/da = M_RB + sum_j J_j^T M_A,j J_j
+//   da/dq = -M^-1 dID/dq,  da/dv = -M^-1 dID/dv,  da/dtau = M^-1.
+// Pinocchio's computeRNEADerivatives gives the first term and, in its data, each joint's
+// velocity and acceleration derivatives (getJoint*Derivatives, LOCAL); the fluid terms' own
+// Jacobians are each hydro unit's (added_mass.hpp, damping.hpp, restoring.hpp), chained here
+// one function per term as in fluid.py.
+//
+// A Derivatives owns a copy of the Dynamics it differentiates, like Plant, and a Pinocchio
+// data of its own for the RNEA derivatives (they overwrite buffers, e.g. data.M and the
+// composite inertias, that the dynamics' articulated pass keeps between calls): not
+// thread-safe, no allocation per call.
+#pragma once
+
+#include <vector>
+
+#include "dynamics.hpp"
+
+namespace uvms {
+
+using Matrix6x = Eigen::Matrix<double, 6, Eigen::Dynamic>;
+using Matrix3x = Eigen::Matrix<double, 3, Eigen::Dynamic>;
+
+// The three Jacobians of zeta_dot (nv x nv each), q along the tangent.
+struct ForwardDynamicsDerivatives {
+  Eigen::MatrixXd da_dq;
+  Eigen::MatrixXd da_dv;
+  Eigen::MatrixXd da_dtau;
+};
+
+// One joint body's motion and its Jacobians, LOCAL frame (mirror of motion.py JointMotion).
+struct JointMotion {
+  Mat3 rotation;
+  Vec3 translation;
+  Vec6 velocity;
+  Matrix6x jacobian;  // d nu / dv = d a / d qdd
+  Matrix6x velocity_dq;
+  Matrix6x acceleration_dq;
+  Matrix6x acceleration_dv;
+
+  Vec3 point(const Vec3& point_in_joint_m) const {
+    return rotation * point_in_joint_m + translation;
+  }
+  // d p_world / dq of a point fixed in the joint frame: R (J^v - [r]x J^w).
+  Matrix3x point_dq(const Vec3& point_in_joint_m) const;
+};
+
+// The flow seen in a body frame: U = R^T u, A = R^T Du/Dt and their d/dq (fluid.py FlowInBody).
+struct FlowSeenByBody {
+  Vec3 velocity;
+  Matrix3x velocity_dq;
+  Vec3 acceleration;
+  Matrix3x acceleration_dq;
+};
+
+class Derivatives {
+ public:
+  explicit Derivatives(const Dynamics& dynamics);
+  Derivatives(const Derivatives&) = delete;
+  Derivatives& operator=(const Derivatives&) = delete;
+
+  const ForwardDynamicsDerivatives& forward_dynamics_derivatives(
+      const ConstVec& q, const ConstVec& v, const ConstVec& tau, const FlowField& flow,
+      const ConstVec* tau_ext, double time_s = 0.0);
+
+  Dynamics& dynamics() { return dynamics_; }
+
+ private:
+  // fext_ = w_j(q, v, a): the fluid wrenches with each body's whole acceleration
+  void wrenches_at(const ConstVec& q, const ConstVec& v, const Eigen::VectorXd& a,
+                   const FlowField& flow, double time_s);
+  void joint_motions();
+  void fluid_jacobians(const FlowField& flow, double time_s);
+  FlowSeenByBody flow_in_body(const JointMotion& motion, const Mat3& rotation_in_joint,
+                              const Vec3& point_in_joint_m, const FlowGradientsAtPoint& flow);
+  void added_mass_jacobians(int joint, const FlowGradientsAtPoint& flow);
+  void restoring_jacobian(int joint, const FlowGradientsAtPoint& flow, bool moving_water);
+  void damping_jacobians(const DampedBody& body, const FlowGradientsAtPoint& flow);
+
+  Dynamics dynamics_;
+  Data data_;  // the RNEA derivatives' and the joint motions' (not the dynamics')
+  std::vector<int> hydro_joints_;
+  std::vector<JointMotion> motion_;  // per joint id (only hydro joints filled)
+  std::vector<Matrix6x> dw_dq_, dw_dv_;
+  ForceVector fext_;
+  Eigen::VectorXd acceleration_;
+  Eigen::MatrixXd did_dq_, did_dv_, mass_;
+  Eigen::LLT<Eigen::MatrixXd> cholesky_;
+  ForwardDynamicsDerivatives out_;
+};
+
+}  // namespace uvms

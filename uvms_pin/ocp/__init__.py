@@ -1,0 +1,9 @@
+"""Optimal control of a UVMS in water with crocoddyl (the ``ocp`` extra:
+``pip install 'uvms-pin[ocp]'``).
+
+`model` (the differential action model: the underwater forward dynamics and their analytical
+derivatives, `uvms_pin.physics.dynamics.forward_dynamics_derivatives`), `costs` (end-effector
+pose, vehicle pose and attitude, effort, state regularisation) and `problems` (a shooting
+problem over a horizon, solved by crocoddyl's box-constrained FDDP). crocoddyl is imported by
+these modules only: the rest of uvms-pin runs without it. docs/derivatives.md.
+"""

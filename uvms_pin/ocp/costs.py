@@ -1,0 +1,167 @@
+"""The cost terms of an underwater OCP: weighted least squares of residuals of the state.
+
+Each term is  l = (1/2) r^T W r  (W = diag(weights)) of a residual r(x, u) with its
+Jacobians R_x (over the tangent dx = (dq, dv)) and R_u; the action model sums the terms and
+their Gauss-Newton derivatives  l_x = R_x^T W r,  l_xx = R_x^T W R_x  (likewise u, xu).
+Frame Jacobians are Pinocchio's LOCAL ones (`pin.getFrameJacobian`) at the node's state,
+after `pin.computeJointJacobians` and `pin.updateFramePlacements` in the node's data.
+
+    frame pose         r = log6(T_target^-1 T_f)         R_q = Jlog6 J_f          (6)
+    frame rotation     r = log3(R_target^T R_f)          R_q = Jlog3 J_f^w        (3)
+    frame position     r = p_f - p_target [m]            R_q = R_f J_f^v          (3)
+    effort             r = u (thrust [N], torque [N m])  R_u = I                  (nu)
+    state              r = (q (-) q_ref, v - v_ref)      R_q = dDifference, R_v = I
+
+None of them depends on v except the state term: no cost on a contact force (the OCP has no
+contact model).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+import pinocchio as pin
+
+from uvms_pin.errors import ParameterError
+from uvms_pin.model.uvms import UVMS
+
+
+def vehicle_frame_id(uvms: UVMS) -> int:
+    """The Pinocchio frame of the vehicle's body (the first body frame on joint 1)."""
+    for k, frame in enumerate(uvms.model.frames):
+        if frame.parentJoint == 1 and frame.type == pin.FrameType.BODY:
+            return k
+    raise ParameterError(f"model '{uvms.model.name}' has no body frame on its vehicle joint")
+
+
+class CostTerm:
+    """(1/2) r^T W r of one residual; subclasses give r and its Jacobians."""
+
+    def __init__(self, weights, size: int, name: str):
+        weights = np.asarray(weights, dtype=float).reshape(-1)
+        if (
+            weights.shape != (size,)
+            or np.any(~(weights >= 0.0))
+            or not np.all(np.isfinite(weights))
+        ):
+            raise ParameterError(f"cost '{name}': {size} finite weights >= 0 needed, got {weights}")
+        self.weights, self.nr, self.name = weights, size, name
+
+    def residual(self, model: pin.Model, data: pin.Data, x: np.ndarray, u: np.ndarray):
+        raise NotImplementedError
+
+    def jacobians(self, model: pin.Model, data: pin.Data, x: np.ndarray, u: np.ndarray):
+        """(R_x (nr, 2 nv), R_u (nr, nu))."""
+        raise NotImplementedError
+
+
+@dataclass(frozen=True)
+class _Frame:
+    frame_id: int
+
+    def jacobian(self, model: pin.Model, data: pin.Data) -> np.ndarray:
+        return pin.getFrameJacobian(model, data, self.frame_id, pin.LOCAL)
+
+
+def _state_jacobian(jq: np.ndarray, nv: int, nu: int) -> tuple[np.ndarray, np.ndarray]:
+    return np.hstack([jq, np.zeros((jq.shape[0], nv))]), np.zeros((jq.shape[0], nu))
+
+
+class FramePose(CostTerm):
+    """(1/2)||log6(T_target^-1 T_f)||^2_W: W over (position [m], rotation [rad])."""
+
+    def __init__(self, frame_id: int, target: pin.SE3, weights):
+        super().__init__(weights, 6, "frame pose")
+        self.frame, self.target_inverse = _Frame(frame_id), target.inverse()
+
+    def _error(self, data: pin.Data) -> pin.SE3:
+        return self.target_inverse * data.oMf[self.frame.frame_id]
+
+    def residual(self, model, data, x, u):
+        return pin.log6(self._error(data)).vector
+
+    def jacobians(self, model, data, x, u):
+        jq = pin.Jlog6(self._error(data)) @ self.frame.jacobian(model, data)
+        return _state_jacobian(jq, model.nv, len(u))
+
+
+class FrameRotation(CostTerm):
+    """(1/2)||log3(R_target^T R_f)||^2_W [rad], e.g. the vehicle's attitude."""
+
+    def __init__(self, frame_id: int, rotation: np.ndarray, weights):
+        super().__init__(weights, 3, "frame rotation")
+        self.frame, self.target_transposed = _Frame(frame_id), np.asarray(rotation, float).T
+
+    def _error(self, data: pin.Data) -> np.ndarray:
+        return self.target_transposed @ data.oMf[self.frame.frame_id].rotation
+
+    def residual(self, model, data, x, u):
+        return pin.log3(self._error(data))
+
+    def jacobians(self, model, data, x, u):
+        jq = pin.Jlog3(self._error(data)) @ self.frame.jacobian(model, data)[3:]
+        return _state_jacobian(jq, model.nv, len(u))
+
+
+class FramePosition(CostTerm):
+    """(1/2)||p_f - p_target||^2_W [m], world axes."""
+
+    def __init__(self, frame_id: int, target_m: np.ndarray, weights):
+        super().__init__(weights, 3, "frame position")
+        self.frame, self.target_m = _Frame(frame_id), np.asarray(target_m, float)
+
+    def residual(self, model, data, x, u):
+        return data.oMf[self.frame.frame_id].translation - self.target_m
+
+    def jacobians(self, model, data, x, u):
+        rotation = data.oMf[self.frame.frame_id].rotation
+        jq = rotation @ self.frame.jacobian(model, data)[:3]
+        return _state_jacobian(jq, model.nv, len(u))
+
+
+class Effort(CostTerm):
+    """(1/2)||u||^2_W: thrust forces [N] and joint torques [N m] (or tau)."""
+
+    def __init__(self, weights):
+        weights = np.asarray(weights, float).reshape(-1)
+        super().__init__(weights, weights.size, "effort")
+
+    def residual(self, model, data, x, u):
+        return np.asarray(u, float).copy()
+
+    def jacobians(self, model, data, x, u):
+        return np.zeros((self.nr, 2 * model.nv)), np.eye(self.nr)
+
+
+class StateDeviation(CostTerm):
+    """(1/2)||x (-) x_ref||^2_W over the tangent (2 nv): (q (-) q_ref, v - v_ref)."""
+
+    def __init__(self, model: pin.Model, x_ref: np.ndarray, weights):
+        super().__init__(weights, 2 * model.nv, "state")
+        x_ref = np.asarray(x_ref, float)
+        if x_ref.shape != (model.nq + model.nv,):
+            raise ParameterError(f"cost 'state': x_ref needs nq + nv = {model.nq + model.nv}")
+        self.q_ref, self.v_ref = x_ref[: model.nq], x_ref[model.nq :]
+
+    def residual(self, model, data, x, u):
+        return np.r_[pin.difference(model, self.q_ref, x[: model.nq]), x[model.nq :] - self.v_ref]
+
+    def jacobians(self, model, data, x, u):
+        nv = model.nv
+        rx = np.zeros((2 * nv, 2 * nv))
+        rx[:nv, :nv] = pin.dDifference(model, self.q_ref, x[: model.nq], pin.ARG1)
+        rx[nv:, nv:] = np.eye(nv)
+        return rx, np.zeros((2 * nv, len(u)))
+
+
+def end_effector_pose(uvms: UVMS, target: pin.SE3, weights) -> FramePose:
+    return FramePose(uvms.require_ee_frame("an end-effector pose cost"), target, weights)
+
+
+def vehicle_pose(uvms: UVMS, target: pin.SE3, weights) -> FramePose:
+    return FramePose(vehicle_frame_id(uvms), target, weights)
+
+
+def vehicle_attitude(uvms: UVMS, rotation: np.ndarray, weights) -> FrameRotation:
+    return FrameRotation(vehicle_frame_id(uvms), rotation, weights)

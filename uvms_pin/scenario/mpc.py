@@ -1,0 +1,88 @@
+"""``[controller] type = "mpc"``: model-predictive control on the analytical derivatives
+(`uvms_pin.control.mpc`; docs/derivatives.md, docs/scenarios.md).
+
+The controller plans on tau (the generalized input the scenario's actuation then allocates
+to the thrusters and limits), bounded by ``tau_limits`` (a DoF whose limit is 0, e.g. the
+unactuated roll and pitch, is not an input of the plan); its model is the plant's, or the
+plant's scaled by [controller.model_error] (as for computed torque); the water it plans in is
+``current_world_m_s`` (what it believes the current is; it does not see the scenario's).
+Needs crocoddyl (``pip install 'uvms-pin[ocp]'``).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pinocchio as pin
+
+from uvms_pin.control.base import Controller
+from uvms_pin.flow import UniformCurrent
+from uvms_pin.model.scaled import scaled_uvms
+from uvms_pin.model.uvms import UVMS
+from uvms_pin.scenario.baselines import model_error_factors
+from uvms_pin.scenario.controller_parts import checked_spec, plain
+from uvms_pin.scenario.schema import Table
+from uvms_pin.sim.run import ControllerSpec
+
+#: the keys of the table with their defaults
+_NUMBERS = {"horizon_s": 1.0, "dt_s": 0.02, "rate_hz": 50.0}
+
+
+def _target(t: Table, uvms: UVMS, task: str) -> pin.SE3:
+    """target_position_m (world, m) and target_rpy (rad): the vehicle's body frame for
+    "station", the end-effector for "end_effector"."""
+    position = t.vector("target_position_m", 3)
+    rpy = t.vector("target_rpy", 3, [0.0, 0.0, 0.0])
+    if task == "end_effector":
+        uvms.require_ee_frame("[controller] type = 'mpc' with task = 'end_effector'")
+    return pin.SE3(pin.rpy.rpyToMatrix(*rpy), position)
+
+
+def build_mpc(t: Table, uvms: UVMS) -> ControllerSpec:
+    """[controller] type = "mpc"."""
+    task = t.string("task", "station", choices=("station", "end_effector"))
+    target = _target(t, uvms, task)
+    posture = t.vector("posture", uvms.n_arm_joints, uvms.neutral_configuration()[7:])
+    fields = {k: t.number(k, default, positive=True) for k, default in _NUMBERS.items()}
+    fields["iterations"] = t.integer("iterations", 3, minimum=1)
+    fields["solver"] = t.string("solver", "box_fddp", choices=("box_fddp", "fddp"))
+    fields["warm_start"] = t.boolean("warm_start", True)
+    default_weights = [100.0] * 6 if task == "station" else [1.0, 1.0, 1.0, 0.1, 0.1, 0.1]
+    fields["pose_weights"] = t.vector("pose_weights", 6, default_weights, nonneg=True)
+    limits = t.vector("tau_limits", uvms.nv, np.full(uvms.nv, np.inf), nonneg=True)
+    current = t.vector("current_world_m_s", 3, [0.0, 0.0, 0.0])
+    factors = model_error_factors(t.table("model_error"))
+    t.finish()
+
+    def build(u: UVMS) -> Controller:
+        from uvms_pin.control.mpc import MpcController  # crocoddyl: imported on use
+        from uvms_pin.ocp.problems import Actuators
+
+        q_ref = u.neutral_configuration()
+        q_ref[:3] = target.translation
+        q_ref[3:7] = pin.Quaternion(target.rotation).coeffs()
+        q_ref[7:] = posture
+        # a DoF with a zero limit has no actuator: not an input of the plan
+        active = np.flatnonzero(limits > 0.0)
+        input_matrix = np.eye(u.nv)[:, active]
+        bounds = None if np.all(np.isinf(limits)) else (-limits[active], limits[active])
+        return MpcController(
+            scaled_uvms(u, **factors),
+            task=task,
+            target=target,
+            posture=q_ref,
+            actuators=Actuators(input_matrix, bounds),
+            flow=UniformCurrent(current) if np.any(current) else None,
+            **fields,
+        )
+
+    recorded = {
+        "task": task,
+        "pose_weights": plain(fields["pose_weights"]),
+        "target_position_m": plain(target.translation),
+        "posture": plain(posture),
+        "tau_limits": plain(limits),
+        "current_world_m_s": plain(current),
+        "model_error": factors,
+        **{k: v for k, v in fields.items() if k != "pose_weights"},
+    }
+    return checked_spec(t, uvms, "mpc", recorded, build)
