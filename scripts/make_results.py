@@ -37,6 +37,7 @@ PRODUCERS = {
     "sea_state": "the sea-state scenario: docs/results/sea_state.md, docs/sea_state_force.png",
     "study_sea_state": "study summary: docs/results/study_sea_state.md",
     "surface": "the free surface, analytic cases and surfacing: docs/results/surface.md, docs/surfacing.png",
+    "world": "the seabed landing and the cost of contacts: docs/results/world.md, docs/seabed_landing.png",
     "derivatives": "cost of the dynamics' derivatives and of an MPC re-plan: docs/results/derivatives.md",
     "tracking": "end-effector tracking, controller x task x conditions: docs/results/tracking.md, docs/tracking_*.png",
 }

@@ -133,6 +133,49 @@ _VARIANTS = [
             "integrator.method": "semi_implicit_euler",
         },
     ),
+    (
+        "seabed_landing.toml",
+        {
+            "world.objects": [
+                {"type": "plane", "point_world_m": [0, 0, -10], "normal_world": [0, 0, 1]},
+                {
+                    "type": "box",
+                    "name": "crate",
+                    "size_m": [1, 1, 1],
+                    "position_world_m": [3, 0, -9],
+                    "rpy_rad": [0, 0, 0.3],
+                    "fixed": True,
+                    "friction_static": 0.8,
+                    "friction_kinetic": 0.7,
+                },
+                {"type": "sphere", "radius_m": 0.5, "position_world_m": [-3, 0, -9.5]},
+                {
+                    "type": "cylinder",
+                    "radius_m": 0.2,
+                    "length_m": 4.0,
+                    "position_world_m": [0, 3, -9.8],
+                    "rpy_rad": [1.5708, 0, 0],
+                },
+                {
+                    "type": "mesh",
+                    "path": "meshes/rock.obj",
+                    "scale": [1, 1, 1],
+                    "position_world_m": [0, -3, -9.8],
+                },
+            ],
+            "world.contact": {
+                "stiffness_N_m": 1e4,
+                "dissipation_s_m": 0.5,
+                "friction_static": 0.6,
+                "friction_kinetic": 0.5,
+                "tangential_stiffness_N_m": 1e4,
+                "tangential_damping_N_s_m": 20.0,
+            },
+            "joints.hard_stops": True,
+            "joints.stop_stiffness_Nm_rad": 500.0,
+            "joints.stop_damping_Nm_s_rad": 2.0,
+        },
+    ),
 ]
 
 _PPC_LEVEL = {

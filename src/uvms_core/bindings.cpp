@@ -312,6 +312,27 @@ void bind_environment(nb::module_& m) {
       .def_rw("viscous_Nms", &uvms::JointFriction::viscous_Nms)
       .def_rw("coulomb_Nm", &uvms::JointFriction::coulomb_Nm)
       .def_rw("velocity_scale_rad_s", &uvms::JointFriction::velocity_scale_rad_s);
+  nb::class_<uvms::JointStopsModel>(m, "JointStops",
+                                    "Compliant stops at the joint limits (joint_stops.hpp).")
+      .def(nb::init<>())
+      .def_rw("q_index", &uvms::JointStopsModel::q_index)
+      .def_rw("v_index", &uvms::JointStopsModel::v_index)
+      .def_rw("lower_rad", &uvms::JointStopsModel::lower_rad)
+      .def_rw("upper_rad", &uvms::JointStopsModel::upper_rad)
+      .def_rw("stiffness_Nm_rad", &uvms::JointStopsModel::stiffness_Nm_rad)
+      .def_rw("damping_Nm_s_rad", &uvms::JointStopsModel::damping_Nm_s_rad);
+  using uvms::WorldBoundsModel;
+  nb::class_<WorldBoundsModel>(m, "WorldBounds",
+                               "The broad phase of the world's contacts (world_bounds.hpp).")
+      .def(nb::init<>())
+      .def_rw("joint_ids", &WorldBoundsModel::joint_ids)
+      .def_rw("centers_in_joint", &WorldBoundsModel::centers_in_joint)
+      .def_rw("radii_m", &WorldBoundsModel::radii_m)
+      .def_rw("plane_normals", &WorldBoundsModel::plane_normals)
+      .def_rw("plane_offsets_m", &WorldBoundsModel::plane_offsets_m)
+      .def_rw("sphere_centers_m", &WorldBoundsModel::sphere_centers_m)
+      .def_rw("sphere_radii_m", &WorldBoundsModel::sphere_radii_m)
+      .def_rw("clearance_m", &WorldBoundsModel::clearance_m);
   nb::enum_<uvms::Method>(m, "Method", "A fixed-step method (integrators.hpp).")
       .value("rk4", uvms::Method::rk4)
       .value("semi_implicit_euler", uvms::Method::semi_implicit_euler);
@@ -332,6 +353,16 @@ void bind_plant(nb::module_& m) {
       .def_rw("contact", &Plant::contact)
       .def_rw("disturbance", &Plant::disturbance)
       .def_rw("joint_friction", &Plant::joint_friction)
+      .def_rw("joint_stops", &Plant::joint_stops)
+      .def_rw("world_bounds", &Plant::world_bounds)
+      .def(
+          "world_clear",
+          [](Plant& p, nb::handle q_obj, nb::handle v_obj, double horizon_s) {
+            UVMS_VECTOR(q, p.dynamics().nq());
+            UVMS_VECTOR(v, p.dynamics().nv());
+            return p.world_clear(q, v, horizon_s);
+          },
+          "q"_a.none(), "v"_a.none(), "horizon_s"_a)
       .def(
           "contact_wrench",
           [](Plant& p, nb::handle q_obj, nb::handle v_obj) -> Eigen::VectorXd {

@@ -52,12 +52,28 @@ const Eigen::VectorXd& Plant::acceleration(double time_s, const ConstVec& q, con
     // delta acts against tau on the vehicle body (joint 1, free-flyer: LOCAL Jacobian [I 0])
     dynamics_.add_local_wrench(1, -disturbance->at(time_s));
   }
-  if (joint_friction.active()) {
-    tau_with_friction_ = tau;
-    joint_friction.subtract_from(v, tau_with_friction_);
-    return dynamics_.accelerations(q, v, tau_with_friction_, nullptr);
+  if (joint_friction.active() || joint_stops) {
+    tau_total_ = tau;
+    if (joint_friction.active()) joint_friction.subtract_from(v, tau_total_);
+    if (joint_stops) joint_stops->add_torque(q, v, tau_total_);
+    return dynamics_.accelerations(q, v, tau_total_, nullptr);
   }
   return dynamics_.accelerations(q, v, tau, nullptr);
+}
+
+bool Plant::world_clear(const ConstVec& q, const ConstVec& v, double horizon_s) {
+  if (world_bounds.radii_m.size() == 0) return true;
+  if (static_cast<Eigen::Index>(world_bounds.joint_ids.size()) != world_bounds.radii_m.size() ||
+      world_bounds.centers_in_joint.cols() != world_bounds.radii_m.size()) {
+    throw InputError("world bounds: one joint, centre and radius per piece");
+  }
+  for (const int j : world_bounds.joint_ids) {
+    if (j < 0 || j >= static_cast<int>(dynamics_.model().njoints)) {
+      throw InputError("world bounds: joint " + std::to_string(j) + " is not in the model");
+    }
+  }
+  dynamics_.kinematics(q, v);
+  return world_bounds.clear(dynamics_.data(), horizon_s);
 }
 
 std::pair<Eigen::VectorXd, Eigen::VectorXd> Plant::advance(double t0, const ConstVec& q0,

@@ -1,7 +1,8 @@
 // The simulated world (mirror of uvms_pin/sim/plant.py): a UVMS in a flow, touching a compliant
 // environment at its end-effector and pushed by a disturbance:
-//   M zeta_dot + h + J_c^T lambda + [delta; 0] = tau + [0; tau_f(v)],
-// tau_f the friction of the arm's joint drives (joint_friction.hpp).
+//   M zeta_dot + h + J_c^T lambda + [delta; 0] = tau + [0; tau_f(v)] + tau_stop,
+// tau_f the friction of the arm's joint drives (joint_friction.hpp), tau_stop the compliant
+// stops at the joint limits (joint_stops.hpp).
 // It advances the plant over one control period with the input held, in one call.
 #pragma once
 
@@ -12,6 +13,8 @@
 #include "dynamics.hpp"
 #include "integrators.hpp"
 #include "joint_friction.hpp"
+#include "joint_stops.hpp"
+#include "world_bounds.hpp"
 
 namespace uvms {
 
@@ -26,12 +29,18 @@ class Plant {
   Contact contact;
   Disturbance disturbance;
   JointFriction joint_friction;
+  JointStops joint_stops;  // compliant stops at the arm joints' limits, or none
 
   // lambda at (q, v): what the end-effector exerts on the environment [N; N m], world axes.
   Vec6 contact_wrench(const ConstVec& q, const ConstVec& v);
   // zeta_dot; contact_world given = use it instead of the contact model (continuous loop).
   const Eigen::VectorXd& acceleration(double time_s, const ConstVec& q, const ConstVec& v,
                                       const ConstVec& tau, const Vec6* contact_world = nullptr);
+  // Whether no piece can reach a world object within horizon_s from (q, v)
+  // (world_bounds.hpp); true without bounds.
+  bool world_clear(const ConstVec& q, const ConstVec& v, double horizon_s);
+  WorldBoundsModel world_bounds;
+
   // (q, v) at t1 from (q0, v0) at t0 with tau held, in the integrator's substeps.
   std::pair<Eigen::VectorXd, Eigen::VectorXd> advance(double t0, const ConstVec& q0,
                                                       const ConstVec& v0, const ConstVec& tau,
@@ -49,7 +58,7 @@ class Plant {
   pinocchio::FrameIndex ee_frame_id_;
   pinocchio::JointIndex ee_joint_id_;
   ManifoldStepper stepper_;
-  Eigen::VectorXd tau_with_friction_;
+  Eigen::VectorXd tau_total_;  // tau - the joint friction + the joint stops' torque
 };
 
 }  // namespace uvms

@@ -153,6 +153,7 @@ def test_joints_past_their_limits_by_known_amounts_for_known_times():
     m = joint_limit_metrics(r)
     assert m["joint_limit_excess_max_rad"] == pytest.approx(0.25, rel=1e-12)
     assert m["joint_limit_excess_time_fraction"] == 150 / N  # samples 300-449
+    assert m["time_at_joint_stop_s"] == pytest.approx(150 * DT, rel=1e-12)  # each held DT
     assert compute_metrics(r)["joint_limit_excess_max_rad"] == m["joint_limit_excess_max_rad"]
 
 
@@ -172,6 +173,7 @@ def test_joints_inside_their_limits_give_exactly_zero():
     assert joint_limit_metrics(r) == {
         "joint_limit_excess_max_rad": 0.0,
         "joint_limit_excess_time_fraction": 0.0,
+        "time_at_joint_stop_s": 0.0,
     }
 
 
@@ -318,3 +320,18 @@ def test_a_funnel_reached_has_a_zero_margin_and_no_force_task_has_no_force_metri
     assert "funnel_margin_min_second" not in force_tracking_metrics(r)
     assert force_tracking_metrics(rollout()) == {}
     assert "force_error_rms_N" not in compute_metrics(rollout())
+
+
+# ---- world contacts --------------------------------------------------------------------
+
+
+def test_world_contact_time_and_peak_force_from_the_logged_pairs():
+    r = rollout(metadata={"world_contact_pairs": ["hull|seabed", "tool|rock"]})
+    contacts = np.zeros((N, 2, 9))
+    contacts[200:500, 0, :3] = [0.0, 3.0, 4.0]  # 5 N on the hull from t = 2 s to 5 s
+    contacts[400:450, 1, :3] = [0.0, -3.0, 8.0]  # and the tool on the rock from 4 to 4.5 s
+    contacts[400:450, 1, 3:6] = [1.0, 2.0, 3.0]  # (a point: not a force)
+    r.signal("world_contact", 18)[:] = contacts.reshape(N, 18)
+    m = compute_metrics(r)
+    assert m["time_in_world_contact_s"] == pytest.approx(300 * DT, rel=1e-12)
+    assert m["world_contact_force_peak_N"] == pytest.approx(12.0, rel=1e-12)  # |(0, 0, 12)|

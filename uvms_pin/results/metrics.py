@@ -64,6 +64,7 @@ def compute_metrics(rollout: RolloutData) -> dict[str, float]:
     out.update(force_tracking_metrics(rollout))
     out.update(joint_limit_metrics(rollout))
     out.update(surface_metrics(rollout))
+    out.update(world_contact_metrics(rollout))
     out.update(task_metrics(rollout))
     out.update(extra_metrics(rollout, out))
     return out
@@ -92,7 +93,8 @@ def energy_metrics(rollout: RolloutData) -> dict[str, float]:
     """The energy of a run. Driven (a force, contact or disturbance did work): its balance,
     E(T) - E(0) = W_tau + W_rest, with W_tau the work of the applied generalized force
     (`work_of_tau_J`) and W_rest the work of the water (damping, currents: dissipation),
-    the contact and the disturbance, what the energy change leaves. Not driven: the largest
+    the contact (the end-effector's, the world's) and the joint stops (their springs hold
+    energy while pressed), and the disturbance, what the energy change leaves. Not driven: the largest
     relative change of E = T + U, max |E(t) - E(0)| / max(|E(0)|, T(0)) (the water's
     damping dissipates; without it, the integration's error)."""
     total = rollout.total_energy_J
@@ -135,11 +137,13 @@ def surface_metrics(rollout: RolloutData) -> dict[str, float]:
 
 
 def joint_limit_metrics(rollout: RolloutData) -> dict[str, float]:
-    """How far the arm went past its position limits [rad] (0: never), and the time share,
+    """How far the arm went past its position limits [rad] (0: never), the time share, and
+    the time at a stop [s] (some joint past a limit; each sample counts until the next),
     over the joints that have limits (a continuous joint has none; {} if no joint has).
 
-    The simulator does not stop a joint at its limit (no hard stops are modelled), so a
-    controller that drives a joint past it shows up here, not as a crash.
+    With joint stops (``[joints] hard_stops``, the default) a joint past its limit is
+    pressing on its compliant stop, by tau / k_s; without them nothing stops it, and a
+    controller that drives a joint past its limit shows up here, not as a crash.
     """
     meta = rollout.metadata
     if "arm_position_lower_rad" not in meta or len(rollout) == 0 or rollout.q.shape[1] <= 7:
@@ -157,9 +161,29 @@ def joint_limit_metrics(rollout: RolloutData) -> dict[str, float]:
         return {}
     q = arm_positions(rollout.q[:, 7:], kinds)[:, limited]
     excess = np.maximum(lower[limited] - q, 0.0) + np.maximum(q - upper[limited], 0.0)
+    held = np.diff(rollout.time_s, append=rollout.time_s[-1])
+    past = np.any(excess > 0.0, axis=1)
     return {
         "joint_limit_excess_max_rad": float(excess.max()),
-        "joint_limit_excess_time_fraction": float(np.mean(np.any(excess > 0.0, axis=1))),
+        "joint_limit_excess_time_fraction": float(np.mean(past)),
+        "time_at_joint_stop_s": float(held @ past),
+    }
+
+
+def world_contact_metrics(rollout: RolloutData) -> dict[str, float]:
+    """From the logged world contacts (signal ``world_contact``, 9 numbers per pair: force
+    [N], point [m], moment [N m]): the time some body touched an object [s] and the
+    largest total contact force on the UVMS [N]."""
+    wrenches = rollout.signals.get("world_contact")
+    if wrenches is None or len(rollout) == 0 or wrenches.shape[1] == 0:
+        return {}
+    per_pair = wrenches.reshape(len(rollout), -1, 9)
+    touching = np.any(np.linalg.norm(per_pair[:, :, :3], axis=2) > 0.0, axis=1)
+    held = np.diff(rollout.time_s, append=rollout.time_s[-1])
+    total = np.linalg.norm(per_pair[:, :, :3].sum(axis=1), axis=1)
+    return {
+        "time_in_world_contact_s": float(held @ touching),
+        "world_contact_force_peak_N": float(total.max()),
     }
 
 

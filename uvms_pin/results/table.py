@@ -11,7 +11,9 @@ Column names are ``<array>.<component>_<unit>``:
   q; ``vx vy vz wx wy wz`` of v; ``fx fy fz mx my mz`` of a wrench or generalized force)
   and the joint's URDF name for the arm (a continuous joint's configuration is two
   columns, ``q.<joint>.cos`` and ``q.<joint>.sin``); a task-space (first-level) quantity uses
-  ``fx fy fz roll pitch yaw``; a signal this module does not know uses its index.
+  ``fx fy fz roll pitch yaw``; the world's contacts (signal ``world_contact``) use
+  ``<body>|<object>.fx fy fz`` (force on the body, N), ``.x y z`` (its point, m) and
+  ``.mx my mz`` (moment about it, N m); a signal this module does not know uses its index.
 - ``_<unit>`` is the SI unit (``m``, ``rad``, ``m_s``, ``rad_s``, ``N``, ``Nm``, ``J``);
   dimensionless columns (quaternion, normalized errors) have none.
 - a signal a controller logged as a `uvms_pin.results.signal.Signal` has its own names and
@@ -117,6 +119,26 @@ def _labels(
     return out
 
 
+#: the 9 columns of each (body, object) pair of the ``world_contact`` signal
+_CONTACT_PAIR = [
+    *_FORCE,
+    ("x", "m"),
+    ("y", "m"),
+    ("z", "m"),
+    ("mx", "Nm"),
+    ("my", "Nm"),
+    ("mz", "Nm"),
+]
+
+
+def _world_contact_labels(rollout: RolloutData, width: int) -> list[tuple[str, str]]:
+    """``world_contact.<body>|<object>.fx_N`` ...: force, point, moment of each pair."""
+    pairs = list(rollout.metadata.get("world_contact_pairs") or [])
+    if len(pairs) * len(_CONTACT_PAIR) != width:
+        return [(f"world_contact.{k}", "") for k in range(width)]
+    return [(f"world_contact.{pair}.{c}", u) for pair in pairs for c, u in _CONTACT_PAIR]
+
+
 #: unit suffix in a column name -> the unit as text in ``attrs["units"]``
 UNIT_TEXT = {"m_s": "m/s", "rad_s": "rad/s", "Nm": "N m"}
 
@@ -155,8 +177,9 @@ def column_layout(rollout: RolloutData) -> list[tuple[str, str, np.ndarray]]:
         prefix, vehicle, joint_layout = SIGNAL_LAYOUTS.get(name, (name, [], None))
         if prefix in _BASE_ARRAYS:
             prefix = f"signal.{prefix}"
-        named = _named_labels(prefix, described.get(name), values.shape[1])
-        if named is not None:
+        if name == "world_contact":
+            labels = _world_contact_labels(rollout, values.shape[1])
+        elif (named := _named_labels(prefix, described.get(name), values.shape[1])) is not None:
             labels = named
         elif not vehicle:
             labels = [(f"{prefix}.{k}", "") for k in range(values.shape[1])]

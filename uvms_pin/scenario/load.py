@@ -5,7 +5,8 @@ A scenario is read in two stages: the TOML becomes a plain dict (on which dotted
 ``{"initial.joint_positions_rad[3]": 0.5}`` are applied, see `uvms_pin.scenario.overrides`;
 that is how ``uvms-pin run --set``, sweeps and robustness tables vary it), then every table
 is checked and built by the module of its concept: ``[water]`` (`water`), ``[initial]``
-(`initial`), ``[environment]`` and ``[disturbance]`` (`world`), ``[actuation]``,
+(`initial`), ``[environment]`` and ``[disturbance]`` (`world`), ``[world]`` and ``[joints]``
+(`objects`), ``[actuation]``,
 ``[sensors]``, ``[integrator]``, ``[control]`` and ``[output]`` (`timing`), ``[controller]``
 (`controller`), ``[baselines]`` (`baselines`), ``[task]`` (`task`) and ``[metrics]``
 (`metrics`). Unknown keys, wrong types and bad values
@@ -32,6 +33,7 @@ from uvms_pin.scenario.controller import build_controller
 from uvms_pin.scenario.initial import build_initial_state
 from uvms_pin.scenario.joints import build_joint_friction, with_joint_lag
 from uvms_pin.scenario.metrics import build_metrics
+from uvms_pin.scenario.objects import build_joint_stops, build_world
 from uvms_pin.scenario.overrides import apply_overrides, parse_key_path
 from uvms_pin.scenario.schema import Table
 from uvms_pin.scenario.sensors import build_sensors
@@ -102,8 +104,10 @@ def _build(raw: dict[str, Any], path: Path, top: Table) -> Scenario:
     q0, v0 = build_initial_state(top.table_or_empty("initial"), uvms)
     task = build_task(top.table("task"), uvms, q0)
     contact = build_environment(top.table("environment"), uvms)
+    world = build_world(top.table("world"), uvms, path.parent)
     disturbance = build_disturbance(top.table("disturbance"))
     joints = top.table_or_empty("joints")
+    joint_stops = build_joint_stops(joints, uvms)
     friction = build_joint_friction(joints, uvms)
     actuation = with_joint_lag(joints, build_actuation(top.table("actuation"), uvms), uvms)
     joints.finish()
@@ -133,12 +137,14 @@ def _build(raw: dict[str, Any], path: Path, top: Table) -> Scenario:
         free_surface=water.free_surface,
         stop_at_surface=water.stop_at_surface,
         joint_friction=friction,
+        world=world,
+        joint_stops=joint_stops,
     )
     try:
         settings = SimulationSettings(
             head.duration_s, integrator, log_period, control_period, head.seed
         )
-        check_log_fits(settings, uvms.nq, uvms.nv, plant.n_logged_hulls)
+        check_log_fits(settings, uvms.nq, uvms.nv, plant.n_logged_columns)
     except ParameterError as exc:
         raise ScenarioError(f"{top.source}: {exc}") from exc
     return Scenario(

@@ -316,6 +316,7 @@ class ClosedLoop:
                 if diverged(q, v):
                     raise _diverged(t0, t, None, self._context((t0, t), self._last_tau_applied))
                 self.time_s, self.q, self.v = float(t), read_only(q), read_only(v)
+                plant.settle(self.q, self.v)  # the friction's anchors move at the log times
                 on_log = abs(t - log_times[logged]) < 1e-9
                 # an event stop is not a log time: the controller raises the violation there
                 self._tick(on_log)
@@ -445,7 +446,7 @@ def simulate_closed_loop(
     """
     from uvms_pin.sim.settings import check_log_fits
 
-    check_log_fits(settings, plant.uvms.nq, plant.uvms.nv, plant.n_logged_hulls)
+    check_log_fits(settings, plant.uvms.nq, plant.uvms.nv, plant.n_logged_columns)
     meta = {**(metadata or {}), **run_metadata(plant, settings)}
     if sensors.navigation is not None:
         meta["signal_units"].update(_described(sensors.navigation.signal_columns()))

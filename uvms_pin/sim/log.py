@@ -4,7 +4,10 @@ Rows are preallocated (the run's number of logged samples, or a first guess that
 full, for an episode of unknown length); the energies are computed once, for the rows
 written, when the log is finished (they are functions of the state alone), and so, under a
 free surface, is each hull's wet fraction (the signal ``wet_fraction``, one column per hull
-named in the metadata's ``hull_names``: 1 deep, 0 out of the water).
+named in the metadata's ``hull_names``: 1 deep, 0 out of the water). With a world, each
+sample also logs the contact of every (body, object) pair (the signal ``world_contact``,
+9 columns per pair named in the metadata's ``world_contact_pairs``: the force on the body
+[N] (3), its point [m] (3) and the moment about that point [N m] (3), world axes).
 """
 
 from __future__ import annotations
@@ -43,6 +46,9 @@ class RolloutLog:
         self.plant = plant if plant is not None and plant.free_surface else None
         if self.plant is not None:
             metadata = {**metadata, "hull_names": hull_names(uvms)}
+        self.world_plant = plant if plant is not None and plant.world is not None else None
+        if self.world_plant is not None:
+            metadata = {**metadata, "world_contact_pairs": plant.world.pair_names}
         self.rollout = Rollout.allocate(max(int(capacity), 1), uvms.nq, uvms.nv, metadata)
         self.count = 0
         self.described: set[str] = set()  # the named signals (`Signal`) already described
@@ -65,6 +71,9 @@ class RolloutLog:
                     self._describe(name, values)
                 values = values.values
             rollout.signal(name, values.size)[k] = values
+        if self.world_plant is not None:
+            wrenches = self.world_plant.world_wrenches(sample.q, sample.v)
+            rollout.signal("world_contact", wrenches.size)[k] = wrenches
         self.count += 1
 
     def _describe(self, name: str, signal: Signal) -> None:
@@ -87,7 +96,7 @@ class RolloutLog:
         """An independent log holding the same samples (the model is shared)."""
         out = RolloutLog.__new__(RolloutLog)
         out.uvms, out.backend, out.count = self.uvms, self.backend, self.count
-        out.plant = self.plant
+        out.plant, out.world_plant = self.plant, self.world_plant
         out.described = set(self.described)
         out.rollout = copy.deepcopy(self.rollout)
         return out

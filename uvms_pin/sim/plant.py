@@ -9,7 +9,9 @@ integrator stage, contact, disturbance, held tau) is one C++ call. The plant's c
 counterpart (`src/uvms_core/plant.hpp`) is built from its flow, contact and disturbance when
 a run starts (`attach`) or on first use; when one of them has no counterpart (e.g. a
 disturbance written in Python) the plant runs on the Python reference and says so once with a
-`CoreFallbackWarning`.
+`CoreFallbackWarning`. A world (`uvms_pin.physics.world`) is Python's: a period in which
+nothing can touch it is one compiled call; one in which something may is integrated in
+Python around the compiled dynamics.
 """
 
 from __future__ import annotations
@@ -30,11 +32,15 @@ from uvms_pin.physics.compiled.contact import contact_to_core
 from uvms_pin.physics.compiled.disturbance import disturbance_to_core
 from uvms_pin.physics.compiled.flow import flow_to_core
 from uvms_pin.physics.compiled.joint_friction import joint_friction_to_core
+from uvms_pin.physics.compiled.joint_stops import joint_stops_to_core
+from uvms_pin.physics.compiled.world import world_bounds_to_core
 from uvms_pin.physics.contact import ContactModel
 from uvms_pin.physics.disturbance import Disturbance
 from uvms_pin.physics.dynamics import dynamics_of, forward_dynamics
 from uvms_pin.physics.joint_friction import JointFriction
+from uvms_pin.physics.joint_stops import JointStops
 from uvms_pin.physics.surface import wet_state
+from uvms_pin.physics.world.world import ContactForces, FrictionMemory, World
 from uvms_pin.sim.actuation import Actuation, Unlimited
 from uvms_pin.sim.integrators import Chart, Integrator
 
@@ -59,6 +65,9 @@ class Plant:
             rises above the surface: for models meant for submerged bodies only.
         joint_friction: viscous and Coulomb friction of the arm's joint drives, a
             generalized force in the dynamics (`uvms_pin.physics.joint_friction`); None: none.
+        world: fixed objects every body's collision geometry touches (the seafloor, rocks,
+            structures; `uvms_pin.physics.world`), or None.
+        joint_stops: compliant stops at the arm joints' limits, or None (no stops).
     """
 
     uvms: UVMS
@@ -71,6 +80,8 @@ class Plant:
     free_surface: bool = True
     stop_at_surface: bool = False
     joint_friction: JointFriction | None = None
+    world: World | None = None
+    joint_stops: JointStops | None = None
 
     def __post_init__(self) -> None:
         self.current_world_m_s = finite_vector("current_world_m_s", self.current_world_m_s, 3)
@@ -87,13 +98,24 @@ class Plant:
             )
         self._backend: Backend = backend_named(self.backend)
         self._ee_data = self.uvms.model.createData()
+        self._world_data = self.uvms.model.createData()
+        self.friction = FrictionMemory()  # the world contacts' state (anchors)
         self.water = self._water()
+        if self.world is not None and self.world.uvms is not self.uvms:
+            raise ParameterError("the plant's world was built for another UVMS")
 
     @property
     def n_logged_hulls(self) -> int:
         """Wet fractions a run of this plant logs per sample (one per hull under a free
         surface, none without)."""
         return len(self.uvms.surface_bodies) if self.free_surface else 0
+
+    @property
+    def n_logged_columns(self) -> int:
+        """Values a run of this plant logs per sample beyond the base arrays: the wet
+        fractions and, with a world, 9 per (body, object) pair (``world_contact``)."""
+        pairs = 0 if self.world is None else len(self.world.pair_names)
+        return self.n_logged_hulls + 9 * pairs
 
     def _water(self) -> FlowField | None:
         """The one flow the bodies see: the uniform current and ``flow`` (None: still water)."""
@@ -113,6 +135,8 @@ class Plant:
             "flow": None if self.water is None else self.water.record(),
             "contact": None if self.contact is None else self.contact.record(),
             "free_surface": bool(self.free_surface),
+            "world": None if self.world is None else self.world.record(),
+            "joint_stops": None if self.joint_stops is None else self.joint_stops.record(),
         }
 
     def check_submerged(self, time_s: float, q: np.ndarray) -> None:
@@ -163,6 +187,7 @@ class Plant:
             flow_to_core(self.water, core),
             contact_to_core(self.contact, core),
             disturbance_to_core(self.disturbance, core),
+            joint_stops_to_core(self.joint_stops, core),
         )
         fallback = next((p for p in parts if isinstance(p, Fallback)), None)
         if fallback is not None:
@@ -171,9 +196,12 @@ class Plant:
         # without one cannot have (checked in __post_init__): frame 0 (the world) stands in
         ee_frame_id = self.uvms.ee_frame_id if self.uvms.has_end_effector else 0
         compiled = core.Plant(dynamics_of(self.uvms).core, ee_frame_id)
-        compiled.flow, compiled.contact, compiled.disturbance = parts
+        compiled.flow, compiled.contact, compiled.disturbance, compiled.joint_stops = parts
         compiled.joint_friction = joint_friction_to_core(self.joint_friction, core)
         compiled.free_surface = bool(self.free_surface)
+        bounds = world_bounds_to_core(self.world, core)
+        if bounds is not None:
+            compiled.world_bounds = bounds
         return compiled
 
     def _core(self):
@@ -196,11 +224,15 @@ class Plant:
         return position, velocity, data
 
     def attach(self, q0: np.ndarray) -> None:
-        """Anchor the environment at the initial end-effector position, and take the current
-        and flow as they are now (the compiled plant is rebuilt from them)."""
+        """Anchor the environment at the initial end-effector position, anchor the friction of
+        every world contact at t = 0 where it is, and take the current and flow as they are
+        now (the compiled plant is rebuilt from them)."""
         if self.contact is not None:
             position, _, _ = self.ee_state(q0, np.zeros(self.uvms.nv))
             self.contact.attach(position)
+        self.friction.clear()
+        # what touches at t = 0 sticks where it is (a body placed on the seafloor stays)
+        self.settle(q0, np.zeros(self.uvms.nv))
         self.water = self._water()
         self.__dict__.pop("_compiled", None)
 
@@ -213,6 +245,51 @@ class Plant:
             return compiled.contact_wrench(q, v)
         position, velocity, _ = self.ee_state(q, v)
         return self.contact.wrench_on_environment_world(position, velocity)
+
+    def world_forces(self, q: np.ndarray, v: np.ndarray) -> ContactForces | None:
+        """The world's contact points and forces at (q, v) (None without a world)."""
+        if self.world is None:
+            return None
+        pin.forwardKinematics(self.uvms.model, self._world_data, q, v)
+        return self.world.forces(self._world_data, self.friction)
+
+    def world_wrenches(self, q: np.ndarray, v: np.ndarray) -> np.ndarray:
+        """Per (body, object) pair, flattened (pairs * 9,): force on the body [N], its point
+        [m], moment about it [N m], world axes (`World.pair_wrenches`); empty without a
+        world."""
+        forces = self.world_forces(q, v)
+        return np.zeros(0) if forces is None else self.world.pair_wrenches(forces).ravel()
+
+    def external_torque(self, q: np.ndarray, v: np.ndarray) -> np.ndarray:
+        """The world's contact forces and the joint stops as generalized forces (nv,)."""
+        out = np.zeros(self.uvms.nv)
+        forces = self.world_forces(q, v)
+        if forces is not None:
+            out += self.world.generalized_force(q, self._world_data, forces)
+        if self.joint_stops is not None:
+            out += self.joint_stops.torque(q, v)
+        return out
+
+    def _world_clear(self, q: np.ndarray, v: np.ndarray, horizon_s: float) -> bool:
+        """No world, or nothing of it within reach over ``horizon_s`` (then no contact
+        persists: the friction forgets its anchors)."""
+        if self.world is None:
+            return True
+        compiled = self._core()
+        if compiled is not None:
+            clear = compiled.world_clear(q, v, horizon_s)
+        else:
+            pin.forwardKinematics(self.uvms.model, self._world_data, q, v)
+            clear = self.world.clear(self._world_data, horizon_s)
+        if clear:
+            self.friction.clear()
+        return clear
+
+    def settle(self, q: np.ndarray, v: np.ndarray) -> None:
+        """After a control period: the friction's anchors move (`World.commit`)."""
+        forces = self.world_forces(q, v)
+        if forces is not None:
+            self.world.commit(forces, self.friction)
 
     def disturbance_wrench(self, time_s: float) -> np.ndarray:
         return (
@@ -230,10 +307,11 @@ class Plant:
         tau: np.ndarray,
         contact_world: np.ndarray | None = None,
     ) -> np.ndarray:
-        """zeta_dot of  M zeta_dot + h + J_c^T lambda + delta = tau + [0; tau_f(v)]
-        (docs/physics.md; tau_f the joint drives' friction)."""
+        """zeta_dot of  M zeta_dot + h + J_c^T lambda + delta = tau + [0; tau_f(v)] + tau_world
+        + tau_stop (docs/physics.md; tau_f the joint drives' friction). With a world the
+        contact is Python's, the dynamics the backend's."""
         compiled = self._core()
-        if compiled is not None:
+        if compiled is not None and self.world is None:
             return compiled.acceleration(time_s, q, v, tau, contact_world)
         model = self.uvms.model
         tau_ext = np.zeros(model.nv)
@@ -249,6 +327,8 @@ class Plant:
         if self.disturbance is not None:
             # the free-flyer's LOCAL Jacobian is [I 0]: a body wrench maps to tau[:6] directly
             tau_ext[:6] -= self.disturbance_wrench(time_s)
+        if self.world is not None or self.joint_stops is not None:
+            tau_ext += self.external_torque(q, v)
         return forward_dynamics(
             self.uvms,
             q,
@@ -286,12 +366,16 @@ class Plant:
         """(q, v) at t1 from (q0, v0) at t0 with the input tau held (zero-order hold).
 
         One compiled call for the whole interval when the integrator has a compiled
-        counterpart (RK4, semi-implicit Euler); the integrator's Python loop otherwise."""
+        counterpart (RK4, semi-implicit Euler) and no world object can be touched in it
+        (`World.clear`: then the world costs one bound test); the integrator's Python loop
+        otherwise, around the compiled dynamics, with the world's contacts."""
         compiled = self._core()
-        if compiled is not None:
+        if compiled is not None and self._world_clear(q0, v0, t1 - t0):
             step = self._compiled_step(integrator)
             if step is not None:
                 return compiled.advance(t0, q0, v0, tau, t1, step)
-        return integrator.advance(
+        q1, v1 = integrator.advance(
             self.uvms.model, lambda t, q, v: self.acceleration(t, q, v, tau), t0, q0, v0, t1
         )
+        self.settle(q1, v1)
+        return q1, v1

@@ -44,7 +44,8 @@ def controller_scenarios(
     # every controller's rollout is kept until the figures are drawn: all of them must fit
     check_memory(
         sum(
-            s.settings.log_bytes(s.uvms.nq, s.uvms.nv, s.plant.n_logged_hulls) for s in out.values()
+            s.settings.log_bytes(s.uvms.nq, s.uvms.nv, s.plant.n_logged_columns)
+            for s in out.values()
         ),
         f"the logs of the {len(out)} runs ({next(iter(out.values())).settings.n_log} samples each)",
         "shorten scenario.duration_s, lengthen output.log_period_s or compare fewer controllers",

@@ -32,6 +32,7 @@ from meshcat.visualizer import ViewerWindow
 
 from uvms_pin.apps.viz.meshcat_scene import EnvironmentView, Frame, SceneStyle, UvmsScene
 from uvms_pin.apps.viz.surface import surface_view_of
+from uvms_pin.apps.viz.world_view import WorldView
 from uvms_pin.errors import LiveServerError, PortInUseError, SimulationError
 from uvms_pin.results.progress import Progress
 from uvms_pin.results.rollout import Rollout
@@ -349,18 +350,21 @@ class LiveView:
 class LiveFeed:
     """An observer of the closed loop pushing every logged sample to a live view."""
 
-    def __init__(self, live: LiveView):
+    def __init__(self, live: LiveView, plant=None):
         self.live = live
+        self.plant = plant if plant is not None and plant.world is not None else None
 
     def on_sample(self, sample: Sample) -> None:
         desired = sample.signals.get("force_desired_world_N")
         desired = getattr(desired, "values", desired)  # an array, or a named `Signal`
+        contacts = None if self.plant is None else self.plant.world_wrenches(sample.q, sample.v)
         self.live.push(
             Frame(
                 sample.time_s,
                 np.array(sample.q),
                 sample.measurement.wrench_world[:3].copy(),
                 None if desired is None else desired.copy(),
+                contacts,
             )
         )
 
@@ -384,6 +388,10 @@ def scene_for_scenario(scenario: Scenario, style: SceneStyle | None = None) -> U
         extent_world_m=extent,
         style=style,
         surface=surface,
+        world=WorldView.from_record(
+            None if scenario.plant.world is None else scenario.plant.world.record(),
+            extent.mean(axis=0),
+        ),
     )
 
 
@@ -392,7 +400,7 @@ def simulate_live(
 ) -> Rollout:
     """`uvms_pin.sim.run.simulate`, with every logged sample pushed to ``live`` (an observer:
     the rollout is the same as without the view)."""
-    return simulate(scenario, progress=progress, observers=[LiveFeed(live)])
+    return simulate(scenario, progress=progress, observers=[LiveFeed(live, scenario.plant)])
 
 
 def run_live(
@@ -440,6 +448,7 @@ def replay_live(
     """Play a saved rollout in a live view at ``speed`` x real time, once a browser is
     connected (it waits for one)."""
     desired = rollout.signals.get("force_desired_world_N")
+    contacts = rollout.signals.get("world_contact")
     with LiveView(scene, port=port, speed=speed, out=out) as live:
         if out is not None:
             print("live view: waiting for a browser to connect (Ctrl-C to stop)", file=out)
@@ -455,6 +464,7 @@ def replay_live(
                     rollout.q[k],
                     rollout.wrench_measured_world[k, :3],
                     None if desired is None else desired[k],
+                    None if contacts is None else contacts[k],
                 )
             )
         _play_to_end(live, out)

@@ -10,8 +10,9 @@ What is drawn (paths under ``/meshcat/uvms_pin``):
 - ``current`` (blue): the water current, above the vehicle, ``current_scale_m_per_m_s`` long
   per m/s (1 m per m/s by default);
 - ``trail``: the end-effector path; ``plumb``: a line from the vehicle down to the sea floor;
-- ``floor``: a sandy sea floor with a 0.5 m grid ``floor_clearance_m`` below the lowest point;
-  a deep-water background gradient.
+- ``floor``: a sandy sea floor with a 0.5 m grid ``floor_clearance_m`` below the lowest point
+  (not drawn when the world has a seafloor of its own); a deep-water background gradient;
+- ``world/*``: the world's objects and contact arrows (`uvms_pin.apps.viz.world_view`).
 
 A scene is static geometry (`UvmsScene.build`) plus, per instant, a pose for each moving
 node (`UvmsScene.poses`): position, quaternion (x, y, z, w) and scale. The live view sends
@@ -34,6 +35,7 @@ import pinocchio as pin
 import umsgpack
 
 from uvms_pin.apps.viz.surface import SurfaceView
+from uvms_pin.apps.viz.world_view import WorldView
 from uvms_pin.errors import VizError
 from uvms_pin.model.uvms import UVMS
 
@@ -59,9 +61,11 @@ class SceneStyle:
         current_scale_m_per_m_s: arrow length per m/s of current [m/(m/s)].
         floor_clearance_m: sea floor this far below the lowest point of the run [m].
         arrow_radius_m: shaft radius of the arrows [m].
+        world_force_scale_m_per_N: arrow length per newton of a world contact force [m/N].
     """
 
     force_scale_m_per_N: float = 0.5
+    world_force_scale_m_per_N: float = 0.02
     current_scale_m_per_m_s: float = 1.0
     floor_clearance_m: float = 1.0
     arrow_radius_m: float = 0.008
@@ -103,6 +107,7 @@ class Frame:
     q: np.ndarray
     force_measured_world_N: np.ndarray | None = None
     force_desired_world_N: np.ndarray | None = None
+    world_contact: np.ndarray | None = None  # a row of the rollout's world_contact signal
 
 
 class RecordingWindow:
@@ -191,9 +196,11 @@ class UvmsScene:
         visual_model: pin.GeometryModel | None = None,
         package_dirs: tuple[str, ...] = (),
         surface: SurfaceView | None = None,
+        world: WorldView | None = None,
     ):
         self.uvms = uvms
         self.surface = surface
+        self.world = world
         self.environment = environment
         self.current_world_m_s = np.asarray(current_world_m_s, dtype=float).reshape(3)
         self.show_forces = environment is not None or show_desired
@@ -241,7 +248,11 @@ class UvmsScene:
             )
         if self.surface is not None:
             parts.append("free surface (translucent blue tiles)")
-        parts.append("tip trail (yellow); sea floor 0.5 m grid")
+        if self.world is not None:
+            scale = self.style.world_force_scale_m_per_N
+            parts.append(f"world contact forces (orange), {scale:g} m per N")
+        floor = self.world is None or not self.world.has_plane
+        parts.append("tip trail (yellow)" + ("; sea floor 0.5 m grid" if floor else ""))
         return "; ".join(parts)
 
     # ---- static geometry ---------------------------------------------------------------
@@ -261,7 +272,10 @@ class UvmsScene:
         root = vis[ROOT]
         root.set_transform(_translation(-self.center_world_m))
         self._build_robot(root)
-        self._build_floor(root)
+        if self.world is None or not self.world.has_plane:
+            self._build_floor(root)
+        if self.world is not None:
+            self.world.build(root["world"], self._build_arrow)
         self._build_environment(root)
         if self.surface is not None:
             self.surface.build(root)
@@ -387,6 +401,13 @@ class UvmsScene:
         out["plumb"] = (base.copy(), np.array([0.0, 0.0, 0.0, 1.0]), np.array([1.0, 1.0, depth]))
         if self.surface is not None:
             out.update(self.surface.poses(frame.time_s))
+        if self.world is not None:
+            scale = self.style.world_force_scale_m_per_N
+            out.update(
+                self.world.arrows(
+                    frame.world_contact, lambda path, tail, f: self._arrow(path, tail, f, scale)
+                )
+            )
         return out
 
     def _arrow(self, path: str, tail, vector, scale: float) -> dict[str, Pose]:

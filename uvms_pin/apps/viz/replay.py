@@ -32,6 +32,7 @@ from uvms_pin.apps.viz.meshcat_scene import (
     recording_visualizer,
 )
 from uvms_pin.apps.viz.surface import surface_view_of
+from uvms_pin.apps.viz.world_view import WorldView
 from uvms_pin.errors import VizError
 from uvms_pin.flow import flow_from_record
 from uvms_pin.model.urdf.load import load_uvms
@@ -85,6 +86,7 @@ def scene_for_rollout(
         extent_world_m=extent,
         style=style,
         surface=surface,
+        world=WorldView.from_record(world.get("world"), extent.mean(axis=0)),
     )
 
 
@@ -133,6 +135,8 @@ def replay_html(
     measured = rollout.wrench_measured_world[good, :3]
     desired = rollout.signals.get("force_desired_world_N")
     desired = desired[good, :3] if desired is not None else None
+    contacts = rollout.signals.get("world_contact")
+    contacts = contacts[good] if contacts is not None else None
     idx, fps = frame_times(time_s, max_fps, max_frames)
     t0 = float(time_s[0])
     keys = (time_s[idx] - t0) * fps  # animation time in frames (meshcat's convention)
@@ -140,7 +144,13 @@ def replay_html(
     anim = meshcat.animation.Animation(default_framerate=fps)
     root = vis[ROOT]
     for key, i in zip(keys, idx, strict=True):
-        frame = Frame(float(time_s[i]), q[i], measured[i], None if desired is None else desired[i])
+        frame = Frame(
+            float(time_s[i]),
+            q[i],
+            measured[i],
+            None if desired is None else desired[i],
+            None if contacts is None else contacts[i],
+        )
         at = anim.at_frame(root, float(key))
         for path, (position, quat, scale) in scene.poses(frame).items():
             node = at[path]

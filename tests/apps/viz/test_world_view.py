@@ -1,0 +1,62 @@
+"""The world as drawn: its objects in the static scene, one arrow per (body, object) pair
+from the pair's contact point along the force, as long as the stated scale."""
+
+from __future__ import annotations
+
+import numpy as np
+import pinocchio as pin
+import pytest
+from viz_support import ROOT
+
+from uvms_pin.apps.viz.meshcat_scene import Frame, SceneStyle, UvmsScene, recording_visualizer
+from uvms_pin.apps.viz.world_view import WorldView
+from uvms_pin.physics.world.objects import plane, solid
+from uvms_pin.physics.world.world import World
+
+ROCK = ROOT / "scenarios" / "meshes" / "rock.obj"
+
+
+@pytest.fixture(scope="module")
+def world(reference_uvms):
+    objects = [
+        plane("seabed", [0, 0, -3], [0.1, 0, 1], 0.6, 0.5),
+        solid("crate", "box", {"size_m": [1, 1, 1]}, [2, 0, -2.5], [0, 0, 0], 0.6, 0.5),
+        solid(
+            "pipe", "cylinder", {"radius_m": 0.2, "length_m": 3}, [0, 2, -2.8], [0, 0, 0], 0.6, 0.5
+        ),
+        solid("rock", "mesh", {"path": ROCK}, [-2, 0, -2.8], [0, 0, 0.3], 0.6, 0.5),
+    ]
+    return World(reference_uvms, objects)
+
+
+def test_the_scene_draws_every_object_and_no_floor_of_its_own(reference_uvms, world):
+    view = WorldView.from_record(world.record(), [0, 0, -2])
+    scene = UvmsScene(reference_uvms, world=view)
+    vis, window = recording_visualizer()
+    scene.build(vis)
+    blob = b"".join(window.commands)
+    for name in (b"seabed", b"crate", b"pipe", b"rock"):
+        assert b"uvms_pin/world/objects/" + name in blob
+    assert b"uvms_pin/world/contacts/pair0" in blob
+    assert b"uvms_pin/floor" not in blob  # the seabed is the floor
+    assert "world contact forces (orange)" in scene.legend()
+
+
+def test_a_pair_arrow_starts_at_its_point_and_is_scale_times_force_long(reference_uvms, world):
+    view = WorldView.from_record(world.record(), [0, 0, -2])
+    style = SceneStyle(world_force_scale_m_per_N=0.02)
+    scene = UvmsScene(reference_uvms, world=view, style=style)
+    contacts = np.zeros((len(world.pair_names), 9))
+    k = 3
+    contacts[k, :3] = [0.0, 30.0, 40.0]  # 50 N
+    contacts[k, 3:6] = [0.5, -0.2, -2.9]
+    poses = scene.poses(Frame(0.0, reference_uvms.neutral_configuration(), None, None, contacts))
+    position, quat, _ = poses[f"world/contacts/pair{k}"]
+    assert np.allclose(position, contacts[k, 3:6])
+    along = pin.Quaternion(np.asarray(quat, dtype=float)).matrix() @ np.array([0.0, 1.0, 0.0])
+    assert np.allclose(along, [0.0, 0.6, 0.8])  # the arrow points along the force
+    shaft = poses[f"world/contacts/pair{k}/shaft"][2][1]
+    head = 4.0 * style.arrow_radius_m
+    assert shaft + head == pytest.approx(0.02 * 50.0)
+    # the other pairs carry no force: their arrows are hidden
+    assert np.all(poses["world/contacts/pair0"][2] < 1e-5)

@@ -1,0 +1,104 @@
+"""Joint stops: compliant, only past a limit, only pushing; the core's equal to the
+reference's."""
+
+from __future__ import annotations
+
+import numpy as np
+import pinocchio as pin
+import pytest
+from conftest import REL, continuous_joint_urdf
+
+import uvms_pin as up
+from uvms_pin.physics.joint_stops import JointStops
+from uvms_pin.sim.integrators import RK4
+from uvms_pin.sim.plant import Plant
+
+
+def _weightless(uvms):
+    """The same UVMS without gravity (no weight, no buoyancy): only the stop holds the arm."""
+    model = pin.Model(uvms.model)
+    model.gravity = pin.Motion.Zero()
+    return uvms.with_model(model)
+
+
+def test_the_stop_torque_is_zero_inside_the_range_and_pushes_back_outside():
+    stops = JointStops(np.array([-1.0, 0.0]), np.array([1.0, np.inf]), 100.0, 2.0)
+    q, v = np.zeros(9), np.zeros(8)
+    q[7:] = [0.5, 3.0]
+    assert not np.any(stops.torque(q, v))
+    q[7:] = [1.1, -0.2]
+    tau = stops.torque(q, v)
+    assert tau[6] == pytest.approx(-100.0 * 0.1) and tau[7] == pytest.approx(100.0 * 0.2)
+    # moving back into the range fast: the damper would pull; the stop does not
+    v[6:] = [-50.0, 50.0]
+    assert np.all(stops.torque(q, v) == 0.0)
+    assert stops.at_stop(q).tolist() == [True, True]
+
+
+@pytest.mark.parametrize("joint", [0, 2])
+def test_a_joint_at_its_effort_limit_stays_within_the_stop_deflection(reference_uvms, joint):
+    uvms = _weightless(reference_uvms)
+    stops = JointStops.of_model(uvms.model, stiffness_Nm_rad=200.0, damping_Nm_s_rad=1.0)
+    effort = float(uvms.model.effortLimit[6 + joint])
+    assert effort > 0.0
+    plant = Plant(uvms, joint_stops=stops, free_surface=False)
+    q = uvms.neutral_configuration()
+    q[:3] = [0.0, 0.0, -5.0]
+    q[7 + joint] = stops.upper_rad[joint]
+    v, tau = np.zeros(uvms.nv), np.zeros(uvms.nv)
+    tau[6 + joint] = effort  # pushing into the stop at the limit of the drive
+    deflection = []
+    for k in range(300):
+        q, v = plant.advance(RK4(1e-3), k * 0.01, q, v, tau, (k + 1) * 0.01)
+        deflection.append(q[7 + joint] - stops.upper_rad[joint])
+    static = effort / stops.stiffness_Nm_rad
+    # a step load from rest against a spring never goes past twice its static deflection
+    assert max(deflection) <= 2.0 * static
+    assert deflection[-1] == pytest.approx(static, rel=0.02)
+    # and without the stop the same push carries the joint far past its limit
+    free = Plant(uvms, free_surface=False)
+    q = uvms.neutral_configuration()
+    q[7 + joint] = stops.upper_rad[joint]
+    q, v = free.advance(RK4(1e-3), 0.0, q, np.zeros(uvms.nv), tau, 1.0)
+    assert q[7 + joint] - stops.upper_rad[joint] > 10 * static
+
+
+def test_the_core_stops_equal_the_reference(reference_uvms):
+    uvms = reference_uvms
+    stops = JointStops.of_model(uvms.model, 300.0, 3.0)
+    core = Plant(uvms, joint_stops=stops, free_surface=False, backend="core")
+    python = Plant(uvms, joint_stops=stops, free_surface=False, backend="python")
+    assert core._core() is not None  # the compiled plant carries the stops
+    rng = np.random.default_rng(5)
+    for _ in range(6):
+        q = uvms.neutral_configuration()
+        q[7:] = rng.uniform(stops.lower_rad - 0.3, stops.upper_rad + 0.3)
+        v, tau = rng.normal(size=uvms.nv), rng.normal(size=uvms.nv)
+        a_core = core.acceleration(0.0, q, v, tau)
+        a_python = python.acceleration(0.0, q, v, tau)
+        assert np.allclose(a_core, a_python, rtol=REL, atol=REL * np.abs(a_python).max())
+    bare = Plant(uvms, free_surface=False)
+    q = uvms.neutral_configuration()
+    v, tau = rng.normal(size=uvms.nv), rng.normal(size=uvms.nv)
+    assert np.array_equal(core.acceleration(0.0, q, v, tau), bare.acceleration(0.0, q, v, tau))
+
+
+def test_a_continuous_joint_has_no_stop_and_the_others_keep_theirs(tmp_path):
+    """arm_joint1 continuous: q holds its cos and sin, so the stops of joints 2-4 sit at
+    shifted coordinates; core and reference agree, and only those joints are pushed."""
+
+    uvms = up.load_uvms(continuous_joint_urdf(tmp_path, ("arm_joint1",)))
+    stops = JointStops.of_model(uvms.model, 300.0, 3.0)
+    assert stops.names == ("arm_joint2", "arm_joint3", "arm_joint4")
+    assert stops.q_index.tolist() == [9, 10, 11] and stops.v_index.tolist() == [7, 8, 9]
+    core = Plant(uvms, joint_stops=stops, free_surface=False, backend="core")
+    python = Plant(uvms, joint_stops=stops, free_surface=False, backend="python")
+    assert core._core() is not None
+    q = uvms.neutral_configuration()
+    q[stops.q_index] = stops.upper_rad + 0.1  # every stopped joint 0.1 rad past its limit
+    v, tau = np.zeros(uvms.nv), np.zeros(uvms.nv)
+    torque = stops.torque(q, v)
+    assert torque[6] == 0.0 and np.allclose(torque[7:], -30.0)
+    a_core = core.acceleration(0.0, q, v, tau)
+    a_python = python.acceleration(0.0, q, v, tau)
+    assert np.allclose(a_core, a_python, rtol=REL, atol=REL * np.abs(a_python).max())

@@ -1,0 +1,95 @@
+"""[world] and [joints] in scenario files: what they build, and clear errors."""
+
+from __future__ import annotations
+
+import re
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from uvms_pin.errors import ScenarioError
+from uvms_pin.scenario.load import load_scenario, scenario_from_raw
+from uvms_pin.scenario.toml import read_toml
+
+SCENARIOS = Path(__file__).resolve().parents[2] / "scenarios"
+SEABED = SCENARIOS / "seabed_landing.toml"
+
+
+def _load(**overrides):
+    return load_scenario(SEABED, overrides)
+
+
+def test_the_seabed_scenario_builds_a_slope_and_a_rock():
+    plant = _load().plant
+    seabed, rock = plant.world.objects
+    assert seabed.kind == "plane" and rock.kind == "mesh"
+    assert np.degrees(np.arccos(seabed.normal_world[2])) == pytest.approx(8.0, abs=1e-3)
+    assert (seabed.friction_static, seabed.friction_kinetic) == (0.7, 0.5)
+    assert plant.joint_stops is not None  # on by default
+    assert len(plant.world.pair_names) == 2 * len(plant.world.body_names)
+
+
+def test_joint_stops_turn_off_and_take_their_parameters():
+    assert _load(**{"joints.hard_stops": False}).plant.joint_stops is None
+    stops = _load(**{"joints.stop_stiffness_Nm_rad": 300.0}).plant.joint_stops
+    assert stops.stiffness_Nm_rad == 300.0
+
+
+def _with_object(k: int, **changes):
+    """The seabed scenario with object k's keys changed (None: removed)."""
+    raw = read_toml(SEABED, ScenarioError)
+    entry = raw["world"]["objects"][k]
+    for key, value in changes.items():
+        if value is None:
+            entry.pop(key)
+        else:
+            entry[key] = value
+    return scenario_from_raw(raw, SEABED)
+
+
+@pytest.mark.parametrize(
+    ("k", "changes", "message"),
+    [
+        (1, {"type": "cone"}, r"world\.objects\[1\]\.type.*must be one of"),
+        (0, {"normal_world": [0, 0, 0]}, r"normal_world must be non-zero"),
+        (0, {"point_world_m": None}, r"world\.objects\[0\]\.point_world_m.*required"),
+        (1, {"path": "nowhere.obj"}, r"world\.objects\[1\]\.path.*no mesh file"),
+        (0, {"friction_kinetic": 0.9}, r"friction_static >= friction_kinetic"),
+        (1, {"fixed": False}, r"free objects are not simulated yet"),
+        (1, {"name": "seabed"}, r"distinct names"),
+        (1, {"radius_m": 1.0}, r"unknown key.*radius_m"),
+        (1, {"scale": [1, 0, 1]}, r"must be > 0|scale"),
+    ],
+)
+def test_bad_objects_are_refused_naming_the_key(k, changes, message):
+    with pytest.raises(ScenarioError, match=message):
+        _with_object(k, **changes)
+
+
+@pytest.mark.parametrize(
+    ("overrides", "message"),
+    [
+        ({"world.contact.stiffness_N_m": 0.0}, r"stiffness_N_m must be > 0"),
+        ({"world.contact.friction_kinetic": 0.9}, r"friction_static >= friction_kinetic"),
+        ({"world.contact.stifness_N_m": 1.0}, r"unknown key"),
+        ({"joints.stop_stiffness_Nm_rad": -1.0}, r"joints\.stop_stiffness_Nm_rad.*positive"),
+        ({"joints.hard_stops": "yes"}, r"joints\.hard_stops.*true or false"),
+    ],
+)
+def test_bad_contact_and_joint_tables_are_refused_naming_the_key(overrides, message):
+    with pytest.raises(ScenarioError, match=message):
+        _load(**overrides)
+
+
+def test_every_object_type_is_built(tmp_path):
+    objects = [
+        {"type": "box", "size_m": [1, 2, 3], "position_world_m": [5, 0, 0]},
+        {"type": "sphere", "radius_m": 0.5, "position_world_m": [0, 5, 0]},
+        {"type": "cylinder", "radius_m": 0.5, "length_m": 2.0, "position_world_m": [0, -5, 0]},
+    ]
+    world = _load(**{"world.objects": objects}).plant.world
+    assert [o.kind for o in world.objects] == ["box", "sphere", "cylinder"]
+    assert [o.name for o in world.objects] == ["box0", "sphere1", "cylinder2"]
+    record = world.record()
+    assert re.search("crate|box0", str(record["objects"]))

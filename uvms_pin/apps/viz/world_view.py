@@ -1,0 +1,114 @@
+"""The world's objects and contact forces as drawn (`uvms_pin.physics.world`).
+
+Paths under the scene root: ``world/objects/<name>`` (the seafloor a sandy slab, solids
+grey-brown, meshes as their file's triangles) and ``world/contacts/pair<k>`` (orange arrows, one
+per (body, object) pair, at the pair's contact point along the force on the body,
+``SceneStyle.world_force_scale_m_per_N`` long per newton). A node's name is never a bare
+number: three.js's animation tracks would read it as an index, and the arrow not move.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass
+from typing import Any
+
+import meshcat
+import meshcat.geometry as mg
+import numpy as np
+
+__all__ = ["WorldView"]
+
+_SAND, _ROCK, _ARROW = 0x8A7A55, 0x807060, 0xFF9020
+_PLANE_HALF_M = 6.0  # half the side of the drawn patch of an (infinite) plane
+
+
+def _matrix(rotation, translation) -> np.ndarray:
+    out = np.eye(4)
+    out[:3, :3] = np.asarray(rotation, dtype=float)
+    out[:3, 3] = np.asarray(translation, dtype=float)
+    return out
+
+
+def _phong(color: int, opacity: float = 1.0) -> mg.MeshPhongMaterial:
+    return mg.MeshPhongMaterial(color=color, opacity=opacity, transparent=opacity < 1.0)
+
+
+@dataclass(frozen=True)
+class WorldView:
+    """What a world record (`World.record`) draws.
+
+    Attributes:
+        objects: each object's record. pairs: ``body|object`` of each logged pair.
+        center_world_m: where the scene is (a plane is drawn as a patch around it).
+    """
+
+    objects: tuple[dict[str, Any], ...]
+    pairs: tuple[str, ...]
+    center_world_m: np.ndarray
+
+    @classmethod
+    def from_record(cls, record: dict | None, center_world_m) -> WorldView | None:
+        if not record or not record.get("objects"):
+            return None
+        return cls(
+            tuple(record["objects"]),
+            tuple(record.get("pairs", ())),
+            np.asarray(center_world_m, dtype=float).reshape(3),
+        )
+
+    @property
+    def has_plane(self) -> bool:
+        return any(o["type"] == "plane" for o in self.objects)
+
+    def build(self, node: meshcat.Visualizer, build_arrow: Callable) -> None:
+        """Draw the objects under ``node`` and an arrow per pair (``build_arrow(node,
+        color)``)."""
+        for obj in self.objects:
+            self._build_object(node[f"objects/{obj['name']}"], obj)
+        for k in range(len(self.pairs)):
+            build_arrow(node[f"contacts/pair{k}"], _ARROW)
+
+    def _build_object(self, node: meshcat.Visualizer, obj: dict[str, Any]) -> None:
+        rotation = np.asarray(obj["rotation_world"], dtype=float)
+        position = np.asarray(obj["position_world_m"], dtype=float)
+        kind = obj["type"]
+        if kind == "plane":
+            # the patch of the plane nearest the scene's centre, its top face on the plane
+            normal = rotation[:, 2]
+            foot = self.center_world_m - ((self.center_world_m - position) @ normal) * normal
+            side = 2.0 * _PLANE_HALF_M
+            node.set_object(mg.Box([side, side, 0.04]), _phong(_SAND, 0.9))
+            node.set_transform(_matrix(rotation, foot - 0.02 * normal))
+            return
+        node.set_object(_geometry(obj), _phong(_ROCK))
+        turn = np.eye(3)
+        if kind == "cylinder":  # meshcat's cylinder lies along y, the object's along z
+            turn = np.array([[1.0, 0.0, 0.0], [0.0, 0.0, -1.0], [0.0, 1.0, 0.0]])
+        node.set_transform(_matrix(rotation @ turn, position))
+
+    def arrows(self, contacts: np.ndarray | None, arrow: Callable) -> dict[str, Any]:
+        """Poses of the pairs' arrows for one logged row of the ``world_contact`` signal
+        (pairs * 9: force [N], point [m], moment): ``arrow(path, tail, vector)``."""
+        out: dict[str, Any] = {}
+        rows = None if contacts is None else np.asarray(contacts, dtype=float).reshape(-1, 9)
+        for k in range(len(self.pairs)):
+            force = None if rows is None else rows[k, :3]
+            tail = np.zeros(3) if rows is None else rows[k, 3:6]
+            out.update(arrow(f"world/contacts/pair{k}", tail, force))
+        return out
+
+
+def _geometry(obj: dict[str, Any]):
+    kind = obj["type"]
+    if kind == "box":
+        return mg.Box(obj["size_m"])
+    if kind == "sphere":
+        return mg.Sphere(obj["radius_m"])
+    if kind == "cylinder":
+        return mg.Cylinder(obj["length_m"], obj["radius_m"])
+    import trimesh  # only meshes need it
+
+    mesh = trimesh.load(obj["path"], force="mesh")
+    vertices = np.asarray(mesh.vertices, dtype=float) * np.asarray(obj["scale"], dtype=float)
+    return mg.TriangularMeshGeometry(vertices, np.asarray(mesh.faces))

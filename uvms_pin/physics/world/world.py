@@ -1,0 +1,189 @@
+"""The world a UVMS touches: fixed objects, the contact law, and the forces at one state.
+
+At a state (q, zeta) each contact point i (`uvms_pin.physics.world.touch`) gets
+
+    f_i = f_n,i n_i + f_t,i        on the robot, at x_i, world axes      [N]
+
+(`uvms_pin.physics.world.contact_law`), and the bodies receive the generalized force
+
+    tau_world = sum_i J_i(q)^T f_i,
+
+J_i the linear Jacobian of the material point at x_i (the joint's world-aligned Jacobian
+moved to x_i). The objects are fixed: their reaction goes to the ground.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+import pinocchio as pin
+
+from uvms_pin.errors import ParameterError
+from uvms_pin.model.uvms import UVMS
+from uvms_pin.physics.world.contact_law import ContactLaw, friction_force_N, normal_force_N
+from uvms_pin.physics.world.objects import WorldObject
+from uvms_pin.physics.world.robot_geometry import RobotPiece, robot_pieces
+from uvms_pin.physics.world.touch import Bounds, Touch, clear_of, cross, touch
+
+__all__ = ["ContactForces", "FrictionMemory", "World"]
+
+Key = tuple[int, int, int]
+
+
+@dataclass
+class FrictionMemory:
+    """The friction's state, kept between control periods (`World.commit`): where each
+    contact point (piece, object, corner) stuck (its anchor, world [m]), and the patches
+    (piece * n_objects + object) slipping (they slip on above mu_k; a sticking one breaks
+    away at mu_s: the static-kinetic hysteresis of Coulomb friction)."""
+
+    anchors: dict[Key, np.ndarray] = field(default_factory=dict)
+    slipping: set[int] = field(default_factory=set)
+
+    def clear(self) -> None:
+        self.anchors.clear()
+        self.slipping.clear()
+
+
+@dataclass(frozen=True)
+class ContactForces:
+    """The contact points at one state and the force on the robot at each.
+
+    Attributes:
+        touch: the points. force_world_N: f_i (m, 3). normal_N: f_n,i (m,).
+        sticking: each point within its static cone (m,).
+    """
+
+    touch: Touch
+    force_world_N: np.ndarray
+    normal_N: np.ndarray
+    sticking: np.ndarray
+
+
+@dataclass
+class World:
+    """Fixed objects and the contact law, for one UVMS.
+
+    Attributes:
+        uvms: the model whose bodies touch. objects: the fixed objects.
+        law: stiffness, dissipation, friction regularization (and default coefficients).
+    """
+
+    uvms: UVMS
+    objects: Sequence[WorldObject]
+    law: ContactLaw = field(default_factory=ContactLaw)
+
+    def __post_init__(self) -> None:
+        self.objects = tuple(self.objects)
+        bodies = self.uvms.surface_bodies
+        self.body_names = [self.uvms.hydro_bodies[int(k)].name for k in bodies.body_index]
+        self.pieces: tuple[RobotPiece, ...] = robot_pieces(self.uvms, self.body_names)
+        names = [o.name for o in self.objects]
+        if len(set(names)) != len(names):
+            raise ParameterError(f"world objects need distinct names, got {names}")
+        self.bounds = Bounds.of(self.objects)
+        self._mu = np.array(
+            [[o.friction_static, o.friction_kinetic] for o in self.objects], dtype=float
+        ).reshape(-1, 2)
+
+    # ---- names ----------------------------------------------------------------------
+    @property
+    def pair_names(self) -> list[str]:
+        """``body|object`` for every pair (body-major): the logged wrenches' order."""
+        return [f"{b}|{o.name}" for b in self.body_names for o in self.objects]
+
+    def record(self) -> dict[str, Any]:
+        return {
+            "objects": [o.record() for o in self.objects],
+            "contact": self.law.record(),
+            "pairs": self.pair_names,
+        }
+
+    def clear(self, data: pin.Data, horizon_s: float) -> bool:
+        """Nothing can touch within ``horizon_s`` (`uvms_pin.physics.world.touch.clear_of`),
+        after ``pin.forwardKinematics(model, data, q, v)``."""
+        return clear_of(data, self.pieces, self.bounds, horizon_s)
+
+    # ---- forces ---------------------------------------------------------------------
+    def forces(self, data: pin.Data, memory: FrictionMemory) -> ContactForces:
+        """The force at each contact point after ``pin.forwardKinematics(model, data, q,
+        v)``, with the anchors of ``memory`` (read only)."""
+        found = touch(data, self.pieces, self.objects, self.bounds)
+        normal = found.normal_world
+        velocity = found.velocity_world_m_s
+        rate = -np.einsum("ij,ij->i", velocity, normal)
+        f_n = normal_force_N(self.law, found.depth_m, rate)
+        keys = found.keys()
+        anchors = np.array(
+            [memory.anchors.get(k, x) for k, x in zip(keys, found.point_world_m, strict=True)]
+        ).reshape(-1, 3)
+        stretch = found.point_world_m - anchors
+        stretch -= normal * np.einsum("ij,ij->i", stretch, normal)[:, None]
+        v_t = velocity + normal * rate[:, None]
+        mu = self._mu[found.obj]
+        patch = found.piece * len(self.objects) + found.obj
+        slipping = np.array([int(g) in memory.slipping for g in patch], dtype=bool)
+        limit = np.where(slipping, mu[:, 1], mu[:, 0])
+        f_t, stick = friction_force_N(self.law, f_n, stretch, v_t, patch, limit, mu[:, 1])
+        return ContactForces(found, f_n[:, None] * normal + f_t, f_n, stick)
+
+    def generalized_force(self, q: np.ndarray, data: pin.Data, forces: ContactForces) -> np.ndarray:
+        """tau_world = sum_i J_i^T f_i (nv,) [N, N m]; ``data`` after forward kinematics."""
+        model = self.uvms.model
+        out = np.zeros(model.nv)
+        if len(forces.touch) == 0:
+            return out
+        pin.computeJointJacobians(model, data, q)
+        joints = np.array([self.pieces[p].joint_id for p in forces.touch.piece])
+        for j in np.unique(joints):
+            mine = joints == j
+            f = forces.force_world_N[mine]
+            arm = forces.touch.point_world_m[mine] - data.oMi[int(j)].translation
+            wrench = np.concatenate([f.sum(axis=0), cross(arm, f).sum(axis=0)])
+            jac = pin.getJointJacobian(model, data, int(j), pin.LOCAL_WORLD_ALIGNED)
+            out += jac.T @ wrench
+        return out
+
+    def commit(self, forces: ContactForces, memory: FrictionMemory) -> None:
+        """After a control period: a sticking point keeps its anchor (a new one anchors
+        where it is), a slipping one moves its anchor to where the spring gives its
+        share of the kinetic force (a = x + f_t / k_t) and its patch is marked slipping; a
+        point no longer touching is forgotten."""
+        found, law = forces.touch, self.law
+        normal = found.normal_world
+        f_t = forces.force_world_N - forces.normal_N[:, None] * normal
+        kept, slipping = {}, set()
+        patch = found.piece * len(self.objects) + found.obj
+        for k, key in enumerate(found.keys()):
+            x = found.point_world_m[k]
+            if forces.sticking[k]:
+                kept[key] = memory.anchors.get(key, x)
+            else:
+                kept[key] = x + f_t[k] / law.tangential_stiffness_N_m
+                slipping.add(int(patch[k]))
+        memory.anchors, memory.slipping = kept, slipping
+
+    def pair_wrenches(self, forces: ContactForces) -> np.ndarray:
+        """Per pair (body, object), body-major: the resultant force on the body [N] (3),
+        its point [m] (3, the normal-force-weighted mean of the contact points; zeros
+        without contact) and the moment about that point [N m] (3), world axes: (pairs, 9)."""
+        n_obj = len(self.objects)
+        out = np.zeros((len(self.body_names) * n_obj, 9))
+        found = forces.touch
+        if len(found) == 0:
+            return out
+        bodies = np.array([self.pieces[p].body for p in found.piece])
+        pair = bodies * n_obj + found.obj
+        for k in np.unique(pair):
+            mine = pair == k
+            f, x = forces.force_world_N[mine], found.point_world_m[mine]
+            weight = forces.normal_N[mine]
+            total = float(weight.sum())
+            center = (weight @ x) / total if total > 0.0 else x.mean(axis=0)
+            out[k, :3] = f.sum(axis=0)
+            out[k, 3:6] = center
+            out[k, 6:] = cross(x - center, f).sum(axis=0)
+        return out
