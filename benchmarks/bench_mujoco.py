@@ -137,6 +137,8 @@ def ee_position(uvms: up.UVMS, q: np.ndarray) -> np.ndarray:
 
 def build_system(name: str, uvms: up.UVMS, urdf_text: str, q0: np.ndarray) -> System:
     """The MuJoCo twin of ``uvms`` with the spring anchored at the end-effector at q0."""
+    q0 = q0.copy()
+    q0[2] = -3.0  # deep: the free surface (on by default) cuts no body; the twin has none
     anchor = ee_position(uvms, q0)
     options = MjcfOptions(
         timestep_s=STEP_S,
