@@ -84,7 +84,8 @@ def test_the_comparison_overwrite_removes_its_models_directory_once_empty(tmp_pa
 def test_run_outputs_are_exactly_the_files_a_run_writes(tmp_path):
     """RUN lists the outputs by name: a new figure must be added there (or --overwrite
     would leave it stale). The sea-state scenario writes every figure but one (flow.png
-    too); the surfacing scenario started at the waterline writes surface.png."""
+    too); the surfacing scenario started at the waterline writes surface.png; a tracking
+    task writes tracking.png."""
     from uvms_pin.apps.outputs import write_outputs
     from uvms_pin.scenario.load import load_scenario
     from uvms_pin.sim.run import simulate
@@ -104,8 +105,14 @@ def test_run_outputs_are_exactly_the_files_a_run_writes(tmp_path):
     )
     figures = write_outputs(simulate(at_the_surface), out / "surfacing")
     assert "surface.png" in {p.name for p in figures}
+    tracking = load_scenario(
+        ROOT / "scenarios" / "lbv150_ee_circle.toml", {"scenario.duration_s": 0.1}
+    )
+    figures = write_outputs(simulate(tracking, progress=False), out / "tracking")
+    assert "tracking.png" in {p.name for p in figures}
     written = {p.name for p in out.iterdir() if p.is_file()}
-    written |= {p.name for p in (out / "surfacing").iterdir()}
+    for sub in ("surfacing", "tracking"):
+        written |= {p.name for p in (out / sub).iterdir()}
     assert written | {"replay.html"} == set(RUN.patterns)  # replay.html: with --html
 
 

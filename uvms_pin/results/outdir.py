@@ -66,6 +66,7 @@ RUN = OutputKind(
         "second_level_errors.png",
         "flow.png",  # runs with waves or a varying current
         "surface.png",  # runs in which a body left the water in part
+        "tracking.png",  # runs with a tracking task ([task])
     ),
     ("rollout.npz", "rollout.json", "metrics.json", "replay.html"),
 )
