@@ -16,7 +16,7 @@ import numpy as np
 
 from uvms_pin.errors import ParameterError
 
-__all__ = ["Signal", "unit_suffix"]
+__all__ = ["Signal", "described", "unit_suffix"]
 
 _COMPONENT = re.compile(r"^[A-Za-z_][\w]*$")
 
@@ -61,7 +61,13 @@ class Signal:
 
     def describe(self) -> dict[str, list[str]]:
         """What the rollout's metadata keeps of it: component names and units."""
-        return {"components": list(self.components), "units": list(self.units)}
+        return described(self.components, self.units)
+
+
+def described(components: Sequence[str], units: Sequence[str]) -> dict[str, list[str]]:
+    """A signal's entry in the rollout's ``signal_units`` metadata: its columns' component
+    names and units (a `Signal`'s, or a thruster's or sensor's columns)."""
+    return {"components": list(components), "units": list(units)}
 
 
 def unit_suffix(unit: str) -> str:

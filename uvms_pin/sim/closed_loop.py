@@ -35,6 +35,7 @@ from uvms_pin.errors import (
     SimulationError,
 )
 from uvms_pin.results.rollout import Rollout
+from uvms_pin.results.signal import described
 from uvms_pin.results.status import ERROR, INTERRUPTED, OK, RunStatus, Violation
 from uvms_pin.sim.divergence import NUMERICAL_FAILURES, diverged, divergence_context
 from uvms_pin.sim.integrators import Adaptive
@@ -423,7 +424,7 @@ def _described(columns: dict[str, list[tuple[str, str]]]) -> dict[str, dict[str,
     """Producers' (component, unit) columns per signal in the rollout's ``signal_units``
     record, the one a controller's `Signal` is described by (`uvms_pin.sim.log`)."""
     return {
-        name: {"components": [c for c, _ in cols], "units": [u for _, u in cols]}
+        name: described([c for c, _ in cols], [u for _, u in cols])
         for name, cols in columns.items()
     }
 
