@@ -7,6 +7,9 @@ Past a limit by e = q - q_max > 0 (or e = q_min - q > 0) a joint gets the torque
 a spring-damper that, like the contact's normal force, never pulls the joint back into its
 range faster than the spring alone would (the max(0, .)): it acts only past the limit and
 only pushes. Held by an effort tau, a joint rests at e = tau / k_s past its limit.
+The spring stores U_stop = 1/2 k_s e^2 [J] (`JointStops.energy_J`): a part of the potential
+energy, so that an undamped stop conserves kinetic + potential energy (the damper and the
+max(0, .) only take energy out).
 Joints with an infinite limit (continuous) have no stop there.
 """
 
@@ -84,6 +87,13 @@ class JointStops:
         push_up = np.where(under > 0.0, np.maximum(0.0, k * under - c * rates), 0.0)
         out[self.v_index] = push_up - push_down
         return out
+
+    def energy_J(self, q: np.ndarray) -> float:
+        """U_stop = sum 1/2 k_s e^2 [J] over the joints past a limit at q (nq,): the
+        potential whose negative gradient is the spring part of `torque`."""
+        joints = np.asarray(q)[self.q_index]
+        over = np.maximum(joints - self.upper_rad, 0.0) + np.maximum(self.lower_rad - joints, 0.0)
+        return float(0.5 * self.stiffness_Nm_rad * over @ over)
 
     def at_stop(self, q: np.ndarray) -> np.ndarray:
         """Which joints are past a limit (n,) bool, at q (nq,) or a trajectory (T, nq)."""

@@ -1,5 +1,6 @@
-"""``[world]``: fixed objects (``[[world.objects]]``) every body touches, and the contact
-law's parameters (``[world.contact]``); ``[joints]``: the joint stops."""
+"""``[world]``: objects (``[[world.objects]]``: fixed, or free with a ``mass_kg`` or
+``density_kg_m3``) every body touches, and the contact law's parameters
+(``[world.contact]``, with ``self_collision``); ``[joints]``: the joint stops."""
 
 from __future__ import annotations
 
@@ -10,6 +11,7 @@ from uvms_pin.errors import ParameterError
 from uvms_pin.model.uvms import UVMS
 from uvms_pin.physics.joint_stops import JointStops
 from uvms_pin.physics.world.contact_law import ContactLaw
+from uvms_pin.physics.world.free_object import FreeObject, free_object
 from uvms_pin.physics.world.objects import WorldObject, plane, solid
 from uvms_pin.physics.world.world import World
 from uvms_pin.scenario.schema import Table
@@ -21,13 +23,17 @@ def build_world(t: Table | None, uvms: UVMS, base_dir: Path) -> World | None:
     """The world of [world] (its objects and contact law), None without objects."""
     if t is None:
         return None
-    law = _law(t.table_or_empty("contact"))
-    objects = [_object(o, k, law, base_dir) for k, o in enumerate(t.tables("objects"))]
+    contact = t.table_or_empty("contact")
+    self_collision = contact.boolean("self_collision", False)
+    law = _law(contact)
+    built = [_object(o, k, law, base_dir, uvms) for k, o in enumerate(t.tables("objects"))]
     t.finish()
-    if not objects:
+    fixed = [o for o in built if isinstance(o, WorldObject)]
+    free = [o for o in built if isinstance(o, FreeObject)]
+    if not built and not self_collision:
         return None
     try:
-        return World(uvms, objects, law)
+        return World(uvms, fixed, law, free, self_collision)
     except ParameterError as exc:
         raise t.fail(str(exc)) from exc
 
@@ -47,19 +53,52 @@ def _law(t: Table) -> ContactLaw:
     return law
 
 
-def _object(t: Table, index: int, law: ContactLaw, base_dir: Path) -> WorldObject:
+def _object(
+    t: Table, index: int, law: ContactLaw, base_dir: Path, uvms: UVMS
+) -> WorldObject | FreeObject:
     kind = t.string("type", choices=tuple(OBJECTS))
     name = t.string("name", f"{kind}{index}")
-    if not t.boolean("fixed", True):
-        raise t.error("fixed", "free objects are not simulated yet: only fixed objects (true)")
+    mass = t.number("mass_kg", None, positive=True) if t.has("mass_kg") else None
+    density = t.number("density_kg_m3", None, positive=True) if t.has("density_kg_m3") else None
+    free = mass is not None or density is not None
+    fixed = t.boolean("fixed", not free)
+    if fixed == free:
+        raise t.error(
+            "fixed",
+            "an object with a mass_kg or density_kg_m3 is free (fixed = false)"
+            if free
+            else "a free object (fixed = false) needs mass_kg or density_kg_m3",
+        )
+    if free and kind == "plane":
+        raise t.error("type", "a plane cannot be free (it has no mass)")
+    if mass is not None and density is not None:
+        raise t.error("mass_kg", "give mass_kg or density_kg_m3, not both")
     mu_s = t.number("friction_static", law.friction_static, nonneg=True)
     mu_k = t.number("friction_kinetic", min(law.friction_kinetic, mu_s), nonneg=True)
     try:
-        out = OBJECTS[kind](t, name, mu_s, mu_k, base_dir)
+        if free:
+            out = _free(t, name, kind, (mu_s, mu_k), base_dir, uvms, mass, density)
+        else:
+            out = OBJECTS[kind](t, name, mu_s, mu_k, base_dir)
     except ParameterError as exc:
         raise t.fail(str(exc)) from exc
     t.finish()
     return out
+
+
+def _free(t: Table, name: str, kind: str, mu, base_dir: Path, uvms: UVMS, mass, density):
+    """A free object of [[world.objects]] (`free_object`)."""
+    pose = (t.vector("position_world_m", 3), t.vector("rpy_rad", 3, [0.0, 0.0, 0.0]))
+    return free_object(
+        name,
+        kind,
+        SIZES[kind](t, base_dir),
+        pose,
+        mass_kg=mass,
+        density_kg_m3=density,
+        water_density_kg_m3=uvms.water_density_kg_m3,
+        friction=mu,
+    )
 
 
 def _plane(t: Table, name: str, mu_s: float, mu_k: float, base_dir: Path) -> WorldObject:
@@ -85,19 +124,21 @@ def _mesh_sizes(t: Table, base_dir: Path) -> dict:
     return {"path": path, "scale": t.vector("scale", 3, [1.0, 1.0, 1.0]).tolist()}
 
 
-#: [[world.objects]] type -> how the object is built from its table
+#: a solid's type -> its sizes read from its table
+SIZES: dict[str, Callable[[Table, Path], dict]] = {
+    "box": lambda t, _: {"size_m": t.vector("size_m", 3)},
+    "sphere": lambda t, _: {"radius_m": t.number("radius_m", positive=True)},
+    "cylinder": lambda t, _: {
+        "radius_m": t.number("radius_m", positive=True),
+        "length_m": t.number("length_m", positive=True),
+    },
+    "mesh": _mesh_sizes,
+}
+
+#: [[world.objects]] type -> how the (fixed) object is built from its table
 OBJECTS: dict[str, Callable[..., WorldObject]] = {
     "plane": _plane,
-    "box": _solid("box", lambda t, _: {"size_m": t.vector("size_m", 3)}),
-    "sphere": _solid("sphere", lambda t, _: {"radius_m": t.number("radius_m", positive=True)}),
-    "cylinder": _solid(
-        "cylinder",
-        lambda t, _: {
-            "radius_m": t.number("radius_m", positive=True),
-            "length_m": t.number("length_m", positive=True),
-        },
-    ),
-    "mesh": _solid("mesh", _mesh_sizes),
+    **{kind: _solid(kind, sizes) for kind, sizes in SIZES.items()},
 }
 
 

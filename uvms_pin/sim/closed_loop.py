@@ -97,6 +97,12 @@ class ClosedLoop:
         if not (np.all(np.isfinite(q0)) and np.all(np.isfinite(v0))):
             raise ParameterError("initial state has a non-finite value")
         q0[3:7] /= np.linalg.norm(q0[3:7])
+        bodies = self.plant.free_bodies
+        if bodies is not None and bodies.objects and self.settings.control_period_s is None:
+            raise ParameterError(
+                "free objects are integrated with the UVMS period by period: they need a "
+                "sampled controller ([control] period_s), not a continuous one"
+            )
         self.time_s, self.q, self.v = 0.0, read_only(q0), read_only(v0)
         self.sensors = sensors
         self.plant.actuation.start(self.settings.control_period_s)

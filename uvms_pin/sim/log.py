@@ -4,10 +4,15 @@ Rows are preallocated (the run's number of logged samples, or a first guess that
 full, for an episode of unknown length); the energies are computed once, for the rows
 written, when the log is finished (they are functions of the state alone), and so, under a
 free surface, is each hull's wet fraction (the signal ``wet_fraction``, one column per hull
-named in the metadata's ``hull_names``: 1 deep, 0 out of the water). With a world, each
+named in the metadata's ``hull_names``: 1 deep, 0 out of the water); the potential energy
+includes the joint stops' springs (`JointStops.energy_J`). With a world, each
 sample also logs the contact of every (body, object) pair (the signal ``world_contact``,
 9 columns per pair named in the metadata's ``world_contact_pairs``: the force on the body
-[N] (3), its point [m] (3) and the moment about that point [N m] (3), world axes).
+[N] (3), its point [m] (3) and the moment about that point [N m] (3), world axes; the
+UVMS against free objects and its own vehicle included). With free objects, the signal
+``free_objects`` holds each object's pose and body velocity (names and units in
+``signal_units``) and ``free_object_contact`` their own pairs' wrenches (the same 9
+columns, pairs named in ``free_object_contact_pairs``).
 """
 
 from __future__ import annotations
@@ -18,7 +23,7 @@ from typing import Any
 from uvms_pin.model.uvms import UVMS
 from uvms_pin.physics.dynamics import kinetic_energy, potential_energy
 from uvms_pin.results.rollout import Rollout
-from uvms_pin.results.signal import Signal
+from uvms_pin.results.signal import Signal, described
 from uvms_pin.sim.plant import Plant
 from uvms_pin.sim.sample import Sample
 
@@ -47,8 +52,23 @@ class RolloutLog:
         if self.plant is not None:
             metadata = {**metadata, "hull_names": hull_names(uvms)}
         self.world_plant = plant if plant is not None and plant.world is not None else None
+        # the joint stops' springs hold energy: a part of the potential energy logged
+        self.stops = None if plant is None else plant.joint_stops
         if self.world_plant is not None:
-            metadata = {**metadata, "world_contact_pairs": plant.world.pair_names}
+            metadata = {**metadata, "world_contact_pairs": plant.contact_pair_names}
+        self.free_plant = None
+        if self.world_plant is not None and plant.free_bodies and plant.free_bodies.objects:
+            self.free_plant = plant
+            names, units = plant.free_bodies.state_columns()
+            units_meta = {
+                **metadata.get("signal_units", {}),
+                "free_objects": described(names, units),
+            }
+            metadata = {
+                **metadata,
+                "free_object_contact_pairs": plant.object_pair_names,
+                "signal_units": units_meta,
+            }
         self.rollout = Rollout.allocate(max(int(capacity), 1), uvms.nq, uvms.nv, metadata)
         self.count = 0
         self.described: set[str] = set()  # the named signals (`Signal`) already described
@@ -74,6 +94,10 @@ class RolloutLog:
         if self.world_plant is not None:
             wrenches = self.world_plant.world_wrenches(sample.q, sample.v)
             rollout.signal("world_contact", wrenches.size)[k] = wrenches
+        if self.free_plant is not None:
+            states, wrenches = self.free_plant.free_object_log(sample.q, sample.v)
+            rollout.signal("free_objects", states.size)[k] = states
+            rollout.signal("free_object_contact", wrenches.size)[k] = wrenches
         self.count += 1
 
     def _describe(self, name: str, signal: Signal) -> None:
@@ -96,7 +120,8 @@ class RolloutLog:
         """An independent log holding the same samples (the model is shared)."""
         out = RolloutLog.__new__(RolloutLog)
         out.uvms, out.backend, out.count = self.uvms, self.backend, self.count
-        out.plant, out.world_plant = self.plant, self.world_plant
+        out.plant, out.world_plant, out.stops = self.plant, self.world_plant, self.stops
+        out.free_plant = self.free_plant
         out.described = set(self.described)
         out.rollout = copy.deepcopy(self.rollout)
         return out
@@ -118,6 +143,8 @@ class RolloutLog:
                 self.uvms, rollout.q[k], rollout.v[k], backend=self.backend, **surface
             )
             rollout.potential_energy_J[k] = potential_energy(self.uvms, rollout.q[k], **surface)
+            if self.stops is not None:
+                rollout.potential_energy_J[k] += self.stops.energy_J(rollout.q[k])
         return rollout
 
 

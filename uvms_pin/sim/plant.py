@@ -42,6 +42,7 @@ from uvms_pin.physics.joint_stops import JointStops
 from uvms_pin.physics.surface import wet_state
 from uvms_pin.physics.world.world import ContactForces, FrictionMemory, World
 from uvms_pin.sim.actuation import Actuation, Unlimited
+from uvms_pin.sim.free_bodies import FreeBodies
 from uvms_pin.sim.integrators import Chart, Integrator
 
 
@@ -103,6 +104,9 @@ class Plant:
         self.water = self._water()
         if self.world is not None and self.world.uvms is not self.uvms:
             raise ParameterError("the plant's world was built for another UVMS")
+        # free objects and the arm against its vehicle: the moving contacts (None: none)
+        moving = self.world is not None and (self.world.free or self.world.self_collision)
+        self.free_bodies = FreeBodies(self) if moving else None
 
     @property
     def n_logged_hulls(self) -> int:
@@ -114,8 +118,24 @@ class Plant:
     def n_logged_columns(self) -> int:
         """Values a run of this plant logs per sample beyond the base arrays: the wet
         fractions and, with a world, 9 per (body, object) pair (``world_contact``)."""
-        pairs = 0 if self.world is None else len(self.world.pair_names)
-        return self.n_logged_hulls + 9 * pairs
+        pairs = len(self.contact_pair_names) + len(self.object_pair_names)
+        objects = 0 if self.free_bodies is None else len(self.free_bodies.state_columns()[0])
+        return self.n_logged_hulls + 9 * pairs + objects
+
+    @property
+    def contact_pair_names(self) -> list[str]:
+        """``first|second`` of every logged contact pair of the UVMS (``world_contact``):
+        its bodies against the fixed objects, then against the free objects and its own
+        vehicle."""
+        if self.world is None:
+            return []
+        extra = [] if self.free_bodies is None else self.free_bodies.moving.uvms_pair_names
+        return self.world.pair_names + extra
+
+    @property
+    def object_pair_names(self) -> list[str]:
+        """The free objects' logged pairs (``free_object_contact``)."""
+        return [] if self.free_bodies is None else self.free_bodies.moving.object_pair_names
 
     def _water(self) -> FlowField | None:
         """The one flow the bodies see: the uniform current and ``flow`` (None: still water)."""
@@ -135,9 +155,17 @@ class Plant:
             "flow": None if self.water is None else self.water.record(),
             "contact": None if self.contact is None else self.contact.record(),
             "free_surface": bool(self.free_surface),
-            "world": None if self.world is None else self.world.record(),
+            "world": None if self.world is None else self._world_record(),
             "joint_stops": None if self.joint_stops is None else self.joint_stops.record(),
         }
+
+    def _world_record(self) -> dict[str, Any]:
+        out = self.world.record()
+        if self.free_bodies is not None:
+            out["pairs"] = self.contact_pair_names
+            out["object_pairs"] = self.object_pair_names
+            out.update(self.free_bodies.record())
+        return out
 
     def check_submerged(self, time_s: float, q: np.ndarray) -> None:
         """With ``stop_at_surface``: raise SimulationError when a body's centre of buoyancy
@@ -231,6 +259,8 @@ class Plant:
             position, _, _ = self.ee_state(q0, np.zeros(self.uvms.nv))
             self.contact.attach(position)
         self.friction.clear()
+        if self.free_bodies is not None:
+            self.free_bodies.reset()
         # what touches at t = 0 sticks where it is (a body placed on the seafloor stays)
         self.settle(q0, np.zeros(self.uvms.nv))
         self.water = self._water()
@@ -258,14 +288,30 @@ class Plant:
         [m], moment about it [N m], world axes (`World.pair_wrenches`); empty without a
         world."""
         forces = self.world_forces(q, v)
-        return np.zeros(0) if forces is None else self.world.pair_wrenches(forces).ravel()
+        if forces is None:
+            return np.zeros(0)
+        fixed = self.world.pair_wrenches(forces).ravel()
+        if self.free_bodies is None:
+            return fixed
+        return np.concatenate([fixed, self.free_bodies.wrenches(q, v)[0]])
 
-    def external_torque(self, q: np.ndarray, v: np.ndarray) -> np.ndarray:
-        """The world's contact forces and the joint stops as generalized forces (nv,)."""
+    def free_object_log(self, q: np.ndarray, v: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """(the free objects' states, their contact pairs' wrenches) now, flattened."""
+        bodies = self.free_bodies
+        return bodies.state_values(), bodies.wrenches(q, v)[1]
+
+    def external_torque(
+        self, q: np.ndarray, v: np.ndarray, extra_torque: np.ndarray | None = None
+    ) -> np.ndarray:
+        """The world's contact forces and the joint stops as generalized forces (nv,);
+        ``extra_torque``: the moving contacts' (free objects, self-collision) when the
+        system's integration computed them, else they are taken at the objects' states now."""
         out = np.zeros(self.uvms.nv)
         forces = self.world_forces(q, v)
         if forces is not None:
             out += self.world.generalized_force(q, self._world_data, forces)
+        if self.free_bodies is not None:
+            out += self.free_bodies.torques(q, v)[0] if extra_torque is None else extra_torque
         if self.joint_stops is not None:
             out += self.joint_stops.torque(q, v)
         return out
@@ -281,6 +327,8 @@ class Plant:
         else:
             pin.forwardKinematics(self.uvms.model, self._world_data, q, v)
             clear = self.world.clear(self._world_data, horizon_s)
+        if self.free_bodies is not None and self.free_bodies.near(q, v, horizon_s):
+            return False
         if clear:
             self.friction.clear()
         return clear
@@ -290,6 +338,8 @@ class Plant:
         forces = self.world_forces(q, v)
         if forces is not None:
             self.world.commit(forces, self.friction)
+        if self.free_bodies is not None:
+            self.free_bodies.settle(q, v)
 
     def disturbance_wrench(self, time_s: float) -> np.ndarray:
         return (
@@ -306,10 +356,12 @@ class Plant:
         v: np.ndarray,
         tau: np.ndarray,
         contact_world: np.ndarray | None = None,
+        extra_torque: np.ndarray | None = None,
     ) -> np.ndarray:
         """zeta_dot of  M zeta_dot + h + J_c^T lambda + delta = tau + [0; tau_f(v)] + tau_world
         + tau_stop (docs/physics.md; tau_f the joint drives' friction). With a world the
-        contact is Python's, the dynamics the backend's."""
+        contact is Python's, the dynamics the backend's; ``extra_torque`` as in
+        `external_torque`."""
         compiled = self._core()
         if compiled is not None and self.world is None:
             return compiled.acceleration(time_s, q, v, tau, contact_world)
@@ -328,7 +380,7 @@ class Plant:
             # the free-flyer's LOCAL Jacobian is [I 0]: a body wrench maps to tau[:6] directly
             tau_ext[:6] -= self.disturbance_wrench(time_s)
         if self.world is not None or self.joint_stops is not None:
-            tau_ext += self.external_torque(q, v)
+            tau_ext += self.external_torque(q, v, extra_torque)
         return forward_dynamics(
             self.uvms,
             q,
@@ -369,6 +421,10 @@ class Plant:
         counterpart (RK4, semi-implicit Euler) and no world object can be touched in it
         (`World.clear`: then the world costs one bound test); the integrator's Python loop
         otherwise, around the compiled dynamics, with the world's contacts."""
+        if self.free_bodies is not None and self.free_bodies.objects:
+            q1, v1 = self.free_bodies.advance(integrator, t0, q0, v0, tau, t1)
+            self.settle(q1, v1)
+            return q1, v1
         compiled = self._core()
         if compiled is not None and self._world_clear(q0, v0, t1 - t0):
             step = self._compiled_step(integrator)

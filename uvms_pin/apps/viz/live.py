@@ -357,7 +357,11 @@ class LiveFeed:
     def on_sample(self, sample: Sample) -> None:
         desired = sample.signals.get("force_desired_world_N")
         desired = getattr(desired, "values", desired)  # an array, or a named `Signal`
-        contacts = None if self.plant is None else self.plant.world_wrenches(sample.q, sample.v)
+        plant = self.plant
+        contacts = None if plant is None else plant.world_wrenches(sample.q, sample.v)
+        free = objects = None
+        if plant is not None and plant.free_bodies is not None and plant.free_bodies.objects:
+            free, objects = plant.free_object_log(sample.q, sample.v)
         self.live.push(
             Frame(
                 sample.time_s,
@@ -365,6 +369,8 @@ class LiveFeed:
                 sample.measurement.wrench_world[:3].copy(),
                 None if desired is None else desired.copy(),
                 contacts,
+                free,
+                objects,
             )
         )
 
@@ -388,10 +394,7 @@ def scene_for_scenario(scenario: Scenario, style: SceneStyle | None = None) -> U
         extent_world_m=extent,
         style=style,
         surface=surface,
-        world=WorldView.from_record(
-            None if scenario.plant.world is None else scenario.plant.world.record(),
-            extent.mean(axis=0),
-        ),
+        world=WorldView.from_record(scenario.plant.record()["world"], extent.mean(axis=0)),
     )
 
 
@@ -449,6 +452,8 @@ def replay_live(
     connected (it waits for one)."""
     desired = rollout.signals.get("force_desired_world_N")
     contacts = rollout.signals.get("world_contact")
+    free = rollout.signals.get("free_objects")
+    object_contact = rollout.signals.get("free_object_contact")
     with LiveView(scene, port=port, speed=speed, out=out) as live:
         if out is not None:
             print("live view: waiting for a browser to connect (Ctrl-C to stop)", file=out)
@@ -465,6 +470,8 @@ def replay_live(
                     rollout.wrench_measured_world[k, :3],
                     None if desired is None else desired[k],
                     None if contacts is None else contacts[k],
+                    None if free is None else free[k],
+                    None if object_contact is None else object_contact[k],
                 )
             )
         _play_to_end(live, out)

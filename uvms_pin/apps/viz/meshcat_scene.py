@@ -108,6 +108,8 @@ class Frame:
     force_measured_world_N: np.ndarray | None = None
     force_desired_world_N: np.ndarray | None = None
     world_contact: np.ndarray | None = None  # a row of the rollout's world_contact signal
+    free_objects: np.ndarray | None = None  # a row of the free_objects signal (poses)
+    object_contact: np.ndarray | None = None  # a row of free_object_contact
 
 
 class RecordingWindow:
@@ -405,9 +407,12 @@ class UvmsScene:
             scale = self.style.world_force_scale_m_per_N
             out.update(
                 self.world.arrows(
-                    frame.world_contact, lambda path, tail, f: self._arrow(path, tail, f, scale)
+                    frame.world_contact,
+                    lambda path, tail, f: self._arrow(path, tail, f, scale),
+                    frame.object_contact,
                 )
             )
+            out.update(self.world.free_poses(frame.free_objects))
         return out
 
     def _arrow(self, path: str, tail, vector, scale: float) -> dict[str, Pose]:

@@ -135,8 +135,10 @@ def replay_html(
     measured = rollout.wrench_measured_world[good, :3]
     desired = rollout.signals.get("force_desired_world_N")
     desired = desired[good, :3] if desired is not None else None
-    contacts = rollout.signals.get("world_contact")
-    contacts = contacts[good] if contacts is not None else None
+    contacts, free, object_contact = (
+        None if rollout.signals.get(name) is None else rollout.signals[name][good]
+        for name in ("world_contact", "free_objects", "free_object_contact")
+    )
     idx, fps = frame_times(time_s, max_fps, max_frames)
     t0 = float(time_s[0])
     keys = (time_s[idx] - t0) * fps  # animation time in frames (meshcat's convention)
@@ -150,6 +152,8 @@ def replay_html(
             measured[i],
             None if desired is None else desired[i],
             None if contacts is None else contacts[i],
+            None if free is None else free[i],
+            None if object_contact is None else object_contact[i],
         )
         at = anim.at_frame(root, float(key))
         for path, (position, quat, scale) in scene.poses(frame).items():

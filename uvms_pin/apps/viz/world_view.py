@@ -3,7 +3,9 @@
 Paths under the scene root: ``world/objects/<name>`` (the seafloor a sandy slab, solids
 grey-brown, meshes as their file's triangles) and ``world/contacts/pair<k>`` (orange arrows, one
 per (body, object) pair, at the pair's contact point along the force on the body,
-``SceneStyle.world_force_scale_m_per_N`` long per newton). A node's name is never a bare
+``SceneStyle.world_force_scale_m_per_N`` long per newton). Free objects are drawn under
+``world/free/<name>`` (a lighter colour) and move with their logged pose (the
+``free_objects`` signal); their own pairs' arrows are ``world/contacts/object<k>``. A node's name is never a bare
 number: three.js's animation tracks would read it as an index, and the arrow not move.
 """
 
@@ -16,10 +18,12 @@ from typing import Any
 import meshcat
 import meshcat.geometry as mg
 import numpy as np
+import pinocchio as pin
 
 __all__ = ["WorldView"]
 
-_SAND, _ROCK, _ARROW = 0x8A7A55, 0x807060, 0xFF9020
+_SAND, _ROCK, _ARROW, _FREE = 0x8A7A55, 0x807060, 0xFF9020, 0xC09050
+_STATE = 13  # per free object in the free_objects signal: p (3), quaternion (4), nu (6)
 _PLANE_HALF_M = 6.0  # half the side of the drawn patch of an (infinite) plane
 
 
@@ -46,15 +50,19 @@ class WorldView:
     objects: tuple[dict[str, Any], ...]
     pairs: tuple[str, ...]
     center_world_m: np.ndarray
+    free: tuple[dict[str, Any], ...] = ()
+    object_pairs: tuple[str, ...] = ()
 
     @classmethod
     def from_record(cls, record: dict | None, center_world_m) -> WorldView | None:
-        if not record or not record.get("objects"):
+        if not record or not (record.get("objects") or record.get("free_objects")):
             return None
         return cls(
-            tuple(record["objects"]),
+            tuple(record.get("objects", ())),
             tuple(record.get("pairs", ())),
             np.asarray(center_world_m, dtype=float).reshape(3),
+            tuple(record.get("free_objects", ())),
+            tuple(record.get("object_pairs", ())),
         )
 
     @property
@@ -68,6 +76,28 @@ class WorldView:
             self._build_object(node[f"objects/{obj['name']}"], obj)
         for k in range(len(self.pairs)):
             build_arrow(node[f"contacts/pair{k}"], _ARROW)
+        for obj in self.free:
+            # the shape in a child node: the parent moves with the pose, the child turns
+            # a cylinder (meshcat's lies along y)
+            child = node[f"free/{obj['name']}/shape"]
+            child.set_object(_geometry(obj), _phong(_FREE))
+            child.set_transform(_matrix(_turn(obj["type"]), np.zeros(3)))
+        for k in range(len(self.object_pairs)):
+            build_arrow(node[f"contacts/object{k}"], _ARROW)
+
+    def free_poses(self, states: np.ndarray | None) -> dict[str, Any]:
+        """Poses of the free objects for one logged row of the ``free_objects`` signal
+        (their initial poses without one)."""
+        out: dict[str, Any] = {}
+        rows = None if states is None else np.asarray(states, dtype=float).reshape(-1, _STATE)
+        for k, obj in enumerate(self.free):
+            if rows is None:
+                position = np.asarray(obj["position_world_m"], dtype=float)
+                quat = pin.Quaternion(np.asarray(obj["rotation_world"], dtype=float)).coeffs()
+            else:
+                position, quat = rows[k, :3], rows[k, 3:7]
+            out[f"world/free/{obj['name']}"] = (position.copy(), np.array(quat), np.ones(3))
+        return out
 
     def _build_object(self, node: meshcat.Visualizer, obj: dict[str, Any]) -> None:
         rotation = np.asarray(obj["rotation_world"], dtype=float)
@@ -82,21 +112,35 @@ class WorldView:
             node.set_transform(_matrix(rotation, foot - 0.02 * normal))
             return
         node.set_object(_geometry(obj), _phong(_ROCK))
-        turn = np.eye(3)
-        if kind == "cylinder":  # meshcat's cylinder lies along y, the object's along z
-            turn = np.array([[1.0, 0.0, 0.0], [0.0, 0.0, -1.0], [0.0, 1.0, 0.0]])
-        node.set_transform(_matrix(rotation @ turn, position))
+        node.set_transform(_matrix(rotation @ _turn(kind), position))
 
-    def arrows(self, contacts: np.ndarray | None, arrow: Callable) -> dict[str, Any]:
+    def arrows(
+        self, contacts: np.ndarray | None, arrow: Callable, objects: np.ndarray | None = None
+    ) -> dict[str, Any]:
         """Poses of the pairs' arrows for one logged row of the ``world_contact`` signal
-        (pairs * 9: force [N], point [m], moment): ``arrow(path, tail, vector)``."""
+        (pairs * 9: force [N], point [m], moment) and of ``free_object_contact``
+        (``objects``): ``arrow(path, tail, vector)``."""
         out: dict[str, Any] = {}
-        rows = None if contacts is None else np.asarray(contacts, dtype=float).reshape(-1, 9)
-        for k in range(len(self.pairs)):
-            force = None if rows is None else rows[k, :3]
-            tail = np.zeros(3) if rows is None else rows[k, 3:6]
-            out.update(arrow(f"world/contacts/pair{k}", tail, force))
+        for label, names, row in (
+            ("pair", self.pairs, contacts),
+            ("object", self.object_pairs, objects),
+        ):
+            rows = None if row is None else np.asarray(row, dtype=float).reshape(-1, 9)
+            if rows is not None and len(rows) != len(names):
+                rows = None  # a record that does not fit: no arrows rather than wrong ones
+            for k in range(len(names)):
+                force = None if rows is None else rows[k, :3]
+                tail = np.zeros(3) if rows is None else rows[k, 3:6]
+                out.update(arrow(f"world/contacts/{label}{k}", tail, force))
         return out
+
+
+def _turn(kind: str) -> np.ndarray:
+    """The drawn shape's rotation in the object's frame: meshcat's cylinder lies along y,
+    the object's along z."""
+    if kind == "cylinder":
+        return np.array([[1.0, 0.0, 0.0], [0.0, 0.0, -1.0], [0.0, 1.0, 0.0]])
+    return np.eye(3)
 
 
 def _geometry(obj: dict[str, Any]):

@@ -18,7 +18,7 @@ import pinocchio as pin
 from uvms_pin.physics.world.objects import WorldObject
 from uvms_pin.physics.world.robot_geometry import RobotPiece
 
-__all__ = ["Bounds", "Touch", "clear_of", "touch"]
+__all__ = ["Bounds", "Touch", "clear_of", "coal_point", "reach_spheres", "touch"]
 
 _REQUEST = coal.CollisionRequest()  # one contact, depth and normal: what a pair needs
 
@@ -72,7 +72,7 @@ def _corners_below(piece: RobotPiece, where: pin.SE3, obj: WorldObject):
     return inside, points[inside], depth[inside]
 
 
-def _coal_point(piece: RobotPiece, where: pin.SE3, obj: WorldObject):
+def coal_point(piece: RobotPiece, where: pin.SE3, obj: WorldObject):
     """coal's deepest point of the pair: (point (3,), normal out of the object, depth) or
     None when apart."""
     result = coal.CollisionResult()
@@ -99,6 +99,15 @@ def clear_of(
     ``pin.forwardKinematics(model, data, q, v)``): every piece's bounding sphere, grown by
     twice the distance its fastest point covers at the current speed plus `CLEARANCE_M`,
     misses every object's bound. Then a whole control period runs without the world."""
+    centers_m, reach_m = reach_spheres(data, pieces, horizon_s)
+    return not bounds.near(centers_m, reach_m)
+
+
+def reach_spheres(
+    data: pin.Data, pieces: Sequence[RobotPiece], horizon_s: float
+) -> tuple[np.ndarray, np.ndarray]:
+    """(centres (p, 3) [m], radii (p,) [m]) of the spheres holding every piece over
+    ``horizon_s`` (`clear_of`), after ``pin.forwardKinematics(model, data, q, v)``."""
     centers, reach = [], []
     for piece in pieces:
         local = piece.placement_in_joint.translation
@@ -108,8 +117,7 @@ def clear_of(
         )
         centers.append(data.oMi[piece.joint_id].act(local))
         reach.append(piece.bound_radius_m + 2.0 * speed * horizon_s + CLEARANCE_M)
-    centers_m = np.array(centers).reshape(-1, 3)
-    return not bounds.near(centers_m, np.array(reach, dtype=float))
+    return np.array(centers).reshape(-1, 3), np.array(reach, dtype=float)
 
 
 @dataclass(frozen=True)
@@ -175,7 +183,7 @@ def touch(
                     (np.full(count, p), np.full(count, o), corners, points, normals, depths)
                 )
             continue
-        found = _coal_point(piece, where[p], obj)
+        found = coal_point(piece, where[p], obj)
         if found is not None:
             point, normal, depth = found
             chunks.append(

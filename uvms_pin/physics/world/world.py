@@ -70,18 +70,24 @@ class World:
     Attributes:
         uvms: the model whose bodies touch. objects: the fixed objects.
         law: stiffness, dissipation, friction regularization (and default coefficients).
+        free: the free objects (`uvms_pin.physics.world.free_object.FreeObject`), each its
+            own floating body; their contacts are `uvms_pin.physics.world.moving`'s.
+        self_collision: the arm's links touch the vehicle (adjacent links excepted).
     """
 
     uvms: UVMS
     objects: Sequence[WorldObject]
     law: ContactLaw = field(default_factory=ContactLaw)
+    free: Sequence[Any] = ()
+    self_collision: bool = False
 
     def __post_init__(self) -> None:
         self.objects = tuple(self.objects)
+        self.free = tuple(self.free)
         bodies = self.uvms.surface_bodies
         self.body_names = [self.uvms.hydro_bodies[int(k)].name for k in bodies.body_index]
         self.pieces: tuple[RobotPiece, ...] = robot_pieces(self.uvms, self.body_names)
-        names = [o.name for o in self.objects]
+        names = [o.name for o in self.objects] + [o.name for o in self.free]
         if len(set(names)) != len(names):
             raise ParameterError(f"world objects need distinct names, got {names}")
         self.bounds = Bounds.of(self.objects)
@@ -98,7 +104,8 @@ class World:
     def record(self) -> dict[str, Any]:
         return {
             "objects": [o.record() for o in self.objects],
-            "contact": self.law.record(),
+            "free_objects": [o.record() for o in self.free],
+            "contact": {**self.law.record(), "self_collision": bool(self.self_collision)},
             "pairs": self.pair_names,
         }
 

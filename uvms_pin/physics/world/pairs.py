@@ -1,0 +1,228 @@
+"""Contact between two moving bodies: a piece of the UVMS against a piece of a free object,
+a free object's against another's, or (on request, ``self_collision``) an arm link's
+against the vehicle's.
+
+A pair (a, b) of pieces that overlap touches at coal's deepest point x, with the normal n
+out of b towards a and the depth delta (`uvms_pin.physics.world.touch.coal_point`, b posed
+as an object). The same law as against a fixed object (`contact_law`) sees the relative
+velocity of the material points at x,
+
+    v_rel = v_a(x) - v_b(x),      delta_dot = -n . v_rel,
+
+and gives the force f on a; b receives -f at the same point, so that the exchange is equal
+and opposite (it conserves the two bodies' momentum) and its power, -f . v_rel, is what the
+law dissipates (never positive: the normal force never pulls, friction opposes the slip).
+The friction's anchor is kept in b's joint frame: it moves with b. Each pair is its own
+friction patch (one point).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import numpy as np
+import pinocchio as pin
+
+from uvms_pin.physics.world.contact_law import ContactLaw, friction_force_N, normal_force_N
+from uvms_pin.physics.world.objects import WorldObject
+from uvms_pin.physics.world.robot_geometry import RobotPiece
+from uvms_pin.physics.world.touch import coal_point, cross, reach_spheres
+from uvms_pin.physics.world.world import FrictionMemory
+
+__all__ = ["PairContacts", "PiecePairs", "joint_forces"]
+
+
+@dataclass(frozen=True)
+class PairContacts:
+    """The touching pairs at one state.
+
+    Attributes:
+        pair: which pair of `PiecePairs.pairs` (m,). point_world_m: x (m, 3).
+        normal_world: n, out of b towards a (m, 3). depth_m: delta > 0 (m,).
+        velocity_world_m_s: v_rel = v_a(x) - v_b(x) (m, 3).
+        force_world_N: f on a (b gets -f) (m, 3). normal_N: f_n (m,).
+        sticking: within the static cone (m,).
+    """
+
+    pair: np.ndarray
+    point_world_m: np.ndarray
+    normal_world: np.ndarray
+    depth_m: np.ndarray
+    velocity_world_m_s: np.ndarray
+    force_world_N: np.ndarray
+    normal_N: np.ndarray
+    sticking: np.ndarray
+
+    def __len__(self) -> int:
+        return len(self.pair)
+
+
+def _material_velocity(data: pin.Data, joint: int, point: np.ndarray) -> np.ndarray:
+    """The world velocity (3,) of the point of joint ``joint``'s body now at ``point``."""
+    placement, twist = data.oMi[joint], data.v[joint]
+    angular = placement.rotation @ twist.angular
+    return placement.rotation @ twist.linear + np.cross(angular, point - placement.translation)
+
+
+def joint_forces(
+    model: pin.Model, data: pin.Data, q: np.ndarray, joints, points_m, forces_N
+) -> np.ndarray:
+    """sum_i J_i^T f_i (nv,) [N, N m]: world forces f_i (k, 3) at world points x_i (k, 3)
+    on the bodies of ``joints`` (k,), J_i the linear Jacobian of the material point at
+    x_i; ``data`` after forward kinematics at q."""
+    out = np.zeros(model.nv)
+    joints = np.asarray(joints, dtype=int)
+    if len(joints) == 0:
+        return out
+    pin.computeJointJacobians(model, data, q)
+    for j in np.unique(joints):
+        mine = joints == j
+        f = np.asarray(forces_N)[mine]
+        arm = np.asarray(points_m)[mine] - data.oMi[int(j)].translation
+        wrench = np.concatenate([f.sum(axis=0), cross(arm, f).sum(axis=0)])
+        out += pin.getJointJacobian(model, data, int(j), pin.LOCAL_WORLD_ALIGNED).T @ wrench
+    return out
+
+
+@dataclass(frozen=True)
+class PiecePairs:
+    """The pairs of pieces of body a (of one model) and body b (of another, or the same)
+    that may touch, and the law they touch by.
+
+    Attributes:
+        pieces_a, pieces_b: the two sides' pieces. pairs: (index in a, index in b) each.
+        law: the contact law. mu: (mu_s, mu_k) per pair (n, 2).
+        names: ``body_a|body_b`` of each pair (logs, views).
+    """
+
+    pieces_a: tuple[RobotPiece, ...]
+    pieces_b: tuple[RobotPiece, ...]
+    pairs: tuple[tuple[int, int], ...]
+    law: ContactLaw
+    mu: np.ndarray
+    names: tuple[str, ...]
+
+    def near(self, data_a: pin.Data, data_b: pin.Data, horizon_s: float) -> bool:
+        """Whether some pair may touch within ``horizon_s`` (bounding spheres grown by the
+        distance their points cover, `touch.reach_spheres`); after forward kinematics."""
+        if not self.pairs:
+            return False
+        ca, ra = reach_spheres(data_a, self.pieces_a, horizon_s)
+        cb, rb = reach_spheres(data_b, self.pieces_b, horizon_s)
+        a, b = np.array(self.pairs).T
+        return bool(np.any(np.linalg.norm(ca[a] - cb[b], axis=1) < ra[a] + rb[b]))
+
+    def forces(self, data_a: pin.Data, data_b: pin.Data, memory: FrictionMemory) -> PairContacts:
+        """The touching pairs and the force on a at each, after ``forwardKinematics(q, v)``
+        of both models, with the anchors of ``memory`` (read only)."""
+        found = []
+        for k, (a, b) in enumerate(self.pairs):
+            pa, pb = self.pieces_a[a], self.pieces_b[b]
+            where_a = data_a.oMi[pa.joint_id] * pa.placement_in_joint
+            where_b = data_b.oMi[pb.joint_id] * pb.placement_in_joint
+            gap = np.linalg.norm(where_a.translation - where_b.translation)
+            if gap >= pa.bound_radius_m + pb.bound_radius_m:
+                continue
+            obstacle = WorldObject("b", "piece", pb.shape, where_b, 0.0, 0.0, pb.bound_radius_m)
+            hit = coal_point(pa, where_a, obstacle)
+            if hit is not None:
+                found.append((k, *hit))
+        if not found:
+            return _none()
+        pair = np.array([f[0] for f in found], dtype=int)
+        point = np.array([f[1] for f in found], dtype=float)
+        normal = np.array([f[2] for f in found], dtype=float)
+        depth = np.array([f[3] for f in found], dtype=float)
+        velocity = np.array(
+            [
+                _material_velocity(data_a, self.pieces_a[self.pairs[k][0]].joint_id, x)
+                - _material_velocity(data_b, self.pieces_b[self.pairs[k][1]].joint_id, x)
+                for k, x in zip(pair, point, strict=True)
+            ]
+        )
+        rate = -np.einsum("ij,ij->i", velocity, normal)
+        f_n = normal_force_N(self.law, depth, rate)
+        anchors = np.array(
+            [self._anchor(data_b, memory, int(k), x) for k, x in zip(pair, point, strict=True)]
+        )
+        stretch = point - anchors
+        stretch -= normal * np.einsum("ij,ij->i", stretch, normal)[:, None]
+        v_t = velocity + normal * rate[:, None]
+        mu = self.mu[pair]
+        limit = np.where([int(k) in memory.slipping for k in pair], mu[:, 1], mu[:, 0])
+        f_t, stick = friction_force_N(self.law, f_n, stretch, v_t, pair, limit, mu[:, 1])
+        force = f_n[:, None] * normal + f_t
+        return PairContacts(pair, point, normal, depth, velocity, force, f_n, stick)
+
+    def _joint_b(self, k: int) -> int:
+        return self.pieces_b[self.pairs[k][1]].joint_id
+
+    def _anchor(self, data_b: pin.Data, memory: FrictionMemory, k: int, x: np.ndarray):
+        local = memory.anchors.get((k, 0, -1))
+        return x if local is None else data_b.oMi[self._joint_b(k)].act(local)
+
+    def commit(self, data_b: pin.Data, contacts: PairContacts, memory: FrictionMemory) -> None:
+        """After a control period (`World.commit`'s rule): a sticking pair keeps its anchor
+        (a new one anchors where it is), a slipping one moves it to x + f_t / k_t; anchors
+        are kept in b's joint frame."""
+        kept, slipping = {}, set()
+        f_t = contacts.force_world_N - contacts.normal_N[:, None] * contacts.normal_world
+        for i, k in enumerate(contacts.pair.tolist()):
+            x = contacts.point_world_m[i]
+            if contacts.sticking[i]:
+                kept[(k, 0, -1)] = memory.anchors.get(
+                    (k, 0, -1), data_b.oMi[self._joint_b(k)].actInv(x)
+                )
+            else:
+                moved = x + f_t[i] / self.law.tangential_stiffness_N_m
+                kept[(k, 0, -1)] = data_b.oMi[self._joint_b(k)].actInv(moved)
+                slipping.add(k)
+        memory.anchors, memory.slipping = kept, slipping
+
+    def generalized_forces(
+        self,
+        model_a: pin.Model,
+        data_a: pin.Data,
+        q_a: np.ndarray,
+        model_b: pin.Model,
+        data_b: pin.Data,
+        q_b: np.ndarray,
+        contacts: PairContacts,
+    ) -> tuple[np.ndarray, np.ndarray]:
+        """(tau_a (nv_a,), tau_b (nv_b,)): f on a's bodies, -f on b's (`joint_forces`)."""
+        joints_a = [self.pieces_a[self.pairs[k][0]].joint_id for k in contacts.pair]
+        joints_b = [self._joint_b(int(k)) for k in contacts.pair]
+        x, f = contacts.point_world_m, contacts.force_world_N
+        return (
+            joint_forces(model_a, data_a, q_a, joints_a, x, f),
+            joint_forces(model_b, data_b, q_b, joints_b, x, -f),
+        )
+
+    def pair_wrenches(self, contacts: PairContacts) -> np.ndarray:
+        """Per pair: force on a [N] (3), point [m] (3), zero moment (one point) (n, 9)."""
+        out = np.zeros((len(self.pairs), 9))
+        out[contacts.pair, :3] = contacts.force_world_N
+        out[contacts.pair, 3:6] = contacts.point_world_m
+        return out
+
+
+def _none() -> PairContacts:
+    empty3 = np.zeros((0, 3))
+    return PairContacts(
+        np.zeros(0, dtype=int), empty3, empty3, np.zeros(0), empty3, empty3, np.zeros(0),
+        np.zeros(0, dtype=bool),
+    )  # fmt: skip
+
+
+def piece_pairs(
+    pieces_a: Sequence[RobotPiece],
+    pieces_b: Sequence[RobotPiece],
+    pairs: Sequence[tuple[int, int]],
+    law: ContactLaw,
+    friction: tuple[float, float],
+    names: Sequence[str],
+) -> PiecePairs:
+    """`PiecePairs` with one friction (mu_s, mu_k) for every pair."""
+    mu = np.tile(np.asarray(friction, dtype=float), (len(pairs), 1)).reshape(-1, 2)
+    return PiecePairs(tuple(pieces_a), tuple(pieces_b), tuple(pairs), law, mu, tuple(names))
