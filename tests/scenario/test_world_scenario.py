@@ -56,7 +56,11 @@ def _with_object(k: int, **changes):
         (0, {"point_world_m": None}, r"world\.objects\[0\]\.point_world_m.*required"),
         (1, {"path": "nowhere.obj"}, r"world\.objects\[1\]\.path.*no mesh file"),
         (0, {"friction_kinetic": 0.9}, r"friction_static >= friction_kinetic"),
-        (1, {"fixed": False}, r"free objects are not simulated yet"),
+        (1, {"fixed": False}, r"fixed.*needs mass_kg or density_kg_m3"),
+        (1, {"mass_kg": 10.0, "fixed": True}, r"fixed.*is free"),
+        (1, {"mass_kg": 10.0, "density_kg_m3": 2000.0}, r"mass_kg.*not both"),
+        (0, {"mass_kg": 10.0}, r"type.*a plane cannot be free"),
+        (1, {"mass_kg": -1.0}, r"mass_kg"),
         (1, {"name": "seabed"}, r"distinct names"),
         (1, {"radius_m": 1.0}, r"unknown key.*radius_m"),
         (1, {"scale": [1, 0, 1]}, r"must be > 0|scale"),
@@ -93,3 +97,29 @@ def test_every_object_type_is_built(tmp_path):
     assert [o.name for o in world.objects] == ["box0", "sphere1", "cylinder2"]
     record = world.record()
     assert re.search("crate|box0", str(record["objects"]))
+
+
+def test_a_free_object_scenario_builds_its_floating_body():
+    scenario = load_scenario(SCENARIOS / "push_object.toml")
+    world = scenario.plant.world
+    (box,) = world.free
+    assert box.name == "box" and box.kind == "box"
+    assert box.mass_kg == pytest.approx(1100.0 * 0.25 * 0.5 * 0.25)
+    (body,) = box.uvms.hydro_bodies
+    assert body.params.volume_m3 == pytest.approx(0.25 * 0.5 * 0.25)  # derived: its shape
+    assert np.allclose(box.q0[:3], [0.80, -0.11, -9.875])
+    assert [o.name for o in world.objects] == ["seabed"]
+    record = scenario.plant.record()["world"]
+    assert record["free_objects"][0]["free"] is True
+    assert "Python" in record["integration"]
+    assert record["object_pairs"] == ["box|seabed"]
+    assert scenario.plant.contact_pair_names[-1].endswith("|box")
+
+
+def test_self_collision_is_a_contact_key():
+    scenario = load_scenario(SEABED, {"world.contact.self_collision": True})
+    assert scenario.plant.world.self_collision
+    names = scenario.plant.contact_pair_names
+    # the arm's links beyond the first against the vehicle's shapes
+    assert any(n.startswith("alpha_wrist_link") and "|base_link" in n for n in names)
+    assert not any(n.startswith("alpha_shoulder_link") for n in names if "|base_link" in n)

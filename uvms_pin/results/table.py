@@ -13,7 +13,8 @@ Column names are ``<array>.<component>_<unit>``:
   columns, ``q.<joint>.cos`` and ``q.<joint>.sin``); a task-space (first-level) quantity uses
   ``fx fy fz roll pitch yaw``; the world's contacts (signal ``world_contact``) use
   ``<body>|<object>.fx fy fz`` (force on the body, N), ``.x y z`` (its point, m) and
-  ``.mx my mz`` (moment about it, N m); a signal this module does not know uses its index.
+  ``.mx my mz`` (moment about it, N m), and so do the free objects' (``free_object_contact``);
+  a signal this module does not know uses its index.
 - ``_<unit>`` is the SI unit (``m``, ``rad``, ``m_s``, ``rad_s``, ``N``, ``Nm``, ``J``);
   dimensionless columns (quaternion, normalized errors) have none.
 - a signal a controller logged as a `uvms_pin.results.signal.Signal` has its own names and
@@ -131,12 +132,21 @@ _CONTACT_PAIR = [
 ]
 
 
-def _world_contact_labels(rollout: RolloutData, width: int) -> list[tuple[str, str]]:
-    """``world_contact.<body>|<object>.fx_N`` ...: force, point, moment of each pair."""
-    pairs = list(rollout.metadata.get("world_contact_pairs") or [])
+#: a signal of pair wrenches -> the metadata key naming its pairs
+_PAIR_SIGNALS = {
+    "world_contact": "world_contact_pairs",
+    "free_object_contact": "free_object_contact_pairs",
+}
+
+
+def _world_contact_labels(
+    rollout: RolloutData, width: int, name: str = "world_contact"
+) -> list[tuple[str, str]]:
+    """``<name>.<body>|<object>.fx_N`` ...: force, point, moment of each pair."""
+    pairs = list(rollout.metadata.get(_PAIR_SIGNALS[name]) or [])
     if len(pairs) * len(_CONTACT_PAIR) != width:
-        return [(f"world_contact.{k}", "") for k in range(width)]
-    return [(f"world_contact.{pair}.{c}", u) for pair in pairs for c, u in _CONTACT_PAIR]
+        return [(f"{name}.{k}", "") for k in range(width)]
+    return [(f"{name}.{pair}.{c}", u) for pair in pairs for c, u in _CONTACT_PAIR]
 
 
 #: unit suffix in a column name -> the unit as text in ``attrs["units"]``
@@ -177,8 +187,8 @@ def column_layout(rollout: RolloutData) -> list[tuple[str, str, np.ndarray]]:
         prefix, vehicle, joint_layout = SIGNAL_LAYOUTS.get(name, (name, [], None))
         if prefix in _BASE_ARRAYS:
             prefix = f"signal.{prefix}"
-        if name == "world_contact":
-            labels = _world_contact_labels(rollout, values.shape[1])
+        if name in _PAIR_SIGNALS:
+            labels = _world_contact_labels(rollout, values.shape[1], name)
         elif (named := _named_labels(prefix, described.get(name), values.shape[1])) is not None:
             labels = named
         elif not vehicle:

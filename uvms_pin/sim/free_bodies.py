@@ -17,17 +17,14 @@ all. The objects' friction anchors move once a control period, as the UVMS's do.
 from __future__ import annotations
 
 import re
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
 import numpy as np
 import pinocchio as pin
 
 from uvms_pin.physics.dynamics import forward_dynamics
 from uvms_pin.physics.world.moving import MovingContacts, State
-
-if TYPE_CHECKING:
-    from uvms_pin.sim.integrators import Integrator
-    from uvms_pin.sim.plant import Plant
+from uvms_pin.sim.integrators import Integrator
 
 __all__ = ["FreeBodies"]
 
@@ -47,9 +44,10 @@ def _system_model(uvms_model: pin.Model, n_objects: int) -> pin.Model:
 
 
 class FreeBodies:
-    """The free objects' states and the moving contacts, for one plant."""
+    """The free objects' states and the moving contacts, for one plant (a
+    `uvms_pin.sim.plant.Plant`: its UVMS, world, water and dynamics)."""
 
-    def __init__(self, plant: Plant):
+    def __init__(self, plant: Any):
         world = plant.world
         self.plant = plant
         self.objects = world.free
