@@ -10,6 +10,7 @@ from viz_support import ROOT
 
 from uvms_pin.apps.viz.meshcat_scene import Frame, SceneStyle, UvmsScene, recording_visualizer
 from uvms_pin.apps.viz.world_view import WorldView
+from uvms_pin.physics.world.free_object import free_object
 from uvms_pin.physics.world.objects import plane, solid
 from uvms_pin.physics.world.world import World
 
@@ -60,3 +61,30 @@ def test_a_pair_arrow_starts_at_its_point_and_is_scale_times_force_long(referenc
     assert shaft + head == pytest.approx(0.02 * 50.0)
     # the other pairs carry no force: their arrows are hidden
     assert np.all(poses["world/contacts/pair0"][2] < 1e-5)
+
+
+def test_a_free_object_is_drawn_where_its_logged_pose_puts_it(reference_uvms, world):
+    box = free_object(
+        "crate2", "box", {"size_m": [0.4, 0.4, 0.4]}, ([1.0, 1.0, -2.8], [0, 0, 0]),
+        mass_kg=50.0, water_density_kg_m3=1025.0,
+    )  # fmt: skip
+    free_world = World(reference_uvms, world.objects, world.law, [box])
+    record = {**free_world.record(), "object_pairs": ["crate2|seabed"]}
+    view = WorldView.from_record(record, [0, 0, -2])
+    scene = UvmsScene(reference_uvms, world=view)
+    vis, window = recording_visualizer()
+    scene.build(vis)
+    blob = b"".join(window.commands)
+    assert b"uvms_pin/world/free/crate2/shape" in blob
+    assert b"uvms_pin/world/contacts/object0" in blob
+    q = reference_uvms.neutral_configuration()
+    at_start = scene.poses(Frame(0.0, q))["world/free/crate2"]
+    assert np.allclose(at_start[0], [1.0, 1.0, -2.8]) and np.allclose(at_start[1], [0, 0, 0, 1])
+    turned = pin.Quaternion(pin.rpy.rpyToMatrix(0.0, 0.0, 0.5)).coeffs()
+    state = np.concatenate([[2.0, 1.5, -2.75], turned, np.zeros(6)])
+    pushed = np.zeros(9)
+    pushed[:3], pushed[3:6] = [0.0, 0.0, 80.0], [2.0, 1.5, -2.95]
+    poses = scene.poses(Frame(1.0, q, free_objects=state, object_contact=pushed))
+    position, quat, _ = poses["world/free/crate2"]
+    assert np.allclose(position, [2.0, 1.5, -2.75]) and np.allclose(quat, turned)
+    assert np.allclose(poses["world/contacts/object0"][0], [2.0, 1.5, -2.95])

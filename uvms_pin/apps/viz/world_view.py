@@ -22,7 +22,7 @@ import pinocchio as pin
 
 __all__ = ["WorldView"]
 
-_SAND, _ROCK, _ARROW, _FREE = 0x8A7A55, 0x807060, 0xFF9020, 0xC09050
+_SAND, _ROCK, _ARROW, _FREE = 0x8A7A55, 0x807060, 0xFF9020, 0xC8643C
 _STATE = 13  # per free object in the free_objects signal: p (3), quaternion (4), nu (6)
 _PLANE_HALF_M = 6.0  # half the side of the drawn patch of an (infinite) plane
 
