@@ -100,8 +100,7 @@ class ClosedLoop:
         self.time_s, self.q, self.v = 0.0, read_only(q0), read_only(v0)
         self.sensors = sensors
         self.plant.actuation.start(self.settings.control_period_s)
-        if sensors.navigation is not None:
-            sensors.navigation.start(self.settings.control_period_s)
+        sensors.start_navigation(self.settings.control_period_s)
         if self.controller is not None:
             with self._controller_code("reset"):
                 self.controller.reset()
@@ -164,8 +163,7 @@ class ClosedLoop:
         """The loop now, as its observers see it."""
         controller = self.controller
         signals = self.plant.actuation.signals()
-        if self.sensors.navigation is not None:
-            signals.update(self.sensors.navigation.signals())
+        signals.update(self.sensors.navigation_signals())
         if controller is not None:
             with self._controller_code("signals"):
                 signals = {**controller.signals(), **signals}
@@ -241,8 +239,9 @@ class ClosedLoop:
     def _tick(self, logged: bool) -> np.ndarray:
         """Measure, command and actuate at the current state; log if ``logged``."""
         measurement, contact = self.measure()
-        if self.sensors.navigation is not None:  # stateful: once per tick
-            self.sensors.navigation.update(self.time_s, self.q, self.v)
+        # stateful, once per tick: the navigation sensors and the estimator (which may
+        # replace the vehicle part of what the controller is given)
+        measurement = self.sensors.navigate(self.time_s, self.q, self.v, measurement)
         tau = self.command(measurement)
         tau_applied = self.actuate(tau)
         if logged:
