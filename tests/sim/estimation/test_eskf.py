@@ -16,12 +16,12 @@ from uvms_pin.sim.estimation.spec import EstimatorSpec
 from uvms_pin.sim.navigation.acoustic import DvlSpec, UsblSpec
 
 SPEC = EstimatorSpec()
-SEEDS = range(24)
+SEEDS = range(16)
 
 
 @pytest.fixture(scope="module")
 def monte_carlo():
-    return [run(seed, SPEC) for seed in SEEDS]
+    return [run(seed, SPEC, duration_s=20.0) for seed in SEEDS]
 
 
 def test_nees_is_chi_square_over_monte_carlo_seeds(monte_carlo):
@@ -104,7 +104,7 @@ def test_dropouts_grow_the_covariance_and_keep_the_filter_consistent():
         dvl=DvlSpec(noise_m_s=0.01, max_altitude_m=5.0),
         usbl=UsblSpec(noise_m=0.1, period_s=1.0, latency_s=0.5, dropout_probability=0.6),
     )
-    runs = [run(seed, SPEC, navigation=sparse, duration_s=30.0) for seed in range(8)]
+    runs = [run(seed, SPEC, navigation=sparse, duration_s=20.0) for seed in range(5)]
     r = runs[0]
     variance = r.covariances[:, 0, 0]
     steps = np.diff(variance)
