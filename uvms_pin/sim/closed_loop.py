@@ -115,6 +115,12 @@ class ClosedLoop:
         contact = self.plant.contact_wrench(self.q, self.v)
         return self.sensors.measure(self.time_s, self.q, self.v, contact), contact
 
+    def observe(self) -> tuple[Measurement, np.ndarray]:
+        """`measure`, then, once per control tick, the navigation sensors and the estimator
+        (`SensorSuite.navigate`): (what the controller is given, the true contact wrench)."""
+        measurement, contact = self.measure()
+        return self.sensors.navigate(self.time_s, self.q, self.v, measurement), contact
+
     def command(self, measurement: Measurement) -> np.ndarray:
         """The controller's tau (nv,) for ``measurement`` (SimulationError if it is not nv
         finite numbers)."""
@@ -238,10 +244,7 @@ class ClosedLoop:
 
     def _tick(self, logged: bool) -> np.ndarray:
         """Measure, command and actuate at the current state; log if ``logged``."""
-        measurement, contact = self.measure()
-        # stateful, once per tick: the navigation sensors and the estimator (which may
-        # replace the vehicle part of what the controller is given)
-        measurement = self.sensors.navigate(self.time_s, self.q, self.v, measurement)
+        measurement, contact = self.observe()
         tau = self.command(measurement)
         tau_applied = self.actuate(tau)
         if logged:

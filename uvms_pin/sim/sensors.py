@@ -208,7 +208,7 @@ class SensorSuite:
         if self.navigation is None:
             return {}
         signals: dict[str, np.ndarray | Signal] = self.navigation.signals()
-        if self.estimator is not None:
+        if self.estimator is not None and self._estimator_started:
             signals.update(self.estimator.signals())
         return signals
 
