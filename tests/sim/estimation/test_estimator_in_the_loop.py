@@ -121,3 +121,14 @@ def test_the_estimators_noise_defaults_to_the_sensors_and_can_be_overridden():
     assert changed.measurement_noise_of(nav).usbl_m == 0.5
     imu = changed.imu_noise_of(nav)
     assert imu.gyro_noise == 1e-3 and imu.accel_noise == 2e-3  # the rest from the IMU
+
+
+def test_the_shipped_scenario_holds_its_station_on_the_estimate():
+    """README's bound: within 0.15 m of the station (true distance) after the 10 s
+    transient, the controller never seeing the truth; the filter consistent meanwhile."""
+    rollout = up.simulate(load_scenario(SCENARIO))
+    metrics = rollout.metrics()
+    assert rollout.metadata["status"] == "ok"
+    assert metrics["task_position_error_max_m"] < 0.15
+    assert metrics["estimate_within_3_sigma_fraction"] > 0.98
+    assert metrics["estimate_position_error_rms_m"] < 0.1
