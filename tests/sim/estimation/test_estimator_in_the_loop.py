@@ -132,3 +132,21 @@ def test_the_shipped_scenario_holds_its_station_on_the_estimate():
     assert metrics["task_position_error_max_m"] < 0.15
     assert metrics["estimate_within_3_sigma_fraction"] > 0.98
     assert metrics["estimate_position_error_rms_m"] < 0.1
+
+
+def test_the_ppc_runs_on_the_estimate():
+    """The model-free PPC of the realistic force task, its vehicle measured by the filter
+    (started at the truth): the force task still holds over its first half second."""
+    scenario = ROOT / "scenarios" / "realistic_force_tracking.toml"
+    overrides = {
+        "scenario.duration_s": 0.5,
+        "sensors.imu": {"gyro_noise_rad_s_rthz": 3e-4, "accel_noise_m_s2_rthz": 2e-3},
+        "sensors.depth": {"noise_Pa": 100.0},
+        "sensors.dvl": {"noise_m_s": 0.01, "seabed_depth_m": 10.0},
+        "sensors.usbl": {"noise_m": 0.1, "latency_s": 0.5},
+        "estimator": {"controller_input": "estimate", "draw_initial_error": False},
+    }
+    rollout = up.simulate(load_scenario(scenario, overrides))
+    assert rollout.metadata["status"] == "ok"
+    estimate = rollout.signals["estimate"]
+    assert 0.0 < np.abs(estimate[:, :3] - rollout.q[:, :3]).max() < 0.05
