@@ -41,6 +41,7 @@ PRODUCERS = {
     "push_object": "a free box pushed across the seafloor: docs/results/push_object.md, docs/push_object.png",
     "derivatives": "cost of the dynamics' derivatives and of an MPC re-plan: docs/results/derivatives.md",
     "tracking": "end-effector tracking, controller x task x conditions: docs/results/tracking.md, docs/tracking_*.png",
+    "estimator": "station keeping on the navigation estimate: docs/results/estimator.md, docs/estimator_station_keeping.png",
 }
 
 
