@@ -10,7 +10,7 @@ import math
 import numpy as np
 import pinocchio as pin
 import pytest
-from conftest import RHO, G, body_urdf, hydro_xml
+from conftest import RHO, ROOT, G, body_urdf, hydro_xml
 
 import uvms_pin as up
 from uvms_pin.hydro.params import HydroParams
@@ -230,3 +230,15 @@ def test_both_backends_integrate_free_objects_alike(load_body):
         finals.append(np.concatenate([states[-1][1], states[-1][2], states[-1][3]]))
     assert np.allclose(finals[0], finals[1], rtol=1e-9, atol=1e-11)
     assert np.linalg.norm(finals[0][13 + 7 : 13 + 10]) > 1e-3  # the ball moved
+
+
+def test_a_free_mesh_has_its_volume_mass_and_a_positive_inertia():
+    rock = free_object(
+        "rock", "mesh", {"path": ROOT / "scenarios" / "meshes" / "rock.obj"},
+        ([0, 0, -5], [0, 0, 0]), density_kg_m3=2600.0, water_density_kg_m3=RHO,
+    )  # fmt: skip
+    (body,) = rock.uvms.hydro_bodies
+    assert rock.mass_kg == pytest.approx(2600.0 * body.params.volume_m3, rel=1e-9)
+    inertia = rock.uvms.model.inertias[1].inertia
+    assert np.all(np.linalg.eigvalsh(inertia) > 0.0)
+    assert len(rock.pieces) == 1  # its hull collides
