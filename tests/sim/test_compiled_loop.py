@@ -8,7 +8,7 @@ import pytest
 from conftest import ROOT
 
 from uvms_pin.control.base import Controller
-from uvms_pin.errors import FunnelViolation
+from uvms_pin.errors import ActuationWarning, FunnelViolation
 from uvms_pin.scenario.load import load_scenario
 from uvms_pin.sim.run import simulate
 
@@ -129,3 +129,16 @@ def test_a_python_part_makes_the_loop_take_the_python_path():
     assert meta["python_ticks"] == 51
     continuous = simulate(load_scenario(PAPER, {"scenario.duration_s": 0.05}), progress=False)
     assert continuous.metadata["closed_loop"]["reason"] == "continuous-time control"
+
+
+def test_what_the_thrusters_cannot_produce_is_warned_alike():
+    # all six components asked of 4 thrusters that cannot roll or pitch: the allocation
+    # drops a part of every command, tracked tick by tick in the core as in Python
+    overrides = {"actuation.allocated_components": [0, 1, 2, 3, 4, 5], "scenario.duration_s": 0.3}
+    warned = {}
+    for compiled in (True, False):
+        with pytest.warns(ActuationWarning) as record:
+            rollout, _ = _run(REALISTIC, overrides, compiled)
+        warned[compiled] = [str(w.message) for w in record if w.category is ActuationWarning]
+        assert rollout.metadata["closed_loop"]["path"] == ("compiled" if compiled else "python")
+    assert warned[True] == warned[False] and "roll moment" in warned[True][0]
