@@ -37,8 +37,11 @@ from uvms_pin.sim.plant import Plant
 from uvms_pin.sim.sample import ProgressReport
 from uvms_pin.sim.settings import SimulationSettings
 
-#: Ticks per call: a 500 Hz loop returns to Python (Ctrl-C, progress) every 0.5 s simulated.
+#: Ticks per call at most: a 500 Hz loop returns to Python (Ctrl-C, progress) every 0.5 s
+#: simulated. A run starts with `FIRST_CHUNK_TICKS`, doubled at every call: a run that stops
+#: early (most of a study's) does not draw noise and f_d for ticks it never reaches.
 CHUNK_TICKS = 250
+FIRST_CHUNK_TICKS = 32
 
 #: The law's signals in the order the Python loop logs them (`PrescribedPerformanceController.
 #: signals`), each: where it comes from ("desired": the f_d / rpy_d table; "kernel": the
@@ -156,6 +159,7 @@ class CompiledLoop:
             n: slice(a, b) for n, (a, b) in self.kernel.kernel.signal_layout().items()
         }
         self.progress = [o for o in loop.observers if isinstance(o, ProgressReport)]
+        self.chunk_ticks = FIRST_CHUNK_TICKS
 
     @classmethod
     def build(
@@ -192,7 +196,8 @@ class CompiledLoop:
         """Ticks from ``first`` in one call: (the next tick to run, stopped: that tick is
         the Python loop's)."""
         loop, settings = self.loop, self.settings
-        n = min(CHUNK_TICKS, settings.final_tick + 1 - first)
+        n = min(self.chunk_ticks, settings.final_tick + 1 - first)
+        self.chunk_ticks = min(2 * self.chunk_ticks, CHUNK_TICKS)
         times = (np.arange(first, first + n, dtype=float) * settings.period_s).tolist()
         desired = np.ascontiguousarray(self._desired(times))
         n = len(desired)
