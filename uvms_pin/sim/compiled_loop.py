@@ -116,6 +116,7 @@ def _why_not(plant, controller, sensors, settings, observers, log) -> str | None
         (plant.world is not None, "a world (its contacts are Python's)"),
         (plant.stop_at_surface, "stop_at_surface"),
         (sensors.navigation is not None, "navigation sensors"),
+        (getattr(sensors, "estimator", None) is not None, "a navigation estimator"),
         (any(o is not log and not isinstance(o, ProgressReport) for o in observers),
          "an observer that needs every sample"),
     )  # fmt: skip
