@@ -17,7 +17,11 @@ measured here, to one ``pin.aba`` call on the same model or to MuJoCo doing the 
 3. one closed-loop tick of scenarios/realistic_force_tracking.toml: the same Python PPC,
    sensors and thruster allocation compute tau from a `Measurement` of each simulator's
    state, then the plant advances 2 ms;
-4. the plant per 2 ms with 4-, 6- and 7-joint arms (reference, UR5, Panda on the
+4. the whole 2 s closed loop of that scenario as ``up.simulate`` runs it (measurement with its
+   noise, PPC, allocation, plant, log and the rollout's energies), on the compiled loop and on
+   the Python loop (`uvms_pin.sim.compiled_loop`), per 2 ms tick, against MuJoCo's plant alone
+   (4 RK4 ``mj_step``, no controller);
+5. the plant per 2 ms with 4-, 6- and 7-joint arms (reference, UR5, Panda on the
    reference vehicle).
 
 When uvms-pin grows a ``backend=`` keyword (on ``forward_dynamics``, on ``Plant`` or on
@@ -320,6 +324,23 @@ def _mujoco_loop(scenario, system: System, ticks: int) -> None:
             mujoco.mj_step(model, data)
 
 
+def whole_loop_cases(system: System, duration_s: float) -> dict[str, Callable[[], object]]:
+    """The realistic scenario's ``duration_s`` closed loop by ``up.simulate`` (each loop
+    path), and MuJoCo's plant alone over as many 2 ms periods."""
+    scenario = up.load_scenario(SCENARIO, {"scenario.duration_s": duration_s})
+    ticks = round(duration_s / CONTROL_PERIOD_S)
+    period = mujoco_plant_case(system)
+
+    def run(compiled: bool):
+        return lambda: up.simulate(scenario, progress=False, compiled_loop=compiled)
+
+    return {
+        "uvms-pin simulate, compiled loop": run(True),
+        "uvms-pin simulate, Python loop": run(False),
+        "MuJoCo plant alone": lambda: [period() for _ in range(ticks)],
+    }
+
+
 # ---- report -------------------------------------------------------------------------------
 
 
@@ -383,6 +404,7 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--repeat", type=int, default=25, help="rounds; the best is kept")
     parser.add_argument("--ticks", type=int, default=25, help="closed-loop ticks per run")
+    parser.add_argument("--loop-s", type=float, default=2.0, help="whole closed loop [s]")
     parser.add_argument("--out", type=Path, default=ROOT / "out" / "bench" / "mujoco.md")
     args = parser.parse_args()
     if min(args.repeat, args.ticks) < 1:
@@ -409,6 +431,13 @@ def main() -> None:
             closed_loop_cases(args.ticks),
             args.repeat,
             per_call=args.ticks,
+        ),
+        measure_section(
+            f"whole closed loop, realistic scenario, {args.loop_s:g} s, per 2 ms tick",
+            reference,
+            whole_loop_cases(reference, args.loop_s),
+            max(3, args.repeat // 5),
+            per_call=round(args.loop_s / CONTROL_PERIOD_S),
         ),
     ]
     with tempfile.TemporaryDirectory(prefix="uvms_bench_") as tmp:

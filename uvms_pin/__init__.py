@@ -41,6 +41,7 @@ __getattr__, __dir__, _lazy_names = lazy_exports(
         "uvms_pin.results.signal": ("Signal",),
         "uvms_pin.scenario.load": ("load_scenario",),
         "uvms_pin.sim.run": ("Scenario", "simulate"),
+        "uvms_pin.sim.batch": ("simulate_batch",),
     },
 )
 
@@ -81,5 +82,6 @@ __all__ = [
     "potential_energy",
     "shipped_path",
     "simulate",
+    "simulate_batch",
     "step_derivatives",
 ]

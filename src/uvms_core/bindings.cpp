@@ -21,6 +21,8 @@
 namespace nb = nanobind;
 using namespace nb::literals;
 
+void bind_sampled_loop(nb::module_& m);  // loop_bindings.cpp
+
 namespace {
 
 using uvms::ConstVec;
@@ -517,4 +519,5 @@ NB_MODULE(_core, m) {
   bind_environment(m);
   bind_plant(m);
   bind_ppc(m);
+  bind_sampled_loop(m);
 }

@@ -93,9 +93,12 @@ def test_a_measurement_never_aliases_the_plant_state():
 
 def test_stepping_by_hand_gives_the_run_of_simulate():
     """What the Gymnasium environment does (measure, command, actuate, step, log) is the
-    closed loop ``simulate`` runs: the same samples to the last bit."""
+    closed loop ``simulate`` runs: the same samples to the last bit on the Python loop, and to
+    rounding (1e-12) on the compiled loop (its allocation products sum in another order)."""
     scenario = _short(**{"sensors.force_noise_N": 0.05, "sensors.velocity_noise": 0.01})
-    reference = simulate(scenario, progress=False)
+    reference = simulate(scenario, progress=False, compiled_loop=False)
+    compiled = simulate(scenario, progress=False)
+    assert compiled.metadata["closed_loop"]["path"] == "compiled"
     settings = scenario.settings
     controller = scenario.controller_factory(scenario.uvms)
     loop = ClosedLoop(scenario.plant, settings, controller)
@@ -117,6 +120,10 @@ def test_stepping_by_hand_gives_the_run_of_simulate():
     assert len(rollout) == len(reference)
     for name in ("time_s", "q", "v", "tau", "wrench_measured_world", "kinetic_energy_J"):
         np.testing.assert_array_equal(getattr(rollout, name), getattr(reference, name))
+        scale = max(1.0, float(np.max(np.abs(getattr(reference, name)))))
+        np.testing.assert_allclose(
+            getattr(compiled, name), getattr(reference, name), rtol=0, atol=1e-12 * scale
+        )
 
 
 def test_the_status_is_typed_saved_and_read_back(tmp_path):

@@ -433,6 +433,17 @@ class PrescribedPerformanceController(Controller):
         )
         return self._last_signals
 
+    def adopt_kernel_call(
+        self, time_s: float, force_desired: np.ndarray, rpy_desired: np.ndarray
+    ) -> None:
+        """The compiled kernel's last call (at ``time_s``, with these f_d and rpy_d) was made
+        for this controller by the compiled closed loop (`uvms_pin.sim.compiled_loop`): its
+        signals and margin are this controller's last, as after an ok `compute`."""
+        self._core_last = (float(time_s), force_desired, rpy_desired, False)
+        self._last = None
+        self._last_signals = None
+        self._margin = None
+
     def desired_force_world_N(self, time_s: float) -> np.ndarray:
         """f_d(t) (3,) [N], world axes: the force this controller tracks."""
         return np.asarray(self._desired_force(time_s), dtype=float)

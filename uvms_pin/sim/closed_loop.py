@@ -37,6 +37,7 @@ from uvms_pin.errors import (
 from uvms_pin.results.rollout import Rollout
 from uvms_pin.results.signal import described
 from uvms_pin.results.status import ERROR, INTERRUPTED, OK, RunStatus, Violation
+from uvms_pin.sim.compiled_loop import CompiledLoop, LoopPath
 from uvms_pin.sim.divergence import NUMERICAL_FAILURES, diverged, divergence_context
 from uvms_pin.sim.integrators import Adaptive
 from uvms_pin.sim.log import RolloutLog
@@ -68,7 +69,10 @@ class ClosedLoop:
         settings: SimulationSettings,
         controller: Controller | None = None,
         observers: Sequence[Observer] = (),
+        *,
+        compiled: bool = True,
     ):
+        self.compiled = compiled  # the sampled loop may run in the core (`compiled_loop`)
         self.plant = plant
         self.settings = settings
         self.controller = controller
@@ -224,13 +228,16 @@ class ClosedLoop:
         self.observers.insert(0, log)
         wall_start = time.perf_counter()
         span = [0.0, 0.0]  # the interval being integrated, for a divergence message
+        path = LoopPath()
+        log.rollout.metadata["closed_loop"] = path.record()
         try:
             self.start(q0, v0, sensors)
             log.rollout.metadata["world"] = self.plant.record()  # as simulated: anchored
             if self.settings.control_period_s is None:
+                path.reason = "continuous-time control"
                 self._run_continuous(span)
             else:
-                self._run_sampled(span)
+                self._run_sampled(span, log, path)
         except NUMERICAL_FAILURES as exc:
             error = _diverged(*span, exc, self._context(tuple(span), self._last_tau_applied))
             raise _stopped(log, wall_start, error) from exc
@@ -242,6 +249,7 @@ class ClosedLoop:
             )
             raise
         finally:
+            log.rollout.metadata["closed_loop"] = path.record()
             self.observers.remove(log)
             dropped = self.plant.actuation.dropped()
             if dropped is not None:
@@ -257,16 +265,31 @@ class ClosedLoop:
             self.notify(self.sample(measurement, contact, tau, tau_applied))
         return tau_applied
 
-    def _run_sampled(self, span: list[float]) -> None:
+    def _run_sampled(self, span: list[float], log: RolloutLog, path: LoopPath) -> None:
+        """Every tick, in chunks of compiled ticks when the whole loop has a compiled
+        counterpart (`CompiledLoop`); a tick the core hands back, and every tick otherwise,
+        in Python."""
         settings = self.settings
         ticks_per_log = settings.ticks_per_log
         n_ticks = (settings.n_log - 1) * ticks_per_log
-        for tick in range(n_ticks + 1):
+        compiled, path.reason = CompiledLoop.build(self, log, self.compiled)
+        tick = 0
+        while tick <= n_ticks:
+            if compiled is not None:
+                reached, stopped = compiled.run(tick)
+                path.compiled_ticks += reached - tick
+                tick = reached
+                if not stopped:
+                    continue
+                if tick > n_ticks:
+                    return
+            path.python_ticks += 1
             tau_applied = self._tick(tick % ticks_per_log == 0)
             if tick == n_ticks:
                 return
             span[:] = self.time_s, self.time_s + settings.control_period_s
             self.step(tau_applied)
+            tick += 1
 
     def _run_continuous(self, span: list[float]) -> None:
         """One integrator pass per re-basing segment, states at the log times; the
@@ -447,11 +470,14 @@ def simulate_closed_loop(
     *,
     metadata: dict[str, Any] | None = None,
     observers: Sequence[Observer] = (),
+    compiled: bool = True,
 ) -> Rollout:
     """Run ``controller`` on ``plant`` from (q0, v0) for ``settings.duration_s``.
 
     Returns the rollout (status ``ok``); the run's settings, versions and model are added to
-    ``metadata``. Raises as `ClosedLoop.run`.
+    ``metadata``. ``compiled``: a sampled loop whose every part the core knows runs in the
+    core (`uvms_pin.sim.compiled_loop`; False: in Python, tick by tick); the metadata's
+    ``closed_loop`` says which path ran. Raises as `ClosedLoop.run`.
     """
     from uvms_pin.sim.settings import check_log_fits
 
@@ -460,5 +486,5 @@ def simulate_closed_loop(
     if sensors.navigation is not None:
         meta["signal_units"].update(_described(sensors.navigation.signal_columns()))
     log = RolloutLog(plant.uvms, settings.n_log, meta, backend=plant.backend, plant=plant)
-    loop = ClosedLoop(plant, settings, controller, observers)
+    loop = ClosedLoop(plant, settings, controller, observers, compiled=compiled)
     return loop.run(q0, v0, sensors, log)

@@ -125,6 +125,7 @@ def simulate(
     progress: bool | Progress | None = True,
     observers: Sequence[Observer] = (),
     controller: Controller | None = None,
+    compiled_loop: bool = True,
 ) -> Rollout:
     """Run a scenario: fresh sensors (seeded) and controller, closed loop, rollout.
 
@@ -134,6 +135,9 @@ def simulate(
     every logged sample. ``observers``: called with every logged sample (`Observer`), e.g.
     a live view. ``controller``: an instance to run instead of the one the scenario builds
     (it is reset first; the rollout records its class, with type and parameters None).
+    ``compiled_loop``: False runs a sampled loop tick by tick in Python even when the core
+    could run it (`uvms_pin.sim.compiled_loop`; the rollout's ``closed_loop`` metadata says
+    which path ran).
 
     Raises FunnelViolation / SimulationError with the partial rollout attached as
     ``exc.rollout`` (see `uvms_pin.sim.closed_loop.ClosedLoop.run`). With
@@ -144,13 +148,15 @@ def simulate(
     if progress is True:
         with progress_printer(scenario.name, duration_s) as printer:
             reports = [ProgressReport(printer, duration_s)]
-            return _simulate(scenario, [*observers, *reports], controller)
+            return _simulate(scenario, [*observers, *reports], controller, compiled_loop)
     callback = callback_or_none(progress)
     reports = [] if callback is None else [ProgressReport(callback, duration_s)]
-    return _simulate(scenario, [*observers, *reports], controller)
+    return _simulate(scenario, [*observers, *reports], controller, compiled_loop)
 
 
-def _simulate(scenario: Scenario, observers: list[Observer], given: Controller | None) -> Rollout:
+def _simulate(
+    scenario: Scenario, observers: list[Observer], given: Controller | None, compiled: bool
+) -> Rollout:
     settings = scenario.settings
     sensors = SensorSuite(
         scenario.uvms.model, scenario.sensor_config, settings.duration_s, settings.seed
@@ -182,6 +188,7 @@ def _simulate(scenario: Scenario, observers: list[Observer], given: Controller |
             settings,
             metadata=metadata,
             observers=observers,
+            compiled=compiled,
         )
     except (SimulationError, KeyboardInterrupt) as exc:  # the partial rollout too
         partial = getattr(exc, "rollout", None)

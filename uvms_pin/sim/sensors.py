@@ -107,6 +107,24 @@ class SampledNoise:
         """True when the noise is identically zero (bound 0)."""
         return self._spec.bound == 0.0
 
+    def values(self, times_s: np.ndarray) -> np.ndarray:
+        """The signal at each of ``times_s`` (n,) sorted ascending, (n, width): row i equal,
+        bit for bit, to ``self(times_s[i])`` (the same operations, element by element)."""
+        times_s = np.asarray(times_s, dtype=float)
+        if self.silent or len(times_s) == 0:
+            return np.zeros((len(times_s), self._width))
+        position = np.maximum(times_s, 0.0) / self.period_s
+        k = np.minimum((position + 1e-9).astype(np.int64), self._rows - 2)
+        s = np.minimum(np.maximum(position - k, 0.0), 1.0)
+        self._rows_from(int(k[0]))
+        self._rows_from(int(k[-1]))
+        if int(k[0]) < self._first:  # wider than the window kept: one time at a time
+            return np.array([self(t) for t in times_s.tolist()])
+        here = self._window[k - self._first]
+        after = self._window[k + 1 - self._first]
+        blend = (s * s * (3.0 - 2.0 * s))[:, None]
+        return np.where((s < 1e-9)[:, None], here, here + blend * (after - here))
+
     def __call__(self, time_s: float) -> np.ndarray:
         position = max(time_s, 0.0) / self.period_s
         k = min(int(position + 1e-9), self._rows - 2)
@@ -221,6 +239,20 @@ class SensorSuite:
         if not self._torque.silent:
             out[3:] = self._torque(time_s)
         return out
+
+    @property
+    def state_noisy(self) -> bool:
+        """True when q or v is measured with noise (else as it is)."""
+        return self._state_noisy
+
+    def noise_table(self, times_s: np.ndarray) -> np.ndarray:
+        """The noise `measure` adds at each of ``times_s`` (sorted), one row per time:
+        [force (3) N, torque (3) N m, orientation (3) rad, position (3) m, joints (nv - 6)
+        rad, velocity (nv)], bit for bit the values `measure` uses (the compiled loop's
+        input, src/uvms_core/sampled_loop.hpp)."""
+        channels = (self._force, self._torque, self._orientation, self._position,
+                    self._joints, self._velocity)  # fmt: skip
+        return np.ascontiguousarray(np.hstack([c.values(times_s) for c in channels]))
 
     def measure(
         self, time_s: float, q: np.ndarray, v: np.ndarray, wrench_world: np.ndarray

@@ -219,3 +219,14 @@ def test_your_own_metrics_are_study_columns(tmp_path):
     row = execute_run(str(study.base), study.runs()[0])
     assert row["status"] == "ok", row["error"]
     assert 0.0 < row["heave_speed_peak_m_s"] < 1.0
+
+
+def test_runs_executed_together_on_threads_give_the_rows_of_each_alone(tmp_path, serial_table):
+    from uvms_pin.apps.study.runner import execute_runs
+
+    study, serial = serial_table
+    base = str(study.base)
+    rows = execute_runs(base, study.runs(), num_threads=2)
+    together = pd.DataFrame(rows).drop(columns=[c for c in VOLATILE if c in rows[0]])
+    alone = _stable(serial).drop(columns=["base_sha256"])
+    pd.testing.assert_frame_equal(together[alone.columns], alone, check_dtype=False)

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import os
 from collections.abc import Callable
 from pathlib import Path
 from typing import Any
@@ -15,6 +16,7 @@ from uvms_pin.scenario.baselines import baseline_controller_table
 from uvms_pin.scenario.load import scenario_from_raw
 from uvms_pin.scenario.overrides import apply_overrides
 from uvms_pin.scenario.toml import read_toml
+from uvms_pin.sim.batch import run_batch
 from uvms_pin.sim.run import Scenario, simulate
 
 __all__ = ["compare_controllers", "controller_scenarios", "run_controller"]
@@ -61,6 +63,11 @@ def run_controller(name: str, scenario: Scenario, criteria: Criteria) -> tuple[d
         rollout, stopped = simulate(scenario, progress=False), ""
     except (FunnelViolation, SimulationError) as exc:
         rollout, stopped = getattr(exc, "rollout", None), f"run stopped: {exc}"
+    return _row(name, scenario, rollout, stopped, criteria)
+
+
+def _row(name, scenario, rollout, stopped: str, criteria: Criteria) -> tuple[dict, Rollout]:
+    """(row, rollout) of a controller's run, ``stopped`` saying why it stopped early."""
     if rollout is None or len(rollout) == 0:
         raise SimulationError(f"controller '{name}': {stopped or 'no samples'}")
     if scenario.task is not None:
@@ -73,11 +80,16 @@ def compare_controllers(
     criteria: Criteria,
     progress: Callable[[str], None] | None = None,
 ) -> tuple[list[dict], dict[str, Rollout]]:
-    """Rows (in the given order) and rollouts of every controller's run."""
+    """Rows (in the given order) and rollouts of every controller's run, the runs side by
+    side on threads (`uvms_pin.sim.batch.run_batch`: each the run alone, bit for bit)."""
+    if progress is not None:
+        progress(f"running {', '.join(scenarios)} ...")
+    runs = run_batch(list(scenarios.values()), min(len(scenarios), os.cpu_count() or 1) or 1)
     rows, rollouts = [], {}
-    for name, scenario in scenarios.items():
-        if progress is not None:
-            progress(f"running {name} ...")
-        row, rollouts[name] = run_controller(name, scenario, criteria)
+    for (name, scenario), run in zip(scenarios.items(), runs, strict=True):
+        if run.error is not None and not isinstance(run.error, SimulationError):
+            raise run.error  # a bug or a bad input, not a result
+        stopped = "" if run.error is None else f"run stopped: {run.error}"
+        row, rollouts[name] = _row(name, scenario, run.rollout, stopped, criteria)
         rows.append(row)
     return rows, rollouts

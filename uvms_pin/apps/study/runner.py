@@ -23,29 +23,46 @@ saturation), every metric of `Rollout.metrics`, the run's wall time and host.
 from __future__ import annotations
 
 import contextlib
-import json
 import logging
-import math
 import os
 import signal
-import socket
 import sys
 import threading
 import time
-import traceback
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-import numpy as np
 import pandas as pd
 
+# the runs as they execute on a worker (re-exported: part of the runner's interface)
+from uvms_pin.apps.study.execute import (
+    RUNS_PER_TASK,
+    base_row,
+    error_row,
+    execute_run,
+    execute_runs,
+    rollout_quantities,
+)
 from uvms_pin.apps.study.identity import check_same_study, file_sha256, record_study_inputs
 from uvms_pin.apps.study.spec import Run, Study
 from uvms_pin.checks import check_memory
-from uvms_pin.errors import ControllerError, FunnelViolation, SimulationError, StudyError
+from uvms_pin.errors import StudyError
 from uvms_pin.results.atomic import atomic_path
+
+__all__ = [
+    "STATUSES",
+    "ResultStore",
+    "Summary",
+    "base_row",
+    "error_row",
+    "execute_run",
+    "execute_runs",
+    "load_results",
+    "rollout_quantities",
+    "run_study",
+]
 
 RESULTS_FILE = "results.parquet"
 PARTS_DIR = "parts"
@@ -53,107 +70,6 @@ ROLLOUTS_DIR = "rollouts"
 STATUSES = ("ok", "FunnelViolation", "diverged", "error")
 
 RunFunction = Callable[[str, Run, "str | None"], dict[str, Any]]
-
-
-# ---- one run (executes on a worker) --------------------------------------------------------
-
-
-def execute_run(base: str, run: Run, rollout_dir: str | None = None) -> dict[str, Any]:
-    """Load the base scenario with the run's overrides, scale the plant, simulate; a row.
-
-    Never raises for a failed run: the status and message go in the row.
-    """
-    from uvms_pin.apps.study.plant import modify_plant
-    from uvms_pin.scenario.load import load_scenario
-    from uvms_pin.sim.run import simulate
-
-    start = time.perf_counter()
-    row = base_row(run)
-    rollout = None
-    try:
-        scenario = modify_plant(load_scenario(base, run.overrides), run.plant)
-        row["net_buoyancy_N"] = scenario.uvms.net_buoyancy_N
-        try:
-            rollout = simulate(scenario, progress=False)
-        except FunnelViolation as exc:
-            rollout = getattr(exc, "rollout", None)
-            row.update(
-                status="FunnelViolation",
-                error=str(exc),
-                violation_level=exc.level,
-                violation_component=exc.component,
-                violation_time_s=float(exc.time_s),
-            )
-        except ControllerError as exc:  # the controller raised: not a result, an error
-            rollout = getattr(exc, "rollout", None)
-            row.update(status="error", error=str(exc))
-            cause = exc.__cause__
-            row["traceback"] = exc.user_traceback or "".join(
-                traceback.format_exception(cause, limit=8) if cause else ()
-            )
-        except SimulationError as exc:
-            rollout = getattr(exc, "rollout", None)
-            row.update(status="diverged", error=str(exc))
-        if rollout is not None:
-            row.update(rollout_quantities(rollout))
-            row.update(rollout.metrics())
-            if rollout_dir is not None:
-                rollout.save(Path(rollout_dir) / run.run_id)
-    except Exception as exc:  # a bug or a bad input in one run must not stop the study
-        row.update(status="error", error=f"{type(exc).__name__}: {exc}")
-        row["traceback"] = traceback.format_exc(limit=8)
-    row["run_wall_time_s"] = time.perf_counter() - start
-    return row
-
-
-def base_row(run: Run) -> dict[str, Any]:
-    """The columns every row has, whatever happened to the run."""
-    row: dict[str, Any] = {
-        "run_id": run.run_id,
-        "run_index": run.index,
-        "sample": run.sample,
-        "seed": run.seed,
-        "status": "ok",
-        "error": "",
-        "violation_level": "",
-        "violation_component": "",
-        "violation_time_s": math.nan,
-        "host": socket.gethostname(),
-    }
-    for path, value in run.values.items():
-        row[run.columns.get(path, path)] = (
-            value if not isinstance(value, list) else json.dumps(value)
-        )
-    return row
-
-
-def rollout_quantities(rollout) -> dict[str, float]:
-    """Initial orientation error, and how often the actuators saturated."""
-    out: dict[str, float] = {}
-    s = rollout.signals
-    if "e_x" in s and len(s["e_x"]):
-        e_o = s["e_x"][0, 3:6]
-        for name, value in zip(("roll", "pitch", "yaw"), e_o, strict=True):
-            out[f"initial_error_{name}_rad"] = float(value)
-        out["initial_orientation_error_max_rad"] = float(np.max(np.abs(e_o)))
-    if "xi_x" in s and len(s["xi_x"]):
-        out["initial_orientation_xi_max"] = float(np.max(np.abs(s["xi_x"][0, 3:6])))
-    commanded = s.get("tau_commanded")
-    if commanded is not None and len(commanded):
-        clipped = np.abs(commanded - rollout.tau) > 1e-6 * np.maximum(1.0, np.abs(commanded))
-        # surge, sway, heave, yaw: roll and pitch may be unactuated (always "clipped")
-        out["vehicle_saturation_fraction"] = float(
-            np.mean(np.any(clipped[:, [0, 1, 2, 5]], axis=1))
-        )
-        out["joint_saturation_fraction"] = float(np.mean(np.any(clipped[:, 6:], axis=1)))
-    return out
-
-
-def error_row(run: Run, exc: BaseException) -> dict[str, Any]:
-    """The row of a run whose task itself failed (worker killed, unpicklable result...)."""
-    row = base_row(run)
-    row.update(status="error", error=f"{type(exc).__name__}: {exc}", host="")
-    return row
 
 
 # ---- the table -----------------------------------------------------------------------------
@@ -445,19 +361,25 @@ def _run_on_dask(todo, base, rollout_dir, run_fn, finished, workers, scheduler) 
 
     client, cluster = _client(workers, scheduler)
     futures = {}
+    # the package's runs go a few per task (`execute_runs`); a worker with several threads
+    # runs several tasks at once, in parallel in the compiled loop (the GIL released)
+    per_task = RUNS_PER_TASK if run_fn is execute_run else 1
     try:
-        for run in todo:
+        for start in range(0, len(todo), per_task):
+            runs = todo[start : start + per_task]
             future = client.submit(
-                run_fn, base, run, rollout_dir, key=f"uvms-run-{run.run_id}", pure=False
-            )
-            futures[future] = run
+                _task, run_fn, base, runs, rollout_dir,
+                key=f"uvms-run-{runs[0].run_id}", pure=False,
+            )  # fmt: skip
+            futures[future] = runs
         for future in as_completed(futures):
-            run = futures[future]
+            runs = futures[future]
             try:
-                row = future.result()
+                rows = future.result()
             except Exception as exc:  # the task itself failed (e.g. its worker died)
-                row = error_row(run, exc)
-            finished(row)
+                rows = [error_row(run, exc) for run in runs]
+            for row in rows:
+                finished(row)
             future.release()
     finally:
         for future in futures:
@@ -466,3 +388,11 @@ def _run_on_dask(todo, base, rollout_dir, run_fn, finished, workers, scheduler) 
         client.close()
         if cluster is not None:
             cluster.close()
+
+
+def _task(run_fn: RunFunction, base, runs, rollout_dir) -> list[dict[str, Any]]:
+    """The rows of one Dask task's runs: `execute_runs` (a batch), or one by one through
+    another ``run_fn``."""
+    if run_fn is execute_run:
+        return execute_runs(base, runs, rollout_dir)
+    return [run_fn(base, run, rollout_dir) for run in runs]

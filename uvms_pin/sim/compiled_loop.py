@@ -1,0 +1,277 @@
+"""The sampled closed loop in the compiled core: many ticks per call, the GIL released.
+
+`ClosedLoop` (`uvms_pin.sim.closed_loop`) runs its sampled loop here, a chunk of ticks per
+call of the core's ``run_sampled_chunk`` (src/uvms_core/sampled_loop.hpp), when every part of
+the loop has a compiled counterpart: the plant (`Plant`'s compiled plant, no world, no stop at
+the surface), a fixed-step integrator, the PPC law (its compiled kernel, the package's class
+itself), sensors without navigation, the actuation (`Unlimited`, or thrusters with their ideal
+drives and the joints' effort limits), and observers that need only the log and the progress.
+Otherwise `CompiledLoop.build` says why not, and the loop runs in Python as always; the
+rollout's metadata ``closed_loop`` says which path ran and why.
+
+Everything random or user-written stays Python's and comes in as tables per chunk: the
+sensors' seeded noise at the ticks (`SensorSuite.noise_table`, the very numbers `measure`
+adds) and f_d(t), rpy_d(t). A tick the core does not finish as the ordinary case (the law's
+status not ok: a funnel left, the solver declining; a failed or diverged step) is not
+committed: the Python loop runs that tick (and raises as it does), then the chunks resume. So
+both paths give the same rollout (to rounding: tests/sim/test_compiled_loop.py), a funnel
+violation stops at the same tick, and Ctrl-C, honoured between chunks, keeps the rows of the
+chunks done.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass
+from types import ModuleType
+from typing import Any
+
+import numpy as np
+
+from uvms_pin.control.performance import transformed_error
+from uvms_pin.control.ppc import PrescribedPerformanceController
+from uvms_pin.sim.actuation import Actuation, ThrustersAndJointLimits, Unlimited
+from uvms_pin.sim.integrators import FixedStep
+from uvms_pin.sim.log import RolloutLog
+from uvms_pin.sim.plant import Plant
+from uvms_pin.sim.sample import ProgressReport
+from uvms_pin.sim.settings import SimulationSettings
+
+#: Ticks per call at most: a 500 Hz loop returns to Python (Ctrl-C, progress) every 0.5 s
+#: simulated. A run starts with `FIRST_CHUNK_TICKS`, doubled at every call: a run that stops
+#: early (most of a study's) does not draw noise and f_d for ticks it never reaches.
+CHUNK_TICKS = 250
+FIRST_CHUNK_TICKS = 32
+
+#: The law's signals in the order the Python loop logs them (`PrescribedPerformanceController.
+#: signals`), each: where it comes from ("desired": the f_d / rpy_d table; "kernel": the
+#: kernel's buffer; "eps": the transformed error of a kernel signal).
+_PPC_SIGNALS = (
+    ("force_desired_world_N", "desired", slice(0, 3)),
+    ("rpy_desired", "desired", slice(3, 6)),
+    ("rpy_ee", "kernel", "rpy_ee"),
+    ("e_x", "kernel", "e_x"),
+    ("rho_x", "kernel", "rho_x"),
+    ("xi_x", "kernel", "xi_x"),
+    ("eps_x", "eps", "xi_x"),
+    ("xdot_r", "kernel", "xdot_r"),
+    ("zeta_r", "kernel", "zeta_r"),
+    ("e_zeta", "kernel", "e_zeta"),
+    ("rho_zeta", "kernel", "rho_zeta"),
+    ("xi_zeta", "kernel", "xi_zeta"),
+    ("eps_zeta", "eps", "xi_zeta"),
+    ("tau", "kernel", "tau"),
+)
+
+
+@dataclass
+class LoopPath:
+    """Which loop ran a run: why not compiled (None when it was), and the ticks each path
+    ran (the Python loop runs the ticks the core hands back, see the module docstring)."""
+
+    reason: str | None = None
+    compiled_ticks: int = 0
+    python_ticks: int = 0
+
+    def record(self) -> dict[str, Any]:
+        return {
+            "path": "compiled" if self.compiled_ticks else "python",
+            "reason": self.reason,
+            "compiled_ticks": self.compiled_ticks,
+            "python_ticks": self.python_ticks,
+        }
+
+
+def _actuation_to_core(actuation: Actuation, core: ModuleType, nv: int):
+    """The core's LoopActuation of ``actuation``, or the reason it has none."""
+    out = core.LoopActuation()
+    if type(actuation) is Unlimited:
+        return out
+    if type(actuation) is not ThrustersAndJointLimits:
+        return f"the actuation {type(actuation).__name__} has no compiled counterpart"
+    if not actuation._ideal:
+        return "thruster drives with curves or dynamics have no compiled counterpart"
+    limits = actuation.joint_effort_limits_Nm
+    if limits is not None and limits.shape != (nv - 6,):
+        return "joint effort limits do not match the arm"  # the Python loop raises
+    out.thrusters = True
+    out.allocation = actuation.allocation
+    out.allocation_pinv = actuation._allocation_pinv
+    out.lower_N, out.upper_N = actuation._lower, actuation._upper
+    out.full_forward_N, out.full_reverse_N = actuation._full_forward, actuation._full_reverse
+    out.joint_limits_Nm = np.zeros(0) if limits is None else limits
+    out.residual = np.zeros((0, 0)) if actuation._residual is None else actuation._residual
+    out.components = [int(k) for k in actuation.allocated_components]
+    return out
+
+
+def _why_not(plant, controller, sensors, settings, observers, log) -> str | None:
+    """Why this loop cannot run compiled (the first part without a counterpart), or None."""
+    checks = (
+        (settings.control_period_s is None, "continuous-time control"),
+        (not isinstance(settings.integrator, FixedStep), "an adaptive integrator"),
+        (type(controller) is not PrescribedPerformanceController,
+         f"the controller {type(controller).__name__} is not compiled"),
+        (getattr(controller, "_kernel", None) is None, "the controller's Python backend"),
+        (plant.world is not None, "a world (its contacts are Python's)"),
+        (plant.stop_at_surface, "stop_at_surface"),
+        (sensors.navigation is not None, "navigation sensors"),
+        (getattr(sensors, "estimator", None) is not None, "a navigation estimator"),
+        (any(o is not log and not isinstance(o, ProgressReport) for o in observers),
+         "an observer that needs every sample"),
+    )  # fmt: skip
+    reason = next((why for failed, why in checks if failed), None)
+    if reason is not None:
+        return reason
+    if plant._core() is None:
+        return "the plant runs on the Python reference"
+    if plant._compiled_step(settings.integrator) is None:
+        return f"the integrator {type(settings.integrator).__name__} is not compiled"
+    return None
+
+
+class CompiledLoop:
+    """One run's compiled sampled loop: its core objects, tables and log buffer."""
+
+    def __init__(self, core: ModuleType, loop, log: RolloutLog, actuation_core):
+        plant: Plant = loop.plant
+        settings: SimulationSettings = loop.settings
+        self.core, self.loop, self.log = core, loop, log
+        self.controller: PrescribedPerformanceController = loop.controller
+        self.kernel = self.controller._kernel
+        self.actuation_core = actuation_core
+        self.settings = core.LoopSettings()
+        self.settings.integrator = plant._compiled_step(settings.integrator)
+        self.settings.period_s = float(settings.control_period_s)
+        self.settings.ticks_per_log = int(settings.ticks_per_log)
+        self.settings.final_tick = (settings.n_log - 1) * settings.ticks_per_log
+        self.settings.state_noisy = loop.sensors.state_noisy
+        uvms = plant.uvms
+        self.nq, self.nv = uvms.nq, uvms.nv
+        self.m = len(plant.actuation.thrusters) if actuation_core.thrusters else 0
+        n_signals = len(self.kernel.packed)
+        self.row = {
+            name: slice(*span)
+            for name, span in core.loop_row(self.nq, self.nv, self.m, n_signals).items()
+        }
+        width = self.row["thrust"].stop
+        self.buffer = np.zeros((CHUNK_TICKS // self.settings.ticks_per_log + 1, width))
+        self.kernel_slices = {
+            n: slice(a, b) for n, (a, b) in self.kernel.kernel.signal_layout().items()
+        }
+        self.progress = [o for o in loop.observers if isinstance(o, ProgressReport)]
+        self.chunk_ticks = FIRST_CHUNK_TICKS
+
+    @classmethod
+    def build(
+        cls, loop, log: RolloutLog, allowed: bool = True
+    ) -> tuple[CompiledLoop | None, str | None]:
+        """(the compiled loop of ``loop``, None) or (None, why it runs in Python)."""
+        if not allowed:
+            return None, "the Python loop was asked for"
+        plant = loop.plant
+        reason = _why_not(plant, loop.controller, loop.sensors, loop.settings, loop.observers, log)
+        if reason is not None:
+            return None, reason
+        core = plant._backend.counterpart(lambda module: module)  # compiled: _core() is set
+        actuation = _actuation_to_core(plant.actuation, core, plant.uvms.nv)
+        if isinstance(actuation, str):
+            return None, actuation
+        return cls(core, loop, log, actuation), None
+
+    # ---- one chunk ----------------------------------------------------------------------
+    def _desired(self, times: Sequence[float]) -> np.ndarray:
+        """f_d, rpy_d at ``times`` (n x 6), up to the first time where one raises (the
+        Python loop's tick then raises it)."""
+        force, rpy = self.controller._desired_force, self.controller._desired_rpy
+        out = np.empty((len(times), 6))
+        for i, t in enumerate(times):
+            try:
+                out[i, :3] = force(t)
+                out[i, 3:] = rpy(t)
+            except Exception:
+                return out[:i]
+        return out
+
+    def run(self, first: int) -> tuple[int, bool]:
+        """Ticks from ``first`` in one call: (the next tick to run, stopped: that tick is
+        the Python loop's)."""
+        loop, settings = self.loop, self.settings
+        n = min(self.chunk_ticks, settings.final_tick + 1 - first)
+        self.chunk_ticks = min(2 * self.chunk_ticks, CHUNK_TICKS)
+        times = (np.arange(first, first + n, dtype=float) * settings.period_s).tolist()
+        desired = np.ascontiguousarray(self._desired(times))
+        n = len(desired)
+        if n == 0:
+            return first, True
+        noise = loop.sensors.noise_table(np.array(times[:n]))
+        q, v = np.array(loop.q), np.array(loop.v)
+        actuation = loop.plant.actuation
+        command, thrust, dropped = (
+            (actuation._command, actuation._thrust, actuation._dropped_max)
+            if self.actuation_core.thrusters
+            else (np.zeros(0), np.zeros(0), np.zeros(0))
+        )
+        done, rows, stopped = self.core.run_sampled_chunk(
+            loop.plant._core(), self.kernel.kernel, self.actuation_core, settings, first, n,
+            q, v, noise, desired, self.buffer, command, thrust, dropped,
+        )  # fmt: skip
+        if done:
+            self._commit(first, done, rows, q, v, desired)
+        return first + done, stopped or done < n
+
+    def _commit(self, first: int, done: int, rows: int, q, v, desired: np.ndarray) -> None:
+        """The loop's state after the chunk's ``done`` ticks, its ``rows`` into the log."""
+        loop, period = self.loop, self.settings.period_s
+        last = first + done - 1
+        q.setflags(write=False)
+        v.setflags(write=False)
+        loop.q, loop.v = q, v
+        if last < self.settings.final_tick:
+            loop.time_s = (last + 1) * period
+        else:
+            loop.time_s = last * period
+        self.controller.adopt_kernel_call(last * period, desired[done - 1, :3].copy(),
+                                          desired[done - 1, 3:].copy())  # fmt: skip
+        if rows:
+            logged = [i for i in range(done) if (first + i) % self.settings.ticks_per_log == 0]
+            self._log(self.buffer[:rows], desired[logged])
+            for report in self.progress:
+                for t in self.buffer[:rows, 0].tolist():
+                    report.on_sample(_AtTime(t))
+
+    def _log(self, block: np.ndarray, desired: np.ndarray) -> None:
+        """``block``'s rows into the rollout, as `RolloutLog.on_sample` writes samples."""
+        log, row = self.log, self.row
+        rows = len(block)
+        while log.count + rows > len(log.rollout):
+            log._grow()
+        rollout, k = log.rollout, slice(log.count, log.count + rows)
+        rollout.time_s[k] = block[:, 0]
+        rollout.q[k] = block[:, row["q"]]
+        rollout.v[k] = block[:, row["v"]]
+        rollout.tau[k] = block[:, row["tau"]]
+        rollout.signal("tau_commanded", self.nv)[k] = block[:, row["tau_commanded"]]
+        rollout.wrench_contact_world[k] = block[:, row["contact"]]
+        rollout.wrench_measured_world[k] = block[:, row["measured_wrench"]]
+        rollout.wrench_disturbance_body[k] = block[:, row["disturbance"]]
+        signals = block[:, row["signals"]]
+        for name, source, where in _PPC_SIGNALS:
+            if source == "desired":
+                values = desired[:, where]
+            else:
+                values = signals[:, self.kernel_slices[where]]
+                if source == "eps":
+                    values = transformed_error(values)
+            rollout.signal(name, values.shape[1])[k] = values
+        if self.m:
+            rollout.signal("thruster_command", self.m)[k] = block[:, row["command"]]
+            rollout.signal("thrust", self.m)[k] = block[:, row["thrust"]]
+        log.count += rows
+
+
+@dataclass(frozen=True)
+class _AtTime:
+    """What a `ProgressReport` reads of a sample: its time."""
+
+    time_s: float
