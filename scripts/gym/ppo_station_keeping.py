@@ -59,7 +59,7 @@ def train(args) -> dict:
 
     from uvms_pin.apps.gym.sb3 import Sb3VecEnv
 
-    torch.set_num_threads(args.threads)
+    torch.set_num_threads(args.torch_threads)  # the batch has its own threads
     venv = VecMonitor(Sb3VecEnv(make_vector(args.num_envs, args.threads, args.duration)))
     venv.seed(args.seed)
     curve: list[dict] = []
@@ -118,6 +118,7 @@ def main() -> None:
     parser.add_argument("--timesteps", type=int, default=300_000)
     parser.add_argument("--num-envs", type=int, default=16)
     parser.add_argument("--threads", type=int, default=2)
+    parser.add_argument("--torch-threads", type=int, default=1, help="torch's threads")
     parser.add_argument("--n-steps", type=int, default=256, help="PPO steps per env per update")
     parser.add_argument("--duration", type=float, default=4.0, help="episode length [s]")
     parser.add_argument("--seed", type=int, default=0)
