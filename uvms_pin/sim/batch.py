@@ -15,7 +15,7 @@ the numbers of a single `ClosedLoop` run with the same seed, whatever T.
 
 What the batch does not simulate is refused with a ParameterError naming it: a world
 (fixed objects), a flow (waves, sea states; a uniform current is supported), thruster
-drives with lag, navigation sensors, ``stop_at_surface``, the Python backend, or a
+drives with lag, navigation sensors or an estimator, ``stop_at_surface``, the Python backend, or a
 plant part without a compiled counterpart.
 """
 
@@ -54,6 +54,7 @@ def _unsupported(plant: Plant, sensors: SensorConfig) -> str | None:
         (plant.flow is not None, "a flow (waves, sea states, varying currents)"),
         (plant.stop_at_surface, "stop_at_surface"),
         (sensors.navigation.fitted, "navigation sensors"),
+        (sensors.estimator is not None, "a navigation estimator"),
         (not isinstance(actuation, (Unlimited, ThrustersAndJointLimits)),
          f"the actuation {type(actuation).__name__}"),
         (isinstance(actuation, ThrustersAndJointLimits) and not actuation._ideal,
