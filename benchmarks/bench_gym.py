@@ -13,7 +13,10 @@ CPU time per ``env.step`` (``time.process_time``, best of ``--repeat`` batches o
   same process), which compares across machines: a step integrates one control period
   (RK4 substeps of the full hydrodynamic forward dynamics, 4 per substep) and measures.
 
-Also ``gymnasium.vector.SyncVectorEnv`` with 4 copies (steps of all copies per second).
+Also ``gymnasium.vector.SyncVectorEnv`` with 4 copies (steps of all copies per second),
+and the native vector environment (``vectorization_mode="vector_entry_point"``) at T = 1
+and T = 2 threads as ratios to MuJoCo's ``rollout`` of its twin's plant alone, in wall-clock
+time (benchmarks/bench_vector.py).
 """
 
 from __future__ import annotations
@@ -25,6 +28,7 @@ import time
 import gymnasium as gym
 import numpy as np
 import pinocchio as pin
+from bench_vector import run as run_vector
 from timing import best_times, one_blas_thread
 
 import uvms_pin.apps.gym  # noqa: F401 - registers the environments
@@ -87,10 +91,13 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--steps", type=int, default=200)
     parser.add_argument("--repeat", type=int, default=3)
+    parser.add_argument("--vector-envs", type=int, default=64, help="N of the vector env")
+    parser.add_argument("--vector-steps", type=int, default=50, help="steps per timed call")
     parser.add_argument("--json", help="also write the results to this file")
     args = parser.parse_args()
     one_blas_thread()
     results = run(args.steps, args.repeat)
+    vector = run_vector(args.vector_envs, args.vector_steps, max(args.repeat, 5))
     for env_id, r in results.items():
         print(
             f"{env_id}: {r['steps_per_s']:.0f} steps/s, {r['simulated_s_per_s']:.2f} simulated s/s "
@@ -98,9 +105,18 @@ def main() -> None:
             f"{r['step_in_aba_calls']:.0f} pin.aba calls (aba {r['aba_s'] * 1e6:.2f} us); "
             f"SyncVectorEnv x4: {r['sync_vector_4_env_steps_per_s']:.0f} env steps/s"
         )
+    print(
+        f"vector env (ForceTracking, N = {vector['num_envs']}, wall clock): "
+        f"T=1 {vector['vector_T1_per_s']:.0f} env steps/s = "
+        f"{vector['vector_over_mujoco_T1']:.2f}x mujoco.rollout ({vector['mujoco_T1_per_s']:.0f} "
+        f"periods/s); T=2 {vector['vector_T2_per_s']:.0f} env steps/s = "
+        f"{vector['vector_over_mujoco_T2']:.2f}x mujoco.rollout ({vector['mujoco_T2_per_s']:.0f} "
+        f"periods/s); T=2 / T=1 = {vector['vector_T2_over_T1']:.2f} "
+        f"(mujoco.rollout {vector['mujoco_T2_over_T1']:.2f})"
+    )
     if args.json:
         with open(args.json, "w") as f:
-            json.dump(results, f, indent=2)
+            json.dump({**results, "vector_entry_point": vector}, f, indent=2)
 
 
 if __name__ == "__main__":

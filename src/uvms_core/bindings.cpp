@@ -490,6 +490,8 @@ void bind_ppc(nb::module_& m) {
 
 }  // namespace
 
+void bind_batch_plant(nb::module_& m);  // batch_bindings.cpp
+
 NB_MODULE(_core, m) {
   m.doc() = "Compiled dynamics, plant and controller of uvms-pin (C++ on Pinocchio's C++ API).";
   m.attr("API_VERSION") = uvms::kApiVersion;
@@ -518,6 +520,7 @@ NB_MODULE(_core, m) {
   bind_derivatives(m);
   bind_environment(m);
   bind_plant(m);
+  bind_batch_plant(m);
   bind_ppc(m);
   bind_sampled_loop(m);
 }

@@ -52,6 +52,8 @@ class Plant {
                                                     const ConstVec& v);
 
   Dynamics& dynamics() { return dynamics_; }
+  const Dynamics& dynamics() const { return dynamics_; }
+  int ee_frame_id() const { return static_cast<int>(ee_frame_id_); }
 
  private:
   Dynamics dynamics_;

@@ -44,6 +44,36 @@ def effort_penalty(action: np.ndarray, weight: float) -> float:
     return weight * float(action @ action) / action.size  # w mean(a^2)
 
 
+def effort_penalties(actions: np.ndarray, weight: float) -> np.ndarray:
+    """w mean(a^2) of each row of ``actions`` (N, nv)."""
+    return weight * np.einsum("ij,ij->i", actions, actions) / actions.shape[1]
+
+
+@dataclass(frozen=True)
+class BatchOutcome:
+    """rewards (N,), terminated (N,) and the terms that made them, (N,) each."""
+
+    reward: np.ndarray
+    terminated: np.ndarray
+    terms: dict[str, np.ndarray]
+
+    def row(self, i: int) -> StepOutcome:
+        terms = {name: float(values[i]) for name, values in self.terms.items()}
+        return StepOutcome(float(self.reward[i]), bool(self.terminated[i]), terms)
+
+
+def rotation_angle_from(target_xyzw: np.ndarray, quaternions_xyzw: np.ndarray) -> np.ndarray:
+    """|log(R_d^T R)| [rad] of each row (N, 4) of quaternions xyzw against the target's:
+    the angle of q_d^* q, 2 atan2(|vec|, |w|), in [0, pi] (as |pin.log3| of the matrices)."""
+    x, y, z, w = (-target_xyzw[0], -target_xyzw[1], -target_xyzw[2], target_xyzw[3])
+    qx, qy, qz, qw = quaternions_xyzw.T
+    rel_w = w * qw - x * qx - y * qy - z * qz
+    rel_x = w * qx + qw * x + y * qz - z * qy
+    rel_y = w * qy + qw * y + z * qx - x * qz
+    rel_z = w * qz + qw * z + x * qy - y * qx
+    return 2.0 * np.arctan2(np.sqrt(rel_x**2 + rel_y**2 + rel_z**2), np.abs(rel_w))
+
+
 class ForceTrackingTask:
     """Track f_d(t) at the end-effector inside a funnel.
 
@@ -72,17 +102,34 @@ class ForceTrackingTask:
     def goal(self, time_s: float) -> np.ndarray:
         return np.asarray(self.desired_force(time_s), dtype=float)
 
+    def bound(self, time_s: float) -> np.ndarray:
+        """rho(t) (3,) [N] of the funnel, inf without one."""
+        return np.full(3, np.inf) if self.funnel is None else self.funnel.value(time_s)
+
     def outcome(
         self, time_s: float, q: np.ndarray, contact_world: np.ndarray, action: np.ndarray
     ) -> StepOutcome:
-        error = contact_world[:3] - self.goal(time_s)
-        tracking = float(error @ error)
-        effort = effort_penalty(action, self.effort_weight)
-        outside = self.funnel is not None and bool(
-            np.any(np.abs(error) >= self.funnel.value(time_s))
-        )
-        terms = {"force_error_N": float(np.sqrt(tracking)), "effort_penalty": effort}
-        return StepOutcome(-tracking - effort, outside, terms)
+        return self.outcomes(
+            self.goal(time_s)[None], self.bound(time_s)[None], q[None], contact_world[None],
+            action[None],
+        ).row(0)  # fmt: skip
+
+    def outcomes(
+        self,
+        goal: np.ndarray,
+        bound: np.ndarray,
+        q: np.ndarray,
+        contact_world: np.ndarray,
+        action: np.ndarray,
+    ) -> BatchOutcome:
+        """Per row: goal f_d (N, 3) [N], funnel bound rho (N, 3), true state q, true
+        contact (N, 6) and normalized action (N, nv)."""
+        error = contact_world[:, :3] - goal
+        tracking = np.einsum("ij,ij->i", error, error)
+        effort = effort_penalties(action, self.effort_weight)
+        outside = np.any(np.abs(error) >= bound, axis=1)
+        terms = {"force_error_N": np.sqrt(tracking), "effort_penalty": effort}
+        return BatchOutcome(-tracking - effort, outside, terms)
 
 
 class StationKeepingTask:
@@ -99,27 +146,42 @@ class StationKeepingTask:
             )
         self.target_position_m = np.asarray(target_q[:3], dtype=float).copy()
         self.target_quaternion = np.asarray(target_q[3:7], dtype=float).copy()
-        self._target_rotation = pin.Quaternion(self.target_quaternion).toRotationMatrix()
         self.max_position_error_m = max_position_error_m
         self.effort_weight = effort_weight
 
     def goal(self, time_s: float) -> np.ndarray:
         return np.concatenate([self.target_position_m, self.target_quaternion])
 
+    def bound(self, time_s: float) -> np.ndarray:
+        """No time-varying bound: the position bound is ``max_position_error_m``."""
+        return np.zeros(0)
+
     def outcome(
         self, time_s: float, q: np.ndarray, contact_world: np.ndarray, action: np.ndarray
     ) -> StepOutcome:
-        position_error = float(np.linalg.norm(q[:3] - self.target_position_m))
-        rotation = pin.Quaternion(q[3:7]).toRotationMatrix()
-        angle_error = float(np.linalg.norm(pin.log3(self._target_rotation.T @ rotation)))
-        effort = effort_penalty(action, self.effort_weight)
+        return self.outcomes(None, None, q[None], contact_world[None], action[None]).row(0)
+
+    def outcomes(
+        self,
+        goal: np.ndarray | None,
+        bound: np.ndarray | None,
+        q: np.ndarray,
+        contact_world: np.ndarray,
+        action: np.ndarray,
+    ) -> BatchOutcome:
+        """Per row of the true states q (N, nq) and normalized actions (N, nv) (the goal
+        is constant; goal, bound and contact unused)."""
+        offset = q[:, :3] - self.target_position_m
+        position_error = np.sqrt(np.einsum("ij,ij->i", offset, offset))
+        angle_error = rotation_angle_from(self.target_quaternion, q[:, 3:7])
+        effort = effort_penalties(action, self.effort_weight)
         reward = -((position_error / POSITION_SCALE_M) ** 2) - (angle_error / ANGLE_SCALE_RAD) ** 2
         terms = {
             "position_error_m": position_error,
             "angle_error_rad": angle_error,
             "effort_penalty": effort,
         }
-        return StepOutcome(reward - effort, position_error > self.max_position_error_m, terms)
+        return BatchOutcome(reward - effort, position_error > self.max_position_error_m, terms)
 
 
 class PoseTrackingTask:

@@ -1,0 +1,96 @@
+// nanobind section of the batched plant (batch_plant.hpp): uvms_pin._core.BatchPlant and its
+// settings; the Python side that fills them is uvms_pin/physics/compiled/batch.py.
+#include <nanobind/eigen/dense.h>
+#include <nanobind/nanobind.h>
+#include <nanobind/ndarray.h>
+#include <nanobind/stl/string.h>
+#include <nanobind/stl/variant.h>
+#include <nanobind/stl/vector.h>
+
+#include "batch_plant.hpp"
+
+namespace nb = nanobind;
+using namespace nb::literals;
+
+namespace {
+
+using uvms::BatchPlant;
+using uvms::InputError;
+
+// A read-only numpy view of a buffer of the batch, kept alive by it.
+template <typename Scalar>
+nb::ndarray<nb::numpy, const Scalar> view(const Scalar* data, size_t rows, size_t cols) {
+  if (cols == 0) return nb::ndarray<nb::numpy, const Scalar>(data, {rows}, nb::handle());
+  return nb::ndarray<nb::numpy, const Scalar>(data, {rows, cols}, nb::handle());
+}
+
+#define UVMS_BATCH_VIEW(name)                                                                \
+  def_prop_ro(                                                                              \
+      #name,                                                                                \
+      [](const BatchPlant& b) {                                                             \
+        return view(b.name.data(), size_t(b.name.rows()), size_t(b.name.cols()));           \
+      },                                                                                    \
+      nb::rv_policy::reference_internal)
+
+using Commands = nb::ndarray<const double, nb::ndim<2>, nb::c_contig, nb::device::cpu>;
+using Mask = nb::ndarray<const bool, nb::ndim<1>, nb::c_contig, nb::device::cpu>;
+
+void step(BatchPlant& b, const Commands& tau_commanded, const Mask& stepping) {
+  const size_t n = size_t(b.num_envs()), nv = size_t(b.nv());
+  if (tau_commanded.shape(0) != n || tau_commanded.shape(1) != nv) {
+    throw InputError("tau_commanded must have shape (" + std::to_string(n) + ", " +
+                     std::to_string(nv) + "), got (" + std::to_string(tau_commanded.shape(0)) +
+                     ", " + std::to_string(tau_commanded.shape(1)) + ")");
+  }
+  if (stepping.shape(0) != n) {
+    throw InputError("stepping must have " + std::to_string(n) + " entries");
+  }
+  const Eigen::Map<const Eigen::ArrayXd> all(tau_commanded.data(), Eigen::Index(n * nv));
+  if (!all.allFinite()) throw InputError("tau_commanded contains a non-finite value");
+  nb::gil_scoped_release release;  // the threads run without the interpreter
+  b.step(tau_commanded.data(), stepping.data());
+}
+
+}  // namespace
+
+void bind_batch_plant(nb::module_& m) {
+  nb::class_<uvms::BatchActuation>(m, "BatchActuation",
+                                   "Thrusters and joint limits of a batch (batch_plant.hpp).")
+      .def(nb::init<>())
+      .def_rw("limited", &uvms::BatchActuation::limited)
+      .def_rw("allocation", &uvms::BatchActuation::allocation)
+      .def_rw("allocation_pinv", &uvms::BatchActuation::allocation_pinv)
+      .def_rw("lower_N", &uvms::BatchActuation::lower_N)
+      .def_rw("upper_N", &uvms::BatchActuation::upper_N)
+      .def_rw("joint_limits_Nm", &uvms::BatchActuation::joint_limits_Nm);
+  nb::class_<uvms::BatchNoise>(m, "BatchNoise", "Sensor-noise layout of a batch (batch_plant.hpp).")
+      .def(nb::init<>())
+      .def_rw("sample_period_s", &uvms::BatchNoise::sample_period_s)
+      .def_rw("rows", &uvms::BatchNoise::rows)
+      .def_rw("silent", &uvms::BatchNoise::silent);
+  nb::class_<BatchPlant>(m, "BatchPlant", "N environments of one plant on T threads (batch_plant.hpp).")
+      .def(nb::init<const uvms::Plant&, const uvms::FixedStep&, double, uvms::BatchActuation,
+                    uvms::BatchNoise, int, int>(),
+           "prototype"_a, "integrator"_a, "control_period_s"_a, "actuation"_a, "noise"_a,
+           "num_envs"_a, "num_threads"_a)
+      .def_prop_ro("num_envs", &BatchPlant::num_envs)
+      .def_prop_ro("num_threads", &BatchPlant::num_threads)
+      .def("reset", &BatchPlant::reset, "i"_a, "q0"_a, "v0"_a, "contact"_a, "noise_tables"_a,
+           "environment i to t = 0 at (q0, v0), with its contact and noise tables")
+      .def("step", &step, "tau_commanded"_a, "stepping"_a,
+           "advance the environments with stepping[i] one control period (GIL released)")
+      .UVMS_BATCH_VIEW(q)
+      .UVMS_BATCH_VIEW(v)
+      .UVMS_BATCH_VIEW(q_measured)
+      .UVMS_BATCH_VIEW(v_measured)
+      .UVMS_BATCH_VIEW(wrench_measured)
+      .UVMS_BATCH_VIEW(contact_world)
+      .UVMS_BATCH_VIEW(tau_applied)
+      .def_prop_ro(
+          "tick", [](const BatchPlant& b) { return view(b.tick.data(), size_t(b.tick.rows()), 0); },
+          nb::rv_policy::reference_internal)
+      .def_prop_ro(
+          "status",
+          [](const BatchPlant& b) { return view(b.status.data(), size_t(b.status.rows()), 0); },
+          nb::rv_policy::reference_internal);
+}

@@ -1,0 +1,99 @@
+// N environments of one plant advanced together over a control period, on T threads
+// (mirror of one tick of uvms_pin/sim/closed_loop.py's sampled loop with the controller
+// replaced by a given command, as the Gymnasium environments step it):
+//   tau_applied = actuation(tau_commanded); (q, v) advanced over the period with it held;
+//   lambda = the contact wrench at the new state; the measurement = state + sensor noise.
+// Each environment has its own state, contact anchor, sensor-noise tables (drawn from its
+// own seed by the caller at reset, uvms_pin/sim/sensors.py's streams) and status. Each
+// thread works on its own Plant (its own Pinocchio Data and scratch; the model is copied,
+// read-only); an environment's numbers do not depend on the thread that computed them, so
+// the results are the same for any T.
+#pragma once
+
+#include <memory>
+#include <vector>
+
+#include "plant.hpp"
+
+namespace uvms {
+
+using RowMatrix = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
+
+// Thrusters with ideal drives and joint effort limits (uvms_pin/sim/actuation.py,
+// ThrustersAndJointLimits), or none (Unlimited: the command applied as it is).
+struct BatchActuation {
+  bool limited = false;
+  Eigen::MatrixXd allocation;       // B (6 x m): body wrench of unit thrusts
+  Eigen::MatrixXd allocation_pinv;  // (m x 6): f = B_s^+ tau_s, zero columns for the others
+  Eigen::VectorXd lower_N, upper_N;  // thrust limits (m,)
+  Eigen::VectorXd joint_limits_Nm;   // |tau_j| limits (nj,), empty: unlimited
+
+  // out = B clip(B^+ tau[:6], lower, upper); the arm's torques clipped to their limits.
+  void apply(const ConstVec& tau_commanded, Eigen::Ref<Eigen::VectorXd> out) const;
+};
+
+// The six noise channels of uvms_pin/sim/sensors.py, in its stream order.
+enum NoiseChannel : int { kForce = 0, kTorque, kPosition, kOrientation, kJoints, kVelocity };
+constexpr int kNoiseChannels = 6;
+
+// Sensor noise sampled every sample_period_s, smoothstep-blended between samples (sensors.py,
+// SampledNoise); rows samples per episode and environment. A silent channel is zero.
+struct BatchNoise {
+  double sample_period_s = 1e-3;
+  int rows = 2;
+  std::vector<int> silent = std::vector<int>(kNoiseChannels, 1);  // 1: zero
+};
+
+// What became of an environment in the last step.
+enum BatchStatus : int { kRunning = 0, kDiverged = 1 };
+
+class BatchPlant {
+ public:
+  BatchPlant(const Plant& prototype, const FixedStep& integrator, double control_period_s,
+             BatchActuation actuation, BatchNoise noise, int num_envs, int num_threads);
+  BatchPlant(const BatchPlant&) = delete;
+  BatchPlant& operator=(const BatchPlant&) = delete;
+
+  int num_envs() const { return num_envs_; }
+  int num_threads() const { return static_cast<int>(plants_.size()); }
+  int nq() const { return nq_; }
+  int nv() const { return nv_; }
+
+  // Environment i starts at t = 0 from (q0, v0) (quaternion normalised by the caller), with
+  // its contact (anchored) and noise tables (rows x width per channel; silent ones ignored).
+  void reset(int i, const ConstVec& q0, const ConstVec& v0, const Contact& contact,
+             const std::vector<RowMatrix>& noise_tables);
+  // Every environment with stepping[i] advanced one control period under tau_commanded
+  // (N x nv, row-major); the others are left as they are. A diverged one keeps its state.
+  void step(const double* tau_commanded, const bool* stepping);
+
+  // state and outputs, one row per environment
+  RowMatrix q, v, q_measured, v_measured, wrench_measured, contact_world, tau_applied;
+  Eigen::Matrix<long long, Eigen::Dynamic, 1> tick;  // control periods since the reset
+  Eigen::Matrix<int, Eigen::Dynamic, 1> status;     // BatchStatus
+
+ private:
+  void step_range(int thread, int begin, int end, const double* tau_commanded,
+                  const bool* stepping);
+  void step_one(int thread, int i, const double* tau_commanded);
+  void measure(int thread, int i);
+  // channel c's noise of environment i at time_s, into out (the channel's width)
+  void noise_at(int c, int i, double time_s, Eigen::Ref<Eigen::VectorXd> out) const;
+
+  int num_envs_, nq_, nv_;
+  double period_s_;
+  FixedStep integrator_;
+  BatchActuation actuation_;
+  BatchNoise noise_;
+  bool state_noisy_;
+  std::vector<int> widths_;
+  std::vector<RowMatrix> tables_;  // channel c: (N rows) x width, env i at rows i*rows..
+  std::vector<Contact> contacts_;
+  std::vector<std::unique_ptr<Plant>> plants_;  // one per thread
+  struct Scratch {
+    Eigen::VectorXd tau, dq, noise, q;
+  };
+  std::vector<Scratch> scratch_;  // per thread
+};
+
+}  // namespace uvms

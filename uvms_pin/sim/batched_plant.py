@@ -1,0 +1,202 @@
+"""N copies of a plant stepped together, one control period per call, on T threads.
+
+`BatchedPlant` is the compiled batch (src/uvms_core/batch_plant.hpp) of the sampled closed
+loop's tick with the controller replaced by a given command, as the Gymnasium environments
+step it: per environment, tau_applied = actuation(tau_commanded) (thruster allocation and
+saturation, joint effort limits), (q, v) advanced over the period with it held, the true
+contact wrench at the new state, and the measurement (state + sensor noise) at the new
+tick. The interpreter lock is released while the threads run.
+
+Each environment has its own state, contact anchor (where its end-effector is at its
+reset), tick count, status (running or diverged) and sensor noise: the noise tables of an
+episode are drawn at its reset from the episode seed with exactly the streams of
+`uvms_pin.sim.sensors.SensorSuite` (one per channel), so an environment of the batch gives
+the numbers of a single `ClosedLoop` run with the same seed, whatever T.
+
+What the batch does not simulate is refused with a ParameterError naming it: a world
+(fixed objects), a flow (waves, sea states; a uniform current is supported), thruster
+drives with lag, navigation sensors or an estimator, ``stop_at_surface``, the Python backend, or a
+plant part without a compiled counterpart.
+"""
+
+from __future__ import annotations
+
+import math
+from types import ModuleType
+
+import numpy as np
+import pinocchio as pin
+
+from uvms_pin.errors import ParameterError
+from uvms_pin.physics.compiled.backend import Fallback, backend_named
+from uvms_pin.physics.compiled.contact import contact_to_core
+from uvms_pin.sim.actuation import Actuation, ThrustersAndJointLimits, Unlimited
+from uvms_pin.sim.plant import Plant
+from uvms_pin.sim.sensors import SensorConfig
+from uvms_pin.sim.settings import SimulationSettings
+
+#: BatchStatus of the core: what became of an environment in the last step
+RUNNING, DIVERGED = 0, 1
+
+
+def check_count(name: str, value: object) -> int:
+    """``value`` as a positive int, or ParameterError naming ``name``."""
+    if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or value <= 0:
+        raise ParameterError(f"{name} must be an integer >= 1, got {value!r}")
+    return int(value)
+
+
+def _unsupported(plant: Plant, sensors: SensorConfig) -> str | None:
+    """What of the plant or sensors the batch cannot simulate, or None."""
+    actuation = plant.actuation
+    checks = (
+        (plant.world is not None, "a world (fixed objects)"),
+        (plant.flow is not None, "a flow (waves, sea states, varying currents)"),
+        (plant.stop_at_surface, "stop_at_surface"),
+        (sensors.navigation.fitted, "navigation sensors"),
+        (sensors.estimator is not None, "a navigation estimator"),
+        (not isinstance(actuation, (Unlimited, ThrustersAndJointLimits)),
+         f"the actuation {type(actuation).__name__}"),
+        (isinstance(actuation, ThrustersAndJointLimits) and not actuation._ideal,
+         "thruster drives with lag or rate limits"),
+    )  # fmt: skip
+    return next((what for bad, what in checks if bad), None)
+
+
+def _actuation_to_core(actuation: Actuation, core: ModuleType):
+    out = core.BatchActuation()
+    if isinstance(actuation, ThrustersAndJointLimits):
+        out.limited = True
+        out.allocation = actuation.allocation
+        out.allocation_pinv = actuation._allocation_pinv
+        out.lower_N, out.upper_N = actuation._lower, actuation._upper
+        if actuation.joint_effort_limits_Nm is not None:
+            out.joint_limits_Nm = actuation.joint_effort_limits_Nm
+    return out
+
+
+def _noise_specs(sensors: SensorConfig) -> tuple:
+    """The six channels in `SensorSuite`'s stream order."""
+    return (sensors.force_noise, sensors.torque_noise, sensors.position_noise,
+            sensors.orientation_noise, sensors.joint_noise, sensors.velocity_noise)  # fmt: skip
+
+
+class BatchedPlant:
+    """``num_envs`` copies of ``plant`` stepped together on ``num_threads`` threads.
+
+    Args:
+        plant: the plant (its compiled counterpart is copied per thread).
+        settings: the control period, integrator and episode duration (noise tables).
+        sensors: the sensors' noise.
+        num_envs, num_threads: N >= 1, T >= 1 (T above N uses N threads).
+
+    State, read-only views (N rows): ``q``, ``v``, ``q_measured``, ``v_measured``,
+    ``wrench_measured`` (force N, torque N m, world axes, with noise), ``contact_world``
+    (true), ``tau_applied``, ``tick`` (control periods since the reset), ``status``.
+    """
+
+    def __init__(
+        self,
+        plant: Plant,
+        settings: SimulationSettings,
+        sensors: SensorConfig,
+        num_envs: int,
+        num_threads: int = 1,
+    ):
+        num_envs = check_count("num_envs", num_envs)
+        num_threads = check_count("num_threads", num_threads)
+        if settings.control_period_s is None:
+            raise ParameterError("the batched plant needs a sampled loop (control.period_s)")
+        what = _unsupported(plant, sensors)
+        if what is not None:
+            raise ParameterError(f"the batched plant does not simulate {what}")
+        backend = backend_named(plant.backend)
+        if not backend.compiled:
+            raise ParameterError("the batched plant runs on the compiled core (backend 'core')")
+        self.plant, self.settings, self.sensors = plant, settings, sensors
+        self.period_s = float(settings.control_period_s)
+        self._rows = math.ceil(settings.duration_s / sensors.sample_period_s) + 2
+        self._specs = _noise_specs(sensors)
+        nv = plant.uvms.nv
+        self._widths = (3, 3, 3, 3, nv - 6, nv)
+        self._core = backend.counterpart(
+            lambda core: self._build(core, settings, num_envs, num_threads)
+        )
+        if isinstance(self._core, Fallback):
+            raise ParameterError(f"the batched plant needs the compiled core: {self._core.reason}")
+        self._stepping = np.ones(num_envs, dtype=bool)
+
+    def _build(self, core: ModuleType, settings, num_envs: int, num_threads: int):
+        plant = self.plant
+        # the prototype needs a placed contact: anchored here at q0, replaced at each reset
+        plant.attach(pin.neutral(plant.uvms.model))
+        prototype = plant._core()
+        if prototype is None:
+            return Fallback("a plant part with no compiled counterpart")
+        integrator = settings.integrator.to_core(backend_named(plant.backend))
+        if isinstance(integrator, Fallback):
+            return integrator
+        noise = core.BatchNoise()
+        noise.sample_period_s = float(self.sensors.sample_period_s)
+        noise.rows = self._rows
+        noise.silent = [int(spec.bound == 0.0) for spec in self._specs]
+        return core.BatchPlant(
+            prototype, integrator, self.period_s, _actuation_to_core(plant.actuation, core),
+            noise, num_envs, num_threads,
+        )  # fmt: skip
+
+    # ---- state ------------------------------------------------------------------------
+    def __getattr__(self, name: str):
+        if name in ("q", "v", "q_measured", "v_measured", "wrench_measured", "contact_world",
+                    "tau_applied", "tick", "status", "num_envs", "num_threads"):  # fmt: skip
+            return getattr(self.__dict__["_core"], name)
+        raise AttributeError(name)
+
+    def time_s(self) -> np.ndarray:
+        """Each environment's time [s]: tick * period (as `ClosedLoop` counts it)."""
+        return self._core.tick * self.period_s
+
+    # ---- the episode -------------------------------------------------------------------
+    def noise_tables(self, seed: int) -> list[np.ndarray]:
+        """An episode's noise samples per channel (rows x width; empty for a silent one),
+        drawn as `SensorSuite` draws them from ``seed``."""
+        children = np.random.SeedSequence(seed).spawn(len(self._specs))
+        tables = []
+        for spec, width, child in zip(self._specs, self._widths, children, strict=True):
+            if spec.bound == 0.0:
+                tables.append(np.zeros((0, 0)))
+            else:
+                tables.append(spec.draw(np.random.default_rng(child), (self._rows, width)))
+        return tables
+
+    def reset(self, i: int, q0: np.ndarray, v0: np.ndarray, seed: int) -> None:
+        """Environment ``i`` to t = 0 at (q0, v0) (the quaternion normalised), its contact
+        anchored at its end-effector, its noise drawn from ``seed``."""
+        q0 = np.array(q0, dtype=float)
+        v0 = np.array(v0, dtype=float)
+        model = self.plant.uvms.model
+        if q0.shape != (model.nq,) or v0.shape != (model.nv,):
+            raise ParameterError(
+                f"q0 must have {model.nq} and v0 {model.nv} entries, got {q0.shape}, {v0.shape}"
+            )
+        if not (np.all(np.isfinite(q0)) and np.all(np.isfinite(v0))):
+            raise ParameterError("initial state has a non-finite value")
+        q0[3:7] /= np.linalg.norm(q0[3:7])
+        contact = self.plant.contact
+        if contact is not None:
+            contact.attach(self.plant.ee_state(q0, np.zeros(model.nv))[0])
+        core_contact = contact_to_core(contact, self._core_module())
+        self._core.reset(int(i), q0, v0, core_contact, self.noise_tables(seed))
+
+    def _core_module(self) -> ModuleType:
+        from uvms_pin.physics.compiled.extension import core_module
+
+        return core_module()
+
+    def step(self, tau_commanded: np.ndarray, stepping: np.ndarray | None = None) -> None:
+        """Advance the environments with ``stepping`` (all by default) one control period
+        under ``tau_commanded`` (N, nv) [N, N m]; a diverged one keeps its state and gets
+        ``status`` DIVERGED."""
+        tau = np.ascontiguousarray(tau_commanded, dtype=float)
+        mask = self._stepping if stepping is None else np.ascontiguousarray(stepping, dtype=bool)
+        self._core.step(tau, mask)
