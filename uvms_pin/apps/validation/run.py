@@ -59,12 +59,14 @@ def run_pool_validation(
     step_s: float = STEP_S,
     figures: bool = True,
     progress: Callable[[str], None] | None = None,
+    vehicle_urdf: str | Path | None = None,
 ) -> dict:
     """Validate every trial of ``data_dir`` (or those named); write the results to ``out_dir``.
 
     Writes ``pool_validation.json`` (`summary`), ``pool_validation.csv`` (`summary_csv`) and,
     with ``figures``, ``<trial>.png`` per trial. Every trial file is read and checked before
-    anything is simulated or written.
+    anything is simulated or written. ``vehicle_urdf``: another trial vehicle (e.g. the one
+    ``uvms-pin identify --out`` writes) in place of the shipped one.
 
     Raises:
         DataError: a missing directory, no trials, an unknown trial name or a bad file.
@@ -81,7 +83,7 @@ def run_pool_validation(
     check_trials_fit(files)
     trials = [load_trial(p) for p in files]
     check_step(step_s, trials)
-    uvms = trial_uvms()
+    uvms = trial_uvms(vehicle_urdf)
     comparisons = []
     for trial in trials:
         comparisons.append(compare_trial(uvms, trial, step_s))
