@@ -55,24 +55,43 @@ def _synthetic_trials(uvms, rng, noise_rad: float) -> list[TrialSetup]:
     return setups
 
 
-def test_fit_recovers_the_parameters_of_synthetic_trials():
-    """Truth: roll and pitch linear damping 2.5 and 1.8 N m s, roll quadratic damping 3 N m s^2,
-    the centre of buoyancy 2 mm off to the side, roll added mass doubled; 0.05 deg of noise
-    on roll and pitch. From the catalogue values (0, 0.8, 1.19, shipped r_B, 0.189), the fit
-    finds them again within a few per cent (2 % of the shift for r_B)."""
+def _truth(catalogue, parameters) -> np.ndarray:
+    """Roll and pitch linear damping 2.5 and 1.8 N m s, roll quadratic damping 3 N m s^2, the
+    centre of buoyancy 2 mm off to the side, the roll added mass doubled."""
+    return parameter_values(catalogue, parameters, HULL) + np.array([2.5, 1.0, 1.81, 0.002, 0.189])
+
+
+def test_fit_recovers_the_parameters_of_exact_synthetic_trials():
+    """Without noise, from the catalogue values (0, 0.8, 1.19, shipped r_B, 0.189), the fit
+    finds the truth to 1e-6 (the Jacobian is right: Gauss-Newton converges quadratically)."""
     parameters = parse_parameters(NAMES)
     catalogue = trial_uvms()
-    start = parameter_values(catalogue, parameters, HULL)
-    truth = start + np.array([2.5, 1.0, 1.81, 0.002, 0.189])
+    truth = _truth(catalogue, parameters)
+    synthetic = with_parameters(catalogue, parameters, truth, HULL)
+    setups = _synthetic_trials(synthetic, np.random.default_rng(1), 0.0)
+    fit = fit_parameters(catalogue, setups, parameters, HULL, 0.05, max_iterations=12)
+    assert fit.rms_deg[0] > 0.3  # the start is far off the data
+    assert fit.rms_deg[-1] < 1e-6
+    np.testing.assert_allclose(fit.values, truth, rtol=1e-6)
+    assert parameter_values(fit.uvms, parameters, HULL) == pytest.approx(fit.values)
+
+
+def test_fit_recovers_the_parameters_of_noisy_synthetic_trials():
+    """With 0.05 deg of white noise on roll and pitch, the fit explains the data down to the
+    noise and finds the parameters within what the noise allows: 5 % for the linear damping
+    and the added mass, 2 % of the shift of r_B, 20 % for the quadratic roll damping (it
+    trades off against the linear one at these rates)."""
+    parameters = parse_parameters(NAMES)
+    catalogue = trial_uvms()
+    truth = _truth(catalogue, parameters)
     synthetic = with_parameters(catalogue, parameters, truth, HULL)
     setups = _synthetic_trials(synthetic, np.random.default_rng(2024), np.radians(0.05))
     fit = fit_parameters(catalogue, setups, parameters, HULL, 0.05, max_iterations=30)
-    assert fit.rms_deg[0] > 0.3  # the start is far off the data
-    assert fit.rms_deg[-1] < 0.06  # the fit explains the data down to its noise
-    np.testing.assert_allclose(fit.values[:3], truth[:3], rtol=0.05)
+    assert fit.rms_deg[-1] < 0.05  # ~ the noise (the fit absorbs a little of it)
+    np.testing.assert_allclose(fit.values[:2], truth[:2], rtol=0.05)
+    np.testing.assert_allclose(fit.values[2], truth[2], rtol=0.2)
     assert abs(fit.values[3] - truth[3]) < 0.02 * 0.002
-    np.testing.assert_allclose(fit.values[4], truth[4], rtol=0.1)
-    assert parameter_values(fit.uvms, parameters, HULL) == pytest.approx(fit.values)
+    np.testing.assert_allclose(fit.values[4], truth[4], rtol=0.05)
 
 
 def test_identified_vehicle_urdf_is_the_identified_model(tmp_path):
@@ -84,19 +103,31 @@ def test_identified_vehicle_urdf_is_the_identified_model(tmp_path):
     identified = with_parameters(uvms, parameters, values, HULL)
     path = tmp_path / "vehicle.urdf"
     params = hydro_body(identified, HULL).params
-    path.write_text(urdf_text(urdf_with_hydro(shipped_path("models/bluerov2_heavy_hinsdale2023.urdf"), HULL, params)))
+    path.write_text(
+        urdf_text(
+            urdf_with_hydro(shipped_path("models/bluerov2_heavy_hinsdale2023.urdf"), HULL, params)
+        )
+    )
     loaded = trial_uvms(path)
     assert hydro_body(loaded, HULL).params == params
     trial = load_trial(DATA_DIR / "_alt_011-1.npz")
     direct, via_file = compare_trial(identified, trial), compare_trial(loaded, trial)
     np.testing.assert_allclose(via_file.simulated, direct.simulated, rtol=0, atol=1e-12)
     result = run(
-        "validate", "pool", str(DATA_DIR), "--out", str(tmp_path / "v"), "--trials",
-        "_alt_011-1", "--vehicle", str(path), "--no-figures",
+        "validate",
+        "pool",
+        str(DATA_DIR),
+        "--out",
+        str(tmp_path / "v"),
+        "--trials",
+        "_alt_011-1",
+        "--vehicle",
+        str(path),
+        "--no-figures",
     )
     assert result.returncode == 0, result.stderr
     summary = json.loads((tmp_path / "v" / "pool_validation.json").read_text())
-    roll, pitch = direct.rmse_deg("simulated")
+    roll, _ = direct.rmse_deg("simulated")
     assert summary["trials"]["_alt_011-1"]["roll_rmse_deg"] == pytest.approx(roll, rel=1e-9)
 
 

@@ -6,7 +6,7 @@ import numpy as np
 import pinocchio as pin
 import pytest
 from conftest import ROOT
-from scipy.interpolate import CubicSpline
+from scipy.interpolate import CubicSpline, PPoly
 
 import uvms_pin as up
 from uvms_pin.apps.validation.identify import HULL
@@ -45,7 +45,7 @@ def uvms():
 
 def synthetic_arm(duration_s: float = 3.0) -> JointTrajectory:
     """A smooth, lively arm motion (each joint a sum of two sines)."""
-    t = np.linspace(0.0, duration_s, 301)
+    t = np.linspace(-0.5, duration_s + 0.5, 301)
     phases = np.arange(4)[None, :]
     q = 0.6 * np.sin(1.3 * t[:, None] + phases) + 0.3 * np.sin(2.9 * t[:, None] - phases)
     q[:, 1] += 1.2  # keep the shoulder and elbow away from their stops
@@ -97,7 +97,8 @@ def test_states_are_those_of_the_validation_simulation(uvms):
 
 def test_roll_pitch_sensitivity_matches_finite_differences_of_the_simulation(uvms):
     """d(roll, pitch)/dp propagated along 3 s of simulation against central differences of
-    whole simulations, for every kind of parameter (added mass through its own differences)."""
+    whole simulations, for every kind of parameter (added mass and the arm's delay through
+    their own differences)."""
     names = (
         "linear_damping.roll",
         "linear_damping.pitch",
@@ -108,6 +109,7 @@ def test_roll_pitch_sensitivity_matches_finite_differences_of_the_simulation(uvm
         "center_of_buoyancy.z",
         "added_mass.roll",
         "added_mass.pitch",
+        "arm_delay",
     )
     parameters = parse_parameters(names)
     arm = synthetic_arm(3.0)
@@ -127,7 +129,9 @@ def test_roll_pitch_sensitivity_matches_finite_differences_of_the_simulation(uvm
             shifted = values.copy()
             shifted[k] += sign * step
             perturbed = with_parameters(uvms, parameters, shifted, HULL)
-            q, _ = simulate_prescribed_arm(perturbed, arm, q0, nu0, times, 0.02)
+            # the same spline, at t + delay
+            moved_arm = JointTrajectory(PPoly(arm.spline.c, arm.spline.x - shifted[-1]))
+            q, _ = simulate_prescribed_arm(perturbed, moved_arm, q0, nu0, times, 0.02)
             ends.append(roll_pitch_rad(q[:, 3:7]))
         numeric = (ends[0] - ends[1]) / (2 * step)
         scale = np.abs(numeric).max()

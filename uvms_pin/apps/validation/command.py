@@ -26,6 +26,7 @@ def _cmd_validate_pool(args: argparse.Namespace) -> int:
         figures=not args.no_figures,
         progress=None if args.quiet else lambda line: print(line, file=sys.stderr, flush=True),
         vehicle_urdf=args.vehicle,
+        arm_delay_s=args.arm_delay,
     )
     print(
         f"{len(result['trials'])} trials: mean roll RMSE {result['mean_roll_rmse_deg']:.3f} deg, "
@@ -55,8 +56,9 @@ def add_identify_arguments(parser: argparse.ArgumentParser) -> None:
         type=nonempty("parameter names"),
         help="comma-separated hull parameters to fit on the simulation error, each "
         "<kind>.<axis>: linear_damping, quadratic_damping, added_mass along x, y, z, roll, "
-        "pitch, yaw, or center_of_buoyancy.x|y|z (default: the quasi-static centre-of-"
-        "buoyancy fit)",
+        "pitch, yaw, or center_of_buoyancy.x|y|z, and arm_delay (how late the encoders are "
+        "on the IMU's clock [s]); 'default': roll and pitch linear and quadratic damping and "
+        "the centre of buoyancy (without --fit: the quasi-static centre-of-buoyancy fit)",
     )
     parser.add_argument(
         "--out",
@@ -115,6 +117,14 @@ def register(subparsers) -> argparse.ArgumentParser:
         type=path_text,
         help="the trial vehicle's URDF instead of the shipped one, e.g. the identified "
         "vehicle `uvms-pin identify --out DIR` writes (DIR/bluerov2_heavy_identified.urdf)",
+    )
+    pool.add_argument(
+        "--arm-delay",
+        type=finite,
+        default=0.0,
+        metavar="S",
+        help="the encoder stream is this late on the IMU's clock [s] (default 0; "
+        "`uvms-pin identify --fit ...,arm_delay` fits it)",
     )
     pool.add_argument("--no-figures", action="store_true", help="skip the per-trial figures")
     pool.add_argument("--quiet", action="store_true", help="no per-trial progress lines")

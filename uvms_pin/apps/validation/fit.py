@@ -109,6 +109,8 @@ def fit_parameters(
         raise SimulationError(f"the trials cannot be simulated at the start values {values}")
     r, jac = first
     start_values, history, lam, iteration = values.copy(), [_rms_deg(r)], 1e-3, 0
+    if progress is not None:
+        progress(f"start: RMS {history[0]:.4f} deg")
     floor = np.array([0.0 if p.nonnegative else -np.inf for p in parameters])
     while iteration < max_iterations and lam < 1e10:
         iteration += 1

@@ -6,7 +6,8 @@ The fit (`uvms_pin.apps.validation.fit`) runs on the identification trials
 simulated on every trial, and the held-out trials say whether the fit generalises. Writes
 ``identification.json``, the identified vehicle as a URDF (`IDENTIFIED_VEHICLE`, usable by
 ``uvms-pin validate pool --vehicle`` and anywhere a vehicle URDF goes) and, with figures, one
-``identified<trial>.png`` per held-out trial.
+``identified<trial>.png`` per held-out trial. An identified ``arm_delay`` (a property of
+the recording, not of the vehicle) is in the JSON; ``validate pool --arm-delay`` takes it.
 """
 
 from __future__ import annotations
@@ -27,6 +28,7 @@ from uvms_pin.apps.validation.pool import (
     compare_trial,
     trial_setup,
 )
+from uvms_pin.apps.validation.sensitivity import SensitiveModel
 from uvms_pin.apps.validation.trials import check_trials_fit, find_trials, load_trial
 from uvms_pin.errors import DataError
 from uvms_pin.model.mount.text import urdf_text
@@ -139,11 +141,15 @@ def run_identification(
     fit = fit_parameters(
         start, setups, parameters, HULL, step_s, max_iterations=max_iterations, progress=progress
     )
+    delay_s = SensitiveModel(start, parameters, HULL, fit.values).arm_delay_s
     tables, comparisons = {}, {}
     for trial in trials:
-        pair = compare_trial(start, trial, step_s), compare_trial(fit.uvms, trial, step_s)
+        pair = (
+            compare_trial(start, trial, step_s),
+            compare_trial(fit.uvms, trial, step_s, delay_s),
+        )
         tables[trial.name], comparisons[trial.name] = _rmse_table(*pair), pair
-    result = _summary(fit, tables)
+    result = {**_summary(fit, tables), "arm_delay_s": delay_s}
     if out_dir is not None:
         out = Path(out_dir)
         out.mkdir(parents=True, exist_ok=True)

@@ -39,6 +39,7 @@ from scipy.spatial.transform import Rotation
 from uvms_pin.apps.arguments import comma_names
 from uvms_pin.apps.validation.command import add_identify_arguments
 from uvms_pin.apps.validation.identification import (
+    DEFAULT_FIT,
     IDENTIFIED_VEHICLE,
     run_identification,
     split_trials,
@@ -213,7 +214,11 @@ def run(args: argparse.Namespace) -> int:
     start = trial_uvms() if args.cob is None else with_cob(trial_uvms(), args.cob)
     if args.fit is None:
         return _quasi_static(args, start)
-    names = comma_names("--fit", args.fit, "parameter names")
+    names = (
+        list(DEFAULT_FIT)
+        if args.fit.strip() == "default"
+        else comma_names("--fit", args.fit, "parameter names")
+    )
     if args.out is not None:
         check_writable(args.out)  # before minutes of fitting, not after
     result = run_identification(
@@ -229,6 +234,11 @@ def run(args: argparse.Namespace) -> int:
     _print_fit(result)
     if args.out is not None:
         print(f"wrote {args.out}/identification.json, {IDENTIFIED_VEHICLE}")
+        if result["arm_delay_s"]:
+            print(
+                f"validate with: --vehicle {args.out}/{IDENTIFIED_VEHICLE} "
+                f"--arm-delay {result['arm_delay_s']:.6g}"
+            )
     return 0
 
 

@@ -17,7 +17,11 @@ and analytic (`generalized_force_sensitivity`):
 
 Added mass enters M(q) and the Kirchhoff and Coriolis terms nonlinearly: its sensitivity is
 taken by central finite differences of the vehicle's acceleration (`uvms_pin.apps.validation.
-sensitivity`), the one parameter kind the analytic path does not cover.
+sensitivity`), the one hydrodynamic kind the analytic path does not cover.
+
+One parameter is not the water's: ``arm_delay`` [s], how late the arm's encoder stream is on
+the IMU's clock (the arm is prescribed at t + delay). It is not part of the model either: it
+belongs to the recording, and its sensitivity is a central difference too.
 """
 
 from __future__ import annotations
@@ -46,6 +50,7 @@ __all__ = [
 
 AXES = ("x", "y", "z", "roll", "pitch", "yaw")
 KINDS = ("linear_damping", "quadratic_damping", "added_mass", "center_of_buoyancy")
+ARM_DELAY = "arm_delay"
 #: kinds whose entries must stay >= 0 (dissipation, a positive semi-definite added mass)
 NONNEGATIVE = ("linear_damping", "quadratic_damping", "added_mass")
 
@@ -59,12 +64,17 @@ class HydroParameter:
 
     @property
     def name(self) -> str:
-        return f"{self.kind}.{AXES[self.axis]}"
+        return ARM_DELAY if self.kind == ARM_DELAY else f"{self.kind}.{AXES[self.axis]}"
 
     @property
     def analytic(self) -> bool:
         """True when the sensitivity is analytic (the force is linear in the parameter)."""
-        return self.kind != "added_mass"
+        return self.kind not in ("added_mass", ARM_DELAY)
+
+    @property
+    def hydrodynamic(self) -> bool:
+        """True for a coefficient of the body (False: the recording's ``arm_delay``)."""
+        return self.kind != ARM_DELAY
 
     @property
     def nonnegative(self) -> bool:
@@ -107,11 +117,14 @@ def parse_parameters(names: Sequence[str]) -> tuple[HydroParameter, ...]:
         )
     out = []
     for name in names:
+        if name.strip() == ARM_DELAY:
+            out.append(HydroParameter(ARM_DELAY, 0))
+            continue
         kind, _, axis = name.strip().partition(".")
         if kind not in KINDS or axis not in AXES:
             raise ParameterError(
                 f"unknown parameter '{name}': give <kind>.<axis>, kind one of {', '.join(KINDS)}, "
-                f"axis one of {', '.join(AXES)}"
+                f"axis one of {', '.join(AXES)}, or {ARM_DELAY}"
             )
         if kind == "center_of_buoyancy" and AXES.index(axis) > 2:
             raise ParameterError(f"unknown parameter '{name}': center_of_buoyancy has x, y, z")
@@ -133,16 +146,17 @@ def hydro_body(uvms: UVMS, link: str) -> HydroBody:
 
 
 def parameter_values(uvms: UVMS, parameters: Sequence[HydroParameter], link: str) -> np.ndarray:
-    """The parameters' current values on ``link`` of ``uvms``."""
+    """The parameters' current values on ``link`` of ``uvms`` (``arm_delay``: 0, the model
+    holds none)."""
     params = hydro_body(uvms, link).params
-    return np.array([p.value(params) for p in parameters])
+    return np.array([p.value(params) if p.hydrodynamic else 0.0 for p in parameters])
 
 
 def with_parameters(
     uvms: UVMS, parameters: Sequence[HydroParameter], values: np.ndarray, link: str
 ) -> UVMS:
     """The same system with ``link``'s parameters set to ``values`` (ParameterError if the
-    result is not a valid body, e.g. a negative damping)."""
+    result is not a valid body, e.g. a negative damping; ``arm_delay`` is not the model's)."""
     hydro_body(uvms, link)
 
     def replaced(body: HydroBody) -> HydroParams:
@@ -150,7 +164,8 @@ def with_parameters(
             return body.params
         params = body.params
         for parameter, value in zip(parameters, values, strict=True):
-            params = parameter.replaced(params, float(value))
+            if parameter.hydrodynamic:
+                params = parameter.replaced(params, float(value))
         return params
 
     return uvms.with_hydro(replaced)

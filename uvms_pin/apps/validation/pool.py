@@ -131,15 +131,18 @@ class TrialSetup:
     nu_vehicle0: np.ndarray  # (6,) the measured initial body twist
 
 
-def trial_setup(trial: PoolTrial) -> TrialSetup:
+def trial_setup(trial: PoolTrial, arm_delay_s: float = 0.0) -> TrialSetup:
     """The arm trajectory, the IMU samples inside its span and the initial state of a trial.
+
+    ``arm_delay_s``: how late the encoder stream is on the IMU's clock; the arm is at time t
+    where the encoders say it was at t + arm_delay_s.
 
     Raises:
         DataError: fewer than 2 IMU samples inside the encoder span.
     """
     start, end = trial.common_span_s
     arm = JointTrajectory.from_samples(
-        trial.encoder_time_s, joint_angles_rad(trial.encoder_rad), JOINT_CUTOFF_HZ
+        trial.encoder_time_s - arm_delay_s, joint_angles_rad(trial.encoder_rad), JOINT_CUTOFF_HZ
     )
     arm_start, arm_end = arm.span_s
     inside = (trial.imu_time_s >= max(start, arm_start)) & (trial.imu_time_s <= min(end, arm_end))
@@ -151,9 +154,12 @@ def trial_setup(trial: PoolTrial) -> TrialSetup:
     return TrialSetup(arm, times, measured, q_vehicle0, nu_vehicle0)
 
 
-def compare_trial(uvms: UVMS, trial: PoolTrial, step_s: float = STEP_S) -> TrialComparison:
-    """Simulate one trial and line up measured, simulated, held and published roll/pitch."""
-    setup = trial_setup(trial)
+def compare_trial(
+    uvms: UVMS, trial: PoolTrial, step_s: float = STEP_S, arm_delay_s: float = 0.0
+) -> TrialComparison:
+    """Simulate one trial and line up measured, simulated, held and published roll/pitch
+    (``arm_delay_s``: `trial_setup`)."""
+    setup = trial_setup(trial, arm_delay_s)
     arm, times, measured = setup.arm, setup.time_s, setup.measured
     q_vehicle, _ = simulate_prescribed_arm(
         uvms, arm, setup.q_vehicle0, setup.nu_vehicle0, times, step_s

@@ -14,8 +14,8 @@ dID/dx = -M da/dx, and the vehicle rows, which carry no input, give
 
     A = M_vv^-1 (M da/dx)_v,        B_p = M_vv^-1 dF_v/dp
 
-(F the fluid's generalized force, `parameters.generalized_force_sensitivity`; for added mass,
-central differences of a_v). S is integrated with the same classical Runge-Kutta stages as
+(F the fluid's generalized force, `parameters.generalized_force_sensitivity`; for added mass
+and the arm's delay, central differences of a_v). S is integrated with the same classical Runge-Kutta stages as
 the state (a 4th-order approximation of the exact flow's sensitivity), from S(t0) = 0: the
 initial state is measured, not fitted.
 """
@@ -24,7 +24,7 @@ from __future__ import annotations
 
 import itertools
 import math
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -47,6 +47,8 @@ __all__ = ["SensitiveModel", "Trajectory", "roll_pitch_tangent", "simulate_with_
 
 #: relative central-difference step for the added-mass sensitivities
 ADDED_MASS_STEP = 1e-5
+#: central-difference step of the arm delay [s] (the arm spline's grid is 0.01 s)
+DELAY_STEP_S = 1e-3
 
 
 @dataclass(frozen=True)
@@ -77,7 +79,7 @@ class SensitiveModel:
         self.uvms = with_parameters(uvms, parameters, self.values, link)
         self.differenced = []  # (column, step, uvms at +step, uvms at -step)
         for k, p in enumerate(self.parameters):
-            if p.analytic:
+            if p.analytic or not p.hydrodynamic:
                 continue
             step = ADDED_MASS_STEP * max(1.0, abs(self.values[k]))
             shifted = [self.values.copy(), self.values.copy()]
@@ -86,6 +88,9 @@ class SensitiveModel:
             models = [with_parameters(uvms, parameters, s, link) for s in shifted]
             self.differenced.append((k, step, *models))
         self.analytic_columns = [k for k, p in enumerate(self.parameters) if p.analytic]
+        delays = [k for k, p in enumerate(self.parameters) if not p.hydrodynamic]
+        self.delay_column = delays[0] if delays else None
+        self.arm_delay_s = 0.0 if self.delay_column is None else float(self.values[delays[0]])
 
     def acceleration(self, q: np.ndarray, v: np.ndarray, qdd_arm: np.ndarray, uvms=None):
         """(a_v, M, chol(M_vv)) at the full state (q, v), arm acceleration qdd_arm."""
@@ -95,8 +100,11 @@ class SensitiveModel:
         factor = cho_factor(mass[:6, :6])
         return cho_solve(factor, -h[:6] - mass[:6, 6:] @ qdd_arm), mass, h, factor
 
-    def jacobians(self, q: np.ndarray, v: np.ndarray, qdd_arm: np.ndarray):
-        """(a_v (6,), A (6, 12) = da_v/d(dq_v, dnu_v), B (6, n_p) = da_v/dp)."""
+    def jacobians(self, q_v: np.ndarray, nu_v: np.ndarray, arm_at: Callable, t: float):
+        """(a_v (6,), A (6, 12) = da_v/d(dq_v, dnu_v), B (6, n_p) = da_v/dp) at time t, the
+        arm at ``arm_at(t + arm delay)`` ((q, qdot, qddot))."""
+        q_arm, qd_arm, qdd_arm = arm_at(t + self.arm_delay_s)
+        q, v = np.concatenate([q_v, q_arm]), np.concatenate([nu_v, qd_arm])
         a_v, mass, h, factor = self.acceleration(q, v, qdd_arm)
         tau = mass @ np.concatenate([a_v, qdd_arm]) + h
         da_dq, da_dv, _ = forward_dynamics_derivatives(self.uvms, q, v, tau)
@@ -109,6 +117,13 @@ class SensitiveModel:
             a_plus = self.acceleration(q, v, qdd_arm, plus)[0]
             a_minus = self.acceleration(q, v, qdd_arm, minus)[0]
             jac_params[:, k] = (a_plus - a_minus) / (2.0 * step)
+        if self.delay_column is not None:
+            ends = []
+            for shift in (DELAY_STEP_S, -DELAY_STEP_S):
+                arm = arm_at(t + self.arm_delay_s + shift)
+                q, v = np.concatenate([q_v, arm[0]]), np.concatenate([nu_v, arm[1]])
+                ends.append(self.acceleration(q, v, arm[2])[0])
+            jac_params[:, self.delay_column] = (ends[0] - ends[1]) / (2.0 * DELAY_STEP_S)
         return a_v, jac_state, jac_params
 
 
@@ -145,7 +160,8 @@ def simulate_with_sensitivity(
     times_s: np.ndarray,
     step_s: float,
 ) -> Trajectory:
-    """`simulate_prescribed_arm` (the same states) with S = dx/dp at ``times_s``."""
+    """`simulate_prescribed_arm` (the same states, the arm at t + the model's arm delay)
+    with S = dx/dp at ``times_s``."""
     times_s = np.asarray(times_s, dtype=float)
     start, end = arm.span_s
     if times_s[0] < start - 1e-9 or times_s[-1] > end + 1e-9:
@@ -156,10 +172,11 @@ def simulate_with_sensitivity(
     chart = python_chart(flyer)
     n_p = len(model.parameters)
 
+    def arm_at(t):
+        return arm(min(max(t, start), end))
+
     def rhs(t, q_v, nu_v, s):
-        q_arm, qd_arm, qdd_arm = arm(min(max(t, start), end))
-        q, v = np.concatenate([q_v, q_arm]), np.concatenate([nu_v, qd_arm])
-        a_v, jac_state, jac_params = model.jacobians(q, v, qdd_arm)
+        a_v, jac_state, jac_params = model.jacobians(q_v, nu_v, arm_at, t)
         ds = np.empty_like(s)
         ds[:6] = s[6:] - pin.Motion(nu_v).action @ s[:6]
         ds[6:] = jac_state @ s + jac_params
