@@ -40,15 +40,27 @@ def _trial_rows(result: dict) -> list[str]:
 if __name__ == "__main__":
     producer_cli(__doc__)
     out = scratch("identification")
-    uvms_pin("identify", "data/hinsdale2023", "--fit", "default", "--out", str(out), "--quiet")
+    uvms_pin(
+        "identify",
+        "data/hinsdale2023",
+        "--fit",
+        "default",
+        "--max-iterations",
+        "10",
+        "--out",
+        str(out),
+        "--quiet",
+    )
     result = json.loads((out / "identification.json").read_text())
     held, used = result["held_out"], result["identification"]
     body = (
-        "`uvms-pin identify data/hinsdale2023 --fit default --out out/results/identification` "
+        "`uvms-pin identify data/hinsdale2023 --fit default --max-iterations 10 --out "
+        "out/results/identification` "
         f"({result['iterations']} Levenberg-Marquardt iterations; RMS of the fit residual "
         f"{result['fit_rms_deg'][0]:.3f} -> {result['fit_rms_deg'][-1]:.3f} deg).\n\n"
         + "\n".join(_parameter_rows(result))
-        + "\n\nMean RMSE [deg], catalogue -> identified: held-out trials roll "
+        + f"\n\nIdentified arm delay (the encoders' lag on the IMU clock): "
+        f"{result['arm_delay_s']:.3f} s.\n\nMean RMSE [deg], catalogue -> identified: held-out trials roll "
         f"{held['mean_start_roll_rmse_deg']:.3f} -> {held['mean_identified_roll_rmse_deg']:.3f}, "
         f"pitch {held['mean_start_pitch_rmse_deg']:.3f} -> "
         f"{held['mean_identified_pitch_rmse_deg']:.3f}; identification trials roll "

@@ -9,7 +9,8 @@ from __future__ import annotations
 import argparse
 import sys
 
-from uvms_pin.apps.arguments import comma_names, count, finite, nonempty, path_text, positive
+from uvms_pin.apps.arguments import comma_names, finite, nonempty, path_text, positive
+from uvms_pin.apps.validation.identify_arguments import add_identify_arguments
 from uvms_pin.results.outdir import check_writable
 
 
@@ -35,43 +36,6 @@ def _cmd_validate_pool(args: argparse.Namespace) -> int:
     figures = "" if args.no_figures else " and one figure per trial"
     print(f"wrote {args.out}/pool_validation.json, pool_validation.csv{figures}")
     return 0
-
-
-def add_identify_arguments(parser: argparse.ArgumentParser) -> None:
-    """The arguments of ``identify`` (also ``python -m uvms_pin.apps.validation.identify``)."""
-    parser.add_argument("data_dir", type=path_text, help="the pool trials, e.g. data/hinsdale2023")
-    parser.add_argument(
-        "--every", type=count(1), default=10, help="quasi-static fit: every n-th IMU sample"
-    )
-    parser.add_argument(
-        "--cob",
-        nargs=3,
-        type=finite,
-        metavar=("X", "Y", "Z"),
-        help="start from this hull centre of buoyancy [m] (base_link frame) instead of the "
-        "shipped model's, e.g. Kolano's 0.0074 0 0.02",
-    )
-    parser.add_argument(
-        "--fit",
-        type=nonempty("parameter names"),
-        help="comma-separated hull parameters to fit on the simulation error, each "
-        "<kind>.<axis>: linear_damping, quadratic_damping, added_mass along x, y, z, roll, "
-        "pitch, yaw, or center_of_buoyancy.x|y|z, and arm_delay (how late the encoders are "
-        "on the IMU's clock [s]); 'default': roll and pitch linear and quadratic damping and "
-        "the centre of buoyancy (without --fit: the quasi-static centre-of-buoyancy fit)",
-    )
-    parser.add_argument(
-        "--out",
-        type=path_text,
-        help="with --fit: write identification.json, the identified vehicle's URDF and a "
-        "figure per held-out trial here",
-    )
-    parser.add_argument("--step", type=positive, default=0.05, help="largest RK4 step [s]")
-    parser.add_argument(
-        "--max-iterations", type=count(1), default=20, help="Levenberg-Marquardt iterations"
-    )
-    parser.add_argument("--no-figures", action="store_true", help="skip the figures")
-    parser.add_argument("--quiet", action="store_true", help="no per-iteration progress lines")
 
 
 def _cmd_identify(args: argparse.Namespace) -> int:

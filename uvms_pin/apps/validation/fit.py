@@ -90,7 +90,7 @@ def fit_parameters(
     *,
     start: np.ndarray | None = None,
     max_iterations: int = 20,
-    tolerance: float = 1e-6,
+    tolerance: float = 1e-4,
     progress: Callable[[str], None] | None = None,
 ) -> FitResult:
     """Levenberg-Marquardt fit of ``parameters`` of ``link`` to the trials' roll and pitch.

@@ -37,13 +37,13 @@ from scipy.optimize import least_squares
 from scipy.spatial.transform import Rotation
 
 from uvms_pin.apps.arguments import comma_names
-from uvms_pin.apps.validation.command import add_identify_arguments
 from uvms_pin.apps.validation.identification import (
     DEFAULT_FIT,
     IDENTIFIED_VEHICLE,
     run_identification,
     split_trials,
 )
+from uvms_pin.apps.validation.identify_arguments import add_identify_arguments
 from uvms_pin.apps.validation.pool import (
     IDENTIFICATION_TRIALS,
     JOINT_CUTOFF_HZ,
