@@ -51,7 +51,13 @@ def identified_figure(start: TrialComparison, identified: TrialComparison, path:
         rmse = start.rmse_deg("simulated")[k]
         ax.plot(t, np.degrees(start.simulated[:, k]), "C0--", label=f"catalogue ({rmse:.2f})")
         rmse = identified.rmse_deg("simulated")[k]
-        ax.plot(t, np.degrees(identified.simulated[:, k]), "C3", label=f"identified ({rmse:.2f})")
+        # an identified arm delay moves the simulated window by as much: its own time axis
+        ax.plot(
+            identified.time_s,
+            np.degrees(identified.simulated[:, k]),
+            "C3",
+            label=f"identified ({rmse:.2f})",
+        )
         if start.published is not None:
             rmse = start.rmse_deg("published")[k]
             ax.plot(
