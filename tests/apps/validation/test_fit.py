@@ -11,6 +11,7 @@ import pytest
 from conftest import run
 from test_sensitivity import DATA_DIR, initial_state, synthetic_arm
 
+from uvms_pin.apps.validation.figures import identified_figure
 from uvms_pin.apps.validation.fit import fit_parameters
 from uvms_pin.apps.validation.identify import HULL
 from uvms_pin.apps.validation.parameters import (
@@ -157,3 +158,10 @@ def test_identify_names_a_missing_identification_trial(tmp_path):
     assert "Traceback" not in result.stderr and not out.exists()
     result = run("identify", str(tmp_path / "nope"), "--fit", "linear_damping.roll")
     assert result.returncode == 2 and "not a directory" in result.stderr
+
+
+def test_identified_figure_takes_runs_on_windows_an_arm_delay_moved(tmp_path):
+    uvms, trial = trial_uvms(), load_trial(DATA_DIR / "_alt_011-1.npz")
+    start, delayed = compare_trial(uvms, trial), compare_trial(uvms, trial, arm_delay_s=0.25)
+    assert len(start.time_s) != len(delayed.time_s)
+    assert identified_figure(start, delayed, tmp_path / "f.png").stat().st_size > 10_000
