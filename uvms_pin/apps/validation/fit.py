@@ -44,7 +44,7 @@ class FitResult:
     start: np.ndarray
     values: np.ndarray
     rms_deg: list[float]  # RMS of the residual [deg] at the start and each accepted step
-    iterations: int
+    iterations: int  # steps tried, accepted or not
     uvms: UVMS  # the system with the fitted values
 
 

@@ -186,7 +186,11 @@ def _quasi_static(args, start: UVMS) -> int:
 
 def _print_fit(result: dict) -> None:
     print(f"identification trials: {', '.join(result['identification_trials'])}")
-    print(f"{result['link']}: {result['iterations']} Levenberg-Marquardt iterations")
+    accepted = len(result["fit_rms_deg"]) - 1
+    print(
+        f"{result['link']}: {result['iterations']} Levenberg-Marquardt steps tried, "
+        f"{accepted} accepted"
+    )
     for name, p in result["parameters"].items():
         print(f"  {name}: {p['start']:.6g} -> {p['identified']:.6g} ({p['sensitivity']})")
     for which in ("identification", "held_out"):
