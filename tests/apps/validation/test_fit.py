@@ -165,3 +165,11 @@ def test_identified_figure_takes_runs_on_windows_an_arm_delay_moved(tmp_path):
     start, delayed = compare_trial(uvms, trial), compare_trial(uvms, trial, arm_delay_s=0.25)
     assert len(start.time_s) != len(delayed.time_s)
     assert identified_figure(start, delayed, tmp_path / "f.png").stat().st_size > 10_000
+
+
+def test_identify_refuses_a_step_longer_than_the_imu_intervals(tmp_path):
+    out = tmp_path / "out"
+    result = run("identify", str(DATA_DIR), "--fit", "arm_delay", "--step", "10", "--out", str(out))
+    assert result.returncode == 2
+    assert "--step 10 s is longer than the longest IMU interval" in result.stderr
+    assert not out.exists()

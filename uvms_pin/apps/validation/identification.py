@@ -28,6 +28,7 @@ from uvms_pin.apps.validation.pool import (
     compare_trial,
     trial_setup,
 )
+from uvms_pin.apps.validation.run import check_step
 from uvms_pin.apps.validation.sensitivity import SensitiveModel
 from uvms_pin.apps.validation.trials import check_trials_fit, find_trials, load_trial
 from uvms_pin.errors import DataError
@@ -132,13 +133,15 @@ def run_identification(
     (nothing written when None). Every input is checked before the fit begins.
 
     Raises:
-        ParameterError: an unknown parameter name. DataError: missing or bad trial files.
+        ParameterError: an unknown parameter name, a bad step (`check_step`).
+        DataError: missing or bad trial files.
     """
     parameters = parse_parameters(parameter_names)
     hydro_body(start, HULL)
     training, held_out = split_trials(data_dir)
     check_trials_fit(training + held_out)
     trials = [load_trial(p) for p in training + held_out]
+    check_step(step_s, trials)
     setups = [trial_setup(t) for t in trials[: len(training)]]
     fit = fit_parameters(
         start, setups, parameters, HULL, step_s, max_iterations=max_iterations, progress=progress
