@@ -41,6 +41,7 @@ PRODUCERS = {
     "world": "the seabed landing and the cost of contacts: docs/results/world.md, docs/seabed_landing.png",
     "derivatives": "cost of the dynamics' derivatives and of an MPC re-plan: docs/results/derivatives.md",
     "tracking": "end-effector tracking, controller x task x conditions: docs/results/tracking.md, docs/tracking_*.png",
+    "estimator": "station keeping on the navigation estimate: docs/results/estimator.md, docs/estimator_station_keeping.png",
 }
 
 

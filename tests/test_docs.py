@@ -239,6 +239,13 @@ _VARIANTS += [
         True,
     ),
     ("lbv150_ee_circle.toml", {"task": {"type": "hold", "target": "vehicle"}}, True),
+    (
+        "estimator_station_keeping.toml",
+        {"estimator.draw_initial_error": False, "estimator.gyro_noise_rad_s_rthz": 1e-3,
+         "estimator.gyro_bias_walk_rad_s2_rthz": 1e-5, "estimator.accel_noise_m_s2_rthz": 1e-2,
+         "estimator.accel_bias_walk_m_s3_rthz": 1e-4, "estimator.dvl_noise_m_s": 0.02,
+         "estimator.depth_noise_m": 0.02, "estimator.usbl_noise_m": 0.2},
+    ),
 ]  # fmt: skip
 # (file, overrides[, True: the dict's tables replace the file's whole tables instead])
 

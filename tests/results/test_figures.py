@@ -40,7 +40,8 @@ def test_plot_helpers_return_the_figure_without_a_path(passive, ppc, tmp_path):
 def test_plot_all_gives_the_figures_the_rollout_has_data_for(passive, ppc):
     assert set(passive.plot()) == {"pose", "velocities", "energy"}
     figures = ppc.plot()
-    assert set(figures) == set(KINDS) - {"tracking"}  # no [task] in the PPC's scenario
+    # no [task] and no [estimator] in the PPC's scenario
+    assert set(figures) == set(KINDS) - {"tracking", "estimate"}
     assert all(isinstance(f, Figure) for f in figures.values())
     # one panel per first-level error; one per velocity error (vehicle 6 + arm, hidden spares)
     assert len(figures["first_level"].axes) == 6
@@ -53,6 +54,18 @@ def test_plot_kind_errors_name_the_problem(passive):
         passive.plot("forces")
     with pytest.raises(ParameterError, match=r"cannot plot 'first_level'.*e_x"):
         passive.plot("first_level")
+
+
+def test_a_run_with_an_estimator_has_its_figure():
+    from uvms_pin.scenario.load import load_scenario
+    from uvms_pin.sim.run import simulate
+
+    scenario = load_scenario(
+        ROOT / "scenarios" / "estimator_station_keeping.toml", {"scenario.duration_s": 0.3}
+    )
+    rollout = simulate(scenario, progress=False)
+    figure = rollout.plot("estimate")
+    assert isinstance(figure, Figure) and len(figure.axes) == 12
 
 
 def test_a_tracking_run_has_its_figure(tmp_path):

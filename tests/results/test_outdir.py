@@ -85,7 +85,7 @@ def test_run_outputs_are_exactly_the_files_a_run_writes(tmp_path):
     """RUN lists the outputs by name: a new figure must be added there (or --overwrite
     would leave it stale). The sea-state scenario writes every figure but one (flow.png
     too); the surfacing scenario started at the waterline writes surface.png; a tracking
-    task writes tracking.png."""
+    task writes tracking.png; an estimator estimate.png."""
     from uvms_pin.apps.outputs import write_outputs
     from uvms_pin.scenario.load import load_scenario
     from uvms_pin.sim.run import simulate
@@ -110,8 +110,13 @@ def test_run_outputs_are_exactly_the_files_a_run_writes(tmp_path):
     )
     figures = write_outputs(simulate(tracking, progress=False), out / "tracking")
     assert "tracking.png" in {p.name for p in figures}
+    estimating = load_scenario(
+        ROOT / "scenarios" / "estimator_station_keeping.toml", {"scenario.duration_s": 0.1}
+    )
+    figures = write_outputs(simulate(estimating, progress=False), out / "estimating")
+    assert "estimate.png" in {p.name for p in figures}
     written = {p.name for p in out.iterdir() if p.is_file()}
-    for sub in ("surfacing", "tracking"):
+    for sub in ("surfacing", "tracking", "estimating"):
         written |= {p.name for p in (out / sub).iterdir()}
     assert written | {"replay.html"} == set(RUN.patterns)  # replay.html: with --html
 

@@ -41,6 +41,7 @@ def write_results(rollout: Rollout, out: Path) -> list[str]:
 
 def write_figures(rollout: Rollout, out: Path) -> list[Path]:
     """Every figure the rollout has data for (none below two samples) into ``out``."""
+    from uvms_pin.results.figures.estimate import estimate_figures
     from uvms_pin.results.figures.paper import paper_figures
     from uvms_pin.results.figures.standard import standard_figures
     from uvms_pin.results.figures.tracking import tracking_figures
@@ -49,6 +50,7 @@ def write_figures(rollout: Rollout, out: Path) -> list[Path]:
         paper_figures(rollout, out)
         + standard_figures(rollout, out)
         + tracking_figures(rollout, out)
+        + estimate_figures(rollout, out)
         + _flow_figure(rollout, out)
         + _surface_figure(rollout, out)
     )

@@ -7,6 +7,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from uvms_pin.results.estimate_metrics import estimate_metrics
 from uvms_pin.results.extra_metrics import extra_metrics
 from uvms_pin.results.joint_positions import KINDS, REVOLUTE, arm_positions, configuration_width
 from uvms_pin.results.task_metrics import task_metrics
@@ -66,6 +67,7 @@ def compute_metrics(rollout: RolloutData) -> dict[str, float]:
     out.update(surface_metrics(rollout))
     out.update(world_contact_metrics(rollout))
     out.update(task_metrics(rollout))
+    out.update(estimate_metrics(rollout))
     out.update(extra_metrics(rollout, out))
     return out
 

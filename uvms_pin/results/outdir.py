@@ -67,6 +67,7 @@ RUN = OutputKind(
         "flow.png",  # runs with waves or a varying current
         "surface.png",  # runs in which a body left the water in part
         "tracking.png",  # runs with a tracking task ([task])
+        "estimate.png",  # runs with a navigation estimator ([estimator])
     ),
     ("rollout.npz", "rollout.json", "metrics.json", "replay.html"),
 )

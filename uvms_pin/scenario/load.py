@@ -7,8 +7,8 @@ that is how ``uvms-pin run --set``, sweeps and robustness tables vary it), then 
 is checked and built by the module of its concept: ``[water]`` (`water`), ``[initial]``
 (`initial`), ``[environment]`` and ``[disturbance]`` (`world`), ``[world]`` and ``[joints]``
 (`objects`), ``[actuation]``,
-``[sensors]``, ``[integrator]``, ``[control]`` and ``[output]`` (`timing`), ``[controller]``
-(`controller`), ``[baselines]`` (`baselines`), ``[task]`` (`task`) and ``[metrics]``
+``[sensors]``, ``[estimator]`` (`estimator`), ``[integrator]``, ``[control]`` and
+``[output]`` (`timing`), ``[controller]`` (`controller`), ``[baselines]`` (`baselines`), ``[task]`` (`task`) and ``[metrics]``
 (`metrics`). Unknown keys, wrong types and bad values
 raise `ScenarioError` naming the file and the key, or the override when an override set it,
 with the closest known key. ``model`` is a path relative to the scenario file or the name of
@@ -30,6 +30,7 @@ from uvms_pin.model.uvms import UVMS
 from uvms_pin.scenario.actuation import build_actuation
 from uvms_pin.scenario.baselines import check_baselines
 from uvms_pin.scenario.controller import build_controller
+from uvms_pin.scenario.estimator import build_estimator
 from uvms_pin.scenario.initial import build_initial_state
 from uvms_pin.scenario.joints import build_joint_friction, with_joint_lag
 from uvms_pin.scenario.metrics import build_metrics
@@ -111,7 +112,9 @@ def _build(raw: dict[str, Any], path: Path, top: Table) -> Scenario:
     friction = build_joint_friction(joints, uvms)
     actuation = with_joint_lag(joints, build_actuation(top.table("actuation"), uvms), uvms)
     joints.finish()
-    sensor_config = build_sensors(top.table_or_empty("sensors"), water.density_kg_m3)
+    sensor_config = build_sensors(top.table_or_empty("sensors"), water.density_kg_m3, world)
+    estimator = build_estimator(top.table("estimator"), sensor_config.navigation)
+    sensor_config = replace(sensor_config, estimator=estimator)
     integrator, backend = build_integrator(top.table_or_empty("integrator"))
     control_period = build_control_period(top.table_or_empty("control"))
     log_period = build_log_period(top.table_or_empty("output"))

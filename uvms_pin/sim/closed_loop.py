@@ -100,8 +100,7 @@ class ClosedLoop:
         self.time_s, self.q, self.v = 0.0, read_only(q0), read_only(v0)
         self.sensors = sensors
         self.plant.actuation.start(self.settings.control_period_s)
-        if sensors.navigation is not None:
-            sensors.navigation.start(self.settings.control_period_s)
+        sensors.start_navigation(self.settings.control_period_s)
         if self.controller is not None:
             with self._controller_code("reset"):
                 self.controller.reset()
@@ -115,6 +114,12 @@ class ClosedLoop:
         self.plant.check_submerged(self.time_s, self.q)
         contact = self.plant.contact_wrench(self.q, self.v)
         return self.sensors.measure(self.time_s, self.q, self.v, contact), contact
+
+    def observe(self) -> tuple[Measurement, np.ndarray]:
+        """`measure`, then, once per control tick, the navigation sensors and the estimator
+        (`SensorSuite.navigate`): (what the controller is given, the true contact wrench)."""
+        measurement, contact = self.measure()
+        return self.sensors.navigate(self.time_s, self.q, self.v, measurement), contact
 
     def command(self, measurement: Measurement) -> np.ndarray:
         """The controller's tau (nv,) for ``measurement`` (SimulationError if it is not nv
@@ -164,8 +169,7 @@ class ClosedLoop:
         """The loop now, as its observers see it."""
         controller = self.controller
         signals = self.plant.actuation.signals()
-        if self.sensors.navigation is not None:
-            signals.update(self.sensors.navigation.signals())
+        signals.update(self.sensors.navigation_signals())
         if controller is not None:
             with self._controller_code("signals"):
                 signals = {**controller.signals(), **signals}
@@ -240,9 +244,7 @@ class ClosedLoop:
 
     def _tick(self, logged: bool) -> np.ndarray:
         """Measure, command and actuate at the current state; log if ``logged``."""
-        measurement, contact = self.measure()
-        if self.sensors.navigation is not None:  # stateful: once per tick
-            self.sensors.navigation.update(self.time_s, self.q, self.v)
+        measurement, contact = self.observe()
         tau = self.command(measurement)
         tau_applied = self.actuate(tau)
         if logged:

@@ -19,6 +19,9 @@ import pinocchio as pin
 
 from uvms_pin.control.measurement import Measurement, read_only
 from uvms_pin.errors import ParameterError
+from uvms_pin.results.signal import Signal
+from uvms_pin.sim.estimation.estimator import NavigationEstimator
+from uvms_pin.sim.estimation.spec import EstimatorSpec
 from uvms_pin.sim.navigation.suite import NavigationSpec, NavigationSuite
 
 
@@ -126,6 +129,9 @@ class SensorConfig:
         sample_period_s: sensor rate: a new noise value is drawn every sample period.
         navigation: the vehicle's navigation sensors (IMU, depth, DVL, USBL), logged as
             signals; what a controller measures is unchanged by them.
+        estimator: a navigation filter on them (`uvms_pin.sim.estimation`), or None; with
+            ``controller_input = "estimate"`` the controller's measurement carries its
+            estimate in place of the measured vehicle state.
     """
 
     force_noise: NoiseSpec = NoiseSpec()
@@ -136,6 +142,7 @@ class SensorConfig:
     velocity_noise: NoiseSpec = NoiseSpec()
     sample_period_s: float = 1e-3
     navigation: NavigationSpec = field(default_factory=NavigationSpec)
+    estimator: EstimatorSpec | None = None
 
 
 class SensorSuite:
@@ -157,6 +164,10 @@ class SensorSuite:
         self._velocity = SampledNoise(config.velocity_noise, model.nv, period, duration_s, rngs[5])
         nav = config.navigation
         self.navigation = NavigationSuite(nav, seed) if nav.fitted else None
+        self.estimator = (
+            None if config.estimator is None else NavigationEstimator(config.estimator, nav, seed)
+        )
+        self._estimator_started = False
         self._state_noisy = any(
             s.bound > 0.0
             for s in (
@@ -166,6 +177,40 @@ class SensorSuite:
                 config.velocity_noise,
             )
         )
+
+    def start_navigation(self, period_s: float | None) -> None:
+        """A run starts: the navigation sensors sample every control period ``period_s``;
+        the estimator starts at the first tick's true state (`navigate`)."""
+        if self.navigation is not None:
+            self.navigation.start(period_s)
+        self._estimator_started = False
+
+    def navigate(
+        self, time_s: float, q: np.ndarray, v: np.ndarray, measurement: Measurement
+    ) -> Measurement:
+        """Once per control tick: the navigation sensors read the true (q, v), the
+        estimator filters their readings; the measurement the controller is given
+        (``measurement``, or its vehicle part replaced by the estimate)."""
+        if self.navigation is None:
+            return measurement
+        self.navigation.update(time_s, q, v)
+        estimator = self.estimator
+        if estimator is None:
+            return measurement
+        if not self._estimator_started:  # the prior is drawn around the initial truth
+            estimator.start(self.navigation.period_s, q, v)
+            self._estimator_started = True
+        estimator.update(time_s, self.navigation.signals())
+        return estimator.measurement(measurement) if estimator.feeds_controller else measurement
+
+    def navigation_signals(self) -> dict[str, np.ndarray | Signal]:
+        """The navigation sensors' readings and the estimate, as logged signals."""
+        if self.navigation is None:
+            return {}
+        signals: dict[str, np.ndarray | Signal] = self.navigation.signals()
+        if self.estimator is not None and self._estimator_started:
+            signals.update(self.estimator.signals())
+        return signals
 
     def force_noise(self, time_s: float) -> np.ndarray:
         """[force noise (3) N; torque noise (3) N m] at time_s."""

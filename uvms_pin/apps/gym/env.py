@@ -187,7 +187,7 @@ class UvmsEnv(gym.Env):
         self._anchor = None
         if scenario.plant.contact is not None:
             self._anchor = scenario.plant.ee_state(loop.q, loop.v)[0]
-        self._measurement, self._contact = loop.measure()
+        self._measurement, self._contact = loop.observe()
         return self._observation(), {"seed": episode_seed, "time_s": 0.0}
 
     def step(self, action):
@@ -208,7 +208,7 @@ class UvmsEnv(gym.Env):
         info: dict[str, Any] = {"seed": self.episode_seed}
         try:
             loop.step(tau_applied)
-            self._measurement, self._contact = loop.measure()
+            self._measurement, self._contact = loop.observe()
         except SimulationError as exc:
             self._measurement = None  # the episode is over: reset() before stepping again
             self._failure = exc

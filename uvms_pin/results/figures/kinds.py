@@ -7,6 +7,7 @@ from collections.abc import Callable
 from matplotlib.figure import Figure
 
 from uvms_pin.errors import ParameterError
+from uvms_pin.results.figures.estimate import ESTIMATE_SIGNALS, plot_estimate
 from uvms_pin.results.figures.paper import (
     PPC_SIGNALS,
     plot_first_level,
@@ -26,6 +27,7 @@ KINDS: dict[str, tuple[Callable[..., Figure], tuple[str, ...]]] = {
     "first_level": (plot_first_level, PPC_SIGNALS),
     "second_level": (plot_second_level, PPC_SIGNALS),
     "tracking": (plot_tracking, TRACKING_SIGNALS),
+    "estimate": (plot_estimate, ESTIMATE_SIGNALS),
 }
 
 

@@ -1,17 +1,20 @@
 """What a DVL needs of the world: its altitude above the bottom. A flat bottom at a depth
-now; a seafloor of the world table can answer the same question later."""
+(``sensors.dvl.seabed_depth_m``), or the seafloor of the world table: its planes whose
+outward normal points up (``[[world.objects]] type = "plane"``, flat or sloping)."""
 
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import Protocol
 
 import numpy as np
 
 from uvms_pin.errors import ParameterError
+from uvms_pin.physics.world.objects import WorldObject
 
-__all__ = ["FlatSeabed", "Seabed"]
+__all__ = ["FlatSeabed", "PlaneSeabed", "Seabed", "world_seabed"]
 
 
 class Seabed(Protocol):
@@ -34,3 +37,30 @@ class FlatSeabed:
 
     def altitude_m(self, position_world_m: np.ndarray) -> float:
         return float(position_world_m[2] + self.depth_m)
+
+
+@dataclass(frozen=True)
+class PlaneSeabed:
+    """The bottom made of planes n . (x - p0) = 0 (unit normals n with n_z > 0, up out of
+    the ground). Straight below x the plane is n . (x - p0) / n_z under it; the bottom is
+    the highest of them, so the altitude is their least."""
+
+    points_world_m: tuple[tuple[float, float, float], ...]
+    normals_world: tuple[tuple[float, float, float], ...]
+
+    def altitude_m(self, position_world_m: np.ndarray) -> float:
+        points, normals = np.asarray(self.points_world_m), np.asarray(self.normals_world)
+        heights = np.einsum("ij,ij->i", normals, position_world_m - points) / normals[:, 2]
+        return float(heights.min())
+
+
+def world_seabed(objects: Sequence[WorldObject]) -> PlaneSeabed | None:
+    """The seafloor of the world's ``objects``: its planes facing up (n_z > 0.1; a wall is
+    not a bottom a DVL locks on), or None if it has none."""
+    floors = [o for o in objects if o.is_plane and o.normal_world[2] > 0.1]
+    if not floors:
+        return None
+    return PlaneSeabed(
+        tuple(tuple(map(float, o.placement.translation)) for o in floors),
+        tuple(tuple(map(float, o.normal_world)) for o in floors),
+    )

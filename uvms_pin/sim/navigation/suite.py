@@ -16,7 +16,7 @@ import pinocchio as pin
 from uvms_pin.errors import ParameterError
 from uvms_pin.sim.navigation.acoustic import DepthSensor, Dvl, DvlSpec, Usbl, UsblSpec
 from uvms_pin.sim.navigation.imu import Imu, ImuSpec
-from uvms_pin.sim.navigation.seabed import FlatSeabed
+from uvms_pin.sim.navigation.seabed import FlatSeabed, Seabed
 
 __all__ = ["NAVIGATION_SEED_INDEX", "NavigationSpec", "NavigationSuite"]
 
@@ -39,7 +39,8 @@ class NavigationSpec:
 
     Attributes:
         imu: `ImuSpec`. depth_noise_Pa: the pressure sensor's noise [Pa] (None: none fitted).
-        dvl: `DvlSpec`, with the bottom at ``seabed_depth_m`` [m] below the surface.
+        dvl: `DvlSpec`, over a flat bottom ``seabed_depth_m`` [m] below the surface or over
+            ``seabed`` (the world's seafloor, `uvms_pin.sim.navigation.seabed`): one of them.
         usbl: `UsblSpec`.
     """
 
@@ -49,10 +50,19 @@ class NavigationSpec:
     usbl: UsblSpec | None = None
     seabed_depth_m: float | None = None
     water_density_kg_m3: float = 1025.0
+    seabed: Seabed | None = None
 
     def __post_init__(self) -> None:
-        if self.dvl is not None and self.seabed_depth_m is None:
-            raise ParameterError("a DVL needs a sea bottom: give its depth (seabed_depth_m)")
+        if self.seabed is not None and self.seabed_depth_m is not None:
+            raise ParameterError(
+                "the DVL's bottom is given twice: the world's seafloor and seabed_depth_m = "
+                f"{self.seabed_depth_m}; give one of them"
+            )
+        if self.dvl is not None and self.seabed_depth_m is None and self.seabed is None:
+            raise ParameterError(
+                "a DVL needs a sea bottom: give its depth (seabed_depth_m) or a world "
+                'seafloor ([[world.objects]] type = "plane")'
+            )
 
     @property
     def fitted(self) -> bool:
@@ -72,7 +82,9 @@ class NavigationSuite:
             if spec.depth_noise_Pa is None
             else DepthSensor(spec.depth_noise_Pa, spec.water_density_kg_m3, rngs[2])
         )
-        seabed = None if spec.seabed_depth_m is None else FlatSeabed(spec.seabed_depth_m)
+        seabed = spec.seabed
+        if spec.seabed_depth_m is not None:
+            seabed = FlatSeabed(spec.seabed_depth_m)
         self.dvl = None if spec.dvl is None else Dvl(spec.dvl, seabed, rngs[3])
         self.usbl = None if spec.usbl is None else Usbl(spec.usbl, rngs[4])
         self._velocity_world: np.ndarray | None = None
