@@ -1,4 +1,5 @@
-"""``uvms-pin validate pool DATA_DIR --out DIR``: the pool trials against the simulator.
+"""``uvms-pin validate pool DATA_DIR --out DIR``: the pool trials against the simulator;
+``uvms-pin identify DATA_DIR``: the trial vehicle's parameters fitted to them.
 
 Wired into `uvms_pin.apps.cli.main.build_parser` with ``register(sub)``.
 """
@@ -8,7 +9,8 @@ from __future__ import annotations
 import argparse
 import sys
 
-from uvms_pin.apps.arguments import comma_names, nonempty, path_text, positive
+from uvms_pin.apps.arguments import comma_names, finite, nonempty, path_text, positive
+from uvms_pin.apps.validation.identify_arguments import add_identify_arguments
 from uvms_pin.results.outdir import check_writable
 
 
@@ -24,6 +26,8 @@ def _cmd_validate_pool(args: argparse.Namespace) -> int:
         step_s=args.step,
         figures=not args.no_figures,
         progress=None if args.quiet else lambda line: print(line, file=sys.stderr, flush=True),
+        vehicle_urdf=args.vehicle,
+        arm_delay_s=args.arm_delay,
     )
     print(
         f"{len(result['trials'])} trials: mean roll RMSE {result['mean_roll_rmse_deg']:.3f} deg, "
@@ -32,6 +36,12 @@ def _cmd_validate_pool(args: argparse.Namespace) -> int:
     figures = "" if args.no_figures else " and one figure per trial"
     print(f"wrote {args.out}/pool_validation.json, pool_validation.csv{figures}")
     return 0
+
+
+def _cmd_identify(args: argparse.Namespace) -> int:
+    from uvms_pin.apps.validation.identify import run
+
+    return run(args)
 
 
 def register(subparsers) -> argparse.ArgumentParser:
@@ -66,7 +76,33 @@ def register(subparsers) -> argparse.ArgumentParser:
         help="largest RK4 step [s]: each IMU interval is split into equal steps no longer than "
         "this; at most the longest IMU interval (default 0.05, the median interval)",
     )
+    pool.add_argument(
+        "--vehicle",
+        type=path_text,
+        help="the trial vehicle's URDF instead of the shipped one, e.g. the identified "
+        "vehicle `uvms-pin identify --out DIR` writes (DIR/bluerov2_heavy_identified.urdf)",
+    )
+    pool.add_argument(
+        "--arm-delay",
+        type=finite,
+        default=0.0,
+        metavar="S",
+        help="the encoder stream is this late on the IMU's clock [s] (default 0; "
+        "`uvms-pin identify --fit ...,arm_delay` fits it)",
+    )
     pool.add_argument("--no-figures", action="store_true", help="skip the per-trial figures")
     pool.add_argument("--quiet", action="store_true", help="no per-trial progress lines")
     pool.set_defaults(func=_cmd_validate_pool)
+    identify = subparsers.add_parser(
+        "identify",
+        help="fit the pool-trial vehicle's hydrodynamic parameters, report held-out trials",
+        description=(
+            "Fit the trial vehicle's hull parameters on the identification trials of DATA_DIR "
+            "(families 001 and 008) and report the held-out ones: by default its centre of "
+            "buoyancy on the quasi-static attitude; with --fit, the named parameters on the "
+            "simulation error by Levenberg-Marquardt."
+        ),
+    )
+    add_identify_arguments(identify)
+    identify.set_defaults(func=_cmd_identify)
     return parser

@@ -17,6 +17,11 @@ buoyancy, e.g. Kolano's own (0.0074, 0, 0.02) m, from which the correction is fo
 
 Identification trials: the trajectory families 001 and 008 (6 trials); the families 002,
 009 and 011 (6 trials) are held out for validation (`IDENTIFICATION_TRIALS`).
+
+With ``--fit NAMES`` (e.g. ``linear_damping.roll,center_of_buoyancy.y``), the named hull
+parameters are fitted instead on the simulation error of the whole trials, by
+Levenberg-Marquardt with sensitivities propagated along the simulation
+(`uvms_pin.apps.validation.identification`); ``--out DIR`` writes the identified vehicle.
 """
 
 from __future__ import annotations
@@ -31,6 +36,14 @@ import numpy as np
 from scipy.optimize import least_squares
 from scipy.spatial.transform import Rotation
 
+from uvms_pin.apps.arguments import comma_names
+from uvms_pin.apps.validation.identification import (
+    DEFAULT_FIT,
+    IDENTIFIED_VEHICLE,
+    run_identification,
+    split_trials,
+)
+from uvms_pin.apps.validation.identify_arguments import add_identify_arguments
 from uvms_pin.apps.validation.pool import (
     IDENTIFICATION_TRIALS,
     JOINT_CUTOFF_HZ,
@@ -38,10 +51,11 @@ from uvms_pin.apps.validation.pool import (
     trial_uvms,
 )
 from uvms_pin.apps.validation.prescribed import JointTrajectory
-from uvms_pin.apps.validation.trials import find_trials, load_trial, roll_pitch_rad
+from uvms_pin.apps.validation.trials import load_trial, roll_pitch_rad
 from uvms_pin.errors import SimulationError
 from uvms_pin.model.uvms import UVMS
 from uvms_pin.physics.dynamics import bias_forces
+from uvms_pin.results.outdir import check_writable
 
 __all__ = [
     "IDENTIFICATION_TRIALS",
@@ -147,25 +161,10 @@ def fit_centre_of_buoyancy(
     return result.x, before, result.fun.reshape(-1, 2)
 
 
-def main(argv: list[str] | None = None) -> int:
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("data_dir", help="the pool trials, e.g. data/hinsdale2023")
-    parser.add_argument("--every", type=int, default=10, help="use every n-th IMU sample")
-    parser.add_argument(
-        "--cob",
-        nargs=3,
-        type=float,
-        metavar=("X", "Y", "Z"),
-        help="start from this hull centre of buoyancy [m] (base_link frame) instead of the "
-        "shipped model's, e.g. Kolano's 0.0074 0 0.02",
-    )
-    args = parser.parse_args(argv)
-    files = {p.stem: p for p in find_trials(args.data_dir)}
-    training = [files[n] for n in IDENTIFICATION_TRIALS]
-    held_out = [p for n, p in files.items() if n not in IDENTIFICATION_TRIALS]
-    # the shipped trial model may already hold a correction: fit the one relative to the file
-    uvms = trial_uvms() if args.cob is None else with_cob(trial_uvms(), args.cob)
-    offset, before, after = fit_centre_of_buoyancy(uvms, training, args.every)
+def _quasi_static(args, start: UVMS) -> int:
+    """The centre-of-buoyancy fit on the quasi-static attitude, printed."""
+    training, held_out = split_trials(args.data_dir)
+    offset, before, after = fit_centre_of_buoyancy(start, training, args.every)
     print(f"identification trials: {', '.join(IDENTIFICATION_TRIALS)}")
     millimetres = ", ".join(f"{round(1e3 * x, 2) + 0.0:.2f}" for x in offset)  # no -0.00
     print(
@@ -177,11 +176,80 @@ def main(argv: list[str] | None = None) -> int:
         f"{rms_deg(before)} -> {rms_deg(after)}"
     )
     data = [_samples(p, args.every) for p in held_out]
+    moved = with_cob_offset(start, offset)
     print(
         "quasi-static roll, pitch RMS [deg] on held-out trials: "
-        f"{rms_deg(_errors(uvms, data))} -> {rms_deg(_errors(with_cob_offset(uvms, offset), data))}"
+        f"{rms_deg(_errors(start, data))} -> {rms_deg(_errors(moved, data))}"
     )
     return 0
+
+
+def _print_fit(result: dict) -> None:
+    print(f"identification trials: {', '.join(result['identification_trials'])}")
+    accepted = len(result["fit_rms_deg"]) - 1
+    print(
+        f"{result['link']}: {result['iterations']} Levenberg-Marquardt steps tried, "
+        f"{accepted} accepted"
+    )
+    for name, p in result["parameters"].items():
+        print(f"  {name}: {p['start']:.6g} -> {p['identified']:.6g} ({p['sensitivity']})")
+    for which in ("identification", "held_out"):
+        m = result[which]
+        print(
+            f"{which.replace('_', '-')} trials, mean roll, pitch RMSE [deg]: "
+            f"{m['mean_start_roll_rmse_deg']:.3f}, {m['mean_start_pitch_rmse_deg']:.3f} -> "
+            f"{m['mean_identified_roll_rmse_deg']:.3f}, {m['mean_identified_pitch_rmse_deg']:.3f}"
+        )
+    for name, t in result["trials"].items():
+        kind = "identification" if name in IDENTIFICATION_TRIALS else "held out"
+        published = t["published_roll_rmse_deg"]
+        extra = "" if published is None else f" (published simulator: {published:.3f})"
+        print(
+            f"  {name} ({kind}): roll {t['start_roll_rmse_deg']:.3f} -> "
+            f"{t['identified_roll_rmse_deg']:.3f}{extra}, pitch {t['start_pitch_rmse_deg']:.3f}"
+            f" -> {t['identified_pitch_rmse_deg']:.3f}"
+        )
+
+
+def run(args: argparse.Namespace) -> int:
+    """``identify``: the quasi-static centre-of-buoyancy fit, or with ``--fit`` the dynamic
+    fit of the named parameters (`uvms_pin.apps.validation.identification`)."""
+    # the shipped trial model may already hold a correction: fit the one relative to the file
+    start = trial_uvms() if args.cob is None else with_cob(trial_uvms(), args.cob)
+    if args.fit is None:
+        return _quasi_static(args, start)
+    names = (
+        list(DEFAULT_FIT)
+        if args.fit.strip() == "default"
+        else comma_names("--fit", args.fit, "parameter names")
+    )
+    if args.out is not None:
+        check_writable(args.out)  # before minutes of fitting, not after
+    result = run_identification(
+        args.data_dir,
+        args.out,
+        names,
+        start=start,
+        step_s=args.step,
+        max_iterations=args.max_iterations,
+        figures=not args.no_figures,
+        progress=None if args.quiet else lambda line: print(line, file=sys.stderr, flush=True),
+    )
+    _print_fit(result)
+    if args.out is not None:
+        print(f"wrote {args.out}/identification.json, {IDENTIFIED_VEHICLE}")
+        if result["arm_delay_s"]:
+            print(
+                f"validate with: --vehicle {args.out}/{IDENTIFIED_VEHICLE} "
+                f"--arm-delay {result['arm_delay_s']:.6g}"
+            )
+    return 0
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    add_identify_arguments(parser)
+    return run(parser.parse_args(argv))
 
 
 if __name__ == "__main__":

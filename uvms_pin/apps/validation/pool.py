@@ -15,6 +15,7 @@ import io
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass
+from pathlib import Path
 
 import numpy as np
 from scipy.spatial.transform import Rotation
@@ -29,8 +30,11 @@ from uvms_pin.model.uvms import UVMS
 __all__ = [
     "ENCODER_COLUMNS",
     "ENCODER_OFFSETS_RAD",
+    "TRIAL_VEHICLE",
     "TrialComparison",
+    "TrialSetup",
     "compare_trial",
+    "trial_setup",
     "trial_uvms",
 ]
 
@@ -55,10 +59,16 @@ IDENTIFICATION_TRIALS = (
 )
 
 
-def trial_uvms() -> UVMS:
-    """The BlueROV2 Heavy + Alpha 5 as trimmed for the 2023 trials, in fresh water."""
+#: the trial vehicle's URDF (the identified one, `uvms-pin identify --out`, replaces it)
+TRIAL_VEHICLE = "models/bluerov2_heavy_hinsdale2023.urdf"
+
+
+def trial_uvms(vehicle_urdf: str | Path | None = None) -> UVMS:
+    """The BlueROV2 Heavy + Alpha 5 as trimmed for the 2023 trials, in fresh water; with
+    ``vehicle_urdf``, that vehicle file instead of the shipped one (e.g. an identified one)."""
+    vehicle = shipped_path(TRIAL_VEHICLE) if vehicle_urdf is None else Path(vehicle_urdf)
     return mount_arm(
-        shipped_path("models/bluerov2_heavy_hinsdale2023.urdf"),
+        vehicle,
         shipped_path("models/reach_alpha5.urdf"),
         ALPHA5_MOUNT,
         tool=None,
@@ -110,11 +120,29 @@ def _initial_state(trial: PoolTrial, t0: float) -> tuple[np.ndarray, np.ndarray]
     return q_vehicle, np.concatenate([velocity_body, omega_body])
 
 
-def compare_trial(uvms: UVMS, trial: PoolTrial, step_s: float = STEP_S) -> TrialComparison:
-    """Simulate one trial and line up measured, simulated, held and published roll/pitch."""
+@dataclass(frozen=True)
+class TrialSetup:
+    """What a simulation of one trial starts from and is compared with."""
+
+    arm: JointTrajectory  # the prescribed (filtered) arm joints
+    time_s: np.ndarray  # the IMU samples inside the encoder span
+    measured: np.ndarray  # (n, 2) roll, pitch [rad] there
+    q_vehicle0: np.ndarray  # (7,) the measured initial configuration
+    nu_vehicle0: np.ndarray  # (6,) the measured initial body twist
+
+
+def trial_setup(trial: PoolTrial, arm_delay_s: float = 0.0) -> TrialSetup:
+    """The arm trajectory, the IMU samples inside its span and the initial state of a trial.
+
+    ``arm_delay_s``: how late the encoder stream is on the IMU's clock; the arm is at time t
+    where the encoders say it was at t + arm_delay_s.
+
+    Raises:
+        DataError: fewer than 2 IMU samples inside the encoder span.
+    """
     start, end = trial.common_span_s
     arm = JointTrajectory.from_samples(
-        trial.encoder_time_s, joint_angles_rad(trial.encoder_rad), JOINT_CUTOFF_HZ
+        trial.encoder_time_s - arm_delay_s, joint_angles_rad(trial.encoder_rad), JOINT_CUTOFF_HZ
     )
     arm_start, arm_end = arm.span_s
     inside = (trial.imu_time_s >= max(start, arm_start)) & (trial.imu_time_s <= min(end, arm_end))
@@ -123,7 +151,19 @@ def compare_trial(uvms: UVMS, trial: PoolTrial, step_s: float = STEP_S) -> Trial
         raise DataError(f"trial {trial.name}: fewer than 2 IMU samples inside the encoder span")
     measured = roll_pitch_rad(trial.imu_quat_xyzw[inside])
     q_vehicle0, nu_vehicle0 = _initial_state(trial, times[0])
-    q_vehicle, _ = simulate_prescribed_arm(uvms, arm, q_vehicle0, nu_vehicle0, times, step_s)
+    return TrialSetup(arm, times, measured, q_vehicle0, nu_vehicle0)
+
+
+def compare_trial(
+    uvms: UVMS, trial: PoolTrial, step_s: float = STEP_S, arm_delay_s: float = 0.0
+) -> TrialComparison:
+    """Simulate one trial and line up measured, simulated, held and published roll/pitch
+    (``arm_delay_s``: `trial_setup`)."""
+    setup = trial_setup(trial, arm_delay_s)
+    arm, times, measured = setup.arm, setup.time_s, setup.measured
+    q_vehicle, _ = simulate_prescribed_arm(
+        uvms, arm, setup.q_vehicle0, setup.nu_vehicle0, times, step_s
+    )
     simulated = roll_pitch_rad(q_vehicle[:, 3:7])
     published = None
     if trial.published is not None:

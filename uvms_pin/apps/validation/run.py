@@ -59,12 +59,16 @@ def run_pool_validation(
     step_s: float = STEP_S,
     figures: bool = True,
     progress: Callable[[str], None] | None = None,
+    vehicle_urdf: str | Path | None = None,
+    arm_delay_s: float = 0.0,
 ) -> dict:
     """Validate every trial of ``data_dir`` (or those named); write the results to ``out_dir``.
 
     Writes ``pool_validation.json`` (`summary`), ``pool_validation.csv`` (`summary_csv`) and,
     with ``figures``, ``<trial>.png`` per trial. Every trial file is read and checked before
-    anything is simulated or written.
+    anything is simulated or written. ``vehicle_urdf``: another trial vehicle (e.g. the one
+    ``uvms-pin identify --out`` writes) in place of the shipped one; ``arm_delay_s``: how
+    late the encoder stream is on the IMU's clock (identified by ``identify --fit arm_delay``).
 
     Raises:
         DataError: a missing directory, no trials, an unknown trial name or a bad file.
@@ -81,10 +85,10 @@ def run_pool_validation(
     check_trials_fit(files)
     trials = [load_trial(p) for p in files]
     check_step(step_s, trials)
-    uvms = trial_uvms()
+    uvms = trial_uvms(vehicle_urdf)
     comparisons = []
     for trial in trials:
-        comparisons.append(compare_trial(uvms, trial, step_s))
+        comparisons.append(compare_trial(uvms, trial, step_s, arm_delay_s))
         if progress is not None:
             roll, pitch = comparisons[-1].rmse_deg("simulated")
             progress(f"{trial.name}: roll RMSE {roll:.2f} deg, pitch RMSE {pitch:.2f} deg")

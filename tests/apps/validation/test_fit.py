@@ -1,0 +1,175 @@
+"""Levenberg-Marquardt identification: it recovers the parameters synthetic trials were
+simulated with, and `uvms-pin identify --fit` refuses bad input and writes a usable model."""
+
+from __future__ import annotations
+
+import json
+import shutil
+
+import numpy as np
+import pytest
+from conftest import run
+from test_sensitivity import DATA_DIR, initial_state, synthetic_arm
+
+from uvms_pin.apps.validation.figures import identified_figure
+from uvms_pin.apps.validation.fit import fit_parameters
+from uvms_pin.apps.validation.identify import HULL
+from uvms_pin.apps.validation.parameters import (
+    hydro_body,
+    parameter_values,
+    parse_parameters,
+    with_parameters,
+)
+from uvms_pin.apps.validation.pool import (
+    IDENTIFICATION_TRIALS,
+    TrialSetup,
+    compare_trial,
+    trial_uvms,
+)
+from uvms_pin.apps.validation.prescribed import simulate_prescribed_arm
+from uvms_pin.apps.validation.trials import load_trial, roll_pitch_rad
+from uvms_pin.model.mount.text import urdf_text
+from uvms_pin.model.resources import shipped_path
+from uvms_pin.model.urdf.write_hydro import urdf_with_hydro
+
+NAMES = (
+    "linear_damping.roll",
+    "linear_damping.pitch",
+    "quadratic_damping.roll",
+    "center_of_buoyancy.y",
+    "added_mass.roll",
+)
+
+
+def _synthetic_trials(uvms, rng, noise_rad: float) -> list[TrialSetup]:
+    """Two 5 s trials (the arm's motion shifted in time) simulated with ``uvms``, roll and
+    pitch measured with white noise."""
+    setups = []
+    for shift_s, roll_rate in ((0.0, 0.25), (1.7, -0.3)):
+        arm = synthetic_arm(5.0 + shift_s)
+        times = np.arange(shift_s, shift_s + 5.0 + 1e-9, 0.05)
+        q0, nu0 = initial_state()
+        nu0[3] = roll_rate
+        q, _ = simulate_prescribed_arm(uvms, arm, q0, nu0, times, 0.05)
+        measured = roll_pitch_rad(q[:, 3:7]) + rng.normal(scale=noise_rad, size=(len(times), 2))
+        setups.append(TrialSetup(arm, times, measured, q0, nu0))
+    return setups
+
+
+def _truth(catalogue, parameters) -> np.ndarray:
+    """Roll and pitch linear damping 2.5 and 1.8 N m s, roll quadratic damping 3 N m s^2, the
+    centre of buoyancy 2 mm off to the side, the roll added mass doubled."""
+    return parameter_values(catalogue, parameters, HULL) + np.array([2.5, 1.0, 1.81, 0.002, 0.189])
+
+
+def test_fit_recovers_the_parameters_of_exact_synthetic_trials():
+    """Without noise, from the catalogue values (0, 0.8, 1.19, shipped r_B, 0.189), the fit
+    finds the truth to 1e-6 (the Jacobian is right: Gauss-Newton converges quadratically)."""
+    parameters = parse_parameters(NAMES)
+    catalogue = trial_uvms()
+    truth = _truth(catalogue, parameters)
+    synthetic = with_parameters(catalogue, parameters, truth, HULL)
+    setups = _synthetic_trials(synthetic, np.random.default_rng(1), 0.0)
+    fit = fit_parameters(catalogue, setups, parameters, HULL, 0.05, max_iterations=12)
+    assert fit.rms_deg[0] > 0.3  # the start is far off the data
+    assert fit.rms_deg[-1] < 1e-6
+    np.testing.assert_allclose(fit.values, truth, rtol=1e-6)
+    assert parameter_values(fit.uvms, parameters, HULL) == pytest.approx(fit.values)
+
+
+def test_fit_recovers_the_parameters_of_noisy_synthetic_trials():
+    """With 0.05 deg of white noise on roll and pitch, the fit explains the data down to the
+    noise and finds the parameters within what the noise allows: 5 % for the linear damping
+    and the added mass, 2 % of the shift of r_B, 20 % for the quadratic roll damping (it
+    trades off against the linear one at these rates)."""
+    parameters = parse_parameters(NAMES)
+    catalogue = trial_uvms()
+    truth = _truth(catalogue, parameters)
+    synthetic = with_parameters(catalogue, parameters, truth, HULL)
+    setups = _synthetic_trials(synthetic, np.random.default_rng(2024), np.radians(0.05))
+    fit = fit_parameters(catalogue, setups, parameters, HULL, 0.05, max_iterations=30)
+    assert fit.rms_deg[-1] < 0.05  # ~ the noise (the fit absorbs a little of it)
+    np.testing.assert_allclose(fit.values[:2], truth[:2], rtol=0.05)
+    np.testing.assert_allclose(fit.values[2], truth[2], rtol=0.2)
+    assert abs(fit.values[3] - truth[3]) < 0.02 * 0.002
+    np.testing.assert_allclose(fit.values[4], truth[4], rtol=0.05)
+
+
+def test_identified_vehicle_urdf_is_the_identified_model(tmp_path):
+    """The URDF written for an identified hull loads back (through `validate pool
+    --vehicle`'s `trial_uvms`) as the same model: same hull coefficients, same simulation."""
+    parameters = parse_parameters(("linear_damping.roll", "center_of_buoyancy.z"))
+    uvms = trial_uvms()
+    values = parameter_values(uvms, parameters, HULL) + np.array([1.234, -0.001])
+    identified = with_parameters(uvms, parameters, values, HULL)
+    path = tmp_path / "vehicle.urdf"
+    params = hydro_body(identified, HULL).params
+    path.write_text(
+        urdf_text(
+            urdf_with_hydro(shipped_path("models/bluerov2_heavy_hinsdale2023.urdf"), HULL, params)
+        )
+    )
+    loaded = trial_uvms(path)
+    assert hydro_body(loaded, HULL).params == params
+    trial = load_trial(DATA_DIR / "_alt_011-1.npz")
+    direct, via_file = compare_trial(identified, trial), compare_trial(loaded, trial)
+    np.testing.assert_allclose(via_file.simulated, direct.simulated, rtol=0, atol=1e-12)
+    result = run(
+        "validate",
+        "pool",
+        str(DATA_DIR),
+        "--out",
+        str(tmp_path / "v"),
+        "--trials",
+        "_alt_011-1",
+        "--vehicle",
+        str(path),
+        "--no-figures",
+    )
+    assert result.returncode == 0, result.stderr
+    summary = json.loads((tmp_path / "v" / "pool_validation.json").read_text())
+    roll, _ = direct.rmse_deg("simulated")
+    assert summary["trials"]["_alt_011-1"]["roll_rmse_deg"] == pytest.approx(roll, rel=1e-9)
+
+
+@pytest.mark.parametrize(
+    ("fit", "message"),
+    [
+        ("linear_damping.roll,spring.x", "unknown parameter 'spring.x'"),
+        ("center_of_buoyancy.yaw", "center_of_buoyancy has x, y, z"),
+        ("linear_damping.roll,,", "none empty"),
+    ],
+)
+def test_identify_refuses_unknown_parameters_before_writing(tmp_path, fit, message):
+    out = tmp_path / "out"
+    result = run("identify", str(DATA_DIR), "--fit", fit, "--out", str(out))
+    assert result.returncode == 2, result.stderr
+    assert message in result.stderr and "Traceback" not in result.stderr
+    assert not out.exists()
+
+
+def test_identify_names_a_missing_identification_trial(tmp_path):
+    for name in IDENTIFICATION_TRIALS[1:]:
+        shutil.copy(DATA_DIR / f"{name}.npz", tmp_path)
+    out = tmp_path / "out"
+    result = run("identify", str(tmp_path), "--fit", "linear_damping.roll", "--out", str(out))
+    assert result.returncode == 2
+    assert "identification trial(s) _alt_001-0 missing" in result.stderr
+    assert "Traceback" not in result.stderr and not out.exists()
+    result = run("identify", str(tmp_path / "nope"), "--fit", "linear_damping.roll")
+    assert result.returncode == 2 and "not a directory" in result.stderr
+
+
+def test_identified_figure_takes_runs_on_windows_an_arm_delay_moved(tmp_path):
+    uvms, trial = trial_uvms(), load_trial(DATA_DIR / "_alt_011-1.npz")
+    start, delayed = compare_trial(uvms, trial), compare_trial(uvms, trial, arm_delay_s=0.25)
+    assert len(start.time_s) != len(delayed.time_s)
+    assert identified_figure(start, delayed, tmp_path / "f.png").stat().st_size > 10_000
+
+
+def test_identify_refuses_a_step_longer_than_the_imu_intervals(tmp_path):
+    out = tmp_path / "out"
+    result = run("identify", str(DATA_DIR), "--fit", "arm_delay", "--step", "10", "--out", str(out))
+    assert result.returncode == 2
+    assert "--step 10 s is longer than the longest IMU interval" in result.stderr
+    assert not out.exists()
