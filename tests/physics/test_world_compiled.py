@@ -22,6 +22,7 @@ import pytest
 from conftest import RHO, body_urdf, hydro_xml
 
 from uvms_pin.errors import ParameterError
+from uvms_pin.physics.compiled.extension import core_module
 from uvms_pin.physics.world.contact_law import ContactLaw
 from uvms_pin.physics.world.objects import plane, solid
 from uvms_pin.physics.world.world import FrictionMemory, World
@@ -288,3 +289,75 @@ def test_the_compiled_calls_refuse_bad_input(load_body):
         compiled.world_forces(q, np.full(uvms.nv, np.nan), FrictionMemory())
     with pytest.raises(ParameterError, match="FrictionMemory"):
         compiled.world_forces(q, v, {"anchors": {}})
+
+
+def _sphere_on(core, joint_id: int, placement: pin.SE3, radius: float):
+    shape = core.ContactShape()
+    shape.joint_id = joint_id
+    shape.set_placement(placement.rotation, placement.translation)
+    shape.set_geometry(core.ContactKind.sphere, np.array([radius]), np.zeros((3, 0)))
+    shape.bound_radius_m = radius
+    return shape
+
+
+def _point_jacobian(model, data, joint: int, point: np.ndarray) -> np.ndarray:
+    """The world linear Jacobian (3, nv) of joint's material point at ``point``."""
+    jac = pin.getJointJacobian(model, data, joint, pin.LOCAL_WORLD_ALIGNED)
+    return jac[:3] - pin.skew(point - data.oMi[joint].translation) @ jac[3:]
+
+
+@pytest.mark.parametrize("slide_m_s", [0.05, 2.0])  # sticks (|f_trial| < mu_s f_n), slips
+def test_a_shape_on_another_moving_body_is_pushed_back(reference_uvms, slide_m_s):
+    """A body-body pair in the core: a sphere on the arm's last link against a sphere on
+    the vehicle (both moving), against the same law evaluated here: the force on the link,
+    its reaction on the vehicle, the relative velocity in the damping and the friction."""
+    uvms, model = reference_uvms, reference_uvms.model
+    core = core_module()
+    rng = np.random.default_rng(4)
+    q = uvms.neutral_configuration()
+    q[7:] = rng.uniform(-0.5, 0.5, uvms.nv - 6)
+    v = rng.normal(scale=0.02, size=uvms.nv)
+    tau = rng.normal(scale=5.0, size=uvms.nv)
+    data = model.createData()
+    pin.forwardKinematics(model, data, q, v)
+    pin.computeJointJacobians(model, data, q)
+    link, vehicle, r1, r2 = model.njoints - 1, 1, 0.05, 0.07
+    c1 = data.oMi[link].translation.copy()
+    n = np.array([0.3, -0.2, 0.9]) / np.linalg.norm([0.3, -0.2, 0.9])
+    c2 = c1 - (r1 + r2 - 0.01) * n  # 1 cm deep, n out of the vehicle's sphere
+    compiled = Plant(uvms, free_surface=False)._core()
+    contact = core.WorldContact()
+    contact.pieces = [_sphere_on(core, link, pin.SE3.Identity(), r1)]
+    on_vehicle = data.oMi[vehicle].actInv(pin.SE3(np.eye(3), c2))
+    contact.objects = [_sphere_on(core, vehicle, on_vehicle, r2)]
+    bounds = core.WorldBounds()
+    bounds.joint_ids, bounds.centers_in_joint = [link], np.zeros((3, 1))
+    bounds.radii_m = np.array([r1])
+    bounds.sphere_centers_m, bounds.sphere_radii_m = c2[:, None], np.array([r2])
+    compiled.world, compiled.world_bounds = contact, bounds
+    # the link's point slides along the tangent at about slide_m_s
+    tangent = np.cross(n, [1.0, 0.0, 0.0])
+    v[7:] += slide_m_s * np.linalg.pinv(_point_jacobian(model, data, link, c1)[:, 7:]) @ tangent
+    pin.forwardKinematics(model, data, q, v)
+    pin.computeJointJacobians(model, data, q)
+
+    x = 0.5 * ((c1 - r1 * n) + (c2 + r2 * n))
+    j1, j2 = (_point_jacobian(model, data, j, x) for j in (link, vehicle))
+    relative = (j1 - j2) @ v
+    rate = -relative @ n
+    law = ContactLaw()
+    f_n = law.stiffness_N_m * 0.01 * max(0.0, 1.0 + law.dissipation_s_m * rate)
+    trial = -law.tangential_damping_N_s_m * (relative + n * rate)
+    mu_s, mu_k = 0.6, 0.5  # the core's defaults for an object
+    stick = np.linalg.norm(trial) <= mu_s * f_n
+    f_t = trial if stick else trial * mu_k * f_n / np.linalg.norm(trial)
+    force = f_n * n + f_t
+    got = compiled.world_forces(q, v, FrictionMemory())
+    assert got["sticking"] == [bool(stick)] and stick == (slide_m_s < 1.0)
+    assert _close(got["point_world_m"][0], x, 1.0)
+    assert _close(got["force_world_N"][0], force, np.abs(force).max())
+    # on the link +f at x, on the vehicle -f at x: J1^T f - J2^T f in the dynamics
+    with_world = compiled.acceleration_in_world(0.0, q, v, tau, FrictionMemory())
+    bare = Plant(uvms, free_surface=False)._core()  # without the pair
+    expected = bare.acceleration(0.0, q, v, tau + (j1 - j2).T @ force, None)
+    assert np.allclose(with_world, expected, rtol=TOL, atol=1e-10 * np.abs(expected).max())
