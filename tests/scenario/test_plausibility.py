@@ -26,6 +26,8 @@ WAVES = {"water.waves.amplitude_m": 0.1, "water.waves.period_s": 8.0}
         ({**WAVES, "water.waves.amplitude_m": 60.0}, "60 m cannot be physical: no sea wave is that high"),
         ({**WAVES, "water.waves.amplitude_m": 20.0}, "steeper than 1/7: it breaks"),
         ({"water.sea.significant_height_m": 1.0, "water.sea.peak_period_s": 0.01}, "override 'water.sea.peak_period_s': 0.01 s cannot be physical"),
+        ({"initial.position_world_m": [0.0, 0.0, 1e9]}, "initial.position_world_m[2]: 1e+09 m cannot be physical"),
+        ({"initial.position_world_m": [0.0, 0.0, -2e4]}, "initial.position_world_m[2]: -20000 m cannot be physical: deeper than the deepest sea floor"),
     ],
 )  # fmt: skip
 def test_what_no_water_or_sea_can_be_is_refused(overrides, message):
@@ -41,6 +43,7 @@ def test_what_no_water_or_sea_can_be_is_refused(overrides, message):
         ({"water.current_world_m_s": [7.0, 0.0, 0.0]}, "7 m/s is far outside sea and tidal currents (0 to 5 m/s)"),
         ({**WAVES, "water.waves.period_s": 40.0}, "40 s is far outside sea waves"),
         ({"integrator.step_s": 1e-9}, "override 'integrator.step_s': 1e-09 s is far outside the steps a UVMS run needs (1e-05 to 0.05 s); every simulated second takes 1/step steps"),
+        ({"initial.position_world_m": [0.0, 0.0, 50.0]}, "initial.position_world_m[2] = 50 m is far outside starting depths in the sea"),
         ({"control.period_s": 1e-5, "output.log_period_s": 0.02, "integrator.step_s": 1e-5}, "override 'control.period_s': 1e-05 s is far outside controller rates"),
     ],
 )  # fmt: skip

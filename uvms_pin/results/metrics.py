@@ -201,6 +201,21 @@ def transient_end_s(rollout: RolloutData, fraction: float = 0.05) -> float:
     return float(rollout.time_s[settled[0]])
 
 
+def force_overshoot_N(error_N: np.ndarray) -> float:
+    """The largest force error past the desired force [N], over every component.
+
+    ``error_N`` (n, k): e = f_e - f_d per sample. A component whose initial error is nonzero
+    overshoots when its error takes the opposite sign (by how much); a component starting at
+    zero error overshoots by any error it takes later, of either sign. 0 when nothing overshoots
+    or with fewer than two samples.
+    """
+    if len(error_N) < 2:
+        return 0.0
+    initial_sign = np.sign(error_N[0])
+    past = np.where(initial_sign != 0.0, -initial_sign * error_N, np.abs(error_N))
+    return float(max(0.0, np.max(past[1:])))
+
+
 def force_tracking_metrics(rollout: RolloutData) -> dict[str, float]:
     """Force-control metrics from a run that logged the controller's signals.
 
@@ -217,8 +232,6 @@ def force_tracking_metrics(rollout: RolloutData) -> dict[str, float]:
     norm = np.linalg.norm(error, axis=1)
     t_transient = transient_end_s(rollout)
     after = rollout.time_s >= t_transient
-    initial_sign = np.sign(error[0])
-    overshoot = np.where(initial_sign != 0.0, -initial_sign * error, np.abs(error))
     out = {
         "force_error_rms_N": _rms(norm),
         "force_error_max_N": float(norm.max()),
@@ -227,7 +240,7 @@ def force_tracking_metrics(rollout: RolloutData) -> dict[str, float]:
         "force_error_max_after_transient_N": float(norm[after].max())
         if np.any(after)
         else math.nan,
-        "force_overshoot_N": float(max(0.0, np.max(overshoot[1:]) if len(overshoot) > 1 else 0.0)),
+        "force_overshoot_N": force_overshoot_N(error),
     }
     for level, key in (("first", "xi_x"), ("second", "xi_zeta")):
         if key in signals:

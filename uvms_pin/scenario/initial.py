@@ -5,9 +5,21 @@ from __future__ import annotations
 import numpy as np
 import pinocchio as pin
 
+from uvms_pin.checks import Plausible
 from uvms_pin.model.uvms import UVMS
 from uvms_pin.scenario.schema import Table
 from uvms_pin.sim.divergence import DIVERGED_SPEED
+
+#: The height of the vehicle's origin above the still water's top, z = 0 [m]: below the deepest
+#: sea floor it cannot be in the sea; far above the water, a run is a long free fall first
+START_HEIGHT = Plausible(
+    "m",
+    usual=(-11000.0, 10.0),
+    possible=(-11000.0, 1.0e5),
+    usual_text="starting depths in the sea, or a drop of a few metres into it",
+    impossible_text="deeper than the deepest sea floor (~10.9 km) or above the atmosphere",
+    hints=("", "a height in mm?"),
+)
 
 
 def build_initial_state(t: Table, uvms: UVMS) -> tuple[np.ndarray, np.ndarray]:
@@ -16,6 +28,7 @@ def build_initial_state(t: Table, uvms: UVMS) -> tuple[np.ndarray, np.ndarray]:
     any angle), the generalized velocity (nv,)."""
     arm = uvms.arm_joints
     position = t.vector("position_world_m", 3, [0.0, 0.0, 0.0])
+    t.plausible("position_world_m[2]", float(position[2]), START_HEIGHT)
     rpy = t.vector("rpy_rad", 3, [0.0, 0.0, 0.0])
     joints = t.vector("joint_positions_rad", arm.count, arm.clip(np.zeros(arm.count)))
     velocity = t.vector("velocity", uvms.nv, np.zeros(uvms.nv))

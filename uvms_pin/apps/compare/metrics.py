@@ -4,7 +4,8 @@ Every controller is judged on the same window and the same quantities (the TRUE 
 force, the sensor's noise excluded):
 
 - force error e_f = f_e - f_d [N]: RMS and peak of |e_f| after ``after_s``;
-- overshoot [N]: the largest error of the sign opposite to the initial error (any component);
+- overshoot [N]: `force_overshoot_N`, as in a run's metrics: the largest error of the sign
+  opposite to the initial error (any component; a component starting at zero error: any error);
 - settling time [s]: the last time |e_f| exceeded ``band_N`` (0 if never; NaN if it does not
   settle, i.e. still outside the band at the end);
 - orientation error: RMS and peak of |rpy_ee - rpy_d| after ``after_s`` [rad];
@@ -24,7 +25,7 @@ from typing import Any
 
 import numpy as np
 
-from uvms_pin.results.metrics import joint_limit_metrics
+from uvms_pin.results.metrics import force_overshoot_N, joint_limit_metrics
 from uvms_pin.results.rollout import Rollout
 from uvms_pin.sim.actuation import Actuation
 
@@ -77,8 +78,6 @@ def comparison_row(
     error = rollout.wrench_contact_world[:, :3] - signals["force_desired_world_N"]
     norm = np.linalg.norm(error, axis=1)
     after = time_s >= criteria.after_s
-    initial = np.sign(error[0])
-    overshoot = np.where(initial != 0.0, -initial * error, 0.0)
     outside = np.flatnonzero(norm > criteria.band_N)
     settling = 0.0 if outside.size == 0 else float(time_s[outside[-1]])
     if outside.size and outside[-1] == len(norm) - 1:
@@ -92,7 +91,7 @@ def comparison_row(
         "status": rollout.metadata.get("status", "ok") if not stopped else "stopped",
         "force_error_rms_N": _rms(norm[after]),
         "force_error_peak_N": _peak(norm[after]),
-        "overshoot_N": float(max(0.0, np.max(overshoot[1:]))) if len(norm) > 1 else 0.0,
+        "overshoot_N": force_overshoot_N(error),
         "settling_time_s": settling,
         "orientation_error_rms_rad": _rms(orientation[after]),
         "orientation_error_peak_rad": _peak(orientation[after]),
