@@ -22,7 +22,11 @@ measured here, to one ``pin.aba`` call on the same model or to MuJoCo doing the 
    the Python loop (`uvms_pin.sim.compiled_loop`), per 2 ms tick, against MuJoCo's plant alone
    (4 RK4 ``mj_step``, no controller);
 5. the plant per 2 ms with 4-, 6- and 7-joint arms (reference, UR5, Panda on the
-   reference vehicle).
+   reference vehicle);
+6. the plant per 2 ms in a world (bench_world.py's: a seafloor, a crate, a boulder and a
+   pipe), the reference vehicle resting on the seafloor on the four bottom corners of its
+   hull box (uvms-pin: Hunt-Crossley and Coulomb contacts, compiled with coal; MuJoCo: the
+   same geoms in its twin, its own soft contacts with their default solver settings).
 
 When uvms-pin grows a ``backend=`` keyword (on ``forward_dynamics``, on ``Plant`` or on
 ``Plant.acceleration``), every uvms-pin row is measured for each backend.
@@ -35,6 +39,7 @@ import inspect
 import json
 import math
 import tempfile
+import xml.etree.ElementTree as ET
 from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
@@ -42,6 +47,8 @@ from pathlib import Path
 import mujoco
 import numpy as np
 import pinocchio as pin
+from bench_world import objects as world_objects
+from bench_world import resting_floor_z
 from timing import best_times, one_blas_thread
 
 import uvms_pin as up
@@ -58,12 +65,14 @@ from uvms_pin.model.mount.mount import mount_arm_detailed
 from uvms_pin.model.mount.split import split_urdf
 from uvms_pin.physics.contact import LinearSpring
 from uvms_pin.physics.disturbance import SinusoidalDisturbance
+from uvms_pin.physics.world.world import World
 from uvms_pin.sim.integrators import RK4
 from uvms_pin.sim.plant import Plant
 from uvms_pin.sim.sensors import SensorSuite
 
 ROOT = Path(__file__).resolve().parents[1]
 REFERENCE_URDF = ROOT / "models" / "uvms_lbv150.urdf"
+VEHICLE_URDF = ROOT / "models" / "lbv150.urdf"
 SCENARIO = ROOT / "scenarios" / "realistic_force_tracking.toml"
 CONTROL_PERIOD_S = 2e-3
 STEP_S = 5e-4
@@ -255,6 +264,75 @@ def plant_cases(system: System) -> dict[str, Callable[[], object]]:
     return cases
 
 
+# ---- a world with contacts ----------------------------------------------------------------
+
+
+def _world_geoms(mjcf: str, objects: list) -> str:
+    """The MJCF with the world's objects as geoms the robot's geoms collide with (and they
+    only with the world: the robot's own pieces do not touch each other here either)."""
+    root = ET.fromstring(mjcf)
+    for flag in root.iter("flag"):  # the twin is exported without contacts
+        flag.set("contact", "enable")
+    for geom in root.iter("geom"):
+        geom.set("contype", "1")
+        geom.set("conaffinity", "0")
+    world = root.find("worldbody")
+    for obj in objects:
+        placement = obj.placement
+        mu = f"{obj.friction_static} 0.005 0.0001"
+        common = {"contype": "0", "conaffinity": "1", "friction": mu, "name": obj.name}
+        position = " ".join(repr(float(x)) for x in placement.translation)
+        quat = pin.Quaternion(placement.rotation)
+        orientation = " ".join(repr(float(x)) for x in (quat.w, quat.x, quat.y, quat.z))
+        size = {
+            "plane": "0 0 1",
+            "box": " ".join(repr(float(x) / 2) for x in obj.params.get("size_m", [])),
+            "sphere": repr(obj.params.get("radius_m")),
+            "cylinder": f"{obj.params.get('radius_m')} {obj.params.get('length_m', 0) / 2}",
+        }[obj.kind]
+        ET.SubElement(
+            world, "geom", type=obj.kind, size=size, pos=position, quat=orientation, **common
+        )
+    return ET.tostring(root, encoding="unicode")
+
+
+def resting_system() -> tuple[System, World]:
+    """The reference vehicle resting on bench_world's seafloor (four corners of its hull box
+    2 mm deep), and its MuJoCo twin with the same objects."""
+    # the twin needs a frame for its sites: the vehicle's body
+    uvms = up.load_uvms(VEHICLE_URDF, ee_frame="base_link", sensor_frame="base_link")
+    q0 = uvms.neutral_configuration()
+    q0[:3] = [0.0, 0.0, -5.0]
+    world = World(uvms, world_objects(resting_floor_z(uvms, q0)))
+    options = MjcfOptions(timestep_s=STEP_S, integrator="RK4")
+    mjcf = _world_geoms(uvms_to_mjcf(uvms, VEHICLE_URDF.read_text(), options), world.objects)
+    mj_model = mujoco.MjModel.from_xml_string(mjcf)
+    return System("vehicle", uvms, mj_model, q0, np.zeros(uvms.nv)), world
+
+
+def contact_cases(system: System, world: World) -> dict[str, Callable[[], object]]:
+    """One 2 ms period resting on the seafloor: uvms-pin (each backend), MuJoCo."""
+    cases = {}
+    q, v, tau = system.q0, system.v0, np.zeros(system.uvms.nv)
+    for backend in plant_backends():
+        plant = make_plant(system.uvms, backend, world=world, free_surface=False)
+        plant.attach(system.q0)
+        integrator = RK4(STEP_S)
+        cases[f"{label(backend)} plant"] = lambda p=plant, b=backend, i=integrator: advance(
+            p, i, b, 0.0, q, v, tau, CONTROL_PERIOD_S
+        )
+    cases[MJ_PLANT] = mujoco_plant_case(system)
+    return cases
+
+
+def contacts_of(system: System, world: World) -> tuple[int, int]:
+    """(uvms-pin's contact points, MuJoCo's contacts) at the resting state."""
+    ours = len(Plant(system.uvms, world=world).world_forces(system.q0, system.v0).touch)
+    data = mujoco_data(system, system.q0, system.v0)
+    mujoco.mj_forward(system.mj_model, data)
+    return ours, int(data.ncon)
+
+
 # ---- the closed loop ----------------------------------------------------------------------
 
 
@@ -440,6 +518,16 @@ def main() -> None:
             per_call=round(args.loop_s / CONTROL_PERIOD_S),
         ),
     ]
+    resting, world = resting_system()
+    points, mj_contacts = contacts_of(resting, world)
+    sections.append(
+        measure_section(
+            f"2 ms plant resting on the seafloor ({points} contacts; MuJoCo {mj_contacts})",
+            resting,
+            contact_cases(resting, world),
+            args.repeat,
+        )
+    )
     with tempfile.TemporaryDirectory(prefix="uvms_bench_") as tmp:
         systems = [reference] + [mounted_system(arm, Path(tmp) / arm) for arm in ARMS[1:]]
     arms = measure_growth(systems, args.repeat)

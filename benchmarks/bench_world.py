@@ -11,8 +11,13 @@ alone (models/lbv150.urdf). Rows, each as a ratio to the same model without a wo
 - world, nothing near: a seafloor 5 m below and a box, a sphere and a pipe metres away:
   each period costs one compiled bound test, then the same compiled call;
 - world, 4 contacts: the vehicle resting on the seafloor on the four bottom corners of its
-  hull box (the period is integrated in Python around the compiled dynamics; the UVMS's
-  arm hangs below its hull, so the vehicle alone rests on four corners).
+  hull box: the contacts are compiled too (coal's C++ API), the period one compiled call
+  (the UVMS's arm hangs below its hull, so the vehicle alone rests on four corners);
+- the same on the Python reference (``backend="python"``: contacts through coal's Python
+  bindings, the Python dynamics), for scale.
+
+Each row is also given as a multiple of one ``pin.aba`` on the same model (rigid, no
+water), timed in the same rounds.
 
 CPU time of this process, best of interleaved rounds, one BLAS thread (`timing.py`).
 """
@@ -24,6 +29,7 @@ import json
 from pathlib import Path
 
 import numpy as np
+import pinocchio as pin
 from timing import best_times, one_blas_thread
 
 import uvms_pin as up
@@ -35,6 +41,7 @@ from uvms_pin.sim.plant import Plant
 
 ROOT = Path(__file__).resolve().parents[1]
 PERIOD_S, STEP_S = 2e-3, 5e-4
+ABA = "pin.aba"
 
 
 def objects(floor_z: float) -> list:
@@ -56,7 +63,7 @@ def objects(floor_z: float) -> list:
     ]
 
 
-def _resting_floor_z(uvms: up.UVMS, q: np.ndarray) -> float:
+def resting_floor_z(uvms: up.UVMS, q: np.ndarray) -> float:
     """A floor 2 mm above the lowest corner of the vehicle's hull at q."""
     probe = World(uvms, objects(-100.0))
     hull = next(p for p in probe.pieces if p.joint_id == 1 and p.corners_m is not None)
@@ -81,15 +88,25 @@ def cases() -> tuple[dict, dict]:
         )
         if label == "vehicle":  # the UVMS's arm hangs below its hull: it rests on the hull
             resting = Plant(
-                uvms, free_surface=False, world=World(uvms, objects(_resting_floor_z(uvms, q)))
+                uvms, free_surface=False, world=World(uvms, objects(resting_floor_z(uvms, q)))
             )
             contacts = len(resting.world_forces(q, np.zeros(uvms.nv)).touch)
             rows[f"{label}: world, {contacts} contacts"] = resting
+            rows[f"{label}: world, {contacts} contacts (Python reference)"] = Plant(
+                uvms, free_surface=False, world=resting.world, backend="python"
+            )
             info["contacts"] = contacts
         for name, plant in rows.items():
             plant.attach(q)
             table[name] = _period(plant, q)
+        table[f"{label}: {ABA}"] = _aba(uvms, q)
     return table, info
+
+
+def _aba(uvms: up.UVMS, q: np.ndarray):
+    model = uvms.model
+    data, v = model.createData(), np.zeros(model.nv)
+    return lambda: pin.aba(model, data, q, v, v)
 
 
 def _period(plant: Plant, q: np.ndarray):
@@ -106,12 +123,17 @@ def main() -> None:
     with one_blas_thread():
         table, info = cases()
         best = best_times(table, args.repeat)
-    print("| plant over one 2 ms period | time [us] | / contact-free |\n|---|---|---|")
+    print(
+        "| plant over one 2 ms period | time [us] | / contact-free | x pin.aba |\n|---|---|---|---|"
+    )
     rows = {}
     for name, seconds in best.items():
-        base = best[name.split(":")[0] + ": contact-free"]
-        rows[name] = {"s": seconds, "ratio": seconds / base}
-        print(f"| {name} | {seconds * 1e6:.0f} | {seconds / base:.2f} |")
+        model = name.split(":")[0]
+        if name == f"{model}: {ABA}":
+            continue
+        base, aba = best[f"{model}: contact-free"], best[f"{model}: {ABA}"]
+        rows[name] = {"s": seconds, "ratio": seconds / base, "aba": seconds / aba}
+        print(f"| {name} | {seconds * 1e6:.0f} | {seconds / base:.2f} | {seconds / aba:.0f} |")
     if args.json:
         args.json.write_text(json.dumps({**info, "rows": rows}, indent=2))
 

@@ -17,6 +17,7 @@
 #include "derivatives.hpp"
 #include "plant.hpp"
 #include "ppc.hpp"
+#include "world_bindings.hpp"
 
 namespace nb = nanobind;
 using namespace nb::literals;
@@ -348,8 +349,9 @@ void bind_environment(nb::module_& m) {
 
 void bind_plant(nb::module_& m) {
   using uvms::Plant;
-  nb::class_<Plant>(m, "Plant", "A UVMS in water, touching and pushed (plant.hpp).")
-      .def(nb::init<const uvms::Dynamics&, int>(), "dynamics"_a, "ee_frame_id"_a)
+  auto plant = nb::class_<Plant>(m, "Plant", "A UVMS in water, touching and pushed (plant.hpp).");
+  bind_plant_world(plant);
+  plant.def(nb::init<const uvms::Dynamics&, int>(), "dynamics"_a, "ee_frame_id"_a)
       .def_rw("flow", &Plant::flow)
       .def_rw("free_surface", &Plant::free_surface)
       .def_rw("contact", &Plant::contact)
@@ -519,6 +521,7 @@ NB_MODULE(_core, m) {
   bind_dynamics(m);
   bind_derivatives(m);
   bind_environment(m);
+  bind_world(m);
   bind_plant(m);
   bind_batch_plant(m);
   bind_ppc(m);

@@ -48,6 +48,10 @@ const Eigen::VectorXd& Plant::acceleration(double time_s, const ConstVec& q, con
     // the robot receives -lambda at the tip
     dynamics_.add_world_wrench(static_cast<int>(ee_joint_id_), position, -lambda);
   }
+  if (world && world_active_) {
+    world->forces(dynamics_.data(), friction, world_forces_);
+    world->add_to(dynamics_, world_forces_);
+  }
   if (disturbance) {
     // delta acts against tau on the vehicle body (joint 1, free-flyer: LOCAL Jacobian [I 0])
     dynamics_.add_local_wrench(1, -disturbance->at(time_s));
@@ -82,12 +86,50 @@ std::pair<Eigen::VectorXd, Eigen::VectorXd> Plant::advance(double t0, const Cons
                                                            const FixedStep& integrator) {
   stepper_.q = q0;
   stepper_.v = v0;
+  // a world: the broad phase first (nothing within reach: no contact persists, the friction
+  // forgets its anchors and the period runs without the world), else the contacts
+  bool settle = false;
+  if (world) {
+    check_world();
+    world_active_ = !world_clear(q0, v0, t1 - t0);
+    if (!world_active_) friction.clear();
+    settle = world_active_;
+  }
   auto rhs = [&](double t, const Eigen::VectorXd& q,
                  const Eigen::VectorXd& v) -> const Eigen::VectorXd& {
     return acceleration(t, q, v, tau);
   };
-  stepper_.advance(rhs, t0, t1, integrator);
+  try {
+    stepper_.advance(rhs, t0, t1, integrator);
+  } catch (...) {
+    world_active_ = true;
+    throw;
+  }
+  world_active_ = true;
+  if (settle) {  // the anchors move (World.commit), at the period's end
+    world->commit(world_forces(stepper_.q, stepper_.v), friction);
+  }
   return {stepper_.q, stepper_.v};
+}
+
+void Plant::check_world() {
+  if (!world) return;
+  world->check(dynamics_.model());
+  if (static_cast<Eigen::Index>(world->pieces.size()) != world_bounds.radii_m.size()) {
+    throw InputError("world contact: the world bounds must hold one sphere per piece");
+  }
+}
+
+const ContactForces& Plant::world_forces(const ConstVec& q, const ConstVec& v) {
+  world_forces_.touch.clear();
+  world_forces_.force_world_N.clear();
+  world_forces_.normal_N.resize(0);
+  world_forces_.sticking.clear();
+  if (!world) return world_forces_;
+  check_world();
+  dynamics_.kinematics(q, v);
+  world->forces(dynamics_.data(), friction, world_forces_);
+  return world_forces_;
 }
 
 std::pair<Eigen::VectorXd, Eigen::VectorXd> Plant::chart(const ConstVec& q0,

@@ -2,10 +2,12 @@
 // environment at its end-effector and pushed by a disturbance:
 //   M zeta_dot + h + J_c^T lambda + [delta; 0] = tau + [0; tau_f(v)] + tau_stop,
 // tau_f the friction of the arm's joint drives (joint_friction.hpp), tau_stop the compliant
-// stops at the joint limits (joint_stops.hpp).
+// stops at the joint limits (joint_stops.hpp), and with a world (world_contact.hpp) + tau_world,
+// the contacts of every body's collision shapes with the world's objects.
 // It advances the plant over one control period with the input held, in one call.
 #pragma once
 
+#include <optional>
 #include <utility>
 
 #include "contact.hpp"
@@ -15,6 +17,7 @@
 #include "joint_friction.hpp"
 #include "joint_stops.hpp"
 #include "world_bounds.hpp"
+#include "world_contact.hpp"
 
 namespace uvms {
 
@@ -40,6 +43,12 @@ class Plant {
   // (world_bounds.hpp); true without bounds.
   bool world_clear(const ConstVec& q, const ConstVec& v, double horizon_s);
   WorldBoundsModel world_bounds;
+  // The world's contacts, or none; with one, a period in which something may touch is
+  // integrated with them (the anchors of `friction` held) and ends with World.commit.
+  std::optional<WorldContactModel> world;
+  FrictionMemory friction;  // the world contacts' state between periods (see world_contact.hpp)
+  // The contact points and forces at (q, v) with `friction` (World.forces); no world: none.
+  const ContactForces& world_forces(const ConstVec& q, const ConstVec& v);
 
   // (q, v) at t1 from (q0, v0) at t0 with tau held, in the integrator's substeps.
   std::pair<Eigen::VectorXd, Eigen::VectorXd> advance(double t0, const ConstVec& q0,
@@ -60,7 +69,10 @@ class Plant {
   pinocchio::FrameIndex ee_frame_id_;
   pinocchio::JointIndex ee_joint_id_;
   ManifoldStepper stepper_;
-  Eigen::VectorXd tau_total_;  // tau - the joint friction + the joint stops' torque
+  Eigen::VectorXd tau_total_;
+  bool world_active_ = true;  // false over a period the broad phase cleared
+  ContactForces world_forces_;
+  void check_world();  // tau - the joint friction + the joint stops' torque
 };
 
 }  // namespace uvms

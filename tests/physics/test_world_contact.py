@@ -1,5 +1,6 @@
 """Contact with the world: bodies resting, sticking, sliding and bouncing on the seafloor,
-checked against statics, Coulomb's law, a one-dimensional impact and the energy."""
+checked against statics, Coulomb's law, a one-dimensional impact and the energy, on both
+backends (the compiled contacts and the Python reference)."""
 
 from __future__ import annotations
 
@@ -22,6 +23,11 @@ A, B, C = 1.0, 0.5, 0.5  # box [m]
 DENSITY = 3.0  # the box is three times as dense as the water
 FLOOR_Z = -10.0
 ADDED = (60.0, 90.0, 110.0, 5.0, 6.0, 7.0)  # diagonal added mass of the box [kg, kg m^2]
+
+
+@pytest.fixture(params=["core", "python"])
+def backend(request) -> str:
+    return request.param
 
 
 def _box(load_body, damping=(0.0,) * 6):
@@ -67,11 +73,11 @@ def _slope_world(uvms, theta, mu_s, mu_k, law: ContactLaw):
     return World(uvms, [plane("seafloor", [0.0, 0.0, FLOOR_Z], normal, mu_s, mu_k)], law)
 
 
-def test_a_box_rests_on_the_seafloor_with_its_net_weight_and_does_not_sink(load_body):
+def test_a_box_rests_on_the_seafloor_with_its_net_weight_and_does_not_sink(load_body, backend):
     uvms = _box(load_body, damping=(200.0,) * 6)
     law = ContactLaw(stiffness_N_m=1e5, dissipation_s_m=0.5)
     world = World(uvms, [plane("seafloor", [0, 0, FLOOR_Z], [0, 0, 1], 0.6, 0.5)], law)
-    plant = Plant(uvms, world=world, free_surface=False)
+    plant = Plant(uvms, world=world, free_surface=False, backend=backend)
     q, _ = _on_slope(uvms, 0.0, lift_m=0.02)
     states = _run(plant, q, np.zeros(uvms.nv), 60.0, step_s=1e-2, period_s=5e-2)
     _, q_end, v_end = states[-1]
@@ -88,7 +94,7 @@ def test_a_box_rests_on_the_seafloor_with_its_net_weight_and_does_not_sink(load_
 
 
 @pytest.mark.parametrize("theta_deg", [10.0, 25.0])
-def test_a_block_on_a_slope_gentler_than_its_friction_stays_put(load_body, theta_deg):
+def test_a_block_on_a_slope_gentler_than_its_friction_stays_put(load_body, theta_deg, backend):
     uvms = _box(load_body, damping=(500.0,) * 6)  # the water's drag damps its rocking
     theta = math.radians(theta_deg)
     mu_s, mu_k = 0.6, 0.4
@@ -97,7 +103,7 @@ def test_a_block_on_a_slope_gentler_than_its_friction_stays_put(load_body, theta
     # about critical (a spring ringing past mu_s f_n would break away: the step of the load
     # would then be felt, not the static friction)
     law = ContactLaw(1e5, 5.0, tangential_stiffness_N_m=1e5, tangential_damping_N_s_m=3e4)
-    plant = Plant(uvms, world=_slope_world(uvms, theta, mu_s, mu_k, law))
+    plant = Plant(uvms, world=_slope_world(uvms, theta, mu_s, mu_k, law), backend=backend)
     # placed at rest on the slope at the depth that carries it, sticking where it is
     depth = _net_weight_N() * math.cos(theta) / (4 * law.stiffness_N_m)
     q, _ = _on_slope(uvms, theta, lift_m=-depth)
@@ -120,12 +126,13 @@ def test_a_block_on_a_slope_gentler_than_its_friction_stays_put(load_body, theta
 
 
 @pytest.mark.parametrize("theta_deg", [35.0, 45.0])
-def test_a_block_on_a_steep_slope_slides_at_the_coulomb_acceleration(load_body, theta_deg):
+def test_a_block_on_a_steep_slope_slides_at_the_coulomb_acceleration(load_body, theta_deg, backend):
     uvms = _box(load_body)
     theta = math.radians(theta_deg)
     mu_s, mu_k = 0.6, 0.4
     assert math.tan(theta) > mu_s
-    plant = Plant(uvms, world=_slope_world(uvms, theta, mu_s, mu_k, ContactLaw(1e5, 0.5)))
+    world = _slope_world(uvms, theta, mu_s, mu_k, ContactLaw(1e5, 0.5))
+    plant = Plant(uvms, world=world, backend=backend)
     q, _ = _on_slope(uvms, theta)
     states = _run(plant, q, np.zeros(uvms.nv), 2.0, step_s=2e-3, period_s=1e-2)
     downslope = np.array([-math.cos(theta), 0.0, -math.sin(theta)])
@@ -162,13 +169,18 @@ def _impact_oracle(mass_kg, net_weight_N, law, speed_in):
     return -sol.y_events[0][0][1]
 
 
-@pytest.mark.parametrize("dissipation", [0.0, 0.3, 1.0])
-def test_a_dropped_sphere_rebounds_as_the_contact_damping_says(load_body, dissipation):
+# the Python reference once (a minute a run; the compiled runs agree with it to 1e-12,
+# tests/physics/test_world_compiled.py)
+@pytest.mark.parametrize(
+    ("dissipation", "backend"),
+    [(0.0, "core"), (0.3, "core"), (1.0, "core"), (0.3, "python")],
+)
+def test_a_dropped_sphere_rebounds_as_the_contact_damping_says(load_body, dissipation, backend):
     radius, added = 0.2, 20.0
     uvms, m, volume = _sphere(load_body, radius, 2.0, added)
     law = ContactLaw(stiffness_N_m=2e5, dissipation_s_m=dissipation)
     world = World(uvms, [plane("seafloor", [0, 0, FLOOR_Z], [0, 0, 1], 0.6, 0.5)], law)
-    plant = Plant(uvms, world=world, free_surface=False)
+    plant = Plant(uvms, world=world, free_surface=False, backend=backend)
     q = uvms.neutral_configuration()
     q[2] = FLOOR_Z + radius + 0.05
     v = np.zeros(uvms.nv)
@@ -204,13 +216,13 @@ def test_a_dropped_sphere_rebounds_as_the_contact_damping_says(load_body, dissip
         assert energy[-1] < energy[0] - 0.05 * scale
 
 
-def test_a_sphere_rests_on_a_box_object_through_coal(load_body):
+def test_a_sphere_rests_on_a_box_object_through_coal(load_body, backend):
     radius = 0.2
     uvms, m, volume = _sphere(load_body, radius, 2.0, 20.0)
 
     box = solid("block", "box", {"size_m": [1.0, 1.0, 0.4]}, [0, 0, FLOOR_Z], [0, 0, 0], 0.6, 0.5)
     world = World(uvms, [box], ContactLaw(stiffness_N_m=1e5, dissipation_s_m=2.0))
-    plant = Plant(uvms, world=world, free_surface=False)
+    plant = Plant(uvms, world=world, free_surface=False, backend=backend)
     q = uvms.neutral_configuration()
     q[2] = FLOOR_Z + 0.2 + radius + 0.005
     states = _run(plant, q, np.zeros(uvms.nv), 5.0)

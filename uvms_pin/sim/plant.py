@@ -9,9 +9,11 @@ integrator stage, contact, disturbance, held tau) is one C++ call. The plant's c
 counterpart (`src/uvms_core/plant.hpp`) is built from its flow, contact and disturbance when
 a run starts (`attach`) or on first use; when one of them has no counterpart (e.g. a
 disturbance written in Python) the plant runs on the Python reference and says so once with a
-`CoreFallbackWarning`. A world (`uvms_pin.physics.world`) is Python's: a period in which
-nothing can touch it is one compiled call; one in which something may is integrated in
-Python around the compiled dynamics.
+`CoreFallbackWarning`. A world (`uvms_pin.physics.world`) has its compiled counterpart too
+(src/uvms_core/world_contact.hpp, coal's C++ API): a period in which nothing can touch it is
+one compiled call without it, one in which something may is one compiled call with the
+contacts. The friction's state (`friction`, a `FrictionMemory`) stays on this plant for
+both backends: the compiled call reads it and writes it back.
 """
 
 from __future__ import annotations
@@ -33,7 +35,7 @@ from uvms_pin.physics.compiled.disturbance import disturbance_to_core
 from uvms_pin.physics.compiled.flow import flow_to_core
 from uvms_pin.physics.compiled.joint_friction import joint_friction_to_core
 from uvms_pin.physics.compiled.joint_stops import joint_stops_to_core
-from uvms_pin.physics.compiled.world import world_bounds_to_core
+from uvms_pin.physics.compiled.world import world_bounds_to_core, world_contact_to_core
 from uvms_pin.physics.contact import ContactModel
 from uvms_pin.physics.disturbance import Disturbance
 from uvms_pin.physics.dynamics import dynamics_of, forward_dynamics
@@ -230,6 +232,7 @@ class Plant:
         bounds = world_bounds_to_core(self.world, core)
         if bounds is not None:
             compiled.world_bounds = bounds
+            compiled.world = world_contact_to_core(self.world, core)
         return compiled
 
     def _core(self):
@@ -360,11 +363,14 @@ class Plant:
     ) -> np.ndarray:
         """zeta_dot of  M zeta_dot + h + J_c^T lambda + delta = tau + [0; tau_f(v)] + tau_world
         + tau_stop (docs/physics.md; tau_f the joint drives' friction). With a world the
-        contact is Python's, the dynamics the backend's; ``extra_torque`` as in
+        contact at the anchors of ``friction``, compiled with the rest on the core (the moving
+        contacts, free objects and self-collision, are Python's); ``extra_torque`` as in
         `external_torque`."""
         compiled = self._core()
         if compiled is not None and self.world is None:
             return compiled.acceleration(time_s, q, v, tau, contact_world)
+        if compiled is not None and contact_world is None and self.free_bodies is None:
+            return compiled.acceleration_in_world(time_s, q, v, tau, self.friction)
         model = self.uvms.model
         tau_ext = np.zeros(model.nv)
         if self.joint_friction is not None:
@@ -418,18 +424,25 @@ class Plant:
         """(q, v) at t1 from (q0, v0) at t0 with the input tau held (zero-order hold).
 
         One compiled call for the whole interval when the integrator has a compiled
-        counterpart (RK4, semi-implicit Euler) and no world object can be touched in it
-        (`World.clear`: then the world costs one bound test); the integrator's Python loop
-        otherwise, around the compiled dynamics, with the world's contacts."""
+        counterpart (RK4, semi-implicit Euler): without a world, or with one of fixed objects
+        (a bound test first: nothing within reach, the period runs without it; else with the
+        contacts, and the friction's anchors move at its end, `World.commit`). With free
+        objects, the system's own integration (`FreeBodies.advance`); with self-collision
+        only, compiled while nothing can touch. The integrator's Python loop otherwise,
+        around the compiled right-hand side."""
         if self.free_bodies is not None and self.free_bodies.objects:
             q1, v1 = self.free_bodies.advance(integrator, t0, q0, v0, tau, t1)
             self.settle(q1, v1)
             return q1, v1
         compiled = self._core()
-        if compiled is not None and self._world_clear(q0, v0, t1 - t0):
-            step = self._compiled_step(integrator)
-            if step is not None:
-                return compiled.advance(t0, q0, v0, tau, t1, step)
+        step = None if compiled is None else self._compiled_step(integrator)
+        if step is not None and self.world is None:
+            return compiled.advance(t0, q0, v0, tau, t1, step)
+        if step is not None and self.free_bodies is None:
+            return compiled.advance_in_world(t0, q0, v0, tau, t1, step, self.friction)
+        clear = compiled is not None and self._world_clear(q0, v0, t1 - t0)
+        if clear and step is not None:
+            return compiled.advance(t0, q0, v0, tau, t1, step)
         q1, v1 = integrator.advance(
             self.uvms.model, lambda t, q, v: self.acceleration(t, q, v, tau), t0, q0, v0, t1
         )

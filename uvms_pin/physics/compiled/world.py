@@ -1,14 +1,21 @@
-"""A world's broad phase as the core's (src/uvms_core/world_bounds.hpp): `WorldBounds`.
+"""A world as the core's: its broad phase (src/uvms_core/world_bounds.hpp, `WorldBounds`)
+and its contacts (world_contact.hpp, `WorldContact`: the shapes of contact_shapes.hpp, the
+law of contact_law.hpp), built from the Python reference (`uvms_pin.physics.world`).
 
-The contacts themselves stay in Python (coal); the compiled plant only says whether a
-control period can touch anything (`uvms_pin.physics.world.touch.clear_of`)."""
+Each robot piece and world object becomes a `ContactShape`: the same coal geometry on a
+joint (0, the universe, for a fixed object) at a placement in that joint's frame; a convex
+hull crosses as the points qhull built it from, so that the core's hull is the same one."""
 
 from __future__ import annotations
 
 from types import ModuleType
+from typing import Any
 
+import coal
 import numpy as np
+import pinocchio as pin
 
+from uvms_pin.errors import ModelError
 from uvms_pin.physics.world.touch import CLEARANCE_M
 from uvms_pin.physics.world.world import World
 
@@ -36,4 +43,61 @@ def world_bounds_to_core(world: World | None, core: ModuleType):
     )
     out.sphere_radii_m = np.array([o.bound_radius_m for o in solids], dtype=float)
     out.clearance_m = CLEARANCE_M
+    return out
+
+
+def _geometry(shape: Any, core: ModuleType) -> tuple[Any, np.ndarray, np.ndarray]:
+    """(core kind, sizes, points (3, n)) of a coal shape (what `ContactShape.set_geometry`
+    takes): sizes as the Python side built it (a box's edges are twice coal's half sides)."""
+    none = np.zeros((3, 0))
+    if isinstance(shape, coal.Halfspace):
+        return core.ContactKind.plane, np.zeros(0), none
+    if isinstance(shape, coal.Box):
+        return core.ContactKind.box, 2.0 * np.asarray(shape.halfSide, dtype=float), none
+    if isinstance(shape, coal.Sphere):
+        return core.ContactKind.sphere, np.array([shape.radius]), none
+    if isinstance(shape, coal.Cylinder):
+        return core.ContactKind.cylinder, np.array([shape.radius, 2.0 * shape.halfLength]), none
+    if isinstance(shape, coal.Ellipsoid):
+        return core.ContactKind.ellipsoid, np.asarray(shape.radii, dtype=float), none
+    if isinstance(shape, coal.ConvexBase) and hasattr(shape, "built_from_m"):
+        return core.ContactKind.convex, np.zeros(0), np.asarray(shape.built_from_m).T
+    raise ModelError(f"no compiled contact geometry for a {type(shape).__name__}")
+
+
+def _shape(core: ModuleType, shape: Any, joint_id: int, placement: pin.SE3, radius: float):
+    out = core.ContactShape()
+    out.joint_id = int(joint_id)
+    out.set_placement(placement.rotation, placement.translation)
+    out.set_geometry(*_geometry(shape, core))
+    out.bound_radius_m = float(radius)
+    return out
+
+
+def world_contact_to_core(world: World | None, core: ModuleType):
+    """The core's contacts of ``world`` (None: no world): its pieces (on their joints), its
+    objects (fixed: joint 0) and its law."""
+    if world is None:
+        return None
+    pieces = []
+    for piece in world.pieces:
+        where = piece.placement_in_joint
+        shape = _shape(core, piece.shape, piece.joint_id, where, piece.bound_radius_m)
+        shape.body = int(piece.body)
+        corners = piece.corners_m
+        shape.corners_m = np.zeros((3, 0)) if corners is None else np.asarray(corners).T
+        pieces.append(shape)
+    objects = []
+    for obj in world.objects:
+        shape = _shape(core, obj.shape, 0, obj.placement, obj.bound_radius_m)
+        shape.friction_static = float(obj.friction_static)
+        shape.friction_kinetic = float(obj.friction_kinetic)
+        objects.append(shape)
+    law = core.ContactLaw()
+    law.stiffness_N_m = world.law.stiffness_N_m
+    law.dissipation_s_m = world.law.dissipation_s_m
+    law.tangential_stiffness_N_m = world.law.tangential_stiffness_N_m
+    law.tangential_damping_N_s_m = world.law.tangential_damping_N_s_m
+    out = core.WorldContact()
+    out.pieces, out.objects, out.law = pieces, objects, law
     return out

@@ -151,8 +151,13 @@ def _shape(name: str, kind: str, sizes: dict[str, Any]) -> tuple[Any, float, dic
 
 
 def convex_hull(points_m: np.ndarray) -> coal.Convex:
-    """coal's convex hull (qhull) of the points (n, 3)."""
+    """coal's convex hull (qhull) of the points (n, 3). The points it is built from stay
+    with it (``hull.built_from_m``): the compiled core builds the same hull from the same
+    points (qhull's output depends on their order, not only on the polytope)."""
+    source = np.array(points_m, dtype=float).reshape(-1, 3)
     points = coal.StdVec_Vec3s()
-    for p in np.asarray(points_m, dtype=float):
+    for p in source:
         points.append(p)
-    return coal.Convex.convexHull(points, True, None)
+    hull = coal.Convex.convexHull(points, True, None)
+    hull.built_from_m = source
+    return hull

@@ -1,0 +1,115 @@
+#include "world_touch.hpp"
+
+#include <coal/collision.h>
+
+namespace uvms {
+
+void near_pairs(const Placements& piece_where, const std::vector<ContactShape>& pieces,
+                const Placements& object_where, const std::vector<ContactShape>& objects,
+                std::vector<std::pair<int, int>>& out) {
+  out.clear();
+  const int n_pieces = static_cast<int>(pieces.size());
+  const int n_objects = static_cast<int>(objects.size());
+  // planes: the height of the piece's centre over the plane below its radius
+  for (int p = 0; p < n_pieces; ++p) {
+    const Vec3& center = piece_where[static_cast<std::size_t>(p)].translation();
+    const double radius = pieces[static_cast<std::size_t>(p)].bound_radius_m;
+    for (int o = 0; o < n_objects; ++o) {
+      const auto k = static_cast<std::size_t>(o);
+      if (!objects[k].is_plane()) continue;
+      const Vec3 normal = object_where[k].rotation().col(2);
+      const double height = center.dot(normal) - normal.dot(object_where[k].translation());
+      if (height < radius) out.emplace_back(p, o);
+    }
+  }
+  // the others: bounding spheres that overlap
+  for (int p = 0; p < n_pieces; ++p) {
+    const Vec3& center = piece_where[static_cast<std::size_t>(p)].translation();
+    const double radius = pieces[static_cast<std::size_t>(p)].bound_radius_m;
+    for (int o = 0; o < n_objects; ++o) {
+      const auto k = static_cast<std::size_t>(o);
+      if (objects[k].is_plane()) continue;
+      const double gap = (center - object_where[k].translation()).norm();
+      if (gap < radius + objects[k].bound_radius_m) out.emplace_back(p, o);
+    }
+  }
+}
+
+namespace {
+
+coal::Transform3s transform_of(const pinocchio::SE3& where) {
+  return coal::Transform3s(where.rotation(), where.translation());
+}
+
+void add_point(const pinocchio::Data& data, const ContactShape& piece, const ContactShape& object,
+               int p, int o, int corner, const Vec3& point, const Vec3& normal, double depth,
+               Touch& out) {
+  out.piece.push_back(p);
+  out.obj.push_back(o);
+  out.corner.push_back(corner);
+  out.point_world_m.push_back(point);
+  out.normal_world.push_back(normal);
+  out.depth_m.push_back(depth);
+  // relative to the object's material point there (zero for a fixed object)
+  out.velocity_world_m_s.push_back(point_velocity(data, piece, point) -
+                                   point_velocity(data, object, point));
+}
+
+// Each corner of the piece under the plane (_corners_below of touch.py).
+void corners_below(const pinocchio::Data& data, const ContactShape& piece,
+                   const pinocchio::SE3& where, const ContactShape& plane,
+                   const pinocchio::SE3& plane_where, int p, int o, Touch& out) {
+  const Vec3 normal = plane_where.rotation().col(2);
+  for (Eigen::Index c = 0; c < piece.corners_m.cols(); ++c) {
+    const Vec3 point = where.translation() + where.rotation() * piece.corners_m.col(c);
+    const double depth = (plane_where.translation() - point).dot(normal);
+    if (depth > 0.0) add_point(data, piece, plane, p, o, static_cast<int>(c), point, normal, depth, out);
+  }
+}
+
+// coal's deepest point of the pair (_coal_point of touch.py), when they overlap.
+void coal_point(const pinocchio::Data& data, const ContactShape& piece,
+                const pinocchio::SE3& where, const ContactShape& object,
+                const pinocchio::SE3& object_where, int p, int o, Touch& out) {
+  static const coal::CollisionRequest request;  // one contact, depth and normal
+  coal::CollisionResult result;
+  if (coal::collide(piece.geometry.get(), transform_of(where), object.geometry.get(),
+                    transform_of(object_where), request, result) == 0) {
+    return;
+  }
+  const coal::Contact& contact = result.getContact(0);
+  const double depth = -contact.penetration_depth;
+  if (!(depth > 0.0)) return;
+  const Vec3 point = 0.5 * (contact.nearest_points[0] + contact.nearest_points[1]);
+  // coal's normal points from the first shape (the piece) to the second (the object)
+  add_point(data, piece, object, p, o, -1, point, -contact.normal, depth, out);
+}
+
+}  // namespace
+
+void touch(const pinocchio::Data& data, const std::vector<ContactShape>& pieces,
+           const std::vector<ContactShape>& objects, Placements& piece_where,
+           Placements& object_where, Touch& out) {
+  out.clear();
+  piece_where.resize(pieces.size());
+  object_where.resize(objects.size());
+  for (std::size_t p = 0; p < pieces.size(); ++p) piece_where[p] = placement_of(data, pieces[p]);
+  for (std::size_t o = 0; o < objects.size(); ++o) {
+    object_where[o] = placement_of(data, objects[o]);
+  }
+  static thread_local std::vector<std::pair<int, int>> pairs;
+  near_pairs(piece_where, pieces, object_where, objects, pairs);
+  for (const auto& [p, o] : pairs) {
+    const auto& piece = pieces[static_cast<std::size_t>(p)];
+    const auto& object = objects[static_cast<std::size_t>(o)];
+    const auto& where = piece_where[static_cast<std::size_t>(p)];
+    const auto& object_at = object_where[static_cast<std::size_t>(o)];
+    if (object.is_plane() && piece.has_corners()) {
+      corners_below(data, piece, where, object, object_at, p, o, out);
+    } else {
+      coal_point(data, piece, where, object, object_at, p, o, out);
+    }
+  }
+}
+
+}  // namespace uvms

@@ -1,0 +1,71 @@
+// Where a UVMS touches the world at one state (mirror of uvms_pin/physics/world/touch.py): the
+// contact points, a bounding-sphere broad phase first (objects far away cost one test), then
+// the narrow phase: against a plane each corner of a piece below it is a contact point, its
+// depth along the plane's normal; otherwise coal's GJK/EPA give the deepest point, its depth
+// and normal (one point per pair).
+#pragma once
+
+#include <utility>
+#include <vector>
+
+#include <pinocchio/multibody/data.hpp>
+
+#include "contact_shapes.hpp"
+#include "hydro_bodies.hpp"
+
+namespace uvms {
+
+using Placements = aligned_vector<pinocchio::SE3>;
+
+// The m contact points at one state (Touch of touch.py).
+struct Touch {
+  std::vector<int> piece, obj, corner;  // corner: the piece's corner index, -1: coal's point
+  std::vector<Vec3> point_world_m;      // where the force acts, on the piece
+  std::vector<Vec3> normal_world;       // unit, out of the object towards the piece
+  std::vector<double> depth_m;          // penetration > 0
+  std::vector<Vec3> velocity_world_m_s;  // the piece's velocity relative to the object's there
+
+  std::size_t size() const { return piece.size(); }
+  void clear() {
+    piece.clear();
+    obj.clear();
+    corner.clear();
+    point_world_m.clear();
+    normal_world.clear();
+    depth_m.clear();
+    velocity_world_m_s.clear();
+  }
+};
+
+// A shape's placement in the world after kinematics (oMi of its joint times its placement).
+inline pinocchio::SE3 placement_of(const pinocchio::Data& data, const ContactShape& shape) {
+  return data.oMi[static_cast<std::size_t>(shape.joint_id)] * shape.placement_in_joint;
+}
+
+// The velocity (world) of the material point at x of the body carrying the shape (zero for
+// the universe), from the LOCAL joint velocity kinematics leaves in data.
+inline Vec3 point_velocity(const pinocchio::Data& data, const ContactShape& shape,
+                           const Vec3& point_world_m) {
+  const auto j = static_cast<std::size_t>(shape.joint_id);
+  if (j == 0) return Vec3::Zero();
+  const auto& rotation = data.oMi[j].rotation();
+  const Vec3 linear = rotation * data.v[j].linear();
+  const Vec3 angular = rotation * data.v[j].angular();
+  return linear + angular.cross(point_world_m - data.oMi[j].translation());
+}
+
+// (piece, object) of every piece whose bounding sphere reaches an object's bound (planes
+// first, then the others, each in (piece, object) order: Bounds.near of touch.py).
+void near_pairs(const Placements& piece_where,
+                const std::vector<ContactShape>& pieces,
+                const Placements& object_where,
+                const std::vector<ContactShape>& objects,
+                std::vector<std::pair<int, int>>& out);
+
+// The contact points after kinematics (touch of touch.py); piece_where and object_where are
+// filled with every shape's placement.
+void touch(const pinocchio::Data& data, const std::vector<ContactShape>& pieces,
+           const std::vector<ContactShape>& objects, Placements& piece_where,
+           Placements& object_where, Touch& out);
+
+}  // namespace uvms
