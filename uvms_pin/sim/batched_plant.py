@@ -31,7 +31,7 @@ from uvms_pin.errors import ParameterError
 from uvms_pin.physics.compiled.backend import Fallback, backend_named
 from uvms_pin.physics.compiled.contact import contact_to_core
 from uvms_pin.sim.actuation import Actuation, ThrustersAndJointLimits, Unlimited
-from uvms_pin.sim.plant import Plant
+from uvms_pin.sim.plant import Plant, checked_start
 from uvms_pin.sim.sensors import SensorConfig
 from uvms_pin.sim.settings import SimulationSettings
 
@@ -172,16 +172,8 @@ class BatchedPlant:
     def reset(self, i: int, q0: np.ndarray, v0: np.ndarray, seed: int) -> None:
         """Environment ``i`` to t = 0 at (q0, v0) (the quaternion normalised), its contact
         anchored at its end-effector, its noise drawn from ``seed``."""
-        q0 = np.array(q0, dtype=float)
-        v0 = np.array(v0, dtype=float)
         model = self.plant.uvms.model
-        if q0.shape != (model.nq,) or v0.shape != (model.nv,):
-            raise ParameterError(
-                f"q0 must have {model.nq} and v0 {model.nv} entries, got {q0.shape}, {v0.shape}"
-            )
-        if not (np.all(np.isfinite(q0)) and np.all(np.isfinite(v0))):
-            raise ParameterError("initial state has a non-finite value")
-        q0[3:7] /= np.linalg.norm(q0[3:7])
+        q0, v0 = checked_start(model, q0, v0)
         contact = self.plant.contact
         if contact is not None:
             contact.attach(self.plant.ee_state(q0, np.zeros(model.nv))[0])

@@ -41,7 +41,7 @@ from uvms_pin.sim.compiled_loop import CompiledLoop, LoopPath
 from uvms_pin.sim.divergence import NUMERICAL_FAILURES, diverged, divergence_context
 from uvms_pin.sim.integrators import Adaptive
 from uvms_pin.sim.log import RolloutLog
-from uvms_pin.sim.plant import Plant
+from uvms_pin.sim.plant import Plant, checked_start
 from uvms_pin.sim.sample import Observer, Sample
 from uvms_pin.sim.sensors import SensorSuite
 from uvms_pin.sim.settings import SimulationSettings
@@ -92,15 +92,7 @@ class ClosedLoop:
             ParameterError: a state of the wrong size or with a non-finite value.
         """
         model = self.plant.uvms.model
-        q0 = np.array(q0, dtype=float)
-        v0 = np.array(v0, dtype=float)
-        if q0.shape != (model.nq,) or v0.shape != (model.nv,):
-            raise ParameterError(
-                f"q0 must have {model.nq} and v0 {model.nv} entries, got {q0.shape}, {v0.shape}"
-            )
-        if not (np.all(np.isfinite(q0)) and np.all(np.isfinite(v0))):
-            raise ParameterError("initial state has a non-finite value")
-        q0[3:7] /= np.linalg.norm(q0[3:7])
+        q0, v0 = checked_start(model, q0, v0)
         bodies = self.plant.free_bodies
         if bodies is not None and bodies.objects and self.settings.control_period_s is None:
             raise ParameterError(

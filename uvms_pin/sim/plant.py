@@ -448,3 +448,20 @@ class Plant:
         )
         self.settle(q1, v1)
         return q1, v1
+
+
+def checked_start(
+    model: pin.Model, q0: np.ndarray, v0: np.ndarray
+) -> tuple[np.ndarray, np.ndarray]:
+    """Copies of a starting state (q0 (nq,), v0 (nv,)) with the vehicle's quaternion
+    normalised; a ParameterError for a wrong size or a non-finite value."""
+    q0 = np.array(q0, dtype=float)
+    v0 = np.array(v0, dtype=float)
+    if q0.shape != (model.nq,) or v0.shape != (model.nv,):
+        raise ParameterError(
+            f"q0 must have {model.nq} and v0 {model.nv} entries, got {q0.shape}, {v0.shape}"
+        )
+    if not (np.all(np.isfinite(q0)) and np.all(np.isfinite(v0))):
+        raise ParameterError("initial state has a non-finite value")
+    q0[3:7] /= np.linalg.norm(q0[3:7])
+    return q0, v0
