@@ -178,3 +178,45 @@ def test_the_rollout_records_the_world_as_simulated():
             scenario.plant.water.surface_elevation(t, points[:, :2]),
             rtol=1e-14,
         )
+
+
+@pytest.mark.parametrize(
+    ("change", "message"),
+    [
+        (lambda q, v: (q[:-1], v), "q0 must have"),
+        (lambda q, v: (q, np.append(v, 0.0)), "v0 "),
+        (lambda q, v: (q, np.where(np.arange(v.size) == 2, np.nan, v)), "non-finite"),
+    ],
+)
+def test_a_bad_starting_state_is_refused_by_the_loop_and_the_batch(change, message):
+    """The closed loop and the batched plant share one check of a starting state."""
+    from uvms_pin.sim.batched_plant import BatchedPlant
+
+    scenario = _short()
+    settings = scenario.settings
+    loop = ClosedLoop(scenario.plant, settings, scenario.controller_factory(scenario.uvms))
+    sensors = SensorSuite(
+        scenario.uvms.model, scenario.sensor_config, settings.duration_s, settings.seed
+    )
+    q0, v0 = change(scenario.q0.copy(), scenario.v0.copy())
+    with pytest.raises(up.ParameterError, match=message):
+        loop.start(q0, v0, sensors)
+    batch = BatchedPlant(scenario.plant, settings, scenario.sensor_config, 2)
+    with pytest.raises(up.ParameterError, match=message):
+        batch.reset(1, q0, v0, seed=3)
+
+
+def test_a_starting_quaternion_is_normalised_in_a_copy():
+    scenario = _short()
+    settings = scenario.settings
+    loop = ClosedLoop(scenario.plant, settings, scenario.controller_factory(scenario.uvms))
+    sensors = SensorSuite(
+        scenario.uvms.model, scenario.sensor_config, settings.duration_s, settings.seed
+    )
+    q0 = scenario.q0.copy()
+    q0[3:7] *= 2.0
+    given = q0.copy()
+    loop.start(q0, scenario.v0, sensors)
+    np.testing.assert_array_equal(q0, given)  # the caller's array is not changed
+    measurement, _ = loop.measure()
+    assert np.linalg.norm(measurement.q[3:7]) == pytest.approx(1.0, abs=1e-12)
