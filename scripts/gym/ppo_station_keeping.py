@@ -55,12 +55,16 @@ def train(args) -> dict:
     import torch
     from stable_baselines3 import PPO
     from stable_baselines3.common.callbacks import BaseCallback
-    from stable_baselines3.common.vec_env import VecMonitor
+    from stable_baselines3.common.vec_env import VecMonitor, VecNormalize
 
     from uvms_pin.apps.gym.sb3 import Sb3VecEnv
 
     torch.set_num_threads(args.torch_threads)  # the batch has its own threads
     venv = VecMonitor(Sb3VecEnv(make_vector(args.num_envs, args.threads, args.duration)))
+    if args.normalize:
+        # running mean/std of observations and returns (the monitor inside logs raw rewards):
+        # the observation mixes metres, radians and newtons
+        venv = VecNormalize(venv, gamma=0.99)
     venv.seed(args.seed)
     curve: list[dict] = []
     start = time.perf_counter()
@@ -122,6 +126,10 @@ def main() -> None:
     parser.add_argument("--n-steps", type=int, default=256, help="PPO steps per env per update")
     parser.add_argument("--duration", type=float, default=4.0, help="episode length [s]")
     parser.add_argument("--seed", type=int, default=0)
+    parser.add_argument(
+        "--no-normalize", dest="normalize", action="store_false",
+        help="feed raw observations and rewards (default: VecNormalize)",
+    )  # fmt: skip
     parser.add_argument("--out", type=Path, default=Path("docs/ppo_station_keeping.png"))
     args = parser.parse_args()
     result = train(args)
