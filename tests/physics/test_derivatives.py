@@ -259,15 +259,7 @@ def test_free_surface_deep_bodies_have_the_deep_derivatives(reference_uvms, back
             np.testing.assert_array_equal(a, b)
 
 
-@pytest.mark.parametrize("depth_m", [0.0, 0.1, 5.0])
-def test_free_surface_cutting_a_body_is_refused(reference_uvms, depth_m):
-    """At or near the surface (or out of the water) the wet-fraction terms would need
-    differentiating: refused with a message naming the joints, never a silent wrong answer."""
-    q = reference_uvms.neutral_configuration()
-    q[2] = depth_m
-    zero = np.zeros(reference_uvms.nv)
-    with pytest.raises(ParameterError, match=r"free_surface=True.*surface cuts or leaves dry"):
-        up.forward_dynamics_derivatives(reference_uvms, q, zero, zero, free_surface=True)
+# the surface cutting a hull: tests/physics/test_derivatives_surface.py
 
 
 # ---- one control period ----------------------------------------------------------------------

@@ -34,7 +34,6 @@ from uvms_pin.physics.compiled.dynamics import CompiledDynamics
 from uvms_pin.physics.derivatives.reference import (
     forward_dynamics_derivatives as reference_derivatives,
 )
-from uvms_pin.physics.derivatives.reference import require_deep
 from uvms_pin.physics.reference import ReferenceDynamics, check_time
 from uvms_pin.physics.surface import wet_state
 
@@ -190,19 +189,20 @@ def forward_dynamics_derivatives(
         flow, time_s: a `uvms_pin.flow.FlowField` (it must give `gradient_kinematics`) and
             the time it is evaluated at [s].
         backend: "core" (compiled, default) or "python" (the reference).
-        free_surface: the water has a top (see `bias_forces`). The derivatives are those of
-            bodies wholly under it: a state where the surface cuts a hull (or leaves it
-            dry) raises ParameterError (the wet-fraction terms are not differentiated).
+        free_surface: the water has a top (see `bias_forces`). Where the surface cuts a
+            hull, its wet-fraction terms are differentiated too (wet volume and centroid,
+            scaled added mass and damping, the wet-fraction wrenches; the hull geometry's
+            own pose Jacobian by differences of its wetting): docs/derivatives.md. Where a
+            hull starts to touch the surface or becomes wholly wet or dry the dynamics have
+            a kink: the derivative of the side the state is on is returned.
     """
     dynamics = dynamics_of(uvms, backend)
     water = _checked_flow(flow) if current_world is None else _uniform_or(current_world, flow)
     time_s = check_time(time_s)
-    if free_surface:
-        require_deep(uvms, finite_vector("q", q, uvms.nq), water, time_s)
     # q, v, tau and tau_ext are checked (shape, finite) by the reference and by the core
     if isinstance(dynamics, ReferenceDynamics):
-        return reference_derivatives(uvms, q, v, tau, water, time_s, tau_ext)
-    return dynamics.forward_dynamics_derivatives(q, v, tau, water, time_s, tau_ext)
+        return reference_derivatives(uvms, q, v, tau, water, time_s, tau_ext, free_surface)
+    return dynamics.forward_dynamics_derivatives(q, v, tau, water, time_s, tau_ext, free_surface)
 
 
 def _uniform_or(current_world: np.ndarray, flow: FlowField | None) -> FlowField | None:

@@ -25,6 +25,7 @@ from uvms_pin.hydro.restoring import point_force_jacobians
 from uvms_pin.hydro.vector import skew
 from uvms_pin.model.uvms import UVMS
 from uvms_pin.physics.derivatives.motion import JointMotion
+from uvms_pin.physics.surface import WetState
 
 _IDENTITY = np.eye(3)
 
@@ -130,12 +131,31 @@ def point_force_dq(
     return dw_dq
 
 
+def hydrostatics(uvms: UVMS, wet: WetState | None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(V_j (nj,), r_j (nj, 3), M_A,j (nj, 6, 6)) per joint: the model's, or the wet ones
+    under a free surface (`uvms_pin.physics.surface`)."""
+    if wet is None:
+        return (
+            uvms.volume_per_joint_m3,
+            uvms.center_of_buoyancy_per_joint_m,
+            uvms.added_mass_per_joint,
+        )
+    return wet.volume_per_joint_m3, wet.center_of_buoyancy_per_joint_m, wet.added_mass_per_joint
+
+
 def restoring_jacobian(
-    uvms: UVMS, joint: int, motion: JointMotion, flow: FlowAtPoint, moving_water: bool
+    uvms: UVMS,
+    joint: int,
+    motion: JointMotion,
+    flow: FlowAtPoint,
+    moving_water: bool,
+    wet: WetState | None = None,
 ) -> np.ndarray:
     """dw/dq (6, nv) of buoyancy -rho V g and the Froude-Krylov load rho V Du/Dt, at the
-    joint body's centre of buoyancy (both world forces at a body point)."""
-    volume, cob = uvms.volume_per_joint_m3[joint], uvms.center_of_buoyancy_per_joint_m[joint]
+    joint body's centre of buoyancy (both world forces at a body point); V and r held (the
+    wet ones under a free surface: their own change is `derivatives.surface`'s)."""
+    volumes, cobs, _ = hydrostatics(uvms, wet)
+    volume, cob = volumes[joint], cobs[joint]
     mass_of_water = uvms.water_density_kg_m3 * volume
     force = -mass_of_water * uvms.model.gravity.linear
     force_dq = None
@@ -145,12 +165,20 @@ def restoring_jacobian(
     return point_force_dq(force, force_dq, cob, motion)
 
 
+def damping_scale(uvms: UVMS, wet: WetState, body: int) -> float:
+    """The wet fraction that scales damped body ``body``'s drag (1 for a body without a
+    hull: always wet)."""
+    hull = int(uvms.surface_bodies.hull_of_damped[body])
+    return 1.0 if hull < 0 else float(wet.fraction[hull])
+
+
 def damping_jacobians(
-    uvms: UVMS, body: int, motion: JointMotion, flow: FlowAtPoint
+    uvms: UVMS, body: int, motion: JointMotion, flow: FlowAtPoint, scale: float = 1.0
 ) -> tuple[np.ndarray, np.ndarray]:
     """(dw/dq, dw/dv) (6, nv) in the joint frame of damped body ``body`` (its index in
-    ``uvms.hydro_bodies_with_damping``): w = X^T d(nu_r), nu_r = X nu - [U; 0] in the body's
-    own frame (X the joint-to-body motion transform), d the damping wrench."""
+    ``uvms.hydro_bodies_with_damping``): w = s X^T d(nu_r), nu_r = X nu - [U; 0] in the
+    body's own frame (X the joint-to-body motion transform), d the damping wrench, s a held
+    scale (the wet fraction under a free surface)."""
     action = uvms.damping_action[body]
     seen = flow_in_body(
         motion,
@@ -159,8 +187,10 @@ def damping_jacobians(
         flow,
     )
     relative = action @ motion.velocity - np.r_[seen.velocity, 0.0, 0.0, 0.0]
-    slope = action.T @ damping_jacobian(
-        uvms.damping_linear[body], uvms.damping_quadratic[body], relative
+    slope = (
+        scale
+        * action.T
+        @ damping_jacobian(uvms.damping_linear[body], uvms.damping_quadratic[body], relative)
     )
     dw_dq = slope @ (action @ motion.velocity_dq - _linear(seen.velocity_dq))
     dw_dv = slope @ action @ motion.jacobian
@@ -168,29 +198,36 @@ def damping_jacobians(
 
 
 def fluid_wrench_jacobians(
-    uvms: UVMS, motions: dict[int, JointMotion], flow: FlowField | None, time_s: float
+    uvms: UVMS,
+    motions: dict[int, JointMotion],
+    flow: FlowField | None,
+    time_s: float,
+    wet: WetState | None = None,
 ) -> tuple[np.ndarray, np.ndarray]:
     """d fext_j / dq and d fext_j / dv (njoints, 6, nv) of the fluid wrench on every joint
     body, the sum of its terms (the flow sampled where `uvms_pin.physics.reference` samples
-    it: each joint body's centre of buoyancy, each damped link's origin)."""
+    it: each joint body's centre of buoyancy, each damped link's origin). Under a free
+    surface (``wet``) the wet volumes, centres of buoyancy, added masses and damping scales
+    are used and held: their own change with the state is `derivatives.surface`'s."""
     nj, nv = uvms.model.njoints, uvms.model.nv
     dw_dq, dw_dv = np.zeros((nj, 6, nv)), np.zeros((nj, 6, nv))
-    cob = uvms.center_of_buoyancy_per_joint_m
+    _, cob, added_mass = hydrostatics(uvms, wet)
     at_cob = {
         j: flow_at(flow, time_s, motions[j].point(cob[j]))
         for j in {*uvms.joints_with_added_mass, *uvms.joints_with_volume}
     }
     for j in uvms.joints_with_added_mass:
         seen = flow_in_body(motions[j], _IDENTITY, cob[j], at_cob[j])
-        dq, dv = added_mass_jacobians(uvms.added_mass_per_joint[j], motions[j], seen)
+        dq, dv = added_mass_jacobians(added_mass[j], motions[j], seen)
         dw_dq[j] += dq
         dw_dv[j] += dv
     for j in uvms.joints_with_volume:
-        dw_dq[j] += restoring_jacobian(uvms, j, motions[j], at_cob[j], flow is not None)
+        dw_dq[j] += restoring_jacobian(uvms, j, motions[j], at_cob[j], flow is not None, wet)
     for body, j in enumerate(uvms.damping_joint_ids):
         motion = motions[int(j)]
         origin = motion.point(uvms.damping_origin_in_joint_m[body])
-        dq, dv = damping_jacobians(uvms, body, motion, flow_at(flow, time_s, origin))
+        scale = 1.0 if wet is None else damping_scale(uvms, wet, body)
+        dq, dv = damping_jacobians(uvms, body, motion, flow_at(flow, time_s, origin), scale)
         dw_dq[j] += dq
         dw_dv[j] += dv
     return dw_dq, dw_dv

@@ -21,14 +21,15 @@ import pinocchio as pin
 from scipy.linalg import cho_factor, cho_solve
 
 from uvms_pin.checks import finite_vector
-from uvms_pin.errors import ParameterError, SimulationError
+from uvms_pin.errors import SimulationError
 from uvms_pin.flow import FlowField
 from uvms_pin.model.uvms import UVMS
-from uvms_pin.physics.derivatives.fluid import fluid_wrench_jacobians
+from uvms_pin.physics.derivatives.fluid import fluid_wrench_jacobians, hydrostatics
 from uvms_pin.physics.derivatives.motion import JointMotion, joint_motions
+from uvms_pin.physics.derivatives.surface import wet_term_jacobians
 from uvms_pin.physics.reference import ReferenceDynamics
 from uvms_pin.physics.reference import _fluid_wrenches as fluid_wrenches
-from uvms_pin.physics.surface import wet_state
+from uvms_pin.physics.surface import WetState, wet_state
 
 
 def hydro_joints(uvms: UVMS) -> list[int]:
@@ -44,14 +45,21 @@ def inverse_dynamics_derivatives(
     a: np.ndarray,
     flow: FlowField | None,
     time_s: float,
+    free_surface: bool = False,
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray, dict[int, JointMotion]]:
-    """(dID/dq, dID/dv, M, the joint motions) at (q, v, a), water included (nv x nv each)."""
+    """(dID/dq, dID/dv, M, the joint motions) at (q, v, a), water included (nv x nv each);
+    ``free_surface``: the hulls cut by the surface (`derivatives.surface`)."""
     model, data = uvms.model, uvms.data
     motions = joint_motions(model, data, q, v, a, hydro_joints(uvms))
     # forward kinematics at (q, v, a) is in data: the wrenches hold -M_A a_j, a_j the body's
     # whole acceleration
-    fext = fluid_wrenches(uvms, flow, time_s)
-    dw_dq, dw_dv = fluid_wrench_jacobians(uvms, motions, flow, time_s)
+    wet: WetState | None = wet_state(uvms, data, flow, time_s) if free_surface else None
+    fext = fluid_wrenches(uvms, flow, time_s, wet)
+    dw_dq, dw_dv = fluid_wrench_jacobians(uvms, motions, flow, time_s, wet)
+    if wet is not None:
+        surface_dq, surface_dv = wet_term_jacobians(uvms, motions, flow, time_s, wet)
+        dw_dq, dw_dv = dw_dq + surface_dq, dw_dv + surface_dv
+    added_mass = hydrostatics(uvms, wet)[2]
     did_dq, did_dv, mass = (
         np.array(m) for m in pin.computeRNEADerivatives(model, data, q, v, a, fext)
     )
@@ -59,7 +67,7 @@ def inverse_dynamics_derivatives(
         jac = motion.jacobian
         did_dq -= jac.T @ dw_dq[j]
         did_dv -= jac.T @ dw_dv[j]
-        mass += jac.T @ uvms.added_mass_per_joint[j] @ jac
+        mass += jac.T @ added_mass[j] @ jac
     return did_dq, did_dv, mass, motions
 
 
@@ -80,35 +88,19 @@ def forward_dynamics_derivatives(
     flow: FlowField | None,
     time_s: float,
     tau_ext: np.ndarray | None = None,
+    free_surface: bool = False,
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """(da/dq, da/dv, da/dtau) (nv x nv each) of the forward dynamics, q along the tangent;
-    ``tau_ext`` (a generalized force, nv) is held fixed. ParameterError for a vector of the
-    wrong shape or with a non-finite entry."""
+    ``tau_ext`` (a generalized force, nv) is held fixed; ``free_surface``: the water has a
+    top (the wet-fraction terms of a cut hull included, `derivatives.surface`).
+    ParameterError for a vector of the wrong shape or with a non-finite entry."""
     q, v = finite_vector("q", q, uvms.nq), finite_vector("v", v, uvms.nv)
     tau = finite_vector("tau", tau, uvms.nv)
     if tau_ext is not None:
         tau_ext = finite_vector("tau_ext", tau_ext, uvms.nv)
-    a = ReferenceDynamics(uvms).forward_dynamics_in(q, v, tau, flow, time_s, tau_ext)
-    did_dq, did_dv, mass, _ = inverse_dynamics_derivatives(uvms, q, v, a, flow, time_s)
+    a = ReferenceDynamics(uvms).forward_dynamics_in(q, v, tau, flow, time_s, tau_ext, free_surface)
+    did_dq, did_dv, mass, _ = inverse_dynamics_derivatives(
+        uvms, q, v, a, flow, time_s, free_surface
+    )
     inverse = inverse_of_mass(mass, q)
     return -inverse @ did_dq, -inverse @ did_dv, inverse
-
-
-def require_deep(uvms: UVMS, q: np.ndarray, flow: FlowField | None, time_s: float) -> None:
-    """ParameterError unless every hull is deep under the free surface at (q, t): there
-    the dynamics are those of water without a top (`uvms_pin.physics.surface`), and so are
-    their derivatives. The wet-fraction terms of a body the surface cuts are not
-    differentiated (nor is the jump in them where a body starts touching it)."""
-    data = uvms.model.createData()
-    pin.forwardKinematics(uvms.model, data, q)
-    wet = wet_state(uvms, data, flow, time_s)
-    if wet is None:
-        return
-    bodies = uvms.surface_bodies
-    names = [uvms.model.names[int(bodies.joint_ids[h])] for h in np.flatnonzero(wet.fraction < 1)]
-    raise ParameterError(
-        "forward_dynamics_derivatives with free_surface=True needs every body deep under the "
-        f"surface; at t = {time_s:.6g} s the surface cuts or leaves dry the hull(s) on joint(s) "
-        f"{sorted(set(names))} (wet fractions {np.round(wet.fraction, 4).tolist()}): the "
-        "derivatives of the wet-fraction terms are not implemented"
-    )

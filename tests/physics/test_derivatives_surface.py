@@ -1,0 +1,215 @@
+"""The derivatives of the forward dynamics under a free surface that cuts the hulls
+(`uvms_pin.physics.derivatives.surface`): against 4-point central differences of the
+reference dynamics with the same surface, on random states near z = 0 of shipped models
+and mounted arms (boxes, cylinders, spheres; Panda's meshes), in still water, a current and
+waves. States within a few difference steps of a kink (a hull starting to touch the
+surface, or becoming wholly wet or dry) are skipped: the dynamics are not differentiable
+there."""
+
+from __future__ import annotations
+
+import warnings
+
+import numpy as np
+import pinocchio as pin
+import pytest
+from conftest import central_difference, mount_on_reference_vehicle
+
+import uvms_pin as up
+from uvms_pin.errors import CoreFallbackWarning
+from uvms_pin.flow import AiryWave, IrregularSea, UniformCurrent
+from uvms_pin.model.resources import example_robot_data_dir, shipped_path
+from uvms_pin.physics.derivatives.surface import wetting_jacobian, wetting_vector
+from uvms_pin.physics.surface import wet_state
+
+FD_REL = 1e-6
+#: small on q: a mesh hull's waterplane has a kink each time the surface crosses a vertex
+STEP = 1e-6
+STEP_V = 1e-5
+
+FLOWS = {
+    "still": None,
+    "current": UniformCurrent([0.3, -0.1, 0.05]),
+    "wave": AiryWave(0.15, 3.0, heading_rad=0.4) + UniformCurrent([0.1, 0.0, 0.0]),
+    "sea": IrregularSea(0.4, 5.0, n_components=12, seed=3),
+}
+
+
+@pytest.fixture(scope="module")
+def models(reference_uvms, tmp_path_factory):
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", up.ModelWarning)
+        out = {
+            "lbv150 + arm": reference_uvms,
+            "bluerov2 + alpha5": up.load_uvms(shipped_path("models/uvms_bluerov2_alpha5.urdf")),
+            "ur5 mounted": mount_on_reference_vehicle("ur5", tmp_path_factory.mktemp("u")),
+        }
+        if example_robot_data_dir() is not None:
+            out["panda (meshes)"] = mount_on_reference_vehicle(
+                "panda", tmp_path_factory.mktemp("p")
+            )
+    return out
+
+
+def _near_the_surface(uvms: up.UVMS, rng: np.random.Generator):
+    """A random attitude, arm and velocity, the vehicle's origin within 0.3 m of z = 0."""
+    q = uvms.neutral_configuration()
+    q[:2] = rng.normal(scale=0.5, size=2)
+    q[2] = rng.uniform(-0.3, 0.3)
+    q[3:7] = pin.Quaternion(pin.rpy.rpyToMatrix(*rng.normal(scale=0.6, size=3))).coeffs()
+    lo = np.maximum(uvms.model.lowerPositionLimit[7:], -np.pi)
+    hi = np.minimum(uvms.model.upperPositionLimit[7:], np.pi)
+    q[7:] = rng.uniform(lo, hi)
+    return q, rng.normal(scale=0.5, size=uvms.nv), rng.normal(scale=5.0, size=uvms.nv)
+
+
+def _fractions(uvms, q, flow, time_s):
+    data = uvms.model.createData()
+    pin.forwardKinematics(uvms.model, data, q)
+    wet = wet_state(uvms, data, flow, time_s)
+    return np.ones(len(uvms.surface_bodies)) if wet is None else wet.fraction
+
+
+def _clear_of_kinks(uvms, q, flow, time_s, reach=3 * 2 * STEP) -> bool:
+    """No hull changes between cut and wholly wet or dry within the differences' reach
+    (each direction of the tangent, 3 times the widest step). (A mesh's vertex crossings
+    are not looked for: at this step one within reach is rare.)"""
+    cut = lambda f: (f > 0.0) & (f < 1.0)  # noqa: E731
+    at = cut(_fractions(uvms, q, flow, time_s))
+    for k in range(uvms.nv):
+        for sign in (-1.0, 1.0):
+            dq = np.zeros(uvms.nv)
+            dq[k] = sign * reach
+            moved = _fractions(uvms, pin.integrate(uvms.model, q, dq), flow, time_s)
+            if np.any(cut(moved) != at):
+                return False
+    return True
+
+
+def _relative_error(got, expected) -> float:
+    return float(np.max(np.abs(got - expected)) / max(np.max(np.abs(expected)), 1e-300))
+
+
+def assert_matches_finite_differences(uvms, q, v, tau, flow, time_s):
+    kw = {"flow": flow, "time_s": time_s, "backend": "python", "free_surface": True}
+
+    def accel(qq, vv, tt):
+        return up.forward_dynamics(uvms, qq, vv, tt, **kw)
+
+    da_dq, da_dv, da_dtau = up.forward_dynamics_derivatives(uvms, q, v, tau, **kw)
+    integrate = lambda x, dx: pin.integrate(uvms.model, x, dx)  # noqa: E731
+    nv = uvms.nv
+    fd_q = central_difference(lambda x: accel(x, v, tau), q, nv, STEP, integrate)
+    fd_v = central_difference(lambda x: accel(q, x, tau), v, nv, STEP_V * max(1, np.abs(v).max()))
+    fd_tau = central_difference(lambda x: accel(q, v, x), tau, nv, 1e-3 * np.abs(tau).max())
+    errors = [_relative_error(*p) for p in ((da_dq, fd_q), (da_dv, fd_v), (da_dtau, fd_tau))]
+    assert max(errors) < FD_REL, f"relative errors (dq, dv, dtau): {errors}"
+    return errors
+
+
+@pytest.mark.parametrize("flow", list(FLOWS), ids=list(FLOWS))
+def test_cut_hulls_match_finite_differences(models, flow):
+    """Every model, random states with at least one hull cut by the surface."""
+    rng = np.random.default_rng(41)
+    for name, uvms in models.items():
+        tested = 0
+        for _ in range(40):
+            q, v, tau = _near_the_surface(uvms, rng)
+            fraction = _fractions(uvms, q, FLOWS[flow], 0.7)
+            if not np.any((fraction > 0.0) & (fraction < 1.0)):
+                continue
+            if not _clear_of_kinks(uvms, q, FLOWS[flow], 0.7):
+                continue
+            assert_matches_finite_differences(uvms, q, v, tau, FLOWS[flow], 0.7)
+            tested += 1
+            if tested == 2:
+                break
+        assert tested == 2, f"{name}: too few states with a cut hull away from the kinks"
+
+
+def test_the_surface_terms_are_not_zero(reference_uvms):
+    """The cut hulls' own terms matter: without them (the wet values held) the derivatives
+    miss the finite differences by far more than the tolerance."""
+    from uvms_pin.physics.derivatives import reference
+
+    rng = np.random.default_rng(42)
+    for _ in range(40):
+        q, v, tau = _near_the_surface(reference_uvms, rng)
+        fraction = _fractions(reference_uvms, q, None, 0.0)
+        if np.any((fraction > 0.05) & (fraction < 0.95)):
+            break
+    full = up.forward_dynamics_derivatives(
+        reference_uvms, q, v, tau, free_surface=True, backend="python"
+    )
+    original = reference.wet_term_jacobians
+    nj, nv = reference_uvms.model.njoints, reference_uvms.nv
+    reference.wet_term_jacobians = lambda *a: (np.zeros((nj, 6, nv)), np.zeros((nj, 6, nv)))
+    try:
+        held = up.forward_dynamics_derivatives(
+            reference_uvms, q, v, tau, free_surface=True, backend="python"
+        )
+    finally:
+        reference.wet_term_jacobians = original
+    assert _relative_error(held[0], full[0]) > 1e-2
+
+
+def test_the_hull_geometry_jacobian_matches_its_differences(reference_uvms):
+    """dx/d delta of one cut hull (its volume, moment, fraction, gradient and rate) against
+    a 2-point difference at another step: the 4-point formula's own accuracy."""
+    uvms = reference_uvms
+    bodies = uvms.surface_bodies
+    q = uvms.neutral_configuration()
+    q[2] = 0.02
+    q[3:7] = pin.Quaternion(pin.rpy.rpyToMatrix(0.2, -0.1, 0.3)).coeffs()
+    data = uvms.model.createData()
+    pin.forwardKinematics(uvms.model, data, q)
+    flow = AiryWave(0.15, 3.0, heading_rad=0.4)
+    h = int(np.argmax(_fractions(uvms, q, flow, 0.3) * (_fractions(uvms, q, flow, 0.3) < 1)))
+    placement = data.oMi[int(bodies.joint_ids[h])]
+    got = wetting_jacobian(bodies.hulls[h], float(bodies.bound_radius_m[h]), placement, flow, 0.3)
+    step = 1e-6
+    expected = np.column_stack(
+        [
+            (
+                wetting_vector(bodies.hulls[h], placement * pin.exp6(step * e), flow, 0.3)
+                - wetting_vector(bodies.hulls[h], placement * pin.exp6(-step * e), flow, 0.3)
+            )
+            / (2 * step)
+            for e in np.eye(6)
+        ]
+    )
+    assert np.abs(got).max() > 0.0
+    np.testing.assert_allclose(got, expected, rtol=0, atol=1e-6 * np.abs(expected).max())
+
+
+def test_deep_and_dry_states_are_unchanged(reference_uvms):
+    """Deep under the surface: exactly the derivatives without a top. Wholly out of the
+    water (every hull dry): those of the model in air, buoyancy, added mass and damping gone
+    (finite differences agree: away from the kink nothing is wet)."""
+    rng = np.random.default_rng(43)
+    q, v, tau = _near_the_surface(reference_uvms, rng)
+    q[2] = -6.0
+    kw = {"backend": "python"}
+    with_top = up.forward_dynamics_derivatives(reference_uvms, q, v, tau, free_surface=True, **kw)
+    without = up.forward_dynamics_derivatives(reference_uvms, q, v, tau, **kw)
+    for a, b in zip(with_top, without, strict=True):
+        np.testing.assert_array_equal(a, b)
+    q[2] = 5.0
+    assert np.all(_fractions(reference_uvms, q, None, 0.0) == 0.0)
+    assert_matches_finite_differences(reference_uvms, q, v, tau, None, 0.0)
+
+
+@pytest.mark.parametrize("depth_m", [0.0, 0.1])
+def test_the_core_backend_gives_the_reference_at_the_surface(reference_uvms, depth_m):
+    """backend="core" with a cut hull: the reference's derivatives (with a warning while the
+    core has no wet-fraction derivatives), equal to backend="python"."""
+    q = reference_uvms.neutral_configuration()
+    q[2] = depth_m
+    v, tau = np.full(reference_uvms.nv, 0.1), np.ones(reference_uvms.nv)
+    expected = up.forward_dynamics_derivatives(
+        reference_uvms, q, v, tau, free_surface=True, backend="python"
+    )
+    with pytest.warns(CoreFallbackWarning, match="free surface"):
+        got = up.forward_dynamics_derivatives(reference_uvms, q, v, tau, free_surface=True)
+    for a, b in zip(got, expected, strict=True):
+        np.testing.assert_array_equal(a, b)
