@@ -41,6 +41,7 @@ from uvms_pin.physics.derivatives.joint_limits import (
     joint_friction_jacobian,
     joint_stop_jacobians,
 )
+from uvms_pin.physics.derivatives.world_contact import world_contact_jacobians
 from uvms_pin.physics.disturbance import Disturbance
 from uvms_pin.physics.dynamics import (
     dynamics_of,
@@ -412,15 +413,18 @@ class Plant:
     ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """(da/dq, da/dv, da/dtau) (nv x nv each, q along the tangent) of `acceleration`:
         the water (flow, free surface) by `forward_dynamics_derivatives`, and the plant's
-        own generalized forces tau_g(q, v), the joint drives' friction and the joint stops
-        (`uvms_pin.physics.derivatives.joint_limits`): da/dx += M^-1 d tau_g/dx. The
-        disturbance depends on time only (no state derivative). A stop at its kink (reaching
-        its limit, letting go) gives the derivative of the side the state is on.
+        own generalized forces tau_g(q, v), the world's contacts (a piece's corners on a
+        plane: `uvms_pin.physics.derivatives.world_contact`), the joint drives' friction and
+        the joint stops (`uvms_pin.physics.derivatives.joint_limits`): da/dx += M^-1
+        d tau_g/dx. The disturbance depends on time only (no state derivative). Frozen at
+        the state: the contacts' active set, anchors and stick or slip (``friction``). At a
+        kink (a contact or a stop starting or ending) the derivative of the side the state
+        is on is returned.
 
         Raises:
             ParameterError: the plant has a term whose derivatives are not implemented: an
-                end-effector contact environment, free objects or self-collision, or a world
-                contact active at (q, v) (a world nothing touches is fine).
+                end-effector contact environment, free objects or self-collision, or an
+                active contact of a smooth piece or with a solid object (coal's point).
         """
         q, v = finite_vector("q", q, self.uvms.nq), finite_vector("v", v, self.uvms.nv)
         if self.contact is not None or self.free_bodies is not None:
@@ -428,14 +432,13 @@ class Plant:
                 "acceleration_derivatives: the end-effector contact environment, free "
                 "objects and self-collision are not differentiated"
             )
-        forces = self.world_forces(q, v)
-        if forces is not None and len(forces.touch):
-            raise ParameterError(
-                f"acceleration_derivatives: {len(forces.touch)} world contact point(s) active "
-                "at this state; the world's contact forces are not differentiated"
-            )
         nv = self.uvms.nv
         tau_ext, by_q, by_v = np.zeros(nv), np.zeros((nv, nv)), np.zeros((nv, nv))
+        forces = self.world_forces(q, v)
+        if forces is not None and len(forces.touch):
+            tau_ext += self.world.generalized_force(q, self._world_data, forces)
+            world_q, world_v = world_contact_jacobians(self.world, q, v, forces, self.friction)
+            by_q, by_v = by_q + world_q, by_v + world_v
         if self.joint_friction is not None:
             tau_ext[6:] += self.joint_friction.torque_Nm(v[6:])
             by_v += joint_friction_jacobian(self.joint_friction, v)
