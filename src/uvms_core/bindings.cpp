@@ -271,21 +271,22 @@ void bind_derivatives(nb::module_& m) {
           "forward_dynamics_derivatives",
           [](Derivatives& d, nb::handle q_obj, nb::handle v_obj, nb::handle tau_obj,
              const std::optional<uvms::FlowField>& flow, double time_s,
-             nb::handle tau_ext_obj) -> ForwardDynamicsDerivatives {
+             nb::handle tau_ext_obj, bool free_surface) -> ForwardDynamicsDerivatives {
             const int nq = d.dynamics().nq(), nv = d.dynamics().nv();
             UVMS_VECTOR(q, nq);
             UVMS_VECTOR(v, nv);
             UVMS_VECTOR(tau, nv);
             if (tau_ext_obj.is_none()) {
               return d.forward_dynamics_derivatives(q, v, tau, flow_or_still(flow), nullptr,
-                                                    time_s);
+                                                    time_s, free_surface);
             }
             UVMS_VECTOR(tau_ext, nv);
             const ConstVec ext(tau_ext);
-            return d.forward_dynamics_derivatives(q, v, tau, flow_or_still(flow), &ext, time_s);
+            return d.forward_dynamics_derivatives(q, v, tau, flow_or_still(flow), &ext, time_s,
+                                                  free_surface);
           },
           "q"_a.none(), "v"_a.none(), "tau"_a.none(), "flow"_a.none(), "time_s"_a,
-          "tau_ext"_a.none() = nb::none());
+          "tau_ext"_a.none() = nb::none(), "free_surface"_a = false);
 }
 
 // ---- the environment (contact.hpp, disturbance.hpp) and the integrators -----------------

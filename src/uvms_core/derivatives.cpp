@@ -65,13 +65,13 @@ void Derivatives::wrenches_at(const ConstVec& q, const ConstVec& v, const Eigen:
     // whole acceleration a_j
     for (int j = 0; j < d.model_.njoints; ++j) fext_[j] = d.fext_[j];
     for (int j : d.joints_with_added_mass_) {
-      fext_[j].toVector() -= d.hydro_.added_mass_per_joint[j] * d.acc_[j];
+      fext_[j].toVector() -= d.added_mass(j) * d.acc_[j];
     }
     return;
   }
   // kinematics at (q, v, a): the wrenches' -M_A a_bias becomes -M_A a_j
   pinocchio::forwardKinematics(d.model_, d.data_, q, v, ConstVec(a));
-  d.fluid_wrenches(time_s, flow, true);
+  d.fluid_wrenches(time_s, flow, true, free_surface_);
   fext_ = d.fext_;
 }
 
@@ -109,9 +109,9 @@ FlowSeenByBody Derivatives::flow_in_body(const JointMotion& motion, const Mat3& 
 // w = -M_A (a - nu_c_dot) - C_A(nu_r) nu_r, nu_c_dot = [A - w x U; 0] (fluid.py).
 void Derivatives::added_mass_jacobians(int joint, const FlowGradientsAtPoint& flow) {
   const auto& m = motion_[joint];
-  const Mat6& added = dynamics_.hydro_.added_mass_per_joint[joint];
-  const FlowSeenByBody seen = flow_in_body(
-      m, Mat3::Identity(), dynamics_.hydro_.center_of_buoyancy_per_joint_m[joint], flow);
+  const Mat6& added = dynamics_.added_mass(joint);
+  const FlowSeenByBody seen =
+      flow_in_body(m, Mat3::Identity(), dynamics_.center_of_buoyancy(joint), flow);
   const Vec3 omega = m.velocity.tail<3>();
   const Matrix3x rate_dq = seen.acceleration_dq - skew(omega) * seen.velocity_dq +
                            skew(seen.velocity) * m.velocity_dq.bottomRows<3>();
@@ -128,8 +128,8 @@ void Derivatives::restoring_jacobian(int joint, const FlowGradientsAtPoint& flow
                                      bool moving_water) {
   const auto& m = motion_[joint];
   const auto& hydro = dynamics_.hydro_;
-  const Vec3& cob = hydro.center_of_buoyancy_per_joint_m[joint];
-  const double mass_of_water = hydro.water_density_kg_m3 * hydro.volume_per_joint_m3[joint];
+  const Vec3& cob = dynamics_.center_of_buoyancy(joint);
+  const double mass_of_water = hydro.water_density_kg_m3 * dynamics_.volume(joint);
   Vec3 force = -mass_of_water * dynamics_.model_.gravity.linear();
   if (moving_water) force += mass_of_water * flow.acceleration_world;
   const auto jac = point_force_jacobians(m.rotation.transpose() * force, cob, m.rotation);
@@ -147,8 +147,8 @@ void Derivatives::damping_jacobians(const DampedBody& body, const FlowGradientsA
       flow_in_body(m, body.rotation_in_joint, body.position_in_joint_m, flow);
   const Mat6& x = body.action_joint_to_body;
   const Vec6 relative = x * m.velocity - linear_twist(seen.velocity);
-  const Mat6 slope =
-      x.transpose() * damping_jacobian(body.linear_damping, body.quadratic_damping, relative);
+  const Mat6 slope = dynamics_.damping_fraction(body) * x.transpose() *
+                     damping_jacobian(body.linear_damping, body.quadratic_damping, relative);
   dw_dq_[body.joint_id].noalias() += slope * (x * m.velocity_dq - linear_rows(seen.velocity_dq));
   dw_dv_[body.joint_id].noalias() += (slope * x) * m.jacobian;
 }
@@ -162,12 +162,12 @@ void Derivatives::fluid_jacobians(const FlowField& flow, double time_s) {
   const bool moving_water = !flow.waves.empty() || !flow.current_world_m_s.isZero(0.0);
   const FlowGradientsAtPoint still;
   for (int j : hydro_joints_) {
-    const bool added = !hydro.added_mass_per_joint[j].isZero(0.0);
-    const bool volume = hydro.volume_per_joint_m3[j] != 0.0;
+    const bool added = !dynamics_.added_mass(j).isZero(0.0);
+    const bool volume = dynamics_.volume(j) != 0.0;
     if (!added && !volume) continue;
     const FlowGradientsAtPoint at_cob =
         moving_water
-            ? flow.gradients_at(time_s, motion_[j].point(hydro.center_of_buoyancy_per_joint_m[j]))
+            ? flow.gradients_at(time_s, motion_[j].point(dynamics_.center_of_buoyancy(j)))
             : still;
     if (added) added_mass_jacobians(j, at_cob);
     if (volume) restoring_jacobian(j, at_cob, !flow.waves.empty());
@@ -182,9 +182,10 @@ void Derivatives::fluid_jacobians(const FlowField& flow, double time_s) {
 
 const ForwardDynamicsDerivatives& Derivatives::forward_dynamics_derivatives(
     const ConstVec& q, const ConstVec& v, const ConstVec& tau, const FlowField& flow,
-    const ConstVec* tau_ext, double time_s) {
+    const ConstVec* tau_ext, double time_s, bool free_surface) {
   auto& d = dynamics_;
-  acceleration_ = d.forward_dynamics(q, v, tau, flow, tau_ext, time_s);
+  free_surface_ = free_surface;
+  acceleration_ = d.forward_dynamics(q, v, tau, flow, tau_ext, time_s, free_surface);
   wrenches_at(q, v, acceleration_, flow, time_s);
   // the RNEA derivatives write the blocks of each joint's support and subtree only
   did_dq_.setZero();
@@ -197,6 +198,7 @@ const ForwardDynamicsDerivatives& Derivatives::forward_dynamics_derivatives(
   mass_ = data_.M;
   joint_motions();
   fluid_jacobians(flow, time_s);
+  if (d.wet_active_) surface_jacobians(flow, time_s);
   for (int j : hydro_joints_) {
     const auto& jac = motion_[j].jacobian;
     did_dq_.noalias() -= jac.transpose() * dw_dq_[j];
@@ -205,7 +207,7 @@ const ForwardDynamicsDerivatives& Derivatives::forward_dynamics_derivatives(
   mass_.triangularView<Eigen::StrictlyLower>() = mass_.transpose();  // filled: upper triangle
   for (int j : d.joints_with_added_mass_) {
     const auto& jac = motion_[j].jacobian;
-    mass_.noalias() += jac.transpose() * (d.hydro_.added_mass_per_joint[j] * jac);
+    mass_.noalias() += jac.transpose() * (d.added_mass(j) * jac);
   }
   cholesky_.compute(mass_);
   if (cholesky_.info() != Eigen::Success) {

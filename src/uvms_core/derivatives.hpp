@@ -10,6 +10,11 @@
 // Jacobians are each hydro unit's (added_mass.hpp, damping.hpp, restoring.hpp), chained here
 // one function per term as in fluid.py.
 //
+// Under a free surface (derivatives_surface.cpp, mirror of physics/derivatives/surface.py)
+// the terms above use the wet volumes, centres of buoyancy, added masses and damping
+// fractions, held; the surface's own terms (through each cut hull's wetting x_i, its pose
+// Jacobian by 4-point differences of Hull::wet) are added to dw/dq and dw/dv.
+//
 // A Derivatives owns a copy of the Dynamics it differentiates, like Plant, and a Pinocchio
 // data of its own for the RNEA derivatives (they overwrite buffers, e.g. data.M and the
 // composite inertias, that the dynamics' articulated pass keeps between calls): not
@@ -65,7 +70,7 @@ class Derivatives {
 
   const ForwardDynamicsDerivatives& forward_dynamics_derivatives(
       const ConstVec& q, const ConstVec& v, const ConstVec& tau, const FlowField& flow,
-      const ConstVec* tau_ext, double time_s = 0.0);
+      const ConstVec* tau_ext, double time_s = 0.0, bool free_surface = false);
 
   Dynamics& dynamics() { return dynamics_; }
 
@@ -80,6 +85,9 @@ class Derivatives {
   void added_mass_jacobians(int joint, const FlowGradientsAtPoint& flow);
   void restoring_jacobian(int joint, const FlowGradientsAtPoint& flow, bool moving_water);
   void damping_jacobians(const DampedBody& body, const FlowGradientsAtPoint& flow);
+  // derivatives_surface.cpp: the wet-fraction terms of the hulls the surface cuts
+  void surface_jacobians(const FlowField& flow, double time_s);
+  void surface_joint_terms(int joint, const FlowGradientsAtPoint& at_cob, bool moving_water);
 
   Dynamics dynamics_;
   Data data_;  // the RNEA derivatives' and the joint motions' (not the dynamics')
@@ -87,6 +95,9 @@ class Derivatives {
   std::vector<JointMotion> motion_;  // per joint id (only hydro joints filled)
   std::vector<Matrix6x> dw_dq_, dw_dv_;
   ForceVector fext_;
+  bool free_surface_ = false;
+  std::vector<char> cut_;                               // per hull: 0 < f < 1
+  std::vector<Eigen::Matrix<double, 12, Eigen::Dynamic>> wetting_dq_;  // dx_i/dq per cut hull
   Eigen::VectorXd acceleration_;
   Eigen::MatrixXd did_dq_, did_dv_, mass_;
   Eigen::LLT<Eigen::MatrixXd> cholesky_;

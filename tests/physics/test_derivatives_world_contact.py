@@ -155,3 +155,16 @@ def test_a_solid_object_s_contact_is_refused(reference_uvms):
     assert len(boxed.world_forces(q, v).touch)
     with pytest.raises(ParameterError, match="coal's deepest point"):
         boxed.acceleration_derivatives(0.1, q, v, tau)
+
+
+def test_the_core_backend_gives_the_reference(reference_uvms):
+    """The plant on the core: the water's derivatives compiled, the contacts' the same."""
+    rng = np.random.default_rng(66)
+    plant, q, v, tau = _on_the_floor(reference_uvms, rng, np.array([0.0, 0.0, 1.0]))
+    _anchor(plant, q, v, 2e-4, slipping=False)
+    python = plant.acceleration_derivatives(0.1, q, v, tau)
+    compiled = Plant(reference_uvms, world=plant.world, backend="core")
+    compiled.friction = plant.friction
+    core = compiled.acceleration_derivatives(0.1, q, v, tau)
+    for a, b in zip(core, python, strict=True):
+        np.testing.assert_allclose(a, b, rtol=0, atol=1e-10 * np.abs(b).max())

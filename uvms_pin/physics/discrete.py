@@ -39,7 +39,8 @@ def step_derivatives(
     ``step_s`` [s] from (q, v) at ``time_s``, tau (and tau_ext) held, and its Jacobians.
 
     The other arguments are those of `forward_dynamics_derivatives` (the flow is evaluated
-    at each substep's time; ``free_surface`` needs every body deep at every substep).
+    at each substep's time; with ``free_surface`` a hull the surface cuts adds its
+    wet-fraction terms, one-sided at the kinks).
     """
     q, v = finite_vector("q", q, uvms.nq), finite_vector("v", v, uvms.nv)
     tau = finite_vector("tau", tau, uvms.nv)

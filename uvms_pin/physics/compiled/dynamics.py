@@ -11,9 +11,7 @@ from __future__ import annotations
 from types import ModuleType
 
 import numpy as np
-import pinocchio as pin
 
-from uvms_pin.checks import finite_vector
 from uvms_pin.flow import FlowField
 from uvms_pin.model.uvms import UVMS
 from uvms_pin.physics.compiled.backend import Fallback
@@ -24,7 +22,6 @@ from uvms_pin.physics.derivatives.reference import (
     forward_dynamics_derivatives as reference_derivatives,
 )
 from uvms_pin.physics.reference import ReferenceDynamics
-from uvms_pin.physics.surface import wet_state
 
 
 def hydro_bodies_to_core(uvms: UVMS, core: ModuleType):
@@ -72,19 +69,6 @@ class CompiledDynamics:
         self.mass_matrix = self.core.mass_matrix
         self.bias_forces = self.core.bias_forces
         self.forward_dynamics = self.core.forward_dynamics
-
-    def _surface_fallback(
-        self, q: np.ndarray, flow: FlowField | None, time_s: float
-    ) -> Fallback | None:
-        """None when every hull is deep under the free surface at (q, t) (the core's
-        derivatives are then those of water without a top, exactly); a `Fallback` when the
-        surface cuts a hull or leaves one dry (the core has no wet-fraction derivatives)."""
-        uvms = self._reference.uvms
-        data = uvms.model.createData()
-        pin.forwardKinematics(uvms.model, data, finite_vector("q", q, uvms.nq))
-        if wet_state(uvms, data, flow, time_s) is None:
-            return None
-        return Fallback("the derivatives of a hull the free surface cuts or leaves dry")
 
     def _flow_struct(self, flow: FlowField | None):
         """The core's FlowField of ``flow`` (the last one is kept: a flow is immutable), or
@@ -148,8 +132,6 @@ class CompiledDynamics:
         of these dynamics, built on first use; a flow the core has no counterpart of runs on
         the reference (`uvms_pin.physics.derivatives.reference`), with a warning."""
         compiled = core_module().FlowField() if flow is None else self._flow_struct(flow)
-        if free_surface and not isinstance(compiled, Fallback):
-            compiled = self._surface_fallback(q, flow, time_s) or compiled
         if isinstance(compiled, Fallback):
             compiled.warn("these derivatives", stacklevel=4)
             return reference_derivatives(
@@ -157,5 +139,7 @@ class CompiledDynamics:
             )
         if self._derivatives is None:
             self._derivatives = core_module().Derivatives(self.core)
-        out = self._derivatives.forward_dynamics_derivatives(q, v, tau, compiled, time_s, tau_ext)
+        out = self._derivatives.forward_dynamics_derivatives(
+            q, v, tau, compiled, time_s, tau_ext, free_surface
+        )
         return out.da_dq, out.da_dv, out.da_dtau
