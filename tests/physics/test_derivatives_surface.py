@@ -218,3 +218,29 @@ def test_the_core_matches_the_reference_at_the_surface(models, flow):
             got = up.forward_dynamics_derivatives(uvms, q, v, tau, backend="core", **kw)
             errors = [_relative_error(g, e) for g, e in zip(got, expected, strict=True)]
             assert max(errors) < CORE_REL, f"{name}: {errors}"
+
+
+def test_one_control_period_at_the_surface(reference_uvms):
+    """`up.step_derivatives` with the surface cutting the vehicle: against central
+    differences of the plant's semi-implicit Euler over the period, the surface included."""
+    from uvms_pin.sim.integrators import SemiImplicitEuler
+
+    uvms, model, nv = reference_uvms, reference_uvms.model, reference_uvms.nv
+    period, step, t0 = 0.02, 0.005, 0.3
+    q, v, tau = next(_cut_states(uvms, None, np.random.default_rng(45), 1, True))
+
+    def period_end(qq, vv):
+        def rhs(t, q_, v_):
+            return up.forward_dynamics(uvms, q_, v_, tau, time_s=t, free_surface=True)
+
+        return SemiImplicitEuler(step_s=step).advance(model, rhs, t0, qq, vv, t0 + period)
+
+    got = up.step_derivatives(uvms, q, v, tau, period, step_s=step, time_s=t0, free_surface=True)
+    q1, _ = period_end(q, v)
+
+    def end_state(x):
+        qe, ve = period_end(pin.integrate(model, q, x[:nv]), x[nv:])
+        return np.r_[pin.difference(model, q1, qe), ve]
+
+    fd = central_difference(end_state, np.r_[np.zeros(nv), v], 2 * nv, STEP_V)
+    assert _relative_error(got.dx_dx, fd) < FD_REL
