@@ -7,6 +7,7 @@ reach of the plane, or a patch near its cone, are not used (the active set is fr
 
 from __future__ import annotations
 
+import coal
 import numpy as np
 import pinocchio as pin
 import pytest
@@ -168,3 +169,54 @@ def test_the_core_backend_gives_the_reference(reference_uvms):
     core = compiled.acceleration_derivatives(0.1, q, v, tau)
     for a, b in zip(core, python, strict=True):
         np.testing.assert_allclose(a, b, rtol=0, atol=1e-10 * np.abs(b).max())
+
+
+def _lowest_points(world: World, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(every corner's height, every sphere's lowest height) along z (world)."""
+    model = world.uvms.model
+    data = model.createData()
+    pin.forwardKinematics(model, data, q)
+    spheres = []
+    for piece in world.pieces:
+        if isinstance(piece.shape, coal.Sphere):
+            where = data.oMi[piece.joint_id] * piece.placement_in_joint
+            spheres.append(where.translation[2] - piece.shape.radius)
+    return _corner_heights(world, q, np.array([0.0, 0.0, 1.0])), np.array(spheres)
+
+
+@pytest.mark.parametrize("anchored", [False, True], ids=["new", "anchored"])
+def test_a_sphere_on_the_floor_matches_finite_differences(anchored):
+    """The BlueROV2 + Alpha 5 (its links are spheres): a link resting on the seafloor, its
+    contact point sliding on the sphere as the state moves."""
+    import warnings
+
+    import uvms_pin as up
+    from uvms_pin.model.resources import shipped_path
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", up.ModelWarning)
+        uvms = up.load_uvms(shipped_path("models/uvms_bluerov2_alpha5.urdf"))
+    rng = np.random.default_rng(67)
+    probe = World(uvms, [plane("floor", [0, 0, -50.0], [0, 0, 1], 0.6, 0.5)])
+    for _ in range(500):
+        q = uvms.neutral_configuration()
+        q[:3] = [0.3, -0.2, -3.0]
+        q[3:7] = pin.Quaternion(pin.rpy.rpyToMatrix(*rng.normal(scale=0.3, size=3))).coeffs()
+        lo = np.maximum(uvms.model.lowerPositionLimit[7:], -np.pi)
+        hi = np.minimum(uvms.model.upperPositionLimit[7:], np.pi)
+        q[7:] = rng.uniform(lo, hi)
+        corners, spheres = _lowest_points(probe, q)
+        level = spheres.min() + rng.uniform(0.004, 0.01)
+        everything = np.r_[corners, spheres]
+        if corners.min() > spheres.min() and np.min(np.abs(everything - level)) > MARGIN_M:
+            break
+    else:
+        raise AssertionError("no state with a sphere on the floor clear of the kinks")
+    world = World(uvms, [plane("floor", [0, 0, level], [0, 0, 1], 0.6, 0.5)])
+    plant = Plant(uvms, world=world, backend="python")
+    v, tau = rng.normal(scale=0.05, size=uvms.nv), rng.normal(scale=5.0, size=uvms.nv)
+    forces = plant.world_forces(q, v)
+    assert np.any(forces.touch.corner < 0)  # a sphere's point
+    if anchored:
+        _anchor(plant, q, v, 1e-4, slipping=False)
+    _assert_matches(plant, q, v, tau)

@@ -413,8 +413,8 @@ class Plant:
     ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """(da/dq, da/dv, da/dtau) (nv x nv each, q along the tangent) of `acceleration`:
         the water (flow, free surface) by `forward_dynamics_derivatives`, and the plant's
-        own generalized forces tau_g(q, v), the world's contacts (a piece's corners on a
-        plane: `uvms_pin.physics.derivatives.world_contact`), the joint drives' friction and
+        own generalized forces tau_g(q, v), the world's contacts (a piece's corners or a
+        sphere on a plane: `uvms_pin.physics.derivatives.world_contact`), the joint drives' friction and
         the joint stops (`uvms_pin.physics.derivatives.joint_limits`): da/dx += M^-1
         d tau_g/dx. The disturbance depends on time only (no state derivative). Frozen at
         the state: the contacts' active set, anchors and stick or slip (``friction``). At a
@@ -424,7 +424,7 @@ class Plant:
         Raises:
             ParameterError: the plant has a term whose derivatives are not implemented: an
                 end-effector contact environment, free objects or self-collision, or an
-                active contact of a smooth piece or with a solid object (coal's point).
+                active contact of an ellipsoid or with a solid object (coal's point).
         """
         q, v = finite_vector("q", q, self.uvms.nq), finite_vector("v", v, self.uvms.nv)
         if self.contact is not None or self.free_bodies is not None:

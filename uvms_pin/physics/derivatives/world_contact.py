@@ -31,12 +31,18 @@ and has none of its derivative). A new contact anchors where it is: its stretch 
 whatever the state, and so is its derivative. Where the active set or a max changes the
 force has a kink; the derivative of the side the state is on is returned.
 
-Not differentiated (ParameterError): coal's one deepest point of a smooth piece or of a
-solid object (its point is not fixed on the piece), free objects and self-collision.
+A sphere on a plane (coal's one point of the pair: the midpoint of the deepest points,
+x = c - (R - delta/2) n, delta = R - (c - p_0) . n) slides on the sphere: dx = (I - n n^T/2) dc,
+d delta = -n . dc, its velocity is the body's at x (d v gains w x (dx - the material
+point's dx)) and the wrench's arm in the joint frame moves by R^T (dx - material dx).
+
+Not differentiated (ParameterError): an ellipsoid's deepest point, a contact with a solid
+object (coal's GJK/EPA point), free objects and self-collision.
 """
 
 from __future__ import annotations
 
+import coal
 import numpy as np
 import pinocchio as pin
 
@@ -62,15 +68,18 @@ def world_contact_jacobians(
     out_q, out_v = np.zeros((nv, nv)), np.zeros((nv, nv))
     if len(touch) == 0:
         return out_q, out_v
-    if np.any(touch.corner < 0) or not all(world.objects[int(o)].is_plane for o in touch.obj):
-        raise ParameterError(
-            "the derivatives of a world contact cover a piece's corners on a plane; a smooth "
-            "piece's or a solid object's contact (coal's deepest point) is not differentiated"
-        )
+    for p, o, corner in touch.keys():
+        sphere = isinstance(world.pieces[p].shape, coal.Sphere)
+        if not world.objects[o].is_plane or (corner < 0 and not sphere):
+            raise ParameterError(
+                "the derivatives of a world contact cover a piece's corners or a sphere on a "
+                f"plane; the contact of piece {p} with '{world.objects[o].name}' (coal's "
+                "deepest point of an ellipsoid, or a solid object) is not differentiated"
+            )
     data = model.createData()
     joints = sorted({world.pieces[int(p)].joint_id for p in touch.piece})
     motions = joint_motions(model, data, q, v, np.zeros(nv), joints)
-    force_dq, force_dv, arms = _force_jacobians(world, forces, memory, motions)
+    force_dq, force_dv, arms, slide = _force_jacobians(world, forces, memory, motions)
     # the projection J_j^T moving with q, the joint wrenches held (Pinocchio's RNEA)
     fext = [pin.Force.Zero() for _ in range(model.njoints)]
     for i, p in enumerate(touch.piece):
@@ -87,6 +96,9 @@ def world_contact_jacobians(
         motion = motions[world.pieces[int(p)].joint_id]
         jac_t = motion.jacobian.T
         out_q += jac_t @ point_force_dq(forces.force_world_N[i], force_dq[i], arms[i], motion)
+        # a sphere's point slides on it: its arm in the joint frame moves by R^T slide
+        force_body = motion.rotation.T @ forces.force_world_N[i]
+        out_q += jac_t[:, 3:] @ (-skew(force_body) @ motion.rotation.T @ slide[i])
         by_force = np.vstack([motion.rotation.T, skew(arms[i]) @ motion.rotation.T])
         out_v += jac_t @ by_force @ force_dv[i]
     return out_q, out_v
@@ -98,32 +110,44 @@ def _force_jacobians(
     memory: FrictionMemory,
     motions: dict[int, JointMotion],
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """(dF_i/dq, dF_i/dv (m, 3, nv), r_i (m, 3) the points in their joints' frames)."""
+    """(dF_i/dq, dF_i/dv (m, 3, nv), r_i (m, 3) the points in their joints' frames, and
+    how each point slides on its body (m, 3, nv): dx_i minus the material point's motion)."""
     touch, law = forces.touch, world.law
     m, nv = len(touch), world.uvms.nv
+    normal = touch.normal_world
     arms = np.zeros((m, 3))
     point_dq, velocity_dq = np.zeros((m, 3, nv)), np.zeros((m, 3, nv))
-    point_dv = np.zeros((m, 3, nv))
+    point_dv, slide = np.zeros((m, 3, nv)), np.zeros((m, 3, nv))
+    depth_dq = np.zeros((m, nv))
     for i, p in enumerate(touch.piece):
-        motion = motions[world.pieces[int(p)].joint_id]
+        piece = world.pieces[int(p)]
+        motion = motions[piece.joint_id]
         rotation = motion.rotation
         arms[i] = rotation.T @ (touch.point_world_m[i] - motion.translation)
         r_hat = skew(arms[i])
         point_velocity = motion.velocity[:3] + np.cross(motion.velocity[3:], arms[i])
-        point_dq[i] = motion.point_dq(arms[i])
-        point_dv[i] = point_dq[i]  # d x / dq = d v / dv = J_i
+        material = motion.point_dq(arms[i])
+        point_dv[i] = material  # d v / dv = J_i, the body's point there
         velocity_dq[i] = rotation @ (
             motion.velocity_dq[:3]
             - r_hat @ motion.velocity_dq[3:]
             - skew(point_velocity) @ motion.rotation_dq
         )
-    normal = touch.normal_world
+        if touch.corner[i] >= 0:  # a corner: a material point
+            point_dq[i] = material
+            depth_dq[i] = -normal[i] @ material
+            continue
+        # a sphere: delta = R - (c - p_0) . n, x = c - (R - delta / 2) n
+        center_dq = motion.point_dq(piece.placement_in_joint.translation)
+        depth_dq[i] = -normal[i] @ center_dq
+        point_dq[i] = center_dq - 0.5 * np.outer(normal[i], normal[i] @ center_dq)
+        slide[i] = point_dq[i] - material
+        velocity_dq[i] += skew(rotation @ motion.velocity[3:]) @ slide[i]
     # normal force: f_n = k delta max(0, 1 + d rate)
     rate = -np.einsum("ij,ij->i", touch.velocity_world_m_s, normal)
     damping = 1.0 + law.dissipation_s_m * rate
     pushing = (damping > 0.0)[:, None]
     k = law.stiffness_N_m
-    depth_dq = -np.einsum("ik,ikn->in", normal, point_dq)
     rate_dq = -np.einsum("ik,ikn->in", normal, velocity_dq)
     rate_dv = -np.einsum("ik,ikn->in", normal, point_dv)
     normal_dq = np.where(
@@ -164,7 +188,7 @@ def _force_jacobians(
                 out[i] = sigma * d_trial[i] + np.outer(trial_raw[row], d_sigma)
     force_dq = normal[:, :, None] * normal_dq[:, None, :] + friction_dq
     force_dv = normal[:, :, None] * normal_dv[:, None, :] + friction_dv
-    return force_dq, force_dv, arms
+    return force_dq, force_dv, arms, slide
 
 
 def _unscaled_trial(
