@@ -3,6 +3,8 @@
 from __future__ import annotations
 
 import json
+import math
+import time
 
 from _common import producer_cli, publish_figure, scratch, uvms_pin, write_result
 
@@ -40,27 +42,33 @@ def _trial_rows(result: dict) -> list[str]:
 if __name__ == "__main__":
     producer_cli(__doc__)
     out = scratch("identification")
+    started = time.perf_counter()
     uvms_pin(
         "identify",
         "data/hinsdale2023",
         "--fit",
         "default",
-        "--max-iterations",
-        "10",
         "--out",
         str(out),
         "--quiet",
     )
+    elapsed_min = (time.perf_counter() - started) / 60.0
     result = json.loads((out / "identification.json").read_text())
     held, used = result["held_out"], result["identification"]
+    state = "converged" if result["converged"] else "**not converged**"
     body = (
-        "`uvms-pin identify data/hinsdale2023 --fit default --max-iterations 10 --out "
-        "out/results/identification` "
-        f"({result['iterations']} Levenberg-Marquardt iterations; RMS of the fit residual "
-        f"{result['fit_rms_deg'][0]:.3f} -> {result['fit_rms_deg'][-1]:.3f} deg).\n\n"
+        "`uvms-pin identify data/hinsdale2023 --fit default --out out/results/identification` "
+        f"(Levenberg-Marquardt: {result['iterations']} steps tried, "
+        f"{result['accepted_steps']} accepted, stopped by the `{result['stop_reason']}` "
+        f"criterion, {state}; largest cosine between the residual and a Jacobian column "
+        f"{result['gradient_cosine']:.1e}; RMS of the fit residual "
+        f"{result['fit_rms_deg'][0]:.3f} -> {result['fit_rms_deg'][-1]:.3f} deg; "
+        f"{elapsed_min:.0f} min on this machine).\n\n"
         + "\n".join(_parameter_rows(result))
-        + f"\n\nIdentified arm delay (the encoders' lag on the IMU clock): "
-        f"{result['arm_delay_s']:.3f} s.\n\nMean RMSE [deg], catalogue -> identified: held-out trials roll "
+        + f"\n\nIdentified properties of the recording: arm delay (the encoders' lag on the IMU "
+        f"clock) {result['arm_delay_s']:.3f} s, IMU mounting yaw on the hull "
+        f"{math.degrees(result['imu_yaw_rad']):.2f} deg.\n\n"
+        "Mean RMSE [deg], catalogue -> identified: held-out trials roll "
         f"{held['mean_start_roll_rmse_deg']:.3f} -> {held['mean_identified_roll_rmse_deg']:.3f}, "
         f"pitch {held['mean_start_pitch_rmse_deg']:.3f} -> "
         f"{held['mean_identified_pitch_rmse_deg']:.3f}; identification trials roll "
