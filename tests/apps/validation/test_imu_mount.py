@@ -1,25 +1,30 @@
-"""The IMU's mounting yaw: its maps, and the fit's Jacobian in it against finite differences."""
+"""The IMU's mounting yaw: its maps, the fit's Jacobian in it against finite differences, the
+motion-capture cross-check, and the command line that takes it (and warns of a capped fit)."""
 
 from __future__ import annotations
 
+import json
+
 import numpy as np
 import pytest
+from conftest import run
 from scipy.spatial.transform import Rotation
-from test_sensitivity import initial_state, synthetic_arm
+from test_sensitivity import DATA_DIR, initial_state, synthetic_arm
 
 from uvms_pin.apps.validation.fit import simulation_residuals
 from uvms_pin.apps.validation.identify import HULL
 from uvms_pin.apps.validation.imu_mount import (
     imu_roll_pitch,
     imu_tangent,
+    roll_against_mocap_slope,
     start_sensitivity,
     vehicle_start,
 )
 from uvms_pin.apps.validation.parameters import parameter_values, parse_parameters
-from uvms_pin.apps.validation.pool import TrialSetup, trial_uvms
+from uvms_pin.apps.validation.pool import TrialSetup, compare_trial, trial_uvms
 from uvms_pin.apps.validation.prescribed import simulate_prescribed_arm
 from uvms_pin.apps.validation.sensitivity import SensitiveModel
-from uvms_pin.apps.validation.trials import roll_pitch_rad
+from uvms_pin.apps.validation.trials import load_trial, roll_pitch_rad
 
 
 def test_vehicle_start_and_reading_invert_each_other():
@@ -89,3 +94,89 @@ def test_fit_jacobian_in_imu_yaw_and_damping_matches_finite_differences():
         np.testing.assert_allclose(
             jac[:, k], numeric, rtol=0, atol=2e-4 * scale, err_msg=parameter.name
         )
+
+
+def test_an_imu_turned_against_the_tracked_frame_shows_in_the_roll_against_pitch_slope():
+    """A vehicle pitching through +-10 deg with some roll and yaw, tracked in a frame turned
+    -93 deg in yaw (world) and read by an IMU turned 3 deg (body): the slope is 3 deg to 2 %."""
+    t = np.linspace(0.0, 20.0, 401)
+    euler_zyx = np.column_stack(
+        [0.3 * np.sin(0.2 * t), np.radians(10.0) * np.sin(0.4 * t), 0.05 + 0.02 * np.cos(0.3 * t)]
+    )
+    vehicle = Rotation.from_euler("ZYX", euler_zyx)
+    psi = np.radians(3.0)
+    imu = (vehicle * Rotation.from_rotvec([0.0, 0.0, psi])).as_quat()
+    mocap = (Rotation.from_euler("z", -93.0, degrees=True) * vehicle).as_quat()
+    pitch, difference = roll_against_mocap_slope(t, imu, t + 0.001, mocap)
+    assert len(pitch) == len(t) and abs(pitch.mean()) < 1e-12
+    slope = (pitch @ difference) / (pitch @ pitch)
+    assert slope == pytest.approx(psi, rel=0.02)
+    # the same IMU without a turn: no slope
+    pitch, difference = roll_against_mocap_slope(t, vehicle.as_quat(), t, mocap)
+    assert abs((pitch @ difference) / (pitch @ pitch)) < 1e-9
+
+
+def test_validate_pool_takes_the_imu_yaw_in_degrees(tmp_path):
+    """`validate pool --imu-yaw 2` is `compare_trial` with psi = 2 deg, and differs from 0."""
+    trial = load_trial(DATA_DIR / "_alt_011-1.npz")
+    result = run(
+        "validate",
+        "pool",
+        str(DATA_DIR),
+        "--out",
+        str(tmp_path),
+        "--trials",
+        "_alt_011-1",
+        "--imu-yaw",
+        "2",
+        "--no-figures",
+    )
+    assert result.returncode == 0, result.stderr
+    roll = json.loads((tmp_path / "pool_validation.json").read_text())["trials"]["_alt_011-1"]
+    turned = compare_trial(trial_uvms(), trial, imu_yaw_rad=np.radians(2.0))
+    assert roll["roll_rmse_deg"] == pytest.approx(turned.rmse_deg("simulated")[0], rel=1e-9)
+    assert turned.rmse_deg("simulated")[0] != pytest.approx(
+        compare_trial(trial_uvms(), trial).rmse_deg("simulated")[0], rel=1e-3
+    )
+
+
+def test_identify_warns_when_the_fit_stops_at_its_cap(monkeypatch, capsys):
+    """The command still reports and exits 0, but says on stderr the fit did not converge."""
+    from uvms_pin.apps.validation import identify
+
+    def capped(*args, **kwargs):
+        trial = {
+            "start_roll_rmse_deg": 0.5,
+            "start_pitch_rmse_deg": 0.5,
+            "identified_roll_rmse_deg": 0.4,
+            "identified_pitch_rmse_deg": 0.4,
+            "published_roll_rmse_deg": None,
+            "published_pitch_rmse_deg": None,
+        }
+        means = {
+            f"mean_{k}_rmse_deg": 0.4
+            for k in ("start_roll", "start_pitch", "identified_roll", "identified_pitch")
+        }
+        return {
+            "link": HULL,
+            "parameters": {},
+            "iterations": 2,
+            "accepted_steps": 2,
+            "stop_reason": "iteration cap",
+            "converged": False,
+            "gradient_cosine": 0.1,
+            "fit_rms_deg": [0.5, 0.45, 0.4],
+            "identification_trials": [],
+            "held_out": means,
+            "identification": means,
+            "trials": {"_alt_011-1": trial},
+            "arm_delay_s": 0.0,
+            "imu_yaw_rad": 0.0,
+        }
+
+    monkeypatch.setattr(identify, "run_identification", capped)
+    code = identify.main([str(DATA_DIR), "--fit", "imu_yaw", "--max-iterations", "2"])
+    out, err = capsys.readouterr()
+    assert code == 0
+    assert "stopped: iteration cap (NOT converged)" in out
+    assert "stopped at its cap of 2 iterations, not converged" in err

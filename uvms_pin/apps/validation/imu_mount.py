@@ -10,6 +10,10 @@ the IMU's first sample (`vehicle_start`), and is compared in the IMU's axes
 (`imu_roll_pitch`). psi is a property of the recording set-up, like the arm's delay, not of
 the vehicle: `uvms_pin.apps.validation.parameters` names it ``imu_yaw``.
 
+A check independent of the model (`roll_against_mocap_slope`): the motion capture tracks
+another frame on the same hull; if the two frames differ by a yaw psi_rel, the IMU's roll minus
+the tracked frame's roll grows as psi_rel times the pitch.
+
 Sensitivities (right perturbations R exp([dtheta]x), the free-flyer tangent):
 
     start:  dtheta_vehicle0 / dpsi = -e_z,   d omega_vehicle0 / dpsi = e_z x omega_vehicle0,
@@ -21,7 +25,13 @@ from __future__ import annotations
 import numpy as np
 from scipy.spatial.transform import Rotation
 
-__all__ = ["imu_roll_pitch", "imu_tangent", "start_sensitivity", "vehicle_start"]
+__all__ = [
+    "imu_roll_pitch",
+    "imu_tangent",
+    "roll_against_mocap_slope",
+    "start_sensitivity",
+    "vehicle_start",
+]
 
 
 def _yaw(psi_rad: float) -> Rotation:
@@ -61,3 +71,23 @@ def imu_roll_pitch(quat_vehicle_xyzw: np.ndarray, psi_rad: float) -> np.ndarray:
 def imu_tangent(psi_rad: float) -> np.ndarray:
     """(3, 3) dtheta_imu / dtheta_vehicle = Rz(psi)^T."""
     return _yaw(psi_rad).as_matrix().T
+
+
+def roll_against_mocap_slope(
+    imu_time_s: np.ndarray,
+    imu_quat_xyzw: np.ndarray,
+    mocap_time_s: np.ndarray,
+    mocap_quat_xyzw: np.ndarray,
+    max_gap_s: float = 0.02,
+) -> tuple[np.ndarray, np.ndarray]:
+    """(pitch - its mean, roll_imu - roll_mocap - its mean) [rad] at the IMU samples that have
+    a motion-capture sample within ``max_gap_s``: the least-squares slope of the second on the
+    first is the yaw [rad] of the IMU's axes relative to the tracked frame's (roll and pitch,
+    intrinsic Z-Y-X, do not depend on either world frame's yaw). Centred per trial, so that
+    trials pool without their constant tilts."""
+    k = np.clip(np.searchsorted(mocap_time_s, imu_time_s), 0, len(mocap_time_s) - 1)
+    near = np.abs(mocap_time_s[k] - imu_time_s) < max_gap_s
+    imu = Rotation.from_quat(imu_quat_xyzw[near]).as_euler("ZYX")[:, ::-1]
+    mocap = Rotation.from_quat(mocap_quat_xyzw[k[near]]).as_euler("ZYX")[:, ::-1]
+    pitch, difference = imu[:, 1], imu[:, 0] - mocap[:, 0]
+    return pitch - pitch.mean(), difference - difference.mean()
