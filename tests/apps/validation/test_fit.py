@@ -188,6 +188,7 @@ def test_identified_vehicle_urdf_is_the_identified_model(tmp_path):
         ("linear_damping.roll,spring.x", "unknown parameter 'spring.x'"),
         ("center_of_buoyancy.yaw", "center_of_buoyancy has x, y, z"),
         ("linear_damping.roll,,", "none empty"),
+        ("default,imu_yaw", "parameter given twice: imu_yaw"),  # default holds it
     ],
 )
 def test_identify_refuses_unknown_parameters_before_writing(tmp_path, fit, message):

@@ -220,11 +220,9 @@ def run(args: argparse.Namespace) -> int:
     start = trial_uvms() if args.cob is None else with_cob(trial_uvms(), args.cob)
     if args.fit is None:
         return _quasi_static(args, start)
-    names = (
-        list(DEFAULT_FIT)
-        if args.fit.strip() == "default"
-        else comma_names("--fit", args.fit, "parameter names")
-    )
+    names = []  # 'default' stands for `DEFAULT_FIT`, alone or with more names
+    for name in comma_names("--fit", args.fit, "parameter names"):
+        names += list(DEFAULT_FIT) if name == "default" else [name]
     if args.out is not None:
         check_writable(args.out)  # before minutes of fitting, not after
     result = run_identification(

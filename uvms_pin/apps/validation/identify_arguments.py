@@ -31,7 +31,8 @@ def add_identify_arguments(parser: argparse.ArgumentParser) -> None:
         "<kind>.<axis>: linear_damping, quadratic_damping, added_mass along x, y, z, roll, "
         "pitch, yaw, or center_of_buoyancy.x|y|z, arm_delay (how late the encoders are "
         "on the IMU's clock [s]) and imu_yaw (the IMU's mounting yaw on the hull [rad]); 'default': roll and pitch linear and quadratic damping, "
-        "the centre of buoyancy, arm_delay and imu_yaw (without --fit: the quasi-static centre-of-buoyancy fit)",
+        "the centre of buoyancy, arm_delay and imu_yaw, also with more names, e.g. "
+        "default,added_mass.roll (without --fit: the quasi-static centre-of-buoyancy fit)",
     )
     parser.add_argument(
         "--out",
