@@ -28,7 +28,7 @@ from uvms_pin.apps.validation.pool import (
     trial_uvms,
 )
 from uvms_pin.apps.validation.prescribed import simulate_prescribed_arm
-from uvms_pin.apps.validation.trials import load_trial, roll_pitch_rad
+from uvms_pin.apps.validation.trials import load_trial
 from uvms_pin.errors import ParameterError
 from uvms_pin.model.mount.text import urdf_text
 from uvms_pin.model.resources import shipped_path
@@ -43,17 +43,20 @@ NAMES = (
 )
 
 
-def _synthetic_trials(uvms, rng, noise_rad: float) -> list[TrialSetup]:
+def _synthetic_trials(uvms, rng, noise_rad: float, imu_yaw_rad: float = 0.0) -> list[TrialSetup]:
     """Two 5 s trials (the arm's motion shifted in time) simulated with ``uvms``, roll and
-    pitch measured with white noise."""
+    pitch measured with white noise by an IMU turned ``imu_yaw_rad`` on the hull (the setup
+    holds what that IMU measured at the start)."""
     setups = []
     for shift_s, roll_rate in ((0.0, 0.25), (1.7, -0.3)):
         arm = synthetic_arm(5.0 + shift_s)
         times = np.arange(shift_s, shift_s + 5.0 + 1e-9, 0.05)
         q0, nu0 = initial_state()
         nu0[3] = roll_rate
-        q, _ = simulate_prescribed_arm(uvms, arm, q0, nu0, times, 0.05)
-        measured = roll_pitch_rad(q[:, 3:7]) + rng.normal(scale=noise_rad, size=(len(times), 2))
+        q_vehicle0, nu_vehicle0 = vehicle_start(q0, nu0, imu_yaw_rad)
+        q, _ = simulate_prescribed_arm(uvms, arm, q_vehicle0, nu_vehicle0, times, 0.05)
+        noise = rng.normal(scale=noise_rad, size=(len(times), 2))
+        measured = imu_roll_pitch(q[:, 3:7], imu_yaw_rad) + noise
         setups.append(TrialSetup(arm, times, measured, q0, nu0))
     return setups
 
@@ -110,16 +113,7 @@ def test_fit_recovers_an_imu_mounting_yaw_with_the_damping():
     catalogue = trial_uvms()
     truth = parameter_values(catalogue, parameters, HULL) + np.array([np.radians(3.0), 1.5, 0.001])
     synthetic = with_parameters(catalogue, parameters, truth, HULL)
-    setups = []
-    for shift_s, roll_rate in ((0.0, 0.25), (1.7, -0.3)):
-        arm = synthetic_arm(5.0 + shift_s)
-        times = np.arange(shift_s, shift_s + 5.0 + 1e-9, 0.05)
-        q_imu0, nu_imu0 = initial_state()
-        nu_imu0[3] = roll_rate
-        q0, nu0 = vehicle_start(q_imu0, nu_imu0, truth[0])
-        q, _ = simulate_prescribed_arm(synthetic, arm, q0, nu0, times, 0.05)
-        measured = imu_roll_pitch(q[:, 3:7], truth[0])
-        setups.append(TrialSetup(arm, times, measured, q_imu0, nu_imu0))
+    setups = _synthetic_trials(synthetic, np.random.default_rng(1), 0.0, truth[0])
     fit = fit_parameters(catalogue, setups, parameters, HULL, 0.05, max_iterations=20)
     assert fit.rms_deg[0] > 0.1 and fit.rms_deg[-1] < 1e-6
     np.testing.assert_allclose(fit.values, truth, rtol=1e-6)
