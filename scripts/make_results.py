@@ -34,7 +34,7 @@ PRODUCERS = {
     "study_paper_claims": "study summary: docs/results/study_paper_claims.md",
     "bluerov_force": "BlueROV2 + Alpha 5 force task: docs/results/bluerov_force.md, docs/bluerov_alpha5_force.png",
     "pool_validation": "pool trials vs simulator: docs/results/pool_validation.md, docs/pool_*.png",
-    "identification": "hull parameters fitted to the pool trials: docs/results/identification.md, docs/identified_alt_002-0.png",
+    "identification": "hull parameters fitted to the pool trials: docs/results/identification.md, docs/identified_alt_002-0.png, docs/identified_alt_002-1.png",
     "sea_state": "the sea-state scenario: docs/results/sea_state.md, docs/sea_state_force.png",
     "study_sea_state": "study summary: docs/results/study_sea_state.md",
     "surface": "the free surface, analytic cases and surfacing: docs/results/surface.md, docs/surfacing.png",

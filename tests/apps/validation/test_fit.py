@@ -14,6 +14,7 @@ from test_sensitivity import DATA_DIR, initial_state, synthetic_arm
 from uvms_pin.apps.validation.figures import identified_figure
 from uvms_pin.apps.validation.fit import fit_parameters
 from uvms_pin.apps.validation.identify import HULL
+from uvms_pin.apps.validation.imu_mount import imu_roll_pitch, vehicle_start
 from uvms_pin.apps.validation.parameters import (
     hydro_body,
     parameter_values,
@@ -27,7 +28,8 @@ from uvms_pin.apps.validation.pool import (
     trial_uvms,
 )
 from uvms_pin.apps.validation.prescribed import simulate_prescribed_arm
-from uvms_pin.apps.validation.trials import load_trial, roll_pitch_rad
+from uvms_pin.apps.validation.trials import load_trial
+from uvms_pin.errors import ParameterError
 from uvms_pin.model.mount.text import urdf_text
 from uvms_pin.model.resources import shipped_path
 from uvms_pin.model.urdf.write_hydro import urdf_with_hydro
@@ -41,17 +43,20 @@ NAMES = (
 )
 
 
-def _synthetic_trials(uvms, rng, noise_rad: float) -> list[TrialSetup]:
+def _synthetic_trials(uvms, rng, noise_rad: float, imu_yaw_rad: float = 0.0) -> list[TrialSetup]:
     """Two 5 s trials (the arm's motion shifted in time) simulated with ``uvms``, roll and
-    pitch measured with white noise."""
+    pitch measured with white noise by an IMU turned ``imu_yaw_rad`` on the hull (the setup
+    holds what that IMU measured at the start)."""
     setups = []
     for shift_s, roll_rate in ((0.0, 0.25), (1.7, -0.3)):
         arm = synthetic_arm(5.0 + shift_s)
         times = np.arange(shift_s, shift_s + 5.0 + 1e-9, 0.05)
         q0, nu0 = initial_state()
         nu0[3] = roll_rate
-        q, _ = simulate_prescribed_arm(uvms, arm, q0, nu0, times, 0.05)
-        measured = roll_pitch_rad(q[:, 3:7]) + rng.normal(scale=noise_rad, size=(len(times), 2))
+        q_vehicle0, nu_vehicle0 = vehicle_start(q0, nu0, imu_yaw_rad)
+        q, _ = simulate_prescribed_arm(uvms, arm, q_vehicle0, nu_vehicle0, times, 0.05)
+        noise = rng.normal(scale=noise_rad, size=(len(times), 2))
+        measured = imu_roll_pitch(q[:, 3:7], imu_yaw_rad) + noise
         setups.append(TrialSetup(arm, times, measured, q0, nu0))
     return setups
 
@@ -70,11 +75,49 @@ def test_fit_recovers_the_parameters_of_exact_synthetic_trials():
     truth = _truth(catalogue, parameters)
     synthetic = with_parameters(catalogue, parameters, truth, HULL)
     setups = _synthetic_trials(synthetic, np.random.default_rng(1), 0.0)
-    fit = fit_parameters(catalogue, setups, parameters, HULL, 0.05, max_iterations=12)
+    fit = fit_parameters(catalogue, setups, parameters, HULL, 0.05, max_iterations=20)
     assert fit.rms_deg[0] > 0.3  # the start is far off the data
     assert fit.rms_deg[-1] < 1e-6
     np.testing.assert_allclose(fit.values, truth, rtol=1e-6)
     assert parameter_values(fit.uvms, parameters, HULL) == pytest.approx(fit.values)
+    # it stopped by itself, converged, before the cap
+    assert fit.converged and fit.stop_reason == "exact"
+    assert fit.iterations < 20
+
+
+def test_fit_says_it_stopped_at_its_cap_and_refuses_bad_tolerances():
+    """One step from far off is not convergence: the fit says so (`iteration cap`)."""
+    parameters = parse_parameters(NAMES[:2])
+    catalogue = trial_uvms()
+    truth = parameter_values(catalogue, parameters, HULL) + np.array([2.5, 1.0])
+    synthetic = with_parameters(catalogue, parameters, truth, HULL)
+    setups = _synthetic_trials(synthetic, np.random.default_rng(1), 0.0)[:1]
+    lines = []
+    fit = fit_parameters(
+        catalogue, setups, parameters, HULL, 0.05, max_iterations=1, progress=lines.append
+    )
+    assert fit.iterations == 1 and fit.stop_reason == "iteration cap" and not fit.converged
+    assert lines[0].startswith("start: RMS") and lines[-1].endswith("iteration cap")
+    assert fit.rms_deg[-1] < fit.rms_deg[0]  # the one step still lowered the cost
+    with pytest.raises(ParameterError, match="cost_tolerance must be > 0"):
+        fit_parameters(catalogue, setups, parameters, HULL, 0.05, cost_tolerance=0.0)
+    with pytest.raises(ParameterError, match="max_iterations must be >= 1"):
+        fit_parameters(catalogue, setups, parameters, HULL, 0.05, max_iterations=0)
+
+
+def test_fit_recovers_an_imu_mounting_yaw_with_the_damping():
+    """Synthetic trials read by an IMU turned 3 deg on the hull: from psi = 0 the fit finds
+    psi and the roll damping to 1e-6 (the start's and the reading's sensitivities are right),
+    and stops converged."""
+    parameters = parse_parameters(("imu_yaw", "linear_damping.roll", "center_of_buoyancy.y"))
+    catalogue = trial_uvms()
+    truth = parameter_values(catalogue, parameters, HULL) + np.array([np.radians(3.0), 1.5, 0.001])
+    synthetic = with_parameters(catalogue, parameters, truth, HULL)
+    setups = _synthetic_trials(synthetic, np.random.default_rng(1), 0.0, truth[0])
+    fit = fit_parameters(catalogue, setups, parameters, HULL, 0.05, max_iterations=20)
+    assert fit.rms_deg[0] > 0.1 and fit.rms_deg[-1] < 1e-6
+    np.testing.assert_allclose(fit.values, truth, rtol=1e-6)
+    assert fit.converged
 
 
 def test_fit_recovers_the_parameters_of_noisy_synthetic_trials():
@@ -89,6 +132,7 @@ def test_fit_recovers_the_parameters_of_noisy_synthetic_trials():
     setups = _synthetic_trials(synthetic, np.random.default_rng(2024), np.radians(0.05))
     fit = fit_parameters(catalogue, setups, parameters, HULL, 0.05, max_iterations=30)
     assert fit.rms_deg[-1] < 0.05  # ~ the noise (the fit absorbs a little of it)
+    assert fit.stop_reason in ("gradient", "cost", "step") and fit.iterations < 30
     np.testing.assert_allclose(fit.values[:2], truth[:2], rtol=0.05)
     np.testing.assert_allclose(fit.values[2], truth[2], rtol=0.2)
     assert abs(fit.values[3] - truth[3]) < 0.02 * 0.002
@@ -138,6 +182,7 @@ def test_identified_vehicle_urdf_is_the_identified_model(tmp_path):
         ("linear_damping.roll,spring.x", "unknown parameter 'spring.x'"),
         ("center_of_buoyancy.yaw", "center_of_buoyancy has x, y, z"),
         ("linear_damping.roll,,", "none empty"),
+        ("default,imu_yaw", "parameter given twice: imu_yaw"),  # default holds it
     ],
 )
 def test_identify_refuses_unknown_parameters_before_writing(tmp_path, fit, message):

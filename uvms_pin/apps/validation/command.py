@@ -7,6 +7,7 @@ Wired into `uvms_pin.apps.cli.main.build_parser` with ``register(sub)``.
 from __future__ import annotations
 
 import argparse
+import math
 import sys
 
 from uvms_pin.apps.arguments import comma_names, finite, nonempty, path_text, positive
@@ -28,6 +29,7 @@ def _cmd_validate_pool(args: argparse.Namespace) -> int:
         progress=None if args.quiet else lambda line: print(line, file=sys.stderr, flush=True),
         vehicle_urdf=args.vehicle,
         arm_delay_s=args.arm_delay,
+        imu_yaw_rad=math.radians(args.imu_yaw),
     )
     print(
         f"{len(result['trials'])} trials: mean roll RMSE {result['mean_roll_rmse_deg']:.3f} deg, "
@@ -89,6 +91,14 @@ def register(subparsers) -> argparse.ArgumentParser:
         metavar="S",
         help="the encoder stream is this late on the IMU's clock [s] (default 0; "
         "`uvms-pin identify --fit ...,arm_delay` fits it)",
+    )
+    pool.add_argument(
+        "--imu-yaw",
+        type=finite,
+        default=0.0,
+        metavar="DEG",
+        help="the IMU is mounted turned by this yaw on the hull [deg] (default 0; "
+        "`uvms-pin identify --fit ...,imu_yaw` fits it)",
     )
     pool.add_argument("--no-figures", action="store_true", help="skip the per-trial figures")
     pool.add_argument("--quiet", action="store_true", help="no per-trial progress lines")

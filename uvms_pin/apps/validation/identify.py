@@ -187,9 +187,11 @@ def _quasi_static(args, start: UVMS) -> int:
 def _print_fit(result: dict) -> None:
     print(f"identification trials: {', '.join(result['identification_trials'])}")
     accepted = len(result["fit_rms_deg"]) - 1
+    stop = result["stop_reason"]
+    state = "converged" if result["converged"] else "NOT converged"
     print(
         f"{result['link']}: {result['iterations']} Levenberg-Marquardt steps tried, "
-        f"{accepted} accepted"
+        f"{accepted} accepted; stopped: {stop} ({state})"
     )
     for name, p in result["parameters"].items():
         print(f"  {name}: {p['start']:.6g} -> {p['identified']:.6g} ({p['sensitivity']})")
@@ -218,11 +220,9 @@ def run(args: argparse.Namespace) -> int:
     start = trial_uvms() if args.cob is None else with_cob(trial_uvms(), args.cob)
     if args.fit is None:
         return _quasi_static(args, start)
-    names = (
-        list(DEFAULT_FIT)
-        if args.fit.strip() == "default"
-        else comma_names("--fit", args.fit, "parameter names")
-    )
+    names = []  # 'default' stands for `DEFAULT_FIT`, alone or with more names
+    for name in comma_names("--fit", args.fit, "parameter names"):
+        names += list(DEFAULT_FIT) if name == "default" else [name]
     if args.out is not None:
         check_writable(args.out)  # before minutes of fitting, not after
     result = run_identification(
@@ -236,13 +236,21 @@ def run(args: argparse.Namespace) -> int:
         progress=None if args.quiet else lambda line: print(line, file=sys.stderr, flush=True),
     )
     _print_fit(result)
+    if not result["converged"]:
+        print(
+            f"warning: the fit stopped at its cap of {args.max_iterations} iterations, not "
+            "converged: raise --max-iterations",
+            file=sys.stderr,
+        )
     if args.out is not None:
         print(f"wrote {args.out}/identification.json, {IDENTIFIED_VEHICLE}")
+        recording = ""
         if result["arm_delay_s"]:
-            print(
-                f"validate with: --vehicle {args.out}/{IDENTIFIED_VEHICLE} "
-                f"--arm-delay {result['arm_delay_s']:.6g}"
-            )
+            recording += f" --arm-delay {result['arm_delay_s']:.6g}"
+        if result["imu_yaw_rad"]:
+            recording += f" --imu-yaw {np.degrees(result['imu_yaw_rad']):.6g}"
+        if recording:
+            print(f"validate with: --vehicle {args.out}/{IDENTIFIED_VEHICLE}{recording}")
     return 0
 
 

@@ -29,9 +29,10 @@ def add_identify_arguments(parser: argparse.ArgumentParser) -> None:
         type=nonempty("parameter names"),
         help="comma-separated hull parameters to fit on the simulation error, each "
         "<kind>.<axis>: linear_damping, quadratic_damping, added_mass along x, y, z, roll, "
-        "pitch, yaw, or center_of_buoyancy.x|y|z, and arm_delay (how late the encoders are "
-        "on the IMU's clock [s]); 'default': roll and pitch linear and quadratic damping, "
-        "the centre of buoyancy and arm_delay (without --fit: the quasi-static centre-of-buoyancy fit)",
+        "pitch, yaw, or center_of_buoyancy.x|y|z, arm_delay (how late the encoders are "
+        "on the IMU's clock [s]) and imu_yaw (the IMU's mounting yaw on the hull [rad]); 'default': roll and pitch linear and quadratic damping, "
+        "the centre of buoyancy, arm_delay and imu_yaw, also with more names, e.g. "
+        "default,added_mass.roll (without --fit: the quasi-static centre-of-buoyancy fit)",
     )
     parser.add_argument(
         "--out",
@@ -41,7 +42,12 @@ def add_identify_arguments(parser: argparse.ArgumentParser) -> None:
     )
     parser.add_argument("--step", type=positive, default=0.05, help="largest RK4 step [s]")
     parser.add_argument(
-        "--max-iterations", type=count(1), default=20, help="Levenberg-Marquardt iterations"
+        "--max-iterations",
+        type=count(1),
+        default=50,
+        help="cap on the Levenberg-Marquardt steps tried (default 50); the fit stops earlier "
+        "once converged (residual orthogonal to the Jacobian, or a step that lowers the cost "
+        "by < 1e-5 relative or moves no parameter); it says why it stopped",
     )
     parser.add_argument("--no-figures", action="store_true", help="skip the figures")
     parser.add_argument("--quiet", action="store_true", help="no per-iteration progress lines")

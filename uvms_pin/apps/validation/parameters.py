@@ -19,9 +19,11 @@ Added mass enters M(q) and the Kirchhoff and Coriolis terms nonlinearly: its sen
 taken by central finite differences of the vehicle's acceleration (`uvms_pin.apps.validation.
 sensitivity`), the one hydrodynamic kind the analytic path does not cover.
 
-One parameter is not the water's: ``arm_delay`` [s], how late the arm's encoder stream is on
-the IMU's clock (the arm is prescribed at t + delay). It is not part of the model either: it
-belongs to the recording, and its sensitivity is a central difference too.
+Two parameters are not the water's: they belong to the recording, not to the model.
+``arm_delay`` [s] is how late the arm's encoder stream is on the IMU's clock (the arm is
+prescribed at t + delay); its sensitivity is a central difference too. ``imu_yaw`` [rad] is the
+IMU's mounting yaw on the hull (`uvms_pin.apps.validation.imu_mount`): it moves the start and
+the reading of the attitude, not the dynamics, and its sensitivity is analytic.
 """
 
 from __future__ import annotations
@@ -51,6 +53,11 @@ __all__ = [
 AXES = ("x", "y", "z", "roll", "pitch", "yaw")
 KINDS = ("linear_damping", "quadratic_damping", "added_mass", "center_of_buoyancy")
 ARM_DELAY = "arm_delay"
+IMU_YAW = "imu_yaw"
+#: the recording's parameters (not the model's), named alone
+RECORDING = (ARM_DELAY, IMU_YAW)
+#: kinds that enter the fluid's force linearly (analytic `generalized_force_sensitivity`)
+FORCE_LINEAR = ("linear_damping", "quadratic_damping", "center_of_buoyancy")
 #: kinds whose entries must stay >= 0 (dissipation, a positive semi-definite added mass)
 NONNEGATIVE = ("linear_damping", "quadratic_damping", "added_mass")
 
@@ -64,17 +71,24 @@ class HydroParameter:
 
     @property
     def name(self) -> str:
-        return ARM_DELAY if self.kind == ARM_DELAY else f"{self.kind}.{AXES[self.axis]}"
+        return self.kind if self.kind in RECORDING else f"{self.kind}.{AXES[self.axis]}"
 
     @property
     def analytic(self) -> bool:
-        """True when the sensitivity is analytic (the force is linear in the parameter)."""
-        return self.kind not in ("added_mass", ARM_DELAY)
+        """True when the sensitivity is analytic (the force is linear in the parameter, or
+        the IMU's mounting yaw)."""
+        return self.kind in FORCE_LINEAR or self.kind == IMU_YAW
+
+    @property
+    def force_linear(self) -> bool:
+        """True when the fluid's force is linear in the parameter (damping, r_B)."""
+        return self.kind in FORCE_LINEAR
 
     @property
     def hydrodynamic(self) -> bool:
-        """True for a coefficient of the body (False: the recording's ``arm_delay``)."""
-        return self.kind != ARM_DELAY
+        """True for a coefficient of the body (False: the recording's ``arm_delay``,
+        ``imu_yaw``)."""
+        return self.kind not in RECORDING
 
     @property
     def nonnegative(self) -> bool:
@@ -117,14 +131,14 @@ def parse_parameters(names: Sequence[str]) -> tuple[HydroParameter, ...]:
         )
     out = []
     for name in names:
-        if name.strip() == ARM_DELAY:
-            out.append(HydroParameter(ARM_DELAY, 0))
+        if name.strip() in RECORDING:
+            out.append(HydroParameter(name.strip(), 0))
             continue
         kind, _, axis = name.strip().partition(".")
         if kind not in KINDS or axis not in AXES:
             raise ParameterError(
                 f"unknown parameter '{name}': give <kind>.<axis>, kind one of {', '.join(KINDS)}, "
-                f"axis one of {', '.join(AXES)}, or {ARM_DELAY}"
+                f"axis one of {', '.join(AXES)}, or {' or '.join(RECORDING)}"
             )
         if kind == "center_of_buoyancy" and AXES.index(axis) > 2:
             raise ParameterError(f"unknown parameter '{name}': center_of_buoyancy has x, y, z")
@@ -146,8 +160,8 @@ def hydro_body(uvms: UVMS, link: str) -> HydroBody:
 
 
 def parameter_values(uvms: UVMS, parameters: Sequence[HydroParameter], link: str) -> np.ndarray:
-    """The parameters' current values on ``link`` of ``uvms`` (``arm_delay``: 0, the model
-    holds none)."""
+    """The parameters' current values on ``link`` of ``uvms`` (``arm_delay``, ``imu_yaw``:
+    0, the model holds none)."""
     params = hydro_body(uvms, link).params
     return np.array([p.value(params) if p.hydrodynamic else 0.0 for p in parameters])
 
@@ -156,7 +170,8 @@ def with_parameters(
     uvms: UVMS, parameters: Sequence[HydroParameter], values: np.ndarray, link: str
 ) -> UVMS:
     """The same system with ``link``'s parameters set to ``values`` (ParameterError if the
-    result is not a valid body, e.g. a negative damping; ``arm_delay`` is not the model's)."""
+    result is not a valid body, e.g. a negative damping; the recording's parameters are not the
+    model's)."""
     hydro_body(uvms, link)
 
     def replaced(body: HydroBody) -> HydroParams:
@@ -193,8 +208,9 @@ def generalized_force_sensitivity(
     parameters: Sequence[HydroParameter],
     link: str,
 ) -> np.ndarray:
-    """dF/dp (nv, n_analytic) of the fluid's generalized force, in still water without a
-    free surface, for the analytic parameters among ``parameters`` (in their order).
+    """dF/dp (nv, n_linear) of the fluid's generalized force, in still water without a
+    free surface, for the parameters among ``parameters`` it is linear in (`force_linear`, in
+    their order).
 
     F = J_j^T X^T w: w the body-frame wrench, nu_r = X J_j v the body's velocity in its hydro
     frame (no current), f_B the buoyancy R_body^T (-rho V g).
@@ -208,7 +224,7 @@ def generalized_force_sensitivity(
     rotation = data.oMi[body.joint_id].rotation @ body.placement_in_joint.rotation
     buoyancy_world = -uvms.water_density_kg_m3 * body.params.volume_m3 * model.gravity.linear
     buoyancy_body = rotation.T @ buoyancy_world
-    columns = [_wrench_sensitivity(p, nu_r, buoyancy_body) for p in parameters if p.analytic]
+    columns = [_wrench_sensitivity(p, nu_r, buoyancy_body) for p in parameters if p.force_linear]
     if not columns:
         return np.zeros((uvms.nv, 0))
     return jac.T @ action.T @ np.column_stack(columns)

@@ -20,6 +20,7 @@ from pathlib import Path
 import numpy as np
 from scipy.spatial.transform import Rotation
 
+from uvms_pin.apps.validation.imu_mount import imu_roll_pitch, vehicle_start
 from uvms_pin.apps.validation.prescribed import JointTrajectory, low_pass, simulate_prescribed_arm
 from uvms_pin.apps.validation.trials import PoolTrial, roll_pitch_rad
 from uvms_pin.errors import DataError
@@ -155,16 +156,21 @@ def trial_setup(trial: PoolTrial, arm_delay_s: float = 0.0) -> TrialSetup:
 
 
 def compare_trial(
-    uvms: UVMS, trial: PoolTrial, step_s: float = STEP_S, arm_delay_s: float = 0.0
+    uvms: UVMS,
+    trial: PoolTrial,
+    step_s: float = STEP_S,
+    arm_delay_s: float = 0.0,
+    imu_yaw_rad: float = 0.0,
 ) -> TrialComparison:
     """Simulate one trial and line up measured, simulated, held and published roll/pitch
-    (``arm_delay_s``: `trial_setup`)."""
+    (``arm_delay_s``: `trial_setup`; ``imu_yaw_rad``: the IMU's mounting yaw on the hull,
+    `uvms_pin.apps.validation.imu_mount`: the vehicle starts from the IMU's attitude turned
+    back by it, and the simulated attitude is read in the IMU's axes)."""
     setup = trial_setup(trial, arm_delay_s)
     arm, times, measured = setup.arm, setup.time_s, setup.measured
-    q_vehicle, _ = simulate_prescribed_arm(
-        uvms, arm, setup.q_vehicle0, setup.nu_vehicle0, times, step_s
-    )
-    simulated = roll_pitch_rad(q_vehicle[:, 3:7])
+    q0, nu0 = vehicle_start(setup.q_vehicle0, setup.nu_vehicle0, imu_yaw_rad)
+    q_vehicle, _ = simulate_prescribed_arm(uvms, arm, q0, nu0, times, step_s)
+    simulated = imu_roll_pitch(q_vehicle[:, 3:7], imu_yaw_rad)
     published = None
     if trial.published is not None:
         pub = trial.published

@@ -61,6 +61,7 @@ def run_pool_validation(
     progress: Callable[[str], None] | None = None,
     vehicle_urdf: str | Path | None = None,
     arm_delay_s: float = 0.0,
+    imu_yaw_rad: float = 0.0,
 ) -> dict:
     """Validate every trial of ``data_dir`` (or those named); write the results to ``out_dir``.
 
@@ -68,7 +69,8 @@ def run_pool_validation(
     with ``figures``, ``<trial>.png`` per trial. Every trial file is read and checked before
     anything is simulated or written. ``vehicle_urdf``: another trial vehicle (e.g. the one
     ``uvms-pin identify --out`` writes) in place of the shipped one; ``arm_delay_s``: how
-    late the encoder stream is on the IMU's clock (identified by ``identify --fit arm_delay``).
+    late the encoder stream is on the IMU's clock (identified by ``identify --fit arm_delay``);
+    ``imu_yaw_rad``: the IMU's mounting yaw on the hull (``identify --fit imu_yaw``).
 
     Raises:
         DataError: a missing directory, no trials, an unknown trial name or a bad file.
@@ -88,7 +90,7 @@ def run_pool_validation(
     uvms = trial_uvms(vehicle_urdf)
     comparisons = []
     for trial in trials:
-        comparisons.append(compare_trial(uvms, trial, step_s, arm_delay_s))
+        comparisons.append(compare_trial(uvms, trial, step_s, arm_delay_s, imu_yaw_rad))
         if progress is not None:
             roll, pitch = comparisons[-1].rmse_deg("simulated")
             progress(f"{trial.name}: roll RMSE {roll:.2f} deg, pitch RMSE {pitch:.2f} deg")

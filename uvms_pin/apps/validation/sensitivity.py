@@ -17,7 +17,8 @@ dID/dx = -M da/dx, and the vehicle rows, which carry no input, give
 (F the fluid's generalized force, `parameters.generalized_force_sensitivity`; for added mass
 and the arm's delay, central differences of a_v). S is integrated with the same classical Runge-Kutta stages as
 the state (a 4th-order approximation of the exact flow's sensitivity), from S(t0) = 0: the
-initial state is measured, not fitted.
+initial state is measured, not fitted (except where a parameter moves it, e.g. the IMU's
+mounting yaw: then the caller gives S(t0)).
 """
 
 from __future__ import annotations
@@ -32,6 +33,8 @@ import pinocchio as pin
 from scipy.linalg import cho_factor, cho_solve
 
 from uvms_pin.apps.validation.parameters import (
+    ARM_DELAY,
+    IMU_YAW,
     HydroParameter,
     generalized_force_sensitivity,
     parameter_values,
@@ -79,7 +82,7 @@ class SensitiveModel:
         self.uvms = with_parameters(uvms, parameters, self.values, link)
         self.differenced = []  # (column, step, uvms at +step, uvms at -step)
         for k, p in enumerate(self.parameters):
-            if p.analytic or not p.hydrodynamic:
+            if p.force_linear or not p.hydrodynamic:
                 continue
             step = ADDED_MASS_STEP * max(1.0, abs(self.values[k]))
             shifted = [self.values.copy(), self.values.copy()]
@@ -87,10 +90,21 @@ class SensitiveModel:
             shifted[1][k] -= step
             models = [with_parameters(uvms, parameters, s, link) for s in shifted]
             self.differenced.append((k, step, *models))
-        self.analytic_columns = [k for k, p in enumerate(self.parameters) if p.analytic]
-        delays = [k for k, p in enumerate(self.parameters) if not p.hydrodynamic]
-        self.delay_column = delays[0] if delays else None
-        self.arm_delay_s = 0.0 if self.delay_column is None else float(self.values[delays[0]])
+        self.force_columns = [k for k, p in enumerate(self.parameters) if p.force_linear]
+        self.delay_column = self._column(ARM_DELAY)
+        self.arm_delay_s = (
+            0.0 if self.delay_column is None else float(self.values[self.delay_column])
+        )
+        # the IMU's mounting yaw leaves the dynamics alone (its column of B stays 0): it moves
+        # the start and the reading (`uvms_pin.apps.validation.imu_mount`)
+        self.imu_yaw_column = self._column(IMU_YAW)
+        self.imu_yaw_rad = (
+            0.0 if self.imu_yaw_column is None else float(self.values[self.imu_yaw_column])
+        )
+
+    def _column(self, kind: str) -> int | None:
+        found = [k for k, p in enumerate(self.parameters) if p.kind == kind]
+        return found[0] if found else None
 
     def acceleration(self, q: np.ndarray, v: np.ndarray, qdd_arm: np.ndarray, uvms=None):
         """(a_v, M, chol(M_vv)) at the full state (q, v), arm acceleration qdd_arm."""
@@ -112,7 +126,7 @@ class SensitiveModel:
         jac_state = cho_solve(factor, state)
         jac_params = np.zeros((6, len(self.parameters)))
         force = generalized_force_sensitivity(self.uvms, q, v, self.parameters, self.link)
-        jac_params[:, self.analytic_columns] = cho_solve(factor, force[:6])
+        jac_params[:, self.force_columns] = cho_solve(factor, force[:6])
         for k, step, plus, minus in self.differenced:
             a_plus = self.acceleration(q, v, qdd_arm, plus)[0]
             a_minus = self.acceleration(q, v, qdd_arm, minus)[0]
@@ -159,9 +173,10 @@ def simulate_with_sensitivity(
     nu_vehicle0: np.ndarray,
     times_s: np.ndarray,
     step_s: float,
+    sensitivity0: np.ndarray | None = None,
 ) -> Trajectory:
     """`simulate_prescribed_arm` (the same states, the arm at t + the model's arm delay)
-    with S = dx/dp at ``times_s``."""
+    with S = dx/dp at ``times_s``, from S(t0) = ``sensitivity0`` (12, n_p) (default 0)."""
     times_s = np.asarray(times_s, dtype=float)
     start, end = arm.span_s
     if times_s[0] < start - 1e-9 or times_s[-1] > end + 1e-9:
@@ -182,7 +197,10 @@ def simulate_with_sensitivity(
         ds[6:] = jac_state @ s + jac_params
         return a_v, ds
 
-    q, v, s = np.asarray(q_vehicle0, float), np.asarray(nu_vehicle0, float), np.zeros((12, n_p))
+    s = np.zeros((12, n_p)) if sensitivity0 is None else np.array(sensitivity0, dtype=float)
+    if s.shape != (12, n_p):
+        raise ParameterError(f"sensitivity0 has shape {s.shape}, expected (12, {n_p})")
+    q, v = np.asarray(q_vehicle0, float), np.asarray(nu_vehicle0, float)
     qs, vs, ss = [q], [v], [s]
     for t0, t1 in itertools.pairwise(times_s):
         n, h = _substeps(float(t0), float(t1), step_s)
