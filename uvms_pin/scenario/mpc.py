@@ -3,7 +3,11 @@
 
 The controller plans on tau (the generalized input the scenario's actuation then allocates
 to the thrusters and limits), bounded by ``tau_limits`` (a DoF whose limit is 0, e.g. the
-unactuated roll and pitch, is not an input of the plan); its model is the plant's, or the
+unactuated roll and pitch, is not an input of the plan); with ``inputs = "thrusters"`` it
+plans on the scenario's thrusters instead, u = (thrust of each [N], joint torques [N m]),
+tau = B_u u (`uvms_pin.physics.discrete.input_matrix`), each thrust within its own
+[-max_reverse_N, max_forward_N] and each joint torque within the actuation's effort limit
+(else ``tau_limits``'s): what the thrusters can really give, coupled and asymmetric; its model is the plant's, or the
 plant's scaled by [controller.model_error] (as for computed torque); the water it plans in is
 ``current_world_m_s`` (what it believes the current is; it does not see the scenario's).
 
@@ -27,6 +31,7 @@ from uvms_pin.scenario.baselines import model_error_factors
 from uvms_pin.scenario.controller_parts import checked_spec, desired_force_profile, plain
 from uvms_pin.scenario.schema import Table
 from uvms_pin.scenario.world import build_environment
+from uvms_pin.sim.actuation import Actuation, ThrustersAndJointLimits, Unlimited
 from uvms_pin.sim.run import ControllerSpec
 
 #: the keys of the table with their defaults
@@ -73,8 +78,22 @@ def _force_task(t: Table, uvms: UVMS) -> tuple[dict, dict]:
     return fields, recorded
 
 
-def build_mpc(t: Table, uvms: UVMS) -> ControllerSpec:
-    """[controller] type = "mpc"."""
+def _thruster_inputs(t: Table, actuation: Actuation, nv: int, limits: np.ndarray):
+    """(B_u, (lower, upper)) of u = (thrusts, joint torques) on the scenario's thrusters."""
+    from uvms_pin.physics.discrete import input_matrix
+
+    if not isinstance(actuation, ThrustersAndJointLimits):
+        raise t.error("inputs", "'thrusters' needs [[actuation.thruster]] in the scenario")
+    thrusters = actuation.thrusters
+    efforts = actuation.joint_effort_limits_Nm
+    joints = limits[6:] if efforts is None else efforts
+    lower = np.r_[[-th.max_reverse_N for th in thrusters], -joints]
+    upper = np.r_[[th.max_forward_N for th in thrusters], joints]
+    return input_matrix(thrusters, nv), (lower, upper)
+
+
+def build_mpc(t: Table, uvms: UVMS, actuation: Actuation | None = None) -> ControllerSpec:
+    """[controller] type = "mpc" (``actuation``: the scenario's, for inputs = "thrusters")."""
     task = t.string("task", "station", choices=TASKS)
     target = _target(t, uvms, task)
     force_fields, force_recorded = _force_task(t, uvms) if task == "force" else ({}, {})
@@ -87,6 +106,12 @@ def build_mpc(t: Table, uvms: UVMS) -> ControllerSpec:
         default_weights = [100.0] * 6 if task == "station" else [1.0, 1.0, 1.0, 0.1, 0.1, 0.1]
         fields["pose_weights"] = t.vector("pose_weights", 6, default_weights, nonneg=True)
     limits = t.vector("tau_limits", uvms.nv, np.full(uvms.nv, np.inf), nonneg=True)
+    inputs = t.string("inputs", "tau", choices=("tau", "thrusters"))
+    on_thrusters = (
+        _thruster_inputs(t, actuation or Unlimited(), uvms.nv, limits)
+        if inputs == "thrusters"
+        else None
+    )
     current = t.vector("current_world_m_s", 3, [0.0, 0.0, 0.0])
     factors = model_error_factors(t.table("model_error"))
     t.finish()
@@ -102,16 +127,18 @@ def build_mpc(t: Table, uvms: UVMS) -> ControllerSpec:
         q_ref[7:] = posture
         # the controller places its own copy of the environment on its first re-plan
         force_task = MpcForceTask(**force_fields) if task == "force" else None
-        # a DoF with a zero limit has no actuator: not an input of the plan
-        active = np.flatnonzero(limits > 0.0)
-        input_matrix = np.eye(u.nv)[:, active]
-        bounds = None if np.all(np.isinf(limits)) else (-limits[active], limits[active])
+        if on_thrusters is not None:
+            actuators = Actuators(*on_thrusters)
+        else:  # a DoF with a zero limit has no actuator: not an input of the plan
+            active = np.flatnonzero(limits > 0.0)
+            bounds = None if np.all(np.isinf(limits)) else (-limits[active], limits[active])
+            actuators = Actuators(np.eye(u.nv)[:, active], bounds)
         return MpcController(
             scaled_uvms(u, **factors),
             task=task,
             target=target,
             posture=q_ref,
-            actuators=Actuators(input_matrix, bounds),
+            actuators=actuators,
             flow=UniformCurrent(current) if np.any(current) else None,
             force_task=force_task,
             **fields,
@@ -124,6 +151,7 @@ def build_mpc(t: Table, uvms: UVMS) -> ControllerSpec:
         "target_position_m": None if target is None else plain(target.translation),
         "posture": plain(posture),
         "tau_limits": plain(limits),
+        "inputs": inputs,
         "current_world_m_s": plain(current),
         "model_error": factors,
         **{k: v for k, v in fields.items() if k != "pose_weights"},
