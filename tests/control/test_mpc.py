@@ -15,12 +15,13 @@ from uvms_pin.control.measurement import Measurement
 from uvms_pin.errors import ParameterError
 from uvms_pin.model.scaled import scaled_uvms
 from uvms_pin.model.vehicles import bluerov2_heavy
+from uvms_pin.physics.contact import LinearSpring
 from uvms_pin.sim.integrators import RK4
 from uvms_pin.sim.plant import Plant
 
 pytest.importorskip("crocoddyl")
 
-from uvms_pin.control.mpc import MpcController
+from uvms_pin.control.mpc import MpcController, MpcForceTask
 from uvms_pin.ocp import problems
 
 CURRENT = np.array([0.3, 0.1, 0.0])
@@ -109,3 +110,14 @@ def test_mpc_refuses_bad_settings(reference_uvms):
         MpcController(reference_uvms, task="station", target=target, posture=q0, solver="ipopt")
     with pytest.raises(ParameterError, match="rate_hz"):
         MpcController(reference_uvms, task="station", target=target, posture=q0, rate_hz=0.0)
+    with pytest.raises(ParameterError, match="one node"):
+        MpcController(
+            reference_uvms, task="station", target=target, posture=q0, horizon_s=0.01, dt_s=0.02
+        )
+    with pytest.raises(ParameterError, match="force_task"):
+        MpcController(reference_uvms, task="force", target=None, posture=q0)
+    force_task = MpcForceTask(LinearSpring(np.full(3, 2.0)), lambda t: np.zeros(3))
+    with pytest.raises(ParameterError, match="force_task"):
+        MpcController(
+            reference_uvms, task="station", target=target, posture=q0, force_task=force_task
+        )
