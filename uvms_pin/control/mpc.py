@@ -47,6 +47,11 @@ __all__ = ["MpcController", "MpcForceTask"]
 TASKS = ("station", "end_effector", "force")
 #: the iterations of a plan without a warm start (the first, or every one without warm_start)
 COLD_START_ITERATIONS = 20
+#: the line search of a warm-started re-plan: each trial step costs one rollout of the
+#: horizon; when 1, 1/2 and 1/4 fail, crocoddyl takes the last step whatever it gives, here
+#: 1/512 (the warm start kept, nearly), as crocoddyl's own ten (1 down to 1/512) would end,
+#: six rollouts sooner. A cold plan tries all ten.
+REPLAN_STEP_LENGTHS = (1.0, 0.5, 0.25, 2.0**-9)
 
 
 @dataclass(frozen=True)
@@ -180,6 +185,7 @@ class MpcController(Controller):
         self._signals: dict[str, np.ndarray] = {}
         # one solver for the run: each re-plan starts from the last one's regularization
         self._solver = problems.solver_of(self.problem, self.bounded)
+        self._cold_steps = list(self._solver.alphas)
         self._regularization: float | None = None
 
     def _initial_guess(self, x: np.ndarray) -> tuple[list, list]:
@@ -220,6 +226,7 @@ class MpcController(Controller):
         x = np.r_[measurement.q, measurement.v]
         self.problem.x0 = x
         cold = self._guess is None or not self.warm_start
+        self._solver.alphas = self._cold_steps if cold else list(REPLAN_STEP_LENGTHS)
         solver = problems.solve(
             self.problem,
             iterations=max(self.iterations, COLD_START_ITERATIONS) if cold else self.iterations,
