@@ -81,6 +81,8 @@ class UnderwaterActionModel(crocoddyl.DifferentialActionModelAbstract):
             self, UvmsState(uvms.model), b_u.shape[1], nr
         )
         self.uvms, self.terms, self.input_matrix = uvms, list(terms), b_u
+        # scale_i W_i of every residual row, in the terms' order
+        self._weights = np.concatenate([np.zeros(0), *(s * term.weights for term, s in terms)])
         self.water = {"flow": flow, "time_s": float(time_s), "backend": backend}
         needing = [term.name for term, _ in terms if term.needs_contact]
         if needing and contact is None:
@@ -113,10 +115,8 @@ class UnderwaterActionModel(crocoddyl.DifferentialActionModelAbstract):
             self.uvms, q, v, self.input_matrix @ u, tau_ext=tau_ext, **self.water
         )
         data.residuals = [term.residual(model, pdata, x, u, data.contact) for term, _ in self.terms]
-        data.cost = sum(
-            0.5 * scale * float(r @ (term.weights * r))
-            for (term, scale), r in zip(self.terms, data.residuals, strict=True)
-        )
+        residual = np.concatenate([np.zeros(0), *data.residuals])
+        data.cost = 0.5 * float(residual @ (self._weights * residual))
 
     def calcDiff(self, data, x, u=None):
         q, v, u = self._split(x, u)
@@ -140,21 +140,22 @@ class UnderwaterActionModel(crocoddyl.DifferentialActionModelAbstract):
 
     def _cost_derivatives(self, data, x, u, contact) -> None:
         """Gauss-Newton: l_x = R_x^T W r, l_xx = R_x^T W R_x (likewise u, xu), summed (the
-        joint Jacobians at q already in the node's Pinocchio data)."""
+        joint Jacobians at q already in the node's Pinocchio data): the terms' rows stacked,
+        R = [R_x R_u] (nr, nx + nu), so that the sums are two products."""
         model, pdata = self.uvms.model, data.pinocchio
-        nx, nu = 2 * model.nv, self.nu
-        lx, lu = np.zeros(nx), np.zeros(nu)
-        lxx, luu, lxu = np.zeros((nx, nx)), np.zeros((nu, nu)), np.zeros((nx, nu))
-        for (term, scale), r in zip(self.terms, data.residuals, strict=True):
+        nx = 2 * model.nv
+        stacked = np.empty((self.nr, nx + self.nu))
+        row = 0
+        for term, _ in self.terms:
             rx, ru = term.jacobians(model, pdata, x, u, contact)
-            w = scale * term.weights
-            lx += rx.T @ (w * r)
-            lu += ru.T @ (w * r)
-            lxx += rx.T @ (w[:, None] * rx)
-            luu += ru.T @ (w[:, None] * ru)
-            lxu += rx.T @ (w[:, None] * ru)
-        data.Lx[:], data.Lu[:] = lx, lu
-        data.Lxx[:, :], data.Luu[:, :], data.Lxu[:, :] = lxx, luu, lxu
+            stacked[row : row + term.nr, :nx], stacked[row : row + term.nr, nx:] = rx, ru
+            row += term.nr
+        weighted = self._weights[:, None] * stacked
+        gradient = weighted.T @ np.concatenate([np.zeros(0), *data.residuals])
+        hessian = stacked.T @ weighted
+        data.Lx[:], data.Lu[:] = gradient[:nx], gradient[nx:]
+        data.Lxx[:, :], data.Luu[:, :] = hessian[:nx, :nx], hessian[nx:, nx:]
+        data.Lxu[:, :] = hessian[:nx, nx:]
 
     def createData(self):
         return UnderwaterActionData(self)
