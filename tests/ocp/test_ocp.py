@@ -193,6 +193,8 @@ def _force_model(uvms, contact_model, actuators: problems.Actuators):
         (costs.end_effector_attitude(uvms, np.eye(3), np.ones(3)), 1.0),
         (costs.StateDeviation(uvms.model, x_ref, np.full(2 * uvms.nv, 0.1)), 1.0),
         (costs.Effort(np.ones(nu)), 1e-3),
+        # a wide margin: some joints of the random states are past it (a non-zero term)
+        (costs.JointLimitMargin(uvms.model, 1.0, 10.0), 1.0),
     ]
     contact = TaskContact(uvms.ee_frame_id, contact_model)
     return UnderwaterActionModel(uvms, terms, input_matrix_=actuators.input_matrix, contact=contact)
@@ -226,6 +228,7 @@ def test_calc_diff_with_the_contact_matches_crocoddyl_numdiff(reference_uvms, en
     numdiff.calc(nd_data, x, u)
     numdiff.calcDiff(nd_data, x, u)
     assert np.linalg.norm(data.contact.wrench_world[:3]) > 1.0
+    assert np.any(data.residuals[-1])  # the joint-limit term is active
     q, v = x[: uvms.nq], x[uvms.nq :]
     free = up.forward_dynamics(uvms, q, v, model.input_matrix @ u)
     assert np.abs(data.xout - free).max() > 0.1

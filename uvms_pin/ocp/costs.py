@@ -12,6 +12,7 @@ after `pin.computeJointJacobians` and `pin.updateFramePlacements` in the node's 
     effort             r = u (thrust [N], torque [N m])  R_u = I                  (nu)
     state              r = (q (-) q_ref, v - v_ref)      R_q = dDifference, R_v = I
     contact force      r = f - f_d [N]                   R_x = [df/dq, df/dv]     (3)
+    joint limits       r = q_j - clip(q_j, lo_j, hi_j)   R_q = 1 outside, else 0  (n)
 
 The contact force f = lambda[:3] is the end-effector's push on its environment (world axes)
 in a node whose dynamics hold a contact (`uvms_pin.ocp.model.UnderwaterActionModel` with
@@ -198,6 +199,33 @@ class ContactForce(CostTerm):
 
     def jacobians(self, model, data, x, u, contact=None):
         return np.hstack([contact.wrench_dq[:3], contact.wrench_dv[:3]]), np.zeros((3, len(u)))
+
+
+class JointLimitMargin(CostTerm):
+    """(1/2)||q_j - clip(q_j, lo_j + m, hi_j - m)||^2_W [rad]: zero inside the one-DoF arm
+    joints' limits less a margin m, growing past it (a soft wall the plan keeps off the
+    stops; the plant's limits are not in the dynamics)."""
+
+    def __init__(self, model: pin.Model, margin_rad: float, weight: float):
+        joints = [j for j in range(2, model.njoints) if model.nqs[j] == model.nvs[j] == 1]
+        super().__init__(np.full(len(joints), weight), len(joints), "joint limits")
+        if not (margin_rad >= 0.0 and np.isfinite(margin_rad)):
+            raise ParameterError(f"joint limits: margin_rad must be >= 0, got {margin_rad}")
+        self.q_index = np.array([model.idx_qs[j] for j in joints], dtype=int)
+        self.v_index = np.array([model.idx_vs[j] for j in joints], dtype=int)
+        self.lower = model.lowerPositionLimit[self.q_index] + margin_rad
+        self.upper = model.upperPositionLimit[self.q_index] - margin_rad
+
+    def residual(self, model, data, x, u, contact=None):
+        q = x[self.q_index]
+        return q - np.clip(q, self.lower, self.upper)
+
+    def jacobians(self, model, data, x, u, contact=None):
+        q = x[self.q_index]
+        rx = np.zeros((self.nr, 2 * model.nv))
+        outside = (q < self.lower) | (q > self.upper)
+        rx[np.arange(self.nr), self.v_index] = outside
+        return rx, np.zeros((self.nr, len(u)))
 
 
 def end_effector_pose(uvms: UVMS, target: pin.SE3, weights) -> FramePose:

@@ -223,6 +223,8 @@ def force_tracking(
     posture_weight: float = 1.0,
     velocity_weight: float = 0.1,
     effort_weight: float = 1e-4,
+    limit_margin_rad: float = 0.1,
+    limit_weight: float = 1e3,
     backend: str = "core",
 ) -> ForceTracking:
     """Press on ``contact`` with the desired force f_d(t) [N] while holding the end-effector's
@@ -230,7 +232,8 @@ def force_tracking(
 
     Per node at time t_k: (1/2)||f - f_d(t_k)||^2_Wf + (1/2)||log3(R_d^T R_ee)||^2_Wo +
     posture_weight (1/2)||arm (-) arm_0||^2 + velocity_weight (1/2)||v||^2 +
-    effort_weight (1/2)||u||^2; the terminal node the same without the effort. The vehicle's
+    effort_weight (1/2)||u||^2 + limit_weight (1/2)||arm past its limits less
+    limit_margin_rad||^2; the terminal node the same without the effort. The vehicle's
     position is free (it moves to make the force); f the contact's force on the environment
     in every node's dynamics (`uvms_pin.physics.derivatives.task_contact`)."""
     x0 = np.asarray(x0, float)
@@ -250,6 +253,7 @@ def force_tracking(
                 (next(pending), 1.0),
                 (costs.end_effector_attitude(uvms, rotation, attitude_weights), 1.0),
                 (costs.StateDeviation(uvms.model, x0, hold), 1.0),
+                (costs.JointLimitMargin(uvms.model, limit_margin_rad, limit_weight), 1.0),
             ]
             return out + ([(costs.Effort(np.ones(nu)), effort)] if effort > 0.0 else [])
 
