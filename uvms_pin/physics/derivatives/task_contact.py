@@ -144,6 +144,12 @@ def contact_wrench(
     velocities, WORLD joint Jacobians, the frame's placement)."""
     pin.forwardKinematics(model, data, q, v)
     pin.computeJointJacobians(model, data, q)
+    return _contact_in(contact, model, data)
+
+
+def _contact_in(contact: TaskContact, model: pin.Model, data: pin.Data) -> ContactWrench:
+    """The `ContactWrench` from ``data``'s joint placements, velocities and WORLD joint
+    Jacobians (already at the state)."""
     placement = pin.updateFramePlacement(model, data, contact.frame_id)
     position = placement.translation.copy()
     velocity = pin.getFrameVelocity(model, data, contact.frame_id, pin.LOCAL_WORLD_ALIGNED).linear
@@ -186,10 +192,13 @@ def projection_dq(
     """d(J_W^T F)/dq (nv, nv) with F = [f; n] (6,) a fixed wrench about the world origin
     (world axes): [k, m] = -J_k . (J_m x* F) where ``mask`` [k, m] (`supports_mask`)."""
     force, moment = wrench_world_origin[:3], wrench_world_origin[3:]
-    # J_m x* F = [w_m x f; v_m x f + w_m x n] = [-[f]x w_m; -[f]x v_m - [n]x w_m]
+    # -(J_m x* F) = -[w_m x f; v_m x f + w_m x n] = [[f]x w_m; [f]x v_m + [n]x w_m]
     linear, angular = jacobian_world[:3], jacobian_world[3:]
-    dual = np.vstack([-skew(force) @ angular, -skew(force) @ linear - skew(moment) @ angular])
-    return np.where(mask, -jacobian_world.T @ dual, 0.0)
+    by_force = skew(force)
+    minus_dual = np.empty_like(jacobian_world)
+    minus_dual[:3] = by_force @ angular
+    minus_dual[3:] = by_force @ linear + skew(moment) @ angular
+    return (jacobian_world.T @ minus_dual) * mask
 
 
 def contact_derivatives(
@@ -203,9 +212,10 @@ def contact_derivatives(
     """The `ContactWrench` at (q, v) and its `ContactJacobians` (see the module docstring);
     ``mask``: `supports_mask` of ``model`` (computed when None)."""
     mask = supports_mask(model) if mask is None else mask
-    state = contact_wrench(contact, model, data, q, v)
     nv, fid = model.nv, contact.frame_id
+    # the kinematics at (q, v) and the WORLD joint Jacobians, with their derivatives
     pin.computeForwardKinematicsDerivatives(model, data, q, v, np.zeros(nv))
+    state = _contact_in(contact, model, data)
     local_dq, local_jacobian = pin.getFrameVelocityDerivatives(model, data, fid, pin.LOCAL)
     rotation = data.oMf[fid].rotation
     local_linear = rotation.T @ state.velocity_world_m_s
