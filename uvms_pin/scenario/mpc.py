@@ -60,6 +60,7 @@ def _force_task(t: Table, uvms: UVMS) -> tuple[dict, dict]:
     contact_table = t.table("contact")
     if contact_table is None:
         raise t.error("contact", "task 'force' needs [controller.contact], the environment's model")
+    contact_raw = dict(contact_table.data)  # as written (the reader consumes the table)
     contact = build_environment(contact_table, uvms)
     desired_force, force_raw = desired_force_profile(t)
     fields = {
@@ -71,7 +72,7 @@ def _force_task(t: Table, uvms: UVMS) -> tuple[dict, dict]:
         "posture_weight": t.number("posture_weight", 1.0, nonneg=True),
     }
     recorded = {
-        "contact": contact_table.data,
+        "contact": contact_raw,
         "desired_force": force_raw,
         **{k: plain(v) for k, v in fields.items() if k not in ("contact", "desired_force")},
     }
