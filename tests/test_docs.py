@@ -55,6 +55,19 @@ _VARIANTS = [
     ),
     ("passive_current.toml", {}),
     ("mpc_station_keeping.toml", {"controller.model_error": {"damping_scale": 1.2}}),
+    ("mpc_force_tracking.toml", {"controller.model_error": {"mass_scale": 1.1}}),
+    (
+        "mpc_force_tracking.toml",
+        {
+            "controller.contact": {
+                "type": "plane",
+                "normal_world": [-1.0, 0.0, 0.0],
+                "stiffness_N_m": 100.0,
+                "damping_N_s_m": 5.0,
+                "anchor_world_m": [0.5, 0.0, -2.0],
+            }
+        },
+    ),
     (
         "sea_state_force_tracking.toml",
         {"water.sea.spreading_exponent": 4.0, "water.sea.seed": 3, "water.sea.water_depth_m": 30.0},

@@ -1,9 +1,9 @@
-"""The controller comparison: the realistic task with the PPC and the three baselines,
+"""The controller comparison: the realistic task with the PPC, the three baselines and MPC,
 nominal and over the robustness set."""
 
 from _common import producer_cli, publish_figure, scratch, uvms_pin, write_result
 
-CONTROLLERS = "ppc,pi_force,impedance,computed_torque"
+CONTROLLERS = "ppc,pi_force,impedance,computed_torque,mpc"
 
 if __name__ == "__main__":
     producer_cli(__doc__)

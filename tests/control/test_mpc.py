@@ -15,12 +15,13 @@ from uvms_pin.control.measurement import Measurement
 from uvms_pin.errors import ParameterError
 from uvms_pin.model.scaled import scaled_uvms
 from uvms_pin.model.vehicles import bluerov2_heavy
+from uvms_pin.physics.contact import LinearSpring
 from uvms_pin.sim.integrators import RK4
 from uvms_pin.sim.plant import Plant
 
 pytest.importorskip("crocoddyl")
 
-from uvms_pin.control.mpc import MpcController
+from uvms_pin.control.mpc import MpcController, MpcForceTask
 from uvms_pin.ocp import problems
 
 CURRENT = np.array([0.3, 0.1, 0.0])
@@ -109,3 +110,57 @@ def test_mpc_refuses_bad_settings(reference_uvms):
         MpcController(reference_uvms, task="station", target=target, posture=q0, solver="ipopt")
     with pytest.raises(ParameterError, match="rate_hz"):
         MpcController(reference_uvms, task="station", target=target, posture=q0, rate_hz=0.0)
+    with pytest.raises(ParameterError, match="one node"):
+        MpcController(
+            reference_uvms, task="station", target=target, posture=q0, horizon_s=0.01, dt_s=0.02
+        )
+    with pytest.raises(ParameterError, match="force_task"):
+        MpcController(reference_uvms, task="force", target=None, posture=q0)
+    force_task = MpcForceTask(LinearSpring(np.full(3, 2.0)), lambda t: np.zeros(3))
+    with pytest.raises(ParameterError, match="force_task"):
+        MpcController(
+            reference_uvms, task="station", target=target, posture=q0, force_task=force_task
+        )
+
+
+def test_the_force_task_previews_the_desired_force_and_places_its_spring(reference_uvms):
+    """Each re-plan moves f_d along the horizon (node k: f_d(t + k dt)); the controller's
+    own spring is anchored where the tip is at its first plan (the plant's convention), and
+    again after a reset; the plant's model object is never touched."""
+    uvms = reference_uvms
+    q0 = _start(uvms)
+    q0[7:] = [-0.2, 1.0, -0.8, 0.2]
+    spring = LinearSpring(np.full(3, 2.0))
+
+    def desired(t):
+        return np.array([0.4 + 0.4 * np.sin(np.pi * t), 0.0, 0.1 * t])
+
+    controller = MpcController(
+        uvms,
+        task="force",
+        target=None,
+        posture=q0,
+        horizon_s=0.2,
+        dt_s=0.05,
+        rate_hz=20.0,
+        force_task=MpcForceTask(spring, desired),
+    )
+    tracking = controller.force_tracking
+    assert len(tracking.forces) == controller.problem.T + 1 == 5
+    for t in (0.0, 0.05, 0.1):
+        controller.compute(t, Measurement(t, q0, np.zeros(uvms.nv), np.zeros(6)))
+        for k, term in enumerate(tracking.forces):
+            np.testing.assert_allclose(term.target_N, desired(t + 0.05 * k), rtol=0, atol=1e-15)
+    data = uvms.model.createData()
+    pin.framesForwardKinematics(uvms.model, data, q0)
+    np.testing.assert_array_equal(
+        controller._contact.model.anchor, data.oMf[uvms.ee_frame_id].translation
+    )
+    assert spring.anchor is None  # the caller's model stays unplaced
+    moved = q0.copy()
+    moved[0] += 0.1
+    controller.reset()
+    controller.compute(0.0, Measurement(0.0, moved, np.zeros(uvms.nv), np.zeros(6)))
+    assert controller._contact.model.anchor[0] == pytest.approx(
+        data.oMf[uvms.ee_frame_id].translation[0] + 0.1, abs=1e-12
+    )

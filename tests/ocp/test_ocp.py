@@ -180,3 +180,66 @@ def test_station_hold_in_a_current_with_bounded_thrusters(reference_uvms):
     passive = problems.station_hold(uvms, x0, station, horizon_s=1.0, dt_s=0.02, flow=current)
     xs = passive.rollout([np.zeros(uvms.nv)] * passive.T)
     assert np.linalg.norm(xs[-1][:3] - q0[:3]) > 0.08
+
+
+def _force_model(uvms, contact_model, actuators: problems.Actuators):
+    """A node of the force task: the contact in the dynamics, its force in the cost."""
+    from uvms_pin.physics.derivatives.task_contact import TaskContact
+
+    nu = actuators.nu(uvms.nv)
+    x_ref = np.r_[uvms.neutral_configuration(), np.zeros(uvms.nv)]
+    terms = [
+        (costs.ContactForce([0.4, 0.1, -0.2], [1.0, 0.5, 0.1]), 1.0),
+        (costs.end_effector_attitude(uvms, np.eye(3), np.ones(3)), 1.0),
+        (costs.StateDeviation(uvms.model, x_ref, np.full(2 * uvms.nv, 0.1)), 1.0),
+        (costs.Effort(np.ones(nu)), 1e-3),
+        # a wide margin: some joints of the random states are past it (a non-zero term)
+        (costs.JointLimitMargin(uvms.model, 1.0, 10.0), 1.0),
+    ]
+    contact = TaskContact(uvms.ee_frame_id, contact_model)
+    return UnderwaterActionModel(uvms, terms, input_matrix_=actuators.input_matrix, contact=contact)
+
+
+@pytest.mark.parametrize("environment", ["spring", "plane"])
+def test_calc_diff_with_the_contact_matches_crocoddyl_numdiff(reference_uvms, environment):
+    """With the end-effector on a spring or a spring-damper plane: Fx (the contact's
+    generalized force and its derivatives inside) and Lx (the contact-force cost) against
+    crocoddyl's NumDiff, held to 1e-5 as above; the contact does change the dynamics."""
+    from uvms_pin.physics.contact import CompliantPlane, LinearSpring
+
+    uvms = reference_uvms
+    rng = np.random.default_rng(9)
+    x = _state(uvms, rng)
+    data = uvms.model.createData()
+    pin.framesForwardKinematics(uvms.model, data, x[: uvms.nq])
+    tip = data.oMf[uvms.ee_frame_id].translation
+    normal = np.array([-1.0, 0.2, 0.1]) / np.linalg.norm([-1.0, 0.2, 0.1])
+    contact_model = (
+        LinearSpring(np.array([20.0, 30.0, 50.0]), tip - [0.1, 0.05, -0.05])
+        if environment == "spring"
+        else CompliantPlane(normal, 1000.0, 2.0, tip + 0.005 * normal)
+    )
+    model = _force_model(uvms, contact_model, _thrusters(uvms))
+    numdiff = crocoddyl.DifferentialActionModelNumDiff(model, False)
+    data, nd_data = model.createData(), numdiff.createData()
+    u = rng.normal(scale=5.0, size=model.nu)
+    model.calc(data, x, u)
+    model.calcDiff(data, x, u)
+    numdiff.calc(nd_data, x, u)
+    numdiff.calcDiff(nd_data, x, u)
+    assert np.linalg.norm(data.contact.wrench_world[:3]) > 1.0
+    assert np.any(data.residuals[-1])  # the joint-limit term is active
+    q, v = x[: uvms.nq], x[uvms.nq :]
+    free = up.forward_dynamics(uvms, q, v, model.input_matrix @ u)
+    assert np.abs(data.xout - free).max() > 0.1
+    for name in ("Fx", "Fu", "Lx", "Lu"):
+        got, expected = getattr(data, name), getattr(nd_data, name)
+        scale = max(np.abs(expected).max(), 1e-9)
+        assert np.abs(got - expected).max() < 1e-5 * scale, name
+
+
+def test_a_contact_force_cost_needs_a_contact(reference_uvms):
+    from uvms_pin.errors import ParameterError
+
+    with pytest.raises(ParameterError, match="contact force"):
+        UnderwaterActionModel(reference_uvms, [(costs.ContactForce(np.zeros(3), np.ones(3)), 1.0)])

@@ -11,28 +11,69 @@ current; None: it plans in still water).
 
 Tasks: "station" keeps the vehicle's body frame at a pose and the arm at its posture
 (`problems.station_hold`); "end_effector" brings the end-effector to a pose and holds it
-(`problems.point_to_point`, re-planned over a receding horizon).
+(`problems.point_to_point`, re-planned over a receding horizon); "force" presses the
+end-effector on a compliant environment to track a desired force f_d(t) while holding its
+attitude (`problems.force_tracking`, the paper's task): the controller's model of the
+environment (`MpcForceTask.contact`, a `uvms_pin.physics.contact` model; placed where the
+tip is at the first re-plan unless its point is given) is in every node's dynamics, and
+each re-plan moves the desired force along the horizon (the controller previews f_d).
+Unlike the PPC (model-free) the MPC is model-based: it needs the vehicle's, the water's and
+the environment's models, and what they get wrong it corrects only through re-planning.
 """
 
 from __future__ import annotations
 
+import copy
 import math
+from collections.abc import Callable
+from dataclasses import dataclass, field
 
 import numpy as np
 import pinocchio as pin
+from numpy.typing import ArrayLike
 
 from uvms_pin.control.base import Controller
 from uvms_pin.control.measurement import Measurement
+from uvms_pin.control.task_space import first_level_error
 from uvms_pin.errors import ParameterError
 from uvms_pin.flow import FlowField
 from uvms_pin.model.uvms import UVMS
 from uvms_pin.ocp import problems
+from uvms_pin.physics.contact import ContactModel
+from uvms_pin.physics.derivatives.task_contact import TaskContact
 
-__all__ = ["MpcController"]
+__all__ = ["MpcController", "MpcForceTask"]
 
-TASKS = ("station", "end_effector")
+TASKS = ("station", "end_effector", "force")
 #: the iterations of a plan without a warm start (the first, or every one without warm_start)
 COLD_START_ITERATIONS = 20
+#: the line search of a warm-started re-plan: each trial step costs one rollout of the
+#: horizon; when 1, 1/2 and 1/4 fail, crocoddyl takes the last step whatever it gives, here
+#: 1/512 (the warm start kept, nearly), as crocoddyl's own ten (1 down to 1/512) would end,
+#: six rollouts sooner. A cold plan tries all ten.
+REPLAN_STEP_LENGTHS = (1.0, 0.5, 0.25, 2.0**-9)
+
+
+@dataclass(frozen=True)
+class MpcForceTask:
+    """The force task of the MPC (task "force"): what to press on and how hard.
+
+    Attributes:
+        contact: the environment the controller believes in (its own copy is used): a spring
+            or a plane (`uvms_pin.physics.contact`); its anchor / surface point given, or
+            None: where the tip is at the first re-plan (the plant's own convention).
+        desired_force: f_d(t) (3,) [N, world axes], the force on the environment.
+        desired_rpy: the end-effector's attitude to hold (roll, pitch, yaw) [rad].
+        force_weights: of the force error (3,) [1/N^2]; attitude_weights (3,) [1/rad^2];
+            posture_weight: of the arm's deviation from the posture [1/rad^2].
+    """
+
+    contact: ContactModel
+    desired_force: Callable[[float], np.ndarray]
+    desired_rpy: ArrayLike = (0.0, 0.0, 0.0)
+    force_weights: ArrayLike = field(default_factory=lambda: np.full(3, 100.0))
+    attitude_weights: ArrayLike = field(default_factory=lambda: np.full(3, 100.0))
+    posture_weight: float = 1.0
 
 
 class MpcController(Controller):
@@ -52,6 +93,7 @@ class MpcController(Controller):
         flow: the water the controller plans in. warm_start: shift the previous solution.
         pose_weights: of the target pose's error (x, y, z [m], rotation [rad]); None: the
             problem's default (`problems.station_hold`, `problems.point_to_point`).
+        force_task: the force task's `MpcForceTask` (task "force" only; ``target`` unused).
     """
 
     def __init__(
@@ -59,7 +101,7 @@ class MpcController(Controller):
         uvms: UVMS,
         *,
         task: str,
-        target: pin.SE3,
+        target: pin.SE3 | None,
         posture: np.ndarray,
         horizon_s: float = 1.0,
         dt_s: float = 0.02,
@@ -71,9 +113,16 @@ class MpcController(Controller):
         warm_start: bool = True,
         pose_weights: np.ndarray | None = None,
         backend: str = "core",
+        force_task: MpcForceTask | None = None,
     ):
         if task not in TASKS:
             raise ParameterError(f"mpc task must be one of {TASKS}, got '{task}'")
+        if (task == "force") != (force_task is not None):
+            raise ParameterError("mpc: a force_task is given with task 'force' and only then")
+        if not (horizon_s >= dt_s > 0.0 and math.isfinite(horizon_s)):
+            raise ParameterError(
+                f"mpc needs 0 < dt_s <= horizon_s (at least one node), got {dt_s}, {horizon_s}"
+            )
         if solver not in ("box_fddp", "fddp"):
             raise ParameterError(f"mpc solver must be 'box_fddp' or 'fddp', got '{solver}'")
         if not (rate_hz > 0.0 and math.isfinite(rate_hz)) or iterations < 1:
@@ -83,19 +132,20 @@ class MpcController(Controller):
         self.uvms = uvms.with_model(pin.Model(uvms.model))
         actuators = problems.Actuators() if actuators is None else actuators
         x_ref = np.r_[np.asarray(posture, float), np.zeros(uvms.nv)]
-        build = problems.station_hold if task == "station" else problems.point_to_point
-        weights = {} if pose_weights is None else {"pose_weights": pose_weights}
-        self.problem = build(
-            self.uvms,
-            x_ref,
-            target,
-            horizon_s=horizon_s,
-            dt_s=dt_s,
-            actuators=actuators,
-            flow=flow,
-            backend=backend,
-            **weights,
-        )
+        self.force_task, self.force_tracking = force_task, None
+        common = {
+            "horizon_s": horizon_s,
+            "dt_s": dt_s,
+            "actuators": actuators,
+            "flow": flow,
+            "backend": backend,
+        }
+        if force_task is not None:
+            self.problem = self._force_problem(force_task, x_ref, common)
+        else:
+            build = problems.station_hold if task == "station" else problems.point_to_point
+            weights = {} if pose_weights is None else {"pose_weights": pose_weights}
+            self.problem = build(self.uvms, x_ref, target, **common, **weights)
         self.period_s = 1.0 / rate_hz
         self.iterations, self.bounded, self.warm_start = (
             iterations,
@@ -107,11 +157,36 @@ class MpcController(Controller):
         )
         self.reset()
 
+    def _force_problem(self, task: MpcForceTask, x_ref: np.ndarray, common: dict):
+        """The force task's OCP on the controller's own copy of the environment."""
+        ee = self.uvms.require_ee_frame("the MPC's force task")
+        self._contact = TaskContact(ee, copy.deepcopy(task.contact))
+        self._rpy_desired = np.asarray(task.desired_rpy, float).reshape(-1)
+        if self._rpy_desired.shape != (3,) or not np.all(np.isfinite(self._rpy_desired)):
+            raise ParameterError(f"mpc desired_rpy: 3 finite angles, got {task.desired_rpy}")
+        self._ee_data = self.uvms.model.createData()
+        self.force_tracking = problems.force_tracking(
+            self.uvms,
+            x_ref,
+            self._contact,
+            task.desired_force,
+            pin.rpy.rpyToMatrix(*self._rpy_desired),
+            force_weights=task.force_weights,
+            attitude_weights=task.attitude_weights,
+            posture_weight=task.posture_weight,
+            **common,
+        )
+        return self.force_tracking.problem
+
     def reset(self) -> None:
         self._next_plan_s = -math.inf
         self._guess: tuple[list, list] | None = None
         self._tau = np.zeros(self.uvms.nv)
         self._signals: dict[str, np.ndarray] = {}
+        # one solver for the run: each re-plan starts from the last one's regularization
+        self._solver = problems.solver_of(self.problem, self.bounded)
+        self._cold_steps = list(self._solver.alphas)
+        self._regularization: float | None = None
 
     def _initial_guess(self, x: np.ndarray) -> tuple[list, list]:
         nodes = self.problem.T
@@ -120,23 +195,51 @@ class MpcController(Controller):
         xs, us = self._guess
         return [x, *xs[2:], xs[-1]], [*us[1:], us[-1]]
 
+    def _force_signals(self, time_s: float, measurement: Measurement) -> dict[str, np.ndarray]:
+        """f_d(t) and the task error e_x = [f_meas - f_d (3) N; wrap(rpy_ee - rpy_d) (3) rad]
+        (the PPC's), for the logs and the comparison of controllers."""
+        model, data, ee = self.uvms.model, self._ee_data, self._contact.frame_id
+        pin.framesForwardKinematics(model, data, measurement.q)
+        rpy_ee = pin.rpy.matrixToRpy(data.oMf[ee].rotation)
+        force_desired = np.asarray(self.force_task.desired_force(time_s), float)
+        error = first_level_error(
+            np.asarray(measurement.wrench_world), force_desired, rpy_ee, self._rpy_desired
+        )
+        return {"force_desired_world_N": force_desired, "e_x": np.array(error)}
+
+    def _start_force_plan(self, time_s: float, measurement: Measurement) -> None:
+        """Place the environment (first plan: at the tip unless its point is given) and move
+        the desired force along the horizon."""
+        if self._guess is None:
+            data = self._ee_data
+            pin.framesForwardKinematics(self.uvms.model, data, measurement.q)
+            self._contact.model.attach(data.oMf[self._contact.frame_id].translation)
+        self.force_tracking.retarget(self.force_task.desired_force, time_s)
+
     def compute(self, time_s: float, measurement: Measurement) -> np.ndarray:
+        if self.force_task is not None:
+            self._signals.update(self._force_signals(time_s, measurement))
         if time_s < self._next_plan_s:
             return self._tau
+        if self.force_task is not None:
+            self._start_force_plan(time_s, measurement)
         x = np.r_[measurement.q, measurement.v]
         self.problem.x0 = x
         cold = self._guess is None or not self.warm_start
+        self._solver.alphas = self._cold_steps if cold else list(REPLAN_STEP_LENGTHS)
         solver = problems.solve(
             self.problem,
             iterations=max(self.iterations, COLD_START_ITERATIONS) if cold else self.iterations,
             warm_start=self._initial_guess(x),
-            bounded=self.bounded,
+            solver=self._solver,
+            regularization=self._regularization if self.warm_start else None,
         )
         self._guess = (list(solver.xs), list(solver.us))
+        self._regularization = solver.preg
         u0 = np.array(solver.us[0])
         self._tau = self.input_matrix @ u0
         self._next_plan_s = time_s + self.period_s - 1e-12
-        self._signals = {"mpc_cost": np.array([solver.cost]), "mpc_u": u0}
+        self._signals.update({"mpc_cost": np.array([solver.cost]), "mpc_u": u0})
         return self._tau
 
     def signals(self) -> dict[str, np.ndarray]:

@@ -8,7 +8,14 @@ their analytical derivatives along the tangent,
 
     Fx = [da/dq, da/dv],     Fu = da/dtau B_u,
 
-and the Gauss-Newton derivatives of the cost terms (`uvms_pin.ocp.costs`). Bounds on u
+and the Gauss-Newton derivatives of the cost terms (`uvms_pin.ocp.costs`). With a
+``contact`` (the end-effector on a compliant environment, `uvms_pin.physics.contact`), the
+environment's push is in the dynamics, tau_ext(q, v) = -J^T lambda(p, p_dot), and in their
+derivatives (`uvms_pin.physics.derivatives.task_contact`; da/dtau_ext = da/dtau = M^-1):
+
+    Fx += M^-1 [d tau_ext/dq, d tau_ext/dv].
+
+Bounds on u
 (thrust and effort limits) go to crocoddyl's box-constrained solvers through ``u_lb`` /
 ``u_ub``.
 """
@@ -26,6 +33,12 @@ from uvms_pin.model.uvms import UVMS
 from uvms_pin.ocp.costs import CostTerm
 from uvms_pin.ocp.crocoddyl_module import crocoddyl_module
 from uvms_pin.ocp.state import UvmsState
+from uvms_pin.physics.derivatives.task_contact import (
+    TaskContact,
+    contact_derivatives,
+    contact_wrench,
+    supports_mask,
+)
 from uvms_pin.physics.dynamics import forward_dynamics, forward_dynamics_derivatives
 
 crocoddyl = crocoddyl_module()
@@ -44,6 +57,8 @@ class UnderwaterActionModel(crocoddyl.DifferentialActionModelAbstract):
             flow is frozen at [s] (one model per node for a moving flow).
         u_bounds: (lower, upper) (nu,) each, or None for none.
         backend: "core" (compiled) or "python" (the reference).
+        contact: the end-effector's environment (a `TaskContact`, its model placed before
+            the first calc), or None; a term with ``needs_contact`` requires one.
     """
 
     def __init__(
@@ -56,6 +71,7 @@ class UnderwaterActionModel(crocoddyl.DifferentialActionModelAbstract):
         time_s: float = 0.0,
         u_bounds: tuple[np.ndarray, np.ndarray] | None = None,
         backend: str = "core",
+        contact: TaskContact | None = None,
     ):
         b_u = np.eye(uvms.nv) if input_matrix_ is None else np.asarray(input_matrix_, float)
         if b_u.ndim != 2 or b_u.shape[0] != uvms.nv:
@@ -65,7 +81,15 @@ class UnderwaterActionModel(crocoddyl.DifferentialActionModelAbstract):
             self, UvmsState(uvms.model), b_u.shape[1], nr
         )
         self.uvms, self.terms, self.input_matrix = uvms, list(terms), b_u
+        # scale_i W_i of every residual row, in the terms' order
+        self._weights = np.concatenate([np.zeros(0), *(s * term.weights for term, s in terms)])
         self.water = {"flow": flow, "time_s": float(time_s), "backend": backend}
+        needing = [term.name for term, _ in terms if term.needs_contact]
+        if needing and contact is None:
+            raise ParameterError(f"cost(s) {needing} need a contact in the node's dynamics")
+        self.contact = contact
+        # where d J_k/dq_m can be non-zero (the contact's derivatives), once per model
+        self._supports = None if contact is None else supports_mask(uvms.model)
         if u_bounds is not None:
             lower, upper = (np.asarray(b, float).reshape(-1) for b in u_bounds)
             if lower.shape != (self.nu,) or upper.shape != (self.nu,) or np.any(lower > upper):
@@ -79,43 +103,59 @@ class UnderwaterActionModel(crocoddyl.DifferentialActionModelAbstract):
 
     def calc(self, data, x, u=None):
         q, v, u = self._split(x, u)
-        data.xout[:] = forward_dynamics(self.uvms, q, v, self.input_matrix @ u, **self.water)
         model, pdata = self.uvms.model, data.pinocchio
-        pin.forwardKinematics(model, pdata, q, v)
+        if self.contact is None:
+            pin.forwardKinematics(model, pdata, q, v)
+            data.contact, tau_ext = None, None
+        else:  # its kinematics at (q, v) are the costs' too
+            data.contact = contact_wrench(self.contact, model, pdata, q, v)
+            tau_ext = data.contact.tau_ext
         pin.updateFramePlacements(model, pdata)
-        data.residuals = [term.residual(model, pdata, x, u) for term, _ in self.terms]
-        data.cost = sum(
-            0.5 * scale * float(r @ (term.weights * r))
-            for (term, scale), r in zip(self.terms, data.residuals, strict=True)
+        data.xout[:] = forward_dynamics(
+            self.uvms, q, v, self.input_matrix @ u, tau_ext=tau_ext, **self.water
         )
+        data.residuals = [term.residual(model, pdata, x, u, data.contact) for term, _ in self.terms]
+        residual = np.concatenate([np.zeros(0), *data.residuals])
+        data.cost = 0.5 * float(residual @ (self._weights * residual))
 
     def calcDiff(self, data, x, u=None):
         q, v, u = self._split(x, u)
-        nv = self.uvms.nv
+        model, pdata, nv = self.uvms.model, data.pinocchio, self.uvms.nv
+        contact, tau_ext = None, None
+        if self.contact is not None:
+            # also the WORLD joint Jacobians in pdata, as computeJointJacobians leaves them
+            state, contact = contact_derivatives(self.contact, model, pdata, q, v, self._supports)
+            tau_ext = state.tau_ext
+        else:
+            pin.computeJointJacobians(model, pdata, q)
         da_dq, da_dv, da_dtau = forward_dynamics_derivatives(
-            self.uvms, q, v, self.input_matrix @ u, **self.water
+            self.uvms, q, v, self.input_matrix @ u, tau_ext=tau_ext, **self.water
         )
+        if contact is not None:
+            da_dq += da_dtau @ contact.tau_dq
+            da_dv += da_dtau @ contact.tau_dv
         data.Fx[:, :nv], data.Fx[:, nv:] = da_dq, da_dv
         data.Fu[:, :] = da_dtau @ self.input_matrix
-        self._cost_derivatives(data, x, u)
+        self._cost_derivatives(data, x, u, contact)
 
-    def _cost_derivatives(self, data, x, u) -> None:
-        """Gauss-Newton: l_x = R_x^T W r, l_xx = R_x^T W R_x (likewise u, xu), summed."""
+    def _cost_derivatives(self, data, x, u, contact) -> None:
+        """Gauss-Newton: l_x = R_x^T W r, l_xx = R_x^T W R_x (likewise u, xu), summed (the
+        joint Jacobians at q already in the node's Pinocchio data): the terms' rows stacked,
+        R = [R_x R_u] (nr, nx + nu), so that the sums are two products."""
         model, pdata = self.uvms.model, data.pinocchio
-        pin.computeJointJacobians(model, pdata, x[: model.nq])
-        nx, nu = 2 * model.nv, self.nu
-        lx, lu = np.zeros(nx), np.zeros(nu)
-        lxx, luu, lxu = np.zeros((nx, nx)), np.zeros((nu, nu)), np.zeros((nx, nu))
-        for (term, scale), r in zip(self.terms, data.residuals, strict=True):
-            rx, ru = term.jacobians(model, pdata, x, u)
-            w = scale * term.weights
-            lx += rx.T @ (w * r)
-            lu += ru.T @ (w * r)
-            lxx += rx.T @ (w[:, None] * rx)
-            luu += ru.T @ (w[:, None] * ru)
-            lxu += rx.T @ (w[:, None] * ru)
-        data.Lx[:], data.Lu[:] = lx, lu
-        data.Lxx[:, :], data.Luu[:, :], data.Lxu[:, :] = lxx, luu, lxu
+        nx = 2 * model.nv
+        stacked = np.empty((self.nr, nx + self.nu))
+        row = 0
+        for term, _ in self.terms:
+            rx, ru = term.jacobians(model, pdata, x, u, contact)
+            stacked[row : row + term.nr, :nx], stacked[row : row + term.nr, nx:] = rx, ru
+            row += term.nr
+        weighted = self._weights[:, None] * stacked
+        gradient = weighted.T @ np.concatenate([np.zeros(0), *data.residuals])
+        hessian = stacked.T @ weighted
+        data.Lx[:], data.Lu[:] = gradient[:nx], gradient[nx:]
+        data.Lxx[:, :], data.Luu[:, :] = hessian[:nx, :nx], hessian[nx:, nx:]
+        data.Lxu[:, :] = hessian[:nx, nx:]
 
     def createData(self):
         return UnderwaterActionData(self)
@@ -128,3 +168,4 @@ class UnderwaterActionData(crocoddyl.DifferentialActionDataAbstract):
         crocoddyl.DifferentialActionDataAbstract.__init__(self, model)
         self.pinocchio = model.uvms.model.createData()
         self.residuals: list[np.ndarray] = []
+        self.contact = None  # the last calc's ContactWrench (None without a contact)

@@ -4,12 +4,15 @@ A problem has N nodes of dt_s each: every running node is the `UnderwaterActionM
 integrated by crocoddyl's Euler (v+ = v + dt a, q+ = q (+) dt v+: the plant's semi-implicit
 Euler with a step of dt_s), the flow frozen at the node's time; the terminal node carries the
 terminal costs. `point_to_point` moves the end-effector to a pose, `station_hold` keeps the
-vehicle at a pose (e.g. in a current); `solve` runs box-constrained FDDP (the thrust and
+vehicle at a pose (e.g. in a current), `force_tracking` presses the end-effector on a
+compliant environment (the contact in every node's dynamics) to track a desired force while
+holding its attitude; `solve` runs box-constrained FDDP (the thrust and
 effort limits as bounds) from a warm start or the initial state held.
 """
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable
 from dataclasses import dataclass
 
@@ -22,6 +25,7 @@ from uvms_pin.model.uvms import UVMS
 from uvms_pin.ocp import costs
 from uvms_pin.ocp.crocoddyl_module import crocoddyl_module
 from uvms_pin.ocp.model import UnderwaterActionModel, WeightedTerms
+from uvms_pin.physics.derivatives.task_contact import TaskContact
 
 crocoddyl = crocoddyl_module()
 
@@ -53,8 +57,13 @@ def shooting_problem(
     flow: FlowField | None = None,
     time_s: float = 0.0,
     backend: str = "core",
+    contact: TaskContact | None = None,
+    per_node: bool = False,
 ):
-    """A crocoddyl.ShootingProblem from x0 over ``nodes`` steps of ``dt_s`` [s]."""
+    """A crocoddyl.ShootingProblem from x0 over ``nodes`` steps of ``dt_s`` [s], each node's
+    dynamics with ``contact`` (None: none). The running nodes share one model in a steady
+    flow unless ``per_node`` (each its own terms: ``running`` is called once per node, in
+    order, e.g. for a cost whose target moves along the horizon)."""
     if nodes < 1 or not (dt_s > 0.0 and np.isfinite(dt_s)):
         raise ParameterError(f"need nodes >= 1 and dt_s > 0, got {nodes}, {dt_s}")
     nu = actuators.nu(uvms.nv)
@@ -68,10 +77,12 @@ def shooting_problem(
             time_s=t,
             u_bounds=actuators.bounds,
             backend=backend,
+            contact=contact,
         )
 
     # a steady flow: one model shared by the running nodes (each has its own data)
-    shared = node(running, time_s) if flow is None or isinstance(flow, UniformCurrent) else None
+    steady = flow is None or isinstance(flow, UniformCurrent)
+    shared = node(running, time_s) if steady and not per_node else None
     models = [
         crocoddyl.IntegratedActionModelEuler(
             shared if shared is not None else node(running, time_s + k * dt_s), dt_s
@@ -179,15 +190,119 @@ def station_hold(
     )
 
 
-def solve(problem, *, iterations: int = 100, warm_start=None, bounded: bool = True):
-    """Solve ``problem`` by crocoddyl's SolverBoxFDDP (bounded) or SolverFDDP; warm start:
-    (xs, us), else the initial state held with zero input. Returns the solver (``xs``,
-    ``us``, ``cost``, ``iter``, ``isFeasible``)."""
-    solver = crocoddyl.SolverBoxFDDP(problem) if bounded else crocoddyl.SolverFDDP(problem)
+@dataclass
+class ForceTracking:
+    """A force-tracking shooting problem and its contact-force terms, one per node (running
+    nodes, then the terminal one) at ``offsets_s`` from the plan's start: `retarget` moves
+    the desired force along the horizon (a receding horizon re-plans from a later time)."""
+
+    problem: object  # crocoddyl.ShootingProblem
+    forces: list[costs.ContactForce]
+    offsets_s: list[float]
+
+    def retarget(self, desired_force: Callable[[float], np.ndarray], time_s: float) -> None:
+        """Each node's f_d = desired_force(time_s + its offset) [N, world axes]."""
+        for term, offset in zip(self.forces, self.offsets_s, strict=True):
+            term.target_N = np.asarray(desired_force(time_s + offset), dtype=float)
+
+
+def force_tracking(
+    uvms: UVMS,
+    x0: np.ndarray,
+    contact: TaskContact,
+    desired_force: Callable[[float], np.ndarray],
+    rotation: np.ndarray,
+    *,
+    horizon_s: float = 1.0,
+    dt_s: float = 0.02,
+    actuators: Actuators = Actuators(),
+    flow: FlowField | None = None,
+    time_s: float = 0.0,
+    force_weights=(100.0, 100.0, 100.0),
+    attitude_weights=(100.0, 100.0, 100.0),
+    posture_weight: float = 1.0,
+    velocity_weight: float = 0.1,
+    effort_weight: float = 1e-4,
+    limit_margin_rad: float = 0.1,
+    limit_weight: float = 1e3,
+    backend: str = "core",
+) -> ForceTracking:
+    """Press on ``contact`` with the desired force f_d(t) [N] while holding the end-effector's
+    attitude at ``rotation`` (world <- end-effector), the arm near its posture in x0.
+
+    Per node at time t_k: (1/2)||f - f_d(t_k)||^2_Wf + (1/2)||log3(R_d^T R_ee)||^2_Wo +
+    posture_weight (1/2)||arm (-) arm_0||^2 + velocity_weight (1/2)||v||^2 +
+    effort_weight (1/2)||u||^2 + limit_weight (1/2)||arm past its limits less
+    limit_margin_rad||^2; the terminal node the same without the effort. The vehicle's
+    position is free (it moves to make the force); f the contact's force on the environment
+    in every node's dynamics (`uvms_pin.physics.derivatives.task_contact`)."""
+    x0 = np.asarray(x0, float)
+    nodes = _nodes(horizon_s, dt_s)
+    hold = np.r_[
+        np.zeros(6), np.full(uvms.nv - 6, posture_weight), np.full(uvms.nv, velocity_weight)
+    ]
+    offsets = [k * dt_s for k in range(nodes + 1)]
+    forces = [
+        costs.ContactForce(desired_force(time_s + offset), force_weights) for offset in offsets
+    ]
+    pending = iter(forces)
+
+    def terms(effort: float):
+        def build(nu: int):
+            out = [
+                (next(pending), 1.0),
+                (costs.end_effector_attitude(uvms, rotation, attitude_weights), 1.0),
+                (costs.StateDeviation(uvms.model, x0, hold), 1.0),
+                (costs.JointLimitMargin(uvms.model, limit_margin_rad, limit_weight), 1.0),
+            ]
+            return out + ([(costs.Effort(np.ones(nu)), effort)] if effort > 0.0 else [])
+
+        return build
+
+    problem = shooting_problem(
+        uvms,
+        x0,
+        terms(effort_weight),
+        terms(0.0),
+        nodes=nodes,
+        dt_s=dt_s,
+        actuators=actuators,
+        flow=flow,
+        time_s=time_s,
+        backend=backend,
+        contact=contact,
+        per_node=True,
+    )
+    return ForceTracking(problem, forces, offsets)
+
+
+def solver_of(problem, bounded: bool = True):
+    """crocoddyl's SolverBoxFDDP (bounded: the input bounds enforced) or SolverFDDP for
+    ``problem``."""
+    return crocoddyl.SolverBoxFDDP(problem) if bounded else crocoddyl.SolverFDDP(problem)
+
+
+def solve(
+    problem,
+    *,
+    iterations: int = 100,
+    warm_start=None,
+    bounded: bool = True,
+    solver=None,
+    regularization: float | None = None,
+):
+    """Solve ``problem`` by crocoddyl's SolverBoxFDDP (bounded) or SolverFDDP (or by
+    ``solver``, one of `solver_of` kept between solves); warm start: (xs, us), else the
+    initial state held with zero input; ``regularization``: the initial one (e.g. the last
+    solve's ``preg``: a receding horizon keeps what the previous plans learnt of the
+    problem's curvature), None: crocoddyl's smallest. Returns the solver (``xs``, ``us``,
+    ``cost``, ``iter``, ``isFeasible``, ``preg``)."""
+    solver = solver_of(problem, bounded) if solver is None else solver
     if warm_start is None:
         xs = [problem.x0] * (problem.T + 1)
         us = [np.zeros(m.nu) for m in problem.runningModels]
     else:
         xs, us = warm_start
-    solver.solve(list(xs), list(us), iterations, False)
+    initial = math.nan if regularization is None else float(regularization)
+    solver.solve(list(xs), list(us), iterations, False, initial)
     return solver

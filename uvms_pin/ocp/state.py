@@ -44,12 +44,12 @@ class UvmsState(crocoddyl.StateAbstract):
 
     def diff(self, x0: np.ndarray, x1: np.ndarray) -> np.ndarray:
         (q0, v0), (q1, v1) = self._split(x0), self._split(x1)
-        return np.r_[pin.difference(self.model, q0, q1), v1 - v0]
+        return np.concatenate((pin.difference(self.model, q0, q1), v1 - v0))
 
     def integrate(self, x: np.ndarray, dx: np.ndarray) -> np.ndarray:
         q, v = self._split(x)
         nv = self.model.nv
-        return np.r_[pin.integrate(self.model, q, dx[:nv]), v + dx[nv:]]
+        return np.concatenate((pin.integrate(self.model, q, dx[:nv]), v + dx[nv:]))
 
     def _block(self, jq: np.ndarray, sign: float = 1.0) -> np.ndarray:
         nv = self.model.nv

@@ -75,6 +75,8 @@ def build_controller(
             error.user_traceback = exc.user_traceback  # the user's module or class raised
             raise error from exc
         return spec
+    if kind == "mpc":  # it may plan on the scenario's thrusters
+        return build_mpc(t, uvms, actuation or Unlimited())
     if kind not in CONTROLLERS:
         choices = ", ".join([*CONTROLLERS, *TRACKING_CONTROLLERS])
         raise t.error(

@@ -15,14 +15,15 @@ def test_compare_controllers_short_run(tmp_path):
     out = tmp_path / "cmp"
     result = run_cli(
         [
-            "compare-controllers", str(REALISTIC), "--controllers", "ppc,pi_force,computed_torque",
+            "compare-controllers", str(REALISTIC), "--controllers", "ppc,pi_force,computed_torque,mpc",
             "--set", "scenario.duration_s=0.1", "--out", str(out), "--quiet",
         ],
         tmp_path,
     )  # fmt: skip
     assert result.returncode == 0, result.stderr
     rows = list(csv.DictReader((out / "controllers.csv").open()))
-    assert [r["controller"] for r in rows] == ["ppc", "pi_force", "computed_torque"]
+    # mpc: the realistic scenario's [baselines.mpc] (crocoddyl is in the dev extra)
+    assert [r["controller"] for r in rows] == ["ppc", "pi_force", "computed_torque", "mpc"]
     for row in rows:
         assert math.isfinite(float(row["force_error_rms_N"]))
         assert row["success"] in ("True", "False")
@@ -47,6 +48,8 @@ def test_compare_controllers_short_run(tmp_path):
         (["--controllers", "ppc,ppc"], "twice"),
         (["--set", "baselines.pi_force.damping=-1"], "damping"),
         (["--after", "100"], "--after"),
+        (["--controllers", "ppc,mpc", "--set", "baselines.mpc.horizon_s=0.01"], "horizon_s"),
+        (["--controllers", "mpc", "--set", "baselines.mpc.task='dance'"], "task"),
     ],
 )
 def test_compare_controllers_bad_input(tmp_path, args, message):
