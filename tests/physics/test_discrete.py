@@ -126,15 +126,27 @@ def test_rk4_period_of_every_shipped_model_matches_the_plant(name):
     assert_rk4_period_matches_the_plant(uvms, "waves", np.random.default_rng(42), backend="core")
 
 
-def test_rk4_period_on_the_compiled_derivatives_is_the_reference(reference_uvms):
-    """backend="core" (the compiled per-stage derivatives) gives the reference's Jacobians."""
-    q, v, tau = random_state(reference_uvms, np.random.default_rng(43))
-    kw = {"integrator": RK4(step_s=STEP_S), "time_s": T0_S, "flow": WAVES}
-    python = up.step_derivatives(reference_uvms, q, v, tau, PERIOD_S, backend="python", **kw)
-    core = up.step_derivatives(reference_uvms, q, v, tau, PERIOD_S, backend="core", **kw)
+@pytest.mark.parametrize("method", ["rk4", "semi_implicit_euler"])
+@pytest.mark.parametrize("ball", [False, True], ids=["revolute", "ball"])
+def test_the_compiled_period_is_the_reference(reference_uvms, method, ball):
+    """backend="core" (the whole period in one compiled call, step_derivatives.hpp) gives
+    the reference's end state and Jacobians, in waves, with a held tau_ext."""
+    uvms = with_spherical_joint(reference_uvms, 3) if ball else reference_uvms
+    rng = np.random.default_rng(43)
+    q, v, tau = random_state(uvms, rng)
+    kw = {
+        "integrator": method,
+        "step_s": STEP_S,
+        "time_s": T0_S,
+        "flow": WAVES,
+        "tau_ext": rng.normal(size=uvms.nv),
+    }
+    python = up.step_derivatives(uvms, q, v, tau, PERIOD_S, backend="python", **kw)
+    core = up.step_derivatives(uvms, q, v, tau, PERIOD_S, backend="core", **kw)
     for name in ("q", "v", "dx_dx", "dx_dtau"):
         got, expected = getattr(core, name), getattr(python, name)
-        assert np.max(np.abs(got - expected)) <= 1e-10 * max(1.0, np.max(np.abs(expected)))
+        error = np.max(np.abs(got - expected)) / max(1.0, np.max(np.abs(expected)))
+        assert error < 1e-10, f"{name}: {error}"
 
 
 def test_the_integrator_is_named_or_given(reference_uvms):

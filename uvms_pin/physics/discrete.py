@@ -16,13 +16,23 @@ from uvms_pin.checks import finite_vector
 from uvms_pin.errors import ParameterError
 from uvms_pin.flow import FlowField
 from uvms_pin.model.uvms import UVMS
+from uvms_pin.physics.compiled.backend import Fallback
+from uvms_pin.physics.compiled.dynamics import CompiledDynamics
 from uvms_pin.physics.derivatives.step import (
+    METHODS,
     FixedStepIntegrator,
     StepDerivatives,
     input_matrix,
     step_derivatives_of,
+    substeps,
 )
-from uvms_pin.physics.dynamics import forward_dynamics, forward_dynamics_derivatives
+from uvms_pin.physics.dynamics import (
+    _flow_of_call,
+    dynamics_of,
+    forward_dynamics,
+    forward_dynamics_derivatives,
+)
+from uvms_pin.physics.reference import check_time
 
 __all__ = ["StepDerivatives", "input_matrix", "step_derivatives"]
 
@@ -51,6 +61,11 @@ def step_derivatives(
     `SemiImplicitEuler` (its own step_s; then no ``step_s``). The other arguments are those
     of `forward_dynamics_derivatives` (the flow is evaluated at each stage's time;
     ``free_surface`` needs every body deep at every stage).
+
+    With ``backend="core"`` the whole period is one compiled call
+    (src/uvms_core/step_derivatives.hpp), except with ``free_surface`` (each stage is then
+    checked deep from Python, on the compiled stage derivatives) or in a flow the core has no
+    counterpart of (the Python loop, on the reference, with a warning).
     """
     if isinstance(integrator, str):
         method, step_s = integrator, 1e-3 if step_s is None else step_s
@@ -58,8 +73,20 @@ def step_derivatives(
         raise ParameterError("give step_s or an integrator object (with its step_s), not both")
     else:
         method, step_s = integrator.core_method, integrator.step_s
+    if method not in METHODS:
+        raise ParameterError(f"integrator must be one of {METHODS}, got '{method}'")
+    substeps(period_s, step_s)  # checks both
     q, v = finite_vector("q", q, uvms.nq), finite_vector("v", v, uvms.nv)
     tau = finite_vector("tau", tau, uvms.nv)
+    dynamics = dynamics_of(uvms, backend)
+    if isinstance(dynamics, CompiledDynamics) and not free_surface:
+        water = _flow_of_call(np.zeros(3) if current_world is None else current_world, flow)
+        ext = None if tau_ext is None else finite_vector("tau_ext", tau_ext, uvms.nv)
+        out = dynamics.step_derivatives(
+            q, v, tau, water, check_time(time_s), ext, float(period_s), step_s, method
+        )
+        if not isinstance(out, Fallback):
+            return StepDerivatives(q=out.q, v=out.v, dx_dx=out.dx_dx, dx_dtau=out.dx_dtau)
     common = {
         "current_world": np.zeros(3) if current_world is None else current_world,
         "flow": flow,

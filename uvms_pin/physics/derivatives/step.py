@@ -115,6 +115,9 @@ def euler_substep(
     return pin.integrate(model, q, w), v_next, np.vstack([dq_next, dv_next])
 
 
+#: the integrators differentiated (their names in `uvms_pin.sim.integrators`' core_method)
+METHODS = ("semi_implicit_euler", "rk4")
+
 #: the classical Runge-Kutta tableau: stage times c_i, stage rows a_(i+1, i) = c_(i+1), weights
 _RK4_TIMES = (0.0, 0.5, 0.5, 1.0)
 _RK4_WEIGHTS = (1.0 / 6.0, 2.0 / 6.0, 2.0 / 6.0, 1.0 / 6.0)
@@ -190,7 +193,7 @@ def step_derivatives_of(
         def substep(t, q, v):
             return euler_substep(model, derivative, t, q, v, tau, h)
     else:
-        raise ParameterError(f"method must be 'semi_implicit_euler' or 'rk4', got '{method}'")
+        raise ParameterError(f"method must be one of {METHODS}, got '{method}'")
     state = np.eye(2 * nv)  # d(q_k, v_k)/d(q_0, v_0)
     forced = np.zeros((2 * nv, nv))  # d(q_k, v_k)/dtau
     for k in range(n):
