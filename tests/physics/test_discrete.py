@@ -149,6 +149,19 @@ def test_the_compiled_period_is_the_reference(reference_uvms, method, ball):
         assert error < 1e-10, f"{name}: {error}"
 
 
+def test_a_deep_period_under_a_free_surface_is_the_period_without_one(reference_uvms):
+    """free_surface=True runs the stages from Python (each checked deep) on the compiled
+    stage derivatives: deep, the same period as the compiled call without a surface."""
+    q, v, tau = random_state(reference_uvms, np.random.default_rng(45))
+    q[2] = -6.0
+    kw = {"integrator": RK4(step_s=STEP_S), "time_s": T0_S, "flow": WAVES}
+    surface = up.step_derivatives(reference_uvms, q, v, tau, PERIOD_S, free_surface=True, **kw)
+    deep = up.step_derivatives(reference_uvms, q, v, tau, PERIOD_S, **kw)
+    for name in ("q", "v", "dx_dx", "dx_dtau"):
+        got, expected = getattr(surface, name), getattr(deep, name)
+        assert np.max(np.abs(got - expected)) < 1e-10 * max(1.0, np.max(np.abs(expected)))
+
+
 def test_the_integrator_is_named_or_given(reference_uvms):
     """An integrator object is its method and its substep; Euler stays the default."""
     q, v, tau = random_state(reference_uvms, np.random.default_rng(44))
