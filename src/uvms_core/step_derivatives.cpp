@@ -142,10 +142,12 @@ StepDerivatives::StepDerivatives(const Dynamics& dynamics) : derivatives_(dynami
       se3_.push_back(joint.idx_v());
     } else if (kind == "JointModelSpherical") {
       so3_.push_back(joint.idx_v());
-    } else if (kind.rfind("JointModelComposite", 0) == 0 || kind.rfind("JointModelMimic", 0) == 0 ||
-               !(joint.nq() == joint.nv() || (joint.nq() == 2 && joint.nv() == 1))) {
-      throw InputError("the chart derivatives know free-flyer, spherical, revolute, prismatic "
-                       "and continuous joints; joint '" + model.names[j] + "' is " + kind);
+    } else if (unknown_chart_.empty() &&
+               (kind.rfind("JointModelComposite", 0) == 0 ||
+                kind.rfind("JointModelMimic", 0) == 0 ||
+                !(joint.nq() == joint.nv() || (joint.nq() == 2 && joint.nv() == 1)))) {
+      unknown_chart_ = "the chart derivatives know free-flyer, spherical, revolute, prismatic "
+                       "and continuous joints; joint '" + model.names[j] + "' is " + kind;
     }
   }
   const int nq = model.nq, nv = model.nv;
@@ -282,6 +284,9 @@ const StepJacobians& StepDerivatives::period(const ConstVec& q, const ConstVec& 
   tau_ext_ = tau_ext;
   q_ = q;
   v_ = v;
+  if (integrator.method == Method::rk4 && !unknown_chart_.empty()) {
+    throw InputError(unknown_chart_);
+  }
   const auto [n, h] = substeps(0.0, period_s, integrator.step_s);
   out_.dx_dx.setIdentity(2 * nv, 2 * nv);  // d(q_k, v_k)/d(q_0, v_0)
   out_.dx_dtau.setZero(2 * nv, nv);        // d(q_k, v_k)/dtau

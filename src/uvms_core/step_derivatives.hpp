@@ -16,6 +16,7 @@
 // A StepDerivatives owns a Derivatives (its own copy of the dynamics): not thread-safe.
 #pragma once
 
+#include <string>
 #include <vector>
 
 #include "derivatives.hpp"
@@ -60,6 +61,7 @@ class StepDerivatives {
 
   Derivatives derivatives_;
   std::vector<int> se3_, so3_;  // velocity offsets of the free flyers and spherical joints
+  std::string unknown_chart_;   // why RK4 is refused (a joint of another kind), or empty
   // the call's held inputs
   const ConstVec* tau_ = nullptr;
   const FlowField* flow_ = nullptr;
