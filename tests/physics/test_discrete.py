@@ -26,7 +26,7 @@ from uvms_pin.sim.integrators import RK4, SemiImplicitEuler
 from uvms_pin.sim.plant import Plant
 
 #: relative agreement of the period's Jacobians with the finite differences of the plant
-FD_REL = 1e-6
+FD_REL = 1e-7
 STEP = 1e-5
 PERIOD_S, STEP_S, T0_S = 0.02, 0.01, 0.4  # two RK4 substeps per period
 
