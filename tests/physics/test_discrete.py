@@ -19,8 +19,8 @@ import pytest
 from conftest import central_difference, mount_on_reference_vehicle, with_spherical_joint
 
 import uvms_pin as up
-from uvms_pin.errors import ParameterError
-from uvms_pin.flow import AiryWave, UniformCurrent
+from uvms_pin.errors import CoreFallbackWarning, ParameterError
+from uvms_pin.flow import AiryWave, DepthProfileCurrent, UniformCurrent
 from uvms_pin.model.resources import shipped_models, shipped_path
 from uvms_pin.sim.integrators import RK4, SemiImplicitEuler
 from uvms_pin.sim.plant import Plant
@@ -160,6 +160,17 @@ def test_a_deep_period_under_a_free_surface_is_the_period_without_one(reference_
     for name in ("q", "v", "dx_dx", "dx_dtau"):
         got, expected = getattr(surface, name), getattr(deep, name)
         assert np.max(np.abs(got - expected)) < 1e-10 * max(1.0, np.max(np.abs(expected)))
+
+
+def test_a_flow_without_core_counterpart_runs_the_period_from_python(reference_uvms):
+    """A sheared current (no core counterpart): the Python loop on the reference, warned."""
+    q, v, tau = random_state(reference_uvms, np.random.default_rng(46))
+    sheared = DepthProfileCurrent([0.4, 0.1, 0.05], [0.0, 10.0], [1.0, 0.2])
+    kw = {"integrator": "rk4", "step_s": STEP_S, "time_s": T0_S, "flow": sheared}
+    with pytest.warns(CoreFallbackWarning):
+        core = up.step_derivatives(reference_uvms, q, v, tau, PERIOD_S, **kw)
+    python = up.step_derivatives(reference_uvms, q, v, tau, PERIOD_S, backend="python", **kw)
+    np.testing.assert_allclose(core.dx_dx, python.dx_dx, rtol=0, atol=1e-12)
 
 
 def test_the_integrator_is_named_or_given(reference_uvms):
