@@ -16,6 +16,8 @@ measured in this process (`timing.py`, one BLAS thread) divided by one rigid-bod
   discrete-transition Jacobians by finite differences, Euler and implicitfast, centred.
   MuJoCo's fluid model has no added-mass acceleration term: the job differs, the cost is
   what a MuJoCo user pays for the Jacobians of one step.
+- the Jacobians of one 20 ms control period of the plant's RK4 (two substeps, eight
+  stages: ``up.step_derivatives(..., integrator="rk4")``), compiled and Python reference.
 
 A second table times one re-plan of the MPC controller (`uvms_pin.control.mpc`, station
 keeping in the current with the BlueROV2 Heavy's eight bounded thrusters, a 1 s horizon of
@@ -105,6 +107,14 @@ def cases_of(system) -> dict[str, object]:
             uvms, q, v, tau
         ),
     }
+    # one 20 ms control period of the plant's RK4 (two 10 ms substeps, 8 stages), tau held
+    period = {"integrator": "rk4", "step_s": 0.01, "current_world": CURRENT_WORLD_M_S}
+    cases["core step_derivatives, RK4 period (2 x 10 ms)"] = lambda: up.step_derivatives(
+        uvms, q, v, tau, 0.02, **period
+    )
+    cases["python step_derivatives, RK4 period (2 x 10 ms)"] = lambda: up.step_derivatives(
+        uvms, q, v, tau, 0.02, backend="python", **period
+    )
     for name, integrator in (
         ("Euler", mujoco.mjtIntegrator.mjINT_EULER),
         ("implicitfast", mujoco.mjtIntegrator.mjINT_IMPLICITFAST),

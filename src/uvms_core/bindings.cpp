@@ -23,6 +23,7 @@ namespace nb = nanobind;
 using namespace nb::literals;
 
 void bind_sampled_loop(nb::module_& m);  // loop_bindings.cpp
+void bind_step_derivatives(nb::module_& m);  // step_bindings.cpp
 
 namespace {
 
@@ -521,6 +522,7 @@ NB_MODULE(_core, m) {
   bind_flow(m);
   bind_dynamics(m);
   bind_derivatives(m);
+  bind_step_derivatives(m);
   bind_environment(m);
   bind_world(m);
   bind_plant(m);

@@ -65,6 +65,7 @@ class CompiledDynamics:
         self._reference = reference
         self._flow: tuple[FlowField | None, object] = (None, None)  # the last flow converted
         self._derivatives = None  # core.Derivatives, built on first use
+        self._step_derivatives = None  # core.StepDerivatives, built on first use
         # the calls in a uniform current: the C++ methods themselves (no Python in between)
         self.mass_matrix = self.core.mass_matrix
         self.bias_forces = self.core.bias_forces
@@ -143,3 +144,30 @@ class CompiledDynamics:
             q, v, tau, compiled, time_s, tau_ext, free_surface
         )
         return out.da_dq, out.da_dv, out.da_dtau
+
+    def step_derivatives(
+        self,
+        q: np.ndarray,
+        v: np.ndarray,
+        tau: np.ndarray,
+        flow: FlowField | None,
+        time_s: float,
+        tau_ext: np.ndarray | None,
+        period_s: float,
+        step_s: float,
+        method: str,
+    ):
+        """The core's `StepJacobians` of one period (src/uvms_core/step_derivatives.hpp) in
+        substeps of at most ``step_s`` of ``method`` ("rk4", "semi_implicit_euler"), or the
+        Fallback of a flow it has no counterpart of."""
+        core = core_module()
+        compiled = core.FlowField() if flow is None else self._flow_struct(flow)
+        if isinstance(compiled, Fallback):
+            return compiled
+        if self._step_derivatives is None:
+            self._step_derivatives = core.StepDerivatives(self.core)
+        integrator = core.FixedStep()
+        integrator.method, integrator.step_s = getattr(core.Method, method), float(step_s)
+        return self._step_derivatives.period(
+            q, v, tau, compiled, time_s, tau_ext, period_s, integrator
+        )
