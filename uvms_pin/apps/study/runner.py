@@ -404,19 +404,27 @@ def _run_on_forked_processes(todo, base, rollout_dir, tasks, finished, workers) 
         with _sigint_ignored_by_children():  # the first submit forks every worker
             for runs in _chunks(todo, batch_fn):
                 futures[pool.submit(_task, run_fn, batch_fn, base, runs, rollout_dir)] = runs
-        for future in as_completed(futures):
-            runs = futures[future]
-            try:
-                rows = future.result()
-            except Exception as exc:  # the task itself failed (e.g. its worker died)
-                rows = [error_row(run, exc) for run in runs]
-            finished(rows)
+        _collect(as_completed(futures), futures, finished)
     except BaseException:  # Ctrl-C: the workers (which ignore it) are stopped, not awaited
         pool.shutdown(wait=False, cancel_futures=True)
         for process in list((getattr(pool, "_processes", None) or {}).values()):
             process.terminate()
         raise
     pool.shutdown(wait=True)
+
+
+def _collect(completed, futures: dict, finished) -> None:
+    """Each task's rows to ``finished`` as its future completes (``completed``, in that
+    order; error rows when the task itself failed, e.g. its worker died)."""
+    for future in completed:
+        runs = futures[future]
+        try:
+            rows = future.result()
+        except Exception as exc:
+            rows = [error_row(run, exc) for run in runs]
+        finished(rows)
+        if hasattr(future, "release"):  # a Dask future: its result freed on the cluster now
+            future.release()
 
 
 def _run_on_dask(todo, base, rollout_dir, tasks, finished, workers, scheduler) -> None:
@@ -435,14 +443,7 @@ def _run_on_dask(todo, base, rollout_dir, tasks, finished, workers, scheduler) -
                 key=f"uvms-run-{runs[0].run_id}", pure=False,
             )  # fmt: skip
             futures[future] = runs
-        for future in as_completed(futures):
-            runs = futures[future]
-            try:
-                rows = future.result()
-            except Exception as exc:  # the task itself failed (e.g. its worker died)
-                rows = [error_row(run, exc) for run in runs]
-            finished(rows)
-            future.release()
+        _collect(as_completed(futures), futures, finished)
     finally:
         for future in futures:
             if not future.done():
