@@ -139,8 +139,17 @@ class ResultStore:
     def record(self, rows: dict[str, Any] | list[dict[str, Any]]) -> None:
         """Durably add one row, or the rows of one task together (a part file named after
         the first one's run id: one write for a task's runs)."""
+        import pyarrow as pa
+        import pyarrow.parquet as pq
+
         rows = [rows] if isinstance(rows, dict) else rows
-        _atomic_parquet(pd.DataFrame(rows), self.parts / f"{rows[0]['run_id']}.parquet")
+        # straight to Arrow: the table pandas would write (every row's columns in order of
+        # appearance, a missing value null), without its per-column conversion (a task's
+        # part is written while the workers run)
+        names = dict.fromkeys(name for row in rows for name in row)
+        columns = {name: [row.get(name) for row in rows] for name in names}
+        with atomic_path(self.parts / f"{rows[0]['run_id']}.parquet") as tmp:
+            pq.write_table(pa.Table.from_pydict(columns), tmp)
 
     def compact(self) -> pd.DataFrame:
         """Rewrite the table with every row, atomically; then drop the merged parts."""
