@@ -3,13 +3,16 @@
 from __future__ import annotations
 
 import re
+import time
 
 from _common import scratch, uvms_pin, write_result
 
 
 def produce(name: str, study: str, title: str) -> None:
     out = scratch(name)
+    start = time.perf_counter()
     uvms_pin("sweep", study, "--out", str(out), "--workers", "2", "--quiet")
+    sweep_s = time.perf_counter() - start  # the whole command: start-up, runs, table
     uvms_pin("report", str(out))
     report = (out / "report.md").read_text()
     # the summary only: figures are many and large; they stay in out/results/<name>/
@@ -18,6 +21,7 @@ def produce(name: str, study: str, title: str) -> None:
     report = re.sub(r"^# .*\n", "", report, count=1)
     body = (
         f"`uvms-pin sweep {study} --out out/results/{name} --workers 2` then "
-        f"`uvms-pin report out/results/{name}` (figures there):\n\n{report}"
+        f"`uvms-pin report out/results/{name}` (figures there). The sweep command took "
+        f"{sweep_s:.1f} s of wall time (start-up, runs on 2 workers, table).\n\n{report}"
     )
     write_result(name, title, f"python scripts/results/{name}.py", body)

@@ -54,22 +54,13 @@ void step(BatchPlant& b, const Commands& tau_commanded, const Mask& stepping) {
 }  // namespace
 
 void bind_batch_plant(nb::module_& m) {
-  nb::class_<uvms::BatchActuation>(m, "BatchActuation",
-                                   "Thrusters and joint limits of a batch (batch_plant.hpp).")
-      .def(nb::init<>())
-      .def_rw("limited", &uvms::BatchActuation::limited)
-      .def_rw("allocation", &uvms::BatchActuation::allocation)
-      .def_rw("allocation_pinv", &uvms::BatchActuation::allocation_pinv)
-      .def_rw("lower_N", &uvms::BatchActuation::lower_N)
-      .def_rw("upper_N", &uvms::BatchActuation::upper_N)
-      .def_rw("joint_limits_Nm", &uvms::BatchActuation::joint_limits_Nm);
   nb::class_<uvms::BatchNoise>(m, "BatchNoise", "Sensor-noise layout of a batch (batch_plant.hpp).")
       .def(nb::init<>())
       .def_rw("sample_period_s", &uvms::BatchNoise::sample_period_s)
       .def_rw("rows", &uvms::BatchNoise::rows)
       .def_rw("silent", &uvms::BatchNoise::silent);
   nb::class_<BatchPlant>(m, "BatchPlant", "N environments of one plant on T threads (batch_plant.hpp).")
-      .def(nb::init<const uvms::Plant&, const uvms::FixedStep&, double, uvms::BatchActuation,
+      .def(nb::init<const uvms::Plant&, const uvms::FixedStep&, double, uvms::Actuation,
                     uvms::BatchNoise, int, int>(),
            "prototype"_a, "integrator"_a, "control_period_s"_a, "actuation"_a, "noise"_a,
            "num_envs"_a, "num_threads"_a)

@@ -3,6 +3,7 @@
 #include <cmath>
 #include <exception>
 #include <string>
+#include <algorithm>
 #include <thread>
 
 #include <pinocchio/algorithm/joint-configuration.hpp>
@@ -13,41 +14,8 @@ namespace uvms {
 // (uvms_pin/sim/divergence.py, DIVERGED_SPEED).
 constexpr double kDivergedSpeed = 1e4;
 
-void BatchActuation::apply(const ConstVec& tau_commanded, Eigen::Ref<Eigen::VectorXd> out) const {
-  if (!limited) {
-    out = tau_commanded;
-    return;
-  }
-  const Eigen::VectorXd thrust =
-      (allocation_pinv * tau_commanded.head<6>()).cwiseMax(lower_N).cwiseMin(upper_N);
-  out.head<6>() = allocation * thrust;
-  const Eigen::Index nj = tau_commanded.size() - 6;
-  if (joint_limits_Nm.size() == 0) {
-    out.tail(nj) = tau_commanded.tail(nj);
-  } else {
-    out.tail(nj) = tau_commanded.tail(nj).cwiseMax(-joint_limits_Nm).cwiseMin(joint_limits_Nm);
-  }
-}
-
-namespace {
-
-void check_actuation(const BatchActuation& a, int nv) {
-  if (!a.limited) return;
-  const Eigen::Index m = a.allocation.cols();
-  if (a.allocation.rows() != 6 || m == 0 || a.allocation_pinv.rows() != m ||
-      a.allocation_pinv.cols() != 6 || a.lower_N.size() != m || a.upper_N.size() != m) {
-    throw InputError("batch actuation: B must be 6 x m, B^+ m x 6 and the limits m long");
-  }
-  if (a.joint_limits_Nm.size() != 0 && a.joint_limits_Nm.size() != nv - 6) {
-    throw InputError("batch actuation: " + std::to_string(a.joint_limits_Nm.size()) +
-                     " joint limits for " + std::to_string(nv - 6) + " arm joints");
-  }
-}
-
-}  // namespace
-
 BatchPlant::BatchPlant(const Plant& prototype, const FixedStep& integrator,
-                       double control_period_s, BatchActuation actuation, BatchNoise noise,
+                       double control_period_s, Actuation actuation, BatchNoise noise,
                        int num_envs, int num_threads)
     : num_envs_(num_envs),
       nq_(prototype.dynamics().nq()),
@@ -70,7 +38,7 @@ BatchPlant::BatchPlant(const Plant& prototype, const FixedStep& integrator,
   if (prototype.world_bounds.radii_m.size() != 0) {
     throw InputError("the batched plant has no world objects (they are integrated in Python)");
   }
-  check_actuation(actuation_, nv_);
+  actuation_.check(nv_);
   widths_ = {3, 3, 3, 3, nv_ - 6, nv_};
   state_noisy_ = false;
   for (int c = kPosition; c < kNoiseChannels; ++c) state_noisy_ |= !noise_.silent[c];
@@ -88,7 +56,8 @@ BatchPlant::BatchPlant(const Plant& prototype, const FixedStep& integrator,
     plant->joint_stops = prototype.joint_stops;
     plants_.push_back(std::move(plant));
     scratch_.push_back({Eigen::VectorXd::Zero(nv_), Eigen::VectorXd::Zero(nv_),
-                        Eigen::VectorXd::Zero(nv_), Eigen::VectorXd::Zero(nq_)});
+                        Eigen::VectorXd::Zero(nv_), Eigen::VectorXd::Zero(nq_),
+                        Eigen::VectorXd::Zero(actuation_.n_thrusters())});
   }
   contacts_.assign(num_envs, prototype.contact);
   q = RowMatrix::Zero(num_envs, nq_);
@@ -100,6 +69,14 @@ BatchPlant::BatchPlant(const Plant& prototype, const FixedStep& integrator,
   tau_applied = RowMatrix::Zero(num_envs, nv_);
   tick = Eigen::Matrix<long long, Eigen::Dynamic, 1>::Zero(num_envs);
   status = Eigen::Matrix<int, Eigen::Dynamic, 1>::Zero(num_envs);
+  errors_.assign(threads, nullptr);
+  // last (a started thread must be joined: no destructor runs if the constructor throws)
+  try {
+    for (int t = 1; t < threads; ++t) pool_.emplace_back([this, t] { serve(t); });
+  } catch (...) {
+    stop_pool();
+    throw;
+  }
 }
 
 void BatchPlant::reset(int i, const ConstVec& q0, const ConstVec& v0, const Contact& contact,
@@ -195,7 +172,7 @@ void BatchPlant::step_one(int thread, int i, const double* tau_commanded) {
   Plant& plant = *plants_[thread];
   Scratch& scratch = scratch_[thread];
   const Eigen::Map<const Eigen::VectorXd> command(tau_commanded + Eigen::Index(i) * nv_, nv_);
-  actuation_.apply(command, scratch.tau);
+  actuation_.apply(command, scratch.tau, scratch.thrust);
   tau_applied.row(i) = scratch.tau.transpose();
   plant.contact = contacts_[i];
   const double t0 = static_cast<double>(tick(i)) * period_s_;
@@ -218,38 +195,68 @@ void BatchPlant::step_one(int thread, int i, const double* tau_commanded) {
   measure(thread, i);
 }
 
-void BatchPlant::step_range(int thread, int begin, int end, const double* tau_commanded,
-                            const bool* stepping) {
-  for (int i = begin; i < end; ++i) {
-    if (stepping[i]) step_one(thread, i, tau_commanded);
+void BatchPlant::work(int thread) {
+  try {
+    for (int i = next_env_.fetch_add(1); i < num_envs_; i = next_env_.fetch_add(1)) {
+      if (round_stepping_[i]) step_one(thread, i, round_tau_);
+    }
+  } catch (...) {
+    errors_[thread] = std::current_exception();
+  }
+}
+
+void BatchPlant::serve(int thread) {
+  long long served = 0;
+  for (;;) {
+    {
+      std::unique_lock<std::mutex> lock(mutex_);
+      wake_.wait(lock, [&] { return quit_ || round_ != served; });
+      if (quit_) return;
+      served = round_;
+    }
+    work(thread);
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      if (--busy_ == 0) done_.notify_one();
+    }
   }
 }
 
 void BatchPlant::step(const double* tau_commanded, const bool* stepping) {
-  const int threads = num_threads();
-  // contiguous blocks: environment i always on the same thread for a given T (not that it
-  // matters: an environment's numbers do not depend on the thread)
-  std::vector<std::thread> workers;
-  std::vector<std::exception_ptr> errors(threads);
-  auto block = [&](int t) { return static_cast<int>((Eigen::Index(num_envs_) * t) / threads); };
-  for (int t = 1; t < threads; ++t) {
-    workers.emplace_back([&, t] {
-      try {
-        step_range(t, block(t), block(t + 1), tau_commanded, stepping);
-      } catch (...) {
-        errors[t] = std::current_exception();
-      }
-    });
+  // an environment's numbers do not depend on the thread that steps it (each thread has its
+  // own Plant, a copy of the prototype; the contact is the environment's own)
+  round_tau_ = tau_commanded;
+  round_stepping_ = stepping;
+  next_env_.store(0);
+  std::fill(errors_.begin(), errors_.end(), nullptr);
+  if (!pool_.empty()) {
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      busy_ = static_cast<int>(pool_.size());
+      ++round_;
+    }
+    wake_.notify_all();
   }
-  try {
-    step_range(0, block(0), block(1), tau_commanded, stepping);
-  } catch (...) {
-    errors[0] = std::current_exception();
+  work(0);
+  if (!pool_.empty()) {
+    std::unique_lock<std::mutex> lock(mutex_);
+    done_.wait(lock, [&] { return busy_ == 0; });
   }
-  for (auto& w : workers) w.join();
-  for (const auto& e : errors) {
+  for (const auto& e : errors_) {
     if (e) std::rethrow_exception(e);
   }
 }
+
+void BatchPlant::stop_pool() {
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    quit_ = true;
+  }
+  wake_.notify_all();
+  for (auto& t : pool_) t.join();
+  pool_.clear();
+}
+
+BatchPlant::~BatchPlant() { stop_pool(); }
 
 }  // namespace uvms

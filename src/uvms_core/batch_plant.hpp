@@ -1,7 +1,7 @@
 // N environments of one plant advanced together over a control period, on T threads
 // (mirror of one tick of uvms_pin/sim/closed_loop.py's sampled loop with the controller
 // replaced by a given command, as the Gymnasium environments step it):
-//   tau_applied = actuation(tau_commanded); (q, v) advanced over the period with it held;
+//   tau_applied = actuation(tau_commanded) (actuation.hpp); (q, v) advanced over the period with it held;
 //   lambda = the contact wrench at the new state; the measurement = state + sensor noise.
 // Each environment has its own state, contact anchor, sensor-noise tables (drawn from its
 // own seed by the caller at reset, uvms_pin/sim/sensors.py's streams) and status. Each
@@ -10,27 +10,20 @@
 // the results are the same for any T.
 #pragma once
 
+#include <atomic>
+#include <condition_variable>
+#include <exception>
 #include <memory>
+#include <mutex>
+#include <thread>
 #include <vector>
 
+#include "actuation.hpp"
 #include "plant.hpp"
 
 namespace uvms {
 
 using RowMatrix = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
-
-// Thrusters with ideal drives and joint effort limits (uvms_pin/sim/actuation.py,
-// ThrustersAndJointLimits), or none (Unlimited: the command applied as it is).
-struct BatchActuation {
-  bool limited = false;
-  Eigen::MatrixXd allocation;       // B (6 x m): body wrench of unit thrusts
-  Eigen::MatrixXd allocation_pinv;  // (m x 6): f = B_s^+ tau_s, zero columns for the others
-  Eigen::VectorXd lower_N, upper_N;  // thrust limits (m,)
-  Eigen::VectorXd joint_limits_Nm;   // |tau_j| limits (nj,), empty: unlimited
-
-  // out = B clip(B^+ tau[:6], lower, upper); the arm's torques clipped to their limits.
-  void apply(const ConstVec& tau_commanded, Eigen::Ref<Eigen::VectorXd> out) const;
-};
 
 // The six noise channels of uvms_pin/sim/sensors.py, in its stream order.
 enum NoiseChannel : int { kForce = 0, kTorque, kPosition, kOrientation, kJoints, kVelocity };
@@ -50,9 +43,10 @@ enum BatchStatus : int { kRunning = 0, kDiverged = 1 };
 class BatchPlant {
  public:
   BatchPlant(const Plant& prototype, const FixedStep& integrator, double control_period_s,
-             BatchActuation actuation, BatchNoise noise, int num_envs, int num_threads);
+             Actuation actuation, BatchNoise noise, int num_envs, int num_threads);
   BatchPlant(const BatchPlant&) = delete;
   BatchPlant& operator=(const BatchPlant&) = delete;
+  ~BatchPlant();
 
   int num_envs() const { return num_envs_; }
   int num_threads() const { return static_cast<int>(plants_.size()); }
@@ -73,8 +67,12 @@ class BatchPlant {
   Eigen::Matrix<int, Eigen::Dynamic, 1> status;     // BatchStatus
 
  private:
-  void step_range(int thread, int begin, int end, const double* tau_commanded,
-                  const bool* stepping);
+  // Thread `thread` steps the environments it takes from the shared counter until none is
+  // left (each takes the next one: the threads stay busy whatever each environment costs).
+  void work(int thread);
+  // The body of pool thread `thread` (1 .. T - 1): waits for a step, works, says it is done.
+  void serve(int thread);
+  void stop_pool();  // the pool threads told to quit and joined
   void step_one(int thread, int i, const double* tau_commanded);
   void measure(int thread, int i);
   // channel c's noise of environment i at time_s, into out (the channel's width)
@@ -83,7 +81,7 @@ class BatchPlant {
   int num_envs_, nq_, nv_;
   double period_s_;
   FixedStep integrator_;
-  BatchActuation actuation_;
+  Actuation actuation_;
   BatchNoise noise_;
   bool state_noisy_;
   std::vector<int> widths_;
@@ -91,9 +89,21 @@ class BatchPlant {
   std::vector<Contact> contacts_;
   std::vector<std::unique_ptr<Plant>> plants_;  // one per thread
   struct Scratch {
-    Eigen::VectorXd tau, dq, noise, q;
+    Eigen::VectorXd tau, dq, noise, q, thrust;
   };
   std::vector<Scratch> scratch_;  // per thread
+
+  // The pool: T - 1 threads started once (the calling thread is the T-th), woken per step.
+  std::vector<std::thread> pool_;
+  std::mutex mutex_;
+  std::condition_variable wake_, done_;
+  long long round_ = 0;  // steps started (a pool thread works once per round)
+  int busy_ = 0;         // pool threads still working on this round
+  bool quit_ = false;
+  std::atomic<int> next_env_{0};
+  const double* round_tau_ = nullptr;
+  const bool* round_stepping_ = nullptr;
+  std::vector<std::exception_ptr> errors_;  // per thread, of this round
 };
 
 }  // namespace uvms

@@ -27,20 +27,32 @@ Eigen::Map<Eigen::VectorXd> map(Out1& a) {
 }  // namespace
 
 void bind_sampled_loop(nb::module_& m) {
-  using uvms::LoopActuation;
+  using uvms::Actuation;
   using uvms::LoopSettings;
-  nb::class_<LoopActuation>(m, "LoopActuation", "The loop's actuation (sampled_loop.hpp).")
+  nb::class_<Actuation>(m, "Actuation",
+                        "Thrusters and joint limits, or none (actuation.hpp); the closed loop's "
+                        "and the batched plant's.")
       .def(nb::init<>())
-      .def_rw("thrusters", &LoopActuation::thrusters)
-      .def_rw("allocation", &LoopActuation::allocation)
-      .def_rw("allocation_pinv", &LoopActuation::allocation_pinv)
-      .def_rw("lower_N", &LoopActuation::lower_N)
-      .def_rw("upper_N", &LoopActuation::upper_N)
-      .def_rw("full_forward_N", &LoopActuation::full_forward_N)
-      .def_rw("full_reverse_N", &LoopActuation::full_reverse_N)
-      .def_rw("joint_limits_Nm", &LoopActuation::joint_limits_Nm)
-      .def_rw("residual", &LoopActuation::residual)
-      .def_rw("components", &LoopActuation::components);
+      .def_rw("thrusters", &Actuation::thrusters)
+      .def_rw("allocation", &Actuation::allocation)
+      .def_rw("allocation_pinv", &Actuation::allocation_pinv)
+      .def_rw("lower_N", &Actuation::lower_N)
+      .def_rw("upper_N", &Actuation::upper_N)
+      .def_rw("full_forward_N", &Actuation::full_forward_N)
+      .def_rw("full_reverse_N", &Actuation::full_reverse_N)
+      .def_rw("joint_limits_Nm", &Actuation::joint_limits_Nm)
+      .def_rw("residual", &Actuation::residual)
+      .def_rw("components", &Actuation::components)
+      .def(
+          "apply",
+          [](const Actuation& a, const Eigen::VectorXd& tau_commanded) {
+            a.check(static_cast<int>(tau_commanded.size()));
+            Eigen::VectorXd tau_applied(tau_commanded.size());
+            Eigen::VectorXd thrust = Eigen::VectorXd::Zero(a.n_thrusters());
+            a.apply(tau_commanded, tau_applied, thrust);
+            return nb::make_tuple(tau_applied, thrust);
+          },
+          "tau_commanded"_a, "(tau_applied, thrusts f): actuation.py's apply, ideal drives");
   nb::class_<LoopSettings>(m, "LoopSettings", "The loop's settings (sampled_loop.hpp).")
       .def(nb::init<>())
       .def_rw("integrator", &LoopSettings::integrator)
@@ -72,7 +84,7 @@ void bind_sampled_loop(nb::module_& m) {
   m.def(
       "run_sampled_chunk",
       [](uvms::Plant& plant, uvms::PrescribedPerformanceController& law,
-         const LoopActuation& actuation, const LoopSettings& settings, int first, int n_ticks,
+         const Actuation& actuation, const LoopSettings& settings, int first, int n_ticks,
          Out1 q, Out1 v, In2 noise, In2 desired, Out2 log, Out1 command, Out1 thrust,
          Out1 dropped_max) {
         const auto& model = plant.dynamics().model();

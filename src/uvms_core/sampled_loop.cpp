@@ -16,32 +16,6 @@ bool diverged(const Eigen::VectorXd& q, const Eigen::VectorXd& v) {
   return !q.allFinite() || !v.allFinite() || v.cwiseAbs().maxCoeff() > kDivergedSpeed;
 }
 
-// tau_a of tau_c (actuation.py: Unlimited.apply, ThrustersAndJointLimits.apply with ideal
-// drives); the thrusters' commands and thrusts into command, thrust; the largest part of an
-// allocated command no thrust can produce into dropped_max.
-void actuate(const LoopActuation& a, const Eigen::VectorXd& tau_commanded,
-             Eigen::VectorXd& tau_applied, Eigen::VectorXd& command, Eigen::VectorXd& thrust,
-             Eigen::VectorXd& dropped_max) {
-  tau_applied = tau_commanded;
-  if (!a.thrusters) return;
-  const Eigen::Index n_components = static_cast<Eigen::Index>(a.components.size());
-  if (a.residual.size() != 0) {
-    Eigen::VectorXd chosen(n_components);
-    for (Eigen::Index k = 0; k < n_components; ++k) chosen[k] = tau_commanded[a.components[k]];
-    dropped_max = dropped_max.cwiseMax((a.residual * chosen).cwiseAbs());
-  }
-  thrust = (a.allocation_pinv * tau_commanded.head<6>()).cwiseMax(a.lower_N).cwiseMin(a.upper_N);
-  for (Eigen::Index i = 0; i < thrust.size(); ++i) {
-    command[i] = thrust[i] / (thrust[i] >= 0.0 ? a.full_forward_N[i] : a.full_reverse_N[i]);
-  }
-  tau_applied.head<6>() = a.allocation * thrust;
-  if (a.joint_limits_Nm.size() != 0) {
-    const Eigen::Index nj = a.joint_limits_Nm.size();
-    tau_applied.tail(nj) =
-        tau_commanded.tail(nj).cwiseMax(-a.joint_limits_Nm).cwiseMin(a.joint_limits_Nm);
-  }
-}
-
 // The work of one tick, committed only when the whole tick succeeded.
 struct Tick {
   explicit Tick(int nq, int nv, int m)
@@ -69,7 +43,7 @@ LoopRow::LoopRow(int nq, int nv, int n_thrusters, int n_signals) {
 }
 
 ChunkOutcome run_sampled_chunk(Plant& plant, PrescribedPerformanceController& law,
-                               const LoopActuation& actuation, const LoopSettings& settings,
+                               const Actuation& actuation, const LoopSettings& settings,
                                int first, int n_ticks, Eigen::Ref<Eigen::VectorXd> q,
                                Eigen::Ref<Eigen::VectorXd> v, const double* noise,
                                const double* desired, double* log, LoopActuationState state) {
@@ -118,7 +92,9 @@ ChunkOutcome run_sampled_chunk(Plant& plant, PrescribedPerformanceController& la
     w.command = state.command;
     w.thrust = state.thrust;
     w.dropped = state.dropped_max;
-    actuate(actuation, w.tau_commanded, w.tau_applied, w.command, w.thrust, w.dropped);
+    actuation.track_dropped(w.tau_commanded, w.dropped);
+    actuation.apply(w.tau_commanded, w.tau_applied, w.thrust);
+    if (actuation.thrusters) actuation.commands(w.thrust, w.command);
     // ---- log (log.py, RolloutLog.on_sample): written now, counted once the tick commits
     const bool logged = tick % settings.ticks_per_log == 0;
     if (logged) {

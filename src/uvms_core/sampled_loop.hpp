@@ -6,7 +6,7 @@
 //             v_meas = v + n_v(t_k)   (sensors.py, SensorSuite.measure)
 //   command:  tau_c = PPC(t_k, measurement, f_d(t_k), rpy_d(t_k))       (ppc.hpp)
 //   actuate:  f = clip(B_s^+ tau_c[s], -f_rev, f_fwd), tau_a = [B f; clip(tau_c,arm, +-limits)]
-//             (actuation.py, ThrustersAndJointLimits with ideal drives; or tau_a = tau_c)
+//             (actuation.hpp: actuation.py, ThrustersAndJointLimits with ideal drives; or tau_a = tau_c)
 //   log:      every ticks_per_log-th tick, one packed row (see LoopRow)
 //   advance:  (q, v) over [t_k, t_k + T] with tau_a held                  (plant.hpp)
 // The noise samples n(t_k) and f_d, rpy_d come in as tables (drawn and evaluated by Python
@@ -20,23 +20,11 @@
 
 #include <vector>
 
+#include "actuation.hpp"
 #include "plant.hpp"
 #include "ppc.hpp"
 
 namespace uvms {
-
-// The actuation between the law and the plant (actuation.py): none (tau_a = tau_c), or
-// thrusters (allocation, saturation) with their ideal drives and the joints' effort limits.
-struct LoopActuation {
-  bool thrusters = false;
-  Eigen::MatrixXd allocation;       // B (6 x m), columns [d_i; r_i x d_i]
-  Eigen::MatrixXd allocation_pinv;  // (m x 6): B_s^+ with zero columns off the allocated ones
-  Eigen::VectorXd lower_N, upper_N;             // thrust limits (m): -max_reverse, max_forward
-  Eigen::VectorXd full_forward_N, full_reverse_N;  // the linear curve's u = f / these
-  Eigen::VectorXd joint_limits_Nm;              // |tau_j| limits (n_joints); empty: none
-  Eigen::MatrixXd residual;                     // I - B_s B_s^+ (c x c); empty: spanned
-  std::vector<int> components;                  // the allocated components s
-};
 
 // The loop's fixed settings for one run.
 struct LoopSettings {
@@ -74,7 +62,7 @@ struct ChunkOutcome {
 // committed tick. noise: n_ticks x noise_width(nv); desired: n_ticks x 6 [f_d (3); rpy_d (3)];
 // log: at least the logged ticks' rows, each LoopRow::width wide.
 ChunkOutcome run_sampled_chunk(Plant& plant, PrescribedPerformanceController& law,
-                               const LoopActuation& actuation, const LoopSettings& settings,
+                               const Actuation& actuation, const LoopSettings& settings,
                                int first, int n_ticks, Eigen::Ref<Eigen::VectorXd> q,
                                Eigen::Ref<Eigen::VectorXd> v, const double* noise,
                                const double* desired, double* log, LoopActuationState state);

@@ -9,6 +9,7 @@ one with `uvms_pin.model.urdf.load.load_uvms`.
 
 from __future__ import annotations
 
+import copy
 import dataclasses
 from collections.abc import Callable
 from dataclasses import dataclass, field
@@ -224,12 +225,22 @@ class UVMS:
         return q
 
     def copy(self) -> UVMS:
-        """An independent UVMS sharing the static parts but with its own work buffer."""
-        return dataclasses.replace(self)
+        """An independent UVMS sharing the static parts (the Pinocchio model, the bodies'
+        hydrodynamics and the arrays derived from them, all read-only) but with its own
+        work buffer and its own `cache` (the compiled dynamics are built again)."""
+        return self.with_model(self.model)
 
     def with_model(self, model: pin.Model) -> UVMS:
-        """The same hydrodynamics and frames on another (e.g. re-scaled) Pinocchio model."""
-        return dataclasses.replace(self, model=model)
+        """The same hydrodynamics and frames on another (e.g. re-scaled) Pinocchio model:
+        what is derived from the hydrodynamics is shared when ``model`` has the same joints
+        (it depends on nothing else), rebuilt otherwise."""
+        if model.njoints != self.model.njoints or list(model.names) != list(self.model.names):
+            return dataclasses.replace(self, model=model)
+        out = copy.copy(self)
+        out.model = model
+        out.data = model.createData()
+        out.cache = {}
+        return out
 
     def with_hydro(self, transform: Callable[[HydroBody], HydroParams]) -> UVMS:
         """A UVMS whose every body's params are replaced by ``transform(body)``."""

@@ -35,7 +35,7 @@ from uvms_pin.physics.derivatives.reference import (
     forward_dynamics_derivatives as reference_derivatives,
 )
 from uvms_pin.physics.reference import ReferenceDynamics, check_time
-from uvms_pin.physics.surface import wet_state
+from uvms_pin.physics.surface import WetState, wet_state
 
 _NO_CURRENT = np.zeros(3)
 
@@ -257,8 +257,18 @@ def potential_energy(
     q = finite_vector("q", q, uvms.nq)
     model, data = uvms.model, uvms.data
     pin.forwardKinematics(model, data, q)
-    energy = float(pin.computePotentialEnergy(model, data, q))
     wet = wet_state(uvms, data, _checked_flow(flow), check_time(time_s)) if free_surface else None
+    return potential_energy_placed(uvms, data, q, wet)
+
+
+def potential_energy_placed(
+    uvms: UVMS, data: pin.Data, q: np.ndarray, wet: WetState | None
+) -> float:
+    """`potential_energy` at ``q`` once the forward kinematics are in ``data`` and the wet
+    state is known (``wet``: `wet_state` there, None deep or without a free surface): a log
+    that also records the wet fractions computes them once."""
+    model = uvms.model
+    energy = float(pin.computePotentialEnergy(model, data, q))
     volumes = uvms.volume_per_joint_m3 if wet is None else wet.volume_per_joint_m3
     cobs = (
         uvms.center_of_buoyancy_per_joint_m if wet is None else wet.center_of_buoyancy_per_joint_m

@@ -25,7 +25,7 @@ from typing import Any
 
 from uvms_pin.errors import ParameterError, PlausibilityWarning, ScenarioError, UvmsPinError
 from uvms_pin.model.resources import resolve_model
-from uvms_pin.model.urdf.load import load_uvms
+from uvms_pin.model.urdf.loaded import loaded_uvms
 from uvms_pin.model.uvms import UVMS
 from uvms_pin.scenario.actuation import build_actuation
 from uvms_pin.scenario.baselines import check_baselines
@@ -186,4 +186,5 @@ def _model(head: Head, water: Water, path: Path, scenario: Table) -> UVMS:
         raise scenario.error("model", str(exc)) from None
     with warnings.catch_warnings():  # the density was judged as [water] density_kg_m3
         warnings.simplefilter("ignore", PlausibilityWarning)
-        return load_uvms(model_path, water_density_kg_m3=water.density_kg_m3)
+        # parsed once per process (a study loads the same model for every run)
+        return loaded_uvms(model_path, water_density_kg_m3=water.density_kg_m3)

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import copy
+import functools
 import tomllib
 from pathlib import Path
 from typing import Any
@@ -32,6 +34,12 @@ def read_toml(path: Path, error: type[UvmsPinError], source: str | None = None) 
             "TOML files must be saved as UTF-8"
         ) from exc
     try:
-        return tomllib.loads(text)
+        return copy.deepcopy(_parsed(text))  # the caller's own: it may change it
     except tomllib.TOMLDecodeError as exc:
         raise error(f"{source}: not valid TOML ({exc})") from exc
+
+
+@functools.lru_cache(maxsize=32)
+def _parsed(text: str) -> dict[str, Any]:
+    """``text`` parsed, once per process (a study reads its base scenario for every run)."""
+    return tomllib.loads(text)

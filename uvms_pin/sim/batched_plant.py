@@ -30,7 +30,8 @@ import pinocchio as pin
 from uvms_pin.errors import ParameterError
 from uvms_pin.physics.compiled.backend import Fallback, backend_named
 from uvms_pin.physics.compiled.contact import contact_to_core
-from uvms_pin.sim.actuation import Actuation, ThrustersAndJointLimits, Unlimited
+from uvms_pin.sim.actuation import ThrustersAndJointLimits, Unlimited
+from uvms_pin.sim.compiled_actuation import actuation_to_core
 from uvms_pin.sim.plant import Plant, checked_start
 from uvms_pin.sim.sensors import SensorConfig
 from uvms_pin.sim.settings import SimulationSettings
@@ -61,18 +62,6 @@ def _unsupported(plant: Plant, sensors: SensorConfig) -> str | None:
          "thruster drives with lag or rate limits"),
     )  # fmt: skip
     return next((what for bad, what in checks if bad), None)
-
-
-def _actuation_to_core(actuation: Actuation, core: ModuleType):
-    out = core.BatchActuation()
-    if isinstance(actuation, ThrustersAndJointLimits):
-        out.limited = True
-        out.allocation = actuation.allocation
-        out.allocation_pinv = actuation._allocation_pinv
-        out.lower_N, out.upper_N = actuation._lower, actuation._upper
-        if actuation.joint_effort_limits_Nm is not None:
-            out.joint_limits_Nm = actuation.joint_effort_limits_Nm
-    return out
 
 
 def _noise_specs(sensors: SensorConfig) -> tuple:
@@ -141,7 +130,7 @@ class BatchedPlant:
         noise.rows = self._rows
         noise.silent = [int(spec.bound == 0.0) for spec in self._specs]
         return core.BatchPlant(
-            prototype, integrator, self.period_s, _actuation_to_core(plant.actuation, core),
+            prototype, integrator, self.period_s, actuation_to_core(plant.actuation, core, plant.uvms.nv),
             noise, num_envs, num_threads,
         )  # fmt: skip
 

@@ -30,7 +30,7 @@ import numpy as np
 
 from uvms_pin.control.performance import transformed_error
 from uvms_pin.control.ppc import PrescribedPerformanceController
-from uvms_pin.sim.actuation import Actuation, ThrustersAndJointLimits, Unlimited
+from uvms_pin.sim.compiled_actuation import actuation_to_core
 from uvms_pin.sim.integrators import FixedStep
 from uvms_pin.sim.log import RolloutLog
 from uvms_pin.sim.plant import Plant
@@ -80,29 +80,6 @@ class LoopPath:
             "compiled_ticks": self.compiled_ticks,
             "python_ticks": self.python_ticks,
         }
-
-
-def _actuation_to_core(actuation: Actuation, core: ModuleType, nv: int):
-    """The core's LoopActuation of ``actuation``, or the reason it has none."""
-    out = core.LoopActuation()
-    if type(actuation) is Unlimited:
-        return out
-    if type(actuation) is not ThrustersAndJointLimits:
-        return f"the actuation {type(actuation).__name__} has no compiled counterpart"
-    if not actuation._ideal:
-        return "thruster drives with curves or dynamics have no compiled counterpart"
-    limits = actuation.joint_effort_limits_Nm
-    if limits is not None and limits.shape != (nv - 6,):
-        return "joint effort limits do not match the arm"  # the Python loop raises
-    out.thrusters = True
-    out.allocation = actuation.allocation
-    out.allocation_pinv = actuation._allocation_pinv
-    out.lower_N, out.upper_N = actuation._lower, actuation._upper
-    out.full_forward_N, out.full_reverse_N = actuation._full_forward, actuation._full_reverse
-    out.joint_limits_Nm = np.zeros(0) if limits is None else limits
-    out.residual = np.zeros((0, 0)) if actuation._residual is None else actuation._residual
-    out.components = [int(k) for k in actuation.allocated_components]
-    return out
 
 
 def _why_not(plant, controller, sensors, settings, observers, log) -> str | None:
@@ -174,7 +151,7 @@ class CompiledLoop:
         if reason is not None:
             return None, reason
         core = plant._backend.counterpart(lambda module: module)  # compiled: _core() is set
-        actuation = _actuation_to_core(plant.actuation, core, plant.uvms.nv)
+        actuation = actuation_to_core(plant.actuation, core, plant.uvms.nv)
         if isinstance(actuation, str):
             return None, actuation
         return cls(core, loop, log, actuation), None

@@ -20,8 +20,11 @@ from __future__ import annotations
 import copy
 from typing import Any
 
+import pinocchio as pin
+
 from uvms_pin.model.uvms import UVMS
-from uvms_pin.physics.dynamics import kinetic_energy, potential_energy
+from uvms_pin.physics.dynamics import kinetic_energy, potential_energy_placed
+from uvms_pin.physics.surface import wet_state
 from uvms_pin.results.rollout import Rollout
 from uvms_pin.results.signal import Signal, described
 from uvms_pin.sim.plant import Plant
@@ -130,21 +133,28 @@ class RolloutLog:
         """The rollout of the samples written so far, with their energies."""
         rollout = self.rollout
         rollout.truncate(self.count)
-        plant = self.plant
+        plant, uvms = self.plant, self.uvms
         surface = {} if plant is None else {"free_surface": True, "flow": plant.water}
+        fractions = None
+        if plant is not None:
+            fractions = rollout.signal("wet_fraction", len(uvms.surface_bodies))
+            fractions[:] = 1.0  # deep: the rows the wet state leaves None
+        model, data = uvms.model, uvms.data
         for k in range(self.count):
+            q = rollout.q[k]
             if plant is not None:
                 surface["time_s"] = float(rollout.time_s[k])
-                width = len(self.uvms.surface_bodies)
-                rollout.signal("wet_fraction", width)[k] = plant.wet_fractions(
-                    surface["time_s"], rollout.q[k]
-                )
             rollout.kinetic_energy_J[k] = kinetic_energy(
-                self.uvms, rollout.q[k], rollout.v[k], backend=self.backend, **surface
+                uvms, q, rollout.v[k], backend=self.backend, **surface
             )
-            rollout.potential_energy_J[k] = potential_energy(self.uvms, rollout.q[k], **surface)
+            # the placements and the wet state once, for the wet fractions and U
+            pin.forwardKinematics(model, data, q)
+            wet = None if plant is None else wet_state(uvms, data, plant.water, surface["time_s"])
+            if wet is not None:
+                fractions[k] = wet.fraction
+            rollout.potential_energy_J[k] = potential_energy_placed(uvms, data, q, wet)
             if self.stops is not None:
-                rollout.potential_energy_J[k] += self.stops.energy_J(rollout.q[k])
+                rollout.potential_energy_J[k] += self.stops.energy_J(q)
         return rollout
 
 

@@ -9,7 +9,7 @@ import paused_cli
 import pytest
 from cli_support import STUDY, interrupt, passive_scenario, run_cli, tree_digest
 
-from uvms_pin.apps.study.runner import load_results
+from uvms_pin.apps.study.runner import RUNS_PER_TASK, load_results
 
 
 def _sweep(tmp_path, *extra: str):
@@ -51,9 +51,11 @@ def test_a_study_directory_refuses_another_study_and_a_changed_base(tmp_path):
     assert table["simulated_time_s"].tolist() == pytest.approx([0.06, 0.06])  # the new base only
 
 
-def test_ctrl_c_on_a_dask_sweep_prints_one_message_and_the_rerun_finishes(tmp_path):
+def test_ctrl_c_on_a_parallel_sweep_prints_one_message_and_the_rerun_finishes(tmp_path):
     """Ctrl-C once the sweep has recorded its first row (it waits there, held by a test
-    hook: however fast the runs, the sweep is in the middle when interrupted)."""
+    hook: however fast the runs, the sweep is in the middle when interrupted). A worker's
+    task is `RUNS_PER_TASK` runs, whose rows are stored together: those of the first task
+    are recorded."""
     (tmp_path / "base.toml").write_text(passive_scenario(0.5))
     (tmp_path / "study.toml").write_text(STUDY.replace("seed = 3", "seed = 3\nsamples = 15"))
     command = ["sweep", "study.toml", "--out", "out", "--workers", "1"]
@@ -69,10 +71,11 @@ def test_ctrl_c_on_a_dask_sweep_prints_one_message_and_the_rerun_finishes(tmp_pa
     assert "Traceback" not in err and "KeyboardInterrupt" not in err, err
     assert "interrupted:" in err and "rerun the same command to finish" in err
     assert len([line for line in err.splitlines() if "interrupted" in line]) == 1, err
-    assert len(load_results(tmp_path / "out")) == 1  # what was recorded before Ctrl-C
+    recorded = load_results(tmp_path / "out")  # what was recorded before Ctrl-C
+    assert list(recorded["run_index"]) == list(range(RUNS_PER_TASK))
 
     rerun = _sweep(tmp_path, "--workers", "0")
     assert rerun.returncode == 0, rerun.stderr
-    assert "29 run now, 1 already recorded" in rerun.stdout
+    assert f"{30 - RUNS_PER_TASK} run now, {RUNS_PER_TASK} already recorded" in rerun.stdout
     table = pd.read_parquet(tmp_path / "out" / "results.parquet")
     assert len(table) == 30 and table["run_id"].is_unique

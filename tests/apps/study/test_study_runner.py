@@ -230,3 +230,30 @@ def test_runs_executed_together_on_threads_give_the_rows_of_each_alone(tmp_path,
     together = pd.DataFrame(rows).drop(columns=[c for c in VOLATILE if c in rows[0]])
     alone = _stable(serial).drop(columns=["base_sha256"])
     pd.testing.assert_frame_equal(together[alone.columns], alone, check_dtype=False)
+
+
+def test_a_tasks_rows_are_stored_together_as_pandas_would_write_them(tmp_path):
+    """One part file per task, written through Arrow: rows with other columns (an error's
+    traceback, a metric only some runs have, a missing value) read back as pandas' own."""
+    import numpy as np
+
+    from uvms_pin.apps.study.runner import ResultStore
+
+    rows = [
+        {"run_id": "a", "run_index": 0, "status": "ok", "x": 1.5, "error": ""},
+        {
+            "run_id": "b",
+            "run_index": 1,
+            "status": "error",
+            "error": "boom",
+            "traceback": "tb",
+            "x": np.float64(2.0),
+            "y": float("nan"),
+        },
+        {"run_id": "c", "run_index": 2, "status": "ok", "x": None},
+    ]
+    store = ResultStore(tmp_path / "out")
+    store.record(rows)
+    assert len(list((tmp_path / "out" / "parts").glob("*.parquet"))) == 1
+    pd.DataFrame(rows).to_parquet(tmp_path / "ref.parquet", index=False)
+    pd.testing.assert_frame_equal(store.load(), pd.read_parquet(tmp_path / "ref.parquet"))

@@ -72,25 +72,56 @@ class _CaseStudy(Study):
 
 def execute_case(base: str, run: Run, rollout_dir: str | None, criteria: Criteria) -> dict:
     """One controller on one case: the comparison row (never raises; errors go in the row)."""
-    from uvms_pin.apps.compare.runs import run_controller
+    return execute_cases(base, [run], rollout_dir, criteria)[0]
+
+
+def execute_cases(
+    base: str, runs: list[Run], rollout_dir: str | None, criteria: Criteria
+) -> list[dict]:
+    """`execute_case` of each of ``runs``, their scenarios built one by one and simulated
+    together (`uvms_pin.sim.batch.run_batch`, one thread: a study's worker is one process of
+    one thread); the rows in order, each the row of the run alone, its wall time its build
+    plus its simulation."""
+    from uvms_pin.apps.compare.runs import batch_run_row
+    from uvms_pin.sim.batch import run_batch
+
+    rows, built, wall_s = [], [], []
+    for run in runs:
+        start = time.perf_counter()
+        rows.append(base_row(run))
+        try:
+            built.append((len(rows) - 1, _case_scenario(base, run)))
+        except Exception as exc:  # one failed case must not stop the others
+            _case_failed(rows[-1], exc)
+        wall_s.append(time.perf_counter() - start)
+    outcomes = run_batch([scenario for _, scenario in built], 1) if built else []
+    for (k, scenario), outcome in zip(built, outcomes, strict=True):
+        try:
+            compared, _ = batch_run_row(runs[k].values["controller"], scenario, outcome, criteria)
+            compared.pop("controller")
+            rows[k].update(compared)  # status "ok" or "stopped" (the reason says why)
+        except Exception as exc:
+            _case_failed(rows[k], exc)
+        wall_s[k] += outcome.wall_s
+    for row, seconds in zip(rows, wall_s, strict=True):
+        row["run_wall_time_s"] = seconds
+    return rows
+
+
+def _case_scenario(base: str, run: Run):
+    """The scenario of one controller on one case."""
     from uvms_pin.scenario.baselines import baseline_controller_table
     from uvms_pin.scenario.load import scenario_from_raw
 
-    start = time.perf_counter()
-    row = base_row(run)
-    try:
-        raw = apply_overrides(read_toml(Path(base), ScenarioError), run.overrides)
-        variant = {k: v for k, v in raw.items() if k != "baselines"}
-        variant["controller"] = baseline_controller_table(raw, run.values["controller"])
-        scenario = modify_plant(scenario_from_raw(variant, base), run.plant)
-        compared, _ = run_controller(run.values["controller"], scenario, criteria)
-        compared.pop("controller")
-        row.update(compared)  # status "ok" or "stopped" (the reason says why)
-    except Exception as exc:  # one failed case must not stop the others
-        row.update(status="error", error=f"{type(exc).__name__}: {exc}")
-        row["traceback"] = traceback.format_exc(limit=8)
-    row["run_wall_time_s"] = time.perf_counter() - start
-    return row
+    raw = apply_overrides(read_toml(Path(base), ScenarioError), run.overrides)
+    variant = {k: v for k, v in raw.items() if k != "baselines"}
+    variant["controller"] = baseline_controller_table(raw, run.values["controller"])
+    return modify_plant(scenario_from_raw(variant, base), run.plant)
+
+
+def _case_failed(row: dict, exc: BaseException) -> None:
+    row.update(status="error", error=f"{type(exc).__name__}: {exc}")
+    row["traceback"] = "".join(traceback.format_exception(exc, limit=8))
 
 
 def run_robustness(
@@ -127,7 +158,8 @@ def run_robustness(
             runs.append(Run(run_id(values, seed), len(runs), 0, seed, values, overrides, factors))
     study = _CaseStudy("robustness", "", spec, scenario_path.resolve(), 0, 1, {}, (), {}, raw, runs)
     run_fn = functools.partial(execute_case, criteria=criteria)
-    run_study(study, out, workers=workers, progress=False, run_fn=run_fn)
+    batch_fn = functools.partial(execute_cases, criteria=criteria)
+    run_study(study, out, workers=workers, progress=False, run_fn=run_fn, batch_fn=batch_fn)
     table = load_results(out)
     return table.sort_values("run_index").to_dict("records")
 

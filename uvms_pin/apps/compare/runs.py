@@ -16,10 +16,10 @@ from uvms_pin.scenario.baselines import baseline_controller_table
 from uvms_pin.scenario.load import scenario_from_raw
 from uvms_pin.scenario.overrides import apply_overrides
 from uvms_pin.scenario.toml import read_toml
-from uvms_pin.sim.batch import run_batch
+from uvms_pin.sim.batch import BatchRun, run_batch
 from uvms_pin.sim.run import Scenario, simulate
 
-__all__ = ["compare_controllers", "controller_scenarios", "run_controller"]
+__all__ = ["batch_run_row", "compare_controllers", "controller_scenarios", "run_controller"]
 
 
 def controller_scenarios(
@@ -87,9 +87,15 @@ def compare_controllers(
     runs = run_batch(list(scenarios.values()), min(len(scenarios), os.cpu_count() or 1) or 1)
     rows, rollouts = [], {}
     for (name, scenario), run in zip(scenarios.items(), runs, strict=True):
-        if run.error is not None and not isinstance(run.error, SimulationError):
-            raise run.error  # a bug or a bad input, not a result
-        stopped = "" if run.error is None else f"run stopped: {run.error}"
-        row, rollouts[name] = _row(name, scenario, run.rollout, stopped, criteria)
+        row, rollouts[name] = batch_run_row(name, scenario, run, criteria)
         rows.append(row)
     return rows, rollouts
+
+
+def batch_run_row(name: str, scenario: Scenario, run: BatchRun, criteria: Criteria):
+    """(row, rollout) of a controller's run of a batch (`run_controller`'s, the run done by
+    `run_batch`); its exception raised again when it is a bug or a bad input, not a result."""
+    if run.error is not None and not isinstance(run.error, SimulationError):
+        raise run.error
+    stopped = "" if run.error is None else f"run stopped: {run.error}"
+    return _row(name, scenario, run.rollout, stopped, criteria)

@@ -58,7 +58,7 @@ def _cmd_sweep(args: argparse.Namespace) -> int:
 def _workers_text(workers: int | None) -> str:
     if workers == 0:
         return "this process (serial)"
-    return f"a local cluster of {workers or 'cpu-count'} worker processes"
+    return f"{workers or 'cpu-count'} local worker processes"
 
 
 def _cmd_report(args: argparse.Namespace) -> int:
@@ -85,7 +85,7 @@ def register(subparsers) -> None:
         "--workers",
         type=process_count(0),
         default=None,
-        help="local cluster worker processes (1 thread each; default: CPU count; 0 = serial, no Dask)",
+        help="local worker processes, forked (1 thread each; default: CPU count; 0 = serial)",
     )
     where.add_argument(
         "--scheduler",

@@ -1,4 +1,4 @@
-"""Run a study on ``dask.distributed`` into one Parquet table, resumably.
+"""Run a study on local processes or ``dask.distributed`` into one Parquet table, resumably.
 
 Layout of an output directory::
 
@@ -70,6 +70,7 @@ ROLLOUTS_DIR = "rollouts"
 STATUSES = ("ok", "FunnelViolation", "diverged", "error")
 
 RunFunction = Callable[[str, Run, "str | None"], dict[str, Any]]
+BatchFunction = Callable[[str, list[Run], "str | None"], list[dict[str, Any]]]
 
 
 # ---- the table -----------------------------------------------------------------------------
@@ -135,9 +136,20 @@ class ResultStore:
         table = table.drop_duplicates("run_id", keep="last")
         return table.sort_values("run_index", kind="stable").reset_index(drop=True)
 
-    def record(self, row: dict[str, Any]) -> None:
-        """Durably add one row (a part file named after the run id)."""
-        _atomic_parquet(pd.DataFrame([row]), self.parts / f"{row['run_id']}.parquet")
+    def record(self, rows: dict[str, Any] | list[dict[str, Any]]) -> None:
+        """Durably add one row, or the rows of one task together (a part file named after
+        the first one's run id: one write for a task's runs)."""
+        import pyarrow as pa
+        import pyarrow.parquet as pq
+
+        rows = [rows] if isinstance(rows, dict) else rows
+        # straight to Arrow: the table pandas would write (every row's columns in order of
+        # appearance, a missing value null), without its per-column conversion (a task's
+        # part is written while the workers run)
+        names = dict.fromkeys(name for row in rows for name in row)
+        columns = {name: [row.get(name) for row in rows] for name in names}
+        with atomic_path(self.parts / f"{rows[0]['run_id']}.parquet") as tmp:
+            pq.write_table(pa.Table.from_pydict(columns), tmp)
 
     def compact(self) -> pd.DataFrame:
         """Rewrite the table with every row, atomically; then drop the merged parts."""
@@ -212,16 +224,18 @@ def run_study(
     keep_rollouts: bool = False,
     progress: bool = True,
     retry_errors: bool = False,
-    compact_every: int = 20,
+    compact_every: int = 100,
     compact_interval_s: float = 60.0,
     run_fn: RunFunction = execute_run,
     on_result: Callable[[dict[str, Any]], None] | None = None,
+    batch_fn: BatchFunction | None = None,
 ) -> Summary:
     """Run every run of ``study`` not yet recorded in ``out``; return the counts.
 
     Args:
-        workers: LocalCluster size (processes, 1 thread each); 0 runs serially in this
-            process (no Dask; for debugging and tests). Default: the CPU count.
+        workers: local worker processes (forked from this one; a Dask LocalCluster where
+            processes cannot be forked), 1 thread each; 0 runs serially in this process
+            (for debugging and tests). Default: the CPU count.
         scheduler: address of a running Dask scheduler (overrides ``workers``).
         keep_rollouts: save each run's rollout under ``out/rollouts/<run id>/``.
         retry_errors: rerun recorded runs whose status is ``error`` (not the funnel
@@ -230,6 +244,9 @@ def run_study(
             this much time, whichever comes first (rows are durable before that anyway).
         run_fn: what each task executes (tests inject failures through it).
         on_result: called with each new row after it is recorded.
+        batch_fn: what a task executes for a few runs at once (`RUNS_PER_TASK`), their rows
+            in order, each ``run_fn``'s row of the run (default: `execute_runs` for
+            `execute_run`; None for another ``run_fn``: one run per task).
     """
     out = Path(out)
     store, recorded = _open_store(study, out)
@@ -246,12 +263,18 @@ def run_study(
     compaction = _Compaction(store, compact_every, compact_interval_s)
     recorder = _Recorder(base_sha, counts, summary, bar, compaction, on_result)
     base = str(study.base)
+    if batch_fn is None and run_fn is execute_run:
+        batch_fn = execute_runs
     try:
+        tasks = (run_fn, batch_fn)
         if workers == 0 and scheduler is None:
-            for run in todo:
-                recorder.record(run_fn(base, run, rollout_dir))
+            for runs in _chunks(todo, batch_fn):
+                for row in _task(run_fn, batch_fn, base, runs, rollout_dir):
+                    recorder.record([row])  # row by row: what was seen is what is stored
+        elif scheduler is None and _can_fork():
+            _run_on_forked_processes(todo, base, rollout_dir, tasks, recorder.record, workers)
         else:
-            _run_on_dask(todo, base, rollout_dir, run_fn, recorder.record, workers, scheduler)
+            _run_on_dask(todo, base, rollout_dir, tasks, recorder.record, workers, scheduler)
     finally:
         bar.close()
         store.compact()
@@ -341,46 +364,95 @@ class _Recorder:
     compaction: _Compaction
     on_result: Callable[[dict[str, Any]], None] | None
 
-    def record(self, row: dict[str, Any]) -> None:
-        """Record one finished run's row (see the class)."""
-        row["base_sha256"] = self.base_sha256
-        self.compaction.store.record(row)
+    def record(self, rows: list[dict[str, Any]]) -> None:
+        """Record the rows of one task's finished runs, stored together (see the class)."""
+        for row in rows:
+            row["base_sha256"] = self.base_sha256
+        self.compaction.store.record(rows)
         counts = self.counts
-        counts[row["status"]] = counts.get(row["status"], 0) + 1
-        self.summary["run"] += 1
-        self.summary[row["status"]] = counts[row["status"]]
-        self.bar.update(1)
-        self.bar.set_postfix_str(_failures(counts), refresh=False)
-        self.compaction.row_added()
-        if self.on_result is not None:
-            self.on_result(row)
+        for row in rows:
+            counts[row["status"]] = counts.get(row["status"], 0) + 1
+            self.summary["run"] += 1
+            self.summary[row["status"]] = counts[row["status"]]
+            self.bar.update(1)
+            self.bar.set_postfix_str(_failures(counts), refresh=False)
+            self.compaction.row_added()
+            if self.on_result is not None:
+                self.on_result(row)
 
 
-def _run_on_dask(todo, base, rollout_dir, run_fn, finished, workers, scheduler) -> None:
+def _can_fork() -> bool:
+    """Whether worker processes can be forked from this one (POSIX but macOS, where forking
+    a process that has loaded system frameworks is unsafe)."""
+    import multiprocessing
+
+    return sys.platform != "darwin" and "fork" in multiprocessing.get_all_start_methods()
+
+
+def _chunks(todo: list[Run], batch_fn: BatchFunction | None) -> list[list[Run]]:
+    """The runs of each task: `RUNS_PER_TASK` with a batch function, else one."""
+    per_task = RUNS_PER_TASK if batch_fn is not None else 1
+    return [todo[start : start + per_task] for start in range(0, len(todo), per_task)]
+
+
+def _run_on_forked_processes(todo, base, rollout_dir, tasks, finished, workers) -> None:
+    """The tasks on ``workers`` processes forked from this one (the local case): they start
+    with this process's modules imported, where a Dask LocalCluster's spawned workers import
+    everything again and its scheduler and nannies start and stop (seconds, which a study of
+    short runs notices). A worker that dies (killed, a crash in compiled code) breaks the
+    pool: the runs not finished then are recorded as errors, which ``--retry-errors`` runs
+    again."""
+    import multiprocessing
+    from concurrent.futures import ProcessPoolExecutor, as_completed
+
+    run_fn, batch_fn = tasks
+    context = multiprocessing.get_context("fork")
+    pool = ProcessPoolExecutor(workers or os.cpu_count() or 1, mp_context=context)
+    futures = {}
+    try:
+        with _sigint_ignored_by_children():  # the first submit forks every worker
+            for runs in _chunks(todo, batch_fn):
+                futures[pool.submit(_task, run_fn, batch_fn, base, runs, rollout_dir)] = runs
+        _collect(as_completed(futures), futures, finished)
+    except BaseException:  # Ctrl-C: the workers (which ignore it) are stopped, not awaited
+        pool.shutdown(wait=False, cancel_futures=True)
+        for process in list((getattr(pool, "_processes", None) or {}).values()):
+            process.terminate()
+        raise
+    pool.shutdown(wait=True)
+
+
+def _collect(completed, futures: dict, finished) -> None:
+    """Each task's rows to ``finished`` as its future completes (``completed``, in that
+    order; error rows when the task itself failed, e.g. its worker died)."""
+    for future in completed:
+        runs = futures[future]
+        try:
+            rows = future.result()
+        except Exception as exc:
+            rows = [error_row(run, exc) for run in runs]
+        finished(rows)
+        if hasattr(future, "release"):  # a Dask future: its result freed on the cluster now
+            future.release()
+
+
+def _run_on_dask(todo, base, rollout_dir, tasks, finished, workers, scheduler) -> None:
     from dask.distributed import as_completed
 
+    run_fn, batch_fn = tasks
     client, cluster = _client(workers, scheduler)
     futures = {}
-    # the package's runs go a few per task (`execute_runs`); a worker with several threads
-    # runs several tasks at once, in parallel in the compiled loop (the GIL released)
-    per_task = RUNS_PER_TASK if run_fn is execute_run else 1
+    # runs go a few per task when there is a batch function (`execute_runs`); a worker with
+    # several threads runs several tasks at once, in parallel in the compiled loop (the GIL
+    # released)
     try:
-        for start in range(0, len(todo), per_task):
-            runs = todo[start : start + per_task]
+        for runs in _chunks(todo, batch_fn):
             future = client.submit(
-                _task, run_fn, base, runs, rollout_dir,
+                _task, run_fn, batch_fn, base, runs, rollout_dir,
                 key=f"uvms-run-{runs[0].run_id}", pure=False,
             )  # fmt: skip
             futures[future] = runs
-        for future in as_completed(futures):
-            runs = futures[future]
-            try:
-                rows = future.result()
-            except Exception as exc:  # the task itself failed (e.g. its worker died)
-                rows = [error_row(run, exc) for run in runs]
-            for row in rows:
-                finished(row)
-            future.release()
+        _collect(as_completed(futures), futures, finished)
     finally:
         for future in futures:
             if not future.done():
@@ -390,9 +462,11 @@ def _run_on_dask(todo, base, rollout_dir, run_fn, finished, workers, scheduler) 
             cluster.close()
 
 
-def _task(run_fn: RunFunction, base, runs, rollout_dir) -> list[dict[str, Any]]:
-    """The rows of one Dask task's runs: `execute_runs` (a batch), or one by one through
-    another ``run_fn``."""
-    if run_fn is execute_run:
-        return execute_runs(base, runs, rollout_dir)
+def _task(
+    run_fn: RunFunction, batch_fn: BatchFunction | None, base, runs, rollout_dir
+) -> list[dict[str, Any]]:
+    """The rows of one task's runs: ``batch_fn``'s (a batch), or one by one through
+    ``run_fn``."""
+    if batch_fn is not None:
+        return batch_fn(base, runs, rollout_dir)
     return [run_fn(base, run, rollout_dir) for run in runs]
