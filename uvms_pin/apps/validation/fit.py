@@ -131,6 +131,32 @@ def _gradient_cosine(
     return float(np.max(np.where(held, 0.0, cosine), initial=0.0))
 
 
+def _check_settings(max_iterations: int, **tolerances: float) -> None:
+    """ParameterError for a tolerance that is not positive or ``max_iterations`` < 1."""
+    for name, value in tolerances.items():
+        if not value > 0.0:
+            raise ParameterError(f"{name} must be > 0, got {value}")
+    if max_iterations < 1:
+        raise ParameterError(f"max_iterations must be >= 1, got {max_iterations}")
+
+
+def _damped_step(
+    values: np.ndarray, r: np.ndarray, jac: np.ndarray, lam: float, floor: np.ndarray
+) -> tuple[np.ndarray, np.ndarray]:
+    """(the candidate values, the scaling diag(J^T J)) of one Levenberg-Marquardt step:
+    (J^T J + lam diag(J^T J)) dp = -J^T r, the candidate clipped at the bounds ``floor``."""
+    gradient, normal = jac.T @ r, jac.T @ jac
+    scale = np.maximum(np.diag(normal), 1e-12 * max(1.0, float(np.max(np.diag(normal)))))
+    # a parameter held at its bound by a gradient that pushes it outwards stays there:
+    # the step of the others is solved without it (projecting a coupled step onto the
+    # bound afterwards would not lower the cost)
+    free = ~((values <= floor) & (gradient > 0.0))
+    step = np.zeros_like(values)
+    reduced = normal[np.ix_(free, free)] + lam * np.diag(scale[free])
+    step[free] = np.linalg.solve(reduced, -gradient[free])
+    return np.maximum(values + step, floor), scale
+
+
 def fit_parameters(
     uvms: UVMS,
     setups: Sequence[TrialSetup],
@@ -155,16 +181,13 @@ def fit_parameters(
         ParameterError: a tolerance that is not positive, ``max_iterations`` < 1.
         SimulationError: the simulation fails at the start values.
     """
-    for name, value in (
-        ("cost_tolerance", cost_tolerance),
-        ("gradient_tolerance", gradient_tolerance),
-        ("step_tolerance", step_tolerance),
-        ("exact_rms_rad", exact_rms_rad),
-    ):
-        if not value > 0.0:
-            raise ParameterError(f"{name} must be > 0, got {value}")
-    if max_iterations < 1:
-        raise ParameterError(f"max_iterations must be >= 1, got {max_iterations}")
+    _check_settings(
+        max_iterations,
+        cost_tolerance=cost_tolerance,
+        gradient_tolerance=gradient_tolerance,
+        step_tolerance=step_tolerance,
+        exact_rms_rad=exact_rms_rad,
+    )
     parameters = tuple(parameters)
     values = parameter_values(uvms, parameters, link) if start is None else np.array(start, float)
     first = _evaluate(uvms, parameters, link, values, setups, step_s)
@@ -188,16 +211,7 @@ def fit_parameters(
             reason = "no descent"
             break
         iteration += 1
-        gradient, normal = jac.T @ r, jac.T @ jac
-        scale = np.maximum(np.diag(normal), 1e-12 * max(1.0, float(np.max(np.diag(normal)))))
-        # a parameter held at its bound by a gradient that pushes it outwards stays there:
-        # the step of the others is solved without it (projecting a coupled step onto the
-        # bound afterwards would not lower the cost)
-        free = ~((values <= floor) & (gradient > 0.0))
-        step = np.zeros_like(values)
-        reduced = normal[np.ix_(free, free)] + lam * np.diag(scale[free])
-        step[free] = np.linalg.solve(reduced, -gradient[free])
-        candidate = np.maximum(values + step, floor)
+        candidate, scale = _damped_step(values, r, jac, lam, floor)
         trial = _evaluate(uvms, parameters, link, candidate, setups, step_s)
         cost, new_cost = 0.5 * r @ r, np.inf if trial is None else 0.5 * trial[0] @ trial[0]
         if new_cost >= cost:

@@ -165,8 +165,28 @@ def _force_jacobians(
         projector @ velocity_dq
     )
     trial_dv = -law.tangential_damping_N_s_m * (projector @ point_dv)
+    friction_dq, friction_dv = _slipping_scaled(
+        world, forces, memory, (trial_dq, trial_dv), (normal_dq, normal_dv)
+    )
+    force_dq = normal[:, :, None] * normal_dq[:, None, :] + friction_dq
+    force_dv = normal[:, :, None] * normal_dv[:, None, :] + friction_dv
+    return force_dq, force_dv, arms, slide
+
+
+def _slipping_scaled(
+    world: World,
+    forces: ContactForces,
+    memory: FrictionMemory,
+    trial: tuple[np.ndarray, np.ndarray],
+    normal: tuple[np.ndarray, np.ndarray],
+) -> tuple[np.ndarray, np.ndarray]:
+    """(dF_t,i/dq, dF_t,i/dv) (m, 3, nv): the trial friction's derivatives ``trial``, those of
+    a slipping patch's points scaled: f_t,i = sigma f_trial,i, sigma = mu_k L / |T| (L the
+    patch's normal load, T its summed trial force), d sigma from ``normal`` (df_n/dq, df_n/dv)."""
+    touch = forces.touch
+    trial_dq, trial_dv = trial
+    normal_dq, normal_dv = normal
     friction_dq, friction_dv = trial_dq.copy(), trial_dv.copy()
-    # a slipping patch: f_t,i = sigma f_trial,i, sigma = mu_k L / |T|
     patch = touch.piece * len(world.objects) + touch.obj
     for group in np.unique(patch[~forces.sticking]):
         mine = np.flatnonzero(patch == group)
@@ -186,9 +206,7 @@ def _force_jacobians(
             d_sigma = mu * (d_normal[mine].sum(axis=0) / size - load * total @ d_total / size**3)
             for row, i in enumerate(mine):
                 out[i] = sigma * d_trial[i] + np.outer(trial_raw[row], d_sigma)
-    force_dq = normal[:, :, None] * normal_dq[:, None, :] + friction_dq
-    force_dv = normal[:, :, None] * normal_dv[:, None, :] + friction_dv
-    return force_dq, force_dv, arms, slide
+    return friction_dq, friction_dv
 
 
 def _unscaled_trial(
