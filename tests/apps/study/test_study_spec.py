@@ -119,6 +119,9 @@ BAD = [
         "joint limits",
     ),
     ('base = "scenario.toml"', 'base = "missing.toml"', "study.base", "not found"),
+    ("values = [1.0, 3.0]", 'values = [1.0, "3"]', "parameter[1]", "mixes kinds"),
+    ("values = [1.0, 3.0]", "values = [true, false]", "parameter[1]", "plant factor needs numbers"),
+    ("values = [1.0, 3.0]", "values = [{a = 1}]", "parameter[1]", "not a finite number"),
 ]
 
 
@@ -153,3 +156,19 @@ def test_a_negative_stiffness_inside_a_random_range_is_found_without_drawing_it(
     )
     with pytest.raises(StudyError, match=r"parameter\[0\] 'environment.stiffness_N_m' = -1.0"):
         load_study(write_study(tmp_path, text))
+
+
+def test_a_string_apply_other_than_set_and_a_bad_string_fail_before_any_run(tmp_path):
+    """apply = "scale" needs numbers; a string the scenario does not know (an integrator
+    that does not exist) is found by loading the base with it, naming the parameter."""
+    choices = STUDY.replace(
+        '[[parameter]]\npath = "plant.buoyancy_scale"',
+        '[[parameter]]\npath = "integrator.method"\nvalues = ["rk4", "leapfrog"]\n\n'
+        '[[parameter]]\npath = "plant.buoyancy_scale"',
+        1,
+    )
+    with pytest.raises(StudyError, match="leapfrog"):
+        load_study(write_study(tmp_path, choices))
+    scaled = choices.replace('values = ["rk4", "leapfrog"]', 'apply = "scale"\nvalues = ["rk4"]')
+    with pytest.raises(StudyError, match="apply = 'scale' needs numbers"):
+        load_study(write_study(tmp_path, scaled))

@@ -37,7 +37,8 @@ def report_parameters(table: pd.DataFrame, info: dict[str, Any]) -> list[dict[st
         if path not in table.columns:
             continue
         column = table[path]
-        numeric = pd.api.types.is_numeric_dtype(column)
+        # booleans are two categories, not numbers to scale or cut into ranges
+        numeric = pd.api.types.is_numeric_dtype(column) and not pd.api.types.is_bool_dtype(column)
         log = bool(
             entry.get("distribution") == "log-uniform"
             or "logspace" in entry

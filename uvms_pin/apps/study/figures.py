@@ -16,6 +16,7 @@ from typing import Any, NamedTuple
 import numpy as np
 import pandas as pd
 from matplotlib.figure import Figure
+from matplotlib.ticker import FormatStrFormatter, LogLocator, NullFormatter
 
 from uvms_pin.apps.study.bins import bins, ordered_labels
 from uvms_pin.apps.study.statistics import bin_failure_rates, heatmap_pairs, violation_rate_grid
@@ -102,18 +103,34 @@ def scatter_figure(
     for ax, p in zip(axes, params, strict=True):
         for status, color in STATUS_COLORS.items():
             rows = table[table["status"] == status]
+            # a text axis cannot take the NaN a stopped run's metric may hold
+            rows = rows[np.isfinite(rows[metric].astype(float))]
             if len(rows) and p["numeric"]:
                 ax.scatter(rows[p["path"]], rows[metric], s=10, color=color, label=status)
             elif len(rows):
-                ax.scatter(rows[p["path"]].astype(str), rows[metric], s=10, color=color)
+                ax.scatter(
+                    rows[p["path"]].astype(str), rows[metric], s=10, color=color, label=status
+                )
         if p["log"]:
             ax.set_xscale("log")
+            _log_ticks(ax, table[p["path"]])
         ax.set_xlabel(p["path"])
         ax.set_ylabel(metric)
         ax.grid(True, alpha=0.3)
     axes[0].legend(loc="best", fontsize="small")
     fig.suptitle(f"{metric} vs parameters (colour: status)")
     return _save(fig, path)
+
+
+def _log_ticks(ax, values: pd.Series) -> None:
+    """Readable ticks on a log axis: matplotlib's default minor labels overprint on a
+    narrow panel; a range of about a decade gets 2 and 5 times the powers of ten, wider
+    ones the powers alone."""
+    if values.max() < 30.0 * values.min():
+        ax.xaxis.set_minor_locator(LogLocator(base=10.0, subs=(2.0, 5.0)))
+        ax.xaxis.set_minor_formatter(FormatStrFormatter("%g"))
+    else:
+        ax.xaxis.set_minor_formatter(NullFormatter())
 
 
 def box_figure(table: pd.DataFrame, params: list[dict[str, Any]], metric: str, path: Path) -> Path:

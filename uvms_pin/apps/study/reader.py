@@ -140,6 +140,9 @@ def _parameter(t: Table, k: int, base_raw: dict[str, Any], fixed: dict[str, Any]
     else:
         distribution, args = None, {}
         grid = _GRIDS[kinds[0]](t)
+        if _value_kind(grid[0]) != "number" and (apply != "set" or path.startswith(PLANT_PREFIX)):
+            what = "a plant factor" if path.startswith(PLANT_PREFIX) else f"apply = '{apply}'"
+            raise t.fail(f"values: {what} needs numbers, got {grid[0]!r}")
     t.finish()
     return Parameter(path, t.label, apply, grid, distribution, args)
 
@@ -165,13 +168,29 @@ def _check_target(
 
 
 def _values(t: Table) -> tuple[Any, ...]:
+    """A listed grid: numbers (or lists of numbers), or booleans, or strings (one kind per
+    parameter: a table column holds one type); the latter two only set a key."""
     values = t.pop_raw("values")
     if not isinstance(values, list) or not values:
         raise t.fail("values: the list is empty")
+    kind = _value_kind(values[0])
     for v in values:
-        if not (is_number(v) or (isinstance(v, list) and v and all(is_number(x) for x in v))):
-            raise t.fail(f"values: {v!r} is not a finite number or list of numbers")
+        if _value_kind(v) is None:
+            raise t.fail(
+                f"values: {v!r} is not a finite number, a list of numbers, a boolean or a string"
+            )
+        if _value_kind(v) != kind:
+            raise t.fail(f"values: {values!r} mixes kinds: give numbers, booleans or strings")
     return tuple(values)
+
+
+def _value_kind(value: Any) -> str | None:
+    """ "number" (a finite number or a non-empty list of them), "boolean", "string" or None."""
+    if is_number(value) or (isinstance(value, list) and value and all(map(is_number, value))):
+        return "number"
+    if isinstance(value, bool):
+        return "boolean"
+    return "string" if isinstance(value, str) else None
 
 
 def _spaced(kind: str):
