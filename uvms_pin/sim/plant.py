@@ -37,17 +37,8 @@ from uvms_pin.physics.compiled.joint_friction import joint_friction_to_core
 from uvms_pin.physics.compiled.joint_stops import joint_stops_to_core
 from uvms_pin.physics.compiled.world import world_bounds_to_core, world_contact_to_core
 from uvms_pin.physics.contact import ContactModel
-from uvms_pin.physics.derivatives.joint_limits import (
-    joint_friction_jacobian,
-    joint_stop_jacobians,
-)
-from uvms_pin.physics.derivatives.world_contact import world_contact_jacobians
 from uvms_pin.physics.disturbance import Disturbance
-from uvms_pin.physics.dynamics import (
-    dynamics_of,
-    forward_dynamics,
-    forward_dynamics_derivatives,
-)
+from uvms_pin.physics.dynamics import dynamics_of, forward_dynamics
 from uvms_pin.physics.joint_friction import JointFriction
 from uvms_pin.physics.joint_stops import JointStops
 from uvms_pin.physics.surface import wet_state
@@ -411,55 +402,10 @@ class Plant:
     def acceleration_derivatives(
         self, time_s: float, q: np.ndarray, v: np.ndarray, tau: np.ndarray
     ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """(da/dq, da/dv, da/dtau) (nv x nv each, q along the tangent) of `acceleration`:
-        the water (flow, free surface) by `forward_dynamics_derivatives`, and the plant's
-        own generalized forces tau_g(q, v), the world's contacts (a piece's corners or a
-        sphere on a plane: `uvms_pin.physics.derivatives.world_contact`), the joint drives' friction and
-        the joint stops (`uvms_pin.physics.derivatives.joint_limits`): da/dx += M^-1
-        d tau_g/dx. The disturbance depends on time only (no state derivative). Frozen at
-        the state: the contacts' active set, anchors and stick or slip (``friction``). At a
-        kink (a contact or a stop starting or ending) the derivative of the side the state
-        is on is returned.
+        """(da/dq, da/dv, da/dtau) of `acceleration` (`uvms_pin.sim.plant_derivatives`)."""
+        from uvms_pin.sim.plant_derivatives import acceleration_derivatives
 
-        Raises:
-            ParameterError: the plant has a term whose derivatives are not implemented: an
-                end-effector contact environment, free objects or self-collision, or an
-                active contact of an ellipsoid or with a solid object (coal's point).
-        """
-        q, v = finite_vector("q", q, self.uvms.nq), finite_vector("v", v, self.uvms.nv)
-        if self.contact is not None or self.free_bodies is not None:
-            raise ParameterError(
-                "acceleration_derivatives: the end-effector contact environment, free "
-                "objects and self-collision are not differentiated"
-            )
-        nv = self.uvms.nv
-        tau_ext, by_q, by_v = np.zeros(nv), np.zeros((nv, nv)), np.zeros((nv, nv))
-        forces = self.world_forces(q, v)
-        if forces is not None and len(forces.touch):
-            tau_ext += self.world.generalized_force(q, self._world_data, forces)
-            world_q, world_v = world_contact_jacobians(self.world, q, v, forces, self.friction)
-            by_q, by_v = by_q + world_q, by_v + world_v
-        if self.joint_friction is not None:
-            tau_ext[6:] += self.joint_friction.torque_Nm(v[6:])
-            by_v += joint_friction_jacobian(self.joint_friction, v)
-        if self.disturbance is not None:
-            tau_ext[:6] -= self.disturbance_wrench(time_s)
-        if self.joint_stops is not None:
-            tau_ext += self.joint_stops.torque(q, v)
-            stop_q, stop_v = joint_stop_jacobians(self.joint_stops, q, v)
-            by_q, by_v = by_q + stop_q, by_v + stop_v
-        da_dq, da_dv, inverse_mass = forward_dynamics_derivatives(
-            self.uvms,
-            q,
-            v,
-            tau,
-            flow=self.water,
-            time_s=time_s,
-            tau_ext=tau_ext,
-            backend=self.backend,
-            free_surface=self.free_surface,
-        )
-        return da_dq + inverse_mass @ by_q, da_dv + inverse_mass @ by_v, inverse_mass
+        return acceleration_derivatives(self, time_s, q, v, tau)
 
     def chart(self) -> Chart | None:
         """The compiled local chart of the adaptive integrators, or None (Python path)."""

@@ -1,0 +1,70 @@
+"""The derivatives of a plant's acceleration: the water's from
+`uvms_pin.physics.dynamics.forward_dynamics_derivatives`, with the plant's own generalized
+forces (world contacts, joint friction, joint stops) and their Jacobians added."""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+
+from uvms_pin.checks import finite_vector
+from uvms_pin.errors import ParameterError
+from uvms_pin.physics.derivatives.joint_limits import joint_friction_jacobian, joint_stop_jacobians
+from uvms_pin.physics.derivatives.world_contact import world_contact_jacobians
+from uvms_pin.physics.dynamics import forward_dynamics_derivatives
+
+
+def acceleration_derivatives(
+    plant: Any, time_s: float, q: np.ndarray, v: np.ndarray, tau: np.ndarray
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(da/dq, da/dv, da/dtau) (nv x nv each, q along the tangent) of ``plant``'s
+    acceleration (a `uvms_pin.sim.plant.Plant`, which calls this: no import back):
+    the water (flow, free surface) by `forward_dynamics_derivatives`, and the plant's
+    own generalized forces tau_g(q, v), the world's contacts (a piece's corners or a
+    sphere on a plane: `uvms_pin.physics.derivatives.world_contact`), the joint drives' friction and
+    the joint stops (`uvms_pin.physics.derivatives.joint_limits`): da/dx += M^-1
+    d tau_g/dx. The disturbance depends on time only (no state derivative). Frozen at
+    the state: the contacts' active set, anchors and stick or slip (``friction``). At a
+    kink (a contact or a stop starting or ending) the derivative of the side the state
+    is on is returned.
+
+    Raises:
+        ParameterError: the plant has a term whose derivatives are not implemented: an
+            end-effector contact environment, free objects or self-collision, or an
+            active contact of an ellipsoid or with a solid object (coal's point).
+    """
+    q, v = finite_vector("q", q, plant.uvms.nq), finite_vector("v", v, plant.uvms.nv)
+    if plant.contact is not None or plant.free_bodies is not None:
+        raise ParameterError(
+            "acceleration_derivatives: the end-effector contact environment, free "
+            "objects and self-collision are not differentiated"
+        )
+    nv = plant.uvms.nv
+    tau_ext, by_q, by_v = np.zeros(nv), np.zeros((nv, nv)), np.zeros((nv, nv))
+    forces = plant.world_forces(q, v)
+    if forces is not None and len(forces.touch):
+        tau_ext += plant.world.generalized_force(q, plant._world_data, forces)
+        world_q, world_v = world_contact_jacobians(plant.world, q, v, forces, plant.friction)
+        by_q, by_v = by_q + world_q, by_v + world_v
+    if plant.joint_friction is not None:
+        tau_ext[6:] += plant.joint_friction.torque_Nm(v[6:])
+        by_v += joint_friction_jacobian(plant.joint_friction, v)
+    if plant.disturbance is not None:
+        tau_ext[:6] -= plant.disturbance_wrench(time_s)
+    if plant.joint_stops is not None:
+        tau_ext += plant.joint_stops.torque(q, v)
+        stop_q, stop_v = joint_stop_jacobians(plant.joint_stops, q, v)
+        by_q, by_v = by_q + stop_q, by_v + stop_v
+    da_dq, da_dv, inverse_mass = forward_dynamics_derivatives(
+        plant.uvms,
+        q,
+        v,
+        tau,
+        flow=plant.water,
+        time_s=time_s,
+        tau_ext=tau_ext,
+        backend=plant.backend,
+        free_surface=plant.free_surface,
+    )
+    return da_dq + inverse_mass @ by_q, da_dv + inverse_mass @ by_v, inverse_mass
