@@ -19,12 +19,12 @@ inline Vec6 kirchhoff_wrench(const Mat6& added_mass, const Vec6& velocity_body) 
 // and (p xbar) = [0 [p1]x; [p1]x [p2]x] (dnu x* p = -(p xbar) dnu).
 inline Mat6 kirchhoff_jacobian(const Mat6& added_mass, const Vec6& velocity_body) {
   const Vec6 p = added_mass * velocity_body;
-  Mat6 cross_star = Mat6::Zero();
   const Mat3 w_hat = skew(velocity_body.tail<3>());
-  cross_star.topLeftCorner<3, 3>() = w_hat;
-  cross_star.bottomLeftCorner<3, 3>() = skew(velocity_body.head<3>());
-  cross_star.bottomRightCorner<3, 3>() = w_hat;
-  Mat6 out = cross_star * added_mass;
+  // (nu x*) M_A by blocks: (nu x*) = [[w]x 0; [v]x [w]x]
+  Mat6 out;
+  out.topRows<3>().noalias() = w_hat * added_mass.topRows<3>();
+  out.bottomRows<3>().noalias() = skew(velocity_body.head<3>()) * added_mass.topRows<3>();
+  out.bottomRows<3>().noalias() += w_hat * added_mass.bottomRows<3>();
   const Mat3 p1_hat = skew(p.head<3>());
   out.topRightCorner<3, 3>() -= p1_hat;
   out.bottomLeftCorner<3, 3>() -= p1_hat;

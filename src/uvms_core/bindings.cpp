@@ -164,8 +164,11 @@ void bind_flow(nb::module_& m) {
 }
 
 // The flow of a call: None (still water) or a FlowField.
-uvms::FlowField flow_or_still(const std::optional<uvms::FlowField>& flow) {
-  return flow ? *flow : uvms::FlowField{};
+// The flow passed from Python (None: still water), by reference: a FlowField copy per call
+// (its wave list) would cost more than the small calls it feeds
+const uvms::FlowField& flow_or_still(const uvms::FlowField* flow) {
+  static const uvms::FlowField still{};
+  return flow != nullptr ? *flow : still;
 }
 
 uvms::FlowField current_only(nb::handle current_world_obj) {
@@ -195,7 +198,7 @@ void bind_dynamics(nb::module_& m) {
           "q"_a.none())
       .def(
           "mass_matrix_in",
-          [](Dynamics& d, nb::handle q_obj, const std::optional<uvms::FlowField>& flow,
+          [](Dynamics& d, nb::handle q_obj, const uvms::FlowField* flow,
              double time_s, bool free_surface) -> Eigen::MatrixXd {
             UVMS_VECTOR(q, d.nq());
             return d.mass_matrix_in(q, flow_or_still(flow), time_s, free_surface);
@@ -213,7 +216,7 @@ void bind_dynamics(nb::module_& m) {
       .def(
           "bias_forces_in",
           [](Dynamics& d, nb::handle q_obj, nb::handle v_obj,
-             const std::optional<uvms::FlowField>& flow, double time_s,
+             const uvms::FlowField* flow, double time_s,
              bool free_surface) -> Eigen::VectorXd {
             UVMS_VECTOR(q, d.nq());
             UVMS_VECTOR(v, d.nv());
@@ -237,7 +240,7 @@ void bind_dynamics(nb::module_& m) {
       .def(
           "forward_dynamics_in",
           [](Dynamics& d, nb::handle q_obj, nb::handle v_obj, nb::handle tau_obj,
-             const std::optional<uvms::FlowField>& flow, double time_s,
+             const uvms::FlowField* flow, double time_s,
              nb::handle tau_ext_obj, bool free_surface) -> Eigen::VectorXd {
             UVMS_VECTOR(q, d.nq());
             UVMS_VECTOR(v, d.nv());
@@ -271,7 +274,7 @@ void bind_derivatives(nb::module_& m) {
       .def(
           "forward_dynamics_derivatives",
           [](Derivatives& d, nb::handle q_obj, nb::handle v_obj, nb::handle tau_obj,
-             const std::optional<uvms::FlowField>& flow, double time_s,
+             const uvms::FlowField* flow, double time_s,
              nb::handle tau_ext_obj, bool free_surface) -> ForwardDynamicsDerivatives {
             const int nq = d.dynamics().nq(), nv = d.dynamics().nv();
             UVMS_VECTOR(q, nq);

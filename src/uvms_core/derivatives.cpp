@@ -14,14 +14,6 @@ namespace uvms {
 
 namespace {
 
-// A (3, n) block as the linear rows of a (6, n) twist block.
-Matrix6x linear_rows(const Matrix3x& block) {
-  Matrix6x out(6, block.cols());
-  out.topRows<3>() = block;
-  out.bottomRows<3>().setZero();
-  return out;
-}
-
 Vec6 linear_twist(const Vec3& linear) {
   Vec6 out;
   out << linear, Vec3::Zero();
@@ -32,6 +24,45 @@ Vec6 linear_twist(const Vec3& linear) {
 
 Matrix3x JointMotion::point_dq(const Vec3& point_in_joint_m) const {
   return rotation * (jacobian.topRows<3>() - skew(point_in_joint_m) * jacobian.bottomRows<3>());
+}
+
+namespace {
+
+// by_pose += d/d delta of a body-frame vector G_b p(delta), p the world point fixed at
+// point_in_joint_m (dp = R [I, -[r]x] delta), G_b = R_b^T G the flow's gradient seen in the
+// body: G_b R [I, -[r]x].
+void add_point_motion(const Mat3& gradient_in_body, const Mat3& rotation,
+                      const Vec3& point_in_joint_m, Mat36& by_pose) {
+  const Mat3 along = gradient_in_body * rotation;
+  by_pose.leftCols<3>() += along;
+  by_pose.rightCols<3>().noalias() -= along * skew(point_in_joint_m);
+}
+
+}  // namespace
+
+FlowSeenByBody flow_in_body(const JointMotion& motion, const Mat3& rotation_in_joint,
+                            const Vec3& point_in_joint_m, const FlowGradientsAtPoint& flow) {
+  const Mat3 to_body = (motion.rotation * rotation_in_joint).transpose();
+  FlowSeenByBody out;
+  out.velocity = to_body * flow.velocity_world;
+  out.acceleration = to_body * flow.acceleration_world;
+  // turning the frame (R -> R exp([dtheta]x)): d(R_b^T u)/dtheta = [U]x R_ij^T
+  out.velocity_by_pose.leftCols<3>().setZero();
+  out.velocity_by_pose.rightCols<3>().noalias() =
+      skew(out.velocity) * rotation_in_joint.transpose();
+  out.acceleration_by_pose.leftCols<3>().setZero();
+  out.acceleration_by_pose.rightCols<3>().noalias() =
+      skew(out.acceleration) * rotation_in_joint.transpose();
+  // moving the point through a non-uniform flow (a uniform current has no gradient)
+  if (!flow.gradient.isZero(0.0)) {
+    add_point_motion(to_body * flow.gradient, motion.rotation, point_in_joint_m,
+                     out.velocity_by_pose);
+  }
+  if (!flow.acceleration_gradient.isZero(0.0)) {
+    add_point_motion(to_body * flow.acceleration_gradient, motion.rotation, point_in_joint_m,
+                     out.acceleration_by_pose);
+  }
+  return out;
 }
 
 Derivatives::Derivatives(const Dynamics& dynamics)
@@ -47,10 +78,13 @@ Derivatives::Derivatives(const Dynamics& dynamics)
   for (int j : hydro_joints_) {
     auto& m = motion_[j];
     m.jacobian = m.velocity_dq = m.acceleration_dq = m.acceleration_dv = Matrix6x::Zero(6, nv);
+    m.columns = model.idx_vs[j] + model.nvs[j];
   }
   dw_dq_.assign(nj, Matrix6x::Zero(6, nv));
   dw_dv_.assign(nj, Matrix6x::Zero(6, nv));
   fext_.assign(nj, pinocchio::Force::Zero());
+  sensitivity_.resize(nj);
+  work_ = Matrix6x::Zero(6, nv);
   acceleration_ = Eigen::VectorXd::Zero(nv);
   did_dq_ = did_dv_ = mass_ = Eigen::MatrixXd::Zero(nv, nv);
   cholesky_ = Eigen::LLT<Eigen::MatrixXd>(nv);
@@ -91,74 +125,89 @@ void Derivatives::joint_motions() {
   }
 }
 
-FlowSeenByBody Derivatives::flow_in_body(const JointMotion& motion, const Mat3& rotation_in_joint,
-                                         const Vec3& point_in_joint_m,
-                                         const FlowGradientsAtPoint& flow) {
-  const Mat3 rotation = motion.rotation * rotation_in_joint;
-  const Matrix3x point_dq = motion.point_dq(point_in_joint_m);
-  const Matrix3x theta_dq = rotation_in_joint.transpose() * motion.jacobian.bottomRows<3>();
-  FlowSeenByBody out;
-  out.velocity = rotation.transpose() * flow.velocity_world;
-  out.acceleration = rotation.transpose() * flow.acceleration_world;
-  out.velocity_dq = rotation.transpose() * flow.gradient * point_dq + skew(out.velocity) * theta_dq;
-  out.acceleration_dq = rotation.transpose() * flow.acceleration_gradient * point_dq +
-                        skew(out.acceleration) * theta_dq;
-  return out;
-}
-
-// w = -M_A (a - nu_c_dot) - C_A(nu_r) nu_r, nu_c_dot = [A - w x U; 0] (fluid.py).
-void Derivatives::added_mass_jacobians(int joint, const FlowGradientsAtPoint& flow) {
+// w = -M_A (a - nu_c_dot) - C_A(nu_r) nu_r, nu_r = nu - [U; 0], nu_c_dot = [A - w x U; 0]
+// (fluid.py), U and A the flow seen at the centre of buoyancy.
+void Derivatives::added_mass_sensitivity(int joint, const FlowGradientsAtPoint& flow) {
   const auto& m = motion_[joint];
+  auto& s = sensitivity_[joint];
   const Mat6& added = dynamics_.added_mass(joint);
   const FlowSeenByBody seen =
       flow_in_body(m, Mat3::Identity(), dynamics_.center_of_buoyancy(joint), flow);
-  const Vec3 omega = m.velocity.tail<3>();
-  const Matrix3x rate_dq = seen.acceleration_dq - skew(omega) * seen.velocity_dq +
-                           skew(seen.velocity) * m.velocity_dq.bottomRows<3>();
-  const Matrix3x rate_dv = skew(seen.velocity) * m.jacobian.bottomRows<3>();
   const Mat6 kirchhoff = kirchhoff_jacobian(added, m.velocity - linear_twist(seen.velocity));
-  dw_dq_[joint].noalias() -= added * (m.acceleration_dq - linear_rows(rate_dq));
-  dw_dq_[joint].noalias() -= kirchhoff * (m.velocity_dq - linear_rows(seen.velocity_dq));
-  dw_dv_[joint].noalias() -= added * (m.acceleration_dv - linear_rows(rate_dv));
-  dw_dv_[joint].noalias() -= kirchhoff * m.jacobian;
+  s.by_acceleration -= added;
+  s.by_velocity -= kirchhoff;
+  // w x U in nu_c_dot: d/dw = [U]x
+  s.by_velocity.rightCols<3>().noalias() += added.leftCols<3>() * skew(seen.velocity);
+  // U in nu_r (-C_A: +K) and in nu_c_dot (-w x U), A in nu_c_dot
+  const Mat36 rate_by_pose =
+      seen.acceleration_by_pose - skew(m.velocity.tail<3>()) * seen.velocity_by_pose;
+  s.by_pose.noalias() += kirchhoff.leftCols<3>() * seen.velocity_by_pose;
+  s.by_pose.noalias() += added.leftCols<3>() * rate_by_pose;
 }
 
 // Buoyancy -rho V g and Froude-Krylov rho V Du/Dt: world forces at the centre of buoyancy.
-void Derivatives::restoring_jacobian(int joint, const FlowGradientsAtPoint& flow,
-                                     bool moving_water) {
+void Derivatives::restoring_sensitivity(int joint, const FlowGradientsAtPoint& flow,
+                                        bool waves) {
   const auto& m = motion_[joint];
-  const auto& hydro = dynamics_.hydro_;
+  auto& s = sensitivity_[joint];
   const Vec3& cob = dynamics_.center_of_buoyancy(joint);
-  const double mass_of_water = hydro.water_density_kg_m3 * dynamics_.volume(joint);
+  const double mass_of_water = dynamics_.hydro_.water_density_kg_m3 * dynamics_.volume(joint);
   Vec3 force = -mass_of_water * dynamics_.model_.gravity.linear();
-  if (moving_water) force += mass_of_water * flow.acceleration_world;
+  if (waves) force += mass_of_water * flow.acceleration_world;
   const auto jac = point_force_jacobians(m.rotation.transpose() * force, cob, m.rotation);
-  dw_dq_[joint].noalias() += jac.by_rotation * m.jacobian.bottomRows<3>();
-  if (moving_water) {
-    dw_dq_[joint].noalias() +=
-        jac.by_force * (mass_of_water * flow.acceleration_gradient * m.point_dq(cob));
+  s.by_pose.rightCols<3>() += jac.by_rotation;
+  if (waves && !flow.acceleration_gradient.isZero(0.0)) {  // Du/Dt sampled at the moved point
+    Mat36 force_by_pose = Mat36::Zero();
+    add_point_motion(mass_of_water * flow.acceleration_gradient, m.rotation, cob,
+                     force_by_pose);
+    s.by_pose.noalias() += jac.by_force * force_by_pose;
   }
 }
 
 // w = X^T d(nu_r), nu_r = X nu - [U; 0] in the damped link's own frame.
-void Derivatives::damping_jacobians(const DampedBody& body, const FlowGradientsAtPoint& flow) {
+void Derivatives::damping_sensitivity(const DampedBody& body, const FlowGradientsAtPoint& flow) {
   const auto& m = motion_[body.joint_id];
+  auto& s = sensitivity_[body.joint_id];
   const FlowSeenByBody seen =
       flow_in_body(m, body.rotation_in_joint, body.position_in_joint_m, flow);
   const Mat6& x = body.action_joint_to_body;
+  const double fraction = dynamics_.damping_fraction(body);
+  if (x.isIdentity(0.0)) {  // damped at the joint frame itself (X = I): the usual case
+    const Vec6 relative = m.velocity - linear_twist(seen.velocity);
+    const Mat6 slope =
+        fraction * damping_jacobian(body.linear_damping, body.quadratic_damping, relative);
+    s.by_velocity += slope;
+    s.by_pose.noalias() -= slope.leftCols<3>() * seen.velocity_by_pose;
+    return;
+  }
   const Vec6 relative = x * m.velocity - linear_twist(seen.velocity);
-  const Mat6 slope = dynamics_.damping_fraction(body) * x.transpose() *
+  const Mat6 slope = fraction * x.transpose() *
                      damping_jacobian(body.linear_damping, body.quadratic_damping, relative);
-  dw_dq_[body.joint_id].noalias() += slope * (x * m.velocity_dq - linear_rows(seen.velocity_dq));
-  dw_dv_[body.joint_id].noalias() += (slope * x) * m.jacobian;
+  s.by_velocity.noalias() += slope * x;
+  s.by_pose.noalias() -= slope.leftCols<3>() * seen.velocity_by_pose;
+}
+
+// dw/dq = W_a da/dq + W_nu dnu/dq + W_delta J,  dw/dv = W_a da/dv + W_nu J.
+// Coefficient-based products on the columns up to the joint's own (the others are zero): for
+// a (6, 6) by (6, n) product Eigen would otherwise take its blocked GEMM, with a workspace
+// allocation per call, once 6 + 6 + n >= 20.
+void Derivatives::chain_sensitivity(int joint) {
+  const auto& m = motion_[joint];
+  const auto& s = sensitivity_[joint];
+  const int n = m.columns;
+  auto dw_dq = dw_dq_[joint].leftCols(n);
+  auto dw_dv = dw_dv_[joint].leftCols(n);
+  dw_dq.noalias() = s.by_velocity.lazyProduct(m.velocity_dq.leftCols(n));
+  dw_dq.noalias() += s.by_pose.lazyProduct(m.jacobian.leftCols(n));
+  dw_dv.noalias() = s.by_velocity.lazyProduct(m.jacobian.leftCols(n));
+  if (s.by_acceleration.isZero(0.0)) return;  // no added mass on this body
+  dw_dq.noalias() += s.by_acceleration.lazyProduct(m.acceleration_dq.leftCols(n));
+  dw_dv.noalias() += s.by_acceleration.lazyProduct(m.acceleration_dv.leftCols(n));
 }
 
 void Derivatives::fluid_jacobians(const FlowField& flow, double time_s) {
   const auto& hydro = dynamics_.hydro_;
-  for (int j : hydro_joints_) {
-    dw_dq_[j].setZero();
-    dw_dv_[j].setZero();
-  }
+  for (int j : hydro_joints_) sensitivity_[j] = WrenchSensitivity{};
   const bool moving_water = !flow.waves.empty() || !flow.current_world_m_s.isZero(0.0);
   const FlowGradientsAtPoint still;
   for (int j : hydro_joints_) {
@@ -169,15 +218,16 @@ void Derivatives::fluid_jacobians(const FlowField& flow, double time_s) {
         moving_water
             ? flow.gradients_at(time_s, motion_[j].point(dynamics_.center_of_buoyancy(j)))
             : still;
-    if (added) added_mass_jacobians(j, at_cob);
-    if (volume) restoring_jacobian(j, at_cob, !flow.waves.empty());
+    if (added) added_mass_sensitivity(j, at_cob);
+    if (volume) restoring_sensitivity(j, at_cob, !flow.waves.empty());
   }
   for (const auto& body : hydro.damped_bodies) {
     const auto& m = motion_[body.joint_id];
-    damping_jacobians(body, moving_water
-                                ? flow.gradients_at(time_s, m.point(body.position_in_joint_m))
-                                : still);
+    damping_sensitivity(body, moving_water
+                                  ? flow.gradients_at(time_s, m.point(body.position_in_joint_m))
+                                  : still);
   }
+  for (int j : hydro_joints_) chain_sensitivity(j);
 }
 
 const ForwardDynamicsDerivatives& Derivatives::forward_dynamics_derivatives(
@@ -199,15 +249,20 @@ const ForwardDynamicsDerivatives& Derivatives::forward_dynamics_derivatives(
   joint_motions();
   fluid_jacobians(flow, time_s);
   if (d.wet_active_) surface_jacobians(flow, time_s);
+  // depth-6 products, coefficient-based at any nv, on the columns up to each joint's own
+  // (J_j and dw_j are zero beyond them)
   for (int j : hydro_joints_) {
-    const auto& jac = motion_[j].jacobian;
-    did_dq_.noalias() -= jac.transpose() * dw_dq_[j];
-    did_dv_.noalias() -= jac.transpose() * dw_dv_[j];
+    const int n = motion_[j].columns;
+    const auto jac_t = motion_[j].jacobian.leftCols(n).transpose();
+    did_dq_.topLeftCorner(n, n).noalias() -= jac_t.lazyProduct(dw_dq_[j].leftCols(n));
+    did_dv_.topLeftCorner(n, n).noalias() -= jac_t.lazyProduct(dw_dv_[j].leftCols(n));
   }
   mass_.triangularView<Eigen::StrictlyLower>() = mass_.transpose();  // filled: upper triangle
   for (int j : d.joints_with_added_mass_) {
-    const auto& jac = motion_[j].jacobian;
-    mass_.noalias() += jac.transpose() * (d.added_mass(j) * jac);
+    const int n = motion_[j].columns;
+    const auto jac = motion_[j].jacobian.leftCols(n);
+    work_.leftCols(n).noalias() = d.added_mass(j).lazyProduct(jac);
+    mass_.topLeftCorner(n, n).noalias() += jac.transpose().lazyProduct(work_.leftCols(n));
   }
   cholesky_.compute(mass_);
   if (cholesky_.info() != Eigen::Success) {
@@ -215,8 +270,8 @@ const ForwardDynamicsDerivatives& Derivatives::forward_dynamics_derivatives(
   }
   out_.da_dtau.setIdentity();
   cholesky_.solveInPlace(out_.da_dtau);
-  out_.da_dq.noalias() = -out_.da_dtau * did_dq_;
-  out_.da_dv.noalias() = -out_.da_dtau * did_dv_;
+  out_.da_dq.noalias() = -out_.da_dtau.lazyProduct(did_dq_);
+  out_.da_dv.noalias() = -out_.da_dtau.lazyProduct(did_dv_);
   return out_;
 }
 

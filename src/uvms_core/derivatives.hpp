@@ -7,8 +7,13 @@
 //   da/dq = -M^-1 dID/dq,  da/dv = -M^-1 dID/dv,  da/dtau = M^-1.
 // Pinocchio's computeRNEADerivatives gives the first term and, in its data, each joint's
 // velocity and acceleration derivatives (getJoint*Derivatives, LOCAL); the fluid terms' own
-// Jacobians are each hydro unit's (added_mass.hpp, damping.hpp, restoring.hpp), chained here
-// one function per term as in fluid.py.
+// Jacobians are each hydro unit's (added_mass.hpp, damping.hpp, restoring.hpp), one function
+// per term as in fluid.py. fluid.py writes each term's dw/dq and dw/dv as (6, nv) blocks; here
+// each term gives its 6 x 6 sensitivities to the body's acceleration, velocity and pose
+// (WrenchSensitivity), summed per joint and chained with the joint's motion derivatives once:
+//   dw/dq = W_a da/dq + W_nu dnu/dq + W_delta J,   dw/dv = W_a da/dv + W_nu J,
+// the same sums regrouped (five (6, n) products per joint instead of about twenty; the
+// Python reference, which the tests compare with to 1e-10, keeps the term-by-term form).
 //
 // Under a free surface (derivatives_surface.cpp, mirror of physics/derivatives/surface.py)
 // the terms above use the wet volumes, centres of buoyancy, added masses and damping
@@ -46,6 +51,8 @@ struct JointMotion {
   Matrix6x velocity_dq;
   Matrix6x acceleration_dq;
   Matrix6x acceleration_dv;
+  // nonzero columns: those up to the joint's own (its support and joints before it)
+  int columns = 0;
 
   Vec3 point(const Vec3& point_in_joint_m) const {
     return rotation * point_in_joint_m + translation;
@@ -54,12 +61,28 @@ struct JointMotion {
   Matrix3x point_dq(const Vec3& point_in_joint_m) const;
 };
 
-// The flow seen in a body frame: U = R^T u, A = R^T Du/Dt and their d/dq (fluid.py FlowInBody).
+using Mat36 = Eigen::Matrix<double, 3, 6>;
+
+// The flow seen in a body frame, U = R_b^T u and A = R_b^T Du/Dt at a point fixed in the
+// joint frame, and their Jacobians in the joint frame's own twist delta = [dp; dtheta]
+// (R -> R exp([dtheta]x), p -> p + R dp): d/dq = d/d delta J (fluid.py FlowInBody).
 struct FlowSeenByBody {
   Vec3 velocity;
-  Matrix3x velocity_dq;
   Vec3 acceleration;
-  Matrix3x acceleration_dq;
+  Mat36 velocity_by_pose;
+  Mat36 acceleration_by_pose;
+};
+
+FlowSeenByBody flow_in_body(const JointMotion& motion, const Mat3& rotation_in_joint,
+                            const Vec3& point_in_joint_m, const FlowGradientsAtPoint& flow);
+
+// A joint body's fluid wrench w(a, nu, pose), linearised: dw = W_a da + W_nu dnu + W_delta
+// delta, each term adding its own; chained with the joint's motion derivatives once per
+// joint (6 x 6 products, not one (6, nv) product per term).
+struct WrenchSensitivity {
+  Mat6 by_acceleration = Mat6::Zero();
+  Mat6 by_velocity = Mat6::Zero();
+  Mat6 by_pose = Mat6::Zero();
 };
 
 class Derivatives {
@@ -80,11 +103,11 @@ class Derivatives {
                    const FlowField& flow, double time_s);
   void joint_motions();
   void fluid_jacobians(const FlowField& flow, double time_s);
-  FlowSeenByBody flow_in_body(const JointMotion& motion, const Mat3& rotation_in_joint,
-                              const Vec3& point_in_joint_m, const FlowGradientsAtPoint& flow);
-  void added_mass_jacobians(int joint, const FlowGradientsAtPoint& flow);
-  void restoring_jacobian(int joint, const FlowGradientsAtPoint& flow, bool moving_water);
-  void damping_jacobians(const DampedBody& body, const FlowGradientsAtPoint& flow);
+  // each term's sensitivities (added to sensitivity_[joint]), then the chain rule
+  void added_mass_sensitivity(int joint, const FlowGradientsAtPoint& flow);
+  void restoring_sensitivity(int joint, const FlowGradientsAtPoint& flow, bool waves);
+  void damping_sensitivity(const DampedBody& body, const FlowGradientsAtPoint& flow);
+  void chain_sensitivity(int joint);
   // derivatives_surface.cpp: the wet-fraction terms of the hulls the surface cuts
   void surface_jacobians(const FlowField& flow, double time_s);
   void surface_joint_terms(int joint, const FlowGradientsAtPoint& at_cob, bool moving_water);
@@ -95,6 +118,8 @@ class Derivatives {
   std::vector<JointMotion> motion_;  // per joint id (only hydro joints filled)
   std::vector<Matrix6x> dw_dq_, dw_dv_;
   ForceVector fext_;
+  std::vector<WrenchSensitivity> sensitivity_;  // per joint id (hydro joints)
+  Matrix6x work_;  // M_A J of the mass matrix
   bool free_surface_ = false;
   std::vector<char> cut_;                               // per hull: 0 < f < 1
   std::vector<Eigen::Matrix<double, 12, Eigen::Dynamic>> wetting_dq_;  // dx_i/dq per cut hull

@@ -151,7 +151,8 @@ void Derivatives::surface_joint_terms(int j, const FlowGradientsAtPoint& at_cob,
     dw_dq.noalias() += added * linear_block(flow_rate_dq - skew(omega) * flow_dq);
     dw_dq.noalias() += kirchhoff_jacobian(added, relative) * linear_block(flow_dq);
   }
-  const Matrix6x relative_dq = m.velocity_dq - linear_block(seen.velocity_dq + flow_dq);
+  const Matrix3x seen_velocity_dq = seen.velocity_by_pose * m.jacobian;
+  const Matrix6x relative_dq = m.velocity_dq - linear_block(seen_velocity_dq + flow_dq);
   const Vec6 acceleration = data_.a[j].toVector();
   for (std::size_t h = 0; h < bodies.size(); ++h) {
     if (bodies[h].joint_id != j) continue;

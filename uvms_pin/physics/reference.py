@@ -14,6 +14,8 @@ works in the UVMS's Pinocchio data buffer; none allocates a model.
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 import pinocchio as pin
 from scipy.linalg import cho_factor, cho_solve
@@ -34,7 +36,7 @@ from uvms_pin.physics.surface import WetState, wet_state
 def check_time(time_s: float) -> float:
     """``time_s`` as a float, or ParameterError if it is not finite."""
     time_s = float(time_s)
-    if not np.isfinite(time_s):
+    if not math.isfinite(time_s):  # math, not numpy: this check is on every dynamics call
         raise ParameterError(f"time_s must be finite, got {time_s}")
     return time_s
 
