@@ -7,10 +7,12 @@
 // It advances the plant over one control period with the input held, in one call.
 #pragma once
 
+#include <memory>
 #include <optional>
 #include <utility>
 
 #include "contact.hpp"
+#include "derivatives_world_contact.hpp"
 #include "disturbance.hpp"
 #include "dynamics.hpp"
 #include "integrators.hpp"
@@ -50,6 +52,13 @@ class Plant {
   // The contact points and forces at (q, v) with `friction` (World.forces); no world: none.
   const ContactForces& world_forces(const ConstVec& q, const ConstVec& v);
 
+  // (da/dq, da/dv, da/dtau) of acceleration() with the world's contacts at `friction`'s
+  // anchors, q along the tangent (plant_derivatives.cpp, mirror of
+  // uvms_pin/sim/plant_derivatives.py); InputError for an end-effector contact.
+  const ForwardDynamicsDerivatives& acceleration_derivatives(double time_s, const ConstVec& q,
+                                                             const ConstVec& v,
+                                                             const ConstVec& tau);
+
   // (q, v) at t1 from (q0, v0) at t0 with tau held, in the integrator's substeps.
   std::pair<Eigen::VectorXd, Eigen::VectorXd> advance(double t0, const ConstVec& q0,
                                                       const ConstVec& v0, const ConstVec& tau,
@@ -72,6 +81,13 @@ class Plant {
   Eigen::VectorXd tau_total_;
   bool world_active_ = true;  // false over a period the broad phase cleared
   ContactForces world_forces_;
+  // acceleration_derivatives' own (built on first use): the water's derivatives (a copy of
+  // the dynamics), the world contacts', the plant's generalized forces and their Jacobians
+  std::unique_ptr<Derivatives> derivatives_;
+  std::unique_ptr<WorldContactDerivatives> world_derivatives_;
+  Eigen::VectorXd force_tau_;
+  Eigen::MatrixXd force_dq_, force_dv_;
+  ForwardDynamicsDerivatives acceleration_derivatives_;
   void check_world();  // tau - the joint friction + the joint stops' torque
 };
 

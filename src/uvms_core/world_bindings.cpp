@@ -171,5 +171,18 @@ void bind_plant_world(nb::class_<Plant>& plant) {
             read_memory(friction, p.friction);
             return forces_dict(p.world_forces(qc, vc));
           },
-          "q"_a, "v"_a, "friction"_a, "The contact points and forces (World.forces) as arrays.");
+          "q"_a, "v"_a, "friction"_a, "The contact points and forces (World.forces) as arrays.")
+      .def(
+          "acceleration_derivatives",
+          [](Plant& p, double t, const Eigen::VectorXd& q, const Eigen::VectorXd& v,
+             const Eigen::VectorXd& tau, nb::handle friction) {
+            const int nq = p.dynamics().nq(), nv = p.dynamics().nv();
+            const auto qc = checked("q", q, nq), vc = checked("v", v, nv);
+            const auto u = checked("tau", tau, nv);
+            read_memory(friction, p.friction);
+            return uvms::ForwardDynamicsDerivatives(p.acceleration_derivatives(t, qc, vc, u));
+          },
+          "time_s"_a, "q"_a, "v"_a, "tau"_a, "friction"_a,
+          "(da/dq, da/dv, da/dtau) of acceleration_in_world with the world's contacts at the "
+          "anchors of friction (read only), the joint friction and stops (plant_derivatives.cpp).");
 }

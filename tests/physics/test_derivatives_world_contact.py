@@ -159,7 +159,8 @@ def test_a_solid_object_s_contact_is_refused(reference_uvms):
 
 
 def test_the_core_backend_gives_the_reference(reference_uvms):
-    """The plant on the core: the water's derivatives compiled, the contacts' the same."""
+    """The plant on the core: the whole compiled (src/uvms_core/plant_derivatives.cpp), the
+    same (tests/physics/derivatives/test_world_contact_core.py: every case)."""
     rng = np.random.default_rng(66)
     plant, q, v, tau = _on_the_floor(reference_uvms, rng, np.array([0.0, 0.0, 1.0]))
     _anchor(plant, q, v, 2e-4, slipping=False)

@@ -1,6 +1,12 @@
 """The derivatives of a plant's acceleration: the water's from
 `uvms_pin.physics.dynamics.forward_dynamics_derivatives`, with the plant's own generalized
-forces (world contacts, joint friction, joint stops) and their Jacobians added."""
+forces (world contacts, joint friction, joint stops) and their Jacobians added.
+
+On the compiled core (a plant with ``backend="core"`` whose parts all have a compiled
+counterpart) the whole of it is one compiled call, `src/uvms_core/plant_derivatives.cpp`,
+on the compiled world's own contact points and forces (`derivatives_world_contact.cpp`,
+`derivatives_joint_limits.hpp` mirror the Python files); the functions here are its
+reference (``backend="python"``)."""
 
 from __future__ import annotations
 
@@ -13,6 +19,7 @@ from uvms_pin.errors import ParameterError
 from uvms_pin.physics.derivatives.joint_limits import joint_friction_jacobian, joint_stop_jacobians
 from uvms_pin.physics.derivatives.world_contact import world_contact_jacobians
 from uvms_pin.physics.dynamics import forward_dynamics_derivatives
+from uvms_pin.physics.reference import check_time
 
 
 def acceleration_derivatives(
@@ -40,6 +47,12 @@ def acceleration_derivatives(
             "acceleration_derivatives: the end-effector contact environment, free "
             "objects and self-collision are not differentiated"
         )
+    compiled = plant._core()
+    if compiled is not None:
+        out = compiled.acceleration_derivatives(
+            check_time(time_s), q, v, finite_vector("tau", tau, plant.uvms.nv), plant.friction
+        )
+        return out.da_dq, out.da_dv, out.da_dtau
     nv = plant.uvms.nv
     tau_ext, by_q, by_v = np.zeros(nv), np.zeros((nv, nv)), np.zeros((nv, nv))
     forces = plant.world_forces(q, v)
