@@ -131,7 +131,7 @@ def test_point_to_point_moves_the_end_effector(reference_uvms):
     start = data.oMf[uvms.ee_frame_id]
     target = pin.SE3(start.rotation, start.translation + np.array([0.1, 0.0, -0.05]))
     problem = problems.point_to_point(uvms, x0, target, horizon_s=1.0, dt_s=0.02)
-    solver = problems.solve(problem, iterations=60, bounded=False)
+    solver = problems.solve(problem, iterations=60, solver="fddp")
     q_end = solver.xs[-1][: uvms.nq]
     pin.framesForwardKinematics(uvms.model, data, q_end)
     miss_m = np.linalg.norm(data.oMf[uvms.ee_frame_id].translation - target.translation)

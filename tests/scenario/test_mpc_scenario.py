@@ -54,6 +54,28 @@ def test_mpc_keys_are_checked():
         load_scenario(SCENARIO, {"controller.tau_limits": [1.0, 2.0]})
     with pytest.raises(ScenarioError, match=r"controller\.horizon_s"):
         load_scenario(SCENARIO, {"controller.horizon_s": -1.0})
+    with pytest.raises(ScenarioError, match=r"controller\.solver.*box_fddp, fddp, csqp"):
+        load_scenario(SCENARIO, {"controller.solver": "ipopt"})
+    with pytest.raises(ScenarioError, match=r"controller\.integrator.*euler, rk4"):
+        load_scenario(SCENARIO, {"controller.integrator": "rk2"})
+
+
+def test_mpc_solver_and_integrator_keys_reach_the_controller():
+    """solver = "csqp" and integrator = "rk4" build an MPC with mim_solvers' CSQP on RK4
+    nodes, the thrust bounds as the nodes' constraints; the scenario's choices are the ocp
+    layer's."""
+    pytest.importorskip("mim_solvers")
+    from uvms_pin.ocp import problems
+    from uvms_pin.scenario import mpc
+
+    assert mpc.SOLVERS == problems.SOLVERS and mpc.INTEGRATORS == problems.INTEGRATORS
+    overrides = {"controller.solver": "csqp", "controller.integrator": "rk4"}
+    scenario = load_scenario(FORCE_SCENARIO, overrides)
+    controller = scenario.controller_factory(scenario.plant.uvms)
+    assert type(controller._solver).__name__ == "SolverCSQP"
+    node = controller.problem.runningModels[0]
+    assert type(node).__name__ == "IntegratedActionModelRK"
+    assert node.ng == node.nu and np.all(node.g_ub > 0.0)
 
 
 FORCE_SCENARIO = SCENARIO.with_name("mpc_force_tracking.toml")
