@@ -118,6 +118,7 @@ class UnderwaterActionModel(crocoddyl.DifferentialActionModelAbstract):
             data.contact, tau_ext = None, None
         else:  # its kinematics at (q, v) are the costs' too
             data.contact = contact_wrench(self.contact, model, pdata, q, v)
+            data.contact_x = x.copy()  # where data.contact is (calcDiff reuses it there)
             tau_ext = data.contact.tau_ext
         pin.updateFramePlacements(model, pdata)
         data.xout[:] = forward_dynamics(
@@ -127,7 +128,7 @@ class UnderwaterActionModel(crocoddyl.DifferentialActionModelAbstract):
             self.constraints.calc(data.constraints, x, u)
             data.g[:] = data.constraints.g
         data.residuals = [term.residual(model, pdata, x, u, data.contact) for term, _ in self.terms]
-        residual = np.concatenate([np.zeros(0), *data.residuals])
+        data.residual = residual = np.concatenate([np.zeros(0), *data.residuals])
         data.cost = 0.5 * float(residual @ (self._weights * residual))
 
     def calcDiff(self, data, x, u=None):
@@ -135,8 +136,13 @@ class UnderwaterActionModel(crocoddyl.DifferentialActionModelAbstract):
         model, pdata, nv = self.uvms.model, data.pinocchio, self.uvms.nv
         contact, tau_ext = None, None
         if self.contact is not None:
-            # also the WORLD joint Jacobians in pdata, as computeJointJacobians leaves them
-            state, contact = contact_derivatives(self.contact, model, pdata, q, v, self._supports)
+            # also the WORLD joint Jacobians in pdata, as computeJointJacobians leaves them;
+            # the contact of the last calc reused when it was at this state (crocoddyl's
+            # solvers calc before calcDiff at the same point)
+            known = data.contact if np.array_equal(data.contact_x, x) else None
+            state, contact = contact_derivatives(
+                self.contact, model, pdata, q, v, self._supports, at_state=known
+            )
             tau_ext = state.tau_ext
         else:
             pin.computeJointJacobians(model, pdata, q)
@@ -166,7 +172,7 @@ class UnderwaterActionModel(crocoddyl.DifferentialActionModelAbstract):
             stacked[row : row + term.nr, :nx], stacked[row : row + term.nr, nx:] = rx, ru
             row += term.nr
         weighted = self._weights[:, None] * stacked
-        gradient = weighted.T @ np.concatenate([np.zeros(0), *data.residuals])
+        gradient = weighted.T @ data.residual
         hessian = stacked.T @ weighted
         data.Lx[:], data.Lu[:] = gradient[:nx], gradient[nx:]
         data.Lxx[:, :], data.Luu[:, :] = hessian[:nx, :nx], hessian[nx:, nx:]
@@ -198,4 +204,6 @@ class UnderwaterActionData(crocoddyl.DifferentialActionDataAbstract):
             self.constraints = model.constraints.createData(self._collector)
         self.pinocchio = model.uvms.model.createData()
         self.residuals: list[np.ndarray] = []
+        self.residual = np.zeros(model.nr)  # the residuals stacked (the costs' order)
         self.contact = None  # the last calc's ContactWrench (None without a contact)
+        self.contact_x = np.full(model.state.nx, np.nan)  # the state it was computed at
