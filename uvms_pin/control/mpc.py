@@ -2,8 +2,9 @@
 
 At each re-plan (every 1 / rate_hz seconds) the controller sets the OCP's initial state to
 the measured (q, v), warm-starts its solver (crocoddyl's BoxFDDP or FDDP, or mim_solvers'
-CSQP with the input bounds as constraints) from the previous solution shifted by one node, runs at most ``iterations`` iterations (at most `COLD_START_ITERATIONS` for a
-plan without a warm start, e.g. the first) and applies the first control,
+CSQP with the input bounds as constraints) from the previous solution shifted by one node,
+runs at most ``iterations`` iterations (at most `COLD_START_ITERATIONS` for a plan without
+a warm start, e.g. the first) and applies the first control,
 tau = B_u u_0, held until the next re-plan. The OCP (`uvms_pin.ocp.problems`) is built once
 on the model the controller believes in (it can be wrong on purpose, as for computed
 torque: `uvms_pin.model.scaled.scaled_uvms`) and the water it is told about (a known

@@ -10,6 +10,8 @@ tau = B_u u (`uvms_pin.physics.discrete.input_matrix`), each thrust within its o
 (else ``tau_limits``'s): what the thrusters can really give, coupled and asymmetric; its model is the plant's, or the
 plant's scaled by [controller.model_error] (as for computed torque); the water it plans in is
 ``current_world_m_s`` (what it believes the current is; it does not see the scenario's).
+``solver`` ("box_fddp", "fddp" or "csqp": mim_solvers' CSQP, the bounds as the nodes'
+constraints) and ``integrator`` ("euler" or "rk4" nodes) are `uvms_pin.ocp.problems`'.
 
 ``task = "force"`` is the paper's force task: ``desired_force`` (a [controller.desired_force]
 sine profile, as the PPC's), ``desired_rpy``, ``force_weights``, ``attitude_weights``,
