@@ -135,3 +135,25 @@ def test_csqp_needs_the_bounds_as_constraints(reference_uvms):
         problems.solver_of(problem, "csqp")
     with pytest.raises(ParameterError, match="box_fddp, fddp, csqp"):
         problems.solver_of(problem, "ipopt")
+
+
+def test_solution_copies_what_the_solver_holds(reference_uvms):
+    """`problems.solution` gives copies of xs and us that outlive the solver's containers and
+    its next solve (mim_solvers' ``solver.us[0]`` alone would view freed memory)."""
+    uvms = reference_uvms
+    x0 = np.r_[uvms.neutral_configuration(), np.zeros(uvms.nv)]
+    x0[2] = -3.0
+    station = pin.SE3(np.eye(3), x0[:3].copy())
+    problem = problems.station_hold(
+        uvms, x0, station, horizon_s=0.2, dt_s=0.02, flow=UniformCurrent([0.3, 0.0, 0.0])
+    )
+    solver = problems.solve(problem, iterations=5, solver="csqp")
+    xs, us = problems.solution(solver)
+    expected = np.array(solver.us)
+    assert len(xs) == problem.T + 1 and len(us) == problem.T
+    np.testing.assert_array_equal(np.array(us), expected)
+    assert np.abs(expected).max() > 0.1  # the current is fought
+    problem.x0 = x0 + np.r_[np.full(3, 0.05), np.zeros(uvms.nq + uvms.nv - 3)]
+    problems.solve(problem, iterations=5, solver=solver)
+    np.testing.assert_array_equal(np.array(us), expected)
+    assert np.abs(np.array(solver.us) - expected).max() > 1e-3
