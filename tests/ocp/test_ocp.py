@@ -131,7 +131,7 @@ def test_point_to_point_moves_the_end_effector(reference_uvms):
     start = data.oMf[uvms.ee_frame_id]
     target = pin.SE3(start.rotation, start.translation + np.array([0.1, 0.0, -0.05]))
     problem = problems.point_to_point(uvms, x0, target, horizon_s=1.0, dt_s=0.02)
-    solver = problems.solve(problem, iterations=60, bounded=False)
+    solver = problems.solve(problem, iterations=60, solver="fddp")
     q_end = solver.xs[-1][: uvms.nq]
     pin.framesForwardKinematics(uvms.model, data, q_end)
     miss_m = np.linalg.norm(data.oMf[uvms.ee_frame_id].translation - target.translation)
@@ -243,3 +243,28 @@ def test_a_contact_force_cost_needs_a_contact(reference_uvms):
 
     with pytest.raises(ParameterError, match="contact force"):
         UnderwaterActionModel(reference_uvms, [(costs.ContactForce(np.zeros(3), np.ones(3)), 1.0)])
+
+
+def test_calc_diff_reuses_the_contact_of_calc_only_at_the_same_state(reference_uvms):
+    """calcDiff reuses the contact wrench its calc computed at the same state (crocoddyl's
+    solvers calc first); after a calc elsewhere it recomputes it: the derivatives are those
+    of a calc at the calcDiff's own state, bit for bit."""
+    from uvms_pin.physics.contact import LinearSpring
+
+    uvms = reference_uvms
+    rng = np.random.default_rng(12)
+    x, elsewhere = _state(uvms, rng), _state(uvms, rng)
+    data = uvms.model.createData()
+    pin.framesForwardKinematics(uvms.model, data, x[: uvms.nq])
+    tip = data.oMf[uvms.ee_frame_id].translation
+    spring = LinearSpring(np.array([20.0, 30.0, 50.0]), tip - [0.1, 0.05, -0.05])
+    model = _force_model(uvms, spring, _thrusters(uvms))
+    u = rng.normal(scale=5.0, size=model.nu)
+    same, stale = model.createData(), model.createData()
+    model.calc(same, x, u)
+    model.calcDiff(same, x, u)
+    model.calc(stale, elsewhere, u)
+    stale.residual = same.residual  # the costs' part reads calc's residual (a crocoddyl rule)
+    model.calcDiff(stale, x, u)
+    for name in ("Fx", "Fu", "Lx", "Lu", "Lxx"):
+        np.testing.assert_array_equal(getattr(stale, name), getattr(same, name), err_msg=name)

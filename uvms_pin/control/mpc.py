@@ -1,9 +1,10 @@
 """Model-predictive control on the analytical derivatives: an OCP re-solved at a fixed rate.
 
 At each re-plan (every 1 / rate_hz seconds) the controller sets the OCP's initial state to
-the measured (q, v), warm-starts crocoddyl's (Box)FDDP from the previous solution shifted
-by one node, runs at most ``iterations`` iterations (at most `COLD_START_ITERATIONS` for a
-plan without a warm start, e.g. the first) and applies the first control,
+the measured (q, v), warm-starts its solver (crocoddyl's BoxFDDP or FDDP, or mim_solvers'
+CSQP with the input bounds as constraints) from the previous solution shifted by one node,
+runs at most ``iterations`` iterations (at most `COLD_START_ITERATIONS` for a plan without
+a warm start, e.g. the first) and applies the first control,
 tau = B_u u_0, held until the next re-plan. The OCP (`uvms_pin.ocp.problems`) is built once
 on the model the controller believes in (it can be wrong on purpose, as for computed
 torque: `uvms_pin.model.scaled.scaled_uvms`) and the water it is told about (a known
@@ -24,6 +25,7 @@ the environment's models, and what they get wrong it corrects only through re-pl
 from __future__ import annotations
 
 import copy
+import dataclasses
 import math
 from collections.abc import Callable
 from dataclasses import dataclass, field
@@ -87,8 +89,10 @@ class MpcController(Controller):
         posture: the arm's and vehicle's reference configuration (nq,) for the state terms
             (x_ref = (posture, 0)).
         horizon_s, dt_s: the OCP's horizon and node length [s]. rate_hz: re-plans per second.
-        iterations: solver iterations per re-plan. solver: "box_fddp" (bounds enforced) or
-            "fddp".
+        iterations: solver iterations per re-plan. solver: "box_fddp" (bounds enforced as a
+            box), "fddp" (not enforced) or "csqp" (mim_solvers' CSQP: enforced as the
+            nodes' inequality constraints). integrator: of the OCP's nodes, "euler" or
+            "rk4" (`uvms_pin.ocp.problems.INTEGRATORS`).
         actuators: what u is and its bounds (`uvms_pin.ocp.problems.Actuators`).
         flow: the water the controller plans in. warm_start: shift the previous solution.
         pose_weights: of the target pose's error (x, y, z [m], rotation [rad]); None: the
@@ -108,6 +112,7 @@ class MpcController(Controller):
         rate_hz: float = 50.0,
         iterations: int = 3,
         solver: str = "box_fddp",
+        integrator: str = "euler",
         actuators: problems.Actuators | None = None,
         flow: FlowField | None = None,
         warm_start: bool = True,
@@ -123,14 +128,16 @@ class MpcController(Controller):
             raise ParameterError(
                 f"mpc needs 0 < dt_s <= horizon_s (at least one node), got {dt_s}, {horizon_s}"
             )
-        if solver not in ("box_fddp", "fddp"):
-            raise ParameterError(f"mpc solver must be 'box_fddp' or 'fddp', got '{solver}'")
+        problems.check_solver(solver)
+        problems.check_integrator(integrator)
         if not (rate_hz > 0.0 and math.isfinite(rate_hz)) or iterations < 1:
             raise ParameterError(
                 f"mpc needs rate_hz > 0 and iterations >= 1, got {rate_hz}, {iterations}"
             )
         self.uvms = uvms.with_model(pin.Model(uvms.model))
         actuators = problems.Actuators() if actuators is None else actuators
+        # csqp: the bounds as constraints (box FDDP reads them as a box either way)
+        actuators = dataclasses.replace(actuators, as_constraints=solver == "csqp")
         x_ref = np.r_[np.asarray(posture, float), np.zeros(uvms.nv)]
         self.force_task, self.force_tracking = force_task, None
         common = {
@@ -139,6 +146,7 @@ class MpcController(Controller):
             "actuators": actuators,
             "flow": flow,
             "backend": backend,
+            "integrator": integrator,
         }
         if force_task is not None:
             self.problem = self._force_problem(force_task, x_ref, common)
@@ -147,11 +155,7 @@ class MpcController(Controller):
             weights = {} if pose_weights is None else {"pose_weights": pose_weights}
             self.problem = build(self.uvms, x_ref, target, **common, **weights)
         self.period_s = 1.0 / rate_hz
-        self.iterations, self.bounded, self.warm_start = (
-            iterations,
-            solver == "box_fddp",
-            warm_start,
-        )
+        self.iterations, self.solver, self.warm_start = iterations, solver, warm_start
         self.input_matrix = (
             np.eye(uvms.nv) if actuators.input_matrix is None else actuators.input_matrix
         )
@@ -184,7 +188,7 @@ class MpcController(Controller):
         self._tau = np.zeros(self.uvms.nv)
         self._signals: dict[str, np.ndarray] = {}
         # one solver for the run: each re-plan starts from the last one's regularization
-        self._solver = problems.solver_of(self.problem, self.bounded)
+        self._solver = problems.solver_of(self.problem, self.solver)
         self._cold_steps = list(self._solver.alphas)
         self._regularization: float | None = None
 
@@ -226,7 +230,8 @@ class MpcController(Controller):
         x = np.r_[measurement.q, measurement.v]
         self.problem.x0 = x
         cold = self._guess is None or not self.warm_start
-        self._solver.alphas = self._cold_steps if cold else list(REPLAN_STEP_LENGTHS)
+        if self.solver != "csqp":  # (CSQP's filter line search keeps its own steps)
+            self._solver.alphas = self._cold_steps if cold else list(REPLAN_STEP_LENGTHS)
         solver = problems.solve(
             self.problem,
             iterations=max(self.iterations, COLD_START_ITERATIONS) if cold else self.iterations,
@@ -234,9 +239,9 @@ class MpcController(Controller):
             solver=self._solver,
             regularization=self._regularization if self.warm_start else None,
         )
-        self._guess = (list(solver.xs), list(solver.us))
+        self._guess = problems.solution(solver)
         self._regularization = solver.preg
-        u0 = np.array(solver.us[0])
+        u0 = self._guess[1][0].copy()
         self._tau = self.input_matrix @ u0
         self._next_plan_s = time_s + self.period_s - 1e-12
         self._signals.update({"mpc_cost": np.array([solver.cost]), "mpc_u": u0})

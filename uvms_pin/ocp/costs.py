@@ -90,7 +90,9 @@ class _Frame:
 
 
 def _state_jacobian(jq: np.ndarray, nv: int, nu: int) -> tuple[np.ndarray, np.ndarray]:
-    return np.hstack([jq, np.zeros((jq.shape[0], nv))]), np.zeros((jq.shape[0], nu))
+    rx = np.zeros((jq.shape[0], 2 * nv))
+    rx[:, :nv] = jq
+    return rx, np.zeros((jq.shape[0], nu))
 
 
 class FramePose(CostTerm):
@@ -211,14 +213,15 @@ class JointLimitMargin(CostTerm):
         super().__init__(np.full(len(joints), weight), len(joints), "joint limits")
         if not (margin_rad >= 0.0 and np.isfinite(margin_rad)):
             raise ParameterError(f"joint limits: margin_rad must be >= 0, got {margin_rad}")
-        self.q_index = np.array([model.idx_qs[j] for j in joints], dtype=int)
+        self.q_index = _indices([model.idx_qs[j] for j in joints])
         self.v_index = np.array([model.idx_vs[j] for j in joints], dtype=int)
         self.lower = model.lowerPositionLimit[self.q_index] + margin_rad
         self.upper = model.upperPositionLimit[self.q_index] - margin_rad
 
     def residual(self, model, data, x, u, contact=None):
         q = x[self.q_index]
-        return q - np.clip(q, self.lower, self.upper)
+        # np.clip's own definition, without its dispatch (a third of this term's time)
+        return q - np.minimum(np.maximum(q, self.lower), self.upper)
 
     def jacobians(self, model, data, x, u, contact=None):
         q = x[self.q_index]
@@ -226,6 +229,13 @@ class JointLimitMargin(CostTerm):
         outside = (q < self.lower) | (q > self.upper)
         rx[np.arange(self.nr), self.v_index] = outside
         return rx, np.zeros((self.nr, len(u)))
+
+
+def _indices(indices: list[int]) -> slice | np.ndarray:
+    """A slice for consecutive indices (a view, cheaper than fancy indexing), else an array."""
+    if indices and indices == list(range(indices[0], indices[0] + len(indices))):
+        return slice(indices[0], indices[0] + len(indices))
+    return np.array(indices, dtype=int)
 
 
 def end_effector_pose(uvms: UVMS, target: pin.SE3, weights) -> FramePose:

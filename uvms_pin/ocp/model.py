@@ -15,9 +15,11 @@ derivatives (`uvms_pin.physics.derivatives.task_contact`; da/dtau_ext = da/dtau 
 
     Fx += M^-1 [d tau_ext/dq, d tau_ext/dv].
 
-Bounds on u
-(thrust and effort limits) go to crocoddyl's box-constrained solvers through ``u_lb`` /
-``u_ub``.
+Bounds on u (thrust and effort limits) go to crocoddyl's box-constrained solvers through
+``u_lb`` / ``u_ub``; with ``bounds_as_constraints`` they are also the node's inequality
+constraints, lower <= g(x, u) = u <= upper (G_x = 0, G_u = I: a crocoddyl
+ConstraintModelManager holding a ConstraintModelResidual of ResidualModelControl), what a
+constrained solver (mim_solvers' CSQP) enforces.
 """
 
 from __future__ import annotations
@@ -59,6 +61,8 @@ class UnderwaterActionModel(crocoddyl.DifferentialActionModelAbstract):
         backend: "core" (compiled) or "python" (the reference).
         contact: the end-effector's environment (a `TaskContact`, its model placed before
             the first calc), or None; a term with ``needs_contact`` requires one.
+        bounds_as_constraints: ``u_bounds`` also as the inequality constraints
+            lower <= u <= upper (ng = nu; ignored without bounds).
     """
 
     def __init__(
@@ -72,14 +76,15 @@ class UnderwaterActionModel(crocoddyl.DifferentialActionModelAbstract):
         u_bounds: tuple[np.ndarray, np.ndarray] | None = None,
         backend: str = "core",
         contact: TaskContact | None = None,
+        bounds_as_constraints: bool = False,
     ):
         b_u = np.eye(uvms.nv) if input_matrix_ is None else np.asarray(input_matrix_, float)
         if b_u.ndim != 2 or b_u.shape[0] != uvms.nv:
             raise ParameterError(f"input_matrix_ must be (nv={uvms.nv}, nu), got {b_u.shape}")
-        nr = sum(term.nr for term, _ in terms)
-        crocoddyl.DifferentialActionModelAbstract.__init__(
-            self, UvmsState(uvms.model), b_u.shape[1], nr
-        )
+        nr, nu = sum(term.nr for term, _ in terms), b_u.shape[1]
+        ng = nu if bounds_as_constraints and u_bounds is not None else 0
+        state = UvmsState(uvms.model)
+        crocoddyl.DifferentialActionModelAbstract.__init__(self, state, nu, nr, ng)
         self.uvms, self.terms, self.input_matrix = uvms, list(terms), b_u
         # scale_i W_i of every residual row, in the terms' order
         self._weights = np.concatenate([np.zeros(0), *(s * term.weights for term, s in terms)])
@@ -90,11 +95,15 @@ class UnderwaterActionModel(crocoddyl.DifferentialActionModelAbstract):
         self.contact = contact
         # where d J_k/dq_m can be non-zero (the contact's derivatives), once per model
         self._supports = None if contact is None else supports_mask(uvms.model)
+        self.constraints = None
         if u_bounds is not None:
             lower, upper = (np.asarray(b, float).reshape(-1) for b in u_bounds)
             if lower.shape != (self.nu,) or upper.shape != (self.nu,) or np.any(lower > upper):
                 raise ParameterError(f"u_bounds: two (nu={self.nu},) arrays, lower <= upper")
             self.u_lb, self.u_ub = lower, upper
+        if ng:  # (the manager's own g_lb / g_ub read garbage in the crocoddyl 3.2.1 wheels)
+            self.constraints = _input_constraints(state, lower, upper)
+            self.g_lb, self.g_ub = lower, upper
 
     def _split(self, x: np.ndarray, u: np.ndarray | None):
         nq = self.uvms.nq
@@ -109,13 +118,17 @@ class UnderwaterActionModel(crocoddyl.DifferentialActionModelAbstract):
             data.contact, tau_ext = None, None
         else:  # its kinematics at (q, v) are the costs' too
             data.contact = contact_wrench(self.contact, model, pdata, q, v)
+            data.contact_x = x.copy()  # where data.contact is (calcDiff reuses it there)
             tau_ext = data.contact.tau_ext
         pin.updateFramePlacements(model, pdata)
         data.xout[:] = forward_dynamics(
             self.uvms, q, v, self.input_matrix @ u, tau_ext=tau_ext, **self.water
         )
+        if self.constraints is not None:
+            self.constraints.calc(data.constraints, x, u)
+            data.g[:] = data.constraints.g
         data.residuals = [term.residual(model, pdata, x, u, data.contact) for term, _ in self.terms]
-        residual = np.concatenate([np.zeros(0), *data.residuals])
+        data.residual = residual = np.concatenate([np.zeros(0), *data.residuals])
         data.cost = 0.5 * float(residual @ (self._weights * residual))
 
     def calcDiff(self, data, x, u=None):
@@ -123,8 +136,13 @@ class UnderwaterActionModel(crocoddyl.DifferentialActionModelAbstract):
         model, pdata, nv = self.uvms.model, data.pinocchio, self.uvms.nv
         contact, tau_ext = None, None
         if self.contact is not None:
-            # also the WORLD joint Jacobians in pdata, as computeJointJacobians leaves them
-            state, contact = contact_derivatives(self.contact, model, pdata, q, v, self._supports)
+            # also the WORLD joint Jacobians in pdata, as computeJointJacobians leaves them;
+            # the contact of the last calc reused when it was at this state (crocoddyl's
+            # solvers calc before calcDiff at the same point)
+            known = data.contact if np.array_equal(data.contact_x, x) else None
+            state, contact = contact_derivatives(
+                self.contact, model, pdata, q, v, self._supports, at_state=known
+            )
             tau_ext = state.tau_ext
         else:
             pin.computeJointJacobians(model, pdata, q)
@@ -136,6 +154,9 @@ class UnderwaterActionModel(crocoddyl.DifferentialActionModelAbstract):
             da_dv += da_dtau @ contact.tau_dv
         data.Fx[:, :nv], data.Fx[:, nv:] = da_dq, da_dv
         data.Fu[:, :] = da_dtau @ self.input_matrix
+        if self.constraints is not None:
+            self.constraints.calcDiff(data.constraints, x, u)
+            data.Gx[:, :], data.Gu[:, :] = data.constraints.Gx, data.constraints.Gu
         self._cost_derivatives(data, x, u, contact)
 
     def _cost_derivatives(self, data, x, u, contact) -> None:
@@ -151,7 +172,7 @@ class UnderwaterActionModel(crocoddyl.DifferentialActionModelAbstract):
             stacked[row : row + term.nr, :nx], stacked[row : row + term.nr, nx:] = rx, ru
             row += term.nr
         weighted = self._weights[:, None] * stacked
-        gradient = weighted.T @ np.concatenate([np.zeros(0), *data.residuals])
+        gradient = weighted.T @ data.residual
         hessian = stacked.T @ weighted
         data.Lx[:], data.Lu[:] = gradient[:nx], gradient[nx:]
         data.Lxx[:, :], data.Luu[:, :] = hessian[:nx, :nx], hessian[nx:, nx:]
@@ -161,11 +182,28 @@ class UnderwaterActionModel(crocoddyl.DifferentialActionModelAbstract):
         return UnderwaterActionData(self)
 
 
+def _input_constraints(state, lower: np.ndarray, upper: np.ndarray):
+    """lower <= u <= upper as a crocoddyl ConstraintModelManager (one residual constraint on
+    the control)."""
+    manager = crocoddyl.ConstraintModelManager(state, lower.size)
+    residual = crocoddyl.ResidualModelControl(state, lower.size)
+    bounds = crocoddyl.ConstraintModelResidual(state, residual, lower, upper)
+    manager.addConstraint("input_bounds", bounds)
+    return manager
+
+
 class UnderwaterActionData(crocoddyl.DifferentialActionDataAbstract):
-    """The model's buffers: crocoddyl's, a Pinocchio data and the last residuals."""
+    """The model's buffers: crocoddyl's, a Pinocchio data, the last residuals and the
+    constraints' data (None without constraints)."""
 
     def __init__(self, model: UnderwaterActionModel):
         crocoddyl.DifferentialActionDataAbstract.__init__(self, model)
+        self.constraints = None
+        if model.constraints is not None:
+            self._collector = crocoddyl.DataCollectorAbstract()  # outlives the data using it
+            self.constraints = model.constraints.createData(self._collector)
         self.pinocchio = model.uvms.model.createData()
         self.residuals: list[np.ndarray] = []
+        self.residual = np.zeros(model.nr)  # the residuals stacked (the costs' order)
         self.contact = None  # the last calc's ContactWrench (None without a contact)
+        self.contact_x = np.full(model.state.nx, np.nan)  # the state it was computed at

@@ -1,13 +1,19 @@
-"""Shooting problems of a UVMS in water, and their solution by crocoddyl's FDDP.
+"""Shooting problems of a UVMS in water, and their solution by crocoddyl's FDDP or
+mim_solvers' CSQP.
 
 A problem has N nodes of dt_s each: every running node is the `UnderwaterActionModel`
-integrated by crocoddyl's Euler (v+ = v + dt a, q+ = q (+) dt v+: the plant's semi-implicit
-Euler with a step of dt_s), the flow frozen at the node's time; the terminal node carries the
-terminal costs. `point_to_point` moves the end-effector to a pose, `station_hold` keeps the
-vehicle at a pose (e.g. in a current), `force_tracking` presses the end-effector on a
-compliant environment (the contact in every node's dynamics) to track a desired force while
-holding its attitude; `solve` runs box-constrained FDDP (the thrust and
-effort limits as bounds) from a warm start or the initial state held.
+integrated over dt_s by crocoddyl's Euler (``integrator="euler"``: v+ = v + dt a,
+q+ = q (+) dt v+, the plant's semi-implicit Euler with a step of dt_s) or by crocoddyl's
+fourth-order Runge-Kutta (``"rk4"``: four stages k_i = (v_i, a_i) at x (+) c_i dt k_(i-1),
+x+ = x (+) dt/6 (k_1 + 2 k_2 + 2 k_3 + k_4), and the cost integrated alike; the plant's
+RK4 steps its chart with the chart rate instead, the same to third order), the flow frozen
+at the node's time; the terminal node carries the terminal costs. `point_to_point` moves the
+end-effector to a pose, `station_hold` keeps the vehicle at a pose (e.g. in a current),
+`force_tracking` presses the end-effector on a compliant environment (the contact in every
+node's dynamics) to track a desired force while holding its attitude; `solve` runs
+box-constrained FDDP (the thrust and effort limits as bounds), plain FDDP or CSQP (the limits
+as inequality constraints: `Actuators.as_constraints`) from a warm start or the initial
+state held.
 """
 
 from __future__ import annotations
@@ -23,7 +29,7 @@ from uvms_pin.errors import ParameterError
 from uvms_pin.flow import FlowField, UniformCurrent
 from uvms_pin.model.uvms import UVMS
 from uvms_pin.ocp import costs
-from uvms_pin.ocp.crocoddyl_module import crocoddyl_module
+from uvms_pin.ocp.crocoddyl_module import crocoddyl_module, mim_solvers_module
 from uvms_pin.ocp.model import UnderwaterActionModel, WeightedTerms
 from uvms_pin.physics.derivatives.task_contact import TaskContact
 
@@ -32,14 +38,26 @@ crocoddyl = crocoddyl_module()
 CostBuilder = Callable[[int], WeightedTerms]
 """nu -> the (term, scale) pairs of one node's cost."""
 
+#: the nodes' integrators (crocoddyl's IntegratedActionModelEuler, IntegratedActionModelRK)
+INTEGRATORS = ("euler", "rk4")
+#: the solvers: crocoddyl's SolverBoxFDDP (bounds as a box), SolverFDDP (no bounds),
+#: mim_solvers' SolverCSQP (bounds as constraints)
+SOLVERS = ("box_fddp", "fddp", "csqp")
+#: CSQP's ADMM iterations per QP (mim_solvers' default, 1000, left the station-keeping QP
+#: with saturated thrusters unconverged at every SQP iteration; 200 solved it)
+CSQP_QP_ITERATIONS = 200
+
 
 @dataclass(frozen=True)
 class Actuators:
     """What u is: tau = input_matrix u, within bounds (lower, upper) (None: the identity,
-    unbounded). `uvms_pin.physics.discrete.input_matrix` for thrusters and joint torques."""
+    unbounded). `uvms_pin.physics.discrete.input_matrix` for thrusters and joint torques.
+    ``as_constraints``: the bounds also as each running node's inequality constraints
+    (what the "csqp" solver enforces; box FDDP reads them as a box either way)."""
 
     input_matrix: np.ndarray | None = None
     bounds: tuple[np.ndarray, np.ndarray] | None = None
+    as_constraints: bool = False
 
     def nu(self, nv: int) -> int:
         return nv if self.input_matrix is None else int(np.shape(self.input_matrix)[1])
@@ -59,16 +77,19 @@ def shooting_problem(
     backend: str = "core",
     contact: TaskContact | None = None,
     per_node: bool = False,
+    integrator: str = "euler",
 ):
     """A crocoddyl.ShootingProblem from x0 over ``nodes`` steps of ``dt_s`` [s], each node's
-    dynamics with ``contact`` (None: none). The running nodes share one model in a steady
-    flow unless ``per_node`` (each its own terms: ``running`` is called once per node, in
-    order, e.g. for a cost whose target moves along the horizon)."""
+    dynamics with ``contact`` (None: none) integrated by ``integrator`` (`INTEGRATORS`).
+    The running nodes share one model in a steady flow unless ``per_node`` (each its own
+    terms: ``running`` is called once per node, in order, e.g. for a cost whose target moves
+    along the horizon). The terminal node has no constraints (its u is not an input)."""
     if nodes < 1 or not (dt_s > 0.0 and np.isfinite(dt_s)):
         raise ParameterError(f"need nodes >= 1 and dt_s > 0, got {nodes}, {dt_s}")
+    check_integrator(integrator)
     nu = actuators.nu(uvms.nv)
 
-    def node(costs_of: CostBuilder, t: float):
+    def node(costs_of: CostBuilder, t: float, constrained: bool):
         return UnderwaterActionModel(
             uvms,
             costs_of(nu),
@@ -78,19 +99,49 @@ def shooting_problem(
             u_bounds=actuators.bounds,
             backend=backend,
             contact=contact,
+            bounds_as_constraints=constrained,
         )
 
     # a steady flow: one model shared by the running nodes (each has its own data)
     steady = flow is None or isinstance(flow, UniformCurrent)
-    shared = node(running, time_s) if steady and not per_node else None
+    constrained = actuators.as_constraints
+    shared = node(running, time_s, constrained) if steady and not per_node else None
     models = [
-        crocoddyl.IntegratedActionModelEuler(
-            shared if shared is not None else node(running, time_s + k * dt_s), dt_s
+        integrated_node(
+            shared if shared is not None else node(running, time_s + k * dt_s, constrained),
+            dt_s,
+            integrator,
         )
         for k in range(nodes)
     ]
-    last = crocoddyl.IntegratedActionModelEuler(node(terminal, time_s + nodes * dt_s), 0.0)
-    return crocoddyl.ShootingProblem(np.asarray(x0, float), models, last)
+    last = node(terminal, time_s + nodes * dt_s, False)
+    return crocoddyl.ShootingProblem(
+        np.asarray(x0, float), models, crocoddyl.IntegratedActionModelEuler(last, 0.0)
+    )
+
+
+def integrated_node(model: UnderwaterActionModel, dt_s: float, integrator: str = "euler"):
+    """``model`` integrated over ``dt_s`` [s]: crocoddyl's IntegratedActionModelEuler
+    ("euler") or IntegratedActionModelRK with RKType.four ("rk4")."""
+    if check_integrator(integrator) == "rk4":
+        return crocoddyl.IntegratedActionModelRK(model, crocoddyl.RKType.four, dt_s)
+    return crocoddyl.IntegratedActionModelEuler(model, dt_s)
+
+
+def check_integrator(integrator: str) -> str:
+    """``integrator`` if it is one of `INTEGRATORS`, else ParameterError naming them."""
+    if integrator not in INTEGRATORS:
+        raise ParameterError(
+            f"ocp integrator must be one of {', '.join(INTEGRATORS)}, got '{integrator}'"
+        )
+    return integrator
+
+
+def check_solver(solver: str) -> str:
+    """``solver`` if it is one of `SOLVERS`, else ParameterError naming them."""
+    if solver not in SOLVERS:
+        raise ParameterError(f"ocp solver must be one of {', '.join(SOLVERS)}, got '{solver}'")
+    return solver
 
 
 def _nodes(horizon_s: float, dt_s: float) -> int:
@@ -109,6 +160,7 @@ def point_to_point(
     effort_weight: float = 1e-4,
     pose_weights=(1.0, 1.0, 1.0, 0.1, 0.1, 0.1),
     backend: str = "core",
+    integrator: str = "euler",
 ):
     """Move the end-effector to ``target`` (its pose at the horizon's end, at rest); the
     running cost keeps velocities and effort small. ``pose_weights``: of the pose error
@@ -140,6 +192,7 @@ def point_to_point(
         actuators=actuators,
         flow=flow,
         backend=backend,
+        integrator=integrator,
     )
 
 
@@ -155,6 +208,7 @@ def station_hold(
     effort_weight: float = 1e-4,
     pose_weights=100.0,
     backend: str = "core",
+    integrator: str = "euler",
 ):
     """Keep the vehicle's body frame at ``station`` and the arm as in x0, at rest.
 
@@ -187,6 +241,7 @@ def station_hold(
         actuators=actuators,
         flow=flow,
         backend=backend,
+        integrator=integrator,
     )
 
 
@@ -226,6 +281,7 @@ def force_tracking(
     limit_margin_rad: float = 0.1,
     limit_weight: float = 1e3,
     backend: str = "core",
+    integrator: str = "euler",
 ) -> ForceTracking:
     """Press on ``contact`` with the desired force f_d(t) [N] while holding the end-effector's
     attitude at ``rotation`` (world <- end-effector), the arm near its posture in x0.
@@ -272,14 +328,41 @@ def force_tracking(
         backend=backend,
         contact=contact,
         per_node=True,
+        integrator=integrator,
     )
     return ForceTracking(problem, forces, offsets)
 
 
-def solver_of(problem, bounded: bool = True):
-    """crocoddyl's SolverBoxFDDP (bounded: the input bounds enforced) or SolverFDDP for
-    ``problem``."""
-    return crocoddyl.SolverBoxFDDP(problem) if bounded else crocoddyl.SolverFDDP(problem)
+def solver_of(problem, solver: str = "box_fddp"):
+    """A solver of ``problem`` (`SOLVERS`): crocoddyl's SolverBoxFDDP (the input bounds
+    enforced as a box), SolverFDDP (ignored) or mim_solvers' SolverCSQP (enforced as the
+    nodes' inequality constraints: the problem built with ``Actuators(...,
+    as_constraints=True)``; the mim-solvers package, the ``ocp`` extra)."""
+    check_solver(solver)
+    if solver == "box_fddp":
+        return crocoddyl.SolverBoxFDDP(problem)
+    if solver == "fddp":
+        return crocoddyl.SolverFDDP(problem)
+    unconstrained = [
+        k for k, m in enumerate(problem.runningModels) if m.has_control_limits and m.ng == 0
+    ]
+    if unconstrained:
+        raise ParameterError(
+            f"csqp enforces the input bounds as constraints, but node(s) {unconstrained[:3]}"
+            " have bounds and no constraints: build the problem with "
+            "Actuators(..., as_constraints=True)"
+        )
+    csqp = mim_solvers_module().SolverCSQP(problem)
+    csqp.max_qp_iters = CSQP_QP_ITERATIONS
+    return csqp
+
+
+def solution(solver) -> tuple[list[np.ndarray], list[np.ndarray]]:
+    """(xs, us) of ``solver``, copied. (mim_solvers' ``xs`` / ``us`` are containers returned
+    by value whose items view the container's memory: ``solver.us[0]`` reads freed memory
+    once the container is gone; crocoddyl's are the solver's own. Copy them here.)"""
+    xs, us = solver.xs, solver.us  # held while their items are copied
+    return [np.array(x, dtype=float) for x in xs], [np.array(u, dtype=float) for u in us]
 
 
 def solve(
@@ -287,17 +370,17 @@ def solve(
     *,
     iterations: int = 100,
     warm_start=None,
-    bounded: bool = True,
-    solver=None,
+    solver: str | object = "box_fddp",
     regularization: float | None = None,
 ):
-    """Solve ``problem`` by crocoddyl's SolverBoxFDDP (bounded) or SolverFDDP (or by
-    ``solver``, one of `solver_of` kept between solves); warm start: (xs, us), else the
+    """Solve ``problem`` by ``solver``: a name of `SOLVERS` (a new solver, `solver_of`) or a
+    solver kept between solves (e.g. a receding horizon's); warm start: (xs, us), else the
     initial state held with zero input; ``regularization``: the initial one (e.g. the last
     solve's ``preg``: a receding horizon keeps what the previous plans learnt of the
-    problem's curvature), None: crocoddyl's smallest. Returns the solver (``xs``, ``us``,
-    ``cost``, ``iter``, ``isFeasible``, ``preg``)."""
-    solver = solver_of(problem, bounded) if solver is None else solver
+    problem's curvature), None: the solver's smallest. Returns the solver (``xs``, ``us``,
+    ``cost``, ``iter``, ``preg``; CSQP's ``xs`` may keep gaps to the dynamics, its
+    ``gap_norm`` and ``constraint_norm`` the last iterate's; read xs and us by `solution`)."""
+    solver = solver_of(problem, solver) if isinstance(solver, str) else solver
     if warm_start is None:
         xs = [problem.x0] * (problem.T + 1)
         us = [np.zeros(m.nu) for m in problem.runningModels]

@@ -30,6 +30,10 @@ class UvmsState(crocoddyl.StateAbstract):
         crocoddyl.StateAbstract.__init__(self, model.nq + model.nv, 2 * model.nv)
         self.model = model
         self._rng = np.random.default_rng(seed)
+        # [[J_q, 0], [0, +-I]]: the blocks of every Jacobian, the velocity part set once
+        nv = model.nv
+        self._plus, self._minus = np.zeros((2 * nv, 2 * nv)), np.zeros((2 * nv, 2 * nv))
+        self._plus[nv:, nv:], self._minus[nv:, nv:] = np.eye(nv), -np.eye(nv)
 
     def _split(self, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         return x[: self.model.nq], x[self.model.nq :]
@@ -43,19 +47,18 @@ class UvmsState(crocoddyl.StateAbstract):
         return np.r_[q, self._rng.normal(size=self.model.nv)]
 
     def diff(self, x0: np.ndarray, x1: np.ndarray) -> np.ndarray:
-        (q0, v0), (q1, v1) = self._split(x0), self._split(x1)
-        return np.concatenate((pin.difference(self.model, q0, q1), v1 - v0))
+        model = self.model
+        nq = model.nq
+        return np.concatenate((pin.difference(model, x0[:nq], x1[:nq]), x1[nq:] - x0[nq:]))
 
     def integrate(self, x: np.ndarray, dx: np.ndarray) -> np.ndarray:
-        q, v = self._split(x)
-        nv = self.model.nv
-        return np.concatenate((pin.integrate(self.model, q, dx[:nv]), v + dx[nv:]))
+        model = self.model
+        nq, nv = model.nq, model.nv
+        return np.concatenate((pin.integrate(model, x[:nq], dx[:nv]), x[nq:] + dx[nv:]))
 
     def _block(self, jq: np.ndarray, sign: float = 1.0) -> np.ndarray:
-        nv = self.model.nv
-        out = np.zeros((2 * nv, 2 * nv))
-        out[:nv, :nv] = jq
-        out[nv:, nv:] = sign * np.eye(nv)
+        out = (self._plus if sign > 0.0 else self._minus).copy()
+        out[: self.model.nv, : self.model.nv] = jq
         return out
 
     def Jdiff(self, x0, x1, firstsecond=crocoddyl.Jcomponent.both):

@@ -10,6 +10,8 @@ tau = B_u u (`uvms_pin.physics.discrete.input_matrix`), each thrust within its o
 (else ``tau_limits``'s): what the thrusters can really give, coupled and asymmetric; its model is the plant's, or the
 plant's scaled by [controller.model_error] (as for computed torque); the water it plans in is
 ``current_world_m_s`` (what it believes the current is; it does not see the scenario's).
+``solver`` ("box_fddp", "fddp" or "csqp": mim_solvers' CSQP, the bounds as the nodes'
+constraints) and ``integrator`` ("euler" or "rk4" nodes) are `uvms_pin.ocp.problems`'.
 
 ``task = "force"`` is the paper's force task: ``desired_force`` (a [controller.desired_force]
 sine profile, as the PPC's), ``desired_rpy``, ``force_weights``, ``attitude_weights``,
@@ -40,6 +42,10 @@ _NUMBERS = {"horizon_s": 1.0, "dt_s": 0.02, "rate_hz": 50.0}
 
 #: the tasks and what their targets are
 TASKS = ("station", "end_effector", "force")
+#: the solvers and the nodes' integrators (`uvms_pin.ocp.problems`' SOLVERS, INTEGRATORS:
+#: not imported here, the ocp layer needs crocoddyl; tests/scenario check they agree)
+SOLVERS = ("box_fddp", "fddp", "csqp")
+INTEGRATORS = ("euler", "rk4")
 
 
 def _target(t: Table, uvms: UVMS, task: str) -> pin.SE3 | None:
@@ -101,7 +107,8 @@ def build_mpc(t: Table, uvms: UVMS, actuation: Actuation | None = None) -> Contr
     posture = t.vector("posture", uvms.n_arm_joints, uvms.neutral_configuration()[7:])
     fields = {k: t.number(k, default, positive=True) for k, default in _NUMBERS.items()}
     fields["iterations"] = t.integer("iterations", 3, minimum=1)
-    fields["solver"] = t.string("solver", "box_fddp", choices=("box_fddp", "fddp"))
+    fields["solver"] = t.string("solver", "box_fddp", choices=SOLVERS)
+    fields["integrator"] = t.string("integrator", "euler", choices=INTEGRATORS)
     fields["warm_start"] = t.boolean("warm_start", True)
     if task != "force":
         default_weights = [100.0] * 6 if task == "station" else [1.0, 1.0, 1.0, 0.1, 0.1, 0.1]

@@ -208,14 +208,21 @@ def contact_derivatives(
     q: np.ndarray,
     v: np.ndarray,
     mask: np.ndarray | None = None,
+    at_state: ContactWrench | None = None,
 ) -> tuple[ContactWrench, ContactJacobians]:
     """The `ContactWrench` at (q, v) and its `ContactJacobians` (see the module docstring);
-    ``mask``: `supports_mask` of ``model`` (computed when None)."""
+    ``mask``: `supports_mask` of ``model`` (computed when None); ``at_state``: the
+    `ContactWrench` already computed at this (q, v) (`contact_wrench`: reused, not
+    recomputed; None: computed here)."""
     mask = supports_mask(model) if mask is None else mask
     nv, fid = model.nv, contact.frame_id
     # the kinematics at (q, v) and the WORLD joint Jacobians, with their derivatives
     pin.computeForwardKinematicsDerivatives(model, data, q, v, np.zeros(nv))
-    state = _contact_in(contact, model, data)
+    if at_state is None:
+        state = _contact_in(contact, model, data)
+    else:
+        state = at_state
+        pin.updateFramePlacement(model, data, fid)  # (what _contact_in leaves in data)
     local_dq, local_jacobian = pin.getFrameVelocityDerivatives(model, data, fid, pin.LOCAL)
     rotation = data.oMf[fid].rotation
     local_linear = rotation.T @ state.velocity_world_m_s
