@@ -43,21 +43,15 @@ def _active(us, lower, upper):
     return int(np.sum(np.isclose(us, lower, atol=1e-6) | np.isclose(us, upper, atol=1e-6)))
 
 
-def test_csqp_moves_the_end_effector_within_tight_bounds_like_boxfddp(reference_uvms):
+def test_csqp_moves_the_end_effector_within_tight_bounds_like_boxfddp(reference_uvms, ten_cm_move):
     """The 10 cm end-effector move (1 s, 50 nodes, tau as the input) with |tau| bounded to
     70 % of what the unbounded plan uses (0.2 at least): the bounds bind (59 node inputs at
     a bound, measured, for both solvers); CSQP holds them to 1e-6 (8e-9 measured), leaves no
     gap in its trajectory (its controls replayed give its states to 1e-8), reaches the target
     within 5 mm and the cost of BoxFDDP within 0.1 % (1.1e-4 lower, measured)."""
     uvms = reference_uvms
-    q0 = uvms.neutral_configuration()
-    q0[2] = -3.0
-    q0[7:] = [-0.2, 1.0, -0.8, 0.2]
-    x0 = np.r_[q0, np.zeros(uvms.nv)]
+    x0, target = ten_cm_move.x0, ten_cm_move.target
     data = uvms.model.createData()
-    pin.framesForwardKinematics(uvms.model, data, q0)
-    start = data.oMf[uvms.ee_frame_id]
-    target = pin.SE3(start.rotation, start.translation + np.array([0.1, 0.0, -0.05]))
 
     def build(bounds, as_constraints):
         actuators = problems.Actuators(None, bounds, as_constraints=as_constraints)

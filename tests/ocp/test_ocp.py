@@ -117,19 +117,13 @@ def test_the_model_dynamics_are_uvms_pin_forward_dynamics(reference_uvms):
     np.testing.assert_array_equal(data.xout, expected)
 
 
-def test_point_to_point_moves_the_end_effector(reference_uvms):
+def test_point_to_point_moves_the_end_effector(reference_uvms, ten_cm_move):
     """A 10 cm end-effector move in 1 s (50 nodes), tau as the input: the solved rollout
     reaches the target and ends nearly at rest; replaying its controls through uvms-pin's own
     semi-implicit Euler gives the same trajectory (the OCP's model is the simulator's)."""
     uvms = reference_uvms
-    q0 = uvms.neutral_configuration()
-    q0[2] = -3.0
-    q0[7:] = [-0.2, 1.0, -0.8, 0.2]
-    x0 = np.r_[q0, np.zeros(uvms.nv)]
+    q0, x0, target = ten_cm_move.q0, ten_cm_move.x0, ten_cm_move.target
     data = uvms.model.createData()
-    pin.framesForwardKinematics(uvms.model, data, q0)
-    start = data.oMf[uvms.ee_frame_id]
-    target = pin.SE3(start.rotation, start.translation + np.array([0.1, 0.0, -0.05]))
     problem = problems.point_to_point(uvms, x0, target, horizon_s=1.0, dt_s=0.02)
     solver = problems.solve(problem, iterations=60, solver="fddp")
     q_end = solver.xs[-1][: uvms.nq]

@@ -129,20 +129,14 @@ def test_rk4_node_steps_like_the_plants_rk4(reference_uvms):
         assert half < rk4 / 6.0
 
 
-def test_point_to_point_on_rk4_nodes_reaches_the_target(reference_uvms):
+def test_point_to_point_on_rk4_nodes_reaches_the_target(reference_uvms, ten_cm_move):
     """The 10 cm end-effector move of tests/ocp/test_ocp.py on RK4 nodes: solved to within
     5 mm (0.05 mm measured), and its controls replayed through the plant's RK4 (one 20 ms
     step per node) end within 1e-6 of the plan's last state (6e-8 measured: the plan's
     moves are slow, the two RK4s' difference of order three is small)."""
     uvms = reference_uvms
-    q0 = uvms.neutral_configuration()
-    q0[2] = -3.0
-    q0[7:] = [-0.2, 1.0, -0.8, 0.2]
-    x0 = np.r_[q0, np.zeros(uvms.nv)]
+    q0, x0, target = ten_cm_move.q0, ten_cm_move.x0, ten_cm_move.target
     data = uvms.model.createData()
-    pin.framesForwardKinematics(uvms.model, data, q0)
-    start = data.oMf[uvms.ee_frame_id]
-    target = pin.SE3(start.rotation, start.translation + np.array([0.1, 0.0, -0.05]))
     problem = problems.point_to_point(uvms, x0, target, horizon_s=1.0, dt_s=0.02, integrator="rk4")
     solver = problems.solve(problem, iterations=60, solver="fddp")
     pin.framesForwardKinematics(uvms.model, data, solver.xs[-1][: uvms.nq])
