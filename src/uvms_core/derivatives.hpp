@@ -5,8 +5,9 @@
 //   dID/dq = dRNEA/dq |_(w fixed) - sum_j J_j^T dw_j/dq         (likewise d/dv)
 //   M = dID/da = M_RB + sum_j J_j^T M_A,j J_j
 //   da/dq = -M^-1 dID/dq,  da/dv = -M^-1 dID/dv,  da/dtau = M^-1.
-// Pinocchio's computeRNEADerivatives gives the first term and, in its data, each joint's
-// velocity and acceleration derivatives (getJoint*Derivatives, LOCAL); the fluid terms' own
+// Pinocchio's computeRNEADerivatives gives the first term and, in its data, what each joint's
+// LOCAL velocity and acceleration derivatives are made of (joint_motions(): the formulas of
+// Pinocchio's getJointAccelerationDerivatives, LOCAL, as 6x6 products); the fluid terms' own
 // Jacobians are each hydro unit's (added_mass.hpp, damping.hpp, restoring.hpp), one function
 // per term as in fluid.py. fluid.py writes each term's dw/dq and dw/dv as (6, nv) blocks; here
 // each term gives its 6 x 6 sensitivities to the body's acceleration, velocity and pose
