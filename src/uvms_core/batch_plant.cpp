@@ -205,9 +205,26 @@ void BatchPlant::work(int thread) {
   }
 }
 
+namespace {
+
+// Spin briefly on a condition before blocking on a condition variable: a step's serial part
+// (the Python between two steps) is ~0.1 ms, and waking a blocked thread costs tens of us of
+// every step on each side. Bounded: a thread left idle longer sleeps.
+template <typename Ready>
+bool spin_until(Ready ready) {
+  for (int k = 0; k < 20000; ++k) {
+    if (ready()) return true;
+    std::this_thread::yield();
+  }
+  return ready();
+}
+
+}  // namespace
+
 void BatchPlant::serve(int thread) {
   long long served = 0;
   for (;;) {
+    spin_until([&] { return round_.load() != served; });
     {
       std::unique_lock<std::mutex> lock(mutex_);
       wake_.wait(lock, [&] { return quit_ || round_ != served; });
@@ -239,6 +256,7 @@ void BatchPlant::step(const double* tau_commanded, const bool* stepping) {
   }
   work(0);
   if (!pool_.empty()) {
+    spin_until([&] { return busy_.load() == 0; });
     std::unique_lock<std::mutex> lock(mutex_);
     done_.wait(lock, [&] { return busy_ == 0; });
   }

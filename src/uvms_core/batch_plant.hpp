@@ -93,12 +93,16 @@ class BatchPlant {
   };
   std::vector<Scratch> scratch_;  // per thread
 
-  // The pool: T - 1 threads started once (the calling thread is the T-th), woken per step.
+  // The pool: T - 1 threads started once (the calling thread is the T-th). Between steps a
+  // pool thread spins (yielding) for a while before it blocks, and so does the calling thread
+  // waiting for them: a blocked thread's wake-up cost tens of us on each side of every step,
+  // which held T = 2 to 1.7x T = 1 (now 1.87x, benchmarks/bench_gym.py).
   std::vector<std::thread> pool_;
   std::mutex mutex_;
   std::condition_variable wake_, done_;
-  long long round_ = 0;  // steps started (a pool thread works once per round)
-  int busy_ = 0;         // pool threads still working on this round
+  // written under mutex_, read also without it while spinning (atomics)
+  std::atomic<long long> round_{0};  // steps started (a pool thread works once per round)
+  std::atomic<int> busy_{0};         // pool threads still working on this round
   bool quit_ = false;
   std::atomic<int> next_env_{0};
   const double* round_tau_ = nullptr;
