@@ -4,6 +4,7 @@
 #include <exception>
 #include <string>
 #include <algorithm>
+#include <chrono>
 #include <thread>
 
 #include <pinocchio/algorithm/joint-configuration.hpp>
@@ -207,12 +208,14 @@ void BatchPlant::work(int thread) {
 
 namespace {
 
-// Spin briefly on a condition before blocking on a condition variable: a step's serial part
-// (the Python between two steps) is ~0.1 ms, and waking a blocked thread costs tens of us of
-// every step on each side. Bounded: a thread left idle longer sleeps.
+// Spin (yielding) on a condition for up to 2 ms before blocking on a condition variable: a
+// step's serial part (the Python between two steps) is ~0.1 ms, and waking a blocked thread
+// costs tens of us of every step on each side. A thread left idle longer (a policy's forward
+// pass, an episode's end) sleeps.
 template <typename Ready>
 bool spin_until(Ready ready) {
-  for (int k = 0; k < 20000; ++k) {
+  const auto until = std::chrono::steady_clock::now() + std::chrono::microseconds(2000);
+  while (std::chrono::steady_clock::now() < until) {
     if (ready()) return true;
     std::this_thread::yield();
   }

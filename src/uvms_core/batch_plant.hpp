@@ -94,8 +94,8 @@ class BatchPlant {
   std::vector<Scratch> scratch_;  // per thread
 
   // The pool: T - 1 threads started once (the calling thread is the T-th). Between steps a
-  // pool thread spins (yielding) for a while before it blocks, and so does the calling thread
-  // waiting for them: a blocked thread's wake-up cost tens of us on each side of every step,
+  // pool thread spins (yielding) for up to 2 ms before it blocks, and so does the calling
+  // thread waiting for them: a blocked thread's wake-up cost tens of us on each side of every step,
   // which held T = 2 to 1.7x T = 1 (now 1.87x, benchmarks/bench_gym.py).
   std::vector<std::thread> pool_;
   std::mutex mutex_;
