@@ -213,13 +213,9 @@ namespace {
 // costs tens of us of every step on each side. A thread left idle longer (a policy's forward
 // pass, an episode's end) sleeps.
 template <typename Ready>
-bool spin_until(Ready ready) {
+void spin_until(Ready ready) {
   const auto until = std::chrono::steady_clock::now() + std::chrono::microseconds(2000);
-  while (std::chrono::steady_clock::now() < until) {
-    if (ready()) return true;
-    std::this_thread::yield();
-  }
-  return ready();
+  while (!ready() && std::chrono::steady_clock::now() < until) std::this_thread::yield();
 }
 
 }  // namespace

@@ -111,28 +111,9 @@ void Derivatives::wrenches_at(const ConstVec& q, const ConstVec& v, const Eigen:
 
 namespace {
 
-// X^-1 as a 6x6 motion transform, world to the frame of the placement (R, p) [linear; angular]:
-// [R^T, -R^T [p]x; 0, R^T].
-Mat6 motion_to_local(const pinocchio::SE3& placement) {
-  const Mat3 to_local = placement.rotation().transpose();
-  Mat6 out;
-  out.topLeftCorner<3, 3>() = to_local;
-  out.topRightCorner<3, 3>().noalias() = -to_local * skew(placement.translation());
-  out.bottomLeftCorner<3, 3>().setZero();
-  out.bottomRightCorner<3, 3>() = to_local;
-  return out;
-}
-
-// (m x): the motion cross product as a 6x6 matrix, [[w]x, [v]x; 0, [w]x] for m = [v; w].
-Mat6 motion_cross(const Vec6& motion) {
-  const Mat3 spin = skew(motion.tail<3>());
-  Mat6 out;
-  out.topLeftCorner<3, 3>() = spin;
-  out.topRightCorner<3, 3>() = skew(motion.head<3>());
-  out.bottomLeftCorner<3, 3>().setZero();
-  out.bottomRightCorner<3, 3>() = spin;
-  return out;
-}
+// (m x): the motion cross product as a 6x6 matrix (Pinocchio's action matrix of a motion,
+// [[w]x, [v]x; 0, [w]x] for m = [v; w]).
+Mat6 cross_matrix(const Vec6& motion) { return pinocchio::Motion(motion).toActionMatrix(); }
 
 }  // namespace
 
@@ -151,7 +132,7 @@ void Derivatives::joint_motions() {
   const auto& data = data_;
   for (int j : hydro_joints_) {
     auto& m = motion_[j];
-    const Mat6 to_local = motion_to_local(data.oMi[j]);
+    const Mat6 to_local = data.oMi[j].toActionMatrixInverse();  // X^-1, world -> j
     m.rotation = data.oMi[j].rotation();
     m.translation = data.oMi[j].translation();
     m.velocity = data.v[j].toVector();
@@ -165,17 +146,17 @@ void Derivatives::joint_motions() {
       Vec6 relative = -m.velocity;
       if (parent > 0) {
         const Vec6 parent_velocity = to_local * data.ov[parent].toVector();
-        velocity_dq.noalias() = motion_cross(parent_velocity).lazyProduct(jacobian);
+        velocity_dq.noalias() = cross_matrix(parent_velocity).lazyProduct(jacobian);
         relative += parent_velocity;
       }
-      const Mat6 relative_cross = motion_cross(relative);
+      const Mat6 relative_cross = cross_matrix(relative);
       auto acceleration_dv = m.acceleration_dv.middleCols(first, count);
       acceleration_dv.noalias() = relative_cross.lazyProduct(jacobian);
       acceleration_dv.noalias() += to_local.lazyProduct(data.dJ.middleCols(first, count));
       if (parent > 0) {
         const Vec6 parent_acceleration = to_local * data.oa[parent].toVector();
         auto acceleration_dq = m.acceleration_dq.middleCols(first, count);
-        acceleration_dq.noalias() = motion_cross(parent_acceleration).lazyProduct(jacobian);
+        acceleration_dq.noalias() = cross_matrix(parent_acceleration).lazyProduct(jacobian);
         acceleration_dq.noalias() += relative_cross.lazyProduct(velocity_dq);
       }
     }
@@ -228,19 +209,14 @@ void Derivatives::damping_sensitivity(const DampedBody& body, const FlowGradient
   const FlowSeenByBody seen =
       flow_in_body(m, body.rotation_in_joint, body.position_in_joint_m, flow);
   const Mat6& x = body.action_joint_to_body;
-  const double fraction = dynamics_.damping_fraction(body);
-  if (x.isIdentity(0.0)) {  // damped at the joint frame itself (X = I): the usual case
-    const Vec6 relative = m.velocity - linear_twist(seen.velocity);
-    const Mat6 slope =
-        fraction * damping_jacobian(body.linear_damping, body.quadratic_damping, relative);
-    s.by_velocity += slope;
-    s.by_pose.noalias() -= slope.leftCols<3>() * seen.velocity_by_pose;
-    return;
-  }
-  const Vec6 relative = x * m.velocity - linear_twist(seen.velocity);
-  const Mat6 slope = fraction * x.transpose() *
-                     damping_jacobian(body.linear_damping, body.quadratic_damping, relative);
-  s.by_velocity.noalias() += slope * x;
+  // damped at the joint frame itself (X = I, the usual case): the products by X are skipped
+  const bool at_joint = x.isIdentity(0.0);
+  const Vec6 body_velocity = at_joint ? m.velocity : Vec6(x * m.velocity);
+  const Vec6 relative = body_velocity - linear_twist(seen.velocity);
+  Mat6 slope = dynamics_.damping_fraction(body) *
+               damping_jacobian(body.linear_damping, body.quadratic_damping, relative);
+  if (!at_joint) slope = (x.transpose() * slope).eval();
+  s.by_velocity += at_joint ? slope : Mat6(slope * x);
   s.by_pose.noalias() -= slope.leftCols<3>() * seen.velocity_by_pose;
 }
 
