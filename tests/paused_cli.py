@@ -20,16 +20,22 @@ exactly at that point, however fast or slow the machine.
 from __future__ import annotations
 
 import argparse
+import os
+import select
 import signal
 import subprocess
 import sys
+import threading
 from pathlib import Path
 
 PAUSED = "uvms-pin test hook: paused"
 
 
 def start(hook: list[str], cli_args: list[str], cwd: Path, **popen) -> subprocess.Popen:
-    """The command in the background (text pipes; its own session, default Ctrl-C)."""
+    """The command in the background (text pipes; its own session, default Ctrl-C;
+    faulthandler on: a SIGABRT prints every thread's stack, which a test stuck waiting
+    for it can show)."""
+    popen["env"] = {**popen.get("env", os.environ), "PYTHONFAULTHANDLER": "1"}
     return subprocess.Popen(
         [sys.executable, __file__, *hook, "--", *cli_args],
         cwd=cwd,
@@ -58,9 +64,21 @@ def wait_until_paused(proc: subprocess.Popen) -> list[str]:
 
 
 def _pause(where: str) -> None:
+    """Report the pause, then wait for a signal; its handler's exception (SIGINT:
+    KeyboardInterrupt) propagates from here.
+
+    Not `signal.pause()`: a test sends its signal as soon as it reads the line, which can be
+    before this thread reaches pause(); Python's C handler notes the signal, and pause()
+    then waits for another that never comes. The wake-up file descriptor is written by that
+    handler whenever the signal arrives, so the select below returns in every order."""
+    assert threading.current_thread() is threading.main_thread(), "signals reach the main thread"
+    read_end, write_end = os.pipe()
+    os.set_blocking(write_end, False)
+    signal.set_wakeup_fd(write_end)  # before the line: no signal can be missed
     print(f"{PAUSED} {where}", flush=True)
-    while True:
-        signal.pause()  # a SIGINT handler's KeyboardInterrupt propagates from here
+    while True:  # the pending handler runs (and raises) between two of these calls
+        select.select([read_end], [], [])
+        os.read(read_end, 64)
 
 
 def _pause_at_sample(n: int) -> None:

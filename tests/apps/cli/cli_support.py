@@ -80,10 +80,21 @@ values = [0.0, 0.1]
 
 
 def interrupt(proc: subprocess.Popen, timeout_s: float = 120.0) -> tuple[str, str]:
-    """Ctrl-C as a terminal sends it (to the whole process group); the remaining output."""
+    """Ctrl-C as a terminal sends it (to the whole process group); the remaining output.
+
+    A process group still running ``timeout_s`` later fails the test with the stack of
+    every thread of its processes (SIGABRT: `paused_cli` starts them with faulthandler on),
+    so that a hang seen once, on a slow machine, says where it was."""
     os.killpg(proc.pid, signal.SIGINT)
     try:
         return proc.communicate(timeout=timeout_s)
+    except subprocess.TimeoutExpired as timeout:
+        os.killpg(proc.pid, signal.SIGABRT)
+        _, err = proc.communicate(timeout=60)
+        stacks = [line for line in err.splitlines() if not line.startswith("Extension modules:")]
+        raise AssertionError(
+            f"still running {timeout_s} s after Ctrl-C; its stacks:\n" + "\n".join(stacks)
+        ) from timeout
     finally:
         if proc.poll() is None:
             proc.kill()

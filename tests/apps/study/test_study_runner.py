@@ -2,8 +2,10 @@
 
 from __future__ import annotations
 
+import multiprocessing
 import subprocess
 import sys
+import time
 
 import cloudpickle
 import pandas as pd
@@ -116,6 +118,35 @@ def test_killing_the_sweep_process_and_rerunning_finishes_the_study(tmp_path, se
     assert list(kept) == list(killed["run_wall_time_s"])  # not repeated
     pd.testing.assert_frame_equal(_stable(after), _stable(serial))
     assert not list((out / "parts").glob("*"))
+
+
+def stuck_after_the_first_run(base, run, rollout_dir):
+    """The first run normally; every other blocks (a run of ten minutes)."""
+    if run.index > 0:
+        time.sleep(600)
+    return execute_run(base, run, rollout_dir)
+
+
+def test_ctrl_c_stops_the_forked_workers_at_once(tmp_path):
+    """Ctrl-C (a KeyboardInterrupt where the sweep records a row) while a worker runs a long
+    task and another waits in its queue: the workers are stopped, not awaited, so the
+    command ends when it says so; the row recorded before stays."""
+    study = load_study(write_study(tmp_path))
+
+    def ctrl_c(row):
+        raise KeyboardInterrupt
+
+    try:
+        with pytest.raises(KeyboardInterrupt):
+            run_study(
+                study, tmp_path / "out", workers=1, progress=False,
+                run_fn=stuck_after_the_first_run, on_result=ctrl_c,
+            )  # fmt: skip
+        assert multiprocessing.active_children() == []
+    finally:  # a failed test must not leave a worker asleep for ten minutes
+        for child in multiprocessing.active_children():
+            child.kill()
+    assert list(load_results(tmp_path / "out")["run_index"]) == [0]
 
 
 def flaky_run(base, run, rollout_dir):

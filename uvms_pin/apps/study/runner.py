@@ -415,11 +415,22 @@ def _run_on_forked_processes(todo, base, rollout_dir, tasks, finished, workers) 
                 futures[pool.submit(_task, run_fn, batch_fn, base, runs, rollout_dir)] = runs
         _collect(as_completed(futures), futures, finished)
     except BaseException:  # Ctrl-C: the workers (which ignore it) are stopped, not awaited
-        pool.shutdown(wait=False, cancel_futures=True)
-        for process in list((getattr(pool, "_processes", None) or {}).values()):
-            process.terminate()
+        _stop_pool(pool)
         raise
     pool.shutdown(wait=True)
+
+
+def _stop_pool(pool) -> None:
+    """Stop ``pool``'s workers now: their running and queued tasks are dropped (a rerun
+    runs them). ``shutdown(wait=False)`` alone returns at once but forgets its processes,
+    and the interpreter's exit then waits for every task already handed to a worker: a
+    Ctrl-C that printed its message would hang for as long as those runs take."""
+    processes = list((getattr(pool, "_processes", None) or {}).values())  # before shutdown
+    pool.shutdown(wait=False, cancel_futures=True)
+    for process in processes:
+        process.terminate()
+    for process in processes:
+        process.join()
 
 
 def _collect(completed, futures: dict, finished) -> None:
