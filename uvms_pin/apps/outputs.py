@@ -6,9 +6,11 @@ from pathlib import Path
 
 import numpy as np
 
-from uvms_pin.results.rollout import Rollout
+from uvms_pin.results.rollout import ARRAY_FILE, META_FILE, Rollout
 
 METRICS_FILE = "metrics.json"
+#: what `write_results` writes: the run itself, before its figures
+RESULT_FILES = (ARRAY_FILE, META_FILE, METRICS_FILE)
 
 
 def write_outputs(rollout: Rollout, out: Path) -> list[Path]:
@@ -21,7 +23,6 @@ def write_results(rollout: Rollout, out: Path) -> list[str]:
     """``rollout.npz``, ``rollout.json`` and ``metrics.json`` into ``out`` (each written
     whole or not at all); their names."""
     from uvms_pin.results.atomic import write_json_atomic
-    from uvms_pin.results.rollout import ARRAY_FILE, META_FILE
 
     # the metrics first: one of your own that fails (an input error) leaves nothing written
     metrics = rollout.metrics()
@@ -36,7 +37,7 @@ def write_results(rollout: Rollout, out: Path) -> list[str]:
             **metrics,
         },
     )
-    return [ARRAY_FILE, META_FILE, METRICS_FILE]
+    return list(RESULT_FILES)
 
 
 def write_figures(rollout: Rollout, out: Path) -> list[Path]:

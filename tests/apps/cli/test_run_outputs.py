@@ -82,6 +82,51 @@ def test_a_second_ctrl_c_while_saving_does_not_lose_the_rollout(tmp_path, delay_
     assert not [p.name for p in (tmp_path / "o").iterdir() if p.name.startswith(".")]
 
 
+def _interrupted_run(monkeypatch, cut: str):
+    """``uvms-pin run`` in this process, its run interrupted after 0.1 s (as Ctrl-C does:
+    a KeyboardInterrupt carrying the rollout) and a second Ctrl-C raised by ``cut`` of
+    `uvms_pin.apps.outputs` (``write_results`` or ``write_figures``)."""
+    from uvms_pin.apps import outputs
+    from uvms_pin.apps.cli import run
+    from uvms_pin.apps.cli.main import main
+
+    simulate = run._simulate
+
+    def interrupted(scenario, args, progress):
+        exc = KeyboardInterrupt()
+        exc.rollout = simulate(scenario, args, progress)
+        raise exc
+
+    def ctrl_c(*args, **kwargs):
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(run, "_simulate", interrupted)
+    monkeypatch.setattr(outputs, cut, ctrl_c)
+    return main(["run", "s.toml", "--out", "o", "--quiet"])
+
+
+def test_ctrl_c_cutting_the_figures_still_reports_the_kept_rollout(tmp_path, monkeypatch, capsys):
+    """A second Ctrl-C after the rollout is saved cuts the figures only: both are said (the
+    run's interruption and its rollout kept, then what the save kept), however the two
+    Ctrl-C fall in time."""
+    (tmp_path / "s.toml").write_text(passive_scenario(0.1))
+    monkeypatch.chdir(tmp_path)
+    assert _interrupted_run(monkeypatch, "write_figures") == 130
+    err = capsys.readouterr().err
+    assert "interrupted: the partial rollout (t = 0 to 0.100 s) is kept in o" in err, err
+    assert "interrupted while saving; kept in o: rollout.npz, rollout.json, metrics.json" in err
+    assert len(Rollout.load(tmp_path / "o")) == 6  # t = 0 to 0.1 s, every 0.02 s
+
+
+def test_ctrl_c_cutting_the_rollout_does_not_claim_it_kept(tmp_path, monkeypatch, capsys):
+    (tmp_path / "s.toml").write_text(passive_scenario(0.1))
+    monkeypatch.chdir(tmp_path)
+    assert _interrupted_run(monkeypatch, "write_results") == 130
+    err = capsys.readouterr().err
+    assert "is kept in o" not in err, err
+    assert "interrupted while saving; kept in o: nothing" in err, err
+
+
 def test_overwrite_replaces_a_runs_outputs_keeps_the_users_files_and_follows_the_umask(tmp_path):
     (tmp_path / "s.toml").write_text(passive_scenario(0.1))
     out = tmp_path / "o"

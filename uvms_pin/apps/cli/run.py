@@ -66,11 +66,13 @@ def cmd_run(args: argparse.Namespace) -> int:
             return ending.status
         written, failure = _save(ending, out, args, guard)
     _report(scenario.name, ending, out, written)
+    if ending.status and (failure is None or _rollout_saved(written)):
+        # the run's own ending (interrupted, stopped): true once its rollout is on disk,
+        # whatever then cut the figures
+        print(ending.message, file=sys.stderr)
     if failure is not None:
         print(failure.message, file=sys.stderr)
         return failure.status
-    if ending.status:
-        print(ending.message, file=sys.stderr)
     return ending.status
 
 
@@ -150,6 +152,13 @@ def _save(
         written = _files_of_the_run(out)
         return written, Ending(rollout, EXIT_ENVIRONMENT, _write_failure(exc, out, written))
     return _files_of_the_run(out), None
+
+
+def _rollout_saved(written: list[str]) -> bool:
+    """Whether ``written`` holds the whole rollout and its metrics (`write_results`)."""
+    from uvms_pin.apps.outputs import RESULT_FILES
+
+    return set(RESULT_FILES) <= set(written)
 
 
 def _files_of_the_run(out: Path) -> list[str]:
