@@ -12,6 +12,7 @@
 #include <utility>
 
 #include "contact.hpp"
+#include "derivatives_task_contact.hpp"
 #include "derivatives_world_contact.hpp"
 #include "disturbance.hpp"
 #include "dynamics.hpp"
@@ -53,11 +54,14 @@ class Plant {
   const ContactForces& world_forces(const ConstVec& q, const ConstVec& v);
 
   // (da/dq, da/dv, da/dtau) of acceleration() with the world's contacts at `friction`'s
-  // anchors, q along the tangent (plant_derivatives.cpp, mirror of
-  // uvms_pin/sim/plant_derivatives.py); InputError for an end-effector contact.
+  // anchors and the end-effector's contact, q along the tangent (plant_derivatives.cpp,
+  // mirror of uvms_pin/sim/plant_derivatives.py).
   const ForwardDynamicsDerivatives& acceleration_derivatives(double time_s, const ConstVec& q,
                                                              const ConstVec& v,
                                                              const ConstVec& tau);
+  // The end-effector contact's tau_ext and its derivatives at (q, v)
+  // (derivatives_task_contact.hpp; zero without a contact).
+  const TaskContactDerivatives& contact_derivatives(const ConstVec& q, const ConstVec& v);
 
   // (q, v) at t1 from (q0, v0) at t0 with tau held, in the integrator's substeps.
   std::pair<Eigen::VectorXd, Eigen::VectorXd> advance(double t0, const ConstVec& q0,
@@ -82,9 +86,11 @@ class Plant {
   bool world_active_ = true;  // false over a period the broad phase cleared
   ContactForces world_forces_;
   // acceleration_derivatives' own (built on first use): the water's derivatives (a copy of
-  // the dynamics), the world contacts', the plant's generalized forces and their Jacobians
+  // the dynamics), the world contacts', the end-effector contact's, the plant's generalized
+  // forces and their Jacobians
   std::unique_ptr<Derivatives> derivatives_;
   std::unique_ptr<WorldContactDerivatives> world_derivatives_;
+  std::unique_ptr<TaskContactDerivatives> task_derivatives_;
   Eigen::VectorXd force_tau_;
   Eigen::MatrixXd force_dq_, force_dv_;
   ForwardDynamicsDerivatives acceleration_derivatives_;

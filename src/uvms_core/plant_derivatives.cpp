@@ -5,8 +5,9 @@
 //   da/dq = da/dq|_(tau_ext held) + M^-1 d tau_g/dq,   da/dv likewise,   da/dtau = M^-1
 //
 // tau_g: the world's contacts (derivatives_world_contact.hpp, on the compiled world's own
-// contact points and forces), the joint drives' friction and the joint stops
-// (derivatives_joint_limits.hpp); the disturbance depends on time only. Frozen at the state:
+// contact points and forces), the end-effector's compliant contact, a linear spring or a
+// compliant plane (derivatives_task_contact.hpp), the joint drives' friction and the joint
+// stops (derivatives_joint_limits.hpp); the disturbance depends on time only. Frozen at the state:
 // the contacts' active set, anchors and stick or slip (`friction`). At a kink the derivative
 // of the side the state is on.
 #include "derivatives_joint_limits.hpp"
@@ -18,10 +19,6 @@ const ForwardDynamicsDerivatives& Plant::acceleration_derivatives(double time_s,
                                                                   const ConstVec& q,
                                                                   const ConstVec& v,
                                                                   const ConstVec& tau) {
-  if (has_contact(contact)) {
-    throw InputError(
-        "acceleration_derivatives: the end-effector contact environment is not differentiated");
-  }
   const auto& model = dynamics_.model();
   const int nv = model.nv;
   if (!derivatives_) {
@@ -38,6 +35,12 @@ const ForwardDynamicsDerivatives& Plant::acceleration_derivatives(double time_s,
                                                   force_dq_, force_dv_);
       force_tau_ += world_derivatives_->generalized_force();
     }
+  }
+  if (has_contact(contact)) {  // tau = -J^T lambda, lambda on the environment
+    const auto& task = contact_derivatives(q, v);
+    force_tau_ += task.generalized_force();
+    force_dq_ += task.tau_dq();
+    force_dv_ += task.tau_dv();
   }
   if (joint_friction.active()) {
     joint_friction.subtract_from(v, force_tau_);  // + tau_f = -(b v + c tanh(v / s))
@@ -58,6 +61,15 @@ const ForwardDynamicsDerivatives& Plant::acceleration_derivatives(double time_s,
   out.da_dv.noalias() += water.da_dtau * force_dv_;
   out.da_dtau = water.da_dtau;
   return out;
+}
+
+const TaskContactDerivatives& Plant::contact_derivatives(const ConstVec& q, const ConstVec& v) {
+  const auto& model = dynamics_.model();
+  if (!task_derivatives_) {
+    task_derivatives_ = std::make_unique<TaskContactDerivatives>(model, ee_frame_id_);
+  }
+  task_derivatives_->contact_derivatives(model, contact, q, v);
+  return *task_derivatives_;
 }
 
 }  // namespace uvms

@@ -184,5 +184,25 @@ void bind_plant_world(nb::class_<Plant>& plant) {
           },
           "time_s"_a, "q"_a, "v"_a, "tau"_a, "friction"_a,
           "(da/dq, da/dv, da/dtau) of acceleration_in_world with the world's contacts at the "
-          "anchors of friction (read only), the joint friction and stops (plant_derivatives.cpp).");
+          "anchors of friction (read only), the end-effector's contact, the joint friction and "
+          "stops (plant_derivatives.cpp).")
+      .def(
+          "contact_derivatives",
+          [](Plant& p, const Eigen::VectorXd& q, const Eigen::VectorXd& v) {
+            const auto qc = checked("q", q, p.dynamics().nq());
+            const auto vc = checked("v", v, p.dynamics().nv());
+            const auto& task = p.contact_derivatives(qc, vc);
+            nb::dict out;
+            out["wrench_world"] = uvms::Vec6(task.wrench_world());
+            out["tau_ext"] = Eigen::VectorXd(task.generalized_force());
+            out["wrench_dq"] = Eigen::MatrixXd(task.wrench_dq());
+            out["wrench_dv"] = Eigen::MatrixXd(task.wrench_dv());
+            out["tau_dq"] = Eigen::MatrixXd(task.tau_dq());
+            out["tau_dv"] = Eigen::MatrixXd(task.tau_dv());
+            return out;
+          },
+          "q"_a, "v"_a,
+          "The end-effector contact's lambda, tau_ext = -J^T lambda and their derivatives "
+          "(wrench_dq, wrench_dv, tau_dq, tau_dv) at (q, v), q along the tangent, as a dict "
+          "(derivatives_task_contact.hpp; task_contact.contact_derivatives).");
 }

@@ -4,11 +4,11 @@ forces (world contacts, joint friction, joint stops) and their Jacobians added.
 
 On the compiled core (a plant with ``backend="core"`` whose parts all have a compiled
 counterpart) the whole of it is one compiled call, `src/uvms_core/plant_derivatives.cpp`,
-on the compiled world's own contact points and forces (`derivatives_world_contact.cpp`,
-`derivatives_joint_limits.hpp` mirror the Python files); the functions here are its
-reference (``backend="python"``). With an end-effector contact environment the contact's
-derivatives are Python's (`uvms_pin.physics.derivatives.task_contact`), around the compiled
-water derivatives."""
+on the compiled world's own contact points and forces and the end-effector's contact, a
+linear spring or a compliant plane (`derivatives_world_contact.cpp`,
+`derivatives_task_contact.cpp`, `derivatives_joint_limits.hpp` mirror the Python files); the
+functions here are its reference (``backend="python"``). Another end-effector contact model
+(a subclass of the user's included) takes the Python path, which refuses it by name."""
 
 from __future__ import annotations
 
@@ -20,7 +20,11 @@ import pinocchio as pin
 from uvms_pin.checks import finite_vector
 from uvms_pin.errors import ParameterError
 from uvms_pin.physics.derivatives.joint_limits import joint_friction_jacobian, joint_stop_jacobians
-from uvms_pin.physics.derivatives.task_contact import TaskContact, contact_derivatives
+from uvms_pin.physics.derivatives.task_contact import (
+    WRENCH_JACOBIANS,
+    TaskContact,
+    contact_derivatives,
+)
 from uvms_pin.physics.derivatives.world_contact import world_contact_jacobians
 from uvms_pin.physics.dynamics import forward_dynamics_derivatives
 from uvms_pin.physics.reference import check_time
@@ -61,7 +65,7 @@ def acceleration_derivatives(
         raise ParameterError(
             "acceleration_derivatives: free objects and self-collision are not differentiated"
         )
-    if compiled is not None and plant.contact is None:
+    if compiled is not None and (plant.contact is None or type(plant.contact) in WRENCH_JACOBIANS):
         out = compiled.acceleration_derivatives(
             check_time(time_s), q, v, finite_vector("tau", tau, plant.uvms.nv), plant.friction
         )
