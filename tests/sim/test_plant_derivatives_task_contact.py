@@ -104,10 +104,12 @@ def test_the_contact_derivatives_match_finite_differences(uvms, kind, backend):
 
 def test_without_the_contact_term_the_derivatives_miss(uvms, monkeypatch):
     """The contact's own Jacobians are needed: with them zeroed the q and v derivatives
-    differ from the differences far beyond the tolerance."""
+    differ from the differences far beyond the tolerance (on the Python reference, whose
+    contact term is the function patched here; the core's own term is checked against it
+    in tests/physics/derivatives/test_task_contact_core.py)."""
     rng = np.random.default_rng(62)
     q, v, tau = _state(uvms, rng)
-    plant = _plant(uvms, _contacts(uvms, q, v)["plane"], "core")
+    plant = _plant(uvms, _contacts(uvms, q, v)["plane"], "python")
     expected = _finite_differences(plant, q, v, tau)
     derivatives = plant_derivatives.contact_derivatives
 
