@@ -11,6 +11,7 @@ import re
 import warnings
 
 import numpy as np
+import pinocchio as pin
 import pytest
 from conftest import ROOT
 
@@ -27,6 +28,7 @@ from uvms_pin.physics.compiled.flow import flow_to_core
 from uvms_pin.physics.contact import CompliantPlane, LinearSpring
 from uvms_pin.physics.disturbance import SinusoidalDisturbance
 from uvms_pin.sim.integrators import RK4, Adaptive, SemiImplicitEuler
+from uvms_pin.sim.plant import Plant
 
 
 @pytest.fixture(scope="module")
@@ -104,6 +106,38 @@ def test_contact_and_disturbance_counterparts(core):
     assert (compiled.period_s, compiled.phase_rad) == (4.0, 0.5)
     assert disturbance_to_core(None, core) is None
     assert isinstance(disturbance_to_core(lambda t: np.zeros(6), core), Fallback)
+
+
+class _StifferPlane(CompliantPlane):
+    """A user's contact model: a compliant plane pushing twice as hard."""
+
+    def wrench_on_environment_world(self, position_world_m, velocity_world_m_s):
+        return 2.0 * super().wrench_on_environment_world(position_world_m, velocity_world_m_s)
+
+
+class _QuietSpring(LinearSpring):
+    """A user's subclass of the spring (its law unchanged, but its own)."""
+
+
+def test_a_subclass_of_a_contact_model_has_no_counterpart(core, reference_uvms):
+    """The core mirrors LinearSpring and CompliantPlane, not a user's subclass of them (whose
+    law may differ): a Fallback naming it, and a plant with it runs its own law."""
+    spring = _QuietSpring([2.0, 3.0, 4.0], anchor_world_m=[0.0, 0.0, 0.0])
+    assert isinstance(contact_to_core(spring, core), Fallback)
+    assert "_QuietSpring" in contact_to_core(spring, core).reason
+    q, v = reference_uvms.neutral_configuration(), np.full(reference_uvms.nv, 0.1)
+    data = reference_uvms.model.createData()
+    pin.forwardKinematics(reference_uvms.model, data, q)
+    tip = pin.updateFramePlacement(reference_uvms.model, data, reference_uvms.ee_frame_id)
+    plane = _StifferPlane(
+        [0, 0, 1.0], 500.0, 3.0, point_world_m=tip.translation + np.array([0, 0, 0.02])
+    )
+    assert isinstance(contact_to_core(plane, core), Fallback)
+    expected = Plant(reference_uvms, contact=plane, backend="python")
+    with pytest.warns(CoreFallbackWarning, match="_StifferPlane"):
+        got = Plant(reference_uvms, contact=plane, backend="core").contact_wrench(q, v)
+    assert np.linalg.norm(got) > 1.0
+    np.testing.assert_array_equal(got, expected.contact_wrench(q, v))
 
 
 def test_integrators_say_their_counterpart(core):

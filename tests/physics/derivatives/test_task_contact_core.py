@@ -19,7 +19,7 @@ import pytest
 from conftest import central_difference, mount_on_reference_vehicle
 
 import uvms_pin as up
-from uvms_pin.errors import ParameterError
+from uvms_pin.errors import CoreFallbackWarning, ParameterError
 from uvms_pin.physics.contact import CompliantPlane, LinearSpring
 from uvms_pin.physics.derivatives.task_contact import TaskContact, contact_derivatives
 from uvms_pin.physics.joint_friction import JointFriction
@@ -196,9 +196,14 @@ class _Wall(CompliantPlane):
 
 
 def test_a_users_contact_model_is_refused_by_name_on_the_core(reference_uvms):
+    """A subclass has no compiled counterpart (the plant falls back, warned) and no
+    derivatives (refused by the reference, naming it)."""
     q, v, tau = _state(reference_uvms, 85)
     plane = _contact(reference_uvms, q, v, "plane")
     wall = _Wall(plane.normal_world, plane.stiffness_N_m, point_world_m=plane.point)
     plant = _plant(reference_uvms, wall, "core")
-    with pytest.raises(ParameterError, match="_Wall"):
+    with (
+        pytest.warns(CoreFallbackWarning, match="_Wall"),  # no compiled plant for it
+        pytest.raises(ParameterError, match="_Wall"),
+    ):
         plant.acceleration_derivatives(0.2, q, v, tau)
