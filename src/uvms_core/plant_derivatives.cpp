@@ -7,9 +7,9 @@
 // tau_g: the world's contacts (derivatives_world_contact.hpp, on the compiled world's own
 // contact points and forces), the end-effector's compliant contact, a linear spring or a
 // compliant plane (derivatives_task_contact.hpp), the joint drives' friction and the joint
-// stops (derivatives_joint_limits.hpp); the disturbance depends on time only. Frozen at the state:
-// the contacts' active set, anchors and stick or slip (`friction`). At a kink the derivative
-// of the side the state is on.
+// stops (derivatives_joint_limits.hpp); the disturbance depends on time only. Frozen at the
+// state: the contacts' active set, anchors and stick or slip (`friction`). At a kink the
+// derivative of the side the state is on.
 #include "derivatives_joint_limits.hpp"
 #include "plant.hpp"
 

@@ -7,8 +7,9 @@ counterpart) the whole of it is one compiled call, `src/uvms_core/plant_derivati
 on the compiled world's own contact points and forces and the end-effector's contact, a
 linear spring or a compliant plane (`derivatives_world_contact.cpp`,
 `derivatives_task_contact.cpp`, `derivatives_joint_limits.hpp` mirror the Python files); the
-functions here are its reference (``backend="python"``). Another end-effector contact model
-(a subclass of the user's included) takes the Python path, which refuses it by name."""
+functions here are its reference (``backend="python"``). Any other end-effector contact model
+(a user's, a subclass of those two included) has no compiled counterpart: the reference
+computes, and refuses it by name."""
 
 from __future__ import annotations
 
