@@ -85,6 +85,9 @@ Derivative = Callable[[float, np.ndarray, np.ndarray, np.ndarray], tuple[np.ndar
 
 def substeps(period_s: float, step_s: float) -> tuple[int, float]:
     """(n, h): the fewest equal substeps no longer than ``step_s`` covering the period."""
+    for name, value in (("period_s", period_s), ("step_s", step_s)):
+        if isinstance(value, bool) or not isinstance(value, int | float | np.integer | np.floating):
+            raise ParameterError(f"{name} must be a number [s], got {value!r}")
     if not (period_s > 0.0 and math.isfinite(period_s)):
         raise ParameterError(f"period_s must be positive and finite, got {period_s}")
     if not (step_s > 0.0 and math.isfinite(step_s)):
