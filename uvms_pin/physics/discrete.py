@@ -18,6 +18,7 @@ from uvms_pin.flow import FlowField
 from uvms_pin.model.uvms import UVMS
 from uvms_pin.physics.compiled.backend import Fallback
 from uvms_pin.physics.compiled.dynamics import CompiledDynamics
+from uvms_pin.physics.configuration import checked_configuration
 from uvms_pin.physics.derivatives.step import (
     METHODS,
     FixedStepIntegrator,
@@ -77,14 +78,14 @@ def step_derivatives(
     if method not in METHODS:
         raise ParameterError(f"integrator must be one of {METHODS}, got '{method}'")
     substeps(period_s, step_s)  # checks both
-    q, v = finite_vector("q", q, uvms.nq), finite_vector("v", v, uvms.nv)
-    tau = finite_vector("tau", tau, uvms.nv)
+    q, v = checked_configuration("q", q, uvms.model), finite_vector("v", v, uvms.nv)
+    tau, time_s = finite_vector("tau", tau, uvms.nv), check_time(time_s)
     dynamics = dynamics_of(uvms, backend)
     if isinstance(dynamics, CompiledDynamics) and not free_surface:
         water = _flow_of_call(np.zeros(3) if current_world is None else current_world, flow)
         ext = None if tau_ext is None else finite_vector("tau_ext", tau_ext, uvms.nv)
         out = dynamics.step_derivatives(
-            q, v, tau, water, check_time(time_s), ext, float(period_s), step_s, method
+            q, v, tau, water, time_s, ext, float(period_s), step_s, method
         )
         if not isinstance(out, Fallback):
             return StepDerivatives(q=out.q, v=out.v, dx_dx=out.dx_dx, dx_dtau=out.dx_dtau)
@@ -100,6 +101,4 @@ def step_derivatives(
         a = forward_dynamics(uvms, qq, vv, tt, time_s=t, **common)
         return (a, *forward_dynamics_derivatives(uvms, qq, vv, tt, time_s=t, **common))
 
-    return step_derivatives_of(
-        uvms.model, derivative, float(time_s), q, v, tau, period_s, step_s, method
-    )
+    return step_derivatives_of(uvms.model, derivative, time_s, q, v, tau, period_s, step_s, method)

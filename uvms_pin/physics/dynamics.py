@@ -31,6 +31,7 @@ from uvms_pin.hydro.restoring import buoyancy_potential_energy
 from uvms_pin.model.uvms import UVMS
 from uvms_pin.physics.compiled.backend import backend_named
 from uvms_pin.physics.compiled.dynamics import CompiledDynamics
+from uvms_pin.physics.configuration import checked_configuration
 from uvms_pin.physics.derivatives.reference import (
     forward_dynamics_derivatives as reference_derivatives,
 )
@@ -199,7 +200,9 @@ def forward_dynamics_derivatives(
     dynamics = dynamics_of(uvms, backend)
     water = _checked_flow(flow) if current_world is None else _uniform_or(current_world, flow)
     time_s = check_time(time_s)
-    # q, v, tau and tau_ext are checked (shape, finite) by the reference and by the core
+    # q on the manifold here (the core checks shapes and finiteness only); v, tau and
+    # tau_ext are checked (shape, finite) by the reference and by the core
+    q = checked_configuration("q", q, uvms.model)
     if isinstance(dynamics, ReferenceDynamics):
         return reference_derivatives(uvms, q, v, tau, water, time_s, tau_ext, free_surface)
     return dynamics.forward_dynamics_derivatives(q, v, tau, water, time_s, tau_ext, free_surface)

@@ -34,8 +34,11 @@ from uvms_pin.physics.surface import WetState, wet_state
 
 
 def check_time(time_s: float) -> float:
-    """``time_s`` as a float, or ParameterError if it is not finite."""
-    time_s = float(time_s)
+    """``time_s`` as a float, or ParameterError if it is not a finite number."""
+    try:
+        time_s = float(time_s)
+    except (TypeError, ValueError):  # None, a string, an array of several
+        raise ParameterError(f"time_s must be a finite number, got {time_s!r}") from None
     if not math.isfinite(time_s):  # math, not numpy: this check is on every dynamics call
         raise ParameterError(f"time_s must be finite, got {time_s}")
     return time_s

@@ -20,6 +20,7 @@ import pinocchio as pin
 
 from uvms_pin.checks import finite_vector
 from uvms_pin.errors import ParameterError
+from uvms_pin.physics.configuration import checked_configuration
 from uvms_pin.physics.derivatives.joint_limits import joint_friction_jacobian, joint_stop_jacobians
 from uvms_pin.physics.derivatives.task_contact import (
     WRENCH_JACOBIANS,
@@ -61,7 +62,8 @@ def acceleration_derivatives(
             spring or a compliant plane, or an active contact of an ellipsoid or with a
             solid object (coal's point).
     """
-    q, v = finite_vector("q", q, plant.uvms.nq), finite_vector("v", v, plant.uvms.nv)
+    q = checked_configuration("q", q, plant.uvms.model)
+    v = finite_vector("v", v, plant.uvms.nv)
     if plant.free_bodies is not None:
         raise ParameterError(
             "acceleration_derivatives: free objects and self-collision are not differentiated"

@@ -24,6 +24,7 @@ from uvms_pin.checks import finite_vector
 from uvms_pin.errors import SimulationError
 from uvms_pin.flow import FlowField
 from uvms_pin.model.uvms import UVMS
+from uvms_pin.physics.configuration import checked_configuration
 from uvms_pin.physics.derivatives.fluid import fluid_wrench_jacobians, hydrostatics
 from uvms_pin.physics.derivatives.motion import JointMotion, joint_motions
 from uvms_pin.physics.derivatives.surface import wet_term_jacobians
@@ -93,8 +94,9 @@ def forward_dynamics_derivatives(
     """(da/dq, da/dv, da/dtau) (nv x nv each) of the forward dynamics, q along the tangent;
     ``tau_ext`` (a generalized force, nv) is held fixed; ``free_surface``: the water has a
     top (the wet-fraction terms of a cut hull included, `derivatives.surface`).
-    ParameterError for a vector of the wrong shape or with a non-finite entry."""
-    q, v = finite_vector("q", q, uvms.nq), finite_vector("v", v, uvms.nv)
+    ParameterError for a vector of the wrong shape or with a non-finite entry, or a q off
+    the configuration manifold (`uvms_pin.physics.configuration`)."""
+    q, v = checked_configuration("q", q, uvms.model), finite_vector("v", v, uvms.nv)
     tau = finite_vector("tau", tau, uvms.nv)
     if tau_ext is not None:
         tau_ext = finite_vector("tau_ext", tau_ext, uvms.nv)

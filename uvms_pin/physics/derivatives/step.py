@@ -67,8 +67,15 @@ class StepDerivatives:
     dx_dtau: np.ndarray
 
     def dx_du(self, input_matrix_: np.ndarray) -> np.ndarray:
-        """d(q+, v+)/du (2 nv, m) for tau = B_u u (`input_matrix`)."""
-        return self.dx_dtau @ input_matrix_
+        """d(q+, v+)/du (2 nv, m) for tau = B_u u (`input_matrix`: nv rows, finite);
+        ParameterError for another shape or a non-finite entry."""
+        b_u = np.asarray(input_matrix_, dtype=float)
+        nv = self.dx_dtau.shape[1]
+        if b_u.ndim != 2 or b_u.shape[0] != nv:
+            raise ParameterError(f"the input matrix B_u must have shape ({nv}, m), got {b_u.shape}")
+        if not np.all(np.isfinite(b_u)):
+            raise ParameterError("the input matrix B_u contains a non-finite value")
+        return self.dx_dtau @ b_u
 
 
 class FixedStepIntegrator(Protocol):
@@ -85,6 +92,9 @@ Derivative = Callable[[float, np.ndarray, np.ndarray, np.ndarray], tuple[np.ndar
 
 def substeps(period_s: float, step_s: float) -> tuple[int, float]:
     """(n, h): the fewest equal substeps no longer than ``step_s`` covering the period."""
+    for name, value in (("period_s", period_s), ("step_s", step_s)):
+        if isinstance(value, bool) or not isinstance(value, int | float | np.integer | np.floating):
+            raise ParameterError(f"{name} must be a number [s], got {value!r}")
     if not (period_s > 0.0 and math.isfinite(period_s)):
         raise ParameterError(f"period_s must be positive and finite, got {period_s}")
     if not (step_s > 0.0 and math.isfinite(step_s)):
