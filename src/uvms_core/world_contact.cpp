@@ -28,7 +28,7 @@ void WorldContactModel::check(const Model& model) const {
 void WorldContactModel::forces(const Data& data, const FrictionMemory& memory,
                                ContactForces& out) {
   Touch& found = out.touch;
-  touch(data, pieces, objects, piece_where_, object_where_, found);
+  touch(data, pieces, objects, touch_work_, found);
   const auto m = static_cast<Eigen::Index>(found.size());
   const int n_objects = static_cast<int>(objects.size());
   out.normal_N.resize(m);

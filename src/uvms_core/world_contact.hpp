@@ -62,7 +62,7 @@ struct WorldContactModel {
   void commit(const ContactForces& forces, FrictionMemory& memory) const;
 
  private:
-  Placements piece_where_, object_where_;
+  TouchBuffers touch_work_;
   // work buffers of forces()
   Eigen::Matrix3Xd stretch_, tangential_velocity_, friction_;
   Eigen::VectorXd mu_stick_, mu_kinetic_;

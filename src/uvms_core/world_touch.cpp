@@ -88,18 +88,18 @@ void coal_point(const pinocchio::Data& data, const ContactShape& piece,
 }  // namespace
 
 void touch(const pinocchio::Data& data, const std::vector<ContactShape>& pieces,
-           const std::vector<ContactShape>& objects, Placements& piece_where,
-           Placements& object_where, Touch& out) {
+           const std::vector<ContactShape>& objects, TouchBuffers& work, Touch& out) {
   out.clear();
+  Placements& piece_where = work.piece_where;
+  Placements& object_where = work.object_where;
   piece_where.resize(pieces.size());
   object_where.resize(objects.size());
   for (std::size_t p = 0; p < pieces.size(); ++p) piece_where[p] = placement_of(data, pieces[p]);
   for (std::size_t o = 0; o < objects.size(); ++o) {
     object_where[o] = placement_of(data, objects[o]);
   }
-  static thread_local std::vector<std::pair<int, int>> pairs;
-  near_pairs(piece_where, pieces, object_where, objects, pairs);
-  for (const auto& [p, o] : pairs) {
+  near_pairs(piece_where, pieces, object_where, objects, work.pairs);
+  for (const auto& [p, o] : work.pairs) {
     const auto& piece = pieces[static_cast<std::size_t>(p)];
     const auto& object = objects[static_cast<std::size_t>(o)];
     const auto& where = piece_where[static_cast<std::size_t>(p)];

@@ -62,10 +62,15 @@ void near_pairs(const Placements& piece_where,
                 const std::vector<ContactShape>& objects,
                 std::vector<std::pair<int, int>>& out);
 
-// The contact points after kinematics (touch of touch.py); piece_where and object_where are
-// filled with every shape's placement.
+// touch()'s work buffers, kept by its caller between calls (no allocation per call once
+// sized): every shape's placement and the near (piece, object) pairs.
+struct TouchBuffers {
+  Placements piece_where, object_where;
+  std::vector<std::pair<int, int>> pairs;
+};
+
+// The contact points after kinematics (touch of touch.py).
 void touch(const pinocchio::Data& data, const std::vector<ContactShape>& pieces,
-           const std::vector<ContactShape>& objects, Placements& piece_where,
-           Placements& object_where, Touch& out);
+           const std::vector<ContactShape>& objects, TouchBuffers& work, Touch& out);
 
 }  // namespace uvms

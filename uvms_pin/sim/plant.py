@@ -405,7 +405,9 @@ class Plant:
         """(da/dq, da/dv, da/dtau) of `acceleration` (`uvms_pin.sim.plant_derivatives`)."""
         from uvms_pin.sim.plant_derivatives import acceleration_derivatives
 
-        return acceleration_derivatives(self, time_s, q, v, tau)
+        return acceleration_derivatives(
+            self, time_s, q, v, tau, compiled=self._core(), scratch=self._world_data
+        )
 
     def chart(self) -> Chart | None:
         """The compiled local chart of the adaptive integrators, or None (Python path)."""

@@ -15,6 +15,7 @@ from __future__ import annotations
 from typing import Any
 
 import numpy as np
+import pinocchio as pin
 
 from uvms_pin.checks import finite_vector
 from uvms_pin.errors import ParameterError
@@ -26,10 +27,19 @@ from uvms_pin.physics.reference import check_time
 
 
 def acceleration_derivatives(
-    plant: Any, time_s: float, q: np.ndarray, v: np.ndarray, tau: np.ndarray
+    plant: Any,
+    time_s: float,
+    q: np.ndarray,
+    v: np.ndarray,
+    tau: np.ndarray,
+    *,
+    compiled: Any | None,
+    scratch: pin.Data,
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """(da/dq, da/dv, da/dtau) (nv x nv each, q along the tangent) of ``plant``'s
-    acceleration (a `uvms_pin.sim.plant.Plant`, which calls this: no import back):
+    acceleration (a `uvms_pin.sim.plant.Plant`, which calls this: no import back; it
+    passes its compiled counterpart, or None on the Python path, and a Pinocchio data of
+    its model to work in, ``scratch``):
     the water (flow, free surface) by `forward_dynamics_derivatives`, and the plant's
     own generalized forces tau_g(q, v), the world's contacts (a piece's corners or a
     sphere on a plane: `uvms_pin.physics.derivatives.world_contact`), the end-effector's
@@ -51,13 +61,12 @@ def acceleration_derivatives(
         raise ParameterError(
             "acceleration_derivatives: free objects and self-collision are not differentiated"
         )
-    compiled = plant._core()
     if compiled is not None and plant.contact is None:
         out = compiled.acceleration_derivatives(
             check_time(time_s), q, v, finite_vector("tau", tau, plant.uvms.nv), plant.friction
         )
         return out.da_dq, out.da_dv, out.da_dtau
-    tau_ext, by_q, by_v = _own_forces(plant, time_s, q, v)
+    tau_ext, by_q, by_v = _own_forces(plant, scratch, time_s, q, v)
     da_dq, da_dv, inverse_mass = forward_dynamics_derivatives(
         plant.uvms,
         q,
@@ -73,20 +82,24 @@ def acceleration_derivatives(
 
 
 def _own_forces(
-    plant: Any, time_s: float, q: np.ndarray, v: np.ndarray
+    plant: Any, data: pin.Data, time_s: float, q: np.ndarray, v: np.ndarray
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """The plant's own generalized force tau_g (nv,) at (q, v) and d tau_g/dq, d tau_g/dv
-    (nv, nv): the sum of its parts' (the water's are `forward_dynamics_derivatives`')."""
+    (nv, nv): the sum of its parts' (the water's are `forward_dynamics_derivatives`');
+    ``data``: a Pinocchio data of the plant's model to work in."""
     nv = plant.uvms.nv
     tau_ext, by_q, by_v = np.zeros(nv), np.zeros((nv, nv)), np.zeros((nv, nv))
-    forces = plant.world_forces(q, v)
+    forces = None
+    if plant.world is not None:
+        pin.forwardKinematics(plant.uvms.model, data, q, v)
+        forces = plant.world.forces(data, plant.friction)
     if forces is not None and len(forces.touch):
-        tau_ext += plant.world.generalized_force(q, plant._world_data, forces)
+        tau_ext += plant.world.generalized_force(q, data, forces)
         world_q, world_v = world_contact_jacobians(plant.world, q, v, forces, plant.friction)
         by_q, by_v = by_q + world_q, by_v + world_v
     if plant.contact is not None:  # tau = -J^T lambda, lambda on the environment
         task = TaskContact(plant.uvms.ee_frame_id, plant.contact)  # refuses other models
-        state, jacobians = contact_derivatives(task, plant.uvms.model, plant._ee_data, q, v)
+        state, jacobians = contact_derivatives(task, plant.uvms.model, data, q, v)
         tau_ext += state.tau_ext
         by_q, by_v = by_q + jacobians.tau_dq, by_v + jacobians.tau_dv
     if plant.joint_friction is not None:
