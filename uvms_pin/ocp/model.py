@@ -32,7 +32,7 @@ import pinocchio as pin
 from uvms_pin.errors import ParameterError
 from uvms_pin.flow import FlowField
 from uvms_pin.model.uvms import UVMS
-from uvms_pin.ocp.costs import CostTerm
+from uvms_pin.ocp.costs import CostTerm, Effort
 from uvms_pin.ocp.crocoddyl_module import crocoddyl_module
 from uvms_pin.ocp.state import UvmsState
 from uvms_pin.physics.derivatives.task_contact import (
@@ -82,6 +82,7 @@ class UnderwaterActionModel(crocoddyl.DifferentialActionModelAbstract):
         if b_u.ndim != 2 or b_u.shape[0] != uvms.nv:
             raise ParameterError(f"input_matrix_ must be (nv={uvms.nv}, nu), got {b_u.shape}")
         nr, nu = sum(term.nr for term, _ in terms), b_u.shape[1]
+        _check_terms(terms, nu)
         ng = nu if bounds_as_constraints and u_bounds is not None else 0
         state = UvmsState(uvms.model)
         crocoddyl.DifferentialActionModelAbstract.__init__(self, state, nu, nr, ng)
@@ -98,8 +99,15 @@ class UnderwaterActionModel(crocoddyl.DifferentialActionModelAbstract):
         self.constraints = None
         if u_bounds is not None:
             lower, upper = (np.asarray(b, float).reshape(-1) for b in u_bounds)
-            if lower.shape != (self.nu,) or upper.shape != (self.nu,) or np.any(lower > upper):
-                raise ParameterError(f"u_bounds: two (nu={self.nu},) arrays, lower <= upper")
+            if (
+                lower.shape != (self.nu,)
+                or upper.shape != (self.nu,)
+                or not np.all(lower <= upper)  # (NaN too)
+            ):
+                raise ParameterError(
+                    f"u_bounds: two (nu={self.nu},) arrays, lower <= upper (not NaN), "
+                    f"got {lower}, {upper}"
+                )
             self.u_lb, self.u_ub = lower, upper
         if ng:  # (the manager's own g_lb / g_ub read garbage in the crocoddyl 3.2.1 wheels)
             self.constraints = _input_constraints(state, lower, upper)
@@ -180,6 +188,20 @@ class UnderwaterActionModel(crocoddyl.DifferentialActionModelAbstract):
 
     def createData(self):
         return UnderwaterActionData(self)
+
+
+def _check_terms(terms: WeightedTerms, nu: int) -> None:
+    """Each term's scale finite and >= 0 (a negative one makes the cost unbounded below, a
+    NaN one every cost NaN), an effort term over the nu inputs; else ParameterError."""
+    for term, scale in terms:
+        if not (scale >= 0.0 and np.isfinite(scale)):
+            raise ParameterError(
+                f"cost '{term.name}': its scale must be finite and >= 0, got {scale}"
+            )
+        if isinstance(term, Effort) and term.nr != nu:
+            raise ParameterError(
+                f"cost '{term.name}': {term.nr} weights for the node's {nu} inputs (nu)"
+            )
 
 
 def _input_constraints(state, lower: np.ndarray, upper: np.ndarray):

@@ -87,6 +87,7 @@ def shooting_problem(
     if nodes < 1 or not (dt_s > 0.0 and np.isfinite(dt_s)):
         raise ParameterError(f"need nodes >= 1 and dt_s > 0, got {nodes}, {dt_s}")
     check_integrator(integrator)
+    _check_start(x0, uvms.nq + uvms.nv, "x0")
     nu = actuators.nu(uvms.nv)
 
     def node(costs_of: CostBuilder, t: float, constrained: bool):
@@ -145,7 +146,32 @@ def check_solver(solver: str) -> str:
 
 
 def _nodes(horizon_s: float, dt_s: float) -> int:
-    return max(1, round(horizon_s / dt_s))
+    """round(horizon_s / dt_s), the nodes of a horizon; ParameterError unless both are
+    positive finite times [s] and the horizon holds at least one node."""
+    for name, value in (("dt_s", dt_s), ("horizon_s", horizon_s)):
+        if not (value > 0.0 and math.isfinite(value)):
+            raise ParameterError(f"ocp {name} must be a positive finite time [s], got {value}")
+    nodes = round(horizon_s / dt_s)
+    if nodes < 1:
+        raise ParameterError(
+            f"ocp horizon_s {horizon_s} s holds no node of dt_s {dt_s} s (at least one needed)"
+        )
+    return nodes
+
+
+def _six_weights(name: str, weights) -> np.ndarray:
+    """``weights``: one number or six, as a (6,) array; ParameterError naming ``name``."""
+    values = np.asarray(weights, float).reshape(-1)
+    if values.size not in (1, 6):
+        raise ParameterError(f"ocp {name}: one number or six needed, got {values.size}")
+    return np.broadcast_to(values, (6,)).copy()
+
+
+def _scale(name: str, value: float) -> float:
+    """A cost term's scale: finite and >= 0, else ParameterError naming it."""
+    if not (value >= 0.0 and math.isfinite(value)):
+        raise ParameterError(f"ocp {name} must be finite and >= 0, got {value}")
+    return float(value)
 
 
 def point_to_point(
@@ -166,7 +192,7 @@ def point_to_point(
     running cost keeps velocities and effort small. ``pose_weights``: of the pose error
     (position [m], rotation [rad]), x1e3 at the end."""
     x0 = np.asarray(x0, float)
-    pose_w = np.broadcast_to(np.asarray(pose_weights, float), (6,)).copy()
+    pose_w = _six_weights("pose_weights", pose_weights)
     slow = np.r_[np.zeros(uvms.nv), np.ones(uvms.nv)]
 
     def running(nu: int):
@@ -218,7 +244,7 @@ def station_hold(
     against 1 N of input; give a DoF the input cannot reach (e.g. the passively stable roll
     and pitch of a vehicle without thrust there) a small weight, or the plan fights it."""
     x0 = np.asarray(x0, float)
-    pose_w = np.broadcast_to(np.asarray(pose_weights, float), (6,)).copy()
+    pose_w = _six_weights("pose_weights", pose_weights)
     hold_arm = np.r_[np.zeros(6), np.ones(uvms.nv - 6), np.full(uvms.nv, 0.1)]
 
     def terms(scale: float):
@@ -294,6 +320,7 @@ def force_tracking(
     in every node's dynamics (`uvms_pin.physics.derivatives.task_contact`)."""
     x0 = np.asarray(x0, float)
     nodes = _nodes(horizon_s, dt_s)
+    effort_weight = _scale("effort_weight", effort_weight)
     hold = np.r_[
         np.zeros(6), np.full(uvms.nv - 6, posture_weight), np.full(uvms.nv, velocity_weight)
     ]
@@ -357,6 +384,14 @@ def solver_of(problem, solver: str = "box_fddp"):
     return csqp
 
 
+def _check_start(x0, nx: int, name: str) -> None:
+    """x0 of nx finite values, else ParameterError. (Checked before crocoddyl runs: a
+    node's error raised inside crocoddyl's C++ loop over the nodes aborts the process.)"""
+    x0 = np.asarray(x0, float)
+    if x0.shape != (nx,) or not np.all(np.isfinite(x0)):
+        raise ParameterError(f"ocp {name} must be {nx} finite values (q, v), got {x0}")
+
+
 def solution(solver) -> tuple[list[np.ndarray], list[np.ndarray]]:
     """(xs, us) of ``solver``, copied. (mim_solvers' ``xs`` / ``us`` are containers returned
     by value whose items view the container's memory: ``solver.us[0]`` reads freed memory
@@ -380,12 +415,19 @@ def solve(
     problem's curvature), None: the solver's smallest. Returns the solver (``xs``, ``us``,
     ``cost``, ``iter``, ``preg``; CSQP's ``xs`` may keep gaps to the dynamics, its
     ``gap_norm`` and ``constraint_norm`` the last iterate's; read xs and us by `solution`)."""
+    if isinstance(iterations, bool) or not isinstance(iterations, int | np.integer):
+        raise ParameterError(f"ocp iterations must be an integer >= 1, got {iterations!r}")
+    if iterations < 1:
+        raise ParameterError(f"ocp iterations must be >= 1, got {iterations}")
     solver = solver_of(problem, solver) if isinstance(solver, str) else solver
+    _check_start(problem.x0, problem.runningModels[0].state.nx, "the problem's x0")
     if warm_start is None:
         xs = [problem.x0] * (problem.T + 1)
         us = [np.zeros(m.nu) for m in problem.runningModels]
     else:
         xs, us = warm_start
+        if not all(np.all(np.isfinite(np.asarray(v, float))) for v in (*xs, *us)):
+            raise ParameterError("ocp warm_start: its xs and us must be finite")
     initial = math.nan if regularization is None else float(regularization)
     solver.solve(list(xs), list(us), iterations, False, initial)
     return solver

@@ -115,6 +115,8 @@ def build_mpc(t: Table, uvms: UVMS, actuation: Actuation | None = None) -> Contr
         fields["pose_weights"] = t.vector("pose_weights", 6, default_weights, nonneg=True)
     limits = t.vector("tau_limits", uvms.nv, np.full(uvms.nv, np.inf), nonneg=True)
     inputs = t.string("inputs", "tau", choices=("tau", "thrusters"))
+    if inputs == "tau" and not np.any(limits > 0.0):
+        raise t.error("tau_limits", "is 0 for every DoF: the plan would have no input")
     on_thrusters = (
         _thruster_inputs(t, actuation or Unlimited(), uvms.nv, limits)
         if inputs == "thrusters"

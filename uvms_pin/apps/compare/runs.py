@@ -43,6 +43,12 @@ def controller_scenarios(
             out[name] = scenario_from_raw(variant, path)
         except ScenarioError as exc:
             raise ScenarioError(f"controller '{name}' ([baselines.{name}]): {exc}") from exc
+    first = next(iter(out.values()), None)
+    if first is not None and first.task is None and first.plant.contact is None:
+        raise ScenarioError(
+            f"{path}: compare-controllers compares a force task (an [environment] and a "
+            "desired force) or a tracking [task]; this scenario has neither"
+        )
     # every controller's rollout is kept until the figures are drawn: all of them must fit
     check_memory(
         sum(

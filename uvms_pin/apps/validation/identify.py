@@ -52,7 +52,7 @@ from uvms_pin.apps.validation.pool import (
 )
 from uvms_pin.apps.validation.prescribed import JointTrajectory
 from uvms_pin.apps.validation.trials import load_trial, roll_pitch_rad
-from uvms_pin.errors import SimulationError
+from uvms_pin.errors import ParameterError, SimulationError
 from uvms_pin.model.uvms import UVMS
 from uvms_pin.physics.dynamics import bias_forces
 from uvms_pin.results.outdir import check_writable
@@ -217,6 +217,11 @@ def run(args: argparse.Namespace) -> int:
     """``identify``: the quasi-static centre-of-buoyancy fit, or with ``--fit`` the dynamic
     fit of the named parameters (`uvms_pin.apps.validation.identification`)."""
     # the shipped trial model may already hold a correction: fit the one relative to the file
+    if args.fit is None and args.out is not None:
+        raise ParameterError(
+            f"--out {args.out}: only with --fit (the quasi-static centre-of-buoyancy fit, "
+            "without --fit, prints its result and writes nothing)"
+        )
     start = trial_uvms() if args.cob is None else with_cob(trial_uvms(), args.cob)
     if args.fit is None:
         return _quasi_static(args, start)

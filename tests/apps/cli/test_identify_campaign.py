@@ -1,0 +1,64 @@
+"""``uvms-pin identify``'s bad arguments, as a user meets them: exit 2, a message naming
+what is wrong, no traceback and nothing written in --out. The pool trials are the project's
+own copy, data/hinsdale2023 (tests/apps/validation reach them the same way)."""
+
+from __future__ import annotations
+
+import shutil
+
+import pytest
+from cli_support import ROOT, run_cli
+
+from uvms_pin.apps.validation.pool import IDENTIFICATION_TRIALS
+
+DATA = ROOT / "data" / "hinsdale2023"
+
+
+def _only_identification_trials(tmp_path):
+    folder = tmp_path / "only_fit_trials"
+    folder.mkdir()
+    for name in IDENTIFICATION_TRIALS:
+        shutil.copy(DATA / f"{name}.npz", folder)
+    return folder
+
+
+def _with_a_corrupt_held_out_trial(tmp_path):
+    folder = _only_identification_trials(tmp_path)
+    (folder / "_alt_011-0.npz").write_text("not a zip archive")
+    return folder
+
+
+@pytest.mark.parametrize(
+    ("data", "arguments", "message"),
+    [
+        (None, ["--fit", ""], "--fit: must be parameter names"),
+        (None, ["--fit", ","], "none empty"),
+        (None, ["--fit", "linear_damping.roll,linear_damping.roll"], "given twice"),
+        (None, ["--fit", "added_mass.w"], "unknown parameter 'added_mass.w'"),
+        (None, ["--fit", "linear_damping.roll", "--max-iterations", "0"], "--max-iterations"),
+        (None, ["--fit", "linear_damping.roll", "--step", "0"], "--step"),
+        (None, ["--fit", "linear_damping.roll", "--step", "nan"], "--step"),
+        (None, ["--fit", "linear_damping.roll", "--cob", "nan", "0", "0"], "--cob"),
+        (_only_identification_trials, ["--fit", "linear_damping.roll"], "no trial left to hold"),
+        (_with_a_corrupt_held_out_trial, ["--fit", "linear_damping.roll"], "not a readable NPZ"),
+        # without --fit the quasi-static fit writes nothing: --out was silently ignored
+        (None, [], "--out"),
+    ],
+)
+def test_identify_refuses_bad_arguments_before_writing(tmp_path, data, arguments, message):
+    folder = DATA if data is None else data(tmp_path)
+    out = tmp_path / "out"
+    result = run_cli(["identify", str(folder), *arguments, "--out", str(out)], tmp_path)
+    assert result.returncode == 2, result.stderr
+    assert message in result.stderr and "Traceback" not in result.stderr, result.stderr
+    assert not out.exists()
+
+
+def test_identify_refuses_a_file_as_its_out_directory(tmp_path):
+    out = tmp_path / "a_file"
+    out.write_text("mine")
+    result = run_cli(
+        ["identify", str(DATA), "--fit", "linear_damping.roll", "--out", str(out)], tmp_path
+    )
+    assert result.returncode == 2 and "is a file" in result.stderr, result.stderr
+    assert out.read_text() == "mine"
