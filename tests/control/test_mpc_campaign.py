@@ -8,6 +8,7 @@ crocoddyl is in the dev extra; without it these tests skip.
 from __future__ import annotations
 
 import numpy as np
+import pandas as pd
 import pytest
 from conftest import ROOT
 
@@ -94,14 +95,35 @@ def test_compare_controllers_runs_the_mpc_on_the_force_task_with_csqp(tmp_path, 
 
 
 def test_compare_controllers_refuses_a_scenario_without_a_force_task(tmp_path, capsys):
-    """The station-keeping MPC scenario has no [environment] nor [task]: compare-controllers
-    compares force tracking or a [task]; it was a KeyError traceback (exit 1) after every
-    controller had run."""
+    """The station-keeping MPC scenario without its [task] has no [environment] nor [task]:
+    compare-controllers compares force tracking or a [task]; it was a KeyError traceback
+    (exit 1) after every controller had run."""
+    text = STATION.read_text()
+    start, end = text.index("[task]"), text.index("[baselines.task_priority]")
+    (tmp_path / "no_task.toml").write_text(text[:start] + text[end:])
     out = tmp_path / "cmp"
     code, err = _cli(
-        capsys, "compare-controllers", str(STATION), "--controllers", "mpc",
+        capsys, "compare-controllers", str(tmp_path / "no_task.toml"), "--controllers", "mpc",
         "--set", "scenario.duration_s=0.1", "--out", str(out), "--quiet", "--no-figures",
     )  # fmt: skip
     assert code == 2, err
     assert "force" in err and "[task]" in err and "Traceback" not in err, err
     assert not out.exists()
+
+
+def test_compare_controllers_on_station_keeping_in_a_sea(tmp_path, capsys):
+    """The MPC beside task-priority control holding the vehicle's pose in an irregular sea
+    (the scenario's [task] hold, 0.4 s): one row each, both holding the station within the
+    task's 0.1 m, the MPC's position error no larger than 1 cm."""
+    out = tmp_path / "cmp"
+    code, err = _cli(
+        capsys, "compare-controllers", str(STATION), "--controllers", "mpc,task_priority",
+        "--set", "scenario.duration_s=0.4", "--set", "task.transient_s=0.0",
+        "--set", "water.sea={significant_height_m=0.5, peak_period_s=5.0}",
+        "--out", str(out), "--quiet", "--no-figures",
+    )  # fmt: skip
+    assert code == 0, err
+    table = pd.read_csv(out / "controllers.csv").set_index("controller")
+    assert list(table.index) == ["mpc", "task_priority"]
+    assert table["success"].tolist() == [True, True], table
+    assert table.loc["mpc", "task_position_error_max_m"] < 0.01, table
