@@ -426,7 +426,7 @@ def solve(
         us = [np.zeros(m.nu) for m in problem.runningModels]
     else:
         xs, us = warm_start
-        if not all(np.all(np.isfinite(np.asarray(v, float))) for v in (*xs, *us)):
+        if not np.all(np.isfinite(np.concatenate([*map(np.ravel, xs), *map(np.ravel, us)]))):
             raise ParameterError("ocp warm_start: its xs and us must be finite")
     initial = math.nan if regularization is None else float(regularization)
     solver.solve(list(xs), list(us), iterations, False, initial)

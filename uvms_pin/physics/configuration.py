@@ -10,6 +10,8 @@ gives (|norm - 1| ~ 1e-16) passes.
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 import pinocchio as pin
 
@@ -27,6 +29,16 @@ _UNIT_PART = {"JointModelFreeFlyer": (3, 4), "JointModelPlanar": (2, 2)}
 def checked_configuration(name: str, value, model: pin.Model) -> np.ndarray:
     """``value`` as q (nq,) of ``model``: finite, and on the manifold to `NORM_TOLERANCE`;
     else ParameterError naming ``name`` and the first joint off it."""
+    if (
+        type(value) is np.ndarray
+        and value.dtype == np.float64
+        and value.shape == (model.nq,)
+        and math.isfinite(np.dot(value, value))  # all finite (an overflow: the full check)
+        and pin.isNormalized(model, value, NORM_TOLERANCE)  # (true without a unit part)
+    ):
+        # the common case in under 1 us: the full check below costs 2.4 us, more than the
+        # compiled derivatives' own forward dynamics
+        return value
     q = finite_vector(name, value, model.nq)
     if model.nq == model.nv or pin.isNormalized(model, q, NORM_TOLERANCE):
         return q
