@@ -46,7 +46,7 @@ def _controller(plant_uvms, model_uvms, q0, **kw):
         posture=q0,
         horizon_s=0.5,
         dt_s=0.05,
-        rate_hz=20.0,
+        rate_hz=kw.pop("rate_hz", 20.0),
         iterations=2,
         actuators=problems.Actuators(b_u, (lower, upper)),
         flow=up.flow.UniformCurrent(CURRENT),
@@ -196,3 +196,36 @@ def test_the_force_task_previews_the_desired_force_and_places_its_spring(referen
     assert controller._contact.model.anchor[0] == pytest.approx(
         data.oMf[uvms.ee_frame_id].translation[0] + 0.1, abs=1e-12
     )
+
+
+@pytest.mark.parametrize("rate_hz", [20.0, 5.0])
+def test_the_warm_start_moves_the_last_plan_on_by_the_time_since_it(
+    reference_uvms, monkeypatch, rate_hz
+):
+    """The second plan starts from the first moved on by the time between them in whole
+    nodes (dt_s = 0.05: one node at 20 Hz, four at 5 Hz), the measured state first and the
+    last node repeated at the end: a plan started from a guess misaligned in time begins
+    from where the vehicle was told to be earlier."""
+    q0 = _start(reference_uvms)
+    controller, _ = _controller(reference_uvms, reference_uvms, q0, rate_hz=rate_hz)
+    starts = []
+    solve = problems.solve
+
+    def spy(problem, **kw):
+        starts.append(kw["warm_start"])
+        return solve(problem, **kw)
+
+    monkeypatch.setattr(problems, "solve", spy)
+    v0 = np.zeros(reference_uvms.nv)
+    controller.compute(0.0, Measurement(0.0, q0, v0, np.zeros(6)))
+    xs, us = (list(part) for part in controller._guess)
+    later = 1.0 / rate_hz
+    controller.compute(later, Measurement(later, q0, v0, np.zeros(6)))
+    shift = round(later / 0.05)
+    start_xs, start_us = starts[1]
+    assert len(start_xs) == len(xs) and len(start_us) == len(us)
+    np.testing.assert_array_equal(start_xs[0], np.r_[q0, v0])
+    for k in range(1, len(xs)):
+        np.testing.assert_array_equal(start_xs[k], xs[min(k + shift, len(xs) - 1)])
+    for k in range(len(us)):
+        np.testing.assert_array_equal(start_us[k], us[min(k + shift, len(us) - 1)])

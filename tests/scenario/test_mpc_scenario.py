@@ -206,3 +206,16 @@ def test_a_bad_mpc_horizon_exits_2_on_the_command_line(tmp_path):
     )
     assert result.returncode == 2, result.stderr
     assert "horizon_s" in result.stderr
+
+
+@pytest.mark.parametrize("rate_hz", [1000.0, 30.0, 45.0])
+def test_a_replan_rate_the_control_ticks_cannot_keep_is_refused(rate_hz):
+    """The scenario's controller runs at 100 Hz ([control] period_s = 0.01 s): it can re-plan
+    at 100, 50, 33.3, 25 Hz..., not at 1000 Hz nor 30 Hz (every fourth tick: 25 Hz)."""
+    with pytest.raises(ScenarioError, match=r"controller\.rate_hz.*100 Hz"):
+        load_scenario(SCENARIO, {"controller.rate_hz": rate_hz})
+
+
+@pytest.mark.parametrize("rate_hz", [100.0, 50.0, 100.0 / 3.0, 25.0])
+def test_a_replan_rate_of_whole_control_ticks_is_taken(rate_hz):
+    load_scenario(SCENARIO, {"controller.rate_hz": rate_hz})

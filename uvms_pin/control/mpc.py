@@ -2,7 +2,8 @@
 
 At each re-plan (every 1 / rate_hz seconds) the controller sets the OCP's initial state to
 the measured (q, v), warm-starts its solver (crocoddyl's BoxFDDP or FDDP, or mim_solvers'
-CSQP with the input bounds as constraints) from the previous solution shifted by one node,
+CSQP with the input bounds as constraints) from the previous solution shifted by the nodes
+the time since it spans (one at the usual rate_hz = 1 / dt_s),
 runs at most ``iterations`` iterations (at most `COLD_START_ITERATIONS` for a plan without
 a warm start, e.g. the first) and applies the first control,
 tau = B_u u_0, held until the next re-plan. The OCP (`uvms_pin.ocp.problems`) is built once
@@ -154,7 +155,7 @@ class MpcController(Controller):
             build = problems.station_hold if task == "station" else problems.point_to_point
             weights = {} if pose_weights is None else {"pose_weights": pose_weights}
             self.problem = build(self.uvms, x_ref, target, **common, **weights)
-        self.period_s = 1.0 / rate_hz
+        self.period_s, self.dt_s = 1.0 / rate_hz, dt_s
         self.iterations, self.solver, self.warm_start = iterations, solver, warm_start
         self.input_matrix = (
             np.eye(uvms.nv) if actuators.input_matrix is None else actuators.input_matrix
@@ -184,6 +185,7 @@ class MpcController(Controller):
 
     def reset(self) -> None:
         self._next_plan_s = -math.inf
+        self._last_plan_s = -math.inf
         self._guess: tuple[list, list] | None = None
         self._tau = np.zeros(self.uvms.nv)
         self._signals: dict[str, np.ndarray] = {}
@@ -192,12 +194,15 @@ class MpcController(Controller):
         self._cold_steps = list(self._solver.alphas)
         self._regularization: float | None = None
 
-    def _initial_guess(self, x: np.ndarray) -> tuple[list, list]:
+    def _initial_guess(self, x: np.ndarray, elapsed_s: float) -> tuple[list, list]:
+        """The solver's start: the last plan moved on by the ``elapsed_s`` [s] since it, in
+        whole nodes (its last node repeated at the end), from the measured state x."""
         nodes = self.problem.T
         if self._guess is None or not self.warm_start:
             return [x] * (nodes + 1), [np.zeros(self.problem.runningModels[0].nu)] * nodes
         xs, us = self._guess
-        return [x, *xs[2:], xs[-1]], [*us[1:], us[-1]]
+        shift = min(max(round(elapsed_s / self.dt_s), 0), nodes)
+        return [x, *xs[shift + 1 :], *[xs[-1]] * shift], [*us[shift:], *[us[-1]] * shift]
 
     def _force_signals(self, time_s: float, measurement: Measurement) -> dict[str, np.ndarray]:
         """f_d(t) and the task error e_x = [f_meas - f_d (3) N; wrap(rpy_ee - rpy_d) (3) rad]
@@ -235,7 +240,7 @@ class MpcController(Controller):
         solver = problems.solve(
             self.problem,
             iterations=max(self.iterations, COLD_START_ITERATIONS) if cold else self.iterations,
-            warm_start=self._initial_guess(x),
+            warm_start=self._initial_guess(x, time_s - self._last_plan_s),
             solver=self._solver,
             regularization=self._regularization if self.warm_start else None,
         )
@@ -244,6 +249,7 @@ class MpcController(Controller):
         u0 = self._guess[1][0].copy()
         self._tau = self.input_matrix @ u0
         self._next_plan_s = time_s + self.period_s - 1e-12
+        self._last_plan_s = time_s
         self._signals.update({"mpc_cost": np.array([solver.cost]), "mpc_u": u0})
         return self._tau
 

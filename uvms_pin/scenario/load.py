@@ -34,6 +34,7 @@ from uvms_pin.scenario.estimator import build_estimator
 from uvms_pin.scenario.initial import build_initial_state
 from uvms_pin.scenario.joints import build_joint_friction, with_joint_lag
 from uvms_pin.scenario.metrics import build_metrics
+from uvms_pin.scenario.mpc import check_replan_rate
 from uvms_pin.scenario.objects import build_joint_stops, build_world
 from uvms_pin.scenario.overrides import apply_overrides, parse_key_path
 from uvms_pin.scenario.schema import Table
@@ -126,6 +127,7 @@ def _build(raw: dict[str, Any], path: Path, top: Table) -> Scenario:
         build_controller(top.table("controller"), uvms, path.parent, task, actuation),
         from_file=True,
     )
+    check_replan_rate(top, raw.get("controller"), control_period)
     extra_metrics = build_metrics(top.table("metrics"), path.parent)
     check_baselines(top.table("baselines"), (raw.get("controller") or {}).get("type"))
     top.finish()

@@ -167,3 +167,21 @@ def build_mpc(t: Table, uvms: UVMS, actuation: Actuation | None = None) -> Contr
         **{k: v for k, v in fields.items() if k != "pose_weights"},
     }
     return checked_spec(t, uvms, "mpc", recorded, build)
+
+
+def check_replan_rate(top: Table, controller: dict | None, control_period_s: float | None) -> None:
+    """An MPC re-plans at control ticks: 1 / ``rate_hz`` must be a whole number of control
+    periods, else it would re-plan at another rate than the one asked for (e.g. 1000 Hz on
+    100 Hz ticks, or 30 Hz, every fourth tick: 25 Hz). ScenarioError naming the key."""
+    if not controller or controller.get("type") != "mpc" or control_period_s is None:
+        return
+    rate_hz = float(controller.get("rate_hz", _NUMBERS["rate_hz"]))
+    ticks = 1.0 / (rate_hz * control_period_s)
+    if ticks < 1.0 - 1e-9 or abs(ticks - round(ticks)) > 1e-6 * ticks:
+        control_hz = 1.0 / control_period_s
+        raise top.error(
+            "controller.rate_hz",
+            f"{rate_hz:g} Hz is not the control rate ({control_hz:g} Hz, [control] period_s = "
+            f"{control_period_s:g} s) divided by a whole number: the controller re-plans at "
+            "control ticks, so it would re-plan at another rate",
+        )
