@@ -219,3 +219,10 @@ def test_a_replan_rate_the_control_ticks_cannot_keep_is_refused(rate_hz):
 @pytest.mark.parametrize("rate_hz", [100.0, 50.0, 100.0 / 3.0, 25.0])
 def test_a_replan_rate_of_whole_control_ticks_is_taken(rate_hz):
     load_scenario(SCENARIO, {"controller.rate_hz": rate_hz})
+
+
+def test_a_horizon_whose_problem_cannot_fit_in_memory_is_refused_before_it_is_built():
+    """1e6 s of 20 ms nodes (5e7 nodes, terabytes): refused at once, naming the key and the
+    remedy, where it used to build nodes for minutes."""
+    with pytest.raises(ScenarioError, match=r"controller\.horizon_s.*GiB.*lengthen controller"):
+        load_scenario(SCENARIO, {"controller.horizon_s": 1e6})

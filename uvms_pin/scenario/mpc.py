@@ -25,6 +25,7 @@ from __future__ import annotations
 import numpy as np
 import pinocchio as pin
 
+from uvms_pin.checks import check_memory
 from uvms_pin.control.base import Controller
 from uvms_pin.flow import UniformCurrent
 from uvms_pin.model.scaled import scaled_uvms
@@ -38,6 +39,9 @@ from uvms_pin.sim.run import ControllerSpec
 
 #: the keys of the table with their defaults
 _NUMBERS = {"horizon_s": 1.0, "dt_s": 0.02, "rate_hz": 50.0}
+#: memory of one node of the MPC's problem [bytes]: 143 kB measured on the LBV150 + arm
+#: (nv = 10; 5000 nodes took 715 MB), its matrices growing as nv^2
+_NODE_BYTES_AT_NV_10 = 143e3
 
 
 #: the tasks and what their targets are
@@ -106,6 +110,7 @@ def build_mpc(t: Table, uvms: UVMS, actuation: Actuation | None = None) -> Contr
     force_fields, force_recorded = _force_task(t, uvms) if task == "force" else ({}, {})
     posture = t.vector("posture", uvms.n_arm_joints, uvms.neutral_configuration()[7:])
     fields = {k: t.number(k, default, positive=True) for k, default in _NUMBERS.items()}
+    _check_problem_fits(t, fields["horizon_s"], fields["dt_s"], uvms.nv)
     fields["iterations"] = t.integer("iterations", 3, minimum=1)
     fields["solver"] = t.string("solver", "box_fddp", choices=SOLVERS)
     fields["integrator"] = t.string("integrator", "euler", choices=INTEGRATORS)
@@ -185,3 +190,16 @@ def check_replan_rate(top: Table, controller: dict | None, control_period_s: flo
             f"{control_period_s:g} s) divided by a whole number: the controller re-plans at "
             "control ticks, so it would re-plan at another rate",
         )
+
+
+def _check_problem_fits(t: Table, horizon_s: float, dt_s: float, nv: int) -> None:
+    """Refuse (naming controller.horizon_s) a problem of horizon_s / dt_s nodes that would
+    take more than half the memory available, before it is built (a horizon of 1e6 s, 5e7
+    nodes, ran for minutes towards terabytes)."""
+    nodes = horizon_s / dt_s
+    check_memory(
+        nodes * _NODE_BYTES_AT_NV_10 * max(1.0, (nv / 10.0) ** 2),
+        f"the MPC's problem ({nodes:.3g} nodes: horizon_s {horizon_s:g} s / dt_s {dt_s:g} s)",
+        "shorten controller.horizon_s or lengthen controller.dt_s",
+        lambda message: t.error("horizon_s", message),
+    )
