@@ -84,6 +84,14 @@ class Plausible:
 MAX_SEED = 2**63 - 1
 
 
+def flag(name: str, value) -> bool:
+    """``value`` as a bool (Python's or numpy's), or ParameterError: "yes", 1 or None are
+    refused rather than read by their truth (the compiled core would not take them)."""
+    if isinstance(value, bool | np.bool_):
+        return bool(value)
+    raise ParameterError(f"{name} must be True or False, got {value!r}")
+
+
 def seed_value(name: str, value) -> int:
     """``value`` as a seed: an integer in [0, 2^63 - 1] (numpy's generators take no negative
     seed, and a study table stores seeds as int64); ParameterError naming ``name`` else."""

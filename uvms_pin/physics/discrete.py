@@ -12,7 +12,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from uvms_pin.checks import finite_vector
+from uvms_pin.checks import finite_vector, flag
 from uvms_pin.errors import ParameterError
 from uvms_pin.flow import FlowField
 from uvms_pin.model.uvms import UVMS
@@ -80,6 +80,7 @@ def step_derivatives(
     substeps(period_s, step_s)  # checks both
     q, v = checked_configuration("q", q, uvms.model), finite_vector("v", v, uvms.nv)
     tau, time_s = finite_vector("tau", tau, uvms.nv), check_time(time_s)
+    free_surface = flag("free_surface", free_surface)
     dynamics = dynamics_of(uvms, backend)
     if isinstance(dynamics, CompiledDynamics) and not free_surface:
         water = _flow_of_call(np.zeros(3) if current_world is None else current_world, flow)

@@ -24,7 +24,7 @@ from __future__ import annotations
 import numpy as np
 import pinocchio as pin
 
-from uvms_pin.checks import finite_vector
+from uvms_pin.checks import finite_vector, flag
 from uvms_pin.errors import ParameterError
 from uvms_pin.flow import FlowField, UniformCurrent
 from uvms_pin.hydro.restoring import buoyancy_potential_energy
@@ -90,6 +90,7 @@ def mass_matrix(
     each body's added mass scaled by its wet fraction under the surface of ``flow`` (z = 0
     in still water) at ``time_s``."""
     dynamics = dynamics_of(uvms, backend)
+    free_surface = flag("free_surface", free_surface)
     if not free_surface:
         return dynamics.mass_matrix(q)
     return dynamics.mass_matrix_in(q, _checked_flow(flow), check_time(time_s), True)
@@ -121,6 +122,7 @@ def bias_forces(
             wet fraction (`uvms_pin.physics.surface`). False: water without a top.
     """
     dynamics = dynamics_of(uvms, backend)
+    free_surface = flag("free_surface", free_surface)
     if flow is None and not free_surface:
         return dynamics.bias_forces(q, v, current_world)
     flow = _flow_of_call(current_world, flow)
@@ -156,6 +158,7 @@ def forward_dynamics(
         SimulationError: M not positive definite (e.g. a degenerate model).
     """
     dynamics = dynamics_of(uvms, backend)
+    free_surface = flag("free_surface", free_surface)
     if flow is None and not free_surface:
         return dynamics.forward_dynamics(q, v, tau, current_world, tau_ext)
     flow = _flow_of_call(current_world, flow)
@@ -199,7 +202,7 @@ def forward_dynamics_derivatives(
     """
     dynamics = dynamics_of(uvms, backend)
     water = _checked_flow(flow) if current_world is None else _uniform_or(current_world, flow)
-    time_s = check_time(time_s)
+    time_s, free_surface = check_time(time_s), flag("free_surface", free_surface)
     # q on the manifold here (the core checks shapes and finiteness only); v, tau and
     # tau_ext are checked (shape, finite) by the reference and by the core
     q = checked_configuration("q", q, uvms.model)

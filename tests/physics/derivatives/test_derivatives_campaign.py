@@ -198,6 +198,33 @@ def test_a_unit_quaternion_to_rounding_is_accepted(reference):
         assert all(np.all(np.isfinite(m)) for m in out)
 
 
+@pytest.mark.parametrize("value", ["yes", 1, None], ids=["str", "int", "None"])
+def test_a_free_surface_flag_that_is_not_a_bool_is_named(reference, value):
+    """Before, "yes" was read by its truth on the reference and a nanobind TypeError on the
+    core; every entry point of the dynamics now names it."""
+    q, v, tau = _state(reference)
+    calls = {
+        "mass_matrix": lambda b: up.mass_matrix(reference, q, backend=b, free_surface=value),
+        "bias_forces": lambda b: up.bias_forces(reference, q, v, backend=b, free_surface=value),
+        "forward_dynamics": lambda b: up.forward_dynamics(
+            reference, q, v, tau, backend=b, free_surface=value
+        ),
+        "forward_dynamics_derivatives": lambda b: up.forward_dynamics_derivatives(
+            reference, q, v, tau, backend=b, free_surface=value
+        ),
+        "step_derivatives": lambda b: up.step_derivatives(
+            reference, q, v, tau, 0.02, step_s=0.01, backend=b, free_surface=value
+        ),
+    }
+    for name, call in calls.items():
+        for backend in ("core", "python"):
+            with pytest.raises(ParameterError, match="free_surface must be True or False"):
+                call(backend)
+                pytest.fail(f"{name} ({backend}) took free_surface={value!r}")
+    flag = np.bool_(True)  # numpy's bool is one
+    up.forward_dynamics(reference, q, v, tau, free_surface=flag)
+
+
 @pytest.mark.parametrize("time_s", ["soon", None, np.array([0.1, 0.2]), math.inf])
 def test_a_time_that_is_not_a_finite_number_is_named(reference, time_s):
     q, v, tau = _state(reference)
