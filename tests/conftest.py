@@ -58,6 +58,31 @@ def continuous_joint_urdf(
     return path
 
 
+#: the importer tests' vehicles (uuv_simulator's RexROV, gz-sim's LRAUV)
+IMPORTER_DATA = ROOT / "tests" / "model" / "importer" / "data"
+
+
+def model_beyond_the_reference(name: str, tmp_dir: Path) -> up.UVMS:
+    """A model the derivative campaigns try besides the reference one: "bluerov2_heavy"
+    (the bare vehicle), "rexrov" and "lrauv" (imported), "continuous" (the reference arm's
+    joints continuous) or a catalog arm on the reference vehicle (e.g. "kinova")."""
+    import warnings
+
+    from uvms_pin.model.resources import shipped_path
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", up.ModelWarning)
+        if name == "bluerov2_heavy":
+            return up.load_uvms(shipped_path("models/bluerov2_heavy.urdf"))
+        if name in ("rexrov", "lrauv"):
+            source = {"rexrov": "rexrov_expanded.urdf", "lrauv": "lrauv_hydrodynamics.sdf"}
+            up.import_model(IMPORTER_DATA / source[name], tmp_dir / f"{name}.urdf")
+            return up.load_uvms(tmp_dir / f"{name}.urdf")
+        if name == "continuous":
+            return up.load_uvms(continuous_joint_urdf(tmp_dir))
+        return mount_on_reference_vehicle(name, tmp_dir)
+
+
 def body_urdf(
     *,
     mass: float = 10.0,

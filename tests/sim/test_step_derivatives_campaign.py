@@ -13,43 +13,26 @@ difference of these tiny entries meets: the end is read with atan2 for those joi
 
 from __future__ import annotations
 
-import warnings
-from pathlib import Path
-
 import numpy as np
 import pinocchio as pin
 import pytest
-from conftest import central_difference, continuous_joint_urdf
+from conftest import central_difference, model_beyond_the_reference
 
 import uvms_pin as up
 from uvms_pin.errors import ParameterError
 from uvms_pin.flow import AiryWave, UniformCurrent
-from uvms_pin.model.resources import shipped_path
 from uvms_pin.model.vehicles import bluerov2_heavy
 from uvms_pin.sim.actuation import ThrustersAndJointLimits
 from uvms_pin.sim.integrators import RK4, SemiImplicitEuler
 from uvms_pin.sim.plant import Plant
 
-IMPORTER_DATA = Path(__file__).resolve().parents[1] / "model" / "importer" / "data"
 FD_REL, CORE_REL = 1e-7, 1e-10
 WAVE = AiryWave(0.4, 5.0, heading_rad=0.5, water_depth_m=15.0) + UniformCurrent([0.2, 0.0, 0.0])
 
 
-def _load(name: str, tmp: Path) -> up.UVMS:
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore", up.ModelWarning)
-        if name == "bluerov2_heavy":
-            return up.load_uvms(shipped_path("models/bluerov2_heavy.urdf"))
-        if name == "continuous":
-            return up.load_uvms(continuous_joint_urdf(tmp))
-        source = {"rexrov": "rexrov_expanded.urdf", "lrauv": "lrauv_hydrodynamics.sdf"}[name]
-        up.import_model(IMPORTER_DATA / source, tmp / f"{name}.urdf")
-        return up.load_uvms(tmp / f"{name}.urdf")
-
-
 @pytest.fixture(scope="module", params=["bluerov2_heavy", "rexrov", "lrauv", "continuous"])
 def model(request, tmp_path_factory) -> up.UVMS:
-    return _load(request.param, tmp_path_factory.mktemp(request.param))
+    return model_beyond_the_reference(request.param, tmp_path_factory.mktemp(request.param))
 
 
 def random_state(uvms: up.UVMS, rng: np.random.Generator, depth: float = -3.0):
@@ -116,7 +99,7 @@ def test_thrust_inputs_of_a_bare_vehicle(tmp_path):
     """nv = 6: B_u is the allocation matrix itself; the plant's allocation applies B_u u for
     thrusts inside the limits (input_matrix is its inverse there), and dx+/du = dx+/dtau B_u
     against central differences in u."""
-    uvms = _load("bluerov2_heavy", tmp_path)
+    uvms = model_beyond_the_reference("bluerov2_heavy", tmp_path)
     thrusters = bluerov2_heavy.thrusters()
     b_u = up.input_matrix(thrusters, uvms.nv)
     assert b_u.shape == (6, 8)
@@ -153,7 +136,7 @@ def test_plant_derivatives_with_a_current_a_wave_and_a_hull_cut_by_the_surface(t
     """The RexROV's box hull a third wet (the plant's default free surface), in the plant's
     uniform current plus a wave: both backends against central differences of
     Plant.acceleration."""
-    uvms = _load("rexrov", tmp_path)
+    uvms = model_beyond_the_reference("rexrov", tmp_path)
     q, v, tau = random_state(uvms, np.random.default_rng(343), depth=0.05)
     q[3:7] = pin.Quaternion(pin.rpy.rpyToMatrix(0.1, -0.05, 0.3)).coeffs()
     current = np.array([0.2, -0.1, 0.05])
@@ -178,7 +161,7 @@ def test_plant_derivatives_with_a_current_a_wave_and_a_hull_cut_by_the_surface(t
 
 @pytest.mark.parametrize("backend", ["core", "python"])
 def test_plant_derivatives_refuse_a_quaternion_off_the_unit_sphere(tmp_path, backend):
-    uvms = _load("bluerov2_heavy", tmp_path)
+    uvms = model_beyond_the_reference("bluerov2_heavy", tmp_path)
     q = uvms.neutral_configuration()
     q[2], q[6] = -3.0, 1.001
     plant = Plant(uvms, backend=backend)

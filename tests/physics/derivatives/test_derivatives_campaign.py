@@ -14,7 +14,6 @@ from __future__ import annotations
 
 import math
 import warnings
-from pathlib import Path
 
 import numpy as np
 import pinocchio as pin
@@ -23,33 +22,17 @@ from conftest import (
     REFERENCE_URDF,
     central_difference,
     continuous_joint_urdf,
-    mount_on_reference_vehicle,
+    model_beyond_the_reference,
 )
 
 import uvms_pin as up
 from uvms_pin.errors import ParameterError
 from uvms_pin.flow import AiryWave, FlowField, UniformCurrent
-from uvms_pin.model.resources import shipped_path
 
-IMPORTER_DATA = Path(__file__).resolve().parents[2] / "model" / "importer" / "data"
 #: relative agreement with central differences, and of the core with the reference
 FD_REL, CORE_REL = 1e-7, 1e-10
 CURRENT = UniformCurrent([0.3, -0.2, 0.1])
 WAVE = AiryWave(0.4, 5.0, heading_rad=0.5, water_depth_m=15.0) + UniformCurrent([0.2, 0.0, 0.0])
-
-
-def _load(name: str, tmp: Path) -> up.UVMS:
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore", up.ModelWarning)
-        if name == "bluerov2_heavy":
-            return up.load_uvms(shipped_path("models/bluerov2_heavy.urdf"))
-        if name in ("rexrov", "lrauv"):
-            source = {"rexrov": "rexrov_expanded.urdf", "lrauv": "lrauv_hydrodynamics.sdf"}
-            up.import_model(IMPORTER_DATA / source[name], tmp / f"{name}.urdf")
-            return up.load_uvms(tmp / f"{name}.urdf")
-        if name == "continuous":
-            return up.load_uvms(continuous_joint_urdf(tmp))
-        return mount_on_reference_vehicle(name, tmp)
 
 
 MODELS = ["bluerov2_heavy", "rexrov", "lrauv", "continuous", "kinova"]
@@ -62,7 +45,7 @@ def model(request, tmp_path_factory) -> up.UVMS:
 
         if "kinova" not in available_arms():
             pytest.skip("example-robot-data is not installed")
-    return _load(request.param, tmp_path_factory.mktemp(request.param))
+    return model_beyond_the_reference(request.param, tmp_path_factory.mktemp(request.param))
 
 
 def random_state(uvms: up.UVMS, rng: np.random.Generator, speed: float = 0.5):
