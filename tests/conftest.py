@@ -184,6 +184,22 @@ def random_configuration(uvms: up.UVMS, rng: np.random.Generator) -> np.ndarray:
     return q
 
 
+def random_state(
+    uvms: up.UVMS, rng: np.random.Generator, *, speed: float = 0.5, depth_m: float | None = None
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """A random (q, v, tau): q on the manifold with every joint within its limits (any joint
+    type: ball, continuous; at most +-pi), the vehicle at ``depth_m`` (None: 2.5 to 3.5 m
+    deep, where wave kinematics still matter), v of scale ``speed`` [m/s, rad/s], tau of
+    scale 5 [N, N m]."""
+    model = uvms.model
+    lower = np.maximum(model.lowerPositionLimit, -np.pi)
+    upper = np.minimum(model.upperPositionLimit, np.pi)
+    pin.seed(int(rng.integers(2**31)))  # pin.randomConfiguration draws from its own generator
+    q = pin.randomConfiguration(model, lower, upper)
+    q[2] = -3.0 + rng.uniform(-0.5, 0.5) if depth_m is None else depth_m
+    return q, rng.normal(scale=speed, size=uvms.nv), rng.normal(scale=5.0, size=uvms.nv)
+
+
 def with_spherical_joint(uvms: up.UVMS, joint_id: int) -> up.UVMS:
     """The same bodies and frames, joint ``joint_id`` (a revolute) made a ball joint."""
     old = uvms.model

@@ -19,6 +19,7 @@ import pytest
 from conftest import (
     central_difference,
     mount_on_reference_vehicle,
+    random_state,
     with_spherical_joint,
 )
 
@@ -39,18 +40,6 @@ FLOWS = {
     "irregular": IrregularSea(1.5, 7.0, n_components=30, seed=4, spreading_exponent=3.0),
     "sheared": DepthProfileCurrent([0.4, 0.1, 0.05], [0.0, 10.0], [1.0, 0.2]),
 }
-
-
-def random_state(uvms: up.UVMS, rng: np.random.Generator):
-    """A random (q, v, tau): joints within their limits (any joint type: ball, continuous),
-    the vehicle 2.5-3.5 m deep (wave kinematics grow towards the surface)."""
-    model = uvms.model
-    lower = np.maximum(model.lowerPositionLimit, -np.pi)
-    upper = np.minimum(model.upperPositionLimit, np.pi)
-    pin.seed(int(rng.integers(2**31)))  # pin.randomConfiguration draws from its own generator
-    q = pin.randomConfiguration(model, lower, upper)
-    q[2] = -3.0 + rng.uniform(-0.5, 0.5)
-    return q, rng.normal(scale=0.5, size=uvms.nv), rng.normal(scale=5.0, size=uvms.nv)
 
 
 def _relative_error(got: np.ndarray, expected: np.ndarray) -> float:

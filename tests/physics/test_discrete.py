@@ -16,7 +16,12 @@ import warnings
 import numpy as np
 import pinocchio as pin
 import pytest
-from conftest import central_difference, mount_on_reference_vehicle, with_spherical_joint
+from conftest import (
+    central_difference,
+    mount_on_reference_vehicle,
+    random_state,
+    with_spherical_joint,
+)
 
 import uvms_pin as up
 from uvms_pin.errors import CoreFallbackWarning, ParameterError
@@ -32,19 +37,6 @@ PERIOD_S, STEP_S, T0_S = 0.02, 0.01, 0.4  # two RK4 substeps per period
 
 CURRENT = np.array([0.3, -0.2, 0.1])
 WAVES = AiryWave(0.4, 5.0, heading_rad=0.5, water_depth_m=15.0) + UniformCurrent([0.2, 0.0, 0.0])
-
-
-def random_state(uvms: up.UVMS, rng: np.random.Generator):
-    """A random (q, v, tau), the vehicle 2.5-3.5 m deep, any joint type within its limits."""
-    model = uvms.model
-    pin.seed(int(rng.integers(2**31)))
-    q = pin.randomConfiguration(
-        model,
-        np.maximum(model.lowerPositionLimit, -np.pi),
-        np.minimum(model.upperPositionLimit, np.pi),
-    )
-    q[2] = -3.0 + rng.uniform(-0.5, 0.5)
-    return q, rng.normal(scale=0.5, size=uvms.nv), rng.normal(scale=5.0, size=uvms.nv)
 
 
 def _relative_error(got: np.ndarray, expected: np.ndarray) -> float:

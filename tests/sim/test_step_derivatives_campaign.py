@@ -16,7 +16,7 @@ from __future__ import annotations
 import numpy as np
 import pinocchio as pin
 import pytest
-from conftest import central_difference, model_beyond_the_reference
+from conftest import central_difference, model_beyond_the_reference, random_state
 
 import uvms_pin as up
 from uvms_pin.errors import ParameterError
@@ -33,18 +33,6 @@ WAVE = AiryWave(0.4, 5.0, heading_rad=0.5, water_depth_m=15.0) + UniformCurrent(
 @pytest.fixture(scope="module", params=["bluerov2_heavy", "rexrov", "lrauv", "continuous"])
 def model(request, tmp_path_factory) -> up.UVMS:
     return model_beyond_the_reference(request.param, tmp_path_factory.mktemp(request.param))
-
-
-def random_state(uvms: up.UVMS, rng: np.random.Generator, depth: float = -3.0):
-    model = uvms.model
-    pin.seed(int(rng.integers(2**31)))
-    q = pin.randomConfiguration(
-        model,
-        np.maximum(model.lowerPositionLimit, -np.pi),
-        np.minimum(model.upperPositionLimit, np.pi),
-    )
-    q[2] = depth
-    return q, rng.normal(scale=0.5, size=uvms.nv), rng.normal(scale=5.0, size=uvms.nv)
 
 
 def tangent_difference(model: pin.Model, q0: np.ndarray, q1: np.ndarray) -> np.ndarray:
@@ -65,7 +53,7 @@ def _relative_error(got: np.ndarray, expected: np.ndarray) -> float:
 
 @pytest.mark.parametrize("integrator", [RK4(0.005), SemiImplicitEuler(0.005)], ids=["rk4", "euler"])
 def test_period_jacobians_match_the_plants_period(model, integrator):
-    q, v, tau = random_state(model, np.random.default_rng(340))
+    q, v, tau = random_state(model, np.random.default_rng(340), depth_m=-3.0)
     t0, period = 0.3, 0.02
     kw = {"integrator": integrator, "flow": WAVE, "time_s": t0}
     expected = up.step_derivatives(model, q, v, tau, period, backend="python", **kw)
@@ -108,7 +96,7 @@ def test_thrust_inputs_of_a_bare_vehicle(tmp_path):
     actuation = ThrustersAndJointLimits(thrusters, None)
     np.testing.assert_allclose(actuation.apply(b_u @ u), b_u @ u, rtol=0, atol=1e-12)
     np.testing.assert_allclose(actuation.thrusts(b_u @ u), u, rtol=0, atol=1e-12)
-    q, v, _ = random_state(uvms, np.random.default_rng(342))
+    q, v, _ = random_state(uvms, np.random.default_rng(342), depth_m=-3.0)
     kw = {"integrator": RK4(0.01), "flow": WAVE}
     got = up.step_derivatives(uvms, q, v, b_u @ u, 0.02, **kw)
 
@@ -137,7 +125,7 @@ def test_plant_derivatives_with_a_current_a_wave_and_a_hull_cut_by_the_surface(t
     uniform current plus a wave: both backends against central differences of
     Plant.acceleration."""
     uvms = model_beyond_the_reference("rexrov", tmp_path)
-    q, v, tau = random_state(uvms, np.random.default_rng(343), depth=0.05)
+    q, v, tau = random_state(uvms, np.random.default_rng(343), depth_m=0.05)
     q[3:7] = pin.Quaternion(pin.rpy.rpyToMatrix(0.1, -0.05, 0.3)).coeffs()
     current = np.array([0.2, -0.1, 0.05])
     for backend in ("core", "python"):

@@ -184,7 +184,6 @@ class MpcController(Controller):
         return self.force_tracking.problem
 
     def reset(self) -> None:
-        self._next_plan_s = -math.inf
         self._last_plan_s = -math.inf
         self._guess: tuple[list, list] | None = None
         self._tau = np.zeros(self.uvms.nv)
@@ -228,7 +227,7 @@ class MpcController(Controller):
     def compute(self, time_s: float, measurement: Measurement) -> np.ndarray:
         if self.force_task is not None:
             self._signals.update(self._force_signals(time_s, measurement))
-        if time_s < self._next_plan_s:
+        if time_s < self._last_plan_s + self.period_s - 1e-12:
             return self._tau
         if self.force_task is not None:
             self._start_force_plan(time_s, measurement)
@@ -248,7 +247,6 @@ class MpcController(Controller):
         self._regularization = solver.preg
         u0 = self._guess[1][0].copy()
         self._tau = self.input_matrix @ u0
-        self._next_plan_s = time_s + self.period_s - 1e-12
         self._last_plan_s = time_s
         self._signals.update({"mpc_cost": np.array([solver.cost]), "mpc_u": u0})
         return self._tau

@@ -420,7 +420,7 @@ def solve(
     if iterations < 1:
         raise ParameterError(f"ocp iterations must be >= 1, got {iterations}")
     solver = solver_of(problem, solver) if isinstance(solver, str) else solver
-    _check_start(problem.x0, problem.runningModels[0].state.nx, "the problem's x0")
+    _check_start(problem.x0, problem.nx, "the problem's x0")
     if warm_start is None:
         xs = [problem.x0] * (problem.T + 1)
         us = [np.zeros(m.nu) for m in problem.runningModels]

@@ -23,6 +23,7 @@ from conftest import (
     central_difference,
     continuous_joint_urdf,
     model_beyond_the_reference,
+    random_state,
 )
 
 import uvms_pin as up
@@ -46,19 +47,6 @@ def model(request, tmp_path_factory) -> up.UVMS:
         if "kinova" not in available_arms():
             pytest.skip("example-robot-data is not installed")
     return model_beyond_the_reference(request.param, tmp_path_factory.mktemp(request.param))
-
-
-def random_state(uvms: up.UVMS, rng: np.random.Generator, speed: float = 0.5):
-    """Random q on the manifold (joints within limits, 3 m deep), v of scale ``speed``."""
-    model = uvms.model
-    pin.seed(int(rng.integers(2**31)))
-    q = pin.randomConfiguration(
-        model,
-        np.maximum(model.lowerPositionLimit, -np.pi),
-        np.minimum(model.upperPositionLimit, np.pi),
-    )
-    q[2] = -3.0
-    return q, rng.normal(scale=speed, size=uvms.nv), rng.normal(scale=5.0, size=uvms.nv)
 
 
 def _relative_error(got: np.ndarray, expected: np.ndarray) -> float:
@@ -95,14 +83,14 @@ def _steps(uvms: up.UVMS) -> dict[str, float]:
 @pytest.mark.parametrize("flow", [CURRENT, WAVE], ids=["current", "airy+current"])
 def test_random_states_match_finite_differences_and_the_core(model, flow):
     rng = np.random.default_rng(240)
-    q, v, tau = random_state(model, rng)
+    q, v, tau = random_state(model, rng, depth_m=-3.0)
     fd_error, core_error = check(model, q, v, tau, flow, **_steps(model))
     assert fd_error < FD_REL and core_error < CORE_REL, (fd_error, core_error)
 
 
 def test_brisk_velocities_match(model):
     """4 m/s and 4 rad/s of scale (quadratic damping and C_A dominate)."""
-    q, v, tau = random_state(model, np.random.default_rng(241), speed=4.0)
+    q, v, tau = random_state(model, np.random.default_rng(241), speed=4.0, depth_m=-3.0)
     fd_error, core_error = check(model, q, v, tau, WAVE, **_steps(model))
     assert fd_error < FD_REL and core_error < CORE_REL, (fd_error, core_error)
 
@@ -112,7 +100,7 @@ def test_at_rest_in_a_current_matches(model):
     quadratic damping |x| x (derivative 0 on both sides). A central difference across it is
     off by (2/3) h D_quad: the error falls linearly with the velocity step h (10x per
     decade), i.e. the differences converge to the derivative returned."""
-    q, _, tau = random_state(model, np.random.default_rng(242))
+    q, _, tau = random_state(model, np.random.default_rng(242), depth_m=-3.0)
     v, q_step = np.zeros(model.nv), _steps(model).get("q_step", 1e-5)
     coarse, core_error = check(model, q, v, tau, CURRENT, q_step=q_step, v_step=1e-4)
     fine, _ = check(model, q, v, tau, CURRENT, q_step=q_step, v_step=1e-5)
@@ -121,7 +109,7 @@ def test_at_rest_in_a_current_matches(model):
 
 
 def test_the_mass_matrix_inverse_is_symmetric_and_inverts_the_mass_matrix(model):
-    q, v, tau = random_state(model, np.random.default_rng(243))
+    q, v, tau = random_state(model, np.random.default_rng(243), depth_m=-3.0)
     for backend in ("core", "python"):
         da_dtau = up.forward_dynamics_derivatives(model, q, v, tau, flow=CURRENT, backend=backend)[
             2
@@ -278,7 +266,7 @@ class ShearedByHand(FlowField):
 
 
 def test_a_users_flow_unknown_to_the_core_falls_back_and_matches_differences(reference):
-    q, v, tau = random_state(reference, np.random.default_rng(244))
+    q, v, tau = random_state(reference, np.random.default_rng(244), depth_m=-3.0)
     with pytest.warns(up.errors.CoreFallbackWarning):
         got = up.forward_dynamics_derivatives(reference, q, v, tau, flow=ShearedByHand())
     expected = up.forward_dynamics_derivatives(
