@@ -87,7 +87,9 @@ MAX_SEED = 2**63 - 1
 def flag(name: str, value) -> bool:
     """``value`` as a bool (Python's or numpy's), or ParameterError: "yes", 1 or None are
     refused rather than read by their truth (the compiled core would not take them)."""
-    if isinstance(value, bool | np.bool_):
+    if value is False or value is True:  # (the common case first: this is on every call)
+        return value
+    if isinstance(value, np.bool_):
         return bool(value)
     raise ParameterError(f"{name} must be True or False, got {value!r}")
 
