@@ -50,6 +50,24 @@ def start(hook: list[str], cli_args: list[str], cwd: Path, **popen) -> subproces
     )
 
 
+class _CtrlCOnSetName:
+    """A descriptor whose ``__set_name__`` sends this process SIGINT (a Ctrl-C)."""
+
+    def __set_name__(self, owner: type, name: str) -> None:
+        os.kill(os.getpid(), signal.SIGINT)
+
+
+def ctrl_c_in_a_class_body() -> type:
+    """Press Ctrl-C (SIGINT to this process) while a class body is being defined, as when it
+    lands in a library's import: Python turns an exception raised in ``__set_name__`` into
+    a RuntimeError (3.11), so a handler raising KeyboardInterrupt there is not seen as one."""
+
+    class Defined:
+        attribute = _CtrlCOnSetName()
+
+    return Defined
+
+
 def wait_until_paused(proc: subprocess.Popen) -> list[str]:
     """Block until the process reports its pause; the stdout lines printed before it.
 

@@ -5,6 +5,7 @@ from __future__ import annotations
 import os
 import signal
 
+import paused_cli
 import pytest
 
 from uvms_pin.apps.interrupts import InterruptGuard
@@ -24,9 +25,25 @@ def test_the_first_ctrl_c_raises_the_next_wait_for_the_save(capsys):
             saved = True
         assert saved and guard.pending
         guard.release()
-        with pytest.raises(KeyboardInterrupt):  # after the save: raises again
-            _ctrl_c()
-    assert capsys.readouterr().err.count("saving first, please wait") == 1
+        _ctrl_c()  # after the save: noted, raised at the next checkpoint
+        with pytest.raises(KeyboardInterrupt):
+            guard.checkpoint()
+    err = capsys.readouterr().err
+    assert err.count("saving first, please wait") == 1
+    assert err.count("stopping after this step") == 1
+
+
+def test_after_the_save_a_ctrl_c_in_a_class_body_is_raised_at_the_next_checkpoint():
+    """A Ctrl-C landing in an import (here a class body's ``__set_name__``) must not come
+    out as a RuntimeError: it is raised at the checkpoint, between two figures."""
+    with InterruptGuard() as guard:
+        guard.release()
+        guard.checkpoint()  # nothing noted: goes on
+        defined = paused_cli.ctrl_c_in_a_class_body()
+        assert defined.__name__ == "Defined"
+        with pytest.raises(KeyboardInterrupt):
+            guard.checkpoint()
+        guard.checkpoint()  # raised once
 
 
 def test_a_ctrl_c_during_a_save_raises_when_the_save_is_done():

@@ -6,6 +6,12 @@ a further Ctrl-C is only noted: a user pressing it twice (the first seems slow t
 not cut the save of the partial rollout in half. Once the saving block ends, a Ctrl-C noted
 during it raises (stopping what follows, the figures); the files already renamed into place
 are whole (`uvms_pin.results.atomic`).
+
+After `InterruptGuard.release` (the run saved, its figures to draw) a Ctrl-C is still only
+noted, and raised at the next `InterruptGuard.checkpoint`, between two figures. Raised where
+the program is, it could land inside a library's import or a class body, where Python turns
+it into another exception (an exception in ``__set_name__`` becomes a RuntimeError) and the
+command would end in a traceback instead of saying what it kept.
 """
 
 from __future__ import annotations
@@ -25,6 +31,7 @@ class InterruptGuard:
         self.stopping = False  # a first Ctrl-C was raised
         self.pending = False  # a Ctrl-C arrived while saving
         self._saving = 0
+        self._at_checkpoints = False  # released: a Ctrl-C raises at the next checkpoint
         self._previous = None
         self._installed = False
 
@@ -45,6 +52,11 @@ class InterruptGuard:
                 print("uvms-pin: Ctrl-C: saving first, please wait", file=sys.stderr, flush=True)
             self.pending = True
             return
+        if self._at_checkpoints:
+            if not self.pending:
+                print("uvms-pin: Ctrl-C: stopping after this step", file=sys.stderr, flush=True)
+            self.pending = True
+            return
         self.stopping = True
         raise KeyboardInterrupt
 
@@ -63,6 +75,15 @@ class InterruptGuard:
             raise KeyboardInterrupt
 
     def release(self) -> None:
-        """The saving is done: a further Ctrl-C raises again (a first one was handled)."""
+        """The saving is done: a further Ctrl-C stops what follows at its next `checkpoint`
+        (a first one was handled)."""
         self.stopping = False
         self.pending = False
+        self._at_checkpoints = True
+
+    def checkpoint(self) -> None:
+        """Raise `KeyboardInterrupt` here if a Ctrl-C was noted since `release`."""
+        if self.pending and self._at_checkpoints:
+            self.pending = False
+            self.stopping = True
+            raise KeyboardInterrupt

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+from collections.abc import Callable, Iterator
 from pathlib import Path
 
 import numpy as np
@@ -11,6 +12,8 @@ from uvms_pin.results.rollout import ARRAY_FILE, META_FILE, Rollout
 METRICS_FILE = "metrics.json"
 #: what `write_results` writes: the run itself, before its figures
 RESULT_FILES = (ARRAY_FILE, META_FILE, METRICS_FILE)
+#: a kind of figure: rollout, output directory -> the files written
+FigureWriter = Callable[[Rollout, Path], list[Path]]
 
 
 def write_outputs(rollout: Rollout, out: Path) -> list[Path]:
@@ -40,21 +43,40 @@ def write_results(rollout: Rollout, out: Path) -> list[str]:
     return list(RESULT_FILES)
 
 
-def write_figures(rollout: Rollout, out: Path) -> list[Path]:
-    """Every figure the rollout has data for (none below two samples) into ``out``."""
+def write_figures(
+    rollout: Rollout, out: Path, checkpoint: Callable[[], None] | None = None
+) -> list[Path]:
+    """Every figure the rollout has data for (none below two samples) into ``out``;
+    ``checkpoint`` is called before each kind of figure (a Ctrl-C noted meanwhile raises
+    there: `uvms_pin.apps.interrupts`)."""
+    figures: list[Path] = []
+    for write in _figure_writers(checkpoint or _no_checkpoint):
+        figures += write(rollout, out)
+    return figures
+
+
+def _no_checkpoint() -> None:
+    """No interruption point (the figures of a library call)."""
+
+
+def _figure_writers(checkpoint: Callable[[], None]) -> Iterator[FigureWriter]:
+    """The figure writers, each after a ``checkpoint`` (matplotlib imported after the first)."""
+    checkpoint()
     from uvms_pin.results.figures.estimate import estimate_figures
     from uvms_pin.results.figures.paper import paper_figures
     from uvms_pin.results.figures.standard import standard_figures
     from uvms_pin.results.figures.tracking import tracking_figures
 
-    return (
-        paper_figures(rollout, out)
-        + standard_figures(rollout, out)
-        + tracking_figures(rollout, out)
-        + estimate_figures(rollout, out)
-        + _flow_figure(rollout, out)
-        + _surface_figure(rollout, out)
-    )
+    for write in (
+        paper_figures,
+        standard_figures,
+        tracking_figures,
+        estimate_figures,
+        _flow_figure,
+        _surface_figure,
+    ):
+        yield write
+        checkpoint()
 
 
 def _flow_figure(rollout: Rollout, out: Path) -> list[Path]:

@@ -82,10 +82,10 @@ def test_a_second_ctrl_c_while_saving_does_not_lose_the_rollout(tmp_path, delay_
     assert not [p.name for p in (tmp_path / "o").iterdir() if p.name.startswith(".")]
 
 
-def _interrupted_run(monkeypatch, cut: str):
+def _interrupted_run(monkeypatch, cut: str | None):
     """``uvms-pin run`` in this process, its run interrupted after 0.1 s (as Ctrl-C does:
     a KeyboardInterrupt carrying the rollout) and a second Ctrl-C raised by ``cut`` of
-    `uvms_pin.apps.outputs` (``write_results`` or ``write_figures``)."""
+    `uvms_pin.apps.outputs` (``write_results`` or ``write_figures``; None: not cut)."""
     from uvms_pin.apps import outputs
     from uvms_pin.apps.cli import run
     from uvms_pin.apps.cli.main import main
@@ -101,7 +101,8 @@ def _interrupted_run(monkeypatch, cut: str):
         raise KeyboardInterrupt
 
     monkeypatch.setattr(run, "_simulate", interrupted)
-    monkeypatch.setattr(outputs, cut, ctrl_c)
+    if cut is not None:
+        monkeypatch.setattr(outputs, cut, ctrl_c)
     return main(["run", "s.toml", "--out", "o", "--quiet"])
 
 
@@ -116,6 +117,30 @@ def test_ctrl_c_cutting_the_figures_still_reports_the_kept_rollout(tmp_path, mon
     assert "interrupted: the partial rollout (t = 0 to 0.100 s) is kept in o" in err, err
     assert "interrupted while saving; kept in o: rollout.npz, rollout.json, metrics.json" in err
     assert len(Rollout.load(tmp_path / "o")) == 6  # t = 0 to 0.1 s, every 0.02 s
+
+
+def test_a_ctrl_c_landing_in_a_figures_import_stops_between_figures(tmp_path, monkeypatch, capsys):
+    """A real second Ctrl-C (SIGINT) while the figures are drawn, landing where Python would
+    turn a KeyboardInterrupt into another exception (a class body, as in matplotlib's
+    import): no traceback; the figures stop before the next kind; both messages."""
+    from uvms_pin.results.figures import standard, tracking
+
+    def ctrl_c_in_an_import(rollout, out):
+        paused_cli.ctrl_c_in_a_class_body()
+        return []
+
+    drawn_after = []
+    monkeypatch.setattr(standard, "standard_figures", ctrl_c_in_an_import)
+    monkeypatch.setattr(tracking, "tracking_figures", lambda *a: drawn_after.append(1) or [])
+    (tmp_path / "s.toml").write_text(passive_scenario(0.1))
+    monkeypatch.chdir(tmp_path)
+    assert _interrupted_run(monkeypatch, None) == 130
+    err = capsys.readouterr().err
+    assert "Traceback" not in err, err
+    assert "uvms-pin: Ctrl-C: stopping after this step" in err
+    assert "interrupted: the partial rollout (t = 0 to 0.100 s) is kept in o" in err, err
+    assert "interrupted while saving; kept in o: rollout.npz, rollout.json, metrics.json" in err
+    assert drawn_after == []
 
 
 def test_ctrl_c_cutting_the_rollout_does_not_claim_it_kept(tmp_path, monkeypatch, capsys):
@@ -157,3 +182,21 @@ def test_version_names_the_installed_package(tmp_path):
     result = run_cli(["--version"], cwd=tmp_path)
     assert result.returncode == 0, result.stderr
     assert result.stdout.startswith(f"uvms-pin {metadata.version('uvms-pin')} (pinocchio ")
+
+
+def test_a_ctrl_c_landing_in_any_commands_import_is_an_interruption(monkeypatch, capsys):
+    """Whatever the command, a first Ctrl-C that Python wrapped into a RuntimeError (raised
+    in a class body, as during an import) exits 130 saying so, not with a traceback; any
+    other RuntimeError is still a bug and propagates."""
+    from uvms_pin.apps.cli import main as cli
+
+    monkeypatch.setattr(cli, "_cmd_info", lambda args: paused_cli.ctrl_c_in_a_class_body())
+    assert cli.main(["info", "uvms_lbv150"]) == 130
+    assert capsys.readouterr().err == "uvms-pin: interrupted\n"
+
+    def bug(args):
+        raise RuntimeError("a bug")
+
+    monkeypatch.setattr(cli, "_cmd_info", bug)
+    with pytest.raises(RuntimeError, match="a bug"):
+        cli.main(["info", "uvms_lbv150"])

@@ -231,9 +231,22 @@ def _dispatch(args: argparse.Namespace) -> int:
             )
         print(f"uvms-pin: error: {exc}", file=sys.stderr)
         return EXIT_BAD_INPUT
-    except KeyboardInterrupt:
+    except (KeyboardInterrupt, RuntimeError) as exc:
+        if isinstance(exc, RuntimeError) and not _caused_by_ctrl_c(exc):
+            raise
         print("uvms-pin: interrupted", file=sys.stderr)
         return EXIT_INTERRUPTED
+
+
+def _caused_by_ctrl_c(exc: BaseException) -> bool:
+    """Whether a KeyboardInterrupt is the cause of ``exc``: Python turns one raised inside a
+    class body's ``__set_name__`` (a Ctrl-C landing in an import) into a RuntimeError."""
+    cause = exc.__cause__
+    while cause is not None:
+        if isinstance(cause, KeyboardInterrupt):
+            return True
+        cause = cause.__cause__
+    return False
 
 
 if __name__ == "__main__":

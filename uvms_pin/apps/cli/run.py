@@ -2,7 +2,8 @@
 
 Whatever ends the run (its end, a funnel violation, a divergence, the controller raising,
 Ctrl-C), what was simulated is saved first (rollout.npz, rollout.json, metrics.json, under
-`InterruptGuard.saving`: a second Ctrl-C does not cut it), then the figures. Exit status:
+`InterruptGuard.saving`: a second Ctrl-C does not cut it), then the figures (a Ctrl-C
+stops them between two figures). Exit status:
 0 the run reached its end; 3 it stopped early (the rollout kept); 130 Ctrl-C; 4 the
 system failed us while saving (a full disk...), the message naming the file and what was
 kept.
@@ -138,11 +139,12 @@ def _save(
         with guard.saving():
             write_results(rollout, out)
         guard.release()
-        write_figures(rollout, out)
+        write_figures(rollout, out, guard.checkpoint)
         if args.html:
             from uvms_pin.apps.viz.replay import write_replay
 
             write_replay(rollout, out / "replay.html")
+        guard.checkpoint()  # a Ctrl-C during the replay: the command says it stopped
     except KeyboardInterrupt:
         kept = ", ".join(_files_of_the_run(out)) or "nothing"
         return _files_of_the_run(out), Ending(
