@@ -121,6 +121,12 @@ class CoreFallbackWarning(UvmsPinWarning):
     reference; the message says what and why."""
 
 
+class NodeErrorWarning(UvmsPinWarning):
+    """A node of an optimal-control problem raised outside `uvms_pin.ocp.problems.solve`
+    (crocoddyl's ``problem.calc`` called directly): the error could not cross crocoddyl's
+    C++ code, the node's outputs are placeholders."""
+
+
 class SimulationError(UvmsPinError):
     """The simulation cannot continue (non-finite state, integrator failure)."""
 

@@ -20,6 +20,10 @@ Bounds on u (thrust and effort limits) go to crocoddyl's box-constrained solvers
 constraints, lower <= g(x, u) = u <= upper (G_x = 0, G_u = I: a crocoddyl
 ConstraintModelManager holding a ConstraintModelResidual of ResidualModelControl), what a
 constrained solver (mim_solvers' CSQP) enforces.
+
+An exception raised in calc or calcDiff (a user's cost term or flow) is held, the node's
+cost set to `REJECTED_COST` and its other outputs to zero, and raised by `uvms_pin.ocp.problems.solve` after the solver returns
+(`uvms_pin.ocp.held_errors`: it cannot cross crocoddyl's C++ loop).
 """
 
 from __future__ import annotations
@@ -34,6 +38,7 @@ from uvms_pin.flow import FlowField
 from uvms_pin.model.uvms import UVMS
 from uvms_pin.ocp.costs import CostTerm, Effort
 from uvms_pin.ocp.crocoddyl_module import crocoddyl_module
+from uvms_pin.ocp.held_errors import HeldError
 from uvms_pin.ocp.state import UvmsState
 from uvms_pin.physics.derivatives.task_contact import (
     TaskContact,
@@ -44,6 +49,10 @@ from uvms_pin.physics.derivatives.task_contact import (
 from uvms_pin.physics.dynamics import forward_dynamics, forward_dynamics_derivatives
 
 crocoddyl = crocoddyl_module()
+
+#: the cost of a node that raised: finite, so that no step through it is accepted and the
+#: solver returns (a NaN is itself an exception in mim_solvers' CSQP, which aborts)
+REJECTED_COST = 1e30
 
 WeightedTerms = Sequence[tuple[CostTerm, float]]
 """The cost of a node: (term, scale) pairs, l = sum_i scale_i (1/2) r_i^T W_i r_i."""
@@ -94,6 +103,7 @@ class UnderwaterActionModel(crocoddyl.DifferentialActionModelAbstract):
         if needing and contact is None:
             raise ParameterError(f"cost(s) {needing} need a contact in the node's dynamics")
         self.contact = contact
+        self.held = HeldError()  # what calc / calcDiff raised inside crocoddyl
         # where d J_k/dq_m can be non-zero (the contact's derivatives), once per model
         self._supports = None if contact is None else supports_mask(uvms.model)
         self.constraints = None
@@ -119,6 +129,21 @@ class UnderwaterActionModel(crocoddyl.DifferentialActionModelAbstract):
         return x[:nq], x[nq:], u
 
     def calc(self, data, x, u=None):
+        try:
+            self._calc(data, x, u)
+        except Exception as exc:  # it cannot cross crocoddyl's C++ loop (held_errors)
+            self.held.hold(exc, "calc")
+            _zero(data, "xout", "g", "residual")
+            data.cost = REJECTED_COST
+
+    def calcDiff(self, data, x, u=None):
+        try:
+            self._calc_diff(data, x, u)
+        except Exception as exc:
+            self.held.hold(exc, "calcDiff")
+            _zero(data, "Fx", "Fu", "Gx", "Gu", "Lx", "Lu", "Lxx", "Luu", "Lxu")
+
+    def _calc(self, data, x, u):
         q, v, u = self._split(x, u)
         model, pdata = self.uvms.model, data.pinocchio
         if self.contact is None:
@@ -139,7 +164,7 @@ class UnderwaterActionModel(crocoddyl.DifferentialActionModelAbstract):
         data.residual = residual = np.concatenate([np.zeros(0), *data.residuals])
         data.cost = 0.5 * float(residual @ (self._weights * residual))
 
-    def calcDiff(self, data, x, u=None):
+    def _calc_diff(self, data, x, u):
         q, v, u = self._split(x, u)
         model, pdata, nv = self.uvms.model, data.pinocchio, self.uvms.nv
         contact, tau_ext = None, None
@@ -188,6 +213,13 @@ class UnderwaterActionModel(crocoddyl.DifferentialActionModelAbstract):
 
     def createData(self):
         return UnderwaterActionData(self)
+
+
+def _zero(data, *names: str) -> None:
+    """Zero ``data``'s arrays ``names`` (what a node that raised computed: finite, see
+    `REJECTED_COST`)."""
+    for name in names:
+        getattr(data, name)[...] = 0.0
 
 
 def _check_terms(terms: WeightedTerms, nu: int) -> None:

@@ -30,6 +30,7 @@ from uvms_pin.flow import FlowField, UniformCurrent
 from uvms_pin.model.uvms import UVMS
 from uvms_pin.ocp import costs
 from uvms_pin.ocp.crocoddyl_module import crocoddyl_module, mim_solvers_module
+from uvms_pin.ocp.held_errors import HeldError, ctrl_c_deferred
 from uvms_pin.ocp.model import UnderwaterActionModel, WeightedTerms
 from uvms_pin.physics.derivatives.task_contact import TaskContact
 
@@ -385,8 +386,8 @@ def solver_of(problem, solver: str = "box_fddp"):
 
 
 def _check_start(x0, nx: int, name: str) -> None:
-    """x0 of nx finite values, else ParameterError. (Checked before crocoddyl runs: a
-    node's error raised inside crocoddyl's C++ loop over the nodes aborts the process.)"""
+    """x0 of nx finite values, else ParameterError (before crocoddyl runs: its nodes would
+    compute with NaN)."""
     x0 = np.asarray(x0, float)
     if x0.shape != (nx,) or not np.all(np.isfinite(x0)):
         raise ParameterError(f"ocp {name} must be {nx} finite values (q, v), got {x0}")
@@ -412,7 +413,9 @@ def solve(
     solver kept between solves (e.g. a receding horizon's); warm start: (xs, us), else the
     initial state held with zero input; ``regularization``: the initial one (e.g. the last
     solve's ``preg``: a receding horizon keeps what the previous plans learnt of the
-    problem's curvature), None: the solver's smallest. Returns the solver (``xs``, ``us``,
+    problem's curvature), None: the solver's smallest. An exception a node raised during the
+    solve is raised here once the solver has returned, and a Ctrl-C then too
+    (`uvms_pin.ocp.held_errors`). Returns the solver (``xs``, ``us``,
     ``cost``, ``iter``, ``preg``; CSQP's ``xs`` may keep gaps to the dynamics, its
     ``gap_norm`` and ``constraint_norm`` the last iterate's; read xs and us by `solution`)."""
     if isinstance(iterations, bool) or not isinstance(iterations, int | np.integer):
@@ -429,5 +432,28 @@ def solve(
         if not np.all(np.isfinite(np.concatenate([*map(np.ravel, xs), *map(np.ravel, us)]))):
             raise ParameterError("ocp warm_start: its xs and us must be finite")
     initial = math.nan if regularization is None else float(regularization)
-    solver.solve(list(xs), list(us), iterations, False, initial)
+    holds = _held_errors(problem)
+    for held in holds:
+        held.take()  # (one left by a direct problem.calc: already warned about)
+        held.in_solve = True
+    try:
+        with ctrl_c_deferred():
+            solver.solve(list(xs), list(us), iterations, False, initial)
+    finally:
+        for held in holds:
+            held.in_solve = False
+    errors = [error for error in (held.take() for held in holds) if error is not None]
+    if errors:  # a node's own exception (a user's cost term...), raised here as itself
+        raise errors[0]
     return solver
+
+
+def _held_errors(problem) -> list[HeldError]:
+    """The `HeldError` of each of ``problem``'s differential models (once each; a model
+    shared by the running nodes once), in the nodes' order."""
+    holds: dict[int, HeldError] = {}
+    for node in [*problem.runningModels, problem.terminalModel]:
+        held = getattr(getattr(node, "differential", None), "held", None)
+        if held is not None:
+            holds.setdefault(id(held), held)
+    return list(holds.values())
