@@ -504,6 +504,10 @@ NB_MODULE(_core, m) {
   m.attr("API_VERSION") = uvms::kApiVersion;
   m.attr("PINOCCHIO_VERSION") = PINOCCHIO_VERSION;
   m.attr("SOURCE_HASH") = UVMS_CORE_SOURCE_HASH;
+  m.def("set_leak_warnings", &nb::set_leak_warnings, "on"_a,
+        "Whether nanobind reports this module's objects still alive when it is freed at exit "
+        "(on by default; uvms_pin.ocp turns it off: crocoddyl keeps what its nodes reach "
+        "alive past that point).");
 
   // the project's own exceptions, raised directly from C++
   nb::object errors = nb::module_::import_("uvms_pin.errors");

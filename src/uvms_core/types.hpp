@@ -9,7 +9,7 @@ namespace uvms {
 
 // The version of the interface the Python seam (uvms_pin/physics/compiled/) is written
 // against: the only place it is defined (Python reads _core.API_VERSION).
-constexpr int kApiVersion = 13;
+constexpr int kApiVersion = 14;
 
 using Vec3 = Eigen::Vector3d;
 using Vec6 = Eigen::Matrix<double, 6, 1>;

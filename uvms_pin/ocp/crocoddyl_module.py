@@ -15,7 +15,22 @@ def crocoddyl_module() -> ModuleType:
         raise OptionalDependencyError(
             "uvms_pin.ocp needs crocoddyl: pip install 'uvms-pin[ocp]' (crocoddyl >= 3.2)"
         ) from exc
+    _no_leak_report_at_exit()
     return crocoddyl
+
+
+def _no_leak_report_at_exit() -> None:
+    """Turn off nanobind's report of the compiled core's objects alive at exit.
+
+    crocoddyl holds the Python nodes of a problem from C++, where the garbage collector
+    cannot see. A script's global problem whose cost term is the script's own class makes
+    a cycle through the script's module that the interpreter frees only after the core's
+    module: nanobind then names every core object the script holds as "leaked", a false
+    alarm pointing at uvms-pin's bindings (tests/ocp/test_exit_report.py)."""
+    from uvms_pin.physics.compiled.extension import core_available, core_module
+
+    if core_available():
+        core_module().set_leak_warnings(False)
 
 
 def mim_solvers_module() -> ModuleType:
