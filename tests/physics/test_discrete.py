@@ -187,3 +187,29 @@ def test_bad_integrators_are_refused(reference_uvms):
         up.step_derivatives(reference_uvms, q, zero, zero, 0.01, integrator="rk5")
     with pytest.raises(ParameterError, match="not both"):
         up.step_derivatives(reference_uvms, q, zero, zero, 0.01, step_s=0.01, integrator=RK4())
+
+
+@pytest.mark.parametrize("integrator", [RK4(step_s=STEP_S), SemiImplicitEuler(step_s=STEP_S)])
+@pytest.mark.parametrize("backend", ["python", "core"])
+def test_a_period_not_a_multiple_of_the_step_ends_where_the_plant_does(
+    reference_uvms, integrator, backend
+):
+    """A period of 2.5 substeps is taken in 3 equal substeps (the fewest no longer than
+    step_s), as the plant's integrator takes it: the same end state, to rounding."""
+    q, v, tau = random_state(reference_uvms, np.random.default_rng(47))
+    period_s = 2.5 * STEP_S
+    got = up.step_derivatives(
+        reference_uvms,
+        q,
+        v,
+        tau,
+        period_s,
+        integrator=integrator,
+        time_s=T0_S,
+        flow=WAVES,
+        backend=backend,
+    )
+    plant = Plant(reference_uvms, np.zeros(3), flow=WAVES, free_surface=False, backend="python")
+    q1, v1 = plant.advance(integrator, T0_S, q, v, tau, T0_S + period_s)
+    np.testing.assert_allclose(got.q, q1, rtol=0, atol=1e-12)
+    np.testing.assert_allclose(got.v, v1, rtol=0, atol=1e-11)
