@@ -21,7 +21,7 @@ from uvms_pin.sim.plant import Plant
 
 pytest.importorskip("crocoddyl")
 
-from uvms_pin.control.mpc import MpcController, MpcForceTask
+from uvms_pin.control.mpc import COLD_START_ITERATIONS, MpcController, MpcForceTask
 from uvms_pin.ocp import problems
 
 CURRENT = np.array([0.3, 0.1, 0.0])
@@ -229,3 +229,33 @@ def test_the_warm_start_moves_the_last_plan_on_by_the_time_since_it(
         np.testing.assert_array_equal(start_xs[k], xs[min(k + shift, len(xs) - 1)])
     for k in range(len(us)):
         np.testing.assert_array_equal(start_us[k], us[min(k + shift, len(us) - 1)])
+
+
+def test_the_mpc_replans_at_its_rate_cold_longer_then_from_the_last_regularization(
+    reference_uvms, monkeypatch
+):
+    """At 20 Hz sampled every 10 ms: a plan at 0 and 0.05 s only, tau held in between; the
+    first (cold) plan runs COLD_START_ITERATIONS, the warm one ``iterations`` (2) from the
+    regularization the first ended with."""
+    q0 = _start(reference_uvms)
+    controller, _ = _controller(reference_uvms, reference_uvms, q0, rate_hz=20.0)
+    calls = []
+    solve = problems.solve
+
+    def spy(problem, **kw):
+        solver = solve(problem, **kw)
+        calls.append((kw["iterations"], kw["regularization"], solver.preg))
+        return solver
+
+    monkeypatch.setattr(problems, "solve", spy)
+    v0 = np.zeros(reference_uvms.nv)
+    taus = [
+        controller.compute(t, Measurement(t, q0, v0, np.zeros(6)))
+        for t in (0.0, 0.01, 0.02, 0.03, 0.04, 0.05)
+    ]
+    assert len(calls) == 2
+    for tau in taus[1:5]:
+        np.testing.assert_array_equal(tau, taus[0])
+    (cold_iterations, cold_start, cold_end), (warm_iterations, warm_start, _) = calls
+    assert (cold_iterations, warm_iterations) == (COLD_START_ITERATIONS, 2)
+    assert cold_start is None and warm_start == cold_end
