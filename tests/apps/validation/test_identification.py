@@ -5,7 +5,10 @@ test_fit.py), the split and the bookkeeping run for real on the shipped trials."
 
 from __future__ import annotations
 
+import shutil
+
 import numpy as np
+import pytest
 from test_sensitivity import DATA_DIR
 
 from uvms_pin.apps.validation import identification
@@ -13,6 +16,7 @@ from uvms_pin.apps.validation.fit import FitResult
 from uvms_pin.apps.validation.parameters import parameter_values
 from uvms_pin.apps.validation.pool import IDENTIFICATION_TRIALS, trial_setup, trial_uvms
 from uvms_pin.apps.validation.trials import find_trials, load_trial
+from uvms_pin.errors import DataError
 
 
 class _Comparison:
@@ -34,14 +38,15 @@ def test_the_fit_sees_only_the_identification_trials_and_the_means_keep_them_apa
     held_out = [n for n in names if n not in IDENTIFICATION_TRIALS]
     assert held_out and len(IDENTIFICATION_TRIALS) < len(names)
     number = {name: float(k + 1) for k, name in enumerate(names)}
-    fitted = []
+    fitted, identified = [], trial_uvms()  # (the fit's model: another object than start)
 
     def fit(uvms, setups, parameters_, link, step_s, **kw):
         fitted.append(setups)
         values = parameter_values(uvms, parameters_, link)
-        return FitResult(parameters_, link, values, values, [1.0], 0, uvms, "gradient", 0.0)
+        return FitResult(parameters_, link, values, values, [1.0], 0, identified, "gradient", 0.0)
 
     def compare(uvms, trial, step_s, *delays):
+        assert uvms is (identified if delays else start)
         return _Comparison(number[trial.name] * (2.0 if delays else 1.0))
 
     monkeypatch.setattr(identification, "fit_parameters", fit)
@@ -59,3 +64,13 @@ def test_the_fit_sees_only_the_identification_trials_and_the_means_keep_them_apa
         assert result[group]["mean_start_roll_rmse_deg"] == mean
         assert result[group]["mean_identified_roll_rmse_deg"] == 2.0 * mean
     assert set(result["trials"]) == set(names)
+
+
+def test_a_directory_of_only_the_identification_trials_has_nothing_to_hold_out(tmp_path):
+    for name in IDENTIFICATION_TRIALS:
+        shutil.copy(DATA_DIR / f"{name}.npz", tmp_path)
+    with pytest.raises(DataError, match="no trial left to hold out"):
+        identification.split_trials(tmp_path)
+    training, held_out = identification.split_trials(DATA_DIR)
+    assert [p.stem for p in training] == list(IDENTIFICATION_TRIALS)
+    assert {p.stem for p in held_out}.isdisjoint(IDENTIFICATION_TRIALS) and held_out
