@@ -11,8 +11,9 @@ import pytest
 from conftest import run
 from test_sensitivity import DATA_DIR, initial_state, synthetic_arm
 
+from uvms_pin.apps.validation import fit as fit_module
 from uvms_pin.apps.validation.figures import identified_figure
-from uvms_pin.apps.validation.fit import fit_parameters
+from uvms_pin.apps.validation.fit import _damped_step, _gradient_cosine, fit_parameters
 from uvms_pin.apps.validation.identify import HULL
 from uvms_pin.apps.validation.imu_mount import imu_roll_pitch, vehicle_start
 from uvms_pin.apps.validation.parameters import (
@@ -218,3 +219,48 @@ def test_identify_refuses_a_step_longer_than_the_imu_intervals(tmp_path):
     assert result.returncode == 2
     assert "--step 10 s is longer than the longest IMU interval" in result.stderr
     assert not out.exists()
+
+
+def _rosenbrock(uvms, parameters, link, values, setups, step_s):
+    """r = (10 (p1 - p0^2), 1 - p0) and its Jacobian, in place of the trials' simulation."""
+    p0, p1 = values
+    return np.array([10.0 * (p1 - p0**2), 1.0 - p0]), np.array([[-20.0 * p0, 10.0], [-1.0, 0.0]])
+
+
+def test_fit_damps_a_step_that_overshoots_and_reaches_the_minimum(monkeypatch):
+    """On Rosenbrock's residual from (-1.2, 1) the first Gauss-Newton step raises the cost
+    (to 1171 from 12.1): it is rejected, lambda grows (x4) until a step lowers the cost, and
+    the fit ends at the minimum (1, 1). (A lambda that shrank on rejection would retry the
+    same overshoot until the iteration cap.)"""
+    monkeypatch.setattr(fit_module, "_evaluate", _rosenbrock)
+    parameters = parse_parameters(("center_of_buoyancy.y", "center_of_buoyancy.z"))
+    messages = []
+    result = fit_parameters(
+        trial_uvms(), [], parameters, HULL, 0.05, start=np.array([-1.2, 1.0]),
+        max_iterations=200, progress=messages.append,
+    )  # fmt: skip
+    assert result.converged and result.stop_reason in ("exact", "gradient")
+    np.testing.assert_allclose(result.values, [1.0, 1.0], atol=1e-6)
+    assert "iteration 1: rejected (lambda -> 0.004)" in messages
+    assert all(b < a for a, b in zip(result.rms_deg, result.rms_deg[1:], strict=False))
+
+
+def test_a_parameter_held_at_its_bound_leaves_the_step_and_the_gradient_test():
+    """Linear residual r = J p - b with two coupled columns, p0 >= 0 held at 0 by a gradient
+    pushing it below: the step leaves p0 at 0 and gives p1 the least-squares value with p0
+    = 0 (not the coupled step projected afterwards), and the gradient cosine leaves p0's
+    outward component out (p1's is then 0 at that point); a free parameter's step past its
+    bound stops at the bound."""
+    jac = np.array([[1.0, 1.0], [0.0, 1.0], [1.0, -0.5]])
+    b = np.array([-1.0, 2.0, -0.5])
+    floor = np.array([0.0, -np.inf])
+    values = np.array([0.0, 0.0])
+    assert (jac.T @ (jac @ values - b))[0] > 0.0  # pushes p0 below its bound
+    candidate, _ = _damped_step(values, jac @ values - b, jac, 1e-12, floor)
+    best_p1 = jac[:, 1] @ b / (jac[:, 1] @ jac[:, 1])
+    np.testing.assert_allclose(candidate, [0.0, best_p1], rtol=1e-9, atol=1e-12)
+    at_best = np.array([0.0, best_p1])
+    assert _gradient_cosine(jac @ at_best - b, jac, at_best, floor) < 1e-12
+    inside = np.array([0.05, best_p1])  # p0 free (above its bound): its step goes below
+    candidate, _ = _damped_step(inside, jac @ inside - b, jac, 1e-12, floor)
+    assert candidate[0] == 0.0
