@@ -213,3 +213,23 @@ def test_a_period_not_a_multiple_of_the_step_ends_where_the_plant_does(
     q1, v1 = plant.advance(integrator, T0_S, q, v, tau, T0_S + period_s)
     np.testing.assert_allclose(got.q, q1, rtol=0, atol=1e-12)
     np.testing.assert_allclose(got.v, v1, rtol=0, atol=1e-11)
+
+
+def test_a_current_reaches_the_compiled_period_and_the_default_step_is_1ms(reference_uvms):
+    """current_world is the same water on both backends (the compiled period in a current
+    is the reference's, and not the still-water one); without step_s or an integrator
+    object the substep is 1 ms."""
+    q, v, tau = random_state(reference_uvms, np.random.default_rng(48))
+    kw = {"integrator": "rk4", "step_s": STEP_S, "time_s": T0_S, "current_world": CURRENT}
+    python = up.step_derivatives(reference_uvms, q, v, tau, PERIOD_S, backend="python", **kw)
+    core = up.step_derivatives(reference_uvms, q, v, tau, PERIOD_S, backend="core", **kw)
+    still = up.step_derivatives(
+        reference_uvms, q, v, tau, PERIOD_S, backend="core", integrator="rk4", step_s=STEP_S
+    )
+    for name in ("v", "dx_dx", "dx_dtau"):
+        got, expected = getattr(core, name), getattr(python, name)
+        assert np.max(np.abs(got - expected)) < 1e-10 * max(1.0, np.max(np.abs(expected)))
+    assert np.max(np.abs(core.dx_dx - still.dx_dx)) > 1e-6
+    default = up.step_derivatives(reference_uvms, q, v, tau, 0.01, backend="python")
+    fine = up.step_derivatives(reference_uvms, q, v, tau, 0.01, step_s=1e-3, backend="python")
+    np.testing.assert_array_equal(default.dx_dx, fine.dx_dx)
