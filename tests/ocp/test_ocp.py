@@ -73,6 +73,28 @@ def test_the_state_manifold_is_pinocchios_and_its_jacobians_match_numdiff(refere
                 np.testing.assert_allclose(g, e, atol=1e-6)
 
 
+def test_the_state_difference_of_a_continuous_joint_is_exact_at_tiny_angles(tmp_path):
+    """x1 (-) x0 of a continuous joint (q its cos and sin) is the angle between them to
+    1e-15 rad (the rounding of cos and sin) for steps of 1e-12 to 1e-6 rad, at any base
+    angle: what crocoddyl's NumDiff (steps ~1.5e-8) differences. Pinocchio 4.1's difference returns 0 for about 1 % of such
+    steps (its SO(2) log rounds a trace just above 2 to the identity)."""
+    from conftest import continuous_joint_urdf
+
+    uvms = up.load_uvms(continuous_joint_urdf(tmp_path))
+    model, state = uvms.model, UvmsState(uvms.model)
+    joint = model.getJointId("arm_joint2")
+    iq, iv = model.idx_qs[joint], model.idx_vs[joint]
+    rng = np.random.default_rng(11)
+    x0 = np.r_[pin.neutral(model), np.zeros(model.nv)]
+    for _ in range(500):
+        angle, step = rng.uniform(-np.pi, np.pi), 10 ** rng.uniform(-12, -6)
+        x0[iq : iq + 2] = np.cos(angle), np.sin(angle)
+        tangent = np.zeros(2 * model.nv)
+        tangent[iv] = step
+        x1 = state.integrate(x0, tangent)
+        np.testing.assert_allclose(state.diff(x0, x1)[iv], step, rtol=0.0, atol=1e-15)
+
+
 @pytest.mark.parametrize("actuated", ["tau", "thrusters"])
 @pytest.mark.parametrize(
     "flow",

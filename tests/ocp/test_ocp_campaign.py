@@ -10,7 +10,7 @@ from __future__ import annotations
 import numpy as np
 import pinocchio as pin
 import pytest
-from conftest import ROOT, mount_on_reference_vehicle
+from conftest import ROOT, continuous_joint_urdf, mount_on_reference_vehicle
 
 import uvms_pin as up
 from uvms_pin.errors import ParameterError
@@ -44,6 +44,12 @@ def bare_vehicle() -> up.UVMS:
 def mounted_alpha5(tmp_path_factory) -> up.UVMS:
     """The catalogue's Alpha 5 mounted (upside down) on the reference vehicle."""
     return mount_on_reference_vehicle("alpha5", tmp_path_factory.mktemp("mount"))
+
+
+@pytest.fixture(scope="module")
+def continuous_arm(tmp_path_factory) -> up.UVMS:
+    """The reference UVMS with its four arm joints continuous (q: cos and sin each)."""
+    return up.load_uvms(continuous_joint_urdf(tmp_path_factory.mktemp("continuous")))
 
 
 def _state(uvms, rng):
@@ -108,9 +114,12 @@ def _spring_at_tip(uvms, x):
 
 
 @pytest.mark.parametrize("contact", [False, True], ids=["free", "spring"])
-@pytest.mark.parametrize("which", ["alpha5_uvms", "bare_vehicle", "mounted_alpha5"])
+@pytest.mark.parametrize(
+    "which", ["alpha5_uvms", "bare_vehicle", "mounted_alpha5", "continuous_arm"]
+)
 def test_calc_diff_matches_numdiff_on_other_models(request, which, contact):
-    """The shipped BlueROV2 + Alpha 5, the vehicle alone and an arm mounted by uvms-pin, in a
+    """The shipped BlueROV2 + Alpha 5, the vehicle alone, an arm mounted by uvms-pin and
+    continuous arm joints (NumDiff steps through the state's exact circle difference), in a
     current, with the eight thrusters as the input, with and without the end-effector on a
     spring: the analytic derivatives are crocoddyl's numerical ones."""
     uvms = request.getfixturevalue(which)

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import math
 import os
 
 import numpy as np
@@ -203,6 +204,45 @@ def test_write_json_atomic(tmp_path):
     write_json_atomic(path, {"rmse": np.float64(0.5), "values": np.arange(3)})
     assert json.loads(path.read_text()) == {"rmse": 0.5, "values": [0, 1, 2]}
     assert _listing(tmp_path) == ["metrics.json"]
+
+
+def _strict_json(text: str):
+    """``text`` parsed as standard JSON: NaN, Infinity and -Infinity refused."""
+
+    def refuse(token):
+        raise ValueError(f"not standard JSON: {token}")
+
+    return json.loads(text, parse_constant=refuse)
+
+
+def test_json_files_are_standard_json_with_null_for_non_finite_numbers(tmp_path):
+    """metrics.json and the other summaries are read by jq, JavaScript...: a metric not
+    defined for a run (NaN: no funnel to end a transient) or an infinite one is null,
+    at any depth, numpy's included."""
+    path = tmp_path / "metrics.json"
+    payload = {
+        "transient_end_s": math.nan,
+        "peak": np.float64(np.inf),
+        "nested": {"low": -math.inf, "values": np.array([1.0, np.nan]), "n": np.int64(3)},
+        "list": [np.float32(np.nan), 2.5],
+    }
+    write_json_atomic(path, payload)
+    assert _strict_json(path.read_text()) == {
+        "transient_end_s": None,
+        "peak": None,
+        "nested": {"low": None, "values": [1.0, None], "n": 3},
+        "list": [None, 2.5],
+    }
+
+
+def test_rollout_metadata_keeps_non_finite_numbers_exactly(tmp_path):
+    """rollout.json is read back by Rollout.load: a NaN or infinite value in the metadata
+    comes back as itself (not None)."""
+    r = _filled()
+    r.metadata.update(limit=-math.inf, unknown=math.nan)
+    r.save(tmp_path / "r")
+    back = Rollout.load(tmp_path / "r").metadata
+    assert back["limit"] == -math.inf and math.isnan(back["unknown"])
 
 
 def test_load_without_rollout_raises_parameter_error(tmp_path):

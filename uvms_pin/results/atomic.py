@@ -11,6 +11,7 @@ The temporary file is created with mode 0666 filtered by the umask, as ``open()`
 from __future__ import annotations
 
 import json
+import math
 import os
 import secrets
 from collections.abc import Callable, Iterator
@@ -147,12 +148,31 @@ def _json_default(obj: Any) -> Any:
     raise TypeError(f"not JSON serialisable: {type(obj).__name__}")
 
 
-def json_text(payload: dict[str, Any]) -> str:
+def json_text(payload: dict[str, Any], *, standard: bool = True) -> str:
     """``payload`` as indented JSON with sorted keys (numpy arrays and scalars, paths: as
-    lists, numbers, text); TypeError for anything else, before any file is touched."""
-    return json.dumps(payload, indent=2, sort_keys=True, default=_json_default)
+    lists, numbers, text); TypeError for anything else, before any file is touched.
+
+    ``standard``: a NaN or infinite number is written ``null`` (what every JSON reader
+    accepts: jq, JavaScript...; "not defined for this run"); False: Python's ``NaN`` and
+    ``Infinity`` tokens, which Python reads back exactly (rollout.json, `Rollout.load`)."""
+    if standard:
+        payload = _non_finite_as_null(payload)
+    return json.dumps(
+        payload, indent=2, sort_keys=True, default=_json_default, allow_nan=not standard
+    )
+
+
+def _non_finite_as_null(value: Any) -> Any:
+    """``value`` with every NaN or infinite number (Python's, numpy's, in arrays) as None."""
+    if isinstance(value, dict):
+        return {key: _non_finite_as_null(item) for key, item in value.items()}
+    if isinstance(value, list | tuple | np.ndarray):
+        return [_non_finite_as_null(item) for item in value]
+    if isinstance(value, float | np.floating) and not math.isfinite(value):
+        return None
+    return value
 
 
 def write_json_atomic(path: str | Path, payload: dict[str, Any]) -> Path:
-    """Write ``payload`` as JSON (`json_text`) to ``path`` atomically."""
+    """Write ``payload`` as standard JSON (`json_text`: NaN as null) to ``path`` atomically."""
     return write_text_atomic(path, json_text(payload))

@@ -63,7 +63,7 @@ class Rollout(RolloutData):
         # Fix: serialise the metadata before writing anything; it used to be serialised
         # after rollout.npz was replaced, so unserialisable metadata left a new .npz next
         # to no (or a previous run's) rollout.json.
-        text = json_text(self.metadata)
+        text = json_text(self.metadata, standard=False)  # read back exactly by load
         arrays = {name: getattr(self, name) for name in self._BASE}
         arrays.update({f"signal__{k}": a for k, a in self.signals.items()})
         # both written to temporary files first, then renamed: a full disk (or Ctrl-C) while

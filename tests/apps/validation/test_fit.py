@@ -264,3 +264,64 @@ def test_a_parameter_held_at_its_bound_leaves_the_step_and_the_gradient_test():
     inside = np.array([0.05, best_p1])  # p0 free (above its bound): its step goes below
     candidate, _ = _damped_step(inside, jac @ inside - b, jac, 1e-12, floor)
     assert candidate[0] == 0.0
+
+
+def _three_trials(tmp_path):
+    """A data folder of trials outside the shipped identification split."""
+    tmp_path.mkdir(exist_ok=True)
+    for name in ("_alt_002-0", "_alt_009-1", "_alt_011-1"):
+        shutil.copy(DATA_DIR / f"{name}.npz", tmp_path)
+    return tmp_path
+
+
+def test_identify_fits_on_the_trials_train_names_and_holds_out_the_others(tmp_path):
+    """--train chooses the identification trials (a folder without families 001 and 008):
+    the fit runs on them, identification.json names them, the figures are the others'."""
+    data, out = _three_trials(tmp_path / "data"), tmp_path / "out"
+    result = run(
+        "identify", str(data), "--fit", "linear_damping.roll", "--train", "_alt_011-1",
+        "--max-iterations", "2", "--out", str(out), "--quiet",
+    )  # fmt: skip
+    assert result.returncode == 0, result.stderr
+    summary = json.loads((out / "identification.json").read_text())
+    assert summary["identification_trials"] == ["_alt_011-1"]
+    assert set(summary["trials"]) == {"_alt_002-0", "_alt_009-1", "_alt_011-1"}
+    assert "_alt_011-1 (identification)" in result.stdout
+    assert "_alt_002-0 (held out)" in result.stdout
+    figures = sorted(p.name for p in out.glob("identified*.png"))
+    assert figures == ["identified_alt_002-0.png", "identified_alt_009-1.png"]
+
+
+def test_identify_quasi_static_fit_on_the_trials_train_names(tmp_path):
+    """Without --fit, the centre-of-buoyancy fit on the --train trials: the library's fit
+    on the same two trials, printed."""
+    from uvms_pin.apps.validation.identify import fit_centre_of_buoyancy
+
+    data = _three_trials(tmp_path)
+    result = run("identify", str(data), "--train", "_alt_002-0,_alt_009-1")
+    assert result.returncode == 0, result.stderr
+    assert "identification trials: _alt_002-0, _alt_009-1" in result.stdout
+    printed = result.stdout.split("dr_B = [")[1].split("]")[0]
+    offset, _, _ = fit_centre_of_buoyancy(
+        trial_uvms(), [data / "_alt_002-0.npz", data / "_alt_009-1.npz"]
+    )
+    np.testing.assert_allclose(np.array(printed.split(), dtype=float), offset, atol=1e-6)
+
+
+@pytest.mark.parametrize(
+    ("train", "message"),
+    [
+        ("_alt_099-0", "identification trial(s) _alt_099-0 missing"),
+        ("_alt_002-0,_alt_009-1,_alt_011-1", "no trial left to hold out"),
+        ("_alt_002-0,,_alt_009-1", "none empty"),
+        ("_alt_002-0,_alt_002-0", "given twice"),
+    ],
+)
+def test_identify_refuses_a_bad_train_list_before_writing(tmp_path, train, message):
+    data, out = _three_trials(tmp_path / "data"), tmp_path / "out"
+    result = run(
+        "identify", str(data), "--fit", "linear_damping.roll", "--train", train, "--out", str(out)
+    )
+    assert result.returncode == 2, result.stderr
+    assert message in result.stderr and "Traceback" not in result.stderr
+    assert not out.exists()

@@ -45,6 +45,4 @@ def write_row(row: dict, keep_dir: Path | None) -> None:
     """``keep_dir/row.json`` (nothing if ``keep_dir`` is None)."""
     if keep_dir is not None:
         keep_dir.mkdir(parents=True, exist_ok=True)
-        # NaN (a metric the arm never got) as JSON null
-        clean = {k: None if isinstance(v, float) and math.isnan(v) else v for k, v in row.items()}
-        write_json_atomic(keep_dir / "row.json", clean)
+        write_json_atomic(keep_dir / "row.json", row)  # NaN (a metric never got): null

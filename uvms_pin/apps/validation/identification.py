@@ -60,24 +60,27 @@ DEFAULT_FIT = (
 )
 
 
-def split_trials(data_dir: str | Path) -> tuple[list[Path], list[Path]]:
-    """(identification, held-out) trial files of ``data_dir``.
+def split_trials(
+    data_dir: str | Path, training: Sequence[str] = IDENTIFICATION_TRIALS
+) -> tuple[list[Path], list[Path]]:
+    """(identification, held-out) trial files of ``data_dir``: the trials named in
+    ``training`` (file stems, e.g. "_alt_001-0"; default the shipped split) and the others.
 
     Raises:
-        DataError: a missing directory, no trials, an identification trial missing, or no
-            held-out trial left.
+        DataError: a missing directory, no trials, an identification trial missing (the
+            trials there named), or no held-out trial left.
     """
     files = {p.stem: p for p in find_trials(data_dir)}
-    missing = [n for n in IDENTIFICATION_TRIALS if n not in files]
+    missing = [n for n in training if n not in files]
     if missing:
         raise DataError(
             f"{data_dir}: identification trial(s) {', '.join(missing)} missing "
             f"(have {', '.join(files)})"
         )
-    held_out = [p for n, p in files.items() if n not in IDENTIFICATION_TRIALS]
+    held_out = [p for n, p in files.items() if n not in training]
     if not held_out:
         raise DataError(f"{data_dir}: no trial left to hold out besides the identification ones")
-    return [files[n] for n in IDENTIFICATION_TRIALS], held_out
+    return [files[n] for n in training], held_out
 
 
 def _rmse_table(before: TrialComparison, after: TrialComparison) -> dict:
@@ -99,9 +102,9 @@ def _means(rows: list[dict]) -> dict:
     return {f"mean_{k}_rmse_deg": float(np.mean([r[f"{k}_rmse_deg"] for r in rows])) for k in keys}
 
 
-def _summary(fit: FitResult, tables: dict[str, dict]) -> dict:
-    held = [t for n, t in tables.items() if n not in IDENTIFICATION_TRIALS]
-    used = [t for n, t in tables.items() if n in IDENTIFICATION_TRIALS]
+def _summary(fit: FitResult, tables: dict[str, dict], training: Sequence[str]) -> dict:
+    held = [t for n, t in tables.items() if n not in training]
+    used = [t for n, t in tables.items() if n in training]
     return {
         "link": fit.link,
         "parameters": {
@@ -118,7 +121,7 @@ def _summary(fit: FitResult, tables: dict[str, dict]) -> dict:
         "converged": fit.converged,
         "gradient_cosine": fit.gradient_cosine,
         "fit_rms_deg": fit.rms_deg,
-        "identification_trials": list(IDENTIFICATION_TRIALS),
+        "identification_trials": list(training),
         "held_out": _means(held),
         "identification": _means(used),
         "trials": tables,
@@ -135,8 +138,10 @@ def run_identification(
     max_iterations: int = 50,
     figures: bool = True,
     progress: Callable[[str], None] | None = None,
+    training: Sequence[str] = IDENTIFICATION_TRIALS,
 ) -> dict:
-    """Fit ``parameter_names`` of the hull of ``start`` on the identification trials,
+    """Fit ``parameter_names`` of the hull of ``start`` on the identification trials
+    (``training``: their names, `split_trials`),
     compare start and identified model on every trial, write the results to ``out_dir``
     (nothing written when None). Every input is checked before the fit begins.
 
@@ -146,11 +151,11 @@ def run_identification(
     """
     parameters = parse_parameters(parameter_names)
     hydro_body(start, HULL)
-    training, held_out = split_trials(data_dir)
-    check_trials_fit(training + held_out)
-    trials = [load_trial(p) for p in training + held_out]
+    fitted_on, held_out = split_trials(data_dir, training)
+    check_trials_fit(fitted_on + held_out)
+    trials = [load_trial(p) for p in fitted_on + held_out]
     check_step(step_s, trials)
-    setups = [trial_setup(t) for t in trials[: len(training)]]
+    setups = [trial_setup(t) for t in trials[: len(fitted_on)]]
     fit = fit_parameters(
         start, setups, parameters, HULL, step_s, max_iterations=max_iterations, progress=progress
     )
@@ -163,7 +168,7 @@ def run_identification(
             compare_trial(fit.uvms, trial, step_s, delay_s, yaw_rad),
         )
         tables[trial.name], comparisons[trial.name] = _rmse_table(*pair), pair
-    result = {**_summary(fit, tables), "arm_delay_s": delay_s, "imu_yaw_rad": yaw_rad}
+    result = {**_summary(fit, tables, training), "arm_delay_s": delay_s, "imu_yaw_rad": yaw_rad}
     if out_dir is not None:
         out = Path(out_dir)
         out.mkdir(parents=True, exist_ok=True)

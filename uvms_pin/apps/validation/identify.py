@@ -16,7 +16,8 @@ the correction (an offset of ~0 comes out); ``--cob`` starts from another hull c
 buoyancy, e.g. Kolano's own (0.0074, 0, 0.02) m, from which the correction is found.
 
 Identification trials: the trajectory families 001 and 008 (6 trials); the families 002,
-009 and 011 (6 trials) are held out for validation (`IDENTIFICATION_TRIALS`).
+009 and 011 (6 trials) are held out for validation (`IDENTIFICATION_TRIALS`). ``--train``
+names others (file stems); the rest of the folder is then held out.
 
 With ``--fit NAMES`` (e.g. ``linear_damping.roll,center_of_buoyancy.y``), the named hull
 parameters are fitted instead on the simulation error of the whole trials, by
@@ -163,9 +164,10 @@ def fit_centre_of_buoyancy(
 
 def _quasi_static(args, start: UVMS) -> int:
     """The centre-of-buoyancy fit on the quasi-static attitude, printed."""
-    training, held_out = split_trials(args.data_dir)
+    names = training_trials(args)
+    training, held_out = split_trials(args.data_dir, names)
     offset, before, after = fit_centre_of_buoyancy(start, training, args.every)
-    print(f"identification trials: {', '.join(IDENTIFICATION_TRIALS)}")
+    print(f"identification trials: {', '.join(names)}")
     millimetres = ", ".join(f"{round(1e3 * x, 2) + 0.0:.2f}" for x in offset)  # no -0.00
     print(
         f"hull centre of buoyancy offset dr_B = {np.array2string(offset, precision=6)} m "
@@ -203,7 +205,7 @@ def _print_fit(result: dict) -> None:
             f"{m['mean_identified_roll_rmse_deg']:.3f}, {m['mean_identified_pitch_rmse_deg']:.3f}"
         )
     for name, t in result["trials"].items():
-        kind = "identification" if name in IDENTIFICATION_TRIALS else "held out"
+        kind = "identification" if name in result["identification_trials"] else "held out"
         published = t["published_roll_rmse_deg"]
         extra = "" if published is None else f" (published simulator: {published:.3f})"
         print(
@@ -211,6 +213,14 @@ def _print_fit(result: dict) -> None:
             f"{t['identified_roll_rmse_deg']:.3f}{extra}, pitch {t['start_pitch_rmse_deg']:.3f}"
             f" -> {t['identified_pitch_rmse_deg']:.3f}"
         )
+
+
+def training_trials(args: argparse.Namespace) -> tuple[str, ...]:
+    """The identification trials' names: ``--train`` (comma-separated), else the shipped
+    split (`IDENTIFICATION_TRIALS`)."""
+    if args.train is None:
+        return IDENTIFICATION_TRIALS
+    return tuple(comma_names("--train", args.train, "trial names"))
 
 
 def run(args: argparse.Namespace) -> int:
@@ -239,6 +249,7 @@ def run(args: argparse.Namespace) -> int:
         max_iterations=args.max_iterations,
         figures=not args.no_figures,
         progress=None if args.quiet else lambda line: print(line, file=sys.stderr, flush=True),
+        training=training_trials(args),
     )
     _print_fit(result)
     if not result["converged"]:

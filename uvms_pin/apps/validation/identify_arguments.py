@@ -40,6 +40,14 @@ def add_identify_arguments(parser: argparse.ArgumentParser) -> None:
         help="with --fit: write identification.json, the identified vehicle's URDF and a "
         "figure per held-out trial here",
     )
+    parser.add_argument(
+        "--train",
+        type=nonempty("trial names"),
+        metavar="TRIALS",
+        help="comma-separated names of the trials to fit on (file names without .npz, e.g. "
+        "_alt_001-0,_alt_002-1); the others in DATA_DIR are held out (default: the families "
+        "001 and 008)",
+    )
     parser.add_argument("--step", type=positive, default=0.05, help="largest RK4 step [s]")
     parser.add_argument(
         "--max-iterations",
