@@ -15,7 +15,10 @@ from uvms_pin.errors import ParameterError, PlausibilityWarning
 
 
 def finite_vector(name: str, value, size: int) -> np.ndarray:
-    """``value`` as a float array of shape (size,) with finite entries, or ParameterError."""
+    """``value`` as a float array of shape (size,) with finite entries, or ParameterError
+    (a complex array too: casting it would drop its imaginary part)."""
+    if getattr(getattr(value, "dtype", None), "kind", "") == "c":
+        raise ParameterError(f"{name} must be {size} real numbers, got a complex array")
     try:
         array = np.asarray(value, dtype=float)
     except (TypeError, ValueError) as exc:

@@ -45,10 +45,15 @@ std::string shape_of(nb::handle x) {
 struct VectorArg {
   Array1 array;
   bool ok = false;
+  bool complex = false;  // a complex array: refused, not cast (the imaginary part dropped)
 
   explicit VectorArg(nb::handle x) {
     ok = nb::try_cast(x, array, true);
     if (ok || x.is_none()) return;
+    if (nb::hasattr(x, "dtype") && nb::hasattr(x.attr("dtype"), "kind")) {
+      complex = nb::cast<std::string>(nb::str(x.attr("dtype").attr("kind"))) == "c";
+      if (complex) return;
+    }
     try {
       nb::object converted = nb::module_::import_("numpy").attr("asarray")(x, "dtype"_a = "float64");
       ok = nb::try_cast(converted, array, false);
@@ -63,6 +68,10 @@ struct VectorArg {
 // The vector ``name`` of n finite numbers, or InputError saying what it is instead.
 Eigen::Map<const Eigen::VectorXd> vector(const char* name, nb::handle x, const VectorArg& arg,
                                          Eigen::Index n) {
+  if (arg.complex) {
+    throw InputError(std::string(name) + " must be " + std::to_string(n) +
+                     " real numbers, got a complex array");
+  }
   if (!arg.ok || arg.size() != n) {
     throw InputError(std::string(name) + " must have shape (" + std::to_string(n) +
                      ",), got " + (arg.ok ? "(" + std::to_string(arg.size()) + ",)" : shape_of(x)));

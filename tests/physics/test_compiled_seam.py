@@ -187,6 +187,20 @@ def test_compiled_calls_name_a_bad_vector(reference_uvms, value, message):
         up.mass_matrix(reference_uvms, value)
 
 
+@pytest.mark.parametrize("backend", ["core", "python"])
+def test_a_complex_array_is_refused_not_cast(reference_uvms, backend):
+    """Casting would drop the imaginary part (numpy's ComplexWarning, or under -W error a
+    'must have shape (11,), got (11,)'): both backends refuse it, naming the argument."""
+    uvms = reference_uvms
+    q, v = uvms.neutral_configuration(), np.zeros(uvms.nv)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")  # no ComplexWarning on the way
+        with pytest.raises(ParameterError, match=r"q must be 11 real numbers, got a complex"):
+            up.forward_dynamics(uvms, q.astype(complex), v, v, backend=backend)
+        with pytest.raises(ParameterError, match=r"tau must be 10 real numbers, got a complex"):
+            up.forward_dynamics(uvms, q, v, v + 0j, backend=backend)
+
+
 def test_compiled_calls_take_lists_and_other_dtypes(reference_uvms):
     q = reference_uvms.neutral_configuration()
     expected = up.mass_matrix(reference_uvms, q)
