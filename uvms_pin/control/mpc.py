@@ -85,8 +85,8 @@ class MpcController(Controller):
     Args:
         uvms: the model the controller believes in (a private copy of its Pinocchio model is
             used).
-        task: "station" or "end_effector". target: the pose to hold (vehicle body frame, or
-            end-effector), world frame.
+        task: "station", "end_effector" or "force" (with ``force_task``). target: the pose
+            to hold (vehicle body frame, or end-effector), world frame; None for "force".
         posture: the arm's and vehicle's reference configuration (nq,) for the state terms
             (x_ref = (posture, 0)).
         horizon_s, dt_s: the OCP's horizon and node length [s]. rate_hz: re-plans per second.

@@ -241,7 +241,7 @@ def station_hold(
 
     Per node: (1/2)||log6(T_station^-1 T_vehicle)||^2_W (W = diag(pose_weights) over x, y,
     z [m] and the rotation [rad], body axes) + (1/2)||arm (-) arm_0||^2 + 0.1 (1/2)||v||^2 +
-    effort_weight (1/2)||u||^2 (N, N m); x10 at the end. The default trades 1 cm of error
+    effort_weight (1/2)||u||^2 (N, N m); x10 at the end. The default trades 1 mm of error
     against 1 N of input; give a DoF the input cannot reach (e.g. the passively stable roll
     and pitch of a vehicle without thrust there) a small weight, or the plan fights it."""
     x0 = np.asarray(x0, float)
