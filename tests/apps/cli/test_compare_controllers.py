@@ -120,3 +120,41 @@ def test_the_force_figure_is_titled_and_its_window_line_labelled(tmp_path):
     assert [t.get_text() for t in lower.get_legend().get_texts()] == [
         "after-transient window from t = 0.05 s (errors measured there)"
     ]
+
+
+def test_a_tracking_comparison_says_when_the_run_ends_before_its_transient(tmp_path):
+    """A run shorter than the task's transient has no error to judge: no controller holds
+    the task ('position error RMS nan mm: holds the task' before), and says why; --after
+    (the force task's window) is refused for a [task]."""
+    station = str(ROOT / "scenarios" / "mpc_station_keeping.toml")
+    out = tmp_path / "cmp"
+    result = run_cli(
+        [
+            "compare-controllers", station, "--controllers", "task_priority",
+            "--set", "scenario.duration_s=0.3", "--out", str(out), "--no-figures",
+        ],
+        tmp_path,
+    )  # fmt: skip
+    assert result.returncode == 0, result.stderr
+    assert "holds the task" not in result.stdout
+    assert "no samples after the task's transient (t = 2 s; the run ends at 0.3 s)" in (
+        result.stdout
+    )
+    with open(out / "controllers.csv") as f:
+        (row,) = list(csv.DictReader(f))
+    assert row["success"] == "False"
+    refused = run_cli(
+        [
+            "compare-controllers",
+            station,
+            "--controllers",
+            "task_priority",
+            "--after",
+            "1",
+            "--out",
+            str(tmp_path / "never"),
+        ],
+        tmp_path,
+    )
+    assert refused.returncode == 2 and "--set task.transient_s=S" in refused.stderr
+    assert not (tmp_path / "never").exists()

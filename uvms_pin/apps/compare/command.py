@@ -78,6 +78,11 @@ def _compare_tracking(args: argparse.Namespace, scenarios, criteria, out) -> int
 
     if args.robustness:
         raise ParameterError("--robustness runs the force-tracking cases: not for a [task]")
+    if args.after is not None:
+        raise ParameterError(
+            "--after is the force task's window: a [task] is judged after its transient_s "
+            "(--set task.transient_s=S)"
+        )
     task = next(iter(scenarios.values())).task
     with claim(out, CONTROLLER_COMPARISON, overwrite=args.overwrite):
         say = None if args.quiet else (lambda line: print(line, file=sys.stderr, flush=True))

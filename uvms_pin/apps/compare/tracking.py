@@ -51,6 +51,13 @@ def tracking_row(
     }
     if stopped:
         reason = stopped
+    elif not math.isfinite(row["task_position_error_rms_m"]):
+        transient_s = (rollout.metadata.get("task") or {}).get("transient_s", math.nan)
+        end_s = float(rollout.time_s[-1]) if len(rollout) else 0.0
+        reason = (
+            f"no samples after the task's transient (t = {transient_s:g} s; the run ends at "
+            f"{end_s:g} s)"
+        )
     elif row["joint_limit_excess_max_rad"] > 0.0:
         reason = f"an arm joint went {row['joint_limit_excess_max_rad']:.3f} rad past its limit"
     elif not metrics.get("task_settled", 0.0):
