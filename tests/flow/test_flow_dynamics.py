@@ -8,7 +8,8 @@ import pytest
 from conftest import RHO, body_urdf, hydro_xml, random_configuration
 
 import uvms_pin as up
-from uvms_pin.flow import AiryWave, GaussMarkovCurrent, UniformCurrent
+from uvms_pin.errors import CoreFallbackWarning, ParameterError
+from uvms_pin.flow import AiryWave, FlowField, GaussMarkovCurrent, UniformCurrent
 from uvms_pin.sim.integrators import RK4
 
 RADIUS = 0.1
@@ -107,3 +108,36 @@ def test_time_varying_current_drives_a_neutral_sphere_like_the_water(load_body):
         v[:3] = gm.velocity(t, q[:3])[0]
         acc = up.forward_dynamics(uvms, q, v, np.zeros(6), flow=gm, time_s=t)
         np.testing.assert_allclose(acc[:3], gm.acceleration(t, q[:3])[0], rtol=1e-10, atol=1e-13)
+
+
+class _OnePointFlow(FlowField):
+    """A user's field that returns one point's values whatever the number of points."""
+
+    def velocity(self, time_s, points_world):
+        return np.array([0.1, 0.0, 0.0])
+
+    def local_acceleration(self, time_s, points_world):
+        return np.zeros((len(points_world), 3))
+
+    def velocity_gradient(self, time_s, points_world):
+        return np.zeros((len(points_world), 3, 3))
+
+    def gradient_kinematics(self, time_s, points_world):
+        return np.zeros((len(points_world), 3, 3)), np.zeros((3, 3, 3))  # Hessian one point's
+
+
+def test_a_user_flow_of_the_wrong_shape_is_named_not_a_numpy_error(reference_uvms):
+    """velocity of shape (3,) for n points, or a Hessian of one point: a ParameterError
+    naming the field's method and the shapes (a numpy einsum error before)."""
+    uvms = reference_uvms
+    q = uvms.neutral_configuration()
+    q[2] = -3.0
+    zero = np.zeros(uvms.nv)
+    flow = _OnePointFlow()
+    with pytest.warns(CoreFallbackWarning):
+        with pytest.raises(ParameterError, match=r"velocity returned shape \(3,\), expected"):
+            up.forward_dynamics(uvms, q, zero, zero, flow=flow)
+    flow.velocity = lambda time_s, points: np.zeros((len(points), 3))
+    with pytest.warns(CoreFallbackWarning):
+        with pytest.raises(ParameterError, match=r"gradient_kinematics\[1\] returned shape"):
+            up.forward_dynamics_derivatives(uvms, q, zero, zero, flow=flow)

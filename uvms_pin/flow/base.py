@@ -21,6 +21,19 @@ def as_points(points_world: np.ndarray) -> np.ndarray:
     return points
 
 
+def checked_output(flow: Any, method: str, value: Any, shape: tuple[int, ...]) -> np.ndarray:
+    """What ``flow.method`` returned, as a float array of ``shape``; else ParameterError
+    naming the field and the method (a field of the user's that returns one point's value
+    for n points would otherwise fail deep in numpy)."""
+    array = np.asarray(value, dtype=float)
+    if array.shape != shape:
+        raise ParameterError(
+            f"the flow {flow!r}: {method} returned shape {array.shape}, expected {shape} "
+            f"(one row per point: n = {shape[0]})"
+        )
+    return array
+
+
 class FlowField(ABC):
     """An undisturbed water flow u(t, p) in the world frame (waves: irrotational; a sheared
     current has vorticity, which bodies do not feel: the fluid twist has no angular part).
@@ -55,10 +68,15 @@ class FlowField(ABC):
     ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """(u, du/dt, grad u) at once; fields override it to share work between the three."""
         points = as_points(points_world)
+        n = len(points)
         return (
-            self.velocity(time_s, points),
-            self.local_acceleration(time_s, points),
-            self.velocity_gradient(time_s, points),
+            checked_output(self, "velocity", self.velocity(time_s, points), (n, 3)),
+            checked_output(
+                self, "local_acceleration", self.local_acceleration(time_s, points), (n, 3)
+            ),
+            checked_output(
+                self, "velocity_gradient", self.velocity_gradient(time_s, points), (n, 3, 3)
+            ),
         )
 
     def velocity_and_acceleration(
@@ -89,8 +107,11 @@ class FlowField(ABC):
             grad(Du/Dt)_ij = d(du_i/dt)/dx_j + sum_k H_ikj u_k + sum_k G_ik G_kj.
         """
         points = as_points(points_world)
+        n = len(points)
         u, du_dt, grad = self.kinematics(time_s, points)
         grad_du_dt, hessian = self.gradient_kinematics(time_s, points)
+        grad_du_dt = checked_output(self, "gradient_kinematics[0]", grad_du_dt, (n, 3, 3))
+        hessian = checked_output(self, "gradient_kinematics[1]", hessian, (n, 3, 3, 3))
         material = du_dt + np.einsum("kij,kj->ki", grad, u)
         material_grad = grad_du_dt + np.einsum("kimj,km->kij", hessian, u) + np.matmul(grad, grad)
         return u, grad, material, material_grad
