@@ -89,7 +89,7 @@ def _force_errors(rollout, after_s):
     return np.linalg.norm(force[after], axis=1), np.linalg.norm(attitude[after], axis=1)
 
 
-def test_mpc_force_tracking_holds_the_force_and_is_deterministic():
+def test_mpc_force_tracking_holds_the_force_and_is_deterministic(tmp_path):
     """The paper's task (0.4 +- 0.4 N at 0.5 Hz on the 2 N/m spring) by MPC on the plant's
     own model, planning on the four bounded thrusters: from f = 0 and 0.2 rad of attitude
     error at t = 0, over 1..2 s the force error stays within 0.2 N (0.12 N measured, 0.06 N
@@ -113,6 +113,10 @@ def test_mpc_force_tracking_holds_the_force_and_is_deterministic():
     again = simulate(load_scenario(FORCE_SCENARIO, overrides), progress=False)
     np.testing.assert_array_equal(again.q, first.q)
     np.testing.assert_array_equal(again.tau, first.tau)
+    # its force figure (desired, measured, true); the funnels are the PPC's alone
+    from uvms_pin.results.figures.paper import paper_figures
+
+    assert [p.name for p in paper_figures(first, tmp_path)] == ["force.png"]
 
 
 def test_the_force_mpc_tracks_with_csqp():

@@ -141,12 +141,16 @@ def plot_second_level(
 
 
 def paper_figures(rollout: RolloutData, directory: Path) -> list[Path]:
-    """Figs. 3-5 when the rollout carries the PPC signals; nothing otherwise."""
-    if len(rollout) < 2 or not all(k in rollout.signals for k in PPC_SIGNALS):
+    """Fig. 3 (force.png) when the controller logged a desired force (the PPC, the MPC's
+    force task, the force baselines); Figs. 4-5 (the funnels) when it carries all the PPC's
+    signals; nothing with fewer than two samples."""
+    if len(rollout) < 2 or "force_desired_world_N" not in rollout.signals:
         return []
     directory = Path(directory)
-    return [
-        plot_force(rollout, directory / "force.png"),
-        plot_first_level(rollout, directory / "first_level_errors.png"),
-        plot_second_level(rollout, directory / "second_level_errors.png"),
-    ]
+    written = [plot_force(rollout, directory / "force.png")]
+    if all(k in rollout.signals for k in PPC_SIGNALS):
+        written += [
+            plot_first_level(rollout, directory / "first_level_errors.png"),
+            plot_second_level(rollout, directory / "second_level_errors.png"),
+        ]
+    return written
