@@ -4,6 +4,7 @@ simulated with, and `uvms-pin identify --fit` refuses bad input and writes a usa
 from __future__ import annotations
 
 import json
+import re
 import shutil
 
 import numpy as np
@@ -288,6 +289,8 @@ def test_identify_fits_on_the_trials_train_names_and_holds_out_the_others(tmp_pa
     assert set(summary["trials"]) == {"_alt_002-0", "_alt_009-1", "_alt_011-1"}
     assert "_alt_011-1 (identification)" in result.stdout
     assert "_alt_002-0 (held out)" in result.stdout
+    assert summary["parameters"]["linear_damping.roll"]["unit"] == "N m s/rad"
+    assert re.search(r"linear_damping.roll: \S+ -> \S+ N m s/rad \(analytic\)", result.stdout)
     figures = sorted(p.name for p in out.glob("identified*.png"))
     assert figures == ["identified_alt_002-0.png", "identified_alt_009-1.png"]
 
@@ -325,3 +328,22 @@ def test_identify_refuses_a_bad_train_list_before_writing(tmp_path, train, messa
     assert result.returncode == 2, result.stderr
     assert message in result.stderr and "Traceback" not in result.stderr
     assert not out.exists()
+
+
+@pytest.mark.parametrize(
+    ("name", "unit"),
+    [
+        ("linear_damping.x", "N s/m"),
+        ("linear_damping.pitch", "N m s/rad"),
+        ("quadratic_damping.z", "N s^2/m^2"),
+        ("quadratic_damping.yaw", "N m s^2/rad^2"),
+        ("added_mass.y", "kg"),
+        ("added_mass.roll", "kg m^2"),
+        ("center_of_buoyancy.z", "m"),
+        ("arm_delay", "s"),
+        ("imu_yaw", "rad"),
+    ],
+)
+def test_every_identifiable_parameter_has_its_si_unit(name, unit):
+    (parameter,) = parse_parameters((name,))
+    assert parameter.unit == unit

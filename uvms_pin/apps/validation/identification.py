@@ -112,6 +112,7 @@ def _summary(fit: FitResult, tables: dict[str, dict], training: Sequence[str]) -
                 "start": float(s),
                 "identified": float(x),
                 "sensitivity": "analytic" if p.analytic else "central differences",
+                "unit": p.unit,
             }
             for p, s, x in zip(fit.parameters, fit.start, fit.values, strict=True)
         },

@@ -196,7 +196,9 @@ def _print_fit(result: dict) -> None:
         f"{accepted} accepted; stopped: {stop} ({state})"
     )
     for name, p in result["parameters"].items():
-        print(f"  {name}: {p['start']:.6g} -> {p['identified']:.6g} ({p['sensitivity']})")
+        print(
+            f"  {name}: {p['start']:.6g} -> {p['identified']:.6g} {p['unit']} ({p['sensitivity']})"
+        )
     for which in ("identification", "held_out"):
         m = result[which]
         print(

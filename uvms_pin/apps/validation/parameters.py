@@ -85,6 +85,21 @@ class HydroParameter:
         return self.kind in FORCE_LINEAR
 
     @property
+    def unit(self) -> str:
+        """Its SI unit: a translational axis's (x, y, z) or a rotational one's (roll, pitch,
+        yaw) for the diagonal coefficients; m, s, rad for the others."""
+        if self.kind == "center_of_buoyancy":
+            return "m"
+        if self.kind in RECORDING:
+            return "s" if self.kind == ARM_DELAY else "rad"
+        rotational = self.axis > 2
+        return {
+            "linear_damping": ("N m s/rad" if rotational else "N s/m"),
+            "quadratic_damping": ("N m s^2/rad^2" if rotational else "N s^2/m^2"),
+            "added_mass": ("kg m^2" if rotational else "kg"),
+        }[self.kind]
+
+    @property
     def hydrodynamic(self) -> bool:
         """True for a coefficient of the body (False: the recording's ``arm_delay``,
         ``imu_yaw``)."""
