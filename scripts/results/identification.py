@@ -28,9 +28,12 @@ FIGURES = ("_alt_002-0", "_alt_002-1")
 
 
 def _parameter_rows(result: dict) -> list[str]:
-    rows = ["| parameter | catalogue | identified | sensitivity |", "|---|---|---|---|"]
+    rows = ["| parameter | catalogue | identified | unit | sensitivity |", "|---|---|---|---|---|"]
     for name, p in result["parameters"].items():
-        rows.append(f"| `{name}` | {p['start']:.4g} | {p['identified']:.4g} | {p['sensitivity']} |")
+        rows.append(
+            f"| `{name}` | {p['start']:.4g} | {p['identified']:.4g} | {p['unit']} "
+            f"| {p['sensitivity']} |"
+        )
     return rows
 
 
