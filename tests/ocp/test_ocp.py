@@ -76,8 +76,9 @@ def test_the_state_manifold_is_pinocchios_and_its_jacobians_match_numdiff(refere
 def test_the_state_difference_of_a_continuous_joint_is_exact_at_tiny_angles(tmp_path):
     """x1 (-) x0 of a continuous joint (q its cos and sin) is the angle between them to
     1e-15 rad (the rounding of cos and sin) for steps of 1e-12 to 1e-6 rad, at any base
-    angle: what crocoddyl's NumDiff (steps ~1.5e-8) differences. Pinocchio 4.1's difference returns 0 for about 1 % of such
-    steps (its SO(2) log rounds a trace just above 2 to the identity)."""
+    angle: what crocoddyl's NumDiff (steps ~1.5e-8) differences. Pinocchio 4.1's
+    difference returns 0 for about 1 % of such steps (its SO(2) log rounds a trace just
+    above 2 to the identity)."""
     from conftest import continuous_joint_urdf
 
     uvms = up.load_uvms(continuous_joint_urdf(tmp_path))

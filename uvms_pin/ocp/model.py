@@ -22,8 +22,9 @@ ConstraintModelManager holding a ConstraintModelResidual of ResidualModelControl
 constrained solver (mim_solvers' CSQP) enforces.
 
 An exception raised in calc or calcDiff (a user's cost term or flow) is held, the node's
-cost set to `REJECTED_COST` and its other outputs to zero, and raised by `uvms_pin.ocp.problems.solve` after the solver returns
-(`uvms_pin.ocp.held_errors`: it cannot cross crocoddyl's C++ loop).
+cost set to `REJECTED_COST` and its other outputs to zero, and raised by
+`uvms_pin.ocp.problems.solve` after the solver returns (`uvms_pin.ocp.held_errors`: it
+cannot cross crocoddyl's C++ loop).
 """
 
 from __future__ import annotations
