@@ -12,7 +12,7 @@ measured here, to one ``pin.aba`` call on the same model or to MuJoCo doing the 
 
 1. forward dynamics (with a current), x pin.aba;
 2. the plant over one 2 ms control period, RK4 at 0.5 ms (uvms-pin: the simulator's
-   per-tick call, ``Plant.advance`` with the input held (one compiled call on the core);
+   per-tick call, ``System.advance`` with the input held (one compiled call on the core);
    MuJoCo: 4 ``mj_step`` with ``opt.integrator = RK4``);
 3. one closed-loop tick of scenarios/realistic_force_tracking.toml: the same Python PPC,
    sensors and thruster allocation compute tau from a `Measurement` of each simulator's
@@ -69,6 +69,7 @@ from uvms_pin.physics.world.world import World
 from uvms_pin.sim.integrators import RK4
 from uvms_pin.sim.plant import Plant
 from uvms_pin.sim.sensors import SensorSuite
+from uvms_pin.sim.system import System as BodySystem
 
 ROOT = Path(__file__).resolve().parents[1]
 REFERENCE_URDF = ROOT / "models" / "uvms_lbv150.urdf"
@@ -111,13 +112,6 @@ def make_plant(uvms: up.UVMS, backend: str | None, **fields) -> Plant:
     if backend is not None and "backend" in inspect.signature(Plant).parameters:
         fields["backend"] = backend
     return Plant(uvms, **fields)
-
-
-def plant_rhs(plant: Plant, tau: np.ndarray, backend: str | None) -> Callable:
-    """The right-hand side the simulator integrates over one tick with tau held."""
-    if backend is not None and "backend" in inspect.signature(plant.acceleration).parameters:
-        return lambda t, q, v: plant.acceleration(t, q, v, tau, backend=backend)
-    return lambda t, q, v: plant.acceleration(t, q, v, tau)
 
 
 def plant_backends() -> list[str | None]:
@@ -235,12 +229,18 @@ def uvms_plant_case(system: System, backend: str | None) -> Callable[[], object]
     return lambda: advance(plant, integrator, backend, 0.0, q, v, tau, CONTROL_PERIOD_S)
 
 
+#: each plant's system of bodies, built on its first period
+_BODIES: dict[int, BodySystem] = {}
+
+
 def advance(plant, integrator, backend, t0, q, v, tau, t1):
-    """The simulator's per-tick call: ``Plant.advance`` (one compiled call for the whole
-    period on the core), or the integrator's loop over ``Plant.acceleration``."""
-    if hasattr(plant, "advance"):
-        return plant.advance(integrator, t0, q, v, tau, t1)
-    return integrator.advance(plant.uvms.model, plant_rhs(plant, tau, backend), t0, q, v, t1)
+    """The simulator's per-tick call: the system of bodies' period step (one compiled call
+    for the whole period on the core, the integrator's loop over the right-hand side on the
+    Python reference)."""
+    stepped = _BODIES.get(id(plant))
+    if stepped is None or stepped.plant is not plant:
+        stepped = _BODIES[id(plant)] = BodySystem(plant)
+    return stepped.advance(integrator, t0, q, v, tau, t1)
 
 
 def mujoco_plant_case(system: System) -> Callable[[], object]:

@@ -38,6 +38,7 @@ from uvms_pin.physics.world.objects import plane, solid
 from uvms_pin.physics.world.world import World
 from uvms_pin.sim.integrators import RK4
 from uvms_pin.sim.plant import Plant
+from uvms_pin.sim.system import System
 
 ROOT = Path(__file__).resolve().parents[1]
 PERIOD_S, STEP_S = 2e-3, 5e-4
@@ -111,8 +112,8 @@ def _aba(uvms: up.UVMS, q: np.ndarray):
 
 def _period(plant: Plant, q: np.ndarray):
     v, tau = np.zeros(plant.uvms.nv), np.zeros(plant.uvms.nv)
-    integrator = RK4(STEP_S)
-    return lambda: plant.advance(integrator, 0.0, q, v, tau, PERIOD_S)
+    integrator, system = RK4(STEP_S), System(plant)
+    return lambda: system.advance(integrator, 0.0, q, v, tau, PERIOD_S)
 
 
 def main() -> None:

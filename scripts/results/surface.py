@@ -22,6 +22,7 @@ from uvms_pin.hydro.submerged_cylinder import Cylinder
 from uvms_pin.physics.floating import floating_equilibrium
 from uvms_pin.sim.integrators import RK4
 from uvms_pin.sim.plant import Plant
+from uvms_pin.sim.system import System
 
 RHO, G = 1025.0, 9.81
 A, B, C = 1.0, 0.6, 0.4
@@ -114,11 +115,11 @@ def _at(uvms, z=0.0, rpy=(0.0, 0.0, 0.0)) -> np.ndarray:
 
 
 def _run(uvms, q, v, duration_s, step_s, every=1, flow=None):
-    plant = Plant(uvms, flow=flow, free_surface=True)
-    plant.attach(q)
+    system = System(Plant(uvms, flow=flow, free_surface=True))
+    system.start(system.initial_state(q, v))
     period, out = step_s * every, [(0.0, q, v)]
     for k in range(round(duration_s / period)):
-        q, v = plant.advance(RK4(step_s), k * period, q, v, np.zeros(uvms.nv), (k + 1) * period)
+        q, v = system.advance(RK4(step_s), k * period, q, v, np.zeros(uvms.nv), (k + 1) * period)
         out.append(((k + 1) * period, q, v))
     return out
 

@@ -86,7 +86,7 @@ def test_a_comparison_keeps_every_log_so_all_must_fit(monkeypatch):
 
     path = ROOT / "scenarios" / "realistic_force_tracking.toml"
     one = controller_scenarios(path, ["ppc"])["ppc"]
-    log = one.settings.log_bytes(one.uvms.nq, one.uvms.nv, one.plant.n_logged_hulls)
+    log = one.settings.log_bytes(one.uvms.nq, one.uvms.nv, len(one.uvms.surface_bodies))
     _available(monkeypatch, 2 * log + 10)  # one log fits, two do not
     controller_scenarios(path, ["ppc"])
     with pytest.raises(ScenarioError, match="the logs of the 2 runs"):

@@ -23,6 +23,7 @@ pytest.importorskip("crocoddyl")
 
 from uvms_pin.control.mpc import COLD_START_ITERATIONS, MpcController, MpcForceTask
 from uvms_pin.ocp import problems
+from uvms_pin.sim.system import System
 
 CURRENT = np.array([0.3, 0.1, 0.0])
 
@@ -64,7 +65,7 @@ def _closed_loop(plant_uvms, controller, q0, duration_s=2.0, period_s=0.01):
         t = k * period_s
         tau = controller.compute(t, Measurement(t, q, v, np.zeros(6)))
         taus.append(tau.copy())
-        q, v = plant.advance(integrator, t, q, v, tau, t + period_s)
+        q, v = System(plant).advance(integrator, t, q, v, tau, t + period_s)
         positions.append(q[:3].copy())
     return np.array(positions), np.array(taus)
 

@@ -27,6 +27,7 @@ from uvms_pin.physics.compiled.extension import core_module
 from uvms_pin.physics.compiled.flow import flow_to_core
 from uvms_pin.physics.contact import CompliantPlane, LinearSpring
 from uvms_pin.physics.disturbance import SinusoidalDisturbance
+from uvms_pin.sim.compiled.integrator import integrator_to_core
 from uvms_pin.sim.integrators import RK4, Adaptive, SemiImplicitEuler
 from uvms_pin.sim.plant import Plant
 
@@ -141,12 +142,11 @@ def test_a_subclass_of_a_contact_model_has_no_counterpart(core, reference_uvms):
 
 
 def test_integrators_say_their_counterpart(core):
-    compiled = RK4(2.5e-4).to_core(Backend("core"))
+    compiled = integrator_to_core(RK4(2.5e-4), core)
     assert compiled.method == core.Method.rk4 and compiled.step_s == 2.5e-4
-    euler = SemiImplicitEuler(1e-4).to_core(Backend("core"))
+    euler = integrator_to_core(SemiImplicitEuler(1e-4), core)
     assert euler.method == core.Method.semi_implicit_euler
-    assert isinstance(Adaptive().to_core(Backend("core")), Fallback)
-    assert isinstance(RK4().to_core(Backend("python")), Fallback)
+    assert isinstance(integrator_to_core(Adaptive(), core), Fallback)
 
 
 def test_the_api_version_is_defined_in_cpp_only(core):

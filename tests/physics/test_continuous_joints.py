@@ -17,6 +17,7 @@ from uvms_pin.physics.contact import LinearSpring
 from uvms_pin.physics.disturbance import SinusoidalDisturbance
 from uvms_pin.sim.integrators import RK4, SemiImplicitEuler
 from uvms_pin.sim.plant import Plant
+from uvms_pin.sim.system import System
 
 
 @pytest.fixture(scope="module")
@@ -138,7 +139,7 @@ def test_a_passive_run_moves_as_the_revolute_model(tmp_path, reference_uvms, con
         plant.attach(q0)
         q, v = q0, v0
         for k in range(50):
-            q, v = plant.advance(RK4(2e-3), 0.01 * k, q, v, tau, 0.01 * (k + 1))
+            q, v = System(plant).advance(RK4(2e-3), 0.01 * k, q, v, tau, 0.01 * (k + 1))
         ends.append((np.r_[q[:7], uvms.arm_joints.positions(q)], v))
     assert np.max(np.abs(ends[0][0] - ends[1][0])) < 1e-10
     assert np.max(np.abs(ends[0][1] - ends[1][1])) < 1e-10

@@ -154,7 +154,7 @@ def test_advance_over_a_control_period_matches_the_reference(system, integrator)
 def test_compiled_chart_matches_pinocchio_from_python(system):
     rng = np.random.default_rng(11)
     uvms = system
-    chart = Plant(uvms).chart()
+    chart = Plant(uvms).compiled.chart
     reference = python_chart(uvms.model)
     for _ in range(5):
         q0 = random_configuration(uvms, rng)

@@ -29,6 +29,7 @@ from uvms_pin.flow import AiryWave, DepthProfileCurrent, UniformCurrent
 from uvms_pin.model.resources import shipped_models, shipped_path
 from uvms_pin.sim.integrators import RK4, SemiImplicitEuler
 from uvms_pin.sim.plant import Plant
+from uvms_pin.sim.system import System
 
 #: relative agreement of the period's Jacobians with the finite differences of the plant
 FD_REL = 1e-7
@@ -73,7 +74,7 @@ def assert_rk4_period_matches_the_plant(uvms, water, rng, backend="python"):
     )
 
     def period(qq, vv, tt):
-        return plant.advance(integrator, T0_S, qq, vv, tt, T0_S + PERIOD_S)
+        return System(plant).advance(integrator, T0_S, qq, vv, tt, T0_S + PERIOD_S)
 
     q1, v1 = period(q, v, tau)
     # the same stages as the plant's RK4, to rounding (the chart rate in closed form there)
@@ -210,7 +211,7 @@ def test_a_period_not_a_multiple_of_the_step_ends_where_the_plant_does(
         backend=backend,
     )
     plant = Plant(reference_uvms, np.zeros(3), flow=WAVES, free_surface=False, backend="python")
-    q1, v1 = plant.advance(integrator, T0_S, q, v, tau, T0_S + period_s)
+    q1, v1 = System(plant).advance(integrator, T0_S, q, v, tau, T0_S + period_s)
     np.testing.assert_allclose(got.q, q1, rtol=0, atol=1e-12)
     np.testing.assert_allclose(got.v, v1, rtol=0, atol=1e-11)
 

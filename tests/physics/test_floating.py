@@ -17,6 +17,7 @@ from uvms_pin.flow import AiryWave
 from uvms_pin.physics.floating import floating_equilibrium
 from uvms_pin.sim.integrators import RK4
 from uvms_pin.sim.plant import Plant
+from uvms_pin.sim.system import System
 
 A, B, C = 1.0, 0.6, 0.4  # box [m]
 BOX_MASS = 0.4 * RHO * A * B * C  # floats at 40 % of its height
@@ -47,7 +48,7 @@ def _run(uvms, q, v, duration_s, step_s=1e-3, flow=None, every=10):
     period = step_s * every
     out = [(0.0, q, v)]
     for k in range(round(duration_s / period)):
-        q, v = plant.advance(RK4(step_s), k * period, q, v, tau, (k + 1) * period)
+        q, v = System(plant).advance(RK4(step_s), k * period, q, v, tau, (k + 1) * period)
         out.append(((k + 1) * period, q, v))
     return out
 

@@ -20,6 +20,7 @@ from uvms_pin.physics.world.objects import plane
 from uvms_pin.physics.world.world import World
 from uvms_pin.sim.integrators import RK4
 from uvms_pin.sim.plant import Plant
+from uvms_pin.sim.system import System
 
 FLOOR_Z = -10.0
 
@@ -44,12 +45,20 @@ def _undamped(obj):
     return dataclasses.replace(obj, uvms=uvms)
 
 
-def _run(plant, q, v, tau, duration_s, step_s, period_s):
-    plant.attach(q)
-    out = [(0.0, q, v, plant.free_bodies.state_values())]
+def _run(system, q, v, tau, duration_s, step_s, period_s):
+    """(t, the robot's q, v, the objects' states) after each period of ``system``."""
+    state = system.initial_state(q, v)
+    system.start(state)
+    q_sys, v_sys = state.q, state.v
+    n = system.layout.q_slices[0].stop, system.layout.v_slices[0].stop
+    out = [(0.0, q_sys[: n[0]], v_sys[: n[1]], np.r_[q_sys[n[0] :], v_sys[n[1] :]])]
     for k in range(round(duration_s / period_s)):
-        q, v = plant.advance(RK4(step_s), k * period_s, q, v, tau, (k + 1) * period_s)
-        out.append(((k + 1) * period_s, q, v, plant.free_bodies.state_values()))
+        q_sys, v_sys = system.advance(
+            RK4(step_s), k * period_s, q_sys, v_sys, tau, (k + 1) * period_s
+        )
+        out.append(
+            ((k + 1) * period_s, q_sys[: n[0]], v_sys[: n[1]], np.r_[q_sys[n[0] :], v_sys[n[1] :]])
+        )
     return out
 
 
@@ -96,12 +105,12 @@ def test_a_free_box_dropped_on_the_seafloor_rests_on_its_net_weight(load_body):
     law = ContactLaw(stiffness_N_m=1e5, dissipation_s_m=0.5)
     floor = plane("seafloor", [0, 0, FLOOR_Z], [0, 0, 1], 0.6, 0.5)
     world = World(pusher, [floor], law, [box])
-    plant = Plant(pusher, world=world, free_surface=False)
+    system = System(Plant(pusher, world=world, free_surface=False))
     q = pusher.neutral_configuration()
     q[:3] = [20.0, 0.0, -5.0]  # far away: only the box touches the floor
-    states = _run(plant, q, np.zeros(6), np.zeros(6), 20.0, 4e-3, 2e-2)
-    q_end, v_end = states[-1][1], states[-1][2]
-    sets, fixed = plant.free_bodies.found(q_end, v_end)
+    states = _run(system, q, np.zeros(6), np.zeros(6), 20.0, 4e-3, 2e-2)
+    q_end, v_end, box_end = states[-1][1], states[-1][2], states[-1][3]
+    sets, fixed = system.moving.found(q_end, v_end, [(box_end[:7], box_end[7:])])
     assert all(len(s) == 0 for s in sets)
     forces = fixed[0]
     assert len(forces.touch) == 4  # its four bottom corners
@@ -114,9 +123,10 @@ def test_a_free_box_dropped_on_the_seafloor_rests_on_its_net_weight(load_body):
     # the UVMS did not move: nothing touched it
     assert np.allclose(q_end[:3], [20.0, 0.0, -5.0], atol=1e-9)
     # logged: the box's pair with the floor carries the same force
-    _, wrenches = plant.free_object_log(q_end, v_end)
-    assert plant.object_pair_names == ["box|seafloor"]
-    assert wrenches[:3] == pytest.approx(total, rel=1e-12)
+    logged = system.logged_signals(np.r_[q_end, box_end[:7]], np.r_[v_end, box_end[7:]])
+    assert system.record()["world"]["object_pairs"] == ["box|seafloor"]
+    np.testing.assert_array_equal(logged["free_objects"], box_end)
+    assert logged["free_object_contact"][:3] == pytest.approx(total, rel=1e-12)
 
 
 def _push_setup(load_body, force_N):
@@ -128,20 +138,20 @@ def _push_setup(load_body, force_N):
         )
     )  # fmt: skip
     world = World(pusher, [], ContactLaw(stiffness_N_m=2e4, dissipation_s_m=2.0), [ball])
-    plant = Plant(pusher, world=world, free_surface=False)
+    system = System(Plant(pusher, world=world, free_surface=False))
     q = pusher.neutral_configuration()
     q[:3] = [-0.3, 0.0, -5.0]  # touching the ball's left side
     tau = np.zeros(6)
     tau[0] = force_N
-    return pusher, ball, plant, q, tau
+    return pusher, ball, system, q, tau
 
 
 def test_a_neutral_free_sphere_pushed_by_a_constant_force_accelerates_at_f_over_m_plus_ma(
     load_body,
 ):
     force = 20.0
-    _, ball, plant, q, tau = _push_setup(load_body, force)
-    states = _run(plant, q, np.zeros(6), tau, 3.0, 1e-3, 1e-2)
+    _, ball, system, q, tau = _push_setup(load_body, force)
+    states = _run(system, q, np.zeros(6), tau, 3.0, 1e-3, 1e-2)
     m_ball = ball.mass_kg
     m_added = 0.5 * RHO * 4.0 / 3.0 * math.pi * 0.2**3  # a sphere's: half the displaced water
     m_pusher = 4.0
@@ -153,10 +163,8 @@ def test_a_neutral_free_sphere_pushed_by_a_constant_force_accelerates_at_f_over_
     # and the ball alone obeys f = (m + m_A) a with the contact force f on it: at a state
     t, q_t, v_t, s = states[150]
     states_now = [(s[:7].copy(), s[7:].copy())]
-    accel = plant.free_bodies.acceleration(
-        t, np.concatenate([q_t, s[:7]]), np.concatenate([v_t, s[7:]]), tau
-    )
-    sets, _ = plant.free_bodies.found(q_t, v_t, states_now)
+    accel = system.acceleration(t, np.concatenate([q_t, s[:7]]), np.concatenate([v_t, s[7:]]), tau)
+    sets, _ = system.moving.found(q_t, v_t, states_now)
     f_on_ball = -sets[0].force_world_N.sum(axis=0)
     assert np.linalg.norm(f_on_ball) > 1.0
     rotation = pin.Quaternion(s[3:7]).matrix()
@@ -168,11 +176,11 @@ def test_a_neutral_free_sphere_pushed_by_a_constant_force_accelerates_at_f_over_
 def test_momentum_is_exchanged_equal_and_opposite_and_energy_never_gained(load_body):
     """The pusher hits the neutral ball off-centre (friction acts too), nothing else
     touches, nothing damps: the total linear momentum stays, the kinetic energy never grows."""
-    pusher, ball, plant, q, _ = _push_setup(load_body, 0.0)
+    pusher, ball, system, q, _ = _push_setup(load_body, 0.0)
     q[:3] = [-0.6, 0.08, -5.0]  # 0.3 m apart, 8 cm off the line of centres
     v = np.zeros(6)
     v[0] = 0.5
-    states = _run(plant, q, v, np.zeros(6), 1.5, 5e-4, 1e-2)
+    states = _run(system, q, v, np.zeros(6), 1.5, 5e-4, 1e-2)
     momentum, energy = [], []
     for _, q_t, v_t, s in states:
         p = _momentum_world(pusher, q_t, v_t) + _momentum_world(ball.uvms, s[:7], s[7:])
@@ -187,7 +195,7 @@ def test_momentum_is_exchanged_equal_and_opposite_and_energy_never_gained(load_b
     assert ball_speed > 0.02  # it was hit (4 kg at 0.5 m/s on 51 kg with its added mass)
     assert abs(states[-1][3][8]) > 1e-3  # and off the line: a sideways part
     # never gained: apart again at the end, the energy left is at most the initial
-    bodies = plant.free_bodies
+    bodies = system.moving
     touching = [
         len(bodies.found(q_t, v_t, [(s[:7], s[7:])])[0][0]) > 0 for _, q_t, v_t, s in states
     ]
@@ -197,7 +205,7 @@ def test_momentum_is_exchanged_equal_and_opposite_and_energy_never_gained(load_b
 
 
 def test_free_objects_need_a_sampled_loop(load_body):
-    pusher, _, plant, q, _ = _push_setup(load_body, 0.0)
+    pusher, _, system, q, _ = _push_setup(load_body, 0.0)
     from uvms_pin.control.base import ZeroController
     from uvms_pin.sim.closed_loop import simulate_closed_loop
     from uvms_pin.sim.sensors import SensorConfig, SensorSuite
@@ -206,7 +214,7 @@ def test_free_objects_need_a_sampled_loop(load_body):
     settings = SimulationSettings(0.1, RK4(step_s=1e-3), log_period_s=0.01)
     sensors = SensorSuite(pusher.model, SensorConfig(), 0.1, 0)
     with pytest.raises(up.ParameterError, match="sampled"):
-        simulate_closed_loop(plant, ZeroController(6), sensors, q, np.zeros(6), settings)
+        simulate_closed_loop(system.plant, ZeroController(6), sensors, q, np.zeros(6), settings)
 
 
 def test_both_backends_integrate_free_objects_alike(load_body):
@@ -221,12 +229,12 @@ def test_both_backends_integrate_free_objects_alike(load_body):
         )  # fmt: skip
         floor = plane("seafloor", [0, 0, -5.25], [0, 0, 1], 0.6, 0.5)
         world = World(pusher, [floor], ContactLaw(), [ball])
-        plant = Plant(pusher, world=world, free_surface=False, backend=backend)
+        system = System(Plant(pusher, world=world, free_surface=False, backend=backend))
         q = pusher.neutral_configuration()
         q[:3] = [-0.31, 0.02, -5.0]
         v = np.zeros(6)
         v[0] = 0.3
-        states = _run(plant, q, v, np.zeros(6), 0.3, 1e-3, 1e-2)
+        states = _run(system, q, v, np.zeros(6), 0.3, 1e-3, 1e-2)
         finals.append(np.concatenate([states[-1][1], states[-1][2], states[-1][3]]))
     assert np.allclose(finals[0], finals[1], rtol=1e-9, atol=1e-11)
     assert np.linalg.norm(finals[0][13 + 7 : 13 + 10]) > 1e-3  # the ball moved

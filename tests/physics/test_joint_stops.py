@@ -17,6 +17,7 @@ from uvms_pin.sim.integrators import RK4
 from uvms_pin.sim.plant import Plant
 from uvms_pin.sim.sensors import SensorConfig, SensorSuite
 from uvms_pin.sim.settings import SimulationSettings
+from uvms_pin.sim.system import System
 
 
 def _weightless(uvms):
@@ -54,7 +55,7 @@ def test_a_joint_at_its_effort_limit_stays_within_the_stop_deflection(reference_
     tau[6 + joint] = effort  # pushing into the stop at the limit of the drive
     deflection = []
     for k in range(300):
-        q, v = plant.advance(RK4(1e-3), k * 0.01, q, v, tau, (k + 1) * 0.01)
+        q, v = System(plant).advance(RK4(1e-3), k * 0.01, q, v, tau, (k + 1) * 0.01)
         deflection.append(q[7 + joint] - stops.upper_rad[joint])
     static = effort / stops.stiffness_Nm_rad
     # a step load from rest against a spring never goes past twice its static deflection
@@ -73,7 +74,7 @@ def test_the_core_stops_equal_the_reference(reference_uvms):
     stops = JointStops.of_model(uvms.model, 300.0, 3.0)
     core = Plant(uvms, joint_stops=stops, free_surface=False, backend="core")
     python = Plant(uvms, joint_stops=stops, free_surface=False, backend="python")
-    assert core._core() is not None  # the compiled plant carries the stops
+    assert core.compiled is not None  # the compiled plant carries the stops
     rng = np.random.default_rng(5)
     for _ in range(6):
         q = uvms.neutral_configuration()
@@ -98,7 +99,7 @@ def test_a_continuous_joint_has_no_stop_and_the_others_keep_theirs(tmp_path):
     assert stops.q_index.tolist() == [9, 10, 11] and stops.v_index.tolist() == [7, 8, 9]
     core = Plant(uvms, joint_stops=stops, free_surface=False, backend="core")
     python = Plant(uvms, joint_stops=stops, free_surface=False, backend="python")
-    assert core._core() is not None
+    assert core.compiled is not None
     q = uvms.neutral_configuration()
     q[stops.q_index] = stops.upper_rad + 0.1  # every stopped joint 0.1 rad past its limit
     v, tau = np.zeros(uvms.nv), np.zeros(uvms.nv)

@@ -13,6 +13,7 @@ from uvms_pin.physics.world.contact_law import ContactLaw
 from uvms_pin.physics.world.world import World
 from uvms_pin.sim.integrators import RK4
 from uvms_pin.sim.plant import Plant
+from uvms_pin.sim.system import System
 
 _LINK = """
   <link name="{name}">
@@ -79,17 +80,18 @@ def test_an_arm_folded_into_the_hull_is_pushed_out_only_on_request(tmp_path, sel
     q[8] = 0.5  # the elbow folds the forearm 5 cm deep into the hull's top
     depth0 = _overlap_m(uvms, world, q)
     assert depth0 > 0.03
-    plant.attach(q)
+    system = System(plant)
     v, tau = np.zeros(uvms.nv), np.zeros(uvms.nv)
+    system.start(system.initial_state(q, v))
     for k in range(200):
-        q, v = plant.advance(RK4(1e-3), k * 0.01, q, v, tau, (k + 1) * 0.01)
+        q, v = system.advance(RK4(1e-3), k * 0.01, q, v, tau, (k + 1) * 0.01)
     if self_collision:
-        names = plant.contact_pair_names
+        names = system.contact_pair_names
         assert names == [
             "forearm/collision[0]|hull/collision[0]"
         ]  # the shoulder (jointed to the hull) is excepted
         assert _overlap_m(uvms, world, q) < 0.02 * depth0  # out (to the last contact)
         assert q[8] < 0.5 - 0.05
     else:
-        assert plant.free_bodies is None
+        assert system.moving is None
         assert _overlap_m(uvms, world, q) == pytest.approx(depth0, rel=1e-9)  # through

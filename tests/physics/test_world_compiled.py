@@ -28,6 +28,7 @@ from uvms_pin.physics.world.objects import plane, solid
 from uvms_pin.physics.world.world import FrictionMemory, World
 from uvms_pin.sim.integrators import RK4
 from uvms_pin.sim.plant import Plant
+from uvms_pin.sim.system import System
 
 ROOT = Path(__file__).resolve().parents[2]
 ROCK = ROOT / "scenarios" / "meshes" / "rock.obj"
@@ -113,7 +114,7 @@ def _memory(world: World, q, v, rng: np.random.Generator) -> FrictionMemory:
 def _pair(uvms, world: World) -> tuple[Plant, Plant]:
     core = Plant(uvms, world=world, free_surface=False)
     python = Plant(uvms, world=world, free_surface=False, backend="python")
-    assert core._core() is not None
+    assert core.compiled is not None
     return core, python
 
 
@@ -126,7 +127,7 @@ def _check_forces(plant: Plant, world: World, q, v, memory: FrictionMemory) -> i
     data = world.uvms.model.createData()
     pin.forwardKinematics(world.uvms.model, data, q, v)
     ref = world.forces(data, memory)
-    got = plant._core().world_forces(q, v, memory)
+    got = plant.compiled.world_forces(q, v, memory)
     found = ref.touch
     assert list(got["piece"]) == found.piece.tolist()
     assert list(got["obj"]) == found.obj.tolist()
@@ -215,7 +216,7 @@ def _runs(uvms, world: World, q0, v0, periods: int, period_s: float = 5e-3):
         q, v = q0.copy(), v0.copy()
         states = []
         for k in range(periods):
-            q, v = plant.advance(
+            q, v = System(plant).advance(
                 RK4(1e-3), k * period_s, q, v, np.zeros(uvms.nv), (k + 1) * period_s
             )
             states.append(np.concatenate([q, v]))
@@ -281,7 +282,7 @@ def test_runs_that_stick_slide_and_rebound_are_the_reference(
 def test_the_compiled_calls_refuse_bad_input(load_body):
     uvms = _body(load_body, *BODIES["box"])
     core, _ = _pair(uvms, World(uvms, _objects("box")))
-    compiled = core._core()
+    compiled = core.compiled
     q, v = uvms.neutral_configuration(), np.zeros(uvms.nv)
     with pytest.raises(ParameterError, match="q"):
         compiled.world_forces(q[:-1], v, FrictionMemory())
@@ -325,7 +326,7 @@ def test_a_shape_on_another_moving_body_is_pushed_back(reference_uvms, slide_m_s
     c1 = data.oMi[link].translation.copy()
     n = np.array([0.3, -0.2, 0.9]) / np.linalg.norm([0.3, -0.2, 0.9])
     c2 = c1 - (r1 + r2 - 0.01) * n  # 1 cm deep, n out of the vehicle's sphere
-    compiled = Plant(uvms, free_surface=False)._core()
+    compiled = Plant(uvms, free_surface=False).compiled
     contact = core.WorldContact()
     contact.pieces = [_sphere_on(core, link, pin.SE3.Identity(), r1)]
     on_vehicle = data.oMi[vehicle].actInv(pin.SE3(np.eye(3), c2))
@@ -358,6 +359,6 @@ def test_a_shape_on_another_moving_body_is_pushed_back(reference_uvms, slide_m_s
     assert _close(got["force_world_N"][0], force, np.abs(force).max())
     # on the link +f at x, on the vehicle -f at x: J1^T f - J2^T f in the dynamics
     with_world = compiled.acceleration_in_world(0.0, q, v, tau, FrictionMemory())
-    bare = Plant(uvms, free_surface=False)._core()  # without the pair
+    bare = Plant(uvms, free_surface=False).compiled  # without the pair
     expected = bare.acceleration(0.0, q, v, tau + (j1 - j2).T @ force, None)
     assert np.allclose(with_world, expected, rtol=TOL, atol=1e-10 * np.abs(expected).max())

@@ -18,6 +18,7 @@ from uvms_pin.physics.world.objects import plane, solid
 from uvms_pin.physics.world.world import World
 from uvms_pin.sim.integrators import RK4
 from uvms_pin.sim.plant import Plant
+from uvms_pin.sim.system import System
 
 A, B, C = 1.0, 0.5, 0.5  # box [m]
 DENSITY = 3.0  # the box is three times as dense as the water
@@ -48,7 +49,7 @@ def _run(plant: Plant, q, v, duration_s, step_s=1e-3, period_s=1e-2):
     tau = np.zeros(plant.uvms.nv)
     out = [(0.0, q, v)]
     for k in range(round(duration_s / period_s)):
-        q, v = plant.advance(RK4(step_s), k * period_s, q, v, tau, (k + 1) * period_s)
+        q, v = System(plant).advance(RK4(step_s), k * period_s, q, v, tau, (k + 1) * period_s)
         out.append(((k + 1) * period_s, q, v))
     return out
 

@@ -11,6 +11,7 @@ import pytest
 from uvms_pin.errors import ScenarioError
 from uvms_pin.scenario.load import load_scenario, scenario_from_raw
 from uvms_pin.scenario.toml import read_toml
+from uvms_pin.sim.system import System
 
 SCENARIOS = Path(__file__).resolve().parents[2] / "scenarios"
 SEABED = SCENARIOS / "seabed_landing.toml"
@@ -109,17 +110,18 @@ def test_a_free_object_scenario_builds_its_floating_body():
     assert body.params.volume_m3 == pytest.approx(0.25 * 0.5 * 0.25)  # derived: its shape
     assert np.allclose(box.q0[:3], [0.80, -0.11, -9.87529])
     assert [o.name for o in world.objects] == ["seabed"]
-    record = scenario.plant.record()["world"]
+    system = System(scenario.plant)
+    record = system.record()["world"]
     assert record["free_objects"][0]["free"] is True
     assert "Python" in record["integration"]
     assert record["object_pairs"] == ["box|seabed"]
-    assert scenario.plant.contact_pair_names[-1].endswith("|box")
+    assert system.contact_pair_names[-1].endswith("|box")
 
 
 def test_self_collision_is_a_contact_key():
     scenario = load_scenario(SEABED, {"world.contact.self_collision": True})
     assert scenario.plant.world.self_collision
-    names = scenario.plant.contact_pair_names
+    names = System(scenario.plant).contact_pair_names
     # the arm's links beyond the first against the vehicle's shapes
     assert any(n.startswith("alpha_wrist_link") and "|base_link" in n for n in names)
     assert not any(n.startswith("alpha_shoulder_link") for n in names if "|base_link" in n)

@@ -12,7 +12,7 @@ from uvms_pin.errors import ParameterError
 from uvms_pin.physics.compiled.extension import core_module
 from uvms_pin.scenario.load import load_scenario
 from uvms_pin.sim.actuation import Unlimited
-from uvms_pin.sim.compiled_actuation import actuation_to_core
+from uvms_pin.sim.compiled.actuation import actuation_to_core
 
 
 def _commands(actuation, nv: int, seed: int) -> np.ndarray:

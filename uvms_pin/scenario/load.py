@@ -47,6 +47,7 @@ from uvms_pin.scenario.world import build_disturbance, build_environment
 from uvms_pin.sim.plant import Plant
 from uvms_pin.sim.run import Scenario, shortened
 from uvms_pin.sim.settings import SimulationSettings, check_log_fits
+from uvms_pin.sim.system import System
 
 
 @dataclass(frozen=True)
@@ -149,7 +150,7 @@ def _build(raw: dict[str, Any], path: Path, top: Table) -> Scenario:
         settings = SimulationSettings(
             head.duration_s, integrator, log_period, control_period, head.seed
         )
-        check_log_fits(settings, uvms.nq, uvms.nv, plant.n_logged_columns)
+        check_log_fits(settings, uvms.nq, uvms.nv, System(plant).n_logged_columns)
     except ParameterError as exc:
         raise ScenarioError(f"{top.source}: {exc}") from exc
     return Scenario(

@@ -77,6 +77,13 @@ class ThrustersAndJointLimits(Actuation):
             included. Default: all six.
         drives: the thrusters' curves and dynamics (default: linear curves to the limits,
             no lag).
+
+    Attributes (read-only, what the compiled actuation mirrors): ``allocation`` B (6 x m);
+    ``allocation_pinv`` (m x 6), B_s^+ on the allocated components, zero columns elsewhere;
+    ``lower_N``, ``upper_N`` (m,) the thrust bounds; ``full_forward_N``, ``full_reverse_N``
+    (m,) the thrust of a full command (inf for a zero limit); ``residual`` I - B_s B_s^+ or
+    None when the thrusters span the allocated components; ``drives_ideal``: the default
+    drives (thrust = its allocation at once).
     """
 
     def __init__(
@@ -101,28 +108,28 @@ class ThrustersAndJointLimits(Actuation):
         self.allocation = np.column_stack([t.wrench_column for t in self.thrusters])  # B, 6 x m
         self.allocated_components = components
         # f = B_s^+ tau[s]: written as a 6-column map that ignores the other components
-        self._allocation_pinv = np.zeros((len(self.thrusters), 6))
-        self._allocation_pinv[:, components] = np.linalg.pinv(self.allocation[components])
+        self.allocation_pinv = np.zeros((len(self.thrusters), 6))
+        self.allocation_pinv[:, components] = np.linalg.pinv(self.allocation[components])
         # what of an allocated command no thrust can produce: (I - B_s B_s^+) tau_s, tracked
         # only when the thrusters do not span the allocated components
         chosen = self.allocation[components]
         residual = np.eye(components.size) - chosen @ np.linalg.pinv(chosen)
-        self._residual = residual if np.max(np.abs(residual)) > 1e-9 else None
-        self._dropped_max = np.zeros(components.size)
-        self._lower = -np.array([t.max_reverse_N for t in self.thrusters])
-        self._upper = np.array([t.max_forward_N for t in self.thrusters])
+        self.residual = residual if np.max(np.abs(residual)) > 1e-9 else None
+        self.dropped_max = np.zeros(components.size)
+        self.lower_N = -np.array([t.max_reverse_N for t in self.thrusters])
+        self.upper_N = np.array([t.max_forward_N for t in self.thrusters])
         # the default drives give the allocated thrust at once: computed directly (fast path)
-        self._ideal = drives is None
+        self.drives_ideal = drives is None
         if drives is None:
             drives = ideal_drives(self.thrusters)
         if len(drives.curves) != len(self.thrusters):
             raise ParameterError(f"{len(drives.curves)} drives for {len(self.thrusters)} thrusters")
         self.drives = drives
-        self._command = np.zeros(len(self.thrusters))
-        self._thrust = np.zeros(len(self.thrusters))
+        self.thruster_command = np.zeros(len(self.thrusters))
+        self.thrust_N = np.zeros(len(self.thrusters))
         # the linear curve's command u = f / limit (a zero limit: u = 0, f = 0)
-        self._full_forward = np.where(self._upper > 0.0, self._upper, np.inf)
-        self._full_reverse = np.where(self._lower < 0.0, -self._lower, np.inf)
+        self.full_forward_N = np.where(self.upper_N > 0.0, self.upper_N, np.inf)
+        self.full_reverse_N = np.where(self.lower_N < 0.0, -self.lower_N, np.inf)
         if joint_effort_limits_Nm is not None:
             limits = np.asarray(joint_effort_limits_Nm, dtype=float)
             if np.any(~(limits > 0.0)) or not np.all(np.isfinite(limits)):
@@ -136,25 +143,25 @@ class ThrustersAndJointLimits(Actuation):
         """Per-thruster thrust f (m,) [N] after allocation and saturation."""
         # minimum(maximum()) is np.clip without its per-call dispatch cost
         return np.minimum(
-            np.maximum(self._allocation_pinv @ tau_commanded[:6], self._lower), self._upper
+            np.maximum(self.allocation_pinv @ tau_commanded[:6], self.lower_N), self.upper_N
         )
 
     def saturated(self, tau_commanded: np.ndarray) -> bool:
         """True when a thruster or a joint cannot give what the command asks."""
-        raw = self._allocation_pinv @ tau_commanded[:6]
-        if np.any(raw < self._lower) or np.any(raw > self._upper):
+        raw = self.allocation_pinv @ tau_commanded[:6]
+        if np.any(raw < self.lower_N) or np.any(raw > self.upper_N):
             return True
         limits = self.joint_effort_limits_Nm
         return limits is not None and bool(np.any(np.abs(tau_commanded[6:]) > limits))
 
     def start(self, period_s: float | None = None) -> None:
-        self._dropped_max[:] = 0.0
+        self.dropped_max[:] = 0.0
         self.drives.start(period_s)
-        self._command = np.zeros(len(self.thrusters))
-        self._thrust = np.zeros(len(self.thrusters))
+        self.thruster_command = np.zeros(len(self.thrusters))
+        self.thrust_N = np.zeros(len(self.thrusters))
 
     def signals(self) -> dict[str, np.ndarray]:
-        return {"thruster_command": self._command.copy(), "thrust": self._thrust.copy()}
+        return {"thruster_command": self.thruster_command.copy(), "thrust": self.thrust_N.copy()}
 
     def signal_columns(self) -> dict[str, list[tuple[str, str]]]:
         names = [t.name for t in self.thrusters]
@@ -168,13 +175,13 @@ class ThrustersAndJointLimits(Actuation):
         many as the thrusters' rank lacks, those weighing most in what no thrust reaches."""
         chosen = self.allocation[self.allocated_components]
         missing = self.allocated_components.size - np.linalg.matrix_rank(chosen, tol=1e-9)
-        weight = np.abs(np.diag(self._residual))  # each axis's share no thrust reaches
+        weight = np.abs(np.diag(self.residual))  # each axis's share no thrust reaches
         return sorted(int(k) for k in np.argsort(-weight, kind="stable")[:missing])
 
     def dropped(self) -> str | None:
         """The allocated components no thrust can produce and the largest part of a command
         dropped on each (the allocation is least squares: it leaves them out silently)."""
-        if self._residual is None or not np.any(self._dropped_max > 1e-6):
+        if self.residual is None or not np.any(self.dropped_max > 1e-6):
             return None
         names = ("surge force fx", "sway force fy", "heave force fz", "roll moment mx",
                  "pitch moment my", "yaw moment mz")  # fmt: skip
@@ -182,10 +189,10 @@ class ThrustersAndJointLimits(Actuation):
         lost = self._unproducible()
         components = self.allocated_components
         parts = [
-            f"{self._dropped_max[k]:.3g} {units[components[k]]} of {names[components[k]]}"
+            f"{self.dropped_max[k]:.3g} {units[components[k]]} of {names[components[k]]}"
             for k in lost
-            if self._dropped_max[k] > 1e-6
-        ] or [f"{np.max(self._dropped_max):.3g} N or N m"]  # coupled: no one axis stands out
+            if self.dropped_max[k] > 1e-6
+        ] or [f"{np.max(self.dropped_max):.3g} N or N m"]  # coupled: no one axis stands out
         kept = [int(c) for k, c in enumerate(components) if k not in lost]
         return (
             "the thrusters cannot produce every wrench component the controller commands: "
@@ -194,19 +201,19 @@ class ThrustersAndJointLimits(Actuation):
         )
 
     def apply(self, tau_commanded):
-        if self._residual is not None:  # what no thrust can produce: the largest so far
-            lost = np.abs(self._residual @ tau_commanded[self.allocated_components])
-            np.maximum(self._dropped_max, lost, out=self._dropped_max)
+        if self.residual is not None:  # what no thrust can produce: the largest so far
+            lost = np.abs(self.residual @ tau_commanded[self.allocated_components])
+            np.maximum(self.dropped_max, lost, out=self.dropped_max)
         out = np.empty_like(tau_commanded)
-        if self._ideal:
-            self._thrust = self.thrusts(tau_commanded)
-            self._command = self._thrust / np.where(
-                self._thrust >= 0.0, self._full_forward, self._full_reverse
+        if self.drives_ideal:
+            self.thrust_N = self.thrusts(tau_commanded)
+            self.thruster_command = self.thrust_N / np.where(
+                self.thrust_N >= 0.0, self.full_forward_N, self.full_reverse_N
             )
         else:
-            self._command = self.drives.commands(self.thrusts(tau_commanded))
-            self._thrust = self.drives.advance(self._command)
-        out[:6] = self.allocation @ self._thrust
+            self.thruster_command = self.drives.commands(self.thrusts(tau_commanded))
+            self.thrust_N = self.drives.advance(self.thruster_command)
+        out[:6] = self.allocation @ self.thrust_N
         arm = tau_commanded[6:]
         if self.joint_effort_limits_Nm is None:
             out[6:] = arm

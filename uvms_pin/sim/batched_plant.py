@@ -13,28 +13,28 @@ episode are drawn at its reset from the episode seed with exactly the streams of
 `uvms_pin.sim.sensors.SensorSuite` (one per channel), so an environment of the batch gives
 the numbers of a single `ClosedLoop` run with the same seed, whatever T.
 
-What the batch does not simulate is refused with a ParameterError naming it: a world
-(fixed objects), a flow (waves, sea states; a uniform current is supported), thruster
-drives with lag, navigation sensors or an estimator, ``stop_at_surface``, the Python backend, or a
-plant part without a compiled counterpart.
+What the batch does not simulate is refused with a ParameterError naming it, the reason
+`uvms_pin.sim.pipeline` gives for the batch: a world, a flow (waves, sea states; a uniform
+current is supported), thruster drives with lag, navigation sensors or an estimator,
+``stop_at_surface``, the Python backend, or any part without a compiled counterpart.
 """
 
 from __future__ import annotations
 
 import math
-from types import ModuleType
 
 import numpy as np
 import pinocchio as pin
 
 from uvms_pin.errors import ParameterError
-from uvms_pin.physics.compiled.backend import Fallback, backend_named
 from uvms_pin.physics.compiled.contact import contact_to_core
-from uvms_pin.sim.actuation import ThrustersAndJointLimits, Unlimited
-from uvms_pin.sim.compiled_actuation import actuation_to_core
+from uvms_pin.physics.compiled.extension import core_module
+from uvms_pin.sim.compiled.batch import batch_to_core
+from uvms_pin.sim.pipeline import Pipeline, RunParts, why_not_compiled
 from uvms_pin.sim.plant import Plant, checked_start
 from uvms_pin.sim.sensors import SensorConfig
 from uvms_pin.sim.settings import SimulationSettings
+from uvms_pin.sim.system import System
 
 #: BatchStatus of the core: what became of an environment in the last step
 RUNNING, DIVERGED = 0, 1
@@ -45,23 +45,6 @@ def check_count(name: str, value: object) -> int:
     if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or value <= 0:
         raise ParameterError(f"{name} must be an integer >= 1, got {value!r}")
     return int(value)
-
-
-def _unsupported(plant: Plant, sensors: SensorConfig) -> str | None:
-    """What of the plant or sensors the batch cannot simulate, or None."""
-    actuation = plant.actuation
-    checks = (
-        (plant.world is not None, "a world (fixed objects)"),
-        (plant.flow is not None, "a flow (waves, sea states, varying currents)"),
-        (plant.stop_at_surface, "stop_at_surface"),
-        (sensors.navigation.fitted, "navigation sensors"),
-        (sensors.estimator is not None, "a navigation estimator"),
-        (not isinstance(actuation, (Unlimited, ThrustersAndJointLimits)),
-         f"the actuation {type(actuation).__name__}"),
-        (isinstance(actuation, ThrustersAndJointLimits) and not actuation._ideal,
-         "thruster drives with lag or rate limits"),
-    )  # fmt: skip
-    return next((what for bad, what in checks if bad), None)
 
 
 def _noise_specs(sensors: SensorConfig) -> tuple:
@@ -96,43 +79,23 @@ class BatchedPlant:
         num_threads = check_count("num_threads", num_threads)
         if settings.control_period_s is None:
             raise ParameterError("the batched plant needs a sampled loop (control.period_s)")
-        what = _unsupported(plant, sensors)
-        if what is not None:
-            raise ParameterError(f"the batched plant does not simulate {what}")
-        backend = backend_named(plant.backend)
-        if not backend.compiled:
-            raise ParameterError("the batched plant runs on the compiled core (backend 'core')")
+        self.system = System(plant)
+        # the prototype needs a placed contact: anchored here at q0, replaced at each reset
+        nv = plant.uvms.nv
+        self.system.start(self.system.initial_state(pin.neutral(plant.uvms.model), np.zeros(nv)))
+        reason = why_not_compiled(RunParts(self.system, settings, sensors), Pipeline.BATCH)
+        if reason is not None:
+            raise ParameterError(f"the batched plant does not simulate {reason}")
         self.plant, self.settings, self.sensors = plant, settings, sensors
         self.period_s = float(settings.control_period_s)
         self._rows = math.ceil(settings.duration_s / sensors.sample_period_s) + 2
         self._specs = _noise_specs(sensors)
-        nv = plant.uvms.nv
         self._widths = (3, 3, 3, 3, nv - 6, nv)
-        self._core = backend.counterpart(
-            lambda core: self._build(core, settings, num_envs, num_threads)
-        )
-        if isinstance(self._core, Fallback):
-            raise ParameterError(f"the batched plant needs the compiled core: {self._core.reason}")
-        self._stepping = np.ones(num_envs, dtype=bool)
-
-    def _build(self, core: ModuleType, settings, num_envs: int, num_threads: int):
-        plant = self.plant
-        # the prototype needs a placed contact: anchored here at q0, replaced at each reset
-        plant.attach(pin.neutral(plant.uvms.model))
-        prototype = plant._core()
-        if prototype is None:
-            return Fallback("a plant part with no compiled counterpart")
-        integrator = settings.integrator.to_core(backend_named(plant.backend))
-        if isinstance(integrator, Fallback):
-            return integrator
-        noise = core.BatchNoise()
-        noise.sample_period_s = float(self.sensors.sample_period_s)
-        noise.rows = self._rows
-        noise.silent = [int(spec.bound == 0.0) for spec in self._specs]
-        return core.BatchPlant(
-            prototype, integrator, self.period_s, actuation_to_core(plant.actuation, core, plant.uvms.nv),
-            noise, num_envs, num_threads,
+        self._core = batch_to_core(
+            plant, settings.integrator, self.period_s, sensors.sample_period_s, self._rows,
+            [spec.bound == 0.0 for spec in self._specs], num_envs, num_threads, core_module(),
         )  # fmt: skip
+        self._stepping = np.ones(num_envs, dtype=bool)
 
     # ---- state ------------------------------------------------------------------------
     def __getattr__(self, name: str):
@@ -166,13 +129,9 @@ class BatchedPlant:
         contact = self.plant.contact
         if contact is not None:
             contact.attach(self.plant.ee_state(q0, np.zeros(model.nv))[0])
-        core_contact = contact_to_core(contact, self._core_module())
-        self._core.reset(int(i), q0, v0, core_contact, self.noise_tables(seed))
-
-    def _core_module(self) -> ModuleType:
-        from uvms_pin.physics.compiled.extension import core_module
-
-        return core_module()
+        self._core.reset(
+            int(i), q0, v0, contact_to_core(contact, core_module()), self.noise_tables(seed)
+        )
 
     def step(self, tau_commanded: np.ndarray, stepping: np.ndarray | None = None) -> None:
         """Advance the environments with ``stepping`` (all by default) one control period

@@ -41,10 +41,11 @@ from uvms_pin.sim.compiled_loop import CompiledLoop, LoopPath
 from uvms_pin.sim.divergence import NUMERICAL_FAILURES, diverged, divergence_context
 from uvms_pin.sim.integrators import Adaptive
 from uvms_pin.sim.log import RolloutLog
-from uvms_pin.sim.plant import Plant, checked_start
+from uvms_pin.sim.plant import Plant
 from uvms_pin.sim.sample import Observer, Sample
 from uvms_pin.sim.sensors import SensorSuite
 from uvms_pin.sim.settings import SimulationSettings
+from uvms_pin.sim.system import System, SystemState
 
 # The funnel event fires when the margin min(1 - |xi|) reaches -this: just outside, so
 # that the controller, evaluated at the located event state, reports the violation.
@@ -56,11 +57,13 @@ class ClosedLoop:
     """A plant, its sensors and (optionally) a controller, stepped and observed.
 
     Args:
-        plant: the simulated world. settings: periods, integrator, duration.
+        plant: the robot in its world (the system of bodies, `system`, is built from it).
+        settings: periods, integrator, duration.
         controller: the law run by `run`; None when the caller gives tau (`step`).
         observers: called with every logged sample (`Observer`).
 
-    State: ``time_s`` [s], ``q`` (nq,), ``v`` (nv,), read-only arrays.
+    State: ``time_s`` [s]; ``state``, the system's (`SystemState`: every body); ``q``
+    (nq,), ``v`` (nv,), the robot's part of it; read-only arrays.
     """
 
     def __init__(
@@ -74,12 +77,13 @@ class ClosedLoop:
     ):
         self.compiled = compiled  # the sampled loop may run in the core (`compiled_loop`)
         self.plant = plant
+        self.system = System(plant)
         self.settings = settings
         self.controller = controller
         self.observers = list(observers)
         self.time_s = 0.0
-        self.q = read_only(np.zeros(plant.uvms.nq))
-        self.v = read_only(np.zeros(plant.uvms.nv))
+        layout = self.system.layout
+        self.state = SystemState(read_only(np.zeros(layout.nq)), read_only(np.zeros(layout.nv)))
         self.sensors: SensorSuite | None = None
         self._last_tau_applied: np.ndarray | None = None  # continuous loop: the last stage's
 
@@ -91,22 +95,41 @@ class ClosedLoop:
         Raises:
             ParameterError: a state of the wrong size or with a non-finite value.
         """
-        model = self.plant.uvms.model
-        q0, v0 = checked_start(model, q0, v0)
-        bodies = self.plant.free_bodies
-        if bodies is not None and bodies.objects and self.settings.control_period_s is None:
+        state = self.system.initial_state(q0, v0)
+        if self.system.objects and self.settings.control_period_s is None:
             raise ParameterError(
                 "free objects are integrated with the UVMS period by period: they need a "
                 "sampled controller ([control] period_s), not a continuous one"
             )
-        self.time_s, self.q, self.v = 0.0, read_only(q0), read_only(v0)
+        self.time_s, self.state = 0.0, SystemState(read_only(state.q), read_only(state.v))
         self.sensors = sensors
         self.plant.actuation.start(self.settings.control_period_s)
         sensors.start_navigation(self.settings.control_period_s)
         if self.controller is not None:
             with self._controller_code("reset"):
                 self.controller.reset()
-        self.plant.attach(self.q)
+        self.system.start(self.state)
+
+    # ---- the robot's part of the state ------------------------------------------------------
+    @property
+    def q(self) -> np.ndarray:
+        return self.state.q[self.system.layout.q_slices[0]]
+
+    @q.setter
+    def q(self, value: np.ndarray) -> None:
+        q = np.array(self.state.q)
+        q[self.system.layout.q_slices[0]] = value
+        self.state = SystemState(read_only(q), self.state.v)
+
+    @property
+    def v(self) -> np.ndarray:
+        return self.state.v[self.system.layout.v_slices[0]]
+
+    @v.setter
+    def v(self, value: np.ndarray) -> None:
+        v = np.array(self.state.v)
+        v[self.system.layout.v_slices[0]] = value
+        self.state = SystemState(self.state.q, read_only(v))
 
     def measure(self) -> tuple[Measurement, np.ndarray]:
         """(what the sensors give now, the true contact wrench (6,) [N; N m] world axes).
@@ -150,14 +173,16 @@ class ClosedLoop:
         t0, period = self.time_s, self.settings.control_period_s
         t1 = t0 + period
         try:
-            q, v = self.plant.advance(self.settings.integrator, t0, self.q, self.v, tau_applied, t1)
+            q, v = self.system.advance(
+                self.settings.integrator, t0, self.state.q, self.state.v, tau_applied, t1
+            )
         except (SimulationError, *NUMERICAL_FAILURES) as exc:
             raise _diverged(t0, t1, exc, self._context((t0, t1), tau_applied)) from exc
         if diverged(q, v):
             raise _diverged(t0, t1, None, self._context((t0, t1), tau_applied))
         q.setflags(write=False)  # new arrays of the plant's: frozen, not copied
         v.setflags(write=False)
-        self.q, self.v = q, v
+        self.state = SystemState(q, v)
         # the tick's time, tick * period: no accumulated rounding
         self.time_s = round(t1 / period) * period
 
@@ -175,6 +200,7 @@ class ClosedLoop:
         if controller is not None:
             with self._controller_code("signals"):
                 signals = {**controller.signals(), **signals}
+        signals.update(self.system.logged_signals(self.state.q, self.state.v))
         return Sample(
             self.time_s,
             self.q,
@@ -224,7 +250,7 @@ class ClosedLoop:
         log.rollout.metadata["closed_loop"] = path.record()
         try:
             self.start(q0, v0, sensors)
-            log.rollout.metadata["world"] = self.plant.record()  # as simulated: anchored
+            log.rollout.metadata["world"] = self.system.record()  # as simulated: anchored
             if self.settings.control_period_s is None:
                 path.reason = "continuous-time control"
                 self._run_continuous(span)
@@ -288,7 +314,8 @@ class ClosedLoop:
         controller is evaluated inside the right-hand side. With an adaptive integrator the
         controller's barrier is extended beyond its funnels for trial stages, and the funnel
         margin is an event on accepted steps."""
-        settings, plant, controller = self.settings, self.plant, self.controller
+        settings, system, controller = self.settings, self.system, self.controller
+        plant = system.plant
         adaptive = isinstance(settings.integrator, Adaptive)
         log_times = np.arange(settings.n_log) * settings.log_period_s
 
@@ -312,7 +339,7 @@ class ClosedLoop:
             measurement, contact = at(t, q, v)
             tau_applied = actuation.apply(command(measurement))
             self._last_tau_applied = tau_applied  # for a divergence message
-            acceleration = plant.acceleration(t, q, v, tau_applied, contact)
+            acceleration = system.acceleration(t, q, v, tau_applied, contact)
             # an adaptive solver would shrink its step on a non-finite stage until it gives
             # up with a message that does not say why: stop at once instead (a sum is NaN or
             # inf if any entry is; the exact test only when it is)
@@ -339,8 +366,8 @@ class ClosedLoop:
             for t, q, v in states:
                 if diverged(q, v):
                     raise _diverged(t0, t, None, self._context((t0, t), self._last_tau_applied))
-                self.time_s, self.q, self.v = float(t), read_only(q), read_only(v)
-                plant.settle(self.q, self.v)  # the friction's anchors move at the log times
+                self.time_s, self.state = float(t), SystemState(read_only(q), read_only(v))
+                system.settle(q, v)  # the friction's anchors move at the log times
                 on_log = abs(t - log_times[logged]) < 1e-9
                 # an event stop is not a log time: the controller raises the violation there
                 self._tick(on_log)
@@ -358,9 +385,10 @@ class ClosedLoop:
         with self._controller_code("set_funnel_extension"):
             controller.set_funnel_extension(event is not None)
         try:
+            compiled = self.plant.compiled
             states = self.settings.integrator.advance_through(
-                self.plant.uvms.model, rhs, t0, self.q, self.v, times, event,
-                chart=self.plant.chart(),
+                self.system.model, rhs, t0, self.state.q, self.state.v, times, event,
+                chart=None if compiled is None else compiled.chart,
             )  # fmt: skip
         except SimulationError as exc:  # log the states reached before the failure
             return getattr(exc, "states", []), exc
@@ -473,10 +501,10 @@ def simulate_closed_loop(
     """
     from uvms_pin.sim.settings import check_log_fits
 
-    check_log_fits(settings, plant.uvms.nq, plant.uvms.nv, plant.n_logged_columns)
+    loop = ClosedLoop(plant, settings, controller, observers, compiled=compiled)
+    check_log_fits(settings, plant.uvms.nq, plant.uvms.nv, loop.system.n_logged_columns)
     meta = {**(metadata or {}), **run_metadata(plant, settings)}
     if sensors.navigation is not None:
         meta["signal_units"].update(_described(sensors.navigation.signal_columns()))
-    log = RolloutLog(plant.uvms, settings.n_log, meta, backend=plant.backend, plant=plant)
-    loop = ClosedLoop(plant, settings, controller, observers, compiled=compiled)
+    log = RolloutLog(plant.uvms, settings.n_log, meta, backend=plant.backend, system=loop.system)
     return loop.run(q0, v0, sensors, log)

@@ -30,9 +30,11 @@ import numpy as np
 
 from uvms_pin.control.performance import transformed_error
 from uvms_pin.control.ppc import PrescribedPerformanceController
-from uvms_pin.sim.compiled_actuation import actuation_to_core
-from uvms_pin.sim.integrators import FixedStep
+from uvms_pin.physics.compiled.extension import core_module
+from uvms_pin.sim.compiled.actuation import actuation_to_core
+from uvms_pin.sim.compiled.integrator import integrator_to_core
 from uvms_pin.sim.log import RolloutLog
+from uvms_pin.sim.pipeline import Pipeline, RunParts, why_not_compiled
 from uvms_pin.sim.plant import Plant
 from uvms_pin.sim.sample import ProgressReport
 from uvms_pin.sim.settings import SimulationSettings
@@ -82,31 +84,6 @@ class LoopPath:
         }
 
 
-def _why_not(plant, controller, sensors, settings, observers, log) -> str | None:
-    """Why this loop cannot run compiled (the first part without a counterpart), or None."""
-    checks = (
-        (settings.control_period_s is None, "continuous-time control"),
-        (not isinstance(settings.integrator, FixedStep), "an adaptive integrator"),
-        (type(controller) is not PrescribedPerformanceController,
-         f"the controller {type(controller).__name__} is not compiled"),
-        (getattr(controller, "_kernel", None) is None, "the controller's Python backend"),
-        (plant.world is not None, "a world (its contacts are Python's)"),
-        (plant.stop_at_surface, "stop_at_surface"),
-        (sensors.navigation is not None, "navigation sensors"),
-        (getattr(sensors, "estimator", None) is not None, "a navigation estimator"),
-        (any(o is not log and not isinstance(o, ProgressReport) for o in observers),
-         "an observer that needs every sample"),
-    )  # fmt: skip
-    reason = next((why for failed, why in checks if failed), None)
-    if reason is not None:
-        return reason
-    if plant._core() is None:
-        return "the plant runs on the Python reference"
-    if plant._compiled_step(settings.integrator) is None:
-        return f"the integrator {type(settings.integrator).__name__} is not compiled"
-    return None
-
-
 class CompiledLoop:
     """One run's compiled sampled loop: its core objects, tables and log buffer."""
 
@@ -118,7 +95,7 @@ class CompiledLoop:
         self.kernel = self.controller._kernel
         self.actuation_core = actuation_core
         self.settings = core.LoopSettings()
-        self.settings.integrator = plant._compiled_step(settings.integrator)
+        self.settings.integrator = integrator_to_core(settings.integrator, core)
         self.settings.period_s = float(settings.control_period_s)
         self.settings.ticks_per_log = int(settings.ticks_per_log)
         self.settings.final_tick = (settings.n_log - 1) * settings.ticks_per_log
@@ -147,13 +124,15 @@ class CompiledLoop:
         if not allowed:
             return None, "the Python loop was asked for"
         plant = loop.plant
-        reason = _why_not(plant, loop.controller, loop.sensors, loop.settings, loop.observers, log)
+        observers = [o for o in loop.observers if o is not log]
+        parts = RunParts(
+            loop.system, loop.settings, loop.sensors.config, loop.controller, observers
+        )
+        reason = why_not_compiled(parts, Pipeline.LOOP)
         if reason is not None:
             return None, reason
-        core = plant._backend.counterpart(lambda module: module)  # compiled: _core() is set
+        core = core_module()
         actuation = actuation_to_core(plant.actuation, core, plant.uvms.nv)
-        if isinstance(actuation, str):
-            return None, actuation
         return cls(core, loop, log, actuation), None
 
     # ---- one chunk ----------------------------------------------------------------------
@@ -185,12 +164,12 @@ class CompiledLoop:
         q, v = np.array(loop.q), np.array(loop.v)
         actuation = loop.plant.actuation
         command, thrust, dropped = (
-            (actuation._command, actuation._thrust, actuation._dropped_max)
+            (actuation.thruster_command, actuation.thrust_N, actuation.dropped_max)
             if self.actuation_core.thrusters
             else (np.zeros(0), np.zeros(0), np.zeros(0))
         )
         done, rows, stopped = self.core.run_sampled_chunk(
-            loop.plant._core(), self.kernel.kernel, self.actuation_core, settings, first, n,
+            loop.plant.compiled, self.kernel.kernel, self.actuation_core, settings, first, n,
             q, v, noise, desired, self.buffer, command, thrust, dropped,
         )  # fmt: skip
         if done:

@@ -15,7 +15,6 @@ import math
 from abc import ABC, abstractmethod
 from collections.abc import Callable
 from dataclasses import dataclass
-from types import ModuleType
 from typing import ClassVar
 
 import numpy as np
@@ -23,7 +22,6 @@ import pinocchio as pin
 from scipy.integrate import solve_ivp
 
 from uvms_pin.errors import ParameterError, SimulationError
-from uvms_pin.physics.compiled.backend import Backend, Fallback
 
 Rhs = Callable[[float, np.ndarray, np.ndarray], np.ndarray]
 Event = Callable[[float, np.ndarray, np.ndarray], float]
@@ -41,12 +39,6 @@ class Integrator(ABC):
         self, model: pin.Model, rhs: Rhs, t0: float, q0: np.ndarray, v0: np.ndarray, t1: float
     ) -> tuple[np.ndarray, np.ndarray]:
         """Return (q, v) at t1."""
-
-    def to_core(self, backend: Backend):
-        """The core's counterpart of this integrator (src/uvms_core/integrators.hpp), with
-        which the compiled plant advances a whole period in one call, or the Fallback saying
-        why not (then `advance` runs, on the plant's right-hand side)."""
-        return Fallback(f"the integrator {type(self).__name__}")
 
     def advance_through(
         self,
@@ -124,15 +116,6 @@ class FixedStep(Integrator):
     @abstractmethod
     def step(self, model, rhs, t, q, v, h):
         """(q, v) one substep h [s] after (q, v) at t."""
-
-    def to_core(self, backend):
-        def build(core: ModuleType):
-            out = core.FixedStep()
-            out.method = getattr(core.Method, self.core_method)
-            out.step_s = float(self.step_s)
-            return out
-
-        return backend.counterpart(build)
 
 
 @dataclass(frozen=True)

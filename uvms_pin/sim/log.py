@@ -6,7 +6,7 @@ written, when the log is finished (they are functions of the state alone), and s
 free surface, is each hull's wet fraction (the signal ``wet_fraction``, one column per hull
 named in the metadata's ``hull_names``: 1 deep, 0 out of the water); the potential energy
 includes the joint stops' springs (`JointStops.energy_J`). With a world, each
-sample also logs the contact of every (body, object) pair (the signal ``world_contact``,
+sample also logs (the system of bodies' `System.logged_signals`, among the sample's signals) the contact of every (body, object) pair (the signal ``world_contact``,
 9 columns per pair named in the metadata's ``world_contact_pairs``: the force on the body
 [N] (3), its point [m] (3) and the moment about that point [N m] (3), world axes; the
 UVMS against free objects and its own vehicle included). With free objects, the signal
@@ -27,8 +27,8 @@ from uvms_pin.physics.dynamics import kinetic_energy, potential_energy_placed
 from uvms_pin.physics.surface import wet_state
 from uvms_pin.results.rollout import Rollout
 from uvms_pin.results.signal import Signal, described
-from uvms_pin.sim.plant import Plant
 from uvms_pin.sim.sample import Sample
+from uvms_pin.sim.system import System
 
 
 class RolloutLog:
@@ -37,8 +37,10 @@ class RolloutLog:
     Args:
         uvms: the model (sizes, energies). backend: the dynamics' backend for the energies.
         capacity: rows to allocate first. metadata: the rollout's metadata.
-        plant: the world run in, when it has a free surface (energies and wet fractions
-            under it); None: water without a top.
+        system: the system of bodies run (`uvms_pin.sim.system.System`): its robot's free
+            surface (energies and wet fractions under it), joint stops (their springs'
+            energy) and world (the contact pairs' and free objects' names and units); None:
+            water without a top, no stops, no world.
     """
 
     def __init__(
@@ -47,29 +49,27 @@ class RolloutLog:
         capacity: int,
         metadata: dict[str, Any],
         backend: str = "core",
-        plant: Plant | None = None,
+        system: System | None = None,
     ):
         self.uvms = uvms
         self.backend = backend
+        plant = None if system is None else system.plant
         self.plant = plant if plant is not None and plant.free_surface else None
         if self.plant is not None:
             metadata = {**metadata, "hull_names": hull_names(uvms)}
-        self.world_plant = plant if plant is not None and plant.world is not None else None
         # the joint stops' springs hold energy: a part of the potential energy logged
         self.stops = None if plant is None else plant.joint_stops
-        if self.world_plant is not None:
-            metadata = {**metadata, "world_contact_pairs": plant.contact_pair_names}
-        self.free_plant = None
-        if self.world_plant is not None and plant.free_bodies and plant.free_bodies.objects:
-            self.free_plant = plant
-            names, units = plant.free_bodies.state_columns()
+        if plant is not None and plant.world is not None:
+            metadata = {**metadata, "world_contact_pairs": system.contact_pair_names}
+        if system is not None and system.objects:
+            names, units = system.moving.state_columns()
             units_meta = {
                 **metadata.get("signal_units", {}),
                 "free_objects": described(names, units),
             }
             metadata = {
                 **metadata,
-                "free_object_contact_pairs": plant.object_pair_names,
+                "free_object_contact_pairs": system.moving.moving.object_pair_names,
                 "signal_units": units_meta,
             }
         self.rollout = Rollout.allocate(max(int(capacity), 1), uvms.nq, uvms.nv, metadata)
@@ -94,13 +94,6 @@ class RolloutLog:
                     self._describe(name, values)
                 values = values.values
             rollout.signal(name, values.size)[k] = values
-        if self.world_plant is not None:
-            wrenches = self.world_plant.world_wrenches(sample.q, sample.v)
-            rollout.signal("world_contact", wrenches.size)[k] = wrenches
-        if self.free_plant is not None:
-            states, wrenches = self.free_plant.free_object_log(sample.q, sample.v)
-            rollout.signal("free_objects", states.size)[k] = states
-            rollout.signal("free_object_contact", wrenches.size)[k] = wrenches
         self.count += 1
 
     def _describe(self, name: str, signal: Signal) -> None:
@@ -123,8 +116,7 @@ class RolloutLog:
         """An independent log holding the same samples (the model is shared)."""
         out = RolloutLog.__new__(RolloutLog)
         out.uvms, out.backend, out.count = self.uvms, self.backend, self.count
-        out.plant, out.world_plant, out.stops = self.plant, self.world_plant, self.stops
-        out.free_plant = self.free_plant
+        out.plant, out.stops = self.plant, self.stops
         out.described = set(self.described)
         out.rollout = copy.deepcopy(self.rollout)
         return out

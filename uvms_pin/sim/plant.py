@@ -1,25 +1,22 @@
-"""The simulated world: a UVMS in water, with an environment and disturbances.
+"""A robot in the water: a UVMS (or a bare vehicle), the water around it, what it touches and
+what pushes it.
 
-`Plant.acceleration` is the right-hand side of the closed loop; the controller is not part
-of it (it sees only a `Measurement`). `Plant.advance` moves the plant over one control period
-with the input held.
+`Plant.acceleration` is the robot's right-hand side; the controller is not part of it (it
+sees only a `Measurement`). What moves with the robot (free objects) and how a control period
+is stepped belong to the system of bodies (`uvms_pin.sim.system.System`).
 
-With ``backend="core"`` (default) both run in the compiled core: the whole period (every
-integrator stage, contact, disturbance, held tau) is one C++ call. The plant's compiled
-counterpart (`src/uvms_core/plant.hpp`) is built from its flow, contact and disturbance when
-a run starts (`attach`) or on first use; when one of them has no counterpart (e.g. a
-disturbance written in Python) the plant runs on the Python reference and says so once with a
-`CoreFallbackWarning`. A world (`uvms_pin.physics.world`) has its compiled counterpart too
-(src/uvms_core/world_contact.hpp, coal's C++ API): a period in which nothing can touch it is
-one compiled call without it, one in which something may is one compiled call with the
-contacts. The friction's state (`friction`, a `FrictionMemory`) stays on this plant for
-both backends: the compiled call reads it and writes it back.
+With ``backend="core"`` (default) the right-hand side runs in the compiled core: the plant's
+counterpart (`src/uvms_core/plant.hpp`, built in `uvms_pin.sim.compiled.plant`) mirrors its
+flow, contact, disturbance, joint stops, joint friction and world, rebuilt when a run starts
+(`attach`) or on first use; when one part has none (e.g. a disturbance written in Python) the
+plant computes on the Python reference and says so once with a `CoreFallbackWarning`. The
+world contacts' friction state (`friction`, a `FrictionMemory`) stays on this plant for both
+backends: the compiled calls read it and write it back.
 """
 
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from types import ModuleType
 from typing import Any
 
 import numpy as np
@@ -30,22 +27,15 @@ from uvms_pin.errors import ParameterError, SimulationError
 from uvms_pin.flow import FlowField, SumFlow, UniformCurrent
 from uvms_pin.model.uvms import UVMS
 from uvms_pin.physics.compiled.backend import Backend, Fallback, backend_named
-from uvms_pin.physics.compiled.contact import contact_to_core
-from uvms_pin.physics.compiled.disturbance import disturbance_to_core
-from uvms_pin.physics.compiled.flow import flow_to_core
-from uvms_pin.physics.compiled.joint_friction import joint_friction_to_core
-from uvms_pin.physics.compiled.joint_stops import joint_stops_to_core
-from uvms_pin.physics.compiled.world import world_bounds_to_core, world_contact_to_core
 from uvms_pin.physics.contact import ContactModel
 from uvms_pin.physics.disturbance import Disturbance
-from uvms_pin.physics.dynamics import dynamics_of, forward_dynamics
+from uvms_pin.physics.dynamics import forward_dynamics
 from uvms_pin.physics.joint_friction import JointFriction
 from uvms_pin.physics.joint_stops import JointStops
 from uvms_pin.physics.surface import wet_state
 from uvms_pin.physics.world.world import ContactForces, FrictionMemory, World
 from uvms_pin.sim.actuation import Actuation, Unlimited
-from uvms_pin.sim.free_bodies import FreeBodies
-from uvms_pin.sim.integrators import Chart, Integrator
+from uvms_pin.sim.compiled.plant import plant_to_core
 
 
 @dataclass
@@ -99,53 +89,13 @@ class Plant:
             raise ParameterError(
                 f"joint friction for {self.joint_friction.viscous_Nms.size} joints, the model has {self.uvms.nv - 6}"
             )
+        if self.world is not None and self.world.uvms is not self.uvms:
+            raise ParameterError("the plant's world was built for another UVMS")
         self._backend: Backend = backend_named(self.backend)
         self._ee_data = self.uvms.model.createData()
         self._world_data = self.uvms.model.createData()
         self.friction = FrictionMemory()  # the world contacts' state (anchors)
-        self.water = self._water()
-        if self.world is not None and self.world.uvms is not self.uvms:
-            raise ParameterError("the plant's world was built for another UVMS")
-        # free objects and the arm against its vehicle: the moving contacts (None: none)
-        moving = self.world is not None and (self.world.free or self.world.self_collision)
-        self.free_bodies = FreeBodies(self) if moving else None
-
-    @property
-    def n_logged_hulls(self) -> int:
-        """Wet fractions a run of this plant logs per sample (one per hull under a free
-        surface, none without)."""
-        return len(self.uvms.surface_bodies) if self.free_surface else 0
-
-    @property
-    def n_logged_columns(self) -> int:
-        """Values a run of this plant logs per sample beyond the base arrays: the wet
-        fractions and, with a world, 9 per (body, object) pair (``world_contact``)."""
-        pairs = len(self.contact_pair_names) + len(self.object_pair_names)
-        objects = 0 if self.free_bodies is None else len(self.free_bodies.state_columns()[0])
-        return self.n_logged_hulls + 9 * pairs + objects
-
-    @property
-    def contact_pair_names(self) -> list[str]:
-        """``first|second`` of every logged contact pair of the UVMS (``world_contact``):
-        its bodies against the fixed objects, then against the free objects and its own
-        vehicle."""
-        if self.world is None:
-            return []
-        extra = [] if self.free_bodies is None else self.free_bodies.moving.uvms_pair_names
-        return self.world.pair_names + extra
-
-    @property
-    def object_pair_names(self) -> list[str]:
-        """The free objects' logged pairs (``free_object_contact``)."""
-        return [] if self.free_bodies is None else self.free_bodies.moving.object_pair_names
-
-    def _water(self) -> FlowField | None:
-        """The one flow the bodies see: the uniform current and ``flow`` (None: still water)."""
-        fields = [UniformCurrent(self.current_world_m_s)] if np.any(self.current_world_m_s) else []
-        fields += [self.flow] if self.flow is not None else []
-        if not fields:
-            return None
-        return fields[0] if len(fields) == 1 else SumFlow(tuple(fields))
+        self.water = water_of(self.current_world_m_s, self.flow)
 
     def record(self) -> dict[str, Any]:
         """The world this plant simulates, as plain data (a rollout saves it; figures and
@@ -157,17 +107,9 @@ class Plant:
             "flow": None if self.water is None else self.water.record(),
             "contact": None if self.contact is None else self.contact.record(),
             "free_surface": bool(self.free_surface),
-            "world": None if self.world is None else self._world_record(),
+            "world": None if self.world is None else self.world.record(),
             "joint_stops": None if self.joint_stops is None else self.joint_stops.record(),
         }
-
-    def _world_record(self) -> dict[str, Any]:
-        out = self.world.record()
-        if self.free_bodies is not None:
-            out["pairs"] = self.contact_pair_names
-            out["object_pairs"] = self.object_pair_names
-            out.update(self.free_bodies.record())
-        return out
 
     def check_submerged(self, time_s: float, q: np.ndarray) -> None:
         """With ``stop_at_surface``: raise SimulationError when a body's centre of buoyancy
@@ -204,48 +146,21 @@ class Plant:
 
     def __getstate__(self) -> dict:
         state = dict(self.__dict__)
-        # C++ objects: rebuilt on first use after unpickling
-        state.pop("_compiled", None)
-        state.pop("_step", None)
+        state.pop("_compiled", None)  # a C++ object: rebuilt on first use after unpickling
         return state
 
-    # ---- the compiled plant -----------------------------------------------------------
-    def _to_core(self, core: ModuleType):
-        """The compiled plant mirroring this one, or the Fallback of the first part the core
-        has no counterpart of."""
-        parts = (
-            flow_to_core(self.water, core),
-            contact_to_core(self.contact, core),
-            disturbance_to_core(self.disturbance, core),
-            joint_stops_to_core(self.joint_stops, core),
-        )
-        fallback = next((p for p in parts if isinstance(p, Fallback)), None)
-        if fallback is not None:
-            return fallback
-        # the compiled plant uses the end-effector frame for contact only, which a model
-        # without one cannot have (checked in __post_init__): frame 0 (the world) stands in
-        ee_frame_id = self.uvms.ee_frame_id if self.uvms.has_end_effector else 0
-        compiled = core.Plant(dynamics_of(self.uvms).core, ee_frame_id)
-        compiled.flow, compiled.contact, compiled.disturbance, compiled.joint_stops = parts
-        compiled.joint_friction = joint_friction_to_core(self.joint_friction, core)
-        compiled.free_surface = bool(self.free_surface)
-        bounds = world_bounds_to_core(self.world, core)
-        if bounds is not None:
-            compiled.world_bounds = bounds
-            compiled.world = world_contact_to_core(self.world, core)
-        return compiled
-
-    def _core(self):
-        """The compiled plant, or None: the Python reference computes (warned once)."""
+    @property
+    def compiled(self) -> Any | None:
+        """The compiled plant (`uvms_pin.sim.compiled.plant`), or None: the Python reference
+        computes (warned once when the core was asked for)."""
         if "_compiled" not in self.__dict__:
-            compiled = self._backend.counterpart(self._to_core)
+            compiled = self._backend.counterpart(lambda core: plant_to_core(self, core))
             if isinstance(compiled, Fallback):
                 compiled.warn("this plant", stacklevel=4)
                 compiled = None
             self._compiled = compiled
         return self._compiled
 
-    # ---- kinematics of the tip ----------------------------------------------------------
     def ee_state(self, q: np.ndarray, v: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """End-effector position, linear velocity (world) and its LOCAL_WORLD_ALIGNED Jacobian."""
         model, data, fid = self.uvms.model, self._ee_data, self.uvms.ee_frame_id
@@ -262,18 +177,16 @@ class Plant:
             position, _, _ = self.ee_state(q0, np.zeros(self.uvms.nv))
             self.contact.attach(position)
         self.friction.clear()
-        if self.free_bodies is not None:
-            self.free_bodies.reset()
         # what touches at t = 0 sticks where it is (a body placed on the seafloor stays)
         self.settle(q0, np.zeros(self.uvms.nv))
-        self.water = self._water()
+        self.water = water_of(self.current_world_m_s, self.flow)
         self.__dict__.pop("_compiled", None)
 
     def contact_wrench(self, q: np.ndarray, v: np.ndarray) -> np.ndarray:
         """lambda (6,): the wrench the end-effector exerts on the environment, world axes."""
         if self.contact is None:
             return np.zeros(6)
-        compiled = self._core()
+        compiled = self.compiled
         if compiled is not None:
             return compiled.contact_wrench(q, v)
         position, velocity, _ = self.ee_state(q, v)
@@ -286,63 +199,25 @@ class Plant:
         pin.forwardKinematics(self.uvms.model, self._world_data, q, v)
         return self.world.forces(self._world_data, self.friction)
 
-    def world_wrenches(self, q: np.ndarray, v: np.ndarray) -> np.ndarray:
-        """Per (body, object) pair, flattened (pairs * 9,): force on the body [N], its point
-        [m], moment about it [N m], world axes (`World.pair_wrenches`); empty without a
-        world."""
-        forces = self.world_forces(q, v)
-        if forces is None:
-            return np.zeros(0)
-        fixed = self.world.pair_wrenches(forces).ravel()
-        if self.free_bodies is None:
-            return fixed
-        return np.concatenate([fixed, self.free_bodies.wrenches(q, v)[0]])
-
-    def free_object_log(self, q: np.ndarray, v: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """(the free objects' states, their contact pairs' wrenches) now, flattened."""
-        bodies = self.free_bodies
-        return bodies.state_values(), bodies.wrenches(q, v)[1]
-
     def external_torque(
         self, q: np.ndarray, v: np.ndarray, extra_torque: np.ndarray | None = None
     ) -> np.ndarray:
-        """The world's contact forces and the joint stops as generalized forces (nv,);
-        ``extra_torque``: the moving contacts' (free objects, self-collision) when the
-        system's integration computed them, else they are taken at the objects' states now."""
-        out = np.zeros(self.uvms.nv)
+        """The fixed world's contact forces and the joint stops as generalized forces (nv,),
+        plus ``extra_torque``: what the system of bodies adds (the moving contacts: free
+        objects, the arm against its vehicle)."""
+        out = np.zeros(self.uvms.nv) if extra_torque is None else np.array(extra_torque)
         forces = self.world_forces(q, v)
         if forces is not None:
             out += self.world.generalized_force(q, self._world_data, forces)
-        if self.free_bodies is not None:
-            out += self.free_bodies.torques(q, v)[0] if extra_torque is None else extra_torque
         if self.joint_stops is not None:
             out += self.joint_stops.torque(q, v)
         return out
-
-    def _world_clear(self, q: np.ndarray, v: np.ndarray, horizon_s: float) -> bool:
-        """No world, or nothing of it within reach over ``horizon_s`` (then no contact
-        persists: the friction forgets its anchors)."""
-        if self.world is None:
-            return True
-        compiled = self._core()
-        if compiled is not None:
-            clear = compiled.world_clear(q, v, horizon_s)
-        else:
-            pin.forwardKinematics(self.uvms.model, self._world_data, q, v)
-            clear = self.world.clear(self._world_data, horizon_s)
-        if self.free_bodies is not None and self.free_bodies.near(q, v, horizon_s):
-            return False
-        if clear:
-            self.friction.clear()
-        return clear
 
     def settle(self, q: np.ndarray, v: np.ndarray) -> None:
         """After a control period: the friction's anchors move (`World.commit`)."""
         forces = self.world_forces(q, v)
         if forces is not None:
             self.world.commit(forces, self.friction)
-        if self.free_bodies is not None:
-            self.free_bodies.settle(q, v)
 
     def disturbance_wrench(self, time_s: float) -> np.ndarray:
         return (
@@ -363,14 +238,15 @@ class Plant:
     ) -> np.ndarray:
         """zeta_dot of  M zeta_dot + h + J_c^T lambda + delta = tau + [0; tau_f(v)] + tau_world
         + tau_stop (docs/physics.md; tau_f the joint drives' friction). With a world the
-        contact at the anchors of ``friction``, compiled with the rest on the core (the moving
-        contacts, free objects and self-collision, are Python's); ``extra_torque`` as in
-        `external_torque`."""
-        compiled = self._core()
-        if compiled is not None and self.world is None:
-            return compiled.acceleration(time_s, q, v, tau, contact_world)
-        if compiled is not None and contact_world is None and self.free_bodies is None:
-            return compiled.acceleration_in_world(time_s, q, v, tau, self.friction)
+        contact at the anchors of ``friction``, compiled with the rest on the core;
+        ``extra_torque`` as in `external_torque` (given: the Python reference computes, as
+        for the moving contacts of a system of bodies)."""
+        compiled = self.compiled
+        if compiled is not None and extra_torque is None:
+            if self.world is None:
+                return compiled.acceleration(time_s, q, v, tau, contact_world)
+            if contact_world is None:
+                return compiled.acceleration_in_world(time_s, q, v, tau, self.friction)
         model = self.uvms.model
         tau_ext = np.zeros(model.nv)
         if self.joint_friction is not None:
@@ -385,7 +261,7 @@ class Plant:
         if self.disturbance is not None:
             # the free-flyer's LOCAL Jacobian is [I 0]: a body wrench maps to tau[:6] directly
             tau_ext[:6] -= self.disturbance_wrench(time_s)
-        if self.world is not None or self.joint_stops is not None:
+        if self.world is not None or self.joint_stops is not None or extra_torque is not None:
             tau_ext += self.external_torque(q, v, extra_torque)
         return forward_dynamics(
             self.uvms,
@@ -406,58 +282,23 @@ class Plant:
         from uvms_pin.sim.plant_derivatives import acceleration_derivatives
 
         return acceleration_derivatives(
-            self, time_s, q, v, tau, compiled=self._core(), scratch=self._world_data
+            self, time_s, q, v, tau, compiled=self.compiled, scratch=self._world_data
         )
 
-    def chart(self) -> Chart | None:
-        """The compiled local chart of the adaptive integrators, or None (Python path)."""
-        compiled = self._core()
-        return None if compiled is None else compiled.chart
 
-    def _compiled_step(self, integrator: Integrator):
-        """The core's counterpart of ``integrator`` (kept for the next period), or None."""
-        step = self.__dict__.get("_step")
-        if step is None or step[0] is not integrator:
-            compiled = integrator.to_core(self._backend)
-            step = self._step = (integrator, None if isinstance(compiled, Fallback) else compiled)
-        return step[1]
+def water_of(current_world_m_s: np.ndarray, flow: FlowField | None) -> FlowField | None:
+    """The one flow the bodies see: the uniform current and ``flow`` (None: still water)."""
+    fields = [UniformCurrent(current_world_m_s)] if np.any(current_world_m_s) else []
+    fields += [flow] if flow is not None else []
+    if not fields:
+        return None
+    return fields[0] if len(fields) == 1 else SumFlow(tuple(fields))
 
-    def advance(
-        self,
-        integrator: Integrator,
-        t0: float,
-        q0: np.ndarray,
-        v0: np.ndarray,
-        tau: np.ndarray,
-        t1: float,
-    ) -> tuple[np.ndarray, np.ndarray]:
-        """(q, v) at t1 from (q0, v0) at t0 with the input tau held (zero-order hold).
 
-        One compiled call for the whole interval when the integrator has a compiled
-        counterpart (RK4, semi-implicit Euler): without a world, or with one of fixed objects
-        (a bound test first: nothing within reach, the period runs without it; else with the
-        contacts, and the friction's anchors move at its end, `World.commit`). With free
-        objects, the system's own integration (`FreeBodies.advance`); with self-collision
-        only, compiled while nothing can touch. The integrator's Python loop otherwise,
-        around the compiled right-hand side."""
-        if self.free_bodies is not None and self.free_bodies.objects:
-            q1, v1 = self.free_bodies.advance(integrator, t0, q0, v0, tau, t1)
-            self.settle(q1, v1)
-            return q1, v1
-        compiled = self._core()
-        step = None if compiled is None else self._compiled_step(integrator)
-        if step is not None and self.world is None:
-            return compiled.advance(t0, q0, v0, tau, t1, step)
-        if step is not None and self.free_bodies is None:
-            return compiled.advance_in_world(t0, q0, v0, tau, t1, step, self.friction)
-        clear = compiled is not None and self._world_clear(q0, v0, t1 - t0)
-        if clear and step is not None:
-            return compiled.advance(t0, q0, v0, tau, t1, step)
-        q1, v1 = integrator.advance(
-            self.uvms.model, lambda t, q, v: self.acceleration(t, q, v, tau), t0, q0, v0, t1
-        )
-        self.settle(q1, v1)
-        return q1, v1
+def has_moving_contacts(world: World | None) -> bool:
+    """A world in which more than the robot moves (free objects) or the arm can hit its own
+    vehicle: its contacts are the system of bodies' (`uvms_pin.sim.system`)."""
+    return world is not None and bool(world.free or world.self_collision)
 
 
 def checked_start(

@@ -60,7 +60,8 @@ def acceleration_derivatives(
     """
     q = checked_configuration("q", q, plant.uvms.model)
     v = finite_vector("v", v, plant.uvms.nv)
-    if plant.free_bodies is not None:
+    world = plant.world
+    if world is not None and (world.free or world.self_collision):
         raise ParameterError(
             "acceleration_derivatives: free objects and self-collision are not differentiated"
         )

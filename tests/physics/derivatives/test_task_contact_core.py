@@ -105,7 +105,7 @@ def test_the_compiled_contact_derivatives_match_the_reference(uvms, kind):
     leaving)."""
     q, v, _ = _state(uvms, 81)
     contact = _contact(uvms, q, v, kind)
-    compiled = _plant(uvms, contact, "core")._core()
+    compiled = _plant(uvms, contact, "core").compiled
     assert compiled is not None
     got = compiled.contact_derivatives(q, v)
     task = TaskContact(uvms.ee_frame_id, contact)
@@ -160,7 +160,7 @@ def test_the_contact_terms_are_far_above_the_tolerance(uvms):
     q, v, tau = _state(uvms, 82)
     contact = _contact(uvms, q, v, "plane")
     plant = _plant(uvms, contact, "core")
-    compiled = plant._core()
+    compiled = plant.compiled
     whole = compiled.acceleration_derivatives(0.2, q, v, tau, plant.friction)
     terms = compiled.contact_derivatives(q, v)
     inverse_mass = whole.da_dtau

@@ -18,6 +18,7 @@ from uvms_pin.scenario.overrides import apply_overrides
 from uvms_pin.scenario.toml import read_toml
 from uvms_pin.sim.batch import BatchRun, run_batch
 from uvms_pin.sim.run import Scenario, simulate
+from uvms_pin.sim.system import System
 
 __all__ = ["batch_run_row", "compare_controllers", "controller_scenarios", "run_controller"]
 
@@ -52,7 +53,7 @@ def controller_scenarios(
     # every controller's rollout is kept until the figures are drawn: all of them must fit
     check_memory(
         sum(
-            s.settings.log_bytes(s.uvms.nq, s.uvms.nv, s.plant.n_logged_columns)
+            s.settings.log_bytes(s.uvms.nq, s.uvms.nv, System(s.plant).n_logged_columns)
             for s in out.values()
         ),
         f"the logs of the {len(out)} runs ({next(iter(out.values())).settings.n_log} samples each)",

@@ -181,7 +181,7 @@ class UvmsEnv(gym.Env):
             self.max_steps + 1,
             self._episode_metadata(),
             scenario.plant.backend,
-            plant=scenario.plant,
+            system=loop.system,
         )
         self._failure = None
         self._anchor = None
@@ -272,7 +272,7 @@ class UvmsEnv(gym.Env):
             **run_metadata(scenario.plant, settings),
             "seed": self.episode_seed,
             "log_period_s": settings.control_period_s,
-            "world": scenario.plant.record(),
+            "world": self._loop.system.record(),
         } | _shortened_record(scenario)
 
     # -- helpers -------------------------------------------------------------------------

@@ -348,29 +348,27 @@ class LiveView:
 
 
 class LiveFeed:
-    """An observer of the closed loop pushing every logged sample to a live view."""
+    """An observer of the closed loop pushing every logged sample to a live view (the world's
+    contacts and free objects from the sample's signals, as the rollout logs them)."""
 
-    def __init__(self, live: LiveView, plant=None):
+    def __init__(self, live: LiveView):
         self.live = live
-        self.plant = plant if plant is not None and plant.world is not None else None
 
     def on_sample(self, sample: Sample) -> None:
         desired = sample.signals.get("force_desired_world_N")
         desired = getattr(desired, "values", desired)  # an array, or a named `Signal`
-        plant = self.plant
-        contacts = None if plant is None else plant.world_wrenches(sample.q, sample.v)
-        free = objects = None
-        if plant is not None and plant.free_bodies is not None and plant.free_bodies.objects:
-            free, objects = plant.free_object_log(sample.q, sample.v)
+        contacts = sample.signals.get("world_contact")
+        free = sample.signals.get("free_objects")
+        objects = sample.signals.get("free_object_contact")
         self.live.push(
             Frame(
                 sample.time_s,
                 np.array(sample.q),
                 sample.measurement.wrench_world[:3].copy(),
                 None if desired is None else desired.copy(),
-                contacts,
-                free,
-                objects,
+                None if contacts is None else contacts.copy(),
+                None if free is None else free.copy(),
+                None if objects is None else objects.copy(),
             )
         )
 
@@ -403,7 +401,7 @@ def simulate_live(
 ) -> Rollout:
     """`uvms_pin.sim.run.simulate`, with every logged sample pushed to ``live`` (an observer:
     the rollout is the same as without the view)."""
-    return simulate(scenario, progress=progress, observers=[LiveFeed(live, scenario.plant)])
+    return simulate(scenario, progress=progress, observers=[LiveFeed(live)])
 
 
 def run_live(

@@ -1,0 +1,95 @@
+"""Whether a run is compiled: decided once, before it starts, from one list of reasons.
+
+Two compiled pipelines serve the closed loop: the compiled sampled loop (`Pipeline.LOOP`: a
+run's ticks in chunks of one core call, `uvms_pin.sim.compiled_loop`) and the batched plant
+(`Pipeline.BATCH`: N environments' periods in one call, `uvms_pin.sim.batched_plant`). Each
+reason below names a part without a compiled counterpart and the pipelines it keeps in Python;
+`why_not_compiled` gives the first that applies. The rollout records it (its metadata's
+``closed_loop``), the batched plant refuses with it. The plant's own right-hand side and period
+are compiled part by part whatever the pipeline (`uvms_pin.sim.system.period`).
+"""
+
+from __future__ import annotations
+
+import enum
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass
+from typing import Any
+
+from uvms_pin.physics.compiled.backend import Fallback
+from uvms_pin.physics.compiled.extension import core_module
+from uvms_pin.sim.compiled.actuation import actuation_to_core
+from uvms_pin.sim.compiled.integrator import integrator_to_core
+from uvms_pin.sim.compiled.laws import law_to_core
+from uvms_pin.sim.compiled.plant import plant_to_core
+from uvms_pin.sim.sample import ProgressReport
+from uvms_pin.sim.sensors import SensorConfig
+from uvms_pin.sim.settings import SimulationSettings
+from uvms_pin.sim.system import System
+
+__all__ = ["REASONS", "Pipeline", "RunParts", "why_not_compiled"]
+
+
+class Pipeline(enum.Flag):
+    """The compiled pipelines a reason can keep in Python."""
+
+    LOOP = enum.auto()  # the compiled sampled loop of a run
+    BATCH = enum.auto()  # the batched plant of the vector environments
+    BOTH = LOOP | BATCH
+
+
+@dataclass(frozen=True)
+class RunParts:
+    """What a run is made of, as the choice reads it.
+
+    Attributes:
+        system: the bodies and their world. settings: periods, integrator, duration.
+        sensors: the sensors' configuration. controller: the law (None: the caller gives
+            tau, as a policy does). observers: what watches every sample (besides the log).
+    """
+
+    system: System
+    settings: SimulationSettings
+    sensors: SensorConfig
+    controller: Any = None
+    observers: Sequence[Any] = ()
+
+
+def _fallback(built: Any) -> str | None:
+    return built.reason if isinstance(built, Fallback) else None
+
+
+def _plant(parts: RunParts) -> str | None:
+    plant = parts.system.plant
+    if plant.compiled is not None:
+        return None
+    return _fallback(plant_to_core(plant, core_module())) or "a plant part"
+
+
+#: (the pipelines it keeps in Python, the check: the reason, or None when it does not apply),
+#: in the order they are asked
+REASONS: tuple[tuple[Pipeline, Callable[[RunParts], str | None]], ...] = (
+    (Pipeline.BOTH, lambda p: "the Python backend" if p.system.plant.backend == "python" else None),
+    (Pipeline.BOTH, lambda p: "continuous-time control" if p.settings.control_period_s is None else None),
+    (Pipeline.BOTH, lambda p: _fallback(integrator_to_core(p.settings.integrator, core_module()))),
+    (Pipeline.LOOP, lambda p: None if p.controller is None else _fallback(law_to_core(p.controller, core_module()))),
+    (Pipeline.BOTH, lambda p: "a world (its contacts are stepped period by period)" if p.system.plant.world is not None else None),
+    (Pipeline.BATCH, lambda p: "a flow (waves, sea states, varying currents)" if p.system.plant.flow is not None else None),
+    (Pipeline.BOTH, lambda p: "stop_at_surface" if p.system.plant.stop_at_surface else None),
+    (Pipeline.BOTH, lambda p: "navigation sensors" if p.sensors.navigation.fitted else None),
+    (Pipeline.BOTH, lambda p: "a navigation estimator" if p.sensors.estimator is not None else None),
+    (Pipeline.BOTH, lambda p: _fallback(actuation_to_core(p.system.plant.actuation, core_module(), p.system.plant.uvms.nv))),
+    (Pipeline.LOOP, lambda p: "an observer that needs every sample" if any(not isinstance(o, ProgressReport) for o in p.observers) else None),
+    (Pipeline.BOTH, _plant),
+)  # fmt: skip
+
+
+def why_not_compiled(parts: RunParts, pipeline: Pipeline) -> str | None:
+    """Why ``parts`` cannot run in ``pipeline`` (the first reason of `REASONS` that
+    applies), or None: every part has a compiled counterpart."""
+    for pipelines, check in REASONS:
+        if pipeline & pipelines:
+            reason = check(parts)
+            if reason is not None:
+                return reason
+    return None

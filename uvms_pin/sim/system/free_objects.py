@@ -1,0 +1,86 @@
+"""The moving contacts of a system of bodies: the world's free objects (each a floating body
+of its own) and, on request, the arm against its own vehicle.
+
+Each contact force between two moving bodies is exchanged equal and opposite
+(`uvms_pin.physics.world.moving`); a free object meets the fixed objects as the robot does.
+The objects' states are the system's (`uvms_pin.sim.system.SystemState`): passed in, never
+kept here. What is kept is the contacts' friction state (their anchors), which moves once a
+control period, as the robot's does.
+"""
+
+from __future__ import annotations
+
+import re
+
+import numpy as np
+import pinocchio as pin
+
+from uvms_pin.model.uvms import UVMS
+from uvms_pin.physics.world.moving import MovingContacts, State
+from uvms_pin.physics.world.world import World
+
+__all__ = ["FreeObjects", "State"]
+
+#: per object, the logged components and their units: position (world) [m], quaternion
+#: (x, y, z, w), body velocity [m/s] and angular velocity [rad/s]
+_STATE_COLUMNS = (
+    ("x", "m"), ("y", "m"), ("z", "m"), ("qx", ""), ("qy", ""), ("qz", ""), ("qw", ""),
+    ("u", "m/s"), ("v", "m/s"), ("w", "m/s"), ("p", "rad/s"), ("q", "rad/s"), ("r", "rad/s"),
+)  # fmt: skip
+
+
+class FreeObjects:
+    """The free objects of ``world`` (possibly none, with self-collision only) and the
+    moving contacts between them, the robot ``uvms`` and the fixed objects."""
+
+    def __init__(self, uvms: UVMS, world: World):
+        self.uvms = uvms
+        self.objects = world.free
+        self.moving = MovingContacts.of(world)
+        self.uvms_data = uvms.model.createData()
+        self.datas = [o.uvms.model.createData() for o in self.objects]
+
+    def initial_states(self) -> list[State]:
+        """Each object's state at t = 0 (copies)."""
+        return [(o.q0.copy(), o.v0.copy()) for o in self.objects]
+
+    def reset(self) -> None:
+        """Every anchor forgotten."""
+        self.moving.clear()
+
+    # ---- the contacts at a state ------------------------------------------------------
+    def _kinematics(self, q: np.ndarray, v: np.ndarray, states: list[State]) -> None:
+        pin.forwardKinematics(self.uvms.model, self.uvms_data, q, v)
+        for obj, data, (q_o, v_o) in zip(self.objects, self.datas, states, strict=True):
+            pin.forwardKinematics(obj.uvms.model, data, q_o, v_o)
+
+    def found(self, q: np.ndarray, v: np.ndarray, states: list[State]):
+        """The moving contacts at the robot's (q, zeta) and the objects' ``states``."""
+        self._kinematics(q, v, states)
+        return self.moving.contacts(self.uvms_data, self.datas)
+
+    def torques(self, q: np.ndarray, v: np.ndarray, states: list[State]):
+        """(tau on the robot (nv,), tau on each object (6,)) of the moving contacts."""
+        found = self.found(q, v, states)
+        return self.moving.generalized(q, self.uvms_data, states, self.datas, found)
+
+    def near(self, q: np.ndarray, v: np.ndarray, states: list[State], horizon_s: float) -> bool:
+        """Some moving pair may touch within ``horizon_s``."""
+        self._kinematics(q, v, states)
+        return self.moving.near(self.uvms_data, self.datas, horizon_s)
+
+    def wrenches(self, q: np.ndarray, v: np.ndarray, states: list[State]):
+        """(the robot's pairs' wrenches, the objects' pairs' wrenches), flattened."""
+        return self.moving.wrenches(self.found(q, v, states))
+
+    def settle(self, q: np.ndarray, v: np.ndarray, states: list[State]) -> None:
+        """After a control period: the friction anchors move."""
+        found = self.found(q, v, states)
+        self.moving.commit(self.uvms_data, self.datas, found)
+
+    # ---- what a run logs ------------------------------------------------------------------
+    def state_columns(self) -> tuple[list[str], list[str]]:
+        """(component names, units) of the logged ``free_objects`` signal, per object."""
+        labels = [re.sub(r"\W", "_", o.name) for o in self.objects]
+        names = [f"{label}_{c}" for label in labels for c, _ in _STATE_COLUMNS]
+        return names, [u for _ in self.objects for _, u in _STATE_COLUMNS]

@@ -1,0 +1,83 @@
+"""How a system of bodies crosses one control period, chosen once per integrator.
+
+- compiled: the compiled plant's one call for the whole period (RK4, semi-implicit Euler):
+  without a world; or with fixed objects (a bound test first: nothing within reach, the period
+  runs without them; else with the contacts, and their anchors move at its end);
+- guarded (the arm against its own vehicle, compiled plant): the compiled call while no pair,
+  fixed or moving, can touch over the period, else the integrated step;
+- integrated: the integrator's own loop around the system's right-hand side (free objects,
+  the Python reference, an integrator without a compiled counterpart), the anchors moved at
+  the period's end.
+
+This is the one place the step is made; the constraint solve of rigid contacts, joint limits
+and attachments goes here, after the smooth dynamics, for every body at once.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from typing import Any, Protocol
+
+import numpy as np
+import pinocchio as pin
+
+from uvms_pin.physics.compiled.backend import Fallback
+from uvms_pin.physics.compiled.extension import core_module
+from uvms_pin.sim.compiled.integrator import integrator_to_core
+from uvms_pin.sim.integrators import Integrator
+
+
+class Stepped(Protocol):
+    """What a period step needs of a system of bodies (`uvms_pin.sim.system.System`)."""
+
+    plant: Any
+    model: pin.Model
+    objects: tuple
+    moving: Any
+
+    def acceleration(self, time_s: float, q: np.ndarray, v: np.ndarray, tau: np.ndarray): ...
+
+    def settle(self, q: np.ndarray, v: np.ndarray) -> None: ...
+
+    def clear(self, q: np.ndarray, v: np.ndarray, horizon_s: float) -> bool: ...
+
+
+#: (t0, q0, v0, tau, t1) -> (q1, v1), the system's state at t1
+PeriodStep = Callable[[float, np.ndarray, np.ndarray, np.ndarray, float], tuple]
+
+__all__ = ["PeriodStep", "Stepped", "period_step"]
+
+
+def period_step(system: Stepped, integrator: Integrator) -> PeriodStep:
+    """The period step of ``system`` with ``integrator`` (see the module docstring)."""
+    plant = system.plant
+    compiled = plant.compiled
+    step = None
+    if compiled is not None:
+        step = integrator_to_core(integrator, core_module())
+        step = None if isinstance(step, Fallback) else step
+
+    def integrated(t0, q0, v0, tau, t1):
+        q1, v1 = integrator.advance(
+            system.model, lambda t, q, v: system.acceleration(t, q, v, tau), t0, q0, v0, t1
+        )
+        system.settle(q1, v1)
+        return q1, v1
+
+    if system.objects:
+        return integrated
+    if step is not None and plant.world is None:
+        return lambda t0, q0, v0, tau, t1: compiled.advance(t0, q0, v0, tau, t1, step)
+    if step is not None and system.moving is None:
+        return lambda t0, q0, v0, tau, t1: compiled.advance_in_world(
+            t0, q0, v0, tau, t1, step, plant.friction
+        )
+    if compiled is None:
+        return integrated
+
+    def guarded(t0, q0, v0, tau, t1):
+        if system.clear(q0, v0, t1 - t0) and step is not None:
+            return compiled.advance(t0, q0, v0, tau, t1, step)
+        return integrated(t0, q0, v0, tau, t1)
+
+    return guarded

@@ -1,0 +1,218 @@
+"""A system of bodies: the robot and the free objects of its world, stepped together.
+
+The state stacks the robot's (q, zeta) and each free object's (pose (7,), body velocity (6,))
+(`SystemState`, `Layout`); its configuration space is that of a Pinocchio model made of the
+robot's joints and one free-flyer per object (used to integrate on the manifold, so that
+every integrator steps the whole system with its own rules). The right-hand side is
+
+    zeta_dot   = FD_robot(q, zeta, tau + tau_contact,robot)
+    nu_dot_o   = FD_o(q_o, nu_o, tau_contact,o)                 (each object o)
+
+with every contact force between two moving bodies exchanged equal and opposite
+(`uvms_pin.physics.world.moving`) and the water (current, waves, free surface) the same for
+all. A control period is crossed by one period step, chosen once per integrator
+(`uvms_pin.sim.system.period`); the contacts' friction anchors move at its end.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+import pinocchio as pin
+
+from uvms_pin.physics.dynamics import forward_dynamics
+from uvms_pin.sim.integrators import Integrator
+from uvms_pin.sim.plant import Plant, checked_start, has_moving_contacts
+from uvms_pin.sim.system.free_objects import FreeObjects
+from uvms_pin.sim.system.period import PeriodStep, period_step
+from uvms_pin.sim.system.state import Layout, SystemState
+
+__all__ = ["System"]
+
+#: what a world record says of a run with free objects
+PYTHON_PATH = (
+    "free objects: the system (UVMS and objects) is integrated by the Python integrator "
+    "around the compiled dynamics (the compiled plant has no free objects yet)"
+)
+
+
+def _system_model(robot: pin.Model, n_objects: int) -> pin.Model:
+    """The robot's joints and ``n_objects`` free-flyers under the universe (integration)."""
+    model = pin.Model(robot)
+    for k in range(n_objects):
+        model.addJoint(0, pin.JointModelFreeFlyer(), pin.SE3.Identity(), f"free_object_{k}")
+    return model
+
+
+class System:
+    """The robot ``plant`` and its world's free objects.
+
+    Attributes:
+        plant: the robot in its water, with its environment and fixed world.
+        moving: the moving contacts (`FreeObjects`), None when only the robot moves and its
+            arm does not meet its vehicle.
+        objects: the free objects (`uvms_pin.physics.world.FreeObject`), possibly none.
+        layout: where each body sits in the state. model: the system's Pinocchio model.
+    """
+
+    def __init__(self, plant: Plant):
+        self.plant = plant
+        world = plant.world
+        self.moving = FreeObjects(plant.uvms, world) if has_moving_contacts(world) else None
+        self.objects: tuple = () if self.moving is None else tuple(self.moving.objects)
+        uvms = plant.uvms
+        self.layout = Layout.of(
+            [("robot", uvms.nq, uvms.nv), *[(o.name, 7, 6) for o in self.objects]]
+        )
+        self.model = _system_model(uvms.model, len(self.objects)) if self.objects else uvms.model
+        self._steps: dict[int, tuple[Integrator, PeriodStep]] = {}
+        self._data = uvms.model.createData()  # the bound test's kinematics
+
+    # ---- the state ------------------------------------------------------------------------
+    def initial_state(self, q0: np.ndarray, v0: np.ndarray) -> SystemState:
+        """The state at t = 0: the robot at (q0, v0) (checked, its quaternion normalised),
+        every free object where its scenario puts it."""
+        q0, v0 = checked_start(self.plant.uvms.model, q0, v0)
+        states = [] if self.moving is None else self.moving.initial_states()
+        return self.layout.join([(q0, v0), *states])
+
+    def robot_state(self, q: np.ndarray, v: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """The robot's (q, v) in the system's (q, v) (views)."""
+        return q[self.layout.q_slices[0]], v[self.layout.v_slices[0]]
+
+    def start(self, state: SystemState) -> None:
+        """t = 0 at ``state``: the robot's environment anchored at its end-effector, the
+        flow taken, what touches held where it is (`Plant.attach`), the moving contacts'
+        anchors set afresh."""
+        q, _ = self.robot_state(state.q, state.v)
+        self.plant.attach(q)
+        if self.moving is not None:
+            self.moving.reset()
+            robot, *objects = self.layout.split(state.q, state.v)
+            self.moving.settle(robot[0], np.zeros(self.plant.uvms.nv), objects)
+
+    # ---- the dynamics ---------------------------------------------------------------------
+    def acceleration(
+        self,
+        time_s: float,
+        q: np.ndarray,
+        v: np.ndarray,
+        tau: np.ndarray,
+        contact_world: np.ndarray | None = None,
+    ) -> np.ndarray:
+        """The system's acceleration (nv,) with ``tau`` on the robot (``contact_world``:
+        the robot's end-effector contact as the continuous loop measured it)."""
+        plant = self.plant
+        if self.moving is None:
+            return plant.acceleration(time_s, q, v, tau, contact_world)
+        (q_r, v_r), *objects = self.layout.split(q, v)
+        tau_robot, tau_objects = self.moving.torques(q_r, v_r, objects)
+        out = [plant.acceleration(time_s, q_r, v_r, tau, contact_world, extra_torque=tau_robot)]
+        for obj, (q_o, v_o), tau_o in zip(self.objects, objects, tau_objects, strict=True):
+            out.append(
+                forward_dynamics(
+                    obj.uvms, q_o, v_o, np.zeros(6), tau_ext=tau_o, flow=plant.water,
+                    time_s=time_s, backend=plant.backend, free_surface=plant.free_surface,
+                )
+            )  # fmt: skip
+        return np.concatenate(out)
+
+    def advance(
+        self,
+        integrator: Integrator,
+        t0: float,
+        q0: np.ndarray,
+        v0: np.ndarray,
+        tau: np.ndarray,
+        t1: float,
+    ) -> tuple[np.ndarray, np.ndarray]:
+        """The system's (q, v) at t1 from (q0, v0) at t0 with the robot's input ``tau``
+        held (zero-order hold), by the period step of ``integrator``
+        (`uvms_pin.sim.system.period`, chosen at its first use and kept)."""
+        held = self._steps.get(id(integrator))
+        if held is None or held[0] is not integrator:
+            held = self._steps[id(integrator)] = (integrator, period_step(self, integrator))
+        return held[1](t0, q0, v0, tau, t1)
+
+    def clear(self, q: np.ndarray, v: np.ndarray, horizon_s: float) -> bool:
+        """Nothing can touch over ``horizon_s`` from the robot's (q, v): no fixed object
+        within reach (then no contact persists: the friction forgets its anchors) and no
+        moving pair (a system of the robot alone)."""
+        plant = self.plant
+        if plant.world is None:
+            return True
+        compiled = plant.compiled
+        if compiled is not None:
+            clear = compiled.world_clear(q, v, horizon_s)
+        else:
+            pin.forwardKinematics(plant.uvms.model, self._data, q, v)
+            clear = plant.world.clear(self._data, horizon_s)
+        if self.moving is not None and self.moving.near(q, v, [], horizon_s):
+            return False
+        if clear:
+            plant.friction.clear()
+        return clear
+
+    def settle(self, q: np.ndarray, v: np.ndarray) -> None:
+        """After a control period, at the system's (q, v): every contact's anchors move."""
+        (q_r, v_r), *objects = self.layout.split(q, v)
+        self.plant.settle(q_r, v_r)
+        if self.moving is not None:
+            self.moving.settle(q_r, v_r, objects)
+
+    # ---- what a run records -----------------------------------------------------------------
+    def record(self) -> dict[str, Any]:
+        """The world simulated, as plain data (`Plant.record`, with the moving pairs)."""
+        out = self.plant.record()
+        if self.moving is not None:
+            out["world"] = {
+                **out["world"],
+                "pairs": self.contact_pair_names,
+                "object_pairs": self.moving.moving.object_pair_names,
+                **({"integration": PYTHON_PATH} if self.objects else {}),
+            }
+        return out
+
+    @property
+    def contact_pair_names(self) -> list[str]:
+        """``first|second`` of every logged contact pair of the robot (``world_contact``):
+        its bodies against the fixed objects, then against the free objects and its own
+        vehicle."""
+        world = self.plant.world
+        if world is None:
+            return []
+        extra = [] if self.moving is None else self.moving.moving.uvms_pair_names
+        return world.pair_names + extra
+
+    @property
+    def n_logged_columns(self) -> int:
+        """Values a run of this system logs per sample beyond the robot's arrays: the wet
+        fractions, 9 per contact pair (force [N], point [m], moment [N m]) and 13 per free
+        object (its state)."""
+        plant = self.plant
+        hulls = len(plant.uvms.surface_bodies) if plant.free_surface else 0
+        pairs = len(self.contact_pair_names)
+        if self.moving is not None:
+            pairs += len(self.moving.moving.object_pair_names)
+        return hulls + 9 * pairs + 13 * len(self.objects)
+
+    def logged_signals(self, q: np.ndarray, v: np.ndarray) -> dict[str, np.ndarray]:
+        """What a run logs of the world at the system's (q, v): ``world_contact``, per
+        contact pair of the robot (`contact_pair_names`) the force on its body [N], the
+        point [m] and the moment about it [N m], world axes, flattened; with free objects,
+        ``free_objects`` (their states, `FreeObjects.state_columns`) and
+        ``free_object_contact`` (their pairs' wrenches). Empty without a world."""
+        plant = self.plant
+        if plant.world is None:
+            return {}
+        (q_r, v_r), *objects = self.layout.split(q, v)
+        fixed = plant.world.pair_wrenches(plant.world_forces(q_r, v_r)).ravel()
+        if self.moving is None:
+            return {"world_contact": fixed}
+        robot, between_objects = self.moving.wrenches(q_r, v_r, objects)
+        out = {"world_contact": np.concatenate([fixed, robot])}
+        if self.objects:
+            out["free_objects"] = np.concatenate([np.concatenate(s) for s in objects])
+            out["free_object_contact"] = between_objects
+        return out
