@@ -1,0 +1,117 @@
+"""The system of bodies (uvms_pin.sim.system): one state for every body, one right-hand side,
+one period step chosen once per integrator, the world's logged signals."""
+
+from __future__ import annotations
+
+from unittest import mock
+
+import numpy as np
+import pytest
+from conftest import ROOT
+
+import uvms_pin as up
+from uvms_pin.physics.compiled.extension import core_module
+from uvms_pin.scenario.load import load_scenario
+from uvms_pin.sim.compiled.integrator import integrator_to_core
+from uvms_pin.sim.integrators import RK4
+from uvms_pin.sim.plant import Plant
+from uvms_pin.sim.system import Layout, System
+from uvms_pin.sim.system import period as period_module
+
+PUSH = ROOT / "scenarios" / "push_object.toml"
+
+
+def test_a_layout_splits_and_joins_the_state_of_every_body():
+    layout = Layout.of([("robot", 11, 10), ("a", 7, 6), ("b", 7, 6)])
+    assert (layout.nq, layout.nv) == (25, 22)
+    q, v = np.arange(25.0), np.arange(22.0)
+    parts = layout.split(q, v)
+    assert [p[0].size for p in parts] == [11, 7, 7] and [p[1].size for p in parts] == [10, 6, 6]
+    np.testing.assert_array_equal(parts[1][0], q[11:18])
+    joined = layout.join(parts)
+    np.testing.assert_array_equal(joined.q, q)
+    np.testing.assert_array_equal(joined.v, v)
+
+
+def test_the_robot_alone_is_the_compiled_plants_period_chosen_once(reference_uvms):
+    plant = Plant(reference_uvms, np.array([0.2, 0.0, 0.1]), free_surface=False)
+    system = System(plant)
+    state = system.initial_state(reference_uvms.neutral_configuration(), np.zeros(10))
+    assert (system.layout.nq, system.layout.nv) == (11, 10) and system.objects == ()
+    system.start(state)
+    integrator, tau = RK4(5e-4), np.linspace(-1.0, 1.0, 10)
+    step = integrator_to_core(integrator, core_module())
+    expected = plant.compiled.advance(0.0, state.q, state.v, tau, 0.002, step)
+    with mock.patch.object(
+        period_module, "integrator_to_core", wraps=period_module.integrator_to_core
+    ) as built:
+        q, v = state.q, state.v
+        for k in range(3):
+            q, v = system.advance(integrator, 0.002 * k, q, v, tau, 0.002 * (k + 1))
+            if k == 0:
+                np.testing.assert_array_equal(q, expected[0])
+                np.testing.assert_array_equal(v, expected[1])
+    assert built.call_count == 1  # the period step is chosen at its first use and kept
+
+
+@pytest.fixture(scope="module")
+def push():
+    scenario = load_scenario(PUSH)
+    system = System(scenario.plant)
+    return scenario, system
+
+
+def test_free_objects_join_the_state_and_each_body_has_its_own_dynamics(push):
+    scenario, system = push
+    uvms = scenario.uvms
+    n = len(system.objects)
+    assert n >= 1
+    assert (system.layout.nq, system.layout.nv) == (uvms.nq + 7 * n, uvms.nv + 6 * n)
+    state = system.initial_state(scenario.q0, scenario.v0)
+    system.start(state)
+    for obj, (q_o, v_o) in zip(
+        system.objects, system.layout.split(state.q, state.v)[1:], strict=True
+    ):
+        np.testing.assert_array_equal(q_o, obj.q0)
+        np.testing.assert_array_equal(v_o, obj.v0)
+    # lifted far away from everything: each body alone in the water
+    q, v = state.q.copy(), state.v.copy()
+    q[:3] += [0.0, 0.0, 50.0]
+    for sl in system.layout.q_slices[1:]:
+        q[sl][:3] += [40.0 * (sl.start + 1), 0.0, 60.0]
+    tau = np.full(uvms.nv, 0.5)
+    a = system.acceleration(0.3, q, v, tau)
+    robot_q, robot_v = system.robot_state(q, v)
+    np.testing.assert_allclose(
+        a[: uvms.nv], scenario.plant.acceleration(0.3, robot_q, robot_v, tau), rtol=1e-12
+    )
+    for obj, (q_o, v_o), sl in zip(
+        system.objects, system.layout.split(q, v)[1:], system.layout.v_slices[1:], strict=True
+    ):
+        expected = up.forward_dynamics(
+            obj.uvms, q_o, v_o, np.zeros(6), flow=scenario.plant.water, time_s=0.3,
+            free_surface=scenario.plant.free_surface,
+        )  # fmt: skip
+        np.testing.assert_allclose(a[sl], expected, rtol=1e-12, atol=1e-14)
+
+
+def test_the_world_is_logged_per_pair_and_per_object(push):
+    scenario, system = push
+    state = system.initial_state(scenario.q0, scenario.v0)
+    system.start(state)
+    logged = system.logged_signals(state.q, state.v)
+    assert logged["world_contact"].size == 9 * len(system.contact_pair_names)
+    assert logged["free_objects"].size == 13 * len(system.objects)
+    np.testing.assert_array_equal(
+        logged["free_objects"][:7], system.layout.split(state.q, state.v)[1][0]
+    )
+    pairs = system.record()["world"]["object_pairs"]
+    assert logged["free_object_contact"].size == 9 * len(pairs)
+    assert system.n_logged_columns >= 9 * (len(system.contact_pair_names) + len(pairs)) + 13
+
+
+def test_without_a_world_nothing_more_is_logged(reference_uvms):
+    system = System(Plant(reference_uvms, free_surface=False))
+    state = system.initial_state(reference_uvms.neutral_configuration(), np.zeros(10))
+    assert system.logged_signals(state.q, state.v) == {}
+    assert system.n_logged_columns == 0 and system.moving is None
