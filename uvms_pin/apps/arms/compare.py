@@ -125,7 +125,7 @@ def _check_runs_fit(base, parallel: int) -> None:
         * settings.log_bytes(
             uvms.nq + _MORE_ARM_ENTRIES,
             uvms.nv + _MORE_ARM_ENTRIES,
-            base.plant.n_logged_hulls + _MORE_HULLS if base.plant.free_surface else 0,
+            len(uvms.surface_bodies) + _MORE_HULLS if base.plant.free_surface else 0,
         ),
         f"the logs of {parallel} arm runs at a time ({settings.n_log} samples each)",
         "shorten --duration, lengthen output.log_period_s or lower --jobs",
