@@ -4,6 +4,7 @@ and its errata fixed."""
 from __future__ import annotations
 
 import dataclasses
+from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -87,10 +88,11 @@ class PPCParams:
             raise ParameterError(f"n_joints must be a non-negative integer, got {n_joints}")
         return cls(**overrides).sized(N_VEHICLE + int(n_joints))
 
-    def sized(self, nv: int) -> PPCParams:
+    def sized(self, nv: int, velocity_names: Sequence[str] | None = None) -> PPCParams:
         """A copy whose array fields have 6 (first level) or ``nv`` (second level) entries,
         every value checked (the one place the parameters are); ``self`` when it already is
-        such a copy for ``nv``.
+        such a copy for ``nv``. ``velocity_names``: the nv generalized velocities' names, as
+        errors name a second-level funnel (default: u, v, w, p, q, r, joint 1 rate, ...).
 
         Raises:
             ParameterError: naming the field first: a wrong size or a non-finite value, a
@@ -129,7 +131,8 @@ class PPCParams:
                     f"printed negative gains are an erratum), got {sized[name][bad]} at "
                     f"indices {bad.tolist()}"
                 )
-        for level, names in (("x", FIRST_LEVEL_NAMES), ("zeta", _velocity_names(nv))):
+        names_zeta = _velocity_names(nv) if velocity_names is None else tuple(velocity_names)
+        for level, names in (("x", FIRST_LEVEL_NAMES), ("zeta", names_zeta)):
             funnel = (sized[f"rho0_{level}"], sized[f"rho_inf_{level}"], sized[f"l_{level}_per_s"])
             check_funnel_bounds(*funnel, names)
         for name in ("null_space_gain_per_s", "pinv_relative_cutoff"):

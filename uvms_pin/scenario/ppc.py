@@ -9,6 +9,7 @@ import dataclasses
 from uvms_pin.control.ppc import PrescribedPerformanceController
 from uvms_pin.control.ppc_params import PPCParams
 from uvms_pin.control.spec import ControllerSpec
+from uvms_pin.control.task_space import velocity_names
 from uvms_pin.errors import ParameterError
 from uvms_pin.model.uvms import UVMS
 from uvms_pin.physics.compiled.backend import BACKENDS
@@ -36,7 +37,7 @@ def read_ppc(t: Table, context: ControllerContext) -> ControllerSpec:
     desired_force, force_raw = desired_force_profile(t)
     t.finish()
     try:
-        params = PPCParams(**given).sized(uvms.nv)
+        params = PPCParams(**given).sized(uvms.nv, velocity_names(uvms.model))
     except ParameterError as exc:
         message = str(exc)
         key = next((k for k in given if message.startswith(f"{k} ")), None)
