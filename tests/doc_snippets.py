@@ -10,7 +10,7 @@ for any text.
 
 Long runs are shortened by one mechanism, the package's own: ``UVMS_PIN_MAX_DURATION_S``
 (`uvms_pin.sim.shortened`) is set to `CAP_S` for every snippet, and every shortened run
-says so in its output. An old module path (`OLD_PATHS_ARE_ERRORS`) fails the block.
+says so in its output.
 
 Directives are HTML comments on the lines right above a block's opening fence (invisible
 on GitHub, visible in the source), one per line:
@@ -40,9 +40,6 @@ from pathlib import Path
 
 #: the cap on every scenario run's simulated duration [s] while the snippets run
 CAP_S = "2"
-#: PYTHONWARNINGS while they run: a module path of 0.1 (uvms_pin/_moved.py) is an error, the
-#: documents show the new ones
-OLD_PATHS_ARE_ERRORS = "error:uvms_pin.:DeprecationWarning"
 
 #: fence language -> how the block runs
 LANGUAGES = {

@@ -10,7 +10,7 @@ import pytest
 from conftest import ROOT
 
 from uvms_pin.errors import ScenarioError
-from uvms_pin.scenario.load import load_scenario, scenario_from_raw
+from uvms_pin.scenario.load import load_scenario, scenario_from_dict
 from uvms_pin.scenario.schema import Table
 from uvms_pin.scenario.toml import read_toml
 
@@ -299,7 +299,7 @@ def scenario_keys_read() -> set[str]:
         for file, overrides, *replace in _VARIANTS:
             if replace:
                 raw = {**read_toml(SCENARIOS / file, ScenarioError), **overrides}
-                scenario_from_raw(raw, SCENARIOS / file)
+                scenario_from_dict(raw, SCENARIOS / file)
             else:
                 load_scenario(SCENARIOS / file, overrides)
     return seen

@@ -24,7 +24,6 @@ import pytest
 from conftest import DOCS_RUN_SUMMARY, ROOT
 from doc_snippets import (
     CAP_S,
-    OLD_PATHS_ARE_ERRORS,
     Snippet,
     all_snippets,
     commands,
@@ -70,7 +69,6 @@ def environment() -> dict[str, str]:
     env = dict(os.environ)
     env["PATH"] = os.pathsep.join([str(Path(sys.executable).parent), env.get("PATH", "")])
     env.update({MAX_DURATION_ENV: CAP_S, "MPLBACKEND": "Agg", "PYTHONUNBUFFERED": "1"})
-    env["PYTHONWARNINGS"] = OLD_PATHS_ARE_ERRORS
     env.pop("PYTHONPATH", None)
     return env
 

@@ -14,7 +14,7 @@ from uvms_pin.control.baselines.pi_force import PIForceController
 from uvms_pin.control.measurement import Measurement
 from uvms_pin.errors import ParameterError, ScenarioError
 from uvms_pin.model.scaled import scaled_uvms
-from uvms_pin.scenario.load import load_scenario, scenario_from_raw
+from uvms_pin.scenario.load import load_scenario, scenario_from_dict
 from uvms_pin.scenario.toml import read_toml
 from uvms_pin.sim.closed_loop import simulate_closed_loop
 from uvms_pin.sim.integrators import RK4
@@ -138,7 +138,7 @@ def _with_controller(table: dict):
     raw.pop("baselines")  # the tunings compare-controllers uses; not this table's
     raw["controller"] = {"desired_force": raw["controller"]["desired_force"], **table}
     raw["scenario"]["duration_s"] = 0.1
-    return scenario_from_raw(raw, REALISTIC)
+    return scenario_from_dict(raw, REALISTIC)
 
 
 @pytest.mark.parametrize(

@@ -14,7 +14,8 @@ from conftest import ROOT
 import uvms_pin as up
 from uvms_pin.apps.cli.main import main
 from uvms_pin.control.base import ZeroController
-from uvms_pin.scenario.custom_controller import ControllerSpec, load_controller_class
+from uvms_pin.control.spec import ControllerSpec
+from uvms_pin.scenario.custom_controller import load_controller_class
 from uvms_pin.scenario.load import load_scenario
 from uvms_pin.sim.run import simulate
 
@@ -146,8 +147,9 @@ def test_ppc_records_its_resolved_parameters():
         ('type = "my_ctrl_c:"', "expected 'package.module:ClassName'"),
         (
             'type = "pcc"',
-            "must be one of none, ppc, mpc, pi_force, impedance, computed_torque, task_priority, "
-            "resolved_acceleration or 'package.module:ClassName'",
+            "must be one of computed_torque, impedance, mpc, none, pi_force, ppc, "
+            "resolved_acceleration, task_priority or 'package.module:ClassName', got 'pcc' "
+            "(did you mean 'ppc'?)",
         ),
     ],
 )

@@ -180,26 +180,26 @@ def test_mpc_force_keys_are_checked(overrides, key):
     """A horizon shorter than one node, an unknown task, input or environment, a missing
     environment or a negative weight: a ScenarioError naming the key."""
     if overrides.get("controller.contact", 0) is None:
-        from uvms_pin.scenario.load import scenario_from_raw
+        from uvms_pin.scenario.load import scenario_from_dict
         from uvms_pin.scenario.toml import read_toml
 
         raw = read_toml(FORCE_SCENARIO, ScenarioError)
         del raw["controller"]["contact"]
         with pytest.raises(ScenarioError, match=key):
-            scenario_from_raw(raw, FORCE_SCENARIO)
+            scenario_from_dict(raw, FORCE_SCENARIO)
         return
     with pytest.raises(ScenarioError, match=key):
         load_scenario(FORCE_SCENARIO, overrides)
 
 
 def test_thruster_inputs_need_thrusters():
-    from uvms_pin.scenario.load import scenario_from_raw
+    from uvms_pin.scenario.load import scenario_from_dict
     from uvms_pin.scenario.toml import read_toml
 
     raw = read_toml(FORCE_SCENARIO, ScenarioError)
     del raw["actuation"]
     with pytest.raises(ScenarioError, match=r"controller\.inputs"):
-        scenario_from_raw(raw, FORCE_SCENARIO)
+        scenario_from_dict(raw, FORCE_SCENARIO)
 
 
 def test_a_bad_mpc_horizon_exits_2_on_the_command_line(tmp_path):

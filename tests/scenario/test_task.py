@@ -14,8 +14,9 @@ from conftest import ROOT
 
 from uvms_pin.apps.cli.main import main
 from uvms_pin.errors import ScenarioError
+from uvms_pin.scenario.load import scenario_from_dict
 from uvms_pin.scenario.toml import read_toml
-from uvms_pin.sim.run import Scenario, simulate
+from uvms_pin.sim.run import simulate
 
 CIRCLE = ROOT / "scenarios" / "lbv150_ee_circle.toml"
 
@@ -31,7 +32,7 @@ def _raw(duration_s: float, **tables) -> dict:
 
 
 def test_the_reference_starts_at_the_target():
-    scenario = Scenario.from_dict(read_toml(CIRCLE, ScenarioError), CIRCLE)
+    scenario = scenario_from_dict(read_toml(CIRCLE, ScenarioError), CIRCLE)
     task, uvms = scenario.task, scenario.uvms
     data = uvms.model.createData()
     pin.framesForwardKinematics(uvms.model, data, scenario.q0)
@@ -63,27 +64,27 @@ def test_the_reference_starts_at_the_target():
 )
 def test_bad_task_tables_name_the_key(task, match):
     with pytest.raises(ScenarioError, match=match):
-        Scenario.from_dict(_raw(1.0, task=task), CIRCLE)
+        scenario_from_dict(_raw(1.0, task=task), CIRCLE)
 
 
 def test_tracking_controllers_need_a_task_and_good_keys():
     raw = _raw(1.0)
     raw.pop("task")
     with pytest.raises(ScenarioError, match="'task_priority' follows a tracking task"):
-        Scenario.from_dict(raw, CIRCLE)
+        scenario_from_dict(raw, CIRCLE)
     bad = _raw(1.0, controller={"type": "task_priority", "passive_velocities": [3, 7]})
     with pytest.raises(ScenarioError, match="passive_velocities: must be distinct indices"):
-        Scenario.from_dict(bad, CIRCLE)
+        scenario_from_dict(bad, CIRCLE)
     vehicle_frame = _raw(1.0, controller={"type": "resolved_acceleration"})
     vehicle_frame["task"]["frame"] = "vehicle"
     with pytest.raises(ScenarioError, match="world frame only"):
-        Scenario.from_dict(vehicle_frame, CIRCLE)
+        scenario_from_dict(vehicle_frame, CIRCLE)
 
 
 def test_resolved_acceleration_with_the_exact_model_tracks_the_circle():
     # exact model, still water, no noise, every velocity actuated: the error obeys
     # e'' + K_d e' + K_p e = 0 up to the 100 Hz zero-order hold
-    scenario = Scenario.from_dict(_raw(8.0, controller={"type": "resolved_acceleration"}), CIRCLE)
+    scenario = scenario_from_dict(_raw(8.0, controller={"type": "resolved_acceleration"}), CIRCLE)
     metrics = simulate(scenario, progress=False).metrics()
     assert metrics["task_position_error_max_m"] < 1e-4
     assert metrics["task_orientation_error_max_rad"] < 1e-3
@@ -97,7 +98,7 @@ def test_task_priority_keeps_the_joints_inside_their_limits():
     # the joints at their margins and the pose task keeps what is left of its error
     task = {"type": "hold", "frame": "vehicle", "rpy_rad": [0.0, 0.0, 2.2]}
     raw = _raw(8.0, task=task, controller={"type": "task_priority"})
-    rollout = simulate(Scenario.from_dict(raw, CIRCLE), progress=False)
+    rollout = simulate(scenario_from_dict(raw, CIRCLE), progress=False)
     metrics = rollout.metrics()
     assert metrics["joint_limit_excess_max_rad"] == 0.0
     assert rollout.signals["joint_limit_active"].max() == 1.0
@@ -141,7 +142,7 @@ def test_task_priority_tracks_vehicle_paths_and_vehicle_frame_tasks(task):
     # default gains, no acceleration feed-forward: the velocity level lags a_r / K_v behind
     # (vehicle path: 0.02 m/s^2 / 4 1/s = 5 mm/s), which K_p = 1 1/s turns into ~5 mm
     raw = _raw(6.0, task=task, controller={"type": "task_priority"})
-    metrics = simulate(Scenario.from_dict(raw, CIRCLE), progress=False).metrics()
+    metrics = simulate(scenario_from_dict(raw, CIRCLE), progress=False).metrics()
     assert metrics["task_position_error_max_m"] < 1e-2
     if task.get("track_orientation", True):
         assert metrics["task_orientation_error_max_rad"] < 0.01
@@ -152,7 +153,7 @@ def test_the_integral_takes_up_the_current_the_model_does_not_know():
     def final_error(integral_gain: float) -> float:
         controller = {"type": "task_priority", "integral_gain_per_s2": [integral_gain] * 10}
         raw = _raw(10.0, controller=controller, water={"current_world_m_s": [0.2, 0.0, 0.0]})
-        rollout = simulate(Scenario.from_dict(raw, CIRCLE), progress=False)
+        rollout = simulate(scenario_from_dict(raw, CIRCLE), progress=False)
         return rollout.metrics()["task_position_error_final_m"]
 
     with_integral, without = final_error(4.0), final_error(0.0)

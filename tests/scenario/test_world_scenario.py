@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 from uvms_pin.errors import ScenarioError
-from uvms_pin.scenario.load import load_scenario, scenario_from_raw
+from uvms_pin.scenario.load import load_scenario, scenario_from_dict
 from uvms_pin.scenario.toml import read_toml
 from uvms_pin.sim.system import System
 
@@ -46,7 +46,7 @@ def _with_object(k: int, **changes):
             entry.pop(key)
         else:
             entry[key] = value
-    return scenario_from_raw(raw, SEABED)
+    return scenario_from_dict(raw, SEABED)
 
 
 @pytest.mark.parametrize(

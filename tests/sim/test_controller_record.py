@@ -9,8 +9,9 @@ import numpy as np
 from conftest import ROOT
 
 from uvms_pin.control.base import Controller
+from uvms_pin.control.spec import ControllerSpec
 from uvms_pin.scenario.load import load_scenario
-from uvms_pin.sim.run import ControllerSpec, simulate
+from uvms_pin.sim.run import simulate
 
 REALISTIC = ROOT / "scenarios" / "realistic_force_tracking.toml"
 

@@ -1,4 +1,4 @@
-"""Scenarios built in code (`Scenario.from_dict`), a controller instance passed to
+"""Scenarios built in code (`scenario_from_dict`), a controller instance passed to
 `simulate`, and controllers' named, unit-carrying signals (`Signal`) as table columns."""
 
 from __future__ import annotations
@@ -13,8 +13,9 @@ import uvms_pin as up
 from uvms_pin.control.base import Controller
 from uvms_pin.errors import ParameterError, ScenarioError
 from uvms_pin.results.signal import Signal
+from uvms_pin.scenario.load import scenario_from_dict
 from uvms_pin.scenario.toml import read_toml
-from uvms_pin.sim.run import Scenario, simulate
+from uvms_pin.sim.run import simulate
 
 PASSIVE = ROOT / "scenarios" / "passive_still_water.toml"
 
@@ -54,7 +55,7 @@ class Braking(Controller):
 def test_from_dict_equals_the_file(tmp_path):
     raw = _passive()
     from_file = up.load_scenario(PASSIVE, {"scenario.duration_s": 0.1})
-    from_dict = Scenario.from_dict(raw)
+    from_dict = scenario_from_dict(raw)
     assert from_dict.raw == from_file.raw and from_dict.name == from_file.name
     a, b = simulate(from_file, progress=False), simulate(from_dict, progress=False)
     np.testing.assert_array_equal(a.q, b.q)
@@ -68,13 +69,13 @@ def test_from_dict_checks_keys_as_a_file_is():
     with pytest.raises(
         ScenarioError, match=r"<dict>: \[water\] has unknown key\(s\): densty_kg_m3"
     ):
-        Scenario.from_dict(raw)
+        scenario_from_dict(raw)
     with pytest.raises(ScenarioError, match=r"override 'scenario\.duration_s': must be positive"):
-        Scenario.from_dict(_passive(), overrides={"scenario.duration_s": -1.0})
+        scenario_from_dict(_passive(), overrides={"scenario.duration_s": -1.0})
 
 
 def test_a_controller_instance_runs_and_is_recorded():
-    scenario = Scenario.from_dict(_passive(0.2))
+    scenario = scenario_from_dict(_passive(0.2))
     passive = simulate(scenario, progress=False)
     braking = Braking(30.0)
     rollout = simulate(scenario, progress=False, controller=braking)
@@ -96,7 +97,7 @@ def test_a_controller_instance_runs_and_is_recorded():
 
 
 def test_named_signals_become_named_columns_with_units(tmp_path):
-    scenario = Scenario.from_dict(_passive(0.1))
+    scenario = scenario_from_dict(_passive(0.1))
     rollout = simulate(scenario, progress=False, controller=Braking(1.0))
     frame = rollout.to_dataframe()
     names = rollout.metadata["arm_joint_names"]

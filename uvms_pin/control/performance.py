@@ -25,6 +25,24 @@ from numpy.typing import ArrayLike
 from uvms_pin.errors import FunnelViolation, ParameterError
 
 
+def check_funnel_bounds(
+    rho0: np.ndarray, rho_inf: np.ndarray, decay_rate_per_s: np.ndarray, names: Sequence[str]
+) -> None:
+    """rho0 > rho_inf > 0 and l > 0 for every component (1-D arrays of one size, one name
+    each); ParameterError naming the funnel otherwise."""
+    for j, name in enumerate(names):
+        if not rho_inf[j] > 0.0:
+            raise ParameterError(f"funnel '{name}': rho_inf = {rho_inf[j]} must be > 0")
+        if not rho0[j] > rho_inf[j]:
+            raise ParameterError(
+                f"funnel '{name}': rho0 = {rho0[j]} must be > rho_inf = {rho_inf[j]}"
+            )
+        if not decay_rate_per_s[j] > 0.0:
+            raise ParameterError(
+                f"funnel '{name}': decay_rate_per_s = {decay_rate_per_s[j]} must be > 0"
+            )
+
+
 class PerformanceFunction:
     """Exponentially decaying funnels rho_j(t), one per error component.
 
@@ -73,17 +91,7 @@ class PerformanceFunction:
         names = [str(name) for name in names]
         if len(names) != size:
             raise ParameterError(f"{len(names)} names given for {size} funnel components")
-        for j, name in enumerate(names):
-            if not rho_inf_arr[j] > 0.0:
-                raise ParameterError(f"funnel '{name}': rho_inf = {rho_inf_arr[j]} must be > 0")
-            if not rho0_arr[j] > rho_inf_arr[j]:
-                raise ParameterError(
-                    f"funnel '{name}': rho0 = {rho0_arr[j]} must be > rho_inf = {rho_inf_arr[j]}"
-                )
-            if not rate_arr[j] > 0.0:
-                raise ParameterError(
-                    f"funnel '{name}': decay_rate_per_s = {rate_arr[j]} must be > 0"
-                )
+        check_funnel_bounds(rho0_arr, rho_inf_arr, rate_arr, names)
         self.rho0 = rho0_arr.copy()
         self.rho_inf = rho_inf_arr.copy()
         self.decay_rate_per_s = rate_arr.copy()

@@ -4,12 +4,15 @@ and its errata fixed."""
 from __future__ import annotations
 
 import dataclasses
+from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
 from numpy.typing import ArrayLike
 
+from uvms_pin.control.performance import check_funnel_bounds
 from uvms_pin.errors import ParameterError
+from uvms_pin.results.components import FIRST_LEVEL_NAMES, VEHICLE_VELOCITY_NAMES
 
 #: The vehicle's generalized velocities (a free-flyer: 6); the arm's follow.
 N_VEHICLE = 6
@@ -23,7 +26,9 @@ class PPCParams:
     component: 6 for the first level (``_x``: f_x, f_y, f_z [N]; roll, pitch, yaw [rad]),
     nv = 6 + n_joints for the second level (``_zeta``: u, v, w [m/s]; p, q, r [rad/s];
     joint rates [rad/s]). :meth:`for_uvms` returns fully sized arrays; :meth:`sized`
-    validates and sizes any instance.
+    validates and sizes any instance: that is where the parameters are checked, once; the
+    sized instance it returns is trusted downstream (sizing it again for the same nv
+    returns it as it is).
 
     Defaults are the paper's simulation values (Section 5) with its errata fixed
     (docs/controller.md):
@@ -83,14 +88,20 @@ class PPCParams:
             raise ParameterError(f"n_joints must be a non-negative integer, got {n_joints}")
         return cls(**overrides).sized(N_VEHICLE + int(n_joints))
 
-    def sized(self, nv: int) -> PPCParams:
-        """A copy whose array fields have 6 (first level) or ``nv`` (second level) entries.
+    def sized(self, nv: int, velocity_names: Sequence[str] | None = None) -> PPCParams:
+        """A copy whose array fields have 6 (first level) or ``nv`` (second level) entries,
+        every value checked (the one place the parameters are); ``self`` when it already is
+        such a copy for ``nv``. ``velocity_names``: the nv generalized velocities' names, as
+        errors name a second-level funnel (default: u, v, w, p, q, r, joint 1 rate, ...).
 
         Raises:
-            ParameterError: a field has the wrong size or a non-finite value, a gain is
-                not > 0, or ``null_space_gain_per_s`` / ``pinv_relative_cutoff`` < 0.
+            ParameterError: naming the field first: a wrong size or a non-finite value, a
+                gain not > 0, a funnel without rho0 > rho_inf > 0 and a decay rate > 0, or
+                ``null_space_gain_per_s`` / ``pinv_relative_cutoff`` not finite and >= 0.
         """
         nv = int(nv)
+        if getattr(self, "_checked_nv", None) == nv:
+            return self
         if nv < N_VEHICLE:
             raise ParameterError(f"nv = {nv}: a UVMS has at least the 6 vehicle velocities")
         rho_inf_zeta = self.rho_inf_zeta
@@ -120,17 +131,39 @@ class PPCParams:
                     f"printed negative gains are an erratum), got {sized[name][bad]} at "
                     f"indices {bad.tolist()}"
                 )
+        names_zeta = _velocity_names(nv) if velocity_names is None else tuple(velocity_names)
+        for level, names in (("x", FIRST_LEVEL_NAMES), ("zeta", names_zeta)):
+            funnel = (sized[f"rho0_{level}"], sized[f"rho_inf_{level}"], sized[f"l_{level}_per_s"])
+            check_funnel_bounds(*funnel, names)
         for name in ("null_space_gain_per_s", "pinv_relative_cutoff"):
-            value = float(getattr(self, name))
+            value = _number(name, getattr(self, name))
             if not (np.isfinite(value) and value >= 0.0):
                 raise ParameterError(f"{name} must be finite and >= 0, got {value}")
-        return dataclasses.replace(self, **sized)
+        checked = dataclasses.replace(self, **sized)
+        object.__setattr__(checked, "_checked_nv", nv)  # not a field: not recorded, not compared
+        return checked
+
+
+def _velocity_names(nv: int) -> tuple[str, ...]:
+    return (*VEHICLE_VELOCITY_NAMES, *(f"joint {k + 1} rate" for k in range(nv - N_VEHICLE)))
+
+
+def _number(name: str, value: object) -> float:
+    if isinstance(value, bool) or not isinstance(value, int | float | np.integer | np.floating):
+        raise ParameterError(f"{name} must be a number, got {value!r}")
+    return float(value)
 
 
 def sized_vector(name: str, value: ArrayLike, size: int) -> np.ndarray:
     """``value`` as a read-only (size,) float array: a scalar broadcast, else exactly
     ``size`` finite entries (ParameterError naming ``name`` otherwise)."""
-    array = np.asarray(value, dtype=float)
+    try:
+        array = np.asarray(value)
+    except (TypeError, ValueError):  # ragged lists
+        array = np.asarray(None)
+    if array.dtype.kind not in "iuf":  # no strings, booleans, objects
+        raise ParameterError(f"{name} must be a number or a list of numbers, got {value!r}")
+    array = array.astype(float)
     if array.ndim == 0:
         array = np.full(size, float(array))
     if array.shape != (size,):

@@ -112,6 +112,11 @@ def first_level_error(
     ]
 
 
+def velocity_names(model: pin.Model) -> tuple[str, ...]:
+    """The names of the generalized velocities: the vehicle's (u, v, w, p, q, r), the arm's."""
+    return VEHICLE_VELOCITY_NAMES + tuple(arm_velocity_names(model))
+
+
 def arm_velocity_names(model: pin.Model) -> list[str]:
     """The names of the arm's generalized velocities (a multi-DoF joint: ``name[k]``)."""
     names = []
@@ -252,11 +257,11 @@ class ForceOrientationTask:
         self.model = pin.Model(model)
         self.data = self.model.createData()
         self.ee_frame_id = frame_id_from_name(self.model, ee_frame_name)
-        self.params = params.sized(self.model.nv)
+        self.velocity_names = velocity_names(self.model)
+        self.params = params.sized(self.model.nv, self.velocity_names)
         self.desired_force = signal_of_time(desired_force_world_N, "desired_force_world_N", 3)
         rpy = self.params.desired_rpy if desired_rpy is None else desired_rpy
         self.desired_rpy = signal_of_time(rpy, "desired_rpy", 3)
-        self.velocity_names = VEHICLE_VELOCITY_NAMES + tuple(arm_velocity_names(self.model))
         p = self.params
         self.pull = JointLimitPull(self.model, p.null_space_gain_per_s, p.null_space_target)
         self.reference = ReferenceVelocity(

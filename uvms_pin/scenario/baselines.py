@@ -5,6 +5,7 @@ the scenario's own controller (`baseline_controller_table`)."""
 from __future__ import annotations
 
 import copy
+import functools
 from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any
@@ -13,17 +14,18 @@ from uvms_pin.control.base import Controller
 from uvms_pin.control.baselines.computed_torque import ComputedTorqueController
 from uvms_pin.control.baselines.impedance import ImpedanceController
 from uvms_pin.control.baselines.pi_force import PIForceController
+from uvms_pin.control.spec import ControllerSpec
 from uvms_pin.errors import ScenarioError
 from uvms_pin.model.scaled import scaled_uvms
 from uvms_pin.model.uvms import UVMS
 from uvms_pin.scenario.controller_parts import (
-    checked_spec,
+    CONTROLLERS,
+    ControllerContext,
     desired_force_profile,
     ee_frame_name,
     plain,
 )
 from uvms_pin.scenario.schema import Table
-from uvms_pin.sim.run import ControllerSpec
 
 #: Keys of a PPC [controller] table a baseline of the same task inherits (the same task,
 #: and for the J^# baselines the same pseudo-inverse and null-space pull).
@@ -92,9 +94,9 @@ BASELINES: dict[str, Baseline] = {
 BASELINE_KINDS = tuple(BASELINES)
 
 
-def build_baseline(t: Table, uvms: UVMS, kind: str) -> ControllerSpec:
+def read_baseline(t: Table, context: ControllerContext, kind: str) -> ControllerSpec:
     """[controller] type = ``kind``, a baseline."""
-    baseline = BASELINES[kind]
+    baseline, uvms = BASELINES[kind], context.uvms
     ee_frame = ee_frame_name(t, uvms, kind)
     sizes = {"nv": uvms.nv, "arm": uvms.n_arm_joints}
     fields: dict[str, Any] = {}
@@ -113,7 +115,11 @@ def build_baseline(t: Table, uvms: UVMS, kind: str) -> ControllerSpec:
 
     parameters = {k: plain(v) for k, v in fields.items() if k != "desired_force_world_N"}
     recorded = {"ee_frame": ee_frame, "desired_force": force_raw, "model_error": factors}
-    return checked_spec(t, uvms, kind, {**recorded, **parameters}, build)
+    return ControllerSpec(kind, {**recorded, **parameters}, build)
+
+
+for _kind in BASELINES:
+    CONTROLLERS.register(_kind)(functools.partial(read_baseline, kind=_kind))
 
 
 def model_error_factors(t: Table | None) -> dict[str, float]:

@@ -1,85 +1,59 @@
 """``[controller]``: which law runs and its parameters, as a `ControllerSpec` (what it builds
 and what the rollout records).
 
-``type`` is "none" (zero input), "ppc" (the paper's law, `uvms_pin.scenario.ppc`), a baseline
-("pi_force", "impedance", "computed_torque": `uvms_pin.scenario.baselines`), "mpc"
-(model-predictive control, `uvms_pin.scenario.mpc`) or
-"package.module:ClassName", your own (`uvms_pin.scenario.custom_controller`); with a
-``[task]``, "task_priority" or "resolved_acceleration" (`uvms_pin.scenario.tracking_controllers`).
+``type`` names a reader of the registry `CONTROLLERS`, where each controller's module
+registers its own: "none" (zero input, here), "ppc" (the paper's law, `uvms_pin.scenario.ppc`),
+a baseline ("pi_force", "impedance", "computed_torque": `uvms_pin.scenario.baselines`), "mpc"
+(model-predictive control, `uvms_pin.scenario.mpc`), with a ``[task]`` "task_priority" or
+"resolved_acceleration" (`uvms_pin.scenario.tracking_controllers`); or
+"package.module:ClassName", your own (`uvms_pin.scenario.custom_controller`).
+
+The controller is built once here (`ControllerSpec.checked`), so that a bad parameter is
+found before the run, and that build is the one the run gets.
 """
 
 from __future__ import annotations
 
+import dataclasses
 import functools
-from collections.abc import Callable
-from pathlib import Path
 
 from uvms_pin.control.base import Controller, ZeroController
-from uvms_pin.control.tracking.task import TrackingTask
+from uvms_pin.control.spec import ControllerSpec
 from uvms_pin.errors import ParameterError
 from uvms_pin.model.uvms import UVMS
-from uvms_pin.scenario.baselines import BASELINES, build_baseline
-from uvms_pin.scenario.custom_controller import custom_controller
-from uvms_pin.scenario.mpc import build_mpc
-from uvms_pin.scenario.ppc import build_ppc
+from uvms_pin.scenario import baselines, mpc, ppc, tracking_controllers
+from uvms_pin.scenario.controller_parts import CONTROLLERS, ControllerContext
+from uvms_pin.scenario.custom_controller import read_custom
 from uvms_pin.scenario.schema import Table
-from uvms_pin.scenario.tracking_controllers import TRACKING_CONTROLLERS
-from uvms_pin.sim.actuation import Actuation, Unlimited
-from uvms_pin.sim.run import ControllerSpec
+
+#: the modules that register their readers in `CONTROLLERS` (imported for that)
+REGISTERING_MODULES = (ppc, mpc, baselines, tracking_controllers)
 
 
 def _zero(uvms: UVMS) -> Controller:
     return ZeroController(uvms.nv)
 
 
-NO_CONTROLLER = ControllerSpec("none", {}, _zero)
-
-
-def _none(t: Table, uvms: UVMS) -> ControllerSpec:
+@CONTROLLERS.register("none")
+def read_none(t: Table, context: ControllerContext) -> ControllerSpec:
+    """[controller] type = "none": zero input."""
     t.finish()
-    return NO_CONTROLLER
+    return ControllerSpec("none", {}, _zero)
 
 
-#: [controller] type -> how the controller is built from the table
-CONTROLLERS: dict[str, Callable[[Table, UVMS], ControllerSpec]] = {
-    "none": _none,
-    "ppc": build_ppc,
-    "mpc": build_mpc,
-    **{kind: functools.partial(build_baseline, kind=kind) for kind in BASELINES},
-}
-
-
-def build_controller(
-    t: Table | None,
-    uvms: UVMS,
-    scenario_dir: Path,
-    task: TrackingTask | None = None,
-    actuation: Actuation | None = None,
-) -> ControllerSpec:
-    """The [controller] table's controller (none without the table); the tracking
-    controllers (`TRACKING_CONTROLLERS`) follow the scenario's ``task`` and leave alone the
-    velocities ``actuation`` does not drive."""
-    if t is None:
-        return NO_CONTROLLER
-    kind = t.string("type")
-    if kind in TRACKING_CONTROLLERS:
-        if task is None:
-            raise t.error("type", f"'{kind}' follows a tracking task: the scenario needs a [task]")
-        return TRACKING_CONTROLLERS[kind](t, uvms, task, actuation or Unlimited())
-    if ":" in kind:
-        try:
-            spec = custom_controller(kind, t.rest(), scenario_dir)
-            spec(uvms)  # built once now, so a bad parameter is found before the run
-        except ParameterError as exc:
-            error = t.fail(str(exc))
-            error.user_traceback = exc.user_traceback  # the user's module or class raised
-            raise error from exc
-        return spec
-    if kind == "mpc":  # it may plan on the scenario's thrusters
-        return build_mpc(t, uvms, actuation or Unlimited())
-    if kind not in CONTROLLERS:
-        choices = ", ".join([*CONTROLLERS, *TRACKING_CONTROLLERS])
-        raise t.error(
-            "type", f"must be one of {choices} or 'package.module:ClassName', got '{kind}'"
-        )
-    return CONTROLLERS[kind](t, uvms)
+def build_controller(t: Table | None, context: ControllerContext) -> ControllerSpec:
+    """The [controller] table's controller ("none" without the table), built once now for
+    ``context.uvms`` (a bad parameter raises here, naming the table) and kept for the run."""
+    table = Table.empty("controller", "") if t is None else t
+    kind = "none" if t is None else table.string("type")
+    try:
+        read = functools.partial(read_custom, kind) if ":" in kind else CONTROLLERS[kind]
+    except ParameterError as exc:
+        raise table.error("type", str(exc)) from None
+    try:
+        spec = dataclasses.replace(read(table, context), from_file=True)
+        return spec.checked(context.uvms)
+    except ParameterError as exc:
+        error = table.fail(str(exc))
+        error.user_traceback = exc.user_traceback  # your own module or class raised
+        raise error from exc

@@ -1,18 +1,50 @@
-"""What the controller tables share: the end-effector frame, the desired force, the check that
-a controller builds, and plain records of its parameters."""
+"""What the controller tables share: the registry of their readers (`CONTROLLERS`) and what a
+reader is given (`ControllerContext`), the end-effector frame, the desired force, and plain
+records of the parameters."""
 
 from __future__ import annotations
 
 import math
 from collections.abc import Callable
+from dataclasses import dataclass, field
+from pathlib import Path
 from typing import Any
 
 import numpy as np
 
-from uvms_pin.errors import ParameterError
+from uvms_pin.control.spec import ControllerSpec
+from uvms_pin.control.tracking.task import TrackingTask
 from uvms_pin.model.uvms import UVMS
+from uvms_pin.scenario.registry import Registry
 from uvms_pin.scenario.schema import Table
-from uvms_pin.sim.run import ControllerSpec
+from uvms_pin.sim.actuation import Actuation, Unlimited
+
+
+@dataclass(frozen=True)
+class ControllerContext:
+    """What a [controller] table is read with besides itself.
+
+    Attributes:
+        uvms: the scenario's model. scenario_dir: the scenario file's directory (your own
+            controller's module is found there). task: the scenario's [task] (None without).
+        actuation: the plant's actuation (thrusters the MPC may plan on, the velocities a
+            tracking controller leaves alone).
+    """
+
+    uvms: UVMS
+    scenario_dir: Path = Path(".")
+    task: TrackingTask | None = None
+    actuation: Actuation = field(default_factory=Unlimited)
+
+
+#: reads one [controller] table: (the table, its context) -> what builds the controller
+ControllerReader = Callable[[Table, ControllerContext], ControllerSpec]
+
+#: [controller] type -> its reader; each controller's module registers its own
+#: (``@CONTROLLERS.register("ppc")``); "package.module:ClassName" is your own class
+CONTROLLERS: Registry[ControllerReader] = Registry(
+    "controller type", besides="'package.module:ClassName'"
+)
 
 
 def sine_profile(t: Table | None, size: int) -> Callable[[float], np.ndarray]:
@@ -50,15 +82,3 @@ def ee_frame_name(t: Table, uvms: UVMS, kind: str) -> str:
         return t.string("ee_frame")
     ee_id = uvms.require_ee_frame(f"[controller] type = '{kind}'")
     return uvms.model.frames[ee_id].name
-
-
-def checked_spec(
-    t: Table, uvms: UVMS, kind: str, recorded: dict[str, Any], build: Callable[[UVMS], Any]
-) -> ControllerSpec:
-    """The spec of a controller, built once now so that a bad parameter is found before the
-    run (its ParameterError names the table)."""
-    try:
-        build(uvms)
-    except ParameterError as exc:
-        raise t.fail(str(exc)) from exc
-    return ControllerSpec(kind, recorded, build)

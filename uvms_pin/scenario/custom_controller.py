@@ -22,12 +22,14 @@ from pathlib import Path
 from typing import Any
 
 from uvms_pin.control.base import Controller
+from uvms_pin.control.spec import ControllerSpec
 from uvms_pin.errors import ParameterError
 from uvms_pin.model.uvms import UVMS
 from uvms_pin.results.named import resolve_reference, users_code_failed
-from uvms_pin.sim.run import ControllerSpec
+from uvms_pin.scenario.controller_parts import ControllerContext
+from uvms_pin.scenario.schema import Table
 
-__all__ = ["custom_controller", "load_controller_class"]
+__all__ = ["custom_controller", "load_controller_class", "read_custom"]
 
 
 def load_controller_class(type_path: str, search_dir: str | Path | None = None) -> type:
@@ -73,3 +75,9 @@ def custom_controller(
         return controller
 
     return ControllerSpec(type_path, frozen, build)
+
+
+def read_custom(type_path: str, t: Table, context: ControllerContext) -> ControllerSpec:
+    """[controller] type = "package.module:ClassName": the table's other keys are the
+    class's parameters; the module is searched next to the scenario file first."""
+    return custom_controller(type_path, t.rest(), context.scenario_dir)

@@ -19,6 +19,7 @@ examples.
 from __future__ import annotations
 
 import warnings
+from collections.abc import Mapping
 from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any
@@ -30,6 +31,7 @@ from uvms_pin.model.uvms import UVMS
 from uvms_pin.scenario.actuation import build_actuation
 from uvms_pin.scenario.baselines import check_baselines
 from uvms_pin.scenario.controller import build_controller
+from uvms_pin.scenario.controller_parts import ControllerContext
 from uvms_pin.scenario.estimator import build_estimator
 from uvms_pin.scenario.initial import build_initial_state
 from uvms_pin.scenario.joints import build_joint_friction, with_joint_lag
@@ -77,17 +79,25 @@ def load_scenario(path: str | Path, overrides: dict[str, Any] | None = None) -> 
         ScenarioError: naming the file and the key, or the override that set a bad value.
     """
     path = Path(path)
-    return scenario_from_raw(read_toml(path, ScenarioError), path, overrides)
+    return scenario_from_dict(read_toml(path, ScenarioError), path, overrides)
 
 
-def scenario_from_raw(
-    raw: dict[str, Any], path: str | Path, overrides: dict[str, Any] | None = None
+def scenario_from_dict(
+    data: Mapping[str, Any], path: str | Path = "<dict>", overrides: dict[str, Any] | None = None
 ) -> Scenario:
-    """`load_scenario` of an already-read document ``raw`` (as if read from ``path``:
-    relative model paths and custom controllers resolve next to it)."""
+    """A scenario built in code: ``data`` is what the TOML file would hold, as nested dicts
+    (``{"scenario": {"model": "uvms_lbv150", "duration_s": 5}, "water": {...}}``), checked
+    key by key exactly as a file is (`load_scenario` reads a file and calls this). ``path``:
+    as if read from this file (relative model paths, your own controllers and metrics
+    resolve in its directory: the working directory by default). ``overrides``: dotted
+    keys, as ``uvms-pin run --set``. ``data`` is copied (`apply_overrides`), never changed.
+
+    Raises:
+        ScenarioError: naming the key (and ``path``) of a bad value.
+    """
     path = Path(path)
     source = str(path)
-    raw = apply_overrides(raw, overrides)
+    raw = apply_overrides(dict(data), overrides)
     overridden = {parse_key_path(text).key: text for text in overrides or {}}
     try:
         return shortened(_build(raw, path, Table(raw, "", source, overridden)))
@@ -124,10 +134,8 @@ def _build(raw: dict[str, Any], path: Path, top: Table) -> Scenario:
         raise top.error(
             "sensors", "navigation sensors sample at the control ticks: set [control] period_s"
         )
-    controller = replace(
-        build_controller(top.table("controller"), uvms, path.parent, task, actuation),
-        from_file=True,
-    )
+    context = ControllerContext(uvms, path.parent, task, actuation)
+    controller = build_controller(top.table("controller"), context)
     check_replan_rate(top, raw.get("controller"), control_period)
     extra_metrics = build_metrics(top.table("metrics"), path.parent)
     check_baselines(top.table("baselines"), (raw.get("controller") or {}).get("type"))

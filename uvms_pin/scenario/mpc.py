@@ -27,15 +27,20 @@ import pinocchio as pin
 
 from uvms_pin.checks import check_memory
 from uvms_pin.control.base import Controller
+from uvms_pin.control.spec import ControllerSpec
 from uvms_pin.flow import UniformCurrent
 from uvms_pin.model.scaled import scaled_uvms
 from uvms_pin.model.uvms import UVMS
 from uvms_pin.scenario.baselines import model_error_factors
-from uvms_pin.scenario.controller_parts import checked_spec, desired_force_profile, plain
+from uvms_pin.scenario.controller_parts import (
+    CONTROLLERS,
+    ControllerContext,
+    desired_force_profile,
+    plain,
+)
 from uvms_pin.scenario.schema import Table
 from uvms_pin.scenario.world import build_environment
-from uvms_pin.sim.actuation import Actuation, ThrustersAndJointLimits, Unlimited
-from uvms_pin.sim.run import ControllerSpec
+from uvms_pin.sim.actuation import Actuation, ThrustersAndJointLimits
 
 #: the keys of the table with their defaults
 _NUMBERS = {"horizon_s": 1.0, "dt_s": 0.02, "rate_hz": 50.0}
@@ -103,8 +108,11 @@ def _thruster_inputs(t: Table, actuation: Actuation, nv: int, limits: np.ndarray
     return input_matrix(thrusters, nv), (lower, upper)
 
 
-def build_mpc(t: Table, uvms: UVMS, actuation: Actuation | None = None) -> ControllerSpec:
-    """[controller] type = "mpc" (``actuation``: the scenario's, for inputs = "thrusters")."""
+@CONTROLLERS.register("mpc")
+def read_mpc(t: Table, context: ControllerContext) -> ControllerSpec:
+    """[controller] type = "mpc" (it may plan on the scenario's thrusters: inputs =
+    "thrusters")."""
+    uvms, actuation = context.uvms, context.actuation
     task = t.string("task", "station", choices=TASKS)
     target = _target(t, uvms, task)
     force_fields, force_recorded = _force_task(t, uvms) if task == "force" else ({}, {})
@@ -123,9 +131,7 @@ def build_mpc(t: Table, uvms: UVMS, actuation: Actuation | None = None) -> Contr
     if inputs == "tau" and not np.any(limits > 0.0):
         raise t.error("tau_limits", "is 0 for every DoF: the plan would have no input")
     on_thrusters = (
-        _thruster_inputs(t, actuation or Unlimited(), uvms.nv, limits)
-        if inputs == "thrusters"
-        else None
+        _thruster_inputs(t, actuation, uvms.nv, limits) if inputs == "thrusters" else None
     )
     current = t.vector("current_world_m_s", 3, [0.0, 0.0, 0.0])
     factors = model_error_factors(t.table("model_error"))
@@ -171,7 +177,7 @@ def build_mpc(t: Table, uvms: UVMS, actuation: Actuation | None = None) -> Contr
         "model_error": factors,
         **{k: v for k, v in fields.items() if k != "pose_weights"},
     }
-    return checked_spec(t, uvms, "mpc", recorded, build)
+    return ControllerSpec("mpc", recorded, build)
 
 
 def check_replan_rate(top: Table, controller: dict | None, control_period_s: float | None) -> None:

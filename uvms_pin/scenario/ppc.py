@@ -1,49 +1,47 @@
 """``[controller] type = "ppc"``: the paper's prescribed-performance law; omitted keys keep
-the paper's values (`uvms_pin.control.ppc.PPCParams`)."""
+the paper's values (`uvms_pin.control.ppc_params.PPCParams`, which checks them all: the
+values are taken from the table as they are and checked there, once)."""
 
 from __future__ import annotations
 
 import dataclasses
-from typing import Any
 
-from uvms_pin.control.ppc import PPCParams, PrescribedPerformanceController
+from uvms_pin.control.ppc import PrescribedPerformanceController
+from uvms_pin.control.ppc_params import PPCParams
+from uvms_pin.control.spec import ControllerSpec
+from uvms_pin.control.task_space import velocity_names
 from uvms_pin.errors import ParameterError
 from uvms_pin.model.uvms import UVMS
 from uvms_pin.physics.compiled.backend import BACKENDS
 from uvms_pin.scenario.controller_parts import (
-    checked_spec,
+    CONTROLLERS,
+    ControllerContext,
     desired_force_profile,
     ee_frame_name,
     plain,
 )
 from uvms_pin.scenario.schema import Table
-from uvms_pin.sim.run import ControllerSpec
 
-FIRST_LEVEL_KEYS = ("k_x", "rho0_x", "rho_inf_x", "l_x_per_s")  # 6 components
-SECOND_LEVEL_KEYS = ("k_zeta", "rho0_zeta", "rho_inf_zeta", "l_zeta_per_s", "velocity_weights")
+#: the table's keys that are `PPCParams` fields (the rest: ee_frame, backend, desired_force)
+PARAMS_KEYS = tuple(f.name for f in dataclasses.fields(PPCParams))
 
 
-def build_ppc(t: Table, uvms: UVMS) -> ControllerSpec:
+@CONTROLLERS.register("ppc")
+def read_ppc(t: Table, context: ControllerContext) -> ControllerSpec:
+    """[controller] type = "ppc"."""
+    uvms = context.uvms
     ee_frame = ee_frame_name(t, uvms, "ppc")
-    fields: dict[str, Any] = {}
-    for keys, size in ((FIRST_LEVEL_KEYS, 6), (SECOND_LEVEL_KEYS, uvms.nv)):
-        for key in keys:
-            if t.has(key):
-                fields[key] = t.vector(key, size)
-    for key in ("null_space_gain_per_s", "pinv_relative_cutoff"):
-        if t.has(key):
-            fields[key] = t.number(key, nonneg=True)
-    if t.has("null_space_target"):
-        fields["null_space_target"] = t.vector("null_space_target", uvms.n_arm_joints)
-    desired_rpy = t.vector("desired_rpy", 3, [0.0, 0.0, 0.0])
+    given = {key: t.pop_raw(key) for key in PARAMS_KEYS if t.has(key)}
     # "core": the compiled law (Python reference on the calls it declines); "python": the reference
     backend = t.string("backend", "core", BACKENDS)
     desired_force, force_raw = desired_force_profile(t)
     t.finish()
     try:
-        params = PPCParams(desired_rpy=desired_rpy, **fields).sized(uvms.nv)
+        params = PPCParams(**given).sized(uvms.nv, velocity_names(uvms.model))
     except ParameterError as exc:
-        raise t.fail(str(exc)) from exc
+        message = str(exc)
+        key = next((k for k in given if message.startswith(f"{k} ")), None)
+        raise (t.fail(message) if key is None else t.error(key, message)) from exc
     parameters = {k: plain(v) for k, v in dataclasses.asdict(params).items()}
     recorded = {"ee_frame": ee_frame, "desired_force": force_raw, "backend": backend, **parameters}
 
@@ -52,4 +50,4 @@ def build_ppc(t: Table, uvms: UVMS) -> ControllerSpec:
             u.model, ee_frame, params, desired_force, backend=backend
         )
 
-    return checked_spec(t, uvms, "ppc", recorded, build)
+    return ControllerSpec("ppc", recorded, build)

@@ -12,6 +12,7 @@ from typing import Any
 import numpy as np
 
 from uvms_pin.control.performance import PerformanceFunction
+from uvms_pin.control.spec import ControllerSpec
 from uvms_pin.control.tracking.controllers import (
     ResolvedAccelerationController,
     TaskPriorityController,
@@ -23,12 +24,9 @@ from uvms_pin.model.scaled import scaled_uvms
 from uvms_pin.model.uvms import UVMS
 from uvms_pin.results.components import VEHICLE_VELOCITY_NAMES
 from uvms_pin.scenario.baselines import model_error_factors
-from uvms_pin.scenario.controller_parts import checked_spec, plain
+from uvms_pin.scenario.controller_parts import CONTROLLERS, ControllerContext, plain
 from uvms_pin.scenario.schema import Table
 from uvms_pin.sim.actuation import Actuation
-from uvms_pin.sim.run import ControllerSpec
-
-__all__ = ["TRACKING_CONTROLLERS"]
 
 
 def _kinematic_gains(t: Table, nv: int, passive: tuple[int, ...]) -> KinematicGains:
@@ -86,10 +84,14 @@ def _dynamic_level(t: Table, uvms: UVMS) -> tuple[Callable[[UVMS], Any], dict[st
     )
 
 
-def build_task_priority(
-    t: Table, uvms: UVMS, task: TrackingTask, actuation: Actuation
-) -> ControllerSpec:
+@CONTROLLERS.register("task_priority")
+def read_task_priority(t: Table, context: ControllerContext) -> ControllerSpec:
     """[controller] type = "task_priority"."""
+    uvms, task, actuation = (
+        context.uvms,
+        followed_task(t, context, "task_priority"),
+        context.actuation,
+    )
     gains = _kinematic_gains(t, uvms.nv, passive_velocities(actuation))
     dynamic, recorded = _dynamic_level(t, uvms)
     t.finish()
@@ -99,13 +101,13 @@ def build_task_priority(
 
     kinematic = {k: plain(v) for k, v in vars(gains).items()}
     params = {**kinematic, **{k: plain(v) for k, v in recorded.items()}}
-    return checked_spec(t, uvms, "task_priority", params, build)
+    return ControllerSpec("task_priority", params, build)
 
 
-def build_resolved_acceleration(
-    t: Table, uvms: UVMS, task: TrackingTask, actuation: Actuation
-) -> ControllerSpec:
+@CONTROLLERS.register("resolved_acceleration")
+def read_resolved_acceleration(t: Table, context: ControllerContext) -> ControllerSpec:
     """[controller] type = "resolved_acceleration"."""
+    uvms, task = context.uvms, followed_task(t, context, "resolved_acceleration")
     fields = {
         "position_gain_per_s2": t.vector("position_gain_per_s2", 6, [4.0] * 6),
         "velocity_gain_per_s": t.vector("velocity_gain_per_s", 6, [4.0] * 6),
@@ -119,7 +121,7 @@ def build_resolved_acceleration(
         return ResolvedAccelerationController(scaled_uvms(u, **factors), task, **fields)
 
     params = {**{k: plain(v) for k, v in fields.items()}, "model_error": factors}
-    return checked_spec(t, uvms, "resolved_acceleration", params, build)
+    return ControllerSpec("resolved_acceleration", params, build)
 
 
 def passive_velocities(actuation: Actuation) -> tuple[int, ...]:
@@ -129,11 +131,9 @@ def passive_velocities(actuation: Actuation) -> tuple[int, ...]:
     return tuple(k for k in range(6) if k not in allocated)
 
 
-#: [controller] type -> its builder (the table, the model, the scenario's [task], the
-#: plant's actuation)
-TRACKING_CONTROLLERS: dict[
-    str, Callable[[Table, UVMS, TrackingTask, Actuation], ControllerSpec]
-] = {
-    "task_priority": build_task_priority,
-    "resolved_acceleration": build_resolved_acceleration,
-}
+def followed_task(t: Table, context: ControllerContext, kind: str) -> TrackingTask:
+    """The scenario's [task], which the tracking controller ``kind`` follows (an error
+    naming the table's type without one)."""
+    if context.task is None:
+        raise t.error("type", f"'{kind}' follows a tracking task: the scenario needs a [task]")
+    return context.task

@@ -1,24 +1,24 @@
 """A run: everything one simulation needs (a `Scenario`), and ``simulate(scenario)``.
 
-A scenario is usually read from a TOML file (`uvms_pin.scenario.load_scenario`); it can as
-well be built in code from its parts. `simulate` builds a fresh controller and seeded
+A scenario is usually read from a TOML file (`uvms_pin.scenario.load_scenario`) or from
+nested dicts (`uvms_pin.scenario.scenario_from_dict`): the scenario layer builds it; it can
+as well be built in code from its parts. `simulate` builds a fresh controller and seeded
 sensors, runs the closed loop and returns the rollout.
 """
 
 from __future__ import annotations
 
-import copy
 import dataclasses
-import importlib
 import warnings
-from collections.abc import Callable, Mapping, Sequence
-from dataclasses import dataclass, field
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
 from uvms_pin.control.base import Controller
+from uvms_pin.control.spec import ControllerFactory, ControllerSpec
 from uvms_pin.control.tracking.task import TrackingTask
 from uvms_pin.errors import ParameterError, ShortenedRunWarning, SimulationError
 from uvms_pin.model.uvms import UVMS
@@ -32,29 +32,6 @@ from uvms_pin.sim.sensors import SensorConfig, SensorSuite
 from uvms_pin.sim.settings import SimulationSettings
 from uvms_pin.sim.shortened import max_duration_s, shortened_duration_s, shortened_message
 from uvms_pin.sim.task_record import record_task
-
-ControllerFactory = Callable[[UVMS], Controller]
-
-
-@dataclass(frozen=True)
-class ControllerSpec:
-    """A controller factory that says what it builds: ``spec(uvms) -> Controller``.
-
-    Attributes:
-        type: what it is ("none", "ppc", a baseline or "package.module:ClassName").
-        params: the parameters the controller is built with, as recorded in rollouts
-            (for "ppc": every gain and funnel after defaults and broadcasting).
-        build: makes a fresh controller for a loaded model.
-    """
-
-    type: str
-    params: dict[str, Any] = field(default_factory=dict)
-    build: ControllerFactory = field(default=None, repr=False)
-    #: built from the scenario file's [controller] table (its ``raw`` then records it)
-    from_file: bool = field(default=False, compare=False)
-
-    def __call__(self, uvms: UVMS) -> Controller:
-        return self.build(uvms)
 
 
 @dataclass
@@ -95,28 +72,6 @@ class Scenario:
     @property
     def uvms(self) -> UVMS:
         return self.plant.uvms
-
-    @classmethod
-    def from_dict(
-        cls,
-        data: dict[str, Any],
-        path: str | Path = "<dict>",
-        overrides: dict[str, Any] | None = None,
-    ) -> Scenario:
-        """A scenario built in code: ``data`` is what the TOML file would hold, as nested
-        dicts (``{"scenario": {"model": "uvms_lbv150", "duration_s": 5}, "water": {...}}``),
-        checked key by key exactly as a file is (`uvms_pin.scenario.load`). ``path``: as if
-        read from this file (relative model paths, your own controllers and metrics resolve
-        in its directory: the working directory by default). ``overrides``: dotted keys, as
-        ``uvms-pin run --set``.
-
-        Raises:
-            ScenarioError: naming the key (and ``path``) of a bad value.
-        """
-        # the reader is the layer above this one (it builds Scenarios): reached by name at
-        # call time, so that this layer does not depend on it
-        reader = importlib.import_module("uvms_pin.scenario.load")
-        return reader.scenario_from_raw(copy.deepcopy(dict(data)), path, overrides)
 
 
 def simulate(

@@ -111,12 +111,12 @@ def execute_cases(
 def _case_scenario(base: str, run: Run):
     """The scenario of one controller on one case."""
     from uvms_pin.scenario.baselines import baseline_controller_table
-    from uvms_pin.scenario.load import scenario_from_raw
+    from uvms_pin.scenario.load import scenario_from_dict
 
     raw = apply_overrides(read_toml(Path(base), ScenarioError), run.overrides)
     variant = {k: v for k, v in raw.items() if k != "baselines"}
     variant["controller"] = baseline_controller_table(raw, run.values["controller"])
-    return modify_plant(scenario_from_raw(variant, base), run.plant)
+    return modify_plant(scenario_from_dict(variant, base), run.plant)
 
 
 def _case_failed(row: dict, exc: BaseException) -> None:

@@ -13,7 +13,7 @@ from uvms_pin.checks import check_memory
 from uvms_pin.errors import FunnelViolation, ScenarioError, SimulationError
 from uvms_pin.results.rollout import Rollout
 from uvms_pin.scenario.baselines import baseline_controller_table
-from uvms_pin.scenario.load import scenario_from_raw
+from uvms_pin.scenario.load import scenario_from_dict
 from uvms_pin.scenario.overrides import apply_overrides
 from uvms_pin.scenario.toml import read_toml
 from uvms_pin.sim.batch import BatchRun, run_batch
@@ -41,7 +41,7 @@ def controller_scenarios(
         variant = {k: v for k, v in raw.items() if k != "baselines"}
         variant["controller"] = baseline_controller_table(raw, name)
         try:
-            out[name] = scenario_from_raw(variant, path)
+            out[name] = scenario_from_dict(variant, path)
         except ScenarioError as exc:
             raise ScenarioError(f"controller '{name}' ([baselines.{name}]): {exc}") from exc
     first = next(iter(out.values()), None)

@@ -12,9 +12,10 @@ from __future__ import annotations
 import dataclasses
 import functools
 
+from uvms_pin.control.spec import ControllerSpec
 from uvms_pin.model.scaled import scaled_uvms
 from uvms_pin.model.uvms import UVMS
-from uvms_pin.sim.run import ControllerSpec, Scenario
+from uvms_pin.sim.run import Scenario
 
 
 def modify_plant(scenario: Scenario, factors: dict[str, float]) -> Scenario:
