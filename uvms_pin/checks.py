@@ -53,22 +53,25 @@ class Plausible:
 
     def refusal(self, value: float) -> str | None:
         """Why ``value`` cannot be (for an error naming it), or None."""
-        low, high = self.possible
-        if low <= value <= high:
-            return None
-        return (
-            f"{value:g} {self.unit} cannot be physical: {self.impossible_text} "
-            f"(possible: {low:g} to {high:g} {self.unit}){self._hint(value)}"
+        return self._outside(
+            value, self.possible, f"cannot be physical: {self.impossible_text}", "possible: "
         )
 
     def warning(self, value: float) -> str | None:
         """Why ``value`` is suspicious (for a warning naming it), or None."""
-        low, high = self.usual
+        return self._outside(value, self.usual, f"is far outside {self.usual_text}", "")
+
+    def _outside(
+        self, value: float, bounds: tuple[float, float], verdict: str, range_label: str
+    ) -> str | None:
+        """None if ``value`` is within ``bounds``, else the ``verdict`` on it with the
+        range (``range_label``: what the range is) and the hint of its side."""
+        low, high = bounds
         if low <= value <= high:
             return None
         return (
-            f"{value:g} {self.unit} is far outside {self.usual_text} "
-            f"({low:g} to {high:g} {self.unit}){self._hint(value)}"
+            f"{value:g} {self.unit} {verdict} "
+            f"({range_label}{low:g} to {high:g} {self.unit}){self._hint(value)}"
         )
 
     def check(self, name: str, value: float) -> float:

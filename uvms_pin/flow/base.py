@@ -21,6 +21,16 @@ def as_points(points_world: np.ndarray) -> np.ndarray:
     return points
 
 
+def zero_gradient_kinematics(
+    flow: Any, time_s: float, points_world: np.ndarray
+) -> tuple[np.ndarray, np.ndarray]:
+    """`FlowField.gradient_kinematics` of a field whose du/dt does not vary in space and whose
+    u has no curvature: zeros (n, 3, 3) and (n, 3, 3, 3). Such a field's class takes it as
+    its method (``gradient_kinematics = zero_gradient_kinematics``)."""
+    n = len(as_points(points_world))
+    return np.zeros((n, 3, 3)), np.zeros((n, 3, 3, 3))
+
+
 def checked_output(flow: Any, method: str, value: Any, shape: tuple[int, ...]) -> np.ndarray:
     """What ``flow.method`` returned, as a float array of ``shape``; else ParameterError
     naming the field and the method (a field of the user's that returns one point's value

@@ -21,7 +21,7 @@ import numpy as np
 
 from uvms_pin.checks import finite_vector, seed_value
 from uvms_pin.errors import ParameterError
-from uvms_pin.flow.base import FlowField, as_points
+from uvms_pin.flow.base import FlowField, as_points, zero_gradient_kinematics
 
 _CHUNK = 1024
 
@@ -131,10 +131,8 @@ class GaussMarkovCurrent(FlowField):
     def velocity_gradient(self, time_s, points_world):
         return np.zeros((len(as_points(points_world)), 3, 3))
 
-    def gradient_kinematics(self, time_s, points_world):
-        # uniform in space: no gradient of du/dt, no curvature
-        n = len(as_points(points_world))
-        return np.zeros((n, 3, 3)), np.zeros((n, 3, 3, 3))
+    # uniform in space: no gradient of du/dt, no curvature
+    gradient_kinematics = zero_gradient_kinematics
 
     def record(self) -> dict:
         """Its parameters and seed: the same realisation is drawn again."""

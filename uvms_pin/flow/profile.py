@@ -6,7 +6,7 @@ import numpy as np
 
 from uvms_pin.checks import finite_vector
 from uvms_pin.errors import ParameterError
-from uvms_pin.flow.base import FlowField, as_points
+from uvms_pin.flow.base import FlowField, as_points, zero_gradient_kinematics
 
 
 class DepthProfileCurrent(FlowField):
@@ -71,11 +71,9 @@ class DepthProfileCurrent(FlowField):
         grad[:, :, 2] = slope_z[:, None] * self.velocity_world_m_s
         return grad
 
-    def gradient_kinematics(self, time_s, points_world):
-        # steady, and linear in depth between the tabulated depths: no curvature (the kinks
-        # at the tabulated depths are a set of measure zero)
-        n = len(as_points(points_world))
-        return np.zeros((n, 3, 3)), np.zeros((n, 3, 3, 3))
+    # steady, and linear in depth between the tabulated depths: no curvature (the kinks
+    # at the tabulated depths are a set of measure zero)
+    gradient_kinematics = zero_gradient_kinematics
 
     def record(self) -> dict:
         return {

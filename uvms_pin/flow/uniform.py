@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 
 from uvms_pin.checks import finite_vector
-from uvms_pin.flow.base import FlowField, as_points
+from uvms_pin.flow.base import FlowField, as_points, zero_gradient_kinematics
 
 
 class UniformCurrent(FlowField):
@@ -23,10 +23,8 @@ class UniformCurrent(FlowField):
     def velocity_gradient(self, time_s, points_world):
         return np.zeros((len(as_points(points_world)), 3, 3))
 
-    def gradient_kinematics(self, time_s, points_world):
-        # uniform in space: no gradient of du/dt, no curvature
-        n = len(as_points(points_world))
-        return np.zeros((n, 3, 3)), np.zeros((n, 3, 3, 3))
+    # uniform in space: no gradient of du/dt, no curvature
+    gradient_kinematics = zero_gradient_kinematics
 
     def acceleration(self, time_s, points_world):
         return np.zeros((len(as_points(points_world)), 3))

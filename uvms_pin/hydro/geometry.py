@@ -21,6 +21,12 @@ Models used (all magnitudes, positive):
   With u_ref = 0.1 m/s this gives the BlueROV2 surge ratio D_lin/D_quad = 13.7/141 = 0.097 m/s
   (von Benzon et al. 2022). Pass 0 to get no linear damping.
 
+Arguments every primitive takes: ``water_density_kg_m3``, rho [kg/m^3] > 0;
+``linear_damping_reference_speed_m_s``, u_ref [m/s] >= 0 (default 0.1), and
+``linear_damping_reference_rate_rad_s``, omega_ref [rad/s] >= 0 (default 0.5); where skin
+friction enters, ``skin_friction_coefficient``, Cf [-] >= 0 (default 0.0047, the ITTC-1957
+line at Re = 1e6).
+
 References:
     H. Lamb, Hydrodynamics, 6th ed., Cambridge, 1932, sec. 114-115 (ellipsoid).
     F. H. Imlay, The complete expressions for "added mass" of a rigid body moving in an ideal
@@ -244,11 +250,8 @@ def sphere_hydro(
 
     Args:
         radius_m: r [m] > 0.
-        water_density_kg_m3: rho [kg/m^3] > 0.
         drag_coefficient: Cd of the sphere [-].
-        skin_friction_coefficient: Cf [-] (ITTC-1957 line at Re = 1e6 by default).
-        linear_damping_reference_speed_m_s: u_ref [m/s] >= 0.
-        linear_damping_reference_rate_rad_s: omega_ref [rad/s] >= 0.
+        the others: see the module docstring.
     """
     r = _positive("radius_m", radius_m)
     rho = _positive("water_density_kg_m3", water_density_kg_m3)
@@ -317,11 +320,8 @@ def cylinder_hydro(
     Args:
         radius_m: r [m] > 0.
         length_m: L [m] > 0.
-        water_density_kg_m3: rho [kg/m^3] > 0.
         drag_coefficient_cross, drag_coefficient_axial: Cd [-] >= 0.
-        skin_friction_coefficient: Cf [-] >= 0.
-        linear_damping_reference_speed_m_s: u_ref [m/s] >= 0.
-        linear_damping_reference_rate_rad_s: omega_ref [rad/s] >= 0.
+        the others: see the module docstring.
     """
     r = _positive("radius_m", radius_m)
     length = _positive("length_m", length_m)
@@ -383,10 +383,8 @@ def box_hydro(
 
     Args:
         size_m: (lx, ly, lz) full side lengths [m], each > 0.
-        water_density_kg_m3: rho [kg/m^3] > 0.
         drag_coefficient: Cd [-] >= 0.
-        linear_damping_reference_speed_m_s: u_ref [m/s] >= 0.
-        linear_damping_reference_rate_rad_s: omega_ref [rad/s] >= 0.
+        the others: see the module docstring.
     """
     sides = np.asarray(size_m, dtype=object).reshape(-1)
     if sides.shape != (3,):

@@ -28,6 +28,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
+from typing import ClassVar
 
 import numpy as np
 
@@ -106,10 +107,21 @@ def unit_sphere_cap(depth: float) -> tuple[float, float, float]:
     return volume, centroid, math.pi * (1.0 - depth * depth)
 
 
+class CentredSolid:
+    """A solid symmetric about its origin (its centroid there), of one kind (``label``)."""
+
+    label: ClassVar[str]
+
+    @property
+    def centroid_m(self) -> np.ndarray:
+        return np.zeros(3)
+
+
 @dataclass(frozen=True)
-class Sphere:
+class Sphere(CentredSolid):
     """A sphere of radius r centred on its origin [m]."""
 
+    label = "sphere"
     radius_m: float
 
     def __post_init__(self) -> None:
@@ -123,14 +135,6 @@ class Sphere:
     def bounding_radius_m(self) -> float:
         return self.radius_m
 
-    @property
-    def label(self) -> str:
-        return "sphere"
-
-    @property
-    def centroid_m(self) -> np.ndarray:
-        return np.zeros(3)
-
     def below(self, normal: np.ndarray, depth_m: float) -> WetPart:
         r = self.radius_m
         volume, centroid, area = unit_sphere_cap(depth_m / r)
@@ -143,9 +147,10 @@ class Sphere:
 
 
 @dataclass(frozen=True)
-class Ellipsoid:
+class Ellipsoid(CentredSolid):
     """An ellipsoid of semi-axes (a, b, c) along x, y, z, centred on its origin [m]."""
 
+    label = "ellipsoid"
     semi_axes_m: tuple[float, float, float]
 
     def __post_init__(self) -> None:
@@ -162,14 +167,6 @@ class Ellipsoid:
     @property
     def bounding_radius_m(self) -> float:
         return max(self.semi_axes_m)
-
-    @property
-    def label(self) -> str:
-        return "ellipsoid"
-
-    @property
-    def centroid_m(self) -> np.ndarray:
-        return np.zeros(3)
 
     def below(self, normal: np.ndarray, depth_m: float) -> WetPart:
         axes = np.asarray(self.semi_axes_m)

@@ -27,7 +27,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from uvms_pin.errors import ParameterError
-from uvms_pin.hydro.submerged import WetPart
+from uvms_pin.hydro.submerged import CentredSolid, WetPart
 
 __all__ = ["Cylinder"]
 
@@ -56,8 +56,10 @@ def x_minus_sin(x: float | np.ndarray) -> float | np.ndarray:
 
 
 @dataclass(frozen=True)
-class Cylinder:
+class Cylinder(CentredSolid):
     """A cylinder of radius R and length L along z, centred on its origin [m]."""
+
+    label = "cylinder"
 
     radius_m: float
     length_m: float
@@ -76,14 +78,6 @@ class Cylinder:
     @property
     def bounding_radius_m(self) -> float:
         return math.hypot(self.radius_m, 0.5 * self.length_m)
-
-    @property
-    def label(self) -> str:
-        return "cylinder"
-
-    @property
-    def centroid_m(self) -> np.ndarray:
-        return np.zeros(3)
 
     def below(self, normal: np.ndarray, depth_m: float) -> WetPart:
         n_p = math.hypot(normal[0], normal[1])

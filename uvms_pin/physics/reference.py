@@ -186,7 +186,12 @@ def _bias_forces(
 
 def _solve(uvms: UVMS, q: np.ndarray, rhs: np.ndarray, wet: WetState | None) -> np.ndarray:
     """M(q)^-1 rhs by a Cholesky factorisation (no inverse)."""
-    mass = _mass_matrix(uvms, q, wet)
+    return mass_solve(_mass_matrix(uvms, q, wet), q, rhs)
+
+
+def mass_solve(mass: np.ndarray, q: np.ndarray, rhs: np.ndarray) -> np.ndarray:
+    """``mass``^-1 rhs by a Cholesky factorisation (SimulationError naming q if the mass
+    matrix at q is not positive definite)."""
     try:
         factor = cho_factor(mass, lower=False, check_finite=False)
     except np.linalg.LinAlgError as exc:

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import argparse
 import sys
+from pathlib import Path
 
 from uvms_pin.apps.arguments import (
     add_comparison_command,
@@ -20,9 +21,8 @@ DEFAULT_CONTROLLERS = "ppc,pi_force,impedance,computed_torque"
 
 
 def _cmd_compare_controllers(args: argparse.Namespace) -> int:
-    from uvms_pin.apps.compare.metrics import Criteria
-    from uvms_pin.apps.compare.runs import compare_controllers, controller_scenarios
-    from uvms_pin.apps.compare.table import write_table
+    from uvms_pin.apps.compare.metrics import COLUMNS, Criteria
+    from uvms_pin.apps.compare.runs import controller_scenarios
 
     names = comma_names("--controllers", args.controllers)
     overrides = dict(parse_assignment(text) for text in args.set)
@@ -37,15 +37,14 @@ def _cmd_compare_controllers(args: argparse.Namespace) -> int:
     out = check_writable(args.out)
     if next(iter(scenarios.values())).task is not None:
         return _compare_tracking(args, scenarios, criteria, out)
-    with claim(out, CONTROLLER_COMPARISON, overwrite=args.overwrite):
-        say = None if args.quiet else (lambda line: print(line, file=sys.stderr, flush=True))
-        rows, rollouts = compare_controllers(scenarios, criteria, say)
-        header = (
-            f"Scenario {args.scenario}; force and orientation errors after t = {after_s:g} s, "
-            f"settling band {args.band:g} N, success: peak force error after the transient "
-            f"<= {args.tolerance:g} N, no joint past its limits."
-        )
-        written = write_table(rows, out, header)
+    header = (
+        f"Scenario {args.scenario}; force and orientation errors after t = {after_s:g} s, "
+        f"settling band {args.band:g} N, success: peak force error after the transient "
+        f"<= {args.tolerance:g} N, no joint past its limits."
+    )
+
+    def figures_and_robustness(rows, rollouts, say) -> list[Path]:
+        written = []
         if not args.no_figures:
             from uvms_pin.apps.compare.figures import write_comparison_figures
 
@@ -59,21 +58,21 @@ def _cmd_compare_controllers(args: argparse.Namespace) -> int:
                 args.scenario, names, out / "robustness", criteria, args.jobs, overrides
             )
             written += write_robustness(robust, out)
-    for row in rows:
-        verdict = "holds the task" if row["success"] else f"fails: {row['reason']}"
-        print(
+        return written
+
+    def summary(row) -> str:
+        return (
             f"{row['controller']:<16} force error RMS {row['force_error_rms_N']:.3f} N, "
-            f"peak {row['force_error_peak_N']:.3f} N: {verdict}"
+            f"peak {row['force_error_peak_N']:.3f} N"
         )
-    print("wrote " + ", ".join(str(p) for p in written))
-    return 0
+
+    table = (header, COLUMNS)
+    return _compare(args, scenarios, criteria, out, table, figures_and_robustness, summary)
 
 
 def _compare_tracking(args: argparse.Namespace, scenarios, criteria, out) -> int:
     """The comparison on a tracking task (`uvms_pin.apps.compare.tracking`): its table and
     ``controllers_tracking.png``; ``--robustness`` is for the force task only."""
-    from uvms_pin.apps.compare.runs import compare_controllers
-    from uvms_pin.apps.compare.table import write_table
     from uvms_pin.apps.compare.tracking import TRACKING_COLUMNS, write_tracking_figure
 
     if args.robustness:
@@ -84,23 +83,39 @@ def _compare_tracking(args: argparse.Namespace, scenarios, criteria, out) -> int
             "(--set task.transient_s=S)"
         )
     task = next(iter(scenarios.values())).task
+    header = (
+        f"Scenario {args.scenario}; {task.kind} of the {task.target} ({task.frame} frame); "
+        f"errors after t = {task.transient_s:g} s; success: the run ends with every joint "
+        f"inside its limits and the position error within {task.settle_tolerance_m:g} m."
+    )
+
+    def figure(rows, rollouts, say) -> list[Path]:
+        return [] if args.no_figures else [write_tracking_figure(rollouts, out)]
+
+    def summary(row) -> str:
+        return (
+            f"{row['controller']:<22} position error RMS {1000 * row['task_position_error_rms_m']:.2f} mm, "
+            f"orientation {row['task_orientation_error_rms_rad']:.4f} rad"
+        )
+
+    return _compare(args, scenarios, criteria, out, (header, TRACKING_COLUMNS), figure, summary)
+
+
+def _compare(args: argparse.Namespace, scenarios, criteria, out: Path, table, extras, summary):
+    """Run ``scenarios`` with each controller in the claimed ``out``; write the table
+    (``table``: its header and columns) and what ``extras(rows, rollouts, say)`` writes;
+    print each controller's ``summary(row)`` with its verdict, and what was written."""
+    from uvms_pin.apps.compare.runs import compare_controllers
+    from uvms_pin.apps.compare.table import write_table
+
     with claim(out, CONTROLLER_COMPARISON, overwrite=args.overwrite):
         say = None if args.quiet else (lambda line: print(line, file=sys.stderr, flush=True))
         rows, rollouts = compare_controllers(scenarios, criteria, say)
-        header = (
-            f"Scenario {args.scenario}; {task.kind} of the {task.target} ({task.frame} frame); "
-            f"errors after t = {task.transient_s:g} s; success: the run ends with every joint "
-            f"inside its limits and the position error within {task.settle_tolerance_m:g} m."
-        )
-        written = write_table(rows, out, header, TRACKING_COLUMNS)
-        if not args.no_figures:
-            written.append(write_tracking_figure(rollouts, out))
+        written = write_table(rows, out, *table)
+        written += extras(rows, rollouts, say)
     for row in rows:
         verdict = "holds the task" if row["success"] else f"fails: {row['reason']}"
-        print(
-            f"{row['controller']:<22} position error RMS {1000 * row['task_position_error_rms_m']:.2f} mm, "
-            f"orientation {row['task_orientation_error_rms_rad']:.4f} rad: {verdict}"
-        )
+        print(f"{summary(row)}: {verdict}")
     print("wrote " + ", ".join(str(p) for p in written))
     return 0
 

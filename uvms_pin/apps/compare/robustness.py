@@ -12,8 +12,6 @@ from __future__ import annotations
 
 import copy
 import functools
-import time
-import traceback
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -22,8 +20,9 @@ import numpy as np
 
 from uvms_pin.apps.compare.metrics import COLUMNS, Criteria
 from uvms_pin.apps.compare.table import _text
+from uvms_pin.apps.study.execute import batch_rows
 from uvms_pin.apps.study.plant import modify_plant
-from uvms_pin.apps.study.runner import base_row, load_results, run_study
+from uvms_pin.apps.study.runner import load_results, run_study
 from uvms_pin.apps.study.spec import PLANT_FACTORS, Run, Study, run_id
 from uvms_pin.errors import ScenarioError
 from uvms_pin.results.atomic import write_text_atomic
@@ -83,29 +82,13 @@ def execute_cases(
     one thread); the rows in order, each the row of the run alone, its wall time its build
     plus its simulation."""
     from uvms_pin.apps.compare.runs import batch_run_row
-    from uvms_pin.sim.batch import run_batch
 
-    rows, built, wall_s = [], [], []
-    for run in runs:
-        start = time.perf_counter()
-        rows.append(base_row(run))
-        try:
-            built.append((len(rows) - 1, _case_scenario(base, run)))
-        except Exception as exc:  # one failed case must not stop the others
-            _case_failed(rows[-1], exc)
-        wall_s.append(time.perf_counter() - start)
-    outcomes = run_batch([scenario for _, scenario in built], 1) if built else []
-    for (k, scenario), outcome in zip(built, outcomes, strict=True):
-        try:
-            compared, _ = batch_run_row(runs[k].values["controller"], scenario, outcome, criteria)
-            compared.pop("controller")
-            rows[k].update(compared)  # status "ok" or "stopped" (the reason says why)
-        except Exception as exc:
-            _case_failed(rows[k], exc)
-        wall_s[k] += outcome.wall_s
-    for row, seconds in zip(rows, wall_s, strict=True):
-        row["run_wall_time_s"] = seconds
-    return rows
+    def fill(row: dict, scenario, outcome, run: Run) -> None:
+        compared, _ = batch_run_row(run.values["controller"], scenario, outcome, criteria)
+        compared.pop("controller")
+        row.update(compared)  # status "ok" or "stopped" (the reason says why)
+
+    return batch_rows(runs, lambda row, run: _case_scenario(base, run), fill)
 
 
 def _case_scenario(base: str, run: Run):
@@ -117,11 +100,6 @@ def _case_scenario(base: str, run: Run):
     variant = {k: v for k, v in raw.items() if k != "baselines"}
     variant["controller"] = baseline_controller_table(raw, run.values["controller"])
     return modify_plant(scenario_from_dict(variant, base), run.plant)
-
-
-def _case_failed(row: dict, exc: BaseException) -> None:
-    row.update(status="error", error=f"{type(exc).__name__}: {exc}")
-    row["traceback"] = "".join(traceback.format_exception(exc, limit=8))
 
 
 def run_robustness(

@@ -329,3 +329,23 @@ def scenario_path(scenario: str | Path) -> Path:
         except FileNotFoundError:
             pass
     raise ParameterError(f"scenario {str(scenario)!r}: no such file nor shipped scenario")
+
+
+class PoseEnv(UvmsEnv):
+    """A `UvmsEnv` whose task is a pose: the episode ends when the position error exceeds
+    ``max_position_error_m`` [m] (None: the environment's ``default_max_position_error_m``);
+    ``scenario`` None: its ``default_scenario``."""
+
+    default_scenario: ClassVar[str]
+    default_max_position_error_m: ClassVar[float]
+
+    def __init__(
+        self,
+        scenario: str | Path | None = None,
+        *,
+        max_position_error_m: float | None = None,
+        **kwargs: Any,
+    ):
+        bound = max_position_error_m
+        self._max_position_error_m = self.default_max_position_error_m if bound is None else bound
+        super().__init__(self.default_scenario if scenario is None else scenario, **kwargs)

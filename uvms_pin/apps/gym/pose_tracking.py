@@ -2,10 +2,7 @@
 
 from __future__ import annotations
 
-from pathlib import Path
-from typing import Any
-
-from uvms_pin.apps.gym.env import UvmsEnv
+from uvms_pin.apps.gym.env import PoseEnv
 from uvms_pin.apps.gym.tasks import PoseTrackingTask
 from uvms_pin.errors import ParameterError
 from uvms_pin.sim.run import Scenario
@@ -13,25 +10,18 @@ from uvms_pin.sim.run import Scenario
 DEFAULT_SCENARIO = "lbv150_ee_circle"
 
 
-class PoseTrackingEnv(UvmsEnv):
+class PoseTrackingEnv(PoseEnv):
     """Track the reference pose of the scenario's ``[task]`` (an end-effector or vehicle
     path; docs/gym.md). The scenario's own controller is not used.
 
     Args (besides `UvmsEnv`'s):
-        max_position_error_m: the episode ends when |p_r(t) - p| exceeds it [m].
+        max_position_error_m: the episode ends when |p_r(t) - p| exceeds it [m] (default
+            ``default_max_position_error_m``).
     """
 
     initial_noise = (0.01, 0.01)
-
-    def __init__(
-        self,
-        scenario: str | Path = DEFAULT_SCENARIO,
-        *,
-        max_position_error_m: float = 0.5,
-        **kwargs: Any,
-    ):
-        self._max_position_error_m = max_position_error_m
-        super().__init__(scenario, **kwargs)
+    default_scenario = DEFAULT_SCENARIO
+    default_max_position_error_m = 0.5
 
     def _make_task(self, scenario: Scenario) -> PoseTrackingTask:
         if scenario.task is None:

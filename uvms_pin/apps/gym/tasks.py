@@ -74,6 +74,26 @@ def rotation_angle_from(target_xyzw: np.ndarray, quaternions_xyzw: np.ndarray) -
     return 2.0 * np.arctan2(np.sqrt(rel_x**2 + rel_y**2 + rel_z**2), np.abs(rel_w))
 
 
+def _checked_bound(max_position_error_m: float) -> float:
+    """``max_position_error_m`` [m] if it is positive and finite, else ParameterError."""
+    if not (max_position_error_m > 0.0 and np.isfinite(max_position_error_m)):
+        raise ParameterError(f"max_position_error_m must be positive, got {max_position_error_m}")
+    return max_position_error_m
+
+
+def _pose_outcome(position_error, angle_error, effort, max_position_error_m: float):
+    """(reward, terminated, terms) of a pose task from the position error [m], the angle
+    error [rad] and the effort penalty (floats, or (N,) arrays alike):
+    r = -(e_p / 0.1 m)^2 - (e_R / 0.1 rad)^2 - effort, terminated when e_p exceeds the bound."""
+    reward = -((position_error / POSITION_SCALE_M) ** 2) - (angle_error / ANGLE_SCALE_RAD) ** 2
+    terms = {
+        "position_error_m": position_error,
+        "angle_error_rad": angle_error,
+        "effort_penalty": effort,
+    }
+    return reward - effort, position_error > max_position_error_m, terms
+
+
 class ForceTrackingTask:
     """Track f_d(t) at the end-effector inside a funnel.
 
@@ -140,13 +160,9 @@ class StationKeepingTask:
     goal_names = ("p_d_x_m", "p_d_y_m", "p_d_z_m", "quat_d_x", "quat_d_y", "quat_d_z", "quat_d_w")
 
     def __init__(self, target_q: np.ndarray, max_position_error_m: float, effort_weight: float):
-        if not (max_position_error_m > 0.0 and np.isfinite(max_position_error_m)):
-            raise ParameterError(
-                f"max_position_error_m must be positive, got {max_position_error_m}"
-            )
         self.target_position_m = np.asarray(target_q[:3], dtype=float).copy()
         self.target_quaternion = np.asarray(target_q[3:7], dtype=float).copy()
-        self.max_position_error_m = max_position_error_m
+        self.max_position_error_m = _checked_bound(max_position_error_m)
         self.effort_weight = effort_weight
 
     def goal(self, time_s: float) -> np.ndarray:
@@ -175,13 +191,9 @@ class StationKeepingTask:
         position_error = np.sqrt(np.einsum("ij,ij->i", offset, offset))
         angle_error = rotation_angle_from(self.target_quaternion, q[:, 3:7])
         effort = effort_penalties(action, self.effort_weight)
-        reward = -((position_error / POSITION_SCALE_M) ** 2) - (angle_error / ANGLE_SCALE_RAD) ** 2
-        terms = {
-            "position_error_m": position_error,
-            "angle_error_rad": angle_error,
-            "effort_penalty": effort,
-        }
-        return BatchOutcome(reward - effort, position_error > self.max_position_error_m, terms)
+        return BatchOutcome(
+            *_pose_outcome(position_error, angle_error, effort, self.max_position_error_m)
+        )
 
 
 class PoseTrackingTask:
@@ -203,13 +215,9 @@ class PoseTrackingTask:
         max_position_error_m: float,
         effort_weight: float,
     ):
-        if not (max_position_error_m > 0.0 and np.isfinite(max_position_error_m)):
-            raise ParameterError(
-                f"max_position_error_m must be positive, got {max_position_error_m}"
-            )
         self.task, self.model, self.data = task, model, model.createData()
         self._quaternion = pin.Quaternion(task.rotation_reference).coeffs().copy()
-        self.max_position_error_m = max_position_error_m
+        self.max_position_error_m = _checked_bound(max_position_error_m)
         self.effort_weight = effort_weight
 
     def goal(self, time_s: float) -> np.ndarray:
@@ -225,10 +233,6 @@ class PoseTrackingTask:
             np.linalg.norm(orientation_error(self.task.rotation_reference, rotation))
         )
         effort = effort_penalty(action, self.effort_weight)
-        reward = -((position_error / POSITION_SCALE_M) ** 2) - (angle_error / ANGLE_SCALE_RAD) ** 2
-        terms = {
-            "position_error_m": position_error,
-            "angle_error_rad": angle_error,
-            "effort_penalty": effort,
-        }
-        return StepOutcome(reward - effort, position_error > self.max_position_error_m, terms)
+        return StepOutcome(
+            *_pose_outcome(position_error, angle_error, effort, self.max_position_error_m)
+        )

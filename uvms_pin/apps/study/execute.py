@@ -13,6 +13,7 @@ import math
 import socket
 import time
 import traceback
+from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
@@ -39,27 +40,49 @@ def execute_runs(
     """`execute_run` of each of ``runs``, simulated together on ``num_threads`` threads;
     the rows in order (each the row of the run alone, its wall time its load plus its
     simulation)."""
+
+    def load(row: dict[str, Any], run: Run):
+        scenario = _scenario(base, run)
+        row["net_buoyancy_N"] = scenario.uvms.net_buoyancy_N
+        return scenario
+
+    def fill(row: dict[str, Any], scenario, outcome, run: Run) -> None:
+        _outcome_into(row, outcome, run, rollout_dir)
+
+    return batch_rows(runs, load, fill, num_threads)
+
+
+def batch_rows(
+    runs: list[Run],
+    load: Callable[[dict[str, Any], Run], Any],
+    fill: Callable[[dict[str, Any], Any, Any, Run], None],
+    num_threads: int = 1,
+) -> list[dict[str, Any]]:
+    """A row per run (`base_row`), never an exception: each run's scenario loaded by
+    ``load(row, run)`` (which may add to the row), then all simulated together on
+    ``num_threads`` threads (`uvms_pin.sim.batch.run_batch`) and each outcome put in its row
+    by ``fill(row, scenario, outcome, run)``; a run that raises in either is an "error" row with its
+    traceback. ``run_wall_time_s``: the run's load plus its simulation [s]."""
     from uvms_pin.sim.batch import run_batch
 
-    rows, scenarios, loaded, load_s = [], [], [], []
+    rows, scenarios, loaded, wall_s = [], [], [], []
     for run in runs:
         start = time.perf_counter()
-        row = base_row(run)
-        rows.append(row)
+        rows.append(base_row(run))
         try:
-            scenarios.append(_scenario(base, run))
+            scenarios.append(load(rows[-1], run))
             loaded.append(len(rows) - 1)
-            row["net_buoyancy_N"] = scenarios[-1].uvms.net_buoyancy_N
-        except Exception as exc:  # a bad input in one run must not stop the study
-            _failed(row, exc)
-        load_s.append(time.perf_counter() - start)
-    for k, outcome in zip(loaded, run_batch(scenarios, num_threads), strict=True):
+        except Exception as exc:  # a bad input in one run must not stop the others
+            _failed(rows[-1], exc)
+        wall_s.append(time.perf_counter() - start)
+    outcomes = run_batch(scenarios, num_threads)
+    for k, scenario, outcome in zip(loaded, scenarios, outcomes, strict=True):
         try:
-            _outcome_into(rows[k], outcome, runs[k], rollout_dir)
+            fill(rows[k], scenario, outcome, runs[k])
         except Exception as exc:
             _failed(rows[k], exc)
-        load_s[k] += outcome.wall_s
-    for row, seconds in zip(rows, load_s, strict=True):
+        wall_s[k] += outcome.wall_s
+    for row, seconds in zip(rows, wall_s, strict=True):
         row["run_wall_time_s"] = seconds
     return rows
 

@@ -17,20 +17,12 @@ def trial_figure(c: TrialComparison, path: Path) -> Path:
     fig, axes = new_figure(3, 1, figsize=(8, 8), sharex=True)
     t = c.time_s
     for k, (ax, label) in enumerate(zip(axes[:2], ("roll", "pitch"), strict=False)):
-        roll_or_pitch = [c.rmse_deg(w)[k] for w in ("simulated", "held", "published")]
-        ax.plot(t, np.degrees(c.measured[:, k]), "k", lw=2, label="measured (IMU)")
-        ax.plot(t, np.degrees(c.simulated[:, k]), "C0", label=f"uvms-pin ({roll_or_pitch[0]:.2f})")
-        ax.plot(t, np.degrees(c.held[:, k]), "C7:", label=f"held at start ({roll_or_pitch[1]:.2f})")
-        if c.published is not None:
-            ax.plot(
-                t,
-                np.degrees(c.published[:, k]),
-                "C1--",
-                label=f"published simulator ({roll_or_pitch[2]:.2f})",
-            )
-        ax.set_ylabel(f"{label} [deg]")
-        ax.legend(loc="best", fontsize=8, title="RMSE [deg]", title_fontsize=8)
-        ax.grid(True, alpha=0.3)
+        roll_or_pitch = [c.rmse_deg(w)[k] for w in ("simulated", "held")]
+        models = [
+            (t, c.simulated[:, k], "C0", f"uvms-pin ({roll_or_pitch[0]:.2f})"),
+            (t, c.held[:, k], "C7:", f"held at start ({roll_or_pitch[1]:.2f})"),
+        ]
+        _roll_or_pitch_axis(ax, label, c, k, models, "C1--")
     for j, name in enumerate(_JOINTS):
         axes[2].plot(t, c.joints_rad[:, j], label=name)
     axes[2].set_ylabel("prescribed joint [rad]")
@@ -47,28 +39,39 @@ def identified_figure(start: TrialComparison, identified: TrialComparison, path:
     fig, axes = new_figure(2, 1, figsize=(8, 6), sharex=True)
     t = start.time_s
     for k, (ax, label) in enumerate(zip(axes, ("roll", "pitch"), strict=True)):
-        ax.plot(t, np.degrees(start.measured[:, k]), "k", lw=2, label="measured (IMU)")
-        rmse = start.rmse_deg("simulated")[k]
-        ax.plot(t, np.degrees(start.simulated[:, k]), "C0--", label=f"catalogue ({rmse:.2f})")
-        rmse = identified.rmse_deg("simulated")[k]
-        # an identified arm delay moves the simulated window by as much: its own time axis
-        ax.plot(
-            identified.time_s,
-            np.degrees(identified.simulated[:, k]),
-            "C3",
-            label=f"identified ({rmse:.2f})",
-        )
-        if start.published is not None:
-            rmse = start.rmse_deg("published")[k]
-            ax.plot(
-                t,
-                np.degrees(start.published[:, k]),
-                "C1:",
-                label=f"published simulator ({rmse:.2f})",
-            )
-        ax.set_ylabel(f"{label} [deg]")
-        ax.legend(loc="best", fontsize=8, title="RMSE [deg]", title_fontsize=8)
-        ax.grid(True, alpha=0.3)
+        start_rmse = start.rmse_deg("simulated")[k]
+        identified_rmse = identified.rmse_deg("simulated")[k]
+        models = [
+            (t, start.simulated[:, k], "C0--", f"catalogue ({start_rmse:.2f})"),
+            # an identified arm delay moves the simulated window by as much: its own time axis
+            (
+                identified.time_s,
+                identified.simulated[:, k],
+                "C3",
+                f"identified ({identified_rmse:.2f})",
+            ),
+        ]
+        _roll_or_pitch_axis(ax, label, start, k, models, "C1:")
     axes[1].set_xlabel("time [s]")
     axes[0].set_title(f"pool trial {start.name} (held out): catalogue vs identified hull")
     return save_figure(fig, path)
+
+
+def _roll_or_pitch_axis(ax, label: str, c: TrialComparison, k: int, models, published_style):
+    """Axis ``k`` (0: roll, 1: pitch) of ``c`` [deg]: the measured angle, then each of
+    ``models`` ((time [s], angle [rad], style, legend label) each), then the published
+    simulator's (``published_style``) if there is one; RMSE [deg] in the legend."""
+    ax.plot(c.time_s, np.degrees(c.measured[:, k]), "k", lw=2, label="measured (IMU)")
+    for time_s, angle_rad, style, name in models:
+        ax.plot(time_s, np.degrees(angle_rad), style, label=name)
+    if c.published is not None:
+        rmse = c.rmse_deg("published")[k]
+        ax.plot(
+            c.time_s,
+            np.degrees(c.published[:, k]),
+            published_style,
+            label=f"published simulator ({rmse:.2f})",
+        )
+    ax.set_ylabel(f"{label} [deg]")
+    ax.legend(loc="best", fontsize=8, title="RMSE [deg]", title_fontsize=8)
+    ax.grid(True, alpha=0.3)

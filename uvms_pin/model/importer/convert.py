@@ -29,6 +29,7 @@ from uvms_pin.model.importer.sdf import sdf_model, sdf_to_urdf
 from uvms_pin.model.importer.thrusters import gz_thruster, uuv_thruster
 from uvms_pin.model.importer.tree import link_placements
 from uvms_pin.model.importer.write import hydro_element, thruster_table_text, urdf_text
+from uvms_pin.model.urdf.read import xml_root
 from uvms_pin.results.atomic import atomic_path
 
 __all__ = ["import_model"]
@@ -77,12 +78,7 @@ def import_model(
 def _read_source(path: Path, notes: list[str]) -> tuple[ET.Element, list[ET.Element], str]:
     """(the URDF robot tree to edit, every <plugin> element, "urdf" or "sdf")."""
     where = str(path)
-    if not path.is_file():
-        raise ModelError("file not found", path=where)
-    try:
-        root = ET.parse(path).getroot()
-    except ET.ParseError as exc:
-        raise ModelError(f"not well-formed XML ({exc})", path=where) from exc
+    root = xml_root(path)
     if root.tag == "sdf":
         robot = sdf_to_urdf(sdf_model(root, where), where, notes)
         return robot, list(root.iter("plugin")), "sdf"

@@ -35,30 +35,47 @@ from uvms_pin.model.mount.tool import (
 )
 from uvms_pin.model.mount.tree import URDFTree
 
-__all__ = ["MergedURDF", "merge_urdf"]
+__all__ = ["ArmMerge", "MergedURDF", "merge_urdf"]
 
 #: The vehicle's top-level elements that are kept (``<transmission>``, ``<gazebo>``, ... go).
 _KEEP_TOP_LEVEL = ("link", "joint", "material", "hydrodynamics")
 
 
-@dataclass
-class MergedURDF:
+@dataclass(kw_only=True)
+class ArmMerge:
+    """What the merge did with the arm.
+
+    Attributes:
+        arm_joints: the arm's moving joints, base to wrist (merged-model names).
+        locked_joints: joints made fixed, with the position they were locked at [rad or m].
+        renamed: arm names changed to avoid clashes with the vehicle (old -> new).
+        arm_base_link, ee_link: the links used (arm file names).
+        tool_axis_in_ee_link: unit vector of the tool axis in ``ee_link``'s frame.
+        dry_links: arm links with mass but neither hydrodynamics nor collision geometry.
+        removed_links, removed_joints: the arm the vehicle file carried, replaced (empty
+            for a vehicle alone or with ``keep_existing_arm=True``).
+    """
+
+    arm_joints: list[str]
+    locked_joints: dict[str, float]
+    renamed: dict[str, str]
+    arm_base_link: str
+    ee_link: str
+    tool_axis_in_ee_link: np.ndarray
+    dry_links: list[str] = field(default_factory=list)
+    removed_links: list[str] = field(default_factory=list)
+    removed_joints: list[str] = field(default_factory=list)
+
+
+@dataclass(kw_only=True)
+class MergedURDF(ArmMerge):
     """The merged tree and what :func:`mount_arm_detailed` needs to load it."""
 
     root: ET.Element
     ee_frame: str
     sensor_frame: str
     vehicle_link: str
-    arm_joints: list[str]
-    locked: dict[str, float]
-    renamed: dict[str, str]
-    arm_base_link: str
-    ee_link: str
-    tool_axis: np.ndarray
-    dry_links: list[str]
     hull_box: tuple[np.ndarray, np.ndarray] | None
-    removed_links: list[str] = field(default_factory=list)
-    removed_joints: list[str] = field(default_factory=list)
 
 
 def merge_urdf(
@@ -78,7 +95,25 @@ def merge_urdf(
     keep_existing_arm: bool = False,
 ) -> MergedURDF:
     """Build the merged URDF tree (steps 1-6 of `uvms_pin.model.mount.mount`); nothing is
-    written. The options are :func:`uvms_pin.model.mount.mount.mount_arm_detailed`'s."""
+    written. The arguments before ``*`` are :func:`uvms_pin.model.mount.mount.mount_arm`'s.
+
+    Args:
+        arm_base_link: the arm link bolted to the vehicle (default: the arm's root).
+        ee_link: the wrist/flange link carrying the F/T sensor (default: chosen, see
+            `uvms_pin.model.mount.mount`).
+        vehicle_link: vehicle link the arm is bolted to (default: the vehicle's root).
+        sensor_link: an existing arm link to use as the F/T sensor frame (then no
+            ``ft_sensor`` frame is added; with ``tool=None`` and an ``ee_link`` named as
+            the end-effector frame, an arm file that already has both is used as it is).
+        tool_axis: the tool direction in ``ee_link``'s frame: "x", "-z", ..., a 3-vector,
+            or "auto" (the last arm joint's axis, pointing away from the arm).
+        tool: the probe to add (None: no tool, ``ee`` = the sensor frame).
+        lock_positions: positions of the joints that are locked (default 0, clipped).
+        package_dirs: where ``package://`` mesh paths are found.
+        allow_dry_links: accept arm links with mass but neither hydrodynamics nor collision
+            geometry (they weigh but displace nothing; else ``load_uvms`` rejects them).
+        keep_existing_arm: keep an arm the vehicle file already carries (default: replace it).
+    """
     placement = parse_mount_pose(mount_pose)
     vehicle = URDFTree.read(Path(vehicle_urdf))
     arm = URDFTree.read(Path(arm_urdf))
@@ -116,11 +151,11 @@ def merge_urdf(
         sensor_frame=sensor_frame,
         vehicle_link=vlink,
         arm_joints=[renamed.get(j, j) for j in selection.chain],
-        locked={renamed.get(k, k): v for k, v in locked.items()},
+        locked_joints={renamed.get(k, k): v for k, v in locked.items()},
         renamed=renamed,
         arm_base_link=selection.base,
         ee_link=selection.ee,
-        tool_axis=axis,
+        tool_axis_in_ee_link=axis,
         dry_links=dry,
         hull_box=first_box(vehicle.links[vlink]),
         removed_links=removed_links,

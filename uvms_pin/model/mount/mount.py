@@ -39,17 +39,16 @@ from __future__ import annotations
 import tempfile
 import warnings
 import xml.etree.ElementTree as ET
-from collections.abc import Mapping, Sequence
-from dataclasses import dataclass, field
+from collections.abc import Sequence
+from dataclasses import dataclass, fields
 from pathlib import Path
 
 import numpy as np
 
 from uvms_pin.errors import ModelError, ParameterError
 from uvms_pin.model.mount.catalog import ArmEntry, resolve_arm
-from uvms_pin.model.mount.merge import MergedURDF, merge_urdf
+from uvms_pin.model.mount.merge import ArmMerge, MergedURDF, merge_urdf
 from uvms_pin.model.mount.text import urdf_text, write_text_file
-from uvms_pin.model.mount.tool import REFERENCE_PROBE, ProbeTool
 from uvms_pin.model.resources import find_model
 from uvms_pin.model.trim import TrimReport, TrimSpec, plan_trim
 from uvms_pin.model.trim_urdf import add_trim_links
@@ -59,36 +58,20 @@ from uvms_pin.model.uvms import DEFAULT_WATER_DENSITY_KG_M3, UVMS
 __all__ = ["MountResult", "mount_arm", "mount_arm_detailed"]
 
 
-@dataclass
-class MountResult:
-    """What :func:`mount_arm_detailed` returns.
+@dataclass(kw_only=True)
+class MountResult(ArmMerge):
+    """What :func:`mount_arm_detailed` returns: what the merge did with the arm
+    (`uvms_pin.model.mount.merge.ArmMerge`'s attributes) and
 
     Attributes:
         uvms: the mounted system.
         urdf_text: the merged URDF (mesh paths absolute).
-        arm_joints: the arm's moving joints, base to wrist (merged-model names).
-        locked_joints: joints made fixed, with the position they were locked at [rad or m].
-        renamed: arm names changed to avoid clashes with the vehicle (old -> new).
-        arm_base_link, ee_link: the links used (arm file names).
-        tool_axis_in_ee_link: unit vector of the tool axis in ``ee_link``'s frame.
-        dry_links: arm links with mass but neither hydrodynamics nor collision geometry.
         trim: the trim report, or None.
-        removed_links, removed_joints: the arm the vehicle file carried, replaced (empty
-            for a vehicle alone or with ``keep_existing_arm=True``).
     """
 
     uvms: UVMS
     urdf_text: str
-    arm_joints: list[str]
-    locked_joints: dict[str, float]
-    renamed: dict[str, str]
-    arm_base_link: str
-    ee_link: str
-    tool_axis_in_ee_link: np.ndarray
-    dry_links: list[str] = field(default_factory=list)
     trim: object | None = None
-    removed_links: list[str] = field(default_factory=list)
-    removed_joints: list[str] = field(default_factory=list)
 
     @property
     def derived_bodies(self) -> list[str]:
@@ -135,63 +118,34 @@ def mount_arm_detailed(
     arm_urdf: str | Path | ArmEntry,
     mount_pose,
     *,
-    arm_base_link: str | None = None,
-    ee_link: str | None = None,
-    vehicle_link: str | None = None,
-    sensor_link: str | None = None,
-    tool_axis: str | Sequence[float] = "auto",
-    tool: ProbeTool | None = REFERENCE_PROBE,
-    lock_positions: Mapping[str, float] | None = None,
     water_density_kg_m3: float = DEFAULT_WATER_DENSITY_KG_M3,
-    package_dirs: Sequence[str | Path] = (),
-    allow_dry_links: bool = False,
     trim=None,
     trim_joint_positions: Sequence[float] | None = None,
     save_urdf: str | Path | None = None,
-    keep_existing_arm: bool = False,
+    **merge_options,
 ) -> MountResult:
     """:func:`mount_arm` with every option, returning the UVMS and what was done.
 
     Args (beyond :func:`mount_arm`'s):
-        arm_base_link: the arm link bolted to the vehicle (default: the arm's root).
-        ee_link: the wrist/flange link carrying the F/T sensor (default: chosen, see the
-            module docstring).
-        vehicle_link: vehicle link the arm is bolted to (default: the vehicle's root).
-        sensor_link: an existing arm link to use as the F/T sensor frame (then no
-            ``ft_sensor`` frame is added; with ``tool=None`` and an ``ee_link`` named as
-            the end-effector frame, an arm file that already has both is used as it is).
-        tool_axis: the tool direction in ``ee_link``'s frame: "x", "-z", ..., a 3-vector,
-            or "auto" (the last arm joint's axis, pointing away from the arm).
-        tool: the probe to add (None: no tool, ``ee`` = the sensor frame).
-        lock_positions: positions of the joints that are locked (default 0, clipped).
-        water_density_kg_m3, package_dirs, allow_dry_links: passed to ``load_uvms``.
+        water_density_kg_m3: passed to ``load_uvms``.
         trim: None/False (no trim), True (default `uvms_pin.model.trim.TrimSpec`) or a TrimSpec:
             add foam and ballast for neutral buoyancy and the chosen BG.
         trim_joint_positions: arm configuration at which to trim (default: neutral).
         save_urdf: also write the merged URDF there (atomically).
-        keep_existing_arm: keep an arm the vehicle file already carries (default: replace it).
+        merge_options: how the two files are merged, the keywords of
+            :func:`uvms_pin.model.mount.merge.merge_urdf`: ``arm_base_link``, ``ee_link``
+            (a catalogue entry's by default), ``vehicle_link``, ``sensor_link``,
+            ``tool_axis``, ``tool``, ``lock_positions``, ``package_dirs`` (also passed to
+            ``load_uvms``), ``allow_dry_links``, ``keep_existing_arm``.
     """
     vehicle_urdf = find_model(vehicle_urdf) or vehicle_urdf
     entry = _catalog_entry(arm_urdf)
     if entry is not None:
         arm_urdf = entry.urdf
-        arm_base_link = arm_base_link if arm_base_link is not None else entry.arm_base_link
-        ee_link = ee_link if ee_link is not None else entry.ee_link
-    merged = merge_urdf(
-        vehicle_urdf,
-        arm_urdf,
-        mount_pose,
-        arm_base_link=arm_base_link,
-        ee_link=ee_link,
-        vehicle_link=vehicle_link,
-        sensor_link=sensor_link,
-        tool_axis=tool_axis,
-        tool=tool,
-        lock_positions=lock_positions,
-        package_dirs=package_dirs,
-        allow_dry_links=allow_dry_links,
-        keep_existing_arm=keep_existing_arm,
-    )
+        for key in ("arm_base_link", "ee_link"):
+            if merge_options.get(key) is None:
+                merge_options[key] = getattr(entry, key)
+    merged = merge_urdf(vehicle_urdf, arm_urdf, mount_pose, **merge_options)
     if merged.removed_links:
         warnings.warn(
             f"mount_arm: replaced the arm {vehicle_urdf} carried: removed joints "
@@ -204,7 +158,7 @@ def mount_arm_detailed(
         water_density_kg_m3=water_density_kg_m3,
         ee_frame=merged.ee_frame,
         sensor_frame=merged.sensor_frame,
-        package_dirs=package_dirs,
+        package_dirs=merge_options.get("package_dirs", ()),
     )
     source = f"mount_arm({vehicle_urdf} + {arm_urdf})"
     uvms = _load_merged(merged.root, source, **load_kw)
@@ -265,17 +219,5 @@ def _add_trim(
 
 def _result(merged: MergedURDF, uvms: UVMS, text: str, report: TrimReport | None) -> MountResult:
     """The `MountResult` of a merge, the system loaded from it, its text and trim report."""
-    return MountResult(
-        uvms=uvms,
-        urdf_text=text,
-        arm_joints=merged.arm_joints,
-        locked_joints=merged.locked,
-        renamed=merged.renamed,
-        arm_base_link=merged.arm_base_link,
-        ee_link=merged.ee_link,
-        tool_axis_in_ee_link=merged.tool_axis,
-        dry_links=merged.dry_links,
-        trim=report,
-        removed_links=merged.removed_links,
-        removed_joints=merged.removed_joints,
-    )
+    arm = {f.name: getattr(merged, f.name) for f in fields(ArmMerge)}
+    return MountResult(uvms=uvms, urdf_text=text, trim=report, **arm)

@@ -46,21 +46,11 @@ def collision_hydro(
         ModelError: no shape, an unsupported shape, bad sizes, a mesh not found.
     """
     origin = read_origin(single(collision, "origin", where, link), where, link)
-    geom = single(collision, "geometry", where, link)
-    shape = None if geom is None or len(geom) == 0 else geom[0]
-    if shape is None:
-        raise ModelError("<collision> has no <geometry> shape", path=where, link=link)
+    shape = _shape(single(collision, "geometry", where, link), where, link)
     try:
-        if shape.tag == "box":
-            size = read_numbers(shape.get("size"), 3, "<box size>", where, link)
-            return origin, geometry.box_hydro(size, water_density_kg_m3)
-        if shape.tag == "cylinder":
-            radius = read_numbers(shape.get("radius"), 1, "<cylinder radius>", where, link)[0]
-            length = read_numbers(shape.get("length"), 1, "<cylinder length>", where, link)[0]
-            return origin, geometry.cylinder_hydro(radius, length, water_density_kg_m3)
-        if shape.tag == "sphere":
-            radius = read_numbers(shape.get("radius"), 1, "<sphere radius>", where, link)[0]
-            return origin, geometry.sphere_hydro(radius, water_density_kg_m3)
+        if shape.tag in _PRIMITIVE_HYDRO:
+            dimensions = _dimensions(shape, where, link)
+            return origin, _PRIMITIVE_HYDRO[shape.tag](*dimensions, water_density_kg_m3)
         if shape.tag == "mesh":
             placement, params = _mesh_hydro(
                 shape, water_density_kg_m3, where, link, base_dir, package_dirs
@@ -70,12 +60,8 @@ def collision_hydro(
         raise ModelError(
             f"cannot derive hydrodynamics from <{shape.tag}>: {exc}", path=where, link=link
         ) from exc
-    raise ModelError(
-        f"cannot derive hydrodynamics from collision <{shape.tag}> (box, cylinder, sphere and "
-        "mesh are supported); add a <hydrodynamics> element",
-        path=where,
-        link=link,
-    )
+    what = f"derive hydrodynamics from collision <{shape.tag}>"
+    raise _unsupported(where, link, what, "; add a <hydrodynamics> element")
 
 
 def collision_piece(
@@ -91,10 +77,7 @@ def collision_piece(
         ModelError: as `collision_hydro`.
     """
     origin = read_origin(collision.find("origin"), where, link)
-    geom = collision.find("geometry")
-    shape = None if geom is None or len(geom) == 0 else geom[0]
-    if shape is None:
-        raise ModelError("<collision> has no <geometry> shape", path=where, link=link)
+    shape = _shape(collision.find("geometry"), where, link)
     try:
         solid = _solid(shape, where, link, base_dir, package_dirs)
     except ParameterError as exc:
@@ -108,20 +91,51 @@ def _solid(
     shape: ET.Element, where: str, link: str, base_dir: Path, package_dirs: Sequence[str | Path]
 ) -> Sphere | Polyhedron | Cylinder:
     """The shape of a <box>, <cylinder>, <sphere> or <mesh> element."""
-    if shape.tag == "box":
-        return Polyhedron.box(read_numbers(shape.get("size"), 3, "<box size>", where, link))
-    if shape.tag == "cylinder":
-        radius = read_numbers(shape.get("radius"), 1, "<cylinder radius>", where, link)[0]
-        length = read_numbers(shape.get("length"), 1, "<cylinder length>", where, link)[0]
-        return Cylinder(radius, length)
-    if shape.tag == "sphere":
-        return Sphere(read_numbers(shape.get("radius"), 1, "<sphere radius>", where, link)[0])
+    if shape.tag in _PRIMITIVE_SOLID:
+        return _PRIMITIVE_SOLID[shape.tag](*_dimensions(shape, where, link))
     if shape.tag == "mesh":
         mesh = _mesh_geometry(shape, where, link, base_dir, package_dirs)
         return Polyhedron(mesh.vertices_m, mesh.triangles)
-    raise ModelError(
-        f"cannot use collision <{shape.tag}> as a hull (box, cylinder, sphere and mesh are "
-        "supported)",
+    raise _unsupported(where, link, f"use collision <{shape.tag}> as a hull")
+
+
+#: the dimensions of each primitive shape: its attributes and how many numbers each holds
+_DIMENSIONS = {
+    "box": (("size", 3),),
+    "cylinder": (("radius", 1), ("length", 1)),
+    "sphere": (("radius", 1),),
+}
+#: a primitive's coefficients (`uvms_pin.hydro.geometry`) and its solid, of its dimensions
+_PRIMITIVE_HYDRO = {
+    "box": geometry.box_hydro,
+    "cylinder": geometry.cylinder_hydro,
+    "sphere": geometry.sphere_hydro,
+}
+_PRIMITIVE_SOLID = {"box": Polyhedron.box, "cylinder": Cylinder, "sphere": Sphere}
+
+
+def _shape(geometry_element: ET.Element | None, where: str, link: str) -> ET.Element:
+    """The shape element inside a collision's <geometry>; ModelError if there is none."""
+    if geometry_element is None or len(geometry_element) == 0:
+        raise ModelError("<collision> has no <geometry> shape", path=where, link=link)
+    return geometry_element[0]
+
+
+def _dimensions(shape: ET.Element, where: str, link: str) -> list:
+    """The dimensions [m] of a <box> (its size, 3 numbers), <cylinder> (radius, length) or
+    <sphere> (radius); ModelError naming the attribute if one is missing or malformed."""
+    values = []
+    for name, count in _DIMENSIONS[shape.tag]:
+        numbers = read_numbers(shape.get(name), count, f"<{shape.tag} {name}>", where, link)
+        values.append(numbers if count > 1 else numbers[0])
+    return values
+
+
+def _unsupported(where: str, link: str, what: str, advice: str = "") -> ModelError:
+    """The error of a collision shape that is none of box, cylinder, sphere and mesh:
+    "cannot ``what`` (the supported ones)``advice``"."""
+    return ModelError(
+        f"cannot {what} (box, cylinder, sphere and mesh are supported){advice}",
         path=where,
         link=link,
     )

@@ -14,17 +14,23 @@ from uvms_pin.errors import ModelError
 __all__ = ["read_numbers", "read_origin", "read_urdf_root"]
 
 
+def xml_root(path: Path) -> ET.Element:
+    """The root element of an XML file; ModelError naming the file if it is missing or not
+    well-formed."""
+    if not path.is_file():
+        raise ModelError("file not found", path=str(path))
+    try:
+        return ET.parse(path).getroot()
+    except ET.ParseError as exc:
+        raise ModelError(f"not well-formed XML ({exc})", path=str(path)) from exc
+
+
 def read_urdf_root(path: Path) -> ET.Element:
     """The <robot> element of a URDF file; ModelError naming the file otherwise."""
     where = str(path)
     if path.is_dir():
         raise ModelError("is a directory, not a URDF file", path=where)
-    if not path.is_file():
-        raise ModelError("file not found", path=where)
-    try:
-        root = ET.parse(path).getroot()
-    except ET.ParseError as exc:
-        raise ModelError(f"not well-formed XML ({exc})", path=where) from exc
+    root = xml_root(path)
     if root.tag != "robot":
         raise ModelError(f"root element is <{root.tag}>, expected <robot>", path=where)
     return root

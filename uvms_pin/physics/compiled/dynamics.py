@@ -8,6 +8,8 @@ calls in a uniform current go straight to C++; a call in a flow the core has no 
 
 from __future__ import annotations
 
+import functools
+from collections.abc import Callable
 from types import ModuleType
 
 import numpy as np
@@ -70,6 +72,25 @@ class CompiledDynamics:
         self.mass_matrix = self.core.mass_matrix
         self.bias_forces = self.core.bias_forces
         self.forward_dynamics = self.core.forward_dynamics
+        # the calls in a flow (the reference's arguments, the flow the k-th): the C++ method
+        # in a flow the core has a counterpart of, else the reference's, with a warning
+        self.mass_matrix_in = self._in_flow(self.core.mass_matrix_in, reference.mass_matrix_in, 1)
+        self.bias_forces_in = self._in_flow(self.core.bias_forces_in, reference.bias_forces_in, 2)
+        self.forward_dynamics_in = self._in_flow(
+            self.core.forward_dynamics_in, reference.forward_dynamics_in, 3
+        )
+        # (da/dq, da/dv, da/dtau) in the core (src/uvms_core/derivatives.hpp): its own copy of
+        # these dynamics, built on first use; the arguments of the reference
+        # (`uvms_pin.physics.derivatives.reference`) after its ``uvms``
+        self.forward_dynamics_derivatives = self._in_flow(
+            self._core_derivatives,
+            functools.partial(reference_derivatives, reference.uvms),
+            3,
+            "these derivatives",
+        )
+        # one period's step Jacobians (`_core_period`), or the Fallback of a flow the core
+        # has no counterpart of (the caller chains the reference's stages)
+        self.step_derivatives = self._in_flow(self._core_period, None, 3)
 
     def _flow_struct(self, flow: FlowField | None):
         """The core's FlowField of ``flow`` (the last one is kept: a flow is immutable), or
@@ -78,96 +99,44 @@ class CompiledDynamics:
             self._flow = (flow, flow_to_core(flow, core_module()))
         return self._flow[1]
 
-    def mass_matrix_in(
-        self, q: np.ndarray, flow: FlowField | None, time_s: float, free_surface: bool = False
-    ):
-        compiled = self._flow_struct(flow)
-        if isinstance(compiled, Fallback):
-            compiled.warn("these dynamics", stacklevel=4)
-            return self._reference.mass_matrix_in(q, flow, time_s, free_surface)
-        return self.core.mass_matrix_in(q, compiled, time_s, free_surface)
-
-    def bias_forces_in(
+    def _in_flow(
         self,
-        q: np.ndarray,
-        v: np.ndarray,
-        flow: FlowField | None,
-        time_s: float,
-        free_surface: bool = False,
-    ):
-        compiled = self._flow_struct(flow)
-        if isinstance(compiled, Fallback):
-            compiled.warn("these dynamics", stacklevel=4)
-            return self._reference.bias_forces_in(q, v, flow, time_s, free_surface)
-        return self.core.bias_forces_in(q, v, compiled, time_s, free_surface)
+        compiled: Callable,
+        reference: Callable | None,
+        flow_at: int,
+        what: str = "these dynamics",
+    ) -> Callable:
+        """The call ``reference(*args)`` (``args[flow_at]`` a FlowField or None) made by
+        ``compiled`` with the core's FlowField in its place, or, in a flow the core has no
+        counterpart of, by ``reference`` itself with a `CoreFallbackWarning` naming ``what``
+        (no ``reference``: the `Fallback` is returned)."""
 
-    def forward_dynamics_in(
-        self,
-        q: np.ndarray,
-        v: np.ndarray,
-        tau: np.ndarray,
-        flow: FlowField | None,
-        time_s: float,
-        tau_ext: np.ndarray | None = None,
-        free_surface: bool = False,
-    ):
-        compiled = self._flow_struct(flow)
-        if isinstance(compiled, Fallback):
-            compiled.warn("these dynamics", stacklevel=4)
-            return self._reference.forward_dynamics_in(
-                q, v, tau, flow, time_s, tau_ext, free_surface
-            )
-        return self.core.forward_dynamics_in(q, v, tau, compiled, time_s, tau_ext, free_surface)
+        def call(*args):
+            flow = self._flow_struct(args[flow_at])
+            if isinstance(flow, Fallback):
+                if reference is None:
+                    return flow
+                flow.warn(what, stacklevel=4)
+                return reference(*args)
+            return compiled(*args[:flow_at], flow, *args[flow_at + 1 :])
 
-    def forward_dynamics_derivatives(
-        self,
-        q: np.ndarray,
-        v: np.ndarray,
-        tau: np.ndarray,
-        flow: FlowField | None,
-        time_s: float,
-        tau_ext: np.ndarray | None = None,
-        free_surface: bool = False,
-    ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """(da/dq, da/dv, da/dtau) in the core (src/uvms_core/derivatives.hpp): its own copy
-        of these dynamics, built on first use; a flow the core has no counterpart of runs on
-        the reference (`uvms_pin.physics.derivatives.reference`), with a warning."""
-        compiled = core_module().FlowField() if flow is None else self._flow_struct(flow)
-        if isinstance(compiled, Fallback):
-            compiled.warn("these derivatives", stacklevel=4)
-            return reference_derivatives(
-                self._reference.uvms, q, v, tau, flow, time_s, tau_ext, free_surface
-            )
+        return call
+
+    def _core_derivatives(self, *args) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """`Derivatives.forward_dynamics_derivatives` of the core (built on first use)."""
         if self._derivatives is None:
             self._derivatives = core_module().Derivatives(self.core)
-        out = self._derivatives.forward_dynamics_derivatives(
-            q, v, tau, compiled, time_s, tau_ext, free_surface
-        )
+        out = self._derivatives.forward_dynamics_derivatives(*args)
         return out.da_dq, out.da_dv, out.da_dtau
 
-    def step_derivatives(
-        self,
-        q: np.ndarray,
-        v: np.ndarray,
-        tau: np.ndarray,
-        flow: FlowField | None,
-        time_s: float,
-        tau_ext: np.ndarray | None,
-        period_s: float,
-        step_s: float,
-        method: str,
-    ):
-        """The core's `StepJacobians` of one period (src/uvms_core/step_derivatives.hpp) in
-        substeps of at most ``step_s`` of ``method`` ("rk4", "semi_implicit_euler"), or the
-        Fallback of a flow it has no counterpart of."""
+    def _core_period(self, *args):
+        """The core's `StepJacobians` of one period (src/uvms_core/step_derivatives.hpp), its
+        `StepDerivatives` built on first use: ``args`` are (q, v, tau, flow, time_s, tau_ext,
+        period_s) and the substeps' ``step_s`` and ``method`` ("rk4", "semi_implicit_euler")."""
         core = core_module()
-        compiled = core.FlowField() if flow is None else self._flow_struct(flow)
-        if isinstance(compiled, Fallback):
-            return compiled
         if self._step_derivatives is None:
             self._step_derivatives = core.StepDerivatives(self.core)
+        *period, step_s, method = args
         integrator = core.FixedStep()
         integrator.method, integrator.step_s = getattr(core.Method, method), float(step_s)
-        return self._step_derivatives.period(
-            q, v, tau, compiled, time_s, tau_ext, period_s, integrator
-        )
+        return self._step_derivatives.period(*period, integrator)

@@ -18,17 +18,15 @@ from __future__ import annotations
 
 import numpy as np
 import pinocchio as pin
-from scipy.linalg import cho_factor, cho_solve
 
 from uvms_pin.checks import finite_vector
-from uvms_pin.errors import SimulationError
 from uvms_pin.flow import FlowField
 from uvms_pin.model.uvms import UVMS
 from uvms_pin.physics.configuration import checked_configuration
 from uvms_pin.physics.derivatives.fluid import fluid_wrench_jacobians, hydrostatics
 from uvms_pin.physics.derivatives.motion import JointMotion, joint_motions
 from uvms_pin.physics.derivatives.surface import wet_term_jacobians
-from uvms_pin.physics.reference import ReferenceDynamics
+from uvms_pin.physics.reference import ReferenceDynamics, mass_solve
 from uvms_pin.physics.reference import _fluid_wrenches as fluid_wrenches
 from uvms_pin.physics.surface import WetState, wet_state
 
@@ -74,11 +72,7 @@ def inverse_dynamics_derivatives(
 
 def inverse_of_mass(mass: np.ndarray, q: np.ndarray) -> np.ndarray:
     """M^-1 by a Cholesky factorisation (SimulationError if M is not positive definite)."""
-    try:
-        factor = cho_factor(mass, lower=False, check_finite=False)
-    except np.linalg.LinAlgError as exc:
-        raise SimulationError(f"mass matrix is not positive definite at q = {q}") from exc
-    return cho_solve(factor, np.eye(len(mass)), check_finite=False)
+    return mass_solve(mass, q, np.eye(len(mass)))
 
 
 def forward_dynamics_derivatives(
