@@ -16,6 +16,7 @@ change the simulation.
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import time
 import warnings
@@ -53,6 +54,24 @@ _EVENT_OVERSHOOT = 1e-6
 _NO_SIGNALS: dict[str, np.ndarray] = {}
 
 
+class _RobotPart:
+    """The robot's part of a loop's state: ``q`` (nq,) or ``v`` (nv,), read-only; assigning
+    it replaces that part of the system's state."""
+
+    def __init__(self, field: str):
+        self.field, self.slices = field, f"{field}_slices"
+
+    def __get__(self, loop: ClosedLoop | None, owner: type | None = None):
+        if loop is None:
+            return self
+        return getattr(loop.state, self.field)[getattr(loop.system.layout, self.slices)[0]]
+
+    def __set__(self, loop: ClosedLoop, value: np.ndarray) -> None:
+        whole = np.array(getattr(loop.state, self.field))
+        whole[getattr(loop.system.layout, self.slices)[0]] = value
+        loop.state = dataclasses.replace(loop.state, **{self.field: read_only(whole)})
+
+
 class ClosedLoop:
     """A plant, its sensors and (optionally) a controller, stepped and observed.
 
@@ -65,6 +84,9 @@ class ClosedLoop:
     State: ``time_s`` [s]; ``state``, the system's (`SystemState`: every body); ``q``
     (nq,), ``v`` (nv,), the robot's part of it; read-only arrays.
     """
+
+    q = _RobotPart("q")
+    v = _RobotPart("v")
 
     def __init__(
         self,
@@ -109,27 +131,6 @@ class ClosedLoop:
             with self._controller_code("reset"):
                 self.controller.reset()
         self.system.start(self.state)
-
-    # ---- the robot's part of the state ------------------------------------------------------
-    @property
-    def q(self) -> np.ndarray:
-        return self.state.q[self.system.layout.q_slices[0]]
-
-    @q.setter
-    def q(self, value: np.ndarray) -> None:
-        q = np.array(self.state.q)
-        q[self.system.layout.q_slices[0]] = value
-        self.state = SystemState(read_only(q), self.state.v)
-
-    @property
-    def v(self) -> np.ndarray:
-        return self.state.v[self.system.layout.v_slices[0]]
-
-    @v.setter
-    def v(self, value: np.ndarray) -> None:
-        v = np.array(self.state.v)
-        v[self.system.layout.v_slices[0]] = value
-        self.state = SystemState(self.state.q, read_only(v))
 
     def measure(self) -> tuple[Measurement, np.ndarray]:
         """(what the sensors give now, the true contact wrench (6,) [N; N m] world axes).
