@@ -36,12 +36,11 @@ from uvms_pin.errors import (
     SimulationError,
 )
 from uvms_pin.results.rollout import Rollout
-from uvms_pin.results.signal import described
 from uvms_pin.results.status import ERROR, INTERRUPTED, OK, RunStatus, Violation
 from uvms_pin.sim.compiled_loop import CompiledLoop, LoopPath
 from uvms_pin.sim.divergence import NUMERICAL_FAILURES, diverged, divergence_context
 from uvms_pin.sim.integrators import Adaptive
-from uvms_pin.sim.log import RolloutLog
+from uvms_pin.sim.log import RolloutLog, described_columns, run_metadata
 from uvms_pin.sim.plant import Plant
 from uvms_pin.sim.sample import Observer, Sample
 from uvms_pin.sim.sensors import SensorSuite
@@ -447,40 +446,6 @@ def _stopped(log: RolloutLog, wall_start: float, exc: SimulationError) -> Simula
     return exc
 
 
-def run_metadata(plant: Plant, settings: SimulationSettings) -> dict[str, Any]:
-    """What a rollout records of the run: settings, seed, versions, model and arm joints
-    (their kinds and position limits, None where a joint has none)."""
-    from uvms_pin.results.provenance import package_versions
-
-    uvms = plant.uvms
-    arm = uvms.arm_joints
-    lower, upper = arm.limits_record()
-    return {
-        "seed": settings.seed,
-        "duration_s": settings.duration_s,
-        "log_period_s": settings.log_period_s,
-        "control_period_s": settings.control_period_s,
-        "integrator": type(settings.integrator).__name__,
-        "integrator_settings": dict(vars(settings.integrator)),
-        "versions": package_versions(),
-        "model_source": uvms.source,
-        "arm_joint_names": list(arm.names),
-        "arm_joint_kinds": list(arm.kinds),
-        "arm_position_lower_rad": lower,
-        "arm_position_upper_rad": upper,
-        "signal_units": _described(plant.actuation.signal_columns()),
-    }
-
-
-def _described(columns: dict[str, list[tuple[str, str]]]) -> dict[str, dict[str, list[str]]]:
-    """Producers' (component, unit) columns per signal in the rollout's ``signal_units``
-    record, the one a controller's `Signal` is described by (`uvms_pin.sim.log`)."""
-    return {
-        name: described([c for c, _ in cols], [u for _, u in cols])
-        for name, cols in columns.items()
-    }
-
-
 def simulate_closed_loop(
     plant: Plant,
     controller: Controller,
@@ -506,6 +471,6 @@ def simulate_closed_loop(
     check_log_fits(settings, plant.uvms.nq, plant.uvms.nv, loop.system.n_logged_columns)
     meta = {**(metadata or {}), **run_metadata(plant, settings)}
     if sensors.navigation is not None:
-        meta["signal_units"].update(_described(sensors.navigation.signal_columns()))
+        meta["signal_units"].update(described_columns(sensors.navigation.signal_columns()))
     log = RolloutLog(plant.uvms, settings.n_log, meta, backend=plant.backend, system=loop.system)
     return loop.run(q0, v0, sensors, log)

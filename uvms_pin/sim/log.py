@@ -27,7 +27,9 @@ from uvms_pin.physics.dynamics import kinetic_energy, potential_energy_placed
 from uvms_pin.physics.surface import wet_state
 from uvms_pin.results.rollout import Rollout
 from uvms_pin.results.signal import Signal, described
+from uvms_pin.sim.plant import Plant
 from uvms_pin.sim.sample import Sample
+from uvms_pin.sim.settings import SimulationSettings
 from uvms_pin.sim.system import System
 
 
@@ -153,3 +155,37 @@ class RolloutLog:
 def hull_names(uvms: UVMS) -> list[str]:
     """The name of each hull's body (the columns of the ``wet_fraction`` signal)."""
     return [uvms.hydro_bodies[int(k)].name for k in uvms.surface_bodies.body_index]
+
+
+def run_metadata(plant: Plant, settings: SimulationSettings) -> dict[str, Any]:
+    """What a rollout records of the run: settings, seed, versions, model and arm joints
+    (their kinds and position limits, None where a joint has none)."""
+    from uvms_pin.results.provenance import package_versions
+
+    uvms = plant.uvms
+    arm = uvms.arm_joints
+    lower, upper = arm.limits_record()
+    return {
+        "seed": settings.seed,
+        "duration_s": settings.duration_s,
+        "log_period_s": settings.log_period_s,
+        "control_period_s": settings.control_period_s,
+        "integrator": type(settings.integrator).__name__,
+        "integrator_settings": dict(vars(settings.integrator)),
+        "versions": package_versions(),
+        "model_source": uvms.source,
+        "arm_joint_names": list(arm.names),
+        "arm_joint_kinds": list(arm.kinds),
+        "arm_position_lower_rad": lower,
+        "arm_position_upper_rad": upper,
+        "signal_units": described_columns(plant.actuation.signal_columns()),
+    }
+
+
+def described_columns(columns: dict[str, list[tuple[str, str]]]) -> dict[str, dict[str, list[str]]]:
+    """Producers' (component, unit) columns per signal in the rollout's ``signal_units``
+    record, the one a controller's `Signal` is described by (`uvms_pin.sim.log`)."""
+    return {
+        name: described([c for c, _ in cols], [u for _, u in cols])
+        for name, cols in columns.items()
+    }

@@ -30,8 +30,8 @@ from uvms_pin.model.resources import shipped_path
 from uvms_pin.results.rollout import Rollout
 from uvms_pin.results.status import OK, RunStatus
 from uvms_pin.scenario.load import load_scenario
-from uvms_pin.sim.closed_loop import ClosedLoop, run_metadata
-from uvms_pin.sim.log import RolloutLog
+from uvms_pin.sim.closed_loop import ClosedLoop
+from uvms_pin.sim.log import RolloutLog, run_metadata
 from uvms_pin.sim.run import Scenario
 from uvms_pin.sim.sensors import SensorSuite
 
