@@ -11,6 +11,7 @@ from conftest import ROOT
 
 import uvms_pin as up
 from uvms_pin.physics.compiled.extension import core_module
+from uvms_pin.physics.contact import LinearSpring
 from uvms_pin.scenario.load import load_scenario
 from uvms_pin.sim.compiled.integrator import integrator_to_core
 from uvms_pin.sim.integrators import RK4
@@ -115,3 +116,24 @@ def test_without_a_world_nothing_more_is_logged(reference_uvms):
     state = system.initial_state(reference_uvms.neutral_configuration(), np.zeros(10))
     assert system.logged_signals(state.q, state.v) == {}
     assert system.n_logged_columns == 0 and system.moving is None
+
+
+def test_a_new_start_steps_with_the_plant_as_attached_anew(reference_uvms):
+    """The period step is chosen once, but a run's start anchors the contact anew: the
+    next period is the compiled plant's with the new anchor, not the first run's."""
+    plant = Plant(reference_uvms, contact=LinearSpring(np.full(3, 500.0)), free_surface=False)
+    system = System(plant)
+    integrator, tau = RK4(5e-4), np.zeros(10)
+    first = system.initial_state(reference_uvms.neutral_configuration(), np.zeros(10))
+    system.start(first)
+    system.advance(integrator, 0.0, first.q, first.v, tau, 0.002)
+    q = reference_uvms.neutral_configuration()
+    q[:3] += [0.3, -0.2, 0.1]
+    second = system.initial_state(q, np.full(10, 0.05))
+    system.start(second)
+    got = system.advance(integrator, 0.0, second.q, second.v, tau, 0.002)
+    step = integrator_to_core(integrator, core_module())
+    expected = plant.compiled.advance(0.0, second.q, second.v, tau, 0.002, step)
+    np.testing.assert_array_equal(got[1], expected[1])
+    # and the spring pulls towards the new anchor: the state moved from the new start alone
+    assert np.linalg.norm(got[0][:3] - q[:3]) < 1e-3

@@ -64,12 +64,14 @@ def period_step(system: Stepped, integrator: Integrator) -> PeriodStep:
         system.settle(q1, v1)
         return q1, v1
 
+    # the compiled plant is rebuilt when a run starts (its contact anchored anew): taken at
+    # each period, the choice of step stays
     if system.objects:
         return integrated
     if step is not None and plant.world is None:
-        return lambda t0, q0, v0, tau, t1: compiled.advance(t0, q0, v0, tau, t1, step)
+        return lambda t0, q0, v0, tau, t1: plant.compiled.advance(t0, q0, v0, tau, t1, step)
     if step is not None and system.moving is None:
-        return lambda t0, q0, v0, tau, t1: compiled.advance_in_world(
+        return lambda t0, q0, v0, tau, t1: plant.compiled.advance_in_world(
             t0, q0, v0, tau, t1, step, plant.friction
         )
     if compiled is None:
@@ -77,7 +79,7 @@ def period_step(system: Stepped, integrator: Integrator) -> PeriodStep:
 
     def guarded(t0, q0, v0, tau, t1):
         if system.clear(q0, v0, t1 - t0) and step is not None:
-            return compiled.advance(t0, q0, v0, tau, t1, step)
+            return plant.compiled.advance(t0, q0, v0, tau, t1, step)
         return integrated(t0, q0, v0, tau, t1)
 
     return guarded
