@@ -117,8 +117,8 @@ def test_plant_advance_matches_the_reference_and_stays_on_the_circle(mixed, inte
     v0 = rng.normal(scale=0.5, size=mixed.nv)
     tau = rng.normal(scale=5.0, size=mixed.nv)
     assert_rel(core.acceleration(0.3, q0, v0, tau), python.acceleration(0.3, q0, v0, tau))
-    q_c, v_c = core.advance(integrator, 0.1, q0, v0, tau, 0.15)
-    q_p, v_p = python.advance(integrator, 0.1, q0, v0, tau, 0.15)
+    q_c, v_c = System(core).advance(integrator, 0.1, q0, v0, tau, 0.15)
+    q_p, v_p = System(python).advance(integrator, 0.1, q0, v0, tau, 0.15)
     assert_rel(q_c, q_p)
     assert_rel(v_c, v_p)
     for k in (7, 10):  # (cos, sin) of joints 1 and 3 stay unit vectors

@@ -92,8 +92,8 @@ def test_python_disturbance_falls_back_and_says_so(reference_uvms):
     with warnings.catch_warnings():
         warnings.simplefilter("error")  # said once per plant
         q, v = System(plant).advance(RK4(5e-4), 0.002, q, v, tau, 0.004)
-    q_ref, v_ref = reference.advance(RK4(5e-4), 0.0, q0, v0, tau, 0.002)
-    q_ref, v_ref = reference.advance(RK4(5e-4), 0.002, q_ref, v_ref, tau, 0.004)
+    q_ref, v_ref = System(reference).advance(RK4(5e-4), 0.0, q0, v0, tau, 0.002)
+    q_ref, v_ref = System(reference).advance(RK4(5e-4), 0.002, q_ref, v_ref, tau, 0.004)
     np.testing.assert_allclose(v, v_ref, rtol=1e-12, atol=1e-15)
     assert v[0] != 0.0  # the gust pushed
 

@@ -27,6 +27,7 @@ from uvms_pin.physics.contact import CompliantPlane, LinearSpring
 from uvms_pin.physics.disturbance import SinusoidalDisturbance
 from uvms_pin.sim.integrators import RK4, SemiImplicitEuler, python_chart
 from uvms_pin.sim.plant import Plant
+from uvms_pin.sim.system import System
 
 ERD_ARMS = ("ur5", "panda", "z1")
 
@@ -145,8 +146,8 @@ def test_advance_over_a_control_period_matches_the_reference(system, integrator)
             _attach_inside(plant, q0)
         v0 = rng.normal(scale=0.3, size=uvms.nv)
         tau = rng.normal(scale=5.0, size=uvms.nv)
-        q_c, v_c = core.advance(integrator, 0.1, q0, v0, tau, 0.102)
-        q_p, v_p = python.advance(integrator, 0.1, q0, v0, tau, 0.102)
+        q_c, v_c = System(core).advance(integrator, 0.1, q0, v0, tau, 0.102)
+        q_p, v_p = System(python).advance(integrator, 0.1, q0, v0, tau, 0.102)
         assert_rel(q_c, q_p)
         assert_rel(v_c, v_p)
 
@@ -208,8 +209,8 @@ def test_every_shipped_model_matches_the_reference(name):
     tau = rng.normal(scale=5.0, size=uvms.nv)
     assert_rel(core.acceleration(0.3, q0, v0, tau), python.acceleration(0.3, q0, v0, tau))
     for got, expected in zip(
-        core.advance(RK4(5e-4), 0.1, q0, v0, tau, 0.102),
-        python.advance(RK4(5e-4), 0.1, q0, v0, tau, 0.102),
+        System(core).advance(RK4(5e-4), 0.1, q0, v0, tau, 0.102),
+        System(python).advance(RK4(5e-4), 0.1, q0, v0, tau, 0.102),
         strict=True,
     ):
         assert_rel(got, expected)

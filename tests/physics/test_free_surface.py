@@ -15,6 +15,7 @@ from uvms_pin.flow import AiryWave, IrregularSea, UniformCurrent
 from uvms_pin.model.resources import example_robot_data_dir, shipped_path
 from uvms_pin.sim.integrators import RK4
 from uvms_pin.sim.plant import Plant
+from uvms_pin.sim.system import System
 
 FLOWS = {
     "still": None,
@@ -94,7 +95,7 @@ def test_the_plants_advance_alike_through_the_surface(reference_uvms):
         tau = rng.normal(size=reference_uvms.nv)
         for plant in plants:
             plant.attach(q)
-        (qc, vc), (qp, vp) = (p.advance(RK4(5e-4), 0.3, q, v, tau, 0.302) for p in plants)
+        (qc, vc), (qp, vp) = (System(p).advance(RK4(5e-4), 0.3, q, v, tau, 0.302) for p in plants)
         assert_rel(qc, qp)
         assert_rel(vc, vp)
 
