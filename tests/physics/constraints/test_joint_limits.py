@@ -134,6 +134,8 @@ def test_a_joint_past_its_limit_comes_back_by_the_correction(alpha5):
     mass = up.mass_matrix(alpha5, q)
     for beta in (0.2, 1.0):
         step = constrained_velocity(alpha5.model, mass, v, q, [limits], PERIOD_S, correction=beta)
+        (rows,) = step.rows
+        assert rows.labels == ("alpha_axis_d lower",) and rows.jacobian.shape == (1, alpha5.nv)
         assert step.velocity[7] * PERIOD_S == pytest.approx(beta * 0.01, rel=1e-5)
 
 

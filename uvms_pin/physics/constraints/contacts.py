@@ -107,7 +107,9 @@ class PlaneContacts:
             constraint.calc(model, data, constraint_data)
             models.append(constraint)
             datas.append(constraint_data)
-            jacobians.append(np.array(constraint.jacobian(model, data, constraint_data)))
+            jacobians.append(
+                np.reshape(constraint.jacobian(model, data, constraint_data), (3, model.nv))
+            )
             gaps.append([0.0, 0.0, gap])
             labels += [f"{model.names[sphere.joint_id]}[{k}] {axis}" for axis in ("t1", "t2", "n")]
         if not models:

@@ -80,7 +80,7 @@ class JointLimits:
         constraint = pin.ConstraintModel(limit)
         constraint_data = constraint.createData()
         constraint.calc(model, data, constraint_data)
-        jacobian = np.array(constraint.jacobian(model, data, constraint_data))
+        jacobian = np.reshape(constraint.jacobian(model, data, constraint_data), (-1, model.nv))
         gap = np.array(constraint_data.extract().constraint_residual, dtype=float)
         labels = tuple(
             _label(model, row, k < limit.lowerResidualSize()) for k, row in enumerate(jacobian)
