@@ -1,16 +1,22 @@
 """Point contacts with Coulomb friction solved implicitly (`uvms_pin.physics.constraints`):
 a solid sphere in air on a plane tilted 10 and 40 degrees rolls below the friction limit
 (a = g sin / (1 + I / (m r^2)), |v| = |w| r) and slides above it (a = g (sin - mu cos)),
-without sinking; the contact never adds kinetic energy; a sphere off the plane has no row."""
+without sinking; the contact never adds kinetic energy; a sphere off the plane has no row;
+the BlueROV2 + Alpha 5 in water pressed on a seafloor by its end-effector."""
 
 from __future__ import annotations
+
+import warnings
 
 import numpy as np
 import pinocchio as pin
 import pytest
 
+import uvms_pin as up
 from uvms_pin.errors import ParameterError
+from uvms_pin.model.resources import shipped_path
 from uvms_pin.physics.constraints.contacts import ContactSphere, PlaneContacts
+from uvms_pin.physics.constraints.joint_limits import JointLimits
 from uvms_pin.physics.constraints.step import constrained_velocity
 
 MASS_KG, RADIUS_M, G, MU, PERIOD_S = 1.0, 0.1, 9.81, 0.2, 2e-3
@@ -122,3 +128,42 @@ def test_refusals():
         PlaneContacts((), np.zeros(3), np.zeros(3), MU)
     with pytest.raises(ParameterError, match="friction"):
         PlaneContacts((), np.zeros(3), np.array([0.0, 0.0, 1.0]), -0.1)
+
+
+def test_the_alpha5_pressed_on_the_seafloor_in_water():
+    """The BlueROV2 + Alpha 5 in water, pushed down (20 N) with its end-effector 2 cm
+    above a seafloor (mu = 0.5) and its joints limited: the end-effector lands and stays on
+    the floor (1e-6 m), no impulse adds kinetic energy, with the added mass in M."""
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", up.ModelWarning)
+        uvms = up.load_uvms(shipped_path("models/uvms_bluerov2_alpha5.urdf"))
+    model, data = uvms.model, uvms.model.createData()
+    ee = model.frames[uvms.ee_frame_id]
+    q = uvms.neutral_configuration()
+    q[7:] = uvms.arm_joints.configuration(np.array([-0.2, 0.8, 2.2, 0.2]))
+    pin.framesForwardKinematics(model, data, q)
+    floor_m = data.oMf[uvms.ee_frame_id].translation[2] - 0.02
+    floor = PlaneContacts(
+        (ContactSphere(ee.parentJoint, ee.placement.translation, 0.0),),
+        np.array([0.0, 0.0, floor_m]),
+        np.array([0.0, 0.0, 1.0]),
+        0.5,
+    )
+    constraints = [JointLimits.of_uvms(uvms), floor]
+    tau = np.zeros(uvms.nv)
+    tau[2] = -20.0  # N, down in the vehicle's frame
+    v, lowest_m, touching = np.zeros(uvms.nv), np.inf, 0
+    for _ in range(300):
+        v_free = v + PERIOD_S * up.forward_dynamics(uvms, q, v, tau)
+        mass = up.mass_matrix(uvms, q)
+        step = constrained_velocity(model, mass, v_free, q, constraints, PERIOD_S)
+        assert step.converged
+        assert step.velocity @ mass @ step.velocity <= v_free @ mass @ v_free + 1e-12
+        touching += bool(step.impulses["contacts"].size and step.impulses["contacts"][2] > 1e-9)
+        v = step.velocity
+        q = pin.integrate(model, q, PERIOD_S * v)
+        pin.framesForwardKinematics(model, data, q)
+        lowest_m = min(lowest_m, data.oMf[uvms.ee_frame_id].translation[2] - floor_m)
+    assert lowest_m >= -1e-6
+    assert touching > 200
+    assert np.abs(v).max() < 10.0
