@@ -23,11 +23,9 @@ import pinocchio as pin
 
 from uvms_pin.errors import ParameterError
 from uvms_pin.model.uvms import UVMS
-from uvms_pin.physics.constraints.rows import ConstraintRows
+from uvms_pin.physics.constraints.rows import JOINT_IMPULSE_UNIT, ConstraintRows
 
 __all__ = ["JointLimits"]
-
-_UNIT = "N m s (revolute) / N s (prismatic)"
 
 
 @dataclass(frozen=True)
@@ -76,7 +74,7 @@ class JointLimits:
         )
         limit.makeSelectionFilteredByLimitProximity(q)
         if limit.residualSize() == 0:
-            return ConstraintRows.empty(self.name, _UNIT, model.nv)
+            return ConstraintRows.empty(self.name, JOINT_IMPULSE_UNIT, model.nv)
         constraint = pin.ConstraintModel(limit)
         constraint_data = constraint.createData()
         constraint.calc(model, data, constraint_data)
@@ -87,7 +85,7 @@ class JointLimits:
         )
         return ConstraintRows(
             self.name,
-            _UNIT,
+            JOINT_IMPULSE_UNIT,
             (constraint,),
             (constraint_data,),
             jacobian,

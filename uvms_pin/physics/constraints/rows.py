@@ -16,7 +16,10 @@ from typing import Protocol
 import numpy as np
 import pinocchio as pin
 
-__all__ = ["ConstraintRows", "ConstraintSet"]
+__all__ = ["JOINT_IMPULSE_UNIT", "ConstraintRows", "ConstraintSet"]
+
+#: The unit of an impulse on a joint's coordinate
+JOINT_IMPULSE_UNIT = "N m s (revolute) / N s (prismatic)"
 
 
 @dataclass(frozen=True)
