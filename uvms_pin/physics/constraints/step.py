@@ -1,16 +1,17 @@
 """One implicit velocity-level step of the constraints over a period h (Moreau-Jean).
 
 The smooth dynamics alone bring the velocity to v_free at the period's end. The constraints
-(joint limits, contacts) add the impulse lambda (m,) through their Jacobian J (m x nv) at
-the configuration q of the period's start:
+(joint limits, joint Coulomb friction, contacts) add the impulse lambda (m,) through their
+Jacobian J (m x nv) at the configuration q of the period's start:
 
     v+ = v_free + M^-1 J^T lambda                                    [rad/s, m/s]
     sigma = J v+ + phi(r) / h  in K*,   lambda in K,   lambda . sigma = 0
 
 with M the mass matrix INCLUDING the added mass (the entrained water is accelerated by
 the impulse too), K each block's cone (the positive orthant of a limit or a contact normal,
-the Coulomb cone mu |lambda_t| <= lambda_n of a contact; K* its dual, with De Saxce's
-correction for the non-associated Coulomb law) and r the rows' gaps (`ConstraintRows`).
+the box |lambda| <= c h of a joint's Coulomb friction, the Coulomb cone
+mu |lambda_t| <= lambda_n of a contact; K* its dual, with De Saxce's correction for the
+non-associated Coulomb law) and r the rows' gaps (`ConstraintRows`).
 In terms of the Delassus operator G = J M^-1 J^T the solver (Pinocchio's
 `ADMMConstraintSolver`) finds lambda with sigma = G lambda + g, g = J v_free + phi(r) / h.
 
@@ -117,7 +118,8 @@ def constrained_velocity(
         v_free: the velocity the smooth dynamics reach at the period's end (nv,).
         q: the configuration at the period's start (nq,): J and the gaps are taken there.
         constraints: the constraint sets (`joint_limits.JointLimits`,
-            `contacts.PlaneContacts`), each named once.
+            `joint_friction.JointCoulombFriction`, `contacts.PlaneContacts`), each named
+            once.
         period_s: h [s] (> 0). correction: beta, the fraction of a penetration removed per
             period (0 < beta <= 1). settings: the ADMM settings (`default_settings`).
 
