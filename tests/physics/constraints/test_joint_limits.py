@@ -15,7 +15,7 @@ import uvms_pin as up
 from uvms_pin.errors import ParameterError
 from uvms_pin.model.resources import shipped_path
 from uvms_pin.physics.constraints.joint_limits import JointLimits
-from uvms_pin.physics.constraints.step import constrained_velocity
+from uvms_pin.physics.constraints.step import constrained_configuration, constrained_velocity
 from uvms_pin.physics.joint_stops import JointStops
 
 PERIOD_S = 2e-3
@@ -169,3 +169,20 @@ def test_without_rows_the_velocity_is_the_free_one(alpha5):
     step = constrained_velocity(alpha5.model, mass, v_free, q, [JointLimits.of_uvms(alpha5)], 2e-3)
     assert step.rows == () and step.iterations == 0
     np.testing.assert_array_equal(step.velocity, v_free)
+
+
+def test_the_end_configuration_is_the_free_one_unless_rows_were_solved(alpha5):
+    limits = JointLimits.of_uvms(alpha5)
+    q, _ = _start(alpha5)
+    q_free = q.copy()
+    q_free[7:] += 1e-4  # what a higher-order step would reach, not q (+) h v_free
+    mass = up.mass_matrix(alpha5, q)
+    slow = np.r_[np.zeros(6), 0.1, 0.1, 0.1, 0.1]
+    free_step = constrained_velocity(alpha5.model, mass, slow, q, [limits], PERIOD_S)
+    end = constrained_configuration(alpha5.model, q, q_free, free_step, PERIOD_S)
+    np.testing.assert_array_equal(end, q_free)
+    hurled = np.r_[np.zeros(6), 0.0, -500.0, 0.0, 0.0]  # joint d, 0.8 rad from its limit
+    stopped = constrained_velocity(alpha5.model, mass, hurled, q, [limits], PERIOD_S)
+    end = constrained_configuration(alpha5.model, q, q_free, stopped, PERIOD_S)
+    np.testing.assert_allclose(end, pin.integrate(alpha5.model, q, PERIOD_S * stopped.velocity))
+    assert alpha5.arm_joints.positions(end)[1] == pytest.approx(0.0, abs=1e-9)
