@@ -28,7 +28,7 @@ import pinocchio as pin
 
 from uvms_pin.checks import finite_vector
 from uvms_pin.errors import ParameterError
-from uvms_pin.physics.constraints.rows import ConstraintRows
+from uvms_pin.physics.constraints.rows import ConstraintRows, evaluated
 
 __all__ = ["ContactSphere", "PlaneContacts"]
 
@@ -102,14 +102,10 @@ class PlaneContacts:
                 pin.SE3(placed.rotation.T @ frame, placed.actInv(point)),
             )
             contact.setFriction(self.friction)
-            constraint = pin.ConstraintModel(contact)
-            constraint_data = constraint.createData()
-            constraint.calc(model, data, constraint_data)
+            constraint, constraint_data, jacobian = evaluated(model, data, contact)
             models.append(constraint)
             datas.append(constraint_data)
-            jacobians.append(
-                np.reshape(constraint.jacobian(model, data, constraint_data), (3, model.nv))
-            )
+            jacobians.append(jacobian)
             gaps.append([0.0, 0.0, gap])
             labels += [f"{model.names[sphere.joint_id]}[{k}] {axis}" for axis in ("t1", "t2", "n")]
         if not models:

@@ -21,7 +21,7 @@ import pinocchio as pin
 
 from uvms_pin.errors import ParameterError
 from uvms_pin.model.uvms import UVMS
-from uvms_pin.physics.constraints.rows import JOINT_IMPULSE_UNIT, ConstraintRows
+from uvms_pin.physics.constraints.rows import JOINT_IMPULSE_UNIT, ConstraintRows, evaluated
 
 __all__ = ["JointCoulombFriction"]
 
@@ -66,17 +66,11 @@ class JointCoulombFriction:
             model, pin.StdVec_Index(list(self.joint_ids)), -self.coulomb_Nm, self.coulomb_Nm
         )
         friction.setTimeStep(period_s)
-        constraint = pin.ConstraintModel(friction)
-        constraint_data = constraint.createData()
-        constraint.calc(model, data, constraint_data)
-        jacobian = np.reshape(constraint.jacobian(model, data, constraint_data), (-1, model.nv))
         n = len(self.joint_ids)
-        return ConstraintRows(
+        return ConstraintRows.single(
             self.name,
             JOINT_IMPULSE_UNIT,
-            (constraint,),
-            (constraint_data,),
-            jacobian,
+            evaluated(model, data, friction),
             np.zeros(n),
             np.zeros(n, dtype=bool),
             tuple(model.names[j] for j in self.joint_ids),

@@ -23,7 +23,7 @@ import pinocchio as pin
 
 from uvms_pin.errors import ParameterError
 from uvms_pin.model.uvms import UVMS
-from uvms_pin.physics.constraints.rows import JOINT_IMPULSE_UNIT, ConstraintRows
+from uvms_pin.physics.constraints.rows import JOINT_IMPULSE_UNIT, ConstraintRows, evaluated
 
 __all__ = ["JointLimits"]
 
@@ -75,23 +75,15 @@ class JointLimits:
         limit.makeSelectionFilteredByLimitProximity(q)
         if limit.residualSize() == 0:
             return ConstraintRows.empty(self.name, JOINT_IMPULSE_UNIT, model.nv)
-        constraint = pin.ConstraintModel(limit)
-        constraint_data = constraint.createData()
-        constraint.calc(model, data, constraint_data)
-        jacobian = np.reshape(constraint.jacobian(model, data, constraint_data), (-1, model.nv))
+        constraint = evaluated(model, data, limit)
+        _, constraint_data, jacobian = constraint
         gap = np.array(constraint_data.extract().constraint_residual, dtype=float)
         labels = tuple(
             _label(model, row, k < limit.lowerResidualSize()) for k, row in enumerate(jacobian)
         )
-        return ConstraintRows(
-            self.name,
-            JOINT_IMPULSE_UNIT,
-            (constraint,),
-            (constraint_data,),
-            jacobian,
-            gap,
-            np.ones(gap.shape[0], dtype=bool),
-            labels,
+        positional = np.ones(gap.shape[0], dtype=bool)
+        return ConstraintRows.single(
+            self.name, JOINT_IMPULSE_UNIT, constraint, gap, positional, labels
         )
 
 

@@ -16,7 +16,7 @@ from typing import Protocol
 import numpy as np
 import pinocchio as pin
 
-__all__ = ["JOINT_IMPULSE_UNIT", "ConstraintRows", "ConstraintSet"]
+__all__ = ["JOINT_IMPULSE_UNIT", "ConstraintRows", "ConstraintSet", "evaluated"]
 
 #: The unit of an impulse on a joint's coordinate
 JOINT_IMPULSE_UNIT = "N m s (revolute) / N s (prismatic)"
@@ -51,10 +51,36 @@ class ConstraintRows:
         return int(self.gap.shape[0])
 
     @staticmethod
+    def single(
+        name: str,
+        unit: str,
+        constraint: tuple[pin.ConstraintModel, pin.ConstraintData, np.ndarray],
+        gap: np.ndarray,
+        positional: np.ndarray,
+        labels: tuple[str, ...],
+    ) -> ConstraintRows:
+        """The rows of one Pinocchio constraint, ``constraint`` as `evaluated` gives it."""
+        model, data, jacobian = constraint
+        return ConstraintRows(name, unit, (model,), (data,), jacobian, gap, positional, labels)
+
+    @staticmethod
     def empty(name: str, unit: str, nv: int) -> ConstraintRows:
         """No row: nothing of the set can touch within the period."""
         none = np.zeros(0)
         return ConstraintRows(name, unit, (), (), np.zeros((0, nv)), none, none.astype(bool), ())
+
+
+def evaluated(
+    model: pin.Model, data: pin.Data, specific: object
+) -> tuple[pin.ConstraintModel, pin.ConstraintData, np.ndarray]:
+    """(the generic constraint model, its data after ``calc`` at ``data``'s configuration,
+    its Jacobian (rows x nv)) of one of Pinocchio's specific constraint models
+    (`JointLimitConstraintModel`, `PointContactConstraintModel`, ...)."""
+    constraint = pin.ConstraintModel(specific)
+    constraint_data = constraint.createData()
+    constraint.calc(model, data, constraint_data)
+    jacobian = np.reshape(constraint.jacobian(model, data, constraint_data), (-1, model.nv))
+    return constraint, constraint_data, jacobian
 
 
 class ConstraintSet(Protocol):
