@@ -11,6 +11,7 @@ import pytest
 from conftest import ROOT
 
 from uvms_pin.errors import ParameterError
+from uvms_pin.physics.constraints.joint_limits import JointLimits
 from uvms_pin.scenario.load import load_scenario
 from uvms_pin.sim.batched_plant import BatchedPlant
 from uvms_pin.sim.integrators import Adaptive
@@ -101,3 +102,16 @@ def test_the_loop_records_and_the_batch_refuses_with_the_same_reason():
     station.plant.stop_at_surface = True
     with pytest.raises(ParameterError, match="the batched plant does not simulate stop_at_surface"):
         BatchedPlant(station.plant, station.settings, station.sensor_config, 2)
+
+
+def test_joint_limits_as_constraints_keep_both_pipelines_in_python():
+    scenario = load_scenario(
+        ROOT / "scenarios" / "bluerov_alpha5_force_tracking.toml",
+        {"scenario.duration_s": 0.1, "joints.hard_stops": False},
+    )
+    scenario.plant.joint_limits = JointLimits.of_uvms(scenario.uvms)
+    parts = _parts(scenario)
+    for pipeline in (Pipeline.LOOP, Pipeline.BATCH):
+        assert why_not_compiled(parts, pipeline) == (
+            "joint limits as constraints (their solve is Python's)"
+        )

@@ -11,7 +11,9 @@ from conftest import ROOT
 
 import uvms_pin as up
 from uvms_pin.physics.compiled.extension import core_module
+from uvms_pin.physics.constraints.joint_limits import JointLimits
 from uvms_pin.physics.contact import LinearSpring
+from uvms_pin.physics.joint_stops import JointStops
 from uvms_pin.scenario.load import load_scenario
 from uvms_pin.sim.compiled.integrator import integrator_to_core
 from uvms_pin.sim.integrators import RK4
@@ -137,3 +139,44 @@ def test_a_new_start_steps_with_the_plant_as_attached_anew(reference_uvms):
     np.testing.assert_array_equal(got[1], expected[1])
     # and the spring pulls towards the new anchor: the state moved from the new start alone
     assert np.linalg.norm(got[0][:3] - q[:3]) < 1e-3
+
+
+@pytest.fixture(scope="module")
+def bluerov_alpha5():
+    return load_scenario(ROOT / "scenarios" / "bluerov_alpha5_force_tracking.toml")
+
+
+def _released(scenario, **plant_fields):
+    """The smallest distance of an arm joint to its limits [rad] over 2 s of the BlueROV2 +
+    Alpha 5 released with no input at its scenario's step (RK4, 0.5 ms substeps of a 2 ms
+    period: the arm falls onto its limits), or None when the run diverges."""
+    uvms = scenario.uvms
+    lower, upper = uvms.model.lowerPositionLimit[7:], uvms.model.upperPositionLimit[7:]
+    plant = Plant(uvms, free_surface=True, **plant_fields)
+    system = System(plant)
+    state = system.initial_state(scenario.q0, scenario.v0)
+    system.start(state)
+    q, v, tau = state.q, state.v, np.zeros(uvms.nv)
+    integrator, period, closest = scenario.settings.integrator, 0.002, np.inf
+    for k in range(1000):
+        q, v = system.advance(integrator, k * period, q, v, tau, (k + 1) * period)
+        if not (np.all(np.isfinite(v)) and np.abs(v).max() < 1e3):
+            return None
+        closest = min(closest, np.min(q[7:] - lower), np.min(upper - q[7:]))
+    return closest
+
+
+def test_joint_limits_as_constraints_hold_where_the_stops_diverge(bluerov_alpha5):
+    uvms = bluerov_alpha5.uvms
+    assert _released(bluerov_alpha5, joint_stops=JointStops.of_model(uvms.model)) is None
+    closest = _released(bluerov_alpha5, joint_limits=JointLimits.of_uvms(uvms))
+    assert -1e-6 <= closest < 1e-4  # a joint reached its limit, and none went past it
+
+
+def test_joint_limits_are_either_stops_or_constraints(reference_uvms):
+    with pytest.raises(up.ParameterError, match="not both"):
+        Plant(
+            reference_uvms,
+            joint_stops=JointStops.of_model(reference_uvms.model),
+            joint_limits=JointLimits.of_uvms(reference_uvms),
+        )

@@ -117,11 +117,16 @@ class ClosedLoop:
             ParameterError: a state of the wrong size or with a non-finite value.
         """
         state = self.system.initial_state(q0, v0)
-        if self.system.objects and self.settings.control_period_s is None:
-            raise ParameterError(
-                "free objects are integrated with the UVMS period by period: they need a "
-                "sampled controller ([control] period_s), not a continuous one"
-            )
+        period_by_period = {
+            "free objects": bool(self.system.objects),
+            "joint limits as constraints": self.plant.joint_limits is not None,
+        }
+        for what, present in period_by_period.items():
+            if present and self.settings.control_period_s is None:
+                raise ParameterError(
+                    f"{what} are stepped with the UVMS period by period: they need a "
+                    "sampled controller ([control] period_s), not a continuous one"
+                )
         self.time_s, self.state = 0.0, SystemState(read_only(state.q), read_only(state.v))
         self.sensors = sensors
         self.plant.actuation.start(self.settings.control_period_s)

@@ -27,6 +27,7 @@ from uvms_pin.errors import ParameterError, SimulationError
 from uvms_pin.flow import FlowField, SumFlow, UniformCurrent
 from uvms_pin.model.uvms import UVMS
 from uvms_pin.physics.compiled.backend import Backend, Fallback, backend_named
+from uvms_pin.physics.constraints.joint_limits import JointLimits
 from uvms_pin.physics.contact import ContactModel
 from uvms_pin.physics.disturbance import Disturbance
 from uvms_pin.physics.dynamics import forward_dynamics
@@ -61,6 +62,9 @@ class Plant:
         world: fixed objects every body's collision geometry touches (the seafloor, rocks,
             structures; `uvms_pin.physics.world`), or None.
         joint_stops: compliant stops at the arm joints' limits, or None (no stops).
+        joint_limits: the arm joints' limits as constraints solved implicitly once a control
+            period (`uvms_pin.physics.constraints`: a joint stops at its limit whatever its
+            inertia), or None; not with ``joint_stops``.
     """
 
     uvms: UVMS
@@ -75,6 +79,7 @@ class Plant:
     joint_friction: JointFriction | None = None
     world: World | None = None
     joint_stops: JointStops | None = None
+    joint_limits: JointLimits | None = None
 
     def __post_init__(self) -> None:
         self.current_world_m_s = finite_vector("current_world_m_s", self.current_world_m_s, 3)
@@ -91,6 +96,11 @@ class Plant:
             )
         if self.world is not None and self.world.uvms is not self.uvms:
             raise ParameterError("the plant's world was built for another UVMS")
+        if self.joint_limits is not None and self.joint_stops is not None:
+            raise ParameterError(
+                "the joints' limits are either compliant stops (joint_stops) or constraints "
+                "(joint_limits), not both"
+            )
         self._backend: Backend = backend_named(self.backend)
         self._ee_data = self.uvms.model.createData()
         self._world_data = self.uvms.model.createData()
@@ -109,6 +119,7 @@ class Plant:
             "free_surface": bool(self.free_surface),
             "world": None if self.world is None else self.world.record(),
             "joint_stops": None if self.joint_stops is None else self.joint_stops.record(),
+            "joint_limits": None if self.joint_limits is None else self.joint_limits.record(),
         }
 
     def check_submerged(self, time_s: float, q: np.ndarray) -> None:

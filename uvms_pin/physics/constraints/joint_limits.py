@@ -55,6 +55,10 @@ class JointLimits:
         limited = np.flatnonzero(uvms.arm_joints.limited)
         return JointLimits(tuple(int(2 + k) for k in limited), float(margin))
 
+    def record(self) -> dict[str, object]:
+        """The limits as plain data (a rollout's world record)."""
+        return {"joint_ids": list(self.joint_ids), "margin_rad": self.margin, "solved": "implicitly"}
+
     def rows(
         self, model: pin.Model, data: pin.Data, q: np.ndarray, speed: np.ndarray, period_s: float
     ) -> ConstraintRows:

@@ -9,8 +9,9 @@
   the Python reference, an integrator without a compiled counterpart), the anchors moved at
   the period's end.
 
-This is the one place the step is made; the constraint solve of rigid contacts, joint limits
-and attachments goes here, after the smooth dynamics, for every body at once.
+This is the one place the step is made: the constraints solved implicitly come after the
+smooth dynamics, for every body at once (`constrained`: today the robot's joint limits; rigid
+contacts, joint friction and attachments join them there).
 """
 
 from __future__ import annotations
@@ -21,8 +22,10 @@ from typing import Any, Protocol
 import numpy as np
 import pinocchio as pin
 
+from uvms_pin.errors import SimulationError
 from uvms_pin.physics.compiled.backend import Fallback
 from uvms_pin.physics.compiled.extension import core_module
+from uvms_pin.physics.constraints.step import constrained_configuration, constrained_velocity
 from uvms_pin.sim.compiled.integrator import integrator_to_core
 from uvms_pin.sim.integrators import Integrator
 
@@ -41,6 +44,8 @@ class Stepped(Protocol):
 
     def clear(self, q: np.ndarray, v: np.ndarray, horizon_s: float) -> bool: ...
 
+    def mass_matrix(self, time_s: float, q: np.ndarray) -> np.ndarray: ...
+
 
 #: (t0, q0, v0, tau, t1) -> (q1, v1), the system's state at t1
 PeriodStep = Callable[[float, np.ndarray, np.ndarray, np.ndarray, float], tuple]
@@ -49,7 +54,39 @@ __all__ = ["PeriodStep", "Stepped", "period_step"]
 
 
 def period_step(system: Stepped, integrator: Integrator) -> PeriodStep:
-    """The period step of ``system`` with ``integrator`` (see the module docstring)."""
+    """The period step of ``system`` with ``integrator`` (see the module docstring), then,
+    with the robot's joint limits as constraints, their implicit solve (`constrained`)."""
+    smooth = _smooth_step(system, integrator)
+    if system.plant.joint_limits is None:
+        return smooth
+    return constrained(system, smooth)
+
+
+def constrained(system: Stepped, smooth: PeriodStep) -> PeriodStep:
+    """``smooth`` followed by the constraints' implicit velocity step over the period
+    (`uvms_pin.physics.constraints.step`): the smooth dynamics reach (q_free, v_free); the
+    impulses give v+ = v_free + M^-1 J^T lambda, M(q0) the mass matrix with the added mass
+    (block diagonal over the bodies); the configuration is q0 (+) h v+ when a row was solved,
+    q_free otherwise (a period in which nothing can reach a limit is the smooth step's)."""
+    plant = system.plant
+    sets = (plant.joint_limits,)
+
+    def step(t0, q0, v0, tau, t1):
+        q_free, v_free = smooth(t0, q0, v0, tau, t1)
+        mass = system.mass_matrix(t0, q0)
+        solved = constrained_velocity(system.model, mass, v_free, q0, sets, t1 - t0)
+        if not solved.converged:
+            raise SimulationError(
+                f"the constraint solve did not converge between t = {t0:.6g} s and {t1:.6g} s "
+                f"({solved.iterations} iterations, residual {solved.residual:.3g})"
+            )
+        return constrained_configuration(system.model, q0, q_free, solved, t1 - t0), solved.velocity
+
+    return step
+
+
+def _smooth_step(system: Stepped, integrator: Integrator) -> PeriodStep:
+    """The smooth dynamics' period step (see the module docstring)."""
     plant = system.plant
     compiled = plant.compiled
     step = None

@@ -21,7 +21,7 @@ from typing import Any
 import numpy as np
 import pinocchio as pin
 
-from uvms_pin.physics.dynamics import forward_dynamics
+from uvms_pin.physics.dynamics import forward_dynamics, mass_matrix
 from uvms_pin.sim.integrators import Integrator
 from uvms_pin.sim.plant import Plant, checked_start, has_moving_contacts
 from uvms_pin.sim.system.free_objects import FreeObjects
@@ -134,6 +134,23 @@ class System:
         if held is None or held[0] is not integrator:
             held = self._steps[id(integrator)] = (integrator, period_step(self, integrator))
         return held[1](t0, q0, v0, tau, t1)
+
+    def mass_matrix(self, time_s: float, q: np.ndarray) -> np.ndarray:
+        """M(q) of the system (nv x nv): each body's, added mass included (wet fractions
+        under the free surface at ``time_s``), block diagonal (the bodies meet only through
+        their contacts)."""
+        plant = self.plant
+        water = {"free_surface": plant.free_surface, "flow": plant.water, "time_s": time_s}
+        bodies = [plant.uvms, *(o.uvms for o in self.objects)]
+        out = np.zeros((self.layout.nv, self.layout.nv))
+        for uvms, (q_b, _), part in zip(
+            bodies,
+            self.layout.split(q, np.zeros(self.layout.nv)),
+            self.layout.v_slices,
+            strict=True,
+        ):
+            out[part, part] = mass_matrix(uvms, q_b, backend=plant.backend, **water)
+        return out
 
     def clear(self, q: np.ndarray, v: np.ndarray, horizon_s: float) -> bool:
         """Nothing can touch over ``horizon_s`` from the robot's (q, v): no fixed object
