@@ -2,6 +2,6 @@
 `uvms_pin.physics.world.kind`). Each module registers its kind on import; this list is
 the one place a kind is named."""
 
-from uvms_pin.physics.world.kinds import box, cylinder, mesh, plane, sphere
+from uvms_pin.physics.world.kinds import box, cylinder, ellipsoid, mesh, plane, sphere
 
-__all__ = ["box", "cylinder", "mesh", "plane", "sphere"]
+__all__ = ["box", "cylinder", "ellipsoid", "mesh", "plane", "sphere"]
