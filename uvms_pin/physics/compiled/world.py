@@ -11,12 +11,10 @@ from __future__ import annotations
 from types import ModuleType
 from typing import Any
 
-import coal
 import numpy as np
 import pinocchio as pin
 
 from uvms_pin.errors import ModelError
-from uvms_pin.physics.world.kind import NO_POINTS
 from uvms_pin.physics.world.objects import registered_kinds
 from uvms_pin.physics.world.touch import CLEARANCE_M
 from uvms_pin.physics.world.world import World
@@ -49,15 +47,14 @@ def world_bounds_to_core(world: World | None, core: ModuleType):
 
 
 def _geometry(shape: Any, core: ModuleType) -> tuple[Any, np.ndarray, np.ndarray]:
-    """(core kind, sizes, points (3, n)) of a coal shape (what `ContactShape.set_geometry`
-    takes), as the kind whose coal class it is says (`uvms_pin.physics.world.kind.Compiled`:
-    a box's edges are twice coal's half sides, a hull the points qhull built it from)."""
+    """(core kind, sizes, points (3, n)) of a coal shape, a world object's or a robot
+    piece's (what `ContactShape.set_geometry` takes), as the kind whose coal class it is
+    says (`uvms_pin.physics.world.kind.Compiled`: a box's edges are twice coal's half
+    sides, a hull the points qhull built it from)."""
     for kind in registered_kinds():
         if isinstance(shape, kind.compiled.coal_type):
             name, sizes, points = kind.compiled.of(shape)
             return getattr(core.ContactKind, name), sizes, points
-    if isinstance(shape, coal.Ellipsoid):  # a robot piece's (an ellipsoidal hull)
-        return core.ContactKind.ellipsoid, np.asarray(shape.radii, dtype=float), NO_POINTS
     raise ModelError(f"no compiled contact geometry for a {type(shape).__name__}")
 
 
