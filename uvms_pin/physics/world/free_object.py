@@ -193,7 +193,8 @@ def free_object_of(
     uvms = free_body(name, kind, params, mass_kg, water_density_kg_m3)
     rotation = pin.rpy.rpyToMatrix(np.asarray(params["rpy_rad"], dtype=float))
     position = np.asarray(params["position_world_m"], dtype=float)
-    q0 = np.concatenate([position, pin.Quaternion(rotation).coeffs()])
+    quaternion = pin.Quaternion(rotation).coeffs()
+    q0 = np.concatenate([position, quaternion / float(np.linalg.norm(quaternion))])
     v0 = np.zeros(6) if velocity_body is None else np.asarray(velocity_body, dtype=float)
     kept = {k: v for k, v in params.items() if k != "position_world_m"}
     return FreeObject(name, kind, uvms, q0, v0, friction[0], friction[1], kept)
