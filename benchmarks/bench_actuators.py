@@ -18,9 +18,10 @@ import numpy as np
 from timing import best_times, one_blas_thread
 
 from uvms_pin.scenario.load import load_scenario
-from uvms_pin.sim.navigation.acoustic import DvlSpec, UsblSpec
+from uvms_pin.sim.navigation.dvl import DvlSpec
 from uvms_pin.sim.navigation.imu import ImuSpec
 from uvms_pin.sim.navigation.suite import NavigationSpec, NavigationSuite
+from uvms_pin.sim.navigation.usbl import UsblSpec
 from uvms_pin.sim.system import System
 
 SCENARIO = Path(__file__).resolve().parents[1] / "scenarios" / "realistic_force_tracking.toml"

@@ -163,6 +163,11 @@ _VARIANTS = [
                 },
                 {"type": "sphere", "radius_m": 0.5, "position_world_m": [-3, 0, -9.5]},
                 {
+                    "type": "ellipsoid",
+                    "semi_axes_m": [0.4, 0.3, 0.2],
+                    "position_world_m": [-5, 0, -9],
+                },
+                {
                     "type": "cylinder",
                     "radius_m": 0.2,
                     "length_m": 4.0,

@@ -1,22 +1,31 @@
 """``[world]``: objects (``[[world.objects]]``: fixed, or free with a ``mass_kg`` or
-``density_kg_m3``) every body touches, and the contact law's parameters
+``density_kg_m3``; a ``type`` of `uvms_pin.physics.world.kinds`, whose keys and their
+check are its kind's) every body touches, and the contact law's parameters
 (``[world.contact]``, with ``self_collision``); ``[joints]``: the joint stops."""
 
 from __future__ import annotations
 
 from collections.abc import Callable
 from pathlib import Path
+from typing import Any
 
 from uvms_pin.errors import ParameterError
 from uvms_pin.model.uvms import UVMS
 from uvms_pin.physics.joint_stops import JointStops
 from uvms_pin.physics.world.contact_law import ContactLaw
-from uvms_pin.physics.world.free_object import FreeObject, free_object
-from uvms_pin.physics.world.objects import WorldObject, plane, solid
+from uvms_pin.physics.world.free_object import FreeObject, free_mass, free_object_of
+from uvms_pin.physics.world.kind import Key
+from uvms_pin.physics.world.objects import (
+    WorldObject,
+    checked,
+    fixed_object,
+    kind_names,
+    object_kind,
+)
 from uvms_pin.physics.world.world import World
 from uvms_pin.scenario.schema import Table
 
-__all__ = ["OBJECTS", "build_joint_stops", "build_world"]
+__all__ = ["KEY_READERS", "build_joint_stops", "build_world"]
 
 
 def build_world(t: Table | None, uvms: UVMS, base_dir: Path) -> World | None:
@@ -56,7 +65,7 @@ def _law(t: Table) -> ContactLaw:
 def _object(
     t: Table, index: int, law: ContactLaw, base_dir: Path, uvms: UVMS
 ) -> WorldObject | FreeObject:
-    kind = t.string("type", choices=tuple(OBJECTS))
+    kind = t.string("type", choices=kind_names())
     name = t.string("name", f"{kind}{index}")
     mass = t.number("mass_kg", None, positive=True) if t.has("mass_kg") else None
     density = t.number("density_kg_m3", None, positive=True) if t.has("density_kg_m3") else None
@@ -69,76 +78,38 @@ def _object(
             if free
             else "a free object (fixed = false) needs mass_kg or density_kg_m3",
         )
-    if free and kind == "plane":
-        raise t.error("type", "a plane cannot be free (it has no mass)")
+    if free and object_kind(kind).free is None:
+        raise t.error("type", f"a {kind} cannot be free (it has no mass)")
     if mass is not None and density is not None:
         raise t.error("mass_kg", "give mass_kg or density_kg_m3, not both")
     mu_s = t.number("friction_static", law.friction_static, nonneg=True)
     mu_k = t.number("friction_kinetic", min(law.friction_kinetic, mu_s), nonneg=True)
+    raw = {key.name: KEY_READERS[key.holds](t, key, base_dir) for key in object_kind(kind).keys}
     try:
+        params, mu = checked(name, kind, raw, (mu_s, mu_k))
         if free:
-            out = _free(t, name, kind, (mu_s, mu_k), base_dir, uvms, mass, density)
+            mass = free_mass(name, kind, params, mass, density)
+            out = free_object_of(name, kind, params, mass, uvms.water_density_kg_m3, mu)
         else:
-            out = OBJECTS[kind](t, name, mu_s, mu_k, base_dir)
+            out = fixed_object(name, kind, params, mu)
     except ParameterError as exc:
-        raise t.fail(str(exc)) from exc
+        key = getattr(exc, "key", None)
+        raise (t.fail(str(exc)) if key is None else t.error(key, str(exc))) from exc
     t.finish()
     return out
 
 
-def _free(t: Table, name: str, kind: str, mu, base_dir: Path, uvms: UVMS, mass, density):
-    """A free object of [[world.objects]] (`free_object`)."""
-    pose = (t.vector("position_world_m", 3), t.vector("rpy_rad", 3, [0.0, 0.0, 0.0]))
-    return free_object(
-        name,
-        kind,
-        SIZES[kind](t, base_dir),
-        pose,
-        mass_kg=mass,
-        density_kg_m3=density,
-        water_density_kg_m3=uvms.water_density_kg_m3,
-        friction=mu,
-    )
+def _path(t: Table, key: Key, base_dir: Path) -> Path:
+    """A file, relative to the scenario's folder."""
+    path = Path(t.string(key.name, key.default))
+    return path if path.is_absolute() else base_dir / path
 
 
-def _plane(t: Table, name: str, mu_s: float, mu_k: float, base_dir: Path) -> WorldObject:
-    point = t.vector("point_world_m", 3)
-    normal = t.vector("normal_world", 3, [0.0, 0.0, 1.0])
-    return plane(name, point, normal, mu_s, mu_k)
-
-
-def _solid(kind: str, sizes: Callable[[Table, Path], dict]):
-    def build(t: Table, name: str, mu_s: float, mu_k: float, base_dir: Path) -> WorldObject:
-        position = t.vector("position_world_m", 3)
-        rpy = t.vector("rpy_rad", 3, [0.0, 0.0, 0.0])
-        return solid(name, kind, sizes(t, base_dir), position, rpy, mu_s, mu_k)
-
-    return build
-
-
-def _mesh_sizes(t: Table, base_dir: Path) -> dict:
-    path = Path(t.string("path"))
-    path = path if path.is_absolute() else base_dir / path
-    if not path.is_file():
-        raise t.error("path", f"no mesh file at {path}")
-    return {"path": path, "scale": t.vector("scale", 3, [1.0, 1.0, 1.0]).tolist()}
-
-
-#: a solid's type -> its sizes read from its table
-SIZES: dict[str, Callable[[Table, Path], dict]] = {
-    "box": lambda t, _: {"size_m": t.vector("size_m", 3)},
-    "sphere": lambda t, _: {"radius_m": t.number("radius_m", positive=True)},
-    "cylinder": lambda t, _: {
-        "radius_m": t.number("radius_m", positive=True),
-        "length_m": t.number("length_m", positive=True),
-    },
-    "mesh": _mesh_sizes,
-}
-
-#: [[world.objects]] type -> how the (fixed) object is built from its table
-OBJECTS: dict[str, Callable[..., WorldObject]] = {
-    "plane": _plane,
-    **{kind: _solid(kind, sizes) for kind, sizes in SIZES.items()},
+#: what a kind's key holds -> how it is read from its table (its kind checks the values)
+KEY_READERS: dict[str, Callable[[Table, Key, Path], Any]] = {
+    "number": lambda t, key, _: t.number(key.name, key.default),
+    "vector": lambda t, key, _: t.vector(key.name, 3, key.default),
+    "path": _path,
 }
 
 

@@ -7,8 +7,6 @@ from __future__ import annotations
 from uvms_pin.errors import ParameterError
 from uvms_pin.physics.world.world import World
 from uvms_pin.scenario.schema import Table
-from uvms_pin.sim.navigation.acoustic import DvlSpec, UsblSpec
-from uvms_pin.sim.navigation.imu import ImuSpec
 from uvms_pin.sim.navigation.seabed import world_seabed
 from uvms_pin.sim.navigation.suite import NavigationSpec
 from uvms_pin.sim.sensors import NoiseSpec, SensorConfig
@@ -39,59 +37,37 @@ def build_sensors(
 
 
 def _navigation(t: Table, water_density_kg_m3: float, world: World | None) -> NavigationSpec:
+    """Each registered sensor kind (`uvms_pin.sim.navigation.sensor.SENSORS`) fitted when its
+    table ``[sensors.<name>]`` is present; the DVL's bottom is the world's seafloor or its
+    ``seabed_depth_m``."""
     floor = None if world is None else world_seabed(world.objects)
+    specs, bottom = {}, None
+    for kind, _ in NavigationSpec().sensors():
+        table = t.table(kind.name)
+        if table is None:
+            continue
+        if kind.field == "dvl":
+            bottom = _dvl_bottom(table, floor is not None)
+        try:
+            specs[kind.field] = kind.spec(
+                **{key: table.number(key, default) for key, default in kind.table_keys()}
+            )
+        except ParameterError as exc:
+            raise table.fail(str(exc)) from exc
+        table.finish()
     try:
-        imu, depth, dvl, usbl = (
-            _imu(t.table("imu")),
-            _depth(t.table("depth")),
-            _dvl(t.table("dvl"), floor is not None),
-            _usbl(t.table("usbl")),
-        )
-        depth_m = None if dvl is None else dvl[1]
         return NavigationSpec(
-            imu,
-            depth,
-            None if dvl is None else dvl[0],
-            usbl,
-            depth_m,
-            water_density_kg_m3,
-            seabed=floor if dvl is not None else None,
+            **specs,
+            seabed_depth_m=bottom,
+            water_density_kg_m3=water_density_kg_m3,
+            seabed=floor if "dvl" in specs else None,
         )
     except ParameterError as exc:
         raise t.fail(str(exc)) from exc
 
 
-def _imu(t: Table | None) -> ImuSpec | None:
-    if t is None:
-        return None
-    out = ImuSpec(
-        t.number("gyro_noise_rad_s_rthz", 0.0, nonneg=True),
-        t.number("gyro_bias_walk_rad_s2_rthz", 0.0, nonneg=True),
-        t.number("accel_noise_m_s2_rthz", 0.0, nonneg=True),
-        t.number("accel_bias_walk_m_s3_rthz", 0.0, nonneg=True),
-    )
-    t.finish()
-    return out
-
-
-def _depth(t: Table | None) -> float | None:
-    if t is None:
-        return None
-    noise = t.number("noise_Pa", 0.0, nonneg=True)
-    t.finish()
-    return noise
-
-
-def _dvl(t: Table | None, world_floor: bool) -> tuple[DvlSpec, float | None] | None:
-    """(spec, the flat bottom's depth or None when the world has a seafloor)."""
-    if t is None:
-        return None
-    out = DvlSpec(
-        t.number("noise_m_s", 0.0, nonneg=True),
-        t.number("min_altitude_m", 0.3, nonneg=True),
-        t.number("max_altitude_m", 50.0, positive=True),
-        t.number("dropout_probability", 0.0, nonneg=True),
-    )
+def _dvl_bottom(t: Table, world_floor: bool) -> float | None:
+    """The flat bottom's depth, or None when the world has a seafloor (the DVL's)."""
     if world_floor and t.has("seabed_depth_m"):
         raise t.error(
             "seabed_depth_m",
@@ -103,19 +79,4 @@ def _dvl(t: Table | None, world_floor: bool) -> tuple[DvlSpec, float | None] | N
             "seabed_depth_m",
             "is required: a DVL needs a sea bottom (this key, or a [[world.objects]] plane)",
         )
-    seabed = None if world_floor else t.number("seabed_depth_m", positive=True)
-    t.finish()
-    return out, seabed
-
-
-def _usbl(t: Table | None) -> UsblSpec | None:
-    if t is None:
-        return None
-    out = UsblSpec(
-        t.number("noise_m", 0.0, nonneg=True),
-        t.number("period_s", 1.0, positive=True),
-        t.number("latency_s", 0.0, nonneg=True),
-        t.number("dropout_probability", 0.0, nonneg=True),
-    )
-    t.finish()
-    return out
+    return None if world_floor else t.number("seabed_depth_m", positive=True)

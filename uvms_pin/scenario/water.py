@@ -28,27 +28,19 @@ from uvms_pin.scenario.schema import Table
 #: The speed of the water [m/s]: the fastest tidal races run at ~5 m/s; faster than sound in
 #: water, the incompressible model means nothing
 CURRENT_SPEED = Plausible(
-    "m/s",
-    usual=(0.0, 5.0),
-    possible=(0.0, 1480.0),
-    usual_text="sea and tidal currents",
-    impossible_text="no water flows faster than sound in it (~1480 m/s)",
-)
+    "m/s", (0.0, 5.0), (0.0, 1480.0), "sea and tidal currents",
+    "no water flows faster than sound in it (~1480 m/s)",
+)  # fmt: skip
 #: A regular wave's amplitude, half its height [m]
 AMPLITUDE = Plausible(
-    "m",
-    usual=(0.0, 10.0),
-    possible=(0.0, 50.0),
-    usual_text="sea waves (the highest measured: ~30 m crest to trough)",
-    impossible_text="no sea wave is that high",
-)
+    "m", (0.0, 10.0), (0.0, 50.0), "sea waves (the highest measured: ~30 m crest to trough)",
+    "no sea wave is that high",
+)  # fmt: skip
+#: A sea state's significant wave height [m]
 SIGNIFICANT_HEIGHT = Plausible(
-    "m",
-    usual=(0.0, 15.0),
-    possible=(0.0, 40.0),
-    usual_text="sea states (the highest measured: ~19 m)",
-    impossible_text="no sea state is that high",
-)
+    "m", (0.0, 15.0), (0.0, 40.0), "sea states (the highest measured: ~19 m)",
+    "no sea state is that high",
+)  # fmt: skip
 
 
 @dataclass(frozen=True)
@@ -76,10 +68,10 @@ def build_water(t: Table, seed: int) -> Water:
     # unless asked for as well
     free_surface = t.boolean("free_surface", not stop_at_surface)
     fields = []
-    for key, build in FLOW_TABLES.items():
+    for key, kinds in FLOWS.items():
         table = t.table(key)
         if table is not None:
-            fields.append(_flow_field(table, build, seed))
+            fields.append(_flow_field(table, kinds, seed))
     t.finish()
     flow = None if not fields else fields[0] if len(fields) == 1 else SumFlow(tuple(fields))
     return Water(density, current, flow, free_surface, stop_at_surface)
@@ -114,11 +106,6 @@ def _sea(t: Table, seed: int) -> IrregularSea:
     )
 
 
-def _current(t: Table, seed: int) -> FlowField:
-    kind = t.string("type", "uniform", tuple(CURRENTS))
-    return CURRENTS[kind](t, seed)
-
-
 def _uniform_current(t: Table, seed: int) -> UniformCurrent:
     return UniformCurrent(t.vector("velocity_world_m_s", 3))
 
@@ -140,24 +127,30 @@ def _gauss_markov_current(t: Table, seed: int) -> GaussMarkovCurrent:
     )
 
 
-#: [water.current] type -> how the current is built from its table
-CURRENTS: dict[str, Callable[[Table, int], FlowField]] = {
-    "uniform": _uniform_current,
-    "gauss_markov": _gauss_markov_current,
-    "profile": _profile_current,
-}
-#: the flow tables of [water], in the order their fields are summed
-FLOW_TABLES: dict[str, Callable[[Table, int], FlowField]] = {
-    "current": _current,
-    "waves": _waves,
-    "sea": _sea,
+#: the flows of [water]: its table -> its kinds (``type`` -> how the field is built from the
+#: table; the first is the default, and a table of one kind has no ``type``), in the order
+#: their fields are summed
+FLOWS: dict[str, dict[str, Callable[[Table, int], FlowField]]] = {
+    "current": {
+        "uniform": _uniform_current,
+        "gauss_markov": _gauss_markov_current,
+        "profile": _profile_current,
+    },
+    "waves": {"airy": _waves},
+    "sea": {"jonswap": _sea},
 }
 
 
-def _flow_field(t: Table, build: Callable[[Table, int], FlowField], seed: int) -> FlowField:
-    """Build a flow field from its table; the field's own ParameterErrors name the table."""
+def _flow_field(
+    t: Table, kinds: dict[str, Callable[[Table, int], FlowField]], seed: int
+) -> FlowField:
+    """Build a flow field of its table's kind; the field's own ParameterErrors name the
+    table."""
+    kind = (
+        next(iter(kinds)) if len(kinds) == 1 else t.string("type", next(iter(kinds)), tuple(kinds))
+    )
     try:
-        field = build(t, seed)
+        field = kinds[kind](t, seed)
     except ParameterError as exc:
         raise t.fail(str(exc)) from exc
     t.finish()

@@ -13,7 +13,8 @@ from trajectory import IMU, NAVIGATION, nees, run, still
 
 from uvms_pin.sim.estimation.eskf import NavState, correct, dvl_model, process_noise, transition
 from uvms_pin.sim.estimation.spec import EstimatorSpec
-from uvms_pin.sim.navigation.acoustic import DvlSpec, UsblSpec
+from uvms_pin.sim.navigation.dvl import DvlSpec
+from uvms_pin.sim.navigation.usbl import UsblSpec
 
 SPEC = EstimatorSpec()
 SEEDS = range(16)

@@ -11,9 +11,10 @@ import pinocchio as pin
 from uvms_pin.sim.estimation.eskf import NavState
 from uvms_pin.sim.estimation.estimator import NavigationEstimator
 from uvms_pin.sim.estimation.spec import EstimatorSpec
-from uvms_pin.sim.navigation.acoustic import DvlSpec, UsblSpec
+from uvms_pin.sim.navigation.dvl import DvlSpec
 from uvms_pin.sim.navigation.imu import ImuSpec
 from uvms_pin.sim.navigation.suite import NavigationSpec, NavigationSuite
+from uvms_pin.sim.navigation.usbl import UsblSpec
 
 IMU = ImuSpec(3e-4, 3e-5, 2e-3, 3e-4)
 NAVIGATION = NavigationSpec(

@@ -6,8 +6,10 @@ import numpy as np
 import pytest
 
 from uvms_pin.errors import ParameterError
-from uvms_pin.sim.navigation.acoustic import DepthSensor, Dvl, DvlSpec, Usbl, UsblSpec
+from uvms_pin.sim.navigation.depth import DepthSensor
+from uvms_pin.sim.navigation.dvl import Dvl, DvlSpec
 from uvms_pin.sim.navigation.seabed import FlatSeabed
+from uvms_pin.sim.navigation.usbl import Usbl, UsblSpec
 
 
 def test_depth_from_pressure_is_unbiased_with_the_pressure_noise_in_metres():

@@ -1,7 +1,8 @@
 """The world's objects and contact forces as drawn (`uvms_pin.physics.world`).
 
-Paths under the scene root: ``world/objects/<name>`` (the seafloor a sandy slab, solids
-grey-brown, meshes as their file's triangles) and ``world/contacts/pair<k>`` (orange arrows, one
+Paths under the scene root: ``world/objects/<name>`` (each drawn as its kind's `Drawing`
+says, plain data naming a meshcat geometry: a plane a sandy patch about the scene's centre,
+solids grey-brown, meshes as their file's triangles) and ``world/contacts/pair<k>`` (orange arrows, one
 per (body, object) pair, at the pair's contact point along the force on the body,
 ``SceneStyle.world_force_scale_m_per_N`` long per newton). Free objects are drawn under
 ``world/free/<name>`` (a lighter colour) and move with their logged pose (the
@@ -20,11 +21,13 @@ import meshcat.geometry as mg
 import numpy as np
 import pinocchio as pin
 
+from uvms_pin.physics.world.kind import Drawing
+from uvms_pin.physics.world.objects import object_kind
+
 __all__ = ["WorldView"]
 
 _SAND, _ROCK, _ARROW, _FREE = 0x8A7A55, 0x807060, 0xFF9020, 0xC8643C
 _STATE = 13  # per free object in the free_objects signal: p (3), quaternion (4), nu (6)
-_PLANE_HALF_M = 6.0  # half the side of the drawn patch of an (infinite) plane
 
 
 def _matrix(rotation, translation) -> np.ndarray:
@@ -36,6 +39,9 @@ def _matrix(rotation, translation) -> np.ndarray:
 
 def _phong(color: int, opacity: float = 1.0) -> mg.MeshPhongMaterial:
     return mg.MeshPhongMaterial(color=color, opacity=opacity, transparent=opacity < 1.0)
+
+
+_SAND_PATCH = _phong(_SAND, 0.9)
 
 
 @dataclass(frozen=True)
@@ -67,7 +73,8 @@ class WorldView:
 
     @property
     def has_plane(self) -> bool:
-        return any(o["type"] == "plane" for o in self.objects)
+        """Some object is unbounded (a seafloor): the scene needs no floor of its own."""
+        return any(_drawing(o).unbounded for o in self.objects)
 
     def build(self, node: meshcat.Visualizer, build_arrow: Callable) -> None:
         """Draw the objects under ``node`` and an arrow per pair (``build_arrow(node,
@@ -79,9 +86,10 @@ class WorldView:
         for obj in self.free:
             # the shape in a child node: the parent moves with the pose, the child turns
             # a cylinder (meshcat's lies along y)
+            drawing = _drawing(obj)
             child = node[f"free/{obj['name']}/shape"]
-            child.set_object(_geometry(obj), _phong(_FREE))
-            child.set_transform(_matrix(_turn(obj["type"]), np.zeros(3)))
+            child.set_object(_geometry(drawing), _phong(_FREE))
+            child.set_transform(_matrix(drawing.rotation_in_object, drawing.offset_in_object_m))
         for k in range(len(self.object_pairs)):
             build_arrow(node[f"contacts/object{k}"], _ARROW)
 
@@ -102,17 +110,14 @@ class WorldView:
     def _build_object(self, node: meshcat.Visualizer, obj: dict[str, Any]) -> None:
         rotation = np.asarray(obj["rotation_world"], dtype=float)
         position = np.asarray(obj["position_world_m"], dtype=float)
-        kind = obj["type"]
-        if kind == "plane":
-            # the patch of the plane nearest the scene's centre, its top face on the plane
+        drawing = _drawing(obj)
+        if drawing.unbounded:
+            # the patch nearest the scene's centre
             normal = rotation[:, 2]
-            foot = self.center_world_m - ((self.center_world_m - position) @ normal) * normal
-            side = 2.0 * _PLANE_HALF_M
-            node.set_object(mg.Box([side, side, 0.04]), _phong(_SAND, 0.9))
-            node.set_transform(_matrix(rotation, foot - 0.02 * normal))
-            return
-        node.set_object(_geometry(obj), _phong(_ROCK))
-        node.set_transform(_matrix(rotation @ _turn(kind), position))
+            position = self.center_world_m - ((self.center_world_m - position) @ normal) * normal
+        in_object = _matrix(drawing.rotation_in_object, drawing.offset_in_object_m)
+        node.set_object(_geometry(drawing), _SAND_PATCH if drawing.unbounded else _phong(_ROCK))
+        node.set_transform(_matrix(rotation, position) @ in_object)
 
     def arrows(
         self, contacts: np.ndarray | None, arrow: Callable, objects: np.ndarray | None = None
@@ -135,24 +140,11 @@ class WorldView:
         return out
 
 
-def _turn(kind: str) -> np.ndarray:
-    """The drawn shape's rotation in the object's frame: meshcat's cylinder lies along y,
-    the object's along z."""
-    if kind == "cylinder":
-        return np.array([[1.0, 0.0, 0.0], [0.0, 0.0, -1.0], [0.0, 1.0, 0.0]])
-    return np.eye(3)
+def _drawing(obj: dict[str, Any]) -> Drawing:
+    """How an object's record is drawn: its kind's drawing (plain data)."""
+    return object_kind(obj["type"]).drawing(obj)
 
 
-def _geometry(obj: dict[str, Any]):
-    kind = obj["type"]
-    if kind == "box":
-        return mg.Box(obj["size_m"])
-    if kind == "sphere":
-        return mg.Sphere(obj["radius_m"])
-    if kind == "cylinder":
-        return mg.Cylinder(obj["length_m"], obj["radius_m"])
-    import trimesh  # only meshes need it
-
-    mesh = trimesh.load(obj["path"], force="mesh")
-    vertices = np.asarray(mesh.vertices, dtype=float) * np.asarray(obj["scale"], dtype=float)
-    return mg.TriangularMeshGeometry(vertices, np.asarray(mesh.faces))
+def _geometry(drawing: Drawing) -> mg.Geometry:
+    """The meshcat geometry a drawing names, with its arguments."""
+    return getattr(mg, drawing.geometry)(*drawing.args)

@@ -11,11 +11,11 @@ from __future__ import annotations
 from types import ModuleType
 from typing import Any
 
-import coal
 import numpy as np
 import pinocchio as pin
 
 from uvms_pin.errors import ModelError
+from uvms_pin.physics.world.objects import registered_kinds
 from uvms_pin.physics.world.touch import CLEARANCE_M
 from uvms_pin.physics.world.world import World
 
@@ -47,21 +47,14 @@ def world_bounds_to_core(world: World | None, core: ModuleType):
 
 
 def _geometry(shape: Any, core: ModuleType) -> tuple[Any, np.ndarray, np.ndarray]:
-    """(core kind, sizes, points (3, n)) of a coal shape (what `ContactShape.set_geometry`
-    takes): sizes as the Python side built it (a box's edges are twice coal's half sides)."""
-    none = np.zeros((3, 0))
-    if isinstance(shape, coal.Halfspace):
-        return core.ContactKind.plane, np.zeros(0), none
-    if isinstance(shape, coal.Box):
-        return core.ContactKind.box, 2.0 * np.asarray(shape.halfSide, dtype=float), none
-    if isinstance(shape, coal.Sphere):
-        return core.ContactKind.sphere, np.array([shape.radius]), none
-    if isinstance(shape, coal.Cylinder):
-        return core.ContactKind.cylinder, np.array([shape.radius, 2.0 * shape.halfLength]), none
-    if isinstance(shape, coal.Ellipsoid):
-        return core.ContactKind.ellipsoid, np.asarray(shape.radii, dtype=float), none
-    if isinstance(shape, coal.ConvexBase) and hasattr(shape, "built_from_m"):
-        return core.ContactKind.convex, np.zeros(0), np.asarray(shape.built_from_m).T
+    """(core kind, sizes, points (3, n)) of a coal shape, a world object's or a robot
+    piece's (what `ContactShape.set_geometry` takes), as the kind whose coal class it is
+    says (`uvms_pin.physics.world.kind.Compiled`: a box's edges are twice coal's half
+    sides, a hull the points qhull built it from)."""
+    for kind in registered_kinds():
+        if isinstance(shape, kind.compiled.coal_type):
+            name, sizes, points = kind.compiled.of(shape)
+            return getattr(core.ContactKind, name), sizes, points
     raise ModelError(f"no compiled contact geometry for a {type(shape).__name__}")
 
 

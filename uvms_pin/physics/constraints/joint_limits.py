@@ -57,7 +57,11 @@ class JointLimits:
 
     def record(self) -> dict[str, object]:
         """The limits as plain data (a rollout's world record)."""
-        return {"joint_ids": list(self.joint_ids), "margin_rad": self.margin, "solved": "implicitly"}
+        return {
+            "joint_ids": list(self.joint_ids),
+            "margin_rad": self.margin,
+            "solved": "implicitly",
+        }
 
     def rows(
         self, model: pin.Model, data: pin.Data, q: np.ndarray, speed: np.ndarray, period_s: float

@@ -19,7 +19,7 @@ friction patch (one point).
 from __future__ import annotations
 
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 import pinocchio as pin
@@ -27,32 +27,23 @@ import pinocchio as pin
 from uvms_pin.physics.world.contact_law import ContactLaw, friction_force_N, normal_force_N
 from uvms_pin.physics.world.objects import WorldObject
 from uvms_pin.physics.world.robot_geometry import RobotPiece
-from uvms_pin.physics.world.touch import coal_point, cross, reach_spheres
-from uvms_pin.physics.world.world import FrictionMemory
+from uvms_pin.physics.world.touch import NO_TOUCH, Touch, coal_point, cross, reach_spheres
+from uvms_pin.physics.world.world import ContactForces, FrictionMemory
 
 __all__ = ["PairContacts", "PiecePairs", "joint_forces"]
 
 
 @dataclass(frozen=True)
-class PairContacts:
-    """The touching pairs at one state.
+class PairContacts(ContactForces):
+    """The touching pairs at one state: a `ContactForces` whose points are one a pair
+    (``touch.piece``, ``touch.obj``: the pieces of a and b; ``touch.velocity_world_m_s``:
+    v_rel = v_a(x) - v_b(x); the normals out of b towards a; f on a, b gets -f).
 
     Attributes:
-        pair: which pair of `PiecePairs.pairs` (m,). point_world_m: x (m, 3).
-        normal_world: n, out of b towards a (m, 3). depth_m: delta > 0 (m,).
-        velocity_world_m_s: v_rel = v_a(x) - v_b(x) (m, 3).
-        force_world_N: f on a (b gets -f) (m, 3). normal_N: f_n (m,).
-        sticking: within the static cone (m,).
+        pair: which pair of `PiecePairs.pairs` each point is (m,).
     """
 
-    pair: np.ndarray
-    point_world_m: np.ndarray
-    normal_world: np.ndarray
-    depth_m: np.ndarray
-    velocity_world_m_s: np.ndarray
-    force_world_N: np.ndarray
-    normal_N: np.ndarray
-    sticking: np.ndarray
+    pair: np.ndarray = field(default_factory=lambda: np.zeros(0, dtype=int))
 
     def __len__(self) -> int:
         return len(self.pair)
@@ -129,7 +120,7 @@ class PiecePairs:
             if hit is not None:
                 found.append((k, *hit))
         if not found:
-            return _none()
+            return PairContacts(NO_TOUCH, np.zeros((0, 3)), np.zeros(0), np.zeros(0, dtype=bool))
         pair = np.array([f[0] for f in found], dtype=int)
         point = np.array([f[1] for f in found], dtype=float)
         normal = np.array([f[2] for f in found], dtype=float)
@@ -153,7 +144,9 @@ class PiecePairs:
         limit = np.where([int(k) in memory.slipping for k in pair], mu[:, 1], mu[:, 0])
         f_t, stick = friction_force_N(self.law, f_n, stretch, v_t, pair, limit, mu[:, 1])
         force = f_n[:, None] * normal + f_t
-        return PairContacts(pair, point, normal, depth, velocity, force, f_n, stick)
+        a, b = np.array([self.pairs[k] for k in pair], dtype=int).reshape(-1, 2).T
+        touch = Touch(a, b, np.full(len(pair), -1), point, normal, depth, velocity)
+        return PairContacts(touch, force, f_n, stick, pair)
 
     def _joint_b(self, k: int) -> int:
         return self.pieces_b[self.pairs[k][1]].joint_id
@@ -167,9 +160,9 @@ class PiecePairs:
         (a new one anchors where it is), a slipping one moves it to x + f_t / k_t; anchors
         are kept in b's joint frame."""
         kept, slipping = {}, set()
-        f_t = contacts.force_world_N - contacts.normal_N[:, None] * contacts.normal_world
+        f_t = contacts.force_world_N - contacts.normal_N[:, None] * contacts.touch.normal_world
         for i, k in enumerate(contacts.pair.tolist()):
-            x = contacts.point_world_m[i]
+            x = contacts.touch.point_world_m[i]
             if contacts.sticking[i]:
                 kept[(k, 0, -1)] = memory.anchors.get(
                     (k, 0, -1), data_b.oMi[self._joint_b(k)].actInv(x)
@@ -193,7 +186,7 @@ class PiecePairs:
         """(tau_a (nv_a,), tau_b (nv_b,)): f on a's bodies, -f on b's (`joint_forces`)."""
         joints_a = [self.pieces_a[self.pairs[k][0]].joint_id for k in contacts.pair]
         joints_b = [self._joint_b(int(k)) for k in contacts.pair]
-        x, f = contacts.point_world_m, contacts.force_world_N
+        x, f = contacts.touch.point_world_m, contacts.force_world_N
         return (
             joint_forces(model_a, data_a, q_a, joints_a, x, f),
             joint_forces(model_b, data_b, q_b, joints_b, x, -f),
@@ -203,16 +196,8 @@ class PiecePairs:
         """Per pair: force on a [N] (3), point [m] (3), zero moment (one point) (n, 9)."""
         out = np.zeros((len(self.pairs), 9))
         out[contacts.pair, :3] = contacts.force_world_N
-        out[contacts.pair, 3:6] = contacts.point_world_m
+        out[contacts.pair, 3:6] = contacts.touch.point_world_m
         return out
-
-
-def _none() -> PairContacts:
-    empty3 = np.zeros((0, 3))
-    return PairContacts(
-        np.zeros(0, dtype=int), empty3, empty3, np.zeros(0), empty3, empty3, np.zeros(0),
-        np.zeros(0, dtype=bool),
-    )  # fmt: skip
 
 
 def piece_pairs(

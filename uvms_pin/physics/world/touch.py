@@ -18,7 +18,7 @@ import pinocchio as pin
 from uvms_pin.physics.world.objects import WorldObject
 from uvms_pin.physics.world.robot_geometry import RobotPiece
 
-__all__ = ["Bounds", "Touch", "clear_of", "coal_point", "reach_spheres", "touch"]
+__all__ = ["NO_TOUCH", "Bounds", "Touch", "clear_of", "coal_point", "reach_spheres", "touch"]
 
 _REQUEST = coal.CollisionRequest()  # one contact, depth and normal: what a pair needs
 
@@ -192,11 +192,15 @@ def touch(
     return _stacked(data, pieces, chunks)
 
 
+#: no contact point
+NO_TOUCH = Touch(
+    *(np.zeros(0, dtype=int),) * 3, *(np.zeros((0, 3)),) * 2, np.zeros(0), np.zeros((0, 3))
+)
+
+
 def _stacked(data: pin.Data, pieces: Sequence[RobotPiece], chunks: list) -> Touch:
     if not chunks:
-        empty3 = np.zeros((0, 3))
-        none = np.zeros(0, dtype=int)
-        return Touch(none, none, none, empty3, empty3, np.zeros(0), empty3)
+        return NO_TOUCH
     columns = [np.concatenate(c) for c in zip(*chunks, strict=True)]
     piece, obj, corner = (c.astype(int) for c in columns[:3])
     points, normals, depth = columns[3:]

@@ -8,7 +8,7 @@ from dataclasses import dataclass
 
 from uvms_pin.errors import ParameterError
 from uvms_pin.sim.estimation.eskf import ImuNoise
-from uvms_pin.sim.navigation.acoustic import GRAVITY_M_S2
+from uvms_pin.sim.navigation.depth import GRAVITY_M_S2
 from uvms_pin.sim.navigation.suite import NavigationSpec
 
 __all__ = ["CONTROLLER_INPUTS", "ESTIMATOR_TYPES", "EstimatorSpec", "MeasurementNoise"]

@@ -9,7 +9,8 @@ w, u independent standard normal draws; N the noise density [unit/sqrt(Hz)] (ang
 velocity random walk), K the bias instability's random walk [unit/s/sqrt(Hz)]. Its Allan
 deviation is sigma(tau)^2 = N^2 / tau + K^2 tau / 3 (IEEE Std 952). The accelerometer
 measures the specific force f = R^T (a - g), a the origin's acceleration in the world and
-g = (0, 0, -9.81) m/s^2: at rest it reads +9.81 m/s^2 along the world's up.
+g = (0, 0, -9.81) m/s^2: at rest it reads +9.81 m/s^2 along the world's up
+(``[sensors.imu]``).
 """
 
 from __future__ import annotations
@@ -20,6 +21,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from uvms_pin.errors import ParameterError
+from uvms_pin.sim.navigation.sensor import SensorKind, Tick, check_fields, register
 
 __all__ = ["GRAVITY_WORLD_M_S2", "Imu", "ImuSpec", "NoisyChannel", "allan_deviation"]
 
@@ -42,9 +44,7 @@ class ImuSpec:
     accel_bias_walk_m_s3_rthz: float = 0.0
 
     def __post_init__(self) -> None:
-        for name, value in vars(self).items():
-            if not (math.isfinite(value) and value >= 0.0):
-                raise ParameterError(f"IMU {name} must be finite and >= 0, got {value}")
+        check_fields(self, "IMU")
 
 
 class NoisyChannel:
@@ -110,3 +110,28 @@ def allan_deviation(samples: np.ndarray, dt_s: float, tau_s: float) -> float:
     means = (integral[m:] - integral[:-m]) / (m * dt_s)
     differences = means[m:] - means[:-m]
     return float(np.sqrt(0.5 * np.mean(differences**2)))
+
+
+def _read(imu: Imu, tick: Tick) -> dict[str, np.ndarray]:
+    gyro, accel = imu.measure(
+        tick.angular_velocity_body_rad_s,
+        tick.acceleration_world_m_s2,
+        tick.rotation_world_body,
+        tick.period_s,
+    )
+    return {"imu_gyro": gyro, "imu_accel": accel}
+
+
+IMU = register(
+    SensorKind(
+        name="imu",
+        spec=ImuSpec,
+        streams=(0, 1),
+        columns={
+            "imu_gyro": [("wx", "rad_s"), ("wy", "rad_s"), ("wz", "rad_s")],
+            "imu_accel": [("fx", "m_s2"), ("fy", "m_s2"), ("fz", "m_s2")],
+        },
+        make=lambda spec, nav, rngs: Imu(spec, rngs[0], rngs[1]),
+        read=_read,
+    )
+)

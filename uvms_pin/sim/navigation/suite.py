@@ -14,23 +14,21 @@ import numpy as np
 import pinocchio as pin
 
 from uvms_pin.errors import ParameterError
-from uvms_pin.sim.navigation.acoustic import DepthSensor, Dvl, DvlSpec, Usbl, UsblSpec
-from uvms_pin.sim.navigation.imu import Imu, ImuSpec
-from uvms_pin.sim.navigation.seabed import FlatSeabed, Seabed
+
+# the sensor kinds, each registered by its module on import: the one list of them (a new
+# kind: its module here and its field in `NavigationSpec`)
+from uvms_pin.sim.navigation import depth, dvl, imu, usbl  # noqa: F401
+from uvms_pin.sim.navigation.dvl import DvlSpec
+from uvms_pin.sim.navigation.imu import ImuSpec
+from uvms_pin.sim.navigation.seabed import Seabed
+from uvms_pin.sim.navigation.sensor import SENSORS, SensorKind, Tick
+from uvms_pin.sim.navigation.usbl import UsblSpec
 
 __all__ = ["NAVIGATION_SEED_INDEX", "NavigationSpec", "NavigationSuite"]
 
 #: The child of the run's SeedSequence the navigation sensors draw from (the measurement
 #: noise uses children 0-5).
 NAVIGATION_SEED_INDEX = 6
-
-_COLUMNS = {
-    "imu_gyro": [("wx", "rad_s"), ("wy", "rad_s"), ("wz", "rad_s")],
-    "imu_accel": [("fx", "m_s2"), ("fy", "m_s2"), ("fz", "m_s2")],
-    "depth": [("sensor", "m")],
-    "dvl": [("vx", "m_s"), ("vy", "m_s"), ("vz", "m_s"), ("altitude", "m"), ("lock", "")],
-    "usbl": [("x", "m"), ("y", "m"), ("z", "m"), ("age", "s"), ("new", "")],
-}
 
 
 @dataclass(frozen=True)
@@ -66,7 +64,13 @@ class NavigationSpec:
 
     @property
     def fitted(self) -> bool:
-        return any(x is not None for x in (self.imu, self.depth_noise_Pa, self.dvl, self.usbl))
+        return any(spec is not None for _, spec in self.sensors())
+
+    def sensors(self) -> list[tuple[SensorKind, object]]:
+        """Each registered kind (in the order of their streams) and its spec here (None: not
+        fitted)."""
+        kinds = sorted(SENSORS.values(), key=lambda kind: kind.streams[0])
+        return [(kind, getattr(self, kind.field)) for kind in kinds]
 
 
 class NavigationSuite:
@@ -75,21 +79,24 @@ class NavigationSuite:
     def __init__(self, spec: NavigationSpec, seed: int):
         self.spec = spec
         root = np.random.SeedSequence(seed).spawn(NAVIGATION_SEED_INDEX + 1)[NAVIGATION_SEED_INDEX]
-        rngs = [np.random.default_rng(child) for child in root.spawn(5)]
-        self.imu = None if spec.imu is None else Imu(spec.imu, rngs[0], rngs[1])
-        self.depth = (
-            None
-            if spec.depth_noise_Pa is None
-            else DepthSensor(spec.depth_noise_Pa, spec.water_density_kg_m3, rngs[2])
-        )
-        seabed = spec.seabed
-        if spec.seabed_depth_m is not None:
-            seabed = FlatSeabed(spec.seabed_depth_m)
-        self.dvl = None if spec.dvl is None else Dvl(spec.dvl, seabed, rngs[3])
-        self.usbl = None if spec.usbl is None else Usbl(spec.usbl, rngs[4])
+        count = 1 + max(k for kind in SENSORS.values() for k in kind.streams)
+        rngs = [np.random.default_rng(child) for child in root.spawn(count)]
+        #: the fitted sensors: (kind, sensor)
+        self.fitted = [
+            (kind, kind.make(own, spec, [rngs[k] for k in kind.streams]))
+            for kind, own in spec.sensors()
+            if own is not None
+        ]
+        self._by_name = {kind.name: sensor for kind, sensor in self.fitted}
         self._velocity_world: np.ndarray | None = None
         self._readings: dict[str, np.ndarray] = {}
         self.period_s = 0.0
+
+    def __getattr__(self, name: str):
+        """A sensor by its kind's name (``suite.imu``), None for a kind not fitted."""
+        if name in SENSORS:
+            return self.__dict__["_by_name"].get(name)
+        raise AttributeError(name)
 
     def start(self, period_s: float | None) -> None:
         """A run starts; the sensors sample every control period ``period_s``."""
@@ -101,36 +108,20 @@ class NavigationSuite:
         self._velocity_world = None
 
     def signal_columns(self) -> dict[str, list[tuple[str, str]]]:
-        fitted = {
-            "imu_gyro": self.imu,
-            "imu_accel": self.imu,
-            "depth": self.depth,
-            "dvl": self.dvl,
-            "usbl": self.usbl,
-        }
-        return {name: _COLUMNS[name] for name, sensor in fitted.items() if sensor is not None}
+        return {name: columns for kind, _ in self.fitted for name, columns in kind.columns.items()}
 
     def update(self, time_s: float, q: np.ndarray, v: np.ndarray) -> None:
         """Read every sensor at the tick ``time_s`` from the true (q, v)."""
         rotation = pin.Quaternion(q[3:7]).toRotationMatrix()
-        position = q[:3]
         velocity_world = rotation @ v[:3]
         dt = self.period_s
         previous = self._velocity_world
         acceleration = np.zeros(3) if previous is None else (velocity_world - previous) / dt
         self._velocity_world = velocity_world
-        readings = {}
-        if self.imu is not None:
-            readings["imu_gyro"], readings["imu_accel"] = self.imu.measure(
-                v[3:6], acceleration, rotation, dt
-            )
-        if self.depth is not None:
-            readings["depth"] = np.array([self.depth.measure(position)])
-        if self.dvl is not None:
-            readings["dvl"] = self.dvl.measure(position, v[:3])
-        if self.usbl is not None:
-            readings["usbl"] = self.usbl.measure(time_s, position)
-        self._readings = readings
+        tick = Tick(time_s, q[:3], rotation, v[:3], v[3:6], acceleration, dt)
+        self._readings = {}
+        for kind, sensor in self.fitted:
+            self._readings.update(kind.read(sensor, tick))
 
     def signals(self) -> dict[str, np.ndarray]:
         return {name: values.copy() for name, values in self._readings.items()}
