@@ -24,6 +24,7 @@ from uvms_pin.scenario.load import load_scenario
 from uvms_pin.sim.integrators import RK4
 from uvms_pin.sim.plant import Plant
 from uvms_pin.sim.run import simulate
+from uvms_pin.sim.system import System
 
 AXES = (0.4, 0.25, 0.15)  # a flat boulder, lying on its shortest axis
 FLOOR_Z = -10.0
@@ -71,7 +72,7 @@ def test_a_fixed_ellipsoid_pushes_a_sphere_out_along_its_axis(load_body, axis, s
     assert np.linalg.norm(force) == pytest.approx(1e4 * 0.01, rel=1e-4)
     # along the axis within coal's EPA tolerance on a curved surface's normal (~0.3 deg)
     assert force @ rotation[:, axis] / np.linalg.norm(force) > 0.9999
-    core = Plant(pusher, world=world, free_surface=False)._core()
+    core = Plant(pusher, world=world, free_surface=False).compiled
     got = core.world_forces(q, np.zeros(6), FrictionMemory())
     assert np.allclose(got["force_world_N"], forces.force_world_N, rtol=1e-12, atol=1e-10)
     assert np.allclose(got["point_world_m"], forces.touch.point_world_m, rtol=0, atol=1e-12)
@@ -115,16 +116,17 @@ def test_a_free_ellipsoid_sinks_and_rests_on_the_seabed_on_its_net_weight(load_b
     )  # fmt: skip
     law = ContactLaw(stiffness_N_m=1e5, dissipation_s_m=0.5)
     floor = plane("seabed", [0, 0, FLOOR_Z], [0, 0, 1], 0.6, 0.5)
-    plant = Plant(pusher, world=World(pusher, [floor], law, [boulder]), free_surface=False)
+    system = System(Plant(pusher, world=World(pusher, [floor], law, [boulder]), free_surface=False))
     q = pusher.neutral_configuration()
     q[:3] = [20.0, 0.0, -5.0]  # far away: only the boulder touches the seabed
-    v, tau = np.zeros(6), np.zeros(6)
-    plant.attach(q)
-    period = 2e-2
+    start = system.initial_state(q, np.zeros(6))
+    system.start(start)
+    q_sys, v_sys, tau, period = start.q, start.v, np.zeros(6), 2e-2
     for k in range(1000):  # 20 s
-        q, v = plant.advance(RK4(4e-3), k * period, q, v, tau, (k + 1) * period)
-    state = plant.free_bodies.state_values()
-    _, fixed = plant.free_bodies.found(q, v)
+        q_sys, v_sys = system.advance(RK4(4e-3), k * period, q_sys, v_sys, tau, (k + 1) * period)
+    (q, v), (q_b, v_b) = system.layout.split(q_sys, v_sys)
+    state = np.concatenate([q_b, v_b])
+    _, fixed = system.moving.found(q, v, [(q_b, v_b)])
     forces = fixed[0]
     assert len(forces.touch) == 1  # a smooth shape: coal's one deepest point
     volume = 4.0 / 3.0 * math.pi * np.prod(AXES)
