@@ -1,6 +1,9 @@
-"""``[joints]``: the arm's joint drives: friction (viscous, regularized Coulomb) and the
-torque bandwidth. Without the table there is no friction (``use_model_friction = true``
-takes the URDF's ``<dynamics damping friction>``) and the torque follows its command at once."""
+"""``[joints]``: the arm's joint limits and drives. The limits are compliant stops (a
+spring-damper past each URDF limit, the default), constraints solved implicitly once a control
+period (``stops = "implicit"``: a joint stops at its limit whatever its inertia), or nothing
+(``hard_stops = false``). The drives: friction (viscous, regularized Coulomb) and the torque
+bandwidth; without the table there is no friction (``use_model_friction = true`` takes the
+URDF's ``<dynamics damping friction>``) and the torque follows its command at once."""
 
 from __future__ import annotations
 
@@ -8,10 +11,29 @@ import numpy as np
 
 from uvms_pin.errors import ParameterError
 from uvms_pin.model.uvms import UVMS
+from uvms_pin.physics.constraints.joint_limits import JointLimits
 from uvms_pin.physics.joint_friction import DEFAULT_COULOMB_VELOCITY_RAD_S, JointFriction
+from uvms_pin.physics.joint_stops import JointStops
 from uvms_pin.scenario.schema import Table
 from uvms_pin.sim.actuation import Actuation
 from uvms_pin.sim.joint_drive import LaggedJointTorques
+
+
+def build_joint_limits(t: Table, uvms: UVMS) -> tuple[JointStops | None, JointLimits | None]:
+    """(the compliant stops, the limits as constraints) of [joints]: one of them, or neither
+    for a vehicle without joints (or arm joints without limits) or with ``hard_stops =
+    false``."""
+    on = t.boolean("hard_stops", True)
+    kind = t.string("stops", "compliant", choices=("compliant", "implicit"))
+    stiffness = t.number("stop_stiffness_Nm_rad", 1.0e3, positive=True)
+    damping = t.number("stop_damping_Nm_s_rad", 5.0, nonneg=True)
+    if not on or uvms.n_arm_joints == 0:
+        return None, None
+    if kind == "implicit":
+        limits = JointLimits.of_uvms(uvms)
+        return None, (limits if limits.joint_ids else None)
+    stops = JointStops.of_model(uvms.model, stiffness, damping)
+    return (stops if len(stops.names) else None), None
 
 
 def build_joint_friction(t: Table, uvms: UVMS) -> JointFriction | None:

@@ -34,10 +34,10 @@ from uvms_pin.scenario.controller import build_controller
 from uvms_pin.scenario.controller_parts import ControllerContext
 from uvms_pin.scenario.estimator import build_estimator
 from uvms_pin.scenario.initial import build_initial_state
-from uvms_pin.scenario.joints import build_joint_friction, with_joint_lag
+from uvms_pin.scenario.joints import build_joint_friction, build_joint_limits, with_joint_lag
 from uvms_pin.scenario.metrics import build_metrics
 from uvms_pin.scenario.mpc import check_replan_rate
-from uvms_pin.scenario.objects import build_joint_stops, build_world
+from uvms_pin.scenario.objects import build_world
 from uvms_pin.scenario.overrides import apply_overrides, parse_key_path
 from uvms_pin.scenario.schema import Table
 from uvms_pin.scenario.sensors import build_sensors
@@ -120,7 +120,7 @@ def _build(raw: dict[str, Any], path: Path, top: Table) -> Scenario:
     world = build_world(top.table("world"), uvms, path.parent)
     disturbance = build_disturbance(top.table("disturbance"))
     joints = top.table_or_empty("joints")
-    joint_stops = build_joint_stops(joints, uvms)
+    joint_stops, joint_limits = build_joint_limits(joints, uvms)
     friction = build_joint_friction(joints, uvms)
     actuation = with_joint_lag(joints, build_actuation(top.table("actuation"), uvms), uvms)
     joints.finish()
@@ -153,6 +153,7 @@ def _build(raw: dict[str, Any], path: Path, top: Table) -> Scenario:
         joint_friction=friction,
         world=world,
         joint_stops=joint_stops,
+        joint_limits=joint_limits,
     )
     try:
         settings = SimulationSettings(

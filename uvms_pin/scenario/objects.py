@@ -11,7 +11,6 @@ from typing import Any
 
 from uvms_pin.errors import ParameterError
 from uvms_pin.model.uvms import UVMS
-from uvms_pin.physics.joint_stops import JointStops
 from uvms_pin.physics.world.contact_law import ContactLaw
 from uvms_pin.physics.world.free_object import FreeObject, free_mass, free_object_of
 from uvms_pin.physics.world.kind import Key
@@ -25,7 +24,7 @@ from uvms_pin.physics.world.objects import (
 from uvms_pin.physics.world.world import World
 from uvms_pin.scenario.schema import Table
 
-__all__ = ["KEY_READERS", "build_joint_stops", "build_world"]
+__all__ = ["KEY_READERS", "build_world"]
 
 
 def build_world(t: Table | None, uvms: UVMS, base_dir: Path) -> World | None:
@@ -111,16 +110,3 @@ KEY_READERS: dict[str, Callable[[Table, Key, Path], Any]] = {
     "vector": lambda t, key, _: t.vector(key.name, 3, key.default),
     "path": _path,
 }
-
-
-def build_joint_stops(t: Table, uvms: UVMS) -> JointStops | None:
-    """[joints]: compliant stops at the URDF's joint limits (on unless ``hard_stops =
-    false``); None for a vehicle without joints or with the stops off. The table's other keys
-    (the drives', `uvms_pin.scenario.joints`) are read and checked by the caller."""
-    on = t.boolean("hard_stops", True)
-    stiffness = t.number("stop_stiffness_Nm_rad", 1.0e3, positive=True)
-    damping = t.number("stop_damping_Nm_s_rad", 5.0, nonneg=True)
-    if not on or uvms.n_arm_joints == 0:
-        return None
-    stops = JointStops.of_model(uvms.model, stiffness, damping)
-    return stops if len(stops.names) else None
