@@ -35,6 +35,11 @@ def test_joint_stops_turn_off_and_take_their_parameters():
     assert _load(**{"joints.hard_stops": False}).plant.joint_stops is None
     stops = _load(**{"joints.stop_stiffness_Nm_rad": 300.0}).plant.joint_stops
     assert stops.stiffness_Nm_rad == 300.0
+    implicit = _load(**{"joints.stops": "implicit"}).plant
+    assert implicit.joint_stops is None and len(implicit.joint_limits.joint_ids) >= 1
+    assert (
+        _load(**{"joints.stops": "implicit", "joints.hard_stops": False}).plant.joint_limits is None
+    )
 
 
 def _with_object(k: int, **changes):
@@ -80,6 +85,7 @@ def test_bad_objects_are_refused_naming_the_key(k, changes, message):
         ({"world.contact.stifness_N_m": 1.0}, r"unknown key"),
         ({"joints.stop_stiffness_Nm_rad": -1.0}, r"joints\.stop_stiffness_Nm_rad.*positive"),
         ({"joints.hard_stops": "yes"}, r"joints\.hard_stops.*true or false"),
+        ({"joints.stops": "rigid"}, r"joints\.stops.*compliant, implicit"),
     ],
 )
 def test_bad_contact_and_joint_tables_are_refused_naming_the_key(overrides, message):
