@@ -11,25 +11,20 @@ from uvms_pin.physics.compiled.backend import BACKENDS
 from uvms_pin.scenario.schema import Table
 from uvms_pin.sim.integrators import RK4, Adaptive, Integrator, SemiImplicitEuler
 
+
+def _seconds(usual: tuple[float, float], usual_text: str, hints=("", "")) -> Plausible:
+    """A duration [s]: any positive one is possible, ``usual`` the range runs use."""
+    return Plausible("s", usual, (0.0, math.inf), usual_text, "", hints)
+
+
 #: A fixed integrator step [s]: a UVMS's fastest dynamics (a stiff contact, the joint
 #: drives) want ~1e-4 s, its slowest are seconds; below 1e-5 s a run takes 1e5 steps per
 #: simulated second, above 0.05 s RK4 steps over the joints' dynamics
-STEP = Plausible(
-    "s",
-    usual=(1e-5, 0.05),
-    possible=(0.0, math.inf),
-    usual_text="the steps a UVMS run needs",
-    impossible_text="",
-    hints=("every simulated second takes 1/step steps", ""),
+STEP = _seconds(
+    (1e-5, 0.05), "the steps a UVMS run needs", ("every simulated second takes 1/step steps", "")
 )
 #: A controller's period [s]: real controllers run at 10 Hz to 10 kHz
-CONTROL_PERIOD = Plausible(
-    "s",
-    usual=(1e-4, 0.1),
-    possible=(0.0, math.inf),
-    usual_text="controller rates of 10 Hz to 10 kHz",
-    impossible_text="",
-)
+CONTROL_PERIOD = _seconds((1e-4, 0.1), "controller rates of 10 Hz to 10 kHz")
 
 
 def _fixed_step(kind: type[Integrator]) -> Callable[[Table], Integrator]:

@@ -344,7 +344,7 @@ class ClosedLoop:
             measurement, contact = at(t, q, v)
             tau_applied = actuation.apply(command(measurement))
             self._last_tau_applied = tau_applied  # for a divergence message
-            acceleration = system.acceleration(t, q, v, tau_applied, contact)
+            acceleration = system.acceleration(t, q, v, tau_applied, contact_world=contact)
             # an adaptive solver would shrink its step on a non-finite stage until it gives
             # up with a message that does not say why: stop at once instead (a sum is NaN or
             # inf if any entry is; the exact test only when it is)

@@ -99,6 +99,7 @@ class System:
         q: np.ndarray,
         v: np.ndarray,
         tau: np.ndarray,
+        *,
         contact_world: np.ndarray | None = None,
     ) -> np.ndarray:
         """The system's acceleration (nv,) with ``tau`` on the robot (``contact_world``:
