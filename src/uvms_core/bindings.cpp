@@ -22,6 +22,7 @@
 namespace nb = nanobind;
 using namespace nb::literals;
 
+void bind_sampled_laws(nb::module_& m);  // loop_bindings.cpp
 void bind_sampled_loop(nb::module_& m);  // loop_bindings.cpp
 void bind_step_derivatives(nb::module_& m);  // step_bindings.cpp
 
@@ -454,7 +455,8 @@ void bind_ppc(nb::module_& m) {
       .def_rw("refine_above_condition_bound", &Settings::refine_above_condition_bound)
       .def_rw("xi_clamp", &Settings::xi_clamp)
       .def_rw("min_abs_cos_pitch", &Settings::min_abs_cos_pitch);
-  nb::class_<Ppc>(m, "PrescribedPerformanceController", "The paper's law (ppc.hpp).")
+  nb::class_<Ppc, uvms::SampledLaw>(m, "PrescribedPerformanceController",
+                                    "The paper's law (ppc.hpp).")
       .def(
           "__init__",
           [](Ppc* self, const std::string& model_text, const Settings& settings) {
@@ -543,6 +545,7 @@ NB_MODULE(_core, m) {
   bind_world(m);
   bind_plant(m);
   bind_batch_plant(m);
+  bind_sampled_laws(m);
   bind_ppc(m);
   bind_sampled_loop(m);
 }
