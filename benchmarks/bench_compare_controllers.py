@@ -41,9 +41,7 @@ def main() -> None:
     names = args.controllers.split(",")
     if names[0] != "ppc":
         names.insert(0, "ppc")
-    scenarios = controller_scenarios(
-        args.scenario, names, {"scenario.duration_s": args.duration}
-    )
+    scenarios = controller_scenarios(args.scenario, names, {"scenario.duration_s": args.duration})
     paths = {}
     for name, scenario in scenarios.items():
         meta = simulate(scenario, progress=False).metadata["closed_loop"]

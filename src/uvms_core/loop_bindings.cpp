@@ -7,6 +7,7 @@
 #include <nanobind/stl/vector.h>
 
 #include "law_force_baselines.hpp"
+#include "law_tracking.hpp"
 #include "sampled_loop.hpp"
 
 namespace nb = nanobind;
@@ -116,6 +117,26 @@ void bind_force_baselines(nb::module_& m) {
       .def_rw("state", &uvms::ComputedTorqueLaw::state);
 }
 
+void bind_tracking_laws(nb::module_& m) {
+  using uvms::ResolvedAccelerationSettings;
+  nb::class_<ResolvedAccelerationSettings> ra_settings(
+      m, "ResolvedAccelerationSettings", "Resolved-acceleration law's settings (law_tracking.hpp).");
+  ra_settings.def(nb::init<>())
+      .def_rw("vehicle_target", &ResolvedAccelerationSettings::vehicle_target)
+      .def_rw("vehicle_frame", &ResolvedAccelerationSettings::vehicle_frame)
+      .def_rw("frame_id", &ResolvedAccelerationSettings::frame_id)
+      .def_rw("rotation_reference", &ResolvedAccelerationSettings::rotation_reference)
+      .def_rw("rows", &ResolvedAccelerationSettings::rows)
+      .def_rw("position_gain_per_s2", &ResolvedAccelerationSettings::position_gain_per_s2)
+      .def_rw("velocity_gain_per_s", &ResolvedAccelerationSettings::velocity_gain_per_s)
+      .def_rw("null_space_damping_per_s", &ResolvedAccelerationSettings::null_space_damping_per_s)
+      .def_rw("velocity_weights", &ResolvedAccelerationSettings::velocity_weights);
+  nb::class_<uvms::ResolvedAccelerationLaw, uvms::SampledLaw>(
+      m, "ResolvedAccelerationLaw", "The resolved-acceleration law (law_tracking.hpp).")
+      .def(nb::init<const uvms::Dynamics&, ResolvedAccelerationSettings>(), "dynamics"_a,
+           "settings"_a);
+}
+
 }  // namespace
 
 // The law interface (law.hpp): bound before the laws deriving from it (the PPC's binding).
@@ -149,6 +170,7 @@ void bind_sampled_laws(nb::module_& m) {
 
 void bind_sampled_loop(nb::module_& m) {
   bind_force_baselines(m);
+  bind_tracking_laws(m);
   using uvms::Actuation;
   using uvms::LoopSettings;
   nb::class_<Actuation>(m, "Actuation",

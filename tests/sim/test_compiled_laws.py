@@ -1,12 +1,13 @@
-"""The force baselines' compiled laws (src/uvms_core/law_force_baselines.hpp, built by
-uvms_pin/sim/compiled/laws.py) in the compiled sampled loop against their Python
-controllers in the Python loop: the whole rollout to 1e-12, the same stop, the law's state
-handed over when the core declines a tick."""
+"""The compiled laws of the force baselines (src/uvms_core/law_force_baselines.hpp) and of
+resolved acceleration (law_tracking.hpp), built by uvms_pin/sim/compiled/laws.py, in the
+compiled sampled loop against their Python controllers in the Python loop: the whole
+rollout to 1e-12, the same stop, the law's state handed over when the core declines a tick."""
 
 from __future__ import annotations
 
 import numpy as np
 import pytest
+from conftest import ROOT
 from test_compiled_loop import PAPER, PAPER_SAMPLED, REALISTIC, _assert_same
 
 from uvms_pin.apps.compare.runs import controller_scenarios
@@ -14,7 +15,7 @@ from uvms_pin.control.baselines.computed_torque import ComputedTorqueController
 from uvms_pin.control.baselines.pi_force import PIForceController
 from uvms_pin.control.ppc import PrescribedPerformanceController
 from uvms_pin.control.pseudo_inverse import MinimumNormSolver
-from uvms_pin.errors import ControllerError
+from uvms_pin.errors import ControllerError, SimulationError
 from uvms_pin.physics.compiled.backend import Fallback
 from uvms_pin.physics.compiled.extension import core_module
 from uvms_pin.sim.compiled.laws import law_to_core
@@ -30,13 +31,13 @@ def _scenario(path, kind, overrides):
 
 
 def _both(scenario, **kwargs):
-    """(compiled rollout or exception, Python rollout or exception) of ``scenario``."""
+    """((rollout, the error that stopped it or None) compiled, the same in Python)."""
     out = []
     for compiled in (True, False):
         try:
-            out.append(simulate(scenario, progress=False, compiled_loop=compiled, **kwargs))
-        except ControllerError as exc:
-            out.append(exc)
+            out.append((simulate(scenario, progress=False, compiled_loop=compiled, **kwargs), None))
+        except SimulationError as exc:
+            out.append((exc.rollout, exc))
     return out
 
 
@@ -48,12 +49,19 @@ def _both(scenario, **kwargs):
 )
 def test_each_baseline_runs_compiled_as_in_python(kind, path, overrides):
     scenario = _scenario(path, kind, overrides)
-    compiled, python = _both(scenario)
+    (compiled, stop_c), (python, stop_p) = _both(scenario)
     ticks = round(scenario.settings.duration_s / scenario.settings.control_period_s) + 1
     meta = compiled.metadata["closed_loop"]
-    assert meta == {"path": "compiled", "reason": None, "compiled_ticks": ticks,
-                    "python_ticks": 0}  # fmt: skip
-    assert python.metadata["closed_loop"]["python_ticks"] == ticks
+    if stop_p is None:
+        assert stop_c is None
+        assert meta == {"path": "compiled", "reason": None, "compiled_ticks": ticks,
+                        "python_ticks": 0}  # fmt: skip
+        assert python.metadata["closed_loop"]["python_ticks"] == ticks
+    else:  # the paper's unlimited vehicle with a default-tuned baseline at 500 Hz blows up
+        assert str(stop_c) == str(stop_p) and "diverged" in str(stop_p)
+        python_ticks = python.metadata["closed_loop"]["python_ticks"]
+        assert meta == {"path": "compiled", "reason": None,
+                        "compiled_ticks": python_ticks - 1, "python_ticks": 1}  # fmt: skip
     _assert_same(compiled, python)
     assert np.max(np.abs(compiled.v)) > 1e-2  # the run did something
     assert np.max(np.abs(compiled.signals["e_x"][:, :3])) > 1e-2
@@ -63,7 +71,7 @@ def test_each_baseline_runs_compiled_as_in_python(kind, path, overrides):
 def test_a_declined_tick_raises_in_python_as_in_the_python_loop(kind):
     # the tool's pitch q2 + q3 = pi/2 - 1e-5: the Euler singularity, where the task raises
     singular = {"initial.joint_positions_rad": [-0.2, 1.0, 0.5707863, 0.2]}
-    compiled, python = _both(_scenario(REALISTIC, kind, singular))
+    (_, compiled), (_, python) = _both(_scenario(REALISTIC, kind, singular))
     assert isinstance(compiled, ControllerError) and isinstance(python, ControllerError)
     assert str(compiled) == str(python) and "singular" in str(compiled).lower()
     meta = compiled.rollout.metadata["closed_loop"]
@@ -125,3 +133,32 @@ def test_law_to_core_says_why_a_controller_has_no_law():
     assert law_to_core(python, core).reason == "the controller's Python backend"
     motion = ComputedTorqueController(scenario.uvms, ee, reference=lambda t: (None, None, None))
     assert "motion reference" in law_to_core(motion, core).reason
+    path = ROOT / "scenarios" / "lbv150_ee_circle.toml"
+    tracking = controller_scenarios(path, ["task_priority"])["task_priority"]
+    priority = law_to_core(tracking.controller_factory(tracking.uvms), core)
+    assert "TaskPriorityController is not compiled" in priority.reason
+
+
+@pytest.mark.parametrize(
+    "stem, overrides",
+    [
+        ("lbv150_ee_circle", {}),
+        ("lbv150_ee_circle", {"water.current_world_m_s": [0.1, 0.0, 0.0]}),
+        ("bluerov_alpha5_ee_circle", {}),
+    ],
+    ids=["lbv150", "lbv150-current", "bluerov-alpha5"],
+)
+def test_resolved_acceleration_runs_compiled_as_in_python(stem, overrides):
+    path = ROOT / "scenarios" / f"{stem}.toml"
+    scenario = controller_scenarios(
+        path, ["computed_torque_task"], {"scenario.duration_s": 3.0, **overrides}
+    )["computed_torque_task"]
+    (compiled, stop_c), (python, stop_p) = _both(scenario)
+    assert stop_c is None and stop_p is None
+    ticks = round(scenario.settings.duration_s / scenario.settings.control_period_s) + 1
+    assert compiled.metadata["closed_loop"] == {
+        "path": "compiled", "reason": None, "compiled_ticks": ticks, "python_ticks": 0}  # fmt: skip
+    _assert_same(compiled, python)
+    assert compiled.metadata["signal_units"]["task_position_error"] == python.metadata[
+        "signal_units"]["task_position_error"]  # fmt: skip
+    assert np.max(np.abs(compiled.signals["task_position_error"])) > 1e-4

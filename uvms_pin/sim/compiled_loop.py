@@ -47,6 +47,7 @@ from uvms_pin.sim.settings import SimulationSettings
 CHUNK_TICKS = 250
 FIRST_CHUNK_TICKS = 32
 
+
 @dataclass
 class LoopPath:
     """Which loop ran a run: why not compiled (None when it was), and the ticks each path

@@ -158,9 +158,7 @@ class EndEffectorTask:
 
     def reference_velocity(self, state: TaskState, xdot_r: np.ndarray) -> np.ndarray:
         """zeta_r (nv,) = J^# xdot_r + (I - J^# J) zeta_0 [m/s, rad/s], the PPC's eq. (9)."""
-        return self.reference(
-            state.q, state.rpy_ee, state.jacobian_lwa, [float(x) for x in xdot_r]
-        )
+        return self.reference(state.q, state.rpy_ee, state.jacobian_lwa, [float(x) for x in xdot_r])
 
     def world_rates(self, state: TaskState, euler_rates: np.ndarray) -> np.ndarray:
         """omega_world (3,) [rad/s] of Euler rates at the end-effector's attitude."""

@@ -8,7 +8,8 @@ controller evaluates them), the law's state handed between the Python controller
 core (the Python loop runs the ticks the core declines), and the named signals of its
 packed buffer, in the order the Python controller logs them. Or a `Fallback` naming why the
 controller runs in Python: a user's own controller or a subclass (its `compute` is not the
-one the core mirrors), the controller's Python backend, a motion reference.
+one the core mirrors), the controller's Python backend, a motion reference, the
+task-priority controller (not compiled yet).
 
 Each law reads the controller's public attributes only; the law mirrors the controller's
 `compute` line by line (tests/sim/test_compiled_laws.py: the whole rollout to 1e-12).
@@ -22,14 +23,16 @@ from types import ModuleType
 
 import numpy as np
 
+from uvms_pin.control.base import Controller
 from uvms_pin.control.baselines.computed_torque import ComputedTorqueController
 from uvms_pin.control.baselines.impedance import ImpedanceController
 from uvms_pin.control.baselines.pi_force import PIForceController
 from uvms_pin.control.baselines.task import EndEffectorTask, ForceOrientationLoop
-from uvms_pin.control.base import Controller
 from uvms_pin.control.performance import transformed_error
 from uvms_pin.control.ppc import PPCSignals, PrescribedPerformanceController
 from uvms_pin.control.pseudo_inverse import REFINE_ABOVE_CONDITION_BOUND
+from uvms_pin.control.tracking.controllers import ResolvedAccelerationController, task_signals
+from uvms_pin.control.tracking.task import TrackingTask
 from uvms_pin.physics.compiled.backend import Fallback
 from uvms_pin.physics.dynamics import dynamics_of
 from uvms_pin.physics.kinematics import EULER_SINGULARITY_MIN_ABS_COS_PITCH
@@ -222,6 +225,34 @@ def _computed_torque(controller: ComputedTorqueController, core: ModuleType) -> 
     return _ForceLoopLaw(controller, law, _task_desired(task))
 
 
+# ---- the tracking laws -------------------------------------------------------------------
+def _path_desired(task: TrackingTask) -> Callable[[float], np.ndarray]:
+    """[p_r (3) m; p_dot_r (3) m/s; p_ddot_r (3) m/s^2] of the task's path at t."""
+    path = task.path
+
+    def desired(time_s: float) -> np.ndarray:
+        return np.concatenate(path.at(time_s))
+
+    return desired
+
+
+def _resolved_acceleration(controller: ResolvedAccelerationController, core: ModuleType) -> CoreLaw:
+    task = controller.task
+    settings = core.ResolvedAccelerationSettings()
+    settings.vehicle_target = task.target == "vehicle"
+    settings.vehicle_frame = task.frame == "vehicle"
+    settings.frame_id = task.frame_id(controller.model)
+    settings.rotation_reference = np.asarray(task.rotation_reference, dtype=float)
+    settings.rows = task.rows.stop
+    settings.position_gain_per_s2 = controller.k_p
+    settings.velocity_gain_per_s = controller.k_d
+    settings.null_space_damping_per_s = controller.k_n
+    settings.velocity_weights = controller.weights
+    law = core.ResolvedAccelerationLaw(dynamics_of(controller.uvms, "core").core, settings)
+    described = task_signals(task, np.zeros(3), np.zeros(3))
+    return CoreLaw(controller, law, _path_desired(task), described)
+
+
 #: The controllers with a compiled law, by their exact class (a subclass may change
 #: `compute`: it runs in Python).
 _LAWS: dict[type, Callable[[Controller, ModuleType], CoreLaw | Fallback]] = {
@@ -229,6 +260,7 @@ _LAWS: dict[type, Callable[[Controller, ModuleType], CoreLaw | Fallback]] = {
     PIForceController: _pi_force,
     ImpedanceController: _impedance,
     ComputedTorqueController: _computed_torque,
+    ResolvedAccelerationController: _resolved_acceleration,
 }
 
 
