@@ -1,4 +1,5 @@
-"""Cost of each row of ``uvms-pin compare-controllers``, as a ratio to the PPC's row.
+"""Cost of each row of ``uvms-pin compare-controllers``, as a ratio to the PPC's row (the
+first controller's).
 
     .venv/bin/python benchmarks/bench_compare_controllers.py [SCENARIO] [--repeat N]
         [--duration S] [--controllers ppc,pi_force,...] [--json FILE]
@@ -6,7 +7,8 @@
 Each controller's run of the scenario (default scenarios/realistic_force_tracking.toml,
 shortened to ``--duration``) is simulated as compare-controllers simulates it (its
 [baselines.<name>] tuning, `controller_scenarios`), and reported as a ratio of its time to
-the PPC row's, timed in the same process: the figures compare across machines. Times are this
+the first row's (the PPC's by default; on a tracking scenario name its controllers, e.g.
+``--controllers task_priority,computed_torque_task``), timed in the same process: the figures compare across machines. Times are this
 process's CPU time, best of ``--repeat`` interleaved rounds (`timing.py`). The path each run
 took (the compiled sampled loop, or the Python loop and why) is printed with it, and, with
 ``--python-loop``, each row's time on the Python loop too (``compiled_loop=False``: what a
@@ -39,8 +41,6 @@ def main() -> None:
     args = parser.parse_args()
     one_blas_thread()
     names = args.controllers.split(",")
-    if names[0] != "ppc":
-        names.insert(0, "ppc")
     scenarios = controller_scenarios(args.scenario, names, {"scenario.duration_s": args.duration})
     paths = {}
     for name, scenario in scenarios.items():
@@ -57,15 +57,20 @@ def main() -> None:
         args.repeat,
         batch_s=0.0,
     )
-    base = seconds["ppc", True]
+    first = names[0]
+    base = seconds[first, True]
     print(f"{Path(args.scenario).name}, {args.duration:g} s simulated per run, "
-          f"best of {args.repeat}; ratios to the ppc row ({base:.3f} s)")  # fmt: skip
+          f"best of {args.repeat}; ratios to the {first} row ({base:.3f} s)")  # fmt: skip
     print(f"{'controller':<18}{'ratio':>8}{'python loop':>13}  loop")
     ratios = {}
     for name in names:
         ratio = seconds[name, True] / base
         python = seconds.get((name, False), float("nan")) / base
-        ratios[name] = {"ratio_to_ppc": ratio, "python_loop_ratio": python, "loop": paths[name]}
+        ratios[name] = {
+            f"ratio_to_{first}": ratio,
+            "python_loop_ratio": python,
+            "loop": paths[name],
+        }
         print(f"{name:<18}{ratio:>8.2f}{python:>13.2f}  {paths[name]}")
     if args.json is not None:
         args.json.write_text(json.dumps(ratios, indent=1))
