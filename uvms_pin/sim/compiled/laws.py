@@ -40,11 +40,6 @@ from uvms_pin.results.signal import Signal
 
 __all__ = ["CoreLaw", "law_to_core"]
 
-#: One signal of the log: (name, values of the logged rows) from the rows' packed signals
-#: (n x size of the law's buffer) and their desired rows (n x desired_size).
-SignalColumns = Callable[[np.ndarray, np.ndarray], list[tuple[str, np.ndarray]]]
-
-
 class CoreLaw:
     """A controller's compiled law and the Python around it (module docstring).
 
