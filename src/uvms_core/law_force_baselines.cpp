@@ -78,41 +78,53 @@ bool ForceBaselineLaw::evaluate(const LawInput& in) {
   return true;
 }
 
-// ---- PI force --------------------------------------------------------------------------------
+// ---- the laws with the PI outer loop ----------------------------------------------------------
 
-PiForceLaw::PiForceLaw(pinocchio::Model model, PiForceSettings settings)
-    : ForceBaselineLaw(model, settings,
-                       {{"force_desired_world_N", 0, 3},
-                        {"e_x", 0, 6},
-                        {"xdot_r", 0, 6},
-                        {"zeta_r", 0, model.nv},
-                        {"force_integral_Ns", 0, 3},
-                        {"tau", 0, model.nv}}),
-      s_(std::move(settings)) {
-  require_size("damping", s_.damping.size(), nv());
+ForceLoopLaw::ForceLoopLaw(pinocchio::Model model, const ForceTaskSettings& task,
+                           ForceLoopGains gains, std::vector<SignalSlot> names_and_sizes)
+    : ForceBaselineLaw(std::move(model), task, std::move(names_and_sizes)),
+      gains_(std::move(gains)) {
   f_d_ = slot("force_desired_world_N");
   e_x_ = slot("e_x");
-  xdot_r_ = slot("xdot_r");
   zeta_r_ = slot("zeta_r");
-  integral_ = slot("force_integral_Ns");
   tau_ = slot("tau");
 }
 
-LawStatus PiForceLaw::command(const LawInput& in) {
-  if (!evaluate(in)) return LawStatus::declined;
-  ForceLoopState next;
-  const Vec6 xdot_r = force_loop_velocity(s_, in.time_s, error_, state, next);
-  auto zeta_r = at(zeta_r_);
-  if (!task_.reference_velocity(xdot_r, zeta_r)) return LawStatus::declined;
-  next_ = next;
+bool ForceLoopLaw::reference(const LawInput& in, Vec6& xdot_r) {
+  if (!evaluate(in)) return false;
+  xdot_r = force_loop_velocity(gains_, in.time_s, error_, state, next_);
+  if (!task_.reference_velocity(xdot_r, at(zeta_r_))) return false;
   at(f_d_) = Eigen::Map<const Vec3>(in.desired);
   at(e_x_) = error_;
+  return true;
+}
+
+// ---- PI force --------------------------------------------------------------------------------
+
+PiForceLaw::PiForceLaw(pinocchio::Model model, PiForceSettings settings)
+    : ForceLoopLaw(model, settings, settings,
+                   {{"force_desired_world_N", 0, 3},
+                    {"e_x", 0, 6},
+                    {"xdot_r", 0, 6},
+                    {"zeta_r", 0, model.nv},
+                    {"force_integral_Ns", 0, 3},
+                    {"tau", 0, model.nv}}),
+      damping_(std::move(settings.damping)) {
+  require_size("damping", damping_.size(), nv());
+  xdot_r_ = slot("xdot_r");
+  integral_ = slot("force_integral_Ns");
+}
+
+LawStatus PiForceLaw::command(const LawInput& in) {
+  Vec6 xdot_r;
+  if (!reference(in, xdot_r)) return LawStatus::declined;
   at(xdot_r_) = xdot_r;
-  at(integral_) = next.integral_Ns;
+  at(integral_) = next_.integral_Ns;
   // tau = -K_d (zeta - zeta_r)
+  const auto zeta_r = at(zeta_r_);
   auto tau = at(tau_);
   for (Eigen::Index j = 0; j < tau.size(); ++j) {
-    tau[j] = -s_.damping[j] * (in.v[j] - zeta_r[j]);
+    tau[j] = -damping_[j] * (in.v[j] - zeta_r[j]);
   }
   return LawStatus::ok;
 }
@@ -178,34 +190,28 @@ LawStatus ImpedanceLaw::command(const LawInput& in) {
 // ---- computed torque ----------------------------------------------------------------------
 
 ComputedTorqueLaw::ComputedTorqueLaw(const Dynamics& dynamics, ComputedTorqueSettings settings)
-    : ForceBaselineLaw(dynamics.model(), settings,
-                       {{"force_desired_world_N", 0, 3},
-                        {"e_x", 0, 6},
-                        {"zeta_r", 0, dynamics.model().nv},
-                        {"tau", 0, dynamics.model().nv}}),
+    : ForceLoopLaw(dynamics.model(), settings, settings,
+                   {{"force_desired_world_N", 0, 3},
+                    {"e_x", 0, 6},
+                    {"zeta_r", 0, dynamics.model().nv},
+                    {"tau", 0, dynamics.model().nv}}),
       dynamics_(dynamics),
-      s_(std::move(settings)) {
-  require_size("velocity_gain_per_s", s_.velocity_gain_per_s.size(), nv());
+      velocity_gain_(std::move(settings.velocity_gain_per_s)) {
+  require_size("velocity_gain_per_s", velocity_gain_.size(), nv());
   q_ = Eigen::VectorXd::Zero(nq());
   v_ = Eigen::VectorXd::Zero(nv());
   acceleration_ = Eigen::VectorXd::Zero(nv());
-  f_d_ = slot("force_desired_world_N");
-  e_x_ = slot("e_x");
-  zeta_r_ = slot("zeta_r");
-  tau_ = slot("tau");
 }
 
 LawStatus ComputedTorqueLaw::command(const LawInput& in) {
-  if (!evaluate(in)) return LawStatus::declined;
-  ForceLoopState next;
-  const Vec6 xdot_r = force_loop_velocity(s_, in.time_s, error_, state, next);
-  auto zeta_r = at(zeta_r_);
-  if (!task_.reference_velocity(xdot_r, zeta_r)) return LawStatus::declined;
+  Vec6 xdot_r;
+  if (!reference(in, xdot_r)) return LawStatus::declined;
   q_ = Eigen::Map<const Eigen::VectorXd>(in.q, nq());
   v_ = Eigen::Map<const Eigen::VectorXd>(in.v, nv());
   // a = K_v (zeta_r - zeta);  tau = M(q) a + h(q, zeta) + J^lwa^T w_meas (still water)
+  const auto zeta_r = at(zeta_r_);
   for (Eigen::Index j = 0; j < nv(); ++j) {
-    acceleration_[j] = s_.velocity_gain_per_s[j] * (zeta_r[j] - v_[j]);
+    acceleration_[j] = velocity_gain_[j] * (zeta_r[j] - v_[j]);
   }
   auto tau = at(tau_);
   try {
@@ -215,9 +221,6 @@ LawStatus ComputedTorqueLaw::command(const LawInput& in) {
     return LawStatus::declined;
   }
   tau.noalias() += task_.jacobian_lwa().transpose() * Eigen::Map<const Vec6>(in.wrench_world);
-  next_ = next;
-  at(f_d_) = Eigen::Map<const Vec3>(in.desired);
-  at(e_x_) = error_;
   return LawStatus::ok;
 }
 

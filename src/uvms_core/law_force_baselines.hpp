@@ -70,22 +70,38 @@ class ForceBaselineLaw : public SampledLaw {
   Eigen::VectorXd signals_;
 };
 
+// The laws with the PI outer loop (PI force, computed torque): zeta_r from the loop, its
+// state committed with the tick. Their signals start with f_d, e_x and end with zeta_r, tau.
+class ForceLoopLaw : public ForceBaselineLaw {
+ public:
+  void commit() override { state = next_; }
+  ForceLoopState state;  // the committed state (the Python loop's, between chunks)
+
+ protected:
+  ForceLoopLaw(pinocchio::Model model, const ForceTaskSettings& task, ForceLoopGains gains,
+               std::vector<SignalSlot> names_and_sizes);
+  // The task at the tick's measurement, xdot_r of the outer loop and zeta_r into its slot,
+  // f_d and e_x into theirs; the loop's next state into next_. false = declined.
+  bool reference(const LawInput& in, Vec6& xdot_r);
+
+  ForceLoopGains gains_;
+  ForceLoopState next_;
+  SignalSlot f_d_, e_x_, zeta_r_, tau_;
+};
+
 // ---- PI force (pi_force.py) --------------------------------------------------------------
 struct PiForceSettings : ForceTaskSettings, ForceLoopGains {
   Eigen::VectorXd damping;  // k_d (nv) [N per m/s; N m per rad/s]
 };
 
-class PiForceLaw : public ForceBaselineLaw {
+class PiForceLaw : public ForceLoopLaw {
  public:
   PiForceLaw(pinocchio::Model model, PiForceSettings settings);
   LawStatus command(const LawInput& in) override;
-  void commit() override { state = next_; }
-  ForceLoopState state;  // the committed state (the Python loop's, between chunks)
 
  private:
-  PiForceSettings s_;
-  ForceLoopState next_;
-  SignalSlot f_d_, e_x_, xdot_r_, zeta_r_, integral_, tau_;
+  Eigen::VectorXd damping_;
+  SignalSlot xdot_r_, integral_;
 };
 
 // ---- impedance (impedance.py) ------------------------------------------------------------
@@ -122,21 +138,17 @@ struct ComputedTorqueSettings : ForceTaskSettings, ForceLoopGains {
   Eigen::VectorXd velocity_gain_per_s;  // K_v (nv) [1/s]
 };
 
-class ComputedTorqueLaw : public ForceBaselineLaw {
+class ComputedTorqueLaw : public ForceLoopLaw {
  public:
   // `dynamics`: the model the controller believes in (copied); its kinematics are the task's.
   ComputedTorqueLaw(const Dynamics& dynamics, ComputedTorqueSettings settings);
   LawStatus command(const LawInput& in) override;
-  void commit() override { state = next_; }
-  ForceLoopState state;
 
  private:
   Dynamics dynamics_;
-  ComputedTorqueSettings s_;
-  ForceLoopState next_;
+  Eigen::VectorXd velocity_gain_;
   FlowField still_water_;
   Eigen::VectorXd q_, v_, acceleration_;
-  SignalSlot f_d_, e_x_, zeta_r_, tau_;
 };
 
 }  // namespace uvms

@@ -8,6 +8,7 @@
 
 #include "law_force_baselines.hpp"
 #include "law_tracking.hpp"
+#include "ppc.hpp"
 #include "sampled_loop.hpp"
 
 namespace nb = nanobind;
@@ -139,8 +140,22 @@ void bind_tracking_laws(nb::module_& m) {
 
 }  // namespace
 
-// The law interface (law.hpp): bound before the laws deriving from it (the PPC's binding).
+// The law interface (law.hpp) and the PPC's settings: bound before the laws deriving from
+// it (the PPC's binding, bindings.cpp).
 void bind_sampled_laws(nb::module_& m) {
+  using uvms::PpcSettings;
+  nb::class_<PpcSettings> ppc_settings(m, "PpcSettings",
+                                       "Gains, funnels and solver settings (ppc.hpp).");
+  bind_task_settings(ppc_settings);
+  ppc_settings.def_rw("k_x", &PpcSettings::k_x)
+      .def_rw("rho0_x", &PpcSettings::rho0_x)
+      .def_rw("rho_inf_x", &PpcSettings::rho_inf_x)
+      .def_rw("l_x_per_s", &PpcSettings::l_x_per_s)
+      .def_rw("k_zeta", &PpcSettings::k_zeta)
+      .def_rw("rho0_zeta", &PpcSettings::rho0_zeta)
+      .def_rw("rho_inf_zeta", &PpcSettings::rho_inf_zeta)
+      .def_rw("l_zeta_per_s", &PpcSettings::l_zeta_per_s)
+      .def_rw("xi_clamp", &PpcSettings::xi_clamp);
   using uvms::SampledLaw;
   nb::class_<SampledLaw>(m, "SampledLaw", "A compiled control law of the sampled loop (law.hpp).")
       .def_prop_ro("nq", &SampledLaw::nq)
