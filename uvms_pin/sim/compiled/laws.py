@@ -40,6 +40,7 @@ from uvms_pin.results.signal import Signal
 
 __all__ = ["CoreLaw", "law_to_core"]
 
+
 class CoreLaw:
     """A controller's compiled law and the Python around it (module docstring).
 
