@@ -22,6 +22,7 @@
 namespace nb = nanobind;
 using namespace nb::literals;
 
+void bind_sampled_laws(nb::module_& m);  // loop_bindings.cpp
 void bind_sampled_loop(nb::module_& m);  // loop_bindings.cpp
 void bind_step_derivatives(nb::module_& m);  // step_bindings.cpp
 
@@ -433,28 +434,9 @@ void bind_ppc(nb::module_& m) {
   using Settings = uvms::PpcSettings;
   m.attr("PPC_STATUS") = nb::make_tuple("ok", "first-level funnel", "second-level funnel",
                                         "solver declined", "Euler singularity", "bad input");
-  nb::class_<Settings>(m, "PpcSettings", "Gains, funnels and solver settings (ppc.hpp).")
-      .def(nb::init<>())
-      .def_rw("ee_frame_id", &Settings::ee_frame_id)
-      .def_rw("k_x", &Settings::k_x)
-      .def_rw("rho0_x", &Settings::rho0_x)
-      .def_rw("rho_inf_x", &Settings::rho_inf_x)
-      .def_rw("l_x_per_s", &Settings::l_x_per_s)
-      .def_rw("k_zeta", &Settings::k_zeta)
-      .def_rw("rho0_zeta", &Settings::rho0_zeta)
-      .def_rw("rho_inf_zeta", &Settings::rho_inf_zeta)
-      .def_rw("l_zeta_per_s", &Settings::l_zeta_per_s)
-      .def_rw("velocity_weights", &Settings::velocity_weights)
-      .def_rw("null_space_gain_per_s", &Settings::null_space_gain_per_s)
-      .def_rw("limited_q_index", &Settings::limited_q_index)
-      .def_rw("limited_v_index", &Settings::limited_v_index)
-      .def_rw("null_space_target", &Settings::null_space_target)
-      .def_rw("half_range", &Settings::half_range)
-      .def_rw("max_condition_bound", &Settings::max_condition_bound)
-      .def_rw("refine_above_condition_bound", &Settings::refine_above_condition_bound)
-      .def_rw("xi_clamp", &Settings::xi_clamp)
-      .def_rw("min_abs_cos_pitch", &Settings::min_abs_cos_pitch);
-  nb::class_<Ppc>(m, "PrescribedPerformanceController", "The paper's law (ppc.hpp).")
+  // PpcSettings: bound with the other laws' settings (loop_bindings.cpp, bind_sampled_laws)
+  nb::class_<Ppc, uvms::SampledLaw>(m, "PrescribedPerformanceController",
+                                    "The paper's law (ppc.hpp).")
       .def(
           "__init__",
           [](Ppc* self, const std::string& model_text, const Settings& settings) {
@@ -482,26 +464,8 @@ void bind_ppc(nb::module_& m) {
                 a[4].array.data(), a[4].size(), extended));
           },
           "time_s"_a, "q"_a.none(), "v"_a.none(), "wrench_world"_a.none(), "force_desired"_a.none(), "rpy_desired"_a.none(),
-          "extended"_a)
-      .def(
-          "signals",
-          [](Ppc& c) {
-            // a read-only view of the last ok call's packed signals (it lives with c)
-            const Eigen::VectorXd& s = c.signals();
-            return nb::ndarray<nb::numpy, const double, nb::ndim<1>>(
-                s.data(), {static_cast<std::size_t>(s.size())}, nb::handle());
-          },
-          nb::rv_policy::reference_internal)
-      .def(
-          "signal_layout",
-          [](Ppc& c) {
-            nb::dict out;
-            for (const auto& slot : c.signal_layout()) {
-              out[slot.name] = nb::make_tuple(slot.offset, slot.offset + slot.size);
-            }
-            return out;
-          },
-          "{name: (start, stop)} of each signal in signals(), in order");
+          "extended"_a);
+  // signals() and signal_layout(): the SampledLaw base's (loop_bindings.cpp)
 }
 
 }  // namespace
@@ -543,6 +507,7 @@ NB_MODULE(_core, m) {
   bind_world(m);
   bind_plant(m);
   bind_batch_plant(m);
+  bind_sampled_laws(m);
   bind_ppc(m);
   bind_sampled_loop(m);
 }

@@ -3,8 +3,12 @@
 #include <nanobind/eigen/dense.h>
 #include <nanobind/nanobind.h>
 #include <nanobind/ndarray.h>
+#include <nanobind/stl/string.h>
 #include <nanobind/stl/vector.h>
 
+#include "law_force_baselines.hpp"
+#include "law_tracking.hpp"
+#include "ppc.hpp"
 #include "sampled_loop.hpp"
 
 namespace nb = nanobind;
@@ -24,9 +28,164 @@ Eigen::Map<Eigen::VectorXd> map(Out1& a) {
   return {a.data(), static_cast<Eigen::Index>(a.shape(0))};
 }
 
+// The fields every force task's settings share (ForceTaskSettings), on a derived struct.
+template <typename Settings>
+void bind_task_settings(nb::class_<Settings>& c) {
+  c.def(nb::init<>())
+      .def_rw("ee_frame_id", &Settings::ee_frame_id)
+      .def_rw("velocity_weights", &Settings::velocity_weights)
+      .def_rw("null_space_gain_per_s", &Settings::null_space_gain_per_s)
+      .def_rw("limited_q_index", &Settings::limited_q_index)
+      .def_rw("limited_v_index", &Settings::limited_v_index)
+      .def_rw("null_space_target", &Settings::null_space_target)
+      .def_rw("half_range", &Settings::half_range)
+      .def_rw("max_condition_bound", &Settings::max_condition_bound)
+      .def_rw("refine_above_condition_bound", &Settings::refine_above_condition_bound)
+      .def_rw("min_abs_cos_pitch", &Settings::min_abs_cos_pitch);
+}
+
+// ForceLoopGains' fields on a derived struct.
+template <typename Settings>
+void bind_loop_gains(nb::class_<Settings>& c) {
+  c.def_rw("kp_force_m_s_per_N", &Settings::kp_force_m_s_per_N)
+      .def_rw("ki_force_m_s2_per_N", &Settings::ki_force_m_s2_per_N)
+      .def_rw("k_orientation_per_s", &Settings::k_orientation_per_s)
+      .def_rw("integral_limit_Ns", &Settings::integral_limit_Ns);
+}
+
+void bind_force_baselines(nb::module_& m) {
+  using uvms::ForceLoopState;
+  using uvms::ImpedanceState;
+  nb::class_<ForceLoopState>(m, "ForceLoopState",
+                             "ForceOrientationLoop's integral and last sample "
+                             "(law_force_baselines.hpp).")
+      .def(nb::init<>())
+      .def_rw("integral_Ns", &ForceLoopState::integral_Ns)
+      .def_rw("started", &ForceLoopState::started)
+      .def_rw("last_time_s", &ForceLoopState::last_time_s)
+      .def_rw("last_force_error_N", &ForceLoopState::last_force_error_N);
+  nb::class_<ImpedanceState>(m, "ImpedanceState", "The impedance's anchor and posture.")
+      .def(nb::init<>())
+      .def_rw("anchored", &ImpedanceState::anchored)
+      .def_rw("anchor_world_m", &ImpedanceState::anchor_world_m)
+      .def_rw("posture_q", &ImpedanceState::posture_q);
+
+  using uvms::PiForceSettings;
+  nb::class_<PiForceSettings> pi_settings(m, "PiForceSettings", "PI force law's settings.");
+  bind_task_settings(pi_settings);
+  bind_loop_gains(pi_settings);
+  pi_settings.def_rw("damping", &PiForceSettings::damping);
+  nb::class_<uvms::PiForceLaw, uvms::SampledLaw>(m, "PiForceLaw",
+                                                 "The PI force law (law_force_baselines.hpp).")
+      .def(
+          "__init__",
+          [](uvms::PiForceLaw* self, const std::string& model_text, const PiForceSettings& s) {
+            new (self) uvms::PiForceLaw(uvms::model_from_text(model_text), s);
+          },
+          "model_text"_a, "settings"_a)
+      .def_rw("state", &uvms::PiForceLaw::state);
+
+  using uvms::ImpedanceSettings;
+  nb::class_<ImpedanceSettings> imp_settings(m, "ImpedanceSettings", "Impedance law's settings.");
+  bind_task_settings(imp_settings);
+  imp_settings.def_rw("stiffness_N_m", &ImpedanceSettings::stiffness_N_m)
+      .def_rw("damping_N_s_m", &ImpedanceSettings::damping_N_s_m)
+      .def_rw("stiffness_Nm_rad", &ImpedanceSettings::stiffness_Nm_rad)
+      .def_rw("damping_Nm_s_rad", &ImpedanceSettings::damping_Nm_s_rad)
+      .def_rw("velocity_damping", &ImpedanceSettings::velocity_damping)
+      .def_rw("posture_stiffness_Nm_rad", &ImpedanceSettings::posture_stiffness_Nm_rad);
+  nb::class_<uvms::ImpedanceLaw, uvms::SampledLaw>(m, "ImpedanceLaw",
+                                                   "The impedance law (law_force_baselines.hpp).")
+      .def(
+          "__init__",
+          [](uvms::ImpedanceLaw* self, const std::string& model_text,
+             const ImpedanceSettings& s) {
+            new (self) uvms::ImpedanceLaw(uvms::model_from_text(model_text), s);
+          },
+          "model_text"_a, "settings"_a)
+      .def_rw("state", &uvms::ImpedanceLaw::state);
+
+  using uvms::ComputedTorqueSettings;
+  nb::class_<ComputedTorqueSettings> ct_settings(m, "ComputedTorqueSettings",
+                                                 "Computed-torque law's settings.");
+  bind_task_settings(ct_settings);
+  bind_loop_gains(ct_settings);
+  ct_settings.def_rw("velocity_gain_per_s", &ComputedTorqueSettings::velocity_gain_per_s);
+  nb::class_<uvms::ComputedTorqueLaw, uvms::SampledLaw>(
+      m, "ComputedTorqueLaw", "The computed-torque law (law_force_baselines.hpp).")
+      .def(nb::init<const uvms::Dynamics&, ComputedTorqueSettings>(), "dynamics"_a,
+           "settings"_a)
+      .def_rw("state", &uvms::ComputedTorqueLaw::state);
+}
+
+void bind_tracking_laws(nb::module_& m) {
+  using uvms::ResolvedAccelerationSettings;
+  nb::class_<ResolvedAccelerationSettings> ra_settings(
+      m, "ResolvedAccelerationSettings", "Resolved-acceleration law's settings (law_tracking.hpp).");
+  ra_settings.def(nb::init<>())
+      .def_rw("vehicle_target", &ResolvedAccelerationSettings::vehicle_target)
+      .def_rw("vehicle_frame", &ResolvedAccelerationSettings::vehicle_frame)
+      .def_rw("frame_id", &ResolvedAccelerationSettings::frame_id)
+      .def_rw("rotation_reference", &ResolvedAccelerationSettings::rotation_reference)
+      .def_rw("rows", &ResolvedAccelerationSettings::rows)
+      .def_rw("position_gain_per_s2", &ResolvedAccelerationSettings::position_gain_per_s2)
+      .def_rw("velocity_gain_per_s", &ResolvedAccelerationSettings::velocity_gain_per_s)
+      .def_rw("null_space_damping_per_s", &ResolvedAccelerationSettings::null_space_damping_per_s)
+      .def_rw("velocity_weights", &ResolvedAccelerationSettings::velocity_weights);
+  nb::class_<uvms::ResolvedAccelerationLaw, uvms::SampledLaw>(
+      m, "ResolvedAccelerationLaw", "The resolved-acceleration law (law_tracking.hpp).")
+      .def(nb::init<const uvms::Dynamics&, ResolvedAccelerationSettings>(), "dynamics"_a,
+           "settings"_a);
+}
+
 }  // namespace
 
+// The law interface (law.hpp) and the PPC's settings: bound before the laws deriving from
+// it (the PPC's binding, bindings.cpp).
+void bind_sampled_laws(nb::module_& m) {
+  using uvms::PpcSettings;
+  nb::class_<PpcSettings> ppc_settings(m, "PpcSettings",
+                                       "Gains, funnels and solver settings (ppc.hpp).");
+  bind_task_settings(ppc_settings);
+  ppc_settings.def_rw("k_x", &PpcSettings::k_x)
+      .def_rw("rho0_x", &PpcSettings::rho0_x)
+      .def_rw("rho_inf_x", &PpcSettings::rho_inf_x)
+      .def_rw("l_x_per_s", &PpcSettings::l_x_per_s)
+      .def_rw("k_zeta", &PpcSettings::k_zeta)
+      .def_rw("rho0_zeta", &PpcSettings::rho0_zeta)
+      .def_rw("rho_inf_zeta", &PpcSettings::rho_inf_zeta)
+      .def_rw("l_zeta_per_s", &PpcSettings::l_zeta_per_s)
+      .def_rw("xi_clamp", &PpcSettings::xi_clamp);
+  using uvms::SampledLaw;
+  nb::class_<SampledLaw>(m, "SampledLaw", "A compiled control law of the sampled loop (law.hpp).")
+      .def_prop_ro("nq", &SampledLaw::nq)
+      .def_prop_ro("nv", &SampledLaw::nv)
+      .def_prop_ro("desired_size", &SampledLaw::desired_size)
+      .def_prop_ro("tau_offset", &SampledLaw::tau_offset)
+      .def(
+          "signals",
+          [](SampledLaw& c) {
+            // a read-only view of the last ok command's packed signals (it lives with c)
+            const Eigen::VectorXd& s = c.signals();
+            return nb::ndarray<nb::numpy, const double, nb::ndim<1>>(
+                s.data(), {static_cast<std::size_t>(s.size())}, nb::handle());
+          },
+          nb::rv_policy::reference_internal)
+      .def(
+          "signal_layout",
+          [](SampledLaw& c) {
+            nb::dict out;
+            for (const auto& slot : c.signal_layout()) {
+              out[slot.name] = nb::make_tuple(slot.offset, slot.offset + slot.size);
+            }
+            return out;
+          },
+          "{name: (start, stop)} of each signal in signals(), in order");
+}
+
 void bind_sampled_loop(nb::module_& m) {
+  bind_force_baselines(m);
+  bind_tracking_laws(m);
   using uvms::Actuation;
   using uvms::LoopSettings;
   nb::class_<Actuation>(m, "Actuation",
@@ -83,7 +242,7 @@ void bind_sampled_loop(nb::module_& m) {
   m.def("noise_width", &uvms::noise_width, "nv"_a, "Entries of one tick's noise row.");
   m.def(
       "run_sampled_chunk",
-      [](uvms::Plant& plant, uvms::PrescribedPerformanceController& law,
+      [](uvms::Plant& plant, uvms::SampledLaw& law,
          const Actuation& actuation, const LoopSettings& settings, int first, int n_ticks,
          Out1 q, Out1 v, In2 noise, In2 desired, Out2 log, Out1 command, Out1 thrust,
          Out1 dropped_max) {
@@ -97,7 +256,8 @@ void bind_sampled_loop(nb::module_& m) {
         require(static_cast<int>(noise.shape(0)) >= n_ticks &&
                     static_cast<int>(noise.shape(1)) == uvms::noise_width(model.nv),
                 "noise table of the wrong shape");
-        require(static_cast<int>(desired.shape(0)) >= n_ticks && desired.shape(1) == 6,
+        require(static_cast<int>(desired.shape(0)) >= n_ticks &&
+                    static_cast<int>(desired.shape(1)) == law.desired_size(),
                 "desired table of the wrong shape");
         const int m_thrusters = static_cast<int>(thrust.shape(0));
         require(command.shape(0) == thrust.shape(0), "command and thrust sizes differ");

@@ -27,11 +27,8 @@
 
 #include <vector>
 
-#include <Eigen/Cholesky>
-#include <pinocchio/multibody/data.hpp>
-#include <pinocchio/multibody/model.hpp>
-
-#include "types.hpp"
+#include "law.hpp"
+#include "law_force_task.hpp"
 
 namespace uvms {
 
@@ -45,35 +42,23 @@ enum class PpcStatus : int {
   bad_input = 5,            // a vector of the wrong size or with a non-finite entry
 };
 
-// Gains, funnels and the pseudo-inverse's settings, sized and validated by the Python
-// controller (PPCParams.sized) and by its MinimumNormSolver.
-struct PpcSettings {
-  int ee_frame_id = 0;
+// Gains and funnels, sized and validated by the Python controller (PPCParams.sized); the
+// task's (frame, J^# and its weights, null-space task, solver) are ForceTaskSettings'.
+struct PpcSettings : ForceTaskSettings {
   Vec6 k_x, rho0_x, rho_inf_x, l_x_per_s;  // first level
-  // second level (nv each); velocity_weights W of J^# = W^-1 J^T (J W^-1 J^T)^-1
-  Eigen::VectorXd k_zeta, rho0_zeta, rho_inf_zeta, l_zeta_per_s, velocity_weights;
-  // null-space task zeta_0,j = -k_0 (q_j - q_0,j) / h_j on the limited arm joints
-  // (q index, v index, target q_0,j [rad], half-range h_j [rad]); k_0 = 0: no task
-  double null_space_gain_per_s = 0.0;
-  std::vector<int> limited_q_index, limited_v_index;
-  Eigen::VectorXd null_space_target, half_range;
-  // MinimumNormSolver: the largest certified bound of cond(J W^-1/2)^2 it accepts, and the
-  // bound above which it refines once (pseudo_inverse.py: MAX_GRAM_CONDITION_BOUND capped by
-  // 1 / cutoff^2, REFINE_ABOVE_CONDITION_BOUND)
-  double max_condition_bound = 1e7;
-  double refine_above_condition_bound = 1e3;
-  double xi_clamp = 1.0 - 1e-6;         // _XI_CLAMP: where the funnel extension starts
-  double min_abs_cos_pitch = 1e-3;      // kinematics.EULER_SINGULARITY_MIN_ABS_COS_PITCH
+  // second level (nv each)
+  Eigen::VectorXd k_zeta, rho0_zeta, rho_inf_zeta, l_zeta_per_s;
+  double xi_clamp = 1.0 - 1e-6;  // _XI_CLAMP: where the funnel extension starts
 };
 
-class PrescribedPerformanceController {
+class PrescribedPerformanceController : public SampledLaw {
  public:
   PrescribedPerformanceController(pinocchio::Model model, PpcSettings settings);
   PrescribedPerformanceController(const PrescribedPerformanceController&) = delete;
   PrescribedPerformanceController& operator=(const PrescribedPerformanceController&) = delete;
 
-  int nq() const { return model_.nq; }
-  int nv() const { return model_.nv; }
+  int nq() const override { return task_.model().nq; }
+  int nv() const override { return task_.model().nv; }
 
   // One call of the law at time t [s] (the funnels' time) for the measured q (nq), v (nv),
   // wrench_world (6: force [N] then torque [N m], world axes), with f_d(t) (3) [N] and
@@ -84,39 +69,31 @@ class PrescribedPerformanceController {
                     const double* force_desired, Eigen::Index force_size,
                     const double* rpy_desired, Eigen::Index rpy_size, bool extended);
 
+  // The sampled loop's law (law.hpp): desired row [f_d (3); rpy_d (3)], compute() without
+  // the funnel extension; any status but ok declines.
+  int desired_size() const override { return 6; }
+  LawStatus command(const LawInput& in) override;
+  Eigen::Index tau_offset() const override { return zeta_offset(4); }
+
   // The last ok call's signals, packed in one buffer (see the offsets below): rpy_ee (3),
   // e_x, rho_x, xi_x, xdot_r (6 each), zeta_r, e_zeta, rho_zeta, xi_zeta, tau (nv each),
   // margin = 1 - max |xi| over both levels (1).
-  const Eigen::VectorXd& signals() const { return committed_; }
+  const Eigen::VectorXd& signals() const override { return committed_; }
   static constexpr Eigen::Index kRpyEe = 0, kEx = 3, kRhoX = 9, kXiX = 15, kXdotR = 21,
                                 kZetaR = 27;
-  Eigen::Index zeta_offset(int k) const { return kZetaR + k * model_.nv; }  // 0 zeta_r .. 4 tau
-  Eigen::Index margin_offset() const { return kZetaR + 5 * model_.nv; }
-  // Where each signal sits in signals(): (name, offset, size), in this order; the only place
-  // the layout is written (the Python controller reads its views from it).
-  struct SignalSlot {
-    const char* name;
-    Eigen::Index offset, size;
-  };
-  std::vector<SignalSlot> signal_layout() const;
+  Eigen::Index zeta_offset(int k) const { return kZetaR + k * nv(); }  // 0 zeta_r .. 4 tau
+  Eigen::Index margin_offset() const { return kZetaR + 5 * nv(); }
+  std::vector<SignalSlot> signal_layout() const override;
 
   // zeta_0 (nv) of the null-space task at q: the Python null_space_velocity (for tests).
-  const Eigen::VectorXd& null_space_velocity(const Eigen::VectorXd& q);
+  const Eigen::VectorXd& null_space_velocity(const Eigen::VectorXd& q) {
+    return task_.null_space_velocity(q);
+  }
 
  private:
-  // zeta_r into working_ from J^lwa_ and xdot_r; false if the solver declined.
-  bool reference_velocity(const Vec3& rpy_ee, const Vec6& xdot_r);
-  // MinimumNormSolver.solve: x (nv) = J^# rhs for J = J^lwa_; false = declined (use the SVD).
-  bool minimum_norm_solve(const Vec6& rhs, Eigen::Ref<Eigen::VectorXd> x);
-
-  pinocchio::Model model_;
-  pinocchio::Data data_;
+  ForceOrientationTask task_;
   PpcSettings s_;
-  Eigen::VectorXd inverse_weights_, null_space_scale_;  // 1 / w;  -k_0 / h_j
-  Eigen::VectorXd q_;                                   // q as Pinocchio's VectorXs
-  pinocchio::Data::Matrix6x jacobian_lwa_, weighted_, solved_;  // J^lwa, J W^-1, G^-1 J W^-1
-  Eigen::LLT<Mat6> cholesky_;
-  Eigen::VectorXd zeta_0_, working_, committed_;
+  Eigen::VectorXd working_, committed_;
 };
 
 }  // namespace uvms

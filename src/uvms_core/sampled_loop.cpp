@@ -42,7 +42,7 @@ LoopRow::LoopRow(int nq, int nv, int n_thrusters, int n_signals) {
   width = thrust + n_thrusters;
 }
 
-ChunkOutcome run_sampled_chunk(Plant& plant, PrescribedPerformanceController& law,
+ChunkOutcome run_sampled_chunk(Plant& plant, SampledLaw& law,
                                const Actuation& actuation, const LoopSettings& settings,
                                int first, int n_ticks, Eigen::Ref<Eigen::VectorXd> q,
                                Eigen::Ref<Eigen::VectorXd> v, const double* noise,
@@ -52,6 +52,7 @@ ChunkOutcome run_sampled_chunk(Plant& plant, PrescribedPerformanceController& la
   const int m = static_cast<int>(state.thrust.size());
   const LoopRow row(nq, nv, m, static_cast<int>(law.signals().size()));
   const int width = noise_width(nv);
+  const int desired_width = law.desired_size();
   Tick w(nq, nv, m);
   Eigen::VectorXd q_now = q, v_now = v;
   ChunkOutcome out;
@@ -74,16 +75,19 @@ ChunkOutcome run_sampled_chunk(Plant& plant, PrescribedPerformanceController& la
       q_in = w.q_meas.data();
       v_in = w.v_meas.data();
     }
-    // ---- command (ppc.hpp); anything but ok is the Python loop's tick
-    const double* d = desired + static_cast<std::ptrdiff_t>(i) * 6;
-    const PpcStatus status =
-        law.compute(time_s, q_in, nq, v_in, nv, w.wrench.data(), 6, d, 3, d + 3, 3, false);
-    if (status != PpcStatus::ok) {
+    // ---- command (law.hpp); anything but ok is the Python loop's tick
+    LawInput input;
+    input.time_s = time_s;
+    input.q = q_in;
+    input.v = v_in;
+    input.wrench_world = w.wrench.data();
+    input.desired = desired + static_cast<std::ptrdiff_t>(i) * desired_width;
+    if (law.command(input) != LawStatus::ok) {
       out.stopped = true;
       return out;
     }
     const Eigen::VectorXd& signals = law.signals();
-    w.tau_commanded = signals.segment(law.zeta_offset(4), nv);
+    w.tau_commanded = signals.segment(law.tau_offset(), nv);
     if (!w.tau_commanded.allFinite()) {
       out.stopped = true;
       return out;
@@ -133,6 +137,7 @@ ChunkOutcome run_sampled_chunk(Plant& plant, PrescribedPerformanceController& la
       }
     }
     // ---- commit
+    law.commit();
     state.command = w.command;
     state.thrust = w.thrust;
     state.dropped_max = w.dropped;

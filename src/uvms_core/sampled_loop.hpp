@@ -4,13 +4,15 @@
 //   measure:  lambda = contact(q, v); wrench_meas = lambda + n_w(t_k);
 //             q_meas = integrate(q, [0; n_o(t_k); n_j(t_k)]) with q_meas[:3] = q[:3] + n_p(t_k),
 //             v_meas = v + n_v(t_k)   (sensors.py, SensorSuite.measure)
-//   command:  tau_c = PPC(t_k, measurement, f_d(t_k), rpy_d(t_k))       (ppc.hpp)
+//   command:  tau_c = law(t_k, measurement, desired row k)   (law.hpp: the PPC, ppc.hpp; the
+//             force baselines, law_force_baselines.hpp)
 //   actuate:  f = clip(B_s^+ tau_c[s], -f_rev, f_fwd), tau_a = [B f; clip(tau_c,arm, +-limits)]
 //             (actuation.hpp: actuation.py, ThrustersAndJointLimits with ideal drives; or tau_a = tau_c)
 //   log:      every ticks_per_log-th tick, one packed row (see LoopRow)
 //   advance:  (q, v) over [t_k, t_k + T] with tau_a held                  (plant.hpp)
-// The noise samples n(t_k) and f_d, rpy_d come in as tables (drawn and evaluated by Python
-// from the run's recorded seed and the user's functions), so both loops use the same numbers.
+// The noise samples n(t_k) and the desired values (f_d(t_k), rpy_d(t_k) for the force laws)
+// come in as tables (drawn and evaluated by Python from the run's recorded seed and the
+// user's functions), so both loops use the same numbers.
 //
 // A tick is committed whole or not at all: when anything in it is not the ordinary case (the
 // law's status is not ok: a funnel left, the solver declining...; a non-finite tau; the plant's
@@ -22,7 +24,7 @@
 
 #include "actuation.hpp"
 #include "plant.hpp"
-#include "ppc.hpp"
+#include "law.hpp"
 
 namespace uvms {
 
@@ -59,9 +61,9 @@ struct ChunkOutcome {
 
 // Ticks first .. first + n_ticks - 1 (at most to settings.final_tick) from (q, v) at tick
 // `first`; q, v, the actuation's state and the law's signals are those after the last
-// committed tick. noise: n_ticks x noise_width(nv); desired: n_ticks x 6 [f_d (3); rpy_d (3)];
-// log: at least the logged ticks' rows, each LoopRow::width wide.
-ChunkOutcome run_sampled_chunk(Plant& plant, PrescribedPerformanceController& law,
+// committed tick (law.commit() after each). noise: n_ticks x noise_width(nv); desired:
+// n_ticks x law.desired_size(); log: at least the logged ticks' rows, each LoopRow::width wide.
+ChunkOutcome run_sampled_chunk(Plant& plant, SampledLaw& law,
                                const Actuation& actuation, const LoopSettings& settings,
                                int first, int n_ticks, Eigen::Ref<Eigen::VectorXd> q,
                                Eigen::Ref<Eigen::VectorXd> v, const double* noise,

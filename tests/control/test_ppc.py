@@ -354,14 +354,20 @@ def test_model_free_inertias_do_not_matter(q_bent, backend):
 
 
 def test_model_free_the_compiled_law_uses_only_frame_kinematics():
-    """The compiled law (src/uvms_core/ppc.cpp) includes one Pinocchio algorithm, the frame
-    Jacobian, and calls no other (the Python test below cannot patch C++ calls)."""
-    source = (ROOT / "src" / "uvms_core" / "ppc.cpp").read_text()
-    header = (ROOT / "src" / "uvms_core" / "ppc.hpp").read_text()
+    """The compiled law (src/uvms_core/ppc.cpp on the force task, law_force_task.cpp)
+    includes one Pinocchio algorithm, the frame Jacobian, and calls no other (the Python
+    test below cannot patch C++ calls); it includes none of the core's dynamics."""
+    core = ROOT / "src" / "uvms_core"
+    names = ("ppc", "law_force_task")
+    source = "".join((core / f"{name}.cpp").read_text() for name in names)
+    header = "".join((core / f"{name}.hpp").read_text() for name in names)
+    header += (core / "law.hpp").read_text()
     algorithms = re.findall(r"#include <pinocchio/algorithm/([\w-]+)\.hpp>", source + header)
     assert algorithms == ["frames"]
     calls = set(re.findall(r"pinocchio::(\w+)\(", source))
     assert calls == {"computeFrameJacobian"}, calls
+    local = set(re.findall(r'#include "([\w.]+)"', source + header))
+    assert local == {"ppc.hpp", "law.hpp", "law_force_task.hpp", "types.hpp"}, local
 
 
 def test_model_free_no_dynamics_algorithm_is_called(model, q_bent, monkeypatch):

@@ -215,6 +215,11 @@ class PrescribedPerformanceController(Controller):
         kernel = PpcKernel.build(backend_named(self.backend), self.model, self.kernel_settings())
         return None if isinstance(kernel, Fallback) else kernel
 
+    @property
+    def kernel(self) -> PpcKernel | None:
+        """The compiled law of this controller (None with the Python backend)."""
+        return self._kernel
+
     def kernel_settings(self) -> dict[str, object]:
         """The compiled law's settings (the fields of the core's PpcSettings, by name)."""
         params, zeta, pull = self.params, self.performance_zeta, self._pull

@@ -3,17 +3,18 @@
 `ClosedLoop` (`uvms_pin.sim.closed_loop`) runs its sampled loop here, a chunk of ticks per
 call of the core's ``run_sampled_chunk`` (src/uvms_core/sampled_loop.hpp), when every part of
 the loop has a compiled counterpart: the plant (`Plant`'s compiled plant, no world, no stop at
-the surface), a fixed-step integrator, the PPC law (its compiled kernel, the package's class
-itself), sensors without navigation, the actuation (`Unlimited`, or thrusters with their ideal
+the surface), a fixed-step integrator, the controller's law (the package's PPC and force
+baselines, their own classes: `uvms_pin.sim.compiled.laws`), sensors without navigation, the actuation (`Unlimited`, or thrusters with their ideal
 drives and the joints' effort limits), and observers that need only the log and the progress.
 Otherwise `CompiledLoop.build` says why not, and the loop runs in Python as always; the
 rollout's metadata ``closed_loop`` says which path ran and why.
 
 Everything random or user-written stays Python's and comes in as tables per chunk: the
 sensors' seeded noise at the ticks (`SensorSuite.noise_table`, the very numbers `measure`
-adds) and f_d(t), rpy_d(t). A tick the core does not finish as the ordinary case (the law's
-status not ok: a funnel left, the solver declining; a failed or diverged step) is not
-committed: the Python loop runs that tick (and raises as it does), then the chunks resume. So
+adds) and the law's desired values, f_d(t), rpy_d(t). A tick the core does not finish as the
+ordinary case (the law's status not ok: a funnel left, the solver declining; a failed or
+diverged step) is not committed: the Python loop runs that tick (and raises as it does), the
+law's state (an integral, an anchor) handed over, then the chunks resume. So
 both paths give the same rollout (to rounding: tests/sim/test_compiled_loop.py), a funnel
 violation stops at the same tick, and Ctrl-C, honoured between chunks, keeps the rows of the
 chunks done.
@@ -28,11 +29,10 @@ from typing import Any
 
 import numpy as np
 
-from uvms_pin.control.performance import transformed_error
-from uvms_pin.control.ppc import PrescribedPerformanceController
 from uvms_pin.physics.compiled.extension import core_module
 from uvms_pin.sim.compiled.actuation import actuation_to_core
 from uvms_pin.sim.compiled.integrator import integrator_to_core
+from uvms_pin.sim.compiled.laws import CoreLaw, law_to_core
 from uvms_pin.sim.log import RolloutLog
 from uvms_pin.sim.pipeline import Pipeline, RunParts, why_not_compiled
 from uvms_pin.sim.plant import Plant
@@ -44,26 +44,6 @@ from uvms_pin.sim.settings import SimulationSettings
 #: early (most of a study's) does not draw noise and f_d for ticks it never reaches.
 CHUNK_TICKS = 250
 FIRST_CHUNK_TICKS = 32
-
-#: The law's signals in the order the Python loop logs them (`PrescribedPerformanceController.
-#: signals`), each: where it comes from ("desired": the f_d / rpy_d table; "kernel": the
-#: kernel's buffer; "eps": the transformed error of a kernel signal).
-_PPC_SIGNALS = (
-    ("force_desired_world_N", "desired", slice(0, 3)),
-    ("rpy_desired", "desired", slice(3, 6)),
-    ("rpy_ee", "kernel", "rpy_ee"),
-    ("e_x", "kernel", "e_x"),
-    ("rho_x", "kernel", "rho_x"),
-    ("xi_x", "kernel", "xi_x"),
-    ("eps_x", "eps", "xi_x"),
-    ("xdot_r", "kernel", "xdot_r"),
-    ("zeta_r", "kernel", "zeta_r"),
-    ("e_zeta", "kernel", "e_zeta"),
-    ("rho_zeta", "kernel", "rho_zeta"),
-    ("xi_zeta", "kernel", "xi_zeta"),
-    ("eps_zeta", "eps", "xi_zeta"),
-    ("tau", "kernel", "tau"),
-)
 
 
 @dataclass
@@ -87,12 +67,10 @@ class LoopPath:
 class CompiledLoop:
     """One run's compiled sampled loop: its core objects, tables and log buffer."""
 
-    def __init__(self, core: ModuleType, loop, log: RolloutLog, actuation_core):
+    def __init__(self, core: ModuleType, loop, log: RolloutLog, law: CoreLaw, actuation_core):
         plant: Plant = loop.plant
         settings: SimulationSettings = loop.settings
-        self.core, self.loop, self.log = core, loop, log
-        self.controller: PrescribedPerformanceController = loop.controller
-        self.kernel = self.controller._kernel
+        self.core, self.loop, self.log, self.law = core, loop, log, law
         self.actuation_core = actuation_core
         self.settings = core.LoopSettings()
         self.settings.integrator = integrator_to_core(settings.integrator, core)
@@ -103,16 +81,13 @@ class CompiledLoop:
         uvms = plant.uvms
         self.nq, self.nv = uvms.nq, uvms.nv
         self.m = len(plant.actuation.thrusters) if actuation_core.thrusters else 0
-        n_signals = len(self.kernel.packed)
+        n_signals = len(law.law.signals())
         self.row = {
             name: slice(*span)
             for name, span in core.loop_row(self.nq, self.nv, self.m, n_signals).items()
         }
         width = self.row["thrust"].stop
         self.buffer = np.zeros((CHUNK_TICKS // self.settings.ticks_per_log + 1, width))
-        self.kernel_slices = {
-            n: slice(a, b) for n, (a, b) in self.kernel.kernel.signal_layout().items()
-        }
         self.progress = [o for o in loop.observers if isinstance(o, ProgressReport)]
         self.chunk_ticks = FIRST_CHUNK_TICKS
 
@@ -132,19 +107,19 @@ class CompiledLoop:
         if reason is not None:
             return None, reason
         core = core_module()
+        law = law_to_core(loop.controller, core)
         actuation = actuation_to_core(plant.actuation, core, plant.uvms.nv)
-        return cls(core, loop, log, actuation), None
+        return cls(core, loop, log, law, actuation), None
 
     # ---- one chunk ----------------------------------------------------------------------
     def _desired(self, times: Sequence[float]) -> np.ndarray:
-        """f_d, rpy_d at ``times`` (n x 6), up to the first time where one raises (the
-        Python loop's tick then raises it)."""
-        force, rpy = self.controller._desired_force, self.controller._desired_rpy
-        out = np.empty((len(times), 6))
+        """The law's desired rows at ``times`` (n x desired_size), up to the first time where
+        one raises (the Python loop's tick then raises it)."""
+        desired = self.law.desired
+        out = np.empty((len(times), self.law.desired_size))
         for i, t in enumerate(times):
             try:
-                out[i, :3] = force(t)
-                out[i, 3:] = rpy(t)
+                out[i] = desired(t)
             except Exception:
                 return out[:i]
         return out
@@ -168,8 +143,9 @@ class CompiledLoop:
             if self.actuation_core.thrusters
             else (np.zeros(0), np.zeros(0), np.zeros(0))
         )
+        self.law.push()  # the Python loop may have run ticks: its state is the law's
         done, rows, stopped = self.core.run_sampled_chunk(
-            loop.plant.compiled, self.kernel.kernel, self.actuation_core, settings, first, n,
+            loop.plant.compiled, self.law.law, self.actuation_core, settings, first, n,
             q, v, noise, desired, self.buffer, command, thrust, dropped,
         )  # fmt: skip
         if done:
@@ -187,8 +163,7 @@ class CompiledLoop:
             loop.time_s = (last + 1) * period
         else:
             loop.time_s = last * period
-        self.controller.adopt_kernel_call(last * period, desired[done - 1, :3].copy(),
-                                          desired[done - 1, 3:].copy())  # fmt: skip
+        self.law.pull(last * period, desired[done - 1])
         if rows:
             logged = [i for i in range(done) if (first + i) % self.settings.ticks_per_log == 0]
             self._log(self.buffer[:rows], desired[logged])
@@ -211,15 +186,11 @@ class CompiledLoop:
         rollout.wrench_contact_world[k] = block[:, row["contact"]]
         rollout.wrench_measured_world[k] = block[:, row["measured_wrench"]]
         rollout.wrench_disturbance_body[k] = block[:, row["disturbance"]]
-        signals = block[:, row["signals"]]
-        for name, source, where in _PPC_SIGNALS:
-            if source == "desired":
-                values = desired[:, where]
-            else:
-                values = signals[:, self.kernel_slices[where]]
-                if source == "eps":
-                    values = transformed_error(values)
+        for name, values in self.law.columns(block[:, row["signals"]], desired):
             rollout.signal(name, values.shape[1])[k] = values
+            signal = self.law.described.get(name)
+            if signal is not None and name not in log.described:
+                log._describe(name, signal)
         if self.m:
             rollout.signal("thruster_command", self.m)[k] = block[:, row["command"]]
             rollout.signal("thrust", self.m)[k] = block[:, row["thrust"]]

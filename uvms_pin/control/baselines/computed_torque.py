@@ -22,6 +22,7 @@ It does not know the current or the waves (h is evaluated in still water).
 from __future__ import annotations
 
 from collections.abc import Callable
+from dataclasses import dataclass, fields
 from typing import Any
 
 import numpy as np
@@ -34,10 +35,22 @@ from uvms_pin.control.measurement import Measurement
 from uvms_pin.model.uvms import UVMS
 from uvms_pin.physics.dynamics import bias_forces, mass_matrix
 
-__all__ = ["ComputedTorqueController", "MotionReference"]
+__all__ = ["ComputedTorqueController", "InnerLoopGains", "MotionReference"]
 
 #: t [s] -> (q_r (nq,), zeta_r (nv,), zeta_dot_r (nv,)).
 MotionReference = Callable[[float], tuple[np.ndarray, np.ndarray, np.ndarray]]
+
+
+@dataclass(frozen=True)
+class InnerLoopGains:
+    """The inner loop's gains: velocity_gain_per_s K_v (nv,) > 0 [1/s];
+    position_gain_per_s2 K_q (nv,) >= 0 [1/s^2] (motion task only). Scalars broadcast."""
+
+    velocity_gain_per_s: ArrayLike = 5.0
+    position_gain_per_s2: ArrayLike = 25.0
+
+
+_GAIN_NAMES = tuple(f.name for f in fields(InnerLoopGains))
 
 
 class ComputedTorqueController(Controller):
@@ -47,11 +60,10 @@ class ComputedTorqueController(Controller):
         uvms: the model the controller believes in (a private copy of its Pinocchio model
             is used: the plant's work buffers are never touched).
         ee_frame_name: end-effector frame (the force task and the contact Jacobian).
-        velocity_gain_per_s: K_v (nv,) > 0 [1/s].
-        position_gain_per_s2: K_q (nv,) >= 0 [1/s^2] (motion task only).
         reference: a `MotionReference` for a motion task; None = force/orientation task.
-        **force_task: the force task, keywords of `ForceTaskOptions` as for
-            `PIForceController` (kp_force_m_s_per_N, ki_force_m_s2_per_N,
+        **options: the inner loop's gains, keywords of `InnerLoopGains`
+            (velocity_gain_per_s, position_gain_per_s2), and the force task, keywords of
+            `ForceTaskOptions` as for `PIForceController` (kp_force_m_s_per_N, ki_force_m_s2_per_N,
             k_orientation_per_s, integral_limit_Ns, desired_force_world_N, desired_rpy,
             velocity_weights, null_space_gain_per_s, null_space_target).
     """
@@ -61,19 +73,18 @@ class ComputedTorqueController(Controller):
         uvms: UVMS,
         ee_frame_name: str,
         *,
-        velocity_gain_per_s: ArrayLike = 5.0,
-        position_gain_per_s2: ArrayLike = 25.0,
         reference: MotionReference | None = None,
-        **force_task: Any,
+        **options: Any,
     ):
-        options = ForceTaskOptions(**force_task)
+        gains = InnerLoopGains(**{k: options.pop(k) for k in _GAIN_NAMES if k in options})
+        force_task = ForceTaskOptions(**options)
         self.uvms = uvms.with_model(pin.Model(uvms.model))
-        self.task = options.task(self.uvms.model, ee_frame_name)
+        self.task = force_task.task(self.uvms.model, ee_frame_name)
         nv = self.task.nv
-        self.k_v = gain_vector("velocity_gain_per_s", velocity_gain_per_s, nv, positive=True)
-        self.k_q = gain_vector("position_gain_per_s2", position_gain_per_s2, nv)
+        self.k_v = gain_vector("velocity_gain_per_s", gains.velocity_gain_per_s, nv, positive=True)
+        self.k_q = gain_vector("position_gain_per_s2", gains.position_gain_per_s2, nv)
         self.reference = reference
-        self.loop = options.loop()
+        self.loop = force_task.loop()
         self._signals: dict[str, np.ndarray] = {}
 
     def reset(self) -> None:

@@ -66,29 +66,30 @@ class ImpedanceController(Controller):
         self.reset()
 
     def reset(self) -> None:
-        self._anchor_world_m: np.ndarray | None = None
-        self._posture_q: np.ndarray | None = None
+        #: p_a (3,) [m] and the q (nq,) whose arm part is held, taken at the first call
+        self.anchor_world_m: np.ndarray | None = None
+        self.posture_q: np.ndarray | None = None
         self._signals: dict[str, np.ndarray] = {}
 
     def compute(self, time_s: float, measurement: Measurement) -> np.ndarray:
         state = self.task.evaluate(time_s, measurement)
         position = self.task.data.oMf[self.task.ee_frame_id].translation.copy()
-        if self._anchor_world_m is None:
-            self._anchor_world_m = position
-            self._posture_q = np.array(state.q)  # the whole q: held by its arm part
+        if self.anchor_world_m is None:
+            self.anchor_world_m = position
+            self.posture_q = np.array(state.q)  # the whole q: held by its arm part
         twist = state.jacobian_lwa @ state.v  # [p_dot; omega] world axes
         rotation_desired = pin.rpy.rpyToMatrix(*state.rpy_desired)
         rotation_error = pin.log3(rotation_desired @ state.rotation.T)  # world axes [rad]
         wrench = np.r_[
             state.force_desired_world_N
-            + self.k_p * (self._anchor_world_m - position)
+            + self.k_p * (self.anchor_world_m - position)
             - self.d_p * twist[:3],
             self.k_o * rotation_error - self.d_o * twist[3:],
         ]
         tau = state.jacobian_lwa.T @ wrench - self.d_zeta * state.v
         # the arm's posture error on the joints' own manifold (a continuous joint's q is
         # (cos, sin)): pin.difference gives one angle or length per joint
-        posture_error = pin.difference(self.task.model, self._posture_q, state.q)[6:]
+        posture_error = pin.difference(self.task.model, self.posture_q, state.q)[6:]
         tau[6:] -= self.k_q * posture_error
         self._signals = {
             "force_desired_world_N": state.force_desired_world_N,

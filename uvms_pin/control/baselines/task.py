@@ -131,10 +131,14 @@ class EndEffectorTask:
             model, ee_frame_name, params, desired_force_world_N, desired_rpy
         )
         self.model, self.data, self.ee_frame_id = task.model, task.data, task.ee_frame_id
+        #: the sized parameters of J^# and of the null-space pull (`PPCParams.sized`)
+        self.params = task.params
         self.nv = self.model.nv
         self.velocity_names = task.velocity_names
-        self._desired_force, self._desired_rpy = task.desired_force, task.desired_rpy
-        self._reference = task.reference
+        #: f_d(t) (3,) [N] and rpy_d(t) (3,) [rad], checked functions of time
+        self.desired_force, self.desired_rpy = task.desired_force, task.desired_rpy
+        #: zeta_r of a task velocity (`ReferenceVelocity`: its J^# weights, solver, pull)
+        self.reference = task.reference
 
     def evaluate(self, time_s: float, measurement: Measurement) -> TaskState:
         """The task at ``measurement``: errors, rotation and J^lwa (checks the input).
@@ -144,8 +148,8 @@ class EndEffectorTask:
                 singularity (pitch = +-90 deg).
         """
         q, v, wrench = check_measurement(measurement, self.model.nq, self.nv)
-        force_desired = self._desired_force(float(time_s))
-        rpy_desired = self._desired_rpy(float(time_s))
+        force_desired = self.desired_force(float(time_s))
+        rpy_desired = self.desired_rpy(float(time_s))
         rotation, jacobian = frame_rotation_and_jacobian(self.model, self.data, q, self.ee_frame_id)
         rpy_ee = pin.rpy.matrixToRpy(rotation)
         check_euler_singularity(self.model, self.ee_frame_id, rpy_ee)
@@ -154,9 +158,7 @@ class EndEffectorTask:
 
     def reference_velocity(self, state: TaskState, xdot_r: np.ndarray) -> np.ndarray:
         """zeta_r (nv,) = J^# xdot_r + (I - J^# J) zeta_0 [m/s, rad/s], the PPC's eq. (9)."""
-        return self._reference(
-            state.q, state.rpy_ee, state.jacobian_lwa, [float(x) for x in xdot_r]
-        )
+        return self.reference(state.q, state.rpy_ee, state.jacobian_lwa, [float(x) for x in xdot_r])
 
     def world_rates(self, state: TaskState, euler_rates: np.ndarray) -> np.ndarray:
         """omega_world (3,) [rad/s] of Euler rates at the end-effector's attitude."""
@@ -191,15 +193,17 @@ class ForceOrientationLoop:
 
     def reset(self) -> None:
         self.integral_Ns = np.zeros(3)
-        self._last: tuple[float, np.ndarray] | None = None
+        #: (time [s], e_f (3,) [N]) of the latest call, the next rectangle's; None: no call yet
+        self.last_sample: tuple[float, np.ndarray] | None = None
 
     def velocity(self, time_s: float, error: np.ndarray) -> np.ndarray:
         """xdot_r (6,) [m/s (3); rad/s Euler rates (3)] for the task error e (6,)."""
-        if self._last is not None and time_s > self._last[0]:
-            step = (time_s - self._last[0]) * self._last[1]
+        last = self.last_sample
+        if last is not None and time_s > last[0]:
+            step = (time_s - last[0]) * last[1]
             self.integral_Ns = np.clip(self.integral_Ns + step, -self.limit, self.limit)
-        if self._last is None or time_s > self._last[0]:
-            self._last = (time_s, error[:3].copy())
+        if last is None or time_s > last[0]:
+            self.last_sample = (time_s, error[:3].copy())
         force_rate = -(self.kp * error[:3] + self.ki * self.integral_Ns)
         return np.r_[force_rate, -self.k_o * error[3:]]
 

@@ -18,8 +18,12 @@ It has no integral action: a current it does not model leaves a steady error.
 
 from __future__ import annotations
 
+from dataclasses import dataclass
+from typing import Any
+
 import numpy as np
 import pinocchio as pin
+from numpy.typing import ArrayLike
 
 from uvms_pin.control.base import Controller
 from uvms_pin.control.baselines.task import gain_vector
@@ -32,7 +36,12 @@ from uvms_pin.model.uvms import UVMS
 from uvms_pin.physics.dynamics import bias_forces, mass_matrix
 from uvms_pin.results.signal import Signal
 
-__all__ = ["ResolvedAccelerationController", "TaskPriorityController", "task_signals"]
+__all__ = [
+    "ResolvedAccelerationController",
+    "ResolvedAccelerationGains",
+    "TaskPriorityController",
+    "task_signals",
+]
 
 _XYZ = ("x", "y", "z")
 _ROT = ("rx", "ry", "rz")
@@ -83,26 +92,34 @@ class TaskPriorityController(Controller):
         return self._signals
 
 
+@dataclass(frozen=True)
+class ResolvedAccelerationGains:
+    """The gains of `ResolvedAccelerationController` (scalars broadcast).
+
+    Attributes:
+        position_gain_per_s2: K_p (6,) > 0 [1/s^2]. velocity_gain_per_s: K_d (6,) > 0 [1/s].
+        null_space_damping_per_s: K_n >= 0 [1/s]. velocity_weights: W (nv,) > 0 of J^#_W
+        (None: ones).
+    """
+
+    position_gain_per_s2: ArrayLike = 4.0
+    velocity_gain_per_s: ArrayLike = 4.0
+    null_space_damping_per_s: float = 2.0
+    velocity_weights: ArrayLike | None = None
+
+
 class ResolvedAccelerationController(Controller):
     """Computed torque in task space (module docstring).
 
     Args:
         uvms: the model believed in (a private copy). task: an end-effector task in the world
-            frame or a vehicle task. position_gain_per_s2: K_p [1/s^2].
-            velocity_gain_per_s: K_d [1/s]. null_space_damping_per_s: K_n [1/s].
-        velocity_weights: W (nv,) of J^#_W (None: ones).
+            frame or a vehicle task. **gains: keywords of `ResolvedAccelerationGains`
+            (position_gain_per_s2, velocity_gain_per_s, null_space_damping_per_s,
+            velocity_weights); an unknown one is a TypeError.
     """
 
-    def __init__(
-        self,
-        uvms: UVMS,
-        task: TrackingTask,
-        *,
-        position_gain_per_s2: float = 4.0,
-        velocity_gain_per_s: float = 4.0,
-        null_space_damping_per_s: float = 2.0,
-        velocity_weights=None,
-    ):
+    def __init__(self, uvms: UVMS, task: TrackingTask, **gains: Any):
+        options = ResolvedAccelerationGains(**gains)
         if task.target == "end_effector" and task.frame != "world":
             raise ParameterError(
                 "computed torque tracks end-effector tasks in the world frame only "
@@ -112,14 +129,18 @@ class ResolvedAccelerationController(Controller):
         self.model = self.uvms.model
         self.data = self.model.createData()
         self.task = task
-        self.k_p = gain_vector("position_gain_per_s2", position_gain_per_s2, 6, positive=True)
-        self.k_d = gain_vector("velocity_gain_per_s", velocity_gain_per_s, 6, positive=True)
-        self.k_n = float(gain_vector("null_space_damping_per_s", null_space_damping_per_s, 1)[0])
+        self.k_p = gain_vector(
+            "position_gain_per_s2", options.position_gain_per_s2, 6, positive=True
+        )
+        self.k_d = gain_vector("velocity_gain_per_s", options.velocity_gain_per_s, 6, positive=True)
+        damping = options.null_space_damping_per_s
+        self.k_n = float(gain_vector("null_space_damping_per_s", damping, 1)[0])
         nv = self.model.nv
+        weights = options.velocity_weights
         self.weights = (
             np.ones(nv)
-            if velocity_weights is None
-            else gain_vector("velocity_weights", velocity_weights, nv, positive=True)
+            if weights is None
+            else gain_vector("velocity_weights", weights, nv, positive=True)
         )
         self._frame_id = task.frame_id(self.model)
         self._signals: dict = {}

@@ -1,21 +1,268 @@
-"""The core's control laws of the package's controllers."""
+"""The compiled laws of the sampled closed loop (src/uvms_core/law.hpp), built from the
+package's controllers: the only place the core's law objects are built.
+
+`law_to_core` gives, for a controller, a `CoreLaw`: the core's law (its `law`, what
+``run_sampled_chunk`` calls at every tick) with what the loop does around it in Python: the
+tick's row of the desired table (the user's functions of time evaluated here, as the Python
+controller evaluates them), the law's state handed between the Python controller and the
+core (the Python loop runs the ticks the core declines), and the named signals of its
+packed buffer, in the order the Python controller logs them. Or a `Fallback` naming why the
+controller runs in Python: a user's own controller or a subclass (its `compute` is not the
+one the core mirrors), the controller's Python backend, a motion reference, the
+task-priority controller (not compiled yet).
+
+Each law reads the controller's public attributes only; the law mirrors the controller's
+`compute` line by line (tests/sim/test_compiled_laws.py: the whole rollout to 1e-12).
+"""
 
 from __future__ import annotations
 
+import dataclasses
+from collections.abc import Callable
 from types import ModuleType
-from typing import Any
 
-from uvms_pin.control.ppc import PrescribedPerformanceController
+import numpy as np
+
+from uvms_pin.control.base import Controller
+from uvms_pin.control.baselines.computed_torque import ComputedTorqueController
+from uvms_pin.control.baselines.impedance import ImpedanceController
+from uvms_pin.control.baselines.pi_force import PIForceController
+from uvms_pin.control.baselines.task import EndEffectorTask, ForceOrientationLoop
+from uvms_pin.control.performance import transformed_error
+from uvms_pin.control.ppc import PPCSignals, PrescribedPerformanceController
+from uvms_pin.control.pseudo_inverse import REFINE_ABOVE_CONDITION_BOUND
+from uvms_pin.control.tracking.controllers import ResolvedAccelerationController, task_signals
+from uvms_pin.control.tracking.task import TrackingTask
 from uvms_pin.physics.compiled.backend import Fallback
+from uvms_pin.physics.dynamics import dynamics_of
+from uvms_pin.physics.kinematics import EULER_SINGULARITY_MIN_ABS_COS_PITCH
+from uvms_pin.results.signal import Signal
 
-__all__ = ["law_to_core"]
+__all__ = ["CoreLaw", "law_to_core"]
 
 
-def law_to_core(controller: Any, core: ModuleType):
-    """The core's law of ``controller``, or the `Fallback` saying why it has none."""
-    if type(controller) is not PrescribedPerformanceController:
-        return Fallback(f"the controller {type(controller).__name__} is not compiled")
-    kernel = getattr(controller, "_kernel", None)
+class CoreLaw:
+    """A controller's compiled law and the Python around it (module docstring).
+
+    Attributes:
+        law: the core's law (a ``SampledLaw``). desired_size: entries of a desired row.
+        described: the signals the controller logs as a `Signal` (component names and
+            units), by name, for the rollout's metadata.
+    """
+
+    def __init__(
+        self,
+        controller: Controller,
+        law,
+        desired: Callable[[float], np.ndarray],
+        described: dict[str, Signal] | None = None,
+    ):
+        self.controller, self.law, self._desired = controller, law, desired
+        self.described = described or {}
+        self.desired_size = int(law.desired_size)
+        self.slices = {n: slice(a, b) for n, (a, b) in law.signal_layout().items()}
+
+    def desired(self, time_s: float) -> np.ndarray:
+        """The desired row at ``time_s`` (what the user's functions raise, raised)."""
+        return self._desired(time_s)
+
+    def push(self) -> None:
+        """The Python controller's state into the law (before a chunk: the Python loop may
+        have run ticks since the last one)."""
+
+    def pull(self, time_s: float, desired: np.ndarray) -> None:
+        """The law's state after a chunk into the Python controller; its last tick was at
+        ``time_s`` with the desired row ``desired``."""
+
+    def columns(self, signals: np.ndarray, desired: np.ndarray) -> list[tuple[str, np.ndarray]]:
+        """The controller's logged signals, in its order, of the logged rows' packed signals
+        and desired rows: every signal of the buffer but tau (logged as tau_commanded)."""
+        return [(n, signals[:, where]) for n, where in self.slices.items() if n != "tau"]
+
+
+def _task_desired(task) -> Callable[[float], np.ndarray]:
+    """[f_d(t) (3); rpy_d(t) (3)] of a force task (its checked functions of time)."""
+    force, rpy = task.desired_force, task.desired_rpy
+
+    def desired(time_s: float) -> np.ndarray:
+        return np.concatenate([force(time_s), rpy(time_s)])
+
+    return desired
+
+
+# ---- the PPC ---------------------------------------------------------------------------------
+#: The PPC's logged signals (`PPCSignals`, in order) that are the tick's desired values.
+_PPC_DESIRED = {"force_desired_world_N": slice(0, 3), "rpy_desired": slice(3, 6)}
+
+
+class _PpcLaw(CoreLaw):
+    """The PPC's kernel (stateless; its last call adopted by the controller)."""
+
+    def pull(self, time_s: float, desired: np.ndarray) -> None:
+        self.controller.adopt_kernel_call(time_s, desired[:3].copy(), desired[3:].copy())
+
+    def columns(self, signals: np.ndarray, desired: np.ndarray) -> list[tuple[str, np.ndarray]]:
+        """`PPCSignals`' fields: the desired values, the kernel's signals, and eps = the
+        transformed error of the kernel's xi of the same level."""
+        out = []
+        for field in dataclasses.fields(PPCSignals)[1:]:  # after time_s
+            name = field.name
+            if name in _PPC_DESIRED:
+                values = desired[:, _PPC_DESIRED[name]]
+            elif name.startswith("eps_"):
+                values = transformed_error(signals[:, self.slices["xi_" + name[4:]]])
+            else:
+                values = signals[:, self.slices[name]]
+            out.append((name, values))
+        return out
+
+
+def _ppc(controller: PrescribedPerformanceController, core: ModuleType) -> CoreLaw | Fallback:
+    kernel = controller.kernel
     if kernel is None:
-        return Fallback("the controller's Python backend")
-    return kernel.kernel
+        return Fallback("the controller's Python backend", asked=True)
+    return _PpcLaw(controller, kernel.kernel, _task_desired(controller.task))
+
+
+# ---- the force baselines -----------------------------------------------------------------
+def _task_settings(settings, task: EndEffectorTask):
+    """The force task's fields of the core's ``settings`` (ForceTaskSettings) from ``task``."""
+    reference, params = task.reference, task.params
+    pull = reference.pull
+    settings.ee_frame_id = task.ee_frame_id
+    settings.velocity_weights = params.velocity_weights
+    settings.null_space_gain_per_s = float(params.null_space_gain_per_s)
+    settings.limited_q_index = pull.limited_q_index.tolist()
+    settings.limited_v_index = pull.limited_v_index.tolist()
+    settings.null_space_target = np.asarray(pull.target, dtype=float)
+    settings.half_range = pull.half_range
+    settings.max_condition_bound = reference.solver.max_condition_bound
+    settings.refine_above_condition_bound = REFINE_ABOVE_CONDITION_BOUND
+    settings.min_abs_cos_pitch = EULER_SINGULARITY_MIN_ABS_COS_PITCH
+    return settings
+
+
+def _loop_gains(settings, loop: ForceOrientationLoop):
+    """ForceLoopGains' fields of the core's ``settings`` from the outer loop."""
+    settings.kp_force_m_s_per_N = loop.kp
+    settings.ki_force_m_s2_per_N = loop.ki
+    settings.k_orientation_per_s = loop.k_o
+    settings.integral_limit_Ns = loop.limit
+    return settings
+
+
+class _ForceLoopLaw(CoreLaw):
+    """A law with the PI outer loop's state (`ForceOrientationLoop`)."""
+
+    def push(self) -> None:
+        loop, state = self.controller.loop, self.law.state
+        state.integral_Ns = loop.integral_Ns
+        state.started = loop.last_sample is not None
+        if state.started:
+            state.last_time_s, state.last_force_error_N = loop.last_sample
+        self.law.state = state
+
+    def pull(self, time_s: float, desired: np.ndarray) -> None:
+        loop, state = self.controller.loop, self.law.state
+        loop.integral_Ns = np.array(state.integral_Ns)
+        loop.last_sample = (
+            (state.last_time_s, np.array(state.last_force_error_N)) if state.started else None
+        )
+
+
+class _ImpedanceLaw(CoreLaw):
+    """The impedance law, its anchor and posture its state."""
+
+    def push(self) -> None:
+        controller, state = self.controller, self.law.state
+        state.anchored = controller.anchor_world_m is not None
+        if state.anchored:
+            state.anchor_world_m = controller.anchor_world_m
+            state.posture_q = controller.posture_q
+        self.law.state = state
+
+    def pull(self, time_s: float, desired: np.ndarray) -> None:
+        state = self.law.state
+        if state.anchored:
+            self.controller.anchor_world_m = np.array(state.anchor_world_m)
+            self.controller.posture_q = np.array(state.posture_q)
+
+
+def _pi_force(controller: PIForceController, core: ModuleType) -> CoreLaw:
+    task = controller.task
+    settings = _loop_gains(_task_settings(core.PiForceSettings(), task), controller.loop)
+    settings.damping = controller.damping
+    law = core.PiForceLaw(task.model.saveToString(), settings)
+    return _ForceLoopLaw(controller, law, _task_desired(task))
+
+
+def _impedance(controller: ImpedanceController, core: ModuleType) -> CoreLaw:
+    task = controller.task
+    settings = _task_settings(core.ImpedanceSettings(), task)
+    settings.stiffness_N_m = controller.k_p
+    settings.damping_N_s_m = controller.d_p
+    settings.stiffness_Nm_rad = controller.k_o
+    settings.damping_Nm_s_rad = controller.d_o
+    settings.velocity_damping = controller.d_zeta
+    settings.posture_stiffness_Nm_rad = controller.k_q
+    law = core.ImpedanceLaw(task.model.saveToString(), settings)
+    return _ImpedanceLaw(controller, law, _task_desired(task))
+
+
+def _computed_torque(controller: ComputedTorqueController, core: ModuleType) -> CoreLaw | Fallback:
+    if controller.reference is not None:
+        return Fallback("a motion reference (the computed-torque law mirrors the force task)")
+    task = controller.task
+    settings = _loop_gains(_task_settings(core.ComputedTorqueSettings(), task), controller.loop)
+    settings.velocity_gain_per_s = controller.k_v
+    # the model the controller believes in: the dynamics its mass_matrix and bias_forces use
+    dynamics = dynamics_of(controller.uvms, "core").core
+    law = core.ComputedTorqueLaw(dynamics, settings)
+    return _ForceLoopLaw(controller, law, _task_desired(task))
+
+
+# ---- the tracking laws -------------------------------------------------------------------
+def _path_desired(task: TrackingTask) -> Callable[[float], np.ndarray]:
+    """[p_r (3) m; p_dot_r (3) m/s; p_ddot_r (3) m/s^2] of the task's path at t."""
+    path = task.path
+
+    def desired(time_s: float) -> np.ndarray:
+        return np.concatenate(path.at(time_s))
+
+    return desired
+
+
+def _resolved_acceleration(controller: ResolvedAccelerationController, core: ModuleType) -> CoreLaw:
+    task = controller.task
+    settings = core.ResolvedAccelerationSettings()
+    settings.vehicle_target = task.target == "vehicle"
+    settings.vehicle_frame = task.frame == "vehicle"
+    settings.frame_id = task.frame_id(controller.model)
+    settings.rotation_reference = np.asarray(task.rotation_reference, dtype=float)
+    settings.rows = task.rows.stop
+    settings.position_gain_per_s2 = controller.k_p
+    settings.velocity_gain_per_s = controller.k_d
+    settings.null_space_damping_per_s = controller.k_n
+    settings.velocity_weights = controller.weights
+    law = core.ResolvedAccelerationLaw(dynamics_of(controller.uvms, "core").core, settings)
+    described = task_signals(task, np.zeros(3), np.zeros(3))
+    return CoreLaw(controller, law, _path_desired(task), described)
+
+
+#: The controllers with a compiled law, by their exact class (a subclass may change
+#: `compute`: it runs in Python).
+_LAWS: dict[type, Callable[[Controller, ModuleType], CoreLaw | Fallback]] = {
+    PrescribedPerformanceController: _ppc,
+    PIForceController: _pi_force,
+    ImpedanceController: _impedance,
+    ComputedTorqueController: _computed_torque,
+    ResolvedAccelerationController: _resolved_acceleration,
+}
+
+
+def law_to_core(controller: Controller, core: ModuleType) -> CoreLaw | Fallback:
+    """The compiled law of ``controller`` in the core module ``core``, or why it has none."""
+    build = _LAWS.get(type(controller))
+    if build is None:
+        return Fallback(f"the controller {type(controller).__name__} is not compiled")
+    return build(controller, core)

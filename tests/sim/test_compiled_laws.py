@@ -1,0 +1,164 @@
+"""The compiled laws of the force baselines (src/uvms_core/law_force_baselines.hpp) and of
+resolved acceleration (law_tracking.hpp), built by uvms_pin/sim/compiled/laws.py, in the
+compiled sampled loop against their Python controllers in the Python loop: the whole
+rollout to 1e-12, the same stop, the law's state handed over when the core declines a tick."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from conftest import ROOT
+from test_compiled_loop import PAPER, PAPER_SAMPLED, REALISTIC, _assert_same
+
+from uvms_pin.apps.compare.runs import controller_scenarios
+from uvms_pin.control.baselines.computed_torque import ComputedTorqueController
+from uvms_pin.control.baselines.pi_force import PIForceController
+from uvms_pin.control.ppc import PrescribedPerformanceController
+from uvms_pin.control.pseudo_inverse import MinimumNormSolver
+from uvms_pin.errors import ControllerError, SimulationError
+from uvms_pin.physics.compiled.backend import Fallback
+from uvms_pin.physics.compiled.extension import core_module
+from uvms_pin.sim.compiled.laws import law_to_core
+from uvms_pin.sim.run import simulate
+
+BASELINES = ("pi_force", "impedance", "computed_torque")
+#: the paper's scenario sampled at 500 Hz with RK4 (its own is continuous-time)
+PAPER_BASELINE = {k: v for k, v in PAPER_SAMPLED.items() if k != "controller.k_zeta"}
+
+
+def _scenario(path, kind, overrides):
+    return controller_scenarios(path, [kind], {"scenario.duration_s": 1.0, **overrides})[kind]
+
+
+def _both(scenario, **kwargs):
+    """((rollout, the error that stopped it or None) compiled, the same in Python)."""
+    out = []
+    for compiled in (True, False):
+        try:
+            out.append((simulate(scenario, progress=False, compiled_loop=compiled, **kwargs), None))
+        except SimulationError as exc:
+            out.append((exc.rollout, exc))
+    return out
+
+
+@pytest.mark.parametrize("kind", BASELINES)
+@pytest.mark.parametrize(
+    "path, overrides",
+    [(REALISTIC, {}), (PAPER, PAPER_BASELINE)],
+    ids=["realistic", "paper-sampled"],
+)
+def test_each_baseline_runs_compiled_as_in_python(kind, path, overrides):
+    scenario = _scenario(path, kind, overrides)
+    (compiled, stop_c), (python, stop_p) = _both(scenario)
+    ticks = round(scenario.settings.duration_s / scenario.settings.control_period_s) + 1
+    meta = compiled.metadata["closed_loop"]
+    if stop_p is None:
+        assert stop_c is None
+        assert meta == {"path": "compiled", "reason": None, "compiled_ticks": ticks,
+                        "python_ticks": 0}  # fmt: skip
+        assert python.metadata["closed_loop"]["python_ticks"] == ticks
+    else:  # the paper's unlimited vehicle with a default-tuned baseline at 500 Hz blows up
+        assert str(stop_c) == str(stop_p) and "diverged" in str(stop_p)
+        python_ticks = python.metadata["closed_loop"]["python_ticks"]
+        assert meta == {"path": "compiled", "reason": None,
+                        "compiled_ticks": python_ticks - 1, "python_ticks": 1}  # fmt: skip
+    _assert_same(compiled, python)
+    assert np.max(np.abs(compiled.v)) > 1e-2  # the run did something
+    assert np.max(np.abs(compiled.signals["e_x"][:, :3])) > 1e-2
+
+
+@pytest.mark.parametrize("kind", BASELINES)
+def test_a_declined_tick_raises_in_python_as_in_the_python_loop(kind):
+    # the tool's pitch q2 + q3 = pi/2 - 1e-5: the Euler singularity, where the task raises
+    singular = {"initial.joint_positions_rad": [-0.2, 1.0, 0.5707863, 0.2]}
+    (_, compiled), (_, python) = _both(_scenario(REALISTIC, kind, singular))
+    assert isinstance(compiled, ControllerError) and isinstance(python, ControllerError)
+    assert str(compiled) == str(python) and "singular" in str(compiled).lower()
+    meta = compiled.rollout.metadata["closed_loop"]
+    assert meta["reason"] is None and meta["python_ticks"] == 1
+    assert meta["compiled_ticks"] == 0
+
+
+@pytest.mark.parametrize("kind", ["pi_force", "computed_torque"])
+def test_ticks_the_solver_declines_hand_the_integral_over(kind):
+    # a solver that accepts only the better-conditioned half of the run's Jacobians: the
+    # other ticks take the exact SVD route in Python, the integral handed back and forth
+    scenario = _scenario(REALISTIC, kind, {"scenario.duration_s": 0.6})
+    controller = scenario.controller_factory(scenario.uvms)
+    reference = controller.task.reference
+    bound = _median_condition_bound(scenario, reference.weights)
+    # the solver's largest certified bound is 1 / cutoff^2 (its cutoff is not the SVD's)
+    reference.solver = MinimumNormSolver(reference.weights, float(np.sqrt(1.0 / bound)))
+    compiled = simulate(scenario, progress=False, controller=controller, compiled_loop=True)
+    python = simulate(scenario, progress=False, controller=controller, compiled_loop=False)
+    meta = compiled.metadata["closed_loop"]
+    assert meta["compiled_ticks"] > 20 and meta["python_ticks"] > 20
+    _assert_same(compiled, python)
+    assert np.max(np.abs(compiled.signals["e_x"][:, :3])) > 1e-2
+
+
+def _median_condition_bound(scenario, weights) -> float:
+    """The median over a Python run's logged states of the solver's certified bound
+    tr G tr G^-1, G = J W^-1 J^T."""
+    rollout = simulate(scenario, progress=False, compiled_loop=False)
+    task = scenario.controller_factory(scenario.uvms).task
+    inverse_weights = 1.0 if weights is None else 1.0 / np.asarray(weights)
+    bounds = []
+    for q in rollout.q:
+        jacobian = task.evaluate(0.0, _Measured(q, rollout.v[0])).jacobian_lwa
+        gram = (jacobian * inverse_weights) @ jacobian.T
+        bounds.append(np.trace(gram) * np.trace(np.linalg.inv(gram)))
+    return float(np.median(bounds))
+
+
+class _Measured:
+    def __init__(self, q, v):
+        self.q, self.v, self.wrench_world = q, v, np.zeros(6)
+
+
+def test_law_to_core_says_why_a_controller_has_no_law():
+    core = core_module()
+    scenario = _scenario(REALISTIC, "computed_torque", {})
+    controller = scenario.controller_factory(scenario.uvms)
+    assert not isinstance(law_to_core(controller, core), Fallback)
+    model, task = scenario.uvms.model, controller.task
+    ee = task.model.frames[task.ee_frame_id].name
+
+    class Mine(PIForceController):
+        pass
+
+    mine = law_to_core(Mine(model, ee), core)
+    assert isinstance(mine, Fallback) and "Mine is not compiled" in mine.reason
+    python = PrescribedPerformanceController(model, ee, backend="python")
+    assert law_to_core(python, core).reason == "the controller's Python backend"
+    motion = ComputedTorqueController(scenario.uvms, ee, reference=lambda t: (None, None, None))
+    assert "motion reference" in law_to_core(motion, core).reason
+    path = ROOT / "scenarios" / "lbv150_ee_circle.toml"
+    tracking = controller_scenarios(path, ["task_priority"])["task_priority"]
+    priority = law_to_core(tracking.controller_factory(tracking.uvms), core)
+    assert "TaskPriorityController is not compiled" in priority.reason
+
+
+@pytest.mark.parametrize(
+    "stem, overrides",
+    [
+        ("lbv150_ee_circle", {}),
+        ("lbv150_ee_circle", {"water.current_world_m_s": [0.1, 0.0, 0.0]}),
+        ("bluerov_alpha5_ee_circle", {}),
+    ],
+    ids=["lbv150", "lbv150-current", "bluerov-alpha5"],
+)
+def test_resolved_acceleration_runs_compiled_as_in_python(stem, overrides):
+    path = ROOT / "scenarios" / f"{stem}.toml"
+    scenario = controller_scenarios(
+        path, ["computed_torque_task"], {"scenario.duration_s": 3.0, **overrides}
+    )["computed_torque_task"]
+    (compiled, stop_c), (python, stop_p) = _both(scenario)
+    assert stop_c is None and stop_p is None
+    ticks = round(scenario.settings.duration_s / scenario.settings.control_period_s) + 1
+    assert compiled.metadata["closed_loop"] == {
+        "path": "compiled", "reason": None, "compiled_ticks": ticks, "python_ticks": 0}  # fmt: skip
+    _assert_same(compiled, python)
+    assert compiled.metadata["signal_units"]["task_position_error"] == python.metadata[
+        "signal_units"]["task_position_error"]  # fmt: skip
+    assert np.max(np.abs(compiled.signals["task_position_error"])) > 1e-4
