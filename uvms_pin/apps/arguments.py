@@ -12,6 +12,7 @@ from __future__ import annotations
 import argparse
 import math
 import os
+import sys
 from collections.abc import Callable
 
 from uvms_pin.errors import ParameterError
@@ -77,6 +78,14 @@ def nonempty(what: str) -> Callable[[str], str]:
 
 #: a file or directory given on the command line
 path_text = nonempty("a path")
+
+
+def progress_printer(quiet: bool) -> Callable[[str], None] | None:
+    """What a command reports its progress with: None when ``quiet``, else a function that
+    prints each line to stderr at once (the results go to stdout)."""
+    if quiet:
+        return None
+    return lambda line: print(line, file=sys.stderr, flush=True)
 
 
 def add_set_option(parser: argparse.ArgumentParser, help_text: str) -> None:

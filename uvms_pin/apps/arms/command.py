@@ -18,6 +18,7 @@ from uvms_pin.apps.arguments import (
     finite,
     positive,
     process_count,
+    progress_printer,
 )
 from uvms_pin.apps.exit_codes import EXIT_BAD_INPUT, EXIT_RUN_STOPPED
 from uvms_pin.model.mount.catalog import available_arms
@@ -48,7 +49,7 @@ def _cmd_compare_arms(args: argparse.Namespace) -> int:
         overrides=tuple(parse_assignment(text) for text in args.set),
     )
     out = check_writable(args.out)
-    say = None if args.quiet else (lambda line: print(line, file=sys.stderr, flush=True))
+    say = progress_printer(args.quiet)
     with claim(out, COMPARISON, overwrite=args.overwrite):
         rows = compare_arms(args.scenario, arms, out, settings, jobs=args.jobs, progress=say)
     width = max(len(r["arm"]) for r in rows)

@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import argparse
-import sys
 from pathlib import Path
 
 from uvms_pin.apps.arguments import (
@@ -12,6 +11,7 @@ from uvms_pin.apps.arguments import (
     comma_names,
     positive,
     process_count,
+    progress_printer,
 )
 from uvms_pin.errors import ParameterError
 from uvms_pin.results.outdir import CONTROLLER_COMPARISON, check_writable, claim
@@ -109,7 +109,7 @@ def _compare(args: argparse.Namespace, scenarios, criteria, out: Path, table, ex
     from uvms_pin.apps.compare.table import write_table
 
     with claim(out, CONTROLLER_COMPARISON, overwrite=args.overwrite):
-        say = None if args.quiet else (lambda line: print(line, file=sys.stderr, flush=True))
+        say = progress_printer(args.quiet)
         rows, rollouts = compare_controllers(scenarios, criteria, say)
         written = write_table(rows, out, *table)
         written += extras(rows, rollouts, say)

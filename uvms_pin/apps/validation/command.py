@@ -8,9 +8,15 @@ from __future__ import annotations
 
 import argparse
 import math
-import sys
 
-from uvms_pin.apps.arguments import comma_names, finite, nonempty, path_text, positive
+from uvms_pin.apps.arguments import (
+    comma_names,
+    finite,
+    nonempty,
+    path_text,
+    positive,
+    progress_printer,
+)
 from uvms_pin.apps.validation.identify_arguments import add_identify_arguments
 from uvms_pin.results.outdir import check_writable
 
@@ -26,7 +32,7 @@ def _cmd_validate_pool(args: argparse.Namespace) -> int:
         trial_names=names,
         step_s=args.step,
         figures=not args.no_figures,
-        progress=None if args.quiet else lambda line: print(line, file=sys.stderr, flush=True),
+        progress=progress_printer(args.quiet),
         vehicle_urdf=args.vehicle,
         arm_delay_s=args.arm_delay,
         imu_yaw_rad=math.radians(args.imu_yaw),

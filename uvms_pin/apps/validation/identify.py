@@ -37,7 +37,7 @@ import numpy as np
 from scipy.optimize import least_squares
 from scipy.spatial.transform import Rotation
 
-from uvms_pin.apps.arguments import comma_names
+from uvms_pin.apps.arguments import comma_names, progress_printer
 from uvms_pin.apps.validation.identification import (
     DEFAULT_FIT,
     IDENTIFIED_VEHICLE,
@@ -250,7 +250,7 @@ def run(args: argparse.Namespace) -> int:
         step_s=args.step,
         max_iterations=args.max_iterations,
         figures=not args.no_figures,
-        progress=None if args.quiet else lambda line: print(line, file=sys.stderr, flush=True),
+        progress=progress_printer(args.quiet),
         training=training_trials(args),
     )
     _print_fit(result)
