@@ -9,13 +9,12 @@ the Python reference evaluates that call.
 
 from __future__ import annotations
 
-from types import ModuleType
-
 import numpy as np
 import pinocchio as pin
 
 from uvms_pin.control.pseudo_inverse import REFINE_ABOVE_CONDITION_BOUND
 from uvms_pin.physics.compiled.backend import Backend, Fallback
+from uvms_pin.physics.compiled.ppc import ppc_to_core
 from uvms_pin.physics.kinematics import EULER_SINGULARITY_MIN_ABS_COS_PITCH
 
 #: The signals of a call, in the order the Python law keeps them (`PPCSignals`).
@@ -27,8 +26,8 @@ class PpcKernel:
     """One compiled law with its constants, and read-only views of its last ok call's
     signals by name (``views["tau"]``, ..., ``views["margin"]``: 1 - max |xi|)."""
 
-    def __init__(self, core: ModuleType, model: pin.Model, settings):
-        self.kernel = core.PrescribedPerformanceController(model.saveToString(), settings)
+    def __init__(self, kernel):
+        self.kernel = kernel  # the core's law (`uvms_pin.physics.compiled.ppc`)
         #: every signal of the last ok call in one read-only buffer (the views are slices)
         self.packed = packed = self.kernel.signals()
         self.views = {
@@ -44,16 +43,13 @@ class PpcKernel:
     ) -> PpcKernel | Fallback:
         """The kernel of ``model`` with ``settings`` (the fields of the core's PpcSettings,
         by name), or the backend's Fallback (the Python reference was asked for)."""
-
-        def build(core: ModuleType) -> PpcKernel:
-            compiled = core.PpcSettings()
-            for name, value in settings.items():
-                setattr(compiled, name, value)
-            compiled.refine_above_condition_bound = REFINE_ABOVE_CONDITION_BOUND
-            compiled.min_abs_cos_pitch = EULER_SINGULARITY_MIN_ABS_COS_PITCH
-            return cls(core, model, compiled)
-
-        return backend.counterpart(build)
+        constants = {
+            "refine_above_condition_bound": REFINE_ABOVE_CONDITION_BOUND,
+            "min_abs_cos_pitch": EULER_SINGULARITY_MIN_ABS_COS_PITCH,
+        }
+        return backend.counterpart(
+            lambda core: cls(ppc_to_core(core, model, {**settings, **constants}))
+        )
 
     def copies(self) -> tuple[np.ndarray, ...]:
         """Copies of the last ok call's signals, in the order of `SIGNALS`."""

@@ -31,8 +31,8 @@ import numpy as np
 
 from uvms_pin.physics.compiled.extension import core_module
 from uvms_pin.sim.compiled.actuation import actuation_to_core
-from uvms_pin.sim.compiled.integrator import integrator_to_core
 from uvms_pin.sim.compiled.laws import CoreLaw, law_to_core
+from uvms_pin.sim.compiled.loop_settings import loop_settings_to_core
 from uvms_pin.sim.log import RolloutLog
 from uvms_pin.sim.pipeline import Pipeline, RunParts, why_not_compiled
 from uvms_pin.sim.plant import Plant
@@ -72,12 +72,7 @@ class CompiledLoop:
         settings: SimulationSettings = loop.settings
         self.core, self.loop, self.log, self.law = core, loop, log, law
         self.actuation_core = actuation_core
-        self.settings = core.LoopSettings()
-        self.settings.integrator = integrator_to_core(settings.integrator, core)
-        self.settings.period_s = float(settings.control_period_s)
-        self.settings.ticks_per_log = int(settings.ticks_per_log)
-        self.settings.final_tick = (settings.n_log - 1) * settings.ticks_per_log
-        self.settings.state_noisy = loop.sensors.state_noisy
+        self.settings = loop_settings_to_core(core, settings, loop.sensors.state_noisy)
         uvms = plant.uvms
         self.nq, self.nv = uvms.nq, uvms.nv
         self.m = len(plant.actuation.thrusters) if actuation_core.thrusters else 0
@@ -176,7 +171,7 @@ class CompiledLoop:
         log, row = self.log, self.row
         rows = len(block)
         while log.count + rows > len(log.rollout):
-            log._grow()
+            log.grow()
         rollout, k = log.rollout, slice(log.count, log.count + rows)
         rollout.time_s[k] = block[:, 0]
         rollout.q[k] = block[:, row["q"]]
@@ -190,7 +185,7 @@ class CompiledLoop:
             rollout.signal(name, values.shape[1])[k] = values
             signal = self.law.described.get(name)
             if signal is not None and name not in log.described:
-                log._describe(name, signal)
+                log.describe(name, signal)
         if self.m:
             rollout.signal("thruster_command", self.m)[k] = block[:, row["command"]]
             rollout.signal("thrust", self.m)[k] = block[:, row["thrust"]]

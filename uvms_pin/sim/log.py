@@ -80,7 +80,7 @@ class RolloutLog:
 
     def on_sample(self, sample: Sample) -> None:
         if self.count == len(self.rollout):
-            self._grow()
+            self.grow()
         k, rollout = self.count, self.rollout
         rollout.time_s[k] = sample.time_s
         rollout.q[k] = sample.q
@@ -93,19 +93,20 @@ class RolloutLog:
         for name, values in sample.signals.items():
             if isinstance(values, Signal):
                 if name not in self.described:
-                    self._describe(name, values)
+                    self.describe(name, values)
                 values = values.values
             rollout.signal(name, values.size)[k] = values
         self.count += 1
 
-    def _describe(self, name: str, signal: Signal) -> None:
+    def describe(self, name: str, signal: Signal) -> None:
         """Keep a named signal's component names and units in the metadata
         (``signal_units``: name -> {"components": [...], "units": [...]})."""
         described = self.rollout.metadata.setdefault("signal_units", {})
         described[name] = signal.describe()
         self.described.add(name)
 
-    def _grow(self) -> None:
+    def grow(self) -> None:
+        """Twice the rows (the samples written kept): for a log whose length is not known."""
         old, n = self.rollout, len(self.rollout)
         grown = Rollout.allocate(2 * n, self.uvms.nq, self.uvms.nv, old.metadata)
         for name in Rollout._BASE:
