@@ -11,6 +11,7 @@ sees), no module over 500 lines and no function over 80 (docstrings aside).
 from __future__ import annotations
 
 import ast
+import re
 import subprocess
 import sys
 from pathlib import Path
@@ -226,3 +227,28 @@ def test_the_command_line_answers_without_loading_the_stack():
     result = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
     assert result.returncode == 0, result.stderr
     assert result.stdout.strip() == "", f"--help loads {result.stdout.strip()}"
+
+
+#: The compiled seam: the only folders whose modules build the core's objects
+SEAM = ("physics/compiled/", "sim/compiled/")
+CORE_OBJECT = re.compile(r"\bcore\.[A-Z]\w*\(")
+
+
+def test_core_objects_are_built_only_in_the_compiled_seam():
+    """A core object (``core.Plant(...)``, ``core.LoopSettings()``, ...) is built in
+    `physics/compiled/` or `sim/compiled/` only, from its Python counterpart's public
+    attributes; everywhere else holds what the seam built."""
+    outside = [
+        f"{path.relative_to(PACKAGE)}:{k + 1}"
+        for path in _modules()
+        if not str(path.relative_to(PACKAGE)).startswith(SEAM)
+        for k, line in enumerate(path.read_text().splitlines())
+        if CORE_OBJECT.search(line)
+    ]
+    assert outside == []
+
+
+def test_the_seam_check_sees_a_core_object_built_elsewhere():
+    assert CORE_OBJECT.search("        out = core.Plant(dynamics, 0)")
+    assert CORE_OBJECT.search("settings = core.LoopSettings()")
+    assert not CORE_OBJECT.search("core.run_sampled_chunk(plant, law)")
