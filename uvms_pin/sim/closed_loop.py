@@ -16,7 +16,6 @@ change the simulation.
 
 from __future__ import annotations
 
-import dataclasses
 import math
 import time
 import warnings
@@ -53,24 +52,6 @@ _EVENT_OVERSHOOT = 1e-6
 _NO_SIGNALS: dict[str, np.ndarray] = {}
 
 
-class _RobotPart:
-    """The robot's part of a loop's state: ``q`` (nq,) or ``v`` (nv,), read-only; assigning
-    it replaces that part of the system's state."""
-
-    def __init__(self, field: str):
-        self.field, self.slices = field, f"{field}_slices"
-
-    def __get__(self, loop: ClosedLoop | None, owner: type | None = None):
-        if loop is None:
-            return self
-        return getattr(loop.state, self.field)[getattr(loop.system.layout, self.slices)[0]]
-
-    def __set__(self, loop: ClosedLoop, value: np.ndarray) -> None:
-        whole = np.array(getattr(loop.state, self.field))
-        whole[getattr(loop.system.layout, self.slices)[0]] = value
-        loop.state = dataclasses.replace(loop.state, **{self.field: read_only(whole)})
-
-
 class ClosedLoop:
     """A plant, its sensors and (optionally) a controller, stepped and observed.
 
@@ -84,8 +65,24 @@ class ClosedLoop:
     (nq,), ``v`` (nv,), the robot's part of it; read-only arrays.
     """
 
-    q = _RobotPart("q")
-    v = _RobotPart("v")
+    @property
+    def state(self) -> SystemState:
+        return self._state
+
+    @state.setter
+    def state(self, state: SystemState) -> None:
+        self._state = state
+        self._robot = self.system.robot_state(state.q, state.v)
+
+    @property
+    def q(self) -> np.ndarray:
+        """The robot's configuration (nq,), a read-only view of the state."""
+        return self._robot[0]
+
+    @property
+    def v(self) -> np.ndarray:
+        """The robot's generalized velocity (nv,), a read-only view of the state."""
+        return self._robot[1]
 
     def __init__(
         self,
@@ -141,15 +138,17 @@ class ClosedLoop:
 
         Raises SimulationError when a body reached the free surface and the plant stops
         there (``stop_at_surface``)."""
-        self.plant.check_submerged(self.time_s, self.q)
-        contact = self.plant.contact_wrench(self.q, self.v)
-        return self.sensors.measure(self.time_s, self.q, self.v, contact), contact
+        q, v = self._robot
+        self.plant.check_submerged(self.time_s, q)
+        contact = self.plant.contact_wrench(q, v)
+        return self.sensors.measure(self.time_s, q, v, contact), contact
 
     def observe(self) -> tuple[Measurement, np.ndarray]:
         """`measure`, then, once per control tick, the navigation sensors and the estimator
         (`SensorSuite.navigate`): (what the controller is given, the true contact wrench)."""
         measurement, contact = self.measure()
-        return self.sensors.navigate(self.time_s, self.q, self.v, measurement), contact
+        q, v = self._robot
+        return self.sensors.navigate(self.time_s, q, v, measurement), contact
 
     def command(self, measurement: Measurement) -> np.ndarray:
         """The controller's tau (nv,) for ``measurement`` (SimulationError if it is not nv

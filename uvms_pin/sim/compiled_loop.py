@@ -38,6 +38,7 @@ from uvms_pin.sim.pipeline import Pipeline, RunParts, why_not_compiled
 from uvms_pin.sim.plant import Plant
 from uvms_pin.sim.sample import ProgressReport
 from uvms_pin.sim.settings import SimulationSettings
+from uvms_pin.sim.system import SystemState
 
 #: Ticks per call at most: a 500 Hz loop returns to Python (Ctrl-C, progress) every 0.5 s
 #: simulated. A run starts with `FIRST_CHUNK_TICKS`, doubled at every call: a run that stops
@@ -153,7 +154,7 @@ class CompiledLoop:
         last = first + done - 1
         q.setflags(write=False)
         v.setflags(write=False)
-        loop.q, loop.v = q, v
+        loop.state = SystemState(q, v)  # the compiled loop runs the robot alone
         if last < self.settings.final_tick:
             loop.time_s = (last + 1) * period
         else:

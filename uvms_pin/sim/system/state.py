@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import NamedTuple
 
 import numpy as np
 
@@ -51,12 +52,11 @@ class Layout:
         )
 
 
-@dataclass(frozen=True)
-class SystemState:
+class SystemState(NamedTuple):
     """q (nq,) and v (nv,) of every body of a system, stacked as its `Layout` says: the
     robot's configuration and generalized velocity (free-flyer: position [m], quaternion
     (x, y, z, w); body velocity [m/s, rad/s]; joints [rad, rad/s]) first, then each free
-    object's pose (7,) and body velocity (6,)."""
+    object's pose (7,) and body velocity (6,). (A tuple: made once a control period.)"""
 
     q: np.ndarray
     v: np.ndarray

@@ -78,7 +78,10 @@ class System:
         return self.layout.join([(q0, v0), *states])
 
     def robot_state(self, q: np.ndarray, v: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """The robot's (q, v) in the system's (q, v) (views)."""
+        """The robot's (q, v) in the system's (q, v) (views; the arrays themselves when the
+        robot moves alone)."""
+        if not self.objects:
+            return q, v
         return q[self.layout.q_slices[0]], v[self.layout.v_slices[0]]
 
     def start(self, state: SystemState) -> None:
