@@ -131,3 +131,8 @@ def test_self_collision_is_a_contact_key():
     # the arm's links beyond the first against the vehicle's shapes
     assert any(n.startswith("alpha_wrist_link") and "|base_link" in n for n in names)
     assert not any(n.startswith("alpha_shoulder_link") for n in names if "|base_link" in n)
+
+
+def test_implicit_joint_limits_need_a_sampled_controller():
+    with pytest.raises(ScenarioError, match=r"joints: stops = \"implicit\".*\[control\] period_s"):
+        load_scenario(SCENARIOS / "paper_force_tracking.toml", {"joints.stops": "implicit"})

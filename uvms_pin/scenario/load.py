@@ -130,6 +130,11 @@ def _build(raw: dict[str, Any], path: Path, top: Table) -> Scenario:
     integrator, backend = build_integrator(top.table_or_empty("integrator"))
     control_period = build_control_period(top.table_or_empty("control"))
     log_period = build_log_period(top.table_or_empty("output"))
+    if control_period is None and joint_limits is not None:
+        raise top.error(
+            "joints",
+            'stops = "implicit" solves the limits once a control period: set [control] period_s',
+        )
     if control_period is None and sensor_config.navigation.fitted:
         raise top.error(
             "sensors", "navigation sensors sample at the control ticks: set [control] period_s"
