@@ -147,13 +147,9 @@ class System:
         water = {"free_surface": plant.free_surface, "flow": plant.water, "time_s": time_s}
         bodies = [plant.uvms, *(o.uvms for o in self.objects)]
         out = np.zeros((self.layout.nv, self.layout.nv))
-        for uvms, (q_b, _), part in zip(
-            bodies,
-            self.layout.split(q, np.zeros(self.layout.nv)),
-            self.layout.v_slices,
-            strict=True,
-        ):
-            out[part, part] = mass_matrix(uvms, q_b, backend=plant.backend, **water)
+        layout = self.layout
+        for uvms, at, part in zip(bodies, layout.q_slices, layout.v_slices, strict=True):
+            out[part, part] = mass_matrix(uvms, q[at], backend=plant.backend, **water)
         return out
 
     def clear(self, q: np.ndarray, v: np.ndarray, horizon_s: float) -> bool:
