@@ -9,7 +9,7 @@ from collections.abc import Callable
 from uvms_pin.checks import Plausible
 from uvms_pin.physics.compiled.backend import BACKENDS
 from uvms_pin.scenario.schema import Table
-from uvms_pin.sim.integrators import RK4, Adaptive, Integrator, SemiImplicitEuler
+from uvms_pin.sim.integrators import RK4, Adaptive, FixedStep, Integrator, SemiImplicitEuler
 
 
 def _seconds(usual: tuple[float, float], usual_text: str, hints=("", "")) -> Plausible:
@@ -64,6 +64,18 @@ def build_control_period(t: Table) -> float | None:
         t.plausible("period_s", period, CONTROL_PERIOD)
     t.finish()
     return period
+
+
+def passive_period(period_s: float | None, integrator: Integrator, passive: bool) -> float | None:
+    """The control period of a run: ``period_s`` as given; without one, a run with no
+    controller (``passive``) and a fixed-step integrator is sampled at that integrator's step
+    (which the log period is a multiple of, `SimulationSettings` checks): nothing is
+    controlled, and the constraints solved once a period (the joint limits) are solved at
+    every step. Otherwise None: continuous control (an adaptive integrator keeps its own
+    steps)."""
+    if period_s is not None or not passive or not isinstance(integrator, FixedStep):
+        return period_s
+    return float(integrator.step_s)
 
 
 def build_log_period(t: Table) -> float:
