@@ -4,6 +4,7 @@ uniform random actions (64 environments x 3,000 steps each: how many episodes di
 
 from __future__ import annotations
 
+import importlib
 import time
 
 import gymnasium as gym
@@ -11,13 +12,15 @@ import numpy as np
 from _common import producer_cli, scratch, uvms_pin, write_result
 
 import uvms_pin as up
-import uvms_pin.apps.gym
+from uvms_pin.results.metrics import joint_limit_metrics
 
 PASSIVE = "scenarios/passive_still_water.toml"
 #: each model with a start within its joint limits (the scenario's velocity swings the arm)
 MODELS = {"uvms_bluerov2_alpha5": "[-0.2, 0.8, 2.2, 0.2]", "uvms_lbv150": "[0.0, 0.5, -0.5, 0.0]"}
 ENVIRONMENTS = ("uvms_pin/StationKeeping-v0", "uvms_pin/ForceTracking-v0")
 NUM_ENVS, STEPS, SEED = 64, 3000, 2026
+
+importlib.import_module("uvms_pin.apps.gym")  # registers the environments
 
 
 def passive_rows() -> list[str]:
@@ -30,13 +33,20 @@ def passive_rows() -> list[str]:
             "--set", f"initial.joint_positions_rad={joints}",
         )  # fmt: skip
         rollout = up.Rollout.load(out)
-        meta = rollout.metadata
-        metrics = meta.get("metrics", {})
+        meta, world = rollout.metadata, rollout.metadata["world"]
+        limits = joint_limit_metrics(rollout)
+        kind = (
+            "constraints"
+            if world["joint_limits"]
+            else "compliant"
+            if world["joint_stops"]
+            else "none"
+        )
         rows.append(
             f"| {model} | {meta['status']} (exit {result.returncode}) | "
-            f"{rollout.time_s[-1]:.2f} | {meta['parameters']['joints'].get('stops', '-')} | "
-            f"{metrics.get('joint_limit_excess_max_rad', float('nan')):.2e} | "
-            f"{metrics.get('time_at_joint_stop_s', float('nan')):.2f} |"
+            f"{rollout.time_s[-1]:.2f} | {kind} | {meta['closed_loop']['path']} | "
+            f"{limits['joint_limit_excess_max_rad']:.1e} | {limits['time_at_joint_stop_s']:.2f} | "
+            f"{np.abs(rollout.v[:, 6:]).max():.2f} |"
         )
     return rows
 
@@ -68,8 +78,9 @@ def main() -> None:
         f"`uvms-pin run {PASSIVE} --set scenario.model=... --set scenario.duration_s=60`: "
         "no controller, RK4 at the scenario's 2 ms step (a passive run is sampled at the "
         "integrator's step, its joint limits solved implicitly at each):\n\n"
-        "| model | status | simulated [s] | joint limits | largest excess past a limit [rad] "
-        "| time some joint is at a limit [s] |\n|---|---|---|---|---|---|\n"
+        "| model | status | simulated [s] | joint limits | loop | largest excess past a limit "
+        "[rad] | time some joint is at a limit [s] | fastest joint rate [rad/s] |\n"
+        "|---|---|---|---|---|---|---|---|\n"
         + "\n".join(passive)
         + "\n\nThe vector environments (`gym.make_vec(..., vectorization_mode="
         '"vector_entry_point")`) driven by `action_space.sample()` (seed '

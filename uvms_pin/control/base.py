@@ -56,7 +56,15 @@ class ZeroController(Controller):
 
     def __init__(self, nv: int, nq: int | None = None):
         self._tau = np.zeros(nv)
-        self.nv, self.nq = int(nv), None if nq is None else int(nq)
+        self._nq = None if nq is None else int(nq)
+
+    @property
+    def nv(self) -> int:
+        return int(self._tau.size)
+
+    @property
+    def nq(self) -> int | None:
+        return self._nq
 
     def compute(self, time_s: float, measurement: Measurement) -> np.ndarray:
         return self._tau

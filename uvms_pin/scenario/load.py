@@ -129,6 +129,7 @@ def _build(raw: dict[str, Any], path: Path, top: Table) -> Scenario:
     control_period = passive_period(
         build_control_period(top.table_or_empty("control")),
         integrator,
+        log_period,
         passive=(raw.get("controller") or {}).get("type", "none") == "none",
     )
     joints = top.table_or_empty("joints")

@@ -66,15 +66,20 @@ def build_control_period(t: Table) -> float | None:
     return period
 
 
-def passive_period(period_s: float | None, integrator: Integrator, passive: bool) -> float | None:
+def passive_period(
+    period_s: float | None, integrator: Integrator, log_period_s: float, passive: bool
+) -> float | None:
     """The control period of a run: ``period_s`` as given; without one, a run with no
-    controller (``passive``) and a fixed-step integrator is sampled at that integrator's step
-    (which the log period is a multiple of, `SimulationSettings` checks): nothing is
-    controlled, and the constraints solved once a period (the joint limits) are solved at
-    every step. Otherwise None: continuous control (an adaptive integrator keeps its own
-    steps)."""
+    controller (``passive``) and a fixed-step integrator whose step divides the log period is
+    sampled at that step: nothing is controlled, and the constraints solved once a period
+    (the joint limits) are solved at every step. Otherwise None: continuous control (an
+    adaptive integrator keeps its own steps; a step that does not divide the log period is
+    refused by `SimulationSettings`, naming the step)."""
     if period_s is not None or not passive or not isinstance(integrator, FixedStep):
         return period_s
+    ratio = log_period_s / integrator.step_s
+    if ratio < 1.0 - 1e-9 or abs(ratio - round(ratio)) > 1e-6 * ratio:
+        return None
     return float(integrator.step_s)
 
 
