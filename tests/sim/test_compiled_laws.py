@@ -18,8 +18,8 @@ from uvms_pin.control.pseudo_inverse import MinimumNormSolver
 from uvms_pin.errors import ControllerError, SimulationError
 from uvms_pin.physics.compiled.backend import Fallback
 from uvms_pin.physics.compiled.extension import core_module
-from uvms_pin.sim.compiled.laws import law_to_core
 from uvms_pin.results.metrics import joint_limit_metrics
+from uvms_pin.sim.compiled.laws import law_to_core
 from uvms_pin.sim.run import simulate
 
 BASELINES = ("pi_force", "impedance", "computed_torque")
