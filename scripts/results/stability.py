@@ -46,7 +46,7 @@ def passive_rows() -> list[str]:
             f"| {model} | {meta['status']} (exit {result.returncode}) | "
             f"{rollout.time_s[-1]:.2f} | {kind} | {meta['closed_loop']['path']} | "
             f"{limits['joint_limit_excess_max_rad']:.1e} | {limits['time_at_joint_stop_s']:.2f} | "
-            f"{np.abs(rollout.v[:, 6:]).max():.2f} |"
+            f"{np.abs(rollout.v[:, 6:]).max():.2f} | {meta['real_time_factor']:.0f} |"
         )
     return rows
 
@@ -79,8 +79,8 @@ def main() -> None:
         "no controller, RK4 at the scenario's 2 ms step (a passive run is sampled at the "
         "integrator's step, its joint limits solved implicitly at each):\n\n"
         "| model | status | simulated [s] | joint limits | loop | largest excess past a limit "
-        "[rad] | time some joint is at a limit [s] | fastest joint rate [rad/s] |\n"
-        "|---|---|---|---|---|---|---|---|\n"
+        "[rad] | time some joint is at a limit [s] | fastest joint rate [rad/s] "
+        "| real-time factor |\n|---|---|---|---|---|---|---|---|---|\n"
         + "\n".join(passive)
         + "\n\nThe vector environments (`gym.make_vec(..., vectorization_mode="
         '"vector_entry_point")`) driven by `action_space.sample()` (seed '

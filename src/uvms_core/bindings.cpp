@@ -352,7 +352,8 @@ void bind_environment(nb::module_& m) {
       .def(
           "constrain",
           [](const JointLimitConstraintsModel& limits, const Eigen::MatrixXd& mass,
-             nb::handle q0_obj, nb::handle v_free_obj, double period_s) {
+             nb::handle q0_obj, nb::handle v_free_obj, double period_s,
+             nb::handle least_speed_obj) {
             const Eigen::Index nv = mass.rows();
             if (mass.cols() != nv || !mass.allFinite()) {
               throw InputError("mass must be a square matrix of finite numbers");
@@ -360,11 +361,16 @@ void bind_environment(nb::module_& m) {
             const VectorArg q0_arg(q0_obj);
             const auto q0 = vector("q0", q0_obj, q0_arg, q0_arg.ok ? q0_arg.size() : -1);
             UVMS_VECTOR(v_free, nv);
+            Eigen::VectorXd least = Eigen::VectorXd::Zero(nv);
+            if (!least_speed_obj.is_none()) {
+              UVMS_VECTOR(least_speed, nv);
+              least = least_speed;
+            }
             Eigen::VectorXd v = v_free;
-            const bool solved = limits.constrain(mass, q0, v, period_s);
+            const bool solved = limits.constrain(mass, q0, v, period_s, least);
             return std::make_pair(solved, v);
           },
-          "mass"_a, "q0"_a, "v_free"_a, "period_s"_a,
+          "mass"_a, "q0"_a, "v_free"_a, "period_s"_a, "least_speed"_a = nb::none(),
           "(whether a row was selected, v+) over period_s from q0 (joint_limits.hpp).");
   using uvms::WorldBoundsModel;
   nb::class_<WorldBoundsModel>(m, "WorldBounds",

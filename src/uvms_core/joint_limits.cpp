@@ -151,17 +151,22 @@ void JointLimitConstraintsModel::check(Eigen::Index nq, Eigen::Index nv) const {
 }
 
 bool JointLimitConstraintsModel::within_reach(const Eigen::Ref<const Eigen::VectorXd>& q0,
-                                              const Eigen::VectorXd& v, double h) const {
-  check(q0.size(), v.size());
-  return selected(*this, q0, v.cwiseAbs(), h).rows > 0;
+                                              const Eigen::VectorXd& speed, double h) const {
+  check(q0.size(), speed.size());
+  return selected(*this, q0, speed, h).rows > 0;
 }
 
-bool JointLimitConstraintsModel::constrain(const Eigen::MatrixXd& mass, const Eigen::Ref<const Eigen::VectorXd>& q0,
-                                           Eigen::VectorXd& v, double h) const {
+bool JointLimitConstraintsModel::constrain(const Eigen::MatrixXd& mass,
+                                           const Eigen::Ref<const Eigen::VectorXd>& q0,
+                                           Eigen::VectorXd& v, double h,
+                                           const Eigen::VectorXd& least_speed) const {
   check(q0.size(), v.size());
   if (!(std::isfinite(h) && h > 0.0)) throw InputError("joint limits: the period must be > 0");
+  if (least_speed.size() != v.size() || !least_speed.allFinite()) {
+    throw InputError("joint limits: least_speed must hold nv finite numbers");
+  }
   const Eigen::VectorXd v_free = v;
-  Eigen::VectorXd speed = v_free.cwiseAbs();
+  Eigen::VectorXd speed = v_free.cwiseAbs().cwiseMax(least_speed.cwiseAbs());
   Box box = selected(*this, q0, speed, h);
   if (box.rows == 0) return false;
   for (int round = 0; round < kMaxRounds; ++round) {

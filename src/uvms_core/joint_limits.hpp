@@ -16,7 +16,7 @@
 // tolerance.
 //
 // Rows: those that can close within the period, gap <= h |v_j| + margin, with |v| the
-// velocity's magnitudes, widened with the solved velocity and solved again until the selection
+// velocity's magnitudes (at least the smooth step's own), widened with the solved velocity and solved again until the selection
 // no longer grows (at most 4 rounds, then once more), as the Python reference does.
 #pragma once
 
@@ -37,17 +37,19 @@ struct JointLimitConstraintsModel {
 
   void check(Eigen::Index nq, Eigen::Index nv) const;
 
-  // Whether some row is within reach of the period h [s] at the velocity v from q0 (else
-  // constrain() leaves v as it is and selects nothing).
-  bool within_reach(const Eigen::Ref<const Eigen::VectorXd>& q0, const Eigen::VectorXd& v,
+  // Whether some row is within reach of the period h [s] from q0 when each coordinate moves
+  // at `speed` [rad/s, m/s] (else constrain() with that least speed selects nothing).
+  bool within_reach(const Eigen::Ref<const Eigen::VectorXd>& q0, const Eigen::VectorXd& speed,
                     double h) const;
 
   // v (in: v_free, out: v+) over the period h [s] from the configuration q0, mass the mass
-  // matrix M(q0) (nv x nv, added mass included). Returns whether any row was selected (then
-  // the configuration advances as q0 (+) h v+, else the smooth step's own stands).
+  // matrix M(q0) (nv x nv, added mass included). The rows are selected with the speed
+  // max(|v|, least_speed) per coordinate: least_speed the smooth step's own (its start
+  // velocity and its mean over the period, whose end may cross a limit its end velocity
+  // would not reach). Returns whether any row was selected (then the configuration advances
+  // as q0 (+) h v+, else the smooth step's own stands).
   bool constrain(const Eigen::MatrixXd& mass, const Eigen::Ref<const Eigen::VectorXd>& q0,
-                 Eigen::VectorXd& v,
-                 double h) const;
+                 Eigen::VectorXd& v, double h, const Eigen::VectorXd& least_speed) const;
 };
 
 using JointLimitConstraints = std::optional<JointLimitConstraintsModel>;

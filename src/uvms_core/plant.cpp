@@ -110,14 +110,24 @@ std::pair<Eigen::VectorXd, Eigen::VectorXd> Plant::advance(double t0, const Cons
   if (settle) {  // the anchors move (World.commit), at the period's end
     world->commit(world_forces(stepper_.q, stepper_.v), friction);
   }
-  if (joint_limits && joint_limits->within_reach(q0, stepper_.v, t1 - t0)) {
-    // M(q0) with the added mass (wet fractions at t0), as System.mass_matrix
-    const Eigen::MatrixXd mass = dynamics_.mass_matrix_in(q0, flow, t0, free_surface);
-    Eigen::VectorXd v1 = stepper_.v;
-    if (joint_limits->constrain(mass, q0, v1, t1 - t0)) {
-      Eigen::VectorXd q1(q0.size());
-      pinocchio::integrate(dynamics_.model(), q0, ((t1 - t0) * v1).eval(), q1);
-      return {q1, v1};
+  // a smooth step that diverged is returned as it is: the loop names the divergence
+  if (joint_limits && stepper_.q.allFinite() && stepper_.v.allFinite()) {
+    // the smooth step's own speeds: its start, its end and its mean over the period (RK4's
+    // end may cross a limit that its end velocity would not reach), as period.py's constrained
+    const double h = t1 - t0;
+    limit_speed_.resize(dynamics_.model().nv);
+    pinocchio::difference(dynamics_.model(), q0, stepper_.q, limit_speed_);
+    limit_speed_ =
+        (limit_speed_.cwiseAbs() / h).cwiseMax(v0.cwiseAbs()).cwiseMax(stepper_.v.cwiseAbs());
+    if (joint_limits->within_reach(q0, limit_speed_, h)) {
+      // M(q0) with the added mass (wet fractions at t0), as System.mass_matrix
+      const Eigen::MatrixXd& mass = dynamics_.mass_matrix_in(q0, flow, t0, free_surface);
+      Eigen::VectorXd v1 = stepper_.v;
+      if (joint_limits->constrain(mass, q0, v1, h, limit_speed_)) {
+        Eigen::VectorXd q1(q0.size());
+        pinocchio::integrate(dynamics_.model(), q0, (h * v1).eval(), q1);
+        return {q1, v1};
+      }
     }
   }
   return {stepper_.q, stepper_.v};

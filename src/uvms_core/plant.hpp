@@ -90,6 +90,7 @@ class Plant {
   pinocchio::JointIndex ee_joint_id_;
   ManifoldStepper stepper_;
   Eigen::VectorXd tau_total_;
+  Eigen::VectorXd limit_speed_;  // the joint limits' least selection speed (advance)
   bool world_active_ = true;  // false over a period the broad phase cleared
   ContactForces world_forces_;
   // acceleration_derivatives' own (built on first use): the water's derivatives (a copy of

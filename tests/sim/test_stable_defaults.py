@@ -47,12 +47,19 @@ def test_random_actions_do_not_diverge_the_station_keeping_environment():
     )
     envs.action_space.seed(3)
     envs.reset(seed=3)
-    diverged = 0
+    batch, arm = envs.unwrapped.batch, envs.unwrapped.single_env.scenario.uvms.arm_joints
+    diverged, worst_rad, at_limit = 0, -np.inf, 0
     for _ in range(400):
         *_, infos = envs.step(envs.action_space.sample())
         diverged += int(np.sum(infos["diverged"]))
+        positions = np.array([arm.positions(q) for q in np.asarray(batch.q)])
+        gap = np.minimum(positions - arm.lower, arm.upper - positions)[:, arm.limited]
+        worst_rad = max(worst_rad, float(-gap.min()))
+        at_limit += int(np.sum(gap.min(axis=1) <= 1e-6))
     envs.close()
     assert diverged == 0
+    assert at_limit > 100  # the random torques did drive the arm onto its limits ...
+    assert worst_rad <= 1e-9  # ... and the batch's solve held it there
 
 
 def test_the_limits_solved_in_the_core_are_the_python_loops():

@@ -10,6 +10,7 @@ from uvms_pin.checks import Plausible
 from uvms_pin.physics.compiled.backend import BACKENDS
 from uvms_pin.scenario.schema import Table
 from uvms_pin.sim.integrators import RK4, Adaptive, FixedStep, Integrator, SemiImplicitEuler
+from uvms_pin.sim.settings import is_multiple
 
 
 def _seconds(usual: tuple[float, float], usual_text: str, hints=("", "")) -> Plausible:
@@ -77,8 +78,7 @@ def passive_period(
     refused by `SimulationSettings`, naming the step)."""
     if period_s is not None or not passive or not isinstance(integrator, FixedStep):
         return period_s
-    ratio = log_period_s / integrator.step_s
-    if ratio < 1.0 - 1e-9 or abs(ratio - round(ratio)) > 1e-6 * ratio:
+    if not is_multiple(log_period_s, integrator.step_s):
         return None
     return float(integrator.step_s)
 

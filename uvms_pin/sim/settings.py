@@ -83,10 +83,15 @@ class SimulationSettings:
         return round(self.log_period_s / self.control_period_s)
 
 
-def _require_multiple(whole: float, part: float, whole_name: str, part_name: str) -> None:
-    """ParameterError unless whole = n part for an integer n >= 1 (relative slack 1e-6)."""
+def is_multiple(whole: float, part: float) -> bool:
+    """Whether whole = n part for an integer n >= 1 (relative slack 1e-6)."""
     ratio = whole / part
-    if ratio < 1.0 - 1e-9 or abs(ratio - round(ratio)) > 1e-6 * max(1.0, ratio):
+    return ratio >= 1.0 - 1e-9 and abs(ratio - round(ratio)) <= 1e-6 * max(1.0, ratio)
+
+
+def _require_multiple(whole: float, part: float, whole_name: str, part_name: str) -> None:
+    """ParameterError unless whole = n part for an integer n >= 1 (`is_multiple`)."""
+    if not is_multiple(whole, part):
         raise ParameterError(
             f"{whole_name} = {whole:g} s must be an integer multiple (>= 1) of "
             f"{part_name} = {part:g} s: the run would not be the one recorded"

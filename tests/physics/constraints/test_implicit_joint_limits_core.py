@@ -60,12 +60,16 @@ def test_the_core_gives_the_reference_velocity(uvms):
     core = joint_limits_to_core(limits, uvms.model, core_module())
     solved_rows, pressed, worst = 0, 0, 0.0
     tight = default_settings(tolerance=1e-12, max_iterations=20000)
+    least = np.random.default_rng(4)
     for q, v_free in _states(uvms, 150, seed=11):
         mass = up.mass_matrix(uvms, q)
+        # the smooth step's own speeds, from none to above the end velocity's
+        least_speed = np.abs(v_free) * least.uniform(0.0, 2.0, uvms.nv)
         reference = constrained_velocity(
-            uvms.model, mass, v_free, q, [limits], PERIOD_S, settings=tight
-        )
-        selected, velocity = core.constrain(mass, q, v_free, PERIOD_S)
+            uvms.model, mass, v_free, q, [limits], PERIOD_S, settings=tight,
+            least_speed=least_speed,
+        )  # fmt: skip
+        selected, velocity = core.constrain(mass, q, v_free, PERIOD_S, least_speed)
         assert selected == bool(reference.rows)
         worst = max(worst, float(np.abs(velocity - reference.velocity).max()))
         # the exact optimum of 1/2 |v - v_free|_M^2 over the bounds: not above the ADMM's
@@ -121,6 +125,29 @@ def test_far_from_every_limit_nothing_is_solved():
     selected, velocity = core.constrain(up.mass_matrix(uvms, q), q, v_free, PERIOD_S)
     assert not selected
     assert np.array_equal(velocity, v_free)
+
+
+def test_a_limit_the_smooth_step_crosses_is_selected_by_its_own_speed():
+    """A joint 5 mm off its limit that arrived at 20 rad/s and ends the smooth period at rest:
+    its end velocity reaches nothing, the period's start (or mean) speed does, so the row is
+    solved (the smooth end, past the limit, is not kept) in the core and in the reference."""
+    uvms = _load(MODELS[0])
+    limits = JointLimits.of_uvms(uvms)
+    core = joint_limits_to_core(limits, uvms.model, core_module())
+    q = uvms.neutral_configuration()
+    q[7:] = uvms.arm_joints.configuration(np.array([-0.2, 0.8, 2.2, 0.2]))
+    joint = uvms.model.joints[limits.joint_ids[1]]
+    q[joint.idx_q] = uvms.model.lowerPositionLimit[joint.idx_q] + 5e-3
+    mass = up.mass_matrix(uvms, q)
+    v_free = np.zeros(uvms.nv)
+    started = np.zeros(uvms.nv)
+    started[joint.idx_v] = 20.0
+    assert not core.constrain(mass, q, v_free, PERIOD_S)[0]
+    assert not constrained_velocity(uvms.model, mass, v_free, q, [limits], PERIOD_S).rows
+    assert core.constrain(mass, q, v_free, PERIOD_S, started)[0]
+    assert constrained_velocity(
+        uvms.model, mass, v_free, q, [limits], PERIOD_S, least_speed=started
+    ).rows
 
 
 @pytest.mark.parametrize(

@@ -119,6 +119,7 @@ def constrained_velocity(
     *,
     correction: float = DEFAULT_CORRECTION,
     settings: pin.ADMMSolverSettings | None = None,
+    least_speed: np.ndarray | None = None,
 ) -> ConstrainedVelocity:
     """v+ = v_free + M^-1 J^T lambda over the period ``period_s`` (see the module docstring).
 
@@ -132,10 +133,14 @@ def constrained_velocity(
             once.
         period_s: h [s] (> 0). correction: beta, the fraction of a penetration removed per
             period (0 < beta <= 1). settings: the ADMM settings (`default_settings`).
+        least_speed: (nv,) [m/s, rad/s], the smooth step's own speeds (its start velocity and
+            its mean over the period, whose end may cross a limit that its end velocity would
+            not reach); None: none.
 
     Only the rows that can close within the period are solved: those whose gap is at most
-    h |J_k| |v| with |v| the velocity's magnitudes; as the impulses change v, the selection
-    is widened with the new velocity and solved again until it no longer grows.
+    h |J_k| |v| with |v| the velocity's magnitudes (at least ``least_speed``); as the
+    impulses change v, the selection is widened with the new velocity and solved again
+    until it no longer grows.
 
     Raises:
         ParameterError: a size that does not match the model, a non-finite value, a period
@@ -152,6 +157,8 @@ def constrained_velocity(
     pin.computeJointJacobians(model, data, q)
     data.q_in = q
     speed = np.abs(v_free)
+    if least_speed is not None:
+        speed = np.maximum(speed, np.abs(finite_vector("least_speed", least_speed, model.nv)))
     blocks = tuple(c.rows(model, data, q, speed, h) for c in constraints)
     for _ in range(_MAX_ROUNDS):
         step = _solve(mass, v_free, blocks, h, correction, settings or default_settings())

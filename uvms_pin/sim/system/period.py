@@ -72,8 +72,16 @@ def constrained(system: Stepped, smooth: PeriodStep) -> PeriodStep:
 
     def step(t0, q0, v0, tau, t1):
         q_free, v_free = smooth(t0, q0, v0, tau, t1)
+        if not (np.all(np.isfinite(q_free)) and np.all(np.isfinite(v_free))):
+            return q_free, v_free  # diverged: the loop names the divergence
         mass = system.mass_matrix(t0, q0)
-        solved = constrained_velocity(system.model, mass, v_free, q0, sets, t1 - t0)
+        # the smooth step's own speeds: its start and its mean over the period (RK4's end
+        # may cross a limit that its end velocity would not reach)
+        travelled = np.abs(pin.difference(system.model, q0, q_free)) / (t1 - t0)
+        solved = constrained_velocity(
+            system.model, mass, v_free, q0, sets, t1 - t0,
+            least_speed=np.maximum(np.abs(v0), travelled),
+        )  # fmt: skip
         if not solved.converged:
             raise SimulationError(
                 f"the constraint solve did not converge between t = {t0:.6g} s and {t1:.6g} s "
