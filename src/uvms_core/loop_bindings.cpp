@@ -186,6 +186,10 @@ void bind_task_priority_law(nb::module_& m) {
           "model_text"_a, "settings"_a, "level"_a, "With the PPC's velocity level.")
       .def_prop_rw("state", &TaskPriorityLaw::state, &TaskPriorityLaw::set_state,
                    "The inverse-dynamics level's committed state.");
+}
+
+// The prioritized recursion of the kinematic level (task_priority.hpp), for the tests.
+void bind_prioritized_velocity(nb::module_& m) {
   m.def(
       "prioritized_velocity",
       [](const std::vector<std::pair<Eigen::MatrixXd, Eigen::VectorXd>>& tasks,
@@ -233,6 +237,7 @@ void bind_tracking_laws(nb::module_& m) {
       .def(nb::init<const uvms::Dynamics&, ResolvedAccelerationSettings>(), "dynamics"_a,
            "settings"_a);
   bind_task_priority_law(m);
+  bind_prioritized_velocity(m);
 }
 
 }  // namespace
