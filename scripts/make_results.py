@@ -43,6 +43,7 @@ PRODUCERS = {
     "derivatives": "cost of the dynamics' derivatives and of an MPC re-plan: docs/results/derivatives.md",
     "tracking": "end-effector tracking, controller x task x conditions: docs/results/tracking.md, docs/tracking_*.png",
     "estimator": "station keeping on the navigation estimate: docs/results/estimator.md, docs/estimator_station_keeping.png",
+    "stability": "passive models for 60 s and random actions in the environments: docs/results/stability.md",
 }
 
 

@@ -55,6 +55,7 @@ BatchPlant::BatchPlant(const Plant& prototype, const FixedStep& integrator,
     plant->disturbance = prototype.disturbance;
     plant->joint_friction = prototype.joint_friction;
     plant->joint_stops = prototype.joint_stops;
+    plant->joint_limits = prototype.joint_limits;
     plants_.push_back(std::move(plant));
     scratch_.push_back({Eigen::VectorXd::Zero(nv_), Eigen::VectorXd::Zero(nv_),
                         Eigen::VectorXd::Zero(nv_), Eigen::VectorXd::Zero(nq_),

@@ -339,6 +339,33 @@ void bind_environment(nb::module_& m) {
       .def_rw("upper_rad", &uvms::JointStopsModel::upper_rad)
       .def_rw("stiffness_Nm_rad", &uvms::JointStopsModel::stiffness_Nm_rad)
       .def_rw("damping_Nm_s_rad", &uvms::JointStopsModel::damping_Nm_s_rad);
+  using uvms::JointLimitConstraintsModel;
+  nb::class_<JointLimitConstraintsModel>(
+      m, "JointLimits", "The joint limits as constraints solved implicitly (joint_limits.hpp).")
+      .def(nb::init<>())
+      .def_rw("q_index", &JointLimitConstraintsModel::q_index)
+      .def_rw("v_index", &JointLimitConstraintsModel::v_index)
+      .def_rw("lower_rad", &JointLimitConstraintsModel::lower_rad)
+      .def_rw("upper_rad", &JointLimitConstraintsModel::upper_rad)
+      .def_rw("margin", &JointLimitConstraintsModel::margin)
+      .def_rw("correction", &JointLimitConstraintsModel::correction)
+      .def(
+          "constrain",
+          [](const JointLimitConstraintsModel& limits, const Eigen::MatrixXd& mass,
+             nb::handle q0_obj, nb::handle v_free_obj, double period_s) {
+            const Eigen::Index nv = mass.rows();
+            if (mass.cols() != nv || !mass.allFinite()) {
+              throw InputError("mass must be a square matrix of finite numbers");
+            }
+            const VectorArg q0_arg(q0_obj);
+            const auto q0 = vector("q0", q0_obj, q0_arg, q0_arg.ok ? q0_arg.size() : -1);
+            UVMS_VECTOR(v_free, nv);
+            Eigen::VectorXd v = v_free;
+            const bool solved = limits.constrain(mass, q0, v, period_s);
+            return std::make_pair(solved, v);
+          },
+          "mass"_a, "q0"_a, "v_free"_a, "period_s"_a,
+          "(whether a row was selected, v+) over period_s from q0 (joint_limits.hpp).");
   using uvms::WorldBoundsModel;
   nb::class_<WorldBoundsModel>(m, "WorldBounds",
                                "The broad phase of the world's contacts (world_bounds.hpp).")
@@ -373,6 +400,7 @@ void bind_plant(nb::module_& m) {
       .def_rw("disturbance", &Plant::disturbance)
       .def_rw("joint_friction", &Plant::joint_friction)
       .def_rw("joint_stops", &Plant::joint_stops)
+      .def_rw("joint_limits", &Plant::joint_limits)
       .def_rw("world_bounds", &Plant::world_bounds)
       .def(
           "world_clear",

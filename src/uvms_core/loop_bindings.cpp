@@ -11,6 +11,7 @@
 #include "law_force_baselines.hpp"
 #include "law_task_priority.hpp"
 #include "law_tracking.hpp"
+#include "law_zero.hpp"
 #include "ppc.hpp"
 #include "sampled_loop.hpp"
 
@@ -72,6 +73,9 @@ void bind_force_baselines(nb::module_& m) {
       .def_rw("anchored", &ImpedanceState::anchored)
       .def_rw("anchor_world_m", &ImpedanceState::anchor_world_m)
       .def_rw("posture_q", &ImpedanceState::posture_q);
+
+  nb::class_<uvms::ZeroLaw, uvms::SampledLaw>(m, "ZeroLaw", "No input at all (law_zero.hpp).")
+      .def(nb::init<int, int>(), "nq"_a, "nv"_a);
 
   using uvms::PiForceSettings;
   nb::class_<PiForceSettings> pi_settings(m, "PiForceSettings", "PI force law's settings.");

@@ -1,6 +1,7 @@
 #include "plant.hpp"
 
 #include <pinocchio/algorithm/frames.hpp>
+#include <pinocchio/algorithm/joint-configuration.hpp>
 #include <pinocchio/algorithm/kinematics.hpp>
 
 namespace uvms {
@@ -108,6 +109,16 @@ std::pair<Eigen::VectorXd, Eigen::VectorXd> Plant::advance(double t0, const Cons
   world_active_ = true;
   if (settle) {  // the anchors move (World.commit), at the period's end
     world->commit(world_forces(stepper_.q, stepper_.v), friction);
+  }
+  if (joint_limits && joint_limits->within_reach(q0, stepper_.v, t1 - t0)) {
+    // M(q0) with the added mass (wet fractions at t0), as System.mass_matrix
+    const Eigen::MatrixXd mass = dynamics_.mass_matrix_in(q0, flow, t0, free_surface);
+    Eigen::VectorXd v1 = stepper_.v;
+    if (joint_limits->constrain(mass, q0, v1, t1 - t0)) {
+      Eigen::VectorXd q1(q0.size());
+      pinocchio::integrate(dynamics_.model(), q0, ((t1 - t0) * v1).eval(), q1);
+      return {q1, v1};
+    }
   }
   return {stepper_.q, stepper_.v};
 }

@@ -4,7 +4,8 @@
 // tau_f the friction of the arm's joint drives (joint_friction.hpp), tau_stop the compliant
 // stops at the joint limits (joint_stops.hpp), and with a world (world_contact.hpp) + tau_world,
 // the contacts of every body's collision shapes with the world's objects.
-// It advances the plant over one control period with the input held, in one call.
+// It advances the plant over one control period with the input held, in one call; the joint
+// limits may instead be constraints solved implicitly at the period's end (joint_limits.hpp).
 #pragma once
 
 #include <memory>
@@ -18,6 +19,7 @@
 #include "dynamics.hpp"
 #include "integrators.hpp"
 #include "joint_friction.hpp"
+#include "joint_limits.hpp"
 #include "joint_stops.hpp"
 #include "world_bounds.hpp"
 #include "world_contact.hpp"
@@ -36,6 +38,8 @@ class Plant {
   Disturbance disturbance;
   JointFriction joint_friction;
   JointStops joint_stops;  // compliant stops at the arm joints' limits, or none
+  // or the limits as constraints solved implicitly at the end of each period (advance)
+  JointLimitConstraints joint_limits;
 
   // lambda at (q, v): what the end-effector exerts on the environment [N; N m], world axes.
   Vec6 contact_wrench(const ConstVec& q, const ConstVec& v);
@@ -63,7 +67,10 @@ class Plant {
   // (derivatives_task_contact.hpp; zero without a contact).
   const TaskContactDerivatives& contact_derivatives(const ConstVec& q, const ConstVec& v);
 
-  // (q, v) at t1 from (q0, v0) at t0 with tau held, in the integrator's substeps.
+  // (q, v) at t1 from (q0, v0) at t0 with tau held, in the integrator's substeps; with
+  // joint_limits, their implicit velocity step follows (joint_limits.hpp): when a row is
+  // solved, q1 = q0 (+) (t1 - t0) v+, else the substeps' own (mirror of
+  // uvms_pin/sim/system/period.py, constrained).
   std::pair<Eigen::VectorXd, Eigen::VectorXd> advance(double t0, const ConstVec& q0,
                                                       const ConstVec& v0, const ConstVec& tau,
                                                       double t1, const FixedStep& integrator);

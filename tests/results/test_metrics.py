@@ -149,11 +149,16 @@ def test_joints_past_their_limits_by_known_amounts_for_known_times():
     r = limited()
     r.q[300:400, 7] = UPPER[0] + 0.1  # joint 1 above its upper limit for samples 300-399
     r.q[350:450, 9] = LOWER[2] - 0.25  # joint 3 below its lower limit for 350-449
-    r.q[:, 10] = UPPER[3]  # joint 4 exactly at its limit all along: not past it
     m = joint_limit_metrics(r)
     assert m["joint_limit_excess_max_rad"] == pytest.approx(0.25, rel=1e-12)
     assert m["joint_limit_excess_time_fraction"] == 150 / N  # samples 300-449
     assert m["time_at_joint_stop_s"] == pytest.approx(150 * DT, rel=1e-12)  # each held DT
+    # joint 4 exactly at its limit (as a limit solved as a constraint holds it), samples
+    # 500-599: not past it, but at its stop
+    r.q[500:600, 10] = UPPER[3]
+    m = joint_limit_metrics(r)
+    assert m["joint_limit_excess_time_fraction"] == 150 / N
+    assert m["time_at_joint_stop_s"] == pytest.approx(250 * DT, rel=1e-12)
     assert compute_metrics(r)["joint_limit_excess_max_rad"] == m["joint_limit_excess_max_rad"]
 
 

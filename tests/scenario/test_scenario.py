@@ -35,7 +35,9 @@ def test_minimal_scenario_defaults(tmp_path):
     assert scenario.name == "tiny"
     assert isinstance(scenario.plant.actuation, Unlimited)
     np.testing.assert_array_equal(scenario.plant.current_world_m_s, np.zeros(3))
-    assert scenario.settings.control_period_s is None
+    # no controller: sampled at the integrator's step (RK4, 1 ms), the joint limits solved
+    assert scenario.settings.control_period_s == scenario.settings.integrator.step_s == 1e-3
+    assert scenario.plant.joint_limits is not None and scenario.plant.joint_stops is None
 
 
 @pytest.mark.parametrize(

@@ -27,19 +27,34 @@ def test_the_seabed_scenario_builds_a_slope_and_a_rock():
     assert seabed.kind == "plane" and rock.kind == "mesh"
     assert np.degrees(np.arccos(seabed.normal_world[2])) == pytest.approx(8.0, abs=1e-3)
     assert (seabed.friction_static, seabed.friction_kinetic) == (0.7, 0.5)
-    assert plant.joint_stops is not None  # on by default
+    # on by default: with a control period, as constraints
+    assert plant.joint_stops is None and plant.joint_limits is not None
     assert len(plant.world.pair_names) == 2 * len(plant.world.body_names)
 
 
 def test_joint_stops_turn_off_and_take_their_parameters():
-    assert _load(**{"joints.hard_stops": False}).plant.joint_stops is None
-    stops = _load(**{"joints.stop_stiffness_Nm_rad": 300.0}).plant.joint_stops
-    assert stops.stiffness_Nm_rad == 300.0
+    off = _load(**{"joints.hard_stops": False}).plant
+    assert off.joint_stops is None and off.joint_limits is None
+    compliant = {"joints.stops": "compliant"}
+    stops = _load(**compliant, **{"joints.stop_stiffness_Nm_rad": 300.0}).plant
+    assert stops.joint_stops.stiffness_Nm_rad == 300.0 and stops.joint_limits is None
     implicit = _load(**{"joints.stops": "implicit"}).plant
     assert implicit.joint_stops is None and len(implicit.joint_limits.joint_ids) >= 1
-    assert (
-        _load(**{"joints.stops": "implicit", "joints.hard_stops": False}).plant.joint_limits is None
+
+
+def test_the_default_limits_follow_the_control():
+    """Constraints with a control period, compliant stops under continuous control, and a
+    run without a controller sampled at its fixed-step integrator's step."""
+    continuous = load_scenario(SCENARIOS / "paper_force_tracking.toml")
+    assert continuous.settings.control_period_s is None
+    assert continuous.plant.joint_limits is None and continuous.plant.joint_stops is not None
+    passive = load_scenario(SCENARIOS / "passive_still_water.toml")
+    assert passive.settings.control_period_s == passive.settings.integrator.step_s
+    assert passive.plant.joint_limits is not None and passive.plant.joint_stops is None
+    adaptive = load_scenario(
+        SCENARIOS / "passive_still_water.toml", {"integrator": {"method": "LSODA"}}
     )
+    assert adaptive.settings.control_period_s is None and adaptive.plant.joint_stops is not None
 
 
 def _with_object(k: int, **changes):
@@ -134,5 +149,5 @@ def test_self_collision_is_a_contact_key():
 
 
 def test_implicit_joint_limits_need_a_sampled_controller():
-    with pytest.raises(ScenarioError, match=r"joints: stops = \"implicit\".*\[control\] period_s"):
+    with pytest.raises(ScenarioError, match=r"joints\.stops.*\"implicit\".*\[control\] period_s"):
         load_scenario(SCENARIOS / "paper_force_tracking.toml", {"joints.stops": "implicit"})

@@ -18,6 +18,7 @@ from uvms_pin.control.pseudo_inverse import MinimumNormSolver
 from uvms_pin.errors import ControllerError, SimulationError
 from uvms_pin.physics.compiled.backend import Fallback
 from uvms_pin.physics.compiled.extension import core_module
+from uvms_pin.results.metrics import joint_limit_metrics
 from uvms_pin.sim.compiled.laws import law_to_core
 from uvms_pin.sim.run import simulate
 
@@ -62,7 +63,11 @@ def test_each_baseline_runs_compiled_as_in_python(kind, path, overrides):
         python_ticks = python.metadata["closed_loop"]["python_ticks"]
         assert meta == {"path": "compiled", "reason": None,
                         "compiled_ticks": python_ticks - 1, "python_ticks": 1}  # fmt: skip
-    _assert_same(compiled, python)
+    # a joint resting on its limit (the paper's arm under a default-tuned baseline) lands
+    # each period at q0 + h (-r / h): its gap r is the rounding of the last landing (~1e-16
+    # rad), which v = -r / h turns into ~1e-13 rad/s, not the same in the two loops
+    rests = joint_limit_metrics(python).get("time_at_joint_stop_s", 0.0) > 0.0
+    _assert_same(compiled, python, rtol=1e-11 if rests else 1e-12)
     assert np.max(np.abs(compiled.v)) > 1e-2  # the run did something
     assert np.max(np.abs(compiled.signals["e_x"][:, :3])) > 1e-2
 

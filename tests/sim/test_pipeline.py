@@ -11,7 +11,6 @@ import pytest
 from conftest import ROOT
 
 from uvms_pin.errors import ParameterError
-from uvms_pin.physics.constraints.joint_limits import JointLimits
 from uvms_pin.scenario.load import load_scenario
 from uvms_pin.sim.batched_plant import BatchedPlant
 from uvms_pin.sim.integrators import Adaptive
@@ -104,14 +103,12 @@ def test_the_loop_records_and_the_batch_refuses_with_the_same_reason():
         BatchedPlant(station.plant, station.settings, station.sensor_config, 2)
 
 
-def test_joint_limits_as_constraints_keep_both_pipelines_in_python():
+def test_joint_limits_as_constraints_are_compiled_in_both_pipelines():
     scenario = load_scenario(
         ROOT / "scenarios" / "bluerov_alpha5_force_tracking.toml",
-        {"scenario.duration_s": 0.1, "joints.hard_stops": False},
+        {"scenario.duration_s": 0.1, "joints.stops": "implicit"},
     )
-    scenario.plant.joint_limits = JointLimits.of_uvms(scenario.uvms)
+    assert scenario.plant.joint_limits is not None and scenario.plant.joint_stops is None
     parts = _parts(scenario)
     for pipeline in (Pipeline.LOOP, Pipeline.BATCH):
-        assert why_not_compiled(parts, pipeline) == (
-            "joint limits as constraints (their solve is Python's)"
-        )
+        assert why_not_compiled(parts, pipeline) is None

@@ -46,10 +46,25 @@ class Controller(ABC):
 
 
 class ZeroController(Controller):
-    """No input at all: the passive system."""
+    """No input at all: the passive system.
 
-    def __init__(self, nv: int):
+    Args:
+        nv: the velocity dimension (tau's size). nq: the configuration's, when known (the
+            compiled loop's zero law needs it to check it is the plant's; without it the
+            loop runs in Python).
+    """
+
+    def __init__(self, nv: int, nq: int | None = None):
         self._tau = np.zeros(nv)
+        self._nq = None if nq is None else int(nq)
+
+    @property
+    def nv(self) -> int:
+        return int(self._tau.size)
+
+    @property
+    def nq(self) -> int | None:
+        return self._nq
 
     def compute(self, time_s: float, measurement: Measurement) -> np.ndarray:
         return self._tau

@@ -93,12 +93,11 @@ def _non_negative(name: str, value: float) -> float:
     return x
 
 
-def _linear_from_quadratic(
-    quadratic: np.ndarray, reference_speed_m_s: float, reference_rate_rad_s: float
-) -> np.ndarray:
-    """Diagonal linear damping D_lin = D_quad * [u_ref]*3 + [omega_ref]*3 (see module doc)."""
-    u = _non_negative("linear_damping_reference_speed_m_s", reference_speed_m_s)
-    w = _non_negative("linear_damping_reference_rate_rad_s", reference_rate_rad_s)
+def _linear_from_quadratic(quadratic: np.ndarray, reference: tuple[float, float]) -> np.ndarray:
+    """Diagonal linear damping D_lin = D_quad * [u_ref]*3 + [omega_ref]*3 (see module doc),
+    ``reference`` = (u_ref [m/s], omega_ref [rad/s]), each checked finite and >= 0."""
+    u = _non_negative("linear_damping_reference_speed_m_s", reference[0])
+    w = _non_negative("linear_damping_reference_rate_rad_s", reference[1])
     return np.diag(quadratic * np.array([u, u, u, w, w, w]))
 
 
@@ -106,19 +105,17 @@ def _at_centre(
     volume_m3: float,
     added_mass: np.ndarray,
     quadratic_damping: np.ndarray,
-    reference_speed_m_s: float,
-    reference_rate_rad_s: float,
+    reference: tuple[float, float],
     origin: str,
 ) -> HydroParams:
     """A primitive's coefficients at its centre (its centre of buoyancy, by symmetry), the
-    linear damping from the quadratic one at the reference speed and rate, marked derived."""
+    linear damping from the quadratic one at the ``reference`` speed and rate (the
+    primitive's two ``linear_damping_reference_*`` arguments), marked derived."""
     return HydroParams(
         volume_m3=volume_m3,
         center_of_buoyancy_m=np.zeros(3),
         added_mass=added_mass,
-        linear_damping=_linear_from_quadratic(
-            quadratic_damping, reference_speed_m_s, reference_rate_rad_s
-        ),
+        linear_damping=_linear_from_quadratic(quadratic_damping, reference),
         quadratic_damping=quadratic_damping,
         derived=True,
         origin=origin,
@@ -257,20 +254,15 @@ def sphere_hydro(
     rho = _positive("water_density_kg_m3", water_density_kg_m3)
     cd = _non_negative("drag_coefficient", drag_coefficient)
     cf = _non_negative("skin_friction_coefficient", skin_friction_coefficient)
+    reference = (linear_damping_reference_speed_m_s, linear_damping_reference_rate_rad_s)
     volume = 4.0 / 3.0 * math.pi * r**3
     ma = 0.5 * rho * volume
     added = np.diag([ma, ma, ma, 0.0, 0.0, 0.0])
     d_lin = 0.5 * rho * cd * math.pi * r * r
     d_rot = 3.0 * math.pi**2 / 8.0 * rho * cf * r**5
     quadratic = np.array([d_lin, d_lin, d_lin, d_rot, d_rot, d_rot])
-    return _at_centre(
-        volume,
-        added,
-        quadratic,
-        linear_damping_reference_speed_m_s,
-        linear_damping_reference_rate_rad_s,
-        f"sphere r={r:g} m: potential-flow added mass, Cd={cd:g}",
-    )
+    origin = f"sphere r={r:g} m: potential-flow added mass, Cd={cd:g}"
+    return _at_centre(volume, added, quadratic, reference, origin)
 
 
 def cylinder_hydro(
@@ -329,6 +321,7 @@ def cylinder_hydro(
     cd_x = _non_negative("drag_coefficient_cross", drag_coefficient_cross)
     cd_a = _non_negative("drag_coefficient_axial", drag_coefficient_axial)
     cf = _non_negative("skin_friction_coefficient", skin_friction_coefficient)
+    reference = (linear_damping_reference_speed_m_s, linear_damping_reference_rate_rad_s)
 
     volume = math.pi * r * r * length
     m_strip = rho * volume  # Ca = 1 times the displaced mass
@@ -342,15 +335,11 @@ def cylinder_hydro(
     d_tumble = rho * cd_x * r * length**4 / 32.0 + 4.0 / 15.0 * rho * cd_a * r**5
     d_roll = math.pi * rho * cf * r**4 * (length + 0.4 * r)
     quadratic = np.array([d_cross, d_cross, d_axial, d_tumble, d_tumble, d_roll])
-    return _at_centre(
-        volume,
-        added,
-        quadratic,
-        linear_damping_reference_speed_m_s,
-        linear_damping_reference_rate_rad_s,
+    origin = (
         f"cylinder r={r:g} m L={length:g} m: strip-theory added mass (Ca=1), "
-        f"axial k1={k_axial:.3f}, Cd={cd_x:g}/{cd_a:g}",
+        f"axial k1={k_axial:.3f}, Cd={cd_x:g}/{cd_a:g}"
     )
+    return _at_centre(volume, added, quadratic, reference, origin)
 
 
 def box_hydro(
@@ -392,6 +381,7 @@ def box_hydro(
     lx, ly, lz = (_positive(f"size_m[{i}]", s) for i, s in enumerate(sides))
     rho = _positive("water_density_kg_m3", water_density_kg_m3)
     cd = _non_negative("drag_coefficient", drag_coefficient)
+    reference = (linear_damping_reference_speed_m_s, linear_damping_reference_rate_rad_s)
 
     volume = lx * ly * lz
     k = 0.5 * (6.0 / math.pi) ** (1.0 / 3.0)  # equal-volume semi-axis factor
@@ -408,14 +398,8 @@ def box_hydro(
             rho * cd * lz * (lx**4 + ly**4) / 64.0,
         ]
     )
-    return _at_centre(
-        volume,
-        added,
-        quadratic,
-        linear_damping_reference_speed_m_s,
-        linear_damping_reference_rate_rad_s,
-        f"box {lx:g}x{ly:g}x{lz:g} m: equal-volume ellipsoid added mass (Lamb), Cd={cd:g}",
-    )
+    origin = f"box {lx:g}x{ly:g}x{lz:g} m: equal-volume ellipsoid added mass (Lamb), Cd={cd:g}"
+    return _at_centre(volume, added, quadratic, reference, origin)
 
 
 # --------------------------------------------------------------------------- change of frame

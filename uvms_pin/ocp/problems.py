@@ -21,6 +21,7 @@ from __future__ import annotations
 import math
 from collections.abc import Callable
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 import pinocchio as pin
@@ -175,23 +176,58 @@ def _scale(name: str, value: float) -> float:
     return float(value)
 
 
+@dataclass(frozen=True)
+class Horizon:
+    """The keywords every problem builder (`point_to_point`, `station_hold`,
+    `force_tracking`) takes besides its task: a plan of ``horizon_s`` [s] in nodes of
+    ``dt_s`` [s] (round(horizon_s / dt_s) of them), u as ``actuators`` says, in ``flow``
+    (None: still water), the dynamics on ``backend`` ("core" or "python"), each node
+    integrated by ``integrator`` (`INTEGRATORS`)."""
+
+    horizon_s: float = 1.0
+    dt_s: float = 0.02
+    actuators: Actuators = Actuators()
+    flow: FlowField | None = None
+    backend: str = "core"
+    integrator: str = "euler"
+
+    @property
+    def nodes(self) -> int:
+        """round(horizon_s / dt_s); ParameterError unless both are positive finite times and
+        the horizon holds a node."""
+        return _nodes(self.horizon_s, self.dt_s)
+
+    def problem(self, uvms: UVMS, x0: np.ndarray, running, terminal, **node_options):
+        """`shooting_problem` from ``x0`` over this horizon (``node_options``: its
+        ``time_s``, ``contact``, ``per_node``)."""
+        return shooting_problem(
+            uvms,
+            x0,
+            running,
+            terminal,
+            nodes=self.nodes,
+            dt_s=self.dt_s,
+            actuators=self.actuators,
+            flow=self.flow,
+            backend=self.backend,
+            integrator=self.integrator,
+            **node_options,
+        )
+
+
 def point_to_point(
     uvms: UVMS,
     x0: np.ndarray,
     target: pin.SE3,
     *,
-    horizon_s: float = 1.0,
-    dt_s: float = 0.02,
-    actuators: Actuators = Actuators(),
-    flow: FlowField | None = None,
     effort_weight: float = 1e-4,
     pose_weights=(1.0, 1.0, 1.0, 0.1, 0.1, 0.1),
-    backend: str = "core",
-    integrator: str = "euler",
+    **horizon: Any,
 ):
     """Move the end-effector to ``target`` (its pose at the horizon's end, at rest); the
     running cost keeps velocities and effort small. ``pose_weights``: of the pose error
-    (position [m], rotation [rad]), x1e3 at the end."""
+    (position [m], rotation [rad]), x1e3 at the end. ``horizon``: the `Horizon` keywords."""
+    horizon = Horizon(**horizon)
     x0 = np.asarray(x0, float)
     pose_w = _six_weights("pose_weights", pose_weights)
     slow = np.r_[np.zeros(uvms.nv), np.ones(uvms.nv)]
@@ -209,18 +245,7 @@ def point_to_point(
             (costs.StateDeviation(uvms.model, x0, slow), 10.0),
         ]
 
-    return shooting_problem(
-        uvms,
-        x0,
-        running,
-        terminal,
-        nodes=_nodes(horizon_s, dt_s),
-        dt_s=dt_s,
-        actuators=actuators,
-        flow=flow,
-        backend=backend,
-        integrator=integrator,
-    )
+    return horizon.problem(uvms, x0, running, terminal)
 
 
 def station_hold(
@@ -228,14 +253,9 @@ def station_hold(
     x0: np.ndarray,
     station: pin.SE3,
     *,
-    horizon_s: float = 1.0,
-    dt_s: float = 0.02,
-    actuators: Actuators = Actuators(),
-    flow: FlowField | None = None,
     effort_weight: float = 1e-4,
     pose_weights=100.0,
-    backend: str = "core",
-    integrator: str = "euler",
+    **horizon: Any,
 ):
     """Keep the vehicle's body frame at ``station`` and the arm as in x0, at rest.
 
@@ -243,7 +263,9 @@ def station_hold(
     z [m] and the rotation [rad], body axes) + (1/2)||arm (-) arm_0||^2 + 0.1 (1/2)||v||^2 +
     effort_weight (1/2)||u||^2 (N, N m); x10 at the end. The default trades 1 mm of error
     against 1 N of input; give a DoF the input cannot reach (e.g. the passively stable roll
-    and pitch of a vehicle without thrust there) a small weight, or the plan fights it."""
+    and pitch of a vehicle without thrust there) a small weight, or the plan fights it.
+    ``horizon``: the `Horizon` keywords."""
+    horizon = Horizon(**horizon)
     x0 = np.asarray(x0, float)
     pose_w = _six_weights("pose_weights", pose_weights)
     hold_arm = np.r_[np.zeros(6), np.ones(uvms.nv - 6), np.full(uvms.nv, 0.1)]
@@ -258,18 +280,7 @@ def station_hold(
 
         return build
 
-    return shooting_problem(
-        uvms,
-        x0,
-        terms(1.0),
-        terms(10.0),
-        nodes=_nodes(horizon_s, dt_s),
-        dt_s=dt_s,
-        actuators=actuators,
-        flow=flow,
-        backend=backend,
-        integrator=integrator,
-    )
+    return horizon.problem(uvms, x0, terms(1.0), terms(10.0))
 
 
 @dataclass
@@ -295,10 +306,6 @@ def force_tracking(
     desired_force: Callable[[float], np.ndarray],
     rotation: np.ndarray,
     *,
-    horizon_s: float = 1.0,
-    dt_s: float = 0.02,
-    actuators: Actuators = Actuators(),
-    flow: FlowField | None = None,
     time_s: float = 0.0,
     force_weights=(100.0, 100.0, 100.0),
     attitude_weights=(100.0, 100.0, 100.0),
@@ -307,8 +314,7 @@ def force_tracking(
     effort_weight: float = 1e-4,
     limit_margin_rad: float = 0.1,
     limit_weight: float = 1e3,
-    backend: str = "core",
-    integrator: str = "euler",
+    **horizon: Any,
 ) -> ForceTracking:
     """Press on ``contact`` with the desired force f_d(t) [N] while holding the end-effector's
     attitude at ``rotation`` (world <- end-effector), the arm near its posture in x0.
@@ -318,14 +324,16 @@ def force_tracking(
     effort_weight (1/2)||u||^2 + limit_weight (1/2)||arm past its limits less
     limit_margin_rad||^2; the terminal node the same without the effort. The vehicle's
     position is free (it moves to make the force); f the contact's force on the environment
-    in every node's dynamics (`uvms_pin.physics.derivatives.task_contact`)."""
+    in every node's dynamics (`uvms_pin.physics.derivatives.task_contact`); ``time_s`` [s]:
+    the plan's start. ``horizon``: the `Horizon` keywords."""
+    horizon = Horizon(**horizon)
     x0 = np.asarray(x0, float)
-    nodes = _nodes(horizon_s, dt_s)
+    nodes = horizon.nodes
     effort_weight = _scale("effort_weight", effort_weight)
     hold = np.r_[
         np.zeros(6), np.full(uvms.nv - 6, posture_weight), np.full(uvms.nv, velocity_weight)
     ]
-    offsets = [k * dt_s for k in range(nodes + 1)]
+    offsets = [k * horizon.dt_s for k in range(nodes + 1)]
     forces = [
         costs.ContactForce(desired_force(time_s + offset), force_weights) for offset in offsets
     ]
@@ -343,20 +351,8 @@ def force_tracking(
 
         return build
 
-    problem = shooting_problem(
-        uvms,
-        x0,
-        terms(effort_weight),
-        terms(0.0),
-        nodes=nodes,
-        dt_s=dt_s,
-        actuators=actuators,
-        flow=flow,
-        time_s=time_s,
-        backend=backend,
-        contact=contact,
-        per_node=True,
-        integrator=integrator,
+    problem = horizon.problem(
+        uvms, x0, terms(effort_weight), terms(0.0), time_s=time_s, contact=contact, per_node=True
     )
     return ForceTracking(problem, forces, offsets)
 

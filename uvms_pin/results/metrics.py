@@ -115,6 +115,10 @@ def energy_metrics(rollout: RolloutData) -> dict[str, float]:
     }
 
 
+#: How close to a limit a joint counts as held at it [rad or m] (the constraint solve ends a
+#: joint within h times its 1e-8 tolerance of its limit, far below this)
+AT_LIMIT_RAD = 1e-6
+
 #: A wet fraction this far below 1 counts as partly out of the water (rounding aside).
 _WET = 1.0 - 1e-9
 
@@ -143,9 +147,11 @@ def joint_limit_metrics(rollout: RolloutData) -> dict[str, float]:
     the time at a stop [s] (some joint past a limit; each sample counts until the next),
     over the joints that have limits (a continuous joint has none; {} if no joint has).
 
-    With joint stops (``[joints] hard_stops``, the default) a joint past its limit is
-    pressing on its compliant stop, by tau / k_s; without them nothing stops it, and a
-    controller that drives a joint past its limit shows up here, not as a crash.
+    With compliant stops a joint past its limit is pressing on its stop, by tau / k_s; with
+    the limits as constraints (the default with a control period) it rests at its limit, and
+    ``time_at_joint_stop_s`` counts the time some joint is within ``AT_LIMIT_RAD`` of a limit
+    or past it. Without either nothing stops a joint, and a controller that drives one past
+    its limit shows up here, not as a crash.
     """
     meta = rollout.metadata
     if "arm_position_lower_rad" not in meta or len(rollout) == 0 or rollout.q.shape[1] <= 7:
@@ -165,10 +171,13 @@ def joint_limit_metrics(rollout: RolloutData) -> dict[str, float]:
     excess = np.maximum(lower[limited] - q, 0.0) + np.maximum(q - upper[limited], 0.0)
     held = np.diff(rollout.time_s, append=rollout.time_s[-1])
     past = np.any(excess > 0.0, axis=1)
+    # a limit solved as a constraint holds its joint AT the limit (to the solver's tolerance)
+    gap = np.minimum(q - lower[limited], upper[limited] - q)
+    at_stop = np.any(gap <= AT_LIMIT_RAD, axis=1)
     return {
         "joint_limit_excess_max_rad": float(excess.max()),
         "joint_limit_excess_time_fraction": float(np.mean(past)),
-        "time_at_joint_stop_s": float(held @ past),
+        "time_at_joint_stop_s": float(held @ at_stop),
     }
 
 

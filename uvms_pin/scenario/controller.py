@@ -31,7 +31,7 @@ REGISTERING_MODULES = (ppc, mpc, baselines, tracking_controllers)
 
 
 def _zero(uvms: UVMS) -> Controller:
-    return ZeroController(uvms.nv)
+    return ZeroController(uvms.nv, uvms.nq)
 
 
 @CONTROLLERS.register("none")

@@ -1,6 +1,7 @@
-"""``[joints]``: the arm's joint limits and drives. The limits are compliant stops (a
-spring-damper past each URDF limit, the default), constraints solved implicitly once a control
-period (``stops = "implicit"``: a joint stops at its limit whatever its inertia), or nothing
+"""``[joints]``: the arm's joint limits and drives. The limits are constraints solved
+implicitly once a control period (``stops = "implicit"``, the default with a control period: a
+joint stops at its limit whatever its inertia), compliant stops (``stops = "compliant"``, a
+spring-damper past each URDF limit, the default under continuous control), or nothing
 (``hard_stops = false``). The drives: friction (viscous, regularized Coulomb) and the torque
 bandwidth; without the table there is no friction (``use_model_friction = true`` takes the
 URDF's ``<dynamics damping friction>``) and the torque follows its command at once."""
@@ -19,12 +20,22 @@ from uvms_pin.sim.actuation import Actuation
 from uvms_pin.sim.joint_drive import LaggedJointTorques
 
 
-def build_joint_limits(t: Table, uvms: UVMS) -> tuple[JointStops | None, JointLimits | None]:
+def build_joint_limits(
+    t: Table, uvms: UVMS, sampled: bool
+) -> tuple[JointStops | None, JointLimits | None]:
     """(the compliant stops, the limits as constraints) of [joints]: one of them, or neither
     for a vehicle without joints (or arm joints without limits) or with ``hard_stops =
-    false``."""
+    false``. ``sampled``: the control has a period; the constraints are solved once per
+    period, so they are the default then and refused without one (continuous control takes
+    the compliant stops, which its adaptive integrators resolve)."""
     on = t.boolean("hard_stops", True)
-    kind = t.string("stops", "compliant", choices=("compliant", "implicit"))
+    default = "implicit" if sampled else "compliant"
+    kind = t.string("stops", default, choices=("compliant", "implicit"))
+    if kind == "implicit" and not sampled:
+        raise t.error(
+            "stops",
+            '"implicit" solves the limits once a control period: set [control] period_s',
+        )
     stiffness = t.number("stop_stiffness_Nm_rad", 1.0e3, positive=True)
     damping = t.number("stop_damping_Nm_s_rad", 5.0, nonneg=True)
     if not on or uvms.n_arm_joints == 0:

@@ -42,7 +42,12 @@ from uvms_pin.scenario.overrides import apply_overrides, parse_key_path
 from uvms_pin.scenario.schema import Table
 from uvms_pin.scenario.sensors import build_sensors
 from uvms_pin.scenario.task import build_task
-from uvms_pin.scenario.timing import build_control_period, build_integrator, build_log_period
+from uvms_pin.scenario.timing import (
+    build_control_period,
+    build_integrator,
+    build_log_period,
+    passive_period,
+)
 from uvms_pin.scenario.toml import read_toml
 from uvms_pin.scenario.water import Water, build_water
 from uvms_pin.scenario.world import build_disturbance, build_environment
@@ -119,22 +124,22 @@ def _build(raw: dict[str, Any], path: Path, top: Table) -> Scenario:
     contact = build_environment(top.table("environment"), uvms)
     world = build_world(top.table("world"), uvms, path.parent)
     disturbance = build_disturbance(top.table("disturbance"))
+    integrator, backend = build_integrator(top.table_or_empty("integrator"))
+    log_period = build_log_period(top.table_or_empty("output"))
+    control_period = passive_period(
+        build_control_period(top.table_or_empty("control")),
+        integrator,
+        log_period,
+        passive=(raw.get("controller") or {}).get("type", "none") == "none",
+    )
     joints = top.table_or_empty("joints")
-    joint_stops, joint_limits = build_joint_limits(joints, uvms)
+    joint_stops, joint_limits = build_joint_limits(joints, uvms, control_period is not None)
     friction = build_joint_friction(joints, uvms)
     actuation = with_joint_lag(joints, build_actuation(top.table("actuation"), uvms), uvms)
     joints.finish()
     sensor_config = build_sensors(top.table_or_empty("sensors"), water.density_kg_m3, world)
     estimator = build_estimator(top.table("estimator"), sensor_config.navigation)
     sensor_config = replace(sensor_config, estimator=estimator)
-    integrator, backend = build_integrator(top.table_or_empty("integrator"))
-    control_period = build_control_period(top.table_or_empty("control"))
-    log_period = build_log_period(top.table_or_empty("output"))
-    if control_period is None and joint_limits is not None:
-        raise top.error(
-            "joints",
-            'stops = "implicit" solves the limits once a control period: set [control] period_s',
-        )
     if control_period is None and sensor_config.navigation.fitted:
         raise top.error(
             "sensors", "navigation sensors sample at the control ticks: set [control] period_s"

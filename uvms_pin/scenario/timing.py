@@ -9,7 +9,7 @@ from collections.abc import Callable
 from uvms_pin.checks import Plausible
 from uvms_pin.physics.compiled.backend import BACKENDS
 from uvms_pin.scenario.schema import Table
-from uvms_pin.sim.integrators import RK4, Adaptive, Integrator, SemiImplicitEuler
+from uvms_pin.sim.integrators import RK4, Adaptive, FixedStep, Integrator, SemiImplicitEuler
 
 
 def _seconds(usual: tuple[float, float], usual_text: str, hints=("", "")) -> Plausible:
@@ -64,6 +64,23 @@ def build_control_period(t: Table) -> float | None:
         t.plausible("period_s", period, CONTROL_PERIOD)
     t.finish()
     return period
+
+
+def passive_period(
+    period_s: float | None, integrator: Integrator, log_period_s: float, passive: bool
+) -> float | None:
+    """The control period of a run: ``period_s`` as given; without one, a run with no
+    controller (``passive``) and a fixed-step integrator whose step divides the log period is
+    sampled at that step: nothing is controlled, and the constraints solved once a period
+    (the joint limits) are solved at every step. Otherwise None: continuous control (an
+    adaptive integrator keeps its own steps; a step that does not divide the log period is
+    refused by `SimulationSettings`, naming the step)."""
+    if period_s is not None or not passive or not isinstance(integrator, FixedStep):
+        return period_s
+    ratio = log_period_s / integrator.step_s
+    if ratio < 1.0 - 1e-9 or abs(ratio - round(ratio)) > 1e-6 * ratio:
+        return None
+    return float(integrator.step_s)
 
 
 def build_log_period(t: Table) -> float:

@@ -76,7 +76,6 @@ REASONS: tuple[tuple[Pipeline, Callable[[RunParts], str | None]], ...] = (
     (Pipeline.BOTH, lambda p: "a world (its contacts are stepped period by period)" if p.system.plant.world is not None else None),
     (Pipeline.BATCH, lambda p: "a flow (waves, sea states, varying currents)" if p.system.plant.flow is not None else None),
     (Pipeline.BOTH, lambda p: "stop_at_surface" if p.system.plant.stop_at_surface else None),
-    (Pipeline.BOTH, lambda p: "joint limits as constraints (their solve is Python's)" if p.system.plant.joint_limits is not None else None),
     (Pipeline.BOTH, lambda p: "navigation sensors" if p.sensors.navigation.fitted else None),
     (Pipeline.BOTH, lambda p: "a navigation estimator" if p.sensors.estimator is not None else None),
     (Pipeline.BOTH, lambda p: _fallback(actuation_to_core(p.system.plant.actuation, core_module(), p.system.plant.uvms.nv))),

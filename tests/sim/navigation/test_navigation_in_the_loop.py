@@ -85,5 +85,5 @@ def test_navigation_sensors_in_a_continuous_loop_are_refused_at_load(tmp_path):
 
     with pytest.raises(ScenarioError, match=r"\[control\] period_s"):
         load_scenario(
-            ROOT / "scenarios" / "passive_still_water.toml", {"sensors.depth": {"noise_Pa": 1.0}}
+            ROOT / "scenarios" / "paper_force_tracking.toml", {"sensors.depth": {"noise_Pa": 1.0}}
         )

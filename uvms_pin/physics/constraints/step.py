@@ -47,11 +47,15 @@ from uvms_pin.errors import ParameterError
 from uvms_pin.physics.constraints.rows import ConstraintRows, ConstraintSet
 
 __all__ = [
+    "DEFAULT_CORRECTION",
     "ConstrainedVelocity",
     "constrained_configuration",
     "constrained_velocity",
     "default_settings",
 ]
+
+#: beta, the fraction of a penetration removed per period (the module docstring)
+DEFAULT_CORRECTION = 0.2
 
 #: How often the selection of rows is widened (see `constrained_velocity`)
 _MAX_ROUNDS = 4
@@ -113,7 +117,7 @@ def constrained_velocity(
     constraints: Sequence[ConstraintSet],
     period_s: float,
     *,
-    correction: float = 0.2,
+    correction: float = DEFAULT_CORRECTION,
     settings: pin.ADMMSolverSettings | None = None,
 ) -> ConstrainedVelocity:
     """v+ = v_free + M^-1 J^T lambda over the period ``period_s`` (see the module docstring).

@@ -23,7 +23,7 @@ from types import ModuleType
 
 import numpy as np
 
-from uvms_pin.control.base import Controller
+from uvms_pin.control.base import Controller, ZeroController
 from uvms_pin.control.baselines.computed_torque import ComputedTorqueController
 from uvms_pin.control.baselines.impedance import ImpedanceController
 from uvms_pin.control.baselines.pi_force import PIForceController
@@ -193,6 +193,13 @@ class _ImpedanceLaw(CoreLaw):
             self.controller.posture_q = np.array(state.posture_q)
 
 
+def _zero(controller: ZeroController, core: ModuleType) -> CoreLaw | Fallback:
+    if controller.nq is None:
+        return Fallback("a ZeroController without nq is not compiled")
+    law = core.ZeroLaw(controller.nq, controller.nv)
+    return CoreLaw(controller, law, lambda time_s: np.zeros(0))
+
+
 def _pi_force(controller: PIForceController, core: ModuleType) -> CoreLaw:
     task = controller.task
     settings = _loop_gains(_task_settings(core.PiForceSettings(), task), controller.loop)
@@ -308,6 +315,7 @@ def _task_priority(controller: TaskPriorityController, core: ModuleType) -> Core
 #: The controllers with a compiled law, by their exact class (a subclass may change
 #: `compute`: it runs in Python).
 _LAWS: dict[type, Callable[[Controller, ModuleType], CoreLaw | Fallback]] = {
+    ZeroController: _zero,
     PrescribedPerformanceController: _ppc,
     PIForceController: _pi_force,
     ImpedanceController: _impedance,

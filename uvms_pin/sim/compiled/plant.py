@@ -1,5 +1,5 @@
 """The compiled plant (src/uvms_core/plant.hpp) of a `Plant`: its dynamics, flow, contact,
-disturbance, joint stops, joint friction and world, each built by its own part of the seam
+disturbance, joint stops or limits, joint friction and world, each built by its own part of the seam
 (`uvms_pin.physics.compiled`)."""
 
 from __future__ import annotations
@@ -12,6 +12,7 @@ from uvms_pin.physics.compiled.contact import contact_to_core
 from uvms_pin.physics.compiled.disturbance import disturbance_to_core
 from uvms_pin.physics.compiled.flow import flow_to_core
 from uvms_pin.physics.compiled.joint_friction import joint_friction_to_core
+from uvms_pin.physics.compiled.joint_limits import joint_limits_to_core
 from uvms_pin.physics.compiled.joint_stops import joint_stops_to_core
 from uvms_pin.physics.compiled.world import world_bounds_to_core, world_contact_to_core
 from uvms_pin.physics.dynamics import dynamics_of
@@ -27,6 +28,7 @@ class PlantParts(Protocol):
     contact: Any
     disturbance: Any
     joint_stops: Any
+    joint_limits: Any
     joint_friction: Any
     free_surface: bool
     world: Any
@@ -50,6 +52,7 @@ def plant_to_core(plant: PlantParts, core: ModuleType):
     compiled = core.Plant(dynamics_of(uvms).core, uvms.ee_frame_id if uvms.has_end_effector else 0)
     compiled.flow, compiled.contact, compiled.disturbance, compiled.joint_stops = parts
     compiled.joint_friction = joint_friction_to_core(plant.joint_friction, core)
+    compiled.joint_limits = joint_limits_to_core(plant.joint_limits, uvms.model, core)
     compiled.free_surface = bool(plant.free_surface)
     bounds = world_bounds_to_core(plant.world, core)
     if bounds is not None:

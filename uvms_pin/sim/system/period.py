@@ -11,7 +11,9 @@
 
 This is the one place the step is made: the constraints solved implicitly come after the
 smooth dynamics, for every body at once (`constrained`: today the robot's joint limits; rigid
-contacts, joint friction and attachments join them there).
+contacts, joint friction and attachments join them there). The compiled plant solves the joint
+limits itself at the end of its call (src/uvms_core/joint_limits.hpp, the same step); the
+integrated step is followed by the Python reference's solve.
 """
 
 from __future__ import annotations
@@ -54,12 +56,9 @@ __all__ = ["PeriodStep", "Stepped", "period_step"]
 
 
 def period_step(system: Stepped, integrator: Integrator) -> PeriodStep:
-    """The period step of ``system`` with ``integrator`` (see the module docstring), then,
-    with the robot's joint limits as constraints, their implicit solve (`constrained`)."""
-    smooth = _smooth_step(system, integrator)
-    if system.plant.joint_limits is None:
-        return smooth
-    return constrained(system, smooth)
+    """The period step of ``system`` with ``integrator`` (see the module docstring), with the
+    robot's joint limits as constraints solved implicitly at its end (`constrained`)."""
+    return _step(system, integrator)
 
 
 def constrained(system: Stepped, smooth: PeriodStep) -> PeriodStep:
@@ -85,8 +84,9 @@ def constrained(system: Stepped, smooth: PeriodStep) -> PeriodStep:
     return step
 
 
-def _smooth_step(system: Stepped, integrator: Integrator) -> PeriodStep:
-    """The smooth dynamics' period step (see the module docstring)."""
+def _step(system: Stepped, integrator: Integrator) -> PeriodStep:
+    """The period step (see the module docstring): the compiled plant's call (its joint
+    limits solved in it) or the integrated step (then `constrained` in Python)."""
     plant = system.plant
     compiled = plant.compiled
     step = None
@@ -94,12 +94,14 @@ def _smooth_step(system: Stepped, integrator: Integrator) -> PeriodStep:
         step = integrator_to_core(integrator, core_module())
         step = None if isinstance(step, Fallback) else step
 
-    def integrated(t0, q0, v0, tau, t1):
+    def smooth(t0, q0, v0, tau, t1):
         q1, v1 = integrator.advance(
             system.model, lambda t, q, v: system.acceleration(t, q, v, tau), t0, q0, v0, t1
         )
         system.settle(q1, v1)
         return q1, v1
+
+    integrated = smooth if plant.joint_limits is None else constrained(system, smooth)
 
     # the compiled plant is rebuilt when a run starts (its contact anchored anew): taken at
     # each period, the choice of step stays
