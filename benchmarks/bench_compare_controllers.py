@@ -12,7 +12,12 @@ the first row's (the PPC's by default; on a tracking scenario name its controlle
 process's CPU time, best of ``--repeat`` interleaved rounds (`timing.py`). The path each run
 took (the compiled sampled loop, or the Python loop and why) is printed with it, and, with
 ``--python-loop``, each row's time on the Python loop too (``compiled_loop=False``: what a
-controller without a compiled law costs), as a ratio to the same PPC row.
+controller without a compiled law costs), as a ratio to the same PPC row, and the row's
+compiled loop as a ratio to its own Python loop (the column "compiled / python"). The
+compiled task-priority loop against its Python loop, on the LBV150 circle:
+
+    .venv/bin/python benchmarks/bench_compare_controllers.py scenarios/lbv150_ee_circle.toml \
+        --controllers task_priority,task_priority_ppc,computed_torque_task --python-loop
 """
 
 from __future__ import annotations
@@ -61,7 +66,7 @@ def main() -> None:
     base = seconds[first, True]
     print(f"{Path(args.scenario).name}, {args.duration:g} s simulated per run, "
           f"best of {args.repeat}; ratios to the {first} row ({base:.3f} s)")  # fmt: skip
-    print(f"{'controller':<18}{'ratio':>8}{'python loop':>13}  loop")
+    print(f"{'controller':<22}{'ratio':>8}{'python loop':>13}{'compiled / python':>19}  loop")
     ratios = {}
     for name in names:
         ratio = seconds[name, True] / base
@@ -69,9 +74,10 @@ def main() -> None:
         ratios[name] = {
             f"ratio_to_{first}": ratio,
             "python_loop_ratio": python,
+            "compiled_to_python": ratio / python,
             "loop": paths[name],
         }
-        print(f"{name:<18}{ratio:>8.2f}{python:>13.2f}  {paths[name]}")
+        print(f"{name:<22}{ratio:>8.2f}{python:>13.2f}{ratio / python:>19.3f}  {paths[name]}")
     if args.json is not None:
         args.json.write_text(json.dumps(ratios, indent=1))
 

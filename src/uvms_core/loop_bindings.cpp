@@ -3,10 +3,13 @@
 #include <nanobind/eigen/dense.h>
 #include <nanobind/nanobind.h>
 #include <nanobind/ndarray.h>
+#include <nanobind/stl/optional.h>
+#include <nanobind/stl/pair.h>
 #include <nanobind/stl/string.h>
 #include <nanobind/stl/vector.h>
 
 #include "law_force_baselines.hpp"
+#include "law_task_priority.hpp"
 #include "law_tracking.hpp"
 #include "law_zero.hpp"
 #include "ppc.hpp"
@@ -122,6 +125,103 @@ void bind_force_baselines(nb::module_& m) {
       .def_rw("state", &uvms::ComputedTorqueLaw::state);
 }
 
+// The task-priority law (law_task_priority.hpp), its settings and its dynamic levels'.
+void bind_task_priority_law(nb::module_& m) {
+  using uvms::TaskPrioritySettings;
+  nb::class_<TaskPrioritySettings>(m, "TaskPrioritySettings",
+                                   "The tracking task and the kinematic level's gains "
+                                   "(task_priority.hpp).")
+      .def(nb::init<>())
+      .def_rw("vehicle_target", &TaskPrioritySettings::vehicle_target)
+      .def_rw("vehicle_frame", &TaskPrioritySettings::vehicle_frame)
+      .def_rw("frame_id", &TaskPrioritySettings::frame_id)
+      .def_rw("rotation_reference", &TaskPrioritySettings::rotation_reference)
+      .def_rw("rows", &TaskPrioritySettings::rows)
+      .def_rw("position_gain_per_s", &TaskPrioritySettings::position_gain_per_s)
+      .def_rw("orientation_gain_per_s", &TaskPrioritySettings::orientation_gain_per_s)
+      .def_rw("attitude_gain_per_s", &TaskPrioritySettings::attitude_gain_per_s)
+      .def_rw("joint_limit_margin_rad", &TaskPrioritySettings::joint_limit_margin_rad)
+      .def_rw("joint_limit_gain_per_s", &TaskPrioritySettings::joint_limit_gain_per_s)
+      .def_rw("manipulability_threshold", &TaskPrioritySettings::manipulability_threshold)
+      .def_rw("manipulability_gain", &TaskPrioritySettings::manipulability_gain)
+      .def_rw("velocity_weights", &TaskPrioritySettings::velocity_weights)
+      .def_rw("damping", &TaskPrioritySettings::damping)
+      .def_rw("passive_velocities", &TaskPrioritySettings::passive_velocities);
+  using uvms::InverseDynamicsSettings;
+  nb::class_<InverseDynamicsSettings>(m, "InverseDynamicsSettings",
+                                      "InverseDynamicsLevel's gains (dynamic_level.hpp).")
+      .def(nb::init<>())
+      .def_rw("velocity_gain_per_s", &InverseDynamicsSettings::velocity_gain_per_s)
+      .def_rw("integral_gain_per_s2", &InverseDynamicsSettings::integral_gain_per_s2)
+      .def_rw("integral_limit", &InverseDynamicsSettings::integral_limit);
+  using uvms::InverseDynamicsState;
+  nb::class_<InverseDynamicsState>(m, "InverseDynamicsState",
+                                   "InverseDynamicsLevel's integral and last call.")
+      .def(nb::init<>())
+      .def_rw("integral", &InverseDynamicsState::integral)
+      .def_rw("started", &InverseDynamicsState::started)
+      .def_rw("last_time_s", &InverseDynamicsState::last_time_s);
+  using uvms::PpcVelocitySettings;
+  nb::class_<PpcVelocitySettings>(m, "PpcVelocitySettings",
+                                  "PpcVelocityLevel's gain and funnel (dynamic_level.hpp).")
+      .def(nb::init<>())
+      .def_rw("gain", &PpcVelocitySettings::gain)
+      .def_rw("rho0", &PpcVelocitySettings::rho0)
+      .def_rw("rho_inf", &PpcVelocitySettings::rho_inf)
+      .def_rw("decay_rate_per_s", &PpcVelocitySettings::decay_rate_per_s);
+  using uvms::TaskPriorityLaw;
+  nb::class_<TaskPriorityLaw, uvms::SampledLaw>(m, "TaskPriorityLaw",
+                                                "The task-priority law (law_task_priority.hpp).")
+      .def(
+          "__init__",
+          [](TaskPriorityLaw* self, const std::string& model_text,
+             const TaskPrioritySettings& s, const uvms::Dynamics& dynamics,
+             const InverseDynamicsSettings& level) {
+            new (self) TaskPriorityLaw(uvms::model_from_text(model_text), s, dynamics, level);
+          },
+          "model_text"_a, "settings"_a, "dynamics"_a, "level"_a,
+          "With the inverse-dynamics level on `dynamics`.")
+      .def(
+          "__init__",
+          [](TaskPriorityLaw* self, const std::string& model_text,
+             const TaskPrioritySettings& s, const PpcVelocitySettings& level) {
+            new (self) TaskPriorityLaw(uvms::model_from_text(model_text), s, level);
+          },
+          "model_text"_a, "settings"_a, "level"_a, "With the PPC's velocity level.")
+      .def_prop_rw("state", &TaskPriorityLaw::state, &TaskPriorityLaw::set_state,
+                   "The inverse-dynamics level's committed state.");
+}
+
+// The prioritized recursion of the kinematic level (task_priority.hpp), for the tests.
+void bind_prioritized_velocity(nb::module_& m) {
+  m.def(
+      "prioritized_velocity",
+      [](const std::vector<std::pair<Eigen::MatrixXd, Eigen::VectorXd>>& tasks,
+         const Eigen::VectorXd& weights, double damping,
+         const std::optional<Eigen::VectorXd>& secondary) {
+        const auto n = weights.size();
+        if (n == 0 || !(weights.array() > 0.0).all() || !(damping > 0.0)) {
+          throw uvms::InputError("prioritized_velocity: weights and damping must be positive");
+        }
+        std::vector<uvms::PriorityTask> list;
+        for (const auto& [jacobian, rate] : tasks) {
+          if (jacobian.cols() != n || rate.size() != jacobian.rows()) {
+            throw uvms::InputError("prioritized_velocity: a task's J must be m x " +
+                                   std::to_string(n) + " and its x of m entries");
+          }
+          list.push_back({jacobian, rate});
+        }
+        if (secondary && secondary->size() != n) {
+          throw uvms::InputError("prioritized_velocity: secondary needs " + std::to_string(n) +
+                                 " entries");
+        }
+        return uvms::prioritized_velocity(list, weights, damping,
+                                          secondary ? &*secondary : nullptr);
+      },
+      "tasks"_a, "weights"_a, "damping"_a, "secondary"_a = nb::none(),
+      "task_priority.py's prioritized_velocity (task_priority.hpp).");
+}
+
 void bind_tracking_laws(nb::module_& m) {
   using uvms::ResolvedAccelerationSettings;
   nb::class_<ResolvedAccelerationSettings> ra_settings(
@@ -140,6 +240,8 @@ void bind_tracking_laws(nb::module_& m) {
       m, "ResolvedAccelerationLaw", "The resolved-acceleration law (law_tracking.hpp).")
       .def(nb::init<const uvms::Dynamics&, ResolvedAccelerationSettings>(), "dynamics"_a,
            "settings"_a);
+  bind_task_priority_law(m);
+  bind_prioritized_velocity(m);
 }
 
 }  // namespace

@@ -138,10 +138,6 @@ def test_law_to_core_says_why_a_controller_has_no_law():
     assert law_to_core(python, core).reason == "the controller's Python backend"
     motion = ComputedTorqueController(scenario.uvms, ee, reference=lambda t: (None, None, None))
     assert "motion reference" in law_to_core(motion, core).reason
-    path = ROOT / "scenarios" / "lbv150_ee_circle.toml"
-    tracking = controller_scenarios(path, ["task_priority"])["task_priority"]
-    priority = law_to_core(tracking.controller_factory(tracking.uvms), core)
-    assert "TaskPriorityController is not compiled" in priority.reason
 
 
 @pytest.mark.parametrize(

@@ -8,8 +8,8 @@ controller evaluates them), the law's state handed between the Python controller
 core (the Python loop runs the ticks the core declines), and the named signals of its
 packed buffer, in the order the Python controller logs them. Or a `Fallback` naming why the
 controller runs in Python: a user's own controller or a subclass (its `compute` is not the
-one the core mirrors), the controller's Python backend, a motion reference, the
-task-priority controller (not compiled yet).
+one the core mirrors), the controller's Python backend, a motion reference, a task-priority
+controller on a dynamic level of another class.
 
 Each law reads the controller's public attributes only; the law mirrors the controller's
 `compute` line by line (tests/sim/test_compiled_laws.py: the whole rollout to 1e-12).
@@ -31,7 +31,12 @@ from uvms_pin.control.baselines.task import EndEffectorTask, ForceOrientationLoo
 from uvms_pin.control.performance import transformed_error
 from uvms_pin.control.ppc import PPCSignals, PrescribedPerformanceController
 from uvms_pin.control.pseudo_inverse import REFINE_ABOVE_CONDITION_BOUND
-from uvms_pin.control.tracking.controllers import ResolvedAccelerationController, task_signals
+from uvms_pin.control.tracking.controllers import (
+    ResolvedAccelerationController,
+    TaskPriorityController,
+    task_signals,
+)
+from uvms_pin.control.tracking.dynamic_level import InverseDynamicsLevel, PpcVelocityLevel
 from uvms_pin.control.tracking.task import TrackingTask
 from uvms_pin.physics.compiled.backend import Fallback
 from uvms_pin.physics.dynamics import dynamics_of
@@ -239,14 +244,19 @@ def _path_desired(task: TrackingTask) -> Callable[[float], np.ndarray]:
     return desired
 
 
-def _resolved_acceleration(controller: ResolvedAccelerationController, core: ModuleType) -> CoreLaw:
-    task = controller.task
-    settings = core.ResolvedAccelerationSettings()
+def _tracking_settings(settings, task: TrackingTask, model):
+    """The tracking task's fields of the core's ``settings`` (TrackingTaskSettings)."""
     settings.vehicle_target = task.target == "vehicle"
     settings.vehicle_frame = task.frame == "vehicle"
-    settings.frame_id = task.frame_id(controller.model)
+    settings.frame_id = task.frame_id(model)
     settings.rotation_reference = np.asarray(task.rotation_reference, dtype=float)
     settings.rows = task.rows.stop
+    return settings
+
+
+def _resolved_acceleration(controller: ResolvedAccelerationController, core: ModuleType) -> CoreLaw:
+    task = controller.task
+    settings = _tracking_settings(core.ResolvedAccelerationSettings(), task, controller.model)
     settings.position_gain_per_s2 = controller.k_p
     settings.velocity_gain_per_s = controller.k_d
     settings.null_space_damping_per_s = controller.k_n
@@ -254,6 +264,52 @@ def _resolved_acceleration(controller: ResolvedAccelerationController, core: Mod
     law = core.ResolvedAccelerationLaw(dynamics_of(controller.uvms, "core").core, settings)
     described = task_signals(task, np.zeros(3), np.zeros(3))
     return CoreLaw(controller, law, _path_desired(task), described)
+
+
+class _InverseDynamicsLaw(CoreLaw):
+    """The task-priority law on inverse dynamics, its integral and last call its state."""
+
+    def push(self) -> None:
+        level, state = self.controller.dynamic, self.law.state
+        state.integral, state.started = level.integral, level.last_time_s is not None
+        state.last_time_s = level.last_time_s or 0.0  # read only when started
+        self.law.state = state
+
+    def pull(self, time_s: float, desired: np.ndarray) -> None:
+        level, state = self.controller.dynamic, self.law.state
+        level.integral = np.array(state.integral)
+        level.last_time_s = state.last_time_s if state.started else None
+
+
+def _task_priority(controller: TaskPriorityController, core: ModuleType) -> CoreLaw | Fallback:
+    dynamic, kinematics = controller.dynamic, controller.kinematics
+    if type(dynamic) not in (InverseDynamicsLevel, PpcVelocityLevel):
+        return Fallback(f"the dynamic level {type(dynamic).__name__} is not compiled")
+    task, gains, model = controller.task, kinematics.gains, kinematics.model
+    settings = _tracking_settings(core.TaskPrioritySettings(), task, model)
+    for name in ("position_gain_per_s", "orientation_gain_per_s", "attitude_gain_per_s",
+                 "joint_limit_margin_rad", "joint_limit_gain_per_s", "manipulability_threshold",
+                 "manipulability_gain", "damping"):  # fmt: skip
+        setattr(settings, name, float(getattr(gains, name)))
+    settings.velocity_weights = kinematics.weights
+    settings.passive_velocities = kinematics.passive.tolist()
+    described = task_signals(task, np.zeros(3), np.zeros(3))
+    if kinematics.bounded_q.size:
+        names = [f"joint_{k + 1}" for k in range(kinematics.bounded_q.size)]
+        described["joint_limit_active"] = Signal(np.zeros(len(names)), names, "")
+    if type(dynamic) is PpcVelocityLevel:
+        level = core.PpcVelocitySettings()
+        funnel = dynamic.funnel
+        level.gain, level.rho0, level.rho_inf = dynamic.k, funnel.rho0, funnel.rho_inf
+        level.decay_rate_per_s = funnel.decay_rate_per_s
+        law = core.TaskPriorityLaw(model.saveToString(), settings, level)
+        return CoreLaw(controller, law, _path_desired(task), described)
+    level = core.InverseDynamicsSettings()
+    level.velocity_gain_per_s, level.integral_gain_per_s2 = dynamic.k_v, dynamic.k_i
+    level.integral_limit = dynamic.limit
+    dynamics = dynamics_of(dynamic.uvms, "core").core
+    law = core.TaskPriorityLaw(model.saveToString(), settings, dynamics, level)
+    return _InverseDynamicsLaw(controller, law, _path_desired(task), described)
 
 
 #: The controllers with a compiled law, by their exact class (a subclass may change
@@ -265,6 +321,7 @@ _LAWS: dict[type, Callable[[Controller, ModuleType], CoreLaw | Fallback]] = {
     ImpedanceController: _impedance,
     ComputedTorqueController: _computed_torque,
     ResolvedAccelerationController: _resolved_acceleration,
+    TaskPriorityController: _task_priority,
 }
 
 
