@@ -83,6 +83,25 @@ class ParameterError(UvmsPinError, ValueError):
     """An argument has the wrong shape, a non-finite value or is out of its valid range."""
 
 
+class InitialOverlapError(ParameterError):
+    """Two bodies overlap at the start of a run deeper than the tolerance (a free object
+    placed inside the robot, another free object, a fixed object or the seabed): the
+    contact would start compressed and fling them apart.
+
+    Attributes:
+        first, second: the two bodies' names. depth_m: how deep they overlap [m].
+    """
+
+    def __init__(self, first: str, second: str, depth_m: float, tolerance_m: float, how: str):
+        super().__init__(
+            f"'{first}' and '{second}' overlap by {depth_m * 1e3:.3g} mm at the start (more "
+            f"than the {tolerance_m * 1e3:g} mm tolerance): {how}"
+        )
+        self.first = first
+        self.second = second
+        self.depth_m = depth_m
+
+
 class ScenarioError(UvmsPinError):
     """A scenario or study file is malformed: unknown key, wrong type, missing entry."""
 
