@@ -95,7 +95,7 @@ class InitialOverlapError(ParameterError):
     def __init__(self, first: str, second: str, depth_m: float, tolerance_m: float, how: str):
         super().__init__(
             f"'{first}' and '{second}' overlap by {depth_m * 1e3:.3g} mm at the start (more "
-            f"than the {tolerance_m * 1e3:g} mm tolerance): {how}"
+            f"than the {tolerance_m * 1e3:.2g} mm tolerance): {how}"
         )
         self.first = first
         self.second = second

@@ -5,18 +5,16 @@ that the run starts without a kick."""
 
 from __future__ import annotations
 
-import math
-
 import numpy as np
 import pinocchio as pin
 import pytest
-from conftest import RHO, ROOT, G, run
+from conftest import RHO, ROOT, run
 
 from uvms_pin.errors import InitialOverlapError, ParameterError
 from uvms_pin.physics.world.contact_law import ContactLaw
 from uvms_pin.physics.world.free_object import free_object
 from uvms_pin.physics.world.objects import plane
-from uvms_pin.physics.world.overlap import OVERLAP_TOLERANCE_M
+from uvms_pin.physics.world.overlap import OVERLAP_TOLERANCE_M, tolerance_m
 from uvms_pin.physics.world.world import World
 from uvms_pin.sim.integrators import RK4
 from uvms_pin.sim.plant import Plant
@@ -68,8 +66,13 @@ def test_a_sphere_inside_the_seabed_is_refused(load_body):
     floor = plane("seabed", [0, 0, FLOOR_Z], [0, 0, 1], 0.6, 0.5)
     ball = _ball("ball", [0.0, 0.0, FLOOR_Z + RADIUS - 0.03])  # 3 cm into the seabed
     system = _system(pusher, [ball], [floor])
-    with pytest.raises(InitialOverlapError, match=r"'seabed' and 'ball' overlap by 30 mm"):
+    with pytest.raises(
+        InitialOverlapError, match=r"'seabed' and 'ball' overlap by 30 mm"
+    ) as caught:
         system.initial_state(_far(pusher), np.zeros(6))
+    # its tolerance: twice the depth at which one point carries its net weight (6.5 mm)
+    assert "more than the 6.5 mm tolerance" in str(caught.value)
+    assert 2 * _net_weight(ball) / 2e4 == pytest.approx(6.47e-3, abs=5e-6)
 
 
 def test_two_free_objects_overlapping_are_refused(load_body):
@@ -84,20 +87,27 @@ def test_two_free_objects_overlapping_are_refused(load_body):
 
 
 def test_resting_contacts_are_accepted(load_body):
-    """Touching (depth 0), and a box at its resting depth (W - B) / (4 k) on the seabed:
-    within the tolerance, the state is the scenario's."""
+    """Touching (depth 0), a dense sphere at its resting depth (W - B) / k (3.2 mm) and a
+    dense box at its resting depth (W - B) / (4 k) (7.6 mm) on the seabed: within their
+    tolerances (2 (W - B) / k), the state is the scenario's."""
     pusher = _pusher(load_body)
+    law = ContactLaw()
     floor = plane("seabed", [0, 0, FLOOR_Z], [0, 0, 1], 0.6, 0.5)
-    ball = _ball("ball", [0.0, 0.0, FLOOR_Z + RADIUS])
-    size = (0.25, 0.5, 0.25)
-    net = (1100.0 - RHO) * math.prod(size) * G
-    resting = net / (4 * ContactLaw().stiffness_N_m)
-    assert 0.0 < resting < OVERLAP_TOLERANCE_M
+    probe = _ball("ball", [0.0, 0.0, 0.0])
+    sunk = _net_weight(probe) / law.stiffness_N_m
+    ball = _ball("ball", [0.0, 0.0, FLOOR_Z + RADIUS - sunk])
+    size = [0.25, 0.5, 0.25]
     box = free_object(
-        "box", "box", {"size_m": list(size)}, ([1.0, 0.0, FLOOR_Z + 0.125 - resting], [0, 0, 0]),
-        density_kg_m3=1100.0, water_density_kg_m3=RHO,
+        "box", "box", {"size_m": size}, ([1.0, 0.0, 0.0], [0, 0, 0]),
+        density_kg_m3=3000.0, water_density_kg_m3=RHO,
     )  # fmt: skip
-    touching = _ball("touching", [0.0, 0.2, FLOOR_Z + RADIUS])  # touches the ball's side
+    resting = _net_weight(box) / (4 * law.stiffness_N_m)
+    assert OVERLAP_TOLERANCE_M < sunk < resting < tolerance_m(box, law)
+    box = free_object(
+        "box", "box", {"size_m": size}, ([1.0, 0.0, FLOOR_Z + 0.125 - resting], [0, 0, 0]),
+        density_kg_m3=3000.0, water_density_kg_m3=RHO,
+    )  # fmt: skip
+    touching = _ball("touching", [0.0, 0.2, FLOOR_Z + RADIUS - sunk])  # touches the ball
     system = _system(pusher, [ball, box, touching], [floor])
     state = system.initial_state(_far(pusher), np.zeros(6))
     np.testing.assert_array_equal(state.q[7:14], ball.q0)
@@ -120,7 +130,8 @@ def test_separate_moves_the_sphere_out_of_the_vehicle_and_the_run_has_no_kick(re
     moved = state.q[uvms.nq : uvms.nq + 3] - ball.q0[:3]
     assert np.linalg.norm(moved) >= move.depth_m - 1e-12
     record = system.record()["world"]["initial_overlap"]
-    assert record["mode"] == "separate" and record["tolerance_m"] == OVERLAP_TOLERANCE_M
+    assert record["mode"] == "separate"
+    assert record["tolerance_m"] == {"ball": pytest.approx(2 * _net_weight(ball) / 2e4)}
     assert record["moved"][0]["object"] == "ball"
     assert record["moved"][0]["depth_m"] == pytest.approx(move.depth_m)
     # nothing deeper than the tolerance is left
@@ -128,11 +139,13 @@ def test_separate_moves_the_sphere_out_of_the_vehicle_and_the_run_has_no_kick(re
     system.start(state)
     q_sys, v_sys, peak = state.q, state.v, 0.0
     for k in range(250):  # 0.5 s
-        q_sys, v_sys = system.advance(RK4(5e-4), k * 2e-3, q_sys, v_sys, np.zeros(uvms.nv), (k + 1) * 2e-3)
+        q_sys, v_sys = system.advance(
+            RK4(5e-4), k * 2e-3, q_sys, v_sys, np.zeros(uvms.nv), (k + 1) * 2e-3
+        )
         (q_r, v_r), *objects = system.layout.split(q_sys, v_sys)
         sets, _ = system.moving.found(q_r, v_r, objects)
         peak = max([peak, *(float(np.abs(s.normal_N).max()) for s in sets if len(s))])
-    weight = (ball.mass_kg - RHO * 4 / 3 * math.pi * RADIUS**3) * G
+    weight = _net_weight(ball)
     assert peak < 5.0 * weight  # the net weight of the ball scale (~68 N), not kN
     vehicle_speed = np.linalg.norm(v_sys[:3])
     assert vehicle_speed < 0.05
@@ -153,7 +166,7 @@ def test_the_command_line_refuses_an_overlap_with_status_2_and_one_line(tmp_path
     assert result.returncode == 2, result.stderr
     lines = result.stderr.strip().splitlines()
     assert lines == [
-        "uvms-pin: error: 'seabed' and 'box' overlap by 75 mm at the start (more than the 1 "
+        "uvms-pin: error: 'seabed' and 'box' overlap by 75 mm at the start (more than the 2.3 "
         'mm tolerance): place them apart, or set [world] initial_overlap = "separate" to move '
         "the free object out along the contact normal before the run"
     ]
@@ -169,6 +182,11 @@ def _pusher(load_body):
         collision=f'<sphere radius="{RADIUS}"/>',
     )  # fmt: skip
     return load_body(urdf)
+
+
+def _net_weight(obj) -> float:
+    """W - B [N]."""
+    return -obj.uvms.net_buoyancy_N
 
 
 def _far(pusher) -> np.ndarray:

@@ -22,7 +22,7 @@ import numpy as np
 import pinocchio as pin
 
 from uvms_pin.physics.dynamics import forward_dynamics, mass_matrix
-from uvms_pin.physics.world.overlap import OVERLAP_TOLERANCE_M
+from uvms_pin.physics.world.overlap import tolerance_m
 from uvms_pin.sim.integrators import Integrator
 from uvms_pin.sim.plant import Plant, checked_start, has_moving_contacts
 from uvms_pin.sim.system.free_objects import FreeObjects
@@ -197,7 +197,9 @@ class System:
             if self.objects:
                 out["world"]["initial_overlap"] = {
                     "mode": self.plant.world.initial_overlap,
-                    "tolerance_m": OVERLAP_TOLERANCE_M,
+                    "tolerance_m": {
+                        o.name: tolerance_m(o, self.plant.world.law) for o in self.objects
+                    },
                     "moved": [o.record(self.objects[o.moved].name) for o in self.separations],
                 }
         return out
