@@ -28,17 +28,33 @@ Coulomb's mu_s and mu_k are the regime switch: the box (mu_s = 0.6) sticks at 10
 f / N = 0.25 tan(theta) and 0.26 tan(theta) and roll at both.
 
 The acceleration is the second derivative of a quadratic fitted to the distance travelled
-from 0.2 s to 1 s (the first 0.2 s: the contact settling from the resting depth the body is
-released at), within 2 % of the analytic one (a sticking box: it creeps less than 0.1 mm).
+from 0.2 s to 1 s (the first 0.2 s: the stick springs taking their load), within 2 % of the
+analytic one; a sticking box creeps less than 1 mm (its stick springs' stretch, the load
+over 4 k_t, and its tilt on its compliant corners) and comes to rest (its fitted
+acceleration below 0.01 m/s^2). The penalty contact
+sinks a body by delta = N / (n k) (3 mm for the sphere at the default k): a sphere rolls
+about coal's point, r - delta / 2 from its centre, 0.8 % slower than the rigid r at 10
+degrees. The cylinder touches a plane by the 2 x 16 corners of its rims' prism
+(`uvms_pin.physics.world.robot_geometry`): it rolls as a 16-gon, each corner landing with an
+impact that takes energy, and about corners delta deep: 4.0 % slower than the smooth
+cylinder at 10 degrees, 2.3 % at 40. That is the contact's geometry, not its friction (the
+cylinder rolled so before the friction's material points); within 5 %, and the 2 % of the
+smooth cylinder is expected to fail (strict xfail) until its rims touch as circles.
 
 The mechanical energy E = T + (m - rho V) g z + 1/2 k sum delta_i^2 + 1/2 k_t sum |s_i|^2
-(kinetic with the added mass, gravity with the buoyancy, and what the contact's springs
-hold) never rises by more than 1e-6 J over the run, read after each control period: the
-contact dissipates (Hunt-Crossley's damper, the tangential damper, the kinetic friction),
-and what is left is the explicit integration of the stiff contact springs and the friction
-anchors moving once a period (a rolling point's material point moves on at the period's end:
-its force acts at the contact point while its stretch is measured at the material point
-that was there when the period began, a difference of order (omega dt)^2 r).
+(kinetic with the added mass, gravity with the buoyancy, what the normal springs and the
+stick springs of the sticking points hold; a slipping point's friction is Coulomb's kinetic
+one, its anchor following) never rises by more than 1e-4 of the kinetic energy gained over
+the run (1e-4 J at least), read after each control period. It cannot stay within 1e-9 J:
+the contact dissipates (Hunt-Crossley's damper, the tangential damper, the kinetic friction)
+but a rolling sphere's stick spring is measured at the material point that was at the
+contact when the period began, while its force acts at the contact point. Over a period that
+point leaves the contact along a cycloid, its tangential drift r (omega dt)^3 / 6, and the
+spring gains k_t |s| times it with no work done by the force: a rise of the order of the
+stick spring's energy, third order in omega dt. Measured: the sphere gains 1.3e-5 J at 10
+degrees and 2.4e-3 J at 40 (49 J of kinetic energy at 1 s, 24 rad/s); the box and the
+cylinder never gain. Before the stretch was measured from material points a sphere on an
+8-degree slope gained 8.1 J in 1 s and spun at 19.7 rad/s while moving 2 cm.
 """
 
 from __future__ import annotations
@@ -71,8 +87,8 @@ SHAPES = {
 }
 #: the points a resting body touches the slope by (its resting depth: N / (points k))
 POINTS = {"sphere": 1, "cylinder": 2, "box": 4}
-#: the rise of the mechanical energy allowed over a run [J]
-ENERGY_RISE_J = 1e-6
+#: the rise of the mechanical energy allowed, relative to the kinetic energy gained
+ENERGY_RISE = 1e-4
 
 
 def _undamped(obj):
@@ -158,7 +174,10 @@ def _energy(slope: Slope, q: np.ndarray, v: np.ndarray) -> float:
     weight = -obj.uvms.net_buoyancy_N
     _, (forces,) = system.moving.found(q_r, v_r, [(q_o, v_o)])
     springs = 0.5 * law.stiffness_N_m * float(np.sum(forces.touch.depth_m**2))
-    springs += 0.5 * law.tangential_stiffness_N_m * float(np.sum(forces.stretch_m**2))
+    # a sticking point's stick spring holds 1/2 k_t |s|^2; a slipping point's friction is
+    # Coulomb's kinetic one, not its spring's (the anchor follows it): nothing held
+    stretch = np.linalg.norm(forces.stretch_m, axis=1)[forces.sticking]
+    springs += 0.5 * law.tangential_stiffness_N_m * float(np.sum(stretch**2))
     return up.kinetic_energy(obj.uvms, q_o, v_o) + weight * q_o[2] + springs
 
 
@@ -198,24 +217,41 @@ def test_the_sphere_s_effective_mass_is_the_closed_form(load_body):
 
 
 @pytest.mark.parametrize("theta_deg", [10.0, 40.0])
-@pytest.mark.parametrize("kind", ["sphere", "cylinder", "box"])
+@pytest.mark.parametrize(("kind", "within"), [("sphere", 0.02), ("cylinder", 0.05), ("box", 0.02)])
 def test_released_on_a_slope_it_rolls_slides_or_sticks_as_the_analytic_case(
-    load_body, kind, theta_deg
+    load_body, kind, within, theta_deg
 ):
     slope = _slope(load_body, kind, theta_deg)
     expected_regime = {"sphere": "rolls", "cylinder": "rolls"}.get(
         kind, "sticks" if theta_deg == 10.0 else "slides"
     )
     assert slope.regime == expected_regime
-    times, distance, energy, (_, v) = _released(slope)
-    late = times >= 0.2
-    acceleration = 2.0 * np.polyfit(times[late], distance[late], 2)[0]
+    times, distance, energy, (q_end, v_end) = _released(slope)
+    _, (q, v) = slope.system.layout.split(q_end, v_end)  # the body's
     if slope.regime == "sticks":
-        assert abs(distance[-1]) < 1e-4
-        assert np.linalg.norm(v[-6:]) < 1e-3
+        assert abs(distance[-1]) < 1e-3
+        assert np.linalg.norm(v[:3]) < 1e-3  # at rest (rocking on its corners at 1 mrad/s)
+        assert abs(_acceleration(times, distance)) < 0.01  # no creep building up
     else:
-        assert acceleration == pytest.approx(slope.expected_m_s2, rel=0.02)
+        assert _acceleration(times, distance) == pytest.approx(slope.expected_m_s2, rel=within)
     if slope.regime == "rolls":  # no slip: the spin is the speed over the radius
-        speed = np.linalg.norm(v[-6:-3])
-        assert np.linalg.norm(v[-3:]) == pytest.approx(speed / 0.1, rel=0.02)
-    assert _rise(energy) <= ENERGY_RISE_J
+        speed = np.linalg.norm(v[:3])
+        assert np.linalg.norm(v[3:]) == pytest.approx(speed / 0.1, rel=0.02)
+    kinetic = up.kinetic_energy(slope.obj.uvms, q, v)
+    assert _rise(energy) <= ENERGY_RISE * max(kinetic, 1.0)
+
+
+@pytest.mark.xfail(
+    strict=True, reason="a cylinder touches a plane by its rims' 16-gon prism: it rolls 2-4 % slow"
+)
+@pytest.mark.parametrize("theta_deg", [10.0, 40.0])
+def test_a_cylinder_rolls_as_the_smooth_cylinder_within_2_percent(load_body, theta_deg):
+    slope = _slope(load_body, "cylinder", theta_deg)
+    times, distance, _, _ = _released(slope)
+    assert _acceleration(times, distance) == pytest.approx(slope.expected_m_s2, rel=0.02)
+
+
+def _acceleration(times: np.ndarray, distance: np.ndarray) -> float:
+    """The second derivative of the quadratic fitted from 0.2 s on [m/s^2]."""
+    late = times >= 0.2
+    return 2.0 * float(np.polyfit(times[late], distance[late], 2)[0])
