@@ -90,16 +90,21 @@ class InitialOverlapError(ParameterError):
 
     Attributes:
         first, second: the two bodies' names. depth_m: how deep they overlap [m].
+        tolerance_m: the deepest overlap allowed there [m].
     """
 
     def __init__(self, first: str, second: str, depth_m: float, tolerance_m: float, how: str):
-        super().__init__(
-            f"'{first}' and '{second}' overlap by {depth_m * 1e3:.3g} mm at the start (more "
-            f"than the {tolerance_m * 1e3:.2g} mm tolerance): {how}"
+        self.first, self.second, self.depth_m, self.tolerance_m = (
+            first,
+            second,
+            depth_m,
+            tolerance_m,
         )
-        self.first = first
-        self.second = second
-        self.depth_m = depth_m
+        depth_mm, tolerance_mm = depth_m * 1e3, tolerance_m * 1e3
+        super().__init__(
+            f"'{first}' and '{second}' overlap by {depth_mm:.3g} mm at the start (more than "
+            f"the {tolerance_mm:.2g} mm tolerance): {how}"
+        )
 
 
 class ScenarioError(UvmsPinError):
