@@ -98,7 +98,8 @@ def _touching_state(world: World, rng: np.random.Generator) -> tuple[np.ndarray,
 
 
 def _memory(world: World, q, v, rng: np.random.Generator) -> FrictionMemory:
-    """Anchors a few mm from the contact points, one patch slipping (when some touch)."""
+    """Anchors a few mm from the contact points, coal's points measured from material points
+    a few mm off, one patch slipping (when some touch)."""
     data = world.uvms.model.createData()
     pin.forwardKinematics(world.uvms.model, data, q, v)
     found = world.forces(data, FrictionMemory()).touch
@@ -106,6 +107,9 @@ def _memory(world: World, q, v, rng: np.random.Generator) -> FrictionMemory:
     for key, x in zip(found.keys(), found.point_world_m, strict=True):
         if rng.uniform() < 0.8:  # some points touch anew (no anchor)
             memory.anchors[key] = x + rng.normal(scale=3e-3, size=3)
+        if key[2] < 0 and rng.uniform() < 0.7:  # coal's point: its stretch from a material one
+            local = data.oMi[world.pieces[key[0]].joint_id].actInv(x)
+            memory.material[key] = local + rng.normal(scale=3e-3, size=3)
     if len(found) and rng.uniform() < 0.5:
         memory.slipping.add(int(found.piece[0]) * len(world.objects) + int(found.obj[0]))
     return memory
