@@ -83,6 +83,30 @@ class ParameterError(UvmsPinError, ValueError):
     """An argument has the wrong shape, a non-finite value or is out of its valid range."""
 
 
+class InitialOverlapError(ParameterError):
+    """Two bodies overlap at the start of a run deeper than the tolerance (a free object
+    placed inside the robot, another free object, a fixed object or the seabed): the
+    contact would start compressed and fling them apart.
+
+    Attributes:
+        first, second: the two bodies' names. depth_m: how deep they overlap [m].
+        tolerance_m: the deepest overlap allowed there [m].
+    """
+
+    def __init__(self, first: str, second: str, depth_m: float, tolerance_m: float, how: str):
+        self.first, self.second, self.depth_m, self.tolerance_m = (
+            first,
+            second,
+            depth_m,
+            tolerance_m,
+        )
+        depth_mm, tolerance_mm = depth_m * 1e3, tolerance_m * 1e3
+        super().__init__(
+            f"'{first}' and '{second}' overlap by {depth_mm:.3g} mm at the start (more than "
+            f"the {tolerance_mm:.2g} mm tolerance): {how}"
+        )
+
+
 class ScenarioError(UvmsPinError):
     """A scenario or study file is malformed: unknown key, wrong type, missing entry."""
 

@@ -159,15 +159,21 @@ void WorldContactDerivatives::force_jacobians(const WorldContactModel& world,
     }
     // the trial friction: -k_t P (x - a) - c_t P v; a new contact's anchor moves with it
     const Mat3 projector = Mat3::Identity() - n * n.transpose();
-    const bool anchored =
-        memory.anchors.count({touch.piece[i], touch.obj[i], touch.corner[i]}) > 0;
+    const ContactKey key{touch.piece[i], touch.obj[i], touch.corner[i]};
+    const bool anchored = memory.anchors.count(key) > 0;
     trial_dq_[i].noalias() = -law.tangential_damping_N_s_m * (projector * velocity_dq_[i]);
-    if (anchored) {
-      trial_dq_[i].noalias() -= law.tangential_stiffness_N_m * (projector * point_dq_[i]);
+    if (anchored) {  // the stretch from the material point the period began at, if any
+      const auto held = touch.corner[i] < 0 ? memory.material.find(key) : memory.material.end();
+      if (held == memory.material.end()) {
+        trial_dq_[i].noalias() -= law.tangential_stiffness_N_m * (projector * point_dq_[i]);
+      } else {
+        trial_dq_[i].noalias() -=
+            law.tangential_stiffness_N_m * (projector * motion.point_dq(held->second));
+      }
     }
     trial_dv_[i].noalias() = -law.tangential_damping_N_s_m * (projector * point_dv_[i]);
   }
-  slipping_scaled(world, forces, memory);
+  slipping_scaled(world, forces);
   for (std::size_t i = 0; i < m; ++i) {
     const auto row = static_cast<Eigen::Index>(i);
     const Vec3& n = touch.normal_world[i];
@@ -177,8 +183,7 @@ void WorldContactDerivatives::force_jacobians(const WorldContactModel& world,
 }
 
 void WorldContactDerivatives::slipping_scaled(const WorldContactModel& world,
-                                              const ContactForces& forces,
-                                              const FrictionMemory& memory) {
+                                              const ContactForces& forces) {
   const Touch& touch = forces.touch;
   const std::size_t m = touch.size();
   const int n_objects = static_cast<int>(world.objects.size());
@@ -198,7 +203,7 @@ void WorldContactDerivatives::slipping_scaled(const WorldContactModel& world,
       if (patch_of(i) != group) continue;
       done[i] = 1;
       load += forces.normal_N[static_cast<Eigen::Index>(i)];
-      total += unscaled_trial(world, forces, memory, i);
+      total += unscaled_trial(world, forces, i);
     }
     const double size = total.norm();
     if (size == 0.0) continue;
@@ -219,24 +224,19 @@ void WorldContactDerivatives::slipping_scaled(const WorldContactModel& world,
           mu * (d_load / size - load * (total.transpose() * d_total) / (size * size * size));
       for (std::size_t i = first; i < m; ++i) {
         if (patch_of(i) != group) continue;
-        out[i] = sigma * d_trial[i] + unscaled_trial(world, forces, memory, i) * d_sigma;
+        out[i] = sigma * d_trial[i] + unscaled_trial(world, forces, i) * d_sigma;
       }
     }
   }
 }
 
 Vec3 WorldContactDerivatives::unscaled_trial(const WorldContactModel& world,
-                                             const ContactForces& forces,
-                                             const FrictionMemory& memory, std::size_t i) const {
+                                             const ContactForces& forces, std::size_t i) const {
   const Touch& touch = forces.touch;
   const auto& law = world.law;
   const Vec3& n = touch.normal_world[i];
-  const Vec3& x = touch.point_world_m[i];
-  const auto anchor = memory.anchors.find({touch.piece[i], touch.obj[i], touch.corner[i]});
-  Vec3 stretch = anchor == memory.anchors.end() ? Vec3::Zero() : Vec3(x - anchor->second);
-  stretch -= n * stretch.dot(n);
   const Vec3& velocity = touch.velocity_world_m_s[i];
-  return -law.tangential_stiffness_N_m * stretch -
+  return -law.tangential_stiffness_N_m * forces.stretch_m[i] -
          law.tangential_damping_N_s_m * (velocity - n * velocity.dot(n));
 }
 

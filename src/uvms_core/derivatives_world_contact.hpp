@@ -64,11 +64,11 @@ class WorldContactDerivatives {
   void force_jacobians(const WorldContactModel& world, const ContactForces& forces,
                        const FrictionMemory& memory);
   // the trial friction's derivatives, a slipping patch's scaled by sigma (and d sigma)
-  void slipping_scaled(const WorldContactModel& world, const ContactForces& forces,
-                       const FrictionMemory& memory);
-  // f_trial = -k_t P (x - a) - c_t P v at point i (before a slip's scaling)
+  void slipping_scaled(const WorldContactModel& world, const ContactForces& forces);
+  // f_trial = -k_t s - c_t P v at point i (before a slip's scaling), s the stretch the
+  // forces were found with
   Vec3 unscaled_trial(const WorldContactModel& world, const ContactForces& forces,
-                      const FrictionMemory& memory, std::size_t i) const;
+                      std::size_t i) const;
   void joint_motions(const Model& model, const ConstVec& q, const ConstVec& v);
 
   Data data_;

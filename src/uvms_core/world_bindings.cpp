@@ -1,8 +1,9 @@
 // The world's contacts in the nanobind module (world_contact.hpp, contact_shapes.hpp): the
 // shapes, the law, the compiled world of a plant, and the plant's operations with a world.
 // The friction's state crosses as the Python plant's FrictionMemory (anchors: a dict
-// (piece, object, corner) -> anchor (3,) [m]; slipping: a set of patches), read before and
-// written back after each call, so that the state lives in one place for both backends.
+// (piece, object, corner) -> anchor (3,) [m]; slipping: a set of patches; material: a dict
+// (piece, object, -1) -> material point (3,) [m]), read before and written back after each
+// call, so that the state lives in one place for both backends.
 #include "world_bindings.hpp"
 
 #include <nanobind/eigen/dense.h>
@@ -27,26 +28,35 @@ void read_memory(nb::handle memory, uvms::FrictionMemory& out) {
   if (!nb::hasattr(memory, "anchors") || !nb::hasattr(memory, "slipping")) {
     throw InputError("friction: a FrictionMemory (anchors, slipping) expected");
   }
-  for (auto [key, value] : nb::borrow<nb::dict>(memory.attr("anchors"))) {
-    if (!nb::isinstance<nb::tuple>(key) || nb::len(key) != 3) {
-      throw InputError("friction: an anchor's key must be (piece, object, corner)");
+  auto read_points = [](nb::handle points, std::map<uvms::ContactKey, uvms::Vec3>& into) {
+    for (auto [key, value] : nb::borrow<nb::dict>(points)) {
+      if (!nb::isinstance<nb::tuple>(key) || nb::len(key) != 3) {
+        throw InputError("friction: an anchor's key must be (piece, object, corner)");
+      }
+      const nb::tuple k = nb::borrow<nb::tuple>(key);
+      const uvms::ContactKey point{nb::cast<int>(k[0]), nb::cast<int>(k[1]),
+                                   nb::cast<int>(k[2])};
+      into[point] = nb::cast<uvms::Vec3>(value);
     }
-    const nb::tuple k = nb::borrow<nb::tuple>(key);
-    const uvms::ContactKey point{nb::cast<int>(k[0]), nb::cast<int>(k[1]), nb::cast<int>(k[2])};
-    out.anchors[point] = nb::cast<uvms::Vec3>(value);
-  }
+  };
+  read_points(memory.attr("anchors"), out.anchors);
+  if (nb::hasattr(memory, "material")) read_points(memory.attr("material"), out.material);
   for (nb::handle patch : memory.attr("slipping")) out.slipping.insert(nb::cast<int>(patch));
 }
 
 void write_memory(const uvms::FrictionMemory& memory, nb::handle out) {
-  nb::dict anchors;
-  for (const auto& [key, anchor] : memory.anchors) {
-    anchors[nb::make_tuple(key[0], key[1], key[2])] = nb::cast(uvms::Vec3(anchor));
-  }
+  auto points = [](const std::map<uvms::ContactKey, uvms::Vec3>& from) {
+    nb::dict into;
+    for (const auto& [key, point] : from) {
+      into[nb::make_tuple(key[0], key[1], key[2])] = nb::cast(uvms::Vec3(point));
+    }
+    return into;
+  };
   nb::set slipping;
   for (const int patch : memory.slipping) slipping.add(nb::int_(patch));
-  out.attr("anchors") = anchors;
+  out.attr("anchors") = points(memory.anchors);
   out.attr("slipping") = slipping;
+  out.attr("material") = points(memory.material);
 }
 
 Eigen::VectorXd checked(const char* name, const Eigen::VectorXd& x, int n) {

@@ -33,6 +33,8 @@ void WorldContactModel::forces(const Data& data, const FrictionMemory& memory,
   const int n_objects = static_cast<int>(objects.size());
   out.normal_N.resize(m);
   out.force_world_N.resize(found.size());
+  out.stretch_m.resize(found.size());
+  out.material_m.resize(found.size());
   stretch_.resize(3, m);
   tangential_velocity_.resize(3, m);
   mu_stick_.resize(m);
@@ -44,11 +46,22 @@ void WorldContactModel::forces(const Data& data, const FrictionMemory& memory,
     const Vec3& point = found.point_world_m[k];
     const double rate = -found.velocity_world_m_s[k].dot(normal);
     out.normal_N[i] = normal_force_N(law, found.depth_m[k], rate);
-    // the tangential stretch from where the point stuck (a new point: no stretch)
-    const auto anchor = memory.anchors.find({found.piece[k], found.obj[k], found.corner[k]});
-    Vec3 stretch = anchor == memory.anchors.end() ? Vec3::Zero() : Vec3(point - anchor->second);
+    // the tangential stretch from where the point stuck (a new point: no stretch), measured
+    // at a point of coal's from the material point the period began at (material_points)
+    const ContactKey key{found.piece[k], found.obj[k], found.corner[k]};
+    Vec3 measured = point;
+    out.material_m[k].setZero();
+    if (found.corner[k] < 0) {
+      const auto& placement = data.oMi[pieces[static_cast<std::size_t>(found.piece[k])].joint_id];
+      out.material_m[k] = placement.actInv(point);
+      const auto held = memory.material.find(key);
+      if (held != memory.material.end()) measured = placement.act(held->second);
+    }
+    const auto anchor = memory.anchors.find(key);
+    Vec3 stretch = anchor == memory.anchors.end() ? Vec3::Zero() : Vec3(measured - anchor->second);
     stretch -= normal * stretch.dot(normal);
     stretch_.col(i) = stretch;
+    out.stretch_m[k] = stretch;
     tangential_velocity_.col(i) = found.velocity_world_m_s[k] + normal * rate;
     const auto& object = objects[static_cast<std::size_t>(found.obj[k])];
     patch_[k] = found.piece[k] * n_objects + found.obj[k];
@@ -82,14 +95,19 @@ void WorldContactModel::add_to(Dynamics& dynamics, const ContactForces& forces) 
 void WorldContactModel::commit(const ContactForces& forces, FrictionMemory& memory) const {
   const Touch& found = forces.touch;
   const int n_objects = static_cast<int>(objects.size());
-  std::map<ContactKey, Vec3> kept;
+  std::map<ContactKey, Vec3> kept, material;
   std::set<int> slipping;
   for (std::size_t k = 0; k < found.size(); ++k) {
     const ContactKey key{found.piece[k], found.obj[k], found.corner[k]};
     const Vec3& x = found.point_world_m[k];
+    if (found.corner[k] < 0) material[key] = forces.material_m[k];
     if (forces.sticking[k]) {
       const auto anchor = memory.anchors.find(key);
-      kept[key] = anchor == memory.anchors.end() ? x : anchor->second;
+      if (found.corner[k] < 0) {  // the stretch carried over to the new contact point
+        kept[key] = x - forces.stretch_m[k];
+      } else {
+        kept[key] = anchor == memory.anchors.end() ? x : anchor->second;
+      }
     } else {
       const Vec3& normal = found.normal_world[k];
       const Vec3 friction = forces.force_world_N[k] - forces.normal_N[static_cast<Eigen::Index>(k)] * normal;
@@ -99,6 +117,7 @@ void WorldContactModel::commit(const ContactForces& forces, FrictionMemory& memo
   }
   memory.anchors.swap(kept);
   memory.slipping.swap(slipping);
+  memory.material.swap(material);
 }
 
 }  // namespace uvms

@@ -29,10 +29,14 @@ using ContactKey = std::array<int, 3>;
 struct FrictionMemory {
   std::map<ContactKey, Vec3> anchors;  // where each point stuck (world) [m]
   std::set<int> slipping;              // patches (piece * n_objects + object) slipping
+  // a point of coal's (corner -1): the piece's material point, in its joint's frame [m],
+  // that was at the contact when the period began; its stretch is measured from there
+  std::map<ContactKey, Vec3> material;
 
   void clear() {
     anchors.clear();
     slipping.clear();
+    material.clear();
   }
 };
 
@@ -42,6 +46,8 @@ struct ContactForces {
   std::vector<Vec3> force_world_N;
   Eigen::VectorXd normal_N;
   std::vector<char> sticking;
+  std::vector<Vec3> stretch_m;   // each point's tangential stretch s [m]
+  std::vector<Vec3> material_m;  // each point in its piece's joint frame [m] (coal's points)
 };
 
 struct WorldContactModel {
@@ -58,7 +64,8 @@ struct WorldContactModel {
   void add_to(Dynamics& dynamics, const ContactForces& forces) const;
   // After a control period (World.commit): a sticking point keeps its anchor (a new one
   // anchors where it is), a slipping one moves it to a = x + f_t / k_t and marks its patch
-  // slipping; a point no longer touching is forgotten.
+  // slipping; a point no longer touching is forgotten. A point of coal's moves on with the
+  // contact: its material point becomes the one now at x, its anchor x - s if it sticks.
   void commit(const ContactForces& forces, FrictionMemory& memory) const;
 
  private:

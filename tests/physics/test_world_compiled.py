@@ -98,7 +98,8 @@ def _touching_state(world: World, rng: np.random.Generator) -> tuple[np.ndarray,
 
 
 def _memory(world: World, q, v, rng: np.random.Generator) -> FrictionMemory:
-    """Anchors a few mm from the contact points, one patch slipping (when some touch)."""
+    """Anchors a few mm from the contact points, coal's points measured from material points
+    a few mm off, one patch slipping (when some touch)."""
     data = world.uvms.model.createData()
     pin.forwardKinematics(world.uvms.model, data, q, v)
     found = world.forces(data, FrictionMemory()).touch
@@ -106,6 +107,9 @@ def _memory(world: World, q, v, rng: np.random.Generator) -> FrictionMemory:
     for key, x in zip(found.keys(), found.point_world_m, strict=True):
         if rng.uniform() < 0.8:  # some points touch anew (no anchor)
             memory.anchors[key] = x + rng.normal(scale=3e-3, size=3)
+        if key[2] < 0 and rng.uniform() < 0.7:  # coal's point: its stretch from a material one
+            local = data.oMi[world.pieces[key[0]].joint_id].actInv(x)
+            memory.material[key] = local + rng.normal(scale=3e-3, size=3)
     if len(found) and rng.uniform() < 0.5:
         memory.slipping.add(int(found.piece[0]) * len(world.objects) + int(found.obj[0]))
     return memory
@@ -229,20 +233,28 @@ def _same_memory(a: FrictionMemory, b: FrictionMemory, scale: float) -> None:
     assert set(a.anchors) == set(b.anchors)
     for key, anchor in a.anchors.items():
         assert _close(anchor, b.anchors[key], scale)
+    assert set(a.material) == set(b.material)  # coal's points: where their stretch starts
+    for key, point in a.material.items():
+        assert _close(point, b.material[key], scale)
 
 
 @pytest.mark.parametrize(
-    ("body", "kind", "tilt", "drop_m_s", "expect"),
+    ("body", "kind", "tilt", "drop_m_s", "expect", "agreeing"),
     [
-        ("box", "tilted plane", 0.15, 0.0, "sticks"),  # tan 0.3 < mu_s = 0.6
-        ("box", "tilted plane", 0.75, 0.0, "slides"),  # tan 0.75 > 0.6
-        ("sphere", "box", 0.0, -1.5, "rebounds"),
-        ("box", "mesh", 0.0, -0.5, "rebounds"),
-        ("cylinder", "box", 0.0, -0.5, "rebounds"),
+        ("box", "tilted plane", 0.15, 0.0, "sticks", 300),  # tan 0.3 < mu_s = 0.6
+        ("box", "tilted plane", 0.75, 0.0, "slides", 300),  # tan 0.75 > 0.6
+        ("sphere", "box", 0.0, -1.5, "rebounds", 300),
+        ("box", "mesh", 0.0, -0.5, "rebounds", 300),
+        # after its rebound the cylinder settles on its flat end on the box's top: coal's
+        # one point of a face on a face lies anywhere on it, and the friction's stretch is
+        # measured from the material point there, so two runs of the Python reference
+        # 1e-14 m apart part from 1.25 s (1e-6 m at 1.25 s, 3 cm at 1.5 s): the backends
+        # are compared before (the forces at one state agree there to the last bit)
+        ("cylinder", "box", 0.0, -0.5, "rebounds", 200),
     ],
 )
 def test_runs_that_stick_slide_and_rebound_are_the_reference(
-    load_body, body, kind, tilt, drop_m_s, expect
+    load_body, body, kind, tilt, drop_m_s, expect, agreeing
 ):
     collision, volume = BODIES[body]
     uvms = _body(load_body, collision, volume)
@@ -262,8 +274,10 @@ def test_runs_that_stick_slide_and_rebound_are_the_reference(
     v0[2] = drop_m_s
     (core, core_memory), (python, python_memory) = _runs(uvms, world, q, v0, 300)
     scale = np.abs(python).max(axis=0)
-    assert np.all(np.abs(core - python) <= TOL * 10 * np.maximum(scale, 1.0))
-    _same_memory(core_memory, python_memory, 10.0)
+    apart = np.abs(core - python)[:agreeing]
+    assert np.all(apart <= TOL * 10 * np.maximum(scale, 1.0))
+    if agreeing == len(python):
+        _same_memory(core_memory, python_memory, 10.0)
     down_slope = np.array([-math.cos(tilt), 0.0, -math.sin(tilt)])
     travel_m = (python[:, :3] - q[:3]) @ down_slope
     if expect == "sticks":

@@ -7,7 +7,8 @@ v_i, the plane's normal n constant and its point p_0):
 
     delta_i = (p_0 - x_i) . n,   delta_dot_i = -n . v_i
     f_n,i = k delta_i max(0, 1 + d delta_dot_i)
-    s_i = P (x_i - a_i),  v_t,i = P v_i   (P = I - n n^T, a_i the anchor)
+    s_i = P (x_i - a_i),  v_t,i = P v_i   (P = I - n n^T, a_i the anchor; a sphere's s_i
+        from its material point the period began at, `FrictionMemory.material`)
     f_trial,i = -k_t s_i - c_t v_t,i
     f_t,i = f_trial,i  (sticking patch),   sigma f_trial,i  (slipping patch),
         sigma = mu_k L / |T|,  L = sum_patch f_n,  T = sum_patch f_trial
@@ -118,6 +119,7 @@ def _force_jacobians(
     arms = np.zeros((m, 3))
     point_dq, velocity_dq = np.zeros((m, 3, nv)), np.zeros((m, 3, nv))
     point_dv, slide = np.zeros((m, 3, nv)), np.zeros((m, 3, nv))
+    measured_dq = np.zeros((m, 3, nv))  # where the stretch is measured from
     depth_dq = np.zeros((m, nv))
     for i, p in enumerate(touch.piece):
         piece = world.pieces[int(p)]
@@ -134,7 +136,7 @@ def _force_jacobians(
             - skew(point_velocity) @ motion.rotation_dq
         )
         if touch.corner[i] >= 0:  # a corner: a material point
-            point_dq[i] = material
+            point_dq[i] = measured_dq[i] = material
             depth_dq[i] = -normal[i] @ material
             continue
         # a sphere: delta = R - (c - p_0) . n, x = c - (R - delta / 2) n
@@ -143,6 +145,9 @@ def _force_jacobians(
         point_dq[i] = center_dq - 0.5 * np.outer(normal[i], normal[i] @ center_dq)
         slide[i] = point_dq[i] - material
         velocity_dq[i] += skew(rotation @ motion.velocity[3:]) @ slide[i]
+        # the stretch from the material point of the period's start (none: the point)
+        held = memory.material.get((int(p), int(touch.obj[i]), -1))
+        measured_dq[i] = point_dq[i] if held is None else motion.point_dq(held)
     # normal force: f_n = k delta max(0, 1 + d rate)
     rate = -np.einsum("ij,ij->i", touch.velocity_world_m_s, normal)
     damping = 1.0 + law.dissipation_s_m * rate
@@ -160,13 +165,13 @@ def _force_jacobians(
     # the trial friction: -k_t P (x - a) - c_t P v; a new contact's anchor moves with it
     projector = np.eye(3)[None] - normal[:, :, None] * normal[:, None, :]
     anchored = np.array([key in memory.anchors for key in touch.keys()], dtype=bool)
-    stretch_dq = np.where(anchored[:, None, None], projector @ point_dq, 0.0)
+    stretch_dq = np.where(anchored[:, None, None], projector @ measured_dq, 0.0)
     trial_dq = -law.tangential_stiffness_N_m * stretch_dq - law.tangential_damping_N_s_m * (
         projector @ velocity_dq
     )
     trial_dv = -law.tangential_damping_N_s_m * (projector @ point_dv)
     friction_dq, friction_dv = _slipping_scaled(
-        world, forces, memory, (trial_dq, trial_dv), (normal_dq, normal_dv)
+        world, forces, (trial_dq, trial_dv), (normal_dq, normal_dv)
     )
     force_dq = normal[:, :, None] * normal_dq[:, None, :] + friction_dq
     force_dv = normal[:, :, None] * normal_dv[:, None, :] + friction_dv
@@ -176,7 +181,6 @@ def _force_jacobians(
 def _slipping_scaled(
     world: World,
     forces: ContactForces,
-    memory: FrictionMemory,
     trial: tuple[np.ndarray, np.ndarray],
     normal: tuple[np.ndarray, np.ndarray],
 ) -> tuple[np.ndarray, np.ndarray]:
@@ -192,7 +196,7 @@ def _slipping_scaled(
         mine = np.flatnonzero(patch == group)
         mu = world._mu[int(touch.obj[mine[0]]), 1]
         load = float(forces.normal_N[mine].sum())
-        trial_raw = _unscaled_trial(world, forces, memory, mine)
+        trial_raw = _unscaled_trial(world, forces, mine)
         total = trial_raw.sum(axis=0)
         size = float(np.linalg.norm(total))
         if size == 0.0:
@@ -209,21 +213,15 @@ def _slipping_scaled(
     return friction_dq, friction_dv
 
 
-def _unscaled_trial(
-    world: World, forces: ContactForces, memory: FrictionMemory, points: np.ndarray
-) -> np.ndarray:
-    """f_trial = -k_t P (x - a) - c_t P v (k, 3) at the given points (before a slip's
-    scaling)."""
+def _unscaled_trial(world: World, forces: ContactForces, points: np.ndarray) -> np.ndarray:
+    """f_trial = -k_t s - c_t P v (k, 3) at the given points (before a slip's scaling), s
+    the stretch the forces were found with."""
     touch, law = forces.touch, world.law
-    keys = touch.keys()
     out = np.zeros((len(points), 3))
     for row, i in enumerate(points):
         n = touch.normal_world[i]
-        x = touch.point_world_m[i]
-        stretch = x - memory.anchors.get(keys[i], x)
-        stretch -= n * (stretch @ n)
         v = touch.velocity_world_m_s[i]
-        out[row] = -law.tangential_stiffness_N_m * stretch - law.tangential_damping_N_s_m * (
-            v - n * (v @ n)
+        out[row] = -law.tangential_stiffness_N_m * forces.stretch_m[i] - (
+            law.tangential_damping_N_s_m * (v - n * (v @ n))
         )
     return out

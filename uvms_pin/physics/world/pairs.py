@@ -12,8 +12,9 @@ velocity of the material points at x,
 and gives the force f on a; b receives -f at the same point, so that the exchange is equal
 and opposite (it conserves the two bodies' momentum) and its power, -f . v_rel, is what the
 law dissipates (never positive: the normal force never pulls, friction opposes the slip).
-The friction's anchor is kept in b's joint frame: it moves with b. Each pair is its own
-friction patch (one point).
+The friction's anchor is kept in b's joint frame: it moves with b; the stretch is measured
+from a's material point that was at x when the period began (`FrictionMemory.material`: a
+point rolling on b is no slip). Each pair is its own friction patch (one point).
 """
 
 from __future__ import annotations
@@ -28,7 +29,7 @@ from uvms_pin.physics.world.contact_law import ContactLaw, friction_force_N, nor
 from uvms_pin.physics.world.objects import WorldObject
 from uvms_pin.physics.world.robot_geometry import RobotPiece
 from uvms_pin.physics.world.touch import NO_TOUCH, Touch, coal_point, cross, reach_spheres
-from uvms_pin.physics.world.world import ContactForces, FrictionMemory
+from uvms_pin.physics.world.world import ContactForces, FrictionMemory, material_points
 
 __all__ = ["PairContacts", "PiecePairs", "joint_forces"]
 
@@ -104,9 +105,9 @@ class PiecePairs:
         a, b = np.array(self.pairs).T
         return bool(np.any(np.linalg.norm(ca[a] - cb[b], axis=1) < ra[a] + rb[b]))
 
-    def forces(self, data_a: pin.Data, data_b: pin.Data, memory: FrictionMemory) -> PairContacts:
-        """The touching pairs and the force on a at each, after ``forwardKinematics(q, v)``
-        of both models, with the anchors of ``memory`` (read only)."""
+    def touching(self, data_a: pin.Data, data_b: pin.Data) -> list[tuple]:
+        """(pair index, point (3,) [m], normal out of b towards a (3,), depth [m]) of every
+        pair that overlaps, after forward kinematics of both models (geometry only)."""
         found = []
         for k, (a, b) in enumerate(self.pairs):
             pa, pb = self.pieces_a[a], self.pieces_b[b]
@@ -119,6 +120,12 @@ class PiecePairs:
             hit = coal_point(pa, where_a, obstacle)
             if hit is not None:
                 found.append((k, *hit))
+        return found
+
+    def forces(self, data_a: pin.Data, data_b: pin.Data, memory: FrictionMemory) -> PairContacts:
+        """The touching pairs and the force on a at each, after ``forwardKinematics(q, v)``
+        of both models, with the anchors of ``memory`` (read only)."""
+        found = self.touching(data_a, data_b)
         if not found:
             return PairContacts(NO_TOUCH, np.zeros((0, 3)), np.zeros(0), np.zeros(0, dtype=bool))
         pair = np.array([f[0] for f in found], dtype=int)
@@ -134,10 +141,13 @@ class PiecePairs:
         )
         rate = -np.einsum("ij,ij->i", velocity, normal)
         f_n = normal_force_N(self.law, depth, rate)
+        keys = [(int(k), 0, -1) for k in pair]
+        joints_a = [self.pieces_a[self.pairs[k][0]].joint_id for k in pair]
+        local, measured = material_points(data_a, joints_a, keys, point, memory)
         anchors = np.array(
-            [self._anchor(data_b, memory, int(k), x) for k, x in zip(pair, point, strict=True)]
+            [self._anchor(data_b, memory, int(k), x) for k, x in zip(pair, measured, strict=True)]
         )
-        stretch = point - anchors
+        stretch = measured - anchors
         stretch -= normal * np.einsum("ij,ij->i", stretch, normal)[:, None]
         v_t = velocity + normal * rate[:, None]
         mu = self.mu[pair]
@@ -146,7 +156,7 @@ class PiecePairs:
         force = f_n[:, None] * normal + f_t
         a, b = np.array([self.pairs[k] for k in pair], dtype=int).reshape(-1, 2).T
         touch = Touch(a, b, np.full(len(pair), -1), point, normal, depth, velocity)
-        return PairContacts(touch, force, f_n, stick, pair)
+        return PairContacts(touch, force, f_n, stick, stretch, local, pair)
 
     def _joint_b(self, k: int) -> int:
         return self.pieces_b[self.pairs[k][1]].joint_id
@@ -156,22 +166,22 @@ class PiecePairs:
         return x if local is None else data_b.oMi[self._joint_b(k)].act(local)
 
     def commit(self, data_b: pin.Data, contacts: PairContacts, memory: FrictionMemory) -> None:
-        """After a control period (`World.commit`'s rule): a sticking pair keeps its anchor
-        (a new one anchors where it is), a slipping one moves it to x + f_t / k_t; anchors
-        are kept in b's joint frame."""
-        kept, slipping = {}, set()
+        """After a control period (`World.commit`'s rule for a point of coal's): the
+        material point of a becomes the one now at x; a sticking pair's anchor moves to
+        x - s (its stretch carried over), a slipping one's to x + f_t / k_t; anchors are
+        kept in b's joint frame."""
+        kept, slipping, material = {}, set(), {}
         f_t = contacts.force_world_N - contacts.normal_N[:, None] * contacts.touch.normal_world
         for i, k in enumerate(contacts.pair.tolist()):
             x = contacts.touch.point_world_m[i]
+            material[(k, 0, -1)] = contacts.material_m[i]
             if contacts.sticking[i]:
-                kept[(k, 0, -1)] = memory.anchors.get(
-                    (k, 0, -1), data_b.oMi[self._joint_b(k)].actInv(x)
-                )
+                moved = x - contacts.stretch_m[i]
             else:
                 moved = x + f_t[i] / self.law.tangential_stiffness_N_m
-                kept[(k, 0, -1)] = data_b.oMi[self._joint_b(k)].actInv(moved)
                 slipping.add(k)
-        memory.anchors, memory.slipping = kept, slipping
+            kept[(k, 0, -1)] = data_b.oMi[self._joint_b(k)].actInv(moved)
+        memory.anchors, memory.slipping, memory.material = kept, slipping, material
 
     def generalized_forces(
         self,

@@ -28,9 +28,13 @@ from uvms_pin.physics.world.objects import WorldObject
 from uvms_pin.physics.world.robot_geometry import RobotPiece, robot_pieces
 from uvms_pin.physics.world.touch import Bounds, Touch, clear_of, cross, touch
 
-__all__ = ["ContactForces", "FrictionMemory", "World"]
+__all__ = ["INITIAL_OVERLAP", "ContactForces", "FrictionMemory", "World", "material_points"]
 
 Key = tuple[int, int, int]
+
+#: what a run does with a free object overlapping another body at its start
+#: (`uvms_pin.physics.world.overlap`): refuse it, or move it out along the contact normal
+INITIAL_OVERLAP = ("refuse", "separate")
 
 
 @dataclass
@@ -38,14 +42,43 @@ class FrictionMemory:
     """The friction's state, kept between control periods (`World.commit`): where each
     contact point (piece, object, corner) stuck (its anchor, world [m]), and the patches
     (piece * n_objects + object) slipping (they slip on above mu_k; a sticking one breaks
-    away at mu_s: the static-kinetic hysteresis of Coulomb friction)."""
+    away at mu_s: the static-kinetic hysteresis of Coulomb friction).
+
+    ``material``: for a point of coal's (corner -1: a sphere's, or any piece against a
+    solid), the piece's material point, in its joint's frame [m], that was at the contact
+    when the period began. The stretch is measured from that point, not from the contact
+    point: a rolling sphere's contact point moves with its centre while the material point
+    there stays (rolling is no slip), so the stretch from the contact point would resist
+    rolling as if it slid, and its moment would spin the sphere up (energy from nowhere).
+    A corner is a material point itself: it has no entry."""
 
     anchors: dict[Key, np.ndarray] = field(default_factory=dict)
     slipping: set[int] = field(default_factory=set)
+    material: dict[Key, np.ndarray] = field(default_factory=dict)
 
     def clear(self) -> None:
         self.anchors.clear()
         self.slipping.clear()
+        self.material.clear()
+
+
+def material_points(
+    data: pin.Data, joints, keys, points_world_m: np.ndarray, memory: FrictionMemory
+) -> tuple[np.ndarray, np.ndarray]:
+    """(each point in its joint's frame (m, 3), where its stretch is measured (m, 3), world
+    [m]): a point of coal's from the material point `FrictionMemory.material` keeps, where
+    that point is now (at the contact point when it has none); a corner from itself."""
+    local = np.zeros((len(keys), 3))
+    measured = np.array(points_world_m, dtype=float).reshape(-1, 3)
+    for i, (key, joint) in enumerate(zip(keys, joints, strict=True)):
+        if key[2] >= 0:
+            continue
+        placement = data.oMi[joint]
+        local[i] = placement.actInv(measured[i])
+        held = memory.material.get(key)
+        if held is not None:
+            measured[i] = placement.act(held)
+    return local, measured
 
 
 @dataclass(frozen=True)
@@ -55,12 +88,17 @@ class ContactForces:
     Attributes:
         touch: the points. force_world_N: f_i (m, 3). normal_N: f_n,i (m,).
         sticking: each point within its static cone (m,).
+        stretch_m: the tangential stretch s_i of each point's friction spring (m, 3) [m].
+        material_m: each point x_i in its piece's joint frame (m, 3) [m] (what
+            `FrictionMemory.material` keeps of a point of coal's).
     """
 
     touch: Touch
     force_world_N: np.ndarray
     normal_N: np.ndarray
     sticking: np.ndarray
+    stretch_m: np.ndarray = field(default_factory=lambda: np.zeros((0, 3)))
+    material_m: np.ndarray = field(default_factory=lambda: np.zeros((0, 3)))
 
 
 @dataclass
@@ -73,6 +111,8 @@ class World:
         free: the free objects (`uvms_pin.physics.world.free_object.FreeObject`), each its
             own floating body; their contacts are `uvms_pin.physics.world.moving`'s.
         self_collision: the arm's links touch the vehicle (adjacent links excepted).
+        initial_overlap: one of `INITIAL_OVERLAP`, what the start does with a free object
+            that overlaps another body (`uvms_pin.physics.world.overlap`).
     """
 
     uvms: UVMS
@@ -80,8 +120,14 @@ class World:
     law: ContactLaw = field(default_factory=ContactLaw)
     free: Sequence[Any] = ()
     self_collision: bool = False
+    initial_overlap: str = "refuse"
 
     def __post_init__(self) -> None:
+        if self.initial_overlap not in INITIAL_OVERLAP:
+            raise ParameterError(
+                f"initial_overlap must be one of {', '.join(INITIAL_OVERLAP)}, "
+                f"got {self.initial_overlap!r}"
+            )
         self.objects = tuple(self.objects)
         self.free = tuple(self.free)
         bodies = self.uvms.surface_bodies
@@ -124,10 +170,12 @@ class World:
         rate = -np.einsum("ij,ij->i", velocity, normal)
         f_n = normal_force_N(self.law, found.depth_m, rate)
         keys = found.keys()
+        joints = [self.pieces[p].joint_id for p in found.piece]
+        local, measured = material_points(data, joints, keys, found.point_world_m, memory)
         anchors = np.array(
-            [memory.anchors.get(k, x) for k, x in zip(keys, found.point_world_m, strict=True)]
+            [memory.anchors.get(k, x) for k, x in zip(keys, measured, strict=True)]
         ).reshape(-1, 3)
-        stretch = found.point_world_m - anchors
+        stretch = measured - anchors
         stretch -= normal * np.einsum("ij,ij->i", stretch, normal)[:, None]
         v_t = velocity + normal * rate[:, None]
         mu = self._mu[found.obj]
@@ -135,7 +183,7 @@ class World:
         slipping = np.array([int(g) in memory.slipping for g in patch], dtype=bool)
         limit = np.where(slipping, mu[:, 1], mu[:, 0])
         f_t, stick = friction_force_N(self.law, f_n, stretch, v_t, patch, limit, mu[:, 1])
-        return ContactForces(found, f_n[:, None] * normal + f_t, f_n, stick)
+        return ContactForces(found, f_n[:, None] * normal + f_t, f_n, stick, stretch, local)
 
     def generalized_force(self, q: np.ndarray, data: pin.Data, forces: ContactForces) -> np.ndarray:
         """tau_world = sum_i J_i^T f_i (nv,) [N, N m]; ``data`` after forward kinematics."""
@@ -158,20 +206,26 @@ class World:
         """After a control period: a sticking point keeps its anchor (a new one anchors
         where it is), a slipping one moves its anchor to where the spring gives its
         share of the kinetic force (a = x + f_t / k_t) and its patch is marked slipping; a
-        point no longer touching is forgotten."""
+        point no longer touching is forgotten. A point of coal's (`FrictionMemory.material`)
+        moves on with the contact: its material point becomes the one now at x, its
+        anchor x - s if it sticks (the stretch s carried over: the spring keeps its load
+        while the point rolls on)."""
         found, law = forces.touch, self.law
         normal = found.normal_world
         f_t = forces.force_world_N - forces.normal_N[:, None] * normal
-        kept, slipping = {}, set()
+        kept, slipping, material = {}, set(), {}
         patch = found.piece * len(self.objects) + found.obj
         for k, key in enumerate(found.keys()):
             x = found.point_world_m[k]
+            if key[2] < 0:
+                material[key] = forces.material_m[k]
             if forces.sticking[k]:
-                kept[key] = memory.anchors.get(key, x)
+                held = memory.anchors.get(key, x)
+                kept[key] = held if key[2] >= 0 else x - forces.stretch_m[k]
             else:
                 kept[key] = x + f_t[k] / law.tangential_stiffness_N_m
                 slipping.add(int(patch[k]))
-        memory.anchors, memory.slipping = kept, slipping
+        memory.anchors, memory.slipping, memory.material = kept, slipping, material
 
     def pair_wrenches(self, forces: ContactForces) -> np.ndarray:
         """Per pair (body, object), body-major: the resultant force on the body [N] (3),

@@ -17,6 +17,7 @@ import pinocchio as pin
 
 from uvms_pin.model.uvms import UVMS
 from uvms_pin.physics.world.moving import MovingContacts, State
+from uvms_pin.physics.world.overlap import Overlap, overlaps, separated
 from uvms_pin.physics.world.world import World
 
 __all__ = ["FreeObjects", "State"]
@@ -43,6 +44,17 @@ class FreeObjects:
     def initial_states(self) -> list[State]:
         """Each object's state at t = 0 (copies)."""
         return [(o.q0.copy(), o.v0.copy()) for o in self.objects]
+
+    def apart(self, q: np.ndarray, states: list[State]) -> tuple[list[State], list[Overlap]]:
+        """(the objects' states, the moves made) at the start with the robot at ``q``: no
+        object deeper than the tolerance in another body, else refused or moved out as the
+        world says (`uvms_pin.physics.world.overlap.separated`)."""
+
+        def overlaps_at(states: list[State]) -> list[Overlap]:
+            self._kinematics(q, np.zeros(self.uvms.nv), states)
+            return overlaps(self.moving, self.uvms_data, self.datas)
+
+        return separated(states, overlaps_at, self.moving.world.initial_overlap)
 
     def reset(self) -> None:
         """Every anchor forgotten."""

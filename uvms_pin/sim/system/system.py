@@ -22,6 +22,7 @@ import numpy as np
 import pinocchio as pin
 
 from uvms_pin.physics.dynamics import forward_dynamics, mass_matrix
+from uvms_pin.physics.world.overlap import tolerance_m
 from uvms_pin.sim.integrators import Integrator
 from uvms_pin.sim.plant import Plant, checked_start, has_moving_contacts
 from uvms_pin.sim.system.free_objects import FreeObjects
@@ -68,13 +69,17 @@ class System:
         self.model = _system_model(uvms.model, len(self.objects)) if self.objects else uvms.model
         self._steps: dict[int, tuple[Integrator, PeriodStep]] = {}
         self._data = uvms.model.createData()  # the bound test's kinematics
+        self.separations: list = []  # the objects' moves out of an overlap at the start
 
     # ---- the state ------------------------------------------------------------------------
     def initial_state(self, q0: np.ndarray, v0: np.ndarray) -> SystemState:
         """The state at t = 0: the robot at (q0, v0) (checked, its quaternion normalised),
-        every free object where its scenario puts it."""
+        every free object where its scenario puts it (moved out of another body when its
+        world asks so, the moves kept in `separations`; else InitialOverlapError)."""
         q0, v0 = checked_start(self.plant.uvms.model, q0, v0)
         states = [] if self.moving is None else self.moving.initial_states()
+        if self.objects:  # none inside another body (`uvms_pin.physics.world.overlap`)
+            states, self.separations = self.moving.apart(q0, states)
         return self.layout.join([(q0, v0), *states])
 
     def robot_state(self, q: np.ndarray, v: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -189,6 +194,14 @@ class System:
                 "object_pairs": self.moving.moving.object_pair_names,
                 **({"integration": PYTHON_PATH} if self.objects else {}),
             }
+            if self.objects:
+                out["world"]["initial_overlap"] = {
+                    "mode": self.plant.world.initial_overlap,
+                    "tolerance_m": {
+                        o.name: tolerance_m(o, self.plant.world.law) for o in self.objects
+                    },
+                    "moved": [o.record(self.objects[o.moved].name) for o in self.separations],
+                }
         return out
 
     @property

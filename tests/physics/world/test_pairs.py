@@ -1,0 +1,59 @@
+"""The friction of a pair of moving pieces (`uvms_pin.physics.world.pairs`): its stretch is
+measured from a's material point of the period's start, and carried over at the period's end
+to the new contact point."""
+
+from __future__ import annotations
+
+import numpy as np
+import pinocchio as pin
+from conftest import RHO, body_urdf, hydro_xml
+
+from uvms_pin.physics.world.contact_law import ContactLaw
+from uvms_pin.physics.world.free_object import free_object
+from uvms_pin.physics.world.world import World
+from uvms_pin.sim.plant import Plant
+from uvms_pin.sim.system import System
+
+
+def _touching(load_body):
+    """A sphere robot 5 mm into a free sphere's side, both at rest."""
+    pusher = load_body(
+        body_urdf(
+            mass=4.0, inertia=(0.016,) * 3, hydro=hydro_xml(4.0 / RHO),
+            collision='<sphere radius="0.1"/>',
+        )
+    )  # fmt: skip
+    ball = free_object(
+        "ball", "sphere", {"radius_m": 0.2}, ([0.0, 0.0, -5.0], [0, 0, 0]),
+        density_kg_m3=RHO, water_density_kg_m3=RHO,
+    )  # fmt: skip
+    system = System(Plant(pusher, world=World(pusher, [], ContactLaw(), [ball])))
+    q = pusher.neutral_configuration()
+    q[:3] = [-0.295, 0.0, -5.0]
+    return system, q, ball
+
+
+def test_a_sticking_pair_s_stretch_is_carried_over_to_the_new_contact_point(load_body):
+    system, q, ball = _touching(load_body)
+    moving = system.moving
+    states = [(ball.q0.copy(), np.zeros(6))]
+    v = np.zeros(6)
+    v[1] = 0.01  # sliding sideways along the ball: a stretch builds
+    moving.settle(q, np.zeros(6), states)  # anchored at rest
+    (memory,) = [s.memory for s in moving.moving.sets]
+    assert list(memory.material) == [(0, 0, -1)]
+    # the robot rolled about its centre and moved: the contact point moved on it
+    turned = q.copy()
+    turned[1] += 2e-4
+    turned[3:7] = pin.Quaternion(pin.rpy.rpyToMatrix(0.0, 0.0, 0.02)).coeffs()
+    (before,), _ = moving.found(turned, v, states)
+    assert before.sticking.all() and np.linalg.norm(before.stretch_m) > 1e-5
+    moving.settle(turned, v, states)
+    (after,), _ = moving.found(turned, v, states)
+    np.testing.assert_allclose(after.stretch_m, before.stretch_m, rtol=0, atol=1e-15)
+    np.testing.assert_allclose(after.force_world_N, before.force_world_N, rtol=1e-12)
+    # the material point is now the one at the contact, in the robot's joint frame
+    data = system.plant.uvms.model.createData()
+    pin.forwardKinematics(system.plant.uvms.model, data, turned)
+    x = after.touch.point_world_m[0]
+    np.testing.assert_allclose(memory.material[(0, 0, -1)], data.oMi[1].actInv(x), atol=1e-15)
