@@ -144,6 +144,8 @@ def _world_modes(system: System, state: SystemState, data: pin.Data, inverse: np
 def system_modes(system: System, state: SystemState, time_s: float = 0.0) -> list[StiffMode]:
     """Every explicit stiff mode of ``system`` at ``state`` (`uvms_pin.sim.stiff_modes`)."""
     plant = system.plant
+    if plant.joint_stops is None and plant.contact is None and plant.world is None:
+        return []  # nothing stiff: no mass matrix to invert
     inverse = np.linalg.inv(system.mass_matrix(time_s, state.q))
     robot = system.layout.v_slices[0]
     robot_inverse = inverse[robot, robot]
