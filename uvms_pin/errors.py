@@ -120,7 +120,10 @@ class StiffModeError(ParameterError):
     def __init__(self, mode, integrator: str, step_s: float, largest_stable_step_s: float):
         self.mode, self.integrator = mode, integrator
         self.step_s, self.largest_stable_step_s = step_s, largest_stable_step_s
-        rates = ", ".join(f"{complex(r).real:.4g}{complex(r).imag:+.4g}j" for r in mode.rates)
+        # + 0.0: no "-0" for an undamped mode's real part
+        rates = ", ".join(
+            f"{r.real + 0.0:.4g}{r.imag + 0.0:+.4g}j" for r in map(complex, mode.rates)
+        )
         super().__init__(
             f"{mode.describe()} is unstable at the {integrator} step of {step_s:g} s "
             f"(its rates lambda = {rates} 1/s leave the step's stability region): the largest "

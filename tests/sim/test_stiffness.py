@@ -17,11 +17,13 @@ from conftest import run
 from scipy.optimize import brentq
 
 from uvms_pin.errors import ParameterError, StiffModeError
+from uvms_pin.physics.contact import CompliantPlane, LinearSpring
+from uvms_pin.physics.joint_stops import JointStops
 from uvms_pin.scenario.load import load_scenario
 from uvms_pin.sim.closed_loop import ClosedLoop
 from uvms_pin.sim.integrators import RK4, Adaptive, SemiImplicitEuler
 from uvms_pin.sim.run import simulate
-from uvms_pin.sim.stiff_modes import StiffMode
+from uvms_pin.sim.stiff_modes import StiffMode, environment_mode, stop_modes
 from uvms_pin.sim.stiffness import check_stiff_modes, is_stable, largest_stable_step_s
 
 SCENARIOS = Path(__file__).resolve().parents[2] / "scenarios"
@@ -173,3 +175,42 @@ def test_every_shipped_scenario_is_accepted_at_its_defaults(path):
     record = check_stiff_modes(loop.system, state, scenario.settings.integrator)
     if record["checked"] and record["stiffest"] is not None:
         assert record["margin"] > 1.0
+
+
+def test_the_rollout_records_the_stiffest_mode_and_its_margin():
+    """seabed_landing's closest mode: the Alpha 5's jaw against the seabed and the rock,
+    at first touch (its most mobile corner: 0.39 kg), 24.9x its 0.5 ms step."""
+    scenario = load_scenario(SCENARIOS / "seabed_landing.toml", {"scenario.duration_s": 0.1})
+    record = simulate(scenario, progress=False).metadata["stiff_modes"]
+    assert record["checked"] and record["integrator"] == "RK4" and record["step_s"] == 5e-4
+    stiffest = record["stiffest"]
+    assert "link 'alpha_jaw_link' against the fixed world" in stiffest["what"]
+    assert stiffest["stiffness"] == 2.0e4 and stiffest["damping"] == 0.0
+    assert stiffest["effective_mass"] == pytest.approx(0.388, abs=0.001)
+    omega = math.sqrt(2.0e4 / stiffest["effective_mass"])
+    assert stiffest["largest_stable_step_s"] * omega == pytest.approx(2.0 * math.sqrt(2.0))
+    assert record["margin"] == pytest.approx(24.9, abs=0.1)
+
+
+def test_the_environment_modes_take_the_end_effectors_mobility():
+    """G = J M^-1 J^T diagonal: a plane along z is the mass 1 / G_zz; the paper's spring is
+    its fastest axis, omega^2 = max K_i G_ii."""
+    mobility = np.diag([1 / 2, 1 / 3, 1 / 4])
+    plane = environment_mode(CompliantPlane([0.0, 0.0, 1.0], 500.0, 3.0), mobility)
+    assert (plane.stiffness, plane.damping, plane.mass) == (500.0, 3.0, pytest.approx(4.0))
+    spring = environment_mode(LinearSpring(np.array([10.0, 20.0, 30.0])), mobility)
+    assert spring.stiffness == 30.0 and spring.stiffness / spring.mass == pytest.approx(7.5)
+
+
+def test_a_stops_inertia_is_the_inverse_of_the_inverse_mass_diagonal():
+    stops = JointStops(np.array([-1.0, -1.0]), np.array([1.0, 1.0]), 300.0, 2.0, ("a", "b"))
+    mass = np.diag([1.0] * 6 + [0.5, 0.25])
+    mass[6, 7] = mass[7, 6] = 0.1  # coupled: I_eff = 1 / (M^-1)_jj, not M_jj
+    modes = stop_modes(stops, np.linalg.inv(mass))
+    assert [m.what for m in modes] == [
+        "the compliant stop of joint 'a'",
+        "the compliant stop of joint 'b'",
+    ]
+    assert modes[0].mass == pytest.approx(0.5 - 0.1**2 / 0.25)
+    assert modes[1].mass == pytest.approx(0.25 - 0.1**2 / 0.5)
+    assert modes[0].units == ("N m/rad", "N m s/rad", "kg m^2")

@@ -176,8 +176,12 @@ def check_stiff_modes(system: System, state: SystemState, integrator: Integrator
             named, with k, c, m_eff, the step and h*).
     """
     name = type(integrator).__name__
-    if not isinstance(integrator, FixedStep) or integrator.linear_step(1.0, np.eye(2)) is None:
-        return {"checked": False, "integrator": name, "reason": "no fixed step: not checked"}
+    if not isinstance(integrator, FixedStep):
+        reason = "an adaptive integrator chooses its own step"
+        return {"checked": False, "integrator": name, "reason": reason}
+    if integrator.linear_step(1.0, np.eye(2)) is None:
+        reason = "the integrator gives no linear step map (FixedStep.linear_step)"
+        return {"checked": False, "integrator": name, "reason": reason}
     modes = system_modes(system, state)
     step_s = float(integrator.step_s)
     record: dict[str, Any] = {"checked": True, "integrator": name, "step_s": step_s}
