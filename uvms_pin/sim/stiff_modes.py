@@ -44,6 +44,7 @@ from dataclasses import dataclass
 import numpy as np
 import pinocchio as pin
 
+from uvms_pin.physics.constraints.contacts import point_jacobian
 from uvms_pin.physics.contact import CompliantPlane, ContactModel, LinearSpring
 from uvms_pin.physics.joint_stops import JointStops
 from uvms_pin.physics.world.contact_law import ContactLaw
@@ -153,18 +154,6 @@ def candidate_contacts(piece: RobotPiece) -> list[tuple[np.ndarray, np.ndarray |
             normal = placement.rotation @ direction
             out.append((placement.act(radii[axis] * direction), normal))
     return out
-
-
-def _skew(r: np.ndarray) -> np.ndarray:
-    return np.array([[0.0, -r[2], r[1]], [r[2], 0.0, -r[0]], [-r[1], r[0], 0.0]])
-
-
-def point_jacobian(model: pin.Model, data: pin.Data, joint_id: int, point_world_m) -> np.ndarray:
-    """J_p (3, nv): the world velocity of the material point of ``joint_id`` at
-    ``point_world_m``, v + w x r, after ``pin.computeJointJacobians``."""
-    jac = pin.getJointJacobian(model, data, joint_id, pin.LOCAL_WORLD_ALIGNED)
-    arm = np.asarray(point_world_m) - data.oMi[joint_id].translation
-    return jac[:3] - _skew(arm) @ jac[3:]
 
 
 def body_mobility(
