@@ -24,7 +24,12 @@ from uvms_pin.sim.closed_loop import ClosedLoop
 from uvms_pin.sim.integrators import RK4, Adaptive, SemiImplicitEuler
 from uvms_pin.sim.run import simulate
 from uvms_pin.sim.stiff_modes import StiffMode, environment_mode, stop_modes
-from uvms_pin.sim.stiffness import check_stiff_modes, is_stable, largest_stable_step_s
+from uvms_pin.sim.stiffness import (
+    check_stiff_modes,
+    is_stable,
+    largest_stable_step_s,
+    system_modes,
+)
 
 SCENARIOS = Path(__file__).resolve().parents[2] / "scenarios"
 
@@ -214,3 +219,20 @@ def test_a_stops_inertia_is_the_inverse_of_the_inverse_mass_diagonal():
     assert modes[0].mass == pytest.approx(0.5 - 0.1**2 / 0.25)
     assert modes[1].mass == pytest.approx(0.25 - 0.1**2 / 0.5)
     assert modes[0].units == ("N m/rad", "N m s/rad", "kg m^2")
+
+
+def test_the_arm_against_its_own_vehicle_is_a_mode_of_their_relative_motion():
+    """With self_collision each arm link (the one jointed to the vehicle aside) meets its
+    vehicle: the two points' relative Jacobian, lighter than the link against the world (the
+    vehicle recoils)."""
+    overrides = {"world.contact.self_collision": True}
+    scenario = load_scenario(SCENARIOS / "seabed_landing.toml", overrides)
+    loop = ClosedLoop(scenario.plant, scenario.settings)
+    modes = system_modes(loop.system, loop.system.initial_state(scenario.q0, scenario.v0))
+    own = {m.what.split(" against")[0]: m.mass for m in modes if "own vehicle" in m.what}
+    world = {m.what.split(" against")[0]: m.mass for m in modes if "fixed world" in m.what}
+    # the shoulder is jointed to the vehicle, the Alpha 5's base is a part of it
+    assert "link 'alpha_shoulder_link_cob'" not in own and "link 'alpha_base_link_cob'" not in own
+    assert "link 'alpha_jaw_link'" in own and "link 'alpha_upper_arm_link_cob'" in own
+    for link, mass in own.items():
+        assert 0.0 < mass <= world[link] + 1e-12
