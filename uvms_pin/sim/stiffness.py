@@ -94,8 +94,8 @@ def _object_bodies(system: System, state: SystemState, inverse: np.ndarray) -> l
         pin.computeJointJacobians(model, data, state.q[layout.q_slices[k + 1]])
         part = layout.v_slices[k + 1]
         mobility = body_mobility(model, data, inverse[part, part], list(obj.pieces))
-        out.append(Body(f"free object '{obj.name}'", mobility, working_depth_m(
-            obj.uvms.net_buoyancy_N, law)))  # fmt: skip
+        depth = working_depth_m(obj.uvms.net_buoyancy_N, law)
+        out.append(Body(f"free object '{obj.name}'", mobility, depth))
     return out
 
 
@@ -116,7 +116,9 @@ def _self_bodies(system: System, data: pin.Data, inverse: np.ndarray) -> list[Bo
     return out
 
 
-def _world_modes(system: System, state: SystemState, data: pin.Data, inverse: np.ndarray):
+def _world_modes(
+    system: System, state: SystemState, data: pin.Data, inverse: np.ndarray
+) -> list[StiffMode]:
     world = system.plant.world
     law = world.law
     robot_inverse = inverse[system.layout.v_slices[0], system.layout.v_slices[0]]
