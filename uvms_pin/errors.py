@@ -107,6 +107,31 @@ class InitialOverlapError(ParameterError):
         )
 
 
+class StiffModeError(ParameterError):
+    """A spring-damper the run integrates explicitly (a world contact, a compliant joint
+    stop, the end-effector's environment) is unstable at the integrator's fixed step: the
+    run is refused before it starts (`uvms_pin.sim.stiffness`).
+
+    Attributes:
+        mode: the `uvms_pin.sim.stiff_modes.StiffMode` (what, k, c, m_eff).
+        integrator: its name. step_s: the run's step [s]. largest_stable_step_s: h* [s].
+    """
+
+    def __init__(self, mode, integrator: str, step_s: float, largest_stable_step_s: float):
+        self.mode, self.integrator = mode, integrator
+        self.step_s, self.largest_stable_step_s = step_s, largest_stable_step_s
+        # + 0.0: no "-0" for an undamped mode's real part
+        rates = ", ".join(
+            f"{r.real + 0.0:.4g}{r.imag + 0.0:+.4g}j" for r in map(complex, mode.rates)
+        )
+        super().__init__(
+            f"{mode.describe()} is unstable at the {integrator} step of {step_s:g} s "
+            f"(its rates lambda = {rates} 1/s leave the step's stability region): the largest "
+            f"stable step is {largest_stable_step_s:.3g} s. Take [integrator] step_s at most "
+            f"that (it must divide the control or log period){mode.remedy}."
+        )
+
+
 class ScenarioError(UvmsPinError):
     """A scenario or study file is malformed: unknown key, wrong type, missing entry."""
 

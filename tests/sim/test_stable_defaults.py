@@ -1,6 +1,7 @@
 """Stable at the defaults, where users go first: the shipped BlueROV2 Heavy + Alpha 5
 released with no input (its light wrist against its joint limits), which the compliant stops
-make diverge within 2 s at the default step, runs on its limits as constraints, compiled;
+make diverge at the default step (refused before the run now: `uvms_pin.sim.stiffness`), runs
+on its limits as constraints, compiled;
 the station-keeping environment under uniform random actions has no diverged step.
 (`scripts/results/stability.py` runs the long versions: 60 s, 64 environments x 3,000 steps.)"""
 
@@ -13,7 +14,7 @@ import numpy as np
 import pytest
 
 import uvms_pin.apps.gym  # noqa: F401  (registers the environments)
-from uvms_pin.errors import SimulationError
+from uvms_pin.errors import StiffModeError
 from uvms_pin.results.metrics import joint_limit_metrics
 from uvms_pin.scenario.load import load_scenario
 from uvms_pin.sim.run import simulate
@@ -35,9 +36,10 @@ def test_the_passive_alpha5_holds_on_its_limits_where_its_stops_diverge():
     assert limits["time_at_joint_stop_s"] > 0.1  # the arm did fall onto its limits
     assert np.abs(rollout.v).max() < 50.0
 
-    # the same with the compliant stops: the wrist at 179 rad/s, t = 19.2 s
+    # the same with the compliant stops (which diverged at t = 19.2 s, the wrist at
+    # 179 rad/s): refused before the run, the wrist's stop named
     compliant = {**ALPHA5, "joints.stops": "compliant", "scenario.duration_s": 20.0}
-    with pytest.raises(SimulationError, match="diverged"):
+    with pytest.raises(StiffModeError, match="the compliant stop of joint 'alpha_axis_b'"):
         simulate(load_scenario(PASSIVE, compliant), progress=False)
 
 

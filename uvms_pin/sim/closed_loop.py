@@ -44,6 +44,7 @@ from uvms_pin.sim.plant import Plant
 from uvms_pin.sim.sample import Observer, Sample
 from uvms_pin.sim.sensors import SensorSuite
 from uvms_pin.sim.settings import SimulationSettings
+from uvms_pin.sim.stiffness import check_stiff_modes
 from uvms_pin.sim.system import System, SystemState
 
 # The funnel event fires when the margin min(1 - |xi|) reaches -this: just outside, so
@@ -104,6 +105,7 @@ class ClosedLoop:
         self.state = SystemState(read_only(np.zeros(layout.nq)), read_only(np.zeros(layout.nv)))
         self.sensors: SensorSuite | None = None
         self._last_tau_applied: np.ndarray | None = None  # continuous loop: the last stage's
+        self.stiff_modes: dict[str, Any] = {}  # the explicit stiff modes checked at `start`
 
     # ---- the steps of the loop ------------------------------------------------------------
     def start(self, q0: np.ndarray, v0: np.ndarray, sensors: SensorSuite) -> None:
@@ -112,6 +114,9 @@ class ClosedLoop:
 
         Raises:
             ParameterError: a state of the wrong size or with a non-finite value.
+            StiffModeError: a spring-damper integrated explicitly is unstable at the
+                integrator's step (`uvms_pin.sim.stiffness`; the checked modes' record is
+                ``stiff_modes``).
         """
         state = self.system.initial_state(q0, v0)
         period_by_period = {
@@ -124,6 +129,7 @@ class ClosedLoop:
                     f"{what} are stepped with the UVMS period by period: they need a "
                     "sampled controller ([control] period_s), not a continuous one"
                 )
+        self.stiff_modes = check_stiff_modes(self.system, state, self.settings.integrator)
         self.time_s, self.state = 0.0, SystemState(read_only(state.q), read_only(state.v))
         self.sensors = sensors
         self.plant.actuation.start(self.settings.control_period_s)
@@ -255,6 +261,7 @@ class ClosedLoop:
         try:
             self.start(q0, v0, sensors)
             log.rollout.metadata["world"] = self.system.record()  # as simulated: anchored
+            log.rollout.metadata["stiff_modes"] = self.stiff_modes
             if self.settings.control_period_s is None:
                 path.reason = "continuous-time control"
                 self._run_continuous(span)

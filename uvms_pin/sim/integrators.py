@@ -117,6 +117,14 @@ class FixedStep(Integrator):
     def step(self, model, rhs, t, q, v, h):
         """(q, v) one substep h [s] after (q, v) at t."""
 
+    def linear_step(self, h: float, rate_matrix: np.ndarray) -> np.ndarray | None:
+        """The matrix Phi of one substep h [s] on the linear system y' = A y, y = (x, x_dot),
+        ``rate_matrix`` A = [[0, I], [-K, -C]] (2n x 2n, K, C stiffness and damping over
+        mass): y+ = Phi y. The step is stable on it while Phi's spectral radius is <= 1
+        (`uvms_pin.sim.stiffness`). None: not known (an integrator of your own; its stiff
+        modes are not checked)."""
+        return None
+
 
 @dataclass(frozen=True)
 class RK4(FixedStep):
@@ -146,6 +154,17 @@ class RK4(FixedStep):
         v = v0 + (h / 6.0) * (a1 + 2.0 * a2 + 2.0 * a3 + a4)
         return pin.integrate(model, q0, delta), v
 
+    def linear_step(self, h, rate_matrix):
+        """Phi = R(h A), R(z) = 1 + z + z^2/2 + z^3/6 + z^4/24 (the degree-4 Taylor
+        polynomial: stable on the imaginary axis up to |h lambda| = 2 sqrt(2), on the
+        negative real axis to 2.785)."""
+        z = h * np.asarray(rate_matrix, dtype=float)
+        out = term = np.eye(len(z))
+        for k in range(1, 5):
+            term = term @ z / k
+            out = out + term
+        return out
+
 
 @dataclass(frozen=True)
 class SemiImplicitEuler(FixedStep):
@@ -157,6 +176,15 @@ class SemiImplicitEuler(FixedStep):
     def step(self, model, rhs, t, q, v, h):
         v = v + h * rhs(t, q, v)
         return pin.integrate(model, q, h * v), v
+
+    def linear_step(self, h, rate_matrix):
+        """v+ = v + h (A_x x + A_v v), x+ = x + h v+: Phi = [[I + h^2 A_x, h (I + h A_v)],
+        [h A_x, I + h A_v]] (A's lower blocks A_x, A_v; undamped: stable to h omega = 2)."""
+        a = np.asarray(rate_matrix, dtype=float)
+        n = len(a) // 2
+        eye = np.eye(n)
+        a_x, a_v = a[n:, :n], a[n:, n:]
+        return np.block([[eye + h * h * a_x, h * (eye + h * a_v)], [h * a_x, eye + h * a_v]])
 
 
 @dataclass(frozen=True)

@@ -5,6 +5,7 @@ from __future__ import annotations
 from pathlib import Path
 
 import numpy as np
+import pytest
 
 import uvms_pin as up
 
@@ -34,3 +35,38 @@ def test_imported_lrauv_with_its_thruster_table_runs_and_its_propeller_pushes(tm
     actuation.start(0.01)
     applied = actuation.apply(np.r_[10.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0])
     np.testing.assert_allclose(applied[:6], [10.0, 0.0, 0.0, 0.0, 0.0, 0.0], atol=1e-12)
+
+
+PASSIVE_LRAUV = (
+    '[scenario]\nmodel = "lrauv.urdf"\nduration_s = 60.0\n\n'
+    "[initial]\nposition_world_m = [0.0, 0.0, -5.0]\nrpy_rad = [0.2, -0.1, 0.3]\n"
+    # the fins swung against their +-0.26 rad limits within the first second
+    "velocity = [0.5, 0.0, 0.1, 0.1, 0.1, 0.3, 0.5, -0.5]\n\n"
+    '[controller]\ntype = "none"\n\n[integrator]\nmethod = "rk4"\nstep_s = 0.005\n\n'
+    "[output]\nlog_period_s = 0.05\n"
+)
+
+
+def test_the_imported_lrauv_with_passive_fins_runs_a_minute_or_is_refused(tmp_path):
+    """Its fins (0.2 kg plates, no added mass or damping in gz-sim's model: 5e-5 kg m^2 about
+    their hinge) on compliant stops of 1000 N m/rad and 5 N m s/rad diverged at their first
+    touch of a stop, at the same time at a 5 ms and a 1 ms step (c / I = 1e5 1/s: RK4 needs
+    h <= 28 us); as constraints (the default of a passive run) they hold, and the stops are
+    refused before the run, the fin's joint named."""
+    from uvms_pin.errors import StiffModeError
+    from uvms_pin.results.metrics import joint_limit_metrics
+
+    up.import_model(LRAUV, tmp_path / "lrauv.urdf")
+    scenario = tmp_path / "passive.toml"
+    scenario.write_text(PASSIVE_LRAUV)
+    for step_s in (0.005, 0.001):
+        rollout = up.simulate(up.load_scenario(scenario, {"integrator.step_s": step_s}))
+        assert rollout.status.ok and rollout.time_s[-1] == 60.0
+        limits = joint_limit_metrics(rollout)
+        assert limits["time_at_joint_stop_s"] > 0.0  # the fins did reach their limits
+        assert limits["joint_limit_excess_max_rad"] < 1e-6
+        assert np.abs(rollout.v).max() < 2.0
+    compliant = up.load_scenario(scenario, {"joints.stops": "compliant"})
+    with pytest.raises(StiffModeError, match=r"the compliant stop of joint '\w+_fins_joint'") as e:
+        up.simulate(compliant)
+    assert e.value.largest_stable_step_s < 1e-4

@@ -30,7 +30,7 @@ from uvms_pin.checks import finite_vector
 from uvms_pin.errors import ParameterError
 from uvms_pin.physics.constraints.rows import ConstraintRows, evaluated
 
-__all__ = ["ContactSphere", "PlaneContacts"]
+__all__ = ["ContactSphere", "PlaneContacts", "point_jacobian"]
 
 _UNIT = "N s"
 
@@ -91,7 +91,7 @@ class PlaneContacts:
             center = placed.act(sphere.center_in_joint)
             gap = float(self.normal_world @ (center - self.point_world)) - sphere.radius_m
             point = center - sphere.radius_m * self.normal_world
-            normal_rate = self.normal_world @ _point_jacobian(model, data, sphere.joint_id, point)
+            normal_rate = self.normal_world @ point_jacobian(model, data, sphere.joint_id, point)
             if gap > period_s * np.abs(normal_rate) @ speed + self.margin:
                 continue
             contact = pin.PointContactConstraintModel(
@@ -130,7 +130,9 @@ def _contact_frame(normal: np.ndarray) -> np.ndarray:
     return np.column_stack([t1, np.cross(normal, t1), normal])
 
 
-def _point_jacobian(model: pin.Model, data: pin.Data, joint_id: int, point: np.ndarray):
+def point_jacobian(
+    model: pin.Model, data: pin.Data, joint_id: int, point: np.ndarray
+) -> np.ndarray:
     """J_p (3 x nv): the world velocity of the body point at ``point`` (world) [m/s],
     v_p = v_o + w x (p - o) from the joint's world-aligned Jacobian at its origin o."""
     jacobian = pin.getJointJacobian(model, data, joint_id, pin.LOCAL_WORLD_ALIGNED)

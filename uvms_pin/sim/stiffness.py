@@ -1,0 +1,203 @@
+"""Stable at its step, or refused before the run: the explicit stiff modes of a run
+(`uvms_pin.sim.stiff_modes`) against its fixed-step integrator.
+
+A fixed step h integrates the mode y' = A y (y = (x, x_dot), A its `StiffMode.rate_matrix`)
+as y+ = Phi(h) y (`uvms_pin.sim.integrators.FixedStep.linear_step`: RK4's Phi = R(h A) with
+R the degree-4 Taylor polynomial, stable while |R(h lambda)| <= 1 for both rates lambda;
+semi-implicit Euler's own matrix). The mode is stable while Phi's spectral radius is <= 1;
+its largest stable step h* is where it first exceeds 1 (for an undamped mode
+h* omega = 2 sqrt(2) with RK4, 2 with semi-implicit Euler; for a strongly damped one
+h* c / m_eff = 2.785 with RK4). `check_stiff_modes` raises a `StiffModeError` naming the mode
+whose h* is below the run's step, before anything is integrated, and otherwise gives the
+record a rollout keeps (``metadata["stiff_modes"]``): the stiffest mode and its margin
+h* / h. An adaptive integrator chooses its own step: nothing is checked, and the record
+says so.
+"""
+
+from __future__ import annotations
+
+import cmath
+import math
+from typing import Any
+
+import numpy as np
+import pinocchio as pin
+
+from uvms_pin.errors import StiffModeError
+from uvms_pin.sim.integrators import FixedStep, Integrator
+from uvms_pin.sim.stiff_modes import (
+    Body,
+    StiffMode,
+    body_mobility,
+    contact_modes,
+    environment_mode,
+    stop_modes,
+    working_depth_m,
+)
+from uvms_pin.sim.system import System, SystemState
+
+__all__ = ["check_stiff_modes", "largest_stable_step_s", "system_modes"]
+
+#: the spectral radius a stable step may reach (an undamped mode under semi-implicit Euler
+#: keeps exactly 1, rounding aside)
+_RADIUS_SLACK = 1e-9
+
+
+def _spectral_radius(phi: np.ndarray) -> float:
+    """max |mu| of a 2 x 2 matrix's eigenvalues mu (mu^2 - tr mu + det = 0)."""
+    trace, det = phi[0, 0] + phi[1, 1], phi[0, 0] * phi[1, 1] - phi[0, 1] * phi[1, 0]
+    root = cmath.sqrt(trace * trace / 4.0 - det)
+    return max(abs(trace / 2.0 + root), abs(trace / 2.0 - root))
+
+
+def is_stable(integrator: FixedStep, step_s: float, mode: StiffMode) -> bool:
+    """Whether one step of ``step_s`` [s] keeps ``mode`` bounded (spectral radius <= 1)."""
+    phi = integrator.linear_step(step_s, mode.rate_matrix)
+    return _spectral_radius(phi) <= 1.0 + _RADIUS_SLACK
+
+
+def largest_stable_step_s(integrator: FixedStep, mode: StiffMode) -> float:
+    """h* [s]: the step at which ``mode`` turns unstable (inf if it never does), to 1e-12
+    relative: doubling from 1e-3 / |lambda|_max, then bisection (the stable steps of a mode
+    with Re lambda <= 0 are an interval [0, h*] for the shipped integrators)."""
+    fastest = float(np.max(np.abs(mode.rates)))
+    if fastest == 0.0:
+        return math.inf
+    low, high = 0.0, 1e-3 / fastest
+    while is_stable(integrator, high, mode):
+        low, high = high, 2.0 * high
+        if high > 1e6 / fastest:
+            return math.inf
+    while high - low > 1e-12 * high:
+        middle = 0.5 * (low + high)
+        low, high = (middle, high) if is_stable(integrator, middle, mode) else (low, middle)
+    return low
+
+
+def _robot_bodies(system: System, data: pin.Data, inverse: np.ndarray) -> list[Body]:
+    world, uvms = system.plant.world, system.plant.uvms
+    depth = working_depth_m(uvms.net_buoyancy_N, world.law)
+    out = []
+    for b, name in enumerate(world.body_names):
+        pieces = [p for p in world.pieces if p.body == b]
+        mobility = body_mobility(uvms.model, data, inverse, pieces)
+        out.append(Body(f"link '{name}'", mobility, depth))
+    return out
+
+
+def _object_bodies(system: System, state: SystemState, inverse: np.ndarray) -> list[Body]:
+    law, layout = system.plant.world.law, system.layout
+    out = []
+    for k, obj in enumerate(system.objects):
+        model = obj.uvms.model
+        data = model.createData()
+        pin.computeJointJacobians(model, data, state.q[layout.q_slices[k + 1]])
+        part = layout.v_slices[k + 1]
+        mobility = body_mobility(model, data, inverse[part, part], list(obj.pieces))
+        depth = working_depth_m(obj.uvms.net_buoyancy_N, law)
+        out.append(Body(f"free object '{obj.name}'", mobility, depth))
+    return out
+
+
+def _self_bodies(system: System, data: pin.Data, inverse: np.ndarray) -> list[Body]:
+    """The arm's links that can touch their vehicle, each relative to it."""
+    world, uvms = system.plant.world, system.plant.uvms
+    model, depth = uvms.model, working_depth_m(uvms.net_buoyancy_N, world.law)
+    out = []
+    for b, name in enumerate(world.body_names):
+        pieces = [
+            p
+            for p in world.pieces
+            if p.body == b and p.joint_id > 1 and model.parents[p.joint_id] != 1
+        ]
+        if pieces:
+            mobility = body_mobility(model, data, inverse, pieces, relative_to=1)
+            out.append(Body(f"link '{name}'", mobility, depth))
+    return out
+
+
+def _world_modes(
+    system: System, state: SystemState, data: pin.Data, inverse: np.ndarray
+) -> list[StiffMode]:
+    world = system.plant.world
+    law = world.law
+    robot_inverse = inverse[system.layout.v_slices[0], system.layout.v_slices[0]]
+    robot = _robot_bodies(system, data, robot_inverse)
+    objects = _object_bodies(system, state, inverse)
+    modes: list[StiffMode] = []
+    if world.objects:
+        fixed = ", ".join(f"'{o.name}'" for o in world.objects)
+        for body in [*robot, *objects]:
+            modes += contact_modes(
+                f"{body.name} against the fixed world ({fixed})", body, None, law
+            )
+    for body in robot:
+        for obj in objects:
+            modes += contact_modes(f"{body.name} against the {obj.name}", body, obj, law)
+    for i, first in enumerate(objects):
+        for other in objects[i + 1 :]:
+            modes += contact_modes(f"{first.name} against the {other.name}", first, other, law)
+    if world.self_collision:
+        for link in _self_bodies(system, data, robot_inverse):
+            modes += contact_modes(f"{link.name} against its own vehicle", link, None, law)
+    return modes
+
+
+def system_modes(system: System, state: SystemState, time_s: float = 0.0) -> list[StiffMode]:
+    """Every explicit stiff mode of ``system`` at ``state`` (`uvms_pin.sim.stiff_modes`)."""
+    plant = system.plant
+    if plant.joint_stops is None and plant.contact is None and plant.world is None:
+        return []  # nothing stiff: no mass matrix to invert
+    inverse = np.linalg.inv(system.mass_matrix(time_s, state.q))
+    robot = system.layout.v_slices[0]
+    robot_inverse = inverse[robot, robot]
+    model = plant.uvms.model
+    data = model.createData()
+    q, _ = system.robot_state(state.q, state.v)
+    pin.computeJointJacobians(model, data, q)
+    modes: list[StiffMode] = []
+    if plant.joint_stops is not None:
+        modes += stop_modes(plant.joint_stops, robot_inverse)
+    if plant.contact is not None:
+        frame = plant.uvms.ee_frame_id
+        pin.updateFramePlacements(model, data)
+        jac = pin.getFrameJacobian(model, data, frame, pin.LOCAL_WORLD_ALIGNED)[:3]
+        mode = environment_mode(plant.contact, jac @ robot_inverse @ jac.T)
+        modes += [] if mode is None else [mode]
+    if plant.world is not None:
+        modes += _world_modes(system, state, data, inverse)
+    return modes
+
+
+def check_stiff_modes(system: System, state: SystemState, integrator: Integrator) -> dict[str, Any]:
+    """The record of the run's stiff modes at ``state`` under ``integrator``: the stiffest
+    (the least largest stable step h*) and its margin h* / h.
+
+    Raises:
+        StiffModeError: a mode is unstable at the integrator's step (the least stable one
+            named, with k, c, m_eff, the step and h*).
+    """
+    name = type(integrator).__name__
+    if not isinstance(integrator, FixedStep):
+        reason = "an adaptive integrator chooses its own step"
+        return {"checked": False, "integrator": name, "reason": reason}
+    if integrator.linear_step(1.0, np.eye(2)) is None:
+        reason = "the integrator gives no linear step map (FixedStep.linear_step)"
+        return {"checked": False, "integrator": name, "reason": reason}
+    modes = system_modes(system, state)
+    step_s = float(integrator.step_s)
+    record: dict[str, Any] = {"checked": True, "integrator": name, "step_s": step_s}
+    if not modes:
+        return {**record, "modes": 0, "stiffest": None, "margin": None}
+    limits = [largest_stable_step_s(integrator, m) for m in modes]
+    k = int(np.argmin(limits))
+    stiffest, limit = modes[k], limits[k]
+    if not is_stable(integrator, step_s, stiffest) or limit < step_s:
+        raise StiffModeError(stiffest, name, step_s, limit)
+    finite = math.isfinite(limit)
+    return {
+        **record,
+        "modes": len(modes),
+        "stiffest": {**stiffest.record(), "largest_stable_step_s": limit if finite else None},
+        "margin": limit / step_s if finite else None,
+    }
