@@ -19,6 +19,7 @@ import pinocchio as pin
 
 from uvms_pin.control.measurement import Measurement, read_only
 from uvms_pin.errors import ParameterError
+from uvms_pin.perception.suite import PerceptionSpec
 from uvms_pin.results.signal import Signal
 from uvms_pin.sim.estimation.estimator import NavigationEstimator
 from uvms_pin.sim.estimation.spec import EstimatorSpec
@@ -147,6 +148,8 @@ class SensorConfig:
         sample_period_s: sensor rate: a new noise value is drawn every sample period.
         navigation: the vehicle's navigation sensors (IMU, depth, DVL, USBL), logged as
             signals; what a controller measures is unchanged by them.
+        perception: the cameras and sonars (`uvms_pin.perception`), fired over the logged
+            states after the run (their images beside the rollout).
         estimator: a navigation filter on them (`uvms_pin.sim.estimation`), or None; with
             ``controller_input = "estimate"`` the controller's measurement carries its
             estimate in place of the measured vehicle state.
@@ -161,6 +164,7 @@ class SensorConfig:
     sample_period_s: float = 1e-3
     navigation: NavigationSpec = field(default_factory=NavigationSpec)
     estimator: EstimatorSpec | None = None
+    perception: PerceptionSpec = field(default_factory=PerceptionSpec)
 
 
 class SensorSuite:

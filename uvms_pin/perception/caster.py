@@ -1,0 +1,117 @@
+"""The one ray caster over a scene of posed shapes: the nearest hit of each ray.
+
+Each body is a shape (`uvms_pin.perception.shapes`, `uvms_pin.perception.mesh`) built once in
+its own frame, a label, and a pose (R, p) that `RayCaster.set_pose` replaces whenever a
+sensor fires: the rays are carried into each body's frame, o_b = R^T (o - p), d_b = R^T d
+(an instance transform), and the hit's normal back, n = R n_b. A body whose bounding sphere
+a ray misses, or meets beyond the nearest hit found so far, is not asked for that ray.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Protocol
+
+import numpy as np
+
+__all__ = ["Hits", "RayCaster", "Shape"]
+
+
+class Shape(Protocol):
+    """What a ray meets, in its own frame (`uvms_pin.perception.shapes`)."""
+
+    bound_radius_m: float
+
+    def hit(self, o: np.ndarray, d: np.ndarray) -> tuple[np.ndarray, np.ndarray]: ...
+
+
+@dataclass(frozen=True)
+class Hits:
+    """What n rays met.
+
+    Attributes:
+        range_m: distance along each (unit) ray to its hit (n,) [m], inf for none.
+        normal_world: the surface's outward unit normal there (n, 3), zero for none.
+        label: the body met (n,): its index + 1 in the caster's ``names``, 0 for none.
+    """
+
+    range_m: np.ndarray
+    normal_world: np.ndarray
+    label: np.ndarray
+
+
+class RayCaster:
+    """Bodies (shape, name) at poses; `cast` finds each ray's nearest hit."""
+
+    def __init__(self) -> None:
+        self.names: list[str] = []
+        self._shapes: list[Shape] = []
+        self._rotations: list[np.ndarray] = []
+        self._positions: list[np.ndarray] = []
+
+    def add(self, name: str, shape: Shape, rotation=None, position_m=None) -> int:
+        """A body named ``name`` (its label: the returned index + 1), at the pose given."""
+        self.names.append(name)
+        self._shapes.append(shape)
+        self._rotations.append(np.eye(3) if rotation is None else np.asarray(rotation, float))
+        self._positions.append(np.zeros(3) if position_m is None else np.asarray(position_m, float))
+        return len(self.names) - 1
+
+    def set_pose(self, index: int, rotation: np.ndarray, position_m: np.ndarray) -> None:
+        """Body ``index`` now at (R (3, 3), p (3,)) in the world."""
+        self._rotations[index] = rotation
+        self._positions[index] = position_m
+
+    def cast(self, origins_world: np.ndarray, directions_world: np.ndarray) -> Hits:
+        """The nearest hit of each ray o + t d (origins (n, 3) or one (3,); unit directions
+        (n, 3), world axes)."""
+        d = np.asarray(directions_world, dtype=float)
+        n = len(d)
+        origin = np.asarray(origins_world, dtype=float)  # one origin (3,): a camera's
+        best = np.full(n, np.inf)
+        normal = np.zeros((n, 3))
+        label = np.zeros(n, dtype=np.int32)
+        for k, shape in enumerate(self._shapes):
+            rotation, position = self._rotations[k], self._positions[k]
+            if origin.ndim == 1 and _inside(shape, (origin - position) @ rotation):
+                continue  # from inside a solid: nothing of it is seen
+            rows = _candidates(origin, d, position, shape.bound_radius_m, best)
+            if rows is not None and len(rows) == 0:
+                continue
+            o_k = origin if rows is None or origin.ndim == 1 else origin[rows]
+            d_k = d if rows is None else d[rows]
+            local = np.broadcast_to((o_k - position) @ rotation, d_k.shape)
+            t, n_local = shape.hit(local, d_k @ rotation)
+            picked = rows if rows is not None else slice(None)
+            nearer = t < best[picked]
+            if not np.any(nearer):
+                continue
+            where = np.flatnonzero(nearer) if rows is None else rows[nearer]
+            best[where] = t[nearer]
+            normal[where] = n_local[nearer] @ rotation.T
+            label[where] = k + 1
+        return Hits(best, normal, label)
+
+
+def _inside(shape: Shape, point: np.ndarray) -> bool:
+    contains = getattr(shape, "contains", None)
+    return contains is not None and contains(point)
+
+
+def _candidates(
+    o: np.ndarray, d: np.ndarray, centre: np.ndarray, radius: float, best: np.ndarray
+) -> np.ndarray | None:
+    """The rays that may meet a body within ``radius`` of ``centre`` nearer than ``best``
+    (None: every ray, an unbounded body)."""
+    if not np.isfinite(radius):
+        return None
+    to_centre = centre - o  # (3,) from one origin, else (n, 3)
+    if to_centre.ndim == 1:
+        along = d @ to_centre
+        across2 = to_centre @ to_centre - along * along
+    else:
+        along = np.einsum("ij,ij->i", to_centre, d)
+        across2 = np.einsum("ij,ij->i", to_centre, to_centre) - along * along
+    reach = radius * (1.0 + 1e-9) + 1e-12
+    near = (across2 <= reach * reach) & (along + reach > 0.0) & (along - reach < best)
+    return np.flatnonzero(near)
