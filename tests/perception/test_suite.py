@@ -54,7 +54,7 @@ def test_a_run_records_its_cameras_and_sonars_beside_an_unchanged_rollout(tmp_pa
     np.testing.assert_array_equal(loaded.camera("front").rgb, camera.rgb)
     np.testing.assert_array_equal(loaded.sonar("fls").intensity, sonar.intensity)
     assert loaded.camera("front").label_names == camera.label_names
-    with pytest.raises(ParameterError, match="no camera 'back'.*front"):
+    with pytest.raises(ParameterError, match=r"no camera 'back'.*front"):
         loaded.camera("back")
     plain.save(tmp_path)  # the previous run's images go with it
     assert not (tmp_path / "perception.npz").exists()
