@@ -48,10 +48,22 @@ def scene() -> Scene:
         plane("seabed", [0, 0, -10.0], [0, 0, 1.0], *friction),
         solid("ball", "sphere", {"radius_m": 0.4}, [3, 0, -9.2], [0, 0, 0], *friction),
         solid("crate", "box", {"size_m": [1, 1, 0.6]}, [4, 1.2, -9.5], [0, 0, 0.4], *friction),
-        solid("pipe", "cylinder", {"radius_m": 0.2, "length_m": 3}, [5, -1.5, -9.7],
-              [1.5708, 0, 0.3], *friction),  # fmt: skip
-        solid("egg", "ellipsoid", {"semi_axes_m": [0.3, 0.4, 0.5]}, [3.5, -0.8, -9.4],
-              [0, 0, 0], *friction),  # fmt: skip
+        solid(
+            "pipe",
+            "cylinder",
+            {"radius_m": 0.2, "length_m": 3},
+            [5, -1.5, -9.7],
+            [1.5708, 0, 0.3],
+            *friction,
+        ),
+        solid(
+            "egg",
+            "ellipsoid",
+            {"semi_axes_m": [0.3, 0.4, 0.5]},
+            [3.5, -0.8, -9.4],
+            [0, 0, 0],
+            *friction,
+        ),
         solid("rock", "mesh", {"path": str(ROCK)}, [2.5, 0.8, -9.8], [0, 0, 0], *friction),
     ]
     out = Scene(uvms, objects)
