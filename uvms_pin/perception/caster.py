@@ -14,7 +14,7 @@ from typing import Protocol
 
 import numpy as np
 
-__all__ = ["Hits", "RayCaster", "Shape"]
+__all__ = ["Bundles", "Hits", "RayCaster", "Shape"]
 
 
 class Shape(Protocol):
@@ -62,9 +62,15 @@ class RayCaster:
         self._rotations[index] = rotation
         self._positions[index] = position_m
 
-    def cast(self, origins_world: np.ndarray, directions_world: np.ndarray) -> Hits:
+    def cast(
+        self,
+        origins_world: np.ndarray,
+        directions_world: np.ndarray,
+        bundles: Bundles | None = None,
+    ) -> Hits:
         """The nearest hit of each ray o + t d (origins (n, 3) or one (3,); unit directions
-        (n, 3), world axes)."""
+        (n, 3), world axes). ``bundles``: the rays of one origin in cones (`Bundles`, world
+        axes), to leave out whole cones that miss a body."""
         d = np.asarray(directions_world, dtype=float)
         n = len(d)
         origin = np.asarray(origins_world, dtype=float)  # one origin (3,): a camera's
@@ -75,7 +81,10 @@ class RayCaster:
             rotation, position = self._rotations[k], self._positions[k]
             if origin.ndim == 1 and _inside(shape, (origin - position) @ rotation):
                 continue  # from inside a solid: nothing of it is seen
-            rows = _candidates(origin, d, position, shape.bound_radius_m, best)
+            within = None
+            if bundles is not None and np.isfinite(shape.bound_radius_m):
+                within = bundles.rays_toward(position - origin, shape.bound_radius_m)
+            rows = _candidates(origin, d, position, shape.bound_radius_m, best, within)
             if rows is not None and len(rows) == 0:
                 continue
             o_k = origin if rows is None or origin.ndim == 1 else origin[rows]
@@ -93,18 +102,67 @@ class RayCaster:
         return Hits(best, normal, label)
 
 
+@dataclass(frozen=True)
+class Bundles:
+    """Rays of one origin grouped in cones: cone j holds the consecutive rays
+    ``starts[j]:starts[j + 1]``, within ``half_angle_rad[j]`` of its unit ``axes[j]``."""
+
+    axes: np.ndarray
+    half_angle_rad: np.ndarray
+    starts: np.ndarray
+
+    @classmethod
+    def of(cls, directions: np.ndarray, starts: np.ndarray) -> Bundles:
+        """The cones of the unit ``directions`` (n, 3) cut at ``starts`` (m + 1,)."""
+        sums = np.add.reduceat(directions, starts[:-1], axis=0)
+        axes = sums / np.linalg.norm(sums, axis=1, keepdims=True)
+        cosines = np.einsum("ij,ij->i", directions, np.repeat(axes, np.diff(starts), axis=0))
+        least = np.minimum.reduceat(cosines, starts[:-1])
+        return cls(axes, np.arccos(np.clip(least, -1.0, 1.0)), np.asarray(starts))
+
+    def rotated(self, rotation: np.ndarray) -> Bundles:
+        """The same cones in the axes where ``rotation`` takes their frame."""
+        return Bundles(self.axes @ rotation.T, self.half_angle_rad, self.starts)
+
+    def rays_toward(self, to_centre: np.ndarray, radius: float) -> np.ndarray | None:
+        """The rays of the cones that may meet the sphere of ``radius`` about ``to_centre``
+        (from the origin), None when the origin is inside it (every ray may)."""
+        distance = float(np.linalg.norm(to_centre))
+        if distance <= radius * (1.0 + 1e-9):
+            return None
+        seen_within = np.arcsin(min(1.0, radius / distance)) + 1e-9
+        off_axis = np.arccos(np.clip(self.axes @ (to_centre / distance), -1.0, 1.0))
+        cones = np.flatnonzero(off_axis <= self.half_angle_rad + seen_within)
+        if len(cones) == 0:
+            return np.zeros(0, dtype=np.int64)
+        starts, stops = self.starts[cones], self.starts[cones + 1]
+        lengths = stops - starts
+        offsets = np.repeat(starts - np.cumsum(lengths) + lengths, lengths)
+        return np.arange(lengths.sum()) + offsets
+
+
 def _inside(shape: Shape, point: np.ndarray) -> bool:
     contains = getattr(shape, "contains", None)
     return contains is not None and contains(point)
 
 
 def _candidates(
-    o: np.ndarray, d: np.ndarray, centre: np.ndarray, radius: float, best: np.ndarray
+    o: np.ndarray,
+    d: np.ndarray,
+    centre: np.ndarray,
+    radius: float,
+    best: np.ndarray,
+    within: np.ndarray | None = None,
 ) -> np.ndarray | None:
-    """The rays that may meet a body within ``radius`` of ``centre`` nearer than ``best``
-    (None: every ray, an unbounded body)."""
+    """The rays (among ``within``, default all) that may meet a body within ``radius`` of
+    ``centre`` nearer than ``best`` (None: every ray, an unbounded body)."""
     if not np.isfinite(radius):
         return None
+    if within is not None:
+        if len(within) == 0:
+            return within
+        d, best = d[within], best[within]
+        o = o if o.ndim == 1 else o[within]
     to_centre = centre - o  # (3,) from one origin, else (n, 3)
     if to_centre.ndim == 1:
         along = d @ to_centre
@@ -113,5 +171,7 @@ def _candidates(
         along = np.einsum("ij,ij->i", to_centre, d)
         across2 = np.einsum("ij,ij->i", to_centre, to_centre) - along * along
     reach = radius * (1.0 + 1e-9) + 1e-12
-    near = (across2 <= reach * reach) & (along + reach > 0.0) & (along - reach < best)
-    return np.flatnonzero(near)
+    near = np.flatnonzero(
+        (across2 <= reach * reach) & (along + reach > 0.0) & (along - reach < best)
+    )
+    return near if within is None else within[near]

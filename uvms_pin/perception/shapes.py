@@ -54,8 +54,7 @@ class Plane:
     def hit(self, o: np.ndarray, d: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         toward = (d[:, 2] < 0.0) & (o[:, 2] > 0.0)
         t = np.where(toward, -o[:, 2] / np.where(toward, d[:, 2], -1.0), np.inf)
-        normal = np.zeros_like(o)
-        normal[:, 2] = 1.0
+        normal = np.broadcast_to(np.array([0.0, 0.0, 1.0]), o.shape)  # one normal, not copied
         return np.where(t > T_MIN_M, t, np.inf), normal
 
 
