@@ -89,3 +89,10 @@ def test_a_sensor_on_a_link_the_model_lacks_is_refused_before_the_run():
     scenario = _scenario({"camera": [{**CAMERA, "link": "mast"}]})
     with pytest.raises(ParameterError, match="link 'mast'"):
         simulate(scenario, progress=False)
+
+
+def test_images_that_would_not_fit_in_memory_are_refused_before_the_run():
+    huge = {**CAMERA, "width": 8192, "height": 8192, "rate_hz": 1000.0}
+    scenario = _scenario({"camera": [huge]}, duration_s=100.0)
+    with pytest.raises(ParameterError, match=r"images of front.*lower their rate_hz"):
+        simulate(scenario, progress=False)

@@ -266,4 +266,11 @@ class Camera:
         }
 
 
-CAMERA = register(PerceptionKind(name="camera", spec=CameraSpec, make=Camera))
+CAMERA = register(
+    PerceptionKind(
+        name="camera",
+        spec=CameraSpec,
+        make=Camera,
+        bytes=lambda spec: spec.width * spec.height * (4 + 3 + 2),  # depth, rgb, label
+    )
+)

@@ -40,12 +40,14 @@ class PerceptionKind:
         make: (spec, scene, random generator) -> the sensor, whose ``fire(time_s)`` gives
             the arrays it records at one firing (name -> array).
         constants: (sensor) -> the arrays it records once (a sonar's range bins), by name.
+        bytes: (spec) -> what one firing records [bytes].
     """
 
     name: str
     spec: type
     make: Callable[[Any, Any, np.random.Generator], Any]
     constants: Callable[[Any], dict[str, np.ndarray]] = lambda sensor: {}
+    bytes: Callable[[Any], float] = lambda spec: 0.0
 
 
 #: ``[[sensors.<name>]]`` -> its kind, filled by each sensor's module on import

@@ -195,6 +195,7 @@ SONAR = register(
         name="sonar",
         spec=SonarSpec,
         make=Sonar,
+        bytes=lambda spec: 4 * spec.bins * spec.beams,
         constants=lambda sonar: {
             "range_m": sonar.spec.range_m,
             "bearing_rad": sonar.spec.bearing_rad,

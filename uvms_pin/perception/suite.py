@@ -11,11 +11,14 @@ its own stream of the run's seed (`PERCEPTION_SEED_INDEX`), in the order of the 
 
 from __future__ import annotations
 
+import math
 from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
+
+from uvms_pin.checks import check_memory
 
 # the sensor kinds, each registered by its module on import: the one list of them
 from uvms_pin.perception import camera, sonar  # noqa: F401
@@ -45,11 +48,19 @@ class PerceptionSpec:
         return [spec.name for _, spec in self.sensors]
 
 
-def check_mounts(spec: PerceptionSpec, model: Any) -> None:
-    """ParameterError naming the sensor and its ``link`` when the robot's model has no such
-    frame (asked before a run, not after it)."""
+def check_mounts(spec: PerceptionSpec, model: Any, duration_s: float = 0.0) -> None:
+    """Before a run, not after it: ParameterError naming the sensor and its ``link`` when the
+    robot's model has no such frame, or when the images of ``duration_s`` [s] would not fit
+    in memory."""
+    total = 0.0
     for kind_name, own in spec.sensors:
         mount_frame(model, own.link, f"{kind_name} '{own.name}'")
+        total += (math.floor(duration_s * own.rate_hz) + 1) * SENSORS[kind_name].bytes(own)
+    check_memory(
+        total,
+        f"the images of {', '.join(spec.names)} over {duration_s:g} s",
+        "lower their rate_hz or their size",
+    )
 
 
 def firing_rows(time_s: np.ndarray, rate_hz: float) -> np.ndarray:

@@ -115,7 +115,7 @@ def _simulate(
     scenario: Scenario, observers: list[Observer], given: Controller | None, compiled: bool
 ) -> Rollout:
     settings = scenario.settings
-    check_mounts(scenario.sensor_config.perception, scenario.uvms.model)
+    check_mounts(scenario.sensor_config.perception, scenario.uvms.model, settings.duration_s)
     sensors = SensorSuite(
         scenario.uvms.model, scenario.sensor_config, settings.duration_s, settings.seed
     )
