@@ -92,10 +92,14 @@ def test_open_water_reads_the_veiling_light_and_lights_brighten_the_target(refer
     assert np.all(dark.rgb == 0)  # night, no lamp
     from uvms_pin.perception.optics import Light
 
-    lamp = Light(intensity=1.0, half_angle_rad=0.3, edge_rad=0.05)
-    lit = _camera(reference_uvms, [_wall(2.0)], surface_irradiance=0.0, lights=(lamp,)).render()
-    assert lit.radiance[15, 20].min() > 0.0  # on the axis: in the cone
-    assert np.all(lit.radiance[0, 0] == 0.0)  # far off the axis: outside it
+    lamp = Light(intensity=1.5, half_angle_rad=0.3, edge_rad=0.05)
+    rho = np.array([0.8, 0.6, 0.4])
+    lit = _camera(reference_uvms, [_wall(2.0)], surface_irradiance=0.0, lights=(lamp,),
+                  reflectance={"wall": tuple(rho)}).render()  # fmt: skip
+    # on the axis, the lamp at the camera: rho I_L / d^2 exp(-beta_D 2 d), nothing scattered
+    beta = np.asarray(JERLOV_KD_PER_M["IB"])
+    np.testing.assert_allclose(lit.radiance[15, 20], rho * 1.5 / 4.0 * np.exp(-beta * 4.0), 1e-12)
+    assert np.all(lit.radiance[0, 0] == 0.0)  # far off the axis: outside the cone
 
 
 def test_the_same_seed_gives_the_same_images(reference_uvms):

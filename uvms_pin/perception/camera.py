@@ -20,7 +20,7 @@ import numpy as np
 
 from uvms_pin.errors import ParameterError
 from uvms_pin.perception.caster import Bundles
-from uvms_pin.perception.optics import Light, WaterOptics, backscatter, cone, direct
+from uvms_pin.perception.optics import Light, WaterOptics, backscatter, cone
 from uvms_pin.perception.scene import Scene
 from uvms_pin.perception.sensor import (
     Mount,
@@ -238,23 +238,32 @@ class Camera:
             -(optics.kd_per_m * depth + optics.beta_d_per_m * r[:, None])
         )
         for light in self.spec.lights:
-            signal += direct(rho, self._lit(light, position, rotation, points, normal), r,
-                             optics.beta_d_per_m)  # fmt: skip
+            signal += self._lit(light, position, rotation, points, normal, rho, r)
         out[met] = signal + backscatter(veiling, r, optics.beta_b_per_m)
         return out
 
-    def _lit(self, light: Light, position, rotation, points, normal) -> np.ndarray:
-        """A light's irradiance (n, 3) on the points (their normals) it reaches."""
+    def _lit(self, light: Light, position, rotation, points, normal, rho, r) -> np.ndarray:
+        """A light's direct signal (n, 3) from the points (their normals, reflectances,
+        ranges): rho I_L cone max(0, n . l) / d^2 exp(-beta_D (d + r)), computed on the
+        points within its outer cone only."""
         source = position + rotation @ np.asarray(light.position_m)
         axis = rotation @ np.asarray(light.direction)
         to_point = points - source
         distance = np.linalg.norm(to_point, axis=1)
         unit = to_point / np.maximum(distance, 1e-12)[:, None]
+        outer = min(np.pi, light.half_angle_rad + light.edge_rad)
+        lit = np.flatnonzero(unit @ axis >= np.cos(outer) - 1e-12)
+        out = np.zeros_like(points)
+        if len(lit) == 0:
+            return out
+        unit, distance = unit[lit], distance[lit]
         off_axis = np.arccos(np.clip(unit @ axis, -1.0, 1.0))
-        facing = np.maximum(0.0, -np.einsum("ij,ij->i", normal, unit))
+        facing = np.maximum(0.0, -np.einsum("ij,ij->i", normal[lit], unit))
         power = light.intensity * cone(off_axis, light.half_angle_rad, light.edge_rad) * facing
         power = power / np.maximum(distance, 1e-6) ** 2
-        return power[:, None] * np.exp(-self.optics.beta_d_per_m * distance[:, None])
+        path = (distance + r[lit])[:, None]
+        out[lit] = rho[lit] * power[:, None] * np.exp(-self.optics.beta_d_per_m * path)
+        return out
 
     def fire(self) -> dict[str, np.ndarray]:
         """What a firing records: depth (float32), rgb, label."""

@@ -84,6 +84,9 @@ class RayCaster:
             within = None
             if bundles is not None and np.isfinite(shape.bound_radius_m):
                 within = bundles.rays_toward(position - origin, shape.bound_radius_m)
+            elif bundles is not None and getattr(shape, "one_sided_plane", False):
+                # a plane seen from its front only: the cones whose rays all leave it go
+                within = bundles.rays_against(rotation[:, 2], (origin - position) @ rotation[:, 2])
             rows = _candidates(origin, d, position, shape.bound_radius_m, best, within)
             if rows is not None and len(rows) == 0:
                 continue
@@ -124,6 +127,15 @@ class Bundles:
         """The same cones in the axes where ``rotation`` takes their frame."""
         return Bundles(self.axes @ rotation.T, self.half_angle_rad, self.starts)
 
+    def rays_against(self, normal: np.ndarray, height_m: float) -> np.ndarray:
+        """The rays of the cones with a ray against ``normal`` (d . n < 0), none when the
+        origin is ``height_m`` <= 0 above the plane (behind it)."""
+        if height_m <= 0.0:
+            return np.zeros(0, dtype=np.int64)
+        return self._rays_of(
+            np.flatnonzero(self.axes @ normal < np.sin(self.half_angle_rad) + 1e-9)
+        )
+
     def rays_toward(self, to_centre: np.ndarray, radius: float) -> np.ndarray | None:
         """The rays of the cones that may meet the sphere of ``radius`` about ``to_centre``
         (from the origin), None when the origin is inside it (every ray may)."""
@@ -132,7 +144,10 @@ class Bundles:
             return None
         seen_within = np.arcsin(min(1.0, radius / distance)) + 1e-9
         off_axis = np.arccos(np.clip(self.axes @ (to_centre / distance), -1.0, 1.0))
-        cones = np.flatnonzero(off_axis <= self.half_angle_rad + seen_within)
+        return self._rays_of(np.flatnonzero(off_axis <= self.half_angle_rad + seen_within))
+
+    def _rays_of(self, cones: np.ndarray) -> np.ndarray:
+        """The rays of ``cones``, in order."""
         if len(cones) == 0:
             return np.zeros(0, dtype=np.int64)
         starts, stops = self.starts[cones], self.starts[cones + 1]
@@ -157,7 +172,7 @@ def _candidates(
     """The rays (among ``within``, default all) that may meet a body within ``radius`` of
     ``centre`` nearer than ``best`` (None: every ray, an unbounded body)."""
     if not np.isfinite(radius):
-        return None
+        return within
     if within is not None:
         if len(within) == 0:
             return within

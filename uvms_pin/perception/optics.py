@@ -33,7 +33,7 @@ import numpy as np
 
 from uvms_pin.errors import ParameterError
 
-__all__ = ["JERLOV_KD_PER_M", "Light", "WaterOptics", "backscatter", "cone", "direct"]
+__all__ = ["JERLOV_KD_PER_M", "Light", "WaterOptics", "backscatter", "cone"]
 
 #: Jerlov (1976), Table XXVII: K_d [1/m] at 650, 550, 450 nm (R, G, B) of each water type:
 #: the oceanic types I to III and the coastal types 1C to 9C
@@ -140,13 +140,6 @@ def cone(off_axis_rad: np.ndarray, half_angle_rad: float, edge_rad: float) -> np
         return (off_axis_rad <= half_angle_rad).astype(float)
     s = np.clip((off_axis_rad - half_angle_rad) / edge_rad, 0.0, 1.0)
     return 1.0 - s * s * (3.0 - 2.0 * s)
-
-
-def direct(
-    reflectance: np.ndarray, irradiance: np.ndarray, range_m: np.ndarray, beta_d: np.ndarray
-) -> np.ndarray:
-    """rho_c E_c exp(-beta_D_c z) (n, 3)."""
-    return reflectance * irradiance * np.exp(-beta_d * range_m[:, None])
 
 
 def backscatter(veiling: np.ndarray, range_m: np.ndarray, beta_b: np.ndarray) -> np.ndarray:

@@ -50,6 +50,7 @@ class Plane:
     """The plane z = 0 of its frame, seen from z > 0 (its normal +z)."""
 
     bound_radius_m: float = np.inf
+    one_sided_plane: bool = True
 
     def hit(self, o: np.ndarray, d: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         toward = (d[:, 2] < 0.0) & (o[:, 2] > 0.0)
