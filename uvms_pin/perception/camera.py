@@ -19,17 +19,10 @@ from typing import Any
 import numpy as np
 
 from uvms_pin.errors import ParameterError
+from uvms_pin.perception import sensor
 from uvms_pin.perception.caster import Bundles
 from uvms_pin.perception.optics import Light, WaterOptics, backscatter, cone
 from uvms_pin.perception.scene import Scene
-from uvms_pin.perception.sensor import (
-    Mount,
-    PerceptionKind,
-    check_mount,
-    mount_frame,
-    register,
-    spec_from_dict,
-)
 
 __all__ = ["CAMERA", "Camera", "CameraSpec", "Frame", "reflectance_of"]
 
@@ -67,7 +60,7 @@ class CameraSpec:
 
     def __post_init__(self) -> None:
         label = f"camera '{self.name}'"
-        check_mount(self, label)
+        sensor.check_mount(self, label)
         for key in ("width", "height"):
             value = getattr(self, key)
             if not (isinstance(value, int) and 1 <= value <= 8192):
@@ -101,10 +94,6 @@ class CameraSpec:
         )
 
     @property
-    def mount(self) -> Mount:
-        return Mount(self.link, self.position_m, self.rpy_rad)
-
-    @property
     def focal_px(self) -> float:
         return 0.5 * self.width / math.tan(0.5 * self.horizontal_fov_rad)
 
@@ -118,10 +107,11 @@ class CameraSpec:
         if not isinstance(lights, list) or not isinstance(reflectance, dict):
             raise ParameterError(f"{label}: lights must be tables, reflectance a table")
         built = tuple(
-            spec_from_dict(Light, light, f"{label}: lights[{k}]") for k, light in enumerate(lights)
+            sensor.spec_from_dict(Light, light, f"{label}: lights[{k}]")
+            for k, light in enumerate(lights)
         )
         colours = {str(k): tuple(float(c) for c in v) for k, v in reflectance.items()}
-        return spec_from_dict(cls, raw, label, lights=built, reflectance=colours)
+        return sensor.spec_from_dict(cls, raw, label, lights=built, reflectance=colours)
 
 
 @dataclass(frozen=True)
@@ -167,14 +157,12 @@ def reflectance_of(names: list[str], given: dict[str, tuple], planes: set[str]) 
     return np.asarray(rows, dtype=float)
 
 
-class Camera:
+class Camera(sensor.Mounted):
     """A `CameraSpec` looking at a `Scene`, its noise drawn from ``rng``."""
 
     def __init__(self, spec: CameraSpec, scene: Scene, rng: np.random.Generator):
-        label = f"camera '{spec.name}'"
-        self.spec, self.scene, self.rng = spec, scene, rng
-        self.frame_id = mount_frame(scene.uvms.model, spec.link, label)
-        self.in_link = spec.mount.placement_in_link()
+        super().__init__(spec, scene, f"camera '{spec.name}'")
+        self.spec, self.rng = spec, rng
         self.rays = pixel_rays(spec)
         self.order, starts = tiles(spec)
         self._tiled = self.rays[self.order]
@@ -188,7 +176,7 @@ class Camera:
 
     def pose(self) -> tuple[np.ndarray, np.ndarray]:
         """(R, p) of the optical frame in the world, after the scene's update."""
-        placed = self.scene.frame_placement(self.frame_id) * self.in_link
+        placed = self.placement()
         return placed.rotation, placed.translation
 
     def render(self) -> Frame:
@@ -275,8 +263,8 @@ class Camera:
         }
 
 
-CAMERA = register(
-    PerceptionKind(
+CAMERA = sensor.register(
+    sensor.PerceptionKind(
         name="camera",
         spec=CameraSpec,
         make=Camera,

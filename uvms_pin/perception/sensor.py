@@ -21,7 +21,7 @@ from uvms_pin.errors import ParameterError
 
 __all__ = [
     "SENSORS",
-    "Mount",
+    "Mounted",
     "PerceptionKind",
     "check_mount",
     "mount_frame",
@@ -107,17 +107,20 @@ def spec_from_dict(cls: type, raw: Mapping[str, Any], label: str, **given: Any) 
     return cls(**values)
 
 
-@dataclass(frozen=True)
-class Mount:
-    """Where a sensor sits: a frame of the robot's model (None: the vehicle's body) and its
-    own frame there (``position_m`` [m], ``rpy_rad`` [rad], roll-pitch-yaw)."""
+class Mounted:
+    """A sensor on a frame of the robot's model (``spec.link``; None: the vehicle's body), its
+    own frame there at ``spec.position_m`` [m] and ``spec.rpy_rad`` [rad] (roll-pitch-yaw),
+    seeing ``scene``."""
 
-    link: str | None
-    position_m: tuple[float, float, float]
-    rpy_rad: tuple[float, float, float]
+    def __init__(self, spec: Any, scene: Any, label: str):
+        self.scene = scene
+        self.frame_id = mount_frame(scene.uvms.model, spec.link, label)
+        rotation = pin.rpy.rpyToMatrix(np.asarray(spec.rpy_rad, dtype=float))
+        self.in_link = pin.SE3(rotation, np.asarray(spec.position_m, dtype=float))
 
-    def placement_in_link(self) -> pin.SE3:
-        return pin.SE3(pin.rpy.rpyToMatrix(np.asarray(self.rpy_rad)), np.asarray(self.position_m))
+    def placement(self) -> pin.SE3:
+        """Its frame in the world, after the scene's update."""
+        return self.scene.frame_placement(self.frame_id) * self.in_link
 
 
 def check_mount(spec: Any, label: str) -> None:

@@ -27,15 +27,8 @@ from typing import Any
 import numpy as np
 
 from uvms_pin.errors import ParameterError
+from uvms_pin.perception import sensor
 from uvms_pin.perception.scene import Scene
-from uvms_pin.perception.sensor import (
-    Mount,
-    PerceptionKind,
-    check_mount,
-    mount_frame,
-    register,
-    spec_from_dict,
-)
 
 __all__ = ["SONAR", "Sonar", "SonarSpec"]
 
@@ -65,7 +58,7 @@ class SonarSpec:
 
     def __post_init__(self) -> None:
         label = f"sonar '{self.name}'"
-        check_mount(self, label)
+        sensor.check_mount(self, label)
         if self.type not in TYPES:
             raise ParameterError(
                 f"{label}: type must be one of {', '.join(TYPES)}, got {self.type!r}"
@@ -91,10 +84,6 @@ class SonarSpec:
                 raise ParameterError(f"{label}: {key} must be finite and >= 0")
 
     @property
-    def mount(self) -> Mount:
-        return Mount(self.link, self.position_m, self.rpy_rad)
-
-    @property
     def range_m(self) -> np.ndarray:
         """The bins' centres (bins,) [m]."""
         step = (self.max_range_m - self.min_range_m) / self.bins
@@ -110,7 +99,7 @@ class SonarSpec:
 
     @classmethod
     def from_dict(cls, raw: dict[str, Any], label: str) -> SonarSpec:
-        return spec_from_dict(cls, raw, label)
+        return sensor.spec_from_dict(cls, raw, label)
 
 
 def _fan(spec: SonarSpec) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -146,20 +135,19 @@ def _across_beams(spec: SonarSpec) -> np.ndarray:
     return taps / taps.sum()
 
 
-class Sonar:
+class Sonar(sensor.Mounted):
     """A `SonarSpec` listening to a `Scene`, its speckle drawn from ``rng``."""
 
     def __init__(self, spec: SonarSpec, scene: Scene, rng: np.random.Generator):
-        self.spec, self.scene, self.rng = spec, scene, rng
-        self.frame_id = mount_frame(scene.uvms.model, spec.link, f"sonar '{spec.name}'")
-        self.in_link = spec.mount.placement_in_link()
+        super().__init__(spec, scene, f"sonar '{spec.name}'")
+        self.spec, self.rng = spec, rng
         self.rays, self.beam, self.weight = _fan(spec)
         self.taps = _across_beams(spec)
 
     def intensity(self) -> np.ndarray:
         """The returns (bins, beams) of the scene as it stands."""
         spec = self.spec
-        placed = self.scene.frame_placement(self.frame_id) * self.in_link
+        placed = self.placement()
         directions = self.rays @ placed.rotation.T
         hits = self.scene.caster.cast(placed.translation, directions)
         r = hits.range_m
@@ -190,8 +178,8 @@ class Sonar:
         return {"intensity": self.intensity().astype(np.float32)}
 
 
-SONAR = register(
-    PerceptionKind(
+SONAR = sensor.register(
+    sensor.PerceptionKind(
         name="sonar",
         spec=SonarSpec,
         make=Sonar,
