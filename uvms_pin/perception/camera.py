@@ -57,6 +57,7 @@ class CameraSpec:
     noise_counts: float = 1.0
     lights: tuple[Light, ...] = ()
     reflectance: dict[str, tuple[float, float, float]] = field(default_factory=dict)
+    in_loop: bool = False
 
     def __post_init__(self) -> None:
         label = f"camera '{self.name}'"

@@ -44,6 +44,11 @@ class PerceptionSpec:
         return bool(self.sensors)
 
     @property
+    def in_loop(self) -> list[Any]:
+        """The cameras that also fire in the loop (``in_loop``: `uvms_pin.perception.loop`)."""
+        return [spec for kind, spec in self.sensors if getattr(spec, "in_loop", False)]
+
+    @property
     def names(self) -> list[str]:
         return [spec.name for _, spec in self.sensors]
 
