@@ -33,6 +33,7 @@ TOP_LEVEL = {
     "hydro",
     "model",
     "ocp",
+    "perception",
     "physics",
     "results",
     "scenario",

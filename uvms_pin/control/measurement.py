@@ -2,9 +2,15 @@
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from collections.abc import Mapping
+from dataclasses import dataclass, field
+from types import MappingProxyType
+from typing import Any
 
 import numpy as np
+
+#: a measurement without images
+_NO_IMAGES: Mapping[str, Any] = MappingProxyType({})
 
 
 def read_only(array: np.ndarray) -> np.ndarray:
@@ -30,14 +36,19 @@ class Measurement:
         wrench_world: measured wrench the end-effector exerts on the environment,
             lambda + noise, at the sensor frame origin with world-aligned axes,
             [force N (3); torque N m (3)].
+        images: the latest image of each camera in the loop, by name
+            (`uvms_pin.perception.loop.LoopImage`; empty without one).
     """
 
     time_s: float
     q: np.ndarray
     v: np.ndarray
     wrench_world: np.ndarray
+    images: Mapping[str, Any] = field(default=None)  # type: ignore[assignment]
 
     def __post_init__(self) -> None:
+        if self.images is None:  # the one empty mapping, not a dict per measurement
+            object.__setattr__(self, "images", _NO_IMAGES)
         # a measurement never aliases anything writable (the plant's state): arrays that are
         # not already read-only float arrays are copied, and the copies frozen
         q, v, w = self.q, self.v, self.wrench_world

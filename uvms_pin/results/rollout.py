@@ -10,7 +10,16 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from uvms_pin.errors import ParameterError
+from uvms_pin.results import perception as frames
 from uvms_pin.results.atomic import atomic_paths, json_text
+from uvms_pin.results.perception import (
+    CameraRecord,
+    SonarRecord,
+    camera_record,
+    load_perception,
+    save_perception,
+    sonar_record,
+)
 from uvms_pin.results.rollout_data import RolloutData
 
 if TYPE_CHECKING:
@@ -55,9 +64,20 @@ class Rollout(RolloutData):
 
         return plot_rollout(self, kind)
 
+    def camera(self, name: str) -> CameraRecord:
+        """The images of the camera ``name`` (``[[sensors.camera]]``): ``time_s`` (T,),
+        ``depth_m`` (T, H, W), ``rgb`` (T, H, W, 3) uint8, ``label`` (T, H, W)."""
+        return camera_record(self.perception, self.metadata, name)
+
+    def sonar(self, name: str) -> SonarRecord:
+        """The images of the sonar ``name`` (``[[sensors.sonar]]``): ``time_s`` (T,),
+        ``intensity`` (T, bins, beams), ``range_m`` (bins,), ``bearing_rad`` (beams,)."""
+        return sonar_record(self.perception, self.metadata, name)
+
     # ---- persistence ------------------------------------------------------------------
     def save(self, directory: str | Path) -> Path:
-        """Write ``rollout.npz`` and ``rollout.json`` into ``directory`` atomically."""
+        """Write ``rollout.npz`` and ``rollout.json`` into ``directory`` atomically (and the
+        cameras' and sonars' images, when it has some, into ``perception.npz``)."""
         out = Path(directory)
         out.mkdir(parents=True, exist_ok=True)
         # Fix: serialise the metadata before writing anything; it used to be serialised
@@ -72,6 +92,11 @@ class Rollout(RolloutData):
             with open(arrays_tmp, "wb") as f:
                 np.savez_compressed(f, **arrays)
             meta_tmp.write_text(text, encoding="utf-8")
+        if self.perception:
+            with atomic_paths(out / frames.FILE) as (frames_tmp,):
+                save_perception(frames_tmp, self.perception)
+        elif (out / frames.FILE).is_file():  # a previous run's images: not this one's
+            (out / frames.FILE).unlink()
         return out
 
     @classmethod
@@ -92,4 +117,5 @@ class Rollout(RolloutData):
             ) from exc
         if not isinstance(metadata, dict):
             raise ParameterError(f"{src / META_FILE}: a JSON object expected")
-        return cls(**base, signals=signals, metadata=metadata)
+        perception = load_perception(src / frames.FILE) if "perception" in metadata else {}
+        return cls(**base, signals=signals, metadata=metadata, perception=perception)

@@ -32,6 +32,8 @@ class RolloutData:
     potential_energy_J: np.ndarray
     signals: dict[str, np.ndarray] = field(default_factory=dict)
     metadata: dict[str, Any] = field(default_factory=dict)
+    #: the cameras' and sonars' records by sensor name (`uvms_pin.results.perception`)
+    perception: dict[str, dict[str, np.ndarray]] = field(default_factory=dict)
 
     _BASE = (
         "time_s",

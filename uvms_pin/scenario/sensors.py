@@ -1,10 +1,13 @@
 """``[sensors]``: the bounded noise of each measured channel and the sensors' rate; the
 vehicle's navigation sensors in ``[sensors.imu]``, ``[sensors.depth]``, ``[sensors.dvl]``
-and ``[sensors.usbl]`` (each fitted when its table is present)."""
+and ``[sensors.usbl]`` (each fitted when its table is present); the cameras and sonars in
+``[[sensors.camera]]`` and ``[[sensors.sonar]]`` (`uvms_pin.perception`)."""
 
 from __future__ import annotations
 
 from uvms_pin.errors import ParameterError
+from uvms_pin.perception.sensor import SENSORS as SEEING
+from uvms_pin.perception.suite import PerceptionSpec
 from uvms_pin.physics.world.world import World
 from uvms_pin.scenario.schema import Table
 from uvms_pin.sim.navigation.seabed import world_seabed
@@ -31,6 +34,7 @@ def build_sensors(
         velocity_noise=spec("velocity_noise"),
         sample_period_s=t.number("sample_period_s", 1e-3, positive=True),
         navigation=_navigation(t, water_density_kg_m3, world),
+        perception=_perception(t),
     )
     t.finish()
     return config
@@ -64,6 +68,24 @@ def _navigation(t: Table, water_density_kg_m3: float, world: World | None) -> Na
         )
     except ParameterError as exc:
         raise t.fail(str(exc)) from exc
+
+
+def _perception(t: Table) -> PerceptionSpec:
+    """Every ``[[sensors.<kind>]]`` of a registered perception kind
+    (`uvms_pin.perception.sensor.SENSORS`), in the file's order; names distinct."""
+    sensors = []
+    for name, kind in SEEING.items():
+        for table in t.tables(name):
+            try:
+                spec = kind.spec.from_dict(table.rest(), table.title)
+            except ParameterError as exc:
+                raise table.fail(str(exc).removeprefix(f"{table.title}: ")) from exc
+            sensors.append((name, spec))
+    names = [spec.name for _, spec in sensors]
+    repeated = sorted({n for n in names if names.count(n) > 1})
+    if repeated:
+        raise t.fail(f"cameras and sonars need distinct names, got {', '.join(repeated)} twice")
+    return PerceptionSpec(tuple(sensors))
 
 
 def _dvl_bottom(t: Table, world_floor: bool) -> float | None:

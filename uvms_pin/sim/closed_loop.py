@@ -134,6 +134,7 @@ class ClosedLoop:
         self.sensors = sensors
         self.plant.actuation.start(self.settings.control_period_s)
         sensors.start_navigation(self.settings.control_period_s)
+        sensors.start_seeing(self.plant, self.system.layout, self.settings.control_period_s)
         if self.controller is not None:
             with self._controller_code("reset"):
                 self.controller.reset()
@@ -151,10 +152,12 @@ class ClosedLoop:
 
     def observe(self) -> tuple[Measurement, np.ndarray]:
         """`measure`, then, once per control tick, the navigation sensors and the estimator
-        (`SensorSuite.navigate`): (what the controller is given, the true contact wrench)."""
+        (`SensorSuite.navigate`) and the cameras in the loop (`SensorSuite.see`): (what the
+        controller is given, the true contact wrench)."""
         measurement, contact = self.measure()
         q, v = self._robot
-        return self.sensors.navigate(self.time_s, q, v, measurement), contact
+        measured = self.sensors.navigate(self.time_s, q, v, measurement)
+        return self.sensors.see(self.time_s, self.state, measured), contact
 
     def command(self, measurement: Measurement) -> np.ndarray:
         """The controller's tau (nv,) for ``measurement`` (SimulationError if it is not nv

@@ -78,6 +78,7 @@ REASONS: tuple[tuple[Pipeline, Callable[[RunParts], str | None]], ...] = (
     (Pipeline.BOTH, lambda p: "stop_at_surface" if p.system.plant.stop_at_surface else None),
     (Pipeline.BOTH, lambda p: "navigation sensors" if p.sensors.navigation.fitted else None),
     (Pipeline.BOTH, lambda p: "a navigation estimator" if p.sensors.estimator is not None else None),
+    (Pipeline.BOTH, lambda p: "cameras in the loop" if p.sensors.perception.in_loop else None),
     (Pipeline.BOTH, lambda p: _fallback(actuation_to_core(p.system.plant.actuation, core_module(), p.system.plant.uvms.nv))),
     (Pipeline.LOOP, lambda p: "an observer that needs every sample" if any(not isinstance(o, ProgressReport) for o in p.observers) else None),
     (Pipeline.BOTH, _plant),

@@ -22,6 +22,8 @@ from uvms_pin.control.spec import ControllerFactory, ControllerSpec
 from uvms_pin.control.tracking.task import TrackingTask
 from uvms_pin.errors import ParameterError, ShortenedRunWarning, SimulationError
 from uvms_pin.model.uvms import UVMS
+from uvms_pin.perception.scene import scene_of
+from uvms_pin.perception.suite import check_mounts, perceive
 from uvms_pin.results.extra_metrics import DIRECTORY_KEY, REFERENCES_KEY
 from uvms_pin.results.progress import Progress, callback_or_none, progress_printer
 from uvms_pin.results.rollout import Rollout
@@ -113,6 +115,7 @@ def _simulate(
     scenario: Scenario, observers: list[Observer], given: Controller | None, compiled: bool
 ) -> Rollout:
     settings = scenario.settings
+    check_mounts(scenario.sensor_config.perception, scenario.uvms.model, settings.duration_s)
     sensors = SensorSuite(
         scenario.uvms.model, scenario.sensor_config, settings.duration_s, settings.seed
     )
@@ -149,10 +152,26 @@ def _simulate(
         partial = getattr(exc, "rollout", None)
         if scenario.task is not None and partial is not None:
             record_task(partial, scenario.task, scenario.uvms)
+        if partial is not None:
+            _perceive(partial, scenario)
         raise
     if scenario.task is not None:
         record_task(rollout, scenario.task, scenario.uvms)
+    _perceive(rollout, scenario)
     return rollout
+
+
+def _perceive(rollout: Rollout, scenario: Scenario) -> None:
+    """The scenario's cameras and sonars fired over the rollout's logged states
+    (`uvms_pin.perception.suite`); nothing without them."""
+    spec = scenario.sensor_config.perception
+    if not spec.fitted or len(rollout) == 0:
+        return
+    plant = scenario.plant
+    world = plant.world
+    n_objects = len(world.free) if world is not None and "free_objects" in rollout.signals else 0
+    scene = scene_of(plant.uvms, world, surface=plant.free_surface)
+    perceive(rollout, spec, scene, scenario.settings.seed, n_objects)
 
 
 def class_path(controller: object) -> str:

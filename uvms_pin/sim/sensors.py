@@ -11,6 +11,7 @@ integrators (a held, stepwise noise makes them restart at every sample).
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from dataclasses import dataclass, field
 
@@ -19,6 +20,9 @@ import pinocchio as pin
 
 from uvms_pin.control.measurement import Measurement, read_only
 from uvms_pin.errors import ParameterError
+from uvms_pin.perception.loop import LoopCameras
+from uvms_pin.perception.scene import scene_of
+from uvms_pin.perception.suite import PerceptionSpec
 from uvms_pin.results.signal import Signal
 from uvms_pin.sim.estimation.estimator import NavigationEstimator
 from uvms_pin.sim.estimation.spec import EstimatorSpec
@@ -147,6 +151,8 @@ class SensorConfig:
         sample_period_s: sensor rate: a new noise value is drawn every sample period.
         navigation: the vehicle's navigation sensors (IMU, depth, DVL, USBL), logged as
             signals; what a controller measures is unchanged by them.
+        perception: the cameras and sonars (`uvms_pin.perception`), fired over the logged
+            states after the run (their images beside the rollout).
         estimator: a navigation filter on them (`uvms_pin.sim.estimation`), or None; with
             ``controller_input = "estimate"`` the controller's measurement carries its
             estimate in place of the measured vehicle state.
@@ -161,6 +167,7 @@ class SensorConfig:
     sample_period_s: float = 1e-3
     navigation: NavigationSpec = field(default_factory=NavigationSpec)
     estimator: EstimatorSpec | None = None
+    perception: PerceptionSpec = field(default_factory=PerceptionSpec)
 
 
 class SensorSuite:
@@ -186,6 +193,9 @@ class SensorSuite:
             None if config.estimator is None else NavigationEstimator(config.estimator, nav, seed)
         )
         self._estimator_started = False
+        self.seed = seed
+        self.seeing: LoopCameras | None = None  # the cameras in the loop, once started
+        self._layout = None
         self._state_noisy = any(
             s.bound > 0.0
             for s in (
@@ -202,6 +212,30 @@ class SensorSuite:
         if self.navigation is not None:
             self.navigation.start(period_s)
         self._estimator_started = False
+
+    def start_seeing(self, plant, layout, period_s: float | None) -> None:
+        """A run starts: the cameras in the loop (`uvms_pin.perception.loop`) see the
+        plant's world afresh, the system's state split by ``layout``; they fire at control
+        ticks (ParameterError without a control period ``period_s``)."""
+        cameras = self.config.perception.in_loop
+        self.seeing = None
+        if not cameras:
+            return
+        if period_s is None:
+            raise ParameterError(
+                "cameras in the loop fire at the control ticks: set [control] period_s"
+            )
+        scene = scene_of(plant.uvms, plant.world, surface=plant.free_surface)
+        self.seeing, self._layout = LoopCameras(cameras, scene, self.seed), layout
+
+    def see(self, time_s: float, state, measurement: Measurement) -> Measurement:
+        """Once per control tick: the cameras in the loop whose instant has come fire from
+        the system's true ``state``; ``measurement`` with their latest images."""
+        if self.seeing is None:
+            return measurement
+        robot, *objects = self._layout.split(state.q, state.v)
+        self.seeing.update(time_s, robot[0], [q for q, _ in objects])
+        return dataclasses.replace(measurement, images=self.seeing.images)
 
     def navigate(
         self, time_s: float, q: np.ndarray, v: np.ndarray, measurement: Measurement

@@ -153,6 +153,11 @@ class UvmsEnv(gym.Env):
         self._vehicle_box = None  # (centre, size) [m], found on the first render
         self._flow_seed = self.scenario.settings.seed
 
+    @property
+    def loop(self) -> ClosedLoop:
+        """The closed loop the environment steps (``loop.state``: the system's true state)."""
+        return self._loop
+
     # -- to be given by a task environment ---------------------------------------------
     def _make_task(self, scenario: Scenario):
         raise NotImplementedError

@@ -23,6 +23,7 @@ import meshcat.geometry as mg
 import numpy as np
 import pinocchio as pin
 
+from uvms_pin.apps.viz.camera_panel import CAMERA_SCRIPT, camera_panel
 from uvms_pin.apps.viz.meshcat_scene import (
     ROOT,
     EnvironmentView,
@@ -181,7 +182,7 @@ def replay_html(
         "frames": len(idx),
         "legend": legend,
     }
-    return _page(window.commands, info)
+    return _page(window.commands, info, camera_panel(rollout, t0))
 
 
 def reference_path_world(rollout: Rollout) -> np.ndarray | None:
@@ -272,6 +273,7 @@ body { margin: 0; background: #04162e; font: 13px/1.35 sans-serif; }
 #uvms-bar button { width: 72px; }
 #uvms-slider { flex: 1; }
 #uvms-time { font-family: monospace; min-width: 150px; text-align: right; }
+#uvms-camera { position: absolute; right: 8px; top: 8px; max-width: 32vw; border: 1px solid #e8f2ff; }
 """
 
 _SCRIPT = """
@@ -296,6 +298,7 @@ function currentTime() {
 function refresh() {
   const t = currentTime();
   if (document.activeElement !== slider) slider.value = t;
+  showCamera(t);
   label.textContent = "t = " + (UVMS_INFO.t0 + t).toFixed(2) + " / "
     + (UVMS_INFO.t0 + UVMS_INFO.duration).toFixed(2) + " s";
   button.textContent = animator.playing ? "pause" : "play";
@@ -320,11 +323,13 @@ seekFromHash();
 """
 
 
-def _page(commands: list[bytes], info: dict[str, Any]) -> str:
+def _page(commands: list[bytes], info: dict[str, Any], camera: dict | None = None) -> str:
     encoded = ",\n".join(f'"{base64.b64encode(c).decode("ascii")}"' for c in commands)
     bundle = _viewer_bundle().replace("</script", "<\\/script")
     esc = html.escape
     info_json = json.dumps(info).replace("</", "<\\/")
+    camera_json = json.dumps(camera).replace("</", "<\\/")
+    image = "" if camera is None else f'<img id="uvms-camera" alt="camera {esc(camera["name"])}">'
     description = f"<br>{esc(info['description'])}" if info["description"] else ""
     frames = ""
     if info["duration"] > 0:
@@ -346,11 +351,14 @@ def _page(commands: list[bytes], info: dict[str, Any]) -> str:
 {esc(info["legend"])}{frames}</div>
 <div id="uvms-bar"><button id="uvms-play">pause</button>
 <input id="uvms-slider" type="range" min="0" value="0"><span id="uvms-time"></span></div>
+{image}
 <script>
 {bundle}
 </script>
 <script>
 const UVMS_INFO = {info_json};
+const UVMS_CAMERA = {camera_json};
+{CAMERA_SCRIPT}
 const UVMS_COMMANDS = [
 {encoded}
 ];

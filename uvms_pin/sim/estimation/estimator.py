@@ -207,7 +207,9 @@ class NavigationEstimator:
         q[3:7] = pin.Quaternion(state.rotation_world_body).coeffs()
         v[:3] = state.rotation_world_body.T @ state.velocity_world_m_s
         v[3:6] = tick.gyro - state.gyro_bias_rad_s
-        return Measurement(measured.time_s, read_only(q), read_only(v), measured.wrench_world)
+        return Measurement(
+            measured.time_s, read_only(q), read_only(v), measured.wrench_world, measured.images
+        )
 
     def signals(self) -> dict[str, Signal]:
         """``estimate`` and ``estimate_variance`` (`ESTIMATE_COLUMNS`, `VARIANCE_COLUMNS`)."""

@@ -1,0 +1,128 @@
+"""The camera: depth, labels and colour against the geometry and the formation model."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from uvms_pin.errors import ParameterError
+from uvms_pin.perception.camera import Camera, CameraSpec
+from uvms_pin.perception.optics import JERLOV_KD_PER_M
+from uvms_pin.perception.scene import Scene
+from uvms_pin.physics.world.objects import plane, solid
+
+DEPTH_M = 5.0  # the vehicle's depth below the surface
+
+
+def _scene(uvms, objects) -> Scene:
+    scene = Scene(uvms, objects)
+    q = uvms.neutral_configuration()
+    q[:3] = [0.0, 0.0, -DEPTH_M]
+    scene.update(q)
+    return scene
+
+
+def _wall(distance_m: float):
+    """A wall facing the vehicle (its normal along -x) ``distance_m`` ahead."""
+    return plane("wall", [distance_m, 0.0, -DEPTH_M], [-1.0, 0.0, 0.0], 0.5, 0.4)
+
+
+def _camera(uvms, objects, **spec) -> Camera:
+    spec = {"name": "front", "width": 41, "height": 31, "noise_counts": 0.0, **spec}
+    return Camera(CameraSpec(**spec), _scene(uvms, objects), np.random.default_rng(0))
+
+
+def test_the_depth_of_a_wall_facing_the_camera_is_its_distance(reference_uvms):
+    frame = _camera(reference_uvms, [_wall(3.0)]).render()
+    wall = frame.label == 1
+    assert wall.mean() > 0.5  # the arm hides a corner
+    np.testing.assert_allclose(frame.depth_m[wall], 3.0, rtol=0, atol=1e-9)
+    np.testing.assert_allclose(
+        frame.normal_world[wall], [[-1.0, 0.0, 0.0]] * wall.sum(), atol=1e-12
+    )
+
+
+def test_the_depth_of_a_sphere_and_a_box_ahead(reference_uvms):
+    ball = solid("ball", "sphere", {"radius_m": 0.5}, [3.0, 0.0, -DEPTH_M], [0, 0, 0], 0.5, 0.4)
+    crate = solid("crate", "box", {"size_m": [1.0, 1.0, 1.0]}, [6.0, 1.5, -DEPTH_M],
+                  [0, 0, 0], 0.5, 0.4)  # fmt: skip
+    camera = _camera(reference_uvms, [ball, crate], width=101, height=81)
+    frame = camera.render()
+    names = camera.scene.names
+    centre = frame.label[40, 50]
+    assert names[centre - 1] == "ball"  # the optical axis passes through its centre
+    assert frame.depth_m[40, 50] == pytest.approx(2.5, abs=1e-9)
+    # every ball pixel: the sphere's near side, z-depth = range * cos
+    rays = camera.rays.reshape(81, 101, 3)
+    on_ball = frame.label == centre
+    d = rays[on_ball]  # optical frame: z forward
+    centre_optical = np.array([0.0, 0.0, 3.0])
+    along = d @ centre_optical
+    expected = (along - np.sqrt(0.25 - (9.0 - along**2))) * d[:, 2]
+    np.testing.assert_allclose(frame.depth_m[on_ball], expected, rtol=0, atol=1e-6)
+    # the crate's front face (x = 5.5 m, y in [1, 2] m, 1 m high) to the left
+    at_face = rays * (5.5 / rays[..., 2:3])
+    front = (np.abs(-at_face[..., 0] - 1.5) < 0.5) & (np.abs(at_face[..., 1]) < 0.5)
+    assert front.sum() > 20
+    assert np.all(np.array(names)[frame.label[front] - 1] == "crate")
+    np.testing.assert_allclose(frame.depth_m[front], 5.5, rtol=0, atol=1e-9)
+
+
+@pytest.mark.parametrize("distance_m", [1.0, 3.0, 8.0])
+def test_a_flat_target_has_the_formation_models_colour(reference_uvms, distance_m):
+    rho = (0.8, 0.6, 0.4)
+    camera = _camera(reference_uvms, [_wall(distance_m)], reflectance={"wall": rho},
+                     water_type="II", exposure=1.5)  # fmt: skip
+    frame = camera.render()
+    kd = np.asarray(JERLOV_KD_PER_M["II"])
+    daylight = np.exp(-kd * DEPTH_M)  # E0 = 1 at the surface; at the wall's (and camera's) depth
+    veiling = 0.2 * daylight
+    # a vertical wall sees half the sky: E = daylight (1 + 0) / 2
+    expected = np.asarray(rho) * 0.5 * daylight * np.exp(-kd * distance_m) + veiling * (
+        1.0 - np.exp(-kd * distance_m)
+    )
+    np.testing.assert_allclose(frame.radiance[15, 20], expected, rtol=1e-12)
+    np.testing.assert_array_equal(frame.rgb[15, 20], np.rint(255 * 1.5 * expected).astype(np.uint8))
+
+
+def test_open_water_reads_the_veiling_light_and_lights_brighten_the_target(reference_uvms):
+    dark = _camera(reference_uvms, [_wall(2.0)], surface_irradiance=0.0).render()
+    assert np.all(dark.rgb == 0)  # night, no lamp
+    from uvms_pin.perception.optics import Light
+
+    lamp = Light(intensity=1.5, half_angle_rad=0.3, edge_rad=0.05)
+    rho = np.array([0.8, 0.6, 0.4])
+    lit = _camera(reference_uvms, [_wall(2.0)], surface_irradiance=0.0, lights=(lamp,),
+                  reflectance={"wall": tuple(rho)}).render()  # fmt: skip
+    # on the axis, the lamp at the camera: rho I_L / d^2 exp(-beta_D 2 d), nothing scattered
+    beta = np.asarray(JERLOV_KD_PER_M["IB"])
+    np.testing.assert_allclose(lit.radiance[15, 20], rho * 1.5 / 4.0 * np.exp(-beta * 4.0), 1e-12)
+    assert np.all(lit.radiance[0, 0] == 0.0)  # far off the axis: outside the cone
+
+
+def test_the_same_seed_gives_the_same_images(reference_uvms):
+    def image(seed):
+        spec = CameraSpec("front", width=41, height=31, noise_counts=3.0)
+        camera = Camera(spec, _scene(reference_uvms, [_wall(3.0)]), np.random.default_rng(seed))
+        return camera.render().rgb
+
+    np.testing.assert_array_equal(image(4), image(4))
+    assert not np.array_equal(image(4), image(5))
+
+
+@pytest.mark.parametrize(
+    ("changes", "key"),
+    [
+        ({"width": 0}, "width"),
+        ({"horizontal_fov_rad": math.pi}, "horizontal_fov_rad"),
+        ({"rate_hz": 0.0}, "rate_hz"),
+        ({"water_type": "muddy"}, "water_type"),
+        ({"position_m": (0.0, math.nan, 0.0)}, "position_m"),
+        ({"reflectance": {"wall": (2.0, 0.0, 0.0)}}, "reflectance.wall"),
+    ],
+)
+def test_a_bad_camera_is_refused_naming_the_key(changes, key):
+    with pytest.raises(ParameterError, match=key):
+        CameraSpec("front", **changes)

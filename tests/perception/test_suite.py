@@ -1,0 +1,98 @@
+"""A run's cameras and sonars: declared in the scenario, fired over the logged states, kept
+beside the rollout."""
+
+from __future__ import annotations
+
+import copy
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from uvms_pin.errors import ParameterError, ScenarioError
+from uvms_pin.perception.suite import firing_rows
+from uvms_pin.results.rollout import Rollout
+from uvms_pin.scenario.load import scenario_from_dict
+from uvms_pin.scenario.toml import read_toml
+from uvms_pin.sim.run import simulate
+
+SEABED = Path(__file__).resolve().parents[2] / "scenarios" / "seabed_landing.toml"
+CAMERA = {"name": "front", "width": 64, "height": 48, "rate_hz": 10.0,
+          "rpy_rad": [-2.4, 0.0, -1.5708], "noise_counts": 2.0}  # fmt: skip
+SONAR = {"name": "fls", "beams": 32, "bins": 64, "rate_hz": 5.0, "rpy_rad": [0.0, 0.5, 0.0]}
+
+
+def _scenario(sensors=None, duration_s=0.2, seed=7):
+    raw = read_toml(SEABED, ScenarioError)
+    raw["scenario"].update(duration_s=duration_s, seed=seed)
+    raw["sensors"] = copy.deepcopy(sensors or {})
+    return scenario_from_dict(raw, SEABED)
+
+
+def test_firing_rows_are_the_first_logged_samples_at_each_instant():
+    times = np.arange(11) * 0.02
+    np.testing.assert_array_equal(firing_rows(times, 10.0), [0, 5, 10])
+    np.testing.assert_array_equal(firing_rows(times, 7.0), [0, 8])  # 1/7 s -> 0.16 s
+    np.testing.assert_array_equal(firing_rows(times, 1000.0), np.arange(11))
+
+
+def test_a_run_records_its_cameras_and_sonars_beside_an_unchanged_rollout(tmp_path):
+    plain = simulate(_scenario(), progress=False)
+    seen = simulate(_scenario({"camera": [CAMERA], "sonar": [SONAR]}), progress=False)
+    np.testing.assert_array_equal(plain.q, seen.q)  # the loop is untouched
+    camera = seen.camera("front")
+    np.testing.assert_allclose(camera.time_s, [0.0, 0.1, 0.2], atol=1e-12)
+    assert camera.rgb.shape == (3, 48, 64, 3) and camera.rgb.dtype == np.uint8
+    assert camera.depth_m.shape == (3, 48, 64) and camera.label.shape == (3, 48, 64)
+    assert "seabed" in [camera.label_names[k - 1] for k in np.unique(camera.label) if k > 0]
+    sonar = seen.sonar("fls")
+    assert sonar.intensity.shape == (2, 64, 32) and sonar.range_m.shape == (64,)
+    assert sonar.bearing_rad.shape == (32,) and sonar.intensity.max() > 0.0
+    seen.save(tmp_path)
+    assert (tmp_path / "perception.npz").is_file()
+    loaded = Rollout.load(tmp_path)
+    np.testing.assert_array_equal(loaded.camera("front").rgb, camera.rgb)
+    np.testing.assert_array_equal(loaded.sonar("fls").intensity, sonar.intensity)
+    assert loaded.camera("front").label_names == camera.label_names
+    with pytest.raises(ParameterError, match=r"no camera 'back'.*front"):
+        loaded.camera("back")
+    plain.save(tmp_path)  # the previous run's images go with it
+    assert not (tmp_path / "perception.npz").exists()
+
+
+def test_the_same_seed_gives_the_same_images():
+    def images(seed):
+        rollout = simulate(_scenario({"camera": [CAMERA]}, 0.1, seed), progress=False)
+        return rollout.camera("front").rgb
+
+    np.testing.assert_array_equal(images(3), images(3))
+    assert not np.array_equal(images(3), images(4))
+
+
+@pytest.mark.parametrize(
+    ("sensors", "message"),
+    [
+        ({"camera": [{**CAMERA, "width": 0}]}, r"sensors\.camera\[0\].*width"),
+        ({"camera": [{**CAMERA, "fov": 1.0}]}, r"sensors\.camera\[0\].*unknown key.*fov"),
+        ({"camera": [{**CAMERA, "rate_hz": "fast"}]}, "rate_hz"),
+        ({"sonar": [{**SONAR, "type": "sidescan"}]}, r"sensors\.sonar\[0\].*type"),
+        ({"camera": [CAMERA], "sonar": [{**SONAR, "name": "front"}]}, "distinct names.*front"),
+        ({"camera": [{"width": 10}]}, "name is required"),
+    ],
+)
+def test_a_bad_sensor_table_is_refused_naming_the_key(sensors, message):
+    with pytest.raises(ScenarioError, match=message):
+        _scenario(sensors)
+
+
+def test_a_sensor_on_a_link_the_model_lacks_is_refused_before_the_run():
+    scenario = _scenario({"camera": [{**CAMERA, "link": "mast"}]})
+    with pytest.raises(ParameterError, match="link 'mast'"):
+        simulate(scenario, progress=False)
+
+
+def test_images_that_would_not_fit_in_memory_are_refused_before_the_run():
+    huge = {**CAMERA, "width": 8192, "height": 8192, "rate_hz": 1000.0}
+    scenario = _scenario({"camera": [huge]}, duration_s=100.0)
+    with pytest.raises(ParameterError, match=r"images of front.*lower their rate_hz"):
+        simulate(scenario, progress=False)

@@ -1,0 +1,274 @@
+"""``[[sensors.camera]]``: a pinhole camera's depth, normals, labels and colour.
+
+Its optical frame (z along the optical axis, x right, y down, as ROS cameras) sits at
+``position_m``, ``rpy_rad`` in its ``link`` (default: the vehicle's body). Pixel (u, v) of a
+``width`` x ``height`` image looks along (x, y, 1) with x = (u + 1/2 - W/2) / f,
+y = (v + 1/2 - H/2) / f, f = (W/2) / tan(fov/2) (square pixels, ``horizontal_fov_rad``).
+The depth image is the z-depth of the first surface met (range times the ray's z: ROS
+depth images), NaN where the ray meets nothing; the colour is the revised underwater image
+formation model (`uvms_pin.perception.optics`), scaled by ``exposure`` to 8 bits, with
+seeded Gaussian noise of ``noise_counts`` (8-bit counts, the run's seed).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from uvms_pin.errors import ParameterError
+from uvms_pin.perception import sensor
+from uvms_pin.perception.caster import Bundles
+from uvms_pin.perception.optics import Light, WaterOptics, backscatter, cone
+from uvms_pin.perception.scene import Scene
+
+__all__ = ["CAMERA", "Camera", "CameraSpec", "Frame", "reflectance_of"]
+
+#: the reflectance (R, G, B) of a label's name when the camera's ``reflectance`` does not
+#: give it: sand for a plane facing up, a dark grey for the robot, a light grey otherwise
+SAND = (0.55, 0.5, 0.35)
+ROBOT = (0.25, 0.25, 0.28)
+OTHER = (0.7, 0.7, 0.7)
+
+#: the side [px] of the square tiles whose rays the caster leaves out together
+TILE_PX = 16
+
+
+@dataclass(frozen=True)
+class CameraSpec:
+    """A camera's table (``[[sensors.camera]]``; the checks in `__post_init__`)."""
+
+    name: str
+    width: int = 320
+    height: int = 240
+    horizontal_fov_rad: float = 1.2
+    rate_hz: float = 10.0
+    link: str | None = None
+    position_m: tuple[float, float, float] = (0.0, 0.0, 0.0)
+    rpy_rad: tuple[float, float, float] = (-math.pi / 2, 0.0, -math.pi / 2)
+    water_type: str = "IB"
+    attenuation_per_m: tuple[float, float, float] | None = None
+    backscatter_per_m: tuple[float, float, float] | None = None
+    surface_irradiance: float = 1.0
+    backscatter_albedo: float = 0.2
+    exposure: float = 1.0
+    noise_counts: float = 1.0
+    lights: tuple[Light, ...] = ()
+    reflectance: dict[str, tuple[float, float, float]] = field(default_factory=dict)
+    in_loop: bool = False
+
+    def __post_init__(self) -> None:
+        label = f"camera '{self.name}'"
+        sensor.check_mount(self, label)
+        for key in ("width", "height"):
+            value = getattr(self, key)
+            if not (isinstance(value, int) and 1 <= value <= 8192):
+                raise ParameterError(f"{label}: {key} must be an integer in [1, 8192], got {value}")
+        if not (0.0 < self.horizontal_fov_rad < math.pi):
+            raise ParameterError(
+                f"{label}: horizontal_fov_rad must be in (0, pi), got {self.horizontal_fov_rad}"
+            )
+        for key in ("exposure", "noise_counts"):
+            value = getattr(self, key)
+            if not (math.isfinite(value) and value >= 0.0):
+                raise ParameterError(f"{label}: {key} must be finite and >= 0, got {value}")
+        try:
+            self.optics  # noqa: B018 (its own checks)
+        except ParameterError as exc:
+            raise ParameterError(f"{label}: {exc}") from exc
+        for name, rgb in self.reflectance.items():
+            if len(rgb) != 3 or not all(0.0 <= c <= 1.0 for c in rgb):
+                raise ParameterError(
+                    f"{label}: reflectance.{name} needs 3 numbers in [0, 1], got {rgb}"
+                )
+
+    @property
+    def optics(self) -> WaterOptics:
+        return WaterOptics(
+            self.water_type,
+            self.attenuation_per_m,
+            self.backscatter_per_m,
+            self.surface_irradiance,
+            self.backscatter_albedo,
+        )
+
+    @property
+    def focal_px(self) -> float:
+        return 0.5 * self.width / math.tan(0.5 * self.horizontal_fov_rad)
+
+    @classmethod
+    def from_dict(cls, raw: dict[str, Any], label: str) -> CameraSpec:
+        """From a table's keys (``lights``: tables of `Light`'s fields; ``reflectance``: a
+        label name -> (R, G, B))."""
+        raw = dict(raw)
+        lights = raw.pop("lights", [])
+        reflectance = raw.pop("reflectance", {})
+        if not isinstance(lights, list) or not isinstance(reflectance, dict):
+            raise ParameterError(f"{label}: lights must be tables, reflectance a table")
+        built = tuple(
+            sensor.spec_from_dict(Light, light, f"{label}: lights[{k}]")
+            for k, light in enumerate(lights)
+        )
+        colours = {str(k): tuple(float(c) for c in v) for k, v in reflectance.items()}
+        return sensor.spec_from_dict(cls, raw, label, lights=built, reflectance=colours)
+
+
+@dataclass(frozen=True)
+class Frame:
+    """One image: ``depth_m`` (H, W) [m] (NaN: nothing met), ``normal_world`` (H, W, 3),
+    ``label`` (H, W) (0: nothing), ``radiance`` (H, W, 3) the model's I_c before the
+    exposure, ``rgb`` (H, W, 3) uint8."""
+
+    depth_m: np.ndarray
+    normal_world: np.ndarray
+    label: np.ndarray
+    radiance: np.ndarray
+    rgb: np.ndarray
+
+
+def pixel_rays(spec: CameraSpec) -> np.ndarray:
+    """The unit rays (H W, 3) of every pixel, row by row, in the optical frame."""
+    f = spec.focal_px
+    u = (np.arange(spec.width) + 0.5 - 0.5 * spec.width) / f
+    v = (np.arange(spec.height) + 0.5 - 0.5 * spec.height) / f
+    x, y = np.meshgrid(u, v)
+    rays = np.column_stack([x.ravel(), y.ravel(), np.ones(x.size)])
+    return rays / np.linalg.norm(rays, axis=1, keepdims=True)
+
+
+def tiles(spec: CameraSpec) -> tuple[np.ndarray, np.ndarray]:
+    """(the pixels in tile order (H W,), where each tile starts in it (tiles + 1,)): square
+    tiles of `TILE_PX`, row by row, their pixels row by row."""
+    v, u = np.divmod(np.arange(spec.width * spec.height), spec.width)
+    across = -(-spec.width // TILE_PX)
+    tile = (v // TILE_PX) * across + u // TILE_PX
+    order = np.argsort(tile, kind="stable")
+    counts = np.bincount(tile)
+    return order, np.concatenate([[0], np.cumsum(counts[counts > 0])])
+
+
+def reflectance_of(names: list[str], given: dict[str, tuple], planes: set[str]) -> np.ndarray:
+    """(labels + 1, 3): row k the reflectance of label k (row 0: nothing met)."""
+    rows = [(0.0, 0.0, 0.0)]
+    for name in names:
+        base = name.split("#")[0]
+        rows.append(given.get(base, SAND if base in planes else OTHER))
+    return np.asarray(rows, dtype=float)
+
+
+class Camera(sensor.Mounted):
+    """A `CameraSpec` looking at a `Scene`, its noise drawn from ``rng``."""
+
+    def __init__(self, spec: CameraSpec, scene: Scene, rng: np.random.Generator):
+        super().__init__(spec, scene, f"camera '{spec.name}'")
+        self.spec, self.rng = spec, rng
+        self.rays = pixel_rays(spec)
+        self.order, starts = tiles(spec)
+        self._tiled = self.rays[self.order]
+        self._bundles = Bundles.of(self._tiled, starts)
+        self.optics = spec.optics
+        robot = set(scene.robot_names)
+        given = dict(spec.reflectance)
+        for name in robot:
+            given.setdefault(name, ROBOT)
+        self.reflectance = reflectance_of(scene.names, given, scene.floor_names)
+
+    def pose(self) -> tuple[np.ndarray, np.ndarray]:
+        """(R, p) of the optical frame in the world, after the scene's update."""
+        placed = self.placement()
+        return placed.rotation, placed.translation
+
+    def render(self) -> Frame:
+        """The image of the scene as it stands."""
+        spec = self.spec
+        rotation, position = self.pose()
+        directions = self._tiled @ rotation.T  # tile by tile: the caster culls whole tiles
+        hits = self.scene.caster.cast(position, directions, self._bundles.rotated(rotation))
+        met = np.isfinite(hits.range_m)
+        depth = np.where(met, hits.range_m * self._tiled[:, 2], np.nan)
+        radiance = self._radiance(position, rotation, directions, hits, met)
+        shape, order = (spec.height, spec.width), self.order
+        pixels = [np.empty_like(a) for a in (depth, hits.normal_world, hits.label, radiance)]
+        for out, tiled in zip(
+            pixels, (depth, hits.normal_world, hits.label, radiance), strict=True
+        ):
+            out[order] = tiled
+        depth, normal, label, radiance = pixels
+        counts = 255.0 * spec.exposure * radiance
+        if spec.noise_counts > 0.0:
+            counts += spec.noise_counts * self.rng.standard_normal(counts.shape, np.float32)
+        rgb = np.clip(np.rint(counts), 0, 255).astype(np.uint8)
+        return Frame(
+            depth.reshape(shape),
+            normal.reshape(*shape, 3),
+            label.reshape(shape),
+            radiance.reshape(*shape, 3),
+            rgb.reshape(*shape, 3),
+        )
+
+    def _radiance(self, position, rotation, directions, hits, met) -> np.ndarray:
+        """I_c (n, 3) of every pixel (`uvms_pin.perception.optics`)."""
+        optics = self.optics
+        veiling = optics.veiling_light(-position[2])
+        out = np.broadcast_to(veiling, (len(directions), 3)).copy()
+        if not np.any(met):
+            return out
+        r = hits.range_m[met]
+        normal = hits.normal_world[met]
+        points = position + r[:, None] * directions[met]
+        rho = self.reflectance[hits.label[met]]
+        # daylight E0 exp(-K_d depth) (1 + n_z) / 2 and the direct path's exp(-beta_D r)
+        # in one exponential
+        depth = np.maximum(-points[:, 2], 0.0)[:, None]
+        sky = (0.5 * optics.surface_irradiance) * (1.0 + normal[:, 2])
+        signal = (rho * sky[:, None]) * np.exp(
+            -(optics.kd_per_m * depth + optics.beta_d_per_m * r[:, None])
+        )
+        for light in self.spec.lights:
+            signal += self._lit(light, position, rotation, points, normal, rho, r)
+        out[met] = signal + backscatter(veiling, r, optics.beta_b_per_m)
+        return out
+
+    def _lit(self, light: Light, position, rotation, points, normal, rho, r) -> np.ndarray:
+        """A light's direct signal (n, 3) from the points (their normals, reflectances,
+        ranges): rho I_L cone max(0, n . l) / d^2 exp(-beta_D (d + r)), computed on the
+        points within its outer cone only."""
+        source = position + rotation @ np.asarray(light.position_m)
+        axis = rotation @ np.asarray(light.direction)
+        to_point = points - source
+        distance = np.linalg.norm(to_point, axis=1)
+        unit = to_point / np.maximum(distance, 1e-12)[:, None]
+        outer = min(np.pi, light.half_angle_rad + light.edge_rad)
+        lit = np.flatnonzero(unit @ axis >= np.cos(outer) - 1e-12)
+        out = np.zeros_like(points)
+        if len(lit) == 0:
+            return out
+        unit, distance = unit[lit], distance[lit]
+        off_axis = np.arccos(np.clip(unit @ axis, -1.0, 1.0))
+        facing = np.maximum(0.0, -np.einsum("ij,ij->i", normal[lit], unit))
+        power = light.intensity * cone(off_axis, light.half_angle_rad, light.edge_rad) * facing
+        power = power / np.maximum(distance, 1e-6) ** 2
+        path = (distance + r[lit])[:, None]
+        out[lit] = rho[lit] * power[:, None] * np.exp(-self.optics.beta_d_per_m * path)
+        return out
+
+    def fire(self) -> dict[str, np.ndarray]:
+        """What a firing records: depth (float32), rgb, label."""
+        frame = self.render()
+        return {
+            "depth_m": frame.depth_m.astype(np.float32),
+            "rgb": frame.rgb,
+            "label": frame.label.astype(np.int16),
+        }
+
+
+CAMERA = sensor.register(
+    sensor.PerceptionKind(
+        name="camera",
+        spec=CameraSpec,
+        make=Camera,
+        bytes=lambda spec: spec.width * spec.height * (4 + 3 + 2),  # depth, rgb, label
+    )
+)

@@ -1,0 +1,152 @@
+"""The world as the sensors see it: one `RayCaster` of the fixed objects, the free objects,
+the robot's own links and the free surface, posed from the system's state when a sensor
+fires (`Scene.update`), never rebuilt.
+
+- fixed objects (`uvms_pin.physics.world.objects.WorldObject`): a plane as the analytic plane
+  seen from its outward side; a box, sphere, cylinder and ellipsoid as themselves; a mesh as
+  its file's triangles (Embree: its concavities are seen, though it collides as its hull);
+- the robot's links: their collision pieces (`uvms_pin.physics.world.robot_geometry`: the
+  URDF ``<collision>`` shapes, a box or mesh as its convex hull), each labelled with its
+  link, placed by the forward kinematics of q;
+- each free object: its pieces at its logged pose (x, y, z, quaternion x, y, z, w);
+- the free surface z = 0, seen from below.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from pathlib import Path
+from typing import Any
+
+import coal
+import numpy as np
+import pinocchio as pin
+
+from uvms_pin.errors import ModelError
+from uvms_pin.model.uvms import UVMS
+from uvms_pin.perception.caster import RayCaster, Shape
+from uvms_pin.perception.mesh import TriangleMesh
+from uvms_pin.perception.shapes import (
+    Convex,
+    Cylinder,
+    Ellipsoid,
+    Plane,
+    Sphere,
+    box,
+    convex_of_points,
+)
+from uvms_pin.physics.world.objects import WorldObject
+from uvms_pin.physics.world.robot_geometry import RobotPiece, robot_pieces
+
+__all__ = ["SURFACE", "Scene", "scene_of", "shape_of"]
+
+#: the free surface's label name
+SURFACE = "surface"
+
+#: flips z: the surface plane's frame, its normal down into the water
+_FACING_DOWN = np.diag([1.0, -1.0, -1.0])
+
+
+def shape_of(geometry: Any) -> Shape:
+    """The ray shape of a coal geometry (in the same frame)."""
+    if isinstance(geometry, coal.Halfspace):
+        return Plane()
+    if isinstance(geometry, coal.Box):
+        return box(geometry.halfSide)
+    if isinstance(geometry, coal.Sphere):
+        return Sphere(float(geometry.radius))
+    if isinstance(geometry, coal.Ellipsoid):
+        return Ellipsoid(tuple(float(r) for r in geometry.radii))
+    if isinstance(geometry, coal.Cylinder):
+        return Cylinder(float(geometry.radius), 2.0 * float(geometry.halfLength))
+    if isinstance(geometry, coal.ConvexBase):
+        return convex_of_points(np.asarray(geometry.points(), dtype=float).reshape(-1, 3))
+    raise ModelError(f"the sensors cannot see a {type(geometry).__name__}")
+
+
+def _seen_shape(obj: WorldObject) -> Shape | Convex | TriangleMesh:
+    """A fixed object's shape as seen: a mesh file by its triangles, the rest as they collide."""
+    if obj.kind == "mesh" and "path" in obj.params:
+        from uvms_pin.hydro.mesh import load_mesh_geometry
+
+        found = load_mesh_geometry(Path(obj.params["path"]), tuple(obj.params["scale"]))
+        return TriangleMesh(found.vertices_m, found.triangles)
+    return shape_of(obj.shape)
+
+
+def _plane_frame(obj: WorldObject) -> tuple[np.ndarray, np.ndarray]:
+    """A plane's frame: its point, z along its outward normal (its placement's)."""
+    return obj.placement.rotation.copy(), obj.placement.translation.copy()
+
+
+class Scene:
+    """The caster of a UVMS in its world, and where each of its bodies is.
+
+    Args:
+        uvms: the robot (its links' collision pieces are seen).
+        objects: the fixed objects. free: the free objects (`FreeObject`).
+        surface: the free surface z = 0 is seen from below.
+    """
+
+    def __init__(
+        self,
+        uvms: UVMS,
+        objects: Sequence[WorldObject] = (),
+        free: Sequence[Any] = (),
+        *,
+        surface: bool = True,
+    ):
+        self.uvms = uvms
+        self.caster = RayCaster()
+        self.data = uvms.model.createData()
+        for obj in objects:
+            rotation, position = _plane_frame(obj)
+            self.caster.add(obj.name, _seen_shape(obj), rotation, position)
+        if surface:
+            self.caster.add(SURFACE, Plane(), _FACING_DOWN, np.zeros(3))
+        names = [uvms.hydro_bodies[int(k)].name for k in uvms.surface_bodies.body_index]
+        #: the robot's links' names; the planes facing up (the seafloor)
+        self.robot_names = tuple(names)
+        self.floor_names = {o.name for o in objects if o.is_plane and o.normal_world[2] > 0.1}
+        self._robot = self._add_pieces(robot_pieces(uvms, names), names)
+        self._free = [
+            self._add_pieces(o.pieces, [o.name] * (1 + max((p.body for p in o.pieces), default=0)))
+            for o in free
+        ]
+
+    def _add_pieces(
+        self, pieces: Sequence[RobotPiece], names: Sequence[str]
+    ) -> list[tuple[int, RobotPiece]]:
+        return [(self.caster.add(names[p.body], shape_of(p.shape)), p) for p in pieces]
+
+    @property
+    def names(self) -> list[str]:
+        """Each label's name: label k is ``names[k - 1]`` (0: nothing met)."""
+        return self.caster.names
+
+    def update(self, q: np.ndarray, object_poses: Sequence[np.ndarray] = ()) -> None:
+        """The bodies where the robot's configuration ``q`` (nq,) and each free object's
+        pose (7,) [m; quaternion x, y, z, w] put them."""
+        model, data = self.uvms.model, self.data
+        pin.forwardKinematics(model, data, q)
+        for index, piece in self._robot:
+            placed = data.oMi[piece.joint_id] * piece.placement_in_joint
+            self.caster.set_pose(index, placed.rotation, placed.translation)
+        for bodies, pose in zip(self._free, object_poses, strict=True):
+            frame = pin.XYZQUATToSE3(np.asarray(pose, dtype=float))
+            for index, piece in bodies:
+                placed = frame * piece.placement_in_joint
+                self.caster.set_pose(index, placed.rotation, placed.translation)
+
+    def frame_placement(self, frame_id: int) -> pin.SE3:
+        """A frame of the robot's model in the world, after `update`."""
+        pin.updateFramePlacement(self.uvms.model, self.data, frame_id)
+        return self.data.oMf[frame_id]
+
+
+def scene_of(uvms: UVMS, world: Any | None, *, surface: bool = True) -> Scene:
+    """The scene of a robot in its world (`uvms_pin.physics.world.world.World`, or None: the
+    robot alone in open water), with the free surface when the water has one."""
+    if world is None:
+        return Scene(uvms, surface=surface)
+    return Scene(uvms, world.objects, world.free, surface=surface)

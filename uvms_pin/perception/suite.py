@@ -1,0 +1,127 @@
+"""A run's cameras and sonars together: fired over its logged states, their images kept
+beside the rollout (`uvms_pin.results.perception`).
+
+A sensor of ``rate_hz`` fires at the first logged sample at or after each of its instants
+k / rate_hz (k = 0, 1, ...): at its rate when the log period divides its period, else at the
+log's grid nearest after. Firing reads the logged state (the robot's q and each free
+object's pose): the loop itself is untouched, so a run with sensors gives the same rollout
+as without them, whatever path (compiled or Python) ran it. Each sensor draws its noise from
+its own stream of the run's seed (`PERCEPTION_SEED_INDEX`), in the order of the scenario.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from uvms_pin.checks import check_memory
+
+# the sensor kinds, each registered by its module on import: the one list of them
+from uvms_pin.perception import camera, sonar  # noqa: F401
+from uvms_pin.perception.scene import Scene
+from uvms_pin.perception.sensor import SENSORS, mount_frame
+from uvms_pin.results.rollout_data import RolloutData
+
+__all__ = ["PERCEPTION_SEED_INDEX", "PerceptionSpec", "check_mounts", "firing_rows", "perceive"]
+
+#: The child of the run's SeedSequence the perception sensors draw from (the measurement
+#: noise uses children 0-5, the navigation sensors 6).
+PERCEPTION_SEED_INDEX = 7
+
+
+@dataclass(frozen=True)
+class PerceptionSpec:
+    """The run's cameras and sonars: (kind name, spec) pairs, in the scenario's order."""
+
+    sensors: tuple[tuple[str, Any], ...] = ()
+
+    @property
+    def fitted(self) -> bool:
+        return bool(self.sensors)
+
+    @property
+    def in_loop(self) -> list[Any]:
+        """The cameras that also fire in the loop (``in_loop``: `uvms_pin.perception.loop`)."""
+        return [spec for kind, spec in self.sensors if getattr(spec, "in_loop", False)]
+
+    @property
+    def names(self) -> list[str]:
+        return [spec.name for _, spec in self.sensors]
+
+
+def check_mounts(spec: PerceptionSpec, model: Any, duration_s: float = 0.0) -> None:
+    """Before a run, not after it: ParameterError naming the sensor and its ``link`` when the
+    robot's model has no such frame, or when the images of ``duration_s`` [s] would not fit
+    in memory."""
+    total = 0.0
+    for kind_name, own in spec.sensors:
+        mount_frame(model, own.link, f"{kind_name} '{own.name}'")
+        total += (math.floor(duration_s * own.rate_hz) + 1) * SENSORS[kind_name].bytes(own)
+    check_memory(
+        total,
+        f"the images of {', '.join(spec.names)} over {duration_s:g} s",
+        "lower their rate_hz or their size",
+    )
+
+
+def firing_rows(time_s: np.ndarray, rate_hz: float) -> np.ndarray:
+    """The rows of ``time_s`` (sorted) a sensor of ``rate_hz`` fires at: the first at or
+    after each k / rate_hz (within 1e-9 s), each row once."""
+    if len(time_s) == 0:
+        return np.zeros(0, dtype=np.int64)
+    instants = np.arange(0.0, float(time_s[-1]) + 1e-9, 1.0 / rate_hz)
+    rows = np.searchsorted(time_s, instants - 1e-9, side="left")
+    return np.unique(rows[rows < len(time_s)])
+
+
+def object_poses(rollout: RolloutData, n_objects: int) -> np.ndarray:
+    """Each row's free-object poses (T, n, 7) from the logged ``free_objects`` signal."""
+    if n_objects == 0:
+        return np.zeros((len(rollout), 0, 7))
+    states = rollout.signals["free_objects"].reshape(len(rollout), n_objects, 13)
+    return states[:, :, :7]
+
+
+def perceive(
+    rollout: RolloutData,
+    spec: PerceptionSpec,
+    scene: Scene,
+    seed: int,
+    n_objects: int = 0,
+) -> None:
+    """Fire every sensor of ``spec`` over ``rollout``'s logged states in ``scene`` (its
+    free objects ``n_objects``), keeping their images in ``rollout.perception`` and what
+    they are in its metadata's ``perception``."""
+    root = np.random.SeedSequence(seed).spawn(PERCEPTION_SEED_INDEX + 1)[PERCEPTION_SEED_INDEX]
+    streams = root.spawn(max(1, len(spec.sensors)))
+    poses = object_poses(rollout, n_objects)
+    described = rollout.metadata.setdefault("perception", {})
+    for (kind_name, own), stream in zip(spec.sensors, streams, strict=False):
+        kind = SENSORS[kind_name]
+        sensor = kind.make(own, scene, np.random.default_rng(stream))
+        rows = firing_rows(rollout.time_s, own.rate_hz)
+        fired = _fire(sensor, scene, rollout.q, poses, rows)
+        rollout.perception[own.name] = {
+            "time_s": rollout.time_s[rows].copy(),
+            **fired,
+            **kind.constants(sensor),
+        }
+        described[own.name] = {"kind": kind_name, "rate_hz": own.rate_hz}
+        if kind_name == "camera":
+            described[own.name]["label_names"] = list(scene.names)
+
+
+def _fire(
+    sensor: Any, scene: Scene, q: np.ndarray, poses: np.ndarray, rows: Sequence[int]
+) -> dict[str, np.ndarray]:
+    """The sensor's arrays at each of ``rows``, stacked."""
+    stacked: dict[str, list[np.ndarray]] = {}
+    for row in rows:
+        scene.update(q[row], list(poses[row]))
+        for key, value in sensor.fire().items():
+            stacked.setdefault(key, []).append(value)
+    return {key: np.stack(values) for key, values in stacked.items()}

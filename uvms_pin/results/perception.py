@@ -1,0 +1,103 @@
+"""What a run's cameras and sonars recorded, beside its rollout (not in its arrays).
+
+A rollout holds them in ``perception``: sensor name -> its arrays (``time_s`` (T,) and what
+each firing gave, stacked: a camera's ``depth_m`` (T, H, W) float32, ``rgb`` (T, H, W, 3)
+uint8 and ``label`` (T, H, W) int16; a sonar's ``intensity`` (T, bins, beams) with its
+``range_m`` (bins,) and ``bearing_rad`` (beams,)); its metadata's ``perception`` says each
+sensor's kind and, for a camera, its labels' names (label k is ``label_names[k - 1]``, 0:
+nothing met). Saved compressed as ``perception.npz`` beside ``rollout.npz``.
+"""
+
+from __future__ import annotations
+
+import zipfile
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from uvms_pin.errors import ParameterError
+
+__all__ = [
+    "FILE",
+    "CameraRecord",
+    "SonarRecord",
+    "camera_record",
+    "load_perception",
+    "save_perception",
+    "sonar_record",
+]
+
+FILE = "perception.npz"
+_SEP = "__"
+
+
+@dataclass(frozen=True)
+class CameraRecord:
+    """A camera's images: ``time_s`` (T,), ``depth_m`` (T, H, W) [m] (NaN: nothing met),
+    ``rgb`` (T, H, W, 3) uint8, ``label`` (T, H, W) and ``label_names``."""
+
+    time_s: np.ndarray
+    depth_m: np.ndarray
+    rgb: np.ndarray
+    label: np.ndarray
+    label_names: tuple[str, ...]
+
+
+@dataclass(frozen=True)
+class SonarRecord:
+    """A sonar's images: ``time_s`` (T,), ``intensity`` (T, bins, beams), ``range_m``
+    (bins,) [m] and ``bearing_rad`` (beams,) [rad]."""
+
+    time_s: np.ndarray
+    intensity: np.ndarray
+    range_m: np.ndarray
+    bearing_rad: np.ndarray
+
+
+def _arrays(perception: dict, metadata: dict, name: str, kind: str) -> dict[str, np.ndarray]:
+    described = metadata.get("perception", {}).get(name)
+    if name not in perception or described is None or described.get("kind") != kind:
+        known = [n for n, d in metadata.get("perception", {}).items() if d.get("kind") == kind]
+        raise ParameterError(
+            f"this rollout has no {kind} '{name}' (its {kind}s: {', '.join(known) or 'none'})"
+        )
+    return perception[name]
+
+
+def camera_record(perception: dict, metadata: dict, name: str) -> CameraRecord:
+    arrays = _arrays(perception, metadata, name, "camera")
+    names = tuple(metadata["perception"][name].get("label_names", ()))
+    return CameraRecord(arrays["time_s"], arrays["depth_m"], arrays["rgb"], arrays["label"], names)
+
+
+def sonar_record(perception: dict, metadata: dict, name: str) -> SonarRecord:
+    arrays = _arrays(perception, metadata, name, "sonar")
+    return SonarRecord(
+        arrays["time_s"], arrays["intensity"], arrays["range_m"], arrays["bearing_rad"]
+    )
+
+
+def save_perception(path: Path, perception: dict[str, dict[str, np.ndarray]]) -> None:
+    """Every sensor's arrays into one compressed ``.npz`` at ``path``."""
+    flat = {
+        f"{name}{_SEP}{key}": a for name, arrays in perception.items() for key, a in arrays.items()
+    }
+    with open(path, "wb") as f:
+        np.savez_compressed(f, **flat)
+
+
+def load_perception(path: Path) -> dict[str, dict[str, np.ndarray]]:
+    """What `save_perception` wrote (empty when there is no file)."""
+    if not path.is_file():
+        return {}
+    out: dict[str, Any] = {}
+    try:
+        with np.load(path) as data:
+            for key in data.files:
+                name, _, array = key.rpartition(_SEP)
+                out.setdefault(name, {})[array] = data[key]
+    except (OSError, ValueError, zipfile.BadZipFile) as exc:
+        raise ParameterError(f"{path} is damaged ({type(exc).__name__}: {exc})") from exc
+    return out
