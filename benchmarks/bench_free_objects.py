@@ -10,9 +10,12 @@ first:
 
 - seabed only: the plant in the scenario's world without its free object (the compiled
   plant's one call);
-- seabed + a box resting on it: the scenario's box on its four bottom corners, its own
-  floating body: the compiled system's one call (the robot, the box, the box's contacts with
-  the seabed, the robot's pairs with the box, every anchor);
+- + a box resting on the seabed: the scenario's box moved 3 m ahead, resting on its four
+  bottom corners, its own floating body: the compiled system's one call (the robot, the box,
+  the box's contacts with the seabed, the robot's pairs with the box tested by their bounding
+  spheres, every anchor);
+- + the box by the jaws: the scenario's box where it starts, within the bounding spheres of
+  the jaws (coal's narrow phase at every stage, nothing touching yet);
 - the same integrated by the Python integrator around the compiled dynamics (the reference
   path: contacts through coal's Python bindings), for scale.
 
@@ -26,6 +29,7 @@ CPU time of this process, best of interleaved rounds, one BLAS thread (`timing.p
 from __future__ import annotations
 
 import argparse
+import dataclasses
 import json
 from pathlib import Path
 
@@ -71,17 +75,29 @@ def _period(plant: Plant, q0: np.ndarray, compiled: bool = True):
     return call, system
 
 
+def _moved(plant: Plant, offset_m: np.ndarray) -> Plant:
+    """The plant with its free objects moved by ``offset_m`` (world) [m]."""
+    world = plant.world
+    free = [dataclasses.replace(o, q0=o.q0 + np.r_[offset_m, np.zeros(4)]) for o in world.free]
+    return Plant(
+        plant.uvms, world=World(plant.uvms, world.objects, world.law, free), free_surface=False,
+        joint_stops=plant.joint_stops, joint_limits=plant.joint_limits,
+    )  # fmt: skip
+
+
 def cases() -> tuple[dict, dict]:
     scenario = load_scenario(SCENARIO)
     plant, q0 = scenario.plant, scenario.q0
-    with_box, system = _period(plant, q0)
+    resting = _moved(plant, np.array([3.0, 0.0, 0.0]))
+    with_box, system = _period(resting, q0)
     (box,) = system.objects
     (q_r, v_r), *objects = system.layout.split(*system.initial_state(q0, scenario.v0))
     _, fixed = system.moving.found(q_r, v_r, objects)
     table = {
         BASE: _period(_without_free_objects(plant), q0)[0],
-        "seabed + a box resting on it": with_box,
-        "seabed + a box resting on it (Python integration)": _period(plant, q0, False)[0],
+        "+ a box resting on the seabed": with_box,
+        "+ the box by the jaws": _period(plant, q0)[0],
+        "+ a box resting on the seabed (Python integration)": _period(resting, q0, False)[0],
     }
     return table, {"box": box.name, "box_contacts": len(fixed[0].touch)}
 

@@ -8,10 +8,10 @@
 // limits may instead be constraints solved implicitly at the period's end (joint_limits.hpp).
 #pragma once
 
+#include <functional>
 #include <memory>
 #include <optional>
 #include <utility>
-#include <vector>
 
 #include "contact.hpp"
 #include "derivatives_task_contact.hpp"
@@ -26,13 +26,6 @@
 #include "world_contact.hpp"
 
 namespace uvms {
-
-// A wrench given at a world point in world axes on a joint's body.
-struct PointWrench {
-  int joint_id = 0;
-  Vec3 point_world_m = Vec3::Zero();
-  Vec6 wrench_world = Vec6::Zero();
-};
 
 class Plant {
  public:
@@ -62,10 +55,11 @@ class Plant {
   // integrated with them (the anchors of `friction` held) and ends with World.commit.
   std::optional<WorldContactModel> world;
   FrictionMemory friction;  // the world contacts' state between periods (see world_contact.hpp)
-  // Forces from the bodies that move beside it (the moving contacts of a system of bodies,
-  // system.hpp), added to the external wrenches by acceleration(): set by the system for
-  // each of its evaluations, empty otherwise.
-  std::vector<PointWrench> moving_wrenches;
+  // The forces of the bodies that move beside it (the moving contacts of a system of bodies,
+  // system.hpp): called by acceleration() after the kinematics and the other external
+  // wrenches, to add its own to the dynamics; set by the system for each of its
+  // evaluations, empty otherwise.
+  std::function<void(Dynamics&)> moving_contacts;
   // The contact points and forces at (q, v) with `friction` (World.forces); no world: none.
   const ContactForces& world_forces(const ConstVec& q, const ConstVec& v);
 

@@ -55,7 +55,7 @@ System::System(Plant& plant, const std::vector<const Dynamics*>& objects)
 }
 
 const Data& System::data_of(int side) {
-  return side < 0 ? robot_data_ : objects_[static_cast<std::size_t>(side)].data();
+  return side < 0 ? *robot_at_ : objects_[static_cast<std::size_t>(side)].data();
 }
 
 const Model& System::model_of(int side) const {
@@ -78,17 +78,15 @@ void System::check() const {
   }
 }
 
-void System::kinematics(const ConstVec& q, const ConstVec& v) {
-  pinocchio::forwardKinematics(plant_.dynamics().model(), robot_data_, q.head(nq_robot_),
-                               v.head(nv_robot_));
+void System::object_kinematics(const ConstVec& q, const ConstVec& v) {
   for (std::size_t k = 0; k < objects_.size(); ++k) {
     const auto i = static_cast<Eigen::Index>(k);
     objects_[k].kinematics(q.segment(nq_robot_ + 7 * i, 7), v.segment(nv_robot_ + 6 * i, 6));
   }
 }
 
-void System::contacts(const ConstVec& q, const ConstVec& v) {
-  kinematics(q, v);
+void System::contacts_at(const Data& robot) {
+  robot_at_ = &robot;
   found_sets_.resize(sets.size());
   for (std::size_t s = 0; s < sets.size(); ++s) {
     auto& set = sets[s];
@@ -103,33 +101,48 @@ void System::contacts(const ConstVec& q, const ConstVec& v) {
   }
 }
 
-const Eigen::VectorXd& System::acceleration(double time_s, const ConstVec& q,
-                                            const ConstVec& v, const ConstVec& tau) {
-  contacts(q, v);
-  // the robot: its plant's acceleration with the moving contacts' forces on its bodies
-  plant_.moving_wrenches.clear();
+void System::contacts(const ConstVec& q, const ConstVec& v) {
+  pinocchio::forwardKinematics(plant_.dynamics().model(), robot_data_, q.head(nq_robot_),
+                               v.head(nv_robot_));
+  object_kinematics(q, v);
+  contacts_at(robot_data_);
+}
+
+void System::add_robot_forces(Dynamics& robot) {
+  contacts_at(robot.data());
   for (std::size_t s = 0; s < sets.size(); ++s) {
     const auto& set = sets[s];
     if (set.a >= 0 && set.b >= 0) continue;
     const auto& found = found_sets_[s].forces;
     for (std::size_t i = 0; i < found.touch.size(); ++i) {
       const auto& point = found.touch.point_world_m[i];
-      Vec6 wrench = Vec6::Zero();
-      wrench.head<3>() = found.force_world_N[i];
-      const int joint_a = set.pairs.pieces_a[static_cast<std::size_t>(found.touch.piece[i])].joint_id;
-      const int joint_b = set.pairs.pieces_b[static_cast<std::size_t>(found.touch.obj[i])].joint_id;
-      if (set.a < 0) plant_.moving_wrenches.push_back({joint_a, point, wrench});
-      if (set.b < 0) plant_.moving_wrenches.push_back({joint_b, point, -wrench});
+      const auto& force = found.force_world_N[i];
+      if (set.a < 0) {
+        const auto& piece = set.pairs.pieces_a[static_cast<std::size_t>(found.touch.piece[i])];
+        add_wrench(robot, piece.joint_id, point, force);
+      }
+      if (set.b < 0) {
+        const auto& piece = set.pairs.pieces_b[static_cast<std::size_t>(found.touch.obj[i])];
+        add_wrench(robot, piece.joint_id, point, -force);
+      }
     }
   }
+}
+
+const Eigen::VectorXd& System::acceleration(double time_s, const ConstVec& q,
+                                            const ConstVec& v, const ConstVec& tau) {
+  object_kinematics(q, v);
+  // the robot: its plant's acceleration, the moving contacts computed and added once its
+  // kinematics is done (add_robot_forces)
+  plant_.moving_contacts = [this](Dynamics& robot) { add_robot_forces(robot); };
   try {
     acceleration_.head(nv_robot_) =
         plant_.acceleration(time_s, q.head(nq_robot_), v.head(nv_robot_), tau);
   } catch (...) {
-    plant_.moving_wrenches.clear();
+    plant_.moving_contacts = nullptr;
     throw;
   }
-  plant_.moving_wrenches.clear();
+  plant_.moving_contacts = nullptr;
   // each object: its water, then its contacts (f on a, -f on b; the fixed world's reaction
   // goes to the ground)
   const FlowField& flow = plant_.flow;

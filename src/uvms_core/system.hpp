@@ -65,15 +65,21 @@ class System {
                                                       double t1, const FixedStep& integrator);
 
  private:
-  void kinematics(const ConstVec& q, const ConstVec& v);
-  // the data of side k of a set (-1: the robot's)
+  void object_kinematics(const ConstVec& q, const ConstVec& v);
+  // Every moving contact, after the objects' kinematics, the robot's in robot.
+  void contacts_at(const Data& robot);
+  // The moving contacts' forces on the robot's bodies (the plant's moving_contacts, called
+  // after its own kinematics: the robot's is done once an evaluation).
+  void add_robot_forces(Dynamics& robot);
+  // the data of side k of a set (-1: the robot's, of the last contacts_at)
   const Data& data_of(int side);
   const Model& model_of(int side) const;
 
   Plant& plant_;
   std::vector<Dynamics> objects_;
   Model model_;  // the robot's joints and one free-flyer per object (integration)
-  Data robot_data_;  // the robot's kinematics for its moving contacts
+  Data robot_data_;  // the robot's kinematics for contacts() and settle()
+  const Data* robot_at_ = nullptr;  // the robot's data of the contacts being computed
   int nq_robot_, nv_robot_;
   ManifoldStepper stepper_;
   std::vector<PairContacts> found_sets_;
