@@ -1,8 +1,44 @@
 #include "moving_contact.hpp"
 
+#include <cmath>
 #include <string>
+#include <utility>
 
 namespace uvms {
+
+namespace {
+
+// The box [lower, upper] (its frame) [m] holding a shape of fixed extent (a box, a convex
+// hull), or an empty one (lower > upper) for the others.
+std::pair<Vec3, Vec3> local_box(const ContactShape& shape) {
+  if (shape.kind == ContactKind::box) {
+    const Vec3 half = static_cast<const coal::Box&>(*shape.geometry).halfSide;
+    return {-half, half};
+  }
+  if (shape.kind == ContactKind::convex) {
+    const auto& points = *static_cast<const coal::ConvexBase&>(*shape.geometry).points;
+    Vec3 lower = Vec3::Constant(INFINITY), upper = Vec3::Constant(-INFINITY);
+    for (const auto& p : points) {
+      lower = lower.cwiseMin(p);
+      upper = upper.cwiseMax(p);
+    }
+    return {lower, upper};
+  }
+  return {Vec3::Ones(), Vec3::Zero()};
+}
+
+// Whether the sphere (centre, radius) [m] misses the box [lower, upper] of a shape placed at
+// where: then the shape the sphere bounds cannot touch it, and coal would find them apart
+// (a cheaper test than its GJK; exact, so the contacts are the same).
+bool sphere_misses(const Vec3& center, double radius, const std::pair<Vec3, Vec3>& box,
+                   const pinocchio::SE3& where) {
+  if ((box.first.array() > box.second.array()).any()) return false;
+  const Vec3 local = where.rotation().transpose() * (center - where.translation());
+  const Vec3 outside = (box.first - local).cwiseMax(local - box.second).cwiseMax(0.0);
+  return outside.norm() > radius;
+}
+
+}  // namespace
 
 void PiecePairsModel::check(const Model& model_a, const Model& model_b) const {
   auto check_pieces = [](const std::vector<ContactShape>& pieces, const Model& model) {
@@ -38,6 +74,12 @@ void PiecePairsModel::forces(const Data& data_a, const Data& data_b,
   Touch& touch = found.touch;
   touch.clear();
   out.pair.clear();
+  if (boxes_a_.size() != pieces_a.size() || boxes_b_.size() != pieces_b.size()) {
+    boxes_a_.clear();
+    boxes_b_.clear();
+    for (const auto& piece : pieces_a) boxes_a_.push_back(local_box(piece));
+    for (const auto& piece : pieces_b) boxes_b_.push_back(local_box(piece));
+  }
   // the pairs that overlap (touching of pairs.py): bounding spheres, then coal's point
   for (std::size_t k = 0; k < pairs.size(); ++k) {
     const auto& pa = pieces_a[static_cast<std::size_t>(pairs[k][0])];
@@ -46,6 +88,10 @@ void PiecePairsModel::forces(const Data& data_a, const Data& data_b,
     const pinocchio::SE3 where_b = placement_of(data_b, pb);
     const double gap = (where_a.translation() - where_b.translation()).norm();
     if (gap >= pa.bound_radius_m + pb.bound_radius_m) continue;
+    if (sphere_misses(where_a.translation(), pa.bound_radius_m, boxes_b_[pairs[k][1]], where_b) ||
+        sphere_misses(where_b.translation(), pb.bound_radius_m, boxes_a_[pairs[k][0]], where_a)) {
+      continue;
+    }
     Vec3 point, normal;
     double depth = 0.0;
     if (!deepest_point(pa, where_a, pb, where_b, point, normal, depth)) continue;

@@ -17,6 +17,7 @@
 
 #include <array>
 #include <optional>
+#include <utility>
 #include <vector>
 
 #include "world_contact.hpp"
@@ -52,6 +53,8 @@ struct PiecePairsModel {
  private:
   Eigen::Matrix3Xd stretch_, tangential_velocity_, friction_;
   Eigen::VectorXd mu_stick_, mu_kinetic_;
+  // each piece's box in its frame (a broad-phase test before coal's; built on first use)
+  std::vector<std::pair<Vec3, Vec3>> boxes_a_, boxes_b_;
 };
 
 // One set of pairs between side a (-1: the UVMS, else a free object) and side b, with its
