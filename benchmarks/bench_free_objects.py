@@ -15,7 +15,8 @@ first:
   the box's contacts with the seabed, the robot's pairs with the box tested by their bounding
   spheres, every anchor);
 - + the box by the jaws: the scenario's box where it starts, within the bounding spheres of
-  the jaws (coal's narrow phase at every stage, nothing touching yet);
+  the jaws, nothing touching yet (each sphere tested against the box's hull box first, coal's
+  narrow phase only for those that meet it);
 - the same integrated by the Python integrator around the compiled dynamics (the reference
   path: contacts through coal's Python bindings), for scale.
 
