@@ -22,6 +22,7 @@ METRICS = (
     ("vehicle_displacement_m", "vehicle displacement [m]", "{:.3g}"),
     ("time_at_joint_stop_s", "time some joint spent at a stop [s]", "{:.3f}"),
     ("wall_time_s", "wall time [s] (machine-dependent)", "{:.3g}"),
+    ("real_time_factor", "real-time factor, simulated / wall time (machine-dependent)", "{:.3g}"),
 )
 
 

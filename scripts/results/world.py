@@ -1,5 +1,6 @@
 """A world to work in: the seabed-landing scenario (metrics and a figure of the landing and
-the probing) and the cost of the world's contacts (benchmarks/bench_world.py)."""
+the probing), the cost of the world's contacts (benchmarks/bench_world.py) and of a free
+object (benchmarks/bench_free_objects.py)."""
 
 from __future__ import annotations
 
@@ -70,13 +71,21 @@ def main() -> None:
     bench = out / "bench_world.json"
     command = [sys.executable, "benchmarks/bench_world.py", "--json", str(bench)]
     printed = subprocess.run(command, cwd=ROOT, check=True, capture_output=True, text=True)
+    command = [sys.executable, "benchmarks/bench_free_objects.py", "--json", str(out / "free.json")]
+    free = subprocess.run(command, cwd=ROOT, check=True, capture_output=True, text=True)
     body = (
         f"`uvms-pin run {SCENARIO}` (exit code {result.returncode}):\n\n"
         + "\n".join(lines)
         + "\n\n![seabed landing](../seabed_landing.png)\n\n"
         + "The cost of the world (`python benchmarks/bench_world.py`): the plant over one "
         "2 ms control period, compiled core, as a ratio to the same model's plant without a "
-        "world:\n\n" + printed.stdout.strip() + "\n"
+        "world:\n\n"
+        + printed.stdout.strip()
+        + "\n\n"
+        + "The cost of a free object (`python benchmarks/bench_free_objects.py`): the system of "
+        "bodies of `scenarios/push_object.toml` over one 2 ms control period, compiled core (one "
+        "call: the robot, the box, every contact and anchor), as a ratio to the same plant "
+        "without its box:\n\n" + free.stdout.strip() + "\n"
     )
     write_result("world", "A world to work in", "python scripts/results/world.py", body)
 

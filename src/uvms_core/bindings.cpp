@@ -25,6 +25,7 @@ using namespace nb::literals;
 void bind_sampled_laws(nb::module_& m);  // loop_bindings.cpp
 void bind_sampled_loop(nb::module_& m);  // loop_bindings.cpp
 void bind_step_derivatives(nb::module_& m);  // step_bindings.cpp
+void bind_system(nb::module_& m);  // system_bindings.cpp
 
 namespace {
 
@@ -540,6 +541,7 @@ NB_MODULE(_core, m) {
   bind_environment(m);
   bind_world(m);
   bind_plant(m);
+  bind_system(m);
   bind_batch_plant(m);
   bind_sampled_laws(m);
   bind_ppc(m);

@@ -8,6 +8,7 @@
 // limits may instead be constraints solved implicitly at the period's end (joint_limits.hpp).
 #pragma once
 
+#include <functional>
 #include <memory>
 #include <optional>
 #include <utility>
@@ -54,6 +55,11 @@ class Plant {
   // integrated with them (the anchors of `friction` held) and ends with World.commit.
   std::optional<WorldContactModel> world;
   FrictionMemory friction;  // the world contacts' state between periods (see world_contact.hpp)
+  // The forces of the bodies that move beside it (the moving contacts of a system of bodies,
+  // system.hpp): called by acceleration() after the kinematics and the other external
+  // wrenches, to add its own to the dynamics; set by the system for each of its
+  // evaluations, empty otherwise.
+  std::function<void(Dynamics&)> moving_contacts;
   // The contact points and forces at (q, v) with `friction` (World.forces); no world: none.
   const ContactForces& world_forces(const ConstVec& q, const ConstVec& v);
 

@@ -17,8 +17,6 @@
 namespace nb = nanobind;
 using namespace nb::literals;
 
-namespace {
-
 using uvms::InputError;
 using uvms::Plant;
 using Rows3 = Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor>;
@@ -59,6 +57,8 @@ void write_memory(const uvms::FrictionMemory& memory, nb::handle out) {
   out.attr("material") = points(memory.material);
 }
 
+namespace {
+
 Eigen::VectorXd checked(const char* name, const Eigen::VectorXd& x, int n) {
   if (x.size() != n) {
     throw InputError(std::string(name) + " must have shape (" + std::to_string(n) + ",), got (" +
@@ -73,6 +73,8 @@ Rows3 rows(const std::vector<uvms::Vec3>& columns) {
   for (std::size_t k = 0; k < columns.size(); ++k) out.row(static_cast<Eigen::Index>(k)) = columns[k];
   return out;
 }
+
+}  // namespace
 
 // World.forces as plain arrays (the fields of ContactForces and its Touch).
 nb::dict forces_dict(const uvms::ContactForces& forces) {
@@ -90,10 +92,10 @@ nb::dict forces_dict(const uvms::ContactForces& forces) {
   nb::list sticking;
   for (const char stick : forces.sticking) sticking.append(nb::bool_(stick != 0));
   out["sticking"] = sticking;
+  out["stretch_m"] = rows(forces.stretch_m);
+  out["material_m"] = rows(forces.material_m);
   return out;
 }
-
-}  // namespace
 
 void bind_world(nb::module_& m) {
   using uvms::ContactKind;

@@ -41,6 +41,28 @@ coal::Transform3s transform_of(const pinocchio::SE3& where) {
   return coal::Transform3s(where.rotation(), where.translation());
 }
 
+}  // namespace
+
+bool deepest_point(const ContactShape& piece, const pinocchio::SE3& where,
+                   const ContactShape& object, const pinocchio::SE3& object_where,
+                   Vec3& point, Vec3& normal, double& depth) {
+  static const coal::CollisionRequest request;  // one contact, depth and normal
+  coal::CollisionResult result;
+  if (coal::collide(piece.geometry.get(), transform_of(where), object.geometry.get(),
+                    transform_of(object_where), request, result) == 0) {
+    return false;
+  }
+  const coal::Contact& contact = result.getContact(0);
+  depth = -contact.penetration_depth;
+  if (!(depth > 0.0)) return false;
+  point = 0.5 * (contact.nearest_points[0] + contact.nearest_points[1]);
+  // coal's normal points from the first shape (the piece) to the second (the object)
+  normal = -contact.normal;
+  return true;
+}
+
+namespace {
+
 void add_point(const pinocchio::Data& data, const ContactShape& piece, const ContactShape& object,
                int p, int o, int corner, const Vec3& point, const Vec3& normal, double depth,
                Touch& out) {
@@ -71,18 +93,11 @@ void corners_below(const pinocchio::Data& data, const ContactShape& piece,
 void coal_point(const pinocchio::Data& data, const ContactShape& piece,
                 const pinocchio::SE3& where, const ContactShape& object,
                 const pinocchio::SE3& object_where, int p, int o, Touch& out) {
-  static const coal::CollisionRequest request;  // one contact, depth and normal
-  coal::CollisionResult result;
-  if (coal::collide(piece.geometry.get(), transform_of(where), object.geometry.get(),
-                    transform_of(object_where), request, result) == 0) {
-    return;
+  Vec3 point, normal;
+  double depth = 0.0;
+  if (deepest_point(piece, where, object, object_where, point, normal, depth)) {
+    add_point(data, piece, object, p, o, -1, point, normal, depth, out);
   }
-  const coal::Contact& contact = result.getContact(0);
-  const double depth = -contact.penetration_depth;
-  if (!(depth > 0.0)) return;
-  const Vec3 point = 0.5 * (contact.nearest_points[0] + contact.nearest_points[1]);
-  // coal's normal points from the first shape (the piece) to the second (the object)
-  add_point(data, piece, object, p, o, -1, point, -contact.normal, depth, out);
 }
 
 }  // namespace

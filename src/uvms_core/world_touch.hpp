@@ -62,6 +62,13 @@ void near_pairs(const Placements& piece_where,
                 const std::vector<ContactShape>& objects,
                 std::vector<std::pair<int, int>>& out);
 
+// coal's deepest point of two overlapping shapes placed in the world (coal_point of
+// touch.py): the point midway between the nearest points, the normal out of the object
+// towards the piece, the depth > 0; false when they are apart.
+bool deepest_point(const ContactShape& piece, const pinocchio::SE3& where,
+                   const ContactShape& object, const pinocchio::SE3& object_where,
+                   Vec3& point, Vec3& normal, double& depth);
+
 // touch()'s work buffers, kept by its caller between calls (no allocation per call once
 // sized): every shape's placement and the near (piece, object) pairs.
 struct TouchBuffers {

@@ -218,8 +218,9 @@ def test_free_objects_need_a_sampled_loop(load_body):
 
 
 def test_both_backends_integrate_free_objects_alike(load_body):
-    """The system's integration is Python's on either backend; the dynamics of each body
-    the backend's: the two agree to rounding."""
+    """On the core backend the system's period is one compiled call (every body and
+    contact), on the Python backend the Python integrator around the reference dynamics:
+    the two agree to rounding."""
     finals = []
     for backend in ("core", "python"):
         pusher = _pusher(load_body)

@@ -94,9 +94,11 @@ class ClosedLoop:
         *,
         compiled: bool = True,
     ):
-        self.compiled = compiled  # the sampled loop may run in the core (`compiled_loop`)
+        # the sampled loop may run in the core (`compiled_loop`), and the period of a system
+        # with free objects (`uvms_pin.sim.system.period`)
+        self.compiled = compiled
         self.plant = plant
-        self.system = System(plant)
+        self.system = System(plant, compiled=compiled)
         self.settings = settings
         self.controller = controller
         self.observers = list(observers)
@@ -263,7 +265,8 @@ class ClosedLoop:
         log.rollout.metadata["closed_loop"] = path.record()
         try:
             self.start(q0, v0, sensors)
-            log.rollout.metadata["world"] = self.system.record()  # as simulated: anchored
+            # as simulated: anchored, and how its period is stepped
+            log.rollout.metadata["world"] = self.system.record(self.settings.integrator)
             log.rollout.metadata["stiff_modes"] = self.stiff_modes
             if self.settings.control_period_s is None:
                 path.reason = "continuous-time control"
@@ -476,8 +479,9 @@ def simulate_closed_loop(
 
     Returns the rollout (status ``ok``); the run's settings, versions and model are added to
     ``metadata``. ``compiled``: a sampled loop whose every part the core knows runs in the
-    core (`uvms_pin.sim.compiled_loop`; False: in Python, tick by tick); the metadata's
-    ``closed_loop`` says which path ran. Raises as `ClosedLoop.run`.
+    core (`uvms_pin.sim.compiled_loop`; False: in Python, tick by tick, and a system with
+    free objects integrated in Python); the metadata's ``closed_loop`` says which path ran
+    (and ``world.integration`` how free objects were stepped). Raises as `ClosedLoop.run`.
     """
     from uvms_pin.sim.settings import check_log_fits
 

@@ -6,7 +6,11 @@ run's ticks in chunks of one core call, `uvms_pin.sim.compiled_loop`) and the ba
 reason below names a part without a compiled counterpart and the pipelines it keeps in Python;
 `why_not_compiled` gives the first that applies. The rollout records it (its metadata's
 ``closed_loop``), the batched plant refuses with it. The plant's own right-hand side and period
-are compiled part by part whatever the pipeline (`uvms_pin.sim.system.period`).
+are compiled part by part whatever the pipeline (`uvms_pin.sim.system.period`); a world keeps
+both pipelines in Python (its contacts are stepped period by period), but the period of a
+system with free objects is one compiled call unless
+`uvms_pin.sim.system.period.why_not_compiled_system` names a reason (recorded under the
+rollout's ``world.integration``).
 """
 
 from __future__ import annotations

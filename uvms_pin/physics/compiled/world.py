@@ -8,6 +8,7 @@ hull crosses as the points qhull built it from, so that the core's hull is the s
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from types import ModuleType
 from typing import Any
 
@@ -15,7 +16,9 @@ import numpy as np
 import pinocchio as pin
 
 from uvms_pin.errors import ModelError
+from uvms_pin.physics.world.contact_law import ContactLaw
 from uvms_pin.physics.world.objects import registered_kinds
+from uvms_pin.physics.world.robot_geometry import RobotPiece
 from uvms_pin.physics.world.touch import CLEARANCE_M
 from uvms_pin.physics.world.world import World
 
@@ -67,30 +70,43 @@ def _shape(core: ModuleType, shape: Any, joint_id: int, placement: pin.SE3, radi
     return out
 
 
-def world_contact_to_core(world: World | None, core: ModuleType):
-    """The core's contacts of ``world`` (None: no world): its pieces (on their joints), its
-    objects (fixed: joint 0) and its law."""
-    if world is None:
-        return None
-    pieces = []
-    for piece in world.pieces:
+def pieces_to_core(pieces: Sequence[RobotPiece], core: ModuleType) -> list:
+    """The core's `ContactShape` of each robot piece (or free object's piece): its shape on
+    its joint, its hull index and the corners it touches a plane by."""
+    out = []
+    for piece in pieces:
         where = piece.placement_in_joint
         shape = _shape(core, piece.shape, piece.joint_id, where, piece.bound_radius_m)
         shape.body = int(piece.body)
         corners = piece.corners_m
         shape.corners_m = np.zeros((3, 0)) if corners is None else np.asarray(corners).T
-        pieces.append(shape)
+        out.append(shape)
+    return out
+
+
+def contact_law_to_core(law: ContactLaw, core: ModuleType):
+    """The core's `ContactLaw` (its coefficients of friction are the objects')."""
+    out = core.ContactLaw()
+    out.stiffness_N_m = law.stiffness_N_m
+    out.dissipation_s_m = law.dissipation_s_m
+    out.tangential_stiffness_N_m = law.tangential_stiffness_N_m
+    out.tangential_damping_N_s_m = law.tangential_damping_N_s_m
+    return out
+
+
+def world_contact_to_core(world: World | None, core: ModuleType):
+    """The core's contacts of ``world`` (None: no world): its pieces (on their joints), its
+    objects (fixed: joint 0) and its law."""
+    if world is None:
+        return None
     objects = []
     for obj in world.objects:
         shape = _shape(core, obj.shape, 0, obj.placement, obj.bound_radius_m)
         shape.friction_static = float(obj.friction_static)
         shape.friction_kinetic = float(obj.friction_kinetic)
         objects.append(shape)
-    law = core.ContactLaw()
-    law.stiffness_N_m = world.law.stiffness_N_m
-    law.dissipation_s_m = world.law.dissipation_s_m
-    law.tangential_stiffness_N_m = world.law.tangential_stiffness_N_m
-    law.tangential_damping_N_s_m = world.law.tangential_damping_N_s_m
     out = core.WorldContact()
-    out.pieces, out.objects, out.law = pieces, objects, law
+    out.pieces = pieces_to_core(world.pieces, core)
+    out.objects = objects
+    out.law = contact_law_to_core(world.law, core)
     return out

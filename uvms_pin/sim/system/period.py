@@ -3,11 +3,15 @@
 - compiled: the compiled plant's one call for the whole period (RK4, semi-implicit Euler):
   without a world; or with fixed objects (a bound test first: nothing within reach, the period
   runs without them; else with the contacts, and their anchors move at its end);
+- compiled system (free objects): the compiled system's one call for the whole period
+  (src/uvms_core/system.hpp): the robot, every free object, every moving contact and the
+  anchors' move at its end, then the joint limits; the friction memories are the Python
+  system's, read and written back by the call;
 - guarded (the arm against its own vehicle, compiled plant): the compiled call while no pair,
   fixed or moving, can touch over the period, else the integrated step;
-- integrated: the integrator's own loop around the system's right-hand side (free objects,
-  the Python reference, an integrator without a compiled counterpart), the anchors moved at
-  the period's end.
+- integrated: the integrator's own loop around the system's right-hand side (the Python
+  reference, an integrator without a compiled counterpart, a part the core cannot do:
+  `why_not_compiled_system` names it), the anchors moved at the period's end.
 
 This is the one place the step is made: the constraints solved implicitly come after the
 smooth dynamics, for every body at once (`constrained`: today the robot's joint limits; rigid
@@ -39,6 +43,10 @@ class Stepped(Protocol):
     model: pin.Model
     objects: tuple
     moving: Any
+    compiled: Any  # the compiled system of bodies with free objects, or its Fallback
+    compiled_allowed: bool
+
+    def friction_memories(self) -> list: ...
 
     def acceleration(self, time_s: float, q: np.ndarray, v: np.ndarray, tau: np.ndarray): ...
 
@@ -52,13 +60,36 @@ class Stepped(Protocol):
 #: (t0, q0, v0, tau, t1) -> (q1, v1), the system's state at t1
 PeriodStep = Callable[[float, np.ndarray, np.ndarray, np.ndarray, float], tuple]
 
-__all__ = ["PeriodStep", "Stepped", "period_step"]
+__all__ = [
+    "PeriodStep",
+    "Stepped",
+    "integrated_step",
+    "period_step",
+    "why_not_compiled_system",
+]
 
 
 def period_step(system: Stepped, integrator: Integrator) -> PeriodStep:
     """The period step of ``system`` with ``integrator`` (see the module docstring), with the
     robot's joint limits as constraints solved implicitly at its end (`constrained`)."""
     return _step(system, integrator)
+
+
+def why_not_compiled_system(system: Stepped, integrator: Integrator | None) -> str | None:
+    """Why the period of ``system`` (with free objects) is not one compiled call, or None:
+    the plant, the ``integrator`` (None: not asked) and every moving contact have their
+    compiled counterparts."""
+    plant = system.plant
+    if not system.compiled_allowed:
+        return "the Python integration was asked for"
+    if plant.compiled is None:
+        return "the Python backend" if plant.backend == "python" else "a plant part"
+    if integrator is not None:
+        step = integrator_to_core(integrator, core_module())
+        if isinstance(step, Fallback):
+            return step.reason
+    built = system.compiled
+    return built.reason if isinstance(built, Fallback) else None
 
 
 def constrained(system: Stepped, smooth: PeriodStep) -> PeriodStep:
@@ -92,6 +123,21 @@ def constrained(system: Stepped, smooth: PeriodStep) -> PeriodStep:
     return step
 
 
+def integrated_step(system: Stepped, integrator: Integrator) -> PeriodStep:
+    """The Python reference's period step: the integrator's own loop around the system's
+    right-hand side, every anchor moved at its end (`Stepped.settle`), then the joint
+    limits (`constrained`)."""
+
+    def smooth(t0, q0, v0, tau, t1):
+        q1, v1 = integrator.advance(
+            system.model, lambda t, q, v: system.acceleration(t, q, v, tau), t0, q0, v0, t1
+        )
+        system.settle(q1, v1)
+        return q1, v1
+
+    return smooth if system.plant.joint_limits is None else constrained(system, smooth)
+
+
 def _step(system: Stepped, integrator: Integrator) -> PeriodStep:
     """The period step (see the module docstring): the compiled plant's call (its joint
     limits solved in it) or the integrated step (then `constrained` in Python)."""
@@ -102,19 +148,17 @@ def _step(system: Stepped, integrator: Integrator) -> PeriodStep:
         step = integrator_to_core(integrator, core_module())
         step = None if isinstance(step, Fallback) else step
 
-    def smooth(t0, q0, v0, tau, t1):
-        q1, v1 = integrator.advance(
-            system.model, lambda t, q, v: system.acceleration(t, q, v, tau), t0, q0, v0, t1
-        )
-        system.settle(q1, v1)
-        return q1, v1
-
-    integrated = smooth if plant.joint_limits is None else constrained(system, smooth)
+    integrated = integrated_step(system, integrator)
 
     # the compiled plant is rebuilt when a run starts (its contact anchored anew): taken at
     # each period, the choice of step stays
     if system.objects:
-        return integrated
+        if why_not_compiled_system(system, integrator) is not None:
+            return integrated
+        # the compiled system follows the compiled plant (rebuilt when a run starts)
+        return lambda t0, q0, v0, tau, t1: system.compiled.advance(
+            t0, q0, v0, tau, t1, step, system.friction_memories()
+        )
     if step is not None and plant.world is None:
         return lambda t0, q0, v0, tau, t1: plant.compiled.advance(t0, q0, v0, tau, t1, step)
     if step is not None and system.moving is None:

@@ -21,21 +21,36 @@ from typing import Any
 import numpy as np
 import pinocchio as pin
 
+from uvms_pin.physics.compiled.backend import Fallback
+from uvms_pin.physics.compiled.extension import core_module
+from uvms_pin.physics.compiled.moving import contacts_of_core, forces_of_core, memories_of
 from uvms_pin.physics.dynamics import forward_dynamics, mass_matrix
 from uvms_pin.physics.world.overlap import tolerance_m
+from uvms_pin.sim.compiled.system import system_to_core
 from uvms_pin.sim.integrators import Integrator
 from uvms_pin.sim.plant import Plant, checked_start, has_moving_contacts
 from uvms_pin.sim.system.free_objects import FreeObjects
-from uvms_pin.sim.system.period import PeriodStep, period_step
+from uvms_pin.sim.system.period import PeriodStep, period_step, why_not_compiled_system
 from uvms_pin.sim.system.state import Layout, SystemState
 
 __all__ = ["System"]
 
-#: what a world record says of a run with free objects
+#: what a world record says of a run with free objects, its period compiled
+COMPILED_PATH = (
+    "free objects: one compiled call a control period steps the system (the UVMS, every "
+    "free object, every contact between them and with the fixed world, the friction anchors)"
+)
+#: ... or integrated in Python, and why
 PYTHON_PATH = (
     "free objects: the system (UVMS and objects) is integrated by the Python integrator "
-    "around the compiled dynamics (the compiled plant has no free objects yet)"
+    "around the compiled dynamics ({reason})"
 )
+
+
+def integration_path(reason: str | None) -> str:
+    """What a world record says of a run with free objects whose compiled period is
+    refused for ``reason`` (None: compiled)."""
+    return COMPILED_PATH if reason is None else PYTHON_PATH.format(reason=reason)
 
 
 def _system_model(robot: pin.Model, n_objects: int) -> pin.Model:
@@ -55,10 +70,13 @@ class System:
             arm does not meet its vehicle.
         objects: the free objects (`uvms_pin.physics.world.FreeObject`), possibly none.
         layout: where each body sits in the state. model: the system's Pinocchio model.
+        compiled_allowed: the period of a system with free objects may be one compiled call
+            (`uvms_pin.sim.system.period`); False: the Python integrator steps it.
     """
 
-    def __init__(self, plant: Plant):
+    def __init__(self, plant: Plant, *, compiled: bool = True):
         self.plant = plant
+        self.compiled_allowed = compiled  # False: free objects integrated in Python
         world = plant.world
         self.moving = FreeObjects(plant.uvms, world) if has_moving_contacts(world) else None
         self.objects: tuple = () if self.moving is None else tuple(self.moving.objects)
@@ -99,6 +117,25 @@ class System:
             self.moving.reset()
             robot, *objects = self.layout.split(state.q, state.v)
             self.moving.settle(robot[0], np.zeros(self.plant.uvms.nv), objects)
+
+    # ---- the compiled system ------------------------------------------------------------
+    @property
+    def compiled(self) -> Any:
+        """The compiled system of bodies (`uvms_pin.sim.compiled.system`) of the compiled
+        plant as it is now (rebuilt with it, when a run starts), or its `Fallback`; None
+        without free objects or a compiled plant."""
+        plant_core = self.plant.compiled
+        if not self.objects or plant_core is None:
+            return None
+        held = self.__dict__.get("_compiled")
+        if held is None or held[0] is not plant_core:
+            held = self._compiled = (plant_core, system_to_core(self, core_module()))
+        return held[1]
+
+    def friction_memories(self) -> list:
+        """Every contact's friction state, as the compiled system reads and writes it: the
+        plant's, each moving pair set's, each free object's against the fixed world."""
+        return memories_of(self.plant.friction, self.moving.moving)
 
     # ---- the dynamics ---------------------------------------------------------------------
     def acceleration(
@@ -184,15 +221,17 @@ class System:
             self.moving.settle(q_r, v_r, objects)
 
     # ---- what a run records -----------------------------------------------------------------
-    def record(self) -> dict[str, Any]:
-        """The world simulated, as plain data (`Plant.record`, with the moving pairs)."""
+    def record(self, integrator: Integrator | None = None) -> dict[str, Any]:
+        """The world simulated, as plain data (`Plant.record`, with the moving pairs and,
+        with free objects, how a period of ``integrator`` steps them)."""
         out = self.plant.record()
         if self.moving is not None:
+            reason = why_not_compiled_system(self, integrator) if self.objects else None
             out["world"] = {
                 **out["world"],
                 "pairs": self.contact_pair_names,
                 "object_pairs": self.moving.moving.object_pair_names,
-                **({"integration": PYTHON_PATH} if self.objects else {}),
+                **({"integration": integration_path(reason)} if self.objects else {}),
             }
             if self.objects:
                 out["world"]["initial_overlap"] = {
@@ -237,10 +276,18 @@ class System:
         if plant.world is None:
             return {}
         (q_r, v_r), *objects = self.layout.split(q, v)
-        fixed = plant.world.pair_wrenches(plant.world_forces(q_r, v_r)).ravel()
-        if self.moving is None:
-            return {"world_contact": fixed}
-        robot, between_objects = self.moving.wrenches(q_r, v_r, objects)
+        compiled = self.compiled
+        if compiled is None or isinstance(compiled, Fallback):
+            fixed = plant.world.pair_wrenches(plant.world_forces(q_r, v_r)).ravel()
+            if self.moving is None:
+                return {"world_contact": fixed}
+            found = self.moving.found(q_r, v_r, objects)
+        else:  # the compiled system's contacts (the same as the reference's, to rounding)
+            memories = self.friction_memories()
+            robot_forces = forces_of_core(plant.compiled.world_forces(q_r, v_r, memories[0]))
+            fixed = plant.world.pair_wrenches(robot_forces).ravel()
+            found = contacts_of_core(compiled.contacts(q, v, memories))
+        robot, between_objects = self.moving.moving.wrenches(found)
         out = {"world_contact": np.concatenate([fixed, robot])}
         if self.objects:
             out["free_objects"] = np.concatenate([np.concatenate(s) for s in objects])

@@ -1,0 +1,242 @@
+#include "system.hpp"
+
+#include <string>
+
+#include <pinocchio/algorithm/joint-configuration.hpp>
+#include <pinocchio/algorithm/kinematics.hpp>
+#include <pinocchio/multibody/joint/joint-free-flyer.hpp>
+
+namespace uvms {
+
+namespace {
+
+// The robot's joints and n free-flyers under the universe (_system_model of system.py).
+Model system_model(const Model& robot, std::size_t n_objects) {
+  Model model = robot;
+  for (std::size_t k = 0; k < n_objects; ++k) {
+    model.addJoint(0, pinocchio::JointModelFreeFlyer(), pinocchio::SE3::Identity(),
+                   "free_object_" + std::to_string(k));
+  }
+  return model;
+}
+
+std::vector<Dynamics> copies(const std::vector<const Dynamics*>& objects) {
+  std::vector<Dynamics> out;
+  out.reserve(objects.size());
+  for (const Dynamics* body : objects) {
+    if (body == nullptr) throw InputError("system: a free object without dynamics");
+    if (body->nq() != 7 || body->nv() != 6) {
+      throw InputError("system: a free object is one floating body (nq 7, nv 6)");
+    }
+    out.emplace_back(*body);
+  }
+  return out;
+}
+
+void add_wrench(Dynamics& dynamics, int joint_id, const Vec3& point, const Vec3& force) {
+  Vec6 wrench = Vec6::Zero();
+  wrench.head<3>() = force;
+  dynamics.add_world_wrench(joint_id, point, wrench);
+}
+
+}  // namespace
+
+System::System(Plant& plant, const std::vector<const Dynamics*>& objects)
+    : plant_(plant),
+      objects_(copies(objects)),
+      model_(system_model(plant.dynamics().model(), objects.size())),
+      robot_data_(plant.dynamics().model()),
+      nq_robot_(plant.dynamics().nq()),
+      nv_robot_(plant.dynamics().nv()),
+      stepper_(model_),
+      acceleration_(model_.nv) {
+  object_worlds.resize(objects_.size());
+  object_memory.resize(objects_.size());
+}
+
+const Data& System::data_of(int side) {
+  return side < 0 ? *robot_at_ : objects_[static_cast<std::size_t>(side)].data();
+}
+
+const Model& System::model_of(int side) const {
+  return side < 0 ? plant_.dynamics().model() : objects_[static_cast<std::size_t>(side)].model();
+}
+
+void System::check() const {
+  const int n = static_cast<int>(objects_.size());
+  for (const auto& set : sets) {
+    if (set.a < -1 || set.a >= n || set.b < -1 || set.b >= n) {
+      throw InputError("system: a pair set's bodies are not the robot or a free object");
+    }
+    set.pairs.check(model_of(set.a), model_of(set.b));
+  }
+  if (object_worlds.size() != objects_.size() || object_memory.size() != objects_.size()) {
+    throw InputError("system: one world (or none) and one friction state per free object");
+  }
+  for (std::size_t k = 0; k < objects_.size(); ++k) {
+    if (object_worlds[k]) object_worlds[k]->check(objects_[k].model());
+  }
+}
+
+void System::object_kinematics(const ConstVec& q, const ConstVec& v) {
+  for (std::size_t k = 0; k < objects_.size(); ++k) {
+    const auto i = static_cast<Eigen::Index>(k);
+    objects_[k].kinematics(q.segment(nq_robot_ + 7 * i, 7), v.segment(nv_robot_ + 6 * i, 6));
+  }
+}
+
+void System::contacts_at(const Data& robot) {
+  robot_at_ = &robot;
+  found_sets_.resize(sets.size());
+  for (std::size_t s = 0; s < sets.size(); ++s) {
+    auto& set = sets[s];
+    set.pairs.forces(data_of(set.a), data_of(set.b), set.memory, found_sets_[s]);
+  }
+  found_objects_.resize(objects_.size());
+  for (std::size_t k = 0; k < objects_.size(); ++k) {
+    found_objects_[k].touch.clear();
+    if (object_worlds[k]) {
+      object_worlds[k]->forces(objects_[k].data(), object_memory[k], found_objects_[k]);
+    }
+  }
+}
+
+void System::contacts(const ConstVec& q, const ConstVec& v) {
+  pinocchio::forwardKinematics(plant_.dynamics().model(), robot_data_, q.head(nq_robot_),
+                               v.head(nv_robot_));
+  object_kinematics(q, v);
+  contacts_at(robot_data_);
+}
+
+void System::add_robot_forces(Dynamics& robot) {
+  contacts_at(robot.data());
+  for (std::size_t s = 0; s < sets.size(); ++s) {
+    const auto& set = sets[s];
+    if (set.a >= 0 && set.b >= 0) continue;
+    const auto& found = found_sets_[s].forces;
+    for (std::size_t i = 0; i < found.touch.size(); ++i) {
+      const auto& point = found.touch.point_world_m[i];
+      const auto& force = found.force_world_N[i];
+      if (set.a < 0) {
+        const auto& piece = set.pairs.pieces_a[static_cast<std::size_t>(found.touch.piece[i])];
+        add_wrench(robot, piece.joint_id, point, force);
+      }
+      if (set.b < 0) {
+        const auto& piece = set.pairs.pieces_b[static_cast<std::size_t>(found.touch.obj[i])];
+        add_wrench(robot, piece.joint_id, point, -force);
+      }
+    }
+  }
+}
+
+const Eigen::VectorXd& System::acceleration(double time_s, const ConstVec& q,
+                                            const ConstVec& v, const ConstVec& tau) {
+  object_kinematics(q, v);
+  // the robot: its plant's acceleration, the moving contacts computed and added once its
+  // kinematics is done (add_robot_forces)
+  plant_.moving_contacts = [this](Dynamics& robot) { add_robot_forces(robot); };
+  try {
+    acceleration_.head(nv_robot_) =
+        plant_.acceleration(time_s, q.head(nq_robot_), v.head(nv_robot_), tau);
+  } catch (...) {
+    plant_.moving_contacts = nullptr;
+    throw;
+  }
+  plant_.moving_contacts = nullptr;
+  // each object: its water, then its contacts (f on a, -f on b; the fixed world's reaction
+  // goes to the ground)
+  const FlowField& flow = plant_.flow;
+  for (std::size_t k = 0; k < objects_.size(); ++k) {
+    Dynamics& body = objects_[k];
+    body.fluid_wrenches(time_s, flow, body.needs_bias_acceleration(), plant_.free_surface);
+  }
+  for (std::size_t s = 0; s < sets.size(); ++s) {
+    const auto& set = sets[s];
+    const auto& found = found_sets_[s].forces;
+    for (std::size_t i = 0; i < found.touch.size(); ++i) {
+      const auto& point = found.touch.point_world_m[i];
+      const auto& force = found.force_world_N[i];
+      if (set.a >= 0) {
+        const auto& piece = set.pairs.pieces_a[static_cast<std::size_t>(found.touch.piece[i])];
+        add_wrench(objects_[static_cast<std::size_t>(set.a)], piece.joint_id, point, force);
+      }
+      if (set.b >= 0) {
+        const auto& piece = set.pairs.pieces_b[static_cast<std::size_t>(found.touch.obj[i])];
+        add_wrench(objects_[static_cast<std::size_t>(set.b)], piece.joint_id, point, -force);
+      }
+    }
+  }
+  for (std::size_t k = 0; k < objects_.size(); ++k) {
+    Dynamics& body = objects_[k];
+    if (object_worlds[k]) object_worlds[k]->add_to(body, found_objects_[k]);
+    const auto i = static_cast<Eigen::Index>(k);
+    acceleration_.segment(nv_robot_ + 6 * i, 6) = body.accelerations(
+        q.segment(nq_robot_ + 7 * i, 7), v.segment(nv_robot_ + 6 * i, 6), zero_tau_, nullptr);
+  }
+  return acceleration_;
+}
+
+void System::settle(const ConstVec& q, const ConstVec& v) {
+  if (plant_.world) {  // the robot's fixed world (Plant.settle)
+    plant_.world->commit(plant_.world_forces(q.head(nq_robot_), v.head(nv_robot_)),
+                         plant_.friction);
+  }
+  contacts(q, v);
+  for (std::size_t s = 0; s < sets.size(); ++s) {
+    sets[s].pairs.commit(data_of(sets[s].b), found_sets_[s], sets[s].memory);
+  }
+  for (std::size_t k = 0; k < objects_.size(); ++k) {
+    if (object_worlds[k]) object_worlds[k]->commit(found_objects_[k], object_memory[k]);
+  }
+}
+
+std::pair<Eigen::VectorXd, Eigen::VectorXd> System::advance(double t0, const ConstVec& q0,
+                                                            const ConstVec& v0,
+                                                            const ConstVec& tau, double t1,
+                                                            const FixedStep& integrator) {
+  if (q0.size() != model_.nq || v0.size() != model_.nv || tau.size() != nv_robot_) {
+    throw InputError("system advance: q0 (" + std::to_string(model_.nq) + "), v0 (" +
+                     std::to_string(model_.nv) + ") and the robot's tau (" +
+                     std::to_string(nv_robot_) + ") expected");
+  }
+  if (!(t1 > t0) || !(integrator.step_s > 0.0)) {
+    throw InputError("advance needs t1 > t0 and a positive step");
+  }
+  check();
+  stepper_.q = q0;
+  stepper_.v = v0;
+  auto rhs = [&](double t, const Eigen::VectorXd& q,
+                 const Eigen::VectorXd& v) -> const Eigen::VectorXd& {
+    return acceleration(t, q, v, tau);
+  };
+  stepper_.advance(rhs, t0, t1, integrator);
+  // a smooth step that diverged is returned as it is: the loop names the divergence
+  if (!(stepper_.q.allFinite() && stepper_.v.allFinite())) return {stepper_.q, stepper_.v};
+  settle(stepper_.q, stepper_.v);
+  const auto& limits = plant_.joint_limits;
+  if (!limits) return {stepper_.q, stepper_.v};
+  // the robot's joint limits (period.py, constrained): rows selected with the smooth step's
+  // own speeds, its start and its mean over the period
+  const double h = t1 - t0;
+  const auto q0_robot = q0.head(nq_robot_);
+  Eigen::VectorXd travelled(nv_robot_);
+  pinocchio::difference(plant_.dynamics().model(), q0_robot, stepper_.q.head(nq_robot_),
+                        travelled);
+  limit_speed_ = (travelled.cwiseAbs() / h)
+                     .cwiseMax(v0.head(nv_robot_).cwiseAbs())
+                     .cwiseMax(stepper_.v.head(nv_robot_).cwiseAbs());
+  if (!limits->within_reach(q0_robot, limit_speed_, h)) return {stepper_.q, stepper_.v};
+  const Eigen::MatrixXd& mass =
+      plant_.dynamics().mass_matrix_in(q0_robot, plant_.flow, t0, plant_.free_surface);
+  Eigen::VectorXd v1 = stepper_.v;
+  Eigen::VectorXd v1_robot = v1.head(nv_robot_);
+  if (!limits->constrain(mass, q0_robot, v1_robot, h, limit_speed_)) {
+    return {stepper_.q, stepper_.v};
+  }
+  v1.head(nv_robot_) = v1_robot;
+  Eigen::VectorXd q1(model_.nq);
+  pinocchio::integrate(model_, q0, (h * v1).eval(), q1);
+  return {q1, v1};
+}
+
+}  // namespace uvms

@@ -1,0 +1,91 @@
+// A system of bodies (mirror of uvms_pin/sim/system/system.py and of the integrated step of
+// period.py): the robot (a Plant, with its environment, joint stops or limits and fixed world)
+// and the world's free objects, each a floating body of its own (a Dynamics of its one-link
+// model, the robot's dynamics for a bare vehicle), stepped together over one control period in
+// one call. The state stacks the robot's (q, zeta) and each object's (pose (7,), body velocity
+// (6,)); the configuration space is the robot's joints and one free-flyer per object. The
+// right-hand side is
+//
+//   zeta_dot = FD_robot(q, zeta, tau + tau_contact,robot)
+//   nu_dot_o = FD_o(q_o, nu_o, tau_contact,o)                       (each object o)
+//
+// with every contact force between two moving bodies exchanged equal and opposite
+// (moving_contact.hpp) and each object touching the fixed objects as the robot does
+// (world_contact.hpp), in the same water (the plant's flow and free surface).
+//
+// A period: the integrator's substeps on the system's manifold, then every contact's friction
+// anchors move (World.commit, PiecePairs.commit) at the period's end, then the robot's joint
+// limits as constraints solved implicitly (period.py, constrained: M block diagonal over the
+// bodies, so the impulses change the robot's velocity only; with a row solved, the whole
+// configuration is q0 (+) h v+).
+#pragma once
+
+#include <optional>
+#include <utility>
+#include <vector>
+
+#include "moving_contact.hpp"
+#include "plant.hpp"
+
+namespace uvms {
+
+class System {
+ public:
+  // The robot's plant (kept by reference: its owner outlives the system) and each free
+  // object's floating body (copied).
+  System(Plant& plant, const std::vector<const Dynamics*>& objects);
+  System(const System&) = delete;
+  System& operator=(const System&) = delete;
+
+  // The pair sets (moving.py's _Set: a = -1 the robot, else an object; b likewise) and each
+  // object's contacts with the fixed objects (none without fixed objects), with their state.
+  std::vector<PairSet> sets;
+  std::vector<std::optional<WorldContactModel>> object_worlds;
+  std::vector<FrictionMemory> object_memory;
+
+  int nq() const { return model_.nq; }
+  int nv() const { return model_.nv; }
+  std::size_t n_objects() const { return objects_.size(); }
+  Plant& plant() { return plant_; }
+
+  // Checks the sets and the object worlds against the models (InputError otherwise).
+  void check() const;
+  // The system's acceleration (nv,) with tau (the robot's nv) held, the anchors read only.
+  const Eigen::VectorXd& acceleration(double time_s, const ConstVec& q, const ConstVec& v,
+                                      const ConstVec& tau);
+  // The contacts at (q, v) (after which found_sets() and found_objects() hold them).
+  void contacts(const ConstVec& q, const ConstVec& v);
+  const std::vector<PairContacts>& found_sets() const { return found_sets_; }
+  const std::vector<ContactForces>& found_objects() const { return found_objects_; }
+  // After a control period at (q, v): every contact's anchors move (System.settle).
+  void settle(const ConstVec& q, const ConstVec& v);
+  // (q, v) at t1 from (q0, v0) at t0 with tau held (see the file's comment).
+  std::pair<Eigen::VectorXd, Eigen::VectorXd> advance(double t0, const ConstVec& q0,
+                                                      const ConstVec& v0, const ConstVec& tau,
+                                                      double t1, const FixedStep& integrator);
+
+ private:
+  void object_kinematics(const ConstVec& q, const ConstVec& v);
+  // Every moving contact, after the objects' kinematics, the robot's in robot.
+  void contacts_at(const Data& robot);
+  // The moving contacts' forces on the robot's bodies (the plant's moving_contacts, called
+  // after its own kinematics: the robot's is done once an evaluation).
+  void add_robot_forces(Dynamics& robot);
+  // the data of side k of a set (-1: the robot's, of the last contacts_at)
+  const Data& data_of(int side);
+  const Model& model_of(int side) const;
+
+  Plant& plant_;
+  std::vector<Dynamics> objects_;
+  Model model_;  // the robot's joints and one free-flyer per object (integration)
+  Data robot_data_;  // the robot's kinematics for contacts() and settle()
+  const Data* robot_at_ = nullptr;  // the robot's data of the contacts being computed
+  int nq_robot_, nv_robot_;
+  ManifoldStepper stepper_;
+  std::vector<PairContacts> found_sets_;
+  std::vector<ContactForces> found_objects_;
+  Eigen::VectorXd acceleration_, limit_speed_;
+  const Eigen::VectorXd zero_tau_ = Eigen::VectorXd::Zero(6);
+};
+
+}  // namespace uvms

@@ -1,0 +1,175 @@
+// The system of bodies in the nanobind module (system.hpp, moving_contact.hpp). The friction's
+// state crosses as the Python system's FrictionMemory objects, in one list: the plant's, each
+// pair set's, then each free object's against the fixed world (None without one); read before
+// and written back after each call, so that it lives in one place for both backends.
+#include <nanobind/eigen/dense.h>
+#include <nanobind/nanobind.h>
+#include <nanobind/stl/array.h>
+#include <nanobind/stl/optional.h>
+#include <nanobind/stl/pair.h>
+#include <nanobind/stl/vector.h>
+
+#include <string>
+
+#include "system.hpp"
+#include "world_bindings.hpp"
+
+namespace nb = nanobind;
+using namespace nb::literals;
+
+namespace {
+
+using uvms::InputError;
+using uvms::System;
+
+// Every memory of the system, in the order of the file's comment.
+std::vector<uvms::FrictionMemory*> memories(System& system) {
+  std::vector<uvms::FrictionMemory*> out{&system.plant().friction};
+  for (auto& set : system.sets) out.push_back(&set.memory);
+  for (auto& memory : system.object_memory) out.push_back(&memory);
+  return out;
+}
+
+std::vector<nb::handle> python_memories(System& system, const nb::handle& given) {
+  const std::size_t expected = 1 + system.sets.size() + system.n_objects();
+  std::vector<nb::handle> out;
+  for (nb::handle memory : given) out.push_back(memory);
+  if (out.size() != expected) {
+    throw InputError("system: " + std::to_string(expected) +
+                     " friction memories expected (the plant's, each pair set's, each "
+                     "object's), got " + std::to_string(out.size()));
+  }
+  return out;
+}
+
+void read_all(System& system, const nb::handle& given) {
+  const auto from = python_memories(system, given);
+  const auto into = memories(system);
+  for (std::size_t k = 0; k < into.size(); ++k) {
+    if (from[k].is_none()) {
+      into[k]->clear();
+    } else {
+      read_memory(from[k], *into[k]);
+    }
+  }
+}
+
+void write_all(System& system, const nb::handle& given) {
+  const auto into = python_memories(system, given);
+  const auto from = memories(system);
+  for (std::size_t k = 0; k < from.size(); ++k) {
+    if (!into[k].is_none()) write_memory(*from[k], into[k]);
+  }
+}
+
+void check_state(System& system, const Eigen::VectorXd& q, const Eigen::VectorXd& v) {
+  if (q.size() != system.nq() || v.size() != system.nv()) {
+    throw InputError("system: q (" + std::to_string(system.nq()) + ",) and v (" +
+                     std::to_string(system.nv()) + ",) expected");
+  }
+  if (!q.allFinite() || !v.allFinite()) throw InputError("system: a non-finite state");
+}
+
+}  // namespace
+
+void bind_system(nb::module_& m) {
+  using uvms::PiecePairsModel;
+  nb::class_<PiecePairsModel>(m, "PiecePairs",
+                              "Pairs of pieces of two moving bodies (moving_contact.hpp).")
+      .def(nb::init<>())
+      .def_rw("pieces_a", &PiecePairsModel::pieces_a)
+      .def_rw("pieces_b", &PiecePairsModel::pieces_b)
+      .def_rw("pairs", &PiecePairsModel::pairs)
+      .def_rw("friction_static", &PiecePairsModel::friction_static)
+      .def_rw("friction_kinetic", &PiecePairsModel::friction_kinetic)
+      .def_rw("law", &PiecePairsModel::law);
+  nb::class_<System>(m, "System",
+                     "The robot's plant and the free objects, one period in one call "
+                     "(system.hpp).")
+      .def(
+          "__init__",
+          [](System* self, uvms::Plant& plant, const std::vector<const uvms::Dynamics*>& objects) {
+            new (self) System(plant, objects);
+          },
+          "plant"_a, "objects"_a, nb::keep_alive<1, 2>(),
+          "The plant (kept alive) and each free object's floating body (copied).")
+      .def_prop_ro("nq", &System::nq)
+      .def_prop_ro("nv", &System::nv)
+      .def(
+          "add_pairs",
+          [](System& s, const PiecePairsModel& pairs, int a, int b) {
+            uvms::PairSet set;
+            set.pairs = pairs;
+            set.a = a;
+            set.b = b;
+            s.sets.push_back(std::move(set));
+            s.check();
+          },
+          "pairs"_a, "a"_a, "b"_a, "A set of pairs between side a and b (-1: the robot).")
+      .def(
+          "set_object_world",
+          [](System& s, std::size_t k, const uvms::WorldContactModel& world) {
+            if (k >= s.n_objects()) throw InputError("system: no free object " + std::to_string(k));
+            s.object_worlds[k] = world;
+            s.check();
+          },
+          "k"_a, "world"_a, "Free object k's contacts with the fixed objects.")
+      .def(
+          "advance",
+          [](System& s, double t0, const Eigen::VectorXd& q0, const Eigen::VectorXd& v0,
+             const Eigen::VectorXd& tau, double t1, const uvms::FixedStep& integrator,
+             nb::handle friction) {
+            check_state(s, q0, v0);
+            if (!tau.allFinite()) throw InputError("system: tau contains a non-finite value");
+            read_all(s, friction);
+            auto out = s.advance(t0, q0, v0, tau, t1, integrator);
+            write_all(s, friction);
+            return out;
+          },
+          "t0"_a, "q0"_a, "v0"_a, "tau"_a, "t1"_a, "integrator"_a, "friction"_a,
+          "The system's (q, v) at t1; the friction memories are read and written back "
+          "(every anchor moved at the period's end).")
+      .def(
+          "acceleration",
+          [](System& s, double t, const Eigen::VectorXd& q, const Eigen::VectorXd& v,
+             const Eigen::VectorXd& tau, nb::handle friction) -> Eigen::VectorXd {
+            check_state(s, q, v);
+            read_all(s, friction);
+            return s.acceleration(t, q, v, tau);
+          },
+          "time_s"_a, "q"_a, "v"_a, "tau"_a, "friction"_a,
+          "The system's acceleration at the anchors of the friction memories (read only).")
+      .def(
+          "contacts",
+          [](System& s, const Eigen::VectorXd& q, const Eigen::VectorXd& v, nb::handle friction) {
+            check_state(s, q, v);
+            read_all(s, friction);
+            s.contacts(q, v);
+            nb::list sets, objects;
+            for (const auto& found : s.found_sets()) {
+              nb::dict out = forces_dict(found.forces);
+              out["pair"] = found.pair;
+              sets.append(out);
+            }
+            for (std::size_t k = 0; k < s.n_objects(); ++k) {
+              if (s.object_worlds[k]) {
+                objects.append(forces_dict(s.found_objects()[k]));
+              } else {
+                objects.append(nb::none());
+              }
+            }
+            return nb::make_tuple(sets, objects);
+          },
+          "q"_a, "v"_a, "friction"_a,
+          "(each pair set's touching pairs, each object's contacts with the fixed world or "
+          "None) at (q, v), as dicts of arrays (MovingContacts.contacts).")
+      .def(
+          "settle",
+          [](System& s, const Eigen::VectorXd& q, const Eigen::VectorXd& v, nb::handle friction) {
+            check_state(s, q, v);
+            read_all(s, friction);
+            s.settle(q, v);
+            write_all(s, friction);
+          },
+          "q"_a, "v"_a, "friction"_a, "Every anchor moves (System.settle).");
+}

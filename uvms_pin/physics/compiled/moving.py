@@ -1,0 +1,106 @@
+"""The moving contacts of a world as the core's (src/uvms_core/moving_contact.hpp,
+`PiecePairs`), built from the Python reference (`uvms_pin.physics.world.moving`), and the
+core's contacts read back as the reference's `ContactForces` and `PairContacts` (what the
+logs and the tests compare).
+
+Each pair set becomes a core `PiecePairs` (the two sides' pieces as `ContactShape`s on their
+joints, the pairs, one (mu_s, mu_k) per pair, the law); each free object's own world against
+the fixed objects a core `WorldContact` (`uvms_pin.physics.compiled.world`)."""
+
+from __future__ import annotations
+
+from types import ModuleType
+from typing import Any
+
+import numpy as np
+
+from uvms_pin.physics.compiled.world import (
+    contact_law_to_core,
+    pieces_to_core,
+    world_contact_to_core,
+)
+from uvms_pin.physics.world.moving import MovingContacts
+from uvms_pin.physics.world.pairs import PairContacts, PiecePairs
+from uvms_pin.physics.world.touch import Touch
+from uvms_pin.physics.world.world import ContactForces
+
+__all__ = [
+    "contacts_of_core",
+    "forces_of_core",
+    "memories_of",
+    "moving_to_core",
+    "piece_pairs_to_core",
+]
+
+
+def piece_pairs_to_core(pairs: PiecePairs, core: ModuleType):
+    """The core's `PiecePairs` of ``pairs``."""
+    out = core.PiecePairs()
+    out.pieces_a = pieces_to_core(pairs.pieces_a, core)
+    out.pieces_b = pieces_to_core(pairs.pieces_b, core)
+    out.pairs = [(int(a), int(b)) for a, b in pairs.pairs]
+    mu = np.asarray(pairs.mu, dtype=float).reshape(-1, 2)
+    out.friction_static = mu[:, 0].tolist()
+    out.friction_kinetic = mu[:, 1].tolist()
+    out.law = contact_law_to_core(pairs.law, core)
+    return out
+
+
+def moving_to_core(moving: MovingContacts, system: Any, core: ModuleType) -> None:
+    """Give the core's ``system`` (a `System` of the plant and the free objects) every pair
+    set of ``moving`` (in its order) and each free object's world against the fixed ones."""
+    for s in moving.sets:
+        system.add_pairs(piece_pairs_to_core(s.pairs, core), s.a, s.b)
+    for k, world in enumerate(moving.object_worlds):
+        if world is not None:
+            system.set_object_world(k, world_contact_to_core(world, core))
+
+
+def memories_of(friction: Any, moving: MovingContacts) -> list:
+    """The friction states the core's system reads and writes back, in its order: the
+    plant's ``friction``, each pair set's, each free object's against the fixed world (None
+    without fixed objects)."""
+    objects = [
+        None if w is None else m
+        for w, m in zip(moving.object_worlds, moving.object_memory, strict=True)
+    ]
+    return [friction, *(s.memory for s in moving.sets), *objects]
+
+
+def _touch(found: dict) -> Touch:
+    return Touch(
+        np.asarray(found["piece"], dtype=int),
+        np.asarray(found["obj"], dtype=int),
+        np.asarray(found["corner"], dtype=int),
+        np.asarray(found["point_world_m"], dtype=float).reshape(-1, 3),
+        np.asarray(found["normal_world"], dtype=float).reshape(-1, 3),
+        np.asarray(found["depth_m"], dtype=float),
+        np.asarray(found["velocity_world_m_s"], dtype=float).reshape(-1, 3),
+    )
+
+
+def _forces(found: dict) -> dict[str, np.ndarray]:
+    return {
+        "force_world_N": np.asarray(found["force_world_N"], dtype=float).reshape(-1, 3),
+        "normal_N": np.asarray(found["normal_N"], dtype=float),
+        "sticking": np.asarray(found["sticking"], dtype=bool),
+        "stretch_m": np.asarray(found["stretch_m"], dtype=float).reshape(-1, 3),
+        "material_m": np.asarray(found["material_m"], dtype=float).reshape(-1, 3),
+    }
+
+
+def forces_of_core(found: dict) -> ContactForces:
+    """The core's contacts with fixed objects (a dict of arrays: `Plant.world_forces`, an
+    object's in the system's ``contacts``) as the reference's `ContactForces`."""
+    return ContactForces(_touch(found), **_forces(found))
+
+
+def contacts_of_core(found: tuple[list, list]) -> tuple[list[PairContacts], list]:
+    """The core system's ``contacts`` (dicts of arrays) as `MovingContacts.contacts` gives
+    them: (each set's `PairContacts`, each object's `ContactForces` or None)."""
+    sets, fixed = found
+    pairs = [
+        PairContacts(_touch(d), **_forces(d), pair=np.asarray(d["pair"], dtype=int)) for d in sets
+    ]
+    objects = [None if d is None else forces_of_core(d) for d in fixed]
+    return pairs, objects

@@ -1,0 +1,42 @@
+"""The compiled system of bodies (src/uvms_core/system.hpp) of a `uvms_pin.sim.system.System`
+with free objects: its compiled plant, each free object's compiled dynamics (a floating body
+of its own) and the moving contacts (`uvms_pin.physics.compiled.moving`), built from their
+public attributes. One call crosses a control period: every body, every contact and the
+anchors' move at its end."""
+
+from __future__ import annotations
+
+from types import ModuleType
+from typing import Any, Protocol
+
+from uvms_pin.errors import ModelError
+from uvms_pin.physics.compiled.backend import Fallback
+from uvms_pin.physics.compiled.moving import moving_to_core
+from uvms_pin.physics.dynamics import dynamics_of
+
+__all__ = ["SystemParts", "system_to_core"]
+
+
+class SystemParts(Protocol):
+    """What the compiled system is built from: a `System`'s public parts."""
+
+    plant: Any
+    objects: tuple
+    moving: Any
+
+
+def system_to_core(system: SystemParts, core: ModuleType):
+    """The core's `System` of ``system`` (its plant compiled as it is now), or the
+    `Fallback` saying why the Python integrator steps it instead."""
+    plant = system.plant.compiled
+    if plant is None:
+        return Fallback("a plant the core does not compile")
+    if system.moving is None:
+        return Fallback("a system without moving contacts")
+    objects = [dynamics_of(o.uvms).core for o in system.objects]
+    out = core.System(plant, objects)
+    try:
+        moving_to_core(system.moving.moving, out, core)
+    except ModelError as exc:  # a piece without a compiled geometry
+        return Fallback(f"a moving contact ({exc})")
+    return out
