@@ -31,6 +31,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 import pinocchio as pin
 
+from uvms_pin.apps.export.ros_cdr import ENCODERS
 from uvms_pin.apps.export.ros_frames import ODOM, LinkTree, relative_placements
 from uvms_pin.apps.export.ros_messages import (
     header,
@@ -63,14 +64,16 @@ _IDENTITY = (np.zeros(3), np.array([0.0, 0.0, 0.0, 1.0]))
 Message = tuple[str, dict, int]
 
 
-def _writer_class():
+def _libraries():
+    """mcap's writer and mcap-ros2-support's encoder factory (the ``ros`` extra)."""
     try:
-        from mcap_ros2.writer import Writer
+        from mcap.writer import Writer
+        from mcap_ros2._dynamic import serialize_dynamic
     except ImportError as exc:
         raise OptionalDependencyError(
             'the MCAP export needs mcap and mcap-ros2-support: pip install "uvms-pin[ros]"'
         ) from exc
-    return Writer
+    return Writer, serialize_dynamic
 
 
 def rollout_model(rollout: RolloutData, urdf: str | Path | None = None) -> UVMS:
@@ -90,7 +93,7 @@ def rollout_model(rollout: RolloutData, urdf: str | Path | None = None) -> UVMS:
 def write_mcap(rollout: RolloutData, path: str | Path, *, urdf: str | Path | None = None) -> Path:
     """Write ``rollout`` to ``path`` as a ROS 2 MCAP bag (the topics of this module's
     docstring); the file appears whole or not at all (written aside, then renamed)."""
-    writer_class = _writer_class()
+    writer_class, serialize_dynamic = _libraries()
     if len(rollout) == 0:
         raise VizError("the rollout has no sample to export")
     uvms = rollout_model(rollout, urdf)
@@ -101,10 +104,16 @@ def write_mcap(rollout: RolloutData, path: str | Path, *, urdf: str | Path | Non
         )
     with atomic_path(path) as tmp, open(tmp, "wb") as stream:
         writer = writer_class(stream)
-        schemas = {name: writer.register_msgdef(name, text) for name, text in MESSAGE_DEFINITIONS.items()}  # fmt: skip
-        types = _topic_types()
+        writer.start(profile="ros2", library="uvms-pin")
+        types, channels, encoders = _topic_types(), {}, {}
         for topic, message, time_ns in messages(rollout, uvms):
-            writer.write_message(topic, schemas[types[topic]], message, time_ns, time_ns)
+            if topic not in channels:  # a channel for each topic the run has data for
+                name = types[topic]
+                text = MESSAGE_DEFINITIONS[name]
+                schema = writer.register_schema(name, "ros2msg", text.encode())
+                channels[topic] = writer.register_channel(topic, "cdr", schema)
+                encoders[topic] = ENCODERS.get(name) or serialize_dynamic(name, text)[name]
+            writer.add_message(channels[topic], time_ns, encoders[topic](message), time_ns)
         writer.finish()
     return Path(path)
 
