@@ -1,35 +1,38 @@
 """The ROS 2 message definitions the MCAP export embeds (ROS 2 Humble's, as ``ros2 msg show``
-writes them with their dependencies), by type name: each a schema of the file, so a reader
-needs no ROS installation to decode it."""
+writes them), by type name: each a schema of the file, its own fields followed by every type
+it uses, so a reader needs no ROS installation to decode it."""
 
+_SEPARATOR = "=" * 80 + "\n"
+
+#: each type's own fields
 # fmt: off
-MESSAGE_DEFINITIONS: dict[str, str] = {
+_FIELDS: dict[str, str] = {
     "tf2_msgs/TFMessage": (
         'geometry_msgs/TransformStamped[] transforms\n'
-        '================================================================================\n'
-        'MSG: geometry_msgs/TransformStamped\n'
+    ),
+    "geometry_msgs/TransformStamped": (
         'std_msgs/Header header\n'
         'string child_frame_id\n'
         'geometry_msgs/Transform transform\n'
-        '================================================================================\n'
-        'MSG: std_msgs/Header\n'
+    ),
+    "std_msgs/Header": (
         'builtin_interfaces/Time stamp\n'
         'string frame_id\n'
-        '================================================================================\n'
-        'MSG: builtin_interfaces/Time\n'
+    ),
+    "builtin_interfaces/Time": (
         'int32 sec\n'
         'uint32 nanosec\n'
-        '================================================================================\n'
-        'MSG: geometry_msgs/Transform\n'
+    ),
+    "geometry_msgs/Transform": (
         'geometry_msgs/Vector3 translation\n'
         'geometry_msgs/Quaternion rotation\n'
-        '================================================================================\n'
-        'MSG: geometry_msgs/Vector3\n'
+    ),
+    "geometry_msgs/Vector3": (
         'float64 x\n'
         'float64 y\n'
         'float64 z\n'
-        '================================================================================\n'
-        'MSG: geometry_msgs/Quaternion\n'
+    ),
+    "geometry_msgs/Quaternion": (
         'float64 x\n'
         'float64 y\n'
         'float64 z\n'
@@ -41,81 +44,41 @@ MESSAGE_DEFINITIONS: dict[str, str] = {
         'float64[] position\n'
         'float64[] velocity\n'
         'float64[] effort\n'
-        '================================================================================\n'
-        'MSG: std_msgs/Header\n'
-        'builtin_interfaces/Time stamp\n'
-        'string frame_id\n'
-        '================================================================================\n'
-        'MSG: builtin_interfaces/Time\n'
-        'int32 sec\n'
-        'uint32 nanosec\n'
     ),
     "geometry_msgs/WrenchStamped": (
         'std_msgs/Header header\n'
         'geometry_msgs/Wrench wrench\n'
-        '================================================================================\n'
-        'MSG: std_msgs/Header\n'
-        'builtin_interfaces/Time stamp\n'
-        'string frame_id\n'
-        '================================================================================\n'
-        'MSG: builtin_interfaces/Time\n'
-        'int32 sec\n'
-        'uint32 nanosec\n'
-        '================================================================================\n'
-        'MSG: geometry_msgs/Wrench\n'
+    ),
+    "geometry_msgs/Wrench": (
         'geometry_msgs/Vector3 force\n'
         'geometry_msgs/Vector3 torque\n'
-        '================================================================================\n'
-        'MSG: geometry_msgs/Vector3\n'
-        'float64 x\n'
-        'float64 y\n'
-        'float64 z\n'
     ),
     "nav_msgs/Odometry": (
         'std_msgs/Header header\n'
         'string child_frame_id\n'
         'geometry_msgs/PoseWithCovariance pose\n'
         'geometry_msgs/TwistWithCovariance twist\n'
-        '================================================================================\n'
-        'MSG: std_msgs/Header\n'
-        'builtin_interfaces/Time stamp\n'
-        'string frame_id\n'
-        '================================================================================\n'
-        'MSG: builtin_interfaces/Time\n'
-        'int32 sec\n'
-        'uint32 nanosec\n'
-        '================================================================================\n'
-        'MSG: geometry_msgs/PoseWithCovariance\n'
+    ),
+    "geometry_msgs/PoseWithCovariance": (
         'geometry_msgs/Pose pose\n'
         'float64[36] covariance\n'
-        '================================================================================\n'
-        'MSG: geometry_msgs/Pose\n'
+    ),
+    "geometry_msgs/Pose": (
         'geometry_msgs/Point position\n'
         'geometry_msgs/Quaternion orientation\n'
-        '================================================================================\n'
-        'MSG: geometry_msgs/Point\n'
+    ),
+    "geometry_msgs/Point": (
         'float64 x\n'
         'float64 y\n'
         'float64 z\n'
-        '================================================================================\n'
-        'MSG: geometry_msgs/Quaternion\n'
-        'float64 x\n'
-        'float64 y\n'
-        'float64 z\n'
-        'float64 w\n'
-        '================================================================================\n'
-        'MSG: geometry_msgs/TwistWithCovariance\n'
+    ),
+    "geometry_msgs/TwistWithCovariance": (
         'geometry_msgs/Twist twist\n'
         'float64[36] covariance\n'
-        '================================================================================\n'
-        'MSG: geometry_msgs/Twist\n'
+    ),
+    "geometry_msgs/Twist": (
         'geometry_msgs/Vector3 linear\n'
         'geometry_msgs/Vector3 angular\n'
-        '================================================================================\n'
-        'MSG: geometry_msgs/Vector3\n'
-        'float64 x\n'
-        'float64 y\n'
-        'float64 z\n'
     ),
     "sensor_msgs/Imu": (
         'std_msgs/Header header\n'
@@ -125,43 +88,16 @@ MESSAGE_DEFINITIONS: dict[str, str] = {
         'float64[9] angular_velocity_covariance\n'
         'geometry_msgs/Vector3 linear_acceleration\n'
         'float64[9] linear_acceleration_covariance\n'
-        '================================================================================\n'
-        'MSG: std_msgs/Header\n'
-        'builtin_interfaces/Time stamp\n'
-        'string frame_id\n'
-        '================================================================================\n'
-        'MSG: builtin_interfaces/Time\n'
-        'int32 sec\n'
-        'uint32 nanosec\n'
-        '================================================================================\n'
-        'MSG: geometry_msgs/Quaternion\n'
-        'float64 x\n'
-        'float64 y\n'
-        'float64 z\n'
-        'float64 w\n'
-        '================================================================================\n'
-        'MSG: geometry_msgs/Vector3\n'
-        'float64 x\n'
-        'float64 y\n'
-        'float64 z\n'
     ),
     "sensor_msgs/FluidPressure": (
         'std_msgs/Header header\n'
         'float64 fluid_pressure\n'
         'float64 variance\n'
-        '================================================================================\n'
-        'MSG: std_msgs/Header\n'
-        'builtin_interfaces/Time stamp\n'
-        'string frame_id\n'
-        '================================================================================\n'
-        'MSG: builtin_interfaces/Time\n'
-        'int32 sec\n'
-        'uint32 nanosec\n'
     ),
     "visualization_msgs/MarkerArray": (
         'visualization_msgs/Marker[] markers\n'
-        '================================================================================\n'
-        'MSG: visualization_msgs/Marker\n'
+    ),
+    "visualization_msgs/Marker": (
         'int32 ARROW=0\n'
         'int32 CUBE=1\n'
         'int32 SPHERE=2\n'
@@ -197,57 +133,96 @@ MESSAGE_DEFINITIONS: dict[str, str] = {
         'string mesh_resource\n'
         'visualization_msgs/MeshFile mesh_file\n'
         'bool mesh_use_embedded_materials\n'
-        '================================================================================\n'
-        'MSG: std_msgs/Header\n'
-        'builtin_interfaces/Time stamp\n'
-        'string frame_id\n'
-        '================================================================================\n'
-        'MSG: builtin_interfaces/Time\n'
-        'int32 sec\n'
-        'uint32 nanosec\n'
-        '================================================================================\n'
-        'MSG: geometry_msgs/Pose\n'
-        'geometry_msgs/Point position\n'
-        'geometry_msgs/Quaternion orientation\n'
-        '================================================================================\n'
-        'MSG: geometry_msgs/Point\n'
-        'float64 x\n'
-        'float64 y\n'
-        'float64 z\n'
-        '================================================================================\n'
-        'MSG: geometry_msgs/Quaternion\n'
-        'float64 x\n'
-        'float64 y\n'
-        'float64 z\n'
-        'float64 w\n'
-        '================================================================================\n'
-        'MSG: geometry_msgs/Vector3\n'
-        'float64 x\n'
-        'float64 y\n'
-        'float64 z\n'
-        '================================================================================\n'
-        'MSG: std_msgs/ColorRGBA\n'
+    ),
+    "std_msgs/ColorRGBA": (
         'float32 r\n'
         'float32 g\n'
         'float32 b\n'
         'float32 a\n'
-        '================================================================================\n'
-        'MSG: builtin_interfaces/Duration\n'
+    ),
+    "builtin_interfaces/Duration": (
         'int32 sec\n'
         'uint32 nanosec\n'
-        '================================================================================\n'
-        'MSG: sensor_msgs/CompressedImage\n'
+    ),
+    "sensor_msgs/CompressedImage": (
         'std_msgs/Header header\n'
         'string format\n'
         'uint8[] data\n'
-        '================================================================================\n'
-        'MSG: visualization_msgs/UVCoordinate\n'
+    ),
+    "visualization_msgs/UVCoordinate": (
         'float32 u\n'
         'float32 v\n'
-        '================================================================================\n'
-        'MSG: visualization_msgs/MeshFile\n'
+    ),
+    "visualization_msgs/MeshFile": (
         'string filename\n'
         'uint8[] data\n'
     ),
 }
 # fmt: on
+
+#: the types a message uses, in the order its definition lists them
+_USES: dict[str, tuple[str, ...]] = {
+    "tf2_msgs/TFMessage": (
+        "geometry_msgs/TransformStamped",
+        "std_msgs/Header",
+        "builtin_interfaces/Time",
+        "geometry_msgs/Transform",
+        "geometry_msgs/Vector3",
+        "geometry_msgs/Quaternion",
+    ),
+    "sensor_msgs/JointState": (
+        "std_msgs/Header",
+        "builtin_interfaces/Time",
+    ),
+    "geometry_msgs/WrenchStamped": (
+        "std_msgs/Header",
+        "builtin_interfaces/Time",
+        "geometry_msgs/Wrench",
+        "geometry_msgs/Vector3",
+    ),
+    "nav_msgs/Odometry": (
+        "std_msgs/Header",
+        "builtin_interfaces/Time",
+        "geometry_msgs/PoseWithCovariance",
+        "geometry_msgs/Pose",
+        "geometry_msgs/Point",
+        "geometry_msgs/Quaternion",
+        "geometry_msgs/TwistWithCovariance",
+        "geometry_msgs/Twist",
+        "geometry_msgs/Vector3",
+    ),
+    "sensor_msgs/Imu": (
+        "std_msgs/Header",
+        "builtin_interfaces/Time",
+        "geometry_msgs/Quaternion",
+        "geometry_msgs/Vector3",
+    ),
+    "sensor_msgs/FluidPressure": (
+        "std_msgs/Header",
+        "builtin_interfaces/Time",
+    ),
+    "visualization_msgs/MarkerArray": (
+        "visualization_msgs/Marker",
+        "std_msgs/Header",
+        "builtin_interfaces/Time",
+        "geometry_msgs/Pose",
+        "geometry_msgs/Point",
+        "geometry_msgs/Quaternion",
+        "geometry_msgs/Vector3",
+        "std_msgs/ColorRGBA",
+        "builtin_interfaces/Duration",
+        "sensor_msgs/CompressedImage",
+        "visualization_msgs/UVCoordinate",
+        "visualization_msgs/MeshFile",
+    ),
+}
+
+
+def _definition(name: str) -> str:
+    return _FIELDS[name] + "".join(
+        f"{_SEPARATOR}MSG: {used}\n{_FIELDS[used]}" for used in _USES[name]
+    )
+
+
+#: the full definition of each message type the bag holds
+MESSAGE_DEFINITIONS: dict[str, str] = {name: _definition(name) for name in _USES}
