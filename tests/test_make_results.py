@@ -71,7 +71,7 @@ def test_make_demo_runs_twice(tmp_path):
     )
     out = tmp_path / "demo"
     command = [
-        "make", "-C", str(ROOT), "-o", ".venv/.installed", "demo",
+        "make", "-C", str(ROOT), "-o", ".venv/.installed", "-o", ".venv/.installed-base", "demo",
         f"DEMO_SCENARIO={scenario}", f"DEMO_OUT={out}",
     ]  # fmt: skip
     for _ in range(2):

@@ -74,6 +74,15 @@ class Rollout(RolloutData):
         ``intensity`` (T, bins, beams), ``range_m`` (bins,), ``bearing_rad`` (beams,)."""
         return sonar_record(self.perception, self.metadata, name)
 
+    def to_mcap(self, path: str | Path, *, urdf: str | Path | None = None) -> Path:
+        """Write this rollout as a ROS 2 bag: one MCAP file, CDR-encoded ROS 2 messages
+        (``/tf``, ``/joint_states``, ``/odometry/truth``, ...; docs/ros.md), written aside
+        and renamed into place. ``urdf``: the model, if it moved since the run. Needs the
+        ``ros`` extra (``pip install "uvms-pin[ros]"``)."""
+        from uvms_pin.apps.export.ros_bag import write_mcap
+
+        return write_mcap(self, path, urdf=urdf)
+
     # ---- persistence ------------------------------------------------------------------
     def save(self, directory: str | Path) -> Path:
         """Write ``rollout.npz`` and ``rollout.json`` into ``directory`` atomically (and the

@@ -11,6 +11,7 @@ from typing import TYPE_CHECKING
 
 from uvms_pin.apps.arguments import add_set_option, path_text, positive
 from uvms_pin.apps.arms.command import register as register_compare_arms
+from uvms_pin.apps.cli.export import register as register_export
 from uvms_pin.apps.cli.run import check_view_options, cmd_run
 from uvms_pin.apps.compare.command import register as register_compare_controllers
 from uvms_pin.apps.exit_codes import (
@@ -170,6 +171,7 @@ def build_parser() -> argparse.ArgumentParser:
     )
     info.set_defaults(func=_cmd_info)
     _add_import(sub)
+    register_export(sub)
     register_study_commands(sub)
     register_compare_arms(sub)
     register_compare_controllers(sub)

@@ -1,0 +1,182 @@
+"""Reading a ROS 2 bag back with rosbags (an independent reader, with its own copy of the ROS 2
+message definitions) and comparing every message with the rollout it was written from (1e-9):
+the links' poses by composing the TF tree read back against Pinocchio's world placements of
+the same frames. Used by tests/apps/export/test_ros_bag.py and the command's tests."""
+
+from __future__ import annotations
+
+from collections import defaultdict
+from pathlib import Path
+
+import numpy as np
+import pinocchio as pin
+from rosbags.rosbag2 import Reader
+from rosbags.typesys import Stores, get_typestore
+
+from uvms_pin.apps.export.ros_bag import rollout_model
+from uvms_pin.apps.export.ros_messages import EPOCH_NS
+from uvms_pin.results.joint_positions import arm_positions
+from uvms_pin.sim.navigation.depth import ATMOSPHERIC_PRESSURE_PA, GRAVITY_M_S2
+
+TOL = 1e-9
+
+
+def read_bag(path: Path) -> dict[str, list[tuple[int, object]]]:
+    """topic -> [(log time [ns], message)], decoded by rosbags with ROS 2 Humble's types."""
+    store = get_typestore(Stores.ROS2_HUMBLE)
+    out: dict[str, list] = defaultdict(list)
+    with Reader(path) as reader:
+        for connection, time_ns, raw in reader.messages():
+            msgtype = connection.msgtype
+            if "/msg/" not in msgtype:
+                pkg, name = msgtype.split("/")
+                msgtype = f"{pkg}/msg/{name}"
+            out[connection.topic].append((time_ns, store.deserialize_cdr(raw, msgtype)))
+    return dict(out)
+
+
+def _vec(v) -> np.ndarray:
+    return np.array([v.x, v.y, v.z])
+
+
+def _quat(q) -> np.ndarray:
+    return np.array([q.x, q.y, q.z, q.w])
+
+
+def _stamp(header) -> int:
+    return header.stamp.sec * 10**9 + header.stamp.nanosec
+
+
+def _se3(t) -> pin.SE3:
+    quat = _quat(t.rotation)
+    return pin.SE3(pin.Quaternion(quat).toRotationMatrix(), _vec(t.translation))
+
+
+def _close(a, b) -> None:
+    np.testing.assert_allclose(np.asarray(a, float), np.asarray(b, float), rtol=0, atol=TOL)
+
+
+def _world_placements(static: list, dynamic: list) -> dict[str, pin.SE3]:
+    """Each frame's placement in ``map``, composed along the TF tree read back."""
+    parent_of = {t.child_frame_id: (t.header.frame_id, _se3(t.transform)) for t in static + dynamic}
+    placed = {"map": pin.SE3.Identity()}
+
+    def world(frame: str) -> pin.SE3:
+        if frame not in placed:
+            parent, local = parent_of[frame]
+            placed[frame] = world(parent) * local
+        return placed[frame]
+
+    return {frame: world(frame) for frame in parent_of}
+
+
+def check_bag(rollout, bag: dict) -> None:
+    """Every message of ``bag`` against ``rollout`` (1e-9)."""
+    n = len(rollout)
+    times = [EPOCH_NS + round(float(t) * 1e9) for t in rollout.time_s]
+    uvms = rollout_model(rollout)
+    model, data = uvms.model, uvms.model.createData()
+    (static_time, static), *_ = bag["/tf_static"]
+    assert len(bag["/tf_static"]) == 1 and static_time == times[0]
+    for topic in ("/tf", "/odometry/truth"):
+        assert [t for t, _ in bag[topic]] == times, topic
+    world = (rollout.metadata.get("world") or {}).get("world") or {}
+    free = [o["name"] for o in world.get("free_objects", ())]
+    kinds = (pin.FrameType.BODY, pin.FrameType.OP_FRAME)
+    frame_ids = [fid for fid, f in enumerate(model.frames) if f.type in kinds]
+    for k in range(n):
+        tf = bag["/tf"][k][1].transforms
+        assert all(_stamp(t.header) == times[k] for t in tf)
+        placements = _world_placements(static.transforms, tf)
+        pin.framesForwardKinematics(model, data, rollout.q[k])
+        for fid in frame_ids:
+            got = placements[model.frames[fid].name]
+            _close(got.translation, data.oMf[fid].translation)
+            _close(got.rotation, data.oMf[fid].rotation)
+        for j, name in enumerate(free):
+            state = rollout.signals["free_objects"][k, 13 * j : 13 * j + 7]
+            _close(placements[name].translation, state[:3])
+            _close(placements[name].rotation, pin.Quaternion(state[3:7]).toRotationMatrix())
+        odom = bag["/odometry/truth"][k][1]
+        _close(
+            [*_vec(odom.pose.pose.position), *_quat(odom.pose.pose.orientation)], rollout.q[k, :7]
+        )
+        _close([*_vec(odom.twist.twist.linear), *_vec(odom.twist.twist.angular)], rollout.v[k, :6])
+        if uvms.ee_frame_id is not None:
+            rotation = data.oMf[uvms.ee_frame_id].rotation
+            for topic, logged in (
+                ("/ee/wrench", rollout.wrench_contact_world[k]),
+                ("/ft_sensor/wrench", rollout.wrench_measured_world[k]),
+            ):
+                time_ns, message = bag[topic][k]
+                assert time_ns == times[k]
+                assert message.header.frame_id == model.frames[uvms.ee_frame_id].name
+                force, torque = _vec(message.wrench.force), _vec(message.wrench.torque)
+                _close(np.concatenate([rotation @ force, rotation @ torque]), logged)
+    _check_joints(rollout, bag, times)
+    _check_navigation(rollout, bag, times)
+    _check_world(world, bag)
+
+
+def _check_joints(rollout, bag: dict, times: list[int]) -> None:
+    meta = rollout.metadata
+    names = meta.get("arm_joint_names", [])
+    if not names:
+        assert "/joint_states" not in bag
+        return
+    positions = arm_positions(rollout.q[:, 7:], meta["arm_joint_kinds"])
+    assert [t for t, _ in bag["/joint_states"]] == times
+    for k, (_, message) in enumerate(bag["/joint_states"]):
+        assert list(message.name) == names
+        _close(message.position, positions[k])
+        _close(message.velocity, rollout.v[k, 6:])
+        _close(message.effort, rollout.tau[k, 6:])
+    if "thrust" in rollout.signals:
+        thrusters = meta["signal_units"]["thrust"]["components"]
+        for k, (_, message) in enumerate(bag["/thrusters"]):
+            assert list(message.name) == thrusters
+            _close(message.effort, rollout.signals["thrust"][k])
+        assert len(bag["/thrusters"]) == len(times)
+
+
+def _nan_close(a, b) -> None:
+    np.testing.assert_allclose(
+        np.asarray(a, float), np.asarray(b, float), rtol=0, atol=TOL, equal_nan=True
+    )
+
+
+def _check_navigation(rollout, bag: dict, times: list[int]) -> None:
+    signals = rollout.signals
+    assert ("estimate" in signals) == ("/odometry/estimate" in bag)
+    assert ("imu_gyro" in signals) == ("/imu" in bag)
+    assert ("depth" in signals) == ("/depth" in bag)
+    for k, (time_ns, message) in enumerate(bag.get("/odometry/estimate", [])):
+        assert time_ns == times[k]
+        estimate = signals["estimate"][k]
+        pose = message.pose.pose
+        _nan_close([*_vec(pose.position), *_quat(pose.orientation)], estimate[:7])
+        rotation = pin.Quaternion(estimate[3:7] / np.linalg.norm(estimate[3:7])).toRotationMatrix()
+        _nan_close(rotation @ _vec(message.twist.twist.linear), estimate[7:10])
+        assert np.isnan(_vec(message.twist.twist.angular)).all()
+    for k, (_, message) in enumerate(bag.get("/imu", [])):
+        _nan_close(_vec(message.angular_velocity), signals["imu_gyro"][k])
+        _nan_close(_vec(message.linear_acceleration), signals["imu_accel"][k])
+        assert message.orientation_covariance[0] == -1.0
+    density = (rollout.metadata.get("world") or {}).get("water_density_kg_m3", 1025.0)
+    for k, (_, message) in enumerate(bag.get("/depth", [])):
+        depth_m = (message.fluid_pressure - ATMOSPHERIC_PRESSURE_PA) / (density * GRAVITY_M_S2)
+        _nan_close(depth_m, signals["depth"][k, 0])
+
+
+def _check_world(world: dict, bag: dict) -> None:
+    objects = [*world.get("objects", ()), *world.get("free_objects", ())]
+    if not objects:
+        assert "/world/markers" not in bag
+        return
+    ((_, message),) = bag["/world/markers"]
+    assert [m.header.frame_id for m in message.markers] == [o["name"] for o in objects]
+    static = {t.child_frame_id: t for t in bag["/tf_static"][0][1].transforms}
+    for record in world.get("objects", ()):
+        placed = _se3(static[record["name"]].transform)
+        _close(placed.translation, record["position_world_m"])
+        _close(placed.rotation, record["rotation_world"])
