@@ -180,7 +180,9 @@ ROUND_TWO = [
     Case("run-controller-constructor-raises", _RUN_NEW, ("s.toml", "[controller]", "rejected its parameters (gain)", "KeyError"), _with_controller(_controller("return None", init="self.gain = {}['gain']"), "gain = 2.0\n"), traceback_of="ctrl.py", watch="new"),
     Case("run-controller-module-fails-to-import", _RUN_NEW, ("importing 'ctrl' failed", "NameError"), _with_controller("import numpy as np\nundefined_name\n"), traceback_of="ctrl.py", watch="new"),
     # ---- 5. a second Ctrl-C while the first is handled -----------------------------------
-    Case("run-second-ctrl-c-while-saving", ("run", "long.toml", "--out", "new", "--quiet"), ("interrupted", "the partial rollout (t = 0 to"), write("long.toml", scenario_with(_URDF, 600.0)), code=130, interrupts=(0.02,), after=rollout_kept("new", "interrupted")),
+    # which message ends the run depends on whether the second press lands during the save
+    # (a race on a loaded machine); test_run_outputs.py holds both outcomes at set delays
+    Case("run-second-ctrl-c-while-saving", ("run", "long.toml", "--out", "new", "--quiet"), ("interrupted",), write("long.toml", scenario_with(_URDF, 600.0)), code=130, interrupts=(0.02,), after=rollout_kept("new", "interrupted")),
     Case("run-three-ctrl-c-in-a-row", ("run", "long.toml", "--out", "new", "--quiet"), ("interrupted",), write("long.toml", scenario_with(_URDF, 600.0)), code=130, interrupts=(0.01, 0.05), after=rollout_kept("new", "interrupted")),
     # ---- 6. seeds numpy would refuse: named where they are given -------------------------
     Case("run-negative-seed", ("run", "{good}", "--out", "new", "--set", "scenario.seed=-5"), ("override 'scenario.seed'", "must be an integer in [0, 2^63 - 1], got -5"), watch="new"),
