@@ -9,7 +9,7 @@ import pytest
 from gymnasium.vector import AutoresetMode
 
 import uvms_pin.apps.gym  # noqa: F401 - registers the environments
-from uvms_pin.errors import ParameterError
+from uvms_pin.errors import ParameterError, StiffModeError
 
 FORCE = "uvms_pin/ForceTracking-v0"
 STATION = "uvms_pin/StationKeeping-v0"
@@ -197,3 +197,23 @@ def test_unsupported_plants_are_refused():
             FORCE, num_envs=2, vectorization_mode="vector_entry_point",
             scenario="sea_state_force_tracking",
         )  # fmt: skip
+
+
+def test_a_stiff_mode_is_refused_before_the_batch_is_built():
+    """The vector environment refuses what its single environment refuses at reset: the
+    compliant stops of StationKeeping's light wrist are unstable at its RK4 step (named,
+    with the largest stable step), so no batch is built and no episode diverges."""
+    overrides = {"joints.stops": "compliant"}
+    with pytest.raises(StiffModeError) as single:
+        gym.make(STATION, overrides=overrides).reset(seed=0)
+    with pytest.raises(StiffModeError) as vector:
+        _vector(STATION, 2, overrides=overrides)
+    assert str(vector.value) == str(single.value)
+    assert "compliant stop of joint" in str(vector.value)
+    assert "largest stable step" in str(vector.value)
+
+
+def test_the_defaults_record_their_stiffest_mode():
+    envs = _vector(STATION, 2)
+    assert envs.unwrapped.stiff_modes["checked"] is True
+    envs.close()

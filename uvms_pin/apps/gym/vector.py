@@ -32,6 +32,8 @@ from uvms_pin.apps.gym.force_tracking import ForceTrackingEnv
 from uvms_pin.apps.gym.station_keeping import StationKeepingEnv
 from uvms_pin.errors import ParameterError
 from uvms_pin.sim.batched_plant import DIVERGED, BatchedPlant, check_count
+from uvms_pin.sim.stiffness import check_stiff_modes
+from uvms_pin.sim.system import System
 
 _MODES = {mode.value: mode for mode in (AutoresetMode.NEXT_STEP, AutoresetMode.SAME_STEP)}
 
@@ -55,6 +57,10 @@ class UvmsVectorEnv(VectorEnv):
         num_envs: N >= 1. num_threads: T >= 1.
         autoreset_mode: AutoresetMode.NEXT_STEP (default) or SAME_STEP.
         **kwargs: the single environment's arguments (scenario, action_scale, ...).
+
+    Attributes:
+        stiff_modes: the scenario's explicit stiff modes as checked before the batch is
+            built (`uvms_pin.sim.stiffness.check_stiff_modes`; StiffModeError if unstable).
     """
 
     metadata: ClassVar[dict[str, Any]] = {
@@ -77,6 +83,11 @@ class UvmsVectorEnv(VectorEnv):
             raise ParameterError("the vector environment does not render: render_mode=None")
         self.single_env = env_class(**kwargs)  # the arguments parsed once, its task and spaces
         scenario = self.single_env.scenario
+        # the batch steps the single environment's plant: its explicit stiff modes are checked
+        # once, at the scenario's start, before the batch takes its memory (as a run does)
+        system = System(scenario.plant)
+        start = system.initial_state(scenario.q0, scenario.v0)
+        self.stiff_modes = check_stiff_modes(system, start, scenario.settings.integrator)
         self.batch = BatchedPlant(
             scenario.plant, scenario.settings, scenario.sensor_config, num_envs, num_threads
         )
