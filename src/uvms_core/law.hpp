@@ -14,11 +14,20 @@
 // compiled law hand the run to each other tick for tick.
 #pragma once
 
+#include <cmath>
 #include <vector>
 
 #include "types.hpp"
 
 namespace uvms {
+
+// All n entries of x finite (a measurement or a desired row a law may decline).
+inline bool all_finite(const double* x, Eigen::Index n) {
+  for (Eigen::Index j = 0; j < n; ++j) {
+    if (!std::isfinite(x[j])) return false;
+  }
+  return true;
+}
 
 enum class LawStatus : int {
   ok = 0,

@@ -23,6 +23,7 @@
 #include <pinocchio/multibody/data.hpp>
 #include <pinocchio/multibody/model.hpp>
 
+#include "law.hpp"
 #include "types.hpp"
 
 namespace uvms {
@@ -48,14 +49,6 @@ struct ForceTaskSettings {
 
 // Python's float x % y: fmod with the sign of the divisor (CPython's float_rem).
 double python_mod(double x, double y);
-
-// All n entries of x finite.
-inline bool all_finite(const double* x, Eigen::Index n) {
-  for (Eigen::Index j = 0; j < n; ++j) {
-    if (!std::isfinite(x[j])) return false;
-  }
-  return true;
-}
 
 class ForceOrientationTask {
  public:

@@ -60,11 +60,8 @@ void TaskPriorityLaw::set_state(const InverseDynamicsState& state) {
 
 LawStatus TaskPriorityLaw::command(const LawInput& in) {
   const int n = nv();
-  for (const auto& [x, size] : {std::pair<const double*, int>{in.q, nq()}, {in.v, n},
-                                {in.desired, 9}}) {
-    for (int j = 0; j < size; ++j) {
-      if (!std::isfinite(x[j])) return LawStatus::declined;
-    }
+  if (!(all_finite(in.q, nq()) && all_finite(in.v, n) && all_finite(in.desired, 9))) {
+    return LawStatus::declined;
   }
   q_ = Eigen::Map<const Eigen::VectorXd>(in.q, nq());
   v_ = Eigen::Map<const Eigen::VectorXd>(in.v, n);

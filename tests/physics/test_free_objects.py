@@ -4,16 +4,15 @@ added mass, momentum conservation and the energy."""
 
 from __future__ import annotations
 
-import dataclasses
 import math
 
 import numpy as np
 import pinocchio as pin
 import pytest
 from conftest import RHO, ROOT, G, body_urdf, hydro_xml
+from free_object_helpers import undamped
 
 import uvms_pin as up
-from uvms_pin.hydro.params import HydroParams
 from uvms_pin.physics.world.contact_law import ContactLaw
 from uvms_pin.physics.world.free_object import free_object, solid_mass_properties
 from uvms_pin.physics.world.objects import plane
@@ -32,17 +31,6 @@ def _pusher(load_body, mass=4.0, radius=0.1):
     collision = f'<sphere radius="{radius}"/>'
     urdf = body_urdf(mass=mass, inertia=inertia, hydro=hydro_xml(volume), collision=collision)
     return load_body(urdf)
-
-
-def _undamped(obj):
-    """The object without hydrodynamic damping (added mass and buoyancy kept)."""
-    uvms = obj.uvms.with_hydro(
-        lambda b: HydroParams(
-            b.params.volume_m3, b.params.center_of_buoyancy_m, b.params.added_mass,
-            np.zeros(6), np.zeros(6),
-        )
-    )  # fmt: skip
-    return dataclasses.replace(obj, uvms=uvms)
 
 
 def _run(system, q, v, tau, duration_s, step_s, period_s):
@@ -131,7 +119,7 @@ def test_a_free_box_dropped_on_the_seafloor_rests_on_its_net_weight(load_body):
 
 def _push_setup(load_body, force_N):
     pusher = _pusher(load_body)
-    ball = _undamped(
+    ball = undamped(
         free_object(
             "ball", "sphere", {"radius_m": 0.2}, ([0.0, 0.0, -5.0], [0, 0, 0]),
             density_kg_m3=RHO, water_density_kg_m3=RHO,

@@ -7,16 +7,15 @@ system the core cannot do still runs in Python, its reason recorded."""
 from __future__ import annotations
 
 import copy
-import dataclasses
 from pathlib import Path
 
 import numpy as np
 import pinocchio as pin
 import pytest
 from conftest import RHO, body_urdf, hydro_xml
+from free_object_helpers import undamped
 
 import uvms_pin as up
-from uvms_pin.hydro.params import HydroParams
 from uvms_pin.physics.compiled.backend import Fallback
 from uvms_pin.physics.compiled.moving import contacts_of_core
 from uvms_pin.physics.world.contact_law import ContactLaw
@@ -193,13 +192,7 @@ def test_two_free_objects_collide_passively_in_the_core(load_body):
             name, "sphere", {"radius_m": 0.2}, ([x, y, -5.0], [0, 0, 0]), density_kg_m3=RHO,
             water_density_kg_m3=RHO, velocity_body=v0,
         )  # fmt: skip
-        undamped = made.uvms.with_hydro(
-            lambda b: HydroParams(
-                b.params.volume_m3, b.params.center_of_buoyancy_m, b.params.added_mass,
-                np.zeros(6), np.zeros(6),
-            )
-        )  # fmt: skip
-        return dataclasses.replace(made, uvms=undamped)
+        return undamped(made)
 
     a = ball("a", 0.0, 0.0, [0.6, 0, 0, 0, 0, 0.5])
     b = ball("b", 0.5, 0.1, [0, 0, 0, 0, 0, 0])

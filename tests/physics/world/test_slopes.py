@@ -66,9 +66,9 @@ import numpy as np
 import pinocchio as pin
 import pytest
 from conftest import RHO, G, body_urdf, hydro_xml
+from free_object_helpers import undamped
 
 import uvms_pin as up
-from uvms_pin.hydro.params import HydroParams
 from uvms_pin.physics.world.contact_law import ContactLaw
 from uvms_pin.physics.world.free_object import free_object
 from uvms_pin.physics.world.objects import plane
@@ -89,17 +89,6 @@ SHAPES = {
 POINTS = {"sphere": 1, "cylinder": 2, "box": 4}
 #: the rise of the mechanical energy allowed, relative to the kinetic energy gained
 ENERGY_RISE = 1e-4
-
-
-def _undamped(obj):
-    """The object without hydrodynamic damping (its buoyancy and added mass kept)."""
-    uvms = obj.uvms.with_hydro(
-        lambda b: HydroParams(
-            b.params.volume_m3, b.params.center_of_buoyancy_m, b.params.added_mass,
-            np.zeros(6), np.zeros(6),
-        )
-    )  # fmt: skip
-    return dataclasses.replace(obj, uvms=uvms)
 
 
 @dataclasses.dataclass
@@ -129,7 +118,7 @@ def _slope(load_body, kind: str, theta_deg: float) -> Slope:
 
     def made(sunk_m: float):
         pose = (foot + normal * (half - sunk_m), pin.rpy.matrixToRpy(rotation))
-        return _undamped(
+        return undamped(
             free_object(
                 "body", kind, sizes, pose, density_kg_m3=DENSITY, water_density_kg_m3=RHO,
                 friction=MU,
