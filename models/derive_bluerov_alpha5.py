@@ -134,7 +134,9 @@ ALPHA_JAW = ("alpha_jaw_link", 0.05, (0.0, 0.0, -0.190), 0.020, (0.05, 0.05, 0.0
 # ---- the Alpha 5's standard jaw (R26, masses P25), in reach_alpha5_jaws.urdf -----------
 # The jaw base sits 99.75 mm along the wrist axis from axis B (R26); in K23's wrist frame the
 # tool points along -z, so the jaw base frame is turned by pi about x: its +z points out of
-# the wrist, as R26's. K23's locked-jaw point mass (ALPHA_JAW) stays as the jaw's housing.
+# the wrist, as R26's. K23's locked-jaw point mass (ALPHA_JAW: 0.05 kg, 0.020 L) stays as the
+# jaw's housing, moved to the jaw base: at K23's 0.19 m it would sit between the fingertips,
+# and a link without collision shapes touches the world by a sphere of its volume (17 mm).
 ALPHA_JAW_BASE_XYZ_M = (0.0, 0.0, -0.09975)
 ALPHA_JAW_BASE_RPY = (math.pi, 0.0, 0.0)
 # finger: joint, link, pivot in the jaw base [m], axis, collision box centre in the finger [m]
@@ -388,7 +390,12 @@ def _finger(joint: str, link: str, pivot, axis, centre, mimic: str | None) -> st
 
 def alpha5_jaws_urdf() -> str:
     """reach_alpha5.urdf with the standard jaw's two fingers moving (R26, P25)."""
+    jaw, mass, _, volume_L, drag = ALPHA_JAW
+    at_base = f'origin xyz="{_f(ALPHA_JAW_BASE_XYZ_M)}" rpy="0 0 0"/>\n  </joint>\n'
     locked = alpha5_urdf().rstrip().removesuffix("</robot>")
+    locked = locked.replace(
+        'origin xyz="0 0 -0.19" rpy="0 0 0"/>\n  </joint>\n', at_base
+    ).replace("jaw, locked closed: a point mass with its volume", "jaw housing: a point mass")
     out = locked.replace(
         "Reach Alpha 5 (arm only), jaw locked; Kolano's identification",
         "Reach Alpha 5 (arm only) with its standard jaw's two fingers (Reach Robotics' "
