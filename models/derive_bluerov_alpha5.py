@@ -143,10 +143,20 @@ ALPHA_JAW_BASE_RPY = (math.pi, 0.0, 0.0)
 # Each finger is a revolute joint, 0 (closed) .. 0.5 rad (open), effort 10, velocity 10
 # (R26); R26 couples them through <mimic> (finger 139 mimics finger 130, multiplier 1).
 ALPHA_FINGERS = (
-    ("alpha_jaw_finger_130_joint", "alpha_jaw_finger_130_link", (0.0, 0.0155, 0.0069),
-     (-1.0, 0.0, 0.0), (0.0, -0.008, 0.045)),
-    ("alpha_jaw_finger_139_joint", "alpha_jaw_finger_139_link", (0.0, -0.0155, 0.0069),
-     (1.0, 0.0, 0.0), (0.0, 0.008, 0.045)),
+    (
+        "alpha_jaw_finger_130_joint",
+        "alpha_jaw_finger_130_link",
+        (0.0, 0.0155, 0.0069),
+        (-1.0, 0.0, 0.0),
+        (0.0, -0.008, 0.045),
+    ),
+    (
+        "alpha_jaw_finger_139_joint",
+        "alpha_jaw_finger_139_link",
+        (0.0, -0.0155, 0.0069),
+        (1.0, 0.0, 0.0),
+        (0.0, 0.008, 0.045),
+    ),
 )
 ALPHA_FINGER_BOX_M = (0.012, 0.03, 0.09)  # collision box x y z (R26)
 ALPHA_FINGER_MASS_KG = 0.055  # P25; inertia: the uniform box's
@@ -363,8 +373,14 @@ def alpha5_urdf() -> str:
 def _box_inertia(mass: float, size) -> tuple[float, ...]:
     """(ixx 0 0 iyy 0 izz) of a uniform box about its centre [kg m^2]."""
     x, y, z = size
-    return (mass * (y * y + z * z) / 12, 0.0, 0.0, mass * (x * x + z * z) / 12, 0.0,
-            mass * (x * x + y * y) / 12)
+    return (
+        mass * (y * y + z * z) / 12,
+        0.0,
+        0.0,
+        mass * (x * x + z * z) / 12,
+        0.0,
+        mass * (x * x + y * y) / 12,
+    )
 
 
 def _finger(joint: str, link: str, pivot, axis, centre, mimic: str | None) -> str:
@@ -373,7 +389,9 @@ def _finger(joint: str, link: str, pivot, axis, centre, mimic: str | None) -> st
     box = f'<geometry><box size="{_f(ALPHA_FINGER_BOX_M)}"/></geometry>'
     lower, upper, effort, velocity = ALPHA_FINGER_LIMITS
     inertia = _box_inertia(ALPHA_FINGER_MASS_KG, ALPHA_FINGER_BOX_M)
-    mimic_line = "" if mimic is None else f'    <mimic joint="{mimic}" multiplier="1" offset="0"/>\n'
+    mimic_line = (
+        "" if mimic is None else f'    <mimic joint="{mimic}" multiplier="1" offset="0"/>\n'
+    )
     return (
         f'  <link name="{link}">\n{_inertial(ALPHA_FINGER_MASS_KG, centre, inertia)}'
         f'    <visual>\n      <origin xyz="{_f(centre)}" rpy="0 0 0"/>\n      {box}\n'
@@ -390,21 +408,25 @@ def _finger(joint: str, link: str, pivot, axis, centre, mimic: str | None) -> st
 
 def alpha5_jaws_urdf() -> str:
     """reach_alpha5.urdf with the standard jaw's two fingers moving (R26, P25)."""
-    jaw, mass, _, volume_L, drag = ALPHA_JAW
     at_base = f'origin xyz="{_f(ALPHA_JAW_BASE_XYZ_M)}" rpy="0 0 0"/>\n  </joint>\n'
     locked = alpha5_urdf().rstrip().removesuffix("</robot>")
-    locked = locked.replace(
-        'origin xyz="0 0 -0.19" rpy="0 0 0"/>\n  </joint>\n', at_base
-    ).replace("jaw, locked closed: a point mass with its volume", "jaw housing: a point mass")
+    locked = locked.replace('origin xyz="0 0 -0.19" rpy="0 0 0"/>\n  </joint>\n', at_base).replace(
+        "jaw, locked closed: a point mass with its volume", "jaw housing: a point mass"
+    )
     out = locked.replace(
         "Reach Alpha 5 (arm only), jaw locked; Kolano's identification",
         "Reach Alpha 5 (arm only) with its standard jaw's two fingers (Reach Robotics' "
         "description); Kolano's identification",
     ).replace('<robot name="reach_alpha5">', '<robot name="reach_alpha5_jaws">')
-    out += '  <!-- the standard jaw: its base, then two fingers (R26) -->\n'
+    out += "  <!-- the standard jaw: its base, then two fingers (R26) -->\n"
     out += '  <link name="alpha_jaw_base_link"/>\n'
-    out += _fixed("alpha_jaw_base_joint", "alpha_wrist_link", "alpha_jaw_base_link",
-                  ALPHA_JAW_BASE_XYZ_M, ALPHA_JAW_BASE_RPY)
+    out += _fixed(
+        "alpha_jaw_base_joint",
+        "alpha_wrist_link",
+        "alpha_jaw_base_link",
+        ALPHA_JAW_BASE_XYZ_M,
+        ALPHA_JAW_BASE_RPY,
+    )
     first = ALPHA_FINGERS[0][0]
     for k, (joint, link, pivot, axis, centre) in enumerate(ALPHA_FINGERS):
         out += _finger(joint, link, pivot, axis, centre, None if k == 0 else first)

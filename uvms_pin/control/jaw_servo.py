@@ -76,8 +76,9 @@ class JawServo:
     schedule: JawSchedule
 
     @classmethod
-    def for_model(cls, model: pin.Model, jaw: JawJoints, max_force_N: float,
-                  schedule: JawSchedule) -> JawServo:
+    def for_model(
+        cls, model: pin.Model, jaw: JawJoints, max_force_N: float, schedule: JawSchedule
+    ) -> JawServo:
         """The servo of ``jaw`` in ``model``: levers, gains from the fingers' inertias."""
         if not (math.isfinite(max_force_N) and max_force_N > 0.0):
             raise ParameterError(f"max_force_N must be positive, got {max_force_N}")
@@ -85,8 +86,9 @@ class JawServo:
         travel = jaw.upper - jaw.lower
         stiffness = max_force_N * lever / (SATURATION_TRAVEL_FRACTION * travel)
         inertia = _joint_inertias(model, jaw)
-        return cls(jaw, float(max_force_N), lever, stiffness,
-                   2.0 * np.sqrt(stiffness * inertia), schedule)
+        return cls(
+            jaw, float(max_force_N), lever, stiffness, 2.0 * np.sqrt(stiffness * inertia), schedule
+        )
 
     def target(self, time_s: float) -> np.ndarray:
         """Each jaw joint's target [rad or m]: closed (lower limit) or open (upper)."""
@@ -121,7 +123,10 @@ class WithJaw(Controller):
         jaw = self.servo.jaw
         q, v = measurement.q, measurement.v
         arm_measurement = Measurement(
-            time_s, q[jaw.arm_q_index], v[jaw.arm_v_index], measurement.wrench_world,
+            time_s,
+            q[jaw.arm_q_index],
+            v[jaw.arm_v_index],
+            measurement.wrench_world,
             measurement.images,
         )
         tau = self._tau.copy()

@@ -50,7 +50,9 @@ class JawJoints:
     upper: np.ndarray
 
     @classmethod
-    def of(cls, model: pin.Model, names: Sequence[str] | None = None, source: str = "") -> JawJoints:
+    def of(
+        cls, model: pin.Model, names: Sequence[str] | None = None, source: str = ""
+    ) -> JawJoints:
         """The jaw joints of ``model``: ``names`` if given, else by the naming rule.
 
         Raises:
