@@ -94,3 +94,14 @@ def test_the_arm_controller_sees_and_commands_the_arm_only(uvms, servo):
     assert jaw.units == ("rad", "rad", "N", "N")
     np.testing.assert_allclose(jaw.values[:2], [0.2, 0.4])
     np.testing.assert_allclose(jaw.values[2:], 10.0)  # both saturated
+
+
+def test_a_sampled_servo_is_softened_for_light_fingers(uvms, servo):
+    jaw = JawJoints.of(uvms.model)
+    sampled = JawServo.for_model(uvms.model, jaw, 10.0, JawSchedule(), period_s=0.002)
+    inertia = servo.damping**2 / (4.0 * servo.stiffness)  # d = 2 sqrt(k I)
+    np.testing.assert_allclose(sampled.stiffness, inertia / (4.0 * 0.002**2), rtol=1e-12)
+    assert np.all(sampled.stiffness < servo.stiffness)
+    np.testing.assert_allclose(sampled.damping * 0.002 / inertia, 1.0, rtol=1e-12)
+    fast = JawServo.for_model(uvms.model, jaw, 10.0, JawSchedule(), period_s=1e-4)
+    np.testing.assert_array_equal(fast.stiffness, servo.stiffness)  # no cap needed

@@ -10,7 +10,10 @@ is a force already). A finger stopped by an object before its target presses it 
 F_max at that point: the servo is then saturated. The stiffness k_i = F_max r_i / (0.05
 travel) saturates the servo 5 % of the joint's travel away from its target, the damping
 d_i = 2 sqrt(k_i I_i) critically damps the free finger (I_i its inertia about its joint,
-from the composite rigid-body inertia at the locked position, `JawServo.for_model`).
+from the composite rigid-body inertia at the closed position, `JawServo.for_model`). Sampled
+every T [s] (a control period), the law is held over T: d_i T / I_i must stay well below 2,
+so with a period k_i is capped at I_i / (4 T^2) (then d_i = I_i / T): a light finger gets a
+softer servo that saturates further from its target, not a loop that diverges.
 
 The target is the jaw's closed position (each joint's lower limit) from ``close_at_s`` until
 ``open_at_s`` and its open position (upper limit) otherwise.
@@ -77,15 +80,23 @@ class JawServo:
 
     @classmethod
     def for_model(
-        cls, model: pin.Model, jaw: JawJoints, max_force_N: float, schedule: JawSchedule
+        cls,
+        model: pin.Model,
+        jaw: JawJoints,
+        max_force_N: float,
+        schedule: JawSchedule,
+        period_s: float | None = None,
     ) -> JawServo:
-        """The servo of ``jaw`` in ``model``: levers, gains from the fingers' inertias."""
+        """The servo of ``jaw`` in ``model``: levers, gains from the fingers' inertias
+        (capped for a law sampled every ``period_s``; None: continuous)."""
         if not (math.isfinite(max_force_N) and max_force_N > 0.0):
             raise ParameterError(f"max_force_N must be positive, got {max_force_N}")
         lever = np.array([_lever_m(model, j) for j in jaw.joint_ids])
         travel = jaw.upper - jaw.lower
         stiffness = max_force_N * lever / (SATURATION_TRAVEL_FRACTION * travel)
         inertia = _joint_inertias(model, jaw)
+        if period_s is not None:
+            stiffness = np.minimum(stiffness, inertia / (4.0 * period_s**2))
         return cls(
             jaw, float(max_force_N), lever, stiffness, 2.0 * np.sqrt(stiffness * inertia), schedule
         )

@@ -56,9 +56,9 @@ class Gripper:
         return dataclasses.replace(spec, params=params, build=build)
 
 
-def build_gripper(t: Table | None, uvms: UVMS) -> Gripper | None:
+def build_gripper(t: Table | None, uvms: UVMS, period_s: float | None) -> Gripper | None:
     """The [gripper] table of a scenario on ``uvms`` (None: a model without jaw joints and
-    no table).
+    no table); ``period_s``: the control period the servo is sampled at (None: continuous).
 
     Raises:
         ScenarioError: naming the key: a bad value, a table for a model without jaw joints.
@@ -87,7 +87,7 @@ def build_gripper(t: Table | None, uvms: UVMS) -> Gripper | None:
         return Gripper(jaw, None, uvms, prismatic)
     try:
         schedule = JawSchedule(close, reopen)
-        servo = JawServo.for_model(uvms.model, jaw, force, schedule)
+        servo = JawServo.for_model(uvms.model, jaw, force, schedule, period_s)
     except ParameterError as exc:
         raise table.fail(str(exc)) from None
     return Gripper(jaw, servo, jaw_locked(uvms, jaw, jaw.lower), prismatic)

@@ -145,7 +145,7 @@ def _build(raw: dict[str, Any], path: Path, top: Table) -> Scenario:
         raise top.error(
             "sensors", "navigation sensors sample at the control ticks: set [control] period_s"
         )
-    gripper = build_gripper(top.table("gripper"), uvms)
+    gripper = build_gripper(top.table("gripper"), uvms, control_period)
     arm_uvms = uvms if gripper is None else gripper.arm_uvms
     context = ControllerContext(arm_uvms, path.parent, task, actuation)
     controller = build_controller(top.table("controller"), context)
