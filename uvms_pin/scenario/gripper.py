@@ -47,13 +47,21 @@ class Gripper:
         model; ``spec`` itself when the controller commands the jaw."""
         if self.servo is None:
             return spec
-        servo, arm_uvms, prismatic = self.servo, self.arm_uvms, self.prismatic
+        params = {**spec.params, "gripper": _record(self.servo)}
+        return dataclasses.replace(spec, params=params, build=_WithJawBuild(self, spec))
 
-        def build(uvms: UVMS) -> WithJaw:
-            return WithJaw(spec(arm_uvms), servo, uvms.nv, prismatic)
 
-        params = {**spec.params, "gripper": _record(servo)}
-        return dataclasses.replace(spec, params=params, build=build)
+@dataclass(frozen=True)
+class _WithJawBuild:
+    """Builds `WithJaw` for the whole model: the arm's controller from ``spec`` on the model
+    with its jaw locked, beside the servo (a class, not a closure: scenarios are pickled)."""
+
+    gripper: Gripper
+    spec: ControllerSpec
+
+    def __call__(self, uvms: UVMS) -> WithJaw:
+        g = self.gripper
+        return WithJaw(self.spec(g.arm_uvms), g.servo, uvms.nv, g.prismatic)
 
 
 def build_gripper(t: Table | None, uvms: UVMS, period_s: float | None) -> Gripper | None:
