@@ -1,5 +1,4 @@
-"""Jaw joints: the naming rule, the shipped Alpha 5 jaw (Reach Robotics' description), and the
-arm's model with its jaw locked."""
+"""Jaw joints: the naming rule and the shipped Alpha 5 jaw (Reach Robotics' description)."""
 
 from __future__ import annotations
 
@@ -12,7 +11,6 @@ import pytest
 import uvms_pin as up
 from uvms_pin.errors import ModelError
 from uvms_pin.model.jaw import JawJoints, is_jaw_name
-from uvms_pin.model.jaw_locked import jaw_locked
 
 MODELS = Path(__file__).resolve().parents[2] / "models"
 JAWS = MODELS / "uvms_bluerov2_alpha5_jaws.urdf"
@@ -67,22 +65,6 @@ def test_opening_the_fingers_moves_their_tips_apart(uvms):
         expected = 2 * (0.0155 - 0.008 * np.cos(angle) + 0.09 * np.sin(angle))
         assert tip_gap(angle) == pytest.approx(expected, rel=1e-12)
     assert tip_gap(0.5) == pytest.approx(0.1032, abs=1e-4)  # the jaw fully open: 10.3 cm
-
-
-def test_locked_jaw_is_the_same_body_without_the_finger_joints(uvms):
-    jaw = JawJoints.of(uvms.model)
-    locked = jaw_locked(uvms, jaw, jaw.lower)
-    assert (locked.nq, locked.nv) == (uvms.nq - 2, uvms.nv - 2)
-    assert locked.mass_kg == pytest.approx(uvms.mass_kg, rel=1e-12)
-    assert locked.volume_m3 == pytest.approx(uvms.volume_m3, rel=1e-12)
-    # same mass matrix on the vehicle and the arm at the locked position
-    q = pin.neutral(uvms.model)
-    q[7:11] = (0.1, 0.8, 2.2, -0.3)
-    full = pin.crba(uvms.model, uvms.model.createData(), q)
-    arm = pin.crba(locked.model, locked.model.createData(), q[jaw.arm_q_index])
-    full, arm = np.triu(full) + np.triu(full, 1).T, np.triu(arm) + np.triu(arm, 1).T
-    np.testing.assert_allclose(arm, full[np.ix_(jaw.arm_v_index, jaw.arm_v_index)], atol=1e-12)
-    assert locked.model.frames[locked.ee_frame_id].name == "ee"
 
 
 def test_jaw_joints_by_name_and_bad_names(uvms):
