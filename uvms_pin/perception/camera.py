@@ -35,6 +35,9 @@ OTHER = (0.7, 0.7, 0.7)
 #: the side [px] of the square tiles whose rays the caster leaves out together
 TILE_PX = 16
 
+#: the rays shaded together: their (n, 3) temporaries stay in the processor's cache
+CHUNK_RAYS = 8192
+
 
 @dataclass(frozen=True)
 class CameraSpec:
@@ -167,6 +170,7 @@ class Camera(sensor.Mounted):
         self.rays = pixel_rays(spec)
         self.order, starts = tiles(spec)
         self._tiled = self.rays[self.order]
+        self._untiled = np.argsort(self.order)  # tile order -> image order
         self._bundles = Bundles.of(self._tiled, starts)
         self.optics = spec.optics
         robot = set(scene.robot_names)
@@ -186,73 +190,90 @@ class Camera(sensor.Mounted):
         rotation, position = self.pose()
         directions = self._tiled @ rotation.T  # tile by tile: the caster culls whole tiles
         hits = self.scene.caster.cast(position, directions, self._bundles.rotated(rotation))
-        met = np.isfinite(hits.range_m)
-        depth = np.where(met, hits.range_m * self._tiled[:, 2], np.nan)
-        radiance = self._radiance(position, rotation, directions, hits, met)
-        shape, order = (spec.height, spec.width), self.order
-        pixels = [np.empty_like(a) for a in (depth, hits.normal_world, hits.label, radiance)]
-        for out, tiled in zip(
-            pixels, (depth, hits.normal_world, hits.label, radiance), strict=True
-        ):
-            out[order] = tiled
-        depth, normal, label, radiance = pixels
+        radiance = np.empty_like(directions)
+        for start in range(0, len(directions), CHUNK_RAYS):
+            part = slice(start, start + CHUNK_RAYS)
+            radiance[part] = self._radiance(
+                position, rotation, directions[part],
+                hits.range_m[part], hits.normal_world[part], hits.label[part],
+            )  # fmt: skip
+        back = self._untiled
+        shape = (spec.height, spec.width)
+        range_m = hits.range_m[back]
+        depth = np.where(np.isfinite(range_m), range_m * self.rays[:, 2], np.nan)
+        radiance = radiance[back]
         counts = 255.0 * spec.exposure * radiance
         if spec.noise_counts > 0.0:
             counts += spec.noise_counts * self.rng.standard_normal(counts.shape, np.float32)
-        rgb = np.clip(np.rint(counts), 0, 255).astype(np.uint8)
+        rgb = np.clip(np.rint(counts, out=counts), 0, 255, out=counts).astype(np.uint8)
         return Frame(
             depth.reshape(shape),
-            normal.reshape(*shape, 3),
-            label.reshape(shape),
+            hits.normal_world[back].reshape(*shape, 3),
+            hits.label[back].reshape(shape),
             radiance.reshape(*shape, 3),
             rgb.reshape(*shape, 3),
         )
 
-    def _radiance(self, position, rotation, directions, hits, met) -> np.ndarray:
-        """I_c (n, 3) of every pixel (`uvms_pin.perception.optics`)."""
+    def _radiance(self, position, rotation, directions, r, normal, label) -> np.ndarray:
+        """I_c (n, 3) of n rays from ``position`` (`uvms_pin.perception.optics`): what they
+        met at ranges ``r`` (inf: nothing), its normals and labels."""
         optics = self.optics
         veiling = optics.veiling_light(-position[2])
+        met = np.isfinite(r)
         out = np.broadcast_to(veiling, (len(directions), 3)).copy()
-        if not np.any(met):
+        if not met.all():  # the rays that met something; all of them, most often
+            if not met.any():
+                return out
+            out[met] = self._radiance(position, rotation, directions[met], r[met], normal[met],
+                                      label[met])  # fmt: skip
             return out
-        r = hits.range_m[met]
-        normal = hits.normal_world[met]
-        points = position + r[:, None] * directions[met]
-        rho = self.reflectance[hits.label[met]]
+        rho = self.reflectance[label]
+        column = r[:, None]
         # daylight E0 exp(-K_d depth) (1 + n_z) / 2 and the direct path's exp(-beta_D r)
         # in one exponential
-        depth = np.maximum(-points[:, 2], 0.0)[:, None]
+        depth = np.maximum(-(position[2] + r * directions[:, 2]), 0.0)[:, None]
         sky = (0.5 * optics.surface_irradiance) * (1.0 + normal[:, 2])
-        signal = (rho * sky[:, None]) * np.exp(
-            -(optics.kd_per_m * depth + optics.beta_d_per_m * r[:, None])
-        )
+        signal = optics.kd_per_m * depth
+        signal += optics.beta_d_per_m * column
+        np.negative(signal, out=signal)
+        np.exp(signal, out=signal)
+        signal *= rho
+        signal *= sky[:, None]
         for light in self.spec.lights:
-            signal += self._lit(light, position, rotation, points, normal, rho, r)
-        out[met] = signal + backscatter(veiling, r, optics.beta_b_per_m)
-        return out
+            self._lit(signal, light, position, rotation, directions, normal, rho, r)
+        signal += backscatter(veiling, r, optics.beta_b_per_m)
+        return signal
 
-    def _lit(self, light: Light, position, rotation, points, normal, rho, r) -> np.ndarray:
-        """A light's direct signal (n, 3) from the points (their normals, reflectances,
-        ranges): rho I_L cone max(0, n . l) / d^2 exp(-beta_D (d + r)), computed on the
-        points within its outer cone only."""
+    def _lit(self, out, light: Light, position, rotation, directions, normal, rho, r) -> None:
+        """Adds to ``out`` (n, 3) a light's direct signal from the points met (their
+        normals, reflectances, ranges): rho I_L cone max(0, n . l) / d^2 exp(-beta_D (d + r)),
+        computed on the points within its outer cone only."""
         source = position + rotation @ np.asarray(light.position_m)
         axis = rotation @ np.asarray(light.direction)
-        to_point = points - source
-        distance = np.linalg.norm(to_point, axis=1)
-        unit = to_point / np.maximum(distance, 1e-12)[:, None]
+        to_point = r[:, None] * directions
+        to_point += position - source
+        distance = np.sqrt(np.einsum("ij,ij->i", to_point, to_point))
+        reach = np.maximum(distance, 1e-12)
+        cosine = (to_point @ axis) / reach
         outer = min(np.pi, light.half_angle_rad + light.edge_rad)
-        lit = np.flatnonzero(unit @ axis >= np.cos(outer) - 1e-12)
-        out = np.zeros_like(points)
-        if len(lit) == 0:
-            return out
-        unit, distance = unit[lit], distance[lit]
-        off_axis = np.arccos(np.clip(unit @ axis, -1.0, 1.0))
-        facing = np.maximum(0.0, -np.einsum("ij,ij->i", normal[lit], unit))
+        lit = cosine >= np.cos(outer) - 1e-12
+        if not lit.all():  # a slice of the rays, not a copy, when the cone holds them all
+            lit = np.flatnonzero(lit)
+            if len(lit) == 0:
+                return
+            to_point, distance, reach, cosine = to_point[lit], distance[lit], reach[lit], cosine[lit]
+            normal, rho, r = normal[lit], rho[lit], r[lit]
+        else:
+            lit = slice(None)
+        off_axis = np.arccos(np.clip(cosine, -1.0, 1.0))
+        facing = np.maximum(0.0, -np.einsum("ij,ij->i", normal, to_point) / reach)
         power = light.intensity * cone(off_axis, light.half_angle_rad, light.edge_rad) * facing
-        power = power / np.maximum(distance, 1e-6) ** 2
-        path = (distance + r[lit])[:, None]
-        out[lit] = rho[lit] * power[:, None] * np.exp(-self.optics.beta_d_per_m * path)
-        return out
+        power /= np.maximum(distance, 1e-6) ** 2
+        path = (distance + r)[:, None] * -self.optics.beta_d_per_m
+        np.exp(path, out=path)
+        path *= power[:, None]
+        path *= rho
+        out[lit] += path
 
     def fire(self) -> dict[str, np.ndarray]:
         """What a firing records: depth (float32), rgb, label."""

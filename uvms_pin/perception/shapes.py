@@ -50,13 +50,17 @@ class Plane:
     """The plane z = 0 of its frame, seen from z > 0 (its normal +z)."""
 
     bound_radius_m: float = np.inf
-    one_sided_plane: bool = True
+
+    def along(self, height_m, rate: np.ndarray) -> np.ndarray:
+        """t [m] of rays from ``height_m`` above it (o_z: a number or (n,)) at ``rate``
+        (d_z (n,)): -o_z / d_z when d_z < 0 < o_z, else inf."""
+        toward = (rate < 0.0) & (height_m > 0.0)
+        t = np.where(toward, -height_m / np.where(toward, rate, -1.0), np.inf)
+        return np.where(t > T_MIN_M, t, np.inf)
 
     def hit(self, o: np.ndarray, d: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        toward = (d[:, 2] < 0.0) & (o[:, 2] > 0.0)
-        t = np.where(toward, -o[:, 2] / np.where(toward, d[:, 2], -1.0), np.inf)
         normal = np.broadcast_to(np.array([0.0, 0.0, 1.0]), o.shape)  # one normal, not copied
-        return np.where(t > T_MIN_M, t, np.inf), normal
+        return self.along(o[:, 2], d[:, 2]), normal
 
 
 @dataclass(frozen=True)
