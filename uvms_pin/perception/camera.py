@@ -261,7 +261,12 @@ class Camera(sensor.Mounted):
             lit = np.flatnonzero(lit)
             if len(lit) == 0:
                 return
-            to_point, distance, reach, cosine = to_point[lit], distance[lit], reach[lit], cosine[lit]
+            to_point, distance, reach, cosine = (
+                to_point[lit],
+                distance[lit],
+                reach[lit],
+                cosine[lit],
+            )
             normal, rho, r = normal[lit], rho[lit], r[lit]
         else:
             lit = slice(None)

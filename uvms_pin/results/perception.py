@@ -3,7 +3,8 @@
 A rollout holds them in ``perception``: sensor name -> its arrays (``time_s`` (T,) and what
 each firing gave, stacked: a camera's ``depth_m`` (T, H, W) float32, ``rgb`` (T, H, W, 3)
 uint8 and ``label`` (T, H, W) int16; a sonar's ``intensity`` (T, bins, beams) with its
-``range_m`` (bins,) and ``bearing_rad`` (beams,)); its metadata's ``perception`` says each
+``range_m`` (bins,) and ``bearing_rad`` (beams,), a multibeam's ``beam_range_m`` and
+``beam_intensity`` (T, beams) too); its metadata's ``perception`` says each
 sensor's kind and, for a camera, its labels' names (label k is ``label_names[k - 1]``, 0:
 nothing met). Saved compressed as ``perception.npz`` beside ``rollout.npz``.
 """
@@ -48,12 +49,16 @@ class CameraRecord:
 @dataclass(frozen=True)
 class SonarRecord:
     """A sonar's images: ``time_s`` (T,), ``intensity`` (T, bins, beams), ``range_m``
-    (bins,) [m] and ``bearing_rad`` (beams,) [rad]."""
+    (bins,) [m] and ``bearing_rad`` (beams,) [rad]; a multibeam's detections
+    ``beam_range_m`` (T, beams) [m] (NaN: none) and ``beam_intensity`` (T, beams) (None for
+    the other types)."""
 
     time_s: np.ndarray
     intensity: np.ndarray
     range_m: np.ndarray
     bearing_rad: np.ndarray
+    beam_range_m: np.ndarray | None = None
+    beam_intensity: np.ndarray | None = None
 
 
 def _arrays(perception: dict, metadata: dict, name: str, kind: str) -> dict[str, np.ndarray]:
@@ -75,7 +80,12 @@ def camera_record(perception: dict, metadata: dict, name: str) -> CameraRecord:
 def sonar_record(perception: dict, metadata: dict, name: str) -> SonarRecord:
     arrays = _arrays(perception, metadata, name, "sonar")
     return SonarRecord(
-        arrays["time_s"], arrays["intensity"], arrays["range_m"], arrays["bearing_rad"]
+        arrays["time_s"],
+        arrays["intensity"],
+        arrays["range_m"],
+        arrays["bearing_rad"],
+        arrays.get("beam_range_m"),
+        arrays.get("beam_intensity"),
     )
 
 
