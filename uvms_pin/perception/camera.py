@@ -21,7 +21,7 @@ import numpy as np
 from uvms_pin.errors import ParameterError
 from uvms_pin.perception import sensor
 from uvms_pin.perception.caster import Bundles
-from uvms_pin.perception.optics import Light, WaterOptics, backscatter, cone
+from uvms_pin.perception.optics import Light, WaterOptics, backscatter, cone_of_cosine
 from uvms_pin.perception.scene import Scene
 
 __all__ = ["CAMERA", "Camera", "CameraSpec", "Frame", "reflectance_of"]
@@ -246,39 +246,25 @@ class Camera(sensor.Mounted):
 
     def _lit(self, out, light: Light, position, rotation, directions, normal, rho, r) -> None:
         """Adds to ``out`` (n, 3) a light's direct signal from the points met (their
-        normals, reflectances, ranges): rho I_L cone max(0, n . l) / d^2 exp(-beta_D (d + r)),
-        computed on the points within its outer cone only."""
+        normals, reflectances, ranges): rho I_L cone max(0, n . l) / d^2 exp(-beta_D (d + r))
+        (on every ray: the cone is exactly 0 beyond its edge, adding nothing, and most rays
+        are within it, so picking them out would cost more)."""
         source = position + rotation @ np.asarray(light.position_m)
         axis = rotation @ np.asarray(light.direction)
         to_point = r[:, None] * directions
         to_point += position - source
         distance = np.sqrt(np.einsum("ij,ij->i", to_point, to_point))
         reach = np.maximum(distance, 1e-12)
-        cosine = (to_point @ axis) / reach
-        outer = min(np.pi, light.half_angle_rad + light.edge_rad)
-        lit = cosine >= np.cos(outer) - 1e-12
-        if not lit.all():  # a slice of the rays, not a copy, when the cone holds them all
-            lit = np.flatnonzero(lit)
-            if len(lit) == 0:
-                return
-            to_point, distance, reach, cosine = (
-                to_point[lit],
-                distance[lit],
-                reach[lit],
-                cosine[lit],
-            )
-            normal, rho, r = normal[lit], rho[lit], r[lit]
-        else:
-            lit = slice(None)
-        off_axis = np.arccos(np.clip(cosine, -1.0, 1.0))
-        facing = np.maximum(0.0, -np.einsum("ij,ij->i", normal, to_point) / reach)
-        power = light.intensity * cone(off_axis, light.half_angle_rad, light.edge_rad) * facing
-        power /= np.maximum(distance, 1e-6) ** 2
+        power = cone_of_cosine((to_point @ axis) / reach, light.half_angle_rad, light.edge_rad)
+        facing = np.einsum("ij,ij->i", normal, to_point)
+        facing /= reach
+        power *= np.maximum(0.0, -facing)
+        power *= light.intensity / np.maximum(distance, 1e-6) ** 2
         path = (distance + r)[:, None] * -self.optics.beta_d_per_m
         np.exp(path, out=path)
         path *= power[:, None]
         path *= rho
-        out[lit] += path
+        out += path
 
     def fire(self) -> dict[str, np.ndarray]:
         """What a firing records: depth (float32), rgb, label."""
