@@ -179,6 +179,18 @@ class Camera(sensor.Mounted):
             given.setdefault(name, ROBOT)
         self.reflectance = reflectance_of(scene.names, given, scene.floor_names)
 
+    def _untile(self, tiled: np.ndarray) -> np.ndarray:
+        """An array (H W, ...) in tile order, in image order: a transposition of blocks when
+        the tiles cover the image exactly, one gather otherwise."""
+        spec = self.spec
+        if spec.width % TILE_PX or spec.height % TILE_PX:
+            return tiled[self._untiled]
+        rest = tiled.shape[1:]
+        blocks = tiled.reshape(
+            spec.height // TILE_PX, spec.width // TILE_PX, TILE_PX, TILE_PX, *rest
+        )
+        return blocks.swapaxes(1, 2).reshape(spec.width * spec.height, *rest)
+
     def pose(self) -> tuple[np.ndarray, np.ndarray]:
         """(R, p) of the optical frame in the world, after the scene's update."""
         placed = self.placement()
@@ -197,19 +209,19 @@ class Camera(sensor.Mounted):
                 position, rotation, directions[part],
                 hits.range_m[part], hits.normal_world[part], hits.label[part],
             )  # fmt: skip
-        back = self._untiled
+        untile = self._untile
         shape = (spec.height, spec.width)
-        range_m = hits.range_m[back]
+        range_m = untile(hits.range_m)
         depth = np.where(np.isfinite(range_m), range_m * self.rays[:, 2], np.nan)
-        radiance = radiance[back]
+        radiance = untile(radiance)
         counts = 255.0 * spec.exposure * radiance
         if spec.noise_counts > 0.0:
             counts += spec.noise_counts * self.rng.standard_normal(counts.shape, np.float32)
         rgb = np.clip(np.rint(counts, out=counts), 0, 255, out=counts).astype(np.uint8)
         return Frame(
             depth.reshape(shape),
-            hits.normal_world[back].reshape(*shape, 3),
-            hits.label[back].reshape(shape),
+            untile(hits.normal_world).reshape(*shape, 3),
+            untile(hits.label).reshape(shape),
             radiance.reshape(*shape, 3),
             rgb.reshape(*shape, 3),
         )
