@@ -89,13 +89,20 @@ def sonar_record(perception: dict, metadata: dict, name: str) -> SonarRecord:
     )
 
 
+#: zlib's fastest level: images compress 3.5 times faster than at its default (6), into a file
+#: about a tenth larger (measured on scenarios/seabed_survey.toml's 151 frames: 0.74 s and
+#: 24.4 MB against 2.6 s and 22.4 MB)
+COMPRESS_LEVEL = 1
+
+
 def save_perception(path: Path, perception: dict[str, dict[str, np.ndarray]]) -> None:
-    """Every sensor's arrays into one compressed ``.npz`` at ``path``."""
-    flat = {
-        f"{name}{_SEP}{key}": a for name, arrays in perception.items() for key, a in arrays.items()
-    }
-    with open(path, "wb") as f:
-        np.savez_compressed(f, **flat)
+    """Every sensor's arrays into one compressed ``.npz`` at ``path`` (what ``np.load``
+    reads: one ``.npy`` per array in a deflated zip)."""
+    with zipfile.ZipFile(path, "w", zipfile.ZIP_DEFLATED, compresslevel=COMPRESS_LEVEL) as zf:
+        for name, arrays in perception.items():
+            for key, array in arrays.items():
+                with zf.open(f"{name}{_SEP}{key}.npy", "w", force_zip64=True) as f:
+                    np.lib.format.write_array(f, np.asanyarray(array), allow_pickle=False)
 
 
 def load_perception(path: Path) -> dict[str, dict[str, np.ndarray]]:
