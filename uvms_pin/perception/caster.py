@@ -4,7 +4,9 @@ Each body is a shape (`uvms_pin.perception.shapes`, `uvms_pin.perception.mesh`) 
 its own frame, a label, and a pose (R, p) that `RayCaster.set_pose` replaces whenever a
 sensor fires: the rays are carried into each body's frame, o_b = R^T (o - p), d_b = R^T d
 (an instance transform), and the hit's normal back, n = R n_b. A body whose bounding sphere
-a ray misses, or meets beyond the nearest hit found so far, is not asked for that ray.
+a ray misses, or meets beyond the nearest hit found so far, is not asked for that ray. A
+plane seen from one origin (a camera's, a sonar's) is met by each ray's rate along its
+normal alone, t = -h / (d . n) for the origin's height h above it (`Plane.along`).
 """
 
 from __future__ import annotations
