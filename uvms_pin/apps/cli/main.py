@@ -141,6 +141,13 @@ def build_parser() -> argparse.ArgumentParser:
     run.add_argument(
         "--html", action="store_true", help="also write replay.html (self-contained, offline)"
     )
+    run.add_argument(
+        "--no-code",
+        action="store_true",
+        help="refuse a scenario that would import a module (a module:Class controller, a "
+        "metric function) or read a file outside its folder and the shipped models: for "
+        "files of unknown origin (docs/security.md)",
+    )
     _add_view_options(run)
     run.set_defaults(func=cmd_run)
     replay = sub.add_parser("replay", help="show a saved rollout: replay.html and/or live")

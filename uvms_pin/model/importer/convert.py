@@ -27,7 +27,7 @@ from uvms_pin.model.importer.plugins import PluginKind, plugin_kind
 from uvms_pin.model.importer.result import ImportedThruster, ImportResult
 from uvms_pin.model.importer.sdf import sdf_model, sdf_to_urdf
 from uvms_pin.model.importer.thrusters import gz_thruster, uuv_thruster
-from uvms_pin.model.importer.tree import link_placements
+from uvms_pin.model.importer.tree import fix_immobile_joints, link_placements
 from uvms_pin.model.importer.write import hydro_element, thruster_table_text, urdf_text
 from uvms_pin.model.urdf.read import xml_root
 from uvms_pin.results.atomic import atomic_path
@@ -53,6 +53,7 @@ def import_model(
     notes: list[str] = []
     robot, plugins, fmt = _read_source(path, notes)
     links = {link.get("name"): link for link in robot.findall("link")}
+    fix_immobile_joints(robot, notes)
     placements = link_placements(robot, where)
     thrusters = _thrusters(robot, plugins, placements, where, notes)
     density, hydro = _hydro(links, plugins, where, notes)
@@ -183,9 +184,13 @@ def _finish_links(
     robot: ET.Element, hydro: dict[str, HydroParams], where: str, notes: list[str]
 ) -> None:
     """Each link with mass gets its ``<hydrodynamics>`` (zero volume: dry, as in the
-    source); a link without mass loses its collision shapes (uvms-pin needs mass there)."""
+    source), unless the source already gives it one (a uvms-pin URDF: kept as it is, never
+    stripped); a link without mass loses its collision shapes (uvms-pin needs mass there)."""
     for link in robot.findall("link"):
         name = link.get("name")
+        own = link.find("hydrodynamics") is not None and name not in hydro
+        if own and link.find("inertial") is not None:
+            continue  # the source's own hydrodynamics, kept
         for old in link.findall("hydrodynamics"):
             link.remove(old)
         if link.find("inertial") is None:
