@@ -17,11 +17,10 @@ import tomllib
 from pathlib import Path
 from typing import Any
 
+from fuzz_bounds import ROOT
 from hypothesis import strategies as st
 
 from uvms_pin.physics.world.objects import registered_kinds
-
-ROOT = Path(__file__).resolve().parents[2]
 
 
 def _toml_blocks(doc: Path) -> list[dict[str, Any]]:
@@ -34,7 +33,14 @@ def _object_tables() -> list[dict[str, Any]]:
     tables = []
     for kind in registered_kinds():
         table = {"type": kind.name}
-        table.update({k.name: k.default or values[k.holds] for k in kind.keys})
+        table.update(
+            {
+                k.name: list(k.default or ()) or values[k.holds]
+                if k.holds == "vector"
+                else k.default or values[k.holds]
+                for k in kind.keys
+            }
+        )
         tables.append(table)
     return tables
 
@@ -47,15 +53,19 @@ def _scenarios() -> dict[str, dict[str, Any]]:
 
 SCENARIOS = _scenarios()
 #: (dotted table, its value): the tables a document can be given from another
-DONORS: list[tuple[tuple[str, ...], Any]] = sorted(
-    {
-        (key, sub): json.dumps(doc[key][sub] if sub else doc[key], sort_keys=True)
-        for doc in [*SCENARIOS.values(), *_toml_blocks(ROOT / "docs" / "sensors.md")]
-        for key in doc
-        for sub in [None, *(k for k, v in doc[key].items() if isinstance(v, dict | list))]
-    }.items()
-)
-DONORS = [((key,) if sub is None else (key, sub), json.loads(text)) for (key, sub), text in DONORS]
+DONORS: list[tuple[tuple[str, ...], Any]] = [
+    (path, json.loads(text))
+    for path, text in sorted(
+        {
+            (key,) if sub is None else (key, sub): json.dumps(
+                doc[key] if sub is None else doc[key][sub], sort_keys=True
+            )
+            for doc in [*SCENARIOS.values(), *_toml_blocks(ROOT / "docs" / "sensors.md")]
+            for key in doc
+            for sub in [None, *(k for k, v in doc[key].items() if isinstance(v, dict | list))]
+        }.items()
+    )
+]
 DONORS += [(("world", "objects"), [table]) for table in _object_tables()]
 
 EDGE_NUMBERS = (0, -0.0, -1, 1e-300, 1e300, math.nan, math.inf, -math.inf, 2**63, -(2**63) - 1,
@@ -75,19 +85,25 @@ scalars = st.one_of(
 )
 values = st.recursive(
     scalars,
-    lambda inner: st.lists(inner, max_size=8) | st.dictionaries(st.text(max_size=8), inner, max_size=4),
+    lambda inner: (
+        st.lists(inner, max_size=8) | st.dictionaries(st.text(max_size=8), inner, max_size=4)
+    ),
     max_leaves=10,
 )
 #: a key of any table: a documented one (in the wrong place), a typo of one, or any text
 key_names = st.one_of(
-    st.sampled_from(KEY_NAMES), st.sampled_from(KEY_NAMES).map(lambda k: k[:-1]), st.text(max_size=10)
+    st.sampled_from(KEY_NAMES),
+    st.sampled_from(KEY_NAMES).map(lambda k: k[:-1]),
+    st.text(max_size=10),
 )
 
 
 def paths_in(doc: Any, prefix: tuple = ()) -> list[tuple]:
     """Every path into ``doc`` (keys and list indices), tables and lists included."""
     out = []
-    items = doc.items() if isinstance(doc, dict) else enumerate(doc) if isinstance(doc, list) else ()
+    items = (
+        doc.items() if isinstance(doc, dict) else enumerate(doc) if isinstance(doc, list) else ()
+    )
     for key, value in items:
         out.append((*prefix, key))
         out.extend(paths_in(value, (*prefix, key)))
@@ -120,7 +136,7 @@ def _delete(draw, doc: dict) -> None:
 def _extra(draw, doc: dict) -> None:
     tables = [(), *(p for p in paths_in(doc) if isinstance(_parent(doc, p)[p[-1]], dict))]
     path = draw(st.sampled_from(tables))
-    table = _parent(doc, (*path, None))[path[-1]] if path else doc
+    table = _parent(doc, path)[path[-1]] if path else doc
     table[draw(key_names)] = draw(values)
 
 
@@ -142,7 +158,11 @@ def _resize(draw, doc: dict) -> None:
         path = draw(st.sampled_from(lists))
         items = _parent(doc, path)[path[-1]]
         size = draw(st.sampled_from([0, 1, 2, len(items) - 1, len(items) + 1, 2 * len(items)]))
-        _parent(doc, path)[path[-1]] = [copy.deepcopy(items[k % len(items)]) for k in range(max(size, 0))] if items else [draw(values)]
+        _parent(doc, path)[path[-1]] = (
+            [copy.deepcopy(items[k % len(items)]) for k in range(max(size, 0))]
+            if items
+            else [draw(values)]
+        )
 
 
 EDITS = (_set, _edge, _delete, _extra, _graft, _resize)
@@ -181,13 +201,17 @@ def _value(v: Any) -> str:
     if isinstance(v, int):
         return str(v)
     if isinstance(v, float):
-        return "nan" if math.isnan(v) else ("inf" if v > 0 else "-inf") if math.isinf(v) else repr(v)
+        return (
+            "nan" if math.isnan(v) else ("inf" if v > 0 else "-inf") if math.isinf(v) else repr(v)
+        )
     if isinstance(v, str):
         return _string(v)
     if isinstance(v, datetime.date):
         return v.isoformat()
-    if isinstance(v, list):
+    if isinstance(v, list | tuple):
         return "[" + ", ".join(_value(x) for x in v if x is not None) + "]"
     if isinstance(v, dict):
-        return "{" + ", ".join(f"{_key(k)} = {_value(x)}" for k, x in v.items() if x is not None) + "}"
+        return (
+            "{" + ", ".join(f"{_key(k)} = {_value(x)}" for k, x in v.items() if x is not None) + "}"
+        )
     raise TypeError(type(v))

@@ -48,7 +48,9 @@ def _quaternion_normalised(q):
 
 CALLS = {
     "mass_matrix": lambda a: dynamics.mass_matrix(UVMS, a["q"], **a["options"]),
-    "bias_forces": lambda a: dynamics.bias_forces(UVMS, a["q"], a["v"], a["current"], **a["options"]),
+    "bias_forces": lambda a: dynamics.bias_forces(
+        UVMS, a["q"], a["v"], a["current"], **a["options"]
+    ),
     "forward_dynamics": lambda a: dynamics.forward_dynamics(
         UVMS, a["q"], a["v"], a["tau"], a["current"], a["tau_ext"], **a["options"]
     ),

@@ -20,7 +20,11 @@ from uvms_pin.errors import UvmsPinWarning  # noqa: E402
 
 numbers = st.sampled_from([0.0, -1.0, 0.01, 1.0, 1e9, math.nan, math.inf, "1", None, True])
 single = st.fixed_dictionaries(
-    {"id": st.sampled_from(["uvms_pin/StationKeeping-v0", "uvms_pin/ForceTracking-v0", "uvms_pin/PoseTracking-v0"])},
+    {
+        "id": st.sampled_from(
+            ["uvms_pin/StationKeeping-v0", "uvms_pin/ForceTracking-v0", "uvms_pin/PoseTracking-v0"]
+        )
+    },
     optional={
         "action_scale": st.sampled_from([0.5, -1.0, 0.0, math.nan, [1.0] * 3, "x"]),
         "clip_actions": st.sampled_from([True, False, "no", 0]),
@@ -30,8 +34,14 @@ single = st.fixed_dictionaries(
         "failure_penalty": numbers,
         "render_mode": st.sampled_from([None, "rgb_array", "human", 3]),
         "overrides": st.sampled_from(
-            [{}, {"scenario.duration_s": -1}, {"control.period_s": 0.0}, {"nope": 1},
-             {"scenario.duration_s": 1e12}, {"initial.position_world_m": [math.nan, 0, 0]}]
+            [
+                {},
+                {"scenario.duration_s": -1},
+                {"control.period_s": 0.0},
+                {"nope": 1},
+                {"scenario.duration_s": 1e12},
+                {"initial.position_world_m": [math.nan, 0, 0]},
+            ]
         ),  # fmt: skip
         "scenario": st.sampled_from(["missing.toml", "scenarios/passive_current.toml", 3]),
     },

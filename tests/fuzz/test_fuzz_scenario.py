@@ -8,7 +8,7 @@ from __future__ import annotations
 import warnings
 
 import numpy as np
-from fuzz_bounds import examples, outcome
+from fuzz_bounds import copied_tree, examples, outcome
 from fuzz_documents import ROOT, SCENARIOS, edited, toml_text
 from hypothesis import given, settings
 from hypothesis import strategies as st
@@ -38,7 +38,7 @@ def test_a_scenario_dict_builds_or_is_refused_naming_the_file(named_doc):
 
 @settings(max_examples=examples(300))
 @given(edited(SCENARIOS), st.integers(0, 2))
-def test_a_scenario_file_loads_or_is_refused_naming_the_file(copied_tree, named_doc, cut):
+def test_a_scenario_file_loads_or_is_refused_naming_the_file(named_doc, cut):
     """The document as TOML; ``cut``: 0 whole, 1 its last line cut in half, 2 a line twice."""
     name, doc = named_doc
     text = toml_text(doc)
@@ -46,7 +46,7 @@ def test_a_scenario_file_loads_or_is_refused_naming_the_file(copied_tree, named_
         text = text[: max(0, len(text) - len(text.splitlines()[-1] if text else "") // 2 - 1)]
     elif cut == 2 and text:
         text += text.splitlines()[0] + "\n"
-    path = copied_tree / "scenarios" / "fuzzed.toml"
+    path = copied_tree() / "scenarios" / "fuzzed.toml"
     path.write_text(text, encoding="utf-8")
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", UvmsPinWarning)

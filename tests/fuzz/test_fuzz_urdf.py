@@ -7,7 +7,7 @@ import warnings
 
 import numpy as np
 import pinocchio as pin
-from fuzz_bounds import examples, outcome
+from fuzz_bounds import copied_tree, examples, outcome
 from fuzz_documents import ROOT
 from fuzz_xml import mutated
 from hypothesis import given, settings
@@ -16,14 +16,17 @@ from uvms_pin.errors import UvmsPinWarning
 from uvms_pin.model.urdf.load import load_uvms
 from uvms_pin.physics.dynamics import mass_matrix
 
-MODELS = {p.name: p.read_text() for p in sorted((ROOT / "models").glob("*.urdf"), key=lambda p: p.stat().st_size)}
+MODELS = {
+    p.name: p.read_text()
+    for p in sorted((ROOT / "models").glob("*.urdf"), key=lambda p: p.stat().st_size)
+}
 
 
 @settings(max_examples=examples(300))
 @given(mutated(MODELS))
-def test_a_urdf_loads_or_is_refused_naming_the_file(copied_tree, named_text):
+def test_a_urdf_loads_or_is_refused_naming_the_file(named_text):
     name, text = named_text
-    path = copied_tree / "models" / "fuzzed.urdf"
+    path = copied_tree() / "models" / "fuzzed.urdf"
     path.write_text(text, encoding="utf-8")
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", UvmsPinWarning)

@@ -37,7 +37,9 @@ FIXED_OBJECT_BYTES, FREE_OBJECT_BYTES, PAIR_BYTES = 2**16, 2**20, 2**14
 def objects_bytes(n_objects: int, n_free: int) -> int:
     """What ``n_objects`` objects (``n_free`` of them free) take [bytes]: each its share,
     each free one a pair with every other body and the robot."""
-    return n_objects * FIXED_OBJECT_BYTES + n_free * (FREE_OBJECT_BYTES + (n_objects + 1) * PAIR_BYTES)
+    return n_objects * FIXED_OBJECT_BYTES + n_free * (
+        FREE_OBJECT_BYTES + (n_objects + 1) * PAIR_BYTES
+    )
 
 
 def build_world(t: Table | None, uvms: UVMS, base_dir: Path) -> World | None:
