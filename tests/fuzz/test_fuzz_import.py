@@ -18,7 +18,7 @@ DATA = ROOT / "tests" / "model" / "importer" / "data"
 SOURCES = {p.name: p.read_text() for p in sorted(DATA.iterdir()) if p.suffix in (".sdf", ".urdf")}
 
 
-@settings(max_examples=examples(200))
+@settings(max_examples=examples(300))
 @given(mutated(SOURCES))
 def test_an_import_writes_or_is_refused_naming_the_file(tmp_path, named_text):
     name, text = named_text

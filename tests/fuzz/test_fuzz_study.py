@@ -16,7 +16,7 @@ from uvms_pin.errors import UvmsPinWarning
 STUDIES = {p.name: tomllib.loads(p.read_text()) for p in sorted((ROOT / "studies").glob("*.toml"))}
 
 
-@settings(max_examples=examples(150))
+@settings(max_examples=examples(300))
 @given(edited(STUDIES))
 def test_a_study_file_loads_or_is_refused_naming_the_file(named_doc):
     name, doc = named_doc

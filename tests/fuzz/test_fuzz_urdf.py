@@ -22,7 +22,7 @@ MODELS = {
 }
 
 
-@settings(max_examples=examples(300))
+@settings(max_examples=examples(500))
 @given(mutated(MODELS))
 def test_a_urdf_loads_or_is_refused_naming_the_file(named_text):
     name, text = named_text
