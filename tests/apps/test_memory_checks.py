@@ -198,3 +198,15 @@ def test_a_mesh_is_weighed_before_it_is_read(tmp_path, monkeypatch):
     _available(monkeypatch, 2 * mesh_bytes(rock) - 1)
     with pytest.raises(ParameterError, match="simplify the mesh"):
         load_mesh_geometry(rock, (1.0, 1.0, 1.1))
+
+
+def test_a_gym_camera_is_weighed_before_its_spaces_are_made(monkeypatch):
+    gym = pytest.importorskip("gymnasium")
+    from uvms_pin.apps.gym.camera import CameraObservation
+
+    env = gym.make("uvms_pin/StationKeeping-v0")
+    camera = {"name": "cam", "width": 8192, "height": 8192, "rate_hz": 10.0}
+    # a frame (8192^2 x 9 bytes) and the image space's bounds (2 x 8192^2 x 3): 1.0 GiB
+    _available(monkeypatch, 2 * 15 * 8192**2 - 1)
+    with pytest.raises(ParameterError, match=r"a 8192 x 8192 camera observation would take 0\.938 GiB"):
+        CameraObservation(env, camera)
