@@ -208,5 +208,7 @@ def test_a_gym_camera_is_weighed_before_its_spaces_are_made(monkeypatch):
     camera = {"name": "cam", "width": 8192, "height": 8192, "rate_hz": 10.0}
     # a frame (8192^2 x 9 bytes) and the image space's bounds (2 x 8192^2 x 3): 1.0 GiB
     _available(monkeypatch, 2 * 15 * 8192**2 - 1)
-    with pytest.raises(ParameterError, match=r"a 8192 x 8192 camera observation would take 0\.938 GiB"):
+    with pytest.raises(
+        ParameterError, match=r"a 8192 x 8192 camera observation would take 0\.938 GiB"
+    ):
         CameraObservation(env, camera)
