@@ -102,3 +102,59 @@ def test_a_quaternion_of_norm_1e300_is_named_not_a_nan_mass_matrix():
     q[5] = 1e300
     with pytest.raises(ParameterError, match="'root_joint' has a quaternion of norm inf"):
         mass_matrix(UVMS, q)
+
+
+# ---- found by the campaign (make fuzz, seed 20261204) ------------------------------------
+
+
+def test_a_gym_action_scale_of_text_is_refused():
+    """Was: ValueError: could not convert string to float: 'x'."""
+    gym = pytest.importorskip("gymnasium")
+    import uvms_pin.apps.gym  # noqa: F401
+
+    with pytest.raises(ParameterError, match="action_scale must be 10 positive finite numbers"):
+        gym.make("uvms_pin/StationKeeping-v0", action_scale="x")
+
+
+def test_a_camera_reflectance_of_no_colours_is_named():
+    """Was: ValueError: could not convert string to float: ':' (and a date: TypeError)."""
+    import tomllib
+
+    doc = tomllib.loads((ROOT / "scenarios" / "visual_approach.toml").read_text())
+    doc["sensors"]["camera"][0]["reflectance"] = {"hull": ":"}
+    with pytest.raises(ScenarioError, match=r"v.toml: .*reflectance must map label names"):
+        scenario_from_dict(doc, ROOT / "scenarios" / "v.toml")
+
+
+def test_a_study_heatmap_of_lists_is_named(tmp_path):
+    """Was: TypeError: unhashable type: 'list'."""
+    import tomllib
+
+    from fuzz_documents import toml_text
+
+    from uvms_pin.apps.study import load_study
+    from uvms_pin.errors import StudyError
+
+    doc = tomllib.loads((ROOT / "studies" / "sea_state.toml").read_text())
+    doc["study"]["base"] = str(ROOT / "studies" / doc["study"]["base"])
+    doc["report"]["heatmaps"] = [[["a"], "b"]]
+    path = tmp_path / "s.toml"
+    path.write_text(toml_text(doc))
+    with pytest.raises(StudyError, match=r"s.toml: report.heatmaps\[0\]: must be two parameter"):
+        load_study(path)
+
+
+ONE_CYLINDER = """<robot name="r"><link name="hull">
+  <inertial><mass value="10"/><inertia ixx="1" ixy="0" ixz="0" iyy="1" iyz="0" izz="1"/></inertial>
+  <collision><geometry><cylinder radius="1e300" length="1"/></geometry></collision>
+</link></robot>"""
+
+
+def test_a_collision_cylinder_of_1e300_m_is_refused(tmp_path):
+    """Was: OverflowError: (34, 'Numerical result out of range') deriving its drag (r^5)."""
+    from uvms_pin.model.urdf.load import load_uvms
+
+    path = tmp_path / "huge.urdf"
+    path.write_text(ONE_CYLINDER)
+    with pytest.raises(ModelError, match=r"huge.urdf: link 'hull': <cylinder radius> = 1e300 m"):
+        load_uvms(path)

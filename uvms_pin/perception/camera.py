@@ -111,7 +111,13 @@ class CameraSpec:
             sensor.spec_from_dict(Light, light, f"{label}: lights[{k}]")
             for k, light in enumerate(lights)
         )
-        colours = {str(k): tuple(float(c) for c in v) for k, v in reflectance.items()}
+        try:
+            colours = {str(k): tuple(float(c) for c in v) for k, v in reflectance.items()}
+        except (TypeError, ValueError) as exc:
+            raise ParameterError(
+                f"{label}: reflectance must map label names to (R, G, B) numbers, "
+                f"got {reflectance!r}"
+            ) from exc
         return sensor.spec_from_dict(cls, raw, label, lights=built, reflectance=colours)
 
 
