@@ -158,3 +158,14 @@ def test_a_collision_cylinder_of_1e300_m_is_refused(tmp_path):
     path.write_text(ONE_CYLINDER)
     with pytest.raises(ModelError, match=r"huge.urdf: link 'hull': <cylinder radius> = 1e300 m"):
         load_uvms(path)
+
+
+def test_a_camera_light_that_is_no_table_is_named():
+    """Was: TypeError: 'datetime.date' object is not iterable (the second campaign)."""
+    import datetime
+    import tomllib
+
+    doc = tomllib.loads((ROOT / "scenarios" / "visual_approach.toml").read_text())
+    doc["sensors"]["camera"][0]["lights"] = [datetime.date(2026, 12, 4)]
+    with pytest.raises(ScenarioError, match=r"v.toml: .*lights must be tables"):
+        scenario_from_dict(doc, ROOT / "scenarios" / "v.toml")

@@ -105,7 +105,8 @@ class CameraSpec:
         raw = dict(raw)
         lights = raw.pop("lights", [])
         reflectance = raw.pop("reflectance", {})
-        if not isinstance(lights, list) or not isinstance(reflectance, dict):
+        tables = isinstance(lights, list) and all(isinstance(light, dict) for light in lights)
+        if not tables or not isinstance(reflectance, dict):
             raise ParameterError(f"{label}: lights must be tables, reflectance a table")
         built = tuple(
             sensor.spec_from_dict(Light, light, f"{label}: lights[{k}]")
