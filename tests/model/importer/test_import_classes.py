@@ -9,6 +9,7 @@ from pathlib import Path
 
 import numpy as np
 import pinocchio as pin
+import pytest
 from conftest import REFERENCE_URDF
 
 from uvms_pin.model.importer.convert import import_model
@@ -54,3 +55,22 @@ def test_a_urdf_with_hydrodynamics_keeps_them(tmp_path):
     assert np.isclose(again.volume_m3, original.volume_m3, rtol=1e-12)
     q = pin.neutral(original.model)
     np.testing.assert_allclose(mass_matrix(again, q), mass_matrix(original, q), rtol=1e-12)
+
+
+DRY = """<robot name="dry"><link name="hull">
+  <inertial><mass value="10"/><inertia ixx="1" ixy="0" ixz="0" iyy="1" iyz="0" izz="1"/></inertial>
+</link></robot>"""
+
+
+def test_a_file_without_hydrodynamics_is_refused_unless_asked_for(tmp_path):
+    from uvms_pin.errors import ModelError
+
+    source, out = tmp_path / "dry.urdf", tmp_path / "out.urdf"
+    source.write_text(DRY)
+    with pytest.raises(ModelError, match=r"dry.urdf: carries no hydrodynamics .* --allow-dry"):
+        import_model(source, out)
+    assert not out.exists()
+    result = import_model(source, out, allow_dry=True)
+    assert (
+        "link 'hull': no hydrodynamics in the source; written dry (volume 0)" in result.not_mapped
+    )

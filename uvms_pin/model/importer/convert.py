@@ -41,10 +41,18 @@ GZ_DEFAULT_DENSITY_KG_M3 = 1000.0  # the Buoyancy system's default
 
 
 def import_model(
-    path: str | Path, out: str | Path | None = None, *, thrusters_out: str | Path | None = None
+    path: str | Path,
+    out: str | Path | None = None,
+    *,
+    thrusters_out: str | Path | None = None,
+    allow_dry: bool = False,
 ) -> ImportResult:
     """Read a Gazebo vehicle; with ``out``, write the URDF there and, when it has thrusters,
     the table to ``thrusters_out`` (default: ``out`` with ``.thrusters.toml``).
+
+    ``allow_dry``: import a file that carries no hydrodynamics at all (no plugin uvms-pin
+    maps, no ``<hydrodynamics>`` element) with every link dry; refused otherwise (a vehicle
+    without water is rarely what was meant).
 
     Raises:
         ModelError: naming the file and what cannot be read or mapped; nothing is written.
@@ -59,6 +67,13 @@ def import_model(
     thrusters = _thrusters(robot, plugins, placements, where, notes)
     density, hydro = _hydro(links, plugins, where, notes)
     _drop_thruster_links(robot, plugins, where, notes)
+    if not (hydro or allow_dry or any(robot.iter("hydrodynamics"))):
+        raise ModelError(
+            "carries no hydrodynamics (no uuv_simulator or gz-sim plugin uvms-pin maps, no "
+            "<hydrodynamics> element): every link would be dry; pass allow_dry=True "
+            "(uvms-pin import --allow-dry) to import it so",
+            path=where,
+        )
     _finish_links(robot, hydro, where, notes)
     result = ImportResult(urdf_text(robot, where, notes), hydro, thrusters, density, notes, fmt)
     if out is not None:
