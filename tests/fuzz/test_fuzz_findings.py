@@ -169,3 +169,14 @@ def test_a_camera_light_that_is_no_table_is_named():
     doc["sensors"]["camera"][0]["lights"] = [datetime.date(2026, 12, 4)]
     with pytest.raises(ScenarioError, match=r"v.toml: .*lights must be tables"):
         scenario_from_dict(doc, ROOT / "scenarios" / "v.toml")
+
+
+def test_a_plane_normal_of_1e300_is_a_direction_not_a_nan():
+    """Was: a NaN normal (its norm overflowed to inf: 'invalid value encountered in divide')."""
+    from uvms_pin.physics.world.objects import checked
+
+    params, _ = checked(
+        "seabed", "plane", {"point_world_m": [0, 0, -10], "normal_world": [1e300, 0, 1]}, (0.5, 0.4)
+    )
+    np.testing.assert_allclose(params["normal_world"], [1.0, 0.0, 1e-300], rtol=1e-15)
+    assert np.all(np.isfinite(params["normal_world"]))
