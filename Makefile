@@ -11,7 +11,7 @@ BASE_STAMP := $(VENV)/.installed-base
 DEMO_SCENARIO ?= scenarios/realistic_force_tracking.toml
 DEMO_OUT ?= out/demo
 
-.PHONY: demo test lint bench results clean
+.PHONY: demo test lint bench results fuzz clean
 
 SOURCES := pyproject.toml CMakeLists.txt $(wildcard src/uvms_core/*.cpp src/uvms_core/*.hpp)
 
@@ -46,6 +46,15 @@ test: $(STAMP) lint
 	    apt-get update && DEBIAN_FRONTEND=noninteractive apt-get install -y chromium; \
 	  else echo "chromium missing and not installable here (needs root + apt-get): browser tests will skip"; fi; }
 	$(BIN)/python -m pytest -q
+
+# the generated-input campaign (tests/fuzz): HYPOTHESIS_PROFILE=campaign draws 6 times the
+# inputs `make test` draws, from FUZZ_SEED (printed; FUZZ_SEED=N make fuzz replays or varies
+# it), and prints how many inputs each entry point got and how long they took
+FUZZ_SEED ?= 20261204
+fuzz: $(STAMP)
+	@echo "fuzz campaign, seed $(FUZZ_SEED)"
+	HYPOTHESIS_PROFILE=campaign $(BIN)/python -m pytest -q tests/fuzz \
+	  --hypothesis-seed=$(FUZZ_SEED) --hypothesis-show-statistics
 
 # every benchmarks/bench_*.py, one after the other (ratios only; tables in out/bench/);
 # the dev install includes the bench extra (mujoco)

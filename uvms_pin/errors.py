@@ -73,6 +73,12 @@ class PlausibilityWarning(UvmsPinWarning):
     that cannot be physical at all is refused instead."""
 
 
+class ObservabilityWarning(UvmsPinWarning):
+    """The estimator the controller is given cannot observe part of the state: without a
+    position fix (USBL, depth) or a velocity one (DVL, USBL), an IMU's integration drifts
+    without bound. The message names what is unobservable and the sensor that would fix it."""
+
+
 class ActuationWarning(UvmsPinWarning):
     """The actuators left out part of what the controller commanded for a reason the
     scenario does not state (a wrench component no thruster can produce): the message names

@@ -12,7 +12,7 @@ import pytest
 from conftest import ROOT
 
 import uvms_pin.checks as checks
-from uvms_pin.errors import DataError, ScenarioError, StudyError
+from uvms_pin.errors import DataError, ParameterError, ScenarioError, StudyError
 
 URDF = ROOT / "models" / "uvms_lbv150.urdf"
 DATA = ROOT / "data" / "hinsdale2023"
@@ -141,3 +141,74 @@ def test_a_runs_log_counts_the_wet_fractions_a_free_surface_adds(monkeypatch):
     with pytest.raises(ScenarioError, match="the log of this run"):
         load_scenario(path, short)
     load_scenario(path, {**short, "water.free_surface": False})  # no wet fractions logged
+
+
+def test_a_vector_env_of_a_billion_environments_is_refused_from_its_estimate():
+    """The issue's example: 10^9 environments ended in a MemoryError traceback; refused now,
+    within a second of the single environment's set-up, saying how much and how much there is."""
+    import time
+
+    gym = pytest.importorskip("gymnasium")
+    import uvms_pin.apps.gym  # noqa: F401
+
+    start = time.perf_counter()
+    with pytest.raises(ParameterError) as info:
+        gym.make_vec(
+            "uvms_pin/ForceTracking-v0", num_envs=10**9, vectorization_mode="vector_entry_point"
+        )
+    assert time.perf_counter() - start < 5.0
+    message = str(info.value)
+    assert "1000000000 environments on 1 threads" in message
+    assert "GiB, more than half of the" in message and "lower num_envs" in message
+
+
+def test_a_batch_estimate_counts_environments_and_threads(monkeypatch):
+    from uvms_pin.sim.batched_plant import THREAD_BYTES, batch_bytes, check_batch_fits
+
+    one = batch_bytes(100, 11, 10, 1, 1)
+    assert batch_bytes(100, 11, 10, 4, 2) == 4 * (one - THREAD_BYTES) + 2 * THREAD_BYTES
+    assert batch_bytes(100, 11, 10, 2, 10**18) == batch_bytes(100, 11, 10, 2, 2)
+    _available(monkeypatch, 2 * batch_bytes(100, 11, 10, 8, 2))
+    check_batch_fits(100, 11, 10, 8, 2)
+    with pytest.raises(ParameterError, match="9 environments on 2 threads"):
+        check_batch_fits(100, 11, 10, 9, 2)
+
+
+def test_world_objects_are_counted_before_they_are_built(tmp_path, monkeypatch):
+    from uvms_pin.scenario.load import load_scenario
+    from uvms_pin.scenario.objects import objects_bytes
+
+    text = (ROOT / "scenarios" / "push_object.toml").read_text()
+    path = tmp_path / "push.toml"
+    path.write_text(text.replace('"../models/', f'"{ROOT}/models/').replace("object_push:", "x:"))
+    _available(monkeypatch, 2 * objects_bytes(2, 1) - 1)  # the seabed and one free box
+    with pytest.raises(ScenarioError, match=r"push.toml: world.objects: 2 objects \(1 free\)"):
+        load_scenario(path)
+
+
+def test_a_mesh_is_weighed_before_it_is_read(tmp_path, monkeypatch):
+    from uvms_pin.hydro.mesh import MESH_BYTES_PER_TRIANGLE, load_mesh_geometry, mesh_bytes
+
+    stl = tmp_path / "huge.stl"  # a binary STL header declaring 2^32 - 1 triangles
+    stl.write_bytes(b"\0" * 80 + (2**32 - 1).to_bytes(4, "little") + b"\0" * 50)
+    assert mesh_bytes(stl) == (2**32 - 1) * MESH_BYTES_PER_TRIANGLE
+    with pytest.raises(ParameterError, match=r"mesh '.*huge.stl' \(134 bytes\) would take"):
+        load_mesh_geometry(stl)
+    rock = ROOT / "scenarios" / "meshes" / "rock.obj"
+    _available(monkeypatch, 2 * mesh_bytes(rock) - 1)
+    with pytest.raises(ParameterError, match="simplify the mesh"):
+        load_mesh_geometry(rock, (1.0, 1.0, 1.1))
+
+
+def test_a_gym_camera_is_weighed_before_its_spaces_are_made(monkeypatch):
+    gym = pytest.importorskip("gymnasium")
+    from uvms_pin.apps.gym.camera import CameraObservation
+
+    env = gym.make("uvms_pin/StationKeeping-v0")
+    camera = {"name": "cam", "width": 8192, "height": 8192, "rate_hz": 10.0}
+    # a frame (8192^2 x 9 bytes) and the image space's bounds (2 x 8192^2 x 3): 1.0 GiB
+    _available(monkeypatch, 2 * 15 * 8192**2 - 1)
+    with pytest.raises(
+        ParameterError, match=r"a 8192 x 8192 camera observation would take 0\.938 GiB"
+    ):
+        CameraObservation(env, camera)

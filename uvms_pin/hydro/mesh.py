@@ -37,6 +37,7 @@ from pathlib import Path
 
 import numpy as np
 
+from uvms_pin.checks import check_memory
 from uvms_pin.errors import ParameterError
 from uvms_pin.hydro import geometry
 from uvms_pin.hydro.params import HydroParams
@@ -136,7 +137,38 @@ def load_mesh_geometry(path: str | Path, scale=(1.0, 1.0, 1.0)) -> MeshGeometry:
     s = np.broadcast_to(np.asarray(scale, dtype=float).reshape(-1), (3,))
     if not np.all(np.isfinite(s)) or np.any(s == 0.0):
         raise ParameterError(f"mesh scale must be finite and non-zero, got {scale!r}")
+    check_mesh_fits(p)
     return _load_cached(str(p.resolve()), p.stat().st_mtime_ns, tuple(float(x) for x in np.abs(s)))
+
+
+#: memory a mesh takes while it is read and reduced (its triangles, merged vertices,
+#: normals, convex hull and their temporaries), per byte of its file and per triangle a
+#: binary STL declares [bytes]: upper bounds (an OBJ's ~40 bytes of text per triangle, an
+#: STL's 50, become ~400 in memory)
+MESH_BYTES_PER_FILE_BYTE, MESH_BYTES_PER_TRIANGLE = 16, 800
+
+
+def mesh_bytes(path: Path) -> int:
+    """What reading the mesh file ``path`` takes [bytes], from its size and, for a binary
+    STL, from the triangle count its header declares (read from the 4 bytes after it)."""
+    size = path.stat().st_size
+    declared = 0
+    if path.suffix.lower() == ".stl" and size >= 84:
+        with open(path, "rb") as f:
+            head = f.read(84)
+        if not head.lstrip().startswith(b"solid"):
+            declared = int.from_bytes(head[80:84], "little")
+    return max(size * MESH_BYTES_PER_FILE_BYTE, declared * MESH_BYTES_PER_TRIANGLE)
+
+
+def check_mesh_fits(path: Path) -> None:
+    """ParameterError before the mesh file ``path`` is read if it would take more than half
+    of the available memory (`uvms_pin.checks.check_memory`)."""
+    check_memory(
+        mesh_bytes(path),
+        f"mesh '{path}' ({path.stat().st_size} bytes)",
+        "simplify the mesh (fewer triangles)",
+    )
 
 
 def mesh_primitive(

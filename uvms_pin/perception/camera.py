@@ -108,13 +108,20 @@ class CameraSpec:
         raw = dict(raw)
         lights = raw.pop("lights", [])
         reflectance = raw.pop("reflectance", {})
-        if not isinstance(lights, list) or not isinstance(reflectance, dict):
+        tables = isinstance(lights, list) and all(isinstance(light, dict) for light in lights)
+        if not tables or not isinstance(reflectance, dict):
             raise ParameterError(f"{label}: lights must be tables, reflectance a table")
         built = tuple(
             sensor.spec_from_dict(Light, light, f"{label}: lights[{k}]")
             for k, light in enumerate(lights)
         )
-        colours = {str(k): tuple(float(c) for c in v) for k, v in reflectance.items()}
+        try:
+            colours = {str(k): tuple(float(c) for c in v) for k, v in reflectance.items()}
+        except (TypeError, ValueError) as exc:
+            raise ParameterError(
+                f"{label}: reflectance must map label names to (R, G, B) numbers, "
+                f"got {reflectance!r}"
+            ) from exc
         return sensor.spec_from_dict(cls, raw, label, lights=built, reflectance=colours)
 
 

@@ -25,7 +25,7 @@ import numpy as np
 import pinocchio as pin
 
 from uvms_pin.checks import finite_vector, flag
-from uvms_pin.errors import ParameterError
+from uvms_pin.errors import ParameterError, SimulationError
 from uvms_pin.flow import FlowField, UniformCurrent
 from uvms_pin.hydro.restoring import buoyancy_potential_energy
 from uvms_pin.model.uvms import UVMS
@@ -35,6 +35,7 @@ from uvms_pin.physics.configuration import checked_configuration
 from uvms_pin.physics.derivatives.reference import (
     forward_dynamics_derivatives as reference_derivatives,
 )
+from uvms_pin.physics.kinematics import check_frame_id
 from uvms_pin.physics.reference import ReferenceDynamics, check_time
 from uvms_pin.physics.surface import WetState, wet_state
 
@@ -75,6 +76,21 @@ def _flow_of_call(current_world: np.ndarray, flow: FlowField | None) -> FlowFiel
     return flow
 
 
+def _finite_result(what: str, value: np.ndarray, uvms: UVMS, q, v=None) -> np.ndarray:
+    """``value``, or an error when finite inputs gave a non-finite result (checked after,
+    at no cost on the way of every call): ParameterError for a q off the configuration
+    manifold (a quaternion of norm 1e300), else SimulationError for a speed whose square
+    (quadratic damping, Coriolis) leaves the floating-point range."""
+    if not np.all(np.isfinite(value)):
+        checked_configuration("q", q, uvms.model)
+        fastest = 0.0 if v is None else float(np.max(np.abs(np.asarray(v, dtype=float))))
+        raise SimulationError(
+            f"{what} is not finite for finite inputs: the fastest entry of zeta, {fastest:.3g}, "
+            "is beyond what its square holds in floating point"
+        )
+    return value
+
+
 def mass_matrix(
     uvms: UVMS,
     q: np.ndarray,
@@ -92,8 +108,9 @@ def mass_matrix(
     dynamics = dynamics_of(uvms, backend)
     free_surface = flag("free_surface", free_surface)
     if not free_surface:
-        return dynamics.mass_matrix(q)
-    return dynamics.mass_matrix_in(q, _checked_flow(flow), check_time(time_s), True)
+        return _finite_result("M(q)", dynamics.mass_matrix(q), uvms, q)
+    mass = dynamics.mass_matrix_in(q, _checked_flow(flow), check_time(time_s), True)
+    return _finite_result("M(q)", mass, uvms, q)
 
 
 def bias_forces(
@@ -124,9 +141,10 @@ def bias_forces(
     dynamics = dynamics_of(uvms, backend)
     free_surface = flag("free_surface", free_surface)
     if flow is None and not free_surface:
-        return dynamics.bias_forces(q, v, current_world)
+        return _finite_result("h(q, zeta)", dynamics.bias_forces(q, v, current_world), uvms, q, v)
     flow = _flow_of_call(current_world, flow)
-    return dynamics.bias_forces_in(q, v, flow, check_time(time_s), free_surface)
+    h = dynamics.bias_forces_in(q, v, flow, check_time(time_s), free_surface)
+    return _finite_result("h(q, zeta)", h, uvms, q, v)
 
 
 def forward_dynamics(
@@ -160,9 +178,13 @@ def forward_dynamics(
     dynamics = dynamics_of(uvms, backend)
     free_surface = flag("free_surface", free_surface)
     if flow is None and not free_surface:
-        return dynamics.forward_dynamics(q, v, tau, current_world, tau_ext)
-    flow = _flow_of_call(current_world, flow)
-    return dynamics.forward_dynamics_in(q, v, tau, flow, check_time(time_s), tau_ext, free_surface)
+        zeta_dot = dynamics.forward_dynamics(q, v, tau, current_world, tau_ext)
+    else:
+        flow = _flow_of_call(current_world, flow)
+        zeta_dot = dynamics.forward_dynamics_in(
+            q, v, tau, flow, check_time(time_s), tau_ext, free_surface
+        )
+    return _finite_result("zeta_dot", zeta_dot, uvms, q, v)
 
 
 def forward_dynamics_derivatives(
@@ -238,10 +260,18 @@ def water_of_call(
 def frame_wrench_to_generalized(
     uvms: UVMS, q: np.ndarray, frame_id: int, wrench_world_aligned: np.ndarray
 ) -> np.ndarray:
-    """tau_ext = J^T w for a wrench at a frame origin, in world-aligned axes [N; N m]."""
+    """tau_ext = J^T w for a wrench at a frame origin, in world-aligned axes [N; N m].
+
+    Raises:
+        ParameterError: q not a finite configuration, frame_id not a frame, the wrench not
+            6 finite numbers.
+    """
     model, data = uvms.model, uvms.data
+    q = checked_configuration("q", q, model)
+    frame_id = check_frame_id(model, frame_id)
+    wrench = finite_vector("wrench_world_aligned", wrench_world_aligned, 6)
     jac = pin.computeFrameJacobian(model, data, q, frame_id, pin.LOCAL_WORLD_ALIGNED)
-    return jac.T @ wrench_world_aligned
+    return jac.T @ wrench
 
 
 def kinetic_energy(

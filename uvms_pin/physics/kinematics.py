@@ -153,7 +153,11 @@ def _check_q(model: pin.Model, q: np.ndarray) -> np.ndarray:
     return q
 
 
-def _check_frame_id(model: pin.Model, frame_id: int) -> int:
+def check_frame_id(model: pin.Model, frame_id: int) -> int:
+    """``frame_id`` as an int naming a frame of ``model``, else ParameterError (Pinocchio
+    does not check it: an index out of range reads past its frames)."""
+    if isinstance(frame_id, bool) or not isinstance(frame_id, int | np.integer):
+        raise ParameterError(f"frame_id must be an integer, got {frame_id!r}")
     if not 0 <= int(frame_id) < model.nframes:
         raise ParameterError(f"frame_id {frame_id} out of range [0, {model.nframes})")
     return int(frame_id)
@@ -168,7 +172,7 @@ def end_effector_pose(
     where ``rpy = (roll, pitch, yaw)`` of the frame's rotation world_R_frame.
     """
     q = _check_q(model, q)
-    frame_id = _check_frame_id(model, frame_id)
+    frame_id = check_frame_id(model, frame_id)
     pin.forwardKinematics(model, data, q)
     placement_world = pin.updateFramePlacement(model, data, frame_id)
     position_world = np.array(placement_world.translation, dtype=float)
@@ -204,7 +208,7 @@ def analytical_jacobian(
             rates are undefined.
     """
     q = _check_q(model, q)
-    frame_id = _check_frame_id(model, frame_id)
+    frame_id = check_frame_id(model, frame_id)
     pin.computeJointJacobians(model, data, q)  # also runs forward kinematics
     placement_world = pin.updateFramePlacement(model, data, frame_id)
     rpy = euler_rpy_from_rotation(placement_world.rotation)

@@ -225,14 +225,24 @@ def claim_file(
     if path.is_dir():
         raise OutputError(f"{option} {path}: is a directory; give a file name (replay.html)")
     directory = check_writable(path.parent, option, shown=str(path))
+    made = [d for d in (directory.absolute(), *directory.absolute().parents) if not d.exists()]
     directory.mkdir(parents=True, exist_ok=True)
-    with _locked(directory, option):
-        if path.exists() and not overwrite:
-            raise OutputError(
-                f"{option} {path} already exists; pass --overwrite to replace it, "
-                "or --out to write elsewhere"
-            )
-        yield path
+    try:
+        with _locked(directory, option):
+            if path.exists() and not overwrite:
+                raise OutputError(
+                    f"{option} {path} already exists; pass --overwrite to replace it, "
+                    "or --out to write elsewhere"
+                )
+            yield path
+    except BaseException:
+        # a failed command leaves no empty directory of its own making behind
+        for created in made:  # (the deepest first)
+            try:
+                created.rmdir()
+            except OSError:  # not empty: something was written there
+                break
+        raise
 
 
 @contextmanager

@@ -4,7 +4,9 @@ fitted). Its keys are in docs/scenarios.md ("Estimator")."""
 
 from __future__ import annotations
 
-from uvms_pin.errors import ParameterError
+import warnings
+
+from uvms_pin.errors import ObservabilityWarning, ParameterError
 from uvms_pin.scenario.schema import Table
 from uvms_pin.sim.estimation.eskf import ImuNoise
 from uvms_pin.sim.estimation.spec import CONTROLLER_INPUTS, ESTIMATOR_TYPES, EstimatorSpec
@@ -53,7 +55,28 @@ def build_estimator(t: Table | None, navigation: NavigationSpec) -> EstimatorSpe
         spec.checked_against(navigation)
     except ParameterError as exc:
         raise t.fail(str(exc)) from exc
+    unobservable = unobservable_states(navigation)
+    if controller_input == "estimate" and unobservable:
+        warnings.warn(
+            f'{t.source}: [estimator] controller_input = "estimate": the controller is given '
+            f"an estimate whose {'; '.join(unobservable)}: it drifts without bound",
+            ObservabilityWarning,
+            stacklevel=2,
+        )
     return spec
+
+
+def unobservable_states(navigation: NavigationSpec) -> list[str]:
+    """What an IMU-propagated estimate cannot observe with the fitted sensors, each with the
+    sensor that would make it observable (empty: all of position and velocity is)."""
+    out = []
+    if navigation.usbl is None:
+        vertical = navigation.depth_noise_Pa is not None
+        what = "horizontal position" if vertical else "position"
+        out.append(f"{what} is unobservable (fit a USBL{'' if vertical else ' or a depth sensor'})")
+    if navigation.dvl is None and navigation.usbl is None:
+        out.append("velocity is unobservable (fit a DVL)")
+    return out
 
 
 def _imu_noise(t: Table, navigation: NavigationSpec) -> ImuNoise | None:

@@ -131,7 +131,7 @@ def _build(raw: dict[str, Any], path: Path, top: Table) -> Scenario:
         build_control_period(top.table_or_empty("control")),
         integrator,
         log_period,
-        passive=(raw.get("controller") or {}).get("type", "none") == "none",
+        passive=_controller_type(raw) == "none",
     )
     joints = top.table_or_empty("joints")
     joint_stops, joint_limits = build_joint_limits(joints, uvms, control_period is not None)
@@ -191,6 +191,13 @@ def _build(raw: dict[str, Any], path: Path, top: Table) -> Scenario:
         extra_metrics=extra_metrics,
         task=task,
     )
+
+
+def _controller_type(raw: dict[str, Any]) -> Any:
+    """``[controller] type`` as written ("none" without the table), before the table is
+    read: a table that is no table is refused when it is read, naming it."""
+    controller = raw.get("controller")
+    return controller.get("type", "none") if isinstance(controller, dict) else "none"
 
 
 def _head(t: Table, path: Path) -> Head:

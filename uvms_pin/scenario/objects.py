@@ -10,6 +10,7 @@ from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
+from uvms_pin.checks import check_memory
 from uvms_pin.errors import ParameterError
 from uvms_pin.model.uvms import UVMS
 from uvms_pin.physics.world.contact_law import ContactLaw
@@ -25,7 +26,20 @@ from uvms_pin.physics.world.objects import (
 from uvms_pin.physics.world.world import INITIAL_OVERLAP, World
 from uvms_pin.scenario.schema import Table
 
-__all__ = ["KEY_READERS", "build_world"]
+__all__ = ["KEY_READERS", "build_world", "objects_bytes"]
+
+#: what an object of the world takes [bytes], upper bounds: a fixed one (its shape and the
+#: contact state against it), a free one besides (its own model and data, in Python and in
+#: the compiled core, its logged state), and every pair of bodies a free object can touch
+FIXED_OBJECT_BYTES, FREE_OBJECT_BYTES, PAIR_BYTES = 2**16, 2**20, 2**14
+
+
+def objects_bytes(n_objects: int, n_free: int) -> int:
+    """What ``n_objects`` objects (``n_free`` of them free) take [bytes]: each its share,
+    each free one a pair with every other body and the robot."""
+    return n_objects * FIXED_OBJECT_BYTES + n_free * (
+        FREE_OBJECT_BYTES + (n_objects + 1) * PAIR_BYTES
+    )
 
 
 def build_world(t: Table | None, uvms: UVMS, base_dir: Path) -> World | None:
@@ -35,7 +49,15 @@ def build_world(t: Table | None, uvms: UVMS, base_dir: Path) -> World | None:
     contact = t.table_or_empty("contact")
     self_collision = contact.boolean("self_collision", False)
     law = _law(contact)
-    built = [_object(o, k, law, base_dir, uvms) for k, o in enumerate(t.tables("objects"))]
+    tables = t.tables("objects")
+    n_free = sum(o.has("mass_kg") or o.has("density_kg_m3") for o in tables)
+    check_memory(
+        objects_bytes(len(tables), n_free),
+        f"{len(tables)} objects ({n_free} free)",
+        "give fewer [[world.objects]]",
+        lambda message: t.error("objects", message),
+    )
+    built = [_object(o, k, law, base_dir, uvms) for k, o in enumerate(tables)]
     overlap = t.string("initial_overlap", "refuse", choices=INITIAL_OVERLAP)
     t.finish()
     fixed = [o for o in built if isinstance(o, WorldObject)]

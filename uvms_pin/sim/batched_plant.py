@@ -26,6 +26,7 @@ import math
 import numpy as np
 import pinocchio as pin
 
+from uvms_pin.checks import check_memory
 from uvms_pin.errors import ParameterError
 from uvms_pin.physics.compiled.contact import contact_to_core
 from uvms_pin.physics.compiled.extension import core_module
@@ -38,6 +39,34 @@ from uvms_pin.sim.system import System
 
 #: BatchStatus of the core: what became of an environment in the last step
 RUNNING, DIVERGED = 0, 1
+#: a thread's copy of the compiled plant (model, data, scratch) [bytes]: an upper bound
+#: (the reference model's is under 1 MiB)
+THREAD_BYTES = 8 * 2**20
+#: an environment's share of the Python side (its generator slot, seed, flags, final
+#: observation slot; the per-environment observations are counted from their size)
+ENV_PYTHON_BYTES = 256
+
+
+def batch_bytes(rows: int, nq: int, nv: int, num_envs: int, num_threads: int) -> int:
+    """What a batch takes [bytes]: per environment its noise tables (``rows`` samples of
+    the 6 + 2 nv noise channels), its state rows (q, q_measured: nq; v, v_measured,
+    tau_applied, an observation: nv; wrench and contact: 12) and its Python share; per
+    thread (at most one per environment) a copy of the plant. ``num_envs`` and
+    ``num_threads`` may be any size: the estimate is exact integer arithmetic."""
+    per_env = 8 * (rows * (6 + 2 * nv) + 2 * nq + 4 * nv + 12) + 16 + ENV_PYTHON_BYTES
+    return num_envs * per_env + min(num_threads, num_envs) * THREAD_BYTES
+
+
+def check_batch_fits(rows: int, nq: int, nv: int, num_envs: int, num_threads: int) -> None:
+    """ParameterError, before anything is allocated, if a batch of ``num_envs``
+    environments on ``num_threads`` threads would take more than half of the available
+    memory (`uvms_pin.checks.check_memory`)."""
+    check_memory(
+        batch_bytes(rows, nq, nv, num_envs, num_threads),
+        f"{num_envs} environments on {min(num_threads, num_envs)} threads "
+        f"({rows} noise samples of {6 + 2 * nv} channels each)",
+        "lower num_envs (or num_threads), or shorten the scenario's duration_s",
+    )
 
 
 def check_count(name: str, value: object) -> int:
@@ -89,11 +118,13 @@ class BatchedPlant:
         self.plant, self.settings, self.sensors = plant, settings, sensors
         self.period_s = float(settings.control_period_s)
         self._rows = math.ceil(settings.duration_s / sensors.sample_period_s) + 2
+        check_batch_fits(self._rows, plant.uvms.nq, nv, num_envs, num_threads)
         self._specs = _noise_specs(sensors)
         self._widths = (3, 3, 3, 3, nv - 6, nv)
+        threads = min(num_threads, num_envs)  # (the core takes a 32-bit count)
         self._core = batch_to_core(
             plant, settings.integrator, self.period_s, sensors.sample_period_s, self._rows,
-            [spec.bound == 0.0 for spec in self._specs], num_envs, num_threads, core_module(),
+            [spec.bound == 0.0 for spec in self._specs], num_envs, threads, core_module(),
         )  # fmt: skip
         self._stepping = np.ones(num_envs, dtype=bool)
 

@@ -31,3 +31,16 @@ def test_a_bad_file_is_exit_2_and_writes_nothing(tmp_path):
     assert result.returncode == 2
     assert "cylinder" in result.stderr and "Traceback" not in result.stderr
     assert not out.exists() and not out.with_suffix(".thrusters.toml").exists()
+
+
+def test_a_failed_import_leaves_no_directory_of_its_own_making(tmp_path):
+    """The --out file's missing directories are made for it, and removed again (when still
+    empty) if the import fails; one that existed stays."""
+    bad = tmp_path / "bad.urdf"
+    bad.write_text("<robot name='x'><link name='a'/><joint/></robot>")
+    result = run("import", str(bad), "--out", str(tmp_path / "new" / "deeper" / "out.urdf"))
+    assert result.returncode == 2, result.stderr
+    assert not (tmp_path / "new").exists()
+    (tmp_path / "kept").mkdir()
+    assert run("import", str(bad), "--out", str(tmp_path / "kept" / "out.urdf")).returncode == 2
+    assert (tmp_path / "kept").is_dir()

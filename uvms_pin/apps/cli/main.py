@@ -91,7 +91,7 @@ def _cmd_import(args: argparse.Namespace) -> int:
         if table.exists() and not args.overwrite:
             raise OutputError(f"--thrusters {table}: exists; pass --overwrite to replace it")
         check_writable(table.parent, "--thrusters", shown=str(table))
-        result = import_model(args.file, out, thrusters_out=table)
+        result = import_model(args.file, out, thrusters_out=table, allow_dry=args.allow_dry)
     print(f"wrote {out}")
     if result.thrusters:
         print(f"wrote {table} ({len(result.thrusters)} thrusters)")
@@ -116,6 +116,11 @@ def _add_import(sub) -> None:
         "--thrusters", help="the thruster table to write (default: OUT with .thrusters.toml)"
     )
     parser.add_argument("--overwrite", action="store_true", help="replace existing files")
+    parser.add_argument(
+        "--allow-dry",
+        action="store_true",
+        help="import a file that carries no hydrodynamics at all (every link dry)",
+    )
     parser.set_defaults(func=_cmd_import)
 
 
@@ -140,6 +145,13 @@ def build_parser() -> argparse.ArgumentParser:
     )
     run.add_argument(
         "--html", action="store_true", help="also write replay.html (self-contained, offline)"
+    )
+    run.add_argument(
+        "--no-code",
+        action="store_true",
+        help="refuse a scenario that would import a module (a module:Class controller, a "
+        "metric function) or read a file outside its folder and the shipped models: for "
+        "files of unknown origin (docs/security.md)",
     )
     _add_view_options(run)
     run.set_defaults(func=cmd_run)

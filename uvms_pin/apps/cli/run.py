@@ -52,6 +52,8 @@ def cmd_run(args: argparse.Namespace) -> int:
 
     check_view_options(args)
     overrides = dict(parse_assignment(text) for text in args.set)
+    if args.no_code:
+        _check_no_code(args.scenario, overrides)
     scenario = load_scenario(args.scenario, overrides)
     out = check_writable(args.out)  # before simulating, not after
     with InterruptGuard() as guard, claim(out, RUN, overwrite=args.overwrite):
@@ -75,6 +77,18 @@ def cmd_run(args: argparse.Namespace) -> int:
         print(failure.message, file=sys.stderr)
         return failure.status
     return ending.status
+
+
+def _check_no_code(scenario_file: str, overrides: dict) -> None:
+    """--no-code: the file (with its overrides) refused before anything is imported or read
+    beyond it (`uvms_pin.scenario.trust`)."""
+    from uvms_pin.errors import ScenarioError
+    from uvms_pin.scenario.overrides import apply_overrides
+    from uvms_pin.scenario.toml import read_toml
+    from uvms_pin.scenario.trust import check_no_code
+
+    path = Path(scenario_file)
+    check_no_code(apply_overrides(read_toml(path, ScenarioError), overrides), path)
 
 
 def _simulate(scenario, args: argparse.Namespace, progress) -> Rollout:

@@ -47,7 +47,10 @@ def action_scale(
         ParameterError: a missing or bad scale.
     """
     if override is not None:
-        scale = np.asarray(override, dtype=float).reshape(-1)
+        try:
+            scale = np.asarray(override, dtype=float).reshape(-1)
+        except (TypeError, ValueError):  # text, a table: not numbers
+            scale = np.full(0, np.nan)
         if scale.shape != (nv,) or not np.all(np.isfinite(scale)) or np.any(scale <= 0.0):
             raise ParameterError(
                 f"action_scale must be {nv} positive finite numbers [N, N m], got {override}"

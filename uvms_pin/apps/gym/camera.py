@@ -14,8 +14,10 @@ from typing import Any
 import gymnasium as gym
 import numpy as np
 
+from uvms_pin.checks import check_memory
 from uvms_pin.perception.camera import Camera, CameraSpec
 from uvms_pin.perception.scene import scene_of
+from uvms_pin.perception.sensor import SENSORS
 from uvms_pin.perception.suite import PERCEPTION_SEED_INDEX
 
 __all__ = ["CameraObservation"]
@@ -35,6 +37,12 @@ class CameraObservation(gym.ObservationWrapper):
         super().__init__(env)
         if not isinstance(camera, CameraSpec):
             camera = CameraSpec.from_dict(dict(camera), "camera")
+        pixels = camera.width * camera.height
+        check_memory(  # a frame, and the observation space's bounds (low, high) of its arrays
+            SENSORS["camera"].bytes(camera) + 2 * pixels * (3 + (4 if depth else 0)),
+            f"a {camera.width} x {camera.height} camera observation",
+            "lower the camera's width and height",
+        )
         plant = env.unwrapped.scenario.plant
         self._scene = scene_of(plant.uvms, plant.world, surface=plant.free_surface)
         self._camera = Camera(camera, self._scene, _episode_stream(None))

@@ -16,6 +16,7 @@ at the scenario's duration_s.
 from __future__ import annotations
 
 import numbers
+import os
 from pathlib import Path
 from typing import Any, ClassVar
 
@@ -324,6 +325,10 @@ def _layout(nq: int, nv: int, goal_size: int) -> dict[str, slice]:
 
 def scenario_path(scenario: str | Path) -> Path:
     """A scenario file, or the name of a shipped one (``realistic_force_tracking``)."""
+    if not isinstance(scenario, str | os.PathLike):
+        raise ParameterError(
+            f"scenario must be a file or a shipped scenario's name, got {scenario!r}"
+        )
     path = Path(scenario)
     if path.is_file():
         return path

@@ -252,8 +252,12 @@ def _check_report(report: dict[str, Any], source: str, paths: set[str]) -> None:
     unknown = set(report) - known
     if unknown:
         raise StudyError(f"{source}: [report] has unknown key(s): {', '.join(sorted(unknown))}")
-    for k, pair in enumerate(report.get("heatmaps", [])):
-        if not (isinstance(pair, list) and len(pair) == 2 and set(pair) <= paths):
+    heatmaps = report.get("heatmaps", [])
+    if not isinstance(heatmaps, list):
+        raise StudyError(f"{source}: report.heatmaps: must be a list of parameter-path pairs")
+    for k, pair in enumerate(heatmaps):
+        texts = isinstance(pair, list) and all(isinstance(p, str) for p in pair)
+        if not (texts and len(pair) == 2 and set(pair) <= paths):
             raise StudyError(
                 f"{source}: report.heatmaps[{k}]: must be two parameter paths, got {pair!r}"
             )

@@ -177,6 +177,10 @@ class Summary(dict):
     """Counts of a sweep: total, skipped (already recorded), run now, and per status."""
 
 
+#: the only interface a local cluster listens on
+LOOPBACK = "127.0.0.1"
+
+
 def _client(workers: int | None, scheduler: str | None):
     from dask.distributed import Client, LocalCluster
 
@@ -189,11 +193,14 @@ def _client(workers: int | None, scheduler: str | None):
                 "is the scheduler running at that address?"
             ) from exc
     with _sigint_ignored_by_children():
+        # every server of the local cluster (scheduler, workers, dashboard) on the loopback
+        # interface: nothing of a study listens on the network (docs/security.md)
         cluster = LocalCluster(
             n_workers=workers or os.cpu_count() or 1,
             threads_per_worker=1,
             processes=True,
-            dashboard_address=":0",
+            host=LOOPBACK,
+            dashboard_address=f"{LOOPBACK}:0",
             silence_logs=logging.ERROR,
         )
     return Client(cluster), cluster

@@ -12,6 +12,7 @@ links (a thruster plugin's propeller) leave the tree and become the thruster tab
 from __future__ import annotations
 
 import copy
+import math
 import xml.etree.ElementTree as ET
 from contextlib import nullcontext
 from pathlib import Path
@@ -27,7 +28,7 @@ from uvms_pin.model.importer.plugins import PluginKind, plugin_kind
 from uvms_pin.model.importer.result import ImportedThruster, ImportResult
 from uvms_pin.model.importer.sdf import sdf_model, sdf_to_urdf
 from uvms_pin.model.importer.thrusters import gz_thruster, uuv_thruster
-from uvms_pin.model.importer.tree import link_placements
+from uvms_pin.model.importer.tree import fix_immobile_joints, link_placements
 from uvms_pin.model.importer.write import hydro_element, thruster_table_text, urdf_text
 from uvms_pin.model.urdf.read import xml_root
 from uvms_pin.results.atomic import atomic_path
@@ -40,10 +41,18 @@ GZ_DEFAULT_DENSITY_KG_M3 = 1000.0  # the Buoyancy system's default
 
 
 def import_model(
-    path: str | Path, out: str | Path | None = None, *, thrusters_out: str | Path | None = None
+    path: str | Path,
+    out: str | Path | None = None,
+    *,
+    thrusters_out: str | Path | None = None,
+    allow_dry: bool = False,
 ) -> ImportResult:
     """Read a Gazebo vehicle; with ``out``, write the URDF there and, when it has thrusters,
     the table to ``thrusters_out`` (default: ``out`` with ``.thrusters.toml``).
+
+    ``allow_dry``: import a file that carries no hydrodynamics at all (no plugin uvms-pin
+    maps, no ``<hydrodynamics>`` element) with every link dry; refused otherwise (a vehicle
+    without water is rarely what was meant).
 
     Raises:
         ModelError: naming the file and what cannot be read or mapped; nothing is written.
@@ -53,10 +62,18 @@ def import_model(
     notes: list[str] = []
     robot, plugins, fmt = _read_source(path, notes)
     links = {link.get("name"): link for link in robot.findall("link")}
+    fix_immobile_joints(robot, notes)
     placements = link_placements(robot, where)
     thrusters = _thrusters(robot, plugins, placements, where, notes)
     density, hydro = _hydro(links, plugins, where, notes)
-    _drop_thruster_links(robot, plugins, notes)
+    _drop_thruster_links(robot, plugins, where, notes)
+    if not (hydro or allow_dry or any(robot.iter("hydrodynamics"))):
+        raise ModelError(
+            "carries no hydrodynamics (no uuv_simulator or gz-sim plugin uvms-pin maps, no "
+            "<hydrodynamics> element): every link would be dry; pass allow_dry=True "
+            "(uvms-pin import --allow-dry) to import it so",
+            path=where,
+        )
     _finish_links(robot, hydro, where, notes)
     result = ImportResult(urdf_text(robot, where, notes), hydro, thrusters, density, notes, fmt)
     if out is not None:
@@ -118,13 +135,13 @@ def _hydro(links, plugins, where, notes) -> tuple[float | None, dict[str, HydroP
     buoyancy = PluginKind.GZ_BUOYANCY in kinds
     for plugin, kind in zip(plugins, kinds, strict=True):
         if kind is PluginKind.UUV_HYDRO:
-            density = _number_or(plugin, "fluid_density", UUV_DEFAULT_DENSITY_KG_M3)
+            density = _number_or(plugin, "fluid_density", UUV_DEFAULT_DENSITY_KG_M3, where)
             for block in plugin.findall("link"):
                 name = _known_link(block.get("name"), links, where)
-                hydro[name] = fossen_hydro(block, _mass(links[name]), density, where, notes)
+                hydro[name] = fossen_hydro(block, _mass(links[name], where), density, where, notes)
             _note_plugin_extras(plugin, {"link", "fluid_density"}, notes)
         elif kind is PluginKind.GZ_BUOYANCY:
-            density = _number_or(plugin, "uniform_fluid_density", GZ_DEFAULT_DENSITY_KG_M3)
+            density = _number_or(plugin, "uniform_fluid_density", GZ_DEFAULT_DENSITY_KG_M3, where)
             _note_plugin_extras(plugin, {"uniform_fluid_density"}, notes)
         elif kind is None:
             notes.append(f"plugin '{plugin.get('name') or plugin.get('filename')}' not mapped")
@@ -152,7 +169,9 @@ def _gz_buoyancy(link, buoyancy: bool, where: str, notes: list[str]) -> tuple[fl
     return 0.0, np.zeros(3)
 
 
-def _drop_thruster_links(robot: ET.Element, plugins: list[ET.Element], notes: list[str]) -> None:
+def _drop_thruster_links(
+    robot: ET.Element, plugins: list[ET.Element], where: str, notes: list[str]
+) -> None:
     """The propeller links and their joints leave the tree: a thruster is an actuator of the
     vehicle, not an arm joint. Their mass is reported."""
     joints = {j.get("name"): j for j in robot.findall("joint")}
@@ -167,13 +186,21 @@ def _drop_thruster_links(robot: ET.Element, plugins: list[ET.Element], notes: li
         else:
             continue
         if any(j.find("parent").get("link") == link for j in joints.values()):
-            raise ModelError(f"thruster link '{link}' carries other links; cannot remove it")
+            raise ModelError(
+                f"thruster link '{link}' carries other links; cannot remove it", path=where
+            )
+        if link not in by_child or links.get(link) not in robot:
+            raise ModelError(
+                f"thruster link '{link}' is no joint's child, or the link of two thruster "
+                "plugins: each thruster needs its own propeller link on a joint",
+                path=where,
+            )
         robot.remove(links[link])
         robot.remove(by_child[link])
         # what was said of the removed joint no longer applies to the written model
         notes[:] = [n for n in notes if not n.startswith(f"joint '{by_child[link].get('name')}':")]
         notes.append(
-            f"thruster link '{link}' ({_mass(links[link]):g} kg) and joint "
+            f"thruster link '{link}' ({_mass(links[link], where):g} kg) and joint "
             f"'{by_child[link].get('name')}' removed from the tree: the thruster is in the "
             "thruster table"
         )
@@ -183,9 +210,13 @@ def _finish_links(
     robot: ET.Element, hydro: dict[str, HydroParams], where: str, notes: list[str]
 ) -> None:
     """Each link with mass gets its ``<hydrodynamics>`` (zero volume: dry, as in the
-    source); a link without mass loses its collision shapes (uvms-pin needs mass there)."""
+    source), unless the source already gives it one (a uvms-pin URDF: kept as it is, never
+    stripped); a link without mass loses its collision shapes (uvms-pin needs mass there)."""
     for link in robot.findall("link"):
         name = link.get("name")
+        own = link.find("hydrodynamics") is not None and name not in hydro
+        if own and link.find("inertial") is not None:
+            continue  # the source's own hydrodynamics, kept
         for old in link.findall("hydrodynamics"):
             link.remove(old)
         if link.find("inertial") is None:
@@ -209,21 +240,32 @@ def _known_link(name: str | None, links: dict[str, ET.Element], where: str) -> s
     return name
 
 
-def _mass(link: ET.Element) -> float:
+def _mass(link: ET.Element, where: str) -> float:
+    """The link's <mass value> [kg] (0 without one); ModelError naming the link if it is
+    not a finite number."""
     mass = link.find("inertial/mass")
-    return 0.0 if mass is None else float(mass.get("value", "0"))
+    text = "0" if mass is None else mass.get("value", "0")
+    try:
+        value = float(text)
+    except ValueError:
+        value = math.nan
+    if not math.isfinite(value):
+        raise ModelError(
+            f"<mass value='{text}'> is not a finite number", path=where, link=link.get("name")
+        )
+    return value
 
 
-def _number_or(plugin: ET.Element, tag: str, default: float) -> float:
+def _number_or(plugin: ET.Element, tag: str, default: float, where: str) -> float:
     text = plugin.findtext(tag)
     if text is None:
         return default
     try:
         value = float(text)
     except ValueError as exc:
-        raise ModelError(f"plugin <{tag}> is not a number: '{text.strip()}'") from exc
-    if not value > 0.0:
-        raise ModelError(f"plugin <{tag}> must be positive, got {value}")
+        raise ModelError(f"plugin <{tag}> is not a number: '{text.strip()}'", path=where) from exc
+    if not (value > 0.0 and math.isfinite(value)):
+        raise ModelError(f"plugin <{tag}> must be positive and finite, got {value}", path=where)
     return value
 
 

@@ -156,13 +156,24 @@ def _joint(
     return out
 
 
+def _joint_numbers(text: str, count: int, where: str, what: str) -> np.ndarray:
+    """``count`` finite numbers of ``text``, or a ModelError naming the file and ``what``."""
+    try:
+        values = np.array([float(v) for v in text.split()])
+    except ValueError:
+        values = np.array([])
+    if values.size != count or not np.all(np.isfinite(values)):
+        raise ModelError(f"{what} must be {count} finite numbers, got '{text.strip()}'", path=where)
+    return values
+
+
 def _axis(
     out: ET.Element, axis: ET.Element, child_pose: pin.SE3, where: str, name: str, notes: list[str]
 ) -> None:
     xyz = axis.find("xyz")
     if xyz is not None and xyz.get("expressed_in"):
         raise ModelError(f"joint '{name}': <xyz expressed_in> is not supported", path=where)
-    direction = np.array([float(v) for v in (axis.findtext("xyz") or "0 0 1").split()])
+    direction = _joint_numbers(axis.findtext("xyz") or "0 0 1", 3, where, f"joint '{name}': <xyz>")
     if (axis.findtext("use_parent_model_frame") or "").strip().lower() in ("1", "true"):
         direction = child_pose.rotation.T @ direction
     ET.SubElement(out, "axis", xyz=numbers_text(direction))
@@ -177,7 +188,11 @@ def _axis(
         ("velocity", UNLIMITED),
     ):
         text = limit.findtext(key)
-        value = default if text is None else float(text)
+        value = (
+            default
+            if text is None
+            else float(_joint_numbers(text, 1, where, f"joint '{name}': <{key}>")[0])
+        )
         if key in ("effort", "velocity") and value < 0.0:
             notes.append(
                 f"joint '{name}': {key} limit {value:g} (unlimited) written as {UNLIMITED:g}"

@@ -10,7 +10,7 @@ import pinocchio as pin
 from uvms_pin.errors import ModelError
 from uvms_pin.model.urdf.read import read_origin
 
-__all__ = ["link_placements", "root_link"]
+__all__ = ["fix_immobile_joints", "link_placements", "root_link"]
 
 
 def root_link(robot: ET.Element, where: str) -> str:
@@ -53,3 +53,27 @@ def axis_of(joint: ET.Element) -> np.ndarray:
         [float(v) for v in (axis.get("xyz", "1 0 0") if axis is not None else "1 0 0").split()]
     )
     return values / np.linalg.norm(values)
+
+
+def fix_immobile_joints(robot: ET.Element, notes: list[str]) -> None:
+    """Joints that cannot move become fixed joints, said so in ``notes``: a ``revolute`` or
+    ``prismatic`` joint whose ``<limit>`` has lower = upper (a simulator's sensor mount,
+    written as a joint of limits 0 to 0) would otherwise be a degree of freedom without
+    inertia behind it: a singular mass matrix."""
+    for joint in robot.findall("joint"):
+        limit = joint.find("limit")
+        if joint.get("type") not in ("revolute", "prismatic") or limit is None:
+            continue
+        lower, upper = limit.get("lower"), limit.get("upper")
+        try:
+            immobile = lower is not None and upper is not None and float(lower) == float(upper)
+        except ValueError:  # not numbers: the loader names them
+            continue
+        if immobile:
+            notes.append(
+                f"joint '{joint.get('name')}': {joint.get('type')} with limits {lower} to "
+                f"{upper} cannot move; written as a fixed joint"
+            )
+            joint.set("type", "fixed")
+            for child in [c for c in joint if c.tag in ("limit", "axis", "dynamics", "mimic")]:
+                joint.remove(child)

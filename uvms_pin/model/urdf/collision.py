@@ -10,6 +10,7 @@ import xml.etree.ElementTree as ET
 from collections.abc import Sequence
 from pathlib import Path
 
+import numpy as np
 import pinocchio as pin
 
 from uvms_pin.errors import ModelError, ParameterError
@@ -121,12 +122,24 @@ def _shape(geometry_element: ET.Element | None, where: str, link: str) -> ET.Ele
     return geometry_element[0]
 
 
+#: the largest dimension of a collision primitive [m]: beyond, no vehicle (and its powers,
+#: r^5 in a tumbling drag, leave the floating-point range long before 1e61 m)
+MAX_DIMENSION_M = 1e4
+
+
 def _dimensions(shape: ET.Element, where: str, link: str) -> list:
     """The dimensions [m] of a <box> (its size, 3 numbers), <cylinder> (radius, length) or
     <sphere> (radius); ModelError naming the attribute if one is missing or malformed."""
     values = []
     for name, count in _DIMENSIONS[shape.tag]:
         numbers = read_numbers(shape.get(name), count, f"<{shape.tag} {name}>", where, link)
+        if np.any(np.abs(numbers) > MAX_DIMENSION_M):
+            raise ModelError(
+                f"<{shape.tag} {name}> = {shape.get(name)} m cannot be physical (a collision "
+                f"shape of a vehicle is under {MAX_DIMENSION_M:g} m; millimetres?)",
+                path=where,
+                link=link,
+            )
         values.append(numbers if count > 1 else numbers[0])
     return values
 

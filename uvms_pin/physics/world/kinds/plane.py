@@ -33,10 +33,14 @@ def _frame_with_z(normal: np.ndarray) -> np.ndarray:
 def check(name: str, raw: Mapping[str, Any]) -> dict[str, Any]:
     point = finite_vector(f"object '{name}' point_world_m", raw["point_world_m"], 3)
     normal = finite_vector(f"object '{name}' normal_world", raw.get("normal_world", (0, 0, 1)), 3)
-    size = float(np.linalg.norm(normal))
-    if size == 0.0:
+    largest = float(np.max(np.abs(normal)))
+    if largest == 0.0:
         raise kind.invalid(name, "normal_world", "must be non-zero")
-    return {"point_world_m": point.tolist(), "normal_world": (normal / size).tolist()}
+    normal = normal / largest  # a direction: its norm then cannot overflow (1e300 entries)
+    return {
+        "point_world_m": point.tolist(),
+        "normal_world": (normal / np.linalg.norm(normal)).tolist(),
+    }
 
 
 def placement(params: dict[str, Any]) -> pin.SE3:

@@ -1,0 +1,217 @@
+"""Documents built from the documented keys, for the generated-input tests: the shipped
+scenarios and studies (every key they use), the tables the docs show (sensors.md's cameras and
+sonars) and one ``[[world.objects]]`` of every registered kind, mutated by a few edits each
+(a value of any type, size and sign, NaN and infinities; a key removed or added; a table
+grafted from another document; a list resized; an element of an array of tables twice).
+
+The strategies edit plain dicts (cheap): nothing heavy is built to draw an input."""
+
+from __future__ import annotations
+
+import copy
+import datetime
+import json
+import math
+import re
+import tomllib
+from pathlib import Path
+from typing import Any
+
+from fuzz_bounds import ROOT
+from hypothesis import strategies as st
+
+from uvms_pin.physics.world.objects import registered_kinds
+
+
+def _toml_blocks(doc: Path) -> list[dict[str, Any]]:
+    return [tomllib.loads(b) for b in re.findall(r"```toml\n(.*?)```", doc.read_text(), re.S)]
+
+
+def _object_tables() -> list[dict[str, Any]]:
+    """One [[world.objects]] table of each kind, every key of the kind given a value."""
+    values = {"number": 0.2, "vector": [0.1, 0.2, -5.0], "path": "meshes/rock.obj"}
+    tables = []
+    for kind in registered_kinds():
+        table = {"type": kind.name}
+        table.update(
+            {
+                k.name: list(k.default or ()) or values[k.holds]
+                if k.holds == "vector"
+                else k.default or values[k.holds]
+                for k in kind.keys
+            }
+        )
+        tables.append(table)
+    return tables
+
+
+def _scenarios() -> dict[str, dict[str, Any]]:
+    # the cheap ones first: hypothesis shrinks towards the first
+    paths = sorted((ROOT / "scenarios").glob("*.toml"), key=lambda p: ("mpc" in p.name, p.name))
+    return {p.name: tomllib.loads(p.read_text()) for p in paths}
+
+
+SCENARIOS = _scenarios()
+#: (dotted table, its value): the tables a document can be given from another
+DONORS: list[tuple[tuple[str, ...], Any]] = [
+    (path, json.loads(text))
+    for path, text in sorted(
+        {
+            (key,) if sub is None else (key, sub): json.dumps(
+                doc[key] if sub is None else doc[key][sub], sort_keys=True
+            )
+            for doc in [*SCENARIOS.values(), *_toml_blocks(ROOT / "docs" / "sensors.md")]
+            for key in doc
+            for sub in [None, *(k for k, v in doc[key].items() if isinstance(v, dict | list))]
+        }.items()
+    )
+]
+DONORS += [(("world", "objects"), [table]) for table in _object_tables()]
+
+EDGE_NUMBERS = (0, -0.0, -1, 1e-300, 1e300, math.nan, math.inf, -math.inf, 2**63, -(2**63) - 1,
+                10**30, 1e-9, 1e9, 0.5, -0.5, 3)  # fmt: skip
+KEY_NAMES = sorted(
+    {k for doc in SCENARIOS.values() for t in doc.values() if isinstance(t, dict) for k in t}
+)
+
+scalars = st.one_of(
+    st.sampled_from(EDGE_NUMBERS),
+    st.booleans(),
+    st.integers(),
+    st.floats(),
+    st.text(max_size=12),
+    st.sampled_from(["uvms_lbv150", "ppc", "none", "rk4", "nan", "", "a:b", "os:system"]),
+    st.just(datetime.date(2026, 12, 4)),
+)
+values = st.recursive(
+    scalars,
+    lambda inner: (
+        st.lists(inner, max_size=8) | st.dictionaries(st.text(max_size=8), inner, max_size=4)
+    ),
+    max_leaves=10,
+)
+#: a key of any table: a documented one (in the wrong place), a typo of one, or any text
+key_names = st.one_of(
+    st.sampled_from(KEY_NAMES),
+    st.sampled_from(KEY_NAMES).map(lambda k: k[:-1]),
+    st.text(max_size=10),
+)
+
+
+def paths_in(doc: Any, prefix: tuple = ()) -> list[tuple]:
+    """Every path into ``doc`` (keys and list indices), tables and lists included."""
+    out = []
+    items = (
+        doc.items() if isinstance(doc, dict) else enumerate(doc) if isinstance(doc, list) else ()
+    )
+    for key, value in items:
+        out.append((*prefix, key))
+        out.extend(paths_in(value, (*prefix, key)))
+    return out
+
+
+def _parent(doc: Any, path: tuple) -> Any:
+    for key in path[:-1]:
+        doc = doc[key]
+    return doc
+
+
+def _set(draw, doc: dict) -> None:
+    path = draw(st.sampled_from(paths_in(doc)))
+    _parent(doc, path)[path[-1]] = draw(values)
+
+
+def _edge(draw, doc: dict) -> None:
+    numeric = [p for p in paths_in(doc) if isinstance(_parent(doc, p)[p[-1]], int | float)]
+    if numeric:
+        path = draw(st.sampled_from(numeric))
+        _parent(doc, path)[path[-1]] = draw(st.sampled_from(EDGE_NUMBERS))
+
+
+def _delete(draw, doc: dict) -> None:
+    path = draw(st.sampled_from(paths_in(doc)))
+    del _parent(doc, path)[path[-1]]
+
+
+def _extra(draw, doc: dict) -> None:
+    tables = [(), *(p for p in paths_in(doc) if isinstance(_parent(doc, p)[p[-1]], dict))]
+    path = draw(st.sampled_from(tables))
+    table = _parent(doc, path)[path[-1]] if path else doc
+    table[draw(key_names)] = draw(values)
+
+
+def _graft(draw, doc: dict) -> None:
+    path, value = draw(st.sampled_from(DONORS))
+    table = doc.setdefault(path[0], {}) if len(path) == 2 else doc
+    if not isinstance(table, dict):
+        return
+    held = table.get(path[-1])
+    if isinstance(held, list) and isinstance(value, list) and draw(st.booleans()):
+        held.extend(copy.deepcopy(value))  # one more camera, thruster, object
+    else:
+        table[path[-1]] = copy.deepcopy(value)
+
+
+def _resize(draw, doc: dict) -> None:
+    lists = [p for p in paths_in(doc) if isinstance(_parent(doc, p)[p[-1]], list)]
+    if lists:
+        path = draw(st.sampled_from(lists))
+        items = _parent(doc, path)[path[-1]]
+        size = draw(st.sampled_from([0, 1, 2, len(items) - 1, len(items) + 1, 2 * len(items)]))
+        _parent(doc, path)[path[-1]] = (
+            [copy.deepcopy(items[k % len(items)]) for k in range(max(size, 0))]
+            if items
+            else [draw(values)]
+        )
+
+
+EDITS = (_set, _edge, _delete, _extra, _graft, _resize)
+
+
+@st.composite
+def edited(draw, documents: dict[str, dict[str, Any]], max_edits: int = 3):
+    """(the name of a document of ``documents``, a copy of it with 1 to ``max_edits`` edits)."""
+    name = draw(st.sampled_from(sorted(documents, key=list(documents).index)))
+    doc = copy.deepcopy(documents[name])
+    for _ in range(draw(st.integers(1, max_edits))):
+        if not doc:
+            break
+        draw(st.sampled_from(EDITS))(draw, doc)
+    return name, doc
+
+
+def toml_text(doc: dict[str, Any]) -> str:
+    """``doc`` as TOML: each top-level entry one line (tables inline), None left out."""
+    return "".join(f"{_key(k)} = {_value(v)}\n" for k, v in doc.items() if v is not None)
+
+
+def _key(key: Any) -> str:
+    return _string(str(key))
+
+
+def _string(text: str) -> str:
+    """A TOML basic string: quotes, backslashes and control characters escaped."""
+    escaped = (c if 0x20 <= ord(c) != 0x7F and c not in '"\\' else f"\\u{ord(c):04x}" for c in text)
+    return '"' + "".join(escaped) + '"'
+
+
+def _value(v: Any) -> str:
+    if isinstance(v, bool):
+        return "true" if v else "false"
+    if isinstance(v, int):
+        return str(v)
+    if isinstance(v, float):
+        return (
+            "nan" if math.isnan(v) else ("inf" if v > 0 else "-inf") if math.isinf(v) else repr(v)
+        )
+    if isinstance(v, str):
+        return _string(v)
+    if isinstance(v, datetime.date):
+        return v.isoformat()
+    if isinstance(v, list | tuple):
+        return "[" + ", ".join(_value(x) for x in v if x is not None) + "]"
+    if isinstance(v, dict):
+        return (
+            "{" + ", ".join(f"{_key(k)} = {_value(x)}" for k, x in v.items() if x is not None) + "}"
+        )
+    raise TypeError(type(v))

@@ -1,0 +1,95 @@
+"""What a scenario names beyond itself (`uvms_pin.scenario.trust`) and ``uvms-pin run
+--no-code``, which refuses a scenario naming a module, or a file outside its folder and the
+shipped models, before anything is imported or read (docs/security.md)."""
+
+from __future__ import annotations
+
+import shutil
+import textwrap
+import tomllib
+from pathlib import Path
+
+import pytest
+from conftest import ROOT
+
+from uvms_pin.apps.cli.main import main
+from uvms_pin.errors import ScenarioError
+from uvms_pin.scenario.trust import check_no_code, reaches
+
+SCENARIOS = ROOT / "scenarios"
+CODE_FREE = ("paper_force_tracking.toml", "realistic_force_tracking.toml", "surfacing.toml")
+
+
+def _scenario(folder: Path, body: str, model: str = "uvms_lbv150") -> Path:
+    path = folder / "theirs.toml"
+    head = f'[scenario]\nmodel = "{model}"\nduration_s = 0.01\n'
+    path.write_text(head + textwrap.dedent(body))
+    return path
+
+
+@pytest.mark.parametrize("name", CODE_FREE)
+def test_a_shipped_scenario_without_code_passes(name):
+    path = SCENARIOS / name
+    check_no_code(tomllib.loads(path.read_text()), path)
+
+
+def test_the_cli_refuses_a_module_controller_before_importing_it(tmp_path, capsys):
+    (tmp_path / "evil.py").write_text("raise SystemExit('imported')\n")
+    path = _scenario(tmp_path, '[controller]\ntype = "evil:Controller"\n')
+    out = tmp_path / "out"
+    assert main(["run", str(path), "--no-code", "--out", str(out), "--quiet"]) == 2
+    err = capsys.readouterr().err
+    assert "theirs.toml: controller.type: 'evil:Controller' would import and run a module" in err
+    assert "--no-code" in err and not out.exists()
+
+
+def test_a_shipped_scenario_with_its_own_controller_is_refused_by_key(tmp_path, capsys):
+    out = tmp_path / "out"
+    assert main(["run", str(SCENARIOS / "push_object.toml"), "--no-code", "--out", str(out)]) == 2
+    assert "push_object.toml: controller.type: 'object_push:ObjectPush'" in capsys.readouterr().err
+
+
+def test_a_metric_function_and_an_override_are_refused(tmp_path, capsys):
+    path = _scenario(tmp_path, '[metrics]\nextra = ["json:dumps"]\n')
+    with pytest.raises(ScenarioError, match=r"metrics.extra\[0\]: 'json:dumps' would import"):
+        check_no_code(tomllib.loads(path.read_text()), path)
+    clean = _scenario(tmp_path, "")
+    args = ["run", str(clean), "--no-code", "--out", str(tmp_path / "o"), "--set"]
+    assert main([*args, 'controller={type="os:system"}']) == 2
+    assert "controller.type: 'os:system'" in capsys.readouterr().err
+
+
+def test_files_outside_the_folder_and_the_shipped_models_are_refused(tmp_path):
+    ours, elsewhere = tmp_path / "ours", tmp_path / "elsewhere"
+    ours.mkdir(), elsewhere.mkdir()
+    shutil.copy(ROOT / "models" / "uvms_lbv150.urdf", elsewhere / "robot.urdf")
+    shutil.copy(ROOT / "models" / "uvms_lbv150.urdf", ours / "robot.urdf")
+    for model in ("uvms_lbv150", str(ROOT / "models" / "uvms_lbv150.urdf"), "robot.urdf"):
+        path = _scenario(ours, "", model)
+        check_no_code(tomllib.loads(path.read_text()), path)  # shipped, or in its folder
+    (ours / "link.urdf").symlink_to(elsewhere / "robot.urdf")
+    for model in ("../elsewhere/robot.urdf", str(elsewhere / "robot.urdf"), "link.urdf"):
+        path = _scenario(ours, "", model)
+        with pytest.raises(ScenarioError, match=r"theirs.toml: scenario.model: reads .*robot.urdf"):
+            check_no_code(tomllib.loads(path.read_text()), path)
+
+
+def test_a_mesh_object_outside_the_folder_is_refused_by_its_index(tmp_path):
+    body = """
+        [[world.objects]]
+        type = "plane"
+        point_world_m = [0, 0, -10]
+        [[world.objects]]
+        type = "mesh"
+        path = "{}"
+        position_world_m = [1, 0, -9]
+    """
+    inside = _scenario(tmp_path, body.format("meshes/rock.obj"))
+    assert [r.key for r in reaches(tomllib.loads(inside.read_text()), tmp_path)] == [
+        "scenario.model",
+        "world.objects[1].path",
+    ]
+    check_no_code(tomllib.loads(inside.read_text()), inside)
+    outside = _scenario(tmp_path, body.format("/etc/passwd"))
+    with pytest.raises(ScenarioError, match=r"world.objects\[1\].path: reads /etc/passwd"):
+        check_no_code(tomllib.loads(outside.read_text()), outside)

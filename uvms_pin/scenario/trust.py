@@ -1,0 +1,91 @@
+"""What a scenario file makes uvms-pin import or read beyond itself, and the refusal of
+``uvms-pin run --no-code`` (docs/security.md).
+
+A scenario file is code when it names code: ``[controller] type = "module:Class"`` and
+``[metrics] extra = ["module:function"]`` import (run) a module with the user's rights, from
+the scenario's folder or anywhere on ``sys.path``. It also names files uvms-pin reads:
+``[scenario] model`` (a URDF) and the ``path`` of a ``[[world.objects]]`` mesh. With
+``--no-code`` (`check_no_code`), a scenario is refused, before anything is imported or read,
+when it names any module, or a file outside its own folder (and the folders below it) and the
+shipped models; the names are judged as the reader will resolve them (symbolic links
+followed), on the table after the ``--set`` overrides.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterator, Mapping
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+from uvms_pin.errors import ScenarioError
+from uvms_pin.model.resources import find_model, shipped_path
+from uvms_pin.physics.world.objects import kind_names, object_kind
+
+
+@dataclass(frozen=True)
+class Reach:
+    """One thing a scenario makes uvms-pin import or read.
+
+    Attributes:
+        key: its dotted key in the file (``"world.objects[1].path"``).
+        module: the ``module:name`` it imports, or "" for a file.
+        path: the file it reads (resolved), or None for a module.
+    """
+
+    key: str
+    module: str = ""
+    path: Path | None = None
+
+
+def reaches(raw: Mapping[str, Any], scenario_dir: Path) -> Iterator[Reach]:
+    """Every module and file the scenario ``raw`` (the TOML as a dict) names; entries of the
+    wrong type are left to the reader, which refuses them."""
+    controller = raw.get("controller")
+    kind = controller.get("type") if isinstance(controller, Mapping) else None
+    if isinstance(kind, str) and ":" in kind:
+        yield Reach("controller.type", module=kind)
+    metrics = raw.get("metrics")
+    extra = metrics.get("extra") if isinstance(metrics, Mapping) else None
+    for k, reference in enumerate(extra if isinstance(extra, list) else []):
+        yield Reach(f"metrics.extra[{k}]", module=str(reference))
+    scenario = raw.get("scenario")
+    model = scenario.get("model") if isinstance(scenario, Mapping) else None
+    if isinstance(model, str) and model.strip():
+        found = find_model(model, scenario_dir)
+        yield Reach("scenario.model", path=found or (scenario_dir / model).resolve())
+    world = raw.get("world")
+    objects = world.get("objects") if isinstance(world, Mapping) else None
+    for k, table in enumerate(objects if isinstance(objects, list) else []):
+        if not isinstance(table, Mapping) or table.get("type") not in kind_names():
+            continue
+        for key in object_kind(table["type"]).keys:
+            entry = table.get(key.name, key.default)
+            if key.holds == "path" and isinstance(entry, str):
+                yield Reach(f"world.objects[{k}].{key.name}", path=(scenario_dir / entry).resolve())
+
+
+def _inside(path: Path, folder: Path) -> bool:
+    return path.is_relative_to(folder.resolve())
+
+
+def check_no_code(raw: Mapping[str, Any], scenario_path: str | Path) -> None:
+    """Refuse (ScenarioError naming the file and the key) a scenario that would import a
+    module, or read a file outside its folder and the shipped models (``--no-code``)."""
+    scenario_path = Path(scenario_path)
+    folders = [scenario_path.parent]
+    try:
+        folders.append(shipped_path("models"))
+    except FileNotFoundError:  # an install without its models: the scenario's folder only
+        pass
+    for reach in reaches(raw, scenario_path.parent):
+        if reach.module:
+            raise ScenarioError(
+                f"{scenario_path}: {reach.key}: '{reach.module}' would import and run a module "
+                "(refused by --no-code: run the file without it only if you trust it as code)"
+            )
+        if reach.path is not None and not any(_inside(reach.path, f) for f in folders):
+            raise ScenarioError(
+                f"{scenario_path}: {reach.key}: reads {reach.path}, outside the scenario's "
+                "folder and the shipped models (refused by --no-code)"
+            )
