@@ -2,6 +2,7 @@
 
 #include <string>
 
+#include <Eigen/Geometry>
 #include <pinocchio/algorithm/joint-configuration.hpp>
 #include <pinocchio/algorithm/kinematics.hpp>
 #include <pinocchio/multibody/joint/joint-free-flyer.hpp>
@@ -31,6 +32,11 @@ std::vector<Dynamics> copies(const std::vector<const Dynamics*>& objects) {
     out.emplace_back(*body);
   }
   return out;
+}
+
+// The rotation of a pose [p; quaternion x, y, z, w].
+Eigen::Matrix3d rotation_of(const Eigen::Ref<const Eigen::VectorXd>& pose) {
+  return Eigen::Quaterniond(pose[6], pose[3], pose[4], pose[5]).normalized().toRotationMatrix();
 }
 
 void add_wrench(Dynamics& dynamics, int joint_id, const Vec3& point, const Vec3& force) {
@@ -258,11 +264,18 @@ void System::constrain(double t0, const ConstVec& q0, const ConstVec& v0, double
     const Vec6 least = (travelled.cwiseAbs() / h).cwiseMax(v0.segment(nv_robot_ + 6 * i, 6).cwiseAbs());
     const Mat6 mass = body.mass_matrix_in(q0_k, plant_.flow, t0, plant_.free_surface);
     body.kinematics(q0_k, v0.segment(nv_robot_ + 6 * i, 6));
+    // the smooth step's body velocity at q_free expressed at q0, where the rows act
+    // (_objects_moved of period.py)
+    const Eigen::Matrix3d r0 = rotation_of(q0_k);
+    const Eigen::Matrix3d turn = r0.transpose() * rotation_of(q1.segment(nq_robot_ + 7 * i, 7));
     Vec6 v_k = v1.segment(nv_robot_ + 6 * i, 6);
+    v_k << turn * v_k.head<3>(), turn * v_k.tail<3>();
     if (object_step_.constrain(*object_worlds[k], object_memory[k], body.data(), mass, v_k, h,
                                least, rigid_found_[k])) {
-      v1.segment(nv_robot_ + 6 * i, 6) = v_k;
-      q1.segment(nq_robot_ + 7 * i, 7) = free_body_configuration(q0_k, v_k, h);
+      const Eigen::Matrix<double, 7, 1> q_end = free_body_configuration(q0_k, v_k, h);
+      q1.segment(nq_robot_ + 7 * i, 7) = q_end;
+      v1.segment(nv_robot_ + 6 * i, 3) = rotation_of(q_end).transpose() * r0 * v_k.head<3>();
+      v1.segment(nv_robot_ + 6 * i + 3, 3) = v_k.tail<3>();
     }
     object_worlds[k]->commit(rigid_found_[k], object_memory[k]);
   }

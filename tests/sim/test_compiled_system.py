@@ -53,7 +53,7 @@ def _scene(load_body, backend: str = "core", compiled: bool = True) -> tuple[Sys
     )  # fmt: skip
     floor = plane("seafloor", [0, 0, FLOOR_Z], [0, 0, 1], 0.6, 0.5)
     law = ContactLaw(stiffness_N_m=3e4, dissipation_s_m=1.0)
-    world = World(pusher, [floor], law, [box, ball])
+    world = World(pusher, [floor], law, [box, ball], fixed_contact="compliant")
     system = System(
         Plant(pusher, world=world, free_surface=False, backend=backend), compiled=compiled
     )

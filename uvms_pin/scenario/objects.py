@@ -2,7 +2,7 @@
 ``density_kg_m3``; a ``type`` of `uvms_pin.physics.world.kinds`, whose keys and their
 check are its kind's) every body touches, the contact law's parameters
 (``[world.contact]``, with ``self_collision``), ``initial_overlap`` (what the start does
-with a free object inside another body) and ``free_object_contact`` (rigid or compliant: how
+with a free object inside another body) and ``fixed_contact`` (rigid or compliant: how
 the free objects touch the fixed world); ``[joints]``: the joint stops."""
 
 from __future__ import annotations
@@ -23,7 +23,7 @@ from uvms_pin.physics.world.objects import (
     kind_names,
     object_kind,
 )
-from uvms_pin.physics.world.world import FREE_OBJECT_CONTACT, INITIAL_OVERLAP, World
+from uvms_pin.physics.world.world import FIXED_CONTACT, INITIAL_OVERLAP, World
 from uvms_pin.scenario.schema import Table
 
 __all__ = ["KEY_READERS", "build_world"]
@@ -38,7 +38,7 @@ def build_world(t: Table | None, uvms: UVMS, base_dir: Path) -> World | None:
     law = _law(contact)
     built = [_object(o, k, law, base_dir, uvms) for k, o in enumerate(t.tables("objects"))]
     overlap = t.string("initial_overlap", "refuse", choices=INITIAL_OVERLAP)
-    free_contact = t.string("free_object_contact", "rigid", choices=FREE_OBJECT_CONTACT)
+    free_contact = t.string("fixed_contact", "rigid", choices=FIXED_CONTACT)
     t.finish()
     fixed = [o for o in built if isinstance(o, WorldObject)]
     free = [o for o in built if isinstance(o, FreeObject)]

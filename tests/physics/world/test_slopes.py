@@ -154,7 +154,7 @@ def _slope(load_body, kind: str, theta_deg: float, contact: str = "rigid") -> Sl
             collision='<sphere radius="0.1"/>',
         )
     )  # fmt: skip  (the robot, far away: only the body moves on the slope)
-    world = World(pusher, [plane("slope", foot, normal, *MU)], law, [obj], free_object_contact=contact)
+    world = World(pusher, [plane("slope", foot, normal, *MU)], law, [obj], fixed_contact=contact)
     system = System(Plant(pusher, world=world, free_surface=False))
     return Slope(system, obj, down, normal, expected, regime, u)
 

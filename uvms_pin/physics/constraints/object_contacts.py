@@ -83,9 +83,7 @@ class ObjectWorldContacts:
         self.memories, self.margin, self.name = tuple(memories), float(margin), name
         # each object's pieces on its joint in the system's model
         self._pieces = [
-            ()
-            if w is None
-            else tuple(dataclasses.replace(p, joint_id=j) for p in w.pieces)
+            () if w is None else tuple(dataclasses.replace(p, joint_id=j) for p in w.pieces)
             for w, j in zip(self.worlds, self.joint_ids, strict=True)
         ]
 
@@ -163,7 +161,9 @@ class ObjectWorldContacts:
                 out.append(None)
                 continue
             if not mine:
-                out.append(ContactForces(NO_TOUCH, np.zeros((0, 3)), np.zeros(0), np.zeros(0, bool)))
+                out.append(
+                    ContactForces(NO_TOUCH, np.zeros((0, 3)), np.zeros(0), np.zeros(0, bool))
+                )
                 continue
             points = [rows.where[i].point for i in mine]
             frames = np.array([rows.where[i].frame for i in mine])

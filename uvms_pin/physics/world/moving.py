@@ -10,7 +10,7 @@ Sets of pairs (`uvms_pin.physics.world.pairs.PiecePairs`), each with its frictio
 
 and, for each free object, its own `World` against the fixed objects: the same compliant
 contact as the UVMS's (corners on a plane, coal's deepest point otherwise), or, with
-``World.free_object_contact`` "rigid", rigid contacts solved as constraints after the smooth
+``World.fixed_contact`` "rigid", rigid contacts solved as constraints after the smooth
 step (`uvms_pin.physics.constraints.object_contacts`): then the smooth dynamics leave them
 out and `rigid_forces` holds the last period's mean contact forces (what a run logs). Every force is exchanged
 equal and opposite between the two bodies of its pair (a fixed object's reaction goes to
@@ -108,7 +108,7 @@ class MovingContacts:
             if own is not None:  # its pairs are named after the object, not its link
                 own.body_names = [obj.name] * len(own.body_names)
         memories = [FrictionMemory() for _ in free]
-        rigid = world.free_object_contact == "rigid"
+        rigid = world.fixed_contact == "rigid"
         out = MovingContacts(world, sets, object_worlds, memories, rigid)
         out.clear()
         return out

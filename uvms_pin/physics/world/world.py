@@ -29,9 +29,10 @@ from uvms_pin.physics.world.robot_geometry import RobotPiece, robot_pieces
 from uvms_pin.physics.world.touch import Bounds, Touch, clear_of, cross, touch
 
 __all__ = [
-    "FREE_OBJECT_CONTACT",
+    "FIXED_CONTACT",
     "INITIAL_OVERLAP",
-    "ContactForces",     "FrictionMemory",
+    "ContactForces",
+    "FrictionMemory",
     "World",
     "material_points",
 ]
@@ -45,7 +46,7 @@ INITIAL_OVERLAP = ("refuse", "separate")
 #: how a free object touches the fixed world (the seabed, fixed solids): as rigid contacts
 #: solved implicitly with the Coulomb cone (`uvms_pin.physics.constraints.object_contacts`),
 #: or by the compliant law integrated with the smooth dynamics (`contact_law`)
-FREE_OBJECT_CONTACT = ("rigid", "compliant")
+FIXED_CONTACT = ("rigid", "compliant")
 
 
 @dataclass
@@ -124,7 +125,7 @@ class World:
         self_collision: the arm's links touch the vehicle (adjacent links excepted).
         initial_overlap: one of `INITIAL_OVERLAP`, what the start does with a free object
             that overlaps another body (`uvms_pin.physics.world.overlap`).
-        free_object_contact: one of `FREE_OBJECT_CONTACT`, how the free objects touch the
+        fixed_contact: one of `FIXED_CONTACT`, how the free objects touch the
             fixed objects.
     """
 
@@ -134,13 +135,13 @@ class World:
     free: Sequence[Any] = ()
     self_collision: bool = False
     initial_overlap: str = "refuse"
-    free_object_contact: str = "rigid"
+    fixed_contact: str = "rigid"
 
     def __post_init__(self) -> None:
-        if self.free_object_contact not in FREE_OBJECT_CONTACT:
+        if self.fixed_contact not in FIXED_CONTACT:
             raise ParameterError(
-                f"free_object_contact must be one of {', '.join(FREE_OBJECT_CONTACT)}, "
-                f"got {self.free_object_contact!r}"
+                f"fixed_contact must be one of {', '.join(FIXED_CONTACT)}, "
+                f"got {self.fixed_contact!r}"
             )
         if self.initial_overlap not in INITIAL_OVERLAP:
             raise ParameterError(
@@ -171,7 +172,7 @@ class World:
             "objects": [o.record() for o in self.objects],
             "free_objects": [o.record() for o in self.free],
             "contact": {**self.law.record(), "self_collision": bool(self.self_collision)},
-            **({"free_object_contact": self.free_object_contact} if self.free else {}),
+            **({"fixed_contact": self.fixed_contact} if self.free else {}),
             "pairs": self.pair_names,
         }
 

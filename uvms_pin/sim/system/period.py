@@ -151,7 +151,9 @@ def _settle_contacts(system: Stepped, solved: ConstrainedVelocity, period_s: flo
     found = contacts.forces(rows, impulse, solved.velocity, period_s)
     moving = system.moving.moving
     moving.rigid_forces = found
-    for world, forces, memory in zip(moving.object_worlds, found, moving.object_memory, strict=True):
+    for world, forces, memory in zip(
+        moving.object_worlds, found, moving.object_memory, strict=True
+    ):
         if world is not None:
             world.commit(forces, memory)
 

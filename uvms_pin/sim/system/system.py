@@ -95,7 +95,7 @@ class System:
         self.separations: list = []  # the objects' moves out of an overlap at the start
 
     def _object_contacts(self) -> ObjectWorldContacts | None:
-        """The free objects' rigid contacts with the fixed world (`World.free_object_contact`
+        """The free objects' rigid contacts with the fixed world (`World.fixed_contact`
         "rigid"), None when they have none or touch it by the compliant law."""
         moving = None if self.moving is None else self.moving.moving
         if moving is None or not moving.rigid or not any(moving.object_worlds):
