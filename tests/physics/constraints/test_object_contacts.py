@@ -23,9 +23,9 @@ from uvms_pin.sim.plant import Plant
 from uvms_pin.sim.system import System
 
 PERIOD_S = 2e-3
-#: compiled (projected Gauss-Seidel to 1e-12 m/s) against the reference (Pinocchio's ADMM
+#: compiled (projected Gauss-Seidel to 1e-10 m/s) against the reference (Pinocchio's ADMM
 #: to 1e-8 m/s): the states of a second of tumbling, rolling and sliding agree to this
-AGREEMENT = 1e-6
+AGREEMENT = 1e-5
 
 
 def _pusher(load_body):
@@ -65,14 +65,17 @@ def _run(system: System, periods: int, compiled: bool):
 
 
 def _scene(load_body, contact: str = "rigid") -> System:
-    """A tilted box dropped with a spin onto a slope beside a fixed box, and a sphere thrown
-    along the seafloor: corners, coal's points, sticking, sliding and rolling."""
+    """A box sliding down a 40-degree slope (its corners on a plane) and a sphere thrown
+    along the seafloor at a fixed box (coal's points on a plane and on a solid), sliding,
+    then rolling, then stopped by the box."""
     floor = plane("seafloor", [0.0, 0.0, -10.0], [0.0, 0.0, 1.0], 0.6, 0.5)
-    slope = plane("slope", [3.0, 0.0, -10.0], [-math.sin(0.3), 0.0, math.cos(0.3)], 0.6, 0.5)
+    tilt = math.radians(40.0)
+    slope = plane("slope", [3.0, 0.0, -10.0], [-math.sin(tilt), 0.0, math.cos(tilt)], 0.6, 0.5)
     rock = solid("rock", "box", {"size_m": [0.3, 0.3, 0.3]}, [0.0, 0.6, -9.85], [0.0] * 3, 0.6, 0.5)
-    box = _object("box", {"size_m": [0.2, 0.3, 0.1]}, [0.0, 0.0, -9.8], (0.3, 0.2, 0.0),
-                  np.array([0.3, 0.2, 0.0, 1.0, 0.0, 2.0]))  # fmt: skip
-    ball = _object("sphere", {"radius_m": 0.1}, [1.0, 0.0, -9.9], velocity=[1.0, 0.5, 0, 0, 0, 0])
+    on_slope = np.array([3.5, 0.0, -10.0 + 0.5 * math.tan(tilt)])
+    normal = np.array([-math.sin(tilt), 0.0, math.cos(tilt)])
+    box = _object("box", {"size_m": [0.2, 0.3, 0.1]}, on_slope + 0.05 * normal, (0.0, -tilt, 0.0))
+    ball = _object("sphere", {"radius_m": 0.1}, [0.0, 0.0, -9.9], velocity=[0, 1.5, 0, 0, 0, 0])
     world = World(
         _pusher(load_body), [floor, slope, rock], ContactLaw(), [box, ball],
         fixed_contact=contact,

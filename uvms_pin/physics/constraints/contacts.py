@@ -30,7 +30,14 @@ from uvms_pin.checks import finite_vector
 from uvms_pin.errors import ParameterError
 from uvms_pin.physics.constraints.rows import ConstraintRows, evaluated
 
-__all__ = ["ContactSphere", "PlaneContacts", "contact_frame", "point_contact", "point_jacobian"]
+__all__ = [
+    "ContactSphere",
+    "PlaneContacts",
+    "contact_frame",
+    "contact_rows",
+    "point_contact",
+    "point_jacobian",
+]
 
 _UNIT = "N s"
 
@@ -82,7 +89,7 @@ class PlaneContacts:
     ) -> ConstraintRows:
         """The contacts at q that can close within ``period_s`` at ``speed``
         (`ConstraintSet.rows`): three rows per contact (t1, t2, n)."""
-        models, datas, jacobians, gaps, labels = [], [], [], [], []
+        evaluated_contacts, gaps, labels = [], [], []
         for k, sphere in enumerate(self.spheres):
             if not 0 < sphere.joint_id < model.njoints:
                 raise ParameterError(f"contact sphere {k}: no joint {sphere.joint_id} in the model")
@@ -92,26 +99,35 @@ class PlaneContacts:
             normal_rate = self.normal_world @ point_jacobian(model, data, sphere.joint_id, point)
             if gap > period_s * np.abs(normal_rate) @ speed + self.margin:
                 continue
-            constraint, constraint_data, jacobian = point_contact(
-                model, data, sphere.joint_id, (point, self.normal_world, gap), self.friction
+            evaluated_contacts.append(
+                point_contact(
+                    model, data, sphere.joint_id, (point, self.normal_world, gap), self.friction
+                )
             )
-            models.append(constraint)
-            datas.append(constraint_data)
-            jacobians.append(jacobian)
-            gaps.append([0.0, 0.0, gap])
-            labels += [f"{model.names[sphere.joint_id]}[{k}] {axis}" for axis in ("t1", "t2", "n")]
-        if not models:
-            return ConstraintRows.empty(self.name, _UNIT, model.nv)
-        return ConstraintRows(
-            self.name,
-            _UNIT,
-            tuple(models),
-            tuple(datas),
-            np.vstack(jacobians),
-            np.concatenate(gaps),
-            np.tile([False, False, True], len(models)),
-            tuple(labels),
-        )
+            gaps.append(gap)
+            labels.append(f"{model.names[sphere.joint_id]}[{k}]")
+        return contact_rows(self.name, model.nv, evaluated_contacts, gaps, labels)
+
+
+def contact_rows(
+    name: str, nv: int, evaluated_contacts: list, gaps: list[float], labels: list[str], where=()
+) -> ConstraintRows:
+    """The rows (three a contact: t1, t2, n) of point contacts, each as `point_contact`
+    gives it, with its signed gap [m] and its label; ``where``: `ConstraintRows.where`."""
+    if not evaluated_contacts:
+        return ConstraintRows.empty(name, _UNIT, nv)
+    models, datas, jacobians = zip(*evaluated_contacts, strict=True)
+    return ConstraintRows(
+        name,
+        _UNIT,
+        tuple(models),
+        tuple(datas),
+        np.vstack(jacobians),
+        np.array([[0.0, 0.0, gap] for gap in gaps]).reshape(-1),
+        np.tile([False, False, True], len(gaps)),
+        tuple(f"{label} {axis}" for label in labels for axis in ("t1", "t2", "n")),
+        tuple(where),
+    )
 
 
 def contact_frame(normal: np.ndarray) -> np.ndarray:

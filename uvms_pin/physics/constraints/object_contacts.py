@@ -31,7 +31,12 @@ import numpy as np
 import pinocchio as pin
 
 from uvms_pin.errors import ParameterError
-from uvms_pin.physics.constraints.contacts import contact_frame, point_contact, point_jacobian
+from uvms_pin.physics.constraints.contacts import (
+    contact_frame,
+    contact_rows,
+    point_contact,
+    point_jacobian,
+)
 from uvms_pin.physics.constraints.rows import ConstraintRows
 from uvms_pin.physics.world.gaps import Candidate, candidates
 from uvms_pin.physics.world.touch import NO_TOUCH, Touch
@@ -39,7 +44,6 @@ from uvms_pin.physics.world.world import ContactForces, FrictionMemory, World
 
 __all__ = ["SLIP_M_S", "ObjectWorldContacts"]
 
-_UNIT = "N s"
 
 #: the tangential speed of a contact point above which its patch slides [m/s]
 SLIP_M_S = 1.0e-6
@@ -92,7 +96,7 @@ class ObjectWorldContacts:
     ) -> ConstraintRows:
         """The contacts at q that can close within ``period_s`` at ``speed``
         (`ConstraintSet.rows`): three rows per contact (t1, t2, n)."""
-        models, datas, jacobians, solved = [], [], [], []
+        evaluated_contacts, solved = [], []
         for k, (world, joint) in enumerate(zip(self.worlds, self.joint_ids, strict=True)):
             if world is None:
                 continue
@@ -109,27 +113,13 @@ class ObjectWorldContacts:
                 if point.gap_m > period_s * np.abs(normal_rate) @ speed + self.margin:
                     continue
                 touching = (point.point_world_m, point.normal_world, point.gap_m)
-                constraint, constraint_data, jacobian = point_contact(
-                    model, data, joint, touching, self._friction(k, point)
+                evaluated_contacts.append(
+                    point_contact(model, data, joint, touching, self._friction(k, point))
                 )
-                models.append(constraint)
-                datas.append(constraint_data)
-                jacobians.append(jacobian)
                 solved.append(_Solved(k, point, contact_frame(point.normal_world)))
-        if not models:
-            return ConstraintRows.empty(self.name, _UNIT, model.nv)
-        names = [self._label(s) for s in solved]
-        return ConstraintRows(
-            self.name,
-            _UNIT,
-            tuple(models),
-            tuple(datas),
-            np.vstack(jacobians),
-            np.array([[0.0, 0.0, s.point.gap_m] for s in solved]).ravel(),
-            np.tile([False, False, True], len(solved)),
-            tuple(f"{n} {axis}" for n in names for axis in ("t1", "t2", "n")),
-            tuple(solved),
-        )
+        gaps = [s.point.gap_m for s in solved]
+        labels = [self._label(s) for s in solved]
+        return contact_rows(self.name, model.nv, evaluated_contacts, gaps, labels, solved)
 
     def _friction(self, k: int, point: Candidate) -> float:
         """mu_k while the point's patch slid over the last period, else mu_s."""

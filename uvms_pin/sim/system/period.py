@@ -191,7 +191,7 @@ def _end(
     nothing was solved)."""
     q_free, v_free = smooth
     if not solved.rows:
-        return np.asarray(q_free, dtype=float), solved.velocity
+        return np.asarray(q_free, dtype=float), np.asarray(v_free, dtype=float)
     acting = np.any(np.vstack([b.jacobian for b in solved.rows]) != 0.0, axis=0)
     q, v = np.array(q_free, dtype=float), np.array(v_free, dtype=float)
     layout, v_plus = system.layout, solved.velocity
