@@ -292,7 +292,8 @@ class System:
             return {}
         (q_r, v_r), *objects = self.layout.split(q, v)
         compiled = self.compiled
-        if compiled is None or isinstance(compiled, Fallback):
+        # the Python integration's own contacts (its rigid contacts' forces are its own)
+        if compiled is None or isinstance(compiled, Fallback) or not self.compiled_allowed:
             fixed = plant.world.pair_wrenches(plant.world_forces(q_r, v_r)).ravel()
             if self.moving is None:
                 return {"world_contact": fixed}
