@@ -2,6 +2,7 @@
 
 #include <string>
 
+#include <Eigen/Geometry>
 #include <pinocchio/algorithm/joint-configuration.hpp>
 #include <pinocchio/algorithm/kinematics.hpp>
 #include <pinocchio/multibody/joint/joint-free-flyer.hpp>
@@ -33,6 +34,11 @@ std::vector<Dynamics> copies(const std::vector<const Dynamics*>& objects) {
   return out;
 }
 
+// The rotation of a pose [p; quaternion x, y, z, w].
+Eigen::Matrix3d rotation_of(const Eigen::Ref<const Eigen::VectorXd>& pose) {
+  return Eigen::Quaterniond(pose[6], pose[3], pose[4], pose[5]).normalized().toRotationMatrix();
+}
+
 void add_wrench(Dynamics& dynamics, int joint_id, const Vec3& point, const Vec3& force) {
   Vec6 wrench = Vec6::Zero();
   wrench.head<3>() = force;
@@ -52,6 +58,7 @@ System::System(Plant& plant, const std::vector<const Dynamics*>& objects)
       acceleration_(model_.nv) {
   object_worlds.resize(objects_.size());
   object_memory.resize(objects_.size());
+  rigid_found_.resize(objects_.size());
 }
 
 const Data& System::data_of(int side) {
@@ -95,7 +102,7 @@ void System::contacts_at(const Data& robot) {
   found_objects_.resize(objects_.size());
   for (std::size_t k = 0; k < objects_.size(); ++k) {
     found_objects_[k].touch.clear();
-    if (object_worlds[k]) {
+    if (object_worlds[k] && !rigid_objects) {
       object_worlds[k]->forces(objects_[k].data(), object_memory[k], found_objects_[k]);
     }
   }
@@ -168,7 +175,7 @@ const Eigen::VectorXd& System::acceleration(double time_s, const ConstVec& q,
   }
   for (std::size_t k = 0; k < objects_.size(); ++k) {
     Dynamics& body = objects_[k];
-    if (object_worlds[k]) object_worlds[k]->add_to(body, found_objects_[k]);
+    if (object_worlds[k] && !rigid_objects) object_worlds[k]->add_to(body, found_objects_[k]);
     const auto i = static_cast<Eigen::Index>(k);
     acceleration_.segment(nv_robot_ + 6 * i, 6) = body.accelerations(
         q.segment(nq_robot_ + 7 * i, 7), v.segment(nv_robot_ + 6 * i, 6), zero_tau_, nullptr);
@@ -185,8 +192,10 @@ void System::settle(const ConstVec& q, const ConstVec& v) {
   for (std::size_t s = 0; s < sets.size(); ++s) {
     sets[s].pairs.commit(data_of(sets[s].b), found_sets_[s], sets[s].memory);
   }
-  for (std::size_t k = 0; k < objects_.size(); ++k) {
-    if (object_worlds[k]) object_worlds[k]->commit(found_objects_[k], object_memory[k]);
+  for (std::size_t k = 0; k < objects_.size(); ++k) {  // rigid: committed by constrain()
+    if (object_worlds[k] && !rigid_objects) {
+      object_worlds[k]->commit(found_objects_[k], object_memory[k]);
+    }
   }
 }
 
@@ -213,30 +222,63 @@ std::pair<Eigen::VectorXd, Eigen::VectorXd> System::advance(double t0, const Con
   // a smooth step that diverged is returned as it is: the loop names the divergence
   if (!(stepper_.q.allFinite() && stepper_.v.allFinite())) return {stepper_.q, stepper_.v};
   settle(stepper_.q, stepper_.v);
-  const auto& limits = plant_.joint_limits;
-  if (!limits) return {stepper_.q, stepper_.v};
-  // the robot's joint limits (period.py, constrained): rows selected with the smooth step's
-  // own speeds, its start and its mean over the period
-  const double h = t1 - t0;
-  const auto q0_robot = q0.head(nq_robot_);
-  Eigen::VectorXd travelled(nv_robot_);
-  pinocchio::difference(plant_.dynamics().model(), q0_robot, stepper_.q.head(nq_robot_),
-                        travelled);
-  limit_speed_ = (travelled.cwiseAbs() / h)
-                     .cwiseMax(v0.head(nv_robot_).cwiseAbs())
-                     .cwiseMax(stepper_.v.head(nv_robot_).cwiseAbs());
-  if (!limits->within_reach(q0_robot, limit_speed_, h)) return {stepper_.q, stepper_.v};
-  const Eigen::MatrixXd& mass =
-      plant_.dynamics().mass_matrix_in(q0_robot, plant_.flow, t0, plant_.free_surface);
-  Eigen::VectorXd v1 = stepper_.v;
-  Eigen::VectorXd v1_robot = v1.head(nv_robot_);
-  if (!limits->constrain(mass, q0_robot, v1_robot, h, limit_speed_)) {
-    return {stepper_.q, stepper_.v};
-  }
-  v1.head(nv_robot_) = v1_robot;
-  Eigen::VectorXd q1(model_.nq);
-  pinocchio::integrate(model_, q0, (h * v1).eval(), q1);
+  Eigen::VectorXd q1 = stepper_.q, v1 = stepper_.v;
+  constrain(t0, q0, v0, t1, q1, v1);
   return {q1, v1};
+}
+
+void System::constrain(double t0, const ConstVec& q0, const ConstVec& v0, double t1,
+                       Eigen::VectorXd& q1, Eigen::VectorXd& v1) {
+  const double h = t1 - t0;
+  const auto& limits = plant_.joint_limits;
+  if (limits) {
+    // the robot's joint limits: rows selected with the smooth step's own speeds, its start
+    // and its mean over the period
+    const auto q0_robot = q0.head(nq_robot_);
+    Eigen::VectorXd travelled(nv_robot_);
+    pinocchio::difference(plant_.dynamics().model(), q0_robot, q1.head(nq_robot_), travelled);
+    limit_speed_ = (travelled.cwiseAbs() / h)
+                       .cwiseMax(v0.head(nv_robot_).cwiseAbs())
+                       .cwiseMax(v1.head(nv_robot_).cwiseAbs());
+    if (limits->within_reach(q0_robot, limit_speed_, h)) {
+      const Eigen::MatrixXd& mass =
+          plant_.dynamics().mass_matrix_in(q0_robot, plant_.flow, t0, plant_.free_surface);
+      Eigen::VectorXd v1_robot = v1.head(nv_robot_);
+      if (limits->constrain(mass, q0_robot, v1_robot, h, limit_speed_)) {
+        v1.head(nv_robot_) = v1_robot;
+        Eigen::VectorXd q1_robot(nq_robot_);
+        pinocchio::integrate(plant_.dynamics().model(), q0_robot, (h * v1_robot).eval(),
+                             q1_robot);
+        q1.head(nq_robot_) = q1_robot;
+      }
+    }
+  }
+  if (!rigid_objects) return;
+  for (std::size_t k = 0; k < objects_.size(); ++k) {
+    if (!object_worlds[k]) continue;
+    const auto i = static_cast<Eigen::Index>(k);
+    const auto q0_k = q0.segment(nq_robot_ + 7 * i, 7);
+    Dynamics& body = objects_[k];
+    Vec6 travelled;
+    pinocchio::difference(body.model(), q0_k, q1.segment(nq_robot_ + 7 * i, 7), travelled);
+    const Vec6 least = (travelled.cwiseAbs() / h).cwiseMax(v0.segment(nv_robot_ + 6 * i, 6).cwiseAbs());
+    const Mat6 mass = body.mass_matrix_in(q0_k, plant_.flow, t0, plant_.free_surface);
+    body.kinematics(q0_k, v0.segment(nv_robot_ + 6 * i, 6));
+    // the smooth step's body velocity at q_free expressed at q0, where the rows act
+    // (_objects_moved of period.py)
+    const Eigen::Matrix3d r0 = rotation_of(q0_k);
+    const Eigen::Matrix3d turn = r0.transpose() * rotation_of(q1.segment(nq_robot_ + 7 * i, 7));
+    Vec6 v_k = v1.segment(nv_robot_ + 6 * i, 6);
+    v_k << turn * v_k.head<3>(), turn * v_k.tail<3>();
+    if (object_step_.constrain(*object_worlds[k], object_memory[k], body.data(), mass, v_k, h,
+                               least, rigid_found_[k])) {
+      const Eigen::Matrix<double, 7, 1> q_end = free_body_configuration(q0_k, v_k, h);
+      q1.segment(nq_robot_ + 7 * i, 7) = q_end;
+      v1.segment(nv_robot_ + 6 * i, 3) = rotation_of(q_end).transpose() * r0 * v_k.head<3>();
+      v1.segment(nv_robot_ + 6 * i + 3, 3) = v_k.tail<3>();
+    }
+    object_worlds[k]->commit(rigid_found_[k], object_memory[k]);
+  }
 }
 
 }  // namespace uvms

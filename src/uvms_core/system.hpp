@@ -14,10 +14,13 @@
 // (world_contact.hpp), in the same water (the plant's flow and free surface).
 //
 // A period: the integrator's substeps on the system's manifold, then every contact's friction
-// anchors move (World.commit, PiecePairs.commit) at the period's end, then the robot's joint
-// limits as constraints solved implicitly (period.py, constrained: M block diagonal over the
-// bodies, so the impulses change the robot's velocity only; with a row solved, the whole
-// configuration is q0 (+) h v+).
+// anchors move (World.commit, PiecePairs.commit) at the period's end, then the constraints
+// solved implicitly (period.py, constrained): the robot's joint limits (joint_limits.hpp) and,
+// with rigid_objects, each free object's rigid contacts with the fixed world
+// (object_contacts.hpp; then the smooth dynamics leave those contacts out). M is block
+// diagonal over the bodies and no row joins two bodies, so each body is solved alone; a body
+// with a solved row moves from q0 with v+ (the robot q0 (+) h v+, an object by
+// free_body_configuration), the others keep the smooth step's end.
 #pragma once
 
 #include <optional>
@@ -25,6 +28,7 @@
 #include <vector>
 
 #include "moving_contact.hpp"
+#include "object_contacts.hpp"
 #include "plant.hpp"
 
 namespace uvms {
@@ -42,6 +46,8 @@ class System {
   std::vector<PairSet> sets;
   std::vector<std::optional<WorldContactModel>> object_worlds;
   std::vector<FrictionMemory> object_memory;
+  // the free objects touch the fixed world by rigid contacts (World.free_object_contact)
+  bool rigid_objects = false;
 
   int nq() const { return model_.nq; }
   int nv() const { return model_.nv; }
@@ -56,7 +62,11 @@ class System {
   // The contacts at (q, v) (after which found_sets() and found_objects() hold them).
   void contacts(const ConstVec& q, const ConstVec& v);
   const std::vector<PairContacts>& found_sets() const { return found_sets_; }
-  const std::vector<ContactForces>& found_objects() const { return found_objects_; }
+  // object k's contacts with the fixed world: at the last contacts() (compliant), or over
+  // the last period solved (rigid_objects: the mean forces of its impulses)
+  const ContactForces& found_object(std::size_t k) const {
+    return rigid_objects ? rigid_found_[k] : found_objects_[k];
+  }
   // After a control period at (q, v): every contact's anchors move (System.settle).
   void settle(const ConstVec& q, const ConstVec& v);
   // (q, v) at t1 from (q0, v0) at t0 with tau held (see the file's comment).
@@ -66,6 +76,9 @@ class System {
 
  private:
   void object_kinematics(const ConstVec& q, const ConstVec& v);
+  // The constraints of the period (see the file's comment) on (q1, v1), the smooth step's end.
+  void constrain(double t0, const ConstVec& q0, const ConstVec& v0, double t1,
+                 Eigen::VectorXd& q1, Eigen::VectorXd& v1);
   // Every moving contact, after the objects' kinematics, the robot's in robot.
   void contacts_at(const Data& robot);
   // The moving contacts' forces on the robot's bodies (the plant's moving_contacts, called
@@ -84,6 +97,8 @@ class System {
   ManifoldStepper stepper_;
   std::vector<PairContacts> found_sets_;
   std::vector<ContactForces> found_objects_;
+  std::vector<ContactForces> rigid_found_;  // each object's contacts of the last period
+  ObjectContactStep object_step_;
   Eigen::VectorXd acceleration_, limit_speed_;
   const Eigen::VectorXd zero_tau_ = Eigen::VectorXd::Zero(6);
 };

@@ -95,6 +95,9 @@ void bind_system(nb::module_& m) {
           "The plant (kept alive) and each free object's floating body (copied).")
       .def_prop_ro("nq", &System::nq)
       .def_prop_ro("nv", &System::nv)
+      .def_rw("rigid_objects", &System::rigid_objects,
+              "The free objects touch the fixed world by rigid contacts solved at each "
+              "period's end (object_contacts.hpp).")
       .def(
           "add_pairs",
           [](System& s, const PiecePairsModel& pairs, int a, int b) {
@@ -153,7 +156,7 @@ void bind_system(nb::module_& m) {
             }
             for (std::size_t k = 0; k < s.n_objects(); ++k) {
               if (s.object_worlds[k]) {
-                objects.append(forces_dict(s.found_objects()[k]));
+                objects.append(forces_dict(s.found_object(k)));
               } else {
                 objects.append(nb::none());
               }

@@ -92,7 +92,7 @@ def test_a_free_box_dropped_on_the_seafloor_rests_on_its_net_weight(load_body):
     )  # fmt: skip
     law = ContactLaw(stiffness_N_m=1e5, dissipation_s_m=0.5)
     floor = plane("seafloor", [0, 0, FLOOR_Z], [0, 0, 1], 0.6, 0.5)
-    world = World(pusher, [floor], law, [box])
+    world = World(pusher, [floor], law, [box], fixed_contact="compliant")  # a soft seabed
     system = System(Plant(pusher, world=world, free_surface=False))
     q = pusher.neutral_configuration()
     q[:3] = [20.0, 0.0, -5.0]  # far away: only the box touches the floor

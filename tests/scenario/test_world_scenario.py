@@ -129,7 +129,7 @@ def test_a_free_object_scenario_builds_its_floating_body():
     assert box.mass_kg == pytest.approx(1100.0 * 0.25 * 0.5 * 0.25)
     (body,) = box.uvms.hydro_bodies
     assert body.params.volume_m3 == pytest.approx(0.25 * 0.5 * 0.25)  # derived: its shape
-    assert np.allclose(box.q0[:3], [0.80, -0.11, -9.87529])
+    assert np.allclose(box.q0[:3], [0.80, -0.11, -9.875])
     assert [o.name for o in world.objects] == ["seabed"]
     system = System(scenario.plant)
     record = system.record()["world"]
@@ -137,6 +137,13 @@ def test_a_free_object_scenario_builds_its_floating_body():
     assert "one compiled call" in record["integration"]
     assert record["object_pairs"] == ["box|seabed"]
     assert system.contact_pair_names[-1].endswith("|box")
+    # rigid on the seabed by default; "compliant" is the compliant law
+    assert record["fixed_contact"] == "rigid" and system.object_contacts is not None
+    push = SCENARIOS / "push_object.toml"
+    soft = load_scenario(push, {"world.fixed_contact": "compliant"}).plant
+    assert soft.world.fixed_contact == "compliant" and System(soft).object_contacts is None
+    with pytest.raises(ScenarioError, match=r"world\.fixed_contact.*rigid, compliant"):
+        load_scenario(push, {"world.fixed_contact": "soft"})
 
 
 def test_self_collision_is_a_contact_key():

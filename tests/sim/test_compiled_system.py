@@ -53,7 +53,7 @@ def _scene(load_body, backend: str = "core", compiled: bool = True) -> tuple[Sys
     )  # fmt: skip
     floor = plane("seafloor", [0, 0, FLOOR_Z], [0, 0, 1], 0.6, 0.5)
     law = ContactLaw(stiffness_N_m=3e4, dissipation_s_m=1.0)
-    world = World(pusher, [floor], law, [box, ball])
+    world = World(pusher, [floor], law, [box, ball], fixed_contact="compliant")
     system = System(
         Plant(pusher, world=world, free_surface=False, backend=backend), compiled=compiled
     )
@@ -242,10 +242,14 @@ def test_a_world_the_core_cannot_do_runs_in_python_with_its_reason(load_body):
 
 def test_push_object_compiled_follows_the_python_integration():
     """The shipped scenario, its controller in the loop, compiled and in Python, over its
-    first 6 s (the jaws meet the box after about 5.5 s): the runs agree to AGREEMENT. Their
-    states differ by rounding, which the contacts' switches (touch, stick, slip) amplify:
-    over the whole 12 s (87 s of the Python integration, too long for a test) the robot's q
-    agreed to 2e-13 and the box's state to 3e-11."""
+    first 6 s (the jaws meet the box after about 5.5 s). The box rests on the seabed by rigid
+    contacts, solved to the reference ADMM's tolerance (1e-8 m/s) and by the core's
+    Gauss-Seidel: the runs agree to 1e-8 until the jaws push the box; then the box breaks
+    away, and where it sticks or slides (a switch of its friction between mu_s and mu_k at
+    1e-6 m/s) the two solves' rounding takes different sides for a period: 7e-5 on the
+    robot's q, 8e-4 on the box's state, 0.01 N on its contact forces (64 N) at 6 s
+    (measured; asked: RIGID_AGREEMENT). With the compliant law (the seabed a spring) the
+    runs agree to AGREEMENT."""
     scenario = load_scenario(ROOT / "scenarios" / "push_object.toml", {"scenario.duration_s": 6.0})
     compiled = up.simulate(scenario, progress=False)
     python = up.simulate(scenario, progress=False, compiled_loop=False)
@@ -257,14 +261,21 @@ def test_push_object_compiled_follows_the_python_integration():
     pairs = compiled.metadata["world_contact_pairs"]
     jaws = [k for k, name in enumerate(pairs) if name.endswith("|box")]
     assert np.abs(on_box[:, jaws, :3]).max() > 1.0  # the UVMS pushed the box
-    np.testing.assert_allclose(compiled.q, python.q, rtol=0, atol=AGREEMENT)
+    before = compiled.time_s < 5.5  # before the jaws reach the box
+    np.testing.assert_allclose(compiled.q[before], python.q[before], rtol=0, atol=1e-8)
+    np.testing.assert_allclose(compiled.q, python.q, rtol=0, atol=RIGID_AGREEMENT)
     np.testing.assert_allclose(
-        compiled.signals["free_objects"], python.signals["free_objects"], rtol=0, atol=AGREEMENT
-    )
+        compiled.signals["free_objects"], python.signals["free_objects"],
+        rtol=0, atol=10 * RIGID_AGREEMENT,
+    )  # fmt: skip
     np.testing.assert_allclose(
         compiled.signals["free_object_contact"], python.signals["free_object_contact"],
-        rtol=0, atol=1e3 * AGREEMENT,
+        rtol=0, atol=0.05,
     )  # fmt: skip
+
+
+#: [m, rad]: push_object compiled against the Python reference on rigid contacts (above)
+RIGID_AGREEMENT = 1e-4
 
 
 AGREEMENT = 1e-10  # [m, rad, m/s, rad/s]; the forces [N] to 1e3 times that (k = 2e4 N/m)
@@ -291,7 +302,9 @@ def test_a_joint_limit_is_solved_in_the_compiled_period_as_in_the_reference():
     """push_object's joint limits are constraints: an arm joint driven into its lower limit
     is stopped there by the compiled period as by the reference's solve (its ADMM to 1e-8),
     the box's configuration advanced as q0 (+) h v+ with the rest."""
-    system, scenario = _push_object_system()
+    # the box on the compliant law: its rigid contacts are solved to the reference's ADMM
+    # tolerance (test_object_contacts), the joint limits here to 1e-9
+    system, scenario = _push_object_system({"world.fixed_contact": "compliant"})
     assert system.plant.joint_limits is not None
     q0 = scenario.q0.copy()
     q0[8] = 2e-4  # the shoulder 0.2 mrad above its lower limit (0), moving into it
@@ -315,7 +328,9 @@ def test_a_joint_limit_is_solved_in_the_compiled_period_as_in_the_reference():
 def test_self_collision_beside_a_free_object_is_compiled_alike():
     """With ``self_collision`` the arm's pairs with its vehicle join the compiled system's
     sets: a few periods agree with the reference's."""
-    system, scenario = _push_object_system({"world.contact.self_collision": True})
+    system, scenario = _push_object_system(
+        {"world.contact.self_collision": True, "world.fixed_contact": "compliant"}
+    )
     assert any(s.a == -1 and s.b == -1 for s in system.moving.moving.sets)
     assert "one compiled call" in system.record(RK4(5e-4))["world"]["integration"]
     state = system.initial_state(scenario.q0, scenario.v0)

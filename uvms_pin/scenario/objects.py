@@ -1,8 +1,9 @@
 """``[world]``: objects (``[[world.objects]]``: fixed, or free with a ``mass_kg`` or
 ``density_kg_m3``; a ``type`` of `uvms_pin.physics.world.kinds`, whose keys and their
 check are its kind's) every body touches, the contact law's parameters
-(``[world.contact]``, with ``self_collision``) and ``initial_overlap`` (what the start does
-with a free object inside another body); ``[joints]``: the joint stops."""
+(``[world.contact]``, with ``self_collision``), ``initial_overlap`` (what the start does
+with a free object inside another body) and ``fixed_contact`` (rigid or compliant: how
+the free objects touch the fixed world); ``[joints]``: the joint stops."""
 
 from __future__ import annotations
 
@@ -23,7 +24,7 @@ from uvms_pin.physics.world.objects import (
     kind_names,
     object_kind,
 )
-from uvms_pin.physics.world.world import INITIAL_OVERLAP, World
+from uvms_pin.physics.world.world import FIXED_CONTACT, INITIAL_OVERLAP, World
 from uvms_pin.scenario.schema import Table
 
 __all__ = ["KEY_READERS", "build_world", "objects_bytes"]
@@ -59,13 +60,14 @@ def build_world(t: Table | None, uvms: UVMS, base_dir: Path) -> World | None:
     )
     built = [_object(o, k, law, base_dir, uvms) for k, o in enumerate(tables)]
     overlap = t.string("initial_overlap", "refuse", choices=INITIAL_OVERLAP)
+    free_contact = t.string("fixed_contact", "rigid", choices=FIXED_CONTACT)
     t.finish()
     fixed = [o for o in built if isinstance(o, WorldObject)]
     free = [o for o in built if isinstance(o, FreeObject)]
     if not built and not self_collision:
         return None
     try:
-        return World(uvms, fixed, law, free, self_collision, overlap)
+        return World(uvms, fixed, law, free, self_collision, overlap, free_contact)
     except ParameterError as exc:
         raise t.fail(str(exc)) from exc
 

@@ -116,7 +116,13 @@ def test_a_free_ellipsoid_sinks_and_rests_on_the_seabed_on_its_net_weight(load_b
     )  # fmt: skip
     law = ContactLaw(stiffness_N_m=1e5, dissipation_s_m=0.5)
     floor = plane("seabed", [0, 0, FLOOR_Z], [0, 0, 1], 0.6, 0.5)
-    system = System(Plant(pusher, world=World(pusher, [floor], law, [boulder]), free_surface=False))
+    system = System(
+        Plant(
+            pusher,
+            world=World(pusher, [floor], law, [boulder], fixed_contact="compliant"),
+            free_surface=False,
+        )
+    )
     q = pusher.neutral_configuration()
     q[:3] = [20.0, 0.0, -5.0]  # far away: only the boulder touches the seabed
     start = system.initial_state(q, np.zeros(6))

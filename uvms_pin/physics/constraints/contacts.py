@@ -30,7 +30,14 @@ from uvms_pin.checks import finite_vector
 from uvms_pin.errors import ParameterError
 from uvms_pin.physics.constraints.rows import ConstraintRows, evaluated
 
-__all__ = ["ContactSphere", "PlaneContacts", "point_jacobian"]
+__all__ = [
+    "ContactSphere",
+    "PlaneContacts",
+    "contact_frame",
+    "contact_rows",
+    "point_contact",
+    "point_jacobian",
+]
 
 _UNIT = "N s"
 
@@ -82,47 +89,48 @@ class PlaneContacts:
     ) -> ConstraintRows:
         """The contacts at q that can close within ``period_s`` at ``speed``
         (`ConstraintSet.rows`): three rows per contact (t1, t2, n)."""
-        frame = _contact_frame(self.normal_world)
-        models, datas, jacobians, gaps, labels = [], [], [], [], []
+        evaluated_contacts, gaps, labels = [], [], []
         for k, sphere in enumerate(self.spheres):
             if not 0 < sphere.joint_id < model.njoints:
                 raise ParameterError(f"contact sphere {k}: no joint {sphere.joint_id} in the model")
-            placed = data.oMi[sphere.joint_id]
-            center = placed.act(sphere.center_in_joint)
+            center = data.oMi[sphere.joint_id].act(sphere.center_in_joint)
             gap = float(self.normal_world @ (center - self.point_world)) - sphere.radius_m
             point = center - sphere.radius_m * self.normal_world
             normal_rate = self.normal_world @ point_jacobian(model, data, sphere.joint_id, point)
             if gap > period_s * np.abs(normal_rate) @ speed + self.margin:
                 continue
-            contact = pin.PointContactConstraintModel(
-                model,
-                0,
-                pin.SE3(frame, point - gap * self.normal_world),
-                sphere.joint_id,
-                pin.SE3(placed.rotation.T @ frame, placed.actInv(point)),
+            evaluated_contacts.append(
+                point_contact(
+                    model, data, sphere.joint_id, (point, self.normal_world, gap), self.friction
+                )
             )
-            contact.setFriction(self.friction)
-            constraint, constraint_data, jacobian = evaluated(model, data, contact)
-            models.append(constraint)
-            datas.append(constraint_data)
-            jacobians.append(jacobian)
-            gaps.append([0.0, 0.0, gap])
-            labels += [f"{model.names[sphere.joint_id]}[{k}] {axis}" for axis in ("t1", "t2", "n")]
-        if not models:
-            return ConstraintRows.empty(self.name, _UNIT, model.nv)
-        return ConstraintRows(
-            self.name,
-            _UNIT,
-            tuple(models),
-            tuple(datas),
-            np.vstack(jacobians),
-            np.concatenate(gaps),
-            np.tile([False, False, True], len(models)),
-            tuple(labels),
-        )
+            gaps.append(gap)
+            labels.append(f"{model.names[sphere.joint_id]}[{k}]")
+        return contact_rows(self.name, model.nv, evaluated_contacts, gaps, labels)
 
 
-def _contact_frame(normal: np.ndarray) -> np.ndarray:
+def contact_rows(
+    name: str, nv: int, evaluated_contacts: list, gaps: list[float], labels: list[str], where=()
+) -> ConstraintRows:
+    """The rows (three a contact: t1, t2, n) of point contacts, each as `point_contact`
+    gives it, with its signed gap [m] and its label; ``where``: `ConstraintRows.where`."""
+    if not evaluated_contacts:
+        return ConstraintRows.empty(name, _UNIT, nv)
+    models, datas, jacobians = zip(*evaluated_contacts, strict=True)
+    return ConstraintRows(
+        name,
+        _UNIT,
+        tuple(models),
+        tuple(datas),
+        np.vstack(jacobians),
+        np.array([[0.0, 0.0, gap] for gap in gaps]).reshape(-1),
+        np.tile([False, False, True], len(gaps)),
+        tuple(f"{label} {axis}" for label in labels for axis in ("t1", "t2", "n")),
+        tuple(where),
+    )
+
+
+def contact_frame(normal: np.ndarray) -> np.ndarray:
     """C = (t1, t2, n) (3x3, a rotation) with n its third column."""
     helper = np.array([1.0, 0.0, 0.0]) if abs(normal[0]) < 0.9 else np.array([0.0, 1.0, 0.0])
     t1 = np.cross(helper, normal)
@@ -138,3 +146,29 @@ def point_jacobian(
     jacobian = pin.getJointJacobian(model, data, joint_id, pin.LOCAL_WORLD_ALIGNED)
     offset = point - data.oMi[joint_id].translation
     return jacobian[:3] - pin.skew(offset) @ jacobian[3:]
+
+
+def point_contact(
+    model: pin.Model,
+    data: pin.Data,
+    joint_id: int,
+    touching: tuple[np.ndarray, np.ndarray, float],
+    friction: float,
+) -> tuple[pin.ConstraintModel, pin.ConstraintData, np.ndarray]:
+    """The evaluated point contact (`rows.evaluated`: three rows t1, t2, n) of the body of
+    ``joint_id`` at its material point ``touching`` = (point (3,) [m], the fixed surface's
+    outward unit normal (3,), the signed gap r [m]) with the Coulomb cone of ``friction``:
+    the surface's point p - r n is the first (joint 0, its z the normal), the body's point
+    p the second (the same rotation), as the module's docstring says."""
+    point, normal, gap = touching
+    frame = contact_frame(normal)
+    placed = data.oMi[joint_id]
+    contact = pin.PointContactConstraintModel(
+        model,
+        0,
+        pin.SE3(frame, point - gap * normal),
+        joint_id,
+        pin.SE3(placed.rotation.T @ frame, placed.actInv(point)),
+    )
+    contact.setFriction(friction)
+    return evaluated(model, data, contact)

@@ -35,6 +35,8 @@ class ConstraintRows:
         gap: r (m,) [rad or m]; 0 on rows without a position.
         positional: (m,) bool, the rows whose gap is a position (limits, contact normals).
         labels: one label per row, for messages and logs.
+        where: what the set needs to read its impulses back (its contact points, one
+            entry per three rows of a contact set), or empty.
     """
 
     name: str
@@ -45,6 +47,7 @@ class ConstraintRows:
     gap: np.ndarray
     positional: np.ndarray
     labels: tuple[str, ...]
+    where: tuple = ()
 
     @property
     def size(self) -> int:

@@ -52,6 +52,7 @@ __all__ = [
     "constrained_configuration",
     "constrained_velocity",
     "default_settings",
+    "free_body_configuration",
 ]
 
 #: beta, the fraction of a penetration removed per period (the module docstring)
@@ -188,6 +189,24 @@ def constrained_configuration(
     if not step.rows:
         return np.asarray(q_free, dtype=float)
     return pin.integrate(model, q, _checked_period(period_s) * step.velocity)
+
+
+def free_body_configuration(q: np.ndarray, v: np.ndarray, period_s: float) -> np.ndarray:
+    """A free body's pose (7,) [m; quaternion x, y, z, w] at the period's end from its pose
+    ``q`` and its constrained body velocity ``v`` (6,) [m/s, rad/s, LOCAL]: its position
+    along the world velocity it has at the start and its rotation by the angular velocity,
+
+        p+ = p + h R v_lin,      R+ = R exp(h w),
+
+    the semi-implicit Euler step on R^3 x SO(3). Not ``pin.integrate`` (the exponential of
+    SE(3), a screw motion): a sphere rolling without slip has the twist of a rotation about
+    its contact point, whose screw lifts its centre by r (1 - cos(w h)) a period (0.1 mm at
+    24 rad/s and 2 ms) off the plane the constraint held it on; here its centre moves along
+    the plane, as the contact's rows J v+ say."""
+    h = _checked_period(period_s)
+    rotation = pin.Quaternion(q[3:7]).normalized().matrix()
+    turned = pin.Quaternion(rotation @ pin.exp3(h * v[3:6])).normalized()
+    return np.concatenate([q[:3] + h * rotation @ v[:3], turned.coeffs()])
 
 
 def _solve(

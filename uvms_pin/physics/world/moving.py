@@ -8,8 +8,11 @@ Sets of pairs (`uvms_pin.physics.world.pairs.PiecePairs`), each with its frictio
 - with ``self_collision``: each arm link's pieces against the vehicle's, except the link
   jointed to the vehicle itself (adjacent: their shapes meet at the joint by design);
 
-and, for each free object, its own `World` against the fixed objects (the same contact as
-the UVMS's: corners on a plane, coal's deepest point otherwise). Every force is exchanged
+and, for each free object, its own `World` against the fixed objects: the same compliant
+contact as the UVMS's (corners on a plane, coal's deepest point otherwise), or, with
+``World.fixed_contact`` "rigid", rigid contacts solved as constraints after the smooth
+step (`uvms_pin.physics.constraints.object_contacts`): then the smooth dynamics leave them
+out and `rigid_forces` holds the last period's mean contact forces (what a run logs). Every force is exchanged
 equal and opposite between the two bodies of its pair (a fixed object's reaction goes to
 the ground).
 """
@@ -22,7 +25,8 @@ import numpy as np
 import pinocchio as pin
 
 from uvms_pin.physics.world.pairs import PairContacts, PiecePairs, piece_pairs
-from uvms_pin.physics.world.world import FrictionMemory, World
+from uvms_pin.physics.world.touch import NO_TOUCH
+from uvms_pin.physics.world.world import ContactForces, FrictionMemory, World
 
 __all__ = ["MovingContacts", "State"]
 
@@ -65,12 +69,18 @@ class MovingContacts:
     Attributes:
         world: the UVMS's world. sets: the pair sets. object_worlds: each free object's
             `World` against the fixed objects (None without fixed objects).
+        object_memory: each free object's friction state against the fixed objects.
+        rigid: the free objects touch the fixed world by rigid contacts (see the module).
+        rigid_forces: with ``rigid``, each object's contacts with the fixed world over the
+            last period (`ObjectWorldContacts.forces`; None without a world).
     """
 
     world: World
     sets: list[_Set]
     object_worlds: list[World | None]
     object_memory: list[FrictionMemory]
+    rigid: bool = False
+    rigid_forces: list = field(default_factory=list)
 
     @staticmethod
     def of(world: World) -> MovingContacts:
@@ -97,7 +107,11 @@ class MovingContacts:
         for obj, own in zip(free, object_worlds, strict=True):
             if own is not None:  # its pairs are named after the object, not its link
                 own.body_names = [obj.name] * len(own.body_names)
-        return MovingContacts(world, sets, object_worlds, [FrictionMemory() for _ in free])
+        memories = [FrictionMemory() for _ in free]
+        rigid = world.fixed_contact == "rigid"
+        out = MovingContacts(world, sets, object_worlds, memories, rigid)
+        out.clear()
+        return out
 
     @property
     def uvms_pair_names(self) -> list[str]:
@@ -119,6 +133,8 @@ class MovingContacts:
             s.memory.clear()
         for m in self.object_memory:
             m.clear()
+        no_touch = ContactForces(NO_TOUCH, np.zeros((0, 3)), np.zeros(0), np.zeros(0, bool))
+        self.rigid_forces = [None if w is None else no_touch for w in self.object_worlds]
 
     def _datas(self, uvms_data: pin.Data, object_datas: list[pin.Data]):
         return lambda side: uvms_data if side < 0 else object_datas[side]
@@ -134,6 +150,8 @@ class MovingContacts:
         objects or None), after forward kinematics of every body with its velocity."""
         data = self._datas(uvms_data, object_datas)
         sets = [s.pairs.forces(data(s.a), data(s.b), s.memory) for s in self.sets]
+        if self.rigid:
+            return sets, list(self.rigid_forces)
         fixed = [
             None if w is None else w.forces(object_datas[k], self.object_memory[k])
             for k, w in enumerate(self.object_worlds)
@@ -162,7 +180,7 @@ class MovingContacts:
             side[0][3][:] += tau_a
             side[1][3][:] += tau_b
         for k, (w, forces) in enumerate(zip(self.object_worlds, fixed, strict=True)):
-            if forces is not None:
+            if forces is not None and not self.rigid:  # rigid: the constraints' impulses
                 tau_objects[k] += w.generalized_force(states[k][0], object_datas[k], forces)
         return tau_uvms, tau_objects
 
@@ -173,7 +191,7 @@ class MovingContacts:
         for s, contacts in zip(self.sets, sets, strict=True):
             s.pairs.commit(data(s.b), contacts, s.memory)
         for k, (w, forces) in enumerate(zip(self.object_worlds, fixed, strict=True)):
-            if forces is not None:
+            if forces is not None and not self.rigid:  # rigid: committed by its step
                 w.commit(forces, self.object_memory[k])
 
     def wrenches(self, found) -> tuple[np.ndarray, np.ndarray]:

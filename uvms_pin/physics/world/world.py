@@ -28,13 +28,25 @@ from uvms_pin.physics.world.objects import WorldObject
 from uvms_pin.physics.world.robot_geometry import RobotPiece, robot_pieces
 from uvms_pin.physics.world.touch import Bounds, Touch, clear_of, cross, touch
 
-__all__ = ["INITIAL_OVERLAP", "ContactForces", "FrictionMemory", "World", "material_points"]
+__all__ = [
+    "FIXED_CONTACT",
+    "INITIAL_OVERLAP",
+    "ContactForces",
+    "FrictionMemory",
+    "World",
+    "material_points",
+]
 
 Key = tuple[int, int, int]
 
 #: what a run does with a free object overlapping another body at its start
 #: (`uvms_pin.physics.world.overlap`): refuse it, or move it out along the contact normal
 INITIAL_OVERLAP = ("refuse", "separate")
+
+#: how a free object touches the fixed world (the seabed, fixed solids): as rigid contacts
+#: solved implicitly with the Coulomb cone (`uvms_pin.physics.constraints.object_contacts`),
+#: or by the compliant law integrated with the smooth dynamics (`contact_law`)
+FIXED_CONTACT = ("rigid", "compliant")
 
 
 @dataclass
@@ -113,6 +125,8 @@ class World:
         self_collision: the arm's links touch the vehicle (adjacent links excepted).
         initial_overlap: one of `INITIAL_OVERLAP`, what the start does with a free object
             that overlaps another body (`uvms_pin.physics.world.overlap`).
+        fixed_contact: one of `FIXED_CONTACT`, how the free objects touch the
+            fixed objects.
     """
 
     uvms: UVMS
@@ -121,8 +135,14 @@ class World:
     free: Sequence[Any] = ()
     self_collision: bool = False
     initial_overlap: str = "refuse"
+    fixed_contact: str = "rigid"
 
     def __post_init__(self) -> None:
+        if self.fixed_contact not in FIXED_CONTACT:
+            raise ParameterError(
+                f"fixed_contact must be one of {', '.join(FIXED_CONTACT)}, "
+                f"got {self.fixed_contact!r}"
+            )
         if self.initial_overlap not in INITIAL_OVERLAP:
             raise ParameterError(
                 f"initial_overlap must be one of {', '.join(INITIAL_OVERLAP)}, "
@@ -152,6 +172,7 @@ class World:
             "objects": [o.record() for o in self.objects],
             "free_objects": [o.record() for o in self.free],
             "contact": {**self.law.record(), "self_collision": bool(self.self_collision)},
+            **({"fixed_contact": self.fixed_contact} if self.free else {}),
             "pairs": self.pair_names,
         }
 

@@ -31,7 +31,12 @@ import pinocchio as pin
 from uvms_pin.errors import SimulationError
 from uvms_pin.physics.compiled.backend import Fallback
 from uvms_pin.physics.compiled.extension import core_module
-from uvms_pin.physics.constraints.step import constrained_configuration, constrained_velocity
+from uvms_pin.physics.constraints.rows import ConstraintRows
+from uvms_pin.physics.constraints.step import (
+    ConstrainedVelocity,
+    constrained_velocity,
+    free_body_configuration,
+)
 from uvms_pin.sim.compiled.integrator import integrator_to_core
 from uvms_pin.sim.integrators import Integrator
 
@@ -45,6 +50,8 @@ class Stepped(Protocol):
     moving: Any
     compiled: Any  # the compiled system of bodies with free objects, or its Fallback
     compiled_allowed: bool
+    layout: Any  # where each body sits in the state (`uvms_pin.sim.system.state.Layout`)
+    object_contacts: Any  # the free objects' rigid contacts with the fixed world, or None
 
     def friction_memories(self) -> list: ...
 
@@ -63,6 +70,7 @@ PeriodStep = Callable[[float, np.ndarray, np.ndarray, np.ndarray, float], tuple]
 __all__ = [
     "PeriodStep",
     "Stepped",
+    "constraint_sets",
     "integrated_step",
     "period_step",
     "why_not_compiled_system",
@@ -92,14 +100,21 @@ def why_not_compiled_system(system: Stepped, integrator: Integrator | None) -> s
     return built.reason if isinstance(built, Fallback) else None
 
 
+def constraint_sets(system: Stepped) -> tuple:
+    """The constraints solved implicitly at the end of ``system``'s period: the robot's
+    joint limits and the free objects' rigid contacts with the fixed world (each when
+    there is one)."""
+    return tuple(s for s in (system.plant.joint_limits, system.object_contacts) if s is not None)
+
+
 def constrained(system: Stepped, smooth: PeriodStep) -> PeriodStep:
     """``smooth`` followed by the constraints' implicit velocity step over the period
     (`uvms_pin.physics.constraints.step`): the smooth dynamics reach (q_free, v_free); the
     impulses give v+ = v_free + M^-1 J^T lambda, M(q0) the mass matrix with the added mass
-    (block diagonal over the bodies); the configuration is q0 (+) h v+ when a row was solved,
-    q_free otherwise (a period in which nothing can reach a limit is the smooth step's)."""
-    plant = system.plant
-    sets = (plant.joint_limits,)
+    (block diagonal over the bodies); each body some solved row acts on moves from q0 with
+    v+ (`_configuration`), the others keep q_free (a period in which nothing can reach a
+    limit or a surface is the smooth step's)."""
+    sets = constraint_sets(system)
 
     def step(t0, q0, v0, tau, t1):
         q_free, v_free = smooth(t0, q0, v0, tau, t1)
@@ -110,7 +125,7 @@ def constrained(system: Stepped, smooth: PeriodStep) -> PeriodStep:
         # may cross a limit that its end velocity would not reach)
         travelled = np.abs(pin.difference(system.model, q0, q_free)) / (t1 - t0)
         solved = constrained_velocity(
-            system.model, mass, v_free, q0, sets, t1 - t0,
+            system.model, mass, _objects_moved(system, v_free, q_free, q0), q0, sets, t1 - t0,
             least_speed=np.maximum(np.abs(v0), travelled),
         )  # fmt: skip
         if not solved.converged:
@@ -118,9 +133,79 @@ def constrained(system: Stepped, smooth: PeriodStep) -> PeriodStep:
                 f"the constraint solve did not converge between t = {t0:.6g} s and {t1:.6g} s "
                 f"({solved.iterations} iterations, residual {solved.residual:.3g})"
             )
-        return constrained_configuration(system.model, q0, q_free, solved, t1 - t0), solved.velocity
+        if system.object_contacts is not None:
+            _settle_contacts(system, solved, t1 - t0)
+        return _end(system, q0, (q_free, v_free), solved, t1 - t0)
 
     return step
+
+
+def _settle_contacts(system: Stepped, solved: ConstrainedVelocity, period_s: float) -> None:
+    """The free objects' contacts of the period solved: their mean forces kept for the logs
+    (`MovingContacts.rigid_forces`), their sliding patches for the next period's cone."""
+    contacts = system.object_contacts
+    rows = next((b for b in solved.rows if b.name == contacts.name), None)
+    if rows is None:
+        rows = ConstraintRows.empty(contacts.name, "N s", system.layout.nv)
+    impulse = solved.impulses.get(contacts.name, np.zeros(0))
+    found = contacts.forces(rows, impulse, solved.velocity, period_s)
+    moving = system.moving.moving
+    moving.rigid_forces = found
+    for world, forces, memory in zip(
+        moving.object_worlds, found, moving.object_memory, strict=True
+    ):
+        if world is not None:
+            world.commit(forces, memory)
+
+
+def _objects_moved(system: Stepped, v: np.ndarray, q_from: np.ndarray, q_to: np.ndarray):
+    """``v`` (nv,) with each free object's body velocity at its pose in ``q_from`` expressed
+    in its frame at ``q_to`` (the same world velocity: R_to^T R_from [v_lin; w]). The smooth
+    step ends with the body velocity of the pose q_free; the rows act at q0 (their
+    Jacobian is for the body velocity there): the two frames differ by the rotation over
+    the period, w h, which, left out, turns a rolling sphere's velocity a little each period
+    (it then rolls 4 % fast and gains energy)."""
+    layout = system.layout
+    out = np.array(v, dtype=float)
+    for at, part in zip(layout.q_slices[1:], layout.v_slices[1:], strict=True):
+        turn = _rotation(q_to[at]).T @ _rotation(q_from[at])
+        out[part] = np.concatenate([turn @ v[part][:3], turn @ v[part][3:]])
+    return out
+
+
+def _rotation(pose: np.ndarray) -> np.ndarray:
+    return pin.Quaternion(pose[3:7]).normalized().matrix()
+
+
+def _end(
+    system: Stepped,
+    q0: np.ndarray,
+    smooth: tuple[np.ndarray, np.ndarray],
+    solved: ConstrainedVelocity,
+    h: float,
+) -> tuple[np.ndarray, np.ndarray]:
+    """(q, v) at the period's end: a body some solved row acts on moves from its q0 with v+
+    (the robot by `constrained_configuration`, q0 (+) h v+; a free object by
+    `free_body_configuration`, its body velocity then expressed at its new pose); a body no
+    row acts on keeps the smooth step's end ``smooth`` = (q_free, v_free) (all of them when
+    nothing was solved)."""
+    q_free, v_free = smooth
+    if not solved.rows:
+        return np.asarray(q_free, dtype=float), np.asarray(v_free, dtype=float)
+    acting = np.any(np.vstack([b.jacobian for b in solved.rows]) != 0.0, axis=0)
+    q, v = np.array(q_free, dtype=float), np.array(v_free, dtype=float)
+    layout, v_plus = system.layout, solved.velocity
+    for k, (at, part) in enumerate(zip(layout.q_slices, layout.v_slices, strict=True)):
+        if not np.any(acting[part]):
+            continue
+        if k == 0:
+            q[at] = pin.integrate(system.plant.uvms.model, q0[at], h * v_plus[part])
+            v[part] = v_plus[part]
+        else:
+            q[at] = free_body_configuration(q0[at], v_plus[part], h)
+            turn = _rotation(q[at]).T @ _rotation(q0[at])
+            v[part] = np.concatenate([turn @ v_plus[part][:3], v_plus[part][3:]])
+    return q, v
 
 
 def integrated_step(system: Stepped, integrator: Integrator) -> PeriodStep:
@@ -135,7 +220,7 @@ def integrated_step(system: Stepped, integrator: Integrator) -> PeriodStep:
         system.settle(q1, v1)
         return q1, v1
 
-    return smooth if system.plant.joint_limits is None else constrained(system, smooth)
+    return constrained(system, smooth) if constraint_sets(system) else smooth
 
 
 def _step(system: Stepped, integrator: Integrator) -> PeriodStep:

@@ -24,6 +24,7 @@ import pinocchio as pin
 from uvms_pin.physics.compiled.backend import Fallback
 from uvms_pin.physics.compiled.extension import core_module
 from uvms_pin.physics.compiled.moving import contacts_of_core, forces_of_core, memories_of
+from uvms_pin.physics.constraints.object_contacts import ObjectWorldContacts
 from uvms_pin.physics.dynamics import forward_dynamics, mass_matrix
 from uvms_pin.physics.world.overlap import tolerance_m
 from uvms_pin.sim.compiled.system import system_to_core
@@ -72,6 +73,9 @@ class System:
         layout: where each body sits in the state. model: the system's Pinocchio model.
         compiled_allowed: the period of a system with free objects may be one compiled call
             (`uvms_pin.sim.system.period`); False: the Python integrator steps it.
+        object_contacts: the free objects' rigid contacts with the fixed world, solved with
+            the joint limits at each period's end
+            (`uvms_pin.physics.constraints.object_contacts`), or None.
     """
 
     def __init__(self, plant: Plant, *, compiled: bool = True):
@@ -85,9 +89,20 @@ class System:
             [("robot", uvms.nq, uvms.nv), *[(o.name, 7, 6) for o in self.objects]]
         )
         self.model = _system_model(uvms.model, len(self.objects)) if self.objects else uvms.model
+        self.object_contacts = self._object_contacts()
         self._steps: dict[int, tuple[Integrator, PeriodStep]] = {}
         self._data = uvms.model.createData()  # the bound test's kinematics
         self.separations: list = []  # the objects' moves out of an overlap at the start
+
+    def _object_contacts(self) -> ObjectWorldContacts | None:
+        """The free objects' rigid contacts with the fixed world (`World.fixed_contact`
+        "rigid"), None when they have none or touch it by the compliant law."""
+        moving = None if self.moving is None else self.moving.moving
+        if moving is None or not moving.rigid or not any(moving.object_worlds):
+            return None
+        first = self.plant.uvms.model.njoints  # each object's free-flyer (_system_model)
+        joints = [first + k for k in range(len(self.objects))]
+        return ObjectWorldContacts(moving.object_worlds, joints, moving.object_memory)
 
     # ---- the state ------------------------------------------------------------------------
     def initial_state(self, q0: np.ndarray, v0: np.ndarray) -> SystemState:
@@ -277,7 +292,8 @@ class System:
             return {}
         (q_r, v_r), *objects = self.layout.split(q, v)
         compiled = self.compiled
-        if compiled is None or isinstance(compiled, Fallback):
+        # the Python integration's own contacts (its rigid contacts' forces are its own)
+        if compiled is None or isinstance(compiled, Fallback) or not self.compiled_allowed:
             fixed = plant.world.pair_wrenches(plant.world_forces(q_r, v_r)).ravel()
             if self.moving is None:
                 return {"world_contact": fixed}

@@ -1,0 +1,265 @@
+#include "object_contacts.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <string>
+
+#include <coal/distance.h>
+#include <Eigen/Cholesky>
+#include <Eigen/Geometry>
+#include <pinocchio/spatial/explog.hpp>
+
+#include "world_touch.hpp"
+
+namespace uvms {
+
+namespace {
+
+// The rounds of widening before the last solve (step.py's _MAX_ROUNDS)
+constexpr int kMaxRounds = 4;
+// |axis . n| beyond which a cylinder stands on an end face (gaps.py's _STANDING)
+constexpr double kStanding = 1.0 - 1.0e-9;
+// the tangential speed above which a patch slides [m/s] (object_contacts.py's SLIP_M_S)
+constexpr double kSlip = 1.0e-6;
+// the Gauss-Seidel sweeps stop when no impulse changes its rows' velocity by more [m/s]
+constexpr double kTolerance = 1.0e-10;
+constexpr int kMaxSweeps = 20000;
+
+coal::Transform3s transform_of(const pinocchio::SE3& where) {
+  return coal::Transform3s(where.rotation(), where.translation());
+}
+
+// The candidates of a piece against a plane by points of its own (_plane_points of gaps.py).
+void plane_points(const ContactShape& piece, const pinocchio::SE3& where, const Vec3& normal,
+                  const Vec3& origin, int p, int o, std::vector<ContactCandidate>& out) {
+  auto add = [&](int corner, const Vec3& point) {
+    out.push_back({p, o, corner, point, normal, (point - origin).dot(normal)});
+  };
+  if (piece.kind == ContactKind::cylinder) {
+    const Vec3 axis = where.rotation().col(2);
+    const Vec3 across = normal - axis * axis.dot(normal);
+    if (across.norm() > std::sqrt(1.0 - kStanding * kStanding)) {
+      const Vec3 down = across.normalized();
+      const auto& cylinder = static_cast<const coal::Cylinder&>(*piece.geometry);
+      for (int rim = 0; rim < 2; ++rim) {
+        const double side = rim == 0 ? -1.0 : 1.0;
+        add(-2 - rim, where.translation() + side * cylinder.halfLength * axis -
+                          cylinder.radius * down);
+      }
+      return;
+    }
+  }
+  for (Eigen::Index c = 0; c < piece.corners_m.cols(); ++c) {
+    add(static_cast<int>(c), where.translation() + where.rotation() * piece.corners_m.col(c));
+  }
+}
+
+// coal's signed distance and nearest point on the piece (_coal_candidate of gaps.py).
+ContactCandidate coal_candidate(const ContactShape& piece, const pinocchio::SE3& where,
+                                const ContactShape& object, const pinocchio::SE3& object_where,
+                                int p, int o) {
+  static const coal::DistanceRequest request;
+  coal::DistanceResult result;
+  const double gap = coal::distance(piece.geometry.get(), transform_of(where),
+                                    object.geometry.get(), transform_of(object_where), request,
+                                    result);
+  // coal's normal points from the first shape (the piece) to the second (the object)
+  return {p, o, -1, result.nearest_points[0], -result.normal, gap};
+}
+
+// C = (t1, t2, n) with n its third column (contact_frame of contacts.py).
+Eigen::Matrix3d contact_frame(const Vec3& normal) {
+  const Vec3 helper = std::abs(normal.x()) < 0.9 ? Vec3::UnitX() : Vec3::UnitY();
+  const Vec3 t1 = helper.cross(normal).normalized();
+  Eigen::Matrix3d out;
+  out << t1, normal.cross(t1), normal;
+  return out;
+}
+
+// J_x (3 x 6): the world velocity of the material point at x for the LOCAL twist.
+Eigen::Matrix<double, 3, 6> point_jacobian(const pinocchio::SE3& body, const Vec3& x) {
+  Eigen::Matrix<double, 3, 6> out;
+  out.leftCols<3>() = body.rotation();
+  out.rightCols<3>() = -pinocchio::skew(Vec3(x - body.translation())) * body.rotation();
+  return out;
+}
+
+}  // namespace
+
+void contact_candidates(const Data& data, const std::vector<ContactShape>& pieces,
+                        const std::vector<ContactShape>& objects, double reach_m,
+                        std::vector<ContactCandidate>& out) {
+  out.clear();
+  Placements where(pieces.size()), object_where(objects.size());
+  for (std::size_t p = 0; p < pieces.size(); ++p) where[p] = placement_of(data, pieces[p]);
+  for (std::size_t o = 0; o < objects.size(); ++o) object_where[o] = placement_of(data, objects[o]);
+  // the broad phase of touch.py's Bounds.near with every piece's sphere grown by the reach:
+  // planes first, then the others, each in (piece, object) order
+  for (const bool planes : {true, false}) {
+    for (std::size_t p = 0; p < pieces.size(); ++p) {
+      const Vec3& center = where[p].translation();
+      const double radius = pieces[p].bound_radius_m + reach_m;
+      for (std::size_t o = 0; o < objects.size(); ++o) {
+        const auto& object = objects[o];
+        if (object.is_plane() != planes) continue;
+        const auto& at = object_where[o];
+        const int pi = static_cast<int>(p), oi = static_cast<int>(o);
+        if (planes) {
+          const Vec3 normal = at.rotation().col(2);
+          if ((center - at.translation()).dot(normal) >= radius) continue;
+          if (pieces[p].has_corners()) {
+            plane_points(pieces[p], where[p], normal, at.translation(), pi, oi, out);
+            continue;
+          }
+        } else if ((center - at.translation()).norm() >= radius + object.bound_radius_m) {
+          continue;
+        }
+        out.push_back(coal_candidate(pieces[p], where[p], object, at, pi, oi));
+      }
+    }
+  }
+}
+
+int ObjectContactStep::select(const WorldContactModel& world, const FrictionMemory& memory,
+                              const Data& data, const Vec6& speed, double h) {
+  const pinocchio::SE3& body = data.oMi[1];
+  double extent = 0.0;
+  for (const auto& piece : world.pieces) {
+    extent = std::max(extent, piece.bound_radius_m + piece.placement_in_joint.translation().norm());
+  }
+  const double reach = h * (speed.head<3>().sum() + speed.tail<3>().sum() * extent) + margin;
+  contact_candidates(data, world.pieces, world.objects, reach, candidates_);
+  selected_.clear();
+  mu_.clear();
+  const int n_objects = static_cast<int>(world.objects.size());
+  for (const auto& candidate : candidates_) {
+    const Eigen::Matrix<double, 1, 6> rate =
+        candidate.normal.transpose() * point_jacobian(body, candidate.point);
+    if (candidate.gap_m > h * rate.cwiseAbs().dot(speed.transpose()) + margin) continue;
+    selected_.push_back(candidate);
+    const auto& object = world.objects[static_cast<std::size_t>(candidate.obj)];
+    const bool sliding = memory.slipping.count(candidate.piece * n_objects + candidate.obj) > 0;
+    mu_.push_back(sliding ? object.friction_kinetic : object.friction_static);
+  }
+  const auto m = static_cast<Eigen::Index>(selected_.size());
+  jacobian_.resize(3 * m, 6);
+  drift_.resize(3 * m);
+  frames_.resize(selected_.size());
+  for (Eigen::Index i = 0; i < m; ++i) {
+    const auto& contact = selected_[static_cast<std::size_t>(i)];
+    frames_[static_cast<std::size_t>(i)] = contact_frame(contact.normal);
+    jacobian_.middleRows<3>(3 * i) =
+        frames_[static_cast<std::size_t>(i)].transpose() * point_jacobian(body, contact.point);
+    const double gap = contact.gap_m;
+    drift_.segment<3>(3 * i) << 0.0, 0.0, (gap >= 0.0 ? gap : correction * gap) / h;
+  }
+  return static_cast<int>(m);
+}
+
+void ObjectContactStep::solve(const Mat6& mass, const Vec6& v_free, Vec6& v) {
+  const Eigen::LLT<Mat6> llt(mass);
+  if (llt.info() != Eigen::Success) {
+    throw SimulationFailure("object contacts: the mass matrix is not positive definite");
+  }
+  minv_jt_ = llt.solve(jacobian_.transpose());
+  delassus_ = jacobian_ * minv_jt_;
+  const Eigen::VectorXd g = jacobian_ * v_free + drift_;
+  const auto m = static_cast<Eigen::Index>(selected_.size());
+  impulse_ = Eigen::VectorXd::Zero(3 * m);
+  Eigen::VectorXd sigma = g;  // G lambda + g, kept up to date
+  double last_change = 0.0;
+  for (int sweep = 0; sweep < kMaxSweeps; ++sweep) {
+    double change = 0.0;
+    for (Eigen::Index i = 0; i < m; ++i) {
+      const Eigen::Index n = 3 * i + 2, t = 3 * i;
+      const Eigen::Vector3d before = impulse_.segment<3>(t);
+      const double normal = std::max(0.0, before[2] - sigma[n] / delassus_(n, n));
+      sigma += delassus_.col(n) * (normal - before[2]);
+      impulse_[n] = normal;
+      const Eigen::Matrix2d g_tt = delassus_.block<2, 2>(t, t);
+      const double mean = 0.5 * g_tt.trace();
+      const double spread = std::sqrt(0.25 * std::pow(g_tt(0, 0) - g_tt(1, 1), 2) +
+                                      g_tt(0, 1) * g_tt(0, 1));
+      Eigen::Vector2d tangential = before.head<2>() - sigma.segment<2>(t) / (mean + spread);
+      const double limit = mu_[static_cast<std::size_t>(i)] * normal;
+      if (tangential.norm() > limit) tangential *= limit / tangential.norm();
+      sigma += delassus_.middleCols<2>(t) * (tangential - before.head<2>());
+      impulse_.segment<2>(t) = tangential;
+      const Eigen::Vector3d step = impulse_.segment<3>(t) - before;
+      change = std::max(change, (delassus_.block<3, 3>(t, t) * step).cwiseAbs().maxCoeff());
+    }
+    last_change = change;
+    if (change <= kTolerance) {
+      v = v_free + minv_jt_ * impulse_;
+      return;
+    }
+  }
+  throw SimulationFailure("object contacts: the Gauss-Seidel sweeps did not settle in " +
+                          std::to_string(kMaxSweeps) + " (a change of " +
+                          std::to_string(last_change) + " m/s at the last)");
+}
+
+void ObjectContactStep::forces(const Vec6& v, double h, ContactForces& out) const {
+  Touch& touch = out.touch;
+  touch.clear();
+  const std::size_t m = selected_.size();
+  out.force_world_N.resize(m);
+  out.normal_N.resize(static_cast<Eigen::Index>(m));
+  out.sticking.resize(m);
+  out.stretch_m.assign(m, Vec3::Zero());
+  out.material_m.assign(m, Vec3::Zero());
+  const Eigen::VectorXd rate = jacobian_ * v;
+  for (std::size_t k = 0; k < m; ++k) {
+    const auto i = static_cast<Eigen::Index>(k);
+    const auto& contact = selected_[k];
+    touch.piece.push_back(contact.piece);
+    touch.obj.push_back(contact.obj);
+    touch.corner.push_back(contact.corner);
+    touch.point_world_m.push_back(contact.point);
+    touch.normal_world.push_back(contact.normal);
+    touch.depth_m.push_back(std::max(-contact.gap_m, 0.0));
+    touch.velocity_world_m_s.push_back(frames_[k] * rate.segment<3>(3 * i));
+    out.force_world_N[k] = frames_[k] * impulse_.segment<3>(3 * i) / h;
+    out.normal_N[i] = impulse_[3 * i + 2] / h;
+    out.sticking[k] = rate.segment<2>(3 * i).norm() <= kSlip;
+  }
+}
+
+bool ObjectContactStep::constrain(const WorldContactModel& world, const FrictionMemory& memory,
+                                  const Data& data, const Mat6& mass, Vec6& v, double h,
+                                  const Vec6& least_speed, ContactForces& out) {
+  if (!(std::isfinite(h) && h > 0.0)) throw InputError("object contacts: the period must be > 0");
+  const Vec6 v_free = v;
+  Vec6 speed = v_free.cwiseAbs().cwiseMax(least_speed.cwiseAbs());
+  int rows = select(world, memory, data, speed, h);
+  if (rows > 0) {
+    bool settled = false;
+    for (int round = 0; round < kMaxRounds && !settled; ++round) {
+      solve(mass, v_free, v);
+      speed = speed.cwiseMax(v.cwiseAbs());
+      // the same count: the same contacts (the selection only grows with the speed), so
+      // the rows selected again are the ones solved
+      const int wider = select(world, memory, data, speed, h);
+      settled = wider == rows;
+      rows = wider;
+    }
+    if (!settled) solve(mass, v_free, v);
+  }
+  forces(v, h, out);
+  return rows > 0;
+}
+
+Eigen::Matrix<double, 7, 1> free_body_configuration(const Eigen::Ref<const Eigen::VectorXd>& q,
+                                                    const Vec6& v, double h) {
+  const Eigen::Quaterniond start(q[6], q[3], q[4], q[5]);
+  const Eigen::Matrix3d rotation = start.normalized().toRotationMatrix();
+  const Eigen::Quaterniond turned(
+      Eigen::Matrix3d(rotation * pinocchio::exp3(Vec3(h * v.tail<3>()))));
+  Eigen::Matrix<double, 7, 1> out;
+  out.head<3>() = q.head<3>() + h * rotation * v.head<3>();
+  const Eigen::Quaterniond unit = turned.normalized();
+  out.tail<4>() << unit.x(), unit.y(), unit.z(), unit.w();
+  return out;
+}
+
+}  // namespace uvms

@@ -1,0 +1,84 @@
+// A free object against the fixed world as rigid point contacts with the Coulomb cone, solved
+// implicitly once a control period (mirror of uvms_pin/physics/world/gaps.py, the candidate
+// points, and uvms_pin/physics/constraints/object_contacts.py with step.py, the rows and the
+// velocity step, for one free object: its contacts are the only rows acting on it, and the
+// system's mass matrix is block diagonal over the bodies).
+//
+// Candidates (piece, object, material point x on the piece, normal n out of the object,
+// signed gap r): against a plane a polyhedron's corners, a cylinder's rim points (the lowest
+// point of each rim circle; its rim's corners when it stands on an end face), else coal's
+// signed distance and nearest point. A contact is solved when r <= h |J_n| |v| + margin. Its
+// rows are J = C^T J_x (3 x 6), C = (t1, t2, n) the contact frame, J_x = [R, -[x - p]x R] the
+// velocity of the body's material point at x for the LOCAL twist (v, w) of the pose (R, p).
+// With G = J M^-1 J^T (M the 6 x 6 mass matrix, added mass included) and
+// g = J v_free + phi(r) / h on the normal rows (phi(r) = r, or correction * r inside),
+//
+//   v+ = v_free + M^-1 J^T lambda,  sigma = G lambda + g,
+//   0 <= lambda_n  _|_  sigma_n >= 0,   lambda_t = argmax dissipation in |lambda_t| <= mu lambda_n
+//
+// (the Coulomb problem the reference's ADMM solves in De Saxce's form), here by projected
+// Gauss-Seidel: for each contact, lambda_n <- max(0, lambda_n - sigma_n / G_nn), then
+// lambda_t <- proj_{|.| <= mu lambda_n}(lambda_t - sigma_t / g_t) with g_t the largest
+// eigenvalue of its 2 x 2 block G_tt (a step whose fixed points are exactly the
+// maximal-dissipation ones), sweeps until no impulse changes the velocity of its own rows by
+// more than kTolerance (1e-12 m/s). mu is mu_k while the patch slid over the last period,
+// mu_s otherwise; a patch slides when one of its points moves tangentially faster than
+// 1e-6 m/s at the period's end (ObjectWorldContacts.forces).
+#pragma once
+
+#include <vector>
+
+#include "world_contact.hpp"
+
+namespace uvms {
+
+// One candidate contact point (Candidate of gaps.py); corner: the piece's corner, a rim's
+// lowest point -2 - rim, -1 coal's point.
+struct ContactCandidate {
+  int piece = 0, obj = 0, corner = -1;
+  Vec3 point = Vec3::Zero();
+  Vec3 normal = Vec3::UnitZ();
+  double gap_m = 0.0;
+};
+
+// Every candidate of the pieces placed by data (after kinematics) on the objects whose bounds
+// are within reach_m [m].
+void contact_candidates(const Data& data, const std::vector<ContactShape>& pieces,
+                        const std::vector<ContactShape>& objects, double reach_m,
+                        std::vector<ContactCandidate>& out);
+
+// The velocity step of one free object against its fixed world.
+class ObjectContactStep {
+ public:
+  double margin = 1.0e-3;   // [m] the allowance of a contact's selection
+  double correction = 0.2;  // beta, the fraction of a penetration removed per period
+
+  // v (in: v_free (6,), out: v+) over the period h from the pose whose kinematics data holds
+  // (q0), mass M(q0) (6 x 6), the contacts with world's objects and the sliding patches of
+  // memory; rows selected with the speed max(|v|, least_speed) per coordinate, widened with
+  // the solved velocity (at most 4 rounds, then once more, as step.py). Returns whether any
+  // contact was solved; out: the contacts and their mean forces over the period.
+  bool constrain(const WorldContactModel& world, const FrictionMemory& memory, const Data& data,
+                 const Eigen::Matrix<double, 6, 6>& mass, Vec6& v, double h,
+                 const Vec6& least_speed, ContactForces& out);
+
+ private:
+  // the contacts within reach at speed; returns their count
+  int select(const WorldContactModel& world, const FrictionMemory& memory, const Data& data,
+             const Vec6& speed, double h);
+  void solve(const Eigen::Matrix<double, 6, 6>& mass, const Vec6& v_free, Vec6& v);
+  void forces(const Vec6& v, double h, ContactForces& out) const;
+
+  std::vector<ContactCandidate> candidates_, selected_;
+  std::vector<double> mu_;
+  Eigen::MatrixXd jacobian_, delassus_, minv_jt_;
+  Eigen::VectorXd drift_, impulse_;
+  std::vector<Eigen::Matrix3d> frames_;
+};
+
+// A free body's pose (7,) at the period's end from its pose q and its body velocity v (6,)
+// (free_body_configuration of step.py): p+ = p + h R v_lin, R+ = R exp(h w).
+Eigen::Matrix<double, 7, 1> free_body_configuration(const Eigen::Ref<const Eigen::VectorXd>& q,
+                                                    const Vec6& v, double h);
+
+}  // namespace uvms
