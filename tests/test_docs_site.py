@@ -43,7 +43,7 @@ def _config() -> dict:
         pass
 
     Loader.add_multi_constructor("!", lambda loader, suffix, node: None)
-    return yaml.load((ROOT / "mkdocs.yml").read_text(), Loader=Loader)  # noqa: S506
+    return yaml.load((ROOT / "mkdocs.yml").read_text(), Loader=Loader)
 
 
 def test_every_page_of_docs_is_in_the_navigation():
@@ -70,7 +70,9 @@ def test_the_site_loads_nothing_from_the_network(site):
     """No font, script or style from another host: the site reads offline."""
     remote = re.compile(r"""<(?:script|link)[^>]+(?:src|href)=["']https?://""")
     offenders = [
-        str(page.relative_to(site)) for page in site.rglob("*.html") if remote.search(page.read_text())
+        str(page.relative_to(site))
+        for page in site.rglob("*.html")
+        if remote.search(page.read_text())
     ]
     assert not offenders, offenders[:5]
 

@@ -14,6 +14,7 @@ import ast
 import re
 from pathlib import Path
 
+from markdown.inlinepatterns import ReferenceInlineProcessor
 from mkdocs.structure.files import File, Files
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -93,8 +94,13 @@ def index_page() -> str:
 
 
 def on_config(config):
-    """GitHub's anchors for headings; the nav's reference entry becomes the layer pages."""
+    """GitHub's anchors for headings, GitHub's reference links (below); the nav's reference
+    entry becomes the layer pages."""
     config.mdx_configs.setdefault("toc", {})["slugify"] = slugify
+    # CommonMark (GitHub): no space between a link's text and its label, so `x[1] [m]` (an
+    # index, then a unit) stays text, as on GitHub; Python-Markdown would read a reference
+    # link there (and mkdocstrings a cross-reference to "m")
+    ReferenceInlineProcessor.RE_LINK = re.compile(r"\[([^\]]*)\]", re.DOTALL | re.UNICODE)
     pages = [{"Overview": NAV_ENTRY}]
     pages += [{f"uvms_pin.{layer}": f"{REFERENCE}/{layer}.md"} for layer in layers()]
 
