@@ -60,7 +60,7 @@ results: $(STAMP)
 # the site: every page of docs/ in mkdocs.yml's nav, the API reference from the docstrings;
 # --strict: a broken link or anchor, a page left out of the nav, an unreadable docstring fail
 docs: $(STAMP)
-	$(BIN)/mkdocs build --strict --site-dir site
+	NO_MKDOCS_2_WARNING=1 $(BIN)/mkdocs build --strict --site-dir site
 
 
 clean:
