@@ -82,3 +82,12 @@ def test_the_doc_test_directives_do_not_show_on_the_site(site):
     page = (site / "getting_started.html").read_text()
     assert "<!-- doc-test:" in page
     assert "doc-test" not in re.sub(r"<!--.*?-->", "", page, flags=re.DOTALL)
+
+
+def test_the_readme_stays_an_introduction():
+    """At most 250 lines, the two set-up commands, and links into the site's pages."""
+    text = (ROOT / "README.md").read_text()
+    assert len(text.splitlines()) <= 250
+    assert "make demo" in text and "make test" in text
+    linked = set(re.findall(r"\]\(docs/(\w+)\.md", text))
+    assert {"getting_started", "reproduce", "scenarios", "api"} <= linked, linked
