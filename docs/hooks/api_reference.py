@@ -68,9 +68,12 @@ def public_names() -> dict[str, str]:
 
 
 def layer_page(layer: str) -> str:
+    """A package shows its docstring alone: its names are those of its modules (re-exported),
+    each shown once, where it is defined."""
     lines = [f"# `uvms_pin.{layer}`", ""]
     for module in modules(layer):
-        lines += [f"::: {module}", ""]
+        package = (PACKAGE.parent / module.replace(".", "/")).is_dir()
+        lines += [f"::: {module}", *(["    options:", "      members: false"] * package), ""]
     return "\n".join(lines)
 
 
