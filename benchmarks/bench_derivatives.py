@@ -16,10 +16,16 @@ measured in this process (`timing.py`, one BLAS thread) divided by one rigid-bod
   discrete-transition Jacobians by finite differences, Euler and implicitfast, centred.
   MuJoCo's fluid model has no added-mass acceleration term: the job differs, the cost is
   what a MuJoCo user pays for the Jacobians of one step.
+- ``up.forward_dynamics_derivatives`` called with ``current_world=`` (the README's way) as
+  with ``flow=``;
 - the Jacobians of one 20 ms control period of the plant's RK4 (two substeps, eight
   stages: ``up.step_derivatives(..., integrator="rk4")``), compiled and Python reference.
 
-A second table times one re-plan of the MPC controller (`uvms_pin.control.mpc`, station
+A second table gives ``up.forward_dynamics_derivatives_batch`` over ``BATCH_STATES`` states
+per call, per state, on one and two threads: wall time (``time.perf_counter``, best of the
+rounds; threads share the work, so CPU time would hide the gain) over the same ``pin.aba``.
+
+A third table times one re-plan of the MPC controller (`uvms_pin.control.mpc`, station
 keeping in the current with the BlueROV2 Heavy's eight bounded thrusters, a 1 s horizon of
 50 nodes, 50 Hz, warm-started BoxFDDP) and gives its real-time factor (the 20 ms period over
 the CPU time of a re-plan; > 1: faster than real time on one core); and of the force-task
@@ -31,6 +37,7 @@ from __future__ import annotations
 
 import argparse
 import itertools
+import time
 from pathlib import Path
 
 import mujoco
@@ -96,6 +103,11 @@ def cases_of(system) -> dict[str, object]:
         ),
         "core forward_dynamics_derivatives (current)": lambda: up.forward_dynamics_derivatives(
             uvms, q, v, tau, flow=current
+        ),
+        "core forward_dynamics_derivatives (current_world=)": (
+            lambda: up.forward_dynamics_derivatives(
+                uvms, q, v, tau, current_world=CURRENT_WORLD_M_S
+            )
         ),
         "core Derivatives object alone (current)": lambda: derivatives.forward_dynamics_derivatives(
             q, v, tau, flow_struct, 0.0
@@ -184,6 +196,42 @@ def mpc_force_cases() -> dict[str, object]:
     return cases
 
 
+#: states per batched call (`batch_table`)
+BATCH_STATES = 256
+
+
+def batch_table(system, unit_s: float, repeat: int) -> str:
+    """Wall time per state of the batched derivatives on 1 and 2 threads, x pin.aba."""
+    uvms = system.uvms
+    rng = np.random.default_rng(2)
+    q = np.tile(system.q0, (BATCH_STATES, 1))
+    q[:, 7:] += rng.uniform(-0.3, 0.3, (BATCH_STATES, uvms.nv - 6))  # the arm's joints
+    v = rng.normal(scale=0.2, size=(BATCH_STATES, uvms.nv))
+    tau = rng.normal(size=(BATCH_STATES, uvms.nv))
+    per_state = {}
+    for threads in (1, 2):
+
+        def call(n=threads):
+            up.forward_dynamics_derivatives_batch(
+                uvms, q, v, tau, current_world=CURRENT_WORLD_M_S, num_threads=n
+            )
+
+        call()
+        rounds = []
+        for _ in range(repeat):
+            start = time.perf_counter()
+            call()
+            rounds.append(time.perf_counter() - start)
+        per_state[threads] = min(rounds) / BATCH_STATES
+    rows = [
+        f"| batched derivatives ({BATCH_STATES} states per call, current) | x pin.aba per state |",
+        "|---|---:|",
+    ]
+    rows += [f"| {n} thread(s) (wall) | {t / unit_s:.1f} |" for n, t in per_state.items()]
+    rows.append(f"| speed-up on 2 threads | {per_state[1] / per_state[2]:.2f}x |")
+    return "\n".join(rows) + "\n"
+
+
 def mpc_table(times: dict[str, float], unit: float) -> str:
     rows = [
         "| MPC (1 s horizon, 50 Hz) | x pin.aba | real-time factor |",
@@ -211,7 +259,9 @@ def main() -> None:
         cases = {**mpc_cases(system), **mpc_force_cases()}
         # one re-plan per sample (10-35 ms): a third of the rounds, at least 5
         mpc = best_times(cases, max(5, args.repeat // 3), batch_s=0.0)
-    text = table(times) + "\n" + mpc_table(mpc, times["pin.aba (rigid, the unit)"])
+        unit = times["pin.aba (rigid, the unit)"]
+        batch = batch_table(system, unit, args.repeat)
+    text = table(times) + "\n" + batch + "\n" + mpc_table(mpc, unit)
     print(text)
     args.out.parent.mkdir(parents=True, exist_ok=True)
     args.out.write_text(text)

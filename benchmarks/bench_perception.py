@@ -8,7 +8,9 @@ a seabed plane, with five objects ahead (a sphere, a box, a cylinder, an ellipso
 rock mesh of scenarios/meshes/rock.obj), the free surface above. Rows:
 
 - camera 320 x 240 and 640 x 480: one image (depth, normals, labels and colour, one light);
-- imaging sonar 256 beams x 512 bins (32 rays per beam);
+- imaging sonar 256 beams x 512 bins (32 rays per beam); a multibeam profiler of 256
+  beams (4 rays each, looking down: its soundings and water column); the DVL's four beams
+  cast at the seabed and the objects;
 - the ray caster's choice: 76,800 rays against the rock mesh by Embree (``embreex``) and
   by trimesh's pure-Python intersector (``ray_triangle``, rtree);
 - a run of scenarios/seabed_landing.toml (2 s simulated) and of
@@ -36,15 +38,17 @@ from uvms_pin.perception.sonar import Sonar, SonarSpec
 from uvms_pin.perception.suite import PerceptionSpec
 from uvms_pin.physics.world.objects import plane, solid
 from uvms_pin.scenario import load_scenario
+from uvms_pin.sim.navigation.dvl import Dvl, DvlSpec
+from uvms_pin.sim.navigation.seabed import world_seabed
 
 ROOT = Path(__file__).resolve().parents[1]
 ROCK = ROOT / "scenarios" / "meshes" / "rock.obj"
 
 
-def scene() -> Scene:
-    uvms = up.load_uvms(ROOT / "models" / "uvms_bluerov2_alpha5.urdf")
+def objects() -> list:
+    """The seabed and the five objects ahead of the robot."""
     friction = (0.5, 0.4)
-    objects = [
+    return [
         plane("seabed", [0, 0, -10.0], [0, 0, 1.0], *friction),
         solid("ball", "sphere", {"radius_m": 0.4}, [3, 0, -9.2], [0, 0, 0], *friction),
         solid("crate", "box", {"size_m": [1, 1, 0.6]}, [4, 1.2, -9.5], [0, 0, 0.4], *friction),
@@ -66,7 +70,14 @@ def scene() -> Scene:
         ),
         solid("rock", "mesh", {"path": str(ROCK)}, [2.5, 0.8, -9.8], [0, 0, 0], *friction),
     ]
-    out = Scene(uvms, objects)
+
+
+OBJECTS = objects()
+
+
+def scene() -> Scene:
+    uvms = up.load_uvms(ROOT / "models" / "uvms_bluerov2_alpha5.urdf")
+    out = Scene(uvms, OBJECTS)
     q = uvms.neutral_configuration()
     q[2] = -9.0
     out.update(q)
@@ -121,10 +132,16 @@ def main() -> None:
     seen = scene()
     small, large = camera(seen, 320, 240), camera(seen, 640, 480)
     fls = Sonar(SonarSpec("fls", rpy_rad=(0, 0.3, 0)), seen, np.random.default_rng(0))
+    profiler = SonarSpec("mbes", type="multibeam", rays_per_beam=4, rpy_rad=(0, 1.5708, 0))
+    mbes = Sonar(profiler, seen, np.random.default_rng(0))
+    dvl = Dvl(DvlSpec(beams=4), world_seabed(OBJECTS), np.random.default_rng(0))
+    position, level = np.array([0.0, 0.0, -9.0]), np.eye(3)
     images = {
         "camera 320 x 240": small.render,
         "camera 640 x 480": large.render,
         "sonar 256 beams x 512 bins": fls.intensity,
+        "multibeam 256 beams": mbes.fire,
+        "DVL four beams": lambda: dvl.measure(position, np.zeros(3), level),
         **rays_against_the_rock(),
     }
     times = best_times(images, args.repeat)

@@ -13,8 +13,16 @@ Every number below is an input with its source (models/README.md, sections 7-9, 
   ``urdf/blue_rov_hardware_fixedjaw.urdf`` (Alpha 5 kinematics, derived from Reach
   Robotics' public r5m description, link inertia tensors, effort and velocity limits, the
   arm's mount on the vehicle).
+- R26: Reach Robotics, github.com/Reach-Robotics/reach_robotics_sdk, commit 935ba1e1,
+  ``ROS2/reach_alpha_description/urdf/alpha_5.urdf.xacro`` and
+  ``urdf/end_effectors/standard_jaws.urdf.xacro`` (the jaw: its base 99.75 mm along the
+  wrist axis, two revolute fingers, their pivots, axes, travel, effort, collision boxes).
+- P25: Evan Palmer, github.com/Robotic-Decision-Making-Lab/reach, commit 5e37b9df,
+  ``reach_description/description/alpha_5/standard_jaws/standard_jaws.urdf.xacro`` (the
+  fingers' masses). Both files are under Reach Robotics' licence (use with their products
+  only): their facts (numbers) are taken over, no text.
 
-Run ``python models/derive_bluerov_alpha5.py --write`` to regenerate the three files,
+Run ``python models/derive_bluerov_alpha5.py --write`` to regenerate the files,
 ``--check`` to exit 1 if a file differs from what this script writes.
 """
 
@@ -123,6 +131,36 @@ ALPHA_LINKS = (
     ),
 )
 ALPHA_JAW = ("alpha_jaw_link", 0.05, (0.0, 0.0, -0.190), 0.020, (0.05, 0.05, 0.05))
+# ---- the Alpha 5's standard jaw (R26, masses P25), in reach_alpha5_jaws.urdf -----------
+# The jaw base sits 99.75 mm along the wrist axis from axis B (R26); in K23's wrist frame the
+# tool points along -z, so the jaw base frame is turned by pi about x: its +z points out of
+# the wrist, as R26's. K23's locked-jaw point mass (ALPHA_JAW: 0.05 kg, 0.020 L) stays as the
+# jaw's housing, moved to the jaw base: at K23's 0.19 m it would sit between the fingertips,
+# and a link without collision shapes touches the world by a sphere of its volume (17 mm).
+ALPHA_JAW_BASE_XYZ_M = (0.0, 0.0, -0.09975)
+ALPHA_JAW_BASE_RPY = (math.pi, 0.0, 0.0)
+# finger: joint, link, pivot in the jaw base [m], axis, collision box centre in the finger [m]
+# Each finger is a revolute joint, 0 (closed) .. 0.5 rad (open), effort 10, velocity 10
+# (R26); R26 couples them through <mimic> (finger 139 mimics finger 130, multiplier 1).
+ALPHA_FINGERS = (
+    (
+        "alpha_jaw_finger_130_joint",
+        "alpha_jaw_finger_130_link",
+        (0.0, 0.0155, 0.0069),
+        (-1.0, 0.0, 0.0),
+        (0.0, -0.008, 0.045),
+    ),
+    (
+        "alpha_jaw_finger_139_joint",
+        "alpha_jaw_finger_139_link",
+        (0.0, -0.0155, 0.0069),
+        (1.0, 0.0, 0.0),
+        (0.0, 0.008, 0.045),
+    ),
+)
+ALPHA_FINGER_BOX_M = (0.012, 0.03, 0.09)  # collision box x y z (R26)
+ALPHA_FINGER_MASS_KG = 0.055  # P25; inertia: the uniform box's
+ALPHA_FINGER_LIMITS = (0.0, 0.5, 10.0, 10.0)  # lower, upper [rad], effort, velocity (R26)
 HALF_PI = math.pi / 2
 # joint, parent, child, xyz, rpy, lower, upper [rad], effort [N m], velocity [rad/s]
 # Angles are K23's: raw Reach encoder minus 3.07 rad (axis E) and 2.879 rad (axis B).
@@ -332,6 +370,69 @@ def alpha5_urdf() -> str:
     return out + "</robot>\n"
 
 
+def _box_inertia(mass: float, size) -> tuple[float, ...]:
+    """(ixx 0 0 iyy 0 izz) of a uniform box about its centre [kg m^2]."""
+    x, y, z = size
+    return (
+        mass * (y * y + z * z) / 12,
+        0.0,
+        0.0,
+        mass * (x * x + z * z) / 12,
+        0.0,
+        mass * (x * x + y * y) / 12,
+    )
+
+
+def _finger(joint: str, link: str, pivot, axis, centre, mimic: str | None) -> str:
+    """One finger of the standard jaw: a box link on a revolute joint (R26, P25); no
+    <hydrodynamics>: the loader derives them from the collision box."""
+    box = f'<geometry><box size="{_f(ALPHA_FINGER_BOX_M)}"/></geometry>'
+    lower, upper, effort, velocity = ALPHA_FINGER_LIMITS
+    inertia = _box_inertia(ALPHA_FINGER_MASS_KG, ALPHA_FINGER_BOX_M)
+    mimic_line = (
+        "" if mimic is None else f'    <mimic joint="{mimic}" multiplier="1" offset="0"/>\n'
+    )
+    return (
+        f'  <link name="{link}">\n{_inertial(ALPHA_FINGER_MASS_KG, centre, inertia)}'
+        f'    <visual>\n      <origin xyz="{_f(centre)}" rpy="0 0 0"/>\n      {box}\n'
+        '      <material name="alpha_grey"><color rgba="0.3 0.3 0.3 1"/></material>\n'
+        f'    </visual>\n    <collision>\n      <origin xyz="{_f(centre)}" rpy="0 0 0"/>\n'
+        f"      {box}\n    </collision>\n  </link>\n"
+        f'  <joint name="{joint}" type="revolute">\n    <parent link="alpha_jaw_base_link"/>\n'
+        f'    <child link="{link}"/>\n    <origin xyz="{_f(pivot)}" rpy="0 0 0"/>\n'
+        f'    <axis xyz="{_f(axis)}"/>\n'
+        f'    <limit lower="{lower:.9g}" upper="{upper:.9g}" effort="{effort:.9g}" '
+        f'velocity="{velocity:.9g}"/>\n{mimic_line}  </joint>\n'
+    )
+
+
+def alpha5_jaws_urdf() -> str:
+    """reach_alpha5.urdf with the standard jaw's two fingers moving (R26, P25)."""
+    at_base = f'origin xyz="{_f(ALPHA_JAW_BASE_XYZ_M)}" rpy="0 0 0"/>\n  </joint>\n'
+    locked = alpha5_urdf().rstrip().removesuffix("</robot>")
+    locked = locked.replace('origin xyz="0 0 -0.19" rpy="0 0 0"/>\n  </joint>\n', at_base).replace(
+        "jaw, locked closed: a point mass with its volume", "jaw housing: a point mass"
+    )
+    out = locked.replace(
+        "Reach Alpha 5 (arm only), jaw locked; Kolano's identification",
+        "Reach Alpha 5 (arm only) with its standard jaw's two fingers (Reach Robotics' "
+        "description); Kolano's identification",
+    ).replace('<robot name="reach_alpha5">', '<robot name="reach_alpha5_jaws">')
+    out += "  <!-- the standard jaw: its base, then two fingers (R26) -->\n"
+    out += '  <link name="alpha_jaw_base_link"/>\n'
+    out += _fixed(
+        "alpha_jaw_base_joint",
+        "alpha_wrist_link",
+        "alpha_jaw_base_link",
+        ALPHA_JAW_BASE_XYZ_M,
+        ALPHA_JAW_BASE_RPY,
+    )
+    first = ALPHA_FINGERS[0][0]
+    for k, (joint, link, pivot, axis, centre) in enumerate(ALPHA_FINGERS):
+        out += _finger(joint, link, pivot, axis, centre, None if k == 0 else first)
+    return out + "</robot>\n"
+
+
 # the force-task UVMS (scenarios/bluerov_alpha5_force_tracking.toml): the catalogue vehicle
 # with the Alpha 5 at K23's mount, uvms-pin's default probe on the wrist, trimmed by
 # uvms_pin.model.trim (foam on top, lead below; BG 2 cm) at the scenario's initial arm pose, sea water
@@ -351,9 +452,14 @@ def force_task_urdf() -> str:
         trim=True,
         trim_joint_positions=FORCE_TASK_ARM_POSE_RAD,
     )
+    return _with_comment(result, "BlueROV2 Heavy + Reach Alpha 5 + probe")
+
+
+def _with_comment(result, what: str) -> str:
+    """The mounted file's text with a first comment: what it is and its trim."""
     comment = (
-        "<!-- GENERATED by models/derive_bluerov_alpha5.py: BlueROV2 Heavy + Reach Alpha 5 + "
-        "probe, trimmed with uvms_pin.model.mount.mount (trim: "
+        f"<!-- GENERATED by models/derive_bluerov_alpha5.py: {what}"
+        ", trimmed with uvms_pin.model.mount.mount (trim: "
         + result.trim.summary().replace("\n", "; ").replace("--", "-")
         + ") -->\n"
     )
@@ -364,11 +470,30 @@ def force_task_urdf() -> str:
     return comment + text
 
 
+def jaws_uvms_urdf() -> str:
+    """bluerov2_heavy.urdf + reach_alpha5_jaws.urdf, fingers moving, no probe (the ``ee``
+    frame is the wrist's sensor frame), trimmed as the force-task file with the jaw closed."""
+    from uvms_pin.model.mount.mount import mount_arm_detailed
+
+    result = mount_arm_detailed(
+        HERE / "bluerov2_heavy.urdf",
+        HERE / "reach_alpha5_jaws.urdf",
+        (ALPHA_MOUNT_XYZ_M, (0.0, 0.0, 0.0)),
+        trim=True,
+        trim_joint_positions=(*FORCE_TASK_ARM_POSE_RAD, 0.0, 0.0),
+        tool=None,
+        moving_jaw=True,
+    )
+    return _with_comment(result, "BlueROV2 Heavy + Reach Alpha 5 with its moving jaw")
+
+
 FILES = {
     "bluerov2_heavy.urdf": bluerov2_heavy_urdf,
     "bluerov2_heavy_hinsdale2023.urdf": trial_vehicle_urdf,
     "reach_alpha5.urdf": alpha5_urdf,
     "uvms_bluerov2_alpha5.urdf": force_task_urdf,
+    "reach_alpha5_jaws.urdf": alpha5_jaws_urdf,
+    "uvms_bluerov2_alpha5_jaws.urdf": jaws_uvms_urdf,
 }
 
 

@@ -43,6 +43,8 @@ PRODUCERS = {
     "derivatives": "cost of the dynamics' derivatives and of an MPC re-plan: docs/results/derivatives.md",
     "tracking": "end-effector tracking, controller x task x conditions: docs/results/tracking.md, docs/tracking_*.png",
     "estimator": "station keeping on the navigation estimate: docs/results/estimator.md, docs/estimator_station_keeping.png",
+    "bench_perception": "cameras, sonars and the DVL's beams on one core: docs/results/bench_perception.md",
+    "seabed_survey": "a survey with a multibeam, a sonar, a camera and a beam-cast DVL: docs/results/seabed_survey.md, docs/seabed_survey.png",
     "stability": "passive models for 60 s and random actions in the environments: docs/results/stability.md",
 }
 

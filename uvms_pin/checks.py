@@ -4,6 +4,7 @@ of what a command is about to allocate (`check_memory`), and of what is physical
 
 from __future__ import annotations
 
+import math
 import os
 import warnings
 from collections.abc import Callable
@@ -17,6 +18,13 @@ from uvms_pin.errors import ParameterError, PlausibilityWarning
 def finite_vector(name: str, value, size: int) -> np.ndarray:
     """``value`` as a float array of shape (size,) with finite entries, or ParameterError
     (a complex array too: casting it would drop its imaginary part)."""
+    if (
+        type(value) is np.ndarray
+        and value.dtype == np.float64
+        and value.shape == (size,)
+        and math.isfinite(np.dot(value, value))  # all finite (an overflow: the full check)
+    ):
+        return value  # the common case without the checks' temporaries (a hot path's inputs)
     if getattr(getattr(value, "dtype", None), "kind", "") == "c":
         raise ParameterError(f"{name} must be {size} real numbers, got a complex array")
     try:
@@ -108,6 +116,15 @@ def seed_value(name: str, value) -> int:
     if not 0 <= int(value) <= MAX_SEED:
         raise ParameterError(f"{name} must be an integer in [0, 2^63 - 1], got {value}")
     return int(value)
+
+
+def thread_count(num_threads: int | None) -> int:
+    """``num_threads`` checked (a positive integer), or every core for None."""
+    if num_threads is None:
+        return os.cpu_count() or 1
+    if isinstance(num_threads, bool) or not isinstance(num_threads, int) or num_threads < 1:
+        raise ParameterError(f"num_threads must be a positive integer, got {num_threads!r}")
+    return num_threads
 
 
 def available_memory_bytes() -> int | None:

@@ -3,10 +3,12 @@
 #include <nanobind/eigen/dense.h>
 #include <nanobind/nanobind.h>
 #include <nanobind/ndarray.h>
+#include <nanobind/stl/optional.h>
 #include <nanobind/stl/string.h>
 #include <nanobind/stl/variant.h>
 #include <nanobind/stl/vector.h>
 
+#include "batch_derivatives.hpp"
 #include "batch_plant.hpp"
 
 namespace nb = nanobind;
@@ -51,7 +53,58 @@ void step(BatchPlant& b, const Commands& tau_commanded, const Mask& stepping) {
   b.step(tau_commanded.data(), stepping.data());
 }
 
+using States = nb::ndarray<const double, nb::ndim<2>, nb::c_contig, nb::device::cpu>;
+using Times = nb::ndarray<const double, nb::ndim<1>, nb::c_contig, nb::device::cpu>;
+using Jacobians = nb::ndarray<double, nb::ndim<3>, nb::c_contig, nb::device::cpu>;
+
+std::string shape_text(size_t rows, size_t cols) {
+  return "(" + std::to_string(rows) + ", " + std::to_string(cols) + ")";
+}
+
+// `states` of shape (n, cols) with finite entries, or InputError naming it
+void check_states(const char* name, const States& states, size_t n, size_t cols) {
+  if (states.shape(0) != n || states.shape(1) != cols) {
+    throw InputError(std::string(name) + " must have shape " + shape_text(n, cols) + ", got " +
+                     shape_text(states.shape(0), states.shape(1)));
+  }
+  if (!Eigen::Map<const Eigen::ArrayXd>(states.data(), Eigen::Index(n * cols)).allFinite()) {
+    throw InputError(std::string(name) + " contains a non-finite value");
+  }
+}
+
+void compute_derivatives(uvms::BatchDerivatives& b, const States& q, const States& v,
+                         const States& tau, std::optional<States> tau_ext, const Times& time_s,
+                         const uvms::FlowField& flow, bool free_surface, Jacobians da_dq,
+                         Jacobians da_dv, Jacobians da_dtau) {
+  const size_t n = q.shape(0), nq = size_t(b.nq()), nv = size_t(b.nv());
+  check_states("q", q, n, nq);
+  check_states("v", v, n, nv);
+  check_states("tau", tau, n, nv);
+  if (tau_ext) check_states("tau_ext", *tau_ext, n, nv);
+  if (time_s.shape(0) != n) throw InputError("time_s must have " + std::to_string(n) + " entries");
+  for (const Jacobians* out : {&da_dq, &da_dv, &da_dtau}) {
+    if (out->shape(0) != n || out->shape(1) != nv || out->shape(2) != nv) {
+      throw InputError("the Jacobians' buffers must have shape (n, nv, nv)");
+    }
+  }
+  const uvms::BatchStates states{int(n), q.data(), v.data(), tau.data(),
+                                 tau_ext ? tau_ext->data() : nullptr, time_s.data()};
+  nb::gil_scoped_release release;  // the threads run without the interpreter
+  b.compute(states, flow, free_surface, {da_dq.data(), da_dv.data(), da_dtau.data()});
+}
+
 }  // namespace
+
+void bind_batch_derivatives(nb::module_& m) {
+  nb::class_<uvms::BatchDerivatives>(
+      m, "BatchDerivatives",
+      "The forward dynamics' derivatives at n states on T threads (batch_derivatives.hpp).")
+      .def(nb::init<const uvms::Dynamics&, int>(), "dynamics"_a, "num_threads"_a)
+      .def_prop_ro("num_threads", &uvms::BatchDerivatives::num_threads)
+      .def("compute", &compute_derivatives, "q"_a, "v"_a, "tau"_a, "tau_ext"_a.none(), "time_s"_a,
+           "flow"_a, "free_surface"_a, "da_dq"_a, "da_dv"_a, "da_dtau"_a,
+           "fill da_dq, da_dv, da_dtau (n, nv, nv) at the n states (GIL released)");
+}
 
 void bind_batch_plant(nb::module_& m) {
   nb::class_<uvms::BatchNoise>(m, "BatchNoise", "Sensor-noise layout of a batch (batch_plant.hpp).")

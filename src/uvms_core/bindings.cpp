@@ -506,6 +506,7 @@ void bind_ppc(nb::module_& m) {
 }  // namespace
 
 void bind_batch_plant(nb::module_& m);  // batch_bindings.cpp
+void bind_batch_derivatives(nb::module_& m);  // batch_bindings.cpp
 
 NB_MODULE(_core, m) {
   m.doc() = "Compiled dynamics, plant and controller of uvms-pin (C++ on Pinocchio's C++ API).";
@@ -543,6 +544,7 @@ NB_MODULE(_core, m) {
   bind_plant(m);
   bind_system(m);
   bind_batch_plant(m);
+  bind_batch_derivatives(m);
   bind_sampled_laws(m);
   bind_ppc(m);
   bind_sampled_loop(m);

@@ -126,3 +126,13 @@ def test_the_same_seed_gives_the_same_images(reference_uvms):
 def test_a_bad_camera_is_refused_naming_the_key(changes, key):
     with pytest.raises(ParameterError, match=key):
         CameraSpec("front", **changes)
+
+
+@pytest.mark.parametrize(("width", "height"), [(48, 32), (41, 31)])
+def test_tiles_go_back_to_image_order(reference_uvms, width, height):
+    """By a transposition of blocks when the tiles cover the image, by a gather otherwise:
+    the same pixels either way."""
+    camera = _camera(reference_uvms, [_wall(3.0)], width=width, height=height)
+    tiled = np.arange(width * height * 3, dtype=float).reshape(-1, 3)
+    np.testing.assert_array_equal(camera._untile(tiled), tiled[np.argsort(camera.order)])
+    np.testing.assert_array_equal(camera._untile(camera._tiled), camera.rays)

@@ -21,7 +21,7 @@ import numpy as np
 from uvms_pin.errors import ParameterError
 from uvms_pin.perception import sensor
 from uvms_pin.perception.caster import Bundles
-from uvms_pin.perception.optics import Light, WaterOptics, backscatter, cone
+from uvms_pin.perception.optics import Light, WaterOptics, backscatter, cone_of_cosine
 from uvms_pin.perception.scene import Scene
 
 __all__ = ["CAMERA", "Camera", "CameraSpec", "Frame", "reflectance_of"]
@@ -34,6 +34,9 @@ OTHER = (0.7, 0.7, 0.7)
 
 #: the side [px] of the square tiles whose rays the caster leaves out together
 TILE_PX = 16
+
+#: the rays shaded together: their (n, 3) temporaries stay in the processor's cache
+CHUNK_RAYS = 8192
 
 
 @dataclass(frozen=True)
@@ -167,6 +170,7 @@ class Camera(sensor.Mounted):
         self.rays = pixel_rays(spec)
         self.order, starts = tiles(spec)
         self._tiled = self.rays[self.order]
+        self._untiled = np.argsort(self.order)  # tile order -> image order
         self._bundles = Bundles.of(self._tiled, starts)
         self.optics = spec.optics
         robot = set(scene.robot_names)
@@ -174,6 +178,18 @@ class Camera(sensor.Mounted):
         for name in robot:
             given.setdefault(name, ROBOT)
         self.reflectance = reflectance_of(scene.names, given, scene.floor_names)
+
+    def _untile(self, tiled: np.ndarray) -> np.ndarray:
+        """An array (H W, ...) in tile order, in image order: a transposition of blocks when
+        the tiles cover the image exactly, one gather otherwise."""
+        spec = self.spec
+        if spec.width % TILE_PX or spec.height % TILE_PX:
+            return tiled[self._untiled]
+        rest = tiled.shape[1:]
+        blocks = tiled.reshape(
+            spec.height // TILE_PX, spec.width // TILE_PX, TILE_PX, TILE_PX, *rest
+        )
+        return blocks.swapaxes(1, 2).reshape(spec.width * spec.height, *rest)
 
     def pose(self) -> tuple[np.ndarray, np.ndarray]:
         """(R, p) of the optical frame in the world, after the scene's update."""
@@ -186,73 +202,81 @@ class Camera(sensor.Mounted):
         rotation, position = self.pose()
         directions = self._tiled @ rotation.T  # tile by tile: the caster culls whole tiles
         hits = self.scene.caster.cast(position, directions, self._bundles.rotated(rotation))
-        met = np.isfinite(hits.range_m)
-        depth = np.where(met, hits.range_m * self._tiled[:, 2], np.nan)
-        radiance = self._radiance(position, rotation, directions, hits, met)
-        shape, order = (spec.height, spec.width), self.order
-        pixels = [np.empty_like(a) for a in (depth, hits.normal_world, hits.label, radiance)]
-        for out, tiled in zip(
-            pixels, (depth, hits.normal_world, hits.label, radiance), strict=True
-        ):
-            out[order] = tiled
-        depth, normal, label, radiance = pixels
+        radiance = np.empty_like(directions)
+        for start in range(0, len(directions), CHUNK_RAYS):
+            part = slice(start, start + CHUNK_RAYS)
+            radiance[part] = self._radiance(
+                position, rotation, directions[part],
+                hits.range_m[part], hits.normal_world[part], hits.label[part],
+            )  # fmt: skip
+        untile = self._untile
+        shape = (spec.height, spec.width)
+        range_m = untile(hits.range_m)
+        depth = np.where(np.isfinite(range_m), range_m * self.rays[:, 2], np.nan)
+        radiance = untile(radiance)
         counts = 255.0 * spec.exposure * radiance
         if spec.noise_counts > 0.0:
             counts += spec.noise_counts * self.rng.standard_normal(counts.shape, np.float32)
-        rgb = np.clip(np.rint(counts), 0, 255).astype(np.uint8)
+        rgb = np.clip(np.rint(counts, out=counts), 0, 255, out=counts).astype(np.uint8)
         return Frame(
             depth.reshape(shape),
-            normal.reshape(*shape, 3),
-            label.reshape(shape),
+            untile(hits.normal_world).reshape(*shape, 3),
+            untile(hits.label).reshape(shape),
             radiance.reshape(*shape, 3),
             rgb.reshape(*shape, 3),
         )
 
-    def _radiance(self, position, rotation, directions, hits, met) -> np.ndarray:
-        """I_c (n, 3) of every pixel (`uvms_pin.perception.optics`)."""
+    def _radiance(self, position, rotation, directions, r, normal, label) -> np.ndarray:
+        """I_c (n, 3) of n rays from ``position`` (`uvms_pin.perception.optics`): what they
+        met at ranges ``r`` (inf: nothing), its normals and labels."""
         optics = self.optics
         veiling = optics.veiling_light(-position[2])
+        met = np.isfinite(r)
         out = np.broadcast_to(veiling, (len(directions), 3)).copy()
-        if not np.any(met):
+        if not met.all():  # the rays that met something; all of them, most often
+            if not met.any():
+                return out
+            out[met] = self._radiance(position, rotation, directions[met], r[met], normal[met],
+                                      label[met])  # fmt: skip
             return out
-        r = hits.range_m[met]
-        normal = hits.normal_world[met]
-        points = position + r[:, None] * directions[met]
-        rho = self.reflectance[hits.label[met]]
+        rho = self.reflectance[label]
+        column = r[:, None]
         # daylight E0 exp(-K_d depth) (1 + n_z) / 2 and the direct path's exp(-beta_D r)
         # in one exponential
-        depth = np.maximum(-points[:, 2], 0.0)[:, None]
+        depth = np.maximum(-(position[2] + r * directions[:, 2]), 0.0)[:, None]
         sky = (0.5 * optics.surface_irradiance) * (1.0 + normal[:, 2])
-        signal = (rho * sky[:, None]) * np.exp(
-            -(optics.kd_per_m * depth + optics.beta_d_per_m * r[:, None])
-        )
+        signal = optics.kd_per_m * depth
+        signal += optics.beta_d_per_m * column
+        np.negative(signal, out=signal)
+        np.exp(signal, out=signal)
+        signal *= rho
+        signal *= sky[:, None]
         for light in self.spec.lights:
-            signal += self._lit(light, position, rotation, points, normal, rho, r)
-        out[met] = signal + backscatter(veiling, r, optics.beta_b_per_m)
-        return out
+            self._lit(signal, light, position, rotation, directions, normal, rho, r)
+        signal += backscatter(veiling, r, optics.beta_b_per_m)
+        return signal
 
-    def _lit(self, light: Light, position, rotation, points, normal, rho, r) -> np.ndarray:
-        """A light's direct signal (n, 3) from the points (their normals, reflectances,
-        ranges): rho I_L cone max(0, n . l) / d^2 exp(-beta_D (d + r)), computed on the
-        points within its outer cone only."""
+    def _lit(self, out, light: Light, position, rotation, directions, normal, rho, r) -> None:
+        """Adds to ``out`` (n, 3) a light's direct signal from the points met (their
+        normals, reflectances, ranges): rho I_L cone max(0, n . l) / d^2 exp(-beta_D (d + r))
+        (on every ray: the cone is exactly 0 beyond its edge, adding nothing, and most rays
+        are within it, so picking them out would cost more)."""
         source = position + rotation @ np.asarray(light.position_m)
         axis = rotation @ np.asarray(light.direction)
-        to_point = points - source
-        distance = np.linalg.norm(to_point, axis=1)
-        unit = to_point / np.maximum(distance, 1e-12)[:, None]
-        outer = min(np.pi, light.half_angle_rad + light.edge_rad)
-        lit = np.flatnonzero(unit @ axis >= np.cos(outer) - 1e-12)
-        out = np.zeros_like(points)
-        if len(lit) == 0:
-            return out
-        unit, distance = unit[lit], distance[lit]
-        off_axis = np.arccos(np.clip(unit @ axis, -1.0, 1.0))
-        facing = np.maximum(0.0, -np.einsum("ij,ij->i", normal[lit], unit))
-        power = light.intensity * cone(off_axis, light.half_angle_rad, light.edge_rad) * facing
-        power = power / np.maximum(distance, 1e-6) ** 2
-        path = (distance + r[lit])[:, None]
-        out[lit] = rho[lit] * power[:, None] * np.exp(-self.optics.beta_d_per_m * path)
-        return out
+        to_point = r[:, None] * directions
+        to_point += position - source
+        distance = np.sqrt(np.einsum("ij,ij->i", to_point, to_point))
+        reach = np.maximum(distance, 1e-12)
+        power = cone_of_cosine((to_point @ axis) / reach, light.half_angle_rad, light.edge_rad)
+        facing = np.einsum("ij,ij->i", normal, to_point)
+        facing /= reach
+        power *= np.maximum(0.0, -facing)
+        power *= light.intensity / np.maximum(distance, 1e-6) ** 2
+        path = (distance + r)[:, None] * -self.optics.beta_d_per_m
+        np.exp(path, out=path)
+        path *= power[:, None]
+        path *= rho
+        out += path
 
     def fire(self) -> dict[str, np.ndarray]:
         """What a firing records: depth (float32), rgb, label."""

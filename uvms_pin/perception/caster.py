@@ -4,7 +4,9 @@ Each body is a shape (`uvms_pin.perception.shapes`, `uvms_pin.perception.mesh`) 
 its own frame, a label, and a pose (R, p) that `RayCaster.set_pose` replaces whenever a
 sensor fires: the rays are carried into each body's frame, o_b = R^T (o - p), d_b = R^T d
 (an instance transform), and the hit's normal back, n = R n_b. A body whose bounding sphere
-a ray misses, or meets beyond the nearest hit found so far, is not asked for that ray.
+a ray misses, or meets beyond the nearest hit found so far, is not asked for that ray. A
+plane seen from one origin (a camera's, a sonar's) is met by each ray's rate along its
+normal alone, t = -h / (d . n) for the origin's height h above it (`Plane.along`).
 """
 
 from __future__ import annotations
@@ -13,6 +15,8 @@ from dataclasses import dataclass
 from typing import Protocol
 
 import numpy as np
+
+from uvms_pin.perception.shapes import Plane
 
 __all__ = ["Bundles", "Hits", "RayCaster", "Shape"]
 
@@ -74,35 +78,50 @@ class RayCaster:
         d = np.asarray(directions_world, dtype=float)
         n = len(d)
         origin = np.asarray(origins_world, dtype=float)  # one origin (3,): a camera's
-        best = np.full(n, np.inf)
-        normal = np.zeros((n, 3))
-        label = np.zeros(n, dtype=np.int32)
+        hits = Hits(np.full(n, np.inf), np.zeros((n, 3)), np.zeros(n, dtype=np.int32))
         for k, shape in enumerate(self._shapes):
             rotation, position = self._rotations[k], self._positions[k]
             if origin.ndim == 1 and _inside(shape, (origin - position) @ rotation):
                 continue  # from inside a solid: nothing of it is seen
-            within = None
-            if bundles is not None and np.isfinite(shape.bound_radius_m):
-                within = bundles.rays_toward(position - origin, shape.bound_radius_m)
-            elif bundles is not None and getattr(shape, "one_sided_plane", False):
-                # a plane seen from its front only: the cones whose rays all leave it go
-                within = bundles.rays_against(rotation[:, 2], (origin - position) @ rotation[:, 2])
-            rows = _candidates(origin, d, position, shape.bound_radius_m, best, within)
-            if rows is not None and len(rows) == 0:
+            if origin.ndim == 1 and isinstance(shape, Plane):
+                found = _on_plane(shape, rotation, position, origin, d, hits.range_m)
+            else:
+                found = self._on_body(k, origin, d, bundles, hits.range_m)
+            if found is None:
                 continue
-            o_k = origin if rows is None or origin.ndim == 1 else origin[rows]
-            d_k = d if rows is None else d[rows]
-            local = np.broadcast_to((o_k - position) @ rotation, d_k.shape)
-            t, n_local = shape.hit(local, d_k @ rotation)
-            picked = rows if rows is not None else slice(None)
-            nearer = t < best[picked]
-            if not np.any(nearer):
-                continue
-            where = np.flatnonzero(nearer) if rows is None else rows[nearer]
-            best[where] = t[nearer]
-            normal[where] = n_local[nearer] @ rotation.T
-            label[where] = k + 1
-        return Hits(best, normal, label)
+            where, t, normal_world = found
+            hits.range_m[where] = t
+            hits.normal_world[where] = normal_world
+            hits.label[where] = k + 1
+        return hits
+
+    def _on_body(
+        self,
+        k: int,
+        origin: np.ndarray,
+        d: np.ndarray,
+        bundles: Bundles | None,
+        best: np.ndarray,
+    ) -> tuple[np.ndarray, np.ndarray, np.ndarray] | None:
+        """The rays body ``k`` meets nearer than ``best``: (their rows, ranges, world
+        normals), None for none."""
+        shape, rotation, position = self._shapes[k], self._rotations[k], self._positions[k]
+        within = None
+        if bundles is not None and np.isfinite(shape.bound_radius_m):
+            within = bundles.rays_toward(position - origin, shape.bound_radius_m)
+        rows = _candidates(origin, d, position, shape.bound_radius_m, best, within)
+        if rows is not None and len(rows) == 0:
+            return None
+        o_k = origin if rows is None or origin.ndim == 1 else origin[rows]
+        d_k = d if rows is None else d[rows]
+        local = np.broadcast_to((o_k - position) @ rotation, d_k.shape)
+        t, n_local = shape.hit(local, d_k @ rotation)
+        picked = rows if rows is not None else slice(None)
+        nearer = t < best[picked]
+        if not np.any(nearer):
+            return None
+        where = np.flatnonzero(nearer) if rows is None else rows[nearer]
+        return where, t[nearer], n_local[nearer] @ rotation.T
 
 
 @dataclass(frozen=True)
@@ -127,15 +146,6 @@ class Bundles:
         """The same cones in the axes where ``rotation`` takes their frame."""
         return Bundles(self.axes @ rotation.T, self.half_angle_rad, self.starts)
 
-    def rays_against(self, normal: np.ndarray, height_m: float) -> np.ndarray:
-        """The rays of the cones with a ray against ``normal`` (d . n < 0), none when the
-        origin is ``height_m`` <= 0 above the plane (behind it)."""
-        if height_m <= 0.0:
-            return np.zeros(0, dtype=np.int64)
-        return self._rays_of(
-            np.flatnonzero(self.axes @ normal < np.sin(self.half_angle_rad) + 1e-9)
-        )
-
     def rays_toward(self, to_centre: np.ndarray, radius: float) -> np.ndarray | None:
         """The rays of the cones that may meet the sphere of ``radius`` about ``to_centre``
         (from the origin), None when the origin is inside it (every ray may)."""
@@ -159,6 +169,28 @@ class Bundles:
 def _inside(shape: Shape, point: np.ndarray) -> bool:
     contains = getattr(shape, "contains", None)
     return contains is not None and contains(point)
+
+
+def _on_plane(
+    plane: Plane,
+    rotation: np.ndarray,
+    position: np.ndarray,
+    origin: np.ndarray,
+    d: np.ndarray,
+    best: np.ndarray,
+) -> tuple[np.ndarray, np.ndarray, np.ndarray] | None:
+    """The rays from one ``origin`` a plane (its frame at ``rotation``, ``position``) meets
+    nearer than ``best``: (their rows, ranges, its world normal), None for none. Only the
+    height above it and each ray's rate along its normal are computed (o_b and d_b's z)."""
+    normal_world = rotation[:, 2]
+    height_m = float((origin - position) @ normal_world)
+    if height_m <= 0.0:
+        return None  # behind it: a plane is seen from its front only
+    t = plane.along(height_m, d @ normal_world)  # every ray: cheaper than culling cones
+    where = np.flatnonzero(t < best)
+    if len(where) == 0:
+        return None
+    return where, t[where], normal_world
 
 
 def _candidates(

@@ -142,6 +142,18 @@ def cone(off_axis_rad: np.ndarray, half_angle_rad: float, edge_rad: float) -> np
     return 1.0 - s * s * (3.0 - 2.0 * s)
 
 
+def cone_of_cosine(cosine: np.ndarray, half_angle_rad: float, edge_rad: float) -> np.ndarray:
+    """`cone` of the angles whose cosines are ``cosine`` (n,): 1 within the half-angle and
+    0 beyond its edge without an arccos, which only the rays on the edge take."""
+    out = (cosine >= np.cos(half_angle_rad)).astype(float)
+    if edge_rad > 0.0:
+        outer = min(np.pi, half_angle_rad + edge_rad)
+        band = np.flatnonzero((out == 0.0) & (cosine > np.cos(outer)))
+        angle = np.arccos(np.clip(cosine[band], -1.0, 1.0))
+        out[band] = cone(angle, half_angle_rad, edge_rad)
+    return out
+
+
 def backscatter(veiling: np.ndarray, range_m: np.ndarray, beta_b: np.ndarray) -> np.ndarray:
     """B_inf_c (1 - exp(-beta_B_c z)) (n, 3); B_inf where z is inf."""
     return veiling * -np.expm1(-beta_b * range_m[:, None])

@@ -38,7 +38,7 @@ from uvms_pin.perception.shapes import (
 from uvms_pin.physics.world.objects import WorldObject
 from uvms_pin.physics.world.robot_geometry import RobotPiece, robot_pieces
 
-__all__ = ["SURFACE", "Scene", "scene_of", "shape_of"]
+__all__ = ["SURFACE", "Scene", "add_objects", "scene_of", "shape_of"]
 
 #: the free surface's label name
 SURFACE = "surface"
@@ -79,6 +79,13 @@ def _plane_frame(obj: WorldObject) -> tuple[np.ndarray, np.ndarray]:
     return obj.placement.rotation.copy(), obj.placement.translation.copy()
 
 
+def add_objects(caster: RayCaster, objects: Sequence[WorldObject]) -> None:
+    """Each fixed object into ``caster``, as it is seen, where it is placed."""
+    for obj in objects:
+        rotation, position = _plane_frame(obj)
+        caster.add(obj.name, _seen_shape(obj), rotation, position)
+
+
 class Scene:
     """The caster of a UVMS in its world, and where each of its bodies is.
 
@@ -99,9 +106,7 @@ class Scene:
         self.uvms = uvms
         self.caster = RayCaster()
         self.data = uvms.model.createData()
-        for obj in objects:
-            rotation, position = _plane_frame(obj)
-            self.caster.add(obj.name, _seen_shape(obj), rotation, position)
+        add_objects(self.caster, objects)
         if surface:
             self.caster.add(SURFACE, Plane(), _FACING_DOWN, np.zeros(3))
         names = [uvms.hydro_bodies[int(k)].name for k in uvms.surface_bodies.body_index]

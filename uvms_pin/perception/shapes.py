@@ -50,13 +50,17 @@ class Plane:
     """The plane z = 0 of its frame, seen from z > 0 (its normal +z)."""
 
     bound_radius_m: float = np.inf
-    one_sided_plane: bool = True
+
+    def along(self, height_m, rate: np.ndarray) -> np.ndarray:
+        """t [m] of rays from ``height_m`` above it (o_z: a number or (n,)) at ``rate``
+        (d_z (n,)): -o_z / d_z when d_z < 0 < o_z, else inf."""
+        toward = (rate < 0.0) & (height_m > 0.0)
+        t = np.where(toward, -height_m / np.where(toward, rate, -1.0), np.inf)
+        return np.where(t > T_MIN_M, t, np.inf)
 
     def hit(self, o: np.ndarray, d: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        toward = (d[:, 2] < 0.0) & (o[:, 2] > 0.0)
-        t = np.where(toward, -o[:, 2] / np.where(toward, d[:, 2], -1.0), np.inf)
         normal = np.broadcast_to(np.array([0.0, 0.0, 1.0]), o.shape)  # one normal, not copied
-        return np.where(t > T_MIN_M, t, np.inf), normal
+        return self.along(o[:, 2], d[:, 2]), normal
 
 
 @dataclass(frozen=True)
@@ -114,7 +118,8 @@ def _slabs(
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """(t_enter, index of the face entered by, t_exit) of the polytope A x <= b."""
     rate = d @ normals.T  # (n, f): a . d
-    gap = offsets - o @ normals.T  # b - a . o: >= 0 inside the face's half-space
+    one = len(o) > 0 and o.strides[0] == 0  # one origin broadcast to every ray: once
+    gap = offsets - (o[:1] if one else o) @ normals.T  # b - a . o, >= 0 inside
     # parallel to a face (a . d = 0): a huge t of the gap's sign, as a face left: never
     # left (gap >= 0) or left before the start (outside it: no hit)
     rate[rate == 0.0] = 1e-300
@@ -181,8 +186,7 @@ class Cylinder:
 
     def hit(self, o: np.ndarray, d: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         half = 0.5 * self.length_m
-        caps = np.array([[0.0, 0.0, 1.0], [0.0, 0.0, -1.0]])
-        cap_enter, cap_face, cap_leave = _slabs(caps, np.array([half, half]), o, d)
+        cap_enter, cap_leave, cap_z = _caps(half, o[:, 2], d[:, 2])
         a = d[:, 0] ** 2 + d[:, 1] ** 2
         flat = a < 1e-300  # along the axis: inside the side's region or never
         safe = np.where(flat, 1.0, a)
@@ -194,7 +198,23 @@ class Cylinder:
         enter = np.maximum(cap_enter, side_enter)
         leave = np.minimum(cap_leave, side_leave)
         t = np.where((enter > T_MIN_M) & (enter <= leave), enter, np.inf)
-        point = o + np.where(np.isfinite(t), t, 0.0)[:, None] * d
-        radial = np.column_stack([point[:, 0], point[:, 1], np.zeros(len(o))]) / self.radius_m
-        normal = np.where((side_enter >= cap_enter)[:, None], radial, caps[cap_face])
+        along = np.where(np.isfinite(t), t, 0.0)
+        side = side_enter >= cap_enter
+        normal = np.zeros((len(o), 3))
+        normal[:, 0] = np.where(side, (o[:, 0] + along * d[:, 0]) / self.radius_m, 0.0)
+        normal[:, 1] = np.where(side, (o[:, 1] + along * d[:, 1]) / self.radius_m, 0.0)
+        normal[:, 2] = np.where(side, 0.0, cap_z)
         return t, normal
+
+
+def _caps(half: float, oz: np.ndarray, dz: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(t_enter, t_exit, the entered face's normal z) of the slab |z| <= ``half``: `_slabs`
+    of its two faces z = +-half (normals +-z), written out (a parallel ray, d_z = 0, takes
+    its rates as +1e-300, as there)."""
+    down, up = dz < 0.0, dz > 0.0
+    rate = np.where(down | up, dz, 1.0)
+    top, bottom = (half - oz) / rate, (half + oz) / -rate  # the faces' t, d_z != 0
+    parallel_leave = np.minimum((half - oz) / 1e-300, (half + oz) / 1e-300)
+    enter = np.where(down, top, np.where(up, bottom, -np.inf))
+    leave = np.where(up, top, np.where(down, bottom, parallel_leave))
+    return enter, leave, np.where(up, -1.0, 1.0)

@@ -1,4 +1,5 @@
-"""``[[sensors.sonar]]``: a forward-looking imaging sonar and a single-beam altimeter.
+"""``[[sensors.sonar]]``: a forward-looking imaging sonar, a multibeam profiler and a
+single-beam altimeter.
 
 The sonar's frame sits at ``position_m``, ``rpy_rad`` in its ``link`` (default: the vehicle's
 body), x along its acoustic axis, y to port, z up. An ``imaging`` sonar has ``beams`` beams at
@@ -16,6 +17,13 @@ Across beams the returns are blurred by the array's pattern, sinc^2 of the beam 
 beamwidths (taps at +-1, +-2 beams), and each cell's intensity is multiplied by an
 exponential draw (fully developed speckle: the intensity of a Rayleigh amplitude; J. W.
 Goodman, Speckle Phenomena in Optics, 2007), seeded by the run's seed when ``speckle``.
+
+A ``multibeam`` profiler has the imaging sonar's fan (mounted looking down, its fan across
+the track) and detects the bottom in each beam: its range is the echo-weighted mean of its
+rays' ranges, sum_i e_i r_i / sum_i e_i (the centre of gravity of the beam's echo, amplitude
+detection: X. Lurton, An Introduction to Underwater Acoustics, 2nd ed. 2010, ch. 8), plus
+Gaussian noise of ``range_noise_m``; its intensity the sum of its echoes (speckled as a
+cell). A beam that hears nothing within its ranges reads NaN.
 """
 
 from __future__ import annotations
@@ -32,7 +40,7 @@ from uvms_pin.perception.scene import Scene
 
 __all__ = ["SONAR", "Sonar", "SonarSpec"]
 
-TYPES = ("imaging", "altimeter")
+TYPES = ("imaging", "multibeam", "altimeter")
 
 
 @dataclass(frozen=True)
@@ -55,6 +63,7 @@ class SonarSpec:
     absorption_db_per_m: float = 0.1
     reflectivity: float = 0.5
     speckle: bool = True
+    range_noise_m: float = 0.0
 
     def __post_init__(self) -> None:
         label = f"sonar '{self.name}'"
@@ -79,7 +88,7 @@ class SonarSpec:
                 f"{label}: needs 0 <= min_range_m < max_range_m (finite), got "
                 f"{self.min_range_m}, {self.max_range_m}"
             )
-        for key in ("absorption_db_per_m", "reflectivity"):
+        for key in ("absorption_db_per_m", "reflectivity", "range_noise_m"):
             if not (math.isfinite(getattr(self, key)) and getattr(self, key) >= 0.0):
                 raise ParameterError(f"{label}: {key} must be finite and >= 0")
 
@@ -144,8 +153,9 @@ class Sonar(sensor.Mounted):
         self.rays, self.beam, self.weight = _fan(spec)
         self.taps = _across_beams(spec)
 
-    def intensity(self) -> np.ndarray:
-        """The returns (bins, beams) of the scene as it stands."""
+    def echoes(self) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+        """What the rays heard in the scene as it stands: (each heard ray's range bin, beam,
+        range [m] and echo), the rays heard within [min_range_m, max_range_m) only."""
         spec = self.spec
         placed = self.placement()
         directions = self.rays @ placed.rotation.T
@@ -163,7 +173,16 @@ class Sonar(sensor.Mounted):
             * 10.0 ** (-0.2 * spec.absorption_db_per_m * r_heard)
             / np.maximum(r_heard, step) ** 2
         )
-        cells = k[heard].astype(np.int64) * spec.beams + self.beam[heard]
+        return k[heard].astype(np.int64), self.beam[heard], r_heard, echo
+
+    def intensity(self) -> np.ndarray:
+        """The returns (bins, beams) of the scene as it stands."""
+        return self._image(*self.echoes())
+
+    def _image(self, k, beam, r, echo) -> np.ndarray:
+        """The echoes' image (bins, beams): binned, blurred across beams, speckled."""
+        spec = self.spec
+        cells = k * spec.beams + beam
         image = np.bincount(cells, echo, minlength=spec.bins * spec.beams)
         image = image.reshape(spec.bins, spec.beams)
         if len(self.taps) > 1:
@@ -173,9 +192,30 @@ class Sonar(sensor.Mounted):
             image = image * self.rng.standard_exponential(image.shape)
         return image
 
+    def profile(self, beam, r, echo) -> tuple[np.ndarray, np.ndarray]:
+        """Each beam's bottom detection from its heard rays: (range [m] (beams,), the
+        echo-weighted mean of its rays' ranges plus noise, NaN where it heard nothing;
+        intensity (beams,), its echoes' sum, speckled)."""
+        spec = self.spec
+        energy = np.bincount(beam, echo, minlength=spec.beams)
+        moment = np.bincount(beam, echo * r, minlength=spec.beams)
+        heard = energy > 0.0
+        range_m = np.where(heard, moment / np.where(heard, energy, 1.0), np.nan)
+        if spec.range_noise_m > 0.0:
+            range_m = range_m + spec.range_noise_m * self.rng.standard_normal(spec.beams)
+        if spec.speckle:
+            energy = energy * self.rng.standard_exponential(spec.beams)
+        return range_m, energy
+
     def fire(self) -> dict[str, np.ndarray]:
-        """What a firing records: its intensity (float32)."""
-        return {"intensity": self.intensity().astype(np.float32)}
+        """What a firing records: its intensity (float32); a multibeam's detections too,
+        ``beam_range_m`` and ``beam_intensity`` (beams,)."""
+        k, beam, r, echo = self.echoes()
+        out = {"intensity": self._image(k, beam, r, echo).astype(np.float32)}
+        if self.spec.type == "multibeam":
+            range_m, energy = self.profile(beam, r, echo)
+            out["beam_range_m"], out["beam_intensity"] = range_m, energy.astype(np.float32)
+        return out
 
 
 SONAR = sensor.register(

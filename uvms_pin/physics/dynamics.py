@@ -201,7 +201,7 @@ def forward_dynamics_derivatives(
             a kink: the derivative of the side the state is on is returned.
     """
     dynamics = dynamics_of(uvms, backend)
-    water = _checked_flow(flow) if current_world is None else _uniform_or(current_world, flow)
+    water = water_of_call(uvms, current_world, flow)
     time_s, free_surface = check_time(time_s), flag("free_surface", free_surface)
     # q on the manifold here (the core checks shapes and finiteness only); v, tau and
     # tau_ext are checked (shape, finite) by the reference and by the core
@@ -211,12 +211,28 @@ def forward_dynamics_derivatives(
     return dynamics.forward_dynamics_derivatives(q, v, tau, water, time_s, tau_ext, free_surface)
 
 
-def _uniform_or(current_world: np.ndarray, flow: FlowField | None) -> FlowField | None:
-    """The flow of a call: ``flow``, or the uniform current (None in still water)."""
+def water_of_call(
+    uvms: UVMS, current_world: np.ndarray | None, flow: FlowField | None
+) -> FlowField | None:
+    """The flow of a call given ``current_world`` or ``flow`` (or neither: still water, None):
+    ``flow`` (checked), or the uniform current.
+
+    The same current gives the same `UniformCurrent` (kept in ``uvms.cache``): the compiled
+    dynamics convert a flow once and keep it by identity, so a call repeated in one current
+    (a rollout's derivatives, an optimal-control node) pays for no conversion."""
+    if current_world is None:
+        return _checked_flow(flow)
     if flow is not None:
         return _flow_of_call(current_world, flow)
     current = finite_vector("current_world", current_world, 3)
-    return UniformCurrent(current) if np.any(current) else None
+    if not np.any(current):
+        return None
+    key = current.tobytes()
+    last = uvms.cache.get("uniform_current")
+    if last is None or last[0] != key:
+        last = (key, UniformCurrent(current.copy()))
+        uvms.cache["uniform_current"] = last
+    return last[1]
 
 
 def frame_wrench_to_generalized(

@@ -13,10 +13,11 @@ from collections.abc import Mapping, Sequence
 from pathlib import Path
 from typing import Any
 
+from uvms_pin.checks import thread_count
 from uvms_pin.errors import ParameterError, SimulationError
 from uvms_pin.results.rollout import Rollout
 from uvms_pin.scenario.load import load_scenario, scenario_from_dict
-from uvms_pin.sim.batch import run_batch, thread_count
+from uvms_pin.sim.batch import run_batch
 from uvms_pin.sim.run import Scenario
 
 

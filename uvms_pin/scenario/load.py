@@ -33,6 +33,7 @@ from uvms_pin.scenario.baselines import check_baselines
 from uvms_pin.scenario.controller import build_controller
 from uvms_pin.scenario.controller_parts import ControllerContext
 from uvms_pin.scenario.estimator import build_estimator
+from uvms_pin.scenario.gripper import build_gripper
 from uvms_pin.scenario.initial import build_initial_state
 from uvms_pin.scenario.joints import build_joint_friction, build_joint_limits, with_joint_lag
 from uvms_pin.scenario.metrics import build_metrics
@@ -144,8 +145,12 @@ def _build(raw: dict[str, Any], path: Path, top: Table) -> Scenario:
         raise top.error(
             "sensors", "navigation sensors sample at the control ticks: set [control] period_s"
         )
-    context = ControllerContext(uvms, path.parent, task, actuation)
+    gripper = build_gripper(top.table("gripper"), uvms, control_period)
+    arm_uvms = uvms if gripper is None else gripper.arm_uvms
+    context = ControllerContext(arm_uvms, path.parent, task, actuation)
     controller = build_controller(top.table("controller"), context)
+    if gripper is not None:
+        controller = gripper.wrap(controller).checked(uvms)
     check_replan_rate(top, raw.get("controller"), control_period)
     extra_metrics = build_metrics(top.table("metrics"), path.parent)
     check_baselines(top.table("baselines"), (raw.get("controller") or {}).get("type"))

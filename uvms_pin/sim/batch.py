@@ -13,14 +13,13 @@ over processes and machines.
 
 from __future__ import annotations
 
-import os
 import threading
 import time
 from collections.abc import Sequence
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
 
-from uvms_pin.errors import ParameterError
+from uvms_pin.checks import thread_count
 from uvms_pin.results.rollout import Rollout
 from uvms_pin.sim.run import Scenario, simulate
 
@@ -69,11 +68,3 @@ def run_batch(
                 f.cancel()
             exc.runs = [f.result() if not f.cancelled() else BatchRun(None, exc) for f in futures]
             raise
-
-
-def thread_count(num_threads: int | None) -> int:
-    if num_threads is None:
-        return os.cpu_count() or 1
-    if isinstance(num_threads, bool) or not isinstance(num_threads, int) or num_threads < 1:
-        raise ParameterError(f"num_threads must be a positive integer, got {num_threads!r}")
-    return num_threads

@@ -14,6 +14,7 @@ from pathlib import Path
 import numpy as np
 
 from uvms_pin.errors import ModelError
+from uvms_pin.model.jaw import is_jaw_name
 from uvms_pin.model.mount.existing_arm import existing_arm
 from uvms_pin.model.mount.hull import first_box
 from uvms_pin.model.mount.joints import prepare_arm_joints
@@ -93,6 +94,7 @@ def merge_urdf(
     package_dirs: Sequence[str | Path] = (),
     allow_dry_links: bool = False,
     keep_existing_arm: bool = False,
+    moving_jaw: bool = False,
 ) -> MergedURDF:
     """Build the merged URDF tree (steps 1-6 of `uvms_pin.model.mount.mount`); nothing is
     written. The arguments before ``*`` are :func:`uvms_pin.model.mount.mount.mount_arm`'s.
@@ -113,6 +115,9 @@ def merge_urdf(
         allow_dry_links: accept arm links with mass but neither hydrodynamics nor collision
             geometry (they weigh but displace nothing; else ``load_uvms`` rejects them).
         keep_existing_arm: keep an arm the vehicle file already carries (default: replace it).
+        moving_jaw: keep the jaw's joints below ``ee_link`` moving (named by the rule of
+            `uvms_pin.model.jaw`; their <mimic> dropped: each finger is its own joint)
+            instead of locking them.
     """
     placement = parse_mount_pose(mount_pose)
     vehicle = URDFTree.read(Path(vehicle_urdf))
@@ -123,7 +128,9 @@ def merge_urdf(
     axis = tool_axis_in_link(arm, tool_axis, selection.chain, selection.ee, arm.path)
     locks = _lock_positions(arm, lock_positions)
     arm_links, arm_joints = _arm_copies(arm, selection)
-    locked = prepare_arm_joints(arm_joints, selection.chain, locks, arm.path)
+    jaw = [j.get("name") for j in arm_joints if moving_jaw and is_jaw_name(j.get("name"))]
+    jaw = [j for j in jaw if arm.is_moving(j)]
+    locked = prepare_arm_joints(arm_joints, selection.chain + jaw, locks, arm.path)
 
     vehicle_names = (set(vehicle.links) | set(vehicle.joints)) - set(removed_links + removed_joints)
     frames = unique_frame_names(vehicle_names)
@@ -150,7 +157,7 @@ def merge_urdf(
         ee_frame=ee_frame,
         sensor_frame=sensor_frame,
         vehicle_link=vlink,
-        arm_joints=[renamed.get(j, j) for j in selection.chain],
+        arm_joints=[renamed.get(j, j) for j in selection.chain + jaw],
         locked_joints={renamed.get(k, k): v for k, v in locked.items()},
         renamed=renamed,
         arm_base_link=selection.base,

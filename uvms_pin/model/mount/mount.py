@@ -17,7 +17,9 @@ brackets):
    finger, gripper, jaw or hand) (``selection``).
 3. The arm's moving joints on the path base -> ``ee_link`` are the UVMS joints; every other
    moving joint (gripper fingers, a second branch) is locked (made fixed) at
-   ``lock_positions[name]``, default 0 clipped into its limits. Continuous joints on the path
+   ``lock_positions[name]``, default 0 clipped into its limits (with ``moving_jaw=True`` the
+   gripper's joints below the wrist keep moving instead, each its own joint, `<mimic>`
+   dropped: `uvms_pin.model.jaw`). Continuous joints on the path
    become revolute with limits +-2 pi (so q has one angle per joint, as the rest of uvms-pin
    assumes) (``joints``).
 4. Renames the arm's links and joints that clash with the vehicle's (prefix ``arm_``)
@@ -136,7 +138,7 @@ def mount_arm_detailed(
             :func:`uvms_pin.model.mount.merge.merge_urdf`: ``arm_base_link``, ``ee_link``
             (a catalogue entry's by default), ``vehicle_link``, ``sensor_link``,
             ``tool_axis``, ``tool``, ``lock_positions``, ``package_dirs`` (also passed to
-            ``load_uvms``), ``allow_dry_links``, ``keep_existing_arm``.
+            ``load_uvms``), ``allow_dry_links``, ``keep_existing_arm``, ``moving_jaw``.
     """
     vehicle_urdf = find_model(vehicle_urdf) or vehicle_urdf
     entry = _catalog_entry(arm_urdf)

@@ -11,12 +11,10 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 from uvms_pin.errors import ModelError
+from uvms_pin.model.jaw import GRIPPER_WORDS, is_jaw_name
 from uvms_pin.model.mount.tree import URDFTree
 
 __all__ = ["GRIPPER_WORDS", "ArmSelection", "choose_ee_link", "select_arm"]
-
-#: A moving joint whose name has one of these is a gripper's, not the arm's.
-GRIPPER_WORDS = ("finger", "gripper", "jaw", "hand")
 
 
 @dataclass(frozen=True)
@@ -89,7 +87,7 @@ def choose_ee_link(arm: URDFTree, base: str) -> str:
         if len(branches) != 1:
             break
         joint, child, moving = branches[0]
-        if moving and any(w in joint.lower() for w in GRIPPER_WORDS):
+        if moving and is_jaw_name(joint):
             break
         current = child
         if moving:

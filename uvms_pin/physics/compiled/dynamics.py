@@ -68,6 +68,7 @@ class CompiledDynamics:
         self._flow: tuple[FlowField | None, object] = (None, None)  # the last flow converted
         self._derivatives = None  # core.Derivatives, built on first use
         self._step_derivatives = None  # core.StepDerivatives, built on first use
+        self._batch = None  # core.BatchDerivatives, the last built (`batch_derivatives`)
         # the calls in a uniform current: the C++ methods themselves (no Python in between)
         self.mass_matrix = self.core.mass_matrix
         self.bias_forces = self.core.bias_forces
@@ -91,6 +92,17 @@ class CompiledDynamics:
         # one period's step Jacobians (`_core_period`), or the Fallback of a flow the core
         # has no counterpart of (the caller chains the reference's stages)
         self.step_derivatives = self._in_flow(self._core_period, None, 3)
+
+    def batch_derivatives(self, num_threads: int):
+        """The core's BatchDerivatives on ``num_threads`` threads (the last one is kept: each
+        thread holds its own copy of the dynamics)."""
+        if self._batch is None or self._batch.num_threads != num_threads:
+            self._batch = core_module().BatchDerivatives(self.core, num_threads)
+        return self._batch
+
+    def flow_struct(self, flow: FlowField | None):
+        """The core's FlowField of ``flow`` (None: still water), or its `Fallback`."""
+        return self._flow_struct(flow)
 
     def _flow_struct(self, flow: FlowField | None):
         """The core's FlowField of ``flow`` (the last one is kept: a flow is immutable), or

@@ -1,20 +1,26 @@
 """What a DVL needs of the world: its altitude above the bottom. A flat bottom at a depth
 (``sensors.dvl.seabed_depth_m``), or the seafloor of the world table: its planes whose
-outward normal points up (``[[world.objects]] type = "plane"``, flat or sloping)."""
+outward normal points up (``[[world.objects]] type = "plane"``, flat or sloping). A DVL
+whose beams are cast (``beams = 4``) sees the bottom through `bottom_caster`: the flat
+bottom, or every fixed object of the world (its rocks and boxes as well as its planes)."""
 
 from __future__ import annotations
 
 import math
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Protocol
 
 import numpy as np
+import pinocchio as pin
 
 from uvms_pin.errors import ParameterError
+from uvms_pin.perception.caster import RayCaster
+from uvms_pin.perception.scene import add_objects
+from uvms_pin.perception.shapes import Plane
 from uvms_pin.physics.world.objects import WorldObject
 
-__all__ = ["FlatSeabed", "PlaneSeabed", "Seabed", "world_seabed"]
+__all__ = ["FlatSeabed", "PlaneSeabed", "Seabed", "bottom_caster", "world_seabed"]
 
 
 class Seabed(Protocol):
@@ -47,6 +53,8 @@ class PlaneSeabed:
 
     points_world_m: tuple[tuple[float, float, float], ...]
     normals_world: tuple[tuple[float, float, float], ...]
+    #: the world's fixed objects, all of them (what cast beams see; empty: the planes alone)
+    objects: tuple[WorldObject, ...] = field(default=(), compare=False, repr=False)
 
     def altitude_m(self, position_world_m: np.ndarray) -> float:
         points, normals = np.asarray(self.points_world_m), np.asarray(self.normals_world)
@@ -63,4 +71,25 @@ def world_seabed(objects: Sequence[WorldObject]) -> PlaneSeabed | None:
     return PlaneSeabed(
         tuple(tuple(map(float, o.placement.translation)) for o in floors),
         tuple(tuple(map(float, o.normal_world)) for o in floors),
+        tuple(objects),
     )
+
+
+def bottom_caster(seabed: Seabed) -> RayCaster:
+    """The bottom as cast beams see it (`uvms_pin.perception.caster`): a flat bottom's plane,
+    or a world seafloor's fixed objects (its planes alone when it was given none)."""
+    caster = RayCaster()
+    if isinstance(seabed, FlatSeabed):
+        caster.add("seabed", Plane(), np.eye(3), np.array([0.0, 0.0, -seabed.depth_m]))
+    elif isinstance(seabed, PlaneSeabed) and seabed.objects:
+        add_objects(caster, seabed.objects)
+    elif isinstance(seabed, PlaneSeabed):
+        up = np.array([0.0, 0.0, 1.0])
+        for k, (point, normal) in enumerate(
+            zip(seabed.points_world_m, seabed.normals_world, strict=True)
+        ):
+            rotation = pin.Quaternion.FromTwoVectors(up, np.asarray(normal)).toRotationMatrix()
+            caster.add(f"seabed#{k}", Plane(), rotation, np.asarray(point, dtype=float))
+    else:
+        raise ParameterError(f"a DVL's beams cannot be cast at a {type(seabed).__name__}")
+    return caster

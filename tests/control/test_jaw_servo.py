@@ -1,0 +1,107 @@
+"""The jaw's force-limited servo and the arm's controller beside it."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import uvms_pin as up
+from uvms_pin.control.base import Controller
+from uvms_pin.control.jaw_servo import JawSchedule, JawServo, WithJaw
+from uvms_pin.control.measurement import Measurement
+from uvms_pin.errors import ParameterError
+from uvms_pin.model.jaw import JawJoints
+
+JAWS = Path(__file__).resolve().parents[2] / "models" / "uvms_bluerov2_alpha5_jaws.urdf"
+
+
+@pytest.fixture(scope="module")
+def uvms() -> up.UVMS:
+    return up.load_uvms(JAWS)
+
+
+@pytest.fixture(scope="module")
+def servo(uvms) -> JawServo:
+    return JawServo.for_model(uvms.model, JawJoints.of(uvms.model), 10.0, JawSchedule(1.0, 3.0))
+
+
+def test_lever_is_the_fingers_centre_of_mass_off_its_axis(servo):
+    # Reach's finger box centre (0, -8, 45) mm from the pivot, the axis along x
+    np.testing.assert_allclose(servo.lever_m, np.hypot(0.008, 0.045), rtol=1e-12)
+
+
+def test_schedule_closes_then_opens(servo):
+    np.testing.assert_array_equal(servo.target(0.5), [0.5, 0.5])
+    np.testing.assert_array_equal(servo.target(1.0), [0.0, 0.0])
+    np.testing.assert_array_equal(servo.target(2.99), [0.0, 0.0])
+    np.testing.assert_array_equal(servo.target(3.0), [0.5, 0.5])
+
+
+def test_grip_saturates_at_max_force_times_lever(servo):
+    # blocked by an object at 0.3 rad with the jaw closing: pressing with 10 N at the lever
+    tau = servo.torque(2.0, np.array([0.3, 0.3]), np.zeros(2))
+    np.testing.assert_allclose(tau, -10.0 * servo.lever_m, rtol=1e-12)
+    # 5 % of the travel from the target: the linear range's edge
+    near = servo.torque(2.0, np.array([0.025, 0.0125]), np.zeros(2))
+    np.testing.assert_allclose(near, -10.0 * servo.lever_m * np.array([1.0, 0.5]), rtol=1e-12)
+    assert np.all(servo.torque(2.0, np.zeros(2), np.zeros(2)) == 0.0)
+
+
+@pytest.mark.parametrize(
+    ("close", "reopen", "match"),
+    [(-1.0, None, "close_at_s"), (2.0, 1.0, "must come after"), (np.inf, None, "close_at_s")],
+)
+def test_bad_schedules(close, reopen, match):
+    with pytest.raises(ParameterError, match=match):
+        JawSchedule(close, reopen)
+
+
+def test_bad_force(uvms):
+    with pytest.raises(ParameterError, match="max_force_N"):
+        JawServo.for_model(uvms.model, JawJoints.of(uvms.model), 0.0, JawSchedule())
+
+
+class _Recorder(Controller):
+    def __init__(self):
+        self.seen = None
+
+    def compute(self, time_s, measurement):
+        self.seen = measurement
+        return np.arange(10.0)
+
+
+def test_the_arm_controller_sees_and_commands_the_arm_only(uvms, servo):
+    arm = _Recorder()
+    both = WithJaw(arm, servo, uvms.nv, (False, False))
+    q = np.zeros(uvms.nq)
+    q[6] = 1.0
+    q[11:] = (0.2, 0.4)
+    v = np.arange(uvms.nv, dtype=float)
+    tau = both.compute(2.0, Measurement(2.0, q, v, np.zeros(6)))
+    assert arm.seen.q.shape == (11,) and arm.seen.v.shape == (10,)
+    np.testing.assert_array_equal(arm.seen.v, np.arange(10.0))
+    np.testing.assert_array_equal(tau[:10], np.arange(10.0))
+    np.testing.assert_allclose(tau[10:], servo.torque(2.0, np.array([0.2, 0.4]), v[10:]))
+    jaw = both.signals()["jaw"]
+    assert jaw.components == (
+        "alpha_jaw_finger_130_joint",
+        "alpha_jaw_finger_139_joint",
+        "alpha_jaw_finger_130_joint_grip",
+        "alpha_jaw_finger_139_joint_grip",
+    )
+    assert jaw.units == ("rad", "rad", "N", "N")
+    np.testing.assert_allclose(jaw.values[:2], [0.2, 0.4])
+    np.testing.assert_allclose(jaw.values[2:], 10.0)  # both saturated
+
+
+def test_a_sampled_servo_is_softened_for_light_fingers(uvms, servo):
+    jaw = JawJoints.of(uvms.model)
+    sampled = JawServo.for_model(uvms.model, jaw, 10.0, JawSchedule(), period_s=0.002)
+    inertia = servo.damping**2 / (4.0 * servo.stiffness)  # d = 2 sqrt(k I)
+    np.testing.assert_allclose(sampled.stiffness, inertia / (4.0 * 0.002**2), rtol=1e-12)
+    assert np.all(sampled.stiffness < servo.stiffness)
+    np.testing.assert_allclose(sampled.damping * 0.002 / inertia, 1.0, rtol=1e-12)
+    fast = JawServo.for_model(uvms.model, jaw, 10.0, JawSchedule(), period_s=1e-4)
+    np.testing.assert_array_equal(fast.stiffness, servo.stiffness)  # no cap needed
