@@ -1,8 +1,9 @@
 # Two commands do all the set-up on a fresh machine with Python 3.11 and pip:
 #   make demo   - create .venv, install uvms-pin (no extra), run the main scenario into out/demo
 #   make test   - create .venv, install uvms-pin with dev tools, lint and run the test suite
-#   make results - regenerate every table (docs/results/*.md) and figure the README quotes
+#   make results - regenerate every table (docs/results/*.md) and figure the docs quote
 #                  (RESULTS="paper robustness" for some; the list is scripts/make_results.py)
+#   make docs    - build the documentation site into site/ (mkdocs.yml), --strict, offline
 PYTHON ?= python3
 VENV := .venv
 BIN := $(VENV)/bin
@@ -11,7 +12,7 @@ BASE_STAMP := $(VENV)/.installed-base
 DEMO_SCENARIO ?= scenarios/realistic_force_tracking.toml
 DEMO_OUT ?= out/demo
 
-.PHONY: demo test lint bench results fuzz clean
+.PHONY: demo test lint bench results fuzz docs clean
 
 SOURCES := pyproject.toml CMakeLists.txt $(wildcard src/uvms_core/*.cpp src/uvms_core/*.hpp)
 
@@ -65,6 +66,11 @@ bench: $(STAMP)
 results: $(STAMP)
 	$(BIN)/python scripts/make_results.py $(if $(RESULTS),--only $(RESULTS))
 
+# the site: every page of docs/ in mkdocs.yml's nav, the API reference from the docstrings;
+# --strict: a broken link or anchor, a page left out of the nav, an unreadable docstring fail
+docs: $(STAMP)
+	NO_MKDOCS_2_WARNING=1 $(BIN)/mkdocs build --strict --site-dir site
+
 
 clean:
-	rm -rf $(VENV) out build *.egg-info
+	rm -rf $(VENV) out build site *.egg-info

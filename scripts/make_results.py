@@ -1,4 +1,4 @@
-"""Regenerate every table and figure the README quotes (``make results``).
+"""Regenerate every table and figure the documentation quotes (``make results``).
 
     python scripts/make_results.py [--only NAME ...] [--skip NAME ...] [--list]
 

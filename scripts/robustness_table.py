@@ -1,4 +1,4 @@
-"""The README's robustness table: the realistic scenario, same gains, varied conditions.
+"""The robustness table (docs/paper.md): the realistic scenario, same gains, varied conditions.
 
     .venv/bin/python scripts/robustness_table.py [--duration 10] [--jobs 2] [--out out/robustness]
 

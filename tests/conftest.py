@@ -16,7 +16,7 @@ import pytest
 import uvms_pin as up
 
 ROOT = Path(__file__).resolve().parents[1]
-# the tests check full-length runs: a cap on durations in the developer's shell (README:
+# the tests check full-length runs: a cap on durations in the developer's shell (docs/getting_started.md:
 # UVMS_PIN_MAX_DURATION_S) does not apply to them (the doc test sets its own per snippet)
 os.environ.pop("UVMS_PIN_MAX_DURATION_S", None)
 REFERENCE_URDF = ROOT / "models" / "uvms_lbv150.urdf"

@@ -133,10 +133,18 @@ def run_document(doc: str, snippets: list[Snippet], copy: Path, work: Path) -> d
 
 
 def lanes(docs: list[str]) -> list[list[str]]:
-    """The README, and the other documents after one another: two lanes that run side by
-    side, each in its own working copy (the suite is serial: this uses the second core).
-    Blocks of different lanes never share an output (`test_no_two_blocks_write_one_output`)."""
-    return [docs[:1], docs[1:]]
+    """Two lanes that run side by side, each in its own working copy (the suite is serial:
+    this uses the second core): the documents in order, cut where each lane holds about half
+    of the blocks that run. A document reads nothing another one wrote, so any cut works;
+    blocks of different lanes never share an output (`test_no_two_blocks_write_one_output`)."""
+    weights = [sum(s.doc == doc and not (s.skip or s.same_as) for s in SNIPPETS) for doc in docs]
+    done, cut = 0, len(docs)
+    for index, weight in enumerate(weights):
+        done += weight
+        if 2 * done >= sum(weights):
+            cut = index + 1
+            break
+    return [docs[:cut], docs[cut:]]
 
 
 def run_lane(docs: list[str], base: Path, available: dict[str, bool]) -> dict[str, dict]:
@@ -209,7 +217,8 @@ def test_snippet_runs_as_written(snippet: Snippet, doc_run):
 def test_the_documents_have_runnable_blocks():
     """The extraction finds the blocks (a renamed fence language would silently drop them)."""
     counts = {doc: sum(s.doc == doc for s in SNIPPETS) for doc in documents(ROOT)}
-    assert counts["README.md"] >= 10 and counts["docs/api.md"] >= 5, counts
+    assert counts["README.md"] >= 3 and counts["docs/getting_started.md"] >= 5, counts
+    assert counts["docs/api.md"] >= 5, counts
     assert counts["models/README.md"] >= 1, counts
 
 

@@ -18,6 +18,21 @@ def test_every_result_script_is_listed_and_every_listed_result_has_a_script():
     assert producers == set(PRODUCERS)
 
 
+def test_every_result_is_quoted_beside_its_command_on_a_page_of_the_site():
+    """Each table `make results` writes (docs/results/<name>.md) is quoted by a page of the
+    documentation, and docs/reproduce.md names every result with its page: no result is
+    written for a page that no longer exists."""
+    docs = ROOT / "docs"
+    pages = {p.name: p.read_text() for p in docs.glob("*.md") if p.name != "reproduce.md"}
+    rows = [line.split("|") for line in (docs / "reproduce.md").read_text().splitlines()]
+    results = [cells[3] for cells in rows if len(cells) == 5 and cells[1].strip().startswith("[")]
+    named = {word for cell in results for word in cell.strip(" `").split()}
+    assert named == set(PRODUCERS), sorted(named ^ set(PRODUCERS))
+    for name in PRODUCERS:
+        assert (docs / "results" / f"{name}.md").is_file(), name
+        assert any(f"results/{name}.md" in text for text in pages.values()), name
+
+
 def test_the_makefile_runs_the_list():
     makefile = (ROOT / "Makefile").read_text()
     assert "scripts/make_results.py" in makefile and "\nresults:" in makefile

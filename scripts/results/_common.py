@@ -1,6 +1,6 @@
 """Shared by the result producers: where results go and how a result file is written.
 
-Every producer regenerates one result the README quotes: its tables into
+Every producer regenerates one result the documentation quotes (docs/*.md): its tables into
 docs/results/<name>.md (Markdown, with the command that made them), its figures into docs/.
 Scratch output (rollouts, study tables) goes to out/results/<name>/.
 """

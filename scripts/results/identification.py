@@ -92,7 +92,7 @@ def _choice(default: dict, alternatives: dict[str, dict]) -> str:
         f"({without:.4f} -> {rms:.4f} deg) and has independent evidence (below); the roll "
         f"added mass lowers it by {100 * (1 - added['fit_rms_deg'][-1] / rms):.1f} % more, at "
         f"{mass['identified']:.3f} kg m^2, {mass['identified'] / mass['start']:.1f} x the "
-        f"catalogue's {mass['start']:.3f}: these slow trials hardly excite added mass (README), "
+        f"catalogue's {mass['start']:.3f}: these slow trials hardly excite added mass (docs/validation.md), "
         "so it stays out of `default` (`--fit default,added_mass.roll` fits it)."
     )
 

@@ -7,7 +7,7 @@ import json
 
 from _common import producer_cli, publish_figure, scratch, uvms_pin, write_result
 
-FIGURES = ("_alt_011-2", "_alt_002-0")  # the README shows these two
+FIGURES = ("_alt_011-2", "_alt_002-0")  # docs/validation.md shows these two
 
 if __name__ == "__main__":
     producer_cli(__doc__)

@@ -1,5 +1,5 @@
-"""The README's own-controller example (scripts/station_keeping/): how far its PD lets the
-arm-less LBV150 drift from its station in a 0.2 m/s current, and the static offset of a PD."""
+"""The own-controller example of docs/getting_started.md (scripts/station_keeping/): how far
+its PD lets the arm-less LBV150 drift from its station in a 0.2 m/s current, and the static offset of a PD."""
 
 import numpy as np
 import pinocchio as pin

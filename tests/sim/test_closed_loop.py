@@ -70,7 +70,7 @@ def test_paper_scenario_holds_its_funnels(paper_rollout):
 def test_realistic_scenario_holds_its_funnels_within_actuator_limits(realistic):
     """500 Hz, thrust- and torque-limited: the funnels hold; the force error after the
     transient stays below 0.6 rho_inf (0.55 measured: the thrusters saturate during part
-    of every force period, see README); no thrust, torque or joint position limit is
+    of every force period, see docs/paper.md); no thrust, torque or joint position limit is
     exceeded."""
     scenario, rollout = realistic
     _assert_inside_funnels(rollout, 0.6)

@@ -76,9 +76,11 @@ class StiffMode:
 
     Attributes:
         what: which body, joint or object and which contact or stop, for messages.
-        stiffness: k [N/m or N m/rad]. damping: c [N s/m or N m s/rad]. mass: m_eff [kg or
-        kg m^2]. units: those of (k, c, m_eff). remedy: what else makes it stable, as the
-        end of a sentence (", or ...").
+        stiffness: k [N/m or N m/rad].
+        damping: c [N s/m or N m s/rad].
+        mass: m_eff [kg or kg m^2].
+        units: those of (k, c, m_eff).
+        remedy: what else makes it stable, as the end of a sentence (", or ...").
     """
 
     what: str

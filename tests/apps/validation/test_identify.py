@@ -4,7 +4,7 @@ The shift is an input of ``models/derive_bluerov_alpha5.py`` (``TRIAL_COB_CORREC
 fitted once by ``python -m uvms_pin.apps.validation.identify data/hinsdale2023`` on the
 file without it (models/README.md, section 9); here the same fit runs again, through the
 library and through the command line's ``--cob`` (from Kolano's published hull centre of
-buoyancy, as the README shows it).
+buoyancy, as docs/validation.md shows it).
 """
 
 from __future__ import annotations

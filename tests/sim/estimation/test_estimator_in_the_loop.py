@@ -124,7 +124,7 @@ def test_the_estimators_noise_defaults_to_the_sensors_and_can_be_overridden():
 
 
 def test_the_shipped_scenario_holds_its_station_on_the_estimate():
-    """README's bound: within 0.15 m of the station (true distance) after the 10 s
+    """The bound of docs/actuators_sensors.md: within 0.15 m of the station (true distance) after the 10 s
     transient, the controller never seeing the truth; the filter consistent meanwhile."""
     rollout = up.simulate(load_scenario(SCENARIO))
     metrics = rollout.metrics()

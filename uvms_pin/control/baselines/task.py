@@ -219,8 +219,8 @@ class ForceTaskOptions:
         kp_force_m_s_per_N, ki_force_m_s2_per_N, k_orientation_per_s, integral_limit_Ns:
             the outer loop's gains (3,) [m/s per N, m/s per N s, 1/s, N s], per component
             (a scalar broadcasts).
-        desired_force_world_N, desired_rpy, velocity_weights, null_space_gain_per_s,
-            null_space_target: the task's, as `EndEffectorTask`.
+        desired_force_world_N, desired_rpy, velocity_weights, null_space_gain_per_s, null_space_target:
+            the task's, as `EndEffectorTask`.
     """
 
     kp_force_m_s_per_N: ArrayLike = 0.1

@@ -72,9 +72,10 @@ class PpcVelocityLevel:
     """The PPC's velocity level on a given reference (model-free).
 
     Args:
-        nv: the number of velocities. gain: K (nv,) > 0 [N or N m]. funnel: rho(t) of
-        e = zeta - zeta_r (`PerformanceFunction` with nv components). names: the
-        components' names (messages of a FunnelViolation).
+        nv: the number of velocities.
+        gain: K (nv,) > 0 [N or N m].
+        funnel: rho(t) of e = zeta - zeta_r (`PerformanceFunction` with nv components).
+        names: the components' names (messages of a FunnelViolation).
     """
 
     def __init__(self, nv: int, gain, funnel: PerformanceFunction, names: list[str]):
