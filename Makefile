@@ -46,7 +46,8 @@ test: $(STAMP) lint
 	  if [ "$$(id -u)" = 0 ] && command -v apt-get >/dev/null 2>&1; then \
 	    apt-get update && DEBIAN_FRONTEND=noninteractive apt-get install -y chromium; \
 	  else echo "chromium missing and not installable here (needs root + apt-get): browser tests will skip"; fi; }
-	$(BIN)/python -m pytest -q
+	@# two workers per two cores (pytest-xdist): each test is independent of the others' order
+	$(BIN)/python -m pytest -q -n auto
 
 # the generated-input campaign (tests/fuzz): HYPOTHESIS_PROFILE=campaign draws 6 times the
 # inputs `make test` draws, from FUZZ_SEED (printed; FUZZ_SEED=N make fuzz replays or varies

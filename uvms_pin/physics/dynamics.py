@@ -21,6 +21,8 @@ functions below are the public API on it.
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 import pinocchio as pin
 
@@ -81,14 +83,16 @@ def _finite_result(what: str, value: np.ndarray, uvms: UVMS, q, v=None) -> np.nd
     at no cost on the way of every call): ParameterError for a q off the configuration
     manifold (a quaternion of norm 1e300), else SimulationError for a speed whose square
     (quadratic damping, Coriolis) leaves the floating-point range."""
-    if not np.all(np.isfinite(value)):
-        checked_configuration("q", q, uvms.model)
-        fastest = 0.0 if v is None else float(np.max(np.abs(np.asarray(v, dtype=float))))
-        raise SimulationError(
-            f"{what} is not finite for finite inputs: the fastest entry of zeta, {fastest:.3g}, "
-            "is beyond what its square holds in floating point"
-        )
-    return value
+    flat = value.reshape(-1)
+    # the product first: all finite unless it overflows (then the entries are looked at)
+    if math.isfinite(flat @ flat) or np.all(np.isfinite(flat)):
+        return value
+    checked_configuration("q", q, uvms.model)
+    fastest = 0.0 if v is None else float(np.max(np.abs(np.asarray(v, dtype=float))))
+    raise SimulationError(
+        f"{what} is not finite for finite inputs: the fastest entry of zeta, {fastest:.3g}, "
+        "is beyond what its square holds in floating point"
+    )
 
 
 def mass_matrix(
