@@ -184,3 +184,17 @@ def test_the_cli_refuses_an_unknown_live_viewer(capsys):
         main(["run", "scenarios/passive_still_water.toml", "--out", "/tmp/x", "--live", "rviz"])
     assert stop.value.code == 2
     assert "foxglove" in capsys.readouterr().err
+
+
+def test_uvms_pin_replay_live_foxglove_waits_for_a_client_and_sends_the_whole_run(
+    push_rollout, tmp_path, capsys
+):
+    push_rollout.save(tmp_path / "run")
+    port = _free_port()
+    client = Client(f"ws://127.0.0.1:{port}")
+    client.start()
+    code = main(["replay", str(tmp_path / "run"), "--live", "foxglove", "--port", str(port), "--speed", "50"])  # fmt: skip
+    client.join(30.0)
+    assert code == 0 and client.error is None, client.error
+    assert "waiting for a Foxglove client" in capsys.readouterr().out
+    check_bag(push_rollout, dict(client.received))

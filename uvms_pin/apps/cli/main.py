@@ -58,13 +58,13 @@ def _cmd_replay(args: argparse.Namespace) -> int:
         from uvms_pin.apps.viz.foxglove_live import replay_foxglove
 
         topics = SampleTopics(rollout.metadata, rollout_model(rollout, args.urdf))
-        replay_foxglove(rollout, topics, port=args.port, speed=args.speed)
+        replay_foxglove(rollout, topics, port=args.port, speed=args.speed, out=sys.stdout)
     elif args.live:
         from uvms_pin.apps.viz.live import replay_live
         from uvms_pin.apps.viz.replay import scene_for_rollout
 
         scene = scene_for_rollout(rollout, urdf=args.urdf)
-        replay_live(rollout, scene, port=args.port, speed=args.speed)
+        replay_live(rollout, scene, port=args.port, speed=args.speed, out=sys.stdout)
     return 0
 
 

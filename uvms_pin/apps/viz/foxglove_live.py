@@ -31,16 +31,17 @@ from uvms_pin.apps.export.ros_sample import (
     record_of_sample,
     records_of,
 )
-from uvms_pin.apps.viz.live import LOOPBACK, port_is_free
-from uvms_pin.errors import (
-    LiveServerError,
-    OptionalDependencyError,
-    PortInUseError,
-    SimulationError,
+from uvms_pin.apps.viz.live import (
+    LOOPBACK,
+    play_to_end,
+    port_is_free,
+    simulate_watched,
+    wait_for_watcher,
 )
+from uvms_pin.errors import LiveServerError, OptionalDependencyError, PortInUseError
 from uvms_pin.results.progress import Progress
 from uvms_pin.sim.log import run_metadata
-from uvms_pin.sim.run import Scenario, simulate
+from uvms_pin.sim.run import Scenario
 
 if TYPE_CHECKING:
     from uvms_pin.results.rollout import Rollout
@@ -336,13 +337,7 @@ def run_foxglove(
     """Simulate a scenario while serving it to Foxglove; the server is gone when this
     returns. A run that stops early is sent to its end and the error re-raised."""
     with FoxgloveLive(scenario_topics(scenario), port=port, speed=speed, out=out) as live:
-        try:
-            rollout = simulate(scenario, progress=progress, observers=[FoxgloveFeed(live)])
-        except SimulationError:  # FunnelViolation included: send the partial run, re-raise
-            _send_to_end(live, out)
-            raise
-        _send_to_end(live, out)
-        return rollout
+        return simulate_watched(scenario, live, FoxgloveFeed(live), progress=progress, out=out)
 
 
 def replay_foxglove(
@@ -360,23 +355,7 @@ def replay_foxglove(
     records = list(records_of(rollout))
     with FoxgloveLive(topics, port=port, speed=speed, out=out) as live:
         live.advertise(records[0])
-        if out is not None:
-            print("live view: waiting for a Foxglove client to subscribe (Ctrl-C to stop)", file=out)  # fmt: skip
-            out.flush()
-        while not live.watched:
-            if live.error is not None:
-                raise LiveServerError(f"live view failed: {live.error}")
-            time.sleep(0.1)
+        wait_for_watcher(live, "a Foxglove client to subscribe", out)
         for record in records:
             live.push(record)
-        _send_to_end(live, out)
-
-
-def _send_to_end(live: FoxgloveLive, out: TextIO | None) -> None:
-    lag = live.lag_s()
-    if out is not None and lag > 1.0 and live.watched:
-        print(f"live view: sending the last {lag:.1f} s of the run (Ctrl-C to stop)", file=out)
-        out.flush()
-    live.finish()
-    if live.error is not None and out is not None:
-        print(f"live view: stopped streaming: {live.error}", file=out)
+        play_to_end(live, out)
