@@ -12,7 +12,7 @@ from typing import TYPE_CHECKING
 from uvms_pin.apps.arguments import add_set_option, path_text, positive
 from uvms_pin.apps.arms.command import register as register_compare_arms
 from uvms_pin.apps.cli.export import register as register_export
-from uvms_pin.apps.cli.run import check_view_options, cmd_run
+from uvms_pin.apps.cli.run import LIVE_PORTS, check_view_options, cmd_run
 from uvms_pin.apps.compare.command import register as register_compare_controllers
 from uvms_pin.apps.exit_codes import (
     EXIT_BAD_INPUT,
@@ -52,21 +52,37 @@ def _cmd_replay(args: argparse.Namespace) -> int:
             _write_replay(rollout, path, urdf=args.urdf, max_fps=args.fps)
         size_mb = path.stat().st_size / 1e6
         print(f"wrote {path} ({size_mb:.1f} MB, {len(rollout)} samples)")
-    if args.live:
+    if args.live == "foxglove":
+        from uvms_pin.apps.export.ros_bag import rollout_model
+        from uvms_pin.apps.export.ros_sample import SampleTopics
+        from uvms_pin.apps.viz.foxglove_live import replay_foxglove
+
+        topics = SampleTopics(rollout.metadata, rollout_model(rollout, args.urdf))
+        replay_foxglove(rollout, topics, port=args.port, speed=args.speed, out=sys.stdout)
+    elif args.live:
         from uvms_pin.apps.viz.live import replay_live
         from uvms_pin.apps.viz.replay import scene_for_rollout
 
         scene = scene_for_rollout(rollout, urdf=args.urdf)
-        replay_live(rollout, scene, port=args.port, speed=args.speed)
+        replay_live(rollout, scene, port=args.port, speed=args.speed, out=sys.stdout)
     return 0
 
 
 def _add_view_options(parser: argparse.ArgumentParser) -> None:
     parser.add_argument(
-        "--live", action="store_true", help="show the run in meshcat (server on 127.0.0.1)"
+        "--live",
+        nargs="?",
+        const="meshcat",
+        choices=sorted(LIVE_PORTS),
+        help="show the run live on 127.0.0.1: in meshcat (--live, --live meshcat: a browser "
+        "page) or in Foxglove (--live foxglove: a Foxglove WebSocket server with the ROS 2 "
+        'topics of the MCAP export; pip install "uvms-pin[foxglove]")',
     )
     parser.add_argument(
-        "--port", type=int, default=7000, help="live view port (default 7000; 0: any free)"
+        "--port",
+        type=int,
+        default=None,
+        help="live view port (default 7000 for meshcat, 8765 for Foxglove; 0: any free)",
     )
     parser.add_argument(
         "--speed", type=positive, default=1.0, help="live playback speed-up over real time"

@@ -41,8 +41,14 @@ class Ending:
     user_traceback: str = ""
 
 
+#: the live viewers (``--live NAME``) and the port each listens on by default
+LIVE_PORTS = {"meshcat": 7000, "foxglove": 8765}
+
+
 def check_view_options(args: argparse.Namespace) -> None:
-    """--port in range (run, replay)."""
+    """--port in range (run, replay); without --port, the live viewer's own default."""
+    if args.port is None:
+        args.port = LIVE_PORTS.get(args.live or "meshcat")
     if not 0 <= args.port <= 65535:
         raise ParameterError(f"--port must be in 0..65535, got {args.port}")
 
@@ -96,9 +102,11 @@ def _simulate(scenario, args: argparse.Namespace, progress) -> Rollout:
 
     if not args.live:
         return simulate(scenario, progress=progress)
-    from uvms_pin.apps.viz.live import run_live
-
-    return run_live(scenario, port=args.port, speed=args.speed, progress=progress)
+    if args.live == "foxglove":
+        from uvms_pin.apps.viz.foxglove_live import run_foxglove as run_view
+    else:
+        from uvms_pin.apps.viz.live import run_live as run_view
+    return run_view(scenario, port=args.port, speed=args.speed, progress=progress, out=sys.stdout)
 
 
 def _simulate_to_end(scenario, args: argparse.Namespace) -> Ending:

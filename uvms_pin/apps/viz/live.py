@@ -23,7 +23,7 @@ import tempfile
 import threading
 import time
 from pathlib import Path
-from typing import TextIO
+from typing import Protocol, TextIO
 
 import meshcat
 import numpy as np
@@ -37,7 +37,7 @@ from uvms_pin.errors import LiveServerError, PortInUseError, SimulationError
 from uvms_pin.results.progress import Progress
 from uvms_pin.results.rollout import Rollout
 from uvms_pin.sim.run import Scenario, simulate
-from uvms_pin.sim.sample import Sample
+from uvms_pin.sim.sample import Observer, Sample
 
 LOOPBACK = "127.0.0.1"
 DEFAULT_PORT = 7000
@@ -419,23 +419,60 @@ def run_live(
     error re-raised; KeyboardInterrupt closes the view at once and propagates.
     """
     with LiveView(scene_for_scenario(scenario, style), port=port, speed=speed, out=out) as live:
-        try:
-            rollout = simulate_live(scenario, live, progress=progress)
-        except SimulationError:  # FunnelViolation included: show the partial run, re-raise
-            _play_to_end(live, out)
-            raise
-        _play_to_end(live, out)
-        return rollout
+        return simulate_watched(scenario, live, LiveFeed(live), progress=progress, out=out)
 
 
-def _play_to_end(live: LiveView, out: TextIO | None) -> None:
-    lag = live.lag_s()
-    if out is not None and lag > 1.0 and live.watched:
+class Watched(Protocol):
+    """What a live view offers its runner (`LiveView`, the Foxglove server)."""
+
+    watched: bool
+    error: BaseException | None
+
+    def lag_s(self) -> float: ...
+
+    def finish(self) -> None: ...
+
+
+def simulate_watched(
+    scenario: Scenario,
+    view: Watched,
+    feed: Observer,
+    *,
+    progress: Progress | None = None,
+    out: TextIO | None = sys.stdout,
+) -> Rollout:
+    """`simulate` with ``feed`` observing every sample for ``view``; the view shows the run
+    to its end (a run that stops early too, the error then re-raised)."""
+    try:
+        rollout = simulate(scenario, progress=progress, observers=[feed])
+    except SimulationError:  # FunnelViolation included: show the partial run, re-raise
+        play_to_end(view, out)
+        raise
+    play_to_end(view, out)
+    return rollout
+
+
+def wait_for_watcher(view: Watched, what: str, out: TextIO | None) -> None:
+    """Wait until ``view`` is watched (saying so: "waiting for ``what``"); LiveServerError
+    if the view fails meanwhile."""
+    if out is not None:
+        print(f"live view: waiting for {what} (Ctrl-C to stop)", file=out)
+        out.flush()
+    while not view.watched:
+        if view.error is not None:
+            raise LiveServerError(f"live view failed: {view.error}")
+        time.sleep(0.1)
+
+
+def play_to_end(view: Watched, out: TextIO | None) -> None:
+    """Let ``view`` show what it has queued (to a watcher; at once without one), then stop."""
+    lag = view.lag_s()
+    if out is not None and lag > 1.0 and view.watched:
         print(f"live view: playing the last {lag:.1f} s of the run (Ctrl-C to stop)", file=out)
         out.flush()
-    live.finish()
-    if live.error is not None and out is not None:
-        print(f"live view: stopped streaming: {live.error}", file=out)
+    view.finish()
+    if view.error is not None and out is not None:
+        print(f"live view: stopped streaming: {view.error}", file=out)
 
 
 def replay_live(
@@ -453,13 +490,7 @@ def replay_live(
     free = rollout.signals.get("free_objects")
     object_contact = rollout.signals.get("free_object_contact")
     with LiveView(scene, port=port, speed=speed, out=out) as live:
-        if out is not None:
-            print("live view: waiting for a browser to connect (Ctrl-C to stop)", file=out)
-            out.flush()
-        while not live.watched:
-            if live.error is not None:
-                raise LiveServerError(f"live view failed: {live.error}")
-            time.sleep(0.1)
+        wait_for_watcher(live, "a browser to connect", out)
         for k in range(len(rollout)):
             live.push(
                 Frame(
@@ -472,4 +503,4 @@ def replay_live(
                     None if object_contact is None else object_contact[k],
                 )
             )
-        _play_to_end(live, out)
+        play_to_end(live, out)
