@@ -45,7 +45,7 @@ def add_trim_links(root: ET.Element, vehicle_link: str, report: TrimReport) -> N
 
 # drawing only: the foam a translucent amber sheet, the ballast a translucent lead-grey one
 # (each spans the hull's footprint, thin)
-_TRIM_RGBA = {"trim_foam": "1 0.8 0.3 0.35", "trim_ballast": "0.35 0.35 0.38 0.6"}
+_TRIM_RGBA = {"trim_foam": "1 0.8 0.3 0.2", "trim_ballast": "0.35 0.35 0.38 0.6"}
 
 
 def _slab_link(
