@@ -11,7 +11,8 @@ lower into it, hold while the jaw opens, rise. The law:
                                                                 p_0 the jaw's place at t = 0
     e            = p_target - p_jaw
     f_world      = K_p e - K_d v_jaw + K_i int e dt              (PID on the jaw point, world;
-                                                                the integral clipped to f_max)
+                                                                e integrated within 2 cm of the
+                                                                target, clipped to f_max)
     tau_vehicle  = [R^T f_world; -k_a log(R) - d_a omega]        (level attitude)
     tau_arm      = K_p,arm (q_arm,target - q_arm) - K_d,arm qdot_arm
 
@@ -32,6 +33,10 @@ import pinocchio as pin
 
 from uvms_pin.control.base import Controller
 from uvms_pin.errors import ParameterError
+
+
+#: the position error below which the integral acts [m]
+INTEGRATE_WITHIN_M = 0.02
 
 
 def _smooth(x: float) -> float:
@@ -108,7 +113,8 @@ class ObjectRecovery(Controller):
         step_s = 0.0 if self.last_time_s is None else time_s - self.last_time_s
         self.last_time_s = time_s
         limit = self.integral_limit_N
-        self.integral_N = np.clip(self.integral_N + self.ix * error_m * step_s, -limit, limit)
+        if np.linalg.norm(error_m) < INTEGRATE_WITHIN_M:  # no wind-up on the long moves
+            self.integral_N = np.clip(self.integral_N + self.ix * error_m * step_s, -limit, limit)
         rotation = pin.Quaternion(q[3:7]).matrix()
         force_world = self.kx * error_m - self.dx * jaw_velocity_world + self.integral_N
         tau = np.zeros(self.nv)

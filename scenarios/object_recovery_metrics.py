@@ -10,8 +10,9 @@ starts with ``basket`` (its footprint: the union of their extents in x and y).
 - ``placed``: 1 when the sample ends inside the basket's footprint (its centre), below the
   basket's rim, and resting (slower than 1 cm/s); 0 otherwise.
 - ``grasp_slipped``: 1 when the sample, once lifted 5 cm clear of its start, moved more than
-  1 cm in the jaw's frame before it came down again (it slid or fell out of the jaw); 0 when
-  it stayed where the jaw held it, or was never lifted.
+  1 cm in the jaw's frame before the jaw began to open (a finger 0.02 rad or 1 mm wider than
+  when the sample came clear) or the sample came down again (it slid or fell out of the
+  jaw); 0 when it stayed where the jaw held it, or was never lifted.
 - ``grasp_slip_m``: the largest such motion [m].
 """
 
@@ -20,6 +21,7 @@ from __future__ import annotations
 import numpy as np
 import pinocchio as pin
 
+from uvms_pin.model.jaw import JawJoints
 from uvms_pin.model.urdf.load import load_uvms
 
 SAMPLE = "sample"
@@ -28,6 +30,7 @@ JAW_FRAME = "alpha_jaw_base_link"
 RESTING_SPEED_M_S = 0.01
 LIFTED_CLEAR_M = 0.05
 SLIP_TOLERANCE_M = 0.01
+OPENING_RAD = 0.02
 
 
 def _world(rollout) -> dict:
@@ -62,28 +65,35 @@ def basket_footprint(world: dict) -> tuple[np.ndarray, np.ndarray, float]:
     return low[:2], high[:2], float(high[2])
 
 
-def _jaw_positions(rollout) -> tuple[np.ndarray, np.ndarray]:
-    """The jaw frame's world position (n, 3) and rotation (n, 3, 3) at each sample."""
+def _jaw_frames(rollout) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The jaw frame's world position (n, 3) and rotation (n, 3, 3) at each sample, and the
+    jaw joints' positions (n, fingers)."""
     uvms = load_uvms(rollout.metadata["model_source"])
     model, data = uvms.model, uvms.model.createData()
     frame = model.getFrameId(JAW_FRAME)
+    q_all = np.asarray(rollout.q)
+    fingers = q_all[:, JawJoints.of(model, None, uvms.source).q_index]
     positions, rotations = [], []
-    for q in np.asarray(rollout.q):
+    for q in q_all:
         pin.framesForwardKinematics(model, data, q)
         placement = data.oMf[frame]
         positions.append(placement.translation.copy())
         rotations.append(placement.rotation.copy())
-    return np.array(positions), np.array(rotations)
+    return np.array(positions), np.array(rotations), fingers
 
 
 def grasp_slip_m(rollout, sample: np.ndarray) -> float:
-    """The largest motion of the sample in the jaw's frame while it is lifted clear [m]."""
+    """The largest motion of the sample in the jaw's frame while it is lifted clear and the
+    jaw has not begun to open [m]."""
     lifted = sample[:, 2] > sample[0, 2] + LIFTED_CLEAR_M
     if not np.any(lifted):
         return 0.0
     first = int(np.argmax(lifted))
-    last = first + int(np.argmin(lifted[first:])) if not np.all(lifted[first:]) else len(lifted)
-    positions, rotations = _jaw_positions(rollout)
+    positions, rotations, fingers = _jaw_frames(rollout)
+    opening = np.any(fingers > fingers[first] + OPENING_RAD, axis=1)
+    held = lifted & ~opening
+    held[:first] = True
+    last = int(np.argmin(held)) if not np.all(held) else len(held)
     in_jaw = np.einsum("nji,nj->ni", rotations, sample[:, :3] - positions)[first:last]
     return float(np.max(np.linalg.norm(in_jaw - in_jaw[0], axis=1)))
 
