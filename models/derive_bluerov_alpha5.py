@@ -31,6 +31,7 @@ Run ``python models/derive_bluerov_alpha5.py --write`` to regenerate the files,
 from __future__ import annotations
 
 import argparse
+import itertools
 import math
 import re
 import sys
@@ -410,7 +411,7 @@ def _finger_pads(mirror: float) -> list[tuple[tuple, float, tuple]]:
     other finger); ``mirror`` -1 for the finger on the -y pivot (y flipped)."""
     pads = []
     edge = ALPHA_FINGER_EDGE_M
-    for (y0, z0), (y1, z1) in zip(edge[:-1], edge[1:], strict=True):
+    for (y0, z0), (y1, z1) in itertools.pairwise(edge):
         length = math.hypot(y1 - y0, z1 - z0)
         uy, uz = (y1 - y0) / length, (z1 - z0) / length
         half = ALPHA_FINGER_PAD_DEPTH_M / 2  # outward normal (uz, -uy): away from the centre

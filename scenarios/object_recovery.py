@@ -34,7 +34,6 @@ import pinocchio as pin
 from uvms_pin.control.base import Controller
 from uvms_pin.errors import ParameterError
 
-
 #: the position error below which the integral acts [m]
 INTEGRATE_WITHIN_M = 0.02
 

@@ -33,7 +33,11 @@ def _grasp(folder: Path, net_weight_N: float, open_rad: float = 0.38, log_period
     weight ``net_weight_N`` below it, the hull free (no controller)."""
     volume = 4.0 / 3.0 * math.pi * RADIUS_M**3
     data = {
-        "scenario": {"name": "alpha5_grasp", "model": str(alpha5_jaw_urdf(folder)), "duration_s": 1.0},
+        "scenario": {
+            "name": "alpha5_grasp",
+            "model": str(alpha5_jaw_urdf(folder)),
+            "duration_s": 1.0,
+        },
         "water": {"free_surface": False},
         "initial": {"position_world_m": [0.0, 0.0, -5.0], "joint_positions_rad": [open_rad] * 2},
         "world": {
@@ -120,7 +124,10 @@ def _still_with_sample(density_kg_m3: float) -> float:
     rollout = up.simulate(up.load_scenario(RECOVERY, overrides=overrides))
     assert rollout.metadata["status"] == "ok"
     last = np.asarray(rollout.time_s) > 7.0
-    forces = [pin.Quaternion(q[3:7]).matrix() @ tau[:3] for q, tau in zip(rollout.q, rollout.tau)]
+    forces = [
+        pin.Quaternion(q[3:7]).matrix() @ tau[:3]
+        for q, tau in zip(rollout.q, rollout.tau, strict=True)
+    ]
     return float(np.mean(np.asarray(forces)[last, 2]))
 
 
