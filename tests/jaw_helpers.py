@@ -37,21 +37,28 @@ def _finger(side: str, sign: float) -> str:
   </joint>"""
 
 
-def parallel_jaw_urdf(folder: Path) -> Path:
-    """Write the vehicle with its parallel jaw to ``folder``; neutrally buoyant, CoG 5 cm
-    below the hull's centre (hydrodynamics derived from the collision boxes)."""
+def _hull_link(jaw_volume_m3: float, jaw_mass_kg: float) -> str:
+    """The hull's base_link, heavy enough that the UVMS with a jaw of this volume and mass
+    is neutrally buoyant, its CoG 5 cm below the hull's centre."""
     hull_volume = HULL_M[0] * HULL_M[1] * HULL_M[2]
-    pad_volume = PAD_M[0] * PAD_M[1] * PAD_M[2]
-    mass = WATER_KG_M3 * (hull_volume + 2 * pad_volume) - 2 * FINGER_MASS_KG
+    mass = WATER_KG_M3 * (hull_volume + jaw_volume_m3) - jaw_mass_kg
     ixx = mass * (HULL_M[1] ** 2 + HULL_M[2] ** 2) / 12
     izz = mass * (HULL_M[0] ** 2 + HULL_M[1] ** 2) / 12
-    text = f"""<?xml version="1.0"?>
-<robot name="parallel_jaw">
+    return f"""
   <link name="base_link">
     <inertial><origin xyz="0 0 -0.05" rpy="0 0 0"/><mass value="{mass}"/>
       <inertia ixx="{ixx}" iyy="{ixx}" izz="{izz}" ixy="0" ixz="0" iyz="0"/></inertial>
     <collision><geometry><box size="{HULL_M[0]} {HULL_M[1]} {HULL_M[2]}"/></geometry></collision>
-  </link>{_finger("left", 1.0)}{_finger("right", -1.0)}
+  </link>"""
+
+
+def parallel_jaw_urdf(folder: Path) -> Path:
+    """Write the vehicle with its parallel jaw to ``folder``; neutrally buoyant, CoG 5 cm
+    below the hull's centre (hydrodynamics derived from the collision boxes)."""
+    pad_volume = PAD_M[0] * PAD_M[1] * PAD_M[2]
+    hull = _hull_link(2 * pad_volume, 2 * FINGER_MASS_KG)
+    text = f"""<?xml version="1.0"?>
+<robot name="parallel_jaw">{hull}{_finger("left", 1.0)}{_finger("right", -1.0)}
 </robot>
 """
     path = Path(folder) / "parallel_jaw.urdf"
@@ -86,17 +93,8 @@ def alpha5_jaw_urdf(folder: Path) -> Path:
     """Write the heavy hull of `parallel_jaw_urdf` with the shipped Alpha 5 jaw below it,
     pointing down (its fingers close along y, their pivot axes along x); neutrally buoyant."""
     fingers, finger_mass, finger_volume = _alpha5_fingers()
-    hull_volume = HULL_M[0] * HULL_M[1] * HULL_M[2]
-    mass = WATER_KG_M3 * (hull_volume + finger_volume) - finger_mass
-    ixx = mass * (HULL_M[1] ** 2 + HULL_M[2] ** 2) / 12
-    izz = mass * (HULL_M[0] ** 2 + HULL_M[1] ** 2) / 12
     text = f"""<?xml version="1.0"?>
-<robot name="alpha5_jaw_rig">
-  <link name="base_link">
-    <inertial><origin xyz="0 0 -0.05" rpy="0 0 0"/><mass value="{mass}"/>
-      <inertia ixx="{ixx}" iyy="{ixx}" izz="{izz}" ixy="0" ixz="0" iyz="0"/></inertial>
-    <collision><geometry><box size="{HULL_M[0]} {HULL_M[1]} {HULL_M[2]}"/></geometry></collision>
-  </link>
+<robot name="alpha5_jaw_rig">{_hull_link(finger_volume, finger_mass)}
   <link name="alpha_jaw_base_link"/>
   <joint name="alpha_jaw_base_joint" type="fixed">
     <parent link="base_link"/><child link="alpha_jaw_base_link"/>
