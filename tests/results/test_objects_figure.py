@@ -9,7 +9,7 @@ import uvms_pin as up
 from uvms_pin.results.figures.objects import objects_figures, plot_objects
 
 
-def test_a_run_with_a_jaw_and_a_ball_gets_heights_and_fingers(tmp_path):
+def test_a_run_with_a_jaw_and_a_rod_gets_heights_and_fingers(tmp_path):
     scenario = up.load_scenario(
         ROOT / "scenarios" / "gripper_close.toml", {"scenario.duration_s": 0.05}
     )
@@ -17,7 +17,7 @@ def test_a_run_with_a_jaw_and_a_ball_gets_heights_and_fingers(tmp_path):
     fig = plot_objects(rollout)
     assert isinstance(fig, Figure) and len(fig.axes) == 2
     heights, fingers = fig.axes
-    assert [line.get_label() for line in heights.get_lines()] == ["ball"]
+    assert [line.get_label() for line in heights.get_lines()] == ["rod"]
     assert len(fingers.get_lines()) == 2  # one per finger, not their grip forces
     (path,) = objects_figures(rollout, tmp_path)
     assert path == tmp_path / "objects.png" and path.stat().st_size > 1000
