@@ -74,7 +74,9 @@ def _hook_columns(table, axis: str) -> list[str]:
 def test_the_hooks_hold_a_ball_below_2_mu_n_and_let_it_slip_beyond(tmp_path):
     # held: the normal force N each hook presses with, measured; the ball's net weight 95 %
     # of what the two hooks' friction can carry
-    normal_N = 1.49  # about F r / (the contact's arm), r = 45.7 mm, the arm 66 mm
+    # about the pivot: F r = 0.091 N m (r = 45.7 mm), the finger's net weight 0.004 N m and
+    # the friction 0.003 N m, over the contact's 66 mm arm
+    normal_N = 1.49
     weight_N = 0.95 * 2 * MU * normal_N
     _, table = _grasp(tmp_path, weight_N)
     t = np.asarray(table.index, dtype=float)
