@@ -39,7 +39,7 @@ def test_a_grip_too_weak_for_the_sample_leaves_it_on_the_seabed():
     # (2000 - 1025) kg/m^3 x 0.39 L x g = 3.8 N
     volume_m3 = math.pi * 0.025**2 * 0.2
     assert (2000.0 - 1025.0) * volume_m3 * 9.81 > 2 * 0.6 * 0.5 * 3
-    metrics = _metrics(**{"gripper.max_force_N": 0.5, "scenario.duration_s": 16.0})
+    metrics = _metrics(**{"controller.grip_N": 0.5, "scenario.duration_s": 16.0})
     assert metrics["sample_lifted_m"] < 0.05
     assert metrics["placed"] == 0.0
     assert metrics["sample_final_x_m"] == pytest.approx(1.0, abs=0.05)

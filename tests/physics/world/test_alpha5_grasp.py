@@ -115,10 +115,11 @@ def _still_with_sample(density_kg_m3: float) -> float:
     0.2 m) held in the jaw from the start."""
     overrides = {
         "scenario.duration_s": 8.0,
-        "gripper.close_at_s": 0.0,
-        "initial.joint_positions_rad": [0.0, 0.1, 3.2, 0.0, 0.46, 0.46],
-        # 80 mm out from the jaw's base, between the open fingers; the jaw where it starts
-        "world.objects[1].position_world_m": [0.3085, -0.1096, -9.7693],
+        "controller.jaw_close_at_s": 0.0,
+        "controller.jaw_speed_rad_s": 5.0,  # from 0.5 to 0.45 rad (where they start) in 10 ms
+        "initial.joint_positions_rad": [0.0, 0.1, 3.2, 0.0, 0.45, 0.45],
+        # 68 mm out from the jaw's base, between the open fingers; the jaw where it starts
+        "world.objects[1].position_world_m": [0.3085, -0.1096, -9.7573],
         "world.objects[1].density_kg_m3": density_kg_m3,
         "controller.waypoints_world_m": [[0.3085, -0.1096, -9.6893]],
         "controller.phase_durations_s": [1.0],
