@@ -307,9 +307,9 @@ def water_of(current_world_m_s: np.ndarray, flow: FlowField | None) -> FlowField
 
 
 def has_moving_contacts(world: World | None) -> bool:
-    """A world in which more than the robot moves (free objects) or the arm can hit its own
-    vehicle: its contacts are the system of bodies' (`uvms_pin.sim.system`)."""
-    return world is not None and bool(world.free or world.self_collision)
+    """A world in which more than the robot moves (free objects, fixtures with joints) or the
+    arm can hit its own vehicle: its contacts are the system of bodies' (`uvms_pin.sim.system`)."""
+    return world is not None and bool(world.free or world.fixtures or world.self_collision)
 
 
 def checked_start(
