@@ -112,4 +112,4 @@ def test_the_valve_panel_scenario_runs_stable_at_its_step():
     table = rollout.to_dataframe()
     assert np.all(np.isfinite(rollout.q)) and np.max(np.abs(rollout.v)) < 1.0
     np.testing.assert_allclose(table["panel.valve_rad"], 0.0, atol=1e-9)
-    assert "fixture" in rollout.metadata["world"]["integration"]
+    assert "fixture" in rollout.metadata["world"]["world"]["integration"]

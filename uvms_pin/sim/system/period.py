@@ -197,7 +197,8 @@ def _end(
 ) -> tuple[np.ndarray, np.ndarray]:
     """(q, v) at the period's end: a body some solved row acts on moves from its q0 with v+
     (the robot by `constrained_configuration`, q0 (+) h v+; a free object by
-    `free_body_configuration`, its body velocity then expressed at its new pose); a body no
+    `free_body_configuration`, its body velocity then expressed at its new pose; a fixture's
+    revolute and prismatic joints by q0 + h v+); a body no
     row acts on keeps the smooth step's end ``smooth`` = (q_free, v_free) (all of them when
     nothing was solved)."""
     q_free, v_free = smooth

@@ -1,12 +1,15 @@
-"""A system of bodies: the robot and the free objects of its world, stepped together.
+"""A system of bodies: the robot, the free objects and the fixtures of its world, stepped
+together.
 
-The state stacks the robot's (q, zeta) and each free object's (pose (7,), body velocity (6,))
-(`SystemState`, `Layout`); its configuration space is that of a Pinocchio model made of the
-robot's joints and one free-flyer per object (used to integrate on the manifold, so that
-every integrator steps the whole system with its own rules). The right-hand side is
+The state stacks the robot's (q, zeta), each free object's (pose (7,), body velocity (6,))
+and each fixture's joints (q_f, qd_f) (`SystemState`, `Layout`); its configuration space is
+that of a Pinocchio model made of the robot's joints, one free-flyer per object and the
+fixtures' joints (used to integrate on the manifold, so that every integrator steps the
+whole system with its own rules). The right-hand side is
 
     zeta_dot   = FD_robot(q, zeta, tau + tau_contact,robot)
     nu_dot_o   = FD_o(q_o, nu_o, tau_contact,o)                 (each object o)
+    qdd_f      = FD_f(q_f, qd_f, -D_f qd_f + tau_contact,f)     (each fixture f)
 
 with every contact force between two moving bodies exchanged equal and opposite
 (`uvms_pin.physics.world.moving`) and the water (current, waves, free surface) the same for
@@ -64,13 +67,16 @@ def _system_model(robot: pin.Model, n_objects: int) -> pin.Model:
 
 
 class System:
-    """The robot ``plant`` and its world's free objects.
+    """The robot ``plant`` and its world's free objects and fixtures.
 
     Attributes:
         plant: the robot in its water, with its environment and fixed world.
         moving: the moving contacts (`FreeObjects`), None when only the robot moves and its
             arm does not meet its vehicle.
         objects: the free objects (`uvms_pin.physics.world.FreeObject`), possibly none.
+        fixtures: the fixtures (`uvms_pin.physics.world.fixture.Fixture`), after the objects
+            in the state; fixture_constraints, fixture_blocks: their joints' limits and
+            friction, and each one's part of v and its joints (`sim.system.fixtures`).
         layout: where each body sits in the state. model: the system's Pinocchio model.
         compiled_allowed: the period of a system with free objects may be one compiled call
             (`uvms_pin.sim.system.period`); False: the Python integrator steps it.
