@@ -54,3 +54,24 @@ def lever_urdf(
     path = folder / f"{name}.urdf"
     path.write_text(text)
     return path
+
+
+def double_lever_urdf(folder: Path, *, friction_Nm: float) -> Path:
+    """``lever_urdf``'s lever with a second lever on its end (joint ``elbow``, about y, at
+    LEVER_ARM_M), both with the Coulomb friction ``friction_Nm``: two coupled joints."""
+    path = lever_urdf(folder, friction_Nm=friction_Nm, name="double")
+    d, m = LEVER_ARM_M, LEVER_MASS_KG
+    second = f"""  <joint name="elbow" type="revolute">
+    <parent link="lever"/><child link="tip"/>
+    <origin xyz="{d!r} 0 0"/><axis xyz="0 1 0"/>
+    <limit lower="-1.0" upper="1.0" effort="100" velocity="10"/>
+    <dynamics damping="0.0" friction="{friction_Nm!r}"/>
+  </joint>
+  <link name="tip">
+    <inertial><origin xyz="{d!r} 0 0"/><mass value="{m!r}"/>
+      <inertia ixx="1e-4" iyy="1e-4" izz="1e-4" ixy="0" ixz="0" iyz="0"/></inertial>
+  </link>
+</robot>
+"""
+    path.write_text(path.read_text().replace("</robot>\n", second))
+    return path

@@ -8,7 +8,14 @@ from __future__ import annotations
 import numpy as np
 import pinocchio as pin
 import pytest
-from fixture_helpers import LEVER_ARM_M, LEVER_MASS_KG, LEVER_OWN_IYY, VALVE, lever_urdf
+from fixture_helpers import (
+    LEVER_ARM_M,
+    LEVER_MASS_KG,
+    LEVER_OWN_IYY,
+    VALVE,
+    double_lever_urdf,
+    lever_urdf,
+)
 
 from uvms_pin.physics.world.fixture import fixture
 from uvms_pin.physics.world.free_object import free_object
@@ -67,6 +74,16 @@ def test_a_joint_loaded_above_its_friction_turns_at_tau_minus_c_over_i(reference
     assert measured == pytest.approx(expected, rel=0.02)
     # and the angle is the integral of that acceleration
     assert q[-1, 0] == pytest.approx(0.5 * expected * 0.1**2, rel=0.02)
+
+
+def test_a_fixture_of_two_joints_holds_below_their_friction(reference_uvms, tmp_path):
+    """Two coupled joints go through the iterative solver (not the single joint's exact
+    step), to a tolerance scaled by their inverse inertias: no creep beyond 1e-9 rad."""
+    path = double_lever_urdf(tmp_path, friction_Nm=3.3 * TORQUE_NM)  # the hinge carries 3 m g d
+    double = fixture("double", path, ([0.0, 0.0, -5.0], [0.0, 0.0, 0.0]), water_density_kg_m3=RHO)
+    assert double.joint_names == ("hinge", "elbow")
+    q, v = _run(_system(reference_uvms, [double]), reference_uvms, 0.5)
+    assert np.max(np.abs(q - q[0])) < 1e-9 and np.max(np.abs(v)) < 1e-8
 
 
 def _energy(lever, q: np.ndarray, v: np.ndarray) -> float:

@@ -26,8 +26,8 @@ import pinocchio as pin
 from uvms_pin.physics.constraints.joint_friction import JointCoulombFriction
 from uvms_pin.physics.constraints.joint_limits import JointLimits
 from uvms_pin.physics.constraints.rows import JOINT_IMPULSE_UNIT, ConstraintRows
-from uvms_pin.physics.constraints.single_joint import single_joint_step
-from uvms_pin.physics.constraints.step import ConstrainedVelocity, default_settings
+from uvms_pin.physics.constraints.joint_box import joint_box_step
+from uvms_pin.physics.constraints.step import ConstrainedVelocity
 from uvms_pin.physics.dynamics import forward_dynamics
 from uvms_pin.physics.world.fixture import Fixture
 
@@ -36,7 +36,6 @@ __all__ = [
     "FIXTURE_FRICTION",
     "FIXTURE_JOINTS",
     "FIXTURE_LIMITS",
-    "STICKING_RATE",
     "accelerations",
     "blocks",
     "constraints",
@@ -47,13 +46,6 @@ __all__ = [
 
 #: why a system with a fixture is not one compiled call a period
 COMPILED_REFUSAL = "a fixture with joints (type = \"urdf\"): the compiled system holds free objects only"
-
-#: the rate [rad/s or m/s] a sticking fixture joint may keep after the solve: the ADMM
-#: solver's tolerance is on its residual sigma - G lambda, which leaves a joint of inverse
-#: inertia G a rate error of about G times it (a valve handle of 6.6e-3 kg m^2: 150 times)
-STICKING_RATE = 1.0e-10
-#: the iterations the tight solve may take (a plain stick: about 40)
-TIGHT_ITERATIONS = 300
 
 #: the names of the fixtures' constraint sets (their impulses in a solved period)
 FIXTURE_LIMITS, FIXTURE_FRICTION = "fixture_limits", "fixture_friction"
@@ -161,80 +153,57 @@ def with_fixtures(
     **kw,
 ) -> ConstrainedVelocity:
     """The period's constraint step (``solve``: `step.constrained_velocity`, its arguments
-    after ``blocks``) with the fixtures' joints: their rows act on their own coordinates
-    only (the bodies meet through smooth contact forces; M is block diagonal), so the
-    others' sets (``sets`` but ``fixture_sets``) are solved as without fixtures, and each
-    fixture of one joint (``blocks``: its part of v and its system joints) by its exact
-    step (`single_joint_step`: no creep below its friction, the friction and a limit on one
-    coordinate no harder); the fixtures of several joints by the solver, to the tolerance
-    `STICKING_RATE` / max_j G_jj (`_held`)."""
+    after ``blocks``) with the fixtures' joints: their rows (friction and limits) act on
+    their own coordinates only (the bodies meet through smooth contact forces; M is block
+    diagonal over the bodies), so the other sets (``sets`` but ``fixture_sets``) are
+    solved as without fixtures, and each fixture's joints (``blocks``: its part of v and
+    its system joints) by their exact step (`joint_box_step`: no creep below their
+    friction; a joint's friction and its limit on one coordinate no harder than either)."""
     others = [c for c in sets if all(c is not f for f in fixture_sets)]
-    single = all(len(joints) <= 1 for _, joints in blocks)
-    if not single:
-        return _held(solve, mass_matrix, [p for p, _ in blocks], model, mass_matrix, v_free, q,
-                     sets, period_s, **kw)  # fmt: skip
     out = solve(model, mass_matrix, v_free, q, others, period_s, **kw)
-    return _joined(out, _single_joints(fixture_sets, blocks, model, mass_matrix, v_free, q,
-                                       period_s))  # fmt: skip
-
-
-def _single_joints(fixture_sets, blocks, model, mass_matrix, v_free, q, period_s):
-    """(system joint, its velocity index, v+, the friction's and the limits' impulses) of
-    each fixture joint some friction or a reachable limit acts on (`single_joint_step`)."""
     limits = next((c for c in fixture_sets if isinstance(c, JointLimits)), None)
     friction = next((c for c in fixture_sets if isinstance(c, JointCoulombFriction)), None)
     rubbing = {} if friction is None else dict(zip(friction.joint_ids, friction.coulomb_Nm))
     limited = () if limits is None else limits.joint_ids
-    out = []
+    steps = []
     for part, joints in blocks:
         if not joints:
             continue  # a fixture without a moving joint
-        joint = joints[0]
-        at = model.joints[joint].idx_q
-        gaps = (q[at] - model.lowerPositionLimit[at], model.upperPositionLimit[at] - q[at])
-        if joint not in limited:
-            gaps = (np.inf, np.inf)
-        k = part.start
-        step = single_joint_step(float(v_free[k]), float(mass_matrix[k, k]),
-                                 float(rubbing.get(joint, 0.0)), gaps, period_s)  # fmt: skip
-        if joint in rubbing or step.limit_impulse != 0.0:
-            out.append((joint, k, step))
-    return out
+        at = np.array([model.joints[j].idx_q for j in joints])
+        lower = np.where([j in limited for j in joints], q[at] - model.lowerPositionLimit[at], np.inf)
+        upper = np.where([j in limited for j in joints], model.upperPositionLimit[at] - q[at], np.inf)
+        coulomb = np.array([rubbing.get(j, 0.0) for j in joints])
+        step = joint_box_step(v_free[part], mass_matrix[part, part], coulomb, (lower, upper),
+                              period_s)  # fmt: skip
+        steps += [
+            (joint, part.start + i, step.velocity[i], step.friction_impulse[i],
+             step.limit_impulse[i])
+            for i, joint in enumerate(joints)
+            if joint in rubbing or step.limit_impulse[i] != 0.0
+        ]  # fmt: skip
+    return _joined(out, steps)
 
 
 def _joined(out: ConstrainedVelocity, joints: list) -> ConstrainedVelocity:
-    """``out`` with the fixture joints' exact steps: their rates, impulses (the set
-    `FIXTURE_JOINTS`: friction and limit per joint, one row each) and rows (e_j, acting on
-    the joint: its body moves from q0 with v+)."""
+    """``out`` with the fixture joints' exact steps, each (system joint, velocity index, v+,
+    friction impulse, limit impulse): their rates, impulses (the set `FIXTURE_JOINTS`: the
+    friction's and the limits' per joint) and rows (e_j: the joint's body moves from q0
+    with v+)."""
     if not joints:
         return out
     velocity, generalized = out.velocity.copy(), out.generalized_impulse.copy()
-    nv = velocity.size
-    jacobian, impulses = np.zeros((len(joints), nv)), np.zeros((len(joints), 2))
-    for row, (_, k, step) in enumerate(joints):
-        velocity[k] = step.velocity
-        generalized[k] += step.friction_impulse + step.limit_impulse
+    jacobian, impulses = np.zeros((len(joints), velocity.size)), np.zeros((len(joints), 2))
+    for row, (_, k, rate, friction, limit) in enumerate(joints):
+        velocity[k] = rate
+        generalized[k] += friction + limit
         jacobian[row, k] = 1.0
-        impulses[row] = (step.friction_impulse, step.limit_impulse)
+        impulses[row] = (friction, limit)
     rows = ConstraintRows(
         FIXTURE_JOINTS, JOINT_IMPULSE_UNIT, (), (), jacobian, np.zeros(len(joints)),
-        np.zeros(len(joints), dtype=bool), tuple(f"joint {j}" for j, _, _ in joints),
+        np.zeros(len(joints), dtype=bool), tuple(f"joint {j[0]}" for j in joints),
     )  # fmt: skip
     return dataclasses.replace(
         out, velocity=velocity, generalized_impulse=generalized, rows=(*out.rows, rows),
         impulses={**out.impulses, FIXTURE_JOINTS: impulses.reshape(-1)},
         units={**out.units, FIXTURE_JOINTS: JOINT_IMPULSE_UNIT},
     )  # fmt: skip
-
-
-def _held(solve, mass_matrix: np.ndarray, v_slices, *args, **kw) -> ConstrainedVelocity:
-    """``solve`` to the tolerance `STICKING_RATE` / max_j G_jj, G_jj = (M^-1)_jj each
-    fixture joint's inverse inertia (``v_slices``: the fixtures' parts of v), so that a
-    joint held by stiction keeps no rate beyond `STICKING_RATE` (not the default
-    tolerance's 1e-8 G); a period that does not reach it in `TIGHT_ITERATIONS` (a joint at
-    its limit and held by its friction: two rows on one coordinate) is the default's."""
-    inverse = [np.diag(np.linalg.inv(mass_matrix[p, p])) for p in v_slices if p.stop > p.start]
-    largest = max((float(np.max(g)) for g in inverse), default=1.0)
-    tolerance = min(1.0e-8, STICKING_RATE / max(largest, 1.0))
-    tight = solve(*args, settings=default_settings(tolerance, TIGHT_ITERATIONS), **kw)
-    return tight if tight.converged else solve(*args, **kw)
