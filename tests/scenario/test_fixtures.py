@@ -102,7 +102,7 @@ def test_no_code_judges_a_fixtures_file_as_its_reader_finds_it(tmp_path):
     outside = tmp_path.parent / "elsewhere.urdf"
     outside.write_text("<robot/>")
     raw["world"]["objects"][0]["path"] = "../elsewhere.urdf"
-    with pytest.raises(ScenarioError, match="world.objects\\[0\\].path"):
+    with pytest.raises(ScenarioError, match=r"world\.objects\[0\]\.path"):
         check_no_code(raw, tmp_path / "s.toml")
 
 

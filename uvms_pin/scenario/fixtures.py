@@ -66,5 +66,7 @@ def _joint_positions(t: Table) -> Any:
         return None
     values = list(raw.values()) if isinstance(raw, dict) else raw
     if not isinstance(values, list) or not all(is_number(v) for v in values):
-        raise t.error(key, f"must be a table joint name -> number or a list of numbers, got {raw!r}")
+        raise t.error(
+            key, f"must be a table joint name -> number or a list of numbers, got {raw!r}"
+        )
     return {str(k): float(v) for k, v in raw.items()} if isinstance(raw, dict) else values

@@ -38,9 +38,7 @@ def test_the_valve_is_placed_where_its_scenario_puts_it_with_its_urdf_joint():
 
 
 def test_joint_positions_by_name_or_in_order_within_the_limits(tmp_path):
-    valve = fixture(
-        "panel", VALVE, POSE, joint_positions={"valve": 0.4}, water_density_kg_m3=RHO
-    )
+    valve = fixture("panel", VALVE, POSE, joint_positions={"valve": 0.4}, water_density_kg_m3=RHO)
     np.testing.assert_allclose(valve.q0, [0.4])
     assert fixture("p", VALVE, POSE, joint_positions=[1.2], water_density_kg_m3=RHO).q0 == 1.2
     assert valve.signal(np.array([0.3])).components == ("valve",)

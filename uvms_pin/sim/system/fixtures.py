@@ -23,10 +23,10 @@ from collections.abc import Callable, Sequence
 import numpy as np
 import pinocchio as pin
 
+from uvms_pin.physics.constraints.joint_box import joint_box_step
 from uvms_pin.physics.constraints.joint_friction import JointCoulombFriction
 from uvms_pin.physics.constraints.joint_limits import JointLimits
 from uvms_pin.physics.constraints.rows import JOINT_IMPULSE_UNIT, ConstraintRows
-from uvms_pin.physics.constraints.joint_box import joint_box_step
 from uvms_pin.physics.constraints.step import ConstrainedVelocity
 from uvms_pin.physics.dynamics import forward_dynamics
 from uvms_pin.physics.world.fixture import Fixture
@@ -45,7 +45,9 @@ __all__ = [
 ]
 
 #: why a system with a fixture is not one compiled call a period
-COMPILED_REFUSAL = "a fixture with joints (type = \"urdf\"): the compiled system holds free objects only"
+COMPILED_REFUSAL = (
+    'a fixture with joints (type = "urdf"): the compiled system holds free objects only'
+)
 
 #: the names of the fixtures' constraint sets (their impulses in a solved period)
 FIXTURE_LIMITS, FIXTURE_FRICTION = "fixture_limits", "fixture_friction"
@@ -132,12 +134,9 @@ def accelerations(
     friction -D qd_f (`Fixture.viscous_torque`); ``water``: the keyword arguments of
     `forward_dynamics` (flow, time, backend, free surface)."""
     return [
-        forward_dynamics(
-            f.uvms, q, v, f.viscous_torque(v), tau_ext=tau, **water
-        )
+        forward_dynamics(f.uvms, q, v, f.viscous_torque(v), tau_ext=tau, **water)
         for f, (q, v), tau in zip(fixtures, states, contact_torques, strict=True)
     ]
-
 
 
 def with_fixtures(
@@ -163,15 +162,21 @@ def with_fixtures(
     out = solve(model, mass_matrix, v_free, q, others, period_s, **kw)
     limits = next((c for c in fixture_sets if isinstance(c, JointLimits)), None)
     friction = next((c for c in fixture_sets if isinstance(c, JointCoulombFriction)), None)
-    rubbing = {} if friction is None else dict(zip(friction.joint_ids, friction.coulomb_Nm))
+    rubbing = (
+        {} if friction is None else dict(zip(friction.joint_ids, friction.coulomb_Nm, strict=True))
+    )
     limited = () if limits is None else limits.joint_ids
     steps = []
     for part, joints in blocks:
         if not joints:
             continue  # a fixture without a moving joint
         at = np.array([model.joints[j].idx_q for j in joints])
-        lower = np.where([j in limited for j in joints], q[at] - model.lowerPositionLimit[at], np.inf)
-        upper = np.where([j in limited for j in joints], model.upperPositionLimit[at] - q[at], np.inf)
+        lower = np.where(
+            [j in limited for j in joints], q[at] - model.lowerPositionLimit[at], np.inf
+        )
+        upper = np.where(
+            [j in limited for j in joints], model.upperPositionLimit[at] - q[at], np.inf
+        )
         coulomb = np.array([rubbing.get(j, 0.0) for j in joints])
         step = joint_box_step(v_free[part], mass_matrix[part, part], coulomb, (lower, upper),
                               period_s)  # fmt: skip
