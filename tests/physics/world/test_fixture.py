@@ -4,6 +4,7 @@ on the joints that carry them, and the refusals naming the file and the key."""
 
 from __future__ import annotations
 
+import coal
 import numpy as np
 import pinocchio as pin
 import pytest
@@ -69,3 +70,30 @@ def test_bad_input_is_refused_naming_the_key_and_the_file(tmp_path):
     with pytest.raises(ParameterError, match="'hinge' is floating") as refused:
         fixture("lever", floating, POSE, water_density_kg_m3=RHO)
     assert refused.value.key == "path" and str(floating) in str(refused.value)
+
+
+def test_the_receptacles_bore_leaves_a_25_mm_stab_its_clearance():
+    """A 25 mm stab on the bore's axis clears every wall by 1.5 mm (the flats), a 28.5 mm
+    one touches them; the chamfer's mouth takes a stab 10 mm off the axis."""
+    receptacle = fixture("receptacle", RECEPTACLE, ([0, 0, 0], [0, 0, 0]), water_density_kg_m3=RHO)
+
+    def clearance_m(radius_m: float, offset_m: float = 0.0, x_m: float = -0.075) -> float:
+        stab = coal.Cylinder(radius_m, 0.1)
+        along_x = pin.SE3(pin.rpy.rpyToMatrix(0.0, np.pi / 2, 0.0), np.array([x_m, offset_m, 0]))
+        request, distances = coal.DistanceRequest(), []
+        for piece in receptacle.pieces:
+            result = coal.DistanceResult()
+            where = piece.placement_in_joint
+            coal.distance(
+                stab, coal.Transform3s(along_x.rotation, along_x.translation),
+                piece.shape, coal.Transform3s(where.rotation, where.translation),
+                request, result,
+            )  # fmt: skip
+            distances.append(result.min_distance)
+        return min(distances)
+
+    assert clearance_m(0.0125) == pytest.approx(0.0015, abs=1e-6)
+    assert clearance_m(0.01425) < 0.0
+    # 10 mm off the axis, just in front of the mouth: the chamfer, not the wall's end, is hit
+    assert clearance_m(0.0125, offset_m=0.010, x_m=0.055) < 0.0  # its end 5 mm out
+    assert clearance_m(0.0125, offset_m=0.010, x_m=0.08) > 0.0
