@@ -17,6 +17,8 @@ from fixture_helpers import (
     lever_urdf,
 )
 
+from uvms_pin.physics.constraints.joint_limits import JointLimits
+from uvms_pin.physics.constraints.step import constrained_velocity
 from uvms_pin.physics.world.fixture import fixture
 from uvms_pin.physics.world.free_object import free_object
 from uvms_pin.physics.world.world import World
@@ -139,3 +141,22 @@ def test_the_fixtures_are_logged_and_said_to_be_integrated_in_python(reference_u
     assert fixtures.COMPILED_REFUSAL in record["world"]["integration"]
     assert record["world"]["fixtures"][0]["joints"] == ["valve"]
     assert system.n_logged_columns == 9 * len(system.contact_pair_names) + 1
+
+
+def test_a_fixture_touched_by_another_sets_row_is_solved_with_it(tmp_path):
+    """A row of another set on a fixture's joint (as a rigid contact with the robot would
+    be) joins everything into the one solve: the fixture is then not solved apart."""
+    lever = _lever(tmp_path, friction_Nm=0.5, limits=(-0.1, 0.2))
+    model = fixtures.system_model(pin.Model(), [lever])
+    own = fixtures.constraints(1, [lever])
+    other = JointLimits((1,), name="other")  # on the fixture's joint, not the fixture's set
+    q, v_free, h = np.array([0.2]), np.array([3.0]), PERIOD_S
+    mass = lever.uvms.model.inertias[1].mass * LEVER_ARM_M**2 + LEVER_OWN_IYY
+    blocks = fixtures.blocks(1, 0, [lever])
+    args = (model, np.array([[mass]]), v_free, q)
+    apart = fixtures.with_fixtures(constrained_velocity, own, blocks, *args, own, h)
+    assert any(b.name == fixtures.FIXTURE_JOINTS for b in apart.rows) and apart.velocity[0] == 0.0
+    together = fixtures.with_fixtures(constrained_velocity, own, blocks, *args, (*own, other), h)
+    expected = constrained_velocity(*args, (*own, other), h)
+    assert {b.name for b in together.rows} == {b.name for b in expected.rows}
+    np.testing.assert_array_equal(together.velocity, expected.velocity)

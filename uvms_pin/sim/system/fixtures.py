@@ -157,9 +157,13 @@ def with_fixtures(
     diagonal over the bodies), so the other sets (``sets`` but ``fixture_sets``) are
     solved as without fixtures, and each fixture's joints (``blocks``: its part of v and
     its system joints) by their exact step (`joint_box_step`: no creep below their
-    friction; a joint's friction and its limit on one coordinate no harder than either)."""
+    friction; a joint's friction and its limit on one coordinate no harder than either).
+    When a row of the other sets acts on a fixture (a rigid contact between a robot's link
+    and a fixture's), everything is solved at once by ``solve``."""
     others = [c for c in sets if all(c is not f for f in fixture_sets)]
     out = solve(model, mass_matrix, v_free, q, others, period_s, **kw)
+    if _touches_fixtures(out, blocks):  # a row of another set on a fixture (a rigid contact)
+        return solve(model, mass_matrix, v_free, q, sets, period_s, **kw)  # all in one solve
     limits = next((c for c in fixture_sets if isinstance(c, JointLimits)), None)
     friction = next((c for c in fixture_sets if isinstance(c, JointCoulombFriction)), None)
     rubbing = (
@@ -187,6 +191,13 @@ def with_fixtures(
             if joint in rubbing or step.limit_impulse[i] != 0.0
         ]  # fmt: skip
     return _joined(out, steps)
+
+
+def _touches_fixtures(out: ConstrainedVelocity, blocks) -> bool:
+    """Some row ``out`` solved acts on a fixture's coordinates: the fixtures' joints are
+    then not apart from the other constraints."""
+    columns = [k for part, _ in blocks for k in range(part.start, part.stop)]
+    return bool(columns) and any(np.any(b.jacobian[:, columns] != 0.0) for b in out.rows)
 
 
 def _joined(out: ConstrainedVelocity, joints: list) -> ConstrainedVelocity:
