@@ -22,11 +22,13 @@ def lever_urdf(
     limits: tuple[float, float] = (-1.0, 1.0),
     joint_type: str = "revolute",
     name: str = "lever",
+    volume_m3: float = 0.0,
 ) -> Path:
     """A URDF: a fixed ``base`` and a ``lever`` on the revolute joint ``hinge`` about y,
     its mass LEVER_MASS_KG at LEVER_ARM_M along x: at q = 0 its weight is a torque
     m g d about +y (q grows as it falls), its inertia about the axis m d^2 + LEVER_OWN_IYY.
-    Dry (no <hydrodynamics>): its weight alone acts."""
+    Dry (no <hydrodynamics>): its weight alone acts; with ``volume_m3`` > 0 its lever has a
+    <hydrodynamics> element of that volume, buoyant at its mass."""
     m, d, iyy = LEVER_MASS_KG, LEVER_ARM_M, LEVER_OWN_IYY
     limit = (
         f'<limit lower="{limits[0]!r}" upper="{limits[1]!r}" effort="100" velocity="10"/>'
@@ -51,6 +53,12 @@ def lever_urdf(
   </link>
 </robot>
 """
+    if volume_m3 > 0.0:
+        hydro = (
+            f'<hydrodynamics><volume value="{volume_m3!r}"/>'
+            f'<center_of_buoyancy xyz="{d!r} 0 0"/></hydrodynamics>'
+        )
+        text = text.replace("</link>\n</robot>", f"  {hydro}\n  </link>\n</robot>")
     path = folder / f"{name}.urdf"
     path.write_text(text)
     return path

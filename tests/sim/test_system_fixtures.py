@@ -88,6 +88,18 @@ def test_a_fixture_of_two_joints_holds_below_their_friction(reference_uvms, tmp_
     assert np.max(np.abs(q - q[0])) < 1e-9 and np.max(np.abs(v)) < 1e-8
 
 
+def test_a_links_hydrodynamics_element_gives_it_buoyancy(reference_uvms, tmp_path):
+    """A <hydrodynamics> element is read (its buoyancy lightens the lever: half its weight
+    held by a friction the dry lever turns through); a dry link has none derived from its
+    shapes (the slip above would be 17 % slow with its collision box's buoyancy)."""
+    c = 0.95 * TORQUE_NM
+    buoyant = _lever(tmp_path, friction_Nm=c, volume_m3=0.5 * LEVER_MASS_KG / RHO)
+    q, _ = _run(_system(reference_uvms, [buoyant]), reference_uvms, 0.2)
+    assert np.max(np.abs(q)) == 0.0
+    q_dry, _ = _run(_system(reference_uvms, [_lever(tmp_path, friction_Nm=c)]), reference_uvms, 0.2)
+    assert q_dry[-1, 0] > 1e-3
+
+
 def _energy(lever, q: np.ndarray, v: np.ndarray) -> float:
     model = lever.uvms.model
     data = model.createData()
