@@ -47,15 +47,18 @@ COMPILED_PATH = (
 )
 #: ... or integrated in Python, and why
 PYTHON_PATH = (
-    "free objects: the system (UVMS and objects) is integrated by the Python integrator "
+    "{bodies}: the system (UVMS and {others}) is integrated by the Python integrator "
     "around the compiled dynamics ({reason})"
 )
 
 
-def integration_path(reason: str | None) -> str:
-    """What a world record says of a run with free objects whose compiled period is
-    refused for ``reason`` (None: compiled)."""
-    return COMPILED_PATH if reason is None else PYTHON_PATH.format(reason=reason)
+def integration_path(reason: str | None, fixtures_only: bool = False) -> str:
+    """What a world record says of a run with free objects (or only fixtures:
+    ``fixtures_only``) whose compiled period is refused for ``reason`` (None: compiled)."""
+    if reason is None:
+        return COMPILED_PATH
+    bodies, others = ("fixtures", "fixtures") if fixtures_only else ("free objects", "objects")
+    return PYTHON_PATH.format(bodies=bodies, others=others, reason=reason)
 
 
 def _system_model(robot: pin.Model, n_objects: int) -> pin.Model:
@@ -262,7 +265,7 @@ class System:
                 **out["world"],
                 "pairs": self.contact_pair_names,
                 "object_pairs": self.moving.moving.object_pair_names,
-                **({"integration": integration_path(reason)} if several else {}),
+                **({"integration": integration_path(reason, not self.objects)} if several else {}),
             }
             if self.objects:
                 out["world"]["initial_overlap"] = {
