@@ -97,3 +97,13 @@ def test_the_receptacles_bore_leaves_a_25_mm_stab_its_clearance():
     # 10 mm off the axis, just in front of the mouth: the chamfer, not the wall's end, is hit
     assert clearance_m(0.0125, offset_m=0.010, x_m=0.055) < 0.0  # its end 5 mm out
     assert clearance_m(0.0125, offset_m=0.010, x_m=0.08) > 0.0
+
+
+def test_a_prismatic_joint_is_logged_in_metres(tmp_path):
+    latch = fixture(
+        "latch", lever_urdf(tmp_path, friction_Nm=1.0, joint_type="prismatic"), POSE,
+        joint_positions={"hinge": 0.05}, water_density_kg_m3=RHO,
+    )  # fmt: skip
+    assert latch.joint_units == ("m",)
+    signal = latch.signal(latch.q0)
+    assert signal.components == ("hinge",) and signal.units == ("m",) and signal.values[0] == 0.05
