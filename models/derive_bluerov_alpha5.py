@@ -16,7 +16,9 @@ Every number below is an input with its source (models/README.md, sections 7-9, 
 - R26: Reach Robotics, github.com/Reach-Robotics/reach_robotics_sdk, commit 935ba1e1,
   ``ROS2/reach_alpha_description/urdf/alpha_5.urdf.xacro`` and
   ``urdf/end_effectors/standard_jaws.urdf.xacro`` (the jaw: its base 99.75 mm along the
-  wrist axis, two revolute fingers, their pivots, axes, travel, effort, collision boxes).
+  wrist axis, two revolute fingers, their pivots, axes, travel, effort), and the fingers'
+  meshes ``meshes/end_effectors/RS1-130.stl``, ``RS1-139.stl``, measured here (the inner
+  edge's profile, the width, the volume; no mesh is copied): the collision shapes.
 - P25: Evan Palmer, github.com/Robotic-Decision-Making-Lab/reach, commit 5e37b9df,
   ``reach_description/description/alpha_5/standard_jaws/standard_jaws.urdf.xacro`` (the
   fingers' masses). Both files are under Reach Robotics' licence (use with their products
@@ -29,6 +31,7 @@ Run ``python models/derive_bluerov_alpha5.py --write`` to regenerate the files,
 from __future__ import annotations
 
 import argparse
+import itertools
 import math
 import re
 import sys
@@ -158,8 +161,27 @@ ALPHA_FINGERS = (
         (0.0, 0.008, 0.045),
     ),
 )
-ALPHA_FINGER_BOX_M = (0.012, 0.03, 0.09)  # collision box x y z (R26)
-ALPHA_FINGER_MASS_KG = 0.055  # P25; inertia: the uniform box's
+ALPHA_FINGER_BOX_M = (0.012, 0.03, 0.09)  # R26's collision box x y z: mass properties only
+ALPHA_FINGER_MASS_KG = 0.055  # P25; at R26's box centre, inertia: the uniform box's
+# The fingers' collision shapes: one box per straight piece of the finger's inner edge, as
+# measured on R26's mesh RS1-130 (the edge's (y, z) in the finger frame [m], at the mesh's
+# mid-plane x = 0; finger 139 is its mirror image in y). From the pivot out: a straight
+# palm piece, a piece turned 0.2 rad toward the other finger, a hook turned 0.36 rad, and the
+# tip, parallel to the finger. Closed (0 rad) the palm pieces of the two fingers are 2-3 mm
+# apart; the hooks and tips cross the jaw's centre line, where the real fingers interleave.
+# Opened by about 0.36 rad the two hooks are parallel, 40 mm apart: the pocket where a round
+# object of 25-55 mm sits (models/README.md, section 10).
+ALPHA_FINGER_EDGE_M = (
+    (-0.0144, 0.012),
+    (-0.0133, 0.040),
+    (-0.0166, 0.056),
+    (-0.0211, 0.068),
+    (-0.0211, 0.085),
+)
+# the boxes' width along the pivot axis (RS1-139's 9.8 mm) and depth behind the edge, chosen
+# so that the four boxes' volume (6.7 mL) is the mean of the meshes' (6.1 and 7.7 mL)
+ALPHA_FINGER_PAD_WIDTH_M = 0.010
+ALPHA_FINGER_PAD_DEPTH_M = 0.009
 ALPHA_FINGER_LIMITS = (0.0, 0.5, 10.0, 10.0)  # lower, upper [rad], effort, velocity (R26)
 HALF_PI = math.pi / 2
 # joint, parent, child, xyz, rpy, lower, upper [rad], effort [N m], velocity [rad/s]
@@ -269,7 +291,7 @@ def _header(name: str, what: str) -> str:
 # Heavy (black frame side panels, buoyancy foam on top, the 4" acrylic electronics tube with
 # its dome, the 3" battery tube, 8 T200 thrusters where `uvms_pin.model.vehicles.
 # bluerov2_heavy.thrusters()` puts them) and the Reach Alpha 5 (40 mm black housings along
-# each link). No maker's mesh is shipped: models/README.md section 11 says why.
+# each link). No maker's mesh is shipped: models/README.md section 12 says why.
 _BLACK = ("frame_black", "0.06 0.06 0.07 1")
 _FOAM = ("foam_blue", "0.10 0.32 0.72 1")
 _ACRYLIC = ("acrylic", "0.80 0.90 1.00 0.35")
@@ -466,21 +488,47 @@ def _box_inertia(mass: float, size) -> tuple[float, ...]:
     )
 
 
+def _finger_pads(mirror: float) -> list[tuple[tuple, float, tuple]]:
+    """(centre, roll [rad], size) of each box along the finger's inner edge, in the finger
+    frame: the box's inner face lies on the edge piece, its depth behind it (away from the
+    other finger); ``mirror`` -1 for the finger on the -y pivot (y flipped)."""
+    pads = []
+    edge = ALPHA_FINGER_EDGE_M
+    for (y0, z0), (y1, z1) in itertools.pairwise(edge):
+        length = math.hypot(y1 - y0, z1 - z0)
+        uy, uz = (y1 - y0) / length, (z1 - z0) / length
+        half = ALPHA_FINGER_PAD_DEPTH_M / 2  # outward normal (uz, -uy): away from the centre
+        cy, cz = (y0 + y1) / 2 + half * uz, (z0 + z1) / 2 - half * uy
+        size = (ALPHA_FINGER_PAD_WIDTH_M, ALPHA_FINGER_PAD_DEPTH_M, length)
+        pads.append(((0.0, mirror * cy, cz), mirror * math.atan2(-uy, uz) + 0.0, size))
+    return pads
+
+
 def _finger(joint: str, link: str, pivot, axis, centre, mimic: str | None) -> str:
-    """One finger of the standard jaw: a box link on a revolute joint (R26, P25); no
-    <hydrodynamics>: the loader derives them from the collision box."""
-    box = f'<geometry><box size="{_f(ALPHA_FINGER_BOX_M)}"/></geometry>'
+    """One finger of the standard jaw on a revolute joint (R26, P25): R26's mass properties,
+    boxes along the inner edge of R26's mesh as its collision and visual shapes; no
+    <hydrodynamics>: the loader derives them from the collision boxes."""
     lower, upper, effort, velocity = ALPHA_FINGER_LIMITS
     inertia = _box_inertia(ALPHA_FINGER_MASS_KG, ALPHA_FINGER_BOX_M)
     mimic_line = (
         "" if mimic is None else f'    <mimic joint="{mimic}" multiplier="1" offset="0"/>\n'
     )
+    shapes = ""
+    for element in ("visual", "collision"):
+        for pad_centre, roll, size in _finger_pads(-1.0 if centre[1] > 0 else 1.0):
+            material = (
+                '      <material name="alpha_grey"><color rgba="0.3 0.3 0.3 1"/></material>\n'
+                if element == "visual"
+                else ""
+            )
+            shapes += (
+                f'    <{element}>\n      <origin xyz="{_f(pad_centre)}" rpy="{roll:.9g} 0 0"/>\n'
+                f'      <geometry><box size="{_f(size)}"/></geometry>\n{material}'
+                f"    </{element}>\n"
+            )
     return (
         f'  <link name="{link}">\n{_inertial(ALPHA_FINGER_MASS_KG, centre, inertia)}'
-        f'    <visual>\n      <origin xyz="{_f(centre)}" rpy="0 0 0"/>\n      {box}\n'
-        '      <material name="alpha_grey"><color rgba="0.3 0.3 0.3 1"/></material>\n'
-        f'    </visual>\n    <collision>\n      <origin xyz="{_f(centre)}" rpy="0 0 0"/>\n'
-        f"      {box}\n    </collision>\n  </link>\n"
+        f"{shapes}  </link>\n"
         f'  <joint name="{joint}" type="revolute">\n    <parent link="alpha_jaw_base_link"/>\n'
         f'    <child link="{link}"/>\n    <origin xyz="{_f(pivot)}" rpy="0 0 0"/>\n'
         f'    <axis xyz="{_f(axis)}"/>\n'

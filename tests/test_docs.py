@@ -224,6 +224,7 @@ _RESOLVED_ACCELERATION = {
 }
 # the tracking tasks: every path, both targets and frames, both tracking controllers
 _VARIANTS += [
+    ("valve_panel.toml", {}),
     ("gripper_close.toml", {"gripper.joints": ["alpha_jaw_finger_130_joint", "alpha_jaw_finger_139_joint"]}),
     ("gripper_close.toml", {"gripper.by_controller": True, "controller": {"type": "none"}}),
     ("lbv150_ee_circle.toml", {"metrics.extra": []}),

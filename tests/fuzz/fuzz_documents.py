@@ -1,6 +1,6 @@
 """Documents built from the documented keys, for the generated-input tests: the shipped
 scenarios and studies (every key they use), the tables the docs show (sensors.md's cameras and
-sonars) and one ``[[world.objects]]`` of every registered kind, mutated by a few edits each
+sonars) and one ``[[world.objects]]`` of every registered kind and a fixture, mutated by a few edits each
 (a value of any type, size and sign, NaN and infinities; a key removed or added; a table
 grafted from another document; a list resized; an element of an array of tables twice).
 
@@ -42,6 +42,11 @@ def _object_tables() -> list[dict[str, Any]]:
             }
         )
         tables.append(table)
+    # a fixture (type = "urdf", uvms_pin.scenario.fixtures): its joints by name or in order
+    fixture = {"type": "urdf", "name": "panel", "position_world_m": [0.8, 0.0, -2.0],
+               "path": "../models/fixtures/subsea_panel_valve.urdf", "rpy_rad": [0.0, 0.0, 3.1]}  # fmt: skip
+    tables += [{**fixture, "joint_positions_rad": {"valve": 0.2}},
+               {**fixture, "joint_positions_rad": [0.2]}]  # fmt: skip
     return tables
 
 

@@ -85,7 +85,7 @@ def test_run_outputs_are_exactly_the_files_a_run_writes(tmp_path):
     """RUN lists the outputs by name: a new figure must be added there (or --overwrite
     would leave it stale). The sea-state scenario writes every figure but one (flow.png
     too); the surfacing scenario started at the waterline writes surface.png; a tracking
-    task writes tracking.png; an estimator estimate.png."""
+    task writes tracking.png; an estimator estimate.png; free objects objects.png."""
     from uvms_pin.apps.outputs import write_outputs
     from uvms_pin.scenario.load import load_scenario
     from uvms_pin.sim.run import simulate
@@ -115,8 +115,13 @@ def test_run_outputs_are_exactly_the_files_a_run_writes(tmp_path):
     )
     figures = write_outputs(simulate(estimating, progress=False), out / "estimating")
     assert "estimate.png" in {p.name for p in figures}
+    gripping = load_scenario(
+        ROOT / "scenarios" / "gripper_close.toml", {"scenario.duration_s": 0.04}
+    )
+    figures = write_outputs(simulate(gripping, progress=False), out / "gripping")
+    assert "objects.png" in {p.name for p in figures}
     written = {p.name for p in out.iterdir() if p.is_file()}
-    for sub in ("surfacing", "tracking", "estimating"):
+    for sub in ("surfacing", "tracking", "estimating", "gripping"):
         written |= {p.name for p in (out / sub).iterdir()}
     assert written | {"replay.html"} == set(RUN.patterns)  # replay.html: with --html
 

@@ -43,7 +43,8 @@ def test_the_jaw_closes_and_its_opening_and_grip_are_logged():
     np.testing.assert_allclose(angle[t < 0.2], 0.5, atol=1e-4)
     assert grip[t < 0.2].max() < 0.01
     assert grip[(t >= 0.2) & (t < 0.25)].max() == pytest.approx(10.0)  # closing: saturated
-    assert angle.iloc[-1] < 0.01  # closed
+    assert angle.iloc[-1] == pytest.approx(0.36, abs=0.005)  # closed on the rod, hooks parallel
+    assert grip.iloc[-1] == pytest.approx(10.0)  # pressing it with the full grip
     np.testing.assert_array_equal(table["q.alpha_jaw_finger_130_joint_rad"], angle)
 
 

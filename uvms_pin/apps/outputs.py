@@ -63,6 +63,7 @@ def _figure_writers(checkpoint: Callable[[], None]) -> Iterator[FigureWriter]:
     """The figure writers, each after a ``checkpoint`` (matplotlib imported after the first)."""
     checkpoint()
     from uvms_pin.results.figures.estimate import estimate_figures
+    from uvms_pin.results.figures.objects import objects_figures
     from uvms_pin.results.figures.paper import paper_figures
     from uvms_pin.results.figures.standard import standard_figures
     from uvms_pin.results.figures.tracking import tracking_figures
@@ -72,6 +73,7 @@ def _figure_writers(checkpoint: Callable[[], None]) -> Iterator[FigureWriter]:
         standard_figures,
         tracking_figures,
         estimate_figures,
+        objects_figures,
         _flow_figure,
         _surface_figure,
     ):

@@ -68,6 +68,7 @@ RUN = OutputKind(
         "surface.png",  # runs in which a body left the water in part
         "tracking.png",  # runs with a tracking task ([task])
         "estimate.png",  # runs with a navigation estimator ([estimator])
+        "objects.png",  # runs with free objects ([world.objects] with a mass or density)
     ),
     ("rollout.npz", "rollout.json", "metrics.json", "replay.html"),
 )

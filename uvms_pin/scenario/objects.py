@@ -1,6 +1,6 @@
 """``[world]``: objects (``[[world.objects]]``: fixed, or free with a ``mass_kg`` or
 ``density_kg_m3``; a ``type`` of `uvms_pin.physics.world.kinds`, whose keys and their
-check are its kind's) every body touches, the contact law's parameters
+check are its kind's; or ``type = "urdf"``, a fixture with joints, `uvms_pin.scenario.fixtures`) every body touches, the contact law's parameters
 (``[world.contact]``, with ``self_collision``), ``initial_overlap`` (what the start does
 with a free object inside another body) and ``fixed_contact`` (rigid or compliant: how
 the free objects touch the fixed world); ``[joints]``: the joint stops."""
@@ -15,6 +15,7 @@ from uvms_pin.checks import check_memory
 from uvms_pin.errors import ParameterError
 from uvms_pin.model.uvms import UVMS
 from uvms_pin.physics.world.contact_law import ContactLaw
+from uvms_pin.physics.world.fixture import FIXTURE_TYPE, Fixture
 from uvms_pin.physics.world.free_object import FreeObject, free_mass, free_object_of
 from uvms_pin.physics.world.kind import Key
 from uvms_pin.physics.world.objects import (
@@ -25,6 +26,7 @@ from uvms_pin.physics.world.objects import (
     object_kind,
 )
 from uvms_pin.physics.world.world import FIXED_CONTACT, INITIAL_OVERLAP, World
+from uvms_pin.scenario.fixtures import read_fixture
 from uvms_pin.scenario.schema import Table
 
 __all__ = ["KEY_READERS", "build_world", "objects_bytes"]
@@ -64,10 +66,11 @@ def build_world(t: Table | None, uvms: UVMS, base_dir: Path) -> World | None:
     t.finish()
     fixed = [o for o in built if isinstance(o, WorldObject)]
     free = [o for o in built if isinstance(o, FreeObject)]
+    fixtures = [o for o in built if isinstance(o, Fixture)]
     if not built and not self_collision:
         return None
     try:
-        return World(uvms, fixed, law, free, self_collision, overlap, free_contact)
+        return World(uvms, fixed, law, free, self_collision, overlap, free_contact, fixtures)
     except ParameterError as exc:
         raise t.fail(str(exc)) from exc
 
@@ -89,9 +92,11 @@ def _law(t: Table) -> ContactLaw:
 
 def _object(
     t: Table, index: int, law: ContactLaw, base_dir: Path, uvms: UVMS
-) -> WorldObject | FreeObject:
-    kind = t.string("type", choices=kind_names())
+) -> WorldObject | FreeObject | Fixture:
+    kind = t.string("type", choices=(*kind_names(), FIXTURE_TYPE))
     name = t.string("name", f"{kind}{index}")
+    if kind == FIXTURE_TYPE:  # an articulated body, not a shape (`scenario.fixtures`)
+        return read_fixture(t, name, law, base_dir, uvms.water_density_kg_m3)
     mass = t.number("mass_kg", None, positive=True) if t.has("mass_kg") else None
     density = t.number("density_kg_m3", None, positive=True) if t.has("density_kg_m3") else None
     free = mass is not None or density is not None

@@ -4,7 +4,7 @@
 A scenario file is code when it names code: ``[controller] type = "module:Class"`` and
 ``[metrics] extra = ["module:function"]`` import (run) a module with the user's rights, from
 the scenario's folder or anywhere on ``sys.path``. It also names files uvms-pin reads:
-``[scenario] model`` (a URDF) and the ``path`` of a ``[[world.objects]]`` mesh. With
+``[scenario] model`` (a URDF) and the ``path`` of a ``[[world.objects]]`` mesh or fixture. With
 ``--no-code`` (`check_no_code`), a scenario is refused, before anything is imported or read,
 when it names any module, or a file outside its own folder (and the folders below it) and the
 shipped models; the names are judged as the reader will resolve them (symbolic links
@@ -18,8 +18,9 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-from uvms_pin.errors import ScenarioError
+from uvms_pin.errors import ParameterError, ScenarioError
 from uvms_pin.model.resources import find_model, shipped_path
+from uvms_pin.physics.world.fixture import FIXTURE_TYPE, fixture_path
 from uvms_pin.physics.world.objects import kind_names, object_kind
 
 
@@ -57,12 +58,25 @@ def reaches(raw: Mapping[str, Any], scenario_dir: Path) -> Iterator[Reach]:
     world = raw.get("world")
     objects = world.get("objects") if isinstance(world, Mapping) else None
     for k, table in enumerate(objects if isinstance(objects, list) else []):
+        if isinstance(table, Mapping) and table.get("type") == FIXTURE_TYPE:
+            yield _fixture_reach(f"world.objects[{k}].path", table.get("path"), scenario_dir)
+            continue
         if not isinstance(table, Mapping) or table.get("type") not in kind_names():
             continue
         for key in object_kind(table["type"]).keys:
             entry = table.get(key.name, key.default)
             if key.holds == "path" and isinstance(entry, str):
                 yield Reach(f"world.objects[{k}].{key.name}", path=(scenario_dir / entry).resolve())
+
+
+def _fixture_reach(key: str, entry: Any, scenario_dir: Path) -> Reach:
+    """The file a fixture's ``path`` names, as its reader resolves it (`fixture_path`)."""
+    if not isinstance(entry, str):
+        return Reach(key)
+    try:
+        return Reach(key, path=fixture_path(entry, scenario_dir).resolve())
+    except ParameterError:  # no such file: the reader refuses it
+        return Reach(key, path=(scenario_dir / entry).resolve())
 
 
 def _inside(path: Path, folder: Path) -> bool:

@@ -34,6 +34,7 @@ from uvms_pin.physics.dynamics import forward_dynamics
 from uvms_pin.physics.joint_friction import JointFriction
 from uvms_pin.physics.joint_stops import JointStops
 from uvms_pin.physics.surface import wet_state
+from uvms_pin.physics.world.touch import NO_TOUCH
 from uvms_pin.physics.world.world import ContactForces, FrictionMemory, World
 from uvms_pin.sim.actuation import Actuation, Unlimited
 from uvms_pin.sim.compiled.plant import plant_to_core
@@ -207,6 +208,8 @@ class Plant:
         """The world's contact points and forces at (q, v) (None without a world)."""
         if self.world is None:
             return None
+        if not self.world.objects:  # a world of moving bodies alone: nothing fixed to touch
+            return ContactForces(NO_TOUCH, np.zeros((0, 3)), np.zeros(0), np.zeros(0, bool))
         pin.forwardKinematics(self.uvms.model, self._world_data, q, v)
         return self.world.forces(self._world_data, self.friction)
 
@@ -307,9 +310,9 @@ def water_of(current_world_m_s: np.ndarray, flow: FlowField | None) -> FlowField
 
 
 def has_moving_contacts(world: World | None) -> bool:
-    """A world in which more than the robot moves (free objects) or the arm can hit its own
-    vehicle: its contacts are the system of bodies' (`uvms_pin.sim.system`)."""
-    return world is not None and bool(world.free or world.self_collision)
+    """A world in which more than the robot moves (free objects, fixtures with joints) or the
+    arm can hit its own vehicle: its contacts are the system of bodies' (`uvms_pin.sim.system`)."""
+    return world is not None and bool(world.free or world.fixtures or world.self_collision)
 
 
 def checked_start(

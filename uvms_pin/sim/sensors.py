@@ -196,6 +196,7 @@ class SensorSuite:
         self.seed = seed
         self.seeing: LoopCameras | None = None  # the cameras in the loop, once started
         self._layout = None
+        self._free = 0  # the free objects among the bodies the cameras see
         self._state_noisy = any(
             s.bound > 0.0
             for s in (
@@ -227,6 +228,7 @@ class SensorSuite:
             )
         scene = scene_of(plant.uvms, plant.world, surface=plant.free_surface)
         self.seeing, self._layout = LoopCameras(cameras, scene, self.seed), layout
+        self._free = 0 if plant.world is None else len(plant.world.free)  # fixtures follow
 
     def see(self, time_s: float, state, measurement: Measurement) -> Measurement:
         """Once per control tick: the cameras in the loop whose instant has come fire from
@@ -234,7 +236,7 @@ class SensorSuite:
         if self.seeing is None:
             return measurement
         robot, *objects = self._layout.split(state.q, state.v)
-        self.seeing.update(time_s, robot[0], [q for q, _ in objects])
+        self.seeing.update(time_s, robot[0], [q for q, _ in objects[: self._free]])
         return dataclasses.replace(measurement, images=self.seeing.images)
 
     def navigate(

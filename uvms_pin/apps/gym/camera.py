@@ -63,7 +63,8 @@ class CameraObservation(gym.ObservationWrapper):
     def observation(self, observation: np.ndarray) -> dict[str, np.ndarray]:
         loop = self.env.unwrapped.loop
         state = loop.state
-        robot, *objects = loop.system.layout.split(state.q, state.v)
+        robot, *bodies = loop.system.layout.split(state.q, state.v)
+        objects = bodies[: len(loop.system.objects)]  # the free objects (fixtures follow)
         self._scene.update(robot[0], [q for q, _ in objects])
         frame = self._camera.render()
         out = {"state": observation, "image": frame.rgb}

@@ -5,6 +5,9 @@ Sets of pairs (`uvms_pin.physics.world.pairs.PiecePairs`), each with its frictio
 
 - the UVMS's pieces against each free object's (the object's friction);
 - each free object against each later one (the first's friction);
+- the UVMS's pieces and each free object's against each fixture's links (the fixture's
+  friction; `uvms_pin.physics.world.fixture`: its links move with its joints, its root
+  is fixed);
 - with ``self_collision``: each arm link's pieces against the vehicle's, except the link
   jointed to the vehicle itself (adjacent: their shapes meet at the joint by design);
 
@@ -58,6 +61,26 @@ def _self_pairs(world: World) -> PiecePairs | None:
     return piece_pairs(pieces, pieces, pairs, world.law, mu, names)
 
 
+def _fixture_sets(world: World) -> list[_Set]:
+    """The UVMS's pieces, then each free object's, against each fixture's links (sides
+    ``len(world.free) + k``); the fixture's friction. Fixtures do not touch one another
+    or the fixed objects (their roots are fixed)."""
+    sets, law, first = [], world.law, len(world.free)
+    for k, fixture in enumerate(world.fixtures):
+        mu = (fixture.friction_static, fixture.friction_kinetic)
+        links = fixture.piece_names
+        pairs = _all_pairs(len(world.pieces), len(fixture.pieces))
+        names = [f"{world.body_names[world.pieces[a].body]}|{links[b]}" for a, b in pairs]
+        own = piece_pairs(world.pieces, fixture.pieces, pairs, law, mu, names)
+        sets.append(_Set(own, -1, first + k))
+        for i, obj in enumerate(world.free):
+            pairs = _all_pairs(len(obj.pieces), len(fixture.pieces))
+            names = [f"{obj.name}|{links[b]}" for _, b in pairs]
+            own = piece_pairs(obj.pieces, fixture.pieces, pairs, law, mu, names)
+            sets.append(_Set(own, i, first + k))
+    return sets
+
+
 def _all_pairs(n_a: int, n_b: int) -> list[tuple[int, int]]:
     return [(a, b) for a in range(n_a) for b in range(n_b)]
 
@@ -99,6 +122,7 @@ class MovingContacts:
                 names = [f"{first.name}|{other.name}"] * len(pairs)
                 own = piece_pairs(first.pieces, other.pieces, pairs, law, mu, names)
                 sets.append(_Set(own, i, j))
+        sets += _fixture_sets(world)
         if world.self_collision:
             own = _self_pairs(world)
             if own is not None:
@@ -112,6 +136,12 @@ class MovingContacts:
         out = MovingContacts(world, sets, object_worlds, memories, rigid)
         out.clear()
         return out
+
+    @property
+    def bodies(self) -> tuple:
+        """The moving bodies besides the UVMS, by side index: the free objects, then the
+        fixtures (`uvms_pin.physics.world.fixture.Fixture`)."""
+        return (*self.world.free, *self.world.fixtures)
 
     @property
     def uvms_pair_names(self) -> list[str]:
@@ -165,7 +195,8 @@ class MovingContacts:
         (`contacts`)."""
         uvms_model = self.world.uvms.model
         tau_uvms = np.zeros(uvms_model.nv)
-        tau_objects = [np.zeros(6) for _ in states]
+        bodies = self.bodies
+        tau_objects = [np.zeros(b.uvms.model.nv) for b in bodies[: len(states)]]
         sets, fixed = found
         for s, contacts in zip(self.sets, sets, strict=True):
             if len(contacts) == 0:
@@ -173,7 +204,7 @@ class MovingContacts:
             side = [
                 (uvms_model, uvms_data, q, tau_uvms)
                 if k < 0
-                else (self.world.free[k].uvms.model, object_datas[k], states[k][0], tau_objects[k])
+                else (bodies[k].uvms.model, object_datas[k], states[k][0], tau_objects[k])
                 for k in (s.a, s.b)
             ]
             tau_a, tau_b = s.pairs.generalized_forces(*side[0][:3], *side[1][:3], contacts)

@@ -9,6 +9,8 @@ that can touch with a free object on one side,
 - the robot's pieces against each free object's (the object moves out, along -n),
 - each free object against each later one (the later one moves out, along -n),
 - each free object against the fixed objects and the seabed (the object moves, along +n),
+- each free object against a fixture's links (the object moves, along +n; the robot's own
+  start against a fixture is left to its scenario),
 
 is posed at the initial configuration with the contact's own geometry (coal's deepest point,
 `PiecePairs.touching`; a piece's corners under a plane, `touch.touch`), n the contact normal
@@ -115,6 +117,11 @@ def overlaps(
 
     for s in moving.sets:
         if s.b < 0:  # the arm against its own vehicle: the robot's own posture
+            continue
+        if s.b >= len(free):  # a fixture's links: a free object in one moves out (along n)
+            if s.a >= 0:
+                for _, _, normal, depth in s.pairs.touching(object_datas[s.a], object_datas[s.b]):
+                    keep(moving.bodies[s.b].name, free[s.a].name, depth, s.a, normal)
             continue
         data_a = uvms_data if s.a < 0 else object_datas[s.a]
         for k, _, normal, depth in s.pairs.touching(data_a, object_datas[s.b]):

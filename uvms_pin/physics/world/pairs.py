@@ -57,6 +57,13 @@ def _material_velocity(data: pin.Data, joint: int, point: np.ndarray) -> np.ndar
     return placement.rotation @ twist.linear + np.cross(angular, point - placement.translation)
 
 
+def _centres(data: pin.Data, pieces: Sequence[RobotPiece]) -> np.ndarray:
+    """Each piece's frame origin in the world (p, 3) [m], after forward kinematics."""
+    return np.array(
+        [data.oMi[p.joint_id].act(p.placement_in_joint.translation) for p in pieces]
+    ).reshape(-1, 3)
+
+
 def joint_forces(
     model: pin.Model, data: pin.Data, q: np.ndarray, joints, points_m, forces_N
 ) -> np.ndarray:
@@ -95,6 +102,16 @@ class PiecePairs:
     mu: np.ndarray
     names: tuple[str, ...]
 
+    @property
+    def _radii(self) -> tuple[np.ndarray, np.ndarray]:
+        """Each side's pieces' bounding radii [m]."""
+        held = self.__dict__.get("_radii_held")
+        if held is None:
+            held = tuple(np.array([p.bound_radius_m for p in side], dtype=float)
+                         for side in (self.pieces_a, self.pieces_b))  # fmt: skip
+            object.__setattr__(self, "_radii_held", held)
+        return held
+
     def near(self, data_a: pin.Data, data_b: pin.Data, horizon_s: float) -> bool:
         """Whether some pair may touch within ``horizon_s`` (bounding spheres grown by the
         distance their points cover, `touch.reach_spheres`); after forward kinematics."""
@@ -109,7 +126,16 @@ class PiecePairs:
         """(pair index, point (3,) [m], normal out of b towards a (3,), depth [m]) of every
         pair that overlaps, after forward kinematics of both models (geometry only)."""
         found = []
-        for k, (a, b) in enumerate(self.pairs):
+        if not self.pairs:
+            return found
+        # a first cut by the pieces' bounding spheres (a nanometre wider than the test
+        # below, for rounding): the pieces posed once each, not once a pair
+        ca, cb = _centres(data_a, self.pieces_a), _centres(data_b, self.pieces_b)
+        first, second = np.array(self.pairs).T
+        reach = self._radii[0][first] + self._radii[1][second] + 1.0e-9
+        close = np.linalg.norm(ca[first] - cb[second], axis=1) < reach
+        for k in np.flatnonzero(close).tolist():
+            a, b = self.pairs[k]
             pa, pb = self.pieces_a[a], self.pieces_b[b]
             where_a = data_a.oMi[pa.joint_id] * pa.placement_in_joint
             where_b = data_b.oMi[pb.joint_id] * pb.placement_in_joint

@@ -23,7 +23,7 @@ from uvms_pin.hydro.submerged_cylinder import Cylinder
 from uvms_pin.model.uvms import UVMS
 from uvms_pin.physics.world.objects import convex_hull
 
-__all__ = ["RobotPiece", "robot_pieces"]
+__all__ = ["RobotPiece", "coal_of", "robot_pieces"]
 
 RIM_POINTS = 16  # corners of the prism standing for a cylinder's rims against a plane
 
@@ -56,7 +56,7 @@ def _prism_corners(radius_m: float, length_m: float) -> np.ndarray:
     )
 
 
-def _coal_of(shape: Any, name: str) -> tuple[Any, np.ndarray | None]:
+def coal_of(shape: Any, name: str) -> tuple[Any, np.ndarray | None]:
     """(coal geometry, corner points or None) of a hull piece's shape."""
     if isinstance(shape, Sphere):
         return coal.Sphere(shape.radius_m), None
@@ -79,7 +79,7 @@ def robot_pieces(uvms: UVMS, names: list[str]) -> tuple[RobotPiece, ...]:
     pieces = []
     for h, hull in enumerate(bodies.hulls):
         for piece in hull.pieces:
-            shape, corners = _coal_of(piece.shape, names[h])
+            shape, corners = coal_of(piece.shape, names[h])
             pieces.append(
                 RobotPiece(
                     body=h,

@@ -127,6 +127,9 @@ class World:
             that overlaps another body (`uvms_pin.physics.world.overlap`).
         fixed_contact: one of `FIXED_CONTACT`, how the free objects touch the
             fixed objects.
+        fixtures: articulated bodies with a fixed root
+            (`uvms_pin.physics.world.fixture.Fixture`); their links touch the robot and
+            the free objects (`uvms_pin.physics.world.moving`).
     """
 
     uvms: UVMS
@@ -136,6 +139,7 @@ class World:
     self_collision: bool = False
     initial_overlap: str = "refuse"
     fixed_contact: str = "rigid"
+    fixtures: Sequence[Any] = ()
 
     def __post_init__(self) -> None:
         if self.fixed_contact not in FIXED_CONTACT:
@@ -150,10 +154,11 @@ class World:
             )
         self.objects = tuple(self.objects)
         self.free = tuple(self.free)
+        self.fixtures = tuple(self.fixtures)
         bodies = self.uvms.surface_bodies
         self.body_names = [self.uvms.hydro_bodies[int(k)].name for k in bodies.body_index]
         self.pieces: tuple[RobotPiece, ...] = robot_pieces(self.uvms, self.body_names)
-        names = [o.name for o in self.objects] + [o.name for o in self.free]
+        names = [o.name for o in (*self.objects, *self.free, *self.fixtures)]
         if len(set(names)) != len(names):
             raise ParameterError(f"world objects need distinct names, got {names}")
         self.bounds = Bounds.of(self.objects)
@@ -171,6 +176,7 @@ class World:
         return {
             "objects": [o.record() for o in self.objects],
             "free_objects": [o.record() for o in self.free],
+            **({"fixtures": [o.record() for o in self.fixtures]} if self.fixtures else {}),
             "contact": {**self.law.record(), "self_collision": bool(self.self_collision)},
             **({"fixed_contact": self.fixed_contact} if self.free else {}),
             "pairs": self.pair_names,

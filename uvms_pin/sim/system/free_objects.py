@@ -1,9 +1,10 @@
 """The moving contacts of a system of bodies: the world's free objects (each a floating body
-of its own) and, on request, the arm against its own vehicle.
+of its own), its fixtures' links (`uvms_pin.physics.world.fixture`) and, on request, the
+arm against its own vehicle.
 
 Each contact force between two moving bodies is exchanged equal and opposite
 (`uvms_pin.physics.world.moving`); a free object meets the fixed objects as the robot does.
-The objects' states are the system's (`uvms_pin.sim.system.SystemState`): passed in, never
+The bodies' states (free objects', then fixtures') are the system's (`uvms_pin.sim.system.SystemState`): passed in, never
 kept here. What is kept is the contacts' friction state (their anchors), which moves once a
 control period, as the robot's does.
 """
@@ -38,12 +39,13 @@ class FreeObjects:
         self.uvms = uvms
         self.objects = world.free
         self.moving = MovingContacts.of(world)
+        self.bodies = self.moving.bodies  # the free objects, then the fixtures
         self.uvms_data = uvms.model.createData()
-        self.datas = [o.uvms.model.createData() for o in self.objects]
+        self.datas = [o.uvms.model.createData() for o in self.bodies]
 
     def initial_states(self) -> list[State]:
-        """Each object's state at t = 0 (copies)."""
-        return [(o.q0.copy(), o.v0.copy()) for o in self.objects]
+        """Each body's state at t = 0 (copies): the free objects', then the fixtures'."""
+        return [(o.q0.copy(), o.v0.copy()) for o in self.bodies]
 
     def apart(self, q: np.ndarray, states: list[State]) -> tuple[list[State], list[Overlap]]:
         """(the objects' states, the moves made) at the start with the robot at ``q``: no
@@ -63,7 +65,7 @@ class FreeObjects:
     # ---- the contacts at a state ------------------------------------------------------
     def _kinematics(self, q: np.ndarray, v: np.ndarray, states: list[State]) -> None:
         pin.forwardKinematics(self.uvms.model, self.uvms_data, q, v)
-        for obj, data, (q_o, v_o) in zip(self.objects, self.datas, states, strict=True):
+        for obj, data, (q_o, v_o) in zip(self.bodies, self.datas, states, strict=True):
             pin.forwardKinematics(obj.uvms.model, data, q_o, v_o)
 
     def found(self, q: np.ndarray, v: np.ndarray, states: list[State]):

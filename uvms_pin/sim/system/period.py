@@ -23,6 +23,7 @@ integrated step is followed by the Python reference's solve.
 from __future__ import annotations
 
 from collections.abc import Callable
+from functools import partial
 from typing import Any, Protocol
 
 import numpy as np
@@ -39,6 +40,7 @@ from uvms_pin.physics.constraints.step import (
 )
 from uvms_pin.sim.compiled.integrator import integrator_to_core
 from uvms_pin.sim.integrators import Integrator
+from uvms_pin.sim.system.fixtures import with_fixtures
 
 
 class Stepped(Protocol):
@@ -52,6 +54,9 @@ class Stepped(Protocol):
     compiled_allowed: bool
     layout: Any  # where each body sits in the state (`uvms_pin.sim.system.state.Layout`)
     object_contacts: Any  # the free objects' rigid contacts with the fixed world, or None
+    fixtures: tuple  # the fixtures (`uvms_pin.physics.world.fixture`), after the objects
+    fixture_constraints: tuple  # their joint limits and friction (`sim.system.fixtures`)
+    fixture_blocks: list  # each one's part of v and its joints (`fixtures.blocks`)
 
     def friction_memories(self) -> list: ...
 
@@ -102,9 +107,10 @@ def why_not_compiled_system(system: Stepped, integrator: Integrator | None) -> s
 
 def constraint_sets(system: Stepped) -> tuple:
     """The constraints solved implicitly at the end of ``system``'s period: the robot's
-    joint limits and the free objects' rigid contacts with the fixed world (each when
-    there is one)."""
-    return tuple(s for s in (system.plant.joint_limits, system.object_contacts) if s is not None)
+    joint limits, the free objects' rigid contacts with the fixed world and the fixtures'
+    joint limits and friction (each when there is one)."""
+    sets = (system.plant.joint_limits, system.object_contacts, *system.fixture_constraints)
+    return tuple(s for s in sets if s is not None)
 
 
 def constrained(system: Stepped, smooth: PeriodStep) -> PeriodStep:
@@ -124,7 +130,11 @@ def constrained(system: Stepped, smooth: PeriodStep) -> PeriodStep:
         # the smooth step's own speeds: its start and its mean over the period (RK4's end
         # may cross a limit that its end velocity would not reach)
         travelled = np.abs(pin.difference(system.model, q0, q_free)) / (t1 - t0)
-        solved = constrained_velocity(
+        solve = constrained_velocity
+        if system.fixtures:  # their joints' own exact steps (`uvms_pin.sim.system.fixtures`)
+            own = system.fixture_constraints
+            solve = partial(with_fixtures, constrained_velocity, own, system.fixture_blocks)
+        solved = solve(
             system.model, mass, _objects_moved(system, v_free, q_free, q0), q0, sets, t1 - t0,
             least_speed=np.maximum(np.abs(v0), travelled),
         )  # fmt: skip
@@ -167,7 +177,8 @@ def _objects_moved(system: Stepped, v: np.ndarray, q_from: np.ndarray, q_to: np.
     (it then rolls 4 % fast and gains energy)."""
     layout = system.layout
     out = np.array(v, dtype=float)
-    for at, part in zip(layout.q_slices[1:], layout.v_slices[1:], strict=True):
+    free = slice(1, 1 + len(system.objects))  # the fixtures' joints have no frame to turn
+    for at, part in zip(layout.q_slices[free], layout.v_slices[free], strict=True):
         turn = _rotation(q_to[at]).T @ _rotation(q_from[at])
         out[part] = np.concatenate([turn @ v[part][:3], turn @ v[part][3:]])
     return out
@@ -186,7 +197,8 @@ def _end(
 ) -> tuple[np.ndarray, np.ndarray]:
     """(q, v) at the period's end: a body some solved row acts on moves from its q0 with v+
     (the robot by `constrained_configuration`, q0 (+) h v+; a free object by
-    `free_body_configuration`, its body velocity then expressed at its new pose); a body no
+    `free_body_configuration`, its body velocity then expressed at its new pose; a fixture's
+    revolute and prismatic joints by q0 + h v+); a body no
     row acts on keeps the smooth step's end ``smooth`` = (q_free, v_free) (all of them when
     nothing was solved)."""
     q_free, v_free = smooth
@@ -200,6 +212,9 @@ def _end(
             continue
         if k == 0:
             q[at] = pin.integrate(system.plant.uvms.model, q0[at], h * v_plus[part])
+            v[part] = v_plus[part]
+        elif k > len(system.objects):  # a fixture: revolute and prismatic joints, q+ = q + h v+
+            q[at] = q0[at] + h * v_plus[part]
             v[part] = v_plus[part]
         else:
             q[at] = free_body_configuration(q0[at], v_plus[part], h)
@@ -237,7 +252,7 @@ def _step(system: Stepped, integrator: Integrator) -> PeriodStep:
 
     # the compiled plant is rebuilt when a run starts (its contact anchored anew): taken at
     # each period, the choice of step stays
-    if system.objects:
+    if system.objects or system.fixtures:
         if why_not_compiled_system(system, integrator) is not None:
             return integrated
         # the compiled system follows the compiled plant (rebuilt when a run starts)

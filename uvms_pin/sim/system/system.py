@@ -1,12 +1,15 @@
-"""A system of bodies: the robot and the free objects of its world, stepped together.
+"""A system of bodies: the robot, the free objects and the fixtures of its world, stepped
+together.
 
-The state stacks the robot's (q, zeta) and each free object's (pose (7,), body velocity (6,))
-(`SystemState`, `Layout`); its configuration space is that of a Pinocchio model made of the
-robot's joints and one free-flyer per object (used to integrate on the manifold, so that
-every integrator steps the whole system with its own rules). The right-hand side is
+The state stacks the robot's (q, zeta), each free object's (pose (7,), body velocity (6,))
+and each fixture's joints (q_f, qd_f) (`SystemState`, `Layout`); its configuration space is
+that of a Pinocchio model made of the robot's joints, one free-flyer per object and the
+fixtures' joints (used to integrate on the manifold, so that every integrator steps the
+whole system with its own rules). The right-hand side is
 
     zeta_dot   = FD_robot(q, zeta, tau + tau_contact,robot)
     nu_dot_o   = FD_o(q_o, nu_o, tau_contact,o)                 (each object o)
+    qdd_f      = FD_f(q_f, qd_f, -D_f qd_f + tau_contact,f)     (each fixture f)
 
 with every contact force between two moving bodies exchanged equal and opposite
 (`uvms_pin.physics.world.moving`) and the water (current, waves, free surface) the same for
@@ -30,6 +33,7 @@ from uvms_pin.physics.world.overlap import tolerance_m
 from uvms_pin.sim.compiled.system import system_to_core
 from uvms_pin.sim.integrators import Integrator
 from uvms_pin.sim.plant import Plant, checked_start, has_moving_contacts
+from uvms_pin.sim.system import fixtures as fixture_joints
 from uvms_pin.sim.system.free_objects import FreeObjects
 from uvms_pin.sim.system.period import PeriodStep, period_step, why_not_compiled_system
 from uvms_pin.sim.system.state import Layout, SystemState
@@ -43,15 +47,18 @@ COMPILED_PATH = (
 )
 #: ... or integrated in Python, and why
 PYTHON_PATH = (
-    "free objects: the system (UVMS and objects) is integrated by the Python integrator "
+    "{bodies}: the system (UVMS and {others}) is integrated by the Python integrator "
     "around the compiled dynamics ({reason})"
 )
 
 
-def integration_path(reason: str | None) -> str:
-    """What a world record says of a run with free objects whose compiled period is
-    refused for ``reason`` (None: compiled)."""
-    return COMPILED_PATH if reason is None else PYTHON_PATH.format(reason=reason)
+def integration_path(reason: str | None, fixtures_only: bool = False) -> str:
+    """What a world record says of a run with free objects (or only fixtures:
+    ``fixtures_only``) whose compiled period is refused for ``reason`` (None: compiled)."""
+    if reason is None:
+        return COMPILED_PATH
+    bodies, others = ("fixtures", "fixtures") if fixtures_only else ("free objects", "objects")
+    return PYTHON_PATH.format(bodies=bodies, others=others, reason=reason)
 
 
 def _system_model(robot: pin.Model, n_objects: int) -> pin.Model:
@@ -63,13 +70,16 @@ def _system_model(robot: pin.Model, n_objects: int) -> pin.Model:
 
 
 class System:
-    """The robot ``plant`` and its world's free objects.
+    """The robot ``plant`` and its world's free objects and fixtures.
 
     Attributes:
         plant: the robot in its water, with its environment and fixed world.
         moving: the moving contacts (`FreeObjects`), None when only the robot moves and its
             arm does not meet its vehicle.
         objects: the free objects (`uvms_pin.physics.world.FreeObject`), possibly none.
+        fixtures: the fixtures (`uvms_pin.physics.world.fixture.Fixture`), after the objects
+            in the state; fixture_constraints, fixture_blocks: their joints' limits and
+            friction, and each one's part of v and its joints (`sim.system.fixtures`).
         layout: where each body sits in the state. model: the system's Pinocchio model.
         compiled_allowed: the period of a system with free objects may be one compiled call
             (`uvms_pin.sim.system.period`); False: the Python integrator steps it.
@@ -84,11 +94,18 @@ class System:
         world = plant.world
         self.moving = FreeObjects(plant.uvms, world) if has_moving_contacts(world) else None
         self.objects: tuple = () if self.moving is None else tuple(self.moving.objects)
+        self.fixtures: tuple = () if world is None else tuple(world.fixtures)
         uvms = plant.uvms
         self.layout = Layout.of(
             [("robot", uvms.nq, uvms.nv), *[(o.name, 7, 6) for o in self.objects]]
+            + [(f.name, f.uvms.nq, f.uvms.nv) for f in self.fixtures]
         )
-        self.model = _system_model(uvms.model, len(self.objects)) if self.objects else uvms.model
+        model = _system_model(uvms.model, len(self.objects)) if self.objects else uvms.model
+        self.model = fixture_joints.system_model(model, self.fixtures) if self.fixtures else model
+        # the fixtures' joint limits and friction, solved with the other constraints
+        self.fixture_constraints = fixture_joints.constraints(model.njoints, self.fixtures)
+        first_v = self.layout.v_slices[1 + len(self.objects)].start if self.fixtures else 0
+        self.fixture_blocks = fixture_joints.blocks(model.njoints, first_v, self.fixtures)
         self.object_contacts = self._object_contacts()
         self._steps: dict[int, tuple[Integrator, PeriodStep]] = {}
         self._data = uvms.model.createData()  # the bound test's kinematics
@@ -111,14 +128,14 @@ class System:
         world asks so, the moves kept in `separations`; else InitialOverlapError)."""
         q0, v0 = checked_start(self.plant.uvms.model, q0, v0)
         states = [] if self.moving is None else self.moving.initial_states()
-        if self.objects:  # none inside another body (`uvms_pin.physics.world.overlap`)
+        if self.objects or self.fixtures:  # none inside another body (`...world.overlap`)
             states, self.separations = self.moving.apart(q0, states)
         return self.layout.join([(q0, v0), *states])
 
     def robot_state(self, q: np.ndarray, v: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """The robot's (q, v) in the system's (q, v) (views; the arrays themselves when the
         robot moves alone)."""
-        if not self.objects:
+        if len(self.layout.names) == 1:
             return q, v
         return q[self.layout.q_slices[0]], v[self.layout.v_slices[0]]
 
@@ -140,8 +157,10 @@ class System:
         plant as it is now (rebuilt with it, when a run starts), or its `Fallback`; None
         without free objects or a compiled plant."""
         plant_core = self.plant.compiled
-        if not self.objects or plant_core is None:
+        if not (self.objects or self.fixtures) or plant_core is None:
             return None
+        if self.fixtures:
+            return Fallback(fixture_joints.COMPILED_REFUSAL)
         held = self.__dict__.get("_compiled")
         if held is None or held[0] is not plant_core:
             held = self._compiled = (plant_core, system_to_core(self, core_module()))
@@ -167,16 +186,15 @@ class System:
         plant = self.plant
         if self.moving is None:
             return plant.acceleration(time_s, q, v, tau, contact_world)
-        (q_r, v_r), *objects = self.layout.split(q, v)
-        tau_robot, tau_objects = self.moving.torques(q_r, v_r, objects)
+        (q_r, v_r), *bodies = self.layout.split(q, v)
+        tau_robot, tau_bodies = self.moving.torques(q_r, v_r, bodies)
         out = [plant.acceleration(time_s, q_r, v_r, tau, contact_world, extra_torque=tau_robot)]
-        for obj, (q_o, v_o), tau_o in zip(self.objects, objects, tau_objects, strict=True):
-            out.append(
-                forward_dynamics(
-                    obj.uvms, q_o, v_o, np.zeros(6), tau_ext=tau_o, flow=plant.water,
-                    time_s=time_s, backend=plant.backend, free_surface=plant.free_surface,
-                )
-            )  # fmt: skip
+        n = len(self.objects)
+        water = {"flow": plant.water, "time_s": time_s, "backend": plant.backend,
+                 "free_surface": plant.free_surface}  # fmt: skip
+        for obj, (q_o, v_o), tau_o in zip(self.objects, bodies[:n], tau_bodies[:n], strict=True):
+            out.append(forward_dynamics(obj.uvms, q_o, v_o, np.zeros(6), tau_ext=tau_o, **water))
+        out += fixture_joints.accelerations(self.fixtures, bodies[n:], tau_bodies[n:], water)
         return np.concatenate(out)
 
     def advance(
@@ -202,7 +220,7 @@ class System:
         their contacts)."""
         plant = self.plant
         water = {"free_surface": plant.free_surface, "flow": plant.water, "time_s": time_s}
-        bodies = [plant.uvms, *(o.uvms for o in self.objects)]
+        bodies = [plant.uvms, *(o.uvms for o in (*self.objects, *self.fixtures))]
         out = np.zeros((self.layout.nv, self.layout.nv))
         layout = self.layout
         for uvms, at, part in zip(bodies, layout.q_slices, layout.v_slices, strict=True):
@@ -241,12 +259,13 @@ class System:
         with free objects, how a period of ``integrator`` steps them)."""
         out = self.plant.record()
         if self.moving is not None:
-            reason = why_not_compiled_system(self, integrator) if self.objects else None
+            several = bool(self.objects or self.fixtures)
+            reason = why_not_compiled_system(self, integrator) if several else None
             out["world"] = {
                 **out["world"],
                 "pairs": self.contact_pair_names,
                 "object_pairs": self.moving.moving.object_pair_names,
-                **({"integration": integration_path(reason)} if self.objects else {}),
+                **({"integration": integration_path(reason, not self.objects)} if several else {}),
             }
             if self.objects:
                 out["world"]["initial_overlap"] = {
@@ -279,7 +298,8 @@ class System:
         pairs = len(self.contact_pair_names)
         if self.moving is not None:
             pairs += len(self.moving.moving.object_pair_names)
-        return hulls + 9 * pairs + 13 * len(self.objects)
+        joints = sum(len(f.joint_names) for f in self.fixtures)
+        return hulls + 9 * pairs + 13 * len(self.objects) + joints
 
     def logged_signals(self, q: np.ndarray, v: np.ndarray) -> dict[str, np.ndarray]:
         """What a run logs of the world at the system's (q, v): ``world_contact``, per
@@ -291,6 +311,7 @@ class System:
         if plant.world is None:
             return {}
         (q_r, v_r), *objects = self.layout.split(q, v)
+        n = len(self.objects)
         compiled = self.compiled
         # the Python integration's own contacts (its rigid contacts' forces are its own)
         if compiled is None or isinstance(compiled, Fallback) or not self.compiled_allowed:
@@ -306,6 +327,8 @@ class System:
         robot, between_objects = self.moving.moving.wrenches(found)
         out = {"world_contact": np.concatenate([fixed, robot])}
         if self.objects:
-            out["free_objects"] = np.concatenate([np.concatenate(s) for s in objects])
+            out["free_objects"] = np.concatenate([np.concatenate(s) for s in objects[:n]])
             out["free_object_contact"] = between_objects
+        for fixture, (q_f, _) in zip(self.fixtures, objects[n:], strict=True):
+            out[fixture.name] = fixture.signal(q_f)
         return out

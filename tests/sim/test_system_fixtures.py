@@ -1,0 +1,174 @@
+"""Fixtures in the system of bodies (uvms_pin.sim.system.fixtures): a fixture's joints hold
+below their Coulomb friction (stiction: a constraint, not a smoothed torque) and turn above
+it at (tau - c) / I, stop at their limits, never gain energy, and turn when a free object
+pushes them; the fixture is stepped by the Python integrator, and says why."""
+
+from __future__ import annotations
+
+import numpy as np
+import pinocchio as pin
+import pytest
+from fixture_helpers import (
+    LEVER_ARM_M,
+    LEVER_MASS_KG,
+    LEVER_OWN_IYY,
+    VALVE,
+    double_lever_urdf,
+    lever_urdf,
+)
+
+from uvms_pin.physics.constraints.joint_limits import JointLimits
+from uvms_pin.physics.constraints.step import constrained_velocity
+from uvms_pin.physics.world.fixture import fixture
+from uvms_pin.physics.world.free_object import free_object
+from uvms_pin.physics.world.world import World
+from uvms_pin.sim.integrators import RK4
+from uvms_pin.sim.plant import Plant
+from uvms_pin.sim.system import System, fixtures
+
+RHO, PERIOD_S = 1025.0, 0.002
+#: the lever's weight's moment about its axis at q = 0 [N m], its inertia [kg m^2]
+TORQUE_NM = LEVER_MASS_KG * 9.81 * LEVER_ARM_M
+INERTIA = LEVER_MASS_KG * LEVER_ARM_M**2 + LEVER_OWN_IYY
+FAR = np.array([30.0, 30.0, -20.0])  # the robot, out of every fixture's reach
+
+
+def _system(uvms, bodies, free=()) -> System:
+    world = World(uvms, [], free=list(free), fixtures=list(bodies))
+    return System(Plant(uvms, free_surface=False, world=world))
+
+
+def _run(system: System, uvms, seconds: float):
+    """The fixtures' (q, v) at the end of every period over ``seconds`` from rest, the
+    robot far away with no input."""
+    q0 = uvms.neutral_configuration()
+    q0[:3] = FAR
+    state = system.initial_state(q0, np.zeros(uvms.nv))
+    system.start(state)
+    q, v, tau, integrator = state.q, state.v, np.zeros(uvms.nv), RK4(5e-4)
+    at_q, at_v = system.layout.q_slices[-1], system.layout.v_slices[-1]
+    out = [(q[at_q].copy(), v[at_v].copy())]
+    for k in range(round(seconds / PERIOD_S)):
+        q, v = system.advance(integrator, k * PERIOD_S, q, v, tau, (k + 1) * PERIOD_S)
+        out.append((q[at_q].copy(), v[at_v].copy()))
+    return np.array([s[0] for s in out]), np.array([s[1] for s in out])
+
+
+def _lever(tmp_path, **urdf):
+    path = lever_urdf(tmp_path, **urdf)
+    return fixture("lever", path, ([0.0, 0.0, -5.0], [0.0, 0.0, 0.0]), water_density_kg_m3=RHO)
+
+
+def test_a_joint_loaded_below_its_friction_does_not_creep(reference_uvms, tmp_path):
+    lever = _lever(tmp_path, friction_Nm=TORQUE_NM / 0.95)
+    q, v = _run(_system(reference_uvms, [lever]), reference_uvms, 1.0)
+    assert np.max(np.abs(q - q[0])) < 1e-9
+    assert np.max(np.abs(v)) < 1e-9
+
+
+def test_a_joint_loaded_above_its_friction_turns_at_tau_minus_c_over_i(reference_uvms, tmp_path):
+    c = TORQUE_NM / 1.05
+    lever = _lever(tmp_path, friction_Nm=c)
+    q, v = _run(_system(reference_uvms, [lever]), reference_uvms, 0.1)
+    expected = (TORQUE_NM - c) / INERTIA
+    assert np.all(np.diff(q[:, 0]) > 0.0)
+    measured = v[-1, 0] / 0.1
+    assert measured == pytest.approx(expected, rel=0.02)
+    # and the angle is the integral of that acceleration
+    assert q[-1, 0] == pytest.approx(0.5 * expected * 0.1**2, rel=0.02)
+
+
+def test_a_fixture_of_two_joints_holds_below_their_friction(reference_uvms, tmp_path):
+    """Two coupled joints go through the iterative solver (not the single joint's exact
+    step), to a tolerance scaled by their inverse inertias: no creep beyond 1e-9 rad."""
+    path = double_lever_urdf(tmp_path, friction_Nm=3.3 * TORQUE_NM)  # the hinge carries 3 m g d
+    double = fixture("double", path, ([0.0, 0.0, -5.0], [0.0, 0.0, 0.0]), water_density_kg_m3=RHO)
+    assert double.joint_names == ("hinge", "elbow")
+    q, v = _run(_system(reference_uvms, [double]), reference_uvms, 0.5)
+    assert np.max(np.abs(q - q[0])) < 1e-9 and np.max(np.abs(v)) < 1e-8
+
+
+def test_a_links_hydrodynamics_element_gives_it_buoyancy(reference_uvms, tmp_path):
+    """A <hydrodynamics> element is read (its buoyancy lightens the lever: half its weight
+    held by a friction the dry lever turns through); a dry link has none derived from its
+    shapes (the slip above would be 17 % slow with its collision box's buoyancy)."""
+    c = 0.95 * TORQUE_NM
+    buoyant = _lever(tmp_path, friction_Nm=c, volume_m3=0.5 * LEVER_MASS_KG / RHO)
+    q, _ = _run(_system(reference_uvms, [buoyant]), reference_uvms, 0.2)
+    assert np.max(np.abs(q)) == 0.0
+    q_dry, _ = _run(_system(reference_uvms, [_lever(tmp_path, friction_Nm=c)]), reference_uvms, 0.2)
+    assert q_dry[-1, 0] > 1e-3
+
+
+def _energy(lever, q: np.ndarray, v: np.ndarray) -> float:
+    model = lever.uvms.model
+    data = model.createData()
+    kinetic = 0.5 * v @ pin.crba(model, data, q) @ v
+    return float(kinetic + pin.computePotentialEnergy(model, data, q))
+
+
+def test_a_joint_stops_at_its_limit_and_never_gains_energy(reference_uvms, tmp_path):
+    upper = 0.2
+    lever = _lever(tmp_path, friction_Nm=0.1, damping=0.01, limits=(-0.1, upper))
+    q, v = _run(_system(reference_uvms, [lever]), reference_uvms, 0.4)
+    assert q[:, 0].max() <= upper + 1e-6  # the solver's tolerance, h times 1e-8 rad/s
+    assert q[-1, 0] == pytest.approx(upper, abs=1e-5) and abs(v[-1, 0]) < 1e-6
+    energy = np.array([_energy(lever, a, b) for a, b in zip(q, v, strict=True)])
+    assert np.max(np.diff(energy)) < 1e-9
+    assert energy[-1] < energy[0] - 0.1  # what it fell by went into friction and the stop
+
+
+def test_a_free_object_falling_on_the_handle_turns_it(reference_uvms):
+    # the panel faces +x, the handle's axis; its paddle lies along y at q = 0 and turns
+    # towards +z for q > 0: a weight on its -y end turns it
+    pose = ([0.0, 0.0, -5.0], [0.0, 0.0, 0.0])
+    valve = fixture("panel", VALVE, pose, water_density_kg_m3=RHO)
+    radius = 0.05
+    ball = free_object(
+        "ball", "sphere", {"radius_m": radius}, ([0.065, -0.085, -5.0 + 0.02 + radius + 0.002],
+        [0.0, 0.0, 0.0]), density_kg_m3=7800.0, water_density_kg_m3=RHO,
+    )  # fmt: skip
+    system = _system(reference_uvms, [valve], [ball])
+    assert system.layout.names == ("robot", "ball", "panel")
+    q, _ = _run(system, reference_uvms, 0.6)
+    assert q[-1, 0] > 0.05
+    alone = _system(reference_uvms, [valve])
+    q_alone, _ = _run(alone, reference_uvms, 0.2)
+    assert np.max(np.abs(q_alone)) < 1e-9  # the weightless-on-its-axis handle holds
+
+
+def test_the_fixtures_are_logged_and_said_to_be_integrated_in_python(reference_uvms):
+    valve = fixture(
+        "panel", VALVE, ([0.0, 0.0, -5.0], [0.0, 0.0, 0.0]), joint_positions={"valve": 0.3},
+        water_density_kg_m3=RHO,
+    )  # fmt: skip
+    system = _system(reference_uvms, [valve])
+    q0 = reference_uvms.neutral_configuration()
+    q0[:3] = FAR
+    state = system.initial_state(q0, np.zeros(reference_uvms.nv))
+    assert state.q.size == reference_uvms.nq + 1 and state.q[-1] == 0.3
+    logged = system.logged_signals(state.q, state.v)
+    assert logged["panel"].components == ("valve",) and logged["panel"].values[0] == 0.3
+    record = system.record(RK4(5e-4))
+    assert fixtures.COMPILED_REFUSAL in record["world"]["integration"]
+    assert record["world"]["fixtures"][0]["joints"] == ["valve"]
+    assert system.n_logged_columns == 9 * len(system.contact_pair_names) + 1
+
+
+def test_a_fixture_touched_by_another_sets_row_is_solved_with_it(tmp_path):
+    """A row of another set on a fixture's joint (as a rigid contact with the robot would
+    be) joins everything into the one solve: the fixture is then not solved apart."""
+    lever = _lever(tmp_path, friction_Nm=0.5, limits=(-0.1, 0.2))
+    model = fixtures.system_model(pin.Model(), [lever])
+    own = fixtures.constraints(1, [lever])
+    other = JointLimits((1,), name="other")  # on the fixture's joint, not the fixture's set
+    q, v_free, h = np.array([0.2]), np.array([3.0]), PERIOD_S
+    mass = lever.uvms.model.inertias[1].mass * LEVER_ARM_M**2 + LEVER_OWN_IYY
+    blocks = fixtures.blocks(1, 0, [lever])
+    args = (model, np.array([[mass]]), v_free, q)
+    apart = fixtures.with_fixtures(constrained_velocity, own, blocks, *args, own, h)
+    assert any(b.name == fixtures.FIXTURE_JOINTS for b in apart.rows) and apart.velocity[0] == 0.0
+    together = fixtures.with_fixtures(constrained_velocity, own, blocks, *args, (*own, other), h)
+    expected = constrained_velocity(*args, (*own, other), h)
+    assert {b.name for b in together.rows} == {b.name for b in expected.rows}
+    np.testing.assert_array_equal(together.velocity, expected.velocity)
