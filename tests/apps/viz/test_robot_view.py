@@ -182,3 +182,19 @@ def test_the_replay_shows_a_bluerov2_with_an_arm_in_a_browser(bluerov_replay, tm
     # measured 4062 and 13908 here; the box and balls gave 2302 and 4641
     assert foam.sum() > 3000
     assert black.sum() > 9000
+
+
+def test_show_is_a_run_and_replay_option(tmp_path):
+    from viz_support import short_scenario
+
+    from uvms_pin.apps.cli.main import main
+
+    scenario = short_scenario(tmp_path, 0.2)
+    out = tmp_path / "run"
+    assert main(["run", str(scenario), "--out", str(out), "--html", "--show", "both"]) == 0
+    assert "collision shapes (translucent orange)" in (out / "replay.html").read_text()
+    page = tmp_path / "visual.html"
+    assert main(["replay", str(out), "--html", "--out", str(page)]) == 0
+    assert "collision shapes" not in page.read_text()
+    with pytest.raises(SystemExit):
+        main(["replay", str(out), "--html", "--show", "meshes"])
