@@ -286,6 +286,95 @@ def _header(name: str, what: str) -> str:
     )
 
 
+# ---- drawing only (<visual>): no physics number depends on these -------------------------
+# Primitives in the URDF's own <visual> elements, laid out after Blue Robotics' BlueROV2
+# Heavy (black frame side panels, buoyancy foam on top, the 4" acrylic electronics tube with
+# its dome, the 3" battery tube, 8 T200 thrusters where `uvms_pin.model.vehicles.
+# bluerov2_heavy.thrusters()` puts them) and the Reach Alpha 5 (40 mm black housings along
+# each link). No maker's mesh is shipped: models/README.md section 12 says why.
+_BLACK = ("frame_black", "0.06 0.06 0.07 1")
+_FOAM = ("foam_blue", "0.10 0.32 0.72 1")
+_ACRYLIC = ("acrylic", "0.80 0.90 1.00 0.35")
+_ALUMINIUM = ("aluminium", "0.62 0.64 0.68 1")
+_THRUSTER = ("t200_grey", "0.18 0.18 0.20 1")
+# geometry, xyz [m], rpy [rad], material
+BLUEROV_VISUALS = (
+    ('<box size="0.457 0.012 0.22"/>', (0.0, 0.16, -0.015), (0.0, 0.0, 0.0), _BLACK),
+    ('<box size="0.457 0.012 0.22"/>', (0.0, -0.16, -0.015), (0.0, 0.0, 0.0), _BLACK),
+    ('<box size="0.40 0.30 0.010"/>', (0.0, 0.0, -0.122), (0.0, 0.0, 0.0), _BLACK),
+    ('<box size="0.16 0.115 0.012"/>', (0.12, 0.2175, -0.01), (0.0, 0.0, 0.0), _BLACK),
+    ('<box size="0.16 0.115 0.012"/>', (0.12, -0.2175, -0.01), (0.0, 0.0, 0.0), _BLACK),
+    ('<box size="0.16 0.115 0.012"/>', (-0.12, 0.2175, -0.01), (0.0, 0.0, 0.0), _BLACK),
+    ('<box size="0.16 0.115 0.012"/>', (-0.12, -0.2175, -0.01), (0.0, 0.0, 0.0), _BLACK),
+    ('<box size="0.42 0.12 0.065"/>', (0.0, 0.095, 0.0945), (0.0, 0.0, 0.0), _FOAM),
+    ('<box size="0.42 0.12 0.065"/>', (0.0, -0.095, 0.0945), (0.0, 0.0, 0.0), _FOAM),
+    ('<cylinder radius="0.0572" length="0.30"/>', (0.0, 0.0, 0.0), (0.0, HALF_PI, 0.0), _ACRYLIC),
+    ('<sphere radius="0.0572"/>', (0.15, 0.0, 0.0), (0.0, 0.0, 0.0), _ACRYLIC),
+    (
+        '<cylinder radius="0.062" length="0.02"/>',
+        (-0.16, 0.0, 0.0),
+        (0.0, HALF_PI, 0.0),
+        _ALUMINIUM,
+    ),
+    (
+        '<cylinder radius="0.0381" length="0.25"/>',
+        (-0.02, 0.0, -0.085),
+        (0.0, HALF_PI, 0.0),
+        _ALUMINIUM,
+    ),
+)
+T200_VISUAL = '<cylinder radius="0.05" length="0.10"/>'  # T200: 100 mm across, 113 mm long
+# link: (geometry, xyz [m], rpy [rad]) in K23's link frames (the joint axes are z)
+ALPHA_VISUALS = {
+    "alpha_base_link": (
+        ('<cylinder radius="0.02" length="0.15"/>', (-0.075, 0, 0), (0, HALF_PI, 0)),
+    ),
+    "alpha_shoulder_link": (
+        ('<cylinder radius="0.021" length="0.05"/>', (0.0, 0.0, 0.025), (0.0, 0.0, 0.0)),
+        ('<cylinder radius="0.021" length="0.045"/>', (0.02, 0.0, 0.046), (HALF_PI, 0.0, 0.0)),
+    ),
+    "alpha_upper_arm_link": (
+        ('<cylinder radius="0.02" length="0.15"/>', (0.075, 0.0, 0.0), (0.0, HALF_PI, 0.0)),
+    ),
+    "alpha_forearm_link": (
+        ('<cylinder radius="0.021" length="0.045"/>', (0.0, 0.0, 0.0), (0.0, 0.0, 0.0)),
+        ('<cylinder radius="0.02" length="0.03"/>', (0.02, -0.01, 0.0), (HALF_PI, 0.0, 0.0)),
+    ),
+    "alpha_wrist_link": (
+        ('<cylinder radius="0.02" length="0.06"/>', (0.0, 0.0, -0.005), (0.0, 0.0, 0.0)),
+    ),
+}
+_ALPHA_BLACK = ("alpha_black", "0.10 0.10 0.11 1")
+
+
+def _visual(geometry: str, xyz, rpy, material) -> str:
+    name, rgba = material
+    return (
+        f'    <visual>\n      <origin xyz="{_f(xyz)}" rpy="{_f(rpy)}"/>\n'
+        f"      <geometry>{geometry}</geometry>\n"
+        f'      <material name="{name}"><color rgba="{rgba}"/></material>\n    </visual>\n'
+    )
+
+
+def _rpy_of_axis(direction) -> tuple[float, float, float]:
+    """rpy turning a cylinder's z axis onto a unit ``direction`` (z, or in the x-y plane)."""
+    x, y, z = direction
+    if abs(z) > 0.5:
+        return (0.0, 0.0, 0.0)
+    return (0.0, HALF_PI, math.atan2(y, x))
+
+
+def bluerov_visuals() -> str:
+    """The BlueROV2 Heavy's <visual> elements (drawing only)."""
+    from uvms_pin.model.vehicles.bluerov2_heavy import thrusters
+
+    out = "".join(_visual(*item) for item in BLUEROV_VISUALS)
+    for thruster in thrusters():
+        rpy = _rpy_of_axis(thruster.direction_body)
+        out += _visual(T200_VISUAL, thruster.position_body_m, rpy, _THRUSTER)
+    return out
+
+
 def _hull_link(mass, inertia, hydro: str) -> str:
     ixx, iyy, izz = inertia
     box = _f(BLUEROV_BOX_M)
@@ -293,10 +382,8 @@ def _hull_link(mass, inertia, hydro: str) -> str:
         '  <link name="base_link">\n'
         + _inertial(mass, (0.0, 0.0, 0.0), (ixx, 0, 0, iyy, 0, izz))
         + hydro
-        + f'    <visual>\n      <geometry><box size="{box}"/></geometry>\n'
-        '      <material name="bluerov_blue"><color rgba="0.2 0.4 0.7 0.6"/></material>\n'
-        "    </visual>\n"
-        f'    <collision>\n      <geometry><box size="{box}"/></geometry>\n    </collision>\n'
+        + bluerov_visuals()
+        + f'    <collision>\n      <geometry><box size="{box}"/></geometry>\n    </collision>\n'
         "  </link>\n"
     )
 
@@ -364,12 +451,8 @@ def alpha5_urdf() -> str:
     for name, mass, com, inertia, volume_L, cob, drag, added in ALPHA_LINKS:
         # volume 0 here: this link's buoyancy, added mass and drag sit on its _cob frame
         out += f'  <link name="{name}">\n{_inertial(mass, com, inertia)}{_hydro(0.0)}'
-        out += (
-            '    <visual>\n      <origin xyz="' + _f(com) + '" rpy="0 0 0"/>\n'
-            '      <geometry><sphere radius="0.02"/></geometry>\n'
-            '      <material name="alpha_grey"><color rgba="0.3 0.3 0.3 1"/></material>\n'
-            "    </visual>\n  </link>\n"
-        )
+        out += "".join(_visual(*item, _ALPHA_BLACK) for item in ALPHA_VISUALS[name])
+        out += "  </link>\n"
         # the hydrodynamics act at the centre of buoyancy (K23 applies buoyancy and the
         # quadratic drag of the CoB's velocity there): a massless frame at the CoB carries them
         hydro = _hydro(

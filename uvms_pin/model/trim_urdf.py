@@ -43,6 +43,11 @@ def add_trim_links(root: ET.Element, vehicle_link: str, report: TrimReport) -> N
         ET.SubElement(joint, "origin", {"xyz": numbers_text(position), "rpy": "0 0 0"})
 
 
+# drawing only: the foam a translucent amber sheet, the ballast a translucent lead-grey one
+# (each spans the hull's footprint, thin)
+_TRIM_RGBA = {"trim_foam": "1 0.8 0.3 0.2", "trim_ballast": "0.35 0.35 0.38 0.6"}
+
+
 def _slab_link(
     name: str, mass: float, size: tuple[float, float, float], hydro: ET.Element
 ) -> ET.Element:
@@ -73,6 +78,8 @@ def _slab_link(
     visual = ET.SubElement(link, "visual")
     geom = ET.SubElement(visual, "geometry")
     ET.SubElement(geom, "box", {"size": numbers_text([lx, ly, max(lz, 1e-4)])})
+    material = ET.SubElement(visual, "material", {"name": name})
+    ET.SubElement(material, "color", {"rgba": _TRIM_RGBA.get(name, "0.5 0.5 0.5 1")})
     link.append(hydro)
     return link
 

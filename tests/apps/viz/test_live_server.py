@@ -206,7 +206,8 @@ def test_a_browser_receives_the_stream_paced_by_the_clock(reference_uvms, monkey
     clock = ManualClock()
     monkeypatch.setattr(live_module, "time", clock)
     page = HeadlessPage()  # skips without chromium
-    base = "viewer.scene_tree.find(['meshcat', 'uvms_pin', 'robot', 'visuals', 'base_link_0'])"
+    # the vehicle's body node (its pieces sit in it at fixed placements)
+    base = "viewer.scene_tree.find(['meshcat', 'uvms_pin', 'robot', 'visuals', 'root_joint'])"
     x = f"{base}.object.position.x"
     try:
         with LiveView(UvmsScene(reference_uvms), port=0, speed=2.0) as live:

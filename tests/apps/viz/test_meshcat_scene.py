@@ -19,6 +19,7 @@ from uvms_pin.apps.viz.meshcat_scene import (
     pose_matrix,
     recording_visualizer,
 )
+from uvms_pin.apps.viz.robot_view import piece_placement
 from uvms_pin.errors import VizError
 
 
@@ -78,26 +79,33 @@ def test_the_spring_runs_from_its_anchor_to_the_tip(scene, reference_uvms):
 
 
 def test_visuals_are_placed_as_pinocchio_places_them(scene, reference_uvms):
+    """Each piece is drawn at its body's pose times its fixed placement (scale included):
+    where Pinocchio places it."""
     model = reference_uvms.model
     q = pin.randomConfiguration(model, -np.ones(model.nq), np.ones(model.nq))
     poses = scene.poses(Frame(0.0, q))
+    visuals = scene.geometry["visuals"]
     data = model.createData()
-    geom_data = pin.GeometryData(scene.visual_model)
+    geom_data = pin.GeometryData(visuals)
     pin.forwardKinematics(model, data, q)
-    pin.updateGeometryPlacements(model, data, scene.visual_model, geom_data)
-    names = [g.name for g in scene.visual_model.geometryObjects]
-    assert len(names) >= 10
-    for k, name in enumerate(names):
-        np.testing.assert_allclose(
-            pose_matrix(poses[f"robot/visuals/{name}"]), geom_data.oMg[k].homogeneous, atol=1e-12
-        )
+    pin.updateGeometryPlacements(model, data, visuals, geom_data)
+    assert len(visuals.geometryObjects) >= 10
+    for k, obj in enumerate(visuals.geometryObjects):
+        body = pose_matrix(poses[f"robot/visuals/{model.names[obj.parentJoint]}"])
+        expected = geom_data.oMg[k].homogeneous
+        expected[:3, :3] *= np.asarray(obj.meshScale)[None, :]
+        np.testing.assert_allclose(body @ piece_placement(obj), expected, atol=1e-12)
 
 
 def test_the_static_scene_draws_the_robot_and_the_environment(scene):
     vis, window = recording_visualizer()
     scene.build(vis)
     blob = b"".join(window.commands)
-    for path in (b"/meshcat/uvms_pin/robot/visuals/base_link_0", b"environment/anchor", b"floor"):
+    for path in (
+        b"/meshcat/uvms_pin/robot/visuals/root_joint/base_link_0",
+        b"environment/anchor",
+        b"floor",
+    ):
         assert path in blob
 
 

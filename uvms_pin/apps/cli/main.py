@@ -49,7 +49,7 @@ def _cmd_replay(args: argparse.Namespace) -> int:
     if args.html:
         path = Path(args.out) if args.out else Path(args.rollout) / "replay.html"
         with claim_file(path, overwrite=args.overwrite):
-            _write_replay(rollout, path, urdf=args.urdf, max_fps=args.fps)
+            _write_replay(rollout, path, urdf=args.urdf, max_fps=args.fps, show=args.show)
         size_mb = path.stat().st_size / 1e6
         print(f"wrote {path} ({size_mb:.1f} MB, {len(rollout)} samples)")
     if args.live == "foxglove":
@@ -63,7 +63,7 @@ def _cmd_replay(args: argparse.Namespace) -> int:
         from uvms_pin.apps.viz.live import replay_live
         from uvms_pin.apps.viz.replay import scene_for_rollout
 
-        scene = scene_for_rollout(rollout, urdf=args.urdf)
+        scene = scene_for_rollout(rollout, urdf=args.urdf, show=args.show)
         replay_live(rollout, scene, port=args.port, speed=args.speed, out=sys.stdout)
     return 0
 
@@ -86,6 +86,13 @@ def _add_view_options(parser: argparse.ArgumentParser) -> None:
     )
     parser.add_argument(
         "--speed", type=positive, default=1.0, help="live playback speed-up over real time"
+    )
+    parser.add_argument(
+        "--show",
+        choices=("visual", "collision", "both"),
+        default="visual",
+        help="the robot as drawn in meshcat (--html, --live): its URDF <visual> geometry, its "
+        "<collision> shapes (translucent orange) or both",
     )
 
 

@@ -102,11 +102,14 @@ def _simulate(scenario, args: argparse.Namespace, progress) -> Rollout:
 
     if not args.live:
         return simulate(scenario, progress=progress)
-    if args.live == "foxglove":
-        from uvms_pin.apps.viz.foxglove_live import run_foxglove as run_view
-    else:
-        from uvms_pin.apps.viz.live import run_live as run_view
-    return run_view(scenario, port=args.port, speed=args.speed, progress=progress, out=sys.stdout)
+    view = {"port": args.port, "speed": args.speed, "progress": progress, "out": sys.stdout}
+    if args.live == "foxglove":  # Foxglove draws the bag's markers, not the URDF geometry
+        from uvms_pin.apps.viz.foxglove_live import run_foxglove
+
+        return run_foxglove(scenario, **view)
+    from uvms_pin.apps.viz.live import run_live
+
+    return run_live(scenario, show=args.show, **view)
 
 
 def _simulate_to_end(scenario, args: argparse.Namespace) -> Ending:
@@ -165,7 +168,7 @@ def _save(
         if args.html:
             from uvms_pin.apps.viz.replay import write_replay
 
-            write_replay(rollout, out / "replay.html")
+            write_replay(rollout, out / "replay.html", show=args.show)
         guard.checkpoint()  # a Ctrl-C during the replay: the command says it stopped
     except KeyboardInterrupt:
         kept = ", ".join(_files_of_the_run(out)) or "nothing"

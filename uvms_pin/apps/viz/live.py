@@ -373,8 +373,11 @@ class LiveFeed:
         )
 
 
-def scene_for_scenario(scenario: Scenario, style: SceneStyle | None = None) -> UvmsScene:
-    """The scene of a scenario before it runs (extent: the initial vehicle and tip)."""
+def scene_for_scenario(
+    scenario: Scenario, style: SceneStyle | None = None, show: str = "visual"
+) -> UvmsScene:
+    """The scene of a scenario before it runs (extent: the initial vehicle and tip); ``show``
+    the robot's visual geometry, its collision shapes or both (`UvmsScene`)."""
     probe = UvmsScene(scenario.uvms)
     tip0 = probe.ee_position(scenario.q0)
     controller = scenario.raw.get("controller") or {}
@@ -393,6 +396,7 @@ def scene_for_scenario(scenario: Scenario, style: SceneStyle | None = None) -> U
         style=style,
         surface=surface,
         world=WorldView.from_record(scenario.plant.record()["world"], extent.mean(axis=0)),
+        show=show,
     )
 
 
@@ -412,13 +416,15 @@ def run_live(
     progress: Progress | None = None,
     out: TextIO | None = sys.stdout,
     style: SceneStyle | None = None,
+    show: str = "visual",
 ) -> Rollout:
     """Simulate a scenario while showing it live; the server is gone when this returns.
 
     A run that stops early (FunnelViolation, SimulationError) is shown to its end and the
     error re-raised; KeyboardInterrupt closes the view at once and propagates.
     """
-    with LiveView(scene_for_scenario(scenario, style), port=port, speed=speed, out=out) as live:
+    scene = scene_for_scenario(scenario, style, show)
+    with LiveView(scene, port=port, speed=speed, out=out) as live:
         return simulate_watched(scenario, live, LiveFeed(live), progress=progress, out=out)
 
 

@@ -2,7 +2,11 @@
 
 What is drawn (paths under ``/meshcat/uvms_pin``):
 
-- ``robot/visuals/*``: the URDF visual geometry (Pinocchio's meshcat visualiser);
+- ``robot/visuals/<joint>/<geometry>``: the URDF's ``<visual>`` geometry (primitives with
+  their materials, meshes), one node per moving body (named after its joint) holding that
+  body's geometry at its fixed placement, so that an animation moves a body, not each piece;
+- ``robot/collisions/<joint>/<geometry>``: the ``<collision>`` shapes, translucent orange,
+  when asked for (``show="collision"`` or ``"both"``);
 - ``environment/*``: the spring (anchor sphere + helix from the anchor to the tip) or the
   compliant plane (translucent slab);
 - ``forces/measured`` (red) and ``forces/desired`` (green): contact force arrows from the
@@ -22,7 +26,6 @@ them as transforms, the replay records them as animation tracks.
 from __future__ import annotations
 
 import math
-import warnings
 from collections.abc import Mapping
 from dataclasses import dataclass
 from pathlib import Path
@@ -34,6 +37,13 @@ import numpy as np
 import pinocchio as pin
 import umsgpack
 
+from uvms_pin.apps.viz.robot_view import (
+    COLLISION_RGBA,
+    Pose,
+    body_poses,
+    draw_bodies,
+    geometry_groups,
+)
 from uvms_pin.apps.viz.surface import SurfaceView
 from uvms_pin.apps.viz.world_view import WorldView
 from uvms_pin.errors import VizError
@@ -43,8 +53,6 @@ ROOT = "uvms_pin"
 _Y = np.array([0.0, 1.0, 0.0])
 _TINY = 1e-6
 
-# (position, quaternion x y z w, scale)
-Pose = tuple[np.ndarray, np.ndarray, np.ndarray]
 
 _RED = 0xE03030
 _GREEN = 0x20C040
@@ -182,6 +190,9 @@ class UvmsScene:
         style: scales and sizes.
         visual_model: the geometry to draw; default: the visual elements of the URDF
             ``uvms.source`` (meshes found through ``package_dirs``).
+        show: the robot's geometry to draw: ``"visual"`` (the URDF's ``<visual>``
+            elements), ``"collision"`` (its ``<collision>`` shapes, translucent orange) or
+            ``"both"`` (each group can be hidden in meshcat's controls).
         surface: the free surface (animated waves, or the level z = 0 of still water), or
             None (water without a top: not drawn).
     """
@@ -199,6 +210,7 @@ class UvmsScene:
         package_dirs: tuple[str, ...] = (),
         surface: SurfaceView | None = None,
         world: WorldView | None = None,
+        show: str = "visual",
     ):
         self.uvms = uvms
         self.surface = surface
@@ -208,19 +220,11 @@ class UvmsScene:
         self.show_forces = environment is not None or show_desired
         self.show_desired = show_desired
         self.style = style or SceneStyle()
-        if visual_model is None:
-            urdf = Path(uvms.source)
-            if not urdf.is_file():
-                raise VizError(
-                    f"{uvms.source}: no URDF file to read the visual geometry from "
-                    "(pass visual_model=)"
-                )
-            extra = {"package_dirs": [str(d) for d in package_dirs]} if package_dirs else {}
-            visual_model = pin.buildGeomFromUrdf(
-                uvms.model, str(urdf), pin.GeometryType.VISUAL, **extra
-            )
-        self.visual_model = visual_model
-        self.visual_data = pin.GeometryData(self.visual_model)
+        urdf = Path(uvms.source) if uvms.source else None
+        #: what is drawn of the robot, by node group ("visuals", "collisions")
+        self.geometry = geometry_groups(
+            uvms.model, urdf, show, visual_model=visual_model, package_dirs=package_dirs
+        )
         self.data = uvms.model.createData()
 
         points = np.atleast_2d(
@@ -237,6 +241,8 @@ class UvmsScene:
     def legend(self) -> str:
         """What the colours and arrow lengths mean, for what this scene draws."""
         parts = []
+        if "collisions" in self.geometry:
+            parts.append("collision shapes (translucent orange)")
         if self.show_forces:
             forces = "measured (red)" + (", desired (green)" if self.show_desired else "")
             parts.append(f"contact force: {forces}, {self.style.force_scale_m_per_N:g} m per N")
@@ -296,15 +302,9 @@ class UvmsScene:
         )
 
     def _build_robot(self, root: meshcat.Visualizer) -> None:
-        from pinocchio.visualize import MeshcatVisualizer
-
-        viz = MeshcatVisualizer(
-            self.uvms.model, collision_model=None, visual_model=self.visual_model
-        )
-        with warnings.catch_warnings():
-            warnings.simplefilter("ignore")  # unsupported geometry warnings, if any
-            viz.initViewer(viewer=root)
-            viz.loadViewerModel(rootNodeName="robot")
+        for group, geometry in self.geometry.items():
+            rgba = COLLISION_RGBA if group == "collisions" else None
+            draw_bodies(root[f"robot/{group}"], self.uvms.model, geometry, rgba)
 
     def _build_floor(self, root: meshcat.Visualizer) -> None:
         half = 5.0
@@ -370,16 +370,9 @@ class UvmsScene:
         model, data = self.uvms.model, self.data
         q = np.asarray(frame.q, dtype=float)
         pin.forwardKinematics(model, data, q)
-        pin.updateGeometryPlacements(model, data, self.visual_model, self.visual_data)
         out: dict[str, Pose] = {}
-        for k, obj in enumerate(self.visual_model.geometryObjects):
-            placement = self.visual_data.oMg[k]
-            quat = pin.Quaternion(placement.rotation).coeffs().copy()
-            out[f"robot/visuals/{obj.name}"] = (
-                placement.translation.copy(),
-                quat,
-                np.asarray(obj.meshScale, dtype=float).copy(),
-            )
+        for group, geometry in self.geometry.items():
+            out.update(body_poses(model, data, geometry, f"robot/{group}"))
         tip = self._tip_after_kinematics()
         base = q[:3]
         if self.environment is not None and self.environment.kind == "spring":

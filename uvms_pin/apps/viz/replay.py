@@ -53,10 +53,15 @@ def _viewer_bundle() -> str:
 
 
 def scene_for_rollout(
-    rollout: Rollout, *, urdf: str | Path | None = None, style: SceneStyle | None = None
+    rollout: Rollout,
+    *,
+    urdf: str | Path | None = None,
+    style: SceneStyle | None = None,
+    show: str = "visual",
 ) -> UvmsScene:
     """The scene of a rollout: its model (``metadata['model_source']`` or ``urdf``), the
-    world it recorded (``metadata['world']``: contact, current, waves), its extent."""
+    world it recorded (``metadata['world']``: contact, current, waves), its extent; ``show``
+    the robot's visual geometry, its collision shapes or both (`UvmsScene`)."""
     if len(rollout) == 0:
         raise VizError("the rollout has no sample to show")
     meta = rollout.metadata
@@ -88,6 +93,7 @@ def scene_for_rollout(
         style=style,
         surface=surface,
         world=WorldView.from_record(world.get("world"), extent.mean(axis=0)),
+        show=show,
     )
 
 
@@ -122,12 +128,14 @@ def replay_html(
     max_fps: float = 30.0,
     max_frames: int = 1800,
     style: SceneStyle | None = None,
+    show: str = "visual",
 ) -> str:
-    """The replay page of a rollout (a string of HTML)."""
+    """The replay page of a rollout (a string of HTML); ``show``: the robot's ``"visual"``
+    geometry, its ``"collision"`` shapes or ``"both"``."""
     good = np.isfinite(rollout.time_s) & np.all(np.isfinite(rollout.q), axis=1)
     if not np.any(good):
         raise VizError("the rollout has no finite sample to show")
-    scene = scene_for_rollout(rollout, urdf=urdf, style=style)
+    scene = scene_for_rollout(rollout, urdf=urdf, style=style, show=show)
     vis, window = recording_visualizer()
     scene.build(vis)
 

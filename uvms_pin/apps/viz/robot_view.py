@@ -1,0 +1,116 @@
+"""The robot's URDF geometry in meshcat, one node per moving body.
+
+Each geometry object (a ``<visual>`` or ``<collision>`` element: box, cylinder, sphere or
+mesh) is drawn under ``<group>/<joint>/<name>``, at its fixed placement in its joint's frame
+(mesh scale included); only the body nodes ``<group>/<joint>`` move, to the joint's pose
+``oMi``. A body drawn from many pieces (a vehicle's frame, foam, tubes, thrusters) so costs a
+replay one animation track, not one per piece.
+"""
+
+from __future__ import annotations
+
+import warnings
+from pathlib import Path
+
+import meshcat
+import numpy as np
+import pinocchio as pin
+from pinocchio.visualize import MeshcatVisualizer
+
+from uvms_pin.errors import VizError
+
+#: what ``show`` may ask for, and the node groups each draws
+SHOWN = {"visual": ("visuals",), "collision": ("collisions",), "both": ("visuals", "collisions")}
+#: colour of the collision shapes (RGBA): translucent orange over the visuals
+COLLISION_RGBA = np.array([1.0, 0.55, 0.1, 0.45])
+
+# (position, quaternion x y z w, scale)
+Pose = tuple[np.ndarray, np.ndarray, np.ndarray]
+
+
+def geometry_groups(
+    model: pin.Model,
+    urdf: Path | None,
+    show: str,
+    *,
+    visual_model: pin.GeometryModel | None = None,
+    package_dirs: tuple[str, ...] = (),
+) -> dict[str, pin.GeometryModel]:
+    """The geometry to draw, by group (``"visuals"``, ``"collisions"``), as ``show`` asks.
+
+    Args:
+        model: the kinematic model the geometry hangs on.
+        urdf: the URDF file to read ``<visual>`` / ``<collision>`` from (None: only a given
+            ``visual_model`` can be drawn).
+        show: ``"visual"``, ``"collision"`` or ``"both"``.
+        visual_model: the visual geometry, if already built.
+        package_dirs: where ``package://`` and relative mesh paths are looked up.
+    """
+    if show not in SHOWN:
+        raise VizError(f"show={show!r}: expected one of {', '.join(SHOWN)}")
+    kinds = {"visuals": pin.GeometryType.VISUAL, "collisions": pin.GeometryType.COLLISION}
+    out = {}
+    for group in SHOWN[show]:
+        if group == "visuals" and visual_model is not None:
+            out[group] = visual_model
+            continue
+        if urdf is None or not urdf.is_file():
+            raise VizError(
+                f"{urdf}: no URDF file to read the {group[:-1]} geometry from"
+                + (" (pass visual_model=)" if group == "visuals" else "")
+            )
+        extra = {"package_dirs": [str(d) for d in package_dirs]} if package_dirs else {}
+        out[group] = pin.buildGeomFromUrdf(model, str(urdf), kinds[group], **extra)
+    return out
+
+
+class _BodyVisualizer(MeshcatVisualizer):
+    """Pinocchio's meshcat loader (primitives, meshes, URDF colours), its nodes per body."""
+
+    def getViewerNodeName(self, geometry_object, geometry_type):
+        return f"{self.model.names[geometry_object.parentJoint]}/{geometry_object.name}"
+
+
+def draw_bodies(
+    node: meshcat.Visualizer,
+    model: pin.Model,
+    geometry: pin.GeometryModel,
+    rgba: np.ndarray | None = None,
+) -> None:
+    """Every object of ``geometry`` under ``node[<joint>/<name>]`` at its placement in its
+    joint's frame; ``rgba`` overrides the URDF colours (None: keep them)."""
+    viz = _BodyVisualizer(model, collision_model=None, visual_model=geometry)
+    viz.initViewer(viewer=node)
+    for obj in geometry.geometryObjects:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")  # an unsupported geometry is skipped, not fatal
+            viz.loadViewerGeometryObject(obj, pin.GeometryType.VISUAL, rgba)
+        node[viz.getViewerNodeName(obj, pin.GeometryType.VISUAL)].set_transform(
+            piece_placement(obj)
+        )
+
+
+def piece_placement(obj: pin.GeometryObject) -> np.ndarray:
+    """4x4 transform of a piece in its body's node: its placement in the joint frame, the
+    mesh scale applied to its axes."""
+    placement = obj.placement.homogeneous.copy()
+    placement[:3, :3] *= np.asarray(obj.meshScale, dtype=float)[None, :]
+    return placement
+
+
+def moving_bodies(model: pin.Model, geometry: pin.GeometryModel) -> list[int]:
+    """The joints (indices) that carry at least one object of ``geometry``, in order."""
+    return sorted({obj.parentJoint for obj in geometry.geometryObjects})
+
+
+def body_poses(
+    model: pin.Model, data: pin.Data, geometry: pin.GeometryModel, prefix: str
+) -> dict[str, Pose]:
+    """Pose of each body node ``prefix/<joint>`` (world frame, unit scale), from ``data.oMi``
+    (forward kinematics done)."""
+    out: dict[str, Pose] = {}
+    for joint in moving_bodies(model, geometry):
+        placement = data.oMi[joint]
+        quat = pin.Quaternion(placement.rotation).coeffs().copy()
+        out[f"{prefix}/{model.names[joint]}"] = (placement.translation.copy(), quat, np.ones(3))
+    return out
