@@ -1,6 +1,8 @@
 # Two commands do all the set-up on a fresh machine with Python 3.11 and pip:
 #   make demo   - create .venv, install uvms-pin (no extra), run the main scenario into out/demo
 #   make test   - create .venv, install uvms-pin with dev tools, lint and run the test suite
+#   make check  - while developing: lint and every test but the long ones (marked slow), in a
+#                 few minutes on a built checkout
 #   make results - regenerate every table (docs/results/*.md) and figure the docs quote
 #                  (RESULTS="paper robustness" for some; the list is scripts/make_results.py)
 #   make docs    - build the documentation site into site/ (mkdocs.yml), --strict, offline
@@ -12,7 +14,7 @@ BASE_STAMP := $(VENV)/.installed-base
 DEMO_SCENARIO ?= scenarios/realistic_force_tracking.toml
 DEMO_OUT ?= out/demo
 
-.PHONY: demo test lint bench results fuzz docs clean
+.PHONY: demo test check lint bench results fuzz docs clean
 
 SOURCES := pyproject.toml CMakeLists.txt $(wildcard src/uvms_core/*.cpp src/uvms_core/*.hpp)
 
@@ -48,6 +50,12 @@ test: $(STAMP) lint
 	  else echo "chromium missing and not installable here (needs root + apt-get): browser tests will skip"; fi; }
 	@# two workers per two cores (pytest-xdist): each test is independent of the others' order
 	$(BIN)/python -m pytest -q -n auto
+
+# the loop of a change: lint and every test not marked slow (the long physics campaigns, long
+# runs, the generated-input tests, the notebooks, the doc runs and the site: `make test` runs
+# them; pyproject.toml's markers say what slow is), at most 3 minutes on the 2-core machine
+check: $(STAMP) lint
+	$(BIN)/python -m pytest -q -n auto -m "not slow"
 
 # the generated-input campaign (tests/fuzz): HYPOTHESIS_PROFILE=campaign draws 6 times the
 # inputs `make test` draws, from FUZZ_SEED (printed; FUZZ_SEED=N make fuzz replays or varies

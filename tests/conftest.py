@@ -12,6 +12,7 @@ from pathlib import Path
 import numpy as np
 import pinocchio as pin
 import pytest
+from slow_tests import SLOW_MODULES, SLOW_TESTS
 
 import uvms_pin as up
 
@@ -24,6 +25,14 @@ RHO = 1025.0
 G = 9.81
 #: relative agreement of the compiled core with the Python reference
 REL = 1e-12
+
+
+def pytest_collection_modifyitems(config, items) -> None:
+    """Mark ``slow`` the tests tests/slow_tests.py lists (`make check` leaves them out)."""
+    for item in items:
+        path, _, _ = item.nodeid.partition("::")
+        if path.startswith(SLOW_MODULES) or item.nodeid.partition("[")[0] in SLOW_TESTS:
+            item.add_marker(pytest.mark.slow)
 
 
 def mount_on_reference_vehicle(arm: str, tmp_dir: Path) -> up.UVMS:

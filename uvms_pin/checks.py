@@ -38,6 +38,22 @@ def finite_vector(name: str, value, size: int) -> np.ndarray:
     return array
 
 
+def positive(name: str, value: float) -> float:
+    """``value`` as a float, finite and > 0, or ParameterError naming ``name``."""
+    value = float(value)
+    if not (math.isfinite(value) and value > 0.0):
+        raise ParameterError(f"{name} must be finite and > 0, got {value}")
+    return value
+
+
+def nonnegative(name: str, value: float) -> float:
+    """``value`` as a float, finite and >= 0, or ParameterError naming ``name``."""
+    value = float(value)
+    if not (math.isfinite(value) and value >= 0.0):
+        raise ParameterError(f"{name} must be finite and >= 0, got {value}")
+    return value
+
+
 @dataclass(frozen=True)
 class Plausible:
     """What a physical quantity can be (``possible``: beyond, it is refused) and what it

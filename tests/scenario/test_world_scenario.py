@@ -95,7 +95,7 @@ def test_bad_objects_are_refused_naming_the_key(k, changes, message):
 @pytest.mark.parametrize(
     ("overrides", "message"),
     [
-        ({"world.contact.stiffness_N_m": 0.0}, r"stiffness_N_m must be > 0"),
+        ({"world.contact.stiffness_N_m": 0.0}, r"stiffness_N_m must be finite and > 0"),
         ({"world.contact.friction_kinetic": 0.9}, r"friction_static >= friction_kinetic"),
         ({"world.contact.stifness_N_m": 1.0}, r"unknown key"),
         ({"joints.stop_stiffness_Nm_rad": -1.0}, r"joints\.stop_stiffness_Nm_rad.*positive"),

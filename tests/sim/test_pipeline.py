@@ -18,6 +18,7 @@ from uvms_pin.sim.pipeline import REASONS, Pipeline, RunParts, why_not_compiled
 from uvms_pin.sim.run import simulate
 from uvms_pin.sim.sample import ProgressReport
 from uvms_pin.sim.system import System
+from uvms_pin.sim.system.period import why_not_compiled_system
 
 STATION = ROOT / "scenarios" / "gym_station_keeping.toml"
 REALISTIC = ROOT / "scenarios" / "realistic_force_tracking.toml"
@@ -89,7 +90,24 @@ def test_a_reason_applies_only_to_the_pipelines_it_names():
 def test_every_reason_is_asked_in_one_list_and_names_its_pipelines():
     assert len(REASONS) >= 10
     for pipelines, check in REASONS:
-        assert pipelines & Pipeline.BOTH and callable(check)
+        assert pipelines & Pipeline.ALL and callable(check)
+
+
+def test_the_system_period_asks_the_same_list():
+    """The period of a system of bodies (`Pipeline.SYSTEM`) is decided by the list the loop
+    asks: the Python integration asked for (the loop's flag, worded for each), an integrator
+    without a counterpart, the Python backend; none for a plant that compiles."""
+    scenario = _station()
+    system = System(scenario.plant, compiled=False)
+    parts = RunParts(system, scenario.settings, scenario.sensor_config)
+    assert why_not_compiled(parts, Pipeline.LOOP) == "the Python loop was asked for"
+    assert why_not_compiled(parts, Pipeline.BATCH) is None
+    assert why_not_compiled_system(system, None) == "the Python integration was asked for"
+    system = System(scenario.plant)
+    assert why_not_compiled_system(system, None) is None
+    assert why_not_compiled_system(system, Adaptive()) == "the integrator Adaptive"
+    system = System(dataclasses.replace(scenario.plant, backend="python"))
+    assert why_not_compiled_system(system, Adaptive()) == "the Python backend"
 
 
 def test_the_loop_records_and_the_batch_refuses_with_the_same_reason():

@@ -32,6 +32,7 @@ from typing import ClassVar
 
 import numpy as np
 
+from uvms_pin.checks import positive
 from uvms_pin.errors import ParameterError
 
 __all__ = ["Ellipsoid", "Polyhedron", "Sphere", "WetPart"]
@@ -88,13 +89,6 @@ class WetPart:
         )
 
 
-def _positive(name: str, value: float) -> float:
-    value = float(value)
-    if not (math.isfinite(value) and value > 0.0):
-        raise ParameterError(f"{name} must be finite and > 0, got {value}")
-    return value
-
-
 def unit_sphere_cap(depth: float) -> tuple[float, float, float]:
     """(V, centroid height along n, waterplane area) of {|u| <= 1, n . u < depth}."""
     if depth >= 1.0:
@@ -125,7 +119,7 @@ class Sphere(CentredSolid):
     radius_m: float
 
     def __post_init__(self) -> None:
-        object.__setattr__(self, "radius_m", _positive("sphere radius", self.radius_m))
+        object.__setattr__(self, "radius_m", positive("sphere radius", self.radius_m))
 
     @property
     def volume_m3(self) -> float:
@@ -154,7 +148,7 @@ class Ellipsoid(CentredSolid):
     semi_axes_m: tuple[float, float, float]
 
     def __post_init__(self) -> None:
-        axes = tuple(_positive("ellipsoid semi-axis", a) for a in self.semi_axes_m)
+        axes = tuple(positive("ellipsoid semi-axis", a) for a in self.semi_axes_m)
         if len(axes) != 3:
             raise ParameterError(f"an ellipsoid needs 3 semi-axes, got {len(axes)}")
         object.__setattr__(self, "semi_axes_m", axes)
@@ -229,7 +223,7 @@ class Polyhedron:
     @staticmethod
     def box(size_m) -> Polyhedron:
         """The box of full side lengths (a, b, c) centred on its origin."""
-        half = 0.5 * np.array([_positive("box size", s) for s in size_m], dtype=float)
+        half = 0.5 * np.array([positive("box size", s) for s in size_m], dtype=float)
         corners = np.array([[i, j, k] for i in (-1, 1) for j in (-1, 1) for k in (-1, 1)])
         faces = [
             (0, 1, 3), (0, 3, 2), (4, 6, 7), (4, 7, 5),  # x = -a/2, +a/2

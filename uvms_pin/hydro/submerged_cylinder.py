@@ -26,7 +26,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from uvms_pin.errors import ParameterError
+from uvms_pin.checks import positive
 from uvms_pin.hydro.submerged import CentredSolid, WetPart
 
 __all__ = ["Cylinder"]
@@ -66,10 +66,7 @@ class Cylinder(CentredSolid):
 
     def __post_init__(self) -> None:
         for name in ("radius_m", "length_m"):
-            value = float(getattr(self, name))
-            if not (math.isfinite(value) and value > 0.0):
-                raise ParameterError(f"cylinder {name} must be finite and > 0, got {value}")
-            object.__setattr__(self, name, value)
+            object.__setattr__(self, name, positive(f"cylinder {name}", getattr(self, name)))
 
     @property
     def volume_m3(self) -> float:

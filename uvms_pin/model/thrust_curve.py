@@ -14,11 +14,11 @@ Both are non-decreasing, so a driver that wants thrust T sends the command
 
 from __future__ import annotations
 
-import math
 from abc import ABC, abstractmethod
 
 import numpy as np
 
+from uvms_pin.checks import nonnegative
 from uvms_pin.errors import ParameterError
 
 __all__ = ["QuadraticThrustCurve", "TabulatedThrustCurve", "ThrustCurve"]
@@ -57,8 +57,7 @@ class QuadraticThrustCurve(ThrustCurve):
 
     def __init__(self, max_forward_N: float, max_reverse_N: float, deadband: float = 0.0):
         for label, value in (("max_forward_N", max_forward_N), ("max_reverse_N", max_reverse_N)):
-            if not (math.isfinite(value) and value >= 0.0):
-                raise ParameterError(f"{label} must be finite and >= 0, got {value}")
+            nonnegative(label, value)
         if not (0.0 <= deadband < 1.0):
             raise ParameterError(f"deadband must be in [0, 1), got {deadband}")
         self.forward_N, self.reverse_N, self.deadband = (

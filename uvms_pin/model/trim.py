@@ -45,6 +45,7 @@ from dataclasses import asdict, dataclass, field
 import numpy as np
 import pinocchio as pin
 
+from uvms_pin.checks import positive
 from uvms_pin.errors import ParameterError
 from uvms_pin.model.uvms import UVMS
 
@@ -78,12 +79,8 @@ class TrimSpec:
     footprint_center_m: tuple[float, float] | None = None
 
     def __post_init__(self) -> None:
-        if not (math.isfinite(self.bg_m) and self.bg_m > 0.0):
-            raise ParameterError(f"bg_m must be finite and > 0, got {self.bg_m}")
-        for name in ("foam_density_kg_m3", "ballast_density_kg_m3"):
-            value = getattr(self, name)
-            if not (math.isfinite(value) and value > 0.0):
-                raise ParameterError(f"{name} must be finite and > 0, got {value}")
+        for name in ("bg_m", "foam_density_kg_m3", "ballast_density_kg_m3"):
+            positive(name, getattr(self, name))
 
 
 @dataclass

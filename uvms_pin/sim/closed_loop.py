@@ -268,11 +268,13 @@ class ClosedLoop:
             # as simulated: anchored, and how its period is stepped
             log.rollout.metadata["world"] = self.system.record(self.settings.integrator)
             log.rollout.metadata["stiff_modes"] = self.stiff_modes
+            # the pipeline, chosen once: why the loop is not compiled (continuous-time
+            # control among the reasons), or the compiled loop
+            compiled, path.reason = CompiledLoop.build(self, log)
             if self.settings.control_period_s is None:
-                path.reason = "continuous-time control"
                 self._run_continuous(span)
             else:
-                self._run_sampled(span, log, path)
+                self._run_sampled(span, log, path, compiled)
         except NUMERICAL_FAILURES as exc:
             error = _diverged(*span, exc, self._context(tuple(span), self._last_tau_applied))
             raise _stopped(log, wall_start, error) from exc
@@ -300,14 +302,15 @@ class ClosedLoop:
             self.notify(self.sample(measurement, contact, tau, tau_applied))
         return tau_applied
 
-    def _run_sampled(self, span: list[float], log: RolloutLog, path: LoopPath) -> None:
-        """Every tick, in chunks of compiled ticks when the whole loop has a compiled
+    def _run_sampled(
+        self, span: list[float], log: RolloutLog, path: LoopPath, compiled: CompiledLoop | None
+    ) -> None:
+        """Every tick, in chunks of ``compiled`` ticks when the whole loop has a compiled
         counterpart (`CompiledLoop`); a tick the core hands back, and every tick otherwise,
         in Python."""
         settings = self.settings
         ticks_per_log = settings.ticks_per_log
         n_ticks = (settings.n_log - 1) * ticks_per_log
-        compiled, path.reason = CompiledLoop.build(self, log, self.compiled)
         tick = 0
         while tick <= n_ticks:
             if compiled is not None:

@@ -88,12 +88,9 @@ class CompiledLoop:
         self.chunk_ticks = FIRST_CHUNK_TICKS
 
     @classmethod
-    def build(
-        cls, loop, log: RolloutLog, allowed: bool = True
-    ) -> tuple[CompiledLoop | None, str | None]:
-        """(the compiled loop of ``loop``, None) or (None, why it runs in Python)."""
-        if not allowed:
-            return None, "the Python loop was asked for"
+    def build(cls, loop, log: RolloutLog) -> tuple[CompiledLoop | None, str | None]:
+        """(the compiled loop of ``loop``, None) or (None, why it runs in Python: the
+        pipeline's one list of reasons, `uvms_pin.sim.pipeline`)."""
         plant = loop.plant
         observers = [o for o in loop.observers if o is not log]
         parts = RunParts(

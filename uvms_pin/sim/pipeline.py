@@ -1,16 +1,15 @@
 """Whether a run is compiled: decided once, before it starts, from one list of reasons.
 
-Two compiled pipelines serve the closed loop: the compiled sampled loop (`Pipeline.LOOP`: a
-run's ticks in chunks of one core call, `uvms_pin.sim.compiled_loop`) and the batched plant
-(`Pipeline.BATCH`: N environments' periods in one call, `uvms_pin.sim.batched_plant`). Each
-reason below names a part without a compiled counterpart and the pipelines it keeps in Python;
-`why_not_compiled` gives the first that applies. The rollout records it (its metadata's
-``closed_loop``), the batched plant refuses with it. The plant's own right-hand side and period
-are compiled part by part whatever the pipeline (`uvms_pin.sim.system.period`); a world keeps
-both pipelines in Python (its contacts are stepped period by period), but the period of a
-system with free objects is one compiled call unless
-`uvms_pin.sim.system.period.why_not_compiled_system` names a reason (recorded under the
-rollout's ``world.integration``).
+Three compiled pipelines serve a run: the compiled sampled loop (`Pipeline.LOOP`: a run's
+ticks in chunks of one core call, `uvms_pin.sim.compiled_loop`), the batched plant
+(`Pipeline.BATCH`: N environments' periods in one call, `uvms_pin.sim.batched_plant`) and the
+compiled system of bodies (`Pipeline.SYSTEM`: the period of a robot with free objects in one
+call, `uvms_pin.sim.system.period`). Each reason below names a part without a compiled
+counterpart and the pipelines it keeps in Python; `why_not_compiled` gives the first that
+applies. The rollout records it (its metadata's ``closed_loop`` for the loop, ``world.integration``
+for the system's period), the batched plant refuses with it. The plant's own right-hand side
+and period are compiled part by part whatever the pipeline; a world keeps the loop and the
+batch in Python (its contacts are stepped period by period), not the system's period.
 """
 
 from __future__ import annotations
@@ -26,10 +25,10 @@ from uvms_pin.sim.compiled.actuation import actuation_to_core
 from uvms_pin.sim.compiled.integrator import integrator_to_core
 from uvms_pin.sim.compiled.laws import law_to_core
 from uvms_pin.sim.compiled.plant import plant_to_core
+from uvms_pin.sim.integrators import Integrator
 from uvms_pin.sim.sample import ProgressReport
 from uvms_pin.sim.sensors import SensorConfig
 from uvms_pin.sim.settings import SimulationSettings
-from uvms_pin.sim.system import System
 
 __all__ = ["REASONS", "Pipeline", "RunParts", "why_not_compiled"]
 
@@ -39,7 +38,9 @@ class Pipeline(enum.Flag):
 
     LOOP = enum.auto()  # the compiled sampled loop of a run
     BATCH = enum.auto()  # the batched plant of the vector environments
-    BOTH = LOOP | BATCH
+    SYSTEM = enum.auto()  # the period of a system with free objects in one compiled call
+    BOTH = LOOP | BATCH  # the closed loop's two: the run's ticks, the environments' periods
+    ALL = LOOP | BATCH | SYSTEM
 
 
 @dataclass(frozen=True)
@@ -47,20 +48,34 @@ class RunParts:
     """What a run is made of, as the choice reads it.
 
     Attributes:
-        system: the bodies and their world. settings: periods, integrator, duration.
-        sensors: the sensors' configuration. controller: the law (None: the caller gives
-            tau, as a policy does). observers: what watches every sample (besides the log).
+        system: the bodies and their world (a `uvms_pin.sim.system.System`, whose period
+            step asks this list). settings: periods, integrator, duration (None: the
+            system's period alone is asked, with ``integrator``). sensors: the sensors'
+            configuration (None likewise). controller: the law (None: the caller gives tau,
+            as a policy does). observers: what watches every sample (besides the log).
+        integrator: the integrator of a system's period without settings (None: not asked).
     """
 
-    system: System
-    settings: SimulationSettings
-    sensors: SensorConfig
+    system: Any
+    settings: SimulationSettings | None = None
+    sensors: SensorConfig | None = None
     controller: Any = None
     observers: Sequence[Any] = ()
+    integrator: Integrator | None = None
+
+    @property
+    def stepped_by(self) -> Integrator | None:
+        """The integrator of the run's periods (the settings', else ``integrator``)."""
+        return self.integrator if self.settings is None else self.settings.integrator
 
 
 def _fallback(built: Any) -> str | None:
     return built.reason if isinstance(built, Fallback) else None
+
+
+def _integrator(parts: RunParts) -> str | None:
+    integrator = parts.stepped_by
+    return None if integrator is None else _fallback(integrator_to_core(integrator, core_module()))
 
 
 def _plant(parts: RunParts) -> str | None:
@@ -73,9 +88,11 @@ def _plant(parts: RunParts) -> str | None:
 #: (the pipelines it keeps in Python, the check: the reason, or None when it does not apply),
 #: in the order they are asked
 REASONS: tuple[tuple[Pipeline, Callable[[RunParts], str | None]], ...] = (
-    (Pipeline.BOTH, lambda p: "the Python backend" if p.system.plant.backend == "python" else None),
+    (Pipeline.LOOP, lambda p: None if p.system.compiled_allowed else "the Python loop was asked for"),
+    (Pipeline.SYSTEM, lambda p: None if p.system.compiled_allowed else "the Python integration was asked for"),
+    (Pipeline.ALL, lambda p: "the Python backend" if p.system.plant.backend == "python" else None),
     (Pipeline.BOTH, lambda p: "continuous-time control" if p.settings.control_period_s is None else None),
-    (Pipeline.BOTH, lambda p: _fallback(integrator_to_core(p.settings.integrator, core_module()))),
+    (Pipeline.ALL, _integrator),
     (Pipeline.LOOP, lambda p: None if p.controller is None else _fallback(law_to_core(p.controller, core_module()))),
     (Pipeline.BOTH, lambda p: "a world (its contacts are stepped period by period)" if p.system.plant.world is not None else None),
     (Pipeline.BATCH, lambda p: "a flow (waves, sea states, varying currents)" if p.system.plant.flow is not None else None),
@@ -85,7 +102,8 @@ REASONS: tuple[tuple[Pipeline, Callable[[RunParts], str | None]], ...] = (
     (Pipeline.BOTH, lambda p: "cameras in the loop" if p.sensors.perception.in_loop else None),
     (Pipeline.BOTH, lambda p: _fallback(actuation_to_core(p.system.plant.actuation, core_module(), p.system.plant.uvms.nv))),
     (Pipeline.LOOP, lambda p: "an observer that needs every sample" if any(not isinstance(o, ProgressReport) for o in p.observers) else None),
-    (Pipeline.BOTH, _plant),
+    (Pipeline.ALL, _plant),
+    (Pipeline.SYSTEM, lambda p: _fallback(p.system.compiled)),
 )  # fmt: skip
 
 

@@ -190,8 +190,14 @@ def test_a_ctrl_c_landing_in_any_commands_import_is_an_interruption(monkeypatch,
     other RuntimeError is still a bug and propagates."""
     from uvms_pin.apps.cli import main as cli
 
+    # a user's process starts with Python's own Ctrl-C handler; a test worker's may hold
+    # another one, left by what ran before in it (the order differs with -m "not slow")
+    previous = signal.signal(signal.SIGINT, signal.default_int_handler)
     monkeypatch.setattr(cli, "_cmd_info", lambda args: paused_cli.ctrl_c_in_a_class_body())
-    assert cli.main(["info", "uvms_lbv150"]) == 130
+    try:
+        assert cli.main(["info", "uvms_lbv150"]) == 130
+    finally:
+        signal.signal(signal.SIGINT, previous)
     assert capsys.readouterr().err == "uvms-pin: interrupted\n"
 
     def bug(args):

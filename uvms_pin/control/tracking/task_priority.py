@@ -45,7 +45,7 @@ from dataclasses import dataclass, field
 import numpy as np
 import pinocchio as pin
 
-from uvms_pin.checks import finite_vector
+from uvms_pin.checks import finite_vector, nonnegative, positive
 from uvms_pin.control.tracking.task import TrackingTask, orientation_error, vehicle_rotation
 from uvms_pin.errors import ParameterError
 
@@ -84,13 +84,9 @@ class KinematicGains:
     def __post_init__(self) -> None:
         for name in ("position_gain_per_s", "orientation_gain_per_s", "joint_limit_margin_rad",
                      "joint_limit_gain_per_s", "damping"):  # fmt: skip
-            value = getattr(self, name)
-            if not (math.isfinite(value) and value > 0):
-                raise ParameterError(f"{name} must be positive, got {value}")
+            positive(name, getattr(self, name))
         for name in ("attitude_gain_per_s", "manipulability_threshold", "manipulability_gain"):
-            value = getattr(self, name)
-            if not (math.isfinite(value) and value >= 0):
-                raise ParameterError(f"{name} must be >= 0, got {value}")
+            nonnegative(name, getattr(self, name))
 
 
 #: Singular values below this fraction of the largest are rounding (a direction the tasks

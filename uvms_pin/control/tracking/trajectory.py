@@ -23,7 +23,7 @@ from typing import Protocol
 
 import numpy as np
 
-from uvms_pin.checks import finite_vector
+from uvms_pin.checks import finite_vector, nonnegative, positive
 from uvms_pin.errors import ParameterError
 
 __all__ = [
@@ -99,17 +99,7 @@ class Phase:
 
 
 def _periodic(period_s: float, ramp_s: float) -> Phase:
-    if not (math.isfinite(period_s) and period_s > 0):
-        raise ParameterError(f"period_s must be positive, got {period_s}")
-    if not (math.isfinite(ramp_s) and ramp_s >= 0):
-        raise ParameterError(f"ramp_s must be >= 0, got {ramp_s}")
-    return Phase(2.0 * math.pi / period_s, ramp_s)
-
-
-def _radius(name: str, value: float) -> float:
-    if not (math.isfinite(value) and value > 0):
-        raise ParameterError(f"{name} must be positive, got {value}")
-    return float(value)
+    return Phase(2.0 * math.pi / positive("period_s", period_s), nonnegative("ramp_s", ramp_s))
 
 
 class Circle:
@@ -123,7 +113,7 @@ class Circle:
 
     def __init__(self, start, radius_m: float, period_s: float, normal=(0, 0, 1), ramp_s=0.0):
         self.start = finite_vector("start", start, 3)
-        self.radius_m = _radius("radius_m", radius_m)
+        self.radius_m = positive("radius_m", radius_m)
         self.phase = _periodic(period_s, ramp_s)
         self.e1, self.e2 = plane_axes(normal)
         self.center = self.start - self.radius_m * self.e1
@@ -168,7 +158,7 @@ class Lemniscate:
 
     def __init__(self, start, half_width_m, period_s, normal=(0, 0, 1), ramp_s=0.0):
         self.start = finite_vector("start", start, 3)
-        self.a = _radius("half_width_m", half_width_m)
+        self.a = positive("half_width_m", half_width_m)
         self.phase = _periodic(period_s, ramp_s)
         self.e1, self.e2 = plane_axes(normal)
 
@@ -193,7 +183,7 @@ class MinimumJerk:
     def __init__(self, start, goal, duration_s: float, start_s: float = 0.0):
         self.p0 = finite_vector("start", start, 3)
         self.p1 = finite_vector("goal", goal, 3)
-        self.duration_s = _radius("duration_s", duration_s)
+        self.duration_s = positive("duration_s", duration_s)
         if not math.isfinite(start_s):
             raise ParameterError(f"start_s must be finite, got {start_s}")
         self.start_s = float(start_s)

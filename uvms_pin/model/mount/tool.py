@@ -12,6 +12,7 @@ from pathlib import Path
 import numpy as np
 import pinocchio as pin
 
+from uvms_pin.checks import positive
 from uvms_pin.errors import ParameterError
 from uvms_pin.model.mount.origin import add_fixed_joint, origin_of, vector_attribute
 from uvms_pin.model.mount.tree import URDFTree
@@ -52,9 +53,7 @@ class ProbeTool:
 
     def __post_init__(self) -> None:
         for name in ("length_m", "radius_m", "mass_kg"):
-            value = getattr(self, name)
-            if not (math.isfinite(value) and value > 0.0):
-                raise ParameterError(f"ProbeTool.{name} must be finite and > 0, got {value}")
+            positive(f"ProbeTool.{name}", getattr(self, name))
 
 
 #: The default tool of a mount: the reference arm's probe.

@@ -31,6 +31,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from uvms_pin.checks import nonnegative, positive
 from uvms_pin.errors import ParameterError
 
 __all__ = ["ContactLaw", "friction_force_N", "normal_force_N"]
@@ -57,19 +58,13 @@ class ContactLaw:
 
     def __post_init__(self) -> None:
         for name in ("stiffness_N_m", "tangential_stiffness_N_m"):
-            _check(name, getattr(self, name), positive=True)
+            positive(f"contact {name}", getattr(self, name))
         for name in ("dissipation_s_m", "tangential_damping_N_s_m"):
-            _check(name, getattr(self, name), positive=False)
+            nonnegative(f"contact {name}", getattr(self, name))
         check_friction(self.friction_static, self.friction_kinetic, "[world.contact]")
 
     def record(self) -> dict[str, float]:
         return {k: float(v) for k, v in self.__dict__.items()}
-
-
-def _check(name: str, value: float, *, positive: bool) -> None:
-    ok = math.isfinite(value) and (value > 0.0 if positive else value >= 0.0)
-    if not ok:
-        raise ParameterError(f"contact {name} must be {'> 0' if positive else '>= 0'}, got {value}")
 
 
 def check_friction(static: float, kinetic: float, where: str) -> None:

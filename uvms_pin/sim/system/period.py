@@ -40,6 +40,7 @@ from uvms_pin.physics.constraints.step import (
 )
 from uvms_pin.sim.compiled.integrator import integrator_to_core
 from uvms_pin.sim.integrators import Integrator
+from uvms_pin.sim.pipeline import Pipeline, RunParts, why_not_compiled
 from uvms_pin.sim.system.fixtures import with_fixtures
 
 
@@ -89,20 +90,10 @@ def period_step(system: Stepped, integrator: Integrator) -> PeriodStep:
 
 
 def why_not_compiled_system(system: Stepped, integrator: Integrator | None) -> str | None:
-    """Why the period of ``system`` (with free objects) is not one compiled call, or None:
-    the plant, the ``integrator`` (None: not asked) and every moving contact have their
-    compiled counterparts."""
-    plant = system.plant
-    if not system.compiled_allowed:
-        return "the Python integration was asked for"
-    if plant.compiled is None:
-        return "the Python backend" if plant.backend == "python" else "a plant part"
-    if integrator is not None:
-        step = integrator_to_core(integrator, core_module())
-        if isinstance(step, Fallback):
-            return step.reason
-    built = system.compiled
-    return built.reason if isinstance(built, Fallback) else None
+    """Why the period of ``system`` (with free objects) is not one compiled call, or None
+    (``integrator`` None: not asked): the pipeline's one list of reasons
+    (`uvms_pin.sim.pipeline`, `Pipeline.SYSTEM`)."""
+    return why_not_compiled(RunParts(system, integrator=integrator), Pipeline.SYSTEM)
 
 
 def constraint_sets(system: Stepped) -> tuple:
