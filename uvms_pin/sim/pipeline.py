@@ -50,6 +50,7 @@ class RunParts:
         system: the bodies and their world. settings: periods, integrator, duration.
         sensors: the sensors' configuration. controller: the law (None: the caller gives
             tau, as a policy does). observers: what watches every sample (besides the log).
+        robots: how many robots the run holds (`uvms_pin.sim.robots_loop`).
     """
 
     system: System
@@ -57,6 +58,7 @@ class RunParts:
     sensors: SensorConfig
     controller: Any = None
     observers: Sequence[Any] = ()
+    robots: int = 1
 
 
 def _fallback(built: Any) -> str | None:
@@ -73,6 +75,7 @@ def _plant(parts: RunParts) -> str | None:
 #: (the pipelines it keeps in Python, the check: the reason, or None when it does not apply),
 #: in the order they are asked
 REASONS: tuple[tuple[Pipeline, Callable[[RunParts], str | None]], ...] = (
+    (Pipeline.BOTH, lambda p: "several robots (their system is integrated in Python)" if p.robots > 1 else None),
     (Pipeline.BOTH, lambda p: "the Python backend" if p.system.plant.backend == "python" else None),
     (Pipeline.BOTH, lambda p: "continuous-time control" if p.settings.control_period_s is None else None),
     (Pipeline.BOTH, lambda p: _fallback(integrator_to_core(p.settings.integrator, core_module()))),

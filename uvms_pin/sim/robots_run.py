@@ -1,0 +1,132 @@
+"""A run of several robots: a `RobotsScenario` (one `Scenario` per robot, sharing the
+water, the world and the run's timing), and ``simulate_robots(scenario)``.
+
+Each robot's scenario is what a single-robot scenario of its tables would be, but for its
+seed: robot k's sensors draw their noise from `robot_seed` (the scenario's seed and k),
+recorded in its rollout; the water (a sea state's phases) keeps the scenario's seed, the
+same for every robot. One robot alone runs as a single-robot scenario does (the same
+rollout, bit for bit); several run in `uvms_pin.sim.robots_loop`.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+from uvms_pin.errors import ParameterError
+from uvms_pin.perception.suite import check_mounts
+from uvms_pin.results.robots import RobotRollouts
+from uvms_pin.sim.log import RolloutLog, described_columns, run_metadata
+from uvms_pin.sim.robots_loop import RobotsLoop
+from uvms_pin.sim.run import Scenario, controller_record, recorded_parameters, simulate
+from uvms_pin.sim.sensors import SensorSuite
+from uvms_pin.sim.settings import check_log_fits
+from uvms_pin.sim.task_record import record_task
+
+__all__ = ["RobotsScenario", "robot_seed", "simulate_robots"]
+
+#: the odd constant of Fibonacci hashing, 2^64 / golden ratio: the seeds of robots 0, 1, ...
+#: are spread over the seeds' range
+_SPREAD = 0x9E3779B97F4A7C15
+_SEEDS = 2**63
+
+
+def robot_seed(seed: int, index: int) -> int:
+    """Robot ``index``'s seed: (seed + index * 0x9E3779B97F4A7C15) mod 2^63; robot 0's is
+    the scenario's ``seed`` itself."""
+    return (seed + index * _SPREAD) % _SEEDS
+
+
+@dataclass
+class RobotsScenario:
+    """Several robots in one sea.
+
+    Attributes:
+        name, description, path, raw: as a `Scenario`'s (``raw`` the whole document).
+        robots: each robot's scenario (its plant, controller, sensors, start, task, its
+            settings with its own seed), in the document's order. names: the robots'.
+    """
+
+    name: str
+    description: str
+    path: Path
+    raw: dict[str, Any]
+    robots: tuple[Scenario, ...]
+    names: tuple[str, ...]
+
+    @property
+    def settings(self):
+        """The run's timing (the first robot's settings: every robot's but for the seed)."""
+        return self.robots[0].settings
+
+    def robot(self, name: str) -> Scenario:
+        """The scenario of the robot ``name``."""
+        if name not in self.names:
+            raise ParameterError(f"no robot '{name}' in this scenario (robots: {list(self.names)})")
+        return self.robots[self.names.index(name)]
+
+
+def simulate_robots(scenario: RobotsScenario, *, controllers: Sequence | None = None) -> RobotRollouts:
+    """Run every robot of ``scenario``, each with a fresh controller (or the instances
+    ``controllers``, one per robot, reset first) and its own seeded sensors.
+
+    Raises FunnelViolation / SimulationError with the rollouts so far attached as
+    ``exc.rollout`` (a `RobotRollouts`)."""
+    robots = scenario.robots
+    given = list(controllers) if controllers is not None else [None] * len(robots)
+    if len(given) != len(robots):
+        raise ParameterError(f"{len(given)} controllers for {len(robots)} robots")
+    if len(robots) == 1:  # one robot: the single-robot run itself
+        try:
+            rollout = simulate(robots[0], progress=False, controller=given[0])
+        except Exception as exc:
+            if getattr(exc, "rollout", None) is not None:
+                exc.rollout = RobotRollouts({scenario.names[0]: exc.rollout})
+            raise
+        return RobotRollouts({scenario.names[0]: rollout})
+    parts = [_parts(r, g) for r, g in zip(robots, given, strict=True)]
+    loop = RobotsLoop([r.plant for r in robots], scenario.names, scenario.settings, [p[0] for p in parts])
+    logs = []
+    for robot, (_, sensors, metadata), own in zip(robots, parts, loop.loops, strict=True):
+        plant, settings = robot.plant, robot.settings
+        check_log_fits(settings, plant.uvms.nq, plant.uvms.nv, own.system.n_logged_columns)
+        meta = {**metadata, **run_metadata(plant, settings)}
+        if sensors.navigation is not None:
+            meta["signal_units"].update(described_columns(sensors.navigation.signal_columns()))
+        logs.append(RolloutLog(plant.uvms, settings.n_log, meta, backend=plant.backend, system=own.system))
+    starts = [(r.q0, r.v0) for r in robots]
+    try:
+        out = loop.run(starts, [p[1] for p in parts], logs)
+    except Exception as exc:
+        if getattr(exc, "rollout", None) is not None:
+            _record_tasks(scenario, exc.rollout)
+        raise
+    _record_tasks(scenario, out)
+    return out
+
+
+def _parts(robot: Scenario, given) -> tuple[Any, SensorSuite, dict[str, Any]]:
+    """(the robot's controller, its seeded sensors, its rollout's metadata)."""
+    settings = robot.settings
+    check_mounts(robot.sensor_config.perception, robot.uvms.model, settings.duration_s)
+    if robot.sensor_config.perception.fitted:
+        raise ParameterError("cameras and sonars with several robots are not simulated")
+    sensors = SensorSuite(robot.uvms.model, robot.sensor_config, settings.duration_s, settings.seed)
+    controller = robot.controller_factory(robot.uvms) if given is None else given
+    record = controller_record(robot.controller_factory if given is None else None, controller)
+    metadata = {
+        "scenario": robot.name,
+        "scenario_path": str(robot.path),
+        "description": robot.description,
+        "parameters": recorded_parameters(robot, record, instance=given is not None),
+        "controller": record,
+    }
+    return controller, sensors, metadata
+
+
+def _record_tasks(scenario: RobotsScenario, rollouts: RobotRollouts) -> None:
+    for name, robot in zip(scenario.names, scenario.robots, strict=True):
+        if robot.task is not None and len(rollouts.robot(name)):
+            record_task(rollouts.robot(name), robot.task, robot.uvms)

@@ -1,0 +1,170 @@
+"""Several robots in one sea: a system of bodies holding one robot's system per robot.
+
+Each robot is a `System` of its own (its `Plant`: its model, its hydrodynamics in the
+shared water, its actuation, its fixed world, its joint limits) and a block of the state
+(`Layout`, one block per robot, in order). The robots meet only through the contacts
+between them (`uvms_pin.physics.world.between_robots`, every force equal and opposite):
+there is no hydrodynamic interaction (no wake, no added mass of one robot felt by the
+other): each robot's water is the undisturbed flow.
+
+A control period is stepped in one of two ways, chosen at its start:
+
+- apart (no pair of robots can touch over the period, `near`): each robot by its own
+  period step (`System.advance`: its compiled call when it has one), the same as alone;
+- together: the Python integrator around the system's right-hand side (each robot's
+  acceleration with the contacts' generalized force added to its input tau: the dynamics
+  are linear in it), every anchor moved at the period's end, then each robot's constraints
+  solved implicitly (its joint limits: they act within the robot only).
+
+Free objects with several robots are not simulated: a robot's world must not hold any.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+
+import numpy as np
+import pinocchio as pin
+
+from uvms_pin.errors import ParameterError
+from uvms_pin.physics.world.between_robots import RobotContacts
+from uvms_pin.physics.world.contact_law import ContactLaw
+from uvms_pin.physics.world.world import World
+from uvms_pin.sim.integrators import Integrator
+from uvms_pin.sim.system.period import constrained, constraint_sets
+from uvms_pin.sim.system.state import Layout, SystemState
+from uvms_pin.sim.system.system import System
+
+__all__ = ["Robots", "joined_model"]
+
+
+def joined_model(models: Sequence[pin.Model], names: Sequence[str]) -> pin.Model:
+    """One Pinocchio model with every joint of ``models`` in order, each robot's tree
+    under the universe (a joint named ``robot/joint``): its configuration and velocity are
+    the robots' stacked (what the integrator steps)."""
+    out = pin.Model()
+    for model, name in zip(models, names, strict=True):
+        offset = out.njoints - 1
+        for j in range(1, model.njoints):
+            parent = model.parents[j]
+            out.addJoint(
+                0 if parent == 0 else parent + offset,
+                model.joints[j],
+                model.jointPlacements[j],
+                f"{name}/{model.names[j]}",
+            )
+    return out
+
+
+class Robots:
+    """The systems of several robots (``systems``, one each, named ``names``) in one sea.
+
+    Attributes:
+        systems: each robot's own system of bodies. names: the robots' names.
+        contacts: the pairs between robots. layout: one block per robot. model: the joined
+            model (`joined_model`).
+    """
+
+    def __init__(self, systems: Sequence[System], names: Sequence[str]):
+        if len(systems) != len(names) or len(set(names)) != len(names):
+            raise ParameterError(f"one distinct name per robot, got {list(names)}")
+        for system, name in zip(systems, names, strict=True):
+            if system.objects:
+                raise ParameterError(
+                    f"robot '{name}': free objects with several robots are not simulated "
+                    "(a world of fixed objects only)"
+                )
+        self.systems = tuple(systems)
+        self.names = tuple(names)
+        plants = [s.plant for s in self.systems]
+        worlds = [p.world if p.world is not None else World(p.uvms, [], ContactLaw()) for p in plants]
+        self.contacts = RobotContacts.of(worlds, self.names)
+        self.layout = Layout.of([(n, p.uvms.nq, p.uvms.nv) for n, p in zip(names, plants, strict=True)])
+        self.model = joined_model([p.uvms.model for p in plants], self.names)
+        self._datas = [p.uvms.model.createData() for p in plants]
+
+    # ---- the state ------------------------------------------------------------------------
+    def split(self, q: np.ndarray, v: np.ndarray) -> list[tuple[np.ndarray, np.ndarray]]:
+        """Each robot's (q, v), views."""
+        return self.layout.split(q, v)
+
+    def start(self, state: SystemState) -> None:
+        """t = 0 at ``state`` (each robot's system started by its loop): the anchors
+        between robots set afresh where they touch."""
+        self.contacts.clear()
+        q, _ = state
+        zero = np.zeros(self.layout.nv)
+        self.contacts.commit(self._kinematics(q, zero), self.contacts.found(self._datas))
+
+    def _kinematics(self, q: np.ndarray, v: np.ndarray) -> list[pin.Data]:
+        for system, data, (q_k, v_k) in zip(self.systems, self._datas, self.split(q, v), strict=True):
+            pin.forwardKinematics(system.plant.uvms.model, data, q_k, v_k)
+        return self._datas
+
+    # ---- the dynamics ---------------------------------------------------------------------
+    def pushes(self, q: np.ndarray, v: np.ndarray) -> list[np.ndarray]:
+        """Each robot's generalized force (nv_k,) of the contacts between robots at (q, v)."""
+        datas = self._kinematics(q, v)
+        found = self.contacts.found(datas)
+        return self.contacts.generalized([p[0] for p in self.split(q, v)], datas, found)
+
+    def acceleration(
+        self, time_s: float, q: np.ndarray, v: np.ndarray, taus: Sequence[np.ndarray]
+    ) -> np.ndarray:
+        """The robots' accelerations (nv,) with ``taus`` (each robot's input) held: each
+        robot's own right-hand side (`System.acceleration`) with its contacts against the
+        others added to its input."""
+        pushes = self.pushes(q, v)
+        parts = self.split(q, v)
+        out = [
+            system.acceleration(time_s, q_k, v_k, tau + push)
+            for system, (q_k, v_k), tau, push in zip(self.systems, parts, taus, pushes, strict=True)
+        ]
+        return np.concatenate(out)
+
+    def near(self, q: np.ndarray, v: np.ndarray, horizon_s: float) -> bool:
+        """Some two robots may touch within ``horizon_s`` from (q, v)."""
+        return self.contacts.near(self._kinematics(q, v), horizon_s)
+
+    def advance(
+        self,
+        integrator: Integrator,
+        t0: float,
+        q0: np.ndarray,
+        v0: np.ndarray,
+        taus: Sequence[np.ndarray],
+        t1: float,
+    ) -> tuple[np.ndarray, np.ndarray]:
+        """The robots' (q, v) at t1 from (q0, v0) at t0, each robot's input of ``taus``
+        held: apart or together (see the module docstring)."""
+        if not self.near(q0, v0, t1 - t0):
+            self.contacts.clear()  # no contact persists: the friction forgets its anchors
+            ends = [
+                system.advance(integrator, t0, q_k, v_k, tau, t1)
+                for system, (q_k, v_k), tau in zip(self.systems, self.split(q0, v0), taus, strict=True)
+            ]
+            return tuple(self.layout.join(ends))
+        return self._together(integrator, t0, q0, v0, taus, t1)
+
+    def _together(self, integrator, t0, q0, v0, taus, t1) -> tuple[np.ndarray, np.ndarray]:
+        """The period integrated for every robot at once (the contacts between them in the
+        right-hand side), every anchor moved at its end, then each robot's constraints."""
+        q1, v1 = integrator.advance(
+            self.model, lambda t, q, v: self.acceleration(t, q, v, taus), t0, q0, v0, t1
+        )
+        ends = self.split(q1, v1)
+        for system, (q_k, v_k) in zip(self.systems, ends, strict=True):
+            system.settle(q_k, v_k)
+        self.contacts.commit(self._kinematics(q1, v1), self.contacts.found(self._datas))
+        out = []
+        for system, start, end, tau in zip(self.systems, self.split(q0, v0), ends, taus, strict=True):
+            if constraint_sets(system):
+                step = constrained(system, lambda *_, end=end: end)
+                end = step(t0, start[0], start[1], tau, t1)
+            out.append(end)
+        return tuple(self.layout.join(out))
+
+    def contact_signals(self, q: np.ndarray, v: np.ndarray) -> np.ndarray:
+        """The contacts between robots at (q, v), per pair (`RobotContacts.pair_names`):
+        the force on the first robot [N], the point [m], the moment [N m], flattened."""
+        return self.contacts.wrenches(self.contacts.found(self._kinematics(q, v)))
