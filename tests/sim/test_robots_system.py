@@ -1,0 +1,105 @@
+"""Several robots in one sea (uvms_pin.sim.system.robots): the robots' momentum is kept by
+their contacts, each robot alone steps as it would alone, the joined model stacks the
+robots' coordinates."""
+
+from __future__ import annotations
+
+import numpy as np
+import pinocchio as pin
+import pytest
+from conftest import RHO, body_urdf, hydro_xml
+
+import uvms_pin as up
+from uvms_pin.errors import ParameterError
+from uvms_pin.sim.integrators import RK4
+from uvms_pin.sim.plant import Plant
+from uvms_pin.sim.system import System
+from uvms_pin.sim.system.robots import Robots, joined_model
+
+
+def _sphere(load_body, mass=4.0, radius=0.1):
+    """A one-body robot: a neutrally buoyant sphere without added mass or damping (its
+    weight and buoyancy cancel at its centre: no gravity and no water in effect)."""
+    inertia = (0.4 * mass * radius**2,) * 3
+    collision = f'<sphere radius="{radius}"/>'
+    urdf = body_urdf(mass=mass, inertia=inertia, hydro=hydro_xml(mass / RHO), collision=collision)
+    return load_body(urdf)
+
+
+def _momentum_world(uvms, q, v):
+    return pin.Quaternion(q[3:7]).matrix() @ (up.mass_matrix(uvms, q) @ v)[:3]
+
+
+def _two_spheres(load_body):
+    a, b = _sphere(load_body), _sphere(load_body, mass=6.0, radius=0.15)
+    plants = [Plant(u, free_surface=False) for u in (a, b)]
+    return Robots([System(p) for p in plants], ["a", "b"])
+
+
+def test_two_robots_pushing_each_other_keep_their_total_momentum(load_body):
+    """Robot a (4 kg) runs at 0.5 m/s into robot b (6 kg) 5 cm off the line of centres:
+    they touch (friction too) and part; the total linear momentum stays to 1e-6."""
+    robots = _two_spheres(load_body)
+    a, b = (s.plant.uvms for s in robots.systems)
+    q_a, q_b = a.neutral_configuration(), b.neutral_configuration()
+    q_a[:3], q_b[:3] = [-0.5, 0.05, -5.0], [0.0, 0.0, -5.0]
+    v_a = np.zeros(6)
+    v_a[0] = 0.5
+    state = robots.layout.join([(q_a, v_a), (q_b, np.zeros(6))])
+    robots.start(state)
+    q, v = state
+    integrator, period, zero = RK4(step_s=5e-4), 1e-2, [np.zeros(6), np.zeros(6)]
+    momentum, together = [], 0
+    for k in range(150):
+        together += robots.near(q, v, period)
+        q, v = robots.advance(integrator, k * period, q, v, zero, (k + 1) * period)
+        (qa, va), (qb, vb) = robots.split(q, v)
+        momentum.append(_momentum_world(a, qa, va) + _momentum_world(b, qb, vb))
+    momentum = np.array(momentum)
+    p0 = 4.0 * 0.5
+    assert together > 0  # they met
+    assert np.max(np.abs(momentum - np.array([p0, 0.0, 0.0]))) <= 1e-6 * p0
+    (qa, va), (qb, vb) = robots.split(q, v)
+    assert vb[0] > 0.1 and abs(vb[1]) > 1e-3  # b was pushed, and sideways (off-centre)
+    assert np.linalg.norm(qb[:3] - qa[:3]) > 0.25  # apart again
+
+
+def test_robots_apart_step_each_as_alone(load_body):
+    """No robot within reach of another: each robot's period is its own system's, bit for
+    bit."""
+    robots = _two_spheres(load_body)
+    alone = [System(Plant(s.plant.uvms, free_surface=False)) for s in robots.systems]
+    starts = []
+    for k, system in enumerate(robots.systems):
+        q = system.plant.uvms.neutral_configuration()
+        q[:3] = [3.0 * k, 0.0, -5.0]
+        starts.append((q, np.full(6, 0.1)))
+    taus = [np.array([1.0, 0, 0, 0, 0, 0.2]), np.array([0, -2.0, 0, 0.1, 0, 0])]
+    state = robots.layout.join(starts)
+    robots.start(state)
+    integrator = RK4(step_s=2.5e-3)
+    q, v = robots.advance(integrator, 0.0, state.q, state.v, taus, 0.01)
+    for system, (q0, v0), tau, (q1, v1) in zip(alone, starts, taus, robots.split(q, v), strict=True):
+        q_alone, v_alone = system.advance(integrator, 0.0, q0, v0, tau, 0.01)
+        assert np.array_equal(q1, q_alone) and np.array_equal(v1, v_alone)
+
+
+def test_the_joined_model_stacks_the_robots_coordinates(load_body):
+    robots = _two_spheres(load_body)
+    model = robots.model
+    assert (model.nq, model.nv) == (14, 12)
+    assert [model.names[j] for j in range(1, model.njoints)] == ["a/root_joint", "b/root_joint"]
+    q = pin.randomConfiguration(model, -np.ones(model.nq), np.ones(model.nq))
+    dv = np.arange(12) * 0.01
+    stacked = np.concatenate(
+        [pin.integrate(s.plant.uvms.model, q[a], dv[b]) for s, a, b in zip(
+            robots.systems, robots.layout.q_slices, robots.layout.v_slices, strict=True)]
+    )  # fmt: skip
+    assert np.allclose(pin.integrate(model, q, dv), stacked, atol=1e-15)
+    assert joined_model([], []).nq == 0
+
+
+def test_robots_need_distinct_names(load_body):
+    system = System(Plant(_sphere(load_body), free_surface=False))
+    with pytest.raises(ParameterError, match="one distinct name per robot"):
+        Robots([system, system], ["a", "a"])
