@@ -138,6 +138,11 @@ def _robots(
         seeded = replace(robot.settings, seed=robot_seed(robot.settings.seed, k))
         robots.append(shortened(replace(robot, settings=seeded)))
     head = robots[0]
+    if len(robots) > 1 and head.settings.control_period_s is None:
+        raise ScenarioError(
+            f"{path}: [[robots]]: several robots are stepped period by period: they need a "
+            "sampled controller ([control] period_s)"
+        )
     names = tuple(name for name, _ in documents)
     return RobotsScenario(head.name, head.description, path, raw, tuple(robots), names)
 

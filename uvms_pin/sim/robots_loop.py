@@ -75,17 +75,18 @@ class RobotsLoop:
         self.system.start(self.state)
 
     def tick(self, logged: bool) -> list[np.ndarray]:
-        """Each robot measures, commands and actuates on its own (logged if ``logged``):
-        the applied inputs."""
-        out = []
+        """Each robot measures, commands and actuates on its own, then (if ``logged``)
+        every robot's sample is logged: a controller that raises leaves no robot's sample
+        of the tick. The applied inputs."""
+        ticked = []
         for loop in self.loops:
             measurement, contact = loop.observe()
             tau = loop.command(measurement)
-            applied = loop.actuate(tau)
-            if logged:
-                loop.notify(loop.sample(measurement, contact, tau, applied))
-            out.append(applied)
-        return out
+            ticked.append((measurement, contact, tau, loop.actuate(tau)))
+        if logged:
+            for loop, made in zip(self.loops, ticked, strict=True):
+                loop.notify(loop.sample(*made))
+        return [made[3] for made in ticked]
 
     def step(self, taus: list[np.ndarray]) -> None:
         """Every robot one control period on, its input of ``taus`` held."""

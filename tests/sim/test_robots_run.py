@@ -1,0 +1,108 @@
+"""Several robots' run (uvms_pin.sim.robots_loop, robots_run): each controller is given its
+own robot's measurements only; one robot in the robots' loop is the Python loop's run, bit
+for bit; why the run is not compiled is recorded; a stop keeps every robot's rollout."""
+
+from __future__ import annotations
+
+import copy
+
+import numpy as np
+import pytest
+from conftest import ROOT
+
+from uvms_pin.control.base import Controller
+from uvms_pin.errors import ControllerError, ScenarioError
+from uvms_pin.scenario.load import load_scenario, scenario_from_dict
+from uvms_pin.scenario.toml import read_toml
+from uvms_pin.sim.log import RolloutLog, run_metadata
+from uvms_pin.sim.robots_loop import RobotsLoop
+from uvms_pin.sim.robots_run import simulate_robots
+from uvms_pin.sim.run import simulate
+from uvms_pin.sim.sensors import SensorSuite
+
+TWO = ROOT / "scenarios" / "two_robots.toml"
+
+
+class Recorder(Controller):
+    """Holds still (zero input) and keeps every measurement it is given."""
+
+    def __init__(self, nv: int, stop_at_s: float | None = None):
+        self.nv, self.stop_at_s, self.seen = nv, stop_at_s, []
+
+    def reset(self) -> None:
+        self.seen = []
+
+    def compute(self, time_s, measurement):
+        if self.stop_at_s is not None and time_s >= self.stop_at_s:
+            raise RuntimeError("stopped on purpose")
+        self.seen.append((time_s, np.array(measurement.q), np.array(measurement.wrench_world)))
+        return np.zeros(self.nv)
+
+
+def _two(duration_s=0.3):
+    return load_scenario(TWO, {"scenario.duration_s": duration_s})
+
+
+def test_each_controller_sees_its_own_robots_measurements_only():
+    scenario = _two()
+    recorders = [Recorder(r.uvms.nv) for r in scenario.robots]
+    out = simulate_robots(scenario, controllers=recorders)
+    assert out.status.ok
+    for name, recorder in zip(scenario.names, recorders, strict=True):
+        rollout = out.robot(name)
+        times = [t for t, _, _ in recorder.seen]
+        assert times == pytest.approx(np.arange(31) * 0.01)  # every tick, once
+        q_seen = np.array([q for _, q, _ in recorder.seen])[::5]  # the logged ticks
+        # its own robot's state with its own sensor noise (1 mm, 1 mrad, 0.5 mrad)
+        assert np.max(np.abs(q_seen[:, :3] - rollout.q[:, :3])) < 2e-3
+    (_, qa, _), (_, qb, _) = recorders[0].seen[0], recorders[1].seen[0]
+    assert qa[1] == pytest.approx(-1.5, abs=0.01) and qb[1] == pytest.approx(1.5, abs=0.01)
+    # the noise is each robot's own: the two robots' errors at the start differ
+    a0, b0 = (out.robot(n).q[0] for n in scenario.names)
+    error_a = recorders[0].seen[0][1] - a0
+    error_b = recorders[1].seen[0][1] - b0
+    assert not np.allclose(error_a, error_b)
+
+
+def test_one_robot_in_the_robots_loop_is_the_python_loops_run_bit_for_bit():
+    robot = _two().robots[0]
+    alone = simulate(robot, progress=False, compiled_loop=False)
+    settings = robot.settings
+    controller = robot.controller_factory(robot.uvms)
+    loop = RobotsLoop([robot.plant], ["alpha"], settings, [controller])
+    sensors = SensorSuite(robot.uvms.model, robot.sensor_config, settings.duration_s, settings.seed)
+    log = RolloutLog(robot.uvms, settings.n_log, run_metadata(robot.plant, settings), system=loop.loops[0].system)
+    ran = loop.run([(robot.q0, robot.v0)], [sensors], [log]).robot("alpha")
+    for name in ("time_s", "q", "v", "tau", "wrench_measured_world"):
+        assert np.array_equal(getattr(ran, name), getattr(alone, name)), name
+
+
+def test_why_the_run_is_not_compiled_is_recorded_for_every_robot():
+    out = simulate_robots(_two(0.05))
+    for name in out.names:
+        record = out.robot(name).metadata["closed_loop"]
+        assert record["path"] == "python"
+        assert record["reason"] == "several robots (their system is integrated in Python)"
+    assert out.robot("alpha").metadata["seed"] != out.robot("bravo").metadata["seed"]
+
+
+def test_a_controller_that_raises_stops_every_robot_and_keeps_their_rollouts():
+    scenario = _two()
+    recorders = [Recorder(r.uvms.nv) for r in scenario.robots]
+    recorders[1].stop_at_s = 0.1
+    with pytest.raises(ControllerError) as caught:
+        simulate_robots(scenario, controllers=recorders)
+    kept = caught.value.rollout
+    assert kept.names == ["alpha", "bravo"]
+    for name in kept.names:
+        assert kept.robot(name).time_s[-1] == pytest.approx(0.05)
+        assert kept.robot(name).metadata["status"] == "error"
+
+
+def test_several_robots_need_a_sampled_controller():
+    doc = read_toml(TWO, ScenarioError)
+    doc = copy.deepcopy(doc)
+    doc.pop("control")
+    doc["integrator"] = {"method": "RK45"}
+    with pytest.raises(ScenarioError, match=r"\[\[robots\]\]: several robots .* sampled controller"):
+        scenario_from_dict(doc, TWO)
