@@ -10,8 +10,8 @@ rollout, bit for bit); several run in `uvms_pin.sim.robots_loop`.
 
 from __future__ import annotations
 
-from collections.abc import Sequence
-from dataclasses import dataclass
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any
 
@@ -20,12 +20,18 @@ from uvms_pin.perception.suite import check_mounts
 from uvms_pin.results.robots import RobotRollouts
 from uvms_pin.sim.log import RolloutLog, described_columns, run_metadata
 from uvms_pin.sim.robots_loop import RobotsLoop
-from uvms_pin.sim.run import Scenario, controller_record, recorded_parameters, simulate
+from uvms_pin.sim.run import (
+    Scenario,
+    controller_record,
+    recorded_parameters,
+    shortened,
+    simulate,
+)
 from uvms_pin.sim.sensors import SensorSuite
 from uvms_pin.sim.settings import check_log_fits
 from uvms_pin.sim.task_record import record_task
 
-__all__ = ["RobotsScenario", "robot_seed", "simulate_robots"]
+__all__ = ["RobotsScenario", "robot_seed", "shortened_robots", "simulate_robots"]
 
 #: the odd constant of Fibonacci hashing, 2^64 / golden ratio: the seeds of robots 0, 1, ...
 #: are spread over the seeds' range
@@ -66,6 +72,14 @@ class RobotsScenario:
         if name not in self.names:
             raise ParameterError(f"no robot '{name}' in this scenario (robots: {list(self.names)})")
         return self.robots[self.names.index(name)]
+
+
+def shortened_robots(
+    scenario: RobotsScenario, environ: Mapping[str, str] | None = None
+) -> RobotsScenario:
+    """``scenario`` with every robot's run shortened as `uvms_pin.sim.run.shortened` says
+    (``UVMS_PIN_MAX_DURATION_S`` of ``environ``)."""
+    return replace(scenario, robots=tuple(shortened(r, environ) for r in scenario.robots))
 
 
 def simulate_robots(scenario: RobotsScenario, *, controllers: Sequence | None = None) -> RobotRollouts:
