@@ -74,7 +74,10 @@ DONORS: list[tuple[tuple[str, ...], Any]] = [
             )
             for doc in [*SCENARIOS.values(), *_toml_blocks(ROOT / "docs" / "sensors.md")]
             for key in doc
-            for sub in [None, *(k for k, v in _table(doc[key]).items() if isinstance(v, dict | list))]
+            for sub in [
+                None,
+                *(k for k, v in _table(doc[key]).items() if isinstance(v, dict | list)),
+            ]
         }.items()
     )
 ]

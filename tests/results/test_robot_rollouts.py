@@ -17,7 +17,9 @@ from uvms_pin.sim.robots_run import simulate_robots
 
 @pytest.fixture(scope="module")
 def rollouts() -> RobotRollouts:
-    return simulate_robots(load_scenario(ROOT / "scenarios" / "two_robots.toml", {"scenario.duration_s": 0.2}))
+    return simulate_robots(
+        load_scenario(ROOT / "scenarios" / "two_robots.toml", {"scenario.duration_s": 0.2})
+    )
 
 
 def test_a_robots_view_is_its_own_rollout(rollouts):
@@ -27,7 +29,9 @@ def test_a_robots_view_is_its_own_rollout(rollouts):
     assert list(alpha.to_dataframe().columns) == [
         c.removeprefix("alpha/") for c in rollouts.to_dataframe().columns if c.startswith("alpha/")
     ]
-    with pytest.raises(ParameterError, match=r"no robot 'charlie' in this run \(robots: \['alpha', 'bravo'\]\)"):
+    with pytest.raises(
+        ParameterError, match=r"no robot 'charlie' in this run \(robots: \['alpha', 'bravo'\]\)"
+    ):
         rollouts.robot("charlie")
 
 
@@ -36,7 +40,9 @@ def test_the_table_has_each_robots_columns_under_its_name(rollouts):
     alone = rollouts.robot("bravo").to_dataframe()
     assert len(table) == 5 and table.index.equals(alone.index)
     assert table.shape[1] == 2 * alone.shape[1]
-    assert np.array_equal(table["bravo/q.vehicle.y_m"].to_numpy(), alone["q.vehicle.y_m"].to_numpy())
+    assert np.array_equal(
+        table["bravo/q.vehicle.y_m"].to_numpy(), alone["q.vehicle.y_m"].to_numpy()
+    )
     assert table.attrs["units"]["alpha/q.vehicle.x_m"] == "m"
 
 

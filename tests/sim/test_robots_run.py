@@ -71,7 +71,9 @@ def test_one_robot_in_the_robots_loop_is_the_python_loops_run_bit_for_bit():
     controller = robot.controller_factory(robot.uvms)
     loop = RobotsLoop([robot.plant], ["alpha"], settings, [controller])
     sensors = SensorSuite(robot.uvms.model, robot.sensor_config, settings.duration_s, settings.seed)
-    log = RolloutLog(robot.uvms, settings.n_log, run_metadata(robot.plant, settings), system=loop.loops[0].system)
+    log = RolloutLog(
+        robot.uvms, settings.n_log, run_metadata(robot.plant, settings), system=loop.loops[0].system
+    )
     ran = loop.run([(robot.q0, robot.v0)], [sensors], [log]).robot("alpha")
     for name in ("time_s", "q", "v", "tau", "wrench_measured_world"):
         assert np.array_equal(getattr(ran, name), getattr(alone, name)), name
@@ -104,5 +106,7 @@ def test_several_robots_need_a_sampled_controller():
     doc = copy.deepcopy(doc)
     doc.pop("control")
     doc["integrator"] = {"method": "RK45"}
-    with pytest.raises(ScenarioError, match=r"\[\[robots\]\]: several robots .* sampled controller"):
+    with pytest.raises(
+        ScenarioError, match=r"\[\[robots\]\]: several robots .* sampled controller"
+    ):
         scenario_from_dict(doc, TWO)

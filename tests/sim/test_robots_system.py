@@ -79,7 +79,9 @@ def test_robots_apart_step_each_as_alone(load_body):
     robots.start(state)
     integrator = RK4(step_s=2.5e-3)
     q, v = robots.advance(integrator, 0.0, state.q, state.v, taus, 0.01)
-    for system, (q0, v0), tau, (q1, v1) in zip(alone, starts, taus, robots.split(q, v), strict=True):
+    for system, (q0, v0), tau, (q1, v1) in zip(
+        alone, starts, taus, robots.split(q, v), strict=True
+    ):
         q_alone, v_alone = system.advance(integrator, 0.0, q0, v0, tau, 0.01)
         assert np.array_equal(q1, q_alone) and np.array_equal(v1, v_alone)
 

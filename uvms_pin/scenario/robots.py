@@ -16,7 +16,6 @@ import re
 from collections.abc import Mapping
 from typing import Any
 
-from uvms_pin.errors import ScenarioError
 from uvms_pin.scenario.schema import Table
 
 __all__ = ["ROBOT_TABLES", "SHARED_TABLES", "robot_documents"]

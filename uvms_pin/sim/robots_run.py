@@ -82,7 +82,9 @@ def shortened_robots(
     return replace(scenario, robots=tuple(shortened(r, environ) for r in scenario.robots))
 
 
-def simulate_robots(scenario: RobotsScenario, *, controllers: Sequence | None = None) -> RobotRollouts:
+def simulate_robots(
+    scenario: RobotsScenario, *, controllers: Sequence | None = None
+) -> RobotRollouts:
     """Run every robot of ``scenario``, each with a fresh controller (or the instances
     ``controllers``, one per robot, reset first) and its own seeded sensors.
 
@@ -101,7 +103,9 @@ def simulate_robots(scenario: RobotsScenario, *, controllers: Sequence | None = 
             raise
         return RobotRollouts({scenario.names[0]: rollout})
     parts = [_parts(r, g) for r, g in zip(robots, given, strict=True)]
-    loop = RobotsLoop([r.plant for r in robots], scenario.names, scenario.settings, [p[0] for p in parts])
+    loop = RobotsLoop(
+        [r.plant for r in robots], scenario.names, scenario.settings, [p[0] for p in parts]
+    )
     logs = []
     for robot, (_, sensors, metadata), own in zip(robots, parts, loop.loops, strict=True):
         plant, settings = robot.plant, robot.settings
@@ -109,7 +113,9 @@ def simulate_robots(scenario: RobotsScenario, *, controllers: Sequence | None = 
         meta = {**metadata, **run_metadata(plant, settings)}
         if sensors.navigation is not None:
             meta["signal_units"].update(described_columns(sensors.navigation.signal_columns()))
-        logs.append(RolloutLog(plant.uvms, settings.n_log, meta, backend=plant.backend, system=own.system))
+        logs.append(
+            RolloutLog(plant.uvms, settings.n_log, meta, backend=plant.backend, system=own.system)
+        )
     starts = [(r.q0, r.v0) for r in robots]
     try:
         out = loop.run(starts, [p[1] for p in parts], logs)

@@ -15,7 +15,16 @@ TWO = ROOT / "scenarios" / "two_robots.toml"
 
 def test_a_run_of_two_robots_writes_each_robots_results_and_a_block_each(tmp_path, capsys):
     out = tmp_path / "out"
-    args = ["run", str(TWO), "--out", str(out), "--quiet", "--html", "--set", "scenario.duration_s=0.3"]
+    args = [
+        "run",
+        str(TWO),
+        "--out",
+        str(out),
+        "--quiet",
+        "--html",
+        "--set",
+        "scenario.duration_s=0.3",
+    ]
     assert main(args) == 0
     metrics = json.loads((out / "metrics.json").read_text())["robots"]
     assert list(metrics) == ["alpha", "bravo"]

@@ -77,9 +77,13 @@ class Robots:
         self.systems = tuple(systems)
         self.names = tuple(names)
         plants = [s.plant for s in self.systems]
-        worlds = [p.world if p.world is not None else World(p.uvms, [], ContactLaw()) for p in plants]
+        worlds = [
+            p.world if p.world is not None else World(p.uvms, [], ContactLaw()) for p in plants
+        ]
         self.contacts = RobotContacts.of(worlds, self.names)
-        self.layout = Layout.of([(n, p.uvms.nq, p.uvms.nv) for n, p in zip(names, plants, strict=True)])
+        self.layout = Layout.of(
+            [(n, p.uvms.nq, p.uvms.nv) for n, p in zip(names, plants, strict=True)]
+        )
         self.model = joined_model([p.uvms.model for p in plants], self.names)
         self._datas = [p.uvms.model.createData() for p in plants]
 
@@ -97,7 +101,9 @@ class Robots:
         self.contacts.commit(self._kinematics(q, zero), self.contacts.found(self._datas))
 
     def _kinematics(self, q: np.ndarray, v: np.ndarray) -> list[pin.Data]:
-        for system, data, (q_k, v_k) in zip(self.systems, self._datas, self.split(q, v), strict=True):
+        for system, data, (q_k, v_k) in zip(
+            self.systems, self._datas, self.split(q, v), strict=True
+        ):
             pin.forwardKinematics(system.plant.uvms.model, data, q_k, v_k)
         return self._datas
 
@@ -141,7 +147,9 @@ class Robots:
             self.contacts.clear()  # no contact persists: the friction forgets its anchors
             ends = [
                 system.advance(integrator, t0, q_k, v_k, tau, t1)
-                for system, (q_k, v_k), tau in zip(self.systems, self.split(q0, v0), taus, strict=True)
+                for system, (q_k, v_k), tau in zip(
+                    self.systems, self.split(q0, v0), taus, strict=True
+                )
             ]
             return tuple(self.layout.join(ends))
         return self._together(integrator, t0, q0, v0, taus, t1)
@@ -157,7 +165,9 @@ class Robots:
             system.settle(q_k, v_k)
         self.contacts.commit(self._kinematics(q1, v1), self.contacts.found(self._datas))
         out = []
-        for system, start, end, tau in zip(self.systems, self.split(q0, v0), ends, taus, strict=True):
+        for system, start, end, tau in zip(
+            self.systems, self.split(q0, v0), ends, taus, strict=True
+        ):
             if constraint_sets(system):
                 step = constrained(system, lambda *_, end=end: end)
                 end = step(t0, start[0], start[1], tau, t1)
