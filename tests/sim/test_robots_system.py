@@ -52,7 +52,7 @@ def test_two_robots_pushing_each_other_keep_their_total_momentum(load_body):
     momentum, together = [], 0
     for k in range(150):
         together += robots.near(q, v, period)
-        q, v = robots.advance(integrator, k * period, q, v, zero, (k + 1) * period)
+        q, v = robots.advance(integrator, k * period, (q, v), zero, (k + 1) * period)
         (qa, va), (qb, vb) = robots.split(q, v)
         momentum.append(_momentum_world(a, qa, va) + _momentum_world(b, qb, vb))
     momentum = np.array(momentum)
@@ -78,7 +78,7 @@ def test_robots_apart_step_each_as_alone(load_body):
     state = robots.layout.join(starts)
     robots.start(state)
     integrator = RK4(step_s=2.5e-3)
-    q, v = robots.advance(integrator, 0.0, state.q, state.v, taus, 0.01)
+    q, v = robots.advance(integrator, 0.0, state, taus, 0.01)
     for system, (q0, v0), tau, (q1, v1) in zip(
         alone, starts, taus, robots.split(q, v), strict=True
     ):

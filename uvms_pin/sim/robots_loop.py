@@ -23,7 +23,7 @@ from uvms_pin.results.robots import RobotRollouts
 from uvms_pin.results.status import INTERRUPTED, OK, RunStatus
 from uvms_pin.sim.closed_loop import ClosedLoop, _diverged, _finished, _stopped
 from uvms_pin.sim.compiled_loop import LoopPath
-from uvms_pin.sim.divergence import NUMERICAL_FAILURES, diverged
+from uvms_pin.sim.divergence import NUMERICAL_FAILURES, diverged, divergence_context
 from uvms_pin.sim.log import RolloutLog
 from uvms_pin.sim.pipeline import Pipeline, RunParts, why_not_compiled
 from uvms_pin.sim.plant import Plant
@@ -89,24 +89,34 @@ class RobotsLoop:
         return [made[3] for made in ticked]
 
     def step(self, taus: list[np.ndarray]) -> None:
-        """Every robot one control period on, its input of ``taus`` held."""
-        t0, period = self.time_s, self.settings.control_period_s
-        t1 = t0 + period
+        """Every robot one control period on, its input of ``taus`` held.
+
+        Raises SimulationError when the state diverges, naming what stood out for each
+        robot at the period's start."""
+        t0 = self.time_s
+        span = (t0, t0 + self.settings.control_period_s)
         try:
-            q, v = self.system.advance(
-                self.settings.integrator, t0, self.state.q, self.state.v, taus, t1
-            )
+            state = self.system.advance(self.settings.integrator, t0, self.state, taus, span[1])
         except (SimulationError, *NUMERICAL_FAILURES) as exc:
-            raise _diverged(t0, t1, exc, "several robots") from exc
-        if diverged(q, v):
-            raise _diverged(t0, t1, None, "several robots")
-        q.setflags(write=False)
-        v.setflags(write=False)
-        self.state = SystemState(q, v)
-        self.time_s = round(t1 / period) * period
-        for loop, (q_k, v_k) in zip(self.loops, self.system.split(q, v), strict=True):
+            raise _diverged(*span, exc, self._context(span, taus)) from exc
+        if diverged(*state):
+            raise _diverged(*span, None, self._context(span, taus))
+        for part in state:  # new arrays of the system's: frozen, not copied
+            part.setflags(write=False)
+        self.state = state
+        self.time_s = (
+            round(span[1] / self.settings.control_period_s) * self.settings.control_period_s
+        )
+        for loop, (q_k, v_k) in zip(self.loops, self.system.split(*state), strict=True):
             loop.state = SystemState(q_k, v_k)
             loop.time_s = self.time_s
+
+    def _context(self, span: tuple[float, float], taus: list[np.ndarray]) -> str:
+        """What stood out for each robot over ``span`` (`divergence_context`)."""
+        return "; ".join(
+            f"robot {name}: {divergence_context(loop.plant, span, loop.q, loop.v, tau)}"
+            for name, loop, tau in zip(self.system.names, self.loops, taus, strict=True)
+        )
 
     def run(
         self,

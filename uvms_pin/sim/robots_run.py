@@ -16,14 +16,12 @@ from pathlib import Path
 from typing import Any
 
 from uvms_pin.errors import ParameterError
-from uvms_pin.perception.suite import check_mounts
 from uvms_pin.results.robots import RobotRollouts
 from uvms_pin.sim.log import RolloutLog, described_columns, run_metadata
 from uvms_pin.sim.robots_loop import RobotsLoop
 from uvms_pin.sim.run import (
     Scenario,
-    controller_record,
-    recorded_parameters,
+    run_parts,
     shortened,
     simulate,
 )
@@ -128,22 +126,11 @@ def simulate_robots(
 
 
 def _parts(robot: Scenario, given) -> tuple[Any, SensorSuite, dict[str, Any]]:
-    """(the robot's controller, its seeded sensors, its rollout's metadata)."""
-    settings = robot.settings
-    check_mounts(robot.sensor_config.perception, robot.uvms.model, settings.duration_s)
+    """(the robot's controller, its seeded sensors, its rollout's metadata): a single
+    robot's (`run_parts`); cameras and sonars are not fired for several robots."""
     if robot.sensor_config.perception.fitted:
         raise ParameterError("cameras and sonars with several robots are not simulated")
-    sensors = SensorSuite(robot.uvms.model, robot.sensor_config, settings.duration_s, settings.seed)
-    controller = robot.controller_factory(robot.uvms) if given is None else given
-    record = controller_record(robot.controller_factory if given is None else None, controller)
-    metadata = {
-        "scenario": robot.name,
-        "scenario_path": str(robot.path),
-        "description": robot.description,
-        "parameters": recorded_parameters(robot, record, instance=given is not None),
-        "controller": record,
-    }
-    return controller, sensors, metadata
+    return run_parts(robot, given)
 
 
 def _record_tasks(scenario: RobotsScenario, rollouts: RobotRollouts) -> None:

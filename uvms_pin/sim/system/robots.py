@@ -133,28 +133,24 @@ class Robots:
         return self.contacts.near(self._kinematics(q, v), horizon_s)
 
     def advance(
-        self,
-        integrator: Integrator,
-        t0: float,
-        q0: np.ndarray,
-        v0: np.ndarray,
-        taus: Sequence[np.ndarray],
-        t1: float,
-    ) -> tuple[np.ndarray, np.ndarray]:
-        """The robots' (q, v) at t1 from (q0, v0) at t0, each robot's input of ``taus``
-        held: apart or together (see the module docstring)."""
+        self, integrator: Integrator, t0: float, state: SystemState, taus: Sequence, t1: float
+    ) -> SystemState:
+        """The robots' state at t1 from ``state`` at t0, each robot's input of ``taus``
+        (nv_k,) held: apart or together (see the module docstring)."""
+        q0, v0 = state
         if not self.near(q0, v0, t1 - t0):
             self.contacts.clear()  # no contact persists: the friction forgets its anchors
-            ends = [
-                system.advance(integrator, t0, q_k, v_k, tau, t1)
-                for system, (q_k, v_k), tau in zip(
-                    self.systems, self.split(q0, v0), taus, strict=True
-                )
-            ]
-            return tuple(self.layout.join(ends))
+            return self.layout.join(
+                [
+                    system.advance(integrator, t0, q_k, v_k, tau, t1)
+                    for system, (q_k, v_k), tau in zip(
+                        self.systems, self.split(q0, v0), taus, strict=True
+                    )
+                ]
+            )
         return self._together(integrator, t0, q0, v0, taus, t1)
 
-    def _together(self, integrator, t0, q0, v0, taus, t1) -> tuple[np.ndarray, np.ndarray]:
+    def _together(self, integrator, t0, q0, v0, taus, t1) -> SystemState:
         """The period integrated for every robot at once (the contacts between them in the
         right-hand side), every anchor moved at its end, then each robot's constraints."""
         q1, v1 = integrator.advance(
@@ -172,7 +168,7 @@ class Robots:
                 step = constrained(system, lambda *_, end=end: end)
                 end = step(t0, start[0], start[1], tau, t1)
             out.append(end)
-        return tuple(self.layout.join(out))
+        return self.layout.join(out)
 
     def contact_signals(self, q: np.ndarray, v: np.ndarray) -> np.ndarray:
         """The contacts between robots at (q, v), per pair (`RobotContacts.pair_names`):
