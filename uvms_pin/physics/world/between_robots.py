@@ -11,7 +11,7 @@ total momentum is kept by their contacts.
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -19,6 +19,8 @@ import pinocchio as pin
 
 from uvms_pin.physics.world.moving import _all_pairs, _Set, _unique
 from uvms_pin.physics.world.pairs import PairContacts, piece_pairs
+from uvms_pin.physics.world.robot_reach import reach_sphere, robot_reach_m
+from uvms_pin.physics.world.touch import reach_spheres
 from uvms_pin.physics.world.world import World
 
 __all__ = ["RobotContacts"]
@@ -31,10 +33,12 @@ class RobotContacts:
     Attributes:
         worlds: each robot's world (its pieces, its body names, the law).
         sets: one pair set for each two robots i < j (``a = i``, ``b = j``).
+        reach_m: each robot's reach from its vehicle (`robot_reach.robot_reach_m`).
     """
 
     worlds: tuple[World, ...]
     sets: list[_Set]
+    reach_m: tuple[float, ...]
 
     @staticmethod
     def of(worlds: Sequence[World], names: Sequence[str]) -> RobotContacts:
@@ -53,7 +57,8 @@ class RobotContacts:
                 mu = (first.law.friction_static, first.law.friction_kinetic)
                 own = piece_pairs(first.pieces, other.pieces, pairs, first.law, mu, labels)
                 sets.append(_Set(own, i, j))
-        return RobotContacts(tuple(worlds), sets)
+        reach = tuple(robot_reach_m(w.uvms.model, w.pieces) for w in worlds)
+        return RobotContacts(tuple(worlds), sets, reach)
 
     @property
     def pair_names(self) -> list[str]:
@@ -65,10 +70,39 @@ class RobotContacts:
         for s in self.sets:
             s.memory.clear()
 
-    def near(self, datas: Sequence[pin.Data], horizon_s: float) -> bool:
-        """Some pair may touch within ``horizon_s`` (after forward kinematics of every robot
-        with its velocity)."""
-        return any(s.pairs.near(datas[s.a], datas[s.b], horizon_s) for s in self.sets)
+    def near(
+        self,
+        states: Sequence[tuple[np.ndarray, np.ndarray]],
+        kinematics: Callable[[], Sequence[pin.Data]],
+        horizon_s: float,
+    ) -> bool:
+        """Some pair may touch within ``horizon_s`` from the robots' ``states`` ((q, v)
+        each): first each robot's sphere (`robot_reach.reach_sphere`), then, for two robots
+        whose spheres meet, their pieces' (`touch.reach_spheres`, after ``kinematics()``:
+        forward kinematics of every robot with its velocity). The cost of far robots is one
+        distance a pair of robots."""
+        robots = [
+            reach_sphere(q, v, r, horizon_s) for (q, v), r in zip(states, self.reach_m, strict=True)
+        ]
+        close = [
+            s
+            for s in self.sets
+            if s.pairs.pairs
+            and np.linalg.norm(robots[s.a][0] - robots[s.b][0]) < robots[s.a][1] + robots[s.b][1]
+        ]
+        if not close:
+            return False
+        datas = kinematics()
+        spheres: dict[int, tuple[np.ndarray, np.ndarray]] = {}
+        for s in close:
+            for k in (s.a, s.b):
+                if k not in spheres:
+                    spheres[k] = reach_spheres(datas[k], self.worlds[k].pieces, horizon_s)
+            (ca, ra), (cb, rb) = spheres[s.a], spheres[s.b]
+            a, b = np.array(s.pairs.pairs).T
+            if np.any(np.linalg.norm(ca[a] - cb[b], axis=1) < ra[a] + rb[b]):
+                return True
+        return False
 
     def found(self, datas: Sequence[pin.Data]) -> list[PairContacts]:
         """Each set's touching pairs, after forward kinematics of every robot with its

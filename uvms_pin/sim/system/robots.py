@@ -130,7 +130,7 @@ class Robots:
 
     def near(self, q: np.ndarray, v: np.ndarray, horizon_s: float) -> bool:
         """Some two robots may touch within ``horizon_s`` from (q, v)."""
-        return self.contacts.near(self._kinematics(q, v), horizon_s)
+        return self.contacts.near(self.split(q, v), lambda: self._kinematics(q, v), horizon_s)
 
     def advance(
         self, integrator: Integrator, t0: float, state: SystemState, taus: Sequence, t1: float
