@@ -86,6 +86,11 @@ def test_why_the_run_is_not_compiled_is_recorded_for_every_robot():
         assert record["path"] == "python"
         assert record["reason"] == "several robots (their system is integrated in Python)"
     assert out.robot("alpha").metadata["seed"] != out.robot("bravo").metadata["seed"]
+    pairs = out.robot("alpha").metadata["robot_contact_pairs"]
+    assert pairs == out.robot("bravo").metadata["robot_contact_pairs"]
+    assert pairs[0].startswith("alpha/") and "|bravo/" in pairs[0]
+    logged = out.robot("alpha").signals["robot_contact"]
+    assert logged.shape == (len(out), 9 * len(pairs)) and not np.any(logged)  # 3 m apart
 
 
 def test_a_controller_that_raises_stops_every_robot_and_keeps_their_rollouts():

@@ -64,6 +64,19 @@ def test_two_robots_pushing_each_other_keep_their_total_momentum(load_body):
     assert np.linalg.norm(qb[:3] - qa[:3]) > 0.25  # apart again
 
 
+def test_each_robot_logs_the_force_on_itself_equal_and_opposite(load_body):
+    robots = _two_spheres(load_body)
+    q_a, q_b = (s.plant.uvms.neutral_configuration() for s in robots.systems)
+    q_a[:3], q_b[:3] = [-0.24, 0.0, -5.0], [0.0, 0.0, -5.0]  # 1 cm deep
+    state = robots.layout.join([(q_a, np.zeros(6)), (q_b, np.zeros(6))])
+    robots.start(state)
+    on_a, on_b = (s["robot_contact"] for s in robots.contact_signals(*state))
+    assert robots.contact_pair_names(0) == robots.contact_pair_names(1) == ["a/body|b/body"]
+    assert on_a[0] < -1.0 and np.allclose(on_a[1:3], 0.0)  # b pushes a towards -x
+    assert np.array_equal(on_b[:3], -on_a[:3]) and np.array_equal(on_b[3:], on_a[3:])
+    assert on_a[3:6] == pytest.approx([-0.145, 0.0, -5.0], abs=0.01)  # between the two
+
+
 def test_robots_apart_step_each_as_alone(load_body):
     """No robot within reach of another: each robot's period is its own system's, bit for
     bit."""

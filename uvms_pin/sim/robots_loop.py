@@ -14,6 +14,7 @@ from __future__ import annotations
 import time
 import warnings
 from collections.abc import Sequence
+from dataclasses import replace
 
 import numpy as np
 
@@ -76,16 +77,19 @@ class RobotsLoop:
 
     def tick(self, logged: bool) -> list[np.ndarray]:
         """Each robot measures, commands and actuates on its own, then (if ``logged``)
-        every robot's sample is logged: a controller that raises leaves no robot's sample
-        of the tick. The applied inputs."""
+        every robot's sample is logged (with its contacts against the other robots,
+        `Robots.contact_signals`): a controller that raises leaves no robot's sample of the
+        tick. The applied inputs."""
         ticked = []
         for loop in self.loops:
             measurement, contact = loop.observe()
             tau = loop.command(measurement)
             ticked.append((measurement, contact, tau, loop.actuate(tau)))
         if logged:
-            for loop, made in zip(self.loops, ticked, strict=True):
-                loop.notify(loop.sample(*made))
+            contacts = self.system.contact_signals(*self.state)
+            for loop, made, own in zip(self.loops, ticked, contacts, strict=True):
+                sample = loop.sample(*made)
+                loop.notify(replace(sample, signals={**sample.signals, **own}))
         return [made[3] for made in ticked]
 
     def step(self, taus: list[np.ndarray]) -> None:

@@ -107,8 +107,12 @@ def simulate_robots(
     logs = []
     for robot, (_, sensors, metadata), own in zip(robots, parts, loop.loops, strict=True):
         plant, settings = robot.plant, robot.settings
-        check_log_fits(settings, plant.uvms.nq, plant.uvms.nv, own.system.n_logged_columns)
+        pairs = loop.system.contact_pair_names(len(logs))
+        columns = own.system.n_logged_columns + 9 * len(pairs)
+        check_log_fits(settings, plant.uvms.nq, plant.uvms.nv, columns)
         meta = {**metadata, **run_metadata(plant, settings)}
+        if pairs:  # the signal robot_contact's pairs (`Robots.contact_signals`)
+            meta["robot_contact_pairs"] = pairs
         if sensors.navigation is not None:
             meta["signal_units"].update(described_columns(sensors.navigation.signal_columns()))
         logs.append(

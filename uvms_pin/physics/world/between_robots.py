@@ -60,10 +60,9 @@ class RobotContacts:
         reach = tuple(robot_reach_m(w.uvms.model, w.pieces) for w in worlds)
         return RobotContacts(tuple(worlds), sets, reach)
 
-    @property
-    def pair_names(self) -> list[str]:
-        """Every pair's name, in the order of `wrenches`."""
-        return _unique([n for s in self.sets for n in s.pairs.names])
+    def pair_names(self, robot: int) -> list[str]:
+        """The names of the pairs ``robot`` (an index) is in, in the order of `wrenches`."""
+        return _unique([n for s in self.sets if robot in (s.a, s.b) for n in s.pairs.names])
 
     def clear(self) -> None:
         """Every anchor forgotten."""
@@ -131,8 +130,14 @@ class RobotContacts:
         for s, contacts in zip(self.sets, found, strict=True):
             s.pairs.commit(datas[s.b], contacts, s.memory)
 
-    def wrenches(self, found: list[PairContacts]) -> np.ndarray:
-        """Every pair's force on its first robot [N], point [m], moment [N m] (world
-        axes), flattened in the order of `pair_names`."""
-        parts = [s.pairs.pair_wrenches(c).ravel() for s, c in zip(self.sets, found, strict=True)]
-        return np.concatenate([np.zeros(0), *parts])
+    def wrenches(self, robot: int, found: list[PairContacts]) -> np.ndarray:
+        """Every pair ``robot`` is in (`pair_names`): the force on ``robot`` [N], the point
+        [m], zero moment [N m] (one point; world axes), flattened."""
+        parts = [np.zeros(0)]
+        for s, contacts in zip(self.sets, found, strict=True):
+            if robot in (s.a, s.b):
+                rows = s.pairs.pair_wrenches(contacts)
+                if robot == s.b:  # the second robot receives -f at the same point
+                    rows[:, :3] *= -1.0
+                parts.append(rows.ravel())
+        return np.concatenate(parts)

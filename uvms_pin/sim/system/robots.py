@@ -170,7 +170,18 @@ class Robots:
             out.append(end)
         return self.layout.join(out)
 
-    def contact_signals(self, q: np.ndarray, v: np.ndarray) -> np.ndarray:
-        """The contacts between robots at (q, v), per pair (`RobotContacts.pair_names`):
-        the force on the first robot [N], the point [m], the moment [N m], flattened."""
-        return self.contacts.wrenches(self.contacts.found(self._kinematics(q, v)))
+    def contact_signals(self, q: np.ndarray, v: np.ndarray) -> list[dict[str, np.ndarray]]:
+        """What each robot logs of the contacts between robots at (q, v): ``robot_contact``,
+        per pair it is in (`contact_pair_names`), the force on it [N], the point [m], the
+        moment [N m] (world axes), flattened; nothing for a robot without pairs."""
+        found = self.contacts.found(self._kinematics(q, v))
+        return [
+            {"robot_contact": self.contacts.wrenches(k, found)}
+            if self.contact_pair_names(k)
+            else {}
+            for k in range(len(self.systems))
+        ]
+
+    def contact_pair_names(self, robot: int) -> list[str]:
+        """``name/body|name/body`` of every pair of robot ``robot`` (an index)."""
+        return self.contacts.pair_names(robot)
