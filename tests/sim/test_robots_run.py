@@ -115,3 +115,20 @@ def test_several_robots_need_a_sampled_controller():
         ScenarioError, match=r"\[\[robots\]\]: several robots .* sampled controller"
     ):
         scenario_from_dict(doc, TWO)
+
+
+def test_the_free_objects_are_the_first_robots_and_every_robot_touches_them():
+    doc = copy.deepcopy(read_toml(TWO, ScenarioError))
+    doc["scenario"]["duration_s"] = 0.2
+    box = {"type": "box", "name": "box", "size_m": [0.3, 0.3, 0.3], "density_kg_m3": 1025.0,
+           "position_world_m": [0.0, 0.0, -2.0]}  # fmt: skip
+    doc["world"] = {"objects": [box]}
+    out = simulate_robots(scenario_from_dict(doc, TWO))
+    assert out.status.ok
+    alpha, bravo = out.robot("alpha"), out.robot("bravo")
+    assert alpha.signals["free_objects"].shape == (len(out), 13)  # the box's state
+    assert "free_objects" not in bravo.signals
+    assert [o["name"] for o in alpha.metadata["world"]["world"]["free_objects"]] == ["box"]
+    assert bravo.metadata["world"]["world"]["free_objects"] == []
+    assert any(p.endswith("|box") for p in bravo.metadata["robot_contact_pairs"])
+    assert not any(p.endswith("|box") for p in alpha.metadata["robot_contact_pairs"])

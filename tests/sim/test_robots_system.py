@@ -8,12 +8,16 @@ import numpy as np
 import pinocchio as pin
 import pytest
 from conftest import RHO, body_urdf, hydro_xml
+from free_object_helpers import undamped
 
 import uvms_pin as up
 from uvms_pin.errors import ParameterError
+from uvms_pin.physics.world.contact_law import ContactLaw
+from uvms_pin.physics.world.free_object import free_object
+from uvms_pin.physics.world.world import World
 from uvms_pin.sim.integrators import RK4
 from uvms_pin.sim.plant import Plant
-from uvms_pin.sim.system import System
+from uvms_pin.sim.system import System, SystemState
 from uvms_pin.sim.system.robots import Robots, joined_model
 
 
@@ -75,6 +79,49 @@ def test_each_robot_logs_the_force_on_itself_equal_and_opposite(load_body):
     assert on_a[0] < -1.0 and np.allclose(on_a[1:3], 0.0)  # b pushes a towards -x
     assert np.array_equal(on_b[:3], -on_a[:3]) and np.array_equal(on_b[3:], on_a[3:])
     assert on_a[3:6] == pytest.approx([-0.145, 0.0, -5.0], abs=0.01)  # between the two
+
+
+def test_a_robot_pushes_a_free_object_into_another_robot_and_momentum_stays(load_body):
+    """Robot b runs into a free ball that the first robot's system holds; the ball runs on
+    into robot a: b's pairs with the ball are the robots' own, a's its system's; the total
+    linear momentum of the three (their added mass included) stays to 1e-6."""
+    ball = undamped(
+        free_object(
+            "ball", "sphere", {"radius_m": 0.2}, ([0.0, 0.0, -5.0], [0, 0, 0]),
+            density_kg_m3=RHO, water_density_kg_m3=RHO,
+        )
+    )  # fmt: skip
+    a, b = _sphere(load_body), _sphere(load_body, mass=6.0, radius=0.15)
+    law = ContactLaw(stiffness_N_m=2e4, dissipation_s_m=2.0)
+    first = System(Plant(a, world=World(a, [], law, [ball]), free_surface=False))
+    second = System(Plant(b, world=World(b, [], law), free_surface=False))
+    robots = Robots([first, second], ["a", "b"])
+    assert robots.contact_pair_names(1) == ["a/body|b/body", "b/body|ball"]
+    q_a, q_b = a.neutral_configuration(), b.neutral_configuration()
+    q_a[:3], q_b[:3] = [0.45, 0.02, -5.0], [-0.6, 0.0, -5.0]
+    v_b = np.zeros(6)
+    v_b[0] = 0.8
+    state = robots.layout.join([first.initial_state(q_a, np.zeros(6)), (q_b, v_b)])
+    for system, part in zip(robots.systems, robots.split(*state), strict=True):
+        system.start(SystemState(*part))
+    robots.start(state)
+    q, v = state
+    integrator, period, zero = RK4(step_s=5e-4), 1e-2, [np.zeros(6), np.zeros(6)]
+    momentum = []
+    for k in range(200):
+        q, v = robots.advance(integrator, k * period, (q, v), zero, (k + 1) * period)
+        (qa, va), (qb, vb), (qo, vo) = robots.sides(q, v)
+        momentum.append(
+            _momentum_world(a, qa, va)
+            + _momentum_world(b, qb, vb)
+            + _momentum_world(ball.uvms, qo, vo)
+        )
+    momentum = np.array(momentum)
+    p0 = 6.0 * 0.8
+    assert np.max(np.abs(momentum - np.array([p0, 0.0, 0.0]))) <= 1e-6 * p0
+    (qa, va), (qb, vb), (qo, vo) = robots.sides(q, v)
+    assert va[0] > 0.05  # the ball reached a
+    assert qo[0] > 0.01  # and moved on from where b hit it
 
 
 def test_robots_apart_step_each_as_alone(load_body):

@@ -11,6 +11,7 @@ reason is recorded where every run records why it is not compiled
 
 from __future__ import annotations
 
+import dataclasses
 import time
 import warnings
 from collections.abc import Sequence
@@ -58,6 +59,7 @@ class RobotsLoop:
                 "controller ([control] period_s), not a continuous one"
             )
         self.settings = settings
+        plants = [plants[0], *(_without_free_objects(p) for p in plants[1:])]
         self.loops = [
             ClosedLoop(p, settings, c, compiled=False)
             for p, c in zip(plants, controllers, strict=True)
@@ -182,3 +184,11 @@ class RobotsLoop:
             rollout.metadata["closed_loop"] = path.record()
         names = self.system.names
         return RobotRollouts(dict(zip(names, rollouts, strict=True)))
+
+
+def _without_free_objects(plant: Plant) -> Plant:
+    """``plant`` in its world without the free objects: they are the first robot's system's
+    (`uvms_pin.sim.system.robots`)."""
+    if plant.world is None or not plant.world.free:
+        return plant
+    return dataclasses.replace(plant, world=dataclasses.replace(plant.world, free=()))
