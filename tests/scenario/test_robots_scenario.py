@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 from conftest import ROOT
 
-from uvms_pin.errors import ScenarioError
+from uvms_pin.errors import ParameterError, ScenarioError
 from uvms_pin.scenario.load import load_scenario, scenario_from_dict
 from uvms_pin.scenario.robots import ROBOT_TABLES
 from uvms_pin.scenario.toml import read_toml
@@ -93,3 +93,15 @@ def test_bad_robots_are_refused_naming_the_key(edit, message):
     edit(doc)
     with pytest.raises(ScenarioError, match=message):
         scenario_from_dict(doc, AS_IF)
+
+
+def test_a_single_robots_part_asked_of_several_robots_is_refused_by_name():
+    scenario = load_scenario(ROOT / "scenarios" / "two_robots.toml")
+    with pytest.raises(
+        ScenarioError, match=r"several robots \(\[\[robots\]\]\) has no single 'plant'"
+    ):
+        scenario.plant  # noqa: B018 - what a single-robot tool asks first
+    with pytest.raises(AttributeError):
+        scenario.no_such_thing  # noqa: B018
+    with pytest.raises(ParameterError, match=r"no robot 'charlie' in this scenario"):
+        scenario.robot("charlie")

@@ -15,7 +15,7 @@ from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any
 
-from uvms_pin.errors import ParameterError
+from uvms_pin.errors import ParameterError, ScenarioError
 from uvms_pin.results.robots import RobotRollouts
 from uvms_pin.sim.log import RolloutLog, described_columns, run_metadata
 from uvms_pin.sim.robots_loop import RobotsLoop
@@ -31,6 +31,11 @@ from uvms_pin.sim.task_record import record_task
 
 __all__ = ["RobotsScenario", "robot_seed", "shortened_robots", "simulate_robots"]
 
+#: what a single robot's scenario has and several robots have each (`RobotsScenario`)
+_ONE_ROBOTS = frozenset(
+    ("plant", "controller_factory", "sensor_config", "q0", "v0", "uvms", "task", "extra_metrics",
+     "shortened_from_s")
+)  # fmt: skip
 #: the odd constant of Fibonacci hashing, 2^64 / golden ratio: the seeds of robots 0, 1, ...
 #: are spread over the seeds' range
 _SPREAD = 0x9E3779B97F4A7C15
@@ -64,6 +69,17 @@ class RobotsScenario:
     def settings(self):
         """The run's timing (the first robot's settings: every robot's but for the seed)."""
         return self.robots[0].settings
+
+    def __getattr__(self, name: str) -> Any:
+        """A single robot's part asked of several robots (a study, a comparison, the gym
+        environments run one robot): a `ScenarioError` saying so."""
+        if name in _ONE_ROBOTS:
+            raise ScenarioError(
+                f"{self.path}: a scenario of several robots ([[robots]]) has no single "
+                f"'{name}': run it with uvms_pin.simulate_robots or `uvms-pin run`, or take "
+                "one robot's scenario (RobotsScenario.robot(name))"
+            )
+        raise AttributeError(name)
 
     def robot(self, name: str) -> Scenario:
         """The scenario of the robot ``name``."""
