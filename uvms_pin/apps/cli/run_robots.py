@@ -1,8 +1,8 @@
 """``uvms-pin run`` of a scenario with ``[[robots]]``: every robot's results in a directory
 of its name, and ``metrics.json`` (a block per robot) beside them.
 
-Each robot's directory holds what a single robot's run writes (its rollout, its own
-figures and, with ``--html``, its own replay page: the other robots are not drawn in it).
+Each robot's directory holds what a single robot's run writes (its rollout and its own
+figures); ``--html`` writes ``replay.html`` beside them, drawing every robot.
 Exit status as ``uvms-pin run``'s: 0 the run reached its end, 3 it stopped early (what was
 simulated is saved), 130 Ctrl-C.
 """
@@ -52,12 +52,13 @@ def run_robots(scenario: RobotsScenario, args: argparse.Namespace) -> int:
 
 
 def _figures(rollouts, out, html: bool) -> None:
-    """Each robot's figures (and replay page) in its directory."""
+    """Each robot's figures in its directory; with ``html``, ``replay.html`` drawing every
+    robot (`uvms_pin.apps.viz.robots_replay`)."""
     from uvms_pin.apps.outputs import write_figures
 
     for name, rollout in rollouts.rollouts.items():
         write_figures(rollout, out / name)
-        if html and len(rollout):
-            from uvms_pin.apps.viz.replay import write_replay
+    if html and len(rollouts):
+        from uvms_pin.apps.viz.robots_replay import write_robots_replay
 
-            write_replay(rollout, out / name / "replay.html")
+        write_robots_replay(rollouts, out / "replay.html")
