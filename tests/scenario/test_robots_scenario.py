@@ -105,3 +105,15 @@ def test_a_single_robots_part_asked_of_several_robots_is_refused_by_name():
         scenario.no_such_thing  # noqa: B018
     with pytest.raises(ParameterError, match=r"no robot 'charlie' in this scenario"):
         scenario.robot("charlie")
+
+
+def test_an_override_of_a_robots_key_is_named_in_its_error():
+    two = ROOT / "scenarios" / "two_robots.toml"
+    moved = load_scenario(two, {"robots[1].initial.position_world_m": [0.0, 2.5, -2.0]})
+    assert moved.robot("bravo").q0[:3].tolist() == [0.0, 2.5, -2.0]
+    assert moved.robot("alpha").q0[1] == -1.5
+    with pytest.raises(
+        ScenarioError,
+        match=r"robot 'bravo' .*: override 'robots\[1\]\.initial\.position_world_m': needs 3",
+    ):
+        load_scenario(two, {"robots[1].initial.position_world_m": [0.0, 2.5]})

@@ -40,7 +40,7 @@ from uvms_pin.scenario.metrics import build_metrics
 from uvms_pin.scenario.mpc import check_replan_rate
 from uvms_pin.scenario.objects import build_world
 from uvms_pin.scenario.overrides import apply_overrides, parse_key_path
-from uvms_pin.scenario.robots import robot_documents
+from uvms_pin.scenario.robots import robot_documents, robot_overrides
 from uvms_pin.scenario.schema import Table
 from uvms_pin.scenario.sensors import build_sensors
 from uvms_pin.scenario.task import build_task
@@ -131,8 +131,9 @@ def _robots(
     (`uvms_pin.scenario.robots`), its sensors' seed its own (`robot_seed`)."""
     robots = []
     for k, (name, document) in enumerate(documents):
+        own = robot_overrides(overridden, k)
         try:
-            robot = _build(document, path, Table(document, "", str(path), overridden))
+            robot = _build(document, path, Table(document, "", str(path), own))
         except ScenarioError as exc:
             raise ScenarioError(f"robot '{name}' ([[robots]] entry {k}): {exc}") from exc
         seeded = replace(robot.settings, seed=robot_seed(robot.settings.seed, k))

@@ -18,7 +18,7 @@ from typing import Any
 
 from uvms_pin.scenario.schema import Table
 
-__all__ = ["ROBOT_TABLES", "SHARED_TABLES", "robot_documents"]
+__all__ = ["ROBOT_TABLES", "SHARED_TABLES", "robot_documents", "robot_overrides"]
 
 #: the tables a [[robots]] entry may hold: a robot's own
 ROBOT_TABLES = (
@@ -70,3 +70,15 @@ def robot_documents(
         scenario = {**shared.get("scenario", {}), "model": model}
         out.append((name, {**shared, "scenario": scenario, **own}))
     return out
+
+
+def robot_overrides(overridden: dict[str, str], index: int) -> dict[str, str]:
+    """The overridden keys as robot ``index``'s document names them (``robots[1].initial.x``
+    -> ``initial.x``; a shared table's as they are), so that an error about a value an
+    override set names the override."""
+    prefix = f"robots[{index}]."
+    return {
+        key.removeprefix(prefix): text
+        for key, text in overridden.items()
+        if key.startswith(prefix) or not key.startswith("robots")
+    }
