@@ -48,3 +48,5 @@ def test_a_robot_without_pieces_reaches_nothing_and_a_prismatic_arm_everywhere()
     assert robot_reach_m(model, []) == 0.0
     model.addJoint(1, pin.JointModelPX(), pin.SE3.Identity(), "slide")
     assert robot_reach_m(model, []) == math.inf
+    at_rest = reach_sphere(np.zeros(8), np.zeros(7), math.inf, 0.01)  # no 0 x inf = nan
+    assert at_rest[1] == math.inf

@@ -60,7 +60,10 @@ def reach_sphere(
     q: np.ndarray, v: np.ndarray, reach_m: float, horizon_s: float
 ) -> tuple[np.ndarray, float]:
     """(centre (3,) [m], radius [m]) of the sphere holding the robot at (q, v) (free-flyer
-    first) over ``horizon_s`` (see the module docstring)."""
+    first) over ``horizon_s`` (see the module docstring); an infinite one without a
+    bound (``reach_m`` infinite)."""
+    if math.isinf(reach_m):
+        return q[:3], math.inf
     speed = (
         float(np.linalg.norm(v[:3]))
         + float(np.linalg.norm(v[3:6])) * reach_m
