@@ -60,3 +60,12 @@ def test_metrics_have_a_block_per_robot_saved_and_read_back(rollouts, tmp_path):
     assert np.array_equal(back.robot("bravo").q, rollouts.robot("bravo").q)
     with pytest.raises(ParameterError, match="holds no run of several robots"):
         RobotRollouts.load(tmp_path / "alpha")
+
+
+def test_each_robots_figures_by_name(rollouts):
+    import matplotlib.pyplot as plt
+
+    figures = rollouts.plot("pose")
+    assert list(figures) == ["alpha", "bravo"]
+    assert all(hasattr(f, "savefig") for f in figures.values())
+    plt.close("all")
