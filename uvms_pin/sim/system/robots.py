@@ -204,13 +204,14 @@ class Robots:
         (q, v): ``robot_contact``, per pair it is in (`contact_pair_names`), the force on it
         [N], the point [m], the moment [N m] (world axes), flattened; nothing for a robot
         without pairs."""
-        found = self.contacts.found(self._kinematics(q, v))
-        return [
-            {"robot_contact": self.contacts.wrenches(k, found)}
-            if self.contact_pair_names(k)
-            else {}
-            for k in range(len(self.systems))
-        ]
+        if self.near(q, v, 0.0):
+            found = self.contacts.found(self._kinematics(q, v))
+            logged = [self.contacts.wrenches(k, found) for k in range(len(self.systems))]
+        else:  # nothing within reach: no pair touches (the narrow phase skipped)
+            logged = [
+                np.zeros(9 * len(self.contact_pair_names(k))) for k in range(len(self.systems))
+            ]
+        return [{"robot_contact": wrenches} if len(wrenches) else {} for wrenches in logged]
 
     def contact_pair_names(self, robot: int) -> list[str]:
         """``name/body|name/body`` (or ``name/body|object``) of every pair of robot
