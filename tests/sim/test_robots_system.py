@@ -7,7 +7,7 @@ from __future__ import annotations
 import numpy as np
 import pinocchio as pin
 import pytest
-from conftest import RHO, body_urdf, hydro_xml
+from conftest import RHO, ROOT, body_urdf, hydro_xml
 from free_object_helpers import undamped
 
 import uvms_pin as up
@@ -165,3 +165,34 @@ def test_robots_need_distinct_names(load_body):
     system = System(Plant(_sphere(load_body), free_surface=False))
     with pytest.raises(ParameterError, match="one distinct name per robot"):
         Robots([system, system], ["a", "a"])
+
+
+def test_robots_near_but_not_touching_step_together_as_each_alone():
+    """Two BlueROV2 Heavy + Alpha 5 0.7 m apart: within each other's reach sphere (the
+    period is integrated for both at once, in Python around the compiled dynamics), nothing
+    touches: each robot ends where its own compiled period step takes it, to 1e-9."""
+    from uvms_pin.scenario.load import load_scenario
+
+    scenario = load_scenario(
+        ROOT / "scenarios" / "two_robots.toml",
+        {"robots[1].initial.position_world_m": [0.0, -0.8, -2.0]},
+    )
+    plants = [r.plant for r in scenario.robots]
+    robots = Robots([System(p) for p in plants], scenario.names)
+    alone = [System(p) for p in plants]
+    starts = [(r.q0, np.full(r.uvms.nv, 0.05)) for r in scenario.robots]
+    state = robots.layout.join(starts)
+    for system, part in zip(robots.systems, robots.split(*state), strict=True):
+        system.start(SystemState(*part))
+    robots.start(state)
+    assert robots.near(*state, 0.01)
+    taus = [np.r_[1.0, 0.0, 2.0, 0.0, 0.0, 0.1, 0.05, 0.0, 0.0, 0.0] for _ in starts]
+    integrator = scenario.settings.integrator
+    q, v = robots.advance(integrator, 0.0, state, taus, 0.01)
+    assert not np.any(robots.contact_signals(q, v)[0]["robot_contact"])
+    for system, (q0, v0), tau, (q1, v1) in zip(
+        alone, starts, taus, robots.split(q, v), strict=True
+    ):
+        q_alone, v_alone = system.advance(integrator, 0.0, q0, v0, tau, 0.01)
+        assert np.max(np.abs(q1 - q_alone)) < 1e-9 and np.max(np.abs(v1 - v_alone)) < 1e-9
+        assert np.max(np.abs(v1 - v0)) > 1e-3  # it moved
