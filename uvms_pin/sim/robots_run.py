@@ -15,7 +15,7 @@ from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any
 
-from uvms_pin.errors import ParameterError, ScenarioError
+from uvms_pin.errors import ParameterError, ScenarioError, SimulationError
 from uvms_pin.results.robots import RobotRollouts
 from uvms_pin.sim.log import RolloutLog, described_columns, run_metadata
 from uvms_pin.sim.robots_loop import RobotsLoop
@@ -111,7 +111,7 @@ def simulate_robots(
     if len(robots) == 1:  # one robot: the single-robot run itself
         try:
             rollout = simulate(robots[0], progress=False, controller=given[0])
-        except Exception as exc:
+        except (SimulationError, KeyboardInterrupt) as exc:  # the partial rollout too
             if getattr(exc, "rollout", None) is not None:
                 exc.rollout = RobotRollouts({scenario.names[0]: exc.rollout})
             raise
@@ -137,7 +137,7 @@ def simulate_robots(
     starts = [(r.q0, r.v0) for r in robots]
     try:
         out = loop.run(starts, [p[1] for p in parts], logs)
-    except Exception as exc:
+    except (SimulationError, KeyboardInterrupt) as exc:  # the partial rollouts too
         if getattr(exc, "rollout", None) is not None:
             _record_tasks(scenario, exc.rollout)
         raise
