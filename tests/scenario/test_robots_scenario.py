@@ -117,3 +117,11 @@ def test_an_override_of_a_robots_key_is_named_in_its_error():
         match=r"robot 'bravo' .*: override 'robots\[1\]\.initial\.position_world_m': needs 3",
     ):
         load_scenario(two, {"robots[1].initial.position_world_m": [0.0, 2.5]})
+
+
+def test_a_comparison_of_controllers_refuses_several_robots():
+    from uvms_pin.scenario.baselines import baseline_controller_table
+
+    raw = read_toml(ROOT / "scenarios" / "two_robots.toml", ScenarioError)
+    with pytest.raises(ScenarioError, match=r"several robots \(\[\[robots\]\]\): a comparison"):
+        baseline_controller_table(raw, "ppc")
