@@ -5,6 +5,7 @@ for bit; why the run is not compiled is recorded; a stop keeps every robot's rol
 from __future__ import annotations
 
 import copy
+import json
 
 import numpy as np
 import pytest
@@ -117,7 +118,7 @@ def test_several_robots_need_a_sampled_controller():
         scenario_from_dict(doc, TWO)
 
 
-def test_the_free_objects_are_the_first_robots_and_every_robot_touches_them():
+def test_the_free_objects_are_the_first_robots_and_every_robot_touches_them(tmp_path):
     doc = copy.deepcopy(read_toml(TWO, ScenarioError))
     doc["scenario"]["duration_s"] = 0.2
     box = {"type": "box", "name": "box", "size_m": [0.3, 0.3, 0.3], "density_kg_m3": 1025.0,
@@ -132,3 +133,10 @@ def test_the_free_objects_are_the_first_robots_and_every_robot_touches_them():
     assert bravo.metadata["world"]["world"]["free_objects"] == []
     assert any(p.endswith("|box") for p in bravo.metadata["robot_contact_pairs"])
     assert not any(p.endswith("|box") for p in alpha.metadata["robot_contact_pairs"])
+    (box,) = out.object_metrics().values()
+    moved = alpha.signals["free_objects"][-1, :3]
+    assert [box["final_x_m"], box["final_y_m"], box["final_z_m"]] == moved.tolist()
+    assert 0.0 <= box["displacement_m"] < 0.05 and box["max_speed_m_s"] < 0.5  # neutral, untouched
+    out.save(tmp_path)
+    assert json.loads((tmp_path / "metrics.json").read_text())["objects"]["box"] == box
+    assert simulate_robots(_two(0.05)).object_metrics() == {}

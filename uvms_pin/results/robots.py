@@ -3,8 +3,9 @@
 ``rollouts.robot(name)`` is that robot's rollout, with every view a single robot's has
 (``q``, ``v``, ``to_dataframe()``, ``plot()``, ``metrics()``); ``to_dataframe()`` puts
 every robot's columns side by side, each prefixed by the robot's name (``bluerov_a/q.vehicle.x_m``);
-``metrics()`` has a block per robot; ``save`` writes each robot's rollout in a directory of
-its name and ``metrics.json`` (the blocks) beside them.
+``metrics()`` has a block per robot (``object_metrics()`` one per free object); ``save``
+writes each robot's rollout in a directory of its name and ``metrics.json`` (the blocks)
+beside them.
 """
 
 from __future__ import annotations
@@ -12,6 +13,8 @@ from __future__ import annotations
 from collections.abc import Mapping
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
+
+import numpy as np
 
 from uvms_pin.errors import ParameterError
 from uvms_pin.results.atomic import write_json_atomic
@@ -64,6 +67,30 @@ class RobotRollouts:
         """Each robot's metrics (`Rollout.metrics`), by name."""
         return {name: r.metrics() for name, r in self.rollouts.items()}
 
+    def object_metrics(self) -> dict[str, dict[str, float]]:
+        """Each free object's summary, by name (the objects are the first robot's rollout's
+        signal ``free_objects``): where it ended (``final_x_m``, ``final_y_m``,
+        ``final_z_m``), how far it moved from where it started (``displacement_m``) and its
+        greatest speed (``max_speed_m_s``); none without free objects."""
+        first = next(iter(self.rollouts.values()))
+        states = first.signals.get("free_objects")
+        world = (first.metadata.get("world") or {}).get("world") or {}
+        names = [o["name"] for o in world.get("free_objects", [])]
+        if states is None or not len(first) or not names:
+            return {}
+        out = {}
+        for k, name in enumerate(names):
+            own = states[:, 13 * k : 13 * (k + 1)]
+            final = own[-1, :3]
+            out[name] = {
+                "final_x_m": float(final[0]),
+                "final_y_m": float(final[1]),
+                "final_z_m": float(final[2]),
+                "displacement_m": float(np.linalg.norm(final - own[0, :3])),
+                "max_speed_m_s": float(np.linalg.norm(own[:, 7:10], axis=1).max()),
+            }
+        return out
+
     def to_dataframe(self) -> pd.DataFrame:
         """Every robot's table (`Rollout.to_dataframe`) side by side on the time index,
         each column prefixed ``name/``; ``attrs["units"]`` likewise."""
@@ -85,7 +112,8 @@ class RobotRollouts:
 
     def save(self, directory: str | Path) -> Path:
         """Each robot's rollout in ``directory/<name>/`` and ``metrics.json`` (a block per
-        robot, with its status and seed) in ``directory``."""
+        robot, with its status and seed; with free objects, a block per object:
+        `object_metrics`) in ``directory``."""
         out = Path(directory)
         blocks = {}
         for name, rollout in self.rollouts.items():
@@ -95,7 +123,10 @@ class RobotRollouts:
                 **rollout.metrics(),
             }
             rollout.save(out / name)
-        write_json_atomic(out / ROBOTS_FILE, {"robots": blocks})
+        objects = self.object_metrics()
+        write_json_atomic(
+            out / ROBOTS_FILE, {"robots": blocks, **({"objects": objects} if objects else {})}
+        )
         return out
 
     @classmethod
