@@ -15,6 +15,7 @@ from uvms_pin.errors import ParameterError
 from uvms_pin.physics.world.contact_law import ContactLaw
 from uvms_pin.physics.world.free_object import free_object
 from uvms_pin.physics.world.world import World
+from uvms_pin.scenario.load import load_scenario
 from uvms_pin.sim.integrators import RK4
 from uvms_pin.sim.plant import Plant
 from uvms_pin.sim.system import System, SystemState
@@ -171,8 +172,6 @@ def test_robots_near_but_not_touching_step_together_as_each_alone():
     """Two BlueROV2 Heavy + Alpha 5 0.7 m apart: within each other's reach sphere (the
     period is integrated for both at once, in Python around the compiled dynamics), nothing
     touches: each robot ends where its own compiled period step takes it, to 1e-9."""
-    from uvms_pin.scenario.load import load_scenario
-
     scenario = load_scenario(
         ROOT / "scenarios" / "two_robots.toml",
         {"robots[1].initial.position_world_m": [0.0, -0.8, -2.0]},
