@@ -16,6 +16,7 @@ from pathlib import Path
 from typing import Any
 
 from uvms_pin.errors import ParameterError, ScenarioError, SimulationError
+from uvms_pin.results.progress import Progress
 from uvms_pin.results.robots import RobotRollouts
 from uvms_pin.sim.log import RolloutLog, described_columns, run_metadata
 from uvms_pin.sim.robots_loop import RobotsLoop
@@ -25,6 +26,7 @@ from uvms_pin.sim.run import (
     shortened,
     simulate,
 )
+from uvms_pin.sim.sample import ProgressReport
 from uvms_pin.sim.sensors import SensorSuite
 from uvms_pin.sim.settings import check_log_fits
 from uvms_pin.sim.task_record import record_task
@@ -97,10 +99,14 @@ def shortened_robots(
 
 
 def simulate_robots(
-    scenario: RobotsScenario, *, controllers: Sequence | None = None
+    scenario: RobotsScenario,
+    *,
+    controllers: Sequence | None = None,
+    progress: Progress | None = None,
 ) -> RobotRollouts:
     """Run every robot of ``scenario``, each with a fresh controller (or the instances
-    ``controllers``, one per robot, reset first) and its own seeded sensors.
+    ``controllers``, one per robot, reset first) and its own seeded sensors; ``progress``:
+    a callable ``(t_s, duration_s)`` called after every logged sample (None: silent).
 
     Raises FunnelViolation / SimulationError with the rollouts so far attached as
     ``exc.rollout`` (a `RobotRollouts`)."""
@@ -110,7 +116,7 @@ def simulate_robots(
         raise ParameterError(f"{len(given)} controllers for {len(robots)} robots")
     if len(robots) == 1:  # one robot: the single-robot run itself
         try:
-            rollout = simulate(robots[0], progress=False, controller=given[0])
+            rollout = simulate(robots[0], progress=progress or False, controller=given[0])
         except (SimulationError, KeyboardInterrupt) as exc:  # the partial rollout too
             if getattr(exc, "rollout", None) is not None:
                 exc.rollout = RobotRollouts({scenario.names[0]: exc.rollout})
@@ -134,6 +140,8 @@ def simulate_robots(
         logs.append(
             RolloutLog(plant.uvms, settings.n_log, meta, backend=plant.backend, system=own.system)
         )
+    if progress is not None:  # the first robot's samples are every robot's times
+        loop.loops[0].observers.append(ProgressReport(progress, scenario.settings.duration_s))
     starts = [(r.q0, r.v0) for r in robots]
     try:
         out = loop.run(starts, [p[1] for p in parts], logs)

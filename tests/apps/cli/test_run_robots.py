@@ -40,3 +40,10 @@ def test_a_run_of_two_robots_writes_each_robots_results_and_a_block_each(tmp_pat
     assert "robot alpha: ok" in printed and "robot bravo: ok" in printed
     assert main(args) != 0  # a second run does not mix its results into the first's
     assert main([*args, "--overwrite"]) == 0
+
+
+def test_the_progress_is_shown_unless_quiet(tmp_path, capsys):
+    args = ["run", str(TWO), "--out", str(tmp_path / "out"), "--set", "scenario.duration_s=0.1"]
+    assert main(args) == 0
+    shown = capsys.readouterr().err
+    assert "two_robots" in shown and "0.10" in shown

@@ -15,6 +15,7 @@ import sys
 from uvms_pin.apps.exit_codes import EXIT_INTERRUPTED, EXIT_RUN_STOPPED
 from uvms_pin.errors import ParameterError, SimulationError
 from uvms_pin.results.outdir import RUN, check_writable, claim
+from uvms_pin.results.progress import progress_printer
 from uvms_pin.sim.robots_run import RobotsScenario, simulate_robots
 
 
@@ -27,7 +28,7 @@ def run_robots(scenario: RobotsScenario, args: argparse.Namespace) -> int:
     with claim(out, RUN, overwrite=args.overwrite):
         status, message = 0, ""
         try:
-            rollouts = simulate_robots(scenario)
+            rollouts = _simulate(scenario, args.quiet)
         except SimulationError as exc:
             rollouts, status = exc.rollout, EXIT_RUN_STOPPED
             message = f"uvms-pin: run stopped: {exc}; what was simulated is kept in {out}"
@@ -49,6 +50,14 @@ def run_robots(scenario: RobotsScenario, args: argparse.Namespace) -> int:
     if message:
         print(message, file=sys.stderr)
     return status
+
+
+def _simulate(scenario: RobotsScenario, quiet: bool):
+    """The run, with the progress line of ``uvms-pin run`` unless ``quiet``."""
+    if quiet:
+        return simulate_robots(scenario)
+    with progress_printer(scenario.name, scenario.settings.duration_s, delay_s=0.0) as printer:
+        return simulate_robots(scenario, progress=printer)
 
 
 def _figures(rollouts, out, html: bool) -> None:
