@@ -22,6 +22,7 @@ from uvms_pin.sim.run import simulate
 from uvms_pin.sim.sensors import SensorSuite
 
 TWO = ROOT / "scenarios" / "two_robots.toml"
+GRIPPER = ROOT / "scenarios" / "gripper_close.toml"
 
 
 class Recorder(Controller):
@@ -140,3 +141,28 @@ def test_the_free_objects_are_the_first_robots_and_every_robot_touches_them(tmp_
     out.save(tmp_path)
     assert json.loads((tmp_path / "metrics.json").read_text())["objects"]["box"] == box
     assert simulate_robots(_two(0.05)).object_metrics() == {}
+
+
+def test_a_robot_grasps_the_first_robots_ball_as_a_single_robot_does():
+    """scenarios/gripper_close.toml's robot as robot "b", the ball the first robot's (robot
+    "a", 3 m away): b's jaws close on the ball through pairs of its own, and the ball and b
+    move as in the single robot's run integrated in Python (its reference path), to 1e-6
+    (b's own dynamics are the compiled plant's here, the Python reference's there: equal to
+    1e-12 a call, the squeeze's stiff contact grows that)."""
+    doc = read_toml(GRIPPER, ScenarioError)
+    doc["scenario"]["duration_s"] = 0.4
+    single = simulate(
+        scenario_from_dict(copy.deepcopy(doc), GRIPPER), progress=False, compiled_loop=False
+    )
+    model = doc["scenario"].pop("model")
+    own = {key: doc.pop(key) for key in ("initial", "gripper", "controller")}
+    far = copy.deepcopy(own)
+    far["initial"]["position_world_m"] = [0.0, -3.0, -9.75]
+    doc["robots"] = [{"name": "a", "model": model, **far}, {"name": "b", "model": model, **own}]
+    out = simulate_robots(scenario_from_dict(doc, GRIPPER))
+    ball = out.robot("a").signals["free_objects"][:, :3]
+    assert np.max(np.abs(ball - single.signals["free_objects"][:, :3])) < 1e-6
+    assert np.max(np.abs(out.robot("b").q - single.q)) < 1e-6
+    assert np.max(np.abs(ball[-1] - ball[0])) > 1e-3  # squeezed: it moved
+    gripped = out.robot("b").signals["robot_contact"]
+    assert np.abs(gripped).max() > 1.0  # the jaws' force on b [N]
