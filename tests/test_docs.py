@@ -260,6 +260,7 @@ _VARIANTS += [
         True,
     ),
     ("lbv150_ee_circle.toml", {"task": {"type": "hold", "target": "vehicle"}}, True),
+    ("two_robots.toml", {}),
     (
         "estimator_station_keeping.toml",
         {"estimator.draw_initial_error": False, "estimator.gyro_noise_rad_s_rthz": 1e-3,

@@ -1,6 +1,7 @@
 """Documents built from the documented keys, for the generated-input tests: the shipped
-scenarios and studies (every key they use), the tables the docs show (sensors.md's cameras and
-sonars) and one ``[[world.objects]]`` of every registered kind and a fixture, mutated by a few edits each
+scenarios and studies (every key they use, [[robots]] entries' too), the tables the docs show
+(sensors.md's cameras and sonars) and one ``[[world.objects]]`` of every registered kind and a
+fixture, mutated by a few edits each
 (a value of any type, size and sign, NaN and infinities; a key removed or added; a table
 grafted from another document; a list resized; an element of an array of tables twice).
 
@@ -21,6 +22,7 @@ from fuzz_bounds import ROOT
 from hypothesis import strategies as st
 
 from uvms_pin.physics.world.objects import registered_kinds
+from uvms_pin.scenario.robots import ROBOT_TABLES
 
 
 def _toml_blocks(doc: Path) -> list[dict[str, Any]]:
@@ -50,6 +52,17 @@ def _object_tables() -> list[dict[str, Any]]:
     return tables
 
 
+def _table(value: Any) -> dict[str, Any]:
+    """A top-level entry's keys: a table's own; an array of tables' ([[robots]]): none."""
+    return value if isinstance(value, dict) else {}
+
+
+def _robot_entries(doc: dict[str, Any]) -> list[dict[str, Any]]:
+    """The [[robots]] entries of ``doc`` (none for a single-robot document)."""
+    entries = doc.get("robots")
+    return [e for e in entries if isinstance(e, dict)] if isinstance(entries, list) else []
+
+
 def _scenarios() -> dict[str, dict[str, Any]]:
     # the cheap ones first: hypothesis shrinks towards the first
     paths = sorted((ROOT / "scenarios").glob("*.toml"), key=lambda p: ("mpc" in p.name, p.name))
@@ -67,7 +80,10 @@ DONORS: list[tuple[tuple[str, ...], Any]] = [
             )
             for doc in [*SCENARIOS.values(), *_toml_blocks(ROOT / "docs" / "sensors.md")]
             for key in doc
-            for sub in [None, *(k for k, v in doc[key].items() if isinstance(v, dict | list))]
+            for sub in [
+                None,
+                *(k for k, v in _table(doc[key]).items() if isinstance(v, dict | list)),
+            ]
         }.items()
     )
 ]
@@ -77,7 +93,10 @@ EDGE_NUMBERS = (0, -0.0, -1, 1e-300, 1e300, math.nan, math.inf, -math.inf, 2**63
                 10**30, 1e-9, 1e9, 0.5, -0.5, 3)  # fmt: skip
 KEY_NAMES = sorted(
     {k for doc in SCENARIOS.values() for t in doc.values() if isinstance(t, dict) for k in t}
+    | {k for doc in SCENARIOS.values() for entry in _robot_entries(doc) for k in entry}
 )
+#: the tables a [[robots]] entry holds, from every document: what `_graft_robot` gives one
+ROBOT_DONORS = [(p[0], value) for p, value in DONORS if len(p) == 1 and p[0] in ROBOT_TABLES]
 
 scalars = st.one_of(
     st.sampled_from(EDGE_NUMBERS),
@@ -170,7 +189,16 @@ def _resize(draw, doc: dict) -> None:
         )
 
 
-EDITS = (_set, _edge, _delete, _extra, _graft, _resize)
+def _graft_robot(draw, doc: dict) -> None:
+    """A robot's table from another document into a [[robots]] entry (a robot's table into
+    a single-robot document is `_graft`'s)."""
+    entries = _robot_entries(doc)
+    if entries and ROBOT_DONORS:
+        key, value = draw(st.sampled_from(ROBOT_DONORS))
+        draw(st.sampled_from(entries))[key] = copy.deepcopy(value)
+
+
+EDITS = (_set, _edge, _delete, _extra, _graft, _resize, _graft_robot)
 
 
 @st.composite

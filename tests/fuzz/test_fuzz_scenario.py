@@ -20,8 +20,8 @@ AS_IF = ROOT / "scenarios" / "fuzzed.toml"
 
 
 def _check_scenario(scenario) -> None:
-    if scenario is not None:
-        assert np.all(np.isfinite(scenario.q0)) and np.all(np.isfinite(scenario.v0))
+    for robot in getattr(scenario, "robots", () if scenario is None else (scenario,)):
+        assert np.all(np.isfinite(robot.q0)) and np.all(np.isfinite(robot.v0))
 
 
 @settings(max_examples=examples(700))

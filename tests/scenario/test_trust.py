@@ -93,3 +93,17 @@ def test_a_mesh_object_outside_the_folder_is_refused_by_its_index(tmp_path):
     outside = _scenario(tmp_path, body.format("/etc/passwd"))
     with pytest.raises(ScenarioError, match=r"world.objects\[1\].path: reads /etc/passwd"):
         check_no_code(tomllib.loads(outside.read_text()), outside)
+
+
+def test_a_robots_controller_module_and_model_are_judged_as_the_single_robots():
+    two = SCENARIOS / "two_robots.toml"
+    raw = tomllib.loads(two.read_text())
+    check_no_code(raw, two)  # the shipped two robots: code-free
+    assert [r.key for r in reaches(raw, SCENARIOS)] == ["robots[0].model", "robots[1].model"]
+    raw["robots"][1]["controller"] = {"type": "evil:Controller"}
+    with pytest.raises(ScenarioError, match=r"robots\[1\]\.controller\.type: 'evil:Controller'"):
+        check_no_code(raw, two)
+    raw["robots"][1]["controller"] = {"type": "none"}
+    raw["robots"][0]["model"] = "/etc/passwd"
+    with pytest.raises(ScenarioError, match=r"robots\[0\]\.model: reads /etc/passwd"):
+        check_no_code(raw, two)

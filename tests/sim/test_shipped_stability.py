@@ -13,6 +13,7 @@ import pytest
 from uvms_pin.errors import ShortenedRunWarning
 from uvms_pin.model.resources import shipped_models
 from uvms_pin.scenario.load import load_scenario
+from uvms_pin.sim.robots_run import RobotsScenario, shortened_robots, simulate_robots
 from uvms_pin.sim.run import shortened, simulate
 
 SCENARIOS = Path(__file__).resolve().parents[2] / "scenarios"
@@ -41,7 +42,17 @@ def test_every_shipped_model_runs_passive_at_the_default_step(model):
 
 @pytest.mark.parametrize("path", sorted(SCENARIOS.glob("*.toml")), ids=lambda p: p.stem)
 def test_every_shipped_scenario_runs_its_first_second(path):
+    scenario = load_scenario(path)
     with pytest.warns(ShortenedRunWarning):
-        scenario = shortened(load_scenario(path), {"UVMS_PIN_MAX_DURATION_S": "1"})
-    rollout = _checked_run(scenario)
-    assert rollout.time_s[-1] == pytest.approx(1.0)
+        if isinstance(scenario, RobotsScenario):  # [[robots]]: every robot's rollout
+            scenario = shortened_robots(scenario, {"UVMS_PIN_MAX_DURATION_S": "1"})
+        else:
+            scenario = shortened(scenario, {"UVMS_PIN_MAX_DURATION_S": "1"})
+    if isinstance(scenario, RobotsScenario):
+        rollouts = simulate_robots(scenario).rollouts.values()
+        assert all(r.metadata["status"] == "ok" for r in rollouts)
+    else:
+        rollouts = [_checked_run(scenario)]
+    for rollout in rollouts:
+        assert np.all(np.isfinite(rollout.q)) and np.all(np.isfinite(rollout.v))
+        assert rollout.time_s[-1] == pytest.approx(1.0)

@@ -143,8 +143,12 @@ def baseline_controller_table(raw: dict[str, Any], kind: str) -> dict[str, Any]:
 
     Raises:
         ScenarioError: ``kind`` is not the scenario's controller, a named variant nor a
-            baseline.
+            baseline; the scenario holds several robots.
     """
+    if "robots" in raw:
+        raise ScenarioError(
+            "a scenario of several robots ([[robots]]): a comparison of controllers runs one"
+        )
     controller = raw.get("controller") or {}
     if controller.get("type") == kind:
         return copy.deepcopy(controller)

@@ -40,6 +40,7 @@ from uvms_pin.scenario.metrics import build_metrics
 from uvms_pin.scenario.mpc import check_replan_rate
 from uvms_pin.scenario.objects import build_world
 from uvms_pin.scenario.overrides import apply_overrides, parse_key_path
+from uvms_pin.scenario.robots import robot_documents, robot_overrides
 from uvms_pin.scenario.schema import Table
 from uvms_pin.scenario.sensors import build_sensors
 from uvms_pin.scenario.task import build_task
@@ -53,6 +54,7 @@ from uvms_pin.scenario.toml import read_toml
 from uvms_pin.scenario.water import Water, build_water
 from uvms_pin.scenario.world import build_disturbance, build_environment
 from uvms_pin.sim.plant import Plant
+from uvms_pin.sim.robots_run import RobotsScenario, robot_seed
 from uvms_pin.sim.run import Scenario, shortened
 from uvms_pin.sim.settings import SimulationSettings, check_log_fits
 from uvms_pin.sim.system import System
@@ -69,7 +71,9 @@ class Head:
     seed: int
 
 
-def load_scenario(path: str | Path, overrides: dict[str, Any] | None = None) -> Scenario:
+def load_scenario(
+    path: str | Path, overrides: dict[str, Any] | None = None
+) -> Scenario | RobotsScenario:
     """Read a scenario TOML file, apply dotted overrides and build the objects.
 
     Args:
@@ -90,7 +94,7 @@ def load_scenario(path: str | Path, overrides: dict[str, Any] | None = None) -> 
 
 def scenario_from_dict(
     data: Mapping[str, Any], path: str | Path = "<dict>", overrides: dict[str, Any] | None = None
-) -> Scenario:
+) -> Scenario | RobotsScenario:
     """A scenario built in code: ``data`` is what the TOML file would hold, as nested dicts
     (``{"scenario": {"model": "uvms_lbv150", "duration_s": 5}, "water": {...}}``), checked
     key by key exactly as a file is (`load_scenario` reads a file and calls this). ``path``:
@@ -100,12 +104,17 @@ def scenario_from_dict(
 
     Raises:
         ScenarioError: naming the key (and ``path``) of a bad value.
+
+    A document with ``[[robots]]`` gives a `RobotsScenario` (`uvms_pin.scenario.robots`).
     """
     path = Path(path)
     source = str(path)
     raw = apply_overrides(dict(data), overrides)
     overridden = {parse_key_path(text).key: text for text in overrides or {}}
     try:
+        documents = robot_documents(raw, source, overridden)
+        if documents is not None:  # [[robots]]: several robots in one sea
+            return _robots(raw, path, documents, overridden)
         return shortened(_build(raw, path, Table(raw, "", source, overridden)))
     except ScenarioError:
         raise
@@ -113,6 +122,30 @@ def scenario_from_dict(
         error = ScenarioError(f"{source}: {exc}")
         error.user_traceback = exc.user_traceback
         raise error from exc
+
+
+def _robots(
+    raw: dict[str, Any], path: Path, documents: list, overridden: dict[str, str]
+) -> RobotsScenario:
+    """The scenario of several robots: each robot's document read as a single robot's
+    (`uvms_pin.scenario.robots`), its sensors' seed its own (`robot_seed`)."""
+    robots = []
+    for k, (name, document) in enumerate(documents):
+        own = robot_overrides(overridden, k)
+        try:
+            robot = _build(document, path, Table(document, "", str(path), own))
+        except ScenarioError as exc:
+            raise ScenarioError(f"robot '{name}' ([[robots]] entry {k}): {exc}") from exc
+        seeded = replace(robot.settings, seed=robot_seed(robot.settings.seed, k))
+        robots.append(shortened(replace(robot, settings=seeded)))
+    head = robots[0]
+    if len(robots) > 1 and head.settings.control_period_s is None:
+        raise ScenarioError(
+            f"{path}: [[robots]]: several robots are stepped period by period: they need a "
+            "sampled controller ([control] period_s)"
+        )
+    names = tuple(name for name, _ in documents)
+    return RobotsScenario(head.name, head.description, path, raw, tuple(robots), names)
 
 
 def _build(raw: dict[str, Any], path: Path, top: Table) -> Scenario:

@@ -4,7 +4,8 @@
 A scenario file is code when it names code: ``[controller] type = "module:Class"`` and
 ``[metrics] extra = ["module:function"]`` import (run) a module with the user's rights, from
 the scenario's folder or anywhere on ``sys.path``. It also names files uvms-pin reads:
-``[scenario] model`` (a URDF) and the ``path`` of a ``[[world.objects]]`` mesh or fixture. With
+``[scenario] model`` (a URDF) and the ``path`` of a ``[[world.objects]]`` mesh or fixture; each
+``[[robots]]`` entry its controller and model likewise. With
 ``--no-code`` (`check_no_code`), a scenario is refused, before anything is imported or read,
 when it names any module, or a file outside its own folder (and the folders below it) and the
 shipped models; the names are judged as the reader will resolve them (symbolic links
@@ -55,6 +56,7 @@ def reaches(raw: Mapping[str, Any], scenario_dir: Path) -> Iterator[Reach]:
     if isinstance(model, str) and model.strip():
         found = find_model(model, scenario_dir)
         yield Reach("scenario.model", path=found or (scenario_dir / model).resolve())
+    yield from _robot_reaches(raw, scenario_dir)
     world = raw.get("world")
     objects = world.get("objects") if isinstance(world, Mapping) else None
     for k, table in enumerate(objects if isinstance(objects, list) else []):
@@ -77,6 +79,20 @@ def _fixture_reach(key: str, entry: Any, scenario_dir: Path) -> Reach:
         return Reach(key, path=fixture_path(entry, scenario_dir).resolve())
     except ParameterError:  # no such file: the reader refuses it
         return Reach(key, path=(scenario_dir / entry).resolve())
+
+
+def _robot_reaches(raw: Mapping[str, Any], scenario_dir: Path) -> Iterator[Reach]:
+    """What each ``[[robots]]`` entry names: its controller's module, its model."""
+    entries = raw.get("robots")
+    for k, entry in enumerate(entries if isinstance(entries, list) else []):
+        if not isinstance(entry, Mapping):
+            continue
+        for reach in reaches(
+            {"controller": entry.get("controller"), "scenario": entry}, scenario_dir
+        ):
+            yield Reach(
+                f"robots[{k}].{reach.key.removeprefix('scenario.')}", reach.module, reach.path
+            )
 
 
 def _inside(path: Path, folder: Path) -> bool:

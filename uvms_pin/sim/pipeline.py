@@ -54,6 +54,7 @@ class RunParts:
             configuration (None likewise). controller: the law (None: the caller gives tau,
             as a policy does). observers: what watches every sample (besides the log).
         integrator: the integrator of a system's period without settings (None: not asked).
+        robots: how many robots the run holds (`uvms_pin.sim.robots_loop`).
     """
 
     system: Any
@@ -62,6 +63,7 @@ class RunParts:
     controller: Any = None
     observers: Sequence[Any] = ()
     integrator: Integrator | None = None
+    robots: int = 1
 
     @property
     def stepped_by(self) -> Integrator | None:
@@ -90,6 +92,7 @@ def _plant(parts: RunParts) -> str | None:
 REASONS: tuple[tuple[Pipeline, Callable[[RunParts], str | None]], ...] = (
     (Pipeline.LOOP, lambda p: None if p.system.compiled_allowed else "the Python loop was asked for"),
     (Pipeline.SYSTEM, lambda p: None if p.system.compiled_allowed else "the Python integration was asked for"),
+    (Pipeline.BOTH, lambda p: "several robots (their system is integrated in Python)" if p.robots > 1 else None),
     (Pipeline.ALL, lambda p: "the Python backend" if p.system.plant.backend == "python" else None),
     (Pipeline.BOTH, lambda p: "continuous-time control" if p.settings.control_period_s is None else None),
     (Pipeline.ALL, _integrator),

@@ -111,9 +111,11 @@ def simulate(
     return _simulate(scenario, [*observers, *reports], controller, compiled_loop)
 
 
-def _simulate(
-    scenario: Scenario, observers: list[Observer], given: Controller | None, compiled: bool
-) -> Rollout:
+def run_parts(
+    scenario: Scenario, given: Controller | None = None
+) -> tuple[Controller, SensorSuite, dict[str, Any]]:
+    """What a run of ``scenario`` starts from: (a fresh controller, or the instance
+    ``given``; its sensors, seeded with the settings' seed; its rollout's metadata)."""
     settings = scenario.settings
     check_mounts(scenario.sensor_config.perception, scenario.uvms.model, settings.duration_s)
     sensors = SensorSuite(
@@ -136,6 +138,14 @@ def _simulate(
     }
     if scenario.shortened_from_s is not None:
         metadata["shortened_from_s"] = scenario.shortened_from_s
+    return controller, sensors, metadata
+
+
+def _simulate(
+    scenario: Scenario, observers: list[Observer], given: Controller | None, compiled: bool
+) -> Rollout:
+    settings = scenario.settings
+    controller, sensors, metadata = run_parts(scenario, given)
     try:
         rollout = simulate_closed_loop(
             scenario.plant,

@@ -7,6 +7,7 @@ import pytest
 from conftest import ROOT
 
 from uvms_pin.scenario.load import load_scenario
+from uvms_pin.sim.robots_run import RobotsScenario, simulate_robots
 from uvms_pin.sim.run import simulate
 
 pytest.importorskip("rosbags")
@@ -19,6 +20,8 @@ SCENARIOS = sorted((ROOT / "scenarios").glob("*.toml"))
 @pytest.fixture(scope="module", params=SCENARIOS, ids=[p.stem for p in SCENARIOS])
 def short_rollout(request):
     scenario = load_scenario(request.param, {"scenario.duration_s": 0.5})
+    if isinstance(scenario, RobotsScenario):  # [[robots]]: a robot's rollout is one robot's
+        return simulate_robots(scenario).robot(scenario.names[-1])
     return simulate(scenario, progress=False)
 
 

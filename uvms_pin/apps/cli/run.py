@@ -55,12 +55,17 @@ def check_view_options(args: argparse.Namespace) -> None:
 
 def cmd_run(args: argparse.Namespace) -> int:
     from uvms_pin.scenario.load import load_scenario
+    from uvms_pin.sim.run import Scenario
 
     check_view_options(args)
     overrides = dict(parse_assignment(text) for text in args.set)
     if args.no_code:
         _check_no_code(args.scenario, overrides)
     scenario = load_scenario(args.scenario, overrides)
+    if not isinstance(scenario, Scenario):  # [[robots]]: several robots
+        from uvms_pin.apps.cli.run_robots import run_robots
+
+        return run_robots(scenario, args)
     out = check_writable(args.out)  # before simulating, not after
     with InterruptGuard() as guard, claim(out, RUN, overwrite=args.overwrite):
         ending = _simulate_to_end(scenario, args)

@@ -58,10 +58,12 @@ def scene_for_rollout(
     urdf: str | Path | None = None,
     style: SceneStyle | None = None,
     show: str = "visual",
+    also_world_m: np.ndarray | None = None,
 ) -> UvmsScene:
     """The scene of a rollout: its model (``metadata['model_source']`` or ``urdf``), the
-    world it recorded (``metadata['world']``: contact, current, waves), its extent; ``show``
-    the robot's visual geometry, its collision shapes or both (`UvmsScene`)."""
+    world it recorded (``metadata['world']``: contact, current, waves), its extent (with
+    the points ``also_world_m`` (n, 3): other robots to keep in view); ``show`` the robot's
+    visual geometry, its collision shapes or both (`UvmsScene`)."""
     if len(rollout) == 0:
         raise VizError("the rollout has no sample to show")
     meta = rollout.metadata
@@ -76,7 +78,7 @@ def scene_for_rollout(
     uvms = load_uvms(source, water_density_kg_m3=density)
     scene0 = UvmsScene(uvms)  # for forward kinematics only
     tips = np.array([scene0.ee_position(q) for q in _every(rollout.q, 400)])
-    extent = np.vstack([tips, rollout.q[:, :3]])
+    extent = np.vstack([tips, rollout.q[:, :3], *([] if also_world_m is None else [also_world_m])])
     surface = surface_view_of(
         flow_from_record(world.get("flow")),
         bool(world.get("free_surface")),
@@ -129,15 +131,22 @@ def replay_html(
     max_frames: int = 1800,
     style: SceneStyle | None = None,
     show: str = "visual",
+    others: Any = None,
 ) -> str:
     """The replay page of a rollout (a string of HTML); ``show``: the robot's ``"visual"``
-    geometry, its ``"collision"`` shapes or ``"both"``."""
+    geometry, its ``"collision"`` shapes or ``"both"``; ``others``: more robots drawn beside
+    it (`uvms_pin.apps.viz.robots_replay.OtherRobots`: their extent, their geometry and
+    their poses at each of the rollout's samples)."""
     good = np.isfinite(rollout.time_s) & np.all(np.isfinite(rollout.q), axis=1)
     if not np.any(good):
         raise VizError("the rollout has no finite sample to show")
-    scene = scene_for_rollout(rollout, urdf=urdf, style=style, show=show)
+    also = None if others is None else others.extent_world_m
+    scene = scene_for_rollout(rollout, urdf=urdf, style=style, show=show, also_world_m=also)
     vis, window = recording_visualizer()
     scene.build(vis)
+    if others is not None:
+        others.build(vis[ROOT])
+    rows = np.flatnonzero(good)  # the rollout's sample of each good row
 
     time_s = rollout.time_s[good]
     q = rollout.q[good]
@@ -165,7 +174,10 @@ def replay_html(
             None if object_contact is None else object_contact[i],
         )
         at = anim.at_frame(root, float(key))
-        for path, (position, quat, scale) in scene.poses(frame).items():
+        poses = scene.poses(frame)
+        if others is not None:
+            poses.update(others.poses(int(rows[i])))
+        for path, (position, quat, scale) in poses.items():
             node = at[path]
             node.set_property("position", "vector3", position.tolist())
             node.set_property("quaternion", "quaternion", quat.tolist())

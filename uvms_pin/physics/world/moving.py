@@ -39,7 +39,8 @@ State = tuple[np.ndarray, np.ndarray]
 
 @dataclass
 class _Set:
-    """One set of pairs between side a (-1: the UVMS, else a free object) and side b."""
+    """One set of pairs between side a (-1: the UVMS, else a free object) and side b (between
+    several robots a side is a robot's index: `uvms_pin.physics.world.between_robots`)."""
 
     pairs: PiecePairs
     a: int

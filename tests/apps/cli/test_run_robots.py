@@ -1,0 +1,49 @@
+"""``uvms-pin run`` of a scenario with [[robots]] (uvms_pin.apps.cli.run_robots): each
+robot's results in a directory of its name, metrics.json with a block per robot, one
+replay page."""
+
+from __future__ import annotations
+
+import json
+
+from conftest import ROOT
+
+from uvms_pin.apps.cli.main import main
+from uvms_pin.results.robots import RobotRollouts
+
+TWO = ROOT / "scenarios" / "two_robots.toml"
+
+
+def test_a_run_of_two_robots_writes_each_robots_results_and_a_block_each(tmp_path, capsys):
+    out = tmp_path / "out"
+    args = [
+        "run",
+        str(TWO),
+        "--out",
+        str(out),
+        "--quiet",
+        "--html",
+        "--set",
+        "scenario.duration_s=0.3",
+    ]
+    assert main(args) == 0
+    metrics = json.loads((out / "metrics.json").read_text())["robots"]
+    assert list(metrics) == ["alpha", "bravo"]
+    assert all(m["status"] == "ok" and m["simulated_time_s"] == 0.3 for m in metrics.values())
+    for name in ("alpha", "bravo"):
+        assert {"rollout.npz", "rollout.json", "pose.png"} <= {
+            p.name for p in (out / name).iterdir()
+        }
+    assert (out / "replay.html").stat().st_size > 100_000  # one page, every robot
+    assert RobotRollouts.load(out).robot("bravo").q.shape == (7, 11)
+    printed = capsys.readouterr().out
+    assert "robot alpha: ok" in printed and "robot bravo: ok" in printed
+    assert main(args) != 0  # a second run does not mix its results into the first's
+    assert main([*args, "--overwrite"]) == 0
+
+
+def test_the_progress_is_shown_unless_quiet(tmp_path, capsys):
+    args = ["run", str(TWO), "--out", str(tmp_path / "out"), "--set", "scenario.duration_s=0.1"]
+    assert main(args) == 0
+    shown = capsys.readouterr().err
+    assert "two_robots" in shown and "0.10" in shown

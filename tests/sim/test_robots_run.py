@@ -1,0 +1,168 @@
+"""Several robots' run (uvms_pin.sim.robots_loop, robots_run): each controller is given its
+own robot's measurements only; one robot in the robots' loop is the Python loop's run, bit
+for bit; why the run is not compiled is recorded; a stop keeps every robot's rollout."""
+
+from __future__ import annotations
+
+import copy
+import json
+
+import numpy as np
+import pytest
+from conftest import ROOT
+
+from uvms_pin.control.base import Controller
+from uvms_pin.errors import ControllerError, ScenarioError
+from uvms_pin.scenario.load import load_scenario, scenario_from_dict
+from uvms_pin.scenario.toml import read_toml
+from uvms_pin.sim.log import RolloutLog, run_metadata
+from uvms_pin.sim.robots_loop import RobotsLoop
+from uvms_pin.sim.robots_run import simulate_robots
+from uvms_pin.sim.run import simulate
+from uvms_pin.sim.sensors import SensorSuite
+
+TWO = ROOT / "scenarios" / "two_robots.toml"
+GRIPPER = ROOT / "scenarios" / "gripper_close.toml"
+
+
+class Recorder(Controller):
+    """Holds still (zero input) and keeps every measurement it is given."""
+
+    def __init__(self, nv: int, stop_at_s: float | None = None):
+        self.nv, self.stop_at_s, self.seen = nv, stop_at_s, []
+
+    def reset(self) -> None:
+        self.seen = []
+
+    def compute(self, time_s, measurement):
+        if self.stop_at_s is not None and time_s >= self.stop_at_s:
+            raise RuntimeError("stopped on purpose")
+        self.seen.append((time_s, np.array(measurement.q), np.array(measurement.wrench_world)))
+        return np.zeros(self.nv)
+
+
+def _two(duration_s=0.3):
+    return load_scenario(TWO, {"scenario.duration_s": duration_s})
+
+
+def test_each_controller_sees_its_own_robots_measurements_only():
+    scenario = _two()
+    recorders = [Recorder(r.uvms.nv) for r in scenario.robots]
+    out = simulate_robots(scenario, controllers=recorders)
+    assert out.status.ok
+    for name, recorder in zip(scenario.names, recorders, strict=True):
+        rollout = out.robot(name)
+        times = [t for t, _, _ in recorder.seen]
+        assert times == pytest.approx(np.arange(31) * 0.01)  # every tick, once
+        q_seen = np.array([q for _, q, _ in recorder.seen])[::5]  # the logged ticks
+        # its own robot's state with its own sensor noise (1 mm, 1 mrad, 0.5 mrad)
+        assert np.max(np.abs(q_seen[:, :3] - rollout.q[:, :3])) < 2e-3
+    (_, qa, _), (_, qb, _) = recorders[0].seen[0], recorders[1].seen[0]
+    assert qa[1] == pytest.approx(-1.5, abs=0.01) and qb[1] == pytest.approx(1.5, abs=0.01)
+    # the noise is each robot's own: the two robots' errors at the start differ
+    a0, b0 = (out.robot(n).q[0] for n in scenario.names)
+    error_a = recorders[0].seen[0][1] - a0
+    error_b = recorders[1].seen[0][1] - b0
+    assert not np.allclose(error_a, error_b)
+
+
+def test_one_robot_in_the_robots_loop_is_the_python_loops_run_bit_for_bit():
+    robot = _two().robots[0]
+    alone = simulate(robot, progress=False, compiled_loop=False)
+    settings = robot.settings
+    controller = robot.controller_factory(robot.uvms)
+    loop = RobotsLoop([robot.plant], ["alpha"], settings, [controller])
+    sensors = SensorSuite(robot.uvms.model, robot.sensor_config, settings.duration_s, settings.seed)
+    log = RolloutLog(
+        robot.uvms, settings.n_log, run_metadata(robot.plant, settings), system=loop.loops[0].system
+    )
+    ran = loop.run([(robot.q0, robot.v0)], [sensors], [log]).robot("alpha")
+    for name in ("time_s", "q", "v", "tau", "wrench_measured_world"):
+        assert np.array_equal(getattr(ran, name), getattr(alone, name)), name
+
+
+def test_why_the_run_is_not_compiled_is_recorded_for_every_robot():
+    out = simulate_robots(_two(0.05))
+    for name in out.names:
+        record = out.robot(name).metadata["closed_loop"]
+        assert record["path"] == "python"
+        assert record["reason"] == "several robots (their system is integrated in Python)"
+    assert out.robot("alpha").metadata["seed"] != out.robot("bravo").metadata["seed"]
+    pairs = out.robot("alpha").metadata["robot_contact_pairs"]
+    assert pairs == out.robot("bravo").metadata["robot_contact_pairs"]
+    assert pairs[0].startswith("alpha/") and "|bravo/" in pairs[0]
+    logged = out.robot("alpha").signals["robot_contact"]
+    assert logged.shape == (len(out), 9 * len(pairs)) and not np.any(logged)  # 3 m apart
+
+
+def test_a_controller_that_raises_stops_every_robot_and_keeps_their_rollouts():
+    scenario = _two()
+    recorders = [Recorder(r.uvms.nv) for r in scenario.robots]
+    recorders[1].stop_at_s = 0.1
+    with pytest.raises(ControllerError) as caught:
+        simulate_robots(scenario, controllers=recorders)
+    kept = caught.value.rollout
+    assert kept.names == ["alpha", "bravo"]
+    for name in kept.names:
+        assert kept.robot(name).time_s[-1] == pytest.approx(0.05)
+        assert kept.robot(name).metadata["status"] == "error"
+
+
+def test_several_robots_need_a_sampled_controller():
+    doc = read_toml(TWO, ScenarioError)
+    doc = copy.deepcopy(doc)
+    doc.pop("control")
+    doc["integrator"] = {"method": "RK45"}
+    with pytest.raises(
+        ScenarioError, match=r"\[\[robots\]\]: several robots .* sampled controller"
+    ):
+        scenario_from_dict(doc, TWO)
+
+
+def test_the_free_objects_are_the_first_robots_and_every_robot_touches_them(tmp_path):
+    doc = copy.deepcopy(read_toml(TWO, ScenarioError))
+    doc["scenario"]["duration_s"] = 0.2
+    box = {"type": "box", "name": "box", "size_m": [0.3, 0.3, 0.3], "density_kg_m3": 1025.0,
+           "position_world_m": [0.0, 0.0, -2.0]}  # fmt: skip
+    doc["world"] = {"objects": [box]}
+    out = simulate_robots(scenario_from_dict(doc, TWO))
+    assert out.status.ok
+    alpha, bravo = out.robot("alpha"), out.robot("bravo")
+    assert alpha.signals["free_objects"].shape == (len(out), 13)  # the box's state
+    assert "free_objects" not in bravo.signals
+    assert [o["name"] for o in alpha.metadata["world"]["world"]["free_objects"]] == ["box"]
+    assert bravo.metadata["world"]["world"]["free_objects"] == []
+    assert any(p.endswith("|box") for p in bravo.metadata["robot_contact_pairs"])
+    assert not any(p.endswith("|box") for p in alpha.metadata["robot_contact_pairs"])
+    (box,) = out.object_metrics().values()
+    moved = alpha.signals["free_objects"][-1, :3]
+    assert [box["final_x_m"], box["final_y_m"], box["final_z_m"]] == moved.tolist()
+    assert 0.0 <= box["displacement_m"] < 0.05 and box["max_speed_m_s"] < 0.5  # neutral, untouched
+    out.save(tmp_path)
+    assert json.loads((tmp_path / "metrics.json").read_text())["objects"]["box"] == box
+    assert simulate_robots(_two(0.05)).object_metrics() == {}
+
+
+def test_a_robot_grasps_the_first_robots_ball_as_a_single_robot_does():
+    """scenarios/gripper_close.toml's robot as robot "b", the ball the first robot's (robot
+    "a", 3 m away): b's jaws close on the ball through pairs of its own, and the ball and b
+    move as in the single robot's run integrated in Python (its reference path), to 1e-6
+    (b's own dynamics are the compiled plant's here, the Python reference's there: equal to
+    1e-12 a call, the squeeze's stiff contact grows that)."""
+    doc = read_toml(GRIPPER, ScenarioError)
+    doc["scenario"]["duration_s"] = 0.4
+    single = simulate(
+        scenario_from_dict(copy.deepcopy(doc), GRIPPER), progress=False, compiled_loop=False
+    )
+    model = doc["scenario"].pop("model")
+    own = {key: doc.pop(key) for key in ("initial", "gripper", "controller")}
+    far = copy.deepcopy(own)
+    far["initial"]["position_world_m"] = [0.0, -3.0, -9.75]
+    doc["robots"] = [{"name": "a", "model": model, **far}, {"name": "b", "model": model, **own}]
+    out = simulate_robots(scenario_from_dict(doc, GRIPPER))
+    ball = out.robot("a").signals["free_objects"][:, :3]
+    assert np.max(np.abs(ball - single.signals["free_objects"][:, :3])) < 1e-6
+    assert np.max(np.abs(out.robot("b").q - single.q)) < 1e-6
+    assert np.max(np.abs(ball[-1] - ball[0])) > 1e-3  # squeezed: it moved
+    gripped = out.robot("b").signals["robot_contact"]
+    assert np.abs(gripped).max() > 1.0  # the jaws' force on b [N]

@@ -1,0 +1,197 @@
+"""Several robots in one sea (uvms_pin.sim.system.robots): the robots' momentum is kept by
+their contacts, each robot alone steps as it would alone, the joined model stacks the
+robots' coordinates."""
+
+from __future__ import annotations
+
+import numpy as np
+import pinocchio as pin
+import pytest
+from conftest import RHO, ROOT, body_urdf, hydro_xml
+from free_object_helpers import undamped
+
+import uvms_pin as up
+from uvms_pin.errors import ParameterError
+from uvms_pin.physics.world.contact_law import ContactLaw
+from uvms_pin.physics.world.free_object import free_object
+from uvms_pin.physics.world.world import World
+from uvms_pin.scenario.load import load_scenario
+from uvms_pin.sim.integrators import RK4
+from uvms_pin.sim.plant import Plant
+from uvms_pin.sim.system import System, SystemState
+from uvms_pin.sim.system.robots import Robots, joined_model
+
+
+def _sphere(load_body, mass=4.0, radius=0.1):
+    """A one-body robot: a neutrally buoyant sphere without added mass or damping (its
+    weight and buoyancy cancel at its centre: no gravity and no water in effect)."""
+    inertia = (0.4 * mass * radius**2,) * 3
+    collision = f'<sphere radius="{radius}"/>'
+    urdf = body_urdf(mass=mass, inertia=inertia, hydro=hydro_xml(mass / RHO), collision=collision)
+    return load_body(urdf)
+
+
+def _momentum_world(uvms, q, v):
+    return pin.Quaternion(q[3:7]).matrix() @ (up.mass_matrix(uvms, q) @ v)[:3]
+
+
+def _two_spheres(load_body):
+    a, b = _sphere(load_body), _sphere(load_body, mass=6.0, radius=0.15)
+    plants = [Plant(u, free_surface=False) for u in (a, b)]
+    return Robots([System(p) for p in plants], ["a", "b"])
+
+
+def test_two_robots_pushing_each_other_keep_their_total_momentum(load_body):
+    """Robot a (4 kg) runs at 0.5 m/s into robot b (6 kg) 5 cm off the line of centres:
+    they touch (friction too) and part; the total linear momentum stays to 1e-6."""
+    robots = _two_spheres(load_body)
+    a, b = (s.plant.uvms for s in robots.systems)
+    q_a, q_b = a.neutral_configuration(), b.neutral_configuration()
+    q_a[:3], q_b[:3] = [-0.5, 0.05, -5.0], [0.0, 0.0, -5.0]
+    v_a = np.zeros(6)
+    v_a[0] = 0.5
+    state = robots.layout.join([(q_a, v_a), (q_b, np.zeros(6))])
+    robots.start(state)
+    q, v = state
+    integrator, period, zero = RK4(step_s=5e-4), 1e-2, [np.zeros(6), np.zeros(6)]
+    momentum, together = [], 0
+    for k in range(150):
+        together += robots.near(q, v, period)
+        q, v = robots.advance(integrator, k * period, (q, v), zero, (k + 1) * period)
+        (qa, va), (qb, vb) = robots.split(q, v)
+        momentum.append(_momentum_world(a, qa, va) + _momentum_world(b, qb, vb))
+    momentum = np.array(momentum)
+    p0 = 4.0 * 0.5
+    assert together > 0  # they met
+    assert np.max(np.abs(momentum - np.array([p0, 0.0, 0.0]))) <= 1e-6 * p0
+    (qa, va), (qb, vb) = robots.split(q, v)
+    assert vb[0] > 0.1 and abs(vb[1]) > 1e-3  # b was pushed, and sideways (off-centre)
+    assert np.linalg.norm(qb[:3] - qa[:3]) > 0.25  # apart again
+
+
+def test_each_robot_logs_the_force_on_itself_equal_and_opposite(load_body):
+    robots = _two_spheres(load_body)
+    q_a, q_b = (s.plant.uvms.neutral_configuration() for s in robots.systems)
+    q_a[:3], q_b[:3] = [-0.24, 0.0, -5.0], [0.0, 0.0, -5.0]  # 1 cm deep
+    state = robots.layout.join([(q_a, np.zeros(6)), (q_b, np.zeros(6))])
+    robots.start(state)
+    on_a, on_b = (s["robot_contact"] for s in robots.contact_signals(*state))
+    assert robots.contact_pair_names(0) == robots.contact_pair_names(1) == ["a/body|b/body"]
+    assert on_a[0] < -1.0 and np.allclose(on_a[1:3], 0.0)  # b pushes a towards -x
+    assert np.array_equal(on_b[:3], -on_a[:3]) and np.array_equal(on_b[3:], on_a[3:])
+    assert on_a[3:6] == pytest.approx([-0.145, 0.0, -5.0], abs=0.01)  # between the two
+
+
+def test_a_robot_pushes_a_free_object_into_another_robot_and_momentum_stays(load_body):
+    """Robot b runs into a free ball that the first robot's system holds; the ball runs on
+    into robot a: b's pairs with the ball are the robots' own, a's its system's; the total
+    linear momentum of the three (their added mass included) stays to 1e-6."""
+    ball = undamped(
+        free_object(
+            "ball", "sphere", {"radius_m": 0.2}, ([0.0, 0.0, -5.0], [0, 0, 0]),
+            density_kg_m3=RHO, water_density_kg_m3=RHO,
+        )
+    )  # fmt: skip
+    a, b = _sphere(load_body), _sphere(load_body, mass=6.0, radius=0.15)
+    law = ContactLaw(stiffness_N_m=2e4, dissipation_s_m=2.0)
+    first = System(Plant(a, world=World(a, [], law, [ball]), free_surface=False))
+    second = System(Plant(b, world=World(b, [], law), free_surface=False))
+    robots = Robots([first, second], ["a", "b"])
+    assert robots.contact_pair_names(1) == ["a/body|b/body", "b/body|ball"]
+    q_a, q_b = a.neutral_configuration(), b.neutral_configuration()
+    q_a[:3], q_b[:3] = [0.45, 0.02, -5.0], [-0.6, 0.0, -5.0]
+    v_b = np.zeros(6)
+    v_b[0] = 0.8
+    state = robots.layout.join([first.initial_state(q_a, np.zeros(6)), (q_b, v_b)])
+    for system, part in zip(robots.systems, robots.split(*state), strict=True):
+        system.start(SystemState(*part))
+    robots.start(state)
+    q, v = state
+    integrator, period, zero = RK4(step_s=5e-4), 1e-2, [np.zeros(6), np.zeros(6)]
+    momentum = []
+    for k in range(200):
+        q, v = robots.advance(integrator, k * period, (q, v), zero, (k + 1) * period)
+        (qa, va), (qb, vb), (qo, vo) = robots.sides(q, v)
+        momentum.append(
+            _momentum_world(a, qa, va)
+            + _momentum_world(b, qb, vb)
+            + _momentum_world(ball.uvms, qo, vo)
+        )
+    momentum = np.array(momentum)
+    p0 = 6.0 * 0.8
+    assert np.max(np.abs(momentum - np.array([p0, 0.0, 0.0]))) <= 1e-6 * p0
+    (qa, va), (qb, vb), (qo, vo) = robots.sides(q, v)
+    assert va[0] > 0.05  # the ball reached a
+    assert qo[0] > 0.01  # and moved on from where b hit it
+
+
+def test_robots_apart_step_each_as_alone(load_body):
+    """No robot within reach of another: each robot's period is its own system's, bit for
+    bit."""
+    robots = _two_spheres(load_body)
+    alone = [System(Plant(s.plant.uvms, free_surface=False)) for s in robots.systems]
+    starts = []
+    for k, system in enumerate(robots.systems):
+        q = system.plant.uvms.neutral_configuration()
+        q[:3] = [3.0 * k, 0.0, -5.0]
+        starts.append((q, np.full(6, 0.1)))
+    taus = [np.array([1.0, 0, 0, 0, 0, 0.2]), np.array([0, -2.0, 0, 0.1, 0, 0])]
+    state = robots.layout.join(starts)
+    robots.start(state)
+    integrator = RK4(step_s=2.5e-3)
+    q, v = robots.advance(integrator, 0.0, state, taus, 0.01)
+    for system, (q0, v0), tau, (q1, v1) in zip(
+        alone, starts, taus, robots.split(q, v), strict=True
+    ):
+        q_alone, v_alone = system.advance(integrator, 0.0, q0, v0, tau, 0.01)
+        assert np.array_equal(q1, q_alone) and np.array_equal(v1, v_alone)
+
+
+def test_the_joined_model_stacks_the_robots_coordinates(load_body):
+    robots = _two_spheres(load_body)
+    model = robots.model
+    assert (model.nq, model.nv) == (14, 12)
+    assert [model.names[j] for j in range(1, model.njoints)] == ["a/root_joint", "b/root_joint"]
+    q = pin.randomConfiguration(model, -np.ones(model.nq), np.ones(model.nq))
+    dv = np.arange(12) * 0.01
+    stacked = np.concatenate(
+        [pin.integrate(s.plant.uvms.model, q[a], dv[b]) for s, a, b in zip(
+            robots.systems, robots.layout.q_slices, robots.layout.v_slices, strict=True)]
+    )  # fmt: skip
+    assert np.allclose(pin.integrate(model, q, dv), stacked, atol=1e-15)
+    assert joined_model([], []).nq == 0
+
+
+def test_robots_need_distinct_names(load_body):
+    system = System(Plant(_sphere(load_body), free_surface=False))
+    with pytest.raises(ParameterError, match="one distinct name per robot"):
+        Robots([system, system], ["a", "a"])
+
+
+def test_robots_near_but_not_touching_step_together_as_each_alone():
+    """Two BlueROV2 Heavy + Alpha 5 0.7 m apart: within each other's reach sphere (the
+    period is integrated for both at once, in Python around the compiled dynamics), nothing
+    touches: each robot ends where its own compiled period step takes it, to 1e-9."""
+    scenario = load_scenario(
+        ROOT / "scenarios" / "two_robots.toml",
+        {"robots[1].initial.position_world_m": [0.0, -0.8, -2.0]},
+    )
+    plants = [r.plant for r in scenario.robots]
+    robots = Robots([System(p) for p in plants], scenario.names)
+    alone = [System(p) for p in plants]
+    starts = [(r.q0, np.full(r.uvms.nv, 0.05)) for r in scenario.robots]
+    state = robots.layout.join(starts)
+    for system, part in zip(robots.systems, robots.split(*state), strict=True):
+        system.start(SystemState(*part))
+    robots.start(state)
+    assert robots.near(*state, 0.01)
+    taus = [np.r_[1.0, 0.0, 2.0, 0.0, 0.0, 0.1, 0.05, 0.0, 0.0, 0.0] for _ in starts]
+    integrator = scenario.settings.integrator
+    q, v = robots.advance(integrator, 0.0, state, taus, 0.01)
+    assert not np.any(robots.contact_signals(q, v)[0]["robot_contact"])
+    for system, (q0, v0), tau, (q1, v1) in zip(
+        alone, starts, taus, robots.split(q, v), strict=True
+    ):
+        q_alone, v_alone = system.advance(integrator, 0.0, q0, v0, tau, 0.01)
+        assert np.max(np.abs(q1 - q_alone)) < 1e-9 and np.max(np.abs(v1 - v_alone)) < 1e-9
+        assert np.max(np.abs(v1 - v0)) > 1e-3  # it moved

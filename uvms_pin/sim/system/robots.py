@@ -1,0 +1,219 @@
+"""Several robots in one sea: a system of bodies holding one robot's system per robot.
+
+Each robot is a `System` of its own (its `Plant`: its model, its hydrodynamics in the
+shared water, its actuation, its fixed world, its joint limits) and a block of the state
+(`Layout`, one block per robot, in order). The robots meet only through the contacts
+between them (`uvms_pin.physics.world.between_robots`, every force equal and opposite):
+there is no hydrodynamic interaction (no wake, no added mass of one robot felt by the
+other): each robot's water is the undisturbed flow.
+
+A control period is stepped in one of two ways, chosen at its start:
+
+- apart (no pair of robots, nor another robot and an object, can touch over the period,
+  `near`): each robot's system by its own period step (`System.advance`: its compiled call
+  when it has one), the same as alone;
+- together: the Python integrator around the system's right-hand side (each robot's
+  acceleration with the contacts' generalized force added to its input tau: the dynamics
+  are linear in it), every anchor moved at the period's end, then each robot's constraints
+  solved implicitly (its joint limits: they act within the robot only).
+
+The world's free objects belong to the first robot's system (its moving contacts with them,
+their contacts with each other and with the fixed world, as for a single robot); the other
+robots touch them through pairs of their own (`uvms_pin.physics.world.between_robots`), and
+their worlds hold no free object (`uvms_pin.sim.robots_loop` builds them so). The
+first robot's system is then apart when no other robot can reach another robot or an object.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+
+import numpy as np
+import pinocchio as pin
+
+from uvms_pin.errors import ParameterError
+from uvms_pin.physics.world.between_robots import RobotContacts
+from uvms_pin.physics.world.contact_law import ContactLaw
+from uvms_pin.physics.world.world import World
+from uvms_pin.sim.integrators import Integrator
+from uvms_pin.sim.system.period import constrained, constraint_sets
+from uvms_pin.sim.system.state import Layout, SystemState
+from uvms_pin.sim.system.system import System
+
+__all__ = ["Robots", "joined_model"]
+
+
+def joined_model(models: Sequence[pin.Model], names: Sequence[str]) -> pin.Model:
+    """One Pinocchio model with every joint of ``models`` in order, each robot's tree
+    under the universe (a joint named ``robot/joint``): its configuration and velocity are
+    the robots' stacked (what the integrator steps)."""
+    out = pin.Model()
+    for model, name in zip(models, names, strict=True):
+        offset = out.njoints - 1
+        for j in range(1, model.njoints):
+            parent = model.parents[j]
+            out.addJoint(
+                0 if parent == 0 else parent + offset,
+                model.joints[j],
+                model.jointPlacements[j],
+                f"{name}/{model.names[j]}",
+            )
+    return out
+
+
+class Robots:
+    """The systems of several robots (``systems``, one each, named ``names``) in one sea;
+    the first robot's system may hold the world's free objects.
+
+    Attributes:
+        systems: each robot's own system of bodies. names: the robots' names.
+        objects: the free objects (the first system's). contacts: the pairs between robots
+            and between the other robots and the objects. layout: one block per robot's
+            system (the first holds the objects after its robot). model: the joined model
+            (`joined_model`).
+    """
+
+    def __init__(self, systems: Sequence[System], names: Sequence[str]):
+        if len(systems) != len(names) or len(set(names)) != len(names):
+            raise ParameterError(f"one distinct name per robot, got {list(names)}")
+        for system, name in zip(systems[1:], names[1:], strict=True):
+            if system.objects:
+                raise ParameterError(
+                    f"robot '{name}': the free objects are the first robot's system's; "
+                    "the others' worlds hold none"
+                )
+        self.systems = tuple(systems)
+        self.names = tuple(names)
+        self.objects = self.systems[0].objects
+        plants = [s.plant for s in self.systems]
+        worlds = [
+            p.world if p.world is not None else World(p.uvms, [], ContactLaw()) for p in plants
+        ]
+        self.contacts = RobotContacts.of(worlds, self.names, self.objects)
+        self.layout = Layout.of(
+            [(n, s.layout.nq, s.layout.nv) for n, s in zip(names, self.systems, strict=True)]
+        )
+        self.model = joined_model([s.model for s in self.systems], self.names)
+        self._datas = [side.model.createData() for side in self.contacts.sides]
+
+    # ---- the state ------------------------------------------------------------------------
+    def split(self, q: np.ndarray, v: np.ndarray) -> list[tuple[np.ndarray, np.ndarray]]:
+        """Each robot's system's (q, v), views."""
+        return self.layout.split(q, v)
+
+    def sides(self, q: np.ndarray, v: np.ndarray) -> list[tuple[np.ndarray, np.ndarray]]:
+        """(q, v) of each robot, then of each free object, views."""
+        parts = self.split(q, v)
+        robots = [s.robot_state(*part) for s, part in zip(self.systems, parts, strict=True)]
+        return [*robots, *self.systems[0].layout.split(*parts[0])[1:]]
+
+    def start(self, state: SystemState) -> None:
+        """t = 0 at ``state`` (each robot's system started by its loop): the anchors of the
+        contacts between robots (and objects) set afresh where they touch."""
+        self.contacts.clear()
+        q, _ = state
+        zero = np.zeros(self.layout.nv)
+        self.contacts.commit(self._kinematics(q, zero), self.contacts.found(self._datas))
+
+    def _kinematics(self, q: np.ndarray, v: np.ndarray) -> list[pin.Data]:
+        for side, data, (q_k, v_k) in zip(
+            self.contacts.sides, self._datas, self.sides(q, v), strict=True
+        ):
+            pin.forwardKinematics(side.model, data, q_k, v_k)
+        return self._datas
+
+    # ---- the dynamics ---------------------------------------------------------------------
+    def pushes(self, q: np.ndarray, v: np.ndarray) -> list[np.ndarray]:
+        """Each side's generalized force (nv_k,) of the contacts between robots and with
+        the objects at (q, v): the robots', then the objects'."""
+        datas = self._kinematics(q, v)
+        found = self.contacts.found(datas)
+        return self.contacts.generalized([p[0] for p in self.sides(q, v)], datas, found)
+
+    def acceleration(
+        self, time_s: float, q: np.ndarray, v: np.ndarray, taus: Sequence[np.ndarray]
+    ) -> np.ndarray:
+        """The accelerations (nv,) with ``taus`` (each robot's input) held: each robot's
+        system's own right-hand side (`System.acceleration`) with the robot's contacts
+        against the others added to its input, and an object's pushes by the other robots
+        as M_o^-1 tau (the dynamics are linear in the input; M_o with the added mass)."""
+        n = len(self.systems)
+        pushes = self.pushes(q, v)
+        parts = self.split(q, v)
+        out = [
+            system.acceleration(time_s, q_k, v_k, tau + push)
+            for system, (q_k, v_k), tau, push in zip(
+                self.systems, parts, taus, pushes[:n], strict=True
+            )
+        ]
+        on_objects = pushes[n:]
+        if any(np.any(p) for p in on_objects):
+            first = self.systems[0]
+            mass = first.mass_matrix(time_s, parts[0][0])
+            for part, push in zip(first.layout.v_slices[1:], on_objects, strict=True):
+                out[0][part] += np.linalg.solve(mass[part, part], push)
+        return np.concatenate(out)
+
+    def near(self, q: np.ndarray, v: np.ndarray, horizon_s: float) -> bool:
+        """Some two robots, or a robot but the first and an object, may touch within
+        ``horizon_s`` from (q, v)."""
+        return self.contacts.near(self.sides(q, v), lambda: self._kinematics(q, v), horizon_s)
+
+    def advance(
+        self, integrator: Integrator, t0: float, state: SystemState, taus: Sequence, t1: float
+    ) -> SystemState:
+        """The state at t1 from ``state`` at t0, each robot's input of ``taus`` (nv_k,)
+        held: apart or together (see the module docstring)."""
+        q0, v0 = state
+        if not self.near(q0, v0, t1 - t0):
+            self.contacts.clear()  # no contact persists: the friction forgets its anchors
+            return self.layout.join(
+                [
+                    system.advance(integrator, t0, q_k, v_k, tau, t1)
+                    for system, (q_k, v_k), tau in zip(
+                        self.systems, self.split(q0, v0), taus, strict=True
+                    )
+                ]
+            )
+        return self._together(integrator, t0, q0, v0, taus, t1)
+
+    def _together(self, integrator, t0, q0, v0, taus, t1) -> SystemState:
+        """The period integrated for every body at once (the contacts between robots and
+        with the objects in the right-hand side), every anchor moved at its end, then each
+        robot's system's constraints (its joint limits; the first's objects' rigid
+        contacts with the fixed world)."""
+        q1, v1 = integrator.advance(
+            self.model, lambda t, q, v: self.acceleration(t, q, v, taus), t0, q0, v0, t1
+        )
+        ends = self.split(q1, v1)
+        for system, (q_k, v_k) in zip(self.systems, ends, strict=True):
+            system.settle(q_k, v_k)
+        self.contacts.commit(self._kinematics(q1, v1), self.contacts.found(self._datas))
+        out = []
+        for system, start, end, tau in zip(
+            self.systems, self.split(q0, v0), ends, taus, strict=True
+        ):
+            if constraint_sets(system):
+                step = constrained(system, lambda *_, end=end: end)
+                end = step(t0, start[0], start[1], tau, t1)
+            out.append(end)
+        return self.layout.join(out)
+
+    def contact_signals(self, q: np.ndarray, v: np.ndarray) -> list[dict[str, np.ndarray]]:
+        """What each robot logs of its contacts with the other robots (and the objects) at
+        (q, v): ``robot_contact``, per pair it is in (`contact_pair_names`), the force on it
+        [N], the point [m], the moment [N m] (world axes), flattened; nothing for a robot
+        without pairs."""
+        if self.near(q, v, 0.0):
+            found = self.contacts.found(self._kinematics(q, v))
+            logged = [self.contacts.wrenches(k, found) for k in range(len(self.systems))]
+        else:  # nothing within reach: no pair touches (the narrow phase skipped)
+            logged = [
+                np.zeros(9 * len(self.contact_pair_names(k))) for k in range(len(self.systems))
+            ]
+        return [{"robot_contact": wrenches} if len(wrenches) else {} for wrenches in logged]
+
+    def contact_pair_names(self, robot: int) -> list[str]:
+        """``name/body|name/body`` (or ``name/body|object``) of every pair of robot
+        ``robot`` (an index)."""
+        return self.contacts.pair_names(robot)
