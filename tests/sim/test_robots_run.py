@@ -12,7 +12,7 @@ import pytest
 from conftest import ROOT
 
 from uvms_pin.control.base import Controller
-from uvms_pin.errors import ControllerError, ScenarioError
+from uvms_pin.errors import ControllerError, ParameterError, ScenarioError
 from uvms_pin.scenario.load import load_scenario, scenario_from_dict
 from uvms_pin.scenario.toml import read_toml
 from uvms_pin.sim.log import RolloutLog, run_metadata
@@ -166,3 +166,13 @@ def test_a_robot_grasps_the_first_robots_ball_as_a_single_robot_does():
     assert np.max(np.abs(ball[-1] - ball[0])) > 1e-3  # squeezed: it moved
     gripped = out.robot("b").signals["robot_contact"]
     assert np.abs(gripped).max() > 1.0  # the jaws' force on b [N]
+
+
+def test_a_fixture_with_several_robots_is_refused_by_name():
+    doc = copy.deepcopy(read_toml(TWO, ScenarioError))
+    doc["scenario"]["duration_s"] = 0.05
+    panel = {"type": "urdf", "name": "panel", "path": str(ROOT / "models" / "fixtures" / "subsea_panel_valve.urdf"),
+             "position_world_m": [0.0, 5.0, -2.0]}  # fmt: skip
+    doc["world"] = {"objects": [panel]}
+    with pytest.raises(ParameterError, match="fixtures"):
+        simulate_robots(scenario_from_dict(doc, TWO))

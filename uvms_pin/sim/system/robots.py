@@ -82,6 +82,12 @@ class Robots:
                     f"robot '{name}': the free objects are the first robot's system's; "
                     "the others' worlds hold none"
                 )
+        if any(system.fixtures for system in systems):
+            # the robots' contacts and state name a robot's blocks, then the free objects'
+            raise ParameterError(
+                "fixtures ([[world.objects]] type = \"urdf\") are not simulated with several "
+                "robots yet: use one robot, or leave the fixture out"
+            )
         self.systems = tuple(systems)
         self.names = tuple(names)
         self.objects = self.systems[0].objects
