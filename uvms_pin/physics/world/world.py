@@ -31,6 +31,7 @@ from uvms_pin.physics.world.touch import Bounds, Touch, clear_of, cross, touch
 __all__ = [
     "FIXED_CONTACT",
     "INITIAL_OVERLAP",
+    "MOVING_CONTACT",
     "ContactForces",
     "FrictionMemory",
     "World",
@@ -47,6 +48,11 @@ INITIAL_OVERLAP = ("refuse", "separate")
 #: solved implicitly with the Coulomb cone (`uvms_pin.physics.constraints.object_contacts`),
 #: or by the compliant law integrated with the smooth dynamics (`contact_law`)
 FIXED_CONTACT = ("rigid", "compliant")
+
+#: how two moving bodies touch (a robot link and a free object, two free objects, an arm
+#: link and its vehicle): by the compliant law integrated with the smooth dynamics, or as
+#: rigid contacts solved implicitly (`uvms_pin.physics.constraints.moving_contacts`)
+MOVING_CONTACT = ("compliant", "rigid")
 
 
 @dataclass
@@ -127,6 +133,7 @@ class World:
             that overlaps another body (`uvms_pin.physics.world.overlap`).
         fixed_contact: one of `FIXED_CONTACT`, how the free objects touch the
             fixed objects.
+        moving_contact: one of `MOVING_CONTACT`, how two moving bodies touch.
     """
 
     uvms: UVMS
@@ -136,13 +143,15 @@ class World:
     self_collision: bool = False
     initial_overlap: str = "refuse"
     fixed_contact: str = "rigid"
+    moving_contact: str = "compliant"
 
     def __post_init__(self) -> None:
-        if self.fixed_contact not in FIXED_CONTACT:
-            raise ParameterError(
-                f"fixed_contact must be one of {', '.join(FIXED_CONTACT)}, "
-                f"got {self.fixed_contact!r}"
-            )
+        for key, value, choices in (
+            ("fixed_contact", self.fixed_contact, FIXED_CONTACT),
+            ("moving_contact", self.moving_contact, MOVING_CONTACT),
+        ):
+            if value not in choices:
+                raise ParameterError(f"{key} must be one of {', '.join(choices)}, got {value!r}")
         if self.initial_overlap not in INITIAL_OVERLAP:
             raise ParameterError(
                 f"initial_overlap must be one of {', '.join(INITIAL_OVERLAP)}, "
@@ -173,6 +182,7 @@ class World:
             "free_objects": [o.record() for o in self.free],
             "contact": {**self.law.record(), "self_collision": bool(self.self_collision)},
             **({"fixed_contact": self.fixed_contact} if self.free else {}),
+            **({"moving_contact": self.moving_contact} if self.free or self.self_collision else {}),
             "pairs": self.pair_names,
         }
 

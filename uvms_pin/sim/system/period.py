@@ -52,6 +52,7 @@ class Stepped(Protocol):
     compiled_allowed: bool
     layout: Any  # where each body sits in the state (`uvms_pin.sim.system.state.Layout`)
     object_contacts: Any  # the free objects' rigid contacts with the fixed world, or None
+    moving_constraints: Any  # the rigid contacts between moving bodies, or None
 
     def friction_memories(self) -> list: ...
 
@@ -102,9 +103,10 @@ def why_not_compiled_system(system: Stepped, integrator: Integrator | None) -> s
 
 def constraint_sets(system: Stepped) -> tuple:
     """The constraints solved implicitly at the end of ``system``'s period: the robot's
-    joint limits and the free objects' rigid contacts with the fixed world (each when
-    there is one)."""
-    return tuple(s for s in (system.plant.joint_limits, system.object_contacts) if s is not None)
+    joint limits, the free objects' rigid contacts with the fixed world and the rigid
+    contacts between moving bodies (each when there is one)."""
+    sets = (system.plant.joint_limits, system.object_contacts, system.moving_constraints)
+    return tuple(s for s in sets if s is not None)
 
 
 def constrained(system: Stepped, smooth: PeriodStep) -> PeriodStep:
@@ -133,29 +135,38 @@ def constrained(system: Stepped, smooth: PeriodStep) -> PeriodStep:
                 f"the constraint solve did not converge between t = {t0:.6g} s and {t1:.6g} s "
                 f"({solved.iterations} iterations, residual {solved.residual:.3g})"
             )
-        if system.object_contacts is not None:
-            _settle_contacts(system, solved, t1 - t0)
+        _settle_contacts(system, solved, t1 - t0)
         return _end(system, q0, (q_free, v_free), solved, t1 - t0)
 
     return step
 
 
 def _settle_contacts(system: Stepped, solved: ConstrainedVelocity, period_s: float) -> None:
-    """The free objects' contacts of the period solved: their mean forces kept for the logs
-    (`MovingContacts.rigid_forces`), their sliding patches for the next period's cone."""
-    contacts = system.object_contacts
+    """The rigid contacts of the period solved: their mean forces kept for the logs
+    (`MovingContacts.rigid_forces`, `MovingContacts.rigid_pair_forces`), their sliding
+    patches for the next period's cone."""
+    if system.object_contacts is not None:
+        found = _solved_forces(system, system.object_contacts, solved, period_s)
+        moving = system.moving.moving
+        moving.rigid_forces = found
+        for world, forces, memory in zip(
+            moving.object_worlds, found, moving.object_memory, strict=True
+        ):
+            if world is not None:
+                world.commit(forces, memory)
+    if system.moving_constraints is not None:
+        found = _solved_forces(system, system.moving_constraints, solved, period_s)
+        system.moving.moving.rigid_pair_forces = found
+        system.moving_constraints.commit(found)
+
+
+def _solved_forces(system: Stepped, contacts: Any, solved: ConstrainedVelocity, period_s: float):
+    """``contacts``' forces (its ``forces``) of the period ``solved`` (none: no row)."""
     rows = next((b for b in solved.rows if b.name == contacts.name), None)
     if rows is None:
         rows = ConstraintRows.empty(contacts.name, "N s", system.layout.nv)
     impulse = solved.impulses.get(contacts.name, np.zeros(0))
-    found = contacts.forces(rows, impulse, solved.velocity, period_s)
-    moving = system.moving.moving
-    moving.rigid_forces = found
-    for world, forces, memory in zip(
-        moving.object_worlds, found, moving.object_memory, strict=True
-    ):
-        if world is not None:
-            world.commit(forces, memory)
+    return contacts.forces(rows, impulse, solved.velocity, period_s)
 
 
 def _objects_moved(system: Stepped, v: np.ndarray, q_from: np.ndarray, q_to: np.ndarray):
