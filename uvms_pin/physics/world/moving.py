@@ -21,6 +21,7 @@ opposite between the two bodies of its pair (a fixed object's reaction goes to t
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -78,6 +79,9 @@ class MovingContacts:
         rigid_pairs: the moving pairs touch by rigid contacts (see the module).
         rigid_pair_forces: with ``rigid_pairs``, each set's contacts over the last period
             (`MovingPairContacts.forces`).
+        rigid_source: where the rigid contacts of the last period are read when a compiled
+            system solved them (its ``rigid_contacts``, as (sets, objects)), or None: the
+            two attributes above.
     """
 
     world: World
@@ -88,6 +92,7 @@ class MovingContacts:
     rigid_forces: list = field(default_factory=list)
     rigid_pairs: bool = False
     rigid_pair_forces: list = field(default_factory=list)
+    rigid_source: Callable[[], tuple[list, list]] | None = None
 
     @staticmethod
     def of(world: World) -> MovingContacts:
@@ -159,12 +164,15 @@ class MovingContacts:
         """(each set's touching pairs, each free object's `ContactForces` against the fixed
         objects or None), after forward kinematics of every body with its velocity."""
         data = self._datas(uvms_data, object_datas)
+        rigid_sets, rigid_fixed = self.rigid_pair_forces, self.rigid_forces
+        if self.rigid_source is not None and (self.rigid or self.rigid_pairs):
+            rigid_sets, rigid_fixed = self.rigid_source()
         if self.rigid_pairs:
-            sets = list(self.rigid_pair_forces)
+            sets = list(rigid_sets)
         else:
             sets = [s.pairs.forces(data(s.a), data(s.b), s.memory) for s in self.sets]
         if self.rigid:
-            return sets, list(self.rigid_forces)
+            return sets, list(rigid_fixed)
         fixed = [
             None if w is None else w.forces(object_datas[k], self.object_memory[k])
             for k, w in enumerate(self.object_worlds)

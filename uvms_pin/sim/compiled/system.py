@@ -33,8 +33,6 @@ def system_to_core(system: SystemParts, core: ModuleType):
         return Fallback("a plant the core does not compile")
     if system.moving is None:
         return Fallback("a system without moving contacts")
-    if system.moving.moving.rigid_pairs:
-        return Fallback("rigid contacts between moving bodies (solved in Python)")
     objects = [dynamics_of(o.uvms).core for o in system.objects]
     out = core.System(plant, objects)
     try:

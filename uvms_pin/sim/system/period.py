@@ -31,10 +31,12 @@ import pinocchio as pin
 from uvms_pin.errors import SimulationError
 from uvms_pin.physics.compiled.backend import Fallback
 from uvms_pin.physics.compiled.extension import core_module
+from uvms_pin.physics.compiled.moving import contacts_of_core
 from uvms_pin.physics.constraints.rows import ConstraintRows
 from uvms_pin.physics.constraints.step import (
     ConstrainedVelocity,
     constrained_velocity,
+    default_settings,
     free_body_configuration,
 )
 from uvms_pin.sim.compiled.integrator import integrator_to_core
@@ -103,9 +105,11 @@ def why_not_compiled_system(system: Stepped, integrator: Integrator | None) -> s
 
 def constraint_sets(system: Stepped) -> tuple:
     """The constraints solved implicitly at the end of ``system``'s period: the robot's
-    joint limits, the free objects' rigid contacts with the fixed world and the rigid
-    contacts between moving bodies (each when there is one)."""
-    sets = (system.plant.joint_limits, system.object_contacts, system.moving_constraints)
+    joint limits and joint Coulomb friction, the free objects' rigid contacts with the fixed
+    world and the rigid contacts between moving bodies (each when there is one)."""
+    plant = system.plant
+    sets = (plant.joint_limits, plant.joint_coulomb, system.object_contacts)
+    sets += (system.moving_constraints,)
     return tuple(s for s in sets if s is not None)
 
 
@@ -117,6 +121,9 @@ def constrained(system: Stepped, smooth: PeriodStep) -> PeriodStep:
     v+ (`_configuration`), the others keep q_free (a period in which nothing can reach a
     limit or a surface is the smooth step's)."""
     sets = constraint_sets(system)
+    # a sticking joint creeps at the solver's tolerance on the rows' velocities: 1e-10 rad/s
+    # keeps it below 1e-9 rad a second (the default 1e-8 let a held finger creep 7e-8 m)
+    settings = None if system.plant.joint_coulomb is None else default_settings(1e-10)
 
     def step(t0, q0, v0, tau, t1):
         q_free, v_free = smooth(t0, q0, v0, tau, t1)
@@ -128,7 +135,7 @@ def constrained(system: Stepped, smooth: PeriodStep) -> PeriodStep:
         travelled = np.abs(pin.difference(system.model, q0, q_free)) / (t1 - t0)
         solved = constrained_velocity(
             system.model, mass, _objects_moved(system, v_free, q_free, q0), q0, sets, t1 - t0,
-            least_speed=np.maximum(np.abs(v0), travelled),
+            least_speed=np.maximum(np.abs(v0), travelled), settings=settings,
         )  # fmt: skip
         if not solved.converged:
             raise SimulationError(
@@ -249,8 +256,12 @@ def _step(system: Stepped, integrator: Integrator) -> PeriodStep:
     # the compiled plant is rebuilt when a run starts (its contact anchored anew): taken at
     # each period, the choice of step stays
     if system.objects:
+        moving = system.moving.moving
         if why_not_compiled_system(system, integrator) is not None:
+            moving.rigid_source = None  # its own rigid contacts: `_settle_contacts`
             return integrated
+        # the compiled system's rigid contacts of the last period, when asked
+        moving.rigid_source = lambda: contacts_of_core(system.compiled.rigid_contacts())
         # the compiled system follows the compiled plant (rebuilt when a run starts)
         return lambda t0, q0, v0, tau, t1: system.compiled.advance(
             t0, q0, v0, tau, t1, step, system.friction_memories()
