@@ -63,10 +63,20 @@ double CoupledConstraintStep::piece_speed(const SystemAtStart& at, int side,
 void CoupledConstraintStep::add_pair_rows(const SystemAtStart& at, const Eigen::VectorXd& speed,
                                           double h) {
   const auto& sets = *at.sets;
+  // each piece's speed bound, computed once a selection (-1: not yet)
+  std::vector<double> speed_a, speed_b;
+  const auto cached = [&](std::vector<double>& held, int index, int side,
+                          const ContactShape& piece) {
+    double& value = held[static_cast<std::size_t>(index)];
+    if (value < 0.0) value = piece_speed(at, side, piece, speed);
+    return value;
+  };
   for (std::size_t s = 0; s < sets.size(); ++s) {
     const PairSet& set = sets[s];
     const Data& data_a = set.a < 0 ? *at.robot_data : *at.objects[static_cast<std::size_t>(set.a)];
     const Data& data_b = set.b < 0 ? *at.robot_data : *at.objects[static_cast<std::size_t>(set.b)];
+    speed_a.assign(set.pairs.pieces_a.size(), -1.0);
+    speed_b.assign(set.pairs.pieces_b.size(), -1.0);
     for (std::size_t k = 0; k < set.pairs.pairs.size(); ++k) {
       const auto [ia, ib] = set.pairs.pairs[k];
       const ContactShape& piece_a = set.pairs.pieces_a[static_cast<std::size_t>(ia)];
@@ -75,7 +85,7 @@ void CoupledConstraintStep::add_pair_rows(const SystemAtStart& at, const Eigen::
       const pinocchio::SE3 where_b = placement_of(data_b, piece_b);
       const double apart = (where_a.translation() - where_b.translation()).norm();
       const double closing =
-          piece_speed(at, set.a, piece_a, speed) + piece_speed(at, set.b, piece_b, speed);
+          cached(speed_a, ia, set.a, piece_a) + cached(speed_b, ib, set.b, piece_b);
       if (apart >= piece_a.bound_radius_m + piece_b.bound_radius_m + h * closing + margin) {
         continue;
       }
