@@ -54,6 +54,8 @@ void plane_points(const ContactShape& piece, const pinocchio::SE3& where, const 
   }
 }
 
+}  // namespace
+
 // coal's signed distance and nearest point on the piece (_coal_candidate of gaps.py).
 ContactCandidate coal_candidate(const ContactShape& piece, const pinocchio::SE3& where,
                                 const ContactShape& object, const pinocchio::SE3& object_where,
@@ -83,8 +85,6 @@ Eigen::Matrix<double, 3, 6> point_jacobian(const pinocchio::SE3& body, const Vec
   out.rightCols<3>() = -pinocchio::skew(Vec3(x - body.translation())) * body.rotation();
   return out;
 }
-
-}  // namespace
 
 void contact_candidates(const Data& data, const std::vector<ContactShape>& pieces,
                         const std::vector<ContactShape>& objects, double reach_m,
@@ -156,6 +156,48 @@ int ObjectContactStep::select(const WorldContactModel& world, const FrictionMemo
   return static_cast<int>(m);
 }
 
+void coulomb_gauss_seidel(const Eigen::MatrixXd& delassus, const Eigen::VectorXd& g,
+                          const std::vector<Eigen::Index>& cone_rows,
+                          const std::vector<double>& mu,
+                          const std::vector<Eigen::Index>& unilateral, Eigen::VectorXd& impulse,
+                          const char* what) {
+  Eigen::VectorXd sigma = g + delassus * impulse;  // G lambda + g, kept up to date
+  double last_change = 0.0;
+  for (int sweep = 0; sweep < kMaxSweeps; ++sweep) {
+    double change = 0.0;
+    for (const Eigen::Index j : unilateral) {  // lambda_j >= 0 _|_ sigma_j >= 0
+      const double before = impulse[j];
+      const double after = std::max(0.0, before - sigma[j] / delassus(j, j));
+      sigma += delassus.col(j) * (after - before);
+      impulse[j] = after;
+      change = std::max(change, std::abs(delassus(j, j) * (after - before)));
+    }
+    for (std::size_t c = 0; c < cone_rows.size(); ++c) {
+      const Eigen::Index t = cone_rows[c], n = t + 2;
+      const Eigen::Vector3d before = impulse.segment<3>(t);
+      const double normal = std::max(0.0, before[2] - sigma[n] / delassus(n, n));
+      sigma += delassus.col(n) * (normal - before[2]);
+      impulse[n] = normal;
+      const Eigen::Matrix2d g_tt = delassus.block<2, 2>(t, t);
+      const double mean = 0.5 * g_tt.trace();
+      const double spread = std::sqrt(0.25 * std::pow(g_tt(0, 0) - g_tt(1, 1), 2) +
+                                      g_tt(0, 1) * g_tt(0, 1));
+      Eigen::Vector2d tangential = before.head<2>() - sigma.segment<2>(t) / (mean + spread);
+      const double limit = mu[c] * normal;
+      if (tangential.norm() > limit) tangential *= limit / tangential.norm();
+      sigma += delassus.middleCols<2>(t) * (tangential - before.head<2>());
+      impulse.segment<2>(t) = tangential;
+      const Eigen::Vector3d step = impulse.segment<3>(t) - before;
+      change = std::max(change, (delassus.block<3, 3>(t, t) * step).cwiseAbs().maxCoeff());
+    }
+    last_change = change;
+    if (change <= kTolerance) return;
+  }
+  throw SimulationFailure(std::string(what) + ": the Gauss-Seidel sweeps did not settle in " +
+                          std::to_string(kMaxSweeps) + " (a change of " +
+                          std::to_string(last_change) + " m/s at the last)");
+}
+
 void ObjectContactStep::solve(const Mat6& mass, const Vec6& v_free, Vec6& v) {
   const Eigen::LLT<Mat6> llt(mass);
   if (llt.info() != Eigen::Success) {
@@ -166,40 +208,14 @@ void ObjectContactStep::solve(const Mat6& mass, const Vec6& v_free, Vec6& v) {
   const Eigen::VectorXd g = jacobian_ * v_free + drift_;
   const auto m = static_cast<Eigen::Index>(selected_.size());
   impulse_ = Eigen::VectorXd::Zero(3 * m);
-  Eigen::VectorXd sigma = g;  // G lambda + g, kept up to date
-  double last_change = 0.0;
-  for (int sweep = 0; sweep < kMaxSweeps; ++sweep) {
-    double change = 0.0;
-    for (Eigen::Index i = 0; i < m; ++i) {
-      const Eigen::Index n = 3 * i + 2, t = 3 * i;
-      const Eigen::Vector3d before = impulse_.segment<3>(t);
-      const double normal = std::max(0.0, before[2] - sigma[n] / delassus_(n, n));
-      sigma += delassus_.col(n) * (normal - before[2]);
-      impulse_[n] = normal;
-      const Eigen::Matrix2d g_tt = delassus_.block<2, 2>(t, t);
-      const double mean = 0.5 * g_tt.trace();
-      const double spread = std::sqrt(0.25 * std::pow(g_tt(0, 0) - g_tt(1, 1), 2) +
-                                      g_tt(0, 1) * g_tt(0, 1));
-      Eigen::Vector2d tangential = before.head<2>() - sigma.segment<2>(t) / (mean + spread);
-      const double limit = mu_[static_cast<std::size_t>(i)] * normal;
-      if (tangential.norm() > limit) tangential *= limit / tangential.norm();
-      sigma += delassus_.middleCols<2>(t) * (tangential - before.head<2>());
-      impulse_.segment<2>(t) = tangential;
-      const Eigen::Vector3d step = impulse_.segment<3>(t) - before;
-      change = std::max(change, (delassus_.block<3, 3>(t, t) * step).cwiseAbs().maxCoeff());
-    }
-    last_change = change;
-    if (change <= kTolerance) {
-      v = v_free + minv_jt_ * impulse_;
-      return;
-    }
-  }
-  throw SimulationFailure("object contacts: the Gauss-Seidel sweeps did not settle in " +
-                          std::to_string(kMaxSweeps) + " (a change of " +
-                          std::to_string(last_change) + " m/s at the last)");
+  cone_rows_.resize(selected_.size());
+  for (Eigen::Index i = 0; i < m; ++i) cone_rows_[static_cast<std::size_t>(i)] = 3 * i;
+  coulomb_gauss_seidel(delassus_, g, cone_rows_, mu_, {}, impulse_, "object contacts");
+  v = v_free + minv_jt_ * impulse_;
 }
 
-void ObjectContactStep::forces(const Vec6& v, double h, ContactForces& out) const {
+void ObjectContactStep::forces(const Vec6& v, const Eigen::VectorXd& impulse, double h,
+                               ContactForces& out) const {
   Touch& touch = out.touch;
   touch.clear();
   const std::size_t m = selected_.size();
@@ -219,8 +235,8 @@ void ObjectContactStep::forces(const Vec6& v, double h, ContactForces& out) cons
     touch.normal_world.push_back(contact.normal);
     touch.depth_m.push_back(std::max(-contact.gap_m, 0.0));
     touch.velocity_world_m_s.push_back(frames_[k] * rate.segment<3>(3 * i));
-    out.force_world_N[k] = frames_[k] * impulse_.segment<3>(3 * i) / h;
-    out.normal_N[i] = impulse_[3 * i + 2] / h;
+    out.force_world_N[k] = frames_[k] * impulse.segment<3>(3 * i) / h;
+    out.normal_N[i] = impulse[3 * i + 2] / h;
     out.sticking[k] = rate.segment<2>(3 * i).norm() <= kSlip;
   }
 }
@@ -245,7 +261,8 @@ bool ObjectContactStep::constrain(const WorldContactModel& world, const Friction
     }
     if (!settled) solve(mass, v_free, v);
   }
-  forces(v, h, out);
+  if (rows == 0) impulse_.resize(0);
+  forces(v, impulse_, h, out);
   return rows > 0;
 }
 

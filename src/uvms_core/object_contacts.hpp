@@ -21,7 +21,7 @@
 // lambda_t <- proj_{|.| <= mu lambda_n}(lambda_t - sigma_t / g_t) with g_t the largest
 // eigenvalue of its 2 x 2 block G_tt (a step whose fixed points are exactly the
 // maximal-dissipation ones), sweeps until no impulse changes the velocity of its own rows by
-// more than kTolerance (1e-12 m/s). mu is mu_k while the patch slid over the last period,
+// more than kTolerance (1e-10 m/s). mu is mu_k while the patch slid over the last period,
 // mu_s otherwise; a patch slides when one of its points moves tangentially faster than
 // 1e-6 m/s at the period's end (ObjectWorldContacts.forces).
 #pragma once
@@ -47,6 +47,30 @@ void contact_candidates(const Data& data, const std::vector<ContactShape>& piece
                         const std::vector<ContactShape>& objects, double reach_m,
                         std::vector<ContactCandidate>& out);
 
+// coal's signed distance and nearest point on the piece (placed at where) to the object
+// (placed at object_where), the normal out of the object (_coal_candidate of gaps.py).
+ContactCandidate coal_candidate(const ContactShape& piece, const pinocchio::SE3& where,
+                                const ContactShape& object, const pinocchio::SE3& object_where,
+                                int p, int o);
+
+// C = (t1, t2, n) with n its third column (contact_frame of contacts.py).
+Eigen::Matrix3d contact_frame(const Vec3& normal);
+
+// J_x (3 x 6): the world velocity of the material point at x of a free body at pose `body`
+// for its LOCAL twist.
+Eigen::Matrix<double, 3, 6> point_jacobian(const pinocchio::SE3& body, const Vec3& x);
+
+// The Coulomb problem's projected Gauss-Seidel (see the file's comment) on the Delassus
+// operator G and the free rows' velocity g: impulse (in: the start, out: the solution) with
+// the cones of `cone_rows` (each a contact's first row t1, then t2, n; mu per contact) and
+// the unilateral rows `unilateral` (lambda >= 0, a joint limit's); throws SimulationFailure
+// after kMaxSweeps. what: for the message.
+void coulomb_gauss_seidel(const Eigen::MatrixXd& delassus, const Eigen::VectorXd& g,
+                          const std::vector<Eigen::Index>& cone_rows,
+                          const std::vector<double>& mu,
+                          const std::vector<Eigen::Index>& unilateral, Eigen::VectorXd& impulse,
+                          const char* what);
+
 // The velocity step of one free object against its fixed world.
 class ObjectContactStep {
  public:
@@ -62,18 +86,27 @@ class ObjectContactStep {
                  const Eigen::Matrix<double, 6, 6>& mass, Vec6& v, double h,
                  const Vec6& least_speed, ContactForces& out);
 
- private:
-  // the contacts within reach at speed; returns their count
+  // The contacts within reach at speed; returns their count. After it: their rows
+  // (jacobian(), 3 a contact: t1, t2, n, for the body's LOCAL twist), the rows' drift
+  // phi(r) / h (drift()) and each contact's friction (mu()).
   int select(const WorldContactModel& world, const FrictionMemory& memory, const Data& data,
              const Vec6& speed, double h);
+  const Eigen::MatrixXd& jacobian() const { return jacobian_; }
+  const Eigen::VectorXd& drift() const { return drift_; }
+  const std::vector<double>& mu() const { return mu_; }
+  // The selected contacts' mean forces over the period h of their impulses (3 a contact)
+  // and the body's velocity v after the step.
+  void forces(const Vec6& v, const Eigen::VectorXd& impulse, double h, ContactForces& out) const;
+
+ private:
   void solve(const Eigen::Matrix<double, 6, 6>& mass, const Vec6& v_free, Vec6& v);
-  void forces(const Vec6& v, double h, ContactForces& out) const;
 
   std::vector<ContactCandidate> candidates_, selected_;
   std::vector<double> mu_;
   Eigen::MatrixXd jacobian_, delassus_, minv_jt_;
   Eigen::VectorXd drift_, impulse_;
   std::vector<Eigen::Matrix3d> frames_;
+  std::vector<Eigen::Index> cone_rows_;
 };
 
 // A free body's pose (7,) at the period's end from its pose q and its body velocity v (6,)

@@ -97,6 +97,11 @@ void System::contacts_at(const Data& robot) {
   found_sets_.resize(sets.size());
   for (std::size_t s = 0; s < sets.size(); ++s) {
     auto& set = sets[s];
+    if (rigid_pairs) {  // the constraints' impulses: no force in the smooth dynamics
+      found_sets_[s].forces.touch.clear();
+      found_sets_[s].pair.clear();
+      continue;
+    }
     set.pairs.forces(data_of(set.a), data_of(set.b), set.memory, found_sets_[s]);
   }
   found_objects_.resize(objects_.size());
@@ -189,7 +194,7 @@ void System::settle(const ConstVec& q, const ConstVec& v) {
                          plant_.friction);
   }
   contacts(q, v);
-  for (std::size_t s = 0; s < sets.size(); ++s) {
+  for (std::size_t s = 0; s < sets.size() && !rigid_pairs; ++s) {  // rigid: by constrain()
     sets[s].pairs.commit(data_of(sets[s].b), found_sets_[s], sets[s].memory);
   }
   for (std::size_t k = 0; k < objects_.size(); ++k) {  // rigid: committed by constrain()
@@ -229,6 +234,10 @@ std::pair<Eigen::VectorXd, Eigen::VectorXd> System::advance(double t0, const Con
 
 void System::constrain(double t0, const ConstVec& q0, const ConstVec& v0, double t1,
                        Eigen::VectorXd& q1, Eigen::VectorXd& v1) {
+  if (rigid_pairs) {
+    constrain_coupled(t0, q0, v0, t1, q1, v1);
+    return;
+  }
   const double h = t1 - t0;
   const auto& limits = plant_.joint_limits;
   if (limits) {
@@ -278,6 +287,79 @@ void System::constrain(double t0, const ConstVec& q0, const ConstVec& v0, double
       v1.segment(nv_robot_ + 6 * i + 3, 3) = v_k.tail<3>();
     }
     object_worlds[k]->commit(rigid_found_[k], object_memory[k]);
+  }
+}
+
+void System::constrain_coupled(double t0, const ConstVec& q0, const ConstVec& v0, double t1,
+                               Eigen::VectorXd& q1, Eigen::VectorXd& v1) {
+  const double h = t1 - t0;
+  const Model& robot = plant_.dynamics().model();
+  SystemAtStart at;
+  at.robot = &robot;
+  at.robot_data = &robot_data_;
+  at.q0_robot = q0.head(nq_robot_);
+  at.limits = plant_.joint_limits ? &*plant_.joint_limits : nullptr;
+  at.sets = &sets;
+  // the least speeds: the smooth step's start and its mean over the period (period.py)
+  Eigen::VectorXd least(model_.nv), travelled(nv_robot_);
+  pinocchio::difference(robot, at.q0_robot, q1.head(nq_robot_), travelled);
+  least.head(nv_robot_) = (travelled.cwiseAbs() / h).cwiseMax(v0.head(nv_robot_).cwiseAbs());
+  std::vector<Eigen::MatrixXd> masses{
+      plant_.dynamics().mass_matrix_in(at.q0_robot, plant_.flow, t0, plant_.free_surface)};
+  Eigen::VectorXd v = v1;
+  for (std::size_t k = 0; k < objects_.size(); ++k) {
+    const auto i = static_cast<Eigen::Index>(k);
+    const auto q0_k = q0.segment(nq_robot_ + 7 * i, 7);
+    Dynamics& body = objects_[k];
+    Vec6 moved;
+    pinocchio::difference(body.model(), q0_k, q1.segment(nq_robot_ + 7 * i, 7), moved);
+    least.segment<6>(nv_robot_ + 6 * i) =
+        (moved.cwiseAbs() / h).cwiseMax(v0.segment(nv_robot_ + 6 * i, 6).cwiseAbs());
+    masses.emplace_back(body.mass_matrix_in(q0_k, plant_.flow, t0, plant_.free_surface));
+    body.kinematics(q0_k, v0.segment(nv_robot_ + 6 * i, 6));
+    at.objects.push_back(&body.data());
+    const bool rigid_world = rigid_objects && object_worlds[k].has_value();
+    at.object_worlds.push_back(rigid_world ? &*object_worlds[k] : nullptr);
+    at.object_memory.push_back(&object_memory[k]);
+    // the smooth step's body velocity at q_free expressed at q0, where the rows act
+    const Eigen::Matrix3d turn =
+        rotation_of(q0_k).transpose() * rotation_of(q1.segment(nq_robot_ + 7 * i, 7));
+    v.segment<3>(nv_robot_ + 6 * i) = turn * v1.segment<3>(nv_robot_ + 6 * i);
+    v.segment<3>(nv_robot_ + 6 * i + 3) = turn * v1.segment<3>(nv_robot_ + 6 * i + 3);
+  }
+  const bool solved = coupled_step_.constrain(at, masses, v, h, least);
+  if (solved && coupled_step_.acting(0)) {
+    v1.head(nv_robot_) = v.head(nv_robot_);
+    Eigen::VectorXd q1_robot(nq_robot_);
+    pinocchio::integrate(robot, at.q0_robot, (h * v.head(nv_robot_)).eval(), q1_robot);
+    q1.head(nq_robot_) = q1_robot;
+  }
+  for (std::size_t k = 0; k < objects_.size(); ++k) {
+    const auto i = static_cast<Eigen::Index>(k);
+    if (solved && coupled_step_.acting(1 + k)) {
+      const auto q0_k = q0.segment(nq_robot_ + 7 * i, 7);
+      const Vec6 v_k = v.segment<6>(nv_robot_ + 6 * i);
+      const Eigen::Matrix<double, 7, 1> q_end = free_body_configuration(q0_k, v_k, h);
+      q1.segment(nq_robot_ + 7 * i, 7) = q_end;
+      v1.segment(nv_robot_ + 6 * i, 3) =
+          rotation_of(q_end).transpose() * rotation_of(q0_k) * v_k.head<3>();
+      v1.segment(nv_robot_ + 6 * i + 3, 3) = v_k.tail<3>();
+    }
+    if (rigid_objects && object_worlds[k]) {
+      rigid_found_[k] = coupled_step_.object_forces(k);
+      object_worlds[k]->commit(rigid_found_[k], object_memory[k]);
+    }
+  }
+  // each pair set: its forces of the period kept, which pairs slid (their next cone mu_k)
+  rigid_sets_.resize(sets.size());
+  for (std::size_t s = 0; s < sets.size(); ++s) {
+    rigid_sets_[s] = coupled_step_.pair_forces(s);
+    FrictionMemory& memory = sets[s].memory;
+    memory.clear();
+    const auto& found = rigid_sets_[s];
+    for (std::size_t c = 0; c < found.pair.size(); ++c) {
+      if (!found.forces.sticking[c]) memory.slipping.insert(found.pair[c]);
+    }
   }
 }
 

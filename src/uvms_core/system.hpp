@@ -18,15 +18,18 @@
 // solved implicitly (period.py, constrained): the robot's joint limits (joint_limits.hpp) and,
 // with rigid_objects, each free object's rigid contacts with the fixed world
 // (object_contacts.hpp; then the smooth dynamics leave those contacts out). M is block
-// diagonal over the bodies and no row joins two bodies, so each body is solved alone; a body
-// with a solved row moves from q0 with v+ (the robot q0 (+) h v+, an object by
-// free_body_configuration), the others keep the smooth step's end.
+// diagonal over the bodies; while no row joins two bodies each body is solved alone. With
+// rigid_pairs the contacts between moving bodies are rows too, joining two bodies: then every
+// row of the system is solved in one problem (moving_constraints.hpp). A body with a solved
+// row moves from q0 with v+ (the robot q0 (+) h v+, an object by free_body_configuration),
+// the others keep the smooth step's end.
 #pragma once
 
 #include <optional>
 #include <utility>
 #include <vector>
 
+#include "moving_constraints.hpp"
 #include "moving_contact.hpp"
 #include "object_contacts.hpp"
 #include "plant.hpp"
@@ -48,6 +51,8 @@ class System {
   std::vector<FrictionMemory> object_memory;
   // the free objects touch the fixed world by rigid contacts (World.free_object_contact)
   bool rigid_objects = false;
+  // the moving bodies touch each other by rigid contacts (World.moving_contact)
+  bool rigid_pairs = false;
 
   int nq() const { return model_.nq; }
   int nv() const { return model_.nv; }
@@ -61,7 +66,12 @@ class System {
                                       const ConstVec& tau);
   // The contacts at (q, v) (after which found_sets() and found_objects() hold them).
   void contacts(const ConstVec& q, const ConstVec& v);
-  const std::vector<PairContacts>& found_sets() const { return found_sets_; }
+  // each pair set's contacts: at the last contacts() (compliant), or over the last period
+  // solved (rigid_pairs: the mean forces of its impulses)
+  const std::vector<PairContacts>& found_sets() {
+    rigid_sets_.resize(sets.size());  // none solved yet: none touching
+    return rigid_pairs ? rigid_sets_ : found_sets_;
+  }
   // object k's contacts with the fixed world: at the last contacts() (compliant), or over
   // the last period solved (rigid_objects: the mean forces of its impulses)
   const ContactForces& found_object(std::size_t k) const {
@@ -79,6 +89,9 @@ class System {
   // The constraints of the period (see the file's comment) on (q1, v1), the smooth step's end.
   void constrain(double t0, const ConstVec& q0, const ConstVec& v0, double t1,
                  Eigen::VectorXd& q1, Eigen::VectorXd& v1);
+  // ... with rigid_pairs: every row of the system in one solve (moving_constraints.hpp).
+  void constrain_coupled(double t0, const ConstVec& q0, const ConstVec& v0, double t1,
+                         Eigen::VectorXd& q1, Eigen::VectorXd& v1);
   // Every moving contact, after the objects' kinematics, the robot's in robot.
   void contacts_at(const Data& robot);
   // The moving contacts' forces on the robot's bodies (the plant's moving_contacts, called
@@ -98,7 +111,9 @@ class System {
   std::vector<PairContacts> found_sets_;
   std::vector<ContactForces> found_objects_;
   std::vector<ContactForces> rigid_found_;  // each object's contacts of the last period
+  std::vector<PairContacts> rigid_sets_;    // each set's contacts of the last period
   ObjectContactStep object_step_;
+  CoupledConstraintStep coupled_step_;
   Eigen::VectorXd acceleration_, limit_speed_;
   const Eigen::VectorXd zero_tau_ = Eigen::VectorXd::Zero(6);
 };

@@ -98,6 +98,30 @@ void bind_system(nb::module_& m) {
       .def_rw("rigid_objects", &System::rigid_objects,
               "The free objects touch the fixed world by rigid contacts solved at each "
               "period's end (object_contacts.hpp).")
+      .def_rw("rigid_pairs", &System::rigid_pairs,
+              "The moving bodies touch each other by rigid contacts, every row of the "
+              "system solved in one problem at each period's end (moving_constraints.hpp).")
+      .def(
+          "rigid_contacts",
+          [](System& s) {
+            nb::list sets, objects;
+            for (const auto& found : s.found_sets()) {
+              nb::dict out = forces_dict(s.rigid_pairs ? found.forces : uvms::ContactForces{});
+              out["pair"] = s.rigid_pairs ? found.pair : std::vector<int>{};
+              sets.append(out);
+            }
+            for (std::size_t k = 0; k < s.n_objects(); ++k) {
+              if (s.object_worlds[k] && s.rigid_objects) {
+                objects.append(forces_dict(s.found_object(k)));
+              } else {
+                objects.append(nb::none());
+              }
+            }
+            return nb::make_tuple(sets, objects);
+          },
+          "The rigid contacts of the last period solved: (each pair set's, each object's "
+          "with the fixed world or None), as dicts of arrays; empty where they are "
+          "compliant.")
       .def(
           "add_pairs",
           [](System& s, const PiecePairsModel& pairs, int a, int b) {

@@ -101,8 +101,11 @@ def test_the_urdfs_dynamics_friction_is_used_only_when_asked(tmp_path):
     scenario = scenario.replace('model = "uvms_lbv150"', 'model = "model.urdf"')
     (tmp_path / "run.toml").write_text(scenario)
     assert load_scenario(tmp_path / "run.toml").plant.joint_friction is None
-    friction = load_scenario(
-        tmp_path / "run.toml", {"joints.use_model_friction": True}
-    ).plant.joint_friction
-    np.testing.assert_array_equal(friction.viscous_Nms, [0.5] * 4)
+    plant = load_scenario(tmp_path / "run.toml", {"joints.use_model_friction": True}).plant
+    np.testing.assert_array_equal(plant.joint_friction.viscous_Nms, [0.5] * 4)
+    # with a control period the Coulomb part is a constraint (true stiction) by default
+    np.testing.assert_array_equal(plant.joint_friction.coulomb_Nm, [0.0] * 4)
+    np.testing.assert_array_equal(plant.joint_coulomb.coulomb_Nm, [0.2] * 4)
+    smooth = {"joints.use_model_friction": True, "joints.coulomb": "smooth"}
+    friction = load_scenario(tmp_path / "run.toml", smooth).plant.joint_friction
     np.testing.assert_array_equal(friction.coulomb_Nm, [0.2] * 4)

@@ -2,8 +2,9 @@
 implicitly once a control period (``stops = "implicit"``, the default with a control period: a
 joint stops at its limit whatever its inertia), compliant stops (``stops = "compliant"``, a
 spring-damper past each URDF limit, the default under continuous control), or nothing
-(``hard_stops = false``). The drives: friction (viscous, regularized Coulomb) and the torque
-bandwidth; without the table there is no friction (``use_model_friction = true`` takes the
+(``hard_stops = false``). The drives: friction (viscous; Coulomb as a constraint with true
+stiction, ``coulomb = "constraint"``, the default with a control period, or regularized,
+``coulomb = "smooth"``) and the torque bandwidth; without the table there is no friction (``use_model_friction = true`` takes the
 URDF's ``<dynamics damping friction>``) and the torque follows its command at once."""
 
 from __future__ import annotations
@@ -12,12 +13,16 @@ import numpy as np
 
 from uvms_pin.errors import ParameterError
 from uvms_pin.model.uvms import UVMS
+from uvms_pin.physics.constraints.joint_friction import JointCoulombFriction
 from uvms_pin.physics.constraints.joint_limits import JointLimits
 from uvms_pin.physics.joint_friction import DEFAULT_COULOMB_VELOCITY_RAD_S, JointFriction
 from uvms_pin.physics.joint_stops import JointStops
 from uvms_pin.scenario.schema import Table
 from uvms_pin.sim.actuation import Actuation
 from uvms_pin.sim.joint_drive import LaggedJointTorques
+
+#: how a joint's Coulomb friction acts (`build_joint_friction`)
+COULOMB = ("constraint", "smooth")
 
 
 def build_joint_limits(
@@ -47,11 +52,23 @@ def build_joint_limits(
     return (stops if len(stops.names) else None), None
 
 
-def build_joint_friction(t: Table, uvms: UVMS) -> JointFriction | None:
-    """The drives' friction (None when the model has no joint or no friction)."""
+def build_joint_friction(
+    t: Table, uvms: UVMS, sampled: bool
+) -> tuple[JointFriction | None, JointCoulombFriction | None]:
+    """(the drives' friction as a force, their Coulomb friction as a constraint): each None
+    when the model has no joint or no such friction. ``coulomb`` "constraint" (the default
+    with a control period, ``sampled``) solves the Coulomb part once a period with the other
+    constraints, the force keeping the viscous part; "smooth" keeps it in the force,
+    regularized by tanh (continuous control has only this one)."""
+    kind = t.string("coulomb", "constraint" if sampled else "smooth", choices=COULOMB)
+    if kind == "constraint" and not sampled:
+        raise t.error(
+            "coulomb",
+            '"constraint" solves the friction once a control period: set [control] period_s',
+        )
     n = uvms.nv - 6
     if n == 0:
-        return None
+        return None, None
     model = uvms.model
     # opt-in: arm files often carry <dynamics> values tuned for another simulator
     from_model = t.boolean("use_model_friction", False)
@@ -62,11 +79,16 @@ def build_joint_friction(t: Table, uvms: UVMS) -> JointFriction | None:
         "coulomb_Nm", n, model.friction[6:].copy() if from_model else np.zeros(n), nonneg=True
     )
     scale = t.number("coulomb_velocity_rad_s", DEFAULT_COULOMB_VELOCITY_RAD_S, positive=True)
+    constraint = None
+    if kind == "constraint" and np.any(coulomb):
+        if any(uvms.model.joints[j].nv != 1 for j in range(2, uvms.model.njoints)):
+            raise t.error("coulomb", '"constraint" needs joints of one coordinate each')
+        constraint, coulomb = JointCoulombFriction.of_uvms(uvms, coulomb), np.zeros(n)
     try:
         friction = JointFriction(viscous, coulomb, np.full(n, scale))
     except ParameterError as exc:
         raise t.fail(str(exc)) from exc
-    return friction if friction.active else None
+    return (friction if friction.active else None), constraint
 
 
 def with_joint_lag(t: Table, actuation: Actuation, uvms: UVMS) -> Actuation:

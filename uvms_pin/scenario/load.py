@@ -168,7 +168,7 @@ def _build(raw: dict[str, Any], path: Path, top: Table) -> Scenario:
     )
     joints = top.table_or_empty("joints")
     joint_stops, joint_limits = build_joint_limits(joints, uvms, control_period is not None)
-    friction = build_joint_friction(joints, uvms)
+    friction, coulomb = build_joint_friction(joints, uvms, control_period is not None)
     actuation = with_joint_lag(joints, build_actuation(top.table("actuation"), uvms), uvms)
     joints.finish()
     sensor_config = build_sensors(top.table_or_empty("sensors"), water.density_kg_m3, world)
@@ -202,6 +202,7 @@ def _build(raw: dict[str, Any], path: Path, top: Table) -> Scenario:
         world=world,
         joint_stops=joint_stops,
         joint_limits=joint_limits,
+        joint_coulomb=coulomb,
     )
     try:
         settings = SimulationSettings(

@@ -25,7 +25,7 @@ from uvms_pin.physics.world.objects import (
     kind_names,
     object_kind,
 )
-from uvms_pin.physics.world.world import FIXED_CONTACT, INITIAL_OVERLAP, World
+from uvms_pin.physics.world.world import FIXED_CONTACT, INITIAL_OVERLAP, MOVING_CONTACT, World
 from uvms_pin.scenario.fixtures import read_fixture
 from uvms_pin.scenario.schema import Table
 
@@ -63,6 +63,7 @@ def build_world(t: Table | None, uvms: UVMS, base_dir: Path) -> World | None:
     built = [_object(o, k, law, base_dir, uvms) for k, o in enumerate(tables)]
     overlap = t.string("initial_overlap", "refuse", choices=INITIAL_OVERLAP)
     free_contact = t.string("fixed_contact", "rigid", choices=FIXED_CONTACT)
+    moving_contact = t.string("moving_contact", "compliant", choices=MOVING_CONTACT)
     t.finish()
     fixed = [o for o in built if isinstance(o, WorldObject)]
     free = [o for o in built if isinstance(o, FreeObject)]
@@ -70,7 +71,10 @@ def build_world(t: Table | None, uvms: UVMS, base_dir: Path) -> World | None:
     if not built and not self_collision:
         return None
     try:
-        return World(uvms, fixed, law, free, self_collision, overlap, free_contact, fixtures)
+        return World(
+            uvms, fixed, law, free, self_collision, overlap, free_contact,
+            fixtures=fixtures, moving_contact=moving_contact,
+        )  # fmt: skip
     except ParameterError as exc:
         raise t.fail(str(exc)) from exc
 

@@ -27,6 +27,7 @@ from uvms_pin.errors import ParameterError, SimulationError
 from uvms_pin.flow import FlowField, SumFlow, UniformCurrent
 from uvms_pin.model.uvms import UVMS
 from uvms_pin.physics.compiled.backend import Backend, Fallback, backend_named
+from uvms_pin.physics.constraints.joint_friction import JointCoulombFriction
 from uvms_pin.physics.constraints.joint_limits import JointLimits
 from uvms_pin.physics.contact import ContactModel
 from uvms_pin.physics.disturbance import Disturbance
@@ -66,6 +67,10 @@ class Plant:
         joint_limits: the arm joints' limits as constraints solved implicitly once a control
             period (`uvms_pin.physics.constraints`: a joint stops at its limit whatever its
             inertia), or None; not with ``joint_stops``.
+        joint_coulomb: the arm joints' Coulomb friction as constraints solved implicitly
+            once a control period (`uvms_pin.physics.constraints.joint_friction`: a joint
+            loaded below its friction torque does not move), or None; ``joint_friction``
+            then carries only the viscous part.
     """
 
     uvms: UVMS
@@ -81,6 +86,7 @@ class Plant:
     world: World | None = None
     joint_stops: JointStops | None = None
     joint_limits: JointLimits | None = None
+    joint_coulomb: JointCoulombFriction | None = None
 
     def __post_init__(self) -> None:
         self.current_world_m_s = finite_vector("current_world_m_s", self.current_world_m_s, 3)
@@ -121,6 +127,11 @@ class Plant:
             "world": None if self.world is None else self.world.record(),
             "joint_stops": None if self.joint_stops is None else self.joint_stops.record(),
             "joint_limits": None if self.joint_limits is None else self.joint_limits.record(),
+            **(
+                {}
+                if self.joint_coulomb is None
+                else {"joint_coulomb_Nm": self.joint_coulomb.coulomb_Nm.tolist()}
+            ),
         }
 
     def check_submerged(self, time_s: float, q: np.ndarray) -> None:

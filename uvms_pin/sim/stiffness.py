@@ -131,6 +131,8 @@ def _world_modes(
             modes += contact_modes(
                 f"{body.name} against the fixed world ({fixed})", body, None, law
             )
+    if world.moving_contact == "rigid":  # constraints: no spring between moving bodies
+        return modes
     for body in robot:
         for obj in objects:
             modes += contact_modes(f"{body.name} against the {obj.name}", body, obj, law)

@@ -6,7 +6,8 @@ logs and the tests compare).
 Each pair set becomes a core `PiecePairs` (the two sides' pieces as `ContactShape`s on their
 joints, the pairs, one (mu_s, mu_k) per pair, the law); each free object's own world against
 the fixed objects a core `WorldContact` (`uvms_pin.physics.compiled.world`), touched by
-rigid contacts when the world says so (the core system's ``rigid_objects``)."""
+rigid contacts when the world says so (the core system's ``rigid_objects``), and the pairs
+between moving bodies likewise (``rigid_pairs``)."""
 
 from __future__ import annotations
 
@@ -56,6 +57,7 @@ def moving_to_core(moving: MovingContacts, system: Any, core: ModuleType) -> Non
         if world is not None:
             system.set_object_world(k, world_contact_to_core(world, core))
     system.rigid_objects = bool(moving.rigid)
+    system.rigid_pairs = bool(moving.rigid_pairs)
 
 
 def memories_of(friction: Any, moving: MovingContacts) -> list:

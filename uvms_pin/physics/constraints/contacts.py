@@ -154,19 +154,25 @@ def point_contact(
     joint_id: int,
     touching: tuple[np.ndarray, np.ndarray, float],
     friction: float,
+    surface_joint: int = 0,
 ) -> tuple[pin.ConstraintModel, pin.ConstraintData, np.ndarray]:
     """The evaluated point contact (`rows.evaluated`: three rows t1, t2, n) of the body of
-    ``joint_id`` at its material point ``touching`` = (point (3,) [m], the fixed surface's
+    ``joint_id`` at its material point ``touching`` = (point (3,) [m], the surface's
     outward unit normal (3,), the signed gap r [m]) with the Coulomb cone of ``friction``:
-    the surface's point p - r n is the first (joint 0, its z the normal), the body's point
-    p the second (the same rotation), as the module's docstring says."""
+    the surface's point p - r n is the first (on ``surface_joint``: 0 the fixed world, else
+    a moving body; its z the normal), the body's point p the second (the same rotation), as
+    the module's docstring says. With a moving surface the rows are C^T (J_body(p) -
+    J_surface(p)) v: Pinocchio takes both bodies' velocities at the second point p."""
     point, normal, gap = touching
     frame = contact_frame(normal)
     placed = data.oMi[joint_id]
+    surface = data.oMi[surface_joint] if surface_joint else None
     contact = pin.PointContactConstraintModel(
         model,
-        0,
-        pin.SE3(frame, point - gap * normal),
+        surface_joint,
+        pin.SE3(frame, point - gap * normal)
+        if surface is None
+        else surface.actInv(pin.SE3(frame, point - gap * normal)),
         joint_id,
         pin.SE3(placed.rotation.T @ frame, placed.actInv(point)),
     )

@@ -62,11 +62,11 @@ class JointCoulombFriction:
         for joint_id in self.joint_ids:
             if not 0 < joint_id < model.njoints or model.joints[joint_id].nv != 1:
                 raise ParameterError(f"joint {joint_id} is not a joint with one velocity")
-        # Pinocchio takes the bounds over the whole velocity (nv,) and keeps the joints'
-        bound = np.zeros(model.nv)
-        bound[[model.joints[j].idx_v for j in self.joint_ids]] = self.coulomb_Nm
+        # Pinocchio reads the bounds at each joint's velocity index: (nv,) vectors
+        upper = np.zeros(model.nv)
+        upper[[model.joints[j].idx_v for j in self.joint_ids]] = self.coulomb_Nm
         friction = pin.JointFrictionConstraintModel(
-            model, pin.StdVec_Index(list(self.joint_ids)), -bound, bound
+            model, pin.StdVec_Index(list(self.joint_ids)), -upper, upper
         )
         friction.setTimeStep(period_s)
         n = len(self.joint_ids)

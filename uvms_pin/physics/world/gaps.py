@@ -27,7 +27,7 @@ from uvms_pin.physics.world.objects import WorldObject
 from uvms_pin.physics.world.robot_geometry import RobotPiece
 from uvms_pin.physics.world.touch import Bounds
 
-__all__ = ["Candidate", "candidates"]
+__all__ = ["Candidate", "candidates", "coal_candidate"]
 
 _REQUEST = coal.DistanceRequest()  # signed distance and nearest points
 
@@ -64,7 +64,11 @@ def _plane_points(piece: RobotPiece, where: pin.SE3, obj: WorldObject):
     return list(range(len(points))), points
 
 
-def _coal_candidate(p: int, o: int, piece: RobotPiece, where: pin.SE3, obj: WorldObject):
+def coal_candidate(
+    p: int, o: int, piece: RobotPiece, where: pin.SE3, obj: WorldObject
+) -> Candidate:
+    """The candidate of ``piece`` (index p, placed at ``where``) on ``obj`` (index o) by
+    coal's signed distance: its nearest point on the piece, the normal out of the object."""
     result = coal.DistanceResult()
     transform = coal.Transform3s(where.rotation, where.translation)
     gap = coal.distance(piece.shape, transform, obj.shape, obj.transform, _REQUEST, result)
@@ -98,5 +102,5 @@ def candidates(
                 for c, x, r in zip(corners, points, gaps, strict=True)
             ]
         else:
-            out.append(_coal_candidate(p, o, piece, where[p], obj))
+            out.append(coal_candidate(p, o, piece, where[p], obj))
     return out

@@ -15,13 +15,16 @@ and, for each free object, its own `World` against the fixed objects: the same c
 contact as the UVMS's (corners on a plane, coal's deepest point otherwise), or, with
 ``World.fixed_contact`` "rigid", rigid contacts solved as constraints after the smooth
 step (`uvms_pin.physics.constraints.object_contacts`): then the smooth dynamics leave them
-out and `rigid_forces` holds the last period's mean contact forces (what a run logs). Every force is exchanged
-equal and opposite between the two bodies of its pair (a fixed object's reaction goes to
-the ground).
+out and `rigid_forces` holds the last period's mean contact forces (what a run logs). With
+``World.moving_contact`` "rigid" the pairs between moving bodies are rigid contacts too
+(`uvms_pin.physics.constraints.moving_contacts`): the smooth dynamics leave them out and
+`rigid_pair_forces` holds their last period's forces. Every force is exchanged equal and
+opposite between the two bodies of its pair (a fixed object's reaction goes to the ground).
 """
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -97,6 +100,12 @@ class MovingContacts:
         rigid: the free objects touch the fixed world by rigid contacts (see the module).
         rigid_forces: with ``rigid``, each object's contacts with the fixed world over the
             last period (`ObjectWorldContacts.forces`; None without a world).
+        rigid_pairs: the moving pairs touch by rigid contacts (see the module).
+        rigid_pair_forces: with ``rigid_pairs``, each set's contacts over the last period
+            (`MovingPairContacts.forces`).
+        rigid_source: where the rigid contacts of the last period are read when a compiled
+            system solved them (its ``rigid_contacts``, as (sets, objects)), or None: the
+            two attributes above.
     """
 
     world: World
@@ -105,6 +114,9 @@ class MovingContacts:
     object_memory: list[FrictionMemory]
     rigid: bool = False
     rigid_forces: list = field(default_factory=list)
+    rigid_pairs: bool = False
+    rigid_pair_forces: list = field(default_factory=list)
+    rigid_source: Callable[[], tuple[list, list]] | None = None
 
     @staticmethod
     def of(world: World) -> MovingContacts:
@@ -134,7 +146,8 @@ class MovingContacts:
                 own.body_names = [obj.name] * len(own.body_names)
         memories = [FrictionMemory() for _ in free]
         rigid = world.fixed_contact == "rigid"
-        out = MovingContacts(world, sets, object_worlds, memories, rigid)
+        rigid_pairs = world.moving_contact == "rigid"
+        out = MovingContacts(world, sets, object_worlds, memories, rigid, rigid_pairs=rigid_pairs)
         out.clear()
         return out
 
@@ -166,6 +179,8 @@ class MovingContacts:
             m.clear()
         no_touch = ContactForces(NO_TOUCH, np.zeros((0, 3)), np.zeros(0), np.zeros(0, bool))
         self.rigid_forces = [None if w is None else no_touch for w in self.object_worlds]
+        none = PairContacts(NO_TOUCH, np.zeros((0, 3)), np.zeros(0), np.zeros(0, dtype=bool))
+        self.rigid_pair_forces = [none for _ in self.sets]
 
     def _datas(self, uvms_data: pin.Data, object_datas: list[pin.Data]):
         return lambda side: uvms_data if side < 0 else object_datas[side]
@@ -180,9 +195,15 @@ class MovingContacts:
         """(each set's touching pairs, each free object's `ContactForces` against the fixed
         objects or None), after forward kinematics of every body with its velocity."""
         data = self._datas(uvms_data, object_datas)
-        sets = [s.pairs.forces(data(s.a), data(s.b), s.memory) for s in self.sets]
+        rigid_sets, rigid_fixed = self.rigid_pair_forces, self.rigid_forces
+        if self.rigid_source is not None and (self.rigid or self.rigid_pairs):
+            rigid_sets, rigid_fixed = self.rigid_source()
+        if self.rigid_pairs:
+            sets = list(rigid_sets)
+        else:
+            sets = [s.pairs.forces(data(s.a), data(s.b), s.memory) for s in self.sets]
         if self.rigid:
-            return sets, list(self.rigid_forces)
+            return sets, list(rigid_fixed)
         fixed = [
             None if w is None else w.forces(object_datas[k], self.object_memory[k])
             for k, w in enumerate(self.object_worlds)
@@ -200,7 +221,7 @@ class MovingContacts:
         tau_objects = [np.zeros(b.uvms.model.nv) for b in bodies[: len(states)]]
         sets, fixed = found
         for s, contacts in zip(self.sets, sets, strict=True):
-            if len(contacts) == 0:
+            if len(contacts) == 0 or self.rigid_pairs:  # rigid: the constraints' impulses
                 continue
             side = [
                 (uvms_model, uvms_data, q, tau_uvms)
@@ -221,7 +242,8 @@ class MovingContacts:
         data = self._datas(uvms_data, object_datas)
         sets, fixed = found
         for s, contacts in zip(self.sets, sets, strict=True):
-            s.pairs.commit(data(s.b), contacts, s.memory)
+            if not self.rigid_pairs:  # rigid: committed by its step
+                s.pairs.commit(data(s.b), contacts, s.memory)
         for k, (w, forces) in enumerate(zip(self.object_worlds, fixed, strict=True)):
             if forces is not None and not self.rigid:  # rigid: committed by its step
                 w.commit(forces, self.object_memory[k])

@@ -31,6 +31,7 @@ from uvms_pin.physics.world.touch import Bounds, Touch, clear_of, cross, touch
 __all__ = [
     "FIXED_CONTACT",
     "INITIAL_OVERLAP",
+    "MOVING_CONTACT",
     "ContactForces",
     "FrictionMemory",
     "World",
@@ -47,6 +48,11 @@ INITIAL_OVERLAP = ("refuse", "separate")
 #: solved implicitly with the Coulomb cone (`uvms_pin.physics.constraints.object_contacts`),
 #: or by the compliant law integrated with the smooth dynamics (`contact_law`)
 FIXED_CONTACT = ("rigid", "compliant")
+
+#: how two moving bodies touch (a robot link and a free object, two free objects, an arm
+#: link and its vehicle): by the compliant law integrated with the smooth dynamics, or as
+#: rigid contacts solved implicitly (`uvms_pin.physics.constraints.moving_contacts`)
+MOVING_CONTACT = ("compliant", "rigid")
 
 
 @dataclass
@@ -130,6 +136,8 @@ class World:
         fixtures: articulated bodies with a fixed root
             (`uvms_pin.physics.world.fixture.Fixture`); their links touch the robot and
             the free objects (`uvms_pin.physics.world.moving`).
+        moving_contact: one of `MOVING_CONTACT`, how two moving bodies touch ("compliant"
+            only with fixtures: the rigid rows know the robot and the free objects).
     """
 
     uvms: UVMS
@@ -140,13 +148,15 @@ class World:
     initial_overlap: str = "refuse"
     fixed_contact: str = "rigid"
     fixtures: Sequence[Any] = ()
+    moving_contact: str = "compliant"
 
     def __post_init__(self) -> None:
-        if self.fixed_contact not in FIXED_CONTACT:
-            raise ParameterError(
-                f"fixed_contact must be one of {', '.join(FIXED_CONTACT)}, "
-                f"got {self.fixed_contact!r}"
-            )
+        for key, value, choices in (
+            ("fixed_contact", self.fixed_contact, FIXED_CONTACT),
+            ("moving_contact", self.moving_contact, MOVING_CONTACT),
+        ):
+            if value not in choices:
+                raise ParameterError(f"{key} must be one of {', '.join(choices)}, got {value!r}")
         if self.initial_overlap not in INITIAL_OVERLAP:
             raise ParameterError(
                 f"initial_overlap must be one of {', '.join(INITIAL_OVERLAP)}, "
@@ -155,6 +165,12 @@ class World:
         self.objects = tuple(self.objects)
         self.free = tuple(self.free)
         self.fixtures = tuple(self.fixtures)
+        if self.fixtures and self.moving_contact == "rigid":
+            # the rigid rows map a pair's side to the robot or a free object's free-flyer
+            raise ParameterError(
+                'moving_contact = "rigid" is not available with fixtures ("urdf" objects) '
+                'yet: their links touch by the compliant law (moving_contact = "compliant")'
+            )
         bodies = self.uvms.surface_bodies
         self.body_names = [self.uvms.hydro_bodies[int(k)].name for k in bodies.body_index]
         self.pieces: tuple[RobotPiece, ...] = robot_pieces(self.uvms, self.body_names)
@@ -179,6 +195,7 @@ class World:
             **({"fixtures": [o.record() for o in self.fixtures]} if self.fixtures else {}),
             "contact": {**self.law.record(), "self_collision": bool(self.self_collision)},
             **({"fixed_contact": self.fixed_contact} if self.free else {}),
+            **({"moving_contact": self.moving_contact} if self.free or self.self_collision else {}),
             "pairs": self.pair_names,
         }
 

@@ -30,6 +30,7 @@ class PlantParts(Protocol):
     joint_stops: Any
     joint_limits: Any
     joint_friction: Any
+    joint_coulomb: Any
     free_surface: bool
     world: Any
 
@@ -46,6 +47,8 @@ def plant_to_core(plant: PlantParts, core: ModuleType):
     fallback = next((p for p in parts if isinstance(p, Fallback)), None)
     if fallback is not None:
         return fallback
+    if plant.joint_coulomb is not None:
+        return Fallback("joint Coulomb friction as a constraint (solved by the Python step)")
     uvms = plant.uvms
     # the compiled plant uses the end-effector frame for contact only, which a model without
     # one cannot have (Plant checks): frame 0 (the world) stands in

@@ -32,10 +32,12 @@ import pinocchio as pin
 from uvms_pin.errors import SimulationError
 from uvms_pin.physics.compiled.backend import Fallback
 from uvms_pin.physics.compiled.extension import core_module
+from uvms_pin.physics.compiled.moving import contacts_of_core
 from uvms_pin.physics.constraints.rows import ConstraintRows
 from uvms_pin.physics.constraints.step import (
     ConstrainedVelocity,
     constrained_velocity,
+    default_settings,
     free_body_configuration,
 )
 from uvms_pin.sim.compiled.integrator import integrator_to_core
@@ -58,6 +60,7 @@ class Stepped(Protocol):
     fixtures: tuple  # the fixtures (`uvms_pin.physics.world.fixture`), after the objects
     fixture_constraints: tuple  # their joint limits and friction (`sim.system.fixtures`)
     fixture_blocks: list  # each one's part of v and its joints (`fixtures.blocks`)
+    moving_constraints: Any  # the rigid contacts between moving bodies, or None
 
     def friction_memories(self) -> list: ...
 
@@ -98,9 +101,12 @@ def why_not_compiled_system(system: Stepped, integrator: Integrator | None) -> s
 
 def constraint_sets(system: Stepped) -> tuple:
     """The constraints solved implicitly at the end of ``system``'s period: the robot's
-    joint limits, the free objects' rigid contacts with the fixed world and the fixtures'
-    joint limits and friction (each when there is one)."""
-    sets = (system.plant.joint_limits, system.object_contacts, *system.fixture_constraints)
+    joint limits and joint Coulomb friction, the free objects' rigid contacts with the fixed
+    world, the rigid contacts between moving bodies and the fixtures' joint limits and
+    friction (each when there is one)."""
+    plant = system.plant
+    sets = (plant.joint_limits, plant.joint_coulomb, system.object_contacts)
+    sets += (system.moving_constraints, *system.fixture_constraints)
     return tuple(s for s in sets if s is not None)
 
 
@@ -112,6 +118,9 @@ def constrained(system: Stepped, smooth: PeriodStep) -> PeriodStep:
     v+ (`_configuration`), the others keep q_free (a period in which nothing can reach a
     limit or a surface is the smooth step's)."""
     sets = constraint_sets(system)
+    # a sticking joint creeps at the solver's tolerance on the rows' velocities: 1e-10 rad/s
+    # keeps it below 1e-9 rad a second (the default 1e-8 let a held finger creep 7e-8 m)
+    settings = None if system.plant.joint_coulomb is None else default_settings(1e-10)
 
     def step(t0, q0, v0, tau, t1):
         q_free, v_free = smooth(t0, q0, v0, tau, t1)
@@ -127,36 +136,45 @@ def constrained(system: Stepped, smooth: PeriodStep) -> PeriodStep:
             solve = partial(with_fixtures, constrained_velocity, own, system.fixture_blocks)
         solved = solve(
             system.model, mass, _objects_moved(system, v_free, q_free, q0), q0, sets, t1 - t0,
-            least_speed=np.maximum(np.abs(v0), travelled),
+            least_speed=np.maximum(np.abs(v0), travelled), settings=settings,
         )  # fmt: skip
         if not solved.converged:
             raise SimulationError(
                 f"the constraint solve did not converge between t = {t0:.6g} s and {t1:.6g} s "
                 f"({solved.iterations} iterations, residual {solved.residual:.3g})"
             )
-        if system.object_contacts is not None:
-            _settle_contacts(system, solved, t1 - t0)
+        _settle_contacts(system, solved, t1 - t0)
         return _end(system, q0, (q_free, v_free), solved, t1 - t0)
 
     return step
 
 
 def _settle_contacts(system: Stepped, solved: ConstrainedVelocity, period_s: float) -> None:
-    """The free objects' contacts of the period solved: their mean forces kept for the logs
-    (`MovingContacts.rigid_forces`), their sliding patches for the next period's cone."""
-    contacts = system.object_contacts
+    """The rigid contacts of the period solved: their mean forces kept for the logs
+    (`MovingContacts.rigid_forces`, `MovingContacts.rigid_pair_forces`), their sliding
+    patches for the next period's cone."""
+    if system.object_contacts is not None:
+        found = _solved_forces(system, system.object_contacts, solved, period_s)
+        moving = system.moving.moving
+        moving.rigid_forces = found
+        for world, forces, memory in zip(
+            moving.object_worlds, found, moving.object_memory, strict=True
+        ):
+            if world is not None:
+                world.commit(forces, memory)
+    if system.moving_constraints is not None:
+        found = _solved_forces(system, system.moving_constraints, solved, period_s)
+        system.moving.moving.rigid_pair_forces = found
+        system.moving_constraints.commit(found)
+
+
+def _solved_forces(system: Stepped, contacts: Any, solved: ConstrainedVelocity, period_s: float):
+    """``contacts``' forces (its ``forces``) of the period ``solved`` (none: no row)."""
     rows = next((b for b in solved.rows if b.name == contacts.name), None)
     if rows is None:
         rows = ConstraintRows.empty(contacts.name, "N s", system.layout.nv)
     impulse = solved.impulses.get(contacts.name, np.zeros(0))
-    found = contacts.forces(rows, impulse, solved.velocity, period_s)
-    moving = system.moving.moving
-    moving.rigid_forces = found
-    for world, forces, memory in zip(
-        moving.object_worlds, found, moving.object_memory, strict=True
-    ):
-        if world is not None:
-            world.commit(forces, memory)
+    return contacts.forces(rows, impulse, solved.velocity, period_s)
 
 
 def _objects_moved(system: Stepped, v: np.ndarray, q_from: np.ndarray, q_to: np.ndarray):
@@ -244,8 +262,13 @@ def _step(system: Stepped, integrator: Integrator) -> PeriodStep:
     # the compiled plant is rebuilt when a run starts (its contact anchored anew): taken at
     # each period, the choice of step stays
     if system.objects or system.fixtures:
+        moving = None if system.moving is None else system.moving.moving
         if why_not_compiled_system(system, integrator) is not None:
+            if moving is not None:
+                moving.rigid_source = None  # its own rigid contacts: `_settle_contacts`
             return integrated
+        # the compiled system's rigid contacts of the last period, when asked
+        moving.rigid_source = lambda: contacts_of_core(system.compiled.rigid_contacts())
         # the compiled system follows the compiled plant (rebuilt when a run starts)
         return lambda t0, q0, v0, tau, t1: system.compiled.advance(
             t0, q0, v0, tau, t1, step, system.friction_memories()

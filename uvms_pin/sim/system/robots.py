@@ -85,7 +85,7 @@ class Robots:
         if any(system.fixtures for system in systems):
             # the robots' contacts and state name a robot's blocks, then the free objects'
             raise ParameterError(
-                "fixtures ([[world.objects]] type = \"urdf\") are not simulated with several "
+                'fixtures ([[world.objects]] type = "urdf") are not simulated with several '
                 "robots yet: use one robot, or leave the fixture out"
             )
         self.systems = tuple(systems)

@@ -27,6 +27,7 @@ import pinocchio as pin
 from uvms_pin.physics.compiled.backend import Fallback
 from uvms_pin.physics.compiled.extension import core_module
 from uvms_pin.physics.compiled.moving import contacts_of_core, forces_of_core, memories_of
+from uvms_pin.physics.constraints.moving_contacts import MovingPairContacts
 from uvms_pin.physics.constraints.object_contacts import ObjectWorldContacts
 from uvms_pin.physics.dynamics import forward_dynamics, mass_matrix
 from uvms_pin.physics.world.overlap import tolerance_m
@@ -86,6 +87,8 @@ class System:
         object_contacts: the free objects' rigid contacts with the fixed world, solved with
             the joint limits at each period's end
             (`uvms_pin.physics.constraints.object_contacts`), or None.
+        moving_constraints: the rigid contacts between moving bodies, solved with them
+            (`uvms_pin.physics.constraints.moving_contacts`), or None.
     """
 
     def __init__(self, plant: Plant, *, compiled: bool = True):
@@ -107,6 +110,12 @@ class System:
         first_v = self.layout.v_slices[1 + len(self.objects)].start if self.fixtures else 0
         self.fixture_blocks = fixture_joints.blocks(model.njoints, first_v, self.fixtures)
         self.object_contacts = self._object_contacts()
+        moving = None if self.moving is None else self.moving.moving
+        self.moving_constraints = (
+            MovingPairContacts(moving.sets, uvms.model.njoints)
+            if moving is not None and moving.rigid_pairs and moving.sets
+            else None
+        )
         self._steps: dict[int, tuple[Integrator, PeriodStep]] = {}
         self._data = uvms.model.createData()  # the bound test's kinematics
         self.separations: list = []  # the objects' moves out of an overlap at the start

@@ -1,0 +1,103 @@
+// The constraints of a system of bodies solved together once a control period, when two moving
+// bodies touch by rigid contacts (mirror of uvms_pin/physics/constraints/moving_contacts.py
+// with step.py and period.py's constrained): the robot's joint limits, each free object's rigid
+// contacts with the fixed world (with rigid_objects) and the rigid contacts between moving
+// bodies, one Coulomb problem over the system's velocity.
+//
+// Rows (at the period's start q0): a joint limit's (lower: gap q_j - q_min, J = +e_j; upper:
+// q_max - q_j, J = -e_j), an object's fixed-world contact's (object_contacts.hpp, on its six
+// columns) and, for each pair (a, b) of pieces of two moving bodies that can touch within the
+// period, coal's signed distance between the shapes: the nearest point x on a, the normal n out
+// of b, the gap r, and the three rows
+//
+//   J v = C^T (J_a(x) - J_b(x)) v      (C = (t1, t2, n); J_a, J_b the world velocity of each
+//                                       body's material point at x)
+//
+// so that one impulse acts on a and its opposite on b at x. A pair is selected when
+// r <= h |J_n| |v| + margin; the broad phase first asks that the pieces' bounding spheres be
+// within h (s_a + s_b) + margin, s a bound on the speed of a piece's points,
+// |J_lin(c)| |v| + |J_ang| |v| R (moving_contacts.py's _reach_speed). mu is mu_k while the pair
+// slid over the last period, mu_s otherwise.
+//
+// With M block diagonal over the bodies (the robot's nv_r x nv_r, each object's 6 x 6, added
+// mass included), G = J M^-1 J^T couples the bodies through the pairs' rows; the problem
+//   v+ = v_free + M^-1 J^T lambda,  sigma = G lambda + J v_free + phi(r) / h,
+//   limits: 0 <= lambda _|_ sigma >= 0;  contacts: the Coulomb cone, maximal dissipation
+// is solved by the projected Gauss-Seidel of object_contacts.hpp (coulomb_gauss_seidel, 1e-10
+// m/s on the rows' velocities); the Python reference's ADMM stops at 1e-8. Rows selected with
+// the speed max(|v_free|, least_speed), widened with the solved velocity (at most 4 rounds,
+// then once more), as step.py.
+#pragma once
+
+#include <vector>
+
+#include "joint_limits.hpp"
+#include "moving_contact.hpp"
+#include "object_contacts.hpp"
+
+namespace uvms {
+
+// What the coupled step reads of a system at the period's start q0.
+struct SystemAtStart {
+  const Model* robot = nullptr;  // the robot's model
+  Data* robot_data = nullptr;    // its data: the step computes its joint Jacobians at q0
+  Eigen::VectorXd q0_robot;
+  const JointLimitConstraintsModel* limits = nullptr;  // the robot's limits, or none
+  std::vector<const Data*> objects;  // each object's kinematics at q0 (its placements)
+  // each object's fixed world touched by rigid contacts (none: no row), its friction state
+  std::vector<const WorldContactModel*> object_worlds;
+  std::vector<const FrictionMemory*> object_memory;
+  const std::vector<PairSet>* sets = nullptr;  // the pairs between moving bodies
+};
+
+class CoupledConstraintStep {
+ public:
+  double margin = 1.0e-3;   // [m, rad] the allowance of a row's selection
+  double correction = 0.2;  // beta, the fraction of a penetration removed per period
+
+  // v (in: v_free (the system's nv; each object's body velocity at its pose in q0), out: v+)
+  // over the period h; masses: the robot's M(q0) then each object's. Returns whether any row
+  // was solved; then acting(), object_forces() and pair_forces() say what acted.
+  bool constrain(const SystemAtStart& at, const std::vector<Eigen::MatrixXd>& masses,
+                 Eigen::VectorXd& v, double h, const Eigen::VectorXd& least_speed);
+  // Whether a solved row acts on body k (0: the robot, 1 + i: object i).
+  bool acting(std::size_t k) const { return acting_[k] != 0; }
+  // Object i's fixed-world contacts of the period (their mean forces), and set s's pairs.
+  const ContactForces& object_forces(std::size_t i) const { return object_found_[i]; }
+  const PairContacts& pair_forces(std::size_t s) const { return pair_found_[s]; }
+
+ private:
+  // One selected contact between two moving bodies: its set, pair, candidate and frame.
+  struct PairRow {
+    int set = 0, pair = 0;
+    ContactCandidate point;
+    Eigen::Matrix3d frame;
+  };
+  int select(const SystemAtStart& at, const Eigen::VectorXd& speed, double h);
+  void add_pair_rows(const SystemAtStart& at, const Eigen::VectorXd& speed, double h);
+  // The world velocity Jacobian (3 x nv) of side's material point at x, and a bound on the
+  // speed of the points of the piece (side -1: the robot, else an object).
+  Eigen::MatrixXd side_jacobian(const SystemAtStart& at, int side, const ContactShape& piece,
+                                const Vec3& x) const;
+  double piece_speed(const SystemAtStart& at, int side, const ContactShape& piece,
+                     const Eigen::VectorXd& speed) const;
+  void solve(const std::vector<Eigen::MatrixXd>& masses, const Eigen::VectorXd& v_free,
+             Eigen::VectorXd& v);
+  void forces(const SystemAtStart& at, const Eigen::VectorXd& v, double h);
+
+  Eigen::Index nv_ = 0, nv_robot_ = 0;
+  std::vector<ObjectContactStep> object_steps_;
+  std::vector<Eigen::Index> object_rows_;  // each object's first fixed-world row
+  std::vector<PairRow> pair_rows_;
+  Eigen::Index first_pair_row_ = 0;
+  std::vector<Eigen::RowVectorXd> rows_;
+  std::vector<double> drift_, mu_;
+  std::vector<Eigen::Index> unilateral_, cone_rows_;
+  std::vector<char> acting_;
+  Eigen::MatrixXd jacobian_, minv_jt_, delassus_, robot_jacobians_;
+  Eigen::VectorXd impulse_;
+  std::vector<ContactForces> object_found_;
+  std::vector<PairContacts> pair_found_;
+};
+
+}  // namespace uvms

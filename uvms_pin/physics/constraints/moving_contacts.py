@@ -1,0 +1,226 @@
+"""Contacts between two moving bodies (a robot link and a free object, two free objects, an
+arm link and its own vehicle) as rigid point contacts with the Coulomb cone (Pinocchio's
+`PointContactConstraintModel` between two joints), solved implicitly by
+`step.constrained_velocity` with the joint limits and the objects' fixed-world contacts.
+
+Each pair (a, b) of pieces of a pair set (`uvms_pin.physics.world.moving`: the sets'
+pairs, their friction and their memories) that can touch within the period has one
+candidate: coal's signed distance between the two shapes (`gaps.coal_candidate`, b posed as
+an object), its nearest point x on a, the normal n out of b towards a and the gap r [m]
+(< 0 inside). Its three rows in the frame C = (t1, t2, n) are
+
+    J v = C^T (J_a(x) - J_b(x)) v      the velocity of a's material point at x relative to
+                                       b's there [m/s]: tangential (two rows), normal,
+
+so one impulse lambda (N s) acts on a and its opposite -lambda on b at the same point: the
+exchange is equal and opposite, it conserves the two bodies' momentum, and with the cone
+
+    |lambda_t| <= mu lambda_n,   mu = mu_s while the pair stuck over the last period,
+                                 mu_k while it slid (a pair is its own patch),
+
+and maximal dissipation, the step never adds energy (`step`'s module docstring). The
+Delassus operator G = J M^-1 J^T now couples the bodies (M block diagonal over them). A
+contact is solved when r <= h |J_n| |v| + margin, as a fixed-world contact is.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass
+from typing import Protocol
+
+import numpy as np
+import pinocchio as pin
+
+from uvms_pin.errors import ParameterError
+from uvms_pin.physics.constraints.contacts import (
+    contact_frame,
+    contact_rows,
+    point_contact,
+    point_jacobian,
+)
+from uvms_pin.physics.constraints.object_contacts import SLIP_M_S
+from uvms_pin.physics.constraints.rows import ConstraintRows
+from uvms_pin.physics.world.gaps import Candidate, coal_candidate
+from uvms_pin.physics.world.objects import WorldObject
+from uvms_pin.physics.world.pairs import PairContacts, PiecePairs
+from uvms_pin.physics.world.robot_geometry import RobotPiece
+from uvms_pin.physics.world.touch import Touch
+from uvms_pin.physics.world.world import FrictionMemory
+
+__all__ = ["MovingPairContacts", "PairSet"]
+
+
+class PairSet(Protocol):
+    """A set of pairs between side a and side b (-1: the robot, k >= 0: free object k)."""
+
+    pairs: PiecePairs
+    a: int
+    b: int
+    memory: FrictionMemory
+
+
+@dataclass(frozen=True)
+class _Solved:
+    """What `MovingPairContacts.forces` needs of one solved contact: its pair set, the
+    pair's index there, its point (piece: a's, obj: b's) and its frame (t1, t2, n)."""
+
+    set: int
+    pair: int
+    point: Candidate
+    frame: np.ndarray
+
+
+def _on_joint(pieces: Sequence[RobotPiece], side: int, first_object_joint: int):
+    """The pieces of one side on their joints in the system's model: the robot's as they
+    are, free object k's on its free-flyer ``first_object_joint + k``."""
+    if side < 0:
+        return tuple(pieces)
+    return tuple(dataclasses.replace(p, joint_id=first_object_joint + side) for p in pieces)
+
+
+def _reach_speed(model: pin.Model, data: pin.Data, piece: RobotPiece, speed: np.ndarray):
+    """A bound [m/s] on the speed of any point of ``piece`` when each velocity coordinate
+    moves at most ``speed``: |J_lin(c)| speed + |J_ang| speed * R, c its frame's origin."""
+    joint = piece.joint_id
+    centre = (data.oMi[joint] * piece.placement_in_joint).translation
+    linear = np.abs(point_jacobian(model, data, joint, centre)) @ speed
+    angular = np.abs(pin.getJointJacobian(model, data, joint, pin.LOCAL_WORLD_ALIGNED)[3:]) @ speed
+    return float(np.linalg.norm(linear) + np.linalg.norm(angular) * piece.bound_radius_m)
+
+
+class MovingPairContacts:
+    """The contacts between moving bodies, as constraints.
+
+    Args:
+        sets: the pair sets (`PairSet`: `uvms_pin.physics.world.moving.MovingContacts.sets`),
+            their memories kept between periods (which pairs slide).
+        first_object_joint: free object 0's free-flyer in the system's model (object k's is
+            the next k-th).
+        margin: [m] the allowance of a contact's selection (`step.constrained_velocity`).
+        name: the key of the impulses in the step's result.
+    """
+
+    def __init__(
+        self,
+        sets: Sequence[PairSet],
+        first_object_joint: int,
+        margin: float = 1.0e-3,
+        name: str = "moving_contacts",
+    ):
+        if not (math.isfinite(margin) and margin >= 0.0):
+            raise ParameterError(f"the contacts' margin must be >= 0 [m], got {margin}")
+        self.sets, self.margin, self.name = tuple(sets), float(margin), name
+        self._pieces = [
+            (
+                _on_joint(s.pairs.pieces_a, s.a, first_object_joint),
+                _on_joint(s.pairs.pieces_b, s.b, first_object_joint),
+            )
+            for s in self.sets
+        ]
+
+    def rows(
+        self, model: pin.Model, data: pin.Data, q: np.ndarray, speed: np.ndarray, period_s: float
+    ) -> ConstraintRows:
+        """The contacts at q that can close within ``period_s`` at ``speed``
+        (`ConstraintSet.rows`): three rows per contact (t1, t2, n)."""
+        evaluated_contacts, solved = [], []
+        for s, pair_set in enumerate(self.sets):
+            pieces_a, pieces_b = self._pieces[s]
+            for k, (ia, ib) in enumerate(pair_set.pairs.pairs):
+                point = self._candidate(model, data, speed, period_s, pieces_a[ia], pieces_b[ib])
+                if point is None:
+                    continue
+                point = dataclasses.replace(point, piece=ia, obj=ib)
+                joints = (pieces_a[ia].joint_id, pieces_b[ib].joint_id)
+                touching = (point.point_world_m, point.normal_world, point.gap_m)
+                mu_static, mu_kinetic = pair_set.pairs.mu[k]
+                mu = mu_kinetic if k in pair_set.memory.slipping else mu_static
+                evaluated_contacts.append(
+                    point_contact(model, data, joints[0], touching, mu, surface_joint=joints[1])
+                )
+                solved.append(_Solved(s, k, point, contact_frame(point.normal_world)))
+        gaps = [c.point.gap_m for c in solved]
+        labels = [self.sets[c.set].pairs.names[c.pair] for c in solved]
+        return contact_rows(self.name, model.nv, evaluated_contacts, gaps, labels, solved)
+
+    def _candidate(
+        self,
+        model: pin.Model,
+        data: pin.Data,
+        speed: np.ndarray,
+        period_s: float,
+        piece_a: RobotPiece,
+        piece_b: RobotPiece,
+    ) -> Candidate | None:
+        """The pair's candidate if its gap can close within the period, else None."""
+        where_a = data.oMi[piece_a.joint_id] * piece_a.placement_in_joint
+        where_b = data.oMi[piece_b.joint_id] * piece_b.placement_in_joint
+        apart = np.linalg.norm(where_a.translation - where_b.translation)
+        closing = _reach_speed(model, data, piece_a, speed)
+        closing += _reach_speed(model, data, piece_b, speed)
+        if apart >= piece_a.bound_radius_m + piece_b.bound_radius_m + period_s * closing + (
+            self.margin
+        ):
+            return None
+        obstacle = WorldObject("b", "piece", piece_b.shape, where_b, 0.0, 0.0, 0.0)
+        point = coal_candidate(0, 0, piece_a, where_a, obstacle)
+        relative = point_jacobian(model, data, piece_a.joint_id, point.point_world_m)
+        relative -= point_jacobian(model, data, piece_b.joint_id, point.point_world_m)
+        normal_rate = point.normal_world @ relative
+        if point.gap_m > period_s * np.abs(normal_rate) @ speed + self.margin:
+            return None
+        return point
+
+    def forces(
+        self, rows: ConstraintRows, impulse: np.ndarray, velocity: np.ndarray, period_s: float
+    ) -> list[PairContacts]:
+        """Each pair set's contacts of a solved period (`PairContacts`): the mean force
+        f = C lambda / h on a at each point [N] (b gets -f), its normal part, the relative
+        velocity of the points after the step (J v+) and whether it stuck (tangential speed
+        at most `SLIP_M_S`). ``rows``: this set's solved rows, ``impulse`` their lambda
+        (N s), ``velocity`` the system's v+."""
+        rate = rows.jacobian @ velocity if rows.size else np.zeros(0)
+        out = []
+        for s in range(len(self.sets)):
+            mine = [i for i, c in enumerate(rows.where) if c.set == s]
+            frames = np.array([rows.where[i].frame for i in mine]).reshape(-1, 3, 3)
+            points = [rows.where[i].point for i in mine]
+            local_impulse = np.array([impulse[3 * i : 3 * i + 3] for i in mine]).reshape(-1, 3)
+            local_rate = np.array([rate[3 * i : 3 * i + 3] for i in mine]).reshape(-1, 3)
+            touch = Touch(
+                np.array([p.piece for p in points], dtype=int),
+                np.array([p.obj for p in points], dtype=int),
+                np.full(len(mine), -1, dtype=int),
+                np.array([p.point_world_m for p in points]).reshape(-1, 3),
+                np.array([p.normal_world for p in points]).reshape(-1, 3),
+                np.array([max(-p.gap_m, 0.0) for p in points]),
+                np.einsum("kij,kj->ki", frames, local_rate),
+            )
+            zeros = np.zeros((len(mine), 3))
+            out.append(
+                PairContacts(
+                    touch,
+                    np.einsum("kij,kj->ki", frames, local_impulse) / period_s,
+                    local_impulse[:, 2] / period_s,
+                    np.linalg.norm(local_rate[:, :2], axis=1) <= SLIP_M_S,
+                    zeros,
+                    zeros.copy(),
+                    np.array([rows.where[i].pair for i in mine], dtype=int),
+                )
+            )
+        return out
+
+    def commit(self, found: Sequence[PairContacts]) -> None:
+        """After a solved period: each set's memory keeps which pairs slid (their next
+        cone is mu_k), no anchor (the constraint holds a sticking pair itself)."""
+        for pair_set, contacts in zip(self.sets, found, strict=True):
+            memory = pair_set.memory
+            memory.anchors, memory.material = {}, {}
+            memory.slipping = {
+                int(k)
+                for k, stuck in zip(contacts.pair, contacts.sticking, strict=True)
+                if not stuck
+            }
