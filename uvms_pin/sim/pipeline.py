@@ -90,9 +90,9 @@ def _plant(parts: RunParts) -> str | None:
 #: (the pipelines it keeps in Python, the check: the reason, or None when it does not apply),
 #: in the order they are asked
 REASONS: tuple[tuple[Pipeline, Callable[[RunParts], str | None]], ...] = (
+    (Pipeline.BOTH, lambda p: "several robots (their system is integrated in Python)" if p.robots > 1 else None),
     (Pipeline.LOOP, lambda p: None if p.system.compiled_allowed else "the Python loop was asked for"),
     (Pipeline.SYSTEM, lambda p: None if p.system.compiled_allowed else "the Python integration was asked for"),
-    (Pipeline.BOTH, lambda p: "several robots (their system is integrated in Python)" if p.robots > 1 else None),
     (Pipeline.ALL, lambda p: "the Python backend" if p.system.plant.backend == "python" else None),
     (Pipeline.BOTH, lambda p: "continuous-time control" if p.settings.control_period_s is None else None),
     (Pipeline.ALL, _integrator),
