@@ -1,5 +1,5 @@
 """The controller of scenarios/valve_turn.toml: a timed sequence of phases that brings the
-arm's end (the Alpha 5's jaw, closed: the model's ball of ``tip_radius_m`` at ``tip_frame``)
+arm's end (the Alpha 5's fixed jaw: the model's ball of ``tip_radius_m`` at ``tip_frame``)
 onto the end of a quarter-turn valve's paddle and sweeps it through 90 degrees about the
 valve's axis, the arm held in a fixed posture (pointing down) and the vehicle's thrusters
 giving the push.
