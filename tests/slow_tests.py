@@ -21,6 +21,12 @@ SLOW_MODULES = (
 #: module::function (every parameter of it)
 SLOW_TESTS = frozenset(
     (
+        "tests/scenario/test_valve_turn.py::test_the_valve_is_turned_a_quarter_turn_by_the_thrusters_push",
+        "tests/scenario/test_valve_turn.py::test_a_push_budget_below_the_friction_leaves_the_valve_closed",
+        "tests/scenario/test_object_recovery.py::test_the_sample_is_lifted_carried_and_placed_in_the_basket",
+        "tests/scenario/test_object_recovery.py::test_a_grip_too_weak_for_the_sample_leaves_it_on_the_seabed",
+        "tests/apps/viz/test_foxglove_live.py::test_a_running_simulation_is_streamed_at_real_time_as_it_runs",
+        "tests/apps/viz/test_foxglove_live.py::test_uvms_pin_replay_live_foxglove_waits_for_a_client_and_sends_the_whole_run",
         "tests/apps/arms/test_compare.py::test_keep_rollouts_writes_each_arms_outputs",
         "tests/apps/cli/test_cli.py::test_run_passive_scenario_writes_rollout_metrics_and_figures",
         "tests/apps/cli/test_compare_controllers.py::test_a_tracking_comparison_says_when_the_run_ends_before_its_transient",
