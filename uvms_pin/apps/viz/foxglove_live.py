@@ -31,13 +31,8 @@ from uvms_pin.apps.export.ros_sample import (
     record_of_sample,
     records_of,
 )
-from uvms_pin.apps.viz.live import (
-    LOOPBACK,
-    play_to_end,
-    port_is_free,
-    simulate_watched,
-    wait_for_watcher,
-)
+from uvms_pin.apps.viz.live import LOOPBACK, port_is_free
+from uvms_pin.apps.viz.watched import play_to_end, simulate_watched, wait_for_watcher
 from uvms_pin.errors import LiveServerError, OptionalDependencyError, PortInUseError
 from uvms_pin.results.progress import Progress
 from uvms_pin.sim.log import run_metadata

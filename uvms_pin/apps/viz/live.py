@@ -23,7 +23,7 @@ import tempfile
 import threading
 import time
 from pathlib import Path
-from typing import Protocol, TextIO
+from typing import TextIO
 
 import meshcat
 import numpy as np
@@ -32,12 +32,13 @@ from meshcat.visualizer import ViewerWindow
 
 from uvms_pin.apps.viz.meshcat_scene import EnvironmentView, Frame, SceneStyle, UvmsScene
 from uvms_pin.apps.viz.surface import surface_view_of
+from uvms_pin.apps.viz.watched import play_to_end, simulate_watched, wait_for_watcher
 from uvms_pin.apps.viz.world_view import WorldView
-from uvms_pin.errors import LiveServerError, PortInUseError, SimulationError
+from uvms_pin.errors import LiveServerError, PortInUseError
 from uvms_pin.results.progress import Progress
 from uvms_pin.results.rollout import Rollout
 from uvms_pin.sim.run import Scenario, simulate
-from uvms_pin.sim.sample import Observer, Sample
+from uvms_pin.sim.sample import Sample
 
 LOOPBACK = "127.0.0.1"
 DEFAULT_PORT = 7000
@@ -426,59 +427,6 @@ def run_live(
     scene = scene_for_scenario(scenario, style, show)
     with LiveView(scene, port=port, speed=speed, out=out) as live:
         return simulate_watched(scenario, live, LiveFeed(live), progress=progress, out=out)
-
-
-class Watched(Protocol):
-    """What a live view offers its runner (`LiveView`, the Foxglove server)."""
-
-    watched: bool
-    error: BaseException | None
-
-    def lag_s(self) -> float: ...
-
-    def finish(self) -> None: ...
-
-
-def simulate_watched(
-    scenario: Scenario,
-    view: Watched,
-    feed: Observer,
-    *,
-    progress: Progress | None = None,
-    out: TextIO | None = sys.stdout,
-) -> Rollout:
-    """`simulate` with ``feed`` observing every sample for ``view``; the view shows the run
-    to its end (a run that stops early too, the error then re-raised)."""
-    try:
-        rollout = simulate(scenario, progress=progress, observers=[feed])
-    except SimulationError:  # FunnelViolation included: show the partial run, re-raise
-        play_to_end(view, out)
-        raise
-    play_to_end(view, out)
-    return rollout
-
-
-def wait_for_watcher(view: Watched, what: str, out: TextIO | None) -> None:
-    """Wait until ``view`` is watched (saying so: "waiting for ``what``"); LiveServerError
-    if the view fails meanwhile."""
-    if out is not None:
-        print(f"live view: waiting for {what} (Ctrl-C to stop)", file=out)
-        out.flush()
-    while not view.watched:
-        if view.error is not None:
-            raise LiveServerError(f"live view failed: {view.error}")
-        time.sleep(0.1)
-
-
-def play_to_end(view: Watched, out: TextIO | None) -> None:
-    """Let ``view`` show what it has queued (to a watcher; at once without one), then stop."""
-    lag = view.lag_s()
-    if out is not None and lag > 1.0 and view.watched:
-        print(f"live view: playing the last {lag:.1f} s of the run (Ctrl-C to stop)", file=out)
-        out.flush()
-    view.finish()
-    if view.error is not None and out is not None:
-        print(f"live view: stopped streaming: {view.error}", file=out)
 
 
 def replay_live(
