@@ -20,10 +20,10 @@ constexpr double kSlip = 1.0e-6;
 
 }  // namespace
 
-Eigen::MatrixXd CoupledConstraintStep::side_jacobian(const SystemAtStart& at, int side,
-                                                     const ContactShape& piece,
-                                                     const Vec3& x) const {
-  Eigen::MatrixXd out = Eigen::MatrixXd::Zero(3, nv_);
+Eigen::MatrixXd CoupledConstraintStep::side_twist_jacobian(const SystemAtStart& at, int side,
+                                                           const ContactShape& piece,
+                                                           const Vec3& x) const {
+  Eigen::MatrixXd out = Eigen::MatrixXd::Zero(6, nv_);
   if (side < 0) {
     Eigen::Matrix<double, 6, Eigen::Dynamic> joint(6, nv_robot_);
     joint.setZero();
@@ -31,12 +31,21 @@ Eigen::MatrixXd CoupledConstraintStep::side_jacobian(const SystemAtStart& at, in
                                 static_cast<pinocchio::JointIndex>(piece.joint_id),
                                 pinocchio::LOCAL_WORLD_ALIGNED, joint);
     const Vec3 offset = x - at.robot_data->oMi[static_cast<std::size_t>(piece.joint_id)].translation();
-    out.leftCols(nv_robot_) = joint.topRows<3>() - pinocchio::skew(offset) * joint.bottomRows<3>();
+    out.topLeftCorner(3, nv_robot_) = joint.topRows<3>() - pinocchio::skew(offset) * joint.bottomRows<3>();
+    out.bottomLeftCorner(3, nv_robot_) = joint.bottomRows<3>();
   } else {
     const auto k = static_cast<std::size_t>(side);
-    out.middleCols<6>(nv_robot_ + 6 * side) = point_jacobian(at.objects[k]->oMi[1], x);
+    const pinocchio::SE3& body = at.objects[k]->oMi[1];
+    out.block<3, 6>(0, nv_robot_ + 6 * side) = point_jacobian(body, x);
+    out.block<3, 3>(3, nv_robot_ + 6 * side + 3) = body.rotation();
   }
   return out;
+}
+
+Eigen::MatrixXd CoupledConstraintStep::side_jacobian(const SystemAtStart& at, int side,
+                                                     const ContactShape& piece,
+                                                     const Vec3& x) const {
+  return side_twist_jacobian(at, side, piece, x).topRows(3);
 }
 
 double CoupledConstraintStep::piece_speed(const SystemAtStart& at, int side,
@@ -44,18 +53,9 @@ double CoupledConstraintStep::piece_speed(const SystemAtStart& at, int side,
                                           const Eigen::VectorXd& speed) const {
   const Data& data = side < 0 ? *at.robot_data : *at.objects[static_cast<std::size_t>(side)];
   const Vec3 centre = placement_of(data, piece).translation();
-  const Eigen::MatrixXd linear = side_jacobian(at, side, piece, centre);
-  Eigen::MatrixXd angular = Eigen::MatrixXd::Zero(3, nv_);
-  if (side < 0) {
-    Eigen::Matrix<double, 6, Eigen::Dynamic> joint(6, nv_robot_);
-    joint.setZero();
-    pinocchio::getJointJacobian(*at.robot, *at.robot_data,
-                                static_cast<pinocchio::JointIndex>(piece.joint_id),
-                                pinocchio::LOCAL_WORLD_ALIGNED, joint);
-    angular.leftCols(nv_robot_) = joint.bottomRows<3>();
-  } else {
-    angular.block<3, 3>(0, nv_robot_ + 6 * side + 3) = data.oMi[1].rotation();
-  }
+  const Eigen::MatrixXd twist = side_twist_jacobian(at, side, piece, centre);
+  const auto linear = twist.topRows(3);
+  const auto angular = twist.bottomRows(3);
   return (linear.cwiseAbs() * speed).norm() +
          (angular.cwiseAbs() * speed).norm() * piece.bound_radius_m;
 }

@@ -79,6 +79,10 @@ class CoupledConstraintStep {
   // speed of the points of the piece (side -1: the robot, else an object).
   Eigen::MatrixXd side_jacobian(const SystemAtStart& at, int side, const ContactShape& piece,
                                 const Vec3& x) const;
+  // the same point's velocity (3 rows) over the piece's body's angular velocity (3 rows), in
+  // world axes (6 x nv): one joint Jacobian for both
+  Eigen::MatrixXd side_twist_jacobian(const SystemAtStart& at, int side,
+                                      const ContactShape& piece, const Vec3& x) const;
   double piece_speed(const SystemAtStart& at, int side, const ContactShape& piece,
                      const Eigen::VectorXd& speed) const;
   void solve(const std::vector<Eigen::MatrixXd>& masses, const Eigen::VectorXd& v_free,
