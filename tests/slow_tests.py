@@ -21,6 +21,7 @@ SLOW_MODULES = (
 #: module::function (every parameter of it)
 SLOW_TESTS = frozenset(
     (
+        "tests/physics/world/test_tumbling_boxes.py::test_the_python_reference_lands_the_same_boxes_without_stopping",
         "tests/scenario/test_valve_turn.py::test_the_valve_is_turned_a_quarter_turn_by_the_thrusters_push",
         "tests/scenario/test_valve_turn.py::test_a_push_budget_below_the_friction_leaves_the_valve_closed",
         "tests/scenario/test_object_recovery.py::test_the_sample_is_lifted_carried_and_placed_in_the_basket",

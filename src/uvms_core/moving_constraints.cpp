@@ -183,7 +183,7 @@ void CoupledConstraintStep::solve(const std::vector<Eigen::MatrixXd>& masses,
       jacobian_ * v_free + Eigen::Map<const Eigen::VectorXd>(drift_.data(), jacobian_.rows());
   impulse_ = Eigen::VectorXd::Zero(jacobian_.rows());
   coulomb_gauss_seidel(delassus_, g, cone_rows_, mu_, unilateral_, impulse_,
-                       "coupled constraints");
+                       "coupled constraints", stalled);
   v = v_free + minv_jt_ * impulse_;
 }
 

@@ -65,6 +65,8 @@ class CoupledConstraintStep {
   // Object i's fixed-world contacts of the period (their mean forces), and set s's pairs.
   const ContactForces& object_forces(std::size_t i) const { return object_found_[i]; }
   const PairContacts& pair_forces(std::size_t s) const { return pair_found_[s]; }
+  // the solves of this step that stalled and were accepted (object_contacts.hpp)
+  StalledSolves stalled;
 
  private:
   // One selected contact between two moving bodies: its set, pair, candidate and frame.

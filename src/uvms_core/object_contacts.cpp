@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <string>
 
 #include <coal/distance.h>
@@ -24,6 +25,11 @@ constexpr double kSlip = 1.0e-6;
 // the Gauss-Seidel sweeps stop when no impulse changes its rows' velocity by more [m/s]
 constexpr double kTolerance = 1.0e-10;
 constexpr int kMaxSweeps = 20000;
+// a stalled solve is kept with a residual of at most this fraction of its rows' largest speed
+// |g|_inf, and at least kAcceptableResidual [m/s] (step.py's ACCEPTABLE_RELATIVE_RESIDUAL,
+// ACCEPTABLE_RESIDUAL_M_S)
+constexpr double kAcceptableRelative = 1.0e-4;
+constexpr double kAcceptableResidual = 1.0e-5;
 
 coal::Transform3s transform_of(const pinocchio::SE3& where) {
   return coal::Transform3s(where.rotation(), where.translation());
@@ -160,7 +166,7 @@ void coulomb_gauss_seidel(const Eigen::MatrixXd& delassus, const Eigen::VectorXd
                           const std::vector<Eigen::Index>& cone_rows,
                           const std::vector<double>& mu,
                           const std::vector<Eigen::Index>& unilateral, Eigen::VectorXd& impulse,
-                          const char* what) {
+                          const char* what, StalledSolves& stalled) {
   Eigen::VectorXd sigma = g + delassus * impulse;  // G lambda + g, kept up to date
   double last_change = 0.0;
   for (int sweep = 0; sweep < kMaxSweeps; ++sweep) {
@@ -193,9 +199,45 @@ void coulomb_gauss_seidel(const Eigen::MatrixXd& delassus, const Eigen::VectorXd
     last_change = change;
     if (change <= kTolerance) return;
   }
+  const double residual = coulomb_residual(delassus, g, cone_rows, mu, unilateral, impulse);
+  const double acceptable =
+      std::max(kAcceptableResidual, kAcceptableRelative * g.cwiseAbs().maxCoeff());
+  if (residual <= acceptable) {  // stalled (non-associated law, singular G), small enough
+    stalled.add(residual);
+    return;
+  }
+  char numbers[160];
+  std::snprintf(numbers, sizeof numbers,
+                " (a change of %.3g m/s at the last, residual %.3g m/s, above the %.3g m/s a "
+                "stalled solve may keep)",
+                last_change, residual, acceptable);
   throw SimulationFailure(std::string(what) + ": the Gauss-Seidel sweeps did not settle in " +
-                          std::to_string(kMaxSweeps) + " (a change of " +
-                          std::to_string(last_change) + " m/s at the last)");
+                          std::to_string(kMaxSweeps) + numbers);
+}
+
+double coulomb_residual(const Eigen::MatrixXd& delassus, const Eigen::VectorXd& g,
+                        const std::vector<Eigen::Index>& cone_rows, const std::vector<double>& mu,
+                        const std::vector<Eigen::Index>& unilateral,
+                        const Eigen::VectorXd& impulse) {
+  const Eigen::VectorXd sigma = g + delassus * impulse;
+  double out = 0.0;
+  auto normal_row = [&](Eigen::Index j) {
+    out = std::max({out, -std::min(sigma[j], 0.0),
+                    std::min(std::max(sigma[j], 0.0), impulse[j] * delassus(j, j))});
+  };
+  for (const Eigen::Index j : unilateral) normal_row(j);
+  for (std::size_t c = 0; c < cone_rows.size(); ++c) {
+    const Eigen::Index t = cone_rows[c], n = t + 2;
+    normal_row(n);
+    if (impulse[n] <= 0.0) continue;
+    const Eigen::Vector2d force = impulse.segment<2>(t), slip = sigma.segment<2>(t);
+    if (force.norm() < mu[c] * impulse[n] * (1.0 - 1.0e-9)) {
+      out = std::max(out, slip.norm());  // inside the cone: sticking
+    } else {
+      out = std::max(out, (slip + slip.norm() * force / std::max(force.norm(), 1e-300)).norm());
+    }
+  }
+  return out;
 }
 
 void ObjectContactStep::solve(const Mat6& mass, const Vec6& v_free, Vec6& v) {
@@ -210,7 +252,7 @@ void ObjectContactStep::solve(const Mat6& mass, const Vec6& v_free, Vec6& v) {
   impulse_ = Eigen::VectorXd::Zero(3 * m);
   cone_rows_.resize(selected_.size());
   for (Eigen::Index i = 0; i < m; ++i) cone_rows_[static_cast<std::size_t>(i)] = 3 * i;
-  coulomb_gauss_seidel(delassus_, g, cone_rows_, mu_, {}, impulse_, "object contacts");
+  coulomb_gauss_seidel(delassus_, g, cone_rows_, mu_, {}, impulse_, "object contacts", stalled);
   v = v_free + minv_jt_ * impulse_;
 }
 

@@ -26,6 +26,7 @@
 // 1e-6 m/s at the period's end (ObjectWorldContacts.forces).
 #pragma once
 
+#include <algorithm>
 #include <vector>
 
 #include "world_contact.hpp"
@@ -60,16 +61,40 @@ Eigen::Matrix3d contact_frame(const Vec3& normal);
 // for its LOCAL twist.
 Eigen::Matrix<double, 3, 6> point_jacobian(const pinocchio::SE3& body, const Vec3& x);
 
+// The solves that stalled above kTolerance and were accepted (step.py's StalledSolves): with
+// friction the problem is not a convex program, and with more contacts than freedoms (a box's
+// four corners) G is singular; on a box rocking or landing on its corners the sweeps stall.
+// The last impulse is kept when its residual (coulomb_residual) is at most 1e-4 of the rows'
+// largest speed |g|_inf and at least 1e-5 m/s (step.py's acceptable_residual).
+struct StalledSolves {
+  int count = 0;
+  double worst_residual_m_s = 0.0;
+  void add(double residual_m_s) {
+    ++count;
+    worst_residual_m_s = std::max(worst_residual_m_s, residual_m_s);
+  }
+};
+
+// How far impulse is from solving the problem of coulomb_gauss_seidel [m/s] (0: solved): the
+// largest of each unilateral row's and contact normal's penetration -min(sigma, 0) and
+// complementarity min(sigma^+, lambda G_jj), a sticking contact's tangential speed, a sliding
+// one's departure from maximal dissipation |sigma_t + |sigma_t| lambda_t / |lambda_t||.
+double coulomb_residual(const Eigen::MatrixXd& delassus, const Eigen::VectorXd& g,
+                        const std::vector<Eigen::Index>& cone_rows, const std::vector<double>& mu,
+                        const std::vector<Eigen::Index>& unilateral,
+                        const Eigen::VectorXd& impulse);
+
 // The Coulomb problem's projected Gauss-Seidel (see the file's comment) on the Delassus
 // operator G and the free rows' velocity g: impulse (in: the start, out: the solution) with
 // the cones of `cone_rows` (each a contact's first row t1, then t2, n; mu per contact) and
-// the unilateral rows `unilateral` (lambda >= 0, a joint limit's); throws SimulationFailure
-// after kMaxSweeps. what: for the message.
+// the unilateral rows `unilateral` (lambda >= 0, a joint limit's). After kMaxSweeps the last
+// sweep's impulse is kept when its coulomb_residual is acceptable (StalledSolves; counted in
+// stalled); otherwise throws SimulationFailure. what: for the message.
 void coulomb_gauss_seidel(const Eigen::MatrixXd& delassus, const Eigen::VectorXd& g,
                           const std::vector<Eigen::Index>& cone_rows,
                           const std::vector<double>& mu,
                           const std::vector<Eigen::Index>& unilateral, Eigen::VectorXd& impulse,
-                          const char* what);
+                          const char* what, StalledSolves& stalled);
 
 // The velocity step of one free object against its fixed world.
 class ObjectContactStep {
@@ -94,6 +119,8 @@ class ObjectContactStep {
   const Eigen::MatrixXd& jacobian() const { return jacobian_; }
   const Eigen::VectorXd& drift() const { return drift_; }
   const std::vector<double>& mu() const { return mu_; }
+  // the solves of this step that stalled and were accepted
+  StalledSolves stalled;
   // The selected contacts' mean forces over the period h of their impulses (3 a contact)
   // and the body's velocity v after the step.
   void forces(const Vec6& v, const Eigen::VectorXd& impulse, double h, ContactForces& out) const;

@@ -11,6 +11,10 @@ namespace uvms {
 
 namespace {
 
+// A free object whose velocity the period's impulses changed by at most this [m/s, rad/s]
+// keeps the smooth step's end (period.py's PUSHED_M_S)
+constexpr double kPushed = 1.0e-9;
+
 // The robot's joints and n free-flyers under the universe (_system_model of system.py).
 Model system_model(const Model& robot, std::size_t n_objects) {
   Model model = robot;
@@ -279,8 +283,11 @@ void System::constrain(double t0, const ConstVec& q0, const ConstVec& v0, double
     const Eigen::Matrix3d turn = r0.transpose() * rotation_of(q1.segment(nq_robot_ + 7 * i, 7));
     Vec6 v_k = v1.segment(nv_robot_ + 6 * i, 6);
     v_k << turn * v_k.head<3>(), turn * v_k.tail<3>();
+    const Vec6 v_free = v_k;
+    // an object the impulses did not move keeps the smooth step's end (period.py's _end)
     if (object_step_.constrain(*object_worlds[k], object_memory[k], body.data(), mass, v_k, h,
-                               least, rigid_found_[k])) {
+                               least, rigid_found_[k]) &&
+        (v_k - v_free).cwiseAbs().maxCoeff() > kPushed) {
       const Eigen::Matrix<double, 7, 1> q_end = free_body_configuration(q0_k, v_k, h);
       q1.segment(nq_robot_ + 7 * i, 7) = q_end;
       v1.segment(nv_robot_ + 6 * i, 3) = rotation_of(q_end).transpose() * r0 * v_k.head<3>();
@@ -327,6 +334,7 @@ void System::constrain_coupled(double t0, const ConstVec& q0, const ConstVec& v0
     v.segment<3>(nv_robot_ + 6 * i) = turn * v1.segment<3>(nv_robot_ + 6 * i);
     v.segment<3>(nv_robot_ + 6 * i + 3) = turn * v1.segment<3>(nv_robot_ + 6 * i + 3);
   }
+  const Eigen::VectorXd v_free = v;
   const bool solved = coupled_step_.constrain(at, masses, v, h, least);
   if (solved && coupled_step_.acting(0)) {
     v1.head(nv_robot_) = v.head(nv_robot_);
@@ -336,7 +344,9 @@ void System::constrain_coupled(double t0, const ConstVec& q0, const ConstVec& v0
   }
   for (std::size_t k = 0; k < objects_.size(); ++k) {
     const auto i = static_cast<Eigen::Index>(k);
-    if (solved && coupled_step_.acting(1 + k)) {
+    const auto part = Eigen::seqN(nv_robot_ + 6 * i, 6);
+    if (solved && coupled_step_.acting(1 + k) &&
+        (v(part) - v_free(part)).cwiseAbs().maxCoeff() > kPushed) {
       const auto q0_k = q0.segment(nq_robot_ + 7 * i, 7);
       const Vec6 v_k = v.segment<6>(nv_robot_ + 6 * i);
       const Eigen::Matrix<double, 7, 1> q_end = free_body_configuration(q0_k, v_k, h);

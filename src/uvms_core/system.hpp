@@ -79,6 +79,15 @@ class System {
   }
   // After a control period at (q, v): every contact's anchors move (System.settle).
   void settle(const ConstVec& q, const ConstVec& v);
+  // The constraint solves since the system was built that stalled and were accepted
+  // (object_contacts.hpp's StalledSolves), of the objects' and the coupled steps.
+  StalledSolves stalled_solves() const {
+    StalledSolves out = object_step_.stalled;
+    out.count += coupled_step_.stalled.count;
+    out.worst_residual_m_s =
+        std::max(out.worst_residual_m_s, coupled_step_.stalled.worst_residual_m_s);
+    return out;
+  }
   // (q, v) at t1 from (q0, v0) at t0 with tau held (see the file's comment).
   std::pair<Eigen::VectorXd, Eigen::VectorXd> advance(double t0, const ConstVec& q0,
                                                       const ConstVec& v0, const ConstVec& tau,

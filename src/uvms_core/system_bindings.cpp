@@ -93,6 +93,14 @@ void bind_system(nb::module_& m) {
           },
           "plant"_a, "objects"_a, nb::keep_alive<1, 2>(),
           "The plant (kept alive) and each free object's floating body (copied).")
+      .def_prop_ro(
+          "stalled_solves",
+          [](const System& self) {
+            const uvms::StalledSolves stalled = self.stalled_solves();
+            return std::make_pair(stalled.count, stalled.worst_residual_m_s);
+          },
+          "(count, worst residual [m/s]) of the constraint solves that stalled in a cycle "
+          "below the acceptable residual and were kept (object_contacts.hpp).")
       .def_prop_ro("nq", &System::nq)
       .def_prop_ro("nv", &System::nv)
       .def_rw("rigid_objects", &System::rigid_objects,

@@ -287,6 +287,7 @@ class ClosedLoop:
             raise
         finally:
             log.rollout.metadata["closed_loop"] = path.record()
+            log.rollout.metadata.update(self.system.solves_record())
             self.observers.remove(log)
             dropped = self.plant.actuation.dropped()
             if dropped is not None:

@@ -66,6 +66,10 @@ _SOFTER_CONTACT = (
     ", or soften the contact ([world.contact] stiffness_N_m, dissipation_s_m), or make the "
     "body heavier"
 )
+_RIGID_PAIRS = (
+    ', or make the contacts between moving bodies rigid ([world] moving_contact = "rigid": '
+    "solved implicitly, stable at any step)"
+)
 _SOFTER_ENV = ", or soften the environment ([environment] stiffness_N_m, damping_N_s_m)"
 ANGULAR = ("N m/rad", "N m s/rad", "kg m^2")
 
@@ -195,9 +199,10 @@ def contact_modes(what: str, first: Body, second: Body | None, law: ContactLaw) 
     depth = max(first.working_depth_m, 0.0 if second is None else second.working_depth_m)
     k, mass = law.stiffness_N_m, 1.0 / mobility
     damping = k * law.dissipation_s_m * depth
+    remedy = _SOFTER_CONTACT if second is None else _RIGID_PAIRS + _SOFTER_CONTACT
     return [
-        StiffMode(f"{what}, at first touch", k, 0.0, mass, remedy=_SOFTER_CONTACT),
-        StiffMode(f"{what}, {depth * 1e3:.3g} mm deep", k, damping, mass, remedy=_SOFTER_CONTACT),
+        StiffMode(f"{what}, at first touch", k, 0.0, mass, remedy=remedy),
+        StiffMode(f"{what}, {depth * 1e3:.3g} mm deep", k, damping, mass, remedy=remedy),
     ]
 
 

@@ -29,6 +29,7 @@ from uvms_pin.physics.compiled.extension import core_module
 from uvms_pin.physics.compiled.moving import contacts_of_core, forces_of_core, memories_of
 from uvms_pin.physics.constraints.moving_contacts import MovingPairContacts
 from uvms_pin.physics.constraints.object_contacts import ObjectWorldContacts
+from uvms_pin.physics.constraints.step import StalledSolves
 from uvms_pin.physics.dynamics import forward_dynamics, mass_matrix
 from uvms_pin.physics.world.overlap import tolerance_m
 from uvms_pin.sim.compiled.system import system_to_core
@@ -36,7 +37,12 @@ from uvms_pin.sim.integrators import Integrator
 from uvms_pin.sim.plant import Plant, checked_start, has_moving_contacts
 from uvms_pin.sim.system import fixtures as fixture_joints
 from uvms_pin.sim.system.free_objects import FreeObjects
-from uvms_pin.sim.system.period import PeriodStep, period_step, why_not_compiled_system
+from uvms_pin.sim.system.period import (
+    PeriodStep,
+    constraint_sets,
+    period_step,
+    why_not_compiled_system,
+)
 from uvms_pin.sim.system.state import Layout, SystemState
 
 __all__ = ["System"]
@@ -119,6 +125,7 @@ class System:
         self._steps: dict[int, tuple[Integrator, PeriodStep]] = {}
         self._data = uvms.model.createData()  # the bound test's kinematics
         self.separations: list = []  # the objects' moves out of an overlap at the start
+        self.stalled = StalledSolves()  # the run's constraint solves accepted after stalling
 
     def _object_contacts(self) -> ObjectWorldContacts | None:
         """The free objects' rigid contacts with the fixed world (`World.fixed_contact`
@@ -154,6 +161,7 @@ class System:
         anchors set afresh."""
         q, _ = self.robot_state(state.q, state.v)
         self.plant.attach(q)
+        self.stalled = StalledSolves()
         if self.moving is not None:
             self.moving.reset()
             robot, *objects = self.layout.split(state.q, state.v)
@@ -285,6 +293,20 @@ class System:
                     "moved": [o.record(self.objects[o.moved].name) for o in self.separations],
                 }
         return out
+
+    def stalled_solves(self) -> StalledSolves:
+        """The run's constraint solves accepted after stalling (`StalledSolves`): the Python
+        step's and the compiled system's (rebuilt, so counted afresh, when a run starts)."""
+        core = self.compiled
+        if core is None or isinstance(core, Fallback):
+            return self.stalled
+        return self.stalled.merged(*core.stalled_solves)
+
+    def solves_record(self) -> dict[str, Any]:
+        """``{"constraint_solves": ...}`` (`StalledSolves.record`) for a run's metadata when
+        the system solves constraints at its periods' ends, else empty."""
+        solves = bool(constraint_sets(self))
+        return {"constraint_solves": self.stalled_solves().record()} if solves else {}
 
     @property
     def contact_pair_names(self) -> list[str]:
