@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <limits>
 #include <string>
 
 #include <coal/distance.h>
@@ -30,6 +31,11 @@ constexpr int kMaxSweeps = 20000;
 // ACCEPTABLE_RESIDUAL_M_S)
 constexpr double kAcceptableRelative = 1.0e-4;
 constexpr double kAcceptableResidual = 1.0e-5;
+// a solve is taken as stalled, from sweep kFirstStallCheck, when its residual at a check every
+// kStallCheck sweeps is more than kStallRatio of the last check's (and acceptable)
+constexpr int kFirstStallCheck = 2000;
+constexpr int kStallCheck = 1000;
+constexpr double kStallRatio = 0.5;
 
 coal::Transform3s transform_of(const pinocchio::SE3& where) {
   return coal::Transform3s(where.rotation(), where.translation());
@@ -169,6 +175,9 @@ void coulomb_gauss_seidel(const Eigen::MatrixXd& delassus, const Eigen::VectorXd
                           const char* what, StalledSolves& stalled) {
   Eigen::VectorXd sigma = g + delassus * impulse;  // G lambda + g, kept up to date
   double last_change = 0.0;
+  const double acceptable =
+      std::max(kAcceptableResidual, kAcceptableRelative * g.cwiseAbs().maxCoeff());
+  double checked = std::numeric_limits<double>::infinity();  // the last check's residual
   for (int sweep = 0; sweep < kMaxSweeps; ++sweep) {
     double change = 0.0;
     for (const Eigen::Index j : unilateral) {  // lambda_j >= 0 _|_ sigma_j >= 0
@@ -198,10 +207,19 @@ void coulomb_gauss_seidel(const Eigen::MatrixXd& delassus, const Eigen::VectorXd
     }
     last_change = change;
     if (change <= kTolerance) return;
+    if ((sweep + 1) % kStallCheck == 0) {
+      // stalled: no better than half the residual kStallCheck sweeps ago (a converging
+      // solve gains orders of magnitude over as many), and acceptable
+      const double residual = coulomb_residual(delassus, g, cone_rows, mu, unilateral, impulse);
+      if (sweep + 1 >= kFirstStallCheck && residual <= acceptable &&
+          residual > kStallRatio * checked) {
+        stalled.add(residual);
+        return;
+      }
+      checked = residual;
+    }
   }
   const double residual = coulomb_residual(delassus, g, cone_rows, mu, unilateral, impulse);
-  const double acceptable =
-      std::max(kAcceptableResidual, kAcceptableRelative * g.cwiseAbs().maxCoeff());
   if (residual <= acceptable) {  // stalled (non-associated law, singular G), small enough
     stalled.add(residual);
     return;

@@ -87,7 +87,8 @@ double coulomb_residual(const Eigen::MatrixXd& delassus, const Eigen::VectorXd& 
 // The Coulomb problem's projected Gauss-Seidel (see the file's comment) on the Delassus
 // operator G and the free rows' velocity g: impulse (in: the start, out: the solution) with
 // the cones of `cone_rows` (each a contact's first row t1, then t2, n; mu per contact) and
-// the unilateral rows `unilateral` (lambda >= 0, a joint limit's). After kMaxSweeps the last
+// the unilateral rows `unilateral` (lambda >= 0, a joint limit's). From sweep 2,000 a solve
+// whose residual (checked every 1,000 sweeps) no longer halves is stalled; after kMaxSweeps the last
 // sweep's impulse is kept when its coulomb_residual is acceptable (StalledSolves; counted in
 // stalled); otherwise throws SimulationFailure. what: for the message.
 void coulomb_gauss_seidel(const Eigen::MatrixXd& delassus, const Eigen::VectorXd& g,
