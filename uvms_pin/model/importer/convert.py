@@ -24,6 +24,7 @@ from uvms_pin.hydro.params import HydroParams
 from uvms_pin.model.importer.collision_volume import collision_volume
 from uvms_pin.model.importer.fossen import fossen_hydro
 from uvms_pin.model.importer.gz_hydrodynamics import gz_hydrodynamics
+from uvms_pin.model.importer.includes import inline_includes
 from uvms_pin.model.importer.plugins import PluginKind, plugin_kind
 from uvms_pin.model.importer.result import ImportedThruster, ImportResult
 from uvms_pin.model.importer.sdf import sdf_model, sdf_to_urdf
@@ -97,6 +98,10 @@ def _read_source(path: Path, notes: list[str]) -> tuple[ET.Element, list[ET.Elem
     where = str(path)
     root = xml_root(path)
     if root.tag == "sdf":
+        inline_includes(root, path, notes)
+        for world in root.iter("world"):  # the GUI's plugins are not the vehicle's
+            for gui in world.findall("gui"):
+                world.remove(gui)
         robot = sdf_to_urdf(sdf_model(root, where), where, notes)
         return robot, list(root.iter("plugin")), "sdf"
     if root.tag != "robot":
