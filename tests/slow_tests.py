@@ -65,6 +65,8 @@ SLOW_TESTS = frozenset(
         "tests/control/test_mpc_campaign.py::test_mpc_runs_end_to_end_shortened_and_twice_bit_for_bit",
         "tests/flow/test_flow_core.py::test_the_sea_state_closed_loop_is_the_same_on_both_backends",
         "tests/model/importer/test_imported_vehicle_runs.py::test_the_imported_lrauv_with_passive_fins_runs_a_minute_or_is_refused",
+        "tests/model/importer/test_imported_vehicle_runs.py::test_the_imported_lrauv_with_lifting_fins_runs_a_minute_and_its_fins_only_take_energy",
+        "tests/model/importer/test_imported_vehicle_runs.py::test_the_imported_lrauv_steers_with_its_rudder_held_as_a_joint",
         "tests/model/test_mount.py::test_compare_arms_runs_the_force_task",
         "tests/ocp/test_csqp.py::test_csqp_keeps_station_with_saturated_thrusters_like_boxfddp",
         "tests/ocp/test_node_errors.py::test_an_error_in_a_node_reaches_the_caller_of_solve",

@@ -44,6 +44,18 @@ _VARIANTS = [
     (
         "passive_still_water.toml",
         {
+            "controller": {
+                "type": "joint_hold",
+                "positions_rad": {"arm_joint1": 0.1},
+                "stiffness_Nm_rad": 2.0,
+                "damping_Nms_rad": 0.1,
+                "vehicle_wrench_body": [1.0, 0.0, 0.0, 0.0, 0.0, 0.0],
+            }
+        },
+    ),
+    (
+        "passive_still_water.toml",
+        {
             "controller.type": "computed_torque",
             "controller.model_error": {
                 "mass_scale": 1.3,

@@ -147,7 +147,7 @@ def test_ppc_records_its_resolved_parameters():
         ('type = "my_ctrl_c:"', "expected 'package.module:ClassName'"),
         (
             'type = "pcc"',
-            "must be one of computed_torque, impedance, mpc, none, pi_force, ppc, "
+            "must be one of computed_torque, impedance, joint_hold, mpc, none, pi_force, ppc, "
             "resolved_acceleration, task_priority or 'package.module:ClassName', got 'pcc' "
             "(did you mean 'ppc'?)",
         ),

@@ -1,7 +1,8 @@
 """Documents built from the documented keys, for the generated-input tests: the shipped
 scenarios and studies (every key they use, [[robots]] entries' too), the tables the docs show
-(sensors.md's cameras and sonars) and one ``[[world.objects]]`` of every registered kind and a
-fixture, mutated by a few edits each
+(sensors.md's cameras and sonars), the documented keys and tables no shipped scenario
+uses (`UNSHIPPED_KEYS`, `UNSHIPPED_TABLES`) and one ``[[world.objects]]`` of every
+registered kind and a fixture, mutated by a few edits each
 (a value of any type, size and sign, NaN and infinities; a key removed or added; a table
 grafted from another document; a list resized; an element of an array of tables twice).
 
@@ -88,12 +89,31 @@ DONORS: list[tuple[tuple[str, ...], Any]] = [
     )
 ]
 DONORS += [(("world", "objects"), [table]) for table in _object_tables()]
+#: documented keys no shipped scenario uses: (table, key, a valid value, a document holding
+#: the table), each grafted as that document's table with the key set
+UNSHIPPED_KEYS = (
+    ("actuation", "thruster_curve", "t200_16v", "bluerov_alpha5_force_tracking.toml"),
+)
+DONORS += [
+    ((table,), {**SCENARIOS[doc][table], key: value}) for table, key, value, doc in UNSHIPPED_KEYS
+]
+#: documented tables no shipped scenario holds, grafted whole
+UNSHIPPED_TABLES = (
+    (
+        ("controller",),
+        {"type": "joint_hold", "positions_rad": {"arm_joint1": 0.2}, "stiffness_Nm_rad": 2.0,
+         "damping_Nms_rad": 0.1, "vehicle_wrench_body": [5.0, 0.0, 0.0, 0.0, 0.0, 0.0]},
+    ),
+)  # fmt: skip
+DONORS += list(UNSHIPPED_TABLES)
 
 EDGE_NUMBERS = (0, -0.0, -1, 1e-300, 1e300, math.nan, math.inf, -math.inf, 2**63, -(2**63) - 1,
                 10**30, 1e-9, 1e9, 0.5, -0.5, 3)  # fmt: skip
 KEY_NAMES = sorted(
     {k for doc in SCENARIOS.values() for t in doc.values() if isinstance(t, dict) for k in t}
     | {k for doc in SCENARIOS.values() for entry in _robot_entries(doc) for k in entry}
+    | {key for _, key, _, _ in UNSHIPPED_KEYS}
+    | {key for _, table in UNSHIPPED_TABLES for key in table}
 )
 #: the tables a [[robots]] entry holds, from every document: what `_graft_robot` gives one
 ROBOT_DONORS = [(p[0], value) for p, value in DONORS if len(p) == 1 and p[0] in ROBOT_TABLES]

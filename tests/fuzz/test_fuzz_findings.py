@@ -180,3 +180,14 @@ def test_a_plane_normal_of_1e300_is_a_direction_not_a_nan():
     )
     np.testing.assert_allclose(params["normal_world"], [1.0, 0.0, 1e-300], rtol=1e-15)
     assert np.all(np.isfinite(params["normal_world"]))
+
+
+def test_a_camera_water_type_that_is_no_name_is_refused_by_key():
+    """Was: TypeError: unhashable type: 'list' (a list looked up among the Jerlov types)."""
+    import tomllib
+
+    path = ROOT / "scenarios" / "visual_approach.toml"
+    doc = tomllib.loads(path.read_text())
+    doc["sensors"]["camera"][0]["water_type"] = ["IB"]
+    with pytest.raises(ScenarioError, match=r"water_type must be a Jerlov type .* got \['IB'\]"):
+        scenario_from_dict(doc, path)

@@ -30,7 +30,8 @@ def test_geometry_matches_von_benzon_layout():
 
 def test_t200_limits_at_16_volts():
     assert T200_16V.max_forward_N == pytest.approx(5.25 * 9.80665)
-    assert T200_16V.max_reverse_N == pytest.approx(4.1 * 9.80665)
+    # the measured table's end at 1100 us (the technical details round it to 4.1 kgf)
+    assert T200_16V.max_reverse_N == pytest.approx(4.07 * 9.80665, rel=1e-15)
     assert T200_16V.thrust_N(1.0) == pytest.approx(T200_16V.max_forward_N)
     assert T200_16V.thrust_N(-1.0) == pytest.approx(-T200_16V.max_reverse_N)
     assert T200_16V.thrust_N(0.5) == pytest.approx(0.25 * T200_16V.max_forward_N)

@@ -271,6 +271,22 @@ def test_force_error_after_the_transient_is_the_ripple():
     )
 
 
+def test_without_a_force_funnel_the_after_transient_errors_are_left_out_not_null():
+    """The MPC and the baselines have no funnel to end a transient: no NaN (null in
+    metrics.json) for them, the keys are absent; the whole run's errors stay."""
+    r, _, _ = tracking_run()
+    del r.signals["rho_x"]
+    m = force_tracking_metrics(r)
+    for key in (
+        "transient_end_s",
+        "force_error_rms_after_transient_N",
+        "force_error_max_after_transient_N",
+    ):
+        assert key not in m and key not in compute_metrics(r)
+    assert m["force_error_max_N"] == pytest.approx(0.4, rel=1e-12)
+    assert all(math.isfinite(value) for value in m.values())
+
+
 def test_overshoot_is_the_largest_error_past_the_desired_force():
     r, _, _ = tracking_run()
     # the x error starts negative (-0.4 N) and goes up to +0.15 N

@@ -107,3 +107,89 @@ def test_a_robots_controller_module_and_model_are_judged_as_the_single_robots():
     raw["robots"][0]["model"] = "/etc/passwd"
     with pytest.raises(ScenarioError, match=r"robots\[0\]\.model: reads /etc/passwd"):
         check_no_code(raw, two)
+
+
+def _model_with_mesh(folder: Path, filename: str, where: str = "visual") -> Path:
+    """The LBV150 with one more <visual> or <collision> mesh on its first link."""
+    text = (ROOT / "models" / "uvms_lbv150.urdf").read_text()
+    start = text.index("<link name=")
+    end = text.index(">", start) + 1
+    mesh = f'<{where}><geometry><mesh filename="{filename}"/></geometry></{where}>'
+    (folder / "model.urdf").write_text(text[:end] + mesh + text[end:])
+    return folder / "model.urdf"
+
+
+def test_a_models_mesh_outside_the_folder_is_refused_with_the_model_and_the_file(tmp_path):
+    ours, elsewhere = tmp_path / "ours", tmp_path / "elsewhere"
+    (ours / "meshes").mkdir(parents=True), elsewhere.mkdir()
+    (elsewhere / "secret.obj").write_text("v 0 0 0\n")
+    (ours / "meshes" / "rock.obj").write_text("v 0 0 0\n")
+    (ours / "meshes" / "link.obj").symlink_to(elsewhere / "secret.obj")
+    path = _scenario(ours, "", "model.urdf")
+    for inside in ("meshes/rock.obj", f"file://{ours / 'meshes' / 'rock.obj'}"):
+        _model_with_mesh(ours, inside)
+        check_no_code(tomllib.loads(path.read_text()), path)
+    for where in ("visual", "collision"):
+        for outside in (
+            "../elsewhere/secret.obj",
+            str(elsewhere / "secret.obj"),
+            f"file://{elsewhere / 'secret.obj'}",
+            "meshes/link.obj",
+            "../elsewhere/missing.obj",  # judged where the reader would look
+        ):
+            _model_with_mesh(ours, outside, where)
+            pattern = (
+                rf"scenario\.model \(model\.urdf\) <mesh filename='{outside}'>: reads "
+                rf"{elsewhere}/(secret|missing)\.obj, outside the scenario's folder"
+            )
+            with pytest.raises(ScenarioError, match=pattern):
+                check_no_code(tomllib.loads(path.read_text()), path)
+
+
+def test_the_cli_refuses_a_models_outside_mesh_before_reading_it(tmp_path, capsys, monkeypatch):
+    ours = tmp_path / "ours"
+    ours.mkdir()
+    (tmp_path / "secret.obj").write_text("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n")
+    _model_with_mesh(ours, "../secret.obj")
+    path = _scenario(ours, "", "model.urdf")
+    opened = []
+    real_open = open
+
+    def watched_open(file, *args, **kwargs):
+        opened.append(str(file))
+        return real_open(file, *args, **kwargs)
+
+    monkeypatch.setattr("builtins.open", watched_open)
+    out = tmp_path / "out"
+    assert main(["run", str(path), "--no-code", "--html", "--out", str(out), "--quiet"]) == 2
+    assert "<mesh filename='../secret.obj'>: reads" in capsys.readouterr().err
+    assert not out.exists() and not any("secret" in name for name in opened)
+
+
+def test_a_fixtures_and_a_robots_meshes_are_judged_too(tmp_path):
+    ours = tmp_path / "ours"
+    ours.mkdir()
+    text = (ROOT / "models" / "fixtures" / "subsea_panel_valve.urdf").read_text()
+    start = text.index("<link name=")
+    end = text.index(">", start) + 1
+    mesh = '<visual><geometry><mesh filename="/etc/passwd"/></geometry></visual>'
+    (ours / "panel.urdf").write_text(text[:end] + mesh + text[end:])
+    body = """
+        [[world.objects]]
+        type = "urdf"
+        name = "panel"
+        path = "panel.urdf"
+        position_world_m = [0.8, 0.0, -2.0]
+    """
+    path = _scenario(ours, body)
+    with pytest.raises(
+        ScenarioError,
+        match=r"world\.objects\[0\]\.path \(panel\.urdf\) <mesh filename='/etc/passwd'>: reads",
+    ):
+        check_no_code(tomllib.loads(path.read_text()), path)
+    _model_with_mesh(ours, "/etc/passwd")
+    raw = tomllib.loads((SCENARIOS / "two_robots.toml").read_text())
+    raw["robots"][0]["model"] = "uvms_bluerov2_alpha5"  # shipped: its name
+    raw["robots"][1]["model"] = "model.urdf"
+    with pytest.raises(ScenarioError, match=r"robots\[1\]\.model \(model\.urdf\) <mesh filename="):
+        check_no_code(raw, ours / "two.toml")

@@ -21,11 +21,12 @@ from uvms_pin.checks import Plausible
 from uvms_pin.errors import ModelError
 from uvms_pin.hydro.added_mass import added_mass_in_parent
 from uvms_pin.hydro.hull import HullPiece
+from uvms_pin.hydro.lift_drag import LiftDragParams
 from uvms_pin.hydro.params import HydroParams
 from uvms_pin.model.arm_joints import ArmJoints
 from uvms_pin.model.hulls import SurfaceBodies
 
-__all__ = ["DEFAULT_WATER_DENSITY_KG_M3", "UVMS", "HydroBody"]
+__all__ = ["DEFAULT_WATER_DENSITY_KG_M3", "UVMS", "Fin", "HydroBody"]
 
 DEFAULT_WATER_DENSITY_KG_M3 = 1025.0  # sea water; a parameter of load_uvms, never hidden
 
@@ -77,6 +78,27 @@ class HydroBody:
         return self.placement_in_joint.inverse().action
 
 
+@dataclass(frozen=True)
+class Fin:
+    """A lifting surface on one link (gz-sim's ``LiftDrag``; `uvms_pin.hydro.lift_drag`).
+
+    Attributes:
+        name: the URDF link.
+        joint_id: index of the Pinocchio joint whose body carries the link.
+        placement_in_joint: SE3 of the link frame (where ``params`` are given) in the joint
+            frame.
+        params: the fin's coefficients, centre of pressure and directions, link frame.
+        control_q_index: the index in q of the control joint whose angle changes the lift
+            (``control_joint_rad_to_cl``), or None: the fin's own link turns with its joint.
+    """
+
+    name: str
+    joint_id: int
+    placement_in_joint: pin.SE3
+    params: LiftDragParams
+    control_q_index: int | None = None
+
+
 @dataclass
 class UVMS:
     """A loaded underwater vehicle-manipulator system (static model plus a work buffer).
@@ -91,6 +113,8 @@ class UVMS:
             the wrist force/torque sensor, or None for a model without them (a vehicle
             alone): what needs them asks through `require_ee_frame`.
         source: path of the URDF file.
+        fins: the links' lifting surfaces (``<lift_drag>``), a force of the plant's
+            (`uvms_pin.physics.fins`), not of `forward_dynamics`.
     """
 
     model: pin.Model
@@ -99,6 +123,7 @@ class UVMS:
     ee_frame_id: int | None
     sensor_frame_id: int | None
     source: str = ""
+    fins: tuple[Fin, ...] = ()
     data: pin.Data = field(init=False, repr=False)
     added_mass_per_joint: np.ndarray = field(init=False, repr=False)
     hydro_bodies_with_damping: tuple[HydroBody, ...] = field(init=False, repr=False)

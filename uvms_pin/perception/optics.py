@@ -70,7 +70,7 @@ class WaterOptics:
     backscatter_albedo: float = 0.2
 
     def __post_init__(self) -> None:
-        if self.water_type not in JERLOV_KD_PER_M:
+        if not isinstance(self.water_type, str) or self.water_type not in JERLOV_KD_PER_M:
             raise ParameterError(
                 f"water_type must be a Jerlov type ({', '.join(JERLOV_KD_PER_M)}), "
                 f"got {self.water_type!r}"

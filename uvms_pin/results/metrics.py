@@ -9,6 +9,7 @@ import numpy as np
 
 from uvms_pin.results.estimate_metrics import estimate_metrics
 from uvms_pin.results.extra_metrics import extra_metrics
+from uvms_pin.results.free_objects import free_object_metrics
 from uvms_pin.results.joint_positions import KINDS, REVOLUTE, arm_positions, configuration_width
 from uvms_pin.results.task_metrics import task_metrics
 
@@ -66,6 +67,7 @@ def compute_metrics(rollout: RolloutData) -> dict[str, float]:
     out.update(joint_limit_metrics(rollout))
     out.update(surface_metrics(rollout))
     out.update(world_contact_metrics(rollout))
+    out.update(free_object_metrics(rollout))
     out.update(task_metrics(rollout))
     out.update(estimate_metrics(rollout))
     out.update(extra_metrics(rollout, out))
@@ -231,7 +233,11 @@ def force_tracking_metrics(rollout: RolloutData) -> dict[str, float]:
     """Force-control metrics from a run that logged the controller's signals.
 
     Force error is the TRUE one, f_e - f_d (the sensor's noise excluded), per component;
-    "after transient" starts at `transient_end_s`. Overshoot: the largest error of the
+    "after transient" starts at `transient_end_s`, the time the force funnel has closed: a
+    run without a force funnel (the MPC, the baselines) has no such time, and its
+    ``transient_end_s`` and after-transient errors are left out rather than given as NaN
+    (the whole run's ``force_error_rms_N`` and ``force_error_max_N`` are there; `uvms-pin
+    compare-controllers` judges every controller after one window, ``--after``). Overshoot: the largest error of the
     opposite sign to the initial error, over every force component [N]. Funnel margin:
     min over time and components of 1 - |xi| per level (> 0 means the funnel held).
     """
@@ -241,18 +247,19 @@ def force_tracking_metrics(rollout: RolloutData) -> dict[str, float]:
     desired = signals["force_desired_world_N"]
     error = rollout.wrench_contact_world[:, :3] - desired
     norm = np.linalg.norm(error, axis=1)
-    t_transient = transient_end_s(rollout)
-    after = rollout.time_s >= t_transient
     out = {
         "force_error_rms_N": _rms(norm),
         "force_error_max_N": float(norm.max()),
-        "transient_end_s": t_transient,
-        "force_error_rms_after_transient_N": _rms(norm[after]),
-        "force_error_max_after_transient_N": float(norm[after].max())
-        if np.any(after)
-        else math.nan,
         "force_overshoot_N": force_overshoot_N(error),
     }
+    t_transient = transient_end_s(rollout)
+    if math.isfinite(t_transient):  # a funnel's last sample is always within it: never empty
+        after = rollout.time_s >= t_transient
+        out.update(
+            transient_end_s=t_transient,
+            force_error_rms_after_transient_N=_rms(norm[after]),
+            force_error_max_after_transient_N=float(norm[after].max()),
+        )
     for level, key in (("first", "xi_x"), ("second", "xi_zeta")):
         if key in signals:
             out[f"funnel_margin_min_{level}"] = float(np.min(1.0 - np.abs(signals[key])))

@@ -69,6 +69,7 @@ RUN = OutputKind(
         "tracking.png",  # runs with a tracking task ([task])
         "estimate.png",  # runs with a navigation estimator ([estimator])
         "objects.png",  # runs with free objects ([world.objects] with a mass or density)
+        "contacts.png",  # runs with a world ([world.objects], a seabed)
     ),
     ("rollout.npz", "rollout.json", "metrics.json", "replay.html"),
 )

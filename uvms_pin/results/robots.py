@@ -14,10 +14,9 @@ from collections.abc import Mapping
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
-import numpy as np
-
 from uvms_pin.errors import ParameterError
 from uvms_pin.results.atomic import write_json_atomic
+from uvms_pin.results.free_objects import free_object_summary
 from uvms_pin.results.rollout import Rollout
 from uvms_pin.results.status import RunStatus
 
@@ -69,27 +68,11 @@ class RobotRollouts:
 
     def object_metrics(self) -> dict[str, dict[str, float]]:
         """Each free object's summary, by name (the objects are the first robot's rollout's
-        signal ``free_objects``): where it ended (``final_x_m``, ``final_y_m``,
-        ``final_z_m``), how far it moved from where it started (``displacement_m``) and its
-        greatest speed (``max_speed_m_s``); none without free objects."""
-        first = next(iter(self.rollouts.values()))
-        states = first.signals.get("free_objects")
-        world = (first.metadata.get("world") or {}).get("world") or {}
-        names = [o["name"] for o in world.get("free_objects", [])]
-        if states is None or not len(first) or not names:
-            return {}
-        out = {}
-        for k, name in enumerate(names):
-            own = states[:, 13 * k : 13 * (k + 1)]
-            final = own[-1, :3]
-            out[name] = {
-                "final_x_m": float(final[0]),
-                "final_y_m": float(final[1]),
-                "final_z_m": float(final[2]),
-                "displacement_m": float(np.linalg.norm(final - own[0, :3])),
-                "max_speed_m_s": float(np.linalg.norm(own[:, 7:10], axis=1).max()),
-            }
-        return out
+        signal ``free_objects``; `uvms_pin.results.free_objects.free_object_summary`): where
+        it ended (``final_x_m``, ``final_y_m``, ``final_z_m``), how far it moved from where it
+        started (``displacement_m``) and its greatest speed (``max_speed_m_s``); none without
+        free objects."""
+        return free_object_summary(next(iter(self.rollouts.values())))
 
     def to_dataframe(self) -> pd.DataFrame:
         """Every robot's table (`Rollout.to_dataframe`) side by side on the time index,

@@ -1,6 +1,9 @@
 """``[actuation]``: the vehicle's thrusters (``[[actuation.thruster]]``) and the arm's joint
 torque limits; without the table every DoF is actuated without limit.
 
+``thruster_curve`` (one of `CURVES`, default "linear") is every thruster's ``curve`` unless
+its entry names its own: one key switches a vehicle's thrusters to the T200 table.
+
 A thruster entry: ``name``, ``position_body_m``, ``direction_body``, ``max_forward_N``,
 ``max_reverse_N`` (the allocation's limits); its drive: ``curve`` ("linear", "quadratic",
 "t200_16v"), ``deadband`` (quadratic: the command fraction giving no thrust),
@@ -30,7 +33,8 @@ def build_actuation(t: Table | None, uvms: UVMS) -> Actuation:
     entries = t.tables("thruster")
     if not entries:
         raise t.fail("needs at least one [[actuation.thruster]]")
-    parts = [_thruster(e, k) for k, e in enumerate(entries)]
+    default_curve = t.string("thruster_curve", "linear", CURVES)
+    parts = [_thruster(e, k, default_curve) for k, e in enumerate(entries)]
     parts = _shared_curves(parts)
     thrusters = [p[0] for p in parts]
     drives = ThrusterDrives([p[1] for p in parts], [p[2] for p in parts], [p[3] for p in parts])
@@ -45,12 +49,13 @@ def build_actuation(t: Table | None, uvms: UVMS) -> Actuation:
         raise t.fail(str(exc)) from exc
 
 
-def _thruster(t: Table, k: int) -> tuple[Thruster, ThrustCurve, float, float]:
-    """(the thruster, its curve, its time constant [s], its rate limit [N/s])."""
+def _thruster(t: Table, k: int, default_curve: str) -> tuple[Thruster, ThrustCurve, float, float]:
+    """(the thruster, its curve (``default_curve`` unless it names one), its time constant
+    [s], its rate limit [N/s])."""
     name = t.string("name", f"thruster{k}")
     position = t.vector("position_body_m", 3)
     direction = t.vector("direction_body", 3)
-    kind = t.string("curve", "linear", CURVES)
+    kind = t.string("curve", default_curve, CURVES)
     table_curve = t200_16v_curve() if kind == "t200_16v" else None
     # a tabulated curve brings its own limits; lower ones may be given
     forward = t.number(

@@ -5,7 +5,8 @@ and what the rollout records).
 registers its own: "none" (zero input, here), "ppc" (the paper's law, `uvms_pin.scenario.ppc`),
 a baseline ("pi_force", "impedance", "computed_torque": `uvms_pin.scenario.baselines`), "mpc"
 (model-predictive control, `uvms_pin.scenario.mpc`), with a ``[task]`` "task_priority" or
-"resolved_acceleration" (`uvms_pin.scenario.tracking_controllers`); or
+"resolved_acceleration" (`uvms_pin.scenario.tracking_controllers`), "joint_hold" (arm
+joints held at set angles and a constant push: `uvms_pin.scenario.joint_hold`); or
 "package.module:ClassName", your own (`uvms_pin.scenario.custom_controller`).
 
 The controller is built once here (`ControllerSpec.checked`), so that a bad parameter is
@@ -21,13 +22,13 @@ from uvms_pin.control.base import Controller, ZeroController
 from uvms_pin.control.spec import ControllerSpec
 from uvms_pin.errors import ParameterError
 from uvms_pin.model.uvms import UVMS
-from uvms_pin.scenario import baselines, mpc, ppc, tracking_controllers
+from uvms_pin.scenario import baselines, joint_hold, mpc, ppc, tracking_controllers
 from uvms_pin.scenario.controller_parts import CONTROLLERS, ControllerContext
 from uvms_pin.scenario.custom_controller import read_custom
 from uvms_pin.scenario.schema import Table
 
 #: the modules that register their readers in `CONTROLLERS` (imported for that)
-REGISTERING_MODULES = (ppc, mpc, baselines, tracking_controllers)
+REGISTERING_MODULES = (ppc, mpc, baselines, tracking_controllers, joint_hold)
 
 
 def _zero(uvms: UVMS) -> Controller:

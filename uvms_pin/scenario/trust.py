@@ -5,7 +5,9 @@ A scenario file is code when it names code: ``[controller] type = "module:Class"
 ``[metrics] extra = ["module:function"]`` import (run) a module with the user's rights, from
 the scenario's folder or anywhere on ``sys.path``. It also names files uvms-pin reads:
 ``[scenario] model`` (a URDF) and the ``path`` of a ``[[world.objects]]`` mesh or fixture; each
-``[[robots]]`` entry its controller and model likewise. With
+``[[robots]]`` entry its controller and model likewise; and a URDF it names (the model, a
+fixture) names files in turn: its ``<mesh filename>`` (visual and collision) and any other
+``filename`` attribute, read by the loader and by the replay's drawing. With
 ``--no-code`` (`check_no_code`), a scenario is refused, before anything is imported or read,
 when it names any module, or a file outside its own folder (and the folders below it) and the
 shipped models; the names are judged as the reader will resolve them (symbolic links
@@ -14,13 +16,14 @@ followed), on the table after the ``--set`` overrides.
 
 from __future__ import annotations
 
+import xml.etree.ElementTree as ET
 from collections.abc import Iterator, Mapping
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
 from uvms_pin.errors import ParameterError, ScenarioError
-from uvms_pin.model.resources import find_model, shipped_path
+from uvms_pin.model.resources import find_model, resolve_resource, shipped_path
 from uvms_pin.physics.world.fixture import FIXTURE_TYPE, fixture_path
 from uvms_pin.physics.world.objects import kind_names, object_kind
 
@@ -56,12 +59,15 @@ def reaches(raw: Mapping[str, Any], scenario_dir: Path) -> Iterator[Reach]:
     if isinstance(model, str) and model.strip():
         found = find_model(model, scenario_dir)
         yield Reach("scenario.model", path=found or (scenario_dir / model).resolve())
+        yield from _urdf_reaches("scenario.model", found)
     yield from _robot_reaches(raw, scenario_dir)
     world = raw.get("world")
     objects = world.get("objects") if isinstance(world, Mapping) else None
     for k, table in enumerate(objects if isinstance(objects, list) else []):
         if isinstance(table, Mapping) and table.get("type") == FIXTURE_TYPE:
-            yield _fixture_reach(f"world.objects[{k}].path", table.get("path"), scenario_dir)
+            fixture = _fixture_reach(f"world.objects[{k}].path", table.get("path"), scenario_dir)
+            yield fixture
+            yield from _urdf_reaches(fixture.key, fixture.path)
             continue
         if not isinstance(table, Mapping) or table.get("type") not in kind_names():
             continue
@@ -69,6 +75,32 @@ def reaches(raw: Mapping[str, Any], scenario_dir: Path) -> Iterator[Reach]:
             entry = table.get(key.name, key.default)
             if key.holds == "path" and isinstance(entry, str):
                 yield Reach(f"world.objects[{k}].{key.name}", path=(scenario_dir / entry).resolve())
+
+
+def _urdf_reaches(key: str, urdf: Path | None) -> Iterator[Reach]:
+    """The files a URDF names in ``filename`` attributes (meshes, visual and collision), as
+    its readers resolve them (`resolve_resource`: relative to the URDF's folder, ``file://``,
+    ``package://``); after the URDF's own `Reach`, so that a caller stopping at a URDF
+    outside reads nothing of it. A URDF that cannot be read, or a name that resolves to no
+    file through ``package://``, is left to the reader, which refuses it."""
+    if urdf is None or not urdf.is_file():
+        return
+    try:
+        root = ET.parse(urdf).getroot()
+    except (OSError, ET.ParseError):
+        return
+    for element in root.iter():
+        filename = element.get("filename")
+        if not filename:
+            continue
+        found = resolve_resource(filename, urdf.parent)
+        if found is None and filename.startswith("package://"):
+            continue
+        named = Path(filename.removeprefix("file://"))
+        path = found if found is not None else urdf.parent / named
+        yield Reach(
+            f"{key} ({urdf.name}) <{element.tag} filename='{filename}'>", path=path.resolve()
+        )
 
 
 def _fixture_reach(key: str, entry: Any, scenario_dir: Path) -> Reach:

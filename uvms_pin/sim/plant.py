@@ -8,7 +8,8 @@ is stepped belong to the system of bodies (`uvms_pin.sim.system.System`).
 With ``backend="core"`` (default) the right-hand side runs in the compiled core: the plant's
 counterpart (`src/uvms_core/plant.hpp`, built in `uvms_pin.sim.compiled.plant`) mirrors its
 flow, contact, disturbance, joint stops, joint friction and world, rebuilt when a run starts
-(`attach`) or on first use; when one part has none (e.g. a disturbance written in Python) the
+(`attach`) or on first use; when one part has none (e.g. a disturbance written in Python, or
+the model's fins: `uvms_pin.physics.fins`) the
 plant computes on the Python reference and says so once with a `CoreFallbackWarning`. The
 world contacts' friction state (`friction`, a `FrictionMemory`) stays on this plant for both
 backends: the compiled calls read it and write it back.
@@ -32,6 +33,7 @@ from uvms_pin.physics.constraints.joint_limits import JointLimits
 from uvms_pin.physics.contact import ContactModel
 from uvms_pin.physics.disturbance import Disturbance
 from uvms_pin.physics.dynamics import forward_dynamics
+from uvms_pin.physics.fins import fin_generalized_force, fin_wrenches_world
 from uvms_pin.physics.joint_friction import JointFriction
 from uvms_pin.physics.joint_stops import JointStops
 from uvms_pin.physics.surface import wet_state
@@ -111,6 +113,7 @@ class Plant:
         self._backend: Backend = backend_named(self.backend)
         self._ee_data = self.uvms.model.createData()
         self._world_data = self.uvms.model.createData()
+        self._fin_data = self.uvms.model.createData()
         self.friction = FrictionMemory()  # the world contacts' state (anchors)
         self.water = water_of(self.current_world_m_s, self.flow)
 
@@ -288,6 +291,9 @@ class Plant:
             tau_ext[:6] -= self.disturbance_wrench(time_s)
         if self.world is not None or self.joint_stops is not None or extra_torque is not None:
             tau_ext += self.external_torque(q, v, extra_torque)
+        if self.uvms.fins:  # lift and drag: the Python reference alone (plant_to_core)
+            wrenches = fin_wrenches_world(self.uvms, self._fin_data, q, v, self.water, time_s)
+            tau_ext += fin_generalized_force(self.uvms, self._fin_data, q, wrenches)
         return forward_dynamics(
             self.uvms,
             q,

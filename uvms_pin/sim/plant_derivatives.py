@@ -54,7 +54,7 @@ def acceleration_derivatives(
 
     Raises:
         ParameterError: the plant has a term whose derivatives are not implemented: free
-            objects or self-collision, an end-effector environment other than a linear
+            objects or self-collision, fins (lift and drag), an end-effector environment other than a linear
             spring or a compliant plane, or an active contact of an ellipsoid or with a
             solid object (coal's point).
     """
@@ -64,6 +64,11 @@ def acceleration_derivatives(
     if world is not None and (world.free or world.self_collision):
         raise ParameterError(
             "acceleration_derivatives: free objects and self-collision are not differentiated"
+        )
+    if plant.uvms.fins:
+        raise ParameterError(
+            "acceleration_derivatives: the fins' lift and drag (<lift_drag>) are not "
+            f"differentiated (fins on links {', '.join(f.name for f in plant.uvms.fins)})"
         )
     if compiled is not None:  # (a contact model without a counterpart: no compiled plant)
         out = compiled.acceleration_derivatives(

@@ -5,6 +5,7 @@ the BlueROV2 Heavy + Alpha 5 replay within its size bound."""
 from __future__ import annotations
 
 import xml.etree.ElementTree as ET
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -144,6 +145,28 @@ def test_a_mesh_visual_is_drawn_from_its_file_at_its_scale(tmp_path):
     matrix = np.array(placed["matrix"], dtype=float).reshape(4, 4).T  # column-major
     np.testing.assert_allclose(matrix, piece_placement(obj), atol=1e-6)
     np.testing.assert_allclose(np.linalg.norm(matrix[:3, :3], axis=0), [0.5, 0.25, 0.2])
+
+
+def test_a_relative_mesh_visual_is_found_from_the_urdfs_folder_as_the_loader_finds_it(
+    tmp_path, monkeypatch
+):
+    """pinocchio looks a relative mesh up in its package directories only: the URDF's folder
+    is one, so a model whose visuals sit beside it draws from any working directory; a
+    visual it cannot find is a VizError naming the URDF, not a ValueError."""
+    (tmp_path / "meshes").mkdir()
+    (tmp_path / "meshes" / "rock.obj").write_bytes((SCENARIOS / "meshes" / "rock.obj").read_bytes())
+    text = (ROOT / "models" / "bluerov2_heavy.urdf").read_text()
+    mesh = '<visual><geometry><mesh filename="{}"/></geometry></visual>\n  </link>'
+    urdf = tmp_path / "rov.urdf"
+    urdf.write_text(text.replace("</link>", mesh.format("meshes/rock.obj"), 1))
+    monkeypatch.chdir(ROOT)
+    uvms = up.load_uvms(urdf, ee_frame="base_link", sensor_frame="base_link")
+    paths = [o.meshPath for o in UvmsScene(uvms).geometry["visuals"].geometryObjects]
+    assert str(tmp_path / "meshes" / "rock.obj") in [str(Path(p).resolve()) for p in paths]
+    urdf.write_text(text.replace("</link>", mesh.format("meshes/none.obj"), 1))
+    uvms = up.load_uvms(urdf, ee_frame="base_link", sensor_frame="base_link")
+    with pytest.raises(VizError, match=r"rov\.urdf: cannot draw its visuals: .*none\.obj"):
+        UvmsScene(uvms)
 
 
 @pytest.fixture(scope="module")

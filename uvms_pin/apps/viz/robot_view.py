@@ -59,8 +59,13 @@ def geometry_groups(
                 f"{urdf}: no URDF file to read the {group[:-1]} geometry from"
                 + (" (pass visual_model=)" if group == "visuals" else "")
             )
-        extra = {"package_dirs": [str(d) for d in package_dirs]} if package_dirs else {}
-        out[group] = pin.buildGeomFromUrdf(model, str(urdf), kinds[group], **extra)
+        # pinocchio looks a relative mesh path up in package_dirs only: the URDF's folder
+        # last, so that it resolves as uvms-pin's own reader resolves it (its folder)
+        dirs = [*(str(d) for d in package_dirs), str(urdf.parent)]
+        try:
+            out[group] = pin.buildGeomFromUrdf(model, str(urdf), kinds[group], package_dirs=dirs)
+        except ValueError as exc:  # pinocchio: a mesh it cannot find or read
+            raise VizError(f"{urdf}: cannot draw its {group}: {exc}") from exc
     return out
 
 

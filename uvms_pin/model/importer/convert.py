@@ -6,7 +6,8 @@ it (`uvms_pin.model.importer.fossen`); or gz-sim's Hydrodynamics system for it
 (`uvms_pin.model.importer.gz_hydrodynamics`) with the buoyancy gz-sim's Buoyancy system
 gives it (its collision primitives' volume); or, with no plugin, that buoyancy alone when
 the file has a Buoyancy system, else nothing (a dry link, as in the simulator). Thruster
-links (a thruster plugin's propeller) leave the tree and become the thruster table.
+links (a thruster plugin's propeller) leave the tree and become the thruster table; a
+LiftDrag system's link gets a ``<lift_drag>`` (`uvms_pin.model.importer.lift_drag`).
 """
 
 from __future__ import annotations
@@ -24,6 +25,8 @@ from uvms_pin.hydro.params import HydroParams
 from uvms_pin.model.importer.collision_volume import collision_volume
 from uvms_pin.model.importer.fossen import fossen_hydro
 from uvms_pin.model.importer.gz_hydrodynamics import gz_hydrodynamics
+from uvms_pin.model.importer.includes import inline_includes
+from uvms_pin.model.importer.lift_drag import add_fins
 from uvms_pin.model.importer.plugins import PluginKind, plugin_kind
 from uvms_pin.model.importer.result import ImportedThruster, ImportResult
 from uvms_pin.model.importer.sdf import sdf_model, sdf_to_urdf
@@ -75,6 +78,7 @@ def import_model(
             path=where,
         )
     _finish_links(robot, hydro, where, notes)
+    add_fins(robot, plugins, where, notes)
     result = ImportResult(urdf_text(robot, where, notes), hydro, thrusters, density, notes, fmt)
     if out is not None:
         out = Path(out)
@@ -97,6 +101,10 @@ def _read_source(path: Path, notes: list[str]) -> tuple[ET.Element, list[ET.Elem
     where = str(path)
     root = xml_root(path)
     if root.tag == "sdf":
+        inline_includes(root, path, notes)
+        for world in root.iter("world"):  # the GUI's plugins are not the vehicle's
+            for gui in world.findall("gui"):
+                world.remove(gui)
         robot = sdf_to_urdf(sdf_model(root, where), where, notes)
         return robot, list(root.iter("plugin")), "sdf"
     if root.tag != "robot":

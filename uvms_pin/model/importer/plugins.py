@@ -17,10 +17,14 @@ class PluginKind(Enum):
     GZ_HYDRO = "gz-sim Hydrodynamics"
     GZ_THRUSTER = "gz-sim Thruster"
     GZ_BUOYANCY = "gz-sim Buoyancy"
+    GZ_LIFT_DRAG = "gz-sim LiftDrag"
 
 
 # (substring of filename or name, kind); first match wins
 _SIGNATURES = (
+    # not AdvancedLiftDrag (other parameters): its names hold neither string
+    ("systems::liftdrag", PluginKind.GZ_LIFT_DRAG),
+    ("gz-sim-lift-drag-system", PluginKind.GZ_LIFT_DRAG),
     ("underwater_object", PluginKind.UUV_HYDRO),
     ("uuv_thruster", PluginKind.UUV_THRUSTER),
     ("hydrodynamics", PluginKind.GZ_HYDRO),

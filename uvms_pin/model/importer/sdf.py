@@ -33,7 +33,7 @@ def sdf_model(root: ET.Element, where: str) -> ET.Element:
         names = [m.get("name") for m in root.iter("model")]
         raise ModelError(
             f"needs exactly one <model> with <link>s, found {len(models)} (models: {names}); "
-            "an <include>d model must be inlined first",
+            'a model nested in another is not supported: include it with merge="true"',
             path=where,
         )
     return models[0]

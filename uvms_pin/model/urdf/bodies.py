@@ -24,7 +24,7 @@ from uvms_pin.model.urdf.inertial import check_inertial
 from uvms_pin.model.urdf.read import single
 from uvms_pin.model.uvms import HydroBody
 
-__all__ = ["hydro_bodies"]
+__all__ = ["hydro_bodies", "link_carrier"]
 
 
 @dataclass
@@ -61,7 +61,7 @@ def hydro_bodies(
         if not _has_inertial(link, name in hydro_elements, where, name):
             continue  # a frame-only link: no body, no hydrodynamics
         mass_kg = check_inertial(single(link, "inertial", where, name), where, name)
-        joint_id, placement = _carrier(model, name, where)
+        joint_id, placement = link_carrier(model, name, where)
         hydro = hydro_elements.get(name)
         collisions = link.findall("collision")
         if hydro is not None:
@@ -139,7 +139,7 @@ def _has_inertial(link: ET.Element, has_hydro: bool, where: str, name: str) -> b
     return has_inertial
 
 
-def _carrier(model: pin.Model, link: str, where: str) -> tuple[int, pin.SE3]:
+def link_carrier(model: pin.Model, link: str, where: str) -> tuple[int, pin.SE3]:
     """(Pinocchio joint whose body carries ``link``, the link's placement in its frame)."""
     frame_id = model.getFrameId(link, pin.BODY)
     if frame_id >= len(model.frames):

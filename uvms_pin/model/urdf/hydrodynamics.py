@@ -20,7 +20,7 @@ import numpy as np
 
 from uvms_pin.errors import ModelError, ParameterError
 from uvms_pin.hydro.params import HydroParams
-from uvms_pin.model.urdf.read import read_numbers, single
+from uvms_pin.model.urdf.read import known_children, read_numbers, single
 
 __all__ = ["HYDRO_TAGS", "hydro_elements_by_link", "parse_hydro"]
 
@@ -55,13 +55,7 @@ def hydro_elements_by_link(
 
 def parse_hydro(element: ET.Element, where: str, link: str) -> HydroParams:
     """The coefficients a <hydrodynamics> element gives (absent matrices are zero)."""
-    for child in element:
-        if child.tag not in HYDRO_TAGS:
-            raise ModelError(
-                f"unknown tag <{child.tag}> in <hydrodynamics>; known: {', '.join(sorted(HYDRO_TAGS))}",
-                path=where,
-                link=link,
-            )
+    known_children(element, HYDRO_TAGS, where, link)
     volume_el = single(element, "volume", where, link)
     if volume_el is None:
         raise ModelError("<hydrodynamics> has no <volume>", path=where, link=link)

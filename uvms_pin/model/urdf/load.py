@@ -16,6 +16,7 @@ from uvms_pin.errors import ModelError, ModelWarning, ParameterError
 from uvms_pin.model.native_stderr import captured_native_stderr
 from uvms_pin.model.urdf.bodies import hydro_bodies
 from uvms_pin.model.urdf.hydrodynamics import hydro_elements_by_link
+from uvms_pin.model.urdf.lift_drag import read_fins
 from uvms_pin.model.urdf.read import read_numbers, read_urdf_root, single
 from uvms_pin.model.uvms import BODY_DENSITY, DEFAULT_WATER_DENSITY_KG_M3, UVMS, WATER_DENSITY
 
@@ -88,6 +89,7 @@ def load_uvms(
         ee_frame_id=_optional_frame_id(model, ee_frame, DEFAULT_EE_FRAME, where),
         sensor_frame_id=_optional_frame_id(model, sensor_frame, DEFAULT_SENSOR_FRAME, where),
         source=where,
+        fins=read_fins(root, model, where),
     )
     uvms.arm_joints  # noqa: B018 - refuses a planar or floating arm joint now, naming it
     _check_densities(uvms, where)

@@ -11,7 +11,7 @@ import pinocchio as pin
 
 from uvms_pin.errors import ModelError
 
-__all__ = ["read_numbers", "read_origin", "read_urdf_root"]
+__all__ = ["known_children", "read_numbers", "read_origin", "read_urdf_root"]
 
 
 def xml_root(path: Path) -> ET.Element:
@@ -72,3 +72,14 @@ def single(element: ET.Element, tag: str, where: str, link: str) -> ET.Element |
             f"<{element.tag}> has {len(found)} <{tag}> elements; give one", path=where, link=link
         )
     return found[0] if found else None
+
+
+def known_children(element: ET.Element, known, where: str, link: str) -> None:
+    """ModelError naming the first child of ``element`` whose tag is not in ``known``."""
+    for child in element:
+        if child.tag not in known:
+            raise ModelError(
+                f"unknown tag <{child.tag}> in <{element.tag}>; known: {', '.join(sorted(known))}",
+                path=where,
+                link=link,
+            )

@@ -7,8 +7,10 @@ y starboard, z down) and converted here to the body frame x forward, y left, z u
 45 deg off the surge axis; vertical thrusters at (+-0.120, +-0.218, 0) m, axes along z.
 Positive thrust pushes along ``direction_body``; every T200 can thrust both ways.
 
-T200 thrust (Blue Robotics T200 technical details, 16 V): 5.25 kgf forward, 4.1 kgf
-reverse (the nozzle favours the forward direction). `T200.thrust_N` is the quadratic
+T200 thrust at 16 V: the ends of Blue Robotics' measured table (`uvms_pin.model.vehicles.t200`,
+1900 and 1100 us): 5.25 kgf forward, 4.07 kgf reverse (the nozzle favours the forward
+direction; the technical details round the reverse to 4.1 kgf). The scenarios' limits and
+``curve = "t200_16v"`` therefore agree. `T200.thrust_N` is the quadratic
 command law f = F_max u |u| used for a normalised command u in [-1, 1] (thrust grows
 with the square of propeller speed, which grows about linearly with the ESC command).
 """
@@ -22,10 +24,9 @@ import numpy as np
 
 from uvms_pin.errors import ParameterError
 from uvms_pin.model.thruster import Thruster
+from uvms_pin.model.vehicles.t200 import t200_16v_curve
 
 __all__ = ["T200", "T200_16V", "thrusters"]
-
-_KGF_N = 9.80665
 
 
 @dataclass(frozen=True)
@@ -44,7 +45,7 @@ class T200:
         return math.copysign(limit * command * command, command)
 
 
-T200_16V = T200(16.0, 5.25 * _KGF_N, 4.1 * _KGF_N)
+T200_16V = T200(16.0, t200_16v_curve().max_forward_N, t200_16v_curve().max_reverse_N)
 
 _H = math.sqrt(0.5)
 # name, position (FLU) [m], direction (FLU) for positive thrust

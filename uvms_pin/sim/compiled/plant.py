@@ -17,7 +17,10 @@ from uvms_pin.physics.compiled.joint_stops import joint_stops_to_core
 from uvms_pin.physics.compiled.world import world_bounds_to_core, world_contact_to_core
 from uvms_pin.physics.dynamics import dynamics_of
 
-__all__ = ["PlantParts", "plant_to_core"]
+__all__ = ["FINS_REASON", "PlantParts", "plant_to_core"]
+
+#: why a model with fins (`uvms_pin.physics.fins`) runs on the Python reference
+FINS_REASON = "fins (lift and drag, gz-sim's LiftDrag): no compiled counterpart"
 
 
 class PlantParts(Protocol):
@@ -47,6 +50,8 @@ def plant_to_core(plant: PlantParts, core: ModuleType):
     fallback = next((p for p in parts if isinstance(p, Fallback)), None)
     if fallback is not None:
         return fallback
+    if plant.uvms.fins:
+        return Fallback(FINS_REASON)
     if plant.joint_coulomb is not None:
         return Fallback("joint Coulomb friction as a constraint (solved by the Python step)")
     uvms = plant.uvms

@@ -1,0 +1,121 @@
+"""The fins' lift and drag in the dynamics (`uvms_pin.physics.fins`): the generalized force
+is the fins' wrench through their joints' Jacobians (its power is the wrench's), a fin
+moving with the water feels nothing, and a run with fins runs on the Python reference with
+the reason named."""
+
+from __future__ import annotations
+
+import numpy as np
+import pinocchio as pin
+import pytest
+from fin_helpers import import_lrauv
+
+import uvms_pin as up
+from uvms_pin.errors import CoreFallbackWarning, ParameterError
+from uvms_pin.flow import UniformCurrent
+from uvms_pin.physics.fins import fin_generalized_force, fin_wrenches_world
+from uvms_pin.sim.compiled.plant import FINS_REASON
+from uvms_pin.sim.plant import Plant
+
+
+@pytest.fixture(scope="module")
+def lrauv(tmp_path_factory):
+    folder = tmp_path_factory.mktemp("lrauv")
+    import_lrauv(folder)
+    return up.load_uvms(folder / "lrauv.urdf", water_density_kg_m3=1000.0)
+
+
+def _tau(uvms, data, q, v, water=None):
+    return fin_generalized_force(uvms, data, q, fin_wrenches_world(uvms, data, q, v, water))
+
+
+def _state(uvms, rng):
+    q = pin.randomConfiguration(uvms.model, -np.ones(uvms.nq), np.ones(uvms.nq))
+    q[3:7] = pin.Quaternion(pin.exp3(rng.normal(size=3))).coeffs()
+    v = rng.normal(size=uvms.nv) * np.r_[1.0, 1.0, 1.0, 0.3, 0.3, 0.3, 1.0, 1.0]
+    return q, v
+
+
+def test_the_model_has_the_tutorials_two_fins(lrauv):
+    fins = {f.name: f for f in lrauv.fins}  # in the URDF's link order
+    assert sorted(fins) == ["horizontal_fins", "vertical_fins"]
+    vertical = fins["vertical_fins"].params
+    assert (vertical.cla, vertical.area_m2, vertical.fluid_density_kg_m3) == (4.13, 0.0244, 1000.0)
+    assert (vertical.cla_stall, vertical.cda, vertical.cda_stall) == (-1.1, 0.2, 0.03)
+    assert vertical.alpha_stall_rad == 0.17
+    np.testing.assert_array_equal(vertical.forward, [-1.0, 0.0, 0.0])
+    np.testing.assert_array_equal(vertical.upward, [0.0, 1.0, 0.0])
+    assert lrauv.model.names[fins["vertical_fins"].joint_id] == "vertical_fins_joint"
+
+
+def test_the_generalized_force_delivers_the_wrenchs_power_and_never_gains_energy(lrauv):
+    """tau . v = sum F . v_c + M . omega (the Jacobian maps the wrench right), and with
+    c_Ma = 0 it is <= 0: the fins take energy from the motion, never give it."""
+    rng = np.random.default_rng(7)
+    data = lrauv.model.createData()
+    active = 0
+    for _ in range(60):
+        q, v = _state(lrauv, rng)
+        tau = _tau(lrauv, data, q, v)
+        power = 0.0
+        for fin, (centre, force, moment) in zip(
+            lrauv.fins, fin_wrenches_world(lrauv, data, q, v), strict=True
+        ):
+            motion = data.oMi[fin.joint_id].act(data.v[fin.joint_id])
+            power += force @ (motion.linear + np.cross(motion.angular, centre))
+            power += moment @ motion.angular
+            active += bool(np.any(force))
+        assert tau @ v == pytest.approx(power, rel=1e-10, abs=1e-12)
+        assert tau @ v <= 1e-12
+    assert active > 20  # most states have a fin in the flow
+
+
+def test_a_fin_moving_with_the_water_feels_nothing_and_the_water_counts(lrauv):
+    rng = np.random.default_rng(3)
+    data = lrauv.model.createData()
+    q = lrauv.neutral_configuration()
+    q[:3] = rng.normal(size=3)
+    velocity = np.array([-1.2, 0.1, 0.05])
+    v = np.zeros(lrauv.nv)
+    v[:3] = velocity  # at level attitude the body velocity is the world velocity
+    moving = _tau(lrauv, data, q, v)
+    assert np.any(moving)
+    carried = _tau(lrauv, data, q, v, UniformCurrent(velocity))
+    np.testing.assert_array_equal(carried, np.zeros(lrauv.nv))
+    still_body = _tau(lrauv, data, q, np.zeros(lrauv.nv), UniformCurrent(-velocity))
+    np.testing.assert_allclose(still_body, moving, rtol=1e-12, atol=1e-14)
+
+
+def test_the_plant_adds_them_on_the_python_reference_only(lrauv):
+    plant = Plant(lrauv, backend="python", free_surface=False)
+    rng = np.random.default_rng(5)
+    q, v = _state(lrauv, rng)
+    tau = np.zeros(lrauv.nv)
+    without = up.forward_dynamics(lrauv, q, v, tau, backend="python")
+    extra = _tau(lrauv, lrauv.model.createData(), q, v)
+    np.testing.assert_allclose(
+        plant.acceleration(0.0, q, v, tau),
+        up.forward_dynamics(lrauv, q, v, tau, tau_ext=extra, backend="python"),
+        rtol=1e-12,
+        atol=1e-12,
+    )
+    assert not np.allclose(without, plant.acceleration(0.0, q, v, tau))
+    with pytest.warns(CoreFallbackWarning, match="fins"):
+        assert Plant(lrauv).compiled is None
+    with pytest.raises(ParameterError, match="fins' lift and drag"):
+        Plant(lrauv, backend="python").acceleration_derivatives(0.0, q, v, tau)
+
+
+def test_a_run_with_fins_says_why_it_is_not_compiled(tmp_path):
+    import_lrauv(tmp_path)
+    scenario = tmp_path / "run.toml"
+    scenario.write_text(
+        '[scenario]\nmodel = "lrauv.urdf"\nduration_s = 0.2\n\n[water]\ndensity_kg_m3 = 1000.0\n\n'
+        "[initial]\nposition_world_m = [0.0, 0.0, -5.0]\n"
+        "velocity = [-1.0, 0.0, 0.0, 0.0, 0.0, 0.2, 0.0, 0.0]\n\n"
+        '[controller]\ntype = "none"\n'
+    )
+    with pytest.warns(Warning, match="fins"):
+        rollout = up.simulate(up.load_scenario(scenario), progress=False)
+    assert rollout.metadata["closed_loop"]["reason"] == FINS_REASON
+    assert rollout.metadata["closed_loop"]["path"] == "python"
