@@ -72,7 +72,7 @@ class HotStab(Controller):
         kp_Nm_rad: list[float],
         kd_Nm_s_rad: list[float],
         axis_world: list[float] = (1.0, 0.0, 0.0),
-        grasp_in_jaw_m: list[float] = (0.0, 0.0, 0.06),
+        grasp_in_jaw_m: list[float] = (0.0, 0.0, 0.07),
         stab_length_m: float = 0.38,
         depth_m: float = 0.15,
         standoff_m: float = 0.05,

@@ -80,15 +80,14 @@ def _first_or_deepest(reached: np.ndarray, depth: np.ndarray) -> int:
 
 
 def _contact_peak_N(rollout) -> float:
-    """The largest total force between the stab and the receptacle's links [N]."""
+    """The largest total force between the stab and the receptacle's links [N] (the free
+    objects' pairs ``stab|receptacle.<link>...``)."""
     contacts = rollout.signals.get("free_object_contact")
-    pairs = (_world(rollout).get("object_pairs")) or []
-    mine = [
-        k for k, p in enumerate(pairs) if STAB in p.split("|")[0] and RECEPTACLE in p
-    ] or [k for k, p in enumerate(pairs) if STAB in p and RECEPTACLE in p]
+    pairs = [p.split("|") for p in _world(rollout).get("object_pairs") or []]
+    mine = [k for k, (a, b) in enumerate(pairs) if a == STAB and b.startswith(f"{RECEPTACLE}.")]
     if contacts is None or not mine:
         return 0.0
-    rows = np.asarray(contacts).reshape(len(rollout.time_s), -1, 9)[:, mine, :3]
+    rows = np.asarray(contacts).reshape(len(rollout.time_s), len(pairs), 9)[:, mine, :3]
     return float(np.max(np.linalg.norm(rows.sum(axis=1), axis=1)))
 
 
