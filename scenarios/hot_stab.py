@@ -27,16 +27,17 @@ the arm's forward kinematics); the align phase ramps the posture to it.
 The law:
 
     e            = p_target - p_tip
-    f            = K_p e - K_d v_tip + f_trim                       (world)
-    f_push       = clip(a . f, -max_push_N, max_push_N)           (insert and hold)
-    f_world      = f_push a + lateral_gain (I - a a^T) f           (insert and hold), f otherwise
+    f_servo      = K_p e - K_d v_tip                                (world)
+    f_push       = clip(a . (f_servo + f_trim), -max_push_N, max_push_N)
+    f_world      = f_push a + (I - a a^T)(lateral_gain f_servo + f_trim)   (insert, hold)
+                   f_servo + f_trim                                         (otherwise)
     tau_vehicle  = [R^T f_world; -k_a log(R) - d_a omega]          (level attitude)
     tau_arm      = K_p,arm (q_arm,target - q_arm) - K_d,arm qdot_arm
 
 with f_trim an integral of K_i e taken while the tip is within 2 cm of its target before
 the insertion and then frozen (the vehicle's trim): the push along the bore is at most
-``max_push_N`` (the push budget), and the lateral force ``lateral_gain`` times the approach's,
-so that the chamfer, not the thrusters, centres the stab. The jaw is the scenario's
+``max_push_N`` (the push budget), and the lateral servo ``lateral_gain`` times the
+approach's (the trim kept whole), so that the chamfer, not the thrusters, centres the stab. The jaw is the scenario's
 ``[gripper]`` servo (this controller is built on the model with the jaw locked).
 
 A scenario's own controller (``type = "hot_stab:HotStab"``).
@@ -105,7 +106,7 @@ class HotStab(Controller):
         aimed = np.asarray(mouth_world_m, dtype=float) + np.asarray(aim_error_m, dtype=float)
         self.standoff_world_m = aimed - standoff_m * self.axis
         self.inserted_world_m = aimed + (depth_m + overtravel_m) * self.axis
-        self.tip_in_jaw_m = np.asarray(grasp_in_jaw_m, dtype=float) + [-stab_length_m / 2, 0, 0]
+        self.tip_in_jaw_m = np.asarray(grasp_in_jaw_m, dtype=float) - [stab_length_m / 2, 0, 0]
         self.max_push_N = float(max_push_N)
         self.lateral_gain = float(lateral_gain)
         nv_arm = self.model.nv - 6
@@ -201,13 +202,15 @@ class HotStab(Controller):
         if not pushing and np.linalg.norm(error_m) < INTEGRATE_WITHIN_M:
             limit = self.integral_limit_N
             self.trim_N = np.clip(self.trim_N + self.ix * error_m * step_s, -limit, limit)
-        force = self.kx * error_m - self.dx * tip_velocity + self.trim_N
+        servo = self.kx * error_m - self.dx * tip_velocity
         if not pushing:
             self.push_N = 0.0
-            return force
+            return servo + self.trim_N
+        force = servo + self.trim_N
         self.push_N = float(np.clip(self.axis @ force, -self.max_push_N, self.max_push_N))
-        lateral = force - (self.axis @ force) * self.axis
-        return self.push_N * self.axis + self.lateral_gain * lateral
+        lateral = servo - (self.axis @ servo) * self.axis
+        trim = self.trim_N - (self.axis @ self.trim_N) * self.axis
+        return self.push_N * self.axis + self.lateral_gain * lateral + trim
 
     def compute(self, time_s, measurement):
         q, v = measurement.q, measurement.v

@@ -16,8 +16,13 @@ axis (into it), and its lateral offset |(I - a a^T)(p_tip - p_mouth)|.
 - ``bore_offset_m``: the lateral offset when the tip first passes the chamfer (d >= 0) [m]
   (at the deepest sample if it never does).
 - ``contact_force_peak_N``: the largest total force between the stab and the receptacle [N].
-- ``stab_slip_m``: the largest motion of the stab's centre in the jaw's frame after
-  SETTLED_S (the jaw closed on it) [m]; ``stab_slipped``: 1 when it exceeds SLIP_TOLERANCE_M.
+- ``stab_slip_m``: the largest motion of the stab's centre in the jaw's frame along the
+  stab's axis after SETTLED_S (the jaw closed on it): a slip through the grip [m].
+- ``stab_shift_m``: the largest such motion across the stab's axis [m]: the fingers are
+  servoed each on its own, so a sideways push moves the stab and both fingers together
+  between the jaw's sides (a compliance, not a slip), up to the stab leaving the jaw.
+- ``stab_slipped``: 1 when ``stab_slip_m`` exceeds SLIP_TOLERANCE_M or ``stab_shift_m``
+  exceeds LOST_M (the stab has left the fingers), 0 otherwise.
 """
 
 from __future__ import annotations
@@ -35,6 +40,8 @@ CHAMFER_M = 0.01
 DEPTH_TOLERANCE_M = 0.005
 SLIP_TOLERANCE_M = 0.005
 SETTLED_S = 0.5
+#: across its axis, this far from where the jaw closed on it the stab is out of the jaw [m]
+LOST_M = 0.02
 
 
 def _world(rollout) -> dict:
@@ -91,15 +98,26 @@ def _contact_peak_N(rollout) -> float:
     return float(np.max(np.linalg.norm(rows.sum(axis=1), axis=1)))
 
 
-def stab_slip_m(rollout, states: np.ndarray) -> float:
-    """The largest motion of the stab's centre in the jaw's frame after SETTLED_S [m]."""
+def stab_motion_in_jaw_m(rollout, states: np.ndarray) -> tuple[float, float]:
+    """The largest motion of the stab's centre in the jaw's frame after SETTLED_S: along the
+    stab's axis (a slip through the grip) and across it (the stab and the fingers moving
+    together between the jaw's sides, or the stab leaving the jaw) [m]."""
     positions, rotations, _ = _jaw_frames(rollout)
     in_jaw = np.einsum("nji,nj->ni", rotations, states[:, :3] - positions)
     settled = np.asarray(rollout.time_s) >= SETTLED_S
     if not np.any(settled):
-        return 0.0
-    held = in_jaw[settled]
-    return float(np.max(np.linalg.norm(held - held[0], axis=1)))
+        return 0.0, 0.0
+    moved = in_jaw[settled] - in_jaw[settled][0]
+    axis_in_jaw = np.einsum(
+        "nji,nj->ni",
+        rotations[settled],
+        np.array([pin.Quaternion(*q[[3, 0, 1, 2]]).matrix()[:, 2] for q in states[settled, 3:7]]),
+    )
+    along = np.abs(np.einsum("ni,ni->n", moved, axis_in_jaw))
+    across = np.linalg.norm(
+        moved - np.einsum("ni,ni->n", moved, axis_in_jaw)[:, None] * axis_in_jaw, axis=1
+    )
+    return float(np.max(along)), float(np.max(across))
 
 
 def insertion(rollout) -> dict[str, float]:
@@ -109,7 +127,7 @@ def insertion(rollout) -> dict[str, float]:
     mouth, axis = bore(_named(world.get("fixtures", []), RECEPTACLE, "fixture"))
     states = _stab_states(rollout)
     depth, offset = tip_depth_and_offset(states, float(stab["length_m"]), mouth, axis)
-    slip = stab_slip_m(rollout, states)
+    slip, shift = stab_motion_in_jaw_m(rollout, states)
     return {
         "insertion_depth_m": float(depth[-1]),
         "insertion_depth_max_m": float(np.max(depth)),
@@ -118,5 +136,6 @@ def insertion(rollout) -> dict[str, float]:
         "bore_offset_m": float(offset[_first_or_deepest(depth >= 0.0, depth)]),
         "contact_force_peak_N": _contact_peak_N(rollout),
         "stab_slip_m": slip,
-        "stab_slipped": float(slip > SLIP_TOLERANCE_M),
+        "stab_shift_m": shift,
+        "stab_slipped": float(slip > SLIP_TOLERANCE_M or shift > LOST_M),
     }

@@ -72,7 +72,9 @@ def _rollout(tips_world_m: np.ndarray, centre_shift_m: np.ndarray | None = None,
 
 
 def _path(depths_m, lateral_m):
-    return np.array([MOUTH + [d, y, 0.0] for d, y in zip(depths_m, lateral_m, strict=True)])
+    return np.array(
+        [MOUTH + np.array([d, y, 0.0]) for d, y in zip(depths_m, lateral_m, strict=True)]
+    )
 
 
 def test_a_stab_at_full_depth_is_inserted_and_its_offsets_are_read_at_the_mouth(metrics_module):
@@ -101,3 +103,48 @@ def test_a_stab_short_of_full_depth_or_slipping_in_the_jaw_is_said_so(metrics_mo
     shift[3:, 0] = -0.008
     m = metrics_module.insertion(_rollout(_path(depths, [0.0] * 5), centre_shift_m=shift))
     assert m["stab_slipped"] == 1.0 and m["stab_slip_m"] == pytest.approx(0.008)
+    assert m["stab_shift_m"] == pytest.approx(0.0, abs=1e-9)
+    # 6 mm sideways between the fingers: a shift, not a slip; 30 mm: out of the jaw
+    for across, slipped in ((0.006, 0.0), (0.03, 1.0)):
+        shift = np.zeros((5, 3))
+        shift[3:, 1] = across
+        m = metrics_module.insertion(_rollout(_path(depths, [0.0] * 5), centre_shift_m=shift))
+        assert m["stab_shift_m"] == pytest.approx(across)
+        assert m["stab_slip_m"] == pytest.approx(0.0, abs=1e-9)
+        assert m["stab_slipped"] == slipped
+
+
+def _metrics(**overrides) -> dict[str, float]:
+    rollout = up.simulate(up.load_scenario(SCENARIO, overrides=overrides))
+    assert rollout.metadata["status"] == "ok"
+    return rollout.metrics()
+
+
+def test_the_stab_is_inserted_to_full_depth_the_chamfer_taking_the_aim_error():
+    m = _metrics()
+    assert m["inserted"] == 1.0
+    assert m["insertion_depth_m"] == pytest.approx(0.15, abs=0.002)
+    # it met the chamfer 4-7 mm off the bore's axis and went in within the 1.5 mm clearance
+    assert 0.004 < m["mouth_offset_m"] < 0.008
+    assert m["bore_offset_m"] < 0.0015
+    assert m["stab_slipped"] == 0.0 and m["stab_slip_m"] < 0.005
+    assert 1.0 < m["contact_force_peak_N"] < 20.0  # within the push budget
+    assert m["energy_max_increase_J"] < 0.05
+
+
+def test_a_grip_too_weak_for_the_stab_drops_it_and_nothing_is_inserted():
+    # 0.2 N per finger: 2 mu F = 0.2 N at most, the stab's net weight
+    # (1400 - 1025) kg/m^3 x pi 0.0125^2 x 0.38 m^3 x g = 0.69 N; it falls in the approach
+    net_weight_N = (1400 - 1025) * math.pi * 0.0125**2 * 0.38 * 9.81
+    assert 2 * 0.5 * 0.2 < net_weight_N
+    m = _metrics(**{"gripper.max_force_N": 0.2, "scenario.duration_s": 6.0})
+    assert m["inserted"] == 0.0 and m["stab_slipped"] == 1.0
+    assert m["insertion_depth_max_m"] < -0.05  # never near the mouth
+    assert m["contact_force_peak_N"] == 0.0
+
+
+def test_a_push_budget_too_small_leaves_the_stab_short_of_full_depth():
+    m = _metrics(**{"controller.max_push_N": 0.3})
+    assert m["inserted"] == 0.0
+    assert m["insertion_depth_m"] < 0.1
+    assert m["stab_slipped"] == 0.0  # held, only pushed too softly

@@ -124,7 +124,9 @@ def test_a_fixture_is_drawn_with_its_links_at_its_logged_joint_positions(referen
         turned = pin.Quaternion(np.asarray(quat, dtype=float)).matrix()
         assert np.allclose(turned, data.oMi[handle].rotation)
         # the handle turns about the panel's x (world -x here): by the logged angle
-        assert np.allclose(turned, pin.rpy.rpyToMatrix(0.0, 0.0, np.pi) @ pin.rpy.rpyToMatrix(angle, 0, 0))
+        assert np.allclose(
+            turned, pin.rpy.rpyToMatrix(0.0, 0.0, np.pi) @ pin.rpy.rpyToMatrix(angle, 0, 0)
+        )
     # without a logged row: its initial position
     initial = scene.poses(Frame(0.0, q))["world/fixtures/panel/valve"][1]
     expected = pin.rpy.rpyToMatrix(0.0, 0.0, np.pi) @ pin.rpy.rpyToMatrix(0.2, 0, 0)

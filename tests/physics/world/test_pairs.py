@@ -75,7 +75,11 @@ def test_a_force_on_a_body_fixed_to_the_world_moves_no_joint():
     on_world = joint_forces(model, data, q, [0], [[1.0, 0.0, 0.0]], force)
     assert np.array_equal(on_world, np.zeros(1))
     # 10 N up at 1 m along x about y: -10 N m; the world's share adds nothing
-    both = joint_forces(model, data, q, [0, hinge], [[1.0, 0, 0], [1.0, 0, 0]], np.vstack([force, force]))
+    both = joint_forces(
+        model, data, q, [0, hinge], [[1.0, 0, 0], [1.0, 0, 0]], np.vstack([force, force])
+    )
     assert np.allclose(both, [-10.0])
     nothing = pin.Model()
-    assert joint_forces(nothing, nothing.createData(), np.zeros(0), [0], [[0, 0, 0]], force).shape == (0,)
+    assert joint_forces(
+        nothing, nothing.createData(), np.zeros(0), [0], [[0, 0, 0]], force
+    ).shape == (0,)
