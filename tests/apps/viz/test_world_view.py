@@ -131,3 +131,23 @@ def test_a_fixture_is_drawn_with_its_links_at_its_logged_joint_positions(referen
     initial = scene.poses(Frame(0.0, q))["world/fixtures/panel/valve"][1]
     expected = pin.rpy.rpyToMatrix(0.0, 0.0, np.pi) @ pin.rpy.rpyToMatrix(0.2, 0, 0)
     assert np.allclose(pin.Quaternion(np.asarray(initial, dtype=float)).matrix(), expected)
+
+
+def test_the_live_feed_hands_the_fixtures_joint_rows_to_the_scene(reference_uvms):
+    from types import SimpleNamespace
+
+    from uvms_pin.apps.viz.live import LiveFeed
+    from uvms_pin.results.signal import Signal
+
+    pushed = []
+    feed = LiveFeed(SimpleNamespace(push=pushed.append))
+    q = reference_uvms.neutral_configuration()
+    sample = SimpleNamespace(
+        time_s=1.0, q=q, measurement=SimpleNamespace(wrench_world=np.zeros(6)),
+        signals={"panel": Signal([0.9], ["valve"], "rad")},
+    )  # fmt: skip
+    feed.on_sample(sample)
+    _, view = _valve_view(reference_uvms)
+    poses = UvmsScene(reference_uvms, world=view).poses(pushed[0])
+    rotation = pin.Quaternion(np.asarray(poses["world/fixtures/panel/valve"][1])).matrix()
+    assert np.allclose(rotation, pin.rpy.rpyToMatrix(0.9, 0.0, 0.0))
