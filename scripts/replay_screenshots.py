@@ -38,12 +38,20 @@ _CLOSE = (
     "viewer.camera.position.set(0.75, 0.35, -0.85); viewer.controls.update(); true"
 )
 
+# the hot stab's receptacle close up, from the side above (the stab at full depth)
+_RECEPTACLE = (
+    "viewer.set_transform(['meshcat', 'uvms_pin'], "
+    "[1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, -0.72, 0.11, 2.25, 1]); "
+    "viewer.camera.position.set(-0.15, 0.3, 0.5); viewer.controls.update(); true"
+)
+
 SHOTS = {
     "push_object": Shot("push_object", 10.0, "docs/push_object_replay.png"),
     "seabed_landing": Shot("seabed_landing", 11.0, "docs/seabed_landing_replay.png"),
     "bluerov_alpha5": Shot(
         "bluerov_alpha5_force_tracking", 5.0, "docs/replay_bluerov_alpha5.png", (1000, 640), _CLOSE
     ),
+    "hot_stab": Shot("hot_stab", 12.0, "docs/hot_stab_replay.png", (1000, 640), _RECEPTACLE),
 }
 
 

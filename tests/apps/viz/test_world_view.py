@@ -88,3 +88,66 @@ def test_a_free_object_is_drawn_where_its_logged_pose_puts_it(reference_uvms, wo
     position, quat, _ = poses["world/free/crate2"]
     assert np.allclose(position, [2.0, 1.5, -2.75]) and np.allclose(quat, turned)
     assert np.allclose(poses["world/contacts/object0"][0], [2.0, 1.5, -2.95])
+
+
+VALVE = ROOT / "models" / "fixtures" / "subsea_panel_valve.urdf"
+
+
+def _valve_view(reference_uvms, rpy=(0.0, 0.0, 0.0)):
+    from uvms_pin.physics.world.fixture import fixture
+
+    panel = fixture(
+        "panel", VALVE, ([0.5, -0.2, -2.0], rpy), joint_positions={"valve": 0.2},
+        water_density_kg_m3=1025.0,
+    )  # fmt: skip
+    view = WorldView.from_record(World(reference_uvms, (), fixtures=[panel]).record(), [0, 0, -2])
+    return panel, view
+
+
+def test_a_fixture_is_drawn_with_its_links_at_its_logged_joint_positions(reference_uvms):
+    panel, view = _valve_view(reference_uvms, (0.0, 0.0, np.pi))
+    scene = UvmsScene(reference_uvms, world=view)
+    vis, window = recording_visualizer()
+    scene.build(vis)
+    blob = b"".join(window.commands)
+    assert b"uvms_pin/world/fixtures/panel/universe" in blob  # the panel, fixed in the world
+    assert b"uvms_pin/world/fixtures/panel/valve" in blob  # the handle, on its joint
+    q = reference_uvms.neutral_configuration()
+    model, data = panel.uvms.model, panel.uvms.model.createData()
+    handle = model.getJointId("valve")
+    for angle in (0.0, 0.7, np.pi / 2):
+        position, quat, _ = scene.poses(Frame(0.0, q, fixtures={"panel": np.array([angle])}))[
+            "world/fixtures/panel/valve"
+        ]
+        pin.forwardKinematics(model, data, np.array([angle]))
+        assert np.allclose(position, data.oMi[handle].translation)
+        turned = pin.Quaternion(np.asarray(quat, dtype=float)).matrix()
+        assert np.allclose(turned, data.oMi[handle].rotation)
+        # the handle turns about the panel's x (world -x here): by the logged angle
+        assert np.allclose(
+            turned, pin.rpy.rpyToMatrix(0.0, 0.0, np.pi) @ pin.rpy.rpyToMatrix(angle, 0, 0)
+        )
+    # without a logged row: its initial position
+    initial = scene.poses(Frame(0.0, q))["world/fixtures/panel/valve"][1]
+    expected = pin.rpy.rpyToMatrix(0.0, 0.0, np.pi) @ pin.rpy.rpyToMatrix(0.2, 0, 0)
+    assert np.allclose(pin.Quaternion(np.asarray(initial, dtype=float)).matrix(), expected)
+
+
+def test_the_live_feed_hands_the_fixtures_joint_rows_to_the_scene(reference_uvms):
+    from types import SimpleNamespace
+
+    from uvms_pin.apps.viz.live import LiveFeed
+    from uvms_pin.results.signal import Signal
+
+    pushed = []
+    feed = LiveFeed(SimpleNamespace(push=pushed.append))
+    q = reference_uvms.neutral_configuration()
+    sample = SimpleNamespace(
+        time_s=1.0, q=q, measurement=SimpleNamespace(wrench_world=np.zeros(6)),
+        signals={"panel": Signal([0.9], ["valve"], "rad")},
+    )  # fmt: skip
+    feed.on_sample(sample)
+    _, view = _valve_view(reference_uvms)
+    poses = UvmsScene(reference_uvms, world=view).poses(pushed[0])
+    rotation = pin.Quaternion(np.asarray(poses["world/fixtures/panel/valve"][1])).matrix()
+    assert np.allclose(rotation, pin.rpy.rpyToMatrix(0.9, 0.0, 0.0))

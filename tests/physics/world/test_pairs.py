@@ -57,3 +57,29 @@ def test_a_sticking_pair_s_stretch_is_carried_over_to_the_new_contact_point(load
     pin.forwardKinematics(system.plant.uvms.model, data, turned)
     x = after.touch.point_world_m[0]
     np.testing.assert_allclose(memory.material[(0, 0, -1)], data.oMi[1].actInv(x), atol=1e-15)
+
+
+def test_a_force_on_a_body_fixed_to_the_world_moves_no_joint():
+    """A fixture's root link hangs on joint 0 (the world): a contact force on it is taken by
+    the world (zero generalized force; Pinocchio's Jacobian of joint 0 is not asked for),
+    while a force on a moving body beside it still counts."""
+    from uvms_pin.physics.world.pairs import joint_forces
+
+    model = pin.Model()
+    hinge = model.addJoint(0, pin.JointModelRY(), pin.SE3.Identity(), "hinge")
+    model.appendBodyToJoint(hinge, pin.Inertia.FromSphere(1.0, 0.1), pin.SE3.Identity())
+    data = model.createData()
+    q = np.zeros(1)
+    pin.forwardKinematics(model, data, q)
+    force = np.array([[0.0, 0.0, 10.0]])
+    on_world = joint_forces(model, data, q, [0], [[1.0, 0.0, 0.0]], force)
+    assert np.array_equal(on_world, np.zeros(1))
+    # 10 N up at 1 m along x about y: -10 N m; the world's share adds nothing
+    both = joint_forces(
+        model, data, q, [0, hinge], [[1.0, 0, 0], [1.0, 0, 0]], np.vstack([force, force])
+    )
+    assert np.allclose(both, [-10.0])
+    nothing = pin.Model()
+    assert joint_forces(
+        nothing, nothing.createData(), np.zeros(0), [0], [[0, 0, 0]], force
+    ).shape == (0,)

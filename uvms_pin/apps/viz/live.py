@@ -370,6 +370,8 @@ class LiveFeed:
                 None if contacts is None else contacts.copy(),
                 None if free is None else free.copy(),
                 None if objects is None else objects.copy(),
+                # every signal by name: the scene draws the fixtures' (named after them)
+                {k: np.asarray(getattr(s, "values", s)) for k, s in sample.signals.items()},
             )
         )
 

@@ -118,6 +118,7 @@ class Frame:
     world_contact: np.ndarray | None = None  # a row of the rollout's world_contact signal
     free_objects: np.ndarray | None = None  # a row of the free_objects signal (poses)
     object_contact: np.ndarray | None = None  # a row of free_object_contact
+    fixtures: Mapping[str, np.ndarray] | None = None  # a row of each fixture's signal, by name
 
 
 class RecordingWindow:
@@ -406,6 +407,7 @@ class UvmsScene:
                 )
             )
             out.update(self.world.free_poses(frame.free_objects))
+            out.update(self.world.fixture_poses(frame.fixtures))
         return out
 
     def _arrow(self, path: str, tail, vector, scale: float) -> dict[str, Pose]:

@@ -157,6 +157,7 @@ def replay_html(
         None if rollout.signals.get(name) is None else rollout.signals[name][good]
         for name in ("world_contact", "free_objects", "free_object_contact")
     )
+    fixtures = _fixture_rows(rollout, scene, good)
     idx, fps = frame_times(time_s, max_fps, max_frames)
     t0 = float(time_s[0])
     keys = (time_s[idx] - t0) * fps  # animation time in frames (meshcat's convention)
@@ -172,6 +173,7 @@ def replay_html(
             None if contacts is None else contacts[i],
             None if free is None else free[i],
             None if object_contact is None else object_contact[i],
+            {name: rows_[i] for name, rows_ in fixtures.items()},
         )
         at = anim.at_frame(root, float(key))
         poses = scene.poses(frame)
@@ -203,6 +205,12 @@ def replay_html(
         "legend": legend,
     }
     return _page(window.commands, info, camera_panel(rollout, t0))
+
+
+def _fixture_rows(rollout: Rollout, scene: UvmsScene, good: np.ndarray) -> dict[str, np.ndarray]:
+    """Each drawn fixture's logged joint positions (its signal, named after it), good rows."""
+    names = () if scene.world is None else (f.name for f in scene.world.fixtures)
+    return {n: rollout.signals[n][good] for n in names if rollout.signals.get(n) is not None}
 
 
 def reference_path_world(rollout: Rollout) -> np.ndarray | None:

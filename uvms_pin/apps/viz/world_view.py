@@ -6,13 +6,15 @@ solids grey-brown, meshes as their file's triangles) and ``world/contacts/pair<k
 per (body, object) pair, at the pair's contact point along the force on the body,
 ``SceneStyle.world_force_scale_m_per_N`` long per newton). Free objects are drawn under
 ``world/free/<name>`` (a lighter colour) and move with their logged pose (the
-``free_objects`` signal); their own pairs' arrows are ``world/contacts/object<k>``. A node's name is never a bare
+``free_objects`` signal); their own pairs' arrows are ``world/contacts/object<k>``. Fixtures
+(``type = "urdf"``) are drawn under ``world/fixtures/<name>``, their links at their logged
+joint positions (`uvms_pin.apps.viz.fixture_view`). A node's name is never a bare
 number: three.js's animation tracks would read it as an index, and the arrow not move.
 """
 
 from __future__ import annotations
 
-from collections.abc import Callable
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 from typing import Any
 
@@ -21,6 +23,7 @@ import meshcat.geometry as mg
 import numpy as np
 import pinocchio as pin
 
+from uvms_pin.apps.viz.fixture_view import FixtureView
 from uvms_pin.physics.world.kind import Drawing
 from uvms_pin.physics.world.objects import object_kind
 
@@ -58,10 +61,12 @@ class WorldView:
     center_world_m: np.ndarray
     free: tuple[dict[str, Any], ...] = ()
     object_pairs: tuple[str, ...] = ()
+    fixtures: tuple[FixtureView, ...] = ()
 
     @classmethod
     def from_record(cls, record: dict | None, center_world_m) -> WorldView | None:
-        if not record or not (record.get("objects") or record.get("free_objects")):
+        kinds = ("objects", "free_objects", "fixtures")
+        if not record or not any(record.get(kind) for kind in kinds):
             return None
         return cls(
             tuple(record.get("objects", ())),
@@ -69,6 +74,7 @@ class WorldView:
             np.asarray(center_world_m, dtype=float).reshape(3),
             tuple(record.get("free_objects", ())),
             tuple(record.get("object_pairs", ())),
+            tuple(FixtureView.from_record(f) for f in record.get("fixtures", ())),
         )
 
     @property
@@ -92,6 +98,16 @@ class WorldView:
             child.set_transform(_matrix(drawing.rotation_in_object, drawing.offset_in_object_m))
         for k in range(len(self.object_pairs)):
             build_arrow(node[f"contacts/object{k}"], _ARROW)
+        for view in self.fixtures:
+            view.build(node[f"fixtures/{view.name}"])
+
+    def fixture_poses(self, joints: Mapping[str, np.ndarray] | None) -> dict[str, Any]:
+        """Poses of the fixtures' bodies for one logged row of each fixture's signal (by the
+        fixture's name; a fixture without a row: its initial joint positions)."""
+        out: dict[str, Any] = {}
+        for view in self.fixtures:
+            out.update(view.poses(None if joints is None else joints.get(view.name)))
+        return out
 
     def free_poses(self, states: np.ndarray | None) -> dict[str, Any]:
         """Poses of the free objects for one logged row of the ``free_objects`` signal

@@ -69,13 +69,14 @@ def joint_forces(
 ) -> np.ndarray:
     """sum_i J_i^T f_i (nv,) [N, N m]: world forces f_i (k, 3) at world points x_i (k, 3)
     on the bodies of ``joints`` (k,), J_i the linear Jacobian of the material point at
-    x_i; ``data`` after forward kinematics at q."""
+    x_i; ``data`` after forward kinematics at q. A force on a body fixed to the world
+    (joint 0: a fixture's root link) moves no joint."""
     out = np.zeros(model.nv)
     joints = np.asarray(joints, dtype=int)
-    if len(joints) == 0:
+    if not np.any(joints > 0):
         return out
     pin.computeJointJacobians(model, data, q)
-    for j in np.unique(joints):
+    for j in np.unique(joints[joints > 0]):
         mine = joints == j
         f = np.asarray(forces_N)[mine]
         arm = np.asarray(points_m)[mine] - data.oMi[int(j)].translation
