@@ -121,9 +121,12 @@ def kinematics_of(data: pin.Data) -> tuple[np.ndarray, np.ndarray]:
     ``data`` after forward kinematics: each joint's placement in the world (njoints, 12:
     rotation row-major, then translation [m]) and LOCAL velocity (njoints, 6: linear [m/s],
     angular [rad/s])."""
-    placements = np.array([np.concatenate((m.rotation.ravel(), m.translation)) for m in data.oMi])
-    velocities = np.array([m.vector for m in data.v])
-    return placements, velocities
+    placements, twists = data.oMi, data.v
+    n = len(placements)
+    # one Python object per joint (indexing the vectors is faster than iterating them)
+    homogeneous = np.array([placements[j].homogeneous for j in range(n)])
+    rows = np.concatenate((homogeneous[:, :3, :3].reshape(n, 9), homogeneous[:, :3, 3]), axis=1)
+    return rows, np.array([twists[j].vector for j in range(n)])
 
 
 class PairSearch:
