@@ -62,6 +62,39 @@ void write_all(System& system, const nb::handle& given) {
   }
 }
 
+// A side's kinematics as forces() reads it: each joint's placement in the world (a row of
+// rotation, row-major, then translation: (njoints, 12)) and LOCAL velocity ((njoints, 6),
+// linear then angular), as the Python side's Pinocchio data holds them after kinematics.
+pinocchio::Data side_kinematics(const char* side, const Eigen::MatrixXd& placements,
+                                const Eigen::MatrixXd& velocities,
+                                const std::vector<uvms::ContactShape>& pieces) {
+  const Eigen::Index n = placements.rows();
+  if (placements.cols() != 12 || velocities.rows() != n || velocities.cols() != 6) {
+    throw InputError(std::string("pairs: side ") + side +
+                     " needs placements (njoints, 12) and velocities (njoints, 6)");
+  }
+  if (!placements.allFinite() || !velocities.allFinite()) {
+    throw InputError(std::string("pairs: side ") + side + " has a non-finite kinematics");
+  }
+  for (const auto& piece : pieces) {
+    if (piece.joint_id < 0 || piece.joint_id >= n) {
+      throw InputError(std::string("pairs: side ") + side + " has no joint " +
+                       std::to_string(piece.joint_id) + " for a piece");
+    }
+  }
+  pinocchio::Data data;
+  data.oMi.resize(static_cast<std::size_t>(n));
+  data.v.resize(static_cast<std::size_t>(n));
+  for (Eigen::Index j = 0; j < n; ++j) {
+    uvms::Mat3 rotation;
+    for (int r = 0; r < 3; ++r) rotation.row(r) = placements.row(j).segment<3>(3 * r);
+    const auto k = static_cast<std::size_t>(j);
+    data.oMi[k] = pinocchio::SE3(rotation, placements.row(j).segment<3>(9).transpose());
+    data.v[k] = pinocchio::Motion(uvms::Vec6(velocities.row(j).transpose()));
+  }
+  return data;
+}
+
 void check_state(System& system, const Eigen::VectorXd& q, const Eigen::VectorXd& v) {
   if (q.size() != system.nq() || v.size() != system.nv()) {
     throw InputError("system: q (" + std::to_string(system.nq()) + ",) and v (" +
@@ -82,7 +115,31 @@ void bind_system(nb::module_& m) {
       .def_rw("pairs", &PiecePairsModel::pairs)
       .def_rw("friction_static", &PiecePairsModel::friction_static)
       .def_rw("friction_kinetic", &PiecePairsModel::friction_kinetic)
-      .def_rw("law", &PiecePairsModel::law);
+      .def_rw("law", &PiecePairsModel::law)
+      .def(
+          "forces",
+          [](PiecePairsModel& pairs, const Eigen::MatrixXd& placements_a,
+             const Eigen::MatrixXd& velocities_a, const Eigen::MatrixXd& placements_b,
+             const Eigen::MatrixXd& velocities_b, nb::handle friction) {
+            const auto data_a = side_kinematics("a", placements_a, velocities_a, pairs.pieces_a);
+            const auto data_b = side_kinematics("b", placements_b, velocities_b, pairs.pieces_b);
+            if (pairs.friction_static.size() != pairs.pairs.size() ||
+                pairs.friction_kinetic.size() != pairs.pairs.size()) {
+              throw InputError("pairs: one (mu_s, mu_k) per pair expected");
+            }
+            uvms::FrictionMemory memory;
+            read_memory(friction, memory);
+            uvms::PairContacts found;
+            pairs.forces(data_a, data_b, memory, found);
+            nb::dict out = forces_dict(found.forces);
+            out["pair"] = found.pair;
+            return out;
+          },
+          "placements_a"_a, "velocities_a"_a, "placements_b"_a, "velocities_b"_a, "friction"_a,
+          "The touching pairs and their forces (PiecePairs.forces) from each side's joint "
+          "placements (njoints, 12: rotation row-major, translation) and LOCAL velocities "
+          "(njoints, 6), with the anchors of friction (a FrictionMemory, read only), as a "
+          "dict of arrays.");
   nb::class_<System>(m, "System",
                      "The robot's plant and the free objects, one period in one call "
                      "(system.hpp).")

@@ -15,6 +15,7 @@ from types import ModuleType
 from typing import Any
 
 import numpy as np
+import pinocchio as pin
 
 from uvms_pin.physics.compiled.world import (
     contact_law_to_core,
@@ -24,13 +25,16 @@ from uvms_pin.physics.compiled.world import (
 from uvms_pin.physics.world.moving import MovingContacts
 from uvms_pin.physics.world.pairs import PairContacts, PiecePairs
 from uvms_pin.physics.world.touch import Touch
-from uvms_pin.physics.world.world import ContactForces
+from uvms_pin.physics.world.world import ContactForces, FrictionMemory
 
 __all__ = [
+    "PairSearch",
     "contacts_of_core",
     "forces_of_core",
+    "kinematics_of",
     "memories_of",
     "moving_to_core",
+    "pair_contacts_of_core",
     "piece_pairs_to_core",
 ]
 
@@ -99,12 +103,41 @@ def forces_of_core(found: dict) -> ContactForces:
     return ContactForces(_touch(found), **_forces(found))
 
 
+def pair_contacts_of_core(found: dict) -> PairContacts:
+    """A core pair set's contacts (a dict of arrays) as the reference's `PairContacts`."""
+    return PairContacts(_touch(found), **_forces(found), pair=np.asarray(found["pair"], dtype=int))
+
+
 def contacts_of_core(found: tuple[list, list]) -> tuple[list[PairContacts], list]:
     """The core system's ``contacts`` (dicts of arrays) as `MovingContacts.contacts` gives
     them: (each set's `PairContacts`, each object's `ContactForces` or None)."""
     sets, fixed = found
-    pairs = [
-        PairContacts(_touch(d), **_forces(d), pair=np.asarray(d["pair"], dtype=int)) for d in sets
-    ]
     objects = [None if d is None else forces_of_core(d) for d in fixed]
-    return pairs, objects
+    return [pair_contacts_of_core(d) for d in sets], objects
+
+
+def kinematics_of(data: pin.Data) -> tuple[np.ndarray, np.ndarray]:
+    """A side's kinematics as the core's `PiecePairs.forces` reads it, from Pinocchio's
+    ``data`` after forward kinematics: each joint's placement in the world (njoints, 12:
+    rotation row-major, then translation [m]) and LOCAL velocity (njoints, 6: linear [m/s],
+    angular [rad/s])."""
+    placements, twists = data.oMi, data.v
+    n = len(placements)
+    # one Python object per joint (indexing the vectors is faster than iterating them)
+    homogeneous = np.array([placements[j].homogeneous for j in range(n)])
+    rows = np.concatenate((homogeneous[:, :3, :3].reshape(n, 9), homogeneous[:, :3, 3]), axis=1)
+    return rows, np.array([twists[j].vector for j in range(n)])
+
+
+class PairSearch:
+    """The compiled counterpart of ``pairs.forces`` (`PiecePairs.forces`: the touching pairs
+    and the law's forces at them; called with the same arguments, it gives the same
+    `PairContacts`): the core's PiecePairs (moving_contact.hpp) fed each side's joint
+    placements and velocities (`kinematics_of`)."""
+
+    def __init__(self, pairs: PiecePairs, core: ModuleType):
+        self._compiled = piece_pairs_to_core(pairs, core)
+
+    def __call__(self, data_a: pin.Data, data_b: pin.Data, memory: FrictionMemory) -> PairContacts:
+        found = self._compiled.forces(*kinematics_of(data_a), *kinematics_of(data_b), memory)
+        return pair_contacts_of_core(found)

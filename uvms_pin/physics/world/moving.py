@@ -43,12 +43,16 @@ State = tuple[np.ndarray, np.ndarray]
 @dataclass
 class _Set:
     """One set of pairs between side a (-1: the UVMS, else a free object) and side b (between
-    several robots a side is a robot's index: `uvms_pin.physics.world.between_robots`)."""
+    several robots a side is a robot's index: `uvms_pin.physics.world.between_robots`).
+    ``search``: what finds its contacts, (data_a, data_b, memory) -> `PairContacts`, when a
+    compiled counterpart does (`uvms_pin.physics.compiled.moving.PairSearch`); None: the
+    reference, `PiecePairs.forces`."""
 
     pairs: PiecePairs
     a: int
     b: int
     memory: FrictionMemory = field(default_factory=FrictionMemory)
+    search: Callable[..., PairContacts] | None = None
 
 
 def _self_pairs(world: World) -> PiecePairs | None:
@@ -201,7 +205,7 @@ class MovingContacts:
         if self.rigid_pairs:
             sets = list(rigid_sets)
         else:
-            sets = [s.pairs.forces(data(s.a), data(s.b), s.memory) for s in self.sets]
+            sets = [(s.search or s.pairs.forces)(data(s.a), data(s.b), s.memory) for s in self.sets]
         if self.rigid:
             return sets, list(rigid_fixed)
         fixed = [

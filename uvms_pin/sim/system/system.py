@@ -104,6 +104,8 @@ class System:
         self.moving = FreeObjects(plant.uvms, world) if has_moving_contacts(world) else None
         self.objects: tuple = () if self.moving is None else tuple(self.moving.objects)
         self.fixtures: tuple = () if world is None else tuple(world.fixtures)
+        if self.fixtures and compiled:  # integrated in Python: its contacts searched compiled
+            fixture_joints.search_compiled(self.moving.moving, plant.backend)
         uvms = plant.uvms
         self.layout = Layout.of(
             [("robot", uvms.nq, uvms.nv), *[(o.name, 7, 6) for o in self.objects]]
