@@ -35,7 +35,7 @@ WARM_UP_S = 1.0
 
 
 def _parameters(rollout) -> dict:
-    return ((rollout.metadata.get("controller") or {}).get("parameters")) or {}
+    return (rollout.metadata.get("controller") or {}).get("params") or {}
 
 
 def upward_force_N(rollout) -> np.ndarray:

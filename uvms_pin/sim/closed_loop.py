@@ -143,9 +143,8 @@ class ClosedLoop:
         self.system.start(self.state)
 
     def measure(self, held_wrench: np.ndarray | None = None) -> tuple[Measurement, np.ndarray]:
-        """(what the sensors give now, the true contact wrench (6,) [N; N m] world axes),
-        ``held_wrench`` (the wrench on held objects, `SensorConfig.held_object_wrench`)
-        added to the environment's.
+        """(what the sensors give now, the true contact wrench (6,) [N; N m] world axes), plus
+        ``held_wrench`` (on held objects: `SensorConfig.held_object_wrench`).
 
         Raises SimulationError when a body reached the free surface and the plant stops
         there (``stop_at_surface``)."""
