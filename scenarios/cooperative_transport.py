@@ -123,7 +123,7 @@ class CooperativeTransport(Controller):
         funnel_start_m: float = 0.05,
         funnel_end_m: float = 0.01,
         funnel_rate_per_s: float = 0.5,
-        estimate_gain_per_s: float = 5.0,
+        estimate_gain_per_s: float = 30.0,
         force_filter_s: float = 0.1,
         period_s: float = 0.002,
         grasp_offset_in_jaw_m: list[float] = (0.0, 0.0, 0.071),
