@@ -107,6 +107,11 @@ def test_two_robots_holding_the_bar_at_rest_share_its_net_weight_as_their_coeffi
     assert (up_N["alpha"] + up_N["bravo"]) / weight_N == pytest.approx(1.0, abs=0.03)
     bar = rollouts.robot("alpha").signals["free_objects"][:, :3]
     assert np.max(np.abs(bar - bar[0])) < 0.005
+    # what each controller measured is that push, within the sensor's 0.1 N noise
+    for name in rollouts.names:
+        robot = rollouts.robot(name)
+        noise = robot.wrench_measured_world[:, :3] - robot.wrench_contact_world[:, :3]
+        assert np.max(np.abs(noise)) <= 0.1 + 1e-9
 
 
 @pytest.mark.slow
