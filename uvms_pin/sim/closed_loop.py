@@ -151,8 +151,7 @@ class ClosedLoop:
         q, v = self._robot
         self.plant.check_submerged(self.time_s, q)
         contact = self.plant.contact_wrench(q, v)
-        if held_wrench is not None:
-            contact = contact + held_wrench
+        contact = contact if held_wrench is None else contact + held_wrench
         return self.sensors.measure(self.time_s, q, v, contact), contact
 
     def observe(self, held_wrench: np.ndarray | None = None) -> tuple[Measurement, np.ndarray]:
