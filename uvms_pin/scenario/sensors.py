@@ -35,6 +35,7 @@ def build_sensors(
         sample_period_s=t.number("sample_period_s", 1e-3, positive=True),
         navigation=_navigation(t, water_density_kg_m3, world),
         perception=_perception(t),
+        held_object_wrench=t.boolean("held_object_wrench", False),
     )
     t.finish()
     return config

@@ -142,21 +142,23 @@ class ClosedLoop:
                 self.controller.reset()
         self.system.start(self.state)
 
-    def measure(self) -> tuple[Measurement, np.ndarray]:
-        """(what the sensors give now, the true contact wrench (6,) [N; N m] world axes).
+    def measure(self, held_wrench: np.ndarray | None = None) -> tuple[Measurement, np.ndarray]:
+        """(what the sensors give now, the true contact wrench (6,) [N; N m] world axes), plus
+        ``held_wrench`` (on held objects: `SensorConfig.held_object_wrench`).
 
         Raises SimulationError when a body reached the free surface and the plant stops
         there (``stop_at_surface``)."""
         q, v = self._robot
         self.plant.check_submerged(self.time_s, q)
         contact = self.plant.contact_wrench(q, v)
+        contact = contact if held_wrench is None else contact + held_wrench
         return self.sensors.measure(self.time_s, q, v, contact), contact
 
-    def observe(self) -> tuple[Measurement, np.ndarray]:
+    def observe(self, held_wrench: np.ndarray | None = None) -> tuple[Measurement, np.ndarray]:
         """`measure`, then, once per control tick, the navigation sensors and the estimator
         (`SensorSuite.navigate`) and the cameras in the loop (`SensorSuite.see`): (what the
         controller is given, the true contact wrench)."""
-        measurement, contact = self.measure()
+        measurement, contact = self.measure(held_wrench)
         q, v = self._robot
         measured = self.sensors.navigate(self.time_s, q, v, measurement)
         return self.sensors.see(self.time_s, self.state, measured), contact

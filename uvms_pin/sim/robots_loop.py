@@ -83,8 +83,8 @@ class RobotsLoop:
         `Robots.contact_signals`): a controller that raises leaves no robot's sample of the
         tick. The applied inputs."""
         ticked = []
-        for loop in self.loops:
-            measurement, contact = loop.observe()
+        for loop, held in zip(self.loops, self._held_wrenches(), strict=True):
+            measurement, contact = loop.observe(held)
             tau = loop.command(measurement)
             ticked.append((measurement, contact, tau, loop.actuate(tau)))
         if logged:
@@ -93,6 +93,23 @@ class RobotsLoop:
                 sample = loop.sample(*made)
                 loop.notify(replace(sample, signals={**sample.signals, **own}))
         return [made[3] for made in ticked]
+
+    def _held_wrenches(self) -> list[np.ndarray | None]:
+        """What each robot's force/torque sensor measures of the free objects it holds
+        (`SensorConfig.held_object_wrench`), at its end-effector frame's origin, world axes:
+        `Robots.object_wrenches` with the moment carried from the world's origin; None for a
+        robot whose sensor does not."""
+        wanted = [loop.sensors.config.held_object_wrench for loop in self.loops]
+        if not any(wanted):
+            return [None] * len(self.loops)
+        wrenches = self.system.object_wrenches(*self.state)
+        out = []
+        for loop, want, wrench in zip(self.loops, wanted, wrenches, strict=True):
+            if want:
+                at_sensor, _, _ = loop.plant.ee_state(loop.q, loop.v)
+                wrench = np.concatenate([wrench[:3], wrench[3:] - np.cross(at_sensor, wrench[:3])])
+            out.append(wrench if want else None)
+        return out
 
     def step(self, taus: list[np.ndarray]) -> None:
         """Every robot one control period on, its input of ``taus`` held.

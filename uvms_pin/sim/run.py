@@ -20,7 +20,7 @@ import numpy as np
 from uvms_pin.control.base import Controller
 from uvms_pin.control.spec import ControllerFactory, ControllerSpec
 from uvms_pin.control.tracking.task import TrackingTask
-from uvms_pin.errors import ParameterError, ShortenedRunWarning, SimulationError
+from uvms_pin.errors import ParameterError, ScenarioError, ShortenedRunWarning, SimulationError
 from uvms_pin.model.uvms import UVMS
 from uvms_pin.perception.scene import scene_of
 from uvms_pin.perception.suite import check_mounts, perceive
@@ -145,6 +145,11 @@ def _simulate(
     scenario: Scenario, observers: list[Observer], given: Controller | None, compiled: bool
 ) -> Rollout:
     settings = scenario.settings
+    if scenario.sensor_config.held_object_wrench:
+        raise ScenarioError(
+            f"{scenario.path}: [sensors] held_object_wrench is measured in runs of several "
+            "robots ([[robots]]) only"
+        )
     controller, sensors, metadata = run_parts(scenario, given)
     try:
         rollout = simulate_closed_loop(

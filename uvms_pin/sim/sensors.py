@@ -156,6 +156,10 @@ class SensorConfig:
         estimator: a navigation filter on them (`uvms_pin.sim.estimation`), or None; with
             ``controller_input = "estimate"`` the controller's measurement carries its
             estimate in place of the measured vehicle state.
+        held_object_wrench: the force/torque sensor also measures the wrench the robot's
+            pieces exert on the free objects (what its jaws hold), at its end-effector frame's
+            origin, world axes (`uvms_pin.sim.system.robots.Robots.object_wrenches`; runs of
+            several robots only).
     """
 
     force_noise: NoiseSpec = NoiseSpec()
@@ -168,6 +172,7 @@ class SensorConfig:
     navigation: NavigationSpec = field(default_factory=NavigationSpec)
     estimator: EstimatorSpec | None = None
     perception: PerceptionSpec = field(default_factory=PerceptionSpec)
+    held_object_wrench: bool = False
 
 
 class SensorSuite:

@@ -219,6 +219,35 @@ class Robots:
             ]
         return [{"robot_contact": wrenches} if len(wrenches) else {} for wrenches in logged]
 
+    def object_wrenches(self, q: np.ndarray, v: np.ndarray) -> list[np.ndarray]:
+        """Each robot's wrench on the free objects at (q, v), (6,) world axes: the force
+        [N] its pieces exert on them, summed, and its moment about the world's origin [N m]
+        (sum of p x f + m over the pairs): the first robot's from its system's contacts
+        (``world_contact``'s pairs with an object), the others' from their pairs with the
+        objects (``robot_contact``). Zero for a robot touching none."""
+        objects = {o.name for o in self.objects}
+        first = self.systems[0]
+        rows = [(first.logged_signals(*self.split(q, v)[0]).get("world_contact"),
+                 first.contact_pair_names)]  # fmt: skip
+        others = self.contact_signals(q, v)[1:]
+        rows += [
+            (own.get("robot_contact"), self.contact_pair_names(k))
+            for k, own in enumerate(others, start=1)
+        ]
+        out = []
+        for logged, names in rows:
+            wrench = np.zeros(6)
+            if logged is not None and len(names):
+                pairs = np.asarray(logged).reshape(len(names), 9)
+                held = [k for k, n in enumerate(names) if n.rsplit("|", 1)[-1] in objects]
+                force_on_object = -pairs[held, :3]
+                wrench[:3] = force_on_object.sum(axis=0)
+                wrench[3:] = (np.cross(pairs[held, 3:6], force_on_object) - pairs[held, 6:9]).sum(
+                    axis=0
+                )
+            out.append(wrench)
+        return out
+
     def contact_pair_names(self, robot: int) -> list[str]:
         """``name/body|name/body`` (or ``name/body|object``) of every pair of robot
         ``robot`` (an index)."""
