@@ -119,7 +119,7 @@ def bounded_thrust() -> dict[str, str]:
     """Every T200's forward and reverse limits divided by `THRUST_DIVISOR`."""
     return {
         f"{key} = {value}": f"{key} = {value / THRUST_DIVISOR:.3f}"
-        for key, value in (("max_forward_N", 51.48), ("max_reverse_N", 40.21))
+        for key, value in (("max_forward_N", 51.48), ("max_reverse_N", 39.91))
     }
 
 
