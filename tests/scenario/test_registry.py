@@ -20,6 +20,7 @@ BUILT_IN = (
     "computed_torque",
     "task_priority",
     "resolved_acceleration",
+    "joint_hold",
 )
 
 
