@@ -2,7 +2,9 @@
 
     uvms-pin run scenarios/hot_stab.toml --out out/hot_stab
     uvms-pin run scenarios/hot_stab.toml --out out/hot_stab_weak --set gripper.max_force_N=0.2
-    python scenarios/hot_stab_figure.py out/hot_stab out/hot_stab_weak docs/hot_stab.png
+    uvms-pin run scenarios/hot_stab.toml --out out/hot_stab_push --set controller.max_push_N=0.3
+    python scenarios/hot_stab_figure.py out/hot_stab out/hot_stab_weak out/hot_stab_push \
+        docs/hot_stab.png
 
 Top: the stab tip's depth past the receptacle's mouth (the chamfer's 10 mm before it, full
 depth 0.15 m); middle: the tip's lateral offset from the bore's axis (the clearance, 1.5 mm,
