@@ -298,11 +298,12 @@ class System:
 
     def stalled_solves(self) -> StalledSolves:
         """The run's constraint solves accepted after stalling (`StalledSolves`): the Python
-        step's and the compiled system's (rebuilt, so counted afresh, when a run starts)."""
-        core = self.compiled
-        if core is None or isinstance(core, Fallback):
+        step's and the compiled system's (rebuilt, so counted afresh, when a run starts; read
+        only when the run built it: a Python-stepped run does not build one to read zeros)."""
+        held = self.__dict__.get("_compiled")
+        if held is None or held[0] is not self.plant.compiled or isinstance(held[1], Fallback):
             return self.stalled
-        return self.stalled.merged(*core.stalled_solves)
+        return self.stalled.merged(*held[1].stalled_solves)
 
     def solves_record(self) -> dict[str, Any]:
         """``{"constraint_solves": ...}`` (`StalledSolves.record`) for a run's metadata when
