@@ -165,12 +165,6 @@ class World:
         self.objects = tuple(self.objects)
         self.free = tuple(self.free)
         self.fixtures = tuple(self.fixtures)
-        if self.fixtures and self.moving_contact == "rigid":
-            # the rigid rows map a pair's side to the robot or a free object's free-flyer
-            raise ParameterError(
-                'moving_contact = "rigid" is not available with fixtures ("urdf" objects) '
-                'yet: their links touch by the compliant law (moving_contact = "compliant")'
-            )
         bodies = self.uvms.surface_bodies
         self.body_names = [self.uvms.hydro_bodies[int(k)].name for k in bodies.body_index]
         self.pieces: tuple[RobotPiece, ...] = robot_pieces(self.uvms, self.body_names)

@@ -120,7 +120,11 @@ class System:
         self.object_contacts = self._object_contacts()
         moving = None if self.moving is None else self.moving.moving
         self.moving_constraints = (
-            MovingPairContacts(moving.sets, uvms.model.njoints)
+            MovingPairContacts(
+                moving.sets,
+                uvms.model.njoints,
+                (len(self.objects), fixture_joints.joint_ids(model.njoints, self.fixtures)),
+            )
             if moving is not None and moving.rigid_pairs and moving.sets
             else None
         )
