@@ -23,6 +23,8 @@ r + h J v+ = h sigma >= 0.
                                                period's end, never crossed: predictive)
     phi(r) = correction * r       for r < 0   (a penetration, e.g. an initial state past a
                                                limit, is removed by this fraction per period)
+    phi(e) = correction * e       on a bilateral row (an attachment's pose error e, held at
+                                  zero both ways: sigma = 0, the impulse of any sign)
 
 ``correction`` (0 < beta <= 1) is the discrete Baumgarte gain: beta = Kp h^2 of the
 continuous stabilisation r_ddot + Kd r_dot + Kp r = 0 sampled once per period. 1 removes a
@@ -325,6 +327,10 @@ def _solve(
     gap = np.concatenate([b.gap for b in blocks])
     positional = np.concatenate([b.positional for b in blocks])
     phi = np.where(positional, np.where(gap >= 0.0, gap, correction * gap), 0.0)
+    bilateral = np.concatenate(
+        [np.zeros(b.size, dtype=bool) if b.bilateral is None else b.bilateral for b in blocks]
+    )
+    phi = np.where(bilateral, correction * gap, phi)  # an error both ways (an attachment)
     minv_jt = np.linalg.solve(mass, jacobian.T)
     delassus = jacobian @ minv_jt
     drift = jacobian @ v_free + phi / h
