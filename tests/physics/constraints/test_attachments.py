@@ -108,6 +108,15 @@ def test_a_body_and_the_ball_it_holds_move_as_one_rigid_body(load_body):
     np.testing.assert_allclose(gap, [0.3, 0.0, 0.0], atol=1e-9)
 
 
+def _beyond_the_tool(uvms):
+    """(the neutral configuration, the tool's joint, a point 0.12 m along its joint's z)."""
+    q0 = uvms.neutral_configuration()
+    data = uvms.model.createData()
+    pin.forwardKinematics(uvms.model, data, q0)
+    joint = uvms.model.frames[uvms.model.getBodyId("tool")].parentJoint
+    return q0, joint, data.oMi[joint].act(np.array([0.0, 0.0, 0.12]))
+
+
 def test_the_tool_keeps_its_ball_while_the_arm_and_vehicle_are_driven(reference_uvms):
     """Random torques on every joint and the vehicle for 0.6 s (joints up to 2 rad/s): the
     ball stays at its pose in the tool's frame within 1e-4 (m and rad) while the tool moves
@@ -115,11 +124,7 @@ def test_the_tool_keeps_its_ball_while_the_arm_and_vehicle_are_driven(reference_
     (h |v|)^2 L on the anchor (a joint chain's end does not move on a screw) and the
     correction removes beta of it a period: about 3e-5 here, bounded, not integrated."""
     uvms = reference_uvms
-    q0 = uvms.neutral_configuration()
-    data = uvms.model.createData()
-    pin.forwardKinematics(uvms.model, data, q0)
-    jaw = uvms.model.frames[uvms.model.getBodyId("tool")].parentJoint
-    centre = data.oMi[jaw].act(np.array([0.0, 0.0, 0.12]))
+    q0, jaw, centre = _beyond_the_tool(uvms)
     system = _held(uvms, _ball(centre, density_kg_m3=2000.0, radius_m=0.03), "tool")
     rng = np.random.default_rng(7)
     torques = rng.uniform(-1.0, 1.0, (400, uvms.nv)) * np.r_[[4.0] * 6, [0.2] * (uvms.nv - 6)]
@@ -136,11 +141,7 @@ def test_the_tool_keeps_its_ball_while_the_arm_and_vehicle_are_driven(reference_
 
 def test_a_released_ball_sinks_away_from_the_tool(reference_uvms):
     uvms = reference_uvms
-    q0 = uvms.neutral_configuration()
-    data = uvms.model.createData()
-    pin.forwardKinematics(uvms.model, data, q0)
-    jaw = uvms.model.frames[uvms.model.getBodyId("tool")].parentJoint
-    centre = data.oMi[jaw].act(np.array([0.0, 0.0, 0.12]))
+    q0, _, centre = _beyond_the_tool(uvms)
     ball = _ball(centre, density_kg_m3=4000.0, radius_m=0.03)
     system = _held(uvms, ball, "tool", release_at_s=0.2)
     run = _run(system, q0, 0.5)
