@@ -235,10 +235,11 @@ _RESOLVED_ACCELERATION = {
     "model_error": {"mass_scale": 1.1},
 }
 # the tracking tasks: every path, both targets and frames, both tracking controllers
-#: a free object held by the jaw until 5 s (`attached_to`, `release_at_s`)
+#: a free object held by the jaw from 1 s to 5 s (`attached_to`, `attach_at_s`, `release_at_s`)
 _HELD_BALL = {
     "type": "sphere", "name": "held", "radius_m": 0.03, "density_kg_m3": 2000.0,
-    "position_world_m": [1.0, 0.0, -9.0], "attached_to": "alpha_jaw_link", "release_at_s": 5.0,
+    "position_world_m": [1.0, 0.0, -9.0], "attached_to": "alpha_jaw_link", "attach_at_s": 1.0,
+    "release_at_s": 5.0,
 }  # fmt: skip
 
 _VARIANTS += [

@@ -55,7 +55,7 @@ def test_the_vehicle_carries_the_ball_its_jaw_holds():
     assert held.q[-1, 2] < alone.q[-1, 2] - 1e-3
     world = held.metadata["world"]["world"]
     assert world["attachments"] == [
-        {"object_name": "ball", "link": "alpha_jaw_link", "release_at_s": None}
+        {"object_name": "ball", "link": "alpha_jaw_link", "release_at_s": None, "attach_at_s": 0.0}
     ]
     assert ATTACHMENT_REFUSAL in world["integration"]
 

@@ -1,5 +1,6 @@
 """``[world]``: objects (``[[world.objects]]``: fixed, or free with a ``mass_kg`` or
-``density_kg_m3``, held by a robot link with ``attached_to`` (until ``release_at_s``); a
+``density_kg_m3``, held by a robot link with ``attached_to`` (from ``attach_at_s`` until
+``release_at_s``); a
 ``type`` of `uvms_pin.physics.world.kinds`, whose keys and their
 check are its kind's; or ``type = "urdf"``, a fixture with joints, `uvms_pin.scenario.fixtures`) every body touches, the contact law's parameters
 (``[world.contact]``, with ``self_collision``), ``initial_overlap`` (what the start does
@@ -123,7 +124,11 @@ def _object(
         raise t.error("mass_kg", "give mass_kg or density_kg_m3, not both")
     if free and t.has("attached_to"):
         release = t.number("release_at_s", None, positive=True) if t.has("release_at_s") else None
-        attachments.append(Attachment(name, t.string("attached_to"), release))
+        begin = t.number("attach_at_s", 0.0, nonneg=True)
+        try:
+            attachments.append(Attachment(name, t.string("attached_to"), release, begin))
+        except ParameterError as exc:
+            raise t.error("release_at_s", str(exc)) from exc
     mu_s = t.number("friction_static", law.friction_static, nonneg=True)
     mu_k = t.number("friction_kinetic", min(law.friction_kinetic, mu_s), nonneg=True)
     raw = {key.name: KEY_READERS[key.holds](t, key, base_dir) for key in object_kind(kind).keys}

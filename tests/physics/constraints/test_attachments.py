@@ -156,6 +156,29 @@ def test_a_released_ball_sinks_away_from_the_tool(reference_uvms):
     assert apart[-1] > 0.05  # then it sinks: g' t^2 / 2 over 0.3 s is about 0.3 m
 
 
+def test_an_attachment_that_begins_later_holds_the_ball_where_it_then_is(reference_uvms):
+    """attach_at_s = 0.2: the heavy ball sinks on its own until then, and from then on
+    keeps its pose in the tool's frame as it was at 0.2 s."""
+    uvms = reference_uvms
+    q0, _, centre = _beyond_the_tool(uvms)
+    ball = _ball(centre, density_kg_m3=4000.0, radius_m=0.03)
+    attachment = Attachment("ball", "tool", attach_at_s=0.2)
+    built = World(uvms, [], free=[ball], attachments=[attachment])
+    system = System(Plant(uvms, free_surface=False, world=built))
+    run = _run(system, q0, 0.5)
+    begin = round(0.2 / PERIOD_S)
+    (held,) = system.attachments.held
+    model, moved = system.model, system.model.createData()
+    relative = []
+    for q, _ in run:
+        pin.forwardKinematics(model, moved, q)
+        pose = moved.oMi[held.link_joint].inverse() * moved.oMi[held.object_joint]
+        relative.append(pose.translation.copy())
+    relative = np.array(relative)
+    assert np.linalg.norm(relative[begin] - relative[0]) > 0.05  # it sank before
+    assert np.max(np.abs(relative[begin:] - relative[begin])) < 1e-4  # then held there
+
+
 def test_bad_attachments_are_refused_naming_the_object_or_the_link(reference_uvms):
     ball = _ball([3.0, 0.0, -5.0])
     with pytest.raises(ParameterError, match="'crate' is not a free object"):
@@ -165,8 +188,12 @@ def test_bad_attachments_are_refused_naming_the_object_or_the_link(reference_uvm
     with pytest.raises(ParameterError, match="attached twice"):
         World(reference_uvms, [], free=[ball],
               attachments=[Attachment("ball", "tool")] * 2)  # fmt: skip
-    with pytest.raises(ParameterError, match="release_at_s must be finite and > 0"):
+    with pytest.raises(ParameterError, match="release_at_s must be finite and after"):
         Attachment("ball", "tool", release_at_s=-1.0)
+    with pytest.raises(ParameterError, match=r"after attach_at_s \(0.5 s\), got 0.3"):
+        Attachment("ball", "tool", release_at_s=0.3, attach_at_s=0.5)
+    with pytest.raises(ParameterError, match="attach_at_s must be finite and >= 0"):
+        Attachment("ball", "tool", attach_at_s=float("nan"))
 
 
 def test_a_system_with_an_attachment_says_it_is_solved_in_python(reference_uvms):

@@ -4,7 +4,7 @@ object's free-flyer), solved implicitly by `step.constrained_velocity` with the 
 limits and the contacts.
 
 An attachment fixes the object's frame O in the link's joint frame L at their relative
-pose at the start, P = (oM_L)^-1 oM_O. Its six rows are bilateral (no cone, no sign):
+pose when it begins to hold (the start, or its ``attach_at_s``), P = (oM_L)^-1 oM_O. Its six rows are bilateral (no cone, no sign):
 
     J v = d e / dt,    e = log6(P^-1 (oM_L)^-1 oM_O)   [m; rad]
 
@@ -39,7 +39,8 @@ ATTACHMENT_REFUSAL = "a free object attached to a link (the attachments are solv
 @dataclass(frozen=True)
 class HeldObject:
     """One attachment in the system's model: its spec, the link's joint, the object's
-    free-flyer joint and the object's pose in the link's joint frame (set at the start)."""
+    free-flyer joint and the object's pose in the link's joint frame (taken when it begins
+    to hold)."""
 
     spec: Attachment
     link_joint: int
@@ -52,36 +53,51 @@ class Attachments:
 
     Args:
         joints: (spec, the link's joint, the object's free-flyer joint) of each attachment
-            in the system's model; each is placed at a run's start (`place`).
+            in the system's model. Each is placed when it begins to hold: at a run's start
+            (`place`) or at the first period from its ``attach_at_s`` (`rows`).
         name: the key of their impulses in a step's result.
     """
 
     def __init__(self, joints: Sequence[tuple[Attachment, int, int]], name: str = "attachments"):
+        for spec, link_joint, object_joint in joints:
+            if not (link_joint > 0 and object_joint > 0):
+                raise ParameterError(f"the attachment of '{spec.object_name}': no such joint")
         self.joints = tuple(joints)
         self.name = name
-        self.held: tuple[HeldObject, ...] = ()
-        self.time_s = 0.0  # the period's start: which attachments still hold
+        self.placed: dict[int, HeldObject] = {}  # each attachment's, once it holds
+        self.time_s = 0.0  # the period's start: which attachments hold
+
+    @property
+    def held(self) -> tuple[HeldObject, ...]:
+        """The attachments placed so far, in order."""
+        return tuple(self.placed[k] for k in sorted(self.placed))
 
     def place(self, model: pin.Model, q: np.ndarray) -> None:
-        """Each object held at its pose in its link's frame at ``q`` (a run's start)."""
+        """A run's start at ``q``: the attachments that hold at t = 0 are placed there, the
+        others forgotten until they begin."""
         data = model.createData()
         pin.forwardKinematics(model, data, q)
-        held = []
-        for spec, link_joint, object_joint in self.joints:
-            if not (0 < link_joint < model.njoints and 0 < object_joint < model.njoints):
-                raise ParameterError(f"the attachment of '{spec.object_name}': no such joint")
-            placement = data.oMi[link_joint].inverse() * data.oMi[object_joint]
-            held.append(HeldObject(spec, link_joint, object_joint, placement))
-        self.held, self.time_s = tuple(held), 0.0
+        self.placed, self.time_s = {}, 0.0
+        self._place_due(data)
 
     def at(self, time_s: float) -> None:
-        """The period starting at ``time_s``: the attachments released before it are off."""
+        """The period starting at ``time_s``: which attachments hold over it."""
         self.time_s = float(time_s)
+
+    def _place_due(self, data: pin.Data) -> None:
+        """Each attachment that holds at ``time_s`` and is not placed yet: at its object's
+        pose in its link's frame now (``data`` after the forward kinematics)."""
+        for k, (spec, link_joint, object_joint) in enumerate(self.joints):
+            if k not in self.placed and spec.held(self.time_s):
+                placement = data.oMi[link_joint].inverse() * data.oMi[object_joint]
+                self.placed[k] = HeldObject(spec, link_joint, object_joint, placement)
 
     def rows(
         self, model: pin.Model, data: pin.Data, q: np.ndarray, speed: np.ndarray, period_s: float
     ) -> ConstraintRows:
-        """Six bilateral rows for each attachment still holding (whatever the speed)."""
+        """Six bilateral rows for each attachment holding over the period (whatever the
+        speed); one that begins now is placed at ``q`` first."""
+        self._place_due(data)
         holding = [h for h in self.held if h.spec.held(self.time_s)]
         if not holding:
             return ConstraintRows.empty(self.name, ATTACHMENT_IMPULSE_UNIT, model.nv)
@@ -102,14 +118,6 @@ class Attachments:
             np.vstack(jacobians), gap, np.ones(gap.size, dtype=bool), tuple(labels),
             tuple(holding), np.ones(gap.size, dtype=bool),
         )  # fmt: skip
-
-    def wrenches(self, rows: ConstraintRows, impulse: np.ndarray, period_s: float) -> dict:
-        """Each holding attachment's mean wrench over a solved period on the object [N; N m]
-        (the constraint's impulse over h, in the anchor's frame): {object name: (6,)}."""
-        out = {}
-        for k, h in enumerate(rows.where):
-            out[h.spec.object_name] = np.asarray(impulse[6 * k : 6 * k + 6]) / period_s
-        return out
 
 
 def anchor_error(model: pin.Model, data: pin.Data, held: HeldObject) -> np.ndarray:
