@@ -168,7 +168,11 @@ def _mujoco_grasp(scenario, q: np.ndarray, block_pose: np.ndarray, options: Mjcf
     ET.SubElement(body, "freejoint", name="block")
     mass = 1.2 * 1025.0 * BLOCK_M[0] * BLOCK_M[1] * BLOCK_M[2]
     a, b, c = BLOCK_M
-    inertia = [mass * (b * b + c * c) / 12, mass * (a * a + c * c) / 12, mass * (a * a + b * b) / 12]
+    inertia = [
+        mass * (b * b + c * c) / 12,
+        mass * (a * a + c * c) / 12,
+        mass * (a * a + b * b) / 12,
+    ]
     ET.SubElement(body, "inertial", pos="0 0 0", mass=repr(mass),
                   diaginertia=" ".join(repr(x) for x in inertia))  # fmt: skip
     ET.SubElement(
