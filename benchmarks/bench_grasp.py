@@ -18,6 +18,13 @@ system's one call. Rows, one 1 ms period each (RK4 at 0.25 ms), as a ratio to th
 - + the grasped block (compliant contacts): the same with the contact law's springs, for
   scale.
 
+- MuJoCo on the same grasp: the jaw's MJCF twin (`uvms_pin.apps.export.mjcf`) with the block
+  and its contacts, settled 0.4 s in MuJoCo from uvms-pin's held state, each finger closed
+  by a 2 N motor; one 1 ms period as RK4 at 0.25 ms (uvms-pin's steps) and as MuJoCo's usual
+  single semi-implicit Euler step. Its soft contacts and pyramidal cones differ from the
+  rigid Coulomb cones here; the info line gives the block's slip over 0.5 s held, to show
+  both hold it.
+
 CPU time of this process, best of interleaved rounds, one BLAS thread (`timing.py`).
 """
 
@@ -27,12 +34,16 @@ import argparse
 import json
 import sys
 import tempfile
+import xml.etree.ElementTree as ET
 from pathlib import Path
 
+import mujoco
 import numpy as np
 from timing import best_times, one_blas_thread
 
 import uvms_pin as up
+from uvms_pin.apps.export.mjcf import MjcfOptions, uvms_to_mjcf
+from uvms_pin.apps.export.mujoco_state import qpos_from_q
 from uvms_pin.sim.integrators import RK4
 from uvms_pin.sim.plant import Plant
 from uvms_pin.sim.system import System
@@ -43,7 +54,15 @@ from jaw_helpers import FINGER_Z_M, PAD_M, parallel_jaw_urdf  # noqa: E402
 
 PERIOD_S, STEP_S = 1e-3, 2.5e-4
 BASE = "the jaw alone"
+RIGID = "+ the grasped block (rigid contacts)"
 BLOCK_M = (0.03, 0.04, 0.03)
+#: the MuJoCo twins of the grasp: RK4 at uvms-pin's 0.25 ms step, and MuJoCo's own usual
+#: setting, one semi-implicit Euler step a 1 ms period
+MUJOCO_TWINS = {
+    "MuJoCo, the grasp (RK4, 4 x 0.25 ms)": MjcfOptions(timestep_s=STEP_S, integrator="RK4"),
+    "MuJoCo, the grasp (Euler, 1 x 1 ms)": MjcfOptions(timestep_s=PERIOD_S, integrator="Euler"),
+}
+_HELD_BLOCK: list = [None]  # the block's pose in uvms-pin's held grasp (set by `_held`)
 
 
 def _split_pads(path: Path) -> Path:
@@ -109,6 +128,7 @@ def _held(folder: Path, contact: str):
     integrator = RK4(STEP_S)
     for k in range(20):  # its friction memories and forces settle
         q_s, v_s = system.advance(integrator, k * PERIOD_S, q_s, v_s, tau, (k + 1) * PERIOD_S)
+    _HELD_BLOCK[:] = [q_s[scenario.uvms.nq : scenario.uvms.nq + 7].copy()]
     sets, _ = system.moving.found(*system.robot_state(q_s, v_s), system.layout.split(q_s, v_s)[1:])
     points = sum(len(s) for s in sets)
     memories = [m for m in system.friction_memories() if m is not None]
@@ -122,6 +142,82 @@ def _held(folder: Path, contact: str):
     return call, points, q_s[: scenario.uvms.nq], v_s[: scenario.uvms.nv], scenario
 
 
+# ---- the MuJoCo twin of the grasp -----------------------------------------------------------
+
+
+def _mujoco_grasp(scenario, q: np.ndarray, block_pose: np.ndarray, options: MjcfOptions):
+    """The jaw's MJCF twin (`uvms_pin.apps.export.mjcf`: the same bodies, joints and
+    collision boxes) with the block: a free box of the same size and mass, friction 0.8, its
+    buoyancy a gravity compensation of 1/1.2 of its weight (the twin's fluid model gives it no
+    added mass); the robot's boxes touch the block, not one another. Each finger closes with
+    a 2 N motor (the servo saturated, as held in uvms-pin). (model, data) at the held state
+    of uvms-pin's grasp, then settled 0.4 s in MuJoCo's own contacts."""
+    uvms = scenario.uvms
+    root = ET.fromstring(uvms_to_mjcf(uvms, Path(uvms.source).read_text(), options))
+    for flag in root.iter("flag"):  # the twin is exported without contacts
+        flag.set("contact", "enable")
+    for geom in root.iter("geom"):
+        geom.set("contype", "1")
+        geom.set("conaffinity", "0")
+    world = root.find("worldbody")
+    body = ET.SubElement(
+        world, "body", name="block", gravcomp=repr(1.0 / 1.2),
+        pos=" ".join(repr(float(x)) for x in block_pose[:3]),
+        quat=" ".join(repr(float(x)) for x in (block_pose[6], *block_pose[3:6])),
+    )  # fmt: skip
+    ET.SubElement(body, "freejoint", name="block")
+    mass = 1.2 * 1025.0 * BLOCK_M[0] * BLOCK_M[1] * BLOCK_M[2]
+    a, b, c = BLOCK_M
+    inertia = [
+        mass * (b * b + c * c) / 12,
+        mass * (a * a + c * c) / 12,
+        mass * (a * a + b * b) / 12,
+    ]
+    ET.SubElement(body, "inertial", pos="0 0 0", mass=repr(mass),
+                  diaginertia=" ".join(repr(x) for x in inertia))  # fmt: skip
+    ET.SubElement(
+        body, "geom", type="box", size=" ".join(repr(x / 2) for x in BLOCK_M),
+        friction="0.8 0.005 0.0001", contype="0", conaffinity="1", condim="3",
+    )  # fmt: skip
+    actuators = ET.SubElement(root, "actuator")
+    for side in ("left", "right"):
+        ET.SubElement(actuators, "motor", joint=f"{side}_finger_joint", gear="1")
+    model = mujoco.MjModel.from_xml_string(ET.tostring(root, encoding="unicode"))
+    data = mujoco.MjData(model)
+    data.qpos[: model.nq - 7] = qpos_from_q(q)
+    data.qpos[model.nq - 7 :] = block_pose[[0, 1, 2, 6, 3, 4, 5]]
+    data.ctrl[:] = -2.0  # each finger closing with 2 N
+    mujoco.mj_forward(model, data)
+    for _ in range(round(0.4 / model.opt.timestep)):
+        mujoco.mj_step(model, data)
+    return model, data
+
+
+def _mujoco_period(model, data) -> tuple:
+    """One 1 ms period of the settled MuJoCo grasp from its state (restored at each call),
+    and the block's slip against the hull over a further 0.5 s held [m]."""
+    spec = mujoco.mjtState.mjSTATE_INTEGRATION
+    state = np.empty(mujoco.mj_stateSize(model, spec))
+    mujoco.mj_getState(model, data, state, spec)
+    steps = round(PERIOD_S / model.opt.timestep)
+
+    def call():
+        mujoco.mj_setState(model, data, state, spec)
+        for _ in range(steps):
+            mujoco.mj_step(model, data)
+
+    def offset():
+        hull = data.xpos[1].copy()
+        return data.qpos[model.nq - 7 : model.nq - 4] - hull
+
+    before = offset()
+    for _ in range(round(0.5 / model.opt.timestep)):
+        mujoco.mj_step(model, data)
+    slip = float(np.linalg.norm(offset() - before))
+    mujoco.mj_setState(model, data, state, spec)
+    return call, slip
+
+
 def cases(folder: Path) -> tuple[dict, dict]:
     rigid, points, q, v, scenario = _held(folder, "rigid")
     compliant, compliant_points, *_ = _held(folder, "compliant")
@@ -132,10 +228,16 @@ def cases(folder: Path) -> tuple[dict, dict]:
     integrator = RK4(STEP_S)
     table = {
         BASE: lambda: alone.advance(integrator, 0.0, q, v, tau, PERIOD_S),
-        "+ the grasped block (rigid contacts)": rigid,
+        RIGID: rigid,
         "+ the grasped block (compliant contacts)": compliant,
     }
-    return table, {"rigid_points": points, "compliant_points": compliant_points}
+    info = {"rigid_points": points, "compliant_points": compliant_points}
+    block = np.asarray(_HELD_BLOCK[0])
+    for label, options in MUJOCO_TWINS.items():
+        model, data = _mujoco_grasp(scenario, q, block, options)
+        table[label], info[f"{label}: block slip over 0.5 s [m]"] = _mujoco_period(model, data)
+        info[f"{label}: contacts"] = int(data.ncon)
+    return table, info
 
 
 def main() -> None:
@@ -147,11 +249,13 @@ def main() -> None:
         table, info = cases(Path(folder))
         best = best_times(table, args.repeat)
     print(f"contact points: {info}")
-    print("| one 1 ms period | time [us] | / the jaw alone |\n|---|---|---|")
+    print("| one 1 ms period | time [us] | / the jaw alone | uvms-pin rigid / this |")
+    print("|---|---|---|---|")
     rows = {}
     for name, seconds in best.items():
         rows[name] = {"s": seconds, "ratio": seconds / best[BASE]}
-        print(f"| {name} | {seconds * 1e6:.0f} | {seconds / best[BASE]:.2f} |")
+        versus = f"{best[RIGID] / seconds:.2f}" if name.startswith("MuJoCo") else ""
+        print(f"| {name} | {seconds * 1e6:.0f} | {seconds / best[BASE]:.2f} | {versus} |")
     if args.json:
         args.json.write_text(json.dumps({**info, "rows": rows}, indent=2))
 

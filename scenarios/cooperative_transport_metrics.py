@@ -14,7 +14,7 @@ The leader's (the first robot's rollout logs the bar, ``free_objects``):
 - ``bar_final_distance_m``: the bar centre's distance to the path's end at the last sample.
 - ``bar_tracking_error_max_m``, ``bar_tracking_error_rms_m``: |bar centre - x_d(t)| from the
   path's start on, x_d the desired path (the leader's logged target moved by its grasp
-  offset).
+  offset); left out of a run that ends before the path starts (a short sweep's).
 - ``bar_delivered``: 1 when ``bar_final_distance_m`` < 5 cm.
 
 The follower's:
@@ -71,12 +71,11 @@ def _leader(rollout, params: dict) -> dict[str, float]:
     moving = t >= float(params.get("path_start_s", 2.0))
     error = np.linalg.norm(bar - path, axis=1)[moving]
     final = float(np.linalg.norm(bar[-1] - end))
-    return {
-        "bar_final_distance_m": final,
-        "bar_tracking_error_max_m": float(error.max()),
-        "bar_tracking_error_rms_m": float(np.sqrt(np.mean(error**2))),
-        "bar_delivered": float(final < DELIVERED_WITHIN_M),
-    }
+    out = {"bar_final_distance_m": final, "bar_delivered": float(final < DELIVERED_WITHIN_M)}
+    if error.size:  # a run that ends before the path starts has no tracking error
+        out["bar_tracking_error_max_m"] = float(error.max())
+        out["bar_tracking_error_rms_m"] = float(np.sqrt(np.mean(error**2)))
+    return out
 
 
 def _follower(rollout) -> dict[str, float]:
@@ -112,11 +111,14 @@ def internal_force_N(first, second, first_share: float) -> np.ndarray:
 
 def team(rollouts) -> dict[str, float]:
     """The metrics of both robots: ``internal_force_max_N`` and ``internal_force_rms_N``
-    (`internal_force_N`, the leader first) after the first second (the grip settling)."""
+    (`internal_force_N`, the leader first) after the first second (the grip settling); none
+    for a run shorter than that."""
     leader, follower = (rollouts.robot(n) for n in rollouts.names)
     share = float(_parameters(leader)["load_share"])
     force = internal_force_N(leader, follower, share)
     settled = np.asarray(leader.time_s) >= WARM_UP_S
+    if not np.any(settled):  # a run shorter than the grip's settling
+        return {}
     return {
         "internal_force_max_N": float(force[settled].max()),
         "internal_force_rms_N": float(np.sqrt(np.mean(force[settled] ** 2))),

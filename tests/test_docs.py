@@ -235,6 +235,13 @@ _RESOLVED_ACCELERATION = {
     "model_error": {"mass_scale": 1.1},
 }
 # the tracking tasks: every path, both targets and frames, both tracking controllers
+#: a free object held by the jaw from 1 s to 5 s (`attached_to`, `attach_at_s`, `release_at_s`)
+_HELD_BALL = {
+    "type": "sphere", "name": "held", "radius_m": 0.03, "density_kg_m3": 2000.0,
+    "position_world_m": [1.0, 0.0, -9.0], "attached_to": "alpha_jaw_link", "attach_at_s": 1.0,
+    "release_at_s": 5.0,
+}  # fmt: skip
+
 _VARIANTS += [
     ("valve_panel.toml", {}),
     ("gripper_close.toml", {"gripper.joints": ["alpha_jaw_finger_130_joint", "alpha_jaw_finger_139_joint"]}),
@@ -273,6 +280,7 @@ _VARIANTS += [
     ),
     ("lbv150_ee_circle.toml", {"task": {"type": "hold", "target": "vehicle"}}, True),
     ("two_robots.toml", {}),
+    ("push_object.toml", {"world.objects": [_HELD_BALL]}),
     (
         "estimator_station_keeping.toml",
         {"estimator.draw_initial_error": False, "estimator.gyro_noise_rad_s_rthz": 1e-3,

@@ -23,7 +23,7 @@ from uvms_pin.scenario.load import load_scenario
 from uvms_pin.sim.closed_loop import ClosedLoop
 from uvms_pin.sim.integrators import RK4, Adaptive, SemiImplicitEuler
 from uvms_pin.sim.run import simulate
-from uvms_pin.sim.stiff_modes import StiffMode, environment_mode, stop_modes
+from uvms_pin.sim.stiff_modes import StiffMode, candidate_contacts, environment_mode, stop_modes
 from uvms_pin.sim.stiffness import (
     check_stiff_modes,
     is_stable,
@@ -237,3 +237,68 @@ def test_the_arm_against_its_own_vehicle_is_a_mode_of_their_relative_motion():
     assert "link 'alpha_jaw_link'" in own and "link 'alpha_upper_arm_link_cob'" in own
     for link, mass in own.items():
         assert 0.0 < mass <= world[link] + 1e-12
+
+
+def _handle_mobility_1_kg(system, state) -> float:
+    """The valve handle's largest point mobility [1/kg] over its pieces' candidate points,
+    by hand: one revolute joint of inertia I (the system's M block, added mass included)
+    about the unit axis a through o, a point p moves at a x (p - o) per rad/s:
+    |a x (p - o)|^2 / I."""
+    fixture = system.fixtures[0]
+    model = fixture.uvms.model
+    data = model.createData()
+    q = state.q[system.layout.q_slices[-1]]
+    part = system.layout.v_slices[-1]
+    inertia = float(system.mass_matrix(0.0, state.q)[part, part][0, 0])
+    pin.forwardKinematics(model, data, q)
+    axis, origin = data.oMi[1].rotation[:, 0], data.oMi[1].translation
+    worst = 0.0
+    for piece in (p for p in fixture.pieces if p.joint_id == 1):
+        for point, _ in candidate_contacts(piece):
+            lever = np.cross(axis, data.oMi[1].act(point) - origin)
+            worst = max(worst, float(lever @ lever) / inertia)
+    return worst
+
+
+def test_a_fixtures_moving_link_is_a_mode_of_its_joints_inertia():
+    """A robot link against the valve's handle: the pair's 1/m_eff is the link's (as
+    against the panel's fixed plate) plus the handle's, the handle's its points'
+    |a x r|^2 / I."""
+    scenario = load_scenario(SCENARIOS / "valve_turn.toml")
+    loop = ClosedLoop(scenario.plant, scenario.settings)
+    state = loop.system.initial_state(scenario.q0, scenario.v0)
+    modes = system_modes(loop.system, state)
+    handle = {
+        m.what.split(" against")[0]: m.mass
+        for m in modes
+        if "joint 'valve' of fixture 'panel', at first touch" in m.what
+    }
+    # the panel's plate is on the universe: against it a link moves alone
+    alone = {
+        m.what.split(" against")[0]: m.mass
+        for m in modes
+        if "fixture 'panel's base, at first touch" in m.what
+    }
+    assert set(handle) == set(alone) and len(handle) > 5
+    expected = _handle_mobility_1_kg(loop.system, state)
+    for link, mass in handle.items():
+        assert 1.0 / mass - 1.0 / alone[link] == pytest.approx(expected, rel=1e-9)
+    based = [m for m in modes if "fixture 'panel's base" in m.what]
+    assert all("moving_contact" in m.remedy for m in based)
+
+
+def test_a_stiff_fixture_contact_is_refused_naming_the_rigid_remedy():
+    """Contacts a hundred times stiffer put the jaw against the handle past its stable step;
+    the refusal names the fixture and the rigid moving contact, with which that pair is a
+    constraint (no longer a mode)."""
+    stiff = {"world.contact.stiffness_N_m": 2.0e6}
+    scenario = load_scenario(SCENARIOS / "valve_turn.toml", stiff)
+    loop = ClosedLoop(scenario.plant, scenario.settings)
+    state = loop.system.initial_state(scenario.q0, scenario.v0)
+    with pytest.raises(StiffModeError, match="fixture 'panel'") as caught:
+        check_stiff_modes(loop.system, state, scenario.settings.integrator)
+    assert 'moving_contact = "rigid"' in str(caught.value)
+    rigid = load_scenario(SCENARIOS / "valve_turn.toml", {**stiff, "world.moving_contact": "rigid"})
+    loop = ClosedLoop(rigid.plant, rigid.settings)
+    modes = system_modes(loop.system, loop.system.initial_state(rigid.q0, rigid.v0))
+    assert not any("fixture" in m.what for m in modes)

@@ -1,5 +1,7 @@
 """``[world]``: objects (``[[world.objects]]``: fixed, or free with a ``mass_kg`` or
-``density_kg_m3``; a ``type`` of `uvms_pin.physics.world.kinds`, whose keys and their
+``density_kg_m3``, held by a robot link with ``attached_to`` (from ``attach_at_s`` until
+``release_at_s``); a
+``type`` of `uvms_pin.physics.world.kinds`, whose keys and their
 check are its kind's; or ``type = "urdf"``, a fixture with joints, `uvms_pin.scenario.fixtures`) every body touches, the contact law's parameters
 (``[world.contact]``, with ``self_collision``), ``initial_overlap`` (what the start does
 with a free object inside another body) and ``fixed_contact`` (rigid or compliant: how
@@ -14,6 +16,7 @@ from typing import Any
 from uvms_pin.checks import check_memory
 from uvms_pin.errors import ParameterError
 from uvms_pin.model.uvms import UVMS
+from uvms_pin.physics.world.attachment import Attachment
 from uvms_pin.physics.world.contact_law import ContactLaw
 from uvms_pin.physics.world.fixture import FIXTURE_TYPE, Fixture
 from uvms_pin.physics.world.free_object import FreeObject, free_mass, free_object_of
@@ -60,7 +63,8 @@ def build_world(t: Table | None, uvms: UVMS, base_dir: Path) -> World | None:
         "give fewer [[world.objects]]",
         lambda message: t.error("objects", message),
     )
-    built = [_object(o, k, law, base_dir, uvms) for k, o in enumerate(tables)]
+    attachments: list[Attachment] = []
+    built = [_object(o, k, law, base_dir, uvms, attachments) for k, o in enumerate(tables)]
     overlap = t.string("initial_overlap", "refuse", choices=INITIAL_OVERLAP)
     free_contact = t.string("fixed_contact", "rigid", choices=FIXED_CONTACT)
     moving_contact = t.string("moving_contact", "compliant", choices=MOVING_CONTACT)
@@ -73,7 +77,7 @@ def build_world(t: Table | None, uvms: UVMS, base_dir: Path) -> World | None:
     try:
         return World(
             uvms, fixed, law, free, self_collision, overlap, free_contact,
-            fixtures=fixtures, moving_contact=moving_contact,
+            fixtures=fixtures, moving_contact=moving_contact, attachments=attachments,
         )  # fmt: skip
     except ParameterError as exc:
         raise t.fail(str(exc)) from exc
@@ -95,8 +99,10 @@ def _law(t: Table) -> ContactLaw:
 
 
 def _object(
-    t: Table, index: int, law: ContactLaw, base_dir: Path, uvms: UVMS
+    t: Table, index: int, law: ContactLaw, base_dir: Path, uvms: UVMS, attachments: list
 ) -> WorldObject | FreeObject | Fixture:
+    """The object of table ``t``; a free object's ``attached_to`` (and ``release_at_s``)
+    appended to ``attachments``."""
     kind = t.string("type", choices=(*kind_names(), FIXTURE_TYPE))
     name = t.string("name", f"{kind}{index}")
     if kind == FIXTURE_TYPE:  # an articulated body, not a shape (`scenario.fixtures`)
@@ -116,6 +122,13 @@ def _object(
         raise t.error("type", f"a {kind} cannot be free (it has no mass)")
     if mass is not None and density is not None:
         raise t.error("mass_kg", "give mass_kg or density_kg_m3, not both")
+    if free and t.has("attached_to"):
+        release = t.number("release_at_s", None, positive=True) if t.has("release_at_s") else None
+        begin = t.number("attach_at_s", 0.0, nonneg=True)
+        try:
+            attachments.append(Attachment(name, t.string("attached_to"), release, begin))
+        except ParameterError as exc:
+            raise t.error("release_at_s", str(exc)) from exc
     mu_s = t.number("friction_static", law.friction_static, nonneg=True)
     mu_k = t.number("friction_kinetic", min(law.friction_kinetic, mu_s), nonneg=True)
     raw = {key.name: KEY_READERS[key.holds](t, key, base_dir) for key in object_kind(kind).keys}

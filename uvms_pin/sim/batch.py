@@ -20,7 +20,9 @@ from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
 
 from uvms_pin.checks import thread_count
+from uvms_pin.results.robots import RobotRollouts
 from uvms_pin.results.rollout import Rollout
+from uvms_pin.sim.robots_run import RobotsScenario, simulate_robots
 from uvms_pin.sim.run import Scenario, simulate
 
 
@@ -31,15 +33,19 @@ class BatchRun:
     KeyboardInterrupt, or any other exception the run raised; None for a run that
     finished)."""
 
-    rollout: Rollout | None
+    rollout: Rollout | RobotRollouts | None
     error: BaseException | None = None
     wall_s: float = 0.0  # the run's own wall time (others ran meanwhile)
 
 
 def run_batch(
-    scenarios: Sequence[Scenario], num_threads: int | None = None, *, compiled_loop: bool = True
+    scenarios: Sequence[Scenario | RobotsScenario],
+    num_threads: int | None = None,
+    *,
+    compiled_loop: bool = True,
 ) -> list[BatchRun]:
-    """Simulate each of ``scenarios`` (each used by one run only) on ``num_threads`` threads
+    """Simulate each of ``scenarios`` (each used by one run only; a scenario of several
+    robots by `simulate_robots`, its rollout a `RobotRollouts`) on ``num_threads`` threads
     (default: the CPU count); one `BatchRun` per scenario, in order. Ctrl-C stops every run at
     its next logged sample (each keeps its partial rollout) and is raised again, with the
     batch's runs as ``exc.runs``."""
@@ -53,7 +59,10 @@ def run_batch(
 
         start = time.perf_counter()
         try:
-            rollout = simulate(scenario, progress=progress, compiled_loop=compiled_loop)
+            if isinstance(scenario, RobotsScenario):  # several robots: their own run
+                rollout = simulate_robots(scenario, progress=progress)
+            else:
+                rollout = simulate(scenario, progress=progress, compiled_loop=compiled_loop)
             return BatchRun(rollout, None, time.perf_counter() - start)
         except (Exception, KeyboardInterrupt) as exc:  # the run's outcome, kept with the others'
             return BatchRun(getattr(exc, "rollout", None), exc, time.perf_counter() - start)

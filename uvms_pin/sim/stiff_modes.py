@@ -11,9 +11,11 @@ rates lambda = -c / (2 m_eff) +- sqrt((c / (2 m_eff))^2 - k / m_eff) [1/s]. Whic
 
 - a world contact (`uvms_pin.physics.world.contact_law`) of each body (each hull of the
   robot, each free object) against the fixed world, of each pair of moving bodies that can
-  touch (the robot's bodies and the free objects, the free objects between them, with
-  ``self_collision`` the arm's links against their vehicle), with 1/m_eff the sum of both
-  sides' (the arm against its own vehicle: of the two points' relative Jacobian). A body's
+  touch (the robot's bodies and the free objects, the free objects between them, each of
+  them against each fixture's links, with ``self_collision`` the arm's links against their
+  vehicle), with 1/m_eff the sum of both sides' (the arm against its own vehicle: of the
+  two points' relative Jacobian; a fixture's link through its own joints, its root link
+  fixed). A body's
   candidate points are its collision pieces' corners (a box's, a mesh hull's, a cylinder's
   rim prism) and, for a sphere or ellipsoid, its tips along its axes; its m_eff the lightest of them along its most mobile direction (the normal can be
   any: the body turns, an object lies anywhere; a sphere's or an ellipsoid's normal is its
@@ -190,16 +192,20 @@ def body_mobility(
     return worst
 
 
-def contact_modes(what: str, first: Body, second: Body | None, law: ContactLaw) -> list[StiffMode]:
+def contact_modes(
+    what: str, first: Body, second: Body | None, law: ContactLaw, moving: bool = False
+) -> list[StiffMode]:
     """The two normal modes of ``first`` against ``second`` (None: the fixed world): at first
-    touch and at the deeper of both bodies' working depth."""
+    touch and at the deeper of both bodies' working depth. ``moving``: a pair between moving
+    bodies whose second side is fixed all the same (a fixture's root link), whose remedy is
+    the rigid moving contact."""
     mobility = first.mobility_1_kg + (0.0 if second is None else second.mobility_1_kg)
     if not mobility > 0.0:
         return []
     depth = max(first.working_depth_m, 0.0 if second is None else second.working_depth_m)
     k, mass = law.stiffness_N_m, 1.0 / mobility
     damping = k * law.dissipation_s_m * depth
-    remedy = _SOFTER_CONTACT if second is None else _RIGID_PAIRS + _SOFTER_CONTACT
+    remedy = _SOFTER_CONTACT if second is None and not moving else _RIGID_PAIRS + _SOFTER_CONTACT
     return [
         StiffMode(f"{what}, at first touch", k, 0.0, mass, remedy=remedy),
         StiffMode(f"{what}, {depth * 1e3:.3g} mm deep", k, damping, mass, remedy=remedy),

@@ -99,6 +99,31 @@ def _object_bodies(system: System, state: SystemState, inverse: np.ndarray) -> l
     return out
 
 
+def _fixture_bodies(
+    system: System, state: SystemState, inverse: np.ndarray
+) -> tuple[list[Body], list[str]]:
+    """Each fixture's links that move (a joint >= 1 carries their pieces), their mobility
+    through the fixture's own joints (its block of M^-1), and the fixtures whose root link
+    touches (fixed: a contact there is one with the fixed world). A link's working depth is
+    the least (its weight goes to its joint)."""
+    law, layout = system.plant.world.law, system.layout
+    first = 1 + len(system.objects)
+    links, rooted = [], []
+    for k, fixture in enumerate(system.fixtures):
+        model = fixture.uvms.model
+        data = model.createData()
+        pin.computeJointJacobians(model, data, state.q[layout.q_slices[first + k]])
+        part = layout.v_slices[first + k]
+        if any(p.joint_id == 0 for p in fixture.pieces):
+            rooted.append(fixture.name)
+        for joint in sorted({p.joint_id for p in fixture.pieces} - {0}):
+            pieces = [p for p in fixture.pieces if p.joint_id == joint]
+            mobility = body_mobility(model, data, inverse[part, part], pieces)
+            name = f"link on joint '{model.names[joint]}' of fixture '{fixture.name}'"
+            links.append(Body(name, mobility, working_depth_m(0.0, law)))
+    return links, rooted
+
+
 def _self_bodies(system: System, data: pin.Data, inverse: np.ndarray) -> list[Body]:
     """The arm's links that can touch their vehicle, each relative to it."""
     world, uvms = system.plant.world, system.plant.uvms
@@ -136,6 +161,13 @@ def _world_modes(
     for body in robot:
         for obj in objects:
             modes += contact_modes(f"{body.name} against the {obj.name}", body, obj, law)
+    links, rooted = _fixture_bodies(system, state, inverse)
+    for body in [*robot, *objects]:
+        for link in links:
+            modes += contact_modes(f"{body.name} against the {link.name}", body, link, law)
+        for name in rooted:  # the fixture's fixed root link: a moving pair all the same
+            modes += contact_modes(f"{body.name} against fixture '{name}'s base", body, None,
+                                   law, moving=True)  # fmt: skip
     for i, first in enumerate(objects):
         for other in objects[i + 1 :]:
             modes += contact_modes(f"{first.name} against the {other.name}", first, other, law)

@@ -279,3 +279,16 @@ def test_same_motion_when_the_water_only_buoys(system):
             uvms.water_density_kg_m3,
             MjcfOptions().viscosity_Pa_s,
         )
+
+
+def test_a_model_without_an_end_effector_is_exported_without_sites(tmp_path):
+    """A jaw rig (tests/jaw_helpers.py) has no end-effector or sensor frame: its twin has its
+    bodies and joints and no site (the export used to index the frames with None)."""
+    import mujoco
+    from jaw_helpers import parallel_jaw_urdf
+
+    path = parallel_jaw_urdf(tmp_path)
+    uvms = up.load_uvms(path)
+    assert uvms.ee_frame_id is None and uvms.sensor_frame_id is None
+    twin = mujoco.MjModel.from_xml_string(uvms_to_mjcf(uvms, path.read_text()))
+    assert twin.nsite == 0 and twin.njnt == 3 and twin.nv == uvms.nv

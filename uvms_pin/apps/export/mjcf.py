@@ -152,7 +152,9 @@ def uvms_to_mjcf(
     for j in range(1, model.njoints):
         bodies[j] = _joint_body(uvms, j, bodies[model.parents[j]], axes[j], options)
     _add_fluid_geoms(uvms, urdf, bodies, options, Path(base_dir), package_dirs)
-    for frame_id in dict.fromkeys((uvms.ee_frame_id, uvms.sensor_frame_id)):
+    # a model without an end-effector or a sensor frame (a jaw rig, a bare vehicle) has no site
+    frames = (uvms.ee_frame_id, uvms.sensor_frame_id)
+    for frame_id in dict.fromkeys(f for f in frames if f is not None):
         frame = model.frames[frame_id]
         _placed(bodies[frame.parentJoint], "site", frame.placement, name=frame.name)
     if options.spring_stiffness_N_m > 0.0:

@@ -21,6 +21,8 @@ import numpy as np
 
 from uvms_pin.apps.study.spec import Run
 from uvms_pin.errors import ControllerError, FunnelViolation, SimulationError
+from uvms_pin.results.robots import RobotRollouts
+from uvms_pin.sim.robots_run import RobotsScenario
 
 #: Runs per Dask task: fewer tasks to schedule, runs of a task overlapping on threads.
 RUNS_PER_TASK = 4
@@ -43,7 +45,8 @@ def execute_runs(
 
     def load(row: dict[str, Any], run: Run):
         scenario = _scenario(base, run)
-        row["net_buoyancy_N"] = scenario.uvms.net_buoyancy_N
+        for prefix, robot in _robots(scenario):
+            row[f"{prefix}net_buoyancy_N"] = robot.uvms.net_buoyancy_N
         return scenario
 
     def fill(row: dict[str, Any], scenario, outcome, run: Run) -> None:
@@ -122,11 +125,29 @@ def _outcome_into(row: dict[str, Any], outcome, run: Run, rollout_dir: str | Non
         raise exc
     elif exc is not None:  # a bug or a bad input in one run must not stop the study
         _failed(row, exc)
-    if rollout is not None:
+    if isinstance(rollout, RobotRollouts):  # several robots: each one's columns, "name/..."
+        for name in rollout.names:
+            row.update(_prefixed(f"{name}/", rollout_quantities(rollout.robot(name))))
+        for name, metrics in {**rollout.metrics(), **rollout.object_metrics()}.items():
+            row.update(_prefixed(f"{name}/", metrics))
+    elif rollout is not None:
         row.update(rollout_quantities(rollout))
         row.update(rollout.metrics())
+    if rollout is not None:
         if rollout_dir is not None:
             rollout.save(Path(rollout_dir) / run.run_id)
+
+
+def _robots(scenario) -> list[tuple[str, Any]]:
+    """(column prefix, scenario) of each robot: "" for a single robot's scenario, "name/"
+    for each of several robots'."""
+    if isinstance(scenario, RobotsScenario):
+        return [(f"{n}/", r) for n, r in zip(scenario.names, scenario.robots, strict=True)]
+    return [("", scenario)]
+
+
+def _prefixed(prefix: str, values: dict[str, Any]) -> dict[str, Any]:
+    return {f"{prefix}{k}": v for k, v in values.items()}
 
 
 def base_row(run: Run) -> dict[str, Any]:

@@ -15,13 +15,20 @@ import functools
 from uvms_pin.control.spec import ControllerSpec
 from uvms_pin.model.scaled import scaled_uvms
 from uvms_pin.model.uvms import UVMS
+from uvms_pin.sim.robots_run import RobotsScenario
 from uvms_pin.sim.run import Scenario
 
 
-def modify_plant(scenario: Scenario, factors: dict[str, float]) -> Scenario:
-    """The scenario with its plant's UVMS scaled by ``factors`` (names of `scaled_uvms`)."""
+def modify_plant(
+    scenario: Scenario | RobotsScenario, factors: dict[str, float]
+) -> Scenario | RobotsScenario:
+    """The scenario with its plant's UVMS scaled by ``factors`` (names of `scaled_uvms`);
+    a scenario of several robots with every robot's plant scaled alike."""
     if all(v == 1.0 for v in factors.values()):
         return scenario
+    if isinstance(scenario, RobotsScenario):
+        robots = tuple(modify_plant(robot, factors) for robot in scenario.robots)
+        return dataclasses.replace(scenario, robots=robots)
     nominal, spec = scenario.uvms, scenario.controller_factory
     uvms = scaled_uvms(nominal, **factors)
     plant = dataclasses.replace(scenario.plant, uvms=uvms)

@@ -142,8 +142,12 @@ def point_jacobian(
     model: pin.Model, data: pin.Data, joint_id: int, point: np.ndarray
 ) -> np.ndarray:
     """J_p (3 x nv): the world velocity of the body point at ``point`` (world) [m/s],
-    v_p = v_o + w x (p - o) from the joint's world-aligned Jacobian at its origin o."""
-    jacobian = pin.getJointJacobian(model, data, joint_id, pin.LOCAL_WORLD_ALIGNED)
+    v_p = v_o + w x (p - o) from the joint's world-aligned Jacobian at its origin o; zero on
+    the universe (joint 0: a fixture's root link), whose Jacobian Pinocchio does not give."""
+    if joint_id == 0:
+        return np.zeros((3, model.nv))
+    # a model of one velocity (a fixture's single joint): eigenpy gives a (6,) vector
+    jacobian = pin.getJointJacobian(model, data, joint_id, pin.LOCAL_WORLD_ALIGNED).reshape(6, -1)
     offset = point - data.oMi[joint_id].translation
     return jacobian[:3] - pin.skew(offset) @ jacobian[3:]
 

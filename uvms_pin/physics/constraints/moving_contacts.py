@@ -73,18 +73,26 @@ class _Solved:
     frame: np.ndarray
 
 
-def _on_joint(pieces: Sequence[RobotPiece], side: int, first_object_joint: int):
+def _on_joint(pieces: Sequence[RobotPiece], side: int, first_object_joint: int, fixtures):
     """The pieces of one side on their joints in the system's model: the robot's as they
-    are, free object k's on its free-flyer ``first_object_joint + k``."""
+    are, free object k's on its free-flyer ``first_object_joint + k``, fixture k's (side
+    ``n_objects + k``; ``fixtures`` = (n_objects, each fixture's system joints)) on the
+    system joint of their own joint j >= 1, its root link's (j = 0) on the universe."""
+    n_objects, fixture_joints = fixtures
     if side < 0:
         return tuple(pieces)
-    return tuple(dataclasses.replace(p, joint_id=first_object_joint + side) for p in pieces)
+    if side < n_objects or not fixture_joints:
+        return tuple(dataclasses.replace(p, joint_id=first_object_joint + side) for p in pieces)
+    own = (0, *fixture_joints[side - n_objects])
+    return tuple(dataclasses.replace(p, joint_id=own[p.joint_id]) for p in pieces)
 
 
 def _reach_speed(model: pin.Model, data: pin.Data, piece: RobotPiece, speed: np.ndarray):
     """A bound [m/s] on the speed of any point of ``piece`` when each velocity coordinate
     moves at most ``speed``: |J_lin(c)| speed + |J_ang| speed * R, c its frame's origin."""
     joint = piece.joint_id
+    if joint == 0:  # a fixture's root link: fixed
+        return 0.0
     centre = (data.oMi[joint] * piece.placement_in_joint).translation
     linear = np.abs(point_jacobian(model, data, joint, centre)) @ speed
     angular = np.abs(pin.getJointJacobian(model, data, joint, pin.LOCAL_WORLD_ALIGNED)[3:]) @ speed
@@ -99,6 +107,9 @@ class MovingPairContacts:
             their memories kept between periods (which pairs slide).
         first_object_joint: free object 0's free-flyer in the system's model (object k's is
             the next k-th).
+        fixtures: (the number of free objects, each fixture's joints in the system's model,
+            its own joints 1, 2, ... in order: `uvms_pin.sim.system.fixtures.joint_ids`);
+            a fixture's side in ``sets`` follows the free objects'.
         margin: [m] the allowance of a contact's selection (`step.constrained_velocity`).
         name: the key of the impulses in the step's result.
     """
@@ -107,6 +118,7 @@ class MovingPairContacts:
         self,
         sets: Sequence[PairSet],
         first_object_joint: int,
+        fixtures: tuple[int, Sequence[tuple[int, ...]]] = (0, ()),
         margin: float = 1.0e-3,
         name: str = "moving_contacts",
     ):
@@ -115,8 +127,8 @@ class MovingPairContacts:
         self.sets, self.margin, self.name = tuple(sets), float(margin), name
         self._pieces = [
             (
-                _on_joint(s.pairs.pieces_a, s.a, first_object_joint),
-                _on_joint(s.pairs.pieces_b, s.b, first_object_joint),
+                _on_joint(s.pairs.pieces_a, s.a, first_object_joint, fixtures),
+                _on_joint(s.pairs.pieces_b, s.b, first_object_joint, fixtures),
             )
             for s in self.sets
         ]

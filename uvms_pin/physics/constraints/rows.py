@@ -37,6 +37,9 @@ class ConstraintRows:
         labels: one label per row, for messages and logs.
         where: what the set needs to read its impulses back (its contact points, one
             entry per three rows of a contact set), or empty.
+        bilateral: (m,) bool, the rows held at zero both ways (an attachment's): their
+            gap is an error the step removes at the correction's rate whatever its sign;
+            None: none.
     """
 
     name: str
@@ -48,6 +51,7 @@ class ConstraintRows:
     positional: np.ndarray
     labels: tuple[str, ...]
     where: tuple = ()
+    bilateral: np.ndarray | None = None
 
     @property
     def size(self) -> int:

@@ -23,6 +23,8 @@ r + h J v+ = h sigma >= 0.
                                                period's end, never crossed: predictive)
     phi(r) = correction * r       for r < 0   (a penetration, e.g. an initial state past a
                                                limit, is removed by this fraction per period)
+    phi(e) = correction * e       on a bilateral row (an attachment's pose error e, held at
+                                  zero both ways: sigma = 0, the impulse of any sign)
 
 ``correction`` (0 < beta <= 1) is the discrete Baumgarte gain: beta = Kp h^2 of the
 continuous stabilisation r_ddot + Kd r_dot + Kp r = 0 sampled once per period. 1 removes a
@@ -43,11 +45,15 @@ accepted when its residual is at most `ACCEPTABLE_RELATIVE_RESIDUAL` (1e-4) of t
 speed its rows must absorb, |g|_inf = |J v_free + phi(r) / h|_inf, and at least
 `ACCEPTABLE_RESIDUAL_M_S` (1e-5 m/s: a gap wrong by 1e-8 m over a 1 ms period); the run
 counts those periods (`StalledSolves`) and its metadata says how many and the largest
-residual. Above it the run stops, naming the period.
+residual. A solve that stalls above it is solved once more with the ADMM's Anderson
+acceleration, which breaks such cycles where plain iterations do not (a stab held in its
+receptacle's bore: 5.1e-5 m/s after 5,000 plain iterations, 1.6e-8 after 461 accelerated);
+only if that one too ends above the bound does the run stop, naming the period.
 """
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass
@@ -79,6 +85,9 @@ DEFAULT_CORRECTION = 0.2
 #: [m/s] (the module docstring)
 ACCEPTABLE_RELATIVE_RESIDUAL = 1.0e-4
 ACCEPTABLE_RESIDUAL_M_S = 1.0e-5
+#: the iterates the ADMM's Anderson acceleration combines when a plain solve stalled
+#: (`_solve_or_accelerate`)
+ANDERSON_CAPACITY = 5
 
 #: How often the selection of rows is widened (see `constrained_velocity`)
 _MAX_ROUNDS = 4
@@ -226,14 +235,39 @@ def constrained_velocity(
     if least_speed is not None:
         speed = np.maximum(speed, np.abs(finite_vector("least_speed", least_speed, model.nv)))
     blocks = tuple(c.rows(model, data, q, speed, h) for c in constraints)
+    settings = settings or default_settings()
     for _ in range(_MAX_ROUNDS):
-        step = _solve(mass, v_free, blocks, h, correction, settings or default_settings())
+        step = _solve_or_accelerate(mass, v_free, blocks, h, correction, settings)
         speed = np.maximum(speed, np.abs(step.velocity))
         wider = tuple(c.rows(model, data, q, speed, h) for c in constraints)
         if sum(b.size for b in wider) == sum(b.size for b in blocks):
             return step
         blocks = wider
-    return _solve(mass, v_free, blocks, h, correction, settings or default_settings())
+    return _solve_or_accelerate(mass, v_free, blocks, h, correction, settings)
+
+
+def _solve_or_accelerate(
+    mass: np.ndarray,
+    v_free: np.ndarray,
+    blocks: tuple[ConstraintRows, ...],
+    h: float,
+    correction: float,
+    settings: pin.ADMMSolverSettings,
+) -> ConstrainedVelocity:
+    """`_solve`, and when it stalls above the residual it may keep, the same solve again
+    with Anderson acceleration (`ANDERSON_CAPACITY` iterates): the better of the two (the
+    accepted one, else the smaller residual), with both solves' iterations. A stab in its
+    receptacle's bore held by two fingers (45 rows) stalled at 5.1e-5 m/s after 5,000 plain
+    iterations (above its 4.4e-5) and at 1.8e-5 after 20,000; accelerated, it converged to
+    1.6e-8 in 461. Only a stalled solve is retried: every other period is unchanged."""
+    plain = _solve(mass, v_free, blocks, h, correction, settings)
+    if plain.accepted:
+        return plain
+    faster = default_settings(settings.absolute_feasibility_tol, settings.max_iterations)
+    faster.anderson_capacity = ANDERSON_CAPACITY
+    retried = _solve(mass, v_free, blocks, h, correction, faster)
+    best = retried if retried.accepted or retried.residual < plain.residual else plain
+    return dataclasses.replace(best, iterations=plain.iterations + retried.iterations)
 
 
 def constrained_configuration(
@@ -293,6 +327,10 @@ def _solve(
     gap = np.concatenate([b.gap for b in blocks])
     positional = np.concatenate([b.positional for b in blocks])
     phi = np.where(positional, np.where(gap >= 0.0, gap, correction * gap), 0.0)
+    bilateral = np.concatenate(
+        [np.zeros(b.size, dtype=bool) if b.bilateral is None else b.bilateral for b in blocks]
+    )
+    phi = np.where(bilateral, correction * gap, phi)  # an error both ways (an attachment)
     minv_jt = np.linalg.solve(mass, jacobian.T)
     delassus = jacobian @ minv_jt
     drift = jacobian @ v_free + phi / h

@@ -14,6 +14,7 @@ moved to x_i). The objects are fixed: their reaction goes to the ground.
 
 from __future__ import annotations
 
+import dataclasses
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 from typing import Any
@@ -136,8 +137,9 @@ class World:
         fixtures: articulated bodies with a fixed root
             (`uvms_pin.physics.world.fixture.Fixture`); their links touch the robot and
             the free objects (`uvms_pin.physics.world.moving`).
-        moving_contact: one of `MOVING_CONTACT`, how two moving bodies touch ("compliant"
-            only with fixtures: the rigid rows know the robot and the free objects).
+        moving_contact: one of `MOVING_CONTACT`, how two moving bodies touch.
+        attachments: free objects held rigidly by the robot's links
+            (`uvms_pin.physics.world.attachment.Attachment`), each object at most once.
     """
 
     uvms: UVMS
@@ -149,6 +151,7 @@ class World:
     fixed_contact: str = "rigid"
     fixtures: Sequence[Any] = ()
     moving_contact: str = "compliant"
+    attachments: Sequence[Any] = ()
 
     def __post_init__(self) -> None:
         for key, value, choices in (
@@ -165,12 +168,8 @@ class World:
         self.objects = tuple(self.objects)
         self.free = tuple(self.free)
         self.fixtures = tuple(self.fixtures)
-        if self.fixtures and self.moving_contact == "rigid":
-            # the rigid rows map a pair's side to the robot or a free object's free-flyer
-            raise ParameterError(
-                'moving_contact = "rigid" is not available with fixtures ("urdf" objects) '
-                'yet: their links touch by the compliant law (moving_contact = "compliant")'
-            )
+        self.attachments = tuple(self.attachments)
+        self._check_attachments()
         bodies = self.uvms.surface_bodies
         self.body_names = [self.uvms.hydro_bodies[int(k)].name for k in bodies.body_index]
         self.pieces: tuple[RobotPiece, ...] = robot_pieces(self.uvms, self.body_names)
@@ -188,6 +187,30 @@ class World:
         """``body|object`` for every pair (body-major): the logged wrenches' order."""
         return [f"{b}|{o.name}" for b in self.body_names for o in self.objects]
 
+    def _check_attachments(self) -> None:
+        """Each attachment names a free object of this world (once) and a link of the
+        robot."""
+        free = {o.name for o in self.free}
+        model, seen = self.uvms.model, set()
+        for a in self.attachments:
+            if a.object_name not in free:
+                raise ParameterError(
+                    f"attached_to: '{a.object_name}' is not a free object of the world"
+                )
+            if a.object_name in seen:
+                raise ParameterError(f"attached_to: '{a.object_name}' is attached twice")
+            seen.add(a.object_name)
+            if not model.existBodyName(a.link):
+                links = ", ".join(f.name for f in model.frames if f.type == pin.FrameType.BODY)
+                raise ParameterError(
+                    f"attached_to: '{a.link}' (for '{a.object_name}') is not a link of the "
+                    f"robot; its links: {links}"
+                )
+
+    def link_joint(self, link: str) -> int:
+        """The robot's joint that carries ``link``."""
+        return int(self.uvms.model.frames[self.uvms.model.getBodyId(link)].parentJoint)
+
     def record(self) -> dict[str, Any]:
         return {
             "objects": [o.record() for o in self.objects],
@@ -197,6 +220,11 @@ class World:
             **({"fixed_contact": self.fixed_contact} if self.free else {}),
             **({"moving_contact": self.moving_contact} if self.free or self.self_collision else {}),
             "pairs": self.pair_names,
+            **(
+                {"attachments": [dataclasses.asdict(a) for a in self.attachments]}
+                if self.attachments
+                else {}
+            ),
         }
 
     def clear(self, data: pin.Data, horizon_s: float) -> bool:

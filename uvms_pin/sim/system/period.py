@@ -14,8 +14,8 @@
   `why_not_compiled_system` names it), the anchors moved at the period's end.
 
 This is the one place the step is made: the constraints solved implicitly come after the
-smooth dynamics, for every body at once (`constrained`: today the robot's joint limits; rigid
-contacts, joint friction and attachments join them there). The compiled plant solves the joint
+smooth dynamics, for every body at once (`constrained`: the joint limits and Coulomb
+friction, the rigid contacts and the attachments, `constraint_sets`). The compiled plant solves the joint
 limits itself at the end of its call (src/uvms_core/joint_limits.hpp, the same step); the
 integrated step is followed by the Python reference's solve.
 """
@@ -62,6 +62,7 @@ class Stepped(Protocol):
     fixture_constraints: tuple  # their joint limits and friction (`sim.system.fixtures`)
     fixture_blocks: list  # each one's part of v and its joints (`fixtures.blocks`)
     moving_constraints: Any  # the rigid contacts between moving bodies, or None
+    attachments: Any  # the free objects held by the robot's links, or None
     stalled: StalledSolves  # the run's solves accepted after stalling (`step`)
 
     def friction_memories(self) -> list: ...
@@ -109,11 +110,11 @@ def why_not_compiled_system(system: Stepped, integrator: Integrator | None) -> s
 def constraint_sets(system: Stepped) -> tuple:
     """The constraints solved implicitly at the end of ``system``'s period: the robot's
     joint limits and joint Coulomb friction, the free objects' rigid contacts with the fixed
-    world, the rigid contacts between moving bodies and the fixtures' joint limits and
-    friction (each when there is one)."""
+    world, the rigid contacts between moving bodies, the attachments and the fixtures'
+    joint limits and friction (each when there is one)."""
     plant = system.plant
     sets = (plant.joint_limits, plant.joint_coulomb, system.object_contacts)
-    sets += (system.moving_constraints, *system.fixture_constraints)
+    sets += (system.moving_constraints, system.attachments, *system.fixture_constraints)
     return tuple(s for s in sets if s is not None)
 
 

@@ -88,6 +88,11 @@ class Robots:
                 'fixtures ([[world.objects]] type = "urdf") are not simulated with several '
                 "robots yet: use one robot, or leave the fixture out"
             )
+        if any(system.attachments is not None for system in systems):
+            raise ParameterError(
+                "attached_to ([[world.objects]]) is not simulated with several robots yet: "
+                "use one robot, or let the robots grasp the object"
+            )
         self.systems = tuple(systems)
         self.names = tuple(names)
         self.objects = self.systems[0].objects

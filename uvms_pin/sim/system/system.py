@@ -27,6 +27,7 @@ import pinocchio as pin
 from uvms_pin.physics.compiled.backend import Fallback
 from uvms_pin.physics.compiled.extension import core_module
 from uvms_pin.physics.compiled.moving import contacts_of_core, forces_of_core, memories_of
+from uvms_pin.physics.constraints.attachments import ATTACHMENT_REFUSAL, Attachments
 from uvms_pin.physics.constraints.moving_contacts import MovingPairContacts
 from uvms_pin.physics.constraints.object_contacts import ObjectWorldContacts
 from uvms_pin.physics.constraints.step import StalledSolves
@@ -120,10 +121,15 @@ class System:
         self.object_contacts = self._object_contacts()
         moving = None if self.moving is None else self.moving.moving
         self.moving_constraints = (
-            MovingPairContacts(moving.sets, uvms.model.njoints)
+            MovingPairContacts(
+                moving.sets,
+                uvms.model.njoints,
+                (len(self.objects), fixture_joints.joint_ids(model.njoints, self.fixtures)),
+            )
             if moving is not None and moving.rigid_pairs and moving.sets
             else None
         )
+        self.attachments = _attachments(world, self.objects, uvms.model.njoints)
         self._steps: dict[int, tuple[Integrator, PeriodStep]] = {}
         self._data = uvms.model.createData()  # the bound test's kinematics
         self.separations: list = []  # the objects' moves out of an overlap at the start
@@ -164,6 +170,8 @@ class System:
         q, _ = self.robot_state(state.q, state.v)
         self.plant.attach(q)
         self.stalled = StalledSolves()
+        if self.attachments is not None:  # each object held where it starts in its link
+            self.attachments.place(self.model, state.q)
         if self.moving is not None:
             self.moving.reset()
             robot, *objects = self.layout.split(state.q, state.v)
@@ -180,6 +188,8 @@ class System:
             return None
         if self.fixtures:
             return Fallback(fixture_joints.COMPILED_REFUSAL)
+        if self.attachments is not None:
+            return Fallback(ATTACHMENT_REFUSAL)
         held = self.__dict__.get("_compiled")
         if held is None or held[0] is not plant_core:
             held = self._compiled = (plant_core, system_to_core(self, core_module()))
@@ -228,6 +238,8 @@ class System:
         """The system's (q, v) at t1 from (q0, v0) at t0 with the robot's input ``tau``
         held (zero-order hold), by the period step of ``integrator``
         (`uvms_pin.sim.system.period`, chosen at its first use and kept)."""
+        if self.attachments is not None:
+            self.attachments.at(t0)
         held = self._steps.get(id(integrator))
         if held is None or held[0] is not integrator:
             held = self._steps[id(integrator)] = (integrator, period_step(self, integrator))
@@ -366,3 +378,15 @@ class System:
         for fixture, (q_f, _) in zip(self.fixtures, objects[n:], strict=True):
             out[fixture.name] = fixture.signal(q_f)
         return out
+
+
+def _attachments(world, objects: tuple, first_object_joint: int) -> Attachments | None:
+    """The world's attachments (`uvms_pin.physics.constraints.attachments`) in the system's
+    model (free object k on joint ``first_object_joint + k``), or None."""
+    if world is None or not world.attachments:
+        return None
+    index = {o.name: k for k, o in enumerate(objects)}
+    return Attachments(
+        [(a, world.link_joint(a.link), first_object_joint + index[a.object_name])
+         for a in world.attachments]
+    )  # fmt: skip

@@ -1,0 +1,64 @@
+"""A constraint solve that stalls above the residual it may keep is solved once more with
+the ADMM's Anderson acceleration (`step._solve_or_accelerate`): the accepted one of the
+two is kept, else the smaller residual, with both solves' iterations; a solve that is
+accepted at once is not retried (every other period stays as it was)."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from uvms_pin.physics.constraints import step
+from uvms_pin.physics.constraints.step import ANDERSON_CAPACITY, ConstrainedVelocity
+
+SPEED_M_S = 1.0  # the rows' largest speed: a stalled solve may keep 1e-4 m/s
+
+
+def _result(residual: float, converged: bool, iterations: int) -> ConstrainedVelocity:
+    velocity = np.full(2, residual)
+    return ConstrainedVelocity(
+        velocity, {}, {}, np.zeros(2), (), iterations, residual, converged, SPEED_M_S
+    )
+
+
+@pytest.fixture
+def solves(monkeypatch):
+    """`step._solve` answering from a queue, recording each call's Anderson capacity."""
+    queue: list[ConstrainedVelocity] = []
+    capacities: list[int] = []
+
+    def fake(mass, v_free, blocks, h, correction, settings):
+        capacities.append(int(settings.anderson_capacity))
+        return queue.pop(0)
+
+    monkeypatch.setattr(step, "_solve", fake)
+    return queue, capacities
+
+
+def _solve():
+    settings = step.default_settings()
+    return step._solve_or_accelerate(np.eye(2), np.zeros(2), (), 1e-3, 0.5, settings)
+
+
+def test_an_accepted_solve_is_not_retried(solves):
+    queue, capacities = solves
+    queue += [_result(5e-5, False, 5000)]  # stalled below 1e-4 m/s: kept
+    out = _solve()
+    assert capacities == [0] and out.residual == 5e-5 and out.iterations == 5000
+
+
+def test_a_solve_stalled_above_its_bound_is_retried_accelerated(solves):
+    queue, capacities = solves
+    queue += [_result(3e-4, False, 5000), _result(1e-9, True, 461)]
+    out = _solve()
+    assert capacities == [0, ANDERSON_CAPACITY]
+    assert out.converged and out.residual == 1e-9 and out.iterations == 5461
+
+
+def test_the_smaller_residual_is_kept_when_neither_is_accepted(solves):
+    queue, _ = solves
+    queue += [_result(3e-4, False, 5000), _result(6e-4, False, 5000)]
+    out = _solve()
+    assert not out.accepted and out.residual == 3e-4 and out.iterations == 10000
+    queue += [_result(6e-4, False, 5000), _result(3e-4, False, 5000)]
+    assert _solve().residual == 3e-4
