@@ -119,3 +119,44 @@ def test_a_run_with_fins_says_why_it_is_not_compiled(tmp_path):
         rollout = up.simulate(up.load_scenario(scenario), progress=False)
     assert rollout.metadata["closed_loop"]["reason"] == FINS_REASON
     assert rollout.metadata["closed_loop"]["path"] == "python"
+
+
+def test_a_fin_above_the_free_surface_gives_nothing_and_one_across_it_a_share(lrauv):
+    """With a free surface a fin's wrench is scaled by its wet fraction: whole with its centre
+    of pressure sqrt(A)/2 below the surface or deeper, nothing as far above it, half at it."""
+    from uvms_pin.physics.fins import wet_fraction
+
+    data = lrauv.model.createData()
+    k = [f.name for f in lrauv.fins].index("vertical_fins")  # in the flow of v below
+    fin = lrauv.fins[k]
+    size = np.sqrt(fin.params.area_m2)
+    v = np.zeros(lrauv.nv)
+    v[:3] = [-1.2, 0.1, 0.05]
+
+    def wrench_at(depth_m: float):
+        q = lrauv.neutral_configuration()
+        pin.forwardKinematics(lrauv.model, data, q)
+        centre = (data.oMi[fin.joint_id] * fin.placement_in_joint).act(fin.params.cp_m)
+        q[2] += -depth_m - centre[2]  # the fin's centre of pressure at z = -depth
+        wet = fin_wrenches_world(lrauv, data, q, v, free_surface=True)[k]
+        whole = fin_wrenches_world(lrauv, data, q, v)[k]
+        return wet, whole
+
+    deep, whole = wrench_at(size)
+    np.testing.assert_array_equal(deep[1], whole[1])
+    assert np.any(whole[1])
+    dry, _ = wrench_at(-size)
+    np.testing.assert_array_equal(dry[1], np.zeros(3))
+    half, whole = wrench_at(0.0)
+    np.testing.assert_allclose(half[1], 0.5 * whole[1], rtol=1e-12)
+    assert wet_fraction(np.array([0.0, 0.0, 0.25 * size]), fin.params.area_m2, None, 0.0) == 0.25
+
+
+def test_the_mujoco_twin_of_a_model_with_fins_says_it_leaves_them_out(lrauv):
+    from pathlib import Path
+
+    from uvms_pin.apps.export.mjcf import uvms_to_mjcf
+    from uvms_pin.errors import ModelWarning
+
+    with pytest.warns(ModelWarning, match="'horizontal_fins', 'vertical_fins' have no MuJoCo"):
+        uvms_to_mjcf(lrauv, Path(lrauv.source).read_text(), base_dir=Path(lrauv.source).parent)

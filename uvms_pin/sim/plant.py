@@ -292,7 +292,9 @@ class Plant:
         if self.world is not None or self.joint_stops is not None or extra_torque is not None:
             tau_ext += self.external_torque(q, v, extra_torque)
         if self.uvms.fins:  # lift and drag: the Python reference alone (plant_to_core)
-            wrenches = fin_wrenches_world(self.uvms, self._fin_data, q, v, self.water, time_s)
+            wrenches = fin_wrenches_world(
+                self.uvms, self._fin_data, q, v, self.water, time_s, bool(self.free_surface)
+            )
             tau_ext += fin_generalized_force(self.uvms, self._fin_data, q, wrenches)
         return forward_dynamics(
             self.uvms,

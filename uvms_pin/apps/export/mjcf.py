@@ -26,12 +26,15 @@ What differs (MuJoCo's fluid model is another, approximate model):
   inertia-box fluid model instead (carriers: a point mass, whose box is of zero size);
 - a uniform current is MuJoCo's ``opt.wind`` (the medium's velocity), set by the caller;
 - joint limits are written but not enforced (``limited="false"``), as in uvms-pin's
-  simulator; contacts are disabled.
+  simulator; contacts are disabled;
+- fins (gz-sim's LiftDrag, `uvms_pin.physics.fins`) have no counterpart: the twin has their
+  links, not their lift and drag (a `ModelWarning` names them).
 """
 
 from __future__ import annotations
 
 import math
+import warnings
 import xml.etree.ElementTree as ET
 from collections.abc import Sequence
 from dataclasses import dataclass
@@ -40,7 +43,7 @@ from pathlib import Path
 import numpy as np
 import pinocchio as pin
 
-from uvms_pin.errors import ModelError, ParameterError
+from uvms_pin.errors import ModelError, ModelWarning, ParameterError
 from uvms_pin.hydro.mesh import load_mesh_geometry
 from uvms_pin.model.resources import resolve_resource
 from uvms_pin.model.urdf.read import read_numbers, read_origin
@@ -134,6 +137,14 @@ def uvms_to_mjcf(
     except ET.ParseError as exc:
         raise ModelError(f"urdf_text is not well-formed XML ({exc})") from exc
     model = uvms.model
+    if uvms.fins:
+        names = ", ".join(f"'{f.name}'" for f in uvms.fins)
+        warnings.warn(
+            f"the fins {names} have no MuJoCo counterpart: the twin has their links, not "
+            "their lift and drag",
+            ModelWarning,
+            stacklevel=2,
+        )
     root = ET.Element("mujoco", model=urdf.get("name", "uvms"))
     ET.SubElement(root, "compiler", angle="radian", inertiafromgeom="false")
     option = ET.SubElement(
