@@ -17,7 +17,10 @@ from uvms_pin.apps.arguments import (
     positive,
     progress_printer,
 )
-from uvms_pin.apps.validation.identify_arguments import add_identify_arguments
+from uvms_pin.apps.validation.identify_arguments import (
+    add_identify_arguments,
+    check_identify_arguments,
+)
 from uvms_pin.results.outdir import check_writable
 
 
@@ -47,6 +50,7 @@ def _cmd_validate_pool(args: argparse.Namespace) -> int:
 
 
 def _cmd_identify(args: argparse.Namespace) -> int:
+    check_identify_arguments(args)  # at once: the fitting code takes seconds to import
     from uvms_pin.apps.validation.identify import run
 
     return run(args)
