@@ -6,13 +6,14 @@ import os
 import shutil
 import subprocess
 import sys
+from collections import Counter
 from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 import pinocchio as pin
 import pytest
-from slow_tests import SLOW_MODULES, SLOW_TESTS
+from slow_tests import SLOW_MODULES, SLOW_TESTS, longest_first
 
 import uvms_pin as up
 
@@ -28,11 +29,15 @@ REL = 1e-12
 
 
 def pytest_collection_modifyitems(config, items) -> None:
-    """Mark ``slow`` the tests tests/slow_tests.py lists (`make check` leaves them out)."""
+    """Mark ``slow`` the tests tests/slow_tests.py lists (`make check` leaves them out), then
+    put the longest files first (`longest_first`)."""
+    slow_in_file: Counter[str] = Counter()
     for item in items:
         path, _, _ = item.nodeid.partition("::")
         if path.startswith(SLOW_MODULES) or item.nodeid.partition("[")[0] in SLOW_TESTS:
             item.add_marker(pytest.mark.slow)
+            slow_in_file[path] += 1
+    items.sort(key=lambda item: longest_first(item.nodeid.partition("::")[0], slow_in_file))
 
 
 def mount_on_reference_vehicle(arm: str, tmp_dir: Path) -> up.UVMS:

@@ -6,16 +6,26 @@ the result scripts, the generated-input tests (tests/fuzz) and the corpus of bad
 whole; elsewhere the long physics runs and campaigns, the identification fits, the command-line
 runs that write every output. The agreement of the compiled dynamics with the Python reference
 and the first second of every shipped scenario stay in `make check` (they guard every change).
+
+The order of the files: `make test` hands whole files to its two workers (pytest-xdist
+``--dist loadfile``: a file's module- and session-scoped fixtures, the doc runs, the bad-input
+corpus, run once, on one worker), in collection order; `longest_first` puts the long files
+first, so that no worker ends the suite alone with a long file begun last.
 """
 
+from __future__ import annotations
+
+from collections.abc import Mapping
+
+#: whole files, longest first: `make test`'s workers start them in this order (`longest_first`)
 SLOW_MODULES = (
-    "tests/fuzz/",
     "tests/test_docs_run.py",
-    "tests/test_docs_site.py",
-    "tests/test_notebooks.py",
-    "tests/test_make_results.py",
     "tests/apps/cli/test_bad_inputs.py",
+    "tests/test_notebooks.py",
+    "tests/test_docs_site.py",
+    "tests/test_make_results.py",
     "tests/apps/validation/test_fit.py",
+    "tests/fuzz/",
 )
 
 #: module::function (every parameter of it)
@@ -106,3 +116,13 @@ SLOW_TESTS = frozenset(
         "tests/test_docs.py::test_nothing_points_to_notes_outside_the_repository",
     )
 )
+
+
+def longest_first(path: str, slow_in_file: Mapping[str, int]) -> tuple[int, int]:
+    """The sort key of a test file (``tests/...py``) in the run: the `SLOW_MODULES` in their
+    order, then the files holding the most slow tests (``slow_in_file``), then the rest (a
+    stable sort keeps the collection order among equals and the tests of a file together)."""
+    for index, prefix in enumerate(SLOW_MODULES):
+        if path.startswith(prefix):
+            return (index, 0)
+    return (len(SLOW_MODULES), -slow_in_file.get(path, 0))
