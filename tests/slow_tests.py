@@ -49,8 +49,6 @@ SLOW_TESTS = frozenset(
         "tests/apps/cli/test_compare_controllers.py::test_compare_controllers_short_run",
         "tests/apps/cli/test_compare_controllers.py::test_robustness_set_through_the_study_runner",
         "tests/apps/cli/test_export_command.py::test_export_writes_a_bag_the_reader_opens",
-        "tests/apps/cli/test_identify_campaign.py::test_identify_refuses_a_file_as_its_out_directory",
-        "tests/apps/cli/test_identify_campaign.py::test_identify_refuses_bad_arguments_before_writing",
         "tests/apps/cli/test_run_outputs.py::test_a_second_ctrl_c_while_saving_does_not_lose_the_rollout",
         "tests/apps/cli/test_run_outputs.py::test_ctrl_c_keeps_the_partial_rollout_and_a_second_run_into_its_out_is_refused",
         "tests/apps/cli/test_run_outputs.py::test_overwrite_replaces_a_runs_outputs_keeps_the_users_files_and_follows_the_umask",
