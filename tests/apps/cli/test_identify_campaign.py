@@ -68,18 +68,28 @@ def test_identify_refuses_a_file_as_its_out_directory(tmp_path):
     assert out.read_text() == "mine"
 
 
-def test_a_bad_argument_is_refused_before_the_fitting_code_is_imported(tmp_path):
+@pytest.mark.parametrize(
+    ("arguments", "message"),
+    [
+        (["identify", str(DATA), "--fit", "added_mass.w"], "unknown parameter 'added_mass.w'"),
+        (["validate", "pool", str(DATA), "--out", "o", "--trials", "x"], "no trial named x"),
+    ],
+)
+def test_a_bad_argument_is_refused_before_the_fitting_code_is_imported(
+    tmp_path, arguments, message
+):
     """What takes seconds (SciPy's signal processing, matplotlib, the trial vehicle, reading
-    the trials) comes after every argument has been checked."""
+    the trials) comes after every argument has been checked: identify and validate pool."""
     check = (
         "import sys\n"
         "from uvms_pin.apps.cli.main import main\n"
-        f"status = main(['identify', {str(DATA)!r}, '--fit', 'added_mass.w'])\n"
-        "print(status, 'uvms_pin.apps.validation.identification' in sys.modules, "
+        f"status = main({arguments!r})\n"
+        "print(status, 'uvms_pin.apps.validation.pool' in sys.modules, "
         "'matplotlib' in sys.modules)\n"
     )
     done = subprocess.run(
         [sys.executable, "-c", check], cwd=tmp_path, capture_output=True, text=True, check=False
     )
     assert done.stdout.split() == ["2", "False", "False"], done.stdout + done.stderr
-    assert "unknown parameter 'added_mass.w'" in done.stderr
+    assert message in done.stderr
+    assert not (tmp_path / "o").exists()

@@ -27,6 +27,7 @@ __all__ = [
     "find_trials",
     "load_trial",
     "roll_pitch_rad",
+    "select_trials",
     "split_trials",
 ]
 
@@ -238,3 +239,24 @@ def split_trials(
     if not held_out:
         raise DataError(f"{data_dir}: no trial left to hold out besides the identification ones")
     return [files[n] for n in training], held_out
+
+
+def select_trials(data_dir: str | Path, trial_names: Sequence[str] | None = None) -> list[Path]:
+    """The trial files of ``data_dir`` (or those named, in that order), checked as far as can
+    be without reading them: they exist, are NPZ archives and fit in memory
+    (`check_trials_fit`).
+
+    Raises:
+        DataError: a missing directory, no trials, an unknown trial name or a bad file.
+    """
+    files = find_trials(data_dir)
+    if trial_names is not None:
+        by_name = {p.stem: p for p in files}
+        unknown = [n for n in trial_names if n not in by_name]
+        if unknown:
+            raise DataError(
+                f"{data_dir}: no trial named {', '.join(unknown)} (have {', '.join(by_name)})"
+            )
+        files = [by_name[n] for n in trial_names]
+    check_trials_fit(files)
+    return files
