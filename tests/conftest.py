@@ -40,6 +40,7 @@ def pytest_collection_modifyitems(config, items) -> None:
         path, _, _ = item.nodeid.partition("::")
         if path.startswith(SLOW_MODULES) or item.nodeid.partition("[")[0] in SLOW_TESTS:
             item.add_marker(pytest.mark.slow)
+        if item.get_closest_marker("slow") is not None:  # listed here or marked in its file
             slow_in_file[path] += 1
     items.sort(key=lambda item: longest_first(item.nodeid.partition("::")[0], slow_in_file))
 

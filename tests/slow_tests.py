@@ -114,11 +114,21 @@ SLOW_TESTS = frozenset(
 )
 
 
+#: the files of single runs of a minute or more (CPU, serial), longest first: after the
+#: `SLOW_MODULES` in `longest_first`'s order
+LONG_FILES = (
+    "tests/scenario/test_hot_stab.py",
+    "tests/scenario/test_cooperative_transport.py",
+    "tests/scenario/test_valve_turn.py",
+)
+
+
 def longest_first(path: str, slow_in_file: Mapping[str, int]) -> tuple[int, int]:
-    """The sort key of a test file (``tests/...py``) in the run: the `SLOW_MODULES` in their
-    order, then the files holding the most slow tests (``slow_in_file``), then the rest (a
-    stable sort keeps the collection order among equals and the tests of a file together)."""
-    for index, prefix in enumerate(SLOW_MODULES):
+    """The sort key of a test file (``tests/...py``) in the run: the `SLOW_MODULES`, then the
+    `LONG_FILES`, in their order, then the files holding the most slow tests
+    (``slow_in_file``), then the rest (a stable sort keeps the collection order among equals
+    and the tests of a file together)."""
+    for index, prefix in enumerate(SLOW_MODULES + LONG_FILES):
         if path.startswith(prefix):
             return (index, 0)
-    return (len(SLOW_MODULES), -slow_in_file.get(path, 0))
+    return (len(SLOW_MODULES) + len(LONG_FILES), -slow_in_file.get(path, 0))
