@@ -48,14 +48,17 @@ test: $(STAMP) lint
 	  if [ "$$(id -u)" = 0 ] && command -v apt-get >/dev/null 2>&1; then \
 	    apt-get update && DEBIAN_FRONTEND=noninteractive apt-get install -y chromium; \
 	  else echo "chromium missing and not installable here (needs root + apt-get): browser tests will skip"; fi; }
-	@# two workers per two cores (pytest-xdist): each test is independent of the others' order
-	$(BIN)/python -m pytest -q -n auto
+	@# two workers per two cores (pytest-xdist): each test is independent of the others' order;
+	@# whole files to a worker (--dist loadfile: a file's shared run, the doc runs, the bad-input
+	@# corpus, is made once, not once per worker), in the order collected: the longest files
+	@# first (tests/slow_tests.py), so that no worker ends alone with a long file begun last
+	$(BIN)/python -m pytest -q -n auto --dist loadfile --no-loadscope-reorder
 
 # the loop of a change: lint and every test not marked slow (the long physics campaigns, long
 # runs, the generated-input tests, the notebooks, the doc runs and the site: `make test` runs
 # them; pyproject.toml's markers say what slow is), at most 3 minutes on the 2-core machine
 check: $(STAMP) lint
-	$(BIN)/python -m pytest -q -n auto -m "not slow"
+	$(BIN)/python -m pytest -q -n auto --dist loadfile --no-loadscope-reorder -m "not slow"
 
 # the generated-input campaign (tests/fuzz): HYPOTHESIS_PROFILE=campaign draws 6 times the
 # inputs `make test` draws, from FUZZ_SEED (printed; FUZZ_SEED=N make fuzz replays or varies

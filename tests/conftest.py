@@ -2,17 +2,22 @@
 
 from __future__ import annotations
 
+import contextlib
+import io
 import os
 import shutil
 import subprocess
 import sys
+import traceback
+import warnings
+from collections import Counter
 from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 import pinocchio as pin
 import pytest
-from slow_tests import SLOW_MODULES, SLOW_TESTS
+from slow_tests import SLOW_MODULES, SLOW_TESTS, longest_first
 
 import uvms_pin as up
 
@@ -28,11 +33,16 @@ REL = 1e-12
 
 
 def pytest_collection_modifyitems(config, items) -> None:
-    """Mark ``slow`` the tests tests/slow_tests.py lists (`make check` leaves them out)."""
+    """Mark ``slow`` the tests tests/slow_tests.py lists (`make check` leaves them out), then
+    put the longest files first (`longest_first`)."""
+    slow_in_file: Counter[str] = Counter()
     for item in items:
         path, _, _ = item.nodeid.partition("::")
         if path.startswith(SLOW_MODULES) or item.nodeid.partition("[")[0] in SLOW_TESTS:
             item.add_marker(pytest.mark.slow)
+        if item.get_closest_marker("slow") is not None:  # listed here or marked in its file
+            slow_in_file[path] += 1
+    items.sort(key=lambda item: longest_first(item.nodeid.partition("::")[0], slow_in_file))
 
 
 def mount_on_reference_vehicle(arm: str, tmp_dir: Path) -> up.UVMS:
@@ -280,6 +290,66 @@ def run(*args: str, cwd: Path = ROOT) -> subprocess.CompletedProcess:
         timeout=600,
         check=False,
     )
+
+
+def run_cli_in_process(args: list[str], cwd: Path) -> subprocess.CompletedProcess:
+    """``uvms-pin ARGS`` in ``cwd`` run in this process as the console script runs it:
+    ``sys.exit(main(ARGS))``, an uncaught exception printed as the interpreter prints it (exit
+    status 1), Python's default warning filters; stdout and stderr captured as text. The
+    modules the run imported from ``cwd`` (a user's controller) are forgotten after it, as a
+    new process would not have them. A second of import time spared per call; what only a
+    process shows (Ctrl-C, a closed stdout, the interpreter's own exit) needs `run_cli`."""
+    from uvms_pin.apps.cli.main import main
+
+    out, err = io.StringIO(), io.StringIO()
+    modules_before = set(sys.modules)
+    previous_cwd = Path.cwd()
+    os.chdir(cwd)
+    try:
+        with (
+            contextlib.redirect_stdout(out),
+            contextlib.redirect_stderr(err),
+            warnings.catch_warnings(),
+        ):
+            _python_default_warning_filters()
+            try:
+                status = main(list(args))
+            except SystemExit as exc:  # argparse's errors, --version
+                status = _exit_status(exc.code)
+            except Exception:
+                traceback.print_exc()
+                status = 1
+    finally:
+        os.chdir(previous_cwd)
+        _forget_modules_under(Path(cwd).resolve(), set(sys.modules) - modules_before)
+    return subprocess.CompletedProcess(["uvms-pin", *args], status, out.getvalue(), err.getvalue())
+
+
+def _python_default_warning_filters() -> None:
+    """The filters of a fresh ``python`` (no -W, no PYTHONWARNINGS): what pytest added removed;
+    changing them also voids the once-per-location records of earlier runs."""
+    warnings.resetwarnings()
+    for category in (DeprecationWarning, PendingDeprecationWarning, ImportWarning, ResourceWarning):
+        warnings.simplefilter("ignore", category)
+    warnings.filterwarnings("default", category=DeprecationWarning, module="__main__")
+
+
+def _exit_status(code: object) -> int:
+    """The process's exit status for ``sys.exit(code)``: None 0, an int itself, else the
+    code printed on stderr and 1."""
+    if code is None:
+        return 0
+    if isinstance(code, int):
+        return code
+    print(code, file=sys.stderr)
+    return 1
+
+
+def _forget_modules_under(directory: Path, names: set[str]) -> None:
+    for name in names:
+        file = getattr(sys.modules.get(name), "__file__", None)
+        if file and Path(file).resolve().is_relative_to(directory):
+            del sys.modules[name]
 
 
 def assert_rel(actual: np.ndarray, expected: np.ndarray, rel: float = REL) -> None:

@@ -6,11 +6,11 @@ from __future__ import annotations
 import re
 
 from conftest import ROOT
-from slow_tests import SLOW_MODULES, SLOW_TESTS
+from slow_tests import LONG_FILES, SLOW_MODULES, SLOW_TESTS
 
 
 def test_every_slow_module_and_test_exists():
-    for path in SLOW_MODULES:
+    for path in SLOW_MODULES + LONG_FILES:
         assert (ROOT / path).exists(), path
     for name in SLOW_TESTS:
         path, _, function = name.partition("::")

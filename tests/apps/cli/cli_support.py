@@ -8,9 +8,9 @@ import signal
 import subprocess
 from pathlib import Path
 
-from conftest import ROOT, uvms_pin_command
+from conftest import ROOT, run_cli_in_process, uvms_pin_command
 
-__all__ = ["ROOT", "uvms_pin_command"]
+__all__ = ["ROOT", "run_cli_in_process", "uvms_pin_command"]
 URDF = ROOT / "models" / "uvms_lbv150.urdf"
 
 

@@ -5,13 +5,20 @@ the system failed; 130: Ctrl-C; 0: a run that warns), print only the project's m
 argparse's usage and message) naming the input and what is wrong, no traceback but the
 user's own code's shown as such, and leave the results already on disk as they were (their
 files hashed before and after); an ``--out`` that did not exist must still not exist, or
-hold what the case says was kept (checked by its ``after``). All cases run concurrently (each is a
-process that spends most of its time importing), so the corpus takes a few import times.
+hold what the case says was kept (checked by its ``after``).
+
+Most cases run in this process through the command's entry point (`run_cli_in_process`:
+``main(ARGS)`` as the console script calls it, stdout, stderr and the exit status captured),
+one after the other: a process per case would spend a second or two importing. The cases
+that need a process run as one, concurrently: Ctrl-C (``interrupts``), a script of the user's
+(``script``), and `IN_A_PROCESS`, one case of each kind of answer, which proves the process
+says what the entry point says (`test_the_entry_point_answers_as_the_installed_command`).
 """
 
 from __future__ import annotations
 
 import os
+import re
 import shutil
 import signal
 import subprocess
@@ -23,7 +30,7 @@ from pathlib import Path
 import paused_cli
 import pytest
 from bad_inputs_round2 import ROUND_TWO
-from cli_support import STUDY, URDF, passive_scenario, run_cli, tree_digest
+from cli_support import STUDY, URDF, passive_scenario, run_cli, run_cli_in_process, tree_digest
 from corpus import BAD_URDF, GOOD_BUT, Case, check_case
 from corpus import copy_study_inputs as _copy_study_inputs
 from corpus import mkdir as _mkdir
@@ -95,6 +102,26 @@ CASES = [
     Case("unknown-command", ("frobnicate",), ("frobnicate", "invalid choice")),
 ]  # fmt: skip
 CASES += ROUND_TWO
+CASES_BY_NAME = {case.name: case for case in CASES}
+
+#: run as the installed command in a process of their own, one of each kind of answer: an
+#: argparse usage error, the project's error, a run stopped with the user's traceback, a
+#: diverged run, a run that warns and succeeds, a model that warns (the others of these kinds
+#: run in this process: `run_cli_in_process`)
+IN_A_PROCESS = frozenset(
+    (
+        "no-command",
+        "run-missing-scenario",
+        "run-controller-raises-later",
+        "run-current-of-1400-m-s",
+        "run-fresh-water-density-warned",
+        "info-flat-mesh-as-a-hull",
+    )
+)
+
+
+def _needs_a_process(case: Case) -> bool:
+    return bool(case.interrupts or case.script or case.name in IN_A_PROCESS)
 
 
 @pytest.fixture(scope="module")
@@ -138,8 +165,8 @@ def outcomes(workspace) -> dict[str, tuple]:
         "ro": str(_not_writable(workspace)),
     }
 
-    def one(case: Case):
-        case_dir = workspace / "cases" / case.name
+    def one(case: Case, root: str = "cases"):
+        case_dir = workspace / root / case.name
         case_dir.mkdir(parents=True)
         shutil.copytree(workspace / "prior_run", case_dir / "prior")
         shutil.copytree(workspace / "prior_study", case_dir / "study_out")
@@ -155,13 +182,19 @@ def outcomes(workspace) -> dict[str, tuple]:
                 [sys.executable, case.script, *args],
                 cwd=case_dir, capture_output=True, text=True, timeout=300, check=False,
             )  # fmt: skip
+        elif root == "in_process" or not _needs_a_process(case):
+            result = run_cli_in_process(args, cwd=case_dir)
         else:
             result = run_cli(args, cwd=case_dir)
         return result, before, tree_digest(watched), existed, watched.exists()
 
     with ThreadPoolExecutor(max_workers=2 * (os.cpu_count() or 1)) as pool:
-        results = pool.map(one, CASES)
-        return {case.name: r for case, r in zip(CASES, results, strict=True)}
+        in_processes = {c.name: pool.submit(one, c) for c in CASES if _needs_a_process(c)}
+        found = {c.name: one(c) for c in CASES if not _needs_a_process(c)}
+        found.update({name: future.result() for name, future in in_processes.items()})
+        for name in IN_A_PROCESS:  # the same case through the entry point, for the comparison
+            found[f"{name} (in process)"] = one(CASES_BY_NAME[name], "in_process")
+        return found
 
 
 def _interrupted(args: list[str], cwd: Path, delays: tuple[float, ...]):
@@ -185,7 +218,23 @@ def _interrupted(args: list[str], cwd: Path, delays: tuple[float, ...]):
 
 def test_the_corpus_is_large_and_its_names_unique():
     assert len(CASES) >= 100
-    assert len({c.name for c in CASES}) == len(CASES)
+    assert len(CASES_BY_NAME) == len(CASES)
+    assert IN_A_PROCESS <= set(CASES_BY_NAME)
+
+
+@pytest.mark.parametrize("name", sorted(IN_A_PROCESS))
+def test_the_entry_point_answers_as_the_installed_command(name: str, outcomes):
+    """The in-process runner is faithful: a case of each kind of answer gives the same exit
+    status, stderr and stdout (the case's directory, the run's duration aside) and leaves the
+    same files. (Every case of the corpus was compared so once, when the corpus moved in.)"""
+    process, in_process = outcomes[name], outcomes[f"{name} (in process)"]
+    (ran, *process_files), (called, *in_process_files) = process, in_process
+    assert called.returncode == ran.returncode
+    for stream in ("stderr", "stdout"):
+        assert _comparable(getattr(called, stream), "in_process") == _comparable(
+            getattr(ran, stream), "cases"
+        )
+    assert in_process_files == process_files
 
 
 @pytest.mark.parametrize("case", CASES, ids=[c.name for c in CASES])
@@ -200,3 +249,13 @@ def test_a_bad_input_is_refused_cleanly(case: Case, outcomes, workspace):
     assert exists == existed, f"{case.watch} was {'created' if exists else 'removed'}"
     if case.after is not None:
         case.after(workspace / "cases" / case.name)
+
+
+def _comparable(text: str, root: str) -> str:
+    """``text`` with what differs between two runs of a case masked: the case's directory
+    (``.../ROOT/<case>``), how long the run took, how much memory was free."""
+    text = re.sub(rf"\S*/{root}/[^/\s]+", "<case dir>", text)
+    text = re.sub(
+        r"in [\d.]+ s \(real-time factor [\d.]+\)", "in <t> s (real-time factor <r>)", text
+    )
+    return re.sub(r"[\d.]+ GiB available", "<m> GiB available", text)

@@ -1,4 +1,5 @@
-"""``uvms-pin validate pool`` on shipped trials: its outputs, its targets and bad input."""
+"""``uvms-pin validate pool`` on shipped trials: its outputs, its targets and bad input (the
+bad input run in-process, `run_cli_in_process`: refused before the simulation is imported)."""
 
 from __future__ import annotations
 
@@ -9,7 +10,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from conftest import run
+from conftest import run, run_cli_in_process
 
 DATA = Path(__file__).resolve().parents[3] / "data" / "hinsdale2023"
 # the two shortest trials (17 s each), both held out of the identification (models/README.md)
@@ -60,7 +61,9 @@ def test_short_trials_meet_the_targets(short_run):
 
 def test_missing_data_directory_is_exit_2_and_writes_nothing(tmp_path):
     out = tmp_path / "out"
-    result = run("validate", "pool", str(tmp_path / "nope"), "--out", str(out))
+    result = run_cli_in_process(
+        ["validate", "pool", str(tmp_path / "nope"), "--out", str(out)], tmp_path
+    )
     assert result.returncode == 2
     assert "not a directory" in result.stderr and "Traceback" not in result.stderr
     assert not out.exists()
@@ -68,7 +71,7 @@ def test_missing_data_directory_is_exit_2_and_writes_nothing(tmp_path):
 
 def test_directory_without_trials_is_exit_2(tmp_path):
     out = tmp_path / "out"
-    result = run("validate", "pool", str(tmp_path), "--out", str(out))
+    result = run_cli_in_process(["validate", "pool", str(tmp_path), "--out", str(out)], tmp_path)
     assert result.returncode == 2
     assert "no trial files" in result.stderr
     assert not out.exists()
@@ -78,14 +81,16 @@ def test_one_bad_file_stops_before_anything_is_written(tmp_path):
     shutil.copy(DATA / "_alt_011-1.npz", tmp_path)
     (tmp_path / "_zz_broken.npz").write_bytes(b"PK\x03\x04 truncated")
     out = tmp_path / "out"
-    result = run("validate", "pool", str(tmp_path), "--out", str(out))
+    result = run_cli_in_process(["validate", "pool", str(tmp_path), "--out", str(out)], tmp_path)
     assert result.returncode == 2
     assert "_zz_broken.npz" in result.stderr and "Traceback" not in result.stderr
     assert not out.exists()
 
 
 def test_unknown_trial_name_is_exit_2(tmp_path):
-    result = run("validate", "pool", str(DATA), "--out", str(tmp_path / "o"), "--trials", "x")
+    result = run_cli_in_process(
+        ["validate", "pool", str(DATA), "--out", str(tmp_path / "o"), "--trials", "x"], tmp_path
+    )
     assert result.returncode == 2
     assert "no trial named x" in result.stderr
 
@@ -102,8 +107,19 @@ def test_a_step_that_would_not_be_the_step_used_is_refused(tmp_path, step, messa
     """--step is the largest step of each IMU interval: one longer than every interval
     would silently be each interval's length; one so short it takes hours is refused too."""
     out = tmp_path / "o"
-    result = run(
-        "validate", "pool", str(DATA), "--out", str(out), "--trials", "_alt_011-1", "--step", step
+    result = run_cli_in_process(
+        [
+            "validate",
+            "pool",
+            str(DATA),
+            "--out",
+            str(out),
+            "--trials",
+            "_alt_011-1",
+            "--step",
+            step,
+        ],
+        tmp_path,
     )
     assert result.returncode == 2, result.stderr
     assert message in result.stderr and "Traceback" not in result.stderr

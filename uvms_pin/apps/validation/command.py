@@ -17,15 +17,21 @@ from uvms_pin.apps.arguments import (
     positive,
     progress_printer,
 )
-from uvms_pin.apps.validation.identify_arguments import add_identify_arguments
+from uvms_pin.apps.validation.identify_arguments import (
+    add_identify_arguments,
+    check_identify_arguments,
+)
 from uvms_pin.results.outdir import check_writable
 
 
 def _cmd_validate_pool(args: argparse.Namespace) -> int:
-    from uvms_pin.apps.validation.run import run_pool_validation
+    from uvms_pin.apps.validation.trials import select_trials
 
     names = None if args.trials is None else comma_names("--trials", args.trials, "trial names")
     check_writable(args.out)  # before minutes of simulation, not after
+    select_trials(args.data_dir, names)  # at once: the simulation code takes seconds to import
+    from uvms_pin.apps.validation.run import run_pool_validation
+
     result = run_pool_validation(
         args.data_dir,
         args.out,
@@ -47,6 +53,7 @@ def _cmd_validate_pool(args: argparse.Namespace) -> int:
 
 
 def _cmd_identify(args: argparse.Namespace) -> int:
+    check_identify_arguments(args)  # at once: the fitting code takes seconds to import
     from uvms_pin.apps.validation.identify import run
 
     return run(args)

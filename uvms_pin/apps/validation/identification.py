@@ -20,7 +20,7 @@ import numpy as np
 
 from uvms_pin.apps.validation.figures import identified_figure
 from uvms_pin.apps.validation.fit import FitResult, fit_parameters
-from uvms_pin.apps.validation.parameters import hydro_body, parse_parameters
+from uvms_pin.apps.validation.parameters import DEFAULT_FIT, hydro_body, parse_parameters
 from uvms_pin.apps.validation.pool import (
     IDENTIFICATION_TRIALS,
     STEP_S,
@@ -31,8 +31,7 @@ from uvms_pin.apps.validation.pool import (
 )
 from uvms_pin.apps.validation.run import check_step
 from uvms_pin.apps.validation.sensitivity import SensitiveModel
-from uvms_pin.apps.validation.trials import check_trials_fit, find_trials, load_trial
-from uvms_pin.errors import DataError
+from uvms_pin.apps.validation.trials import check_trials_fit, load_trial, split_trials
 from uvms_pin.model.mount.text import urdf_text
 from uvms_pin.model.resources import shipped_path
 from uvms_pin.model.urdf.write_hydro import urdf_with_hydro
@@ -43,44 +42,6 @@ __all__ = ["DEFAULT_FIT", "IDENTIFIED_VEHICLE", "run_identification", "split_tri
 
 HULL = "base_link"
 IDENTIFIED_VEHICLE = "bluerov2_heavy_identified.urdf"
-#: what the pool trials excite: roll and pitch damping, the hull's centre of buoyancy, and two
-#: properties of the recording: the encoders' lag on the IMU clock (left out, ~0.2 s of lag
-#: reads as too little damping) and the IMU's mounting yaw on the hull (left out, the roll the
-#: IMU reads in proportion to pitch, psi theta, is left as a pitch-dependent roll error)
-DEFAULT_FIT = (
-    "linear_damping.roll",
-    "linear_damping.pitch",
-    "quadratic_damping.roll",
-    "quadratic_damping.pitch",
-    "center_of_buoyancy.x",
-    "center_of_buoyancy.y",
-    "center_of_buoyancy.z",
-    "arm_delay",
-    "imu_yaw",
-)
-
-
-def split_trials(
-    data_dir: str | Path, training: Sequence[str] = IDENTIFICATION_TRIALS
-) -> tuple[list[Path], list[Path]]:
-    """(identification, held-out) trial files of ``data_dir``: the trials named in
-    ``training`` (file stems, e.g. "_alt_001-0"; default the shipped split) and the others.
-
-    Raises:
-        DataError: a missing directory, no trials, an identification trial missing (the
-            trials there named), or no held-out trial left.
-    """
-    files = {p.stem: p for p in find_trials(data_dir)}
-    missing = [n for n in training if n not in files]
-    if missing:
-        raise DataError(
-            f"{data_dir}: identification trial(s) {', '.join(missing)} missing "
-            f"(have {', '.join(files)})"
-        )
-    held_out = [p for n, p in files.items() if n not in training]
-    if not held_out:
-        raise DataError(f"{data_dir}: no trial left to hold out besides the identification ones")
-    return [files[n] for n in training], held_out
 
 
 def _rmse_table(before: TrialComparison, after: TrialComparison) -> dict:

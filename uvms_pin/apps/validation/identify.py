@@ -37,14 +37,14 @@ import numpy as np
 from scipy.optimize import least_squares
 from scipy.spatial.transform import Rotation
 
-from uvms_pin.apps.arguments import comma_names, progress_printer
-from uvms_pin.apps.validation.identification import (
-    DEFAULT_FIT,
-    IDENTIFIED_VEHICLE,
-    run_identification,
-    split_trials,
+from uvms_pin.apps.arguments import progress_printer
+from uvms_pin.apps.validation.identification import IDENTIFIED_VEHICLE, run_identification
+from uvms_pin.apps.validation.identify_arguments import (
+    add_identify_arguments,
+    check_identify_arguments,
+    fit_names,
+    training_trials,
 )
-from uvms_pin.apps.validation.identify_arguments import add_identify_arguments
 from uvms_pin.apps.validation.pool import (
     IDENTIFICATION_TRIALS,
     JOINT_CUTOFF_HZ,
@@ -52,11 +52,10 @@ from uvms_pin.apps.validation.pool import (
     trial_uvms,
 )
 from uvms_pin.apps.validation.prescribed import JointTrajectory
-from uvms_pin.apps.validation.trials import load_trial, roll_pitch_rad
-from uvms_pin.errors import ParameterError, SimulationError
+from uvms_pin.apps.validation.trials import load_trial, roll_pitch_rad, split_trials
+from uvms_pin.errors import SimulationError
 from uvms_pin.model.uvms import UVMS
 from uvms_pin.physics.dynamics import bias_forces
-from uvms_pin.results.outdir import check_writable
 
 __all__ = [
     "IDENTIFICATION_TRIALS",
@@ -217,35 +216,18 @@ def _print_fit(result: dict) -> None:
         )
 
 
-def training_trials(args: argparse.Namespace) -> tuple[str, ...]:
-    """The identification trials' names: ``--train`` (comma-separated), else the shipped
-    split (`IDENTIFICATION_TRIALS`)."""
-    if args.train is None:
-        return IDENTIFICATION_TRIALS
-    return tuple(comma_names("--train", args.train, "trial names"))
-
-
 def run(args: argparse.Namespace) -> int:
     """``identify``: the quasi-static centre-of-buoyancy fit, or with ``--fit`` the dynamic
-    fit of the named parameters (`uvms_pin.apps.validation.identification`)."""
+    fit of the named parameters (`uvms_pin.apps.validation.identification`); ``args`` as
+    `check_identify_arguments` passed them."""
     # the shipped trial model may already hold a correction: fit the one relative to the file
-    if args.fit is None and args.out is not None:
-        raise ParameterError(
-            f"--out {args.out}: only with --fit (the quasi-static centre-of-buoyancy fit, "
-            "without --fit, prints its result and writes nothing)"
-        )
     start = trial_uvms() if args.cob is None else with_cob(trial_uvms(), args.cob)
     if args.fit is None:
         return _quasi_static(args, start)
-    names = []  # 'default' stands for `DEFAULT_FIT`, alone or with more names
-    for name in comma_names("--fit", args.fit, "parameter names"):
-        names += list(DEFAULT_FIT) if name == "default" else [name]
-    if args.out is not None:
-        check_writable(args.out)  # before minutes of fitting, not after
     result = run_identification(
         args.data_dir,
         args.out,
-        names,
+        fit_names(args),
         start=start,
         step_s=args.step,
         max_iterations=args.max_iterations,
@@ -275,7 +257,9 @@ def run(args: argparse.Namespace) -> int:
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     add_identify_arguments(parser)
-    return run(parser.parse_args(argv))
+    args = parser.parse_args(argv)
+    check_identify_arguments(args)
+    return run(args)
 
 
 if __name__ == "__main__":

@@ -1,13 +1,16 @@
 """The arguments of ``uvms-pin identify`` (and of ``python -m uvms_pin.apps.validation.identify``),
-apart from the fitting code so that the command line stays light to import."""
+apart from the fitting code so that the command line stays light to import, and their checks:
+every one is checked before the fitting code (SciPy's signal processing, matplotlib) is
+imported or a trial read, so a bad one is refused at once."""
 
 from __future__ import annotations
 
 import argparse
 
-from uvms_pin.apps.arguments import count, finite, nonempty, path_text, positive
+from uvms_pin.apps.arguments import comma_names, count, finite, nonempty, path_text, positive
+from uvms_pin.errors import ParameterError
 
-__all__ = ["add_identify_arguments"]
+__all__ = ["add_identify_arguments", "check_identify_arguments", "fit_names", "training_trials"]
 
 
 def add_identify_arguments(parser: argparse.ArgumentParser) -> None:
@@ -59,3 +62,51 @@ def add_identify_arguments(parser: argparse.ArgumentParser) -> None:
     )
     parser.add_argument("--no-figures", action="store_true", help="skip the figures")
     parser.add_argument("--quiet", action="store_true", help="no per-iteration progress lines")
+
+
+def training_trials(args: argparse.Namespace) -> tuple[str, ...]:
+    """The identification trials' names: ``--train`` (comma-separated), else the shipped
+    split (`IDENTIFICATION_TRIALS`)."""
+    from uvms_pin.apps.validation.trials import IDENTIFICATION_TRIALS
+
+    if args.train is None:
+        return IDENTIFICATION_TRIALS
+    return tuple(comma_names("--train", args.train, "trial names"))
+
+
+def fit_names(args: argparse.Namespace) -> list[str]:
+    """``--fit``'s parameter names, 'default' standing for `DEFAULT_FIT` (alone or with more
+    names)."""
+    from uvms_pin.apps.validation.parameters import DEFAULT_FIT
+
+    names = []
+    for name in comma_names("--fit", args.fit, "parameter names"):
+        names += list(DEFAULT_FIT) if name == "default" else [name]
+    return names
+
+
+def check_identify_arguments(args: argparse.Namespace) -> None:
+    """Refuse what ``identify`` would refuse later, before anything slow: ``--out`` without
+    ``--fit`` or not writable, unknown or repeated ``--fit`` names, a trial folder without
+    the identification trials or without a held-out one, a trial file that is no NPZ archive
+    or too large for memory (their sizes read from the archives' directories, not the data).
+    The step against the trials' IMU intervals is checked once they are read.
+
+    Raises:
+        ParameterError: a bad option. DataError: a bad trial folder or file.
+    """
+    from uvms_pin.apps.validation.parameters import parse_parameters
+    from uvms_pin.apps.validation.trials import check_trials_fit, split_trials
+    from uvms_pin.results.outdir import check_writable
+
+    if args.fit is None and args.out is not None:
+        raise ParameterError(
+            f"--out {args.out}: only with --fit (the quasi-static centre-of-buoyancy fit, "
+            "without --fit, prints its result and writes nothing)"
+        )
+    if args.fit is not None:
+        parse_parameters(fit_names(args))
+    if args.out is not None:
+        check_writable(args.out)  # before minutes of fitting, not after
+    fitted_on, held_out = split_trials(args.data_dir, training_trials(args))
+    check_trials_fit(fitted_on + held_out)

@@ -42,6 +42,7 @@ from uvms_pin.model.uvms import UVMS, HydroBody
 
 __all__ = [
     "AXES",
+    "DEFAULT_FIT",
     "KINDS",
     "HydroParameter",
     "generalized_force_sensitivity",
@@ -131,6 +132,23 @@ class HydroParameter:
         matrix = getattr(params, self.kind).copy()
         matrix[i, i] = value
         return dataclasses.replace(params, **{self.kind: matrix})
+
+
+#: what the pool trials excite: roll and pitch damping, the hull's centre of buoyancy, and two
+#: properties of the recording: the encoders' lag on the IMU clock (left out, ~0.2 s of lag
+#: reads as too little damping) and the IMU's mounting yaw on the hull (left out, the roll the
+#: IMU reads in proportion to pitch, psi theta, is left as a pitch-dependent roll error)
+DEFAULT_FIT = (
+    "linear_damping.roll",
+    "linear_damping.pitch",
+    "quadratic_damping.roll",
+    "quadratic_damping.pitch",
+    "center_of_buoyancy.x",
+    "center_of_buoyancy.y",
+    "center_of_buoyancy.z",
+    "arm_delay",
+    "imu_yaw",
+)
 
 
 def parse_parameters(names: Sequence[str]) -> tuple[HydroParameter, ...]:

@@ -22,7 +22,7 @@ from scipy.spatial.transform import Rotation
 
 from uvms_pin.apps.validation.imu_mount import imu_roll_pitch, vehicle_start
 from uvms_pin.apps.validation.prescribed import JointTrajectory, low_pass, simulate_prescribed_arm
-from uvms_pin.apps.validation.trials import PoolTrial, roll_pitch_rad
+from uvms_pin.apps.validation.trials import IDENTIFICATION_TRIALS, PoolTrial, roll_pitch_rad
 from uvms_pin.errors import DataError
 from uvms_pin.model.mount.mount import mount_arm
 from uvms_pin.model.resources import shipped_path
@@ -31,6 +31,7 @@ from uvms_pin.model.uvms import UVMS
 __all__ = [
     "ENCODER_COLUMNS",
     "ENCODER_OFFSETS_RAD",
+    "IDENTIFICATION_TRIALS",
     "TRIAL_VEHICLE",
     "TrialComparison",
     "TrialSetup",
@@ -48,16 +49,6 @@ ENCODER_OFFSETS_RAD = np.array([3.07, 0.0, 0.0, 2.879])
 JOINT_CUTOFF_HZ = 2.0  # the arm's quintic moves last seconds; this keeps them, drops jitter
 RATE_CUTOFF_HZ = 1.0  # initial body rates and velocity: the trend, not the sensor noise
 STEP_S = 0.05  # RK4 step = the IMU interval; 0.02 s changes the RMSE by < 0.002 deg
-# trials the hull's centre of buoyancy was identified on (`uvms_pin.apps.validation.identify`);
-# the others are held out
-IDENTIFICATION_TRIALS = (
-    "_alt_001-0",
-    "_alt_001-1",
-    "_alt_001-2",
-    "_alt_008-0",
-    "_alt_008-1",
-    "_alt_008-2",
-)
 
 
 #: the trial vehicle's URDF (the identified one, `uvms-pin identify --out`, replaces it)

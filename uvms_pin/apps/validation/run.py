@@ -16,8 +16,8 @@ from uvms_pin.apps.validation.pool import (
     summary_csv,
     trial_uvms,
 )
-from uvms_pin.apps.validation.trials import check_trials_fit, find_trials, load_trial
-from uvms_pin.errors import DataError, ParameterError
+from uvms_pin.apps.validation.trials import load_trial, select_trials
+from uvms_pin.errors import ParameterError
 from uvms_pin.results.atomic import write_json_atomic, write_text_atomic
 
 #: RK4 steps a validation may take over all its trials (~0.2 ms each in pure Python: ~30 min)
@@ -75,17 +75,7 @@ def run_pool_validation(
     Raises:
         DataError: a missing directory, no trials, an unknown trial name or a bad file.
     """
-    files = find_trials(data_dir)
-    if trial_names is not None:
-        by_name = {p.stem: p for p in files}
-        unknown = [n for n in trial_names if n not in by_name]
-        if unknown:
-            raise DataError(
-                f"{data_dir}: no trial named {', '.join(unknown)} (have {', '.join(by_name)})"
-            )
-        files = [by_name[n] for n in trial_names]
-    check_trials_fit(files)
-    trials = [load_trial(p) for p in files]
+    trials = [load_trial(p) for p in select_trials(data_dir, trial_names)]
     check_step(step_s, trials)
     uvms = trial_uvms(vehicle_urdf)
     comparisons = []

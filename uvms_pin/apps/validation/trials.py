@@ -10,6 +10,7 @@ Loading checks every key, shape and time vector and raises `DataError` naming th
 from __future__ import annotations
 
 import zipfile
+from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -19,7 +20,16 @@ from scipy.spatial.transform import Rotation
 from uvms_pin.checks import check_memory
 from uvms_pin.errors import DataError
 
-__all__ = ["PoolTrial", "PublishedSimulation", "find_trials", "load_trial", "roll_pitch_rad"]
+__all__ = [
+    "IDENTIFICATION_TRIALS",
+    "PoolTrial",
+    "PublishedSimulation",
+    "find_trials",
+    "load_trial",
+    "roll_pitch_rad",
+    "select_trials",
+    "split_trials",
+]
 
 # key -> number of columns (0: a vector)
 _TRIAL_KEYS = {
@@ -78,6 +88,18 @@ class PoolTrial:
 def roll_pitch_rad(quat_xyzw: np.ndarray) -> np.ndarray:
     """(n, 2) roll and pitch of R = Rz(yaw) Ry(pitch) Rx(roll) (intrinsic Z-Y-X) [rad]."""
     return Rotation.from_quat(quat_xyzw).as_euler("ZYX")[:, ::-1][:, :2]
+
+
+# trials the hull's centre of buoyancy was identified on (`uvms_pin.apps.validation.identify`);
+# the others are held out
+IDENTIFICATION_TRIALS = (
+    "_alt_001-0",
+    "_alt_001-1",
+    "_alt_001-2",
+    "_alt_008-0",
+    "_alt_008-1",
+    "_alt_008-2",
+)
 
 
 def find_trials(data_dir: str | Path) -> list[Path]:
@@ -194,3 +216,47 @@ def load_trial(path: str | Path) -> PoolTrial:
     if end - start < 1.0:
         raise DataError(f"{path}: the IMU, mocap and encoder streams overlap for < 1 s")
     return trial
+
+
+def split_trials(
+    data_dir: str | Path, training: Sequence[str] = IDENTIFICATION_TRIALS
+) -> tuple[list[Path], list[Path]]:
+    """(identification, held-out) trial files of ``data_dir``: the trials named in
+    ``training`` (file stems, e.g. "_alt_001-0"; default the shipped split) and the others.
+
+    Raises:
+        DataError: a missing directory, no trials, an identification trial missing (the
+            trials there named), or no held-out trial left.
+    """
+    files = {p.stem: p for p in find_trials(data_dir)}
+    missing = [n for n in training if n not in files]
+    if missing:
+        raise DataError(
+            f"{data_dir}: identification trial(s) {', '.join(missing)} missing "
+            f"(have {', '.join(files)})"
+        )
+    held_out = [p for n, p in files.items() if n not in training]
+    if not held_out:
+        raise DataError(f"{data_dir}: no trial left to hold out besides the identification ones")
+    return [files[n] for n in training], held_out
+
+
+def select_trials(data_dir: str | Path, trial_names: Sequence[str] | None = None) -> list[Path]:
+    """The trial files of ``data_dir`` (or those named, in that order), checked as far as can
+    be without reading them: they exist, are NPZ archives and fit in memory
+    (`check_trials_fit`).
+
+    Raises:
+        DataError: a missing directory, no trials, an unknown trial name or a bad file.
+    """
+    files = find_trials(data_dir)
+    if trial_names is not None:
+        by_name = {p.stem: p for p in files}
+        unknown = [n for n in trial_names if n not in by_name]
+        if unknown:
+            raise DataError(
+                f"{data_dir}: no trial named {', '.join(unknown)} (have {', '.join(by_name)})"
+            )
+        files = [by_name[n] for n in trial_names]
+    check_trials_fit(files)
+    return files
