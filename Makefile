@@ -20,16 +20,30 @@ SOURCES := pyproject.toml CMakeLists.txt $(wildcard src/uvms_core/*.cpp src/uvms
 
 # pip builds the compiled core (src/uvms_core, CMakeLists.txt) while installing: a changed
 # C++ source re-runs the install. The demo needs uvms-pin alone ($(BASE_STAMP)); the tests,
-# lint and benchmarks the dev extra ($(STAMP), which includes it)
+# lint and benchmarks the dev extra ($(STAMP), which includes it).
+# The build requirements (pyproject.toml's [build-system] requires, the one list of them, plus
+# what scikit-build-core asks for: cmake or ninja when the system has none) go into the venv
+# first and pip builds with --no-build-isolation: `pin` (and coal, eigenpy, boost) is installed
+# once, not a second time in a throw-away build environment, and a re-install compiles only the
+# changed units (the include paths stay those of the venv, the build directory is build/).
+BUILD_REQUIRES := $(VENV)/build-requirements.txt
+define install_core
+	$(BIN)/python -c 'import tomllib; print(*tomllib.load(open("pyproject.toml", "rb"))["build-system"]["requires"], sep="\n")' > $(BUILD_REQUIRES)
+	$(BIN)/python -m pip install --quiet -r $(BUILD_REQUIRES)
+	extra=$$($(BIN)/python -c 'from scikit_build_core.build import get_requires_for_build_editable as r; print(*r())'); \
+	  [ -z "$$extra" ] || $(BIN)/python -m pip install --quiet $$extra
+	$(BIN)/python -m pip install --quiet --no-build-isolation -e '.$(1)'
+endef
+
 $(STAMP): $(SOURCES)
 	$(PYTHON) -m venv $(VENV)
 	$(BIN)/python -m pip install --quiet --upgrade pip
-	$(BIN)/python -m pip install --quiet -e '.[dev]'
+	$(call install_core,[dev])
 	touch $(STAMP) $(BASE_STAMP)
 
 $(BASE_STAMP): $(SOURCES)
 	$(PYTHON) -m venv $(VENV)
-	$(BIN)/python -m pip install --quiet -e .
+	$(call install_core,)
 	touch $(BASE_STAMP)
 
 demo: $(BASE_STAMP)
