@@ -54,6 +54,7 @@ BatchPlant::BatchPlant(const Plant& prototype, const FixedStep& integrator,
     plant->free_surface = prototype.free_surface;
     plant->disturbance = prototype.disturbance;
     plant->joint_friction = prototype.joint_friction;
+    plant->fins = prototype.fins;
     plant->joint_stops = prototype.joint_stops;
     plant->joint_limits = prototype.joint_limits;
     plants_.push_back(std::move(plant));

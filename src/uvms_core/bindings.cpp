@@ -331,6 +331,43 @@ void bind_environment(nb::module_& m) {
       .def_rw("viscous_Nms", &uvms::JointFriction::viscous_Nms)
       .def_rw("coulomb_Nm", &uvms::JointFriction::coulomb_Nm)
       .def_rw("velocity_scale_rad_s", &uvms::JointFriction::velocity_scale_rad_s);
+  nb::class_<uvms::LiftDrag>(m, "LiftDrag", "A fin's LiftDrag parameters (fins.hpp).")
+      .def(nb::init<>())
+      .def_rw("area_m2", &uvms::LiftDrag::area_m2)
+      .def_rw("fluid_density_kg_m3", &uvms::LiftDrag::fluid_density_kg_m3)
+      .def_rw("cla", &uvms::LiftDrag::cla)
+      .def_rw("cda", &uvms::LiftDrag::cda)
+      .def_rw("cma", &uvms::LiftDrag::cma)
+      .def_rw("alpha_stall_rad", &uvms::LiftDrag::alpha_stall_rad)
+      .def_rw("cla_stall", &uvms::LiftDrag::cla_stall)
+      .def_rw("cda_stall", &uvms::LiftDrag::cda_stall)
+      .def_rw("cma_stall", &uvms::LiftDrag::cma_stall)
+      .def_rw("alpha0_rad", &uvms::LiftDrag::alpha0_rad)
+      .def_rw("cp_m", &uvms::LiftDrag::cp_m)
+      .def_rw("forward", &uvms::LiftDrag::forward)
+      .def_rw("upward", &uvms::LiftDrag::upward)
+      .def_rw("radial_symmetry", &uvms::LiftDrag::radial_symmetry)
+      .def_rw("reversible", &uvms::LiftDrag::reversible)
+      .def_rw("control_joint_rad_to_cl", &uvms::LiftDrag::control_joint_rad_to_cl)
+      .def_rw("cm_delta", &uvms::LiftDrag::cm_delta);
+  nb::class_<uvms::Fin>(m, "Fin", "A fin on a joint's body (fins.hpp).")
+      .def(nb::init<>())
+      .def_rw("joint_id", &uvms::Fin::joint_id)
+      .def_rw("rotation_in_joint", &uvms::Fin::rotation_in_joint)
+      .def_rw("translation_in_joint", &uvms::Fin::translation_in_joint)
+      .def_rw("params", &uvms::Fin::params)
+      .def_rw("control_q_index", &uvms::Fin::control_q_index);
+  nb::class_<uvms::Fins>(m, "Fins", "The fins of a model (fins.hpp).")
+      .def(nb::init<>())
+      .def_rw("fins", &uvms::Fins::fins);
+  m.def(
+      "lift_drag_wrench",
+      [](const uvms::LiftDrag& params, const uvms::Mat3& rotation_world,
+         const uvms::Vec3& velocity_world_m_s, double control_rad) {
+        return uvms::lift_drag_wrench(params, rotation_world, velocity_world_m_s, control_rad);
+      },
+      "params"_a, "rotation_world"_a, "velocity_world_m_s"_a, "control_rad"_a = 0.0,
+      "(force [N] at the centre of pressure, moment [N m]), world axes (fins.hpp).");
   nb::class_<uvms::JointStopsModel>(m, "JointStops",
                                     "Compliant stops at the joint limits (joint_stops.hpp).")
       .def(nb::init<>())
@@ -406,6 +443,7 @@ void bind_plant(nb::module_& m) {
       .def_rw("contact", &Plant::contact)
       .def_rw("disturbance", &Plant::disturbance)
       .def_rw("joint_friction", &Plant::joint_friction)
+      .def_rw("fins", &Plant::fins)
       .def_rw("joint_stops", &Plant::joint_stops)
       .def_rw("joint_limits", &Plant::joint_limits)
       .def_rw("world_bounds", &Plant::world_bounds)

@@ -54,6 +54,7 @@ const Eigen::VectorXd& Plant::acceleration(double time_s, const ConstVec& q, con
     world->add_to(dynamics_, world_forces_);
   }
   if (moving_contacts) moving_contacts(dynamics_);
+  if (fins.active()) fins.add_to(dynamics_, q, flow, time_s, free_surface);
   if (disturbance) {
     // delta acts against tau on the vehicle body (joint 1, free-flyer: LOCAL Jacobian [I 0])
     dynamics_.add_local_wrench(1, -disturbance->at(time_s));

@@ -18,6 +18,7 @@
 #include "derivatives_world_contact.hpp"
 #include "disturbance.hpp"
 #include "dynamics.hpp"
+#include "fins.hpp"
 #include "integrators.hpp"
 #include "joint_friction.hpp"
 #include "joint_limits.hpp"
@@ -38,6 +39,7 @@ class Plant {
   Contact contact;
   Disturbance disturbance;
   JointFriction joint_friction;
+  Fins fins;  // gz-sim's LiftDrag fins (fins.hpp), none by default
   JointStops joint_stops;  // compliant stops at the arm joints' limits, or none
   // or the limits as constraints solved implicitly at the end of each period (advance)
   JointLimitConstraints joint_limits;

@@ -19,6 +19,9 @@ const ForwardDynamicsDerivatives& Plant::acceleration_derivatives(double time_s,
                                                                   const ConstVec& q,
                                                                   const ConstVec& v,
                                                                   const ConstVec& tau) {
+  if (fins.active()) {  // their lift and drag have no derivatives here (nor in Python)
+    throw InputError("fins: the derivatives of a plant with fins (lift and drag) are not available");
+  }
   const auto& model = dynamics_.model();
   const int nv = model.nv;
   if (!derivatives_) {

@@ -1,7 +1,8 @@
 """The fins' lift and drag in the dynamics (`uvms_pin.physics.fins`): the generalized force
 is the fins' wrench through their joints' Jacobians (its power is the wrench's), a fin
-moving with the water feels nothing, and a run with fins runs on the Python reference with
-the reason named."""
+moving with the water feels nothing, a fin above the free surface nothing either; the
+compiled plant's fins (src/uvms_core/fins.hpp) agree with the reference, and a run with
+fins is compiled."""
 
 from __future__ import annotations
 
@@ -11,10 +12,10 @@ import pytest
 from fin_helpers import import_lrauv
 
 import uvms_pin as up
-from uvms_pin.errors import CoreFallbackWarning, ParameterError
+from uvms_pin.errors import ParameterError
 from uvms_pin.flow import UniformCurrent
+from uvms_pin.hydro.lift_drag import lift_drag_wrench
 from uvms_pin.physics.fins import fin_generalized_force, fin_wrenches_world
-from uvms_pin.sim.compiled.plant import FINS_REASON
 from uvms_pin.sim.plant import Plant
 
 
@@ -86,39 +87,74 @@ def test_a_fin_moving_with_the_water_feels_nothing_and_the_water_counts(lrauv):
     np.testing.assert_allclose(still_body, moving, rtol=1e-12, atol=1e-14)
 
 
-def test_the_plant_adds_them_on_the_python_reference_only(lrauv):
-    plant = Plant(lrauv, backend="python", free_surface=False)
+def test_the_plant_adds_them_and_the_core_agrees_with_the_reference(lrauv):
+    """The plant's acceleration is forward_dynamics with the fins' generalized force; the
+    compiled plant (src/uvms_core/fins.hpp) gives the Python reference's to 1e-10 in random
+    states, in still water, in a current and across the free surface; the force alone too;
+    derivatives are refused by name on both."""
+    from uvms_pin.physics.compiled.extension import core_module
+    from uvms_pin.physics.compiled.fins import lift_drag_to_core
+
     rng = np.random.default_rng(5)
-    q, v = _state(lrauv, rng)
     tau = np.zeros(lrauv.nv)
-    without = up.forward_dynamics(lrauv, q, v, tau, backend="python")
+    q, v = _state(lrauv, rng)
+    reference = Plant(lrauv, backend="python", free_surface=False)
     extra = _tau(lrauv, lrauv.model.createData(), q, v)
     np.testing.assert_allclose(
-        plant.acceleration(0.0, q, v, tau),
+        reference.acceleration(0.0, q, v, tau),
         up.forward_dynamics(lrauv, q, v, tau, tau_ext=extra, backend="python"),
         rtol=1e-12,
         atol=1e-12,
     )
-    assert not np.allclose(without, plant.acceleration(0.0, q, v, tau))
-    with pytest.warns(CoreFallbackWarning, match="fins"):
-        assert Plant(lrauv).compiled is None
+    assert np.any(extra)
+    for current, surface in (([0.0] * 3, False), ([0.3, -0.2, 0.1], False), ([0.0] * 3, True)):
+        water = {"current_world_m_s": np.array(current), "free_surface": surface}
+        python = Plant(lrauv, backend="python", **water)
+        core = Plant(lrauv, **water)
+        assert core.compiled is not None
+        for _ in range(20):
+            q, v = _state(lrauv, rng)
+            if surface:  # the fins' centres near the surface: some wet, some not
+                q[2] = rng.uniform(-0.3, 0.3)
+            np.testing.assert_allclose(
+                core.acceleration(0.0, q, v, tau),
+                python.acceleration(0.0, q, v, tau),
+                rtol=1e-10,
+                atol=1e-10,
+            )
+    core = core_module()
+    for fin in lrauv.fins:
+        for _ in range(50):
+            rotation = pin.exp3(rng.normal(size=3))
+            velocity, control = rng.normal(size=3), rng.normal(scale=0.2)
+            force, moment = core.lift_drag_wrench(
+                lift_drag_to_core(fin.params, core), rotation, velocity, control
+            )
+            expected = lift_drag_wrench(fin.params, rotation, velocity, control)
+            np.testing.assert_allclose(force, expected[0], rtol=1e-12, atol=1e-12)
+            np.testing.assert_allclose(moment, expected[1], rtol=1e-12, atol=1e-12)
     with pytest.raises(ParameterError, match="fins' lift and drag"):
-        Plant(lrauv, backend="python").acceleration_derivatives(0.0, q, v, tau)
+        reference.acceleration_derivatives(0.0, q, v, tau)
+    with pytest.raises(ParameterError, match="fins"):
+        Plant(lrauv).acceleration_derivatives(0.0, q, v, tau)
 
 
-def test_a_run_with_fins_says_why_it_is_not_compiled(tmp_path):
+def test_a_run_with_fins_is_compiled_and_agrees_with_the_python_loop(tmp_path):
     import_lrauv(tmp_path)
     scenario = tmp_path / "run.toml"
     scenario.write_text(
-        '[scenario]\nmodel = "lrauv.urdf"\nduration_s = 0.2\n\n[water]\ndensity_kg_m3 = 1000.0\n\n'
+        '[scenario]\nmodel = "lrauv.urdf"\nduration_s = 0.5\n\n[water]\ndensity_kg_m3 = 1000.0\n\n'
         "[initial]\nposition_world_m = [0.0, 0.0, -5.0]\n"
         "velocity = [-1.0, 0.0, 0.0, 0.0, 0.0, 0.2, 0.0, 0.0]\n\n"
         '[controller]\ntype = "none"\n'
     )
-    with pytest.warns(Warning, match="fins"):
-        rollout = up.simulate(up.load_scenario(scenario), progress=False)
-    assert rollout.metadata["closed_loop"]["reason"] == FINS_REASON
-    assert rollout.metadata["closed_loop"]["path"] == "python"
+    compiled = up.simulate(up.load_scenario(scenario), progress=False)
+    assert compiled.metadata["closed_loop"]["path"] == "compiled"
+    python = up.simulate(up.load_scenario(scenario), progress=False, compiled_loop=False)
+    assert python.metadata["closed_loop"]["path"] == "python"
+    np.testing.assert_allclose(compiled.q, python.q, atol=1e-9)
+    # the fins turned the motion: a run without them goes elsewhere
+    assert np.max(np.abs(compiled.v[-1] - compiled.v[0])) > 1e-3
 
 
 def test_a_fin_above_the_free_surface_gives_nothing_and_one_across_it_a_share(lrauv):

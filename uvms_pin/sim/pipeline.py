@@ -24,7 +24,7 @@ from uvms_pin.physics.compiled.extension import core_module
 from uvms_pin.sim.compiled.actuation import actuation_to_core
 from uvms_pin.sim.compiled.integrator import integrator_to_core
 from uvms_pin.sim.compiled.laws import law_to_core
-from uvms_pin.sim.compiled.plant import FINS_REASON, plant_to_core
+from uvms_pin.sim.compiled.plant import plant_to_core
 from uvms_pin.sim.integrators import Integrator
 from uvms_pin.sim.sample import ProgressReport
 from uvms_pin.sim.sensors import SensorConfig
@@ -105,7 +105,6 @@ REASONS: tuple[tuple[Pipeline, Callable[[RunParts], str | None]], ...] = (
     (Pipeline.BOTH, lambda p: "cameras in the loop" if p.sensors.perception.in_loop else None),
     (Pipeline.BOTH, lambda p: _fallback(actuation_to_core(p.system.plant.actuation, core_module(), p.system.plant.uvms.nv))),
     (Pipeline.LOOP, lambda p: "an observer that needs every sample" if any(not isinstance(o, ProgressReport) for o in p.observers) else None),
-    (Pipeline.ALL, lambda p: FINS_REASON if p.system.plant.uvms.fins else None),
     (Pipeline.ALL, _plant),
     (Pipeline.SYSTEM, lambda p: _fallback(p.system.compiled)),
 )  # fmt: skip

@@ -7,10 +7,9 @@ is stepped belong to the system of bodies (`uvms_pin.sim.system.System`).
 
 With ``backend="core"`` (default) the right-hand side runs in the compiled core: the plant's
 counterpart (`src/uvms_core/plant.hpp`, built in `uvms_pin.sim.compiled.plant`) mirrors its
-flow, contact, disturbance, joint stops, joint friction and world, rebuilt when a run starts
-(`attach`) or on first use; when one part has none (e.g. a disturbance written in Python, or
-the model's fins: `uvms_pin.physics.fins`) the
-plant computes on the Python reference and says so once with a `CoreFallbackWarning`. The
+flow, contact, disturbance, joint stops, joint friction, the model's fins
+(`uvms_pin.physics.fins`) and world, rebuilt when a run starts (`attach`) or on first use;
+when one part has none (e.g. a disturbance written in Python) the plant computes on the Python reference and says so once with a `CoreFallbackWarning`. The
 world contacts' friction state (`friction`, a `FrictionMemory`) stays on this plant for both
 backends: the compiled calls read it and write it back.
 """
@@ -291,7 +290,7 @@ class Plant:
             tau_ext[:6] -= self.disturbance_wrench(time_s)
         if self.world is not None or self.joint_stops is not None or extra_torque is not None:
             tau_ext += self.external_torque(q, v, extra_torque)
-        if self.uvms.fins:  # lift and drag: the Python reference alone (plant_to_core)
+        if self.uvms.fins:  # lift and drag (the compiled plant's: src/uvms_core/fins.hpp)
             wrenches = fin_wrenches_world(
                 self.uvms, self._fin_data, q, v, self.water, time_s, bool(self.free_surface)
             )

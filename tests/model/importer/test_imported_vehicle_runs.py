@@ -77,21 +77,19 @@ def test_the_imported_lrauv_with_lifting_fins_runs_a_minute_and_its_fins_only_ta
     tmp_path,
 ):
     """With gz-sim's tutorial LiftDrag on both fins (tests/fin_helpers.py) the passive run
-    above lasts its minute at its 5 ms step on the Python reference (the reason recorded),
+    above lasts its minute at its 5 ms step (the compiled loop, its fins in the core),
     and the fins' lift and drag at every logged state take power from the motion, never give
     it (c_Ma = 0: lift normal to the flow, drag against it)."""
     from fin_helpers import import_lrauv
 
     from uvms_pin.physics.fins import fin_generalized_force, fin_wrenches_world
-    from uvms_pin.sim.compiled.plant import FINS_REASON
 
     import_lrauv(tmp_path)
     scenario = tmp_path / "passive.toml"
     scenario.write_text(PASSIVE_LRAUV)
-    with pytest.warns(Warning, match="fins"):
-        rollout = up.simulate(up.load_scenario(scenario), progress=False)
+    rollout = up.simulate(up.load_scenario(scenario), progress=False)
     assert rollout.status.ok and rollout.time_s[-1] == 60.0
-    assert rollout.metadata["closed_loop"]["reason"] == FINS_REASON
+    assert rollout.metadata["closed_loop"]["path"] == "compiled"
     assert np.all(np.isfinite(rollout.q)) and np.abs(rollout.v).max() < 2.0
     uvms = up.load_uvms(tmp_path / "lrauv.urdf")
     data = uvms.model.createData()

@@ -1,5 +1,5 @@
 """The compiled plant (src/uvms_core/plant.hpp) of a `Plant`: its dynamics, flow, contact,
-disturbance, joint stops or limits, joint friction and world, each built by its own part of the seam
+disturbance, joint stops or limits, joint friction, fins and world, each built by its own part of the seam
 (`uvms_pin.physics.compiled`)."""
 
 from __future__ import annotations
@@ -10,6 +10,7 @@ from typing import Any, Protocol
 from uvms_pin.physics.compiled.backend import Fallback
 from uvms_pin.physics.compiled.contact import contact_to_core
 from uvms_pin.physics.compiled.disturbance import disturbance_to_core
+from uvms_pin.physics.compiled.fins import fins_to_core
 from uvms_pin.physics.compiled.flow import flow_to_core
 from uvms_pin.physics.compiled.joint_friction import joint_friction_to_core
 from uvms_pin.physics.compiled.joint_limits import joint_limits_to_core
@@ -17,10 +18,7 @@ from uvms_pin.physics.compiled.joint_stops import joint_stops_to_core
 from uvms_pin.physics.compiled.world import world_bounds_to_core, world_contact_to_core
 from uvms_pin.physics.dynamics import dynamics_of
 
-__all__ = ["FINS_REASON", "PlantParts", "plant_to_core"]
-
-#: why a model with fins (`uvms_pin.physics.fins`) runs on the Python reference
-FINS_REASON = "fins (lift and drag, gz-sim's LiftDrag): no compiled counterpart"
+__all__ = ["PlantParts", "plant_to_core"]
 
 
 class PlantParts(Protocol):
@@ -50,8 +48,6 @@ def plant_to_core(plant: PlantParts, core: ModuleType):
     fallback = next((p for p in parts if isinstance(p, Fallback)), None)
     if fallback is not None:
         return fallback
-    if plant.uvms.fins:
-        return Fallback(FINS_REASON)
     if plant.joint_coulomb is not None:
         return Fallback("joint Coulomb friction as a constraint (solved by the Python step)")
     uvms = plant.uvms
@@ -60,6 +56,7 @@ def plant_to_core(plant: PlantParts, core: ModuleType):
     compiled = core.Plant(dynamics_of(uvms).core, uvms.ee_frame_id if uvms.has_end_effector else 0)
     compiled.flow, compiled.contact, compiled.disturbance, compiled.joint_stops = parts
     compiled.joint_friction = joint_friction_to_core(plant.joint_friction, core)
+    compiled.fins = fins_to_core(uvms.fins, core)
     compiled.joint_limits = joint_limits_to_core(plant.joint_limits, uvms.model, core)
     compiled.free_surface = bool(plant.free_surface)
     bounds = world_bounds_to_core(plant.world, core)
