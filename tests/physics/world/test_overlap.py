@@ -215,3 +215,42 @@ def test_a_scenario_s_separate_moves_the_box_out_of_the_seabed_and_says_so():
     assert moved["object"] == "box" and moved["bodies"] == ["seabed", "box"]
     assert moved["depth_m"] == pytest.approx(0.075, abs=1e-9)
     assert moved["moved_world_m"] == pytest.approx([0.0, 0.0, 0.075], abs=1e-9)
+
+
+def test_the_robot_started_inside_a_fixed_box_is_refused_naming_both(tmp_path):
+    """The robot's own start in a fixed object (a rock at its arm): it never moves, so the
+    run is refused (status 2, one line) in either mode; before, the compressed contact flung
+    the passive robot out, +6.5 J from nothing in 0.04 s."""
+    box = '{type="box", name="rock", size_m=[0.3, 0.3, 0.3], position_world_m=[0.75, 0.0, -2.1]}'
+    for mode in ("refuse", "separate"):
+        out = tmp_path / mode
+        result = run(
+            "run", str(ROOT / "scenarios" / "passive_still_water.toml"), "--quiet",
+            "--out", str(out), "--set", f"world={{objects=[{box}], initial_overlap=\"{mode}\"}}",
+        )  # fmt: skip
+        assert result.returncode == 2, result.stderr
+        (line,) = result.stderr.strip().splitlines()
+        assert line.startswith("uvms-pin: error: 'arm_link") and "and 'rock' overlap by 7" in line
+        assert "the robot is never moved" in line and "Traceback" not in result.stderr
+        assert not out.exists()
+
+
+def test_the_robot_under_the_seabed_is_refused_and_one_resting_on_it_is_not(reference_uvms):
+    """A seabed plane 5 cm over the vehicle's lowest point is refused; the same plane 1 mm
+    under it starts (no contact)."""
+    q, _ = _vehicle_center(reference_uvms)
+    data = reference_uvms.model.createData()
+    pin.forwardKinematics(reference_uvms.model, data, q)
+    world = World(reference_uvms, [])
+    lowest = min(
+        (data.oMi[p.joint_id] * p.placement_in_joint).translation[2] - p.bound_radius_m
+        for p in world.pieces
+    )  # under every piece's bounding sphere: clear of the vehicle
+    clear = _system(
+        reference_uvms, [], [plane("seabed", [0, 0, lowest - 1e-3], [0, 0, 1], 0.5, 0.4)]
+    )
+    clear.initial_state(q, np.zeros(reference_uvms.nv))
+    high = _system(reference_uvms, [], [plane("seabed", [0, 0, lowest + 0.5], [0, 0, 1], 0.5, 0.4)])
+    with pytest.raises(InitialOverlapError, match="and 'seabed' overlap by") as caught:
+        high.initial_state(q, np.zeros(reference_uvms.nv))
+    assert caught.value.second == "seabed" and caught.value.depth_m > 0.05
