@@ -21,6 +21,27 @@ START_HEIGHT = Plausible(
     hints=("", "a height in mm?"),
 )
 
+#: The vehicle's initial speed |v| [m/s]: a UVMS moves at a few m/s at most (the refusal of
+#: a speed no run can have is `DIVERGED_SPEED`'s, below)
+START_SPEED = Plausible(
+    "m/s",
+    usual=(0.0, 10.0),
+    possible=(0.0, DIVERGED_SPEED),
+    usual_text="the speeds of a vehicle in water (a few m/s at most)",
+    impossible_text="only a blown-up integration is that fast",
+    hints=("", "a speed in cm/s or mm/s?"),
+)
+#: The largest initial angular or joint rate [rad/s]: a vehicle turns and an arm's joint
+#: moves at a few rad/s
+START_RATE = Plausible(
+    "rad/s",
+    usual=(0.0, 100.0),
+    possible=(0.0, DIVERGED_SPEED),
+    usual_text="the rates of a vehicle or an arm's joint (a few rad/s)",
+    impossible_text="only a blown-up integration is that fast",
+    hints=("", "a rate in deg/s?"),
+)
+
 
 def build_initial_state(t: Table, uvms: UVMS) -> tuple[np.ndarray, np.ndarray]:
     """(q0, v0): the vehicle's position [m] and roll, pitch, yaw [rad] in the world, the arm
@@ -39,6 +60,8 @@ def build_initial_state(t: Table, uvms: UVMS) -> tuple[np.ndarray, np.ndarray]:
             f"{np.max(np.abs(velocity)):g} is not a physical speed (the simulator treats "
             f"|v| >= {DIVERGED_SPEED:g} m/s or rad/s as diverged)",
         )
+    t.plausible("velocity", float(np.linalg.norm(velocity[:3])), START_SPEED)
+    t.plausible("velocity", float(np.max(np.abs(velocity[3:]), initial=0.0)), START_RATE)
     outside = arm.outside(joints)
     if outside:
         raise t.error("joint_positions_rad", f"outside the joint limits for {', '.join(outside)}")
