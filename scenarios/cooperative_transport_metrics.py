@@ -14,7 +14,7 @@ The leader's (the first robot's rollout logs the bar, ``free_objects``):
 - ``bar_final_distance_m``: the bar centre's distance to the path's end at the last sample.
 - ``bar_tracking_error_max_m``, ``bar_tracking_error_rms_m``: |bar centre - x_d(t)| from the
   path's start on, x_d the desired path (the leader's logged target moved by its grasp
-  offset).
+  offset); absent from a run that ends before the path starts (a shortened run).
 - ``bar_delivered``: 1 when ``bar_final_distance_m`` < 5 cm.
 
 The follower's:
@@ -71,12 +71,11 @@ def _leader(rollout, params: dict) -> dict[str, float]:
     moving = t >= float(params.get("path_start_s", 2.0))
     error = np.linalg.norm(bar - path, axis=1)[moving]
     final = float(np.linalg.norm(bar[-1] - end))
-    return {
-        "bar_final_distance_m": final,
-        "bar_tracking_error_max_m": float(error.max()),
-        "bar_tracking_error_rms_m": float(np.sqrt(np.mean(error**2))),
-        "bar_delivered": float(final < DELIVERED_WITHIN_M),
-    }
+    out = {"bar_final_distance_m": final, "bar_delivered": float(final < DELIVERED_WITHIN_M)}
+    if error.size:  # the path started within the run
+        out["bar_tracking_error_max_m"] = float(error.max())
+        out["bar_tracking_error_rms_m"] = float(np.sqrt(np.mean(error**2)))
+    return out
 
 
 def _follower(rollout) -> dict[str, float]:
