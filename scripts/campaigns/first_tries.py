@@ -184,7 +184,8 @@ def _still(doc: dict) -> bool:
     moving = any(water.get(k) for k in ("waves", "sea", "current")) or any(
         water.get("current_world_m_s", [0.0]) or [0.0]
     )
-    return not moving and "disturbance" not in doc and "environment" not in doc
+    driven = any(k in doc for k in ("disturbance", "environment", "gripper"))  # the jaw's servo
+    return not moving and not driven
 
 
 def _free_object_cases(doc: dict) -> list[tuple[str, list[str], bool]]:
@@ -294,12 +295,23 @@ def _run_cli(scenario: Path, sets: list[str], out: Path, duration: float) -> tup
     return done.returncode, done.stdout + done.stderr, time.perf_counter() - start
 
 
+def _raised_on_purpose(text: str) -> bool:
+    """The traceback is the one the command line shows of a scenario's own code (a metric,
+    a controller: "your code raised") and its last frame is a ``raise`` of that code: the
+    code refused on purpose, naming why. Any other traceback is a failure."""
+    if "your code raised" not in text and "your controller's code" not in text:
+        return False
+    lines = text.split("Traceback (most recent call last):", 1)[1].splitlines()
+    code = [ln.strip() for ln in lines if ln.startswith("    ") and not ln.strip().startswith("^")]
+    return bool(code) and code[-1].startswith("raise ")
+
+
 def _classify(code: int, text: str, out: Path, passive: bool) -> tuple[str, str]:
     lines = [ln for ln in text.splitlines() if ln.strip() and "warning:" not in ln]
     last = lines[-1] if lines else ""
     if code == -1:
         return "BAD", text
-    if "Traceback (most recent call last)" in text and "user code" not in text:
+    if "Traceback (most recent call last)" in text and not _raised_on_purpose(text):
         return "BAD", "traceback: " + last
     if code == 0:
         problem = _judge_rollouts(out, passive)
