@@ -392,6 +392,12 @@ def _gym_episode(env_id: str, kwargs: dict, seed: int, steps: int) -> tuple[str,
                 return "BAD", f"non-finite observation or reward at step {_}"
             if info.get("diverged"):
                 return "BAD", f"diverged at step {_}: {info.get('failure', '')}"
+            v = np.asarray(env.unwrapped._loop.v)  # the true state, not the observation
+            if np.linalg.norm(v[:3]) > MAX_SPEED_M_S or np.abs(v[3:]).max() > MAX_RATE_RAD_S:
+                return (
+                    "BAD",
+                    f"speed {np.linalg.norm(v[:3]):.1f} m/s, rate {np.abs(v[3:]).max():.0f} rad/s at step {_}",
+                )
             if terminated or truncated:
                 resets += 1
                 obs, info = env.reset()
