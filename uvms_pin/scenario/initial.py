@@ -21,25 +21,22 @@ START_HEIGHT = Plausible(
     hints=("", "a height in mm?"),
 )
 
-#: The vehicle's initial speed |v| [m/s]: a UVMS moves at a few m/s at most (the refusal of
-#: a speed no run can have is `DIVERGED_SPEED`'s, below)
-START_SPEED = Plausible(
-    "m/s",
-    usual=(0.0, 10.0),
-    possible=(0.0, DIVERGED_SPEED),
-    usual_text="the speeds of a vehicle in water (a few m/s at most)",
-    impossible_text="only a blown-up integration is that fast",
-    hints=("", "a speed in cm/s or mm/s?"),
+
+def _start_rate(unit: str, usual_max: float, usual_text: str, hint: str) -> Plausible:
+    """An initial speed or rate [unit]: usual up to ``usual_max``; from `DIVERGED_SPEED` on
+    refused (below, with its own message)."""
+    fast = "only a blown-up integration is that fast"
+    return Plausible(unit, (0.0, usual_max), (0.0, DIVERGED_SPEED), usual_text, fast, ("", hint))
+
+
+#: The vehicle's initial speed |v| [m/s]: a UVMS moves at a few m/s at most
+START_SPEED = _start_rate(
+    "m/s", 10.0, "the speeds of a vehicle in water (a few m/s at most)", "a speed in cm/s or mm/s?"
 )
 #: The largest initial angular or joint rate [rad/s]: a vehicle turns and an arm's joint
 #: moves at a few rad/s
-START_RATE = Plausible(
-    "rad/s",
-    usual=(0.0, 100.0),
-    possible=(0.0, DIVERGED_SPEED),
-    usual_text="the rates of a vehicle or an arm's joint (a few rad/s)",
-    impossible_text="only a blown-up integration is that fast",
-    hints=("", "a rate in deg/s?"),
+START_RATE = _start_rate(
+    "rad/s", 100.0, "the rates of a vehicle or an arm's joint (a few rad/s)", "a rate in deg/s?"
 )
 
 
