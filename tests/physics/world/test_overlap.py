@@ -235,22 +235,27 @@ def test_the_robot_started_inside_a_fixed_box_is_refused_naming_both(tmp_path):
         assert not out.exists()
 
 
-def test_the_robot_under_the_seabed_is_refused_and_one_resting_on_it_is_not(reference_uvms):
-    """A seabed plane 5 cm over the vehicle's lowest point is refused; the same plane 1 mm
-    under it starts (no contact)."""
-    q, _ = _vehicle_center(reference_uvms)
-    data = reference_uvms.model.createData()
-    pin.forwardKinematics(reference_uvms.model, data, q)
-    world = World(reference_uvms, [])
+def test_the_robot_under_the_seabed_is_refused_and_one_clear_of_it_is_not():
+    """A run (`simulate`) with a seabed 0.5 m over its pieces' lowest bound is refused,
+    naming the seabed; the same seabed 1 mm under every piece's bounding sphere runs."""
+    from uvms_pin.scenario.load import load_scenario
+    from uvms_pin.sim.run import simulate
+
+    scenario = load_scenario(ROOT / "scenarios" / "passive_still_water.toml")
+    uvms, q = scenario.plant.uvms, scenario.q0
+    data = uvms.model.createData()
+    pin.forwardKinematics(uvms.model, data, q)
     lowest = min(
         (data.oMi[p.joint_id] * p.placement_in_joint).translation[2] - p.bound_radius_m
-        for p in world.pieces
-    )  # under every piece's bounding sphere: clear of the vehicle
-    clear = _system(
-        reference_uvms, [], [plane("seabed", [0, 0, lowest - 1e-3], [0, 0, 1], 0.5, 0.4)]
+        for p in World(uvms, []).pieces
     )
-    clear.initial_state(q, np.zeros(reference_uvms.nv))
-    high = _system(reference_uvms, [], [plane("seabed", [0, 0, lowest + 0.5], [0, 0, 1], 0.5, 0.4)])
+
+    def run(seabed_z: float):
+        seabed = {"type": "plane", "name": "seabed", "point_world_m": [0.0, 0.0, seabed_z]}
+        overrides = {"world": {"objects": [seabed]}, "scenario.duration_s": 0.04}
+        return simulate(load_scenario(ROOT / "scenarios" / "passive_still_water.toml", overrides))
+
+    assert run(lowest - 1e-3).metadata["status"] == "ok"
     with pytest.raises(InitialOverlapError, match="and 'seabed' overlap by") as caught:
-        high.initial_state(q, np.zeros(reference_uvms.nv))
-    assert caught.value.second == "seabed" and caught.value.depth_m > 0.05
+        run(lowest + 0.5)
+    assert caught.value.second == "seabed" and caught.value.depth_m > 0.01

@@ -181,7 +181,7 @@ def _released(slope: Slope):
     system = slope.system
     robot = system.plant.uvms
     q = robot.neutral_configuration()
-    q[:3] = [-20.0, 0.0, -5.0]  # far away and above the slope (at +20 m it was under it)
+    q[:3] = [20.0, 0.0, -5.0]
     state = system.initial_state(q, np.zeros(robot.nv))
     system.start(state)
     q_sys, v_sys = state.q, state.v

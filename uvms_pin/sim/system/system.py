@@ -31,7 +31,7 @@ from uvms_pin.physics.constraints.moving_contacts import MovingPairContacts
 from uvms_pin.physics.constraints.object_contacts import ObjectWorldContacts
 from uvms_pin.physics.constraints.step import StalledSolves
 from uvms_pin.physics.dynamics import forward_dynamics, mass_matrix
-from uvms_pin.physics.world.overlap import robot_started_apart, tolerance_m
+from uvms_pin.physics.world.overlap import tolerance_m
 from uvms_pin.sim.compiled.system import system_to_core
 from uvms_pin.sim.integrators import Integrator
 from uvms_pin.sim.plant import Plant, checked_start, has_moving_contacts
@@ -143,10 +143,8 @@ class System:
     def initial_state(self, q0: np.ndarray, v0: np.ndarray) -> SystemState:
         """The state at t = 0: the robot at (q0, v0) (checked, its quaternion normalised),
         every free object where its scenario puts it (moved out of another body when its
-        world asks so, the moves kept in `separations`; else InitialOverlapError); the
-        robot itself inside a fixed object or the seabed: InitialOverlapError."""
+        world asks so, the moves kept in `separations`; else InitialOverlapError)."""
         q0, v0 = checked_start(self.plant.uvms.model, q0, v0)
-        robot_started_apart(self.plant.world, self.plant.uvms.model, q0)
         states = [] if self.moving is None else self.moving.initial_states()
         if self.objects or self.fixtures:  # none inside another body (`...world.overlap`)
             states, self.separations = self.moving.apart(q0, states)
