@@ -43,6 +43,14 @@ class ObjectPush(Controller):
         self.target = np.asarray(arm_target_rad, dtype=float)
         self.kp = np.asarray(kp_Nm_rad, dtype=float)
         self.kd = np.asarray(kd_Nm_s_rad, dtype=float)
+        arm = self.nv - 6
+        for name, values in (("arm_target_rad", self.target), ("kp_Nm_rad", self.kp),
+                             ("kd_Nm_s_rad", self.kd)):  # fmt: skip
+            if values.shape != (arm,):
+                raise ValueError(
+                    f"{name} has {values.size} entries, the model's arm has {arm} joints "
+                    "(this controller pushes with an arm: a UVMS model)"
+                )
         self.kz, self.dz = (float(g) for g in depth_gains)
         self.ka, self.da = (float(g) for g in attitude_gains)
         self.q0: np.ndarray | None = None

@@ -158,3 +158,14 @@ def test_self_collision_is_a_contact_key():
 def test_implicit_joint_limits_need_a_sampled_controller():
     with pytest.raises(ScenarioError, match=r"joints\.stops.*\"implicit\".*\[control\] period_s"):
         load_scenario(SCENARIOS / "paper_force_tracking.toml", {"joints.stops": "implicit"})
+
+
+def test_the_push_controller_on_a_vehicle_without_an_arm_is_refused_naming_why():
+    """`push_object.toml --set scenario.model=bluerov2_heavy`: its controller raised a
+    numpy broadcast error at t = 0 (the run stopped, exit 3); refused as it loads now."""
+    overrides = {
+        "scenario.model": "bluerov2_heavy",
+        "initial": {"position_world_m": [0.0, 0.0, -9.75]},
+    }
+    with pytest.raises(ScenarioError, match="arm_target_rad has 4 entries, the model's arm has 0"):
+        load_scenario(SCENARIOS / "push_object.toml", overrides)
