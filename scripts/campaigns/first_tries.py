@@ -3,6 +3,7 @@ them (the `uvms-pin run` command line, `gymnasium.make`), each classified.
 
     .venv/bin/python scripts/campaigns/first_tries.py [--only SUBSTRING] [--duration 1] [--jobs 2]
         [--gym-steps 300] [--out out/first_tries] [--no-gym] [--no-cli]
+        [--bad-of out/first_tries/first_tries.json]
 
 Every scenario in scenarios/*.toml at its defaults and with the variants tried first (a
 larger step, rigid moving contacts, another duration, a changed or added object, another
@@ -346,10 +347,16 @@ def _cli_case(args, index: int, path: Path, variant: str, sets: list[str], passi
     )
 
 
+def _chosen(args, label: str) -> bool:
+    """Whether to run the case ``label``: it contains ``--only``, and was BAD in the
+    ``--bad-of`` table when one is given."""
+    return (not args.only or args.only in label) and (args.bad_of is None or label in args.bad_of)
+
+
 def run_cli_cases(args, results: list[dict]) -> None:
     """Every scenario's cases, ``args.jobs`` command lines at a time; in the cases' order."""
     cases = [(path, *case) for path in SCENARIOS for case in _scenario_cases(path)]
-    cases = [c for c in cases if not args.only or args.only in f"{c[0].stem}: {c[1]}"]
+    cases = [c for c in cases if _chosen(args, f"{c[0].stem}: {c[1]}")]
     with ThreadPoolExecutor(max_workers=args.jobs) as pool:
         futures = [pool.submit(_cli_case, args, k, *case) for k, case in enumerate(cases)]
         results += [f.result() for f in futures]
@@ -413,7 +420,7 @@ def run_gym_cases(args, results: list[dict]) -> None:
         seeds = (args.seed, args.seed + 1, args.seed + 2) if "defaults" in label else (args.seed,)
         for seed in seeds:
             case = f"gym {label} seed {seed}"
-            if args.only and args.only not in case:
+            if not _chosen(args, case):
                 continue
             start = time.perf_counter()
             try:
@@ -466,7 +473,12 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--out", type=Path, default=ROOT / "out" / "first_tries")
     parser.add_argument("--no-gym", action="store_true")
     parser.add_argument("--no-cli", action="store_true")
+    parser.add_argument("--bad-of", type=Path, help="rerun the BAD cases of this first_tries.json")
     args = parser.parse_args(argv)
+    if args.bad_of is not None:
+        args.bad_of = {
+            r["case"] for r in json.loads(args.bad_of.read_text()) if r["outcome"] == "BAD"
+        }
     args.out.mkdir(parents=True, exist_ok=True)
     results: list[dict] = []
     if not args.no_cli:
