@@ -14,7 +14,7 @@ The leader's (the first robot's rollout logs the bar, ``free_objects``):
 - ``bar_final_distance_m``: the bar centre's distance to the path's end at the last sample.
 - ``bar_tracking_error_max_m``, ``bar_tracking_error_rms_m``: |bar centre - x_d(t)| from the
   path's start on, x_d the desired path (the leader's logged target moved by its grasp
-  offset); left out of a run that ends before the path starts (a short sweep's).
+  offset); left out of a run that ends before the path starts (a shortened run, a short sweep's).
 - ``bar_delivered``: 1 when ``bar_final_distance_m`` < 5 cm.
 
 The follower's:

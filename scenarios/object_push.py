@@ -18,6 +18,23 @@ import pinocchio as pin
 from uvms_pin.control.base import Controller
 
 
+def arm_pd(nv: int, arm_target_rad, kp_Nm_rad, kd_Nm_s_rad):
+    """(q_target, K_p, K_d) of an arm joint PD law as arrays; ValueError unless each has one
+    entry per arm joint (nv - 6): these controllers move an arm (a UVMS model)."""
+    arm = nv - 6
+    out = []
+    for name, values in (("arm_target_rad", arm_target_rad), ("kp_Nm_rad", kp_Nm_rad),
+                         ("kd_Nm_s_rad", kd_Nm_s_rad)):  # fmt: skip
+        values = np.asarray(values, dtype=float)
+        if values.shape != (arm,):
+            raise ValueError(
+                f"{name} has {values.size} entries, the model's arm has {arm} joints "
+                "(this controller moves an arm: a UVMS model)"
+            )
+        out.append(values)
+    return tuple(out)
+
+
 def _smooth(x: float) -> float:
     s = min(max(x, 0.0), 1.0)
     return 3 * s**2 - 2 * s**3
@@ -40,9 +57,7 @@ class ObjectPush(Controller):
         self.nv = uvms.nv
         self.depth_m, self.surge_force_N = float(depth_m), float(surge_force_N)
         self.push_start_s, self.ramp_s = float(push_start_s), float(ramp_s)
-        self.target = np.asarray(arm_target_rad, dtype=float)
-        self.kp = np.asarray(kp_Nm_rad, dtype=float)
-        self.kd = np.asarray(kd_Nm_s_rad, dtype=float)
+        self.target, self.kp, self.kd = arm_pd(self.nv, arm_target_rad, kp_Nm_rad, kd_Nm_s_rad)
         self.kz, self.dz = (float(g) for g in depth_gains)
         self.ka, self.da = (float(g) for g in attitude_gains)
         self.q0: np.ndarray | None = None

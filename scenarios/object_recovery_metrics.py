@@ -39,7 +39,10 @@ def _world(rollout) -> dict:
 
 def _sample_columns(rollout) -> np.ndarray:
     """The sample's logged pose and velocity: (n, 13) [x y z qx qy qz qw u v w p q r]."""
-    components = rollout.metadata["signal_units"]["free_objects"]["components"]
+    units = rollout.metadata.get("signal_units", {}).get("free_objects") or {}
+    components = units.get("components", [])
+    if f"{SAMPLE}_x" not in components:  # the world's objects changed (--set world=...)
+        raise ValueError(f"no free object named {SAMPLE!r} in the rollout's world")
     first = components.index(f"{SAMPLE}_x")
     return np.asarray(rollout.signals["free_objects"])[:, first : first + 13]
 

@@ -11,6 +11,7 @@ uvms_pin.scenario.custom_controller."""
 from __future__ import annotations
 
 import numpy as np
+from object_push import arm_pd
 
 from uvms_pin.control.base import Controller
 
@@ -29,9 +30,7 @@ class SeabedProbe(Controller):
     ):
         self.nv = uvms.nv
         self.heave_force_N = float(heave_force_N)
-        self.target = np.asarray(arm_target_rad, dtype=float)
-        self.kp = np.asarray(kp_Nm_rad, dtype=float)
-        self.kd = np.asarray(kd_Nm_s_rad, dtype=float)
+        self.target, self.kp, self.kd = arm_pd(self.nv, arm_target_rad, kp_Nm_rad, kd_Nm_s_rad)
         self.ramp_s, self.start_s = float(ramp_s), float(start_s)
         self.yaw_damping = float(yaw_damping_Nm_s_rad)
         self.q0: np.ndarray | None = None

@@ -26,7 +26,9 @@ TURNED_FRACTION = 0.95
 
 
 def _valve_rad(rollout) -> np.ndarray:
-    components = rollout.metadata["signal_units"][FIXTURE]["components"]
+    components = (rollout.metadata.get("signal_units", {}).get(FIXTURE) or {}).get("components")
+    if not components or JOINT not in components:  # the world's objects changed
+        raise ValueError(f"no fixture {FIXTURE!r} with a joint {JOINT!r} in the rollout's world")
     return np.asarray(rollout.signals[FIXTURE])[:, components.index(JOINT)]
 
 

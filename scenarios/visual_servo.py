@@ -25,6 +25,7 @@ from __future__ import annotations
 
 import numpy as np
 import pinocchio as pin
+from object_push import arm_pd
 
 from uvms_pin.control.base import Controller
 from uvms_pin.physics.dynamics import bias_forces
@@ -59,11 +60,10 @@ class VisualServo(Controller):
             pin.rpy.rpyToMatrix(np.asarray(camera_rpy_rad, dtype=float)),
             np.asarray(camera_position_m, dtype=float),
         )
-        self.arm_target = np.asarray(arm_target_rad, dtype=float)
+        self.arm_target, self.kp, self.kd = arm_pd(uvms.nv, arm_target_rad, kp_Nm_rad, kd_Nm_s_rad)
         self.gain, self.max_speed, self.standoff = gain_per_s, max_speed_m_s, standoff_m
         self.kv = velocity_gain_N_s_m
         self.k_rotation, self.k_rate = attitude_gains
-        self.kp, self.kd = np.asarray(kp_Nm_rad, float), np.asarray(kd_Nm_s_rad, float)
         self.data = uvms.model.createData()
         self.error = np.zeros(3)
         self.heading: np.ndarray | None = None

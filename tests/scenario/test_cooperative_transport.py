@@ -131,3 +131,33 @@ def test_a_short_transport_delivers_the_bar_with_the_funnels_kept(tmp_path):
     metrics = rollouts.metrics()
     assert metrics["alpha"]["bar_final_distance_m"] < 0.05
     assert metrics["bravo"]["funnel_kept"] == 1.0
+
+
+class _ShortRollout:
+    """A leader's rollout that ends (1.5 s) before its path starts (2 s): a shortened run."""
+
+    def __init__(self):
+        self.time_s = np.arange(0.0, 1.52, 0.02)
+        n = len(self.time_s)
+        self.metadata = {
+            "controller": {
+                "params": {
+                    "role": "leader",
+                    "object_net_weight_N": 2.0,
+                    "path_start_s": 2.0,
+                    "waypoints_world_m": [[0.0, 0.0, -5.0], [2.0, 0.0, -5.0]],
+                }
+            }
+        }
+        self.wrench_contact_world = np.tile([0.0, 0.0, 1.0, 0.0, 0.0, 0.0], (n, 1))
+        bar = np.tile([0.0, 0.0, -5.0], (n, 1))
+        self.signals = {"free_objects": bar, "estimate": bar}
+
+
+def test_the_metrics_of_a_run_ending_before_the_path_starts_leave_the_tracking_out():
+    """`UVMS_PIN_MAX_DURATION_S=1` on the shipped scenario: its metric raised on the empty
+    tracking window (ValueError, the run lost); the tracking errors are left out now."""
+    metrics = _module("cooperative_transport_metrics").transport(_ShortRollout())
+    assert metrics["load_share_end"] == pytest.approx(0.5)
+    assert metrics["bar_final_distance_m"] == pytest.approx(2.0) and metrics["bar_delivered"] == 0
+    assert not any(name.startswith("bar_tracking_error") for name in metrics)

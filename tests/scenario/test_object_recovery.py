@@ -43,3 +43,13 @@ def test_a_grip_too_weak_for_the_sample_leaves_it_on_the_seabed():
     assert metrics["sample_lifted_m"] < 0.05
     assert metrics["placed"] == 0.0
     assert metrics["sample_final_x_m"] == pytest.approx(1.0, abs=0.05)
+
+
+def test_its_metric_names_the_missing_sample_when_the_world_is_replaced():
+    """`--set world=...` without the sample: the metric said KeyError: 'free_objects' (an
+    accident of its code); it names the free object it needs now."""
+    seabed = {"type": "plane", "name": "seabed", "point_world_m": [0.0, 0.0, -30.0]}
+    overrides = {"world": {"objects": [seabed]}, "scenario.duration_s": 0.1}
+    rollout = up.simulate(up.load_scenario(SCENARIO, overrides=overrides))
+    with pytest.raises(up.ParameterError, match="no free object named 'sample'"):
+        rollout.metrics()

@@ -45,6 +45,8 @@ def test_what_no_water_or_sea_can_be_is_refused(overrides, message):
         ({"integrator.step_s": 1e-9}, "override 'integrator.step_s': 1e-09 s is far outside the steps a UVMS run needs (1e-05 to 0.05 s); every simulated second takes 1/step steps"),
         ({"initial.position_world_m": [0.0, 0.0, 50.0]}, "initial.position_world_m[2] = 50 m is far outside starting depths in the sea"),
         ({"control.period_s": 1e-5, "output.log_period_s": 0.02, "integrator.step_s": 1e-5}, "override 'control.period_s': 1e-05 s is far outside controller rates"),
+        ({"initial.velocity": [100.0] + [0.0] * 9}, "override 'initial.velocity': 100 m/s is far outside the speeds of a vehicle in water (a few m/s at most) (0 to 10 m/s)"),
+        ({"initial.velocity": [0.0] * 9 + [500.0]}, "override 'initial.velocity': 500 rad/s is far outside the rates of a vehicle or an arm's joint"),
     ],
 )  # fmt: skip
 def test_what_no_vehicle_usually_meets_is_warned_once(overrides, message):

@@ -56,3 +56,13 @@ def test_the_controller_refuses_phases_it_does_not_have():
     uvms = up.load_uvms(SCENARIOS.parent / "models" / "uvms_bluerov2_alpha5.urdf")
     with pytest.raises(ParameterError, match="phase_durations_s"):
         ValveTurn(uvms, [0.785, -0.156, -2.027], [1.0, 2.0], [0.0] * 4, [1.0] * 4, [0.1] * 4)
+
+
+def test_its_metric_names_the_missing_valve_when_the_world_is_replaced():
+    """`--set world=...` without the panel: the metric said KeyError: 'panel' (an accident
+    of its code); it names the fixture and joint it needs now."""
+    seabed = {"type": "plane", "name": "seabed", "point_world_m": [0.0, 0.0, -30.0]}
+    overrides = {"world": {"objects": [seabed]}, "scenario.duration_s": 0.1}
+    rollout = up.simulate(up.load_scenario(SCENARIO, overrides=overrides))
+    with pytest.raises(ParameterError, match="no fixture 'panel' with a joint 'valve'"):
+        rollout.metrics()

@@ -158,3 +158,19 @@ def test_self_collision_is_a_contact_key():
 def test_implicit_joint_limits_need_a_sampled_controller():
     with pytest.raises(ScenarioError, match=r"joints\.stops.*\"implicit\".*\[control\] period_s"):
         load_scenario(SCENARIOS / "paper_force_tracking.toml", {"joints.stops": "implicit"})
+
+
+@pytest.mark.parametrize(
+    ("name", "controller"),
+    [("push_object", "ObjectPush"), ("seabed_landing", "SeabedProbe"), ("visual_approach", "VisualServo")],
+)  # fmt: skip
+def test_an_arm_controller_on_a_vehicle_without_an_arm_is_refused_naming_why(name, controller):
+    """`--set scenario.model=bluerov2_heavy` on a scenario whose controller moves an arm:
+    ObjectPush and SeabedProbe raised a numpy broadcast error at t = 0 (the run stopped,
+    exit 3); each is refused as the scenario loads now, naming both counts."""
+    overrides = {"scenario.model": "bluerov2_heavy", "initial": {"position_world_m": [0, 0, -8.0]}}
+    with pytest.raises(
+        ScenarioError, match="arm_target_rad has 4 entries, the model's arm has 0"
+    ) as caught:
+        load_scenario(SCENARIOS / f"{name}.toml", overrides)
+    assert controller in str(caught.value)

@@ -22,6 +22,24 @@ START_HEIGHT = Plausible(
 )
 
 
+def _start_rate(unit: str, usual_max: float, usual_text: str, hint: str) -> Plausible:
+    """An initial speed or rate [unit]: usual up to ``usual_max``; from `DIVERGED_SPEED` on
+    refused (below, with its own message)."""
+    fast = "only a blown-up integration is that fast"
+    return Plausible(unit, (0.0, usual_max), (0.0, DIVERGED_SPEED), usual_text, fast, ("", hint))
+
+
+#: The vehicle's initial speed |v| [m/s]: a UVMS moves at a few m/s at most
+START_SPEED = _start_rate(
+    "m/s", 10.0, "the speeds of a vehicle in water (a few m/s at most)", "a speed in cm/s or mm/s?"
+)
+#: The largest initial angular or joint rate [rad/s]: a vehicle turns and an arm's joint
+#: moves at a few rad/s
+START_RATE = _start_rate(
+    "rad/s", 100.0, "the rates of a vehicle or an arm's joint (a few rad/s)", "a rate in deg/s?"
+)
+
+
 def build_initial_state(t: Table, uvms: UVMS) -> tuple[np.ndarray, np.ndarray]:
     """(q0, v0): the vehicle's position [m] and roll, pitch, yaw [rad] in the world, the arm
     joints [rad or m] (one per joint, inside their limits; a continuous joint's angle is
@@ -39,6 +57,8 @@ def build_initial_state(t: Table, uvms: UVMS) -> tuple[np.ndarray, np.ndarray]:
             f"{np.max(np.abs(velocity)):g} is not a physical speed (the simulator treats "
             f"|v| >= {DIVERGED_SPEED:g} m/s or rad/s as diverged)",
         )
+    t.plausible("velocity", float(np.linalg.norm(velocity[:3])), START_SPEED)
+    t.plausible("velocity", float(np.max(np.abs(velocity[3:]), initial=0.0)), START_RATE)
     outside = arm.outside(joints)
     if outside:
         raise t.error("joint_positions_rad", f"outside the joint limits for {', '.join(outside)}")

@@ -34,6 +34,7 @@ from uvms_pin.errors import (
     ParameterError,
     SimulationError,
 )
+from uvms_pin.physics.world.overlap import robot_started_apart
 from uvms_pin.results.rollout import Rollout
 from uvms_pin.results.status import ERROR, INTERRUPTED, OK, RunStatus, Violation
 from uvms_pin.sim.compiled_loop import CompiledLoop, LoopPath
@@ -116,11 +117,14 @@ class ClosedLoop:
 
         Raises:
             ParameterError: a state of the wrong size or with a non-finite value.
+            InitialOverlapError: a free object, or the robot itself, starts inside another
+                body (`uvms_pin.physics.world.overlap`).
             StiffModeError: a spring-damper integrated explicitly is unstable at the
                 integrator's step (`uvms_pin.sim.stiffness`; the checked modes' record is
                 ``stiff_modes``).
         """
         state = self.system.initial_state(q0, v0)
+        robot_started_apart(self.plant.world, self.plant.uvms.model, state.q[: self.plant.uvms.nq])
         period_by_period = {
             "free objects": bool(self.system.objects),
             "joint limits as constraints": self.plant.joint_limits is not None,

@@ -215,3 +215,47 @@ def test_a_scenario_s_separate_moves_the_box_out_of_the_seabed_and_says_so():
     assert moved["object"] == "box" and moved["bodies"] == ["seabed", "box"]
     assert moved["depth_m"] == pytest.approx(0.075, abs=1e-9)
     assert moved["moved_world_m"] == pytest.approx([0.0, 0.0, 0.075], abs=1e-9)
+
+
+def test_the_robot_started_inside_a_fixed_box_is_refused_naming_both(tmp_path):
+    """The robot's own start in a fixed object (a rock at its arm): it never moves, so the
+    run is refused (status 2, one line) in either mode; before, the compressed contact flung
+    the passive robot out, +6.5 J from nothing in 0.04 s."""
+    box = '{type="box", name="rock", size_m=[0.3, 0.3, 0.3], position_world_m=[0.75, 0.0, -2.1]}'
+    for mode in ("refuse", "separate"):
+        out = tmp_path / mode
+        result = run(
+            "run", str(ROOT / "scenarios" / "passive_still_water.toml"), "--quiet",
+            "--out", str(out), "--set", f"world={{objects=[{box}], initial_overlap=\"{mode}\"}}",
+        )  # fmt: skip
+        assert result.returncode == 2, result.stderr
+        (line,) = result.stderr.strip().splitlines()
+        assert line.startswith("uvms-pin: error: 'arm_link") and "and 'rock' overlap by 7" in line
+        assert "the robot is never moved" in line and "Traceback" not in result.stderr
+        assert not out.exists()
+
+
+def test_the_robot_under_the_seabed_is_refused_and_one_clear_of_it_is_not():
+    """A run (`simulate`) with a seabed 0.5 m over its pieces' lowest bound is refused,
+    naming the seabed; the same seabed 1 mm under every piece's bounding sphere runs."""
+    from uvms_pin.scenario.load import load_scenario
+    from uvms_pin.sim.run import simulate
+
+    scenario = load_scenario(ROOT / "scenarios" / "passive_still_water.toml")
+    uvms, q = scenario.plant.uvms, scenario.q0
+    data = uvms.model.createData()
+    pin.forwardKinematics(uvms.model, data, q)
+    lowest = min(
+        (data.oMi[p.joint_id] * p.placement_in_joint).translation[2] - p.bound_radius_m
+        for p in World(uvms, []).pieces
+    )
+
+    def run(seabed_z: float):
+        seabed = {"type": "plane", "name": "seabed", "point_world_m": [0.0, 0.0, seabed_z]}
+        overrides = {"world": {"objects": [seabed]}, "scenario.duration_s": 0.04}
+        return simulate(load_scenario(ROOT / "scenarios" / "passive_still_water.toml", overrides))
+
+    assert run(lowest - 1e-3).metadata["status"] == "ok"
+    with pytest.raises(InitialOverlapError, match="and 'seabed' overlap by") as caught:
+        run(lowest + 0.5)
+    assert caught.value.second == "seabed" and caught.value.depth_m > 0.01

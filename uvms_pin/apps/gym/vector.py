@@ -31,6 +31,7 @@ from uvms_pin.apps.gym.env import UvmsEnv, _episode_seed
 from uvms_pin.apps.gym.force_tracking import ForceTrackingEnv
 from uvms_pin.apps.gym.station_keeping import StationKeepingEnv
 from uvms_pin.errors import ParameterError
+from uvms_pin.physics.world.overlap import robot_started_apart
 from uvms_pin.sim.batched_plant import DIVERGED, BatchedPlant, check_count
 from uvms_pin.sim.stiffness import check_stiff_modes
 from uvms_pin.sim.system import System
@@ -87,6 +88,7 @@ class UvmsVectorEnv(VectorEnv):
         # once, at the scenario's start, before the batch takes its memory (as a run does)
         system = System(scenario.plant)
         start = system.initial_state(scenario.q0, scenario.v0)
+        robot_started_apart(scenario.plant.world, scenario.plant.uvms.model, scenario.q0)
         self.stiff_modes = check_stiff_modes(system, start, scenario.settings.integrator)
         self.batch = BatchedPlant(
             scenario.plant, scenario.settings, scenario.sensor_config, num_envs, num_threads

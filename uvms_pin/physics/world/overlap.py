@@ -31,7 +31,11 @@ neutral object), is
   until no pair is deeper than the tolerance; each move recorded (`Overlap.record`). An
   object held between two bodies that cannot both be left is refused as well.
 
-The robot never moves: its initial state is the scenario's.
+The robot never moves: its initial state is the scenario's. The robot's own pieces against
+the fixed objects and the seabed (`robot_overlaps`) are posed the same way with the robot's
+tolerance, max(1 mm, 2 |W - B| / k) of its whole net weight: a deeper start is refused in
+either mode (a robot placed into a rock or under the seabed would start with the contact
+compressed, kilonewtons at once, and be flung out: energy from nothing).
 """
 
 from __future__ import annotations
@@ -48,8 +52,17 @@ from uvms_pin.physics.world.contact_law import ContactLaw
 from uvms_pin.physics.world.free_object import FreeObject
 from uvms_pin.physics.world.moving import MovingContacts, State
 from uvms_pin.physics.world.touch import touch
+from uvms_pin.physics.world.world import World
 
-__all__ = ["OVERLAP_TOLERANCE_M", "Overlap", "overlaps", "separated", "tolerance_m"]
+__all__ = [
+    "OVERLAP_TOLERANCE_M",
+    "Overlap",
+    "overlaps",
+    "robot_overlaps",
+    "robot_started_apart",
+    "separated",
+    "tolerance_m",
+]
 
 #: the least tolerance [m]: what a neutral object may overlap (see the module's docstring)
 OVERLAP_TOLERANCE_M = 1.0e-3
@@ -96,6 +109,41 @@ def tolerance_m(obj: FreeObject, law: ContactLaw) -> float:
     """max(`OVERLAP_TOLERANCE_M`, 2 |W - B| / k) [m] of a free object (its net weight in
     the water, k the law's stiffness per point)."""
     return max(OVERLAP_TOLERANCE_M, 2.0 * abs(obj.uvms.net_buoyancy_N) / law.stiffness_N_m)
+
+
+def robot_overlaps(world: World, data: pin.Data) -> list[Overlap]:
+    """The robot's deepest point in each fixed object (the seabed included), the deepest
+    first, after ``pin.forwardKinematics`` of the robot; ``moved`` -1 (the robot never
+    moves), the tolerance the robot's (`tolerance_m` of its net weight)."""
+    tolerance = max(
+        OVERLAP_TOLERANCE_M, 2.0 * abs(world.uvms.net_buoyancy_N) / world.law.stiffness_N_m
+    )
+    found: dict[tuple[str, str], Overlap] = {}
+    hits = touch(data, world.pieces, world.objects, world.bounds)
+    for piece, obj, normal, depth in zip(
+        hits.piece, hits.obj, hits.normal_world, hits.depth_m, strict=True
+    ):
+        first = world.body_names[world.pieces[piece].body]
+        key = (first, world.objects[obj].name)
+        if key not in found or depth > found[key].depth_m:
+            found[key] = Overlap(*key, float(depth), -1, np.asarray(normal, float), tolerance)
+    return sorted(found.values(), key=lambda o: -o.depth_m)
+
+
+def robot_started_apart(world: World | None, model: pin.Model, q: np.ndarray) -> None:
+    """Raises `InitialOverlapError` when the robot at ``q`` starts inside a fixed object
+    or the seabed deeper than its tolerance (`robot_overlaps`); nothing else."""
+    if world is None or not world.objects:
+        return
+    data = model.createData()
+    pin.forwardKinematics(model, data, q, np.zeros(model.nv))
+    deep = [o for o in robot_overlaps(world, data) if o.deep]
+    if deep:
+        how = (
+            "the robot is never moved: start it clear of the object "
+            "(initial.position_world_m, initial.joint_positions_rad) or move the object"
+        )
+        raise _refused(deep[0], how)
 
 
 def overlaps(
