@@ -16,21 +16,23 @@ from uvms_pin.sim.robots_run import simulate_robots
 
 SCENARIOS = Path(__file__).resolve().parents[3] / "scenarios"
 
-STUDY = f"""
-[study]
-name = "two_robots_mass"
-base = "{SCENARIOS / "two_robots.toml"}"
-seed = 3
-samples = 1
 
-[[parameter]]
-path = "scenario.duration_s"
-values = [0.2]
+def _study(name: str, base: str, grid: dict[str, list]) -> str:
+    """A study of ``base`` (a shipped scenario) over the grid ``grid`` (path -> values)."""
+    parameters = "".join(
+        f'\n[[parameter]]\npath = "{path}"\nvalues = {values}\n' for path, values in grid.items()
+    )
+    return (
+        f'[study]\nname = "{name}"\nbase = "{SCENARIOS / base}"\nseed = 3\nsamples = 1\n'
+        + parameters
+    )
 
-[[parameter]]
-path = "plant.mass_scale"
-values = [1.0, 1.2]
-"""
+
+STUDY = _study(
+    "two_robots_mass",
+    "two_robots.toml",
+    {"scenario.duration_s": [0.2], "plant.mass_scale": [1.0, 1.2]},
+)
 
 
 def test_each_robot_has_its_columns_and_the_plant_factor_scales_every_robot(tmp_path):
@@ -54,21 +56,11 @@ def test_each_robot_has_its_columns_and_the_plant_factor_scales_every_robot(tmp_
 def test_a_robots_own_key_is_a_parameter(tmp_path):
     """The follower's load share of the cooperative transport, per run: its controller gets
     it (recorded in its rollout's parameters), and the bar's own columns are in the row."""
-    text = f"""
-[study]
-name = "share"
-base = "{SCENARIOS / "cooperative_transport.toml"}"
-seed = 3
-samples = 1
-
-[[parameter]]
-path = "scenario.duration_s"
-values = [0.1]
-
-[[parameter]]
-path = "robots[1].controller.load_share"
-values = [0.4]
-"""
+    text = _study(
+        "share",
+        "cooperative_transport.toml",
+        {"scenario.duration_s": [0.1], "robots[1].controller.load_share": [0.4]},
+    )
     study = load_study(write_study(tmp_path, text))
     (row,) = execute_runs(str(study.base), study.runs(), rollout_dir=str(tmp_path / "runs"))
     assert row["status"] == "ok", row["error"]

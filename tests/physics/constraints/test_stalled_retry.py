@@ -37,7 +37,7 @@ def solves(monkeypatch):
 
 def _solve():
     settings = step.default_settings()
-    return step._solve_or_accelerate(np.eye(2), np.zeros(2), (), 1e-3, 0.5, settings)
+    return step._solve_or_accelerate(np.eye(2), np.zeros(2), (), 1e-3, 0.5, settings=settings)
 
 
 def test_an_accepted_solve_is_not_retried(solves):

@@ -237,35 +237,28 @@ def constrained_velocity(
     blocks = tuple(c.rows(model, data, q, speed, h) for c in constraints)
     settings = settings or default_settings()
     for _ in range(_MAX_ROUNDS):
-        step = _solve_or_accelerate(mass, v_free, blocks, h, correction, settings)
+        step = _solve_or_accelerate(mass, v_free, blocks, h, correction, settings=settings)
         speed = np.maximum(speed, np.abs(step.velocity))
         wider = tuple(c.rows(model, data, q, speed, h) for c in constraints)
         if sum(b.size for b in wider) == sum(b.size for b in blocks):
             return step
         blocks = wider
-    return _solve_or_accelerate(mass, v_free, blocks, h, correction, settings)
+    return _solve_or_accelerate(mass, v_free, blocks, h, correction, settings=settings)
 
 
-def _solve_or_accelerate(
-    mass: np.ndarray,
-    v_free: np.ndarray,
-    blocks: tuple[ConstraintRows, ...],
-    h: float,
-    correction: float,
-    settings: pin.ADMMSolverSettings,
-) -> ConstrainedVelocity:
-    """`_solve`, and when it stalls above the residual it may keep, the same solve again
-    with Anderson acceleration (`ANDERSON_CAPACITY` iterates): the better of the two (the
+def _solve_or_accelerate(*problem: object, settings: pin.ADMMSolverSettings) -> ConstrainedVelocity:
+    """`_solve` of ``problem`` (mass, v_free, blocks, h, correction), and when it stalls above
+    the residual it may keep, the same solve again with Anderson acceleration (`ANDERSON_CAPACITY` iterates): the better of the two (the
     accepted one, else the smaller residual), with both solves' iterations. A stab in its
     receptacle's bore held by two fingers (45 rows) stalled at 5.1e-5 m/s after 5,000 plain
     iterations (above its 4.4e-5) and at 1.8e-5 after 20,000; accelerated, it converged to
     1.6e-8 in 461. Only a stalled solve is retried: every other period is unchanged."""
-    plain = _solve(mass, v_free, blocks, h, correction, settings)
+    plain = _solve(*problem, settings)
     if plain.accepted:
         return plain
     faster = default_settings(settings.absolute_feasibility_tol, settings.max_iterations)
     faster.anderson_capacity = ANDERSON_CAPACITY
-    retried = _solve(mass, v_free, blocks, h, correction, faster)
+    retried = _solve(*problem, faster)
     best = retried if retried.accepted or retried.residual < plain.residual else plain
     return dataclasses.replace(best, iterations=plain.iterations + retried.iterations)
 
