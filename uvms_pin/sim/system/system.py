@@ -149,7 +149,9 @@ class System:
     def initial_state(self, q0: np.ndarray, v0: np.ndarray) -> SystemState:
         """The state at t = 0: the robot at (q0, v0) (checked, its quaternion normalised),
         every free object where its scenario puts it (moved out of another body when its
-        world asks so, the moves kept in `separations`; else InitialOverlapError)."""
+        world asks so, the moves kept in `separations`; else InitialOverlapError). The robot's
+        own start inside a fixed object is not checked here: a run checks it where it starts
+        (`uvms_pin.sim.closed_loop.ClosedLoop.start`, the vector environments)."""
         q0, v0 = checked_start(self.plant.uvms.model, q0, v0)
         states = [] if self.moving is None else self.moving.initial_states()
         if self.objects or self.fixtures:  # none inside another body (`...world.overlap`)
