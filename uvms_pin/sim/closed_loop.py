@@ -31,10 +31,8 @@ from uvms_pin.errors import (
     ActuationWarning,
     ControllerError,
     FunnelViolation,
-    ParameterError,
     SimulationError,
 )
-from uvms_pin.physics.world.overlap import robot_started_apart
 from uvms_pin.results.rollout import Rollout
 from uvms_pin.results.status import ERROR, INTERRUPTED, OK, RunStatus, Violation
 from uvms_pin.sim.compiled_loop import CompiledLoop, LoopPath
@@ -42,10 +40,10 @@ from uvms_pin.sim.divergence import NUMERICAL_FAILURES, diverged, divergence_con
 from uvms_pin.sim.integrators import Adaptive
 from uvms_pin.sim.log import RolloutLog, described_columns, run_metadata
 from uvms_pin.sim.plant import Plant
+from uvms_pin.sim.run_start import checked_run_start
 from uvms_pin.sim.sample import Observer, Sample
 from uvms_pin.sim.sensors import SensorSuite
 from uvms_pin.sim.settings import SimulationSettings
-from uvms_pin.sim.stiffness import check_stiff_modes
 from uvms_pin.sim.system import System, SystemState
 
 # The funnel event fires when the margin min(1 - |xi|) reaches -this: just outside, so
@@ -115,27 +113,11 @@ class ClosedLoop:
         """t = 0 at (q0, v0) (the quaternion normalised), measured by ``sensors`` (seeded
         noise), the environment anchored at the end-effector, the controller reset.
 
-        Raises:
-            ParameterError: a state of the wrong size or with a non-finite value.
-            InitialOverlapError: a free object, or the robot itself, starts inside another
-                body (`uvms_pin.physics.world.overlap`).
-            StiffModeError: a spring-damper integrated explicitly is unstable at the
-                integrator's step (`uvms_pin.sim.stiffness`; the checked modes' record is
-                ``stiff_modes``).
+        Raises what `uvms_pin.sim.run_start.checked_run_start` raises (a bad state, an
+        overlap, a continuous controller for a system stepped period by period, a stiff mode;
+        the checked modes' record is ``stiff_modes``).
         """
-        state = self.system.initial_state(q0, v0)
-        robot_started_apart(self.plant.world, self.plant.uvms.model, state.q[: self.plant.uvms.nq])
-        period_by_period = {
-            "free objects": bool(self.system.objects),
-            "joint limits as constraints": self.plant.joint_limits is not None,
-        }
-        for what, present in period_by_period.items():
-            if present and self.settings.control_period_s is None:
-                raise ParameterError(
-                    f"{what} are stepped with the UVMS period by period: they need a "
-                    "sampled controller ([control] period_s), not a continuous one"
-                )
-        self.stiff_modes = check_stiff_modes(self.system, state, self.settings.integrator)
+        state, self.stiff_modes = checked_run_start(self.system, q0, v0, self.settings)
         self.time_s, self.state = 0.0, SystemState(read_only(state.q), read_only(state.v))
         self.sensors = sensors
         self.plant.actuation.start(self.settings.control_period_s)

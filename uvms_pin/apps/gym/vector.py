@@ -31,9 +31,8 @@ from uvms_pin.apps.gym.env import UvmsEnv, _episode_seed
 from uvms_pin.apps.gym.force_tracking import ForceTrackingEnv
 from uvms_pin.apps.gym.station_keeping import StationKeepingEnv
 from uvms_pin.errors import ParameterError
-from uvms_pin.physics.world.overlap import robot_started_apart
 from uvms_pin.sim.batched_plant import DIVERGED, BatchedPlant, check_count
-from uvms_pin.sim.stiffness import check_stiff_modes
+from uvms_pin.sim.run_start import checked_run_start
 from uvms_pin.sim.system import System
 
 _MODES = {mode.value: mode for mode in (AutoresetMode.NEXT_STEP, AutoresetMode.SAME_STEP)}
@@ -61,7 +60,7 @@ class UvmsVectorEnv(VectorEnv):
 
     Attributes:
         stiff_modes: the scenario's explicit stiff modes as checked before the batch is
-            built (`uvms_pin.sim.stiffness.check_stiff_modes`; StiffModeError if unstable).
+            built (`uvms_pin.sim.run_start.checked_run_start`; StiffModeError if unstable).
     """
 
     metadata: ClassVar[dict[str, Any]] = {
@@ -87,9 +86,7 @@ class UvmsVectorEnv(VectorEnv):
         # the batch steps the single environment's plant: its explicit stiff modes are checked
         # once, at the scenario's start, before the batch takes its memory (as a run does)
         system = System(scenario.plant)
-        start = system.initial_state(scenario.q0, scenario.v0)
-        robot_started_apart(scenario.plant.world, scenario.plant.uvms.model, scenario.q0)
-        self.stiff_modes = check_stiff_modes(system, start, scenario.settings.integrator)
+        _, self.stiff_modes = checked_run_start(system, scenario.q0, scenario.v0, scenario.settings)
         self.batch = BatchedPlant(
             scenario.plant, scenario.settings, scenario.sensor_config, num_envs, num_threads
         )
