@@ -39,6 +39,7 @@ from pathlib import Path
 
 import mujoco
 import numpy as np
+from bench_mujoco import robot_touching
 from timing import best_times, one_blas_thread
 
 import uvms_pin as up
@@ -153,12 +154,7 @@ def _mujoco_grasp(scenario, q: np.ndarray, block_pose: np.ndarray, options: Mjcf
     a 2 N motor (the servo saturated, as held in uvms-pin). (model, data) at the held state
     of uvms-pin's grasp, then settled 0.4 s in MuJoCo's own contacts."""
     uvms = scenario.uvms
-    root = ET.fromstring(uvms_to_mjcf(uvms, Path(uvms.source).read_text(), options))
-    for flag in root.iter("flag"):  # the twin is exported without contacts
-        flag.set("contact", "enable")
-    for geom in root.iter("geom"):
-        geom.set("contype", "1")
-        geom.set("conaffinity", "0")
+    root = robot_touching(uvms_to_mjcf(uvms, Path(uvms.source).read_text(), options))
     world = root.find("worldbody")
     body = ET.SubElement(
         world, "body", name="block", gravcomp=repr(1.0 / 1.2),

@@ -267,15 +267,22 @@ def plant_cases(system: System) -> dict[str, Callable[[], object]]:
 # ---- a world with contacts ----------------------------------------------------------------
 
 
-def _world_geoms(mjcf: str, objects: list) -> str:
-    """The MJCF with the world's objects as geoms the robot's geoms collide with (and they
-    only with the world: the robot's own pieces do not touch each other here either)."""
+def robot_touching(mjcf: str) -> ET.Element:
+    """The twin's MJCF tree with contacts on, each of the robot's geoms touching what has
+    conaffinity 1 (what is added after), not the robot's own others."""
     root = ET.fromstring(mjcf)
     for flag in root.iter("flag"):  # the twin is exported without contacts
         flag.set("contact", "enable")
     for geom in root.iter("geom"):
         geom.set("contype", "1")
         geom.set("conaffinity", "0")
+    return root
+
+
+def _world_geoms(mjcf: str, objects: list) -> str:
+    """The MJCF with the world's objects as geoms the robot's geoms collide with (and they
+    only with the world: the robot's own pieces do not touch each other here either)."""
+    root = robot_touching(mjcf)
     world = root.find("worldbody")
     for obj in objects:
         placement = obj.placement
