@@ -82,6 +82,44 @@ def test_each_robot_logs_the_force_on_itself_equal_and_opposite(load_body):
     assert on_a[3:6] == pytest.approx([-0.145, 0.0, -5.0], abs=0.01)  # between the two
 
 
+def test_the_core_finds_the_robots_contacts_as_the_reference_does(load_body):
+    """With the compiled backend every pair set of several robots (between robots, and the
+    first robot's with its free objects) is searched by the core (`search_compiled`): at a
+    touching state with friction anchors it finds the reference's pairs, points and
+    forces (the same arithmetic: to 1e-12); the "python" backend keeps the reference's."""
+    a, b = _sphere(load_body), _sphere(load_body, mass=6.0, radius=0.15)
+    ball = free_object(
+        "ball", "sphere", {"radius_m": 0.05}, ([-0.14, 0.0, -4.86], [0.0, 0.0, 0.0]),
+        density_kg_m3=2000.0, water_density_kg_m3=RHO,
+    )  # fmt: skip
+    first = System(Plant(a, world=World(a, [], ContactLaw(), [ball]), free_surface=False))
+    robots = Robots([first, System(Plant(b, free_surface=False))], ["a", "b"])
+    sets = [*robots.contacts.sets, *robots.systems[0].moving.moving.sets]
+    assert sets and all(s.search is not None for s in sets)
+    q_a, q_b = a.neutral_configuration(), b.neutral_configuration()
+    q_a[:3], q_b[:3] = [-0.24, 0.0, -5.0], [0.0, 0.003, -5.0]  # 1 cm deep, off-centre
+    v_a = np.array([0.2, 0.05, 0.0, 0.0, 0.0, 0.3])
+    state = robots.layout.join([first.initial_state(q_a, v_a), (q_b, np.zeros(6))])
+    for system, part in zip(robots.systems, robots.split(*state), strict=True):
+        system.start(SystemState(*part))
+    robots.start(state)  # anchors set: the next search has friction stretch
+    q, v = robots.advance(RK4(step_s=5e-4), 0.0, state, [np.zeros(6)] * 2, 2e-3)
+    datas = robots._kinematics(q, v)
+    found = robots.contacts.found(datas)
+    reference = [s.pairs.forces(datas[s.a], datas[s.b], s.memory) for s in robots.contacts.sets]
+    assert sum(len(c.pair) for c in found) > 0
+    for core, ref in zip(found, reference, strict=True):
+        assert np.array_equal(core.pair, ref.pair)
+        np.testing.assert_allclose(core.force_world_N, ref.force_world_N, rtol=0, atol=1e-12)
+        np.testing.assert_allclose(
+            core.touch.point_world_m, ref.touch.point_world_m, rtol=0, atol=1e-12
+        )
+    python = Robots(
+        [System(Plant(u, free_surface=False, backend="python")) for u in (a, b)], ["a", "b"]
+    )
+    assert all(s.search is None for s in python.contacts.sets)
+
+
 def test_a_robot_pushes_a_free_object_into_another_robot_and_momentum_stays(load_body):
     """Robot b runs into a free ball that the first robot's system holds; the ball runs on
     into robot a: b's pairs with the ball are the robots' own, a's its system's; the total

@@ -1,4 +1,4 @@
-"""The compiled contact search of a system with fixtures (uvms_pin.sim.system.fixtures.
+"""The compiled contact search of a system with fixtures (uvms_pin.physics.compiled.moving.
 search_compiled, uvms_pin.physics.compiled.moving.PairSearch): the core's PiecePairs finds
 the same touching pairs, points, normals, depths and forces as the reference's
 `PiecePairs.forces` (the same arithmetic: to 1e-12), for the robot's pieces and a free

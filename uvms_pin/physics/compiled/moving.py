@@ -11,12 +11,14 @@ between moving bodies likewise (``rigid_pairs``)."""
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from types import ModuleType
 from typing import Any
 
 import numpy as np
 import pinocchio as pin
 
+from uvms_pin.physics.compiled.backend import Fallback, backend_named
 from uvms_pin.physics.compiled.world import (
     contact_law_to_core,
     pieces_to_core,
@@ -36,6 +38,7 @@ __all__ = [
     "moving_to_core",
     "pair_contacts_of_core",
     "piece_pairs_to_core",
+    "search_compiled",
 ]
 
 
@@ -141,3 +144,19 @@ class PairSearch:
     def __call__(self, data_a: pin.Data, data_b: pin.Data, memory: FrictionMemory) -> PairContacts:
         found = self._compiled.forces(*kinematics_of(data_a), *kinematics_of(data_b), memory)
         return pair_contacts_of_core(found)
+
+
+def search_compiled(sets: Sequence[Any], backend: str) -> None:
+    """Every pair set of ``sets`` (`uvms_pin.physics.world.moving`'s, each with ``pairs``
+    and ``search``) searched by the core (`PairSearch`: the touching pairs and their forces,
+    as `PiecePairs.forces` finds them) when ``backend`` is the compiled one; the Python
+    reference's search otherwise (the "python" backend, a reference run). For the systems
+    integrated in Python (with fixtures, or several robots touching) the contact search at
+    every stage of the integrator is the part worth compiling."""
+    searches = backend_named(backend).counterpart(
+        lambda core: [PairSearch(s.pairs, core) for s in sets]
+    )
+    if isinstance(searches, Fallback):
+        return
+    for s, search in zip(sets, searches, strict=True):
+        s.search = search

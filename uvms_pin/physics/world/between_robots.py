@@ -139,7 +139,7 @@ class RobotContacts:
     def found(self, datas: Sequence[pin.Data]) -> list[PairContacts]:
         """Each set's touching pairs, after forward kinematics of every robot with its
         velocity."""
-        return [s.pairs.forces(datas[s.a], datas[s.b], s.memory) for s in self.sets]
+        return [(s.search or s.pairs.forces)(datas[s.a], datas[s.b], s.memory) for s in self.sets]
 
     def generalized(
         self, qs: Sequence[np.ndarray], datas: Sequence[pin.Data], found: list[PairContacts]

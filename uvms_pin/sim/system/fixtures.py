@@ -14,8 +14,8 @@ pose, with its URDF limits). Per fixture f, over a period:
 The compiled system of bodies holds free objects only: a system with a fixture is stepped
 by the Python integrator (`COMPILED_REFUSAL`, said once in `why_not_compiled_system`) around
 the compiled robot dynamics and, with the compiled backend, the compiled contact search of
-every moving pair set (`search_compiled`: the core's PiecePairs, the same arithmetic as
-`PiecePairs.forces`).
+every moving pair set (`uvms_pin.physics.compiled.moving.search_compiled`: the core's
+PiecePairs, the same arithmetic as `PiecePairs.forces`).
 """
 
 from __future__ import annotations
@@ -26,8 +26,6 @@ from collections.abc import Callable, Sequence
 import numpy as np
 import pinocchio as pin
 
-from uvms_pin.physics.compiled.backend import Fallback, backend_named
-from uvms_pin.physics.compiled.moving import PairSearch
 from uvms_pin.physics.constraints.joint_box import joint_box_step
 from uvms_pin.physics.constraints.joint_friction import JointCoulombFriction
 from uvms_pin.physics.constraints.joint_limits import JointLimits
@@ -35,7 +33,6 @@ from uvms_pin.physics.constraints.rows import JOINT_IMPULSE_UNIT, ConstraintRows
 from uvms_pin.physics.constraints.step import ConstrainedVelocity
 from uvms_pin.physics.dynamics import forward_dynamics
 from uvms_pin.physics.world.fixture import Fixture
-from uvms_pin.physics.world.moving import MovingContacts
 
 __all__ = [
     "COMPILED_REFUSAL",
@@ -46,13 +43,12 @@ __all__ = [
     "blocks",
     "constraints",
     "joint_ids",
-    "search_compiled",
     "system_model",
     "with_fixtures",
 ]
 
 #: why a system with a fixture is not one compiled call a period (its moving contacts are
-#: searched by the core all the same: `search_compiled`)
+#: searched by the core all the same: `physics.compiled.moving.search_compiled`)
 COMPILED_REFUSAL = (
     'a fixture with joints (type = "urdf"): the compiled system holds free objects only'
 )
@@ -83,21 +79,6 @@ def system_model(model: pin.Model, fixtures: Sequence[Fixture]) -> pin.Model:
             out.appendBodyToJoint(added, own.inertias[j], pin.SE3.Identity())
             ids.append(added)
     return out
-
-
-def search_compiled(moving: MovingContacts, backend: str) -> None:
-    """Every pair set of ``moving`` searched by the core (`PairSearch`: the touching pairs
-    and their forces, as `PiecePairs.forces` finds them) when ``backend`` is the compiled
-    one; the Python reference's search otherwise (the "python" backend, a reference run).
-    A system with fixtures is integrated in Python (`COMPILED_REFUSAL`): its contact search
-    at every stage of the integrator is the part worth compiling."""
-    searches = backend_named(backend).counterpart(
-        lambda core: [PairSearch(s.pairs, core) for s in moving.sets]
-    )
-    if isinstance(searches, Fallback):
-        return
-    for s, search in zip(moving.sets, searches, strict=True):
-        s.search = search
 
 
 def joint_ids(first: int, fixtures: Sequence[Fixture]) -> list[tuple[int, ...]]:

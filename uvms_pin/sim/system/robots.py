@@ -15,7 +15,9 @@ A control period is stepped in one of two ways, chosen at its start:
 - together: the Python integrator around the system's right-hand side (each robot's
   acceleration with the contacts' generalized force added to its input tau: the dynamics
   are linear in it), every anchor moved at the period's end, then each robot's constraints
-  solved implicitly (its joint limits: they act within the robot only).
+  solved implicitly (its joint limits: they act within the robot only). With the compiled
+  backend every pair set's contacts are found by the core at each stage
+  (`uvms_pin.physics.compiled.moving.search_compiled`, the reference's arithmetic).
 
 The world's free objects belong to the first robot's system (its moving contacts with them,
 their contacts with each other and with the fixed world, as for a single robot); the other
@@ -32,6 +34,7 @@ import numpy as np
 import pinocchio as pin
 
 from uvms_pin.errors import ParameterError
+from uvms_pin.physics.compiled.moving import search_compiled
 from uvms_pin.physics.world.between_robots import RobotContacts
 from uvms_pin.physics.world.contact_law import ContactLaw
 from uvms_pin.physics.world.world import World
@@ -101,6 +104,11 @@ class Robots:
             p.world if p.world is not None else World(p.uvms, [], ContactLaw()) for p in plants
         ]
         self.contacts = RobotContacts.of(worlds, self.names, self.objects)
+        # integrated in Python (each robot's loop is): every stage's contact search is the
+        # core's, unless the plants are the Python reference's
+        first = self.systems[0].moving
+        sets = [*self.contacts.sets, *(() if first is None else first.moving.sets)]
+        search_compiled(sets, plants[0].backend)
         self.layout = Layout.of(
             [(n, s.layout.nq, s.layout.nv) for n, s in zip(names, self.systems, strict=True)]
         )

@@ -26,7 +26,12 @@ import pinocchio as pin
 
 from uvms_pin.physics.compiled.backend import Fallback
 from uvms_pin.physics.compiled.extension import core_module
-from uvms_pin.physics.compiled.moving import contacts_of_core, forces_of_core, memories_of
+from uvms_pin.physics.compiled.moving import (
+    contacts_of_core,
+    forces_of_core,
+    memories_of,
+    search_compiled,
+)
 from uvms_pin.physics.constraints.attachments import ATTACHMENT_REFUSAL, Attachments
 from uvms_pin.physics.constraints.moving_contacts import MovingPairContacts
 from uvms_pin.physics.constraints.object_contacts import ObjectWorldContacts
@@ -106,7 +111,7 @@ class System:
         self.objects: tuple = () if self.moving is None else tuple(self.moving.objects)
         self.fixtures: tuple = () if world is None else tuple(world.fixtures)
         if self.fixtures and compiled:  # integrated in Python: its contacts searched compiled
-            fixture_joints.search_compiled(self.moving.moving, plant.backend)
+            search_compiled(self.moving.moving.sets, plant.backend)
         uvms = plant.uvms
         self.layout = Layout.of(
             [("robot", uvms.nq, uvms.nv), *[(o.name, 7, 6) for o in self.objects]]
