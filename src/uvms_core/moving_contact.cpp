@@ -42,10 +42,11 @@ bool sphere_misses(const Vec3& center, double radius, const std::pair<Vec3, Vec3
 
 void PiecePairsModel::check(const Model& model_a, const Model& model_b) const {
   auto check_pieces = [](const std::vector<ContactShape>& pieces, const Model& model) {
+    // joint 0: a link fixed in the world (a fixture's root), at rest where its model puts it
     for (const auto& piece : pieces) {
-      if (piece.joint_id < 1 || piece.joint_id >= static_cast<int>(model.njoints)) {
+      if (piece.joint_id < 0 || piece.joint_id >= static_cast<int>(model.njoints)) {
         throw InputError("moving contact: a piece's joint " + std::to_string(piece.joint_id) +
-                         " is not a moving joint of its model");
+                         " is not a joint of its model");
       }
       if (!piece.geometry) throw InputError("moving contact: a piece has no geometry");
     }

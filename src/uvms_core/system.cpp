@@ -1,5 +1,7 @@
 #include "system.hpp"
 
+#include "joint_box.hpp"
+
 #include <string>
 
 #include <Eigen/Geometry>
@@ -15,14 +17,44 @@ namespace {
 // keeps the smooth step's end (period.py's PUSHED_M_S)
 constexpr double kPushed = 1.0e-9;
 
-// The robot's joints and n free-flyers under the universe (_system_model of system.py).
-Model system_model(const Model& robot, std::size_t n_objects) {
+// The robot's joints, n free-flyers under the universe (_system_model of system.py), then
+// every fixture's joints, its root joints under the universe (fixtures.system_model).
+Model system_model(const Model& robot, std::size_t n_objects,
+                   const std::vector<FixtureBody>& fixtures) {
   Model model = robot;
   for (std::size_t k = 0; k < n_objects; ++k) {
     model.addJoint(0, pinocchio::JointModelFreeFlyer(), pinocchio::SE3::Identity(),
                    "free_object_" + std::to_string(k));
   }
+  for (std::size_t k = 0; k < fixtures.size(); ++k) {
+    const Model& own = fixtures[k].body.model();
+    std::vector<pinocchio::JointIndex> ids{0};
+    for (pinocchio::JointIndex j = 1; j < static_cast<pinocchio::JointIndex>(own.njoints); ++j) {
+      ids.push_back(model.addJoint(ids[own.parents[j]], own.joints[j], own.jointPlacements[j],
+                                   "fixture_" + std::to_string(k) + "/" + own.names[j]));
+    }
+  }
   return model;
+}
+
+std::vector<FixtureBody> checked(std::vector<FixtureBody> fixtures) {
+  for (const auto& f : fixtures) {
+    const Model& model = f.body.model();
+    const auto n = static_cast<Eigen::Index>(model.nv);
+    if (model.nq != model.nv) {
+      throw InputError("system: a fixture's joints are revolute or prismatic (nq = nv)");
+    }
+    if (f.damping.size() != n || f.coulomb.size() != n || f.lower.size() != n ||
+        f.upper.size() != n) {
+      throw InputError("system: a fixture needs damping, coulomb, lower and upper (" +
+                       std::to_string(n) + ",) each");
+    }
+    if ((f.coulomb.array() < 0.0).any() || (f.damping.array() < 0.0).any() ||
+        f.coulomb.hasNaN() || f.damping.hasNaN() || f.lower.hasNaN() || f.upper.hasNaN()) {
+      throw InputError("system: a fixture's damping and friction are >= 0, its limits numbers");
+    }
+  }
+  return fixtures;
 }
 
 std::vector<Dynamics> copies(const std::vector<const Dynamics*>& objects) {
@@ -51,10 +83,12 @@ void add_wrench(Dynamics& dynamics, int joint_id, const Vec3& point, const Vec3&
 
 }  // namespace
 
-System::System(Plant& plant, const std::vector<const Dynamics*>& objects)
+System::System(Plant& plant, const std::vector<const Dynamics*>& objects,
+               std::vector<FixtureBody> fixtures)
     : plant_(plant),
       objects_(copies(objects)),
-      model_(system_model(plant.dynamics().model(), objects.size())),
+      fixtures_(checked(std::move(fixtures))),
+      model_(system_model(plant.dynamics().model(), objects.size(), fixtures_)),
       robot_data_(plant.dynamics().model()),
       nq_robot_(plant.dynamics().nq()),
       nv_robot_(plant.dynamics().nv()),
@@ -63,23 +97,44 @@ System::System(Plant& plant, const std::vector<const Dynamics*>& objects)
   object_worlds.resize(objects_.size());
   object_memory.resize(objects_.size());
   rigid_found_.resize(objects_.size());
+  Eigen::Index at_q = nq_robot_ + 7 * static_cast<Eigen::Index>(objects_.size());
+  Eigen::Index at_v = nv_robot_ + 6 * static_cast<Eigen::Index>(objects_.size());
+  for (const auto& f : fixtures_) {
+    fixture_q_.push_back(at_q);
+    fixture_v_.push_back(at_v);
+    at_q += f.body.nq();
+    at_v += f.body.nv();
+  }
+}
+
+Dynamics& System::body_of(int side) {
+  const auto k = static_cast<std::size_t>(side);
+  return k < objects_.size() ? objects_[k] : fixtures_[k - objects_.size()].body;
 }
 
 const Data& System::data_of(int side) {
-  return side < 0 ? *robot_at_ : objects_[static_cast<std::size_t>(side)].data();
+  return side < 0 ? *robot_at_ : body_of(side).data();
 }
 
 const Model& System::model_of(int side) const {
-  return side < 0 ? plant_.dynamics().model() : objects_[static_cast<std::size_t>(side)].model();
+  if (side < 0) return plant_.dynamics().model();
+  const auto k = static_cast<std::size_t>(side);
+  return k < objects_.size() ? objects_[k].model() : fixtures_[k - objects_.size()].body.model();
 }
 
 void System::check() const {
-  const int n = static_cast<int>(objects_.size());
+  const int n = static_cast<int>(objects_.size() + fixtures_.size());
   for (const auto& set : sets) {
     if (set.a < -1 || set.a >= n || set.b < -1 || set.b >= n) {
-      throw InputError("system: a pair set's bodies are not the robot or a free object");
+      throw InputError(
+          "system: a pair set's bodies are not the robot, a free object or a fixture");
     }
     set.pairs.check(model_of(set.a), model_of(set.b));
+  }
+  if (rigid_pairs && !fixtures_.empty()) {
+    throw InputError(
+        "system: rigid contacts between moving bodies with a fixture are the Python "
+        "reference's (its joints solved with those rows)");
   }
   if (object_worlds.size() != objects_.size() || object_memory.size() != objects_.size()) {
     throw InputError("system: one world (or none) and one friction state per free object");
@@ -93,6 +148,10 @@ void System::object_kinematics(const ConstVec& q, const ConstVec& v) {
   for (std::size_t k = 0; k < objects_.size(); ++k) {
     const auto i = static_cast<Eigen::Index>(k);
     objects_[k].kinematics(q.segment(nq_robot_ + 7 * i, 7), v.segment(nv_robot_ + 6 * i, 6));
+  }
+  for (std::size_t k = 0; k < fixtures_.size(); ++k) {
+    Dynamics& body = fixtures_[k].body;
+    body.kinematics(q.segment(fixture_q_[k], body.nq()), v.segment(fixture_v_[k], body.nv()));
   }
 }
 
@@ -162,10 +221,11 @@ const Eigen::VectorXd& System::acceleration(double time_s, const ConstVec& q,
   // each object: its water, then its contacts (f on a, -f on b; the fixed world's reaction
   // goes to the ground)
   const FlowField& flow = plant_.flow;
-  for (std::size_t k = 0; k < objects_.size(); ++k) {
-    Dynamics& body = objects_[k];
+  for (std::size_t k = 0; k < objects_.size() + fixtures_.size(); ++k) {
+    Dynamics& body = body_of(static_cast<int>(k));
     body.fluid_wrenches(time_s, flow, body.needs_bias_acceleration(), plant_.free_surface);
   }
+  // a piece on a fixture's root link (joint 0, fixed in the world) moves nothing
   for (std::size_t s = 0; s < sets.size(); ++s) {
     const auto& set = sets[s];
     const auto& found = found_sets_[s].forces;
@@ -174,11 +234,11 @@ const Eigen::VectorXd& System::acceleration(double time_s, const ConstVec& q,
       const auto& force = found.force_world_N[i];
       if (set.a >= 0) {
         const auto& piece = set.pairs.pieces_a[static_cast<std::size_t>(found.touch.piece[i])];
-        add_wrench(objects_[static_cast<std::size_t>(set.a)], piece.joint_id, point, force);
+        if (piece.joint_id > 0) add_wrench(body_of(set.a), piece.joint_id, point, force);
       }
       if (set.b >= 0) {
         const auto& piece = set.pairs.pieces_b[static_cast<std::size_t>(found.touch.obj[i])];
-        add_wrench(objects_[static_cast<std::size_t>(set.b)], piece.joint_id, point, -force);
+        if (piece.joint_id > 0) add_wrench(body_of(set.b), piece.joint_id, point, -force);
       }
     }
   }
@@ -188,6 +248,14 @@ const Eigen::VectorXd& System::acceleration(double time_s, const ConstVec& q,
     const auto i = static_cast<Eigen::Index>(k);
     acceleration_.segment(nv_robot_ + 6 * i, 6) = body.accelerations(
         q.segment(nq_robot_ + 7 * i, 7), v.segment(nv_robot_ + 6 * i, 6), zero_tau_, nullptr);
+  }
+  // each fixture: its joints' viscous friction -D qd as their input
+  for (std::size_t k = 0; k < fixtures_.size(); ++k) {
+    FixtureBody& f = fixtures_[k];
+    const auto v_f = v.segment(fixture_v_[k], f.body.nv());
+    const Eigen::VectorXd viscous = -f.damping.cwiseProduct(v_f);
+    acceleration_.segment(fixture_v_[k], f.body.nv()) =
+        f.body.accelerations(q.segment(fixture_q_[k], f.body.nq()), v_f, viscous, nullptr);
   }
   return acceleration_;
 }
@@ -243,6 +311,7 @@ void System::constrain(double t0, const ConstVec& q0, const ConstVec& v0, double
     return;
   }
   const double h = t1 - t0;
+  constrain_fixtures(t0, q0, h, q1, v1);
   const auto& limits = plant_.joint_limits;
   if (limits) {
     // the robot's joint limits: rows selected with the smooth step's own speeds, its start
@@ -294,6 +363,33 @@ void System::constrain(double t0, const ConstVec& q0, const ConstVec& v0, double
       v1.segment(nv_robot_ + 6 * i + 3, 3) = v_k.tail<3>();
     }
     object_worlds[k]->commit(rigid_found_[k], object_memory[k]);
+  }
+}
+
+void System::constrain_fixtures(double t0, const ConstVec& q0, double h, Eigen::VectorXd& q1,
+                                Eigen::VectorXd& v1) {
+  for (std::size_t k = 0; k < fixtures_.size(); ++k) {
+    FixtureBody& f = fixtures_[k];
+    const int n = f.body.nv();
+    if (n == 0 || !f.constrained()) continue;
+    const auto q0_f = q0.segment(fixture_q_[k], n);
+    const Eigen::VectorXd v_free = v1.segment(fixture_v_[k], n);
+    const Eigen::MatrixXd& mass = f.body.mass_matrix_in(q0_f, plant_.flow, t0, plant_.free_surface);
+    const Eigen::VectorXd gap_low = q0_f - f.lower, gap_high = f.upper - q0_f;
+    const JointBoxStep step = joint_box_step(v_free, mass, f.coulomb, gap_low, gap_high, h);
+    // a joint with friction, or one its limit pushed, is a row: its rate is the step's, and
+    // the fixture moves from q0 with v+ (period.py's _end); the others keep v_free
+    bool acting = false;
+    Eigen::VectorXd v_plus = v_free;
+    for (int j = 0; j < n; ++j) {
+      if (f.coulomb[j] > 0.0 || step.limit_impulse[j] != 0.0) {
+        v_plus[j] = step.velocity[j];
+        acting = true;
+      }
+    }
+    if (!acting) continue;
+    v1.segment(fixture_v_[k], n) = v_plus;
+    q1.segment(fixture_q_[k], n) = q0_f + h * v_plus;
   }
 }
 

@@ -13,6 +13,17 @@
 // (moving_contact.hpp) and each object touching the fixed objects as the robot does
 // (world_contact.hpp), in the same water (the plant's flow and free surface).
 //
+// Fixtures (URDFs whose root is fixed in the world, mirror of uvms_pin/sim/system/fixtures.py)
+// follow the objects: their joints in the state and in the model, each fixture's
+//
+//   qdd_f = FD_f(q_f, qd_f, -D_f qd_f + tau_contact,f)
+//
+// in the same water, its links a side of the pair sets (side n_objects + k), and at the
+// period's end its joints' limits and Coulomb friction by their exact step (joint_box.hpp;
+// the bodies meet through smooth contact forces, so each fixture's joints are apart from the
+// other rows). Rigid contacts between moving bodies are not held with fixtures (the Python
+// reference solves a fixture's joints with those rows in one problem).
+//
 // A period: the integrator's substeps on the system's manifold, then every contact's friction
 // anchors move (World.commit, PiecePairs.commit) at the period's end, then the constraints
 // solved implicitly (period.py, constrained): the robot's joint limits (joint_limits.hpp) and,
@@ -36,11 +47,27 @@
 
 namespace uvms {
 
+// A fixture of the system: its joints' dynamics (a fixed-base model, its links in the water)
+// and what acts along each joint: viscous damping D, Coulomb friction c, position limits.
+struct FixtureBody {
+  Dynamics body;
+  Eigen::VectorXd damping;  // D (nv_f,) [N m s/rad or N s/m]
+  Eigen::VectorXd coulomb;  // c (nv_f,) [N m or N], 0: none
+  Eigen::VectorXd lower;    // q_min (nv_f,) [rad or m], -inf: none
+  Eigen::VectorXd upper;    // q_max, +inf: none
+  // some joint has friction or a limit: its joints are stepped at the period's end
+  bool constrained() const {
+    return (coulomb.array() > 0.0).any() || lower.array().isFinite().any() ||
+           upper.array().isFinite().any();
+  }
+};
+
 class System {
  public:
-  // The robot's plant (kept by reference: its owner outlives the system) and each free
-  // object's floating body (copied).
-  System(Plant& plant, const std::vector<const Dynamics*>& objects);
+  // The robot's plant (kept by reference: its owner outlives the system), each free
+  // object's floating body (copied) and the fixtures (copied).
+  System(Plant& plant, const std::vector<const Dynamics*>& objects,
+         std::vector<FixtureBody> fixtures = {});
   System(const System&) = delete;
   System& operator=(const System&) = delete;
 
@@ -57,6 +84,7 @@ class System {
   int nq() const { return model_.nq; }
   int nv() const { return model_.nv; }
   std::size_t n_objects() const { return objects_.size(); }
+  std::size_t n_fixtures() const { return fixtures_.size(); }
   Plant& plant() { return plant_; }
 
   // Checks the sets and the object worlds against the models (InputError otherwise).
@@ -98,6 +126,9 @@ class System {
   // The constraints of the period (see the file's comment) on (q1, v1), the smooth step's end.
   void constrain(double t0, const ConstVec& q0, const ConstVec& v0, double t1,
                  Eigen::VectorXd& q1, Eigen::VectorXd& v1);
+  // Each fixture's joints by their exact step (joint_box.hpp), after the smooth step.
+  void constrain_fixtures(double t0, const ConstVec& q0, double h, Eigen::VectorXd& q1,
+                          Eigen::VectorXd& v1);
   // ... with rigid_pairs: every row of the system in one solve (moving_constraints.hpp).
   void constrain_coupled(double t0, const ConstVec& q0, const ConstVec& v0, double t1,
                          Eigen::VectorXd& q1, Eigen::VectorXd& v1);
@@ -106,13 +137,18 @@ class System {
   // The moving contacts' forces on the robot's bodies (the plant's moving_contacts, called
   // after its own kinematics: the robot's is done once an evaluation).
   void add_robot_forces(Dynamics& robot);
-  // the data of side k of a set (-1: the robot's, of the last contacts_at)
+  // the data of side k of a set (-1: the robot's, of the last contacts_at; then the free
+  // objects; then the fixtures)
   const Data& data_of(int side);
   const Model& model_of(int side) const;
+  // the body of side k >= 0 (a free object, or a fixture after them)
+  Dynamics& body_of(int side);
 
   Plant& plant_;
   std::vector<Dynamics> objects_;
-  Model model_;  // the robot's joints and one free-flyer per object (integration)
+  std::vector<FixtureBody> fixtures_;
+  std::vector<Eigen::Index> fixture_q_, fixture_v_;  // each fixture's first index in q, v
+  Model model_;  // the robot's joints, one free-flyer per object, the fixtures' joints
   Data robot_data_;  // the robot's kinematics for contacts() and settle()
   const Data* robot_at_ = nullptr;  // the robot's data of the contacts being computed
   int nq_robot_, nv_robot_;

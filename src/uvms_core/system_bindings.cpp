@@ -11,6 +11,7 @@
 
 #include <string>
 
+#include "joint_box.hpp"
 #include "system.hpp"
 #include "world_bindings.hpp"
 
@@ -106,6 +107,17 @@ void check_state(System& system, const Eigen::VectorXd& q, const Eigen::VectorXd
 }  // namespace
 
 void bind_system(nb::module_& m) {
+  m.def(
+      "joint_box_step",
+      [](const Eigen::VectorXd& v_free, const Eigen::MatrixXd& mass, const Eigen::VectorXd& coulomb,
+         const Eigen::VectorXd& gap_low, const Eigen::VectorXd& gap_high, double period_s) {
+        const uvms::JointBoxStep step =
+            uvms::joint_box_step(v_free, mass, coulomb, gap_low, gap_high, period_s);
+        return nb::make_tuple(step.velocity, step.friction_impulse, step.limit_impulse);
+      },
+      "v_free"_a, "mass"_a, "coulomb"_a, "gap_low"_a, "gap_high"_a, "period_s"_a,
+      "(v+, friction impulse, limit impulse) of one body's joints (joint_box.hpp; the "
+      "reference: uvms_pin.physics.constraints.joint_box.joint_box_step).");
   using uvms::PiecePairsModel;
   nb::class_<PiecePairsModel>(m, "PiecePairs",
                               "Pairs of pieces of two moving bodies (moving_contact.hpp).")
@@ -150,6 +162,31 @@ void bind_system(nb::module_& m) {
           },
           "plant"_a, "objects"_a, nb::keep_alive<1, 2>(),
           "The plant (kept alive) and each free object's floating body (copied).")
+      .def(
+          "__init__",
+          [](System* self, uvms::Plant& plant, const std::vector<const uvms::Dynamics*>& objects,
+             const std::vector<const uvms::Dynamics*>& fixtures,
+             const std::vector<Eigen::VectorXd>& damping,
+             const std::vector<Eigen::VectorXd>& coulomb,
+             const std::vector<Eigen::VectorXd>& lower,
+             const std::vector<Eigen::VectorXd>& upper) {
+            const std::size_t n = fixtures.size();
+            if (damping.size() != n || coulomb.size() != n || lower.size() != n ||
+                upper.size() != n) {
+              throw InputError("system: damping, coulomb, lower and upper: one per fixture");
+            }
+            std::vector<uvms::FixtureBody> bodies;
+            for (std::size_t k = 0; k < n; ++k) {
+              if (fixtures[k] == nullptr) throw InputError("system: a fixture without dynamics");
+              bodies.push_back({*fixtures[k], damping[k], coulomb[k], lower[k], upper[k]});
+            }
+            new (self) System(plant, objects, std::move(bodies));
+          },
+          "plant"_a, "objects"_a, "fixtures"_a, "damping"_a, "coulomb"_a, "lower"_a, "upper"_a,
+          nb::keep_alive<1, 2>(),
+          "The plant (kept alive), each free object's floating body and each fixture's "
+          "joints (copied) with, per fixture, its joints' viscous damping, Coulomb friction "
+          "and limits (-inf, inf: none).")
       .def_prop_ro(
           "stalled_solves",
           [](const System& self) {

@@ -1,7 +1,8 @@
 """Fixtures in the system of bodies (uvms_pin.sim.system.fixtures): a fixture's joints hold
 below their Coulomb friction (stiction: a constraint, not a smoothed torque) and turn above
 it at (tau - c) / I, stop at their limits, never gain energy, and turn when a free object
-pushes them; the fixture is stepped by the Python integrator, and says why."""
+pushes them; the fixture is stepped in the compiled system of bodies (compliant moving contacts) or
+by the Python integrator (rigid ones), and says which."""
 
 from __future__ import annotations
 
@@ -137,7 +138,9 @@ def test_a_free_object_falling_on_the_handle_turns_it(reference_uvms):
     assert np.max(np.abs(q_alone)) < 1e-9  # the weightless-on-its-axis handle holds
 
 
-def test_the_fixtures_are_logged_and_said_to_be_integrated_in_python(reference_uvms):
+def test_the_fixtures_are_logged_and_said_how_they_are_stepped(reference_uvms):
+    """Compiled with compliant moving contacts (the default); integrated in Python with
+    rigid ones, naming why."""
     valve = fixture(
         "panel", VALVE, ([0.0, 0.0, -5.0], [0.0, 0.0, 0.0]), joint_positions={"valve": 0.3},
         water_density_kg_m3=RHO,
@@ -150,9 +153,12 @@ def test_the_fixtures_are_logged_and_said_to_be_integrated_in_python(reference_u
     logged = system.logged_signals(state.q, state.v)
     assert logged["panel"].components == ("valve",) and logged["panel"].values[0] == 0.3
     record = system.record(RK4(5e-4))
-    assert fixtures.COMPILED_REFUSAL in record["world"]["integration"]
+    assert record["world"]["integration"].startswith("fixtures: one compiled call")
     assert record["world"]["fixtures"][0]["joints"] == ["valve"]
     assert system.n_logged_columns == 9 * len(system.contact_pair_names) + 1
+    world = World(reference_uvms, [], fixtures=[valve], moving_contact="rigid")
+    rigid = System(Plant(reference_uvms, free_surface=False, world=world))
+    assert fixtures.COMPILED_REFUSAL in rigid.record(RK4(5e-4))["world"]["integration"]
 
 
 def test_a_fixture_touched_by_another_sets_row_is_solved_with_it(tmp_path):

@@ -97,6 +97,16 @@ class Fixture:
         return tuple(range(1, self.uvms.model.njoints))
 
     @property
+    def limits(self) -> tuple[np.ndarray, np.ndarray]:
+        """(q_min, q_max) (nv,) [rad or m]: the URDF's ``<limit>`` of each joint that has
+        both (finite), else (-inf, inf): no limit."""
+        model = self.uvms.model
+        at = [model.joints[j].idx_q for j in self.joint_ids]
+        low, high = model.lowerPositionLimit[at], model.upperPositionLimit[at]
+        limited = np.isfinite(low) & np.isfinite(high) & (np.maximum(-low, high) < 1e300)
+        return np.where(limited, low, -np.inf), np.where(limited, high, np.inf)
+
+    @property
     def damping(self) -> np.ndarray:
         """D (nv,) [N m s/rad or N s/m], the URDF's ``<dynamics damping>``."""
         return np.array(self.uvms.model.damping, dtype=float)

@@ -1,6 +1,7 @@
 """The compiled system of bodies (src/uvms_core/system.hpp) of a `uvms_pin.sim.system.System`
-with free objects: its compiled plant, each free object's compiled dynamics (a floating body
-of its own) and the moving contacts (`uvms_pin.physics.compiled.moving`), built from their
+with free objects or fixtures: its compiled plant, each free object's compiled dynamics (a
+floating body of its own), each fixture's (its joints, their damping, friction and limits:
+`uvms_pin.physics.world.fixture.Fixture`) and the moving contacts (`uvms_pin.physics.compiled.moving`), built from their
 public attributes. One call crosses a control period: every body, every contact and the
 anchors' move at its end."""
 
@@ -22,6 +23,7 @@ class SystemParts(Protocol):
 
     plant: Any
     objects: tuple
+    fixtures: tuple
     moving: Any
 
 
@@ -34,7 +36,12 @@ def system_to_core(system: SystemParts, core: ModuleType):
     if system.moving is None:
         return Fallback("a system without moving contacts")
     objects = [dynamics_of(o.uvms).core for o in system.objects]
-    out = core.System(plant, objects)
+    fixtures = system.fixtures
+    out = core.System(
+        plant, objects, [dynamics_of(f.uvms).core for f in fixtures],
+        [f.damping for f in fixtures], [f.coulomb for f in fixtures],
+        *zip(*[f.limits for f in fixtures], strict=True) if fixtures else ([], []),
+    )  # fmt: skip
     try:
         moving_to_core(system.moving.moving, out, core)
     except ModelError as exc:  # a piece without a compiled geometry

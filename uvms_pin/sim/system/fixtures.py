@@ -11,11 +11,15 @@ pose, with its URDF limits). Per fixture f, over a period:
   reached within the period) and their Coulomb friction with stiction
   (`JointCoulombFriction`, a row per joint with c_j > 0, |lambda_j| <= c_j h).
 
-The compiled system of bodies holds free objects only: a system with a fixture is stepped
-by the Python integrator (`COMPILED_REFUSAL`, said once in `why_not_compiled_system`) around
-the compiled robot dynamics and, with the compiled backend, the compiled contact search of
-every moving pair set (`uvms_pin.physics.compiled.moving.search_compiled`: the core's
-PiecePairs, the same arithmetic as `PiecePairs.forces`).
+The compiled system of bodies (src/uvms_core/system.hpp) holds the fixtures with compliant
+moving contacts: their joints' dynamics and their exact step (src/uvms_core/joint_box.hpp),
+built from its ``limits``, ``damping`` and ``coulomb``. With rigid moving contacts a fixture's
+joints are solved with those rows in one problem, which only the Python reference does: such
+a system is stepped by the Python integrator (`COMPILED_REFUSAL`, said once in
+`why_not_compiled_system`) around the compiled robot dynamics and, with the compiled backend,
+the compiled contact search of every moving pair set
+(`uvms_pin.physics.compiled.moving.search_compiled`: the core's PiecePairs, the same
+arithmetic as `PiecePairs.forces`).
 """
 
 from __future__ import annotations
@@ -47,10 +51,12 @@ __all__ = [
     "with_fixtures",
 ]
 
-#: why a system with a fixture is not one compiled call a period (its moving contacts are
-#: searched by the core all the same: `physics.compiled.moving.search_compiled`)
+#: why a system with a fixture and rigid moving contacts is not one compiled call a period
+#: (its moving contacts are searched by the core all the same:
+#: `physics.compiled.moving.search_compiled`)
 COMPILED_REFUSAL = (
-    'a fixture with joints (type = "urdf"): the compiled system holds free objects only'
+    'a fixture (type = "urdf") with rigid moving contacts: its joints are solved with '
+    "those rows in one problem, which the compiled system does not do"
 )
 
 #: the names of the fixtures' constraint sets (their impulses in a solved period)
@@ -110,15 +116,14 @@ def constraints(first: int, fixtures: Sequence[Fixture]) -> tuple:
     ids = joint_ids(first, fixtures)
     limited, rubbing, coulomb = [], [], []
     for fixture, own in zip(fixtures, ids, strict=True):
-        model = fixture.uvms.model
-        for j, system_joint in zip(range(1, model.njoints), own, strict=True):
-            q = model.joints[j].idx_q
-            low, high = model.lowerPositionLimit[q], model.upperPositionLimit[q]
-            if np.isfinite(low) and np.isfinite(high) and max(-low, high) < 1e300:
+        lower, _ = fixture.limits
+        friction = fixture.coulomb
+        for i, system_joint in enumerate(own):
+            if np.isfinite(lower[i]):
                 limited.append(system_joint)
-            if model.friction[model.joints[j].idx_v] > 0.0:
+            if friction[i] > 0.0:
                 rubbing.append(system_joint)
-                coulomb.append(float(model.friction[model.joints[j].idx_v]))
+                coulomb.append(float(friction[i]))
     out: list = []
     if limited:
         out.append(JointLimits(tuple(limited), name=FIXTURE_LIMITS))

@@ -55,8 +55,8 @@ __all__ = ["System"]
 
 #: what a world record says of a run with free objects, its period compiled
 COMPILED_PATH = (
-    "free objects: one compiled call a control period steps the system (the UVMS, every "
-    "free object, every contact between them and with the fixed world, the friction anchors)"
+    "{bodies}: one compiled call a control period steps the system (the UVMS, every "
+    "{each}, every contact between them and with the fixed world, the friction anchors)"
 )
 #: ... or integrated in Python, and why
 PYTHON_PATH = (
@@ -68,9 +68,10 @@ PYTHON_PATH = (
 def integration_path(reason: str | None, fixtures_only: bool = False) -> str:
     """What a world record says of a run with free objects (or only fixtures:
     ``fixtures_only``) whose compiled period is refused for ``reason`` (None: compiled)."""
-    if reason is None:
-        return COMPILED_PATH
     bodies, others = ("fixtures", "fixtures") if fixtures_only else ("free objects", "objects")
+    if reason is None:
+        each = "fixture's joints" if fixtures_only else "free object and fixture's joints"
+        return COMPILED_PATH.format(bodies=bodies, each=each)
     return PYTHON_PATH.format(bodies=bodies, others=others, reason=reason)
 
 
@@ -193,7 +194,7 @@ class System:
         plant_core = self.plant.compiled
         if not (self.objects or self.fixtures) or plant_core is None:
             return None
-        if self.fixtures:
+        if self.fixtures and self.moving.moving.rigid_pairs:
             return Fallback(fixture_joints.COMPILED_REFUSAL)
         if self.attachments is not None:
             return Fallback(ATTACHMENT_REFUSAL)
