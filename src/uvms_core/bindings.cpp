@@ -26,6 +26,7 @@ void bind_sampled_laws(nb::module_& m);  // loop_bindings.cpp
 void bind_sampled_loop(nb::module_& m);  // loop_bindings.cpp
 void bind_step_derivatives(nb::module_& m);  // step_bindings.cpp
 void bind_system(nb::module_& m);  // system_bindings.cpp
+void bind_robots(nb::module_& m);  // system_bindings.cpp
 
 namespace {
 
@@ -581,6 +582,7 @@ NB_MODULE(_core, m) {
   bind_world(m);
   bind_plant(m);
   bind_system(m);
+  bind_robots(m);
   bind_batch_plant(m);
   bind_batch_derivatives(m);
   bind_sampled_laws(m);

@@ -176,10 +176,14 @@ void System::contacts_at(const Data& robot) {
   }
 }
 
-void System::contacts(const ConstVec& q, const ConstVec& v) {
+void System::kinematics(const ConstVec& q, const ConstVec& v) {
   pinocchio::forwardKinematics(plant_.dynamics().model(), robot_data_, q.head(nq_robot_),
                                v.head(nv_robot_));
   object_kinematics(q, v);
+}
+
+void System::contacts(const ConstVec& q, const ConstVec& v) {
+  kinematics(q, v);
   contacts_at(robot_data_);
 }
 
@@ -201,6 +205,9 @@ void System::add_robot_forces(Dynamics& robot) {
         add_wrench(robot, piece.joint_id, point, -force);
       }
     }
+  }
+  for (const Push& push : pushes) {
+    if (push.side < 0) add_wrench(robot, push.joint_id, push.point, push.force);
   }
 }
 
@@ -240,6 +247,11 @@ const Eigen::VectorXd& System::acceleration(double time_s, const ConstVec& q,
         const auto& piece = set.pairs.pieces_b[static_cast<std::size_t>(found.touch.obj[i])];
         if (piece.joint_id > 0) add_wrench(body_of(set.b), piece.joint_id, point, -force);
       }
+    }
+  }
+  for (const Push& push : pushes) {
+    if (push.side >= 0 && push.joint_id > 0) {
+      add_wrench(body_of(push.side), push.joint_id, push.point, push.force);
     }
   }
   for (std::size_t k = 0; k < objects_.size(); ++k) {

@@ -81,8 +81,20 @@ class System {
   // the moving bodies touch each other by rigid contacts (World.moving_contact)
   bool rigid_pairs = false;
 
+  // Point forces from bodies outside the system (the other robots of a RobotsSystem): the
+  // world force [N] at a world point [m] on a joint's body of the robot (side -1) or of an
+  // object (side k), added to the contacts' while set (each acceleration reads them).
+  struct Push {
+    int side = -1;
+    int joint_id = 0;
+    Vec3 point = Vec3::Zero();
+    Vec3 force = Vec3::Zero();
+  };
+  std::vector<Push> pushes;
+
   int nq() const { return model_.nq; }
   int nv() const { return model_.nv; }
+  const Model& model() const { return model_; }
   std::size_t n_objects() const { return objects_.size(); }
   std::size_t n_fixtures() const { return fixtures_.size(); }
   Plant& plant() { return plant_; }
@@ -94,6 +106,11 @@ class System {
                                       const ConstVec& tau);
   // The contacts at (q, v) (after which found_sets() and found_objects() hold them).
   void contacts(const ConstVec& q, const ConstVec& v);
+  // The kinematics at (q, v) of the robot (robot_data()) and of the objects (object_data()).
+  void kinematics(const ConstVec& q, const ConstVec& v);
+  const Data& robot_data() const { return robot_data_; }
+  const Data& object_data(std::size_t k) { return objects_[k].data(); }
+  const Model& object_model(std::size_t k) const { return objects_[k].model(); }
   // each pair set's contacts: at the last contacts() (compliant), or over the last period
   // solved (rigid_pairs: the mean forces of its impulses)
   const std::vector<PairContacts>& found_sets() {

@@ -12,6 +12,7 @@
 #include <string>
 
 #include "joint_box.hpp"
+#include "robots.hpp"
 #include "system.hpp"
 #include "world_bindings.hpp"
 
@@ -104,7 +105,82 @@ void check_state(System& system, const Eigen::VectorXd& q, const Eigen::VectorXd
   if (!q.allFinite() || !v.allFinite()) throw InputError("system: a non-finite state");
 }
 
+// Each robot's system's memories (a list per system, System's order), then each between
+// set's: read before a RobotsSystem call (its integration reads the anchors only).
+void read_robots(uvms::RobotsSystem& robots, const nb::handle& systems, const nb::handle& own) {
+  std::vector<nb::handle> per_system, per_set;
+  for (nb::handle h : systems) per_system.push_back(h);
+  for (nb::handle h : own) per_set.push_back(h);
+  if (per_system.size() != robots.n_robots() || per_set.size() != robots.sets.size()) {
+    throw InputError("robots: one list of memories per robot's system and one memory per set");
+  }
+  for (std::size_t k = 0; k < per_system.size(); ++k) read_all(robots.system(k), per_system[k]);
+  for (std::size_t s = 0; s < per_set.size(); ++s) read_memory(per_set[s], robots.sets[s].memory);
+}
+
+void check_robots_state(uvms::RobotsSystem& robots, const Eigen::VectorXd& q,
+                        const Eigen::VectorXd& v) {
+  if (q.size() != robots.nq() || v.size() != robots.nv()) {
+    throw InputError("robots: q (" + std::to_string(robots.nq()) + ",) and v (" +
+                     std::to_string(robots.nv()) + ",) expected");
+  }
+  if (!q.allFinite() || !v.allFinite()) throw InputError("robots: a non-finite state");
+}
+
 }  // namespace
+
+void bind_robots(nb::module_& m) {
+  using uvms::RobotsSystem;
+  nb::class_<RobotsSystem>(m, "RobotsSystem",
+                           "Several robots' systems integrated together over a period "
+                           "(robots.hpp).")
+      .def(
+          "__init__",
+          [](RobotsSystem* self, const std::vector<System*>& systems) {
+            new (self) RobotsSystem(systems);
+          },
+          "systems"_a, nb::keep_alive<1, 2>(),
+          "Each robot's compiled system, in order (kept alive).")
+      .def_prop_ro("nq", &RobotsSystem::nq)
+      .def_prop_ro("nv", &RobotsSystem::nv)
+      .def(
+          "add_pairs",
+          [](RobotsSystem& r, const uvms::PiecePairsModel& pairs, int a, int b) {
+            uvms::PairSet set;
+            set.pairs = pairs;
+            set.a = a;
+            set.b = b;
+            r.sets.push_back(std::move(set));
+            r.check();
+          },
+          "pairs"_a, "a"_a, "b"_a,
+          "A set of pairs between side a and b (robot k: k; the first system's object i: "
+          "the number of robots + i).")
+      .def(
+          "acceleration",
+          [](RobotsSystem& r, double t, const Eigen::VectorXd& q, const Eigen::VectorXd& v,
+             const std::vector<Eigen::VectorXd>& taus, nb::handle systems,
+             nb::handle memories) -> Eigen::VectorXd {
+            check_robots_state(r, q, v);
+            read_robots(r, systems, memories);
+            return r.acceleration(t, q, v, taus);
+          },
+          "time_s"_a, "q"_a, "v"_a, "taus"_a, "system_memories"_a, "memories"_a,
+          "The joined acceleration at the anchors of the memories (read only).")
+      .def(
+          "integrate",
+          [](RobotsSystem& r, double t0, const Eigen::VectorXd& q0, const Eigen::VectorXd& v0,
+             const std::vector<Eigen::VectorXd>& taus, double t1,
+             const uvms::FixedStep& integrator, nb::handle systems, nb::handle memories) {
+            check_robots_state(r, q0, v0);
+            read_robots(r, systems, memories);
+            return r.integrate(t0, q0, v0, taus, t1, integrator);
+          },
+          "t0"_a, "q0"_a, "v0"_a, "taus"_a, "t1"_a, "integrator"_a, "system_memories"_a,
+          "memories"_a,
+          "(q, v) at t1 by the integrator's steps (the anchors read only: the caller moves "
+          "them and solves each system's constraints).");
+}
 
 void bind_system(nb::module_& m) {
   m.def(

@@ -120,6 +120,56 @@ def test_the_core_finds_the_robots_contacts_as_the_reference_does(load_body):
     assert all(s.search is None for s in python.contacts.sets)
 
 
+def _touching_with_a_ball(load_body, backend: str = "core"):
+    """Robots a (4 kg sphere, holding a ball in its world) and b (6 kg) 1 cm into each
+    other, b against the ball, a moving: (robots, state, a, b)."""
+    a, b = _sphere(load_body), _sphere(load_body, mass=6.0, radius=0.15)
+    ball = free_object(
+        "ball", "sphere", {"radius_m": 0.05}, ([-0.14, 0.0, -4.86], [0.0, 0.0, 0.0]),
+        density_kg_m3=2000.0, water_density_kg_m3=RHO,
+    )  # fmt: skip
+    plant = Plant(a, world=World(a, [], ContactLaw(), [ball]), free_surface=False, backend=backend)
+    first = System(plant)
+    robots = Robots([first, System(Plant(b, free_surface=False, backend=backend))], ["a", "b"])
+    q_a, q_b = a.neutral_configuration(), b.neutral_configuration()
+    q_a[:3], q_b[:3] = [-0.24, 0.0, -5.0], [0.0, 0.003, -5.0]
+    v_a = np.array([0.2, 0.05, 0.0, 0.0, 0.0, 0.3])
+    state = robots.layout.join([first.initial_state(q_a, v_a), (q_b, np.zeros(6))])
+    for system, part in zip(robots.systems, robots.split(*state), strict=True):
+        system.start(SystemState(*part))
+    robots.start(state)
+    return robots, state
+
+
+def test_the_core_integrates_the_robots_together_as_the_reference(load_body):
+    """While they touch, one core call integrates the period (`RobotsSystem`): its
+    acceleration at a touching state with anchors is the reference's (the contacts between
+    robots and with the objects as point forces, the reference's J^T f in the input) and a
+    period of it ends where the Python integrator does, to rounding."""
+    robots, state = _touching_with_a_ball(load_body)
+    core, _ = robots.compiled
+    robots.advance(RK4(step_s=5e-4), 0.0, state, [np.zeros(6)] * 2, 2e-3)  # anchors stretched
+    q, v = robots.advance(RK4(step_s=5e-4), 2e-3, state, [np.zeros(6)] * 2, 4e-3)
+    taus = [np.linspace(-1.0, 1.0, 6), np.linspace(2.0, -0.5, 6)]
+    memories = [s.memory for s in robots.contacts.sets]
+    assert sum(len(c.pair) for c in robots.contacts.found(robots._kinematics(q, v))) > 0
+    reference = robots.acceleration(0.0, q, v, taus)
+    compiled = core.acceleration(0.0, q, v, taus, robots._memories(), memories)
+    np.testing.assert_allclose(compiled, reference, rtol=0.0, atol=1e-9 * np.abs(reference).max())
+    python = RK4(step_s=5e-4).advance(
+        robots.model, lambda t, q_, v_: robots.acceleration(t, q_, v_, taus), 0.0, q, v, 2e-3
+    )
+    ends = robots._integrate(RK4(step_s=5e-4), 0.0, q, v, taus, 2e-3)
+    np.testing.assert_allclose(ends[0], python[0], rtol=0.0, atol=1e-12)
+    np.testing.assert_allclose(ends[1], python[1], rtol=0.0, atol=1e-9)
+    assert robots.integration(RK4(step_s=5e-4)) is None
+
+
+def test_the_python_backend_integrates_the_robots_in_python(load_body):
+    robots, _ = _touching_with_a_ball(load_body, backend="python")
+    assert robots.integration(RK4(step_s=5e-4)) == "the Python backend"
+
+
 def test_a_robot_pushes_a_free_object_into_another_robot_and_momentum_stays(load_body):
     """Robot b runs into a free ball that the first robot's system holds; the ball runs on
     into robot a: b's pairs with the ball are the robots' own, a's its system's; the total

@@ -155,8 +155,11 @@ class RobotsLoop:
             loop.observers.insert(0, log)
         try:
             self.start(starts, sensors)
+            together = self.system.integration(self.settings.integrator)
+            together = TOGETHER_COMPILED if together is None else TOGETHER_PYTHON.format(together)
             for loop, log in zip(self.loops, logs, strict=True):
                 log.rollout.metadata["world"] = loop.system.record(self.settings.integrator)
+                log.rollout.metadata["world"]["robots_together"] = together
                 log.rollout.metadata["stiff_modes"] = loop.stiff_modes
             self._run_ticks(path)
         except SimulationError as exc:  # a divergence, a funnel left, a controller raising
@@ -201,6 +204,11 @@ class RobotsLoop:
             rollout.metadata["closed_loop"] = path.record()
         names = self.system.names
         return RobotRollouts(dict(zip(names, rollouts, strict=True)))
+
+
+#: what a run records of the periods in which the robots may touch (`Robots.integration`)
+TOGETHER_COMPILED = "while they can touch, one compiled call a period integrates every robot"
+TOGETHER_PYTHON = "while they can touch, the Python integrator steps every robot ({})"
 
 
 def _without_free_objects(plant: Plant) -> Plant:

@@ -27,14 +27,15 @@ class SystemParts(Protocol):
     moving: Any
 
 
-def system_to_core(system: SystemParts, core: ModuleType):
+def system_to_core(system: SystemParts, core: ModuleType, *, alone: bool = False):
     """The core's `System` of ``system`` (its plant compiled as it is now), or the
-    `Fallback` saying why the Python integrator steps it instead."""
+    `Fallback` saying why the Python integrator steps it instead (``alone``: a robot
+    without moving contacts is a system too, as several robots need one each)."""
     plant = system.plant.compiled
     if plant is None:
         return Fallback("a plant the core does not compile")
     if system.moving is None:
-        return Fallback("a system without moving contacts")
+        return core.System(plant, []) if alone else Fallback("a system without moving contacts")
     objects = [dynamics_of(o.uvms).core for o in system.objects]
     fixtures = system.fixtures
     out = core.System(

@@ -16,7 +16,9 @@ A control period is stepped in one of two ways, chosen at its start:
   acceleration with the contacts' generalized force added to its input tau: the dynamics
   are linear in it), every anchor moved at the period's end, then each robot's constraints
   solved implicitly (its joint limits: they act within the robot only). With the compiled
-  backend every pair set's contacts are found by the core at each stage
+  backend the integration is one core call (`uvms_pin.sim.compiled.robots`: every robot's
+  compiled system, the contacts between them added to their bodies), and every pair set's
+  contacts outside it (the anchors' move, the logs) are found by the core
   (`uvms_pin.physics.compiled.moving.search_compiled`, the reference's arithmetic).
 
 The world's free objects belong to the first robot's system (its moving contacts with them,
@@ -29,15 +31,20 @@ first robot's system is then apart when no other robot can reach another robot o
 from __future__ import annotations
 
 from collections.abc import Sequence
+from typing import Any
 
 import numpy as np
 import pinocchio as pin
 
 from uvms_pin.errors import ParameterError
+from uvms_pin.physics.compiled.backend import Fallback
+from uvms_pin.physics.compiled.extension import core_module
 from uvms_pin.physics.compiled.moving import search_compiled
 from uvms_pin.physics.world.between_robots import RobotContacts
 from uvms_pin.physics.world.contact_law import ContactLaw
 from uvms_pin.physics.world.world import World
+from uvms_pin.sim.compiled.integrator import integrator_to_core
+from uvms_pin.sim.compiled.robots import robots_to_core
 from uvms_pin.sim.integrators import Integrator
 from uvms_pin.sim.system.period import constrained, constraint_sets
 from uvms_pin.sim.system.state import Layout, SystemState
@@ -196,14 +203,58 @@ class Robots:
             )
         return self._together(integrator, t0, q0, v0, taus, t1)
 
+    # ---- the compiled integration ---------------------------------------------------------
+    @property
+    def compiled(self) -> Any:
+        """The core's integration of the robots together (`uvms_pin.sim.compiled.robots`)
+        of the robots' compiled plants as they are now (rebuilt with them, when a run
+        starts), or its `Fallback`: the Python backend, a plant the core cannot compile."""
+        plants = tuple(s.plant.compiled for s in self.systems)
+        held = self.__dict__.get("_compiled")
+        if held is None or any(a is not b for a, b in zip(held[0], plants, strict=True)):
+            if self.systems[0].plant.backend == "python":
+                built = Fallback("the Python backend", asked=True)
+            else:
+                built = robots_to_core(self, core_module())
+            held = self._compiled = (plants, built)
+        return held[1]
+
+    def _memories(self) -> list[list]:
+        """Each robot's system's friction memories, as its core system reads them."""
+        return [
+            [s.plant.friction] if s.moving is None else s.friction_memories()
+            for s in self.systems
+        ]
+
+    def integration(self, integrator: Integrator) -> str | None:
+        """Why the periods in which the robots touch are integrated by the Python
+        integrator, or None: by one core call each."""
+        built = self.compiled
+        if isinstance(built, Fallback):
+            return built.reason
+        return _fallback_reason(integrator_to_core(integrator, core_module()))
+
+    def _integrate(self, integrator, t0, q0, v0, taus, t1) -> SystemState:
+        """The smooth step of the period with every body at once: one core call, or the
+        Python integrator around `acceleration`."""
+        built = self.compiled
+        step = None if isinstance(built, Fallback) else integrator_to_core(integrator, core_module())
+        if step is None or isinstance(step, Fallback):
+            return integrator.advance(
+                self.model, lambda t, q, v: self.acceleration(t, q, v, taus), t0, q0, v0, t1
+            )
+        memories = [s.memory for s in self.contacts.sets]
+        return built[0].integrate(
+            t0, q0, v0, [np.asarray(t, dtype=float) for t in taus], t1, step, self._memories(),
+            memories,
+        )  # fmt: skip
+
     def _together(self, integrator, t0, q0, v0, taus, t1) -> SystemState:
         """The period integrated for every body at once (the contacts between robots and
         with the objects in the right-hand side), every anchor moved at its end, then each
         robot's system's constraints (its joint limits; the first's objects' rigid
         contacts with the fixed world)."""
-        q1, v1 = integrator.advance(
-            self.model, lambda t, q, v: self.acceleration(t, q, v, taus), t0, q0, v0, t1
-        )
+        q1, v1 = self._integrate(integrator, t0, q0, v0, taus, t1)
         ends = self.split(q1, v1)
         for system, (q_k, v_k) in zip(self.systems, ends, strict=True):
             system.settle(q_k, v_k)
@@ -265,3 +316,7 @@ class Robots:
         """``name/body|name/body`` (or ``name/body|object``) of every pair of robot
         ``robot`` (an index)."""
         return self.contacts.pair_names(robot)
+
+
+def _fallback_reason(built: Any) -> str | None:
+    return built.reason if isinstance(built, Fallback) else None
