@@ -105,6 +105,17 @@ void check_state(System& system, const Eigen::VectorXd& q, const Eigen::VectorXd
   if (!q.allFinite() || !v.allFinite()) throw InputError("system: a non-finite state");
 }
 
+// A pair set between sides a and b added to a System's or a RobotsSystem's sets, checked.
+template <class Owner>
+void add_pair_set(Owner& owner, const uvms::PiecePairsModel& pairs, int a, int b) {
+  uvms::PairSet set;
+  set.pairs = pairs;
+  set.a = a;
+  set.b = b;
+  owner.sets.push_back(std::move(set));
+  owner.check();
+}
+
 // Each robot's system's memories (a list per system, System's order), then each between
 // set's: read before a RobotsSystem call (its integration reads the anchors only).
 void read_robots(uvms::RobotsSystem& robots, const nb::handle& systems, const nb::handle& own) {
@@ -145,14 +156,7 @@ void bind_robots(nb::module_& m) {
       .def_prop_ro("nv", &RobotsSystem::nv)
       .def(
           "add_pairs",
-          [](RobotsSystem& r, const uvms::PiecePairsModel& pairs, int a, int b) {
-            uvms::PairSet set;
-            set.pairs = pairs;
-            set.a = a;
-            set.b = b;
-            r.sets.push_back(std::move(set));
-            r.check();
-          },
+          &add_pair_set<RobotsSystem>,
           "pairs"_a, "a"_a, "b"_a,
           "A set of pairs between side a and b (robot k: k; the first system's object i: "
           "the number of robots + i).")
@@ -302,14 +306,7 @@ void bind_system(nb::module_& m) {
           "compliant.")
       .def(
           "add_pairs",
-          [](System& s, const PiecePairsModel& pairs, int a, int b) {
-            uvms::PairSet set;
-            set.pairs = pairs;
-            set.a = a;
-            set.b = b;
-            s.sets.push_back(std::move(set));
-            s.check();
-          },
+          &add_pair_set<System>,
           "pairs"_a, "a"_a, "b"_a, "A set of pairs between side a and b (-1: the robot).")
       .def(
           "set_object_world",
