@@ -57,6 +57,7 @@ BatchPlant::BatchPlant(const Plant& prototype, const FixedStep& integrator,
     plant->fins = prototype.fins;
     plant->joint_stops = prototype.joint_stops;
     plant->joint_limits = prototype.joint_limits;
+    plant->joint_coulomb_Nm = prototype.joint_coulomb_Nm;
     plants_.push_back(std::move(plant));
     scratch_.push_back({Eigen::VectorXd::Zero(nv_), Eigen::VectorXd::Zero(nv_),
                         Eigen::VectorXd::Zero(nv_), Eigen::VectorXd::Zero(nq_),

@@ -447,6 +447,8 @@ void bind_plant(nb::module_& m) {
       .def_rw("fins", &Plant::fins)
       .def_rw("joint_stops", &Plant::joint_stops)
       .def_rw("joint_limits", &Plant::joint_limits)
+      .def_rw("joint_coulomb_Nm", &Plant::joint_coulomb_Nm,
+              "The joints' Coulomb friction as a constraint (nv; empty: none).")
       .def_rw("world_bounds", &Plant::world_bounds)
       .def(
           "world_clear",

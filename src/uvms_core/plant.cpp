@@ -1,10 +1,18 @@
 #include "plant.hpp"
 
+#include <limits>
+
+#include "joint_box.hpp"
+
 #include <pinocchio/algorithm/frames.hpp>
 #include <pinocchio/algorithm/joint-configuration.hpp>
 #include <pinocchio/algorithm/kinematics.hpp>
 
 namespace uvms {
+
+namespace {
+constexpr double kInfinity = std::numeric_limits<double>::infinity();
+}  // namespace
 
 Plant::Plant(const Dynamics& dynamics, int ee_frame_id)
     : dynamics_(dynamics), stepper_(dynamics_.model()) {
@@ -113,26 +121,53 @@ std::pair<Eigen::VectorXd, Eigen::VectorXd> Plant::advance(double t0, const Cons
     world->commit(world_forces(stepper_.q, stepper_.v), friction);
   }
   // a smooth step that diverged is returned as it is: the loop names the divergence
-  if (joint_limits && stepper_.q.allFinite() && stepper_.v.allFinite()) {
-    // the smooth step's own speeds: its start, its end and its mean over the period (RK4's
-    // end may cross a limit that its end velocity would not reach), as period.py's constrained
-    const double h = t1 - t0;
-    limit_speed_.resize(dynamics_.model().nv);
-    pinocchio::difference(dynamics_.model(), q0, stepper_.q, limit_speed_);
-    limit_speed_ =
-        (limit_speed_.cwiseAbs() / h).cwiseMax(v0.cwiseAbs()).cwiseMax(stepper_.v.cwiseAbs());
-    if (joint_limits->within_reach(q0, limit_speed_, h)) {
-      // M(q0) with the added mass (wet fractions at t0), as System.mass_matrix
-      const Eigen::MatrixXd& mass = dynamics_.mass_matrix_in(q0, flow, t0, free_surface);
-      Eigen::VectorXd v1 = stepper_.v;
-      if (joint_limits->constrain(mass, q0, v1, h, limit_speed_)) {
-        Eigen::VectorXd q1(q0.size());
-        pinocchio::integrate(dynamics_.model(), q0, (h * v1).eval(), q1);
-        return {q1, v1};
+  if (!(stepper_.q.allFinite() && stepper_.v.allFinite())) return {stepper_.q, stepper_.v};
+  Eigen::VectorXd q1 = stepper_.q, v1 = stepper_.v;
+  constrain_joints(t0, q0, v0, t1 - t0, q1, v1);
+  return {q1, v1};
+}
+
+bool Plant::constrain_joints(double t0, const ConstVec& q0, const ConstVec& v0, double h,
+                             Eigen::VectorXd& q1, Eigen::VectorXd& v1) {
+  const Model& model = dynamics_.model();
+  if (joint_coulomb_Nm.size() > 0) {
+    if (joint_coulomb_Nm.size() != model.nv) {
+      throw InputError("plant: joint_coulomb_Nm needs one number per velocity coordinate");
+    }
+    // every joint's friction is a row (period.py: the robot moves from q0 with v+); each
+    // limited joint's limits bound its rate (the rows the reference selects are those that
+    // can bind: the others leave the same solution)
+    Eigen::VectorXd gap_low = Eigen::VectorXd::Constant(model.nv, kInfinity);
+    Eigen::VectorXd gap_high = Eigen::VectorXd::Constant(model.nv, kInfinity);
+    double correction = 0.2;
+    if (joint_limits) {
+      const auto& limits = *joint_limits;
+      correction = limits.correction;
+      for (std::size_t i = 0; i < limits.q_index.size(); ++i) {
+        const auto k = static_cast<Eigen::Index>(i);
+        gap_low[limits.v_index[i]] = q0[limits.q_index[i]] - limits.lower_rad[k];
+        gap_high[limits.v_index[i]] = limits.upper_rad[k] - q0[limits.q_index[i]];
       }
     }
+    const Eigen::MatrixXd& mass = dynamics_.mass_matrix_in(q0, flow, t0, free_surface);
+    const JointBoxStep step =
+        joint_box_step(v1, mass, joint_coulomb_Nm, gap_low, gap_high, h, correction);
+    v1 = step.velocity;
+    pinocchio::integrate(model, q0, (h * v1).eval(), q1);
+    return true;
   }
-  return {stepper_.q, stepper_.v};
+  if (!joint_limits) return false;
+  // the smooth step's own speeds: its start, its end and its mean over the period (RK4's
+  // end may cross a limit that its end velocity would not reach), as period.py's constrained
+  limit_speed_.resize(model.nv);
+  pinocchio::difference(model, q0, q1, limit_speed_);
+  limit_speed_ = (limit_speed_.cwiseAbs() / h).cwiseMax(v0.cwiseAbs()).cwiseMax(v1.cwiseAbs());
+  if (!joint_limits->within_reach(q0, limit_speed_, h)) return false;
+  // M(q0) with the added mass (wet fractions at t0), as System.mass_matrix
+  const Eigen::MatrixXd& mass = dynamics_.mass_matrix_in(q0, flow, t0, free_surface);
+  if (!joint_limits->constrain(mass, q0, v1, h, limit_speed_)) return false;
+  pinocchio::integrate(model, q0, (h * v1).eval(), q1);
+  return true;
 }
 
 void Plant::check_world() {

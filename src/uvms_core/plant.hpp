@@ -43,6 +43,11 @@ class Plant {
   JointStops joint_stops;  // compliant stops at the arm joints' limits, or none
   // or the limits as constraints solved implicitly at the end of each period (advance)
   JointLimitConstraints joint_limits;
+  // The arm joints' Coulomb friction as a constraint [N m or N] (nv: 0 on the vehicle's
+  // coordinates and on the joints without; empty: none): at the period's end, with the joint
+  // limits, the exact step of joint_box.hpp over the robot's velocity (mirror of period.py's
+  // constrained with `JointCoulombFriction` rows): the robot then moves from q0 with v+.
+  Eigen::VectorXd joint_coulomb_Nm;
 
   // lambda at (q, v): what the end-effector exerts on the environment [N; N m], world axes.
   Vec6 contact_wrench(const ConstVec& q, const ConstVec& v);
@@ -87,6 +92,12 @@ class Plant {
   // configuration q = integrate(q0, delta) and delta_dot = Jint(q0, delta)^-1 v.
   std::pair<Eigen::VectorXd, Eigen::VectorXd> chart(const ConstVec& q0, const ConstVec& delta,
                                                     const ConstVec& v);
+
+  // The end of a period [t0, t0 + h] whose smooth step went from (q0, v0) to (q1, v1): the
+  // joint limits' implicit step, or with joint_coulomb_Nm the joints' exact step with their
+  // friction and limits; (q1, v1) replaced when a row acted. Returns whether one did.
+  bool constrain_joints(double t0, const ConstVec& q0, const ConstVec& v0, double h,
+                        Eigen::VectorXd& q1, Eigen::VectorXd& v1);
 
   Dynamics& dynamics() { return dynamics_; }
   const Dynamics& dynamics() const { return dynamics_; }

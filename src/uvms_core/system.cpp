@@ -131,6 +131,11 @@ void System::check() const {
     }
     set.pairs.check(model_of(set.a), model_of(set.b));
   }
+  if (rigid_pairs && plant_.joint_coulomb_Nm.size() > 0) {
+    throw InputError(
+        "system: rigid contacts between moving bodies with the joints' Coulomb friction are "
+        "the Python reference's (solved with those rows in one problem)");
+  }
   if (rigid_pairs && !fixtures_.empty()) {
     throw InputError(
         "system: rigid contacts between moving bodies with a fixture are the Python "
@@ -324,28 +329,12 @@ void System::constrain(double t0, const ConstVec& q0, const ConstVec& v0, double
   }
   const double h = t1 - t0;
   constrain_fixtures(t0, q0, h, q1, v1);
-  const auto& limits = plant_.joint_limits;
-  if (limits) {
-    // the robot's joint limits: rows selected with the smooth step's own speeds, its start
-    // and its mean over the period
-    const auto q0_robot = q0.head(nq_robot_);
-    Eigen::VectorXd travelled(nv_robot_);
-    pinocchio::difference(plant_.dynamics().model(), q0_robot, q1.head(nq_robot_), travelled);
-    limit_speed_ = (travelled.cwiseAbs() / h)
-                       .cwiseMax(v0.head(nv_robot_).cwiseAbs())
-                       .cwiseMax(v1.head(nv_robot_).cwiseAbs());
-    if (limits->within_reach(q0_robot, limit_speed_, h)) {
-      const Eigen::MatrixXd& mass =
-          plant_.dynamics().mass_matrix_in(q0_robot, plant_.flow, t0, plant_.free_surface);
-      Eigen::VectorXd v1_robot = v1.head(nv_robot_);
-      if (limits->constrain(mass, q0_robot, v1_robot, h, limit_speed_)) {
-        v1.head(nv_robot_) = v1_robot;
-        Eigen::VectorXd q1_robot(nq_robot_);
-        pinocchio::integrate(plant_.dynamics().model(), q0_robot, (h * v1_robot).eval(),
-                             q1_robot);
-        q1.head(nq_robot_) = q1_robot;
-      }
-    }
+  // the robot's joint limits (and Coulomb friction): its plant's step (Plant::constrain_joints)
+  Eigen::VectorXd q1_robot = q1.head(nq_robot_), v1_robot = v1.head(nv_robot_);
+  if (plant_.constrain_joints(t0, q0.head(nq_robot_), v0.head(nv_robot_), h, q1_robot,
+                              v1_robot)) {
+    q1.head(nq_robot_) = q1_robot;
+    v1.head(nv_robot_) = v1_robot;
   }
   if (!rigid_objects) return;
   for (std::size_t k = 0; k < objects_.size(); ++k) {

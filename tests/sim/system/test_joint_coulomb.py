@@ -16,6 +16,7 @@ from uvms_pin.physics.constraints.joint_limits import JointLimits
 from uvms_pin.sim.integrators import RK4
 from uvms_pin.sim.plant import Plant
 from uvms_pin.sim.system import System
+from uvms_pin.sim.system.period import integrated_step, period_step
 
 PERIOD_S = 2e-3
 COULOMB_N = 0.5  # the left finger's (a prismatic joint: N)
@@ -85,3 +86,42 @@ def test_the_scenario_chooses_the_constraint_with_a_control_period(tmp_path):
     plant = up.scenario_from_dict(data, tmp_path / "jaw.toml").plant
     assert plant.joint_coulomb is None
     assert plant.joint_friction.coulomb_Nm.tolist() == [0.5, 0.5]
+
+
+@pytest.mark.parametrize("force_N", [0.3, 0.8, 3.0])
+def test_the_compiled_step_is_the_references(tmp_path, force_N):
+    """The compiled plant steps the joints' friction and limits at each period's end by
+    their exact step (src/uvms_core/joint_box.hpp) over the robot's velocity; the
+    reference (`integrated_step`: the same compiled dynamics, then Pinocchio's ADMM on the
+    `JointCoulombFriction` and `JointLimits` rows) agrees to its tolerance: the left finger
+    held (0.3 N against its 0.5 N), sliding (0.8 N) and driven into its limit (3 N), the
+    right one, without friction, pushed by the same force to its limit, while the vehicle
+    floats."""
+    uvms, q = _jaw(tmp_path)
+    plant = Plant(
+        uvms, free_surface=False, joint_limits=JointLimits.of_uvms(uvms),
+        joint_coulomb=JointCoulombFriction.of_uvms(uvms, [COULOMB_N, 0.0]),
+    )  # fmt: skip
+    system = System(plant)
+    assert plant.compiled is not None and len(plant.compiled.joint_coulomb_Nm) == uvms.nv
+    compiled_step = period_step(system, RK4(5e-4))
+    reference_step = integrated_step(system, RK4(5e-4))
+    tau = np.zeros(uvms.nv)
+    tau[6:8] = force_N
+    state = system.initial_state(q, np.zeros(uvms.nv))
+    system.start(state)
+    (qc, vc), (qr, vr) = (state.q, state.v), (state.q, state.v)
+    for k in range(150):  # 0.3 s
+        t0, t1 = k * PERIOD_S, (k + 1) * PERIOD_S
+        qc, vc = compiled_step(t0, qc, vc, tau, t1)
+        qr, vr = reference_step(t0, qr, vr, tau, t1)
+        np.testing.assert_allclose(qc, qr, rtol=0.0, atol=1e-8)
+        np.testing.assert_allclose(vc, vr, rtol=0.0, atol=1e-6)
+    upper = uvms.model.upperPositionLimit[7:9]
+    if force_N < COULOMB_N:
+        assert abs(qc[7] - q[7]) < 1e-9  # held by its friction
+    else:
+        assert qc[7] > q[7] + 1e-3  # slid open
+    assert qc[8] == pytest.approx(upper[1], abs=1e-6)  # the frictionless one at its limit
+    if force_N > 1.0:
+        assert qc[7] == pytest.approx(upper[0], abs=1e-6)

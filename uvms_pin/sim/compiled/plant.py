@@ -7,6 +7,8 @@ from __future__ import annotations
 from types import ModuleType
 from typing import Any, Protocol
 
+import numpy as np
+
 from uvms_pin.physics.compiled.backend import Fallback
 from uvms_pin.physics.compiled.contact import contact_to_core
 from uvms_pin.physics.compiled.disturbance import disturbance_to_core
@@ -48,8 +50,6 @@ def plant_to_core(plant: PlantParts, core: ModuleType):
     fallback = next((p for p in parts if isinstance(p, Fallback)), None)
     if fallback is not None:
         return fallback
-    if plant.joint_coulomb is not None:
-        return Fallback("joint Coulomb friction as a constraint (solved by the Python step)")
     uvms = plant.uvms
     # the compiled plant uses the end-effector frame for contact only, which a model without
     # one cannot have (Plant checks): frame 0 (the world) stands in
@@ -58,6 +58,12 @@ def plant_to_core(plant: PlantParts, core: ModuleType):
     compiled.joint_friction = joint_friction_to_core(plant.joint_friction, core)
     compiled.fins = fins_to_core(uvms.fins, core)
     compiled.joint_limits = joint_limits_to_core(plant.joint_limits, uvms.model, core)
+    if plant.joint_coulomb is not None:  # c at each rubbing joint's velocity coordinate
+        coulomb = np.zeros(uvms.nv)
+        friction = plant.joint_coulomb
+        for joint, value in zip(friction.joint_ids, friction.coulomb_Nm, strict=True):
+            coulomb[uvms.model.joints[joint].idx_v] = value
+        compiled.joint_coulomb_Nm = coulomb
     compiled.free_surface = bool(plant.free_surface)
     bounds = world_bounds_to_core(plant.world, core)
     if bounds is not None:

@@ -222,8 +222,7 @@ class Robots:
     def _memories(self) -> list[list]:
         """Each robot's system's friction memories, as its core system reads them."""
         return [
-            [s.plant.friction] if s.moving is None else s.friction_memories()
-            for s in self.systems
+            [s.plant.friction] if s.moving is None else s.friction_memories() for s in self.systems
         ]
 
     def integration(self, integrator: Integrator) -> str | None:
@@ -238,7 +237,9 @@ class Robots:
         """The smooth step of the period with every body at once: one core call, or the
         Python integrator around `acceleration`."""
         built = self.compiled
-        step = None if isinstance(built, Fallback) else integrator_to_core(integrator, core_module())
+        step = (
+            None if isinstance(built, Fallback) else integrator_to_core(integrator, core_module())
+        )
         if step is None or isinstance(step, Fallback):
             return integrator.advance(
                 self.model, lambda t, q, v: self.acceleration(t, q, v, taus), t0, q0, v0, t1
