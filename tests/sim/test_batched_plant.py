@@ -27,11 +27,13 @@ NOISY_STATE = {
 CASES = {
     "realistic_force_tracking": {"scenario.duration_s": 0.03},
     "gym_station_keeping": {"scenario.duration_s": 0.2, **NOISY_STATE},
+    # the arm joints' Coulomb friction as a constraint, solved at each period's end
+    "gym_station_keeping:coulomb": {"scenario.duration_s": 0.2, "joints.coulomb_Nm": [0.8] * 4},
 }
 
 
 def _scenario(name: str):
-    return load_scenario(scenario_path(name), CASES[name])
+    return load_scenario(scenario_path(name.split(":")[0]), CASES[name])
 
 
 def _starts(scenario, num_envs: int, seed: int):
