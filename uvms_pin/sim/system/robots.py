@@ -292,8 +292,11 @@ class Robots:
         objects (``robot_contact``). Zero for a robot touching none."""
         objects = {o.name for o in self.objects}
         first = self.systems[0]
-        rows = [(first.logged_signals(*self.split(q, v)[0]).get("world_contact"),
-                 first.contact_pair_names)]  # fmt: skip
+        rows: list = [(None, [])]
+        if first.moving is not None:  # its pairs with the objects are among its moving pairs
+            (q_r, v_r), *states = first.layout.split(*self.split(q, v)[0])
+            robot_pairs, _ = first.moving.wrenches(q_r, v_r, states)
+            rows = [(robot_pairs, first.moving.moving.uvms_pair_names)]
         others = self.contact_signals(q, v)[1:]
         rows += [
             (own.get("robot_contact"), self.contact_pair_names(k))
