@@ -101,10 +101,13 @@ def test_the_damped_inverse_near_a_singularity_runs_compiled_as_in_python(joints
     # the roll and pitch rates passive) is 1.6e-3 and 7.6e-5: near lambda = 1e-3 and below
     # (singular values of J W^-1/2 up to ~3): the damped inverse's gain s / (s^2 + lambda^2)
     # peaks at 1 / (2 lambda) = 500 there, so the rounding by which LAPACK's SVD and Eigen's
-    # Jacobi SVD differ grows by as much: the loops agree to 1e-11 of each signal's scale
+    # Jacobi SVD differ grows by as much: the loops agree to 1e-11 of each signal's scale on
+    # one machine, to 1.5e-11 on another (an AMD EPYC, whose BLAS kernels LAPACK's SVD
+    # rounds differently; the commit before any change of the core measured the same there):
+    # 5e-11 holds both, far below what a wrong law gives
     exact = {"initial.joint_positions_rad": joints, **NO_NOISE}
     scenario = _scenario(LBV150, duration_s=2.0, **exact)
-    compiled = _compiled_as_python(scenario, rtol=1e-11)
+    compiled = _compiled_as_python(scenario, rtol=5e-11)
     # the damping matters along the run: at its logged states (measured exactly), the
     # reference with lambda = 1e-3 is the logged one, the undamped one another
     level = scenario.controller_factory(scenario.uvms).kinematics
