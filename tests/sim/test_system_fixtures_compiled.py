@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from fixture_helpers import VALVE, lever_urdf
+from fixture_helpers import VALVE, double_lever_urdf, lever_urdf
 
 from uvms_pin.errors import ParameterError
 from uvms_pin.physics.compiled.backend import Fallback
@@ -184,3 +184,40 @@ def test_a_side_with_bad_kinematics_is_refused(reference_uvms, field):
     args[field] = np.zeros((1, 5))
     with pytest.raises(ParameterError, match="side"):
         pairs.forces(*args.values(), system.moving.moving.sets[0].memory)
+
+
+@pytest.mark.parametrize(
+    "urdf",
+    [
+        lambda d: double_lever_urdf(d, friction_Nm=0.3),
+        lambda d: lever_urdf(
+            d,
+            friction_Nm=0.3,
+            damping=0.2,
+            joint_type="prismatic",
+            limits=(-0.02, 0.05),
+            volume_m3=2e-4,
+        ),
+    ],
+    ids=["two coupled joints", "prismatic in the water"],
+)
+def test_a_fixture_falling_on_its_own_as_the_reference(reference_uvms, tmp_path, urdf):
+    """Fixtures of other shapes, no contact: two coupled revolute joints with friction
+    below their load, each reaching a limit; a prismatic joint with damping, friction and
+    a displaced volume (buoyancy and added mass). The compiled system and the reference
+    agree to 1e-9 over 0.6 s, and the joints moved."""
+    body = fixture(
+        "f", urdf(tmp_path), ([0.0, 0.0, -5.0], [0.3, 0.0, 0.0]), water_density_kg_m3=RHO
+    )
+
+    def system(compiled: bool) -> System:
+        world = World(reference_uvms, [], fixtures=[body])
+        return System(Plant(reference_uvms, free_surface=False, world=world), compiled=compiled)
+
+    core = system(True)
+    assert not isinstance(core.compiled, Fallback)
+    compiled = _run(core, reference_uvms, 0.6)
+    reference = _run(system(False), reference_uvms, 0.6)
+    np.testing.assert_allclose(compiled, reference, rtol=0.0, atol=1e-9)
+    joints = compiled[:, reference_uvms.nq :]
+    assert np.max(np.abs(joints[-1] - joints[0])) > 1e-3
