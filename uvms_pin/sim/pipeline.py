@@ -3,7 +3,7 @@
 Three compiled pipelines serve a run: the compiled sampled loop (`Pipeline.LOOP`: a run's
 ticks in chunks of one core call, `uvms_pin.sim.compiled_loop`), the batched plant
 (`Pipeline.BATCH`: N environments' periods in one call, `uvms_pin.sim.batched_plant`) and the
-compiled system of bodies (`Pipeline.SYSTEM`: the period of a robot with free objects in one
+compiled system of bodies (`Pipeline.SYSTEM`: the period of a robot with free objects or fixtures in one
 call, `uvms_pin.sim.system.period`). Each reason below names a part without a compiled
 counterpart and the pipelines it keeps in Python; `why_not_compiled` gives the first that
 applies. The rollout records it (its metadata's ``closed_loop`` for the loop, ``world.integration``
@@ -38,7 +38,9 @@ class Pipeline(enum.Flag):
 
     LOOP = enum.auto()  # the compiled sampled loop of a run
     BATCH = enum.auto()  # the batched plant of the vector environments
-    SYSTEM = enum.auto()  # the period of a system with free objects in one compiled call
+    SYSTEM = (
+        enum.auto()
+    )  # the period of a system with free objects or fixtures in one compiled call
     BOTH = LOOP | BATCH  # the closed loop's two: the run's ticks, the environments' periods
     ALL = LOOP | BATCH | SYSTEM
 

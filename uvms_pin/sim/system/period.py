@@ -3,10 +3,11 @@
 - compiled: the compiled plant's one call for the whole period (RK4, semi-implicit Euler):
   without a world; or with fixed objects (a bound test first: nothing within reach, the period
   runs without them; else with the contacts, and their anchors move at its end);
-- compiled system (free objects): the compiled system's one call for the whole period
-  (src/uvms_core/system.hpp): the robot, every free object, every moving contact and the
-  anchors' move at its end, then the joint limits; the friction memories are the Python
-  system's, read and written back by the call;
+- compiled system (free objects, fixtures): the compiled system's one call for the whole
+  period (src/uvms_core/system.hpp): the robot, every free object, every fixture's joints,
+  every moving contact and the anchors' move at its end, then the joint limits (and joint
+  Coulomb friction), the objects' rigid contacts and the fixtures' joints' exact step; the
+  friction memories are the Python system's, read and written back by the call;
 - guarded (the arm against its own vehicle, compiled plant): the compiled call while no pair,
   fixed or moving, can touch over the period, else the integrated step;
 - integrated: the integrator's own loop around the system's right-hand side (the Python
@@ -54,7 +55,7 @@ class Stepped(Protocol):
     model: pin.Model
     objects: tuple
     moving: Any
-    compiled: Any  # the compiled system of bodies with free objects, or its Fallback
+    compiled: Any  # the compiled system of bodies (free objects, fixtures), or its Fallback
     compiled_allowed: bool
     layout: Any  # where each body sits in the state (`uvms_pin.sim.system.state.Layout`)
     object_contacts: Any  # the free objects' rigid contacts with the fixed world, or None
@@ -101,7 +102,7 @@ def period_step(system: Stepped, integrator: Integrator) -> PeriodStep:
 
 
 def why_not_compiled_system(system: Stepped, integrator: Integrator | None) -> str | None:
-    """Why the period of ``system`` (with free objects) is not one compiled call, or None
+    """Why the period of ``system`` (with free objects or fixtures) is not one compiled call, or None
     (``integrator`` None: not asked): the pipeline's one list of reasons
     (`uvms_pin.sim.pipeline`, `Pipeline.SYSTEM`)."""
     return why_not_compiled(RunParts(system, integrator=integrator), Pipeline.SYSTEM)
