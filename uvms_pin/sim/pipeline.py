@@ -3,8 +3,8 @@
 Three compiled pipelines serve a run: the compiled sampled loop (`Pipeline.LOOP`: a run's
 ticks in chunks of one core call, `uvms_pin.sim.compiled_loop`), the batched plant
 (`Pipeline.BATCH`: N environments' periods in one call, `uvms_pin.sim.batched_plant`) and the
-compiled system of bodies (`Pipeline.SYSTEM`: the period of a robot with free objects or fixtures in one
-call, `uvms_pin.sim.system.period`). Each reason below names a part without a compiled
+compiled system of bodies (`Pipeline.SYSTEM`: the period of a robot with free objects or
+fixtures in one call, `uvms_pin.sim.system.period`). Each reason below names a part without a compiled
 counterpart and the pipelines it keeps in Python; `why_not_compiled` gives the first that
 applies. The rollout records it (its metadata's ``closed_loop`` for the loop, ``world.integration``
 for the system's period), the batched plant refuses with it. The plant's own right-hand side
