@@ -78,6 +78,11 @@ const Eigen::VectorXd& RobotsSystem::acceleration(double time_s, const ConstVec&
                                                   const std::vector<Eigen::VectorXd>& taus) {
   if (taus.size() != systems_.size()) throw InputError("robots: one input tau per robot");
   for (std::size_t k = 0; k < systems_.size(); ++k) {
+    if (taus[k].size() != systems_[k]->plant().dynamics().nv() || !taus[k].allFinite()) {
+      throw InputError("robots: robot " + std::to_string(k) + "'s tau: its nv finite numbers");
+    }
+  }
+  for (std::size_t k = 0; k < systems_.size(); ++k) {
     System& system = *systems_[k];
     system.pushes.clear();
     system.kinematics(q.segment(q_at_[k], system.nq()), v.segment(v_at_[k], system.nv()));
@@ -117,11 +122,6 @@ std::pair<Eigen::VectorXd, Eigen::VectorXd> RobotsSystem::integrate(
   }
   if (!(t1 > t0) || !(integrator.step_s > 0.0)) {
     throw InputError("integrate needs t1 > t0 and a positive step");
-  }
-  for (std::size_t k = 0; k < systems_.size() && k < taus.size(); ++k) {
-    if (taus[k].size() != systems_[k]->plant().dynamics().nv() || !taus[k].allFinite()) {
-      throw InputError("robots: robot " + std::to_string(k) + "'s tau: its nv finite numbers");
-    }
   }
   check();
   for (System* system : systems_) system->check();

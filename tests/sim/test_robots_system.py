@@ -12,10 +12,12 @@ from free_object_helpers import undamped
 
 import uvms_pin as up
 from uvms_pin.errors import ParameterError
+from uvms_pin.physics.compiled.extension import core_module
 from uvms_pin.physics.world.contact_law import ContactLaw
 from uvms_pin.physics.world.free_object import free_object
 from uvms_pin.physics.world.world import World
 from uvms_pin.scenario.load import load_scenario
+from uvms_pin.sim.compiled.integrator import integrator_to_core
 from uvms_pin.sim.integrators import RK4
 from uvms_pin.sim.plant import Plant
 from uvms_pin.sim.system import System, SystemState
@@ -283,3 +285,23 @@ def test_robots_near_but_not_touching_step_together_as_each_alone():
         q_alone, v_alone = system.advance(integrator, 0.0, q0, v0, tau, 0.01)
         assert np.max(np.abs(q1 - q_alone)) < 1e-9 and np.max(np.abs(v1 - v_alone)) < 1e-9
         assert np.max(np.abs(v1 - v0)) > 1e-3  # it moved
+
+
+def test_the_core_robots_refuse_bad_inputs_by_name(load_body):
+    robots, state = _touching_with_a_ball(load_body)
+    core, _ = robots.compiled
+    memories = [s.memory for s in robots.contacts.sets]
+    q, v = state
+    good = [np.zeros(6), np.zeros(6)]
+    for taus, match in (
+        ([np.zeros(6)], "one input tau per robot"),
+        ([np.zeros(6), np.zeros(5)], "robot 1's tau"),
+        ([np.zeros(6), np.full(6, np.nan)], "robot 1's tau"),
+    ):
+        with pytest.raises(ParameterError, match=match):
+            core.acceleration(0.0, q, v, taus, robots._memories(), memories)
+    with pytest.raises(ParameterError, match=r"q \(21,\) and v \(18,\) expected"):
+        step = integrator_to_core(RK4(5e-4), core_module())
+        core.integrate(0.0, q[:-1], v, good, 2e-3, step, robots._memories(), memories)
+    with pytest.raises(ParameterError, match="one list of memories per robot"):
+        core.acceleration(0.0, q, v, good, robots._memories()[:1], memories)

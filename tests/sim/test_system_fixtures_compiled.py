@@ -16,6 +16,7 @@ from uvms_pin.errors import ParameterError
 from uvms_pin.physics.compiled.backend import Fallback
 from uvms_pin.physics.compiled.extension import core_module
 from uvms_pin.physics.compiled.moving import PairSearch, piece_pairs_to_core
+from uvms_pin.physics.dynamics import dynamics_of
 from uvms_pin.physics.world.fixture import fixture
 from uvms_pin.physics.world.free_object import free_object
 from uvms_pin.physics.world.world import World
@@ -221,3 +222,19 @@ def test_a_fixture_falling_on_its_own_as_the_reference(reference_uvms, tmp_path,
     np.testing.assert_allclose(compiled, reference, rtol=0.0, atol=1e-9)
     joints = compiled[:, reference_uvms.nq :]
     assert np.max(np.abs(joints[-1] - joints[0])) > 1e-3
+
+
+def test_the_core_refuses_a_fixture_with_bad_parts(reference_uvms):
+    system = _system(reference_uvms)
+    (valve,) = system.fixtures
+    core = core_module()
+    plant, dynamics = system.plant.compiled, dynamics_of(valve.uvms).core
+    lower, upper = valve.limits
+    for damping, coulomb, match in (
+        (np.zeros(2), valve.coulomb, "damping, coulomb, lower and upper"),
+        (valve.damping, -valve.coulomb - 1.0, ">= 0"),
+    ):
+        with pytest.raises(ParameterError, match=match):
+            core.System(plant, [], [dynamics], [damping], [coulomb], [lower], [upper])
+    with pytest.raises(ParameterError, match="one per fixture"):
+        core.System(plant, [], [dynamics], [], [valve.coulomb], [lower], [upper])
