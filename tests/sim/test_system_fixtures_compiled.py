@@ -136,6 +136,22 @@ def test_the_compiled_system_follows_the_reference(reference_uvms):
     np.testing.assert_allclose(compiled, reference, rtol=0.0, atol=1e-9)
 
 
+def _compiled_as_reference(uvms, free: list, fixtures: list, seconds: float) -> np.ndarray:
+    """The system of ``free`` objects and ``fixtures`` run by the compiled system (one call a
+    period) and by the reference's Python integration: they agree to 1e-9 (asserted); the
+    compiled run's states (`_run`)."""
+
+    def system(compiled: bool) -> System:
+        world = World(uvms, [], free=free, fixtures=fixtures)
+        return System(Plant(uvms, free_surface=False, world=world), compiled=compiled)
+
+    core = system(True)
+    assert not isinstance(core.compiled, Fallback)
+    compiled = _run(core, uvms, seconds)
+    np.testing.assert_allclose(compiled, _run(system(False), uvms, seconds), rtol=0.0, atol=1e-9)
+    return compiled
+
+
 @pytest.mark.parametrize("friction_Nm", [0.2, 2.0])
 def test_a_ball_on_a_fixtures_fixed_base_and_lever_as_the_reference(
     reference_uvms, tmp_path, friction_Nm
@@ -154,15 +170,7 @@ def test_a_ball_on_a_fixtures_fixed_base_and_lever_as_the_reference(
         density_kg_m3=7800.0, water_density_kg_m3=RHO,
     )  # fmt: skip
 
-    def system(compiled: bool) -> System:
-        world = World(reference_uvms, [], free=[ball], fixtures=[lever])
-        return System(Plant(reference_uvms, free_surface=False, world=world), compiled=compiled)
-
-    core = system(True)
-    assert not isinstance(core.compiled, Fallback)
-    compiled = _run(core, reference_uvms, 0.5)
-    reference = _run(system(False), reference_uvms, 0.5)
-    np.testing.assert_allclose(compiled, reference, rtol=0.0, atol=1e-9)
+    compiled = _compiled_as_reference(reference_uvms, [ball], [lever], 0.5)
     ball_z = compiled[:, reference_uvms.nq + 2]
     assert ball_z.min() > -5.0 + 0.025 + 0.05 - 5e-3  # carried: no deeper than the law's sink
     lever_rad = compiled[:, -1]
@@ -211,15 +219,7 @@ def test_a_fixture_falling_on_its_own_as_the_reference(reference_uvms, tmp_path,
         "f", urdf(tmp_path), ([0.0, 0.0, -5.0], [0.3, 0.0, 0.0]), water_density_kg_m3=RHO
     )
 
-    def system(compiled: bool) -> System:
-        world = World(reference_uvms, [], fixtures=[body])
-        return System(Plant(reference_uvms, free_surface=False, world=world), compiled=compiled)
-
-    core = system(True)
-    assert not isinstance(core.compiled, Fallback)
-    compiled = _run(core, reference_uvms, 0.6)
-    reference = _run(system(False), reference_uvms, 0.6)
-    np.testing.assert_allclose(compiled, reference, rtol=0.0, atol=1e-9)
+    compiled = _compiled_as_reference(reference_uvms, [], [body], 0.6)
     joints = compiled[:, reference_uvms.nq :]
     assert np.max(np.abs(joints[-1] - joints[0])) > 1e-3
 
