@@ -27,6 +27,7 @@ void bind_sampled_loop(nb::module_& m);  // loop_bindings.cpp
 void bind_step_derivatives(nb::module_& m);  // step_bindings.cpp
 void bind_system(nb::module_& m);  // system_bindings.cpp
 void bind_robots(nb::module_& m);  // system_bindings.cpp
+void bind_perception(nb::module_& m);  // perception_bindings.cpp
 
 namespace {
 
@@ -590,4 +591,5 @@ NB_MODULE(_core, m) {
   bind_sampled_laws(m);
   bind_ppc(m);
   bind_sampled_loop(m);
+  bind_perception(m);
 }

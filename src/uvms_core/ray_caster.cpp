@@ -1,0 +1,174 @@
+// The ray caster (ray_caster.hpp): bodies at poses, each ray's nearest hit.
+#include "ray_caster.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <string>
+
+namespace uvms::perception {
+
+namespace {
+
+// Whether a ray (world d) from the origin may meet a sphere of `radius` about `to_centre`
+// (centre - origin) nearer than `best`: it passes within the radius, not all behind.
+inline bool may_meet(const Vec3& to_centre, const Vec3& d, double radius, double best) {
+  const double along = d.dot(to_centre);
+  const double across2 = to_centre.dot(to_centre) - along * along;
+  const double reach = radius * (1.0 + 1e-9) + 1e-12;
+  return across2 <= reach * reach && along + reach > 0.0 && along - reach < best;
+}
+
+// A body as one cast sees it: skipped, a plane (its world normal, the origin's height above
+// it), or a solid (the origin in its frame, its centre from the origin, its cones).
+struct Seen {
+  enum { skip, plane, solid } how = skip;
+  Vec3 normal_world = Vec3::Zero();
+  double height_m = 0.0;
+  Vec3 origin_local = Vec3::Zero();
+  Vec3 to_centre = Vec3::Zero();
+  bool bounded = false;
+  bool culled_by_cones = false;
+  std::vector<char> cones;  // the cones that may meet it (when culled_by_cones)
+};
+
+void check_cones(const Cones* cones, Eigen::Index n) {
+  if (cones == nullptr) return;
+  if (cones->count < 0 || cones->starts[0] != 0 || cones->starts[cones->count] != n) {
+    throw InputError("the cones' starts must run from 0 to the number of rays");
+  }
+  for (Eigen::Index j = 0; j < cones->count; ++j) {
+    if (cones->starts[j + 1] < cones->starts[j]) {
+      throw InputError("the cones' starts must not decrease");
+    }
+  }
+}
+
+}  // namespace
+
+int RayCaster::add(RayShape shape, const Mat3& rotation, const Vec3& position_m) {
+  bodies_.push_back({std::move(shape), rotation, position_m});
+  return size() - 1;
+}
+
+void RayCaster::set_pose(int index, const Mat3& rotation, const Vec3& position_m) {
+  if (index < 0 || index >= size()) {
+    throw InputError("no body " + std::to_string(index) + " in the caster (it has " +
+                     std::to_string(size()) + ")");
+  }
+  bodies_[index].rotation = rotation;
+  bodies_[index].position_m = position_m;
+}
+
+bool RayCaster::cones_toward(const Cones& cones, const Vec3& to_centre_f, double radius,
+                             std::vector<char>& seen) {
+  const double distance = to_centre_f.norm();
+  if (distance <= radius * (1.0 + 1e-9)) return false;
+  const double seen_within = std::asin(std::min(1.0, radius / distance)) + 1e-9;
+  const Vec3 toward = to_centre_f / distance;
+  seen.assign(static_cast<std::size_t>(cones.count), 0);
+  for (Eigen::Index j = 0; j < cones.count; ++j) {
+    const Eigen::Map<const Vec3> axis(cones.axes + 3 * j);
+    const double off_axis = std::acos(std::clamp(axis.dot(toward), -1.0, 1.0));
+    seen[j] = off_axis <= cones.half_angle_rad[j] + seen_within;
+  }
+  return true;
+}
+
+void RayCaster::cast(const Vec3& origin, const Mat3& frame_rotation, const double* rays_f,
+                     Eigen::Index n, const Cones* cones, RayHits out) const {
+  check_cones(cones, n);
+  std::vector<Seen> seen(bodies_.size());
+  for (std::size_t k = 0; k < bodies_.size(); ++k) {
+    const Body& body = bodies_[k];
+    Seen& s = seen[k];
+    if (body.shape.kind == ShapeKind::external) continue;  // cast outside the core
+    const Vec3 offset = origin - body.position_m;
+    if (body.shape.kind == ShapeKind::plane) {
+      s.normal_world = body.rotation.col(2);
+      s.height_m = offset.dot(s.normal_world);
+      if (s.height_m > 0.0) s.how = Seen::plane;  // else behind it: seen from its front only
+      continue;
+    }
+    s.origin_local = body.rotation.transpose() * offset;
+    if (body.shape.contains(s.origin_local)) continue;  // from inside a solid: not seen
+    s.how = Seen::solid;
+    s.to_centre = -offset;
+    s.bounded = std::isfinite(body.shape.bound_radius_m);
+    if (s.bounded && cones != nullptr) {
+      s.culled_by_cones = cones_toward(*cones, frame_rotation.transpose() * s.to_centre,
+                                       body.shape.bound_radius_m, s.cones);
+    }
+  }
+  const Eigen::Index groups = cones == nullptr ? 1 : cones->count;
+  std::vector<int> active;
+  active.reserve(bodies_.size());
+  for (Eigen::Index j = 0; j < groups; ++j) {
+    active.clear();
+    for (std::size_t k = 0; k < bodies_.size(); ++k) {
+      const Seen& s = seen[k];
+      if (s.how == Seen::skip || (s.culled_by_cones && !s.cones[j])) continue;
+      active.push_back(static_cast<int>(k));
+    }
+    const Eigen::Index first = cones == nullptr ? 0 : cones->starts[j];
+    const Eigen::Index last = cones == nullptr ? n : cones->starts[j + 1];
+    for (Eigen::Index i = first; i < last; ++i) {
+      const Vec3 d = frame_rotation * Eigen::Map<const Vec3>(rays_f + 3 * i);
+      double best = kInf;
+      Vec3 normal = Vec3::Zero();
+      int label = 0;
+      for (const int k : active) {
+        const Seen& s = seen[k];
+        if (s.how == Seen::plane) {
+          const double t = RayShape::plane_along(s.height_m, d.dot(s.normal_world));
+          if (t < best) {
+            best = t;
+            normal = s.normal_world;
+            label = k + 1;
+          }
+          continue;
+        }
+        const Body& body = bodies_[k];
+        if (s.bounded && !may_meet(s.to_centre, d, body.shape.bound_radius_m, best)) continue;
+        const RayHit hit = body.shape.hit(s.origin_local, body.rotation.transpose() * d);
+        if (hit.t < best) {
+          best = hit.t;
+          normal = body.rotation * hit.normal;
+          label = k + 1;
+        }
+      }
+      out.range_m[i] = best;
+      Eigen::Map<Vec3>(out.normal_world + 3 * i) = normal;
+      out.label[i] = label;
+    }
+  }
+}
+
+std::vector<std::int64_t> RayCaster::rays_toward(int index, const Vec3& origin,
+                                                 const Mat3& frame_rotation,
+                                                 const double* rays_f, Eigen::Index n,
+                                                 const Cones* cones,
+                                                 const double* range_m) const {
+  check_cones(cones, n);
+  const Body& body = bodies_.at(index);
+  std::vector<std::int64_t> rows;
+  const Vec3 to_centre = body.position_m - origin;
+  if (body.shape.contains(body.rotation.transpose() * -to_centre)) return rows;
+  const double radius = body.shape.bound_radius_m;
+  const bool bounded = std::isfinite(radius);
+  std::vector<char> within;
+  const bool culled = bounded && cones != nullptr &&
+                      cones_toward(*cones, frame_rotation.transpose() * to_centre, radius, within);
+  const Eigen::Index groups = cones == nullptr ? 1 : cones->count;
+  for (Eigen::Index j = 0; j < groups; ++j) {
+    if (culled && !within[j]) continue;
+    const Eigen::Index first = cones == nullptr ? 0 : cones->starts[j];
+    const Eigen::Index last = cones == nullptr ? n : cones->starts[j + 1];
+    for (Eigen::Index i = first; i < last; ++i) {
+      const Vec3 d = frame_rotation * Eigen::Map<const Vec3>(rays_f + 3 * i);
+      if (!bounded || may_meet(to_centre, d, radius, range_m[i])) rows.push_back(i);
+    }
+  }
+  return rows;
+}
+
+}  // namespace uvms::perception
