@@ -21,6 +21,7 @@ import numpy as np
 from uvms_pin.errors import ParameterError
 from uvms_pin.perception import sensor
 from uvms_pin.perception.caster import Bundles
+from uvms_pin.perception.compiled_camera import CompiledPixels
 from uvms_pin.perception.optics import Light, WaterOptics, backscatter, cone_of_cosine
 from uvms_pin.perception.scene import Scene
 
@@ -185,6 +186,13 @@ class Camera(sensor.Mounted):
         for name in robot:
             given.setdefault(name, ROBOT)
         self.reflectance = reflectance_of(scene.names, given, scene.floor_names)
+        #: the same pixels computed in the core, when the scene's caster is compiled
+        self._compiled = None
+        if scene.compiled:
+            self._compiled = CompiledPixels(
+                scene.caster, self._tiled, self._bundles, self.order, self.reflectance,
+                self.optics, spec.lights,
+            )  # fmt: skip
 
     def _untile(self, tiled: np.ndarray) -> np.ndarray:
         """An array (H W, ...) in tile order, in image order: a transposition of blocks when
@@ -207,6 +215,26 @@ class Camera(sensor.Mounted):
         """The image of the scene as it stands."""
         spec = self.spec
         rotation, position = self.pose()
+        if self._compiled is not None:
+            depth, normal, label, radiance = self._compiled.pixels(position, rotation)
+        else:
+            depth, normal, label, radiance = self._pixels(position, rotation)
+        counts = 255.0 * spec.exposure * radiance
+        if spec.noise_counts > 0.0:
+            counts += spec.noise_counts * self.rng.standard_normal(counts.shape, np.float32)
+        rgb = np.clip(np.rint(counts, out=counts), 0, 255, out=counts).astype(np.uint8)
+        shape = (spec.height, spec.width)
+        return Frame(
+            depth.reshape(shape),
+            normal.reshape(*shape, 3),
+            label.reshape(shape),
+            radiance.reshape(*shape, 3),
+            rgb.reshape(*shape, 3),
+        )
+
+    def _pixels(self, position, rotation) -> tuple[np.ndarray, ...]:
+        """(depth (H W,) [m], normal (H W, 3), label (H W,), radiance (H W, 3)) in image
+        order, from the optical frame at (``rotation``, ``position``): the reference."""
         directions = self._tiled @ rotation.T  # tile by tile: the caster culls whole tiles
         hits = self.scene.caster.cast(position, directions, self._bundles.rotated(rotation))
         radiance = np.empty_like(directions)
@@ -217,21 +245,9 @@ class Camera(sensor.Mounted):
                 hits.range_m[part], hits.normal_world[part], hits.label[part],
             )  # fmt: skip
         untile = self._untile
-        shape = (spec.height, spec.width)
         range_m = untile(hits.range_m)
         depth = np.where(np.isfinite(range_m), range_m * self.rays[:, 2], np.nan)
-        radiance = untile(radiance)
-        counts = 255.0 * spec.exposure * radiance
-        if spec.noise_counts > 0.0:
-            counts += spec.noise_counts * self.rng.standard_normal(counts.shape, np.float32)
-        rgb = np.clip(np.rint(counts, out=counts), 0, 255, out=counts).astype(np.uint8)
-        return Frame(
-            depth.reshape(shape),
-            untile(hits.normal_world).reshape(*shape, 3),
-            untile(hits.label).reshape(shape),
-            radiance.reshape(*shape, 3),
-            rgb.reshape(*shape, 3),
-        )
+        return depth, untile(hits.normal_world), untile(hits.label), untile(radiance)
 
     def _radiance(self, position, rotation, directions, r, normal, label) -> np.ndarray:
         """I_c (n, 3) of n rays from ``position`` (`uvms_pin.perception.optics`): what they

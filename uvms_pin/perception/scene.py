@@ -25,6 +25,7 @@ import pinocchio as pin
 from uvms_pin.errors import ModelError
 from uvms_pin.model.uvms import UVMS
 from uvms_pin.perception.caster import RayCaster, Shape
+from uvms_pin.perception.compiled_caster import CompiledCaster, caster_for
 from uvms_pin.perception.mesh import TriangleMesh
 from uvms_pin.perception.shapes import (
     Convex,
@@ -93,6 +94,9 @@ class Scene:
         uvms: the robot (its links' collision pieces are seen).
         objects: the fixed objects. free: the free objects (`FreeObject`).
         surface: the free surface z = 0 is seen from below.
+        backend: "core" (the compiled caster, `uvms_pin.perception.compiled_caster`) or
+            "python" (the reference `RayCaster`): chosen here, once, for every sensor of
+            the scene.
     """
 
     def __init__(
@@ -102,9 +106,10 @@ class Scene:
         free: Sequence[Any] = (),
         *,
         surface: bool = True,
+        backend: str = "core",
     ):
         self.uvms = uvms
-        self.caster = RayCaster()
+        self.caster: RayCaster = caster_for(backend)
         self.data = uvms.model.createData()
         add_objects(self.caster, objects)
         if surface:
@@ -123,6 +128,11 @@ class Scene:
         self, pieces: Sequence[RobotPiece], names: Sequence[str]
     ) -> list[tuple[int, RobotPiece]]:
         return [(self.caster.add(names[p.body], shape_of(p.shape)), p) for p in pieces]
+
+    @property
+    def compiled(self) -> bool:
+        """Whether its casts (and its cameras' shading) run in the compiled core."""
+        return isinstance(self.caster, CompiledCaster)
 
     @property
     def names(self) -> list[str]:
@@ -149,9 +159,12 @@ class Scene:
         return self.data.oMf[frame_id]
 
 
-def scene_of(uvms: UVMS, world: Any | None, *, surface: bool = True) -> Scene:
+def scene_of(
+    uvms: UVMS, world: Any | None, *, surface: bool = True, backend: str = "core"
+) -> Scene:
     """The scene of a robot in its world (`uvms_pin.physics.world.world.World`, or None: the
-    robot alone in open water), with the free surface when the water has one."""
+    robot alone in open water), with the free surface when the water has one, cast by
+    ``backend`` (the plant's: "core" or "python")."""
     if world is None:
-        return Scene(uvms, surface=surface)
-    return Scene(uvms, world.objects, world.free, surface=surface)
+        return Scene(uvms, surface=surface, backend=backend)
+    return Scene(uvms, world.objects, world.free, surface=surface, backend=backend)

@@ -185,7 +185,7 @@ def _perceive(rollout: Rollout, scenario: Scenario) -> None:
     plant = scenario.plant
     world = plant.world
     n_objects = len(world.free) if world is not None and "free_objects" in rollout.signals else 0
-    scene = scene_of(plant.uvms, world, surface=plant.free_surface)
+    scene = scene_of(plant.uvms, world, surface=plant.free_surface, backend=plant.backend)
     perceive(rollout, spec, scene, scenario.settings.seed, n_objects)
 
 

@@ -231,7 +231,7 @@ class SensorSuite:
             raise ParameterError(
                 "cameras in the loop fire at the control ticks: set [control] period_s"
             )
-        scene = scene_of(plant.uvms, plant.world, surface=plant.free_surface)
+        scene = scene_of(plant.uvms, plant.world, surface=plant.free_surface, backend=plant.backend)
         self.seeing, self._layout = LoopCameras(cameras, scene, self.seed), layout
         self._free = 0 if plant.world is None else len(plant.world.free)  # fixtures follow
 

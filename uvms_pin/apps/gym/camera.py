@@ -44,7 +44,9 @@ class CameraObservation(gym.ObservationWrapper):
             "lower the camera's width and height",
         )
         plant = env.unwrapped.scenario.plant
-        self._scene = scene_of(plant.uvms, plant.world, surface=plant.free_surface)
+        self._scene = scene_of(
+            plant.uvms, plant.world, surface=plant.free_surface, backend=plant.backend
+        )
         self._camera = Camera(camera, self._scene, _episode_stream(None))
         self._depth = depth
         spaces = {

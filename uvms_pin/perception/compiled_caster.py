@@ -1,0 +1,145 @@
+"""The ray caster in the compiled core: `RayCaster`'s counterpart, the same hits faster.
+
+`CompiledCaster` is a `RayCaster` (the Python reference keeps every body and pose, and casts
+rays of many origins) whose casts from one origin run in the core (``_core.RayCaster``,
+src/uvms_core/ray_caster.cpp, the same formulas as `uvms_pin.perception.shapes`): the
+analytic shapes (plane, sphere, ellipsoid, convex polytope, cylinder) there, ray by ray over
+the bodies whose bounding sphere the ray's cone may meet. Any other shape (a triangle mesh)
+is an external body the core only bounds: the core gives the rays that may meet it nearer
+than what they met, and the shape's own ``hit`` (Embree for a mesh, in one batch) casts
+them, a nearer hit replacing the core's. Measured (benchmarks/bench_perception.py): a
+320 x 240 image's casts in the core take a few milliseconds, the rock mesh's rays in Embree
+a fraction of one, so the meshes stay on Embree (single precision, as in the reference).
+
+The rays may be given in a frame at ``frame_rotation`` (a camera's optical frame), rotated
+in the core: ``cast_from``. Hits agree with `RayCaster.cast`'s to rounding (tests/perception/
+test_compiled_caster.py); on an exact tie between a mesh and an analytic body the analytic
+one is kept (the reference keeps the body added first).
+"""
+
+from __future__ import annotations
+
+from types import ModuleType
+
+import numpy as np
+
+from uvms_pin.perception.caster import Bundles, Hits, RayCaster, Shape
+from uvms_pin.perception.shapes import Convex, Cylinder, Ellipsoid, Plane, Sphere
+from uvms_pin.physics.compiled.backend import Backend, Fallback, backend_named
+
+__all__ = ["CompiledCaster", "caster_for", "cones_of"]
+
+_IDENTITY = np.eye(3)
+
+
+def _add_to_core(core_caster, shape: Shape, rotation: np.ndarray, position: np.ndarray) -> bool:
+    """``shape`` into the core's caster at (R, p); False when it is external (cast here)."""
+    if isinstance(shape, Plane):
+        core_caster.add_plane(rotation, position)
+    elif isinstance(shape, Sphere):
+        core_caster.add_sphere(shape.radius_m, rotation, position)
+    elif isinstance(shape, Ellipsoid):
+        core_caster.add_ellipsoid(np.asarray(shape.semi_axes_m, float), rotation, position)
+    elif isinstance(shape, Cylinder):
+        core_caster.add_cylinder(shape.radius_m, shape.length_m, rotation, position)
+    elif isinstance(shape, Convex):
+        normals = np.ascontiguousarray(shape.normals, dtype=float)
+        offsets = np.ascontiguousarray(shape.offsets, dtype=float)
+        core_caster.add_convex(normals, offsets, shape.bound_radius_m, rotation, position)
+    else:
+        core_caster.add_external(float(shape.bound_radius_m), rotation, position)
+        return False
+    return True
+
+
+def cones_of(bundles: Bundles | None) -> tuple:
+    """The core's cone arguments (axes, half-angles, starts) of ``bundles`` (none: ())."""
+    if bundles is None:
+        return ()
+    return (
+        np.ascontiguousarray(bundles.axes, dtype=float),
+        np.ascontiguousarray(bundles.half_angle_rad, dtype=float),
+        np.ascontiguousarray(bundles.starts, dtype=np.int64),
+    )
+
+
+class CompiledCaster(RayCaster):
+    """A `RayCaster` whose one-origin casts run in ``core`` (the extension module)."""
+
+    def __init__(self, core: ModuleType) -> None:
+        super().__init__()
+        self.core = core  # the extension module (its other perception functions)
+        self._core = core.RayCaster()
+        self._external: list[int] = []  # the bodies cast here (meshes), in order
+
+    def add(self, name: str, shape: Shape, rotation=None, position_m=None) -> int:
+        index = super().add(name, shape, rotation, position_m)
+        rotation, position = self._rotations[index], self._positions[index]
+        if not _add_to_core(self._core, shape, rotation, position):
+            self._external.append(index)
+        return index
+
+    def set_pose(self, index: int, rotation: np.ndarray, position_m: np.ndarray) -> None:
+        self._core.set_pose(index, rotation, position_m)  # checked there, by name
+        super().set_pose(index, rotation, position_m)
+
+    def cast(
+        self,
+        origins_world: np.ndarray,
+        directions_world: np.ndarray,
+        bundles: Bundles | None = None,
+    ) -> Hits:
+        """`RayCaster.cast`: from one origin (3,) in the core, from many by the reference."""
+        origin = np.asarray(origins_world, dtype=float)
+        if origin.ndim != 1:
+            return super().cast(origins_world, directions_world, bundles)
+        return self.cast_from(origin, _IDENTITY, directions_world, cones_of(bundles))
+
+    def cast_from(
+        self,
+        origin_world: np.ndarray,
+        frame_rotation: np.ndarray,
+        rays: np.ndarray,
+        cones: tuple = (),
+    ) -> Hits:
+        """The nearest hit of each ray from ``origin_world`` (3,) along R_f rays[i], ``rays``
+        (n, 3) unit rows in a frame at rotation R_f = ``frame_rotation`` in the world;
+        ``cones``: `cones_of` the rays' `Bundles` in that frame (() for none)."""
+        rays = np.ascontiguousarray(rays, dtype=float)
+        n = len(rays)
+        hits = Hits(np.empty(n), np.empty((n, 3)), np.empty(n, dtype=np.int32))
+        origin = np.asarray(origin_world, dtype=float)
+        self._core.cast(
+            origin, frame_rotation, rays, hits.range_m, hits.normal_world, hits.label, *cones
+        )
+        if self._external:
+            rows = np.empty(n, dtype=np.int64)
+            for k in self._external:
+                self._external_hits(k, origin, frame_rotation, rays, cones, hits, rows)
+        return hits
+
+    def _external_hits(self, k, origin, frame_rotation, rays, cones, hits: Hits, rows) -> None:
+        """Body ``k``'s hits (its own ``hit``) on the rays the core says may meet it nearer
+        than their hits, kept where nearer."""
+        count = self._core.rays_toward(k, origin, frame_rotation, rays, hits.range_m, rows, *cones)
+        if count == 0:
+            return
+        picked = rows[:count]
+        d = rays[picked] @ frame_rotation.T
+        rotation, position = self._rotations[k], self._positions[k]
+        local = np.broadcast_to((origin - position) @ rotation, d.shape)
+        t, n_local = self._shapes[k].hit(local, d @ rotation)
+        nearer = t < hits.range_m[picked]
+        if not np.any(nearer):
+            return
+        where = picked[nearer]
+        hits.range_m[where] = t[nearer]
+        hits.normal_world[where] = n_local[nearer] @ rotation.T
+        hits.label[where] = k + 1
+
+
+def caster_for(backend: str | Backend = "core") -> RayCaster:
+    """The caster a scene computes with, decided once where the scene is built: the
+    `CompiledCaster` for the "core" backend, the reference `RayCaster` for "python"."""
+    built = backend_named(backend).counterpart(CompiledCaster)
+    return RayCaster() if isinstance(built, Fallback) else built
