@@ -46,7 +46,14 @@ struct CameraPixels {
 };
 
 // The cone of a light at the cosine of the angle off its axis: 1 within its half-angle, a
-// smoothstep down to 0 at half-angle + edge, 0 beyond (optics.cone_of_cosine).
+// smoothstep down to 0 at half-angle + edge, 0 beyond (optics.cone_of_cosine); the angle's
+// arccos taken on the edge only.
+struct SpotCone {
+  SpotCone(double half_angle_rad, double edge_rad);
+  double operator()(double cosine) const;
+  double half_angle_rad, edge_rad;
+  double cos_half, cos_outer;  // the cosines of the half-angle and of half-angle + edge
+};
 double cone_of_cosine(double cosine, double half_angle_rad, double edge_rad);
 
 // The pixels of n rays from `origin` along R_f rays_f (the optical frame's unit rows, in the
@@ -56,5 +63,11 @@ void shade(const Vec3& origin, const Mat3& frame_rotation, const double* rays_f,
            const double* range_m, const double* normal_world, const std::int32_t* label,
            const std::int64_t* pixel_of, const double* reflectance, Eigen::Index labels,
            const WaterColour& water, const std::vector<SpotLight>& lights, CameraPixels out);
+
+// The 8-bit counts (n values) of radiance scaled by `scale` (255 times the exposure) plus
+// noise_counts times the standard normal `noise` (single precision; null: none), rounded
+// to the nearest (to even on a tie) and clipped to [0, 255] (Camera.render's).
+void eight_bit(const double* radiance, const float* noise, Eigen::Index n, double scale,
+               double noise_counts, std::uint8_t* rgb);
 
 }  // namespace uvms::perception

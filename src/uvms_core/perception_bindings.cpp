@@ -32,6 +32,8 @@ using Labels = nb::ndarray<std::int32_t, nb::ndim<1>, nb::c_contig, nb::device::
 using InLabels = nb::ndarray<const std::int32_t, nb::ndim<1>, nb::c_contig, nb::device::cpu>;
 using InIndex = nb::ndarray<const std::int64_t, nb::ndim<1>, nb::c_contig, nb::device::cpu>;
 using OutIndex = nb::ndarray<std::int64_t, nb::ndim<1>, nb::c_contig, nb::device::cpu>;
+using Noise = nb::ndarray<const float, nb::ndim<2>, nb::c_contig, nb::device::cpu>;
+using Rgb = nb::ndarray<std::uint8_t, nb::ndim<2>, nb::c_contig, nb::device::cpu>;
 
 void require(bool ok, const std::string& what) {
   if (!ok) throw InputError(what);
@@ -236,4 +238,21 @@ void bind_perception(nb::module_& m) {
       "A camera's pixels from its rays' hits (in the caster's order; ray i is pixel "
       "pixel_of[i]): z-depth (NaN: nothing met), normals, labels and the underwater image "
       "formation model's radiance, written into the outputs (pixel order).");
+
+  m.def(
+      "eight_bit",
+      [](const In2& radiance, double scale, double noise_counts, std::optional<Noise> noise,
+         Rgb rgb) {
+        const auto same = [&radiance](size_t rows, size_t cols) {
+          return rows == radiance.shape(0) && cols == radiance.shape(1);
+        };
+        require(same(rgb.shape(0), rgb.shape(1)), "eight_bit: rgb must have radiance's shape");
+        require(!noise || same(noise->shape(0), noise->shape(1)),
+                "eight_bit: noise must have radiance's shape");
+        eight_bit(radiance.data(), noise ? noise->data() : nullptr,
+                  static_cast<Eigen::Index>(radiance.size()), scale, noise_counts, rgb.data());
+      },
+      "radiance"_a, "scale"_a, "noise_counts"_a, "noise"_a.none(), "rgb"_a,
+      "The 8-bit counts of scale * radiance + noise_counts * noise (float32, or None), "
+      "rounded (to even on a tie) and clipped to [0, 255], written into rgb.");
 }

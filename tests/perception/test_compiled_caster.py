@@ -262,3 +262,27 @@ def test_the_core_refuses_bad_input_by_name():
         core.add_sphere(-1.0, np.eye(3), np.zeros(3))
     core.cast(np.zeros(3), np.eye(3), d, *out)  # and what is right is cast
     np.testing.assert_allclose(out[0], 2.0, atol=TOL)
+
+
+def test_a_firing_records_new_arrays_though_the_compiled_pixels_reuse_their_own(reference_uvms):
+    """`Camera.fire` computes in the camera's buffers: what it returned before is kept, and
+    it equals a new render's (the same noise draws, written into a buffer or not)."""
+    spec = CameraSpec("front", width=48, height=32, rpy_rad=(-1.9, 0.0, -1.5708))
+    scene = _seen(reference_uvms, "core")
+    firing, rendering = (Camera(spec, scene, np.random.default_rng(3)) for _ in range(2))
+    first = firing.fire()
+    kept = {key: value.copy() for key, value in first.items()}
+    q = reference_uvms.neutral_configuration()
+    q[:3] = [0.5, 0.2, -9.3]
+    scene.update(q)
+    second = firing.fire()
+    assert not np.array_equal(second["depth_m"], kept["depth_m"])  # it moved
+    for key in kept:
+        np.testing.assert_array_equal(first[key], kept[key])  # not overwritten
+    q0 = reference_uvms.neutral_configuration()
+    q0[2], q0[7:] = -9.0, q0[7:] + 0.3
+    scene.update(q0)
+    frame = rendering.render()  # the first image again, from a fresh camera of the same seed
+    np.testing.assert_array_equal(frame.rgb, kept["rgb"])
+    np.testing.assert_array_equal(frame.label, kept["label"])
+    np.testing.assert_array_equal(frame.depth_m.astype(np.float32), kept["depth_m"])

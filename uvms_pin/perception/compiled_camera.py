@@ -5,9 +5,9 @@ cones, its rays rotated in the core, a mesh's rays by Embree in between), then s
 ``_core.shade_camera`` (src/uvms_core/camera_shading.cpp): each pixel's z-depth (range times
 the ray's optical z), normal, label and the revised underwater image formation model's
 radiance (`uvms_pin.perception.optics`: daylight, the camera's lights, backscatter), written
-in image order. What stays in Python is per image, not per pixel: the pose, the lights'
-placement, the veiling light; the noise and the 8-bit counts are the camera's own
-(`Camera.render`), the same for both backends. The pixels agree with the reference's to
+in image order; ``_core.eight_bit`` makes the 8-bit counts. What stays in Python is per
+image, not per pixel: the pose, the lights' placement, the veiling light, and the noise,
+drawn by the camera's own generator (`Camera.render`): the same draws for both backends. The pixels agree with the reference's to
 rounding (tests/perception/test_compiled_caster.py).
 """
 
@@ -17,7 +17,7 @@ from typing import Any
 
 import numpy as np
 
-from uvms_pin.perception.caster import Bundles
+from uvms_pin.perception.caster import Bundles, Hits
 from uvms_pin.perception.compiled_caster import cones_of
 from uvms_pin.perception.optics import Light, WaterOptics
 
@@ -50,6 +50,8 @@ class CompiledPixels:
         self.pixel_of = np.ascontiguousarray(pixel_of, dtype=np.int64)
         self.reflectance = np.ascontiguousarray(reflectance, dtype=float)
         self.optics, self.lights = optics, lights
+        n = len(self.rays)  # what the rays met, overwritten by each image
+        self._hits = Hits(np.empty(n), np.empty((n, 3)), np.empty(n, dtype=np.int32))
         self.water = (
             np.asarray(optics.kd_per_m, dtype=float),
             np.asarray(optics.beta_d_per_m, dtype=float),
@@ -57,13 +59,26 @@ class CompiledPixels:
             float(optics.surface_irradiance),
         )
 
-    def pixels(self, position: np.ndarray, rotation: np.ndarray) -> tuple[np.ndarray, ...]:
-        """(depth (H W,) [m], normal (H W, 3), label (H W,), radiance (H W, 3)) in image
-        order, from the optical frame at (``rotation``, ``position``) in the world."""
+    def buffers(self) -> tuple[np.ndarray, ...]:
+        """Arrays for `pixels` to write into (depth, normal, label, radiance) and for the
+        noise (H W, 3) float32."""
         n = len(self.rays)
-        hits = self.caster.cast_from(position, rotation, self.rays, self.cones)
-        depth, normal = np.empty(n), np.empty((n, 3))
-        label, radiance = np.empty(n, dtype=np.int32), np.empty((n, 3))
+        return (
+            np.empty(n),
+            np.empty((n, 3)),
+            np.empty(n, dtype=np.int32),
+            np.empty((n, 3)),
+            np.empty((n, 3), dtype=np.float32),
+        )
+
+    def pixels(
+        self, position: np.ndarray, rotation: np.ndarray, buffers: tuple | None = None
+    ) -> tuple[np.ndarray, ...]:
+        """(depth (H W,) [m], normal (H W, 3), label (H W,), radiance (H W, 3)) in image
+        order, from the optical frame at (``rotation``, ``position``) in the world; written
+        into ``buffers`` (`buffers`), or new arrays."""
+        hits = self.caster.cast_from(position, rotation, self.rays, self.cones, self._hits)
+        depth, normal, label, radiance = (buffers or self.buffers())[:4]
         lights = np.array(
             [
                 [
@@ -84,3 +99,9 @@ class CompiledPixels:
             depth, normal, label, radiance,
         )  # fmt: skip
         return depth, normal, label, radiance
+
+    def eight_bit(self, radiance: np.ndarray, scale: float, noise_counts: float, noise):
+        """`uvms_pin.perception.camera.eight_bit` in the core: the same counts."""
+        rgb = np.empty(radiance.shape, dtype=np.uint8)
+        self.core.eight_bit(radiance, scale, noise_counts, noise, rgb)
+        return rgb

@@ -101,13 +101,15 @@ class CompiledCaster(RayCaster):
         frame_rotation: np.ndarray,
         rays: np.ndarray,
         cones: tuple = (),
+        out: Hits | None = None,
     ) -> Hits:
         """The nearest hit of each ray from ``origin_world`` (3,) along R_f rays[i], ``rays``
         (n, 3) unit rows in a frame at rotation R_f = ``frame_rotation`` in the world;
-        ``cones``: `cones_of` the rays' `Bundles` in that frame (() for none)."""
+        ``cones``: `cones_of` the rays' `Bundles` in that frame (() for none); ``out``: the
+        `Hits` of n rays to overwrite (None: new arrays)."""
         rays = np.ascontiguousarray(rays, dtype=float)
         n = len(rays)
-        hits = Hits(np.empty(n), np.empty((n, 3)), np.empty(n, dtype=np.int32))
+        hits = out or Hits(np.empty(n), np.empty((n, 3)), np.empty(n, dtype=np.int32))
         origin = np.asarray(origin_world, dtype=float)
         self._core.cast(
             origin, frame_rotation, rays, hits.range_m, hits.normal_world, hits.label, *cones

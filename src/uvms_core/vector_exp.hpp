@@ -1,0 +1,25 @@
+// exp over an array, vectorized: the exponentials of a camera's pixels (camera_shading.cpp).
+//
+// exp(x) = 2^k exp(r), k = round(x / ln 2), r = x - k ln 2 in [-ln 2 / 2, ln 2 / 2] (ln 2 in
+// two parts, Cody and Waite, so that r is exact to rounding), exp(r) by its Taylor polynomial
+// of degree 13 (remainder below |r|^14 / 14! < 5e-18), 2^k put in the exponent's bits: within
+// an ulp or two of std::exp (tests/perception/test_compiled_caster.py). The loop has no branch,
+// so the compiler vectorizes it; on x86-64 it is compiled twice, for the baseline (SSE2) and
+// for x86-64-v3 (AVX2, FMA), the processor's picked when the module loads (GCC's
+// target_clones): the build's flags stay the baseline's.
+#pragma once
+
+#include <Eigen/Core>
+
+namespace uvms::perception {
+
+// The smallest and largest exponents taken: exp(-708) = 3.3e-308, the smallest normal double
+// being 2.2e-308; the caller clamps (the camera's exponents are <= 0, exp(-708) standing
+// for the 0 or subnormal std::exp gives below it).
+constexpr double kExpLowest = -708.0;
+constexpr double kExpHighest = 708.0;
+
+// x[i] <- exp(x[i]) for i < n, each x[i] in [kExpLowest, kExpHighest].
+void exp_in_place(double* x, Eigen::Index n);
+
+}  // namespace uvms::perception
