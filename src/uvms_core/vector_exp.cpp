@@ -4,12 +4,6 @@
 #include <cstdint>
 #include <cstring>
 
-#if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__) && defined(__linux__)
-#define UVMS_VECTOR_CLONES __attribute__((target_clones("arch=x86-64-v3", "default")))
-#else
-#define UVMS_VECTOR_CLONES
-#endif
-
 namespace uvms::perception {
 
 UVMS_VECTOR_CLONES

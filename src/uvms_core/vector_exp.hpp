@@ -11,6 +11,14 @@
 
 #include <Eigen/Core>
 
+// A function compiled twice on x86-64 Linux (GCC): for the baseline and for x86-64-v3 (AVX2,
+// FMA), the processor's picked when the module loads; elsewhere once, for the baseline.
+#if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__) && defined(__linux__)
+#define UVMS_VECTOR_CLONES __attribute__((target_clones("arch=x86-64-v3", "default")))
+#else
+#define UVMS_VECTOR_CLONES
+#endif
+
 namespace uvms::perception {
 
 // The smallest and largest exponents taken: exp(-708) = 3.3e-308, the smallest normal double
