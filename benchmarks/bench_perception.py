@@ -7,10 +7,12 @@ The scene: the reference BlueROV2 Heavy + Alpha 5 (its links' collision shapes),
 a seabed plane, with five objects ahead (a sphere, a box, a cylinder, an ellipsoid and the
 rock mesh of scenarios/meshes/rock.obj), the free surface above. Rows:
 
-- camera 320 x 240 and 640 x 480: one image (depth, normals, labels and colour, one light);
-- imaging sonar 256 beams x 512 bins (32 rays per beam); a multibeam profiler of 256
-  beams (4 rays each, looking down: its soundings and water column); the DVL's four beams
-  cast at the seabed and the objects;
+- camera 320 x 240 and 640 x 480: one image (depth, normals, labels and colour, one light),
+  by the compiled caster and shading (the "core" backend, the default) and by the Python
+  reference ("python");
+- imaging sonar 256 beams x 512 bins (32 rays per beam), both backends; a multibeam
+  profiler of 256 beams (4 rays each, looking down: its soundings and water column); the
+  DVL's four beams cast at the seabed and the objects;
 - the ray caster's choice: 76,800 rays against the rock mesh by Embree (``embreex``) and
   by trimesh's pure-Python intersector (``ray_triangle``, rtree);
 - a run of scenarios/seabed_landing.toml (2 s simulated) and of
@@ -75,9 +77,9 @@ def objects() -> list:
 OBJECTS = objects()
 
 
-def scene() -> Scene:
+def scene(backend: str = "core") -> Scene:
     uvms = up.load_uvms(ROOT / "models" / "uvms_bluerov2_alpha5.urdf")
-    out = Scene(uvms, OBJECTS)
+    out = Scene(uvms, OBJECTS, backend=backend)
     q = uvms.neutral_configuration()
     q[2] = -9.0
     out.update(q)
@@ -129,9 +131,10 @@ def main() -> None:
     parser.add_argument("--json", type=Path)
     args = parser.parse_args()
     one_blas_thread()
-    seen = scene()
+    seen, reference = scene("core"), scene("python")
     small, large = camera(seen, 320, 240), camera(seen, 640, 480)
-    fls = Sonar(SonarSpec("fls", rpy_rad=(0, 0.3, 0)), seen, np.random.default_rng(0))
+    fls_spec = SonarSpec("fls", rpy_rad=(0, 0.3, 0))
+    fls = Sonar(fls_spec, seen, np.random.default_rng(0))
     profiler = SonarSpec("mbes", type="multibeam", rays_per_beam=4, rpy_rad=(0, 1.5708, 0))
     mbes = Sonar(profiler, seen, np.random.default_rng(0))
     dvl = Dvl(DvlSpec(beams=4), world_seabed(OBJECTS), np.random.default_rng(0))
@@ -139,7 +142,12 @@ def main() -> None:
     images = {
         "camera 320 x 240": small.render,
         "camera 640 x 480": large.render,
+        "camera 320 x 240, Python reference": camera(reference, 320, 240).render,
+        "camera 640 x 480, Python reference": camera(reference, 640, 480).render,
         "sonar 256 beams x 512 bins": fls.intensity,
+        "sonar 256 beams x 512 bins, Python reference": Sonar(
+            fls_spec, reference, np.random.default_rng(0)
+        ).intensity,
         "multibeam 256 beams": mbes.fire,
         "DVL four beams": lambda: dvl.measure(position, np.zeros(3), level),
         **rays_against_the_rock(),

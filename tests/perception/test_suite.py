@@ -96,3 +96,39 @@ def test_images_that_would_not_fit_in_memory_are_refused_before_the_run():
     scenario = _scenario({"camera": [huge]}, duration_s=100.0)
     with pytest.raises(ParameterError, match=r"images of front.*lower their rate_hz"):
         simulate(scenario, progress=False)
+
+
+def test_the_sensors_are_cast_on_the_plants_backend_with_the_same_images(monkeypatch):
+    """`simulate` builds the sensors' scene once, on the plant's backend ([integrator]
+    backend); the compiled caster's images are the Python reference's over the same log."""
+    import uvms_pin.sim.run as run
+    from uvms_pin.perception.scene import scene_of
+    from uvms_pin.perception.suite import perceive
+
+    built = []
+
+    def spy(*args, **kwargs):
+        scene = scene_of(*args, **kwargs)
+        built.append(scene.compiled)
+        return scene
+
+    monkeypatch.setattr(run, "scene_of", spy)
+    sensors = {"camera": [CAMERA], "sonar": [SONAR]}
+    rollout = simulate(_scenario(sensors), progress=False)
+    raw = read_toml(SEABED, ScenarioError)
+    raw["scenario"].update(duration_s=0.04, seed=7)
+    raw["integrator"]["backend"] = "python"
+    raw["sensors"] = copy.deepcopy(sensors)
+    simulate(scenario_from_dict(raw, SEABED), progress=False)
+    assert built == [True, False]
+    compiled = {name: dict(images) for name, images in rollout.perception.items()}
+    scenario = _scenario(sensors)
+    plant = scenario.plant
+    reference = scene_of(plant.uvms, plant.world, surface=plant.free_surface, backend="python")
+    perceive(rollout, scenario.sensor_config.perception, reference, 7)
+    camera, sonar = rollout.perception["front"], rollout.perception["fls"]
+    np.testing.assert_array_equal(compiled["front"]["rgb"], camera["rgb"])
+    np.testing.assert_array_equal(compiled["front"]["label"], camera["label"])
+    np.testing.assert_allclose(compiled["front"]["depth_m"], camera["depth_m"], rtol=1e-6)
+    np.testing.assert_allclose(compiled["fls"]["intensity"], sonar["intensity"], rtol=1e-5)
+    assert sonar["intensity"].max() > 0.0
