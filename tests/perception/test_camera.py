@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+import sys
 
 import numpy as np
 import pytest
@@ -16,8 +17,18 @@ from uvms_pin.physics.world.objects import plane, solid
 DEPTH_M = 5.0  # the vehicle's depth below the surface
 
 
+#: the scene's backend, set for each test by `_both_backends`
+BACKEND = "core"
+
+
+@pytest.fixture(autouse=True, params=["core", "python"])
+def _both_backends(request, monkeypatch):
+    """Every test on the compiled caster and on the Python reference."""
+    monkeypatch.setattr(sys.modules[__name__], "BACKEND", request.param)
+
+
 def _scene(uvms, objects) -> Scene:
-    scene = Scene(uvms, objects)
+    scene = Scene(uvms, objects, backend=BACKEND)
     q = uvms.neutral_configuration()
     q[:3] = [0.0, 0.0, -DEPTH_M]
     scene.update(q)

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import sys
+
 import numpy as np
 import pytest
 
@@ -10,9 +12,18 @@ from uvms_pin.perception.scene import Scene
 from uvms_pin.perception.sonar import Sonar, SonarSpec
 from uvms_pin.physics.world.objects import plane, solid
 
+#: the scene's backend, set for each test by `_both_backends`
+BACKEND = "core"
+
+
+@pytest.fixture(autouse=True, params=["core", "python"])
+def _both_backends(request, monkeypatch):
+    """Every test on the compiled caster and on the Python reference."""
+    monkeypatch.setattr(sys.modules[__name__], "BACKEND", request.param)
+
 
 def _scene(uvms, objects) -> Scene:
-    scene = Scene(uvms, objects)
+    scene = Scene(uvms, objects, backend=BACKEND)
     q = uvms.neutral_configuration()
     q[:3] = [0.0, 0.0, -20.0]
     scene.update(q)
