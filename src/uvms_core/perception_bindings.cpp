@@ -170,9 +170,9 @@ void bind_perception(nb::module_& m) {
             c.cast(origin, frame_rotation, rays.data(), n, cones ? &*cones : nullptr,
                    {range_m.data(), normal_world.data(), label.data()});
           },
-          "origin_world"_a, "frame_rotation"_a, "rays"_a, "range_m"_a, "normal_world"_a,
-          "label"_a, "cone_axes"_a = nb::none(), "cone_half_angle_rad"_a = nb::none(),
-          "cone_starts"_a = nb::none(),
+          "origin_world"_a, "frame_rotation"_a, "rays"_a, "range_m"_a.noconvert(),
+          "normal_world"_a.noconvert(), "label"_a.noconvert(), "cone_axes"_a = nb::none(),
+          "cone_half_angle_rad"_a = nb::none(), "cone_starts"_a = nb::none(),
           "The nearest hit of each ray from origin_world along frame_rotation @ rays[i] "
           "(unit rows), written into range_m (inf: none), normal_world and label (0: none); "
           "external bodies left out.")
@@ -192,7 +192,8 @@ void bind_perception(nb::module_& m) {
             std::copy(found.begin(), found.end(), rows.data());
             return found.size();
           },
-          "index"_a, "origin_world"_a, "frame_rotation"_a, "rays"_a, "range_m"_a, "rows"_a,
+          "index"_a, "origin_world"_a, "frame_rotation"_a, "rays"_a, "range_m"_a,
+          "rows"_a.noconvert(),
           "cone_axes"_a = nb::none(), "cone_half_angle_rad"_a = nb::none(),
           "cone_starts"_a = nb::none(),
           "The rays that may meet body index nearer than range_m, written into rows; "
@@ -233,8 +234,8 @@ void bind_perception(nb::module_& m) {
       },
       "origin_world"_a, "frame_rotation"_a, "rays"_a, "range_m"_a, "normal_world"_a, "label"_a,
       "pixel_of"_a, "reflectance"_a, "kd_per_m"_a, "beta_d_per_m"_a, "beta_b_per_m"_a,
-      "surface_irradiance"_a, "veiling"_a, "lights"_a, "depth_m"_a, "normal_out"_a,
-      "label_out"_a, "radiance"_a,
+      "surface_irradiance"_a, "veiling"_a, "lights"_a, "depth_m"_a.noconvert(),
+      "normal_out"_a.noconvert(), "label_out"_a.noconvert(), "radiance"_a.noconvert(),
       "A camera's pixels from its rays' hits (in the caster's order; ray i is pixel "
       "pixel_of[i]): z-depth (NaN: nothing met), normals, labels and the underwater image "
       "formation model's radiance, written into the outputs (pixel order).");
@@ -252,7 +253,7 @@ void bind_perception(nb::module_& m) {
         eight_bit(radiance.data(), noise ? noise->data() : nullptr,
                   static_cast<Eigen::Index>(radiance.size()), scale, noise_counts, rgb.data());
       },
-      "radiance"_a, "scale"_a, "noise_counts"_a, "noise"_a.none(), "rgb"_a,
+      "radiance"_a, "scale"_a, "noise_counts"_a, "noise"_a.none(), "rgb"_a.noconvert(),
       "The 8-bit counts of scale * radiance + noise_counts * noise (float32, or None), "
       "rounded (to even on a tie) and clipped to [0, 255], written into rgb.");
 }

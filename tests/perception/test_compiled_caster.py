@@ -286,3 +286,13 @@ def test_a_firing_records_new_arrays_though_the_compiled_pixels_reuse_their_own(
     np.testing.assert_array_equal(frame.rgb, kept["rgb"])
     np.testing.assert_array_equal(frame.label, kept["label"])
     np.testing.assert_array_equal(frame.depth_m.astype(np.float32), kept["depth_m"])
+
+
+def test_an_output_of_another_dtype_is_refused_not_written_into_a_copy():
+    compiled = caster_for("core")
+    compiled.add("ball", Sphere(1.0), np.eye(3), [3.0, 0.0, 0.0])
+    d = np.tile([1.0, 0.0, 0.0], (4, 1))
+    with pytest.raises(TypeError):  # int64 labels: the core would write a temporary
+        compiled._core.cast(
+            np.zeros(3), np.eye(3), d, np.empty(4), np.empty((4, 3)), np.empty(4, dtype=np.int64)
+        )
