@@ -29,6 +29,7 @@ import numpy as np
 from uvms_pin.perception.caster import Bundles, Hits, RayCaster, Shape
 from uvms_pin.perception.shapes import Convex, Cylinder, Ellipsoid, Plane, Sphere
 from uvms_pin.physics.compiled.backend import Backend, Fallback, backend_named
+from uvms_pin.physics.compiled.ray_caster import ray_caster
 
 __all__ = ["CompiledCaster", "caster_for", "cones_of"]
 
@@ -72,7 +73,7 @@ class CompiledCaster(RayCaster):
     def __init__(self, core: ModuleType) -> None:
         super().__init__()
         self.core = core  # the extension module (its other perception functions)
-        self._core = core.RayCaster()
+        self._core = ray_caster(core)
         self._external: list[int] = []  # the bodies cast here (meshes), in order
 
     def add(self, name: str, shape: Shape, rotation=None, position_m=None) -> int:
