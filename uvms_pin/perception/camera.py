@@ -145,8 +145,8 @@ def pixel_rays(spec: CameraSpec) -> np.ndarray:
     u = (np.arange(spec.width) + 0.5 - 0.5 * spec.width) / f
     v = (np.arange(spec.height) + 0.5 - 0.5 * spec.height) / f
     x, y = np.meshgrid(u, v)
-    rays = np.column_stack([x.ravel(), y.ravel(), np.ones(x.size)])
-    return rays / np.linalg.norm(rays, axis=1, keepdims=True)
+    length = np.sqrt(x * x + y * y + 1.0).ravel()  # |(x, y, 1)|, summed in that order
+    return np.column_stack([x.ravel() / length, y.ravel() / length, 1.0 / length])
 
 
 def tiles(spec: CameraSpec) -> tuple[np.ndarray, np.ndarray]:
@@ -155,7 +155,8 @@ def tiles(spec: CameraSpec) -> tuple[np.ndarray, np.ndarray]:
     v, u = np.divmod(np.arange(spec.width * spec.height), spec.width)
     across = -(-spec.width // TILE_PX)
     tile = (v // TILE_PX) * across + u // TILE_PX
-    order = np.argsort(tile, kind="stable")
+    # a stable sort of small integers: numpy's radix sort (linear) for 16 bits
+    order = np.argsort(tile.astype(np.uint16) if tile[-1] < 2**16 else tile, kind="stable")
     counts = np.bincount(tile)
     return order, np.concatenate([[0], np.cumsum(counts[counts > 0])])
 
@@ -187,7 +188,8 @@ class Camera(sensor.Mounted):
         self.rays = pixel_rays(spec)
         self.order, starts = tiles(spec)
         self._tiled = self.rays[self.order]
-        self._untiled = np.argsort(self.order)  # tile order -> image order
+        self._untiled = np.empty_like(self.order)  # tile order -> image order: the inverse
+        self._untiled[self.order] = np.arange(len(self.order))
         self._bundles = Bundles.of(self._tiled, starts)
         self.optics = spec.optics
         robot = set(scene.robot_names)
