@@ -10,7 +10,7 @@ than what they met, and the shape's own ``hit`` (Embree for a mesh, in one batch
 them, a nearer hit replacing the core's. Measured (benchmarks/bench_perception.py's scene,
 one core): a 320 x 240 image's casts take 3.3 ms (2.3 ms in the core, the rock's rays in
 Embree the rest), 12.3 ms by the reference; Embree takes about 0.1 us a ray, glue included
-(7.4 ms for 76,800 rays against the rock), which a scalar bounding-volume hierarchy of our
+(7.2 ms for 76,800 rays against the rock), which a scalar bounding-volume hierarchy of our
 own would hardly beat (not measured): the meshes stay on Embree (single precision, as in
 the reference).
 
