@@ -33,6 +33,8 @@ using InLabels = nb::ndarray<const std::int32_t, nb::ndim<1>, nb::c_contig, nb::
 using InIndex = nb::ndarray<const std::int64_t, nb::ndim<1>, nb::c_contig, nb::device::cpu>;
 using OutIndex = nb::ndarray<std::int64_t, nb::ndim<1>, nb::c_contig, nb::device::cpu>;
 using Noise = nb::ndarray<const float, nb::ndim<2>, nb::c_contig, nb::device::cpu>;
+using Out2f = nb::ndarray<float, nb::ndim<2>, nb::c_contig, nb::device::cpu>;
+using In1f = nb::ndarray<const float, nb::ndim<1>, nb::c_contig, nb::device::cpu>;
 using Rgb = nb::ndarray<std::uint8_t, nb::ndim<2>, nb::c_contig, nb::device::cpu>;
 
 void require(bool ok, const std::string& what) {
@@ -197,7 +199,60 @@ void bind_perception(nb::module_& m) {
           "cone_axes"_a = nb::none(), "cone_half_angle_rad"_a = nb::none(),
           "cone_starts"_a = nb::none(),
           "The rays that may meet body index nearer than range_m, written into rows; "
-          "their count.");
+          "their count.")
+      .def(
+          "mesh_rays",
+          [](const RayCaster& c, int index, const Vec3& origin, const Mat3& frame_rotation,
+             const In2& rays, const In1& range_m, OutIndex rows, Out2f origins_local,
+             Out2f directions_local, std::optional<In2> cone_axes,
+             std::optional<In1> cone_half_angle_rad, std::optional<InIndex> cone_starts) {
+            const Eigen::Index n = rows3(rays, "rays");
+            const auto sized = [n](size_t size) { return size == static_cast<size_t>(n); };
+            require(index >= 0 && index < c.size(), "mesh_rays: no such body");
+            require(sized(range_m.shape(0)) && sized(rows.shape(0)) &&
+                        sized(origins_local.shape(0)) && origins_local.shape(1) == 3 &&
+                        sized(directions_local.shape(0)) && directions_local.shape(1) == 3,
+                    "mesh_rays: range_m (n,), rows (n,), origins and directions (n, 3)");
+            const auto cones = ConeArgs{cone_axes, cone_half_angle_rad, cone_starts}.view();
+            return c.mesh_rays(index, origin, frame_rotation, rays.data(), n,
+                               cones ? &*cones : nullptr, range_m.data(), rows.data(),
+                               origins_local.data(), directions_local.data());
+          },
+          "index"_a, "origin_world"_a, "frame_rotation"_a, "rays"_a, "range_m"_a,
+          "rows"_a.noconvert(), "origins_local"_a.noconvert(), "directions_local"_a.noconvert(),
+          "cone_axes"_a = nb::none(), "cone_half_angle_rad"_a = nb::none(),
+          "cone_starts"_a = nb::none(),
+          "rays_toward's rays into rows, with their origins and directions in the body's "
+          "frame (float32) for a mesh's caster; their count.")
+      .def(
+          "merge_mesh_hits",
+          [](const RayCaster& c, int index, const Mat3& frame_rotation, const In2& rays,
+             const InIndex& rows, const In1f& range_t, const InLabels& triangle,
+             const In2& normals_local, Out1 range_m, Out2 normal_world, Labels label) {
+            const Eigen::Index n = rows3(rays, "rays");
+            const auto count = static_cast<Eigen::Index>(rows.shape(0));
+            require(index >= 0 && index < c.size(), "merge_mesh_hits: no such body");
+            require(range_t.shape(0) == rows.shape(0) && triangle.shape(0) == rows.shape(0),
+                    "merge_mesh_hits: rows, range_t and triangle must have one length");
+            require(normals_local.shape(1) == 3, "merge_mesh_hits: normals_local (f, 3)");
+            require(range_m.shape(0) == static_cast<size_t>(n) &&
+                        normal_world.shape(0) == static_cast<size_t>(n) &&
+                        normal_world.shape(1) == 3 && label.shape(0) == static_cast<size_t>(n),
+                    "merge_mesh_hits: range_m (n,), normal_world (n, 3), label (n,)");
+            for (Eigen::Index j = 0; j < count; ++j) {
+              require(rows.data()[j] >= 0 && rows.data()[j] < n, "merge_mesh_hits: a row is "
+                                                                  "not one of the rays");
+            }
+            c.merge_mesh_hits(index, frame_rotation, rays.data(), rows.data(), count,
+                              range_t.data(), triangle.data(), normals_local.data(),
+                              static_cast<Eigen::Index>(normals_local.shape(0)),
+                              {range_m.data(), normal_world.data(), label.data()});
+          },
+          "index"_a, "frame_rotation"_a, "rays"_a, "rows"_a, "range_t"_a, "triangle"_a,
+          "normals_local"_a, "range_m"_a.noconvert(), "normal_world"_a.noconvert(),
+          "label"_a.noconvert(),
+          "A mesh caster's hits (range_t, triangle: -1 none) of mesh_rays' rows kept where "
+          "on a triangle's front and nearer than range_m (TriangleMesh.hit's rule).");
 
   m.def(
       "shade_camera",

@@ -171,4 +171,47 @@ std::vector<std::int64_t> RayCaster::rays_toward(int index, const Vec3& origin,
   return rows;
 }
 
+Eigen::Index RayCaster::mesh_rays(int index, const Vec3& origin, const Mat3& frame_rotation,
+                                  const double* rays_f, Eigen::Index n, const Cones* cones,
+                                  const double* range_m, std::int64_t* rows, float* origins_local,
+                                  float* directions_local) const {
+  const std::vector<std::int64_t> found =
+      rays_toward(index, origin, frame_rotation, rays_f, n, cones, range_m);
+  const Body& body = bodies_.at(index);
+  const Vec3 origin_local = body.rotation.transpose() * (origin - body.position_m);
+  const Mat3 to_local = body.rotation.transpose() * frame_rotation;
+  for (std::size_t j = 0; j < found.size(); ++j) {
+    rows[j] = found[j];
+    const Vec3 d = to_local * Eigen::Map<const Vec3>(rays_f + 3 * found[j]);
+    for (int c = 0; c < 3; ++c) {
+      origins_local[3 * j + c] = static_cast<float>(origin_local[c]);
+      directions_local[3 * j + c] = static_cast<float>(d[c]);
+    }
+  }
+  return static_cast<Eigen::Index>(found.size());
+}
+
+void RayCaster::merge_mesh_hits(int index, const Mat3& frame_rotation, const double* rays_f,
+                                const std::int64_t* rows, Eigen::Index count,
+                                const float* range_t, const std::int32_t* triangle,
+                                const double* normals_local, Eigen::Index triangles,
+                                RayHits out) const {
+  const Body& body = bodies_.at(index);
+  const Mat3 to_local = body.rotation.transpose() * frame_rotation;
+  for (Eigen::Index j = 0; j < count; ++j) {
+    const std::int32_t k = triangle[j];
+    if (k < 0) continue;  // nothing met
+    if (k >= triangles) throw InputError("a mesh hit's triangle is not one of the mesh's");
+    const std::int64_t i = rows[j];
+    const Eigen::Map<const Vec3> normal(normals_local + 3 * k);
+    const Vec3 d = to_local * Eigen::Map<const Vec3>(rays_f + 3 * i);
+    if (!(normal.dot(d) < 0.0)) continue;  // its back: from inside a closed mesh
+    const double t = static_cast<double>(range_t[j]);
+    if (!(t > kTMinM) || !(t < out.range_m[i])) continue;
+    out.range_m[i] = t;
+    Eigen::Map<Vec3>(out.normal_world + 3 * i) = body.rotation * normal;
+    out.label[i] = index + 1;
+  }
+}
+
 }  // namespace uvms::perception

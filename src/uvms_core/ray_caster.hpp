@@ -63,6 +63,22 @@ class RayCaster {
                                         Eigen::Index n, const Cones* cones,
                                         const double* range_m) const;
 
+  // rays_toward's rays, and each one's origin and direction in the body's frame (single
+  // precision, as a triangle mesh's caster takes them: (count, 3) row-major each); their count.
+  Eigen::Index mesh_rays(int index, const Vec3& origin, const Mat3& frame_rotation,
+                         const double* rays_f, Eigen::Index n, const Cones* cones,
+                         const double* range_m, std::int64_t* rows, float* origins_local,
+                         float* directions_local) const;
+
+  // What a mesh's caster found for mesh_rays' `count` rays: each one's range t (single
+  // precision) and triangle (-1: none), the triangles' outward unit normals in the body's frame
+  // (triangles, 3); a hit is kept when it is on a triangle's front (n . d < 0), beyond the
+  // least range, and nearer than what its ray met (`out`, updated). TriangleMesh.hit's rule.
+  void merge_mesh_hits(int index, const Mat3& frame_rotation, const double* rays_f,
+                       const std::int64_t* rows, Eigen::Index count, const float* range_t,
+                       const std::int32_t* triangle, const double* normals_local,
+                       Eigen::Index triangles, RayHits out) const;
+
  private:
   struct Body {
     RayShape shape;

@@ -15,7 +15,8 @@
 // - cylinder (radius r, length L along z): x^2 + y^2 <= r^2 and the slab |z| <= L / 2.
 //
 // An `external` body (a triangle mesh) is cast outside the core (Embree, from Python): the
-// core only knows its bounding sphere.
+// core knows its bounding sphere, picks its rays and keeps its hits (RayCaster::mesh_rays,
+// merge_mesh_hits).
 #pragma once
 
 #include <Eigen/Core>

@@ -6,8 +6,10 @@ src/uvms_core/ray_caster.cpp, the same formulas as `uvms_pin.perception.shapes`)
 analytic shapes (plane, sphere, ellipsoid, convex polytope, cylinder) there, ray by ray over
 the bodies whose bounding sphere the ray's cone may meet. Any other shape (a triangle mesh)
 is an external body the core only bounds: the core gives the rays that may meet it nearer
-than what they met, and the shape's own ``hit`` (Embree for a mesh, in one batch) casts
-them, a nearer hit replacing the core's. Measured (benchmarks/bench_perception.py's scene,
+than what they met and a nearer hit replaces the core's. A mesh's rays are put in its frame
+by the core (single precision), cast by Embree in one batch (`TriangleMesh.first_hits`),
+and its front hits kept by the core (`TriangleMesh.hit`'s rule); any other shape's by its
+own ``hit``. Measured (benchmarks/bench_perception.py's scene,
 one core): a 320 x 240 image's casts take 3.3 ms (2.3 ms in the core, the rock's rays in
 Embree the rest), 12.3 ms by the reference; Embree takes about 0.1 us a ray, glue included
 (7.2 ms for 76,800 rays against the rock), which a scalar bounding-volume hierarchy of our
@@ -27,6 +29,7 @@ from types import ModuleType
 import numpy as np
 
 from uvms_pin.perception.caster import Bundles, Hits, RayCaster, Shape
+from uvms_pin.perception.mesh import TriangleMesh
 from uvms_pin.perception.shapes import Convex, Cylinder, Ellipsoid, Plane, Sphere
 from uvms_pin.physics.compiled.backend import Backend, Fallback, backend_named
 from uvms_pin.physics.compiled.ray_caster import ray_caster
@@ -75,6 +78,7 @@ class CompiledCaster(RayCaster):
         self.core = core  # the extension module (its other perception functions)
         self._core = ray_caster(core)
         self._external: list[int] = []  # the bodies cast here (meshes), in order
+        self._scratch: tuple[np.ndarray, ...] | None = None  # `_buffers`
 
     def add(self, name: str, shape: Shape, rotation=None, position_m=None) -> int:
         index = super().add(name, shape, rotation, position_m)
@@ -118,15 +122,44 @@ class CompiledCaster(RayCaster):
         self._core.cast(
             origin, frame_rotation, rays, hits.range_m, hits.normal_world, hits.label, *cones
         )
-        if self._external:
-            rows = np.empty(n, dtype=np.int64)
-            for k in self._external:
-                self._external_hits(k, origin, frame_rotation, rays, cones, hits, rows)
+        for k in self._external:
+            if isinstance(self._shapes[k], TriangleMesh):
+                self._mesh_hits(k, origin, frame_rotation, rays, cones, hits)
+            else:
+                self._external_hits(k, origin, frame_rotation, rays, cones, hits)
         return hits
 
-    def _external_hits(self, k, origin, frame_rotation, rays, cones, hits: Hits, rows) -> None:
+    def _buffers(self, n: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """(rows (n,), origins (n, 3) float32, directions (n, 3) float32) for n rays, kept
+        for the next cast of as many (a camera's)."""
+        if self._scratch is None or len(self._scratch[0]) != n:
+            self._scratch = (
+                np.empty(n, dtype=np.int64),
+                np.empty((n, 3), dtype=np.float32),
+                np.empty((n, 3), dtype=np.float32),
+            )
+        return self._scratch
+
+    def _mesh_hits(self, k, origin, frame_rotation, rays, cones, hits: Hits) -> None:
+        """Mesh ``k``'s hits: the core picks its rays and puts them in its frame, Embree casts
+        them (`TriangleMesh.first_hits`), the core keeps the nearer front hits."""
+        rows, origins, directions = self._buffers(len(rays))
+        count = self._core.mesh_rays(
+            k, origin, frame_rotation, rays, hits.range_m, rows, origins, directions, *cones
+        )
+        if count == 0:
+            return
+        mesh = self._shapes[k]
+        t, triangle = mesh.first_hits(origins[:count], directions[:count])
+        self._core.merge_mesh_hits(
+            k, frame_rotation, rays, rows[:count], t, triangle, mesh.normals,
+            hits.range_m, hits.normal_world, hits.label,
+        )  # fmt: skip
+
+    def _external_hits(self, k, origin, frame_rotation, rays, cones, hits: Hits) -> None:
         """Body ``k``'s hits (its own ``hit``) on the rays the core says may meet it nearer
         than their hits, kept where nearer."""
+        rows = self._buffers(len(rays))[0]
         count = self._core.rays_toward(k, origin, frame_rotation, rays, hits.range_m, rows, *cones)
         if count == 0:
             return

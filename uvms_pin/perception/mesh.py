@@ -38,18 +38,26 @@ class TriangleMesh:
         self._normals = normals / np.where(length > 0.0, length, 1.0)
         self.bound_radius_m = float(np.max(np.linalg.norm(vertices, axis=1)))
 
+    @property
+    def normals(self) -> np.ndarray:
+        """The triangles' outward unit normals (f, 3), in the mesh's frame."""
+        return self._normals
+
+    def first_hits(self, o32: np.ndarray, d32: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Embree's first hit of each ray o + t d (contiguous float32 (n, 3), the mesh's
+        frame): (t (n,) float32, its triangle (n,) int32, -1 for none), either side."""
+        out = self._scene.run(o32, d32, output=1)
+        return out["tfar"], np.where(out["geomID"] >= 0, out["primID"], -1).astype(np.int32)
+
     def hit(self, o: np.ndarray, d: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         n = len(o)
         if n == 0:
             return np.full(0, np.inf), np.zeros((0, 3))
-        out = self._scene.run(
-            np.ascontiguousarray(o, dtype=np.float32),
-            np.ascontiguousarray(d, dtype=np.float32),
-            output=1,
+        tfar, triangle = self.first_hits(
+            np.ascontiguousarray(o, dtype=np.float32), np.ascontiguousarray(d, dtype=np.float32)
         )
-        triangle = out["primID"]
-        met = (out["geomID"] >= 0) & (triangle >= 0)
+        met = triangle >= 0
         normal = self._normals[np.where(met, triangle, 0)]
         front = met & (np.einsum("ij,ij->i", normal, d) < 0.0)
-        t = np.where(front, out["tfar"].astype(float), np.inf)
+        t = np.where(front, tfar.astype(float), np.inf)
         return np.where(t > T_MIN_M, t, np.inf), normal
