@@ -12,7 +12,7 @@ and its front hits kept by the core (`TriangleMesh.hit`'s rule); any other shape
 own ``hit``. Measured (benchmarks/bench_perception.py's scene,
 one core): a 320 x 240 image's casts take 3.3 ms (2.3 ms in the core, the rock's rays in
 Embree the rest), 12.3 ms by the reference; Embree takes about 0.1 us a ray, glue included
-(7.2 ms for 76,800 rays against the rock), which a scalar bounding-volume hierarchy of our
+(7.5 ms for 76,800 rays against the rock), which a scalar bounding-volume hierarchy of our
 own would hardly beat (not measured): the meshes stay on Embree (single precision, as in
 the reference).
 
