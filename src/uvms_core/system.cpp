@@ -131,16 +131,6 @@ void System::check() const {
     }
     set.pairs.check(model_of(set.a), model_of(set.b));
   }
-  if (rigid_pairs && plant_.joint_coulomb_Nm.size() > 0) {
-    throw InputError(
-        "system: rigid contacts between moving bodies with the joints' Coulomb friction are "
-        "the Python reference's (solved with those rows in one problem)");
-  }
-  if (rigid_pairs && !fixtures_.empty()) {
-    throw InputError(
-        "system: rigid contacts between moving bodies with a fixture are the Python "
-        "reference's (its joints solved with those rows)");
-  }
   if (object_worlds.size() != objects_.size() || object_memory.size() != objects_.size()) {
     throw InputError("system: one world (or none) and one friction state per free object");
   }
@@ -431,8 +421,39 @@ void System::constrain_coupled(double t0, const ConstVec& q0, const ConstVec& v0
     v.segment<3>(nv_robot_ + 6 * i) = turn * v1.segment<3>(nv_robot_ + 6 * i);
     v.segment<3>(nv_robot_ + 6 * i + 3) = turn * v1.segment<3>(nv_robot_ + 6 * i + 3);
   }
+  // each fixture: its joints' model and data at q0, its least speeds and its mass
+  for (std::size_t k = 0; k < fixtures_.size(); ++k) {
+    FixtureBody& f = fixtures_[k];
+    const int n = f.body.nv();
+    const auto q0_f = q0.segment(fixture_q_[k], n);
+    least.segment(fixture_v_[k], n) = ((q1.segment(fixture_q_[k], n) - q0_f).cwiseAbs() / h)
+                                          .cwiseMax(v0.segment(fixture_v_[k], n).cwiseAbs());
+    masses.emplace_back(f.body.mass_matrix_in(q0_f, plant_.flow, t0, plant_.free_surface));
+    at.fixtures.push_back({&f.body.model(), &f.body.data(), q0_f, fixture_v_[k], &f.lower,
+                           &f.upper, &f.coulomb});
+  }
+  at.joint_coulomb = plant_.joint_coulomb_Nm;
   const Eigen::VectorXd v_free = v;
-  const bool solved = coupled_step_.constrain(at, masses, v, h, least);
+  bool solved = coupled_step_.constrain(at, masses, v, h, least);
+  // a rigid contact acting on a fixture's joints: the fixtures' own rows join it in one
+  // problem; else each fixture's joints take their exact step (fixtures.with_fixtures)
+  bool fixtures_joined = false;
+  for (std::size_t k = 0; k < fixtures_.size() && solved; ++k) {
+    fixtures_joined = fixtures_joined || coupled_step_.acting(1 + objects_.size() + k);
+  }
+  if (fixtures_joined) {
+    at.fixture_rows = true;
+    v = v_free;
+    solved = coupled_step_.constrain(at, masses, v, h, least);
+    for (std::size_t k = 0; k < fixtures_.size(); ++k) {
+      if (!coupled_step_.acting(1 + objects_.size() + k)) continue;
+      const int n = fixtures_[k].body.nv();
+      v1.segment(fixture_v_[k], n) = v.segment(fixture_v_[k], n);
+      q1.segment(fixture_q_[k], n) = q0.segment(fixture_q_[k], n) + h * v.segment(fixture_v_[k], n);
+    }
+  } else {
+    constrain_fixtures(t0, q0, h, q1, v1);
+  }
   if (solved && coupled_step_.acting(0)) {
     v1.head(nv_robot_) = v.head(nv_robot_);
     Eigen::VectorXd q1_robot(nq_robot_);

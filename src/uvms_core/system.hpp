@@ -20,9 +20,9 @@
 //
 // in the same water, its links a side of the pair sets (side n_objects + k), and at the
 // period's end its joints' limits and Coulomb friction by their exact step (joint_box.hpp;
-// the bodies meet through smooth contact forces, so each fixture's joints are apart from the
-// other rows). Rigid contacts between moving bodies are not held with fixtures (the Python
-// reference solves a fixture's joints with those rows in one problem).
+// while the bodies meet through smooth contact forces each fixture's joints are apart from
+// the other rows). With rigid_pairs, when a solved contact row acts on a fixture's joints,
+// its limits and friction join that one problem instead (fixtures.with_fixtures).
 //
 // A period: the integrator's substeps on the system's manifold, then every contact's friction
 // anchors move (World.commit, PiecePairs.commit) at the period's end, then the constraints
@@ -31,7 +31,8 @@
 // (object_contacts.hpp; then the smooth dynamics leave those contacts out). M is block
 // diagonal over the bodies; while no row joins two bodies each body is solved alone. With
 // rigid_pairs the contacts between moving bodies are rows too, joining two bodies: then every
-// row of the system is solved in one problem (moving_constraints.hpp). A body with a solved
+// row of the system is solved in one problem (moving_constraints.hpp), the robot's joints'
+// Coulomb friction among them (box rows). A body with a solved
 // row moves from q0 with v+ (the robot q0 (+) h v+, an object by free_body_configuration),
 // the others keep the smooth step's end.
 #pragma once

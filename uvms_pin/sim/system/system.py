@@ -58,11 +58,6 @@ COMPILED_PATH = (
     "{bodies}: one compiled call a control period steps the system (the UVMS, every "
     "{each}, every contact between them and with the fixed world, the friction anchors)"
 )
-#: why joint Coulomb friction with rigid moving contacts is not one compiled call a period
-COULOMB_RIGID_REFUSAL = (
-    "the joints' Coulomb friction with rigid moving contacts: solved with those rows in one "
-    "problem, which the compiled system does not do"
-)
 #: ... or integrated in Python, and why
 PYTHON_PATH = (
     "{bodies}: the system (UVMS and {others}) is integrated by the Python integrator "
@@ -199,10 +194,6 @@ class System:
         plant_core = self.plant.compiled
         if not (self.objects or self.fixtures) or plant_core is None:
             return None
-        if self.fixtures and self.moving.moving.rigid_pairs:
-            return Fallback(fixture_joints.COMPILED_REFUSAL)
-        if self.plant.joint_coulomb is not None and self.moving.moving.rigid_pairs:
-            return Fallback(COULOMB_RIGID_REFUSAL)
         if self.attachments is not None:
             return Fallback(ATTACHMENT_REFUSAL)
         held = self.__dict__.get("_compiled")
