@@ -2,10 +2,12 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <string>
 
 #include <Eigen/Cholesky>
 #include <pinocchio/algorithm/jacobian.hpp>
+#include <pinocchio/spatial/explog.hpp>
 
 #include "world_touch.hpp"
 
@@ -125,6 +127,34 @@ void CoupledConstraintStep::add_pair_rows(const SystemAtStart& at, const Eigen::
   }
 }
 
+void CoupledConstraintStep::add_attachment_rows(const SystemAtStart& at, double h) {
+  for (const AttachmentAtStart& held : at.attachments) {
+    const auto k = static_cast<std::size_t>(held.object);
+    const pinocchio::SE3& object = at.objects[k]->oMi[1];
+    const pinocchio::SE3 target =
+        at.robot_data->oMi[static_cast<std::size_t>(held.link_joint)] * held.placement;
+    // the rows in the target's frame c1: -(its link's chain) + (the object's body twist)
+    Eigen::Matrix<double, 6, Eigen::Dynamic> link(6, nv_robot_);
+    link.setZero();
+    pinocchio::getJointJacobian(*at.robot, *at.robot_data,
+                                static_cast<pinocchio::JointIndex>(held.link_joint),
+                                pinocchio::WORLD, link);
+    const Eigen::Matrix<double, 6, 6> to_target = target.toActionMatrixInverse();
+    Eigen::MatrixXd rows = Eigen::MatrixXd::Zero(6, nv_);
+    rows.leftCols(nv_robot_) = -to_target * link;
+    // the free-flyer's WORLD Jacobian is Ad(oM_O) on its LOCAL body velocity
+    rows.middleCols<6>(nv_robot_ + 6 * static_cast<Eigen::Index>(k)) =
+        to_target * object.toActionMatrix();
+    const Vec6 error = pinocchio::log6(target.actInv(object)).toVector();
+    for (int r = 0; r < 6; ++r) {
+      boxes_.push_back({static_cast<Eigen::Index>(rows_.size()),
+                        std::numeric_limits<double>::infinity()});
+      rows_.push_back(rows.row(r));
+      drift_.push_back(correction * error[r] / h);
+    }
+  }
+}
+
 void CoupledConstraintStep::add_fixture_rows(const SystemAtStart& at, const Eigen::VectorXd& speed,
                                              double h) {
   const auto phi = [&](double gap) { return gap >= 0.0 ? gap : correction * gap; };
@@ -215,7 +245,8 @@ int CoupledConstraintStep::select(const SystemAtStart& at, const Eigen::VectorXd
     }
   }
   first_pair_row_ = static_cast<Eigen::Index>(rows_.size());
-  add_pair_rows(at, speed, h);
+  if (at.pair_rows) add_pair_rows(at, speed, h);
+  add_attachment_rows(at, h);
   if (at.fixture_rows) add_fixture_rows(at, speed, h);
   const auto m = static_cast<Eigen::Index>(rows_.size());
   jacobian_.resize(m, nv_);
@@ -317,6 +348,14 @@ bool CoupledConstraintStep::constrain(const SystemAtStart& at,
       (at.joint_coulomb.size() != 0 && at.joint_coulomb.size() != nv_robot_)) {
     throw InputError(
         "coupled constraints: the robot's, each object's and each fixture's velocity and mass");
+  }
+  for (const AttachmentAtStart& held : at.attachments) {
+    if (held.link_joint < 1 || held.link_joint >= at.robot->njoints || held.object < 0 ||
+        static_cast<std::size_t>(held.object) >= at.objects.size()) {
+      throw InputError("coupled constraints: an attachment's link joint (" +
+                       std::to_string(held.link_joint) + ") or object (" +
+                       std::to_string(held.object) + ") is not the system's");
+    }
   }
   for (std::size_t k = 0; k < bodies_.size(); ++k) {
     if (masses[k].rows() != bodies_[k].second || masses[k].cols() != bodies_[k].second) {

@@ -58,6 +58,18 @@ struct FixtureAtStart {
   const Eigen::VectorXd* coulomb = nullptr;  // [N m or N]
 };
 
+// A free object held by a robot link over the period (attachments.py): the link's joint, the
+// object, and the object's pose P in the link's joint frame kept since it began to hold. Six
+// bilateral rows, Pinocchio's FrameAnchorConstraintModel with c1 = L P and c2 = O:
+//   J v = Ad(oM_c1)^-1 (J_O - J_L) v,   e = log6(oM_c1^-1 oM_O)   [m; rad]
+// (J_L, J_O the WORLD spatial Jacobians of the link's joint and of the object's free-flyer),
+// held at J v+ = -beta e / h whatever the sign: the impulse of any sign (a box without bound).
+struct AttachmentAtStart {
+  int link_joint = 0;
+  int object = 0;
+  pinocchio::SE3 placement = pinocchio::SE3::Identity();
+};
+
 // What the coupled step reads of a system at the period's start q0.
 struct SystemAtStart {
   const Model* robot = nullptr;  // the robot's model
@@ -79,6 +91,11 @@ struct SystemAtStart {
   // robot's) and Coulomb friction (box rows), as fixtures.with_fixtures does when a rigid
   // contact acts on a fixture's joints
   bool fixture_rows = false;
+  // the contacts between moving bodies are rows (World.moving_contact rigid); else they are
+  // the smooth dynamics' compliant forces and only the other rows are solved
+  bool pair_rows = true;
+  // the attachments holding over the period
+  std::vector<AttachmentAtStart> attachments;
 };
 
 class CoupledConstraintStep {
@@ -137,6 +154,8 @@ class CoupledConstraintStep {
   const Data& side_data(const SystemAtStart& at, int side) const;
   // the fixtures' own rows (at.fixture_rows): their limits, then their friction
   void add_fixture_rows(const SystemAtStart& at, const Eigen::VectorXd& speed, double h);
+  // each attachment's six bilateral rows
+  void add_attachment_rows(const SystemAtStart& at, double h);
   // each body's range of columns in v (robot, objects, fixtures)
   std::vector<std::pair<Eigen::Index, Eigen::Index>> bodies_;
   std::vector<char> acting_;

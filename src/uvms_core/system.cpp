@@ -2,6 +2,7 @@
 
 #include "joint_box.hpp"
 
+#include <algorithm>
 #include <string>
 
 #include <Eigen/Geometry>
@@ -313,7 +314,9 @@ std::pair<Eigen::VectorXd, Eigen::VectorXd> System::advance(double t0, const Con
 
 void System::constrain(double t0, const ConstVec& q0, const ConstVec& v0, double t1,
                        Eigen::VectorXd& q1, Eigen::VectorXd& v1) {
-  if (rigid_pairs) {
+  const bool holding = std::any_of(attachments.begin(), attachments.end(),
+                                   [&](const Attachment& a) { return a.held(t0); });
+  if (rigid_pairs || holding) {
     constrain_coupled(t0, q0, v0, t1, q1, v1);
     return;
   }
@@ -433,6 +436,23 @@ void System::constrain_coupled(double t0, const ConstVec& q0, const ConstVec& v0
                            &f.upper, &f.coulomb});
   }
   at.joint_coulomb = plant_.joint_coulomb_Nm;
+  at.pair_rows = rigid_pairs;
+  // each attachment holding over the period, placed where the two are at q0 when it begins
+  // (attachments.py's _place_due): the robot's kinematics at q0, each object's above
+  pinocchio::forwardKinematics(robot, robot_data_, at.q0_robot);
+  for (Attachment& held : attachments) {
+    if (held.object < 0 || static_cast<std::size_t>(held.object) >= objects_.size() ||
+        held.link_joint < 1 || held.link_joint >= robot.njoints) {
+      throw InputError("system: an attachment's link joint or object is not the system's");
+    }
+    if (!held.held(t0)) continue;
+    if (!held.placed) {
+      held.placement = robot_data_.oMi[static_cast<std::size_t>(held.link_joint)].actInv(
+          at.objects[static_cast<std::size_t>(held.object)]->oMi[1]);
+      held.placed = true;
+    }
+    at.attachments.push_back({held.link_joint, held.object, held.placement});
+  }
   const Eigen::VectorXd v_free = v;
   bool solved = coupled_step_.constrain(at, masses, v, h, least);
   // a rigid contact acting on a fixture's joints: the fixtures' own rows join it in one
@@ -478,6 +498,7 @@ void System::constrain_coupled(double t0, const ConstVec& q0, const ConstVec& v0
       object_worlds[k]->commit(rigid_found_[k], object_memory[k]);
     }
   }
+  if (!rigid_pairs) return;  // compliant pairs: their memories are settle()'s
   // each pair set: its forces of the period kept, which pairs slid (their next cone mu_k)
   rigid_sets_.resize(sets.size());
   for (std::size_t s = 0; s < sets.size(); ++s) {

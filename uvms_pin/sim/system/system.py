@@ -32,7 +32,7 @@ from uvms_pin.physics.compiled.moving import (
     memories_of,
     search_compiled,
 )
-from uvms_pin.physics.constraints.attachments import ATTACHMENT_REFUSAL, Attachments
+from uvms_pin.physics.constraints.attachments import Attachments
 from uvms_pin.physics.constraints.moving_contacts import MovingPairContacts
 from uvms_pin.physics.constraints.object_contacts import ObjectWorldContacts
 from uvms_pin.physics.constraints.step import StalledSolves
@@ -180,6 +180,9 @@ class System:
         self.stalled = StalledSolves()
         if self.attachments is not None:  # each object held where it starts in its link
             self.attachments.place(self.model, state.q)
+            held = self.__dict__.get("_compiled")  # the core's: placed at its first period
+            if held is not None and not isinstance(held[1], Fallback):
+                held[1].forget_attachments()
         if self.moving is not None:
             self.moving.reset()
             robot, *objects = self.layout.split(state.q, state.v)
@@ -194,8 +197,6 @@ class System:
         plant_core = self.plant.compiled
         if not (self.objects or self.fixtures) or plant_core is None:
             return None
-        if self.attachments is not None:
-            return Fallback(ATTACHMENT_REFUSAL)
         held = self.__dict__.get("_compiled")
         if held is None or held[0] is not plant_core:
             held = self._compiled = (plant_core, system_to_core(self, core_module()))
