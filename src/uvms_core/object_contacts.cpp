@@ -36,6 +36,9 @@ constexpr double kAcceptableResidual = 1.0e-5;
 constexpr int kFirstStallCheck = 2000;
 constexpr int kStallCheck = 1000;
 constexpr double kStallRatio = 0.5;
+// a solve that stops progressing within this residual [m/s] has converged (a tenth of the
+// reference ADMM's 1e-8): it stops there without being counted as stalled
+constexpr double kConverged = 1.0e-9;
 
 coal::Transform3s transform_of(const pinocchio::SE3& where) {
   return coal::Transform3s(where.rotation(), where.translation());
@@ -223,7 +226,7 @@ void coulomb_gauss_seidel(const Eigen::MatrixXd& delassus, const Eigen::VectorXd
           coulomb_residual(delassus, g, cone_rows, mu, unilateral, impulse, boxes);
       if (sweep + 1 >= kFirstStallCheck && residual <= acceptable &&
           residual > kStallRatio * checked) {
-        stalled.add(residual);
+        if (residual > kConverged) stalled.add(residual);
         return;
       }
       checked = residual;
@@ -231,7 +234,7 @@ void coulomb_gauss_seidel(const Eigen::MatrixXd& delassus, const Eigen::VectorXd
   }
   const double residual = coulomb_residual(delassus, g, cone_rows, mu, unilateral, impulse, boxes);
   if (residual <= acceptable) {  // stalled (non-associated law, singular G), small enough
-    stalled.add(residual);
+    if (residual > kConverged) stalled.add(residual);
     return;
   }
   char numbers[160];

@@ -65,7 +65,9 @@ Eigen::Matrix<double, 3, 6> point_jacobian(const pinocchio::SE3& body, const Vec
 // friction the problem is not a convex program, and with more contacts than freedoms (a box's
 // four corners) G is singular; on a box rocking or landing on its corners the sweeps stall.
 // The last impulse is kept when its residual (coulomb_residual) is at most 1e-4 of the rows'
-// largest speed |g|_inf and at least 1e-5 m/s (step.py's acceptable_residual).
+// largest speed |g|_inf and at least 1e-5 m/s (step.py's acceptable_residual). A solve that
+// stops progressing within 1e-9 m/s (a tenth of the reference ADMM's tolerance) has
+// converged and is not counted.
 struct StalledSolves {
   int count = 0;
   double worst_residual_m_s = 0.0;

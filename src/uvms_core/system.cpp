@@ -439,7 +439,7 @@ void System::constrain_coupled(double t0, const ConstVec& q0, const ConstVec& v0
   at.pair_rows = rigid_pairs;
   // each attachment holding over the period, placed where the two are at q0 when it begins
   // (attachments.py's _place_due): the robot's kinematics at q0, each object's above
-  pinocchio::forwardKinematics(robot, robot_data_, at.q0_robot);
+  bool kinematics = false;
   for (Attachment& held : attachments) {
     if (held.object < 0 || static_cast<std::size_t>(held.object) >= objects_.size() ||
         held.link_joint < 1 || held.link_joint >= robot.njoints) {
@@ -447,6 +447,8 @@ void System::constrain_coupled(double t0, const ConstVec& q0, const ConstVec& v0
     }
     if (!held.held(t0)) continue;
     if (!held.placed) {
+      if (!kinematics) pinocchio::forwardKinematics(robot, robot_data_, at.q0_robot);
+      kinematics = true;
       held.placement = robot_data_.oMi[static_cast<std::size_t>(held.link_joint)].actInv(
           at.objects[static_cast<std::size_t>(held.object)]->oMi[1]);
       held.placed = true;
