@@ -40,6 +40,7 @@ PRODUCERS = {
     "surface": "the free surface, analytic cases and surfacing: docs/results/surface.md, docs/surfacing.png",
     "world": "the seabed landing and the cost of contacts: docs/results/world.md, docs/seabed_landing.png",
     "push_object": "a free box pushed across the seafloor: docs/results/push_object.md, docs/push_object.png",
+    "contact_modes": "compliant or rigid moving contacts, scenario by scenario: docs/results/contact_modes.md",
     "derivatives": "cost of the dynamics' derivatives and of an MPC re-plan: docs/results/derivatives.md",
     "tracking": "end-effector tracking, controller x task x conditions: docs/results/tracking.md, docs/tracking_*.png",
     "estimator": "station keeping on the navigation estimate: docs/results/estimator.md, docs/estimator_station_keeping.png",

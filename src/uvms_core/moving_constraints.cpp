@@ -2,10 +2,12 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <string>
 
 #include <Eigen/Cholesky>
 #include <pinocchio/algorithm/jacobian.hpp>
+#include <pinocchio/spatial/explog.hpp>
 
 #include "world_touch.hpp"
 
@@ -33,13 +35,31 @@ Eigen::MatrixXd CoupledConstraintStep::side_twist_jacobian(const SystemAtStart& 
     const Vec3 offset = x - at.robot_data->oMi[static_cast<std::size_t>(piece.joint_id)].translation();
     out.topLeftCorner(3, nv_robot_) = joint.topRows<3>() - pinocchio::skew(offset) * joint.bottomRows<3>();
     out.bottomLeftCorner(3, nv_robot_) = joint.bottomRows<3>();
-  } else {
+  } else if (static_cast<std::size_t>(side) < at.objects.size()) {
     const auto k = static_cast<std::size_t>(side);
     const pinocchio::SE3& body = at.objects[k]->oMi[1];
     out.block<3, 6>(0, nv_robot_ + 6 * side) = point_jacobian(body, x);
     out.block<3, 3>(3, nv_robot_ + 6 * side + 3) = body.rotation();
+  } else if (piece.joint_id > 0) {  // a fixture's link; its root link (joint 0) is fixed
+    const FixtureAtStart& fixture = at.fixtures[static_cast<std::size_t>(side) - at.objects.size()];
+    const auto n = static_cast<Eigen::Index>(fixture.model->nv);
+    Eigen::Matrix<double, 6, Eigen::Dynamic> joint(6, n);
+    joint.setZero();
+    pinocchio::getJointJacobian(*fixture.model, *fixture.data,
+                                static_cast<pinocchio::JointIndex>(piece.joint_id),
+                                pinocchio::LOCAL_WORLD_ALIGNED, joint);
+    const Vec3 offset =
+        x - fixture.data->oMi[static_cast<std::size_t>(piece.joint_id)].translation();
+    out.block(0, fixture.offset, 3, n) = joint.topRows<3>() - pinocchio::skew(offset) * joint.bottomRows<3>();
+    out.block(3, fixture.offset, 3, n) = joint.bottomRows<3>();
   }
   return out;
+}
+
+const Data& CoupledConstraintStep::side_data(const SystemAtStart& at, int side) const {
+  if (side < 0) return *at.robot_data;
+  const auto k = static_cast<std::size_t>(side);
+  return k < at.objects.size() ? *at.objects[k] : *at.fixtures[k - at.objects.size()].data;
 }
 
 Eigen::MatrixXd CoupledConstraintStep::side_jacobian(const SystemAtStart& at, int side,
@@ -51,7 +71,7 @@ Eigen::MatrixXd CoupledConstraintStep::side_jacobian(const SystemAtStart& at, in
 double CoupledConstraintStep::piece_speed(const SystemAtStart& at, int side,
                                           const ContactShape& piece,
                                           const Eigen::VectorXd& speed) const {
-  const Data& data = side < 0 ? *at.robot_data : *at.objects[static_cast<std::size_t>(side)];
+  const Data& data = side_data(at, side);
   const Vec3 centre = placement_of(data, piece).translation();
   const Eigen::MatrixXd twist = side_twist_jacobian(at, side, piece, centre);
   const auto linear = twist.topRows(3);
@@ -73,8 +93,8 @@ void CoupledConstraintStep::add_pair_rows(const SystemAtStart& at, const Eigen::
   };
   for (std::size_t s = 0; s < sets.size(); ++s) {
     const PairSet& set = sets[s];
-    const Data& data_a = set.a < 0 ? *at.robot_data : *at.objects[static_cast<std::size_t>(set.a)];
-    const Data& data_b = set.b < 0 ? *at.robot_data : *at.objects[static_cast<std::size_t>(set.b)];
+    const Data& data_a = side_data(at, set.a);
+    const Data& data_b = side_data(at, set.b);
     speed_a.assign(set.pairs.pieces_a.size(), -1.0);
     speed_b.assign(set.pairs.pieces_b.size(), -1.0);
     for (std::size_t k = 0; k < set.pairs.pairs.size(); ++k) {
@@ -103,8 +123,68 @@ void CoupledConstraintStep::add_pair_rows(const SystemAtStart& at, const Eigen::
       const bool sliding = set.memory.slipping.count(static_cast<int>(k)) > 0;
       mu_.push_back(sliding ? set.pairs.friction_kinetic[k] : set.pairs.friction_static[k]);
       pair_rows_.push_back({static_cast<int>(s), static_cast<int>(k), point, frame});
-      acting_[set.a < 0 ? 0 : 1 + static_cast<std::size_t>(set.a)] = 1;
-      acting_[set.b < 0 ? 0 : 1 + static_cast<std::size_t>(set.b)] = 1;
+    }
+  }
+}
+
+void CoupledConstraintStep::add_attachment_rows(const SystemAtStart& at, double h) {
+  for (const AttachmentAtStart& held : at.attachments) {
+    const auto k = static_cast<std::size_t>(held.object);
+    const pinocchio::SE3& object = at.objects[k]->oMi[1];
+    const pinocchio::SE3 target =
+        at.robot_data->oMi[static_cast<std::size_t>(held.link_joint)] * held.placement;
+    // the rows in the target's frame c1: -(its link's chain) + (the object's body twist)
+    Eigen::Matrix<double, 6, Eigen::Dynamic> link(6, nv_robot_);
+    link.setZero();
+    pinocchio::getJointJacobian(*at.robot, *at.robot_data,
+                                static_cast<pinocchio::JointIndex>(held.link_joint),
+                                pinocchio::WORLD, link);
+    const Eigen::Matrix<double, 6, 6> to_target = target.toActionMatrixInverse();
+    Eigen::MatrixXd rows = Eigen::MatrixXd::Zero(6, nv_);
+    rows.leftCols(nv_robot_) = -to_target * link;
+    // the free-flyer's WORLD Jacobian is Ad(oM_O) on its LOCAL body velocity
+    rows.middleCols<6>(nv_robot_ + 6 * static_cast<Eigen::Index>(k)) =
+        to_target * object.toActionMatrix();
+    const Vec6 error = pinocchio::log6(target.actInv(object)).toVector();
+    for (int r = 0; r < 6; ++r) {
+      boxes_.push_back({static_cast<Eigen::Index>(rows_.size()),
+                        std::numeric_limits<double>::infinity()});
+      rows_.push_back(rows.row(r));
+      drift_.push_back(correction * error[r] / h);
+    }
+  }
+}
+
+void CoupledConstraintStep::add_fixture_rows(const SystemAtStart& at, const Eigen::VectorXd& speed,
+                                             double h) {
+  const auto phi = [&](double gap) { return gap >= 0.0 ? gap : correction * gap; };
+  // the limits (fixtures.constraints' JointLimits: lower rows first, then upper)
+  for (const bool lower : {true, false}) {
+    for (const FixtureAtStart& fixture : at.fixtures) {
+      for (Eigen::Index j = 0; j < fixture.q0.size(); ++j) {
+        const double bound = lower ? (*fixture.lower)[j] : (*fixture.upper)[j];
+        if (!std::isfinite(bound)) continue;
+        const Eigen::Index iv = fixture.offset + j;
+        const double gap = lower ? fixture.q0[j] - bound : bound - fixture.q0[j];
+        if (gap > h * speed[iv] + margin) continue;
+        Eigen::RowVectorXd row = Eigen::RowVectorXd::Zero(nv_);
+        row[iv] = lower ? 1.0 : -1.0;
+        unilateral_.push_back(static_cast<Eigen::Index>(rows_.size()));
+        rows_.push_back(row);
+        drift_.push_back(phi(gap) / h);
+      }
+    }
+  }
+  // their Coulomb friction: a row per joint with c > 0, |lambda| <= c h, always
+  for (const FixtureAtStart& fixture : at.fixtures) {
+    for (Eigen::Index j = 0; j < fixture.q0.size(); ++j) {
+      const double c = (*fixture.coulomb)[j];
+      if (!(c > 0.0)) continue;
+      Eigen::RowVectorXd row = Eigen::RowVectorXd::Zero(nv_);
+      row[fixture.offset + j] = 1.0;
+      boxes_.push_back({static_cast<Eigen::Index>(rows_.size()), c * h});
+      rows_.push_back(row);
+      drift_.push_back(0.0);
     }
   }
 }
@@ -115,9 +195,9 @@ int CoupledConstraintStep::select(const SystemAtStart& at, const Eigen::VectorXd
   drift_.clear();
   mu_.clear();
   unilateral_.clear();
+  boxes_.clear();
   cone_rows_.clear();
   pair_rows_.clear();
-  acting_.assign(1 + at.objects.size(), 0);
   const auto phi = [&](double gap) { return gap >= 0.0 ? gap : correction * gap; };
   if (at.limits != nullptr) {  // lower rows first, then upper (joint_limits.py's order)
     const auto& limits = *at.limits;
@@ -133,9 +213,18 @@ int CoupledConstraintStep::select(const SystemAtStart& at, const Eigen::VectorXd
         unilateral_.push_back(static_cast<Eigen::Index>(rows_.size()));
         rows_.push_back(row);
         drift_.push_back(phi(gap) / h);
-        acting_[0] = 1;
       }
     }
+  }
+  // the robot's joints' Coulomb friction: a box row per joint with c > 0, always
+  for (Eigen::Index iv = 0; iv < at.joint_coulomb.size(); ++iv) {
+    const double c = at.joint_coulomb[iv];
+    if (!(c > 0.0)) continue;
+    Eigen::RowVectorXd row = Eigen::RowVectorXd::Zero(nv_);
+    row[iv] = 1.0;
+    boxes_.push_back({static_cast<Eigen::Index>(rows_.size()), c * h});
+    rows_.push_back(row);
+    drift_.push_back(0.0);
   }
   for (std::size_t i = 0; i < at.objects.size(); ++i) {
     object_rows_[i] = static_cast<Eigen::Index>(rows_.size());
@@ -154,13 +243,21 @@ int CoupledConstraintStep::select(const SystemAtStart& at, const Eigen::VectorXd
       }
       mu_.push_back(step.mu()[static_cast<std::size_t>(c)]);
     }
-    if (n > 0) acting_[1 + i] = 1;
   }
   first_pair_row_ = static_cast<Eigen::Index>(rows_.size());
-  add_pair_rows(at, speed, h);
+  if (at.pair_rows) add_pair_rows(at, speed, h);
+  add_attachment_rows(at, h);
+  if (at.fixture_rows) add_fixture_rows(at, speed, h);
   const auto m = static_cast<Eigen::Index>(rows_.size());
   jacobian_.resize(m, nv_);
   for (Eigen::Index r = 0; r < m; ++r) jacobian_.row(r) = rows_[static_cast<std::size_t>(r)];
+  // a body acted on: some row has a non-zero column of its coordinates (period.py's _end)
+  acting_.assign(bodies_.size(), 0);
+  for (std::size_t k = 0; k < bodies_.size(); ++k) {
+    const auto [first, n] = bodies_[k];
+    acting_[k] = m > 0 && n > 0 && (jacobian_.middleCols(first, n).array() != 0.0).any();
+  }
+  if (at.joint_coulomb.size() > 0) acting_[0] = 1;
   return static_cast<int>(m);
 }
 
@@ -183,7 +280,7 @@ void CoupledConstraintStep::solve(const std::vector<Eigen::MatrixXd>& masses,
       jacobian_ * v_free + Eigen::Map<const Eigen::VectorXd>(drift_.data(), jacobian_.rows());
   impulse_ = Eigen::VectorXd::Zero(jacobian_.rows());
   coulomb_gauss_seidel(delassus_, g, cone_rows_, mu_, unilateral_, impulse_,
-                       "coupled constraints", stalled);
+                       "coupled constraints", stalled, boxes_);
   v = v_free + minv_jt_ * impulse_;
 }
 
@@ -233,9 +330,40 @@ bool CoupledConstraintStep::constrain(const SystemAtStart& at,
   }
   nv_robot_ = static_cast<Eigen::Index>(at.robot->nv);
   nv_ = v.size();
-  if (nv_ != nv_robot_ + 6 * static_cast<Eigen::Index>(at.objects.size()) ||
-      least_speed.size() != nv_ || masses.size() != 1 + at.objects.size()) {
-    throw InputError("coupled constraints: the robot's and each object's velocity and mass");
+  bodies_.assign(1, {0, nv_robot_});
+  for (std::size_t i = 0; i < at.objects.size(); ++i) {
+    bodies_.emplace_back(nv_robot_ + 6 * static_cast<Eigen::Index>(i), 6);
+  }
+  Eigen::Index expected = nv_robot_ + 6 * static_cast<Eigen::Index>(at.objects.size());
+  for (const FixtureAtStart& fixture : at.fixtures) {
+    const auto n = static_cast<Eigen::Index>(fixture.model->nv);
+    if (fixture.offset != expected || fixture.q0.size() != n || fixture.lower->size() != n ||
+        fixture.upper->size() != n || fixture.coulomb->size() != n) {
+      throw InputError("coupled constraints: a fixture's coordinates, limits and friction");
+    }
+    bodies_.emplace_back(expected, n);
+    expected += n;
+  }
+  if (nv_ != expected || least_speed.size() != nv_ || masses.size() != bodies_.size() ||
+      (at.joint_coulomb.size() != 0 && at.joint_coulomb.size() != nv_robot_)) {
+    throw InputError(
+        "coupled constraints: the robot's, each object's and each fixture's velocity and mass");
+  }
+  for (const AttachmentAtStart& held : at.attachments) {
+    if (held.link_joint < 1 || held.link_joint >= at.robot->njoints || held.object < 0 ||
+        static_cast<std::size_t>(held.object) >= at.objects.size()) {
+      throw InputError("coupled constraints: an attachment's link joint (" +
+                       std::to_string(held.link_joint) + ") or object (" +
+                       std::to_string(held.object) + ") is not the system's");
+    }
+  }
+  for (std::size_t k = 0; k < bodies_.size(); ++k) {
+    if (masses[k].rows() != bodies_[k].second || masses[k].cols() != bodies_[k].second) {
+      throw InputError("coupled constraints: body " + std::to_string(k) + "'s mass matrix is " +
+                       std::to_string(masses[k].rows()) + " x " +
+                       std::to_string(masses[k].cols()) + ", its velocity " +
+                       std::to_string(bodies_[k].second));
+    }
   }
   object_steps_.resize(at.objects.size());
   object_rows_.assign(at.objects.size(), 0);
@@ -244,6 +372,9 @@ bool CoupledConstraintStep::constrain(const SystemAtStart& at,
     step.correction = correction;
   }
   pinocchio::computeJointJacobians(*at.robot, *at.robot_data, at.q0_robot);
+  for (const FixtureAtStart& fixture : at.fixtures) {
+    pinocchio::computeJointJacobians(*fixture.model, *fixture.data, fixture.q0);
+  }
   const Eigen::VectorXd v_free = v;
   Eigen::VectorXd speed = v_free.cwiseAbs().cwiseMax(least_speed.cwiseAbs());
   int rows = select(at, speed, h);

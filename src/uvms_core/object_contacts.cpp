@@ -36,6 +36,9 @@ constexpr double kAcceptableResidual = 1.0e-5;
 constexpr int kFirstStallCheck = 2000;
 constexpr int kStallCheck = 1000;
 constexpr double kStallRatio = 0.5;
+// a solve that stops progressing within this residual [m/s] has converged (a tenth of the
+// reference ADMM's 1e-8): it stops there without being counted as stalled
+constexpr double kConverged = 1.0e-9;
 
 coal::Transform3s transform_of(const pinocchio::SE3& where) {
   return coal::Transform3s(where.rotation(), where.translation());
@@ -172,7 +175,8 @@ void coulomb_gauss_seidel(const Eigen::MatrixXd& delassus, const Eigen::VectorXd
                           const std::vector<Eigen::Index>& cone_rows,
                           const std::vector<double>& mu,
                           const std::vector<Eigen::Index>& unilateral, Eigen::VectorXd& impulse,
-                          const char* what, StalledSolves& stalled) {
+                          const char* what, StalledSolves& stalled,
+                          const std::vector<BoxRow>& boxes) {
   Eigen::VectorXd sigma = g + delassus * impulse;  // G lambda + g, kept up to date
   double last_change = 0.0;
   const double acceptable =
@@ -183,6 +187,14 @@ void coulomb_gauss_seidel(const Eigen::MatrixXd& delassus, const Eigen::VectorXd
     for (const Eigen::Index j : unilateral) {  // lambda_j >= 0 _|_ sigma_j >= 0
       const double before = impulse[j];
       const double after = std::max(0.0, before - sigma[j] / delassus(j, j));
+      sigma += delassus.col(j) * (after - before);
+      impulse[j] = after;
+      change = std::max(change, std::abs(delassus(j, j) * (after - before)));
+    }
+    for (const BoxRow& box : boxes) {  // |lambda_j| <= bound: stick inside, slip at it
+      const Eigen::Index j = box.row;
+      const double before = impulse[j];
+      const double after = std::clamp(before - sigma[j] / delassus(j, j), -box.bound, box.bound);
       sigma += delassus.col(j) * (after - before);
       impulse[j] = after;
       change = std::max(change, std::abs(delassus(j, j) * (after - before)));
@@ -210,18 +222,19 @@ void coulomb_gauss_seidel(const Eigen::MatrixXd& delassus, const Eigen::VectorXd
     if ((sweep + 1) % kStallCheck == 0) {
       // stalled: no better than half the residual kStallCheck sweeps ago (a converging
       // solve gains orders of magnitude over as many), and acceptable
-      const double residual = coulomb_residual(delassus, g, cone_rows, mu, unilateral, impulse);
+      const double residual =
+          coulomb_residual(delassus, g, cone_rows, mu, unilateral, impulse, boxes);
       if (sweep + 1 >= kFirstStallCheck && residual <= acceptable &&
           residual > kStallRatio * checked) {
-        stalled.add(residual);
+        if (residual > kConverged) stalled.add(residual);
         return;
       }
       checked = residual;
     }
   }
-  const double residual = coulomb_residual(delassus, g, cone_rows, mu, unilateral, impulse);
+  const double residual = coulomb_residual(delassus, g, cone_rows, mu, unilateral, impulse, boxes);
   if (residual <= acceptable) {  // stalled (non-associated law, singular G), small enough
-    stalled.add(residual);
+    if (residual > kConverged) stalled.add(residual);
     return;
   }
   char numbers[160];
@@ -236,7 +249,7 @@ void coulomb_gauss_seidel(const Eigen::MatrixXd& delassus, const Eigen::VectorXd
 double coulomb_residual(const Eigen::MatrixXd& delassus, const Eigen::VectorXd& g,
                         const std::vector<Eigen::Index>& cone_rows, const std::vector<double>& mu,
                         const std::vector<Eigen::Index>& unilateral,
-                        const Eigen::VectorXd& impulse) {
+                        const Eigen::VectorXd& impulse, const std::vector<BoxRow>& boxes) {
   const Eigen::VectorXd sigma = g + delassus * impulse;
   double out = 0.0;
   auto normal_row = [&](Eigen::Index j) {
@@ -244,6 +257,13 @@ double coulomb_residual(const Eigen::MatrixXd& delassus, const Eigen::VectorXd& 
                     std::min(std::max(sigma[j], 0.0), impulse[j] * delassus(j, j))});
   };
   for (const Eigen::Index j : unilateral) normal_row(j);
+  for (const BoxRow& box : boxes) {
+    const double lambda = impulse[box.row], rate = sigma[box.row];
+    const bool at_bound = std::abs(lambda) >= box.bound * (1.0 - 1.0e-9) && box.bound > 0.0;
+    // at its bound it may only slip against the impulse (rate lambda <= 0)
+    out = std::max(out, at_bound ? std::max(rate * (lambda > 0.0 ? 1.0 : -1.0), 0.0)
+                                 : (box.bound > 0.0 ? std::abs(rate) : 0.0));
+  }
   for (std::size_t c = 0; c < cone_rows.size(); ++c) {
     const Eigen::Index t = cone_rows[c], n = t + 2;
     normal_row(n);

@@ -65,7 +65,9 @@ Eigen::Matrix<double, 3, 6> point_jacobian(const pinocchio::SE3& body, const Vec
 // friction the problem is not a convex program, and with more contacts than freedoms (a box's
 // four corners) G is singular; on a box rocking or landing on its corners the sweeps stall.
 // The last impulse is kept when its residual (coulomb_residual) is at most 1e-4 of the rows'
-// largest speed |g|_inf and at least 1e-5 m/s (step.py's acceptable_residual).
+// largest speed |g|_inf and at least 1e-5 m/s (step.py's acceptable_residual). A solve that
+// stops progressing within 1e-9 m/s (a tenth of the reference ADMM's tolerance) has
+// converged and is not counted.
 struct StalledSolves {
   int count = 0;
   double worst_residual_m_s = 0.0;
@@ -75,19 +77,29 @@ struct StalledSolves {
   }
 };
 
+// A row whose impulse lies in a box, |lambda| <= bound (a joint's Coulomb friction over the
+// period h: bound = c h, step.py's box cone; bound = inf: a bilateral row, lambda of any sign).
+// Its law: |lambda| < bound => sigma = 0 (it sticks); lambda = +-bound => sigma opposes lambda.
+struct BoxRow {
+  Eigen::Index row = 0;
+  double bound = 0.0;
+};
+
 // How far impulse is from solving the problem of coulomb_gauss_seidel [m/s] (0: solved): the
 // largest of each unilateral row's and contact normal's penetration -min(sigma, 0) and
-// complementarity min(sigma^+, lambda G_jj), a sticking contact's tangential speed, a sliding
+// complementarity min(sigma^+, lambda G_jj), a box row's speed inside its box |sigma| or
+// along its bound's side (sigma lambda > 0), a sticking contact's tangential speed, a sliding
 // one's departure from maximal dissipation |sigma_t + |sigma_t| lambda_t / |lambda_t||.
 double coulomb_residual(const Eigen::MatrixXd& delassus, const Eigen::VectorXd& g,
                         const std::vector<Eigen::Index>& cone_rows, const std::vector<double>& mu,
                         const std::vector<Eigen::Index>& unilateral,
-                        const Eigen::VectorXd& impulse);
+                        const Eigen::VectorXd& impulse, const std::vector<BoxRow>& boxes = {});
 
 // The Coulomb problem's projected Gauss-Seidel (see the file's comment) on the Delassus
 // operator G and the free rows' velocity g: impulse (in: the start, out: the solution) with
 // the cones of `cone_rows` (each a contact's first row t1, then t2, n; mu per contact) and
-// the unilateral rows `unilateral` (lambda >= 0, a joint limit's). From sweep 2,000 a solve
+// the unilateral rows `unilateral` (lambda >= 0, a joint limit's) and the box rows `boxes`
+// (lambda <- clamp(lambda - sigma / G_jj, -bound, bound)). From sweep 2,000 a solve
 // whose residual (checked every 1,000 sweeps) no longer halves is stalled; after kMaxSweeps the last
 // sweep's impulse is kept when its coulomb_residual is acceptable (StalledSolves; counted in
 // stalled); otherwise throws SimulationFailure. what: for the message.
@@ -95,7 +107,8 @@ void coulomb_gauss_seidel(const Eigen::MatrixXd& delassus, const Eigen::VectorXd
                           const std::vector<Eigen::Index>& cone_rows,
                           const std::vector<double>& mu,
                           const std::vector<Eigen::Index>& unilateral, Eigen::VectorXd& impulse,
-                          const char* what, StalledSolves& stalled);
+                          const char* what, StalledSolves& stalled,
+                          const std::vector<BoxRow>& boxes = {});
 
 // The velocity step of one free object against its fixed world.
 class ObjectContactStep {

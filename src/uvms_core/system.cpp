@@ -2,6 +2,7 @@
 
 #include "joint_box.hpp"
 
+#include <algorithm>
 #include <string>
 
 #include <Eigen/Geometry>
@@ -130,16 +131,6 @@ void System::check() const {
           "system: a pair set's bodies are not the robot, a free object or a fixture");
     }
     set.pairs.check(model_of(set.a), model_of(set.b));
-  }
-  if (rigid_pairs && plant_.joint_coulomb_Nm.size() > 0) {
-    throw InputError(
-        "system: rigid contacts between moving bodies with the joints' Coulomb friction are "
-        "the Python reference's (solved with those rows in one problem)");
-  }
-  if (rigid_pairs && !fixtures_.empty()) {
-    throw InputError(
-        "system: rigid contacts between moving bodies with a fixture are the Python "
-        "reference's (its joints solved with those rows)");
   }
   if (object_worlds.size() != objects_.size() || object_memory.size() != objects_.size()) {
     throw InputError("system: one world (or none) and one friction state per free object");
@@ -323,7 +314,9 @@ std::pair<Eigen::VectorXd, Eigen::VectorXd> System::advance(double t0, const Con
 
 void System::constrain(double t0, const ConstVec& q0, const ConstVec& v0, double t1,
                        Eigen::VectorXd& q1, Eigen::VectorXd& v1) {
-  if (rigid_pairs) {
+  const bool holding = std::any_of(attachments.begin(), attachments.end(),
+                                   [&](const Attachment& a) { return a.held(t0); });
+  if (rigid_pairs || holding) {
     constrain_coupled(t0, q0, v0, t1, q1, v1);
     return;
   }
@@ -431,8 +424,58 @@ void System::constrain_coupled(double t0, const ConstVec& q0, const ConstVec& v0
     v.segment<3>(nv_robot_ + 6 * i) = turn * v1.segment<3>(nv_robot_ + 6 * i);
     v.segment<3>(nv_robot_ + 6 * i + 3) = turn * v1.segment<3>(nv_robot_ + 6 * i + 3);
   }
+  // each fixture: its joints' model and data at q0, its least speeds and its mass
+  for (std::size_t k = 0; k < fixtures_.size(); ++k) {
+    FixtureBody& f = fixtures_[k];
+    const int n = f.body.nv();
+    const auto q0_f = q0.segment(fixture_q_[k], n);
+    least.segment(fixture_v_[k], n) = ((q1.segment(fixture_q_[k], n) - q0_f).cwiseAbs() / h)
+                                          .cwiseMax(v0.segment(fixture_v_[k], n).cwiseAbs());
+    masses.emplace_back(f.body.mass_matrix_in(q0_f, plant_.flow, t0, plant_.free_surface));
+    at.fixtures.push_back({&f.body.model(), &f.body.data(), q0_f, fixture_v_[k], &f.lower,
+                           &f.upper, &f.coulomb});
+  }
+  at.joint_coulomb = plant_.joint_coulomb_Nm;
+  at.pair_rows = rigid_pairs;
+  // each attachment holding over the period, placed where the two are at q0 when it begins
+  // (attachments.py's _place_due): the robot's kinematics at q0, each object's above
+  bool kinematics = false;
+  for (Attachment& held : attachments) {
+    if (held.object < 0 || static_cast<std::size_t>(held.object) >= objects_.size() ||
+        held.link_joint < 1 || held.link_joint >= robot.njoints) {
+      throw InputError("system: an attachment's link joint or object is not the system's");
+    }
+    if (!held.held(t0)) continue;
+    if (!held.placed) {
+      if (!kinematics) pinocchio::forwardKinematics(robot, robot_data_, at.q0_robot);
+      kinematics = true;
+      held.placement = robot_data_.oMi[static_cast<std::size_t>(held.link_joint)].actInv(
+          at.objects[static_cast<std::size_t>(held.object)]->oMi[1]);
+      held.placed = true;
+    }
+    at.attachments.push_back({held.link_joint, held.object, held.placement});
+  }
   const Eigen::VectorXd v_free = v;
-  const bool solved = coupled_step_.constrain(at, masses, v, h, least);
+  bool solved = coupled_step_.constrain(at, masses, v, h, least);
+  // a rigid contact acting on a fixture's joints: the fixtures' own rows join it in one
+  // problem; else each fixture's joints take their exact step (fixtures.with_fixtures)
+  bool fixtures_joined = false;
+  for (std::size_t k = 0; k < fixtures_.size() && solved; ++k) {
+    fixtures_joined = fixtures_joined || coupled_step_.acting(1 + objects_.size() + k);
+  }
+  if (fixtures_joined) {
+    at.fixture_rows = true;
+    v = v_free;
+    solved = coupled_step_.constrain(at, masses, v, h, least);
+    for (std::size_t k = 0; k < fixtures_.size(); ++k) {
+      if (!coupled_step_.acting(1 + objects_.size() + k)) continue;
+      const int n = fixtures_[k].body.nv();
+      v1.segment(fixture_v_[k], n) = v.segment(fixture_v_[k], n);
+      q1.segment(fixture_q_[k], n) = q0.segment(fixture_q_[k], n) + h * v.segment(fixture_v_[k], n);
+    }
+  } else {
+    constrain_fixtures(t0, q0, h, q1, v1);
+  }
   if (solved && coupled_step_.acting(0)) {
     v1.head(nv_robot_) = v.head(nv_robot_);
     Eigen::VectorXd q1_robot(nq_robot_);
@@ -457,6 +500,7 @@ void System::constrain_coupled(double t0, const ConstVec& q0, const ConstVec& v0
       object_worlds[k]->commit(rigid_found_[k], object_memory[k]);
     }
   }
+  if (!rigid_pairs) return;  // compliant pairs: their memories are settle()'s
   // each pair set: its forces of the period kept, which pairs slid (their next cone mu_k)
   rigid_sets_.resize(sets.size());
   for (std::size_t s = 0; s < sets.size(); ++s) {

@@ -20,9 +20,9 @@
 //
 // in the same water, its links a side of the pair sets (side n_objects + k), and at the
 // period's end its joints' limits and Coulomb friction by their exact step (joint_box.hpp;
-// the bodies meet through smooth contact forces, so each fixture's joints are apart from the
-// other rows). Rigid contacts between moving bodies are not held with fixtures (the Python
-// reference solves a fixture's joints with those rows in one problem).
+// while the bodies meet through smooth contact forces each fixture's joints are apart from
+// the other rows). With rigid_pairs, when a solved contact row acts on a fixture's joints,
+// its limits and friction join that one problem instead (fixtures.with_fixtures).
 //
 // A period: the integrator's substeps on the system's manifold, then every contact's friction
 // anchors move (World.commit, PiecePairs.commit) at the period's end, then the constraints
@@ -31,11 +31,15 @@
 // (object_contacts.hpp; then the smooth dynamics leave those contacts out). M is block
 // diagonal over the bodies; while no row joins two bodies each body is solved alone. With
 // rigid_pairs the contacts between moving bodies are rows too, joining two bodies: then every
-// row of the system is solved in one problem (moving_constraints.hpp). A body with a solved
+// row of the system is solved in one problem (moving_constraints.hpp), the robot's joints'
+// Coulomb friction among them (box rows). A body with a solved
 // row moves from q0 with v+ (the robot q0 (+) h v+, an object by free_body_configuration),
-// the others keep the smooth step's end.
+// the others keep the smooth step's end. An attachment holding over the period joins its
+// robot link and free object by six bilateral rows, solved with every other row in one problem
+// as with rigid_pairs (moving_constraints.hpp).
 #pragma once
 
+#include <limits>
 #include <optional>
 #include <utility>
 #include <vector>
@@ -60,6 +64,19 @@ struct FixtureBody {
     return (coulomb.array() > 0.0).any() || lower.array().isFinite().any() ||
            upper.array().isFinite().any();
   }
+};
+
+// A free object held rigidly by a robot link (mirror of attachments.py's Attachments): from
+// attach_at_s until release_at_s [s], at the pose the two have at the start of the first
+// period it holds (placed; then placement is the object's pose in the link's joint frame).
+struct Attachment {
+  int link_joint = 0;  // the robot's joint carrying the link
+  int object = 0;      // the free object
+  double attach_at_s = 0.0;
+  double release_at_s = std::numeric_limits<double>::infinity();
+  bool placed = false;
+  pinocchio::SE3 placement = pinocchio::SE3::Identity();
+  bool held(double time_s) const { return attach_at_s <= time_s && time_s < release_at_s; }
 };
 
 class System {
@@ -91,6 +108,14 @@ class System {
     Vec3 force = Vec3::Zero();
   };
   std::vector<Push> pushes;
+
+  // The free objects held by the robot's links: each holding period's velocities are solved
+  // with the other rows in one problem (constrain_coupled, its six bilateral rows).
+  std::vector<Attachment> attachments;
+  // A run starts: no attachment placed (each is placed at the start of its first period).
+  void forget_attachments() {
+    for (auto& held : attachments) held.placed = false;
+  }
 
   int nq() const { return model_.nq; }
   int nv() const { return model_.nv; }

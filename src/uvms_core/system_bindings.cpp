@@ -9,6 +9,7 @@
 #include <nanobind/stl/pair.h>
 #include <nanobind/stl/vector.h>
 
+#include <cmath>
 #include <string>
 
 #include "joint_box.hpp"
@@ -308,6 +309,33 @@ void bind_system(nb::module_& m) {
           "add_pairs",
           &add_pair_set<System>,
           "pairs"_a, "a"_a, "b"_a, "A set of pairs between side a and b (-1: the robot).")
+      .def(
+          "add_attachment",
+          [](System& s, int link_joint, int object, double attach_at_s, double release_at_s) {
+            if (object < 0 || static_cast<std::size_t>(object) >= s.n_objects()) {
+              throw InputError("system: no free object " + std::to_string(object));
+            }
+            const int njoints = s.plant().dynamics().model().njoints;
+            if (link_joint < 1 || link_joint >= njoints) {
+              throw InputError("system: the robot has no joint " + std::to_string(link_joint));
+            }
+            if (!(std::isfinite(attach_at_s) && attach_at_s >= 0.0) ||
+                !(release_at_s > attach_at_s)) {
+              throw InputError("system: an attachment holds from attach_at_s >= 0 until a "
+                               "later release_at_s (inf: the run's end)");
+            }
+            uvms::Attachment held;
+            held.link_joint = link_joint;
+            held.object = object;
+            held.attach_at_s = attach_at_s;
+            held.release_at_s = release_at_s;
+            s.attachments.push_back(held);
+          },
+          "link_joint"_a, "object"_a, "attach_at_s"_a, "release_at_s"_a,
+          "Free object `object` held by the robot's joint `link_joint` from attach_at_s "
+          "until release_at_s [s] (inf: none), at the pose the two have when it begins.")
+      .def("forget_attachments", &System::forget_attachments,
+           "A run starts: each attachment is placed anew at the start of its first period.")
       .def(
           "set_object_world",
           [](System& s, std::size_t k, const uvms::WorldContactModel& world) {

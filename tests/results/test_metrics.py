@@ -160,6 +160,16 @@ def test_joints_past_their_limits_by_known_amounts_for_known_times():
     assert m["joint_limit_excess_time_fraction"] == 150 / N
     assert m["time_at_joint_stop_s"] == pytest.approx(250 * DT, rel=1e-12)
     assert compute_metrics(r)["joint_limit_excess_max_rad"] == m["joint_limit_excess_max_rad"]
+    # ... or past it by a rounding (a constraint's 1e-15): at its stop, not past it, though
+    # the largest excess stays exact
+    r.q[:, 7:] = 0.0
+    r.q[500:600, 10] = UPPER[3] + 4e-15
+    m = joint_limit_metrics(r)
+    assert m["joint_limit_excess_time_fraction"] == 0.0
+    assert 0.0 < m["joint_limit_excess_max_rad"] < 1e-14
+    assert m["time_at_joint_stop_s"] == pytest.approx(100 * DT, rel=1e-12)
+    r.q[500:600, 10] = UPPER[3] + 2e-9
+    assert joint_limit_metrics(r)["joint_limit_excess_time_fraction"] == 100 / N
 
 
 def test_a_joint_swinging_across_its_limit():

@@ -120,6 +120,10 @@ def energy_metrics(rollout: RolloutData) -> dict[str, float]:
 #: How close to a limit a joint counts as held at it [rad or m] (the constraint solve ends a
 #: joint within h times its 1e-8 tolerance of its limit, far below this)
 AT_LIMIT_RAD = 1e-6
+#: How far past a limit a joint must be to count in the time past it [rad or m]: a joint a
+#: constraint holds at its limit ends there to rounding (3.7e-15 rad measured on a finger of
+#: gripper_close with rigid moving contacts), which is at its stop, not past it
+PAST_LIMIT_RAD = 1e-9
 
 #: A wet fraction this far below 1 counts as partly out of the water (rounding aside).
 _WET = 1.0 - 1e-9
@@ -150,7 +154,8 @@ def joint_limit_metrics(rollout: RolloutData) -> dict[str, float]:
     over the joints that have limits (a continuous joint has none; {} if no joint has).
 
     With compliant stops a joint past its limit is pressing on its stop, by tau / k_s; with
-    the limits as constraints (the default with a control period) it rests at its limit, and
+    the limits as constraints (the default with a control period) it rests at its limit (to
+    rounding: the time share counts a joint more than ``PAST_LIMIT_RAD`` past it), and
     ``time_at_joint_stop_s`` counts the time some joint is within ``AT_LIMIT_RAD`` of a limit
     or past it. Without either nothing stops a joint, and a controller that drives one past
     its limit shows up here, not as a crash.
@@ -172,7 +177,7 @@ def joint_limit_metrics(rollout: RolloutData) -> dict[str, float]:
     q = arm_positions(rollout.q[:, 7:], kinds)[:, limited]
     excess = np.maximum(lower[limited] - q, 0.0) + np.maximum(q - upper[limited], 0.0)
     held = np.diff(rollout.time_s, append=rollout.time_s[-1])
-    past = np.any(excess > 0.0, axis=1)
+    past = np.any(excess > PAST_LIMIT_RAD, axis=1)
     # a limit solved as a constraint holds its joint AT the limit (to the solver's tolerance)
     gap = np.minimum(q - lower[limited], upper[limited] - q)
     at_stop = np.any(gap <= AT_LIMIT_RAD, axis=1)

@@ -100,6 +100,8 @@ def test_never_settling_a_large_error_and_a_joint_past_its_limit_are_failures():
     # the peak after t = 1 s is 0.2 N > 0.15 N
     row = comparison_row("ppc", r, SurgeLimited(), Criteria(after_s=1.0, tolerance_N=0.15))
     assert not row["success"] and "0.200 N > 0.15 N" in row["reason"]
+    r.q[500:510, 8] = 1.0 + 1e-14  # at its upper limit to rounding (a constraint's): held
+    assert comparison_row("ppc", r, SurgeLimited(), Criteria(after_s=2.0))["success"]
     r.q[500:510, 8] = 1.25  # joint 2 a quarter radian past its upper limit
     row = comparison_row("ppc", r, SurgeLimited(), Criteria(after_s=2.0))
     assert not row["success"] and row["reason"] == "an arm joint went 0.250 rad past its limit"

@@ -25,7 +25,7 @@ from typing import Any
 
 import numpy as np
 
-from uvms_pin.results.metrics import force_overshoot_N, joint_limit_metrics
+from uvms_pin.results.metrics import PAST_LIMIT_RAD, force_overshoot_N, joint_limit_metrics
 from uvms_pin.results.rollout import Rollout
 from uvms_pin.sim.actuation import Actuation
 
@@ -122,6 +122,6 @@ def _failure(row: dict[str, Any], rollout: Rollout, criteria: Criteria, stopped:
             f"{row['force_error_peak_N']:.3f} N > {criteria.tolerance_N:g} N"
         )
     excess = joint_limit_metrics(rollout).get("joint_limit_excess_max_rad", 0.0)
-    if excess > 0.0:
+    if excess > PAST_LIMIT_RAD:  # a constraint holds a joint at its limit to rounding
         return f"an arm joint went {excess:.3f} rad past its limit"
     return ""

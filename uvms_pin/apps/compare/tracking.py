@@ -14,6 +14,7 @@ from typing import Any
 
 import numpy as np
 
+from uvms_pin.results.metrics import PAST_LIMIT_RAD
 from uvms_pin.results.rollout import Rollout
 from uvms_pin.sim.actuation import Actuation
 
@@ -58,7 +59,7 @@ def tracking_row(
             f"no samples after the task's transient (t = {transient_s:g} s; the run ends at "
             f"{end_s:g} s)"
         )
-    elif row["joint_limit_excess_max_rad"] > 0.0:
+    elif row["joint_limit_excess_max_rad"] > PAST_LIMIT_RAD:  # rounding at a limit is not past it
         reason = f"an arm joint went {row['joint_limit_excess_max_rad']:.3f} rad past its limit"
     elif not metrics.get("task_settled", 0.0):
         final = metrics.get("task_position_error_final_m", math.nan)

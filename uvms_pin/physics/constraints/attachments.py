@@ -14,6 +14,9 @@ bodies over a period (each moves from q0 with its v+, a joint chain's end not on
 is removed at the rate beta a period, not integrated. One impulse acts on the link and its
 opposite on the object: the pair's momentum is kept, and a bilateral constraint at rest
 in its frame (e = 0) does no work, so it never adds energy.
+
+The compiled system of bodies mirrors it (src/uvms_core/moving_constraints.hpp: the same rows
+from the link's and the object's Jacobians, bilateral rows of its projected Gauss-Seidel).
 """
 
 from __future__ import annotations
@@ -28,12 +31,10 @@ from uvms_pin.errors import ParameterError
 from uvms_pin.physics.constraints.rows import ConstraintRows, evaluated
 from uvms_pin.physics.world.attachment import Attachment
 
-__all__ = ["ATTACHMENT_IMPULSE_UNIT", "ATTACHMENT_REFUSAL", "Attachments", "HeldObject"]
+__all__ = ["ATTACHMENT_IMPULSE_UNIT", "Attachments", "HeldObject"]
 
 #: an attachment's impulse: three forces and three moments over the period
 ATTACHMENT_IMPULSE_UNIT = "N s (3), N m s (3)"
-#: why a system with an attachment is not one compiled call a period
-ATTACHMENT_REFUSAL = "a free object attached to a link (the attachments are solved in Python)"
 
 
 @dataclass(frozen=True)

@@ -1,12 +1,13 @@
 """The compiled system of bodies (src/uvms_core/system.hpp) of a `uvms_pin.sim.system.System`
 with free objects or fixtures: its compiled plant, each free object's compiled dynamics (a
 floating body of its own), each fixture's (its joints, their damping, friction and limits:
-`uvms_pin.physics.world.fixture.Fixture`) and the moving contacts (`uvms_pin.physics.compiled.moving`), built from their
+`uvms_pin.physics.world.fixture.Fixture`), the attachments and the moving contacts (`uvms_pin.physics.compiled.moving`), built from their
 public attributes. One call crosses a control period: every body, every contact and the
 anchors' move at its end."""
 
 from __future__ import annotations
 
+import math
 from types import ModuleType
 from typing import Any, Protocol
 
@@ -25,6 +26,7 @@ class SystemParts(Protocol):
     objects: tuple
     fixtures: tuple
     moving: Any
+    attachments: Any  # `uvms_pin.physics.constraints.attachments.Attachments`, or None
 
 
 def system_to_core(system: SystemParts, core: ModuleType, *, alone: bool = False):
@@ -47,4 +49,13 @@ def system_to_core(system: SystemParts, core: ModuleType, *, alone: bool = False
         moving_to_core(system.moving.moving, out, core)
     except ModelError as exc:  # a piece without a compiled geometry
         return Fallback(f"a moving contact ({exc})")
+    # free object k is joint njoints + k of the system's model (`System.model`)
+    first_object_joint = system.plant.uvms.model.njoints
+    for spec, link_joint, object_joint in (
+        () if system.attachments is None else system.attachments.joints
+    ):
+        released = math.inf if spec.release_at_s is None else spec.release_at_s
+        out.add_attachment(
+            link_joint, object_joint - first_object_joint, spec.attach_at_s, released
+        )
     return out

@@ -11,15 +11,11 @@ pose, with its URDF limits). Per fixture f, over a period:
   reached within the period) and their Coulomb friction with stiction
   (`JointCoulombFriction`, a row per joint with c_j > 0, |lambda_j| <= c_j h).
 
-The compiled system of bodies (src/uvms_core/system.hpp) holds the fixtures with compliant
-moving contacts: their joints' dynamics and their exact step (src/uvms_core/joint_box.hpp),
-built from its ``limits``, ``damping`` and ``coulomb``. With rigid moving contacts a fixture's
-joints are solved with those rows in one problem, which only the Python reference does: such
-a system is stepped by the Python integrator (`COMPILED_REFUSAL`, said once in
-`why_not_compiled_system`) around the compiled robot dynamics and, with the compiled backend,
-the compiled contact search of every moving pair set
-(`uvms_pin.physics.compiled.moving.search_compiled`: the core's PiecePairs, the same
-arithmetic as `PiecePairs.forces`).
+The compiled system of bodies (src/uvms_core/system.hpp) holds the fixtures, built from their
+``limits``, ``damping`` and ``coulomb``: their joints' dynamics and their exact step
+(src/uvms_core/joint_box.hpp); with rigid moving contacts, the same choice as `with_fixtures`
+(a rigid contact acting on a fixture's joints brings its limits and friction into the one
+solve, src/uvms_core/moving_constraints.hpp).
 """
 
 from __future__ import annotations
@@ -39,7 +35,6 @@ from uvms_pin.physics.dynamics import forward_dynamics
 from uvms_pin.physics.world.fixture import Fixture
 
 __all__ = [
-    "COMPILED_REFUSAL",
     "FIXTURE_FRICTION",
     "FIXTURE_JOINTS",
     "FIXTURE_LIMITS",
@@ -50,14 +45,6 @@ __all__ = [
     "system_model",
     "with_fixtures",
 ]
-
-#: why a system with a fixture and rigid moving contacts is not one compiled call a period
-#: (its moving contacts are searched by the core all the same:
-#: `physics.compiled.moving.search_compiled`)
-COMPILED_REFUSAL = (
-    'a fixture (type = "urdf") with rigid moving contacts: its joints are solved with '
-    "those rows in one problem, which the compiled system does not do"
-)
 
 #: the names of the fixtures' constraint sets (their impulses in a solved period)
 FIXTURE_LIMITS, FIXTURE_FRICTION = "fixture_limits", "fixture_friction"

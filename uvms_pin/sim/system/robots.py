@@ -98,6 +98,17 @@ class Robots:
                 'fixtures ([[world.objects]] type = "urdf") are not simulated with several '
                 "robots yet: use one robot, or leave the fixture out"
             )
+        if any(
+            system.moving is not None and system.moving.moving.rigid_pairs for system in systems
+        ):
+            # the contacts between robots, and the other robots' with the objects, are the
+            # contact law's forces: only the first robot's pairs would be rigid rows
+            raise ParameterError(
+                '[world] moving_contact = "rigid" is not simulated with several robots yet: '
+                "their contacts with each other and the others' with the objects are "
+                "compliant, and a grasp rigid for one robot and compliant for the other "
+                "loses what they hold; leave moving_contact compliant"
+            )
         if any(system.attachments is not None for system in systems):
             raise ParameterError(
                 "attached_to ([[world.objects]]) is not simulated with several robots yet: "

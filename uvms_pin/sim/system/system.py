@@ -32,7 +32,7 @@ from uvms_pin.physics.compiled.moving import (
     memories_of,
     search_compiled,
 )
-from uvms_pin.physics.constraints.attachments import ATTACHMENT_REFUSAL, Attachments
+from uvms_pin.physics.constraints.attachments import Attachments
 from uvms_pin.physics.constraints.moving_contacts import MovingPairContacts
 from uvms_pin.physics.constraints.object_contacts import ObjectWorldContacts
 from uvms_pin.physics.constraints.step import StalledSolves
@@ -57,11 +57,6 @@ __all__ = ["System"]
 COMPILED_PATH = (
     "{bodies}: one compiled call a control period steps the system (the UVMS, every "
     "{each}, every contact between them and with the fixed world, the friction anchors)"
-)
-#: why joint Coulomb friction with rigid moving contacts is not one compiled call a period
-COULOMB_RIGID_REFUSAL = (
-    "the joints' Coulomb friction with rigid moving contacts: solved with those rows in one "
-    "problem, which the compiled system does not do"
 )
 #: ... or integrated in Python, and why
 PYTHON_PATH = (
@@ -185,6 +180,9 @@ class System:
         self.stalled = StalledSolves()
         if self.attachments is not None:  # each object held where it starts in its link
             self.attachments.place(self.model, state.q)
+            held = self.__dict__.get("_compiled")  # the core's: placed at its first period
+            if held is not None and not isinstance(held[1], Fallback):
+                held[1].forget_attachments()
         if self.moving is not None:
             self.moving.reset()
             robot, *objects = self.layout.split(state.q, state.v)
@@ -199,12 +197,6 @@ class System:
         plant_core = self.plant.compiled
         if not (self.objects or self.fixtures) or plant_core is None:
             return None
-        if self.fixtures and self.moving.moving.rigid_pairs:
-            return Fallback(fixture_joints.COMPILED_REFUSAL)
-        if self.plant.joint_coulomb is not None and self.moving.moving.rigid_pairs:
-            return Fallback(COULOMB_RIGID_REFUSAL)
-        if self.attachments is not None:
-            return Fallback(ATTACHMENT_REFUSAL)
         held = self.__dict__.get("_compiled")
         if held is None or held[0] is not plant_core:
             held = self._compiled = (plant_core, system_to_core(self, core_module()))
