@@ -5,6 +5,7 @@ the same camera images; the backend chosen once, where the scene is built."""
 from __future__ import annotations
 
 import math
+import sys
 from pathlib import Path
 
 import numpy as np
@@ -26,9 +27,11 @@ from uvms_pin.perception.shapes import (
     box,
     convex_of_points,
 )
-from uvms_pin.physics.world.objects import plane, solid
 
 ROCK = Path(__file__).resolve().parents[2] / "scenarios" / "meshes" / "rock.obj"
+sys.path.insert(0, str(ROCK.parents[2] / "benchmarks"))
+import bench_perception  # noqa: E402  (its scene is the one benchmarked)
+
 TOL = 1e-12
 
 
@@ -195,31 +198,9 @@ def test_many_origins_are_cast_by_the_reference():
 
 
 def _seen(uvms, backend: str) -> Scene:
-    """The benchmark's scene: a seabed, five solids and the rock mesh, the robot above."""
-    friction = (0.5, 0.4)
-    objects = [
-        plane("seabed", [0, 0, -10.0], [0, 0, 1.0], *friction),
-        solid("ball", "sphere", {"radius_m": 0.4}, [3, 0, -9.2], [0, 0, 0], *friction),
-        solid("crate", "box", {"size_m": [1, 1, 0.6]}, [4, 1.2, -9.5], [0, 0, 0.4], *friction),
-        solid(
-            "pipe",
-            "cylinder",
-            {"radius_m": 0.2, "length_m": 3},
-            [5, -1.5, -9.7],
-            [1.5708, 0, 0.3],
-            *friction,
-        ),
-        solid(
-            "egg",
-            "ellipsoid",
-            {"semi_axes_m": [0.3, 0.4, 0.5]},
-            [3.5, -0.8, -9.4],
-            [0, 0, 0],
-            *friction,
-        ),
-        solid("rock", "mesh", {"path": str(ROCK)}, [2.5, 0.8, -9.8], [0, 0, 0], *friction),
-    ]
-    scene = Scene(uvms, objects, backend=backend)
+    """The benchmark's scene (benchmarks/bench_perception.py: a seabed, five solids and the
+    rock mesh), the robot above."""
+    scene = Scene(uvms, bench_perception.objects(), backend=backend)
     q = uvms.neutral_configuration()
     q[2] = -9.0
     q[7:] += 0.3  # the arm bent into view
