@@ -11,6 +11,7 @@ import uvms_pin as up
 from tests.conftest import random_state
 from uvms_pin.errors import ParameterError
 from uvms_pin.flow import AiryWave, UniformCurrent
+from uvms_pin.physics.dynamics import water_of_call
 
 CURRENT = np.array([0.3, -0.1, 0.05])
 
@@ -95,6 +96,26 @@ def test_current_world_equals_the_uniform_current_and_follows_a_changed_array(re
     assert not np.allclose(changed[1], first[1])
     for a, b in zip(changed, want, strict=True):
         np.testing.assert_array_equal(a, b)
+
+
+def test_a_kept_current_is_reused_by_its_bytes_and_a_bad_one_still_refused(reference_uvms):
+    """`water_of_call` hands a current given again (the same float64 bytes) the flow it
+    built for it without checking it again; anything else is checked: a non-finite entry,
+    a wrong shape, zero (still water), another dtype or a list."""
+    uvms = reference_uvms
+    kept = water_of_call(uvms, CURRENT.copy(), None)
+    assert water_of_call(uvms, CURRENT.copy(), None) is kept  # the same bytes, another array
+    assert water_of_call(uvms, CURRENT.astype(np.float32).astype(float), None) is not None
+    for bad, message in [
+        (np.array([np.nan, 0.0, 0.0]), "current_world contains a non-finite value"),
+        (np.r_[CURRENT, 0.0], "current_world must have shape"),
+        (CURRENT[:2], "current_world must have shape"),
+    ]:
+        with pytest.raises(ParameterError, match=message):
+            water_of_call(uvms, bad, None)
+    assert water_of_call(uvms, np.zeros(3), None) is None
+    assert water_of_call(uvms, list(CURRENT), None).velocity_world_m_s.tolist() == list(CURRENT)
+    assert water_of_call(uvms, CURRENT.astype(np.float32), None) is not None
 
 
 @pytest.mark.parametrize(
