@@ -127,6 +127,15 @@ void CoupledConstraintStep::add_pair_rows(const SystemAtStart& at, const Eigen::
   }
 }
 
+Eigen::Index CoupledConstraintStep::add_coordinate_row(Eigen::Index iv, double sign,
+                                                      double drift) {
+  Eigen::RowVectorXd row = Eigen::RowVectorXd::Zero(nv_);
+  row[iv] = sign;
+  rows_.push_back(row);
+  drift_.push_back(drift);
+  return static_cast<Eigen::Index>(rows_.size()) - 1;
+}
+
 void CoupledConstraintStep::add_attachment_rows(const SystemAtStart& at, double h) {
   for (const AttachmentAtStart& held : at.attachments) {
     const auto k = static_cast<std::size_t>(held.object);
@@ -157,7 +166,6 @@ void CoupledConstraintStep::add_attachment_rows(const SystemAtStart& at, double 
 
 void CoupledConstraintStep::add_fixture_rows(const SystemAtStart& at, const Eigen::VectorXd& speed,
                                              double h) {
-  const auto phi = [&](double gap) { return gap >= 0.0 ? gap : correction * gap; };
   // the limits (fixtures.constraints' JointLimits: lower rows first, then upper)
   for (const bool lower : {true, false}) {
     for (const FixtureAtStart& fixture : at.fixtures) {
@@ -167,11 +175,7 @@ void CoupledConstraintStep::add_fixture_rows(const SystemAtStart& at, const Eige
         const Eigen::Index iv = fixture.offset + j;
         const double gap = lower ? fixture.q0[j] - bound : bound - fixture.q0[j];
         if (gap > h * speed[iv] + margin) continue;
-        Eigen::RowVectorXd row = Eigen::RowVectorXd::Zero(nv_);
-        row[iv] = lower ? 1.0 : -1.0;
-        unilateral_.push_back(static_cast<Eigen::Index>(rows_.size()));
-        rows_.push_back(row);
-        drift_.push_back(phi(gap) / h);
+        unilateral_.push_back(add_coordinate_row(iv, lower ? 1.0 : -1.0, phi(gap) / h));
       }
     }
   }
@@ -180,11 +184,7 @@ void CoupledConstraintStep::add_fixture_rows(const SystemAtStart& at, const Eige
     for (Eigen::Index j = 0; j < fixture.q0.size(); ++j) {
       const double c = (*fixture.coulomb)[j];
       if (!(c > 0.0)) continue;
-      Eigen::RowVectorXd row = Eigen::RowVectorXd::Zero(nv_);
-      row[fixture.offset + j] = 1.0;
-      boxes_.push_back({static_cast<Eigen::Index>(rows_.size()), c * h});
-      rows_.push_back(row);
-      drift_.push_back(0.0);
+      boxes_.push_back({add_coordinate_row(fixture.offset + j, 1.0, 0.0), c * h});
     }
   }
 }
@@ -198,7 +198,6 @@ int CoupledConstraintStep::select(const SystemAtStart& at, const Eigen::VectorXd
   boxes_.clear();
   cone_rows_.clear();
   pair_rows_.clear();
-  const auto phi = [&](double gap) { return gap >= 0.0 ? gap : correction * gap; };
   if (at.limits != nullptr) {  // lower rows first, then upper (joint_limits.py's order)
     const auto& limits = *at.limits;
     for (const bool lower : {true, false}) {
@@ -208,11 +207,7 @@ int CoupledConstraintStep::select(const SystemAtStart& at, const Eigen::VectorXd
         const double gap = lower ? at.q0_robot[iq] - limits.lower_rad[k]
                                  : limits.upper_rad[k] - at.q0_robot[iq];
         if (gap > h * speed[iv] + limits.margin) continue;
-        Eigen::RowVectorXd row = Eigen::RowVectorXd::Zero(nv_);
-        row[iv] = lower ? 1.0 : -1.0;
-        unilateral_.push_back(static_cast<Eigen::Index>(rows_.size()));
-        rows_.push_back(row);
-        drift_.push_back(phi(gap) / h);
+        unilateral_.push_back(add_coordinate_row(iv, lower ? 1.0 : -1.0, phi(gap) / h));
       }
     }
   }
@@ -220,11 +215,7 @@ int CoupledConstraintStep::select(const SystemAtStart& at, const Eigen::VectorXd
   for (Eigen::Index iv = 0; iv < at.joint_coulomb.size(); ++iv) {
     const double c = at.joint_coulomb[iv];
     if (!(c > 0.0)) continue;
-    Eigen::RowVectorXd row = Eigen::RowVectorXd::Zero(nv_);
-    row[iv] = 1.0;
-    boxes_.push_back({static_cast<Eigen::Index>(rows_.size()), c * h});
-    rows_.push_back(row);
-    drift_.push_back(0.0);
+    boxes_.push_back({add_coordinate_row(iv, 1.0, 0.0), c * h});
   }
   for (std::size_t i = 0; i < at.objects.size(); ++i) {
     object_rows_[i] = static_cast<Eigen::Index>(rows_.size());

@@ -156,6 +156,10 @@ class CoupledConstraintStep {
   void add_fixture_rows(const SystemAtStart& at, const Eigen::VectorXd& speed, double h);
   // each attachment's six bilateral rows
   void add_attachment_rows(const SystemAtStart& at, double h);
+  // A row sign e_iv (a joint's limit or friction) with its drift; returns its index.
+  Eigen::Index add_coordinate_row(Eigen::Index iv, double sign, double drift);
+  // phi(r) / h's numerator: a gap r >= 0 as it is, a penetration by the correction
+  double phi(double gap) const { return gap >= 0.0 ? gap : correction * gap; }
   // each body's range of columns in v (robot, objects, fixtures)
   std::vector<std::pair<Eigen::Index, Eigen::Index>> bodies_;
   std::vector<char> acting_;
