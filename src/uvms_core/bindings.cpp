@@ -28,6 +28,7 @@ void bind_step_derivatives(nb::module_& m);  // step_bindings.cpp
 void bind_system(nb::module_& m);  // system_bindings.cpp
 void bind_robots(nb::module_& m);  // system_bindings.cpp
 void bind_perception(nb::module_& m);  // perception_bindings.cpp
+void bind_ocp(nb::module_& m);  // ocp_bindings.cpp
 
 namespace {
 
@@ -592,4 +593,5 @@ NB_MODULE(_core, m) {
   bind_ppc(m);
   bind_sampled_loop(m);
   bind_perception(m);
+  bind_ocp(m);
 }

@@ -199,31 +199,42 @@ def test_the_force_task_previews_the_desired_force_and_places_its_spring(referen
     )
 
 
+def _spy_on_plans(controller) -> list[tuple]:
+    """The (x, cold, iterations, warm start, regularization) and the returned preg of each
+    re-plan ``controller`` makes from now on (whichever planner solves it)."""
+    calls, plan = [], controller._plan
+
+    def spy(x, cold, iterations, warm, regularization):
+        guess, cost, preg = plan(x, cold, iterations, warm, regularization)
+        calls.append((x, cold, iterations, warm, regularization, preg))
+        return guess, cost, preg
+
+    controller._plan = spy
+    return calls
+
+
+@pytest.mark.parametrize("planner", ["core", "python"])
 @pytest.mark.parametrize("rate_hz", [20.0, 5.0])
 def test_the_warm_start_moves_the_last_plan_on_by_the_time_since_it(
-    reference_uvms, monkeypatch, rate_hz
+    reference_uvms, rate_hz, planner
 ):
     """The second plan starts from the first moved on by the time between them in whole
     nodes (dt_s = 0.05: one node at 20 Hz, four at 5 Hz), the measured state first and the
     last node repeated at the end: a plan started from a guess misaligned in time begins
     from where the vehicle was told to be earlier."""
     q0 = _start(reference_uvms)
-    controller, _ = _controller(reference_uvms, reference_uvms, q0, rate_hz=rate_hz)
-    starts = []
-    solve = problems.solve
-
-    def spy(problem, **kw):
-        starts.append(kw["warm_start"])
-        return solve(problem, **kw)
-
-    monkeypatch.setattr(problems, "solve", spy)
+    controller, _ = _controller(
+        reference_uvms, reference_uvms, q0, rate_hz=rate_hz, planner=planner
+    )
+    assert (controller.planner_path == "compiled") == (planner == "core")
+    calls = _spy_on_plans(controller)
     v0 = np.zeros(reference_uvms.nv)
     controller.compute(0.0, Measurement(0.0, q0, v0, np.zeros(6)))
     xs, us = (list(part) for part in controller._guess)
     later = 1.0 / rate_hz
     controller.compute(later, Measurement(later, q0, v0, np.zeros(6)))
     shift = round(later / 0.05)
-    start_xs, start_us = starts[1]
+    start_xs, start_us = calls[1][3]
     assert len(start_xs) == len(xs) and len(start_us) == len(us)
     np.testing.assert_array_equal(start_xs[0], np.r_[q0, v0])
     for k in range(1, len(xs)):
@@ -232,23 +243,16 @@ def test_the_warm_start_moves_the_last_plan_on_by_the_time_since_it(
         np.testing.assert_array_equal(start_us[k], us[min(k + shift, len(us) - 1)])
 
 
+@pytest.mark.parametrize("planner", ["core", "python"])
 def test_the_mpc_replans_at_its_rate_cold_longer_then_from_the_last_regularization(
-    reference_uvms, monkeypatch
+    reference_uvms, planner
 ):
     """At 20 Hz sampled every 10 ms: a plan at 0 and 0.05 s only, tau held in between; the
     first (cold) plan runs COLD_START_ITERATIONS, the warm one ``iterations`` (2) from the
     regularization the first ended with."""
     q0 = _start(reference_uvms)
-    controller, _ = _controller(reference_uvms, reference_uvms, q0, rate_hz=20.0)
-    calls = []
-    solve = problems.solve
-
-    def spy(problem, **kw):
-        solver = solve(problem, **kw)
-        calls.append((kw["iterations"], kw["regularization"], solver.preg))
-        return solver
-
-    monkeypatch.setattr(problems, "solve", spy)
+    controller, _ = _controller(reference_uvms, reference_uvms, q0, rate_hz=20.0, planner=planner)
+    calls = _spy_on_plans(controller)
     v0 = np.zeros(reference_uvms.nv)
     taus = [
         controller.compute(t, Measurement(t, q0, v0, np.zeros(6)))
@@ -257,6 +261,10 @@ def test_the_mpc_replans_at_its_rate_cold_longer_then_from_the_last_regularizati
     assert len(calls) == 2
     for tau in taus[1:5]:
         np.testing.assert_array_equal(tau, taus[0])
-    (cold_iterations, cold_start, cold_end), (warm_iterations, warm_start, _) = calls
+    (
+        (*_, cold, cold_iterations, _, cold_start, cold_end),
+        (*_, warm, warm_iterations, _, warm_start, _),
+    ) = calls
+    assert (cold, warm) == (True, False)
     assert (cold_iterations, warm_iterations) == (COLD_START_ITERATIONS, 2)
     assert cold_start is None and warm_start == cold_end

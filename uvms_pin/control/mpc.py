@@ -42,12 +42,16 @@ from uvms_pin.errors import ParameterError
 from uvms_pin.flow import FlowField
 from uvms_pin.model.uvms import UVMS
 from uvms_pin.ocp import problems
+from uvms_pin.ocp.compiled import place_contact, planner_of
+from uvms_pin.physics.compiled.backend import Fallback
 from uvms_pin.physics.contact import ContactModel
 from uvms_pin.physics.derivatives.task_contact import TaskContact
 
 __all__ = ["MpcController", "MpcForceTask"]
 
 TASKS = ("station", "end_effector", "force")
+#: where the re-plans are solved (`MpcController`'s ``planner``)
+PLANNERS = ("core", "python")
 #: the iterations of a plan without a warm start (the first, or every one without warm_start)
 COLD_START_ITERATIONS = 20
 #: the line search of a warm-started re-plan: each trial step costs one rollout of the
@@ -99,6 +103,12 @@ class MpcController(Controller):
         pose_weights: of the target pose's error (x, y, z [m], rotation [rad]); None: the
             problem's default (`problems.station_hold`, `problems.point_to_point`).
         force_task: the force task's `MpcForceTask` (task "force" only; ``target`` unused).
+        planner: "core": each re-plan solved in the compiled core, crocoddyl's C++ FDDP on
+            the compiled nodes (`uvms_pin.ocp.compiled`; where the core has no
+            counterpart, e.g. the "csqp" solver or a cost of the user's own class, the
+            Python problem is solved instead and `planner_path` says why); "python": the
+            Python problem always (crocoddyl calling `uvms_pin.ocp.model` per node, the
+            reference the compiled planner is tested against).
     """
 
     def __init__(
@@ -120,6 +130,7 @@ class MpcController(Controller):
         pose_weights: np.ndarray | None = None,
         backend: str = "core",
         force_task: MpcForceTask | None = None,
+        planner: str = "core",
     ):
         if task not in TASKS:
             raise ParameterError(f"mpc task must be one of {TASKS}, got '{task}'")
@@ -131,6 +142,8 @@ class MpcController(Controller):
             )
         problems.check_solver(solver)
         problems.check_integrator(integrator)
+        if planner not in PLANNERS:
+            raise ParameterError(f"mpc planner must be one of {PLANNERS}, got '{planner}'")
         if not (rate_hz > 0.0 and math.isfinite(rate_hz)) or iterations < 1:
             raise ParameterError(
                 f"mpc needs rate_hz > 0 and iterations >= 1, got {rate_hz}, {iterations}"
@@ -160,6 +173,17 @@ class MpcController(Controller):
         self.input_matrix = (
             np.eye(uvms.nv) if actuators.input_matrix is None else actuators.input_matrix
         )
+        # the re-plans in the core (no Python per node), decided once: the planner, or the
+        # reason the Python problem is solved instead (`planner_path`)
+        compiled = planner_of(self.problem, solver) if backend == planner == "core" else None
+        self._planner = None if isinstance(compiled, Fallback | None) else compiled
+        if self._planner is not None:
+            self.planner_path = "compiled"
+        elif compiled is None:
+            self.planner_path = f"asked for: backend '{backend}', planner '{planner}'"
+        else:
+            self.planner_path = compiled.reason
+        self._plan = self._plan_compiled if self._planner is not None else self._plan_python
         self.reset()
 
     def _force_problem(self, task: MpcForceTask, x_ref: np.ndarray, common: dict):
@@ -229,27 +253,51 @@ class MpcController(Controller):
             self._signals.update(self._force_signals(time_s, measurement))
         if time_s < self._last_plan_s + self.period_s - 1e-12:
             return self._tau
+        cold = self._guess is None or not self.warm_start
         if self.force_task is not None:
             self._start_force_plan(time_s, measurement)
         x = np.r_[measurement.q, measurement.v]
         self.problem.x0 = x
-        cold = self._guess is None or not self.warm_start
+        iterations = max(self.iterations, COLD_START_ITERATIONS) if cold else self.iterations
+        warm = self._initial_guess(x, time_s - self._last_plan_s)
+        regularization = self._regularization if self.warm_start else None
+        self._guess, cost, self._regularization = self._plan(
+            x, cold, iterations, warm, regularization
+        )
+        u0 = self._guess[1][0].copy()
+        self._tau = self.input_matrix @ u0
+        self._last_plan_s = time_s
+        self._signals.update({"mpc_cost": np.array([cost]), "mpc_u": u0})
+        return self._tau
+
+    def _plan_python(self, x, cold, iterations, warm, regularization):
+        """One re-plan by crocoddyl from Python (the reference): ((xs, us), cost, preg)."""
         if self.solver != "csqp":  # (CSQP's filter line search keeps its own steps)
             self._solver.alphas = self._cold_steps if cold else list(REPLAN_STEP_LENGTHS)
         solver = problems.solve(
             self.problem,
-            iterations=max(self.iterations, COLD_START_ITERATIONS) if cold else self.iterations,
-            warm_start=self._initial_guess(x, time_s - self._last_plan_s),
+            iterations=iterations,
+            warm_start=warm,
             solver=self._solver,
-            regularization=self._regularization if self.warm_start else None,
+            regularization=regularization,
         )
-        self._guess = problems.solution(solver)
-        self._regularization = solver.preg
-        u0 = self._guess[1][0].copy()
-        self._tau = self.input_matrix @ u0
-        self._last_plan_s = time_s
-        self._signals.update({"mpc_cost": np.array([solver.cost]), "mpc_u": u0})
-        return self._tau
+        return problems.solution(solver), solver.cost, solver.preg
+
+    def _plan_compiled(self, x, cold, iterations, warm, regularization):
+        """The same re-plan in the core (`uvms_pin.ocp.compiled`): the problem's
+        initial state, environment and desired forces given to the planner first."""
+        planner = self._planner
+        planner.set_x0(x)
+        if self.force_task is not None:
+            place_contact(planner, self._contact.model)
+            for node, term in enumerate(self.force_tracking.forces):
+                planner.set_force_target(node, term.target_N)
+        steps = planner.default_step_lengths if cold else list(REPLAN_STEP_LENGTHS)
+        result = planner.solve(
+            *warm, iterations, math.nan if regularization is None else regularization, steps
+        )
+        guess = ([np.array(v) for v in planner.xs], [np.array(v) for v in planner.us])
+        return guess, result.cost, result.regularization
 
     def signals(self) -> dict[str, np.ndarray]:
         return self._signals
