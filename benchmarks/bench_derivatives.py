@@ -27,10 +27,12 @@ rounds; threads share the work, so CPU time would hide the gain) over the same `
 
 A third table times one re-plan of the MPC controller (`uvms_pin.control.mpc`, station
 keeping in the current with the BlueROV2 Heavy's eight bounded thrusters, a 1 s horizon of
-50 nodes, 50 Hz, warm-started BoxFDDP) and gives its real-time factor (the 20 ms period over
-the CPU time of a re-plan; > 1: faster than real time on one core); and of the force-task
-MPC of scenarios/mpc_force_tracking.toml (the LBV150's four thrusters, the spring in every
-node's dynamics and its derivatives, the same horizon and rate) from the scenario's start.
+50 nodes, 50 Hz and 100 Hz, warm-started BoxFDDP) and gives its real-time factor (the
+period over the CPU time of a re-plan; > 1: faster than real time on one core); and of the
+force-task MPC of scenarios/mpc_force_tracking.toml (the LBV150's four thrusters, the spring
+in every node's dynamics and its derivatives, the same horizon, 50 Hz) from the scenario's
+start. Each on the compiled planner (the default: `uvms_pin.ocp.compiled`) and on the
+Python one (crocoddyl calling the Python nodes, which call the compiled dynamics).
 """
 
 from __future__ import annotations
@@ -137,8 +139,15 @@ def cases_of(system) -> dict[str, object]:
     return cases
 
 
-def mpc_cases(system) -> dict[str, object]:
-    """One warm-started re-plan of a station-keeping MPC per call, at 1 and 3 iterations."""
+#: the MPC's planners: "core" (the compiled OCP, crocoddyl's C++ FDDP on the compiled
+#: nodes) and "python" (crocoddyl calling uvms_pin.ocp's Python nodes, which call the core)
+PLANNERS = ("core", "python")
+
+
+def mpc_cases(system) -> dict[str, tuple[object, float]]:
+    """One warm-started re-plan of a station-keeping MPC per call, at 1 and 3 iterations on
+    both planners, and at 100 Hz (the period 10 ms) on the compiled one: name -> (call,
+    period [s])."""
     import pinocchio as pin_
 
     from uvms_pin.control.measurement import Measurement
@@ -155,8 +164,10 @@ def mpc_cases(system) -> dict[str, object]:
     )
     actuators = Actuators(up.input_matrix(thrusters, uvms.nv), bounds)
     measurement = Measurement(0.0, q0, system.v0, np.zeros(6))
+    settings = [(planner, n, 50.0) for planner in PLANNERS for n in (1, 3)]
+    settings.append(("core", 1, 100.0))
     cases = {}
-    for iterations in (1, 3):
+    for planner, iterations, rate_hz in settings:
         controller = MpcController(
             uvms,
             task="station",
@@ -164,35 +175,44 @@ def mpc_cases(system) -> dict[str, object]:
             posture=q0,
             horizon_s=1.0,
             dt_s=0.02,
-            rate_hz=50.0,
+            rate_hz=rate_hz,
             iterations=iterations,
             actuators=actuators,
             flow=up.flow.UniformCurrent(CURRENT_WORLD_M_S),
+            planner=planner,
         )
         clock = itertools.count()
-        cases[f"MPC station re-plan, 50 nodes, {iterations} iteration(s)"] = (
-            lambda c=controller, k=clock: c.compute(0.02 * next(k), measurement)
+        period = 1.0 / rate_hz
+        name = f"station, {iterations} iteration(s), {rate_hz:.0f} Hz, {planner} planner"
+        cases[name] = (
+            lambda c=controller, k=clock, p=period: c.compute(p * next(k), measurement),
+            period,
         )
     return cases
 
 
-def mpc_force_cases() -> dict[str, object]:
+def mpc_force_cases() -> dict[str, tuple[object, float]]:
     """One warm-started re-plan of scenarios/mpc_force_tracking.toml's MPC per call, at 1
-    and 3 iterations, from the scenario's initial state (the desired force 0.4 N away)."""
+    and 3 iterations on both planners, from the scenario's initial state (the desired force
+    0.4 N away): name -> (call, period [s])."""
     from uvms_pin.control.measurement import Measurement
     from uvms_pin.scenario.load import load_scenario
 
     cases = {}
-    for iterations in (1, 3):
-        scenario = load_scenario(
-            ROOT / "scenarios" / "mpc_force_tracking.toml", {"controller.iterations": iterations}
-        )
-        controller = scenario.controller_factory(scenario.plant.uvms)
-        measurement = Measurement(0.0, scenario.q0, scenario.v0, np.zeros(6))
-        clock = itertools.count()
-        cases[f"MPC force task re-plan, 50 nodes, {iterations} iteration(s)"] = (
-            lambda c=controller, k=clock, m=measurement: c.compute(0.02 * next(k), m)
-        )
+    for planner in PLANNERS:
+        for iterations in (1, 3):
+            scenario = load_scenario(
+                ROOT / "scenarios" / "mpc_force_tracking.toml",
+                {"controller.iterations": iterations, "controller.planner": planner},
+            )
+            controller = scenario.controller_factory(scenario.plant.uvms)
+            measurement = Measurement(0.0, scenario.q0, scenario.v0, np.zeros(6))
+            clock = itertools.count()
+            name = f"force task, {iterations} iteration(s), 50 Hz, {planner} planner"
+            cases[name] = (
+                lambda c=controller, k=clock, m=measurement: c.compute(0.02 * next(k), m),
+                0.02,
+            )
     return cases
 
 
@@ -232,12 +252,12 @@ def batch_table(system, unit_s: float, repeat: int) -> str:
     return "\n".join(rows) + "\n"
 
 
-def mpc_table(times: dict[str, float], unit: float) -> str:
+def mpc_table(times: dict[str, float], periods: dict[str, float], unit: float) -> str:
     rows = [
-        "| MPC (1 s horizon, 50 Hz) | x pin.aba | real-time factor |",
+        "| MPC re-plan (1 s horizon, 50 nodes, warm) | x pin.aba | real-time factor |",
         "|---|---:|---:|",
     ]
-    rows += [f"| {name} | {t / unit:.0f} | {0.02 / t:.1f} |" for name, t in times.items()]
+    rows += [f"| {name} | {t / unit:.0f} | {periods[name] / t:.1f} |" for name, t in times.items()]
     return "\n".join(rows) + "\n"
 
 
@@ -257,11 +277,18 @@ def main() -> None:
         system = reference_system()
         times = best_times(cases_of(system), args.repeat)
         cases = {**mpc_cases(system), **mpc_force_cases()}
-        # one re-plan per sample (10-35 ms): a third of the rounds, at least 5
-        mpc = best_times(cases, max(5, args.repeat // 3), batch_s=0.0)
+        # one re-plan per sample (3-80 ms): a third of the rounds, at least 5
+        calls = {name: call for name, (call, _) in cases.items()}
+        mpc = best_times(calls, max(5, args.repeat // 3), batch_s=0.0)
         unit = times["pin.aba (rigid, the unit)"]
         batch = batch_table(system, unit, args.repeat)
-    text = table(times) + "\n" + batch + "\n" + mpc_table(mpc, unit)
+    text = (
+        table(times)
+        + "\n"
+        + batch
+        + "\n"
+        + mpc_table(mpc, {name: period for name, (_, period) in cases.items()}, unit)
+    )
     print(text)
     args.out.parent.mkdir(parents=True, exist_ok=True)
     args.out.write_text(text)

@@ -65,17 +65,31 @@ def test_mpc_solver_and_integrator_keys_reach_the_controller():
     nodes, the thrust bounds as the nodes' constraints; the scenario's choices are the ocp
     layer's."""
     pytest.importorskip("mim_solvers")
+    from uvms_pin.control.mpc import PLANNERS
     from uvms_pin.ocp import problems
     from uvms_pin.scenario import mpc
 
     assert mpc.SOLVERS == problems.SOLVERS and mpc.INTEGRATORS == problems.INTEGRATORS
+    assert mpc.PLANNERS == PLANNERS
     overrides = {"controller.solver": "csqp", "controller.integrator": "rk4"}
     scenario = load_scenario(FORCE_SCENARIO, overrides)
     controller = scenario.controller_factory(scenario.plant.uvms)
     assert type(controller._solver).__name__ == "SolverCSQP"
+    assert "csqp" in controller.planner_path  # mim_solvers' CSQP: the Python problem
     node = controller.problem.runningModels[0]
     assert type(node).__name__ == "IntegratedActionModelRK"
     assert node.ng == node.nu and np.all(node.g_ub > 0.0)
+
+
+@pytest.mark.parametrize("planner", ["core", "python"])
+def test_the_planner_key_chooses_where_the_replans_are_solved(planner):
+    """planner = "core" (the default) solves each re-plan in the compiled OCP, "python"
+    crocoddyl on the Python nodes; anything else is refused naming the key."""
+    scenario = load_scenario(FORCE_SCENARIO, {"controller.planner": planner})
+    controller = scenario.controller_factory(scenario.plant.uvms)
+    assert (controller.planner_path == "compiled") == (planner == "core")
+    with pytest.raises(ScenarioError, match="planner"):
+        load_scenario(FORCE_SCENARIO, {"controller.planner": "gpu"})
 
 
 FORCE_SCENARIO = SCENARIO.with_name("mpc_force_tracking.toml")

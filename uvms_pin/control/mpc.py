@@ -213,8 +213,10 @@ class MpcController(Controller):
         self._tau = np.zeros(self.uvms.nv)
         self._signals: dict[str, np.ndarray] = {}
         # one solver for the run: each re-plan starts from the last one's regularization
-        self._solver = problems.solver_of(self.problem, self.solver)
-        self._cold_steps = list(self._solver.alphas)
+        # (the Python problem's only when it is the one solved: its nodes' data are many)
+        if self._planner is None:
+            self._solver = problems.solver_of(self.problem, self.solver)
+            self._cold_steps = list(self._solver.alphas)
         self._regularization: float | None = None
 
     def _initial_guess(self, x: np.ndarray, elapsed_s: float) -> tuple[list, list]:

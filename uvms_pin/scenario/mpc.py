@@ -51,10 +51,12 @@ _NODE_BYTES_AT_NV_10 = 143e3
 
 #: the tasks and what their targets are
 TASKS = ("station", "end_effector", "force")
-#: the solvers and the nodes' integrators (`uvms_pin.ocp.problems`' SOLVERS, INTEGRATORS:
-#: not imported here, the ocp layer needs crocoddyl; tests/scenario check they agree)
+#: the solvers, the nodes' integrators and the planners (`uvms_pin.ocp.problems`' SOLVERS,
+#: INTEGRATORS, `uvms_pin.control.mpc.PLANNERS`: not imported here, the ocp layer needs
+#: crocoddyl; tests/scenario check they agree)
 SOLVERS = ("box_fddp", "fddp", "csqp")
 INTEGRATORS = ("euler", "rk4")
+PLANNERS = ("core", "python")
 
 
 def _target(t: Table, uvms: UVMS, task: str) -> pin.SE3 | None:
@@ -123,6 +125,7 @@ def read_mpc(t: Table, context: ControllerContext) -> ControllerSpec:
     fields["solver"] = t.string("solver", "box_fddp", choices=SOLVERS)
     fields["integrator"] = t.string("integrator", "euler", choices=INTEGRATORS)
     fields["warm_start"] = t.boolean("warm_start", True)
+    fields["planner"] = t.string("planner", "core", choices=PLANNERS)
     if task != "force":
         default_weights = [100.0] * 6 if task == "station" else [1.0, 1.0, 1.0, 0.1, 0.1, 0.1]
         fields["pose_weights"] = t.vector("pose_weights", 6, default_weights, nonneg=True)
