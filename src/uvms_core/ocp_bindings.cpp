@@ -6,6 +6,7 @@
 #include <nanobind/stl/variant.h>
 #include <nanobind/stl/vector.h>
 
+#include "law_mpc.hpp"
 #include "ocp_planner.hpp"
 
 namespace nb = nanobind;
@@ -98,4 +99,43 @@ void bind_ocp(nb::module_& m) {
           "node"_a, "x"_a, "u"_a,
           "Node k's differential model at (x, u), calc then calcDiff: its crocoddyl outputs "
           "(xout, cost, r, Fx, Fu, Lx, Lu, Lxx, Luu, Lxu) as a dict.");
+
+  // ---- the MPC as a law of the sampled loop (law_mpc.hpp) -----------------------------------
+  using uvms::MpcLaw;
+  using uvms::MpcLawSettings;
+  using uvms::MpcLawState;
+  nb::class_<MpcLawSettings>(m, "MpcLawSettings", "The MPC law's settings (law_mpc.hpp).")
+      .def(nb::init<>())
+      .def_rw("period_s", &MpcLawSettings::period_s)
+      .def_rw("dt_s", &MpcLawSettings::dt_s)
+      .def_rw("iterations", &MpcLawSettings::iterations)
+      .def_rw("cold_iterations", &MpcLawSettings::cold_iterations)
+      .def_rw("warm_start", &MpcLawSettings::warm_start)
+      .def_rw("replan_step_lengths", &MpcLawSettings::replan_step_lengths)
+      .def_rw("force_task", &MpcLawSettings::force_task)
+      .def_rw("ee_frame_id", &MpcLawSettings::ee_frame_id)
+      .def_rw("rpy_desired", &MpcLawSettings::rpy_desired)
+      .def_rw("contact", &MpcLawSettings::contact)
+      .def_rw("place_at_tip", &MpcLawSettings::place_at_tip);
+  nb::class_<MpcLawState>(m, "MpcLawState", "The MPC law's state, handed to and from Python.")
+      .def(nb::init<>())
+      .def_rw("has_plan", &MpcLawState::has_plan)
+      .def_rw("last_plan_s", &MpcLawState::last_plan_s)
+      .def_rw("xs", &MpcLawState::xs)
+      .def_rw("us", &MpcLawState::us)
+      .def_rw("regularization", &MpcLawState::regularization)
+      .def_rw("tau", &MpcLawState::tau)
+      .def_rw("cost", &MpcLawState::cost)
+      .def_rw("u0", &MpcLawState::u0)
+      .def_rw("contact_point_m", &MpcLawState::contact_point_m)
+      .def_rw("placed_contact", &MpcLawState::placed_contact);
+  nb::class_<MpcLaw, uvms::SampledLaw>(m, "MpcLaw", "The MPC's re-plans as a law (law_mpc.hpp).")
+      .def(
+          "__init__",
+          [](MpcLaw* self, OcpPlanner& planner, const std::string& model_text,
+             const MpcLawSettings& s) {
+            new (self) MpcLaw(planner, uvms::model_from_text(model_text), s);
+          },
+          "planner"_a, "model_text"_a, "settings"_a, nb::keep_alive<1, 2>())
+      .def_rw("state", &MpcLaw::state);
 }

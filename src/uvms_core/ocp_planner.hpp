@@ -46,6 +46,7 @@ class OcpPlanner {
 
   int nodes() const { return static_cast<int>(models_.size()) - 1; }
   int nu() const { return static_cast<int>(spec_.input_matrix.cols()); }
+  const Eigen::MatrixXd& input_matrix() const { return spec_.input_matrix; }
   void set_x0(const Eigen::VectorXd& x0);
   // the environment the contact terms and dynamics use (a problem with a contact only)
   void set_contact(const Contact& contact);

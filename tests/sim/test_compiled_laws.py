@@ -6,6 +6,7 @@ rollout to 1e-12, the same stop, the law's state handed over when the core decli
 from __future__ import annotations
 
 import numpy as np
+import pinocchio as pin
 import pytest
 from conftest import ROOT
 from test_compiled_loop import PAPER, PAPER_SAMPLED, REALISTIC, _assert_same
@@ -19,6 +20,7 @@ from uvms_pin.errors import ControllerError, SimulationError
 from uvms_pin.physics.compiled.backend import Fallback
 from uvms_pin.physics.compiled.extension import core_module
 from uvms_pin.results.metrics import joint_limit_metrics
+from uvms_pin.scenario.load import load_scenario
 from uvms_pin.sim.compiled.laws import law_to_core
 from uvms_pin.sim.run import simulate
 
@@ -163,3 +165,82 @@ def test_resolved_acceleration_runs_compiled_as_in_python(stem, overrides):
     assert compiled.metadata["signal_units"]["task_position_error"] == python.metadata[
         "signal_units"]["task_position_error"]  # fmt: skip
     assert np.max(np.abs(compiled.signals["task_position_error"])) > 1e-4
+
+
+# ---- the MPC (src/uvms_core/law_mpc.hpp) ---------------------------------------------------
+MPC_FORCE = ROOT / "scenarios" / "mpc_force_tracking.toml"
+MPC_STATION = ROOT / "scenarios" / "mpc_station_keeping.toml"
+
+
+@pytest.mark.parametrize(
+    "path, overrides",
+    [
+        (MPC_FORCE, {}),
+        (MPC_FORCE, {"controller.iterations": 2, "controller.warm_start": False}),
+        (MPC_STATION, {}),
+    ],
+    ids=["force", "force-cold", "station"],
+)
+def test_the_mpc_replans_in_the_compiled_loop_as_in_python(path, overrides):
+    """The MPC on its compiled planner, re-planning inside the compiled loop, against the
+    same controller ticked by the Python loop: the whole rollout to 1e-9 (the force task's
+    spring placed at the tip by the law's first plan, its preview of f_d, the warm starts
+    moved on; cold re-plans every time without warm_start). The two loops' plants differ
+    by rounding (1e-16, the other laws' rollouts agree to 1e-12); twenty FDDP iterations from
+    a cold start turn it into up to 2e-10 of a thrust (1e-10 with warm starts)."""
+    pytest.importorskip("crocoddyl")
+    scenario = load_scenario(path, {"scenario.duration_s": 0.6, **overrides})
+    (compiled, stop_c), (python, stop_p) = _both(scenario)
+    assert stop_c is None and stop_p is None
+    ticks = round(0.6 / scenario.settings.control_period_s) + 1
+    assert compiled.metadata["closed_loop"] == {
+        "path": "compiled", "reason": None, "compiled_ticks": ticks, "python_ticks": 0
+    }  # fmt: skip
+    _assert_same(compiled, python, rtol=1e-9)
+    assert np.ptp(compiled.signals["mpc_cost"]) > 0 and np.any(compiled.signals["mpc_u"])
+    if "force" in str(path):
+        assert np.max(np.abs(compiled.signals["e_x"][:, :3])) > 1e-2
+        # the law placed the controller's spring at the tip and handed the point back
+        controller = scenario.controller_factory(scenario.uvms)
+        simulate(scenario, progress=False, controller=controller, compiled_loop=True)
+        data = controller.uvms.model.createData()
+        pin.framesForwardKinematics(controller.uvms.model, data, scenario.q0)
+        tip = data.oMf[controller.uvms.ee_frame_id].translation
+        np.testing.assert_allclose(controller._contact.model.placed_at(), tip, atol=1e-15)
+
+
+def test_replans_without_their_preview_are_the_python_controllers(monkeypatch):
+    """Every other re-plan tick's preview of f_d left NaN: the law declines those ticks, the
+    Python controller re-plans them on the same planner and hands its plan back; the rollout
+    is the Python loop's all the same."""
+    pytest.importorskip("crocoddyl")
+    from uvms_pin.sim.compiled import laws
+
+    force_desired = laws._MpcLaw._force_desired
+    seen = []
+
+    def every_other(self, time_s):
+        out = force_desired(self, time_s)
+        if not np.isnan(out[3]):
+            seen.append(time_s)
+            if len(seen) % 2 == 0:
+                out[3:] = np.nan
+        return out
+
+    monkeypatch.setattr(laws._MpcLaw, "_force_desired", every_other)
+    scenario = load_scenario(MPC_FORCE, {"scenario.duration_s": 0.4})
+    (compiled, _), (python, _) = _both(scenario)
+    meta = compiled.metadata["closed_loop"]
+    assert meta["path"] == "compiled" and 5 <= meta["python_ticks"] <= 15
+    _assert_same(compiled, python, rtol=1e-9)
+
+
+def test_an_mpc_solved_in_python_has_no_law():
+    """CSQP (mim_solvers) or the python planner: the MPC ticks in the Python loop, and the
+    reason names why its re-plans are not compiled."""
+    pytest.importorskip("mim_solvers")
+    for overrides, named in (({"controller.solver": "csqp"}, "csqp"),
+                             ({"controller.planner": "python"}, "planner 'python'")):  # fmt: skip
+        scenario = load_scenario(MPC_FORCE, {"scenario.duration_s": 0.1, **overrides})
+        law = law_to_core(scenario.controller_factory(scenario.uvms), core_module())
+        assert isinstance(law, Fallback) and named in law.reason

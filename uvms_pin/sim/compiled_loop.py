@@ -3,8 +3,9 @@
 `ClosedLoop` (`uvms_pin.sim.closed_loop`) runs its sampled loop here, a chunk of ticks per
 call of the core's ``run_sampled_chunk`` (src/uvms_core/sampled_loop.hpp), when every part of
 the loop has a compiled counterpart: the plant (`Plant`'s compiled plant, no world, no stop at
-the surface), a fixed-step integrator, the controller's law (the package's PPC and force
-baselines, their own classes: `uvms_pin.sim.compiled.laws`), sensors without navigation, the actuation (`Unlimited`, or thrusters with their ideal
+the surface), a fixed-step integrator, the controller's law (the package's PPC, force
+baselines, tracking controllers and the MPC on its compiled planner, their own classes:
+`uvms_pin.sim.compiled.laws`), sensors without navigation, the actuation (`Unlimited`, or thrusters with their ideal
 drives and the joints' effort limits), and observers that need only the log and the progress.
 Otherwise `CompiledLoop.build` says why not, and the loop runs in Python as always; the
 rollout's metadata ``closed_loop`` says which path ran and why.

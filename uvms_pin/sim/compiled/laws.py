@@ -17,7 +17,10 @@ Each law reads the controller's public attributes only; the law mirrors the cont
 
 from __future__ import annotations
 
+import copy
 import dataclasses
+import math
+import sys
 from collections.abc import Callable
 from types import ModuleType
 
@@ -39,6 +42,7 @@ from uvms_pin.control.tracking.controllers import (
 from uvms_pin.control.tracking.dynamic_level import InverseDynamicsLevel, PpcVelocityLevel
 from uvms_pin.control.tracking.task import TrackingTask
 from uvms_pin.physics.compiled.backend import Fallback
+from uvms_pin.physics.compiled.contact import contact_to_core
 from uvms_pin.physics.dynamics import dynamics_of
 from uvms_pin.physics.kinematics import EULER_SINGULARITY_MIN_ABS_COS_PITCH
 from uvms_pin.results.signal import Signal
@@ -312,6 +316,87 @@ def _task_priority(controller: TaskPriorityController, core: ModuleType) -> Core
     return _InverseDynamicsLaw(controller, law, _path_desired(task), described)
 
 
+# ---- the MPC (its module needs crocoddyl: imported by whoever built one) ---------------------
+class _MpcLaw(CoreLaw):
+    """The MPC's re-plans on its compiled planner; its last plan, the plan's time and
+    regularization, tau and its signals the state handed over (src/uvms_core/law_mpc.hpp)."""
+
+    def __init__(self, controller, core: ModuleType):
+        settings = core.MpcLawSettings()
+        settings.period_s, settings.dt_s = controller.period_s, controller.dt_s
+        settings.iterations, settings.warm_start = controller.iterations, controller.warm_start
+        mpc = sys.modules[type(controller).__module__]
+        settings.cold_iterations = mpc.COLD_START_ITERATIONS
+        settings.replan_step_lengths = list(mpc.REPLAN_STEP_LENGTHS)
+        self._offsets = None
+        desired = _no_desired
+        if controller.force_task is not None:
+            contact = controller._contact
+            # the environment's law and given point (NaN: placed at the tip by the first plan)
+            probe = copy.deepcopy(contact.model)
+            probe.attach(np.full(3, np.nan))
+            settings.force_task, settings.ee_frame_id = True, int(contact.frame_id)
+            settings.rpy_desired = controller._rpy_desired
+            settings.contact = contact_to_core(probe, core)
+            settings.place_at_tip = bool(np.isnan(probe.placed_at()).any())
+            desired = self._force_desired
+            self._offsets = list(controller.force_tracking.offsets_s)
+        law = core.MpcLaw(controller._planner, controller.uvms.model.saveToString(), settings)
+        super().__init__(controller, law, desired)
+
+    def _force_desired(self, time_s: float) -> np.ndarray:
+        """[f_d(t) (3); f_d(t + k dt) (3 (N + 1))]: the preview at the ticks on the re-plan
+        grid only (NaN elsewhere: a re-plan due there is the Python controller's)."""
+        controller = self.controller
+        desired_force = controller.force_task.desired_force
+        out = np.full(3 * (len(self._offsets) + 1), np.nan)
+        out[:3] = desired_force(time_s)
+        period = controller.period_s
+        if abs(time_s - round(time_s / period) * period) <= 1e-9:
+            for k, offset in enumerate(self._offsets):
+                out[3 + 3 * k : 6 + 3 * k] = desired_force(time_s + offset)
+        return out
+
+    def push(self) -> None:
+        controller, state = self.controller, self.law.state
+        guess = controller._guess
+        state.has_plan = guess is not None
+        state.last_plan_s = controller._last_plan_s
+        state.xs, state.us = ([], []) if guess is None else (list(guess[0]), list(guess[1]))
+        regularization = controller._regularization
+        state.regularization = math.nan if regularization is None else regularization
+        state.tau = controller._tau
+        state.placed_contact = False  # (set by the law if it places the environment)
+        signals = controller.signals()
+        if "mpc_cost" in signals:
+            state.cost, state.u0 = float(signals["mpc_cost"][0]), signals["mpc_u"]
+        self.law.state = state
+
+    def pull(self, time_s: float, desired: np.ndarray) -> None:
+        controller, state = self.controller, self.law.state
+        if state.placed_contact:  # at its first plan, as _start_force_plan does
+            controller._contact.model.attach(np.array(state.contact_point_m))
+        if state.has_plan:
+            controller._guess = ([np.array(x) for x in state.xs], [np.array(u) for u in state.us])
+            controller._regularization = state.regularization
+        controller._last_plan_s = state.last_plan_s
+        controller._tau = np.array(state.tau)
+        signals = self.law.signals()
+        controller._signals.update(
+            {name: signals[where].copy() for name, where in self.slices.items() if name != "tau"}
+        )
+
+
+def _no_desired(time_s: float) -> np.ndarray:
+    return np.zeros(0)
+
+
+def _mpc(controller, core: ModuleType) -> CoreLaw | Fallback:
+    if controller._planner is None:
+        return Fallback(f"the MPC's re-plans in Python ({controller.planner_path})")
+    return _MpcLaw(controller, core)
+
+
 #: The controllers with a compiled law, by their exact class (a subclass may change
 #: `compute`: it runs in Python).
 _LAWS: dict[type, Callable[[Controller, ModuleType], CoreLaw | Fallback]] = {
@@ -326,8 +411,13 @@ _LAWS: dict[type, Callable[[Controller, ModuleType], CoreLaw | Fallback]] = {
 
 
 def law_to_core(controller: Controller, core: ModuleType) -> CoreLaw | Fallback:
-    """The compiled law of ``controller`` in the core module ``core``, or why it has none."""
+    """The compiled law of ``controller`` in the core module ``core``, or why it has none.
+    (The MPC's class is looked up where it is: its module, which needs crocoddyl, is
+    loaded whenever an MPC exists.)"""
     build = _LAWS.get(type(controller))
+    mpc = sys.modules.get("uvms_pin.control.mpc")
+    if build is None and mpc is not None and type(controller) is mpc.MpcController:
+        build = _mpc
     if build is None:
         return Fallback(f"the controller {type(controller).__name__} is not compiled")
     return build(controller, core)
