@@ -230,14 +230,15 @@ def test_the_command_line_answers_without_loading_the_stack():
     assert result.stdout.strip() == "", f"--help loads {result.stdout.strip()}"
 
 
-#: The compiled seam: the only folders whose modules build the core's objects
-SEAM = ("physics/compiled/", "sim/compiled/")
+#: The compiled seam: the only folders whose modules build the core's objects (and the
+#: optimal-control problem's translation, which sits in the ocp layer above the physics)
+SEAM = ("physics/compiled/", "sim/compiled/", "ocp/compiled.py")
 CORE_OBJECT = re.compile(r"\bcore\.[A-Z]\w*\(")
 
 
 def test_core_objects_are_built_only_in_the_compiled_seam():
     """A core object (``core.Plant(...)``, ``core.LoopSettings()``, ...) is built in
-    `physics/compiled/` or `sim/compiled/` only, from its Python counterpart's public
+    `physics/compiled/`, `sim/compiled/` or `ocp/compiled.py` only, from its Python counterpart's public
     attributes; everywhere else holds what the seam built."""
     outside = [
         f"{path.relative_to(PACKAGE)}:{k + 1}"
