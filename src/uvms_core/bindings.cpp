@@ -12,6 +12,7 @@
 #include <nanobind/stl/variant.h>
 #include <nanobind/stl/vector.h>
 
+#include <pinocchio/algorithm/joint-configuration.hpp>
 #include <pinocchio/config.hpp>
 
 #include "derivatives.hpp"
@@ -304,7 +305,48 @@ void bind_derivatives(nb::module_& m) {
                                                   free_surface);
           },
           "q"_a.none(), "v"_a.none(), "tau"_a.none(), "flow"_a.none(), "time_s"_a,
-          "tau_ext"_a.none() = nb::none(), "free_surface"_a = false);
+          "tau_ext"_a.none() = nb::none(), "free_surface"_a = false)
+      .def(
+          "call",
+          [](Derivatives& d, nb::handle q_obj, nb::handle v_obj, nb::handle tau_obj,
+             const uvms::FlowField* flow, double time_s, nb::handle tau_ext_obj,
+             bool free_surface, double norm_tolerance,
+             nb::ndarray<double, nb::ndim<3>, nb::c_contig, nb::device::cpu> out) {
+            // the public call's (uvms_pin.physics.dynamics.forward_dynamics_derivatives):
+            // q also on the configuration manifold (its unit parts' norms within
+            // norm_tolerance of 1: else InputError, the caller names the joint), and
+            // da/dq, da/dv, da/dtau written into out (3, nv, nv), the caller's new array (one
+            // allocation: three arrays made here would cost more than the Jacobians' chain)
+            const int nq = d.dynamics().nq(), nv = d.dynamics().nv();
+            UVMS_VECTOR(q, nq);
+            UVMS_VECTOR(v, nv);
+            UVMS_VECTOR(tau, nv);
+            if (out.shape(0) != 3 || out.shape(1) != std::size_t(nv) ||
+                out.shape(2) != std::size_t(nv)) {
+              throw InputError("out must have shape (3, nv, nv)");
+            }
+            if (!pinocchio::isNormalized(d.dynamics().model(), q, norm_tolerance)) {
+              throw InputError("q is not on the configuration manifold");
+            }
+            const ForwardDynamicsDerivatives* jacobians = nullptr;
+            if (tau_ext_obj.is_none()) {
+              jacobians = &d.forward_dynamics_derivatives(q, v, tau, flow_or_still(flow),
+                                                          nullptr, time_s, free_surface);
+            } else {
+              UVMS_VECTOR(tau_ext, nv);
+              const ConstVec ext(tau_ext);
+              jacobians = &d.forward_dynamics_derivatives(q, v, tau, flow_or_still(flow), &ext,
+                                                          time_s, free_surface);
+            }
+            using RowMajor = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
+            const Eigen::MatrixXd* parts[3] = {&jacobians->da_dq, &jacobians->da_dv,
+                                               &jacobians->da_dtau};
+            for (int k = 0; k < 3; ++k) {
+              Eigen::Map<RowMajor>(out.data() + std::ptrdiff_t(k) * nv * nv, nv, nv) = *parts[k];
+            }
+          },
+          "q"_a.none(), "v"_a.none(), "tau"_a.none(), "flow"_a.none(), "time_s"_a,
+          "tau_ext"_a.none(), "free_surface"_a, "norm_tolerance"_a, "out"_a);
 }
 
 // ---- the environment (contact.hpp, disturbance.hpp) and the integrators -----------------

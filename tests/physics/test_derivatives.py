@@ -198,6 +198,34 @@ def test_bad_arguments_name_what_is_wrong(reference_uvms):
         up.forward_dynamics_derivatives(reference_uvms, q, zero, zero, time_s=math.nan)
 
 
+def test_the_public_call_checks_q_on_the_manifold_and_returns_its_own_arrays(reference_uvms):
+    """The public call's one compiled call (`CompiledDynamics.public_derivatives`): a q whose
+    quaternion is off the unit sphere is refused naming the joint, as the reference refuses
+    it; a list is read as an array; each call returns new arrays (a later call leaves an
+    earlier result as it was), equal to the core object's."""
+    q = reference_uvms.neutral_configuration()
+    q[3:7] = [0.1, 0.2, 0.3, 0.9]
+    zero = np.zeros(reference_uvms.nv)
+    for backend in ("core", "python"):
+        with pytest.raises(ParameterError, match=r"quaternion of norm .* not 1"):
+            up.forward_dynamics_derivatives(reference_uvms, q, zero, zero, backend=backend)
+    q = pin.normalize(reference_uvms.model, q)
+    rng = np.random.default_rng(3)
+    v, tau = rng.normal(size=reference_uvms.nv), rng.normal(size=reference_uvms.nv)
+    first = up.forward_dynamics_derivatives(
+        reference_uvms, list(q), v, tau, current_world=[0.2, 0, 0]
+    )
+    kept = [a.copy() for a in first]
+    up.forward_dynamics_derivatives(reference_uvms, q, -v, 2 * tau, current_world=[0.2, 0, 0])
+    for a, b in zip(first, kept, strict=True):
+        np.testing.assert_array_equal(a, b)
+    dynamics = up.physics.dynamics.dynamics_of(reference_uvms)
+    flow = dynamics.flow_struct(up.flow.UniformCurrent([0.2, 0.0, 0.0]))
+    expected = dynamics._core_derivatives(q, v, tau, flow, 0.0, None, False)
+    for a, b in zip(first, expected, strict=True):
+        np.testing.assert_array_equal(a, b)
+
+
 # ---- the compiled core against the reference ---------------------------------------------
 
 #: compiled against Python: the same formulas summed in another order

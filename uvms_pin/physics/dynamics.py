@@ -229,6 +229,10 @@ def forward_dynamics_derivatives(
     dynamics = dynamics_of(uvms, backend)
     water = water_of_call(uvms, current_world, flow)
     time_s, free_surface = check_time(time_s), flag("free_surface", free_surface)
+    if isinstance(dynamics, CompiledDynamics):  # one compiled call, the checks in it
+        out = dynamics.public_derivatives(q, v, tau, water, time_s, tau_ext, free_surface)
+        if out is not None:
+            return out
     # q on the manifold here (the core checks shapes and finiteness only); v, tau and
     # tau_ext are checked (shape, finite) by the reference and by the core
     q = checked_configuration("q", q, uvms.model)

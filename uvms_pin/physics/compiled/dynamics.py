@@ -14,12 +14,14 @@ from types import ModuleType
 
 import numpy as np
 
+from uvms_pin.errors import ParameterError
 from uvms_pin.flow import FlowField
 from uvms_pin.model.uvms import UVMS
 from uvms_pin.physics.compiled.backend import Fallback
 from uvms_pin.physics.compiled.extension import core_module
 from uvms_pin.physics.compiled.flow import flow_to_core
 from uvms_pin.physics.compiled.hull import surface_bodies_to_core
+from uvms_pin.physics.configuration import NORM_TOLERANCE, checked_configuration
 from uvms_pin.physics.derivatives.reference import (
     forward_dynamics_derivatives as reference_derivatives,
 )
@@ -133,6 +135,29 @@ class CompiledDynamics:
             return compiled(*args[:flow_at], flow, *args[flow_at + 1 :])
 
         return call
+
+    def public_derivatives(
+        self, q, v, tau, flow: FlowField | None, time_s: float, tau_ext, free_surface: bool
+    ) -> tuple[np.ndarray, np.ndarray, np.ndarray] | None:
+        """The public call's (da/dq, da/dv, da/dtau) in one compiled call (q's manifold check
+        included), or None in a flow the core has no counterpart of (the caller's path then
+        warns and runs the reference). Bad input: the ParameterError of the reference's
+        checks (q's names the joint off the manifold)."""
+        flow_struct = self._flow_struct(flow)
+        if isinstance(flow_struct, Fallback):
+            return None
+        if self._derivatives is None:
+            self._derivatives = core_module().Derivatives(self.core)
+        nv = self._reference.uvms.nv
+        out = np.empty((3, nv, nv))
+        try:
+            self._derivatives.call(
+                q, v, tau, flow_struct, time_s, tau_ext, free_surface, NORM_TOLERANCE, out
+            )
+            return out[0], out[1], out[2]
+        except ParameterError:
+            checked_configuration("q", q, self._reference.uvms.model)  # (names the joint)
+            raise
 
     def _core_derivatives(self, *args) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """`Derivatives.forward_dynamics_derivatives` of the core (built on first use)."""
