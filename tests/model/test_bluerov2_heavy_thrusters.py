@@ -58,3 +58,23 @@ def test_saturation_caps_each_thruster_at_its_t200_limit():
     assert np.all(f >= -T200_16V.max_reverse_N - 1e-12)
     # four horizontal thrusters at 45 deg: at most 4 F cos(45 deg) of surge
     assert actuation.apply(command)[0] <= 4 * T200_16V.max_forward_N * np.sqrt(0.5) + 1e-9
+
+
+def test_a_command_on_the_bounds_is_not_saturated_by_the_allocations_rounding():
+    """Thrusts planned on a limit (an MPC's box-constrained plan: here the eight thrusters'
+    least-norm thrusts of a random wrench, scaled until one is on its limit) pass through
+    B u and back through the allocation with ~1e-15 of rounding: not saturated; 1e-6 of
+    the scale further is. Joint torques likewise against their effort limits."""
+    effort = np.array([10.0, 10.0, 6.0, 3.0])
+    actuation = ThrustersAndJointLimits(thrusters(), effort)
+    rng = np.random.default_rng(4)
+    lower, upper = actuation.lower_N, actuation.upper_N
+    for _ in range(50):
+        raw = actuation.allocation_pinv @ rng.normal(scale=[10, 10, 10, 1, 1, 1])
+        limit = np.where(raw > 0.0, upper, -lower)
+        on_bound = raw / np.max(np.abs(raw) / limit)  # one thrust on its limit, to rounding
+        joints = effort * rng.choice([-1.0, 1.0], 4)
+        assert not actuation.saturated(np.r_[actuation.allocation @ on_bound, joints])
+        past = on_bound * (1.0 + 1e-6)
+        assert actuation.saturated(np.r_[actuation.allocation @ past, np.zeros(4)])
+        assert actuation.saturated(np.r_[np.zeros(6), joints * (1.0 + 1e-6)])

@@ -26,6 +26,12 @@ from uvms_pin.model.thrust_curve import TabulatedThrustCurve
 from uvms_pin.model.thruster import Thruster
 from uvms_pin.sim.thruster_drive import ThrusterDrives
 
+#: how far past its limit a command must ask to count as saturating an actuator [N or N m]:
+#: more than the allocation's rounding (a thrust planned on its bound, B^+ (B u) = u to
+#: ~1e-15, is not saturated; the compared controllers' saturated fraction must not depend on
+#: which side of the bound the rounding falls)
+PAST_LIMIT_N = 1e-9
+
 
 class Actuation(ABC):
     """Maps a commanded generalized input to the applied one."""
@@ -147,12 +153,16 @@ class ThrustersAndJointLimits(Actuation):
         )
 
     def saturated(self, tau_commanded: np.ndarray) -> bool:
-        """True when a thruster or a joint cannot give what the command asks."""
+        """True when a thruster or a joint cannot give what the command asks: past its limit
+        by more than `PAST_LIMIT_N` (a plan that puts a thrust on its bound, as the MPC's
+        box-constrained one does, is not saturated by the allocation's rounding)."""
         raw = self.allocation_pinv @ tau_commanded[:6]
-        if np.any(raw < self.lower_N) or np.any(raw > self.upper_N):
+        if np.any(raw < self.lower_N - PAST_LIMIT_N) or np.any(raw > self.upper_N + PAST_LIMIT_N):
             return True
         limits = self.joint_effort_limits_Nm
-        return limits is not None and bool(np.any(np.abs(tau_commanded[6:]) > limits))
+        return limits is not None and bool(
+            np.any(np.abs(tau_commanded[6:]) > limits + PAST_LIMIT_N)
+        )
 
     def start(self, period_s: float | None = None) -> None:
         self.dropped_max[:] = 0.0
