@@ -176,7 +176,11 @@ MPC_STATION = ROOT / "scenarios" / "mpc_station_keeping.toml"
     "path, overrides",
     [
         (MPC_FORCE, {}),
-        (MPC_FORCE, {"controller.iterations": 2, "controller.warm_start": False}),
+        pytest.param(  # (twenty iterations every re-plan: 5 s)
+            MPC_FORCE,
+            {"controller.iterations": 2, "controller.warm_start": False},
+            marks=pytest.mark.slow,
+        ),
         (MPC_STATION, {}),
     ],
     ids=["force", "force-cold", "station"],
