@@ -8,6 +8,8 @@
 #include <nanobind/stl/variant.h>
 #include <nanobind/stl/vector.h>
 
+#include <pinocchio/algorithm/joint-configuration.hpp>
+
 #include "batch_derivatives.hpp"
 #include "batch_plant.hpp"
 
@@ -103,7 +105,21 @@ void bind_batch_derivatives(nb::module_& m) {
       .def_prop_ro("num_threads", &uvms::BatchDerivatives::num_threads)
       .def("compute", &compute_derivatives, "q"_a, "v"_a, "tau"_a, "tau_ext"_a.none(), "time_s"_a,
            "flow"_a, "free_surface"_a, "da_dq"_a, "da_dv"_a, "da_dtau"_a,
-           "fill da_dq, da_dv, da_dtau (n, nv, nv) at the n states (GIL released)");
+           "fill da_dq, da_dv, da_dtau (n, nv, nv) at the n states (GIL released)")
+      .def(
+          "first_off_manifold",
+          [](const uvms::BatchDerivatives& b, const States& q, double norm_tolerance) {
+            // the first row of q (n, nq) off the configuration manifold (a unit part's norm
+            // beyond norm_tolerance of 1), -1 if none: the caller's check names its joint
+            const size_t n = q.shape(0), nq = size_t(b.nq());
+            check_states("q", q, n, nq);
+            for (size_t k = 0; k < n; ++k) {
+              const Eigen::Map<const Eigen::VectorXd> row(q.data() + k * nq, Eigen::Index(nq));
+              if (!pinocchio::isNormalized(b.model(), row, norm_tolerance)) return long(k);
+            }
+            return -1L;
+          },
+          "q"_a, "norm_tolerance"_a);
 }
 
 void bind_batch_plant(nb::module_& m) {

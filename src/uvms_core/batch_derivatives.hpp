@@ -40,6 +40,7 @@ class BatchDerivatives {
   int num_threads() const { return static_cast<int>(derivatives_.size()); }
   int nq() const { return derivatives_.front()->dynamics().nq(); }
   int nv() const { return derivatives_.front()->dynamics().nv(); }
+  const Model& model() const { return derivatives_.front()->dynamics().model(); }
 
   // Every state's Jacobians in `flow` (shared, read only), the first error of any thread
   // rethrown after all have stopped.
