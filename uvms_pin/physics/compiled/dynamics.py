@@ -68,6 +68,7 @@ class CompiledDynamics:
         self.core = core.Dynamics(uvms.model.saveToString(), hydro_bodies_to_core(uvms, core))
         self._reference = reference
         self._flow: tuple[FlowField | None, object] = (None, None)  # the last flow converted
+        self._jacobians_shape = (3, uvms.nv, uvms.nv)  # the public derivatives' array
         self._derivatives = None  # core.Derivatives, built on first use
         self._step_derivatives = None  # core.StepDerivatives, built on first use
         self._batch = None  # core.BatchDerivatives, the last built (`batch_derivatives`)
@@ -143,13 +144,14 @@ class CompiledDynamics:
         included), or None in a flow the core has no counterpart of (the caller's path then
         warns and runs the reference). Bad input: the ParameterError of the reference's
         checks (q's names the joint off the manifold)."""
-        flow_struct = self._flow_struct(flow)
+        last_flow, flow_struct = self._flow
+        if last_flow is not flow or flow_struct is None:  # (`_flow_struct`, inlined: per call)
+            flow_struct = self._flow_struct(flow)
         if isinstance(flow_struct, Fallback):
             return None
         if self._derivatives is None:
             self._derivatives = core_module().Derivatives(self.core)
-        nv = self._reference.uvms.nv
-        out = np.empty((3, nv, nv))
+        out = np.empty(self._jacobians_shape)
         try:
             self._derivatives.call(
                 q, v, tau, flow_struct, time_s, tau_ext, free_surface, NORM_TOLERANCE, out
