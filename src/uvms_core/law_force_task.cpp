@@ -25,6 +25,8 @@ double python_mod(double x, double y) {
   return mod;
 }
 
+double wrapped_angle(double x_rad) { return python_mod(x_rad + kPi, kTwoPi) - kPi; }
+
 ForceOrientationTask::ForceOrientationTask(pinocchio::Model model, ForceTaskSettings settings)
     : model_(std::move(model)), data_(model_), s_(std::move(settings)) {
   const Eigen::Index nv = model_.nv;
@@ -88,7 +90,7 @@ Vec6 ForceOrientationTask::error(const double* wrench_world, const double* force
   Vec6 e;
   for (int i = 0; i < 3; ++i) {
     e[i] = wrench_world[i] - force_desired[i];
-    e[3 + i] = python_mod(rpy_ee_[i] - rpy_desired[i] + kPi, kTwoPi) - kPi;
+    e[3 + i] = wrapped_angle(rpy_ee_[i] - rpy_desired[i]);
   }
   return e;
 }

@@ -49,6 +49,9 @@ struct ForceTaskSettings {
 
 // Python's float x % y: fmod with the sign of the divisor (CPython's float_rem).
 double python_mod(double x, double y);
+// An angle difference wrapped to [-pi, pi) as first_level_error wraps it:
+// (x + pi) % (2 pi) - pi, in Python's float arithmetic.
+double wrapped_angle(double x_rad);
 
 class ForceOrientationTask {
  public:

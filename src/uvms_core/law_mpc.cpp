@@ -8,16 +8,9 @@
 #include <pinocchio/algorithm/kinematics.hpp>
 #include <pinocchio/math/rpy.hpp>
 
-#include "law_force_task.hpp"  // python_mod
+#include "law_force_task.hpp"  // wrapped_angle
 
 namespace uvms {
-
-namespace {
-
-constexpr double kPi = 3.14159265358979323846;  // math.pi
-constexpr double kTwoPi = 2.0 * kPi;
-
-}  // namespace
 
 MpcLaw::MpcLaw(OcpPlanner& planner, pinocchio::Model model, MpcLawSettings settings)
     : planner_(planner), model_(std::move(model)), data_(model_), s_(std::move(settings)) {
@@ -61,7 +54,7 @@ LawStatus MpcLaw::command(const LawInput& in) {
   if (!all_finite(in.q, nq) || !all_finite(in.v, nv) || !all_finite(in.wrench_world, 6)) {
     return LawStatus::declined;  // (the Python controller raises on it)
   }
-  next_ = state;
+  replanned_ = false;
   if (s_.force_task) {
     if (!all_finite(in.desired, 3)) return LawStatus::declined;
     // f_d(t) and e_x (MpcController._force_signals, first_level_error)
@@ -72,7 +65,7 @@ LawStatus MpcLaw::command(const LawInput& in) {
     for (int i = 0; i < 3; ++i) {
       at(force_desired_)[i] = in.desired[i];
       e_x[i] = in.wrench_world[i] - in.desired[i];
-      e_x[3 + i] = python_mod(rpy[i] - s_.rpy_desired[i] + kPi, kTwoPi) - kPi;
+      e_x[3 + i] = wrapped_angle(rpy[i] - s_.rpy_desired[i]);
     }
   }
   if (in.time_s >= state.last_plan_s + s_.period_s - 1e-12) {
@@ -84,9 +77,10 @@ LawStatus MpcLaw::command(const LawInput& in) {
       return LawStatus::declined;  // the Python controller re-plans this tick and raises
     }
   }
-  at(cost_)[0] = next_.cost;
-  at(u_) = next_.u0;
-  at(tau_) = next_.tau;
+  const MpcLawState& now = replanned_ ? next_ : state;
+  at(cost_)[0] = now.cost;
+  at(u_) = now.u0;
+  at(tau_) = now.tau;
   return LawStatus::ok;
 }
 
@@ -95,6 +89,8 @@ void MpcLaw::replan(const LawInput& in) {
   x_.head(nq) = Eigen::Map<const Eigen::VectorXd>(in.q, nq);
   x_.tail(nv) = Eigen::Map<const Eigen::VectorXd>(in.v, nv);
   const bool cold = !state.has_plan || !s_.warm_start;
+  next_.placed_contact = state.placed_contact;
+  next_.contact_point_m = state.contact_point_m;
   if (s_.force_task) {
     if (!state.has_plan) {  // the first plan: the environment where the tip is (_start_force_plan)
       Contact contact = s_.contact;
@@ -139,6 +135,7 @@ void MpcLaw::replan(const LawInput& in) {
   next_.cost = result.cost;
   next_.u0 = next_.us.front();
   next_.tau.noalias() = planner_.input_matrix() * next_.u0;
+  replanned_ = true;
 }
 
 }  // namespace uvms

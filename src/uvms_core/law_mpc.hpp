@@ -66,7 +66,11 @@ class MpcLaw final : public SampledLaw {
   int nv() const override { return model_.nv; }
   int desired_size() const override;
   LawStatus command(const LawInput& in) override;
-  void commit() override { state = next_; }
+  // a re-plan's state taken (swapped: its vectors' memory kept for the next re-plan)
+  void commit() override {
+    if (replanned_) std::swap(state, next_);
+    replanned_ = false;
+  }
   const Eigen::VectorXd& signals() const override { return signals_; }
   Eigen::Index tau_offset() const override { return tau_.offset; }
   std::vector<SignalSlot> signal_layout() const override;
@@ -83,7 +87,8 @@ class MpcLaw final : public SampledLaw {
   pinocchio::Model model_;
   pinocchio::Data data_;
   MpcLawSettings s_;
-  MpcLawState next_;
+  MpcLawState next_;      // the state after this tick's re-plan (valid when replanned_)
+  bool replanned_ = false;  // this tick re-planned (a tick between re-plans changes nothing)
   Eigen::VectorXd signals_, x_;
   std::vector<Eigen::VectorXd> xs_, us_;  // the warm start
   std::vector<SignalSlot> layout_;

@@ -16,8 +16,11 @@ OcpWorkspace::OcpWorkspace(const Dynamics& dyn, std::optional<int> frame)
       contact(NoContact{}),
       data(dyn.model()),
       jacobian_lwa(Matrix6x::Zero(6, dyn.nv())),
+      q(Eigen::VectorXd::Zero(dyn.nq())),
+      v(Eigen::VectorXd::Zero(dyn.nv())),
       tau(Eigen::VectorXd::Zero(dyn.nv())),
-      tau_ext(Eigen::VectorXd::Zero(dyn.nv())) {
+      tau_ext(Eigen::VectorXd::Zero(dyn.nv())),
+      term_work(dyn.nv()) {
   if (frame) contact_derivatives.emplace(dyn.model(), static_cast<pinocchio::FrameIndex>(*frame));
 }
 
@@ -108,14 +111,15 @@ void UnderwaterActionModel::calc_or_throw(DataBase& data, const Eigen::VectorXd&
                                           const Eigen::VectorXd& u) {
   OcpWorkspace& w = *work_;
   const int nq = state_->get_nq(), nv = state_->get_nv();
-  const Eigen::VectorXd q = x.head(nq), v = x.tail(nv);
+  const Eigen::VectorXd& q = w.q = x.head(nq);
+  const Eigen::VectorXd& v = w.v = x.tail(nv);
   contact_and_frames(q, v);
   w.tau.noalias() = input_matrix_ * u;
   const ConstVec ext(w.tau_ext);
   data.xout = w.dynamics.forward_dynamics(q, v, w.tau, flow_, w.contact_frame ? &ext : nullptr,
                                           time_s_);
   if (!data.xout.allFinite()) throw SimulationFailure("zeta_dot is not finite");
-  const TermState at{w.dynamics.model(), w.data, &wrench_, nullptr, nullptr};
+  const TermState at{w.dynamics.model(), w.data, w.term_work, &wrench_, nullptr, nullptr};
   residuals(data, x, u, at);
 }
 
@@ -123,7 +127,8 @@ void UnderwaterActionModel::calc_diff_or_throw(DataBase& data, const Eigen::Vect
                                                const Eigen::VectorXd& u) {
   OcpWorkspace& w = *work_;
   const int nq = state_->get_nq(), nv = state_->get_nv();
-  const Eigen::VectorXd q = x.head(nq), v = x.tail(nv);
+  const Eigen::VectorXd& q = w.q = x.head(nq);
+  const Eigen::VectorXd& v = w.v = x.tail(nv);
   // the costs' frames and LOCAL Jacobians at q; the contact's own kinematics are its data's
   const Model& model = w.dynamics.model();
   pinocchio::computeJointJacobians(model, w.data, q);
@@ -151,7 +156,7 @@ void UnderwaterActionModel::calc_diff_or_throw(DataBase& data, const Eigen::Vect
   }
   data.Fu.noalias() = d.da_dtau * input_matrix_;
   // Gauss-Newton: the terms' rows stacked, R = [R_x R_u], l_x = R_x^T W r, l_xx = R_x^T W R_x
-  const TermState at{w.dynamics.model(), w.data, &wrench_, wrench_dq, wrench_dv};
+  const TermState at{w.dynamics.model(), w.data, w.term_work, &wrench_, wrench_dq, wrench_dv};
   residuals(data, x, u, at);
   int row = 0;
   for (const auto& term : terms_) {
@@ -161,9 +166,8 @@ void UnderwaterActionModel::calc_diff_or_throw(DataBase& data, const Eigen::Vect
   }
   weighted_ = weights_.asDiagonal() * stacked_;
   const int ndx = 2 * nv;
-  const Eigen::VectorXd gradient = weighted_.transpose() * data.r;
-  data.Lx = gradient.head(ndx);
-  data.Lu = gradient.tail(nu_);
+  data.Lx.noalias() = weighted_.leftCols(ndx).transpose() * data.r;
+  data.Lu.noalias() = weighted_.rightCols(nu_).transpose() * data.r;
   data.Lxx.noalias() = stacked_.leftCols(ndx).transpose() * weighted_.leftCols(ndx);
   data.Luu.noalias() = stacked_.rightCols(nu_).transpose() * weighted_.rightCols(nu_);
   data.Lxu.noalias() = stacked_.leftCols(ndx).transpose() * weighted_.rightCols(nu_);

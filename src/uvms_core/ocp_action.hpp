@@ -47,7 +47,8 @@ struct OcpWorkspace {
   Contact contact;  // the environment, placed by the planner (set_contact)
   Data data;        // the costs' kinematics
   Matrix6x jacobian_lwa;
-  Eigen::VectorXd tau, tau_ext;
+  Eigen::VectorXd q, v, tau, tau_ext;  // a node's state split, its generalized forces
+  TermWork term_work;                  // the cost terms' Jacobian buffers
   std::string held;  // the first failure of a node since the last take()
 };
 

@@ -16,8 +16,10 @@ struct Overloaded : Ts... {
 template <class... Ts>
 Overloaded(Ts...) -> Overloaded<Ts...>;
 
-Matrix6x frame_jacobian(const TermState& at, int frame_id) {
-  Matrix6x jacobian = Matrix6x::Zero(6, at.model.nv);
+// the frame's LOCAL Jacobian, in the work buffer (Pinocchio writes its support columns only)
+const Matrix6x& frame_jacobian(const TermState& at, int frame_id) {
+  Matrix6x& jacobian = at.work.frame_jacobian;
+  jacobian.setZero();
   pinocchio::getFrameJacobian(at.model, at.data, frame_id, pinocchio::LOCAL, jacobian);
   return jacobian;
 }
@@ -92,7 +94,8 @@ void term_jacobian(const CostKind& kind, const TermState& at, const Eigen::Vecto
           },
           [&](const StateDeviationCost& c) {
             // (Pinocchio writes each joint's diagonal block only)
-            Eigen::MatrixXd jq = Eigen::MatrixXd::Zero(nv, nv);
+            Eigen::MatrixXd& jq = at.work.configuration;
+            jq.setZero();
             pinocchio::dDifference(at.model, c.x_ref.head(nq), x.head(nq), jq, pinocchio::ARG1);
             out.topLeftCorner(nv, nv) = jq;
             out.block(nv, nv, nv, nv).setIdentity();

@@ -67,12 +67,21 @@ struct OcpTerm {
 // The rows of a term's residual (nu: the node's inputs, nv: the model's velocities).
 int residual_size(const CostKind& kind, int nv);
 
+// The terms' work buffers (no allocation per call): a frame's LOCAL Jacobian (6, nv) and a
+// configuration Jacobian (nv, nv).
+struct TermWork {
+  explicit TermWork(int nv) : frame_jacobian(Matrix6x::Zero(6, nv)), configuration(nv, nv) {}
+  Matrix6x frame_jacobian;
+  Eigen::MatrixXd configuration;
+};
+
 // What the terms read of the node's state besides x and u: the frames' placements and LOCAL
 // Jacobians (data after computeJointJacobians and updateFramePlacements) and the contact's
 // force and its derivatives (null without a contact).
 struct TermState {
   const Model& model;
   Data& data;
+  TermWork& work;
   const Vec6* wrench_world = nullptr;
   const Matrix6x* wrench_dq = nullptr;
   const Matrix6x* wrench_dv = nullptr;

@@ -106,9 +106,7 @@ void UvmsState::JintegrateTransport(const Eigen::Ref<const Eigen::VectorXd>& x,
                                     crocoddyl::Jcomponent firstsecond) const {
   const int nq = model_.nq, nv = model_.nv;
   const auto arg = firstsecond == crocoddyl::first ? pinocchio::ARG0 : pinocchio::ARG1;
-  Eigen::MatrixXd rows = Jin.topRows(nv);
-  pinocchio::dIntegrateTransport(model_, x.head(nq), dx.head(nv), rows, arg);
-  Jin.topRows(nv) = rows;
+  pinocchio::dIntegrateTransport(model_, x.head(nq), dx.head(nv), Jin.topRows(nv), arg);
 }
 
 }  // namespace uvms

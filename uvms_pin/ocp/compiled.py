@@ -6,20 +6,19 @@ solved by crocoddyl's C++ FDDP without Python per node.
 and returns the planner, or a `Fallback` naming what the core has no counterpart of (a cost
 term of the user's own class, a flow or contact model the core does not mirror, the
 "python" backend, CSQP's constraints, a node integrated otherwise). Each cost term's
-translation is registered here, in `term_to_core`, one function per class of
-`uvms_pin.ocp.costs`.
+translation is registered here, in `TERMS`, one function per class of `uvms_pin.ocp.costs`.
 """
 
 from __future__ import annotations
 
-from functools import singledispatch
+from collections.abc import Callable
 from types import ModuleType
 
 import numpy as np
 
 from uvms_pin.ocp import costs
+from uvms_pin.ocp.crocoddyl_module import crocoddyl_module
 from uvms_pin.ocp.model import UnderwaterActionModel
-from uvms_pin.ocp.problems import crocoddyl
 from uvms_pin.physics.compiled.backend import Fallback
 from uvms_pin.physics.compiled.contact import contact_to_core
 from uvms_pin.physics.compiled.dynamics import CompiledDynamics
@@ -27,48 +26,50 @@ from uvms_pin.physics.compiled.extension import core_module
 from uvms_pin.physics.contact import CompliantPlane, LinearSpring
 from uvms_pin.physics.dynamics import dynamics_of
 
-
-@singledispatch
-def term_to_core(term: costs.CostTerm, core: ModuleType):
-    """The core's cost kind of ``term``, or the Fallback of a term it has no counterpart of."""
-    return Fallback(f"the cost term {type(term).__name__}")
+crocoddyl = crocoddyl_module()
 
 
-@term_to_core.register
-def _(term: costs.FramePose, core: ModuleType):
+def _frame_pose(term: costs.FramePose, core: ModuleType):
     target = term.target_inverse.inverse()
     return core.FramePoseCost(term.frame.frame_id, target.rotation, target.translation)
 
 
-@term_to_core.register
-def _(term: costs.FrameRotation, core: ModuleType):
+def _frame_rotation(term: costs.FrameRotation, core: ModuleType):
     return core.FrameRotationCost(term.frame.frame_id, term.target_transposed.T.copy())
 
 
-@term_to_core.register
-def _(term: costs.FramePosition, core: ModuleType):
+def _frame_position(term: costs.FramePosition, core: ModuleType):
     return core.FramePositionCost(term.frame.frame_id, term.target_m)
 
 
-@term_to_core.register
-def _(term: costs.Effort, core: ModuleType):
+def _effort(term: costs.Effort, core: ModuleType):
     return core.EffortCost(term.nr)
 
 
-@term_to_core.register
-def _(term: costs.StateDeviation, core: ModuleType):
+def _state_deviation(term: costs.StateDeviation, core: ModuleType):
     return core.StateDeviationCost(np.r_[term.q_ref, term.v_ref])
 
 
-@term_to_core.register
-def _(term: costs.ContactForce, core: ModuleType):
+def _contact_force(term: costs.ContactForce, core: ModuleType):
     return core.ContactForceCost(term.target_N)
 
 
-@term_to_core.register
-def _(term: costs.JointLimitMargin, core: ModuleType):
+def _joint_limit_margin(term: costs.JointLimitMargin, core: ModuleType):
     q_index = _index_list(term.q_index, term.nr)
     return core.JointLimitCost(q_index, [int(k) for k in term.v_index], term.lower, term.upper)
+
+
+#: The cost terms with a compiled counterpart, by their exact class (a subclass may change
+#: its residual: it has none), each to the core's cost kind.
+TERMS: dict[type, Callable[..., object]] = {
+    costs.FramePose: _frame_pose,
+    costs.FrameRotation: _frame_rotation,
+    costs.FramePosition: _frame_position,
+    costs.Effort: _effort,
+    costs.StateDeviation: _state_deviation,
+    costs.ContactForce: _contact_force,
+    costs.JointLimitMargin: _joint_limit_margin,
+}
 
 
 def _index_list(index: slice | np.ndarray, size: int) -> list[int]:
@@ -82,12 +83,10 @@ def _terms_to_core(model: UnderwaterActionModel, core: ModuleType):
     """The node's terms as the core's OcpTerm list (scale x weights), or the first Fallback."""
     out = []
     for term, scale in model.terms:
-        if type(term) not in term_to_core.registry:  # a subclass: its own residual
+        translate = TERMS.get(type(term))
+        if translate is None:
             return Fallback(f"the cost term {type(term).__name__}")
-        kind = term_to_core(term, core)
-        if isinstance(kind, Fallback):
-            return kind
-        out.append(core.OcpTerm(kind, scale * term.weights))
+        out.append(core.OcpTerm(translate(term, core), scale * term.weights))
     return out
 
 

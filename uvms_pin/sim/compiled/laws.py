@@ -325,9 +325,11 @@ class _MpcLaw(CoreLaw):
         settings = core.MpcLawSettings()
         settings.period_s, settings.dt_s = controller.period_s, controller.dt_s
         settings.iterations, settings.warm_start = controller.iterations, controller.warm_start
-        mpc = sys.modules[type(controller).__module__]
-        settings.cold_iterations = mpc.COLD_START_ITERATIONS
-        settings.replan_step_lengths = list(mpc.REPLAN_STEP_LENGTHS)
+        # (its module needs crocoddyl: loaded, as an MPC exists)
+        from uvms_pin.control.mpc import COLD_START_ITERATIONS, REPLAN_STEP_LENGTHS
+
+        settings.cold_iterations = COLD_START_ITERATIONS
+        settings.replan_step_lengths = list(REPLAN_STEP_LENGTHS)
         self._offsets = None
         desired = _no_desired
         if controller.force_task is not None:
