@@ -12,10 +12,10 @@
 // derivatives l_x = R_x^T W r, l_xx = R_x^T W R_x (likewise u, xu).
 //
 // The nodes of one problem share one OcpWorkspace (the dynamics, their derivatives, the
-// contact's and a Pinocchio data): crocoddyl calls them one after the other (the
-// libcrocoddyl wheel is built without multithreading: ShootingProblem::set_nthreads says so
-// and stays at one; a build with it would need a workspace per thread), each call computes from its own (x, u) and writes only its
-// node's data. What a node raises (a singular M, a non-finite acceleration) cannot cross
+// contact's and a Pinocchio data): crocoddyl calls them one after the other (the planner
+// sets its problem to one thread: the wheel's libcrocoddyl is built with OpenMP, and nodes
+// run on several threads would need a workspace per thread), each call computes from its
+// own (x, u) and writes only its node's data. What a node raises (a singular M, a non-finite acceleration) cannot cross
 // crocoddyl's loop: the node's cost is set to kRejectedCost, its other outputs to zero, and
 // the first message is held in the workspace for the planner to raise after the solve (as
 // uvms_pin.ocp.held_errors).

@@ -71,6 +71,13 @@ OcpPlanner::OcpPlanner(const Dynamics& dynamics, const OcpProblemSpec& spec,
   auto last = std::make_shared<crocoddyl::IntegratedActionModelEulerTpl<double>>(models_.back(),
                                                                                   0.0);
   problem_ = std::make_shared<crocoddyl::ShootingProblemTpl<double>>(x0, nodes, last);
+  // The nodes share one workspace: one thread. The wheel's libcrocoddyl is built with
+  // OpenMP, and its ShootingProblem runs calc / calcDiff on CROCODDYL_WITH_NTHREADS threads
+  // unless crocoddyl::enableMultithreading() is false, which crocoddyl's Python bindings
+  // set only once a Python-derived model exists; our copy of that flag is not the
+  // library's (hidden visibility), so the thread count is read and set on the problem.
+  // (set_nthreads(1) is silent here: the constructor raised the count, so the flag is on.)
+  if (problem_->get_nthreads() != 1) problem_->set_nthreads(1);
   if (spec.solver == OcpSolver::kBoxFddp) {
     solver_ = std::make_unique<crocoddyl::SolverBoxFDDP>(problem_);
   } else {

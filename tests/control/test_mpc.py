@@ -202,14 +202,14 @@ def test_the_force_task_previews_the_desired_force_and_places_its_spring(referen
 def _spy_on_plans(controller) -> list[tuple]:
     """The (x, cold, iterations, warm start, regularization) and the returned preg of each
     re-plan ``controller`` makes from now on (whichever planner solves it)."""
-    calls, plan = [], controller._plan
+    calls, plan = [], controller._replan
 
     def spy(x, cold, iterations, warm, regularization):
         guess, cost, preg = plan(x, cold, iterations, warm, regularization)
         calls.append((x, cold, iterations, warm, regularization, preg))
         return guess, cost, preg
 
-    controller._plan = spy
+    controller._replan = spy
     return calls
 
 

@@ -7,7 +7,11 @@ crocoddyl (the Python reference's) is in the dev extra; without it these tests s
 
 from __future__ import annotations
 
+import json
 import math
+import subprocess
+import sys
+from pathlib import Path
 
 import numpy as np
 import pinocchio as pin
@@ -23,7 +27,7 @@ pytest.importorskip("crocoddyl")
 
 from uvms_pin.control.measurement import Measurement
 from uvms_pin.control.mpc import MpcController, MpcForceTask
-from uvms_pin.ocp import costs, problems
+from uvms_pin.ocp import costs, plans, problems
 from uvms_pin.ocp.compiled import place_contact, planner_of
 from uvms_pin.ocp.state import UvmsState
 from uvms_pin.physics.compiled.backend import Fallback
@@ -78,10 +82,10 @@ def _every_term(uvms, x_ref, contact: bool):
     return build
 
 
-def _problem(uvms, *, flow=None, contact=None, integrator="euler", nodes=6, bounded=True):
+def _plan(uvms, *, flow=None, contact=None, integrator="euler", nodes=6, bounded=True):
     x0 = _start(uvms)
     terms = _every_term(uvms, x0, contact is not None)
-    return problems.shooting_problem(
+    return plans.plan(
         uvms,
         x0,
         terms,
@@ -129,10 +133,12 @@ def _assert_nodes_agree(problem, planner, uvms, rng, states: int = 3) -> None:
 def test_every_node_is_the_python_node_in_any_water(reference_uvms, flow):
     """All seven cost kinds, thrusters and joint torques within bounds, in still water, a
     current and a wave (each node at its own time): calc and calcDiff equal the reference's."""
-    problem = _problem(reference_uvms, flow=flow)
-    planner = planner_of(problem, "box_fddp")
+    plan = _plan(reference_uvms, flow=flow)
+    planner = planner_of(plan, "box_fddp")
     assert not isinstance(planner, Fallback), planner
-    _assert_nodes_agree(problem, planner, reference_uvms, np.random.default_rng(1))
+    _assert_nodes_agree(
+        problems.problem_of(plan), planner, reference_uvms, np.random.default_rng(1)
+    )
 
 
 @pytest.mark.parametrize(
@@ -150,8 +156,8 @@ def test_the_contact_in_the_dynamics_and_its_force_cost_are_the_references(
     states, not at others) and the contact-force cost: the compiled nodes equal the Python
     ones, the environment placed after the planner was built (as the MPC places it)."""
     contact = TaskContact(reference_uvms.ee_frame_id, environment)
-    problem = _problem(reference_uvms, contact=contact, flow=UniformCurrent([0.2, 0.0, 0.0]))
-    planner = planner_of(problem, "box_fddp")
+    plan = _plan(reference_uvms, contact=contact, flow=UniformCurrent([0.2, 0.0, 0.0]))
+    planner = planner_of(plan, "box_fddp")
     data = reference_uvms.model.createData()
     pin.framesForwardKinematics(
         reference_uvms.model, data, _start(reference_uvms)[: reference_uvms.nq]
@@ -161,7 +167,7 @@ def test_the_contact_in_the_dynamics_and_its_force_cost_are_the_references(
     )
     place_contact(planner, environment)
     rng = np.random.default_rng(2)
-    _assert_nodes_agree(problem, planner, reference_uvms, rng, states=6)
+    _assert_nodes_agree(problems.problem_of(plan), planner, reference_uvms, rng, states=6)
 
 
 def test_a_continuous_joint_model_on_rk4_nodes(tmp_path):
@@ -170,10 +176,10 @@ def test_a_continuous_joint_model_on_rk4_nodes(tmp_path):
     from conftest import continuous_joint_urdf
 
     uvms = up.load_uvms(continuous_joint_urdf(tmp_path))
-    problem = _problem(uvms, integrator="rk4", flow=UniformCurrent([0.1, 0.1, 0.0]))
-    planner = planner_of(problem, "box_fddp")
-    _assert_nodes_agree(problem, planner, uvms, np.random.default_rng(3))
-    _assert_solves_agree(problem, planner, "box_fddp")
+    plan = _plan(uvms, integrator="rk4", flow=UniformCurrent([0.1, 0.1, 0.0]))
+    planner = planner_of(plan, "box_fddp")
+    _assert_nodes_agree(problems.problem_of(plan), planner, uvms, np.random.default_rng(3))
+    _assert_solves_agree(problems.problem_of(plan), planner, "box_fddp")
 
 
 def _assert_solves_agree(problem, planner, solver: str, iterations: int = 8) -> None:
@@ -203,9 +209,9 @@ def _assert_solves_agree(problem, planner, solver: str, iterations: int = 8) -> 
 def test_the_solves_are_crocoddyls_on_the_python_problem(reference_uvms, solver):
     """BoxFDDP (the thrust and effort bounds a box) and FDDP: the compiled solve is the
     Python problem's, iteration for iteration."""
-    problem = _problem(reference_uvms, flow=UniformCurrent([0.3, 0.0, 0.0]), nodes=10)
-    planner = planner_of(problem, solver)
-    _assert_solves_agree(problem, planner, solver)
+    plan = _plan(reference_uvms, flow=UniformCurrent([0.3, 0.0, 0.0]), nodes=10)
+    planner = planner_of(plan, solver)
+    _assert_solves_agree(problems.problem_of(plan), planner, solver)
 
 
 def test_the_compiled_dynamics_and_cost_match_central_differences(reference_uvms):
@@ -214,8 +220,8 @@ def test_the_compiled_dynamics_and_cost_match_central_differences(reference_uvms
     are those of what it computes, not only equal to the reference's."""
     environment = CompliantPlane([0.0, 0.0, 1.0], stiffness_N_m=200.0, damping_N_s_m=15.0)
     contact = TaskContact(reference_uvms.ee_frame_id, environment)
-    problem = _problem(reference_uvms, contact=contact, flow=UniformCurrent([0.2, 0.0, 0.1]))
-    planner = planner_of(problem, "box_fddp")
+    plan = _plan(reference_uvms, contact=contact, flow=UniformCurrent([0.2, 0.0, 0.1]))
+    planner = planner_of(plan, "box_fddp")
     rng = np.random.default_rng(4)
     state = UvmsState(reference_uvms.model)
     x, u = _state(reference_uvms, rng), rng.normal(scale=3.0, size=planner.nu)
@@ -252,9 +258,9 @@ def test_a_node_that_fails_is_raised_after_the_solve(reference_uvms):
     acceleration out): the node's failure cannot cross crocoddyl's loop, it is held and
     raised as SimulationError once the solve returns, naming the node's calc; bad warm
     starts and settings are ParameterError before anything runs."""
-    problem = _problem(reference_uvms, nodes=4)
-    planner = planner_of(problem, "box_fddp")
-    x0 = problem.x0.copy()
+    plan = _plan(reference_uvms, nodes=4)
+    planner = planner_of(plan, "box_fddp")
+    x0 = plan.x0.copy()
     wild = x0.copy()
     wild[reference_uvms.nq :] = 1e160
     us = [np.zeros(planner.nu)] * 4
@@ -277,13 +283,13 @@ def test_a_node_that_fails_is_raised_after_the_solve(reference_uvms):
 def test_what_the_core_has_no_counterpart_of_is_named(reference_uvms):
     """CSQP, a cost term of the user's own class, the python backend: a Fallback naming it
     (the MPC then solves the Python problem and says why in `planner_path`)."""
-    assert "csqp" in planner_of(_problem(reference_uvms), "csqp").reason
+    assert "csqp" in planner_of(_plan(reference_uvms), "csqp").reason
 
     class Mine(costs.Effort):
         pass
 
     x0 = _start(reference_uvms)
-    mine = problems.shooting_problem(
+    mine = plans.plan(
         reference_uvms,
         x0,
         lambda nu: [(Mine(np.ones(nu)), 1.0)],
@@ -293,7 +299,7 @@ def test_what_the_core_has_no_counterpart_of_is_named(reference_uvms):
         actuators=_thrusters(reference_uvms),
     )
     assert "Mine" in planner_of(mine, "box_fddp").reason
-    python = problems.shooting_problem(
+    python = plans.plan(
         reference_uvms,
         x0,
         lambda nu: [(costs.Effort(np.ones(nu)), 1.0)],
@@ -345,3 +351,44 @@ def test_the_mpc_plans_the_same_compiled_or_in_python(reference_uvms, task):
         np.testing.assert_allclose(taus[0], taus[1], rtol=0, atol=1e-6)
         v = v + rng.normal(scale=0.02, size=v.size)
         q = pin.integrate(reference_uvms.model, q, 0.05 * v)
+
+
+_WITHOUT_CROCODDYL = """
+import json, sys
+import uvms_pin as up
+from uvms_pin.scenario.load import load_scenario
+
+finals = []
+for _ in range(2):  # a fresh controller, planner and run each time
+    scenario = load_scenario({path!r}, {{"scenario.duration_s": 0.3}})
+    rollout = up.simulate(scenario, progress=False)
+    finals.append([*rollout.q[-1], *rollout.v[-1]])
+print(json.dumps({{"crocoddyl": "crocoddyl" in sys.modules, "finals": finals,
+                  "loop": rollout.metadata["closed_loop"]["path"]}}))
+"""
+
+
+def test_the_mpc_plans_without_crocoddyls_package_on_one_thread(tmp_path):
+    """An MPC scenario in a process that never imports crocoddyl's Python package (what a
+    base install without the ``ocp`` extra has): its compiled re-plans are the Python
+    planner's, and a second run gives the same numbers bit for bit. (The wheel's
+    libcrocoddyl runs a problem's nodes on several OpenMP threads unless crocoddyl's Python
+    bindings turned that off; the compiled nodes share one workspace: the planner sets one
+    thread. Without it, runs here differed, or stopped on a mass matrix not positive
+    definite.)"""
+    path = str(Path(__file__).resolve().parents[2] / "scenarios" / "mpc_station_keeping.toml")
+    script = tmp_path / "mpc.py"
+    script.write_text(_WITHOUT_CROCODDYL.format(path=path))
+    done = subprocess.run(
+        [sys.executable, str(script)], capture_output=True, text=True, timeout=300, check=False
+    )
+    assert done.returncode == 0, done.stderr
+    out = json.loads(done.stdout.strip().splitlines()[-1])
+    assert out["crocoddyl"] is False and out["loop"] == "compiled"
+    first, second = (np.array(final) for final in out["finals"])
+    np.testing.assert_array_equal(first, second)
+    reference = up.simulate(
+        up.load_scenario(path, {"scenario.duration_s": 0.3, "controller.planner": "python"}),
+        progress=False,
+    )
+    np.testing.assert_allclose(first, np.r_[reference.q[-1], reference.v[-1]], rtol=0, atol=1e-9)

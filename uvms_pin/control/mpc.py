@@ -6,16 +6,19 @@ CSQP with the input bounds as constraints) from the previous solution shifted by
 the time since it spans (one at the usual rate_hz = 1 / dt_s),
 runs at most ``iterations`` iterations (at most `COLD_START_ITERATIONS` for a plan without
 a warm start, e.g. the first) and applies the first control,
-tau = B_u u_0, held until the next re-plan. The OCP (`uvms_pin.ocp.problems`) is built once
-on the model the controller believes in (it can be wrong on purpose, as for computed
+tau = B_u u_0, held until the next re-plan. The OCP (a plan of `uvms_pin.ocp.plans`) is built
+once on the model the controller believes in (it can be wrong on purpose, as for computed
 torque: `uvms_pin.model.scaled.scaled_uvms`) and the water it is told about (a known
-current; None: it plans in still water).
+current; None: it plans in still water). Its re-plans run on the compiled planner
+(`uvms_pin.ocp.compiled`, crocoddyl's C++ solvers, no Python per node and no crocoddyl
+Python package) where the core has a counterpart of every part of the plan, else on
+crocoddyl's problem of the plan (`uvms_pin.ocp.problems`, the ``ocp`` extra).
 
 Tasks: "station" keeps the vehicle's body frame at a pose and the arm at its posture
-(`problems.station_hold`); "end_effector" brings the end-effector to a pose and holds it
-(`problems.point_to_point`, re-planned over a receding horizon); "force" presses the
+(`plans.station_hold`); "end_effector" brings the end-effector to a pose and holds it
+(`plans.point_to_point`, re-planned over a receding horizon); "force" presses the
 end-effector on a compliant environment to track a desired force f_d(t) while holding its
-attitude (`problems.force_tracking`, the paper's task): the controller's model of the
+attitude (`plans.force_tracking`, the paper's task): the controller's model of the
 environment (`MpcForceTask.contact`, a `uvms_pin.physics.contact` model; placed where the
 tip is at the first re-plan unless its point is given) is in every node's dynamics, and
 each re-plan moves the desired force along the horizon (the controller previews f_d).
@@ -27,6 +30,7 @@ from __future__ import annotations
 
 import copy
 import dataclasses
+import functools
 import math
 from collections.abc import Callable
 from dataclasses import dataclass, field
@@ -41,7 +45,7 @@ from uvms_pin.control.task_space import first_level_error
 from uvms_pin.errors import ParameterError
 from uvms_pin.flow import FlowField
 from uvms_pin.model.uvms import UVMS
-from uvms_pin.ocp import problems
+from uvms_pin.ocp import plans
 from uvms_pin.ocp.compiled import place_contact, planner_of
 from uvms_pin.physics.compiled.backend import Fallback
 from uvms_pin.physics.contact import ContactModel
@@ -97,18 +101,19 @@ class MpcController(Controller):
         iterations: solver iterations per re-plan. solver: "box_fddp" (bounds enforced as a
             box), "fddp" (not enforced) or "csqp" (mim_solvers' CSQP: enforced as the
             nodes' inequality constraints). integrator: of the OCP's nodes, "euler" or
-            "rk4" (`uvms_pin.ocp.problems.INTEGRATORS`).
-        actuators: what u is and its bounds (`uvms_pin.ocp.problems.Actuators`).
+            "rk4" (`uvms_pin.ocp.plans.INTEGRATORS`).
+        actuators: what u is and its bounds (`uvms_pin.ocp.plans.Actuators`).
         flow: the water the controller plans in. warm_start: shift the previous solution.
         pose_weights: of the target pose's error (x, y, z [m], rotation [rad]); None: the
-            problem's default (`problems.station_hold`, `problems.point_to_point`).
+            plan's default (`plans.station_hold`, `plans.point_to_point`).
         force_task: the force task's `MpcForceTask` (task "force" only; ``target`` unused).
         planner: "core": each re-plan solved in the compiled core, crocoddyl's C++ FDDP on
             the compiled nodes (`uvms_pin.ocp.compiled`; where the core has no
             counterpart, e.g. the "csqp" solver or a cost of the user's own class, the
             Python problem is solved instead and `planner_path` says why); "python": the
             Python problem always (crocoddyl calling `uvms_pin.ocp.model` per node, the
-            reference the compiled planner is tested against).
+            reference the compiled planner is tested against). The Python problem needs
+            crocoddyl's Python package (the ``ocp`` extra); the compiled planner does not.
     """
 
     def __init__(
@@ -124,7 +129,7 @@ class MpcController(Controller):
         iterations: int = 3,
         solver: str = "box_fddp",
         integrator: str = "euler",
-        actuators: problems.Actuators | None = None,
+        actuators: plans.Actuators | None = None,
         flow: FlowField | None = None,
         warm_start: bool = True,
         pose_weights: np.ndarray | None = None,
@@ -140,8 +145,8 @@ class MpcController(Controller):
             raise ParameterError(
                 f"mpc needs 0 < dt_s <= horizon_s (at least one node), got {dt_s}, {horizon_s}"
             )
-        problems.check_solver(solver)
-        problems.check_integrator(integrator)
+        plans.check_solver(solver)
+        plans.check_integrator(integrator)
         if planner not in PLANNERS:
             raise ParameterError(f"mpc planner must be one of {PLANNERS}, got '{planner}'")
         if not (rate_hz > 0.0 and math.isfinite(rate_hz)) or iterations < 1:
@@ -149,7 +154,7 @@ class MpcController(Controller):
                 f"mpc needs rate_hz > 0 and iterations >= 1, got {rate_hz}, {iterations}"
             )
         self.uvms = uvms.with_model(pin.Model(uvms.model))
-        actuators = problems.Actuators() if actuators is None else actuators
+        actuators = plans.Actuators() if actuators is None else actuators
         # csqp: the bounds as constraints (box FDDP reads them as a box either way)
         actuators = dataclasses.replace(actuators, as_constraints=solver == "csqp")
         x_ref = np.r_[np.asarray(posture, float), np.zeros(uvms.nv)]
@@ -163,11 +168,11 @@ class MpcController(Controller):
             "integrator": integrator,
         }
         if force_task is not None:
-            self.problem = self._force_problem(force_task, x_ref, common)
+            self.plan = self._force_plan(force_task, x_ref, common)
         else:
-            build = problems.station_hold if task == "station" else problems.point_to_point
+            build = plans.station_hold if task == "station" else plans.point_to_point
             weights = {} if pose_weights is None else {"pose_weights": pose_weights}
-            self.problem = build(self.uvms, x_ref, target, **common, **weights)
+            self.plan = build(self.uvms, x_ref, target, **common, **weights)
         self.period_s, self.dt_s = 1.0 / rate_hz, dt_s
         self.iterations, self.solver, self.warm_start = iterations, solver, warm_start
         self.input_matrix = (
@@ -175,7 +180,7 @@ class MpcController(Controller):
         )
         # the re-plans in the core (no Python per node), decided once: the planner, or the
         # reason the Python problem is solved instead (`planner_path`)
-        compiled = planner_of(self.problem, solver) if backend == planner == "core" else None
+        compiled = planner_of(self.plan, solver) if backend == planner == "core" else None
         self._planner = None if isinstance(compiled, Fallback | None) else compiled
         if self._planner is not None:
             self.planner_path = "compiled"
@@ -183,10 +188,19 @@ class MpcController(Controller):
             self.planner_path = f"asked for: backend '{backend}', planner '{planner}'"
         else:
             self.planner_path = compiled.reason
-        self._plan = self._plan_compiled if self._planner is not None else self._plan_python
+        self._replan = self._plan_compiled if self._planner is not None else self._plan_python
         self.reset()
 
-    def _force_problem(self, task: MpcForceTask, x_ref: np.ndarray, common: dict):
+    @functools.cached_property
+    def problem(self):
+        """crocoddyl's ShootingProblem of the plan (`uvms_pin.ocp.problems.problem_of`: its
+        nodes share the plan's cost terms), made on first use: the Python re-plans solve it
+        (the ``ocp`` extra's crocoddyl; a compiled planner needs neither)."""
+        from uvms_pin.ocp.problems import problem_of  # crocoddyl's Python package: on use
+
+        return problem_of(self.plan)
+
+    def _force_plan(self, task: MpcForceTask, x_ref: np.ndarray, common: dict):
         """The force task's OCP on the controller's own copy of the environment."""
         ee = self.uvms.require_ee_frame("the MPC's force task")
         self._contact = TaskContact(ee, copy.deepcopy(task.contact))
@@ -194,7 +208,7 @@ class MpcController(Controller):
         if self._rpy_desired.shape != (3,) or not np.all(np.isfinite(self._rpy_desired)):
             raise ParameterError(f"mpc desired_rpy: 3 finite angles, got {task.desired_rpy}")
         self._ee_data = self.uvms.model.createData()
-        self.force_tracking = problems.force_tracking(
+        self.force_tracking = plans.force_tracking(
             self.uvms,
             x_ref,
             self._contact,
@@ -205,7 +219,7 @@ class MpcController(Controller):
             posture_weight=task.posture_weight,
             **common,
         )
-        return self.force_tracking.problem
+        return self.force_tracking.plan
 
     def reset(self) -> None:
         self._last_plan_s = -math.inf
@@ -215,16 +229,18 @@ class MpcController(Controller):
         # one solver for the run: each re-plan starts from the last one's regularization
         # (the Python problem's only when it is the one solved: its nodes' data are many)
         if self._planner is None:
-            self._solver = problems.solver_of(self.problem, self.solver)
+            from uvms_pin.ocp.problems import solver_of  # crocoddyl's Python package: on use
+
+            self._solver = solver_of(self.problem, self.solver)
             self._cold_steps = list(self._solver.alphas)
         self._regularization: float | None = None
 
     def _initial_guess(self, x: np.ndarray, elapsed_s: float) -> tuple[list, list]:
         """The solver's start: the last plan moved on by the ``elapsed_s`` [s] since it, in
         whole nodes (its last node repeated at the end), from the measured state x."""
-        nodes = self.problem.T
+        nodes = self.plan.nodes
         if self._guess is None or not self.warm_start:
-            return [x] * (nodes + 1), [np.zeros(self.problem.runningModels[0].nu)] * nodes
+            return [x] * (nodes + 1), [np.zeros(self.plan.nu)] * nodes
         xs, us = self._guess
         shift = min(max(round(elapsed_s / self.dt_s), 0), nodes)
         return [x, *xs[shift + 1 :], *[xs[-1]] * shift], [*us[shift:], *[us[-1]] * shift]
@@ -259,11 +275,11 @@ class MpcController(Controller):
         if self.force_task is not None:
             self._start_force_plan(time_s, measurement)
         x = np.r_[measurement.q, measurement.v]
-        self.problem.x0 = x
+        self.plan.x0 = x
         iterations = max(self.iterations, COLD_START_ITERATIONS) if cold else self.iterations
         warm = self._initial_guess(x, time_s - self._last_plan_s)
         regularization = self._regularization if self.warm_start else None
-        self._guess, cost, self._regularization = self._plan(
+        self._guess, cost, self._regularization = self._replan(
             x, cold, iterations, warm, regularization
         )
         u0 = self._guess[1][0].copy()
@@ -274,6 +290,9 @@ class MpcController(Controller):
 
     def _plan_python(self, x, cold, iterations, warm, regularization):
         """One re-plan by crocoddyl from Python (the reference): ((xs, us), cost, preg)."""
+        from uvms_pin.ocp import problems  # crocoddyl's Python package: on use
+
+        self.problem.x0 = x
         if self.solver != "csqp":  # (CSQP's filter line search keeps its own steps)
             self._solver.alphas = self._cold_steps if cold else list(REPLAN_STEP_LENGTHS)
         solver = problems.solve(
@@ -286,8 +305,8 @@ class MpcController(Controller):
         return problems.solution(solver), solver.cost, solver.preg
 
     def _plan_compiled(self, x, cold, iterations, warm, regularization):
-        """The same re-plan in the core (`uvms_pin.ocp.compiled`): the problem's
-        initial state, environment and desired forces given to the planner first."""
+        """The same re-plan in the core (`uvms_pin.ocp.compiled`): the plan's initial
+        state, environment and desired forces given to the planner first."""
         planner = self._planner
         planner.set_x0(x)
         if self.force_task is not None:

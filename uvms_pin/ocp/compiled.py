@@ -1,11 +1,11 @@
-"""A `uvms_pin.ocp` shooting problem as the core's compiled `OcpPlanner`
-(src/uvms_core/ocp_planner.hpp): the same nodes, costs, inputs, bounds, water and contact,
-solved by crocoddyl's C++ FDDP without Python per node.
+"""A `uvms_pin.ocp.plans` shooting plan as the core's compiled `OcpPlanner`
+(src/uvms_core/ocp_planner.hpp): the same nodes, costs, inputs, bounds, water and contact
+as crocoddyl's problem of it (`uvms_pin.ocp.problems.problem_of`, the reference), solved by
+crocoddyl's C++ FDDP without Python per node, and without crocoddyl's Python package.
 
-`planner_of` reads the Python problem (its nodes are the reference, `UnderwaterActionModel`)
-and returns the planner, or a `Fallback` naming what the core has no counterpart of (a cost
-term of the user's own class, a flow or contact model the core does not mirror, the
-"python" backend, CSQP's constraints, a node integrated otherwise). Each cost term's
+`planner_of` reads the plan and returns the planner, or a `Fallback` naming what the core
+has no counterpart of (a cost term of the user's own class, a flow or contact model the core
+does not mirror, the "python" backend, CSQP and its constraints). Each cost term's
 translation is registered here, in `TERMS`, one function per class of `uvms_pin.ocp.costs`.
 """
 
@@ -17,16 +17,13 @@ from types import ModuleType
 import numpy as np
 
 from uvms_pin.ocp import costs
-from uvms_pin.ocp.crocoddyl_module import crocoddyl_module
-from uvms_pin.ocp.model import UnderwaterActionModel
+from uvms_pin.ocp.plans import Node, ShootingPlan
 from uvms_pin.physics.compiled.backend import Fallback
 from uvms_pin.physics.compiled.contact import contact_to_core
 from uvms_pin.physics.compiled.dynamics import CompiledDynamics
 from uvms_pin.physics.compiled.extension import core_module
 from uvms_pin.physics.contact import CompliantPlane, LinearSpring
 from uvms_pin.physics.dynamics import dynamics_of
-
-crocoddyl = crocoddyl_module()
 
 
 def _frame_pose(term: costs.FramePose, core: ModuleType):
@@ -79,10 +76,10 @@ def _index_list(index: slice | np.ndarray, size: int) -> list[int]:
     return [int(k) for k in index]
 
 
-def _terms_to_core(model: UnderwaterActionModel, core: ModuleType):
+def _terms_to_core(node: Node, core: ModuleType):
     """The node's terms as the core's OcpTerm list (scale x weights), or the first Fallback."""
     out = []
-    for term, scale in model.terms:
+    for term, scale in node.terms:
         translate = TERMS.get(type(term))
         if translate is None:
             return Fallback(f"the cost term {type(term).__name__}")
@@ -90,70 +87,42 @@ def _terms_to_core(model: UnderwaterActionModel, core: ModuleType):
     return out
 
 
-#: crocoddyl's integrated models the core mirrors, by the core's name
-_INTEGRATORS = {"IntegratedActionModelEuler": "euler", "IntegratedActionModelRK": "rk4"}
-
-
-def planner_of(problem, solver: str):
-    """The core's `OcpPlanner` of ``problem`` (a crocoddyl.ShootingProblem of
-    `UnderwaterActionModel` nodes, `uvms_pin.ocp.problems.shooting_problem`) solved by
-    ``solver`` ("box_fddp" or "fddp"), or the `Fallback` saying why not. A contact model not
-    placed yet is given later (`place_contact`)."""
+def planner_of(plan: ShootingPlan, solver: str):
+    """The core's `OcpPlanner` of ``plan`` (`uvms_pin.ocp.plans`) solved by ``solver``
+    ("box_fddp" or "fddp"), or the `Fallback` saying why not. A contact model not placed
+    yet is given later (`place_contact`)."""
     core = core_module()
     if solver not in ("box_fddp", "fddp"):
         return Fallback(f"the {solver} solver (mim_solvers, Python)")
-    nodes = [*problem.runningModels]
-    models = [getattr(node, "differential", None) for node in [*nodes, problem.terminalModel]]
-    if any(type(model) is not UnderwaterActionModel for model in models):
-        return Fallback("a node that is not uvms_pin.ocp's UnderwaterActionModel")
-    kinds = {type(node).__name__ for node in nodes}
-    dts = {float(node.dt) for node in nodes}
-    if len(kinds) != 1 or not kinds <= set(_INTEGRATORS) or len(dts) != 1:
-        return Fallback("nodes integrated otherwise than by one Euler or RK4 step each")
-    if isinstance(nodes[0], crocoddyl.IntegratedActionModelRK) and nodes[0].ni != 4:
-        return Fallback("a Runge-Kutta node of another order than four")
-    last = problem.terminalModel
-    if not isinstance(last, crocoddyl.IntegratedActionModelEuler) or last.dt != 0.0:
-        return Fallback("a terminal node other than its model integrated over 0 s")
-    first = models[0]
-    uvms = first.uvms
-    if any(model.uvms is not uvms for model in models):
-        return Fallback("nodes of different models")
-    if any(model.water["backend"] != "core" for model in models):
+    if plan.backend != "core":
         return Fallback("the python backend")
-    if any(model.ng > 0 for model in models):
+    if plan.as_constraints:
         return Fallback("inequality constraints (CSQP's)")
-    flows = {id(model.water["flow"]) for model in models}
-    if len(flows) != 1 or any(
-        not np.array_equal(m.input_matrix, first.input_matrix) for m in models
-    ):
-        return Fallback("nodes in different waters or with different inputs")
-    spec = core.OcpProblemSpec()
-    dynamics = dynamics_of(uvms, "core")
+    dynamics = dynamics_of(plan.uvms, "core")
     if not isinstance(dynamics, CompiledDynamics):
         return Fallback("no compiled core")
-    flow = dynamics.flow_struct(first.water["flow"])
+    flow = dynamics.flow_struct(plan.flow)
     if isinstance(flow, Fallback):
         return flow
-    contact = first.contact
-    if any(model.contact is not contact for model in models):
-        return Fallback("nodes with different contacts")
+    contact = plan.contact
     if contact is not None and type(contact.model) not in (LinearSpring, CompliantPlane):
         return Fallback(f"the contact model {type(contact.model).__name__}")
-    terms = [_terms_to_core(model, core) for model in models]
+    nodes = [*plan.running, plan.terminal]
+    terms = [_terms_to_core(node, core) for node in nodes]
     for made in terms:
         if isinstance(made, Fallback):
             return made
-    spec.dt_s = dts.pop()
-    spec.integrator = getattr(core.OcpIntegrator, _INTEGRATORS[kinds.pop()])
+    spec = core.OcpProblemSpec()
+    spec.dt_s = plan.dt_s
+    spec.integrator = getattr(core.OcpIntegrator, plan.integrator)
     spec.solver = getattr(core.OcpSolver, solver)
-    spec.input_matrix = first.input_matrix
-    if first.has_control_limits:
-        spec.lower, spec.upper = np.array(first.u_lb), np.array(first.u_ub)
+    spec.input_matrix = plan.input_matrix
+    if plan.bounds is not None:
+        spec.lower, spec.upper = (np.array(bound) for bound in plan.bounds)
     spec.flow = flow
-    spec.times_s = [float(model.water["time_s"]) for model in models]
+    spec.times_s = [node.time_s for node in nodes]
     spec.contact_frame = -1 if contact is None else int(contact.frame_id)
-    planner = core.OcpPlanner(dynamics.core, spec, terms[:-1], terms[-1], problem.x0)
+    planner = core.OcpPlanner(dynamics.core, spec, terms[:-1], terms[-1], plan.x0)
     if contact is not None:
         place_contact(planner, contact.model)
     return planner

@@ -29,17 +29,14 @@ cannot cross crocoddyl's C++ loop).
 
 from __future__ import annotations
 
-from collections.abc import Sequence
-
 import numpy as np
 import pinocchio as pin
 
-from uvms_pin.errors import ParameterError
 from uvms_pin.flow import FlowField
 from uvms_pin.model.uvms import UVMS
-from uvms_pin.ocp.costs import CostTerm, Effort
 from uvms_pin.ocp.crocoddyl_module import crocoddyl_module
 from uvms_pin.ocp.held_errors import HeldError
+from uvms_pin.ocp.plans import WeightedTerms, check_terms, checked_bounds, checked_input_matrix
 from uvms_pin.ocp.state import UvmsState
 from uvms_pin.physics.derivatives.task_contact import (
     TaskContact,
@@ -54,9 +51,6 @@ crocoddyl = crocoddyl_module()
 #: the cost of a node that raised: finite, so that no step through it is accepted and the
 #: solver returns (a NaN is itself an exception in mim_solvers' CSQP, which aborts)
 REJECTED_COST = 1e30
-
-WeightedTerms = Sequence[tuple[CostTerm, float]]
-"""The cost of a node: (term, scale) pairs, l = sum_i scale_i (1/2) r_i^T W_i r_i."""
 
 
 class UnderwaterActionModel(crocoddyl.DifferentialActionModelAbstract):
@@ -88,11 +82,9 @@ class UnderwaterActionModel(crocoddyl.DifferentialActionModelAbstract):
         contact: TaskContact | None = None,
         bounds_as_constraints: bool = False,
     ):
-        b_u = np.eye(uvms.nv) if input_matrix_ is None else np.asarray(input_matrix_, float)
-        if b_u.ndim != 2 or b_u.shape[0] != uvms.nv:
-            raise ParameterError(f"input_matrix_ must be (nv={uvms.nv}, nu), got {b_u.shape}")
+        b_u = checked_input_matrix(uvms, input_matrix_)
         nr, nu = sum(term.nr for term, _ in terms), b_u.shape[1]
-        _check_terms(terms, nu)
+        check_terms(terms, nu, contact is not None)
         ng = nu if bounds_as_constraints and u_bounds is not None else 0
         state = UvmsState(uvms.model)
         crocoddyl.DifferentialActionModelAbstract.__init__(self, state, nu, nr, ng)
@@ -100,25 +92,13 @@ class UnderwaterActionModel(crocoddyl.DifferentialActionModelAbstract):
         # scale_i W_i of every residual row, in the terms' order
         self._weights = np.concatenate([np.zeros(0), *(s * term.weights for term, s in terms)])
         self.water = {"flow": flow, "time_s": float(time_s), "backend": backend}
-        needing = [term.name for term, _ in terms if term.needs_contact]
-        if needing and contact is None:
-            raise ParameterError(f"cost(s) {needing} need a contact in the node's dynamics")
         self.contact = contact
         self.held = HeldError()  # what calc / calcDiff raised inside crocoddyl
         # where d J_k/dq_m can be non-zero (the contact's derivatives), once per model
         self._supports = None if contact is None else supports_mask(uvms.model)
         self.constraints = None
         if u_bounds is not None:
-            lower, upper = (np.asarray(b, float).reshape(-1) for b in u_bounds)
-            if (
-                lower.shape != (self.nu,)
-                or upper.shape != (self.nu,)
-                or not np.all(lower <= upper)  # (NaN too)
-            ):
-                raise ParameterError(
-                    f"u_bounds: two (nu={self.nu},) arrays, lower <= upper (not NaN), "
-                    f"got {lower}, {upper}"
-                )
+            lower, upper = checked_bounds(u_bounds, nu)
             self.u_lb, self.u_ub = lower, upper
         if ng:  # (the manager's own g_lb / g_ub read garbage in the crocoddyl 3.2.1 wheels)
             self.constraints = _input_constraints(state, lower, upper)
@@ -221,20 +201,6 @@ def _zero(data, *names: str) -> None:
     `REJECTED_COST`)."""
     for name in names:
         getattr(data, name)[...] = 0.0
-
-
-def _check_terms(terms: WeightedTerms, nu: int) -> None:
-    """Each term's scale finite and >= 0 (a negative one makes the cost unbounded below, a
-    NaN one every cost NaN), an effort term over the nu inputs; else ParameterError."""
-    for term, scale in terms:
-        if not (scale >= 0.0 and np.isfinite(scale)):
-            raise ParameterError(
-                f"cost '{term.name}': its scale must be finite and >= 0, got {scale}"
-            )
-        if isinstance(term, Effort) and term.nr != nu:
-            raise ParameterError(
-                f"cost '{term.name}': {term.nr} weights for the node's {nu} inputs (nu)"
-            )
 
 
 def _input_constraints(state, lower: np.ndarray, upper: np.ndarray):

@@ -142,7 +142,7 @@ def read_mpc(t: Table, context: ControllerContext) -> ControllerSpec:
 
     def build(u: UVMS) -> Controller:
         from uvms_pin.control.mpc import MpcController, MpcForceTask  # crocoddyl: on use
-        from uvms_pin.ocp.problems import Actuators
+        from uvms_pin.ocp.plans import Actuators
 
         q_ref = u.neutral_configuration()
         if target is not None:

@@ -20,7 +20,6 @@ from __future__ import annotations
 import copy
 import dataclasses
 import math
-import sys
 from collections.abc import Callable
 from types import ModuleType
 
@@ -31,6 +30,7 @@ from uvms_pin.control.baselines.computed_torque import ComputedTorqueController
 from uvms_pin.control.baselines.impedance import ImpedanceController
 from uvms_pin.control.baselines.pi_force import PIForceController
 from uvms_pin.control.baselines.task import EndEffectorTask, ForceOrientationLoop
+from uvms_pin.control.mpc import COLD_START_ITERATIONS, REPLAN_STEP_LENGTHS, MpcController
 from uvms_pin.control.performance import transformed_error
 from uvms_pin.control.ppc import PPCSignals, PrescribedPerformanceController
 from uvms_pin.control.pseudo_inverse import REFINE_ABOVE_CONDITION_BOUND
@@ -316,7 +316,7 @@ def _task_priority(controller: TaskPriorityController, core: ModuleType) -> Core
     return _InverseDynamicsLaw(controller, law, _path_desired(task), described)
 
 
-# ---- the MPC (its module needs crocoddyl: imported by whoever built one) ---------------------
+# ---- the MPC -----------------------------------------------------------------------------------
 class _MpcLaw(CoreLaw):
     """The MPC's re-plans on its compiled planner; its last plan, the plan's time and
     regularization, tau and its signals the state handed over (src/uvms_core/law_mpc.hpp)."""
@@ -325,9 +325,6 @@ class _MpcLaw(CoreLaw):
         settings = core.MpcLawSettings()
         settings.period_s, settings.dt_s = controller.period_s, controller.dt_s
         settings.iterations, settings.warm_start = controller.iterations, controller.warm_start
-        # (its module needs crocoddyl: loaded, as an MPC exists)
-        from uvms_pin.control.mpc import COLD_START_ITERATIONS, REPLAN_STEP_LENGTHS
-
         settings.cold_iterations = COLD_START_ITERATIONS
         settings.replan_step_lengths = list(REPLAN_STEP_LENGTHS)
         self._offsets = None
@@ -409,17 +406,13 @@ _LAWS: dict[type, Callable[[Controller, ModuleType], CoreLaw | Fallback]] = {
     ComputedTorqueController: _computed_torque,
     ResolvedAccelerationController: _resolved_acceleration,
     TaskPriorityController: _task_priority,
+    MpcController: _mpc,
 }
 
 
 def law_to_core(controller: Controller, core: ModuleType) -> CoreLaw | Fallback:
-    """The compiled law of ``controller`` in the core module ``core``, or why it has none.
-    (The MPC's class is looked up where it is: its module, which needs crocoddyl, is
-    loaded whenever an MPC exists.)"""
+    """The compiled law of ``controller`` in the core module ``core``, or why it has none."""
     build = _LAWS.get(type(controller))
-    mpc = sys.modules.get("uvms_pin.control.mpc")
-    if build is None and mpc is not None and type(controller) is mpc.MpcController:
-        build = _mpc
     if build is None:
         return Fallback(f"the controller {type(controller).__name__} is not compiled")
     return build(controller, core)
