@@ -60,11 +60,17 @@ def test_each_baseline_runs_compiled_as_in_python(kind, path, overrides):
         assert meta == {"path": "compiled", "reason": None, "compiled_ticks": ticks,
                         "python_ticks": 0}  # fmt: skip
         assert python.metadata["closed_loop"]["python_ticks"] == ticks
-    else:  # the paper's unlimited vehicle with a default-tuned baseline at 500 Hz blows up
-        assert str(stop_c) == str(stop_p) and "diverged" in str(stop_p)
+    else:  # the paper's unlimited vehicle with a default-tuned baseline at 500 Hz: its
+        # wrist races at thousands of rad/s between its limits (the sampled loop unstable)
+        assert str(stop_c) == str(stop_p)
         python_ticks = python.metadata["closed_loop"]["python_ticks"]
-        assert meta == {"path": "compiled", "reason": None,
-                        "compiled_ticks": python_ticks - 1, "python_ticks": 1}  # fmt: skip
+        if "left physics" in str(stop_p):  # found once the run ended: every tick compiled
+            assert meta == {"path": "compiled", "reason": None, "compiled_ticks": ticks,
+                            "python_ticks": 0}  # fmt: skip
+        else:  # diverged: the tick that diverged is handed to Python
+            assert "diverged" in str(stop_p)
+            assert meta == {"path": "compiled", "reason": None,
+                            "compiled_ticks": python_ticks - 1, "python_ticks": 1}  # fmt: skip
     # a joint resting on its limit (the paper's arm under a default-tuned baseline) lands
     # each period at q0 + h (-r / h): its gap r is the rounding of the last landing (~1e-16
     # rad), which v = -r / h turns into ~1e-13 rad/s, not the same in the two loops

@@ -14,7 +14,7 @@ from conftest import ROOT
 import uvms_pin as up
 from uvms_pin.control.base import Controller
 from uvms_pin.scenario.load import load_scenario
-from uvms_pin.sim.divergence import divergence_context
+from uvms_pin.sim.divergence import divergence_context, implausible_motion
 from uvms_pin.sim.plant import Plant
 from uvms_pin.sim.run import simulate
 
@@ -88,3 +88,49 @@ def test_a_physical_state_says_so_with_its_largest_velocity(reference_uvms):
         "at t = 1 s every input was in a physical range; the largest velocity was "
         "vehicle q = -0.3 rad/s"
     )
+
+
+def test_a_bounded_but_unphysical_motion_names_its_joint_and_time(reference_uvms):
+    """`implausible_motion`: the first sample past 100 m/s or rad/s, named with its degree of
+    freedom and time; nothing when every speed stays below, or when the run started above
+    (a start the scenario's own check already warned about)."""
+    n = reference_uvms.nv
+    time_s = np.arange(5) * 0.01
+    v = np.zeros((5, n))
+    v[3:, n - 1] = [576.0, -300.0]
+    v[4, 0] = 150.0
+    when, why = implausible_motion(reference_uvms, time_s, v, np.zeros(n))
+    name = reference_uvms.arm_joints.names[-1]
+    assert when == pytest.approx(0.03) and f"{name} at 576 rad/s" in why
+    v[3:, n - 1] = 99.0
+    v[4, 0] = 0.0
+    assert implausible_motion(reference_uvms, time_s, v, np.zeros(n)) is None
+    v[3, 0] = 200.0
+    assert implausible_motion(reference_uvms, time_s, v, np.full(n, 150.0)) is None
+
+
+def test_a_control_loop_unstable_at_its_period_stops_the_run_with_the_reason():
+    """The object push at a 10 ms control period: its joint PD (k_d = 1.5 N m s/rad on the
+    Alpha 5's light links) is unstable sampled at 10 ms, and the arm's joints race between
+    their limits at hundreds of rad/s without diverging. The run stops (exit 3 from the
+    command line) naming the joint and the likely cause instead of ending "ok"."""
+    scenario = load_scenario(
+        ROOT / "scenarios" / "push_object.toml",
+        {
+            "scenario.duration_s": 0.5,
+            "integrator.step_s": 0.01,
+            "control.period_s": 0.01,
+            "output.log_period_s": 0.01,
+        },
+    )
+    with pytest.raises(up.SimulationError, match=r"left physics at t = .* rad/s") as info:
+        simulate(scenario, progress=False)
+    rollout = info.value.rollout
+    assert not rollout.status.ok and "control.period_s" in rollout.status.reason
+    assert np.abs(rollout.v).max() > 100.0
+    # the same scenario at its own period is physics
+    fine = simulate(
+        load_scenario(ROOT / "scenarios" / "push_object.toml", {"scenario.duration_s": 0.5}),
+        progress=False,
+    )
+    assert fine.status.ok and np.abs(fine.v).max() < 100.0

@@ -36,7 +36,12 @@ from uvms_pin.errors import (
 from uvms_pin.results.rollout import Rollout
 from uvms_pin.results.status import ERROR, INTERRUPTED, OK, RunStatus, Violation
 from uvms_pin.sim.compiled_loop import CompiledLoop, LoopPath
-from uvms_pin.sim.divergence import NUMERICAL_FAILURES, diverged, divergence_context
+from uvms_pin.sim.divergence import (
+    NUMERICAL_FAILURES,
+    diverged,
+    divergence_context,
+    stop_if_implausible,
+)
 from uvms_pin.sim.integrators import Adaptive
 from uvms_pin.sim.log import RolloutLog, described_columns, run_metadata
 from uvms_pin.sim.plant import Plant
@@ -280,7 +285,9 @@ class ClosedLoop:
             dropped = self.plant.actuation.dropped()
             if dropped is not None:
                 warnings.warn(dropped, ActuationWarning, stacklevel=2)
-        return _finished(log, wall_start, RunStatus(OK))
+        rollout = _finished(log, wall_start, RunStatus(OK))
+        stop_if_implausible(self.plant.uvms, rollout, v0)  # finite, but is it physics?
+        return rollout
 
     def _tick(self, logged: bool) -> np.ndarray:
         """Measure, command and actuate at the current state; log if ``logged``."""

@@ -8,6 +8,9 @@ import math
 
 import numpy as np
 
+from uvms_pin.errors import SimulationError
+from uvms_pin.results.status import RunStatus
+
 #: A speed this large [m/s or rad/s] only comes out of a blown-up integration.
 DIVERGED_SPEED = 1e4
 
@@ -46,6 +49,46 @@ def _labels(uvms) -> tuple[list[tuple[str, str]], list[tuple[str, str]]]:
     force = [(f"vehicle {n}", u) for n, u in _VEHICLE_WRENCH]
     force += [(n, "N" if lin else "N m") for n, lin in zip(arm.names, linear, strict=True)]
     return velocity, force
+
+
+def implausible_motion(
+    uvms, time_s: np.ndarray, v: np.ndarray, v0: np.ndarray
+) -> tuple[float, str] | None:
+    """(when, why) a run that stayed finite is not physics, or None: the first logged sample (times
+    ``time_s`` (T,) [s], velocities ``v`` (T, nv)) at which a velocity of the UVMS, the
+    vehicle's or an arm joint's, is past what no UVMS reaches (100 m/s or rad/s), in a run
+    that started below it (``v0``). Joint limits and damping keep such a motion bounded, so
+    nothing diverges; most often it is a sampled control loop unstable at its control
+    period (a derivative gain k_d with k_d T / I > 2 on a light link of inertia I sampled
+    every T), else a step too coarse for a stiff setting."""
+    bound = _IMPLAUSIBLE["speed"]
+    if len(v) == 0 or np.max(np.abs(v0)) > bound:
+        return None
+    past = np.abs(v) > bound
+    if not past.any():
+        return None
+    row = int(np.argmax(past.any(axis=1)))
+    k = int(np.argmax(np.abs(v[row])))
+    name, unit = _labels(uvms)[0][k]
+    return float(time_s[row]), (
+        f"the motion left physics at t = {time_s[row]:.6g} s: {name} at {v[row, k]:.3g} {unit}, "
+        f"past the {bound:g} m/s or rad/s no UVMS reaches (bounded by its limits, not "
+        "diverged): most often the control loop is unstable at its control period (a "
+        "derivative gain too large for a light link's inertia at this period: shorten "
+        "control.period_s or lower the gains), else the step is too coarse"
+    )
+
+
+def stop_if_implausible(uvms, rollout, v0: np.ndarray) -> None:
+    """Raise a SimulationError (``rollout`` attached, its status the stop and its reason)
+    when the rollout's motion is `implausible_motion`."""
+    found = implausible_motion(uvms, rollout.time_s, rollout.v, v0)
+    if found is not None:
+        time_s, reason = found
+        error = SimulationError(reason)
+        error.rollout = rollout
+        rollout.set_status(RunStatus(type(error).__name__, reason, time_s))
+        raise error
 
 
 def divergence_context(
