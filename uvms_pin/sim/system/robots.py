@@ -39,7 +39,7 @@ import pinocchio as pin
 from uvms_pin.errors import ParameterError
 from uvms_pin.physics.compiled.backend import Fallback
 from uvms_pin.physics.compiled.extension import core_module
-from uvms_pin.physics.compiled.moving import search_compiled
+from uvms_pin.physics.compiled.moving import contacts_of_core, search_compiled
 from uvms_pin.physics.world.between_robots import RobotContacts
 from uvms_pin.physics.world.contact_law import ContactLaw
 from uvms_pin.physics.world.world import World
@@ -193,7 +193,11 @@ class Robots:
 
     def near(self, q: np.ndarray, v: np.ndarray, horizon_s: float) -> bool:
         """Some two robots, or a robot but the first and an object, may touch within
-        ``horizon_s`` from (q, v)."""
+        ``horizon_s`` from (q, v): the core's bound test (`RobotsSystem.near`, the same
+        arithmetic) with the compiled backend, else the reference's."""
+        core = self._core()
+        if core is not None:
+            return core.near(q, v, horizon_s)
         return self.contacts.near(self.sides(q, v), lambda: self._kinematics(q, v), horizon_s)
 
     def advance(
@@ -230,6 +234,12 @@ class Robots:
             held = self._compiled = (plants, built)
         return held[1]
 
+    def _core(self) -> Any:
+        """The core's `RobotsSystem`, or None (the Python backend, a plant the core cannot
+        compile: `compiled`)."""
+        built = self.compiled
+        return None if isinstance(built, Fallback) else built[0]
+
     def _memories(self) -> list[list]:
         """Each robot's system's friction memories, as its core system reads them."""
         return [
@@ -265,7 +275,26 @@ class Robots:
         """The period integrated for every body at once (the contacts between robots and
         with the objects in the right-hand side), every anchor moved at its end, then each
         robot's system's constraints (its joint limits; the first's objects' rigid
-        contacts with the fixed world)."""
+        contacts with the fixed world): one core call (`RobotsSystem.advance`, the same
+        steps) when the integration is compiled, else the reference below."""
+        built = self.compiled
+        step = (
+            None if isinstance(built, Fallback) else integrator_to_core(integrator, core_module())
+        )
+        if step is not None and not isinstance(step, Fallback):
+            memories = [s.memory for s in self.contacts.sets]
+            q1, v1 = built[0].advance(
+                t0, q0, v0, [np.asarray(t, dtype=float) for t in taus], t1, step,
+                self._memories(), memories,
+            )  # fmt: skip
+            self._rigid_forces_of(built[1][0])
+            return SystemState(q1, v1)
+        return self.together_reference(integrator, t0, q0, v0, taus, t1)
+
+    def together_reference(self, integrator, t0, q0, v0, taus, t1) -> SystemState:
+        """The reference of `_together`'s period: `_integrate`, then in Python every anchor
+        moved (each system's `System.settle`, the sets between the sides) and each system's
+        constraints (`uvms_pin.sim.system.period.constrained`)."""
         q1, v1 = self._integrate(integrator, t0, q0, v0, taus, t1)
         ends = self.split(q1, v1)
         for system, (q_k, v_k) in zip(self.systems, ends, strict=True):
@@ -280,6 +309,13 @@ class Robots:
                 end = step(t0, start[0], start[1], tau, t1)
             out.append(end)
         return self.layout.join(out)
+
+    def _rigid_forces_of(self, core_system: Any) -> None:
+        """The first system's objects' rigid contacts with the fixed world over the period
+        the core solved, for its logs (as `period._settle_contacts` keeps the reference's)."""
+        first = self.systems[0].moving
+        if first is not None and first.moving.rigid:
+            first.moving.rigid_forces = contacts_of_core(core_system.rigid_contacts())[1]
 
     def contact_signals(self, q: np.ndarray, v: np.ndarray) -> list[dict[str, np.ndarray]]:
         """What each robot logs of its contacts with the other robots (and the objects) at
@@ -300,7 +336,16 @@ class Robots:
         [N] its pieces exert on them, summed, and its moment about the world's origin [N m]
         (sum of p x f + m over the pairs): the first robot's from its system's contacts
         (``world_contact``'s pairs with an object), the others' from their pairs with the
-        objects (``robot_contact``). Zero for a robot touching none."""
+        objects (``robot_contact``). Zero for a robot touching none. With the compiled
+        backend the core's (`RobotsSystem.object_wrenches`: the same sums)."""
+        core = self._core()
+        if core is not None:
+            memories = [s.memory for s in self.contacts.sets]
+            return list(core.object_wrenches(q, v, self._memories(), memories))
+        return self.object_wrenches_reference(q, v)
+
+    def object_wrenches_reference(self, q: np.ndarray, v: np.ndarray) -> list[np.ndarray]:
+        """`object_wrenches` by the reference's contacts (the logged pairs' wrenches)."""
         objects = {o.name for o in self.objects}
         first = self.systems[0]
         rows: list = [(None, [])]
