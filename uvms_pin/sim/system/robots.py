@@ -31,6 +31,7 @@ first robot's system is then apart when no other robot can reach another robot o
 from __future__ import annotations
 
 from collections.abc import Sequence
+from functools import partial
 from typing import Any
 
 import numpy as np
@@ -208,6 +209,7 @@ class Robots:
         q0, v0 = state
         if not self.near(q0, v0, t1 - t0):
             self.contacts.clear()  # no contact persists: the friction forgets its anchors
+            self._rigid_contacts_from(None)  # each system's own step keeps them
             return self.layout.join(
                 [
                     system.advance(integrator, t0, q_k, v_k, tau, t1)
@@ -287,7 +289,7 @@ class Robots:
                 t0, q0, v0, [np.asarray(t, dtype=float) for t in taus], t1, step,
                 self._memories(), memories,
             )  # fmt: skip
-            self._rigid_forces_of(built[1][0])
+            self._rigid_contacts_from(built[1][0])
             return SystemState(q1, v1)
         return self.together_reference(integrator, t0, q0, v0, taus, t1)
 
@@ -310,12 +312,17 @@ class Robots:
             out.append(end)
         return self.layout.join(out)
 
-    def _rigid_forces_of(self, core_system: Any) -> None:
-        """The first system's objects' rigid contacts with the fixed world over the period
-        the core solved, for its logs (as `period._settle_contacts` keeps the reference's)."""
+    def _rigid_contacts_from(self, core_system: Any) -> None:
+        """Where the first system's logs read its objects' rigid contacts with the fixed
+        world of the last period: the core's system that solved it (read when a sample is
+        logged), or None: the reference's (`period._settle_contacts` keeps them)."""
         first = self.systems[0].moving
-        if first is not None and first.moving.rigid:
-            first.moving.rigid_forces = contacts_of_core(core_system.rigid_contacts())[1]
+        if first is None or not first.moving.rigid:
+            return
+        if core_system is None:
+            first.moving.rigid_source = None
+        elif getattr(first.moving.rigid_source, "args", None) != (core_system,):
+            first.moving.rigid_source = partial(_rigid_contacts, core_system)
 
     def contact_signals(self, q: np.ndarray, v: np.ndarray) -> list[dict[str, np.ndarray]]:
         """What each robot logs of its contacts with the other robots (and the objects) at
@@ -376,6 +383,10 @@ class Robots:
         """``name/body|name/body`` (or ``name/body|object``) of every pair of robot
         ``robot`` (an index)."""
         return self.contacts.pair_names(robot)
+
+
+def _rigid_contacts(core_system: Any) -> tuple[list, list]:
+    return contacts_of_core(core_system.rigid_contacts())
 
 
 def _fallback_reason(built: Any) -> str | None:
