@@ -81,12 +81,17 @@ void PiecePairsModel::forces(const Data& data_a, const Data& data_b,
     for (const auto& piece : pieces_a) boxes_a_.push_back(local_box(piece));
     for (const auto& piece : pieces_b) boxes_b_.push_back(local_box(piece));
   }
+  // each piece placed once (a set of every piece against every piece has n_a n_b pairs)
+  where_a_.resize(pieces_a.size());
+  where_b_.resize(pieces_b.size());
+  for (std::size_t i = 0; i < pieces_a.size(); ++i) where_a_[i] = placement_of(data_a, pieces_a[i]);
+  for (std::size_t j = 0; j < pieces_b.size(); ++j) where_b_[j] = placement_of(data_b, pieces_b[j]);
   // the pairs that overlap (touching of pairs.py): bounding spheres, then coal's point
   for (std::size_t k = 0; k < pairs.size(); ++k) {
     const auto& pa = pieces_a[static_cast<std::size_t>(pairs[k][0])];
     const auto& pb = pieces_b[static_cast<std::size_t>(pairs[k][1])];
-    const pinocchio::SE3 where_a = placement_of(data_a, pa);
-    const pinocchio::SE3 where_b = placement_of(data_b, pb);
+    const pinocchio::SE3& where_a = where_a_[static_cast<std::size_t>(pairs[k][0])];
+    const pinocchio::SE3& where_b = where_b_[static_cast<std::size_t>(pairs[k][1])];
     const double gap = (where_a.translation() - where_b.translation()).norm();
     if (gap >= pa.bound_radius_m + pb.bound_radius_m) continue;
     if (sphere_misses(where_a.translation(), pa.bound_radius_m, boxes_b_[pairs[k][1]], where_b) ||
