@@ -1,5 +1,6 @@
 #include "moving_contact.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <string>
 #include <utility>
@@ -36,6 +37,21 @@ bool sphere_misses(const Vec3& center, double radius, const std::pair<Vec3, Vec3
   const Vec3 local = where.rotation().transpose() * (center - where.translation());
   const Vec3 outside = (box.first - local).cwiseMax(local - box.second).cwiseMax(0.0);
   return outside.norm() > radius;
+}
+
+// Whether the sphere (centre, radius) [m] misses a cylinder shape placed at where (its axis
+// z, radius R, half length H): its distance to the solid cylinder, hypot(max(rho - R, 0),
+// max(|z| - H, 0)) in the cylinder's frame, exceeds the radius (exact, as sphere_misses; a
+// cylinder's bounding sphere holds the whole of a bar, its box test would keep every piece
+// near it). False for any other shape.
+bool sphere_misses_cylinder(const Vec3& center, double radius, const ContactShape& shape,
+                            const pinocchio::SE3& where) {
+  if (shape.kind != ContactKind::cylinder) return false;
+  const auto& cylinder = static_cast<const coal::Cylinder&>(*shape.geometry);
+  const Vec3 local = where.rotation().transpose() * (center - where.translation());
+  const double radial = std::max(std::hypot(local.x(), local.y()) - cylinder.radius, 0.0);
+  const double axial = std::max(std::abs(local.z()) - cylinder.halfLength, 0.0);
+  return std::hypot(radial, axial) > radius;
 }
 
 }  // namespace
@@ -95,7 +111,9 @@ void PiecePairsModel::forces(const Data& data_a, const Data& data_b,
     const double gap = (where_a.translation() - where_b.translation()).norm();
     if (gap >= pa.bound_radius_m + pb.bound_radius_m) continue;
     if (sphere_misses(where_a.translation(), pa.bound_radius_m, boxes_b_[pairs[k][1]], where_b) ||
-        sphere_misses(where_b.translation(), pb.bound_radius_m, boxes_a_[pairs[k][0]], where_a)) {
+        sphere_misses(where_b.translation(), pb.bound_radius_m, boxes_a_[pairs[k][0]], where_a) ||
+        sphere_misses_cylinder(where_a.translation(), pa.bound_radius_m, pb, where_b) ||
+        sphere_misses_cylinder(where_b.translation(), pb.bound_radius_m, pa, where_a)) {
       continue;
     }
     Vec3 point, normal;
