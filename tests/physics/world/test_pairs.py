@@ -17,14 +17,16 @@ from uvms_pin.sim.plant import Plant
 from uvms_pin.sim.system import System
 
 
+def _body(load_body, collision: str):
+    """A 4 kg neutrally buoyant one-body robot of the ``collision`` shape."""
+    return load_body(
+        body_urdf(mass=4.0, inertia=(0.016,) * 3, hydro=hydro_xml(4.0 / RHO), collision=collision)
+    )
+
+
 def _touching(load_body):
     """A sphere robot 5 mm into a free sphere's side, both at rest."""
-    pusher = load_body(
-        body_urdf(
-            mass=4.0, inertia=(0.016,) * 3, hydro=hydro_xml(4.0 / RHO),
-            collision='<sphere radius="0.1"/>',
-        )
-    )  # fmt: skip
+    pusher = _body(load_body, '<sphere radius="0.1"/>')
     ball = free_object(
         "ball", "sphere", {"radius_m": 0.2}, ([0.0, 0.0, -5.0], [0, 0, 0]),
         density_kg_m3=RHO, water_density_kg_m3=RHO,
@@ -92,12 +94,7 @@ def test_the_core_finds_a_bars_contacts_as_the_reference_does(load_body):
     beside it, past its ends, into it. The core's search (`PairSearch`, its pieces' spheres
     tested against the solid cylinder before coal's GJK) finds the reference's touching
     pairs, points and forces (`PiecePairs.forces`) at every pose, to 1e-12."""
-    box = load_body(
-        body_urdf(
-            mass=4.0, inertia=(0.016,) * 3, hydro=hydro_xml(4.0 / RHO),
-            collision='<box size="0.1 0.1 0.1"/>',
-        )
-    )  # fmt: skip
+    box = _body(load_body, '<box size="0.1 0.1 0.1"/>')
     bar = free_object(
         "bar", "cylinder", {"radius_m": 0.025, "length_m": 1.0}, ([0.0, 0.0, -5.0], [0, 0, 0]),
         density_kg_m3=1200.0, water_density_kg_m3=RHO,
