@@ -207,7 +207,10 @@ class RobotsLoop:
 
 
 #: what a run records of the periods in which the robots may touch (`Robots.integration`)
-TOGETHER_COMPILED = "while they can touch, one compiled call a period integrates every robot"
+TOGETHER_COMPILED = (
+    "while they can touch, one compiled call a period crosses it for every robot (the "
+    "integration, the anchors' move, each robot's constraints)"
+)
 TOGETHER_PYTHON = "while they can touch, the Python integrator steps every robot ({})"
 
 
