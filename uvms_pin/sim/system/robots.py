@@ -16,9 +16,12 @@ A control period is stepped in one of two ways, chosen at its start:
   acceleration with the contacts' generalized force added to its input tau: the dynamics
   are linear in it), every anchor moved at the period's end, then each robot's constraints
   solved implicitly (its joint limits: they act within the robot only). With the compiled
-  backend the integration is one core call (`uvms_pin.sim.compiled.robots`: every robot's
-  compiled system, the contacts between them added to their bodies), and every pair set's
-  contacts outside it (the anchors' move, the logs) are found by the core
+  backend the whole period is one core call (`uvms_pin.sim.compiled.robots`,
+  `RobotsSystem.advance`: every robot's compiled system, the contacts between them added to
+  their bodies, each system's anchors and constraints as its own compiled step does them;
+  `together_reference` is the same period in Python around the compiled integration), the
+  bound test (`near`) and the sensors' wrenches on the objects (`object_wrenches`) are the
+  core's too, and the pair sets' contacts the logs read are found by the core
   (`uvms_pin.physics.compiled.moving.search_compiled`, the reference's arithmetic).
 
 The world's free objects belong to the first robot's system (its moving contacts with them,
