@@ -6,10 +6,12 @@ absolute figures to assert on.
 
 from __future__ import annotations
 
+import argparse
 import math
 import time
 import timeit
 from collections.abc import Callable, Hashable
+from pathlib import Path
 
 from threadpoolctl import threadpool_limits
 
@@ -46,3 +48,12 @@ def best_times(
             seconds = timer.timeit(numbers[name]) / numbers[name]
             best[name] = min(best[name], seconds)
     return best
+
+
+def bench_arguments(doc: str) -> argparse.Namespace:
+    """A benchmark's command line: ``--repeat N`` (rounds, 15) and ``--json FILE``; ``doc``
+    its module docstring (the first line is the help's description)."""
+    parser = argparse.ArgumentParser(description=doc.splitlines()[0])
+    parser.add_argument("--repeat", type=int, default=15)
+    parser.add_argument("--json", type=Path)
+    return parser.parse_args()

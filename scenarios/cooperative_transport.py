@@ -65,6 +65,7 @@ import pinocchio as pin
 
 from uvms_pin.control.base import Controller
 from uvms_pin.errors import ParameterError
+from uvms_pin.hydro.vector import cross3
 from uvms_pin.physics.dynamics import bias_forces
 from uvms_pin.results.signal import Signal
 
@@ -202,7 +203,7 @@ class CooperativeTransport(Controller):
         point_jacobian = jacobian[:3] - pin.skew(arm) @ jacobian[3:]
         return (
             placement.translation + arm,
-            twist.linear + np.cross(twist.angular, arm),
+            twist.linear + cross3(twist.angular, arm),  # np.cross costs ~10 us a call
             point_jacobian,
         )
 

@@ -1,5 +1,6 @@
 #include "moving_contact.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <string>
 #include <utility>
@@ -36,6 +37,21 @@ bool sphere_misses(const Vec3& center, double radius, const std::pair<Vec3, Vec3
   const Vec3 local = where.rotation().transpose() * (center - where.translation());
   const Vec3 outside = (box.first - local).cwiseMax(local - box.second).cwiseMax(0.0);
   return outside.norm() > radius;
+}
+
+// Whether the sphere (centre, radius) [m] misses a cylinder shape placed at where (its axis
+// z, radius R, half length H): its distance to the solid cylinder, hypot(max(rho - R, 0),
+// max(|z| - H, 0)) in the cylinder's frame, exceeds the radius (exact, as sphere_misses; a
+// cylinder's bounding sphere holds the whole of a bar, its box test would keep every piece
+// near it). False for any other shape.
+bool sphere_misses_cylinder(const Vec3& center, double radius, const ContactShape& shape,
+                            const pinocchio::SE3& where) {
+  if (shape.kind != ContactKind::cylinder) return false;
+  const auto& cylinder = static_cast<const coal::Cylinder&>(*shape.geometry);
+  const Vec3 local = where.rotation().transpose() * (center - where.translation());
+  const double radial = std::max(std::hypot(local.x(), local.y()) - cylinder.radius, 0.0);
+  const double axial = std::max(std::abs(local.z()) - cylinder.halfLength, 0.0);
+  return std::hypot(radial, axial) > radius;
 }
 
 }  // namespace
@@ -81,21 +97,31 @@ void PiecePairsModel::forces(const Data& data_a, const Data& data_b,
     for (const auto& piece : pieces_a) boxes_a_.push_back(local_box(piece));
     for (const auto& piece : pieces_b) boxes_b_.push_back(local_box(piece));
   }
+  // each piece placed once (a set of every piece against every piece has n_a n_b pairs)
+  where_a_.resize(pieces_a.size());
+  where_b_.resize(pieces_b.size());
+  for (std::size_t i = 0; i < pieces_a.size(); ++i) where_a_[i] = placement_of(data_a, pieces_a[i]);
+  for (std::size_t j = 0; j < pieces_b.size(); ++j) where_b_[j] = placement_of(data_b, pieces_b[j]);
   // the pairs that overlap (touching of pairs.py): bounding spheres, then coal's point
   for (std::size_t k = 0; k < pairs.size(); ++k) {
     const auto& pa = pieces_a[static_cast<std::size_t>(pairs[k][0])];
     const auto& pb = pieces_b[static_cast<std::size_t>(pairs[k][1])];
-    const pinocchio::SE3 where_a = placement_of(data_a, pa);
-    const pinocchio::SE3 where_b = placement_of(data_b, pb);
+    const pinocchio::SE3& where_a = where_a_[static_cast<std::size_t>(pairs[k][0])];
+    const pinocchio::SE3& where_b = where_b_[static_cast<std::size_t>(pairs[k][1])];
     const double gap = (where_a.translation() - where_b.translation()).norm();
     if (gap >= pa.bound_radius_m + pb.bound_radius_m) continue;
     if (sphere_misses(where_a.translation(), pa.bound_radius_m, boxes_b_[pairs[k][1]], where_b) ||
-        sphere_misses(where_b.translation(), pb.bound_radius_m, boxes_a_[pairs[k][0]], where_a)) {
+        sphere_misses(where_b.translation(), pb.bound_radius_m, boxes_a_[pairs[k][0]], where_a) ||
+        sphere_misses_cylinder(where_a.translation(), pa.bound_radius_m, pb, where_b) ||
+        sphere_misses_cylinder(where_b.translation(), pb.bound_radius_m, pa, where_a)) {
       continue;
     }
     Vec3 point, normal;
     double depth = 0.0;
-    if (!deepest_point(pa, where_a, pb, where_b, point, normal, depth)) continue;
+    colliders_.resize(pairs.size());
+    if (!deepest_point(pa, where_a, pb, where_b, point, normal, depth, colliders_[k].of(pa, pb))) {
+      continue;
+    }
     out.pair.push_back(static_cast<int>(k));
     touch.piece.push_back(pairs[k][0]);
     touch.obj.push_back(pairs[k][1]);

@@ -158,6 +158,10 @@ class System {
         std::max(out.worst_residual_m_s, coupled_step_.stalled.worst_residual_m_s);
     return out;
   }
+  // The constraints of the period (see the file's comment) on (q1, v1), the smooth step's end
+  // from (q0, v0), after settle() there (advance's last part; a RobotsSystem's too).
+  void constrain(double t0, const ConstVec& q0, const ConstVec& v0, double t1,
+                 Eigen::VectorXd& q1, Eigen::VectorXd& v1);
   // (q, v) at t1 from (q0, v0) at t0 with tau held (see the file's comment).
   std::pair<Eigen::VectorXd, Eigen::VectorXd> advance(double t0, const ConstVec& q0,
                                                       const ConstVec& v0, const ConstVec& tau,
@@ -165,9 +169,6 @@ class System {
 
  private:
   void object_kinematics(const ConstVec& q, const ConstVec& v);
-  // The constraints of the period (see the file's comment) on (q1, v1), the smooth step's end.
-  void constrain(double t0, const ConstVec& q0, const ConstVec& v0, double t1,
-                 Eigen::VectorXd& q1, Eigen::VectorXd& v1);
   // Each fixture's joints by their exact step (joint_box.hpp), after the smooth step.
   void constrain_fixtures(double t0, const ConstVec& q0, double h, Eigen::VectorXd& q1,
                           Eigen::VectorXd& v1);

@@ -117,17 +117,28 @@ void add_pair_set(Owner& owner, const uvms::PiecePairsModel& pairs, int a, int b
   owner.check();
 }
 
+std::vector<nb::handle> items(const nb::handle& list) {
+  std::vector<nb::handle> out;
+  for (nb::handle h : list) out.push_back(h);
+  return out;
+}
+
 // Each robot's system's memories (a list per system, System's order), then each between
 // set's: read before a RobotsSystem call (its integration reads the anchors only).
 void read_robots(uvms::RobotsSystem& robots, const nb::handle& systems, const nb::handle& own) {
-  std::vector<nb::handle> per_system, per_set;
-  for (nb::handle h : systems) per_system.push_back(h);
-  for (nb::handle h : own) per_set.push_back(h);
+  const auto per_system = items(systems), per_set = items(own);
   if (per_system.size() != robots.n_robots() || per_set.size() != robots.sets.size()) {
     throw InputError("robots: one list of memories per robot's system and one memory per set");
   }
   for (std::size_t k = 0; k < per_system.size(); ++k) read_all(robots.system(k), per_system[k]);
   for (std::size_t s = 0; s < per_set.size(); ++s) read_memory(per_set[s], robots.sets[s].memory);
+}
+
+// ... and written back after a call that moved them (RobotsSystem::advance).
+void write_robots(uvms::RobotsSystem& robots, const nb::handle& systems, const nb::handle& own) {
+  const auto per_system = items(systems), per_set = items(own);
+  for (std::size_t k = 0; k < per_system.size(); ++k) write_all(robots.system(k), per_system[k]);
+  for (std::size_t s = 0; s < per_set.size(); ++s) write_memory(robots.sets[s].memory, per_set[s]);
 }
 
 void check_robots_state(uvms::RobotsSystem& robots, const Eigen::VectorXd& q,
@@ -137,6 +148,21 @@ void check_robots_state(uvms::RobotsSystem& robots, const Eigen::VectorXd& q,
                      std::to_string(robots.nv()) + ",) expected");
   }
   if (!q.allFinite() || !v.allFinite()) throw InputError("robots: a non-finite state");
+}
+
+// A period of the robots: integrate() alone (the anchors read only), or the whole advance()
+// (the anchors moved at its end: the memories written back).
+auto robots_period(bool whole) {
+  return [whole](uvms::RobotsSystem& r, double t0, const Eigen::VectorXd& q0,
+                 const Eigen::VectorXd& v0, const std::vector<Eigen::VectorXd>& taus, double t1,
+                 const uvms::FixedStep& integrator, nb::handle systems, nb::handle memories) {
+    check_robots_state(r, q0, v0);
+    read_robots(r, systems, memories);
+    if (!whole) return r.integrate(t0, q0, v0, taus, t1, integrator);
+    auto out = r.advance(t0, q0, v0, taus, t1, integrator);
+    write_robots(r, systems, memories);
+    return out;
+  };
 }
 
 }  // namespace
@@ -173,18 +199,42 @@ void bind_robots(nb::module_& m) {
           "time_s"_a, "q"_a, "v"_a, "taus"_a, "system_memories"_a, "memories"_a,
           "The joined acceleration at the anchors of the memories (read only).")
       .def(
-          "integrate",
-          [](RobotsSystem& r, double t0, const Eigen::VectorXd& q0, const Eigen::VectorXd& v0,
-             const std::vector<Eigen::VectorXd>& taus, double t1,
-             const uvms::FixedStep& integrator, nb::handle systems, nb::handle memories) {
-            check_robots_state(r, q0, v0);
-            read_robots(r, systems, memories);
-            return r.integrate(t0, q0, v0, taus, t1, integrator);
-          },
+          "integrate", robots_period(false),
           "t0"_a, "q0"_a, "v0"_a, "taus"_a, "t1"_a, "integrator"_a, "system_memories"_a,
           "memories"_a,
           "(q, v) at t1 by the integrator's steps (the anchors read only: the caller moves "
-          "them and solves each system's constraints).");
+          "them and solves each system's constraints).")
+      .def_rw("reach_m", &RobotsSystem::reach_m,
+              "Each side's reach from its root joint [m] (inf: no bound): the robots, then the "
+              "first system's objects (the bound test's, near).")
+      .def_rw("clearance_m", &RobotsSystem::clearance_m,
+              "The clearance added to every sphere of the bound test [m].")
+      .def(
+          "advance", robots_period(true),
+          "t0"_a, "q0"_a, "v0"_a, "taus"_a, "t1"_a, "integrator"_a, "system_memories"_a,
+          "memories"_a,
+          "(q, v) at t1: the integrator's steps, every anchor moved at the smooth step's end "
+          "(the memories written back), then each system's constraints (Robots._together).")
+      .def(
+          "near",
+          [](RobotsSystem& r, const Eigen::VectorXd& q, const Eigen::VectorXd& v,
+             double horizon_s) {
+            check_robots_state(r, q, v);
+            return r.near(q, v, horizon_s);
+          },
+          "q"_a, "v"_a, "horizon_s"_a,
+          "Whether some pair of sides may touch within horizon_s (Robots.near).")
+      .def(
+          "object_wrenches",
+          [](RobotsSystem& r, const Eigen::VectorXd& q, const Eigen::VectorXd& v,
+             nb::handle systems, nb::handle memories) -> Eigen::MatrixXd {
+            check_robots_state(r, q, v);
+            read_robots(r, systems, memories);
+            return r.object_wrenches(q, v);
+          },
+          "q"_a, "v"_a, "system_memories"_a, "memories"_a,
+          "Each robot's wrench on the free objects (n_robots, 6): the force [N] and its "
+          "moment about the world's origin [N m], world axes (Robots.object_wrenches).");
 }
 
 void bind_system(nb::module_& m) {

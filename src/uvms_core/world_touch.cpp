@@ -43,15 +43,28 @@ coal::Transform3s transform_of(const pinocchio::SE3& where) {
 
 }  // namespace
 
+const coal::ComputeCollision* Collider::of(const ContactShape& piece, const ContactShape& object) {
+  if (!functor_ || piece_ != piece.geometry.get() || object_ != object.geometry.get()) {
+    piece_ = piece.geometry.get();
+    object_ = object.geometry.get();
+    functor_ = std::make_shared<coal::ComputeCollision>(piece_, object_);
+  }
+  return functor_.get();
+}
+
 bool deepest_point(const ContactShape& piece, const pinocchio::SE3& where,
                    const ContactShape& object, const pinocchio::SE3& object_where,
-                   Vec3& point, Vec3& normal, double& depth) {
+                   Vec3& point, Vec3& normal, double& depth,
+                   const coal::ComputeCollision* collider) {
   static const coal::CollisionRequest request;  // one contact, depth and normal
   coal::CollisionResult result;
-  if (coal::collide(piece.geometry.get(), transform_of(where), object.geometry.get(),
-                    transform_of(object_where), request, result) == 0) {
-    return false;
-  }
+  const coal::Transform3s piece_tf = transform_of(where), object_tf = transform_of(object_where);
+  const std::size_t touching =
+      collider != nullptr
+          ? (*collider)(piece_tf, object_tf, request, result)
+          : coal::collide(piece.geometry.get(), piece_tf, object.geometry.get(), object_tf,
+                          request, result);
+  if (touching == 0) return false;
   const coal::Contact& contact = result.getContact(0);
   depth = -contact.penetration_depth;
   if (!(depth > 0.0)) return false;

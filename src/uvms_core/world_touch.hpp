@@ -5,6 +5,7 @@
 // and normal (one point per pair).
 #pragma once
 
+#include <memory>
 #include <utility>
 #include <vector>
 
@@ -12,6 +13,11 @@
 
 #include "contact_shapes.hpp"
 #include "hydro_bodies.hpp"
+
+namespace coal {
+class ComputeCollision;
+class CollisionGeometry;
+}  // namespace coal
 
 namespace uvms {
 
@@ -64,10 +70,32 @@ void near_pairs(const Placements& piece_where,
 
 // coal's deepest point of two overlapping shapes placed in the world (coal_point of
 // touch.py): the point midway between the nearest points, the normal out of the object
-// towards the piece, the depth > 0; false when they are apart.
+// towards the piece, the depth > 0; false when they are apart. With `collider` (the pair's
+// Collider) coal's functor kept for the pair is called: the same algorithm and answer as
+// coal::collide, without building its GJK/EPA solver (and allocating its buffers) again.
 bool deepest_point(const ContactShape& piece, const pinocchio::SE3& where,
                    const ContactShape& object, const pinocchio::SE3& object_where,
-                   Vec3& point, Vec3& normal, double& depth);
+                   Vec3& point, Vec3& normal, double& depth,
+                   const coal::ComputeCollision* collider = nullptr);
+
+// coal's collision functor of one pair of shapes, kept between calls (deepest_point). A copy
+// starts empty: a functor's solver is its call's scratch, never shared between owners.
+class Collider {
+ public:
+  Collider() = default;
+  Collider(const Collider&) {}
+  Collider& operator=(const Collider&) {
+    functor_.reset();
+    return *this;
+  }
+  // the functor of (piece, object), built on first use or when a shape's geometry changed
+  const coal::ComputeCollision* of(const ContactShape& piece, const ContactShape& object);
+
+ private:
+  std::shared_ptr<coal::ComputeCollision> functor_;
+  const coal::CollisionGeometry* piece_ = nullptr;
+  const coal::CollisionGeometry* object_ = nullptr;
+};
 
 // touch()'s work buffers, kept by its caller between calls (no allocation per call once
 // sized): every shape's placement and the near (piece, object) pairs.

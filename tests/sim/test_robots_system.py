@@ -305,3 +305,98 @@ def test_the_core_robots_refuse_bad_inputs_by_name(load_body):
         core.integrate(0.0, q[:-1], v, good, 2e-3, step, robots._memories(), memories)
     with pytest.raises(ParameterError, match="one list of memories per robot"):
         core.acceleration(0.0, q, v, good, robots._memories()[:1], memories)
+
+
+def _memories_equal(a, b, atol: float) -> bool:
+    """Two friction memories hold the same anchors, material points and slipping patches."""
+    if a.anchors.keys() != b.anchors.keys() or a.material.keys() != b.material.keys():
+        return False
+    same = [np.allclose(a.anchors[k], b.anchors[k], rtol=0, atol=atol) for k in a.anchors]
+    same += [np.allclose(a.material[k], b.material[k], rtol=0, atol=atol) for k in a.material]
+    return all(same) and a.slipping == b.slipping
+
+
+def test_the_core_crosses_the_robots_period_as_the_reference(load_body):
+    """While they touch, one core call crosses the whole period (`RobotsSystem.advance`):
+    the integration, every anchor moved at its end, each system's constraints. Over ten
+    periods of contact (b against a and the ball) it stays with the reference
+    (`Robots.together_reference`: the same integration, the anchors moved in Python), and
+    the anchors it moves are the reference's."""
+    core_run, state = _touching_with_a_ball(load_body)
+    reference, _ = _touching_with_a_ball(load_body)
+    integrator = RK4(step_s=5e-4)
+    taus = [np.linspace(-1.0, 1.0, 6), np.linspace(2.0, -0.5, 6)]
+    ends, ref = state, state
+    for k in range(10):
+        t0, t1 = 2e-3 * k, 2e-3 * (k + 1)
+        ends = core_run._together(integrator, t0, *ends, taus, t1)
+        ref = reference.together_reference(integrator, t0, *ref, taus, t1)
+        np.testing.assert_allclose(ends.q, ref.q, rtol=0.0, atol=1e-12)
+        np.testing.assert_allclose(ends.v, ref.v, rtol=0.0, atol=1e-9)
+    assert np.max(np.abs(ends.v - state.v)) > 1e-2  # the contacts pushed
+    memories, expected = (
+        [m for m in (*r._memories()[0], *r._memories()[1], *(s.memory for s in r.contacts.sets))
+         if m is not None]
+        for r in (core_run, reference)
+    )  # fmt: skip
+    assert sum(len(m.anchors) for m in memories) > 0
+    assert all(_memories_equal(a, b, 1e-12) for a, b in zip(memories, expected, strict=True))
+
+
+def test_the_core_bound_test_and_held_wrenches_are_the_references(load_body):
+    """The core's bound test (`RobotsSystem.near`) answers as the reference's
+    (`RobotContacts.near`) from touching to apart, at every horizon; each robot's wrench on
+    the ball (`RobotsSystem.object_wrenches`) is the reference's, to rounding."""
+    robots, state = _touching_with_a_ball(load_body)
+    ball = robots.layout.q_slices[0].start + 7  # after robot a in the first system
+    state.q[ball : ball + 3] = [-0.145, 0.0, -4.89]  # on a (5 mm deep) and b (18 mm)
+    answers = []
+    for shift in np.linspace(0.0, 1.5, 16):
+        q = state.q.copy()
+        q[robots.layout.q_slices[1].start] += shift  # b moves away along x
+        for horizon_s in (0.0, 0.01, 0.5):
+            reference = robots.contacts.near(
+                robots.sides(q, state.v), lambda q=q: robots._kinematics(q, state.v), horizon_s
+            )
+            assert robots.near(q, state.v, horizon_s) == reference
+            answers.append(reference)
+        wrenches = robots.object_wrenches(q, state.v)
+        expected = robots.object_wrenches_reference(q, state.v)
+        np.testing.assert_allclose(wrenches, expected, rtol=0.0, atol=1e-12)
+    assert any(answers) and not all(answers)
+    on_ball = robots.object_wrenches(*state)
+    assert np.linalg.norm(on_ball[0][:3]) > 0.1 and np.linalg.norm(on_ball[1][:3]) > 0.1
+
+
+def test_the_core_solves_each_robots_joint_limits_as_the_reference():
+    """Two BlueROV2 Heavy + Alpha 5 within reach of each other (one core call a period),
+    each arm's second joint driven into its lower limit: the core solves each robot's
+    limits at the period's end (`System::constrain`) as the reference does
+    (`period.constrained`, Pinocchio's ADMM to 1e-8), neither crossing it."""
+    scenario = load_scenario(
+        ROOT / "scenarios" / "two_robots.toml",
+        {"robots[1].initial.position_world_m": [0.0, -0.8, -2.0]},
+    )
+    plants = [r.plant for r in scenario.robots]
+    runs = [Robots([System(p) for p in plants], scenario.names) for _ in range(2)]
+    starts = []
+    for r in scenario.robots:
+        q, v = r.q0.copy(), np.zeros(r.uvms.nv)
+        q[8], v[7] = 0.002, -0.5  # 2 mm from its lower limit (0), closing at 0.5 rad/s
+        starts.append((q, v))
+    taus = [np.r_[0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, -1.0, 0.0, 0.0] for _ in starts]
+    ends = []
+    for robots, cross in zip(runs, ("_together", "together_reference"), strict=True):
+        state = robots.layout.join(starts)
+        for system, part in zip(robots.systems, robots.split(*state), strict=True):
+            system.start(SystemState(*part))
+        robots.start(state)
+        assert robots.near(*state, 0.01)
+        ends.append(getattr(robots, cross)(scenario.settings.integrator, 0.0, *state, taus, 0.01))
+    (q, v), (q_ref, v_ref) = ends
+    # the core's active set solves the limits exactly (q at 0), the ADMM to its tolerance
+    np.testing.assert_allclose(q, q_ref, rtol=0.0, atol=1e-8)
+    np.testing.assert_allclose(v, v_ref, rtol=0.0, atol=1e-6)
+    for at, part in zip(runs[0].layout.q_slices, runs[0].layout.v_slices, strict=True):
+        assert q[at][8] == pytest.approx(0.0, abs=1e-9)  # it ends at the limit, not past
+        assert v[part][7] == pytest.approx(-0.002 / 0.01, abs=1e-6)  # what closes the gap

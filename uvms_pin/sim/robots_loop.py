@@ -21,6 +21,7 @@ import numpy as np
 
 from uvms_pin.control.base import Controller
 from uvms_pin.errors import ActuationWarning, ParameterError, SimulationError
+from uvms_pin.hydro.vector import cross3
 from uvms_pin.results.robots import RobotRollouts
 from uvms_pin.results.status import INTERRUPTED, OK, RunStatus
 from uvms_pin.sim.closed_loop import ClosedLoop, _diverged, _finished, _stopped
@@ -102,14 +103,13 @@ class RobotsLoop:
         wanted = [loop.sensors.config.held_object_wrench for loop in self.loops]
         if not any(wanted):
             return [None] * len(self.loops)
-        wrenches = self.system.object_wrenches(*self.state)
-        out = []
-        for loop, want, wrench in zip(self.loops, wanted, wrenches, strict=True):
-            if want:
-                at_sensor, _, _ = loop.plant.ee_state(loop.q, loop.v)
-                wrench = np.concatenate([wrench[:3], wrench[3:] - np.cross(at_sensor, wrench[:3])])
-            out.append(wrench if want else None)
-        return out
+        wrenches = np.array(self.system.object_wrenches(*self.state)).reshape(-1, 6)
+        at_sensor = np.array(
+            [loop.plant.ee_state(loop.q, loop.v)[0] if want else np.zeros(3)
+             for loop, want in zip(self.loops, wanted, strict=True)]
+        )  # fmt: skip
+        wrenches[:, 3:] -= cross3(at_sensor, wrenches[:, :3])  # M_p = M_0 - p x F
+        return [wrench if want else None for wrench, want in zip(wrenches, wanted, strict=True)]
 
     def step(self, taus: list[np.ndarray]) -> None:
         """Every robot one control period on, its input of ``taus`` held.
@@ -207,7 +207,10 @@ class RobotsLoop:
 
 
 #: what a run records of the periods in which the robots may touch (`Robots.integration`)
-TOGETHER_COMPILED = "while they can touch, one compiled call a period integrates every robot"
+TOGETHER_COMPILED = (
+    "while they can touch, one compiled call a period crosses it for every robot (the "
+    "integration, the anchors' move, each robot's constraints)"
+)
 TOGETHER_PYTHON = "while they can touch, the Python integrator steps every robot ({})"
 
 

@@ -8,6 +8,8 @@ import numpy as np
 import pinocchio as pin
 from conftest import RHO, body_urdf, hydro_xml
 
+from uvms_pin.physics.compiled.extension import core_module
+from uvms_pin.physics.compiled.moving import PairSearch
 from uvms_pin.physics.world.contact_law import ContactLaw
 from uvms_pin.physics.world.free_object import free_object
 from uvms_pin.physics.world.world import World
@@ -15,14 +17,16 @@ from uvms_pin.sim.plant import Plant
 from uvms_pin.sim.system import System
 
 
+def _body(load_body, collision: str):
+    """A 4 kg neutrally buoyant one-body robot of the ``collision`` shape."""
+    return load_body(
+        body_urdf(mass=4.0, inertia=(0.016,) * 3, hydro=hydro_xml(4.0 / RHO), collision=collision)
+    )
+
+
 def _touching(load_body):
     """A sphere robot 5 mm into a free sphere's side, both at rest."""
-    pusher = load_body(
-        body_urdf(
-            mass=4.0, inertia=(0.016,) * 3, hydro=hydro_xml(4.0 / RHO),
-            collision='<sphere radius="0.1"/>',
-        )
-    )  # fmt: skip
+    pusher = _body(load_body, '<sphere radius="0.1"/>')
     ball = free_object(
         "ball", "sphere", {"radius_m": 0.2}, ([0.0, 0.0, -5.0], [0, 0, 0]),
         density_kg_m3=RHO, water_density_kg_m3=RHO,
@@ -83,3 +87,43 @@ def test_a_force_on_a_body_fixed_to_the_world_moves_no_joint():
     assert joint_forces(
         nothing, nothing.createData(), np.zeros(0), [0], [[0, 0, 0]], force
     ).shape == (0,)
+
+
+def test_the_core_finds_a_bars_contacts_as_the_reference_does(load_body):
+    """A box robot (10 cm) posed all about a free bar (a cylinder 1 m long, 5 cm across):
+    beside it, past its ends, into it. The core's search (`PairSearch`, its pieces' spheres
+    tested against the solid cylinder before coal's GJK) finds the reference's touching
+    pairs, points and forces (`PiecePairs.forces`) at every pose, to 1e-12."""
+    box = _body(load_body, '<box size="0.1 0.1 0.1"/>')
+    bar = free_object(
+        "bar", "cylinder", {"radius_m": 0.025, "length_m": 1.0}, ([0.0, 0.0, -5.0], [0, 0, 0]),
+        density_kg_m3=1200.0, water_density_kg_m3=RHO,
+    )  # fmt: skip
+    system = System(Plant(box, world=World(box, [], ContactLaw(), [bar])))
+    (pairs,) = system.moving.moving.sets
+    search = PairSearch(pairs.pairs, core_module())
+    rng = np.random.default_rng(38)
+    states = system.moving.initial_states()
+    touching = 0
+    for _ in range(300):
+        q = box.neutral_configuration()
+        # the box's centre 0 to 15 cm from the bar's axis, up to 10 cm past its ends
+        angle, radial, along = (
+            rng.uniform(0, 2 * np.pi),
+            rng.uniform(0.0, 0.15),
+            rng.uniform(-0.6, 0.6),
+        )
+        q[:3] = [radial * np.cos(angle), radial * np.sin(angle), -5.0 + along]
+        q[3:7] = pin.Quaternion(pin.exp3(rng.normal(size=3))).coeffs()
+        v = rng.normal(scale=0.1, size=6)
+        system.moving._kinematics(q, v, states)
+        data = system.moving.moving._datas(system.moving.uvms_data, system.moving.datas)
+        python = pairs.pairs.forces(data(pairs.a), data(pairs.b), pairs.memory)
+        core = search(data(pairs.a), data(pairs.b), pairs.memory)
+        assert np.array_equal(core.pair, python.pair)
+        np.testing.assert_allclose(core.force_world_N, python.force_world_N, rtol=0, atol=1e-12)
+        np.testing.assert_allclose(
+            core.touch.point_world_m, python.touch.point_world_m, rtol=0, atol=1e-12
+        )
+        touching += len(python.pair)
+    assert 30 < touching < 270  # both kinds of pose

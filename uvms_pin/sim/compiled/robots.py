@@ -1,9 +1,10 @@
 """The compiled integration of several robots together (src/uvms_core/robots.hpp) of a
 `uvms_pin.sim.system.robots.Robots`: each robot's compiled system (`system_to_core`, a robot
 alone included) and the pair sets between the robots and with the first system's objects,
-built from their public attributes. One call integrates a control period while they touch;
-the anchors' move and each system's constraints stay the reference's
-(`Robots._together`)."""
+built from their public attributes, with each side's reach for the bound test. One call
+crosses a control period while they touch (`Robots._together`: the integration, the anchors'
+move, each system's constraints); the bound test (`Robots.near`) and the force/torque
+sensors' wrenches on the objects (`Robots.object_wrenches`) are a call each."""
 
 from __future__ import annotations
 
@@ -12,6 +13,7 @@ from typing import Any, Protocol
 
 from uvms_pin.physics.compiled.backend import Fallback
 from uvms_pin.physics.compiled.moving import piece_pairs_to_core
+from uvms_pin.physics.world.touch import CLEARANCE_M
 from uvms_pin.sim.compiled.system import system_to_core
 
 __all__ = ["RobotsParts", "robots_to_core"]
@@ -37,4 +39,6 @@ def robots_to_core(robots: RobotsParts, core: ModuleType) -> tuple[Any, list] | 
     out = core.RobotsSystem(systems)
     for s in robots.contacts.sets:
         out.add_pairs(piece_pairs_to_core(s.pairs, core), s.a, s.b)
+    out.reach_m = [side.reach_m for side in robots.contacts.sides]
+    out.clearance_m = CLEARANCE_M
     return out, systems

@@ -16,9 +16,12 @@ A control period is stepped in one of two ways, chosen at its start:
   acceleration with the contacts' generalized force added to its input tau: the dynamics
   are linear in it), every anchor moved at the period's end, then each robot's constraints
   solved implicitly (its joint limits: they act within the robot only). With the compiled
-  backend the integration is one core call (`uvms_pin.sim.compiled.robots`: every robot's
-  compiled system, the contacts between them added to their bodies), and every pair set's
-  contacts outside it (the anchors' move, the logs) are found by the core
+  backend the whole period is one core call (`uvms_pin.sim.compiled.robots`,
+  `RobotsSystem.advance`: every robot's compiled system, the contacts between them added to
+  their bodies, each system's anchors and constraints as its own compiled step does them;
+  `together_reference` is the same period in Python around the compiled integration), the
+  bound test (`near`) and the sensors' wrenches on the objects (`object_wrenches`) are the
+  core's too, and the pair sets' contacts the logs read are found by the core
   (`uvms_pin.physics.compiled.moving.search_compiled`, the reference's arithmetic).
 
 The world's free objects belong to the first robot's system (its moving contacts with them,
@@ -31,6 +34,7 @@ first robot's system is then apart when no other robot can reach another robot o
 from __future__ import annotations
 
 from collections.abc import Sequence
+from functools import partial
 from typing import Any
 
 import numpy as np
@@ -39,7 +43,7 @@ import pinocchio as pin
 from uvms_pin.errors import ParameterError
 from uvms_pin.physics.compiled.backend import Fallback
 from uvms_pin.physics.compiled.extension import core_module
-from uvms_pin.physics.compiled.moving import search_compiled
+from uvms_pin.physics.compiled.moving import contacts_of_core, search_compiled
 from uvms_pin.physics.world.between_robots import RobotContacts
 from uvms_pin.physics.world.contact_law import ContactLaw
 from uvms_pin.physics.world.world import World
@@ -193,7 +197,11 @@ class Robots:
 
     def near(self, q: np.ndarray, v: np.ndarray, horizon_s: float) -> bool:
         """Some two robots, or a robot but the first and an object, may touch within
-        ``horizon_s`` from (q, v)."""
+        ``horizon_s`` from (q, v): the core's bound test (`RobotsSystem.near`, the same
+        arithmetic) with the compiled backend, else the reference's."""
+        core = self._core()
+        if core is not None:
+            return core.near(q, v, horizon_s)
         return self.contacts.near(self.sides(q, v), lambda: self._kinematics(q, v), horizon_s)
 
     def advance(
@@ -204,6 +212,7 @@ class Robots:
         q0, v0 = state
         if not self.near(q0, v0, t1 - t0):
             self.contacts.clear()  # no contact persists: the friction forgets its anchors
+            self._rigid_contacts_from(None)  # each system's own step keeps them
             return self.layout.join(
                 [
                     system.advance(integrator, t0, q_k, v_k, tau, t1)
@@ -229,6 +238,12 @@ class Robots:
                 built = robots_to_core(self, core_module())
             held = self._compiled = (plants, built)
         return held[1]
+
+    def _core(self) -> Any:
+        """The core's `RobotsSystem`, or None (the Python backend, a plant the core cannot
+        compile: `compiled`)."""
+        built = self.compiled
+        return None if isinstance(built, Fallback) else built[0]
 
     def _memories(self) -> list[list]:
         """Each robot's system's friction memories, as its core system reads them."""
@@ -265,7 +280,26 @@ class Robots:
         """The period integrated for every body at once (the contacts between robots and
         with the objects in the right-hand side), every anchor moved at its end, then each
         robot's system's constraints (its joint limits; the first's objects' rigid
-        contacts with the fixed world)."""
+        contacts with the fixed world): one core call (`RobotsSystem.advance`, the same
+        steps) when the integration is compiled, else the reference below."""
+        built = self.compiled
+        step = (
+            None if isinstance(built, Fallback) else integrator_to_core(integrator, core_module())
+        )
+        if step is not None and not isinstance(step, Fallback):
+            memories = [s.memory for s in self.contacts.sets]
+            q1, v1 = built[0].advance(
+                t0, q0, v0, [np.asarray(t, dtype=float) for t in taus], t1, step,
+                self._memories(), memories,
+            )  # fmt: skip
+            self._rigid_contacts_from(built[1][0])
+            return SystemState(q1, v1)
+        return self.together_reference(integrator, t0, q0, v0, taus, t1)
+
+    def together_reference(self, integrator, t0, q0, v0, taus, t1) -> SystemState:
+        """The reference of `_together`'s period: `_integrate`, then in Python every anchor
+        moved (each system's `System.settle`, the sets between the sides) and each system's
+        constraints (`uvms_pin.sim.system.period.constrained`)."""
         q1, v1 = self._integrate(integrator, t0, q0, v0, taus, t1)
         ends = self.split(q1, v1)
         for system, (q_k, v_k) in zip(self.systems, ends, strict=True):
@@ -280,6 +314,18 @@ class Robots:
                 end = step(t0, start[0], start[1], tau, t1)
             out.append(end)
         return self.layout.join(out)
+
+    def _rigid_contacts_from(self, core_system: Any) -> None:
+        """Where the first system's logs read its objects' rigid contacts with the fixed
+        world of the last period: the core's system that solved it (read when a sample is
+        logged), or None: the reference's (`period._settle_contacts` keeps them)."""
+        first = self.systems[0].moving
+        if first is None or not first.moving.rigid:
+            return
+        if core_system is None:
+            first.moving.rigid_source = None
+        elif getattr(first.moving.rigid_source, "args", None) != (core_system,):
+            first.moving.rigid_source = partial(_rigid_contacts, core_system)
 
     def contact_signals(self, q: np.ndarray, v: np.ndarray) -> list[dict[str, np.ndarray]]:
         """What each robot logs of its contacts with the other robots (and the objects) at
@@ -300,7 +346,16 @@ class Robots:
         [N] its pieces exert on them, summed, and its moment about the world's origin [N m]
         (sum of p x f + m over the pairs): the first robot's from its system's contacts
         (``world_contact``'s pairs with an object), the others' from their pairs with the
-        objects (``robot_contact``). Zero for a robot touching none."""
+        objects (``robot_contact``). Zero for a robot touching none. With the compiled
+        backend the core's (`RobotsSystem.object_wrenches`: the same sums)."""
+        core = self._core()
+        if core is not None:
+            memories = [s.memory for s in self.contacts.sets]
+            return list(core.object_wrenches(q, v, self._memories(), memories))
+        return self.object_wrenches_reference(q, v)
+
+    def object_wrenches_reference(self, q: np.ndarray, v: np.ndarray) -> list[np.ndarray]:
+        """`object_wrenches` by the reference's contacts (the logged pairs' wrenches)."""
         objects = {o.name for o in self.objects}
         first = self.systems[0]
         rows: list = [(None, [])]
@@ -331,6 +386,10 @@ class Robots:
         """``name/body|name/body`` (or ``name/body|object``) of every pair of robot
         ``robot`` (an index)."""
         return self.contacts.pair_names(robot)
+
+
+def _rigid_contacts(core_system: Any) -> tuple[list, list]:
+    return contacts_of_core(core_system.rigid_contacts())
 
 
 def _fallback_reason(built: Any) -> str | None:
