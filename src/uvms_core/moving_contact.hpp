@@ -55,6 +55,7 @@ struct PiecePairsModel {
   Eigen::VectorXd mu_stick_, mu_kinetic_;
   // each piece's box in its frame (a broad-phase test before coal's; built on first use)
   std::vector<std::pair<Vec3, Vec3>> boxes_a_, boxes_b_;
+  NarrowPhase narrow_;  // key: the pair's index
 };
 
 // One set of pairs between side a (-1: the UVMS, else a free object) and side b, with its

@@ -43,13 +43,24 @@ coal::Transform3s transform_of(const pinocchio::SE3& where) {
 
 }  // namespace
 
-bool deepest_point(const ContactShape& piece, const pinocchio::SE3& where,
-                   const ContactShape& object, const pinocchio::SE3& object_where,
-                   Vec3& point, Vec3& normal, double& depth) {
+const coal::ComputeCollision& NarrowPhase::of(std::size_t key, const ContactShape& a,
+                                               const ContactShape& b) {
+  if (key >= pairs_.size()) pairs_.resize(key + 1);
+  Pair& pair = pairs_[key];
+  if (!pair.collide || pair.a != a.geometry.get() || pair.b != b.geometry.get()) {
+    pair.a = a.geometry.get();
+    pair.b = b.geometry.get();
+    pair.collide = std::make_unique<coal::ComputeCollision>(pair.a, pair.b);
+  }
+  return *pair.collide;
+}
+
+bool deepest_point(const coal::ComputeCollision& collide, const pinocchio::SE3& where,
+                   const pinocchio::SE3& object_where, Vec3& point, Vec3& normal,
+                   double& depth) {
   static const coal::CollisionRequest request;  // one contact, depth and normal
   coal::CollisionResult result;
-  if (coal::collide(piece.geometry.get(), transform_of(where), object.geometry.get(),
-                    transform_of(object_where), request, result) == 0) {
+  if (collide(transform_of(where), transform_of(object_where), request, result) == 0) {
     return false;
   }
   const coal::Contact& contact = result.getContact(0);
@@ -92,10 +103,11 @@ void corners_below(const pinocchio::Data& data, const ContactShape& piece,
 // coal's deepest point of the pair (_coal_point of touch.py), when they overlap.
 void coal_point(const pinocchio::Data& data, const ContactShape& piece,
                 const pinocchio::SE3& where, const ContactShape& object,
-                const pinocchio::SE3& object_where, int p, int o, Touch& out) {
+                const pinocchio::SE3& object_where, int p, int o,
+                const coal::ComputeCollision& collide, Touch& out) {
   Vec3 point, normal;
   double depth = 0.0;
-  if (deepest_point(piece, where, object, object_where, point, normal, depth)) {
+  if (deepest_point(collide, where, object_where, point, normal, depth)) {
     add_point(data, piece, object, p, o, -1, point, normal, depth, out);
   }
 }
@@ -122,7 +134,9 @@ void touch(const pinocchio::Data& data, const std::vector<ContactShape>& pieces,
     if (object.is_plane() && piece.has_corners()) {
       corners_below(data, piece, where, object, object_at, p, o, out);
     } else {
-      coal_point(data, piece, where, object, object_at, p, o, out);
+      const auto key = static_cast<std::size_t>(p) * objects.size() + static_cast<std::size_t>(o);
+      coal_point(data, piece, where, object, object_at, p, o, work.narrow.of(key, piece, object),
+                 out);
     }
   }
 }

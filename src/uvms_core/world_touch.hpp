@@ -5,6 +5,9 @@
 // and normal (one point per pair).
 #pragma once
 
+#include <coal/collision.h>
+
+#include <memory>
 #include <utility>
 #include <vector>
 
@@ -62,18 +65,44 @@ void near_pairs(const Placements& piece_where,
                 const std::vector<ContactShape>& objects,
                 std::vector<std::pair<int, int>>& out);
 
+// coal's narrow phase of each pair of shapes, kept between calls: a coal::ComputeCollision
+// (the pair's collide function looked up once, its GJK/EPA solver and the EPA's face storage
+// allocated once instead of at every call of coal::collide: the same algorithm, the same
+// contacts bit for bit). A copy starts empty, so that no two owners share a solver.
+class NarrowPhase {
+ public:
+  NarrowPhase() = default;
+  NarrowPhase(const NarrowPhase&) {}
+  NarrowPhase& operator=(const NarrowPhase&) {
+    pairs_.clear();
+    return *this;
+  }
+  // The collide call of pair `key` (any index the caller keeps per pair) of shapes a, b.
+  const coal::ComputeCollision& of(std::size_t key, const ContactShape& a, const ContactShape& b);
+
+ private:
+  struct Pair {
+    const coal::CollisionGeometry* a = nullptr;
+    const coal::CollisionGeometry* b = nullptr;
+    std::unique_ptr<coal::ComputeCollision> collide;
+  };
+  std::vector<Pair> pairs_;
+};
+
 // coal's deepest point of two overlapping shapes placed in the world (coal_point of
 // touch.py): the point midway between the nearest points, the normal out of the object
-// towards the piece, the depth > 0; false when they are apart.
-bool deepest_point(const ContactShape& piece, const pinocchio::SE3& where,
-                   const ContactShape& object, const pinocchio::SE3& object_where,
-                   Vec3& point, Vec3& normal, double& depth);
+// towards the piece, the depth > 0; false when they are apart. `collide`: the pair's
+// (NarrowPhase::of).
+bool deepest_point(const coal::ComputeCollision& collide, const pinocchio::SE3& where,
+                   const pinocchio::SE3& object_where, Vec3& point, Vec3& normal,
+                   double& depth);
 
 // touch()'s work buffers, kept by its caller between calls (no allocation per call once
-// sized): every shape's placement and the near (piece, object) pairs.
+// sized): every shape's placement, the near (piece, object) pairs and their narrow phase.
 struct TouchBuffers {
   Placements piece_where, object_where;
   std::vector<std::pair<int, int>> pairs;
+  NarrowPhase narrow;  // key: piece * objects + object
 };
 
 // The contact points after kinematics (touch of touch.py).
