@@ -6,39 +6,6 @@
 
 namespace uvms {
 
-namespace {
-
-// The box [lower, upper] (its frame) [m] holding a shape of fixed extent (a box, a convex
-// hull), or an empty one (lower > upper) for the others.
-std::pair<Vec3, Vec3> local_box(const ContactShape& shape) {
-  if (shape.kind == ContactKind::box) {
-    const Vec3 half = static_cast<const coal::Box&>(*shape.geometry).halfSide;
-    return {-half, half};
-  }
-  if (shape.kind == ContactKind::convex) {
-    const auto& points = *static_cast<const coal::ConvexBase&>(*shape.geometry).points;
-    Vec3 lower = Vec3::Constant(INFINITY), upper = Vec3::Constant(-INFINITY);
-    for (const auto& p : points) {
-      lower = lower.cwiseMin(p);
-      upper = upper.cwiseMax(p);
-    }
-    return {lower, upper};
-  }
-  return {Vec3::Ones(), Vec3::Zero()};
-}
-
-// Whether the sphere (centre, radius) [m] misses the box [lower, upper] of a shape placed at
-// where: then the shape the sphere bounds cannot touch it, and coal would find them apart
-// (a cheaper test than its GJK; exact, so the contacts are the same).
-bool sphere_misses(const Vec3& center, double radius, const std::pair<Vec3, Vec3>& box,
-                   const pinocchio::SE3& where) {
-  if ((box.first.array() > box.second.array()).any()) return false;
-  const Vec3 local = where.rotation().transpose() * (center - where.translation());
-  const Vec3 outside = (box.first - local).cwiseMax(local - box.second).cwiseMax(0.0);
-  return outside.norm() > radius;
-}
-
-}  // namespace
 
 void PiecePairsModel::check(const Model& model_a, const Model& model_b) const {
   auto check_pieces = [](const std::vector<ContactShape>& pieces, const Model& model) {

@@ -2,6 +2,8 @@
 
 #include <coal/collision.h>
 
+#include <cmath>
+
 namespace uvms {
 
 void near_pairs(const Placements& piece_where, const std::vector<ContactShape>& pieces,
@@ -33,6 +35,48 @@ void near_pairs(const Placements& piece_where, const std::vector<ContactShape>& 
       if (gap < radius + objects[k].bound_radius_m) out.emplace_back(p, o);
     }
   }
+}
+
+LocalBox local_box(const ContactShape& shape) {
+  switch (shape.kind) {
+    case ContactKind::box: {
+      const Vec3 half = static_cast<const coal::Box&>(*shape.geometry).halfSide;
+      return {-half, half};
+    }
+    case ContactKind::sphere: {
+      const double r = static_cast<const coal::Sphere&>(*shape.geometry).radius;
+      return {Vec3::Constant(-r), Vec3::Constant(r)};
+    }
+    case ContactKind::cylinder: {  // its axis along z
+      const auto& cylinder = static_cast<const coal::Cylinder&>(*shape.geometry);
+      const Vec3 half(cylinder.radius, cylinder.radius, cylinder.halfLength);
+      return {-half, half};
+    }
+    case ContactKind::ellipsoid: {
+      const Vec3 half = static_cast<const coal::Ellipsoid&>(*shape.geometry).radii;
+      return {-half, half};
+    }
+    case ContactKind::convex: {
+      const auto& points = *static_cast<const coal::ConvexBase&>(*shape.geometry).points;
+      Vec3 lower = Vec3::Constant(INFINITY), upper = Vec3::Constant(-INFINITY);
+      for (const auto& p : points) {
+        lower = lower.cwiseMin(p);
+        upper = upper.cwiseMax(p);
+      }
+      return {lower, upper};
+    }
+    case ContactKind::plane:
+      break;
+  }
+  return {Vec3::Ones(), Vec3::Zero()};
+}
+
+bool sphere_misses(const Vec3& center, double radius, const LocalBox& box,
+                   const pinocchio::SE3& where) {
+  if ((box.first.array() > box.second.array()).any()) return false;
+  const Vec3 local = where.rotation().transpose() * (center - where.translation());
+  const Vec3 outside = (box.first - local).cwiseMax(local - box.second).cwiseMax(0.0);
+  return outside.norm() > radius;
 }
 
 namespace {
@@ -125,6 +169,12 @@ void touch(const pinocchio::Data& data, const std::vector<ContactShape>& pieces,
   for (std::size_t o = 0; o < objects.size(); ++o) {
     object_where[o] = placement_of(data, objects[o]);
   }
+  if (work.piece_boxes.size() != pieces.size() || work.object_boxes.size() != objects.size()) {
+    work.piece_boxes.clear();
+    work.object_boxes.clear();
+    for (const auto& piece : pieces) work.piece_boxes.push_back(local_box(piece));
+    for (const auto& object : objects) work.object_boxes.push_back(local_box(object));
+  }
   near_pairs(piece_where, pieces, object_where, objects, work.pairs);
   for (const auto& [p, o] : work.pairs) {
     const auto& piece = pieces[static_cast<std::size_t>(p)];
@@ -134,6 +184,13 @@ void touch(const pinocchio::Data& data, const std::vector<ContactShape>& pieces,
     if (object.is_plane() && piece.has_corners()) {
       corners_below(data, piece, where, object, object_at, p, o, out);
     } else {
+      // the bounding spheres overlap: each against the other's box, before coal's GJK
+      const auto& piece_box = work.piece_boxes[static_cast<std::size_t>(p)];
+      const auto& object_box = work.object_boxes[static_cast<std::size_t>(o)];
+      if (sphere_misses(where.translation(), piece.bound_radius_m, object_box, object_at) ||
+          sphere_misses(object_at.translation(), object.bound_radius_m, piece_box, where)) {
+        continue;
+      }
       const auto key = static_cast<std::size_t>(p) * objects.size() + static_cast<std::size_t>(o);
       coal_point(data, piece, where, object, object_at, p, o, work.narrow.of(key, piece, object),
                  out);

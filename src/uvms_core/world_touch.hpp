@@ -65,6 +65,16 @@ void near_pairs(const Placements& piece_where,
                 const std::vector<ContactShape>& objects,
                 std::vector<std::pair<int, int>>& out);
 
+// A box [lower, upper] in a shape's frame [m] holding it, empty (lower > upper) for a plane.
+using LocalBox = std::pair<Vec3, Vec3>;
+LocalBox local_box(const ContactShape& shape);
+
+// Whether the sphere (centre, radius) [m] misses the box of a shape placed at where: then the
+// shape the sphere bounds cannot touch it, and coal would find them apart (a cheaper test
+// than its GJK; exact, so the contacts are the same). False for an empty box.
+bool sphere_misses(const Vec3& center, double radius, const LocalBox& box,
+                   const pinocchio::SE3& where);
+
 // coal's narrow phase of each pair of shapes, kept between calls: a coal::ComputeCollision
 // (the pair's collide function looked up once, its GJK/EPA solver and the EPA's face storage
 // allocated once instead of at every call of coal::collide: the same algorithm, the same
@@ -98,11 +108,13 @@ bool deepest_point(const coal::ComputeCollision& collide, const pinocchio::SE3& 
                    double& depth);
 
 // touch()'s work buffers, kept by its caller between calls (no allocation per call once
-// sized): every shape's placement, the near (piece, object) pairs and their narrow phase.
+// sized): every shape's placement and box, the near (piece, object) pairs and their narrow
+// phase.
 struct TouchBuffers {
   Placements piece_where, object_where;
   std::vector<std::pair<int, int>> pairs;
-  NarrowPhase narrow;  // key: piece * objects + object
+  std::vector<LocalBox> piece_boxes, object_boxes;  // each shape's (local_box), kept
+  NarrowPhase narrow;                               // key: piece * objects + object
 };
 
 // The contact points after kinematics (touch of touch.py).
