@@ -2,7 +2,10 @@
 // contact points, a bounding-sphere broad phase first (objects far away cost one test), then
 // the narrow phase: against a plane each corner of a piece below it is a contact point, its
 // depth along the plane's normal; otherwise coal's GJK/EPA give the deepest point, its depth
-// and normal (one point per pair).
+// and normal (one point per pair). Before coal, each bounding sphere is tested against the
+// other shape's box (sphere_misses: exact, a pair it cuts is one coal finds apart; the
+// reference calls coal on it), and each pair's coal solver is kept between calls
+// (NarrowPhase).
 #pragma once
 
 #include <coal/collision.h>
