@@ -35,6 +35,8 @@ A scenario's own controller (``type = "object_recovery:ObjectRecovery"``).
 
 from __future__ import annotations
 
+import bisect
+import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -103,6 +105,7 @@ class ObjectRecovery(Controller):
                 f"({len(self.waypoints)}), got {list(phase_durations_s)}"
             )
         self.starts = np.concatenate([[0.0], np.cumsum(self.durations)])
+        self._starts = self.starts.tolist()  # bisect's: np.searchsorted's index, cheaper
         self.jaw = JawJoints.of(self.model, None, uvms.source)
         if self.jaw.count == 0:
             raise ParameterError(
@@ -133,11 +136,11 @@ class ObjectRecovery(Controller):
     def target_world_m(self, time_s: float, start_world_m: np.ndarray) -> np.ndarray:
         """The jaw's target at ``time_s``: the current move's smooth interpolation, the
         first from ``start_world_m``."""
-        k = int(np.searchsorted(self.starts, time_s, side="right")) - 1
+        k = bisect.bisect_right(self._starts, time_s) - 1
         if k >= len(self.durations):
             return self.waypoints[-1].copy()
         before = start_world_m if k == 0 else self.waypoints[k - 1]
-        s = _smooth((time_s - self.starts[k]) / self.durations[k])
+        s = _smooth((time_s - self._starts[k]) / self.durations[k])
         return before + s * (self.waypoints[k] - before)
 
     def _vehicle_force_world(self, time_s: float, q: np.ndarray, v: np.ndarray) -> np.ndarray:
@@ -154,7 +157,7 @@ class ObjectRecovery(Controller):
         step_s = 0.0 if self.last_time_s is None else time_s - self.last_time_s
         self.last_time_s = time_s
         limit = self.integral_limit_N
-        if np.linalg.norm(error_m) < INTEGRATE_WITHIN_M:  # no wind-up on the long moves
+        if math.sqrt(error_m @ error_m) < INTEGRATE_WITHIN_M:  # no wind-up on the long moves
             self.integral_N = np.clip(self.integral_N + self.ix * error_m * step_s, -limit, limit)
         return self.kx * error_m - self.dx * jaw_velocity_world + self.integral_N
 
@@ -165,7 +168,7 @@ class ObjectRecovery(Controller):
         tau[:3] = rotation.T @ self._vehicle_force_world(time_s, q, v)
         tau[3:6] = -self.ka * pin.log3(rotation) - self.da * v[3:6]
         tau[self.arm_v] = self.kp * (self.arm_target - q[self.arm_q]) - self.kd * v[self.arm_v]
-        self.jaw_q = q[self.jaw.q_index].copy()
+        self.jaw_q = q[self.jaw.q_index]  # a copy (an index array's)
         self.jaw_tau = self.servo.torque(time_s, self.jaw_q, v[self.jaw.v_index])
         tau[self.jaw.v_index] = self.jaw_tau
         return tau

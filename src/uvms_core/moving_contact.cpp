@@ -1,60 +1,11 @@
 #include "moving_contact.hpp"
 
-#include <algorithm>
 #include <cmath>
 #include <string>
 #include <utility>
 
 namespace uvms {
 
-namespace {
-
-// The box [lower, upper] (its frame) [m] holding a shape of fixed extent (a box, a convex
-// hull), or an empty one (lower > upper) for the others.
-std::pair<Vec3, Vec3> local_box(const ContactShape& shape) {
-  if (shape.kind == ContactKind::box) {
-    const Vec3 half = static_cast<const coal::Box&>(*shape.geometry).halfSide;
-    return {-half, half};
-  }
-  if (shape.kind == ContactKind::convex) {
-    const auto& points = *static_cast<const coal::ConvexBase&>(*shape.geometry).points;
-    Vec3 lower = Vec3::Constant(INFINITY), upper = Vec3::Constant(-INFINITY);
-    for (const auto& p : points) {
-      lower = lower.cwiseMin(p);
-      upper = upper.cwiseMax(p);
-    }
-    return {lower, upper};
-  }
-  return {Vec3::Ones(), Vec3::Zero()};
-}
-
-// Whether the sphere (centre, radius) [m] misses the box [lower, upper] of a shape placed at
-// where: then the shape the sphere bounds cannot touch it, and coal would find them apart
-// (a cheaper test than its GJK; exact, so the contacts are the same).
-bool sphere_misses(const Vec3& center, double radius, const std::pair<Vec3, Vec3>& box,
-                   const pinocchio::SE3& where) {
-  if ((box.first.array() > box.second.array()).any()) return false;
-  const Vec3 local = where.rotation().transpose() * (center - where.translation());
-  const Vec3 outside = (box.first - local).cwiseMax(local - box.second).cwiseMax(0.0);
-  return outside.norm() > radius;
-}
-
-// Whether the sphere (centre, radius) [m] misses a cylinder shape placed at where (its axis
-// z, radius R, half length H): its distance to the solid cylinder, hypot(max(rho - R, 0),
-// max(|z| - H, 0)) in the cylinder's frame, exceeds the radius (exact, as sphere_misses; a
-// cylinder's bounding sphere holds the whole of a bar, its box test would keep every piece
-// near it). False for any other shape.
-bool sphere_misses_cylinder(const Vec3& center, double radius, const ContactShape& shape,
-                            const pinocchio::SE3& where) {
-  if (shape.kind != ContactKind::cylinder) return false;
-  const auto& cylinder = static_cast<const coal::Cylinder&>(*shape.geometry);
-  const Vec3 local = where.rotation().transpose() * (center - where.translation());
-  const double radial = std::max(std::hypot(local.x(), local.y()) - cylinder.radius, 0.0);
-  const double axial = std::max(std::abs(local.z()) - cylinder.halfLength, 0.0);
-  return std::hypot(radial, axial) > radius;
-}
-
-}  // namespace
 
 void PiecePairsModel::check(const Model& model_a, const Model& model_b) const {
   auto check_pieces = [](const std::vector<ContactShape>& pieces, const Model& model) {
@@ -111,17 +62,12 @@ void PiecePairsModel::forces(const Data& data_a, const Data& data_b,
     const double gap = (where_a.translation() - where_b.translation()).norm();
     if (gap >= pa.bound_radius_m + pb.bound_radius_m) continue;
     if (sphere_misses(where_a.translation(), pa.bound_radius_m, boxes_b_[pairs[k][1]], where_b) ||
-        sphere_misses(where_b.translation(), pb.bound_radius_m, boxes_a_[pairs[k][0]], where_a) ||
-        sphere_misses_cylinder(where_a.translation(), pa.bound_radius_m, pb, where_b) ||
-        sphere_misses_cylinder(where_b.translation(), pb.bound_radius_m, pa, where_a)) {
+        sphere_misses(where_b.translation(), pb.bound_radius_m, boxes_a_[pairs[k][0]], where_a)) {
       continue;
     }
     Vec3 point, normal;
     double depth = 0.0;
-    colliders_.resize(pairs.size());
-    if (!deepest_point(pa, where_a, pb, where_b, point, normal, depth, colliders_[k].of(pa, pb))) {
-      continue;
-    }
+    if (!deepest_point(narrow_.of(k, pa, pb), where_a, where_b, point, normal, depth)) continue;
     out.pair.push_back(static_cast<int>(k));
     touch.piece.push_back(pairs[k][0]);
     touch.obj.push_back(pairs[k][1]);

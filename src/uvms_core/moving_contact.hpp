@@ -55,8 +55,8 @@ struct PiecePairsModel {
   Eigen::VectorXd mu_stick_, mu_kinetic_;
   // each piece's box in its frame (a broad-phase test before coal's; built on first use)
   std::vector<std::pair<Vec3, Vec3>> boxes_a_, boxes_b_;
-  std::vector<Collider> colliders_;  // each pair's coal functor (built on first use)
-  Placements where_a_, where_b_;     // each piece's placement in the world, this call's
+  NarrowPhase narrow_;            // key: the pair's index
+  Placements where_a_, where_b_;  // each piece's placement in the world, this call's
 };
 
 // One set of pairs between side a (-1: the UVMS, else a free object) and side b, with its

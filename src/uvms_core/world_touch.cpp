@@ -2,6 +2,8 @@
 
 #include <coal/collision.h>
 
+#include <cmath>
+
 namespace uvms {
 
 void near_pairs(const Placements& piece_where, const std::vector<ContactShape>& pieces,
@@ -35,6 +37,48 @@ void near_pairs(const Placements& piece_where, const std::vector<ContactShape>& 
   }
 }
 
+LocalBox local_box(const ContactShape& shape) {
+  switch (shape.kind) {
+    case ContactKind::box: {
+      const Vec3 half = static_cast<const coal::Box&>(*shape.geometry).halfSide;
+      return {-half, half};
+    }
+    case ContactKind::sphere: {
+      const double r = static_cast<const coal::Sphere&>(*shape.geometry).radius;
+      return {Vec3::Constant(-r), Vec3::Constant(r)};
+    }
+    case ContactKind::cylinder: {  // its axis along z
+      const auto& cylinder = static_cast<const coal::Cylinder&>(*shape.geometry);
+      const Vec3 half(cylinder.radius, cylinder.radius, cylinder.halfLength);
+      return {-half, half};
+    }
+    case ContactKind::ellipsoid: {
+      const Vec3 half = static_cast<const coal::Ellipsoid&>(*shape.geometry).radii;
+      return {-half, half};
+    }
+    case ContactKind::convex: {
+      const auto& points = *static_cast<const coal::ConvexBase&>(*shape.geometry).points;
+      Vec3 lower = Vec3::Constant(INFINITY), upper = Vec3::Constant(-INFINITY);
+      for (const auto& p : points) {
+        lower = lower.cwiseMin(p);
+        upper = upper.cwiseMax(p);
+      }
+      return {lower, upper};
+    }
+    case ContactKind::plane:
+      break;
+  }
+  return {Vec3::Ones(), Vec3::Zero()};
+}
+
+bool sphere_misses(const Vec3& center, double radius, const LocalBox& box,
+                   const pinocchio::SE3& where) {
+  if ((box.first.array() > box.second.array()).any()) return false;
+  const Vec3 local = where.rotation().transpose() * (center - where.translation());
+  const Vec3 outside = (box.first - local).cwiseMax(local - box.second).cwiseMax(0.0);
+  return outside.norm() > radius;
+}
+
 namespace {
 
 coal::Transform3s transform_of(const pinocchio::SE3& where) {
@@ -43,28 +87,26 @@ coal::Transform3s transform_of(const pinocchio::SE3& where) {
 
 }  // namespace
 
-const coal::ComputeCollision* Collider::of(const ContactShape& piece, const ContactShape& object) {
-  if (!functor_ || piece_ != piece.geometry.get() || object_ != object.geometry.get()) {
-    piece_ = piece.geometry.get();
-    object_ = object.geometry.get();
-    functor_ = std::make_shared<coal::ComputeCollision>(piece_, object_);
+const coal::ComputeCollision& NarrowPhase::of(std::size_t key, const ContactShape& a,
+                                               const ContactShape& b) {
+  if (key >= pairs_.size()) pairs_.resize(key + 1);
+  Pair& pair = pairs_[key];
+  if (!pair.collide || pair.a != a.geometry.get() || pair.b != b.geometry.get()) {
+    pair.a = a.geometry.get();
+    pair.b = b.geometry.get();
+    pair.collide = std::make_unique<coal::ComputeCollision>(pair.a, pair.b);
   }
-  return functor_.get();
+  return *pair.collide;
 }
 
-bool deepest_point(const ContactShape& piece, const pinocchio::SE3& where,
-                   const ContactShape& object, const pinocchio::SE3& object_where,
-                   Vec3& point, Vec3& normal, double& depth,
-                   const coal::ComputeCollision* collider) {
+bool deepest_point(const coal::ComputeCollision& collide, const pinocchio::SE3& where,
+                   const pinocchio::SE3& object_where, Vec3& point, Vec3& normal,
+                   double& depth) {
   static const coal::CollisionRequest request;  // one contact, depth and normal
   coal::CollisionResult result;
-  const coal::Transform3s piece_tf = transform_of(where), object_tf = transform_of(object_where);
-  const std::size_t touching =
-      collider != nullptr
-          ? (*collider)(piece_tf, object_tf, request, result)
-          : coal::collide(piece.geometry.get(), piece_tf, object.geometry.get(), object_tf,
-                          request, result);
-  if (touching == 0) return false;
+  if (collide(transform_of(where), transform_of(object_where), request, result) == 0) {
+    return false;
+  }
   const coal::Contact& contact = result.getContact(0);
   depth = -contact.penetration_depth;
   if (!(depth > 0.0)) return false;
@@ -105,10 +147,11 @@ void corners_below(const pinocchio::Data& data, const ContactShape& piece,
 // coal's deepest point of the pair (_coal_point of touch.py), when they overlap.
 void coal_point(const pinocchio::Data& data, const ContactShape& piece,
                 const pinocchio::SE3& where, const ContactShape& object,
-                const pinocchio::SE3& object_where, int p, int o, Touch& out) {
+                const pinocchio::SE3& object_where, int p, int o,
+                const coal::ComputeCollision& collide, Touch& out) {
   Vec3 point, normal;
   double depth = 0.0;
-  if (deepest_point(piece, where, object, object_where, point, normal, depth)) {
+  if (deepest_point(collide, where, object_where, point, normal, depth)) {
     add_point(data, piece, object, p, o, -1, point, normal, depth, out);
   }
 }
@@ -126,6 +169,12 @@ void touch(const pinocchio::Data& data, const std::vector<ContactShape>& pieces,
   for (std::size_t o = 0; o < objects.size(); ++o) {
     object_where[o] = placement_of(data, objects[o]);
   }
+  if (work.piece_boxes.size() != pieces.size() || work.object_boxes.size() != objects.size()) {
+    work.piece_boxes.clear();
+    work.object_boxes.clear();
+    for (const auto& piece : pieces) work.piece_boxes.push_back(local_box(piece));
+    for (const auto& object : objects) work.object_boxes.push_back(local_box(object));
+  }
   near_pairs(piece_where, pieces, object_where, objects, work.pairs);
   for (const auto& [p, o] : work.pairs) {
     const auto& piece = pieces[static_cast<std::size_t>(p)];
@@ -135,7 +184,16 @@ void touch(const pinocchio::Data& data, const std::vector<ContactShape>& pieces,
     if (object.is_plane() && piece.has_corners()) {
       corners_below(data, piece, where, object, object_at, p, o, out);
     } else {
-      coal_point(data, piece, where, object, object_at, p, o, out);
+      // the bounding spheres overlap: each against the other's box, before coal's GJK
+      const auto& piece_box = work.piece_boxes[static_cast<std::size_t>(p)];
+      const auto& object_box = work.object_boxes[static_cast<std::size_t>(o)];
+      if (sphere_misses(where.translation(), piece.bound_radius_m, object_box, object_at) ||
+          sphere_misses(object_at.translation(), object.bound_radius_m, piece_box, where)) {
+        continue;
+      }
+      const auto key = static_cast<std::size_t>(p) * objects.size() + static_cast<std::size_t>(o);
+      coal_point(data, piece, where, object, object_at, p, o, work.narrow.of(key, piece, object),
+                 out);
     }
   }
 }

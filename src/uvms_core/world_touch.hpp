@@ -2,8 +2,13 @@
 // contact points, a bounding-sphere broad phase first (objects far away cost one test), then
 // the narrow phase: against a plane each corner of a piece below it is a contact point, its
 // depth along the plane's normal; otherwise coal's GJK/EPA give the deepest point, its depth
-// and normal (one point per pair).
+// and normal (one point per pair). Before coal, each bounding sphere is tested against the
+// other shape's box (sphere_misses: exact, a pair it cuts is one coal finds apart; the
+// reference calls coal on it), and each pair's coal solver is kept between calls
+// (NarrowPhase).
 #pragma once
+
+#include <coal/collision.h>
 
 #include <memory>
 #include <utility>
@@ -13,11 +18,6 @@
 
 #include "contact_shapes.hpp"
 #include "hydro_bodies.hpp"
-
-namespace coal {
-class ComputeCollision;
-class CollisionGeometry;
-}  // namespace coal
 
 namespace uvms {
 
@@ -68,40 +68,56 @@ void near_pairs(const Placements& piece_where,
                 const std::vector<ContactShape>& objects,
                 std::vector<std::pair<int, int>>& out);
 
-// coal's deepest point of two overlapping shapes placed in the world (coal_point of
-// touch.py): the point midway between the nearest points, the normal out of the object
-// towards the piece, the depth > 0; false when they are apart. With `collider` (the pair's
-// Collider) coal's functor kept for the pair is called: the same algorithm and answer as
-// coal::collide, without building its GJK/EPA solver (and allocating its buffers) again.
-bool deepest_point(const ContactShape& piece, const pinocchio::SE3& where,
-                   const ContactShape& object, const pinocchio::SE3& object_where,
-                   Vec3& point, Vec3& normal, double& depth,
-                   const coal::ComputeCollision* collider = nullptr);
+// A box [lower, upper] in a shape's frame [m] holding it, empty (lower > upper) for a plane.
+using LocalBox = std::pair<Vec3, Vec3>;
+LocalBox local_box(const ContactShape& shape);
 
-// coal's collision functor of one pair of shapes, kept between calls (deepest_point). A copy
-// starts empty: a functor's solver is its call's scratch, never shared between owners.
-class Collider {
+// Whether the sphere (centre, radius) [m] misses the box of a shape placed at where: then the
+// shape the sphere bounds cannot touch it, and coal would find them apart (a cheaper test
+// than its GJK; exact, so the contacts are the same). False for an empty box.
+bool sphere_misses(const Vec3& center, double radius, const LocalBox& box,
+                   const pinocchio::SE3& where);
+
+// coal's narrow phase of each pair of shapes, kept between calls: a coal::ComputeCollision
+// (the pair's collide function looked up once, its GJK/EPA solver and the EPA's face storage
+// allocated once instead of at every call of coal::collide: the same algorithm, the same
+// contacts bit for bit). A copy starts empty, so that no two owners share a solver.
+class NarrowPhase {
  public:
-  Collider() = default;
-  Collider(const Collider&) {}
-  Collider& operator=(const Collider&) {
-    functor_.reset();
+  NarrowPhase() = default;
+  NarrowPhase(const NarrowPhase&) {}
+  NarrowPhase& operator=(const NarrowPhase&) {
+    pairs_.clear();
     return *this;
   }
-  // the functor of (piece, object), built on first use or when a shape's geometry changed
-  const coal::ComputeCollision* of(const ContactShape& piece, const ContactShape& object);
+  // The collide call of pair `key` (any index the caller keeps per pair) of shapes a, b.
+  const coal::ComputeCollision& of(std::size_t key, const ContactShape& a, const ContactShape& b);
 
  private:
-  std::shared_ptr<coal::ComputeCollision> functor_;
-  const coal::CollisionGeometry* piece_ = nullptr;
-  const coal::CollisionGeometry* object_ = nullptr;
+  struct Pair {
+    const coal::CollisionGeometry* a = nullptr;
+    const coal::CollisionGeometry* b = nullptr;
+    std::unique_ptr<coal::ComputeCollision> collide;
+  };
+  std::vector<Pair> pairs_;
 };
 
+// coal's deepest point of two overlapping shapes placed in the world (coal_point of
+// touch.py): the point midway between the nearest points, the normal out of the object
+// towards the piece, the depth > 0; false when they are apart. `collide`: the pair's
+// (NarrowPhase::of).
+bool deepest_point(const coal::ComputeCollision& collide, const pinocchio::SE3& where,
+                   const pinocchio::SE3& object_where, Vec3& point, Vec3& normal,
+                   double& depth);
+
 // touch()'s work buffers, kept by its caller between calls (no allocation per call once
-// sized): every shape's placement and the near (piece, object) pairs.
+// sized): every shape's placement and box, the near (piece, object) pairs and their narrow
+// phase.
 struct TouchBuffers {
   Placements piece_where, object_where;
   std::vector<std::pair<int, int>> pairs;
+  std::vector<LocalBox> piece_boxes, object_boxes;  // each shape's (local_box), kept
+  NarrowPhase narrow;                               // key: piece * objects + object
 };
 
 // The contact points after kinematics (touch of touch.py).

@@ -25,6 +25,7 @@ from uvms_pin.sim.integrators import RK4, Adaptive, SemiImplicitEuler
 from uvms_pin.sim.run import simulate
 from uvms_pin.sim.stiff_modes import StiffMode, candidate_contacts, environment_mode, stop_modes
 from uvms_pin.sim.stiffness import (
+    _stiffest,
     check_stiff_modes,
     is_stable,
     largest_stable_step_s,
@@ -79,6 +80,22 @@ def test_a_point_mass_on_a_spring_turns_unstable_where_the_analysis_says():
         _rk4_real_axis_limit(), rel=1e-9
     )
     assert _rk4_real_axis_limit() == pytest.approx(2.785, abs=1e-3)
+
+
+@pytest.mark.parametrize("integrator", [RK4(step_s=5e-4), SemiImplicitEuler(step_s=5e-4)])
+def test_the_pruned_search_picks_the_argmin_of_every_modes_largest_step(integrator):
+    # springs of many rates in a shuffled order, the stiffest one's twin ahead of it (equal
+    # h*: the first is kept) and one without stiffness (h* inf), as np.argmin picks them
+    rng = np.random.default_rng(7)
+    springs = np.column_stack([10.0 ** rng.uniform(2, 7, 12), rng.uniform(0, 50, 12)])
+    modes = [StiffMode(f"m{i}", k, c, 0.3) for i, (k, c) in enumerate(springs.tolist())]
+    stiff = modes[int(np.argmin([largest_stable_step_s(integrator, m) for m in modes]))]
+    modes.insert(0, StiffMode("twin", stiff.stiffness, stiff.damping, stiff.mass))
+    modes.insert(5, StiffMode("free", 0.0, 0.0, 1.0))
+    limits = [largest_stable_step_s(integrator, m) for m in modes]
+    assert int(np.argmin(limits)) == 0
+    assert _stiffest(integrator, modes) == (0, limits[0])
+    assert _stiffest(integrator, [StiffMode("free", 0.0, 0.0, 1.0)] * 2) == (0, math.inf)
 
 
 def test_a_rk4_run_past_the_largest_step_grows_and_below_it_decays():

@@ -56,22 +56,43 @@ def is_stable(integrator: FixedStep, step_s: float, mode: StiffMode) -> bool:
     return _spectral_radius(phi) <= 1.0 + _RADIUS_SLACK
 
 
-def largest_stable_step_s(integrator: FixedStep, mode: StiffMode) -> float:
+def largest_stable_step_s(
+    integrator: FixedStep, mode: StiffMode, above_s: float = math.inf
+) -> float:
     """h* [s]: the step at which ``mode`` turns unstable (inf if it never does), to 1e-12
     relative: doubling from 1e-3 / |lambda|_max, then bisection (the stable steps of a mode
-    with Re lambda <= 0 are an interval [0, h*] for the shipped integrators)."""
+    with Re lambda <= 0 are an interval [0, h*] for the shipped integrators). Once a stable
+    step exceeds ``above_s`` the search stops there and returns inf: h* > above_s is all a
+    caller looking for the least h* needs (the same steps are tried until then, so an h*
+    below it is the same number)."""
     fastest = float(np.max(np.abs(mode.rates)))
     if fastest == 0.0:
         return math.inf
     low, high = 0.0, 1e-3 / fastest
     while is_stable(integrator, high, mode):
         low, high = high, 2.0 * high
-        if high > 1e6 / fastest:
+        if high > 1e6 / fastest or low > above_s:
             return math.inf
     while high - low > 1e-12 * high:
         middle = 0.5 * (low + high)
         low, high = (middle, high) if is_stable(integrator, middle, mode) else (low, middle)
+        if low > above_s:
+            return math.inf
     return low
+
+
+def _stiffest(integrator: FixedStep, modes: list[StiffMode]) -> tuple[int, float]:
+    """(k, h*_k) of the first mode with the least h* (np.argmin's choice over every mode's
+    `largest_stable_step_s`). The modes are searched fastest first (the likely least h*),
+    each only until its stable steps pass the least h* so far (it cannot be the least
+    then): some fifty stability tests a mode become a few."""
+    order = sorted(range(len(modes)), key=lambda k: -float(np.max(np.abs(modes[k].rates))))
+    best_k, best = None, math.inf
+    for k in order:
+        limit = largest_stable_step_s(integrator, modes[k], best)
+        if best_k is None or limit < best or (limit == best and k < best_k):
+            best_k, best = k, limit
+    return best_k, best
 
 
 def _robot_bodies(system: System, data: pin.Data, inverse: np.ndarray) -> list[Body]:
@@ -223,9 +244,8 @@ def check_stiff_modes(system: System, state: SystemState, integrator: Integrator
     record: dict[str, Any] = {"checked": True, "integrator": name, "step_s": step_s}
     if not modes:
         return {**record, "modes": 0, "stiffest": None, "margin": None}
-    limits = [largest_stable_step_s(integrator, m) for m in modes]
-    k = int(np.argmin(limits))
-    stiffest, limit = modes[k], limits[k]
+    k, limit = _stiffest(integrator, modes)
+    stiffest = modes[k]
     if not is_stable(integrator, step_s, stiffest) or limit < step_s:
         raise StiffModeError(stiffest, name, step_s, limit)
     finite = math.isfinite(limit)
