@@ -17,7 +17,9 @@ constraints) and ``integrator`` ("euler" or "rk4" nodes) are `uvms_pin.ocp.probl
 sine profile, as the PPC's), ``desired_rpy``, ``force_weights``, ``attitude_weights``,
 ``posture_weight``, and the environment the controller believes in, [controller.contact]
 (the keys of [environment]: type "spring" or "plane"; without its anchor it is placed where
-the tip is at the first re-plan). Needs crocoddyl (``pip install 'uvms-pin[ocp]'``).
+the tip is at the first re-plan). The compiled planner needs nothing more; ``planner =
+"python"`` and ``solver = "csqp"`` need crocoddyl and mim-solvers (``pip install
+'uvms-pin[ocp]'``).
 """
 
 from __future__ import annotations
@@ -51,9 +53,9 @@ _NODE_BYTES_AT_NV_10 = 143e3
 
 #: the tasks and what their targets are
 TASKS = ("station", "end_effector", "force")
-#: the solvers, the nodes' integrators and the planners (`uvms_pin.ocp.problems`' SOLVERS,
-#: INTEGRATORS, `uvms_pin.control.mpc.PLANNERS`: not imported here, the ocp layer needs
-#: crocoddyl; tests/scenario check they agree)
+#: the solvers, the nodes' integrators and the planners (`uvms_pin.ocp.plans`' SOLVERS,
+#: INTEGRATORS, `uvms_pin.control.mpc.PLANNERS`: not imported here, the controller's
+#: modules are loaded only when one is built; tests/scenario check they agree)
 SOLVERS = ("box_fddp", "fddp", "csqp")
 INTEGRATORS = ("euler", "rk4")
 PLANNERS = ("core", "python")
@@ -141,7 +143,7 @@ def read_mpc(t: Table, context: ControllerContext) -> ControllerSpec:
     t.finish()
 
     def build(u: UVMS) -> Controller:
-        from uvms_pin.control.mpc import MpcController, MpcForceTask  # crocoddyl: on use
+        from uvms_pin.control.mpc import MpcController, MpcForceTask  # on use
         from uvms_pin.ocp.plans import Actuators
 
         q_ref = u.neutral_configuration()
