@@ -200,8 +200,10 @@ bool RobotsSystem::near(const ConstVec& q, const ConstVec& v, double horizon_s) 
   }
   if (q.size() != model_.nq || v.size() != model_.nv) throw InputError("robots: q, v sizes");
   // each side's sphere about its root (robot_reach.reach_sphere)
-  std::vector<Vec3> centers(n_sides);
-  std::vector<double> radii(n_sides);
+  std::vector<Vec3>& centers = centers_;
+  std::vector<double>& radii = radii_;
+  centers.resize(n_sides);
+  radii.resize(n_sides);
   for (std::size_t side = 0; side < n_sides; ++side) {
     Eigen::Index at_q = 0, at_v = 0, nv = 0;
     side_state(side, at_q, at_v, nv);
@@ -215,7 +217,8 @@ bool RobotsSystem::near(const ConstVec& q, const ConstVec& v, double horizon_s) 
                          2.0 * reach * v.segment(at_v + 6, nv - 6).cwiseAbs().sum();
     radii[side] = reach + 2.0 * speed * horizon_s + clearance_m;
   }
-  std::vector<std::size_t> close;
+  std::vector<std::size_t>& close = close_;
+  close.clear();
   for (std::size_t s = 0; s < sets.size(); ++s) {
     const auto a = static_cast<std::size_t>(sets[s].a), b = static_cast<std::size_t>(sets[s].b);
     if (!sets[s].pairs.pairs.empty() && (centers[a] - centers[b]).norm() < radii[a] + radii[b]) {

@@ -83,6 +83,10 @@ class RobotsSystem {
   ManifoldStepper stepper_;
   Eigen::VectorXd acceleration_;
   std::vector<PairContacts> found_;
+  // near()'s work: each side's sphere about its root, the sets whose sides' spheres meet
+  std::vector<Vec3> centers_;
+  std::vector<double> radii_;
+  std::vector<std::size_t> close_;
 };
 
 }  // namespace uvms

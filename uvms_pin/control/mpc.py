@@ -275,7 +275,6 @@ class MpcController(Controller):
         if self.force_task is not None:
             self._start_force_plan(time_s, measurement)
         x = np.r_[measurement.q, measurement.v]
-        self.plan.x0 = x
         iterations = max(self.iterations, COLD_START_ITERATIONS) if cold else self.iterations
         warm = self._initial_guess(x, time_s - self._last_plan_s)
         regularization = self._regularization if self.warm_start else None

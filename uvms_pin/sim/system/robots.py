@@ -245,6 +245,18 @@ class Robots:
         built = self.compiled
         return None if isinstance(built, Fallback) else built[0]
 
+    def _core_period(self, integrator) -> tuple[Any, Any] | None:
+        """(the core's `RobotsSystem`, its FixedStep of ``integrator``) when a period is one
+        core call, else None (no compiled system, an integrator the core has not)."""
+        core = self._core()
+        step = None if core is None else integrator_to_core(integrator, core_module())
+        return None if step is None or isinstance(step, Fallback) else (core, step)
+
+    def _core_memories(self) -> tuple[list, list]:
+        """What a core call reads of the friction anchors: each robot's system's memories,
+        then each pair set's between the sides."""
+        return self._memories(), [s.memory for s in self.contacts.sets]
+
     def _memories(self) -> list[list]:
         """Each robot's system's friction memories, as its core system reads them."""
         return [
@@ -262,19 +274,13 @@ class Robots:
     def _integrate(self, integrator, t0, q0, v0, taus, t1) -> SystemState:
         """The smooth step of the period with every body at once: one core call, or the
         Python integrator around `acceleration`."""
-        built = self.compiled
-        step = (
-            None if isinstance(built, Fallback) else integrator_to_core(integrator, core_module())
-        )
-        if step is None or isinstance(step, Fallback):
+        core = self._core_period(integrator)
+        if core is None:
             return integrator.advance(
                 self.model, lambda t, q, v: self.acceleration(t, q, v, taus), t0, q0, v0, t1
             )
-        memories = [s.memory for s in self.contacts.sets]
-        return built[0].integrate(
-            t0, q0, v0, [np.asarray(t, dtype=float) for t in taus], t1, step, self._memories(),
-            memories,
-        )  # fmt: skip
+        system, step = core
+        return system.integrate(t0, q0, v0, _floats(taus), t1, step, *self._core_memories())
 
     def _together(self, integrator, t0, q0, v0, taus, t1) -> SystemState:
         """The period integrated for every body at once (the contacts between robots and
@@ -282,19 +288,13 @@ class Robots:
         robot's system's constraints (its joint limits; the first's objects' rigid
         contacts with the fixed world): one core call (`RobotsSystem.advance`, the same
         steps) when the integration is compiled, else the reference below."""
-        built = self.compiled
-        step = (
-            None if isinstance(built, Fallback) else integrator_to_core(integrator, core_module())
-        )
-        if step is not None and not isinstance(step, Fallback):
-            memories = [s.memory for s in self.contacts.sets]
-            q1, v1 = built[0].advance(
-                t0, q0, v0, [np.asarray(t, dtype=float) for t in taus], t1, step,
-                self._memories(), memories,
-            )  # fmt: skip
-            self._rigid_contacts_from(built[1][0])
-            return SystemState(q1, v1)
-        return self.together_reference(integrator, t0, q0, v0, taus, t1)
+        core = self._core_period(integrator)
+        if core is None:
+            return self.together_reference(integrator, t0, q0, v0, taus, t1)
+        system, step = core
+        q1, v1 = system.advance(t0, q0, v0, _floats(taus), t1, step, *self._core_memories())
+        self._rigid_contacts_from(self.compiled[1][0])
+        return SystemState(q1, v1)
 
     def together_reference(self, integrator, t0, q0, v0, taus, t1) -> SystemState:
         """The reference of `_together`'s period: `_integrate`, then in Python every anchor
@@ -350,8 +350,7 @@ class Robots:
         backend the core's (`RobotsSystem.object_wrenches`: the same sums)."""
         core = self._core()
         if core is not None:
-            memories = [s.memory for s in self.contacts.sets]
-            return list(core.object_wrenches(q, v, self._memories(), memories))
+            return list(core.object_wrenches(q, v, *self._core_memories()))
         return self.object_wrenches_reference(q, v)
 
     def object_wrenches_reference(self, q: np.ndarray, v: np.ndarray) -> list[np.ndarray]:
@@ -386,6 +385,11 @@ class Robots:
         """``name/body|name/body`` (or ``name/body|object``) of every pair of robot
         ``robot`` (an index)."""
         return self.contacts.pair_names(robot)
+
+
+def _floats(taus) -> list[np.ndarray]:
+    """Each robot's input as a float array (what the core's calls take)."""
+    return [np.asarray(tau, dtype=float) for tau in taus]
 
 
 def _rigid_contacts(core_system: Any) -> tuple[list, list]:
