@@ -147,3 +147,18 @@ def test_tiles_go_back_to_image_order(reference_uvms, width, height):
     tiled = np.arange(width * height * 3, dtype=float).reshape(-1, 3)
     np.testing.assert_array_equal(camera._untile(tiled), tiled[np.argsort(camera.order)])
     np.testing.assert_array_equal(camera._untile(camera._tiled), camera.rays)
+
+
+def test_the_noise_of_a_uniform_target_has_the_given_deviation(reference_uvms):
+    """The rgb of a wall lit evenly: the noiseless counts plus N(0, noise_counts^2), rounded
+    (the rounding adds 1/12 count^2 of variance)."""
+    camera = _camera(reference_uvms, [_wall(2.0)], width=160, height=120, noise_counts=4.0,
+                     exposure=2.0)  # fmt: skip
+    frame = camera.render()
+    clean = np.rint(255.0 * 2.0 * frame.radiance)
+    # the channels of the wall's pixels far from the clipping at 0 and 255
+    kept = (frame.label == 1)[..., None] & (clean > 20) & (clean < 235)
+    assert kept.sum() > 20000
+    error = frame.rgb[kept].astype(float) - clean[kept]
+    assert abs(error.mean()) < 0.05
+    assert error.std() == pytest.approx(np.sqrt(16.0 + 1.0 / 12.0), rel=0.02)

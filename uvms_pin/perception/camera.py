@@ -7,7 +7,8 @@ y = (v + 1/2 - H/2) / f, f = (W/2) / tan(fov/2) (square pixels, ``horizontal_fov
 The depth image is the z-depth of the first surface met (range times the ray's z: ROS
 depth images), NaN where the ray meets nothing; the colour is the revised underwater image
 formation model (`uvms_pin.perception.optics`), scaled by ``exposure`` to 8 bits, with
-seeded Gaussian noise of ``noise_counts`` (8-bit counts, the run's seed).
+seeded Gaussian noise of ``noise_counts`` (8-bit counts, the run's seed; drawn by
+`uvms_pin.perception.image_noise`).
 """
 
 from __future__ import annotations
@@ -22,6 +23,7 @@ from uvms_pin.errors import ParameterError
 from uvms_pin.perception import sensor
 from uvms_pin.perception.caster import Bundles
 from uvms_pin.perception.compiled_camera import CompiledPixels
+from uvms_pin.perception.image_noise import standard_normal_f32
 from uvms_pin.perception.optics import Light, WaterOptics, backscatter, cone_of_cosine
 from uvms_pin.perception.scene import Scene
 
@@ -243,7 +245,7 @@ class Camera(sensor.Mounted):
         noise = None
         if spec.noise_counts > 0.0:
             out = None if buffers is None else buffers[-1]
-            noise = self.rng.standard_normal(radiance.shape, np.float32, out=out)
+            noise = standard_normal_f32(self.rng, radiance.shape, out=out)
         scale = 255.0 * spec.exposure
         if self._compiled is not None:
             rgb = self._compiled.eight_bit(radiance, scale, spec.noise_counts, noise)
