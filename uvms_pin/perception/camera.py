@@ -68,14 +68,8 @@ class CameraSpec:
     def __post_init__(self) -> None:
         label = f"camera '{self.name}'"
         sensor.check_mount(self, label)
-        for key in ("width", "height"):
-            value = getattr(self, key)
-            if not (isinstance(value, int) and 1 <= value <= 8192):
-                raise ParameterError(f"{label}: {key} must be an integer in [1, 8192], got {value}")
-        if not (0.0 < self.horizontal_fov_rad < math.pi):
-            raise ParameterError(
-                f"{label}: horizontal_fov_rad must be in (0, pi), got {self.horizontal_fov_rad}"
-            )
+        sensor.check_counts(self, label, {"width": 8192, "height": 8192})
+        sensor.check_fields_of_view(self, label, ("horizontal_fov_rad",))
         for key in ("exposure", "noise_counts"):
             value = getattr(self, key)
             if not (math.isfinite(value) and value >= 0.0):

@@ -23,6 +23,8 @@ __all__ = [
     "SENSORS",
     "Mounted",
     "PerceptionKind",
+    "check_counts",
+    "check_fields_of_view",
     "check_mount",
     "mount_frame",
     "register",
@@ -136,6 +138,26 @@ def check_mount(spec: Any, label: str) -> None:
         raise ParameterError(f"{label}: link must be a frame's name, got {spec.link!r}")
     if not (math.isfinite(spec.rate_hz) and spec.rate_hz > 0.0):
         raise ParameterError(f"{label}: rate_hz must be finite and > 0, got {spec.rate_hz}")
+
+
+def check_counts(spec: Any, label: str, most: Mapping[str, int]) -> None:
+    """ParameterError unless each field of ``spec`` named in ``most`` (pixels, beams, bins,
+    rays) is an integer from 1 to its entry there."""
+    for key, largest in most.items():
+        value = getattr(spec, key)
+        if not (isinstance(value, int) and 1 <= value <= largest):
+            raise ParameterError(
+                f"{label}: {key} must be an integer in [1, {largest}], got {value}"
+            )
+
+
+def check_fields_of_view(spec: Any, label: str, keys: tuple[str, ...]) -> None:
+    """ParameterError unless each field of ``spec`` named in ``keys`` is an angle in
+    (0, pi) [rad]."""
+    for key in keys:
+        value = getattr(spec, key)
+        if not (0.0 < value < math.pi):
+            raise ParameterError(f"{label}: {key} must be in (0, pi), got {value}")
 
 
 def mount_frame(model: pin.Model, link: str | None, label: str) -> int:

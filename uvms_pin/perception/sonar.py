@@ -72,17 +72,10 @@ class SonarSpec:
             raise ParameterError(
                 f"{label}: type must be one of {', '.join(TYPES)}, got {self.type!r}"
             )
-        for key, most in (("beams", 4096), ("bins", 8192), ("rays_per_beam", 1024)):
-            value = getattr(self, key)
-            if not (isinstance(value, int) and 1 <= value <= most):
-                raise ParameterError(
-                    f"{label}: {key} must be an integer in [1, {most}], got {value}"
-                )
+        sensor.check_counts(self, label, {"beams": 4096, "bins": 8192, "rays_per_beam": 1024})
         if self.type == "altimeter" and self.beams != 1:
             raise ParameterError(f"{label}: beams must be 1 for an altimeter, got {self.beams}")
-        for key in ("horizontal_fov_rad", "vertical_fov_rad"):
-            if not (0.0 < getattr(self, key) < math.pi):
-                raise ParameterError(f"{label}: {key} must be in (0, pi), got {getattr(self, key)}")
+        sensor.check_fields_of_view(self, label, ("horizontal_fov_rad", "vertical_fov_rad"))
         if not (0.0 <= self.min_range_m < self.max_range_m < math.inf):
             raise ParameterError(
                 f"{label}: needs 0 <= min_range_m < max_range_m (finite), got "

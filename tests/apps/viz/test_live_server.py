@@ -111,6 +111,46 @@ def test_a_live_run_gives_the_same_rollout_and_frees_the_port(tmp_path):
     assert port_is_free(port)
 
 
+def test_a_saved_run_is_replayed_one_frame_a_sample(monkeypatch):
+    """`replay_live` queues every sample of the rollout, in order, once a browser is there."""
+    from uvms_pin.apps.viz import live as live_module
+
+    class _View:
+        def __init__(self, scene, **options):
+            self.watched, self.error, self.frames, self.finished = True, None, [], False
+
+        def __enter__(self):
+            self.__class__.opened = self
+            return self
+
+        def __exit__(self, *exc) -> None:
+            pass
+
+        def push(self, frame: Frame) -> None:
+            self.frames.append(frame)
+
+        def lag_s(self) -> float:
+            return 0.0
+
+        def finish(self) -> None:
+            self.finished = True
+
+    paper = Path(__file__).resolve().parents[3] / "scenarios" / "paper_force_tracking.toml"
+    rollout = simulate(load_scenario(paper, {"scenario.duration_s": 0.1}))
+    monkeypatch.setattr(live_module, "LiveView", _View)
+    live_module.replay_live(rollout, scene=None, out=None)
+    view = _View.opened
+    assert view.finished and len(view.frames) == len(rollout)
+    desired = rollout.signals["force_desired_world_N"]
+    for k, frame in enumerate(view.frames):
+        assert frame.time_s == float(rollout.time_s[k])
+        np.testing.assert_array_equal(frame.q, rollout.q[k])
+        np.testing.assert_array_equal(
+            frame.force_measured_world_N, rollout.wrench_measured_world[k, :3]
+        )
+        np.testing.assert_array_equal(frame.force_desired_world_N, desired[k])
+
+
 def _assert_same(a: Rollout, b: Rollout) -> None:
     for name in Rollout._BASE:
         np.testing.assert_array_equal(getattr(a, name), getattr(b, name), err_msg=name)

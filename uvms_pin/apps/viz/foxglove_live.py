@@ -32,7 +32,7 @@ from uvms_pin.apps.export.ros_sample import (
     records_of,
 )
 from uvms_pin.apps.viz.live import LOOPBACK, port_is_free
-from uvms_pin.apps.viz.watched import play_to_end, simulate_watched, wait_for_watcher
+from uvms_pin.apps.viz.watched import play_saved, simulate_watched
 from uvms_pin.errors import LiveServerError, OptionalDependencyError, PortInUseError
 from uvms_pin.results.progress import Progress
 from uvms_pin.sim.log import run_metadata
@@ -350,7 +350,4 @@ def replay_foxglove(
     records = list(records_of(rollout))
     with FoxgloveLive(topics, port=port, speed=speed, out=out) as live:
         live.advertise(records[0])
-        wait_for_watcher(live, "a Foxglove client to subscribe", out)
-        for record in records:
-            live.push(record)
-        play_to_end(live, out)
+        play_saved(live, "a Foxglove client to subscribe", records, out)

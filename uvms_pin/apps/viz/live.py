@@ -22,6 +22,7 @@ import sys
 import tempfile
 import threading
 import time
+from collections.abc import Iterator
 from pathlib import Path
 from typing import TextIO
 
@@ -32,7 +33,7 @@ from meshcat.visualizer import ViewerWindow
 
 from uvms_pin.apps.viz.meshcat_scene import EnvironmentView, Frame, SceneStyle, UvmsScene
 from uvms_pin.apps.viz.surface import surface_view_of
-from uvms_pin.apps.viz.watched import play_to_end, simulate_watched, wait_for_watcher
+from uvms_pin.apps.viz.watched import play_saved, simulate_watched
 from uvms_pin.apps.viz.world_view import WorldView
 from uvms_pin.errors import LiveServerError, PortInUseError
 from uvms_pin.results.progress import Progress
@@ -441,22 +442,24 @@ def replay_live(
 ) -> None:
     """Play a saved rollout in a live view at ``speed`` x real time, once a browser is
     connected (it waits for one)."""
+    with LiveView(scene, port=port, speed=speed, out=out) as live:
+        play_saved(live, "a browser to connect", _frames_of(rollout), out)
+
+
+def _frames_of(rollout: Rollout) -> Iterator[Frame]:
+    """The frames of a saved rollout, one a sample (its time [s], q, measured force [N], and
+    the desired force, world contacts and free objects it recorded)."""
     desired = rollout.signals.get("force_desired_world_N")
     contacts = rollout.signals.get("world_contact")
     free = rollout.signals.get("free_objects")
     object_contact = rollout.signals.get("free_object_contact")
-    with LiveView(scene, port=port, speed=speed, out=out) as live:
-        wait_for_watcher(live, "a browser to connect", out)
-        for k in range(len(rollout)):
-            live.push(
-                Frame(
-                    float(rollout.time_s[k]),
-                    rollout.q[k],
-                    rollout.wrench_measured_world[k, :3],
-                    None if desired is None else desired[k],
-                    None if contacts is None else contacts[k],
-                    None if free is None else free[k],
-                    None if object_contact is None else object_contact[k],
-                )
-            )
-        play_to_end(live, out)
+    for k in range(len(rollout)):
+        yield Frame(
+            float(rollout.time_s[k]),
+            rollout.q[k],
+            rollout.wrench_measured_world[k, :3],
+            None if desired is None else desired[k],
+            None if contacts is None else contacts[k],
+            None if free is None else free[k],
+            None if object_contact is None else object_contact[k],
+        )

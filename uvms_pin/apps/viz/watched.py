@@ -1,13 +1,14 @@
 """What a live view (the meshcat page, `uvms_pin.apps.viz.live`; the Foxglove server,
 `uvms_pin.apps.viz.foxglove_live`) shares with its runner: a run simulated while the view is
-fed, the wait for a watcher before a saved run is played, and the end of a run played out.
+fed, a saved run played (after the wait for a watcher), and the end of a run played out.
 """
 
 from __future__ import annotations
 
 import sys
 import time
-from typing import Protocol, TextIO
+from collections.abc import Iterable
+from typing import Any, Protocol, TextIO
 
 from uvms_pin.errors import LiveServerError, SimulationError
 from uvms_pin.results.progress import Progress
@@ -15,7 +16,7 @@ from uvms_pin.results.rollout import Rollout
 from uvms_pin.sim.run import Scenario, simulate
 from uvms_pin.sim.sample import Observer
 
-__all__ = ["Watched", "play_to_end", "simulate_watched", "wait_for_watcher"]
+__all__ = ["Watched", "play_saved", "play_to_end", "simulate_watched", "wait_for_watcher"]
 
 
 class Watched(Protocol):
@@ -23,6 +24,8 @@ class Watched(Protocol):
 
     watched: bool
     error: BaseException | None
+
+    def push(self, frame: Any) -> None: ...
 
     def lag_s(self) -> float: ...
 
@@ -58,6 +61,15 @@ def wait_for_watcher(view: Watched, what: str, out: TextIO | None) -> None:
         if view.error is not None:
             raise LiveServerError(f"live view failed: {view.error}")
         time.sleep(0.1)
+
+
+def play_saved(view: Watched, what: str, frames: Iterable[Any], out: TextIO | None) -> None:
+    """Play a saved run's ``frames`` (each as ``view.push`` takes it) in ``view``: wait for a
+    watcher (`wait_for_watcher`, "waiting for ``what``"), queue them all, play them out."""
+    wait_for_watcher(view, what, out)
+    for frame in frames:
+        view.push(frame)
+    play_to_end(view, out)
 
 
 def play_to_end(view: Watched, out: TextIO | None) -> None:
