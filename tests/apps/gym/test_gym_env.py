@@ -13,7 +13,7 @@ from conftest import ROOT
 from gymnasium.utils.env_checker import check_env
 
 import uvms_pin.apps.gym  # noqa: F401 - registers the environments
-from uvms_pin.errors import ParameterError
+from uvms_pin.errors import ParameterError, ScenarioError
 
 FORCE = "uvms_pin/ForceTracking-v0"
 STATION = "uvms_pin/StationKeeping-v0"
@@ -285,6 +285,16 @@ def test_any_scenario_or_model():
     lbv = _make(FORCE, model=str(urdf)).unwrapped
     assert lbv.scenario.uvms.source == str(urdf.resolve()) or lbv.scenario.uvms.source == str(urdf)
     assert lbv.observation_space.shape == (30,)
+
+
+def test_a_model_the_scenarios_joints_do_not_fit_says_how_to_make_them_fit():
+    """The shipped station-keeping scenario's arm start is the LBV150 arm's; the Alpha 5
+    refuses it (a limit), naming the key and the override that fixes it, which then works."""
+    with pytest.raises(ScenarioError, match=r"alpha_axis_c.*overrides=\{'initial\.joint_"):
+        _make(STATION, model="uvms_bluerov2_alpha5")
+    env = _make(STATION, model="uvms_bluerov2_alpha5",
+                overrides={"initial.joint_positions_rad": [-0.2, 0.8, 2.2, 0.2]})  # fmt: skip
+    assert env.action_space.shape == (10,)
 
 
 POSE = "uvms_pin/PoseTracking-v0"

@@ -26,7 +26,7 @@ import pinocchio as pin
 
 from uvms_pin.apps.gym.actions import action_scale as make_action_scale
 from uvms_pin.control.measurement import Measurement
-from uvms_pin.errors import ParameterError, SimulationError
+from uvms_pin.errors import ParameterError, ScenarioError, SimulationError
 from uvms_pin.model.resources import shipped_path
 from uvms_pin.results.rollout import Rollout
 from uvms_pin.results.status import OK, RunStatus
@@ -62,6 +62,22 @@ def _shortened_record(scenario: Scenario) -> dict[str, Any]:
     if scenario.shortened_from_s is None:
         return {}
     return {"shortened_from_s": scenario.shortened_from_s}
+
+
+def _load_with_model(path: Path, overrides: dict[str, Any], model: str | None) -> Scenario:
+    """The scenario at ``path`` with ``overrides``; when ``model`` replaced its model and
+    the rest of the file does not fit the new one, the error says how to make it fit."""
+    try:
+        return load_scenario(path, overrides)
+    except ScenarioError as exc:
+        if model is None:
+            raise
+        raise ScenarioError(
+            f"{exc}. model={model!r} replaces only the scenario's model; its other tables "
+            "were written for the model it names: give the keys that do not fit as "
+            "overrides (e.g. overrides={'initial.joint_positions_rad': [...]}, one number per "
+            "joint of the new model, within its limits), or pass a scenario written for it"
+        ) from None
 
 
 def _episode_seed(np_random: np.random.Generator) -> int:
@@ -125,7 +141,7 @@ class UvmsEnv(gym.Env):
         self.overrides = dict(overrides or {})
         if model is not None:
             self.overrides["scenario.model"] = model
-        self.scenario = load_scenario(self.scenario_path, self.overrides)
+        self.scenario = _load_with_model(self.scenario_path, self.overrides, model)
         if self.scenario.settings.control_period_s is None:
             raise ParameterError(_continuous_control_message(self.scenario, action_scale))
         self._loop = ClosedLoop(self.scenario.plant, self.scenario.settings)
