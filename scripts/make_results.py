@@ -47,6 +47,7 @@ PRODUCERS = {
     "bench_perception": "cameras, sonars and the DVL's beams on one core: docs/results/bench_perception.md",
     "seabed_survey": "a survey with a multibeam, a sonar, a camera and a beam-cast DVL: docs/results/seabed_survey.md, docs/seabed_survey.png",
     "cooperative_transport": "two UVMS carry a bar without communication: docs/results/cooperative_transport.md, docs/cooperative_transport.png",
+    "study_cooperative_share": "study summary: docs/results/study_cooperative_share.md",
     "stability": "passive models for 60 s and random actions in the environments: docs/results/stability.md",
 }
 

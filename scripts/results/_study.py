@@ -4,11 +4,17 @@ from __future__ import annotations
 
 import re
 import time
+from collections.abc import Callable
 
+import pandas as pd
 from _common import scratch, uvms_pin, write_result
 
 
-def produce(name: str, study: str, title: str) -> None:
+def produce(
+    name: str, study: str, title: str, runs: Callable[[pd.DataFrame], str] | None = None
+) -> None:
+    """Sweep ``study`` into out/results/<name>/, report it, write its summary; ``runs``: a
+    Markdown section made from the results table (one row a run), appended after it."""
     out = scratch(name)
     start = time.perf_counter()
     uvms_pin("sweep", study, "--out", str(out), "--workers", "2", "--quiet")
@@ -24,4 +30,6 @@ def produce(name: str, study: str, title: str) -> None:
         f"`uvms-pin report out/results/{name}` (figures there). The sweep command took "
         f"{sweep_s:.1f} s of wall time (start-up, runs on 2 workers, table).\n\n{report}"
     )
+    if runs is not None:
+        body = body.rstrip() + "\n\n" + runs(pd.read_parquet(out / "results.parquet"))
     write_result(name, title, f"python scripts/results/{name}.py", body)

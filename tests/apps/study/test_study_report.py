@@ -9,7 +9,7 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from uvms_pin.apps.study.report import write_report
+from uvms_pin.apps.study.report import STUDY_COPY, write_report
 from uvms_pin.apps.study.runner import RESULTS_FILE
 from uvms_pin.apps.study.spec import column_name
 from uvms_pin.apps.study.statistics import exclude_unfinished_transients
@@ -71,3 +71,37 @@ def test_scaled_and_added_parameters_are_named_for_what_they_hold():
         "initial.joint_positions_rad[1] [+ base]"
     )
     assert column_name("environment.stiffness_N_m") == "environment.stiffness_N_m"
+
+
+def test_a_robots_metrics_get_figures_too(tmp_path):
+    """A several-robots study's metrics are named "robot/metric": each still gets its
+    scatter and box figures (in figures/, its name made a file name), and the report its
+    summary rows and the run outcome."""
+    share = "robots[1].controller.load_share"
+    table = pd.DataFrame(
+        {
+            "run_id": ["a", "b", "c"],
+            "run_index": [0, 1, 2],
+            "status": ["ok"] * 3,
+            "error": [""] * 3,
+            "violation_level": [""] * 3,
+            "violation_component": [""] * 3,
+            "violation_time_s": [math.nan] * 3,
+            "run_wall_time_s": [1.0] * 3,
+            share: [0.3, 0.5, 0.7],
+            "alpha/bar_final_distance_m": [0.4, 0.001, 0.9],
+        }
+    )
+    table.to_parquet(tmp_path / RESULTS_FILE)
+    (tmp_path / STUDY_COPY).write_text(
+        '[study]\nname = "s"\nbase = "x.toml"\nseed = 1\n\n'
+        f'[[parameter]]\npath = "{share}"\nvalues = [0.3, 0.5, 0.7]\n\n'
+        '[report]\nmetrics = ["alpha/bar_final_distance_m"]\n'
+    )
+    report, *figures = write_report(tmp_path)
+    names = {path.name for path in figures}
+    assert {"scatter_alpha_bar_final_distance_m.png", "box_alpha_bar_final_distance_m.png"} <= names
+    assert all(path.is_file() and path.parent == tmp_path / "figures" for path in figures)
+    text = report.read_text()
+    assert "| alpha/bar_final_distance_m | all (3)" in text
+    assert "Status ok (the run reached its end" in text and "**3 of 3 runs" in text

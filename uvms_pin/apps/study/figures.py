@@ -79,9 +79,11 @@ def write_figures(
     if params:
         for metric in metrics:
             figures.append(
-                scatter_figure(table, params, metric, figures_dir / f"scatter_{metric}.png")
+                scatter_figure(table, params, metric, figures_dir / f"scatter_{_slug(metric)}.png")
             )
-            figures.append(box_figure(table, params, metric, figures_dir / f"box_{metric}.png"))
+            figures.append(
+                box_figure(table, params, metric, figures_dir / f"box_{_slug(metric)}.png")
+            )
         figures.append(violation_rate_figure(table, params, figures_dir / "violation_rate.png"))
         by_path = {p["path"]: p for p in params}
         for a, b in heatmap_pairs(table, params, options):

@@ -1,8 +1,8 @@
 """The study report's Markdown (``report.md``), one function per section.
 
-Sections: the header (study, base scenario, runs), the outcome (share of runs whose
-funnels held, with its Wilson interval; where and when the funnels broke; the first
-errors), the parameters (rank correlations, failure rate per bin), the heatmaps, the
+Sections: the header (study, base scenario, runs), the outcome (the share of runs ok, run
+to their end with every funnel held, and its Wilson interval; where and when the funnels
+broke; the first errors), the parameters (rank correlations, failure rate per bin), the heatmaps, the
 metrics and the figures. Numbers come from `statistics`; this module only writes them.
 """
 
@@ -102,7 +102,8 @@ def _outcome(table: pd.DataFrame) -> list[str]:
     return [
         "## Outcome",
         "",
-        f"The funnels held (status ok) in **{ok} of {n} runs ({ok / n:.1%}; 95 % CI "
+        f"Status ok (the run reached its end; under a prescribed-performance controller, "
+        f"with every funnel held) in **{ok} of {n} runs ({ok / n:.1%}; 95 % CI "
         f"{lo:.1%} - {hi:.1%})**.",
         "",
         md_table(pd.DataFrame(status_rows(table))),

@@ -1,0 +1,46 @@
+"""The cooperative_share study (9 runs of the 24 s cooperative transport: the follower's
+load share x the bar's density): its report's summary and every run's transport metrics."""
+
+import pandas as pd
+from _common import producer_cli
+from _study import produce
+
+SHARE = "robots[1].controller.load_share"
+DENSITY = "world.objects[0].density_kg_m3"
+WATER_KG_M3 = 1025.0  # the scenario's water
+BAR_VOLUME_M3 = 3.141592653589793 * 0.025**2 * 1.0  # its bar: radius 25 mm, 1 m long
+COLUMNS = {
+    "alpha/bar_delivered": "delivered (within 5 cm)",
+    "alpha/bar_final_distance_m": "bar's final distance to the path's end [m]",
+    "bar/final_z_m": "bar's final z [m]",
+    "alpha/bar_tracking_error_rms_m": "bar's tracking error, rms [m]",
+    "bravo/funnel_kept": "follower's estimate in its funnel",
+    "bravo/estimate_xi_max": "follower's largest abs(xi)",
+    "bar/max_speed_m_s": "bar's top speed [m/s]",
+}
+
+
+def runs(table: pd.DataFrame) -> str:
+    """Every run: its share, its bar's net weight and what the transport did."""
+    rows = table.sort_values([SHARE, DENSITY])
+    out = pd.DataFrame(
+        {
+            "follower's share c_f (c_l = 0.5)": rows[SHARE],
+            "bar density [kg/m^3]": rows[DENSITY],
+            "net weight [N] (believed 3.37)": (rows[DENSITY] - WATER_KG_M3) * BAR_VOLUME_M3 * 9.81,
+            **{label: rows[column] for column, label in COLUMNS.items()},
+        }
+    )
+    header = "| " + " | ".join(out.columns) + " |\n|" + "---|" * len(out.columns)
+    lines = ["| " + " | ".join(f"{v:.3g}" for v in row) + " |" for row in out.to_numpy()]
+    return "## Every run\n\n" + header + "\n" + "\n".join(lines) + "\n"
+
+
+if __name__ == "__main__":
+    producer_cli(__doc__)
+    produce(
+        "study_cooperative_share",
+        "studies/cooperative_share.toml",
+        "Study: the cooperative transport when the team's load share or the bar's weight is wrong",
+        runs,
+    )
