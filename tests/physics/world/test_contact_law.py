@@ -83,12 +83,14 @@ def test_a_sticking_point_gets_the_tangential_spring_and_damper_force():
     assert np.linalg.norm(expected) < LAW.friction_static * 100.0  # the case is inside the cone
 
 
-def test_a_slipping_patch_gets_kinetic_friction_along_its_trial_force():
+@pytest.mark.parametrize("scale", [1.0, 1e-4])
+def test_a_slipping_patch_gets_kinetic_friction_along_its_trial_force(scale):
     """Outside the cone (|sum f_trial| > mu_s sum f_n) the patch slips: its friction is
     mu_k sum f_n, along sum f_trial (opposing the stretch), spread over its points in
-    proportion to their trial forces."""
-    normal = np.array([10.0, 30.0])
-    slip = np.array([[1e-2, 0.0, 0.0], [5e-3, 5e-3, 0.0]])  # k_t s >> mu_s f_n
+    proportion to their trial forces; at any scale of the forces (also below 1 N: a light
+    touch)."""
+    normal = np.array([10.0, 30.0]) * scale
+    slip = np.array([[1e-2, 0.0, 0.0], [5e-3, 5e-3, 0.0]]) * scale  # k_t s >> mu_s f_n
     velocity = np.zeros((2, 3))
     force, stick = _friction(normal, slip, velocity, [7, 7], LAW.friction_static)
     trial = -LAW.tangential_stiffness_N_m * slip
