@@ -382,3 +382,21 @@ def test_derivatives_follow_the_current_of_each_call(reference_uvms):
         assert not np.allclose(first[k], second[k], rtol=1e-6, atol=0.0)
         np.testing.assert_allclose(second[k], fresh[k], rtol=1e-12, atol=1e-12)
         np.testing.assert_array_equal(again[k], first[k])
+
+
+def test_a_frame_wrench_does_the_virtual_power_of_its_frame_twist(reference_uvms):
+    """tau_ext = J^T w: its power on any zeta equals the wrench's power on the frame's
+    twist, zeta . tau_ext = w . [v_frame; omega_frame] (world-aligned axes at the frame
+    origin), for the end-effector and the vehicle's base frame."""
+    uvms = reference_uvms
+    model, data = uvms.model, uvms.model.createData()
+    rng = np.random.default_rng(12)
+    for frame in (uvms.ee_frame_id, model.getFrameId(model.frames[2].name)):
+        q = random_configuration(uvms, rng)
+        v = rng.normal(size=uvms.nv)
+        wrench = rng.normal(size=6)
+        tau_ext = up.frame_wrench_to_generalized(uvms, q, frame, wrench)
+        pin.forwardKinematics(model, data, q, v)
+        pin.updateFramePlacements(model, data)
+        twist = pin.getFrameVelocity(model, data, frame, pin.LOCAL_WORLD_ALIGNED).vector
+        assert v @ tau_ext == pytest.approx(wrench @ twist, rel=1e-12, abs=1e-12)
