@@ -211,6 +211,25 @@ def test_power_law_current_is_the_one_seventh_law_by_default():
             DepthProfileCurrent([1.0, 0, 0], depths, factors)
 
 
+def test_depth_profile_gradient_is_the_vertical_derivative_of_the_velocity():
+    """grad u [:, 2] = d u / dz by central differences (h = 1e-4 m, exact on a linear piece)
+    inside each piece of a 4-piece table, zero above the first and below the last tabulated
+    depth (constant there); the flow is horizontal, so only that column is non-zero."""
+    profile = DepthProfileCurrent(
+        [0.6, -0.3, 0.0], depths_m=[1.0, 4.0, 6.0, 12.0, 20.0], factors=[1.0, 0.7, 0.9, 0.4, 0.1]
+    )
+    h = 1e-4
+    for depth in (0.5, 2.0, 5.0, 7.5, 15.0, 25.0):
+        point = np.array([[1.0, 2.0, -depth]])
+        step = np.array([0.0, 0.0, h])
+        fd = (profile.velocity(0.0, point + step) - profile.velocity(0.0, point - step))[0] / (
+            2 * h
+        )
+        grad = profile.velocity_gradient(0.0, point)[0]
+        np.testing.assert_allclose(grad[:, 2], fd, atol=1e-9)
+        np.testing.assert_array_equal(grad[:, :2], np.zeros((3, 2)))
+
+
 @pytest.mark.parametrize("n", [0, 2001, 10_000_000, 2.5, True])
 def test_a_sea_has_a_bounded_number_of_components(n):
     """Refused before anything is drawn: 1e7 components took GBs and minutes (deaf to Ctrl-C)."""
