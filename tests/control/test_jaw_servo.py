@@ -5,6 +5,7 @@ from __future__ import annotations
 from pathlib import Path
 
 import numpy as np
+import pinocchio as pin
 import pytest
 
 import uvms_pin as up
@@ -105,3 +106,52 @@ def test_a_sampled_servo_is_softened_for_light_fingers(uvms, servo):
     np.testing.assert_allclose(sampled.damping * 0.002 / inertia, 1.0, rtol=1e-12)
     fast = JawServo.for_model(uvms.model, jaw, 10.0, JawSchedule(), period_s=1e-4)
     np.testing.assert_array_equal(fast.stiffness, servo.stiffness)  # no cap needed
+
+
+def test_servo_damping_opposes_the_fingers_velocity_critically(uvms, servo):
+    """In the linear range the law is tau = k (q* - q) - d v: its velocity part is -d v, with
+    d = 2 sqrt(k I) (critical damping of the finger's inertia I about its joint, from CRBA at
+    the closed position, armature included)."""
+    jaw = JawJoints.of(uvms.model)
+    q = jaw.lower + np.array([0.001, 0.002])  # near the closed target, far from saturation
+    v = np.array([0.05, -0.03])
+    at_rest = servo.torque(2.0, q, np.zeros(2))
+    moving = servo.torque(2.0, q, v)
+    assert np.all(np.abs(moving) < servo.max_force_N * servo.lever_m)  # unsaturated
+    np.testing.assert_allclose(moving - at_rest, -servo.damping * v, rtol=1e-12)
+    q_closed = uvms.neutral_configuration()
+    q_closed[jaw.q_index] = jaw.lower
+    mass = pin.crba(uvms.model, uvms.model.createData(), q_closed)
+    inertia = np.array([mass[i, i] for i in jaw.v_index]) + uvms.model.armature[jaw.v_index]
+    np.testing.assert_allclose(servo.damping, 2.0 * np.sqrt(servo.stiffness * inertia), rtol=1e-12)
+
+
+def test_lever_ignores_the_centre_of_mass_offset_along_the_joint_axis(uvms):
+    """r = |c - (c . a) a|: the finger's centre of mass slid along the joint axis a keeps its
+    distance from the axis, hence its lever (the grip force F_max r)."""
+    model = pin.Model(uvms.model)
+    jaw = JawJoints.of(model)
+    before = JawServo.for_model(model, jaw, 10.0, JawSchedule()).lever_m
+    for j in jaw.joint_ids:
+        joint_data = model.joints[j].createData()
+        model.joints[j].calc(joint_data, pin.neutral(model))
+        axis = np.array(joint_data.S).reshape(-1)[3:]  # the revolute axis, joint frame
+        inertia = model.inertias[j]
+        model.inertias[j] = pin.Inertia(inertia.mass, inertia.lever + 0.03 * axis, inertia.inertia)
+    after = JawServo.for_model(model, jaw, 10.0, JawSchedule()).lever_m
+    # 1e-9: the unaligned joint's axis and the 3 cm slide are rounded (the slide alone would
+    # change the lever by 20 %)
+    np.testing.assert_allclose(after, before, rtol=1e-9)
+
+
+def test_a_prismatic_finger_s_servo_pushes_with_the_grip_force_itself(tmp_path):
+    """A prismatic finger's tau is its force [N]: its lever is 1, and blocked while closing
+    the servo presses with exactly -F_max."""
+    from jaw_helpers import parallel_jaw_urdf
+
+    model = up.load_uvms(parallel_jaw_urdf(tmp_path)).model
+    jaw = JawJoints.of(model)
+    servo = JawServo.for_model(model, jaw, 7.0, JawSchedule(0.0))
+    np.testing.assert_array_equal(servo.lever_m, [1.0, 1.0])
+    blocked = servo.torque(1.0, jaw.upper * 0.5, np.zeros(2))
+    np.testing.assert_allclose(blocked, [-7.0, -7.0], rtol=1e-15)

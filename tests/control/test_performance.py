@@ -11,11 +11,13 @@ import pytest
 
 from uvms_pin.control.performance import (
     PerformanceFunction,
+    barrier_extended,
     check_funnel,
     max_abs,
     normalized_error,
     transformation_gain,
     transformed_error,
+    transformed_error_extended,
 )
 from uvms_pin.errors import FunnelViolation, ParameterError
 
@@ -178,3 +180,49 @@ def test_max_abs_and_nan_anywhere():
         values[position] = np.nan
         assert np.isnan(max_abs(values))
         assert not max_abs(values) < 1.0
+
+
+CLAMP = 0.9  # the extension's clamp here (the controller's is 1 - 1e-6)
+
+
+@pytest.mark.parametrize("xi", [0.0, 0.3, -0.55, 0.9, -0.9])
+def test_funnel_extension_is_eps_and_r_eps_inside_the_clamp(xi):
+    """For |xi| <= clamp the extended transformation is eps(xi) and the extended barrier
+    is r(xi) eps(xi) (the law's P^-1 r eps): the extension changes nothing inside."""
+    eps = transformed_error(xi)
+    assert transformed_error_extended(xi, CLAMP) == pytest.approx(eps, rel=1e-14, abs=1e-15)
+    assert barrier_extended(xi, CLAMP) == pytest.approx(
+        transformation_gain(xi) * eps, rel=1e-14, abs=1e-15
+    )
+
+
+@pytest.mark.parametrize("sign", [1.0, -1.0])
+def test_funnel_extension_continues_linearly_with_the_clamp_slope(sign):
+    """Beyond the clamp both are continued by their tangent at the clamp: eps by slope
+    r(c) = 2 / (1 - c^2), r eps by b'(c) = 4 c eps / (1 - c^2)^2 + r^2 (the derivative of
+    r eps, checked here by its central difference, h = 1e-6, 1e-6 relative); both are
+    odd and keep growing outside (an implicit stage finds no rest beyond the funnel)."""
+    c, h = CLAMP, 1e-6
+    beyond = sign * np.array([c + 0.01, c + 0.5, c + 3.0])
+    eps_c = transformed_error(sign * c)
+    slope_eps = transformation_gain(c)
+    np.testing.assert_allclose(
+        transformed_error_extended(beyond, c), eps_c + slope_eps * (beyond - sign * c), rtol=1e-14
+    )
+
+    def barrier(x):
+        return transformation_gain(x) * transformed_error(x)
+
+    slope_barrier = (barrier(c + h) - barrier(c - h)) / (2 * h)  # r eps is smooth on (-1, 1)
+    np.testing.assert_allclose(
+        barrier_extended(beyond, c),
+        barrier(sign * c) + slope_barrier * (beyond - sign * c),
+        rtol=1e-6,
+    )
+    # C1 at the clamp: one-sided slopes agree
+    right = (barrier_extended(sign * (c + h), c) - barrier_extended(sign * c, c)) / (sign * h)
+    assert right == pytest.approx(slope_barrier, rel=1e-4)
+    for f in (transformed_error_extended, barrier_extended):
+        values = f(beyond, c)
+        assert np.all(sign * np.diff(values) > 0.0)  # growing outward
+        np.testing.assert_allclose(f(-beyond, c), -values, rtol=1e-14)  # odd

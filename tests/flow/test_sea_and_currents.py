@@ -137,6 +137,22 @@ def test_gauss_markov_current_is_seeded_bounded_smooth_and_order_independent():
         gm.velocity(-1.0, [0, 0, 0])
 
 
+def test_gauss_markov_innovations_are_small_kicks_across_its_drawing_chunks():
+    """On its grid the deviation d = v - V_mean is AR(1): d_k+1 - rho d_k is a kick
+    sigma sqrt(1 - rho^2) w_k with w_k standard normal, also where the process draws a new
+    chunk of samples (every 1024): over 3 x 3000 samples no innovation reaches 6 kicks
+    (a normal maximum there is ~4.3). A mean of 10 sigma makes any confusion of v and d at a
+    chunk's start a jump of many kicks."""
+    sigma, time_constant_s, dt, n = 0.1, 2.0, 0.5, 3000
+    mean = np.array([1.0, -1.0, 0.5])
+    gm = GaussMarkovCurrent(mean, sigma, time_constant_s, 6.0 * sigma, seed=5, sample_period_s=dt)
+    deviation = np.array([gm.velocity(k * dt, [0, 0, 0])[0] for k in range(n)]) - mean
+    rho = math.exp(-dt / time_constant_s)
+    kicks = (deviation[1:] - rho * deviation[:-1]) / (sigma * math.sqrt(1.0 - rho**2))
+    assert np.abs(kicks).max() < 6.0
+    assert np.std(kicks) == pytest.approx(1.0, abs=0.05)
+
+
 def test_gauss_markov_current_has_its_stationary_statistics():
     """Sampled on its grid (dt = 0.5 s) the process is AR(1): deviations of mean 0, standard
     deviation sigma, lag-one correlation rho = exp(-dt / T), per component. With the bound
@@ -174,6 +190,44 @@ def test_depth_profile_current():
     assert law.velocity(0.0, [[0, 0, -20.0]])[0, 0] == pytest.approx(0.0)
     with pytest.raises(ParameterError, match="increasing"):
         DepthProfileCurrent([1, 0, 0], [0.0, 0.0], [1, 1])
+
+
+def test_power_law_current_is_the_one_seventh_law_by_default():
+    """u(depth) = U ((d - depth) / d)^(1/7) (the tidal-current law, its default exponent):
+    at half the seabed depth 0.5^(1/7) = 0.906 U, within the tabulation's linear error
+    (64 samples); another exponent is followed too; a seabed at or above the surface, a
+    non-finite depth or factor are refused."""
+    law = DepthProfileCurrent.power_law([1.0, 0.0, 0.0], seabed_depth_m=20.0)
+    for depth in (5.0, 10.0, 15.0):
+        expected = ((20.0 - depth) / 20.0) ** (1.0 / 7.0)
+        assert law.velocity(0.0, [[0, 0, -depth]])[0, 0] == pytest.approx(expected, abs=2e-3)
+    square_root = DepthProfileCurrent.power_law([1.0, 0, 0], seabed_depth_m=20.0, exponent=0.5)
+    assert square_root.velocity(0.0, [[0, 0, -10.0]])[0, 0] == pytest.approx(0.5**0.5, abs=2e-3)
+    for seabed in (0.0, -5.0):
+        with pytest.raises(ParameterError, match="seabed_depth_m must be positive"):
+            DepthProfileCurrent.power_law([1.0, 0, 0], seabed_depth_m=seabed)
+    for depths, factors in (([0.0, np.nan], [1.0, 0.5]), ([0.0, 10.0], [1.0, np.inf])):
+        with pytest.raises(ParameterError, match="must be finite"):
+            DepthProfileCurrent([1.0, 0, 0], depths, factors)
+
+
+def test_depth_profile_gradient_is_the_vertical_derivative_of_the_velocity():
+    """grad u [:, 2] = d u / dz by central differences (h = 1e-4 m, exact on a linear piece)
+    inside each piece of a 4-piece table, zero above the first and below the last tabulated
+    depth (constant there); the flow is horizontal, so only that column is non-zero."""
+    profile = DepthProfileCurrent(
+        [0.6, -0.3, 0.0], depths_m=[1.0, 4.0, 6.0, 12.0, 20.0], factors=[1.0, 0.7, 0.9, 0.4, 0.1]
+    )
+    h = 1e-4
+    for depth in (0.5, 2.0, 5.0, 7.5, 15.0, 25.0):
+        point = np.array([[1.0, 2.0, -depth]])
+        step = np.array([0.0, 0.0, h])
+        fd = (profile.velocity(0.0, point + step) - profile.velocity(0.0, point - step))[0] / (
+            2 * h
+        )
+        grad = profile.velocity_gradient(0.0, point)[0]
+        np.testing.assert_allclose(grad[:, 2], fd, atol=1e-9)
+        np.testing.assert_array_equal(grad[:, :2], np.zeros((3, 2)))
 
 
 @pytest.mark.parametrize("n", [0, 2001, 10_000_000, 2.5, True])

@@ -14,11 +14,20 @@ import pinocchio as pin
 import pytest
 
 from uvms_pin.errors import ParameterError
-from uvms_pin.hydro.added_mass import added_mass_in_parent, kirchhoff_wrench
+from uvms_pin.hydro.added_mass import (
+    added_mass_in_parent,
+    kirchhoff_jacobian,
+    kirchhoff_wrench,
+)
 from uvms_pin.hydro.current import current_acceleration_body, current_velocity_body
 from uvms_pin.hydro.damping import damping_wrench
 from uvms_pin.hydro.params import HydroParams
-from uvms_pin.hydro.restoring import buoyancy_potential_energy, buoyancy_wrench
+from uvms_pin.hydro.restoring import (
+    buoyancy_potential_energy,
+    buoyancy_wrench,
+    froude_krylov_wrench,
+    point_force_jacobians,
+)
 
 RHO = 1025.0
 GRAVITY = np.array([0.0, 0.0, -9.81])
@@ -117,6 +126,32 @@ def test_added_mass_in_parent_keeps_kirchhoff_covariant():
         np.testing.assert_allclose(in_parent, in_child, atol=1e-11 * np.abs(in_child).max())
 
 
+def test_kirchhoff_jacobian_is_the_derivative_of_the_wrench_for_one_body_and_a_stack():
+    """d(C_A(nu) nu)/d nu by central differences. The wrench is quadratic in nu, so the
+    central difference (w(nu + h e_k) - w(nu - h e_k)) / 2h is exact up to rounding (h = 1e-3,
+    1e-10 relative). A stack of bodies (k, 6, 6), (k, 6) gives each body's Jacobian."""
+    rng = _rng(11)
+    k, h = 4, 1e-3
+    added = np.array([_random_psd(rng) for _ in range(k)])
+    nu = rng.normal(size=(k, 6))
+    stacked = kirchhoff_jacobian(added, nu)
+    assert stacked.shape == (k, 6, 6)
+    for b in range(k):
+        fd = np.column_stack(
+            [
+                (
+                    kirchhoff_wrench(added[b], nu[b] + h * e)
+                    - kirchhoff_wrench(added[b], nu[b] - h * e)
+                )
+                / (2 * h)
+                for e in np.eye(6)
+            ]
+        )
+        scale = np.abs(fd).max()
+        np.testing.assert_allclose(kirchhoff_jacobian(added[b], nu[b]), fd, atol=1e-10 * scale)
+        np.testing.assert_allclose(stacked[b], fd, atol=1e-10 * scale)
+
+
 # ---- damping ----------------------------------------------------------------------------
 
 
@@ -195,6 +230,74 @@ def test_buoyancy_moment_is_minus_gradient_of_potential():
                 energy(rotation @ pin.exp3(delta)) - energy(rotation @ pin.exp3(-delta))
             ) / (2 * h)
             assert d_energy == pytest.approx(-moment[k], abs=1e-6 * RHO * volume * 9.81 * 0.1)
+
+
+def test_froude_krylov_is_rho_v_times_flow_acceleration_at_the_centre_of_buoyancy():
+    """The pressure of an accelerating flow pushes the displaced volume with rho V Du/Dt
+    (world) at the centre of buoyancy: R f = rho V a and the moment is r_b x f, for one body
+    and for a stack; with a = -g it is the buoyancy wrench (both are rho V (Du/Dt - g))."""
+    rng = _rng(32)
+    volume = 0.02
+    rotations = np.array([_random_rotation(rng) for _ in range(5)])
+    cobs = rng.normal(size=(5, 3)) * 0.1
+    accelerations = rng.normal(size=(5, 3))
+    stacked = froude_krylov_wrench(np.full(5, volume), cobs, rotations, RHO, accelerations)
+    for b in range(5):
+        wrench = froude_krylov_wrench(volume, cobs[b], rotations[b], RHO, accelerations[b])
+        scale = RHO * volume * np.linalg.norm(accelerations[b])
+        np.testing.assert_allclose(
+            rotations[b] @ wrench[:3], RHO * volume * accelerations[b], atol=1e-12 * scale
+        )
+        np.testing.assert_allclose(wrench[3:], np.cross(cobs[b], wrench[:3]), atol=1e-12 * scale)
+        np.testing.assert_allclose(stacked[b], wrench, atol=1e-12 * scale)
+    np.testing.assert_allclose(
+        froude_krylov_wrench(volume, cobs[0], rotations[0], RHO, -GRAVITY),
+        buoyancy_wrench(volume, cobs[0], rotations[0], RHO, GRAVITY),
+        atol=1e-12 * RHO * volume * 9.81,
+    )
+
+
+def test_point_force_jacobians_are_derivatives_for_one_body_and_a_stack():
+    """w(R, F) = [R^T F; r x R^T F]: d/d theta under R -> R exp([theta]x) by central
+    differences (h = 1e-6, error O(h^2) ~ 1e-12) and d/dF (w is linear in F: exact), for
+    one body and for each body of a stack (k, 3), (k, 3, 3)."""
+    rng = _rng(33)
+    k, h = 4, 1e-6
+    rotations = np.array([_random_rotation(rng) for _ in range(k)])
+    points = rng.normal(size=(k, 3))
+    forces = rng.normal(size=(k, 3)) * 10.0
+
+    def wrench(rotation, point, force):
+        f = rotation.T @ force
+        return np.r_[f, np.cross(point, f)]
+
+    forces_body = np.einsum("kji,kj->ki", rotations, forces)
+    by_rotation_stack, by_force_stack = point_force_jacobians(forces_body, points, rotations)
+    for b in range(k):
+        rotation, point, force = rotations[b], points[b], forces[b]
+        fd_rotation = np.column_stack(
+            [
+                (
+                    wrench(rotation @ pin.exp3(h * e), point, force)
+                    - wrench(rotation @ pin.exp3(-h * e), point, force)
+                )
+                / (2 * h)
+                for e in np.eye(3)
+            ]
+        )
+        fd_force = np.column_stack(
+            [wrench(rotation, point, force + e) - wrench(rotation, point, force) for e in np.eye(3)]
+        )
+        by_rotation, by_force = point_force_jacobians(rotation.T @ force, point, rotation)
+        scale = np.linalg.norm(force) * (1 + np.linalg.norm(point))
+        for got_rotation, got_force in (
+            (by_rotation, by_force),
+            (by_rotation_stack[b], by_force_stack[b]),
+        ):
+            np.testing.assert_allclose(got_rotation, fd_rotation, atol=1e-8 * scale)
+            np.testing.assert_allclose(
+                got_force, fd_force, atol=1e-12 * (1 + np.linalg.norm(point))
+            )
 
 
 # ---- current ----------------------------------------------------------------------------

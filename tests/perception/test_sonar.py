@@ -130,3 +130,72 @@ def test_a_multibeams_range_noise_is_seeded(reference_uvms):
 def test_a_bad_sonar_is_refused_naming_the_key(changes, key):
     with pytest.raises(ParameterError, match=key):
         SonarSpec("fls", **changes)
+
+
+def test_range_bins_are_centred_and_bearings_span_the_fov():
+    """The bins split [min, max) into equal slices, range_m their centres; a multi-beam
+    sonar's bearings span its horizontal FOV symmetrically, an altimeter's one beam looks
+    along its axis (bearing 0)."""
+    spec = SonarSpec("fls", beams=5, bins=8, min_range_m=1.0, max_range_m=5.0)
+    np.testing.assert_allclose(spec.range_m, 1.0 + 0.5 * (np.arange(8) + 0.5), rtol=1e-15)
+    half = 0.5 * spec.horizontal_fov_rad
+    np.testing.assert_allclose(spec.bearing_rad, np.linspace(-half, half, 5), rtol=1e-15)
+    two = SonarSpec("two", beams=2, bins=8)
+    np.testing.assert_allclose(
+        two.bearing_rad, [-0.5 * two.horizontal_fov_rad, 0.5 * two.horizontal_fov_rad]
+    )
+    altimeter = SonarSpec("alt", type="altimeter", beams=1, bins=8, horizontal_fov_rad=0.1)
+    np.testing.assert_array_equal(altimeter.bearing_rad, [0.0])
+
+
+def test_echo_falls_with_two_way_absorption_and_spherical_spreading(reference_uvms):
+    """echo = reflectivity cos^2(incidence) w 10^(-2 alpha r / 10) / r^2: each ray's echo
+    times r^2 10^(0.2 alpha r) is the same for a wall at 4 m or 8 m and for alpha = 0 or
+    0.3 dB/m (the same ray meets both walls at the same incidence)."""
+    heard = {}
+    for distance in (4.0, 8.0):
+        for alpha in (0.0, 0.3):
+            wall = plane("wall", [distance, 0.0, -20.0], [-1.0, 0.0, 0.0], 0.5, 0.4)
+            spec = SonarSpec("fls", beams=16, bins=200, max_range_m=20.0, speckle=False,
+                             absorption_db_per_m=alpha)  # fmt: skip
+            sonar = Sonar(spec, _scene(reference_uvms, [wall]), np.random.default_rng(0))
+            _, _, r, echo = sonar.echoes()
+            assert len(echo) == len(sonar.rays)  # every ray meets the wall
+            heard[distance, alpha] = echo * r**2 * 10.0 ** (0.2 * alpha * r)
+    reference = heard[4.0, 0.0]
+    assert np.all(reference > 0.0)
+    for value in heard.values():
+        np.testing.assert_allclose(value, reference, rtol=1e-9)
+
+
+def test_beam_patterns_are_half_power_at_the_fov_edge_and_sinc_squared_across_beams(
+    reference_uvms,
+):
+    """A forward-looking sonar's rays are weighted by 2^(-(elevation / half vertical FOV)^2)
+    (half power at the FOV's edge), an altimeter's by 2^(-(angle off axis / half FOV)^2);
+    the beams are formed with sinc^2 taps half a beamwidth apart: symmetric, summing to 1,
+    centre over first neighbour pi^2/4 (1 / sinc(1/2)^2) and the first null one beamwidth
+    away (the outer taps zero)."""
+    wall = plane("wall", [5.0, 0.0, -20.0], [-1.0, 0.0, 0.0], 0.5, 0.4)
+    scene = _scene(reference_uvms, [wall])
+    spec = SonarSpec("fls", beams=8, bins=64, vertical_fov_rad=0.4, rays_per_beam=9)
+    sonar = Sonar(spec, scene, np.random.default_rng(0))
+    elevation = np.arcsin(sonar.rays[:, 2])
+    np.testing.assert_allclose(sonar.weight, 0.5 ** ((elevation / 0.2) ** 2), rtol=1e-12)
+    taps = sonar.taps
+    np.testing.assert_allclose(taps, taps[::-1], rtol=1e-15)
+    assert taps.sum() == pytest.approx(1.0, rel=1e-15)
+    assert taps[2] / taps[1] == pytest.approx(np.pi**2 / 4.0, rel=1e-12)
+    np.testing.assert_allclose(taps[[0, 4]], 0.0, atol=1e-16)
+
+    altimeter = SonarSpec("alt", type="altimeter", beams=1, bins=64, horizontal_fov_rad=0.3,
+                          rays_per_beam=5)  # fmt: skip
+    sonar = Sonar(altimeter, scene, np.random.default_rng(0))
+    off_axis = np.arccos(np.clip(sonar.rays[:, 0], -1.0, 1.0))
+    # the fan is a square grid of bearing and elevation: off-axis angle^2 ~ b^2 + e^2
+    bearing = np.arctan2(sonar.rays[:, 1], sonar.rays[:, 0])
+    elevation = np.arcsin(sonar.rays[:, 2])
+    np.testing.assert_allclose(
+        sonar.weight, 0.5 ** ((bearing**2 + elevation**2) / 0.15**2), rtol=1e-2
+    )
+    assert np.argmax(sonar.weight) == np.argmin(off_axis)

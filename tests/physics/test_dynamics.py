@@ -7,7 +7,7 @@ import dataclasses
 import numpy as np
 import pinocchio as pin
 import pytest
-from conftest import RHO, body_urdf, hydro_xml, random_configuration
+from conftest import REFERENCE_URDF, RHO, body_urdf, hydro_xml, random_configuration
 
 import uvms_pin as up
 from uvms_pin.hydro.params import HydroParams
@@ -177,6 +177,30 @@ def test_energy_conserved_without_damping(reference_uvms):
     assert drift < 1e-6, drift
 
 
+@pytest.mark.parametrize("backend", ["core", "python"])
+def test_kinetic_energy_is_the_bodies_plus_the_entrained_water(reference_uvms, backend):
+    """T = T_RB + sum_i 1/2 nu_i^T M_A,i nu_i: Pinocchio's rigid-body kinetic energy plus
+    the fluid kinetic energy of each body's added mass at its body velocity nu_i (LOCAL),
+    at random states (1e-12 relative); doubling the velocities quadruples it."""
+    uvms = reference_uvms
+    model, data = uvms.model, uvms.model.createData()
+    rng = np.random.default_rng(31)
+    for _ in range(5):
+        q = random_configuration(uvms, rng)
+        v = rng.normal(scale=0.5, size=uvms.nv)
+        rigid = pin.computeKineticEnergy(model, data, q, v)
+        fluid = sum(
+            0.5 * data.v[j].vector @ uvms.added_mass_per_joint[j] @ data.v[j].vector
+            for j in range(1, model.njoints)
+        )
+        energy = up.kinetic_energy(uvms, q, v, backend=backend)
+        assert fluid > 0.05 * rigid  # the water's share is not negligible
+        assert energy == pytest.approx(rigid + fluid, rel=1e-12)
+        assert up.kinetic_energy(uvms, q, 2.0 * v, backend=backend) == pytest.approx(
+            4.0 * energy, rel=1e-12
+        )
+
+
 def _world_impulse(uvms: UVMS, q: np.ndarray, v: np.ndarray) -> np.ndarray:
     """Sum over bodies of (I_i + M_A,i) nu_i mapped to the world frame [N s; N m s]."""
     model, data = uvms.model, uvms.model.createData()
@@ -336,3 +360,43 @@ def test_body_drifts_with_current(load_body):
     rotation = pin.Quaternion(q_end[3:7]).toRotationMatrix()
     np.testing.assert_allclose(rotation @ v_end[:3], current, atol=1e-4)
     np.testing.assert_allclose(v_end[3:], 0.0, atol=1e-4)
+
+
+def test_derivatives_follow_the_current_of_each_call(reference_uvms):
+    """forward_dynamics_derivatives in current c2 right after a call in c1 are those of c2
+    (what a fresh model gives in c2), and c1 again gives c1's: the uniform current kept
+    between calls (to convert it once) is only reused for the very same current."""
+    uvms = reference_uvms
+    rng = np.random.default_rng(8)
+    q = random_configuration(uvms, rng)
+    v = rng.normal(scale=0.3, size=uvms.nv)
+    tau = rng.normal(size=uvms.nv)
+    c1, c2 = np.array([0.4, -0.2, 0.1]), np.array([-0.3, 0.5, 0.0])
+    first = up.forward_dynamics_derivatives(uvms, q, v, tau, current_world=c1)
+    second = up.forward_dynamics_derivatives(uvms, q, v, tau, current_world=c2)
+    again = up.forward_dynamics_derivatives(uvms, q, v, tau, current_world=c1.copy())
+    fresh = up.forward_dynamics_derivatives(
+        up.load_uvms(REFERENCE_URDF), q, v, tau, current_world=c2
+    )
+    for k in range(2):  # da/dq and da/dv depend on the current
+        assert not np.allclose(first[k], second[k], rtol=1e-6, atol=0.0)
+        np.testing.assert_allclose(second[k], fresh[k], rtol=1e-12, atol=1e-12)
+        np.testing.assert_array_equal(again[k], first[k])
+
+
+def test_a_frame_wrench_does_the_virtual_power_of_its_frame_twist(reference_uvms):
+    """tau_ext = J^T w: its power on any zeta equals the wrench's power on the frame's
+    twist, zeta . tau_ext = w . [v_frame; omega_frame] (world-aligned axes at the frame
+    origin), for the end-effector and the vehicle's base frame."""
+    uvms = reference_uvms
+    model, data = uvms.model, uvms.model.createData()
+    rng = np.random.default_rng(12)
+    for frame in (uvms.ee_frame_id, model.getFrameId(model.frames[2].name)):
+        q = random_configuration(uvms, rng)
+        v = rng.normal(size=uvms.nv)
+        wrench = rng.normal(size=6)
+        tau_ext = up.frame_wrench_to_generalized(uvms, q, frame, wrench)
+        pin.forwardKinematics(model, data, q, v)
+        pin.updateFramePlacements(model, data)
+        twist = pin.getFrameVelocity(model, data, frame, pin.LOCAL_WORLD_ALIGNED).vector
+        assert v @ tau_ext == pytest.approx(wrench @ twist, rel=1e-12, abs=1e-12)

@@ -88,6 +88,51 @@ def test_lazy_noise_equals_one_draw_of_the_whole_table(distribution, chunk_rows)
         np.testing.assert_allclose(noise((k + s) * period), expected, rtol=0, atol=1e-15)
 
 
+@pytest.mark.parametrize("bound", [0.02, 1.0, 0.0])
+@pytest.mark.parametrize("chunk_rows", [2, 5, 4096])
+def test_noise_values_at_many_times_are_the_signal_at_each_time(bound, chunk_rows):
+    """``values(times)`` (what the compiled loop takes as its noise table) is, row for row
+    and bit for bit, the signal at each time: the draw on the grid, the smoothstep blend
+    s^2 (3 - 2 s) between two draws, times before 0 and past the duration clamped to the
+    table's ends; a zero bound gives zeros. Checked on a second generator of the same seed
+    (the signal is a function of time only)."""
+    period, duration = 1e-2, 0.3
+    spec = NoiseSpec(bound, "uniform")
+
+    def noise():
+        return SampledNoise(
+            spec, 4, period, duration, np.random.default_rng(11), chunk_rows=chunk_rows
+        )
+
+    rng = np.random.default_rng(4)
+    times = np.sort(
+        np.r_[-0.05, 0.0, np.arange(1, 30) * period, rng.uniform(0.0, duration, 40), 0.31, 0.5]
+    )
+    batch = noise().values(times)
+    one_by_one = noise()
+    expected = np.array([one_by_one(float(t)) for t in times])
+    np.testing.assert_array_equal(batch, expected)
+    if bound == 0.0:
+        np.testing.assert_array_equal(batch, np.zeros_like(batch))
+        return
+    table = spec.draw(np.random.default_rng(11), (round(duration / period) + 2, 4))
+    on_grid = (
+        np.isclose(times / period, np.round(times / period)) & (times >= 0) & (times <= duration)
+    )
+    np.testing.assert_array_equal(
+        batch[on_grid], table[np.round(times[on_grid] / period).astype(int)]
+    )
+    k = int(0.123 / period)
+    s = 0.123 / period - k
+    blend = s * s * (3.0 - 2.0 * s)
+    np.testing.assert_allclose(
+        noise().values(np.array([0.123]))[0],
+        table[k] + blend * (table[k + 1] - table[k]),
+        atol=1e-15,
+    )
+    assert np.abs(batch).max() > 0.5 * bound  # not silent
+
+
 def test_lazy_noise_memory_does_not_grow_with_the_duration():
     """A 1e6 s run at 1 kHz would be a 24 GB table; lazily, only two chunks are held."""
     noise = SampledNoise(NoiseSpec(0.1), 3, 1e-3, 1e6, np.random.default_rng(0), chunk_rows=64)
@@ -241,3 +286,28 @@ def test_state_noise_keeps_the_quaternion_unit(reference_uvms):
         m = sensors.measure(t, q, v, wrench)
         assert abs(np.linalg.norm(m.q[3:7]) - 1.0) < 1e-12
         assert not np.allclose(m.q[3:7], q[3:7])
+
+
+def test_noise_table_is_the_noise_measure_adds(reference_uvms):
+    """`noise_table` (the compiled loop's noise input) is, column block by block, what
+    `measure` adds at the same times: force and torque to the wrench, the position offset to
+    q[:3], the joint noise to the arm's q, the velocity noise to v (v_meas = v + n_v), and
+    the orientation noise as the body-frame rotation R_meas = R exp([n_o]x)."""
+    uvms = reference_uvms
+    q, v, wrench = _state(uvms)
+    sensors = SensorSuite(uvms.model, _config(), DURATION, seed=21)
+    times = np.r_[0.0, _times(60)[::7], 2 * PERIOD]
+    times.sort()
+    table = sensors.noise_table(times)
+    nv, n_arm = uvms.nv, uvms.nv - 6
+    assert table.shape == (len(times), 12 + n_arm + nv)
+    for t, row in zip(times, table, strict=True):
+        measured = sensors.measure(float(t), q, v, wrench)
+        np.testing.assert_allclose(measured.wrench_world - wrench, row[:6], rtol=0, atol=1e-15)
+        rotation = pin.Quaternion(q[3:7]).toRotationMatrix()
+        rotation_meas = pin.Quaternion(measured.q[3:7]).toRotationMatrix()
+        np.testing.assert_allclose(pin.log3(rotation.T @ rotation_meas), row[6:9], atol=1e-12)
+        np.testing.assert_allclose(measured.q[:3] - q[:3], row[9:12], rtol=0, atol=1e-15)
+        np.testing.assert_allclose(measured.q[7:] - q[7:], row[12 : 12 + n_arm], atol=1e-15)
+        np.testing.assert_allclose(measured.v - v, row[12 + n_arm :], rtol=0, atol=1e-15)
+    assert np.abs(table[:, 12 + n_arm :]).max() > 0.0  # the velocity noise is not silent

@@ -100,3 +100,46 @@ def test_the_direct_path_equals_linear_drives():
         np.testing.assert_allclose(direct.apply(tau), explicit.apply(tau), rtol=1e-12, atol=1e-12)
         for name in ("thrust", "thruster_command"):
             np.testing.assert_allclose(direct.signals()[name], explicit.signals()[name], atol=1e-12)
+
+
+@pytest.mark.parametrize("dt", [0.004, 0.02, 0.5])
+def test_an_instant_drive_jumps_to_its_steady_thrust_beside_lagged_ones(dt):
+    """tau = 0 and r = inf: f = T_ss at once, whatever the period, also in a vehicle whose
+    other drives do have dynamics (the drives are then stepped one by one): its end value
+    and its mean over the period are both T_ss, its neighbour's follow the lag."""
+    end, mean = first_order_step(
+        np.array([3.0, 0.0]),
+        np.array([-12.0, 10.0]),
+        np.array([0.0, 0.05]),
+        np.array([math.inf, math.inf]),
+        dt,
+    )
+    assert end[0] == -12.0 and mean[0] == -12.0
+    assert end[1] == pytest.approx(10.0 * (1.0 - math.exp(-dt / 0.05)), rel=1e-12)
+    drives = ThrusterDrives(
+        [QuadraticThrustCurve(50.0, 40.0)] * 2, [0.0, 0.05], [math.inf, math.inf]
+    )
+    drives.start(dt)
+    mean = drives.advance(np.array([1.0, 1.0]))
+    assert drives.thrust_N[0] == 50.0 and mean[0] == 50.0
+
+
+def test_instant_drives_have_no_dynamics_and_run_in_a_continuous_loop():
+    """tau = 0 and r = inf for every thruster: no dynamics, so a continuous loop (no control
+    period) is fine and each advance gives the steady thrust; one finite rate limit or one
+    positive time constant is dynamics."""
+    curve = QuadraticThrustCurve(50.0, 40.0)
+    drives = ThrusterDrives([curve, curve], [0.0, 0.0], [math.inf, math.inf])
+    assert not drives.has_dynamics
+    drives.start(None)
+    np.testing.assert_array_equal(drives.advance(np.array([1.0, -1.0])), [50.0, -40.0])
+    assert ThrusterDrives([curve, curve], [0.0, 0.0], [math.inf, 100.0]).has_dynamics
+    assert ThrusterDrives([curve, curve], [0.0, 0.1], [math.inf, math.inf]).has_dynamics
+
+
+@pytest.mark.parametrize(("taus", "rates"), [([0.1], [1.0, 1.0]), ([0.1, 0.1], [1.0])])
+def test_one_time_constant_and_one_rate_limit_per_thruster(taus, rates):
+    """Two thrusters need two time constants and two rate limits: one list short is refused."""
+    curve = QuadraticThrustCurve(1.0, 1.0)
+    with pytest.raises(ParameterError, match="one time constant and one rate limit"):
+        ThrusterDrives([curve, curve], taus, rates)

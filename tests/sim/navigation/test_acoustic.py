@@ -86,3 +86,31 @@ def test_usbl_dropouts_lose_their_share_of_pings():
 def test_bad_parameters_are_refused(factory, match):
     with pytest.raises(ParameterError, match=match):
         factory()
+
+
+def test_usbl_fixes_scatter_about_the_truth_with_their_sigma_and_read_zero_before_the_first():
+    """Each fix is the position when pinged plus white noise of sigma noise_m per world
+    component (unbiased; 10 % on the sigma over 4000 fixes); before the first fix arrives
+    the reading is [0, 0, 0, age -1, new 0]."""
+    sigma = 0.25
+    usbl = Usbl(UsblSpec(noise_m=sigma, period_s=0.1, latency_s=0.05), np.random.default_rng(6))
+    truth = np.array([10.0, -4.0, -30.0])
+    out = np.array([usbl.measure(k * 0.05, truth) for k in range(8002)])
+    np.testing.assert_array_equal(out[0], [0.0, 0.0, 0.0, -1.0, 0.0])
+    fixes = out[out[:, 4] == 1.0, :3]
+    assert len(fixes) == 4000
+    error = fixes - truth
+    assert np.std(error) == pytest.approx(sigma, rel=0.1)
+    assert np.all(np.abs(error.mean(axis=0)) < 5 * sigma / np.sqrt(len(fixes)))
+
+
+def test_usbl_pings_once_per_period_on_its_grid_after_a_gap_in_the_ticks():
+    """A ping is taken at the first tick at or after each multiple of the period; ticks that
+    skip several periods give one ping, and the next is at the next multiple of the period
+    after it (not a burst of the missed ones): ticks at 0, 2.6 s then every 0.1 s, period
+    0.5 s, no latency: fixes at 0, 2.6, 3.0, 3.5, 4.0 s."""
+    usbl = Usbl(UsblSpec(period_s=0.5), np.random.default_rng(1))
+    times = [0.0, 2.6, *(2.6 + 0.1 * k for k in range(1, 15))]
+    new = [usbl.measure(t, np.zeros(3))[4] for t in times]
+    pinged = [t for t, n in zip(times, new, strict=True) if n == 1.0]
+    np.testing.assert_allclose(pinged, [0.0, 2.6, 3.0, 3.5, 4.0], atol=1e-9)

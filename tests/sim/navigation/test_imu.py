@@ -58,3 +58,27 @@ def test_bad_specs_are_refused():
         ImuSpec(gyro_noise_rad_s_rthz=-1.0)
     with pytest.raises(ParameterError, match="tau"):
         allan_deviation(np.zeros(10), 0.1, 1.0)
+
+
+def test_each_spec_entry_drives_its_own_channel_and_term():
+    """ImuSpec's four numbers reach the right channel and term: a gyroscope with white noise
+    only scatters about the truth with sigma = N / sqrt(dt) and no drift, an accelerometer
+    with a bias walk only reads the truth exactly at its first sample and then drifts by
+    steps of sigma = K sqrt(dt) (its consecutive differences), 10 % on 4000 samples."""
+    dt, n = 0.01, 4000
+    imu = Imu(
+        ImuSpec(gyro_noise_rad_s_rthz=N, accel_bias_walk_m_s3_rthz=K * 10),
+        np.random.default_rng(8),
+        np.random.default_rng(9),
+    )
+    rate, acceleration, rotation = np.array([0.1, -0.2, 0.3]), np.zeros(3), np.eye(3)
+    specific_force = np.array([0.0, 0.0, 9.81])
+    readings = [imu.measure(rate, acceleration, rotation, dt) for _ in range(n)]
+    gyro = np.array([g for g, _ in readings]) - rate
+    accel = np.array([a for _, a in readings]) - specific_force
+    assert np.std(gyro) == pytest.approx(N / math.sqrt(dt), rel=0.1)
+    assert abs(np.mean(gyro)) < 5 * N / math.sqrt(dt) / math.sqrt(n)  # no bias walk
+    np.testing.assert_array_equal(accel[0], np.zeros(3))  # no white noise, bias 0 at first
+    steps = np.diff(accel, axis=0)
+    assert np.std(steps) == pytest.approx(K * 10 * math.sqrt(dt), rel=0.1)
+    assert np.abs(accel[-1]).max() > 0.0

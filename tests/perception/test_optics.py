@@ -1,0 +1,79 @@
+"""The water's optics and the camera's lights (`uvms_pin.perception.optics`): daylight and
+backscatter laws, the lights' cones and the validation of their parameters."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from uvms_pin.errors import ParameterError
+from uvms_pin.perception.optics import Light, WaterOptics, backscatter, cone, cone_of_cosine
+
+
+def test_a_lights_direction_is_made_a_unit_vector():
+    """Any non-zero direction is normalised (its sense kept); zero is refused."""
+    light = Light(direction=(0.0, 3.0, 4.0))
+    np.testing.assert_allclose(light.direction, (0.0, 0.6, 0.8), rtol=1e-15)
+    with pytest.raises(ParameterError, match="must not be zero"):
+        Light(direction=(0.0, 0.0, 0.0))
+
+
+def test_cone_is_one_inside_zero_beyond_and_smoothstep_on_its_edge():
+    """1 up to the half-angle (included), 1 - smoothstep over the edge (1/2 at its middle),
+    0 beyond; with no edge a hard cone (1 up to and at the half-angle, 0 beyond, never NaN);
+    `cone_of_cosine` of cos(angle) is `cone` of the angle."""
+    half, edge = 0.4, 0.2
+    angles = np.array([0.0, 0.2, 0.4, 0.45, 0.5, 0.55, 0.6, 0.9, np.pi])
+    values = cone(angles, half, edge)
+    s = np.clip((angles - half) / edge, 0.0, 1.0)
+    np.testing.assert_allclose(values, 1.0 - s * s * (3.0 - 2.0 * s), atol=1e-15)
+    assert values[2] == 1.0 and values[4] == pytest.approx(0.5, abs=1e-15)
+    assert values[6] == pytest.approx(0.0, abs=1e-15) and values[-1] == 0.0
+    assert np.all(np.diff(values) <= 0.0)
+    hard = cone(angles, half, 0.0)
+    np.testing.assert_array_equal(hard, (angles <= half).astype(float))
+    for edge_rad in (edge, 0.0):
+        np.testing.assert_allclose(
+            cone_of_cosine(np.cos(angles), half, edge_rad), cone(angles, half, edge_rad), atol=1e-12
+        )
+
+
+def test_daylight_decays_exponentially_and_backscatter_saturates_to_the_veiling_light():
+    """E(d) = E0 exp(-K_d d) (clamped at the surface), B_inf = b E(camera depth), and
+    backscatter B_inf (1 - exp(-beta_B z)): zero at zero range, half of B_inf at
+    z = ln 2 / beta_B, B_inf at infinite range."""
+    water = WaterOptics(water_type="II", surface_irradiance=2.0, backscatter_albedo=0.3)
+    kd = water.kd_per_m
+    np.testing.assert_allclose(water.daylight(np.array([5.0]))[0], 2.0 * np.exp(-5.0 * kd))
+    np.testing.assert_allclose(water.daylight(np.array([-1.0]))[0], [2.0] * 3)  # above: E0
+    veiling = water.veiling_light(5.0)
+    np.testing.assert_allclose(veiling, 0.3 * 2.0 * np.exp(-5.0 * kd), rtol=1e-15)
+    beta = water.beta_b_per_m
+    ranges = np.array([0.0, np.log(2.0) / beta[1], np.inf])
+    b = backscatter(veiling, ranges, beta)
+    np.testing.assert_array_equal(b[0], np.zeros(3))
+    assert b[1, 1] == pytest.approx(0.5 * veiling[1], rel=1e-14)
+    np.testing.assert_allclose(b[2], veiling, rtol=1e-15)
+
+
+def test_water_optics_accepts_clear_values_at_their_bounds_and_refuses_beyond():
+    """Attenuation and backscatter of 0 (clear water), night (E0 = 0) and albedos 0 and 1 are
+    accepted; negative coefficients, a negative or infinite irradiance, an albedo above 1
+    are refused."""
+    WaterOptics(attenuation_per_m=(0.0, 0.0, 0.0), backscatter_per_m=(0.0, 0.1, 0.0))
+    WaterOptics(surface_irradiance=0.0, backscatter_albedo=0.0)
+    WaterOptics(backscatter_albedo=1.0)
+    Light(intensity=0.0, edge_rad=0.0)
+    bad = [
+        ({"attenuation_per_m": (0.1, -0.01, 0.1)}, "attenuation_per_m"),
+        ({"backscatter_per_m": (0.1, 0.1)}, "backscatter_per_m"),
+        ({"surface_irradiance": -1.0}, "surface_irradiance"),
+        ({"surface_irradiance": np.inf}, "surface_irradiance"),
+        ({"backscatter_albedo": 1.5}, "backscatter_albedo"),
+    ]
+    for changes, match in bad:
+        with pytest.raises(ParameterError, match=match):
+            WaterOptics(**changes)
+    for changes in ({"intensity": -1.0}, {"half_angle_rad": 0.0}, {"edge_rad": -0.1}):
+        with pytest.raises(ParameterError, match="a light needs"):
+            Light(**changes)
