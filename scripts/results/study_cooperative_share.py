@@ -31,8 +31,16 @@ def runs(table: pd.DataFrame) -> str:
             **{label: rows[column] for column, label in COLUMNS.items()},
         }
     )
+    formats = {"bar density [kg/m^3]": "{:.0f}", "delivered (within 5 cm)": "{:.0f}"}
     header = "| " + " | ".join(out.columns) + " |\n|" + "---|" * len(out.columns)
-    lines = ["| " + " | ".join(f"{v:.3g}" for v in row) + " |" for row in out.to_numpy()]
+    lines = [
+        "| "
+        + " | ".join(
+            formats.get(c, "{:.3g}").format(v) for c, v in zip(out.columns, row, strict=True)
+        )
+        + " |"
+        for row in out.to_numpy()
+    ]
     return "## Every run\n\n" + header + "\n" + "\n".join(lines) + "\n"
 
 
