@@ -3,6 +3,7 @@ deep bodies exactly as without a surface, bodies above the water under gravity a
 
 from __future__ import annotations
 
+import re
 import warnings
 
 import numpy as np
@@ -214,3 +215,43 @@ def test_every_shape_is_cut_alike_in_the_core():
             np.testing.assert_allclose(moment, part.moment_m4, atol=1e-12 * scale)
             assert area == pytest.approx(part.waterplane_area_m2, abs=1e-12 * scale)
             np.testing.assert_allclose(wet_moment, part.waterplane_moment_m3, atol=1e-12 * scale)
+
+
+def _arm_link4_variant(tmp_path, damping: bool) -> up.UVMS:
+    """The reference UVMS with arm_link4 stripped of its volume and collision geometry (a
+    body with damping alone), its damping kept or zeroed."""
+    text = shipped_path("models/uvms_lbv150.urdf").read_text()
+    start = text.index('<link name="arm_link4">')
+    end = text.index("</link>", start)
+    link = re.sub(r"\s*<collision>.*?</collision>", "", text[start:end], flags=re.S)
+    link = re.sub(r'<volume value="[^"]*"/>', '<volume value="0"/>', link)
+    if not damping:
+        link = re.sub(r"\s*<(linear|quadratic)_damping [^>]*/>", "", link)
+    path = tmp_path / f"arm_link4_{'damped' if damping else 'undamped'}.urdf"
+    path.write_text(text[:start] + link + text[end:])
+    return up.load_uvms(path)
+
+
+def test_a_body_with_damping_alone_is_always_wet(tmp_path):
+    """A body with neither volume nor geometry has no hull for the surface to cut: its drag
+    acts in full wherever it is (docs/physics.md). Its share of h, the damped model's minus
+    the undamped one's, is the same high above the water, cut by it, and deep without a
+    surface, in both backends."""
+    damped, undamped = _arm_link4_variant(tmp_path, True), _arm_link4_variant(tmp_path, False)
+    assert -1 in damped.surface_bodies.hull_of_damped  # the stripped body has no hull
+    rng = np.random.default_rng(5)
+    q = _near_the_surface(damped, rng)
+    v = rng.normal(scale=0.6, size=damped.nv)
+    for backend in ("core", "python"):
+
+        def drag(z, surface, backend=backend):
+            at = q.copy()
+            at[2] = z
+            return up.bias_forces(damped, at, v, free_surface=surface, backend=backend) - (
+                up.bias_forces(undamped, at, v, free_surface=surface, backend=backend)
+            )
+
+        deep = drag(-8.0, False)
+        assert np.abs(deep[6:]).max() > 1e-3  # the arm's joints feel the link's drag
+        np.testing.assert_allclose(drag(6.0, True), deep, rtol=1e-12, atol=1e-12)
+        np.testing.assert_allclose(drag(q[2], True), deep, rtol=1e-12, atol=1e-12)
