@@ -27,6 +27,9 @@ SCRIPT = textwrap.dedent(
     from uvms_pin.ocp import costs, problems
 
     solver, raised, raise_at = sys.argv[1], sys.argv[2], int(sys.argv[3])
+    # Ctrl-C taken as an interactive run takes it, even when the test runner was started
+    # with SIGINT ignored (a background job), which its children inherit
+    signal.signal(signal.SIGINT, signal.default_int_handler)
     uvms = up.load_uvms({urdf!r})
     x0 = np.r_[pin.neutral(uvms.model), np.zeros(uvms.nv)]
     calls = []
