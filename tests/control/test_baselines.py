@@ -11,6 +11,7 @@ from conftest import ROOT
 from uvms_pin.control.baselines.computed_torque import ComputedTorqueController
 from uvms_pin.control.baselines.impedance import ImpedanceController
 from uvms_pin.control.baselines.pi_force import PIForceController
+from uvms_pin.control.baselines.task import ForceOrientationLoop
 from uvms_pin.control.measurement import Measurement
 from uvms_pin.errors import ParameterError, ScenarioError
 from uvms_pin.model.scaled import scaled_uvms
@@ -188,3 +189,72 @@ def test_each_baseline_on_the_nominal_realistic_task():
     assert verdict["computed_torque"]["orientation_error_peak_rad"] < 0.1
     assert not verdict["impedance"]["success"]
     assert "force error after t = 5 s" in verdict["impedance"]["reason"]
+
+
+@pytest.mark.parametrize("motion", [False, True])
+def test_computed_torque_gives_the_commanded_acceleration_to_its_own_model(reference_uvms, motion):
+    """Inverse dynamics: on the model it believes in, M zeta_dot + h = tau - J^T w_meas, its
+    tau yields exactly the commanded acceleration, a = K_v (zeta_r - zeta) for the force
+    task and a = zeta_dot_r + K_v (zeta_r - zeta) + K_q (q_r (-) q) for a motion task (a
+    reference off the measured state, so that each term counts)."""
+    from uvms_pin.physics.dynamics import bias_forces, mass_matrix
+
+    uvms, ee = reference_uvms, _ee_name(reference_uvms)
+    rng = np.random.default_rng(21)
+    measurement = _measurement(uvms, rng)
+    q, v = measurement.q, measurement.v
+    k_v, k_q = rng.uniform(2.0, 8.0, uvms.nv), rng.uniform(10.0, 30.0, uvms.nv)
+    q_r = pin.integrate(uvms.model, q, rng.normal(0.0, 0.1, uvms.nv))
+    zeta_r, zeta_dot_r = rng.normal(0.0, 0.2, uvms.nv), rng.normal(0.0, 0.5, uvms.nv)
+    controller = ComputedTorqueController(
+        uvms, ee, reference=(lambda t: (q_r, zeta_r, zeta_dot_r)) if motion else None,
+        velocity_gain_per_s=k_v, position_gain_per_s2=k_q, desired_force_world_N=(0.4, 0, 0),
+    )  # fmt: skip
+    tau = controller.compute(0.3, measurement)
+    jacobian = controller.task.evaluate(0.3, measurement).jacobian_lwa
+    wrench = np.asarray(measurement.wrench_world, dtype=float)
+    achieved = np.linalg.solve(
+        mass_matrix(uvms, q), tau - jacobian.T @ wrench - bias_forces(uvms, q, v)
+    )
+    if motion:
+        commanded = zeta_dot_r + k_v * (zeta_r - v) + k_q * pin.difference(uvms.model, q, q_r)
+    else:
+        commanded = k_v * (controller.signals()["zeta_r"] - v)
+    assert np.abs(commanded).max() > 0.1
+    np.testing.assert_allclose(achieved, commanded, rtol=1e-9, atol=1e-9)
+
+
+def test_pi_force_damps_the_velocity_about_its_reference(reference_uvms):
+    """tau = -K_d (zeta - zeta_r): a damping about the reference velocity, each component
+    with its own k_d, so tau . (zeta - zeta_r) = -sum k_d (zeta - zeta_r)^2 < 0 (it only
+    takes energy out of the deviation from the reference)."""
+    uvms, ee = reference_uvms, _ee_name(reference_uvms)
+    rng = np.random.default_rng(22)
+    measurement = _measurement(uvms, rng)
+    damping = rng.uniform(5.0, 40.0, uvms.nv)
+    controller = PIForceController(
+        uvms.model, ee, damping=damping, desired_force_world_N=(0.4, 0.0, 0.0)
+    )
+    controller.compute(0.29, measurement)
+    tau = controller.compute(0.3, measurement)
+    deviation = measurement.v - controller.signals()["zeta_r"]
+    np.testing.assert_allclose(tau, -damping * deviation, rtol=1e-14, atol=1e-14)
+    assert tau @ deviation < 0.0
+
+
+def test_the_force_loop_integrates_its_error_by_rectangles_within_its_limit():
+    """xdot_r = -[kp e_f + ki I_f; k_o e_o], I_f advanced by the rectangle (t - t_last)
+    e_f(t_last) at each later call and clipped to +-integral_limit per component (the
+    anti-windup, both signs)."""
+    kp, ki, k_o = np.array([0.1, 0.2, 0.3]), np.array([0.05, 0.5, 1.0]), np.array([1.0, 2.0, 3.0])
+    loop = ForceOrientationLoop(kp, ki, k_o, np.array([5.0, 5.0, 0.4]))
+    e0 = np.array([2.0, -1.0, 0.5, 0.1, -0.2, 0.3])
+    np.testing.assert_allclose(loop.velocity(1.0, e0), -np.r_[kp * e0[:3], k_o * e0[3:]])
+    e1 = np.array([-1.0, 3.0, 0.2, 0.0, 0.4, -0.1])
+    integral = 0.5 * e0[:3]  # the first sample's error over [1.0, 1.5]
+    expected = -np.r_[kp * e1[:3] + ki * integral, k_o * e1[3:]]
+    np.testing.assert_allclose(loop.velocity(1.5, e1), expected, rtol=1e-14)
+    np.testing.assert_allclose(loop.integral_Ns, integral, rtol=1e-14)
+    # 100 s more of e1 would integrate to (-100, 300, 20) N s: clipped to (-5, 5, 0.4)
+    loop.velocity(101.5, e1)
+    np.testing.assert_allclose(loop.integral_Ns, [-5.0, 5.0, 0.4], rtol=1e-14)

@@ -165,3 +165,17 @@ def test_the_manipulability_task_climbs_its_gradient_in_the_pose_tasks_null_spac
                                     manipulability_threshold=0.5 * w)
     )  # fmt: skip
     np.testing.assert_allclose(relaxed.reference(0.0, q, zero)[0], without, atol=1e-12)
+
+
+def test_a_vehicle_task_has_no_manipulability_task(uvms):
+    """Manipulability is the arm's reach for its end-effector: a vehicle-tracking task
+    gives the same reference with or without a manipulability threshold (w_min = 0.5,
+    whatever w(q) is)."""
+    task = _task(uvms, "vehicle")
+    model = uvms.model
+    rng = np.random.default_rng(8)
+    plain = KinematicLevel(model, task, KinematicGains())
+    asked = KinematicLevel(model, task, KinematicGains(manipulability_threshold=0.5))
+    for _ in range(3):
+        q, v = _q(uvms, rng), rng.normal(size=model.nv)
+        np.testing.assert_array_equal(asked.reference(0.0, q, v)[0], plain.reference(0.0, q, v)[0])

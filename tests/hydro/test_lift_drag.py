@@ -125,3 +125,35 @@ def test_bad_parameters_are_refused_by_name():
     ):
         with pytest.raises(ParameterError, match=word):
             LiftDragParams(**kwargs)
+
+
+@pytest.mark.parametrize("alpha", [-1.2, -0.3, -0.1, 0.1, 0.3, 1.2])
+def test_the_moment_about_the_span_follows_its_own_slopes(alpha):
+    """M = c_M q S along the span, c_M = c_Ma alpha below the stall and c_Ma alpha_s +
+    c_Ma,stall (alpha - alpha_s) beyond it (mirrored below -alpha_s), kept of the sign it
+    had at the stall: with c_Ma = 0.8 and c_Ma,stall = -0.3 (a lift of c_La as FIN's)."""
+    params = LiftDragParams(**{**FIN.__dict__, "cma": 0.8, "cma_stall": -0.3})
+    stall = params.alpha_stall_rad
+    if alpha > stall:
+        cm = max(0.0, 0.8 * stall - 0.3 * (alpha - stall))
+    elif alpha < -stall:
+        cm = min(0.0, -0.8 * stall - 0.3 * (alpha + stall))
+    else:
+        cm = 0.8 * alpha
+    q_area = 0.5 * 1000.0 * SPEED**2 * FIN.area_m2
+    force, moment = lift_drag_wrench(params, np.eye(3), _flow(alpha))
+    np.testing.assert_allclose(moment, cm * q_area * S, rtol=1e-12, atol=1e-12)
+    np.testing.assert_allclose(force, _expected(alpha), rtol=1e-12, atol=1e-12)
+
+
+def test_a_flow_across_the_chord_or_along_the_span_gives_nothing():
+    """A flow normal to the chord (f . v = 0, straight up or down at the fin) meets a
+    one-way fin from neither side: no force. A reversible fin in a flow along its span has
+    no flow in its lift-drag plane (v_ld = 0, the sweep's cos^2 = 0): no force, no moment."""
+    for flow in (SPEED * U, -SPEED * U, SPEED * S):
+        force, moment = lift_drag_wrench(FIN, np.eye(3), flow)
+        assert not force.any() and not moment.any()
+    reversible = LiftDragParams(**{**FIN.__dict__, "reversible": True, "cma": 0.8})
+    force, moment = lift_drag_wrench(reversible, np.eye(3), SPEED * S)
+    np.testing.assert_array_equal(force, np.zeros(3))
+    np.testing.assert_array_equal(moment, np.zeros(3))

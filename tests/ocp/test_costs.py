@@ -139,3 +139,43 @@ def test_the_gauss_newton_blocks_of_a_term_of_state_and_input(reference_uvms):
     np.testing.assert_allclose(data.Lxx, rx.T @ (w * rx), rtol=1e-12, atol=1e-12)
     np.testing.assert_allclose(data.Luu, ru.T @ (w * ru) + 1e-2 * np.eye(nv), rtol=1e-12)
     assert np.abs(data.Lxu).max() > 0.1
+
+
+def test_each_residual_is_its_value_less_its_target_with_jacobians_of_its_size(reference_uvms):
+    """r = 0 where the state meets the term's target (the frames' poses, attitude and
+    position where they are, the state itself, the contact force f = f_d), and r = value -
+    target: a target moved by d moves r by -d. R_x is (nr, 2 nv) and R_u (nr, nu) for
+    every term, the contact force's and the joint-limit margin's included (the action
+    model stacks them)."""
+    from uvms_pin.physics.derivatives.task_contact import ContactJacobians, ContactWrench
+
+    uvms, rng = reference_uvms, np.random.default_rng(13)
+    model, nv = uvms.model, uvms.nv
+    q, v, _ = random_state(uvms, rng)
+    x, u, data = np.r_[q, v], np.zeros(nv), _at(uvms, q, v)
+    ee, vehicle = uvms.ee_frame_id, costs.vehicle_frame_id(uvms)
+    force = np.array([3.0, -1.0, 12.0])
+    contact = ContactWrench(np.r_[force, 0.2, -0.1, 0.3], np.zeros(nv), np.zeros((6, nv)),
+                            np.zeros(3), np.zeros(3))  # fmt: skip
+    shift = np.array([0.2, -0.3, 0.5])
+    at_target = [
+        costs.FramePose(ee, data.oMf[ee], np.ones(6)),
+        costs.FramePose(vehicle, data.oMf[vehicle], np.ones(6)),
+        costs.FrameRotation(ee, data.oMf[ee].rotation, np.ones(3)),
+        costs.FramePosition(ee, data.oMf[ee].translation, np.ones(3)),
+        costs.StateDeviation(model, x, np.ones(2 * nv)),
+        costs.ContactForce(force, np.ones(3)),
+    ]
+    for term in at_target:
+        r = term.residual(model, data, x, u, contact)
+        np.testing.assert_allclose(r, np.zeros(term.nr), atol=1e-12, err_msg=term.name)
+    moved = costs.FramePosition(ee, data.oMf[ee].translation + shift, np.ones(3))
+    np.testing.assert_allclose(moved.residual(model, data, x, u), -shift, atol=1e-12)
+    pushed = costs.ContactForce(force + shift, np.ones(3))
+    np.testing.assert_allclose(pushed.residual(model, data, x, u, contact), -shift, atol=1e-12)
+    derivatives = ContactJacobians(rng.normal(size=(6, nv)), rng.normal(size=(6, nv)),
+                                   np.zeros((nv, nv)), np.zeros((nv, nv)))  # fmt: skip
+    terms = [*at_target, costs.Effort(np.ones(nv)), costs.JointLimitMargin(model, 0.1, 1.0)]
+    for term in terms:
+        rx, ru = term.jacobians(model, data, x, u, derivatives)
+        assert rx.shape == (term.nr, 2 * nv) and ru.shape == (term.nr, nv), term.name

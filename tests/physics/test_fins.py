@@ -15,7 +15,7 @@ import uvms_pin as up
 from uvms_pin.errors import ParameterError
 from uvms_pin.flow import UniformCurrent
 from uvms_pin.hydro.lift_drag import lift_drag_wrench
-from uvms_pin.physics.fins import fin_generalized_force, fin_wrenches_world
+from uvms_pin.physics.fins import fin_generalized_force, fin_wrenches_world, wet_fraction
 from uvms_pin.sim.plant import Plant
 
 
@@ -160,8 +160,6 @@ def test_a_run_with_fins_is_compiled_and_agrees_with_the_python_loop(tmp_path):
 def test_a_fin_above_the_free_surface_gives_nothing_and_one_across_it_a_share(lrauv):
     """With a free surface a fin's wrench is scaled by its wet fraction: whole with its centre
     of pressure sqrt(A)/2 below the surface or deeper, nothing as far above it, half at it."""
-    from uvms_pin.physics.fins import wet_fraction
-
     data = lrauv.model.createData()
     k = [f.name for f in lrauv.fins].index("vertical_fins")  # in the flow of v below
     fin = lrauv.fins[k]
@@ -196,3 +194,24 @@ def test_the_mujoco_twin_of_a_model_with_fins_says_it_leaves_them_out(lrauv):
 
     with pytest.warns(ModelWarning, match="'horizontal_fins', 'vertical_fins' have no MuJoCo"):
         uvms_to_mjcf(lrauv, Path(lrauv.source).read_text(), base_dir=Path(lrauv.source).parent)
+
+
+class _SwellStub:
+    """A free surface eta(t, x) = 0.2 sin(x + t) [m] (only `surface_elevation` is read)."""
+
+    def surface_elevation(self, time_s, xy_world):
+        xy = np.asarray(xy_world, dtype=float).reshape(-1, 2)
+        return 0.2 * np.sin(xy[:, 0] + time_s)
+
+
+@pytest.mark.parametrize("depth_m", [-0.2, -0.05, 0.0, 0.03, 0.1, 0.2])
+def test_the_wet_fraction_follows_the_local_surface_not_the_level(depth_m):
+    """w depends only on the centre of pressure's height above the free surface where it
+    is, c_z - eta(t, c_xy): a fin at a height d above a swell's crest, trough or slope is
+    as wet as one at d above the level surface z = 0."""
+    area = 0.04  # L = 0.2 m
+    level = wet_fraction(np.array([0.0, 0.0, depth_m]), area, None, 0.0)
+    for x, t in ((0.0, 0.0), (0.3, 1.2), (1.0, 0.5708), (-1.0, 0.0)):
+        eta = 0.2 * np.sin(x + t)
+        centre = np.array([x, 0.4, eta + depth_m])
+        assert wet_fraction(centre, area, _SwellStub(), t) == pytest.approx(level, abs=1e-12)

@@ -5,6 +5,7 @@ value and component, or a mass matrix singular along a named degree of freedom."
 from __future__ import annotations
 
 import dataclasses
+import warnings
 
 import numpy as np
 import pinocchio as pin
@@ -13,8 +14,14 @@ from conftest import ROOT
 
 import uvms_pin as up
 from uvms_pin.control.base import Controller
+from uvms_pin.physics.dynamics import mass_matrix
 from uvms_pin.scenario.load import load_scenario
-from uvms_pin.sim.divergence import divergence_context, implausible_motion
+from uvms_pin.sim.divergence import (
+    DIVERGED_SPEED,
+    diverged,
+    divergence_context,
+    implausible_motion,
+)
 from uvms_pin.sim.plant import Plant
 from uvms_pin.sim.run import simulate
 
@@ -134,3 +141,69 @@ def test_a_control_loop_unstable_at_its_period_stops_the_run_with_the_reason():
         progress=False,
     )
     assert fine.status.ok and np.abs(fine.v).max() < 100.0
+
+
+def test_diverged_is_a_non_finite_state_or_a_speed_past_the_bound_either_way():
+    """`diverged(q, v)`: True exactly when q or v holds a NaN or an inf, or some |v_i| >
+    DIVERGED_SPEED = 1e4 (either sign; the bound itself is still physics); a finite q whose
+    entries' sum overflows (the quick reduction inconclusive) is not a divergence."""
+    q, v = np.zeros(9), np.zeros(8)
+    assert not diverged(q, v)
+    for k, value in [(0, DIVERGED_SPEED), (3, -DIVERGED_SPEED), (7, 0.5 * DIVERGED_SPEED)]:
+        fast = v.copy()
+        fast[k] = value
+        assert not diverged(q, fast)
+    for k, value in [(0, 1.01 * DIVERGED_SPEED), (5, -1.01 * DIVERGED_SPEED)]:
+        fast = v.copy()
+        fast[k] = value
+        assert diverged(q, fast)
+    for bad in (np.nan, np.inf, -np.inf):
+        broken_q, broken_v = q.copy(), v.copy()
+        broken_q[2], broken_v[6] = bad, bad
+        assert diverged(broken_q, v) and diverged(q, broken_v)
+    huge = np.full(9, 1e308)  # each finite, their sum inf
+    with np.errstate(over="ignore"):
+        assert not diverged(huge, v)
+        huge[4] = np.nan
+        assert diverged(huge, v)
+
+
+def test_a_disturbance_only_at_the_intervals_midpoint_is_named(reference_uvms):
+    """The time-varying inputs are read at the interval's start t0, its midpoint
+    (t0 + t1) / 2 and its end t1: a pulse of 3e6 N at the midpoint alone, zero at both
+    ends, is still named."""
+
+    def pulse(time_s):
+        wrench = np.zeros(6)
+        if abs(time_s - 1.005) < 1e-9:
+            wrench[2] = 3e6
+        return wrench
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        plant = Plant(reference_uvms, disturbance=pulse)
+    context = divergence_context(
+        plant, (1.0, 1.01), reference_uvms.neutral_configuration(), np.zeros(10), None
+    )
+    assert context.startswith("from t = 1 s: disturbance vehicle fz = 3e+06 N")
+
+
+def test_a_mass_matrix_singular_relative_to_its_largest_eigenvalue_is_named(reference_uvms):
+    """Singular is relative: arm_joint4's link with 1e-13 kg m^2 (no armature, no added
+    mass) leaves M's smallest eigenvalue below 1e-12 of its largest, singular to double
+    precision though not zero, and it is named as such."""
+    model = reference_uvms.model.copy()
+    model.inertias[5] = pin.Inertia(1e-13, np.zeros(3), 1e-13 * np.eye(3))
+    model.armature[9] = 0.0
+    uvms = reference_uvms.with_model(model).with_hydro(
+        lambda b: (
+            b.params
+            if b.joint_id != 5
+            else dataclasses.replace(b.params, added_mass=np.zeros((6, 6)))
+        )
+    )
+    q = uvms.neutral_configuration()
+    eigenvalues = np.linalg.eigvalsh(mass_matrix(uvms, q, backend="python"))
+    assert 0.0 < eigenvalues[0] < 1e-12 * eigenvalues[-1]  # the case: tiny, not zero
+    context = divergence_context(Plant(uvms), (0.0, 0.01), q, np.zeros(10), np.zeros(10))
+    assert "the mass matrix is singular" in context and "along arm_joint4" in context

@@ -279,3 +279,33 @@ def test_adaptive_event_before_the_first_output_time(free_body):
     assert len(states) == 1
     t, q, _ = states[0]
     assert t == pytest.approx(0.05, rel=1e-6) and q[0] == pytest.approx(0.05, rel=1e-6)
+
+
+def test_rk4_is_fourth_order_on_a_time_varying_force(free_body):
+    """A force that depends on time, F(t) = m (cos t, sin 2t / 2, 0) in the body frame,
+    on the body without spin (it keeps its attitude R0): v(t) = v0 + (sin t,
+    (1 - cos 2t) / 4, 0) and p(t) = p0 + R0 (v0 t + (1 - cos t, t / 4 - sin 2t / 8, 0)).
+    RK4 reads the force at t, t + h/2 (twice) and t + h: halving the step divides the
+    error by 2^4 = 16 (assert 12..20)."""
+    model = free_body.model
+
+    def rhs(t, q, v):
+        tau = np.zeros(6)
+        tau[:3] = MASS * np.array([np.cos(t), 0.5 * np.sin(2.0 * t), 0.0])
+        return up.forward_dynamics(free_body, q, v, tau)
+
+    q0, _ = _initial_state(free_body)
+    v0 = np.array([0.3, -0.1, 0.2, 0.0, 0.0, 0.0])
+    rotation = pin.Quaternion(q0[3:7]).matrix()
+    t = DURATION_S
+    v_exact = v0 + np.r_[np.sin(t), (1.0 - np.cos(2.0 * t)) / 4.0, 0.0, 0.0, 0.0, 0.0]
+    q_exact = q0.copy()
+    shift = v0[:3] * t + np.array([1.0 - np.cos(t), t / 4.0 - np.sin(2.0 * t) / 8.0, 0.0])
+    q_exact[:3] += rotation @ shift
+    errors = [
+        _error(model, RK4(h).advance(model, rhs, 0.0, q0, v0, t), (q_exact, v_exact))
+        for h in (0.1, 0.05, 0.025)
+    ]
+    ratios = [errors[i] / errors[i + 1] for i in range(2)]
+    assert errors[-1] > 1e-12
+    assert all(12.0 < r < 20.0 for r in ratios), (errors, ratios)

@@ -15,7 +15,7 @@ import pytest
 import uvms_pin as up
 from uvms_pin.errors import ParameterError
 from uvms_pin.model.resources import shipped_path
-from uvms_pin.physics.constraints.contacts import ContactSphere, PlaneContacts
+from uvms_pin.physics.constraints.contacts import ContactSphere, PlaneContacts, contact_frame
 from uvms_pin.physics.constraints.joint_limits import JointLimits
 from uvms_pin.physics.constraints.step import constrained_velocity
 
@@ -167,3 +167,38 @@ def test_the_alpha5_pressed_on_the_seafloor_in_water():
     assert lowest_m >= -1e-6
     assert touching > 200
     assert np.abs(v).max() < 10.0
+
+
+def test_a_sphere_on_the_models_first_joint_lands_on_the_plane():
+    """Joint 1 is a body like any other (the vehicle's free-flyer in a UVMS): a sphere on
+    it gets its rows, and a free-floating ball (one free-flyer joint) falling at 3 m/s
+    lands on the plane exactly at the period's end, v_z+ = -gap / h, with the normal
+    impulse m (3 - gap / h)."""
+    model = pin.Model()
+    body = model.addJoint(0, pin.JointModelFreeFlyer(), pin.SE3.Identity(), "vehicle")
+    model.appendBodyToJoint(body, pin.Inertia.FromSphere(MASS_KG, RADIUS_M), pin.SE3.Identity())
+    contacts = PlaneContacts(
+        (ContactSphere(body, np.zeros(3), RADIUS_M),), np.zeros(3), np.array([0.0, 0.0, 1.0]), MU
+    )
+    mass = np.diag([MASS_KG] * 3 + [0.4 * MASS_KG * RADIUS_M**2] * 3)
+    q = pin.neutral(model)
+    q[2] = RADIUS_M + 0.002
+    v_free = np.r_[0.0, 0.0, -3.0, 0.0, 0.0, 0.0]
+    step = constrained_velocity(model, mass, v_free, q, [contacts], PERIOD_S)
+    assert step.velocity[2] == pytest.approx(-0.002 / PERIOD_S, rel=1e-6)
+    assert step.impulses["contacts"][2] == pytest.approx(MASS_KG * (3.0 - 1.0), rel=1e-6)
+
+
+@pytest.mark.parametrize(
+    "normal",
+    [(0, 0, 1), (0, 0, -1), (1, 0, 0), (0, 1, 0), (1, 0, 1), (0, 1, 1), (1, 1, 0), (1, 1, 1),
+     (-1, 0, 1), (0.95, 0.3, 0.0), (0.3, 0.95, 0.1)],
+)  # fmt: skip
+def test_the_contact_frame_is_a_rotation_with_the_normal_last(normal):
+    """C = (t1, t2, n) for any unit normal n, whichever helper axis it picks: C^T C = I,
+    det C = +1 (t1 x t2 = n), and n its third column."""
+    n = np.asarray(normal, dtype=float) / np.linalg.norm(normal)
+    frame = contact_frame(n)
+    np.testing.assert_allclose(frame.T @ frame, np.eye(3), atol=1e-14)
+    assert np.linalg.det(frame) == pytest.approx(1.0, abs=1e-14)
+    np.testing.assert_allclose(frame[:, 2], n, atol=1e-15)

@@ -145,3 +145,36 @@ def test_the_scenario_key_chooses_the_moving_contacts(load_body):
     assert soft.record()["world"]["moving_contact"] == "compliant"
     with pytest.raises(ParameterError, match="moving_contact must be one of compliant, rigid"):
         World(pusher, [], ContactLaw(), [ball], moving_contact="soft")
+
+
+@pytest.mark.parametrize("mover", ["a", "b"])
+def test_a_pair_closing_at_the_speed_of_either_body_alone_is_solved(load_body, mover):
+    """The broad phase reaches both bodies' points over the period: of balls a and b 5 mm
+    apart, one at rest and the other coming at 5 m/s (10 mm a 2 ms period), the pair is
+    solved, its rows under the set's name (the key of its impulses in the step's result),
+    in N s; nothing moving, the same pair (over the 1 mm margin) is not, and a pair at rest
+    0.5 mm apart (within the margin) is."""
+    coming = [5.0 if mover == "a" else -5.0, 0.0, 0.0, 0.0, 0.0, 0.0]
+    a = _ball("a", [0.0, 0.0, -5.0], velocity=coming if mover == "a" else None)
+    b = _ball("b", [0.405, 0.0, -5.0], velocity=coming if mover == "b" else None)
+    system = _system(_pusher(load_body), [a, b])
+    q = system.plant.uvms.neutral_configuration()
+    q[:3] = [20.0, 0.0, -5.0]
+    state = system.initial_state(q, np.zeros(6))
+    assert np.abs(state.v).max() == pytest.approx(5.0)  # the mover's velocity, nothing else
+    model, data = system.model, system.model.createData()
+    pin.computeJointJacobians(model, data, state.q)
+    constraints = system.moving_constraints
+    rows = constraints.rows(model, data, state.q, np.abs(state.v), PERIOD_S)
+    assert rows.size == 3 and rows.gap[2] == pytest.approx(0.005, abs=1e-9)
+    assert rows.name == constraints.name and rows.unit == "N s"
+    still = constraints.rows(model, data, state.q, np.zeros(model.nv), PERIOD_S)
+    assert still.size == 0 and still.name == constraints.name
+    near = _system(
+        _pusher(load_body), [_ball("a", [0.0, 0.0, -5.0]), _ball("b", [0.4005, 0.0, -5.0])]
+    )
+    state = near.initial_state(q, np.zeros(6))
+    model, data = near.model, near.model.createData()
+    pin.computeJointJacobians(model, data, state.q)
+    rows = near.moving_constraints.rows(model, data, state.q, np.zeros(model.nv), PERIOD_S)
+    assert rows.size == 3 and rows.gap[2] == pytest.approx(0.0005, abs=1e-9)

@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import numpy as np
 import pinocchio as pin
+import pytest
 from conftest import RHO, body_urdf, hydro_xml
 
 from uvms_pin.physics.compiled.extension import core_module
@@ -127,3 +128,37 @@ def test_the_core_finds_a_bars_contacts_as_the_reference_does(load_body):
         )
         touching += len(python.pair)
     assert 30 < touching < 270  # both kinds of pose
+
+
+def test_two_pieces_touching_one_object_at_once_get_mirrored_pairs(load_body):
+    """A robot of two spheres (r = 0.1 m, 16 cm apart along y) posed symmetrically about
+    y = 0, both 9 mm into a free ball's side (r = 0.2 m) at once: two touching pairs of
+    one set, mirror images of each other (y negated) in their points and forces, each
+    force pushing the robot away from the ball; the core finds the reference's."""
+    second = '</geometry></collision><collision><origin xyz="0 0.16 0"/><geometry>'
+    twins = _body(load_body, f'<sphere radius="0.1"/>{second}<sphere radius="0.1"/>')
+    ball = free_object(
+        "ball", "sphere", {"radius_m": 0.2}, ([0.0, 0.0, -5.0], [0, 0, 0]),
+        density_kg_m3=RHO, water_density_kg_m3=RHO,
+    )  # fmt: skip
+    system = System(Plant(twins, world=World(twins, [], ContactLaw(), [ball])))
+    (pairs,) = system.moving.moving.sets
+    offsets = np.array([p.placement_in_joint.translation for p in pairs.pairs.pieces_a])
+    assert np.ptp(offsets[:, 1]) == pytest.approx(0.16)
+    q = twins.neutral_configuration()
+    # the spheres at y = +-0.08 m: centres 0.2912 m from the ball's, 8.8 mm deep each
+    q[:3] = [-0.28 - offsets[:, 0].mean(), -offsets[:, 1].mean(), -5.0 - offsets[:, 2].mean()]
+    states = system.moving.initial_states()
+    system.moving._kinematics(q, np.zeros(6), states)
+    data = system.moving.moving._datas(system.moving.uvms_data, system.moving.datas)
+    python = pairs.pairs.forces(data(pairs.a), data(pairs.b), pairs.memory)
+    assert len(python) == 2
+    points, forces = python.touch.point_world_m, python.force_world_N
+    low, high = np.argsort(points[:, 1])
+    mirror = np.array([1.0, -1.0, 1.0])
+    np.testing.assert_allclose(points[low] * mirror, points[high], rtol=0, atol=1e-9)
+    np.testing.assert_allclose(forces[low] * mirror, forces[high], rtol=1e-9, atol=1e-9)
+    assert np.all(forces[:, 0] < 0.0)
+    core = PairSearch(pairs.pairs, core_module())(data(pairs.a), data(pairs.b), pairs.memory)
+    assert np.array_equal(core.pair, python.pair)
+    np.testing.assert_allclose(core.force_world_N, forces, rtol=0, atol=1e-12)
