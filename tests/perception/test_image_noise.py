@@ -6,6 +6,7 @@ import numpy as np
 import pytest
 from scipy.special import ndtr
 
+from uvms_pin.errors import ParameterError
 from uvms_pin.perception.image_noise import LEVELS, normal_levels, standard_normal_f32
 
 
@@ -53,5 +54,5 @@ def test_the_same_seed_gives_the_same_draws_written_in_place():
     ],
 )
 def test_an_output_of_the_wrong_kind_is_refused(out):
-    with pytest.raises(ValueError, match="C-contiguous float32"):
+    with pytest.raises(ParameterError, match="C-contiguous float32"):
         standard_normal_f32(np.random.default_rng(0), (4, 3), out=out)

@@ -20,6 +20,8 @@ from functools import cache
 import numpy as np
 from scipy.special import ndtri
 
+from uvms_pin.errors import ParameterError
+
 __all__ = ["LEVELS", "normal_levels", "standard_normal_f32"]
 
 LEVELS = 1 << 16
@@ -46,7 +48,7 @@ def standard_normal_f32(
     if out is None:
         out = np.empty(shape, dtype=np.float32)
     elif out.shape != tuple(shape) or out.dtype != np.float32 or not out.flags.c_contiguous:
-        raise ValueError(f"out must be a C-contiguous float32 array of shape {tuple(shape)}")
+        raise ParameterError(f"out must be a C-contiguous float32 array of shape {tuple(shape)}")
     codes = rng.integers(0, LEVELS, size=size, dtype=np.uint16)
     np.take(normal_levels(), codes, out=out.reshape(size))
     return out
