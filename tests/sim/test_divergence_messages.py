@@ -68,17 +68,22 @@ def test_an_applied_force_no_actuator_makes_is_named():
     assert "applied generalized force arm_joint2 = 1e+30 N m" in str(info.value)
 
 
-def test_a_mass_matrix_singular_along_a_joint_names_the_joint(reference_uvms):
+def _arm_joint4_link(reference_uvms, inertia: pin.Inertia):
+    """The reference UVMS with arm_joint4's link of ``inertia``, no armature, no added mass."""
     model = reference_uvms.model.copy()
-    model.inertias[5] = pin.Inertia.Zero()  # arm_joint4's link, and no armature, no added mass
+    model.inertias[5] = inertia
     model.armature[9] = 0.0
-    uvms = reference_uvms.with_model(model).with_hydro(
+    return reference_uvms.with_model(model).with_hydro(
         lambda b: (
             b.params
             if b.joint_id != 5
             else dataclasses.replace(b.params, added_mass=np.zeros((6, 6)))
         )
     )
+
+
+def test_a_mass_matrix_singular_along_a_joint_names_the_joint(reference_uvms):
+    uvms = _arm_joint4_link(reference_uvms, pin.Inertia.Zero())
     context = divergence_context(
         Plant(uvms), (0.0, 0.01), uvms.neutral_configuration(), np.zeros(10), np.zeros(10)
     )
@@ -192,16 +197,7 @@ def test_a_mass_matrix_singular_relative_to_its_largest_eigenvalue_is_named(refe
     """Singular is relative: arm_joint4's link with 1e-13 kg m^2 (no armature, no added
     mass) leaves M's smallest eigenvalue below 1e-12 of its largest, singular to double
     precision though not zero, and it is named as such."""
-    model = reference_uvms.model.copy()
-    model.inertias[5] = pin.Inertia(1e-13, np.zeros(3), 1e-13 * np.eye(3))
-    model.armature[9] = 0.0
-    uvms = reference_uvms.with_model(model).with_hydro(
-        lambda b: (
-            b.params
-            if b.joint_id != 5
-            else dataclasses.replace(b.params, added_mass=np.zeros((6, 6)))
-        )
-    )
+    uvms = _arm_joint4_link(reference_uvms, pin.Inertia(1e-13, np.zeros(3), 1e-13 * np.eye(3)))
     q = uvms.neutral_configuration()
     eigenvalues = np.linalg.eigvalsh(mass_matrix(uvms, q, backend="python"))
     assert 0.0 < eigenvalues[0] < 1e-12 * eigenvalues[-1]  # the case: tiny, not zero

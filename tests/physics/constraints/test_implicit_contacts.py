@@ -106,15 +106,23 @@ def test_a_sphere_above_the_plane_has_no_row(ball):
     np.testing.assert_allclose(frame[2], [0.0, 0.0, 1.0], atol=1e-15)
 
 
-def test_a_falling_sphere_stops_on_the_plane_without_bouncing(ball):
+def _dropped_on_the_plane(model, joint_id: int, v_free: np.ndarray):
+    """One period of the sphere on ``joint_id`` (a free flyer), 2 mm above the plane z = 0,
+    moving at ``v_free`` before its contact."""
     contacts = PlaneContacts(
-        (ContactSphere(2, np.zeros(3), RADIUS_M),), np.zeros(3), np.array([0.0, 0.0, 1.0]), MU
+        (ContactSphere(joint_id, np.zeros(3), RADIUS_M),),
+        np.zeros(3),
+        np.array([0.0, 0.0, 1.0]),
+        MU,
     )
     mass = np.diag([MASS_KG] * 3 + [0.4 * MASS_KG * RADIUS_M**2] * 3)
-    q = pin.neutral(ball)
+    q = pin.neutral(model)
     q[2] = RADIUS_M + 0.002
-    v_free = np.r_[1.0, 0.0, -3.0, 0.0, 0.0, 0.0]
-    step = constrained_velocity(ball, mass, v_free, q, [contacts], PERIOD_S)
+    return constrained_velocity(model, mass, v_free, q, [contacts], PERIOD_S)
+
+
+def test_a_falling_sphere_stops_on_the_plane_without_bouncing(ball):
+    step = _dropped_on_the_plane(ball, 2, np.r_[1.0, 0.0, -3.0, 0.0, 0.0, 0.0])
     # lands exactly on the plane at the period's end: v_z = -gap / h
     assert step.velocity[2] == pytest.approx(-0.002 / PERIOD_S, rel=1e-6)
     assert step.impulses["contacts"][2] == pytest.approx(MASS_KG * (3.0 - 1.0), rel=1e-6)
@@ -177,14 +185,7 @@ def test_a_sphere_on_the_models_first_joint_lands_on_the_plane():
     model = pin.Model()
     body = model.addJoint(0, pin.JointModelFreeFlyer(), pin.SE3.Identity(), "vehicle")
     model.appendBodyToJoint(body, pin.Inertia.FromSphere(MASS_KG, RADIUS_M), pin.SE3.Identity())
-    contacts = PlaneContacts(
-        (ContactSphere(body, np.zeros(3), RADIUS_M),), np.zeros(3), np.array([0.0, 0.0, 1.0]), MU
-    )
-    mass = np.diag([MASS_KG] * 3 + [0.4 * MASS_KG * RADIUS_M**2] * 3)
-    q = pin.neutral(model)
-    q[2] = RADIUS_M + 0.002
-    v_free = np.r_[0.0, 0.0, -3.0, 0.0, 0.0, 0.0]
-    step = constrained_velocity(model, mass, v_free, q, [contacts], PERIOD_S)
+    step = _dropped_on_the_plane(model, body, np.r_[0.0, 0.0, -3.0, 0.0, 0.0, 0.0])
     assert step.velocity[2] == pytest.approx(-0.002 / PERIOD_S, rel=1e-6)
     assert step.impulses["contacts"][2] == pytest.approx(MASS_KG * (3.0 - 1.0), rel=1e-6)
 
