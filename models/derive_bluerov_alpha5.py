@@ -233,6 +233,29 @@ ALPHA_JOINTS = (
     ),
 )
 ALPHA_ENCODER_OFFSETS_RAD = {"alpha_axis_e": 3.07, "alpha_axis_b": 2.879}
+# The joints' drives (models/README.md, "Joint drives"): each joint's reflected rotor inertia
+# J_rotor N^2 [kg m^2], Pinocchio's armature. The gear ratios N are Reach Robotics' (P25's
+# reach_hardware/src/alpha_5_hardware.cpp, GEAR_RATIO, device ids 5..2 = axes E..B: 1754.4
+# for the three 0.0134 N m/A motors, 340.4 for the wrist's 0.0271 N m/A one); the rotor
+# inertias are estimates for motors of those torque constants (no published value): a
+# 12-13 mm motor, 2e-8 kg m^2 (0.2 g cm^2), and a 16 mm one, 1e-7 kg m^2 (1 g cm^2).
+ALPHA_GEAR_RATIO = {
+    "alpha_axis_e": 1754.4,
+    "alpha_axis_d": 1754.4,
+    "alpha_axis_c": 1754.4,
+    "alpha_axis_b": 340.4,
+}
+ALPHA_ROTOR_INERTIA_KG_M2 = {
+    "alpha_axis_e": 2e-8,
+    "alpha_axis_d": 2e-8,
+    "alpha_axis_c": 2e-8,
+    "alpha_axis_b": 1e-7,
+}
+
+
+def alpha_armature_kg_m2(joint: str) -> float:
+    """A joint's reflected rotor inertia J_rotor N^2 [kg m^2], to 3 significant digits."""
+    return float(f"{ALPHA_ROTOR_INERTIA_KG_M2[joint] * ALPHA_GEAR_RATIO[joint] ** 2:.3g}")
 
 
 def _f(values) -> str:
@@ -466,7 +489,8 @@ def alpha5_urdf() -> str:
             f'    <child link="{child}"/>\n    <origin xyz="{_f(xyz)}" rpy="{_f(rpy)}"/>\n'
             '    <axis xyz="0 0 1"/>\n'
             f'    <limit lower="{lower:.9g}" upper="{upper:.9g}" effort="{effort:.9g}" '
-            f'velocity="{velocity:.9g}"/>\n  </joint>\n'
+            f'velocity="{velocity:.9g}"/>\n'
+            f'    <armature value="{alpha_armature_kg_m2(joint):.9g}"/>\n  </joint>\n'
         )
     name, mass, xyz, volume_L, drag = ALPHA_JAW
     hydro = _hydro(volume_L * 1e-3, quadratic=(*drag, 0, 0, 0))

@@ -5,6 +5,7 @@ from __future__ import annotations
 import contextlib
 import io
 import os
+import re
 import shutil
 import subprocess
 import sys
@@ -30,6 +31,20 @@ RHO = 1025.0
 G = 9.81
 #: relative agreement of the compiled core with the Python reference
 REL = 1e-12
+#: the shipped BlueROV2 Heavy + Reach Alpha 5 (its joints' drives as armature)
+ALPHA5_URDF = ROOT / "models" / "uvms_bluerov2_alpha5.urdf"
+
+
+def without_drives(urdf: Path, tmp_dir: Path) -> Path:
+    """``urdf`` written to ``tmp_dir`` without its joints' ``<armature>`` (their drives'
+    reflected rotor inertia): the light links a URDF without drive data gives (the Alpha 5's
+    wrist link alone: ~8e-5 kg m^2 about its axis, against 0.0117 with its drive)."""
+    text = urdf.read_text()
+    stripped = re.sub(r"\s*<armature [^>]*/>", "", text)
+    assert stripped != text, f"{urdf.name} has no <armature> to take out"
+    path = tmp_dir / f"{urdf.stem}_without_drives.urdf"
+    path.write_text(stripped)
+    return path
 
 
 def pytest_collection_modifyitems(config, items) -> None:

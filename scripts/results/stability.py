@@ -9,7 +9,7 @@ import time
 
 import gymnasium as gym
 import numpy as np
-from _common import producer_cli, scratch, uvms_pin, write_result
+from _common import ROOT, producer_cli, scratch, uvms_pin, write_result
 
 import uvms_pin as up
 from uvms_pin.results.metrics import joint_limit_metrics
@@ -17,7 +17,12 @@ from uvms_pin.results.metrics import joint_limit_metrics
 PASSIVE = "scenarios/passive_still_water.toml"
 #: each model with a start within its joint limits (the scenario's velocity swings the arm)
 MODELS = {"uvms_bluerov2_alpha5": "[-0.2, 0.8, 2.2, 0.2]", "uvms_lbv150": "[0.0, 0.5, -0.5, 0.0]"}
-ENVIRONMENTS = ("uvms_pin/StationKeeping-v0", "uvms_pin/ForceTracking-v0")
+#: each environment as registered, and station keeping on the BlueROV2 Heavy + Alpha 5
+ENVIRONMENTS = (
+    ("uvms_pin/StationKeeping-v0", None),
+    ("uvms_pin/ForceTracking-v0", None),
+    ("uvms_pin/StationKeeping-v0", "scenarios/bluerov_alpha5_force_tracking.toml"),
+)
 NUM_ENVS, STEPS, SEED = 64, 3000, 2026
 
 importlib.import_module("uvms_pin.apps.gym")  # registers the environments
@@ -53,20 +58,29 @@ def passive_rows() -> list[str]:
 
 def random_action_rows() -> list[str]:
     rows = []
-    for env_id in ENVIRONMENTS:
-        envs = gym.make_vec(env_id, num_envs=NUM_ENVS, vectorization_mode="vector_entry_point")
+    for env_id, scenario in ENVIRONMENTS:
+        kwargs = {} if scenario is None else {"scenario": str(ROOT / scenario)}
+        envs = gym.make_vec(
+            env_id, num_envs=NUM_ENVS, vectorization_mode="vector_entry_point", **kwargs
+        )
         envs.action_space.seed(SEED)
         envs.reset(seed=SEED)
         diverged = episodes = 0
+        # each step's fastest arm joint over the environments [rad/s]: what random torques
+        # at the effort limits make of the arm's inertia (its drives' armature included)
+        joint_rates = np.empty(STEPS)
         start = time.perf_counter()
-        for _ in range(STEPS):
+        for k in range(STEPS):
             _, _, terminated, truncated, infos = envs.step(envs.action_space.sample())
             diverged += int(np.sum(infos["diverged"]))
             episodes += int(np.sum(terminated | truncated))
+            joint_rates[k] = np.abs(envs.batch.v[:, 6:]).max()
         wall_s = time.perf_counter() - start
         envs.close()
         rows.append(
-            f"| `{env_id}` | {NUM_ENVS} x {STEPS} | {episodes} | {diverged} | {wall_s:.1f} |"
+            f"| `{env_id}`{'' if scenario is None else f' on `{scenario}`'} "
+            f"| {NUM_ENVS} x {STEPS} | {episodes} | {diverged} "
+            f"| {np.median(joint_rates):.2f} | {joint_rates.max():.1f} | {wall_s:.1f} |"
         )
     return rows
 
@@ -84,9 +98,11 @@ def main() -> None:
         + "\n".join(passive)
         + "\n\nThe vector environments (`gym.make_vec(..., vectorization_mode="
         '"vector_entry_point")`) driven by `action_space.sample()` (seed '
-        f"{SEED}), autoreset on:\n\n"
-        "| environment | environments x steps | episodes ended | diverged steps | wall [s] |\n"
-        "|---|---|---|---|---|\n" + "\n".join(random) + "\n"
+        f"{SEED}), autoreset on; a step's fastest arm joint is the largest |qdot| over the "
+        "environments after it (the Alpha 5's velocity limits are 0.5 and 1 rad/s):\n\n"
+        "| environment | environments x steps | episodes ended | diverged steps "
+        "| a step's fastest arm joint, median [rad/s] | fastest arm joint [rad/s] "
+        "| wall [s] |\n|---|---|---|---|---|---|---|\n" + "\n".join(random) + "\n"
     )
     write_result(
         "stability",

@@ -108,6 +108,34 @@ def test_alpha5_masses_volumes_and_limits():
     np.testing.assert_allclose(np.degrees(arm.model.lowerPositionLimit[7:]), [-175, 0, 0, -165])
 
 
+@pytest.mark.parametrize(
+    "name",
+    ["reach_alpha5", "reach_alpha5_jaws", "uvms_bluerov2_alpha5", "uvms_bluerov2_alpha5_jaws"],
+)
+def test_every_alpha5_file_carries_its_drives_reflected_rotor_inertia(name):
+    """J_rotor N^2 on each arm joint: Reach's gear ratios (1754.4 on axes E, D, C; 340.4 on
+    the wrist) times the estimated rotor inertias (2e-8 and 1e-7 kg m^2), through the
+    mount into the merged files; no armature elsewhere (the fingers, the vehicle)."""
+    kwargs = {} if name.startswith("uvms_") else {"ee_frame": "alpha_wrist_link",
+                                                  "sensor_frame": "alpha_wrist_link"}  # fmt: skip
+    uvms = up.load_uvms(MODELS / f"{name}.urdf", **kwargs)
+    model = uvms.model
+    expected = {"alpha_axis_e": 0.0616, "alpha_axis_d": 0.0616, "alpha_axis_c": 0.0616,
+                "alpha_axis_b": 0.0116}  # fmt: skip
+    armature = np.zeros(model.nv)
+    for joint, value in expected.items():
+        idx_v = model.joints[model.getJointId(joint)].idx_v
+        armature[idx_v] = value
+        assert value == pytest.approx(
+            {"alpha_axis_b": 1e-7 * 340.4**2}.get(joint, 2e-8 * 1754.4**2), rel=2e-3
+        )
+    np.testing.assert_array_equal(model.armature, armature)
+    # the wrist about its own axis: its link's 8e-5 kg m^2 and the drive's 0.0116
+    mass = up.mass_matrix(uvms, uvms.neutral_configuration())
+    wrist = model.joints[model.getJointId("alpha_axis_b")].idx_v
+    assert 0.0116 < mass[wrist, wrist] < 0.0116 + 2e-4
+
+
 @pytest.mark.parametrize("vehicle", [BLUEROV, TRIAL])
 def test_alpha5_mounts_on_both_bluerov_models(vehicle):
     uvms = up.mount_arm(vehicle, ALPHA5, MOUNT, tool=None, water_density_kg_m3=997.0)

@@ -13,7 +13,7 @@ from pathlib import Path
 import numpy as np
 import pinocchio as pin
 import pytest
-from conftest import run
+from conftest import ALPHA5_URDF, run, without_drives
 from scipy.optimize import brentq
 
 from uvms_pin.errors import ParameterError, StiffModeError
@@ -23,7 +23,13 @@ from uvms_pin.scenario.load import load_scenario
 from uvms_pin.sim.closed_loop import ClosedLoop
 from uvms_pin.sim.integrators import RK4, Adaptive, SemiImplicitEuler
 from uvms_pin.sim.run import simulate
-from uvms_pin.sim.stiff_modes import StiffMode, candidate_contacts, environment_mode, stop_modes
+from uvms_pin.sim.stiff_modes import (
+    StiffMode,
+    body_mobility,
+    candidate_contacts,
+    environment_mode,
+    stop_modes,
+)
 from uvms_pin.sim.stiffness import (
     _stiffest,
     check_stiff_modes,
@@ -167,12 +173,17 @@ def test_the_command_line_refuses_it_with_status_2_and_no_traceback(tmp_path):
     assert not out.exists()  # refused before the run: nothing written
 
 
-def test_a_light_wrist_on_compliant_stops_is_refused_naming_its_joint():
+_ALPHA5_ON_COMPLIANT_STOPS = {
+    "joints.stops": "compliant",
+    "scenario.duration_s": 1.0,
+    "initial.joint_positions_rad": [-0.2, 0.8, 2.2, 0.2],  # within the Alpha 5's limits
+}
+
+
+def test_a_light_wrist_on_compliant_stops_is_refused_naming_its_joint(tmp_path):
     overrides = {
-        "scenario.model": "uvms_bluerov2_alpha5",
-        "joints.stops": "compliant",
-        "scenario.duration_s": 1.0,
-        "initial.joint_positions_rad": [-0.2, 0.8, 2.2, 0.2],  # within the Alpha 5's limits
+        "scenario.model": str(without_drives(ALPHA5_URDF, tmp_path)),
+        **_ALPHA5_ON_COMPLIANT_STOPS,
     }
     with pytest.raises(StiffModeError, match=r"the compliant stop of joint '\w+'") as caught:
         simulate(load_scenario(SCENARIOS / "passive_still_water.toml", overrides), progress=False)
@@ -202,17 +213,18 @@ def test_every_shipped_scenario_is_accepted_at_its_defaults(path):
 
 def test_the_rollout_records_the_stiffest_mode_and_its_margin():
     """seabed_landing's closest mode: the Alpha 5's jaw against the seabed and the rock,
-    at first touch (its most mobile corner: 0.39 kg), 24.9x its 0.5 ms step."""
+    at first touch (its most mobile corner: 0.82 kg with the drives' armature), 36.3x its
+    0.5 ms step."""
     scenario = load_scenario(SCENARIOS / "seabed_landing.toml", {"scenario.duration_s": 0.1})
     record = simulate(scenario, progress=False).metadata["stiff_modes"]
     assert record["checked"] and record["integrator"] == "RK4" and record["step_s"] == 5e-4
     stiffest = record["stiffest"]
     assert "link 'alpha_jaw_link' against the fixed world" in stiffest["what"]
     assert stiffest["stiffness"] == 2.0e4 and stiffest["damping"] == 0.0
-    assert stiffest["effective_mass"] == pytest.approx(0.388, abs=0.001)
+    assert stiffest["effective_mass"] == pytest.approx(0.823, abs=0.001)
     omega = math.sqrt(2.0e4 / stiffest["effective_mass"])
     assert stiffest["largest_stable_step_s"] * omega == pytest.approx(2.0 * math.sqrt(2.0))
-    assert record["margin"] == pytest.approx(24.9, abs=0.1)
+    assert record["margin"] == pytest.approx(36.3, abs=0.1)
 
 
 def test_the_environment_modes_take_the_end_effectors_mobility():
@@ -241,19 +253,36 @@ def test_a_stops_inertia_is_the_inverse_of_the_inverse_mass_diagonal():
 
 def test_the_arm_against_its_own_vehicle_is_a_mode_of_their_relative_motion():
     """With self_collision each arm link (the one jointed to the vehicle aside) meets its
-    vehicle: the two points' relative Jacobian, lighter than the link against the world (the
-    vehicle recoils)."""
+    vehicle: the two material points' relative Jacobian, whose vehicle columns cancel
+    (J_a - J_b = [0, J_q]), so 1/m_eff = J_q (M^-1)_qq J_q^T, never below the link's
+    mobility with the vehicle clamped, J_q (M_qq)^-1 J_q^T: the vehicle's recoil can only
+    make the pair lighter."""
     overrides = {"world.contact.self_collision": True}
     scenario = load_scenario(SCENARIOS / "seabed_landing.toml", overrides)
     loop = ClosedLoop(scenario.plant, scenario.settings)
-    modes = system_modes(loop.system, loop.system.initial_state(scenario.q0, scenario.v0))
+    system = loop.system
+    state = system.initial_state(scenario.q0, scenario.v0)
+    modes = system_modes(system, state)
     own = {m.what.split(" against")[0]: m.mass for m in modes if "own vehicle" in m.what}
-    world = {m.what.split(" against")[0]: m.mass for m in modes if "fixed world" in m.what}
     # the shoulder is jointed to the vehicle, the Alpha 5's base is a part of it
     assert "link 'alpha_shoulder_link_cob'" not in own and "link 'alpha_base_link_cob'" not in own
     assert "link 'alpha_jaw_link'" in own and "link 'alpha_upper_arm_link_cob'" in own
-    for link, mass in own.items():
-        assert 0.0 < mass <= world[link] + 1e-12
+    model, world = system.plant.uvms.model, system.plant.world
+    data = model.createData()
+    pin.computeJointJacobians(model, data, state.q[system.layout.q_slices[0]])
+    robot = system.layout.v_slices[0]
+    mass = system.mass_matrix(0.0, state.q)[robot, robot]
+    clamped, joints_only = np.zeros_like(mass), np.zeros_like(mass)
+    clamped[6:, 6:] = np.linalg.inv(mass[6:, 6:])
+    joints_only[6:, 6:] = np.linalg.inv(mass)[6:, 6:]
+    for b, name in enumerate(world.body_names):
+        if f"link '{name}'" not in own:
+            continue
+        pieces = [p for p in world.pieces if p.body == b and p.joint_id > 1]
+        relative_mass = 1.0 / body_mobility(model, data, joints_only, pieces)
+        clamped_mass = 1.0 / body_mobility(model, data, clamped, pieces)
+        assert own[f"link '{name}'"] == pytest.approx(relative_mass, rel=1e-9)
+        assert 0.0 < relative_mass <= clamped_mass * (1.0 + 1e-9)
 
 
 def _handle_mobility_1_kg(system, state) -> float:

@@ -7,7 +7,7 @@ from unittest import mock
 
 import numpy as np
 import pytest
-from conftest import ROOT
+from conftest import ALPHA5_URDF, ROOT, without_drives
 
 import uvms_pin as up
 from uvms_pin.physics.compiled.extension import core_module
@@ -142,8 +142,11 @@ def test_a_new_start_steps_with_the_plant_as_attached_anew(reference_uvms):
 
 
 @pytest.fixture(scope="module")
-def bluerov_alpha5():
-    return load_scenario(ROOT / "scenarios" / "bluerov_alpha5_force_tracking.toml")
+def light_bluerov_alpha5(tmp_path_factory):
+    """The BlueROV2 + Alpha 5 force task without its drives' armature: light arm links."""
+    model = without_drives(ALPHA5_URDF, tmp_path_factory.mktemp("light_alpha5"))
+    path = ROOT / "scenarios" / "bluerov_alpha5_force_tracking.toml"
+    return load_scenario(path, {"scenario.model": str(model)})
 
 
 def _released(scenario, **plant_fields):
@@ -166,10 +169,10 @@ def _released(scenario, **plant_fields):
     return closest
 
 
-def test_joint_limits_as_constraints_hold_where_the_stops_diverge(bluerov_alpha5):
-    uvms = bluerov_alpha5.uvms
-    assert _released(bluerov_alpha5, joint_stops=JointStops.of_model(uvms.model)) is None
-    closest = _released(bluerov_alpha5, joint_limits=JointLimits.of_uvms(uvms))
+def test_joint_limits_as_constraints_hold_where_the_stops_diverge(light_bluerov_alpha5):
+    uvms = light_bluerov_alpha5.uvms
+    assert _released(light_bluerov_alpha5, joint_stops=JointStops.of_model(uvms.model)) is None
+    closest = _released(light_bluerov_alpha5, joint_limits=JointLimits.of_uvms(uvms))
     assert -1e-6 <= closest < 1e-4  # a joint reached its limit, and none went past it
 
 

@@ -1,5 +1,6 @@
 """The arm's joint limits solved implicitly (`uvms_pin.physics.constraints`): the shipped
-BlueROV2 Heavy + Alpha 5, free and driven by random joint torques, stays within its limits
+BlueROV2 Heavy + Alpha 5 without its drives' armature (light links: the hard case), free and
+driven by random joint torques, stays within its limits
 (1e-6 rad) for 2,000 periods of 2 ms where the compliant stops at the same period diverge;
 the impulses never add kinetic energy; the rows, their labels and the refusals."""
 
@@ -10,10 +11,10 @@ import warnings
 import numpy as np
 import pinocchio as pin
 import pytest
+from conftest import ALPHA5_URDF, without_drives
 
 import uvms_pin as up
 from uvms_pin.errors import ParameterError
-from uvms_pin.model.resources import shipped_path
 from uvms_pin.physics.constraints.joint_limits import JointLimits
 from uvms_pin.physics.constraints.step import constrained_configuration, constrained_velocity
 from uvms_pin.physics.joint_stops import JointStops
@@ -25,10 +26,12 @@ DIVERGED = 1e4  # a velocity past this [rad/s, m/s] has diverged
 
 
 @pytest.fixture(scope="module")
-def alpha5():
+def alpha5(tmp_path_factory):
+    """The BlueROV2 + Alpha 5 without its drives' armature: light arm links, stiff stops."""
+    light = without_drives(ALPHA5_URDF, tmp_path_factory.mktemp("light_alpha5"))
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", up.ModelWarning)
-        return up.load_uvms(shipped_path("models/uvms_bluerov2_alpha5.urdf"))
+        return up.load_uvms(light)
 
 
 def _start(uvms) -> tuple[np.ndarray, np.ndarray]:
