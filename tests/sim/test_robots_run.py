@@ -193,3 +193,16 @@ def test_rigid_moving_contacts_with_several_robots_are_refused_by_name():
     refused = r'moving_contact = "rigid" is not simulated with several robots'
     with pytest.raises(ParameterError, match=refused):
         simulate_robots(scenario_from_dict(doc, transport))
+
+
+def test_progress_is_given_as_to_simulate(capsys):
+    """``progress`` as `simulate`'s: False and None silent, a callable called with the run's
+    times up to its duration, anything else refused before the run."""
+    for silent in (False, None):
+        assert len(simulate_robots(_two(0.1), progress=silent).robot("alpha").time_s) > 0
+    assert capsys.readouterr().err == ""
+    seen = []
+    simulate_robots(_two(0.1), progress=lambda t_s, duration_s: seen.append((t_s, duration_s)))
+    assert seen and seen[-1] == pytest.approx((0.1, 0.1)) and all(d == 0.1 for _, d in seen)
+    with pytest.raises(ParameterError, match="progress must be"):
+        simulate_robots(_two(0.1), progress="yes")

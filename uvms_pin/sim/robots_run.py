@@ -16,7 +16,7 @@ from pathlib import Path
 from typing import Any
 
 from uvms_pin.errors import ParameterError, ScenarioError, SimulationError
-from uvms_pin.results.progress import Progress
+from uvms_pin.results.progress import Progress, callback_or_none, progress_printer
 from uvms_pin.results.robots import RobotRollouts
 from uvms_pin.sim.log import RolloutLog, described_columns, run_metadata
 from uvms_pin.sim.robots_loop import RobotsLoop
@@ -102,14 +102,24 @@ def simulate_robots(
     scenario: RobotsScenario,
     *,
     controllers: Sequence | None = None,
-    progress: Progress | None = None,
+    progress: bool | Progress | None = None,
 ) -> RobotRollouts:
     """Run every robot of ``scenario``, each with a fresh controller (or the instances
-    ``controllers``, one per robot, reset first) and its own seeded sensors; ``progress``:
-    a callable ``(t_s, duration_s)`` called after every logged sample (None: silent).
+    ``controllers``, one per robot, reset first) and its own seeded sensors; ``progress``
+    as `uvms_pin.simulate`'s (True: a progress bar; a callable ``(t_s, duration_s)`` called
+    after every logged sample; False or None, the default: silent).
 
     Raises FunnelViolation / SimulationError with the rollouts so far attached as
     ``exc.rollout`` (a `RobotRollouts`)."""
+    if progress is True:
+        with progress_printer(scenario.name, scenario.settings.duration_s) as printer:
+            return _simulate_robots(scenario, controllers, printer)
+    return _simulate_robots(scenario, controllers, callback_or_none(progress))
+
+
+def _simulate_robots(
+    scenario: RobotsScenario, controllers: Sequence | None, progress: Progress | None
+) -> RobotRollouts:
     robots = scenario.robots
     given = list(controllers) if controllers is not None else [None] * len(robots)
     if len(given) != len(robots):
