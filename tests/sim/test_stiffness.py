@@ -187,6 +187,7 @@ def test_a_light_wrist_on_compliant_stops_is_refused_naming_its_joint(tmp_path):
     }
     with pytest.raises(StiffModeError, match=r"the compliant stop of joint '\w+'") as caught:
         simulate(load_scenario(SCENARIOS / "passive_still_water.toml", overrides), progress=False)
+    assert "<armature" in str(caught.value)  # the URDF lacks the drive's inertia: said so
     assert caught.value.mode.units[2] == "kg m^2"
     assert caught.value.mode.mass < 1e-3  # the wrist: ~8e-5 kg m^2
 
@@ -249,6 +250,10 @@ def test_a_stops_inertia_is_the_inverse_of_the_inverse_mass_diagonal():
     assert modes[0].mass == pytest.approx(0.5 - 0.1**2 / 0.25)
     assert modes[1].mass == pytest.approx(0.25 - 0.1**2 / 0.5)
     assert modes[0].units == ("N m/rad", "N m s/rad", "kg m^2")
+    # a joint whose model gives it no drive inertia is told so, one with it is not
+    told = stop_modes(stops, np.linalg.inv(mass), np.array([0.0] * 6 + [0.0, 0.01]))
+    assert "<armature" in told[0].remedy and "<armature" not in told[1].remedy
+    assert "<armature" not in modes[0].remedy  # (the model's armature not given)
 
 
 def test_the_arm_against_its_own_vehicle_is_a_mode_of_their_relative_motion():

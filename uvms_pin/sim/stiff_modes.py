@@ -212,11 +212,21 @@ def contact_modes(
     ]
 
 
-def stop_modes(stops: JointStops, inverse_mass: np.ndarray) -> list[StiffMode]:
-    """One mode per stopped joint: k_s, c_s, I_eff = 1 / (M^-1)_jj."""
+_NO_DRIVE = (
+    ", or give the joint its drive's reflected rotor inertia (the URDF's <armature "
+    'value="..."/> inside the <joint>, kg m^2: J_rotor N^2; this one has none)'
+)
+
+
+def stop_modes(
+    stops: JointStops, inverse_mass: np.ndarray, armature: np.ndarray | None = None
+) -> list[StiffMode]:
+    """One mode per stopped joint: k_s, c_s, I_eff = 1 / (M^-1)_jj. ``armature`` (nv,), the
+    model's: a joint without any is also told it lacks its drive's inertia."""
     out = []
     for name, v_index in zip(stops.names, stops.v_index, strict=True):
         mobility = float(inverse_mass[v_index, v_index])
+        no_drive = armature is not None and not armature[v_index] > 0.0
         out.append(
             StiffMode(
                 f"the compliant stop of joint '{name}'",
@@ -226,7 +236,7 @@ def stop_modes(stops: JointStops, inverse_mass: np.ndarray) -> list[StiffMode]:
                 ANGULAR,
                 ', or solve the limits as constraints ([joints] stops = "implicit", with a '
                 "[control] period_s), or soften the stops (stop_stiffness_Nm_rad, "
-                "stop_damping_Nm_s_rad)",
+                "stop_damping_Nm_s_rad)" + (_NO_DRIVE if no_drive else ""),
             )
         )
     return out

@@ -212,7 +212,7 @@ def system_modes(system: System, state: SystemState, time_s: float = 0.0) -> lis
     pin.computeJointJacobians(model, data, q)
     modes: list[StiffMode] = []
     if plant.joint_stops is not None:
-        modes += stop_modes(plant.joint_stops, robot_inverse)
+        modes += stop_modes(plant.joint_stops, robot_inverse, model.armature)
     if plant.contact is not None:
         frame = plant.uvms.ee_frame_id
         pin.updateFramePlacements(model, data)
