@@ -206,3 +206,9 @@ def test_progress_is_given_as_to_simulate(capsys):
     assert seen and seen[-1] == pytest.approx((0.1, 0.1)) and all(d == 0.1 for _, d in seen)
     with pytest.raises(ParameterError, match="progress must be"):
         simulate_robots(_two(0.1), progress="yes")
+
+
+def test_a_single_robots_scenario_is_refused_naming_simulate():
+    single = load_scenario(GRIPPER, {"scenario.duration_s": 0.1})
+    with pytest.raises(ParameterError, match=r"uvms_pin\.simulate"):
+        simulate_robots(single)

@@ -111,6 +111,12 @@ def simulate_robots(
 
     Raises FunnelViolation / SimulationError with the rollouts so far attached as
     ``exc.rollout`` (a `RobotRollouts`)."""
+    if not isinstance(scenario, RobotsScenario):
+        raise ParameterError(
+            f"simulate_robots takes a scenario of several robots ([[robots]]), got "
+            f"{type(scenario).__name__} {getattr(scenario, 'name', '')!r}: run a single "
+            "robot's scenario with uvms_pin.simulate"
+        )
     if progress is True:
         with progress_printer(scenario.name, scenario.settings.duration_s) as printer:
             return _simulate_robots(scenario, controllers, printer)
