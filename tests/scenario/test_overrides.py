@@ -10,7 +10,8 @@ import pytest
 from conftest import ROOT, run
 
 import uvms_pin as up
-from uvms_pin.scenario.load import load_scenario
+from uvms_pin.errors import ScenarioError
+from uvms_pin.scenario.load import load_scenario, scenario_from_dict
 from uvms_pin.scenario.overrides import apply_overrides, parse_assignment, parse_key_path
 
 PASSIVE = ROOT / "scenarios" / "passive_current.toml"
@@ -208,3 +209,14 @@ def test_a_study_varies_a_thrusters_limit(tmp_path):
         for r in runs
     ]
     assert [t.max_reverse_N for t in limits] == [7.5, 30.0]  # 15 N x 0.5, x 2
+
+
+@pytest.mark.parametrize("overrides", [[("scenario.duration_s", 1.0)], "scenario.duration_s=1", 3])
+def test_overrides_that_are_not_a_mapping_are_a_scenario_error(overrides):
+    with pytest.raises(ScenarioError, match="overrides must be a mapping"):
+        apply_overrides({"scenario": {}}, overrides)
+
+
+def test_a_scenario_built_in_code_must_be_a_mapping():
+    with pytest.raises(ScenarioError, match="a scenario is a mapping of tables"):
+        scenario_from_dict([("scenario", {})])

@@ -109,6 +109,11 @@ def scenario_from_dict(
     """
     path = Path(path)
     source = str(path)
+    if not isinstance(data, Mapping):
+        raise ScenarioError(
+            f"{source}: a scenario is a mapping of tables (what a TOML file holds), got "
+            f"{type(data).__name__}"
+        )
     raw = apply_overrides(dict(data), overrides)
     overridden = {parse_key_path(text).key: text for text in overrides or {}}
     try:

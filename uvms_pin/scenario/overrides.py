@@ -14,6 +14,7 @@ import copy
 import difflib
 import re
 import tomllib
+from collections.abc import Mapping
 from dataclasses import dataclass
 from typing import Any
 
@@ -134,6 +135,11 @@ def apply_overrides(raw: dict[str, Any], overrides: dict[str, Any] | None) -> di
             index into something that is not a list, or out of range, a table given a value
             that is not a table.
     """
+    if overrides is not None and not isinstance(overrides, Mapping):
+        raise ScenarioError(
+            "overrides must be a mapping of dotted keys to values ({'scenario.duration_s': "
+            f"5.0}}), got {type(overrides).__name__}"
+        )
     out = copy.deepcopy(raw)
     for text, value in (overrides or {}).items():
         path = _checked(text, value)
