@@ -111,3 +111,9 @@ def test_a_rescaled_copy_has_its_own_inertias_and_the_original_keeps_its_own():
 def test_a_missing_file_is_the_loaders_error(tmp_path, bad):
     with pytest.raises(up.ModelError):
         loaded_uvms(tmp_path / bad, water_density_kg_m3=1025.0)
+
+
+@pytest.mark.parametrize("bad", [None, 3, ["a.urdf"]])
+def test_a_path_that_is_not_one_is_a_parameter_error(bad):
+    with pytest.raises(up.ParameterError, match="urdf_path must be a path"):
+        up.load_uvms(bad)

@@ -57,6 +57,8 @@ def load_uvms(
     Raises:
         ModelError: naming the file, the link and what is wrong.
     """
+    if not isinstance(urdf_path, str | Path):
+        raise ParameterError(f"urdf_path must be a path to a URDF file, got {urdf_path!r}")
     path = Path(urdf_path)
     where = str(path)
     if not np.isfinite(water_density_kg_m3) or water_density_kg_m3 <= 0.0:
