@@ -194,6 +194,7 @@ def test_render_and_replay_export(tmp_path):
         ({"desired_force_N": [1.0, 2.0]}, "desired_force_N"),
         ({"initial_position_noise_m": -1.0}, "initial_position_noise_m"),
         ({"effort_weight": "high"}, "effort_weight must be a finite number"),
+        ({"overrides": [("control.period_s", 0.01)]}, "overrides must be a mapping"),
     ],
 )
 def test_bad_options_are_clear_errors(kw, match):

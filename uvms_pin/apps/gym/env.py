@@ -17,6 +17,7 @@ from __future__ import annotations
 
 import numbers
 import os
+from collections.abc import Mapping
 from pathlib import Path
 from typing import Any, ClassVar
 
@@ -138,6 +139,11 @@ class UvmsEnv(gym.Env):
                 raise ParameterError(f"{label} must be a finite number >= 0, got {value!r}")
         self.render_mode = render_mode
         self.scenario_path = scenario_path(scenario)
+        if overrides is not None and not isinstance(overrides, Mapping):
+            raise ParameterError(
+                "overrides must be a mapping of dotted scenario keys to values (e.g. "
+                f"{{'control.period_s': 0.01}}), got {type(overrides).__name__}"
+            )
         self.overrides = dict(overrides or {})
         if model is not None:
             self.overrides["scenario.model"] = model
