@@ -35,13 +35,88 @@ namespace {
 constexpr Eigen::Index kBlock = 256;
 using Channels = Eigen::Array<double, 3, Eigen::Dynamic>;  // column j: ray j's (R, G, B)
 
-}  // namespace
+// What an image keeps of each pixel (`shade_into`'s sink). Pixels: the whole image as
+// Camera.render gives it; Recorded: what a firing records.
+struct Pixels {
+  CameraPixels out;
+  void nothing(std::int64_t pixel, std::int32_t label, const double* normal, const Vec3& veiling) {
+    Eigen::Map<Vec3>(out.normal_world + 3 * pixel) = Eigen::Map<const Vec3>(normal);
+    out.label[pixel] = label;
+    out.depth_m[pixel] = std::numeric_limits<double>::quiet_NaN();
+    Eigen::Map<Vec3>(out.radiance + 3 * pixel) = veiling;
+  }
+  void met(std::int64_t pixel, std::int32_t label, const double* normal, double depth_m) {
+    Eigen::Map<Vec3>(out.normal_world + 3 * pixel) = Eigen::Map<const Vec3>(normal);
+    out.label[pixel] = label;
+    out.depth_m[pixel] = depth_m;
+  }
+  void radiance(Eigen::Index, std::int64_t pixel, const Vec3& signal) {
+    Eigen::Map<Vec3>(out.radiance + 3 * pixel) = signal;
+  }
+  void block_done(Eigen::Index) {}
+};
 
-void shade(const Vec3& origin, const Mat3& frame_rotation, const double* rays_f, Eigen::Index n,
-           const double* range_m, const double* normal_world, const std::int32_t* label,
-           const std::int64_t* pixel_of, const double* reflectance, Eigen::Index labels,
-           const WaterColour& water, const std::vector<SpotLight>& lights, CameraPixels out) {
-  const double nan = std::numeric_limits<double>::quiet_NaN();
+// The block's radiance is kept (the rays that met something from 0, the others from kBlock),
+// then made 8-bit counts at once by eight_bit (vectorized), its noise gathered from the codes
+// of its pixels, and the counts put in their pixels.
+struct Recorded {
+  explicit Recorded(const CameraRecord& record)
+      : out(record), radiance_(6 * kBlock), noise_(6 * kBlock), counts_(6 * kBlock),
+        pixels_(2 * kBlock) {}
+  CameraRecord out;
+  std::vector<double> radiance_;
+  std::vector<float> noise_;
+  std::vector<std::uint8_t> counts_;
+  std::vector<std::int64_t> pixels_;
+  Eigen::Index veiled_ = 0;  // the block's rays that met nothing
+
+  // the counts of the `count` pixels from `first` in the block's buffers
+  void colour(Eigen::Index first, Eigen::Index count) {
+    if (count == 0) return;
+    const float* noise = nullptr;
+    if (out.noise_codes != nullptr) {
+      const std::uint16_t* codes = out.noise_codes;
+      const float* levels = out.noise_levels;
+      for (Eigen::Index j = first; j < first + count; ++j) {
+        const std::int64_t pixel = pixels_[j];
+        for (int c = 0; c < 3; ++c) noise_[3 * j + c] = levels[codes[3 * pixel + c]];
+      }
+      noise = noise_.data() + 3 * first;
+    }
+    eight_bit(radiance_.data() + 3 * first, noise, 3 * count, out.scale, out.noise_counts,
+              counts_.data() + 3 * first);
+    std::uint8_t* rgb = out.rgb;
+    for (Eigen::Index j = first; j < first + count; ++j) {
+      std::uint8_t* to = rgb + 3 * pixels_[j];
+      for (int c = 0; c < 3; ++c) to[c] = counts_[3 * j + c];
+    }
+  }
+  void nothing(std::int64_t pixel, std::int32_t label, const double*, const Vec3& veiling) {
+    out.label[pixel] = static_cast<std::int16_t>(label);
+    out.depth_m[pixel] = std::numeric_limits<float>::quiet_NaN();
+    radiance(kBlock + veiled_++, pixel, veiling);
+  }
+  void met(std::int64_t pixel, std::int32_t label, const double*, double depth_m) {
+    out.label[pixel] = static_cast<std::int16_t>(label);
+    out.depth_m[pixel] = static_cast<float>(depth_m);
+  }
+  void radiance(Eigen::Index j, std::int64_t pixel, const Vec3& signal) {
+    Eigen::Map<Vec3>(radiance_.data() + 3 * j) = signal;
+    pixels_[j] = pixel;
+  }
+  void block_done(Eigen::Index count) {
+    colour(0, count);
+    colour(kBlock, veiled_);
+    veiled_ = 0;
+  }
+};
+
+template <class Sink>
+void shade_into(const Vec3& origin, const Mat3& frame_rotation, const double* rays_f,
+                Eigen::Index n, const double* range_m, const double* normal_world,
+                const std::int32_t* label, const std::int64_t* pixel_of,
+                const double* reflectance, Eigen::Index labels, const WaterColour& water,
+                const std::vector<SpotLight>& lights, Sink& sink) {
   const double half_sky = 0.5 * water.surface_irradiance;
   const Eigen::Index n_lights = static_cast<Eigen::Index>(lights.size());
   Channels day(3, kBlock), back(3, kBlock), lit(3, kBlock * n_lights);
@@ -62,15 +137,12 @@ void shade(const Vec3& origin, const Mat3& frame_rotation, const double* rays_f,
       }
       const Eigen::Map<const Vec3> ray_f(rays_f + 3 * i);
       const Eigen::Map<const Vec3> normal(normal_world + 3 * i);
-      Eigen::Map<Vec3>(out.normal_world + 3 * pixel) = normal;
-      out.label[pixel] = k;
       const double r = range_m[i];
       if (!std::isfinite(r)) {  // nothing met: the veiling light
-        out.depth_m[pixel] = nan;
-        Eigen::Map<Vec3>(out.radiance + 3 * pixel) = water.veiling;
+        sink.nothing(pixel, k, normal_world + 3 * i, water.veiling);
         continue;
       }
-      out.depth_m[pixel] = r * ray_f.z();
+      sink.met(pixel, k, normal_world + 3 * i, r * ray_f.z());
       const Eigen::Index j = count++;
       met[j] = i;
       const Vec3 d = frame_rotation * ray_f;
@@ -100,7 +172,10 @@ void shade(const Vec3& origin, const Mat3& frame_rotation, const double* rays_f,
         }
       }
     }
-    if (count == 0) continue;
+    if (count == 0) {
+      sink.block_done(0);
+      continue;
+    }
     // the exponentials, vectorized over the rays that met something (vector_exp.hpp); the
     // backscatter's 1 - exp(-beta_B r) from exp, not expm1: its absolute rounding, 1e-16, is
     // below the radiance's own
@@ -121,9 +196,31 @@ void shade(const Vec3& origin, const Mat3& frame_rotation, const double* rays_f,
       }
       // the backscatter B_inf (1 - exp(-beta_B r))
       for (int c = 0; c < 3; ++c) signal[c] += water.veiling[c] * (1.0 - back(c, j));
-      Eigen::Map<Vec3>(out.radiance + 3 * pixel_of[i]) = signal;
+      sink.radiance(j, pixel_of[i], signal);
     }
+    sink.block_done(count);
   }
+}
+
+}  // namespace
+
+void shade(const Vec3& origin, const Mat3& frame_rotation, const double* rays_f, Eigen::Index n,
+           const double* range_m, const double* normal_world, const std::int32_t* label,
+           const std::int64_t* pixel_of, const double* reflectance, Eigen::Index labels,
+           const WaterColour& water, const std::vector<SpotLight>& lights, CameraPixels out) {
+  Pixels sink{out};
+  shade_into(origin, frame_rotation, rays_f, n, range_m, normal_world, label, pixel_of,
+             reflectance, labels, water, lights, sink);
+}
+
+void shade_record(const Vec3& origin, const Mat3& frame_rotation, const double* rays_f,
+                  Eigen::Index n, const double* range_m, const double* normal_world,
+                  const std::int32_t* label, const std::int64_t* pixel_of,
+                  const double* reflectance, Eigen::Index labels, const WaterColour& water,
+                  const std::vector<SpotLight>& lights, CameraRecord out) {
+  Recorded sink(out);
+  shade_into(origin, frame_rotation, rays_f, n, range_m, normal_world, label, pixel_of,
+             reflectance, labels, water, lights, sink);
 }
 
 // compiled for x86-64-v3 too: its rounding is then one instruction, not a call

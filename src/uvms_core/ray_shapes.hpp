@@ -14,16 +14,18 @@
 // - convex A x <= b (unit rows a of A): each face bounds t from below (a . d < 0) or above;
 // - cylinder (radius r, length L along z): x^2 + y^2 <= r^2 and the slab |z| <= L / 2.
 //
-// An `external` body (a triangle mesh) is cast outside the core (Embree, from Python): the
-// core knows its bounding sphere, picks its rays and keeps its hits (RayCaster::mesh_rays,
-// merge_mesh_hits).
+// A `mesh` body is a triangle mesh (ray_mesh.hpp), cast by the caster itself (it needs the
+// rays' cones). An `external` body (a shape the core does not know) is cast outside the core,
+// from Python: the core knows its bounding sphere and picks its rays (RayCaster::rays_toward).
 #pragma once
 
 #include <Eigen/Core>
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <memory>
 
+#include "ray_mesh.hpp"
 #include "types.hpp"
 
 namespace uvms::perception {
@@ -38,7 +40,7 @@ struct RayHit {
   Vec3 normal = Vec3::Zero();
 };
 
-enum class ShapeKind { plane, sphere, ellipsoid, convex, cylinder, external };
+enum class ShapeKind { plane, sphere, ellipsoid, convex, cylinder, mesh, external };
 
 using FaceRows = Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor>;
 
@@ -51,6 +53,7 @@ struct RayShape {
   Vec3 semi_axes_m = Vec3::Ones();  // ellipsoid
   FaceRows normals;               // convex: outward unit rows a (f, 3)
   Eigen::VectorXd offsets;        // convex: b (f,)
+  std::shared_ptr<const TriangleSet> triangles;  // mesh
 
   // Whether the point (its frame) is inside the solid (a plane, a mesh: never).
   bool contains(const Vec3& p) const {

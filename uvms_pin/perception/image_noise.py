@@ -22,7 +22,7 @@ from scipy.special import ndtri
 
 from uvms_pin.errors import ParameterError
 
-__all__ = ["LEVELS", "normal_levels", "standard_normal_f32"]
+__all__ = ["LEVELS", "normal_codes", "normal_levels", "standard_normal_f32"]
 
 LEVELS = 1 << 16
 
@@ -38,6 +38,12 @@ def normal_levels() -> np.ndarray:
     return table
 
 
+def normal_codes(rng: np.random.Generator, size: int) -> np.ndarray:
+    """``size`` uniform 16-bit codes (uint16) from ``rng``: the draws k whose values are
+    `normal_levels`()[k] (the compiled camera looks them up itself)."""
+    return rng.integers(0, LEVELS, size=size, dtype=np.uint16)
+
+
 def standard_normal_f32(
     rng: np.random.Generator, shape: tuple[int, ...], out: np.ndarray | None = None
 ) -> np.ndarray:
@@ -49,6 +55,5 @@ def standard_normal_f32(
         out = np.empty(shape, dtype=np.float32)
     elif out.shape != tuple(shape) or out.dtype != np.float32 or not out.flags.c_contiguous:
         raise ParameterError(f"out must be a C-contiguous float32 array of shape {tuple(shape)}")
-    codes = rng.integers(0, LEVELS, size=size, dtype=np.uint16)
-    np.take(normal_levels(), codes, out=out.reshape(size))
+    np.take(normal_levels(), normal_codes(rng, size), out=out.reshape(size))
     return out
