@@ -40,7 +40,17 @@ def normal_levels() -> np.ndarray:
 
 def normal_codes(rng: np.random.Generator, size: int) -> np.ndarray:
     """``size`` uniform 16-bit codes (uint16) from ``rng``: the draws k whose values are
-    `normal_levels`()[k] (the compiled camera looks them up itself)."""
+    `normal_levels`()[k] (the compiled camera looks them up itself).
+
+    They are ``rng.integers(0, 65536, size, dtype=np.uint16)``: numpy splits each 64-bit
+    output of PCG64 into 32-bit halves, low first, and each of those into 16-bit halves, low
+    first (keeping an unused 32-bit half for the next call). For a size that is a multiple of
+    4 and no half kept, that is the raw 64-bit outputs read as 16-bit integers, taken so
+    (0.16 ms for a 320 x 240 image's 230,400 codes instead of 0.27 ms): the same codes, the
+    generator left in the same state (tests/perception/test_image_noise.py)."""
+    bits = rng.bit_generator
+    if size % 4 == 0 and type(bits) is np.random.PCG64 and not bits.state["has_uint32"]:
+        return bits.random_raw(size // 4).view(np.uint16)
     return rng.integers(0, LEVELS, size=size, dtype=np.uint16)
 
 
