@@ -140,9 +140,14 @@ def pixel_rays(spec: CameraSpec) -> np.ndarray:
     f = spec.focal_px
     u = (np.arange(spec.width) + 0.5 - 0.5 * spec.width) / f
     v = (np.arange(spec.height) + 0.5 - 0.5 * spec.height) / f
-    x, y = np.meshgrid(u, v)
-    length = np.sqrt(x * x + y * y + 1.0).ravel()  # |(x, y, 1)|, summed in that order
-    return np.column_stack([x.ravel() / length, y.ravel() / length, 1.0 / length])
+    # |(x, y, 1)|, summed in that order, x along a row and y down a column (broadcast, no
+    # meshgrid: a camera is made for each run)
+    length = np.sqrt((u * u)[None, :] + (v * v)[:, None] + 1.0)
+    out = np.empty((spec.height, spec.width, 3))
+    np.divide(u[None, :], length, out=out[..., 0])
+    np.divide(v[:, None], length, out=out[..., 1])
+    np.divide(1.0, length, out=out[..., 2])
+    return out.reshape(-1, 3)
 
 
 def tiles(spec: CameraSpec) -> tuple[np.ndarray, np.ndarray]:
