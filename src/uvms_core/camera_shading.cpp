@@ -141,6 +141,16 @@ template <class Sink>
   const double origin_z = origin.z();
   const Eigen::Index n_lights = static_cast<Eigen::Index>(lights.size());
   Block b(n_lights);
+  // the block's arrays by their data (a store through the outputs' pointers may not reload
+  // them)
+  Eigen::Index* const ray_of = b.ray.data();
+  std::int64_t* const pixel_of_met = b.pixel.data();
+  double* const range_of = b.range_m.data();
+  double* const rate_z = b.rate_z.data();
+  double* const normal_z = b.normal_z.data();
+  double* const rho_of = b.rho.data();
+  double* const depth_of = b.depth_m.data();
+  double* const sky_of = b.sky.data();
   std::vector<SpotCone> cones;
   for (const SpotLight& light : lights) cones.emplace_back(light.half_angle_rad, light.edge_rad);
   for (Eigen::Index first = 0; first < n; first += kBlock) {
@@ -162,13 +172,13 @@ template <class Sink>
       }
       sink.met(pixel, k, normal_world + 3 * i, r * ray_f.z());
       const Eigen::Index j = count++;
-      b.ray[j] = i;
-      b.pixel[j] = pixel;
-      b.range_m[j] = r;
+      ray_of[j] = i;
+      pixel_of_met[j] = pixel;
+      range_of[j] = r;
       const Vec3 d = frame_rotation * ray_f;  // as the lights compute it, the same bits
-      b.rate_z[j] = d.z();
-      b.normal_z[j] = normal_world[3 * i + 2];
-      for (int c = 0; c < 3; ++c) b.rho[c * kBlock + j] = reflectance[3 * k + c];
+      rate_z[j] = d.z();
+      normal_z[j] = normal_world[3 * i + 2];
+      for (int c = 0; c < 3; ++c) rho_of[c * kBlock + j] = reflectance[3 * k + c];
     }
     if (count == 0) {
       sink.block_done(b, 0);
@@ -177,8 +187,8 @@ template <class Sink>
     // daylight E0 exp(-K_d depth) (1 + n_z) / 2 and the direct path's exp(-beta_D r), and
     // the backscatter's exp(-beta_B r): their exponents
     for (Eigen::Index j = 0; j < count; ++j) {
-      b.depth_m[j] = std::max(-(origin_z + b.range_m[j] * b.rate_z[j]), 0.0);
-      b.sky[j] = half_sky * (1.0 + b.normal_z[j]);
+      depth_of[j] = std::max(-(origin_z + range_of[j] * rate_z[j]), 0.0);
+      sky_of[j] = half_sky * (1.0 + normal_z[j]);
     }
     for (int c = 0; c < 3; ++c) {
       const double kd = water.kd_per_m[c], beta_d = water.beta_d_per_m[c];
@@ -186,18 +196,18 @@ template <class Sink>
       double* day = b.day.data() + c * kBlock;
       double* back = b.back.data() + c * kBlock;
       for (Eigen::Index j = 0; j < count; ++j) {
-        double exponent = kd * b.depth_m[j];
-        exponent += beta_d * b.range_m[j];
+        double exponent = kd * depth_of[j];
+        exponent += beta_d * range_of[j];
         day[j] = std::max(-exponent, kExpLowest);
-        back[j] = std::max(-beta_b * b.range_m[j], kExpLowest);
+        back[j] = std::max(-beta_b * range_of[j], kExpLowest);
       }
     }
     // each light: I_L cone max(0, n . l) / d^2, and the exponent of exp(-beta_D (d + r))
     for (Eigen::Index l = 0; l < n_lights; ++l) {
       const SpotLight& light = lights[l];
       for (Eigen::Index j = 0; j < count; ++j) {
-        const Eigen::Index i = b.ray[j];
-        const double r = b.range_m[j];
+        const Eigen::Index i = ray_of[j];
+        const double r = range_of[j];
         const Vec3 d = frame_rotation * Eigen::Map<const Vec3>(rays_f + 3 * i);
         const Eigen::Map<const Vec3> normal(normal_world + 3 * i);
         const Vec3 to_point = r * d + (origin - light.source_world);
@@ -231,7 +241,7 @@ template <class Sink>
       const double* back = b.back.data() + c * kBlock;
       const double* rho = b.rho.data() + c * kBlock;
       double* signal = b.signal.data() + c * kBlock;
-      for (Eigen::Index j = 0; j < count; ++j) signal[j] = day[j] * rho[j] * b.sky[j];
+      for (Eigen::Index j = 0; j < count; ++j) signal[j] = day[j] * rho[j] * sky_of[j];
       for (Eigen::Index l = 0; l < n_lights; ++l) {
         const double* lit = b.lit.data() + (3 * l + c) * kBlock;
         const double* power = b.power.data() + l * kBlock;
