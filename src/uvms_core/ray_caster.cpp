@@ -12,11 +12,16 @@ namespace {
 
 // Whether a ray (world d) from the origin may meet a sphere of `radius` about `to_centre`
 // (centre - origin) nearer than `best`: it passes within the radius, not all behind.
-inline bool may_meet(const Vec3& to_centre, const Vec3& d, double radius, double best) {
+// centre2: |to_centre|^2; reach: the radius and a margin (`reach_of`), both of the cast.
+inline double reach_of(double radius) { return radius * (1.0 + 1e-9) + 1e-12; }
+inline bool may_meet(const Vec3& to_centre, double centre2, double reach, const Vec3& d,
+                     double best) {
   const double along = d.dot(to_centre);
-  const double across2 = to_centre.dot(to_centre) - along * along;
-  const double reach = radius * (1.0 + 1e-9) + 1e-12;
+  const double across2 = centre2 - along * along;
   return across2 <= reach * reach && along + reach > 0.0 && along - reach < best;
+}
+inline bool may_meet(const Vec3& to_centre, const Vec3& d, double radius, double best) {
+  return may_meet(to_centre, to_centre.dot(to_centre), reach_of(radius), d, best);
 }
 
 // A body as one cast sees it: skipped, a plane (its world normal, the origin's height above
@@ -29,6 +34,7 @@ struct Seen {
   double height_m = 0.0;
   Vec3 origin_local = Vec3::Zero();
   Vec3 to_centre = Vec3::Zero();
+  double centre2 = 0.0, reach = 0.0;  // |to_centre|^2, the bounding radius and a margin
   bool bounded = false;
   bool culled_by_cones = false;
   std::vector<char> cones;  // the cones that may meet it (when culled_by_cones)
@@ -146,6 +152,8 @@ void RayCaster::cast(const Vec3& origin, const Mat3& frame_rotation, const doubl
       s.view = std::make_unique<MeshView>(*body.shape.triangles, s.origin_local);
     }
     s.to_centre = -offset;
+    s.centre2 = s.to_centre.dot(s.to_centre);
+    s.reach = reach_of(body.shape.bound_radius_m);
     s.bounded = std::isfinite(body.shape.bound_radius_m);
     if (s.bounded && cones != nullptr) {
       s.culled_by_cones = cones_toward(*cones, frame_rotation.transpose() * s.to_centre,
@@ -172,6 +180,7 @@ void RayCaster::cast(const Vec3& origin, const Mat3& frame_rotation, const doubl
                   (frame_rotation * Eigen::Map<const Vec3>(cones->axes + 3 * j));
       cone.half_angle_rad = cones->half_angle_rad[j];
       s.view->candidates(&cone, s.candidates);
+      if (s.candidates.empty()) active.pop_back();  // no triangle of it in this cone
     }
     const Eigen::Index first = cones == nullptr ? 0 : cones->starts[j];
     const Eigen::Index last = cones == nullptr ? n : cones->starts[j + 1];
@@ -192,7 +201,7 @@ void RayCaster::cast(const Vec3& origin, const Mat3& frame_rotation, const doubl
           continue;
         }
         const Body& body = bodies_[k];
-        if (s.bounded && !may_meet(s.to_centre, d, body.shape.bound_radius_m, best)) continue;
+        if (s.bounded && !may_meet(s.to_centre, s.centre2, s.reach, d, best)) continue;
         const Vec3 d_local = body.rotation.transpose() * d;
         if (s.how == Seen::mesh) {
           // the mesh's nearest crossing, kept on a triangle's front beyond kTMinM
@@ -208,10 +217,10 @@ void RayCaster::cast(const Vec3& origin, const Mat3& frame_rotation, const doubl
           label = k + 1;
           continue;
         }
-        const RayHit hit = body.shape.hit(s.origin_local, d_local);
-        if (hit.t < best) {
-          best = hit.t;
-          normal = body.rotation * hit.normal;
+        const RayCrossing crossed = body.shape.crossing(s.origin_local, d_local);
+        if (crossed.t < best) {  // the normal of the hits kept only
+          best = crossed.t;
+          normal = body.rotation * body.shape.normal_at(s.origin_local, d_local, crossed);
           label = k + 1;
         }
       }
