@@ -105,21 +105,4 @@ void MeshView::candidates(const MeshCone* cone, std::vector<int>& out) const {
   }
 }
 
-MeshView::Crossing MeshView::nearest(const Vec3& d, const std::vector<int>& candidates,
-                                     double bound) const {
-  Crossing out{kInf, -1};
-  for (const int k : candidates) {
-    const Face& face = faces_[k];
-    if (face.lower_m >= std::min(out.t, bound)) break;  // this one and the rest: farther
-    if (d.dot(face.edge[0]) < 0.0 || d.dot(face.edge[1]) < 0.0 || d.dot(face.edge[2]) < 0.0) {
-      continue;  // outside one of its edges
-    }
-    const double rate = face.plane.dot(d);
-    if (rate == 0.0) continue;  // along its plane
-    const double t = face.plane_offset / rate;
-    if (t > 0.0 && t < out.t) out = {t, k};
-  }
-  return out;
-}
-
 }  // namespace uvms::perception
