@@ -78,7 +78,12 @@ MeshView::MeshView(const TriangleSet& mesh, const Vec3& origin_local) {
     face.plane = (mesh.p1[k] - mesh.p0[k]).cross(mesh.p2[k] - mesh.p0[k]);
     face.plane_offset = face.plane.dot(a);
     // a point of the triangle is within r of its centre: at least |centre - o| - r away
-    face.lower_m = (mesh.centre[k] - origin_local).norm() - mesh.radius_m[k];
+    const Vec3 to_centre = mesh.centre[k] - origin_local;
+    const double distance = to_centre.norm();
+    face.lower_m = distance - mesh.radius_m[k];
+    face.sin_seen = distance > mesh.radius_m[k] ? mesh.radius_m[k] / distance : 1.0;
+    face.cos_seen = std::sqrt(std::max(0.0, 1.0 - face.sin_seen * face.sin_seen));
+    face.toward = distance > 0.0 ? Vec3(to_centre / distance) : Vec3::UnitZ();
     order_.push_back(static_cast<int>(k));
   }
   std::sort(order_.begin(), order_.end(),
@@ -94,10 +99,19 @@ void MeshView::candidates(const MeshCone* cone, std::vector<int>& out) const {
   }
   // the cone is wholly outside an edge's plane when its axis is more than 90 degrees plus
   // its half-angle from the plane's inward normal
-  const double outside = -std::sin(spread) - kSineMargin;
+  const double sin_spread = std::sin(spread), cos_spread = std::cos(spread);
+  const double outside = -sin_spread - kSineMargin;
   const Vec3& axis = cone->axis;
   for (const int k : order_) {
     const Face& face = faces_[k];
+    // first its sphere (one dot product, which leaves out most): the cone meets it only if
+    // its axis is within spread + g of the centre's direction (g the angle the sphere
+    // subtends, below 90 degrees: the origin outside it), cos >= cos(spread + g)
+    if (face.sin_seen < 1.0 &&
+        axis.dot(face.toward) <
+            cos_spread * face.cos_seen - sin_spread * face.sin_seen - kSineMargin) {
+      continue;
+    }
     if (axis.dot(face.edge[0]) >= outside && axis.dot(face.edge[1]) >= outside &&
         axis.dot(face.edge[2]) >= outside) {
       out.push_back(k);

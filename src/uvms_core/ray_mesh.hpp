@@ -78,6 +78,10 @@ class MeshView {
     Vec3 plane;
     double plane_offset;
     double lower_m;
+    // its sphere seen from the origin: the unit direction to its centre, the sine and cosine
+    // of the angle it subtends (sine 1: it holds the origin)
+    Vec3 toward;
+    double sin_seen, cos_seen;
   };
   std::vector<Face> faces_;  // by triangle
   std::vector<int> order_;   // the triangles seen (not edge-on to the origin) by lower bound
