@@ -14,7 +14,7 @@ casts them and a nearer hit replaces the core's.
 The reference casts the meshes by Embree, in single precision (`uvms_pin.perception.mesh`):
 the two agree on a mesh's ranges to about 1e-7 relative (Embree's rounding), elsewhere to
 rounding. The core's own casting, measured on the seabed landing's camera (320 x 240, the
-rock filling a quarter of the last image, 19,000 rays toward it): 1.2 ms for the rock's rays
+rock filling a quarter of the last image, 19,000 rays toward it): 0.9 ms for the rock's rays
 where Embree took 2.5 ms, glue included, called once per image from Python.
 
 The rays may be given in a frame at ``frame_rotation`` (a camera's optical frame), rotated
