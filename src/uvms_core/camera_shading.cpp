@@ -1,6 +1,10 @@
 // A camera's pixels from its rays' hits (camera_shading.hpp).
 #include "camera_shading.hpp"
 
+// no a * b + c fused into one rounding where the processor could (x86-64-v3's clones): the
+// radiance is the same, bit for bit, on every processor
+#pragma GCC optimize("fp-contract=off")
+
 #include "vector_exp.hpp"
 
 #include <algorithm>
@@ -30,29 +34,129 @@ double SpotCone::operator()(double cosine) const {
 
 namespace {
 
-// The rays shaded together: their exponents are taken in one vectorized exp
-// (vector_exp.hpp), the per-ray geometry before and the sums after in scalar loops.
+// The rays shaded together, a block at a time: what they met is gathered by channel (their
+// ranges, normals' z, reflectances: arrays of the block's rays that met something), the
+// exponents and the sums after them are loops over those arrays the compiler vectorizes, and
+// the exponentials are taken in one vectorized exp (vector_exp.hpp). Each value is computed
+// by the same operations in the same order as before: the radiance is bit for bit the same.
 constexpr Eigen::Index kBlock = 256;
-using Channels = Eigen::Array<double, 3, Eigen::Dynamic>;  // column j: ray j's (R, G, B)
 
-}  // namespace
+// A block's arrays, by ray that met something (j < count) and channel.
+struct Block {
+  explicit Block(Eigen::Index n_lights)
+      : ray(kBlock), pixel(kBlock), range_m(kBlock), rate_z(kBlock), normal_z(kBlock),
+        sky(kBlock), depth_m(kBlock), power(kBlock * n_lights), rho(3 * kBlock),
+        day(3 * kBlock), back(3 * kBlock), lit(3 * kBlock * n_lights), signal(3 * kBlock) {}
+  std::vector<Eigen::Index> ray;    // its index in the cast
+  std::vector<std::int64_t> pixel;  // its pixel
+  std::vector<double> range_m, rate_z, normal_z, sky, depth_m, power;
+  // by channel c: entry c kBlock + j (lit: (l 3 + c) kBlock + j)
+  std::vector<double> rho, day, back, lit, signal;
+};
 
-void shade(const Vec3& origin, const Mat3& frame_rotation, const double* rays_f, Eigen::Index n,
-           const double* range_m, const double* normal_world, const std::int32_t* label,
-           const std::int64_t* pixel_of, const double* reflectance, Eigen::Index labels,
-           const WaterColour& water, const std::vector<SpotLight>& lights, CameraPixels out) {
-  const double nan = std::numeric_limits<double>::quiet_NaN();
+// What an image keeps of each pixel (`shade_into`'s sink). Pixels: the whole image as
+// Camera.render gives it; Recorded: what a firing records.
+struct Pixels {
+  CameraPixels out;
+  void nothing(std::int64_t pixel, std::int32_t label, const double* normal, const Vec3& veiling) {
+    Eigen::Map<Vec3>(out.normal_world + 3 * pixel) = Eigen::Map<const Vec3>(normal);
+    out.label[pixel] = label;
+    out.depth_m[pixel] = std::numeric_limits<double>::quiet_NaN();
+    Eigen::Map<Vec3>(out.radiance + 3 * pixel) = veiling;
+  }
+  void met(std::int64_t pixel, std::int32_t label, const double* normal, double depth_m) {
+    Eigen::Map<Vec3>(out.normal_world + 3 * pixel) = Eigen::Map<const Vec3>(normal);
+    out.label[pixel] = label;
+    out.depth_m[pixel] = depth_m;
+  }
+  // the block's radiance (`Block::signal`) into its pixels
+  void block_done(const Block& block, Eigen::Index count) {
+    for (Eigen::Index j = 0; j < count; ++j) {
+      double* to = out.radiance + 3 * block.pixel[j];
+      for (int c = 0; c < 3; ++c) to[c] = block.signal[c * kBlock + j];
+    }
+  }
+};
+
+// The block's radiance made 8-bit counts at once by eight_bit (vectorized), channel by
+// channel, their noise gathered from the codes of their pixels; the counts put in their
+// pixels. The rays that met nothing are kept apart (their radiance the veiling light's).
+struct Recorded {
+  explicit Recorded(const CameraRecord& record)
+      : out(record), noise_(3 * kBlock), counts_(3 * kBlock), veiled_pixel_(kBlock),
+        veiled_(3 * kBlock) {}
+  CameraRecord out;
+  std::vector<float> noise_;
+  std::vector<std::uint8_t> counts_;
+  std::vector<std::int64_t> veiled_pixel_;
+  std::vector<double> veiled_;  // by channel, as Block::signal
+  Eigen::Index veiled_count_ = 0;
+
+  // the counts of `count` pixels whose radiance is channels[c kBlock + j]
+  void colour(const double* channels, const std::int64_t* pixels, Eigen::Index count) {
+    if (count == 0) return;
+    for (int c = 0; c < 3; ++c) {
+      const float* noise = nullptr;
+      if (out.noise_codes != nullptr) {
+        const std::uint16_t* codes = out.noise_codes + c;
+        const float* levels = out.noise_levels;
+        float* drawn = noise_.data() + c * kBlock;
+        for (Eigen::Index j = 0; j < count; ++j) drawn[j] = levels[codes[3 * pixels[j]]];
+        noise = drawn;
+      }
+      eight_bit(channels + c * kBlock, noise, count, out.scale, out.noise_counts,
+                counts_.data() + c * kBlock);
+    }
+    std::uint8_t* rgb = out.rgb;
+    for (Eigen::Index j = 0; j < count; ++j) {
+      std::uint8_t* to = rgb + 3 * pixels[j];
+      for (int c = 0; c < 3; ++c) to[c] = counts_[c * kBlock + j];
+    }
+  }
+  void nothing(std::int64_t pixel, std::int32_t label, const double*, const Vec3& veiling) {
+    out.label[pixel] = static_cast<std::int16_t>(label);
+    out.depth_m[pixel] = std::numeric_limits<float>::quiet_NaN();
+    const Eigen::Index j = veiled_count_++;
+    veiled_pixel_[j] = pixel;
+    for (int c = 0; c < 3; ++c) veiled_[c * kBlock + j] = veiling[c];
+  }
+  void met(std::int64_t pixel, std::int32_t label, const double*, double depth_m) {
+    out.label[pixel] = static_cast<std::int16_t>(label);
+    out.depth_m[pixel] = static_cast<float>(depth_m);
+  }
+  void block_done(const Block& block, Eigen::Index count) {
+    colour(block.signal.data(), block.pixel.data(), count);
+    colour(veiled_.data(), veiled_pixel_.data(), veiled_count_);
+    veiled_count_ = 0;
+  }
+};
+
+template <class Sink>
+[[gnu::always_inline]] inline void shade_into(const Vec3& origin, const Mat3& frame_rotation, const double* rays_f,
+                Eigen::Index n, const double* range_m, const double* normal_world,
+                const std::int32_t* label, const std::int64_t* pixel_of,
+                const double* reflectance, Eigen::Index labels, const WaterColour& water,
+                const std::vector<SpotLight>& lights, Sink& sink) {
   const double half_sky = 0.5 * water.surface_irradiance;
+  const double origin_z = origin.z();
   const Eigen::Index n_lights = static_cast<Eigen::Index>(lights.size());
-  Channels day(3, kBlock), back(3, kBlock), lit(3, kBlock * n_lights);
-  Eigen::ArrayXd sky(kBlock), power(kBlock * n_lights);
-  std::vector<Eigen::Index> met(kBlock);  // the block's rays that met something
+  Block b(n_lights);
+  // the block's arrays by their data (a store through the outputs' pointers may not reload
+  // them)
+  Eigen::Index* const ray_of = b.ray.data();
+  std::int64_t* const pixel_of_met = b.pixel.data();
+  double* const range_of = b.range_m.data();
+  double* const rate_z = b.rate_z.data();
+  double* const normal_z = b.normal_z.data();
+  double* const rho_of = b.rho.data();
+  double* const depth_of = b.depth_m.data();
+  double* const sky_of = b.sky.data();
   std::vector<SpotCone> cones;
   for (const SpotLight& light : lights) cones.emplace_back(light.half_angle_rad, light.edge_rad);
   for (Eigen::Index first = 0; first < n; first += kBlock) {
     const Eigen::Index size = std::min(kBlock, n - first);
     Eigen::Index count = 0;
-    // per ray: its pixel's depth, normal and label; the exponents of what it met
+    // per ray: its pixel's depth, normal and label; what it met, gathered
     for (Eigen::Index i = first; i < first + size; ++i) {
       const std::int64_t pixel = pixel_of[i];
       if (pixel < 0 || pixel >= n) throw InputError("a ray's pixel is outside the image");
@@ -61,31 +165,51 @@ void shade(const Vec3& origin, const Mat3& frame_rotation, const double* rays_f,
         throw InputError("a ray's label " + std::to_string(k) + " has no reflectance");
       }
       const Eigen::Map<const Vec3> ray_f(rays_f + 3 * i);
-      const Eigen::Map<const Vec3> normal(normal_world + 3 * i);
-      Eigen::Map<Vec3>(out.normal_world + 3 * pixel) = normal;
-      out.label[pixel] = k;
       const double r = range_m[i];
       if (!std::isfinite(r)) {  // nothing met: the veiling light
-        out.depth_m[pixel] = nan;
-        Eigen::Map<Vec3>(out.radiance + 3 * pixel) = water.veiling;
+        sink.nothing(pixel, k, normal_world + 3 * i, water.veiling);
         continue;
       }
-      out.depth_m[pixel] = r * ray_f.z();
+      sink.met(pixel, k, normal_world + 3 * i, r * ray_f.z());
       const Eigen::Index j = count++;
-      met[j] = i;
-      const Vec3 d = frame_rotation * ray_f;
-      // daylight E0 exp(-K_d depth) (1 + n_z) / 2 and the direct path's exp(-beta_D r)
-      const double depth = std::max(-(origin.z() + r * d.z()), 0.0);
-      sky[j] = half_sky * (1.0 + normal.z());
-      for (int c = 0; c < 3; ++c) {
-        double exponent = water.kd_per_m[c] * depth;
-        exponent += water.beta_d_per_m[c] * r;
-        day(c, j) = std::max(-exponent, kExpLowest);
-        back(c, j) = std::max(-water.beta_b_per_m[c] * r, kExpLowest);
+      ray_of[j] = i;
+      pixel_of_met[j] = pixel;
+      range_of[j] = r;
+      const Vec3 d = frame_rotation * ray_f;  // as the lights compute it, the same bits
+      rate_z[j] = d.z();
+      normal_z[j] = normal_world[3 * i + 2];
+      for (int c = 0; c < 3; ++c) rho_of[c * kBlock + j] = reflectance[3 * k + c];
+    }
+    if (count == 0) {
+      sink.block_done(b, 0);
+      continue;
+    }
+    // daylight E0 exp(-K_d depth) (1 + n_z) / 2 and the direct path's exp(-beta_D r), and
+    // the backscatter's exp(-beta_B r): their exponents
+    for (Eigen::Index j = 0; j < count; ++j) {
+      depth_of[j] = std::max(-(origin_z + range_of[j] * rate_z[j]), 0.0);
+      sky_of[j] = half_sky * (1.0 + normal_z[j]);
+    }
+    for (int c = 0; c < 3; ++c) {
+      const double kd = water.kd_per_m[c], beta_d = water.beta_d_per_m[c];
+      const double beta_b = water.beta_b_per_m[c];
+      double* day = b.day.data() + c * kBlock;
+      double* back = b.back.data() + c * kBlock;
+      for (Eigen::Index j = 0; j < count; ++j) {
+        double exponent = kd * depth_of[j];
+        exponent += beta_d * range_of[j];
+        day[j] = std::max(-exponent, kExpLowest);
+        back[j] = std::max(-beta_b * range_of[j], kExpLowest);
       }
-      // each light: I_L cone max(0, n . l) / d^2, and the exponent of exp(-beta_D (d + r))
-      for (Eigen::Index l = 0; l < n_lights; ++l) {
-        const SpotLight& light = lights[l];
+    }
+    // each light: I_L cone max(0, n . l) / d^2, and the exponent of exp(-beta_D (d + r))
+    for (Eigen::Index l = 0; l < n_lights; ++l) {
+      const SpotLight& light = lights[l];
+      for (Eigen::Index j = 0; j < count; ++j) {
+        const Eigen::Index i = ray_of[j];
+        const double r = range_of[j];
+        const Vec3 d = frame_rotation * Eigen::Map<const Vec3>(rays_f + 3 * i);
+        const Eigen::Map<const Vec3> normal(normal_world + 3 * i);
         const Vec3 to_point = r * d + (origin - light.source_world);
         const double distance = std::sqrt(to_point.dot(to_point));
         const double reach = std::max(distance, 1e-12);
@@ -94,36 +218,63 @@ void shade(const Vec3& origin, const Mat3& frame_rotation, const double* rays_f,
         p *= std::max(0.0, -facing);
         const double least = std::max(distance, 1e-6);
         p *= light.intensity / (least * least);
-        power[l * kBlock + j] = p;
+        b.power[l * kBlock + j] = p;
         for (int c = 0; c < 3; ++c) {
-          lit(c, l * kBlock + j) = std::max((distance + r) * -water.beta_d_per_m[c], kExpLowest);
+          b.lit[(3 * l + c) * kBlock + j] =
+              std::max((distance + r) * -water.beta_d_per_m[c], kExpLowest);
         }
       }
     }
-    if (count == 0) continue;
     // the exponentials, vectorized over the rays that met something (vector_exp.hpp); the
     // backscatter's 1 - exp(-beta_B r) from exp, not expm1: its absolute rounding, 1e-16, is
     // below the radiance's own
-    exp_in_place(day.data(), 3 * count);
-    exp_in_place(back.data(), 3 * count);
-    for (Eigen::Index l = 0; l < n_lights; ++l) {
-      exp_in_place(lit.data() + 3 * l * kBlock, 3 * count);
-    }
-    for (Eigen::Index j = 0; j < count; ++j) {
-      const Eigen::Index i = met[j];
-      const Eigen::Map<const Vec3> rho(reflectance + 3 * label[i]);
-      Vec3 signal;
-      for (int c = 0; c < 3; ++c) signal[c] = day(c, j) * rho[c] * sky[j];
+    for (int c = 0; c < 3; ++c) {
+      exp_in_place(b.day.data() + c * kBlock, count);
+      exp_in_place(b.back.data() + c * kBlock, count);
       for (Eigen::Index l = 0; l < n_lights; ++l) {
-        for (int c = 0; c < 3; ++c) {
-          signal[c] += lit(c, l * kBlock + j) * power[l * kBlock + j] * rho[c];
-        }
+        exp_in_place(b.lit.data() + (3 * l + c) * kBlock, count);
       }
-      // the backscatter B_inf (1 - exp(-beta_B r))
-      for (int c = 0; c < 3; ++c) signal[c] += water.veiling[c] * (1.0 - back(c, j));
-      Eigen::Map<Vec3>(out.radiance + 3 * pixel_of[i]) = signal;
     }
+    // the radiance: rho E exp(...) + B_inf (1 - exp(-beta_B r)), channel by channel
+    for (int c = 0; c < 3; ++c) {
+      const double* day = b.day.data() + c * kBlock;
+      const double* back = b.back.data() + c * kBlock;
+      const double* rho = b.rho.data() + c * kBlock;
+      double* signal = b.signal.data() + c * kBlock;
+      for (Eigen::Index j = 0; j < count; ++j) signal[j] = day[j] * rho[j] * sky_of[j];
+      for (Eigen::Index l = 0; l < n_lights; ++l) {
+        const double* lit = b.lit.data() + (3 * l + c) * kBlock;
+        const double* power = b.power.data() + l * kBlock;
+        for (Eigen::Index j = 0; j < count; ++j) signal[j] += lit[j] * power[j] * rho[j];
+      }
+      const double veiling = water.veiling[c];
+      for (Eigen::Index j = 0; j < count; ++j) signal[j] += veiling * (1.0 - back[j]);
+    }
+    sink.block_done(b, count);
   }
+}
+
+}  // namespace
+
+UVMS_VECTOR_CLONES
+void shade(const Vec3& origin, const Mat3& frame_rotation, const double* rays_f, Eigen::Index n,
+           const double* range_m, const double* normal_world, const std::int32_t* label,
+           const std::int64_t* pixel_of, const double* reflectance, Eigen::Index labels,
+           const WaterColour& water, const std::vector<SpotLight>& lights, CameraPixels out) {
+  Pixels sink{out};
+  shade_into(origin, frame_rotation, rays_f, n, range_m, normal_world, label, pixel_of,
+             reflectance, labels, water, lights, sink);
+}
+
+UVMS_VECTOR_CLONES
+void shade_record(const Vec3& origin, const Mat3& frame_rotation, const double* rays_f,
+                  Eigen::Index n, const double* range_m, const double* normal_world,
+                  const std::int32_t* label, const std::int64_t* pixel_of,
+                  const double* reflectance, Eigen::Index labels, const WaterColour& water,
+                  const std::vector<SpotLight>& lights, CameraRecord out) {
+  Recorded sink(out);
+  shade_into(origin, frame_rotation, rays_f, n, range_m, normal_world, label, pixel_of,
+             reflectance, labels, water, lights, sink);
 }
 
 // compiled for x86-64-v3 too: its rounding is then one instruction, not a call

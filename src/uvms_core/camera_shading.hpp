@@ -45,6 +45,20 @@ struct CameraPixels {
   double* radiance = nullptr;  // I_c before the exposure
 };
 
+// What a firing records of one image (n pixels, pixel order): the z-depth in single
+// precision (NaN: nothing met), the labels in 16 bits and the 8-bit colour (n, 3) of the
+// radiance with the noise drawn as codes (n, 3) of the table noise_levels (null: none), as
+// eight_bit makes it.
+struct CameraRecord {
+  float* depth_m = nullptr;
+  std::int16_t* label = nullptr;
+  std::uint8_t* rgb = nullptr;
+  const std::uint16_t* noise_codes = nullptr;
+  const float* noise_levels = nullptr;  // the standard normal's value of each code
+  double scale = 255.0;                 // the counts of radiance 1
+  double noise_counts = 0.0;            // the noise's deviation [counts]
+};
+
 // The cone of a light at the cosine of the angle off its axis: 1 within its half-angle, a
 // smoothstep down to 0 at half-angle + edge, 0 beyond (optics.cone_of_cosine); the angle's
 // arccos taken on the edge only.
@@ -63,6 +77,13 @@ void shade(const Vec3& origin, const Mat3& frame_rotation, const double* rays_f,
            const double* range_m, const double* normal_world, const std::int32_t* label,
            const std::int64_t* pixel_of, const double* reflectance, Eigen::Index labels,
            const WaterColour& water, const std::vector<SpotLight>& lights, CameraPixels out);
+
+// shade's image as a firing records it (`CameraRecord`): no normals, no radiance kept.
+void shade_record(const Vec3& origin, const Mat3& frame_rotation, const double* rays_f,
+                  Eigen::Index n, const double* range_m, const double* normal_world,
+                  const std::int32_t* label, const std::int64_t* pixel_of,
+                  const double* reflectance, Eigen::Index labels, const WaterColour& water,
+                  const std::vector<SpotLight>& lights, CameraRecord out);
 
 // The 8-bit counts (n values) of radiance scaled by `scale` (255 times the exposure) plus
 // noise_counts times the standard normal `noise` (single precision; null: none), rounded

@@ -1,13 +1,15 @@
 // The perception's caster and camera shading in the nanobind module (ray_caster.hpp,
 // camera_shading.hpp). The Python side is uvms_pin/perception/compiled_caster.py: it fills
-// the caster with the scene's shapes, casts the meshes (Embree) between the two calls, and
-// passes the output arrays, which are written in place (no array is allocated here).
+// the caster with the scene's shapes (its triangle meshes too), casts the shapes the core does
+// not know between the two calls, and passes the output arrays, which are written in place (no
+// array is allocated here).
 #include <nanobind/eigen/dense.h>
 #include <nanobind/nanobind.h>
 #include <nanobind/ndarray.h>
 #include <nanobind/stl/optional.h>
 
 #include <cstdint>
+#include <memory>
 #include <optional>
 #include <string>
 
@@ -32,10 +34,13 @@ using Labels = nb::ndarray<std::int32_t, nb::ndim<1>, nb::c_contig, nb::device::
 using InLabels = nb::ndarray<const std::int32_t, nb::ndim<1>, nb::c_contig, nb::device::cpu>;
 using InIndex = nb::ndarray<const std::int64_t, nb::ndim<1>, nb::c_contig, nb::device::cpu>;
 using OutIndex = nb::ndarray<std::int64_t, nb::ndim<1>, nb::c_contig, nb::device::cpu>;
+using InTriangles = nb::ndarray<const std::int64_t, nb::ndim<2>, nb::c_contig, nb::device::cpu>;
 using Noise = nb::ndarray<const float, nb::ndim<2>, nb::c_contig, nb::device::cpu>;
-using Out2f = nb::ndarray<float, nb::ndim<2>, nb::c_contig, nb::device::cpu>;
 using In1f = nb::ndarray<const float, nb::ndim<1>, nb::c_contig, nb::device::cpu>;
 using Rgb = nb::ndarray<std::uint8_t, nb::ndim<2>, nb::c_contig, nb::device::cpu>;
+using Out1f = nb::ndarray<float, nb::ndim<1>, nb::c_contig, nb::device::cpu>;
+using Labels16 = nb::ndarray<std::int16_t, nb::ndim<1>, nb::c_contig, nb::device::cpu>;
+using Codes = nb::ndarray<const std::uint16_t, nb::ndim<2>, nb::c_contig, nb::device::cpu>;
 
 void require(bool ok, const std::string& what) {
   if (!ok) throw InputError(what);
@@ -66,6 +71,25 @@ struct ConeArgs {
     return Cones{axes->data(), half_angle_rad->data(), starts->data(), m};
   }
 };
+
+// A camera's reflectances (labels + 1, 3) and lights (L, 9) checked (`what`: the function).
+void check_shading(const In2& reflectance, const In2& lights, const std::string& what) {
+  require(reflectance.shape(1) == 3 && reflectance.shape(0) >= 1,
+          what + ": reflectance (labels + 1, 3) expected");
+  require(lights.shape(1) == 9, what + ": lights (L, 9) expected: source (3), unit axis (3), "
+                                       "intensity, half_angle_rad, edge_rad");
+}
+
+// The lights' rows (source (3), unit axis (3), intensity, half_angle_rad, edge_rad).
+std::vector<SpotLight> spots_of(const In2& lights) {
+  std::vector<SpotLight> spots;
+  for (size_t j = 0; j < lights.shape(0); ++j) {
+    const double* row = lights.data() + 9 * j;
+    spots.push_back({Vec3(row[0], row[1], row[2]), Vec3(row[3], row[4], row[5]), row[6], row[7],
+                     row[8]});
+  }
+  return spots;
+}
 
 RayShape shape_of(ShapeKind kind, double bound_radius_m) {
   RayShape s;
@@ -141,6 +165,23 @@ void bind_perception(nb::module_& m) {
           },
           "radius_m"_a, "length_m"_a, "rotation"_a, "position_m"_a)
       .def(
+          "add_mesh",
+          [](RayCaster& c, const In2& vertices_m, const InTriangles& triangles,
+             double bound_radius_m, const Mat3& rotation, const Vec3& position) {
+            const Eigen::Index vertices = rows3(vertices_m, "vertices_m");
+            require(triangles.shape(1) == 3 && triangles.shape(0) >= 1,
+                    "a mesh needs triangles (f, 3) of vertex indices, f >= 1");
+            RayShape s = shape_of(ShapeKind::mesh, bound_radius_m);
+            s.triangles = std::make_shared<const TriangleSet>(
+                TriangleSet::of(vertices_m.data(), vertices, triangles.data(),
+                                static_cast<Eigen::Index>(triangles.shape(0))));
+            return add_checked(c, std::move(s), rotation, position);
+          },
+          "vertices_m"_a, "triangles"_a, "bound_radius_m"_a, "rotation"_a, "position_m"_a,
+          "The triangles vertices_m[triangles] seen from outside (ray_mesh.hpp): a ray's "
+          "nearest crossing, none on a triangle's back (TriangleMesh.hit's rule); "
+          "bound_radius_m: the farthest vertex from the mesh's origin.")
+      .def(
           "add_external",
           [](RayCaster& c, double bound_radius_m, const Mat3& rotation, const Vec3& position) {
             return add_checked(c, shape_of(ShapeKind::external, bound_radius_m), rotation,
@@ -199,60 +240,7 @@ void bind_perception(nb::module_& m) {
           "cone_axes"_a = nb::none(), "cone_half_angle_rad"_a = nb::none(),
           "cone_starts"_a = nb::none(),
           "The rays that may meet body index nearer than range_m, written into rows; "
-          "their count.")
-      .def(
-          "mesh_rays",
-          [](const RayCaster& c, int index, const Vec3& origin, const Mat3& frame_rotation,
-             const In2& rays, const In1& range_m, OutIndex rows, Out2f origins_local,
-             Out2f directions_local, std::optional<In2> cone_axes,
-             std::optional<In1> cone_half_angle_rad, std::optional<InIndex> cone_starts) {
-            const Eigen::Index n = rows3(rays, "rays");
-            const auto sized = [n](size_t size) { return size == static_cast<size_t>(n); };
-            require(index >= 0 && index < c.size(), "mesh_rays: no such body");
-            require(sized(range_m.shape(0)) && sized(rows.shape(0)) &&
-                        sized(origins_local.shape(0)) && origins_local.shape(1) == 3 &&
-                        sized(directions_local.shape(0)) && directions_local.shape(1) == 3,
-                    "mesh_rays: range_m (n,), rows (n,), origins and directions (n, 3)");
-            const auto cones = ConeArgs{cone_axes, cone_half_angle_rad, cone_starts}.view();
-            return c.mesh_rays(index, origin, frame_rotation, rays.data(), n,
-                               cones ? &*cones : nullptr, range_m.data(), rows.data(),
-                               origins_local.data(), directions_local.data());
-          },
-          "index"_a, "origin_world"_a, "frame_rotation"_a, "rays"_a, "range_m"_a,
-          "rows"_a.noconvert(), "origins_local"_a.noconvert(), "directions_local"_a.noconvert(),
-          "cone_axes"_a = nb::none(), "cone_half_angle_rad"_a = nb::none(),
-          "cone_starts"_a = nb::none(),
-          "rays_toward's rays into rows, with their origins and directions in the body's "
-          "frame (float32) for a mesh's caster; their count.")
-      .def(
-          "merge_mesh_hits",
-          [](const RayCaster& c, int index, const Mat3& frame_rotation, const In2& rays,
-             const InIndex& rows, const In1f& range_t, const InLabels& triangle,
-             const In2& normals_local, Out1 range_m, Out2 normal_world, Labels label) {
-            const Eigen::Index n = rows3(rays, "rays");
-            const auto count = static_cast<Eigen::Index>(rows.shape(0));
-            require(index >= 0 && index < c.size(), "merge_mesh_hits: no such body");
-            require(range_t.shape(0) == rows.shape(0) && triangle.shape(0) == rows.shape(0),
-                    "merge_mesh_hits: rows, range_t and triangle must have one length");
-            require(normals_local.shape(1) == 3, "merge_mesh_hits: normals_local (f, 3)");
-            require(range_m.shape(0) == static_cast<size_t>(n) &&
-                        normal_world.shape(0) == static_cast<size_t>(n) &&
-                        normal_world.shape(1) == 3 && label.shape(0) == static_cast<size_t>(n),
-                    "merge_mesh_hits: range_m (n,), normal_world (n, 3), label (n,)");
-            for (Eigen::Index j = 0; j < count; ++j) {
-              require(rows.data()[j] >= 0 && rows.data()[j] < n, "merge_mesh_hits: a row is "
-                                                                  "not one of the rays");
-            }
-            c.merge_mesh_hits(index, frame_rotation, rays.data(), rows.data(), count,
-                              range_t.data(), triangle.data(), normals_local.data(),
-                              static_cast<Eigen::Index>(normals_local.shape(0)),
-                              {range_m.data(), normal_world.data(), label.data()});
-          },
-          "index"_a, "frame_rotation"_a, "rays"_a, "rows"_a, "range_t"_a, "triangle"_a,
-          "normals_local"_a, "range_m"_a.noconvert(), "normal_world"_a.noconvert(),
-          "label"_a.noconvert(),
-          "A mesh caster's hits (range_t, triangle: -1 none) of mesh_rays' rows kept where "
-          "on a triangle's front and nearer than range_m (TriangleMesh.hit's rule).");
+          "their count.");
 
   m.def(
       "shade_camera",
@@ -271,20 +259,11 @@ void bind_perception(nb::module_& m) {
                     normal_out.shape(1) == 3 && sized(label_out.shape(0)) &&
                     sized(radiance.shape(0)) && radiance.shape(1) == 3,
                 "shade_camera: the outputs need n pixels");
-        require(reflectance.shape(1) == 3 && reflectance.shape(0) >= 1,
-                "shade_camera: reflectance (labels + 1, 3) expected");
-        require(lights.shape(1) == 9, "shade_camera: lights (L, 9) expected: source (3), "
-                                      "unit axis (3), intensity, half_angle_rad, edge_rad");
+        check_shading(reflectance, lights, "shade_camera");
         WaterColour water{kd_per_m, beta_d_per_m, beta_b_per_m, surface_irradiance, veiling};
-        std::vector<SpotLight> spots;
-        for (size_t j = 0; j < lights.shape(0); ++j) {
-          const double* row = lights.data() + 9 * j;
-          spots.push_back({Vec3(row[0], row[1], row[2]), Vec3(row[3], row[4], row[5]), row[6],
-                           row[7], row[8]});
-        }
         shade(origin, frame_rotation, rays.data(), n, range_m.data(), normal_world.data(),
               label.data(), pixel_of.data(), reflectance.data(),
-              static_cast<Eigen::Index>(reflectance.shape(0)), water, spots,
+              static_cast<Eigen::Index>(reflectance.shape(0)), water, spots_of(lights),
               {depth_m.data(), normal_out.data(), label_out.data(), radiance.data()});
       },
       "origin_world"_a, "frame_rotation"_a, "rays"_a, "range_m"_a, "normal_world"_a, "label"_a,
@@ -294,6 +273,45 @@ void bind_perception(nb::module_& m) {
       "A camera's pixels from its rays' hits (in the caster's order; ray i is pixel "
       "pixel_of[i]): z-depth (NaN: nothing met), normals, labels and the underwater image "
       "formation model's radiance, written into the outputs (pixel order).");
+
+  m.def(
+      "record_camera",
+      [](const Vec3& origin, const Mat3& frame_rotation, const In2& rays, const In1& range_m,
+         const In2& normal_world, const InLabels& label, const InIndex& pixel_of,
+         const In2& reflectance, const Vec3& kd_per_m, const Vec3& beta_d_per_m,
+         const Vec3& beta_b_per_m, double surface_irradiance, const Vec3& veiling,
+         const In2& lights, std::optional<Codes> noise_codes, const In1f& noise_levels,
+         double scale, double noise_counts, Out1f depth_m, Labels16 label_out, Rgb rgb) {
+        const Eigen::Index n = rows3(rays, "rays");
+        const auto sized = [n](size_t size) { return size == static_cast<size_t>(n); };
+        require(sized(range_m.shape(0)) && sized(normal_world.shape(0)) &&
+                    normal_world.shape(1) == 3 && sized(label.shape(0)) &&
+                    sized(pixel_of.shape(0)),
+                "record_camera: range_m (n,), normal_world (n, 3), label (n,), pixel_of (n,)");
+        require(sized(depth_m.shape(0)) && sized(label_out.shape(0)) && sized(rgb.shape(0)) &&
+                    rgb.shape(1) == 3,
+                "record_camera: depth_m (n,), label_out (n,) and rgb (n, 3) expected");
+        require(!noise_codes || (sized(noise_codes->shape(0)) && noise_codes->shape(1) == 3),
+                "record_camera: noise_codes (n, 3) expected");
+        require(noise_levels.shape(0) == 65536, "record_camera: noise_levels (65536,) expected");
+        check_shading(reflectance, lights, "record_camera");
+        WaterColour water{kd_per_m, beta_d_per_m, beta_b_per_m, surface_irradiance, veiling};
+        CameraRecord out{depth_m.data(), label_out.data(), rgb.data(),
+                         noise_codes ? noise_codes->data() : nullptr, noise_levels.data(),
+                         scale, noise_counts};
+        shade_record(origin, frame_rotation, rays.data(), n, range_m.data(), normal_world.data(),
+                     label.data(), pixel_of.data(), reflectance.data(),
+                     static_cast<Eigen::Index>(reflectance.shape(0)), water, spots_of(lights),
+                     out);
+      },
+      "origin_world"_a, "frame_rotation"_a, "rays"_a, "range_m"_a, "normal_world"_a, "label"_a,
+      "pixel_of"_a, "reflectance"_a, "kd_per_m"_a, "beta_d_per_m"_a, "beta_b_per_m"_a,
+      "surface_irradiance"_a, "veiling"_a, "lights"_a, "noise_codes"_a.none(),
+      "noise_levels"_a, "scale"_a, "noise_counts"_a, "depth_m"_a.noconvert(),
+      "label_out"_a.noconvert(), "rgb"_a.noconvert(),
+      "shade_camera's image as a firing records it, written into the outputs (pixel order): "
+      "the z-depth in float32 (NaN: nothing met), the labels in int16 and the 8-bit colour "
+      "of eight_bit, its noise the values noise_levels[noise_codes] (None: none).");
 
   m.def(
       "eight_bit",

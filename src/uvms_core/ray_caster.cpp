@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <memory>
 #include <string>
 
 namespace uvms::perception {
@@ -11,25 +12,69 @@ namespace {
 
 // Whether a ray (world d) from the origin may meet a sphere of `radius` about `to_centre`
 // (centre - origin) nearer than `best`: it passes within the radius, not all behind.
-inline bool may_meet(const Vec3& to_centre, const Vec3& d, double radius, double best) {
+// centre2: |to_centre|^2; reach: the radius and a margin (`reach_of`), both of the cast.
+inline double reach_of(double radius) { return radius * (1.0 + 1e-9) + 1e-12; }
+inline bool may_meet(const Vec3& to_centre, double centre2, double reach, const Vec3& d,
+                     double best) {
   const double along = d.dot(to_centre);
-  const double across2 = to_centre.dot(to_centre) - along * along;
-  const double reach = radius * (1.0 + 1e-9) + 1e-12;
+  const double across2 = centre2 - along * along;
   return across2 <= reach * reach && along + reach > 0.0 && along - reach < best;
+}
+inline bool may_meet(const Vec3& to_centre, const Vec3& d, double radius, double best) {
+  return may_meet(to_centre, to_centre.dot(to_centre), reach_of(radius), d, best);
 }
 
 // A body as one cast sees it: skipped, a plane (its world normal, the origin's height above
-// it), or a solid (the origin in its frame, its centre from the origin, its cones).
+// it), a solid (the origin in its frame, its centre from the origin, its cones) or a mesh (a
+// solid whose triangles are seen from the origin: `MeshView`, and those the cone being cast
+// may meet).
 struct Seen {
-  enum { skip, plane, solid } how = skip;
+  enum { skip, plane, solid, mesh } how = skip;
   Vec3 normal_world = Vec3::Zero();
   double height_m = 0.0;
   Vec3 origin_local = Vec3::Zero();
   Vec3 to_centre = Vec3::Zero();
+  double centre2 = 0.0, reach = 0.0;  // |to_centre|^2, the bounding radius and a margin
   bool bounded = false;
   bool culled_by_cones = false;
   std::vector<char> cones;  // the cones that may meet it (when culled_by_cones)
+  std::unique_ptr<MeshView> view;
+  std::vector<int> candidates;  // the triangles of the cone being cast
 };
+
+// Rays given without cones, for a caster with meshes: cones of kRaysPerCone consecutive rays
+// each, their axes the rays' normalized sums and their half-angles the widest ray's (as
+// `Bundles.of`), so that a mesh's rays try a few triangles each.
+constexpr Eigen::Index kRaysPerCone = 64;
+
+struct MadeCones {
+  std::vector<double> axes, half_angle_rad;
+  std::vector<std::int64_t> starts;
+  Cones view() const {
+    return {axes.data(), half_angle_rad.data(), starts.data(),
+            static_cast<Eigen::Index>(half_angle_rad.size())};
+  }
+};
+
+MadeCones cones_of_runs(const double* rays_f, Eigen::Index n) {
+  MadeCones out;
+  for (Eigen::Index first = 0; first < n; first += kRaysPerCone) {
+    const Eigen::Index last = std::min(n, first + kRaysPerCone);
+    Vec3 sum = Vec3::Zero();
+    for (Eigen::Index i = first; i < last; ++i) sum += Eigen::Map<const Vec3>(rays_f + 3 * i);
+    const double norm = sum.norm();
+    const Vec3 axis = norm > 0.0 ? Vec3(sum / norm) : Vec3::UnitZ();
+    double least = norm > 0.0 ? 1.0 : -1.0;
+    for (Eigen::Index i = first; i < last; ++i) {
+      least = std::min(least, axis.dot(Eigen::Map<const Vec3>(rays_f + 3 * i)));
+    }
+    out.axes.insert(out.axes.end(), axis.data(), axis.data() + 3);
+    out.half_angle_rad.push_back(std::acos(std::clamp(least, -1.0, 1.0)));
+    out.starts.push_back(first);
+  }
+  out.starts.push_back(n);
+  return out;
+}
 
 void check_cones(const Cones* cones, Eigen::Index n) {
   if (cones == nullptr) return;
@@ -77,6 +122,16 @@ bool RayCaster::cones_toward(const Cones& cones, const Vec3& to_centre_f, double
 void RayCaster::cast(const Vec3& origin, const Mat3& frame_rotation, const double* rays_f,
                      Eigen::Index n, const Cones* cones, RayHits out) const {
   check_cones(cones, n);
+  const bool meshes = std::any_of(bodies_.begin(), bodies_.end(), [](const Body& body) {
+    return body.shape.kind == ShapeKind::mesh;
+  });
+  MadeCones made;
+  Cones runs;
+  if (cones == nullptr && meshes && n > 0) {
+    made = cones_of_runs(rays_f, n);
+    runs = made.view();
+    cones = &runs;
+  }
   std::vector<Seen> seen(bodies_.size());
   for (std::size_t k = 0; k < bodies_.size(); ++k) {
     const Body& body = bodies_[k];
@@ -92,7 +147,13 @@ void RayCaster::cast(const Vec3& origin, const Mat3& frame_rotation, const doubl
     s.origin_local = body.rotation.transpose() * offset;
     if (body.shape.contains(s.origin_local)) continue;  // from inside a solid: not seen
     s.how = Seen::solid;
+    if (body.shape.kind == ShapeKind::mesh) {
+      s.how = Seen::mesh;
+      s.view = std::make_unique<MeshView>(*body.shape.triangles, s.origin_local);
+    }
     s.to_centre = -offset;
+    s.centre2 = s.to_centre.dot(s.to_centre);
+    s.reach = reach_of(body.shape.bound_radius_m);
     s.bounded = std::isfinite(body.shape.bound_radius_m);
     if (s.bounded && cones != nullptr) {
       s.culled_by_cones = cones_toward(*cones, frame_rotation.transpose() * s.to_centre,
@@ -105,9 +166,21 @@ void RayCaster::cast(const Vec3& origin, const Mat3& frame_rotation, const doubl
   for (Eigen::Index j = 0; j < groups; ++j) {
     active.clear();
     for (std::size_t k = 0; k < bodies_.size(); ++k) {
-      const Seen& s = seen[k];
+      Seen& s = seen[k];
       if (s.how == Seen::skip || (s.culled_by_cones && !s.cones[j])) continue;
       active.push_back(static_cast<int>(k));
+      if (s.how != Seen::mesh) continue;
+      // the triangles this cone may meet (its axis in the mesh's frame)
+      if (cones == nullptr) {
+        s.view->candidates(nullptr, s.candidates);
+        continue;
+      }
+      MeshCone cone;
+      cone.axis = bodies_[k].rotation.transpose() *
+                  (frame_rotation * Eigen::Map<const Vec3>(cones->axes + 3 * j));
+      cone.half_angle_rad = cones->half_angle_rad[j];
+      s.view->candidates(&cone, s.candidates);
+      if (s.candidates.empty()) active.pop_back();  // no triangle of it in this cone
     }
     const Eigen::Index first = cones == nullptr ? 0 : cones->starts[j];
     const Eigen::Index last = cones == nullptr ? n : cones->starts[j + 1];
@@ -128,11 +201,26 @@ void RayCaster::cast(const Vec3& origin, const Mat3& frame_rotation, const doubl
           continue;
         }
         const Body& body = bodies_[k];
-        if (s.bounded && !may_meet(s.to_centre, d, body.shape.bound_radius_m, best)) continue;
-        const RayHit hit = body.shape.hit(s.origin_local, body.rotation.transpose() * d);
-        if (hit.t < best) {
-          best = hit.t;
-          normal = body.rotation * hit.normal;
+        if (s.bounded && !may_meet(s.to_centre, s.centre2, s.reach, d, best)) continue;
+        const Vec3 d_local = body.rotation.transpose() * d;
+        if (s.how == Seen::mesh) {
+          // the mesh's nearest crossing, kept on a triangle's front beyond kTMinM
+          // (ray_mesh.hpp: TriangleMesh.hit's rule)
+          const auto crossing = s.view->nearest(d_local, s.candidates, best);
+          if (crossing.triangle < 0) continue;
+          const Vec3& face = body.shape.triangles->normal[crossing.triangle];
+          if (!(face.dot(d_local) < 0.0) || !(crossing.t > kTMinM) || !(crossing.t < best)) {
+            continue;
+          }
+          best = crossing.t;
+          normal = body.rotation * face;
+          label = k + 1;
+          continue;
+        }
+        const RayCrossing crossed = body.shape.crossing(s.origin_local, d_local);
+        if (crossed.t < best) {  // the normal of the hits kept only
+          best = crossed.t;
+          normal = body.rotation * body.shape.normal_at(s.origin_local, d_local, crossed);
           label = k + 1;
         }
       }
@@ -169,49 +257,6 @@ std::vector<std::int64_t> RayCaster::rays_toward(int index, const Vec3& origin,
     }
   }
   return rows;
-}
-
-Eigen::Index RayCaster::mesh_rays(int index, const Vec3& origin, const Mat3& frame_rotation,
-                                  const double* rays_f, Eigen::Index n, const Cones* cones,
-                                  const double* range_m, std::int64_t* rows, float* origins_local,
-                                  float* directions_local) const {
-  const std::vector<std::int64_t> found =
-      rays_toward(index, origin, frame_rotation, rays_f, n, cones, range_m);
-  const Body& body = bodies_.at(index);
-  const Vec3 origin_local = body.rotation.transpose() * (origin - body.position_m);
-  const Mat3 to_local = body.rotation.transpose() * frame_rotation;
-  for (std::size_t j = 0; j < found.size(); ++j) {
-    rows[j] = found[j];
-    const Vec3 d = to_local * Eigen::Map<const Vec3>(rays_f + 3 * found[j]);
-    for (int c = 0; c < 3; ++c) {
-      origins_local[3 * j + c] = static_cast<float>(origin_local[c]);
-      directions_local[3 * j + c] = static_cast<float>(d[c]);
-    }
-  }
-  return static_cast<Eigen::Index>(found.size());
-}
-
-void RayCaster::merge_mesh_hits(int index, const Mat3& frame_rotation, const double* rays_f,
-                                const std::int64_t* rows, Eigen::Index count,
-                                const float* range_t, const std::int32_t* triangle,
-                                const double* normals_local, Eigen::Index triangles,
-                                RayHits out) const {
-  const Body& body = bodies_.at(index);
-  const Mat3 to_local = body.rotation.transpose() * frame_rotation;
-  for (Eigen::Index j = 0; j < count; ++j) {
-    const std::int32_t k = triangle[j];
-    if (k < 0) continue;  // nothing met
-    if (k >= triangles) throw InputError("a mesh hit's triangle is not one of the mesh's");
-    const std::int64_t i = rows[j];
-    const Eigen::Map<const Vec3> normal(normals_local + 3 * k);
-    const Vec3 d = to_local * Eigen::Map<const Vec3>(rays_f + 3 * i);
-    if (!(normal.dot(d) < 0.0)) continue;  // its back: from inside a closed mesh
-    const double t = static_cast<double>(range_t[j]);
-    if (!(t > kTMinM) || !(t < out.range_m[i])) continue;
-    out.range_m[i] = t;
-    Eigen::Map<Vec3>(out.normal_world + 3 * i) = body.rotation * normal;
-    out.label[i] = index + 1;
-  }
 }
 
 }  // namespace uvms::perception

@@ -8,8 +8,12 @@
 // plane is met by each ray's rate along its normal, t = -h / (d . n), h the origin's height
 // above it; any other body is asked only for the rays that pass within its bounding sphere
 // nearer than the nearest hit so far, and, when the rays come in cones (`Cones`), only for
-// the cones that may meet that sphere. Bodies are taken in order, a nearer hit (strictly)
-// replacing the one found: the nearest hit, the first body's on a tie, as the reference.
+// the cones that may meet that sphere. A triangle mesh (ray_mesh.hpp) is culled the same way,
+// then each cone's rays try only the triangles the cone may meet, nearest first; rays given
+// without cones are grouped in cones of consecutive rays when the caster holds a mesh (the
+// hits are the same, the culling is conservative). Bodies are taken in order, a nearer hit
+// (strictly) replacing the one found: the nearest hit, the first body's on a tie, as the
+// reference.
 //
 // The rays are given in a frame (a camera's optical frame) at rotation R_f in the world,
 // d = R_f d_f: the caller does not rotate them each time (R_f = I: world rays).
@@ -57,27 +61,11 @@ class RayCaster {
 
   // The rays (in order) that may meet body `index` nearer than range_m: within its bounding
   // sphere, in a cone that may meet it (all rays for an unbounded body); empty when the
-  // origin is inside its solid. For the bodies cast outside the core (meshes).
+  // origin is inside its solid. For the bodies cast outside the core (`external`).
   std::vector<std::int64_t> rays_toward(int index, const Vec3& origin,
                                         const Mat3& frame_rotation, const double* rays_f,
                                         Eigen::Index n, const Cones* cones,
                                         const double* range_m) const;
-
-  // rays_toward's rays, and each one's origin and direction in the body's frame (single
-  // precision, as a triangle mesh's caster takes them: (count, 3) row-major each); their count.
-  Eigen::Index mesh_rays(int index, const Vec3& origin, const Mat3& frame_rotation,
-                         const double* rays_f, Eigen::Index n, const Cones* cones,
-                         const double* range_m, std::int64_t* rows, float* origins_local,
-                         float* directions_local) const;
-
-  // What a mesh's caster found for mesh_rays' `count` rays: each one's range t (single
-  // precision) and triangle (-1: none), the triangles' outward unit normals in the body's frame
-  // (triangles, 3); a hit is kept when it is on a triangle's front (n . d < 0), beyond the
-  // least range, and nearer than what its ray met (`out`, updated). TriangleMesh.hit's rule.
-  void merge_mesh_hits(int index, const Mat3& frame_rotation, const double* rays_f,
-                       const std::int64_t* rows, Eigen::Index count, const float* range_t,
-                       const std::int32_t* triangle, const double* normals_local,
-                       Eigen::Index triangles, RayHits out) const;
 
  private:
   struct Body {

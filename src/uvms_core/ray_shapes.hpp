@@ -14,16 +14,18 @@
 // - convex A x <= b (unit rows a of A): each face bounds t from below (a . d < 0) or above;
 // - cylinder (radius r, length L along z): x^2 + y^2 <= r^2 and the slab |z| <= L / 2.
 //
-// An `external` body (a triangle mesh) is cast outside the core (Embree, from Python): the
-// core knows its bounding sphere, picks its rays and keeps its hits (RayCaster::mesh_rays,
-// merge_mesh_hits).
+// A `mesh` body is a triangle mesh (ray_mesh.hpp), cast by the caster itself (it needs the
+// rays' cones). An `external` body (a shape the core does not know) is cast outside the core,
+// from Python: the core knows its bounding sphere and picks its rays (RayCaster::rays_toward).
 #pragma once
 
 #include <Eigen/Core>
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <memory>
 
+#include "ray_mesh.hpp"
 #include "types.hpp"
 
 namespace uvms::perception {
@@ -38,7 +40,14 @@ struct RayHit {
   Vec3 normal = Vec3::Zero();
 };
 
-enum class ShapeKind { plane, sphere, ellipsoid, convex, cylinder, external };
+// A ray's first crossing before its normal is taken (`RayShape::crossing`): t, and which face
+// it crosses (a convex body's face; a cylinder's side (0) or cap (+-1, the cap's z)).
+struct RayCrossing {
+  double t = kInf;
+  Eigen::Index face = 0;
+};
+
+enum class ShapeKind { plane, sphere, ellipsoid, convex, cylinder, mesh, external };
 
 using FaceRows = Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor>;
 
@@ -51,6 +60,7 @@ struct RayShape {
   Vec3 semi_axes_m = Vec3::Ones();  // ellipsoid
   FaceRows normals;               // convex: outward unit rows a (f, 3)
   Eigen::VectorXd offsets;        // convex: b (f,)
+  std::shared_ptr<const TriangleSet> triangles;  // mesh
 
   // Whether the point (its frame) is inside the solid (a plane, a mesh: never).
   bool contains(const Vec3& p) const {
@@ -73,19 +83,53 @@ struct RayShape {
 
   // The first crossing of o + t d (its frame) from outside.
   RayHit hit(const Vec3& o, const Vec3& d) const {
+    const RayCrossing crossed = crossing(o, d);
+    return {crossed.t, normal_at(o, d, crossed)};
+  }
+
+  // hit's t (and face), its normal left to normal_at: a caster takes it only for the hits it
+  // keeps (the same normal, computed from the same numbers).
+  RayCrossing crossing(const Vec3& o, const Vec3& d) const {
     switch (kind) {
       case ShapeKind::plane:
-        return {plane_along(o.z(), d.z()), Vec3::UnitZ()};
+        return {plane_along(o.z(), d.z()), 0};
       case ShapeKind::sphere:
-        return sphere_hit(o, d);
+        return sphere_crossing(o, d);
       case ShapeKind::ellipsoid:
-        return ellipsoid_hit(o, d);
+        return ellipsoid_crossing(o, d);
       case ShapeKind::convex:
-        return convex_hit(o, d);
+        return convex_crossing(o, d);
       case ShapeKind::cylinder:
-        return cylinder_hit(o, d);
+        return cylinder_crossing(o, d);
       default:
         return {};
+    }
+  }
+
+  // The outward unit normal of `crossed` (o + t d; none: that at o).
+  Vec3 normal_at(const Vec3& o, const Vec3& d, const RayCrossing& crossed) const {
+    const double along = std::isfinite(crossed.t) ? crossed.t : 0.0;
+    switch (kind) {
+      case ShapeKind::plane:
+        return Vec3::UnitZ();
+      case ShapeKind::sphere:
+        return (o + along * d) / radius_m;
+      case ShapeKind::ellipsoid: {
+        const Vec3 normal =
+            (o + along * d).cwiseQuotient(semi_axes_m.cwiseProduct(semi_axes_m));
+        const double norm = normal.norm();
+        return normal / (norm > 0.0 ? norm : 1.0);
+      }
+      case ShapeKind::convex:
+        return normals.row(crossed.face).transpose();
+      case ShapeKind::cylinder:
+        if (crossed.face == 0) {
+          return Vec3((o.x() + along * d.x()) / radius_m, (o.y() + along * d.y()) / radius_m,
+                      0.0);
+        }
+        return Vec3(0.0, 0.0, static_cast<double>(crossed.face));
+      default:
+        return Vec3::Zero();
     }
   }
 
@@ -111,35 +155,25 @@ struct RayShape {
     }
   }
 
-  RayHit sphere_hit(const Vec3& o, const Vec3& d) const {
+  RayCrossing sphere_crossing(const Vec3& o, const Vec3& d) const {
     const double b = o.dot(d);
     const double c = o.dot(o) - radius_m * radius_m;
     double enter, leave;
     quadratic(b, c, enter, leave);
-    RayHit out;
-    out.t = (enter > kTMinM && c > 0.0) ? enter : kInf;
-    const double along = std::isfinite(out.t) ? out.t : 0.0;
-    out.normal = (o + along * d) / radius_m;
-    return out;
+    return {(enter > kTMinM && c > 0.0) ? enter : kInf, 0};
   }
 
-  RayHit ellipsoid_hit(const Vec3& o, const Vec3& d) const {
+  RayCrossing ellipsoid_crossing(const Vec3& o, const Vec3& d) const {
     const Vec3 os = o.cwiseQuotient(semi_axes_m), ds = d.cwiseQuotient(semi_axes_m);
     const double a = ds.dot(ds);
     const double b = os.dot(ds) / a;
     const double c = (os.dot(os) - 1.0) / a;
     double enter, leave;
     quadratic(b, c, enter, leave);
-    RayHit out;
-    out.t = (enter > kTMinM && c > 0.0) ? enter : kInf;
-    const double along = std::isfinite(out.t) ? out.t : 0.0;
-    const Vec3 normal = (o + along * d).cwiseQuotient(semi_axes_m.cwiseProduct(semi_axes_m));
-    const double norm = normal.norm();
-    out.normal = normal / (norm > 0.0 ? norm : 1.0);
-    return out;
+    return {(enter > kTMinM && c > 0.0) ? enter : kInf, 0};
   }
 
-  RayHit convex_hit(const Vec3& o, const Vec3& d) const {
+  RayCrossing convex_crossing(const Vec3& o, const Vec3& d) const {
     double enter = -kInf, leave = kInf;
     Eigen::Index face = 0;
     for (Eigen::Index f = 0; f < normals.rows(); ++f) {
@@ -158,13 +192,10 @@ struct RayShape {
         leave = std::min(leave, t);
       }
     }
-    RayHit out;
-    out.t = (enter > kTMinM && enter <= leave) ? enter : kInf;
-    out.normal = normals.row(face).transpose();
-    return out;
+    return {(enter > kTMinM && enter <= leave) ? enter : kInf, face};
   }
 
-  RayHit cylinder_hit(const Vec3& o, const Vec3& d) const {
+  RayCrossing cylinder_crossing(const Vec3& o, const Vec3& d) const {
     // the slab |z| <= L / 2: its two faces z = +-half (a parallel ray's rate +1e-300)
     const double half = 0.5 * length_m;
     const bool down = d.z() < 0.0, up = d.z() > 0.0;
@@ -188,16 +219,9 @@ struct RayShape {
     }
     const double enter = std::max(cap_enter, side_enter);
     const double leave = std::min(cap_leave, side_leave);
-    RayHit out;
-    out.t = (enter > kTMinM && enter <= leave) ? enter : kInf;
-    const double along = std::isfinite(out.t) ? out.t : 0.0;
-    if (side_enter >= cap_enter) {
-      out.normal = Vec3((o.x() + along * d.x()) / radius_m, (o.y() + along * d.y()) / radius_m,
-                        0.0);
-    } else {
-      out.normal = Vec3(0.0, 0.0, cap_z);
-    }
-    return out;
+    // the side's normal, or the cap's (+-1: its z)
+    const Eigen::Index face = side_enter >= cap_enter ? 0 : static_cast<Eigen::Index>(cap_z);
+    return {(enter > kTMinM && enter <= leave) ? enter : kInf, face};
   }
 };
 

@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 from uvms_pin.errors import ParameterError
-from uvms_pin.perception.camera import Camera, CameraSpec
+from uvms_pin.perception.camera import Camera, CameraSpec, pixel_rays
 from uvms_pin.perception.optics import JERLOV_KD_PER_M
 from uvms_pin.perception.scene import Scene
 from uvms_pin.physics.world.objects import plane, solid
@@ -162,3 +162,15 @@ def test_the_noise_of_a_uniform_target_has_the_given_deviation(reference_uvms):
     error = frame.rgb[kept].astype(float) - clean[kept]
     assert abs(error.mean()) < 0.05
     assert error.std() == pytest.approx(np.sqrt(16.0 + 1.0 / 12.0), rel=0.02)
+
+
+@pytest.mark.parametrize("width, height, fov", [(320, 240, 1.2), (50, 37, 2.0), (7, 64, 0.3)])
+def test_pixel_rays_are_unit_and_through_each_pixels_centre(width, height, fov):
+    spec = CameraSpec("c", width=width, height=height, horizontal_fov_rad=fov)
+    rays = pixel_rays(spec)
+    assert rays.shape == (width * height, 3) and rays.flags.c_contiguous
+    np.testing.assert_allclose(np.linalg.norm(rays, axis=1), 1.0, atol=1e-15)
+    v, u = np.divmod(np.arange(width * height), width)  # row by row
+    f = 0.5 * width / np.tan(0.5 * fov)
+    np.testing.assert_allclose(rays[:, 0] / rays[:, 2], (u + 0.5 - 0.5 * width) / f, atol=1e-13)
+    np.testing.assert_allclose(rays[:, 1] / rays[:, 2], (v + 0.5 - 0.5 * height) / f, atol=1e-13)

@@ -151,19 +151,98 @@ def test_a_solid_holding_the_origin_and_a_plane_behind_it_are_not_seen_by_either
     _assert_same(expected, compiled.cast(np.zeros(3), d))
 
 
+def _meshes(caster: RayCaster) -> list[int]:
+    """The labels of ``caster``'s triangle meshes."""
+    return [k + 1 for k, shape in enumerate(caster._shapes) if isinstance(shape, TriangleMesh)]
+
+
 @pytest.mark.parametrize("seed", range(2))
-def test_meshes_are_cast_by_embree_between_the_cores_casts(seed):
+def test_meshes_are_cast_in_the_core_as_embree_casts_them(seed):
+    """The core's triangles (double precision, rays without cones grouped in its own) against
+    Embree's (single precision, the reference): ranges to 1e-6."""
     reference, compiled = _random_casters(seed, meshes=2)
-    assert len(compiled._external) == 2  # the meshes are not in the core
+    assert compiled._external == []  # the meshes are in the core
     rng = np.random.default_rng(300 + seed)
     d = _sphere_rays(rng, 6000)
     origin = rng.uniform(-0.5, 0.5, 3)
     expected = reference.cast(origin, d)
-    meshes = [k + 1 for k in compiled._external]
-    assert np.isin(expected.label, meshes).sum() > 5  # the meshes are seen
-    # Embree's single precision: the rays put in the mesh's frame in the core, rounded to
-    # single precision there, may round the other way (a range one float32 step apart)
+    assert np.isin(expected.label, _meshes(reference)).sum() > 5  # the meshes are seen
     _assert_same(expected, compiled.cast(origin, d), tol=1e-6)
+
+
+@pytest.mark.parametrize("seed", range(3))
+def test_a_cameras_cones_see_the_meshes_as_embree_does(seed):
+    """A camera's tiles on the rock: each cone's rays try only the triangles it may meet,
+    and meet what Embree meets (ranges to 1e-6), what the core meets without the cones."""
+    reference, compiled = RayCaster(), caster_for("core")
+    rock = TriangleMesh(*_rock_triangles())
+    rng = np.random.default_rng(400 + seed)
+    for caster in (reference, compiled):
+        caster.add("seabed", Plane(), np.eye(3), [0.0, 0.0, -1.0])
+        caster.add("rock", rock, pin.rpy.rpyToMatrix(0.0, 0.0, 0.4), [1.2, 0.1, -0.8])
+    spec = CameraSpec("c", width=96, height=64, horizontal_fov_rad=rng.uniform(0.6, 1.0))
+    order, starts = tiles(spec)
+    rays = pixel_rays(spec)[order]
+    bundles = Bundles.of(rays, starts)
+    # looking at the rock (near its centre) from about 1 m, above it
+    target = np.array([1.2, 0.1, -0.7]) + rng.uniform(-0.1, 0.1, 3)
+    origin = target + rng.uniform(0.7, 1.1) * np.array([-0.8, rng.uniform(-0.3, 0.3), 0.6])
+    z = (target - origin) / np.linalg.norm(target - origin)  # the optical axis
+    x = np.cross(z, [0.0, 0.0, 1.0])
+    x /= np.linalg.norm(x)  # right; y = z x x down
+    rotation = np.column_stack([x, np.cross(z, x), z])
+    expected = reference.cast(origin, rays @ rotation.T, bundles.rotated(rotation))
+    assert np.mean(expected.label == 2) > 0.2  # the rock fills much of the view
+    got = compiled.cast_from(origin, rotation, rays, cones_of(bundles))
+    _assert_same(expected, got, tol=1e-6)
+    _assert_same(got, compiled.cast(origin, rays @ rotation.T))  # no cones: the same hits
+
+
+def _rock_triangles() -> tuple[np.ndarray, np.ndarray]:
+    import trimesh
+
+    rock = trimesh.load(ROCK, force="mesh")
+    return np.asarray(rock.vertices), np.asarray(rock.faces)
+
+
+def _cube_mesh(half_m: float) -> TriangleMesh:
+    """A cube of half-side ``half_m`` about its origin in 12 triangles, outward."""
+    corners = np.array([[x, y, z] for x in (-1, 1) for y in (-1, 1) for z in (-1, 1)], float)
+    faces = []
+    for axis in range(3):
+        for sign in (-1.0, 1.0):
+            on = np.flatnonzero(corners[:, axis] == sign)
+            # the face's four corners around its normal, counterclockwise seen from outside
+            centre = corners[on].mean(axis=0)
+            u, v = np.eye(3)[(axis + 1) % 3], np.eye(3)[(axis + 2) % 3]
+            angle = np.arctan2((corners[on] - centre) @ v, (corners[on] - centre) @ u)
+            ring = on[np.argsort(sign * angle)]
+            faces += [[ring[0], ring[1], ring[2]], [ring[0], ring[2], ring[3]]]
+    return TriangleMesh(half_m * corners, np.array(faces))
+
+
+def test_a_mesh_cube_is_met_where_the_box_is_and_not_from_inside():
+    """The core's triangles in double precision: a cube's mesh meets the rays where the
+    analytic box does (1e-12); from inside the cube, or behind a lone triangle, nothing."""
+    cube = _cube_mesh(0.5)
+    assert np.all(np.einsum("ij,ij->i", cube.normals, cube.vertices_m[cube.triangles].mean(1)) > 0)
+    rotation, position = pin.rpy.rpyToMatrix(0.3, -0.2, 0.7), np.array([2.0, 0.5, -0.3])
+    meshed, boxed = caster_for("core"), caster_for("core")
+    meshed.add("cube", cube, rotation, position)
+    boxed.add("cube", box([0.5, 0.5, 0.5]), rotation, position)
+    d = _sphere_rays(np.random.default_rng(11), 20000)
+    expected = boxed.cast(np.zeros(3), d)
+    assert np.sum(expected.label == 1) > 300
+    _assert_same(expected, meshed.cast(np.zeros(3), d))
+    assert np.all(meshed.cast(position + 0.1, d).label == 0)  # from inside: its backs
+    lone = caster_for("core")
+    lone.add("sheet", TriangleMesh(cube.vertices_m, cube.triangles[:1]), rotation, position)
+    centroid, normal = cube.vertices_m[cube.triangles[0]].mean(axis=0), cube.normals[0]
+    front = lone.cast(position + rotation @ (centroid + normal), d)
+    assert np.sum(front.label == 1) > 0  # seen from its front
+    np.testing.assert_allclose(front.normal_world[front.label == 1], np.tile(
+        rotation @ normal, (np.sum(front.label == 1), 1)), atol=1e-12)  # fmt: skip
+    assert np.all(lone.cast(position + rotation @ (centroid - normal), d).label == 0)
 
 
 class _Ball:
@@ -229,11 +308,14 @@ def test_the_compiled_camera_gives_the_references_images(reference_uvms, width, 
     rock = expected.label == python.names.index("rock") + 1
     np.testing.assert_allclose(got.depth_m[met & ~rock], expected.depth_m[met & ~rock],
                                rtol=TOL, atol=TOL)  # fmt: skip
-    np.testing.assert_allclose(got.depth_m[rock], expected.depth_m[rock], rtol=0, atol=1e-6)
+    # the rock: Embree's single precision in the reference, the core's triangles in double
+    np.testing.assert_allclose(got.depth_m[rock], expected.depth_m[rock], rtol=2e-6)
     np.testing.assert_allclose(got.normal_world, expected.normal_world, rtol=0, atol=TOL)
-    np.testing.assert_allclose(got.radiance, expected.radiance, rtol=0, atol=1e-9)
+    np.testing.assert_allclose(got.radiance[rock], expected.radiance[rock], rtol=2e-6)
     np.testing.assert_allclose(got.radiance[~rock], expected.radiance[~rock], rtol=0, atol=TOL)
-    np.testing.assert_array_equal(got.rgb, expected.rgb)  # the same noise, drawn once
+    np.testing.assert_array_equal(got.rgb[~rock], expected.rgb[~rock])  # the same noise
+    differ = got.rgb[rock].astype(int) - expected.rgb[rock]
+    assert np.all(np.abs(differ) <= 1) and np.mean(differ != 0) < 0.01  # a rounding at most
 
 
 def test_the_backend_is_chosen_once_where_the_scene_is_built(reference_uvms):
@@ -269,28 +351,72 @@ def test_the_core_refuses_bad_input_by_name():
     np.testing.assert_allclose(out[0], 2.0, atol=TOL)
 
 
-def test_a_firing_records_new_arrays_though_the_compiled_pixels_reuse_their_own(reference_uvms):
-    """`Camera.fire` computes in the camera's buffers: what it returned before is kept, and
-    it equals a new render's (the same noise draws, written into a buffer or not)."""
-    spec = CameraSpec("front", width=48, height=32, rpy_rad=(-1.9, 0.0, -1.5708))
-    scene = _seen(reference_uvms, "core")
+@pytest.mark.parametrize("backend", ["core", "python"])
+def test_a_firing_records_renders_image_into_new_or_given_arrays(reference_uvms, backend):
+    """`Camera.fire` gives what `render` gives (the same noise draws, in the same order): new
+    arrays, or the given ones written into (the run's stack of images), never kept."""
+    lights = (Light((0.1, 0.0, 0.0), intensity=2.0),)
+    spec = CameraSpec("front", width=48, height=32, rpy_rad=(-1.9, 0.0, -1.5708),
+                      lights=lights, noise_counts=3.0, water_type="5C")  # fmt: skip
+    scene = _seen(reference_uvms, backend)
     firing, rendering = (Camera(spec, scene, np.random.default_rng(3)) for _ in range(2))
     first = firing.fire()
     kept = {key: value.copy() for key, value in first.items()}
+    assert {k: (v.dtype, v.shape) for k, v in first.items()} == {
+        "depth_m": (np.float32, (32, 48)), "rgb": (np.uint8, (32, 48, 3)),
+        "label": (np.int16, (32, 48)),
+    }  # fmt: skip
+    stack = {key: np.zeros((2, *value.shape), value.dtype) for key, value in first.items()}
     q = reference_uvms.neutral_configuration()
     q[:3] = [0.5, 0.2, -9.3]
     scene.update(q)
-    second = firing.fire()
-    assert not np.array_equal(second["depth_m"], kept["depth_m"])  # it moved
+    given = {key: values[1] for key, values in stack.items()}
+    assert firing.fire(given) is given
+    assert not np.array_equal(stack["depth_m"][1], kept["depth_m"])  # it moved
+    assert not stack["rgb"][0].any()  # the other image of the stack untouched
     for key in kept:
         np.testing.assert_array_equal(first[key], kept[key])  # not overwritten
     q0 = reference_uvms.neutral_configuration()
     q0[2], q0[7:] = -9.0, q0[7:] + 0.3
     scene.update(q0)
     frame = rendering.render()  # the first image again, from a fresh camera of the same seed
+    assert np.all(np.isnan(frame.depth_m) == np.isnan(kept["depth_m"]))
     np.testing.assert_array_equal(frame.rgb, kept["rgb"])
     np.testing.assert_array_equal(frame.label, kept["label"])
     np.testing.assert_array_equal(frame.depth_m.astype(np.float32), kept["depth_m"])
+    scene.update(q)
+    second = rendering.render()
+    np.testing.assert_array_equal(second.rgb, stack["rgb"][1])
+    np.testing.assert_array_equal(second.depth_m.astype(np.float32), stack["depth_m"][1])
+    wrong = dict(given, label=np.zeros((32, 48), np.int32))
+    with pytest.raises(ParameterError, match="label"):
+        firing.fire(wrong)
+    with pytest.raises(ParameterError, match="rgb"):
+        firing.fire(dict(given, rgb=np.zeros((48, 32, 3), np.uint8).transpose(1, 0, 2)))
+
+
+def test_the_core_refuses_a_bad_record_by_name():
+    scene_rays = pixel_rays(CameraSpec("c", width=16, height=16))
+    compiled = caster_for("core")
+    compiled.add("ball", Sphere(1.0), np.eye(3), [0.0, 0.0, 3.0])
+    n = len(scene_rays)
+    hits = compiled.cast(np.zeros(3), scene_rays)
+    water = (np.full(3, 0.1), np.full(3, 0.1), np.full(3, 0.1), 1.0, np.full(3, 0.2))
+    args = (np.zeros(3), np.eye(3), scene_rays, hits.range_m, hits.normal_world, hits.label,
+            np.arange(n), np.full((2, 3), 0.5), *water, np.zeros((0, 9)))  # fmt: skip
+    levels = np.zeros(65536, np.float32)
+    out = (np.empty(n, np.float32), np.empty(n, np.int16), np.empty((n, 3), np.uint8))
+    core = compiled.core
+    core.record_camera(*args, None, levels, 255.0, 0.0, *out)
+    assert np.all(out[1] == hits.label) and np.all(out[2] > 0)
+    with pytest.raises(ParameterError, match="noise_codes"):
+        core.record_camera(*args, np.zeros((n, 2), np.uint16), levels, 255.0, 1.0, *out)
+    with pytest.raises(ParameterError, match="noise_levels"):
+        core.record_camera(*args, None, levels[:10], 255.0, 1.0, *out)
+    with pytest.raises(ParameterError, match="rgb"):
+        core.record_camera(*args, None, levels, 255.0, 1.0, *out[:2], out[2][:5])
+    with pytest.raises(ParameterError, match="mesh"):
+        core.RayCaster().add_mesh(np.eye(3), np.array([[0, 1, 3]]), 1.0, np.eye(3), np.zeros(3))
 
 
 def test_an_output_of_another_dtype_is_refused_not_written_into_a_copy():

@@ -7,7 +7,12 @@ import pytest
 from scipy.special import ndtr
 
 from uvms_pin.errors import ParameterError
-from uvms_pin.perception.image_noise import LEVELS, normal_levels, standard_normal_f32
+from uvms_pin.perception.image_noise import (
+    LEVELS,
+    normal_codes,
+    normal_levels,
+    standard_normal_f32,
+)
 
 
 def test_the_levels_are_the_normal_quantiles_at_unit_variance():
@@ -56,3 +61,28 @@ def test_the_same_seed_gives_the_same_draws_written_in_place():
 def test_an_output_of_the_wrong_kind_is_refused(out):
     with pytest.raises(ParameterError, match="C-contiguous float32"):
         standard_normal_f32(np.random.default_rng(0), (4, 3), out=out)
+
+
+@pytest.mark.parametrize("sizes", [(230400, 8, 12), (6, 8, 7, 12), (3, 5, 230400)])
+def test_the_codes_are_numpys_integers_and_leave_the_generator_as_they_do(sizes):
+    """`normal_codes` reads PCG64's raw outputs when that gives numpy's own 16-bit integers
+    (a multiple of 4, no 32-bit half kept): the same codes in any sequence of sizes, the
+    generator left in the same state."""
+    ours, numpys = np.random.default_rng(11), np.random.default_rng(11)
+    for size in sizes:
+        codes = normal_codes(ours, size)
+        assert codes.dtype == np.uint16 and codes.shape == (size,)
+        np.testing.assert_array_equal(codes, numpys.integers(0, LEVELS, size, np.uint16))
+        # the same state (a 32-bit half numpy keeps but will not use aside)
+        state, expected = ours.bit_generator.state, numpys.bit_generator.state
+        assert state["has_uint32"] == expected["has_uint32"]
+        if not state["has_uint32"]:
+            state["uinteger"] = expected["uinteger"]
+        assert state == expected
+    for draw in (lambda g: g.random(3), lambda g: g.integers(0, 7, 5, np.uint32)):
+        np.testing.assert_array_equal(draw(ours), draw(numpys))
+    other = np.random.Generator(np.random.MT19937(5))  # not PCG64: numpy's integers
+    np.testing.assert_array_equal(
+        normal_codes(other, 8),
+        np.random.Generator(np.random.MT19937(5)).integers(0, LEVELS, 8, np.uint16),
+    )

@@ -199,3 +199,14 @@ def test_beam_patterns_are_half_power_at_the_fov_edge_and_sinc_squared_across_be
         sonar.weight, 0.5 ** ((bearing**2 + elevation**2) / 0.15**2), rtol=1e-2
     )
     assert np.argmax(sonar.weight) == np.argmin(off_axis)
+
+
+def test_a_firing_is_written_into_the_arrays_given(reference_uvms):
+    """`Sonar.fire(out)`: the run's stack of images written into, the same values."""
+    expected = _multibeam(reference_uvms, 3.0).fire()
+    out = {key: np.zeros_like(value) for key, value in expected.items()}
+    assert _multibeam(reference_uvms, 3.0).fire(out) is out
+    for key, value in expected.items():
+        np.testing.assert_array_equal(out[key], value)
+    with pytest.raises(ParameterError, match="mbes"):
+        _multibeam(reference_uvms, 3.0).fire({"intensity": out["intensity"]})

@@ -23,7 +23,7 @@ from uvms_pin.errors import ParameterError
 from uvms_pin.perception import sensor
 from uvms_pin.perception.caster import Bundles
 from uvms_pin.perception.compiled_camera import CompiledPixels
-from uvms_pin.perception.image_noise import standard_normal_f32
+from uvms_pin.perception.image_noise import normal_codes, standard_normal_f32
 from uvms_pin.perception.optics import Light, WaterOptics, backscatter, cone_of_cosine
 from uvms_pin.perception.scene import Scene
 
@@ -140,9 +140,14 @@ def pixel_rays(spec: CameraSpec) -> np.ndarray:
     f = spec.focal_px
     u = (np.arange(spec.width) + 0.5 - 0.5 * spec.width) / f
     v = (np.arange(spec.height) + 0.5 - 0.5 * spec.height) / f
-    x, y = np.meshgrid(u, v)
-    length = np.sqrt(x * x + y * y + 1.0).ravel()  # |(x, y, 1)|, summed in that order
-    return np.column_stack([x.ravel() / length, y.ravel() / length, 1.0 / length])
+    # |(x, y, 1)|, summed in that order, x along a row and y down a column (broadcast, no
+    # meshgrid: a camera is made for each run)
+    length = np.sqrt((u * u)[None, :] + (v * v)[:, None] + 1.0)
+    out = np.empty((spec.height, spec.width, 3))
+    np.divide(u[None, :], length, out=out[..., 0])
+    np.divide(v[:, None], length, out=out[..., 1])
+    np.divide(1.0, length, out=out[..., 2])
+    return out.reshape(-1, 3)
 
 
 def tiles(spec: CameraSpec) -> tuple[np.ndarray, np.ndarray]:
@@ -194,7 +199,7 @@ class Camera(sensor.Mounted):
             given.setdefault(name, ROBOT)
         self.reflectance = reflectance_of(scene.names, given, scene.floor_names)
         #: the same pixels computed in the core, when the scene's caster is compiled
-        self._compiled, self._buffers = None, None
+        self._compiled = None
         if scene.compiled:
             self._compiled = CompiledPixels(
                 scene.caster, self._tiled, self._bundles, self.order, self.reflectance,
@@ -220,26 +225,15 @@ class Camera(sensor.Mounted):
 
     def render(self) -> Frame:
         """The image of the scene as it stands (new arrays)."""
-        return self._render(reuse=False)
-
-    def _render(self, reuse: bool) -> Frame:
-        """The image; ``reuse``: the compiled pixels and the noise in the camera's own
-        buffers, overwritten by its next image (the rgb only is new): for `fire`, which
-        keeps copies of what it records, so that an image does not write megabytes of new
-        memory it then drops (measured: as long as casting a 320 x 240 image)."""
         spec = self.spec
         rotation, position = self.pose()
-        if reuse and self._compiled is not None and self._buffers is None:
-            self._buffers = self._compiled.buffers()
-        buffers = self._buffers if reuse else None
         if self._compiled is not None:
-            depth, normal, label, radiance = self._compiled.pixels(position, rotation, buffers)
+            depth, normal, label, radiance = self._compiled.pixels(position, rotation)
         else:
             depth, normal, label, radiance = self._pixels(position, rotation)
         noise = None
         if spec.noise_counts > 0.0:
-            out = None if buffers is None else buffers[-1]
-            noise = standard_normal_f32(self.rng, radiance.shape, out=out)
+            noise = standard_normal_f32(self.rng, radiance.shape)
         scale = 255.0 * spec.exposure
         if self._compiled is not None:
             rgb = self._compiled.eight_bit(radiance, scale, spec.noise_counts, noise)
@@ -323,14 +317,49 @@ class Camera(sensor.Mounted):
         path *= rho
         out += path
 
-    def fire(self) -> dict[str, np.ndarray]:
-        """What a firing records: depth (float32), rgb, label (new arrays)."""
-        frame = self._render(reuse=True)
-        return {
-            "depth_m": frame.depth_m.astype(np.float32),
-            "rgb": frame.rgb,
-            "label": frame.label.astype(np.int16),
+    def fire(self, out: dict[str, np.ndarray] | None = None) -> dict[str, np.ndarray]:
+        """What a firing records: ``depth_m`` (H, W) float32, ``rgb`` (H, W, 3) and
+        ``label`` (H, W) int16 of `render`'s image (its values, the same noise draws);
+        written into ``out`` (those arrays, C-contiguous) when given, else new arrays.
+
+        The compiled camera computes only these (`CompiledPixels.record`): no normals,
+        radiance or noise array, nothing copied."""
+        spec = self.spec
+        shape = (spec.height, spec.width)
+        layout = {
+            "depth_m": (shape, np.float32),
+            "rgb": ((*shape, 3), np.uint8),
+            "label": (shape, np.int16),
         }
+        if out is None:
+            out = {key: np.empty(size, dtype=dtype) for key, (size, dtype) in layout.items()}
+        for key, (size, dtype) in layout.items():
+            given = out.get(key)
+            if not (
+                isinstance(given, np.ndarray)
+                and given.shape == size
+                and given.dtype == dtype
+                and given.flags.c_contiguous
+            ):
+                raise ParameterError(
+                    f"camera '{spec.name}': out['{key}'] must be a C-contiguous "
+                    f"{np.dtype(dtype).name} array of shape {size}"
+                )
+        if self._compiled is None:
+            frame = self.render()
+            for key in layout:
+                out[key][...] = getattr(frame, key)
+            return out
+        rotation, position = self.pose()
+        n = spec.width * spec.height
+        codes = None
+        if spec.noise_counts > 0.0:  # the draws `render` makes, in the same order
+            codes = normal_codes(self.rng, 3 * n).reshape(n, 3)
+        flat = (out["depth_m"].reshape(n), out["label"].reshape(n), out["rgb"].reshape(n, 3))
+        self._compiled.record(
+            position, rotation, codes, 255.0 * spec.exposure, spec.noise_counts, flat
+        )
+        return out
 
 
 CAMERA = sensor.register(

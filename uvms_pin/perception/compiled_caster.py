@@ -4,22 +4,22 @@
 rays of many origins) whose casts from one origin run in the core (``_core.RayCaster``,
 src/uvms_core/ray_caster.cpp, the same formulas as `uvms_pin.perception.shapes`): the
 analytic shapes (plane, sphere, ellipsoid, convex polytope, cylinder) there, ray by ray over
-the bodies whose bounding sphere the ray's cone may meet. Any other shape (a triangle mesh)
-is an external body the core only bounds: the core gives the rays that may meet it nearer
-than what they met and a nearer hit replaces the core's. A mesh's rays are put in its frame
-by the core (single precision), cast by Embree in one batch (`TriangleMesh.first_hits`),
-and its front hits kept by the core (`TriangleMesh.hit`'s rule); any other shape's by its
-own ``hit``. Measured (benchmarks/bench_perception.py's scene,
-one core): a 320 x 240 image's casts take 3.3 ms (2.3 ms in the core, the rock's rays in
-Embree the rest), 12.3 ms by the reference; Embree takes about 0.1 us a ray, glue included
-(7.5 ms for 76,800 rays against the rock), which a scalar bounding-volume hierarchy of our
-own would hardly beat (not measured): the meshes stay on Embree (single precision, as in
-the reference).
+the bodies whose bounding sphere the ray's cone may meet, and the triangle meshes
+(`TriangleMesh`) too, in double precision (src/uvms_core/ray_mesh.hpp: each triangle's edge
+planes through the origin once a cast, a cone's rays trying only the triangles it may meet,
+nearest first; `TriangleMesh.hit`'s rule). Any other shape is an external body the core only
+bounds: the core gives the rays that may meet it nearer than what they met, its own ``hit``
+casts them and a nearer hit replaces the core's.
+
+The reference casts the meshes by Embree, in single precision (`uvms_pin.perception.mesh`):
+the two agree on a mesh's ranges to about 1e-7 relative (Embree's rounding), elsewhere to
+rounding. The core's own casting, measured on the seabed landing's camera (320 x 240, the
+rock filling a quarter of the last image, 19,000 rays toward it): 0.9 ms for the rock's rays
+where Embree took 2.5 ms, glue included, called once per image from Python.
 
 The rays may be given in a frame at ``frame_rotation`` (a camera's optical frame), rotated
 in the core: ``cast_from``. Hits agree with `RayCaster.cast`'s to rounding (tests/perception/
-test_compiled_caster.py); on an exact tie between a mesh and an analytic body the analytic
-one is kept (the reference keeps the body added first).
+test_compiled_caster.py); on an exact tie the body added first is kept, as in the reference.
 """
 
 from __future__ import annotations
@@ -53,6 +53,10 @@ def _add_to_core(core_caster, shape: Shape, rotation: np.ndarray, position: np.n
         normals = np.ascontiguousarray(shape.normals, dtype=float)
         offsets = np.ascontiguousarray(shape.offsets, dtype=float)
         core_caster.add_convex(normals, offsets, shape.bound_radius_m, rotation, position)
+    elif isinstance(shape, TriangleMesh):
+        vertices = np.ascontiguousarray(shape.vertices_m, dtype=float)
+        triangles = np.ascontiguousarray(shape.triangles, dtype=np.int64)
+        core_caster.add_mesh(vertices, triangles, shape.bound_radius_m, rotation, position)
     else:
         core_caster.add_external(float(shape.bound_radius_m), rotation, position)
         return False
@@ -77,8 +81,8 @@ class CompiledCaster(RayCaster):
         super().__init__()
         self.core = core  # the extension module (its other perception functions)
         self._core = ray_caster(core)
-        self._external: list[int] = []  # the bodies cast here (meshes), in order
-        self._scratch: tuple[np.ndarray, ...] | None = None  # `_buffers`
+        self._external: list[int] = []  # the bodies cast here (shapes it lacks), in order
+        self._scratch: np.ndarray | None = None  # `_rows`
 
     def add(self, name: str, shape: Shape, rotation=None, position_m=None) -> int:
         index = super().add(name, shape, rotation, position_m)
@@ -123,43 +127,19 @@ class CompiledCaster(RayCaster):
             origin, frame_rotation, rays, hits.range_m, hits.normal_world, hits.label, *cones
         )
         for k in self._external:
-            if isinstance(self._shapes[k], TriangleMesh):
-                self._mesh_hits(k, origin, frame_rotation, rays, cones, hits)
-            else:
-                self._external_hits(k, origin, frame_rotation, rays, cones, hits)
+            self._external_hits(k, origin, frame_rotation, rays, cones, hits)
         return hits
 
-    def _buffers(self, n: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """(rows (n,), origins (n, 3) float32, directions (n, 3) float32) for n rays, kept
-        for the next cast of as many (a camera's)."""
-        if self._scratch is None or len(self._scratch[0]) != n:
-            self._scratch = (
-                np.empty(n, dtype=np.int64),
-                np.empty((n, 3), dtype=np.float32),
-                np.empty((n, 3), dtype=np.float32),
-            )
+    def _rows(self, n: int) -> np.ndarray:
+        """Rows (n,) for n rays, kept for the next cast of as many."""
+        if self._scratch is None or len(self._scratch) != n:
+            self._scratch = np.empty(n, dtype=np.int64)
         return self._scratch
-
-    def _mesh_hits(self, k, origin, frame_rotation, rays, cones, hits: Hits) -> None:
-        """Mesh ``k``'s hits: the core picks its rays and puts them in its frame, Embree casts
-        them (`TriangleMesh.first_hits`), the core keeps the nearer front hits."""
-        rows, origins, directions = self._buffers(len(rays))
-        count = self._core.mesh_rays(
-            k, origin, frame_rotation, rays, hits.range_m, rows, origins, directions, *cones
-        )
-        if count == 0:
-            return
-        mesh = self._shapes[k]
-        t, triangle = mesh.first_hits(origins[:count], directions[:count])
-        self._core.merge_mesh_hits(
-            k, frame_rotation, rays, rows[:count], t, triangle, mesh.normals,
-            hits.range_m, hits.normal_world, hits.label,
-        )  # fmt: skip
 
     def _external_hits(self, k, origin, frame_rotation, rays, cones, hits: Hits) -> None:
         """Body ``k``'s hits (its own ``hit``) on the rays the core says may meet it nearer
         than their hits, kept where nearer."""
-        rows = self._buffers(len(rays))[0]
+        rows = self._rows(len(rays))
         count = self._core.rays_toward(k, origin, frame_rotation, rays, hits.range_m, rows, *cones)
         if count == 0:
             return

@@ -22,7 +22,7 @@ from scipy.special import ndtri
 
 from uvms_pin.errors import ParameterError
 
-__all__ = ["LEVELS", "normal_levels", "standard_normal_f32"]
+__all__ = ["LEVELS", "normal_codes", "normal_levels", "standard_normal_f32"]
 
 LEVELS = 1 << 16
 
@@ -38,6 +38,22 @@ def normal_levels() -> np.ndarray:
     return table
 
 
+def normal_codes(rng: np.random.Generator, size: int) -> np.ndarray:
+    """``size`` uniform 16-bit codes (uint16) from ``rng``: the draws k whose values are
+    `normal_levels`()[k] (the compiled camera looks them up itself).
+
+    They are ``rng.integers(0, 65536, size, dtype=np.uint16)``: numpy splits each 64-bit
+    output of PCG64 into 32-bit halves, low first, and each of those into 16-bit halves, low
+    first (keeping an unused 32-bit half for the next call). For a size that is a multiple of
+    4 and no half kept, that is the raw 64-bit outputs read as 16-bit integers, taken so
+    (0.16 ms for a 320 x 240 image's 230,400 codes instead of 0.27 ms): the same codes, the
+    generator left in the same state (tests/perception/test_image_noise.py)."""
+    bits = rng.bit_generator
+    if size % 4 == 0 and type(bits) is np.random.PCG64 and not bits.state["has_uint32"]:
+        return bits.random_raw(size // 4).view(np.uint16)
+    return rng.integers(0, LEVELS, size=size, dtype=np.uint16)
+
+
 def standard_normal_f32(
     rng: np.random.Generator, shape: tuple[int, ...], out: np.ndarray | None = None
 ) -> np.ndarray:
@@ -49,6 +65,5 @@ def standard_normal_f32(
         out = np.empty(shape, dtype=np.float32)
     elif out.shape != tuple(shape) or out.dtype != np.float32 or not out.flags.c_contiguous:
         raise ParameterError(f"out must be a C-contiguous float32 array of shape {tuple(shape)}")
-    codes = rng.integers(0, LEVELS, size=size, dtype=np.uint16)
-    np.take(normal_levels(), codes, out=out.reshape(size))
+    np.take(normal_levels(), normal_codes(rng, size), out=out.reshape(size))
     return out

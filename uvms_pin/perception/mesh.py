@@ -1,6 +1,7 @@
 """A triangle mesh cast by Embree (Intel's ray-tracing kernels, through ``embreex``).
 
-Its bounding-volume hierarchy is built once, in the mesh's frame; a sensor firing casts
+Its bounding-volume hierarchy is built once, in the mesh's frame, when it is first cast (the
+compiled caster casts the triangles itself: src/uvms_core/ray_mesh.hpp); a sensor firing casts
 its rays in that frame (`uvms_pin.perception.caster` moves the rays, never the mesh). Embree
 works in single precision: a hit is within ~1e-7 of its range (5e-7 m at 5 m); the
 analytic shapes (`uvms_pin.perception.shapes`) are exact in double precision.
@@ -23,15 +24,10 @@ class TriangleMesh:
     outside (a hit on a triangle's back is none: a ray from inside a closed mesh)."""
 
     def __init__(self, vertices_m: np.ndarray, triangles: np.ndarray):
-        from embreex import mesh_construction, rtcore_scene
-
         vertices = np.asarray(vertices_m, dtype=float)
         faces = np.asarray(triangles, dtype=np.int64)
         self.vertices_m, self.triangles = vertices, faces
-        self._scene = rtcore_scene.EmbreeScene()
-        self._mesh = mesh_construction.TriangleMesh(
-            self._scene, np.ascontiguousarray(vertices[faces], dtype=np.float32)
-        )
+        self._scene = None  # Embree's, built when first cast (the compiled caster casts its own)
         normals = np.cross(vertices[faces[:, 1]] - vertices[faces[:, 0]],
                            vertices[faces[:, 2]] - vertices[faces[:, 0]])  # fmt: skip
         length = np.linalg.norm(normals, axis=1, keepdims=True)
@@ -46,6 +42,14 @@ class TriangleMesh:
     def first_hits(self, o32: np.ndarray, d32: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Embree's first hit of each ray o + t d (contiguous float32 (n, 3), the mesh's
         frame): (t (n,) float32, its triangle (n,) int32, -1 for none), either side."""
+        if self._scene is None:
+            from embreex import mesh_construction, rtcore_scene
+
+            self._scene = rtcore_scene.EmbreeScene()
+            self._mesh = mesh_construction.TriangleMesh(
+                self._scene,
+                np.ascontiguousarray(self.vertices_m[self.triangles], dtype=np.float32),
+            )
         out = self._scene.run(o32, d32, output=1)
         return out["tfar"], np.where(out["geomID"] >= 0, out["primID"], -1).astype(np.int32)
 

@@ -4,7 +4,8 @@ fires (`Scene.update`), never rebuilt.
 
 - fixed objects (`uvms_pin.physics.world.objects.WorldObject`): a plane as the analytic plane
   seen from its outward side; a box, sphere, cylinder and ellipsoid as themselves; a mesh as
-  its file's triangles (Embree: its concavities are seen, though it collides as its hull);
+  its file's triangles (`TriangleMesh`: its concavities are seen, though it collides as its
+  hull);
 - the robot's links: their collision pieces (`uvms_pin.physics.world.robot_geometry`: the
   URDF ``<collision>`` shapes, a box or mesh as its convex hull), each labelled with its
   link, placed by the forward kinematics of q;

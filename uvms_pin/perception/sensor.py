@@ -29,6 +29,7 @@ __all__ = [
     "mount_frame",
     "register",
     "spec_from_dict",
+    "written",
 ]
 
 
@@ -39,8 +40,9 @@ class PerceptionKind:
     Attributes:
         name: its tables ``[[sensors.<name>]]``.
         spec: its spec's class (a frozen dataclass; ``from_dict`` builds it from a table).
-        make: (spec, scene, random generator) -> the sensor, whose ``fire(time_s)`` gives
-            the arrays it records at one firing (name -> array).
+        make: (spec, scene, random generator) -> the sensor, whose ``fire(out=None)``
+            gives the arrays it records at one firing (name -> array), written into ``out``
+            (the same names and arrays' shapes) when given.
         constants: (sensor) -> the arrays it records once (a sonar's range bins), by name.
         bytes: (spec) -> what one firing records [bytes].
     """
@@ -123,6 +125,20 @@ class Mounted:
     def placement(self) -> pin.SE3:
         """Its frame in the world, after the scene's update."""
         return self.scene.frame_placement(self.frame_id) * self.in_link
+
+
+def written(
+    fired: dict[str, np.ndarray], out: dict[str, np.ndarray] | None, label: str
+) -> dict[str, np.ndarray]:
+    """A firing's arrays ``fired`` copied into ``out`` (the same names and shapes) when
+    given (ParameterError naming ``label`` otherwise), else ``fired``."""
+    if out is None:
+        return fired
+    if set(out) != set(fired) or any(out[k].shape != v.shape for k, v in fired.items()):
+        raise ParameterError(f"{label}: out must hold {', '.join(fired)} of one firing's shapes")
+    for key, value in fired.items():
+        out[key][...] = value
+    return out
 
 
 def check_mount(spec: Any, label: str) -> None:

@@ -18,7 +18,9 @@ the ray is inside all of them over [max t_enter, min t_exit] (Kay and Kajiya's s
   the slab |z| <= L / 2.
 
 A solid's ``contains(point)`` says whether a point (its frame) is inside it: rays from there
-meet nothing of it (the caster does not ask). The triangle meshes (a rock, a concave hull) are cast by Embree: `uvms_pin.perception.mesh`.
+meet nothing of it (the caster does not ask). The triangle meshes (a rock, a concave hull) are
+cast by Embree in the reference (`uvms_pin.perception.mesh`), by the core's own casting in the
+compiled caster (src/uvms_core/ray_mesh.hpp).
 """
 
 from __future__ import annotations

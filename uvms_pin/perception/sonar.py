@@ -200,15 +200,16 @@ class Sonar(sensor.Mounted):
             energy = energy * self.rng.standard_exponential(spec.beams)
         return range_m, energy
 
-    def fire(self) -> dict[str, np.ndarray]:
+    def fire(self, out: dict[str, np.ndarray] | None = None) -> dict[str, np.ndarray]:
         """What a firing records: its intensity (float32); a multibeam's detections too,
-        ``beam_range_m`` and ``beam_intensity`` (beams,)."""
+        ``beam_range_m`` and ``beam_intensity`` (beams,); copied into ``out`` (the same
+        arrays) when given, else new arrays."""
         k, beam, r, echo = self.echoes()
-        out = {"intensity": self._image(k, beam, r, echo).astype(np.float32)}
+        fired = {"intensity": self._image(k, beam, r, echo).astype(np.float32)}
         if self.spec.type == "multibeam":
             range_m, energy = self.profile(beam, r, echo)
-            out["beam_range_m"], out["beam_intensity"] = range_m, energy.astype(np.float32)
-        return out
+            fired["beam_range_m"], fired["beam_intensity"] = range_m, energy.astype(np.float32)
+        return sensor.written(fired, out, f"sonar '{self.spec.name}'")
 
 
 SONAR = sensor.register(

@@ -118,10 +118,15 @@ def perceive(
 def _fire(
     sensor: Any, scene: Scene, q: np.ndarray, poses: np.ndarray, rows: Sequence[int]
 ) -> dict[str, np.ndarray]:
-    """The sensor's arrays at each of ``rows``, stacked."""
-    stacked: dict[str, list[np.ndarray]] = {}
-    for row in rows:
+    """The sensor's arrays at each of ``rows``, stacked: the first firing's arrays give the
+    stack's, each later one is written into its place (no copy of an image)."""
+    stacked: dict[str, np.ndarray] = {}
+    for k, row in enumerate(rows):
         scene.update(q[row], list(poses[row]))
-        for key, value in sensor.fire().items():
-            stacked.setdefault(key, []).append(value)
-    return {key: np.stack(values) for key, values in stacked.items()}
+        if k == 0:
+            for key, value in sensor.fire().items():
+                stacked[key] = np.empty((len(rows), *value.shape), dtype=value.dtype)
+                stacked[key][0] = value
+        else:
+            sensor.fire({key: values[k] for key, values in stacked.items()})
+    return stacked
