@@ -127,9 +127,15 @@ def test_the_sensors_are_cast_on_the_plants_backend_with_the_same_images(monkeyp
     reference = scene_of(plant.uvms, plant.world, surface=plant.free_surface, backend="python")
     perceive(rollout, scenario.sensor_config.perception, reference, 7)
     camera, sonar = rollout.perception["front"], rollout.perception["fls"]
-    # the rock's ranges: Embree's single precision in the reference, double in the core
     np.testing.assert_array_equal(compiled["front"]["label"], camera["label"])
-    np.testing.assert_allclose(compiled["front"]["depth_m"], camera["depth_m"], rtol=2e-6)
+    # the rock's ranges: Embree's single precision in the reference (float32: a few ulps of
+    # the ray's terms, up to ~7e-6 relative at grazing rays), double in the core; the rest
+    # to the core's rounding
+    rock = camera["label"] == reference.names.index("rock") + 1
+    assert rock.any() and (~rock).any()
+    depth = compiled["front"]["depth_m"]
+    np.testing.assert_allclose(depth[rock], camera["depth_m"][rock], rtol=1e-5)
+    np.testing.assert_allclose(depth[~rock], camera["depth_m"][~rock], rtol=1e-9)
     differ = compiled["front"]["rgb"].astype(int) - camera["rgb"]
     assert np.all(np.abs(differ) <= 1) and np.mean(differ != 0) < 1e-3  # a rounding at most
     np.testing.assert_allclose(compiled["fls"]["intensity"], sonar["intensity"], rtol=1e-5)
