@@ -1,6 +1,7 @@
 """Stable at the defaults: the shipped UVMS released with no input for 60 s at the default
 step (how far a joint ever went past its limit), and the Gymnasium environments driven by
-uniform random actions (64 environments x 3,000 steps each: how many episodes diverged)."""
+uniform random actions (64 environments x 3,000 steps each: how many episodes diverged, how
+fast the arms' joints turn)."""
 
 from __future__ import annotations
 
@@ -99,7 +100,8 @@ def main() -> None:
         + "\n\nThe vector environments (`gym.make_vec(..., vectorization_mode="
         '"vector_entry_point")`) driven by `action_space.sample()` (seed '
         f"{SEED}), autoreset on; a step's fastest arm joint is the largest |qdot| over the "
-        "environments after it (the Alpha 5's velocity limits are 0.5 and 1 rad/s):\n\n"
+        "environments after it (the URDFs' velocity limits: the reference arm's 1.5 and 2 "
+        "rad/s, the Alpha 5's 0.5 and 1 rad/s):\n\n"
         "| environment | environments x steps | episodes ended | diverged steps "
         "| a step's fastest arm joint, median [rad/s] | fastest arm joint [rad/s] "
         "| wall [s] |\n|---|---|---|---|---|---|---|\n" + "\n".join(random) + "\n"
