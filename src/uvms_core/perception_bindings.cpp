@@ -80,6 +80,18 @@ void check_shading(const In2& reflectance, const In2& lights, const std::string&
                                        "intensity, half_angle_rad, edge_rad");
 }
 
+// A cast's n hits, as shade_camera and record_camera take them: its rays (n, 3), the
+// range_m (n,), normal_world (n, 3), label (n,) and pixel_of (n,) of each; n.
+Eigen::Index hits_count(const In2& rays, const In1& range_m, const In2& normal_world,
+                        const InLabels& label, const InIndex& pixel_of, const std::string& what) {
+  const Eigen::Index n = rows3(rays, "rays");
+  const auto sized = [n](size_t size) { return size == static_cast<size_t>(n); };
+  require(sized(range_m.shape(0)) && sized(normal_world.shape(0)) &&
+              normal_world.shape(1) == 3 && sized(label.shape(0)) && sized(pixel_of.shape(0)),
+          what + ": range_m (n,), normal_world (n, 3), label (n,), pixel_of (n,)");
+  return n;
+}
+
 // The lights' rows (source (3), unit axis (3), intensity, half_angle_rad, edge_rad).
 std::vector<SpotLight> spots_of(const In2& lights) {
   std::vector<SpotLight> spots;
@@ -249,12 +261,9 @@ void bind_perception(nb::module_& m) {
          const In2& reflectance, const Vec3& kd_per_m, const Vec3& beta_d_per_m,
          const Vec3& beta_b_per_m, double surface_irradiance, const Vec3& veiling,
          const In2& lights, Out1 depth_m, Out2 normal_out, Labels label_out, Out2 radiance) {
-        const Eigen::Index n = rows3(rays, "rays");
+        const Eigen::Index n =
+            hits_count(rays, range_m, normal_world, label, pixel_of, "shade_camera");
         const auto sized = [n](size_t size) { return size == static_cast<size_t>(n); };
-        require(sized(range_m.shape(0)) && sized(normal_world.shape(0)) &&
-                    normal_world.shape(1) == 3 && sized(label.shape(0)) &&
-                    sized(pixel_of.shape(0)),
-                "shade_camera: range_m (n,), normal_world (n, 3), label (n,), pixel_of (n,)");
         require(sized(depth_m.shape(0)) && sized(normal_out.shape(0)) &&
                     normal_out.shape(1) == 3 && sized(label_out.shape(0)) &&
                     sized(radiance.shape(0)) && radiance.shape(1) == 3,
@@ -282,12 +291,9 @@ void bind_perception(nb::module_& m) {
          const Vec3& beta_b_per_m, double surface_irradiance, const Vec3& veiling,
          const In2& lights, std::optional<Codes> noise_codes, const In1f& noise_levels,
          double scale, double noise_counts, Out1f depth_m, Labels16 label_out, Rgb rgb) {
-        const Eigen::Index n = rows3(rays, "rays");
+        const Eigen::Index n =
+            hits_count(rays, range_m, normal_world, label, pixel_of, "record_camera");
         const auto sized = [n](size_t size) { return size == static_cast<size_t>(n); };
-        require(sized(range_m.shape(0)) && sized(normal_world.shape(0)) &&
-                    normal_world.shape(1) == 3 && sized(label.shape(0)) &&
-                    sized(pixel_of.shape(0)),
-                "record_camera: range_m (n,), normal_world (n, 3), label (n,), pixel_of (n,)");
         require(sized(depth_m.shape(0)) && sized(label_out.shape(0)) && sized(rgb.shape(0)) &&
                     rgb.shape(1) == 3,
                 "record_camera: depth_m (n,), label_out (n,) and rgb (n, 3) expected");
