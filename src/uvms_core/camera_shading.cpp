@@ -44,12 +44,14 @@ constexpr Eigen::Index kBlock = 256;
 // A block's arrays, by ray that met something (j < count) and channel.
 struct Block {
   explicit Block(Eigen::Index n_lights)
-      : ray(kBlock), pixel(kBlock), range_m(kBlock), rate_z(kBlock), normal_z(kBlock),
+      : ray(kBlock), pixel(kBlock), range_m(kBlock), direction(3 * kBlock), normal_z(kBlock),
         sky(kBlock), depth_m(kBlock), power(kBlock * n_lights), rho(3 * kBlock),
         day(3 * kBlock), back(3 * kBlock), lit(3 * kBlock * n_lights), signal(3 * kBlock) {}
   std::vector<Eigen::Index> ray;    // its index in the cast
   std::vector<std::int64_t> pixel;  // its pixel
-  std::vector<double> range_m, rate_z, normal_z, sky, depth_m, power;
+  std::vector<double> range_m;
+  std::vector<double> direction;  // the ray's unit direction in the world, entry 3 j + axis
+  std::vector<double> normal_z, sky, depth_m, power;
   // by channel c: entry c kBlock + j (lit: (l 3 + c) kBlock + j)
   std::vector<double> rho, day, back, lit, signal;
 };
@@ -146,7 +148,7 @@ template <class Sink>
   Eigen::Index* const ray_of = b.ray.data();
   std::int64_t* const pixel_of_met = b.pixel.data();
   double* const range_of = b.range_m.data();
-  double* const rate_z = b.rate_z.data();
+  double* const direction = b.direction.data();
   double* const normal_z = b.normal_z.data();
   double* const rho_of = b.rho.data();
   double* const depth_of = b.depth_m.data();
@@ -175,8 +177,8 @@ template <class Sink>
       ray_of[j] = i;
       pixel_of_met[j] = pixel;
       range_of[j] = r;
-      const Vec3 d = frame_rotation * ray_f;  // as the lights compute it, the same bits
-      rate_z[j] = d.z();
+      // the direction in the world, once a ray: its z for the depth, all of it for the lights
+      Eigen::Map<Vec3>(direction + 3 * j) = frame_rotation * ray_f;
       normal_z[j] = normal_world[3 * i + 2];
       for (int c = 0; c < 3; ++c) rho_of[c * kBlock + j] = reflectance[3 * k + c];
     }
@@ -187,7 +189,7 @@ template <class Sink>
     // daylight E0 exp(-K_d depth) (1 + n_z) / 2 and the direct path's exp(-beta_D r), and
     // the backscatter's exp(-beta_B r): their exponents
     for (Eigen::Index j = 0; j < count; ++j) {
-      depth_of[j] = std::max(-(origin_z + range_of[j] * rate_z[j]), 0.0);
+      depth_of[j] = std::max(-(origin_z + range_of[j] * direction[3 * j + 2]), 0.0);
       sky_of[j] = half_sky * (1.0 + normal_z[j]);
     }
     for (int c = 0; c < 3; ++c) {
@@ -208,7 +210,7 @@ template <class Sink>
       for (Eigen::Index j = 0; j < count; ++j) {
         const Eigen::Index i = ray_of[j];
         const double r = range_of[j];
-        const Vec3 d = frame_rotation * Eigen::Map<const Vec3>(rays_f + 3 * i);
+        const Eigen::Map<const Vec3> d(direction + 3 * j);
         const Eigen::Map<const Vec3> normal(normal_world + 3 * i);
         const Vec3 to_point = r * d + (origin - light.source_world);
         const double distance = std::sqrt(to_point.dot(to_point));
