@@ -33,14 +33,22 @@ def random_episode(scenario: str, seed: int, steps: int) -> float:
     return total
 
 
-def ppc_through_env(scenario: str, duration_s: float) -> tuple[np.ndarray, np.ndarray]:
-    """(q of the PPC run through the environment, q of ``uvms-pin run``) at the log times."""
-    overrides = {"scenario.duration_s": duration_s}
-    reference = load_scenario(scenario_path(scenario), overrides)
+def ppc_through_env(
+    scenario: str,
+    duration_s: float,
+    model: str | None = None,
+    overrides: dict | None = None,
+) -> tuple[np.ndarray, np.ndarray]:
+    """(q of the scenario's controller run through the environment, q of ``uvms-pin run``)
+    at the log times; ``model`` and ``overrides`` as `gym.make` takes them."""
+    overrides = {**(overrides or {}), "scenario.duration_s": duration_s}
+    model_override = {} if model is None else {"scenario.model": model}
+    reference = load_scenario(scenario_path(scenario), {**overrides, **model_override})
     expected = simulate(reference, progress=False)
     env = gym.make(
         "uvms_pin/ForceTracking-v0",
         scenario=scenario,
+        model=model,
         overrides=overrides,
         clip_actions=False,
         initial_position_noise_m=0.0,

@@ -107,8 +107,18 @@ class JawServo:
 
     def torque(self, time_s: float, q_jaw: np.ndarray, v_jaw: np.ndarray) -> np.ndarray:
         """tau per jaw joint [N m or N]: the saturated PD law toward `target`."""
+        return self._law(self.target(time_s), q_jaw, v_jaw)
+
+    def torques(self, times_s: np.ndarray, q_jaw: np.ndarray, v_jaw: np.ndarray) -> np.ndarray:
+        """`torque` of several jaws at once: row i at ``times_s[i]`` [s] from ``q_jaw[i]``,
+        ``v_jaw[i]`` (N, jaw joints) -> (N, jaw joints) [N m or N]."""
+        closed = np.array([self.schedule.closed(float(t)) for t in times_s], dtype=bool)
+        target = np.where(closed[:, None], self.jaw.lower, self.jaw.upper)
+        return self._law(target, q_jaw, v_jaw)
+
+    def _law(self, target: np.ndarray, q_jaw: np.ndarray, v_jaw: np.ndarray) -> np.ndarray:
         limit = self.max_force_N * self.lever_m
-        raw = self.stiffness * (self.target(time_s) - q_jaw) - self.damping * v_jaw
+        raw = self.stiffness * (target - q_jaw) - self.damping * v_jaw
         # minimum(maximum()) is np.clip without its per-call dispatch cost (the same bits)
         return np.minimum(np.maximum(raw, -limit), limit)
 

@@ -229,6 +229,7 @@ def _build(raw: dict[str, Any], path: Path, top: Table) -> Scenario:
         settings,
         extra_metrics=extra_metrics,
         task=task,
+        jaw_servo=None if gripper is None else gripper.servo,
     )
 
 

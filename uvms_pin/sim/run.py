@@ -18,6 +18,7 @@ from typing import Any
 import numpy as np
 
 from uvms_pin.control.base import Controller
+from uvms_pin.control.jaw_servo import JawServo
 from uvms_pin.control.spec import ControllerFactory, ControllerSpec
 from uvms_pin.control.tracking.task import TrackingTask
 from uvms_pin.errors import ParameterError, ScenarioError, ShortenedRunWarning, SimulationError
@@ -55,6 +56,10 @@ class Scenario:
             rollout (`uvms_pin.sim.task_record`), and its metrics to ``metrics()``.
         shortened_from_s: the scenario's own duration [s] when ``UVMS_PIN_MAX_DURATION_S``
             shortened this run (`shortened`), else None.
+        jaw_servo: the servo of the model's jaw joints (``[gripper]``), None when the model
+            has none or the controller commands them (``by_controller``). The controller
+            factory already includes it; a policy that replaces the controller (the gym
+            environments) drives the other joints and leaves the jaw to it.
     """
 
     name: str
@@ -70,6 +75,7 @@ class Scenario:
     extra_metrics: tuple[str, ...] = ()
     task: TrackingTask | None = None
     shortened_from_s: float | None = None
+    jaw_servo: JawServo | None = None
 
     @property
     def uvms(self) -> UVMS:

@@ -49,3 +49,14 @@ def test_unlimited_actuation_needs_an_explicit_scale():
     np.testing.assert_array_equal(action_scale(Unlimited(), 2, [1.0, 2.0]), [1.0, 2.0])
     with pytest.raises(ParameterError, match="positive"):
         action_scale(Unlimited(), 2, [1.0, 0.0])
+
+
+def test_a_scale_of_some_entries_is_their_part_and_an_override_has_their_count():
+    driven = np.array([0, 1, 2, 3, 4, 5, 7])  # tau[6] (a servoed jaw joint) left out
+    np.testing.assert_array_equal(
+        action_scale(_actuation(), 8, driven=driven), action_scale(_actuation(), 8)[driven]
+    )
+    np.testing.assert_array_equal(action_scale(Unlimited(), 8, [1.0] * 7, driven), [1.0] * 7)
+    for bad in ([1.0] * 8, None):  # nv numbers, or none, for 7 driven entries
+        with pytest.raises(ParameterError, match=r"must be 7 positive|<7 numbers"):
+            action_scale(Unlimited(), 8, bad, driven)

@@ -399,3 +399,53 @@ def test_the_render_draws_the_vehicle_at_its_size_and_attitude():
     assert width == pytest.approx(size[0] * np.cos(pitch) + size[2] * np.sin(pitch))
     lbv = _make(FORCE).unwrapped
     np.testing.assert_allclose(vehicle_box(lbv.scenario.uvms)[1], [0.53, 0.245, 0.254])
+
+
+# the BlueROV2 + Alpha 5 force task on the model whose jaw's two fingers move: its [gripper]
+# servo (closed from the start, by default) drives them
+JAW_MODEL = {
+    "scenario": "bluerov_alpha5_force_tracking",
+    "model": "uvms_bluerov2_alpha5_jaws",
+}
+JAW_OVERRIDES = {
+    "initial.joint_positions_rad": [-0.2, 0.8, 2.2, 0.2, 0.0, 0.0],
+    "initial.velocity": [0.0] * 12,
+}
+
+
+def test_the_scenarios_controller_beside_its_jaw_servo_through_the_environment_is_uvms_pin_run():
+    # the scenario's controller (the PPC beside the servo) as the policy: it gives the
+    # vehicle's and arm's entries, the environment's own servo the jaw's
+    q_env, q_run = _ppc_script().ppc_through_env(
+        JAW_MODEL["scenario"], 0.3, JAW_MODEL["model"], JAW_OVERRIDES
+    )
+    assert q_env.shape == q_run.shape == (31, 13)
+    assert np.max(np.abs(q_run[-1] - q_run[0])) > 1e-3  # the run moves
+    np.testing.assert_allclose(q_env, q_run, rtol=0, atol=1e-9)
+    env = gym.make(FORCE, **JAW_MODEL, overrides={**JAW_OVERRIDES, **SHORT}).unwrapped
+    jaw = env.jaw_servo.jaw
+    assert env.action_space.shape == (env.scenario.uvms.nv - jaw.count,)
+    np.testing.assert_array_equal(env.action_index, jaw.arm_v_index)
+
+
+def test_random_actions_leave_a_servoed_jaw_to_its_servo_on_the_measured_jaw():
+    # noisy joints: the servo must read the measurement, as beside a controller
+    noise = {"sensors.joint_noise_rad": 0.001, "sensors.velocity_noise": 0.005}
+    env = gym.make(STATION, **JAW_MODEL, overrides={**JAW_OVERRIDES, **SHORT, **noise})
+    env = env.unwrapped
+    servo, layout = env.jaw_servo, env.observation_layout
+    jaw = servo.jaw
+    env.action_space.seed(5)
+    observation, info = env.reset(seed=5)
+    expected = []
+    for _ in range(40):
+        q, v = observation[layout["q"]], observation[layout["v"]]
+        expected.append(servo.torque(info["time_s"], q[jaw.q_index], v[jaw.v_index]))
+        observation, _, terminated, truncated, info = env.step(env.action_space.sample())
+        assert not (terminated or truncated)
+    tau = env.episode_rollout().signals["tau_commanded"][:40]
+    np.testing.assert_array_equal(tau[:, jaw.v_index], expected)
+    assert np.abs(np.array(expected)).max() > 0.0  # the servo acted
+    # the fingers stay within their velocity limit (10 rad/s): a random torque of their
+    # 10 N m effort limit on a 4e-5 kg m^2 finger turned it at over 100 rad/s in one step
+    assert np.abs(env.episode_rollout().v[:, jaw.v_index]).max() < 10.0

@@ -217,3 +217,28 @@ def test_the_defaults_record_their_stiffest_mode():
     envs = _vector(STATION, 2)
     assert envs.unwrapped.stiff_modes["checked"] is True
     envs.close()
+
+
+def test_with_a_servoed_jaw_the_vector_env_is_n_single_envs():
+    # the model whose jaw's fingers move, its [gripper] servo driving them from each
+    # environment's measured jaw at its own time (episodes of 5 steps, so across resets),
+    # noisy joints so that the measurement differs from the state
+    kw = {
+        "scenario": "bluerov_alpha5_force_tracking",
+        "model": "uvms_bluerov2_alpha5_jaws",
+        "overrides": {
+            "initial.joint_positions_rad": [-0.2, 0.8, 2.2, 0.2, 0.0, 0.0],
+            "initial.velocity": [0.0] * 12,
+            "sensors.joint_noise_rad": 0.001,
+            "sensors.velocity_noise": 0.005,
+            "scenario.duration_s": 0.01,
+        },
+    }
+    num_envs, steps = 3, 16
+    envs = _vector(FORCE, num_envs, num_threads=2, **kw)
+    assert envs.single_action_space.shape == (10,)  # 12 but the two fingers
+    actions = _actions(envs.action_space, steps, seed=2)
+    vector = _vector_run(envs, 40, actions)
+    single = _singles(FORCE, num_envs, 40, actions, **kw)
+    assert single["truncated"].any()
+    _assert_same(vector, single)

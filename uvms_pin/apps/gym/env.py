@@ -7,8 +7,11 @@ Observation (float64), what a controller may measure, in this order (``observati
     wrench_measured (6): F/T force [N] (3), torque [N m] (3), world axes, with noise;
     goal: the task's goal (force tracking: f_d(t) [N] (3); station keeping: p_d [m] (3),
     quaternion xyzw (4)).
-Action (nv,) in [-1, 1]: tau_commanded = action_scale * action (`uvms_pin.apps.gym.actions`),
-then the plant's actuation (thruster allocation and saturation, joint torque limits).
+Action (n,) in [-1, 1]: tau_commanded[action_index] = action_scale * action
+(`uvms_pin.apps.gym.actions`), then the plant's actuation (thruster allocation and
+saturation, joint torque limits). The action drives the vehicle and the arm joints: all nv
+entries, or, on a model whose jaw a ``[gripper]`` servo drives, all but the jaw's, which the
+servo commands from the measurement as it does beside a controller (`jaw_servo`).
 One step = one control period (the scenario's control.period_s); the episode is truncated
 at the scenario's duration_s.
 """
@@ -47,15 +50,22 @@ def _continuous_control_message(scenario: Scenario, action_scale: Any) -> str:
     ``action_scale`` when the scenario has no actuation limits to normalize by."""
     log_period_s = scenario.settings.log_period_s
     fix = f'overrides={{"control.period_s": {log_period_s:g}}}'
+    driven = _driven(scenario)
     try:
-        make_action_scale(scenario.plant.actuation, scenario.uvms.nv, action_scale)
+        make_action_scale(scenario.plant.actuation, scenario.uvms.nv, action_scale, driven)
     except ParameterError:
-        fix += f", action_scale=<{scenario.uvms.nv} numbers [N, N m]> (no [actuation] limits)"
+        fix += f", action_scale=<{len(driven)} numbers [N, N m]> (no [actuation] limits)"
     return (
         f"{scenario.path}: the environment steps one control period at a time, and the "
         "scenario's control is continuous: give it a control period that divides "
         f"output.log_period_s = {log_period_s:g} s, e.g. {fix}"
     )
+
+
+def _driven(scenario: Scenario) -> np.ndarray:
+    """The entries of tau the action drives: every one but a servoed jaw's."""
+    servo = scenario.jaw_servo
+    return np.arange(scenario.uvms.nv) if servo is None else servo.jaw.arm_v_index.copy()
 
 
 def _shortened_record(scenario: Scenario) -> dict[str, Any]:
@@ -93,8 +103,9 @@ class UvmsEnv(gym.Env):
         model: replaces the scenario's model (a shipped model name or a URDF path).
         overrides: dotted scenario overrides, as ``uvms-pin run --set`` (e.g.
             ``{"control.period_s": 0.01}``).
-        action_scale: scale of the normalized action (nv,) [N, N m]; default: the
-            actuation limits (required when the scenario's actuation is unlimited).
+        action_scale: scale of the normalized action (one per entry of ``action_index``)
+            [N, N m]; default: the actuation limits (required when the scenario's
+            actuation is unlimited).
         clip_actions: clip the action to [-1, 1] (False: pass it on; the actuation still
             saturates).
         initial_position_noise_m, initial_joint_noise_rad: bound of the uniform
@@ -152,7 +163,13 @@ class UvmsEnv(gym.Env):
             raise ParameterError(_continuous_control_message(self.scenario, action_scale))
         self._loop = ClosedLoop(self.scenario.plant, self.scenario.settings)
         uvms = self.scenario.uvms
-        self.action_scale = make_action_scale(self.scenario.plant.actuation, uvms.nv, action_scale)
+        #: the entries of tau the action drives (all but a servoed jaw's, `jaw_servo`)
+        self.action_index = _driven(self.scenario)
+        #: the scenario's jaw servo, which commands the jaw joints (None: no servoed jaw)
+        self.jaw_servo = self.scenario.jaw_servo
+        self.action_scale = make_action_scale(
+            self.scenario.plant.actuation, uvms.nv, action_scale, self.action_index
+        )
         self.clip_actions = bool(clip_actions)
         self.initial_position_noise_m = float(initial_position_noise_m)
         self.initial_joint_noise_rad = float(initial_joint_noise_rad)
@@ -164,7 +181,7 @@ class UvmsEnv(gym.Env):
         self.observation_layout = _layout(uvms.nq, uvms.nv, self.task.goal_size)
         size = self.observation_layout["goal"].stop
         self.observation_space = gym.spaces.Box(-np.inf, np.inf, (size,), np.float64)
-        self.action_space = gym.spaces.Box(-1.0, 1.0, (uvms.nv,), np.float64)
+        self.action_space = gym.spaces.Box(-1.0, 1.0, (self.action_index.size,), np.float64)
         self.episode_seed: int | None = None
         self._steps = 0
         self._log: RolloutLog | None = None
@@ -229,9 +246,9 @@ class UvmsEnv(gym.Env):
         if self.clip_actions:
             a = np.clip(a, -1.0, 1.0)
         loop = self._loop
-        tau = self.action_scale * a
-        tau_applied = loop.actuate(tau)
         t, measured = loop.time_s, self._measurement
+        tau = self.commanded_tau(a, t, measured)
+        tau_applied = loop.actuate(tau)
         self._log.on_sample(loop.sample(measured, self._contact, tau, tau_applied))
         info: dict[str, Any] = {"seed": self.episode_seed}
         try:
@@ -248,6 +265,20 @@ class UvmsEnv(gym.Env):
         truncated = self._steps >= self.max_steps and not outcome.terminated
         info.update(time_s=loop.time_s, **outcome.terms)
         return self._observation(), outcome.reward, outcome.terminated, truncated, info
+
+    def commanded_tau(self, action: np.ndarray, time_s: float, measured: Measurement) -> np.ndarray:
+        """tau_commanded (nv,) [N, N m] of a (clipped) normalized ``action`` at ``time_s``:
+        ``action_scale * action`` on `action_index`, the jaw servo's torques from the
+        ``measured`` jaw joints on the jaw's entries."""
+        tau = np.zeros(self.scenario.uvms.nv)
+        tau[self.action_index] = self.action_scale * action
+        servo = self.jaw_servo
+        if servo is not None:
+            jaw = servo.jaw
+            tau[jaw.v_index] = servo.torque(
+                time_s, measured.q[jaw.q_index], measured.v[jaw.v_index]
+            )
+        return tau
 
     def render(self):
         if self.render_mode != "rgb_array":

@@ -10,6 +10,7 @@ import numpy as np
 
 from uvms_pin.apps.gym.env import UvmsEnv
 from uvms_pin.apps.gym.tasks import ForceTrackingTask
+from uvms_pin.control.jaw_servo import WithJaw
 from uvms_pin.control.performance import PerformanceFunction
 from uvms_pin.control.ppc import PrescribedPerformanceController
 from uvms_pin.errors import ParameterError
@@ -53,6 +54,8 @@ class ForceTrackingEnv(UvmsEnv):
         ppc = None
         if getattr(scenario.controller_factory, "type", None) == "ppc":
             ppc = scenario.controller_factory(scenario.uvms)
+            if isinstance(ppc, WithJaw):  # the PPC beside a jaw's servo: the PPC's own
+                ppc = ppc.arm
         return ForceTrackingTask(
             _desired_force(self._desired_force_option, ppc),
             _funnel(self._funnel_option, ppc),

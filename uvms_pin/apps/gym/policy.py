@@ -2,8 +2,9 @@
 
 The controller gets the `Measurement` rebuilt from the observation (its q, v and wrench
 slices) at the time ``info['time_s']``, and its tau is returned as a normalized action,
-tau / action_scale (not clipped: create the environment with ``clip_actions=False`` to
-pass a command beyond the box to the actuation unchanged, as ``uvms-pin run`` does).
+tau[action_index] / action_scale: the entries the action drives (a servoed jaw's are the
+environment's own), not clipped (create the environment with ``clip_actions=False`` to pass
+a command beyond the box to the actuation unchanged, as ``uvms-pin run`` does).
 """
 
 from __future__ import annotations
@@ -36,8 +37,9 @@ class ControllerPolicy:
         self.controller = controller
         self.layout = env.observation_layout
         self.action_scale = env.action_scale
+        self.action_index = env.action_index
 
     def __call__(self, observation: np.ndarray, info: dict[str, Any]) -> np.ndarray:
         measurement = measurement_from_observation(observation, info["time_s"], self.layout)
         tau = np.asarray(self.controller.compute(info["time_s"], measurement), dtype=float)
-        return tau / self.action_scale
+        return tau[self.action_index] / self.action_scale

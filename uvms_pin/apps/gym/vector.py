@@ -153,7 +153,7 @@ class UvmsVectorEnv(VectorEnv):
             for i in np.flatnonzero(resetting):  # NEXT_STEP: the ended episodes start again
                 self._reset_env(int(i), None)
         stepping = ~resetting
-        self.batch.step(a * env.action_scale, stepping)
+        self.batch.step(self._commanded(a), stepping)
         reward, terminated, truncated, infos = self._outcomes(a, stepping)
         observations = self._observations()
         if self.metadata["autoreset_mode"] == AutoresetMode.SAME_STEP:
@@ -164,6 +164,22 @@ class UvmsVectorEnv(VectorEnv):
         return observations, reward, terminated, truncated, infos
 
     # -- helpers -------------------------------------------------------------------------
+    def _commanded(self, a: np.ndarray) -> np.ndarray:
+        """tau_commanded (N, nv) of the actions (N, n), as `UvmsEnv.commanded_tau` makes it
+        for one environment: the scaled action on its entries, the jaw servo's torques from
+        each environment's measured jaw at its own time."""
+        env, batch = self.single_env, self.batch
+        servo = env.jaw_servo
+        if servo is None:
+            return a * env.action_scale
+        tau = np.zeros((self.num_envs, batch.v.shape[1]))
+        tau[:, env.action_index] = a * env.action_scale
+        jaw = servo.jaw
+        tau[:, jaw.v_index] = servo.torques(
+            batch.time_s(), batch.q_measured[:, jaw.q_index], batch.v_measured[:, jaw.v_index]
+        )
+        return tau
+
     def _outcomes(self, a: np.ndarray, stepping: np.ndarray):
         """Rewards, terminations, truncations and infos of the stepped environments (zero
         and False for those that were reset)."""
