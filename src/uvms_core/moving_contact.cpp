@@ -67,7 +67,7 @@ void PiecePairsModel::forces(const Data& data_a, const Data& data_b,
     }
     Vec3 point, normal;
     double depth = 0.0;
-    if (!deepest_point(narrow_.of(k, pa, pb), where_a, where_b, point, normal, depth)) continue;
+    if (!narrow_.deepest(k, pa, where_a, pb, where_b, point, normal, depth)) continue;
     out.pair.push_back(static_cast<int>(k));
     touch.piece.push_back(pairs[k][0]);
     touch.obj.push_back(pairs[k][1]);

@@ -2,6 +2,7 @@
 
 #include <coal/collision.h>
 
+#include <algorithm>
 #include <cmath>
 
 namespace uvms {
@@ -87,23 +88,76 @@ coal::Transform3s transform_of(const pinocchio::SE3& where) {
 
 }  // namespace
 
-const coal::ComputeCollision& NarrowPhase::of(std::size_t key, const ContactShape& a,
-                                               const ContactShape& b) {
+double support_m(const ContactShape& shape, const Vec3& direction) {
+  switch (shape.kind) {
+    case ContactKind::box: {
+      const Vec3& half = static_cast<const coal::Box&>(*shape.geometry).halfSide;
+      return half.dot(direction.cwiseAbs());
+    }
+    case ContactKind::sphere:
+      return static_cast<const coal::Sphere&>(*shape.geometry).radius * direction.norm();
+    case ContactKind::cylinder: {  // its axis along z
+      const auto& cylinder = static_cast<const coal::Cylinder&>(*shape.geometry);
+      return cylinder.radius * std::hypot(direction[0], direction[1]) +
+             cylinder.halfLength * std::abs(direction[2]);
+    }
+    case ContactKind::ellipsoid: {
+      const Vec3& radii = static_cast<const coal::Ellipsoid&>(*shape.geometry).radii;
+      return radii.cwiseProduct(direction).norm();
+    }
+    case ContactKind::convex: {
+      const auto& points = *static_cast<const coal::ConvexBase&>(*shape.geometry).points;
+      double most = -INFINITY;
+      for (const auto& p : points) most = std::max(most, p.dot(direction));
+      return most;
+    }
+    case ContactKind::plane:
+      break;
+  }
+  return INFINITY;
+}
+
+double gap_along_m(const ContactShape& a, const pinocchio::SE3& where_a, const ContactShape& b,
+                   const pinocchio::SE3& where_b, const Vec3& direction_world) {
+  const Vec3& u = direction_world;
+  return u.dot(where_a.translation() - where_b.translation()) -
+         support_m(a, -(where_a.rotation().transpose() * u)) -
+         support_m(b, where_b.rotation().transpose() * u);
+}
+
+bool NarrowPhase::deepest(std::size_t key, const ContactShape& a, const pinocchio::SE3& where_a,
+                          const ContactShape& b, const pinocchio::SE3& where_b, Vec3& point,
+                          Vec3& normal, double& depth) {
   if (key >= pairs_.size()) pairs_.resize(key + 1);
   Pair& pair = pairs_[key];
   if (!pair.collide || pair.a != a.geometry.get() || pair.b != b.geometry.get()) {
     pair.a = a.geometry.get();
     pair.b = b.geometry.get();
     pair.collide = std::make_unique<coal::ComputeCollision>(pair.a, pair.b);
+    pair.apart = false;
   }
-  return *pair.collide;
+  // still apart along the direction that separated them last time: no coal call
+  if (pair.apart &&
+      gap_along_m(a, where_a, b, where_b, where_b.rotation() * pair.apart_in_b) > kApartGap_m) {
+    return false;
+  }
+  if (deepest_point(*pair.collide, where_a, where_b, pair.result, point, normal, depth)) {
+    pair.apart = false;
+    return true;
+  }
+  // apart: GJK's last direction (a's frame, out of b towards a) separates them
+  const Vec3 ray = where_a.rotation() * pair.result.cached_gjk_guess;
+  const double length = ray.norm();
+  pair.apart = length > 0.0 && std::isfinite(length);
+  if (pair.apart) pair.apart_in_b = where_b.rotation().transpose() * (ray / length);
+  return false;
 }
 
 bool deepest_point(const coal::ComputeCollision& collide, const pinocchio::SE3& where,
-                   const pinocchio::SE3& object_where, Vec3& point, Vec3& normal,
-                   double& depth) {
+                   const pinocchio::SE3& object_where, coal::CollisionResult& result,
+                   Vec3& point, Vec3& normal, double& depth) {
   static const coal::CollisionRequest request;  // one contact, depth and normal
-  coal::CollisionResult result;
+  result.clear();
   if (collide(transform_of(where), transform_of(object_where), request, result) == 0) {
     return false;
   }
@@ -147,11 +201,11 @@ void corners_below(const pinocchio::Data& data, const ContactShape& piece,
 // coal's deepest point of the pair (_coal_point of touch.py), when they overlap.
 void coal_point(const pinocchio::Data& data, const ContactShape& piece,
                 const pinocchio::SE3& where, const ContactShape& object,
-                const pinocchio::SE3& object_where, int p, int o,
-                const coal::ComputeCollision& collide, Touch& out) {
+                const pinocchio::SE3& object_where, int p, int o, std::size_t key,
+                NarrowPhase& narrow, Touch& out) {
   Vec3 point, normal;
   double depth = 0.0;
-  if (deepest_point(collide, where, object_where, point, normal, depth)) {
+  if (narrow.deepest(key, piece, where, object, object_where, point, normal, depth)) {
     add_point(data, piece, object, p, o, -1, point, normal, depth, out);
   }
 }
@@ -192,8 +246,7 @@ void touch(const pinocchio::Data& data, const std::vector<ContactShape>& pieces,
         continue;
       }
       const auto key = static_cast<std::size_t>(p) * objects.size() + static_cast<std::size_t>(o);
-      coal_point(data, piece, where, object, object_at, p, o, work.narrow.of(key, piece, object),
-                 out);
+      coal_point(data, piece, where, object, object_at, p, o, key, work.narrow, out);
     }
   }
 }

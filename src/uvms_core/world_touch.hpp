@@ -78,10 +78,29 @@ LocalBox local_box(const ContactShape& shape);
 bool sphere_misses(const Vec3& center, double radius, const LocalBox& box,
                    const pinocchio::SE3& where);
 
+// The support of a shape [m]: the largest direction . x over its points x (its frame; the
+// direction need not be unit: the support scales with it). +inf for a plane (unbounded).
+double support_m(const ContactShape& shape, const Vec3& direction);
+
+// A lower bound [m] of the gap between shape a placed at where_a and b at where_b, from a
+// direction u (world, unit) out of b towards a: min over a of u . x minus max over b of u . y
+// (when > 0, the width of a slab that separates them: they cannot touch).
+double gap_along_m(const ContactShape& a, const pinocchio::SE3& where_a, const ContactShape& b,
+                   const pinocchio::SE3& where_b, const Vec3& direction_world);
+
+// A gap [m] above which coal cannot find two shapes touching: ten times GJK's tolerance
+// (CollisionRequest::gjk_tolerance, 1e-6 m: GJK reports a collision only when its distance,
+// never below the true one, is under that tolerance).
+inline constexpr double kApartGap_m = 1e-5;
+
 // coal's narrow phase of each pair of shapes, kept between calls: a coal::ComputeCollision
 // (the pair's collide function looked up once, its GJK/EPA solver and the EPA's face storage
 // allocated once instead of at every call of coal::collide: the same algorithm, the same
-// contacts bit for bit). A copy starts empty, so that no two owners share a solver.
+// contacts bit for bit) and its result's storage. A pair coal finds apart keeps GJK's
+// separating direction (in b's frame); while that direction still separates the two shapes
+// by more than kApartGap_m (gap_along_m), the pair is apart without calling coal: exact, coal
+// would find it apart too (the reference calls coal on it). A copy starts empty, so that no
+// two owners share a solver.
 class NarrowPhase {
  public:
   NarrowPhase() = default;
@@ -90,14 +109,20 @@ class NarrowPhase {
     pairs_.clear();
     return *this;
   }
-  // The collide call of pair `key` (any index the caller keeps per pair) of shapes a, b.
-  const coal::ComputeCollision& of(std::size_t key, const ContactShape& a, const ContactShape& b);
+  // coal's deepest point of pair `key` (any index the caller keeps per pair): shape a at
+  // where_a against b at where_b (deepest_point); false when they are apart.
+  bool deepest(std::size_t key, const ContactShape& a, const pinocchio::SE3& where_a,
+               const ContactShape& b, const pinocchio::SE3& where_b, Vec3& point,
+               Vec3& normal, double& depth);
 
  private:
   struct Pair {
     const coal::CollisionGeometry* a = nullptr;
     const coal::CollisionGeometry* b = nullptr;
     std::unique_ptr<coal::ComputeCollision> collide;
+    coal::CollisionResult result;
+    bool apart = false;              // whether apart_in_b is a separating direction
+    Vec3 apart_in_b = Vec3::Zero();  // unit, out of b towards a, in b's frame
   };
   std::vector<Pair> pairs_;
 };
@@ -105,10 +130,10 @@ class NarrowPhase {
 // coal's deepest point of two overlapping shapes placed in the world (coal_point of
 // touch.py): the point midway between the nearest points, the normal out of the object
 // towards the piece, the depth > 0; false when they are apart. `collide`: the pair's
-// (NarrowPhase::of).
+// collide function; `result`: its answer (cleared first).
 bool deepest_point(const coal::ComputeCollision& collide, const pinocchio::SE3& where,
-                   const pinocchio::SE3& object_where, Vec3& point, Vec3& normal,
-                   double& depth);
+                   const pinocchio::SE3& object_where, coal::CollisionResult& result,
+                   Vec3& point, Vec3& normal, double& depth);
 
 // touch()'s work buffers, kept by its caller between calls (no allocation per call once
 // sized): every shape's placement and box, the near (piece, object) pairs and their narrow

@@ -130,6 +130,44 @@ def test_the_core_finds_a_bars_contacts_as_the_reference_does(load_body):
     assert 30 < touching < 270  # both kinds of pose
 
 
+def test_the_core_skips_coal_only_for_a_pair_still_apart(load_body):
+    """A tilted box robot (10 cm) brought to a free bar's side from 2 mm away, into it (0.2
+    mm) and back, the gap crossing the core's cut (a pair coal found apart is not searched
+    again while GJK's last separating direction still leaves a gap over 1e-5 m between the
+    two shapes: `NarrowPhase`) at 0.1 um and below: at every pose the core's search, kept
+    from pose to pose, finds the reference's touching pairs, points and forces to 1e-12."""
+    box = _body(load_body, '<box size="0.1 0.1 0.1"/>')
+    bar = free_object(
+        "bar", "cylinder", {"radius_m": 0.025, "length_m": 1.0}, ([0.0, 0.0, -5.0], [0, 0, 0]),
+        density_kg_m3=1200.0, water_density_kg_m3=RHO,
+    )  # fmt: skip
+    system = System(Plant(box, world=World(box, [], ContactLaw(), [bar])))
+    (pairs,) = system.moving.moving.sets
+    search = PairSearch(pairs.pairs, core_module())
+    states = system.moving.initial_states()
+    tilt = pin.exp3(np.array([0.01, 0.02, 0.0]))  # an edge of the box towards the bar
+    reach = 0.05 * np.abs(tilt[0]).sum()  # of the box from its centre towards the bar
+    # the gap [m]: 2 mm down to 0.1 um, 0.2 mm in, and back
+    closing = np.concatenate([np.geomspace(2e-3, 1e-7, 80), -np.geomspace(1e-7, 2e-4, 40)])
+    gaps = np.concatenate([closing, closing[::-1]])
+    touching = 0
+    for k, gap in enumerate(gaps):
+        q = box.neutral_configuration()
+        q[:3] = [0.025 + reach + gap, 0.0, -5.0 + 0.01 * np.cos(k)]
+        q[3:7] = pin.Quaternion(tilt).coeffs()
+        system.moving._kinematics(q, np.full(6, 0.01), states)
+        data = system.moving.moving._datas(system.moving.uvms_data, system.moving.datas)
+        python = pairs.pairs.forces(data(pairs.a), data(pairs.b), pairs.memory)
+        core = search(data(pairs.a), data(pairs.b), pairs.memory)
+        assert np.array_equal(core.pair, python.pair), gap
+        np.testing.assert_allclose(core.force_world_N, python.force_world_N, rtol=0, atol=1e-12)
+        np.testing.assert_allclose(
+            core.touch.point_world_m, python.touch.point_world_m, rtol=0, atol=1e-12
+        )
+        touching += len(python.pair)
+    assert 0 < touching < len(gaps)  # both sides of the contact
+
+
 def test_two_pieces_touching_one_object_at_once_get_mirrored_pairs(load_body):
     """A robot of two spheres (r = 0.1 m, 16 cm apart along y) posed symmetrically about
     y = 0, both 9 mm into a free ball's side (r = 0.2 m) at once: two touching pairs of
