@@ -15,6 +15,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
+from functools import cached_property
 from typing import Any
 
 import numpy as np
@@ -153,13 +154,18 @@ def pixel_rays(spec: CameraSpec) -> np.ndarray:
 def tiles(spec: CameraSpec) -> tuple[np.ndarray, np.ndarray]:
     """(the pixels in tile order (H W,), where each tile starts in it (tiles + 1,)): square
     tiles of `TILE_PX`, row by row, their pixels row by row."""
-    v, u = np.divmod(np.arange(spec.width * spec.height), spec.width)
-    across = -(-spec.width // TILE_PX)
-    tile = (v // TILE_PX) * across + u // TILE_PX
-    # a stable sort of small integers: numpy's radix sort (linear) for 16 bits
-    order = np.argsort(tile.astype(np.uint16) if tile[-1] < 2**16 else tile, kind="stable")
-    counts = np.bincount(tile)
-    return order, np.concatenate([[0], np.cumsum(counts[counts > 0])])
+    width, height = spec.width, spec.height
+    across, down = -(-width // TILE_PX), -(-height // TILE_PX)
+    # the pixels' indices in an image padded to whole tiles (-1: padding), its tiles' blocks
+    # made rows: each row a tile's pixels, row by row (no sort: a camera is made for each run)
+    grid = np.full((down * TILE_PX, across * TILE_PX), -1, dtype=np.intp)
+    grid[:height, :width] = np.arange(width * height).reshape(height, width)
+    blocks = grid.reshape(down, TILE_PX, across, TILE_PX).swapaxes(1, 2)
+    blocks = blocks.reshape(down * across, TILE_PX * TILE_PX)
+    if width % TILE_PX == 0 and height % TILE_PX == 0:
+        return blocks.reshape(-1), np.arange(0, width * height + 1, TILE_PX * TILE_PX)
+    kept = blocks >= 0
+    return blocks[kept], np.concatenate([[0], np.cumsum(np.count_nonzero(kept, axis=1))])
 
 
 def reflectance_of(names: list[str], given: dict[str, tuple], planes: set[str]) -> np.ndarray:
@@ -188,9 +194,7 @@ class Camera(sensor.Mounted):
         self.spec, self.rng = spec, rng
         self.rays = pixel_rays(spec)
         self.order, starts = tiles(spec)
-        self._tiled = self.rays[self.order]
-        self._untiled = np.empty_like(self.order)  # tile order -> image order: the inverse
-        self._untiled[self.order] = np.arange(len(self.order))
+        self._tiled = self._tile(self.rays)
         self._bundles = Bundles.of(self._tiled, starts)
         self.optics = spec.optics
         robot = set(scene.robot_names)
@@ -206,11 +210,34 @@ class Camera(sensor.Mounted):
                 self.optics, spec.lights,
             )  # fmt: skip
 
+    @property
+    def _whole_tiles(self) -> bool:
+        """Whether the tiles cover the image exactly (no tile cut by its edge)."""
+        return self.spec.width % TILE_PX == 0 and self.spec.height % TILE_PX == 0
+
+    @cached_property
+    def _untiled(self) -> np.ndarray:
+        """Tile order -> image order: the inverse of `order` (made when first needed)."""
+        untiled = np.empty_like(self.order)
+        untiled[self.order] = np.arange(len(self.order))
+        return untiled
+
+    def _tile(self, image: np.ndarray) -> np.ndarray:
+        """An array (H W, ...) in image order, in tile order (a copy): a transposition of
+        blocks when the tiles cover the image exactly, one gather otherwise."""
+        if not self._whole_tiles:
+            return image[self.order]
+        spec, rest = self.spec, image.shape[1:]
+        blocks = image.reshape(
+            spec.height // TILE_PX, TILE_PX, spec.width // TILE_PX, TILE_PX, *rest
+        )
+        return blocks.swapaxes(1, 2).reshape(spec.width * spec.height, *rest)
+
     def _untile(self, tiled: np.ndarray) -> np.ndarray:
         """An array (H W, ...) in tile order, in image order: a transposition of blocks when
         the tiles cover the image exactly, one gather otherwise."""
         spec = self.spec
-        if spec.width % TILE_PX or spec.height % TILE_PX:
+        if not self._whole_tiles:
             return tiled[self._untiled]
         rest = tiled.shape[1:]
         blocks = tiled.reshape(
