@@ -141,14 +141,34 @@ def pixel_rays(spec: CameraSpec) -> np.ndarray:
     f = spec.focal_px
     u = (np.arange(spec.width) + 0.5 - 0.5 * spec.width) / f
     v = (np.arange(spec.height) + 0.5 - 0.5 * spec.height) / f
+    return _unit_rays(u[None, :], v[:, None], (spec.height, spec.width))
+
+
+def _unit_rays(x: np.ndarray, y: np.ndarray, shape: tuple[int, ...]) -> np.ndarray:
+    """(x, y, 1) / |(x, y, 1)| (prod(shape), 3) of x and y broadcast to ``shape``."""
     # |(x, y, 1)|, summed in that order, x along a row and y down a column (broadcast, no
     # meshgrid: a camera is made for each run)
-    length = np.sqrt((u * u)[None, :] + (v * v)[:, None] + 1.0)
-    out = np.empty((spec.height, spec.width, 3))
-    np.divide(u[None, :], length, out=out[..., 0])
-    np.divide(v[:, None], length, out=out[..., 1])
+    length = np.sqrt(x * x + y * y + 1.0)
+    out = np.empty((*shape, 3))
+    np.divide(x, length, out=out[..., 0])
+    np.divide(y, length, out=out[..., 1])
     np.divide(1.0, length, out=out[..., 2])
     return out.reshape(-1, 3)
+
+
+def tiled_rays(spec: CameraSpec, order: np.ndarray) -> np.ndarray:
+    """`pixel_rays` in tile order (``order``, `tiles`'): the same values, each computed in
+    its place when the tiles cover the image exactly (no image-order array), else gathered."""
+    if spec.width % TILE_PX or spec.height % TILE_PX:
+        return pixel_rays(spec)[order]
+    f = spec.focal_px
+    u = (np.arange(spec.width) + 0.5 - 0.5 * spec.width) / f
+    v = (np.arange(spec.height) + 0.5 - 0.5 * spec.height) / f
+    across, down = spec.width // TILE_PX, spec.height // TILE_PX
+    # the tiles' blocks (tile row, tile column, row in it, column in it)
+    x = u.reshape(across, TILE_PX)[None, :, None, :]
+    y = v.reshape(down, TILE_PX)[:, None, :, None]
+    return _unit_rays(x, y, (down, across, TILE_PX, TILE_PX))
 
 
 def tiles(spec: CameraSpec) -> tuple[np.ndarray, np.ndarray]:
@@ -192,9 +212,8 @@ class Camera(sensor.Mounted):
     def __init__(self, spec: CameraSpec, scene: Scene, rng: np.random.Generator):
         super().__init__(spec, scene, f"camera '{spec.name}'")
         self.spec, self.rng = spec, rng
-        self.rays = pixel_rays(spec)
         self.order, starts = tiles(spec)
-        self._tiled = self._tile(self.rays)
+        self._tiled = tiled_rays(spec, self.order)
         self._bundles = Bundles.of(self._tiled, starts)
         self.optics = spec.optics
         robot = set(scene.robot_names)
@@ -210,6 +229,12 @@ class Camera(sensor.Mounted):
                 self.optics, spec.lights,
             )  # fmt: skip
 
+    @cached_property
+    def rays(self) -> np.ndarray:
+        """Its pixels' unit rays (H W, 3) in image order (`pixel_rays`; made when first
+        needed: the caster takes them in tile order)."""
+        return pixel_rays(self.spec)
+
     @property
     def _whole_tiles(self) -> bool:
         """Whether the tiles cover the image exactly (no tile cut by its edge)."""
@@ -221,17 +246,6 @@ class Camera(sensor.Mounted):
         untiled = np.empty_like(self.order)
         untiled[self.order] = np.arange(len(self.order))
         return untiled
-
-    def _tile(self, image: np.ndarray) -> np.ndarray:
-        """An array (H W, ...) in image order, in tile order (a copy): a transposition of
-        blocks when the tiles cover the image exactly, one gather otherwise."""
-        if not self._whole_tiles:
-            return image[self.order]
-        spec, rest = self.spec, image.shape[1:]
-        blocks = image.reshape(
-            spec.height // TILE_PX, TILE_PX, spec.width // TILE_PX, TILE_PX, *rest
-        )
-        return blocks.swapaxes(1, 2).reshape(spec.width * spec.height, *rest)
 
     def _untile(self, tiled: np.ndarray) -> np.ndarray:
         """An array (H W, ...) in tile order, in image order: a transposition of blocks when
