@@ -163,6 +163,7 @@ void RayCaster::cast(const Vec3& origin, const Mat3& frame_rotation, const doubl
   const Eigen::Index groups = cones == nullptr ? 1 : cones->count;
   std::vector<int> active;
   active.reserve(bodies_.size());
+  std::vector<double> directions;  // a cone's rays in the world, (count, 3)
   for (Eigen::Index j = 0; j < groups; ++j) {
     active.clear();
     for (std::size_t k = 0; k < bodies_.size(); ++k) {
@@ -184,49 +185,79 @@ void RayCaster::cast(const Vec3& origin, const Mat3& frame_rotation, const doubl
     }
     const Eigen::Index first = cones == nullptr ? 0 : cones->starts[j];
     const Eigen::Index last = cones == nullptr ? n : cones->starts[j + 1];
-    for (Eigen::Index i = first; i < last; ++i) {
-      const Vec3 d = frame_rotation * Eigen::Map<const Vec3>(rays_f + 3 * i);
-      double best = kInf;
-      Vec3 normal = Vec3::Zero();
-      int label = 0;
-      for (const int k : active) {
-        const Seen& s = seen[k];
-        if (s.how == Seen::plane) {
-          const double t = RayShape::plane_along(s.height_m, d.dot(s.normal_world));
-          if (t < best) {
-            best = t;
-            normal = s.normal_world;
-            label = k + 1;
+    // the cone's rays body by body (each ray meets the bodies in the same order as ray by
+    // ray, so its nearest hit is the same), what they met so far kept in the outputs
+    double* const range = out.range_m + first;
+    double* const normal_out = out.normal_world + 3 * first;
+    std::int32_t* const label_out = out.label + first;
+    const Eigen::Index count = last - first;
+    if (static_cast<Eigen::Index>(directions.size()) < 3 * count) directions.resize(3 * count);
+    double* const dirs = directions.data();
+    for (Eigen::Index i = 0; i < count; ++i) {
+      const Vec3 d = frame_rotation * Eigen::Map<const Vec3>(rays_f + 3 * (first + i));
+      Eigen::Map<Vec3>(dirs + 3 * i) = d;
+      range[i] = kInf;
+      Eigen::Map<Vec3>(normal_out + 3 * i) = Vec3::Zero();
+      label_out[i] = 0;
+    }
+    for (const int k : active) {
+      const Seen& s = seen[k];
+      const int label = k + 1;
+      if (s.how == Seen::plane) {
+        const Vec3 plane_normal = s.normal_world;
+        const double height = s.height_m;
+        for (Eigen::Index i = 0; i < count; ++i) {
+          const Vec3 d = Eigen::Map<const Vec3>(dirs + 3 * i);
+          const double t = RayShape::plane_along(height, d.dot(plane_normal));
+          if (t < range[i]) {
+            range[i] = t;
+            Eigen::Map<Vec3>(normal_out + 3 * i) = plane_normal;
+            label_out[i] = label;
           }
-          continue;
         }
-        const Body& body = bodies_[k];
-        if (s.bounded && !may_meet(s.to_centre, s.centre2, s.reach, d, best)) continue;
-        const Vec3 d_local = body.rotation.transpose() * d;
-        if (s.how == Seen::mesh) {
+        continue;
+      }
+      const Body& body = bodies_[k];
+      const Mat3 rotation = body.rotation;
+      const Vec3 to_centre = s.to_centre;
+      const double centre2 = s.centre2, reach = s.reach;
+      const bool bounded = s.bounded;
+      if (s.how == Seen::mesh) {
+        const MeshView& view = *s.view;
+        const TriangleSet& triangles = *body.shape.triangles;
+        for (Eigen::Index i = 0; i < count; ++i) {
+          const Vec3 d = Eigen::Map<const Vec3>(dirs + 3 * i);
+          const double best = range[i];
+          if (bounded && !may_meet(to_centre, centre2, reach, d, best)) continue;
+          const Vec3 d_local = rotation.transpose() * d;
           // the mesh's nearest crossing, kept on a triangle's front beyond kTMinM
           // (ray_mesh.hpp: TriangleMesh.hit's rule)
-          const auto crossing = s.view->nearest(d_local, s.candidates, best);
+          const auto crossing = view.nearest(d_local, s.candidates, best);
           if (crossing.triangle < 0) continue;
-          const Vec3& face = body.shape.triangles->normal[crossing.triangle];
+          const Vec3& face = triangles.normal[crossing.triangle];
           if (!(face.dot(d_local) < 0.0) || !(crossing.t > kTMinM) || !(crossing.t < best)) {
             continue;
           }
-          best = crossing.t;
-          normal = body.rotation * face;
-          label = k + 1;
-          continue;
+          range[i] = crossing.t;
+          Eigen::Map<Vec3>(normal_out + 3 * i) = rotation * face;
+          label_out[i] = label;
         }
-        const RayCrossing crossed = body.shape.crossing(s.origin_local, d_local);
-        if (crossed.t < best) {  // the normal of the hits kept only
-          best = crossed.t;
-          normal = body.rotation * body.shape.normal_at(s.origin_local, d_local, crossed);
-          label = k + 1;
+        continue;
+      }
+      const RayShape& shape = body.shape;
+      const Vec3 origin_local = s.origin_local;
+      for (Eigen::Index i = 0; i < count; ++i) {
+        const Vec3 d = Eigen::Map<const Vec3>(dirs + 3 * i);
+        if (bounded && !may_meet(to_centre, centre2, reach, d, range[i])) continue;
+        const Vec3 d_local = rotation.transpose() * d;
+        const RayCrossing crossed = shape.crossing(origin_local, d_local);
+        if (crossed.t < range[i]) {  // the normal of the hits kept only
+          range[i] = crossed.t;
+          Eigen::Map<Vec3>(normal_out + 3 * i) =
+              rotation * shape.normal_at(origin_local, d_local, crossed);
+          label_out[i] = label;
         }
       }
-      out.range_m[i] = best;
-      Eigen::Map<Vec3>(out.normal_world + 3 * i) = normal;
-      out.label[i] = label;
     }
   }
 }

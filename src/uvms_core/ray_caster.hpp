@@ -13,7 +13,7 @@
 // without cones are grouped in cones of consecutive rays when the caster holds a mesh (the
 // hits are the same, the culling is conservative). Bodies are taken in order, a nearer hit
 // (strictly) replacing the one found: the nearest hit, the first body's on a tie, as the
-// reference.
+// reference; a cone's rays body by body (a body's constants held over its loop of rays).
 //
 // The rays are given in a frame (a camera's optical frame) at rotation R_f in the world,
 // d = R_f d_f: the caller does not rotate them each time (R_f = I: world rays).

@@ -9,7 +9,14 @@ import numpy as np
 import pytest
 
 from uvms_pin.errors import ParameterError
-from uvms_pin.perception.camera import Camera, CameraSpec, pixel_rays
+from uvms_pin.perception.camera import (
+    TILE_PX,
+    Camera,
+    CameraSpec,
+    pixel_rays,
+    tiled_rays,
+    tiles,
+)
 from uvms_pin.perception.optics import JERLOV_KD_PER_M
 from uvms_pin.perception.scene import Scene
 from uvms_pin.physics.world.objects import plane, solid
@@ -147,6 +154,20 @@ def test_tiles_go_back_to_image_order(reference_uvms, width, height):
     tiled = np.arange(width * height * 3, dtype=float).reshape(-1, 3)
     np.testing.assert_array_equal(camera._untile(tiled), tiled[np.argsort(camera.order)])
     np.testing.assert_array_equal(camera._untile(camera._tiled), camera.rays)
+
+
+@pytest.mark.parametrize(("width", "height"), [(48, 32), (41, 31), (16, 16), (5, 300)])
+def test_the_tiles_are_the_pixels_tile_by_tile_and_their_rays_the_same(width, height):
+    """`tiles` (no sort) gives the order of a stable sort by tile, each tile's pixels row by
+    row, and `tiled_rays` the same values as `pixel_rays` in that order."""
+    spec = CameraSpec("c", width=width, height=height, horizontal_fov_rad=1.7)
+    order, starts = tiles(spec)
+    v, u = np.divmod(np.arange(width * height), width)
+    tile = (v // TILE_PX) * -(-width // TILE_PX) + u // TILE_PX
+    np.testing.assert_array_equal(order, np.argsort(tile, kind="stable"))
+    counts = np.bincount(tile)
+    np.testing.assert_array_equal(starts, np.concatenate([[0], np.cumsum(counts)]))
+    np.testing.assert_array_equal(tiled_rays(spec, order), pixel_rays(spec)[order])
 
 
 def test_the_noise_of_a_uniform_target_has_the_given_deviation(reference_uvms):

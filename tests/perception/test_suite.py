@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 from uvms_pin.errors import ParameterError, ScenarioError
-from uvms_pin.perception.suite import firing_rows
+from uvms_pin.perception.suite import HUGE_PAGE, firing_rows, stack_of
 from uvms_pin.results.rollout import Rollout
 from uvms_pin.scenario.load import scenario_from_dict
 from uvms_pin.scenario.toml import read_toml
@@ -140,3 +140,17 @@ def test_the_sensors_are_cast_on_the_plants_backend_with_the_same_images(monkeyp
     assert np.all(np.abs(differ) <= 1) and np.mean(differ != 0) < 1e-3  # a rounding at most
     np.testing.assert_allclose(compiled["fls"]["intensity"], sonar["intensity"], rtol=1e-5)
     assert sonar["intensity"].max() > 0.0
+
+
+@pytest.mark.parametrize(
+    ("shape", "dtype"),
+    [((21, 240, 320), np.float32), ((21, 240, 320, 3), np.uint8), ((3, 4), np.int16)],
+)
+def test_an_image_stack_starts_on_a_huge_page_when_larger_than_one(shape, dtype):
+    stack = stack_of(shape, dtype)
+    assert stack.shape == shape and stack.dtype == dtype and stack.flags.c_contiguous
+    assert stack.flags.writeable
+    if stack.nbytes >= HUGE_PAGE:
+        assert stack.ctypes.data % HUGE_PAGE == 0
+    stack[...] = 7  # all of it is its own
+    assert np.all(stack == 7)

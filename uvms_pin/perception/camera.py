@@ -15,6 +15,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
+from functools import cached_property
 from typing import Any
 
 import numpy as np
@@ -140,26 +141,51 @@ def pixel_rays(spec: CameraSpec) -> np.ndarray:
     f = spec.focal_px
     u = (np.arange(spec.width) + 0.5 - 0.5 * spec.width) / f
     v = (np.arange(spec.height) + 0.5 - 0.5 * spec.height) / f
+    return _unit_rays(u[None, :], v[:, None], (spec.height, spec.width))
+
+
+def _unit_rays(x: np.ndarray, y: np.ndarray, shape: tuple[int, ...]) -> np.ndarray:
+    """(x, y, 1) / |(x, y, 1)| (prod(shape), 3) of x and y broadcast to ``shape``."""
     # |(x, y, 1)|, summed in that order, x along a row and y down a column (broadcast, no
     # meshgrid: a camera is made for each run)
-    length = np.sqrt((u * u)[None, :] + (v * v)[:, None] + 1.0)
-    out = np.empty((spec.height, spec.width, 3))
-    np.divide(u[None, :], length, out=out[..., 0])
-    np.divide(v[:, None], length, out=out[..., 1])
+    length = np.sqrt(x * x + y * y + 1.0)
+    out = np.empty((*shape, 3))
+    np.divide(x, length, out=out[..., 0])
+    np.divide(y, length, out=out[..., 1])
     np.divide(1.0, length, out=out[..., 2])
     return out.reshape(-1, 3)
+
+
+def tiled_rays(spec: CameraSpec, order: np.ndarray) -> np.ndarray:
+    """`pixel_rays` in tile order (``order``, `tiles`'): the same values, each computed in
+    its place when the tiles cover the image exactly (no image-order array), else gathered."""
+    if spec.width % TILE_PX or spec.height % TILE_PX:
+        return pixel_rays(spec)[order]
+    f = spec.focal_px
+    u = (np.arange(spec.width) + 0.5 - 0.5 * spec.width) / f
+    v = (np.arange(spec.height) + 0.5 - 0.5 * spec.height) / f
+    across, down = spec.width // TILE_PX, spec.height // TILE_PX
+    # the tiles' blocks (tile row, tile column, row in it, column in it)
+    x = u.reshape(across, TILE_PX)[None, :, None, :]
+    y = v.reshape(down, TILE_PX)[:, None, :, None]
+    return _unit_rays(x, y, (down, across, TILE_PX, TILE_PX))
 
 
 def tiles(spec: CameraSpec) -> tuple[np.ndarray, np.ndarray]:
     """(the pixels in tile order (H W,), where each tile starts in it (tiles + 1,)): square
     tiles of `TILE_PX`, row by row, their pixels row by row."""
-    v, u = np.divmod(np.arange(spec.width * spec.height), spec.width)
-    across = -(-spec.width // TILE_PX)
-    tile = (v // TILE_PX) * across + u // TILE_PX
-    # a stable sort of small integers: numpy's radix sort (linear) for 16 bits
-    order = np.argsort(tile.astype(np.uint16) if tile[-1] < 2**16 else tile, kind="stable")
-    counts = np.bincount(tile)
-    return order, np.concatenate([[0], np.cumsum(counts[counts > 0])])
+    width, height = spec.width, spec.height
+    across, down = -(-width // TILE_PX), -(-height // TILE_PX)
+    # the pixels' indices in an image padded to whole tiles (-1: padding), its tiles' blocks
+    # made rows: each row a tile's pixels, row by row (no sort: a camera is made for each run)
+    grid = np.full((down * TILE_PX, across * TILE_PX), -1, dtype=np.intp)
+    grid[:height, :width] = np.arange(width * height).reshape(height, width)
+    blocks = grid.reshape(down, TILE_PX, across, TILE_PX).swapaxes(1, 2)
+    blocks = blocks.reshape(down * across, TILE_PX * TILE_PX)
+    if width % TILE_PX == 0 and height % TILE_PX == 0:
+        return blocks.reshape(-1), np.arange(0, width * height + 1, TILE_PX * TILE_PX)
+    kept = blocks >= 0
+    return blocks[kept], np.concatenate([[0], np.cumsum(np.count_nonzero(kept, axis=1))])
 
 
 def reflectance_of(names: list[str], given: dict[str, tuple], planes: set[str]) -> np.ndarray:
@@ -186,11 +212,8 @@ class Camera(sensor.Mounted):
     def __init__(self, spec: CameraSpec, scene: Scene, rng: np.random.Generator):
         super().__init__(spec, scene, f"camera '{spec.name}'")
         self.spec, self.rng = spec, rng
-        self.rays = pixel_rays(spec)
         self.order, starts = tiles(spec)
-        self._tiled = self.rays[self.order]
-        self._untiled = np.empty_like(self.order)  # tile order -> image order: the inverse
-        self._untiled[self.order] = np.arange(len(self.order))
+        self._tiled = tiled_rays(spec, self.order)
         self._bundles = Bundles.of(self._tiled, starts)
         self.optics = spec.optics
         robot = set(scene.robot_names)
@@ -206,11 +229,29 @@ class Camera(sensor.Mounted):
                 self.optics, spec.lights,
             )  # fmt: skip
 
+    @cached_property
+    def rays(self) -> np.ndarray:
+        """Its pixels' unit rays (H W, 3) in image order (`pixel_rays`; made when first
+        needed: the caster takes them in tile order)."""
+        return pixel_rays(self.spec)
+
+    @property
+    def _whole_tiles(self) -> bool:
+        """Whether the tiles cover the image exactly (no tile cut by its edge)."""
+        return self.spec.width % TILE_PX == 0 and self.spec.height % TILE_PX == 0
+
+    @cached_property
+    def _untiled(self) -> np.ndarray:
+        """Tile order -> image order: the inverse of `order` (made when first needed)."""
+        untiled = np.empty_like(self.order)
+        untiled[self.order] = np.arange(len(self.order))
+        return untiled
+
     def _untile(self, tiled: np.ndarray) -> np.ndarray:
         """An array (H W, ...) in tile order, in image order: a transposition of blocks when
         the tiles cover the image exactly, one gather otherwise."""
         spec = self.spec
-        if spec.width % TILE_PX or spec.height % TILE_PX:
+        if not self._whole_tiles:
             return tiled[self._untiled]
         rest = tiled.shape[1:]
         blocks = tiled.reshape(

@@ -124,6 +124,10 @@ class RayCaster:
         return where, t[nearer], n_local[nearer] @ rotation.T
 
 
+#: the rays whose cosines to their cone's axis `Bundles.of` takes at once
+_ROWS = 8192
+
+
 @dataclass(frozen=True)
 class Bundles:
     """Rays of one origin grouped in cones: cone j holds the consecutive rays
@@ -138,8 +142,16 @@ class Bundles:
         """The cones of the unit ``directions`` (n, 3) cut at ``starts`` (m + 1,)."""
         sums = np.add.reduceat(directions, starts[:-1], axis=0)
         axes = sums / np.linalg.norm(sums, axis=1, keepdims=True)
-        cosines = np.einsum("ij,ij->i", directions, np.repeat(axes, np.diff(starts), axis=0))
-        least = np.minimum.reduceat(cosines, starts[:-1])
+        counts = np.diff(starts)
+        least = np.empty(len(axes))
+        j = 0
+        rows = _ROWS if np.all(counts > 0) else len(directions)  # (an empty cone: at once)
+        while j < len(axes):  # cones of about `rows` rays at a time: small temporaries
+            k = max(j + 1, int(np.searchsorted(starts, starts[j] + rows, side="right")) - 1)
+            rays = directions[starts[j] : starts[k]]
+            cosines = np.einsum("ij,ij->i", rays, np.repeat(axes[j:k], counts[j:k], axis=0))
+            least[j:k] = np.minimum.reduceat(cosines, starts[j:k] - starts[j])
+            j = k
         return cls(axes, np.arccos(np.clip(least, -1.0, 1.0)), np.asarray(starts))
 
     def rotated(self, rotation: np.ndarray) -> Bundles:

@@ -3,8 +3,8 @@
 `CompiledCaster` is a `RayCaster` (the Python reference keeps every body and pose, and casts
 rays of many origins) whose casts from one origin run in the core (``_core.RayCaster``,
 src/uvms_core/ray_caster.cpp, the same formulas as `uvms_pin.perception.shapes`): the
-analytic shapes (plane, sphere, ellipsoid, convex polytope, cylinder) there, ray by ray over
-the bodies whose bounding sphere the ray's cone may meet, and the triangle meshes
+analytic shapes (plane, sphere, ellipsoid, convex polytope, cylinder) there, a cone's rays
+body by body over the bodies whose bounding sphere the cone may meet, and the triangle meshes
 (`TriangleMesh`) too, in double precision (src/uvms_core/ray_mesh.hpp: each triangle's edge
 planes through the origin once a cast, a cone's rays trying only the triangles it may meet,
 nearest first; `TriangleMesh.hit`'s rule). Any other shape is an external body the core only

@@ -115,17 +115,36 @@ def perceive(
             described[own.name]["label_names"] = list(scene.names)
 
 
+#: the size of the processor's large pages [bytes] (x86-64's 2 MiB)
+HUGE_PAGE = 1 << 21
+
+
+def stack_of(shape: tuple[int, ...], dtype: np.dtype) -> np.ndarray:
+    """An uninitialised array of ``shape`` and ``dtype`` for a sensor's images, starting on a
+    `HUGE_PAGE` boundary when it is larger than one: the kernel then maps (and zeroes) it by
+    whole large pages when it is first written, not 4 KiB at a time (a 320 x 240 camera's
+    images of 2 s at 10 Hz, 14.5 MB: about 3,500 page faults otherwise, 5 ms)."""
+    dtype = np.dtype(dtype)
+    size = math.prod(shape) * dtype.itemsize
+    if size < HUGE_PAGE:
+        return np.empty(shape, dtype=dtype)
+    raw = np.empty(size + HUGE_PAGE, dtype=np.uint8)
+    skip = -raw.ctypes.data % HUGE_PAGE
+    return raw[skip : skip + size].view(dtype).reshape(shape)
+
+
 def _fire(
     sensor: Any, scene: Scene, q: np.ndarray, poses: np.ndarray, rows: Sequence[int]
 ) -> dict[str, np.ndarray]:
-    """The sensor's arrays at each of ``rows``, stacked: the first firing's arrays give the
-    stack's, each later one is written into its place (no copy of an image)."""
+    """The sensor's arrays at each of ``rows``, stacked (`stack_of`): the first firing's
+    arrays give the stack's, each later one is written into its place (no copy of an
+    image)."""
     stacked: dict[str, np.ndarray] = {}
     for k, row in enumerate(rows):
         scene.update(q[row], list(poses[row]))
         if k == 0:
             for key, value in sensor.fire().items():
-                stacked[key] = np.empty((len(rows), *value.shape), dtype=value.dtype)
+                stacked[key] = stack_of((len(rows), *value.shape), value.dtype)
                 stacked[key][0] = value
         else:
             sensor.fire({key: values[k] for key, values in stacked.items()})
