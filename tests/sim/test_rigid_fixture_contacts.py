@@ -82,7 +82,13 @@ def _valve_and_ball_above_its_paddle():
     return valve, (0.065, -0.085, -5.0 + 0.02 + RADIUS_M + 0.002)
 
 
-@pytest.mark.parametrize("compiled", [True, False], ids=["compiled", "reference"])
+# the reference's run is the long one (`make check` leaves it out): the compiled step is checked
+# against the reference by test_the_compiled_step_solves_the_fixture_as_the_reference
+@pytest.mark.parametrize(
+    "compiled",
+    [True, pytest.param(False, marks=pytest.mark.slow)],
+    ids=["compiled", "reference"],
+)
 def test_a_ball_dropped_on_the_handle_turns_it_and_never_adds_energy(reference_uvms, compiled):
     energy, _, valve_rad, system = _dropped(
         reference_uvms, _valve_and_ball_above_its_paddle(), "rigid", 0.6, compiled
