@@ -45,7 +45,7 @@ import pinocchio as pin
 from uvms_pin.control.base import Controller
 from uvms_pin.control.jaw_servo import JawSchedule, JawServo
 from uvms_pin.errors import ParameterError
-from uvms_pin.model.jaw import JawJoints
+from uvms_pin.model.jaw import JawJoints, slice_if_consecutive
 from uvms_pin.results.signal import Signal
 
 #: the position error below which the integral acts [m]
@@ -117,6 +117,13 @@ class ObjectRecovery(Controller):
         self.servo = SlowJawServo(**vars(servo), speed=float(jaw_speed_rad_s))
         self.arm_v = self.jaw.arm_v_index[6:]  # the arm joints: neither vehicle nor jaw
         self.arm_q = self.jaw.arm_q_index[7:]
+        # the same entries as slices when consecutive: a tick reads views, not copies
+        self._arm_v, self._arm_q = map(slice_if_consecutive, (self.arm_v, self.arm_q))
+        self._jaw_v, self._jaw_q = map(slice_if_consecutive, (self.jaw.v_index, self.jaw.q_index))
+        self._jaw_units = [
+            "m" if self.model.joints[j].shortname().startswith("JointModelP") else "rad"
+            for j in self.jaw.joint_ids
+        ]
         self.arm_target = np.asarray(arm_target_rad, dtype=float)
         self.kp = np.asarray(kp_Nm_rad, dtype=float)
         self.kd = np.asarray(kd_Nm_s_rad, dtype=float)
@@ -158,7 +165,9 @@ class ObjectRecovery(Controller):
         self.last_time_s = time_s
         limit = self.integral_limit_N
         if math.sqrt(error_m @ error_m) < INTEGRATE_WITHIN_M:  # no wind-up on the long moves
-            self.integral_N = np.clip(self.integral_N + self.ix * error_m * step_s, -limit, limit)
+            # minimum(maximum()) is np.clip without its per-call dispatch cost (the same bits)
+            integral = np.maximum(self.integral_N + self.ix * error_m * step_s, -limit)
+            self.integral_N = np.minimum(integral, limit)
         return self.kx * error_m - self.dx * jaw_velocity_world + self.integral_N
 
     def compute(self, time_s, measurement):
@@ -167,23 +176,19 @@ class ObjectRecovery(Controller):
         tau = np.zeros(self.nv)
         tau[:3] = rotation.T @ self._vehicle_force_world(time_s, q, v)
         tau[3:6] = -self.ka * pin.log3(rotation) - self.da * v[3:6]
-        tau[self.arm_v] = self.kp * (self.arm_target - q[self.arm_q]) - self.kd * v[self.arm_v]
-        self.jaw_q = q[self.jaw.q_index]  # a copy (an index array's)
-        self.jaw_tau = self.servo.torque(time_s, self.jaw_q, v[self.jaw.v_index])
-        tau[self.jaw.v_index] = self.jaw_tau
+        tau[self._arm_v] = self.kp * (self.arm_target - q[self._arm_q]) - self.kd * v[self._arm_v]
+        self.jaw_q = q[self._jaw_q]  # frozen (a view of the measurement's) or a copy
+        self.jaw_tau = self.servo.torque(time_s, self.jaw_q, v[self._jaw_v])
+        tau[self._jaw_v] = self.jaw_tau
         return tau
 
     def signals(self) -> dict[str, np.ndarray | Signal]:
         names = self.jaw.names
         grip = np.abs(self.jaw_tau) / self.servo.lever_m
-        units = [
-            "m" if self.model.joints[j].shortname().startswith("JointModelP") else "rad"
-            for j in self.jaw.joint_ids
-        ]
         return {
             "jaw": Signal(
                 np.concatenate([self.jaw_q, grip]),
                 [*names, *(f"{n}_grip" for n in names)],
-                [*units, *("N",) * len(names)],
+                [*self._jaw_units, *("N",) * len(names)],
             )
         }

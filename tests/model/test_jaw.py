@@ -10,7 +10,7 @@ import pytest
 
 import uvms_pin as up
 from uvms_pin.errors import ModelError
-from uvms_pin.model.jaw import JawJoints, is_jaw_name
+from uvms_pin.model.jaw import JawJoints, is_jaw_name, slice_if_consecutive
 
 MODELS = Path(__file__).resolve().parents[2] / "models"
 JAWS = MODELS / "uvms_bluerov2_alpha5_jaws.urdf"
@@ -25,6 +25,16 @@ def uvms() -> up.UVMS:
 def test_naming_rule():
     assert is_jaw_name("left_FINGER_joint") and is_jaw_name("gripper") and is_jaw_name("jaw_a")
     assert not is_jaw_name("alpha_axis_b") and not is_jaw_name("wrist_roll")
+
+
+def test_consecutive_indices_read_as_a_slice_the_same_entries():
+    values = np.arange(10.0) * 1.5
+    for index in (np.array([3, 4, 5]), np.array([0]), np.array([8, 9])):
+        at = slice_if_consecutive(index)
+        assert isinstance(at, slice)
+        np.testing.assert_array_equal(values[at], values[index])
+    for index in (np.array([1, 3]), np.array([5, 4]), np.array([], dtype=int)):
+        assert slice_if_consecutive(index) is index
 
 
 def test_the_alpha5_jaw_as_reach_describes_it(uvms):

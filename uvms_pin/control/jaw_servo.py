@@ -30,7 +30,7 @@ import pinocchio as pin
 from uvms_pin.control.base import Controller
 from uvms_pin.control.measurement import Measurement, read_only
 from uvms_pin.errors import ParameterError
-from uvms_pin.model.jaw import JawJoints
+from uvms_pin.model.jaw import JawJoints, slice_if_consecutive
 from uvms_pin.results.signal import Signal
 
 __all__ = ["JawSchedule", "JawServo", "WithJaw"]
@@ -140,23 +140,27 @@ class WithJaw(Controller):
         self._jaw_tau = np.zeros(servo.jaw.count)
         self._jaw_q = np.zeros(servo.jaw.count)
         self._unit = tuple("m" if p else "rad" for p in prismatic)
+        # where the arm's and the jaw's entries are in q and v: slices when consecutive
+        jaw = servo.jaw
+        self._arm_q, self._arm_v = map(slice_if_consecutive, (jaw.arm_q_index, jaw.arm_v_index))
+        self._jaw_q_at, self._jaw_v_at = map(slice_if_consecutive, (jaw.q_index, jaw.v_index))
 
     def compute(self, time_s: float, measurement: Measurement) -> np.ndarray:
-        jaw = self.servo.jaw
         q, v = measurement.q, measurement.v
-        # the index arrays' copies, frozen: the measurement keeps them as they are
+        # views of the measurement's frozen arrays, or an index array's copies frozen: the
+        # arm's measurement keeps them as they are
         arm_measurement = Measurement(
             time_s,
-            read_only(q[jaw.arm_q_index]),
-            read_only(v[jaw.arm_v_index]),
+            read_only(q[self._arm_q]),
+            read_only(v[self._arm_v]),
             measurement.wrench_world,
             measurement.images,
         )
         tau = self._tau.copy()
-        tau[jaw.arm_v_index] = self.arm.compute(time_s, arm_measurement)
-        self._jaw_q = q[jaw.q_index]  # a copy (an index array's)
-        self._jaw_tau = self.servo.torque(time_s, self._jaw_q, v[jaw.v_index])
-        tau[jaw.v_index] = self._jaw_tau
+        tau[self._arm_v] = self.arm.compute(time_s, arm_measurement)
+        self._jaw_q = q[self._jaw_q_at]  # frozen (a view of the measurement's) or a copy
+        self._jaw_tau = self.servo.torque(time_s, self._jaw_q, v[self._jaw_v_at])
+        tau[self._jaw_v_at] = self._jaw_tau
         return tau
 
     def reset(self) -> None:

@@ -18,7 +18,7 @@ import pinocchio as pin
 
 from uvms_pin.errors import ModelError
 
-__all__ = ["GRIPPER_WORDS", "JawJoints", "is_jaw_name"]
+__all__ = ["GRIPPER_WORDS", "JawJoints", "is_jaw_name", "slice_if_consecutive"]
 
 #: A moving joint whose name has one of these is a gripper's, not the arm's.
 GRIPPER_WORDS = ("finger", "gripper", "jaw", "hand")
@@ -27,6 +27,15 @@ GRIPPER_WORDS = ("finger", "gripper", "jaw", "hand")
 def is_jaw_name(name: str) -> bool:
     """The naming rule: ``name`` has one of `GRIPPER_WORDS` (any case)."""
     return any(word in name.lower() for word in GRIPPER_WORDS)
+
+
+def slice_if_consecutive(index: np.ndarray) -> slice | np.ndarray:
+    """``index`` (increasing) as the slice it spans when its indices are consecutive (the
+    jaw at the end of q and v, the arm before it), else itself: the same entries, read as a
+    view instead of a copy (a control tick's indexing, several times cheaper)."""
+    if len(index) > 0 and np.array_equal(index, np.arange(index[0], index[0] + len(index))):
+        return slice(int(index[0]), int(index[0]) + len(index))
+    return index
 
 
 @dataclass(frozen=True)

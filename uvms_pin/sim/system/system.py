@@ -374,8 +374,10 @@ class System:
             found = self.moving.found(q_r, v_r, objects)
         else:  # the compiled system's contacts (the same as the reference's, to rounding)
             memories = self.friction_memories()
-            robot_forces = forces_of_core(plant.compiled.world_forces(q_r, v_r, memories[0]))
-            fixed = plant.world.pair_wrenches(robot_forces).ravel()
+            fixed = np.zeros(0)  # no fixed object: no pair of the robot's to search or log
+            if plant.world.objects:
+                robot_forces = forces_of_core(plant.compiled.world_forces(q_r, v_r, memories[0]))
+                fixed = plant.world.pair_wrenches(robot_forces).ravel()
             found = contacts_of_core(compiled.contacts(q, v, memories))
         robot, between_objects = self.moving.moving.wrenches(found)
         out = {"world_contact": np.concatenate([fixed, robot])}
