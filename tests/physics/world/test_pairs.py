@@ -90,24 +90,47 @@ def test_a_force_on_a_body_fixed_to_the_world_moves_no_joint():
     ).shape == (0,)
 
 
+class _BoxAndBar:
+    """A box robot (10 cm) and a free bar (a cylinder 1 m long, 5 cm across, at z = -5 m),
+    and the core's search of their pairs (`PairSearch`), kept from call to call."""
+
+    def __init__(self, load_body):
+        self.box = _body(load_body, '<box size="0.1 0.1 0.1"/>')
+        bar = free_object(
+            "bar", "cylinder", {"radius_m": 0.025, "length_m": 1.0}, ([0.0, 0.0, -5.0], [0, 0, 0]),
+            density_kg_m3=1200.0, water_density_kg_m3=RHO,
+        )  # fmt: skip
+        self.system = System(Plant(self.box, world=World(self.box, [], ContactLaw(), [bar])))
+        (self.pairs,) = self.system.moving.moving.sets
+        self.search = PairSearch(self.pairs.pairs, core_module())
+        self.states = self.system.moving.initial_states()
+
+    def compare(self, q: np.ndarray, v: np.ndarray) -> int:
+        """The core's touching pairs, forces and points at (q, v) against the reference's
+        (to 1e-12); how many pairs touch."""
+        moving, pairs = self.system.moving, self.pairs
+        moving._kinematics(q, v, self.states)
+        data = moving.moving._datas(moving.uvms_data, moving.datas)
+        python = pairs.pairs.forces(data(pairs.a), data(pairs.b), pairs.memory)
+        core = self.search(data(pairs.a), data(pairs.b), pairs.memory)
+        assert np.array_equal(core.pair, python.pair), q
+        np.testing.assert_allclose(core.force_world_N, python.force_world_N, rtol=0, atol=1e-12)
+        np.testing.assert_allclose(
+            core.touch.point_world_m, python.touch.point_world_m, rtol=0, atol=1e-12
+        )
+        return len(python.pair)
+
+
 def test_the_core_finds_a_bars_contacts_as_the_reference_does(load_body):
     """A box robot (10 cm) posed all about a free bar (a cylinder 1 m long, 5 cm across):
     beside it, past its ends, into it. The core's search (`PairSearch`, its pieces' spheres
     tested against the solid cylinder before coal's GJK) finds the reference's touching
     pairs, points and forces (`PiecePairs.forces`) at every pose, to 1e-12."""
-    box = _body(load_body, '<box size="0.1 0.1 0.1"/>')
-    bar = free_object(
-        "bar", "cylinder", {"radius_m": 0.025, "length_m": 1.0}, ([0.0, 0.0, -5.0], [0, 0, 0]),
-        density_kg_m3=1200.0, water_density_kg_m3=RHO,
-    )  # fmt: skip
-    system = System(Plant(box, world=World(box, [], ContactLaw(), [bar])))
-    (pairs,) = system.moving.moving.sets
-    search = PairSearch(pairs.pairs, core_module())
+    scene = _BoxAndBar(load_body)
     rng = np.random.default_rng(38)
-    states = system.moving.initial_states()
     touching = 0
     for _ in range(300):
-        q = box.neutral_configuration()
+        q = scene.box.neutral_configuration()
         # the box's centre 0 to 15 cm from the bar's axis, up to 10 cm past its ends
         angle, radial, along = (
             rng.uniform(0, 2 * np.pi),
@@ -117,16 +140,7 @@ def test_the_core_finds_a_bars_contacts_as_the_reference_does(load_body):
         q[:3] = [radial * np.cos(angle), radial * np.sin(angle), -5.0 + along]
         q[3:7] = pin.Quaternion(pin.exp3(rng.normal(size=3))).coeffs()
         v = rng.normal(scale=0.1, size=6)
-        system.moving._kinematics(q, v, states)
-        data = system.moving.moving._datas(system.moving.uvms_data, system.moving.datas)
-        python = pairs.pairs.forces(data(pairs.a), data(pairs.b), pairs.memory)
-        core = search(data(pairs.a), data(pairs.b), pairs.memory)
-        assert np.array_equal(core.pair, python.pair)
-        np.testing.assert_allclose(core.force_world_N, python.force_world_N, rtol=0, atol=1e-12)
-        np.testing.assert_allclose(
-            core.touch.point_world_m, python.touch.point_world_m, rtol=0, atol=1e-12
-        )
-        touching += len(python.pair)
+        touching += scene.compare(q, v)
     assert 30 < touching < 270  # both kinds of pose
 
 
@@ -136,15 +150,7 @@ def test_the_core_skips_coal_only_for_a_pair_still_apart(load_body):
     again while GJK's last separating direction still leaves a gap over 1e-5 m between the
     two shapes: `NarrowPhase`) at 0.1 um and below: at every pose the core's search, kept
     from pose to pose, finds the reference's touching pairs, points and forces to 1e-12."""
-    box = _body(load_body, '<box size="0.1 0.1 0.1"/>')
-    bar = free_object(
-        "bar", "cylinder", {"radius_m": 0.025, "length_m": 1.0}, ([0.0, 0.0, -5.0], [0, 0, 0]),
-        density_kg_m3=1200.0, water_density_kg_m3=RHO,
-    )  # fmt: skip
-    system = System(Plant(box, world=World(box, [], ContactLaw(), [bar])))
-    (pairs,) = system.moving.moving.sets
-    search = PairSearch(pairs.pairs, core_module())
-    states = system.moving.initial_states()
+    scene = _BoxAndBar(load_body)
     tilt = pin.exp3(np.array([0.01, 0.02, 0.0]))  # an edge of the box towards the bar
     reach = 0.05 * np.abs(tilt[0]).sum()  # of the box from its centre towards the bar
     # the gap [m]: 2 mm down to 0.1 um, 0.2 mm in, and back
@@ -152,19 +158,10 @@ def test_the_core_skips_coal_only_for_a_pair_still_apart(load_body):
     gaps = np.concatenate([closing, closing[::-1]])
     touching = 0
     for k, gap in enumerate(gaps):
-        q = box.neutral_configuration()
+        q = scene.box.neutral_configuration()
         q[:3] = [0.025 + reach + gap, 0.0, -5.0 + 0.01 * np.cos(k)]
         q[3:7] = pin.Quaternion(tilt).coeffs()
-        system.moving._kinematics(q, np.full(6, 0.01), states)
-        data = system.moving.moving._datas(system.moving.uvms_data, system.moving.datas)
-        python = pairs.pairs.forces(data(pairs.a), data(pairs.b), pairs.memory)
-        core = search(data(pairs.a), data(pairs.b), pairs.memory)
-        assert np.array_equal(core.pair, python.pair), gap
-        np.testing.assert_allclose(core.force_world_N, python.force_world_N, rtol=0, atol=1e-12)
-        np.testing.assert_allclose(
-            core.touch.point_world_m, python.touch.point_world_m, rtol=0, atol=1e-12
-        )
-        touching += len(python.pair)
+        touching += scene.compare(q, np.full(6, 0.01))
     assert 0 < touching < len(gaps)  # both sides of the contact
 
 
