@@ -136,11 +136,22 @@ class Frame:
     rgb: np.ndarray
 
 
-def pixel_rays(spec: CameraSpec) -> np.ndarray:
-    """The unit rays (H W, 3) of every pixel, row by row, in the optical frame."""
+def whole_tiles(spec: CameraSpec) -> bool:
+    """Whether the tiles of `TILE_PX` cover the image exactly (no tile cut by its edge)."""
+    return spec.width % TILE_PX == 0 and spec.height % TILE_PX == 0
+
+
+def _pixel_coordinates(spec: CameraSpec) -> tuple[np.ndarray, np.ndarray]:
+    """(u (W,), v (H,)): the pixel centres' x / z and y / z in the optical frame."""
     f = spec.focal_px
     u = (np.arange(spec.width) + 0.5 - 0.5 * spec.width) / f
     v = (np.arange(spec.height) + 0.5 - 0.5 * spec.height) / f
+    return u, v
+
+
+def pixel_rays(spec: CameraSpec) -> np.ndarray:
+    """The unit rays (H W, 3) of every pixel, row by row, in the optical frame."""
+    u, v = _pixel_coordinates(spec)
     return _unit_rays(u[None, :], v[:, None], (spec.height, spec.width))
 
 
@@ -159,11 +170,9 @@ def _unit_rays(x: np.ndarray, y: np.ndarray, shape: tuple[int, ...]) -> np.ndarr
 def tiled_rays(spec: CameraSpec, order: np.ndarray) -> np.ndarray:
     """`pixel_rays` in tile order (``order``, `tiles`'): the same values, each computed in
     its place when the tiles cover the image exactly (no image-order array), else gathered."""
-    if spec.width % TILE_PX or spec.height % TILE_PX:
+    if not whole_tiles(spec):
         return pixel_rays(spec)[order]
-    f = spec.focal_px
-    u = (np.arange(spec.width) + 0.5 - 0.5 * spec.width) / f
-    v = (np.arange(spec.height) + 0.5 - 0.5 * spec.height) / f
+    u, v = _pixel_coordinates(spec)
     across, down = spec.width // TILE_PX, spec.height // TILE_PX
     # the tiles' blocks (tile row, tile column, row in it, column in it)
     x = u.reshape(across, TILE_PX)[None, :, None, :]
@@ -182,7 +191,7 @@ def tiles(spec: CameraSpec) -> tuple[np.ndarray, np.ndarray]:
     grid[:height, :width] = np.arange(width * height).reshape(height, width)
     blocks = grid.reshape(down, TILE_PX, across, TILE_PX).swapaxes(1, 2)
     blocks = blocks.reshape(down * across, TILE_PX * TILE_PX)
-    if width % TILE_PX == 0 and height % TILE_PX == 0:
+    if whole_tiles(spec):
         return blocks.reshape(-1), np.arange(0, width * height + 1, TILE_PX * TILE_PX)
     kept = blocks >= 0
     return blocks[kept], np.concatenate([[0], np.cumsum(np.count_nonzero(kept, axis=1))])
@@ -235,11 +244,6 @@ class Camera(sensor.Mounted):
         needed: the caster takes them in tile order)."""
         return pixel_rays(self.spec)
 
-    @property
-    def _whole_tiles(self) -> bool:
-        """Whether the tiles cover the image exactly (no tile cut by its edge)."""
-        return self.spec.width % TILE_PX == 0 and self.spec.height % TILE_PX == 0
-
     @cached_property
     def _untiled(self) -> np.ndarray:
         """Tile order -> image order: the inverse of `order` (made when first needed)."""
@@ -251,7 +255,7 @@ class Camera(sensor.Mounted):
         """An array (H W, ...) in tile order, in image order: a transposition of blocks when
         the tiles cover the image exactly, one gather otherwise."""
         spec = self.spec
-        if not self._whole_tiles:
+        if not whole_tiles(self.spec):
             return tiled[self._untiled]
         rest = tiled.shape[1:]
         blocks = tiled.reshape(
