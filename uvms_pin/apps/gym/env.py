@@ -270,14 +270,13 @@ class UvmsEnv(gym.Env):
         """tau_commanded (nv,) [N, N m] of a (clipped) normalized ``action`` at ``time_s``:
         ``action_scale * action`` on `action_index`, the jaw servo's torques from the
         ``measured`` jaw joints on the jaw's entries."""
+        servo = self.jaw_servo
+        if servo is None:  # the action drives every entry
+            return self.action_scale * action
         tau = np.zeros(self.scenario.uvms.nv)
         tau[self.action_index] = self.action_scale * action
-        servo = self.jaw_servo
-        if servo is not None:
-            jaw = servo.jaw
-            tau[jaw.v_index] = servo.torque(
-                time_s, measured.q[jaw.q_index], measured.v[jaw.v_index]
-            )
+        jaw = servo.jaw
+        tau[jaw.v_index] = servo.torque(time_s, measured.q[jaw.q_index], measured.v[jaw.v_index])
         return tau
 
     def render(self):
