@@ -99,7 +99,11 @@ inline constexpr double kApartGap_m = 1e-5;
 // contacts bit for bit) and its result's storage. A pair coal finds apart keeps GJK's
 // separating direction (in b's frame); while that direction still separates the two shapes
 // by more than kApartGap_m (gap_along_m), the pair is apart without calling coal: exact, coal
-// would find it apart too (the reference calls coal on it). A copy starts empty, so that no
+// would find it apart too (the reference calls coal on it). A pair asked again at the
+// placements of its last coal call gets that call's answer: coal's answer is a function of
+// the two placements (GJK starts from its default guess, not the last one), and a period asks
+// the same placements up to four times (the anchors' move at its end, then the next period's
+// sensors, its first right-hand side and a logged sample). A copy starts empty, so that no
 // two owners share a solver.
 class NarrowPhase {
  public:
@@ -123,6 +127,11 @@ class NarrowPhase {
     coal::CollisionResult result;
     bool apart = false;              // whether apart_in_b is a separating direction
     Vec3 apart_in_b = Vec3::Zero();  // unit, out of b towards a, in b's frame
+    // the last coal call: its placements and its answer (point, normal, depth if touching)
+    bool asked = false, touching = false;
+    pinocchio::SE3 asked_a, asked_b;
+    Vec3 point = Vec3::Zero(), normal = Vec3::Zero();
+    double depth = 0.0;
   };
   std::vector<Pair> pairs_;
 };
