@@ -48,7 +48,6 @@ SLOW_TESTS = frozenset(
         "tests/apps/cli/test_import_command.py::test_import_writes_the_urdf_and_the_table_and_says_what_it_did_not_map",
         "tests/scenario/test_object_recovery.py::test_the_sample_is_lifted_carried_and_placed_in_the_basket",
         "tests/scenario/test_shipped_steps.py::test_the_pushed_box_travels_as_at_half_the_step",
-        "tests/scenario/test_shipped_steps.py::test_the_jaw_squeezes_the_rod_as_at_half_the_step",
         "tests/scenario/test_object_recovery.py::test_a_grip_too_weak_for_the_sample_leaves_it_on_the_seabed",
         "tests/apps/viz/test_foxglove_live.py::test_a_running_simulation_is_streamed_at_real_time_as_it_runs",
         "tests/apps/viz/test_foxglove_live.py::test_uvms_pin_replay_live_foxglove_waits_for_a_client_and_sends_the_whole_run",

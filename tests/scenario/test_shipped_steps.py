@@ -1,7 +1,9 @@
-"""The shipped contact scenarios step at the project's default 1 ms (RK4): what they show is
-what a finer step shows. A contact made stiffer, a lighter finger or a law that needs a
-shorter step than it was given moves these numbers apart (the stiff-mode check only says a
-step is stable, not that it is accurate)."""
+"""A shipped contact scenario that steps at the project's default 1 ms (RK4) shows what a
+finer step shows. A contact made stiffer, a lighter body or a law that needs a shorter step
+than it was given moves these numbers apart (the stiff-mode check only says a step is
+stable, not that it is accurate). The grasps step 0.5 ms: held by friction near its limit,
+a grasp is decided by the stick spring on a light finger pad, which 1 ms does not resolve
+(docs/intervention.md)."""
 
 from __future__ import annotations
 
@@ -34,18 +36,4 @@ def test_the_pushed_box_travels_as_at_half_the_step():
     )
     assert shipped["world_contact_force_peak_N"] == pytest.approx(
         half["world_contact_force_peak_N"], rel=1e-3
-    )
-
-
-def test_the_jaw_squeezes_the_rod_as_at_half_the_step():
-    """gripper_close (4 s): the rod's displacement in the squeeze agrees to 2 % (measured:
-    0.0892, 0.0880 and 0.0876 m at 1, 0.5 and 0.25 ms); the impact's peak force is chaotic
-    (36.6, 35.5 and 37.1 N) and is held to 10 %."""
-    shipped, half = _metrics("gripper_close", None), _metrics("gripper_close", 5e-4)
-    assert shipped["step_s"] == 1e-3
-    assert shipped["object_rod_displacement_m"] == pytest.approx(
-        half["object_rod_displacement_m"], rel=0.02
-    )
-    assert shipped["world_contact_force_peak_N"] == pytest.approx(
-        half["world_contact_force_peak_N"], rel=0.1
     )

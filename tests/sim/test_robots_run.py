@@ -152,9 +152,6 @@ def test_a_robot_grasps_the_first_robots_ball_as_a_single_robot_does():
     about 1e-14 N (`test_robots_system.py`), which the squeeze amplifies."""
     doc = read_toml(GRIPPER, ScenarioError)
     doc["scenario"]["duration_s"] = 0.4
-    # at 0.5 ms, where the spread below was measured (the shipped 1 ms squeezes harder per
-    # step: 2.2e-4 m on the ball; the paths' agreement is what is tested, not the step)
-    doc["integrator"]["step_s"] = 5e-4
     single = simulate(
         scenario_from_dict(copy.deepcopy(doc), GRIPPER), progress=False, compiled_loop=False
     )
