@@ -36,7 +36,6 @@ from uvms_pin.physics.fins import fin_generalized_force, fin_wrenches_world
 from uvms_pin.physics.joint_friction import JointFriction
 from uvms_pin.physics.joint_stops import JointStops
 from uvms_pin.physics.surface import wet_state
-from uvms_pin.physics.world.touch import NO_TOUCH
 from uvms_pin.physics.world.world import ContactForces, FrictionMemory, World
 from uvms_pin.sim.actuation import Actuation, Unlimited
 from uvms_pin.sim.compiled.plant import plant_to_core
@@ -222,7 +221,7 @@ class Plant:
         if self.world is None:
             return None
         if not self.world.objects:  # a world of moving bodies alone: nothing fixed to touch
-            return ContactForces(NO_TOUCH, np.zeros((0, 3)), np.zeros(0), np.zeros(0, bool))
+            return ContactForces.none()
         pin.forwardKinematics(self.uvms.model, self._world_data, q, v)
         return self.world.forces(self._world_data, self.friction)
 

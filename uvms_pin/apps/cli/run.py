@@ -54,6 +54,16 @@ def check_view_options(args: argparse.Namespace) -> None:
 
 
 def cmd_run(args: argparse.Namespace) -> int:
+    from threadpoolctl import threadpool_limits
+
+    # A run is one thread of small numpy operations (a control tick's vectors and matrices):
+    # BLAS worker threads never speed them up, but an operation large enough wakes them and
+    # they spin a while after it, taking a core from the run (and CPU time from the process)
+    with threadpool_limits(limits=1, user_api="blas"):
+        return _run(args)
+
+
+def _run(args: argparse.Namespace) -> int:
     from uvms_pin.scenario.load import load_scenario
     from uvms_pin.sim.run import Scenario
 

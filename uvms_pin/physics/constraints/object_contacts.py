@@ -39,7 +39,7 @@ from uvms_pin.physics.constraints.contacts import (
 )
 from uvms_pin.physics.constraints.rows import ConstraintRows
 from uvms_pin.physics.world.gaps import Candidate, candidates
-from uvms_pin.physics.world.touch import NO_TOUCH, Touch
+from uvms_pin.physics.world.touch import Touch
 from uvms_pin.physics.world.world import ContactForces, FrictionMemory, World
 
 __all__ = ["SLIP_M_S", "ObjectWorldContacts"]
@@ -151,9 +151,7 @@ class ObjectWorldContacts:
                 out.append(None)
                 continue
             if not mine:
-                out.append(
-                    ContactForces(NO_TOUCH, np.zeros((0, 3)), np.zeros(0), np.zeros(0, bool))
-                )
+                out.append(ContactForces.none())
                 continue
             points = [rows.where[i].point for i in mine]
             frames = np.array([rows.where[i].frame for i in mine])

@@ -181,7 +181,7 @@ class MovingContacts:
             s.memory.clear()
         for m in self.object_memory:
             m.clear()
-        no_touch = ContactForces(NO_TOUCH, np.zeros((0, 3)), np.zeros(0), np.zeros(0, bool))
+        no_touch = ContactForces.none()
         self.rigid_forces = [None if w is None else no_touch for w in self.object_worlds]
         none = PairContacts(NO_TOUCH, np.zeros((0, 3)), np.zeros(0), np.zeros(0, dtype=bool))
         self.rigid_pair_forces = [none for _ in self.sets]

@@ -27,7 +27,7 @@ from uvms_pin.model.uvms import UVMS
 from uvms_pin.physics.world.contact_law import ContactLaw, friction_force_N, normal_force_N
 from uvms_pin.physics.world.objects import WorldObject
 from uvms_pin.physics.world.robot_geometry import RobotPiece, robot_pieces
-from uvms_pin.physics.world.touch import Bounds, Touch, clear_of, cross, touch
+from uvms_pin.physics.world.touch import NO_TOUCH, Bounds, Touch, clear_of, cross, touch
 
 __all__ = [
     "FIXED_CONTACT",
@@ -118,6 +118,11 @@ class ContactForces:
     sticking: np.ndarray
     stretch_m: np.ndarray = field(default_factory=lambda: np.zeros((0, 3)))
     material_m: np.ndarray = field(default_factory=lambda: np.zeros((0, 3)))
+
+    @classmethod
+    def none(cls) -> ContactForces:
+        """No contact point: every array empty."""
+        return cls(NO_TOUCH, np.zeros((0, 3)), np.zeros(0), np.zeros(0, dtype=bool))
 
 
 @dataclass
@@ -237,6 +242,8 @@ class World:
         """The force at each contact point after ``pin.forwardKinematics(model, data, q,
         v)``, with the anchors of ``memory`` (read only)."""
         found = touch(data, self.pieces, self.objects, self.bounds)
+        if len(found) == 0:  # the arrays below would all be empty, and cost more than the search
+            return ContactForces.none()
         normal = found.normal_world
         velocity = found.velocity_world_m_s
         rate = -np.einsum("ij,ij->i", velocity, normal)
