@@ -31,7 +31,6 @@ import numpy as np
 import pinocchio as pin
 
 from uvms_pin.physics.world.pairs import PairContacts, PiecePairs, piece_pairs
-from uvms_pin.physics.world.touch import NO_TOUCH
 from uvms_pin.physics.world.world import ContactForces, FrictionMemory, World
 
 __all__ = ["MovingContacts", "State"]
@@ -183,7 +182,7 @@ class MovingContacts:
             m.clear()
         no_touch = ContactForces.none()
         self.rigid_forces = [None if w is None else no_touch for w in self.object_worlds]
-        none = PairContacts(NO_TOUCH, np.zeros((0, 3)), np.zeros(0), np.zeros(0, dtype=bool))
+        none = PairContacts.none()
         self.rigid_pair_forces = [none for _ in self.sets]
 
     def _datas(self, uvms_data: pin.Data, object_datas: list[pin.Data]):

@@ -28,7 +28,7 @@ import pinocchio as pin
 from uvms_pin.physics.world.contact_law import ContactLaw, friction_force_N, normal_force_N
 from uvms_pin.physics.world.objects import WorldObject
 from uvms_pin.physics.world.robot_geometry import RobotPiece
-from uvms_pin.physics.world.touch import NO_TOUCH, Touch, coal_point, cross, reach_spheres
+from uvms_pin.physics.world.touch import Touch, coal_point, cross, reach_spheres
 from uvms_pin.physics.world.world import ContactForces, FrictionMemory, material_points
 
 __all__ = ["PairContacts", "PiecePairs", "joint_forces"]
@@ -154,7 +154,7 @@ class PiecePairs:
         of both models, with the anchors of ``memory`` (read only)."""
         found = self.touching(data_a, data_b)
         if not found:
-            return PairContacts(NO_TOUCH, np.zeros((0, 3)), np.zeros(0), np.zeros(0, dtype=bool))
+            return PairContacts.none()
         pair = np.array([f[0] for f in found], dtype=int)
         point = np.array([f[1] for f in found], dtype=float)
         normal = np.array([f[2] for f in found], dtype=float)

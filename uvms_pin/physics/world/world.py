@@ -121,7 +121,7 @@ class ContactForces:
 
     @classmethod
     def none(cls) -> ContactForces:
-        """No contact point: every array empty."""
+        """No contact point: every array empty (a subclass's own fields at their defaults)."""
         return cls(NO_TOUCH, np.zeros((0, 3)), np.zeros(0), np.zeros(0, dtype=bool))
 
 
