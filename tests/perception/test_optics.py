@@ -7,7 +7,14 @@ import numpy as np
 import pytest
 
 from uvms_pin.errors import ParameterError
-from uvms_pin.perception.optics import Light, WaterOptics, backscatter, cone, cone_of_cosine
+from uvms_pin.perception.optics import (
+    JERLOV_KD_PER_M,
+    Light,
+    WaterOptics,
+    backscatter,
+    cone,
+    cone_of_cosine,
+)
 
 
 def test_a_lights_direction_is_made_a_unit_vector():
@@ -36,6 +43,27 @@ def test_cone_is_one_inside_zero_beyond_and_smoothstep_on_its_edge():
         np.testing.assert_allclose(
             cone_of_cosine(np.cos(angles), half, edge_rad), cone(angles, half, edge_rad), atol=1e-12
         )
+
+
+def test_the_jerlov_types_grow_more_turbid_and_shift_from_blue_to_green_water():
+    """Jerlov's K_d table read as the physics it records: from the clearest oceanic type (I)
+    to the most turbid coastal one (9C) every channel attenuates at least as fast as in the
+    type before; red always faster than green; the least attenuated colour is blue in the
+    clear oceanic waters (I to II) and green from type III on (the coastal waters' yellow
+    substance absorbs blue)."""
+    order = ["I", "IA", "IB", "II", "III", "1C", "3C", "5C", "7C", "9C"]
+    assert list(JERLOV_KD_PER_M) == order
+    kd = np.array([JERLOV_KD_PER_M[name] for name in order])  # (types, R G B)
+    assert np.all(kd > 0.0)
+    assert np.all(np.diff(kd, axis=0) >= 0.0), "a type clearer than the one before it"
+    assert np.all(np.diff(kd[:, [0, 2]], axis=0) > 0.0)  # red and blue strictly
+    assert np.all(kd[:, 0] > kd[:, 1])
+    least = ["RGB"[c] for c in np.argmin(kd, axis=1)]
+    assert least == ["B"] * 4 + ["G"] * 6
+    for name in order:  # the preset is the camera's default beta_D and beta_B too
+        water = WaterOptics(water_type=name)
+        np.testing.assert_array_equal(water.beta_d_per_m, JERLOV_KD_PER_M[name])
+        np.testing.assert_array_equal(water.beta_b_per_m, JERLOV_KD_PER_M[name])
 
 
 def test_daylight_decays_exponentially_and_backscatter_saturates_to_the_veiling_light():
