@@ -93,6 +93,9 @@ def check_bag(rollout, bag: dict) -> None:
             got = placements[model.frames[fid].name]
             _close(got.translation, data.oMf[fid].translation)
             _close(got.rotation, data.oMf[fid].rotation)
+        for frame, placed in _sensor_frames(rollout, model, data).items():
+            _close(placements[frame].translation, placed.translation)
+            _close(placements[frame].rotation, placed.rotation)
         for j, name in enumerate(free):
             state = rollout.signals["free_objects"][k, 13 * j : 13 * j + 7]
             _close(placements[name].translation, state[:3])
@@ -116,6 +119,90 @@ def check_bag(rollout, bag: dict) -> None:
     _check_joints(rollout, bag, times)
     _check_navigation(rollout, bag, times)
     _check_world(world, bag)
+    _check_perception(rollout, bag)
+
+
+def _exported_sensors(rollout) -> dict[str, dict]:
+    """The sensors the bag has topics for: those whose spec the metadata keeps."""
+    described = rollout.metadata.get("perception") or {}
+    return {name: about for name, about in described.items() if "spec" in about}
+
+
+def _sensor_frames(rollout, model, data) -> dict[str, pin.SE3]:
+    """Each camera's optical frame and sonar's frame in the world, from the sample whose
+    kinematics ``data`` holds: its mount frame's placement times its spec's pose there."""
+    out = {}
+    for name, about in _exported_sensors(rollout).items():
+        spec = about["spec"]
+        mount = data.oMf[model.getFrameId(about["frame"])]
+        in_link = pin.SE3(
+            pin.rpy.rpyToMatrix(np.array(spec["rpy_rad"])), np.array(spec["position_m"])
+        )
+        suffix = "_optical_frame" if about["kind"] == "camera" else "_frame"
+        out[name + suffix] = mount * in_link
+    return out
+
+
+def _pixels(message, dtype, channels: int = 1) -> np.ndarray:
+    assert message.is_bigendian == 0
+    row = message.width * channels * np.dtype(dtype).itemsize
+    assert message.step == row
+    shape = (message.height, message.width) + ((channels,) if channels > 1 else ())
+    return np.frombuffer(bytes(message.data), dtype=np.dtype(dtype).newbyteorder("<")).reshape(
+        shape
+    )
+
+
+def _check_perception(rollout, bag: dict) -> None:
+    """Each camera's and sonar's firings: the images bit for bit (no return: +Inf), the
+    camera's intrinsics projecting each pixel's own ray onto that pixel, the multibeam's
+    detections as a LaserScan."""
+    from uvms_pin.perception.camera import CameraSpec, pixel_rays
+
+    for name, about in _exported_sensors(rollout).items():
+        arrays, kind = rollout.perception[name], about["kind"]
+        times = [EPOCH_NS + round(float(t) * 1e9) for t in arrays["time_s"]]
+        image_topic = f"/{name}/image_raw" if kind == "camera" else f"/{name}/image"
+        assert [t for t, _ in bag[image_topic]] == times, image_topic
+        frame = name + ("_optical_frame" if kind == "camera" else "_frame")
+        for k, (_, message) in enumerate(bag[image_topic]):
+            assert message.header.frame_id == frame
+            if kind == "camera":
+                assert message.encoding == "rgb8"
+                np.testing.assert_array_equal(_pixels(message, np.uint8, 3), arrays["rgb"][k])
+                depth = bag[f"/{name}/depth/image"][k][1]
+                assert depth.encoding == "32FC1"
+                expected = np.where(np.isnan(arrays["depth_m"][k]), np.inf, arrays["depth_m"][k])
+                np.testing.assert_array_equal(_pixels(depth, np.float32), expected)
+                labels = bag[f"/{name}/labels"][k][1]
+                assert labels.encoding == "16UC1"
+                np.testing.assert_array_equal(_pixels(labels, np.uint16), arrays["label"][k])
+            else:
+                assert message.encoding == "32FC1"
+                np.testing.assert_array_equal(_pixels(message, np.float32), arrays["intensity"][k])
+        if kind == "camera":
+            spec = CameraSpec(**{**about["spec"], "lights": ()})
+            for _, info in bag[f"/{name}/camera_info"]:
+                k_matrix = np.array(info.k).reshape(3, 3)
+                rays = pixel_rays(spec)  # row by row: pixel (row, column)
+                projected = rays @ k_matrix.T
+                pixel = projected[:, :2] / projected[:, 2:]
+                rows, columns = np.divmod(np.arange(spec.width * spec.height), spec.width)
+                _close(pixel, np.column_stack([columns, rows]) + 0.0)
+                assert (info.width, info.height) == (spec.width, spec.height)
+                assert not np.any(info.d)
+        elif "beam_range_m" in arrays:
+            bearing = arrays["bearing_rad"]
+            for k, (_, scan) in enumerate(bag[f"/{name}/scan"]):
+                assert scan.header.frame_id == frame
+                angles = scan.angle_min + scan.angle_increment * np.arange(len(scan.ranges))
+                np.testing.assert_allclose(angles, bearing, atol=1e-6)  # float32 fields
+                assert scan.angle_max == np.float32(bearing[-1])
+                ranges = np.where(
+                    np.isnan(arrays["beam_range_m"][k]), np.inf, arrays["beam_range_m"][k]
+                )
+                np.testing.assert_array_equal(scan.ranges, ranges.astype(np.float32))
+                np.testing.assert_array_equal(scan.intensities, arrays["beam_intensity"][k])
 
 
 def _check_joints(rollout, bag: dict, times: list[int]) -> None:

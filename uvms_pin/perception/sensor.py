@@ -9,9 +9,10 @@ them) and fires them without naming any.
 
 from __future__ import annotations
 
+import json
 import math
 from collections.abc import Callable, Mapping
-from dataclasses import MISSING, dataclass, fields
+from dataclasses import MISSING, asdict, dataclass, fields
 from typing import Any
 
 import numpy as np
@@ -29,6 +30,7 @@ __all__ = [
     "mount_frame",
     "register",
     "spec_from_dict",
+    "spec_record",
     "written",
 ]
 
@@ -109,6 +111,14 @@ def spec_from_dict(cls: type, raw: Mapping[str, Any], label: str, **given: Any) 
             continue
         values[name] = _value(label, name, default, raw[name])
     return cls(**values)
+
+
+def spec_record(spec: Any) -> dict[str, Any]:
+    """A sensor's spec as the plain values a run's metadata keeps (its fields by name; a
+    light a table of its own): what a reader of the saved run needs to place and read its
+    images (the MCAP export's sensor frames and camera intrinsics); tuples as lists, as the
+    saved metadata reads back."""
+    return json.loads(json.dumps(asdict(spec)))
 
 
 class Mounted:

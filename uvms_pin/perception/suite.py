@@ -23,7 +23,7 @@ from uvms_pin.checks import check_memory
 # the sensor kinds, each registered by its module on import: the one list of them
 from uvms_pin.perception import camera, sonar  # noqa: F401
 from uvms_pin.perception.scene import Scene
-from uvms_pin.perception.sensor import SENSORS, mount_frame
+from uvms_pin.perception.sensor import SENSORS, mount_frame, spec_record
 from uvms_pin.results.rollout_data import RolloutData
 
 __all__ = ["PERCEPTION_SEED_INDEX", "PerceptionSpec", "check_mounts", "firing_rows", "perceive"]
@@ -95,7 +95,8 @@ def perceive(
 ) -> None:
     """Fire every sensor of ``spec`` over ``rollout``'s logged states in ``scene`` (its
     free objects ``n_objects``), keeping their images in ``rollout.perception`` and what
-    they are in its metadata's ``perception``."""
+    they are in its metadata's ``perception``: each sensor's kind, rate, the model frame it
+    is mounted on (``frame``) and its whole spec (``spec``, `spec_record`)."""
     root = np.random.SeedSequence(seed).spawn(PERCEPTION_SEED_INDEX + 1)[PERCEPTION_SEED_INDEX]
     streams = root.spawn(max(1, len(spec.sensors)))
     poses = object_poses(rollout, n_objects)
@@ -110,7 +111,12 @@ def perceive(
             **fired,
             **kind.constants(sensor),
         }
-        described[own.name] = {"kind": kind_name, "rate_hz": own.rate_hz}
+        described[own.name] = {
+            "kind": kind_name,
+            "rate_hz": own.rate_hz,
+            "frame": scene.uvms.model.frames[sensor.frame_id].name,  # the link it is on
+            "spec": spec_record(own),
+        }
         if kind_name == "camera":
             described[own.name]["label_names"] = list(scene.names)
 

@@ -19,7 +19,9 @@ Topics (each message stamped `uvms_pin.apps.export.ros_messages.stamp_ns` of its
 - ``/imu`` (``sensor_msgs/Imu``) and ``/depth`` (``sensor_msgs/FluidPressure``, p_atm +
   rho g d [Pa]) when the run had those sensors; ``/thrusters`` (``sensor_msgs/JointState``,
   the thrust of each thruster [N] as ``effort``) when it had thrusters;
-- ``/world/markers`` (``visualization_msgs/MarkerArray``, once) when it had world objects.
+- ``/world/markers`` (``visualization_msgs/MarkerArray``, once) when it had world objects;
+- each camera's and sonar's images at its firings and its frame in ``/tf_static``
+  (`uvms_pin.apps.export.ros_perception`).
 """
 
 from __future__ import annotations
@@ -28,8 +30,11 @@ from collections.abc import Iterator
 from pathlib import Path
 from typing import TYPE_CHECKING
 
+import pinocchio as pin
+
 from uvms_pin.apps.export.ros_encoding import TopicEncoder
-from uvms_pin.apps.export.ros_sample import MAP, Message, SampleTopics, records_of
+from uvms_pin.apps.export.ros_perception import PerceptionTopics
+from uvms_pin.apps.export.ros_sample import MAP, TOPIC_TYPES, Message, SampleTopics, records_of
 from uvms_pin.errors import VizError
 from uvms_pin.model.urdf.load import load_uvms
 from uvms_pin.model.uvms import DEFAULT_WATER_DENSITY_KG_M3
@@ -79,12 +84,13 @@ def write_mcap(rollout: RolloutData, path: str | Path, *, urdf: str | Path | Non
             f"the rollout's q has {rollout.q.shape[1]} entries, its model {uvms.model.nq}: "
             "not the model it ran (pass --urdf)"
         )
-    encoder = TopicEncoder()
+    seen = perception_topics(rollout, uvms)
+    encoder = TopicEncoder(TOPIC_TYPES | seen.types)
     with atomic_path(path) as tmp, open(tmp, "wb") as stream:
         writer = writer_class(stream)
         writer.start(profile="ros2", library="uvms-pin")
         channels = {}
-        for topic, message, time_ns in messages(rollout, uvms):
+        for topic, message, time_ns in messages(rollout, uvms, seen):
             if topic not in channels:  # a channel for each topic the run has data for
                 name, text = encoder.schema(topic)
                 schema = writer.register_schema(name, "ros2msg", text.encode())
@@ -94,9 +100,24 @@ def write_mcap(rollout: RolloutData, path: str | Path, *, urdf: str | Path | Non
     return Path(path)
 
 
-def messages(rollout: RolloutData, uvms: UVMS) -> Iterator[Message]:
-    """Every message of the bag, in time order (the static ones first)."""
+def perception_topics(rollout: RolloutData, uvms: UVMS) -> PerceptionTopics:
+    """The rollout's cameras and sonars as topics, their frames placed at its first sample."""
+    data = uvms.model.createData()
+    pin.framesForwardKinematics(uvms.model, data, rollout.q[0])
+    return PerceptionTopics(rollout, uvms.model, data)
+
+
+def messages(
+    rollout: RolloutData, uvms: UVMS, seen: PerceptionTopics | None = None
+) -> Iterator[Message]:
+    """Every message of the bag, in time order (the static ones first); ``seen``: its
+    cameras' and sonars' (`perception_topics`)."""
+    seen = seen or perception_topics(rollout, uvms)
     topics = SampleTopics(rollout.metadata, uvms)
-    yield from topics.static(float(rollout.time_s[0]), rollout.q[0])
+    for topic, message, time_ns in topics.static(float(rollout.time_s[0]), rollout.q[0]):
+        if topic == "/tf_static":  # one message: the sensors' frames with the links'
+            message["transforms"].extend(seen.static_transforms(time_ns))
+        yield topic, message, time_ns
     for record in records_of(rollout):
         yield from topics.at(record)
+        yield from seen.at(record.time_s)

@@ -4,7 +4,7 @@ packing, the others through mcap-ros2-support's generic encoder (the ``ros`` ext
 
 from __future__ import annotations
 
-from collections.abc import Callable
+from collections.abc import Callable, Mapping
 
 from uvms_pin.apps.export.ros_cdr import ENCODERS
 from uvms_pin.apps.export.ros_sample import TOPIC_TYPES
@@ -25,10 +25,15 @@ class TopicEncoder:
     """Each topic's ROS 2 type and message definition (`schema`) and its messages as CDR
     bytes (`encode`); an encoder is made once per type.
 
+    Args:
+        types: the topics' ROS 2 types (topic -> type name), `TOPIC_TYPES`'s and, for a
+            bag, its cameras' and sonars' (`uvms_pin.apps.export.ros_perception`).
+
     Raises (at construction): OptionalDependencyError without mcap-ros2-support.
     """
 
-    def __init__(self) -> None:
+    def __init__(self, types: Mapping[str, str] = TOPIC_TYPES) -> None:
+        self.types = types
         try:
             from mcap_ros2._dynamic import serialize_dynamic
         except ImportError as exc:
@@ -36,16 +41,15 @@ class TopicEncoder:
         self._serialize_dynamic = serialize_dynamic
         self._encoders: dict[str, Callable[[dict], bytes]] = {}
 
-    @staticmethod
-    def schema(topic: str) -> tuple[str, str]:
-        """(ROS 2 type, its message definition text) of ``topic`` (one of `TOPIC_TYPES`)."""
-        name = TOPIC_TYPES[topic]
+    def schema(self, topic: str) -> tuple[str, str]:
+        """(ROS 2 type, its message definition text) of ``topic`` (one of ``types``)."""
+        name = self.types[topic]
         return name, MESSAGE_DEFINITIONS[name]
 
     def encode(self, topic: str, message: dict) -> bytes:
         """``message`` (the dict the builders of `uvms_pin.apps.export.ros_messages` make)
         of ``topic`` as CDR."""
-        name = TOPIC_TYPES[topic]
+        name = self.types[topic]
         encoder = self._encoders.get(name)
         if encoder is None:
             encoder = ENCODERS.get(name) or self._serialize_dynamic(name, MESSAGE_DEFINITIONS[name])[name]  # fmt: skip

@@ -153,6 +153,47 @@ _FIELDS: dict[str, str] = {
         'float32 u\n'
         'float32 v\n'
     ),
+    "sensor_msgs/Image": (
+        'std_msgs/Header header\n'
+        'uint32 height\n'
+        'uint32 width\n'
+        'string encoding\n'
+        'uint8 is_bigendian\n'
+        'uint32 step\n'
+        'uint8[] data\n'
+    ),
+    "sensor_msgs/CameraInfo": (
+        'std_msgs/Header header\n'
+        'uint32 height\n'
+        'uint32 width\n'
+        'string distortion_model\n'
+        'float64[] d\n'
+        'float64[9] k\n'
+        'float64[9] r\n'
+        'float64[12] p\n'
+        'uint32 binning_x\n'
+        'uint32 binning_y\n'
+        'sensor_msgs/RegionOfInterest roi\n'
+    ),
+    "sensor_msgs/RegionOfInterest": (
+        'uint32 x_offset\n'
+        'uint32 y_offset\n'
+        'uint32 height\n'
+        'uint32 width\n'
+        'bool do_rectify\n'
+    ),
+    "sensor_msgs/LaserScan": (
+        'std_msgs/Header header\n'
+        'float32 angle_min\n'
+        'float32 angle_max\n'
+        'float32 angle_increment\n'
+        'float32 time_increment\n'
+        'float32 scan_time\n'
+        'float32 range_min\n'
+        'float32 range_max\n'
+        'float32[] ranges\n'
+        'float32[] intensities\n'
+    ),
     "visualization_msgs/MeshFile": (
         'string filename\n'
         'uint8[] data\n'
@@ -198,6 +239,19 @@ _USES: dict[str, tuple[str, ...]] = {
         "geometry_msgs/Vector3",
     ),
     "sensor_msgs/FluidPressure": (
+        "std_msgs/Header",
+        "builtin_interfaces/Time",
+    ),
+    "sensor_msgs/Image": (
+        "std_msgs/Header",
+        "builtin_interfaces/Time",
+    ),
+    "sensor_msgs/CameraInfo": (
+        "std_msgs/Header",
+        "builtin_interfaces/Time",
+        "sensor_msgs/RegionOfInterest",
+    ),
+    "sensor_msgs/LaserScan": (
         "std_msgs/Header",
         "builtin_interfaces/Time",
     ),
