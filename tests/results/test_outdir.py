@@ -85,7 +85,8 @@ def test_run_outputs_are_exactly_the_files_a_run_writes(tmp_path):
     """RUN lists the outputs by name: a new figure must be added there (or --overwrite
     would leave it stale). The sea-state scenario writes every figure but one (flow.png
     too); the surfacing scenario started at the waterline writes surface.png; a tracking
-    task writes tracking.png; an estimator estimate.png; free objects objects.png."""
+    task writes tracking.png; an estimator estimate.png; free objects objects.png; cameras and
+    sonars perception.npz and perception.png."""
     from uvms_pin.apps.outputs import write_outputs
     from uvms_pin.scenario.load import load_scenario
     from uvms_pin.sim.run import simulate
@@ -120,8 +121,11 @@ def test_run_outputs_are_exactly_the_files_a_run_writes(tmp_path):
     )
     figures = write_outputs(simulate(gripping, progress=False), out / "gripping")
     assert "objects.png" in {p.name for p in figures}
+    seeing = load_scenario(ROOT / "scenarios" / "seabed_survey.toml", {"scenario.duration_s": 0.2})
+    figures = write_outputs(simulate(seeing, progress=False), out / "seeing")
+    assert "perception.png" in {p.name for p in figures}
     written = {p.name for p in out.iterdir() if p.is_file()}
-    for sub in ("surfacing", "tracking", "estimating", "gripping"):
+    for sub in ("surfacing", "tracking", "estimating", "gripping", "seeing"):
         written |= {p.name for p in (out / sub).iterdir()}
     assert written | {"replay.html"} == set(RUN.patterns)  # replay.html: with --html
 

@@ -65,6 +65,7 @@ def _figure_writers(checkpoint: Callable[[], None]) -> Iterator[FigureWriter]:
     from uvms_pin.results.figures.estimate import estimate_figures
     from uvms_pin.results.figures.objects import objects_figures
     from uvms_pin.results.figures.paper import paper_figures
+    from uvms_pin.results.figures.perception import perception_figures
     from uvms_pin.results.figures.standard import standard_figures
     from uvms_pin.results.figures.tracking import tracking_figures
 
@@ -74,6 +75,7 @@ def _figure_writers(checkpoint: Callable[[], None]) -> Iterator[FigureWriter]:
         tracking_figures,
         estimate_figures,
         objects_figures,
+        perception_figures,
         _flow_figure,
         _surface_figure,
     ):

@@ -70,6 +70,8 @@ RUN = OutputKind(
         "estimate.png",  # runs with a navigation estimator ([estimator])
         "objects.png",  # runs with free objects ([world.objects] with a mass or density)
         "contacts.png",  # runs with a world ([world.objects], a seabed)
+        "perception.npz",  # runs with cameras or sonars ([[sensors.camera]], [[sensors.sonar]])
+        "perception.png",  # the same
     ),
     ("rollout.npz", "rollout.json", "metrics.json", "replay.html"),
 )
