@@ -8,6 +8,7 @@ import numpy as np
 import pytest
 
 from uvms_pin.apps.export.ros_perception import camera_info, laser_scan
+from uvms_pin.errors import VizError
 from uvms_pin.results.rollout import Rollout
 from uvms_pin.scenario.load import load_scenario
 from uvms_pin.sim.run import simulate
@@ -117,6 +118,16 @@ def test_a_run_saved_before_sensor_specs_were_kept_exports_without_their_topics(
     bag = read_bag(rollout.to_mcap(tmp_path / "old.mcap"))
     check_bag(rollout, bag)
     assert not [topic for topic in bag if topic.startswith(("/wrist", "/profiler", "/altim"))]
+
+
+def test_a_sensor_on_a_frame_the_model_has_not_is_refused_naming_it(saved, tmp_path):
+    """A run exported with another model (``--urdf``) whose frames lack the sensor's mount:
+    the export's error names the frame, nothing is written."""
+    rollout = Rollout.load(saved)
+    rollout.metadata["perception"]["wrist"]["frame"] = "no_such_link"
+    with pytest.raises(VizError, match=r"'no_such_link'.*pass --urdf"):
+        rollout.to_mcap(tmp_path / "run.mcap")
+    assert list(tmp_path.iterdir()) == []
 
 
 def test_no_return_is_sent_as_infinity_and_the_scan_spans_the_bearings():

@@ -28,6 +28,7 @@ import numpy as np
 import pinocchio as pin
 
 from uvms_pin.apps.export.ros_messages import header, stamp_ns, transform
+from uvms_pin.errors import VizError
 
 __all__ = ["PerceptionTopics"]
 
@@ -101,6 +102,11 @@ def _mount(model: pin.Model, data: pin.Data, frame_name: str) -> tuple[str, pin.
     mount itself when it is a link or a named frame (the bag's TF frames), else the link of
     its joint (its placement there fixed), else the world (``map``). ``data``: kinematics
     done."""
+    if not model.existFrame(frame_name):
+        raise VizError(
+            f"the run's sensor is mounted on frame '{frame_name}', which the model has not: "
+            "not the model it ran (pass --urdf)"
+        )
     fid = model.getFrameId(frame_name)
     frame = model.frames[fid]
     if frame.type in (pin.FrameType.BODY, pin.FrameType.OP_FRAME):
