@@ -229,6 +229,9 @@ class Camera(sensor.Mounted):
         given = dict(spec.reflectance)
         for name in robot:
             given.setdefault(name, ROBOT)
+        for label, fixture in scene.fixture_of.items():  # a fixture's colour: all its links'
+            if fixture in given:
+                given.setdefault(label, given[fixture])
         self.reflectance = reflectance_of(scene.names, given, scene.floor_names)
         #: the same pixels computed in the core, when the scene's caster is compiled
         self._compiled = None

@@ -1,8 +1,8 @@
 """Cameras in the loop: images a controller reads from its measurement.
 
 A camera with ``in_loop = true`` also fires during the run, at the first control tick at or
-after each of its instants k / rate_hz, from the system's true state at that tick (the robot
-and every free object). Its latest image is in the measurement the controller is given,
+after each of its instants k / rate_hz, from the system's true state at that tick (the robot,
+every free object and every fixture). Its latest image is in the measurement the controller is given,
 ``measurement.images[name]`` (`LoopImage`), until the next one. Its noise comes from its own
 stream of the run's seed (`LOOP_SEED_INDEX`), apart from the images fired over the log.
 """
@@ -52,9 +52,16 @@ class LoopCameras:
         self._images: dict[str, LoopImage] = {}
         self.images = MappingProxyType(self._images)
 
-    def update(self, time_s: float, q: np.ndarray, object_poses: Sequence[np.ndarray]) -> None:
+    def update(
+        self,
+        time_s: float,
+        q: np.ndarray,
+        object_poses: Sequence[np.ndarray],
+        fixture_positions: Sequence[np.ndarray] | None = None,
+    ) -> None:
         """At the control tick ``time_s``: the cameras whose instant has come fire, from the
-        robot's ``q`` and the free objects' poses (7,) each."""
+        robot's ``q``, the free objects' poses (7,) each and the fixtures' joint positions
+        (None: where they are)."""
         due = [
             k
             for k, camera in enumerate(self.cameras)
@@ -62,7 +69,7 @@ class LoopCameras:
         ]
         if not due:
             return
-        self.scene.update(q, object_poses)
+        self.scene.update(q, object_poses, fixture_positions)
         names = tuple(self.scene.names)
         for k in due:
             camera = self.cameras[k]

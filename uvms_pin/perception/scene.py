@@ -1,5 +1,5 @@
 """The world as the sensors see it: one `RayCaster` of the fixed objects, the free objects,
-the robot's own links and the free surface, posed from the system's state when a sensor
+the fixtures, the robot's own links and the free surface, posed from the system's state when a sensor
 fires (`Scene.update`), never rebuilt.
 
 - fixed objects (`uvms_pin.physics.world.objects.WorldObject`): a plane as the analytic plane
@@ -10,6 +10,9 @@ fires (`Scene.update`), never rebuilt.
   URDF ``<collision>`` shapes, a box or mesh as its convex hull), each labelled with its
   link, placed by the forward kinematics of q;
 - each free object: its pieces at its logged pose (x, y, z, quaternion x, y, z, w);
+- each fixture (`uvms_pin.physics.world.fixture.Fixture`): its links' collision pieces,
+  labelled ``<fixture>.<link>``, placed by its own forward kinematics at its joints'
+  positions (its logged ``<fixture>`` signal; its start until given);
 - the free surface z = 0, seen from below.
 """
 
@@ -94,6 +97,7 @@ class Scene:
     Args:
         uvms: the robot (its links' collision pieces are seen).
         objects: the fixed objects. free: the free objects (`FreeObject`).
+        fixtures: the fixtures (`Fixture`), each seen at its start until `update` moves it.
         surface: the free surface z = 0 is seen from below.
         backend: "core" (the compiled caster, `uvms_pin.perception.compiled_caster`) or
             "python" (the reference `RayCaster`): chosen here, once, for every sensor of
@@ -105,6 +109,7 @@ class Scene:
         uvms: UVMS,
         objects: Sequence[WorldObject] = (),
         free: Sequence[Any] = (),
+        fixtures: Sequence[Any] = (),
         *,
         surface: bool = True,
         backend: str = "core",
@@ -124,6 +129,16 @@ class Scene:
             self._add_pieces(o.pieces, [o.name] * (1 + max((p.body for p in o.pieces), default=0)))
             for o in free
         ]
+        #: each fixture's label names -> the fixture's name (a camera's reflectance of a
+        #: fixture colours all its links)
+        self.fixture_of = {label: f.name for f in fixtures for label in f.piece_names}
+        self.fixture_names = tuple(f.name for f in fixtures)
+        self._fixtures = [
+            (f.uvms.model, f.uvms.model.createData(), self._add_pieces(f.pieces, f.piece_names))
+            for f in fixtures
+        ]
+        for (model, data, pieces), f in zip(self._fixtures, fixtures, strict=True):
+            self._place(model, data, pieces, f.q0)
 
     def _add_pieces(
         self, pieces: Sequence[RobotPiece], names: Sequence[str]
@@ -140,19 +155,31 @@ class Scene:
         """Each label's name: label k is ``names[k - 1]`` (0: nothing met)."""
         return self.caster.names
 
-    def update(self, q: np.ndarray, object_poses: Sequence[np.ndarray] = ()) -> None:
-        """The bodies where the robot's configuration ``q`` (nq,) and each free object's
-        pose (7,) [m; quaternion x, y, z, w] put them."""
-        model, data = self.uvms.model, self.data
-        pin.forwardKinematics(model, data, q)
-        for index, piece in self._robot:
-            placed = data.oMi[piece.joint_id] * piece.placement_in_joint
-            self.caster.set_pose(index, placed.rotation, placed.translation)
+    def update(
+        self,
+        q: np.ndarray,
+        object_poses: Sequence[np.ndarray] = (),
+        fixture_positions: Sequence[np.ndarray] | None = None,
+    ) -> None:
+        """The bodies where the robot's configuration ``q`` (nq,), each free object's pose
+        (7,) [m; quaternion x, y, z, w] and each fixture's joint positions (its nq,) [rad or
+        m] put them (None: the fixtures stay where they are)."""
+        self._place(self.uvms.model, self.data, self._robot, q)
+        if fixture_positions is not None:
+            for (model, data, pieces), q_f in zip(self._fixtures, fixture_positions, strict=True):
+                self._place(model, data, pieces, q_f)
         for bodies, pose in zip(self._free, object_poses, strict=True):
             frame = pin.XYZQUATToSE3(np.asarray(pose, dtype=float))
             for index, piece in bodies:
                 placed = frame * piece.placement_in_joint
                 self.caster.set_pose(index, placed.rotation, placed.translation)
+
+    def _place(self, model: pin.Model, data: pin.Data, pieces, q: np.ndarray) -> None:
+        """An articulated body's ``pieces`` where its configuration ``q`` puts them."""
+        pin.forwardKinematics(model, data, np.asarray(q, dtype=float))
+        for index, piece in pieces:
+            placed = data.oMi[piece.joint_id] * piece.placement_in_joint
+            self.caster.set_pose(index, placed.rotation, placed.translation)
 
     def frame_placement(self, frame_id: int) -> pin.SE3:
         """A frame of the robot's model in the world, after `update`."""
@@ -164,8 +191,8 @@ def scene_of(
     uvms: UVMS, world: Any | None, *, surface: bool = True, backend: str = "core"
 ) -> Scene:
     """The scene of a robot in its world (`uvms_pin.physics.world.world.World`, or None: the
-    robot alone in open water), with the free surface when the water has one, cast by
+    robot alone in open water: its objects, free objects and fixtures), with the free surface when the water has one, cast by
     ``backend`` (the plant's: "core" or "python")."""
     if world is None:
         return Scene(uvms, surface=surface, backend=backend)
-    return Scene(uvms, world.objects, world.free, surface=surface, backend=backend)
+    return Scene(uvms, world.objects, world.free, world.fixtures, surface=surface, backend=backend)

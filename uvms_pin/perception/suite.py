@@ -3,8 +3,8 @@ beside the rollout (`uvms_pin.results.perception`).
 
 A sensor of ``rate_hz`` fires at the first logged sample at or after each of its instants
 k / rate_hz (k = 0, 1, ...): at its rate when the log period divides its period, else at the
-log's grid nearest after. Firing reads the logged state (the robot's q and each free
-object's pose): the loop itself is untouched, so a run with sensors gives the same rollout
+log's grid nearest after. Firing reads the logged state (the robot's q, each free
+object's pose and each fixture's joint positions): the loop itself is untouched, so a run with sensors gives the same rollout
 as without them, whatever path (compiled or Python) ran it. Each sensor draws its noise from
 its own stream of the run's seed (`PERCEPTION_SEED_INDEX`), in the order of the scenario.
 """
@@ -26,7 +26,14 @@ from uvms_pin.perception.scene import Scene
 from uvms_pin.perception.sensor import SENSORS, mount_frame, spec_record
 from uvms_pin.results.rollout_data import RolloutData
 
-__all__ = ["PERCEPTION_SEED_INDEX", "PerceptionSpec", "check_mounts", "firing_rows", "perceive"]
+__all__ = [
+    "PERCEPTION_SEED_INDEX",
+    "PerceptionSpec",
+    "check_mounts",
+    "firing_rows",
+    "fixture_positions",
+    "perceive",
+]
 
 #: The child of the run's SeedSequence the perception sensors draw from (the measurement
 #: noise uses children 0-5, the navigation sensors 6).
@@ -86,6 +93,14 @@ def object_poses(rollout: RolloutData, n_objects: int) -> np.ndarray:
     return states[:, :, :7]
 
 
+def fixture_positions(rollout: RolloutData, names: Sequence[str]) -> list[np.ndarray] | None:
+    """Each fixture's logged joint positions (T, its nq), the signal named after it; None
+    when the run logged none of them (the fixtures then stay at their start)."""
+    if not names or any(name not in rollout.signals for name in names):
+        return None
+    return [np.asarray(rollout.signals[name], dtype=float) for name in names]
+
+
 def perceive(
     rollout: RolloutData,
     spec: PerceptionSpec,
@@ -100,12 +115,13 @@ def perceive(
     root = np.random.SeedSequence(seed).spawn(PERCEPTION_SEED_INDEX + 1)[PERCEPTION_SEED_INDEX]
     streams = root.spawn(max(1, len(spec.sensors)))
     poses = object_poses(rollout, n_objects)
+    fixtures = fixture_positions(rollout, scene.fixture_names)
     described = rollout.metadata.setdefault("perception", {})
     for (kind_name, own), stream in zip(spec.sensors, streams, strict=False):
         kind = SENSORS[kind_name]
         sensor = kind.make(own, scene, np.random.default_rng(stream))
         rows = firing_rows(rollout.time_s, own.rate_hz)
-        fired = _fire(sensor, scene, rollout.q, poses, rows)
+        fired = _fire(sensor, scene, rollout.q, poses, fixtures, rows)
         rollout.perception[own.name] = {
             "time_s": rollout.time_s[rows].copy(),
             **fired,
@@ -140,14 +156,21 @@ def stack_of(shape: tuple[int, ...], dtype: np.dtype) -> np.ndarray:
 
 
 def _fire(
-    sensor: Any, scene: Scene, q: np.ndarray, poses: np.ndarray, rows: Sequence[int]
+    sensor: Any,
+    scene: Scene,
+    q: np.ndarray,
+    poses: np.ndarray,
+    fixtures: list[np.ndarray] | None,
+    rows: Sequence[int],
 ) -> dict[str, np.ndarray]:
     """The sensor's arrays at each of ``rows``, stacked (`stack_of`): the first firing's
     arrays give the stack's, each later one is written into its place (no copy of an
     image)."""
     stacked: dict[str, np.ndarray] = {}
     for k, row in enumerate(rows):
-        scene.update(q[row], list(poses[row]))
+        scene.update(
+            q[row], list(poses[row]), None if fixtures is None else [f[row] for f in fixtures]
+        )
         if k == 0:
             for key, value in sensor.fire().items():
                 stacked[key] = stack_of((len(rows), *value.shape), value.dtype)

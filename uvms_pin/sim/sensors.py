@@ -241,7 +241,8 @@ class SensorSuite:
         if self.seeing is None:
             return measurement
         robot, *objects = self._layout.split(state.q, state.v)
-        self.seeing.update(time_s, robot[0], [q for q, _ in objects[: self._free]])
+        free, fixtures = objects[: self._free], objects[self._free :]
+        self.seeing.update(time_s, robot[0], [q for q, _ in free], [q for q, _ in fixtures])
         return dataclasses.replace(measurement, images=self.seeing.images)
 
     def navigate(

@@ -66,8 +66,9 @@ class CameraObservation(gym.ObservationWrapper):
         loop = self.env.unwrapped.loop
         state = loop.state
         robot, *bodies = loop.system.layout.split(state.q, state.v)
-        objects = bodies[: len(loop.system.objects)]  # the free objects (fixtures follow)
-        self._scene.update(robot[0], [q for q, _ in objects])
+        free = len(loop.system.objects)  # the free objects, then the fixtures
+        objects, fixtures = bodies[:free], bodies[free:]
+        self._scene.update(robot[0], [q for q, _ in objects], [q for q, _ in fixtures])
         frame = self._camera.render()
         out = {"state": observation, "image": frame.rgb}
         if self._depth:
