@@ -13,6 +13,8 @@ fires (`Scene.update`), never rebuilt.
 - each fixture (`uvms_pin.physics.world.fixture.Fixture`): its links' collision pieces,
   labelled ``<fixture>.<link>``, placed by its own forward kinematics at its joints'
   positions (its logged ``<fixture>`` signal; its start until given);
+- the other robots of a run of several (``[[robots]]``): their links' collision pieces,
+  labelled ``<robot>.<link>``, placed by their own configurations;
 - the free surface z = 0, seen from below.
 """
 
@@ -98,6 +100,8 @@ class Scene:
         uvms: the robot (its links' collision pieces are seen).
         objects: the fixed objects. free: the free objects (`FreeObject`).
         fixtures: the fixtures (`Fixture`), each seen at its start until `update` moves it.
+        others: the other robots of a run of several, (name, UVMS) each, seen at their
+            neutral configurations until `update` places them.
         surface: the free surface z = 0 is seen from below.
         backend: "core" (the compiled caster, `uvms_pin.perception.compiled_caster`) or
             "python" (the reference `RayCaster`): chosen here, once, for every sensor of
@@ -110,6 +114,7 @@ class Scene:
         objects: Sequence[WorldObject] = (),
         free: Sequence[Any] = (),
         fixtures: Sequence[Any] = (),
+        others: Sequence[tuple[str, UVMS]] = (),
         *,
         surface: bool = True,
         backend: str = "core",
@@ -139,6 +144,13 @@ class Scene:
         ]
         for (model, data, pieces), f in zip(self._fixtures, fixtures, strict=True):
             self._place(model, data, pieces, f.q0)
+        self._others = []
+        for name, other in others:
+            links = [other.hydro_bodies[int(k)].name for k in other.surface_bodies.body_index]
+            labels = [f"{name}.{link}" for link in links]
+            placed = self._add_pieces(robot_pieces(other, links), labels)
+            self._others.append((other.model, other.model.createData(), placed))
+            self._place(*self._others[-1], other.neutral_configuration())
 
     def _add_pieces(
         self, pieces: Sequence[RobotPiece], names: Sequence[str]
@@ -160,14 +172,19 @@ class Scene:
         q: np.ndarray,
         object_poses: Sequence[np.ndarray] = (),
         fixture_positions: Sequence[np.ndarray] | None = None,
+        other_robots: Sequence[np.ndarray] | None = None,
     ) -> None:
         """The bodies where the robot's configuration ``q`` (nq,), each free object's pose
-        (7,) [m; quaternion x, y, z, w] and each fixture's joint positions (its nq,) [rad or
-        m] put them (None: the fixtures stay where they are)."""
+        (7,) [m; quaternion x, y, z, w], each fixture's joint positions (its nq,) [rad or
+        m] and each other robot's configuration put them (None: the fixtures, the other
+        robots stay where they are)."""
         self._place(self.uvms.model, self.data, self._robot, q)
         if fixture_positions is not None:
             for (model, data, pieces), q_f in zip(self._fixtures, fixture_positions, strict=True):
                 self._place(model, data, pieces, q_f)
+        if other_robots is not None:
+            for (model, data, pieces), q_r in zip(self._others, other_robots, strict=True):
+                self._place(model, data, pieces, q_r)
         for bodies, pose in zip(self._free, object_poses, strict=True):
             frame = pin.XYZQUATToSE3(np.asarray(pose, dtype=float))
             for index, piece in bodies:
@@ -188,11 +205,19 @@ class Scene:
 
 
 def scene_of(
-    uvms: UVMS, world: Any | None, *, surface: bool = True, backend: str = "core"
+    uvms: UVMS,
+    world: Any | None,
+    *,
+    surface: bool = True,
+    backend: str = "core",
+    others: Sequence[tuple[str, UVMS]] = (),
 ) -> Scene:
-    """The scene of a robot in its world (`uvms_pin.physics.world.world.World`, or None: the
-    robot alone in open water: its objects, free objects and fixtures), with the free surface when the water has one, cast by
-    ``backend`` (the plant's: "core" or "python")."""
+    """The scene of a robot in its world (`uvms_pin.physics.world.world.World`: its
+    objects, free objects and fixtures; or None: the robot alone in open water), with the
+    free surface when the water has one, the other robots of a run of several (``others``),
+    cast by ``backend`` (the plant's: "core" or "python")."""
     if world is None:
-        return Scene(uvms, surface=surface, backend=backend)
-    return Scene(uvms, world.objects, world.free, world.fixtures, surface=surface, backend=backend)
+        return Scene(uvms, others=others, surface=surface, backend=backend)
+    return Scene(
+        uvms, world.objects, world.free, world.fixtures, others, surface=surface, backend=backend
+    )

@@ -29,6 +29,7 @@ from uvms_pin.results.rollout_data import RolloutData
 __all__ = [
     "PERCEPTION_SEED_INDEX",
     "PerceptionSpec",
+    "SceneLog",
     "check_mounts",
     "firing_rows",
     "fixture_positions",
@@ -101,27 +102,54 @@ def fixture_positions(rollout: RolloutData, names: Sequence[str]) -> list[np.nda
     return [np.asarray(rollout.signals[name], dtype=float) for name in names]
 
 
+@dataclass(frozen=True)
+class SceneLog:
+    """What poses a scene at each logged row: the robot's ``q`` (T, nq), each free object's
+    pose (T, n, 7), each fixture's joint positions (T, its nq) and each other robot's
+    configuration (T, its nq) of a run of several (None: they stay where they are)."""
+
+    q: np.ndarray
+    object_poses: np.ndarray
+    fixtures: list[np.ndarray] | None = None
+    others: list[np.ndarray] | None = None
+
+    def pose(self, scene: Scene, row: int) -> None:
+        """``scene`` as the log has it at ``row``."""
+        scene.update(
+            self.q[row],
+            list(self.object_poses[row]),
+            None if self.fixtures is None else [f[row] for f in self.fixtures],
+            None if self.others is None else [q[row] for q in self.others],
+        )
+
+
 def perceive(
     rollout: RolloutData,
     spec: PerceptionSpec,
     scene: Scene,
     seed: int,
     n_objects: int = 0,
+    log: SceneLog | None = None,
 ) -> None:
     """Fire every sensor of ``spec`` over ``rollout``'s logged states in ``scene`` (its
-    free objects ``n_objects``), keeping their images in ``rollout.perception`` and what
+    free objects ``n_objects``; ``log``: what poses the scene, when not all in ``rollout``:
+    a run of several robots), keeping their images in ``rollout.perception`` and what
     they are in its metadata's ``perception``: each sensor's kind, rate, the model frame it
     is mounted on (``frame``) and its whole spec (``spec``, `spec_record`)."""
     root = np.random.SeedSequence(seed).spawn(PERCEPTION_SEED_INDEX + 1)[PERCEPTION_SEED_INDEX]
     streams = root.spawn(max(1, len(spec.sensors)))
-    poses = object_poses(rollout, n_objects)
-    fixtures = fixture_positions(rollout, scene.fixture_names)
+    if log is None:  # one robot: its rollout logs the world too
+        log = SceneLog(
+            rollout.q,
+            object_poses(rollout, n_objects),
+            fixture_positions(rollout, scene.fixture_names),
+        )
     described = rollout.metadata.setdefault("perception", {})
     for (kind_name, own), stream in zip(spec.sensors, streams, strict=False):
         kind = SENSORS[kind_name]
         sensor = kind.make(own, scene, np.random.default_rng(stream))
         rows = firing_rows(rollout.time_s, own.rate_hz)
-        fired = _fire(sensor, scene, rollout.q, poses, fixtures, rows)
+        fired = _fire(sensor, scene, log, rows)
         rollout.perception[own.name] = {
             "time_s": rollout.time_s[rows].copy(),
             **fired,
@@ -155,22 +183,13 @@ def stack_of(shape: tuple[int, ...], dtype: np.dtype) -> np.ndarray:
     return raw[skip : skip + size].view(dtype).reshape(shape)
 
 
-def _fire(
-    sensor: Any,
-    scene: Scene,
-    q: np.ndarray,
-    poses: np.ndarray,
-    fixtures: list[np.ndarray] | None,
-    rows: Sequence[int],
-) -> dict[str, np.ndarray]:
+def _fire(sensor: Any, scene: Scene, log: SceneLog, rows: Sequence[int]) -> dict[str, np.ndarray]:
     """The sensor's arrays at each of ``rows``, stacked (`stack_of`): the first firing's
     arrays give the stack's, each later one is written into its place (no copy of an
     image)."""
     stacked: dict[str, np.ndarray] = {}
     for k, row in enumerate(rows):
-        scene.update(
-            q[row], list(poses[row]), None if fixtures is None else [f[row] for f in fixtures]
-        )
+        log.pose(scene, row)
         if k == 0:
             for key, value in sensor.fire().items():
                 stacked[key] = stack_of((len(rows), *value.shape), value.dtype)

@@ -16,6 +16,8 @@ from pathlib import Path
 from typing import Any
 
 from uvms_pin.errors import ParameterError, ScenarioError, SimulationError
+from uvms_pin.perception.scene import scene_of
+from uvms_pin.perception.suite import SceneLog, fixture_positions, object_poses, perceive
 from uvms_pin.results.progress import Progress, callback_or_none, progress_printer
 from uvms_pin.results.robots import RobotRollouts
 from uvms_pin.sim.log import RolloutLog, described_columns, run_metadata
@@ -164,17 +166,54 @@ def _simulate_robots(
     except (SimulationError, KeyboardInterrupt) as exc:  # the partial rollouts too
         if getattr(exc, "rollout", None) is not None:
             _record_tasks(scenario, exc.rollout)
+            _perceive_robots(scenario, exc.rollout)  # what the sensors saw until the stop
         raise
     _record_tasks(scenario, out)
+    _perceive_robots(scenario, out)
     return out
 
 
 def _parts(robot: Scenario, given) -> tuple[Any, SensorSuite, dict[str, Any]]:
     """(the robot's controller, its seeded sensors, its rollout's metadata): a single
-    robot's (`run_parts`); cameras and sonars are not fired for several robots."""
-    if robot.sensor_config.perception.fitted:
-        raise ParameterError("cameras and sonars with several robots are not simulated")
+    robot's (`run_parts`); its cameras fire after the run (`_perceive_robots`), none in the
+    loop."""
+    if robot.sensor_config.perception.in_loop:
+        names = ", ".join(spec.name for spec in robot.sensor_config.perception.in_loop)
+        raise ParameterError(
+            f"cameras in the loop ({names}) are not simulated with several robots: their "
+            "images are made after the run (set in_loop = false)"
+        )
     return run_parts(robot, given)
+
+
+def _perceive_robots(scenario: RobotsScenario, rollouts: RobotRollouts) -> None:
+    """Each robot's cameras and sonars fired over the run's logged states: in the world
+    the first robot's rollout logs (its free objects, its fixtures), seeing the other
+    robots where their rollouts put them (`uvms_pin.perception.suite`)."""
+    first = rollouts.robot(scenario.names[0])
+    if len(first) == 0:
+        return
+    for k, (name, robot) in enumerate(zip(scenario.names, scenario.robots, strict=True)):
+        spec = robot.sensor_config.perception
+        if not spec.fitted:
+            continue
+        plant, world = robot.plant, robot.plant.world
+        others = [j for j in range(len(scenario.robots)) if j != k]
+        scene = scene_of(
+            plant.uvms,
+            world,
+            surface=plant.free_surface,
+            backend=plant.backend,
+            others=[(scenario.names[j], scenario.robots[j].uvms) for j in others],
+        )
+        free = len(world.free) if world is not None and "free_objects" in first.signals else 0
+        log = SceneLog(
+            rollouts.robot(name).q,
+            object_poses(first, free),
+            fixture_positions(first, scene.fixture_names),
+            [rollouts.robot(scenario.names[j]).q for j in others],
+        )
+        perceive(rollouts.robot(name), spec, scene, robot.settings.seed, free, log)
 
 
 def _record_tasks(scenario: RobotsScenario, rollouts: RobotRollouts) -> None:

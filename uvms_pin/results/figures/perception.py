@@ -1,8 +1,8 @@
 """perception.png: what a run's cameras and sonars saw, one band of the figure per sensor.
 
 - a camera: its colour image and its z-depth at four firings evenly spread over the run (the
-  first and the last included), the depth on one colour scale for all four (white: nothing
-  met);
+  first and the last included), the depth on one colour scale for all four, from the nearest
+  to the 98th percentile (white: nothing met);
 - an imaging sonar: its intensity [dB] at the same four instants, range up, bearing across
   (port to the left, as a sonar display), on one dB scale (50 dB below the brightest echo);
 - a multibeam: its swath over the run, each beam's detected range (white: heard nothing)
@@ -85,7 +85,9 @@ def _camera(fig: Figure, grid, row: int, rollout: RolloutData, name: str) -> Non
     shown = snapshot_rows(len(record.time_s))
     depth = record.depth_m[shown]
     finite = depth[np.isfinite(depth)]
-    low, high = (float(finite.min()), float(finite.max())) if finite.size else (0.0, 1.0)
+    # up to the 98th percentile: a few grazing rays meeting the surface hundreds of metres
+    # away would otherwise leave everything near in one colour
+    low, high = (float(finite.min()), float(np.percentile(finite, 98))) if finite.size else (0, 1)
     image = None
     for column, k in enumerate(shown):
         ax = fig.add_subplot(grid[row, column])

@@ -1,0 +1,87 @@
+"""Cameras and sonars in a run of several robots (``[[robots]]``): each robot's own sensors,
+fired after the run over its logged states, see the other robots where their rollouts put
+them; a camera in the loop is refused for several robots, naming it."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from conftest import ROOT
+
+from uvms_pin.errors import ParameterError
+from uvms_pin.perception.camera import Camera
+from uvms_pin.perception.scene import scene_of
+from uvms_pin.scenario.load import load_scenario
+from uvms_pin.sim.robots_run import simulate_robots
+
+#: alpha's camera looks to its left, at bravo 3 m away (optical z along alpha's body y)
+CAMERA = """
+[[robots.sensors.camera]]
+name = "left"
+width = 64
+height = 48
+horizontal_fov_rad = 1.2
+rate_hz = 5.0
+rpy_rad = [-1.5708, 0.0, 0.0]
+noise_counts = 0.0
+"""
+
+
+def _scenario(tmp_path, camera: str = CAMERA, duration_s: float = 0.6):
+    text = (ROOT / "scenarios" / "two_robots.toml").read_text()
+    text = text.replace("../models/", f"{ROOT}/models/")
+    first_sensors = text.index("[robots.sensors]")
+    end = text.index("[robots.actuation]", first_sensors)  # alpha's: its sensors' table ends
+    text = text[:end] + camera + "\n" + text[end:]
+    path = tmp_path / "two.toml"
+    path.write_text(text)
+    return load_scenario(path, {"scenario.duration_s": duration_s})
+
+
+@pytest.fixture(scope="module")
+def run(tmp_path_factory):
+    scenario = _scenario(tmp_path_factory.mktemp("robots"))
+    return scenario, simulate_robots(scenario)
+
+
+def test_a_robots_camera_sees_the_other_robot_where_its_rollout_puts_it(run):
+    """alpha's images label bravo's links ``bravo.<link>``, and equal a camera rendering the
+    scene at each firing's row with bravo at its own logged configuration (moved: bravo
+    draws its circle); bravo, without sensors that see, has no images."""
+    scenario, rollouts = run
+    alpha, bravo = rollouts.robot("alpha"), rollouts.robot("bravo")
+    record = alpha.camera("left")
+    assert len(record.time_s) == 4  # 5 Hz over 0.6 s, t = 0 included
+    seen = {record.label_names[k - 1] for k in np.unique(record.label) if k > 0}
+    assert "bravo.base_link" in seen
+    assert not bravo.perception
+    assert np.ptp(bravo.q[:, 0]) + np.ptp(bravo.q[:, 7:]) > 1e-4  # bravo moves
+    robot = scenario.robots[0]
+    scene = scene_of(robot.uvms, robot.plant.world, surface=robot.plant.free_surface,
+                     others=[("bravo", scenario.robots[1].uvms)])  # fmt: skip
+    spec = scenario.robots[0].sensor_config.perception.sensors[0][1]
+    camera = Camera(spec, scene, np.random.default_rng(0))
+    for k, t in enumerate(record.time_s):
+        row = int(np.searchsorted(alpha.time_s, t))
+        scene.update(alpha.q[row], (), None, [bravo.q[row]])
+        np.testing.assert_array_equal(camera.render().label, record.label[k])
+    # bravo left at its neutral configuration instead: another image (the log is read)
+    scene.update(alpha.q[-1], (), None, [scenario.robots[1].uvms.neutral_configuration()])
+    assert not np.array_equal(camera.render().label, record.label[-1])
+
+
+def test_a_robots_images_are_drawn_from_its_own_seed(run, tmp_path):
+    """The same scenario run again gives the same images; alpha's noise stream is its own
+    (robot seed), so the camera with noise differs from a noiseless one."""
+    scenario, rollouts = run
+    again = simulate_robots(scenario).robot("alpha").camera("left")
+    np.testing.assert_array_equal(again.rgb, rollouts.robot("alpha").camera("left").rgb)
+    noisy = CAMERA.replace("noise_counts = 0.0", "noise_counts = 3.0")
+    seen = simulate_robots(_scenario(tmp_path, noisy, 0.2)).robot("alpha").camera("left")
+    assert not np.array_equal(seen.rgb[0], again.rgb[0])
+
+
+def test_a_camera_in_the_loop_is_refused_for_several_robots(tmp_path):
+    in_loop = CAMERA + "in_loop = true\n"
+    with pytest.raises(ParameterError, match=r"cameras in the loop \(left\).*several robots"):
+        simulate_robots(_scenario(tmp_path, in_loop, 0.1))
