@@ -115,11 +115,20 @@ class RobotRollouts:
     @classmethod
     def load(cls, directory: str | Path) -> RobotRollouts:
         """The rollouts `save` wrote in ``directory``."""
+        src = Path(directory)
+        names = cls.names_in(src)
+        if isinstance(names, Exception):
+            raise ParameterError(f"{src} holds no run of several robots ({names})") from names
+        return cls({name: Rollout.load(src / name) for name in names})
+
+    @staticmethod
+    def names_in(directory: Path) -> list[str] | Exception:
+        """The robots of the run of several `save` wrote in ``directory``, or why it holds
+        none (the error reading it)."""
         import json
 
-        src = Path(directory)
         try:
-            names = list(json.loads((src / ROBOTS_FILE).read_text(encoding="utf-8"))["robots"])
+            text = (Path(directory) / ROBOTS_FILE).read_text(encoding="utf-8")
+            return [str(name) for name in json.loads(text)["robots"]]
         except (OSError, ValueError, KeyError, TypeError) as exc:
-            raise ParameterError(f"{src} holds no run of several robots ({exc})") from exc
-        return cls({name: Rollout.load(src / name) for name in names})
+            return exc

@@ -55,6 +55,17 @@ def test_no_such_run_directory_is_refused(tmp_path):
     assert list(tmp_path.iterdir()) == []
 
 
+def test_a_run_of_several_robots_is_refused_naming_a_robots_directory(run_dir, tmp_path):
+    """A bag is one robot's: the directory of a run of several (its metrics.json lists the
+    robots, each in its own directory) is refused with the path of the first robot's."""
+    robots = tmp_path / "two"
+    robots.mkdir()
+    (robots / "metrics.json").write_text(json.dumps({"robots": ["alpha", "bravo"]}))
+    result = run_cli(["export", "two", "--mcap", "run.mcap"], tmp_path)
+    _refused(result, "several robots (alpha, bravo)", str(Path("two") / "alpha"))
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["two"]
+
+
 def test_an_unwritable_path_is_refused(run_dir, tmp_path):
     (tmp_path / "a_file").write_text("x")
     _refused(run_cli(["export", str(run_dir), "--mcap", "a_file/run.mcap"], tmp_path), "a_file")

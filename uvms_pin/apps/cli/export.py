@@ -14,8 +14,15 @@ def _cmd_export(args: argparse.Namespace) -> int:
         raise UvmsPinError("export: nothing to do, give --mcap FILE")
     from uvms_pin.apps.export.ros_bag import write_mcap
     from uvms_pin.results.outdir import claim_file
-    from uvms_pin.results.rollout import Rollout
+    from uvms_pin.results.robots import RobotRollouts
+    from uvms_pin.results.rollout import ARRAY_FILE, Rollout
 
+    robots = RobotRollouts.names_in(Path(args.run))
+    if not (Path(args.run) / ARRAY_FILE).is_file() and isinstance(robots, list):
+        raise UvmsPinError(
+            f"export: {args.run} holds a run of several robots ({', '.join(robots)}): a bag "
+            f"is one robot's, e.g. uvms-pin export {Path(args.run) / robots[0]} --mcap FILE"
+        )
     rollout = Rollout.load(args.run)
     path = Path(args.mcap)
     with claim_file(path, overwrite=args.overwrite, option="--mcap"):
