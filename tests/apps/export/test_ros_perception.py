@@ -130,6 +130,22 @@ def test_a_sensor_on_a_frame_the_model_has_not_is_refused_naming_it(saved, tmp_p
     assert list(tmp_path.iterdir()) == []
 
 
+@pytest.mark.parametrize(
+    ("sensor", "damage"),
+    [("wrist", lambda about: about["spec"].pop("width")),
+     ("wrist", lambda about: about["spec"].update(rpy_rad=[0.1, 0.2])),
+     ("profiler", lambda about: about["spec"].update(max_range_m="far"))],
+    ids=["no width", "two angles", "a word for a range"],
+)  # fmt: skip
+def test_a_damaged_sensor_record_is_refused_naming_the_sensor(saved, tmp_path, sensor, damage):
+    """A run's metadata edited by hand: the export's error names the sensor, no file."""
+    rollout = Rollout.load(saved)
+    damage(rollout.metadata["perception"][sensor])
+    with pytest.raises(VizError, match=f"sensor '{sensor}' is damaged"):
+        rollout.to_mcap(tmp_path / "run.mcap")
+    assert list(tmp_path.iterdir()) == []
+
+
 def test_no_return_is_sent_as_infinity_and_the_scan_spans_the_bearings():
     """REP 117: a beam that heard nothing reads +Inf (the rollout's NaN); the scan's angles
     are the beams' bearings, its limits the sonar's."""

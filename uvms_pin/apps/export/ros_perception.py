@@ -138,15 +138,37 @@ class PerceptionTopics:
         self._frames: dict[str, tuple[str, str, pin.SE3]] = {}  # (its frame, parent, pose)
         self._next = dict.fromkeys((name for name, _ in self.sensors), 0)
         for name, about in self.sensors:
-            spec = about["spec"]
-            suffix = "_optical_frame" if about["kind"] == "camera" else "_frame"
-            parent, mount = _mount(model, data, about["frame"])
-            in_link = pin.SE3(
-                pin.rpy.rpyToMatrix(np.asarray(spec["rpy_rad"], dtype=float)),
-                np.asarray(spec["position_m"], dtype=float),
-            )
-            self._frames[name] = (f"{name}{suffix}", parent, mount * in_link)
-            self.types.update(self._topic_types(name, about))
+            try:
+                self._add(name, about, model, data)
+            except (KeyError, TypeError, ValueError, IndexError) as exc:
+                raise VizError(
+                    f"the run's record of sensor '{name}' is damaged ({type(exc).__name__}: "
+                    f"{exc}): rerun the scenario"
+                ) from exc
+
+    def _add(self, name: str, about: dict[str, Any], model: pin.Model, data: pin.Data) -> None:
+        """A sensor's frame and topics, what its messages read checked here (a damaged
+        record fails before anything is written)."""
+        spec = about["spec"]
+        suffix = "_optical_frame" if about["kind"] == "camera" else "_frame"
+        parent, mount = _mount(model, data, about["frame"])
+        in_link = pin.SE3(
+            pin.rpy.rpyToMatrix(np.asarray(spec["rpy_rad"], dtype=float).reshape(3)),
+            np.asarray(spec["position_m"], dtype=float).reshape(3),
+        )
+        arrays = self.arrays[name]
+        if about["kind"] == "camera":
+            camera_info(0, "", spec)
+            shapes = {arrays[k].shape[:3] for k in ("rgb", "depth_m", "label")}
+            if len(shapes) != 1 or arrays["time_s"].shape[0] != next(iter(shapes))[0]:
+                raise ValueError("its images' shapes disagree")
+        else:
+            for key in ("rate_hz", "min_range_m", "max_range_m"):  # what a scan reads
+                float(spec[key])
+            if arrays["intensity"].shape[0] != arrays["time_s"].shape[0]:
+                raise ValueError("its images and times disagree")
+        self._frames[name] = (f"{name}{suffix}", parent, mount * in_link)
+        self.types.update(self._topic_types(name, about))
 
     @staticmethod
     def _topic_types(name: str, about: dict[str, Any]) -> dict[str, str]:
