@@ -38,6 +38,17 @@ def _scenario(tmp_path, camera: str = CAMERA, duration_s: float = 0.6):
     return load_scenario(path, {"scenario.duration_s": duration_s})
 
 
+def scene_of_alpha(scenario):
+    """alpha's scene: its world, and bravo (at its neutral configuration until posed)."""
+    robot = scenario.robots[0]
+    return scene_of(robot.uvms, robot.plant.world, surface=robot.plant.free_surface,
+                    others=[("bravo", scenario.robots[1].uvms)])  # fmt: skip
+
+
+def spec_of(scenario):
+    return scenario.robots[0].sensor_config.perception.sensors[0][1]
+
+
 @pytest.fixture(scope="module")
 def run(tmp_path_factory):
     scenario = _scenario(tmp_path_factory.mktemp("robots"))
@@ -54,13 +65,16 @@ def test_a_robots_camera_sees_the_other_robot_where_its_rollout_puts_it(run):
     assert len(record.time_s) == 4  # 5 Hz over 0.6 s, t = 0 included
     seen = {record.label_names[k - 1] for k in np.unique(record.label) if k > 0}
     assert "bravo.base_link" in seen
+    camera_of_run = Camera(spec_of(scenario), scene_of_alpha(scenario), np.random.default_rng(0))
+    bravo_label = camera_of_run.scene.names.index("bravo.base_link") + 1
+    own_label = camera_of_run.scene.names.index("base_link") + 1
+    np.testing.assert_array_equal(  # shaded as a robot, as alpha's own links
+        camera_of_run.reflectance[bravo_label], camera_of_run.reflectance[own_label]
+    )
     assert not bravo.perception
     assert np.ptp(bravo.q[:, 0]) + np.ptp(bravo.q[:, 7:]) > 1e-4  # bravo moves
-    robot = scenario.robots[0]
-    scene = scene_of(robot.uvms, robot.plant.world, surface=robot.plant.free_surface,
-                     others=[("bravo", scenario.robots[1].uvms)])  # fmt: skip
-    spec = scenario.robots[0].sensor_config.perception.sensors[0][1]
-    camera = Camera(spec, scene, np.random.default_rng(0))
+    scene = scene_of_alpha(scenario)
+    camera = Camera(spec_of(scenario), scene, np.random.default_rng(0))
     for k, t in enumerate(record.time_s):
         row = int(np.searchsorted(alpha.time_s, t))
         scene.update(alpha.q[row], (), None, [bravo.q[row]])

@@ -225,7 +225,7 @@ class Camera(sensor.Mounted):
         self._tiled = tiled_rays(spec, self.order)
         self._bundles = Bundles.of(self._tiled, starts)
         self.optics = spec.optics
-        robot = set(scene.robot_names)
+        robot = {*scene.robot_names, *scene.other_robot_names}
         given = dict(spec.reflectance)
         for name in robot:
             given.setdefault(name, ROBOT)

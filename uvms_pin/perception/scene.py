@@ -1,6 +1,6 @@
 """The world as the sensors see it: one `RayCaster` of the fixed objects, the free objects,
-the fixtures, the robot's own links and the free surface, posed from the system's state when a sensor
-fires (`Scene.update`), never rebuilt.
+the fixtures, the robot's own links (and the other robots') and the free surface, posed from
+the system's state when a sensor fires (`Scene.update`), never rebuilt.
 
 - fixed objects (`uvms_pin.physics.world.objects.WorldObject`): a plane as the analytic plane
   seen from its outward side; a box, sphere, cylinder and ellipsoid as themselves; a mesh as
@@ -125,7 +125,7 @@ class Scene:
         add_objects(self.caster, objects)
         if surface:
             self.caster.add(SURFACE, Plane(), _FACING_DOWN, np.zeros(3))
-        names = [uvms.hydro_bodies[int(k)].name for k in uvms.surface_bodies.body_index]
+        names = _link_names(uvms)
         #: the robot's links' names; the planes facing up (the seafloor)
         self.robot_names = tuple(names)
         self.floor_names = {o.name for o in objects if o.is_plane and o.normal_world[2] > 0.1}
@@ -145,12 +145,15 @@ class Scene:
         for (model, data, pieces), f in zip(self._fixtures, fixtures, strict=True):
             self._place(model, data, pieces, f.q0)
         self._others = []
+        #: the other robots' links' label names (a camera shades them as robots)
+        self.other_robot_names: tuple[str, ...] = ()
         for name, other in others:
-            links = [other.hydro_bodies[int(k)].name for k in other.surface_bodies.body_index]
+            links = _link_names(other)
             labels = [f"{name}.{link}" for link in links]
             placed = self._add_pieces(robot_pieces(other, links), labels)
             self._others.append((other.model, other.model.createData(), placed))
             self._place(*self._others[-1], other.neutral_configuration())
+            self.other_robot_names += tuple(labels)
 
     def _add_pieces(
         self, pieces: Sequence[RobotPiece], names: Sequence[str]
@@ -202,6 +205,11 @@ class Scene:
         """A frame of the robot's model in the world, after `update`."""
         pin.updateFramePlacement(self.uvms.model, self.data, frame_id)
         return self.data.oMf[frame_id]
+
+
+def _link_names(uvms: UVMS) -> list[str]:
+    """The robot's links the sensors see: those with collision pieces (its surface bodies)."""
+    return [uvms.hydro_bodies[int(k)].name for k in uvms.surface_bodies.body_index]
 
 
 def scene_of(
