@@ -7,7 +7,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from uvms_pin.apps.export.ros_perception import camera_info, laser_scan
+from uvms_pin.apps.export.ros_perception import camera_info, laser_scan, ros_name
 from uvms_pin.errors import VizError
 from uvms_pin.results.rollout import Rollout
 from uvms_pin.scenario.load import load_scenario
@@ -144,6 +144,14 @@ def test_a_damaged_sensor_record_is_refused_naming_the_sensor(saved, tmp_path, s
     with pytest.raises(VizError, match=f"sensor '{sensor}' is damaged"):
         rollout.to_mcap(tmp_path / "run.mcap")
     assert list(tmp_path.iterdir()) == []
+
+
+def test_a_sensor_name_becomes_a_ros_name():
+    """ROS names are letters, digits and underscores, not starting with a digit."""
+    assert ros_name("front") == "front"
+    assert ros_name("front cam-2") == "front_cam_2"
+    assert ros_name("2nd") == "_2nd"
+    assert ros_name("caméra") == "cam_ra"
 
 
 def test_no_return_is_sent_as_infinity_and_the_scan_spans_the_bearings():

@@ -2,7 +2,7 @@
 (`uvms_pin.apps.export.ros_bag`; docs/ros.md lists them).
 
 Each sensor's frame is a TF frame fixed to the link it is mounted on (``/tf_static``): a
-camera's ``<name>_optical_frame`` (z along the optical axis, x right, y down, as ROS
+camera's ``<name>_optical_frame`` (``<name>`` its name as a ROS name, `ros_name`) (z along the optical axis, x right, y down, as ROS
 cameras), a sonar's ``<name>_frame`` (x along the acoustic axis). At each firing:
 
 - a camera: ``/<name>/image_raw`` (``sensor_msgs/Image``, rgb8), ``/<name>/camera_info``
@@ -21,6 +21,7 @@ before its metadata kept the sensors' specs has none of these topics.
 from __future__ import annotations
 
 import math
+import re
 from collections.abc import Iterator
 from typing import Any
 
@@ -30,7 +31,7 @@ import pinocchio as pin
 from uvms_pin.apps.export.ros_messages import header, stamp_ns, transform
 from uvms_pin.errors import VizError
 
-__all__ = ["PerceptionTopics"]
+__all__ = ["PerceptionTopics", "camera_info", "laser_scan", "ros_name"]
 
 # (topic, message, time [ns])
 Message = tuple[str, dict, int]
@@ -95,6 +96,13 @@ def laser_scan(
         "ranges": ranges.tolist(),
         "intensities": np.asarray(intensity, dtype=np.float32).tolist(),
     }
+
+
+def ros_name(name: str) -> str:
+    """A sensor's name as a ROS name's token: letters, digits and underscores (anything else
+    an underscore), not starting with a digit."""
+    token = re.sub(r"\W", "_", name, flags=re.ASCII)
+    return token if token[:1].isalpha() or token[:1] == "_" else f"_{token}"
 
 
 def _mount(model: pin.Model, data: pin.Data, frame_name: str) -> tuple[str, pin.SE3]:
@@ -167,17 +175,18 @@ class PerceptionTopics:
                 float(spec[key])
             if arrays["intensity"].shape[0] != arrays["time_s"].shape[0]:
                 raise ValueError("its images and times disagree")
-        self._frames[name] = (f"{name}{suffix}", parent, mount * in_link)
-        self.types.update(self._topic_types(name, about))
+        self._frames[name] = (f"{ros_name(name)}{suffix}", parent, mount * in_link)
+        self.types.update(self._topic_types(name, about["kind"], arrays))
 
     @staticmethod
-    def _topic_types(name: str, about: dict[str, Any]) -> dict[str, str]:
-        if about["kind"] == "camera":
+    def _topic_types(name: str, kind: str, arrays: dict) -> dict[str, str]:
+        base = f"/{ros_name(name)}"
+        if kind == "camera":
             topics = ("image_raw", "depth/image", "labels")
-            return {f"/{name}/{t}": _IMAGE for t in topics} | {f"/{name}/camera_info": _INFO}
-        out = {f"/{name}/image": _IMAGE}
-        if about["spec"].get("type") == "multibeam":
-            out[f"/{name}/scan"] = _SCAN
+            return {f"{base}/{t}": _IMAGE for t in topics} | {f"{base}/camera_info": _INFO}
+        out = {f"{base}/image": _IMAGE}
+        if "beam_range_m" in arrays:  # a multibeam's detections
+            out[f"{base}/scan"] = _SCAN
         return out
 
     def static_transforms(self, time_ns: int) -> list[dict]:
@@ -201,6 +210,7 @@ class PerceptionTopics:
 
     def _fired(self, name: str, about: dict, arrays: dict, k: int, time_ns: int):
         frame = self._frames[name][0]
+        name = ros_name(name)  # its topics
         if about["kind"] == "camera":
             depth = arrays["depth_m"][k]
             depth = np.where(np.isnan(depth), np.float32(np.inf), depth).astype("<f4")
