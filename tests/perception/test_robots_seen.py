@@ -99,3 +99,9 @@ def test_a_camera_in_the_loop_is_refused_for_several_robots(tmp_path):
     in_loop = CAMERA + "in_loop = true\n"
     with pytest.raises(ParameterError, match=r"cameras in the loop \(left\).*several robots"):
         simulate_robots(_scenario(tmp_path, in_loop, 0.1))
+
+
+def test_a_robots_camera_on_a_link_its_model_lacks_is_refused_naming_the_robot(tmp_path):
+    on_nothing = CAMERA + 'link = "no_link"\n'
+    with pytest.raises(ParameterError, match=r"robot 'alpha': camera 'left': link 'no_link'"):
+        simulate_robots(_scenario(tmp_path, on_nothing, 0.1))

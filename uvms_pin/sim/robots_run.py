@@ -140,7 +140,12 @@ def _simulate_robots(
                 exc.rollout = RobotRollouts({scenario.names[0]: exc.rollout})
             raise
         return RobotRollouts({scenario.names[0]: rollout})
-    parts = [_parts(r, g) for r, g in zip(robots, given, strict=True)]
+    parts = []
+    for name, robot, controller in zip(scenario.names, robots, given, strict=True):
+        try:
+            parts.append(_parts(robot, controller))
+        except ParameterError as exc:  # which robot's sensors or controller
+            raise ParameterError(f"robot '{name}': {exc}") from exc
     loop = RobotsLoop(
         [r.plant for r in robots], scenario.names, scenario.settings, [p[0] for p in parts]
     )
