@@ -3,6 +3,7 @@ drawn from the rollout's own images."""
 
 from __future__ import annotations
 
+import copy
 import dataclasses
 
 import numpy as np
@@ -20,6 +21,7 @@ from uvms_pin.results.figures.perception import (
     plot_perception,
     snapshot_rows,
 )
+from uvms_pin.results.status import RunStatus
 from uvms_pin.scenario.load import load_scenario
 from uvms_pin.sim.run import simulate
 
@@ -100,3 +102,17 @@ def test_a_run_without_cameras_or_sonars_has_no_perception_figure(tmp_path):
         progress=False,
     )
     assert PERCEPTION_FIGURE not in {p.name for p in write_figures(plain, tmp_path)}
+
+
+def test_a_stopped_runs_figure_says_where_it_stopped(survey):
+    """The stop's reason under the title, a dashed line at its time on the bands drawn
+    over time (the swath, the echogram), none on the images."""
+    stopped = copy.copy(survey)
+    stopped.metadata = dict(survey.metadata)
+    stopped.set_status(RunStatus("SimulationError", "a test's stop", time_s=0.45))
+    fig = plot_perception(stopped)
+    assert "SimulationError: a test's stop" in fig._suptitle.get_text()
+    for ax in fig.axes:
+        stops = [line for line in ax.get_lines() if np.all(np.asarray(line.get_xdata()) == 0.45)]
+        over_time = ax.get_xlabel() == "time [s]"
+        assert bool(stops) == over_time, ax.get_title()

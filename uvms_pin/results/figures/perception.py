@@ -17,7 +17,7 @@ from pathlib import Path
 import numpy as np
 from matplotlib.figure import Figure
 
-from uvms_pin.results.figures.standard import save_figure
+from uvms_pin.results.figures.standard import mark_stop, save_figure
 from uvms_pin.results.perception import camera_record, sonar_record
 from uvms_pin.results.rollout_data import RolloutData
 
@@ -69,14 +69,16 @@ def plot_perception(rollout: RolloutData, path: Path | None = None) -> Figure | 
     rows = sum(r for _, _, r in bands)
     fig = Figure(figsize=(3.2 * SNAPSHOTS + 1.2, 2.7 * rows + 0.6))
     grid = fig.add_gridspec(rows, SNAPSHOTS + 1, width_ratios=[1.0] * SNAPSHOTS + [0.06])
-    row = 0
+    row, over_time = 0, []  # the axes with time along x (a stopped run's stop drawn there)
     for name, kind, height in bands:
         if kind == "camera":
             _camera(fig, grid, row, rollout, name)
         else:
-            _sonar(fig, grid, row, rollout, name)
+            over_time += _sonar(fig, grid, row, rollout, name)
         row += height
-    fig.suptitle(f"{rollout.metadata.get('scenario', '')}: cameras and sonars")
+    mark_stop(
+        fig, over_time, rollout, f"{rollout.metadata.get('scenario', '')}: cameras and sonars"
+    )
     return save_figure(fig, path)
 
 
@@ -101,7 +103,8 @@ def _camera(fig: Figure, grid, row: int, rollout: RolloutData, name: str) -> Non
     fig.colorbar(image, cax=fig.add_subplot(grid[row + 1, SNAPSHOTS]), label="z-depth [m]")
 
 
-def _sonar(fig: Figure, grid, row: int, rollout: RolloutData, name: str) -> None:
+def _sonar(fig: Figure, grid, row: int, rollout: RolloutData, name: str) -> list:
+    """The sonar's band; the axes drawn with time along x (none for an imaging sonar)."""
     record = sonar_record(rollout.perception, rollout.metadata, name)
     period_s = 1.0 / float(rollout.metadata["perception"][name]["rate_hz"])
     times = edges(record.time_s, period_s)
@@ -115,7 +118,7 @@ def _sonar(fig: Figure, grid, row: int, rollout: RolloutData, name: str) -> None
                           interpolation="nearest")  # fmt: skip
         ax.set(xlabel="time [s]", ylabel="bearing [deg]", title=f"multibeam '{name}': detections")
         fig.colorbar(image, cax=fig.add_subplot(grid[row, SNAPSHOTS]), label="range [m]")
-        return
+        return [ax]
     db, low, high = decibels(record.intensity)
     if record.intensity.shape[2] == 1:  # an altimeter: its echogram
         ax = fig.add_subplot(grid[row, :SNAPSHOTS])
@@ -124,7 +127,7 @@ def _sonar(fig: Figure, grid, row: int, rollout: RolloutData, name: str) -> None
                           vmin=low, vmax=high, cmap="copper", interpolation="nearest")  # fmt: skip
         ax.set(xlabel="time [s]", ylabel="range [m]", title=f"altimeter '{name}': echogram")
         fig.colorbar(image, cax=fig.add_subplot(grid[row, SNAPSHOTS]), label="echo [dB]")
-        return
+        return [ax]
     # port (positive bearing) on the left, as a sonar display shows it
     extent = [bearings[1], bearings[0], *ranges]
     for column, k in enumerate(snapshot_rows(len(record.time_s))):
@@ -134,6 +137,7 @@ def _sonar(fig: Figure, grid, row: int, rollout: RolloutData, name: str) -> None
         ax.set(xlabel="bearing [deg] (port +)", ylabel="range [m]" if column == 0 else None)
         ax.set_title(f"sonar '{name}', t = {record.time_s[k]:.2f} s", fontsize=8)
     fig.colorbar(image, cax=fig.add_subplot(grid[row, SNAPSHOTS]), label="echo [dB]")
+    return []
 
 
 def perception_figures(rollout: RolloutData, directory: Path) -> list[Path]:
