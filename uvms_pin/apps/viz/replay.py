@@ -23,7 +23,7 @@ import meshcat.geometry as mg
 import numpy as np
 import pinocchio as pin
 
-from uvms_pin.apps.viz.camera_panel import CAMERA_SCRIPT, camera_panel
+from uvms_pin.apps.viz.camera_panel import PANELS_SCRIPT, image_panels
 from uvms_pin.apps.viz.meshcat_scene import (
     ROOT,
     EnvironmentView,
@@ -204,7 +204,7 @@ def replay_html(
         "frames": len(idx),
         "legend": legend,
     }
-    return _page(window.commands, info, camera_panel(rollout, t0))
+    return _page(window.commands, info, image_panels(rollout, t0))
 
 
 def _fixture_rows(rollout: Rollout, scene: UvmsScene, good: np.ndarray) -> dict[str, np.ndarray]:
@@ -301,7 +301,9 @@ body { margin: 0; background: #04162e; font: 13px/1.35 sans-serif; }
 #uvms-bar button { width: 72px; }
 #uvms-slider { flex: 1; }
 #uvms-time { font-family: monospace; min-width: 150px; text-align: right; }
-#uvms-camera { position: absolute; right: 8px; top: 8px; max-width: 32vw; border: 1px solid #e8f2ff; }
+#uvms-panels { position: absolute; right: 8px; top: 30px; max-width: 32vw; display: flex;
+  flex-direction: column; gap: 6px; }
+#uvms-panels img { max-width: 32vw; max-height: 42vh; border: 1px solid #e8f2ff; }
 """
 
 _SCRIPT = """
@@ -326,7 +328,7 @@ function currentTime() {
 function refresh() {
   const t = currentTime();
   if (document.activeElement !== slider) slider.value = t;
-  showCamera(t);
+  showPanels(t);
   label.textContent = "t = " + (UVMS_INFO.t0 + t).toFixed(2) + " / "
     + (UVMS_INFO.t0 + UVMS_INFO.duration).toFixed(2) + " s";
   button.textContent = animator.playing ? "pause" : "play";
@@ -351,13 +353,14 @@ seekFromHash();
 """
 
 
-def _page(commands: list[bytes], info: dict[str, Any], camera: dict | None = None) -> str:
+def _page(commands: list[bytes], info: dict[str, Any], panels: list[dict] = ()) -> str:
     encoded = ",\n".join(f'"{base64.b64encode(c).decode("ascii")}"' for c in commands)
     bundle = _viewer_bundle().replace("</script", "<\\/script")
     esc = html.escape
     info_json = json.dumps(info).replace("</", "<\\/")
-    camera_json = json.dumps(camera).replace("</", "<\\/")
-    image = "" if camera is None else f'<img id="uvms-camera" alt="camera {esc(camera["name"])}">'
+    panels_json = json.dumps(list(panels)).replace("</", "<\\/")
+    images = "".join(f'<img id="{p["id"]}" alt="{esc(p["label"])}">' for p in panels)
+    image = f'<div id="uvms-panels">{images}</div>' if panels else ""
     description = f"<br>{esc(info['description'])}" if info["description"] else ""
     frames = ""
     if info["duration"] > 0:
@@ -385,8 +388,8 @@ def _page(commands: list[bytes], info: dict[str, Any], camera: dict | None = Non
 </script>
 <script>
 const UVMS_INFO = {info_json};
-const UVMS_CAMERA = {camera_json};
-{CAMERA_SCRIPT}
+const UVMS_PANELS = {panels_json};
+{PANELS_SCRIPT}
 const UVMS_COMMANDS = [
 {encoded}
 ];
