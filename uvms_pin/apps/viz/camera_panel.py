@@ -64,7 +64,7 @@ def sonar_rgb(intensity: np.ndarray, low_db: float, high_db: float) -> np.ndarra
     beam, the largest bearing) on the left."""
     from matplotlib import colormaps
 
-    db = 10.0 * np.log10(np.maximum(intensity, 1e-30))
+    db = decibels(intensity)[0]
     level = np.clip((db - low_db) / max(high_db - low_db, 1e-12), 0.0, 1.0)
     rgb = colormaps["copper"](level[::-1, ::-1])[..., :3]
     return np.round(255.0 * rgb).astype(np.uint8)
