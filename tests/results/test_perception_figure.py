@@ -26,7 +26,8 @@ from uvms_pin.scenario.load import load_scenario
 from uvms_pin.sim.run import simulate
 
 ALTIMETER = {"name": "alt", "type": "altimeter", "beams": 1, "bins": 24, "rate_hz": 10.0,
-             "horizontal_fov_rad": 0.1, "max_range_m": 12.0, "rpy_rad": [0.0, 1.5708, 0.0]}  # fmt: skip
+             "horizontal_fov_rad": 0.1, "max_range_m": 12.0,
+             "rpy_rad": [0.0, 1.5708, 0.0]}  # fmt: skip
 
 
 @pytest.fixture(scope="module")

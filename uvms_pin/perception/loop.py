@@ -2,9 +2,10 @@
 
 A camera with ``in_loop = true`` also fires during the run, at the first control tick at or
 after each of its instants k / rate_hz, from the system's true state at that tick (the robot,
-every free object and every fixture). Its latest image is in the measurement the controller is given,
-``measurement.images[name]`` (`LoopImage`), until the next one. Its noise comes from its own
-stream of the run's seed (`LOOP_SEED_INDEX`), apart from the images fired over the log.
+every free object and every fixture). Its latest image is in the measurement the controller
+is given, ``measurement.images[name]`` (`LoopImage`), until the next one. Its noise comes
+from its own stream of the run's seed (`LOOP_SEED_INDEX`), apart from the images fired over
+the log.
 """
 
 from __future__ import annotations

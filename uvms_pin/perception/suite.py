@@ -3,10 +3,11 @@ beside the rollout (`uvms_pin.results.perception`).
 
 A sensor of ``rate_hz`` fires at the first logged sample at or after each of its instants
 k / rate_hz (k = 0, 1, ...): at its rate when the log period divides its period, else at the
-log's grid nearest after. Firing reads the logged state (the robot's q, each free
-object's pose and each fixture's joint positions): the loop itself is untouched, so a run with sensors gives the same rollout
-as without them, whatever path (compiled or Python) ran it. Each sensor draws its noise from
-its own stream of the run's seed (`PERCEPTION_SEED_INDEX`), in the order of the scenario.
+log's grid nearest after. Firing reads the logged state (the robot's q, each free object's
+pose and each fixture's joint positions): the loop itself is untouched, so a run with
+sensors gives the same rollout as without them, whatever path (compiled or Python) ran it.
+Each sensor draws its noise from its own stream of the run's seed (`PERCEPTION_SEED_INDEX`),
+in the order of the scenario.
 """
 
 from __future__ import annotations

@@ -92,8 +92,9 @@ def saved(tmp_path_factory):
 
 def test_a_camera_on_a_moving_link_and_sonars_export_as_their_images(saved, tmp_path):
     """Every image bit for bit, each sensor's frame composed along the TF tree where its
-    mount (a link, or a frame fixed to one) and pose put it at every sample, the camera's intrinsics projecting each pixel's
-    ray on that pixel; the cases are posed (the arm moves, a beam hears nothing)."""
+    mount (a link, or a frame fixed to one) and pose put it at every sample, the camera's
+    intrinsics projecting each pixel's ray on that pixel; the cases are posed (the arm
+    moves, a beam hears nothing)."""
     rollout = Rollout.load(saved)
     assert np.ptp(rollout.q[:, 7], axis=0) > 1e-3  # the camera's link turns in the run
     beams = rollout.perception["profiler"]["beam_range_m"]

@@ -2,8 +2,9 @@
 (`uvms_pin.apps.export.ros_bag`; docs/ros.md lists them).
 
 Each sensor's frame is a TF frame fixed to the link it is mounted on (``/tf_static``): a
-camera's ``<name>_optical_frame`` (``<name>`` its name as a ROS name, `ros_name`) (z along the optical axis, x right, y down, as ROS
-cameras), a sonar's ``<name>_frame`` (x along the acoustic axis). At each firing:
+camera's ``<name>_optical_frame`` (z along the optical axis, x right, y down, as ROS
+cameras), a sonar's ``<name>_frame`` (x along the acoustic axis); ``<name>`` is the sensor's
+name made a ROS name (`ros_name`). At each firing:
 
 - a camera: ``/<name>/image_raw`` (``sensor_msgs/Image``, rgb8), ``/<name>/camera_info``
   (``sensor_msgs/CameraInfo``: the ideal pinhole the images are, no distortion),
