@@ -1,6 +1,6 @@
 """Cameras and sonars in a run of several robots (``[[robots]]``): each robot's own sensors,
 fired after the run over its logged states, see the other robots where their rollouts put
-them; a camera in the loop is refused for several robots, naming it."""
+them; a camera in the loop sees them where they are at its tick."""
 
 from __future__ import annotations
 
@@ -8,6 +8,7 @@ import numpy as np
 import pytest
 from conftest import ROOT
 
+from uvms_pin.control.base import Controller
 from uvms_pin.errors import ParameterError
 from uvms_pin.perception.camera import Camera
 from uvms_pin.perception.scene import scene_of
@@ -95,10 +96,48 @@ def test_a_robots_images_are_drawn_from_its_own_seed(run, tmp_path):
     assert not np.array_equal(seen.rgb[0], again.rgb[0])
 
 
-def test_a_camera_in_the_loop_is_refused_for_several_robots(tmp_path):
-    in_loop = CAMERA + "in_loop = true\n"
-    with pytest.raises(ParameterError, match=r"cameras in the loop \(left\).*several robots"):
-        simulate_robots(_scenario(tmp_path, in_loop, 0.1))
+class Watching(Controller):
+    """A robot's own controller, keeping the images of its cameras in the loop it is given."""
+
+    def __init__(self, inner: Controller):
+        self.inner, self.seen = inner, []
+
+    def compute(self, time_s, measurement):
+        image = measurement.images.get("left")
+        if image is not None and (not self.seen or self.seen[-1][0] != image.time_s):
+            self.seen.append((image.time_s, image.label.copy()))
+        return self.inner.compute(time_s, measurement)
+
+    def reset(self) -> None:
+        self.inner.reset()
+        self.seen = []
+
+    def signals(self):
+        return self.inner.signals()
+
+
+def test_a_camera_in_the_loop_sees_the_other_robot_as_it_moves(tmp_path):
+    """alpha's controller is given images of bravo where bravo is at that tick: each equals
+    a rendering of the scene with both robots at that tick's logged state (the ticks at
+    the log's samples), and bravo's controller, without cameras, is given none."""
+    scenario = _scenario(tmp_path, CAMERA + "in_loop = true\n", 0.6)
+    watchers = [Watching(robot.controller_factory(robot.uvms)) for robot in scenario.robots]
+    rollouts = simulate_robots(scenario, controllers=watchers)
+    alpha, bravo = rollouts.robot("alpha"), rollouts.robot("bravo")
+    seen = watchers[0].seen
+    assert [t for t, _ in seen] == pytest.approx([0.0, 0.2, 0.4, 0.6])
+    assert watchers[1].seen == []
+    scene = scene_of_alpha(scenario)
+    camera = Camera(spec_of(scenario), scene, np.random.default_rng(0))
+    bravo_label = scene.names.index("bravo.base_link") + 1
+    for t, label in seen:
+        row = int(np.argmin(np.abs(alpha.time_s - t)))
+        assert alpha.time_s[row] == pytest.approx(t)
+        scene.update(alpha.q[row], (), None, [bravo.q[row]])
+        np.testing.assert_array_equal(camera.render().label, label)
+        assert (label == bravo_label).any()
+    # the images fired over the log after the run are the same scene's
+    np.testing.assert_array_equal(alpha.camera("left").label[-1], seen[-1][1])
 
 
 def test_a_robots_camera_on_a_link_its_model_lacks_is_refused_naming_the_robot(tmp_path):

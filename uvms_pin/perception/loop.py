@@ -59,10 +59,11 @@ class LoopCameras:
         q: np.ndarray,
         object_poses: Sequence[np.ndarray],
         fixture_positions: Sequence[np.ndarray] | None = None,
+        other_robots: Sequence[np.ndarray] | None = None,
     ) -> None:
         """At the control tick ``time_s``: the cameras whose instant has come fire, from the
-        robot's ``q``, the free objects' poses (7,) each and the fixtures' joint positions
-        (None: where they are)."""
+        robot's ``q``, the free objects' poses (7,) each, the fixtures' joint positions and
+        the other robots' configurations (None: where they are)."""
         due = [
             k
             for k, camera in enumerate(self.cameras)
@@ -70,7 +71,7 @@ class LoopCameras:
         ]
         if not due:
             return
-        self.scene.update(q, object_poses, fixture_positions)
+        self.scene.update(q, object_poses, fixture_positions, other_robots)
         names = tuple(self.scene.names)
         for k in due:
             camera = self.cameras[k]

@@ -68,6 +68,7 @@ class RobotsLoop:
         self.system = Robots([loop.system for loop in self.loops], names)
         self.time_s = 0.0
         self.state: SystemState | None = None
+        self._seeing: list[int] = []  # the robots whose cameras fire in the loop
 
     def start(self, starts: Sequence[tuple[np.ndarray, np.ndarray]], sensors) -> None:
         """t = 0: every robot's loop started at its (q0, v0) with its ``sensors``, then
@@ -77,6 +78,16 @@ class RobotsLoop:
         self.time_s = 0.0
         self.state = self.system.layout.join([loop.state for loop in self.loops])
         self.system.start(self.state)
+        # the robots whose cameras fire in the loop see the run's world and the others
+        self._seeing = [k for k, loop in enumerate(self.loops) if loop.sensors.seeing is not None]
+        names = self.system.names
+        for k in self._seeing:
+            loop = self.loops[k]
+            others = [(names[j], other.plant.uvms) for j, other in enumerate(self.loops) if j != k]
+            loop.sensors.start_seeing(
+                loop.plant, loop.system.layout, self.settings.control_period_s,
+                world=self.loops[0].plant.world, others=others,
+            )  # fmt: skip
 
     def tick(self, logged: bool) -> list[np.ndarray]:
         """Each robot measures, commands and actuates on its own, then (if ``logged``)
@@ -84,6 +95,7 @@ class RobotsLoop:
         `Robots.contact_signals`): a controller that raises leaves no robot's sample of the
         tick. The applied inputs."""
         ticked = []
+        self._set_scene_views()
         for loop, held in zip(self.loops, self._held_wrenches(), strict=True):
             measurement, contact = loop.observe(held)
             tau = loop.command(measurement)
@@ -94,6 +106,23 @@ class RobotsLoop:
                 sample = loop.sample(*made)
                 loop.notify(replace(sample, signals={**sample.signals, **own}))
         return [made[3] for made in ticked]
+
+    def _set_scene_views(self) -> None:
+        """For each robot whose cameras fire in the loop: the free objects' poses and the
+        fixtures' positions (the first robot's system holds them) and the other robots' q,
+        as they stand (`SensorSuite.scene_view`)."""
+        if not self._seeing:
+            return
+        first = self.loops[0]
+        _, *bodies = first.system.layout.split(first.state.q, first.state.v)
+        world = first.plant.world
+        free = 0 if world is None else len(world.free)
+        objects = [q for q, _ in bodies[:free]]
+        fixtures = [q for q, _ in bodies[free:]]
+        robots = [loop.system.layout.split(loop.state.q, loop.state.v)[0][0] for loop in self.loops]
+        for k in self._seeing:
+            others = [q for j, q in enumerate(robots) if j != k]
+            self.loops[k].sensors.scene_view = (objects, fixtures, others)
 
     def _held_wrenches(self) -> list[np.ndarray | None]:
         """What each robot's force/torque sensor measures of the free objects it holds

@@ -180,14 +180,9 @@ def _simulate_robots(
 
 def _parts(robot: Scenario, given) -> tuple[Any, SensorSuite, dict[str, Any]]:
     """(the robot's controller, its seeded sensors, its rollout's metadata): a single
-    robot's (`run_parts`); its cameras fire after the run (`_perceive_robots`), none in the
-    loop."""
-    if robot.sensor_config.perception.in_loop:
-        names = ", ".join(spec.name for spec in robot.sensor_config.perception.in_loop)
-        raise ParameterError(
-            f"cameras in the loop ({names}) are not simulated with several robots: their "
-            "images are made after the run (set in_loop = false)"
-        )
+    robot's (`run_parts`); its cameras and sonars fire after the run too
+    (`_perceive_robots`), its cameras in the loop see the other robots
+    (`uvms_pin.sim.robots_loop`)."""
     return run_parts(robot, given)
 
 

@@ -200,6 +200,8 @@ class SensorSuite:
         self._estimator_started = False
         self.seed = seed
         self.seeing: LoopCameras | None = None  # the cameras in the loop, once started
+        #: several robots: what the loop's scene holds beyond this robot, each tick
+        self.scene_view: tuple | None = None
         self._layout = None
         self._free = 0  # the free objects among the bodies the cameras see
         self._state_noisy = any(
@@ -219,30 +221,40 @@ class SensorSuite:
             self.navigation.start(period_s)
         self._estimator_started = False
 
-    def start_seeing(self, plant, layout, period_s: float | None) -> None:
+    def start_seeing(self, plant, layout, period_s: float | None, *, world=None, others=()) -> None:
         """A run starts: the cameras in the loop (`uvms_pin.perception.loop`) see the
         plant's world afresh, the system's state split by ``layout``; they fire at control
-        ticks (ParameterError without a control period ``period_s``)."""
+        ticks (ParameterError without a control period ``period_s``). In a run of several
+        robots: ``world`` the run's (the first robot's, with the free objects), ``others``
+        the other robots, (name, UVMS) each, posed by `scene_view` each tick."""
         cameras = self.config.perception.in_loop
-        self.seeing = None
+        self.seeing, self.scene_view = None, None
         if not cameras:
             return
         if period_s is None:
             raise ParameterError(
                 "cameras in the loop fire at the control ticks: set [control] period_s"
             )
-        scene = scene_of(plant.uvms, plant.world, surface=plant.free_surface, backend=plant.backend)
+        world = plant.world if world is None else world
+        scene = scene_of(
+            plant.uvms, world, surface=plant.free_surface, backend=plant.backend, others=others
+        )
         self.seeing, self._layout = LoopCameras(cameras, scene, self.seed), layout
-        self._free = 0 if plant.world is None else len(plant.world.free)  # fixtures follow
+        self._free = 0 if world is None else len(world.free)  # fixtures follow
 
     def see(self, time_s: float, state, measurement: Measurement) -> Measurement:
         """Once per control tick: the cameras in the loop whose instant has come fire from
-        the system's true ``state``; ``measurement`` with their latest images."""
+        the system's true ``state``; ``measurement`` with their latest images. In a run of
+        several robots the world's bodies and the other robots are ``scene_view``'s
+        (free objects' poses, fixtures' positions, other robots' q), set by its loop."""
         if self.seeing is None:
             return measurement
         robot, *objects = self._layout.split(state.q, state.v)
-        free, fixtures = objects[: self._free], objects[self._free :]
-        self.seeing.update(time_s, robot[0], [q for q, _ in free], [q for q, _ in fixtures])
+        if self.scene_view is not None:
+            self.seeing.update(time_s, robot[0], *self.scene_view)
+        else:
+            free, fixtures = objects[: self._free], objects[self._free :]
+            self.seeing.update(time_s, robot[0], [q for q, _ in free], [q for q, _ in fixtures])
         return dataclasses.replace(measurement, images=self.seeing.images)
 
     def navigate(
