@@ -8,6 +8,7 @@ them (the `uvms-pin run` command line, `gymnasium.make`), each classified.
 Every scenario in scenarios/*.toml at its defaults and with the variants tried first (a
 larger step, rigid moving contacts, another duration, a changed or added object, another
 gripper force, another shipped model, the navigation sensors and the estimator switched on,
+the sensors that see (a camera in the loop, an imaging sonar, a multibeam),
 no controller), each a short run (``--duration`` simulated seconds); every Gymnasium
 environment under uniform random actions, several seeds. Each outcome is one of
 
@@ -154,6 +155,8 @@ def _scenario_cases(path: Path) -> list[tuple[str, list[str], bool]]:
     if "robots" in doc:
         for model in ("bluerov2_heavy", "uvms_lbv150", "uvms_bluerov2_alpha5_jaws"):
             cases.append((f"robot0 model {model}", _sets(**{"robots[0]__model": model}), False))
+        seeing = {"robots[0]__sensors__camera": [EYE], "robots[1]__sensors__sonar": SONARS}
+        cases.append(("robots see", _sets(**seeing), False))
         return cases
     passive = _sets(controller={"type": "none"})
     cases.append(("no controller", passive, _still(doc)))
@@ -212,6 +215,16 @@ def _free_object_cases(doc: dict) -> list[tuple[str, list[str], bool]]:
     return cases
 
 
+#: the sensors that see of the "sees" cases: a camera in the loop, an imaging sonar and a
+#: multibeam looking down, small and slow (what they cost is not the question)
+EYE = {"name": "eye", "width": 32, "height": 24, "rate_hz": 5.0, "in_loop": True}
+SONARS = [
+    {"name": "fls", "beams": 16, "bins": 32, "rate_hz": 5.0},
+    {"name": "mb", "type": "multibeam", "beams": 8, "bins": 32, "rate_hz": 5.0,
+     "rpy_rad": [0.0, 1.5708, 0.0]},
+]  # fmt: skip
+
+
 def _sensor_cases() -> list[tuple[str, list[str], bool]]:
     imu = {"gyro_noise_rad_s_rthz": 3e-4, "accel_noise_m_s2_rthz": 2e-3}
     nav = _sets(
@@ -228,6 +241,7 @@ def _sensor_cases() -> list[tuple[str, list[str], bool]]:
             False,
         ),
         ("noise", _sets(sensors__position_noise_m=0.01, sensors__velocity_noise=0.01), False),
+        ("sees", _sets(sensors__camera=[EYE], sensors__sonar=SONARS), False),
     ]
 
 
@@ -250,7 +264,7 @@ def _judge_rollouts(out: Path, passive: bool) -> str:
         rate = np.abs(data["v"][:, 3:]).max()
         if rate > MAX_RATE_RAD_S:
             return f"an angular or joint rate of {rate:.0f} rad/s"
-        problem = _judge_free_objects(file, data)
+        problem = _judge_free_objects(file, data) or _judge_images(file)
         if problem:
             return problem
         if passive:
@@ -258,6 +272,29 @@ def _judge_rollouts(out: Path, passive: bool) -> str:
             gain = float(np.max(energy - energy[0]))
             if gain > ENERGY_GAIN_J:
                 return f"passive scene gained {gain:.3g} J"
+    return ""
+
+
+def _judge_images(file: Path) -> str:
+    """ "" unless the run had cameras or sonars and its images are missing, or not what
+    they are (8-bit colour; depths positive or NaN; intensities finite, >= 0)."""
+    described = json.loads(file.with_name("rollout.json").read_text()).get("perception") or {}
+    if not described:
+        return ""
+    images = file.with_name("perception.npz")
+    if not images.is_file():
+        return f"{file.parent.name}: cameras or sonars but no perception.npz"
+    with np.load(images) as data:
+        for key in data.files:
+            values = data[key]
+            if key.endswith("__rgb") and values.dtype != np.uint8:
+                return f"{key}: {values.dtype}, not 8-bit colour"
+            if key.endswith("__depth_m") and np.any(values[np.isfinite(values)] <= 0.0):
+                return f"{key}: a depth <= 0"
+            if key.endswith("__intensity") and not (
+                np.all(np.isfinite(values)) and np.all(values >= 0)
+            ):
+                return f"{key}: a negative or non-finite echo"
     return ""
 
 
