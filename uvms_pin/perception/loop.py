@@ -53,6 +53,14 @@ class LoopCameras:
         self._images: dict[str, LoopImage] = {}
         self.images = MappingProxyType(self._images)
 
+    def due(self, time_s: float) -> list[int]:
+        """The cameras whose instant has come at the control tick ``time_s``."""
+        return [
+            k
+            for k, camera in enumerate(self.cameras)
+            if time_s >= self._next[k] / camera.spec.rate_hz - 1e-9
+        ]
+
     def update(
         self,
         time_s: float,
@@ -64,11 +72,7 @@ class LoopCameras:
         """At the control tick ``time_s``: the cameras whose instant has come fire, from the
         robot's ``q``, the free objects' poses (7,) each, the fixtures' joint positions and
         the other robots' configurations (None: where they are)."""
-        due = [
-            k
-            for k, camera in enumerate(self.cameras)
-            if time_s >= self._next[k] / camera.spec.rate_hz - 1e-9
-        ]
+        due = self.due(time_s)
         if not due:
             return
         self.scene.update(q, object_poses, fixture_positions, other_robots)

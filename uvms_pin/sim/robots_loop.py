@@ -12,6 +12,7 @@ reason is recorded where every run records why it is not compiled
 from __future__ import annotations
 
 import dataclasses
+import functools
 import time
 import warnings
 from collections.abc import Sequence
@@ -68,7 +69,6 @@ class RobotsLoop:
         self.system = Robots([loop.system for loop in self.loops], names)
         self.time_s = 0.0
         self.state: SystemState | None = None
-        self._seeing: list[int] = []  # the robots whose cameras fire in the loop
 
     def start(self, starts: Sequence[tuple[np.ndarray, np.ndarray]], sensors) -> None:
         """t = 0: every robot's loop started at its (q0, v0) with its ``sensors``, then
@@ -78,16 +78,18 @@ class RobotsLoop:
         self.time_s = 0.0
         self.state = self.system.layout.join([loop.state for loop in self.loops])
         self.system.start(self.state)
-        # the robots whose cameras fire in the loop see the run's world and the others
-        self._seeing = [k for k, loop in enumerate(self.loops) if loop.sensors.seeing is not None]
+        # the robots whose cameras fire in the loop see the run's world and the others, as
+        # they stand when a camera fires (`_scene_view`)
         names = self.system.names
-        for k in self._seeing:
-            loop = self.loops[k]
+        for k, loop in enumerate(self.loops):
+            if loop.sensors.seeing is None:
+                continue
             others = [(names[j], other.plant.uvms) for j, other in enumerate(self.loops) if j != k]
             loop.sensors.start_seeing(
                 loop.plant, loop.system.layout, self.settings.control_period_s,
                 world=self.loops[0].plant.world, others=others,
             )  # fmt: skip
+            loop.sensors.scene_view = functools.partial(self._scene_view, k)
 
     def tick(self, logged: bool) -> list[np.ndarray]:
         """Each robot measures, commands and actuates on its own, then (if ``logged``)
@@ -95,7 +97,6 @@ class RobotsLoop:
         `Robots.contact_signals`): a controller that raises leaves no robot's sample of the
         tick. The applied inputs."""
         ticked = []
-        self._set_scene_views()
         for loop, held in zip(self.loops, self._held_wrenches(), strict=True):
             measurement, contact = loop.observe(held)
             tau = loop.command(measurement)
@@ -107,22 +108,20 @@ class RobotsLoop:
                 loop.notify(replace(sample, signals={**sample.signals, **own}))
         return [made[3] for made in ticked]
 
-    def _set_scene_views(self) -> None:
-        """For each robot whose cameras fire in the loop: the free objects' poses and the
-        fixtures' positions (the first robot's system holds them) and the other robots' q,
-        as they stand (`SensorSuite.scene_view`)."""
-        if not self._seeing:
-            return
+    def _scene_view(self, k: int) -> tuple[list, list, list]:
+        """What robot ``k``'s cameras in the loop see beyond it, as the robots stand: the
+        free objects' poses and the fixtures' positions (the first robot's system holds
+        them) and the other robots' q (`SensorSuite.scene_view`)."""
         first = self.loops[0]
         _, *bodies = first.system.layout.split(first.state.q, first.state.v)
         world = first.plant.world
         free = 0 if world is None else len(world.free)
-        objects = [q for q, _ in bodies[:free]]
-        fixtures = [q for q, _ in bodies[free:]]
-        robots = [loop.system.layout.split(loop.state.q, loop.state.v)[0][0] for loop in self.loops]
-        for k in self._seeing:
-            others = [q for j, q in enumerate(robots) if j != k]
-            self.loops[k].sensors.scene_view = (objects, fixtures, others)
+        others = [
+            loop.system.layout.split(loop.state.q, loop.state.v)[0][0]
+            for j, loop in enumerate(self.loops)
+            if j != k
+        ]
+        return [q for q, _ in bodies[:free]], [q for q, _ in bodies[free:]], others
 
     def _held_wrenches(self) -> list[np.ndarray | None]:
         """What each robot's force/torque sensor measures of the free objects it holds

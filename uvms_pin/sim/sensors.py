@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
+from collections.abc import Callable
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -200,8 +201,9 @@ class SensorSuite:
         self._estimator_started = False
         self.seed = seed
         self.seeing: LoopCameras | None = None  # the cameras in the loop, once started
-        #: several robots: what the loop's scene holds beyond this robot, each tick
-        self.scene_view: tuple | None = None
+        #: several robots: () -> what the loop's scene holds beyond this robot as it stands
+        #: (free objects' poses, fixtures' positions, other robots' q), set by its loop
+        self.scene_view: Callable[[], tuple] | None = None
         self._layout = None
         self._free = 0  # the free objects among the bodies the cameras see
         self._state_noisy = any(
@@ -226,7 +228,7 @@ class SensorSuite:
         plant's world afresh, the system's state split by ``layout``; they fire at control
         ticks (ParameterError without a control period ``period_s``). In a run of several
         robots: ``world`` the run's (the first robot's, with the free objects), ``others``
-        the other robots, (name, UVMS) each, posed by `scene_view` each tick."""
+        the other robots, (name, UVMS) each, posed by `scene_view`."""
         cameras = self.config.perception.in_loop
         self.seeing, self.scene_view = None, None
         if not cameras:
@@ -245,17 +247,21 @@ class SensorSuite:
     def see(self, time_s: float, state, measurement: Measurement) -> Measurement:
         """Once per control tick: the cameras in the loop whose instant has come fire from
         the system's true ``state``; ``measurement`` with their latest images. In a run of
-        several robots the world's bodies and the other robots are ``scene_view``'s
-        (free objects' poses, fixtures' positions, other robots' q), set by its loop."""
+        several robots the world's bodies and the other robots are ``scene_view``'s. The
+        state is split only at the ticks a camera fires."""
         if self.seeing is None:
             return measurement
+        if self.seeing.due(time_s):
+            self._fire_seeing(time_s, state)
+        return dataclasses.replace(measurement, images=self.seeing.images)
+
+    def _fire_seeing(self, time_s: float, state) -> None:
         robot, *objects = self._layout.split(state.q, state.v)
         if self.scene_view is not None:
-            self.seeing.update(time_s, robot[0], *self.scene_view)
+            self.seeing.update(time_s, robot[0], *self.scene_view())
         else:
             free, fixtures = objects[: self._free], objects[self._free :]
             self.seeing.update(time_s, robot[0], [q for q, _ in free], [q for q, _ in fixtures])
-        return dataclasses.replace(measurement, images=self.seeing.images)
 
     def navigate(
         self, time_s: float, q: np.ndarray, v: np.ndarray, measurement: Measurement
