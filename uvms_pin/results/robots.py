@@ -116,19 +116,17 @@ class RobotRollouts:
     def load(cls, directory: str | Path) -> RobotRollouts:
         """The rollouts `save` wrote in ``directory``."""
         src = Path(directory)
-        names = cls.names_in(src)
-        if isinstance(names, Exception):
-            raise ParameterError(f"{src} holds no run of several robots ({names})") from names
-        return cls({name: Rollout.load(src / name) for name in names})
+        return cls({name: Rollout.load(src / name) for name in cls.names_in(src)})
 
     @staticmethod
-    def names_in(directory: Path) -> list[str] | Exception:
-        """The robots of the run of several `save` wrote in ``directory``, or why it holds
-        none (the error reading it)."""
+    def names_in(directory: str | Path) -> list[str]:
+        """The robots of the run of several `save` wrote in ``directory``; ParameterError
+        saying why when it holds none."""
         import json
 
+        src = Path(directory)
         try:
-            text = (Path(directory) / ROBOTS_FILE).read_text(encoding="utf-8")
+            text = (src / ROBOTS_FILE).read_text(encoding="utf-8")
             return [str(name) for name in json.loads(text)["robots"]]
         except (OSError, ValueError, KeyError, TypeError) as exc:
-            return exc
+            raise ParameterError(f"{src} holds no run of several robots ({exc})") from exc

@@ -14,15 +14,10 @@ def _cmd_export(args: argparse.Namespace) -> int:
         raise UvmsPinError("export: nothing to do, give --mcap FILE")
     from uvms_pin.apps.export.ros_bag import write_mcap
     from uvms_pin.results.outdir import claim_file
-    from uvms_pin.results.robots import RobotRollouts
     from uvms_pin.results.rollout import ARRAY_FILE, Rollout
 
-    robots = RobotRollouts.names_in(Path(args.run))
-    if not (Path(args.run) / ARRAY_FILE).is_file() and isinstance(robots, list):
-        raise UvmsPinError(
-            f"export: {args.run} holds a run of several robots ({', '.join(robots)}): a bag "
-            f"is one robot's, e.g. uvms-pin export {Path(args.run) / robots[0]} --mcap FILE"
-        )
+    if not (Path(args.run) / ARRAY_FILE).is_file():
+        _refuse_several_robots(Path(args.run))
     rollout = Rollout.load(args.run)
     path = Path(args.mcap)
     with claim_file(path, overwrite=args.overwrite, option="--mcap"):
@@ -30,6 +25,21 @@ def _cmd_export(args: argparse.Namespace) -> int:
     size_mb = path.stat().st_size / 1e6
     print(f"wrote {path} ({size_mb:.1f} MB, {len(rollout)} samples)")
     return 0
+
+
+def _refuse_several_robots(run: Path) -> None:
+    """UvmsPinError when ``run`` holds a run of several robots: a bag is one robot's."""
+    from uvms_pin.errors import ParameterError
+    from uvms_pin.results.robots import RobotRollouts
+
+    try:
+        robots = RobotRollouts.names_in(run)
+    except ParameterError:
+        return  # not one either: Rollout.load says what is missing
+    raise UvmsPinError(
+        f"export: {run} holds a run of several robots ({', '.join(robots)}): a bag is one "
+        f"robot's, e.g. uvms-pin export {run / robots[0]} --mcap FILE"
+    )
 
 
 def register(sub) -> None:

@@ -112,7 +112,8 @@ def messages(
 ) -> Iterator[Message]:
     """Every message of the bag, in time order (the static ones first); ``seen``: its
     cameras' and sonars' (`perception_topics`)."""
-    seen = seen or perception_topics(rollout, uvms)
+    if seen is None:
+        seen = perception_topics(rollout, uvms)
     topics = SampleTopics(rollout.metadata, uvms)
     for topic, message, time_ns in topics.static(float(rollout.time_s[0]), rollout.q[0]):
         if topic == "/tf_static":  # one message: the sensors' frames with the links'
