@@ -21,7 +21,6 @@ before its metadata kept the sensors' specs has none of these topics.
 
 from __future__ import annotations
 
-import math
 import re
 from collections.abc import Iterator
 from typing import Any
@@ -31,6 +30,7 @@ import pinocchio as pin
 
 from uvms_pin.apps.export.ros_messages import header, stamp_ns, transform
 from uvms_pin.errors import VizError
+from uvms_pin.perception.camera import CameraSpec
 
 __all__ = ["PerceptionTopics", "camera_info", "laser_scan", "ros_name"]
 
@@ -57,11 +57,14 @@ def _image(time_ns: int, frame: str, pixels: np.ndarray, encoding: str) -> dict[
 
 
 def camera_info(time_ns: int, frame: str, spec: dict[str, Any]) -> dict[str, Any]:
-    """``sensor_msgs/CameraInfo`` of a camera's spec: f = W / 2 / tan(hfov / 2) [px] on both
-    axes, the principal point at the image's centre (cx = W / 2 - 1/2, cy = H / 2 - 1/2 in
-    ROS's pixel coordinates, the top-left pixel's centre at (0, 0)), no distortion."""
+    """``sensor_msgs/CameraInfo`` of a camera's spec (its recorded fields): the camera's
+    own focal length on both axes (`CameraSpec.focal_px`, W / 2 / tan(hfov / 2) [px]), the
+    principal point at the image's centre (cx = W / 2 - 1/2, cy = H / 2 - 1/2 in ROS's pixel
+    coordinates, the top-left pixel's centre at (0, 0)), no distortion."""
     width, height = int(spec["width"]), int(spec["height"])
-    f = 0.5 * width / math.tan(0.5 * float(spec["horizontal_fov_rad"]))
+    f = CameraSpec(
+        "info", width=width, height=height, horizontal_fov_rad=float(spec["horizontal_fov_rad"])
+    ).focal_px
     cx, cy = 0.5 * width - 0.5, 0.5 * height - 0.5
     return {
         "header": header(time_ns, frame),

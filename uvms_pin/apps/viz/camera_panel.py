@@ -13,7 +13,7 @@ from typing import Any
 
 import numpy as np
 
-from uvms_pin.results.figures.perception import decibels
+from uvms_pin.results.figures.perception import decibels, snapshot_rows
 from uvms_pin.results.rollout import Rollout
 
 __all__ = ["PANELS_SCRIPT", "image_panels"]
@@ -51,13 +51,6 @@ def _first(rollout: Rollout, kind: str, wanted=lambda name: True) -> str | None:
     return None
 
 
-def _shown_rows(count: int) -> np.ndarray:
-    rows = np.arange(count)
-    if count > MAX_IMAGES:
-        rows = np.unique(np.linspace(0, count - 1, MAX_IMAGES).round().astype(int))
-    return rows
-
-
 def sonar_rgb(intensity: np.ndarray, low_db: float, high_db: float) -> np.ndarray:
     """A sonar image (bins, beams) as 8-bit colour (bins, beams, 3): its dB on the copper
     scale from ``low_db`` to ``high_db``, the nearest bin at the bottom, port (the last
@@ -77,7 +70,7 @@ def image_panels(rollout: Rollout, t0: float) -> list[dict[str, Any]]:
     camera = _first(rollout, "camera")
     if camera is not None:
         record = rollout.camera(camera)
-        rows = _shown_rows(len(record.time_s))
+        rows = snapshot_rows(len(record.time_s), MAX_IMAGES)
         out.append({
             "id": "uvms-camera",
             "label": f"camera {camera}",
@@ -92,7 +85,7 @@ def image_panels(rollout: Rollout, t0: float) -> list[dict[str, Any]]:
     sonar = _first(rollout, "sonar", imaging)
     if sonar is not None:
         record = rollout.sonar(sonar)
-        rows = _shown_rows(len(record.time_s))
+        rows = snapshot_rows(len(record.time_s), MAX_IMAGES)
         _, low, high = decibels(record.intensity)
         out.append({
             "id": "uvms-sonar",
