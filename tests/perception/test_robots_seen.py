@@ -4,6 +4,8 @@ them; a camera in the loop sees them where they are at its tick."""
 
 from __future__ import annotations
 
+import copy
+
 import numpy as np
 import pytest
 from conftest import ROOT
@@ -12,8 +14,9 @@ from uvms_pin.control.base import Controller
 from uvms_pin.errors import ParameterError
 from uvms_pin.perception.camera import Camera
 from uvms_pin.perception.scene import scene_of
+from uvms_pin.perception.suite import SceneLog, perceive
 from uvms_pin.scenario.load import load_scenario
-from uvms_pin.sim.robots_run import simulate_robots
+from uvms_pin.sim.robots_run import robot_seed, simulate_robots
 
 #: alpha's camera looks to its left, at bravo 3 m away (optical z along alpha's body y)
 CAMERA = """
@@ -28,11 +31,14 @@ noise_counts = 0.0
 """
 
 
-def _scenario(tmp_path, camera: str = CAMERA, duration_s: float = 0.6):
+def _scenario(tmp_path, camera: str = CAMERA, duration_s: float = 0.6, robot: int = 0):
+    """two_robots with ``camera`` among robot ``robot``'s sensors (0: alpha, 1: bravo)."""
     text = (ROOT / "scenarios" / "two_robots.toml").read_text()
     text = text.replace("../models/", f"{ROOT}/models/")
-    first_sensors = text.index("[robots.sensors]")
-    end = text.index("[robots.actuation]", first_sensors)  # alpha's: its sensors' table ends
+    sensors = -1
+    for _ in range(robot + 1):
+        sensors = text.index("[robots.sensors]", sensors + 1)
+    end = text.index("[robots.actuation]", sensors)  # the robot's sensors' table ends
     text = text[:end] + camera + "\n" + text[end:]
     path = tmp_path / "two.toml"
     path.write_text(text)
@@ -86,14 +92,26 @@ def test_a_robots_camera_sees_the_other_robot_where_its_rollout_puts_it(run):
 
 
 def test_a_robots_images_are_drawn_from_its_own_seed(run, tmp_path):
-    """The same scenario run again gives the same images; alpha's noise stream is its own
-    (robot seed), so the camera with noise differs from a noiseless one."""
+    """The same scenario run again gives the same images; with noise, bravo's images (robot
+    1) are the ones its own seed (`robot_seed` of the scenario's and 1) gives when fired
+    again over its log, not the scenario's seed (robot 0's)."""
     scenario, rollouts = run
     again = simulate_robots(scenario).robot("alpha").camera("left")
     np.testing.assert_array_equal(again.rgb, rollouts.robot("alpha").camera("left").rgb)
     noisy = CAMERA.replace("noise_counts = 0.0", "noise_counts = 3.0")
-    seen = simulate_robots(_scenario(tmp_path, noisy, 0.2)).robot("alpha").camera("left")
-    assert not np.array_equal(seen.rgb[0], again.rgb[0])
+    noisy = _scenario(tmp_path, noisy.replace("[-1.5708,", "[1.5708,"), 0.2, robot=1)
+    both = simulate_robots(noisy)
+    bravo = both.robot("bravo")
+    own = noisy.robots[1]
+    assert own.settings.seed == robot_seed(noisy.settings.seed, 1) != noisy.settings.seed
+    scene = scene_of(own.uvms, own.plant.world, surface=own.plant.free_surface,
+                     others=[("alpha", noisy.robots[0].uvms)])  # fmt: skip
+    for seed, same in ((own.settings.seed, True), (noisy.settings.seed, False)):
+        fired = copy.copy(bravo)
+        fired.perception, fired.metadata = {}, dict(bravo.metadata)
+        log = SceneLog(bravo.q, np.zeros((len(bravo), 0, 7)), None, [both.robot("alpha").q])
+        perceive(fired, own.sensor_config.perception, scene, seed, log=log)
+        assert np.array_equal(fired.camera("left").rgb, bravo.camera("left").rgb) == same
 
 
 class Watching(Controller):
