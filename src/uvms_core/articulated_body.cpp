@@ -26,6 +26,7 @@
 #include <pinocchio/algorithm/kinematics.hpp>
 
 #include "dynamics.hpp"
+#include "pinocchio_kinematics.hpp"
 
 namespace uvms {
 
@@ -76,8 +77,8 @@ void Dynamics::prepare_articulated() {
   if (!articulated_) return;
   Data scratch(model_);
   Eigen::VectorXd q(model_.nq);
-  pinocchio::neutral(model_, q);
-  pinocchio::forwardKinematics(model_, scratch, ConstVec(q));
+  pinlib::neutral(model_, q);
+  pinlib::forward_kinematics(model_, scratch, ConstVec(q));
   kind_.assign(nj, JointKind::kGeneric);
   body_inertia_.assign(nj, Mat6::Zero());
   inertia_a_.assign(nj, Mat6::Zero());

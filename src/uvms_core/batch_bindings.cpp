@@ -12,6 +12,7 @@
 
 #include "batch_derivatives.hpp"
 #include "batch_plant.hpp"
+#include "pinocchio_kinematics.hpp"
 
 namespace nb = nanobind;
 using namespace nb::literals;
@@ -115,7 +116,7 @@ void bind_batch_derivatives(nb::module_& m) {
             check_states("q", q, n, nq);
             for (size_t k = 0; k < n; ++k) {
               const Eigen::Map<const Eigen::VectorXd> row(q.data() + k * nq, Eigen::Index(nq));
-              if (!pinocchio::isNormalized(b.model(), row, norm_tolerance)) return long(k);
+              if (!uvms::pinlib::is_normalized(b.model(), row, norm_tolerance)) return long(k);
             }
             return -1L;
           },

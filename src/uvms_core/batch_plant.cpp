@@ -9,6 +9,8 @@
 
 #include <pinocchio/algorithm/joint-configuration.hpp>
 
+#include "pinocchio_kinematics.hpp"
+
 namespace uvms {
 
 // A speed this large [m/s or rad/s] only comes out of a blown-up integration
@@ -155,7 +157,7 @@ void BatchPlant::measure(int thread, int i) {
   dq.setZero();
   if (!noise_.silent[kOrientation]) noise_at(kOrientation, i, time_s, dq.segment(3, 3));
   if (!noise_.silent[kJoints]) noise_at(kJoints, i, time_s, dq.tail(nv_ - 6));
-  pinocchio::integrate(plant.dynamics().model(), qi, dq, scratch.q);
+  pinlib::integrate(plant.dynamics().model(), qi, dq, scratch.q);
   if (!noise_.silent[kPosition]) {
     auto part = scratch.noise.head(3);
     noise_at(kPosition, i, time_s, part);

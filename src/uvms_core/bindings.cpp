@@ -16,6 +16,7 @@
 #include <pinocchio/config.hpp>
 
 #include "derivatives.hpp"
+#include "pinocchio_kinematics.hpp"
 #include "plant.hpp"
 #include "ppc.hpp"
 #include "world_bindings.hpp"
@@ -325,7 +326,7 @@ void bind_derivatives(nb::module_& m) {
                 out.shape(2) != std::size_t(nv)) {
               throw InputError("out must have shape (3, nv, nv)");
             }
-            if (!pinocchio::isNormalized(d.dynamics().model(), q, norm_tolerance)) {
+            if (!uvms::pinlib::is_normalized(d.dynamics().model(), q, norm_tolerance)) {
               throw InputError("q is not on the configuration manifold");
             }
             const ForwardDynamicsDerivatives* jacobians = nullptr;

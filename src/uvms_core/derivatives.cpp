@@ -8,6 +8,7 @@
 
 #include "added_mass.hpp"
 #include "damping.hpp"
+#include "pinocchio_dynamics.hpp"
 #include "restoring.hpp"
 
 namespace uvms {
@@ -104,7 +105,7 @@ void Derivatives::wrenches_at(const ConstVec& q, const ConstVec& v, const Eigen:
     return;
   }
   // kinematics at (q, v, a): the wrenches' -M_A a_bias becomes -M_A a_j
-  pinocchio::forwardKinematics(d.model_, d.data_, q, v, ConstVec(a));
+  pinlib::forward_kinematics(d.model_, d.data_, q, v, ConstVec(a));
   d.fluid_wrenches(time_s, flow, true, free_surface_);
   fext_ = d.fext_;
 }
@@ -276,7 +277,7 @@ const ForwardDynamicsDerivatives& Derivatives::forward_dynamics_derivatives(
   // M into data.M, as Pinocchio's own bindings do: the version with external forces adds
   // the armature to data.M, not to its dtau/da argument (Pinocchio 4.1)
   data_.M.setZero();
-  pinocchio::computeRNEADerivatives(d.model_, data_, q, v, ConstVec(acceleration_), fext_,
+  pinlib::compute_rnea_derivatives(d.model_, data_, q, v, ConstVec(acceleration_), fext_,
                                     did_dq_, did_dv_, data_.M);
   mass_ = data_.M;
   joint_motions();

@@ -7,6 +7,8 @@
 #include <pinocchio/algorithm/frames.hpp>
 #include <pinocchio/algorithm/kinematics-derivatives.hpp>
 
+#include "pinocchio_dynamics.hpp"
+
 namespace uvms {
 
 WrenchJacobians spring_jacobians(const LinearSpring& spring, const Vec3&, const Vec3&) {
@@ -99,21 +101,21 @@ void TaskContactDerivatives::contact_derivatives(const Model& model, const Conta
   using pinocchio::LOCAL_WORLD_ALIGNED;
   using pinocchio::WORLD;
   // the kinematics at (q, v) and the WORLD joint Jacobians, with their derivatives
-  pinocchio::computeForwardKinematicsDerivatives(model, data_, q, v, zero_);
+  pinlib::compute_forward_kinematics_derivatives(model, data_, q, v, zero_);
   const auto& placement = pinocchio::updateFramePlacement(model, data_, frame_id_);
   const Vec3 position = placement.translation();
   const Mat3 rotation = placement.rotation();
   const Vec3 velocity =
       pinocchio::getFrameVelocity(model, data_, frame_id_, LOCAL_WORLD_ALIGNED).linear();
   jacobian_lwa_.setZero();
-  pinocchio::getFrameJacobian(model, data_, frame_id_, LOCAL_WORLD_ALIGNED, jacobian_lwa_);
+  pinlib::get_frame_jacobian(model, data_, frame_id_, LOCAL_WORLD_ALIGNED, jacobian_lwa_);
   wrench_ = contact_wrench_world(contact, position, velocity);
   tau_ext_.noalias() = jacobian_lwa_.transpose() * wrench_;
   tau_ext_ = -tau_ext_;
   // d(p_dot)/dq = R (d nu_v/dq - [nu_v]x J_w^local)
   local_dq_.setZero();  // Pinocchio writes the frame's support columns only
   local_jacobian_.setZero();
-  pinocchio::getFrameVelocityDerivatives(model, data_, frame_id_, LOCAL, local_dq_,
+  pinlib::get_frame_velocity_derivatives(model, data_, frame_id_, LOCAL, local_dq_,
                                          local_jacobian_);
   const Vec3 local_linear = rotation.transpose() * velocity;
   arm_dq_ = local_dq_.topRows<3>();
@@ -128,7 +130,7 @@ void TaskContactDerivatives::contact_derivatives(const Model& model, const Conta
   Vec6 about_origin;
   about_origin << force, wrench_.tail<3>() + position.cross(force);
   jacobian_world_.setZero();
-  pinocchio::getFrameJacobian(model, data_, frame_id_, WORLD, jacobian_world_);
+  pinlib::get_frame_jacobian(model, data_, frame_id_, WORLD, jacobian_world_);
   // d(J^T lambda)/dq with lambda fixed: the projection's, and the moment arm p's
   tau_dq_.setZero();
   projection_dq(jacobian_world_, about_origin, mask_, minus_dual_, product_, tau_dq_);

@@ -7,6 +7,7 @@
 #include <pinocchio/algorithm/kinematics-derivatives.hpp>
 #include <pinocchio/algorithm/rnea-derivatives.hpp>
 
+#include "pinocchio_dynamics.hpp"
 #include "restoring.hpp"
 
 namespace uvms {
@@ -24,7 +25,7 @@ WorldContactDerivatives::WorldContactDerivatives(const Model& model) : data_(mod
 
 void WorldContactDerivatives::joint_motions(const Model& model, const ConstVec& q,
                                             const ConstVec& v) {
-  pinocchio::computeForwardKinematicsDerivatives(model, data_, q, v, zero_);
+  pinlib::compute_forward_kinematics_derivatives(model, data_, q, v, zero_);
   for (std::size_t j = 0; j < motion_.size(); ++j) {
     if (!moving_[j]) continue;
     auto& m = motion_[j];
@@ -32,7 +33,7 @@ void WorldContactDerivatives::joint_motions(const Model& model, const ConstVec& 
     m.velocity_dq.setZero(6, model.nv);
     m.jacobian.setZero(6, model.nv);
     const auto joint = static_cast<pinocchio::JointIndex>(j);
-    pinocchio::getJointVelocityDerivatives(model, data_, joint, pinocchio::LOCAL, m.velocity_dq,
+    pinlib::get_joint_velocity_derivatives(model, data_, joint, pinocchio::LOCAL, m.velocity_dq,
                                            m.jacobian);
     m.rotation = data_.oMi[j].rotation();
     m.translation = data_.oMi[j].translation();
@@ -79,10 +80,10 @@ void WorldContactDerivatives::world_contact_jacobians(const Model& model,
   rnea_dq_.setZero();
   rnea_dv_.setZero();
   rnea_da_.setZero();
-  pinocchio::computeRNEADerivatives(model, data_, q, zero_, zero_, fext_, rnea_dq_, rnea_dv_,
+  pinlib::compute_rnea_derivatives(model, data_, q, zero_, zero_, fext_, rnea_dq_, rnea_dv_,
                                     rnea_da_);
   gravity_dq_.setZero();
-  pinocchio::computeGeneralizedGravityDerivatives(model, data_, q, gravity_dq_);
+  pinlib::compute_generalized_gravity_derivatives(model, data_, q, gravity_dq_);
   out_q += gravity_dq_ - rnea_dq_;
   for (std::size_t j = 0; j < motion_.size(); ++j) {
     if (moving_[j]) tau_world_.noalias() += motion_[j].jacobian.transpose() * fext_[j].toVector();

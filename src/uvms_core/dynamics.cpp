@@ -6,6 +6,7 @@
 
 #include "added_mass.hpp"
 #include "damping.hpp"
+#include "pinocchio_dynamics.hpp"
 #include "restoring.hpp"
 
 namespace uvms {
@@ -81,7 +82,7 @@ void Dynamics::prepare() {
 }
 
 void Dynamics::kinematics(const ConstVec& q, const ConstVec& v) {
-  pinocchio::forwardKinematics(model_, data_, q, v, ConstVec(zero_));
+  pinlib::forward_kinematics(model_, data_, q, v, ConstVec(zero_));
 }
 
 void Dynamics::fluid_wrenches(double time_s, const FlowField& flow,
@@ -145,7 +146,7 @@ void Dynamics::add_local_wrench(int joint_id, const Vec6& wrench_local) {
 
 const Eigen::VectorXd& Dynamics::bias_from_wrenches(const ConstVec& q,
                                                     const ConstVec& v) {
-  h_ = pinocchio::rnea(model_, data_, q, v, ConstVec(zero_), fext_);
+  h_ = pinlib::rnea(model_, data_, q, v, ConstVec(zero_), fext_);
   return h_;
 }
 
@@ -156,13 +157,13 @@ const Eigen::MatrixXd& Dynamics::mass_matrix(const ConstVec& q) {
 
 const Eigen::MatrixXd& Dynamics::mass_matrix_in(const ConstVec& q, const FlowField& flow,
                                                 double time_s, bool free_surface) {
-  pinocchio::forwardKinematics(model_, data_, q);
+  pinlib::forward_kinematics(model_, data_, q);
   update_wet_state(time_s, flow, free_surface);
   return assemble_mass_matrix(q);
 }
 
 const Eigen::MatrixXd& Dynamics::assemble_mass_matrix(const ConstVec& q) {
-  pinocchio::crba(model_, data_, q, pinocchio::Convention::WORLD);
+  pinlib::crba(model_, data_, q, pinocchio::Convention::WORLD);
   mass_ = data_.M;
   mass_.triangularView<Eigen::StrictlyLower>() = mass_.transpose();  // crba fills the upper
   for (int j : joints_with_added_mass_) {

@@ -13,6 +13,7 @@
 #include <pinocchio/algorithm/joint-configuration.hpp>
 #include <pinocchio/multibody/model.hpp>
 
+#include "pinocchio_kinematics.hpp"
 #include "types.hpp"
 
 namespace uvms {
@@ -44,7 +45,7 @@ struct ManifoldStepper {
   // on its own: 1 for a one-DoF joint, a 6x6 LU for a free-flyer.
   void chart_rate(const Eigen::VectorXd& q0, const Eigen::VectorXd& delta_in,
                   const Eigen::VectorXd& velocity, Eigen::VectorXd& out) {
-    pinocchio::dIntegrate(model, q0, delta_in, jac, pinocchio::ARG1);
+    pinlib::d_integrate(model, q0, delta_in, jac, pinocchio::ARG1);
     for (int j = 1; j < model.njoints; ++j) {
       const int idx = model.joints[j].idx_v(), n = model.joints[j].nv();
       if (n == 1) {
@@ -64,22 +65,22 @@ struct ManifoldStepper {
     d1 = v;  // Jint(q0, 0) = identity
     delta = 0.5 * h * d1;
     v_stage = v + 0.5 * h * a1;
-    pinocchio::integrate(model, q, delta, q_stage);
+    pinlib::integrate(model, q, delta, q_stage);
     chart_rate(q, delta, v_stage, d2);
     a2 = rhs(t + 0.5 * h, q_stage, v_stage);
     delta = 0.5 * h * d2;
     v_stage = v + 0.5 * h * a2;
-    pinocchio::integrate(model, q, delta, q_stage);
+    pinlib::integrate(model, q, delta, q_stage);
     chart_rate(q, delta, v_stage, d3);
     a3 = rhs(t + 0.5 * h, q_stage, v_stage);
     delta = h * d3;
     v_stage = v + h * a3;
-    pinocchio::integrate(model, q, delta, q_stage);
+    pinlib::integrate(model, q, delta, q_stage);
     chart_rate(q, delta, v_stage, d4);
     a4 = rhs(t + h, q_stage, v_stage);
     delta = (h / 6.0) * (d1 + 2.0 * d2 + 2.0 * d3 + d4);
     v = v + (h / 6.0) * (a1 + 2.0 * a2 + 2.0 * a3 + a4);
-    pinocchio::integrate(model, q, delta, q_stage);
+    pinlib::integrate(model, q, delta, q_stage);
     q = q_stage;
   }
 
@@ -87,7 +88,7 @@ struct ManifoldStepper {
   void semi_implicit_euler_step(Rhs& rhs, double t, double h) {
     v = v + h * rhs(t, q, v);
     delta = h * v;
-    pinocchio::integrate(model, q, delta, q_stage);
+    pinlib::integrate(model, q, delta, q_stage);
     q = q_stage;
   }
 

@@ -9,6 +9,8 @@
 #include <pinocchio/math/rpy.hpp>
 #include <pinocchio/spatial/explog.hpp>
 
+#include "pinocchio_kinematics.hpp"
+
 namespace uvms {
 
 namespace {
@@ -178,7 +180,7 @@ LawStatus ImpedanceLaw::command(const LawInput& in) {
   tau.noalias() = jacobian.transpose() * wrench;
   for (Eigen::Index j = 0; j < tau.size(); ++j) tau[j] -= s_.velocity_damping[j] * v[j];
   // the arm's posture error on the joints' own manifold (pin.difference)
-  pinocchio::difference(task_.model(), next_.posture_q, q_, posture_error_);
+  pinlib::difference(task_.model(), next_.posture_q, q_, posture_error_);
   for (Eigen::Index j = 6; j < tau.size(); ++j) {
     tau[j] -= s_.posture_stiffness_Nm_rad[j - 6] * posture_error_[j];
   }

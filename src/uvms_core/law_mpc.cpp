@@ -9,6 +9,7 @@
 #include <pinocchio/math/rpy.hpp>
 
 #include "law_force_task.hpp"  // wrapped_angle
+#include "pinocchio_kinematics.hpp"
 
 namespace uvms {
 
@@ -58,7 +59,7 @@ LawStatus MpcLaw::command(const LawInput& in) {
   if (s_.force_task) {
     if (!all_finite(in.desired, 3)) return LawStatus::declined;
     // f_d(t) and e_x (MpcController._force_signals, first_level_error)
-    pinocchio::framesForwardKinematics(model_, data_,
+    pinlib::frames_forward_kinematics(model_, data_,
                                        Eigen::Map<const Eigen::VectorXd>(in.q, nq));
     const Vec3 rpy = pinocchio::rpy::matrixToRpy(data_.oMf[s_.ee_frame_id].rotation());
     auto e_x = at(e_x_);

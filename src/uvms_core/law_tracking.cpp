@@ -9,6 +9,8 @@
 #include <pinocchio/algorithm/kinematics.hpp>
 #include <pinocchio/spatial/explog.hpp>
 
+#include "pinocchio_kinematics.hpp"
+
 namespace uvms {
 
 TrackingPose::TrackingPose(pinocchio::Model model, TrackingTaskSettings settings)
@@ -39,12 +41,12 @@ void TrackingPose::evaluate(const Eigen::VectorXd& q) {
     jacobian_.block<3, 3>(3, 3) = rotation_v_;
     return;
   }
-  pinocchio::framesForwardKinematics(model_, data_, q);
+  pinlib::frames_forward_kinematics(model_, data_, q);
   position_ = data_.oMf[s_.frame_id].translation();
   rotation_ = data_.oMf[s_.frame_id].rotation();
-  pinocchio::computeJointJacobians(model_, data_, q);
+  pinlib::compute_joint_jacobians(model_, data_, q);
   jacobian_.setZero();
-  pinocchio::getFrameJacobian(model_, data_, s_.frame_id, pinocchio::LOCAL_WORLD_ALIGNED,
+  pinlib::get_frame_jacobian(model_, data_, s_.frame_id, pinocchio::LOCAL_WORLD_ALIGNED,
                               jacobian_);
   if (s_.vehicle_frame) {  // measured in the vehicle's frame: only the arm moves it
     const Mat3 to_vehicle = rotation_v_.transpose();
@@ -105,7 +107,7 @@ Vec6 ResolvedAccelerationLaw::bias_acceleration(const Eigen::VectorXd& q,
   }
   const auto& model = pose_.model();
   auto& data = pose_.data();
-  pinocchio::forwardKinematics(model, data, q, v, Eigen::VectorXd::Zero(model.nv));
+  pinlib::forward_kinematics(model, data, q, v, Eigen::VectorXd::Zero(model.nv));
   pinocchio::updateFramePlacements(model, data);
   const pinocchio::Motion acceleration = pinocchio::getFrameClassicalAcceleration(
       model, data, s_.frame_id, pinocchio::LOCAL_WORLD_ALIGNED);

@@ -9,6 +9,7 @@
 #include <pinocchio/algorithm/jacobian.hpp>
 #include <pinocchio/spatial/explog.hpp>
 
+#include "pinocchio_kinematics.hpp"
 #include "world_touch.hpp"
 
 namespace uvms {
@@ -29,7 +30,7 @@ Eigen::MatrixXd CoupledConstraintStep::side_twist_jacobian(const SystemAtStart& 
   if (side < 0) {
     Eigen::Matrix<double, 6, Eigen::Dynamic> joint(6, nv_robot_);
     joint.setZero();
-    pinocchio::getJointJacobian(*at.robot, *at.robot_data,
+    pinlib::get_joint_jacobian(*at.robot, *at.robot_data,
                                 static_cast<pinocchio::JointIndex>(piece.joint_id),
                                 pinocchio::LOCAL_WORLD_ALIGNED, joint);
     const Vec3 offset = x - at.robot_data->oMi[static_cast<std::size_t>(piece.joint_id)].translation();
@@ -45,7 +46,7 @@ Eigen::MatrixXd CoupledConstraintStep::side_twist_jacobian(const SystemAtStart& 
     const auto n = static_cast<Eigen::Index>(fixture.model->nv);
     Eigen::Matrix<double, 6, Eigen::Dynamic> joint(6, n);
     joint.setZero();
-    pinocchio::getJointJacobian(*fixture.model, *fixture.data,
+    pinlib::get_joint_jacobian(*fixture.model, *fixture.data,
                                 static_cast<pinocchio::JointIndex>(piece.joint_id),
                                 pinocchio::LOCAL_WORLD_ALIGNED, joint);
     const Vec3 offset =
@@ -145,7 +146,7 @@ void CoupledConstraintStep::add_attachment_rows(const SystemAtStart& at, double 
     // the rows in the target's frame c1: -(its link's chain) + (the object's body twist)
     Eigen::Matrix<double, 6, Eigen::Dynamic> link(6, nv_robot_);
     link.setZero();
-    pinocchio::getJointJacobian(*at.robot, *at.robot_data,
+    pinlib::get_joint_jacobian(*at.robot, *at.robot_data,
                                 static_cast<pinocchio::JointIndex>(held.link_joint),
                                 pinocchio::WORLD, link);
     const Eigen::Matrix<double, 6, 6> to_target = target.toActionMatrixInverse();
@@ -362,9 +363,9 @@ bool CoupledConstraintStep::constrain(const SystemAtStart& at,
     step.margin = margin;
     step.correction = correction;
   }
-  pinocchio::computeJointJacobians(*at.robot, *at.robot_data, at.q0_robot);
+  pinlib::compute_joint_jacobians(*at.robot, *at.robot_data, at.q0_robot);
   for (const FixtureAtStart& fixture : at.fixtures) {
-    pinocchio::computeJointJacobians(*fixture.model, *fixture.data, fixture.q0);
+    pinlib::compute_joint_jacobians(*fixture.model, *fixture.data, fixture.q0);
   }
   const Eigen::VectorXd v_free = v;
   Eigen::VectorXd speed = v_free.cwiseAbs().cwiseMax(least_speed.cwiseAbs());

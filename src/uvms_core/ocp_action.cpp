@@ -7,6 +7,8 @@
 #include <pinocchio/algorithm/jacobian.hpp>
 #include <pinocchio/algorithm/kinematics.hpp>
 
+#include "pinocchio_kinematics.hpp"
+
 namespace uvms {
 
 OcpWorkspace::OcpWorkspace(const Dynamics& dyn, std::optional<int> frame)
@@ -78,18 +80,18 @@ void UnderwaterActionModel::contact_and_frames(const Eigen::VectorXd& q,
                                                const Eigen::VectorXd& v) {
   OcpWorkspace& w = *work_;
   const Model& model = w.dynamics.model();
-  pinocchio::forwardKinematics(model, w.data, q, v);
+  pinlib::forward_kinematics(model, w.data, q, v);
   pinocchio::updateFramePlacements(model, w.data);
   if (!w.contact_frame) return;
   // the end-effector's contact (task_contact.py _contact_in): lambda at (p, p_dot), and
   // tau_ext = -J^T lambda by the frame's Jacobian (the joints' at the placements above)
-  pinocchio::computeJointJacobians(model, w.data);
+  pinlib::compute_joint_jacobians(model, w.data);
   const auto frame = static_cast<pinocchio::FrameIndex>(*w.contact_frame);
   const Vec3 position = w.data.oMf[frame].translation();
   const Vec3 velocity =
       pinocchio::getFrameVelocity(model, w.data, frame, pinocchio::LOCAL_WORLD_ALIGNED).linear();
   w.jacobian_lwa.setZero();
-  pinocchio::getFrameJacobian(model, w.data, frame, pinocchio::LOCAL_WORLD_ALIGNED,
+  pinlib::get_frame_jacobian(model, w.data, frame, pinocchio::LOCAL_WORLD_ALIGNED,
                               w.jacobian_lwa);
   wrench_ = contact_wrench_world(w.contact, position, velocity);
   w.tau_ext.noalias() = -w.jacobian_lwa.transpose() * wrench_;
@@ -131,7 +133,7 @@ void UnderwaterActionModel::calc_diff_or_throw(DataBase& data, const Eigen::Vect
   const Eigen::VectorXd& v = w.v = x.tail(nv);
   // the costs' frames and LOCAL Jacobians at q; the contact's own kinematics are its data's
   const Model& model = w.dynamics.model();
-  pinocchio::computeJointJacobians(model, w.data, q);
+  pinlib::compute_joint_jacobians(model, w.data, q);
   pinocchio::updateFramePlacements(model, w.data);
   w.tau.noalias() = input_matrix_ * u;
   const Matrix6x* wrench_dq = nullptr;

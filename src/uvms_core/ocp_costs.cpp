@@ -5,6 +5,8 @@
 #include <pinocchio/algorithm/joint-configuration.hpp>
 #include <pinocchio/spatial/explog.hpp>
 
+#include "pinocchio_kinematics.hpp"
+
 namespace uvms {
 
 namespace {
@@ -20,7 +22,7 @@ Overloaded(Ts...) -> Overloaded<Ts...>;
 const Matrix6x& frame_jacobian(const TermState& at, int frame_id) {
   Matrix6x& jacobian = at.work.frame_jacobian;
   jacobian.setZero();
-  pinocchio::getFrameJacobian(at.model, at.data, frame_id, pinocchio::LOCAL, jacobian);
+  pinlib::get_frame_jacobian(at.model, at.data, frame_id, pinocchio::LOCAL, jacobian);
   return jacobian;
 }
 
@@ -55,7 +57,7 @@ void term_residual(const CostKind& kind, const TermState& at, const Eigen::Vecto
           },
           [&](const EffortCost&) { out = u; },
           [&](const StateDeviationCost& c) {
-            out.head(nv) = pinocchio::difference(at.model, c.x_ref.head(nq), x.head(nq));
+            out.head(nv) = pinlib::differenced(at.model, c.x_ref.head(nq), x.head(nq));
             out.tail(nv) = x.tail(nv) - c.x_ref.tail(nv);
           },
           [&](const ContactForceCost& c) { out = at.wrench_world->head<3>() - c.target_N; },
@@ -96,7 +98,7 @@ void term_jacobian(const CostKind& kind, const TermState& at, const Eigen::Vecto
             // (Pinocchio writes each joint's diagonal block only)
             Eigen::MatrixXd& jq = at.work.configuration;
             jq.setZero();
-            pinocchio::dDifference(at.model, c.x_ref.head(nq), x.head(nq), jq, pinocchio::ARG1);
+            pinlib::d_difference(at.model, c.x_ref.head(nq), x.head(nq), jq, pinocchio::ARG1);
             out.topLeftCorner(nv, nv) = jq;
             out.block(nv, nv, nv, nv).setIdentity();
           },

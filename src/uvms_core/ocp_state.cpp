@@ -4,7 +4,8 @@
 #include <cmath>
 #include <random>
 
-#include <pinocchio/algorithm/joint-configuration.hpp>
+#include "pinocchio_kinematics.hpp"
+
 
 namespace uvms {
 
@@ -22,7 +23,7 @@ UvmsState::UvmsState(const Model& model)
 
 Eigen::VectorXd UvmsState::zero() const {
   Eigen::VectorXd x = Eigen::VectorXd::Zero(nx_);
-  x.head(model_.nq) = pinocchio::neutral(model_);
+  x.head(model_.nq) = pinlib::neutral(model_);
   return x;
 }
 
@@ -33,7 +34,7 @@ Eigen::VectorXd UvmsState::rand() const {
   Eigen::VectorXd tangent(model_.nv);
   for (int k = 0; k < model_.nv; ++k) tangent[k] = uniform(engine);
   Eigen::VectorXd x(nx_);
-  x.head(model_.nq) = pinocchio::integrate(model_, pinocchio::neutral(model_), tangent);
+  x.head(model_.nq) = pinlib::integrated(model_, pinlib::neutral(model_), tangent);
   for (int k = 0; k < model_.nv; ++k) x[model_.nq + k] = normal(engine);
   return x;
 }
@@ -42,7 +43,7 @@ void UvmsState::diff(const Eigen::Ref<const Eigen::VectorXd>& x0,
                      const Eigen::Ref<const Eigen::VectorXd>& x1,
                      Eigen::Ref<Eigen::VectorXd> dxout) const {
   const int nq = model_.nq, nv = model_.nv;
-  dxout.head(nv) = pinocchio::difference(model_, x0.head(nq), x1.head(nq));
+  dxout.head(nv) = pinlib::differenced(model_, x0.head(nq), x1.head(nq));
   // continuous joints by atan2 (state.py: Pinocchio 4.1's SO(2) log rounds tiny steps to 0)
   for (std::size_t k = 0; k < circle_q_.size(); ++k) {
     const int i = circle_q_[k];
@@ -56,7 +57,7 @@ void UvmsState::integrate(const Eigen::Ref<const Eigen::VectorXd>& x,
                           const Eigen::Ref<const Eigen::VectorXd>& dx,
                           Eigen::Ref<Eigen::VectorXd> xout) const {
   const int nq = model_.nq, nv = model_.nv;
-  xout.head(nq) = pinocchio::integrate(model_, x.head(nq), dx.head(nv));
+  xout.head(nq) = pinlib::integrated(model_, x.head(nq), dx.head(nv));
   xout.tail(nv) = x.tail(nv) + dx.tail(nv);
 }
 
@@ -75,11 +76,11 @@ void UvmsState::Jdiff(const Eigen::Ref<const Eigen::VectorXd>& x0,
                       crocoddyl::Jcomponent firstsecond) const {
   const int nq = model_.nq;
   if (firstsecond == crocoddyl::first || firstsecond == crocoddyl::both) {
-    pinocchio::dDifference(model_, x0.head(nq), x1.head(nq), jq_, pinocchio::ARG0);
+    pinlib::d_difference(model_, x0.head(nq), x1.head(nq), jq_, pinocchio::ARG0);
     block(jq_, -1.0, Jfirst, crocoddyl::setto);
   }
   if (firstsecond == crocoddyl::second || firstsecond == crocoddyl::both) {
-    pinocchio::dDifference(model_, x0.head(nq), x1.head(nq), jq_, pinocchio::ARG1);
+    pinlib::d_difference(model_, x0.head(nq), x1.head(nq), jq_, pinocchio::ARG1);
     block(jq_, 1.0, Jsecond, crocoddyl::setto);
   }
 }
@@ -91,11 +92,11 @@ void UvmsState::Jintegrate(const Eigen::Ref<const Eigen::VectorXd>& x,
                            crocoddyl::Jcomponent firstsecond, crocoddyl::AssignmentOp op) const {
   const int nq = model_.nq, nv = model_.nv;
   if (firstsecond == crocoddyl::first || firstsecond == crocoddyl::both) {
-    pinocchio::dIntegrate(model_, x.head(nq), dx.head(nv), jq_, pinocchio::ARG0);
+    pinlib::d_integrate(model_, x.head(nq), dx.head(nv), jq_, pinocchio::ARG0);
     block(jq_, 1.0, Jfirst, op);
   }
   if (firstsecond == crocoddyl::second || firstsecond == crocoddyl::both) {
-    pinocchio::dIntegrate(model_, x.head(nq), dx.head(nv), jq_, pinocchio::ARG1);
+    pinlib::d_integrate(model_, x.head(nq), dx.head(nv), jq_, pinocchio::ARG1);
     block(jq_, 1.0, Jsecond, op);
   }
 }
@@ -106,7 +107,9 @@ void UvmsState::JintegrateTransport(const Eigen::Ref<const Eigen::VectorXd>& x,
                                     crocoddyl::Jcomponent firstsecond) const {
   const int nq = model_.nq, nv = model_.nv;
   const auto arg = firstsecond == crocoddyl::first ? pinocchio::ARG0 : pinocchio::ARG1;
-  pinocchio::dIntegrateTransport(model_, x.head(nq), dx.head(nv), Jin.topRows(nv), arg);
+  Eigen::MatrixXd transported = Jin.topRows(nv);  // (the library's instantiation: a MatrixXd)
+  pinlib::d_integrate_transport(model_, x.head(nq), dx.head(nv), transported, arg);
+  Jin.topRows(nv) = transported;
 }
 
 }  // namespace uvms

@@ -3,6 +3,7 @@
 #include <limits>
 
 #include "joint_box.hpp"
+#include "pinocchio_kinematics.hpp"
 
 #include <pinocchio/algorithm/frames.hpp>
 #include <pinocchio/algorithm/joint-configuration.hpp>
@@ -153,20 +154,20 @@ bool Plant::constrain_joints(double t0, const ConstVec& q0, const ConstVec& v0, 
     const JointBoxStep step =
         joint_box_step(v1, mass, joint_coulomb_Nm, gap_low, gap_high, h, correction);
     v1 = step.velocity;
-    pinocchio::integrate(model, q0, (h * v1).eval(), q1);
+    pinlib::integrate(model, q0, (h * v1).eval(), q1);
     return true;
   }
   if (!joint_limits) return false;
   // the smooth step's own speeds: its start, its end and its mean over the period (RK4's
   // end may cross a limit that its end velocity would not reach), as period.py's constrained
   limit_speed_.resize(model.nv);
-  pinocchio::difference(model, q0, q1, limit_speed_);
+  pinlib::difference(model, q0, q1, limit_speed_);
   limit_speed_ = (limit_speed_.cwiseAbs() / h).cwiseMax(v0.cwiseAbs()).cwiseMax(v1.cwiseAbs());
   if (!joint_limits->within_reach(q0, limit_speed_, h)) return false;
   // M(q0) with the added mass (wet fractions at t0), as System.mass_matrix
   const Eigen::MatrixXd& mass = dynamics_.mass_matrix_in(q0, flow, t0, free_surface);
   if (!joint_limits->constrain(mass, q0, v1, h, limit_speed_)) return false;
-  pinocchio::integrate(model, q0, (h * v1).eval(), q1);
+  pinlib::integrate(model, q0, (h * v1).eval(), q1);
   return true;
 }
 
@@ -196,7 +197,7 @@ std::pair<Eigen::VectorXd, Eigen::VectorXd> Plant::chart(const ConstVec& q0,
   stepper_.q = q0;
   stepper_.delta = delta;
   stepper_.v = v;
-  pinocchio::integrate(dynamics_.model(), stepper_.q, stepper_.delta, stepper_.q_stage);
+  pinlib::integrate(dynamics_.model(), stepper_.q, stepper_.delta, stepper_.q_stage);
   stepper_.chart_rate(stepper_.q, stepper_.delta, stepper_.v, stepper_.d1);
   return {stepper_.q_stage, stepper_.d1};
 }

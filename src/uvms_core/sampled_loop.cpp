@@ -5,6 +5,8 @@
 
 #include <pinocchio/algorithm/joint-configuration.hpp>
 
+#include "pinocchio_kinematics.hpp"
+
 namespace uvms {
 
 namespace {
@@ -69,7 +71,7 @@ ChunkOutcome run_sampled_chunk(Plant& plant, SampledLaw& law,
       w.dq.setZero();
       w.dq.segment<3>(3) = Eigen::Map<const Vec3>(n + 6);
       w.dq.tail(nj) = Eigen::Map<const Eigen::VectorXd>(n + 12, nj);
-      pinocchio::integrate(model, q_now, w.dq, w.q_meas);
+      pinlib::integrate(model, q_now, w.dq, w.q_meas);
       w.q_meas.head<3>() = q_now.head<3>() + Eigen::Map<const Vec3>(n + 9);
       w.v_meas = v_now + Eigen::Map<const Eigen::VectorXd>(n + 12 + nj, nv);
       q_in = w.q_meas.data();

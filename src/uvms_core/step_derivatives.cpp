@@ -7,6 +7,8 @@
 
 #include <pinocchio/algorithm/joint-configuration.hpp>
 
+#include "pinocchio_kinematics.hpp"
+
 namespace uvms {
 
 namespace {
@@ -194,8 +196,8 @@ void StepDerivatives::euler_substep(double t, double h) {
   stage(t, q_, v_);
   v_ += h * a_;
   const Eigen::VectorXd w = h * v_;
-  pinocchio::dIntegrate(model, q_, w, j0_, pinocchio::ARG0);
-  pinocchio::dIntegrate(model, q_, w, j1_, pinocchio::ARG1);
+  pinlib::d_integrate(model, q_, w, j0_, pinocchio::ARG0);
+  pinlib::d_integrate(model, q_, w, j1_, pinocchio::ARG1);
   local_.setZero();
   auto dv_next = local_.bottomRows(nv);
   dv_next.leftCols(nv) = h * a_q_;
@@ -205,7 +207,7 @@ void StepDerivatives::euler_substep(double t, double h) {
   auto dq_next = local_.topRows(nv);
   dq_next.noalias() = h * j1_ * dv_next;
   dq_next.leftCols(nv) += j0_;
-  pinocchio::integrate(model, q_, w, q_next_);
+  pinlib::integrate(model, q_, w, q_next_);
   q_ = q_next_;
 }
 
@@ -224,9 +226,9 @@ void StepDerivatives::rk4_substep(double t, double h) {
   Eigen::MatrixXd d_rate_sum = Eigen::MatrixXd::Zero(nv, 3 * nv), d_accel_sum = d_rate_sum;
   Eigen::VectorXd q_stage(model.nq);
   for (int i = 0; i < 4; ++i) {
-    pinocchio::integrate(model, q_, delta, q_stage);
-    pinocchio::dIntegrate(model, q_, delta, j0_, pinocchio::ARG0);
-    pinocchio::dIntegrate(model, q_, delta, j1_, pinocchio::ARG1);
+    pinlib::integrate(model, q_, delta, q_stage);
+    pinlib::d_integrate(model, q_, delta, j0_, pinocchio::ARG0);
+    pinlib::d_integrate(model, q_, delta, j1_, pinocchio::ARG1);
     chart_rate(delta, v);
     rate.noalias() = chart_inverse_ * v;  // d_i = Jint(delta_i)^-1 v_i
     d_rate.noalias() = chart_inverse_ * d_v;
@@ -251,13 +253,13 @@ void StepDerivatives::rk4_substep(double t, double h) {
     }
   }
   delta = h * rate_sum;
-  pinocchio::dIntegrate(model, q_, delta, j0_, pinocchio::ARG0);
-  pinocchio::dIntegrate(model, q_, delta, j1_, pinocchio::ARG1);
+  pinlib::d_integrate(model, q_, delta, j0_, pinocchio::ARG0);
+  pinlib::d_integrate(model, q_, delta, j1_, pinocchio::ARG1);
   auto dq_next = local_.topRows(nv);
   dq_next.noalias() = h * j1_ * d_rate_sum;
   dq_next.leftCols(nv) += j0_;
   local_.bottomRows(nv) = e_v + h * d_accel_sum;
-  pinocchio::integrate(model, q_, delta, q_next_);
+  pinlib::integrate(model, q_, delta, q_next_);
   q_ = q_next_;
   v_ += h * accel_sum;
 }

@@ -1,6 +1,7 @@
 #include "system.hpp"
 
 #include "joint_box.hpp"
+#include "pinocchio_kinematics.hpp"
 
 #include <algorithm>
 #include <string>
@@ -173,7 +174,7 @@ void System::contacts_at(const Data& robot) {
 }
 
 void System::kinematics(const ConstVec& q, const ConstVec& v) {
-  pinocchio::forwardKinematics(plant_.dynamics().model(), robot_data_, q.head(nq_robot_),
+  pinlib::forward_kinematics(plant_.dynamics().model(), robot_data_, q.head(nq_robot_),
                                v.head(nv_robot_));
   object_kinematics(q, v);
 }
@@ -335,8 +336,8 @@ void System::constrain(double t0, const ConstVec& q0, const ConstVec& v0, double
     const auto i = static_cast<Eigen::Index>(k);
     const auto q0_k = q0.segment(nq_robot_ + 7 * i, 7);
     Dynamics& body = objects_[k];
-    Vec6 travelled;
-    pinocchio::difference(body.model(), q0_k, q1.segment(nq_robot_ + 7 * i, 7), travelled);
+    const Vec6 travelled =
+        pinlib::differenced(body.model(), q0_k, q1.segment(nq_robot_ + 7 * i, 7));
     const Vec6 least = (travelled.cwiseAbs() / h).cwiseMax(v0.segment(nv_robot_ + 6 * i, 6).cwiseAbs());
     const Mat6 mass = body.mass_matrix_in(q0_k, plant_.flow, t0, plant_.free_surface);
     body.kinematics(q0_k, v0.segment(nv_robot_ + 6 * i, 6));
@@ -399,7 +400,7 @@ void System::constrain_coupled(double t0, const ConstVec& q0, const ConstVec& v0
   at.sets = &sets;
   // the least speeds: the smooth step's start and its mean over the period (period.py)
   Eigen::VectorXd least(model_.nv), travelled(nv_robot_);
-  pinocchio::difference(robot, at.q0_robot, q1.head(nq_robot_), travelled);
+  pinlib::difference(robot, at.q0_robot, q1.head(nq_robot_), travelled);
   least.head(nv_robot_) = (travelled.cwiseAbs() / h).cwiseMax(v0.head(nv_robot_).cwiseAbs());
   std::vector<Eigen::MatrixXd> masses{
       plant_.dynamics().mass_matrix_in(at.q0_robot, plant_.flow, t0, plant_.free_surface)};
@@ -408,8 +409,7 @@ void System::constrain_coupled(double t0, const ConstVec& q0, const ConstVec& v0
     const auto i = static_cast<Eigen::Index>(k);
     const auto q0_k = q0.segment(nq_robot_ + 7 * i, 7);
     Dynamics& body = objects_[k];
-    Vec6 moved;
-    pinocchio::difference(body.model(), q0_k, q1.segment(nq_robot_ + 7 * i, 7), moved);
+    const Vec6 moved = pinlib::differenced(body.model(), q0_k, q1.segment(nq_robot_ + 7 * i, 7));
     least.segment<6>(nv_robot_ + 6 * i) =
         (moved.cwiseAbs() / h).cwiseMax(v0.segment(nv_robot_ + 6 * i, 6).cwiseAbs());
     masses.emplace_back(body.mass_matrix_in(q0_k, plant_.flow, t0, plant_.free_surface));
@@ -447,7 +447,7 @@ void System::constrain_coupled(double t0, const ConstVec& q0, const ConstVec& v0
     }
     if (!held.held(t0)) continue;
     if (!held.placed) {
-      if (!kinematics) pinocchio::forwardKinematics(robot, robot_data_, at.q0_robot);
+      if (!kinematics) pinlib::forward_kinematics(robot, robot_data_, at.q0_robot);
       kinematics = true;
       held.placement = robot_data_.oMi[static_cast<std::size_t>(held.link_joint)].actInv(
           at.objects[static_cast<std::size_t>(held.object)]->oMi[1]);
@@ -479,7 +479,7 @@ void System::constrain_coupled(double t0, const ConstVec& q0, const ConstVec& v0
   if (solved && coupled_step_.acting(0)) {
     v1.head(nv_robot_) = v.head(nv_robot_);
     Eigen::VectorXd q1_robot(nq_robot_);
-    pinocchio::integrate(robot, at.q0_robot, (h * v.head(nv_robot_)).eval(), q1_robot);
+    pinlib::integrate(robot, at.q0_robot, (h * v.head(nv_robot_)).eval(), q1_robot);
     q1.head(nq_robot_) = q1_robot;
   }
   for (std::size_t k = 0; k < objects_.size(); ++k) {

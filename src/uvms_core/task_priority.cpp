@@ -13,6 +13,8 @@
 #include <pinocchio/math/rpy.hpp>
 #include <pinocchio/spatial/explog.hpp>
 
+#include "pinocchio_kinematics.hpp"
+
 namespace uvms {
 
 DampedInverse damped_inverse_and_rows(const Eigen::MatrixXd& matrix, double damping) {
@@ -192,10 +194,10 @@ PriorityTask KinematicLevel::attitude_task() const {
 double KinematicLevel::manipulability(const Eigen::VectorXd& q) {
   const auto& model = pose_.model();
   auto& data = pose_.data();
-  pinocchio::computeJointJacobians(model, data, q);
+  pinlib::compute_joint_jacobians(model, data, q);
   pinocchio::updateFramePlacements(model, data);
   TrackingPose::Matrix6x jac = TrackingPose::Matrix6x::Zero(6, model.nv);
-  pinocchio::getFrameJacobian(model, data, pose_.settings().frame_id,
+  pinlib::get_frame_jacobian(model, data, pose_.settings().frame_id,
                               pinocchio::LOCAL_WORLD_ALIGNED, jac);
   const Eigen::MatrixXd arm = jac.rightCols(model.nv - 6);
   if (std::min(arm.rows(), arm.cols()) == 0) return 0.0;
@@ -215,8 +217,8 @@ bool KinematicLevel::manipulability_velocity(const Eigen::VectorXd& q, Eigen::Ve
   for (int j = 0; j < n - 6; ++j) {  // along each joint's velocity (continuous joints too)
     direction.setZero();
     direction[6 + j] = step;
-    pinocchio::integrate(model, q, direction, plus);
-    pinocchio::integrate(model, q, (-direction).eval(), minus);
+    pinlib::integrate(model, q, direction, plus);
+    pinlib::integrate(model, q, (-direction).eval(), minus);
     const double gradient = (manipulability(plus) - manipulability(minus)) / (2 * step);
     out[6 + j] = gains_.manipulability_gain * gradient;
   }
