@@ -19,6 +19,7 @@
 #include "pinocchio_kinematics.hpp"
 #include "plant.hpp"
 #include "ppc.hpp"
+#include "source_hash.hpp"
 #include "world_bindings.hpp"
 
 namespace nb = nanobind;
@@ -598,7 +599,7 @@ NB_MODULE(_core, m) {
   m.doc() = "Compiled dynamics, plant and controller of uvms-pin (C++ on Pinocchio's C++ API).";
   m.attr("API_VERSION") = uvms::kApiVersion;
   m.attr("PINOCCHIO_VERSION") = PINOCCHIO_VERSION;
-  m.attr("SOURCE_HASH") = UVMS_CORE_SOURCE_HASH;
+  m.attr("SOURCE_HASH") = uvms::core_source_hash();
   m.def("set_leak_warnings", &nb::set_leak_warnings, "on"_a,
         "Whether nanobind reports this module's objects still alive when it is freed at exit "
         "(on by default; uvms_pin.ocp turns it off: crocoddyl keeps what its nodes reach "

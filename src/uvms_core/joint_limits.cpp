@@ -11,9 +11,6 @@ namespace uvms {
 
 namespace {
 
-// The rounds of widening before the last solve (step.py's _MAX_ROUNDS)
-constexpr int kMaxRounds = 4;
-
 // Bounds lo <= v <= hi on some coordinates (the others free: -inf, +inf).
 struct Box {
   Eigen::VectorXd lo, hi;
@@ -169,7 +166,7 @@ bool JointLimitConstraintsModel::constrain(const Eigen::MatrixXd& mass,
   Eigen::VectorXd speed = v_free.cwiseAbs().cwiseMax(least_speed.cwiseAbs());
   Box box = selected(*this, q0, speed, h);
   if (box.rows == 0) return false;
-  for (int round = 0; round < kMaxRounds; ++round) {
+  for (int round = 0; round < kWideningRounds; ++round) {
     v = box_qp(mass, v_free, box);
     speed = speed.cwiseMax(v.cwiseAbs());
     Box wider = selected(*this, q0, speed, h);

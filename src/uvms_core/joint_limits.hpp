@@ -27,6 +27,10 @@
 
 namespace uvms {
 
+// The rounds of widening the selection of active rows before the last solve, in every implicit
+// constraint step of the core (physics/constraints/step.py's _MAX_ROUNDS)
+constexpr int kWideningRounds = 4;
+
 struct JointLimitConstraintsModel {
   std::vector<int> q_index;   // each limited joint's coordinate in q (one coordinate each)
   std::vector<int> v_index;   // and in v

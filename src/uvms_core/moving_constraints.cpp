@@ -14,15 +14,6 @@
 
 namespace uvms {
 
-namespace {
-
-// The rounds of widening before the last solve (step.py's _MAX_ROUNDS)
-constexpr int kMaxRounds = 4;
-// the tangential speed above which a pair slides [m/s] (object_contacts.py's SLIP_M_S)
-constexpr double kSlip = 1.0e-6;
-
-}  // namespace
-
 Eigen::MatrixXd CoupledConstraintStep::side_twist_jacobian(const SystemAtStart& at, int side,
                                                            const ContactShape& piece,
                                                            const Vec3& x) const {
@@ -306,7 +297,7 @@ void CoupledConstraintStep::forces(const SystemAtStart& at, const Eigen::VectorX
     const Eigen::Index n = found.normal_N.size();
     found.normal_N.conservativeResize(n + 1);
     found.normal_N[n] = impulse_[r + 2] / h;
-    found.sticking.push_back(rate.segment<2>(r).norm() <= kSlip);
+    found.sticking.push_back(rate.segment<2>(r).norm() <= kSlipSpeed_m_s);
     found.stretch_m.push_back(Vec3::Zero());
     found.material_m.push_back(Vec3::Zero());
     out.pair.push_back(row.pair);
@@ -372,7 +363,7 @@ bool CoupledConstraintStep::constrain(const SystemAtStart& at,
   int rows = select(at, speed, h);
   if (rows > 0) {
     bool settled = false;
-    for (int round = 0; round < kMaxRounds && !settled; ++round) {
+    for (int round = 0; round < kWideningRounds && !settled; ++round) {
       solve(masses, v_free, v);
       speed = speed.cwiseMax(v.cwiseAbs());
       // the same count: the same rows (the selection only grows with the speed)

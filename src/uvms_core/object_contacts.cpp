@@ -11,18 +11,15 @@
 #include <Eigen/Geometry>
 #include <pinocchio/spatial/explog.hpp>
 
+#include "joint_limits.hpp"
 #include "world_touch.hpp"
 
 namespace uvms {
 
 namespace {
 
-// The rounds of widening before the last solve (step.py's _MAX_ROUNDS)
-constexpr int kMaxRounds = 4;
 // |axis . n| beyond which a cylinder stands on an end face (gaps.py's _STANDING)
 constexpr double kStanding = 1.0 - 1.0e-9;
-// the tangential speed above which a patch slides [m/s] (object_contacts.py's SLIP_M_S)
-constexpr double kSlip = 1.0e-6;
 // the Gauss-Seidel sweeps stop when no impulse changes its rows' velocity by more [m/s]
 constexpr double kTolerance = 1.0e-10;
 constexpr int kMaxSweeps = 20000;
@@ -39,10 +36,6 @@ constexpr double kStallRatio = 0.5;
 // a solve that stops progressing within this residual [m/s] has converged (a tenth of the
 // reference ADMM's 1e-8): it stops there without being counted as stalled
 constexpr double kConverged = 1.0e-9;
-
-coal::Transform3s transform_of(const pinocchio::SE3& where) {
-  return coal::Transform3s(where.rotation(), where.translation());
-}
 
 // The candidates of a piece against a plane by points of its own (_plane_points of gaps.py).
 void plane_points(const ContactShape& piece, const pinocchio::SE3& where, const Vec3& normal,
@@ -317,7 +310,7 @@ void ObjectContactStep::forces(const Vec6& v, const Eigen::VectorXd& impulse, do
     touch.velocity_world_m_s.push_back(frames_[k] * rate.segment<3>(3 * i));
     out.force_world_N[k] = frames_[k] * impulse.segment<3>(3 * i) / h;
     out.normal_N[i] = impulse[3 * i + 2] / h;
-    out.sticking[k] = rate.segment<2>(3 * i).norm() <= kSlip;
+    out.sticking[k] = rate.segment<2>(3 * i).norm() <= kSlipSpeed_m_s;
   }
 }
 
@@ -330,7 +323,7 @@ bool ObjectContactStep::constrain(const WorldContactModel& world, const Friction
   int rows = select(world, memory, data, speed, h);
   if (rows > 0) {
     bool settled = false;
-    for (int round = 0; round < kMaxRounds && !settled; ++round) {
+    for (int round = 0; round < kWideningRounds && !settled; ++round) {
       solve(mass, v_free, v);
       speed = speed.cwiseMax(v.cwiseAbs());
       // the same count: the same contacts (the selection only grows with the speed), so

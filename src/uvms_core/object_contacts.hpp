@@ -33,6 +33,9 @@
 
 namespace uvms {
 
+// the tangential speed above which a contact slides [m/s] (object_contacts.py's SLIP_M_S)
+constexpr double kSlipSpeed_m_s = 1.0e-6;
+
 // One candidate contact point (Candidate of gaps.py); corner: the piece's corner, a rim's
 // lowest point -2 - rim, -1 coal's point.
 struct ContactCandidate {

@@ -80,13 +80,9 @@ bool sphere_misses(const Vec3& center, double radius, const LocalBox& box,
   return outside.norm() > radius;
 }
 
-namespace {
-
 coal::Transform3s transform_of(const pinocchio::SE3& where) {
   return coal::Transform3s(where.rotation(), where.translation());
 }
-
-}  // namespace
 
 double support_m(const ContactShape& shape, const Vec3& direction) {
   switch (shape.kind) {

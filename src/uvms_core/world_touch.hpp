@@ -23,6 +23,9 @@ namespace uvms {
 
 using Placements = aligned_vector<pinocchio::SE3>;
 
+// A placement as coal's transform (the same rotation and translation).
+coal::Transform3s transform_of(const pinocchio::SE3& where);
+
 // The m contact points at one state (Touch of touch.py).
 struct Touch {
   std::vector<int> piece, obj, corner;  // corner: the piece's corner index, -1: coal's point
