@@ -26,13 +26,23 @@ SOURCES := pyproject.toml CMakeLists.txt $(wildcard src/uvms_core/*.cpp src/uvms
 # first and pip builds with --no-build-isolation: `pin` (and coal, eigenpy, boost) is installed
 # once, not a second time in a throw-away build environment, and a re-install compiles only the
 # changed units (the include paths stay those of the venv, the build directory is build/).
+# The package's own dependencies (pyproject.toml's, and the extra's: [dev] or none) are
+# installed while pip compiles the core, by a second pip beside it: the compile keeps both cores
+# busy for minutes, the install is mostly one core unpacking wheels, and the two touch disjoint
+# packages (the build requirements are installed first and satisfy the dependencies' pins).
+# `pip check` then says whether the environment is whole.
 BUILD_REQUIRES := $(VENV)/build-requirements.txt
+DEPENDENCIES := $(VENV)/dependencies.txt
 define install_core
 	$(BIN)/python -c 'import tomllib; print(*tomllib.load(open("pyproject.toml", "rb"))["build-system"]["requires"], sep="\n")' > $(BUILD_REQUIRES)
 	$(BIN)/python -m pip install --quiet -r $(BUILD_REQUIRES)
 	extra=$$($(BIN)/python -c 'from scikit_build_core.build import get_requires_for_build_editable as r; print(*r())'); \
 	  [ -z "$$extra" ] || $(BIN)/python -m pip install --quiet $$extra
-	$(BIN)/python -m pip install --quiet --no-build-isolation -e '.$(1)'
+	$(BIN)/python -c 'import sys, tomllib; p = tomllib.load(open("pyproject.toml", "rb"))["project"]; x = sys.argv[1].strip("[]"); print(*p["dependencies"], *(p["optional-dependencies"][x] if x else ()), sep="\n")' '$(1)' > $(DEPENDENCIES)
+	$(BIN)/python -m pip install --quiet -r $(DEPENDENCIES) & deps=$$!; \
+	  $(BIN)/python -m pip install --quiet --no-build-isolation --no-deps -e . ; built=$$?; \
+	  wait $$deps; installed=$$?; [ $$built = 0 ] && [ $$installed = 0 ]
+	$(BIN)/python -m pip check
 endef
 
 $(STAMP): $(SOURCES)
