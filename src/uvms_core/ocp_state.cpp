@@ -12,7 +12,9 @@ namespace uvms {
 UvmsState::UvmsState(const Model& model)
     : crocoddyl::StateAbstractTpl<double>(model.nq + model.nv, 2 * model.nv),
       model_(model),
-      jq_(Eigen::MatrixXd::Zero(model.nv, model.nv)) {
+      jq_(Eigen::MatrixXd::Zero(model.nv, model.nv)),
+      q_out_(model.nq),
+      v_out_(model.nv) {
   for (int j = 1; j < model.njoints; ++j) {
     if (model.nqs[j] == 2 && model.nvs[j] == 1) {
       circle_q_.push_back(model.idx_qs[j]);
@@ -43,7 +45,10 @@ void UvmsState::diff(const Eigen::Ref<const Eigen::VectorXd>& x0,
                      const Eigen::Ref<const Eigen::VectorXd>& x1,
                      Eigen::Ref<Eigen::VectorXd> dxout) const {
   const int nq = model_.nq, nv = model_.nv;
-  dxout.head(nv) = pinlib::differenced(model_, x0.head(nq), x1.head(nq));
+  q0_ = x0.head(nq);
+  q1_ = x1.head(nq);
+  pinlib::difference(model_, q0_, q1_, v_out_);
+  dxout.head(nv) = v_out_;
   // continuous joints by atan2 (state.py: Pinocchio 4.1's SO(2) log rounds tiny steps to 0)
   for (std::size_t k = 0; k < circle_q_.size(); ++k) {
     const int i = circle_q_[k];
@@ -57,7 +62,10 @@ void UvmsState::integrate(const Eigen::Ref<const Eigen::VectorXd>& x,
                           const Eigen::Ref<const Eigen::VectorXd>& dx,
                           Eigen::Ref<Eigen::VectorXd> xout) const {
   const int nq = model_.nq, nv = model_.nv;
-  xout.head(nq) = pinlib::integrated(model_, x.head(nq), dx.head(nv));
+  q0_ = x.head(nq);
+  dq_ = dx.head(nv);
+  pinlib::integrate(model_, q0_, dq_, q_out_);
+  xout.head(nq) = q_out_;
   xout.tail(nv) = x.tail(nv) + dx.tail(nv);
 }
 
@@ -75,12 +83,14 @@ void UvmsState::Jdiff(const Eigen::Ref<const Eigen::VectorXd>& x0,
                       Eigen::Ref<Eigen::MatrixXd> Jfirst, Eigen::Ref<Eigen::MatrixXd> Jsecond,
                       crocoddyl::Jcomponent firstsecond) const {
   const int nq = model_.nq;
+  q0_ = x0.head(nq);
+  q1_ = x1.head(nq);
   if (firstsecond == crocoddyl::first || firstsecond == crocoddyl::both) {
-    pinlib::d_difference(model_, x0.head(nq), x1.head(nq), jq_, pinocchio::ARG0);
+    pinlib::d_difference(model_, q0_, q1_, jq_, pinocchio::ARG0);
     block(jq_, -1.0, Jfirst, crocoddyl::setto);
   }
   if (firstsecond == crocoddyl::second || firstsecond == crocoddyl::both) {
-    pinlib::d_difference(model_, x0.head(nq), x1.head(nq), jq_, pinocchio::ARG1);
+    pinlib::d_difference(model_, q0_, q1_, jq_, pinocchio::ARG1);
     block(jq_, 1.0, Jsecond, crocoddyl::setto);
   }
 }
@@ -91,12 +101,14 @@ void UvmsState::Jintegrate(const Eigen::Ref<const Eigen::VectorXd>& x,
                            Eigen::Ref<Eigen::MatrixXd> Jsecond,
                            crocoddyl::Jcomponent firstsecond, crocoddyl::AssignmentOp op) const {
   const int nq = model_.nq, nv = model_.nv;
+  q0_ = x.head(nq);
+  dq_ = dx.head(nv);
   if (firstsecond == crocoddyl::first || firstsecond == crocoddyl::both) {
-    pinlib::d_integrate(model_, x.head(nq), dx.head(nv), jq_, pinocchio::ARG0);
+    pinlib::d_integrate(model_, q0_, dq_, jq_, pinocchio::ARG0);
     block(jq_, 1.0, Jfirst, op);
   }
   if (firstsecond == crocoddyl::second || firstsecond == crocoddyl::both) {
-    pinlib::d_integrate(model_, x.head(nq), dx.head(nv), jq_, pinocchio::ARG1);
+    pinlib::d_integrate(model_, q0_, dq_, jq_, pinocchio::ARG1);
     block(jq_, 1.0, Jsecond, op);
   }
 }
@@ -107,9 +119,11 @@ void UvmsState::JintegrateTransport(const Eigen::Ref<const Eigen::VectorXd>& x,
                                     crocoddyl::Jcomponent firstsecond) const {
   const int nq = model_.nq, nv = model_.nv;
   const auto arg = firstsecond == crocoddyl::first ? pinocchio::ARG0 : pinocchio::ARG1;
-  Eigen::MatrixXd transported = Jin.topRows(nv);  // (the library's instantiation: a MatrixXd)
-  pinlib::d_integrate_transport(model_, x.head(nq), dx.head(nv), transported, arg);
-  Jin.topRows(nv) = transported;
+  q0_ = x.head(nq);
+  dq_ = dx.head(nv);
+  transported_ = Jin.topRows(nv);  // (the library's instantiation takes a MatrixXd)
+  pinlib::d_integrate_transport(model_, q0_, dq_, transported_, arg);
+  Jin.topRows(nv) = transported_;
 }
 
 }  // namespace uvms

@@ -61,6 +61,10 @@ class UvmsState : public crocoddyl::StateAbstractTpl<double> {
   Model model_;
   std::vector<int> circle_q_, circle_v_;  // continuous joints: their q (cos) and v indices
   mutable MatrixXs jq_;                   // work buffer (nv, nv)
+  // the configurations and tangents of a call as the library's instantiations take them (plain
+  // vectors: pinocchio_kinematics.hpp), kept so that a node's call allocates nothing
+  mutable VectorXs q0_, q1_, dq_, q_out_, v_out_;
+  mutable MatrixXs transported_;
 };
 
 }  // namespace uvms
