@@ -43,6 +43,13 @@ class Hits:
     normal_world: np.ndarray
     label: np.ndarray
 
+    def keep(self, index: int, where: np.ndarray, range_m, normal_world) -> None:
+        """The rays ``where`` now meet body ``index`` (label index + 1) at ``range_m``, the
+        surface's normal there ``normal_world`` (one (3,) for all, or a row each)."""
+        self.range_m[where] = range_m
+        self.normal_world[where] = normal_world
+        self.label[where] = index + 1
+
 
 class RayCaster:
     """Bodies (shape, name) at poses; `cast` finds each ray's nearest hit."""
@@ -87,12 +94,8 @@ class RayCaster:
                 found = _on_plane(shape, rotation, position, origin, d, hits.range_m)
             else:
                 found = self._on_body(k, origin, d, bundles, hits.range_m)
-            if found is None:
-                continue
-            where, t, normal_world = found
-            hits.range_m[where] = t
-            hits.normal_world[where] = normal_world
-            hits.label[where] = k + 1
+            if found is not None:
+                hits.keep(k, *found)
         return hits
 
     def _on_body(
@@ -105,7 +108,7 @@ class RayCaster:
     ) -> tuple[np.ndarray, np.ndarray, np.ndarray] | None:
         """The rays body ``k`` meets nearer than ``best``: (their rows, ranges, world
         normals), None for none."""
-        shape, rotation, position = self._shapes[k], self._rotations[k], self._positions[k]
+        shape, position = self._shapes[k], self._positions[k]
         within = None
         if bundles is not None and np.isfinite(shape.bound_radius_m):
             within = bundles.rays_toward(position - origin, shape.bound_radius_m)
@@ -114,8 +117,23 @@ class RayCaster:
             return None
         o_k = origin if rows is None or origin.ndim == 1 else origin[rows]
         d_k = d if rows is None else d[rows]
-        local = np.broadcast_to((o_k - position) @ rotation, d_k.shape)
-        t, n_local = shape.hit(local, d_k @ rotation)
+        return self._nearer_hits(k, o_k, d_k, rows, best)
+
+    def _nearer_hits(
+        self,
+        k: int,
+        origin: np.ndarray,
+        d: np.ndarray,
+        rows: np.ndarray | None,
+        best: np.ndarray,
+    ) -> tuple[np.ndarray, np.ndarray, np.ndarray] | None:
+        """Body ``k``'s own ``hit`` (in its frame) of the rays ``rows`` (None: all) from
+        ``origin`` ((3,), or theirs (m, 3)) along ``d`` (theirs (m, 3), world axes), kept
+        where nearer than ``best`` (of all rays): (their rows, ranges, world normals), None
+        for none."""
+        rotation, position = self._rotations[k], self._positions[k]
+        local = np.broadcast_to((origin - position) @ rotation, d.shape)
+        t, n_local = self._shapes[k].hit(local, d @ rotation)
         picked = rows if rows is not None else slice(None)
         nearer = t < best[picked]
         if not np.any(nearer):

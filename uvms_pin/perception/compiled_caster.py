@@ -145,16 +145,9 @@ class CompiledCaster(RayCaster):
             return
         picked = rows[:count]
         d = rays[picked] @ frame_rotation.T
-        rotation, position = self._rotations[k], self._positions[k]
-        local = np.broadcast_to((origin - position) @ rotation, d.shape)
-        t, n_local = self._shapes[k].hit(local, d @ rotation)
-        nearer = t < hits.range_m[picked]
-        if not np.any(nearer):
-            return
-        where = picked[nearer]
-        hits.range_m[where] = t[nearer]
-        hits.normal_world[where] = n_local[nearer] @ rotation.T
-        hits.label[where] = k + 1
+        found = self._nearer_hits(k, origin, d, picked, hits.range_m)
+        if found is not None:
+            hits.keep(k, *found)
 
 
 def caster_for(backend: str | Backend = "core") -> RayCaster:
