@@ -1,9 +1,9 @@
 // A camera's pixels from its rays' hits (camera_shading.hpp).
 #include "camera_shading.hpp"
 
-// no a * b + c fused into one rounding where the processor could (x86-64-v3's clones): the
-// radiance is the same, bit for bit, on every processor
-#pragma GCC optimize("fp-contract=off")
+// compiled with -ffp-contract=off (CMakeLists.txt), as vector_exp.cpp: no a * b + c fused
+// into one rounding where the processor could (x86-64-v3's clones), so the radiance is the
+// same, bit for bit, on every processor
 
 #include "vector_exp.hpp"
 

@@ -1,6 +1,11 @@
 // The ray caster (ray_caster.hpp): bodies at poses, each ray's nearest hit.
 #include "ray_caster.hpp"
 
+// The loops over a cone's rays are vectorized by the compiler (struct-of-arrays kernels,
+// compiled for x86-64-v3 too: `cast`'s clones), with -fno-math-errno -ffp-contract=off for
+// this unit (CMakeLists.txt): the same hits, bit for bit, on every processor.
+#include "vector_exp.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <memory>
@@ -41,6 +46,289 @@ struct Seen {
   std::unique_ptr<MeshView> view;
   std::vector<int> candidates;  // the triangles of the cone being cast
 };
+
+// A cone's rays as the vectorized loops take them, one entry a ray: its world direction by
+// axis, its direction in the body being cast (`local_directions`), and what it met nearest
+// so far (its range is in the outputs): the body (-1: none) and the face (a convex body's,
+// a cylinder's side 0 or cap +-1, a mesh's triangle).
+struct ConeRays {
+  std::vector<double> x, y, z, lx, ly, lz;
+  std::vector<std::int64_t> body, face;
+  std::vector<double> enter, leave;  // a convex body's slabs
+  std::vector<std::int64_t> entered;
+  void resize(Eigen::Index n) {
+    if (static_cast<Eigen::Index>(x.size()) >= n) return;
+    for (auto* v : {&x, &y, &z, &lx, &ly, &lz, &enter, &leave}) v->resize(n);
+    for (auto* v : {&body, &face, &entered}) v->resize(n);
+  }
+};
+
+// The loops over a cone's rays (the kernels below) take plain arrays and numbers, no Eigen
+// type: each is compiled for x86-64-v3 too (UVMS_VECTOR_CLONES), where a call into Eigen
+// would not be inlined. Each computes a value by the same operations, in the same order, as
+// the shapes' own (ray_shapes.hpp) and as Eigen's Vec3 and Mat3 products (noted where it
+// matters): the same bits as the ray-by-ray loop they replace.
+
+// A rotation's entries, row by row (r[3 i + j] = R(i, j)).
+struct Rows {
+  double r[9];
+  explicit Rows(const Mat3& m) {
+    for (int i = 0; i < 3; ++i) {
+      for (int j = 0; j < 3; ++j) r[3 * i + j] = m(i, j);
+    }
+  }
+};
+
+// What a bounded body's `may_meet` reads (unbounded: every ray may meet it).
+struct Bound {
+  double c0, c1, c2, centre2, reach, reach2;
+  bool unbounded;
+};
+
+// `may_meet` of a ray (world d), without a branch (a vector loop takes both sides).
+[[gnu::always_inline]] inline bool may_reach(const Bound& b, double dx, double dy, double dz,
+                                             double best) {
+  const double along = (dx * b.c0 + dy * b.c1) + dz * b.c2;  // d.dot(to_centre)
+  const double across2 = b.centre2 - along * along;
+  return b.unbounded | ((across2 <= b.reach2) & (along + b.reach > 0.0) & (along - b.reach < best));
+}
+
+// The hits kept so far: range (the outputs'), body and face of each ray.
+struct Nearest {
+  double* __restrict range;
+  std::int64_t* __restrict body;
+  std::int64_t* __restrict face;
+};
+
+// Keeps body k's crossing t (face) of ray i where the ray may meet it and it is nearer.
+[[gnu::always_inline]] inline void keep_nearer(const Nearest& out, Eigen::Index i, double t,
+                                               std::int64_t face, bool may, std::int64_t k) {
+  const bool take = may & (t < out.range[i]);
+  out.range[i] = take ? t : out.range[i];
+  out.body[i] = take ? k : out.body[i];
+  out.face[i] = take ? face : out.face[i];
+}
+
+// d = R_f d_f of n rays (row-major (n, 3)), by axis. Eigen's Mat3 * Vec3 sums the first two
+// rows as (r0 f0 + r1 f1) + r2 f2 (one vector of two) and the third as r0 f0 + (r1 f1 +
+// r2 f2) (a reduction of the row).
+UVMS_VECTOR_CLONES
+void world_directions(const Rows& rows, const double* __restrict rays_f, Eigen::Index n,
+                      double* __restrict x, double* __restrict y, double* __restrict z) {
+  const double* r = rows.r;
+  for (Eigen::Index i = 0; i < n; ++i) {
+    const double f0 = rays_f[3 * i], f1 = rays_f[3 * i + 1], f2 = rays_f[3 * i + 2];
+    x[i] = (r[0] * f0 + r[1] * f1) + r[2] * f2;
+    y[i] = (r[3] * f0 + r[4] * f1) + r[5] * f2;
+    z[i] = r[6] * f0 + (r[7] * f1 + r[8] * f2);
+  }
+}
+
+// d_b = R^T d in a body's frame (R its rotation): Eigen's R.transpose() * d, each entry a
+// reduction (a + b) + c of a column of R.
+UVMS_VECTOR_CLONES
+void local_directions(const Rows& rows, Eigen::Index n, const double* __restrict x,
+                      const double* __restrict y, const double* __restrict z,
+                      double* __restrict lx, double* __restrict ly, double* __restrict lz) {
+  const double* r = rows.r;
+  for (Eigen::Index i = 0; i < n; ++i) {
+    lx[i] = (r[0] * x[i] + r[3] * y[i]) + r[6] * z[i];
+    ly[i] = (r[1] * x[i] + r[4] * y[i]) + r[7] * z[i];
+    lz[i] = (r[2] * x[i] + r[5] * y[i]) + r[8] * z[i];
+  }
+}
+
+// A plane (`RayShape::plane_along`): t = -h / (d . n) when d . n < 0 < h.
+UVMS_VECTOR_CLONES
+void nearer_on_plane(double n0, double n1, double n2, double height, std::int64_t k,
+                     Eigen::Index n, const double* __restrict x, const double* __restrict y,
+                     const double* __restrict z, Nearest out) {
+  for (Eigen::Index i = 0; i < n; ++i) {
+    const double rate = (x[i] * n0 + y[i] * n1) + z[i] * n2;
+    const double along = -height / rate;
+    const double t = ((rate < 0.0) & (height > 0.0) & (along > kTMinM)) ? along : kInf;
+    keep_nearer(out, i, t, 0, true, k);
+  }
+}
+
+// A sphere of `radius` seen from o (its frame): the smaller root of |o + t d|^2 = r^2
+// (`RayShape::sphere_crossing`); an ellipsoid of semi-axes s: the unit sphere's in x / s.
+// The rays' directions are given twice: in the world (x, for the bound) and in the body's
+// frame (l).
+struct Directions {
+  const double* __restrict x;
+  const double* __restrict y;
+  const double* __restrict z;
+  const double* __restrict lx;
+  const double* __restrict ly;
+  const double* __restrict lz;
+};
+
+UVMS_VECTOR_CLONES
+void nearer_on_sphere(double o0, double o1, double o2, double c, const Bound& bound,
+                      std::int64_t k, Eigen::Index n, Directions d, Nearest out) {
+  for (Eigen::Index i = 0; i < n; ++i) {
+    const double b = (o0 * d.lx[i] + o1 * d.ly[i]) + o2 * d.lz[i];
+    const double disc = b * b - c;
+    const double enter = -b - std::sqrt(disc);
+    const double t = ((disc >= 0.0) & (enter > kTMinM) & (c > 0.0)) ? enter : kInf;
+    keep_nearer(out, i, t, 0, may_reach(bound, d.x[i], d.y[i], d.z[i], out.range[i]), k);
+  }
+}
+
+UVMS_VECTOR_CLONES
+void nearer_on_ellipsoid(const double* os, double oo, const double* semi_axes,
+                         const Bound& bound, std::int64_t k, Eigen::Index n, Directions d,
+                         Nearest out) {
+  const double s0 = semi_axes[0], s1 = semi_axes[1], s2 = semi_axes[2];
+  const double os0 = os[0], os1 = os[1], os2 = os[2];
+  for (Eigen::Index i = 0; i < n; ++i) {
+    const double d0 = d.lx[i] / s0, d1 = d.ly[i] / s1, d2 = d.lz[i] / s2;
+    const double a = (d0 * d0 + d1 * d1) + d2 * d2;
+    const double b = ((os0 * d0 + os1 * d1) + os2 * d2) / a;
+    const double c = (oo - 1.0) / a;
+    const double disc = b * b - c;
+    const double enter = -b - std::sqrt(disc);
+    const double t = ((disc >= 0.0) & (enter > kTMinM) & (c > 0.0)) ? enter : kInf;
+    keep_nearer(out, i, t, 0, may_reach(bound, d.x[i], d.y[i], d.z[i], out.range[i]), k);
+  }
+}
+
+// A cylinder of `radius` and `length` along z (`RayShape::cylinder_crossing`): the slab
+// |z| <= L / 2 and the infinite cylinder x^2 + y^2 <= r^2; the face: its side (0) or a cap
+// (+-1). std::max(a, b) is (a < b) ? b : a, std::min(a, b) is (b < a) ? b : a.
+UVMS_VECTOR_CLONES
+void nearer_on_cylinder(double o0, double o1, double o2, double radius, double length,
+                        const Bound& bound, std::int64_t k, Eigen::Index n, Directions d,
+                        Nearest out) {
+  const double half = 0.5 * length;
+  const double top_of_parallel = (half - o2) / 1e-300, bottom_of_parallel = (half + o2) / 1e-300;
+  const double parallel_leave =
+      bottom_of_parallel < top_of_parallel ? bottom_of_parallel : top_of_parallel;
+  const double c_raw = o0 * o0 + o1 * o1 - radius * radius;
+  for (Eigen::Index i = 0; i < n; ++i) {
+    const double dx = d.lx[i], dy = d.ly[i], dz = d.lz[i];
+    const bool down = dz < 0.0, up = dz > 0.0;
+    const double rate = (down | up) ? dz : 1.0;
+    const double top = (half - o2) / rate, bottom = (half + o2) / -rate;
+    const double cap_enter = down ? top : (up ? bottom : -kInf);
+    const double cap_leave = up ? top : (down ? bottom : parallel_leave);
+    const double cap_z = up ? -1.0 : 1.0;
+    const double a = dx * dx + dy * dy;
+    const bool flat = a < 1e-300;  // along the axis: inside the side's region or never
+    const double safe = flat ? 1.0 : a;
+    const double b = (o0 * dx + o1 * dy) / safe;
+    const double disc = b * b - c_raw / safe;
+    const double root = std::sqrt(disc);
+    const double side_enter = flat ? (c_raw <= 0.0 ? -kInf : kInf)
+                                   : (disc >= 0.0 ? -b - root : kInf);
+    const double side_leave = flat ? (c_raw <= 0.0 ? kInf : -kInf)
+                                   : (disc >= 0.0 ? -b + root : -kInf);
+    const double enter = cap_enter < side_enter ? side_enter : cap_enter;
+    const double leave = side_leave < cap_leave ? side_leave : cap_leave;
+    const std::int64_t face = side_enter >= cap_enter ? 0 : static_cast<std::int64_t>(cap_z);
+    const double t = ((enter > kTMinM) & (enter <= leave)) ? enter : kInf;
+    keep_nearer(out, i, t, face, may_reach(bound, d.x[i], d.y[i], d.z[i], out.range[i]), k);
+  }
+}
+
+// A convex body A x <= b (`RayShape::convex_crossing`): each face f (unit row a, its gap
+// b_f - o . a) bounds t from below (a . d < 0: the face entered last) or above.
+UVMS_VECTOR_CLONES
+void nearer_on_convex(const double* faces_a, const double* gaps, Eigen::Index faces,
+                      const Bound& bound, std::int64_t k, Eigen::Index n, Directions d,
+                      double* __restrict enter, double* __restrict leave,
+                      std::int64_t* __restrict entered, Nearest out) {
+  for (Eigen::Index i = 0; i < n; ++i) {
+    enter[i] = -kInf;
+    leave[i] = kInf;
+    entered[i] = 0;
+  }
+  for (Eigen::Index f = 0; f < faces; ++f) {
+    const double a0 = faces_a[3 * f], a1 = faces_a[3 * f + 1], a2 = faces_a[3 * f + 2];
+    const double gap = gaps[f];
+    for (Eigen::Index i = 0; i < n; ++i) {
+      double rate = (d.lx[i] * a0 + d.ly[i] * a1) + d.lz[i] * a2;
+      rate = rate == 0.0 ? 1e-300 : rate;  // parallel: a huge t of the gap's sign
+      const double t = gap / rate;
+      const bool facing = rate < 0.0;
+      const bool further = facing & (t > enter[i]);
+      enter[i] = further ? t : enter[i];
+      entered[i] = further ? f : entered[i];
+      leave[i] = (!facing & (t < leave[i])) ? t : leave[i];
+    }
+  }
+  for (Eigen::Index i = 0; i < n; ++i) {
+    const double t = ((enter[i] > kTMinM) & (enter[i] <= leave[i])) ? enter[i] : kInf;
+    keep_nearer(out, i, t, entered[i], may_reach(bound, d.x[i], d.y[i], d.z[i], out.range[i]),
+                k);
+  }
+}
+
+// A bounded body's terms for `may_reach`.
+Bound bound_of(const Seen& s) {
+  return {s.to_centre.x(), s.to_centre.y(), s.to_centre.z(), s.centre2, s.reach,
+          s.reach * s.reach, !s.bounded};
+}
+
+// A solid's crossings of the cone's rays (their directions in its frame already in `rays`).
+void nearer_on_solid(const RayShape& shape, const Seen& s, std::int64_t k, Eigen::Index n,
+                     ConeRays& rays, double* range) {
+  const Nearest out{range, rays.body.data(), rays.face.data()};
+  const Directions d{rays.x.data(),  rays.y.data(),  rays.z.data(),
+                     rays.lx.data(), rays.ly.data(), rays.lz.data()};
+  const Bound bound = bound_of(s);
+  const Vec3& o = s.origin_local;
+  switch (shape.kind) {
+    case ShapeKind::sphere:
+      nearer_on_sphere(o.x(), o.y(), o.z(), o.dot(o) - shape.radius_m * shape.radius_m, bound,
+                       k, n, d, out);
+      return;
+    case ShapeKind::ellipsoid: {
+      const Vec3 os = o.cwiseQuotient(shape.semi_axes_m);
+      nearer_on_ellipsoid(os.data(), os.dot(os), shape.semi_axes_m.data(), bound, k, n, d, out);
+      return;
+    }
+    case ShapeKind::cylinder:
+      nearer_on_cylinder(o.x(), o.y(), o.z(), shape.radius_m, shape.length_m, bound, k, n, d,
+                         out);
+      return;
+    case ShapeKind::convex: {
+      const Eigen::Index faces = shape.normals.rows();
+      Eigen::VectorXd gaps(faces);  // >= 0 inside each face's half-space
+      for (Eigen::Index f = 0; f < faces; ++f) {
+        const Vec3 a = shape.normals.row(f).transpose();
+        gaps[f] = shape.offsets[f] - o.dot(a);
+      }
+      nearer_on_convex(shape.normals.data(), gaps.data(), faces, bound, k, n, d,
+                       rays.enter.data(), rays.leave.data(), rays.entered.data(), out);
+      return;
+    }
+    default:
+      return;
+  }
+}
+
+// A triangle mesh, ray by ray: its nearest crossing among the cone's candidates, kept on a
+// triangle's front beyond kTMinM (ray_mesh.hpp: TriangleMesh.hit's rule).
+void nearer_on_mesh(const RayShape& shape, const Mat3& rotation, const Seen& s,
+                    std::int64_t k, Eigen::Index n, ConeRays& rays, double* range) {
+  const MeshView& view = *s.view;
+  const TriangleSet& triangles = *shape.triangles;
+  for (Eigen::Index i = 0; i < n; ++i) {
+    const Vec3 d(rays.x[i], rays.y[i], rays.z[i]);
+    const double best = range[i];
+    if (s.bounded && !may_meet(s.to_centre, s.centre2, s.reach, d, best)) continue;
+    const Vec3 d_local = rotation.transpose() * d;
+    const auto crossing = view.nearest(d_local, s.candidates, best);
+    if (crossing.triangle < 0) continue;
+    const Vec3& face = triangles.normal[crossing.triangle];
+    if (!(face.dot(d_local) < 0.0) || !(crossing.t > kTMinM) || !(crossing.t < best)) continue;
+    range[i] = crossing.t;
+    rays.body[i] = k;
+    rays.face[i] = crossing.triangle;
+  }
+}
 
 // Rays given without cones, for a caster with meshes: cones of kRaysPerCone consecutive rays
 // each, their axes the rays' normalized sums and their half-angles the widest ray's (as
@@ -163,7 +451,8 @@ void RayCaster::cast(const Vec3& origin, const Mat3& frame_rotation, const doubl
   const Eigen::Index groups = cones == nullptr ? 1 : cones->count;
   std::vector<int> active;
   active.reserve(bodies_.size());
-  std::vector<double> directions;  // a cone's rays in the world, (count, 3)
+  ConeRays rays;
+  const Rows frame_rows(frame_rotation);
   for (Eigen::Index j = 0; j < groups; ++j) {
     active.clear();
     for (std::size_t k = 0; k < bodies_.size(); ++k) {
@@ -185,79 +474,58 @@ void RayCaster::cast(const Vec3& origin, const Mat3& frame_rotation, const doubl
     }
     const Eigen::Index first = cones == nullptr ? 0 : cones->starts[j];
     const Eigen::Index last = cones == nullptr ? n : cones->starts[j + 1];
-    // the cone's rays body by body (each ray meets the bodies in the same order as ray by
-    // ray, so its nearest hit is the same), what they met so far kept in the outputs
-    double* const range = out.range_m + first;
-    double* const normal_out = out.normal_world + 3 * first;
-    std::int32_t* const label_out = out.label + first;
     const Eigen::Index count = last - first;
-    if (static_cast<Eigen::Index>(directions.size()) < 3 * count) directions.resize(3 * count);
-    double* const dirs = directions.data();
-    for (Eigen::Index i = 0; i < count; ++i) {
-      const Vec3 d = frame_rotation * Eigen::Map<const Vec3>(rays_f + 3 * (first + i));
-      Eigen::Map<Vec3>(dirs + 3 * i) = d;
-      range[i] = kInf;
-      Eigen::Map<Vec3>(normal_out + 3 * i) = Vec3::Zero();
-      label_out[i] = 0;
-    }
+    rays.resize(count);
+    // the cone's rays body by body (each ray meets the bodies in the same order as ray by
+    // ray, so its nearest hit is the same), the nearest so far in the outputs' ranges
+    double* const range = out.range_m + first;
+    world_directions(frame_rows, rays_f + 3 * first, count, rays.x.data(), rays.y.data(),
+                     rays.z.data());
+    for (Eigen::Index i = 0; i < count; ++i) range[i] = kInf;
+    std::fill(rays.body.begin(), rays.body.begin() + count, -1);
     for (const int k : active) {
       const Seen& s = seen[k];
-      const int label = k + 1;
       if (s.how == Seen::plane) {
-        const Vec3 plane_normal = s.normal_world;
-        const double height = s.height_m;
-        for (Eigen::Index i = 0; i < count; ++i) {
-          const Vec3 d = Eigen::Map<const Vec3>(dirs + 3 * i);
-          const double t = RayShape::plane_along(height, d.dot(plane_normal));
-          if (t < range[i]) {
-            range[i] = t;
-            Eigen::Map<Vec3>(normal_out + 3 * i) = plane_normal;
-            label_out[i] = label;
-          }
-        }
+        nearer_on_plane(s.normal_world.x(), s.normal_world.y(), s.normal_world.z(), s.height_m,
+                        k, count, rays.x.data(), rays.y.data(), rays.z.data(),
+                        {range, rays.body.data(), rays.face.data()});
         continue;
       }
       const Body& body = bodies_[k];
-      const Mat3 rotation = body.rotation;
-      const Vec3 to_centre = s.to_centre;
-      const double centre2 = s.centre2, reach = s.reach;
-      const bool bounded = s.bounded;
       if (s.how == Seen::mesh) {
-        const MeshView& view = *s.view;
-        const TriangleSet& triangles = *body.shape.triangles;
-        for (Eigen::Index i = 0; i < count; ++i) {
-          const Vec3 d = Eigen::Map<const Vec3>(dirs + 3 * i);
-          const double best = range[i];
-          if (bounded && !may_meet(to_centre, centre2, reach, d, best)) continue;
-          const Vec3 d_local = rotation.transpose() * d;
-          // the mesh's nearest crossing, kept on a triangle's front beyond kTMinM
-          // (ray_mesh.hpp: TriangleMesh.hit's rule)
-          const auto crossing = view.nearest(d_local, s.candidates, best);
-          if (crossing.triangle < 0) continue;
-          const Vec3& face = triangles.normal[crossing.triangle];
-          if (!(face.dot(d_local) < 0.0) || !(crossing.t > kTMinM) || !(crossing.t < best)) {
-            continue;
-          }
-          range[i] = crossing.t;
-          Eigen::Map<Vec3>(normal_out + 3 * i) = rotation * face;
-          label_out[i] = label;
-        }
+        nearer_on_mesh(body.shape, body.rotation, s, k, count, rays, range);
         continue;
       }
-      const RayShape& shape = body.shape;
-      const Vec3 origin_local = s.origin_local;
-      for (Eigen::Index i = 0; i < count; ++i) {
-        const Vec3 d = Eigen::Map<const Vec3>(dirs + 3 * i);
-        if (bounded && !may_meet(to_centre, centre2, reach, d, range[i])) continue;
-        const Vec3 d_local = rotation.transpose() * d;
-        const RayCrossing crossed = shape.crossing(origin_local, d_local);
-        if (crossed.t < range[i]) {  // the normal of the hits kept only
-          range[i] = crossed.t;
-          Eigen::Map<Vec3>(normal_out + 3 * i) =
-              rotation * shape.normal_at(origin_local, d_local, crossed);
-          label_out[i] = label;
-        }
+      local_directions(Rows(body.rotation), count, rays.x.data(), rays.y.data(), rays.z.data(),
+                       rays.lx.data(), rays.ly.data(), rays.lz.data());
+      nearer_on_solid(body.shape, s, k, count, rays, range);
+    }
+    // what each ray met: its label and normal, from the nearest body's own numbers
+    double* const normal_out = out.normal_world + 3 * first;
+    std::int32_t* const label_out = out.label + first;
+    for (Eigen::Index i = 0; i < count; ++i) {
+      const std::int64_t k = rays.body[i];
+      Eigen::Map<Vec3> normal(normal_out + 3 * i);
+      if (k < 0) {
+        normal.setZero();
+        label_out[i] = 0;
+        continue;
       }
+      label_out[i] = static_cast<std::int32_t>(k + 1);
+      const Seen& s = seen[k];
+      if (s.how == Seen::plane) {
+        normal = s.normal_world;
+        continue;
+      }
+      const Body& body = bodies_[k];
+      if (s.how == Seen::mesh) {
+        normal = body.rotation * body.shape.triangles->normal[rays.face[i]];
+        continue;
+      }
+      const Vec3 d(rays.x[i], rays.y[i], rays.z[i]);
+      const Vec3 d_local = body.rotation.transpose() * d;
+      normal = body.rotation * body.shape.normal_at(s.origin_local, d_local,
+                                                    RayCrossing{range[i], rays.face[i]});
     }
   }
 }

@@ -6,7 +6,10 @@
 // an ulp or two of std::exp (tests/perception/test_compiled_caster.py). The loop has no branch,
 // so the compiler vectorizes it; on x86-64 it is compiled twice, for the baseline (SSE2) and
 // for x86-64-v3 (AVX2, FMA), the processor's picked when the module loads (GCC's
-// target_clones): the build's flags stay the baseline's.
+// target_clones): the build's flags stay the baseline's. The units that use the clones are
+// compiled with -ffp-contract=off (CMakeLists.txt): without it GCC fuses p * r + c into one
+// FMA in the x86-64-v3 clone, and an exponential (hence an image) would differ in its last
+// bits between processors with and without AVX2.
 #pragma once
 
 #include <Eigen/Core>
