@@ -265,6 +265,41 @@ void nearer_on_convex(const double* faces_a, const double* gaps, Eigen::Index fa
   }
 }
 
+// One candidate triangle of a mesh against a cone's rays (their directions in its frame):
+// `MeshView::nearest`'s step for each ray, the candidates taken in the same order. A ray still
+// looks while the triangle's lower bound is below min(its crossing so far, its bound) (the
+// candidates come by lower bound: once it stops, it stops for good); inside the triangle's
+// three edges it crosses its plane at t = (N . (p0 - o)) / (N . d), kept if t > 0 and nearer.
+// Returns how many rays still looked (0: none will for the later candidates).
+UVMS_VECTOR_CLONES
+Eigen::Index mesh_candidate(const MeshView::FaceNumbers& f, std::int64_t k, Eigen::Index n,
+                            Directions d, const double* __restrict bound,
+                            double* __restrict t_out, std::int64_t* __restrict k_out) {
+  const double e00 = f.edge[0], e01 = f.edge[1], e02 = f.edge[2];
+  const double e10 = f.edge[3], e11 = f.edge[4], e12 = f.edge[5];
+  const double e20 = f.edge[6], e21 = f.edge[7], e22 = f.edge[8];
+  const double p0 = f.plane[0], p1 = f.plane[1], p2 = f.plane[2];
+  const double offset = f.plane_offset, lower = f.lower_m;
+  Eigen::Index looking = 0;
+  for (Eigen::Index i = 0; i < n; ++i) {
+    const double dx = d.lx[i], dy = d.ly[i], dz = d.lz[i];
+    const double limit = bound[i] < t_out[i] ? bound[i] : t_out[i];  // std::min(t, bound)
+    const bool active = lower < limit;
+    looking += active;
+    const double side0 = (dx * e00 + dy * e01) + dz * e02;  // d . edge
+    const double side1 = (dx * e10 + dy * e11) + dz * e12;
+    const double side2 = (dx * e20 + dy * e21) + dz * e22;
+    const bool inside = (side0 >= 0.0) & (side1 >= 0.0) & (side2 >= 0.0);
+    const double rate = (p0 * dx + p1 * dy) + p2 * dz;  // N . d
+    const double t = offset / rate;
+    const bool nearer =
+        active & inside & (rate != 0.0) & (t > 0.0) & (t < t_out[i]);
+    t_out[i] = nearer ? t : t_out[i];
+    k_out[i] = nearer ? k : k_out[i];
+  }
+  return looking;
+}
+
 // A bounded body's terms for `may_reach`.
 Bound bound_of(const Seen& s) {
   return {s.to_centre.x(), s.to_centre.y(), s.to_centre.z(), s.centre2, s.reach,
@@ -309,24 +344,42 @@ void nearer_on_solid(const RayShape& shape, const Seen& s, std::int64_t k, Eigen
   }
 }
 
-// A triangle mesh, ray by ray: its nearest crossing among the cone's candidates, kept on a
-// triangle's front beyond kTMinM (ray_mesh.hpp: TriangleMesh.hit's rule).
-void nearer_on_mesh(const RayShape& shape, const Mat3& rotation, const Seen& s,
-                    std::int64_t k, Eigen::Index n, ConeRays& rays, double* range) {
+// A triangle mesh: each candidate of the cone (nearest lower bound first) against all its
+// rays (`mesh_candidate`), until none looks further; then a ray's nearest crossing is kept on
+// a triangle's front beyond kTMinM and nearer than what it met (ray_mesh.hpp:
+// TriangleMesh.hit's rule). The same crossings as `MeshView::nearest` ray by ray. A ray that
+// may not meet the mesh's bounding sphere (`may_meet`) looks for nothing (its bound -inf).
+void nearer_on_mesh(const RayShape& shape, const Seen& s, std::int64_t k, Eigen::Index n,
+                    ConeRays& rays, double* range) {
   const MeshView& view = *s.view;
   const TriangleSet& triangles = *shape.triangles;
+  const Bound bound = bound_of(s);
+  double* const limit = rays.enter.data();  // scratch: each ray's bound, its crossing so far
+  double* const crossing_t = rays.leave.data();
+  std::int64_t* const triangle = rays.entered.data();
   for (Eigen::Index i = 0; i < n; ++i) {
-    const Vec3 d(rays.x[i], rays.y[i], rays.z[i]);
-    const double best = range[i];
-    if (s.bounded && !may_meet(s.to_centre, s.centre2, s.reach, d, best)) continue;
-    const Vec3 d_local = rotation.transpose() * d;
-    const auto crossing = view.nearest(d_local, s.candidates, best);
-    if (crossing.triangle < 0) continue;
-    const Vec3& face = triangles.normal[crossing.triangle];
-    if (!(face.dot(d_local) < 0.0) || !(crossing.t > kTMinM) || !(crossing.t < best)) continue;
-    range[i] = crossing.t;
+    const bool may = may_reach(bound, rays.x[i], rays.y[i], rays.z[i], range[i]);
+    limit[i] = may ? range[i] : -kInf;
+    crossing_t[i] = kInf;
+    triangle[i] = -1;
+  }
+  const Directions d{rays.x.data(),  rays.y.data(),  rays.z.data(),
+                     rays.lx.data(), rays.ly.data(), rays.lz.data()};
+  for (const int candidate : s.candidates) {
+    if (mesh_candidate(view.numbers(candidate), candidate, n, d, limit, crossing_t, triangle) ==
+        0) {
+      break;
+    }
+  }
+  for (Eigen::Index i = 0; i < n; ++i) {
+    if (triangle[i] < 0) continue;
+    const Vec3 d_local(rays.lx[i], rays.ly[i], rays.lz[i]);
+    const Vec3& face = triangles.normal[triangle[i]];
+    const double t = crossing_t[i];
+    if (!(face.dot(d_local) < 0.0) || !(t > kTMinM) || !(t < range[i])) continue;
+    range[i] = t;
     rays.body[i] = k;
-    rays.face[i] = crossing.triangle;
+    rays.face[i] = triangle[i];
   }
 }
 
@@ -492,12 +545,12 @@ void RayCaster::cast(const Vec3& origin, const Mat3& frame_rotation, const doubl
         continue;
       }
       const Body& body = bodies_[k];
-      if (s.how == Seen::mesh) {
-        nearer_on_mesh(body.shape, body.rotation, s, k, count, rays, range);
-        continue;
-      }
       local_directions(Rows(body.rotation), count, rays.x.data(), rays.y.data(), rays.z.data(),
                        rays.lx.data(), rays.ly.data(), rays.lz.data());
+      if (s.how == Seen::mesh) {
+        nearer_on_mesh(body.shape, s, k, count, rays, range);
+        continue;
+      }
       nearer_on_solid(body.shape, s, k, count, rays, range);
     }
     // what each ray met: its label and normal, from the nearest body's own numbers

@@ -70,6 +70,27 @@ class MeshView {
   };
   Crossing nearest(const Vec3& d, const std::vector<int>& candidates, double bound) const;
 
+  // What a ray tries of triangle k, as plain numbers (for a loop over many rays): its three
+  // inward edge normals (edge e: entries 3 e .. 3 e + 2), its plane's normal N, N . (p0 - o)
+  // and its lower bound (`nearest`'s, the same values).
+  struct FaceNumbers {
+    double edge[9];
+    double plane[3];
+    double plane_offset;
+    double lower_m;
+  };
+  FaceNumbers numbers(int k) const {
+    const Face& face = faces_[k];
+    FaceNumbers out;
+    for (int e = 0; e < 3; ++e) {
+      for (int a = 0; a < 3; ++a) out.edge[3 * e + a] = face.edge[e][a];
+    }
+    for (int a = 0; a < 3; ++a) out.plane[a] = face.plane[a];
+    out.plane_offset = face.plane_offset;
+    out.lower_m = face.lower_m;
+    return out;
+  }
+
  private:
   // what a ray tries of triangle k: its three inward edge normals (unit), its plane's normal
   // N and N . (p0 - o), its lower bound
