@@ -30,10 +30,7 @@ SOURCES := pyproject.toml CMakeLists.txt $(wildcard src/uvms_core/*.cpp src/uvms
 # installed while pip compiles the core, by a second pip beside it: the compile keeps both cores
 # busy for minutes, the install is mostly one core unpacking wheels, and the two touch disjoint
 # packages (the build requirements are installed first and satisfy the dependencies' pins).
-# `pip check` then says whether the environment is whole. Last, the package's bytecode, as a
-# regular (not editable) install writes it: the hundred-odd Python processes of the tests and
-# the demo read it instead of each compiling the sources again (Python caches nothing itself
-# where PYTHONDONTWRITEBYTECODE is set; a changed source is compiled again where it is imported).
+# `pip check` then says whether the environment is whole.
 BUILD_REQUIRES := $(VENV)/build-requirements.txt
 DEPENDENCIES := $(VENV)/dependencies.txt
 define install_core
@@ -46,7 +43,6 @@ define install_core
 	  $(BIN)/python -m pip install --quiet --no-build-isolation --no-deps -e . ; built=$$?; \
 	  wait $$deps; installed=$$?; [ $$built = 0 ] && [ $$installed = 0 ]
 	$(BIN)/python -m pip check
-	$(BIN)/python -m compileall -q -j 0 uvms_pin scenarios
 endef
 
 $(STAMP): $(SOURCES)
