@@ -121,12 +121,16 @@ class Derivatives {
   ForceVector fext_;
   std::vector<WrenchSensitivity> sensitivity_;  // per joint id (hydro joints)
   Matrix6x work_;  // M_A J of the mass matrix
+  // joint_motions' world products of each joint k's columns, formed once a call (6 x nv):
+  // v_p x S_k, v_p x S_k + dS_k and a_p x S_k + v_p x (v_p x S_k)
+  Matrix6x world_velocity_dq_, world_acceleration_dv_, world_acceleration_dq_;
   bool free_surface_ = false;
   std::vector<char> cut_;                               // per hull: 0 < f < 1
   std::vector<Eigen::Matrix<double, 12, Eigen::Dynamic>> wetting_dq_;  // dx_i/dq per cut hull
   Eigen::VectorXd acceleration_;
   Eigen::MatrixXd did_dq_, did_dv_, mass_;
   Eigen::LLT<Eigen::MatrixXd> cholesky_;
+  Eigen::MatrixXd inverse_factor_;  // L^-1 of the factor, on the way to M^-1
   ForwardDynamicsDerivatives out_;
 };
 
