@@ -129,7 +129,9 @@ namespace {
 
 // m x c for a motion m = [v; w] and each column c = [c_v; c_w] of `in`:
 // [w x c_v + v x c_w; w x c_w] (Pinocchio's Motion::cross), written into `out`'s columns
-// (Into::set), added to them or taken from them.
+// (Into::set), added to them or taken from them. Pinocchio's motionSet::motionAction<SETTO,
+// ADDTO, RMTO> computes the same bits, but the public derivative call took 0.2 to 0.3 us
+// more with it (12.4-12.5 us against 12.2), so the core keeps this loop.
 enum class Into { set, add, subtract };
 
 template <class In, class Out>

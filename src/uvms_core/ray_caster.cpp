@@ -13,18 +13,13 @@ namespace uvms::perception {
 
 namespace {
 
-// Whether a ray (world d) from the origin may meet a sphere of `radius` about `to_centre`
-// (centre - origin) nearer than `best`: it passes within the radius, not all behind.
-// centre2: |to_centre|^2; reach: the radius and a margin (`reach_of`), both of the cast.
-inline double reach_of(double radius) { return radius * (1.0 + 1e-9) + 1e-12; }
-inline bool may_meet(const Vec3& to_centre, double centre2, double reach, const Vec3& d,
-                     double best) {
-  const double along = d.dot(to_centre);
-  const double across2 = centre2 - along * along;
-  return across2 <= reach * reach && along + reach > 0.0 && along - reach < best;
-}
-inline bool may_meet(const Vec3& to_centre, const Vec3& d, double radius, double best) {
-  return may_meet(to_centre, to_centre.dot(to_centre), reach_of(radius), d, best);
+// A bounding sphere of `radius` about `to_centre` (centre - origin) as `may_reach` reads it:
+// a ray may meet it nearer than what it met if it passes within the radius and not all
+// behind, the radius taken with a margin (infinite: unbounded, every ray may meet it).
+Bound bound_around(const Vec3& to_centre, double radius) {
+  const double reach = radius * (1.0 + 1e-9) + 1e-12;
+  return {to_centre.x(), to_centre.y(), to_centre.z(), to_centre.dot(to_centre),
+          reach,         reach * reach,  !std::isfinite(radius)};
 }
 
 // A body as one cast sees it: skipped, a plane (its world normal, the origin's height above
@@ -37,19 +32,12 @@ struct Seen {
   double height_m = 0.0;
   Vec3 origin_local = Vec3::Zero();
   Vec3 to_centre = Vec3::Zero();
-  double centre2 = 0.0, reach = 0.0;  // |to_centre|^2, the bounding radius and a margin
-  bool bounded = false;
+  Bound bound{};  // its bounding sphere (`bound_around`)
   bool culled_by_cones = false;
   std::vector<char> cones;  // the cones that may meet it (when culled_by_cones)
   std::unique_ptr<MeshView> view;
   std::vector<int> candidates;  // the triangles of the cone being cast
 };
-
-// A bounded body's terms for `may_reach`.
-Bound bound_of(const Seen& s) {
-  return {s.to_centre.x(), s.to_centre.y(), s.to_centre.z(), s.centre2, s.reach,
-          s.reach * s.reach, !s.bounded};
-}
 
 // A solid's crossings of the cone's rays (their directions in its frame already in `rays`).
 void nearer_on_solid(const RayShape& shape, const Seen& s, std::int64_t k, Eigen::Index n,
@@ -57,7 +45,7 @@ void nearer_on_solid(const RayShape& shape, const Seen& s, std::int64_t k, Eigen
   const Nearest out{range, rays.body.data(), rays.face.data()};
   const Directions d{rays.x.data(),  rays.y.data(),  rays.z.data(),
                      rays.lx.data(), rays.ly.data(), rays.lz.data()};
-  const Bound bound = bound_of(s);
+  const Bound& bound = s.bound;
   const Vec3& o = s.origin_local;
   switch (shape.kind) {
     case ShapeKind::sphere:
@@ -93,12 +81,12 @@ void nearer_on_solid(const RayShape& shape, const Seen& s, std::int64_t k, Eigen
 // rays (`mesh_candidate`), until none looks further; then a ray's nearest crossing is kept on
 // a triangle's front beyond kTMinM and nearer than what it met (ray_mesh.hpp:
 // TriangleMesh.hit's rule). The same crossings as `MeshView::nearest` ray by ray. A ray that
-// may not meet the mesh's bounding sphere (`may_meet`) looks for nothing (its bound -inf).
+// may not meet the mesh's bounding sphere (`may_reach`) looks for nothing (its bound -inf).
 void nearer_on_mesh(const RayShape& shape, const Seen& s, std::int64_t k, Eigen::Index n,
                     ConeRays& rays, double* range) {
   const MeshView& view = *s.view;
   const TriangleSet& triangles = *shape.triangles;
-  const Bound bound = bound_of(s);
+  const Bound& bound = s.bound;
   double* const limit = rays.enter.data();  // scratch: each ray's bound, its crossing so far
   double* const crossing_t = rays.leave.data();
   std::int64_t* const triangle = rays.entered.data();
@@ -238,10 +226,8 @@ void RayCaster::cast(const Vec3& origin, const Mat3& frame_rotation, const doubl
       s.view = std::make_unique<MeshView>(*body.shape.triangles, s.origin_local);
     }
     s.to_centre = -offset;
-    s.centre2 = s.to_centre.dot(s.to_centre);
-    s.reach = reach_of(body.shape.bound_radius_m);
-    s.bounded = std::isfinite(body.shape.bound_radius_m);
-    if (s.bounded && cones != nullptr) {
+    s.bound = bound_around(s.to_centre, body.shape.bound_radius_m);
+    if (!s.bound.unbounded && cones != nullptr) {
       s.culled_by_cones = cones_toward(*cones, frame_rotation.transpose() * s.to_centre,
                                        body.shape.bound_radius_m, s.cones);
     }
@@ -339,7 +325,8 @@ std::vector<std::int64_t> RayCaster::rays_toward(int index, const Vec3& origin,
   const Vec3 to_centre = body.position_m - origin;
   if (body.shape.contains(body.rotation.transpose() * -to_centre)) return rows;
   const double radius = body.shape.bound_radius_m;
-  const bool bounded = std::isfinite(radius);
+  const Bound bound = bound_around(to_centre, radius);
+  const bool bounded = !bound.unbounded;
   std::vector<char> within;
   const bool culled = bounded && cones != nullptr &&
                       cones_toward(*cones, frame_rotation.transpose() * to_centre, radius, within);
@@ -350,7 +337,7 @@ std::vector<std::int64_t> RayCaster::rays_toward(int index, const Vec3& origin,
     const Eigen::Index last = cones == nullptr ? n : cones->starts[j + 1];
     for (Eigen::Index i = first; i < last; ++i) {
       const Vec3 d = frame_rotation * Eigen::Map<const Vec3>(rays_f + 3 * i);
-      if (!bounded || may_meet(to_centre, d, radius, range_m[i])) rows.push_back(i);
+      if (may_reach(bound, d.x(), d.y(), d.z(), range_m[i])) rows.push_back(i);
     }
   }
   return rows;

@@ -27,7 +27,8 @@ namespace uvms::perception {
 struct ConeRays {
   std::vector<double> x, y, z, lx, ly, lz;
   std::vector<std::int64_t> body, face;
-  std::vector<double> enter, leave;  // a convex body's slabs
+  // scratch: a convex body's slabs (a mesh's: each ray's bound, crossing and triangle)
+  std::vector<double> enter, leave;
   std::vector<std::int64_t> entered;
   void resize(Eigen::Index n) {
     if (static_cast<Eigen::Index>(x.size()) >= n) return;
@@ -46,13 +47,16 @@ struct Rows {
   }
 };
 
-// What a bounded body's `may_meet` reads (unbounded: every ray may meet it).
+// A body's bounding sphere as a cast sees it (ray_caster.cpp's `bound_around`): the centre
+// from the origin, |that|^2, the radius with a margin and its square (unbounded: every ray
+// may meet it).
 struct Bound {
   double c0, c1, c2, centre2, reach, reach2;
   bool unbounded;
 };
 
-// `may_meet` of a ray (world d), without a branch (a vector loop takes both sides).
+// Whether a ray (world d) may meet the sphere nearer than `best`: it passes within the
+// radius, not all behind. Without a branch (a vector loop takes both sides).
 [[gnu::always_inline]] inline bool may_reach(const Bound& b, double dx, double dy, double dz,
                                              double best) {
   const double along = (dx * b.c0 + dy * b.c1) + dz * b.c2;  // d.dot(to_centre)
