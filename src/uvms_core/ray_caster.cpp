@@ -63,7 +63,8 @@ void nearer_on_solid(const RayShape& shape, const Seen& s, std::int64_t k, Eigen
       return;
     case ShapeKind::convex: {
       const Eigen::Index faces = shape.normals.rows();
-      Eigen::VectorXd gaps(faces);  // >= 0 inside each face's half-space
+      std::vector<double>& gaps = rays.gaps;  // >= 0 inside each face's half-space
+      gaps.resize(static_cast<std::size_t>(faces));
       for (Eigen::Index f = 0; f < faces; ++f) {
         const Vec3 a = shape.normals.row(f).transpose();
         gaps[f] = shape.offsets[f] - o.dot(a);

@@ -30,6 +30,7 @@ struct ConeRays {
   // scratch: a convex body's slabs (a mesh's: each ray's bound, crossing and triangle)
   std::vector<double> enter, leave;
   std::vector<std::int64_t> entered;
+  std::vector<double> gaps;  // a convex body's faces' gaps b_f - o . a_f (one a face)
   void resize(Eigen::Index n) {
     if (static_cast<Eigen::Index>(x.size()) >= n) return;
     for (auto* v : {&x, &y, &z, &lx, &ly, &lz, &enter, &leave}) v->resize(n);
