@@ -322,8 +322,10 @@ class LiveView:
                     idx = max(0, bisect.bisect_right(self._times, self._shown_t, 0, n) - 1)
                     # the first frame always goes (the server caches it for late viewers)
                     if idx != shown and (watched or self.shown == 0):
-                        self.scene.show(self.vis, self._frames[idx])
+                        # counted before it is sent: a viewer may draw it (and whoever
+                        # watches the viewer look at `shown`) before show() returns here
                         self.shown += 1
+                        self.scene.show(self.vis, self._frames[idx])
                         for frame in self._frames[len(tips) : idx + 1]:
                             tips.append(self.scene.ee_position(frame.q))
                         if now - last_trail > 0.25 or idx == n - 1 or shown == -1:
