@@ -81,8 +81,8 @@ void nearer_on_solid(const RayShape& shape, const Seen& s, std::int64_t k, Eigen
 // A triangle mesh: each candidate of the cone (nearest lower bound first) against all its
 // rays (`mesh_candidate`), until none looks further; then a ray's nearest crossing is kept on
 // a triangle's front beyond kTMinM and nearer than what it met (ray_mesh.hpp:
-// TriangleMesh.hit's rule). The same crossings as `MeshView::nearest` ray by ray. A ray that
-// may not meet the mesh's bounding sphere (`may_reach`) looks for nothing (its bound -inf).
+// TriangleMesh.hit's rule). A ray that may not meet the mesh's bounding sphere (`may_reach`)
+// looks for nothing (its bound -inf).
 void nearer_on_mesh(const RayShape& shape, const Seen& s, std::int64_t k, Eigen::Index n,
                     ConeRays& rays, double* range) {
   const MeshView& view = *s.view;

@@ -3,9 +3,11 @@
 //
 // The loops take plain arrays and numbers, no Eigen type: each is compiled for x86-64-v3 too
 // (ray_cone.cpp, UVMS_VECTOR_CLONES), where a call into Eigen would not be inlined, and has no
-// branch, so the compiler vectorizes it. Each computes a value by the same operations, in the
-// same order, as the shapes' own (ray_shapes.hpp), MeshView::nearest (ray_mesh.hpp) and
-// Eigen's Vec3 and Mat3 products (noted where it matters): the same bits as a loop ray by ray.
+// branch, so the compiler vectorizes it. They follow the shapes' formulas (ray_shapes.hpp's
+// header; the Python reference's, uvms_pin/perception/shapes.py and mesh.py, which the tests
+// hold them to) and compute each ray's values by the same operations in the same order
+// whatever the loop's width, Eigen's Vec3 and Mat3 products' order included (noted where it
+// matters): the same bits as a loop ray by ray.
 // The unit is compiled with -ffp-contract=off and -fno-math-errno (CMakeLists.txt): no
 // multiply-add fused in the x86-64-v3 clones (the same hits on every processor), and square
 // roots that set no errno (a call that may would keep them out of the vector loops).
@@ -105,13 +107,13 @@ void local_directions(const Rows& rows, Eigen::Index n, const double* __restrict
                       const double* __restrict y, const double* __restrict z,
                       double* __restrict lx, double* __restrict ly, double* __restrict lz);
 
-// A plane (`RayShape::plane_along`): t = -h / (d . n) when d . n < 0 < h.
+// A plane: t = -h / (d . n) when d . n < 0 < h (and t > kTMinM).
 void nearer_on_plane(double n0, double n1, double n2, double height, std::int64_t k,
                      Eigen::Index n, const double* __restrict x, const double* __restrict y,
                      const double* __restrict z, Nearest out);
 
 // A sphere of `radius` seen from o (its frame): the smaller root of |o + t d|^2 = r^2
-// (`RayShape::sphere_crossing`); an ellipsoid of semi-axes s: the unit sphere's in x / s.
+// from outside; an ellipsoid of semi-axes s: the unit sphere's in x / s.
 // A kernel keeps a body's crossing of a ray where the ray may meet its bound (`may_reach`)
 // and it is nearer than what the ray met (`keep_nearer`).
 void nearer_on_sphere(double o0, double o1, double o2, double c, const Bound& bound,
@@ -121,23 +123,23 @@ void nearer_on_ellipsoid(const double* os, double oo, const double* semi_axes,
                          const Bound& bound, std::int64_t k, Eigen::Index n, Directions d,
                          Nearest out);
 
-// A cylinder of `radius` and `length` along z (`RayShape::cylinder_crossing`): the slab
-// |z| <= L / 2 and the infinite cylinder x^2 + y^2 <= r^2; the face: its side (0) or a cap
-// (+-1). std::max(a, b) is (a < b) ? b : a, std::min(a, b) is (b < a) ? b : a.
+// A cylinder of `radius` and `length` along z: the slab |z| <= L / 2 and the infinite
+// cylinder x^2 + y^2 <= r^2; the face: its side (0) or a cap (+-1). std::max(a, b) is
+// (a < b) ? b : a, std::min(a, b) is (b < a) ? b : a.
 void nearer_on_cylinder(double o0, double o1, double o2, double radius, double length,
                         const Bound& bound, std::int64_t k, Eigen::Index n, Directions d,
                         Nearest out);
 
-// A convex body A x <= b (`RayShape::convex_crossing`): each face f (unit row a, its gap
-// b_f - o . a) bounds t from below (a . d < 0: the face entered last) or above.
+// A convex body A x <= b: each face f (unit row a, its gap b_f - o . a) bounds t from below
+// (a . d < 0: the face entered last) or above.
 void nearer_on_convex(const double* faces_a, const double* gaps, Eigen::Index faces,
                       const Bound& bound, std::int64_t k, Eigen::Index n, Directions d,
                       double* __restrict enter, double* __restrict leave,
                       std::int64_t* __restrict entered, Nearest out);
 
-// One candidate triangle of a mesh against a cone's rays (their directions in its frame):
-// `MeshView::nearest`'s step for each ray, the candidates taken in the same order. A ray still
-// looks while the triangle's lower bound is below min(its crossing so far, its bound) (the
+// One candidate triangle of a mesh against a cone's rays (their directions in its frame), the
+// candidates taken nearest lower bound first (`MeshView::candidates`). A ray still looks
+// while the triangle's lower bound is below min(its crossing so far, its bound) (the
 // candidates come by lower bound: once it stops, it stops for good); inside the triangle's
 // three edges it crosses its plane at t = (N . (p0 - o)) / (N . d), kept if t > 0 and nearer.
 // Returns how many rays still looked (0: none will for the later candidates).

@@ -20,13 +20,11 @@
 // the triangles are ordered by lower bound once (`MeshView`); for each cone the ones it may
 // meet are kept in that order (`MeshView::candidates`), and each of its rays tries them
 // nearest first, stopping at the first whose lower bound is beyond what the ray has met
-// (`MeshView::nearest`).
+// (ray_cone.hpp's `mesh_candidate`, all of a cone's rays at once).
 #pragma once
 
 #include <Eigen/Core>
-#include <algorithm>
 #include <cstdint>
-#include <limits>
 #include <vector>
 
 #include "types.hpp"
@@ -61,18 +59,9 @@ class MeshView {
   // The triangles a ray of `cone` (null: any ray) may meet, nearest lower bound first.
   void candidates(const MeshCone* cone, std::vector<int>& out) const;
 
-  // The nearest crossing (either side, t > 0) of the ray along the unit d (the mesh's frame)
-  // among `candidates` (`candidates`' order) nearer than `bound`: its t and triangle (-1:
-  // none nearer than `bound`).
-  struct Crossing {
-    double t;
-    int triangle;
-  };
-  Crossing nearest(const Vec3& d, const std::vector<int>& candidates, double bound) const;
-
-  // What a ray tries of triangle k, as plain numbers (for a loop over many rays): its three
-  // inward edge normals (edge e: entries 3 e .. 3 e + 2), its plane's normal N, N . (p0 - o)
-  // and its lower bound (`nearest`'s, the same values).
+  // What a ray tries of triangle k, as plain numbers (for ray_cone.hpp's `mesh_candidate`,
+  // a loop over many rays): its three inward edge normals (edge e: entries 3 e .. 3 e + 2),
+  // its plane's normal N, N . (p0 - o) and its lower bound.
   struct FaceNumbers {
     double edge[9];
     double plane[3];
@@ -107,23 +96,5 @@ class MeshView {
   std::vector<Face> faces_;  // by triangle
   std::vector<int> order_;   // the triangles seen (not edge-on to the origin) by lower bound
 };
-
-// inline: called for each ray, from the caster's loop over them
-inline MeshView::Crossing MeshView::nearest(const Vec3& d, const std::vector<int>& candidates,
-                                            double bound) const {
-  Crossing out{std::numeric_limits<double>::infinity(), -1};
-  for (const int k : candidates) {
-    const Face& face = faces_[k];
-    if (face.lower_m >= std::min(out.t, bound)) break;  // this one and the rest: farther
-    if (d.dot(face.edge[0]) < 0.0 || d.dot(face.edge[1]) < 0.0 || d.dot(face.edge[2]) < 0.0) {
-      continue;  // outside one of its edges
-    }
-    const double rate = face.plane.dot(d);
-    if (rate == 0.0) continue;  // along its plane
-    const double t = face.plane_offset / rate;
-    if (t > 0.0 && t < out.t) out = {t, k};
-  }
-  return out;
-}
 
 }  // namespace uvms::perception
