@@ -33,10 +33,11 @@ def polynomial_exp(x: np.ndarray) -> np.ndarray:
 
 def test_the_compiled_exponentials_are_those_of_the_baseline_processor():
     """A pixel whose radiance is exactly exp(-r) (no lights, no veiling light, the sky's
-    irradiance (E_0 (1 + n_z) / 2, facing up) and the reflectance 1, beta_D = 1, K_d = 0) gives the polynomial's value to the
-    bit: the x86-64-v3 clone the module picks on a processor with AVX2 rounds as the baseline
-    does (no a * b + c fused, CMakeLists.txt). Compiled with fused multiply-adds (GCC's
-    default there), a tenth of these values differed in their last bit."""
+    irradiance E_0 (1 + n_z) / 2 = 1 facing up, the reflectance 1, beta_D = 1, K_d = 0) gives
+    the polynomial's value to the bit: the x86-64-v3 clone the module picks on a processor
+    with AVX2 rounds as the baseline does (no a * b + c fused, CMakeLists.txt). Compiled with
+    fused multiply-adds (GCC's default there), a tenth of these values differed in their last
+    bit."""
     core = core_module()
     rng = np.random.default_rng(0)
     r = np.concatenate([rng.uniform(0.0, 40.0, 4000), rng.uniform(0.0, 1e-3, 96)])
