@@ -285,6 +285,16 @@ def pytest_terminal_summary(terminalreporter, exitstatus, config):
             terminalreporter.write_line(line)
 
 
+def heavy_packages_loaded_by(code: str, heavy: set[str]) -> list[str]:
+    """The packages of ``heavy`` (top-level names) that running ``code`` in a fresh
+    interpreter loads: what a start-up that does only this pays for."""
+    top_level = "{m.split('.')[0] for m in sys.modules}"
+    report = f"\nimport sys\nprint(','.join(sorted({top_level} & set({sorted(heavy)!r}))))\n"
+    result = subprocess.run([sys.executable, "-c", code + report], capture_output=True, text=True)
+    assert result.returncode == 0, result.stderr
+    return [name for name in result.stdout.strip().split(",") if name]
+
+
 # ---- the command line as a user runs it, and relative comparisons (used across folders)
 def uvms_pin_command() -> list[str]:
     exe = Path(sys.executable).with_name("uvms-pin")

@@ -12,13 +12,11 @@ from __future__ import annotations
 
 import ast
 import re
-import subprocess
-import sys
 from pathlib import Path
 
 import grimp
 import pytest
-from conftest import ROOT
+from conftest import ROOT, heavy_packages_loaded_by
 
 PACKAGE = ROOT / "uvms_pin"
 #: What the package's top level holds: the layers, and four small modules every layer uses.
@@ -217,17 +215,25 @@ def test_modules_and_functions_are_small(path):
 
 
 def test_the_command_line_answers_without_loading_the_stack():
+    code = "from uvms_pin.apps.cli.main import build_parser\nbuild_parser().format_help()"
+    heavy = {"pinocchio", "scipy", "matplotlib", "meshcat", "pandas", "dask"}
+    assert heavy_packages_loaded_by(code, heavy) == []
+
+
+def test_a_compiled_run_loads_no_scipy():
+    """scipy's solvers (quad, solve_ivp, brentq, lapack, ndtri) are imported where they are
+    used: a third of a second that every `uvms-pin run` would otherwise pay at start-up. A
+    shipped scenario loads and runs (compiled, with its controller) without them."""
     code = (
-        "import sys\n"
-        "from uvms_pin.apps.cli.main import build_parser\n"
-        "build_parser().format_help()\n"
-        "heavy = sorted({m.split('.')[0] for m in sys.modules} & {'pinocchio', 'scipy', "
-        "'matplotlib', 'meshcat', 'pandas', 'dask'})\n"
-        "print(','.join(heavy))\n"
+        "import uvms_pin as up\n"
+        "from uvms_pin.scenario import load_scenario\n"
+        "from dataclasses import replace\n"
+        "for name in ('passive_current', 'realistic_force_tracking'):\n"
+        f"    scenario = load_scenario({str(ROOT)!r} + f'/scenarios/{{name}}.toml')\n"
+        "    short = replace(scenario.settings, duration_s=0.2)\n"
+        "    up.simulate(replace(scenario, settings=short), progress=False)\n"
     )
-    result = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
-    assert result.returncode == 0, result.stderr
-    assert result.stdout.strip() == "", f"--help loads {result.stdout.strip()}"
+    assert heavy_packages_loaded_by(code, {"scipy"}) == []
 
 
 #: The compiled seam: the only folders whose modules build the core's objects (and the

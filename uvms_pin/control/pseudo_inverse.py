@@ -21,7 +21,6 @@ operations (e.g. the Euler-rate matrix of the analytical Jacobian) before solvin
 from __future__ import annotations
 
 import numpy as np
-from scipy.linalg import lapack
 
 #: Above this certified bound of cond(J W^-1/2)^2 the solution is refined once: below it the
 #: normal equations' error ~cond^2 * 1e-16 is already ~1e-13 or less.
@@ -97,6 +96,10 @@ class MinimumNormSolver:
         None when that bound exceeds :data:`MAX_GRAM_CONDITION_BOUND` (or 1 / cutoff^2),
         or when G is not numerically positive definite.
         """
+        # scipy.linalg is imported where it is used (0.3 us a call once loaded), not by every
+        # start-up (a sixth of a second)
+        from scipy.linalg import lapack
+
         weighted = jacobian if self._inverse_weights is None else jacobian * self._inverse_weights
         # G is symmetric: hand LAPACK its Fortran-ordered transpose (no copy)
         gram = np.dot(weighted, jacobian.T).T

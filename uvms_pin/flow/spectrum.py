@@ -15,7 +15,6 @@ import functools
 import math
 
 import numpy as np
-from scipy.integrate import quad
 
 from uvms_pin.errors import ParameterError
 
@@ -63,6 +62,10 @@ def _jonswap_normalisation(gamma: float) -> float:
 
     def shaped(x: float) -> float:
         return pm(x) * float(_peak_shape(np.array(x), gamma))
+
+    # scipy.integrate is imported where it is used: it takes a quarter second to import,
+    # which every start-up would pay otherwise
+    from scipy.integrate import quad
 
     m0_pm = quad(pm, 0.05, 50.0, points=[1.0], limit=200)[0]
     m0_j = quad(shaped, 0.05, 50.0, points=[1.0], limit=200)[0]

@@ -44,7 +44,6 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from scipy.integrate import quad
 
 from uvms_pin.errors import ParameterError
 from uvms_pin.hydro.params import HydroParams
@@ -147,6 +146,10 @@ def ellipsoid_shape_integrals(a_m: float, b_m: float, c_m: float) -> tuple[float
     scale = max(a, b, c)
     a2, b2, c2 = (a / scale) ** 2, (b / scale) ** 2, (c / scale) ** 2
     abc = math.sqrt(a2 * b2 * c2)
+
+    # scipy.integrate is imported where it is used: it takes a quarter second to import,
+    # which every start-up would pay otherwise
+    from scipy.integrate import quad
 
     def integral(first: float) -> float:
         # l = s^2, dl = 2 s ds: the integrand decays as s^-4 for large s.

@@ -18,7 +18,6 @@ from __future__ import annotations
 from functools import cache
 
 import numpy as np
-from scipy.special import ndtri
 
 from uvms_pin.errors import ParameterError
 
@@ -31,6 +30,10 @@ LEVELS = 1 << 16
 def normal_levels() -> np.ndarray:
     """(65536,) float32: z_k = Phi^-1((k + 1/2) / 65536), scaled to unit variance
     (read-only, computed once)."""
+    # scipy.special is imported where it is used: it takes a quarter second to import,
+    # which every start-up would pay otherwise
+    from scipy.special import ndtri
+
     z = ndtri((np.arange(LEVELS) + 0.5) / LEVELS)
     z /= np.sqrt(np.mean(z * z))
     table = z.astype(np.float32)

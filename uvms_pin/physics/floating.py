@@ -19,7 +19,6 @@ from __future__ import annotations
 
 import numpy as np
 import pinocchio as pin
-from scipy.optimize import brentq, root
 
 from uvms_pin.checks import finite_vector
 from uvms_pin.errors import SimulationError
@@ -74,6 +73,10 @@ def floating_equilibrium(
             f"{uvms.source or 'the model'} does not float: its weight is not less than the "
             "buoyancy of all its volume"
         )
+    # scipy.optimize is imported where it is used: it takes a quarter second to import,
+    # which every start-up would pay otherwise
+    from scipy.optimize import brentq, root
+
     z = brentq(lift, -span, span, xtol=1e-14, rtol=4 * np.finfo(float).eps, maxiter=200)
     if not free_attitude:
         return _with(q, z, roll, pitch, yaw)

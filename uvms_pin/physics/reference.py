@@ -18,7 +18,6 @@ import math
 
 import numpy as np
 import pinocchio as pin
-from scipy.linalg import cho_factor, cho_solve
 
 from uvms_pin.checks import finite_vector
 from uvms_pin.errors import ParameterError, SimulationError
@@ -192,6 +191,10 @@ def _solve(uvms: UVMS, q: np.ndarray, rhs: np.ndarray, wet: WetState | None) -> 
 def mass_solve(mass: np.ndarray, q: np.ndarray, rhs: np.ndarray) -> np.ndarray:
     """``mass``^-1 rhs by a Cholesky factorisation (SimulationError naming q if the mass
     matrix at q is not positive definite)."""
+    # scipy.linalg is imported where it is used: the compiled runs never are, and would pay a
+    # sixth of a second at start-up
+    from scipy.linalg import cho_factor, cho_solve
+
     try:
         factor = cho_factor(mass, lower=False, check_finite=False)
     except np.linalg.LinAlgError as exc:

@@ -19,7 +19,6 @@ from typing import ClassVar
 
 import numpy as np
 import pinocchio as pin
-from scipy.integrate import solve_ivp
 
 from uvms_pin.errors import ParameterError, SimulationError
 
@@ -219,6 +218,10 @@ class Adaptive(Integrator):
         """One solve_ivp call from t0 to times[-1] in the chart at q0 (keeps the step size
         and Jacobian history across output times; re-base by calling again). The event,
         if any, is checked on every accepted step and located by root finding."""
+        # scipy.integrate is imported where it is used: it takes a quarter second to import,
+        # which every start-up would pay otherwise
+        from scipy.integrate import solve_ivp
+
         nv = model.nv
         chart = python_chart(model) if chart is None else chart
         times = np.asarray(times, dtype=float)
