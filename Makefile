@@ -31,6 +31,9 @@ SOURCES := pyproject.toml CMakeLists.txt $(wildcard src/uvms_core/*.cpp src/uvms
 # busy for minutes, the install is mostly one core unpacking wheels, and the two touch disjoint
 # packages (the build requirements are installed first and satisfy the dependencies' pins).
 # `pip check` then says whether the environment is whole.
+# The package's modules are then compiled to bytecode once (0.3 s), as pip does for a regular
+# install and not for an editable one: every `uvms-pin` and test process would otherwise
+# compile them again where PYTHONDONTWRITEBYTECODE is set (0.15 s a process start-up).
 BUILD_REQUIRES := $(VENV)/build-requirements.txt
 DEPENDENCIES := $(VENV)/dependencies.txt
 define install_core
@@ -43,6 +46,7 @@ define install_core
 	  $(BIN)/python -m pip install --quiet --no-build-isolation --no-deps -e . ; built=$$?; \
 	  wait $$deps; installed=$$?; [ $$built = 0 ] && [ $$installed = 0 ]
 	$(BIN)/python -m pip check
+	$(BIN)/python -m compileall -q -j 0 uvms_pin
 endef
 
 $(STAMP): $(SOURCES)
