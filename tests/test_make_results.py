@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import json
 import subprocess
 import sys
 
@@ -59,16 +60,46 @@ def test_the_runnable_scripts_are_found():
     assert "benchmarks/timing.py" not in names
 
 
+@pytest.fixture(scope="module")
+def helps() -> dict[str, dict]:
+    """Every runnable script's ``--help``, run as ``python SCRIPT --help`` would, all in one
+    fresh interpreter (tests/script_help_driver.py: each script with its own sys.path and
+    none of another's helpers): script path -> exit code, stdout, stderr."""
+    scripts = [str(p) for p in _runnable_scripts()]
+    driver = ROOT / "tests" / "script_help_driver.py"
+    ran = subprocess.run(
+        [sys.executable, str(driver), *scripts], cwd=ROOT, capture_output=True, text=True
+    )
+    assert ran.returncode == 0, ran.stderr[-2000:]
+    return json.loads(ran.stdout)
+
+
 @pytest.mark.parametrize(
     "script", _runnable_scripts(), ids=lambda p: p.relative_to(ROOT).as_posix()
 )
-def test_every_script_starts_and_answers_help_without_running(script):
+def test_every_script_starts_and_answers_help_without_running(script, helps):
     """Imports resolve after a move (sys.path included), and --help runs nothing."""
-    started = subprocess.run(
-        [sys.executable, str(script), "--help"], cwd=ROOT, capture_output=True, text=True
-    )
-    assert started.returncode == 0, started.stderr[-2000:]
-    assert started.stdout.startswith("usage:"), started.stdout[:500]
+    started = helps[str(script)]
+    assert started["code"] == 0, started["stderr"][-2000:]
+    assert started["stdout"].startswith("usage:"), started["stdout"][:500]
+
+
+def test_the_help_driver_reports_a_script_that_cannot_start(tmp_path):
+    """A script whose helper is missing (an import that resolved only beside another script)
+    fails in the driver as it would on its own."""
+    (tmp_path / "one").mkdir()
+    (tmp_path / "two").mkdir()
+    (tmp_path / "one" / "helper_of_one.py").write_text("NAME = 'one'\n")
+    main = "import argparse\nargparse.ArgumentParser().parse_args()\n"
+    (tmp_path / "one" / "a.py").write_text("import helper_of_one\n" + main)
+    (tmp_path / "two" / "b.py").write_text("import helper_of_one\n" + main)
+    driver = ROOT / "tests" / "script_help_driver.py"
+    scripts = [str(tmp_path / "one" / "a.py"), str(tmp_path / "two" / "b.py")]
+    ran = subprocess.run([sys.executable, str(driver), *scripts], capture_output=True, text=True)
+    found = json.loads(ran.stdout)
+    assert found[scripts[0]]["code"] == 0 and found[scripts[0]]["stdout"].startswith("usage:")
+    assert found[scripts[1]]["code"] == 1
+    assert "No module named 'helper_of_one'" in found[scripts[1]]["stderr"]
 
 
 def test_make_demo_runs_twice(tmp_path):
