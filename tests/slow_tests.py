@@ -20,11 +20,11 @@ from collections.abc import Mapping
 #: whole files, longest first: `make test`'s workers start them in this order (`longest_first`)
 SLOW_MODULES = (
     "tests/test_docs_run.py",
-    "tests/apps/cli/test_bad_inputs.py",
-    "tests/test_notebooks.py",
-    "tests/test_docs_site.py",
-    "tests/test_make_results.py",
     "tests/apps/validation/test_fit.py",
+    "tests/test_docs_site.py",
+    "tests/apps/cli/test_bad_inputs.py",
+    "tests/test_make_results.py",
+    "tests/test_notebooks.py",
     "tests/fuzz/",
 )
 

@@ -31,6 +31,13 @@ def backend(request) -> str:
     return request.param
 
 
+#: The long runs (tens of seconds simulated, 4 to 11 s of the Python reference's time each):
+#: compiled only. The Python reference is held to the compiled contacts pointwise and over
+#: runs that stick, slide and rebound (box on a slope, sphere and cylinder on a box, box on a
+#: mesh: tests/physics/test_world_compiled.py), and the short cases here run on both.
+LONG_RUN_BACKEND = pytest.mark.parametrize("backend", ["core"])
+
+
 def _box(load_body, damping=(0.0,) * 6):
     m = DENSITY * RHO * A * B * C
     inertia = (m * (B * B + C * C) / 12, m * (A * A + C * C) / 12, m * (A * A + B * B) / 12)
@@ -74,6 +81,7 @@ def _slope_world(uvms, theta, mu_s, mu_k, law: ContactLaw):
     return World(uvms, [plane("seafloor", [0.0, 0.0, FLOOR_Z], normal, mu_s, mu_k)], law)
 
 
+@LONG_RUN_BACKEND
 def test_a_box_rests_on_the_seafloor_with_its_net_weight_and_does_not_sink(load_body, backend):
     uvms = _box(load_body, damping=(200.0,) * 6)
     law = ContactLaw(stiffness_N_m=1e5, dissipation_s_m=0.5)
@@ -94,6 +102,7 @@ def test_a_box_rests_on_the_seafloor_with_its_net_weight_and_does_not_sink(load_
     assert abs(q_end[2] - z_half) < 1e-7
 
 
+@LONG_RUN_BACKEND
 @pytest.mark.parametrize("theta_deg", [10.0, 25.0])
 def test_a_block_on_a_slope_gentler_than_its_friction_stays_put(load_body, theta_deg, backend):
     uvms = _box(load_body, damping=(500.0,) * 6)  # the water's drag damps its rocking
@@ -217,6 +226,7 @@ def test_a_dropped_sphere_rebounds_as_the_contact_damping_says(load_body, dissip
         assert energy[-1] < energy[0] - 0.05 * scale
 
 
+@LONG_RUN_BACKEND
 def test_a_sphere_rests_on_a_box_object_through_coal(load_body, backend):
     radius = 0.2
     uvms, m, volume = _sphere(load_body, radius, 2.0, 20.0)
