@@ -96,7 +96,7 @@ class MinimumNormSolver:
         None when that bound exceeds :data:`MAX_GRAM_CONDITION_BOUND` (or 1 / cutoff^2),
         or when G is not numerically positive definite.
         """
-        # scipy.linalg is imported where it is used (0.3 us a call once loaded), not by every
+        # scipy.linalg is imported where it is used (0.24 us a call once loaded), not by every
         # start-up (a sixth of a second)
         from scipy.linalg import lapack
 

@@ -191,8 +191,8 @@ def _solve(uvms: UVMS, q: np.ndarray, rhs: np.ndarray, wet: WetState | None) -> 
 def mass_solve(mass: np.ndarray, q: np.ndarray, rhs: np.ndarray) -> np.ndarray:
     """``mass``^-1 rhs by a Cholesky factorisation (SimulationError naming q if the mass
     matrix at q is not positive definite)."""
-    # scipy.linalg is imported where it is used: the compiled runs never are, and would pay a
-    # sixth of a second at start-up
+    # scipy.linalg is imported where it is used: a compiled run never calls this, and would
+    # otherwise pay a sixth of a second at start-up
     from scipy.linalg import cho_factor, cho_solve
 
     try:
