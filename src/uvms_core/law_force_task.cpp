@@ -3,8 +3,9 @@
 #include <string>
 #include <utility>
 
-#include <pinocchio/algorithm/frames.hpp>
 #include <pinocchio/math/rpy.hpp>
+
+#include "pinocchio_frame_jacobian.hpp"
 
 namespace uvms {
 
@@ -72,8 +73,7 @@ bool ForceOrientationTask::finite_input(double time_s, const double* q, const do
 void ForceOrientationTask::evaluate(const double* q) {
   q_ = Eigen::Map<const Eigen::VectorXd>(q, model_.nq);
   jacobian_lwa_.setZero();
-  pinocchio::computeFrameJacobian(model_, data_, q_, s_.ee_frame_id,
-                                  pinocchio::LOCAL_WORLD_ALIGNED, jacobian_lwa_);
+  frame_jacobian_local_world_aligned(model_, data_, q_, s_.ee_frame_id, jacobian_lwa_);
   rpy_ee_ = pinocchio::rpy::matrixToRpy(data_.oMf[s_.ee_frame_id].rotation());
 }
 

@@ -2,11 +2,9 @@
 // frames' placements and Jacobians): through the instantiations the `pin` wheel's
 // libpinocchio_default already holds (PINOCCHIO_ENABLE_TEMPLATE_INSTANTIATION declares them
 // `extern template`), never instantiated again in a unit of the core. The dynamics (RNEA, CRBA,
-// their derivatives) are in pinocchio_dynamics.hpp. One call stays outside: the PPC's
-// computeFrameJacobian (law_force_task.cpp), declared `inline` and so instantiated by GCC for
-// inlining in spite of its extern declaration; composed of the instantiated calls instead
-// (computeJointJacobians, updateFramePlacement, getFrameJacobian) it rounds differently in the
-// last bits, which the published force-tracking runs would show.
+// their derivatives) are in pinocchio_dynamics.hpp. The PPC's computeFrameJacobian, which
+// frames.hxx defines `inline` (GCC instantiates it wherever frames.hpp is included), is called
+// from a unit of its own: pinocchio_frame_jacobian.hpp.
 //
 // Why: an algorithm called with argument types other than the library's (a VectorXd where it
 // instantiated Ref<const VectorXd>, a block where it instantiated VectorXd) is compiled again

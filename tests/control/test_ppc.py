@@ -354,20 +354,23 @@ def test_model_free_inertias_do_not_matter(q_bent, backend):
 
 
 def test_model_free_the_compiled_law_uses_only_frame_kinematics():
-    """The compiled law (src/uvms_core/ppc.cpp on the force task, law_force_task.cpp)
-    includes one Pinocchio algorithm, the frame Jacobian, and calls no other (the Python
-    test below cannot patch C++ calls); it includes none of the core's dynamics."""
+    """The compiled law (src/uvms_core/ppc.cpp on the force task, law_force_task.cpp, and
+    the frame Jacobian's unit, pinocchio_frame_jacobian.cpp) calls one Pinocchio algorithm,
+    the frame Jacobian, and no other (the Python test below cannot patch C++ calls); it
+    includes no Pinocchio algorithm header (the Jacobian's template is declared, not
+    included) and none of the core's dynamics."""
     core = ROOT / "src" / "uvms_core"
-    names = ("ppc", "law_force_task")
+    names = ("ppc", "law_force_task", "pinocchio_frame_jacobian")
     source = "".join((core / f"{name}.cpp").read_text() for name in names)
     header = "".join((core / f"{name}.hpp").read_text() for name in names)
     header += (core / "law.hpp").read_text()
     algorithms = re.findall(r"#include <pinocchio/algorithm/([\w-]+)\.hpp>", source + header)
-    assert algorithms == ["frames"]
+    assert algorithms == []
     calls = set(re.findall(r"pinocchio::(\w+)\(", source))
     assert calls == {"computeFrameJacobian"}, calls
     local = set(re.findall(r'#include "([\w.]+)"', source + header))
-    assert local == {"ppc.hpp", "law.hpp", "law_force_task.hpp", "types.hpp"}, local
+    expected = {"ppc.hpp", "law.hpp", "law_force_task.hpp", "types.hpp"}
+    assert local == expected | {"pinocchio_frame_jacobian.hpp"}, local
 
 
 def test_model_free_no_dynamics_algorithm_is_called(model, q_bent, monkeypatch):
