@@ -14,7 +14,7 @@ BASE_STAMP := $(VENV)/.installed-base
 DEMO_SCENARIO ?= scenarios/realistic_force_tracking.toml
 DEMO_OUT ?= out/demo
 
-.PHONY: demo test check lint bench results fuzz docs clean
+.PHONY: demo test check lint bench results fuzz docs clean browser-install
 
 SOURCES := pyproject.toml CMakeLists.txt $(wildcard src/uvms_core/*.cpp src/uvms_core/*.hpp)
 
@@ -69,13 +69,30 @@ lint: $(STAMP)
 	$(BIN)/ruff format --check .
 	$(BIN)/lint-imports
 
-test: $(STAMP) lint
-	@# the replay tests open replay.html in a real headless browser: Debian's chromium,
-	@# installed here when possible (root with apt-get); otherwise those tests skip
+# the replay tests open replay.html in a real headless browser: Debian's chromium, installed
+# when it is missing and can be (root with apt-get; otherwise those tests skip). In the
+# background, from the start of `make test`, while the venv is made and the core compiles
+# (apt is downloads and one core unpacking: about 30 s that the tests no longer wait for
+# after the build); the tests wait for it to end. Its output: build/browser-install.log.
+BROWSER_LOG := build/browser-install.log
+BROWSER_PID := build/browser-install.pid
+BROWSER_STATUS := build/browser-install.status
+browser-install:
+	@rm -f $(BROWSER_PID) $(BROWSER_STATUS)
 	@command -v chromium >/dev/null 2>&1 || { \
 	  if [ "$$(id -u)" = 0 ] && command -v apt-get >/dev/null 2>&1; then \
-	    apt-get update && DEBIAN_FRONTEND=noninteractive apt-get install -y chromium; \
+	    mkdir -p build; echo "installing Debian's chromium in the background ($(BROWSER_LOG))"; \
+	    ( { apt-get update && DEBIAN_FRONTEND=noninteractive apt-get install -y chromium; }; \
+	      echo $$? > $(BROWSER_STATUS) ) > $(BROWSER_LOG) 2>&1 < /dev/null & echo $$! > $(BROWSER_PID); \
 	  else echo "chromium missing and not installable here (needs root + apt-get): browser tests will skip"; fi; }
+
+test: browser-install $(STAMP) lint
+	@if [ -f $(BROWSER_PID) ]; then \
+	  pid=$$(cat $(BROWSER_PID)); rm -f $(BROWSER_PID); \
+	  kill -0 $$pid 2>/dev/null && echo "waiting for chromium's install to end ($(BROWSER_LOG))"; \
+	  while kill -0 $$pid 2>/dev/null; do sleep 1; done; \
+	  if [ "$$(cat $(BROWSER_STATUS) 2>/dev/null)" != 0 ]; then tail -n 5 $(BROWSER_LOG); \
+	    echo "chromium's install failed ($(BROWSER_LOG)): browser tests will skip"; fi; fi
 	@# two workers per two cores (pytest-xdist): each test is independent of the others' order;
 	@# whole files to a worker (--dist loadfile: a file's shared run, the doc runs, the bad-input
 	@# corpus, is made once, not once per worker), in the order collected: the longest files
