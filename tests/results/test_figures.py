@@ -101,3 +101,24 @@ def test_the_energy_figure_of_a_driven_run_shows_the_balance(passive, ppc):
     assert "work of tau" in labels and any(label.startswith("work of water") for label in labels)
     labels = [line.get_label() for line in plot_energy(passive).axes[0].get_lines()]
     assert "work of tau" not in labels  # nothing drives a passive run
+
+
+def test_a_saved_figure_is_drawn_once_and_is_the_file_matplotlib_writes(
+    passive, tmp_path, monkeypatch
+):
+    """`save_figure` lays the figure out once and draws it once: `savefig` would draw it
+    twice after `Figure.tight_layout` (which leaves a placeholder layout engine). The file is
+    byte for byte the one matplotlib writes after `tight_layout` with the engine left."""
+    from uvms_pin.results.figures.standard import save_figure
+
+    fig = plot_pose(passive)
+    fig.tight_layout()
+    fig.savefig(tmp_path / "matplotlib.png", dpi=120)
+    draws = []
+    original = Figure.draw
+    monkeypatch.setattr(
+        Figure, "draw", lambda self, renderer: draws.append(1) or original(self, renderer)
+    )
+    assert save_figure(plot_pose(passive), tmp_path / "saved.png") == tmp_path / "saved.png"
+    assert len(draws) == 1
+    assert (tmp_path / "saved.png").read_bytes() == (tmp_path / "matplotlib.png").read_bytes()

@@ -13,8 +13,6 @@ from pathlib import Path
 
 import numpy as np
 
-from uvms_pin.results.atomic import atomic_path
-
 #: (row key, title) of the panels, row by row.
 PANELS = (
     ("force_error_rms_N", "force error RMS [N]"),
@@ -62,6 +60,8 @@ def comparison_figure(rows: list[dict], out: Path) -> Path:
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
+    from uvms_pin.results.figures.standard import save_figure
+
     names = [r["arm"] for r in rows]
     colors = [_status_color(r["status"]) for r in rows]
     x = np.arange(len(rows))
@@ -72,9 +72,6 @@ def comparison_figure(rows: list[dict], out: Path) -> Path:
         ax.set_xticks(x, names, rotation=30, ha="right", fontsize=8)
         ax.grid(axis="y", alpha=0.3)
     fig.suptitle("Arms compared (green: task completed, red: failed, gray: unreachable)")
-    fig.tight_layout()
-    path = out / "comparison.png"
-    with atomic_path(path) as tmp:
-        fig.savefig(tmp, dpi=110, format="png")
+    path = save_figure(fig, out / "comparison.png", dpi=110)
     plt.close(fig)
     return path

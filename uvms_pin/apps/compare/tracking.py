@@ -78,6 +78,8 @@ def write_tracking_figure(rollouts: dict[str, Rollout], out: Path) -> Path:
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
+    from uvms_pin.results.figures.standard import save_figure
+
     fig, (ax_p, ax_o) = plt.subplots(2, 1, figsize=(8, 6), sharex=True)
     for name, rollout in rollouts.items():
         signals = rollout.signals
@@ -89,8 +91,6 @@ def write_tracking_figure(rollouts: dict[str, Rollout], out: Path) -> Path:
     ax_o.set_ylabel("orientation error [deg]")
     ax_o.set_xlabel("t [s]")
     ax_p.legend(fontsize=8)
-    fig.tight_layout()
-    path = out / "controllers_tracking.png"
-    fig.savefig(path, dpi=100)
+    path = save_figure(fig, out / "controllers_tracking.png", dpi=100)
     plt.close(fig)
     return path

@@ -20,7 +20,7 @@ from matplotlib.ticker import FormatStrFormatter, LogLocator, NullFormatter
 
 from uvms_pin.apps.study.bins import bins, ordered_labels
 from uvms_pin.apps.study.statistics import bin_failure_rates, heatmap_pairs, violation_rate_grid
-from uvms_pin.results.atomic import atomic_path
+from uvms_pin.results.figures.standard import save_figure
 
 STATUS_COLORS = {
     "ok": "tab:green",
@@ -45,10 +45,7 @@ def _slug(text: str) -> str:
 
 
 def _save(fig: Figure, path: Path) -> Path:
-    fig.tight_layout()
-    with atomic_path(path) as tmp:
-        fig.savefig(tmp, dpi=110, format=path.suffix[1:])
-    return path
+    return save_figure(fig, path, dpi=110)
 
 
 def _grid_axes(n: int, width: float = 4.0, height: float = 3.2):
