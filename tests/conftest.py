@@ -306,7 +306,13 @@ def uvms_pin_command() -> list[str]:
     return [found]
 
 
-def run(*args: str, cwd: Path = ROOT) -> subprocess.CompletedProcess:
+def run(*args: str, cwd: Path = ROOT, process: bool = False) -> subprocess.CompletedProcess:
+    """``uvms-pin ARGS`` in ``cwd``: in this process (`run_cli_in_process`, a second of
+    imports spared a call), or with ``process`` the installed console script in a process of
+    its own (what the entry point's wiring or the interpreter's exit must show).
+    tests/apps/cli/test_bad_inputs.py holds the two to the same answers."""
+    if not process:
+        return run_cli_in_process(list(args), cwd)
     return subprocess.run(
         [*uvms_pin_command(), *args],
         cwd=cwd,

@@ -1,4 +1,5 @@
-"""The command line as a new user runs it (the installed ``uvms-pin`` entry point)."""
+"""The command line as a new user runs it: the installed ``uvms-pin`` entry point (``process``)
+for the first command and the first run, its ``main`` in this process for the rest."""
 
 from __future__ import annotations
 
@@ -10,7 +11,7 @@ from conftest import REFERENCE_URDF, ROOT, run
 
 
 def test_info_prints_the_model_summary():
-    result = run("info", str(REFERENCE_URDF))
+    result = run("info", str(REFERENCE_URDF), process=True)
     assert result.returncode == 0, result.stderr
     out = result.stdout
     for needle in (
@@ -43,7 +44,7 @@ def test_run_passive_scenario_writes_rollout_metrics_and_figures(tmp_path):
         .replace("duration_s = 20.0", "duration_s = 0.5")
     )
     out = tmp_path / "out"
-    result = run("run", str(scenario), "--out", str(out))
+    result = run("run", str(scenario), "--out", str(out), process=True)
     assert result.returncode == 0, result.stderr
     for name in (
         "rollout.npz",

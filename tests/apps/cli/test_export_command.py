@@ -1,5 +1,7 @@
 """``uvms-pin export RUN_DIR --mcap FILE``: a saved run as a ROS 2 bag; bad input exits 2
-with one line naming what was wrong, and nothing is written."""
+with one line naming what was wrong, and nothing is written. The first export runs the
+installed command in a process of its own; the others its ``main`` in this process
+(`run_cli_in_process`), which tests/apps/cli/test_bad_inputs.py holds to the same answers."""
 
 from __future__ import annotations
 
@@ -9,7 +11,7 @@ from pathlib import Path
 
 import pytest
 from cli_support import run_cli
-from conftest import ROOT
+from conftest import ROOT, run_cli_in_process
 
 from uvms_pin.results.rollout import META_FILE, Rollout
 from uvms_pin.scenario.load import load_scenario
@@ -40,18 +42,20 @@ def _refused(result, *words: str) -> None:
 def test_export_writes_a_bag_the_reader_opens(run_dir, tmp_path):
     from ros_bag_check import check_bag, read_bag  # the export's own read-back check
 
-    result = run_cli(["export", str(run_dir), "--mcap", "run.mcap"], tmp_path)
+    result = run_cli(["export", str(run_dir), "--mcap", "run.mcap"], tmp_path)  # a process
     assert result.returncode == 0, result.stderr
     assert result.stdout.startswith("wrote run.mcap (")
     check_bag(Rollout.load(run_dir), read_bag(tmp_path / "run.mcap"))
-    again = run_cli(["export", str(run_dir), "--mcap", "run.mcap"], tmp_path)
+    again = run_cli_in_process(["export", str(run_dir), "--mcap", "run.mcap"], tmp_path)
     _refused(again, "run.mcap", "--overwrite")
-    replaced = run_cli(["export", str(run_dir), "--mcap", "run.mcap", "--overwrite"], tmp_path)
+    replaced = run_cli_in_process(
+        ["export", str(run_dir), "--mcap", "run.mcap", "--overwrite"], tmp_path
+    )
     assert replaced.returncode == 0, replaced.stderr
 
 
 def test_no_such_run_directory_is_refused(tmp_path):
-    _refused(run_cli(["export", "nowhere", "--mcap", "run.mcap"], tmp_path), "nowhere")
+    _refused(run_cli_in_process(["export", "nowhere", "--mcap", "run.mcap"], tmp_path), "nowhere")
     assert list(tmp_path.iterdir()) == []
 
 
@@ -61,18 +65,23 @@ def test_a_run_of_several_robots_is_refused_naming_a_robots_directory(run_dir, t
     robots = tmp_path / "two"
     robots.mkdir()
     (robots / "metrics.json").write_text(json.dumps({"robots": ["alpha", "bravo"]}))
-    result = run_cli(["export", "two", "--mcap", "run.mcap"], tmp_path)
+    result = run_cli_in_process(["export", "two", "--mcap", "run.mcap"], tmp_path)
     _refused(result, "several robots (alpha, bravo)", str(Path("two") / "alpha"))
     assert sorted(p.name for p in tmp_path.iterdir()) == ["two"]
 
 
 def test_an_unwritable_path_is_refused(run_dir, tmp_path):
     (tmp_path / "a_file").write_text("x")
-    _refused(run_cli(["export", str(run_dir), "--mcap", "a_file/run.mcap"], tmp_path), "a_file")
+    _refused(
+        run_cli_in_process(["export", str(run_dir), "--mcap", "a_file/run.mcap"], tmp_path),
+        "a_file",
+    )
     if os.geteuid() != 0:  # root writes anywhere
         locked = tmp_path / "locked"
         locked.mkdir(mode=0o500)
-        _refused(run_cli(["export", str(run_dir), "--mcap", "locked/run.mcap"], tmp_path))
+        _refused(
+            run_cli_in_process(["export", str(run_dir), "--mcap", "locked/run.mcap"], tmp_path)
+        )
         assert list(locked.iterdir()) == []
     assert sorted(p.name for p in tmp_path.iterdir()) in (["a_file"], ["a_file", "locked"])
 
@@ -89,10 +98,12 @@ def test_a_run_without_its_model_is_refused_and_nothing_written(run_dir, tmp_pat
     out = tmp_path / "out"
     out.mkdir()
     _refused(
-        run_cli(["export", str(copy), "--mcap", "out/run.mcap"], tmp_path), "moved.urdf", "--urdf"
+        run_cli_in_process(["export", str(copy), "--mcap", "out/run.mcap"], tmp_path),
+        "moved.urdf",
+        "--urdf",
     )
     assert list(out.iterdir()) == []
 
 
 def test_export_without_a_format_is_refused(run_dir, tmp_path):
-    _refused(run_cli(["export", str(run_dir)], tmp_path), "--mcap")
+    _refused(run_cli_in_process(["export", str(run_dir)], tmp_path), "--mcap")
