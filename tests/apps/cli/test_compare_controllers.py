@@ -1,4 +1,5 @@
-"""``uvms-pin compare-controllers`` on a short run, and its bad inputs (exit 2, nothing written)."""
+"""``uvms-pin compare-controllers`` on a short run, and its bad inputs (exit 2, nothing written;
+run by the command's ``main`` in this process, `run_cli_in_process`)."""
 
 from __future__ import annotations
 
@@ -7,6 +8,7 @@ import math
 
 import pytest
 from cli_support import ROOT, run_cli
+from conftest import run_cli_in_process
 
 REALISTIC = ROOT / "scenarios" / "realistic_force_tracking.toml"
 
@@ -54,7 +56,8 @@ def test_compare_controllers_short_run(tmp_path):
 )
 def test_compare_controllers_bad_input(tmp_path, args, message):
     out = tmp_path / "never"
-    result = run_cli(["compare-controllers", str(REALISTIC), "--out", str(out), *args], tmp_path)
+    args = ["compare-controllers", str(REALISTIC), "--out", str(out), *args]
+    result = run_cli_in_process(args, tmp_path)
     assert result.returncode == 2, result.stderr
     assert message in result.stderr and "Traceback" not in result.stderr
     assert not out.exists()
