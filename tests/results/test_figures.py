@@ -116,9 +116,12 @@ def test_a_saved_figure_is_drawn_once_and_is_the_file_matplotlib_writes(
     fig.savefig(tmp_path / "matplotlib.png", dpi=120)
     draws = []
     original = Figure.draw
-    monkeypatch.setattr(
-        Figure, "draw", lambda self, renderer: draws.append(1) or original(self, renderer)
-    )
+
+    def counted_draw(self, renderer):
+        draws.append(renderer)
+        return original(self, renderer)
+
+    monkeypatch.setattr(Figure, "draw", counted_draw)
     assert save_figure(plot_pose(passive), tmp_path / "saved.png") == tmp_path / "saved.png"
     assert len(draws) == 1
     assert (tmp_path / "saved.png").read_bytes() == (tmp_path / "matplotlib.png").read_bytes()

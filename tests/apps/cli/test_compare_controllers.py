@@ -56,8 +56,8 @@ def test_compare_controllers_short_run(tmp_path):
 )
 def test_compare_controllers_bad_input(tmp_path, args, message):
     out = tmp_path / "never"
-    args = ["compare-controllers", str(REALISTIC), "--out", str(out), *args]
-    result = run_cli_in_process(args, tmp_path)
+    command = ["compare-controllers", str(REALISTIC), "--out", str(out), *args]
+    result = run_cli_in_process(command, tmp_path)
     assert result.returncode == 2, result.stderr
     assert message in result.stderr and "Traceback" not in result.stderr
     assert not out.exists()
