@@ -194,6 +194,32 @@ bool RayCaster::cones_toward(const Cones& cones, const Vec3& to_centre_f, double
   return true;
 }
 
+bool RayCaster::cones_clear_of_faces(const Cones& cones, const Mat3& body_to_frame,
+                                     const RayShape& shape, const Vec3& origin_local,
+                                     bool culled, std::vector<char>& seen) {
+  std::vector<Vec3> outside;  // the outward normals (rays' frame) of the faces facing away
+  for (Eigen::Index f = 0; f < shape.normals.rows(); ++f) {
+    const Vec3 a = shape.normals.row(f).transpose();
+    if (shape.offsets[f] - a.dot(origin_local) < 0.0) outside.push_back(body_to_frame * a);
+  }
+  if (outside.empty()) return culled;
+  if (!culled) seen.assign(static_cast<std::size_t>(cones.count), 1);
+  for (Eigen::Index j = 0; j < cones.count; ++j) {
+    if (!seen[j]) continue;
+    const Eigen::Map<const Vec3> axis(cones.axes + 3 * j);
+    // each ray is within the half-angle of the axis, so within pi/2 of the normal when the
+    // axis is within pi/2 - half-angle of it; 1e-9 rad for the roundings, as cones_toward
+    const double reach = cones.half_angle_rad[j] + 1e-9;
+    for (const Vec3& a : outside) {
+      if (std::acos(std::clamp(axis.dot(a), -1.0, 1.0)) + reach <= 0.5 * M_PI) {
+        seen[j] = 0;
+        break;
+      }
+    }
+  }
+  return true;
+}
+
 void RayCaster::cast(const Vec3& origin, const Mat3& frame_rotation, const double* rays_f,
                      Eigen::Index n, const Cones* cones, RayHits out) const {
   check_cones(cones, n);
@@ -231,6 +257,11 @@ void RayCaster::cast(const Vec3& origin, const Mat3& frame_rotation, const doubl
     if (!s.bound.unbounded && cones != nullptr) {
       s.culled_by_cones = cones_toward(*cones, frame_rotation.transpose() * s.to_centre,
                                        body.shape.bound_radius_m, s.cones);
+      if (body.shape.kind == ShapeKind::convex) {  // a camera beside a box (a vehicle's
+        s.culled_by_cones = cones_clear_of_faces(  // hull): most cones leave it behind
+            *cones, frame_rotation.transpose() * body.rotation, body.shape, s.origin_local,
+            s.culled_by_cones, s.cones);
+      }
     }
   }
   const Eigen::Index groups = cones == nullptr ? 1 : cones->count;

@@ -79,6 +79,14 @@ class RayCaster {
   // rays' frame); false when the origin is inside it (every cone may).
   static bool cones_toward(const Cones& cones, const Vec3& to_centre_f, double radius,
                            std::vector<char>& seen);
+  // Takes out of `seen` (`cones_toward`'s cones; every cone when `culled` is false) the
+  // cones that cannot enter a convex body the origin is outside of: a face with the origin
+  // outside its half-space (b - a . o < 0) and every ray of the cone moving away from its
+  // plane or along it (a . d >= 0) keeps the whole ray outside that half-space. The body's
+  // frame is at `body_to_frame` in the rays' frame. True when `seen` holds the cones.
+  static bool cones_clear_of_faces(const Cones& cones, const Mat3& body_to_frame,
+                                   const RayShape& shape, const Vec3& origin_local,
+                                   bool culled, std::vector<char>& seen);
 };
 
 }  // namespace uvms::perception

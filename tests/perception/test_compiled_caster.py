@@ -138,6 +138,40 @@ def test_cones_leave_out_the_same_bodies_in_both(seed):
     _assert_same(expected, compiled.cast_from(origin, rotation, rays, cones_of(bundles)))
 
 
+@pytest.mark.parametrize("seed", range(4))
+def test_a_camera_beside_a_box_leaves_out_only_cones_that_cannot_enter_it(seed):
+    """A camera just outside a face of a vehicle-sized box (inside its bounding sphere, so
+    no cone is left out by the sphere), and of a hull: the core leaves out the cones that
+    move away from a face the camera is outside of; the others still meet the box and the
+    hull where every ray cast alone meets them."""
+    rng = np.random.default_rng(300 + seed)
+    hull = convex_of_points(rng.normal(scale=0.15, size=(16, 3)))
+    reference, compiled = RayCaster(), caster_for("core")
+    lean = pin.rpy.rpyToMatrix(*rng.uniform(-0.3, 0.3, 3))
+    for caster in (reference, compiled):
+        caster.add("hull_box", box([0.45, 0.3, 0.2]), lean, [0.0, 0.0, 0.0])
+        caster.add("arm", hull, np.eye(3), lean @ [0.9, 0.0, 0.45])
+        caster.add("seabed", Plane(), np.eye(3), [0.0, 0.0, -2.0])
+    spec = CameraSpec("c", width=96, height=64, horizontal_fov_rad=rng.uniform(1.0, 2.0))
+    order, starts = tiles(spec)
+    rays = pixel_rays(spec)[order]
+    bundles = Bundles.of(rays, starts)
+    origin = lean @ [rng.uniform(-0.3, 0.3), rng.uniform(-0.2, 0.2), 0.2 + rng.uniform(0.001, 0.02)]
+    met = set()
+    for yaw in np.linspace(-math.pi, math.pi, 7):
+        for pitch in (-1.2, -0.5, 0.0, 0.6):  # from looking down at the box to up past it
+            rotation = (
+                lean
+                @ pin.rpy.rpyToMatrix(0.0, pitch, yaw)
+                @ pin.rpy.rpyToMatrix(-math.pi / 2, 0.0, -math.pi / 2)
+            )  # the optical frame: z ahead
+            expected = reference.cast(origin, rays @ rotation.T)  # every ray alone
+            got = compiled.cast_from(origin, rotation, rays, cones_of(bundles))
+            _assert_same(expected, got)
+            met |= set(np.unique(expected.label).tolist())
+    assert {1, 2, 3} <= met  # the box, the hull and the seabed were all seen
+
+
 def test_a_solid_holding_the_origin_and_a_plane_behind_it_are_not_seen_by_either():
     reference, compiled = RayCaster(), caster_for("core")
     for caster in (reference, compiled):
