@@ -221,3 +221,43 @@ def test_show_is_a_run_and_replay_option(tmp_path):
     assert "collision shapes" not in page.read_text()
     with pytest.raises(SystemExit):
         main(["replay", str(out), "--html", "--show", "meshes"])
+
+
+DRAW_IN_A_FRESH_PROCESS = """
+import sys
+from pathlib import Path
+import uvms_pin as up
+from uvms_pin.apps.viz.meshcat_scene import recording_visualizer
+from uvms_pin.apps.viz.robot_view import draw_bodies, geometry_groups
+{before}
+urdf = Path({urdf!r})
+uvms = up.load_uvms(urdf)
+geometry = geometry_groups(uvms.model, urdf, "visual")["visuals"]
+viewer, window = recording_visualizer()
+draw_bodies(viewer, uvms.model, geometry)
+assert window.commands, "nothing drawn"
+print(sorted(m for m in ("networkx", "trimesh") if m in sys.modules))
+import trimesh  # importable again after the drawing
+print(type(sys.modules["trimesh"]).__name__)
+"""
+
+
+@pytest.mark.parametrize(
+    ("before", "imported"), [("", "[]"), ("import trimesh", "['networkx', 'trimesh']")]
+)
+def test_drawing_the_robot_does_not_import_trimesh_for_pinocchios_viser_viewer(before, imported):
+    """pinocchio.visualize's viser viewer would import trimesh (with scipy.spatial and
+    networkx: 0.7 s) only to find viser missing: drawing the robot imports none of trimesh,
+    and leaves a trimesh imported before (a mesh object's) and trimesh's import as they
+    were."""
+    import subprocess
+    import sys
+
+    code = DRAW_IN_A_FRESH_PROCESS.format(before=before, urdf=str(BLUEROV_ALPHA5))
+    done = subprocess.run(
+        [sys.executable, "-c", code], capture_output=True, text=True, timeout=120, check=False
+    )
+    assert done.returncode == 0, done.stderr
+    found, module = done.stdout.split("\n")[:2]
+    assert found == imported
+    assert module == "module"

@@ -9,13 +9,14 @@ replay one animation track, not one per piece.
 
 from __future__ import annotations
 
+import sys
 import warnings
+from functools import cache
 from pathlib import Path
 
 import meshcat
 import numpy as np
 import pinocchio as pin
-from pinocchio.visualize import MeshcatVisualizer
 
 from uvms_pin.errors import VizError
 
@@ -69,11 +70,30 @@ def geometry_groups(
     return out
 
 
-class _BodyVisualizer(MeshcatVisualizer):
-    """Pinocchio's meshcat loader (primitives, meshes, URDF colours), its nodes per body."""
+@cache
+def _body_visualizer() -> type:
+    """Pinocchio's meshcat loader (primitives, meshes, URDF colours), its nodes per body.
 
-    def getViewerNodeName(self, geometry_object, geometry_type):
-        return f"{self.model.names[geometry_object.parentJoint]}/{geometry_object.name}"
+    ``pinocchio.visualize`` imports all of pinocchio's viewers, among them the viser one,
+    which imports trimesh (and with it scipy.spatial and networkx) only to find viser
+    missing: 0.7 s of CPU, a third of a replay's start-up, for a module nothing here uses.
+    Where trimesh is not imported yet, it is hidden (``None`` in ``sys.modules`` makes its
+    import fail) while pinocchio.visualize is imported, and is importable again after: the
+    viser viewer then reads as unavailable, as when viser is not installed."""
+    hide = "trimesh" not in sys.modules
+    if hide:
+        sys.modules["trimesh"] = None  # type: ignore[assignment]
+    try:
+        from pinocchio.visualize import MeshcatVisualizer
+    finally:
+        if hide:
+            del sys.modules["trimesh"]
+
+    class BodyVisualizer(MeshcatVisualizer):
+        def getViewerNodeName(self, geometry_object, geometry_type):
+            return f"{self.model.names[geometry_object.parentJoint]}/{geometry_object.name}"
+
+    return BodyVisualizer
 
 
 def draw_bodies(
@@ -84,7 +104,7 @@ def draw_bodies(
 ) -> None:
     """Every object of ``geometry`` under ``node[<joint>/<name>]`` at its placement in its
     joint's frame; ``rgba`` overrides the URDF colours (None: keep them)."""
-    viz = _BodyVisualizer(model, collision_model=None, visual_model=geometry)
+    viz = _body_visualizer()(model, collision_model=None, visual_model=geometry)
     viz.initViewer(viewer=node)
     for obj in geometry.geometryObjects:
         with warnings.catch_warnings():
