@@ -61,16 +61,16 @@ def test_sphere_drag_is_half_rho_cd_area():
 @pytest.mark.parametrize("axes", [(1, 1, 1), (3, 1, 1), (1, 0.5, 0.2), (0.2, 1, 0.4), (1, 1, 1e-3)])
 def test_shape_integrals_sum_to_two_and_match_carlson_form(axes):
     # alpha0 = 2/3 abc R_D(b^2, c^2, a^2) (Carlson's symmetric elliptic integral), an
-    # independent closed form; tolerance 1e-9 absolute.
+    # independent implementation (scipy.special.elliprd) of the closed form the module uses.
     a, b, c = axes
     alpha0, beta0, gamma0 = ellipsoid_shape_integrals(a, b, c)
-    assert alpha0 + beta0 + gamma0 == pytest.approx(2.0, abs=1e-9)
+    assert alpha0 + beta0 + gamma0 == pytest.approx(2.0, abs=1e-14)
     ref = [
         2.0 / 3.0 * a * b * c * elliprd(b * b, c * c, a * a),
         2.0 / 3.0 * a * b * c * elliprd(c * c, a * a, b * b),
         2.0 / 3.0 * a * b * c * elliprd(a * a, b * b, c * c),
     ]
-    np.testing.assert_allclose([alpha0, beta0, gamma0], ref, rtol=0.0, atol=1e-9)
+    np.testing.assert_allclose([alpha0, beta0, gamma0], ref, rtol=1e-14, atol=1e-16)
 
 
 def test_ellipsoid_reduces_to_sphere():

@@ -46,6 +46,7 @@ import math
 import numpy as np
 
 from uvms_pin.errors import ParameterError
+from uvms_pin.hydro.elliptic import carlson_rd
 from uvms_pin.hydro.params import HydroParams
 from uvms_pin.hydro.vector import skew
 
@@ -130,9 +131,10 @@ def ellipsoid_shape_integrals(a_m: float, b_m: float, c_m: float) -> tuple[float
     alpha0 = a b c * int_0^inf dl / ((a^2 + l) Delta(l)),
     Delta(l) = sqrt((a^2 + l)(b^2 + l)(c^2 + l)), and beta0, gamma0 likewise with b^2, c^2 in
     the first factor (Lamb 1932, sec. 114). They are dimensionless, depend only on the aspect
-    ratios and satisfy alpha0 + beta0 + gamma0 = 2 (each is 2/3 for a sphere). Computed with
-    ``scipy.integrate.quad`` after scaling the axes by the largest one and substituting
-    l = s^2, which removes the steep 1/sqrt(l) behaviour of thin bodies near l = 0.
+    ratios and satisfy alpha0 + beta0 + gamma0 = 2 (each is 2/3 for a sphere). The integral
+    is Carlson's symmetric elliptic integral (`uvms_pin.hydro.elliptic`):
+    alpha0 = 2/3 a b c R_D(b^2, c^2, a^2), and cyclically; the axes are scaled by the largest
+    one first.
 
     Args:
         a_m, b_m, c_m: semi-axes along x, y, z [m], finite and > 0.
@@ -146,25 +148,11 @@ def ellipsoid_shape_integrals(a_m: float, b_m: float, c_m: float) -> tuple[float
     scale = max(a, b, c)
     a2, b2, c2 = (a / scale) ** 2, (b / scale) ** 2, (c / scale) ** 2
     abc = math.sqrt(a2 * b2 * c2)
-
-    # scipy.integrate is imported where it is used: it takes a quarter second to import,
-    # which every start-up would pay otherwise
-    from scipy.integrate import quad
-
-    def integral(first: float) -> float:
-        # l = s^2, dl = 2 s ds: the integrand decays as s^-4 for large s.
-        def f(s: float) -> float:
-            lam = s * s
-            delta = math.sqrt((a2 + lam) * (b2 + lam) * (c2 + lam))
-            return 2.0 * s / ((first + lam) * delta)
-
-        small = math.sqrt(min(a2, b2, c2))
-        head, _ = quad(f, 0.0, small, epsabs=0.0, epsrel=1e-12, limit=200)
-        mid, _ = quad(f, small, 1.0, epsabs=0.0, epsrel=1e-12, limit=200)
-        tail, _ = quad(f, 1.0, np.inf, epsabs=0.0, epsrel=1e-12, limit=200)
-        return abc * (head + mid + tail)
-
-    return integral(a2), integral(b2), integral(c2)
+    return (
+        2.0 / 3.0 * abc * carlson_rd(b2, c2, a2),
+        2.0 / 3.0 * abc * carlson_rd(c2, a2, b2),
+        2.0 / 3.0 * abc * carlson_rd(a2, b2, c2),
+    )
 
 
 def _rotational_added_inertia(
