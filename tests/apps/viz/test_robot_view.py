@@ -243,20 +243,35 @@ print(type(sys.modules["trimesh"]).__name__)
 
 
 @pytest.mark.parametrize(
-    ("before", "imported"), [("", "[]"), ("import trimesh", "['networkx', 'trimesh']")]
+    ("before", "viser", "imported"),
+    [
+        ("", False, "[]"),
+        ("import trimesh", False, "['networkx', 'trimesh']"),
+        ("", True, "['networkx', 'trimesh']"),  # viser importable: its viewer left whole
+    ],
 )
-def test_drawing_the_robot_does_not_import_trimesh_for_pinocchios_viser_viewer(before, imported):
+def test_drawing_the_robot_does_not_import_trimesh_for_pinocchios_viser_viewer(
+    before, viser, imported, tmp_path
+):
     """pinocchio.visualize's viser viewer would import trimesh (with scipy.spatial and
     networkx: 0.7 s) only to find viser missing: drawing the robot imports none of trimesh,
     and leaves a trimesh imported before (a mesh object's) and trimesh's import as they
-    were."""
+    were. With viser importable (here a stand-in package), pinocchio's viewer is imported
+    as pinocchio imports it."""
+    import os
     import subprocess
     import sys
 
+    env = dict(os.environ)
+    if viser:
+        (tmp_path / "viser").mkdir()
+        (tmp_path / "viser" / "__init__.py").write_text("")
+        env["PYTHONPATH"] = os.pathsep.join([str(tmp_path), env.get("PYTHONPATH", "")])
     code = DRAW_IN_A_FRESH_PROCESS.format(before=before, urdf=str(BLUEROV_ALPHA5))
     done = subprocess.run(
-        [sys.executable, "-c", code], capture_output=True, text=True, timeout=120, check=False
-    )
+        [sys.executable, "-c", code],
+        capture_output=True, text=True, timeout=120, check=False, env=env,
+    )  # fmt: skip
     assert done.returncode == 0, done.stderr
     found, module = done.stdout.split("\n")[:2]
     assert found == imported

@@ -9,6 +9,7 @@ replay one animation track, not one per piece.
 
 from __future__ import annotations
 
+import importlib.util
 import sys
 import warnings
 from functools import cache
@@ -77,10 +78,10 @@ def _body_visualizer() -> type:
     ``pinocchio.visualize`` imports all of pinocchio's viewers, among them the viser one,
     which imports trimesh (and with it scipy.spatial and networkx) only to find viser
     missing: 0.7 s of CPU, a third of a replay's start-up, for a module nothing here uses.
-    Where trimesh is not imported yet, it is hidden (``None`` in ``sys.modules`` makes its
-    import fail) while pinocchio.visualize is imported, and is importable again after: the
-    viser viewer then reads as unavailable, as when viser is not installed."""
-    hide = "trimesh" not in sys.modules
+    Where viser is not installed (that viewer cannot work) and trimesh is not imported yet,
+    trimesh is hidden (``None`` in ``sys.modules`` makes its import fail) while
+    pinocchio.visualize is imported, and is importable again after."""
+    hide = "trimesh" not in sys.modules and importlib.util.find_spec("viser") is None
     if hide:
         sys.modules["trimesh"] = None  # type: ignore[assignment]
     try:
