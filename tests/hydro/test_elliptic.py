@@ -9,6 +9,7 @@ import numpy as np
 import pytest
 from scipy.special import elliprd
 
+from uvms_pin.errors import ParameterError
 from uvms_pin.hydro.elliptic import carlson_rd
 from uvms_pin.hydro.geometry import ellipsoid_shape_integrals
 
@@ -52,5 +53,5 @@ def test_a_prolate_spheroids_axial_integral_is_lambs_closed_form(ratio):
     ],
 )
 def test_rd_refuses_arguments_outside_its_domain(args):
-    with pytest.raises(ValueError, match="R_D"):
+    with pytest.raises(ParameterError, match="R_D needs finite"):
         carlson_rd(*args)

@@ -19,6 +19,8 @@ from __future__ import annotations
 
 import math
 
+from uvms_pin.errors import ParameterError
+
 __all__ = ["carlson_rd"]
 
 #: the arguments' spread below which the series finishes, relative to their mean: its
@@ -27,11 +29,12 @@ _TOLERANCE = 1.5e-3
 
 
 def carlson_rd(x: float, y: float, z: float) -> float:
-    """R_D(x, y, z) for x, y >= 0 (not both 0) and z > 0 (finite)."""
-    if not (x >= 0.0 and y >= 0.0 and z > 0.0 and x + y > 0.0):
-        raise ValueError(f"R_D needs x, y >= 0 (not both 0) and z > 0, got {x}, {y}, {z}")
-    if not all(math.isfinite(v) for v in (x, y, z)):
-        raise ValueError(f"R_D needs finite arguments, got {x}, {y}, {z}")
+    """R_D(x, y, z) for finite x, y >= 0 (not both 0) and z > 0; else `ParameterError`."""
+    finite = math.isfinite(x) and math.isfinite(y) and math.isfinite(z)
+    if not (finite and x >= 0.0 and y >= 0.0 and z > 0.0 and x + y > 0.0):
+        raise ParameterError(
+            f"R_D needs finite x, y >= 0 (not both 0) and z > 0, got {x}, {y}, {z}"
+        )
     total, weight = 0.0, 1.0
     while True:
         mean = (x + y + 3.0 * z) / 5.0

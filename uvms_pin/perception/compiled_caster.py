@@ -17,9 +17,9 @@ rounding. The core's own casting, measured on the seabed landing's camera (320 x
 rock filling a quarter of the last image, 19,000 rays toward it): 0.9 ms for the rock's rays
 where Embree took 2.5 ms, glue included, called once per image from Python.
 
-A convex body (a box, a hull) whose bounding sphere holds the origin, as a vehicle's box holds
-a camera mounted on it, cannot be left out by its sphere; the core then leaves out the cones
-that move away from a face the origin is outside of (every ray of the cone within pi/2 of the
+For a convex body (a box, a hull) the core also leaves out the cones that move away from a
+face the origin is outside of, which its bounding sphere cannot do when it holds the origin,
+as a vehicle's box holds a camera mounted on it (every ray of the cone within pi/2 of the
 face's outward normal stays outside that face's half-space, so outside the body). The hits
 are the same: a cone is left out only where none of its rays can enter (tests/perception/
 test_compiled_caster.py). The seabed landing's camera sits above its vehicle's box, looking

@@ -4,6 +4,9 @@ the BlueROV2 Heavy + Alpha 5 replay within its size bound."""
 
 from __future__ import annotations
 
+import os
+import subprocess
+import sys
 import xml.etree.ElementTree as ET
 from pathlib import Path
 
@@ -258,10 +261,6 @@ def test_drawing_the_robot_does_not_import_trimesh_for_pinocchios_viser_viewer(
     and leaves a trimesh imported before (a mesh object's) and trimesh's import as they
     were. With viser importable (here a stand-in package), pinocchio's viewer is imported
     as pinocchio imports it."""
-    import os
-    import subprocess
-    import sys
-
     env = dict(os.environ)
     if viser:
         (tmp_path / "viser").mkdir()
@@ -270,8 +269,12 @@ def test_drawing_the_robot_does_not_import_trimesh_for_pinocchios_viser_viewer(
     code = DRAW_IN_A_FRESH_PROCESS.format(before=before, urdf=str(BLUEROV_ALPHA5))
     done = subprocess.run(
         [sys.executable, "-c", code],
-        capture_output=True, text=True, timeout=120, check=False, env=env,
-    )  # fmt: skip
+        capture_output=True,
+        text=True,
+        timeout=120,
+        check=False,
+        env=env,
+    )
     assert done.returncode == 0, done.stderr
     found, module = done.stdout.split("\n")[:2]
     assert found == imported
