@@ -87,7 +87,15 @@ def test_a_bad_sensor_table_is_refused_naming_the_key(sensors, message):
 
 def test_a_sensor_on_a_link_the_model_lacks_is_refused_before_the_run():
     scenario = _scenario({"camera": [{**CAMERA, "link": "mast"}]})
-    with pytest.raises(ParameterError, match="link 'mast'"):
+    with pytest.raises(ParameterError, match=r"camera 'front': link 'mast'.*it has: 'universe'"):
+        simulate(scenario, progress=False)
+
+
+def test_a_misspelt_link_is_refused_with_the_frames_it_resembles():
+    scenario = _scenario({"sonar": [{**SONAR, "link": "base_lnk"}]})
+    with pytest.raises(
+        ParameterError, match=r"sonar 'fls': link 'base_lnk'.*did you mean 'base_link'"
+    ):
         simulate(scenario, progress=False)
 
 

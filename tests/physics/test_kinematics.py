@@ -228,6 +228,14 @@ def test_unknown_frame_lists_available_frames(model):
     with pytest.raises(ParameterError, match="'ee'") as info:
         frame_id_from_name(model, "gripper_tip")
     assert "gripper_tip" in str(info.value)
+    assert "did you mean" not in str(info.value)  # nothing resembles it
+
+
+def test_a_misspelt_frame_is_named_with_the_closest_frames_and_the_argument(model):
+    with pytest.raises(ParameterError, match=r"^task frame 'e' is not a frame.*did you mean 'ee'"):
+        frame_id_from_name(model, "e", "task frame")
+    with pytest.raises(ParameterError, match=r"^frame None is not a frame"):
+        frame_id_from_name(model, None)
 
 
 def test_bad_q_raises():

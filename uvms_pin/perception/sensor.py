@@ -19,6 +19,7 @@ import numpy as np
 import pinocchio as pin
 
 from uvms_pin.errors import ParameterError
+from uvms_pin.physics.kinematics import frame_id_from_name
 
 __all__ = [
     "SENSORS",
@@ -194,6 +195,4 @@ def mount_frame(model: pin.Model, link: str | None, label: str) -> int:
             if frame.parentJoint == 1 and frame.type == pin.FrameType.BODY:
                 return k
         raise ParameterError(f"{label}: the model has no vehicle body frame; give link")
-    if not model.existFrame(link):
-        raise ParameterError(f"{label}: link '{link}' is not a frame of the robot's model")
-    return int(model.getFrameId(link))
+    return frame_id_from_name(model, link, f"{label}: link")

@@ -16,6 +16,7 @@ Conventions (docs/physics.md):
 
 from __future__ import annotations
 
+import difflib
 import math
 
 import numpy as np
@@ -29,16 +30,22 @@ from uvms_pin.errors import ParameterError
 EULER_SINGULARITY_MIN_ABS_COS_PITCH = 1e-3
 
 
-def frame_id_from_name(model: pin.Model, frame_name: str) -> int:
+def frame_id_from_name(model: pin.Model, frame_name: str, what: str = "frame") -> int:
     """Index of the frame called ``frame_name`` in ``model.frames``.
 
     Raises:
-        ParameterError: no frame has this name; the message lists the available frames.
+        ParameterError: no frame has this name; the message starts with ``what`` (the
+            argument that named it: "camera 'front': link"), names the closest frame names
+            and lists the available frames.
     """
     if not isinstance(frame_name, str) or not model.existFrame(frame_name):
-        available = ", ".join(f"'{frame.name}'" for frame in model.frames)
+        names = list(dict.fromkeys(frame.name for frame in model.frames))
+        close = difflib.get_close_matches(str(frame_name), names, n=3, cutoff=0.5)
+        hint = f" (did you mean {', '.join(repr(name) for name in close)}?)" if close else ""
+        available = ", ".join(f"'{name}'" for name in names)
         raise ParameterError(
-            f"unknown frame {frame_name!r}; the model '{model.name}' has: {available}"
+            f"{what} {frame_name!r} is not a frame of the model '{model.name}'{hint}; "
+            f"it has: {available}"
         )
     return int(model.getFrameId(frame_name))
 

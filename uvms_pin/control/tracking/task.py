@@ -27,6 +27,7 @@ import pinocchio as pin
 
 from uvms_pin.control.tracking.trajectory import Path
 from uvms_pin.errors import ParameterError
+from uvms_pin.physics.kinematics import frame_id_from_name
 
 __all__ = ["TARGETS", "TrackingTask", "orientation_error"]
 
@@ -98,9 +99,7 @@ class TrackingTask:
         """The tracked frame's index (-1 for the vehicle)."""
         if self.target == "vehicle":
             return -1
-        if not model.existFrame(self.frame_name):
-            raise ParameterError(f"task frame '{self.frame_name}' is not a frame of the model")
-        return int(model.getFrameId(self.frame_name))
+        return frame_id_from_name(model, self.frame_name, "task frame")
 
     def pose(
         self, model: pin.Model, data: pin.Data, q: np.ndarray
