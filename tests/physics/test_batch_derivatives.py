@@ -142,8 +142,12 @@ def test_bad_threads_and_times_are_refused(reference_uvms):
     q, v, tau = _states(reference_uvms, 3)
     with pytest.raises(ParameterError, match="num_threads"):
         up.forward_dynamics_derivatives_batch(reference_uvms, q, v, tau, num_threads=0)
-    with pytest.raises(ParameterError, match="time_s must be one time or 3 times"):
+    with pytest.raises(ParameterError, match=r"time_s \(one time or 3, one a state\) must have"):
         up.forward_dynamics_derivatives_batch(reference_uvms, q, v, tau, time_s=[0.0, 1.0])
+    with pytest.raises(ParameterError, match=r"time_s .* contains a non-finite value"):
+        up.forward_dynamics_derivatives_batch(reference_uvms, q, v, tau, time_s=[0.0, np.nan, 1])
+    with pytest.raises(ParameterError, match=r"time_s .* must be 3 numbers"):
+        up.forward_dynamics_derivatives_batch(reference_uvms, q, v, tau, time_s=["a", "b", "c"])
 
 
 def test_more_states_than_memory_are_refused_before_anything_is_copied(reference_uvms):

@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from uvms_pin.checks import check_memory, flag, thread_count
+from uvms_pin.checks import check_memory, finite_vector, flag, thread_count
 from uvms_pin.errors import ParameterError
 from uvms_pin.flow import FlowField
 from uvms_pin.model.uvms import UVMS
@@ -121,16 +121,10 @@ def _rows(name: str, value, size: int, count: int | None = None) -> np.ndarray:
 
 
 def _times(time_s, count: int) -> np.ndarray:
-    """One time per state [s]: ``time_s`` repeated, or its (count,) entries, each checked."""
+    """One time per state [s]: ``time_s`` repeated, or its (count,) entries, each finite."""
     if np.ndim(time_s) == 0:
         return np.full(count, check_time(time_s))
-    try:
-        times = np.asarray(time_s, dtype=float)
-    except (TypeError, ValueError) as exc:
-        raise ParameterError(f"time_s must be one time or {count} times [s]") from exc
-    if times.shape != (count,):
-        raise ParameterError(f"time_s must be one time or {count} times [s], got {times.shape}")
-    return np.array([check_time(t) for t in times])
+    return finite_vector(f"time_s (one time or {count}, one a state)", time_s, count)
 
 
 def _one_by_one(uvms, states, times, water, backend, free_surface) -> Jacobians:
