@@ -116,3 +116,37 @@ def test_catalogue_names_and_entries_are_arms():
 def test_an_unknown_arm_name_lists_the_catalogue():
     with pytest.raises(up.ParameterError, match=r"unknown arm 'ur55'.*ur5"):
         up.mount_arm(VEHICLE_URDF, "ur55", POSE)
+
+
+TRIMMED_URDF = ROOT / "models" / "uvms_bluerov2_alpha5.urdf"  # its mount trimmed the Alpha 5
+TRIM = ["trim_foam", "trim_ballast"]
+
+
+def _trim_links(uvms: up.UVMS) -> list[str]:
+    return sorted(f.name for f in uvms.model.frames if "trim_" in f.name and "joint" not in f.name)
+
+
+def test_replacing_a_trimmed_arm_removes_its_trim_and_trims_the_new_arm_alone(tmp_path):
+    """The Alpha 5's foam and ballast go with it: the UR3 on the BlueROV2 + Alpha 5 is the
+    UR3 on the vehicle split from it, trimmed the same way (trim=True: neutral again)."""
+    with pytest.warns(UserWarning, match="replaced the arm"):
+        replaced = mount_arm_detailed(TRIMMED_URDF, "ur3", POSE, trim=True)
+    assert replaced.removed_links[-2:] == TRIM
+    assert replaced.removed_joints[-2:] == [f"{name}_joint" for name in TRIM]
+    split = split_urdf(TRIMMED_URDF, tmp_path, first_arm_joint="alpha_axis_e")
+    assert split.trim_links == tuple(TRIM)
+    for path in (split.vehicle_urdf, split.arm_urdf):
+        assert "trim_" not in path.read_text()
+    on_split = mount_arm_detailed(split.vehicle_urdf, "ur3", POSE, trim=True)
+    assert _trim_links(replaced.uvms) == _trim_links(on_split.uvms)
+    assert replaced.uvms.mass_kg == pytest.approx(on_split.uvms.mass_kg, rel=1e-12)
+    assert replaced.uvms.volume_m3 == pytest.approx(on_split.uvms.volume_m3, rel=1e-12)
+    assert replaced.trim.net_buoyancy_after_N == pytest.approx(0.0, abs=1e-6)
+
+
+def test_a_kept_arm_keeps_its_trim_and_the_new_trim_is_named_apart():
+    kept = mount_arm_detailed(TRIMMED_URDF, "ur3", POSE, trim=True, keep_existing_arm=True)
+    names = _trim_links(kept.uvms)
+    assert set(TRIM) <= set(names) and len(names) == len(set(names)) > len(TRIM)
+    assert all(name in TRIM or name.removeprefix("arm_") in TRIM for name in names)
+    assert kept.trim.net_buoyancy_after_N == pytest.approx(0.0, abs=1e-6)

@@ -93,3 +93,18 @@ def test_a_vehicle_without_an_arm_is_refused_saying_so(tmp_path, capsys):
     assert main(["compare-arms", str(scenario), "--out", str(tmp_path / "o")]) == 2
     assert "is a vehicle without an arm" in capsys.readouterr().err
     assert not (tmp_path / "o").exists()
+
+
+def test_on_a_trimmed_vehicle_each_arm_gets_a_whole_trim_of_its_own(tmp_path):
+    """The BlueROV2 + Alpha 5 carries the trim its mount gave the Alpha 5: a UR3 mounted in
+    its place is trimmed from the vehicle alone (the Alpha 5's foam and ballast left out, not
+    added to), neutral after it, and runs the task."""
+    scenario = ROOT / "scenarios" / "bluerov_alpha5_force_tracking.toml"
+    settings = CompareSettings(duration_s=0.05, ik_starts=4)
+    (row,) = compare_arms(scenario, ["ur3"], tmp_path, settings)
+    assert row["status"] == "ok", row["reason"]
+    assert abs(row["net_buoyancy_after_N"]) < 1e-6
+    model = (tmp_path / "models" / "ur3.urdf").read_text()
+    assert "arm_trim_" not in model  # one trim, not the Alpha 5's and another
+    assert model.count('<link name="trim_foam"') == (row["foam_volume_L"] > 0.0)
+    assert model.count('<link name="trim_ballast"') == (row["ballast_kg"] > 0.0)

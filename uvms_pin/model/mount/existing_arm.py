@@ -1,9 +1,10 @@
 """The arm a vehicle file already carries (``models/uvms_lbv150.urdf``), which a mount
-replaces unless asked to keep it."""
+replaces unless asked to keep it, with the trim a mount added for it."""
 
 from __future__ import annotations
 
 from uvms_pin.model.mount.tree import URDFTree
+from uvms_pin.model.trim_urdf import TRIM_LINKS
 
 __all__ = ["existing_arm"]
 
@@ -13,14 +14,24 @@ _MOUNT_FRAMES = ("ft_sensor", "tool", "ee")
 
 def existing_arm(vehicle: URDFTree) -> tuple[list[str], list[str]]:
     """(links, joints) of the arm a vehicle file already carries: everything below each
-    first moving joint (one without a moving joint above it), and the ``ft_sensor``,
-    ``tool`` and ``ee`` frames wherever they hang; empty for a vehicle alone."""
+    first moving joint (one without a moving joint above it), the ``ft_sensor``, ``tool``
+    and ``ee`` frames wherever they hang and, with an arm, the foam and ballast a mount
+    trimmed it with (`TRIM_LINKS`, fixed to the vehicle: they balanced that arm); empty for
+    a vehicle alone."""
     starts = [
         vehicle.child_of(name)
         for name in vehicle.joint_order
         if vehicle.is_moving(name) and not vehicle.moving_above(name)
     ]
     starts += [f for f in _MOUNT_FRAMES if f in vehicle.parent_joint]
+    if starts:
+        starts += [
+            link
+            for link in TRIM_LINKS
+            if link in vehicle.parent_joint
+            and not vehicle.is_moving(vehicle.parent_joint[link])
+            and not vehicle.moving_above(vehicle.parent_joint[link])
+        ]
     links: set[str] = set()
     for start in starts:
         links.update(vehicle.subtree(start))

@@ -7,6 +7,7 @@ from __future__ import annotations
 import xml.etree.ElementTree as ET
 
 from uvms_pin.model.mount.tree import URDFTree
+from uvms_pin.model.trim_urdf import TRIM_LINKS
 
 __all__ = [
     "ADDED_FRAMES",
@@ -45,8 +46,7 @@ def unique_frame_names(taken: set[str]) -> dict[str, str]:
 def added_names(*, sensor_link: str | None, with_tool: bool, ee_link: str) -> set[str]:
     """The names the merged file will have that no arm element may keep: the mount joint,
     the trim's links and joints, and the sensor, tool and ee frames that will be added."""
-    names = {"arm_mount_joint", "trim_foam", "trim_foam_joint"}
-    names |= {"trim_ballast", "trim_ballast_joint"}
+    names = {"arm_mount_joint"} | {n for link in TRIM_LINKS for n in (link, f"{link}_joint")}
     if sensor_link is None:
         names |= {"ft_sensor", "ft_sensor_joint"}
     if with_tool:

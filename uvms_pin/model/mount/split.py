@@ -1,7 +1,9 @@
 """Split a UVMS URDF into a vehicle URDF and an arm URDF (the inverse of `mount_arm`).
 
 Used to mount other arms on the reference vehicle (the LBV150 without its arm) and to check
-that mounting the reference arm back gives the reference model.
+that mounting the reference arm back gives the reference model. The foam and ballast a mount
+trimmed the arm with (`uvms_pin.model.trim_urdf.TRIM_LINKS` on fixed joints of the vehicle)
+go to neither file: they balanced that arm, and another arm is trimmed for itself.
 """
 
 from __future__ import annotations
@@ -17,6 +19,7 @@ from uvms_pin.errors import ModelError
 from uvms_pin.model.mount.origin import origin_of
 from uvms_pin.model.mount.text import urdf_text, write_text_file
 from uvms_pin.model.mount.tree import URDFTree
+from uvms_pin.model.trim_urdf import TRIM_LINKS
 
 __all__ = ["SplitURDF", "split_urdf"]
 
@@ -33,6 +36,7 @@ class SplitURDF:
     arm_urdf: Path
     vehicle_link: str
     mount_pose: pin.SE3
+    trim_links: tuple[str, ...] = ()  # the mount's trim, left out of both files
 
 
 def split_urdf(
@@ -40,7 +44,8 @@ def split_urdf(
     out_dir: str | Path,
     first_arm_joint: str = REFERENCE_FIRST_ARM_JOINT,
 ) -> SplitURDF:
-    """Write ``vehicle.urdf`` (everything but the arm) and ``arm.urdf`` into ``out_dir``.
+    """Write ``vehicle.urdf`` (everything but the arm and its trim) and ``arm.urdf`` into
+    ``out_dir``.
 
     The arm file's root is an empty link ``arm_mount`` at the first arm joint's origin, so
     mounting it at ``mount_pose`` rebuilds the same kinematics. Top-level ``<hydrodynamics
@@ -56,12 +61,22 @@ def split_urdf(
     joint = tree.joints[first_arm_joint]
     vehicle_link = joint.find("parent").get("link")
     arm_links = set(tree.subtree(tree.child_of(first_arm_joint)))
+    trim = tuple(
+        link
+        for link in TRIM_LINKS
+        if link in tree.parent_joint and not tree.is_moving(tree.parent_joint[link])
+    )
+    dropped = {*trim, *(tree.parent_joint[link] for link in trim)}
     mount = origin_of(joint, path)
 
     vehicle = ET.Element("robot", {"name": tree.root.get("name", "robot") + "_vehicle"})
     arm = ET.Element("robot", {"name": tree.root.get("name", "robot") + "_arm"})
     ET.SubElement(arm, "link", {"name": ARM_MOUNT_LINK})
     for element in tree.root:
+        if element.tag in ("link", "joint", "hydrodynamics") and (
+            element.get("name") in dropped or element.get("link") in dropped
+        ):
+            continue
         item = copy.deepcopy(element)
         for mesh in item.iter("mesh"):
             filename = mesh.get("filename", "")
@@ -89,4 +104,4 @@ def split_urdf(
     vehicle_path, arm_path = out / "vehicle.urdf", out / "arm.urdf"
     for root, target in ((vehicle, vehicle_path), (arm, arm_path)):
         write_text_file(target, urdf_text(root))
-    return SplitURDF(vehicle_path, arm_path, vehicle_link, mount)
+    return SplitURDF(vehicle_path, arm_path, vehicle_link, mount, trim)
