@@ -158,16 +158,27 @@ def baseline_controller_table(raw: dict[str, Any], kind: str) -> dict[str, Any]:
     if "type" in tuning:
         return copy.deepcopy(tuning)
     if kind not in BASELINES:
-        variants = [
-            k
-            for k, v in (raw.get("baselines") or {}).items()
-            if isinstance(v, dict) and "type" in v
-        ]
-        choices = ", ".join((controller.get("type", "none"), *BASELINE_KINDS, *variants))
+        choices = ", ".join((controller.get("type", "none"), *BASELINE_KINDS, *_variants(raw)))
         raise ScenarioError(f"controller '{kind}': this scenario can run {choices}")
     inherited = _TASK_KEYS + (_PSEUDO_INVERSE_INHERITED if BASELINES[kind].pseudo_inverse else ())
     table = {"type": kind, **{k: controller[k] for k in inherited if k in controller}}
     return copy.deepcopy({**table, **tuning})
+
+
+def comparable_controllers(raw: dict[str, Any]) -> list[str]:
+    """The controllers a comparison of the scenario ``raw`` runs when none are named: its
+    own [controller] type, the force baselines on a force task, and each named variant
+    (``[baselines.<name>]`` with its own ``type``). On a tracking [task] the force baselines
+    are left out (they push for a force and follow no trajectory; named, they still run)."""
+    own = (raw.get("controller") or {}).get("type", "none")
+    baselines = () if "task" in raw else BASELINE_KINDS
+    return list(dict.fromkeys((own, *baselines, *_variants(raw))))
+
+
+def _variants(raw: dict[str, Any]) -> list[str]:
+    """The names of the scenario's [baselines.<name>] tables that have their own type."""
+    tables = raw.get("baselines") or {}
+    return [name for name, table in tables.items() if isinstance(table, dict) and "type" in table]
 
 
 def check_baselines(t: Table | None, controller_type: str | None) -> None:

@@ -161,3 +161,38 @@ def test_a_tracking_comparison_says_when_the_run_ends_before_its_transient(tmp_p
     )
     assert refused.returncode == 2 and "--set task.transient_s=S" in refused.stderr
     assert not (tmp_path / "never").exists()
+
+
+@pytest.mark.parametrize(
+    ("scenario", "expected"),
+    [
+        ("realistic_force_tracking", ["ppc", "pi_force", "impedance", "computed_torque", "mpc"]),
+        ("mpc_force_tracking", ["mpc", "pi_force", "impedance", "computed_torque"]),
+        ("lbv150_ee_circle", ["task_priority", "task_priority_ppc", "computed_torque_task"]),
+        ("mpc_station_keeping", ["mpc", "task_priority"]),
+    ],
+)
+def test_without_controllers_a_scenario_compares_what_it_can_be_judged_by(scenario, expected):
+    """Its own controller, its named variants and, on a force task only, the three force
+    baselines: a tracking task's default no longer asks for the PPC it does not have."""
+    from uvms_pin.scenario.baselines import comparable_controllers
+    from uvms_pin.scenario.toml import read_toml
+
+    raw = read_toml(ROOT / "scenarios" / f"{scenario}.toml", ValueError)
+    assert comparable_controllers(raw) == expected
+
+
+def test_a_tracking_scenario_compares_by_default_and_says_when_nothing_can_be_judged(tmp_path):
+    out = tmp_path / "cmp"
+    circle = ROOT / "scenarios" / "lbv150_ee_circle.toml"
+    command = ["compare-controllers", str(circle), "--out", str(out), "--no-figures",
+               "--set", "scenario.duration_s=0.2"]  # fmt: skip
+    result = run_cli_in_process(command, tmp_path)
+    assert result.returncode == 0, result.stderr
+    rows = list(csv.DictReader((out / "controllers.csv").open()))
+    assert [r["controller"] for r in rows] == [
+        "task_priority", "task_priority_ppc", "computed_torque_task"
+    ]  # fmt: skip
+    # the run ends before the task's transient: no error to quote, and why
+    assert "nan" not in result.stdout
+    assert result.stdout.count("no errors to judge: fails: no samples after") == 3

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+import math
 from pathlib import Path
 
 from uvms_pin.apps.arguments import (
@@ -17,16 +18,15 @@ from uvms_pin.errors import ParameterError
 from uvms_pin.results.outdir import CONTROLLER_COMPARISON, check_writable, claim
 from uvms_pin.scenario.overrides import parse_assignment
 
-DEFAULT_CONTROLLERS = "ppc,pi_force,impedance,computed_torque"
-
 
 def _cmd_compare_controllers(args: argparse.Namespace) -> int:
     from uvms_pin.apps.compare.metrics import COLUMNS, Criteria
     from uvms_pin.apps.compare.runs import controller_scenarios
 
-    names = comma_names("--controllers", args.controllers)
+    names = None if args.controllers is None else comma_names("--controllers", args.controllers)
     overrides = dict(parse_assignment(text) for text in args.set)
     scenarios = controller_scenarios(args.scenario, names, overrides)
+    names = list(scenarios)
     duration = next(iter(scenarios.values())).settings.duration_s
     after_s = 0.5 * duration if args.after is None else args.after
     if not after_s < duration:
@@ -93,9 +93,15 @@ def _compare_tracking(args: argparse.Namespace, scenarios, criteria, out) -> int
         return [] if args.no_figures else [write_tracking_figure(rollouts, out)]
 
     def summary(row) -> str:
+        position, orientation = (
+            row["task_position_error_rms_m"],
+            row["task_orientation_error_rms_rad"],
+        )
+        if not (math.isfinite(position) and math.isfinite(orientation)):
+            return f"{row['controller']:<22} no errors to judge"  # its reason follows
         return (
-            f"{row['controller']:<22} position error RMS {1000 * row['task_position_error_rms_m']:.2f} mm, "
-            f"orientation {row['task_orientation_error_rms_rad']:.4f} rad"
+            f"{row['controller']:<22} position error RMS {1000 * position:.2f} mm, "
+            f"orientation {orientation:.4f} rad"
         )
 
     return _compare(args, scenarios, criteria, out, (header, TRACKING_COLUMNS), figure, summary)
@@ -132,9 +138,10 @@ def register(subparsers) -> argparse.ArgumentParser:
     )
     parser.add_argument(
         "--controllers",
-        default=DEFAULT_CONTROLLERS,
-        help=f"comma-separated: the scenario's own type and/or pi_force, impedance, "
-        f"computed_torque (default {DEFAULT_CONTROLLERS})",
+        default=None,
+        help="comma-separated: the scenario's own type, pi_force, impedance, "
+        "computed_torque and its named [baselines.<name>] variants (default: its own type, "
+        "its variants and, on a force task, the three baselines)",
     )
     add_set_option(
         parser, "override a scenario entry for every controller (repeatable), as in 'run'"

@@ -12,7 +12,7 @@ from uvms_pin.apps.compare.tracking import tracking_row
 from uvms_pin.checks import check_memory
 from uvms_pin.errors import FunnelViolation, ScenarioError, SimulationError
 from uvms_pin.results.rollout import Rollout
-from uvms_pin.scenario.baselines import baseline_controller_table
+from uvms_pin.scenario.baselines import baseline_controller_table, comparable_controllers
 from uvms_pin.scenario.load import scenario_from_dict
 from uvms_pin.scenario.overrides import apply_overrides
 from uvms_pin.scenario.toml import read_toml
@@ -24,10 +24,11 @@ __all__ = ["batch_run_row", "compare_controllers", "controller_scenarios", "run_
 
 
 def controller_scenarios(
-    path: str | Path, controllers: list[str], overrides: dict[str, Any] | None = None
+    path: str | Path, controllers: list[str] | None, overrides: dict[str, Any] | None = None
 ) -> dict[str, Scenario]:
     """The scenario at ``path`` once per controller (its [controller] replaced by
-    `baseline_controller_table`), every one built and checked before any run.
+    `baseline_controller_table`), every one built and checked before any run; ``None``:
+    the scenario's `comparable_controllers`.
 
     Raises:
         ScenarioError: a bad file, override or controller name.
@@ -36,7 +37,7 @@ def controller_scenarios(
     # overrides first: they may set a baseline's tuning ("baselines.pi_force.damping=...")
     raw = apply_overrides(read_toml(path, ScenarioError), overrides)
     out = {}
-    for name in controllers:
+    for name in comparable_controllers(raw) if controllers is None else controllers:
         # the controller table that runs; the other tunings are not this run's
         variant = {k: v for k, v in raw.items() if k != "baselines"}
         variant["controller"] = baseline_controller_table(raw, name)
