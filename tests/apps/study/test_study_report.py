@@ -105,3 +105,20 @@ def test_a_robots_metrics_get_figures_too(tmp_path):
     text = report.read_text()
     assert "| alpha/bar_final_distance_m | all (3)" in text
     assert "Status ok (the run reached its end" in text and "**3 of 3 runs" in text
+
+
+def test_a_tracking_studys_task_errors_are_summarised_by_default(tmp_path):
+    """Without [report] metrics, a study whose runs judged a tracking [task] gets its
+    position and orientation errors summarised; one whose runs judged none does not."""
+    table = _table().drop(columns=RMS)
+    table["task_position_error_rms_m"] = [0.01, 0.02, 0.015, 0.012, math.nan, 0.03]
+    table["task_orientation_error_rms_rad"] = [0.1, 0.2, 0.15, 0.12, math.nan, 0.3]
+    table["task_settling_time_s"] = [1.0, 2.0, 1.5, 1.2, math.nan, 3.0]
+    table.to_parquet(tmp_path / RESULTS_FILE)
+    report = write_report(tmp_path)[0].read_text()
+    for metric in ("task_position_error_rms_m", "task_orientation_error_rms_rad"):
+        assert any(line.startswith(f"| {metric} | all") for line in report.splitlines())
+    table[["task_position_error_rms_m", "task_orientation_error_rms_rad"]] = math.nan
+    table.drop(columns="task_settling_time_s").to_parquet(tmp_path / RESULTS_FILE)
+    report = write_report(tmp_path)[0].read_text()
+    assert "task_position_error_rms_m" not in report

@@ -31,6 +31,12 @@ DEFAULT_METRICS = (
     "vehicle_saturation_fraction",
     "simulated_time_s",
 )
+#: a tracking [task]'s metrics, summarised by default where the runs judged one
+TASK_METRICS = (
+    "task_position_error_rms_m",
+    "task_orientation_error_rms_rad",
+    "task_settling_time_s",
+)
 
 
 def _study_info(directory: Path) -> dict[str, Any]:
@@ -59,7 +65,9 @@ def write_report(directory: str | Path) -> list[Path]:
     head = info.get("study", {})
     options = info.get("report", {})
     params = report_parameters(table, info)
-    metrics = [m for m in (options.get("metrics") or DEFAULT_METRICS) if m in table.columns]
+    judged = [m for m in TASK_METRICS if m in table.columns and table[m].notna().any()]
+    chosen = options.get("metrics") or (*DEFAULT_METRICS, *judged)
+    metrics = [m for m in chosen if m in table.columns]
     figures_dir = directory / FIGURES_DIR
     figures_dir.mkdir(exist_ok=True)
     figures, heatmaps = write_figures(table, params, metrics, options, figures_dir)
