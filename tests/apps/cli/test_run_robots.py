@@ -47,3 +47,19 @@ def test_the_progress_is_shown_unless_quiet(tmp_path, capsys):
     assert main(args) == 0
     shown = capsys.readouterr().err
     assert "two_robots" in shown and "0.10" in shown
+
+
+def test_the_replay_of_a_run_of_two_robots_draws_both_and_a_live_view_names_one(tmp_path, capsys):
+    out = tmp_path / "out"
+    args = ["run", str(TWO), "--out", str(out), "--quiet", "--set", "scenario.duration_s=0.2"]
+    assert main([*args, "--html"]) == 0
+    page = out / "replay.html"
+    written_by_run = page.stat().st_size
+    assert main(["replay", str(out), "--html", "--overwrite"]) == 0
+    # the same page as the run's (meshcat's object ids aside), not the first robot's alone
+    assert abs(page.stat().st_size - written_by_run) < 0.01 * written_by_run
+    assert main(["replay", str(out / "alpha"), "--html"]) == 0
+    assert (out / "alpha" / "replay.html").stat().st_size < 0.97 * written_by_run
+    capsys.readouterr()
+    assert main(["replay", str(out), "--live"]) == 2
+    assert f"uvms-pin replay {out / 'alpha'} --live" in capsys.readouterr().err

@@ -45,11 +45,17 @@ def _cmd_replay(args: argparse.Namespace) -> int:
         raise UvmsPinError("replay: nothing to do, give --html and/or --live")
     from uvms_pin.results.rollout import Rollout
 
-    rollout = Rollout.load(args.rollout)
+    robots = _robots_in(Path(args.rollout), args)
+    rollout = Rollout.load(args.rollout) if robots is None else robots.robot(robots.names[0])
     if args.html:
         path = Path(args.out) if args.out else Path(args.rollout) / "replay.html"
         with claim_file(path, overwrite=args.overwrite):
-            _write_replay(rollout, path, urdf=args.urdf, max_fps=args.fps, show=args.show)
+            if robots is None:
+                _write_replay(rollout, path, urdf=args.urdf, max_fps=args.fps, show=args.show)
+            else:
+                from uvms_pin.apps.viz.robots_replay import write_robots_replay
+
+                write_robots_replay(robots, path, max_fps=args.fps, show=args.show)
         size_mb = path.stat().st_size / 1e6
         print(f"wrote {path} ({size_mb:.1f} MB, {len(rollout)} samples)")
     if args.live == "foxglove":
@@ -66,6 +72,27 @@ def _cmd_replay(args: argparse.Namespace) -> int:
         scene = scene_for_rollout(rollout, urdf=args.urdf, show=args.show)
         replay_live(rollout, scene, port=args.port, speed=args.speed, out=sys.stdout)
     return 0
+
+
+def _robots_in(run: Path, args: argparse.Namespace):
+    """The `RobotRollouts` of a run of several robots in ``run`` (its page draws every
+    robot), or None for one robot's run. UvmsPinError for what such a run cannot give: a
+    live view or a --urdf (one robot's each)."""
+    from uvms_pin.errors import ParameterError
+    from uvms_pin.results.robots import RobotRollouts
+
+    try:
+        names = RobotRollouts.names_in(run)
+    except ParameterError:
+        return None  # one robot's run, or none: Rollout.load says what is missing
+    for option, given in (("--live", args.live), ("--urdf", args.urdf)):
+        if given:
+            raise UvmsPinError(
+                f"replay: {run} holds a run of several robots ({', '.join(names)}); {option} "
+                f"is one robot's: give its directory, e.g. uvms-pin replay {run / names[0]} "
+                f"{option}"
+            )
+    return RobotRollouts.load(run)
 
 
 def _add_view_options(parser: argparse.ArgumentParser) -> None:
