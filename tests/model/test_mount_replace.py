@@ -150,3 +150,48 @@ def test_a_kept_arm_keeps_its_trim_and_the_new_trim_is_named_apart():
     assert set(TRIM) <= set(names) and len(names) == len(set(names)) > len(TRIM)
     assert all(name in TRIM or name.removeprefix("arm_") in TRIM for name in names)
     assert kept.trim.net_buoyancy_after_N == pytest.approx(0.0, abs=1e-6)
+
+
+def test_a_trimmed_uvms_split_and_its_arm_mounted_back_with_its_trim_is_that_uvms(tmp_path):
+    """The BlueROV2 + Alpha 5 split: the arm from the joint that bolted its base (the
+    Alpha 5's base link is the arm's), posed in the vehicle's root link through that joint,
+    the trim in neither file; mounted back and trimmed as its file was, the same model."""
+    split = split_urdf(TRIMMED_URDF, tmp_path, first_arm_joint="alpha_axis_e")
+    assert split.vehicle_link == "base_link" and split.trim_links == tuple(TRIM)
+    assert "alpha_" not in split.vehicle_urdf.read_text()
+    reference = up.load_uvms(TRIMMED_URDF)
+    data = reference.model.createData()
+    q = reference.neutral_configuration()
+    q[:7] = (0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 1.0)  # the vehicle frame is the world
+    pin.forwardKinematics(reference.model, data, q)
+    base = reference.model.frames[reference.model.getFrameId("alpha_base_link")]
+    placement = data.oMi[base.parentJoint] * base.placement
+    np.testing.assert_allclose(split.mount_pose.homogeneous, placement.homogeneous, atol=1e-15)
+    again = mount_arm_detailed(
+        split.vehicle_urdf, split.arm_urdf, split.mount_pose, ee_link="ee",
+        sensor_link="ft_sensor", tool=None, trim=True,
+        trim_joint_positions=(-0.2, 0.8, 2.2, 0.2),  # the force task's, as its file was made
+    )  # fmt: skip
+    assert again.uvms.arm_joint_names == reference.arm_joint_names
+    assert again.uvms.mass_kg == pytest.approx(reference.mass_kg, rel=1e-14)
+    assert again.uvms.volume_m3 == pytest.approx(reference.volume_m3, rel=1e-14)
+    assert_same_dynamics(again.uvms, reference)
+
+
+def test_an_arm_on_a_bracket_of_the_vehicle_is_posed_in_the_vehicles_root_link(tmp_path):
+    """An arm whose first joint hangs from a fixed bracket of the vehicle (here the Alpha 5's
+    base, its joint not named as a mount names it): the bracket stays the vehicle's, and the
+    mount pose is the first joint's placement in the root link, through the bracket."""
+    text = TRIMMED_URDF.read_text().replace("arm_mount_joint", "bracket_joint")
+    (tmp_path / "bracket.urdf").write_text(text)
+    split = split_urdf(tmp_path / "bracket.urdf", tmp_path / "split", "alpha_axis_e")
+    assert split.vehicle_link == "base_link"
+    assert 'link name="alpha_base_link"' in split.vehicle_urdf.read_text()
+    reference = up.load_uvms(tmp_path / "bracket.urdf")
+    model, data = reference.model, reference.model.createData()
+    q = reference.neutral_configuration()
+    q[:7] = (0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 1.0)
+    pin.forwardKinematics(model, data, q)
+    joint = data.oMi[model.getJointId("alpha_axis_e")]
+    np.testing.assert_allclose(split.mount_pose.homogeneous, joint.homogeneous, atol=1e-15)
+    assert np.linalg.norm(split.mount_pose.translation) > 0.2  # not the bracket's own frame

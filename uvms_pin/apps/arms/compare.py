@@ -6,7 +6,8 @@ For a scenario (e.g. ``scenarios/realistic_force_tracking.toml``) whose model is
    target of the task is the reference tool tip placement in the world at the scenario's
    start (the spring anchor: the spring attaches where the tip is at t = 0), with the
    paper's initial tool orientation.
-2. Each arm is mounted at the reference arm's mount point under the bow, rotated by
+2. Each arm is mounted at the reference arm's mount point (where its base is bolted, in the
+   vehicle's frame: `split_urdf`'s ``mount_pose``), rotated by
    ``mount_rpy`` (default upside down, (pi, 0, 0): a table-top arm's base z axis points
    down, so the arm hangs under the vehicle as the reference arm does).
 3. The initial arm configuration is solved (:mod:`uvms_pin.apps.arms.initial`) with the vehicle at

@@ -4,6 +4,7 @@ vehicle already uses their names (a kept arm has its own ``ee``)."""
 
 from __future__ import annotations
 
+import re
 import xml.etree.ElementTree as ET
 
 from uvms_pin.model.mount.tree import URDFTree
@@ -13,6 +14,7 @@ __all__ = [
     "ADDED_FRAMES",
     "RENAME_PREFIX",
     "added_names",
+    "is_mount_joint",
     "original_name",
     "rename_clashes",
     "unique_frame_names",
@@ -29,6 +31,12 @@ ADDED_FRAMES = (
     "ee",
     "ee_joint",
 )
+
+
+def is_mount_joint(name: str) -> bool:
+    """Whether ``name`` is the fixed joint a mount bolted an arm's base with
+    (``arm_mount_joint``, or a kept arm's ``arm_arm_mount_joint``...)."""
+    return re.fullmatch(f"({RENAME_PREFIX})*arm_mount_joint", name) is not None
 
 
 def unique_frame_names(taken: set[str]) -> dict[str, str]:

@@ -16,6 +16,7 @@ from pathlib import Path
 import pinocchio as pin
 
 from uvms_pin.errors import ModelError
+from uvms_pin.model.mount.names import is_mount_joint
 from uvms_pin.model.mount.origin import origin_of
 from uvms_pin.model.mount.text import urdf_text, write_text_file
 from uvms_pin.model.mount.tree import URDFTree
@@ -34,7 +35,7 @@ class SplitURDF:
 
     vehicle_urdf: Path
     arm_urdf: Path
-    vehicle_link: str
+    vehicle_link: str  # the vehicle's root link, which mount_pose is in
     mount_pose: pin.SE3
     trim_links: tuple[str, ...] = ()  # the mount's trim, left out of both files
 
@@ -45,10 +46,12 @@ def split_urdf(
     first_arm_joint: str = REFERENCE_FIRST_ARM_JOINT,
 ) -> SplitURDF:
     """Write ``vehicle.urdf`` (everything but the arm and its trim) and ``arm.urdf`` into
-    ``out_dir``.
+    ``out_dir``. The arm is everything below ``first_arm_joint`` or, in a file `mount_arm`
+    wrote, below the fixed joint above it that bolted the arm's base (`is_mount_joint`).
 
     The arm file's root is an empty link ``arm_mount`` at the first arm joint's origin, so
-    mounting it at ``mount_pose`` rebuilds the same kinematics. Top-level ``<hydrodynamics
+    mounting it at ``mount_pose`` (in the vehicle's root link, through the fixed joints
+    between that link and the first arm joint's parent) rebuilds the same kinematics. Top-level ``<hydrodynamics
     link=...>`` elements follow their link. Mesh paths are made absolute.
     """
     path = Path(urdf)
@@ -58,16 +61,19 @@ def split_urdf(
             f"joint '{first_arm_joint}' not found (joints: {', '.join(tree.joints) or 'none'})",
             path=str(path),
         )
-    joint = tree.joints[first_arm_joint]
-    vehicle_link = joint.find("parent").get("link")
-    arm_links = set(tree.subtree(tree.child_of(first_arm_joint)))
+    # a mount's file: the arm from the joint that bolted its base (the base is the arm's)
+    above = tree.path_joints(tree.root_link, tree.parent_of(first_arm_joint))
+    split_at = next((name for name in above if is_mount_joint(name)), first_arm_joint)
+    joint = tree.joints[split_at]
+    vehicle_link = tree.root_link
+    arm_links = set(tree.subtree(tree.child_of(split_at)))
     trim = tuple(
         link
         for link in TRIM_LINKS
         if link in tree.parent_joint and not tree.is_moving(tree.parent_joint[link])
     )
     dropped = {*trim, *(tree.parent_joint[link] for link in trim)}
-    mount = origin_of(joint, path)
+    mount = _placement_in_root(tree, tree.parent_of(split_at), path) * origin_of(joint, path)
 
     vehicle = ET.Element("robot", {"name": tree.root.get("name", "robot") + "_vehicle"})
     arm = ET.Element("robot", {"name": tree.root.get("name", "robot") + "_arm"})
@@ -86,7 +92,7 @@ def split_urdf(
             (arm if element.get("name") in arm_links else vehicle).append(item)
         elif element.tag == "joint":
             child = element.find("child").get("link")
-            if element.get("name") == first_arm_joint:
+            if element.get("name") == split_at:
                 item.find("parent").set("link", ARM_MOUNT_LINK)
                 origin = item.find("origin")
                 if origin is not None:
@@ -105,3 +111,19 @@ def split_urdf(
     for root, target in ((vehicle, vehicle_path), (arm, arm_path)):
         write_text_file(target, urdf_text(root))
     return SplitURDF(vehicle_path, arm_path, vehicle_link, mount, trim)
+
+
+def _placement_in_root(tree: URDFTree, link: str, path: Path) -> pin.SE3:
+    """Where ``link`` is in the root link's frame, through the fixed joints between them (an
+    arm's base bracket: the Alpha 5's ``alpha_base_link``); ModelError if one of them moves
+    (then the joint split at is not the arm's first)."""
+    placement = pin.SE3.Identity()
+    for name in tree.path_joints(tree.root_link, link):
+        if tree.is_moving(name):
+            raise ModelError(
+                f"the arm's first joint hangs below the moving joint '{name}': split at the "
+                "first moving joint from the vehicle",
+                path=str(path),
+            )
+        placement = placement * origin_of(tree.joints[name], path)
+    return placement
