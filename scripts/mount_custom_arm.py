@@ -151,10 +151,9 @@ def main(argv: list[str] | None = None) -> int:
             print(f"error: {exc}", file=sys.stderr)
             return 2
     for row in rows:
-        print(
-            f"{row['arm']:<10} {row['status']:<16} force error RMS {row['force_error_rms_N']:.3f} N"
-            f"  {row['reason']}"
-        )
+        rms = row["force_error_rms_N"]
+        error = f"force error RMS {rms:.3f} N" if rms is not None and math.isfinite(rms) else ""
+        print(f"{row['arm']:<10} {row['status']:<16} {error:<24}  {row['reason']}")
     print(f"wrote {args.out}/comparison.csv, comparison.md, comparison.png")
     return 0
 

@@ -195,3 +195,12 @@ def test_an_arm_on_a_bracket_of_the_vehicle_is_posed_in_the_vehicles_root_link(t
     joint = data.oMi[model.getJointId("alpha_axis_e")]
     np.testing.assert_allclose(split.mount_pose.homogeneous, joint.homogeneous, atol=1e-15)
     assert np.linalg.norm(split.mount_pose.translation) > 0.2  # not the bracket's own frame
+
+
+def test_split_finds_the_arms_first_joint_and_refuses_a_vehicle_alone(tmp_path):
+    found = split_urdf(TRIMMED_URDF, tmp_path / "found")
+    named = split_urdf(TRIMMED_URDF, tmp_path / "named", first_arm_joint="alpha_axis_e")
+    assert found.arm_urdf.read_text() == named.arm_urdf.read_text()
+    assert found.mount_pose.isApprox(named.mount_pose, 0.0)
+    with pytest.raises(up.ModelError, match="give first_arm_joint.*a vehicle alone"):
+        split_urdf(VEHICLE_URDF, tmp_path / "alone")

@@ -24,8 +24,6 @@ from uvms_pin.model.trim_urdf import TRIM_LINKS
 
 __all__ = ["SplitURDF", "split_urdf"]
 
-#: The reference model's first arm joint.
-REFERENCE_FIRST_ARM_JOINT = "arm_joint1"
 ARM_MOUNT_LINK = "arm_mount"
 
 
@@ -43,10 +41,11 @@ class SplitURDF:
 def split_urdf(
     urdf: str | Path,
     out_dir: str | Path,
-    first_arm_joint: str = REFERENCE_FIRST_ARM_JOINT,
+    first_arm_joint: str | None = None,
 ) -> SplitURDF:
     """Write ``vehicle.urdf`` (everything but the arm and its trim) and ``arm.urdf`` into
-    ``out_dir``. The arm is everything below ``first_arm_joint`` or, in a file `mount_arm`
+    ``out_dir``. The arm is everything below ``first_arm_joint`` (default: the moving joint
+    nearest the vehicle; ModelError where there are several or none) or, in a file `mount_arm`
     wrote, below the fixed joint above it that bolted the arm's base (`is_mount_joint`).
 
     The arm file's root is an empty link ``arm_mount`` at the first arm joint's origin, so
@@ -56,6 +55,8 @@ def split_urdf(
     """
     path = Path(urdf)
     tree = URDFTree.read(path)
+    if first_arm_joint is None:
+        first_arm_joint = _first_moving_joint(tree, path)
     if first_arm_joint not in tree.joints:
         raise ModelError(
             f"joint '{first_arm_joint}' not found (joints: {', '.join(tree.joints) or 'none'})",
@@ -127,3 +128,16 @@ def _placement_in_root(tree: URDFTree, link: str, path: Path) -> pin.SE3:
             )
         placement = placement * origin_of(tree.joints[name], path)
     return placement
+
+
+def _first_moving_joint(tree: URDFTree, path: Path) -> str:
+    """The one moving joint without a moving joint above it (an arm's first joint)."""
+    first = [n for n in tree.joint_order if tree.is_moving(n) and not tree.moving_above(n)]
+    if len(first) != 1:
+        found = ", ".join(first) if first else "none: a vehicle alone"
+        raise ModelError(
+            f"split needs the arm's first joint: give first_arm_joint (moving joints nearest "
+            f"the vehicle: {found})",
+            path=str(path),
+        )
+    return first[0]
