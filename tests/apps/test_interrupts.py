@@ -61,3 +61,26 @@ def test_the_previous_handler_is_back_afterwards():
     with InterruptGuard():
         assert signal.getsignal(signal.SIGINT) is not before
     assert signal.getsignal(signal.SIGINT) is before
+
+
+def test_sigterm_stops_as_ctrl_c_does_and_says_it_was_sigterm(capsys):
+    """A batch system's time limit (SIGTERM): the first raises `Terminated`, a
+    KeyboardInterrupt (what a run keeps on Ctrl-C it keeps); one during the save waits for
+    it and is raised after it as SIGTERM; exit status 143. Outside the guard SIGTERM's own
+    handling is back."""
+    from uvms_pin.apps.interrupts import Terminated, stop_status
+
+    previous = signal.getsignal(signal.SIGTERM)
+    with InterruptGuard() as guard:
+        with pytest.raises(Terminated) as first:
+            os.kill(os.getpid(), signal.SIGTERM)
+        assert stop_status(first.value) == (143, "terminated (SIGTERM)")
+        guard.stopping = False  # the run's stop handled: the next one is a fresh stop
+        with pytest.raises(Terminated):
+            with guard.saving():
+                os.kill(os.getpid(), signal.SIGTERM)
+                saved = True
+        assert saved
+    assert signal.getsignal(signal.SIGTERM) == previous
+    assert stop_status(KeyboardInterrupt()) == (130, "interrupted")
+    assert "SIGTERM: saving first, please wait" in capsys.readouterr().err

@@ -202,5 +202,5 @@ def test_split_finds_the_arms_first_joint_and_refuses_a_vehicle_alone(tmp_path):
     named = split_urdf(TRIMMED_URDF, tmp_path / "named", first_arm_joint="alpha_axis_e")
     assert found.arm_urdf.read_text() == named.arm_urdf.read_text()
     assert found.mount_pose.isApprox(named.mount_pose, 0.0)
-    with pytest.raises(up.ModelError, match="give first_arm_joint.*a vehicle alone"):
+    with pytest.raises(up.ModelError, match=r"give first_arm_joint.*a vehicle alone"):
         split_urdf(VEHICLE_URDF, tmp_path / "alone")

@@ -12,6 +12,10 @@ noted, and raised at the next `InterruptGuard.checkpoint`, between two figures. 
 the program is, it could land inside a library's import or a class body, where Python turns
 it into another exception (an exception in ``__set_name__`` becomes a RuntimeError) and the
 command would end in a traceback instead of saying what it kept.
+
+SIGTERM (a batch system's time limit, ``kill``) is handled as Ctrl-C is, raising
+`Terminated` (a `KeyboardInterrupt`): a run it stops keeps what was simulated, and the
+command exits with 143, as a shell reports a process SIGTERM ended.
 """
 
 from __future__ import annotations
@@ -22,43 +26,66 @@ import threading
 from collections.abc import Iterator
 from contextlib import contextmanager
 
+from uvms_pin.apps.exit_codes import EXIT_INTERRUPTED, EXIT_TERMINATED
+
+
+class Terminated(KeyboardInterrupt):
+    """The stop SIGTERM asks for, raised where a first Ctrl-C would be."""
+
+
+def stop_status(exc: KeyboardInterrupt) -> tuple[int, str]:
+    """(exit status, what to call it) of a stop: 143 "terminated (SIGTERM)" for
+    `Terminated`, else 130 "interrupted"."""
+    if isinstance(exc, Terminated):
+        return EXIT_TERMINATED, "terminated (SIGTERM)"
+    return EXIT_INTERRUPTED, "interrupted"
+
+
+#: the signals the guard handles, and what its messages call them
+_NAMES = {signal.SIGINT: "Ctrl-C", signal.SIGTERM: "SIGTERM"}
+
 
 class InterruptGuard:
-    """Installs its SIGINT handler for the ``with`` block (main thread only; elsewhere it
-    does nothing and Python's default handling stays)."""
+    """Installs its SIGINT and SIGTERM handlers for the ``with`` block (main thread only;
+    elsewhere it does nothing and Python's default handling stays)."""
 
     def __init__(self) -> None:
-        self.stopping = False  # a first Ctrl-C was raised
-        self.pending = False  # a Ctrl-C arrived while saving
+        self.stopping = False  # a first Ctrl-C (or SIGTERM) was raised
+        self.pending = False  # one arrived while saving
+        self.terminated = False  # SIGTERM arrived: the stop raised is `Terminated`
         self._saving = 0
         self._at_checkpoints = False  # released: a Ctrl-C raises at the next checkpoint
-        self._previous = None
-        self._installed = False
+        self._previous: dict = {}
 
     def __enter__(self) -> InterruptGuard:
         if threading.current_thread() is threading.main_thread():
-            self._previous = signal.signal(signal.SIGINT, self._on_sigint)
-            self._installed = True
+            self._previous = {sig: signal.signal(sig, self._on_signal) for sig in _NAMES}
         return self
 
     def __exit__(self, *exc_info) -> None:
-        if self._installed:
-            signal.signal(signal.SIGINT, self._previous)
-            self._installed = False
+        for sig, previous in self._previous.items():
+            signal.signal(sig, previous)
+        self._previous = {}
 
-    def _on_sigint(self, signum, frame) -> None:
+    def _on_signal(self, signum, frame) -> None:
+        self.terminated |= signum == signal.SIGTERM
+        name = _NAMES.get(signum, "a signal")
         if self.stopping or self._saving:
             if not self.pending:
-                print("uvms-pin: Ctrl-C: saving first, please wait", file=sys.stderr, flush=True)
+                print(f"uvms-pin: {name}: saving first, please wait", file=sys.stderr, flush=True)
             self.pending = True
             return
         if self._at_checkpoints:
             if not self.pending:
-                print("uvms-pin: Ctrl-C: stopping after this step", file=sys.stderr, flush=True)
+                print(f"uvms-pin: {name}: stopping after this step", file=sys.stderr, flush=True)
             self.pending = True
             return
         self.stopping = True
-        raise KeyboardInterrupt
+        raise self._stop()
+
+    def _stop(self) -> KeyboardInterrupt:
+        """The exception a stop raises: `Terminated` once SIGTERM arrived."""
+        return Terminated("terminated by SIGTERM") if self.terminated else KeyboardInterrupt()
 
     @contextmanager
     def saving(self) -> Iterator[None]:
@@ -72,7 +99,7 @@ class InterruptGuard:
         if self.pending and not self._saving and not self.stopping:
             self.pending = False
             self.stopping = True
-            raise KeyboardInterrupt
+            raise self._stop()
 
     def release(self) -> None:
         """The saving is done: a further Ctrl-C stops what follows at its next `checkpoint`
@@ -86,4 +113,4 @@ class InterruptGuard:
         if self.pending and self._at_checkpoints:
             self.pending = False
             self.stopping = True
-            raise KeyboardInterrupt
+            raise self._stop()

@@ -275,7 +275,7 @@ class ClosedLoop:
             raise _stopped(log, wall_start, exc) from exc.__cause__  # e.g. the controller's
         except KeyboardInterrupt as exc:  # Ctrl-C: the caller may keep what was simulated
             exc.rollout = _finished(
-                log, wall_start, RunStatus(INTERRUPTED, "interrupted by the user")
+                log, wall_start, RunStatus(INTERRUPTED, str(exc) or "interrupted by the user")
             )
             raise
         finally:

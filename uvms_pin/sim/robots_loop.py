@@ -191,11 +191,13 @@ class RobotsLoop:
                 log.rollout.metadata["stiff_modes"] = loop.stiff_modes
             self._run_ticks(path)
         except SimulationError as exc:  # a divergence, a funnel left, a controller raising
+            _shared_samples(logs)
             rollouts = [_stopped(log, wall_start, exc).rollout for log in logs]
             exc.rollout = self._rollouts(rollouts, path)
             raise
         except KeyboardInterrupt as exc:
-            status = RunStatus(INTERRUPTED, "interrupted by the user")
+            _shared_samples(logs)
+            status = RunStatus(INTERRUPTED, str(exc) or "interrupted by the user")
             rollouts = [_finished(log, wall_start, status) for log in logs]
             exc.rollout = self._rollouts(rollouts, path)
             raise
@@ -232,6 +234,15 @@ class RobotsLoop:
             rollout.metadata["closed_loop"] = path.record()
         names = self.system.names
         return RobotRollouts(dict(zip(names, rollouts, strict=True)))
+
+
+def _shared_samples(logs: Sequence[RolloutLog]) -> None:
+    """Every log cut to the samples all the robots logged. A stop between two robots' logs
+    of one tick (Ctrl-C, SIGTERM, a controller raising) leaves the first a sample ahead;
+    the rollouts of one run share their samples (its replay poses every robot at each)."""
+    common = min(log.count for log in logs)
+    for log in logs:
+        log.count = common
 
 
 #: what a run records of the periods in which the robots may touch (`Robots.integration`)

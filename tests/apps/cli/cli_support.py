@@ -79,13 +79,16 @@ values = [0.0, 0.1]
 """
 
 
-def interrupt(proc: subprocess.Popen, timeout_s: float = 120.0) -> tuple[str, str]:
-    """Ctrl-C as a terminal sends it (to the whole process group); the remaining output.
+def interrupt(
+    proc: subprocess.Popen, timeout_s: float = 120.0, sig: int = signal.SIGINT
+) -> tuple[str, str]:
+    """Ctrl-C as a terminal sends it (to the whole process group; ``sig``: another signal,
+    SIGTERM as a batch system sends it); the remaining output.
 
     A process group still running ``timeout_s`` later fails the test with the stack of
     every thread of its processes (SIGABRT: `paused_cli` starts them with faulthandler on),
     so that a hang seen once, on a slow machine, says where it was."""
-    os.killpg(proc.pid, signal.SIGINT)
+    os.killpg(proc.pid, sig)
     try:
         return proc.communicate(timeout=timeout_s)
     except subprocess.TimeoutExpired as timeout:
@@ -93,9 +96,28 @@ def interrupt(proc: subprocess.Popen, timeout_s: float = 120.0) -> tuple[str, st
         _, err = proc.communicate(timeout=60)
         stacks = [line for line in err.splitlines() if not line.startswith("Extension modules:")]
         raise AssertionError(
-            f"still running {timeout_s} s after Ctrl-C; its stacks:\n" + "\n".join(stacks)
+            f"still running {timeout_s} s after {signal.Signals(sig).name}; its stacks:\n"
+            + "\n".join(stacks)
         ) from timeout
     finally:
         if proc.poll() is None:
             proc.kill()
             proc.wait()
+
+
+def stopped_at(
+    hook: list[str], cli_args: list[str], cwd: Path, sig: int = signal.SIGINT
+) -> tuple[int, str, str]:
+    """``uvms-pin CLI_ARGS`` started paused at ``hook`` (`paused_cli`), then sent ``sig``
+    (Ctrl-C by default) as `interrupt` sends it: (its exit status, stdout, stderr)."""
+    import paused_cli
+
+    proc = paused_cli.start(hook, cli_args, cwd)
+    try:
+        paused_cli.wait_until_paused(proc)
+        out, err = interrupt(proc, sig=sig)
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+            proc.wait()
+    return proc.returncode, out, err

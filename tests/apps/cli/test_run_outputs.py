@@ -11,11 +11,12 @@ import stat
 import subprocess
 import time
 from importlib import metadata
+from signal import SIGTERM
 
 import numpy as np
 import paused_cli
 import pytest
-from cli_support import interrupt, passive_scenario, run_cli, uvms_pin_command
+from cli_support import interrupt, passive_scenario, run_cli, stopped_at, uvms_pin_command
 
 from uvms_pin.results.rollout import Rollout
 
@@ -52,6 +53,21 @@ def test_ctrl_c_keeps_the_partial_rollout_and_a_second_run_into_its_out_is_refus
     assert np.all(np.isfinite(rollout.q)) and np.all(np.isfinite(rollout.v))
     assert metrics["simulated_time_s"] == rollout.time_s[-1]
     assert (tmp_path / "o" / "pose.png").stat().st_size > 0
+
+
+def test_sigterm_keeps_the_partial_rollout_as_ctrl_c_does_and_exits_143(tmp_path):
+    """A batch system's time limit (SIGTERM) at the 51st sample of a 60 s run: the run
+    stops, its rollout and figures are saved and say why, and the exit status is 143."""
+    (tmp_path / "long.toml").write_text(passive_scenario(60.0))
+    command = ["run", "long.toml", "--out", "o"]
+    status, _out, err = stopped_at(["--pause-at-sample", "51"], command, tmp_path, SIGTERM)
+    assert status == 143, err
+    assert "Traceback" not in err
+    assert "terminated (SIGTERM): the partial rollout (t = 0 to 1.000 s) is kept in o" in err
+    rollout = Rollout.load(tmp_path / "o")
+    assert rollout.metadata["status"] == "interrupted"
+    assert rollout.metadata["error"] == "terminated by SIGTERM"
+    assert len(rollout) == 51 and (tmp_path / "o" / "pose.png").stat().st_size > 0
 
 
 @pytest.mark.parametrize("delay_s", [0.02, 0.08, 0.15, 0.3])

@@ -63,3 +63,18 @@ def test_the_replay_of_a_run_of_two_robots_draws_both_and_a_live_view_names_one(
     capsys.readouterr()
     assert main(["replay", str(out), "--live"]) == 2
     assert f"uvms-pin replay {out / 'alpha'} --live" in capsys.readouterr().err
+
+
+def test_a_run_of_two_robots_stopped_between_their_logs_keeps_samples_they_share(tmp_path):
+    """Ctrl-C after the first robot logged a sample and before the second did (the 21st
+    sample of the process, a test hook): both rollouts keep the 10 samples they share, and
+    the replay the run writes draws both (it poses every robot at each sample)."""
+    from cli_support import stopped_at
+
+    command = ["run", str(TWO), "--out", "o", "--quiet", "--html"]
+    status, _out, err = stopped_at(["--pause-at-sample", "21"], command, tmp_path)
+    assert status == 130, err
+    assert "Traceback" not in err
+    rollouts = RobotRollouts.load(tmp_path / "o")
+    assert [len(rollouts.robot(name)) for name in rollouts.names] == [10, 10]
+    assert (tmp_path / "o" / "replay.html").stat().st_size > 100_000

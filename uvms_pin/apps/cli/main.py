@@ -20,6 +20,7 @@ from uvms_pin.apps.exit_codes import (
     EXIT_ENVIRONMENT,
     EXIT_INTERRUPTED,
 )
+from uvms_pin.apps.interrupts import stop_status
 from uvms_pin.apps.study.command import register as register_study_commands
 from uvms_pin.apps.validation.command import register as register_validate
 from uvms_pin.errors import OutputError, UvmsPinError, UvmsPinWarning
@@ -298,8 +299,13 @@ def _dispatch(args: argparse.Namespace) -> int:
     except (KeyboardInterrupt, RuntimeError) as exc:
         if isinstance(exc, RuntimeError) and not _caused_by_ctrl_c(exc):
             raise
-        print("uvms-pin: interrupted", file=sys.stderr)
-        return EXIT_INTERRUPTED
+        status, stopped = (
+            stop_status(exc)
+            if isinstance(exc, KeyboardInterrupt)
+            else (EXIT_INTERRUPTED, "interrupted")
+        )
+        print(f"uvms-pin: {stopped}", file=sys.stderr)
+        return status
 
 
 def _caused_by_ctrl_c(exc: BaseException) -> bool:

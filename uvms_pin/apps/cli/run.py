@@ -4,7 +4,8 @@ Whatever ends the run (its end, a funnel violation, a divergence, the controller
 Ctrl-C), what was simulated is saved first (rollout.npz, rollout.json, metrics.json, under
 `InterruptGuard.saving`: a second Ctrl-C does not cut it), then the figures (a Ctrl-C
 stops them between two figures). Exit status:
-0 the run reached its end; 3 it stopped early (the rollout kept); 130 Ctrl-C; 4 the
+0 the run reached its end; 3 it stopped early (the rollout kept); 130 Ctrl-C, 143 SIGTERM (a
+batch system's time limit: handled as Ctrl-C, the rollout kept); 4 the
 system failed us while saving (a full disk...), the message naming the file and what was
 kept.
 """
@@ -18,8 +19,8 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING
 
-from uvms_pin.apps.exit_codes import EXIT_ENVIRONMENT, EXIT_INTERRUPTED, EXIT_RUN_STOPPED
-from uvms_pin.apps.interrupts import InterruptGuard
+from uvms_pin.apps.exit_codes import EXIT_ENVIRONMENT, EXIT_RUN_STOPPED
+from uvms_pin.apps.interrupts import InterruptGuard, stop_status
 from uvms_pin.errors import ParameterError, SimulationError
 from uvms_pin.results.outdir import RUN, check_writable, claim
 from uvms_pin.results.progress import progress_printer
@@ -148,13 +149,12 @@ def _run_or_stop(scenario, args: argparse.Namespace, progress) -> Ending:
             f"uvms-pin: run stopped: {exc}; {_kept(rollout, args.out)}",
             exc.user_traceback,
         )
-    except KeyboardInterrupt as exc:
+    except KeyboardInterrupt as exc:  # Ctrl-C, or SIGTERM (`Terminated`)
+        status, stopped = stop_status(exc)
         rollout = getattr(exc, "rollout", None)
         if rollout is None or not len(rollout):
-            return Ending(None, EXIT_INTERRUPTED, "uvms-pin: interrupted before the first sample")
-        return Ending(
-            rollout, EXIT_INTERRUPTED, f"uvms-pin: interrupted: {_kept(rollout, args.out)}"
-        )
+            return Ending(None, status, f"uvms-pin: {stopped} before the first sample")
+        return Ending(rollout, status, f"uvms-pin: {stopped}: {_kept(rollout, args.out)}")
 
 
 def _kept(rollout: Rollout | None, out: str) -> str:
@@ -185,10 +185,11 @@ def _save(
 
             write_replay(rollout, out / "replay.html", show=args.show)
         guard.checkpoint()  # a Ctrl-C during the replay: the command says it stopped
-    except KeyboardInterrupt:
+    except KeyboardInterrupt as exc:
+        status, stopped = stop_status(exc)
         kept = ", ".join(_files_of_the_run(out)) or "nothing"
         return _files_of_the_run(out), Ending(
-            rollout, EXIT_INTERRUPTED, f"uvms-pin: interrupted while saving; kept in {out}: {kept}"
+            rollout, status, f"uvms-pin: {stopped} while saving; kept in {out}: {kept}"
         )
     except OSError as exc:  # a full disk, a directory removed meanwhile (ResourceError too)
         written = _files_of_the_run(out)

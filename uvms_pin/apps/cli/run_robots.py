@@ -4,7 +4,7 @@ of its name, and ``metrics.json`` (a block per robot) beside them.
 Each robot's directory holds what a single robot's run writes (its rollout and its own
 figures); ``--html`` writes ``replay.html`` beside them, drawing every robot.
 Exit status as ``uvms-pin run``'s: 0 the run reached its end, 3 it stopped early (what was
-simulated is saved), 130 Ctrl-C.
+simulated is saved), 130 Ctrl-C, 143 SIGTERM (handled as Ctrl-C).
 """
 
 from __future__ import annotations
@@ -12,7 +12,8 @@ from __future__ import annotations
 import argparse
 import sys
 
-from uvms_pin.apps.exit_codes import EXIT_INTERRUPTED, EXIT_RUN_STOPPED
+from uvms_pin.apps.exit_codes import EXIT_RUN_STOPPED
+from uvms_pin.apps.interrupts import InterruptGuard, stop_status
 from uvms_pin.errors import ParameterError, SimulationError
 from uvms_pin.results.outdir import RUN, check_writable, claim
 from uvms_pin.results.progress import progress_printer
@@ -25,16 +26,17 @@ def run_robots(scenario: RobotsScenario, args: argparse.Namespace) -> int:
     if args.live:
         raise ParameterError("--live shows one robot: not a scenario with [[robots]]")
     out = check_writable(args.out)
-    with claim(out, RUN, overwrite=args.overwrite):
+    with InterruptGuard(), claim(out, RUN, overwrite=args.overwrite):
         status, message = 0, ""
         try:
             rollouts = _simulate(scenario, args.quiet)
         except SimulationError as exc:
             rollouts, status = exc.rollout, EXIT_RUN_STOPPED
             message = f"uvms-pin: run stopped: {exc}; what was simulated is kept in {out}"
-        except KeyboardInterrupt as exc:
-            rollouts, status = getattr(exc, "rollout", None), EXIT_INTERRUPTED
-            message = f"uvms-pin: interrupted; what was simulated is kept in {out}"
+        except KeyboardInterrupt as exc:  # Ctrl-C, or SIGTERM (`Terminated`)
+            status, stopped = stop_status(exc)
+            rollouts = getattr(exc, "rollout", None)
+            message = f"uvms-pin: {stopped}; what was simulated is kept in {out}"
         if rollouts is None:
             print(message, file=sys.stderr)
             return status
