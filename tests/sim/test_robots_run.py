@@ -212,3 +212,32 @@ def test_a_single_robots_scenario_is_refused_naming_simulate():
     single = load_scenario(GRIPPER, {"scenario.duration_s": 0.1})
     with pytest.raises(ParameterError, match=r"uvms_pin\.simulate"):
         simulate_robots(single)
+
+
+@pytest.mark.parametrize(
+    ("bravo_at", "box_at", "bodies"),
+    [
+        ([0.05, 0.0, -2.0], None, "'alpha/base_link' and 'bravo/base_link' overlap by"),
+        ([0.0, 1.5, -2.0], [0.0, 1.5, -2.0], "'bravo/base_link' and 'box' overlap by"),
+    ],
+)
+def test_robots_that_start_inside_each_other_or_another_robots_object_are_refused(
+    bravo_at, box_at, bodies
+):
+    """Two robots 5 cm apart (their hulls 25 cm into each other: 16 kN at once), or the
+    first robot's free box placed inside bravo: refused before the run, naming both bodies
+    and the depth, as a robot inside a rock is; robots 1.5 m apart with the box clear run."""
+    from uvms_pin.errors import InitialOverlapError
+
+    doc = copy.deepcopy(read_toml(TWO, ScenarioError))
+    doc["scenario"]["duration_s"] = 0.1
+    doc["robots"][0]["initial"]["position_world_m"] = [0.0, 0.0, -2.0]
+    doc["robots"][1]["initial"]["position_world_m"] = bravo_at
+    box = {"type": "box", "name": "box", "size_m": [0.2, 0.2, 0.2], "density_kg_m3": 1025.0,
+           "position_world_m": box_at or [0.0, 0.0, -4.0]}  # fmt: skip
+    doc["world"] = {"objects": [box]}
+    with pytest.raises(InitialOverlapError, match=rf"{bodies} \d+ mm at the start.*start them"):
+        simulate_robots(scenario_from_dict(doc, TWO))
+    doc["robots"][1]["initial"]["position_world_m"] = [0.0, 1.5, -2.0]
+    box["position_world_m"] = [0.0, 0.0, -4.0]
+    assert simulate_robots(scenario_from_dict(doc, TWO)).status.ok

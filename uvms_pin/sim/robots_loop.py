@@ -71,12 +71,14 @@ class RobotsLoop:
         self.state: SystemState | None = None
 
     def start(self, starts: Sequence[tuple[np.ndarray, np.ndarray]], sensors) -> None:
-        """t = 0: every robot's loop started at its (q0, v0) with its ``sensors``, then
-        the contacts between robots anchored."""
+        """t = 0: every robot's loop started at its (q0, v0) with its ``sensors``, the
+        robots refused if they start inside each other, then the contacts between robots
+        anchored."""
         for loop, (q0, v0), suite in zip(self.loops, starts, sensors, strict=True):
             loop.start(q0, v0, suite)
         self.time_s = 0.0
         self.state = self.system.layout.join([loop.state for loop in self.loops])
+        self.system.check_apart(self.state)  # no robot started inside another
         self.system.start(self.state)
         # the robots whose cameras fire in the loop see the run's world and the others, as
         # they stand when a camera fires (`_scene_view`)

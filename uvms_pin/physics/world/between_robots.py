@@ -66,10 +66,12 @@ class RobotContacts:
 
     Attributes:
         sides: the robots, then the free objects. sets: the pair sets (``a``, ``b``: sides).
+        robots: how many of the sides are robots.
     """
 
     sides: tuple[Side, ...]
     sets: list[_Set]
+    robots: int = 0
 
     @staticmethod
     def of(worlds: Sequence[World], names: Sequence[str], objects: Sequence = ()) -> RobotContacts:
@@ -90,7 +92,7 @@ class RobotContacts:
                 sets.append(
                     _set(robots[k], sides[len(worlds) + m], k, len(worlds) + m, worlds[k].law, mu)
                 )
-        return RobotContacts(sides, sets)
+        return RobotContacts(sides, sets, len(worlds))
 
     def pair_names(self, robot: int) -> list[str]:
         """The names of the pairs of side ``robot`` (an index), in the order of `wrenches`."""

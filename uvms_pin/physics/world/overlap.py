@@ -35,12 +35,14 @@ The robot never moves: its initial state is the scenario's. The robot's own piec
 the fixed objects and the seabed (`robot_overlaps`) are posed the same way with the robot's
 tolerance, max(1 mm, 2 |W - B| / k) of its whole net weight: a deeper start is refused in
 either mode (a robot placed into a rock or under the seabed would start with the contact
-compressed, kilonewtons at once, and be flung out: energy from nothing).
+compressed, kilonewtons at once, and be flung out: energy from nothing). So are two robots
+overlapping each other, or a robot but the first overlapping a free object
+(`robots_started_apart`, the smaller tolerance of the two).
 """
 
 from __future__ import annotations
 
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from typing import Any
 
@@ -48,6 +50,7 @@ import numpy as np
 import pinocchio as pin
 
 from uvms_pin.errors import InitialOverlapError
+from uvms_pin.physics.world.between_robots import RobotContacts
 from uvms_pin.physics.world.contact_law import ContactLaw
 from uvms_pin.physics.world.free_object import FreeObject
 from uvms_pin.physics.world.moving import MovingContacts, State
@@ -60,6 +63,8 @@ __all__ = [
     "overlaps",
     "robot_overlaps",
     "robot_started_apart",
+    "robot_tolerance_m",
+    "robots_started_apart",
     "separated",
     "tolerance_m",
 ]
@@ -111,13 +116,16 @@ def tolerance_m(obj: FreeObject, law: ContactLaw) -> float:
     return max(OVERLAP_TOLERANCE_M, 2.0 * abs(obj.uvms.net_buoyancy_N) / law.stiffness_N_m)
 
 
+def robot_tolerance_m(world: World) -> float:
+    """`tolerance_m` of a robot: of its whole net weight, by its world's law."""
+    return max(OVERLAP_TOLERANCE_M, 2.0 * abs(world.uvms.net_buoyancy_N) / world.law.stiffness_N_m)
+
+
 def robot_overlaps(world: World, data: pin.Data) -> list[Overlap]:
     """The robot's deepest point in each fixed object (the seabed included), the deepest
     first, after ``pin.forwardKinematics`` of the robot; ``moved`` -1 (the robot never
-    moves), the tolerance the robot's (`tolerance_m` of its net weight)."""
-    tolerance = max(
-        OVERLAP_TOLERANCE_M, 2.0 * abs(world.uvms.net_buoyancy_N) / world.law.stiffness_N_m
-    )
+    moves), the tolerance the robot's (`robot_tolerance_m`)."""
+    tolerance = robot_tolerance_m(world)
     found: dict[tuple[str, str], Overlap] = {}
     hits = touch(data, world.pieces, world.objects, world.bounds)
     for piece, obj, normal, depth in zip(
@@ -144,6 +152,32 @@ def robot_started_apart(world: World | None, model: pin.Model, q: np.ndarray) ->
             "(initial.position_world_m, initial.joint_positions_rad) or move the object"
         )
         raise _refused(deep[0], how)
+
+
+def robots_started_apart(
+    contacts: RobotContacts, datas: Sequence[pin.Data], tolerances: Sequence[float]
+) -> None:
+    """Raises `InitialOverlapError` when two robots, or a robot but the first and a free
+    object, start overlapping deeper than the smaller tolerance of the two (``tolerances``:
+    each side's, `robot_tolerance_m` for the robots, `tolerance_m` for the objects), after
+    forward kinematics of every side (``datas``). Neither is moved: the robots' starts are
+    their scenarios', and the objects the first robot's (its system separates those from
+    it); the deepest pair is named."""
+    deepest, with_object = None, False
+    for s in contacts.sets:
+        tolerance = min(tolerances[s.a], tolerances[s.b])
+        for k, _, normal, depth in s.pairs.touching(datas[s.a], datas[s.b]):
+            if depth > tolerance and (deepest is None or depth > deepest.depth_m):
+                a, b = s.pairs.pairs[k]
+                first, second = contacts.sides[s.a].labels[a], contacts.sides[s.b].labels[b]
+                deepest = Overlap(first, second, float(depth), -1, np.asarray(normal), tolerance)
+                with_object = s.b >= contacts.robots
+    if deepest is not None:
+        how = (
+            "robots are never moved: start them apart (each [[robots]] entry's "
+            "initial.position_world_m, initial.joint_positions_rad)"
+        )
+        raise _refused(deepest, how + (", or move the object" if with_object else ""))
 
 
 def overlaps(

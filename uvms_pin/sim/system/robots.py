@@ -46,6 +46,7 @@ from uvms_pin.physics.compiled.extension import core_module
 from uvms_pin.physics.compiled.moving import contacts_of_core, search_compiled
 from uvms_pin.physics.world.between_robots import RobotContacts
 from uvms_pin.physics.world.contact_law import ContactLaw
+from uvms_pin.physics.world.overlap import robot_tolerance_m, robots_started_apart, tolerance_m
 from uvms_pin.physics.world.world import World
 from uvms_pin.sim.compiled.integrator import integrator_to_core
 from uvms_pin.sim.compiled.robots import robots_to_core
@@ -126,6 +127,10 @@ class Robots:
             p.world if p.world is not None else World(p.uvms, [], ContactLaw()) for p in plants
         ]
         self.contacts = RobotContacts.of(worlds, self.names, self.objects)
+        # what each side may start overlapping another by (`robots_started_apart`)
+        self._tolerances = [robot_tolerance_m(w) for w in worlds] + [
+            tolerance_m(o, worlds[0].law) for o in self.objects
+        ]
         # integrated in Python (each robot's loop is): every stage's contact search is the
         # core's, unless the plants are the Python reference's
         first = self.systems[0].moving
@@ -147,6 +152,12 @@ class Robots:
         parts = self.split(q, v)
         robots = [s.robot_state(*part) for s, part in zip(self.systems, parts, strict=True)]
         return [*robots, *self.systems[0].layout.split(*parts[0])[1:]]
+
+    def check_apart(self, state: SystemState) -> None:
+        """A run's start at ``state``: `InitialOverlapError` if two robots, or a robot and
+        another's free object, start inside each other (`robots_started_apart`)."""
+        datas = self._kinematics(state[0], np.zeros(self.layout.nv))
+        robots_started_apart(self.contacts, datas, self._tolerances)
 
     def start(self, state: SystemState) -> None:
         """t = 0 at ``state`` (each robot's system started by its loop): the anchors of the
