@@ -9,6 +9,7 @@ from __future__ import annotations
 import numpy as np
 import pinocchio as pin
 import pytest
+from conftest import ROOT
 from fixture_helpers import (
     LEVER_ARM_M,
     LEVER_MASS_KG,
@@ -179,3 +180,20 @@ def test_a_fixture_touched_by_another_sets_row_is_solved_with_it(tmp_path):
     expected = constrained_velocity(*args, (*own, other), h)
     assert {b.name for b in together.rows} == {b.name for b in expected.rows}
     np.testing.assert_array_equal(together.velocity, expected.velocity)
+
+
+def test_a_robot_started_inside_a_fixture_is_refused_naming_both_and_the_depth():
+    """The BlueROV2 placed on the valve panel's front face, its hull 23 cm into the panel:
+    refused before the run (it ran as ok, the vehicle flung off at 0.9 m/s), as a robot
+    started inside a rock is; the shipped start, clear of it, runs."""
+    from uvms_pin.errors import InitialOverlapError
+    from uvms_pin.scenario.load import load_scenario
+    from uvms_pin.sim.run import simulate
+
+    panel = ROOT / "scenarios" / "valve_panel.toml"
+    inside = {"initial.position_world_m": [0.85, -0.156, -2.027], "scenario.duration_s": 0.1}
+    with pytest.raises(
+        InitialOverlapError, match=r"'base_link' and 'panel\.\w+' overlap by \d+ mm"
+    ):
+        simulate(load_scenario(panel, inside), progress=False)
+    assert simulate(load_scenario(panel, {"scenario.duration_s": 0.1}), progress=False).status.ok

@@ -28,13 +28,16 @@ def checked_run_start(
         ParameterError: a state of the wrong size or with a non-finite value; free objects or
             joint-limit constraints under a continuous controller.
         InitialOverlapError: a free object, or the robot itself, starts inside another body
-            (`uvms_pin.physics.world.overlap`).
+            (a fixed object, a fixture's link: `uvms_pin.physics.world.overlap`).
         StiffModeError: a spring-damper integrated explicitly is unstable at the integrator's
             step (`uvms_pin.sim.stiffness`).
     """
     state = system.initial_state(q0, v0)
     plant = system.plant
     robot_started_apart(plant.world, plant.uvms.model, state.q[: plant.uvms.nq])
+    if system.fixtures:  # nor inside a fixture's link
+        robot, *bodies = system.layout.split(state.q, state.v)
+        system.moving.check_robot_clear(robot[0], bodies)
     period_by_period = {
         "free objects": bool(system.objects),
         "joint limits as constraints": plant.joint_limits is not None,

@@ -10,7 +10,7 @@ that can touch with a free object on one side,
 - each free object against each later one (the later one moves out, along -n),
 - each free object against the fixed objects and the seabed (the object moves, along +n),
 - each free object against a fixture's links (the object moves, along +n; the robot's own
-  start against a fixture is left to its scenario),
+  start inside a fixture is refused, `robot_clear_of_fixtures`),
 
 is posed at the initial configuration with the contact's own geometry (coal's deepest point,
 `PiecePairs.touching`; a piece's corners under a plane, `touch.touch`), n the contact normal
@@ -61,6 +61,7 @@ __all__ = [
     "OVERLAP_TOLERANCE_M",
     "Overlap",
     "overlaps",
+    "robot_clear_of_fixtures",
     "robot_overlaps",
     "robot_started_apart",
     "robot_tolerance_m",
@@ -152,6 +153,31 @@ def robot_started_apart(world: World | None, model: pin.Model, q: np.ndarray) ->
             "(initial.position_world_m, initial.joint_positions_rad) or move the object"
         )
         raise _refused(deep[0], how)
+
+
+def robot_clear_of_fixtures(
+    moving: MovingContacts, uvms_data: pin.Data, object_datas: Sequence[pin.Data]
+) -> None:
+    """Raises `InitialOverlapError` when the robot starts inside a fixture's link (a
+    panel, its handle) deeper than the robot's tolerance (`robot_tolerance_m`), after
+    forward kinematics of the robot and every body; the deepest pair named. Neither moves:
+    a fixture's root is fixed, and the robot's start is its scenario's."""
+    world, first = moving.world, len(moving.world.free)
+    tolerance = robot_tolerance_m(world)
+    deepest = None
+    for s in moving.sets:
+        if s.a >= 0 or s.b < first:  # the robot's pieces against a fixture's links only
+            continue
+        for k, _, normal, depth in s.pairs.touching(uvms_data, object_datas[s.b]):
+            if depth > tolerance and (deepest is None or depth > deepest.depth_m):
+                robot_body, link = s.pairs.names[k].split("|", 1)
+                deepest = Overlap(robot_body, link, float(depth), -1, np.asarray(normal), tolerance)
+    if deepest is not None:
+        how = (
+            "the robot is never moved, nor a fixture: start the robot clear of it "
+            "(initial.position_world_m, initial.joint_positions_rad) or move the fixture"
+        )
+        raise _refused(deepest, how)
 
 
 def robots_started_apart(

@@ -18,7 +18,12 @@ import pinocchio as pin
 
 from uvms_pin.model.uvms import UVMS
 from uvms_pin.physics.world.moving import MovingContacts, State
-from uvms_pin.physics.world.overlap import Overlap, overlaps, separated
+from uvms_pin.physics.world.overlap import (
+    Overlap,
+    overlaps,
+    robot_clear_of_fixtures,
+    separated,
+)
 from uvms_pin.physics.world.world import World
 
 __all__ = ["FreeObjects", "State"]
@@ -57,6 +62,12 @@ class FreeObjects:
             return overlaps(self.moving, self.uvms_data, self.datas)
 
         return separated(states, overlaps_at, self.moving.world.initial_overlap)
+
+    def check_robot_clear(self, q: np.ndarray, states: list[State]) -> None:
+        """`InitialOverlapError` if the robot at ``q`` starts inside a fixture's link, the
+        bodies at ``states`` (`uvms_pin.physics.world.overlap.robot_clear_of_fixtures`)."""
+        self._kinematics(q, np.zeros(self.uvms.nv), states)
+        robot_clear_of_fixtures(self.moving, self.uvms_data, self.datas)
 
     def reset(self) -> None:
         """Every anchor forgotten."""
