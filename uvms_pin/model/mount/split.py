@@ -50,8 +50,9 @@ def split_urdf(
 
     The arm file's root is an empty link ``arm_mount`` at the first arm joint's origin, so
     mounting it at ``mount_pose`` (in the vehicle's root link, through the fixed joints
-    between that link and the first arm joint's parent) rebuilds the same kinematics. Top-level ``<hydrodynamics
-    link=...>`` elements follow their link. Mesh paths are made absolute.
+    between that link and the first arm joint's parent) rebuilds the same kinematics.
+    Top-level ``<hydrodynamics link=...>`` elements follow their link. Mesh paths are made
+    absolute.
     """
     path = Path(urdf)
     tree = URDFTree.read(path)
@@ -71,7 +72,9 @@ def split_urdf(
     trim = tuple(
         link
         for link in TRIM_LINKS
-        if link in tree.parent_joint and not tree.is_moving(tree.parent_joint[link])
+        if link in tree.parent_joint
+        and not tree.is_moving(tree.parent_joint[link])
+        and not tree.moving_above(tree.parent_joint[link])
     )
     dropped = {*trim, *(tree.parent_joint[link] for link in trim)}
     mount = _placement_in_root(tree, tree.parent_of(split_at), path) * origin_of(joint, path)
