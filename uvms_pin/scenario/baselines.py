@@ -170,9 +170,9 @@ def comparable_controllers(raw: dict[str, Any]) -> list[str]:
     own [controller] type, the force baselines on a force task, and each named variant
     (``[baselines.<name>]`` with its own ``type``). On a tracking [task] the force baselines
     are left out (they push for a force and follow no trajectory; named, they still run)."""
-    own = (raw.get("controller") or {}).get("type", "none")
+    own = (raw.get("controller") or {}).get("type")
     baselines = () if "task" in raw else BASELINE_KINDS
-    return list(dict.fromkeys((own, *baselines, *_variants(raw))))
+    return list(dict.fromkeys((*([own] if own else []), *baselines, *_variants(raw))))
 
 
 def _variants(raw: dict[str, Any]) -> list[str]:

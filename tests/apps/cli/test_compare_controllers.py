@@ -170,6 +170,7 @@ def test_a_tracking_comparison_says_when_the_run_ends_before_its_transient(tmp_p
         ("mpc_force_tracking", ["mpc", "pi_force", "impedance", "computed_torque"]),
         ("lbv150_ee_circle", ["task_priority", "task_priority_ppc", "computed_torque_task"]),
         ("mpc_station_keeping", ["mpc", "task_priority"]),
+        ("passive_still_water", ["pi_force", "impedance", "computed_torque"]),  # no [controller]
     ],
 )
 def test_without_controllers_a_scenario_compares_what_it_can_be_judged_by(scenario, expected):
@@ -196,3 +197,12 @@ def test_a_tracking_scenario_compares_by_default_and_says_when_nothing_can_be_ju
     # the run ends before the task's transient: no error to quote, and why
     assert "nan" not in result.stdout
     assert result.stdout.count("no errors to judge: fails: no samples after") == 3
+
+
+def test_a_scenario_with_neither_task_is_refused_saying_so_not_naming_a_controller(tmp_path):
+    out = tmp_path / "never"
+    passive = ROOT / "scenarios" / "passive_still_water.toml"
+    result = run_cli_in_process(["compare-controllers", str(passive), "--out", str(out)], tmp_path)
+    assert result.returncode == 2, result.stderr
+    assert "compares a force task" in result.stderr and "this scenario has neither" in result.stderr
+    assert not out.exists()
