@@ -2,10 +2,12 @@
 
 from __future__ import annotations
 
+import contextlib
 import hashlib
 import os
 import signal
 import subprocess
+from collections.abc import Iterator
 from pathlib import Path
 
 from conftest import ROOT, run_cli_in_process, uvms_pin_command
@@ -105,19 +107,27 @@ def interrupt(
             proc.wait()
 
 
-def stopped_at(
-    hook: list[str], cli_args: list[str], cwd: Path, sig: int = signal.SIGINT
-) -> tuple[int, str, str]:
-    """``uvms-pin CLI_ARGS`` started paused at ``hook`` (`paused_cli`), then sent ``sig``
-    (Ctrl-C by default) as `interrupt` sends it: (its exit status, stdout, stderr)."""
+@contextlib.contextmanager
+def paused(hook: list[str], cli_args: list[str], cwd: Path) -> Iterator[subprocess.Popen]:
+    """``uvms-pin CLI_ARGS`` started and waited for until paused at ``hook`` (`paused_cli`);
+    killed on leaving if still running."""
     import paused_cli
 
     proc = paused_cli.start(hook, cli_args, cwd)
     try:
         paused_cli.wait_until_paused(proc)
-        out, err = interrupt(proc, sig=sig)
+        yield proc
     finally:
         if proc.poll() is None:
             proc.kill()
             proc.wait()
+
+
+def stopped_at(
+    hook: list[str], cli_args: list[str], cwd: Path, sig: int = signal.SIGINT
+) -> tuple[int, str, str]:
+    """``uvms-pin CLI_ARGS`` `paused` at ``hook``, then sent ``sig`` (Ctrl-C by default) as
+    `interrupt` sends it: (its exit status, stdout, stderr)."""
+    with paused(hook, cli_args, cwd) as proc:
+        out, err = interrupt(proc, sig=sig)
     return proc.returncode, out, err

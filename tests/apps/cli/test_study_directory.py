@@ -4,10 +4,12 @@ study or a changed base scenario (exit 2, nothing touched), replaces it only wit
 
 from __future__ import annotations
 
+import os
+import signal
+
 import pandas as pd
-import paused_cli
 import pytest
-from cli_support import STUDY, interrupt, passive_scenario, run_cli, tree_digest
+from cli_support import STUDY, passive_scenario, paused, run_cli, stopped_at, tree_digest
 
 from uvms_pin.apps.study.runner import RUNS_PER_TASK, load_results
 
@@ -51,6 +53,42 @@ def test_a_study_directory_refuses_another_study_and_a_changed_base(tmp_path):
     assert table["simulated_time_s"].tolist() == pytest.approx([0.06, 0.06])  # the new base only
 
 
+def _children(pid: int) -> list[int]:
+    """The processes whose parent is ``pid`` (Linux /proc)."""
+    found = []
+    for entry in os.listdir("/proc"):
+        if entry.isdigit():
+            try:
+                with open(f"/proc/{entry}/stat") as stat:
+                    ppid = int(stat.read().rsplit(")", 1)[1].split()[1])
+            except (OSError, ValueError, IndexError):
+                continue
+            if ppid == pid:
+                found.append(int(entry))
+    return found
+
+
+@pytest.mark.skipif(not os.path.isdir("/proc"), reason="lists processes by /proc")
+def test_sigterm_to_a_parallel_sweep_stops_its_workers_with_it(tmp_path):
+    """SIGTERM to the sweep's process alone (`kill PID`, a supervisor; not to its group, as
+    Ctrl-C is) once it recorded its first rows: its forked workers stop with it, none left
+    running on its own; exit 143, what was recorded said."""
+    (tmp_path / "base.toml").write_text(passive_scenario(0.5))
+    (tmp_path / "study.toml").write_text(STUDY.replace("seed = 3", "seed = 3\nsamples = 15"))
+    command = ["sweep", "study.toml", "--out", "out", "--workers", "2"]
+    with paused(["--pause-after-rows", "1"], command, tmp_path) as proc:
+        workers = _children(proc.pid)
+        os.kill(proc.pid, signal.SIGTERM)
+        _, err = proc.communicate(timeout=120)
+    assert len(workers) == 2, workers
+    assert proc.returncode == 143, err
+    assert "terminated (SIGTERM):" in err and "rerun the same command to finish" in err
+    assert "Traceback" not in err
+    for pid in workers:  # stopped and reaped by the sweep before it exited
+        with pytest.raises(ProcessLookupError):
+            os.kill(pid, 0)
+
+
 def test_ctrl_c_on_a_parallel_sweep_prints_one_message_and_the_rerun_finishes(tmp_path):
     """Ctrl-C once the sweep has recorded its first row (it waits there, held by a test
     hook: however fast the runs, the sweep is in the middle when interrupted). A worker's
@@ -59,15 +97,8 @@ def test_ctrl_c_on_a_parallel_sweep_prints_one_message_and_the_rerun_finishes(tm
     (tmp_path / "base.toml").write_text(passive_scenario(0.5))
     (tmp_path / "study.toml").write_text(STUDY.replace("seed = 3", "seed = 3\nsamples = 15"))
     command = ["sweep", "study.toml", "--out", "out", "--workers", "1"]
-    proc = paused_cli.start(["--pause-after-rows", "1"], command, tmp_path)
-    try:
-        paused_cli.wait_until_paused(proc)
-        _, err = interrupt(proc)
-    finally:
-        if proc.poll() is None:
-            proc.kill()
-            proc.wait()
-    assert proc.returncode == 130, err
+    status, _, err = stopped_at(["--pause-after-rows", "1"], command, tmp_path)
+    assert status == 130, err
     assert "Traceback" not in err and "KeyboardInterrupt" not in err, err
     assert "interrupted:" in err and "rerun the same command to finish" in err
     assert len([line for line in err.splitlines() if "interrupted" in line]) == 1, err

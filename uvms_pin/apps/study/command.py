@@ -13,7 +13,7 @@ import sys
 from pathlib import Path
 
 from uvms_pin.apps.arguments import nonempty, path_text, process_count
-from uvms_pin.apps.exit_codes import EXIT_INTERRUPTED
+from uvms_pin.apps.interrupts import InterruptGuard, stop_status
 from uvms_pin.results.outdir import STUDY, check_writable, claim
 
 
@@ -24,7 +24,9 @@ def _cmd_sweep(args: argparse.Namespace) -> int:
     study = load_study(args.study)  # every check happens here, before any run
     runs = study.runs()
     out = check_writable(args.out)
-    with claim(out, STUDY, overwrite=args.overwrite):
+    # SIGTERM (a batch system's time limit, `kill`) stops the sweep as Ctrl-C does: the
+    # workers stopped with it, not left running on their own
+    with InterruptGuard(), claim(out, STUDY, overwrite=args.overwrite):
         where = f"scheduler {args.scheduler}" if args.scheduler else _workers_text(args.workers)
         print(f"study {study.name}: {len(runs)} runs of {study.base} on {where}, results in {out}")
         try:
@@ -37,14 +39,15 @@ def _cmd_sweep(args: argparse.Namespace) -> int:
                 progress=not args.quiet,
                 retry_errors=args.retry_errors,
             )
-        except KeyboardInterrupt:
+        except KeyboardInterrupt as exc:  # Ctrl-C, or SIGTERM (`Terminated`)
+            status, stopped = stop_status(exc)
             recorded = len(load_results(out))
             print(
-                f"\ninterrupted: {recorded} of {len(runs)} runs recorded in {out}; "
+                f"\n{stopped}: {recorded} of {len(runs)} runs recorded in {out}; "
                 "rerun the same command to finish",
                 file=sys.stderr,
             )
-            return EXIT_INTERRUPTED
+            return status
     print(
         f"{summary['run']} run now, {summary['skipped']} already recorded; "
         + ", ".join(

@@ -211,15 +211,18 @@ def _sigint_ignored_by_children():
     """Start worker processes with Ctrl-C ignored (inherited, and Python keeps an ignored
     SIGINT): a terminal's Ctrl-C reaches the whole process group, and each worker would
     print its own KeyboardInterrupt traceback; this process alone handles it and closes
-    the cluster."""
+    the cluster. SIGTERM keeps its default in them (this process may handle it, as
+    ``uvms-pin sweep`` does): it is how this process stops them (`_stop_pool`)."""
     if threading.current_thread() is not threading.main_thread():
         yield
         return
     previous = signal.signal(signal.SIGINT, signal.SIG_IGN)
+    previous_term = signal.signal(signal.SIGTERM, signal.SIG_DFL)
     try:
         yield
     finally:
         signal.signal(signal.SIGINT, previous)
+        signal.signal(signal.SIGTERM, previous_term)
 
 
 def run_study(
