@@ -20,12 +20,14 @@ exactly at that point, however fast or slow the machine.
 from __future__ import annotations
 
 import argparse
+import contextlib
 import os
 import select
 import signal
 import subprocess
 import sys
 import threading
+from collections.abc import Iterator
 from pathlib import Path
 
 PAUSED = "uvms-pin test hook: paused"
@@ -66,6 +68,20 @@ def ctrl_c_in_a_class_body() -> type:
         attribute = _CtrlCOnSetName()
 
     return Defined
+
+
+@contextlib.contextmanager
+def paused(hook: list[str], cli_args: list[str], cwd: Path) -> Iterator[subprocess.Popen]:
+    """The command started (`start`) and waited for until paused at ``hook``; killed on
+    leaving the block if still running."""
+    proc = start(hook, cli_args, cwd)
+    try:
+        wait_until_paused(proc)
+        yield proc
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+            proc.wait()
 
 
 def wait_until_paused(proc: subprocess.Popen) -> list[str]:

@@ -123,3 +123,30 @@ def test_the_catalogue_alpha5_mounted_as_the_reference_is_trims_and_weighs_as_it
     assert alpha5["status"] == "ok", alpha5["reason"]
     assert alpha5["system_mass_kg"] == pytest.approx(reference["system_mass_kg"], rel=1e-9)
     assert abs(alpha5["net_buoyancy_after_N"]) < 1e-6
+
+
+def test_stopping_compare_arms_on_two_processes_stops_its_workers_without_a_traceback(tmp_path):
+    """`compare-arms --jobs 2` stopped while an arm runs (paused at a sample by a test hook):
+    by Ctrl-C to its process group, no worker's KeyboardInterrupt traceback (there was one)
+    and exit 130; by SIGTERM to its process alone, its workers stop with it, exit 143."""
+    import os
+    import signal
+
+    import paused_cli
+
+    command = ["compare-arms", str(SCENARIO), "--arms", "reference,ur3", "--jobs", "2",
+               "--duration", "5", "--out", "o"]  # fmt: skip
+    for sig, status, target in ((signal.SIGINT, 130, "group"), (signal.SIGTERM, 143, "process")):
+        (tmp_path / target).mkdir()
+        with paused_cli.paused(["--pause-at-sample", "30"], command, tmp_path / target) as proc:
+            workers = [int(p) for p in os.popen(f"pgrep -P {proc.pid}").read().split()]
+            if target == "group":
+                os.killpg(proc.pid, sig)
+            else:
+                os.kill(proc.pid, sig)
+            _, err = proc.communicate(timeout=120)
+        assert proc.returncode == status, err
+        assert "Traceback" not in err and len(workers) == 2
+        for pid in workers:
+            with pytest.raises(ProcessLookupError):
+                os.kill(pid, 0)

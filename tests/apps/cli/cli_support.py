@@ -2,12 +2,10 @@
 
 from __future__ import annotations
 
-import contextlib
 import hashlib
 import os
 import signal
 import subprocess
-from collections.abc import Iterator
 from pathlib import Path
 
 from conftest import ROOT, run_cli_in_process, uvms_pin_command
@@ -107,27 +105,13 @@ def interrupt(
             proc.wait()
 
 
-@contextlib.contextmanager
-def paused(hook: list[str], cli_args: list[str], cwd: Path) -> Iterator[subprocess.Popen]:
-    """``uvms-pin CLI_ARGS`` started and waited for until paused at ``hook`` (`paused_cli`);
-    killed on leaving if still running."""
-    import paused_cli
-
-    proc = paused_cli.start(hook, cli_args, cwd)
-    try:
-        paused_cli.wait_until_paused(proc)
-        yield proc
-    finally:
-        if proc.poll() is None:
-            proc.kill()
-            proc.wait()
-
-
 def stopped_at(
     hook: list[str], cli_args: list[str], cwd: Path, sig: int = signal.SIGINT
 ) -> tuple[int, str, str]:
-    """``uvms-pin CLI_ARGS`` `paused` at ``hook``, then sent ``sig`` (Ctrl-C by default) as
+    """``uvms-pin CLI_ARGS`` `paused_cli.paused` at ``hook``, then sent ``sig`` (Ctrl-C by default) as
     `interrupt` sends it: (its exit status, stdout, stderr)."""
-    with paused(hook, cli_args, cwd) as proc:
+    import paused_cli
+
+    with paused_cli.paused(hook, cli_args, cwd) as proc:
         out, err = interrupt(proc, sig=sig)
     return proc.returncode, out, err

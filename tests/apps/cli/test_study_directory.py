@@ -8,8 +8,9 @@ import os
 import signal
 
 import pandas as pd
+import paused_cli
 import pytest
-from cli_support import STUDY, passive_scenario, paused, run_cli, stopped_at, tree_digest
+from cli_support import STUDY, passive_scenario, run_cli, stopped_at, tree_digest
 
 from uvms_pin.apps.study.runner import RUNS_PER_TASK, load_results
 
@@ -76,7 +77,7 @@ def test_sigterm_to_a_parallel_sweep_stops_its_workers_with_it(tmp_path):
     (tmp_path / "base.toml").write_text(passive_scenario(0.5))
     (tmp_path / "study.toml").write_text(STUDY.replace("seed = 3", "seed = 3\nsamples = 15"))
     command = ["sweep", "study.toml", "--out", "out", "--workers", "2"]
-    with paused(["--pause-after-rows", "1"], command, tmp_path) as proc:
+    with paused_cli.paused(["--pause-after-rows", "1"], command, tmp_path) as proc:
         workers = _children(proc.pid)
         os.kill(proc.pid, signal.SIGTERM)
         _, err = proc.communicate(timeout=120)

@@ -21,6 +21,7 @@ from uvms_pin.apps.arguments import (
     progress_printer,
 )
 from uvms_pin.apps.exit_codes import EXIT_BAD_INPUT, EXIT_RUN_STOPPED
+from uvms_pin.apps.interrupts import InterruptGuard
 from uvms_pin.model.mount.catalog import available_arms
 from uvms_pin.results.outdir import COMPARISON, check_writable, claim
 from uvms_pin.scenario.overrides import parse_assignment
@@ -50,7 +51,9 @@ def _cmd_compare_arms(args: argparse.Namespace) -> int:
     )
     out = check_writable(args.out)
     say = progress_printer(args.quiet)
-    with claim(out, COMPARISON, overwrite=args.overwrite):
+    # SIGTERM stops the comparison as Ctrl-C does (`uvms_pin.apps.interrupts`), its workers
+    # with it
+    with InterruptGuard(), claim(out, COMPARISON, overwrite=args.overwrite):
         rows = compare_arms(args.scenario, arms, out, settings, jobs=args.jobs, progress=say)
     width = max(len(r["arm"]) for r in rows)
     for r in rows:

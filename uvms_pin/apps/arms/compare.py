@@ -44,6 +44,7 @@ from uvms_pin.apps.arms.progress import done_line, print_to_stderr
 from uvms_pin.apps.arms.row import COLUMNS
 from uvms_pin.apps.arms.settings import CompareSettings
 from uvms_pin.apps.arms.table import write_comparison
+from uvms_pin.apps.workers import stop_pool, workers_signals
 from uvms_pin.checks import check_memory
 from uvms_pin.errors import ScenarioError
 from uvms_pin.model.mount.catalog import REFERENCE, ArmEntry, resolve_arm
@@ -142,12 +143,18 @@ def _run_in_processes(
     rows: list[dict] = []
     start = time.perf_counter()
     emit = print_to_stderr if progress else None
-    with ProcessPoolExecutor(max_workers=jobs) as pool:
-        futures = [pool.submit(run_one_arm, *a, emit) for a in args]
+    pool = ProcessPoolExecutor(max_workers=jobs)
+    try:
+        with workers_signals():  # the first submit forks every worker
+            futures = [pool.submit(run_one_arm, *a, emit) for a in args]
         for future in futures:
             rows.append(future.result())
             if progress:
                 progress(done_line(rows[-1], start))
+    except BaseException:  # Ctrl-C, SIGTERM: the workers stopped with the command
+        stop_pool(pool)
+        raise
+    pool.shutdown(wait=True)
     return rows
 
 

@@ -22,12 +22,9 @@ saturation), every metric of `Rollout.metrics`, the run's wall time and host.
 
 from __future__ import annotations
 
-import contextlib
 import logging
 import os
-import signal
 import sys
-import threading
 import time
 from collections.abc import Callable
 from dataclasses import dataclass, field
@@ -47,6 +44,7 @@ from uvms_pin.apps.study.execute import (
 )
 from uvms_pin.apps.study.identity import check_same_study, file_sha256, record_study_inputs
 from uvms_pin.apps.study.spec import Run, Study
+from uvms_pin.apps.workers import stop_pool, workers_signals
 from uvms_pin.checks import check_memory
 from uvms_pin.errors import StudyError
 from uvms_pin.results.atomic import atomic_path
@@ -192,7 +190,7 @@ def _client(workers: int | None, scheduler: str | None):
                 f"--scheduler {scheduler}: cannot connect ({type(exc).__name__}: {exc}); "
                 "is the scheduler running at that address?"
             ) from exc
-    with _sigint_ignored_by_children():
+    with workers_signals():
         # every server of the local cluster (scheduler, workers, dashboard) on the loopback
         # interface: nothing of a study listens on the network (docs/security.md)
         cluster = LocalCluster(
@@ -204,25 +202,6 @@ def _client(workers: int | None, scheduler: str | None):
             silence_logs=logging.ERROR,
         )
     return Client(cluster), cluster
-
-
-@contextlib.contextmanager
-def _sigint_ignored_by_children():
-    """Start worker processes with Ctrl-C ignored (inherited, and Python keeps an ignored
-    SIGINT): a terminal's Ctrl-C reaches the whole process group, and each worker would
-    print its own KeyboardInterrupt traceback; this process alone handles it and closes
-    the cluster. SIGTERM keeps its default in them (this process may handle it, as
-    ``uvms-pin sweep`` does): it is how this process stops them (`_stop_pool`)."""
-    if threading.current_thread() is not threading.main_thread():
-        yield
-        return
-    previous = signal.signal(signal.SIGINT, signal.SIG_IGN)
-    previous_term = signal.signal(signal.SIGTERM, signal.SIG_DFL)
-    try:
-        yield
-    finally:
-        signal.signal(signal.SIGINT, previous)
-        signal.signal(signal.SIGTERM, previous_term)
 
 
 def run_study(
@@ -420,27 +399,14 @@ def _run_on_forked_processes(todo, base, rollout_dir, tasks, finished, workers) 
     pool = ProcessPoolExecutor(workers or os.cpu_count() or 1, mp_context=context)
     futures = {}
     try:
-        with _sigint_ignored_by_children():  # the first submit forks every worker
+        with workers_signals():  # the first submit forks every worker
             for runs in _chunks(todo, batch_fn):
                 futures[pool.submit(_task, run_fn, batch_fn, base, runs, rollout_dir)] = runs
         _collect(as_completed(futures), futures, finished)
     except BaseException:  # Ctrl-C: the workers (which ignore it) are stopped, not awaited
-        _stop_pool(pool)
+        stop_pool(pool)
         raise
     pool.shutdown(wait=True)
-
-
-def _stop_pool(pool) -> None:
-    """Stop ``pool``'s workers now: their running and queued tasks are dropped (a rerun
-    runs them). ``shutdown(wait=False)`` alone returns at once but forgets its processes,
-    and the interpreter's exit then waits for every task already handed to a worker: a
-    Ctrl-C that printed its message would hang for as long as those runs take."""
-    processes = list((getattr(pool, "_processes", None) or {}).values())  # before shutdown
-    pool.shutdown(wait=False, cancel_futures=True)
-    for process in processes:
-        process.terminate()
-    for process in processes:
-        process.join()
 
 
 def _collect(completed, futures: dict, finished) -> None:
