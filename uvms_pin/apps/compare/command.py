@@ -14,6 +14,7 @@ from uvms_pin.apps.arguments import (
     process_count,
     progress_printer,
 )
+from uvms_pin.apps.interrupts import InterruptGuard
 from uvms_pin.errors import ParameterError
 from uvms_pin.results.outdir import CONTROLLER_COMPARISON, check_writable, claim
 from uvms_pin.scenario.overrides import parse_assignment
@@ -114,7 +115,8 @@ def _compare(args: argparse.Namespace, scenarios, criteria, out: Path, table, ex
     from uvms_pin.apps.compare.runs import compare_controllers
     from uvms_pin.apps.compare.table import write_table
 
-    with claim(out, CONTROLLER_COMPARISON, overwrite=args.overwrite):
+    # SIGTERM stops the comparison as Ctrl-C does, the robustness set's workers with it
+    with InterruptGuard(), claim(out, CONTROLLER_COMPARISON, overwrite=args.overwrite):
         say = progress_printer(args.quiet)
         rows, rollouts = compare_controllers(scenarios, criteria, say)
         written = write_table(rows, out, *table)
