@@ -15,9 +15,7 @@ __all__ = ["TRIM_LINKS", "add_trim_links"]
 TRIM_LINKS = ("trim_foam", "trim_ballast")
 
 
-def add_trim_links(
-    root: ET.Element, vehicle_link: str, report: TrimReport, prefix: str = "arm_"
-) -> None:
+def add_trim_links(root: ET.Element, vehicle_link: str, report: TrimReport, prefix: str) -> None:
     """Append the foam and ballast as fixed links of ``vehicle_link`` to a URDF tree, named
     `TRIM_LINKS`, each with ``prefix`` put before it while the tree uses the name (the trim
     of an arm a vehicle file keeps beside the new one)."""

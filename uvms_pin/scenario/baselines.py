@@ -158,7 +158,7 @@ def baseline_controller_table(raw: dict[str, Any], kind: str) -> dict[str, Any]:
     if "type" in tuning:
         return copy.deepcopy(tuning)
     if kind not in BASELINES:
-        choices = ", ".join((controller.get("type", "none"), *BASELINE_KINDS, *_variants(raw)))
+        choices = ", ".join(dict.fromkeys((*_own(raw), *BASELINE_KINDS, *_variants(raw))))
         raise ScenarioError(f"controller '{kind}': this scenario can run {choices}")
     inherited = _TASK_KEYS + (_PSEUDO_INVERSE_INHERITED if BASELINES[kind].pseudo_inverse else ())
     table = {"type": kind, **{k: controller[k] for k in inherited if k in controller}}
@@ -170,9 +170,14 @@ def comparable_controllers(raw: dict[str, Any]) -> list[str]:
     own [controller] type, the force baselines on a force task, and each named variant
     (``[baselines.<name>]`` with its own ``type``). On a tracking [task] the force baselines
     are left out (they push for a force and follow no trajectory; named, they still run)."""
-    own = (raw.get("controller") or {}).get("type")
     baselines = () if "task" in raw else BASELINE_KINDS
-    return list(dict.fromkeys((*([own] if own else []), *baselines, *_variants(raw))))
+    return list(dict.fromkeys((*_own(raw), *baselines, *_variants(raw))))
+
+
+def _own(raw: dict[str, Any]) -> list[str]:
+    """The scenario's own controller type, if it has a [controller] with one."""
+    own = (raw.get("controller") or {}).get("type")
+    return [own] if own else []
 
 
 def _variants(raw: dict[str, Any]) -> list[str]:

@@ -193,7 +193,6 @@ class RobotsLoop:
                 log.rollout.metadata["stiff_modes"] = loop.stiff_modes
             self._run_ticks(path)
         except SimulationError as exc:  # a divergence, a funnel left, a controller raising
-            _shared_samples(logs)
             rollouts = [_stopped(log, wall_start, exc).rollout for log in logs]
             exc.rollout = self._rollouts(rollouts, path)
             raise
@@ -239,9 +238,10 @@ class RobotsLoop:
 
 
 def _shared_samples(logs: Sequence[RolloutLog]) -> None:
-    """Every log cut to the samples all the robots logged. A stop between two robots' logs
-    of one tick (Ctrl-C, SIGTERM, a controller raising) leaves the first a sample ahead;
-    the rollouts of one run share their samples (its replay poses every robot at each)."""
+    """Every log cut to the samples all the robots logged. Ctrl-C or SIGTERM between two
+    robots' logs of one tick leaves the first a sample ahead (a controller that raises does
+    so before any robot logs the tick: `tick`); the rollouts of one run share their samples
+    (its replay poses every robot at each)."""
     common = min(log.count for log in logs)
     for log in logs:
         log.count = common

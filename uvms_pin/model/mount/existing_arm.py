@@ -7,7 +7,7 @@ from uvms_pin.model.mount.names import is_mount_joint
 from uvms_pin.model.mount.tree import URDFTree
 from uvms_pin.model.trim_urdf import TRIM_LINKS
 
-__all__ = ["existing_arm"]
+__all__ = ["existing_arm", "mount_trim"]
 
 #: Frames of a mounted arm that hang where the tool is, whatever the arm.
 _MOUNT_FRAMES = ("ft_sensor", "tool", "ee")
@@ -28,16 +28,22 @@ def existing_arm(vehicle: URDFTree) -> tuple[list[str], list[str]]:
     ]
     starts += [f for f in _MOUNT_FRAMES if f in vehicle.parent_joint]
     if starts:
-        starts += [
-            link
-            for link in TRIM_LINKS
-            if link in vehicle.parent_joint
-            and not vehicle.is_moving(vehicle.parent_joint[link])
-            and not vehicle.moving_above(vehicle.parent_joint[link])
-        ]
+        starts += mount_trim(vehicle)
     links: set[str] = set()
     for start in starts:
         links.update(vehicle.subtree(start))
     ordered_links = [n for n in vehicle.link_order if n in links]
     joints = [n for n in vehicle.joint_order if vehicle.child_of(n) in links]
     return ordered_links, joints
+
+
+def mount_trim(tree: URDFTree) -> list[str]:
+    """The foam and ballast links a mount trimmed an arm with: `TRIM_LINKS` hanging by a
+    fixed joint from the vehicle (no moving joint above it)."""
+    return [
+        link
+        for link in TRIM_LINKS
+        if link in tree.parent_joint
+        and not tree.is_moving(tree.parent_joint[link])
+        and not tree.moving_above(tree.parent_joint[link])
+    ]

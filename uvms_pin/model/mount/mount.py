@@ -50,6 +50,7 @@ import numpy as np
 from uvms_pin.errors import ModelError, ParameterError
 from uvms_pin.model.mount.catalog import ArmEntry, resolve_arm
 from uvms_pin.model.mount.merge import ArmMerge, MergedURDF, merge_urdf
+from uvms_pin.model.mount.names import RENAME_PREFIX
 from uvms_pin.model.mount.text import urdf_text, write_text_file
 from uvms_pin.model.resources import find_model
 from uvms_pin.model.trim import TrimReport, TrimSpec, plan_trim
@@ -215,7 +216,7 @@ def _add_trim(
             )
         q[7:] = uvms.arm_joints.configuration(joints)
     report = plan_trim(uvms, q, spec, hull=merged.hull_box)
-    add_trim_links(merged.root, merged.vehicle_link, report)
+    add_trim_links(merged.root, merged.vehicle_link, report, RENAME_PREFIX)
     return report
 
 

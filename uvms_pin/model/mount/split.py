@@ -16,11 +16,11 @@ from pathlib import Path
 import pinocchio as pin
 
 from uvms_pin.errors import ModelError
+from uvms_pin.model.mount.existing_arm import mount_trim
 from uvms_pin.model.mount.names import is_mount_joint
 from uvms_pin.model.mount.origin import origin_of
 from uvms_pin.model.mount.text import urdf_text, write_text_file
 from uvms_pin.model.mount.tree import URDFTree
-from uvms_pin.model.trim_urdf import TRIM_LINKS
 
 __all__ = ["SplitURDF", "split_urdf"]
 
@@ -69,13 +69,7 @@ def split_urdf(
     joint = tree.joints[split_at]
     vehicle_link = tree.root_link
     arm_links = set(tree.subtree(tree.child_of(split_at)))
-    trim = tuple(
-        link
-        for link in TRIM_LINKS
-        if link in tree.parent_joint
-        and not tree.is_moving(tree.parent_joint[link])
-        and not tree.moving_above(tree.parent_joint[link])
-    )
+    trim = tuple(mount_trim(tree))
     dropped = {*trim, *(tree.parent_joint[link] for link in trim)}
     mount = _placement_in_root(tree, tree.parent_of(split_at), path) * origin_of(joint, path)
 

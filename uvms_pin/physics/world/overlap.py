@@ -114,12 +114,16 @@ class Overlap:
 def tolerance_m(obj: FreeObject, law: ContactLaw) -> float:
     """max(`OVERLAP_TOLERANCE_M`, 2 |W - B| / k) [m] of a free object (its net weight in
     the water, k the law's stiffness per point)."""
-    return max(OVERLAP_TOLERANCE_M, 2.0 * abs(obj.uvms.net_buoyancy_N) / law.stiffness_N_m)
+    return _of_net_weight(obj.uvms.net_buoyancy_N, law)
 
 
 def robot_tolerance_m(world: World) -> float:
     """`tolerance_m` of a robot: of its whole net weight, by its world's law."""
-    return max(OVERLAP_TOLERANCE_M, 2.0 * abs(world.uvms.net_buoyancy_N) / world.law.stiffness_N_m)
+    return _of_net_weight(world.uvms.net_buoyancy_N, world.law)
+
+
+def _of_net_weight(net_buoyancy_N: float, law: ContactLaw) -> float:
+    return max(OVERLAP_TOLERANCE_M, 2.0 * abs(net_buoyancy_N) / law.stiffness_N_m)
 
 
 def robot_overlaps(world: World, data: pin.Data) -> list[Overlap]:
