@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import re
 from pathlib import Path
 
 import numpy as np
@@ -155,3 +156,27 @@ def test_a_prismatic_finger_s_servo_pushes_with_the_grip_force_itself(tmp_path):
     np.testing.assert_array_equal(servo.lever_m, [1.0, 1.0])
     blocked = servo.torque(1.0, jaw.upper * 0.5, np.zeros(2))
     np.testing.assert_allclose(blocked, [-7.0, -7.0], rtol=1e-15)
+
+
+def test_a_jaw_whose_joints_have_ros_namespaces_runs_and_logs_them_by_label(tmp_path):
+    """Gazebo and ROS models name their links and joints ``robot/joint`` (uuv_simulator's
+    Oberon 7: ``oberon7/finger_left_joint``): the jaw's log labels them (``bluerov_...``)
+    instead of refusing the run at its first tick."""
+    text = JAWS.read_text()
+    names = set(re.findall(r'<(?:link|joint) name="([^"]+)"', text))
+    for name in sorted(names, key=len, reverse=True):
+        text = text.replace(f'"{name}"', f'"bluerov/{name}"')
+    model = tmp_path / "namespaced.urdf"
+    model.write_text(text)
+    scenario = up.load_scenario(
+        JAWS.parents[1] / "scenarios" / "gripper_close.toml",
+        {"scenario.model": str(model), "scenario.duration_s": 0.4},
+    )
+    rollout = up.simulate(scenario, progress=False)
+    assert rollout.metadata["status"] == "ok"
+    finger = rollout.signals["jaw"][:, 0]
+    assert finger[0] == pytest.approx(0.5) and finger[-1] < 0.45  # it closed at 0.2 s
+    assert rollout.metadata["signal_units"]["jaw"]["components"][:2] == [
+        "bluerov_alpha_jaw_finger_130_joint",
+        "bluerov_alpha_jaw_finger_139_joint",
+    ]

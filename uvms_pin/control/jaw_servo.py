@@ -31,7 +31,7 @@ from uvms_pin.control.base import Controller
 from uvms_pin.control.measurement import Measurement, read_only
 from uvms_pin.errors import ParameterError
 from uvms_pin.model.jaw import JawJoints, slice_if_consecutive
-from uvms_pin.results.signal import Signal
+from uvms_pin.results.signal import Signal, component_label
 
 __all__ = ["JawSchedule", "JawServo", "WithJaw"]
 
@@ -167,7 +167,7 @@ class WithJaw(Controller):
         self.arm.reset()
 
     def signals(self) -> dict[str, np.ndarray | Signal]:
-        names = self.servo.jaw.names
+        names = [component_label(n) for n in self.servo.jaw.names]
         grip = np.abs(self._jaw_tau) / self.servo.lever_m
         jaw = Signal(
             np.concatenate([self._jaw_q, grip]),

@@ -16,7 +16,7 @@ import numpy as np
 
 from uvms_pin.errors import ParameterError
 
-__all__ = ["Signal", "described", "unit_suffix"]
+__all__ = ["Signal", "component_label", "described", "unit_suffix"]
 
 _COMPONENT = re.compile(r"^[A-Za-z_][\w]*$")
 
@@ -68,6 +68,14 @@ def described(components: Sequence[str], units: Sequence[str]) -> dict[str, list
     """A signal's entry in the rollout's ``signal_units`` metadata: its columns' component
     names and units (a `Signal`'s, or a thruster's or sensor's columns)."""
     return {"components": list(components), "units": list(units)}
+
+
+def component_label(name: str) -> str:
+    """A model's name (a joint's, an object's: ``oberon7/finger_left_joint``) as a component
+    name: each character that is not an ASCII letter, digit or underscore an underscore, and
+    an underscore before a leading digit."""
+    label = re.sub(r"\W", "_", name, flags=re.ASCII)
+    return label if label[:1].isalpha() or label[:1] == "_" else f"_{label}"
 
 
 def unit_suffix(unit: str) -> str:

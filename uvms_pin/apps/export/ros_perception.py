@@ -21,7 +21,6 @@ before its metadata kept the sensors' specs has none of these topics.
 
 from __future__ import annotations
 
-import re
 from collections.abc import Iterator
 from typing import Any
 
@@ -31,6 +30,7 @@ import pinocchio as pin
 from uvms_pin.apps.export.ros_messages import header, stamp_ns, transform
 from uvms_pin.errors import VizError
 from uvms_pin.perception.camera import CameraSpec
+from uvms_pin.results.signal import component_label
 
 __all__ = ["PerceptionTopics", "camera_info", "laser_scan", "ros_name"]
 
@@ -105,8 +105,7 @@ def laser_scan(
 def ros_name(name: str) -> str:
     """A sensor's name as a ROS name's token: letters, digits and underscores (anything else
     an underscore), not starting with a digit."""
-    token = re.sub(r"\W", "_", name, flags=re.ASCII)
-    return token if token[:1].isalpha() or token[:1] == "_" else f"_{token}"
+    return component_label(name)
 
 
 def _mount(model: pin.Model, data: pin.Data, frame_name: str) -> tuple[str, pin.SE3]:

@@ -26,7 +26,6 @@ own links do (a box or mesh as its convex hull: model a bore by several boxes).
 
 from __future__ import annotations
 
-import re
 import xml.etree.ElementTree as ET
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
@@ -46,7 +45,7 @@ from uvms_pin.model.urdf.read import read_urdf_root
 from uvms_pin.model.uvms import UVMS
 from uvms_pin.physics.world.kind import invalid, solid_placement
 from uvms_pin.physics.world.robot_geometry import RobotPiece, coal_of
-from uvms_pin.results.signal import Signal
+from uvms_pin.results.signal import Signal, component_label
 
 __all__ = ["FIXTURE_TYPE", "MOVING_JOINTS", "Fixture", "fixture", "fixture_path"]
 
@@ -122,7 +121,7 @@ class Fixture:
 
     def signal(self, q: np.ndarray) -> Signal:
         """Its joints' positions at ``q``, logged as ``<name>.<joint>_rad`` (or ``_m``)."""
-        labels = [re.sub(r"\W", "_", j) for j in self.joint_names]
+        labels = [component_label(j) for j in self.joint_names]
         return Signal(np.asarray(q, dtype=float), labels, self.joint_units)
 
     def record(self) -> dict[str, Any]:

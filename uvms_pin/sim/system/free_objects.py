@@ -11,8 +11,6 @@ control period, as the robot's does.
 
 from __future__ import annotations
 
-import re
-
 import numpy as np
 import pinocchio as pin
 
@@ -25,6 +23,7 @@ from uvms_pin.physics.world.overlap import (
     separated,
 )
 from uvms_pin.physics.world.world import World
+from uvms_pin.results.signal import component_label
 
 __all__ = ["FreeObjects", "State"]
 
@@ -106,6 +105,6 @@ class FreeObjects:
     # ---- what a run logs ------------------------------------------------------------------
     def state_columns(self) -> tuple[list[str], list[str]]:
         """(component names, units) of the logged ``free_objects`` signal, per object."""
-        labels = [re.sub(r"\W", "_", o.name) for o in self.objects]
+        labels = [component_label(o.name) for o in self.objects]
         names = [f"{label}_{c}" for label in labels for c, _ in _STATE_COLUMNS]
         return names, [u for _ in self.objects for _, u in _STATE_COLUMNS]
