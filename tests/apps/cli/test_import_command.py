@@ -25,11 +25,11 @@ def test_import_writes_the_urdf_and_the_table_and_says_what_it_did_not_map(tmp_p
 
 def test_a_bad_file_is_exit_2_and_writes_nothing(tmp_path):
     bad = tmp_path / "bad.urdf"
-    bad.write_text(REXROV.read_text().replace("<type>fossen</type>", "<type>cylinder</type>"))
+    bad.write_text(REXROV.read_text().replace("<type>fossen</type>", "<type>spheroid</type>"))
     out = tmp_path / "out.urdf"
     result = run("import", str(bad), "--out", str(out))
     assert result.returncode == 2
-    assert "cylinder" in result.stderr and "Traceback" not in result.stderr
+    assert "spheroid" in result.stderr and "Traceback" not in result.stderr
     assert not out.exists() and not out.with_suffix(".thrusters.toml").exists()
 
 

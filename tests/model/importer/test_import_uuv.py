@@ -150,7 +150,7 @@ def test_unexpanded_xacro_is_refused(tmp_path):
 @pytest.mark.parametrize(
     ("old", "new", "match"),
     [
-        ("<type>fossen</type>", "<type>sphere</type>", 'type "sphere" cannot be imported'),
+        ("<type>fossen</type>", "<type>box</type>", 'type "box" cannot be imported'),
         ("-74.82 -69.48", "74.82 -69.48", "positive semi-definite"),
         ("<volume>1.83826</volume>", "<volume>x</volume>", "non-numeric"),
         (

@@ -15,7 +15,8 @@ wants them (tau = -M_A nu_dot - C_A nu - D_lin nu - diag(D_quad) |nu| nu):
 
 The file's damping is negative (Fossen's X_u < 0); a positive entry would feed energy in
 and is refused. The buoyancy block (volume, center_of_buoyancy in the link frame,
-neutrally_buoyant, fluid_density) maps one to one.
+neutrally_buoyant, fluid_density) maps one to one. ``type="sphere"`` and ``type="cylinder"``
+are this model with entries of A and Q computed from a shape (`uuv_shapes`).
 """
 
 from __future__ import annotations
@@ -26,6 +27,12 @@ import numpy as np
 
 from uvms_pin.errors import ModelError, ParameterError
 from uvms_pin.hydro.params import HydroParams
+from uvms_pin.model.importer.uuv_shapes import (
+    IN_DEVELOPMENT,
+    SHAPE_TAGS,
+    SHAPES,
+    shape_coefficients,
+)
 from uvms_pin.model.importer.xml import child_numbers, child_text
 
 __all__ = ["LINK_FROM_SNAME", "fossen_hydro", "note_asymmetry"]
@@ -57,19 +64,31 @@ def fossen_hydro(
             "uuv_simulator link block has no <hydrodynamic_model>", path=where, link=link
         )
     kind = child_text(model, "type")
-    if kind != "fossen":
+    if kind != "fossen" and kind not in SHAPES:
+        known = ", ".join(f'"{k}"' for k in ("fossen", *SHAPES))
+        why = " (uuv_simulator logs it as still in development)" if kind in IN_DEVELOPMENT else ""
         raise ModelError(
-            f'<hydrodynamic_model> type "{kind}" cannot be imported (only "fossen")',
+            f'<hydrodynamic_model> type "{kind}" cannot be imported{why}; known: {known}',
             path=where,
             link=link,
         )
-    _note_unmapped(block, _MAPPED, "", link, notes)
-    _note_unmapped(model, _MODEL_MAPPED, "<hydrodynamic_model>/", link, notes)
+    shaped = kind in SHAPES
+    _note_unmapped(block, _MAPPED | ({"box"} if shaped else set()), "", link, notes)
+    _note_unmapped(
+        model, _MODEL_MAPPED | (SHAPE_TAGS if shaped else set()), "<hydrodynamic_model>/", link,
+        notes,
+    )  # fmt: skip
     volume_m3 = _volume(block, mass_kg, rho_kg_m3, where, link, notes)
     cob = child_numbers(block, "center_of_buoyancy", (3,), where, link)
-    added = _sname_to_link(_matrix(model, "added_mass", where, link, diagonal_ok=False))
+    added_sname = _matrix(model, "added_mass", where, link, diagonal_ok=False)
+    quadratic_sname = np.diag(_matrix(model, "quadratic_damping", where, link, diagonal_ok=True))
+    if shaped:
+        added_sname, quadratic_sname = shape_coefficients(
+            kind, model, block, rho_kg_m3, added_sname, quadratic_sname, where, link, notes
+        )
+    added = _sname_to_link(added_sname)
     linear = -_sname_to_link(_matrix(model, "linear_damping", where, link, diagonal_ok=True))
-    quadratic = -np.diag(_matrix(model, "quadratic_damping", where, link, diagonal_ok=True))
+    quadratic = -quadratic_sname
     _note_off_diagonal_quadratic(model, where, link, notes)
     note_asymmetry(added, link, notes)
     try:
@@ -79,7 +98,7 @@ def fossen_hydro(
             0.5 * (added + added.T),
             linear,
             quadratic,
-            origin=f"uuv_simulator fossen model ({where})",
+            origin=f"uuv_simulator {kind} model ({where})",
         )
     except ParameterError as exc:
         raise ModelError(
