@@ -183,12 +183,4 @@ class ObjectRecovery(Controller):
         return tau
 
     def signals(self) -> dict[str, np.ndarray | Signal]:
-        names = self.jaw.names
-        grip = np.abs(self.jaw_tau) / self.servo.lever_m
-        return {
-            "jaw": Signal(
-                np.concatenate([self.jaw_q, grip]),
-                [*names, *(f"{n}_grip" for n in names)],
-                [*self._jaw_units, *("N",) * len(names)],
-            )
-        }
+        return {"jaw": self.servo.signal(self.jaw_q, self.jaw_tau, self._jaw_units)}

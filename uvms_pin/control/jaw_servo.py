@@ -22,6 +22,7 @@ The target is the jaw's closed position (each joint's lower limit) from ``close_
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -116,6 +117,18 @@ class JawServo:
         target = np.where(closed[:, None], self.jaw.lower, self.jaw.upper)
         return self._law(target, q_jaw, v_jaw)
 
+    def signal(self, q_jaw: np.ndarray, tau_jaw: np.ndarray, units: Sequence[str]) -> Signal:
+        """The jaw's log (``jaw.<joint>_rad``, ``jaw.<joint>_grip_N``): each joint's position
+        ``q_jaw`` in ``units`` ("rad" or "m" per joint) and the force its torque ``tau_jaw``
+        presses with at the finger's lever, |tau_i| / r_i [N]; the joints by their
+        `component_label`."""
+        names = [component_label(n) for n in self.jaw.names]
+        return Signal(
+            np.concatenate([q_jaw, np.abs(tau_jaw) / self.lever_m]),
+            [*names, *(f"{n}_grip" for n in names)],
+            [*units, *("N",) * len(names)],
+        )
+
     def _law(self, target: np.ndarray, q_jaw: np.ndarray, v_jaw: np.ndarray) -> np.ndarray:
         limit = self.max_force_N * self.lever_m
         raw = self.stiffness * (target - q_jaw) - self.damping * v_jaw
@@ -167,13 +180,7 @@ class WithJaw(Controller):
         self.arm.reset()
 
     def signals(self) -> dict[str, np.ndarray | Signal]:
-        names = [component_label(n) for n in self.servo.jaw.names]
-        grip = np.abs(self._jaw_tau) / self.servo.lever_m
-        jaw = Signal(
-            np.concatenate([self._jaw_q, grip]),
-            [*names, *(f"{n}_grip" for n in names)],
-            [*self._unit, *("N",) * len(names)],
-        )
+        jaw = self.servo.signal(self._jaw_q, self._jaw_tau, self._unit)
         return {**self.arm.signals(), "jaw": jaw}
 
     def funnel_margin(self) -> float:
