@@ -236,8 +236,8 @@ class UVMS:
         if self.ee_frame_id is None:
             raise ModelError(
                 f"{needed_by} needs an end-effector frame, and this model has none (a vehicle "
-                "without an arm? mount one with uvms_pin.mount_arm, or name the frame with "
-                "load_uvms(..., ee_frame=NAME))",
+                "without an arm? mount one with uvms_pin.mount_arm, or name the frame: "
+                "[scenario] ee_frame = NAME in a scenario, load_uvms(..., ee_frame=NAME))",
                 path=self.source or None,
             )
         return self.ee_frame_id

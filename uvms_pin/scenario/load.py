@@ -28,6 +28,7 @@ from uvms_pin.errors import ParameterError, PlausibilityWarning, ScenarioError, 
 from uvms_pin.model.resources import resolve_model
 from uvms_pin.model.urdf.loaded import loaded_uvms
 from uvms_pin.model.uvms import UVMS
+from uvms_pin.physics.kinematics import frame_id_from_name
 from uvms_pin.scenario.actuation import build_actuation
 from uvms_pin.scenario.baselines import check_baselines
 from uvms_pin.scenario.controller import build_controller
@@ -62,13 +63,17 @@ from uvms_pin.sim.system import System
 
 @dataclass(frozen=True)
 class Head:
-    """``[scenario]``: name, description, model entry, duration [s], master seed."""
+    """``[scenario]``: name, description, model entry, duration [s], master seed, and the
+    names of the model's end-effector and force/torque sensor frames ("": the model's
+    ``ee`` and ``ft_sensor``, `load_uvms`'s defaults)."""
 
     name: str
     description: str
     model: str
     duration_s: float
     seed: int
+    ee_frame: str = ""
+    sensor_frame: str = ""
 
 
 def load_scenario(
@@ -247,6 +252,8 @@ def _head(t: Table, path: Path) -> Head:
         model=t.string("model"),
         duration_s=t.number("duration_s", positive=True),
         seed=t.seed("seed", 0),
+        ee_frame=t.string("ee_frame", ""),
+        sensor_frame=t.string("sensor_frame", ""),
     )
     t.finish()
     return head
@@ -261,4 +268,12 @@ def _model(head: Head, water: Water, path: Path, scenario: Table) -> UVMS:
     with warnings.catch_warnings():  # the density was judged as [water] density_kg_m3
         warnings.simplefilter("ignore", PlausibilityWarning)
         # parsed once per process (a study loads the same model for every run)
-        return loaded_uvms(model_path, water_density_kg_m3=water.density_kg_m3)
+        uvms = loaded_uvms(model_path, water_density_kg_m3=water.density_kg_m3)
+    frames = {}
+    for key, name in (("ee_frame", head.ee_frame), ("sensor_frame", head.sensor_frame)):
+        if name:  # a model whose frames have other names (an imported ROS model's)
+            try:
+                frames[f"{key}_id"] = frame_id_from_name(uvms.model, name, "frame")
+            except ParameterError as exc:
+                raise scenario.error(key, str(exc)) from None
+    return replace(uvms, **frames) if frames else uvms

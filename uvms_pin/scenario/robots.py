@@ -25,6 +25,9 @@ ROBOT_TABLES = (
     "initial", "actuation", "sensors", "joints", "gripper", "controller", "task", "estimator",
     "environment", "disturbance",
 )  # fmt: skip
+#: a robot's own names of its model's frames, as ``[scenario]``'s (its end-effector's, its F/T
+#: sensor's)
+ROBOT_FRAMES = ("ee_frame", "sensor_frame")
 #: the tables every robot shares
 SHARED_TABLES = ("scenario", "water", "world", "integrator", "control", "output", "metrics")
 _NAME = re.compile(r"[A-Za-z0-9_-]+")
@@ -65,9 +68,10 @@ def robot_documents(
         if name in (n for n, _ in out):
             raise entry.error("name", f"'{name}' names two robots")
         model = entry.string("model")
+        frames = {key: entry.string(key) for key in ROBOT_FRAMES if entry.has(key)}
         own = {key: entry.pop_raw(key) for key in ROBOT_TABLES if entry.has(key)}
         entry.finish()
-        scenario = {**shared.get("scenario", {}), "model": model}
+        scenario = {**shared.get("scenario", {}), "model": model, **frames}
         out.append((name, {**shared, "scenario": scenario, **own}))
     return out
 
