@@ -12,6 +12,8 @@ KeyboardInterrupt at that point, as a Ctrl-C would; SIGKILL ends the process. Th
   simulation, with N samples in its log.
 - ``--pause-after-rows K``: once a sweep has durably recorded its K-th row
   (`uvms_pin.apps.study.runner.ResultStore.record`), before it goes on.
+- ``--pause-at-call MODULE:NAME``: when the function ``NAME`` of ``MODULE`` is first
+  called, before it runs (a command's step that is no run's sample: an identification's fit).
 
 A test starts it with `start` and waits with `wait_until_paused`: the process is then
 exactly at that point, however fast or slow the machine.
@@ -151,16 +153,35 @@ def _pause_after_rows(k: int) -> None:
     ResultStore.record = record
 
 
+def _pause_at_call(target: str) -> None:
+    """Pause when the function ``module:name`` is first called (the name as that module
+    holds it: a function it imported is patched there)."""
+    import importlib
+
+    module_name, _, name = target.partition(":")
+    module = importlib.import_module(module_name)
+    original = getattr(module, name)
+
+    def called(*args, **kwargs):
+        _pause(f"at {target}")
+        return original(*args, **kwargs)
+
+    setattr(module, name, called)
+
+
 def main(argv: list[str]) -> int:
     split = argv.index("--")
     parser = argparse.ArgumentParser()
     parser.add_argument("--pause-at-sample", type=int)
     parser.add_argument("--pause-after-rows", type=int)
+    parser.add_argument("--pause-at-call", metavar="MODULE:NAME")
     hooks = parser.parse_args(argv[:split])
     if hooks.pause_at_sample is not None:
         _pause_at_sample(hooks.pause_at_sample)
     if hooks.pause_after_rows is not None:
         _pause_after_rows(hooks.pause_after_rows)
+    if hooks.pause_at_call is not None:
+        _pause_at_call(hooks.pause_at_call)
     from uvms_pin.apps.cli.main import main as cli
 
     return cli(argv[split + 1 :])

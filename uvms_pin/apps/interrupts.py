@@ -41,6 +41,27 @@ def stop_status(exc: KeyboardInterrupt) -> tuple[int, str]:
     return EXIT_INTERRUPTED, "interrupted"
 
 
+@contextmanager
+def sigterm_stops() -> Iterator[None]:
+    """SIGTERM raises `Terminated` while the block runs (main thread only), as a first Ctrl-C
+    raises `KeyboardInterrupt`: a command without an `InterruptGuard` of its own (identify,
+    an import, an export) stops as on Ctrl-C, its ``finally`` blocks and its atomic writes'
+    clean-ups run, and `uvms_pin.apps.cli.main` exits 143 saying so; Python's default
+    would end the process on the spot, silently, leaving temporary files behind."""
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+
+    def stop(signum, frame) -> None:
+        raise Terminated("terminated by SIGTERM")
+
+    previous = signal.signal(signal.SIGTERM, stop)
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGTERM, previous)
+
+
 #: the signals the guard handles, and what its messages call them
 _NAMES = {signal.SIGINT: "Ctrl-C", signal.SIGTERM: "SIGTERM"}
 

@@ -13,8 +13,9 @@ mistyped ``--out`` must not delete a study.
 from __future__ import annotations
 
 import errno
+import json
 import os
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 from contextlib import contextmanager
 from dataclasses import dataclass
 from pathlib import Path
@@ -36,15 +37,21 @@ class OutputKind:
         name: what the directory then holds ("a run's outputs", ...), for messages.
         patterns: every file the command may write; ``overwrite`` removes these only.
         markers: the files whose presence means the directory holds this kind's results.
+        listed: the files (names relative to the directory) the kind's own record there
+            says it wrote, where no pattern can name them (a pool validation's figure per
+            trial, named after the trial); None: the patterns say all.
     """
 
     name: str
     patterns: tuple[str, ...]
     markers: tuple[str, ...]
+    listed: Callable[[Path], list[str]] | None = None
 
     def present(self, directory: Path) -> list[Path]:
         """This kind's files in ``directory`` (sorted)."""
         found = {p for pattern in self.patterns for p in directory.glob(pattern) if p.is_file()}
+        if self.listed is not None:
+            found |= {p for p in map(directory.joinpath, self.listed(directory)) if p.is_file()}
         return sorted(found)
 
     def holds(self, directory: Path) -> bool:
@@ -111,7 +118,32 @@ CONTROLLER_COMPARISON = OutputKind(
     ),
     ("controllers.csv", "controllers.md"),
 )
-KINDS = (RUN, STUDY, COMPARISON, CONTROLLER_COMPARISON)
+
+
+def _pool_figures(directory: Path) -> list[str]:
+    """The figure per trial (``<trial>.png``) of the trials the directory's
+    ``pool_validation.json`` lists (none when it is missing or unreadable)."""
+    try:
+        trials = json.loads((directory / "pool_validation.json").read_text())["trials"]
+    except (OSError, ValueError, KeyError, TypeError):
+        return []
+    return [f"{name}.png" for name in trials if isinstance(name, str) and "/" not in name]
+
+
+#: `uvms-pin identify --fit --out` (uvms_pin.apps.validation.identification)
+IDENTIFICATION = OutputKind(
+    "an identification",
+    ("identification.json", "bluerov2_heavy_identified.urdf", "identified*.png"),
+    ("identification.json", "bluerov2_heavy_identified.urdf"),
+)
+#: `uvms-pin validate pool --out` (uvms_pin.apps.validation.run)
+POOL_VALIDATION = OutputKind(
+    "a pool validation",
+    ("pool_validation.json", "pool_validation.csv"),
+    ("pool_validation.json", "pool_validation.csv"),
+    listed=_pool_figures,
+)
+KINDS = (RUN, STUDY, COMPARISON, CONTROLLER_COMPARISON, IDENTIFICATION, POOL_VALIDATION)
 OVERWRITE_HELP = (
     "replace the results an earlier run left in --out (only files uvms-pin writes are removed)"
 )

@@ -20,7 +20,7 @@ from uvms_pin.apps.exit_codes import (
     EXIT_ENVIRONMENT,
     EXIT_INTERRUPTED,
 )
-from uvms_pin.apps.interrupts import stop_status
+from uvms_pin.apps.interrupts import sigterm_stops, stop_status
 from uvms_pin.apps.study.command import register as register_study_commands
 from uvms_pin.apps.validation.command import register as register_validate
 from uvms_pin.errors import OutputError, UvmsPinError, UvmsPinWarning
@@ -280,7 +280,8 @@ def main(argv: list[str] | None = None) -> int:
 
 def _dispatch(args: argparse.Namespace) -> int:
     try:
-        return args.func(args)
+        with sigterm_stops():
+            return args.func(args)
     except BrokenPipeError:  # the reader of stdout stopped (| head): nothing more to say
         os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
         return EXIT_BROKEN_PIPE

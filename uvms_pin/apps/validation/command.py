@@ -17,11 +17,12 @@ from uvms_pin.apps.arguments import (
     positive,
     progress_printer,
 )
+from uvms_pin.apps.interrupts import InterruptGuard
 from uvms_pin.apps.validation.identify_arguments import (
     add_identify_arguments,
     check_identify_arguments,
 )
-from uvms_pin.results.outdir import check_writable
+from uvms_pin.results.outdir import OVERWRITE_HELP, POOL_VALIDATION, check_writable, claim
 
 
 def _cmd_validate_pool(args: argparse.Namespace) -> int:
@@ -32,17 +33,18 @@ def _cmd_validate_pool(args: argparse.Namespace) -> int:
     select_trials(args.data_dir, names)  # at once: the simulation code takes seconds to import
     from uvms_pin.apps.validation.run import run_pool_validation
 
-    result = run_pool_validation(
-        args.data_dir,
-        args.out,
-        trial_names=names,
-        step_s=args.step,
-        figures=not args.no_figures,
-        progress=progress_printer(args.quiet),
-        vehicle_urdf=args.vehicle,
-        arm_delay_s=args.arm_delay,
-        imu_yaw_rad=math.radians(args.imu_yaw),
-    )
+    with InterruptGuard(), claim(args.out, POOL_VALIDATION, overwrite=args.overwrite):
+        result = run_pool_validation(
+            args.data_dir,
+            args.out,
+            trial_names=names,
+            step_s=args.step,
+            figures=not args.no_figures,
+            progress=progress_printer(args.quiet),
+            vehicle_urdf=args.vehicle,
+            arm_delay_s=args.arm_delay,
+            imu_yaw_rad=math.radians(args.imu_yaw),
+        )
     print(
         f"{len(result['trials'])} trials: mean roll RMSE {result['mean_roll_rmse_deg']:.3f} deg, "
         f"mean pitch RMSE {result['mean_pitch_rmse_deg']:.3f} deg"
@@ -81,6 +83,7 @@ def register(subparsers) -> argparse.ArgumentParser:
         help="directory of trial files, e.g. the shipped data/hinsdale2023",
     )
     pool.add_argument("--out", required=True, type=path_text, help="output directory")
+    pool.add_argument("--overwrite", action="store_true", help=OVERWRITE_HELP)
     pool.add_argument(
         "--trials", type=nonempty("trial names"), help="comma-separated trial names (default: all)"
     )

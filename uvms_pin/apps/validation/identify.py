@@ -28,6 +28,7 @@ Levenberg-Marquardt with sensitivities propagated along the simulation
 from __future__ import annotations
 
 import argparse
+import contextlib
 import dataclasses
 import sys
 from collections.abc import Sequence
@@ -38,6 +39,7 @@ from scipy.optimize import least_squares
 from scipy.spatial.transform import Rotation
 
 from uvms_pin.apps.arguments import progress_printer
+from uvms_pin.apps.interrupts import InterruptGuard
 from uvms_pin.apps.validation.identification import IDENTIFIED_VEHICLE, run_identification
 from uvms_pin.apps.validation.identify_arguments import (
     add_identify_arguments,
@@ -56,6 +58,7 @@ from uvms_pin.apps.validation.trials import load_trial, roll_pitch_rad, split_tr
 from uvms_pin.errors import SimulationError
 from uvms_pin.model.uvms import UVMS
 from uvms_pin.physics.dynamics import bias_forces
+from uvms_pin.results.outdir import IDENTIFICATION, claim
 
 __all__ = [
     "IDENTIFICATION_TRIALS",
@@ -224,17 +227,18 @@ def run(args: argparse.Namespace) -> int:
     start = trial_uvms() if args.cob is None else with_cob(trial_uvms(), args.cob)
     if args.fit is None:
         return _quasi_static(args, start)
-    result = run_identification(
-        args.data_dir,
-        args.out,
-        fit_names(args),
-        start=start,
-        step_s=args.step,
-        max_iterations=args.max_iterations,
-        figures=not args.no_figures,
-        progress=progress_printer(args.quiet),
-        training=training_trials(args),
-    )
+    with InterruptGuard(), _claimed(args):
+        result = run_identification(
+            args.data_dir,
+            args.out,
+            fit_names(args),
+            start=start,
+            step_s=args.step,
+            max_iterations=args.max_iterations,
+            figures=not args.no_figures,
+            progress=progress_printer(args.quiet),
+            training=training_trials(args),
+        )
     _print_fit(result)
     if not result["converged"]:
         print(
@@ -252,6 +256,15 @@ def run(args: argparse.Namespace) -> int:
         if recording:
             print(f"validate with: --vehicle {args.out}/{IDENTIFIED_VEHICLE}{recording}")
     return 0
+
+
+def _claimed(args: argparse.Namespace) -> contextlib.AbstractContextManager:
+    """``--out`` claimed for the identification while it runs (`claim`: refused when it
+    holds another command's results, or an earlier identification's without
+    ``--overwrite``); nothing without ``--out``."""
+    if args.out is None:
+        return contextlib.nullcontext()
+    return claim(args.out, IDENTIFICATION, overwrite=args.overwrite)
 
 
 def main(argv: list[str] | None = None) -> int:

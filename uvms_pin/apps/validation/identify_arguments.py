@@ -9,6 +9,7 @@ import argparse
 
 from uvms_pin.apps.arguments import comma_names, count, finite, nonempty, path_text, positive
 from uvms_pin.errors import ParameterError
+from uvms_pin.results.outdir import OVERWRITE_HELP
 
 __all__ = ["add_identify_arguments", "check_identify_arguments", "fit_names", "training_trials"]
 
@@ -43,6 +44,7 @@ def add_identify_arguments(parser: argparse.ArgumentParser) -> None:
         help="with --fit: write identification.json, the identified vehicle's URDF and a "
         "figure per held-out trial here",
     )
+    parser.add_argument("--overwrite", action="store_true", help=OVERWRITE_HELP)
     parser.add_argument(
         "--train",
         type=nonempty("trial names"),
