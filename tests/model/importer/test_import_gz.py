@@ -116,3 +116,28 @@ def test_notes_about_the_removed_propeller_joint_are_dropped(imported):
     assert any(
         n.startswith("joint 'vertical_fins_joint': effort limit -1") for n in result.not_mapped
     )
+
+
+def test_prefixes_gz_sim_reads_without_a_declaration_do_not_stop_the_import(imported, tmp_path):
+    """MBARI's LRAUV files carry ``<experimental:params>`` and ``gz:type`` without declaring
+    ``xmlns:experimental`` or ``xmlns:gz`` (SDFormat's parser does not ask for it): the
+    vehicle imports as without them."""
+    text = LRAUV.read_text().replace(
+        '<link name="base_link">',
+        '<link name="base_link">\n      <experimental:params><sensor gz:type="salinity"/>'
+        "</experimental:params>",
+        1,
+    )
+    assert "xmlns:gz" not in text and "<experimental:params>" in text
+    source = tmp_path / "undeclared.sdf"
+    source.write_text(text)
+    result = import_model(source)
+    assert result.hydro == imported[0].hydro
+    assert [t.name for t in result.thrusters] == [t.name for t in imported[0].thrusters]
+
+
+def test_xml_that_is_not_well_formed_for_another_reason_is_still_refused(tmp_path):
+    source = tmp_path / "bad.sdf"
+    source.write_text('<sdf version="1.9"><model name="m"><gz:x></model></sdf>')
+    with pytest.raises(ModelError, match="not well-formed XML"):
+        import_model(source)

@@ -176,3 +176,10 @@ def test_neutrally_buoyant_gives_volume_m_over_rho(tmp_path):
     source.write_text(REXROV.read_text().replace("<neutrally_buoyant>0<", "<neutrally_buoyant>1<"))
     result = import_model(source)
     assert result.hydro["rexrov/base_link"].volume_m3 == pytest.approx(1862.87 / 1028.0, rel=1e-15)
+
+
+def test_unexpanded_xacro_without_its_namespace_declared_is_refused_as_xacro(tmp_path):
+    source = tmp_path / "v.urdf.xacro"
+    source.write_text('<robot name="v"><xacro:property name="a" value="1"/></robot>')
+    with pytest.raises(ModelError, match="unexpanded xacro"):
+        import_model(source, tmp_path / "out.urdf")

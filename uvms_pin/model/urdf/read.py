@@ -3,6 +3,7 @@ attributes, with a `ModelError` naming the file, the link and what is wrong."""
 
 from __future__ import annotations
 
+import re
 import xml.etree.ElementTree as ET
 from pathlib import Path
 
@@ -14,15 +15,52 @@ from uvms_pin.errors import ModelError
 __all__ = ["known_children", "read_numbers", "read_origin", "read_urdf_root"]
 
 
+#: what an undeclared prefix stands for where the name is known (an unexpanded xacro file
+#: that forgot its ``xmlns:xacro`` is still recognised as one)
+_KNOWN_NAMESPACES = {"xacro": "http://www.ros.org/wiki/xacro"}
+_UNDECLARED_NAMESPACE = "urn:uvms-pin:undeclared:"
+# a prefix in an element's or an attribute's name
+_PREFIXED = re.compile(r"</?([A-Za-z_][\w.-]*):[A-Za-z_]|\s([A-Za-z_][\w.-]*):[A-Za-z_][\w.-]*\s*=")
+# the root element's start tag: the first tag that is no declaration, comment or doctype
+_ROOT_TAG = re.compile(r"<([A-Za-z_][\w.:-]*)")
+
+
 def xml_root(path: Path) -> ET.Element:
     """The root element of an XML file; ModelError naming the file if it is missing or not
-    well-formed."""
+    well-formed.
+
+    A prefix used without its ``xmlns`` declaration is declared for it: SDFormat's parser
+    (TinyXML2) does not ask for one, and files gz-sim loads use ``gz:`` and ``experimental:``
+    so (MBARI's LRAUV). Such an element's tag is then ``{urn:uvms-pin:undeclared:gz}type``
+    (``xacro:``'s is its usual namespace), which nothing here reads as its own."""
     if not path.is_file():
         raise ModelError("file not found", path=str(path))
     try:
         return ET.parse(path).getroot()
     except ET.ParseError as exc:
+        if "unbound prefix" in str(exc):
+            declared = _with_prefixes_declared(path.read_text(encoding="utf-8", errors="replace"))
+            if declared is not None:
+                return declared
         raise ModelError(f"not well-formed XML ({exc})", path=str(path)) from exc
+
+
+def _with_prefixes_declared(text: str) -> ET.Element | None:
+    """The root of ``text`` with every prefix it uses and does not declare declared on its
+    root element; None when it is still not well-formed."""
+    used = {a or b for a, b in _PREFIXED.findall(text)} - {"xmlns", "xml"}
+    declared = set(re.findall(r"xmlns:([A-Za-z_][\w.-]*)\s*=", text))
+    missing = sorted(used - declared)
+    root = _ROOT_TAG.search(re.sub(r"<!--.*?-->", lambda m: " " * len(m[0]), text, flags=re.S))
+    if not missing or root is None:
+        return None
+    declarations = "".join(
+        f' xmlns:{p}="{_KNOWN_NAMESPACES.get(p, _UNDECLARED_NAMESPACE + p)}"' for p in missing
+    )
+    try:
+        return ET.fromstring(text[: root.end()] + declarations + text[root.end() :])
+    except ET.ParseError:
+        return None
 
 
 def read_urdf_root(path: Path) -> ET.Element:
