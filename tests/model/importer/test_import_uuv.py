@@ -153,11 +153,6 @@ def test_unexpanded_xacro_is_refused(tmp_path):
         ("<type>fossen</type>", "<type>box</type>", 'type "box" cannot be imported'),
         ("-74.82 -69.48", "74.82 -69.48", "positive semi-definite"),
         ("<volume>1.83826</volume>", "<volume>x</volume>", "non-numeric"),
-        (
-            '<link name="rexrov/base_link">\n        <neutrally',
-            '<link name="nope">\n        <neutrally',
-            "'nope'",
-        ),
     ],
 )
 def test_bad_plugin_blocks_are_named(tmp_path, old, new, match):
@@ -183,3 +178,18 @@ def test_unexpanded_xacro_without_its_namespace_declared_is_refused_as_xacro(tmp
     source.write_text('<robot name="v"><xacro:property name="a" value="1"/></robot>')
     with pytest.raises(ModelError, match="unexpanded xacro"):
         import_model(source, tmp_path / "out.urdf")
+
+
+def test_a_plugin_block_of_a_link_the_model_lacks_is_skipped_as_the_plugin_skips_it(tmp_path):
+    """uuv_simulator warns ("Specified link [...] not found") and goes on; so does the
+    import, saying so (DAVE's RexROV + Predator names the Oberon 7's links so)."""
+    text = REXROV.read_text()
+    block = '<link name="rexrov/base_link">\n        <neutrally'
+    assert block in text
+    extra = '<link name="oberon7/base"><volume>0.01</volume><hydrodynamic_model><type>fossen</type></hydrodynamic_model></link>\n      '
+    source = tmp_path / "extra.urdf"
+    source.write_text(text.replace(block, extra + block, 1))
+    result = import_model(source)
+    assert list(result.hydro) == ["rexrov/base_link"]
+    (note,) = [n for n in result.not_mapped if "oberon7/base" in n]
+    assert "not in the model: skipped" in note

@@ -145,6 +145,13 @@ def _hydro(links, plugins, where, notes) -> tuple[float | None, dict[str, HydroP
         if kind is PluginKind.UUV_HYDRO:
             density = _number_or(plugin, "fluid_density", UUV_DEFAULT_DENSITY_KG_M3, where)
             for block in plugin.findall("link"):
+                if block.get("name") and block.get("name") not in links:
+                    # the plugin warns ("Specified link [...] not found") and goes on
+                    notes.append(
+                        f"uuv_simulator plugin block of link '{block.get('name')}', which is not "
+                        "in the model: skipped, as the plugin skips it (with a warning)"
+                    )
+                    continue
                 name = _known_link(block.get("name"), links, where)
                 hydro[name] = fossen_hydro(block, _mass(links[name], where), density, where, notes)
             _note_plugin_extras(plugin, {"link", "fluid_density"}, notes)
