@@ -115,11 +115,13 @@ def test_on_a_trimmed_vehicle_each_arm_gets_a_whole_trim_of_its_own(tmp_path):
 
 def test_the_catalogue_alpha5_mounted_as_the_reference_is_trims_and_weighs_as_it(tmp_path):
     """On the BlueROV2 + Alpha 5 scenario, the catalogue's Alpha 5 bolted where the
-    reference's base is, upright as it is, reaches the contact point and, trimmed from the
-    vehicle alone, weighs what the shipped model weighs: the same foam and ballast."""
+    reference's base is, upright as Reach mounts it (its own orientation, without
+    ``mount_rpy``), reaches the contact point and, trimmed from the vehicle alone, weighs
+    what the shipped model weighs: the same foam and ballast."""
     scenario = ROOT / "scenarios" / "bluerov_alpha5_force_tracking.toml"
-    settings = CompareSettings(duration_s=0.05, ik_starts=4, mount_rpy=(0.0, 0.0, 0.0))
+    settings = CompareSettings(duration_s=0.05, ik_starts=4)
     reference, alpha5 = compare_arms(scenario, ["reference", "alpha5"], tmp_path, settings)
+    assert alpha5["mount_rpy"] == (0.0, 0.0, 0.0)
     assert alpha5["status"] == "ok", alpha5["reason"]
     assert alpha5["system_mass_kg"] == pytest.approx(reference["system_mass_kg"], rel=1e-9)
     assert abs(alpha5["net_buoyancy_after_N"]) < 1e-6

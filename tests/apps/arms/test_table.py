@@ -50,3 +50,18 @@ def test_without_settings_no_settings_line(tmp_path):
     write_comparison(_rows(), tmp_path)
     lines = (tmp_path / "comparison.md").read_text().splitlines()
     assert lines[3] == "" and lines[4].startswith("| arm |")
+
+
+def test_the_mount_orientation_said_is_the_comparisons_or_each_arms_own(tmp_path):
+    rows = _rows()
+    rows[1]["mount_rpy"] = (math.pi, 0.0, 0.0)
+    alpha5 = nan_row("alpha5")
+    alpha5.update(status="ok", mount_rpy=(0.0, 0.0, 0.0))
+    for given, arms, said in [
+        (None, rows, "mount rpy (3.1416, 0.0, 0.0) rad;"),  # one shared: as before
+        (None, [*rows, alpha5], "mount rpy each arm's own [rad]: so100 (3.1416, 0.0, 0.0), "
+         "alpha5 (0.0, 0.0, 0.0);"),
+        ((0.0, 0.5, 0.0), [*rows, alpha5], "mount rpy (0.0, 0.5, 0.0) rad;"),
+    ]:  # fmt: skip
+        write_comparison(arms, tmp_path, scenario="s", settings=CompareSettings(mount_rpy=given))
+        assert said in (tmp_path / "comparison.md").read_text().splitlines()[3]

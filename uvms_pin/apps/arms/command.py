@@ -44,7 +44,7 @@ def _cmd_compare_arms(args: argparse.Namespace) -> int:
     settings = CompareSettings(
         duration_s=args.duration,
         trim=trim,
-        mount_rpy=tuple(args.mount_rpy),
+        mount_rpy=None if args.mount_rpy is None else tuple(args.mount_rpy),
         ik_starts=args.ik_starts,
         keep_rollouts=args.keep_rollouts,
         overrides=tuple(parse_assignment(text) for text in args.set),
@@ -105,9 +105,10 @@ def register(subparsers) -> argparse.ArgumentParser:
         "--mount-rpy",
         type=finite,
         nargs=3,
-        default=(math.pi, 0.0, 0.0),
         metavar=("R", "P", "Y"),
-        help="arm base orientation on the vehicle [rad] (default: upside down)",
+        help="every arm's base orientation on the vehicle [rad] (default: each arm's own: a "
+        "table-top arm or a URDF given by path upside down, (pi, 0, 0); the Alpha 5 as Reach "
+        "mounts it, (0, 0, 0))",
     )
     parser.add_argument(
         "--ik-starts",

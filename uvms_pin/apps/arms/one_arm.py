@@ -141,7 +141,7 @@ def _run_reference(row: dict, job: _ArmJob, base: Scenario, vehicle_mass: float)
 def _mount(job: _ArmJob, water_density_kg_m3: float, **trim) -> MountResult:
     """``job``'s arm on the vehicle (``trim``: the trim keywords of `mount_arm_detailed`)."""
     entry = job.entry
-    pose = (np.asarray(job.mount_xyz), np.asarray(job.settings.mount_rpy))
+    pose = (np.asarray(job.mount_xyz), np.asarray(mount_rpy(job)))
     return mount_arm_detailed(
         job.vehicle_urdf,
         entry.urdf,
@@ -154,6 +154,12 @@ def _mount(job: _ArmJob, water_density_kg_m3: float, **trim) -> MountResult:
     )
 
 
+def mount_rpy(job: _ArmJob) -> tuple[float, float, float]:
+    """How ``job``'s arm is bolted: the comparison's orientation, else the arm's own."""
+    given = job.settings.mount_rpy
+    return job.entry.mount_rpy_rad if given is None else given
+
+
 def _run_mounted(
     row: dict, job: _ArmJob, base: Scenario, overrides: dict, vehicle_mass: float, target: pin.SE3
 ) -> None:
@@ -163,6 +169,7 @@ def _run_mounted(
     mounted = _mount(job, density)
     row.update(
         _untrimmed_columns(mounted.uvms, vehicle_mass),
+        mount_rpy=tuple(mount_rpy(job)),
         derived_hydro_bodies=len(mounted.derived_bodies),
         dry_links=" ".join(mounted.dry_links),
     )

@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
 from typing import Any
 
@@ -17,7 +16,9 @@ class CompareSettings:
     Attributes:
         duration_s: simulated duration [s]; None keeps the scenario's.
         trim: foam and ballast added for the arm at its initial configuration; None: none.
-        mount_rpy: arm base orientation on the vehicle [rad] (default upside down).
+        mount_rpy: every arm's base orientation on the vehicle [rad]; None (default): each
+            arm's own (`ArmEntry.mount_rpy_rad`: a table-top arm upside down, the Alpha 5 as
+            Reach mounts it).
         ik_starts: starts of the initial-configuration search; seed: its random seed.
         keep_rollouts: write each arm's row, rollout, metrics and figures to OUT/<arm>/.
         overrides: scenario overrides for every arm (``--set``), as (dotted key, value)
@@ -26,7 +27,7 @@ class CompareSettings:
 
     duration_s: float | None = None
     trim: TrimSpec | None = TrimSpec()  # noqa: RUF009 - frozen, immutable default
-    mount_rpy: tuple[float, float, float] = (math.pi, 0.0, 0.0)
+    mount_rpy: tuple[float, float, float] | None = None
     ik_starts: int = 24
     seed: int = 0
     keep_rollouts: bool = False

@@ -14,6 +14,7 @@ from pathlib import Path
 from uvms_pin.apps.arms.figure import comparison_figure
 from uvms_pin.apps.arms.row import COLUMNS
 from uvms_pin.apps.arms.settings import CompareSettings
+from uvms_pin.model.mount.catalog import UPSIDE_DOWN
 from uvms_pin.results.atomic import write_text_atomic
 from uvms_pin.results.format import cell_text
 
@@ -49,7 +50,7 @@ def _markdown(rows: list[dict], scenario: str, settings: CompareSettings | None)
         "adapted to each arm's joint count (see `uvms_pin.apps.arms.compare`).",
     ]
     if settings is not None:
-        lines.append(_settings_line(settings))
+        lines.append(_settings_line(settings, rows))
     lines += [
         "",
         "| " + " | ".join(label for _, label in table_cols) + " |",
@@ -62,7 +63,23 @@ def _markdown(rows: list[dict], scenario: str, settings: CompareSettings | None)
     return "\n".join(lines) + "\n"
 
 
-def _settings_line(settings: CompareSettings) -> str:
+def _mount_text(settings: CompareSettings, rows: list[dict]) -> str:
+    """The arms' mount orientation: the comparison's, the one they share, or each one's."""
+    if settings.mount_rpy is not None:
+        return f"mount rpy {_rpy_text(settings.mount_rpy)} rad"
+    mounted = {row["arm"]: row["mount_rpy"] for row in rows if row.get("mount_rpy") is not None}
+    if len(set(mounted.values())) <= 1:
+        shared = next(iter(mounted.values()), UPSIDE_DOWN)
+        return f"mount rpy {_rpy_text(shared)} rad"
+    each = ", ".join(f"{arm} {_rpy_text(rpy)}" for arm, rpy in mounted.items())
+    return f"mount rpy each arm's own [rad]: {each}"
+
+
+def _rpy_text(rpy) -> str:
+    return str(tuple(round(float(x), 4) for x in rpy))
+
+
+def _settings_line(settings: CompareSettings, rows: list[dict]) -> str:
     """Duration, mount orientation and trim of the comparison, in one sentence."""
     trim = (
         "none"
@@ -73,8 +90,8 @@ def _settings_line(settings: CompareSettings) -> str:
         )
     )
     return (
-        f"Duration: {f'{settings.duration_s:g} s' if settings.duration_s else 'as in the scenario'}; mount rpy "
-        f"{tuple(round(x, 4) for x in settings.mount_rpy)} rad; trim: {trim}."
+        f"Duration: {f'{settings.duration_s:g} s' if settings.duration_s else 'as in the scenario'}; "
+        f"{_mount_text(settings, rows)}; trim: {trim}."
     )
 
 

@@ -9,6 +9,7 @@ arm's own description); the tool axis is found from the last joint (``tool_axis=
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -18,6 +19,10 @@ from uvms_pin.model.resources import example_robot_data_dir, shipped_path
 __all__ = ["CATALOG", "REFERENCE", "ArmEntry", "available_arms", "resolve_arm"]
 
 REFERENCE = "reference"
+
+
+#: a table-top arm's base under a vehicle: turned over, its z axis down
+UPSIDE_DOWN = (math.pi, 0.0, 0.0)
 
 
 @dataclass(frozen=True)
@@ -32,6 +37,10 @@ class ArmEntry:
         arm_base_link: the link bolted to the vehicle (None: the URDF's root).
         description: a few words for the report.
         shipped: the URDF ships with uvms-pin (``relative_path`` under its ``models/``).
+        mount_rpy_rad: how its base is bolted under a vehicle, roll, pitch, yaw of the base
+            frame in the vehicle's [rad]: a table-top arm upside down, (pi, 0, 0), its base's
+            z axis down so that it hangs under the hull (the default); an arm built for
+            vehicles as its maker mounts it.
     """
 
     name: str
@@ -40,6 +49,7 @@ class ArmEntry:
     arm_base_link: str | None = None
     description: str = ""
     shipped: bool = False
+    mount_rpy_rad: tuple[float, float, float] = UPSIDE_DOWN
 
     @property
     def urdf(self) -> Path:
@@ -91,6 +101,9 @@ CATALOG: dict[str, ArmEntry] = {
             None,
             "Reach Alpha 5, 4 DoF + locked jaw (shipped)",
             shipped=True,
+            # as Reach mounts it on the BlueROV2 (and models/uvms_bluerov2_alpha5.urdf does):
+            # its base frame the vehicle's, the arm reaching forward
+            mount_rpy_rad=(0.0, 0.0, 0.0),
         ),
     )
 }
