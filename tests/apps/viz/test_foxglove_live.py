@@ -186,15 +186,38 @@ def test_the_cli_refuses_an_unknown_live_viewer(capsys):
     assert "foxglove" in capsys.readouterr().err
 
 
-def test_uvms_pin_replay_live_foxglove_waits_for_a_client_and_sends_the_whole_run(
-    push_rollout, tmp_path, capsys
-):
-    push_rollout.save(tmp_path / "run")
+def _replayed(rollout, run_dir: Path, speed: float) -> Client:
+    """``rollout`` saved in ``run_dir`` and served by `uvms-pin replay --live foxglove` at
+    ``speed`` to a `Client`, which has it all when this returns."""
+    rollout.save(run_dir)
     port = _free_port()
     client = Client(f"ws://127.0.0.1:{port}")
     client.start()
-    code = main(["replay", str(tmp_path / "run"), "--live", "foxglove", "--port", str(port), "--speed", "50"])  # fmt: skip
+    code = main(["replay", str(run_dir), "--live", "foxglove", "--port", str(port), "--speed", str(speed)])  # fmt: skip
     client.join(30.0)
     assert code == 0 and client.error is None, client.error
+    return client
+
+
+def test_uvms_pin_replay_live_foxglove_waits_for_a_client_and_sends_the_whole_run(
+    push_rollout, tmp_path, capsys
+):
+    client = _replayed(push_rollout, tmp_path / "run", speed=50)
     assert "waiting for a Foxglove client" in capsys.readouterr().out
     check_bag(push_rollout, dict(client.received))
+
+
+def test_a_saved_run_with_a_camera_and_a_sonar_is_replayed_with_their_images(tmp_path):
+    """`uvms-pin replay --live foxglove` of a seabed survey sends what its bag holds: the
+    camera's colour, depth and labels and the sonars' images at their firings, their frames
+    in /tf_static (it sent the samples' topics only)."""
+    short = {"scenario.duration_s": 0.3}
+    rollout = simulate(load_scenario(ROOT / "scenarios" / "seabed_survey.toml", short), progress=False)  # fmt: skip
+    assert rollout.perception  # the survey's camera and sonars fired
+    client = _replayed(rollout, tmp_path / "run", speed=20)
+    kinds = {name: about["kind"] for name, about in rollout.metadata["perception"].items()}
+    assert set(kinds.values()) == {"camera", "sonar"}
+    for name, kind in kinds.items():
+        topic = f"/{name}/image_raw" if kind == "camera" else f"/{name}/image"
+        assert topic in client.received, topic
+    check_bag(rollout, dict(client.received))  # every message, images bit for bit

@@ -60,11 +60,10 @@ def _cmd_replay(args: argparse.Namespace) -> int:
         size_mb = path.stat().st_size / 1e6
         print(f"wrote {path} ({size_mb:.1f} MB, {len(rollout)} samples)")
     if args.live == "foxglove":
-        from uvms_pin.apps.export.ros_bag import rollout_model
-        from uvms_pin.apps.export.ros_sample import SampleTopics
+        from uvms_pin.apps.export.ros_bag import SavedRunTopics, rollout_model
         from uvms_pin.apps.viz.foxglove_live import replay_foxglove
 
-        topics = SampleTopics(rollout.metadata, rollout_model(rollout, args.urdf))
+        topics = SavedRunTopics(rollout, rollout_model(rollout, args.urdf))
         replay_foxglove(rollout, topics, port=args.port, speed=args.speed, out=sys.stdout)
     elif args.live:
         from uvms_pin.apps.viz.live import replay_live

@@ -30,11 +30,19 @@ from collections.abc import Iterator
 from pathlib import Path
 from typing import TYPE_CHECKING
 
+import numpy as np
 import pinocchio as pin
 
 from uvms_pin.apps.export.ros_encoding import TopicEncoder
 from uvms_pin.apps.export.ros_perception import PerceptionTopics
-from uvms_pin.apps.export.ros_sample import MAP, TOPIC_TYPES, Message, SampleTopics, records_of
+from uvms_pin.apps.export.ros_sample import (
+    MAP,
+    TOPIC_TYPES,
+    Message,
+    SampleRecord,
+    SampleTopics,
+    records_of,
+)
 from uvms_pin.errors import VizError
 from uvms_pin.model.urdf.load import load_uvms
 from uvms_pin.model.uvms import DEFAULT_WATER_DENSITY_KG_M3
@@ -44,7 +52,7 @@ if TYPE_CHECKING:
     from uvms_pin.model.uvms import UVMS
     from uvms_pin.results.rollout_data import RolloutData
 
-__all__ = ["MAP", "messages", "write_mcap"]
+__all__ = ["MAP", "SavedRunTopics", "messages", "write_mcap"]
 
 
 def _writer_class():
@@ -84,13 +92,13 @@ def write_mcap(rollout: RolloutData, path: str | Path, *, urdf: str | Path | Non
             f"the rollout's q has {rollout.q.shape[1]} entries, its model {uvms.model.nq}: "
             "not the model it ran (pass --urdf)"
         )
-    seen = perception_topics(rollout, uvms)
-    encoder = TopicEncoder(TOPIC_TYPES | seen.types)
+    topics = SavedRunTopics(rollout, uvms)
+    encoder = TopicEncoder(topics.types)
     with atomic_path(path) as tmp, open(tmp, "wb") as stream:
         writer = writer_class(stream)
         writer.start(profile="ros2", library="uvms-pin")
         channels = {}
-        for topic, message, time_ns in messages(rollout, uvms, seen):
+        for topic, message, time_ns in messages(rollout, topics):
             if topic not in channels:  # a channel for each topic the run has data for
                 name, text = encoder.schema(topic)
                 schema = writer.register_schema(name, "ros2msg", text.encode())
@@ -107,18 +115,33 @@ def perception_topics(rollout: RolloutData, uvms: UVMS) -> PerceptionTopics:
     return PerceptionTopics(rollout, uvms.model, data)
 
 
-def messages(
-    rollout: RolloutData, uvms: UVMS, seen: PerceptionTopics | None = None
-) -> Iterator[Message]:
-    """Every message of the bag, in time order (the static ones first); ``seen``: its
-    cameras' and sonars' (`perception_topics`)."""
-    if seen is None:
-        seen = perception_topics(rollout, uvms)
-    topics = SampleTopics(rollout.metadata, uvms)
-    for topic, message, time_ns in topics.static(float(rollout.time_s[0]), rollout.q[0]):
-        if topic == "/tf_static":  # one message: the sensors' frames with the links'
-            message["transforms"].extend(seen.static_transforms(time_ns))
-        yield topic, message, time_ns
+class SavedRunTopics:
+    """A saved run's messages: its samples' (`SampleTopics`: ``static``, ``at``) with its
+    cameras' and sonars' (`PerceptionTopics`): their frames in the one ``/tf_static``, each
+    firing's messages after its sample's. ``types``: every topic's ROS 2 type (for a
+    `TopicEncoder`); ``joint_kinds`` as `SampleTopics`'. What the bag holds and a live view
+    of the saved run sends."""
+
+    def __init__(self, rollout: RolloutData, uvms: UVMS):
+        self.samples = SampleTopics(rollout.metadata, uvms)
+        self.seen = perception_topics(rollout, uvms)
+        self.types = TOPIC_TYPES | self.seen.types
+        self.joint_kinds = self.samples.joint_kinds
+
+    def static(self, time_s: float, q: np.ndarray) -> Iterator[Message]:
+        for topic, message, time_ns in self.samples.static(time_s, q):
+            if topic == "/tf_static":  # one message: the sensors' frames with the links'
+                message["transforms"].extend(self.seen.static_transforms(time_ns))
+            yield topic, message, time_ns
+
+    def at(self, record: SampleRecord) -> Iterator[Message]:
+        yield from self.samples.at(record)
+        yield from self.seen.at(record.time_s)
+
+
+def messages(rollout: RolloutData, topics: SavedRunTopics) -> Iterator[Message]:
+    """Every message of the bag of ``rollout`` (``topics``: its `SavedRunTopics`), in time
+    order (the static ones first)."""
+    yield from topics.static(float(rollout.time_s[0]), rollout.q[0])
     for record in records_of(rollout):
         yield from topics.at(record)
-        yield from seen.at(record.time_s)

@@ -147,7 +147,6 @@ class PerceptionTopics:
         self.arrays = rollout.perception
         self.types: dict[str, str] = {}
         self._frames: dict[str, tuple[str, str, pin.SE3]] = {}  # (its frame, parent, pose)
-        self._next = dict.fromkeys((name for name, _ in self.sensors), 0)
         for name, about in self.sensors:
             try:
                 self._add(name, about, model, data)
@@ -202,14 +201,14 @@ class PerceptionTopics:
 
     def at(self, time_s: float) -> Iterator[Message]:
         """The messages of the sensors that fired at rollout time ``time_s`` [s] (each
-        firing is a logged sample's; called with every sample's time, in order)."""
+        firing is a logged sample's; the same messages however often, in whatever order,
+        a time is asked for: a live view asks for the first sample's twice)."""
         for name, about in self.sensors:
             arrays = self.arrays[name]
-            k = self._next[name]
-            if k >= len(arrays["time_s"]) or float(arrays["time_s"][k]) != time_s:
-                continue
-            self._next[name] = k + 1
-            yield from self._fired(name, about, arrays, k, stamp_ns(time_s))
+            times = arrays["time_s"]
+            k = int(np.searchsorted(times, time_s))
+            if k < len(times) and float(times[k]) == time_s:
+                yield from self._fired(name, about, arrays, k, stamp_ns(time_s))
 
     def _fired(self, name: str, about: dict, arrays: dict, k: int, time_ns: int):
         frame = self._frames[name][0]

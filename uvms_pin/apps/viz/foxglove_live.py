@@ -25,6 +25,7 @@ from typing import TYPE_CHECKING, TextIO
 
 from uvms_pin.apps.export.ros_encoding import TopicEncoder
 from uvms_pin.apps.export.ros_sample import (
+    TOPIC_TYPES,
     Message,
     SampleRecord,
     SampleTopics,
@@ -39,6 +40,7 @@ from uvms_pin.sim.log import run_metadata
 from uvms_pin.sim.run import Scenario
 
 if TYPE_CHECKING:
+    from uvms_pin.apps.export.ros_bag import SavedRunTopics
     from uvms_pin.results.rollout import Rollout
     from uvms_pin.sim.sample import Sample
 
@@ -112,7 +114,8 @@ class FoxgloveLive:
             host,
             out,
         )
-        self.encoder = TopicEncoder()
+        # a saved run's cameras and sonars have topics of their own (`SavedRunTopics`)
+        self.encoder = TopicEncoder(getattr(topics, "types", TOPIC_TYPES))
         self.error: BaseException | None = None
         self._queue: collections.deque[SampleRecord] = collections.deque()
         self._wake = threading.Condition()
@@ -337,14 +340,15 @@ def run_foxglove(
 
 def replay_foxglove(
     rollout: Rollout,
-    topics: SampleTopics,
+    topics: SampleTopics | SavedRunTopics,
     *,
     port: int = DEFAULT_FOXGLOVE_PORT,
     speed: float = 1.0,
     out: TextIO | None = sys.stdout,
 ) -> None:
     """Serve a saved rollout to Foxglove at ``speed`` x real time, once a client has
-    subscribed (it waits for one)."""
+    subscribed (it waits for one); with `SavedRunTopics`, its cameras' and sonars' images
+    too, as its bag has them."""
     if len(rollout) == 0:
         raise LiveServerError("the rollout has no sample to serve")
     records = list(records_of(rollout))
