@@ -206,3 +206,47 @@ def test_a_scenario_with_neither_task_is_refused_saying_so_not_naming_a_controll
     assert result.returncode == 2, result.stderr
     assert "compares a force task" in result.stderr and "this scenario has neither" in result.stderr
     assert not out.exists()
+
+
+RAISER = '''
+from uvms_pin.control.base import Controller
+
+
+class Raiser(Controller):
+    """Cannot start: raises at its first tick, as a baseline does at a singular start."""
+
+    def __init__(self, uvms):
+        pass
+
+    def compute(self, time_s, measurement):
+        raise ValueError("cannot start here")
+'''
+
+
+def test_a_controller_that_cannot_start_is_a_row_and_the_others_are_still_compared(tmp_path):
+    """A controller stopped before its first sample (a force baseline's Euler angles at a
+    tool pointing straight down) stopped the whole comparison; it is a row saying why now,
+    without numbers and without a curve, and the others are compared and drawn."""
+    (tmp_path / "raiser.py").write_text(RAISER)
+    scenario = tmp_path / "s.toml"
+    scenario.write_text(REALISTIC.read_text())
+    out = tmp_path / "cmp"
+    command = [
+        "compare-controllers", str(scenario), "--controllers", "raiser:Raiser,pi_force",
+        "--set", 'controller={type="raiser:Raiser"}', "--set", "scenario.duration_s=0.1",
+        "--out", str(out),
+    ]  # fmt: skip
+    result = run_cli_in_process(command, tmp_path)
+    assert result.returncode == 0, result.stderr
+    rows = list(csv.DictReader((out / "controllers.csv").open()))
+    assert [r["controller"] for r in rows] == ["raiser:Raiser", "pi_force"]
+    assert rows[0]["status"] == "stopped" and rows[0]["success"] == "False"
+    assert (
+        "cannot start here" in rows[0]["reason"] and "before its first sample" in rows[0]["reason"]
+    )
+    assert math.isnan(float(rows[0]["force_error_rms_N"]))
+    assert math.isfinite(float(rows[1]["force_error_rms_N"]))
+    assert "raiser:Raiser" in result.stdout and "no errors to judge" in result.stdout
+    assert "nan" not in result.stdout
+    for name in ("controllers.md", "controllers_force.png", "controllers_metrics.png"):
+        assert (out / name).is_file()

@@ -62,6 +62,8 @@ def _cmd_compare_controllers(args: argparse.Namespace) -> int:
         return written
 
     def summary(row) -> str:
+        if not math.isfinite(row["force_error_rms_N"]):
+            return f"{row['controller']:<16} no errors to judge"  # its reason follows
         return (
             f"{row['controller']:<16} force error RMS {row['force_error_rms_N']:.3f} N, "
             f"peak {row['force_error_peak_N']:.3f} N"
@@ -91,7 +93,7 @@ def _compare_tracking(args: argparse.Namespace, scenarios, criteria, out) -> int
     )
 
     def figure(rows, rollouts, say) -> list[Path]:
-        return [] if args.no_figures else [write_tracking_figure(rollouts, out)]
+        return [] if args.no_figures or not rollouts else [write_tracking_figure(rollouts, out)]
 
     def summary(row) -> str:
         position, orientation = (

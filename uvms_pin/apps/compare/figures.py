@@ -18,7 +18,9 @@ def write_comparison_figures(
     rows: list[dict[str, Any]], rollouts: dict[str, Rollout], out: Path, after_s: float
 ) -> list[Path]:
     """``controllers_force.png`` (`force_figure`) and ``controllers_metrics.png``
-    (`metrics_figure`), each written whole or not at all."""
+    (`metrics_figure`), each written whole or not at all; none when no controller ran."""
+    if not rollouts:
+        return []
     scenario = next(iter(rollouts.values())).metadata.get("scenario", "")
     return [
         save_figure(force_figure(rollouts, after_s), out / "controllers_force.png"),

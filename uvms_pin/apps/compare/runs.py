@@ -2,13 +2,14 @@
 
 from __future__ import annotations
 
+import math
 import os
 from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
-from uvms_pin.apps.compare.metrics import Criteria, comparison_row
-from uvms_pin.apps.compare.tracking import tracking_row
+from uvms_pin.apps.compare.metrics import COLUMNS, Criteria, comparison_row
+from uvms_pin.apps.compare.tracking import TRACKING_COLUMNS, tracking_row
 from uvms_pin.checks import check_memory
 from uvms_pin.errors import FunnelViolation, ScenarioError, SimulationError
 from uvms_pin.results.rollout import Rollout
@@ -74,10 +75,17 @@ def run_controller(name: str, scenario: Scenario, criteria: Criteria) -> tuple[d
     return _row(name, scenario, rollout, stopped, criteria)
 
 
-def _row(name, scenario, rollout, stopped: str, criteria: Criteria) -> tuple[dict, Rollout]:
-    """(row, rollout) of a controller's run, ``stopped`` saying why it stopped early."""
+def _row(name, scenario, rollout, stopped: str, criteria: Criteria) -> tuple[dict, Rollout | None]:
+    """(row, rollout) of a controller's run, ``stopped`` saying why it stopped early; a run
+    stopped before its first sample (the controller cannot start there: a baseline's Euler
+    angles at a tool pointing straight down) is a row without numbers and no rollout: the
+    others are still compared."""
+    columns = COLUMNS if scenario.task is None else TRACKING_COLUMNS
     if rollout is None or len(rollout) == 0:
-        raise SimulationError(f"controller '{name}': {stopped or 'no samples'}")
+        row = dict.fromkeys(columns, math.nan)
+        reason = f"{stopped or 'run stopped'} (before its first sample)"
+        row.update(controller=name, status="stopped", success=False, reason=reason)
+        return row, None
     if scenario.task is not None:
         return tracking_row(name, rollout, scenario.plant.actuation, stopped), rollout
     return comparison_row(name, rollout, scenario.plant.actuation, criteria, stopped), rollout
@@ -88,15 +96,17 @@ def compare_controllers(
     criteria: Criteria,
     progress: Callable[[str], None] | None = None,
 ) -> tuple[list[dict], dict[str, Rollout]]:
-    """Rows (in the given order) and rollouts of every controller's run, the runs side by
-    side on threads (`uvms_pin.sim.batch.run_batch`: each the run alone, bit for bit)."""
+    """Rows (in the given order) and rollouts (of those that ran) of every controller's run,
+    the runs side by side on threads (`uvms_pin.sim.batch.run_batch`: each the run alone, bit for bit)."""
     if progress is not None:
         progress(f"running {', '.join(scenarios)} ...")
     runs = run_batch(list(scenarios.values()), min(len(scenarios), os.cpu_count() or 1) or 1)
     rows, rollouts = [], {}
     for (name, scenario), run in zip(scenarios.items(), runs, strict=True):
-        row, rollouts[name] = batch_run_row(name, scenario, run, criteria)
+        row, rollout = batch_run_row(name, scenario, run, criteria)
         rows.append(row)
+        if rollout is not None:  # one that never ran has no curve to draw
+            rollouts[name] = rollout
     return rows, rollouts
 
 
