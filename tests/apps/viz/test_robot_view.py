@@ -20,7 +20,7 @@ import uvms_pin as up
 from uvms_pin.apps.viz.meshcat_scene import Frame, UvmsScene, recording_visualizer
 from uvms_pin.apps.viz.replay import write_replay
 from uvms_pin.apps.viz.robot_view import moving_bodies, piece_placement
-from uvms_pin.errors import VizError
+from uvms_pin.errors import ModelWarning, VizError
 from uvms_pin.model.vehicles.bluerov2_heavy import thrusters
 from uvms_pin.scenario.load import load_scenario
 from uvms_pin.sim.run import simulate
@@ -155,7 +155,8 @@ def test_a_relative_mesh_visual_is_found_from_the_urdfs_folder_as_the_loader_fin
 ):
     """pinocchio looks a relative mesh up in its package directories only: the URDF's folder
     is one, so a model whose visuals sit beside it draws from any working directory; a
-    visual it cannot find is a VizError naming the URDF, not a ValueError."""
+    visual mesh it cannot find is left out, named in a warning (the rest is drawn), one it
+    cannot read is a VizError naming the URDF, not a ValueError."""
     (tmp_path / "meshes").mkdir()
     (tmp_path / "meshes" / "rock.obj").write_bytes((SCENARIOS / "meshes" / "rock.obj").read_bytes())
     text = (ROOT / "models" / "bluerov2_heavy.urdf").read_text()
@@ -166,10 +167,39 @@ def test_a_relative_mesh_visual_is_found_from_the_urdfs_folder_as_the_loader_fin
     uvms = up.load_uvms(urdf, ee_frame="base_link", sensor_frame="base_link")
     paths = [o.meshPath for o in UvmsScene(uvms).geometry["visuals"].geometryObjects]
     assert str(tmp_path / "meshes" / "rock.obj") in [str(Path(p).resolve()) for p in paths]
+    drawn = len(paths)
     urdf.write_text(text.replace("</link>", mesh.format("meshes/none.obj"), 1))
     uvms = up.load_uvms(urdf, ee_frame="base_link", sensor_frame="base_link")
-    with pytest.raises(VizError, match=r"rov\.urdf: cannot draw its visuals: .*none\.obj"):
+    with pytest.warns(ModelWarning, match=r"1 visual mesh file\(s\) not found.*meshes/none\.obj"):
+        scene = UvmsScene(uvms)
+    assert len(scene.geometry["visuals"].geometryObjects) == drawn - 1
+    (tmp_path / "meshes" / "broken.obj").write_text("not a mesh")
+    urdf.write_text(text.replace("</link>", mesh.format("meshes/broken.obj"), 1))
+    uvms = up.load_uvms(urdf, ee_frame="base_link", sensor_frame="base_link")
+    with pytest.raises(VizError, match=r"(?s)rov\.urdf: cannot draw its visuals: .*broken\.obj"):
         UvmsScene(uvms)
+
+
+def test_a_link_whose_visual_meshes_are_all_missing_is_drawn_by_its_collision_shapes(tmp_path):
+    """An imported model whose meshes stayed behind (uuv_simulator's RexROV: one mesh per
+    link) is drawn by its collision boxes, not as nothing."""
+    urdf = tmp_path / "v.urdf"
+    urdf.write_text(
+        '<robot name="v"><link name="base_link">'
+        '<inertial><mass value="10"/><inertia ixx="1" iyy="1" izz="1" ixy="0" ixz="0" iyz="0"/>'
+        "</inertial>"
+        '<visual><geometry><mesh filename="file:///nowhere/hull.dae"/></geometry></visual>'
+        '<collision><origin xyz="0 0 0.1" rpy="0 0 0"/><geometry><box size="1 0.5 0.4"/>'
+        "</geometry></collision>"
+        '<hydrodynamics><volume value="0.01"/></hydrodynamics>'
+        "</link></robot>"
+    )
+    uvms = up.load_uvms(urdf)
+    with pytest.warns(ModelWarning, match=r"hull\.dae.*1 collision shape\(s\) drawn"):
+        scene = UvmsScene(uvms)
+    (piece,) = scene.geometry["visuals"].geometryObjects
+    np.testing.assert_allclose(piece.placement.translation, [0.0, 0.0, 0.1])
+    assert piece.geometry.halfSide.tolist() == [0.5, 0.25, 0.2]
 
 
 @pytest.fixture(scope="module")

@@ -31,7 +31,13 @@ import numpy as np
 import zmq
 from meshcat.visualizer import ViewerWindow
 
-from uvms_pin.apps.viz.meshcat_scene import EnvironmentView, Frame, SceneStyle, UvmsScene
+from uvms_pin.apps.viz.meshcat_scene import (
+    EnvironmentView,
+    Frame,
+    SceneStyle,
+    UvmsScene,
+    tip_position,
+)
 from uvms_pin.apps.viz.surface import surface_view_of
 from uvms_pin.apps.viz.watched import play_saved, simulate_watched
 from uvms_pin.apps.viz.world_view import WorldView
@@ -384,8 +390,7 @@ def scene_for_scenario(
 ) -> UvmsScene:
     """The scene of a scenario before it runs (extent: the initial vehicle and tip); ``show``
     the robot's visual geometry, its collision shapes or both (`UvmsScene`)."""
-    probe = UvmsScene(scenario.uvms)
-    tip0 = probe.ee_position(scenario.q0)
+    tip0 = tip_position(scenario.uvms, scenario.uvms.model.createData(), scenario.q0)
     controller = scenario.raw.get("controller") or {}
     extent = np.vstack([scenario.q0[:3], tip0])
     surface = surface_view_of(scenario.plant.flow, scenario.plant.free_surface, scenario.q0[:2])

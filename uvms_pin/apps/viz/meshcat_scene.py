@@ -356,15 +356,10 @@ class UvmsScene:
     # ---- per instant -------------------------------------------------------------------
     def ee_position(self, q: np.ndarray) -> np.ndarray:
         """The end-effector position (the vehicle origin for a model without one) [m]."""
-        pin.forwardKinematics(self.uvms.model, self.data, q)
-        return self._tip_after_kinematics()
+        return tip_position(self.uvms, self.data, q)
 
     def _tip_after_kinematics(self) -> np.ndarray:
-        if self.uvms.ee_frame_id is None:
-            return self.data.oMi[1].translation.copy()  # a vehicle alone: trace its origin
-        return pin.updateFramePlacement(
-            self.uvms.model, self.data, self.uvms.ee_frame_id
-        ).translation.copy()
+        return _tip(self.uvms, self.data)
 
     def poses(self, frame: Frame) -> dict[str, Pose]:
         """Pose of every moving node (paths relative to the scene root) at one instant."""
@@ -453,3 +448,17 @@ def _plain(position, scale) -> Pose:
 
 def _hidden() -> Pose:
     return (np.zeros(3), np.array([0.0, 0.0, 0.0, 1.0]), np.full(3, _TINY))
+
+
+def tip_position(uvms: UVMS, data: pin.Data, q: np.ndarray) -> np.ndarray:
+    """The end-effector position at ``q`` (the vehicle origin for a model without one) [m],
+    ``data`` the model's work buffer: what a scene's extent is drawn from, without the
+    scene (its geometry is read from the URDF's meshes)."""
+    pin.forwardKinematics(uvms.model, data, q)
+    return _tip(uvms, data)
+
+
+def _tip(uvms: UVMS, data: pin.Data) -> np.ndarray:
+    if uvms.ee_frame_id is None:
+        return data.oMi[1].translation.copy()  # a vehicle alone: trace its origin
+    return pin.updateFramePlacement(uvms.model, data, uvms.ee_frame_id).translation.copy()

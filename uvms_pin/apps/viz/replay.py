@@ -31,6 +31,7 @@ from uvms_pin.apps.viz.meshcat_scene import (
     SceneStyle,
     UvmsScene,
     recording_visualizer,
+    tip_position,
 )
 from uvms_pin.apps.viz.surface import surface_view_of
 from uvms_pin.apps.viz.world_view import WorldView
@@ -76,8 +77,8 @@ def scene_for_rollout(
         )
     density = float(world.get("water_density_kg_m3", DEFAULT_WATER_DENSITY_KG_M3))
     uvms = load_uvms(source, water_density_kg_m3=density)
-    scene0 = UvmsScene(uvms)  # for forward kinematics only
-    tips = np.array([scene0.ee_position(q) for q in _every(rollout.q, 400)])
+    data = uvms.model.createData()
+    tips = np.array([tip_position(uvms, data, q) for q in _every(rollout.q, 400)])
     extent = np.vstack([tips, rollout.q[:, :3], *([] if also_world_m is None else [also_world_m])])
     surface = surface_view_of(
         flow_from_record(world.get("flow")),

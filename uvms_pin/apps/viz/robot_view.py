@@ -11,7 +11,9 @@ from __future__ import annotations
 
 import importlib.util
 import sys
+import tempfile
 import warnings
+import xml.etree.ElementTree as ET
 from functools import cache
 from pathlib import Path
 
@@ -19,7 +21,8 @@ import meshcat
 import numpy as np
 import pinocchio as pin
 
-from uvms_pin.errors import VizError
+from uvms_pin.errors import ModelWarning, VizError
+from uvms_pin.model.resources import resolve_resource
 
 #: what ``show`` may ask for, and the node groups each draws
 SHOWN = {"visual": ("visuals",), "collision": ("collisions",), "both": ("visuals", "collisions")}
@@ -67,8 +70,63 @@ def geometry_groups(
         try:
             out[group] = pin.buildGeomFromUrdf(model, str(urdf), kinds[group], package_dirs=dirs)
         except ValueError as exc:  # pinocchio: a mesh it cannot find or read
-            raise VizError(f"{urdf}: cannot draw its {group}: {exc}") from exc
+            out[group] = _without_missing_meshes(model, urdf, group, kinds[group], dirs, exc)
     return out
+
+
+def _without_missing_meshes(
+    model: pin.Model, urdf: Path, group: str, kind, dirs: list[str], error: ValueError
+) -> pin.GeometryModel:
+    """The ``group`` geometry of ``urdf`` without the pieces whose mesh file is not found
+    (a model whose meshes stayed behind: an imported one, a copied file), each named in a
+    `ModelWarning`: the rest of the robot is drawn. VizError (``error``'s) when no mesh is
+    missing, or the rest cannot be drawn either."""
+    root = ET.parse(urdf).getroot()
+    tag = group[:-1]  # "visual", "collision"
+    missing: list[str] = []
+    stand_ins = 0
+    for link in root.iter("link"):
+        pieces = link.findall(tag)
+        lost = [piece for piece in pieces if not _found(piece, urdf, dirs)]
+        for piece in lost:
+            link.remove(piece)
+            missing.append(
+                f"link '{link.get('name')}': {piece.find('geometry/mesh').get('filename')}"
+            )
+        if tag == "visual" and lost and len(lost) == len(pieces):
+            # nothing left to see of the link: its collision shapes stand in
+            for shape in link.findall("collision"):
+                if _found(shape, urdf, dirs):
+                    stand_in = ET.SubElement(link, "visual")
+                    stand_in.extend(list(shape))
+                    stand_ins += 1
+    if not missing:
+        raise VizError(f"{urdf}: cannot draw its {group}: {error}") from error
+    with tempfile.TemporaryDirectory() as folder:
+        kept = Path(folder) / urdf.name
+        ET.ElementTree(root).write(kept)
+        try:
+            geometry = pin.buildGeomFromUrdf(model, str(kept), kind, package_dirs=dirs)
+        except ValueError as exc:
+            raise VizError(f"{urdf}: cannot draw its {group}: {exc}") from exc
+    shown = "; ".join(missing[:5]) + (f"; and {len(missing) - 5} more" if len(missing) > 5 else "")
+    instead = (
+        f"; {stand_ins} collision shape(s) drawn for links left with none" if stand_ins else ""
+    )
+    warnings.warn(
+        f"{urdf}: {len(missing)} {tag} mesh file(s) not found, drawn without them "
+        f"({shown}){instead}",
+        ModelWarning,
+        stacklevel=3,
+    )
+    return geometry
+
+
+def _found(piece: ET.Element, urdf: Path, dirs: list[str]) -> bool:
+    """Whether a ``<visual>`` or ``<collision>`` can be drawn as far as its file goes: a
+    primitive, or a mesh whose file is found."""
+    mesh = piece.find("geometry/mesh")
+    return mesh is None or resolve_resource(mesh.get("filename", ""), urdf.parent, dirs) is not None
 
 
 @cache
