@@ -138,3 +138,18 @@ def test_an_empty_out_is_not_the_current_directory(tmp_path, monkeypatch, empty)
     with pytest.raises(OutputError, match="an empty path"), claim(empty, RUN):
         pass
     assert list(tmp_path.iterdir()) == []
+
+
+def test_an_identification_is_known_by_the_files_identify_writes(tmp_path):
+    """The identification's kind names the vehicle file identify writes (a rename of one
+    would leave an earlier identification unrecognised, then mixed with a new one)."""
+    from uvms_pin.apps.validation.identification import IDENTIFIED_VEHICLE
+    from uvms_pin.results.outdir import IDENTIFICATION
+
+    assert IDENTIFIED_VEHICLE in IDENTIFICATION.markers
+    (tmp_path / IDENTIFIED_VEHICLE).write_text("<robot/>")
+    (tmp_path / "identified_alt_002-0.png").write_bytes(b"png")
+    assert IDENTIFICATION.holds(tmp_path)
+    assert [p.name for p in IDENTIFICATION.present(tmp_path)] == [
+        "bluerov2_heavy_identified.urdf", "identified_alt_002-0.png",
+    ]  # fmt: skip
