@@ -76,3 +76,28 @@ def test_an_element_given_twice_is_refused(write_urdf, old, new, message):
     assert old in text, text
     with pytest.raises(up.ModelError, match=message):
         _load(write_urdf, text.replace(old, new, 1))
+
+
+def test_a_body_whose_mass_sits_on_dry_links_beside_a_probe_is_refused_naming_them(write_urdf):
+    """An imported wrist the source gives no hydrodynamics (7.5 kg, volume 0) and a probe of
+    16 mL fixed to it make one body denser than osmium: refused, the refusal naming the dry
+    link rather than only suspecting grams."""
+    text = body_urdf(mass=10.0, hydro=hydro_xml(0.01)).replace(
+        "</robot>",
+        '<link name="wrist"><inertial><mass value="7.5"/>'
+        '<inertia ixx="0.01" iyy="0.01" izz="0.01" ixy="0" ixz="0" iyz="0"/></inertial>'
+        f"<hydrodynamics>{hydro_xml(0.0)}</hydrodynamics></link>"
+        '<joint name="wrist_joint" type="revolute"><parent link="body"/><child link="wrist"/>'
+        '<axis xyz="0 0 1"/><limit lower="-1" upper="1" effort="1" velocity="1"/></joint>'
+        '<link name="probe"><inertial><mass value="0.01"/>'
+        '<inertia ixx="1e-6" iyy="1e-6" izz="1e-6" ixy="0" ixz="0" iyz="0"/></inertial>'
+        f"<hydrodynamics>{hydro_xml(1.6e-5)}</hydrodynamics></link>"
+        '<joint name="probe_joint" type="fixed"><parent link="wrist"/><child link="probe"/>'
+        "</joint></robot>",
+    )
+    with pytest.raises(up.ModelError, match="cannot be physical") as info:
+        _load(write_urdf, text)
+    assert "of its links, wrist displace no water (volume 0)" in str(info.value)
+    with pytest.raises(up.ModelError) as info:  # a wet body in grams: no dry link to name
+        _load(write_urdf, body_urdf(mass=31000.0, hydro=hydro_xml(0.03)))
+    assert "displace no water" not in str(info.value)

@@ -114,10 +114,25 @@ def _check_densities(uvms: UVMS, where: str) -> None:
         density = mass / volume
         refusal = BODY_DENSITY.refusal(density)
         if refusal is not None:
-            raise ModelError(f"{what} {refusal}", path=where)
+            raise ModelError(f"{what} {refusal}{_dry(uvms, joint_id)}", path=where)
         warning = BODY_DENSITY.warning(density)
         if warning is not None:
             warnings.warn(f"{where}: {what} {warning}", ModelWarning, stacklevel=3)
+
+
+def _dry(uvms: UVMS, joint_id: int) -> str:
+    """What a refusal adds when links of the body displace no water (an imported link its
+    source leaves dry, beside a small wet one: a probe): their volume is missing, not a unit
+    wrong."""
+    dry = [
+        b.name for b in uvms.hydro_bodies if b.joint_id == joint_id and b.params.volume_m3 == 0.0
+    ]
+    if not dry:
+        return ""
+    return (
+        f"; of its links, {', '.join(dry)} displace no water (volume 0): if they are dry in "
+        "the source (an imported model's), give them their volume"
+    )
 
 
 def _build_model(path: Path) -> pin.Model:
