@@ -107,9 +107,52 @@ def test_bad_results_name_the_function(scenario_dir, reference, match):
         rollout.metrics()
 
 
-def test_bad_results_are_cli_input_errors(scenario_dir, capsys):
-    code = main(["run", str(scenario_dir / "run.toml"), "--out", str(scenario_dir / "o"),
+def test_a_metric_that_fails_is_an_input_error_that_keeps_the_run(scenario_dir, capsys):
+    """Your metric raising after a run of an hour must not lose the hour: the rollout, its
+    figures and the built-in metrics are written (``metrics.json`` saying what failed), the
+    command exits 2 with your metric's traceback, and the saved rollout computes your
+    metrics once the function is fixed."""
+    out = scenario_dir / "o"
+    code = main(["run", str(scenario_dir / "run.toml"), "--out", str(out),
                  "--quiet", "--set", 'metrics.extra=["my_metrics:raising"]'])  # fmt: skip
+    err = capsys.readouterr().err
     assert code == 2
-    assert "raised RuntimeError" in capsys.readouterr().err
-    assert not (scenario_dir / "o").exists() or not any((scenario_dir / "o").iterdir())
+    assert "your code raised; its traceback" in err and "RuntimeError: no data" in err
+    assert f"kept in {out}: rollout.npz, rollout.json, metrics.json, pose.png" in err
+    metrics = json.loads((out / "metrics.json").read_text())
+    assert (
+        metrics["extra_metrics_error"] == "metric 'my_metrics:raising' raised RuntimeError: no data"
+    )
+    assert metrics["n_samples"] > 0 and "arm_travel_rad" not in metrics
+    rollout = Rollout.load(out)
+    with pytest.raises(ParameterError, match="raised RuntimeError"):
+        rollout.metrics()  # still the broken function
+    rollout.metadata["extra_metrics"] = ["my_metrics:arm_travel"]  # as once fixed
+    assert rollout.metrics()["arm_travel_rad"] > 0.0
+
+
+def test_a_metric_that_fails_in_a_run_of_several_robots_keeps_every_robot(scenario_dir, capsys):
+    """Each robot's rollout and the run's metrics.json are written before the error is
+    said (the first robot's used to be written and the second's not)."""
+    from uvms_pin.results.robots import RobotRollouts
+
+    doc = (scenario_dir / "run.toml").read_text()
+    robots = doc.replace('model = "uvms_lbv150"', "", 1).replace("[initial]", "[robots.initial]")
+    robots = robots.replace(
+        "[metrics]",
+        '[[robots]]\nname = "b"\nmodel = "uvms_lbv150"\n[robots.initial]\nposition_world_m = [3.0, 0.0, -2.0]\n[metrics]',
+    )
+    robots = robots.replace(
+        "[robots.initial]", '[[robots]]\nname = "a"\nmodel = "uvms_lbv150"\n[robots.initial]', 1
+    )
+    (scenario_dir / "two.toml").write_text(robots)
+    out = scenario_dir / "two"
+    code = main(["run", str(scenario_dir / "two.toml"), "--out", str(out), "--quiet",
+                 "--set", 'metrics.extra=["my_metrics:raising"]'])  # fmt: skip
+    err = capsys.readouterr().err
+    assert code == 2, err
+    assert "raised RuntimeError: no data" in err and f"the run is kept in {out}" in err
+    saved = RobotRollouts.load(out)
+    assert saved.names == ["a", "b"]
+    blocks = json.loads((out / "metrics.json").read_text())["robots"]
+    assert all("raised RuntimeError" in blocks[n]["extra_metrics_error"] for n in ("a", "b"))

@@ -88,6 +88,13 @@ def progress_printer(quiet: bool) -> Callable[[str], None] | None:
     return lambda line: print(line, file=sys.stderr, flush=True)
 
 
+def say_user_traceback(traceback: str, what: str = "your code raised") -> None:
+    """The frames of your code that failed (a controller, a metric), shown as such on
+    stderr, before the command's own message; nothing for an empty ``traceback``."""
+    if traceback:
+        print(f"uvms-pin: {what}; its traceback:\n" + traceback.rstrip("\n"), file=sys.stderr)
+
+
 def add_set_option(parser: argparse.ArgumentParser, help_text: str) -> None:
     """``--set KEY=VALUE``, repeatable: scenario entries to override (the command parses
     each with `uvms_pin.scenario.overrides.parse_assignment`); [] if not given."""

@@ -1,6 +1,7 @@
 """The exit status of every ``uvms-pin`` command (documented in docs/api.md, "Errors").
 
-0 success; 2 bad input (nothing was run or written); 3 a run stopped early (funnel
+0 success; 2 bad input (nothing was run or written; but a metric of your own that fails
+after a run: the run is kept, its metrics.json without yours); 3 a run stopped early (funnel
 violation, divergence, the controller raised: its rollout is kept); 4 the system failed
 (a full disk, a file removed meanwhile: the message names the file and what was kept);
 130 Ctrl-C and 143 SIGTERM (what a run simulated is kept); 141 the reader of the output

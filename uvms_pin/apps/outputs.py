@@ -7,6 +7,7 @@ from pathlib import Path
 
 import numpy as np
 
+from uvms_pin.errors import ParameterError
 from uvms_pin.results.rollout import ARRAY_FILE, META_FILE, Rollout
 
 METRICS_FILE = "metrics.json"
@@ -17,18 +18,24 @@ FigureWriter = Callable[[Rollout, Path], list[Path]]
 
 
 def write_outputs(rollout: Rollout, out: Path) -> list[Path]:
-    """Rollout, metrics.json and figures into ``out``; the figures' paths."""
-    write_results(rollout, out)
-    return write_figures(rollout, out)
+    """Rollout, metrics.json and figures into ``out``; the figures' paths. A metric of your
+    own that fails is raised once they are written (`write_results`)."""
+    failure = write_results(rollout, out)
+    figures = write_figures(rollout, out)
+    if failure is not None:
+        raise failure
+    return figures
 
 
-def write_results(rollout: Rollout, out: Path) -> list[str]:
-    """``rollout.npz``, ``rollout.json`` and ``metrics.json`` into ``out`` (each written
-    whole or not at all); their names."""
+def write_results(rollout: Rollout, out: Path) -> ParameterError | None:
+    """``rollout.npz``, ``rollout.json`` and ``metrics.json`` (`RESULT_FILES`) into ``out``,
+    each written whole or not at all. A metric of your own that fails (`checked_metrics`)
+    does not lose the run: ``metrics.json`` holds the built-in metrics and, as
+    ``extra_metrics_error``, what went wrong; its error is returned (None: none failed)."""
     from uvms_pin.results.atomic import write_json_atomic
+    from uvms_pin.results.metrics import checked_metrics
 
-    # the metrics first: one of your own that fails (an input error) leaves nothing written
-    metrics = rollout.metrics()
+    metrics, failure = checked_metrics(rollout)
     out.mkdir(parents=True, exist_ok=True)
     rollout.save(out)
     write_json_atomic(
@@ -37,10 +44,11 @@ def write_results(rollout: Rollout, out: Path) -> list[str]:
             "status": rollout.metadata.get("status"),
             "error": rollout.metadata.get("error", ""),
             "seed": rollout.metadata.get("seed"),
+            **({} if failure is None else {"extra_metrics_error": str(failure)}),
             **metrics,
         },
     )
-    return list(RESULT_FILES)
+    return failure
 
 
 def write_figures(

@@ -7,6 +7,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from uvms_pin.errors import ParameterError
 from uvms_pin.results.estimate_metrics import estimate_metrics
 from uvms_pin.results.extra_metrics import extra_metrics
 from uvms_pin.results.free_objects import free_object_metrics
@@ -21,11 +22,11 @@ def _rms(x: np.ndarray) -> float:
     return float(np.sqrt(np.mean(np.square(x)))) if x.size else math.nan
 
 
-def compute_metrics(rollout: RolloutData) -> dict[str, float]:
+def compute_metrics(rollout: RolloutData, *, extra: bool = True) -> dict[str, float]:
     """Metrics of any run: timing, energy (`energy_metrics`: a balance when driven), motion
-    and effort; a tracking task's (`uvms_pin.results.task_metrics`); then your own, the
-    functions the rollout's metadata names (`uvms_pin.results.extra_metrics`, a scenario's
-    ``[metrics] extra``). Efforts: vehicle force = |tau[0:3]|,
+    and effort; a tracking task's (`uvms_pin.results.task_metrics`); then, with ``extra``,
+    your own, the functions the rollout's metadata names (`uvms_pin.results.extra_metrics`,
+    a scenario's ``[metrics] extra``). Efforts: vehicle force = |tau[0:3]|,
     vehicle torque = |tau[3:6]|, joint torques = max over joints of |tau_j|.
     """
     meta = rollout.metadata
@@ -70,8 +71,21 @@ def compute_metrics(rollout: RolloutData) -> dict[str, float]:
     out.update(free_object_metrics(rollout))
     out.update(task_metrics(rollout))
     out.update(estimate_metrics(rollout))
-    out.update(extra_metrics(rollout, out))
+    if extra:
+        out.update(extra_metrics(rollout, out))
     return out
+
+
+def checked_metrics(rollout: RolloutData) -> tuple[dict[str, float], ParameterError | None]:
+    """(the rollout's metrics, the failure of a metric of your own or None): when one of
+    yours raises or returns what is no metric, the built-in metrics alone and its error
+    (naming it, with its traceback), so that what a run simulated is saved whatever the
+    function does; `compute_metrics` of the saved rollout computes them again once fixed."""
+    built_in = compute_metrics(rollout, extra=False)
+    try:
+        return {**built_in, **extra_metrics(rollout, built_in)}, None
+    except ParameterError as exc:
+        return built_in, exc
 
 
 def driven(rollout: RolloutData) -> bool:

@@ -96,20 +96,33 @@ class RobotRollouts:
     def save(self, directory: str | Path) -> Path:
         """Each robot's rollout in ``directory/<name>/`` and ``metrics.json`` (a block per
         robot, with its status and seed; with free objects, a block per object:
-        `object_metrics`) in ``directory``."""
+        `object_metrics`) in ``directory``.
+
+        Raises:
+            ParameterError: a metric of your own failed (`checked_metrics`), once every file
+                is written: the robot's block holds the built-in metrics and
+                ``extra_metrics_error``.
+        """
+        from uvms_pin.results.metrics import checked_metrics
+
         out = Path(directory)
-        blocks = {}
+        blocks, failures = {}, []
         for name, rollout in self.rollouts.items():
+            metrics, failure = checked_metrics(rollout)
             blocks[name] = {
                 "status": rollout.metadata.get("status"),
                 "seed": rollout.metadata.get("seed"),
-                **rollout.metrics(),
+                **({} if failure is None else {"extra_metrics_error": str(failure)}),
+                **metrics,
             }
+            failures += [failure] if failure is not None else []
             rollout.save(out / name)
         objects = self.object_metrics()
         write_json_atomic(
             out / ROBOTS_FILE, {"robots": blocks, **({"objects": objects} if objects else {})}
         )
+        if failures:
+            raise failures[0]
         return out
 
     @classmethod

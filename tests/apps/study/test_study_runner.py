@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import math
 import multiprocessing
 import subprocess
 import sys
@@ -250,6 +251,26 @@ def test_your_own_metrics_are_study_columns(tmp_path):
     row = execute_run(str(study.base), study.runs()[0])
     assert row["status"] == "ok", row["error"]
     assert 0.0 < row["heave_speed_peak_m_s"] < 1.0
+
+
+def test_your_metric_raising_is_an_error_row_that_keeps_the_built_in_metrics(tmp_path):
+    """The row says "error" with your function's traceback (``--retry-errors`` runs it
+    again once fixed); the run's own metrics are in it, and its rollout saved if asked."""
+    study = load_study(write_study(tmp_path))
+    (tmp_path / "broken_study_metrics.py").write_text(
+        "def broken(rollout):\n    raise KeyError('heave')\n"
+    )
+    with (tmp_path / "scenario.toml").open("a") as f:
+        f.write('\n[metrics]\nextra = ["broken_study_metrics:broken"]\n')
+    run = study.runs()[0]
+    row = execute_run(str(study.base), run, str(tmp_path / "rollouts"))
+    assert (
+        row["status"] == "error"
+        and "metric 'broken_study_metrics:broken' raised KeyError" in row["error"]
+    )
+    assert "broken_study_metrics.py" in row["traceback"]
+    assert row["simulated_time_s"] > 0.0 and math.isfinite(row["force_error_rms_N"])
+    assert (tmp_path / "rollouts" / run.run_id / "rollout.npz").is_file()
 
 
 def test_runs_executed_together_on_threads_give_the_rows_of_each_alone(tmp_path, serial_table):

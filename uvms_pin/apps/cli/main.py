@@ -9,7 +9,7 @@ import warnings
 from pathlib import Path
 from typing import TYPE_CHECKING
 
-from uvms_pin.apps.arguments import add_set_option, path_text, positive
+from uvms_pin.apps.arguments import add_set_option, path_text, positive, say_user_traceback
 from uvms_pin.apps.arms.command import register as register_compare_arms
 from uvms_pin.apps.cli.export import register as register_export
 from uvms_pin.apps.cli.run import LIVE_PORTS, check_view_options, cmd_run
@@ -289,11 +289,7 @@ def _dispatch(args: argparse.Namespace) -> int:
         print(f"uvms-pin: error: {where}{exc.strerror or exc}", file=sys.stderr)
         return EXIT_ENVIRONMENT
     except UvmsPinError as exc:
-        if exc.user_traceback:  # the user's own code failed: its frames, shown as such
-            print(
-                "uvms-pin: your code raised; its traceback:\n" + exc.user_traceback.rstrip("\n"),
-                file=sys.stderr,
-            )
+        say_user_traceback(exc.user_traceback)  # the user's own code failed: its frames
         print(f"uvms-pin: error: {exc}", file=sys.stderr)
         return EXIT_BAD_INPUT
     except (KeyboardInterrupt, RuntimeError) as exc:

@@ -19,7 +19,8 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING
 
-from uvms_pin.apps.exit_codes import EXIT_ENVIRONMENT, EXIT_RUN_STOPPED
+from uvms_pin.apps.arguments import say_user_traceback
+from uvms_pin.apps.exit_codes import EXIT_BAD_INPUT, EXIT_ENVIRONMENT, EXIT_RUN_STOPPED
 from uvms_pin.apps.interrupts import InterruptGuard, stop_status
 from uvms_pin.errors import ParameterError, SimulationError
 from uvms_pin.results.outdir import RUN, check_writable, claim
@@ -80,12 +81,7 @@ def _run(args: argparse.Namespace) -> int:
     out = check_writable(args.out)  # before simulating, not after
     with InterruptGuard() as guard, claim(out, RUN, overwrite=args.overwrite):
         ending = _simulate_to_end(scenario, args)
-        if ending.user_traceback:
-            print(
-                "uvms-pin: the run stopped in your controller's code; its traceback:\n"
-                + ending.user_traceback.rstrip("\n"),
-                file=sys.stderr,
-            )
+        say_user_traceback(ending.user_traceback, "the run stopped in your controller's code")
         if ending.rollout is None:
             print(ending.message, file=sys.stderr)
             return ending.status
@@ -96,6 +92,7 @@ def _run(args: argparse.Namespace) -> int:
         # whatever then cut the figures
         print(ending.message, file=sys.stderr)
     if failure is not None:
+        say_user_traceback(failure.user_traceback)
         print(failure.message, file=sys.stderr)
         return failure.status
     return ending.status
@@ -177,7 +174,7 @@ def _save(
     rollout = ending.rollout
     try:
         with guard.saving():
-            write_results(rollout, out)
+            metric_failure = write_results(rollout, out)
         guard.release()
         write_figures(rollout, out, guard.checkpoint)
         if args.html:
@@ -185,6 +182,15 @@ def _save(
 
             write_replay(rollout, out / "replay.html", show=args.show)
         guard.checkpoint()  # a Ctrl-C during the replay: the command says it stopped
+        if metric_failure is not None:  # your metric's input error, the run kept
+            kept = ", ".join(_files_of_the_run(out))
+            return _files_of_the_run(out), Ending(
+                rollout,
+                EXIT_BAD_INPUT,
+                f"uvms-pin: error: {metric_failure}; kept in {out}: {kept} (metrics.json "
+                f"without your metrics: once fixed, Rollout.load('{out}').metrics())",
+                metric_failure.user_traceback,
+            )
     except KeyboardInterrupt as exc:
         status, stopped = stop_status(exc)
         kept = ", ".join(_files_of_the_run(out)) or "nothing"
@@ -232,8 +238,10 @@ def _shortened_note(rollout: Rollout) -> str:
 
 def _report(name: str, ending: Ending, out: Path, written: list[str]) -> None:
     """The run's line (status, simulated and wall time) and the files written."""
+    from uvms_pin.results.metrics import compute_metrics
+
     rollout = ending.rollout
-    metrics = rollout.metrics()
+    metrics = compute_metrics(rollout, extra=False)  # its timing (yours were saved or said)
     print(
         f"scenario {name}: {rollout.metadata['status']}, simulated "
         f"{metrics['simulated_time_s']:.3f} s in {metrics['wall_time_s']:.2f} s "

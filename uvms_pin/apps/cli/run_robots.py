@@ -12,9 +12,11 @@ from __future__ import annotations
 import argparse
 import sys
 
-from uvms_pin.apps.exit_codes import EXIT_RUN_STOPPED
+from uvms_pin.apps.arguments import say_user_traceback
+from uvms_pin.apps.exit_codes import EXIT_BAD_INPUT, EXIT_RUN_STOPPED
 from uvms_pin.apps.interrupts import InterruptGuard, stop_status
 from uvms_pin.errors import ParameterError, SimulationError
+from uvms_pin.results.metrics import compute_metrics
 from uvms_pin.results.outdir import RUN, check_writable, claim
 from uvms_pin.results.progress import progress_printer
 from uvms_pin.sim.robots_run import RobotsScenario, simulate_robots
@@ -40,10 +42,15 @@ def run_robots(scenario: RobotsScenario, args: argparse.Namespace) -> int:
         if rollouts is None:
             print(message, file=sys.stderr)
             return status
-        rollouts.save(out)
+        try:
+            rollouts.save(out)
+        except ParameterError as exc:  # a metric of yours: the run is kept, then refused
+            metric_failure = exc
+        else:
+            metric_failure = None
         _figures(rollouts, out, args.html)
     for name, rollout in rollouts.rollouts.items():
-        metrics = rollout.metrics()
+        metrics = compute_metrics(rollout, extra=False)  # its timing
         print(
             f"scenario {scenario.name}, robot {name}: {rollout.metadata['status']}, simulated "
             f"{metrics['simulated_time_s']:.3f} s in {metrics['wall_time_s']:.2f} s"
@@ -51,6 +58,14 @@ def run_robots(scenario: RobotsScenario, args: argparse.Namespace) -> int:
     print(f"wrote {out}/metrics.json and {', '.join(f'{out}/{n}/' for n in rollouts.names)}")
     if message:
         print(message, file=sys.stderr)
+    if metric_failure is not None:
+        say_user_traceback(metric_failure.user_traceback)
+        print(
+            f"uvms-pin: error: {metric_failure}; the run is kept in {out} (metrics.json "
+            f"without your metrics: once fixed, RobotRollouts.load('{out}').metrics())",
+            file=sys.stderr,
+        )
+        return EXIT_BAD_INPUT
     return status
 
 

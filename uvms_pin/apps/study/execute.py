@@ -20,7 +20,8 @@ from typing import Any
 import numpy as np
 
 from uvms_pin.apps.study.spec import Run
-from uvms_pin.errors import ControllerError, FunnelViolation, SimulationError
+from uvms_pin.errors import ControllerError, FunnelViolation, ParameterError, SimulationError
+from uvms_pin.results.metrics import checked_metrics
 from uvms_pin.results.robots import RobotRollouts
 from uvms_pin.sim.robots_run import RobotsScenario
 
@@ -125,17 +126,28 @@ def _outcome_into(row: dict[str, Any], outcome, run: Run, rollout_dir: str | Non
         raise exc
     elif exc is not None:  # a bug or a bad input in one run must not stop the study
         _failed(row, exc)
+    # a metric of your own that fails: the row keeps the built-in ones and says "error"
+    # (`--retry-errors` runs it again once fixed), the rollout is saved as asked
+    failures = []
     if isinstance(rollout, RobotRollouts):  # several robots: each one's columns, "name/..."
         for name in rollout.names:
-            row.update(_prefixed(f"{name}/", rollout_quantities(rollout.robot(name))))
-        for name, metrics in {**rollout.metrics(), **rollout.object_metrics()}.items():
+            robot = rollout.robot(name)
+            metrics, failure = checked_metrics(robot)
+            row.update(_prefixed(f"{name}/", {**rollout_quantities(robot), **metrics}))
+            failures += [failure] if failure is not None else []
+        for name, metrics in rollout.object_metrics().items():
             row.update(_prefixed(f"{name}/", metrics))
     elif rollout is not None:
-        row.update(rollout_quantities(rollout))
-        row.update(rollout.metrics())
-    if rollout is not None:
-        if rollout_dir is not None:
+        metrics, failure = checked_metrics(rollout)
+        row.update({**rollout_quantities(rollout), **metrics})
+        failures += [failure] if failure is not None else []
+    if failures and exc is None:
+        _failed(row, failures[0])
+    if rollout is not None and rollout_dir is not None:
+        try:
             rollout.save(Path(rollout_dir) / run.run_id)
+        except ParameterError:  # several robots' save: your metric, already in the row
+            pass
 
 
 def _robots(scenario) -> list[tuple[str, Any]]:
