@@ -122,3 +122,20 @@ def test_a_tracking_studys_task_errors_are_summarised_by_default(tmp_path):
     table.drop(columns="task_settling_time_s").to_parquet(tmp_path / RESULTS_FILE)
     report = write_report(tmp_path)[0].read_text()
     assert "task_position_error_rms_m" not in report
+
+
+def test_a_metric_no_run_has_is_drawn_saying_so_not_with_an_empty_legend(tmp_path):
+    """Every run stopped before the metric's window (its value NaN in each row): the scatter
+    says no run has a value, and matplotlib warns of no empty legend."""
+    import warnings
+
+    from uvms_pin.apps.study.figures import scatter_figure
+
+    table = pd.DataFrame(
+        {"status": ["ok", "error"], "gain": [1.0, 2.0], "force_error_N": [math.nan, math.nan]}
+    )
+    params = [{"path": "gain", "numeric": True, "log": False}]
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        path = scatter_figure(table, params, "force_error_N", tmp_path / "s.png")
+    assert path.stat().st_size > 1000

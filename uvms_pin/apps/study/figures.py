@@ -116,7 +116,10 @@ def scatter_figure(
         ax.set_xlabel(p["path"])
         ax.set_ylabel(metric)
         ax.grid(True, alpha=0.3)
-    axes[0].legend(loc="best", fontsize="small")
+    if axes[0].get_legend_handles_labels()[0]:
+        axes[0].legend(loc="best", fontsize="small")
+    else:  # every run's value is NaN (each stopped before the metric's window): say so
+        axes[0].text(0.5, 0.5, "no run has a value", ha="center", transform=axes[0].transAxes)
     fig.suptitle(f"{metric} vs parameters (colour: status)")
     return _save(fig, path)
 
