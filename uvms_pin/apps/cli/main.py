@@ -141,7 +141,10 @@ def _cmd_import(args: argparse.Namespace) -> int:
         if table.exists() and not args.overwrite:
             raise OutputError(f"--thrusters {table}: exists; pass --overwrite to replace it")
         check_writable(table.parent, "--thrusters", shown=str(table))
-        result = import_model(args.file, out, thrusters_out=table, allow_dry=args.allow_dry)
+        result = import_model(
+            args.file, out, thrusters_out=table, allow_dry=args.allow_dry,
+            balance_inertia=args.balance_inertia,
+        )  # fmt: skip
     print(f"wrote {out}")
     if result.thrusters:
         print(f"wrote {table} ({len(result.thrusters)} thrusters)")
@@ -170,6 +173,12 @@ def _add_import(sub) -> None:
         "--allow-dry",
         action="store_true",
         help="import a file that carries no hydrodynamics at all (every link dry)",
+    )
+    parser.add_argument(
+        "--balance-inertia",
+        action="store_true",
+        help="a link's inertia no mass distribution has (I1 + I2 < I3; Gazebo does not check "
+        "it): raise its smallest principal moment to I3 - I2 instead of refusing it",
     )
     parser.set_defaults(func=_cmd_import)
 

@@ -26,12 +26,13 @@ from uvms_pin.model.importer.collision_volume import collision_volume
 from uvms_pin.model.importer.fossen import fossen_hydro
 from uvms_pin.model.importer.gz_hydrodynamics import gz_hydrodynamics
 from uvms_pin.model.importer.includes import inline_includes
+from uvms_pin.model.importer.inertia import check_inertias
 from uvms_pin.model.importer.lift_drag import add_fins
 from uvms_pin.model.importer.plugins import PluginKind, plugin_kind
 from uvms_pin.model.importer.result import ImportedThruster, ImportResult
 from uvms_pin.model.importer.sdf import sdf_model, sdf_to_urdf
 from uvms_pin.model.importer.thrusters import gz_thruster, uuv_thruster
-from uvms_pin.model.importer.tree import fix_immobile_joints, link_placements
+from uvms_pin.model.importer.tree import fix_immobile_joints, hold_uuv_fins, link_placements
 from uvms_pin.model.importer.write import hydro_element, thruster_table_text, urdf_text
 from uvms_pin.model.urdf.read import xml_root
 from uvms_pin.results.atomic import atomic_path
@@ -49,13 +50,16 @@ def import_model(
     *,
     thrusters_out: str | Path | None = None,
     allow_dry: bool = False,
+    balance_inertia: bool = False,
 ) -> ImportResult:
     """Read a Gazebo vehicle; with ``out``, write the URDF there and, when it has thrusters,
     the table to ``thrusters_out`` (default: ``out`` with ``.thrusters.toml``).
 
     ``allow_dry``: import a file that carries no hydrodynamics at all (no plugin uvms-pin
     maps, no ``<hydrodynamics>`` element) with every link dry; refused otherwise (a vehicle
-    without water is rarely what was meant).
+    without water is rarely what was meant). ``balance_inertia``: a link's inertia that no
+    mass distribution has (Gazebo does not check it) is balanced (`check_inertias`), not
+    refused.
 
     Raises:
         ModelError: naming the file and what cannot be read or mapped; nothing is written.
@@ -66,6 +70,7 @@ def import_model(
     robot, plugins, fmt = _read_source(path, notes)
     links = {link.get("name"): link for link in robot.findall("link")}
     fix_immobile_joints(robot, notes)
+    hold_uuv_fins(robot, [p for p in plugins if plugin_kind(p) is PluginKind.UUV_FIN], notes)
     placements = link_placements(robot, where)
     thrusters = _thrusters(robot, plugins, placements, where, notes)
     density, hydro = _hydro(links, plugins, where, notes)
@@ -79,6 +84,7 @@ def import_model(
         )
     _finish_links(robot, hydro, where, notes)
     add_fins(robot, plugins, where, notes)
+    check_inertias(robot, where, notes, balance=balance_inertia)  # what the loader would refuse
     result = ImportResult(urdf_text(robot, where, notes), hydro, thrusters, density, notes, fmt)
     if out is not None:
         out = Path(out)

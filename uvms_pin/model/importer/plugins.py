@@ -18,6 +18,7 @@ class PluginKind(Enum):
     GZ_THRUSTER = "gz-sim Thruster"
     GZ_BUOYANCY = "gz-sim Buoyancy"
     GZ_LIFT_DRAG = "gz-sim LiftDrag"
+    UUV_FIN = "uuv_simulator Fin"
 
 
 # (substring of filename or name, kind); first match wins
@@ -26,6 +27,7 @@ _SIGNATURES = (
     ("systems::liftdrag", PluginKind.GZ_LIFT_DRAG),
     ("gz-sim-lift-drag-system", PluginKind.GZ_LIFT_DRAG),
     ("underwater_object", PluginKind.UUV_HYDRO),
+    ("uuv_fin", PluginKind.UUV_FIN),
     ("uuv_thruster", PluginKind.UUV_THRUSTER),
     ("hydrodynamics", PluginKind.GZ_HYDRO),
     ("gz::sim::systems::thruster", PluginKind.GZ_THRUSTER),

@@ -10,7 +10,7 @@ import pinocchio as pin
 from uvms_pin.errors import ModelError
 from uvms_pin.model.urdf.read import read_origin
 
-__all__ = ["fix_immobile_joints", "link_placements", "root_link"]
+__all__ = ["fix_immobile_joints", "hold_uuv_fins", "link_placements", "make_fixed", "root_link"]
 
 
 def root_link(robot: ET.Element, where: str) -> str:
@@ -74,6 +74,33 @@ def fix_immobile_joints(robot: ET.Element, notes: list[str]) -> None:
                 f"joint '{joint.get('name')}': {joint.get('type')} with limits {lower} to "
                 f"{upper} cannot move; written as a fixed joint"
             )
-            joint.set("type", "fixed")
-            for child in [c for c in joint if c.tag in ("limit", "axis", "dynamics", "mimic")]:
-                joint.remove(child)
+            make_fixed(joint)
+
+
+def make_fixed(joint: ET.Element) -> None:
+    """``joint`` as a fixed joint where it stands (its origin kept; limit, axis, dynamics and
+    mimic dropped)."""
+    joint.set("type", "fixed")
+    for child in [c for c in joint if c.tag in ("limit", "axis", "dynamics", "mimic")]:
+        joint.remove(child)
+
+
+def hold_uuv_fins(robot: ET.Element, fins: list[ET.Element], notes: list[str]) -> None:
+    """uuv_simulator's Fin plugins (``fins``): each sets its joint to the commanded angle
+    itself (first-order toward it; 0 without a command), so the joint is no degree of freedom
+    of the dynamics: written fixed at 0 (a free fin link of no inertia would make the mass
+    matrix singular). Their lift and drag are not mapped (said in ``notes``)."""
+    joints = {j.get("name"): j for j in robot.findall("joint")}
+    for plugin in fins:
+        name = (plugin.findtext("joint_name") or "").strip()
+        kind = (plugin.findtext("liftdrag/type") or "?").strip()
+        joint = joints.get(name)
+        if joint is None:
+            notes.append(f"fin plugin '{plugin.get('name')}': no joint {name!r} in the model")
+            continue
+        if joint.get("type") != "fixed":
+            make_fixed(joint)
+        notes.append(
+            f"fin joint '{name}': uuv_simulator's Fin plugin sets its angle (0 without a "
+            f"command): written fixed at 0; its lift and drag (<liftdrag> {kind}) not mapped"
+        )

@@ -10,7 +10,7 @@ from uvms_pin.errors import ModelError
 from uvms_pin.model.urdf.read import read_numbers, read_origin, single
 from uvms_pin.results.format import numbers_text
 
-__all__ = ["check_inertial"]
+__all__ = ["check_inertial", "triangle_slack"]
 
 # Relative slack of the inertia checks: URDF inertias are often printed with 3-4 digits,
 # and a flat plate (I3 = I1 + I2 exactly) must not fail on its rounding.
@@ -76,10 +76,18 @@ def _check_rotational_inertia(entries: dict[str, float], mass_kg: float, where: 
             path=where,
             link=link,
         )
-    if principal[0] + principal[1] < principal[2] * (1.0 - _INERTIA_RELATIVE_TOLERANCE):
+    if triangle_slack(matrix) < 0.0:
         raise ModelError(
             f"inertia violates the triangle inequality I1 + I2 >= I3: principal moments "
             f"{moments} kg m^2 (no mass distribution has them)",
             path=where,
             link=link,
         )
+
+
+def triangle_slack(matrix: np.ndarray) -> float:
+    """I1 + I2 - I3 (1 - tolerance) of the principal moments I1 <= I2 <= I3 of a rotational
+    inertia [kg m^2]: negative when it breaks the triangle inequality by more than the
+    rounding of a printed inertia (a flat plate's I1 + I2 = I3 passes)."""
+    principal = np.linalg.eigvalsh(matrix)
+    return float(principal[0] + principal[1] - principal[2] * (1.0 - _INERTIA_RELATIVE_TOLERANCE))
