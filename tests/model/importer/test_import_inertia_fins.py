@@ -4,6 +4,7 @@ by the plugin: held fixed)."""
 
 from __future__ import annotations
 
+import math
 from pathlib import Path
 
 import numpy as np
@@ -24,7 +25,9 @@ FIN = """
     <child link="rexrov/fin0"/><origin xyz="-1.2 0 0" rpy="0 0 0"/><axis xyz="0 0 1"/>
     <limit effort="0" lower="-1.4" upper="1.4" velocity="0"/></joint>
   <gazebo><plugin filename="libuuv_fin_ros_plugin.so" name="fin0_model">
-    <liftdrag><type>TwoLines</type><area>0.04</area></liftdrag>
+    <liftdrag><type>TwoLines</type><area>0.04155</area><fluid_density>1027.0</fluid_density>
+      <a0>0.05</a0><alpha_stall>0.174533</alpha_stall><cla>13.98</cla><cla_stall>0.0</cla_stall>
+      <cda>0.0</cda><cda_stall></cda_stall></liftdrag>
     <joint_name>rexrov/fin0_joint</joint_name><link_name>rexrov/fin0</link_name>
   </plugin></gazebo>
 </robot>"""
@@ -76,9 +79,55 @@ def test_a_uuv_fin_joint_is_held_fixed_and_its_lift_reported_not_mapped(tmp_path
     out = tmp_path / "out.urdf"
     result = import_model(source, out)
     (note,) = [n for n in result.not_mapped if "fin joint 'rexrov/fin0_joint'" in n]
-    assert "written fixed at 0" in note and "<liftdrag> TwoLines) not mapped" in note
+    assert "written fixed at 0" in note
     uvms = load_uvms(out, water_density_kg_m3=1028.0, allow_dry_links=True)
     assert uvms.nv == 6  # the fin is no degree of freedom
+    (fin,) = uvms.fins
+    assert fin.name == "rexrov/fin0"
+
+
+def _uuv_two_lines(v, area, rho, cla, alpha_stall, a0):
+    """uuv_simulator's LiftDragTwoLines::compute for a flow in the fin's x-y plane (c_D = 0,
+    no slope beyond the stall), its steps as written there."""
+    vel = v.copy()
+    angle = math.atan2(v[1], v[0])
+    if angle > math.pi / 2:
+        angle, vel = angle - math.pi, -v
+    elif angle < -math.pi / 2:
+        angle, vel = angle + math.pi, -v
+    alpha = angle + a0
+    cl = cla * (alpha if abs(alpha) <= alpha_stall else math.copysign(alpha_stall, alpha))
+    lift = cl * 0.5 * rho * float(vel @ vel) * area
+    direction = -np.cross([0.0, 0.0, 1.0], v)
+    return lift * direction / np.linalg.norm(direction)
+
+
+def test_a_uuv_two_lines_fin_pushes_as_the_plugin_for_flows_in_its_plane(tmp_path):
+    """The fin's <lift_drag> against uuv_simulator's formula, for flows in the fin's x-y
+    plane (no sweep) above 0.01 m/s, from ahead and from behind, below and beyond the stall."""
+    from uvms_pin.hydro.lift_drag import lift_drag_wrench
+
+    source = _source(tmp_path, REXROV.read_text().replace("</robot>", FIN, 1))
+    out = tmp_path / "out.urdf"
+    import_model(source, out)
+    (fin,) = load_uvms(out, water_density_kg_m3=1028.0, allow_dry_links=True).fins
+    rng = np.random.default_rng(4)
+    for k in range(200):
+        angle = rng.uniform(-0.6, 0.6) + (math.pi if k % 2 else 0.0)
+        v = rng.uniform(0.05, 3.0) * np.array([math.cos(angle), math.sin(angle), 0.0])
+        ours, _ = lift_drag_wrench(fin.params, np.eye(3), v)
+        theirs = _uuv_two_lines(v, 0.04155, 1027.0, 13.98, 0.174533, 0.05)
+        np.testing.assert_allclose(ours, theirs, rtol=1e-5, atol=1e-9)
+
+
+def test_a_uuv_fin_of_the_quadratic_model_is_reported_not_mapped(tmp_path):
+    quadratic = FIN.replace("<type>TwoLines</type>", "<type>Quadratic</type>")
+    source = _source(tmp_path, REXROV.read_text().replace("</robot>", quadratic, 1))
+    result = import_model(source)
+    assert any(
+        "<liftdrag> type 'Quadratic'; its lift and drag not mapped" in n for n in result.not_mapped
+    )
+    assert "<lift_drag>" not in result.urdf_text.split("-->", 1)[1]
 
 
 @pytest.mark.parametrize("balance", [False, True])

@@ -8,6 +8,20 @@ missing ``air_density`` (1.2041 kg/m^3: air) is reported. gz-sim applies the for
 taken from the link's origin (``LiftDrag.cc``: the world wrench at the link origin with the
 torque cp x F), and so does uvms-pin. Source: gz-sim (github.com/gazebosim/gz-sim, commit
 93bbf3e), ``src/systems/lift_drag/LiftDrag.cc``.
+
+uuv_simulator's Fin plugin with its ``<liftdrag>`` of type ``TwoLines`` (uuv_gazebo_plugins,
+``FinPlugin.cc``, ``LiftDragModel.cc``) becomes the same element: it takes the fin link's
+velocity through the water in the link's x-y plane, the angle of attack from x toward y,
+lift along -z x v and drag along -v, both c q S with c_L = c_La alpha and c_D = c_Da alpha
+below the stall and the stall slopes beyond, at the link's centre of mass (ODE's
+``dBodyAddRelForce``); gz-sim's LiftDrag with forward = x, upward = -y, ``reversible`` (uuv
+folds a flow from behind onto the chord) and the centre of pressure at the link's inertial
+origin is that (tests/model/importer/test_import_inertia_fins.py compares the two for flows
+in the plane). What differs, said in the notes: gz-sim scales the coefficients by
+cos^2 of the sweep (uuv does not) and applies no force below 0.01 m/s; beyond the negative
+stall uuv's c_L takes the drag's stall slope, and its c_D changes sign with alpha (a fin that
+pushes): uvms-pin keeps gz-sim's (the lift's slope, |c_D|). ``Quadratic`` (c_D in alpha^2) is
+no LiftDrag: reported as not mapped.
 """
 
 from __future__ import annotations
@@ -16,7 +30,7 @@ import xml.etree.ElementTree as ET
 
 from uvms_pin.errors import ModelError
 from uvms_pin.model.importer.plugins import PluginKind, plugin_kind
-from uvms_pin.model.importer.xml import child_numbers, child_text
+from uvms_pin.model.importer.xml import child_numbers, child_text, element_numbers
 from uvms_pin.model.urdf.lift_drag import FLAGS, NUMBERS, VECTORS
 
 __all__ = ["add_fins"]
@@ -30,11 +44,15 @@ _CONTROL = {"control_joint_name", "control_joint_rad_to_cl", "cm_delta"}
 
 
 def add_fins(robot: ET.Element, plugins: list[ET.Element], where: str, notes: list[str]) -> int:
-    """A ``<lift_drag>`` in the link of each LiftDrag plugin; the number of fins added."""
+    """A ``<lift_drag>`` in the link of each LiftDrag plugin and each uuv_simulator fin of
+    the TwoLines model; the number of fins added."""
     links = {link.get("name"): link for link in robot.findall("link")}
     moving = {j.get("name") for j in robot.findall("joint") if j.get("type") != "fixed"}
     count = 0
     for plugin in plugins:
+        if plugin_kind(plugin) is PluginKind.UUV_FIN:
+            count += _uuv_fin(plugin, links, where, notes)
+            continue
         if plugin_kind(plugin) is not PluginKind.GZ_LIFT_DRAG:
             continue
         name = child_text(plugin, "link_name")
@@ -85,3 +103,43 @@ def _element(
             if value is not None:
                 control.set(attribute, repr(float(value[0])))
     return out
+
+
+#: uuv's TwoLines parameters -> the <lift_drag> child's (empty text: 0, as the plugin reads it)
+_UUV_NUMBERS = {
+    "area": "area", "fluid_density": "fluid_density", "a0": "a0", "alpha_stall": "alpha_stall",
+    "cla": "cla", "cla_stall": "cla_stall", "cda": "cda", "cda_stall": "cda_stall",
+}  # fmt: skip
+
+
+def _uuv_fin(plugin: ET.Element, links: dict[str, ET.Element], where: str, notes: list[str]) -> int:
+    """uuv_simulator's fin ``plugin`` as a ``<lift_drag>`` in its link (1), or a note (0)."""
+    name = child_text(plugin, "link_name")
+    model = plugin.find("liftdrag")
+    kind = None if model is None else child_text(model, "type")
+    if name not in links or model is None or kind != "TwoLines":
+        why = "no link of the model" if name not in links else f"<liftdrag> type {kind!r}"
+        notes.append(f"fin plugin '{plugin.get('name')}': {why}; its lift and drag not mapped")
+        return 0
+    out = ET.Element("lift_drag")
+    for tag, ours in _UUV_NUMBERS.items():
+        element = model.find(tag)
+        if element is None:
+            continue
+        # an empty value is 0 to the plugin (ECA A9's <cda_stall></cda_stall>)
+        empty = not (element.text or "").strip()
+        value = 0.0 if empty else float(element_numbers(element, (1,), where, name)[0])
+        ET.SubElement(out, ours, value=repr(value))
+    origin = links[name].find("inertial/origin")
+    centre = "0 0 0" if origin is None else (origin.get("xyz") or "0 0 0")
+    ET.SubElement(out, "cp", xyz=centre)
+    ET.SubElement(out, "forward", xyz="1 0 0")
+    ET.SubElement(out, "upward", xyz="0 -1 0")
+    ET.SubElement(out, "reversible", value="true")
+    links[name].append(out)
+    notes.append(
+        f"fin '{name}': uuv_simulator's TwoLines lift and drag as a <lift_drag> (gz-sim's "
+        "model: coefficients scaled by cos^2 of the sweep, none below 0.01 m/s, beyond the "
+        "negative stall the lift's slope and |c_D|, where uuv differs)"
+    )
+    return 1

@@ -89,11 +89,10 @@ def hold_uuv_fins(robot: ET.Element, fins: list[ET.Element], notes: list[str]) -
     """uuv_simulator's Fin plugins (``fins``): each sets its joint to the commanded angle
     itself (first-order toward it; 0 without a command), so the joint is no degree of freedom
     of the dynamics: written fixed at 0 (a free fin link of no inertia would make the mass
-    matrix singular). Their lift and drag are not mapped (said in ``notes``)."""
+    matrix singular), said in ``notes``. Their lift and drag: `add_fins`."""
     joints = {j.get("name"): j for j in robot.findall("joint")}
     for plugin in fins:
         name = (plugin.findtext("joint_name") or "").strip()
-        kind = (plugin.findtext("liftdrag/type") or "?").strip()
         joint = joints.get(name)
         if joint is None:
             notes.append(f"fin plugin '{plugin.get('name')}': no joint {name!r} in the model")
@@ -102,5 +101,5 @@ def hold_uuv_fins(robot: ET.Element, fins: list[ET.Element], notes: list[str]) -
             make_fixed(joint)
         notes.append(
             f"fin joint '{name}': uuv_simulator's Fin plugin sets its angle (0 without a "
-            f"command): written fixed at 0; its lift and drag (<liftdrag> {kind}) not mapped"
+            "command): written fixed at 0, the fin's deflection not commandable"
         )
