@@ -271,6 +271,14 @@ def test_your_metric_raising_is_an_error_row_that_keeps_the_built_in_metrics(tmp
     assert "broken_study_metrics.py" in row["traceback"]
     assert row["simulated_time_s"] > 0.0 and math.isfinite(row["force_error_rms_N"])
     assert (tmp_path / "rollouts" / run.run_id / "rollout.npz").is_file()
+    # a run that ends in a funnel violation (3x the buoyancy breaks the heave funnel) keeps
+    # that status, and says your metric failed too
+    buoyant = next(r for r in study.runs() if r.values["plant.buoyancy_scale"] == 3.0)
+    row = execute_run(str(study.base), buoyant)
+    assert row["status"] == "FunnelViolation", row["error"]
+    assert (
+        "funnel violated" in row["error"] and "broken_study_metrics:broken' raised" in row["error"]
+    )
 
 
 def test_runs_executed_together_on_threads_give_the_rows_of_each_alone(tmp_path, serial_table):

@@ -143,6 +143,8 @@ def _outcome_into(row: dict[str, Any], outcome, run: Run, rollout_dir: str | Non
         failures += [failure] if failure is not None else []
     if failures and exc is None:
         _failed(row, failures[0])
+    elif failures:  # the run's own ending stays its status; your metric's failure is said too
+        row["error"] = f"{row.get('error') or ''}; {failures[0]}".lstrip("; ")
     if rollout is not None and rollout_dir is not None:
         try:
             rollout.save(Path(rollout_dir) / run.run_id)
