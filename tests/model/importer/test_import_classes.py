@@ -74,3 +74,26 @@ def test_a_file_without_hydrodynamics_is_refused_unless_asked_for(tmp_path):
     assert (
         "link 'hull': no hydrodynamics in the source; written dry (volume 0)" in result.not_mapped
     )
+
+
+def test_notes_saying_the_same_of_several_names_are_said_once_naming_them_all():
+    from uvms_pin.model.importer.result import ImportResult
+
+    notes = [
+        "joint 'a/j1': revolute with limits 0 to 0 cannot move; written as a fixed joint",
+        "link 'base': <box> not mapped (no uvms-pin counterpart)",
+        "joint 'a/j2': revolute with limits 0 to 0 cannot move; written as a fixed joint",
+        "plugin 'imu' not mapped",
+        "plugin 'gps' not mapped",
+        "link 'x': no hydrodynamics in the source; written dry (volume 0)",
+        "fluid density stated twice",
+    ]
+    result = ImportResult("", {}, [], None, notes)
+    assert result.grouped_notes() == [
+        "joints 'a/j1', 'a/j2': revolute with limits 0 to 0 cannot move; written as a fixed joint",
+        "link 'base': <box> not mapped (no uvms-pin counterpart)",
+        "plugins 'imu', 'gps': not mapped",
+        "link 'x': no hydrodynamics in the source; written dry (volume 0)",
+        "fluid density stated twice",
+    ]
+    assert result.not_mapped == notes  # the URDF keeps each one

@@ -152,7 +152,7 @@ def _cmd_import(args: argparse.Namespace) -> int:
         print(
             f"fluid density in the source: {result.fluid_density_kg_m3:g} kg/m^3 ([water] density_kg_m3)"
         )
-    for note in result.not_mapped:
+    for note in result.grouped_notes():  # the URDF's header comment has each one
         print(f"not mapped: {note}")
     return 0
 

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import re
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -55,3 +56,25 @@ class ImportResult:
     fluid_density_kg_m3: float | None
     not_mapped: list[str] = field(default_factory=list)
     source_format: str = "urdf"
+
+    def grouped_notes(self) -> list[str]:
+        """`not_mapped` with the notes that say the same of several links, joints or plugins
+        said once, naming them all (``links 'a', 'b': no hydrodynamics in the source; ...``),
+        in the order of their first; what a terminal shows (the URDF keeps every note)."""
+        groups: dict[tuple[str, str], list[tuple[str, str]]] = {}
+        for note in self.not_mapped:
+            found = _NAMED.match(note)
+            key = (found["kind"], found["rest"]) if found else ("", note)
+            groups.setdefault(key, []).append((found["name"] if found else "", note))
+        out = []
+        for (kind, rest), members in groups.items():
+            if len(members) == 1:
+                out.append(members[0][1])
+            else:
+                names = ", ".join(repr(name) for name, _ in members)
+                out.append(f"{kind}s {names}: {rest}")
+        return out
+
+
+# a note about one link, joint or plugin: "link 'name': what", "plugin 'name' not mapped"
+_NAMED = re.compile(r"^(?P<kind>link|joint|plugin) '(?P<name>[^']+)':? (?P<rest>.*)$", re.S)
