@@ -152,3 +152,20 @@ def test_stopping_compare_arms_on_two_processes_stops_its_workers_without_a_trac
         for pid in workers:
             with pytest.raises(ProcessLookupError):
                 os.kill(pid, 0)
+
+
+def test_a_metric_of_your_own_that_fails_does_not_make_the_arm_a_model_error(tmp_path):
+    """The table's columns are built-in metrics: the arm runs and is tabulated; with
+    --keep-rollouts its outputs are written and its reason says your metric failed."""
+    (tmp_path / "arm_metrics_broken.py").write_text(
+        "def boom(rollout):\n    raise ValueError('x')\n"
+    )
+    scenario = tmp_path / "s.toml"
+    scenario.write_text(SCENARIO.read_text() + '\n[metrics]\nextra = ["arm_metrics_broken:boom"]\n')
+    settings = CompareSettings(duration_s=0.1, keep_rollouts=True)
+    (row,) = compare_arms(scenario, ["reference"], tmp_path / "out", settings)
+    assert row["status"] == "ok", row["reason"]
+    assert row["simulated_time_s"] == pytest.approx(0.1)
+    assert "metric 'arm_metrics_broken:boom' raised ValueError: x" in row["reason"]
+    saved = json.loads((tmp_path / "out" / "reference" / "metrics.json").read_text())
+    assert "raised ValueError" in saved["extra_metrics_error"]

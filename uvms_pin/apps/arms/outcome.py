@@ -15,6 +15,7 @@ import numpy as np
 
 from uvms_pin.errors import FunnelViolation, SimulationError
 from uvms_pin.model.uvms import UVMS
+from uvms_pin.results.metrics import compute_metrics
 from uvms_pin.sim.run import Scenario, simulate
 
 #: The rollout metrics a row keeps (NaN for one the rollout does not have).
@@ -65,11 +66,16 @@ def run_scenario(
         reason = f"{limits}; {reason}" if reason else limits
         if status == "ok":
             status = "joint limits"
-    metrics = rollout.metrics()
+    # the row's columns are built-in metrics: a metric of your own that fails does not
+    # make the arm a model error (nor is it computed for nothing)
+    metrics = compute_metrics(rollout, extra=False)
     for key in METRICS:
         row[key] = float(metrics.get(key, math.nan))
     row["status"], row["reason"] = status, reason
     if keep_dir is not None:
-        from uvms_pin.apps.outputs import write_outputs
+        from uvms_pin.apps.outputs import write_figures, write_results
 
-        write_outputs(rollout, keep_dir)
+        failure = write_results(rollout, keep_dir)
+        write_figures(rollout, keep_dir)
+        if failure is not None:  # its metrics.json says so too
+            row["reason"] = f"{row['reason']}; {failure}".lstrip("; ")
