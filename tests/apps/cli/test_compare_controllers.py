@@ -250,3 +250,21 @@ def test_a_controller_that_cannot_start_is_a_row_and_the_others_are_still_compar
     assert "nan" not in result.stdout
     for name in ("controllers.md", "controllers_force.png", "controllers_metrics.png"):
         assert (out / name).is_file()
+
+
+def test_a_metric_of_your_own_that_fails_stops_no_tracking_comparison(tmp_path):
+    """A tracking row's columns are built-in metrics: your failing metric is not computed
+    for them (it stopped the whole comparison)."""
+    (tmp_path / "cmp_metrics_broken.py").write_text(
+        "def boom(rollout):\n    raise ValueError('x')\n"
+    )
+    scenario = tmp_path / "circle.toml"
+    circle = (ROOT / "scenarios" / "lbv150_ee_circle.toml").read_text()
+    scenario.write_text(circle + '\n[metrics]\nextra = ["cmp_metrics_broken:boom"]\n')
+    out = tmp_path / "cmp"
+    command = ["compare-controllers", str(scenario), "--out", str(out), "--no-figures",
+               "--controllers", "task_priority", "--set", "scenario.duration_s=0.2"]  # fmt: skip
+    result = run_cli_in_process(command, tmp_path)
+    assert result.returncode == 0, result.stderr
+    rows = list(csv.DictReader((out / "controllers.csv").open()))
+    assert [r["controller"] for r in rows] == ["task_priority"]
