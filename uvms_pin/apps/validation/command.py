@@ -17,7 +17,6 @@ from uvms_pin.apps.arguments import (
     positive,
     progress_printer,
 )
-from uvms_pin.apps.interrupts import InterruptGuard
 from uvms_pin.apps.validation.identify_arguments import (
     add_identify_arguments,
     check_identify_arguments,
@@ -33,7 +32,7 @@ def _cmd_validate_pool(args: argparse.Namespace) -> int:
     select_trials(args.data_dir, names)  # at once: the simulation code takes seconds to import
     from uvms_pin.apps.validation.run import run_pool_validation
 
-    with InterruptGuard(), claim(args.out, POOL_VALIDATION, overwrite=args.overwrite):
+    with claim(args.out, POOL_VALIDATION, overwrite=args.overwrite):
         result = run_pool_validation(
             args.data_dir,
             args.out,

@@ -39,7 +39,6 @@ from scipy.optimize import least_squares
 from scipy.spatial.transform import Rotation
 
 from uvms_pin.apps.arguments import progress_printer
-from uvms_pin.apps.interrupts import InterruptGuard
 from uvms_pin.apps.validation.identification import IDENTIFIED_VEHICLE, run_identification
 from uvms_pin.apps.validation.identify_arguments import (
     add_identify_arguments,
@@ -227,7 +226,7 @@ def run(args: argparse.Namespace) -> int:
     start = trial_uvms() if args.cob is None else with_cob(trial_uvms(), args.cob)
     if args.fit is None:
         return _quasi_static(args, start)
-    with InterruptGuard(), _claimed(args):
+    with _claimed(args):
         result = run_identification(
             args.data_dir,
             args.out,

@@ -358,9 +358,6 @@ class UvmsScene:
         """The end-effector position (the vehicle origin for a model without one) [m]."""
         return tip_position(self.uvms, self.data, q)
 
-    def _tip_after_kinematics(self) -> np.ndarray:
-        return _tip(self.uvms, self.data)
-
     def poses(self, frame: Frame) -> dict[str, Pose]:
         """Pose of every moving node (paths relative to the scene root) at one instant."""
         model, data = self.uvms.model, self.data
@@ -369,7 +366,7 @@ class UvmsScene:
         out: dict[str, Pose] = {}
         for group, geometry in self.geometry.items():
             out.update(body_poses(model, data, geometry, f"robot/{group}"))
-        tip = self._tip_after_kinematics()
+        tip = _tip(self.uvms, self.data)
         base = q[:3]
         if self.environment is not None and self.environment.kind == "spring":
             span = tip - self.environment.point_world_m

@@ -19,12 +19,15 @@ import xml.etree.ElementTree as ET
 import numpy as np
 
 from uvms_pin.errors import ModelError
-from uvms_pin.model.urdf.inertial import check_inertial, triangle_slack
+from uvms_pin.model.urdf.inertial import (
+    INERTIA_KEYS,
+    check_inertial,
+    inertia_matrix,
+    triangle_slack,
+)
 from uvms_pin.results.format import numbers_text
 
 __all__ = ["check_inertias"]
-
-_KEYS = ("ixx", "ixy", "ixz", "iyy", "iyz", "izz")
 
 
 def check_inertias(robot: ET.Element, where: str, notes: list[str], *, balance: bool) -> None:
@@ -42,9 +45,9 @@ def check_inertias(robot: ET.Element, where: str, notes: list[str], *, balance: 
         name = link.get("name", "?")
         inertia = inertial.find("inertia")
         matrix = _matrix(inertia) if inertia is not None else None
+        principal, axes = np.linalg.eigh(matrix) if matrix is not None else (None, None)
         # balanced only when that is all that is wrong (a negative moment is refused below)
-        if matrix is not None and triangle_slack(matrix) < 0.0 and _positive(matrix):
-            principal, axes = np.linalg.eigh(matrix)
+        if principal is not None and triangle_slack(principal) < 0.0 and principal[0] >= 0.0:
             shown = numbers_text(principal, 6, ", ")
             if not balance:
                 raise ModelError(
@@ -67,27 +70,18 @@ def check_inertias(robot: ET.Element, where: str, notes: list[str], *, balance: 
 
 
 def _matrix(inertia: ET.Element) -> np.ndarray | None:
-    """The 3x3 matrix of ``<inertia>``; None when an entry is missing or not a finite number
-    (the loader's check says which)."""
+    """The 3x3 matrix of ``<inertia>`` (`inertia_matrix`); None when an entry is missing, not
+    a finite number or a negative moment (the loader's check says which)."""
     try:
-        e = {key: float(inertia.get(key, "")) for key in _KEYS}
+        entries = {key: float(inertia.get(key, "")) for key in INERTIA_KEYS}
     except ValueError:
         return None
-    if not all(math.isfinite(value) for value in e.values()):
+    finite = all(math.isfinite(value) for value in entries.values())
+    if not finite or min(entries["ixx"], entries["iyy"], entries["izz"]) < 0.0:
         return None
-    return np.array(
-        [
-            [e["ixx"], e["ixy"], e["ixz"]],
-            [e["ixy"], e["iyy"], e["iyz"]],
-            [e["ixz"], e["iyz"], e["izz"]],
-        ]
-    )
-
-
-def _positive(matrix: np.ndarray) -> bool:
-    return bool(np.all(np.diag(matrix) >= 0.0) and np.linalg.eigvalsh(matrix)[0] >= 0.0)
+    return inertia_matrix(entries)
 
 
 def _write(inertia: ET.Element, matrix: np.ndarray) -> None:
-    for key, (row, col) in zip(_KEYS, ((0, 0), (0, 1), (0, 2), (1, 1), (1, 2), (2, 2)), strict=True):  # fmt: skip
+    for key, (row, col) in zip(INERTIA_KEYS, ((0, 0), (0, 1), (0, 2), (1, 1), (1, 2), (2, 2)), strict=True):  # fmt: skip
         inertia.set(key, repr(float(matrix[row, col])))

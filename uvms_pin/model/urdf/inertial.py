@@ -10,11 +10,13 @@ from uvms_pin.errors import ModelError
 from uvms_pin.model.urdf.read import read_numbers, read_origin, single
 from uvms_pin.results.format import numbers_text
 
-__all__ = ["check_inertial", "triangle_slack"]
+__all__ = ["INERTIA_KEYS", "check_inertial", "inertia_matrix", "triangle_slack"]
 
 # Relative slack of the inertia checks: URDF inertias are often printed with 3-4 digits,
 # and a flat plate (I3 = I1 + I2 exactly) must not fail on its rounding.
 _INERTIA_RELATIVE_TOLERANCE = 1e-3
+#: the attributes of ``<inertia>``
+INERTIA_KEYS = ("ixx", "ixy", "ixz", "iyy", "iyz", "izz")
 
 
 def check_inertial(inertial: ET.Element, where: str, link: str) -> float:
@@ -36,7 +38,7 @@ def check_inertial(inertial: ET.Element, where: str, link: str) -> float:
         raise ModelError("<inertial> has no <inertia>", path=where, link=link)
     entries = {
         key: float(read_numbers(inertia_el.get(key), 1, f"<inertia {key}>", where, link)[0])
-        for key in ("ixx", "ixy", "ixz", "iyy", "iyz", "izz")
+        for key in INERTIA_KEYS
     }
     _check_rotational_inertia(entries, mass, where, link)
     return mass
@@ -50,13 +52,7 @@ def _check_rotational_inertia(entries: dict[str, float], mass_kg: float, where: 
     I1 + I2 >= I3 (I1 + I2 - I3 = 2 sum m_k z_k^2 in the principal frame), and I = 0 when
     the mass is zero. Negative diagonal entries are refused outright.
     """
-    matrix = np.array(
-        [
-            [entries["ixx"], entries["ixy"], entries["ixz"]],
-            [entries["ixy"], entries["iyy"], entries["iyz"]],
-            [entries["ixz"], entries["iyz"], entries["izz"]],
-        ]
-    )
+    matrix = inertia_matrix(entries)
     principal = np.linalg.eigvalsh(matrix)
     scale = float(np.max(np.abs(principal)))
     if scale == 0.0:
@@ -76,7 +72,7 @@ def _check_rotational_inertia(entries: dict[str, float], mass_kg: float, where: 
             path=where,
             link=link,
         )
-    if triangle_slack(matrix) < 0.0:
+    if triangle_slack(principal) < 0.0:
         raise ModelError(
             f"inertia violates the triangle inequality I1 + I2 >= I3: principal moments "
             f"{moments} kg m^2 (no mass distribution has them)",
@@ -85,9 +81,22 @@ def _check_rotational_inertia(entries: dict[str, float], mass_kg: float, where: 
         )
 
 
-def triangle_slack(matrix: np.ndarray) -> float:
-    """I1 + I2 - I3 (1 - tolerance) of the principal moments I1 <= I2 <= I3 of a rotational
-    inertia [kg m^2]: negative when it breaks the triangle inequality by more than the
-    rounding of a printed inertia (a flat plate's I1 + I2 = I3 passes)."""
-    principal = np.linalg.eigvalsh(matrix)
+def inertia_matrix(entries: dict[str, float]) -> np.ndarray:
+    """The symmetric 3x3 rotational inertia [kg m^2] of ``<inertia>``'s entries
+    (`INERTIA_KEYS`)."""
+    e = entries
+    return np.array(
+        [
+            [e["ixx"], e["ixy"], e["ixz"]],
+            [e["ixy"], e["iyy"], e["iyz"]],
+            [e["ixz"], e["iyz"], e["izz"]],
+        ]
+    )
+
+
+def triangle_slack(principal: np.ndarray) -> float:
+    """I1 + I2 - I3 (1 - tolerance) of a rotational inertia's principal moments I1 <= I2 <= I3
+    [kg m^2] (``np.linalg.eigvalsh``'s order): negative when it breaks the triangle
+    inequality by more than the rounding of a printed inertia (a flat plate's I1 + I2 = I3
+    passes)."""
     return float(principal[0] + principal[1] - principal[2] * (1.0 - _INERTIA_RELATIVE_TOLERANCE))
