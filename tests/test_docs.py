@@ -3,9 +3,12 @@ outside the repository."""
 
 from __future__ import annotations
 
+import inspect
 import re
+from functools import cache
 from pathlib import Path
 
+import numpy as np
 import pytest
 from conftest import ROOT
 
@@ -305,25 +308,35 @@ _READERS = (
 )
 
 
-def scenario_keys_read() -> set[str]:
+#: the readers that take a ``default`` (the value a key absent from the file takes)
+_DEFAULTED = ("number", "integer", "string", "boolean", "vector", "seed")
+
+
+@cache
+def scenario_reads() -> dict[str, set]:
     """Every dotted key the scenario reader asks for while loading the variants
-    (``actuation.thruster[i].name`` for entries of an array of tables)."""
-    seen: set[str] = set()
+    (``actuation.thruster[i].name`` for entries of an array of tables), with the defaults it
+    was read with (None: required; none recorded for a reader that takes no default)."""
+    seen: dict[str, set] = {}
     table_class = Table
-    originals = {name: getattr(table_class, name) for name in _READERS}
+    originals = {name: getattr(table_class, name) for name in (*_READERS, "seed")}
 
     def recording(name):
         original = originals[name]
+        signature = inspect.signature(original)
 
         def method(self, key, *args, **kwargs):
             where = re.sub(r"\[\d+\]", "[i]", self.where)
-            seen.add(f"{where}.{key}" if where else key)
+            defaults = seen.setdefault(f"{where}.{key}" if where else key, set())
+            if name in _DEFAULTED:
+                default = signature.bind(self, key, *args, **kwargs).arguments.get("default")
+                defaults.add(_hashable(default))
             return original(self, key, *args, **kwargs)
 
         return method
 
     with pytest.MonkeyPatch.context() as patch:
-        for name in _READERS:
+        for name in originals:
             patch.setattr(table_class, name, recording(name))
         for file, overrides, *replace in _VARIANTS:
             if replace:
@@ -332,6 +345,18 @@ def scenario_keys_read() -> set[str]:
             else:
                 load_scenario(SCENARIOS / file, overrides)
     return seen
+
+
+def _hashable(value):
+    """A default as a set holds it: a vector as a tuple of floats."""
+    if isinstance(value, (list, tuple, np.ndarray)):
+        return tuple(float(v) for v in value)
+    return value
+
+
+def scenario_keys_read() -> set[str]:
+    """Every dotted key the scenario reader asks for while loading the variants."""
+    return set(scenario_reads())
 
 
 def _documented_rows(text: str) -> set[str]:
@@ -352,6 +377,187 @@ def test_scenarios_doc_lists_no_key_the_reader_does_not_know():
     assert rows, "no key table found in docs/scenarios.md"
     unknown = sorted(rows - scenario_keys_read())
     assert not unknown, f"docs/scenarios.md documents keys the reader never reads: {unknown}"
+
+
+def _literal(text: str):
+    """A table's default as a value (a number, true/false, "a string", [numbers]); None
+    for a default said in words ("the model's", "none", ...)."""
+    text = text.strip()
+    if re.fullmatch(r"-?\d+(\.\d*)?(e-?\d+)?", text):
+        return float(text)
+    if text in ("true", "false"):
+        return text == "true"
+    if re.fullmatch(r'"[^"<>]*"', text):  # not "thruster<i>": a pattern
+        return text[1:-1]
+    if re.fullmatch(r"\[[-\d., e]+\]", text):
+        return tuple(float(v) for v in text[1:-1].split(","))
+    return None
+
+
+def _documented_defaults(text: str) -> list[tuple[str, str, str]]:
+    """(key, its default, its meaning) of each row ``| `key` | type | default | meaning |``;
+    a row of several keys, ``| `a`, `b` | ... | 1.0, 0.1 | ... |``, gives each its own when
+    the counts agree."""
+    found = []
+    for line in text.splitlines():
+        cells = [c.strip() for c in line.strip().strip("|").split("|")]
+        if not line.startswith("| `") or len(cells) < 4:
+            continue
+        keys = re.findall(r"`([\w.\[\]]+)`", cells[0])
+        values = cells[2].split(", ") if len(keys) > 1 else [cells[2]]
+        if len(values) == len(keys):
+            found += [
+                (key, value, "|".join(cells[3:])) for key, value in zip(keys, values, strict=True)
+            ]
+    return found
+
+
+def _controller_parameter_defaults() -> dict[str, set]:
+    """``controller.<name>`` -> the defaults of the controllers' parameters (their records'
+    fields, their constructors' keywords: the PPC's, the baselines', the tracking laws'),
+    which a ``[controller]`` table fills."""
+    import importlib
+    import pkgutil
+
+    import uvms_pin.control as control
+
+    out: dict[str, set] = {}
+    for info in pkgutil.walk_packages(control.__path__, "uvms_pin.control."):
+        for value in vars(importlib.import_module(info.name)).values():
+            if not isinstance(value, type) or not value.__module__.startswith("uvms_pin."):
+                continue
+            for name, parameter in inspect.signature(value.__init__).parameters.items():
+                if parameter.default not in (inspect.Parameter.empty, None):
+                    out.setdefault(f"controller.{name}", set()).add(_hashable(parameter.default))
+    return out
+
+
+def test_every_default_docs_scenarios_gives_is_the_one_the_reader_takes():
+    """A key absent from the file takes the default its row says. Each literal default in
+    docs/scenarios.md is one the code gives the key (the reader's, or the controller's that
+    the ``[controller]`` table fills); each default the reader gives is one the key's rows
+    say (their default column, or "default N" in their meaning, as a key read by several
+    controllers is documented); a key said to be "required" is read without one."""
+    reads, records = scenario_reads(), _controller_parameter_defaults()
+    rows = _documented_defaults((DOCS / "scenarios.md").read_text())
+    said: dict[str, list] = {}
+    for key, text, meaning in rows:
+        short = re.escape(key.rsplit(".", 1)[-1])
+        mentions = re.findall(rf"(?:^|[^`\w]|`{short}` )default (-?\d+(?:\.\d+)?)", meaning)
+        for other, _, elsewhere in rows:  # "`k_zeta` default 10" in another key's row
+            if other != key:
+                mentions += re.findall(rf"`{short}` default (-?\d+(?:\.\d+)?)", elsewhere)
+        said.setdefault(key, []).extend(
+            v for v in (_literal(text), *map(float, mentions)) if v is not None
+        )
+    checked, wrong = 0, []
+    for key, text, _ in rows:
+        read = {d for d in reads.get(key, ()) if d is not None}
+        if text == "required":
+            if read and None not in reads[key]:
+                wrong.append(f"{key}: documented as required, read with default {read}")
+            continue
+        documented, given = _literal(text), read | records.get(key, set())
+        if documented is not None and given:
+            checked += 1
+            if not any(_same_default(documented, d) for d in given):
+                wrong.append(
+                    f"{key}: documented default {text}, the code's {sorted(given, key=str)}"
+                )
+    for key, values in said.items():
+        if not values:
+            continue  # said in words ("the model's", "the file name")
+        for default in {d for d in reads.get(key, ()) if d is not None}:
+            checked += 1
+            if not any(_same_default(v, default) for v in values):
+                wrong.append(f"{key}: the reader's default {default}, documented {values}")
+    assert checked >= 200, f"only {checked} documented defaults compared"
+    assert not wrong, "docs/scenarios.md and the code disagree:\n" + "\n".join(wrong)
+
+
+def _same_default(documented, read) -> bool:
+    if isinstance(documented, bool) or isinstance(read, bool):
+        return documented is read
+    if isinstance(documented, str) or isinstance(read, str):
+        return documented == read
+    if isinstance(documented, float) and isinstance(read, tuple):
+        documented = (documented,) * len(read)  # one number for every entry of a vector
+    if isinstance(documented, tuple) != isinstance(read, tuple):
+        return False
+    documented, read = np.atleast_1d(documented), np.atleast_1d(read)
+    # the table's digits: pi / 6 is documented as 0.5236
+    return documented.shape == read.shape and np.allclose(documented, read, rtol=1e-4, atol=0)
+
+
+def _sensor_tables(text: str) -> dict[str, list[tuple[list[str], str, str]]]:
+    """Section title -> its key table's rows (keys, default column, meaning column)."""
+    tables: dict[str, list] = {}
+    section = ""
+    for line in text.splitlines():
+        if line.startswith("## "):
+            section = line[3:].strip()
+        cells = [c.strip() for c in line.strip().strip("|").split("|")]
+        if line.startswith("| `") and len(cells) >= 4:
+            keys = re.findall(r"`(\w+)`", cells[0])
+            tables.setdefault(section, []).append((keys, cells[2], cells[3]))
+    return tables
+
+
+def _agrees(default, text: str) -> bool | None:
+    """Whether a field's ``default`` is the documented ``text`` (None: said in words)."""
+    text = text.strip()
+    if isinstance(default, bool):
+        return (text == str(default).lower()) if text in ("true", "false") else None
+    if isinstance(default, str):
+        return text == default
+    number = _literal(text)
+    if isinstance(default, (int, float)) and isinstance(number, float):
+        return float(default) == number
+    if isinstance(default, tuple) and all(isinstance(v, (int, float)) for v in default):
+        if isinstance(number, float):
+            return all(v == number for v in default)
+        if isinstance(number, tuple):
+            return number == tuple(float(v) for v in default)
+    return None
+
+
+def test_the_sensor_tables_in_docs_sensors_give_the_specs_defaults():
+    """docs/sensors.md's camera, sonar and light keys: each is a field of its spec, and each
+    default said as a value is the field's default."""
+    from dataclasses import MISSING, fields
+
+    from uvms_pin.perception.camera import CameraSpec
+    from uvms_pin.perception.optics import Light
+    from uvms_pin.perception.sonar import SonarSpec
+
+    defaults = {
+        spec: {f.name: f.default for f in fields(spec) if f.default is not MISSING}
+        for spec in (CameraSpec, SonarSpec, Light)
+    }
+    tables = _sensor_tables((DOCS / "sensors.md").read_text())
+    checked, wrong = 0, []
+
+    def compare(spec, key: str, text: str) -> None:
+        nonlocal checked
+        if key not in {f.name for f in fields(spec)}:
+            wrong.append(f"{spec.__name__}: documented key {key} is not a field")
+            return
+        verdict = _agrees(defaults[spec].get(key), text)
+        checked += verdict is not None
+        if verdict is False:
+            wrong.append(f"{spec.__name__}.{key}: documented {text}, {defaults[spec][key]!r}")
+
+    for section, spec in (("Camera", CameraSpec), ("Sonar", SonarSpec)):
+        assert section in tables, f"no key table under '## {section}'"
+        for keys, default, meaning in tables[section]:
+            values = default.split(", ") if len(keys) > 1 else [default]
+            for k, key in enumerate(keys):
+                compare(spec, key, values[k] if len(values) == len(keys) else "")
+            if keys == ["lights"]:  # the lights' keys, their defaults in parentheses
+                for key, text in re.findall(r"`(\w+)` \(([-\d.]+)\)", meaning):
+                    compare(Light, key, text)
+    assert checked >= 25, f"only {checked} documented defaults compared"
+    assert not wrong, "docs/sensors.md and the specs disagree:\n" + "\n".join(wrong)
 
 
 def test_studies_doc_names_every_factor_distribution_and_mode():
