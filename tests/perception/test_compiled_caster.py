@@ -461,3 +461,71 @@ def test_an_output_of_another_dtype_is_refused_not_written_into_a_copy():
         compiled._core.cast(
             np.zeros(3), np.eye(3), d, np.empty(4), np.empty((4, 3)), np.empty(4, dtype=np.int64)
         )
+
+
+def _depth(kind: str, size: np.ndarray, point: np.ndarray) -> float:
+    """How far inside the solid of ``size`` the ``point`` (its frame) is, by the solid's
+    own equations: < 1 inside, > 1 outside (a sphere's radius, an ellipsoid's semi-axes, a
+    box's half-extents, a cylinder's radius and half-length)."""
+    if kind in ("sphere", "ellipsoid"):
+        return float(np.linalg.norm(point / size))
+    if kind == "box":
+        return float(np.max(np.abs(point) / size))
+    return max(math.hypot(point[0], point[1]) / size[0], abs(point[2]) / size[2])
+
+
+def _solid(kind: str, rng: np.random.Generator):
+    """(shape, a point inside it (its rays are cast toward it), a membership test of its
+    frame's points: < 1 inside, > 1 outside, and half its extents about that point)."""
+    if kind == "hull":  # by scipy's Delaunay of its points, grown and shrunk 1 %
+        from scipy.spatial import Delaunay
+
+        points = rng.normal(scale=0.5, size=(12, 3))
+        centre = points.mean(axis=0)
+        grown, shrunk = (Delaunay(centre + f * (points - centre)) for f in (1.01, 0.99))
+
+        def depth(p: np.ndarray) -> float:
+            return 0.0 if shrunk.find_simplex(p) >= 0 else 2.0 if grown.find_simplex(p) < 0 else 1.0
+
+        return convex_of_points(points), centre, depth, np.ptp(points, axis=0) / 2
+    size = {
+        "sphere": lambda: np.full(3, rng.uniform(0.2, 1.0)),
+        "ellipsoid": lambda: rng.uniform(0.1, 0.9, 3),
+        "box": lambda: rng.uniform(0.1, 0.8, 3),
+        "cylinder": lambda: np.array([*[rng.uniform(0.1, 0.6)] * 2, rng.uniform(0.1, 1.0)]),
+    }[kind]()
+    shape = {
+        "sphere": lambda: Sphere(size[0]),
+        "ellipsoid": lambda: Ellipsoid(tuple(size)),
+        "box": lambda: box(size),
+        "cylinder": lambda: Cylinder(size[0], 2.0 * size[2]),
+    }[kind]()
+    return shape, np.zeros(3), lambda p: _depth(kind, size, p), size
+
+
+@pytest.mark.parametrize("kind", ["sphere", "ellipsoid", "box", "cylinder", "hull"])
+def test_a_solid_is_seen_from_every_point_outside_it_and_from_none_inside(kind):
+    """From points all about a solid at a random pose (its end caps, corners and sides
+    included), a ray toward its centre meets it exactly when the point is outside it, in
+    both casters; the points within 1 % of its surface are left out (either side holds)."""
+    rng = np.random.default_rng(11)
+    shape, centre, depth, extent = _solid(kind, rng)
+    rotation = pin.rpy.rpyToMatrix(*rng.uniform(-math.pi, math.pi, 3))
+    position = rng.uniform(-1.0, 1.0, 3)
+    reference, compiled = RayCaster(), caster_for("core")
+    for caster in (reference, compiled):
+        caster.add(kind, shape, rotation, position)
+    sides = {True: 0, False: 0}
+    for local in centre + rng.uniform(-1.4, 1.4, (600, 3)) * extent:
+        inside = depth(local)
+        if abs(inside - 1.0) < 0.01:
+            continue
+        outside = inside > 1.0
+        sides[outside] += 1
+        origin = position + rotation @ local
+        toward = rotation @ (centre - local)
+        toward /= np.linalg.norm(toward)
+        for caster in (reference, compiled):
+            seen = caster.cast(origin, toward[None, :]).label[0] == 1
+            assert seen == outside, f"{type(caster).__name__} from {local} (its frame)"
+    assert min(sides.values()) > 40  # both sides sampled
