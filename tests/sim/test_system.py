@@ -183,3 +183,23 @@ def test_joint_limits_are_either_stops_or_constraints(reference_uvms):
             joint_stops=JointStops.of_model(reference_uvms.model),
             joint_limits=JointLimits.of_uvms(reference_uvms),
         )
+
+
+@pytest.mark.parametrize(
+    "name", ["push_object", "valve_panel", "surfacing", "object_recovery", "hot_stab"]
+)
+def test_the_columns_a_run_is_sized_for_are_the_columns_it_logs(name):
+    """`System.n_logged_columns` (what the memory check before a run counts) is exactly the
+    width of the world's signals a short run logs: the wet fractions, the contact pairs'
+    wrenches, the free objects' states and pairs, the fixtures' joints."""
+    period = load_scenario(ROOT / "scenarios" / f"{name}.toml").settings.log_period_s
+    scenario = load_scenario(
+        ROOT / "scenarios" / f"{name}.toml", {"scenario.duration_s": 2 * period}
+    )
+    system = System(scenario.plant)
+    rollout = up.simulate(scenario, progress=False)
+    world = {"wet_fraction", "world_contact", "free_objects", "free_object_contact"}
+    world |= {fixture.name for fixture in system.fixtures}
+    widths = {k: v.reshape(len(v), -1).shape[1] for k, v in rollout.signals.items() if k in world}
+    assert widths, f"{name} logs nothing of its world"
+    assert system.n_logged_columns == sum(widths.values()), widths
