@@ -285,3 +285,18 @@ def test_calc_diff_reuses_the_contact_of_calc_only_at_the_same_state(reference_u
     model.calcDiff(stale, x, u)
     for name in ("Fx", "Fu", "Lx", "Lu", "Lxx"):
         np.testing.assert_array_equal(getattr(stale, name), getattr(same, name), err_msg=name)
+
+
+def test_a_horizon_of_one_node_is_planned_and_one_of_none_refused(reference_uvms, ten_cm_move):
+    """round(horizon_s / dt_s) nodes: a horizon of one node is a problem of one running node
+    that solves (its one control moves the state as the simulator's step does); a horizon
+    below half a node holds none and is refused, naming both times."""
+    uvms, x0, target = reference_uvms, ten_cm_move.x0, ten_cm_move.target
+    problem = problems.point_to_point(uvms, x0, target, horizon_s=0.02, dt_s=0.02)
+    assert problem.T == 1
+    solver = problems.solve(problem, iterations=5, solver="fddp")
+    q0, v0 = x0[: uvms.nq], x0[uvms.nq :]
+    step = up.step_derivatives(uvms, q0, v0, solver.us[0], 0.02, step_s=0.02)
+    np.testing.assert_allclose(np.r_[step.q, step.v], solver.xs[1], atol=1e-8)
+    with pytest.raises(up.ParameterError, match=r"horizon_s 0.009 s holds no node of dt_s 0.02"):
+        problems.point_to_point(uvms, x0, target, horizon_s=0.009, dt_s=0.02)
