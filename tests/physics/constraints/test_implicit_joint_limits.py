@@ -189,3 +189,26 @@ def test_the_end_configuration_is_the_free_one_unless_rows_were_solved(alpha5):
     end = constrained_configuration(alpha5.model, q, q_free, stopped, PERIOD_S)
     np.testing.assert_allclose(end, pin.integrate(alpha5.model, q, PERIOD_S * stopped.velocity))
     assert alpha5.arm_joints.positions(end)[1] == pytest.approx(0.0, abs=1e-9)
+
+
+def test_a_limit_gets_a_row_within_its_reach_plus_the_1_mm_margin(alpha5):
+    """A limit's row is solved when its gap is at most h |v| + margin, the margin 1 mm (1e-3
+    rad) by default (docs/physics.md); a margin of 0 is allowed (the reach alone), a
+    negative one refused."""
+    model, data = alpha5.model, alpha5.model.createData()
+    joint = 2 + int(np.flatnonzero(alpha5.arm_joints.limited)[0])
+    at = model.joints[joint].idx_q
+    speed = np.zeros(model.nv)
+    speed[model.joints[joint].idx_v] = 0.5  # reaches h |v| = 1 mm in a period of 2 ms
+
+    def rows(gap_rad: float, margin: float | None = None) -> int:
+        q, _ = _start(alpha5)
+        q[at] = model.upperPositionLimit[at] - gap_rad
+        limits = JointLimits((joint,)) if margin is None else JointLimits((joint,), margin)
+        return limits.rows(model, data, q, speed, PERIOD_S).size
+
+    assert JointLimits((joint,)).margin == JointLimits.of_uvms(alpha5).margin == 1e-3
+    assert rows(1.9e-3) == 1 and rows(2.1e-3) == 0  # h |v| + 1 mm
+    assert rows(0.9e-3, margin=0.0) == 1 and rows(1.1e-3, margin=0.0) == 0
+    with pytest.raises(ParameterError, match="margin"):
+        JointLimits((joint,), margin=-1e-9)
