@@ -129,6 +129,18 @@ def test_a_falling_sphere_stops_on_the_plane_without_bouncing(ball):
     assert step.units["contacts"] == "N s"
 
 
+def test_a_sphere_on_no_body_of_the_model_is_refused_naming_it(ball):
+    """A contact sphere's joint must be a body of the model: not the universe (joint 0), not
+    past the last joint."""
+    model = ball
+    q, speed = pin.neutral(model), np.zeros(model.nv)
+    for joint_id in (0, model.njoints):
+        sphere = ContactSphere(joint_id, np.zeros(3), RADIUS_M)
+        contacts = PlaneContacts((sphere,), np.zeros(3), np.array([0.0, 0.0, 1.0]), MU)
+        with pytest.raises(ParameterError, match=f"contact sphere 0: no joint {joint_id}"):
+            contacts.rows(model, model.createData(), q, speed, PERIOD_S)
+
+
 def test_refusals():
     with pytest.raises(ParameterError, match="radius"):
         ContactSphere(2, np.zeros(3), -0.1)
