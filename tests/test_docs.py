@@ -394,21 +394,23 @@ def _literal(text: str):
     return None
 
 
-def _documented_defaults(text: str) -> list[tuple[str, str, str]]:
-    """(key, its default, its meaning) of each row ``| `key` | type | default | meaning |``;
-    a row of several keys, ``| `a`, `b` | ... | 1.0, 0.1 | ... |``, gives each its own when
-    the counts agree."""
-    found = []
+def _table_rows(text: str) -> list[tuple[str, str, str, str]]:
+    """(section, key, its default, its meaning) of each row ``| `key` | type | default |
+    meaning |`` under its ``## section``; a row of several keys, ``| `a`, `b` | ... | 1.0,
+    0.1 | ... |``, gives each its own default when the counts agree, else "" (unread)."""
+    found, section = [], ""
     for line in text.splitlines():
+        if line.startswith("## "):
+            section = line[3:].strip()
         cells = [c.strip() for c in line.strip().strip("|").split("|")]
         if not line.startswith("| `") or len(cells) < 4:
             continue
         keys = re.findall(r"`([\w.\[\]]+)`", cells[0])
         values = cells[2].split(", ") if len(keys) > 1 else [cells[2]]
-        if len(values) == len(keys):
-            found += [
-                (key, value, "|".join(cells[3:])) for key, value in zip(keys, values, strict=True)
-            ]
+        if len(values) != len(keys):
+            values = [""] * len(keys)
+        meaning = "|".join(cells[3:])
+        found += [(section, k, v, meaning) for k, v in zip(keys, values, strict=True)]
     return found
 
 
@@ -424,8 +426,8 @@ def _controller_parameter_defaults() -> dict[str, set]:
     out: dict[str, set] = {}
     for info in pkgutil.walk_packages(control.__path__, "uvms_pin.control."):
         for value in vars(importlib.import_module(info.name)).values():
-            if not isinstance(value, type) or not value.__module__.startswith("uvms_pin."):
-                continue
+            if not isinstance(value, type) or value.__module__ != info.name:
+                continue  # a class the module imports is read where it is defined
             for name, parameter in inspect.signature(value.__init__).parameters.items():
                 if parameter.default not in (inspect.Parameter.empty, None):
                     out.setdefault(f"controller.{name}", set()).add(_hashable(parameter.default))
@@ -439,7 +441,7 @@ def test_every_default_docs_scenarios_gives_is_the_one_the_reader_takes():
     say (their default column, or "default N" in their meaning, as a key read by several
     controllers is documented); a key said to be "required" is read without one."""
     reads, records = scenario_reads(), _controller_parameter_defaults()
-    rows = _documented_defaults((DOCS / "scenarios.md").read_text())
+    rows = [row[1:] for row in _table_rows((DOCS / "scenarios.md").read_text())]
     said: dict[str, list] = {}
     for key, text, meaning in rows:
         short = re.escape(key.rsplit(".", 1)[-1])
@@ -489,36 +491,15 @@ def _same_default(documented, read) -> bool:
     return documented.shape == read.shape and np.allclose(documented, read, rtol=1e-4, atol=0)
 
 
-def _sensor_tables(text: str) -> dict[str, list[tuple[list[str], str, str]]]:
-    """Section title -> its key table's rows (keys, default column, meaning column)."""
-    tables: dict[str, list] = {}
-    section = ""
-    for line in text.splitlines():
-        if line.startswith("## "):
-            section = line[3:].strip()
-        cells = [c.strip() for c in line.strip().strip("|").split("|")]
-        if line.startswith("| `") and len(cells) >= 4:
-            keys = re.findall(r"`(\w+)`", cells[0])
-            tables.setdefault(section, []).append((keys, cells[2], cells[3]))
-    return tables
-
-
 def _agrees(default, text: str) -> bool | None:
-    """Whether a field's ``default`` is the documented ``text`` (None: said in words)."""
-    text = text.strip()
-    if isinstance(default, bool):
-        return (text == str(default).lower()) if text in ("true", "false") else None
+    """Whether a field's ``default`` is the documented ``text`` (a bare word for a string
+    field; `_same_default` otherwise); None when the text says it in words."""
     if isinstance(default, str):
-        return text == default
-    number = _literal(text)
-    if isinstance(default, (int, float)) and isinstance(number, float):
-        return float(default) == number
-    if isinstance(default, tuple) and all(isinstance(v, (int, float)) for v in default):
-        if isinstance(number, float):
-            return all(v == number for v in default)
-        if isinstance(number, tuple):
-            return number == tuple(float(v) for v in default)
-    return None
+        return text.strip() == default
+    documented = _literal(text)
+    if documented is None or not isinstance(default, (bool, int, float, tuple)):
+        return None
+    return _same_default(documented, _hashable(default))
 
 
 def test_the_sensor_tables_in_docs_sensors_give_the_specs_defaults():
@@ -534,7 +515,7 @@ def test_the_sensor_tables_in_docs_sensors_give_the_specs_defaults():
         spec: {f.name: f.default for f in fields(spec) if f.default is not MISSING}
         for spec in (CameraSpec, SonarSpec, Light)
     }
-    tables = _sensor_tables((DOCS / "sensors.md").read_text())
+    rows = _table_rows((DOCS / "sensors.md").read_text())
     checked, wrong = 0, []
 
     def compare(spec, key: str, text: str) -> None:
@@ -548,14 +529,13 @@ def test_the_sensor_tables_in_docs_sensors_give_the_specs_defaults():
             wrong.append(f"{spec.__name__}.{key}: documented {text}, {defaults[spec][key]!r}")
 
     for section, spec in (("Camera", CameraSpec), ("Sonar", SonarSpec)):
-        assert section in tables, f"no key table under '## {section}'"
-        for keys, default, meaning in tables[section]:
-            values = default.split(", ") if len(keys) > 1 else [default]
-            for k, key in enumerate(keys):
-                compare(spec, key, values[k] if len(values) == len(keys) else "")
-            if keys == ["lights"]:  # the lights' keys, their defaults in parentheses
-                for key, text in re.findall(r"`(\w+)` \(([-\d.]+)\)", meaning):
-                    compare(Light, key, text)
+        table = [row[1:] for row in rows if row[0] == section]
+        assert table, f"no key table under '## {section}'"
+        for key, default, meaning in table:
+            compare(spec, key, default)
+            if key == "lights":  # the lights' keys, their defaults in parentheses
+                for light_key, text in re.findall(r"`(\w+)` \(([-\d.]+)\)", meaning):
+                    compare(Light, light_key, text)
     assert checked >= 25, f"only {checked} documented defaults compared"
     assert not wrong, "docs/sensors.md and the specs disagree:\n" + "\n".join(wrong)
 
