@@ -183,18 +183,20 @@ def _save(
             write_replay(rollout, out / "replay.html", show=args.show)
         guard.checkpoint()  # a Ctrl-C during the replay: the command says it stopped
         if metric_failure is not None:  # your metric's input error, the run kept
-            kept = ", ".join(_files_of_the_run(out))
-            return _files_of_the_run(out), Ending(
+            written = _files_of_the_run(out)
+            return written, Ending(
                 rollout,
                 EXIT_BAD_INPUT,
-                f"uvms-pin: error: {metric_failure}; kept in {out}: {kept} (metrics.json "
-                f"without your metrics: once fixed, Rollout.load('{out}').metrics())",
+                f"uvms-pin: error: {metric_failure}; kept in {out}: {', '.join(written)} "
+                f"(metrics.json without your metrics: once fixed, "
+                f"Rollout.load('{out}').metrics())",
                 metric_failure.user_traceback,
             )
     except KeyboardInterrupt as exc:
         status, stopped = stop_status(exc)
-        kept = ", ".join(_files_of_the_run(out)) or "nothing"
-        return _files_of_the_run(out), Ending(
+        written = _files_of_the_run(out)
+        kept = ", ".join(written) or "nothing"
+        return written, Ending(
             rollout, status, f"uvms-pin: {stopped} while saving; kept in {out}: {kept}"
         )
     except OSError as exc:  # a full disk, a directory removed meanwhile (ResourceError too)
