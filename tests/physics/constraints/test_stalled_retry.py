@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 from uvms_pin.physics.constraints import step
-from uvms_pin.physics.constraints.step import ANDERSON_CAPACITY, ConstrainedVelocity
+from uvms_pin.physics.constraints.step import ANDERSON_CAPACITY, ConstrainedVelocity, StalledSolves
 
 SPEED_M_S = 1.0  # the rows' largest speed: a stalled solve may keep 1e-4 m/s
 
@@ -62,3 +62,20 @@ def test_the_smaller_residual_is_kept_when_neither_is_accepted(solves):
     assert not out.accepted and out.residual == 3e-4 and out.iterations == 10000
     queue += [_result(6e-4, False, 5000), _result(3e-4, False, 5000)]
     assert _solve().residual == 3e-4
+
+
+def test_a_runs_stalled_solves_are_counted_with_the_worst_residual():
+    """`StalledSolves`: each accepted stalled solve counts once, the largest residual kept;
+    merged with the compiled system's count and worst; recorded as the run's metadata."""
+    stalled = StalledSolves()
+    assert stalled.record()["stalled"] == 0
+    for residual in (3e-6, 8e-5, 1e-6):
+        stalled.add(residual)
+    assert (stalled.count, stalled.worst_residual_m_s) == (3, 8e-5)
+    both = stalled.merged(2, 9e-5)
+    assert (both.count, both.worst_residual_m_s) == (5, 9e-5)
+    assert (stalled.count, stalled.worst_residual_m_s) == (3, 8e-5)  # not changed
+    assert stalled.merged(4, 1e-7).worst_residual_m_s == 8e-5
+    record = stalled.record()
+    assert (record["stalled"], record["worst_stalled_residual_m_s"]) == (3, 8e-5)
+    assert "m/s" in record["acceptable_residual"]

@@ -82,3 +82,17 @@ def test_each_spec_entry_drives_its_own_channel_and_term():
     steps = np.diff(accel, axis=0)
     assert np.std(steps) == pytest.approx(K * 10 * math.sqrt(dt), rel=0.1)
     assert np.abs(accel[-1]).max() > 0.0
+
+
+def test_allan_deviation_takes_every_cluster_time_from_one_sample_to_half_the_record():
+    """tau from dt (clusters of one sample: white noise of density N reads N / sqrt(dt), 5 %)
+    to the longest with two whole clusters and one more sample (2 tau/dt < n); outside that
+    range, refused naming tau."""
+    dt = 0.01
+    channel = NoisyChannel(N, 0.0, np.random.default_rng(11))
+    record = channel.record(np.zeros((20_000, 3)), dt)[:, 0]
+    assert allan_deviation(record, dt, dt) == pytest.approx(N / math.sqrt(dt), rel=0.05)
+    assert allan_deviation(record[:7], dt, 3 * dt) > 0.0  # 2 * 3 < 7: one difference
+    for short, tau_s in ((record[:6], 3 * dt), (record, 0.4 * dt)):  # 2 * 3 = 6; tau/dt -> 0
+        with pytest.raises(ParameterError, match="tau"):
+            allan_deviation(short, dt, tau_s)
