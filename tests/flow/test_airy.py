@@ -129,3 +129,26 @@ def test_bad_parameters_are_refused():
         AiryWave(0.5, 5.0, water_depth_m=-3.0)
     with pytest.raises(ParameterError, match="points_world"):
         AiryWave(0.5, 5.0).velocity(0.0, np.zeros((2, 2)))
+
+
+@pytest.mark.parametrize("period_s", [4.0, 8.0, 12.0])
+def test_wavelength_is_the_deep_water_one_and_shortens_in_shallow_water(period_s):
+    """lambda = g T^2 / (2 pi) in deep water (1.56 T^2 m); in water of depth h it is
+    2 pi / k with k from the dispersion relation, tending to T sqrt(g h) when h << lambda."""
+    deep = AiryWave(0.1, period_s)
+    assert deep.wavelength_m == pytest.approx(G * period_s**2 / (2.0 * math.pi), rel=1e-12)
+    shallow = AiryWave(0.01, period_s, water_depth_m=0.5)
+    assert shallow.wavelength_m < deep.wavelength_m
+    assert shallow.wavelength_m == pytest.approx(period_s * math.sqrt(G * 0.5), rel=0.03)
+
+
+def test_a_wave_steeper_than_one_in_seven_is_refused_naming_its_height_and_length():
+    """Breaking (Michell's limit): a height 2 a over the wavelength above 1/7 is refused, one
+    just below it accepted; the refusal gives the height and the wavelength (deep water at
+    8 s: 99.92 m). Still water (depth 0) is no depth for a wave."""
+    length_m = G * 8.0**2 / (2.0 * math.pi)
+    AiryWave(0.99 * length_m / 14.0, 8.0)  # H / lambda = 0.99 / 7
+    with pytest.raises(ParameterError, match=r"height .*14\.4\d* m over its wavelength 99\.9"):
+        AiryWave(1.01 * length_m / 14.0, 8.0)
+    with pytest.raises(ParameterError, match="water_depth_m"):
+        AiryWave(0.5, 5.0, water_depth_m=0.0)

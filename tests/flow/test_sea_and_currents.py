@@ -236,3 +236,52 @@ def test_a_sea_has_a_bounded_number_of_components(n):
     with pytest.raises(ParameterError, match=r"n_components must be an integer in 1\.\.2000"):
         IrregularSea(0.5, 5.0, n_components=n)
     assert IrregularSea(0.5, 5.0, n_components=2000).components.amplitude_m.size == 2000
+
+
+def test_jonswap_peak_is_gamma_times_pierson_moskowitz_narrowed_by_its_two_widths():
+    """S_J / S_PM = N gamma^r, r = exp(-(w/wp - 1)^2 / (2 sigma^2)): at the peak r = 1, one
+    width below it (sigma = 0.07) and one width above (sigma = 0.09) r = exp(-1/2); N
+    cancels in the ratios to the peak's."""
+    hs, tp, gamma = 2.0, 8.0, 3.3
+    wp = 2.0 * math.pi / tp
+    w = wp * np.array([1.0, 1.0 - 0.07, 1.0 + 0.09])
+    ratio = jonswap_spectrum(w, hs, tp, gamma) / pierson_moskowitz_spectrum(w, hs, tp)
+    np.testing.assert_allclose(ratio[1:] / ratio[0], gamma ** (math.exp(-0.5) - 1.0), rtol=1e-12)
+
+
+def test_an_irregular_sea_draws_its_components_in_its_band_with_uniform_phases():
+    """Frequencies within frequency_range times wp, phases in [0, 2 pi) and spread over it;
+    one component is a sea; a band around the peak is allowed, one above it refused."""
+    sea = IrregularSea(1.0, 6.0, n_components=200, seed=5, frequency_range=(0.6, 2.5))
+    wp = 2.0 * math.pi / 6.0
+    omega, phase = sea.components.angular_frequency_rad_s, sea.components.phase_rad
+    assert 0.6 * wp <= omega.min() and omega.max() <= 2.5 * wp
+    assert omega.min() < 0.62 * wp and omega.max() > 2.45 * wp  # the whole band
+    assert np.all((phase >= 0.0) & (phase < 2.0 * math.pi)) and np.ptp(phase) > 6.0
+    assert IrregularSea(1.0, 6.0, n_components=1).components.amplitude_m.size == 1
+    IrregularSea(1.0, 6.0, frequency_range=(0.9, 1.2))
+    with pytest.raises(ParameterError, match="frequency_range"):
+        IrregularSea(1.0, 6.0, frequency_range=(1.2, 3.5))
+
+
+@pytest.mark.parametrize(
+    "flow",
+    [
+        UniformCurrent([0.3, -0.1, 0.05]),
+        AiryWave(0.3, 6.0),
+        IrregularSea(0.5, 6.0, n_components=5),
+        GaussMarkovCurrent([0.2, 0.0, 0.0], 0.05, 20.0, 0.2, seed=1),
+        DepthProfileCurrent([0.3, 0.1, 0.0], [0.0, 10.0], [1.0, 0.4]),
+        UniformCurrent([0.1, 0.0, 0.0]) + AiryWave(0.2, 5.0),
+    ],
+    ids=repr,
+)
+def test_every_field_answers_each_point_with_a_vector_and_a_gradient(flow):
+    """Velocity, local and material acceleration (n, 3) and the velocity gradient (n, 3, 3)
+    at n points, finite; none at no point."""
+    points = np.array([[0.0, 0.0, -1.0], [2.0, 1.0, -3.0], [-1.0, 4.0, -0.5], [0.5, 0.5, -8.0]])
+    for f in (flow.velocity, flow.local_acceleration, flow.acceleration):
+        assert f(1.3, points).shape == (4, 3) and np.all(np.isfinite(f(1.3, points)))
+        assert f(1.3, np.zeros((0, 3))).shape == (0, 3)
+    gradient = flow.velocity_gradient(1.3, points)
+    assert gradient.shape == (4, 3, 3) and np.all(np.isfinite(gradient))
