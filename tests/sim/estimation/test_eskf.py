@@ -12,6 +12,7 @@ from scipy import stats
 from trajectory import IMU, NAVIGATION, nees, run, still
 
 from uvms_pin.sim.estimation.eskf import NavState, correct, dvl_model, process_noise, transition
+from uvms_pin.sim.estimation.estimator import NavigationEstimator
 from uvms_pin.sim.estimation.spec import EstimatorSpec
 from uvms_pin.sim.navigation.dvl import DvlSpec
 from uvms_pin.sim.navigation.usbl import UsblSpec
@@ -201,3 +202,22 @@ def test_a_correction_pulls_toward_the_measurement_by_the_kalman_gain():
     new, P_new = correct(state, P, np.array([0.1, 0.0, 0.0]) - h, H, np.full(3, 0.01))
     assert new.velocity_world_m_s[0] == pytest.approx(0.1 * 0.04 / 0.05, rel=1e-12)
     assert P_new[3, 3] == pytest.approx(0.04 * 0.01 / 0.05, rel=1e-12)
+
+
+def test_a_depth_reading_is_weighed_by_the_depth_noise_variance():
+    """The first tick's prior is the initial one (sigma_p^2 on z); a depth reading d of
+    variance R = depth_m^2 makes the posterior variance sigma_p^2 R / (sigma_p^2 + R) and
+    moves z by the gain K = sigma_p^2 / (sigma_p^2 + R) toward the reading (z = -d)."""
+    estimator = NavigationEstimator(replace(SPEC, draw_initial_error=False), NAVIGATION, 0)
+    q, v = still(0.0)
+    estimator.start(0.02, q, v)
+    reading_m = -q[2] + 0.2
+    estimator.update(
+        0.0, {"imu_gyro": np.zeros(3), "imu_accel": np.zeros(3), "depth": np.array([reading_m])}
+    )
+    prior, noise = SPEC.initial_sigma[0] ** 2, estimator.noise.depth_m**2
+    assert noise < 0.1 * prior  # the reading counts
+    assert estimator.covariance[2, 2] == pytest.approx(prior * noise / (prior + noise), rel=1e-9)
+    gain = prior / (prior + noise)
+    z = estimator.state.position_world_m[2]
+    assert z == pytest.approx(q[2] - gain * 0.2, rel=1e-9)
