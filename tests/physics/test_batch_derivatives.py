@@ -156,3 +156,23 @@ def test_more_states_than_memory_are_refused_before_anything_is_copied(reference
     v = np.broadcast_to(np.zeros(uvms.nv), (10**9, uvms.nv))
     with pytest.raises(ParameterError, match=r"would take .* GiB"):
         up.forward_dynamics_derivatives_batch(uvms, q, v, v)
+
+
+def test_the_memory_asked_for_is_what_the_call_keeps(reference_uvms, monkeypatch):
+    """The bytes checked before anything is copied are the three Jacobians it returns plus
+    its C-ordered copies of q, v, tau and tau_ext: nothing left out, nothing counted twice."""
+    from uvms_pin.physics import batch_derivatives
+
+    asked = []
+
+    def recorded(needed_bytes, *args, **kwargs):
+        asked.append(needed_bytes)
+        return check_memory(needed_bytes, *args, **kwargs)
+
+    check_memory = batch_derivatives.check_memory
+    monkeypatch.setattr(batch_derivatives, "check_memory", recorded)
+    uvms = reference_uvms
+    q, v, tau = _states(uvms, 5)
+    out = up.forward_dynamics_derivatives_batch(uvms, q, v, tau, tau_ext=0.1 * tau)
+    copies = (q.nbytes, v.nbytes, tau.nbytes, tau.nbytes)
+    assert asked == [sum(j.nbytes for j in out) + sum(copies)]
