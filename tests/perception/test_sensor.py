@@ -46,3 +46,32 @@ def test_a_count_or_field_of_view_out_of_range_is_refused_in_full(spec, changes,
 def test_the_largest_counts_and_widest_fields_of_view_are_accepted():
     CameraSpec("c", width=8192, height=1, horizontal_fov_rad=3.14)
     SonarSpec("c", beams=4096, bins=8192, rays_per_beam=1, vertical_fov_rad=3.14)
+
+
+@pytest.mark.parametrize(
+    "spec",
+    [
+        CameraSpec("cam", width=40, height=30),
+        SonarSpec("fls", beams=16, bins=64),
+        SonarSpec("mbes", type="multibeam", beams=24, bins=32),
+        SonarSpec("alt", type="altimeter", beams=1, bins=50),
+    ],
+    ids=lambda spec: spec.name,
+)
+def test_the_bytes_counted_before_a_run_are_those_a_firing_records(reference_uvms, spec):
+    """The memory check before a run (`suite.check_mounts`) counts each firing as its kind's
+    ``bytes``: exactly the arrays a firing of that sensor records."""
+    import numpy as np
+
+    from uvms_pin.perception.scene import Scene
+    from uvms_pin.perception.sensor import SENSORS
+    from uvms_pin.physics.world.objects import plane
+
+    seabed = plane("seabed", [0.0, 0.0, -25.0], [0.0, 0.0, 1.0], 0.5, 0.4)
+    scene = Scene(reference_uvms, [seabed])
+    q = reference_uvms.neutral_configuration()
+    q[:3] = [0.0, 0.0, -20.0]
+    scene.update(q)
+    kind = next(k for k in SENSORS.values() if isinstance(spec, k.spec))
+    fired = kind.make(spec, scene, np.random.default_rng(0)).fire()
+    assert kind.bytes(spec) == sum(array.nbytes for array in fired.values())

@@ -217,7 +217,11 @@ SONAR = sensor.register(
         name="sonar",
         spec=SonarSpec,
         make=Sonar,
-        bytes=lambda spec: 4 * spec.bins * spec.beams,
+        bytes=lambda spec: (
+            4 * spec.bins * spec.beams  # the image (float32)
+            # a multibeam's detections: range (float64) and intensity (float32) per beam
+            + (8 + 4) * spec.beams * (spec.type == "multibeam")
+        ),
         constants=lambda sonar: {
             "range_m": sonar.spec.range_m,
             "bearing_rad": sonar.spec.bearing_rad,
