@@ -2,8 +2,8 @@
 #include "camera_shading.hpp"
 
 // compiled with -ffp-contract=off (CMakeLists.txt), as vector_exp.cpp: no a * b + c fused
-// into one rounding where the processor could (x86-64-v3's clones), so the radiance is the
-// same, bit for bit, on every processor
+// into one rounding where the processor could (the x86-64-v3 and v4 clones), so the radiance
+// is the same, bit for bit, on every processor
 
 #include "vector_exp.hpp"
 
@@ -279,7 +279,7 @@ void shade_record(const Vec3& origin, const Mat3& frame_rotation, const double* 
              reflectance, labels, water, lights, sink);
 }
 
-// compiled for x86-64-v3 too: its rounding is then one instruction, not a call
+// compiled for x86-64-v3 and v4 too: its rounding is then one instruction, not a call
 UVMS_VECTOR_CLONES
 void eight_bit(const double* radiance, const float* noise, Eigen::Index n, double scale,
                double noise_counts, std::uint8_t* rgb) {

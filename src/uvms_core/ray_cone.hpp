@@ -1,16 +1,16 @@
 // The caster's loops over a cone's rays (ray_caster.cpp's `RayCaster::cast`): each kind of
 // body tried against all of a cone's rays at once, the rays held by axis (`ConeRays`).
 //
-// The loops take plain arrays and numbers, no Eigen type: each is compiled for x86-64-v3 too
-// (ray_cone.cpp, UVMS_VECTOR_CLONES), where a call into Eigen would not be inlined, and has no
-// branch, so the compiler vectorizes it. They follow the shapes' formulas (ray_shapes.hpp's
+// The loops take plain arrays and numbers, no Eigen type: each is compiled for x86-64-v3 and
+// v4 too (ray_cone.cpp, UVMS_VECTOR_CLONES), where a call into Eigen would not be inlined, and
+// has no branch, so the compiler vectorizes it. They follow the shapes' formulas (ray_shapes.hpp's
 // header; the Python reference's, uvms_pin/perception/shapes.py and mesh.py, which the tests
 // hold them to) and compute each ray's values by the same operations in the same order
 // whatever the loop's width, Eigen's Vec3 and Mat3 products' order included (noted where it
 // matters): the same bits as a loop ray by ray.
 // The unit is compiled with -ffp-contract=off and -fno-math-errno (CMakeLists.txt): no
-// multiply-add fused in the x86-64-v3 clones (the same hits on every processor), and square
-// roots that set no errno (a call that may would keep them out of the vector loops).
+// multiply-add fused in the x86-64-v3 and v4 clones (the same hits on every processor), and
+// square roots that set no errno (a call that may would keep them out of the vector loops).
 #pragma once
 
 #include <Eigen/Core>
