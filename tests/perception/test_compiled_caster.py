@@ -529,3 +529,21 @@ def test_a_solid_is_seen_from_every_point_outside_it_and_from_none_inside(kind):
             seen = caster.cast(origin, toward[None, :]).label[0] == 1
             assert seen == outside, f"{type(caster).__name__} from {local} (its frame)"
     assert min(sides.values()) > 40  # both sides sampled
+
+
+def test_the_core_names_each_ray_toward_a_body_it_does_not_know_once():
+    """The rays that may meet an external body (``rays_toward``, rays without cones): every
+    ray whose direction is within the body's bounding sphere as seen from the origin, each
+    named once, in order, their count at most the rays'."""
+    compiled = caster_for("core")
+    centre, radius = np.array([1.5, 0.5, 0.0]), 0.7
+    compiled.add("own", _Ball(radius), np.eye(3), centre)
+    d = _sphere_rays(np.random.default_rng(9), 4000)
+    rows = np.full(len(d), -1, dtype=np.int64)
+    count = compiled._core.rays_toward(0, np.zeros(3), np.eye(3), d, np.full(len(d), np.inf), rows)
+    picked = rows[:count]
+    np.testing.assert_array_equal(picked, np.unique(picked))
+    off_axis = np.arccos(np.clip(d @ centre / np.linalg.norm(centre), -1.0, 1.0))
+    within = np.arcsin(radius / np.linalg.norm(centre))
+    assert set(np.flatnonzero(off_axis < within - 1e-9)) <= set(picked.tolist())
+    assert np.all(off_axis[picked] < within + 1e-9) and 50 < count < len(d)

@@ -49,3 +49,24 @@ def test_the_suite_logs_the_columns_of_the_fitted_kinds_only():
 def test_the_scenario_reader_checks_each_sensor_in_its_table(override, message):
     with pytest.raises(ScenarioError, match=message):
         load_scenario(SCENARIO, override)
+
+
+def test_each_signal_has_the_columns_its_kind_declares():
+    """A kind's ``columns`` name and unit each component of the signal it reads (the run's
+    log and DataFrame are laid out by them): as many as the signal's values, every kind."""
+    from uvms_pin.sim.navigation.dvl import DvlSpec
+
+    spec = NavigationSpec(
+        imu=ImuSpec(1e-3),
+        depth_noise_Pa=10.0,
+        dvl=DvlSpec(0.01),
+        usbl=UsblSpec(0.1),
+        seabed_depth_m=20.0,
+    )
+    suite = NavigationSuite(spec, seed=3)
+    suite.start(0.1)
+    suite.update(0.0, np.r_[0.0, 0.0, -5.0, 0.0, 0.0, 0.0, 1.0], np.zeros(6))
+    signals, columns = suite.signals(), suite.signal_columns()
+    assert set(signals) == set(columns) and len(signals) >= 5
+    for name, values in signals.items():
+        assert np.size(values) == len(columns[name]), name
