@@ -42,3 +42,11 @@ def test_every_table_of_the_registry_is_read_and_summed_in_its_order():
 def test_a_flow_table_is_checked_naming_its_key(data, message):
     with pytest.raises(ScenarioError, match=message):
         _water(data)
+
+
+def test_a_sea_of_one_component_is_read_and_none_refused_naming_the_key():
+    sea = {"significant_height_m": 0.5, "peak_period_s": 7.0}
+    one = _water({"sea": {**sea, "n_components": 1}}).flow
+    assert isinstance(one, IrregularSea) and one.components.amplitude_m.size == 1
+    with pytest.raises(ScenarioError, match=r"water\.sea\.n_components"):
+        _water({"sea": {**sea, "n_components": 0}})
