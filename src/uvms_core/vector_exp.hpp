@@ -17,7 +17,7 @@
 
 // A function compiled three times on x86-64 Linux (GCC): for the baseline, x86-64-v3 (AVX2,
 // FMA) and x86-64-v4 (AVX-512), the processor's picked when the module loads; elsewhere once,
-// for the baseline. The v4 clone took a 320 x 240 image's shading from 4.2 to 3.6 ms on this
+// for the baseline. The v4 clone took a 320 x 240 image's shading from 4.2 to 3.7 ms on this
 // project's machine (AVX-512), the same bits (tests/perception/test_compiled_camera.py).
 #if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__) && defined(__linux__)
 #define UVMS_VECTOR_CLONES \

@@ -281,7 +281,8 @@ def test_every_field_answers_each_point_with_a_vector_and_a_gradient(flow):
     at n points, finite; none at no point."""
     points = np.array([[0.0, 0.0, -1.0], [2.0, 1.0, -3.0], [-1.0, 4.0, -0.5], [0.5, 0.5, -8.0]])
     for f in (flow.velocity, flow.local_acceleration, flow.acceleration):
-        assert f(1.3, points).shape == (4, 3) and np.all(np.isfinite(f(1.3, points)))
+        answer = f(1.3, points)
+        assert answer.shape == (4, 3) and np.all(np.isfinite(answer))
         assert f(1.3, np.zeros((0, 3))).shape == (0, 3)
     gradient = flow.velocity_gradient(1.3, points)
     assert gradient.shape == (4, 3, 3) and np.all(np.isfinite(gradient))

@@ -4,11 +4,15 @@ from __future__ import annotations
 
 import re
 
+import numpy as np
 import pytest
 
 from uvms_pin.errors import ParameterError
 from uvms_pin.perception.camera import CameraSpec
+from uvms_pin.perception.scene import Scene
+from uvms_pin.perception.sensor import SENSORS
 from uvms_pin.perception.sonar import SonarSpec
+from uvms_pin.physics.world.objects import plane
 
 
 @pytest.mark.parametrize(
@@ -61,12 +65,6 @@ def test_the_largest_counts_and_widest_fields_of_view_are_accepted():
 def test_the_bytes_counted_before_a_run_are_those_a_firing_records(reference_uvms, spec):
     """The memory check before a run (`suite.check_mounts`) counts each firing as its kind's
     ``bytes``: exactly the arrays a firing of that sensor records."""
-    import numpy as np
-
-    from uvms_pin.perception.scene import Scene
-    from uvms_pin.perception.sensor import SENSORS
-    from uvms_pin.physics.world.objects import plane
-
     seabed = plane("seabed", [0.0, 0.0, -25.0], [0.0, 0.0, 1.0], 0.5, 0.4)
     scene = Scene(reference_uvms, [seabed])
     q = reference_uvms.neutral_configuration()

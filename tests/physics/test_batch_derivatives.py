@@ -11,6 +11,7 @@ import uvms_pin as up
 from tests.conftest import random_state
 from uvms_pin.errors import ParameterError
 from uvms_pin.flow import AiryWave, UniformCurrent
+from uvms_pin.physics import batch_derivatives
 from uvms_pin.physics.dynamics import water_of_call
 
 CURRENT = np.array([0.3, -0.1, 0.05])
@@ -161,18 +162,15 @@ def test_more_states_than_memory_are_refused_before_anything_is_copied(reference
 def test_the_memory_asked_for_is_what_the_call_keeps(reference_uvms, monkeypatch):
     """The bytes checked before anything is copied are the three Jacobians it returns plus
     its C-ordered copies of q, v, tau and tau_ext: nothing left out, nothing counted twice."""
-    from uvms_pin.physics import batch_derivatives
-
-    asked = []
+    asked, check_memory = [], batch_derivatives.check_memory
 
     def recorded(needed_bytes, *args, **kwargs):
         asked.append(needed_bytes)
         return check_memory(needed_bytes, *args, **kwargs)
 
-    check_memory = batch_derivatives.check_memory
     monkeypatch.setattr(batch_derivatives, "check_memory", recorded)
     uvms = reference_uvms
     q, v, tau = _states(uvms, 5)
     out = up.forward_dynamics_derivatives_batch(uvms, q, v, tau, tau_ext=0.1 * tau)
-    copies = (q.nbytes, v.nbytes, tau.nbytes, tau.nbytes)
+    copies = (q.nbytes, v.nbytes, tau.nbytes, tau.nbytes)  # tau_ext: tau's shape
     assert asked == [sum(j.nbytes for j in out) + sum(copies)]

@@ -220,7 +220,7 @@ SONAR = sensor.register(
         bytes=lambda spec: (
             4 * spec.bins * spec.beams  # the image (float32)
             # a multibeam's detections: range (float64) and intensity (float32) per beam
-            + (8 + 4) * spec.beams * (spec.type == "multibeam")
+            + ((8 + 4) * spec.beams if spec.type == "multibeam" else 0)
         ),
         constants=lambda sonar: {
             "range_m": sonar.spec.range_m,

@@ -11,6 +11,7 @@ from conftest import ROOT
 
 from uvms_pin.errors import ParameterError, ScenarioError
 from uvms_pin.scenario.load import load_scenario
+from uvms_pin.sim.navigation.dvl import DvlSpec
 from uvms_pin.sim.navigation.imu import ImuSpec
 from uvms_pin.sim.navigation.sensor import SENSORS, register
 from uvms_pin.sim.navigation.suite import NavigationSpec, NavigationSuite
@@ -54,8 +55,6 @@ def test_the_scenario_reader_checks_each_sensor_in_its_table(override, message):
 def test_each_signal_has_the_columns_its_kind_declares():
     """A kind's ``columns`` name and unit each component of the signal it reads (the run's
     log and DataFrame are laid out by them): as many as the signal's values, every kind."""
-    from uvms_pin.sim.navigation.dvl import DvlSpec
-
     spec = NavigationSpec(
         imu=ImuSpec(1e-3),
         depth_noise_Pa=10.0,
