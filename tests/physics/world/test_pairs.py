@@ -13,7 +13,7 @@ from uvms_pin.physics.compiled.extension import core_module
 from uvms_pin.physics.compiled.moving import PairSearch
 from uvms_pin.physics.world.contact_law import ContactLaw
 from uvms_pin.physics.world.free_object import free_object
-from uvms_pin.physics.world.world import World
+from uvms_pin.physics.world.world import FrictionMemory, World
 from uvms_pin.sim.plant import Plant
 from uvms_pin.sim.system import System
 
@@ -62,6 +62,41 @@ def test_a_sticking_pair_s_stretch_is_carried_over_to_the_new_contact_point(load
     pin.forwardKinematics(system.plant.uvms.model, data, turned)
     x = after.touch.point_world_m[0]
     np.testing.assert_allclose(memory.material[(0, 0, -1)], data.oMi[1].actInv(x), atol=1e-15)
+
+
+@pytest.mark.parametrize("searched_by", ["reference", "core"])
+def test_a_slipping_pair_slips_on_above_mu_k_and_a_sticking_one_holds_up_to_mu_s(
+    load_body, searched_by
+):
+    """Coulomb's static-kinetic hysteresis, pair by pair: the robot 5 mm into the ball
+    (N = k delta = 100 N, nothing closing) sliding sideways at 0.275 m/s, so that the trial
+    friction c_t v_t = 55 N lies between mu_k N = 50 N and mu_s N = 60 N. A pair that stuck
+    over the last period (its memory) holds: f_t is the trial force. One that slipped slips
+    on: f_t is mu_k N, along the trial force. The core's search chooses as the reference."""
+    system, q, ball = _touching(load_body)
+    law = system.plant.world.law
+    (pairs,) = system.moving.moving.sets
+    mu_s, mu_k = ball.friction_static, ball.friction_kinetic
+    speed = 0.5 * (mu_s + mu_k) * law.stiffness_N_m * 0.005 / law.tangential_damping_N_s_m
+    v = np.zeros(6)
+    v[1] = speed
+    states = system.moving.initial_states()
+    system.moving._kinematics(q, v, states)
+    data = system.moving.moving._datas(system.moving.uvms_data, system.moving.datas)
+    search = pairs.pairs.forces
+    if searched_by == "core":
+        search = PairSearch(pairs.pairs, core_module())
+    normal_N = law.stiffness_N_m * 0.005
+    for slipped in (False, True):
+        memory = FrictionMemory(slipping={0} if slipped else set())
+        found = search(data(pairs.a), data(pairs.b), memory)
+        assert found.normal_N[0] == pytest.approx(normal_N, rel=1e-9)
+        f_t = found.force_world_N[0] - normal_N * found.touch.normal_world[0]
+        trial_N = law.tangential_damping_N_s_m * speed
+        assert mu_k * normal_N < trial_N < mu_s * normal_N
+        assert bool(found.sticking[0]) is not slipped
+        expected = mu_k * normal_N if slipped else trial_N
+        np.testing.assert_allclose(f_t, [0.0, -expected, 0.0], rtol=0, atol=1e-9)
 
 
 def test_a_force_on_a_body_fixed_to_the_world_moves_no_joint():
