@@ -150,3 +150,35 @@ def test_the_world_says_how_free_objects_touch_it(load_body):
     assert System(Plant(pusher, world=soft, free_surface=False)).object_contacts is None
     with pytest.raises(ParameterError, match="fixed_contact must be one of rigid"):
         World(pusher, [floor], ContactLaw(), [box], fixed_contact="soft")
+
+
+def test_a_contact_a_spin_brings_within_the_period_is_solved(load_body):
+    """A contact is solved when its gap can close within the period at the object's speed,
+    its spin included (the normal rate J_n v at the point, omega x r in it): a bar 3 m long
+    4 mm above the seafloor, level, turning about x at 2 rad/s: its end at y = -1.5 m comes
+    down at 3 m/s, 6 mm in a 2 ms period, so its corners there are solved now (its centre
+    does not move: counting the linear speed alone, with the 1 mm margin, they would be
+    left until they were in). At rest, nothing is solved; the margin must be a length."""
+    floor = plane("seafloor", [0.0, 0.0, -10.0], [0.0, 0.0, 1.0], 0.6, 0.5)
+    spin = [0.0, 0.0, 0.0, 2.0, 0.0, 0.0]  # about x: the end at y = -1.5 m goes down
+    rows = {}
+    for name, velocity in (("spinning", spin), ("at rest", None)):
+        bar = _object("box", {"size_m": [0.2, 3.0, 0.1]}, [0.0, 0.0, -9.946], velocity=velocity)
+        world = World(_pusher(load_body), [floor], ContactLaw(), [bar])
+        system = System(Plant(world.uvms, world=world, free_surface=False))
+        robot = system.plant.uvms
+        q = robot.neutral_configuration()
+        q[:3] = [20.0, 0.0, -5.0]
+        state = system.initial_state(q, np.zeros(robot.nv))
+        model, data = system.model, system.model.createData()
+        pin.computeJointJacobians(model, data, state.q)
+        found = system.object_contacts.rows(model, data, state.q, np.abs(state.v), PERIOD_S)
+        rows[name] = found
+    assert rows["at rest"].size == 0
+    spinning = rows["spinning"]
+    assert spinning.size >= 6  # at least the two corners going down
+    corners = np.array([c.point.point_world_m for c in spinning.where])
+    assert np.all(np.abs(corners[:, 1]) == pytest.approx(1.5))
+    assert np.all(corners[:, 2] == pytest.approx(-9.996))  # 4 mm up
+    with pytest.raises(ParameterError, match="margin must be >= 0"):
+        type(system.object_contacts)([None], [1], [None], margin=-1e-3)
