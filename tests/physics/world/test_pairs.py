@@ -99,6 +99,36 @@ def test_a_slipping_pair_slips_on_above_mu_k_and_a_sticking_one_holds_up_to_mu_s
         np.testing.assert_allclose(f_t, [0.0, -expected, 0.0], rtol=0, atol=1e-9)
 
 
+@pytest.mark.parametrize(
+    ("gap_m", "speed_m_s", "horizon_s", "near"),
+    [
+        (-0.005, 0.0, 0.0, True),  # in
+        (0.09, 0.0, 0.0, True),  # within the two clearances
+        (0.15, 0.0, 0.01, False),  # 15 cm apart, still
+        (0.15, 10.0, 0.01, True),  # 10 cm covered in the horizon (twice it: 20 cm)
+        (0.15, 3.0, 0.01, True),  # 3 cm covered (6 cm)
+        (0.15, 1.0, 0.01, False),  # 1 cm covered (2 cm)
+        (0.15, 10.0, 0.0, False),  # no horizon
+    ],
+)
+def test_a_pair_is_near_when_its_pieces_can_meet_within_the_horizon(
+    load_body, gap_m, speed_m_s, horizon_s, near
+):
+    """`PiecePairs.near`: the robot's sphere and the ball, ``gap_m`` apart, the robot coming
+    at ``speed_m_s``: near when their bounding spheres overlap, each grown by a clearance
+    (5 cm) and twice the distance its points can cover in ``horizon_s`` (what lets a period
+    skip the pairs)."""
+    system, q, _ = _touching(load_body)
+    (pairs,) = system.moving.moving.sets
+    q[0] -= gap_m + 0.005  # _touching's robot is 5 mm into the ball
+    v = np.zeros(6)
+    v[0] = speed_m_s  # towards the ball
+    states = system.moving.initial_states()
+    system.moving._kinematics(q, v, states)
+    data = system.moving.moving._datas(system.moving.uvms_data, system.moving.datas)
+    assert pairs.pairs.near(data(pairs.a), data(pairs.b), horizon_s) is near
+
+
 def test_a_force_on_a_body_fixed_to_the_world_moves_no_joint():
     """A fixture's root link hangs on joint 0 (the world): a contact force on it is taken by
     the world (zero generalized force; Pinocchio's Jacobian of joint 0 is not asked for),
