@@ -15,7 +15,8 @@ from scipy.integrate import solve_ivp
 import uvms_pin as up
 from uvms_pin.physics.world.contact_law import ContactLaw
 from uvms_pin.physics.world.objects import plane, solid
-from uvms_pin.physics.world.world import World
+from uvms_pin.physics.world.touch import Touch
+from uvms_pin.physics.world.world import ContactForces, World
 from uvms_pin.sim.integrators import RK4
 from uvms_pin.sim.plant import Plant
 from uvms_pin.sim.system import System
@@ -268,3 +269,32 @@ def test_the_plant_is_unchanged_when_nothing_is_near(reference_uvms):
             a1 = with_world.acceleration(0.0, q, v, tau)
             assert np.allclose(a1, a0, rtol=1e-12, atol=1e-12 * np.abs(a0).max())
         assert len(with_world.world_forces(q, v).touch) == 0
+
+
+def test_each_body_and_object_pair_logs_its_own_wrench(reference_uvms):
+    """`World.pair_wrenches`: one row per (body, object), body-major (body * n_objects +
+    object): the sum of its points' forces, their normal-force-weighted centre and the
+    forces' moment about it; a pair without a point is zeros. Points of the vehicle's hull
+    on the seafloor (two) and of the arm's last link on a rock and on the seafloor."""
+    floor = plane("seafloor", [0.0, 0.0, -10.0], [0.0, 0.0, 1.0], 0.6, 0.5)
+    rock = solid("rock", "box", {"size_m": [0.3] * 3}, [1.0, 0.0, -9.85], [0.0] * 3, 0.6, 0.5)
+    world = World(reference_uvms, [floor, rock], ContactLaw())
+    bodies = [p.body for p in world.pieces]
+    hull, tip = bodies.index(min(bodies)), bodies.index(max(bodies))
+    assert bodies[hull] != bodies[tip]
+    piece, obj = np.array([hull, hull, tip, tip]), np.array([0, 0, 1, 0])
+    point = np.array([[0.0, 0, -10], [0.2, 0, -10], [1.0, 0, -9.7], [0.5, 0.5, -10]])
+    force = np.array([[1.0, 0, 10], [0.0, 2, 30], [-5.0, 0, 0], [0.0, 0, 7]])
+    normal_N = np.array([10.0, 30.0, 5.0, 7.0])
+    up_ = np.tile([0.0, 0.0, 1.0], (4, 1))
+    touch = Touch(piece, obj, np.full(4, -1), point, up_, np.zeros(4), np.zeros((4, 3)))
+    out = world.pair_wrenches(ContactForces(touch, force, normal_N, np.ones(4, dtype=bool)))
+    assert out.shape == (2 * len(world.body_names), 9)
+    row = {(bodies[hull], 0): [0, 1], (bodies[tip], 1): [2], (bodies[tip], 0): [3]}
+    for (body, k), mine in row.items():
+        center = normal_N[mine] @ point[mine] / normal_N[mine].sum()
+        moment = np.cross(point[mine] - center, force[mine]).sum(axis=0)
+        expected = np.concatenate([force[mine].sum(axis=0), center, moment])
+        np.testing.assert_allclose(out[2 * body + k], expected, rtol=0, atol=1e-12)
+    written = [2 * body + k for body, k in row]
+    assert not np.any(np.delete(out, written, axis=0))

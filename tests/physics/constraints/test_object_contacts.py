@@ -107,6 +107,7 @@ def test_a_cylinder_on_a_plane_touches_by_its_rims_lowest_points_and_a_sphere_by
             assert min(c.gap_m for c in found) < 0.0  # one rim inside: 0.12 m + reach
         else:  # coal's signed distance: the centre's height less the radius, inside
             (c,) = found
+            assert c.corner == -1  # coal's one point of the pair, not a corner
             assert c.gap_m == pytest.approx(-0.05, abs=1e-9)
             np.testing.assert_allclose(c.point_world_m, obj.q0[:3] - [0, 0, 0.1], atol=1e-9)
 
