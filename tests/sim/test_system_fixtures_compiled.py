@@ -238,3 +238,29 @@ def test_the_core_refuses_a_fixture_with_bad_parts(reference_uvms):
             core.System(plant, [], [dynamics], [damping], [coulomb], [lower], [upper])
     with pytest.raises(ParameterError, match="one per fixture"):
         core.System(plant, [], [dynamics], [], [valve.coulomb], [lower], [upper])
+
+
+@pytest.mark.parametrize("compiled", [False, True], ids=["python", "core"])
+def test_on_rigid_pairs_a_fixtures_fixed_base_carries_a_ball_while_its_lever_turns(
+    reference_uvms, tmp_path, compiled
+):
+    """Rigid moving pairs: a ball dropped 2 mm onto a lever's fixed base (a piece on the
+    universe, joint 0) rests there, while the lever beside it (0.2 N m of friction against
+    its own weight's 0.98 N m) falls to its 0.3 rad limit: the base's piece does not turn
+    with the lever's joint, so the ball stays where it landed."""
+    lever = fixture(
+        "lever", lever_urdf(tmp_path, friction_Nm=0.2, limits=(-0.05, 0.3)),
+        ([0.0, 0.0, -5.0], [0.0, 0.0, 0.0]), water_density_kg_m3=RHO,
+    )  # fmt: skip
+    ball = free_object(
+        "ball", "sphere", {"radius_m": 0.05}, ([0.02, 0.0, -5.0 + 0.025 + 0.052], [0, 0, 0]),
+        density_kg_m3=7800.0, water_density_kg_m3=RHO,
+    )  # fmt: skip
+    world = World(reference_uvms, [], free=[ball], fixtures=[lever], moving_contact="rigid")
+    system = System(Plant(reference_uvms, free_surface=False, world=world), compiled=compiled)
+    states = _run(system, reference_uvms, 0.5)
+    at = reference_uvms.nq
+    landed = states[len(states) // 5 :, at : at + 3]  # after 0.1 s
+    assert states[:, -1].max() > 0.29  # the lever turned to its limit
+    np.testing.assert_allclose(landed[:, 2], -5.0 + 0.025 + 0.05, rtol=0, atol=1e-4)
+    assert np.ptp(landed, axis=0).max() < 1e-4  # the ball did not move
