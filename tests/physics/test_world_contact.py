@@ -274,8 +274,9 @@ def test_the_plant_is_unchanged_when_nothing_is_near(reference_uvms):
 def test_each_body_and_object_pair_logs_its_own_wrench(reference_uvms):
     """`World.pair_wrenches`: one row per (body, object), body-major (body * n_objects +
     object): the sum of its points' forces, their normal-force-weighted centre and the
-    forces' moment about it; a pair without a point is zeros. Points of the vehicle's hull
-    on the seafloor (two) and of the arm's last link on a rock and on the seafloor."""
+    forces' moment about it (the points' mean when they carry no normal force); a pair
+    without a point is zeros. Points of the vehicle's hull on the seafloor (two) and of the
+    arm's last link on a rock and on the seafloor."""
     floor = plane("seafloor", [0.0, 0.0, -10.0], [0.0, 0.0, 1.0], 0.6, 0.5)
     rock = solid("rock", "box", {"size_m": [0.3] * 3}, [1.0, 0.0, -9.85], [0.0] * 3, 0.6, 0.5)
     world = World(reference_uvms, [floor, rock], ContactLaw())
@@ -286,8 +287,8 @@ def test_each_body_and_object_pair_logs_its_own_wrench(reference_uvms):
     point = np.array([[0.0, 0, -10], [0.2, 0, -10], [1.0, 0, -9.7], [0.5, 0.5, -10]])
     force = np.array([[1.0, 0, 10], [0.0, 2, 30], [-5.0, 0, 0], [0.0, 0, 7]])
     normal_N = np.array([10.0, 30.0, 5.0, 7.0])
-    up_ = np.tile([0.0, 0.0, 1.0], (4, 1))
-    touch = Touch(piece, obj, np.full(4, -1), point, up_, np.zeros(4), np.zeros((4, 3)))
+    normals = np.tile([0.0, 0.0, 1.0], (4, 1))
+    touch = Touch(piece, obj, np.full(4, -1), point, normals, np.zeros(4), np.zeros((4, 3)))
     out = world.pair_wrenches(ContactForces(touch, force, normal_N, np.ones(4, dtype=bool)))
     assert out.shape == (2 * len(world.body_names), 9)
     row = {(bodies[hull], 0): [0, 1], (bodies[tip], 1): [2], (bodies[tip], 0): [3]}
@@ -298,3 +299,6 @@ def test_each_body_and_object_pair_logs_its_own_wrench(reference_uvms):
         np.testing.assert_allclose(out[2 * body + k], expected, rtol=0, atol=1e-12)
     written = [2 * body + k for body, k in row]
     assert not np.any(np.delete(out, written, axis=0))
+    # points that carry no normal force (separating fast: the law's max(0, .)): the mean
+    idle = world.pair_wrenches(ContactForces(touch, force, np.zeros(4), np.ones(4, dtype=bool)))
+    np.testing.assert_allclose(idle[2 * bodies[hull], 3:6], point[:2].mean(axis=0), atol=1e-15)
