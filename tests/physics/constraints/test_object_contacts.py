@@ -13,6 +13,7 @@ from conftest import RHO, body_urdf, hydro_xml
 from free_object_helpers import undamped
 
 from uvms_pin.errors import ParameterError
+from uvms_pin.physics.constraints.object_contacts import ObjectWorldContacts
 from uvms_pin.physics.world.contact_law import ContactLaw
 from uvms_pin.physics.world.free_object import free_object
 from uvms_pin.physics.world.gaps import candidates
@@ -182,4 +183,4 @@ def test_a_contact_a_spin_brings_within_the_period_is_solved(load_body):
     assert np.all(np.abs(corners[:, 1]) == pytest.approx(1.5))
     assert np.all(corners[:, 2] == pytest.approx(-9.996))  # 4 mm up
     with pytest.raises(ParameterError, match="margin must be >= 0"):
-        type(system.object_contacts)([None], [1], [None], margin=-1e-3)
+        ObjectWorldContacts([None], [1], [None], margin=-1e-3)
