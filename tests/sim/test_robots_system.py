@@ -252,6 +252,18 @@ def test_the_joined_model_stacks_the_robots_coordinates(load_body):
     assert joined_model([], []).nq == 0
 
 
+def test_each_robots_tree_hangs_from_the_universe_in_the_joined_model(reference_uvms):
+    """Two UVMS of several links joined: each robot's root joint under the universe, its
+    other joints under their own parents, shifted past the joints before it."""
+    model = reference_uvms.model
+    joined = joined_model([model, model], ["a", "b"])
+    shift = model.njoints - 1
+    own = list(model.parents)[1:]
+    assert own.count(0) == 1 and len(own) > 2  # one root joint, and an arm below it
+    second = [0 if parent == 0 else parent + shift for parent in own]
+    assert list(joined.parents) == [0, *own, *second]
+
+
 def test_robots_need_distinct_names(load_body):
     system = System(Plant(_sphere(load_body), free_surface=False))
     with pytest.raises(ParameterError, match="one distinct name per robot"):
