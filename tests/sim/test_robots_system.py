@@ -168,8 +168,18 @@ def test_the_core_integrates_the_robots_together_as_the_reference(load_body):
 
 
 def test_the_python_backend_integrates_the_robots_in_python(load_body):
-    robots, _ = _touching_with_a_ball(load_body, backend="python")
+    """On the Python backend the robots' periods together are the reference's integration:
+    from a touching state, a period ends where the compiled one does."""
+    robots, state = _touching_with_a_ball(load_body, backend="python")
     assert robots.integration(RK4(step_s=5e-4)) == "the Python backend"
+    compiled_robots, compiled_state = _touching_with_a_ball(load_body)
+    assert robots.near(*state, 2e-3)  # together
+    taus = [np.zeros(6)] * 2
+    q, v = robots.advance(RK4(step_s=5e-4), 0.0, state, taus, 2e-3)
+    q_c, v_c = compiled_robots.advance(RK4(step_s=5e-4), 0.0, compiled_state, taus, 2e-3)
+    assert np.abs(v - state.v).max() > 1e-3  # the contacts pushed
+    np.testing.assert_allclose(q, q_c, rtol=0.0, atol=1e-12)
+    np.testing.assert_allclose(v, v_c, rtol=0.0, atol=1e-9)
 
 
 def test_a_robot_pushes_a_free_object_into_another_robot_and_momentum_stays(load_body):
