@@ -152,6 +152,20 @@ def _compiled_as_reference(uvms, free: list, fixtures: list, seconds: float) -> 
     return compiled
 
 
+def _lever_and_ball(tmp_path, friction_Nm: float):
+    """A lever fixture (limits -0.05 and 0.3 rad) at z = -5 m and a steel ball (r = 5 cm)
+    2 mm above its fixed base."""
+    lever = fixture(
+        "lever", lever_urdf(tmp_path, friction_Nm=friction_Nm, limits=(-0.05, 0.3)),
+        ([0.0, 0.0, -5.0], [0.0, 0.0, 0.0]), water_density_kg_m3=RHO,
+    )  # fmt: skip
+    ball = free_object(
+        "ball", "sphere", {"radius_m": 0.05}, ([0.02, 0.0, -5.0 + 0.025 + 0.052], [0, 0, 0]),
+        density_kg_m3=7800.0, water_density_kg_m3=RHO,
+    )  # fmt: skip
+    return lever, ball
+
+
 @pytest.mark.parametrize("friction_Nm", [0.2, 2.0])
 def test_a_ball_on_a_fixtures_fixed_base_and_lever_as_the_reference(
     reference_uvms, tmp_path, friction_Nm
@@ -161,14 +175,7 @@ def test_a_ball_on_a_fixtures_fixed_base_and_lever_as_the_reference(
     the compliant law), the lever is held by its friction at 2 N m and falls to its limit
     at 0.2 N m. The compiled system and the reference agree to 1e-9 over 0.5 s (measured
     4e-17)."""
-    lever = fixture(
-        "lever", lever_urdf(tmp_path, friction_Nm=friction_Nm, limits=(-0.05, 0.3)),
-        ([0.0, 0.0, -5.0], [0.0, 0.0, 0.0]), water_density_kg_m3=RHO,
-    )  # fmt: skip
-    ball = free_object(
-        "ball", "sphere", {"radius_m": 0.05}, ([0.02, 0.0, -5.0 + 0.025 + 0.052], [0, 0, 0]),
-        density_kg_m3=7800.0, water_density_kg_m3=RHO,
-    )  # fmt: skip
+    lever, ball = _lever_and_ball(tmp_path, friction_Nm)
 
     compiled = _compiled_as_reference(reference_uvms, [ball], [lever], 0.5)
     ball_z = compiled[:, reference_uvms.nq + 2]
@@ -248,14 +255,7 @@ def test_on_rigid_pairs_a_fixtures_fixed_base_carries_a_ball_while_its_lever_tur
     universe, joint 0) rests there, while the lever beside it (0.2 N m of friction against
     its own weight's 0.98 N m) falls to its 0.3 rad limit: the base's piece does not turn
     with the lever's joint, so the ball stays where it landed."""
-    lever = fixture(
-        "lever", lever_urdf(tmp_path, friction_Nm=0.2, limits=(-0.05, 0.3)),
-        ([0.0, 0.0, -5.0], [0.0, 0.0, 0.0]), water_density_kg_m3=RHO,
-    )  # fmt: skip
-    ball = free_object(
-        "ball", "sphere", {"radius_m": 0.05}, ([0.02, 0.0, -5.0 + 0.025 + 0.052], [0, 0, 0]),
-        density_kg_m3=7800.0, water_density_kg_m3=RHO,
-    )  # fmt: skip
+    lever, ball = _lever_and_ball(tmp_path, friction_Nm=0.2)
     world = World(reference_uvms, [], free=[ball], fixtures=[lever], moving_contact="rigid")
     system = System(Plant(reference_uvms, free_surface=False, world=world), compiled=compiled)
     states = _run(system, reference_uvms, 0.5)
