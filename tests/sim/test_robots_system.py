@@ -15,6 +15,7 @@ from uvms_pin.errors import ParameterError
 from uvms_pin.physics.compiled.extension import core_module
 from uvms_pin.physics.world.contact_law import ContactLaw
 from uvms_pin.physics.world.free_object import free_object
+from uvms_pin.physics.world.objects import plane
 from uvms_pin.physics.world.world import World
 from uvms_pin.scenario.load import load_scenario
 from uvms_pin.sim.compiled.integrator import integrator_to_core
@@ -422,3 +423,40 @@ def test_the_core_solves_each_robots_joint_limits_as_the_reference():
     for at, part in zip(runs[0].layout.q_slices, runs[0].layout.v_slices, strict=True):
         assert q[at][8] == pytest.approx(0.0, abs=1e-9)  # it ends at the limit, not past
         assert v[part][7] == pytest.approx(-0.002 / 0.01, abs=1e-6)  # what closes the gap
+
+
+def test_a_first_robots_object_resting_on_the_seabed_logs_its_weight_while_robots_touch(
+    load_body,
+):
+    """Robot a's world holds a seabed (rigid contacts with the fixed world, the default)
+    and a ball resting on it; robots a and b touch, so each period is one core call for
+    both (`RobotsSystem`). What a's run logs of the ball on the seabed is the core's rigid
+    contact of the period: the ball's weight in water, (rho_s - rho) V g, upwards."""
+    a, b = _sphere(load_body), _sphere(load_body, mass=6.0, radius=0.15)
+    radius, density = 0.05, 2000.0
+    seabed = plane("seabed", [0.0, 0.0, -6.0], [0.0, 0.0, 1.0], 0.6, 0.5)
+    ball = free_object(
+        "ball", "sphere", {"radius_m": radius}, ([1.0, 0.0, -6.0 + radius], [0.0, 0.0, 0.0]),
+        density_kg_m3=density, water_density_kg_m3=RHO,
+    )  # fmt: skip
+    world = World(a, [seabed], ContactLaw(), [ball])
+    assert world.fixed_contact == "rigid"
+    first = System(Plant(a, world=world, free_surface=False))
+    robots = Robots([first, System(Plant(b, free_surface=False))], ["a", "b"])
+    q_a, q_b = a.neutral_configuration(), b.neutral_configuration()
+    q_a[:3], q_b[:3] = [-0.24, 0.0, -5.0], [0.0, 0.003, -5.0]  # 1 cm into each other
+    state = robots.layout.join([first.initial_state(q_a, np.zeros(6)), (q_b, np.zeros(6))])
+    for system, part in zip(robots.systems, robots.split(*state), strict=True):
+        system.start(SystemState(*part))
+    robots.start(state)
+    integrator, taus = RK4(step_s=5e-4), [np.zeros(6)] * 2
+    q, v = state
+    for k in range(5):
+        assert robots.near(q, v, 2e-3)  # the robots' period, together
+        q, v = robots.advance(integrator, 2e-3 * k, SystemState(q, v), taus, 2e-3 * (k + 1))
+    q_first, v_first = robots.split(q, v)[0]
+    logged = first.logged_signals(q_first, v_first)["free_object_contact"].reshape(-1, 9)
+    names = first.moving.moving.object_pair_names
+    on_seabed = logged[[k for k, n in enumerate(names) if "seabed" in n]].sum(axis=0)
+    weight_N = (density - RHO) * 4.0 / 3.0 * np.pi * radius**3 * 9.81
+    np.testing.assert_allclose(on_seabed[:3], [0.0, 0.0, weight_N], rtol=1e-3, atol=1e-6)
