@@ -25,6 +25,7 @@ from uvms_pin.errors import ParameterError
 from uvms_pin.physics.compiled.extension import core_module
 from uvms_pin.physics.world.contact_law import ContactLaw
 from uvms_pin.physics.world.objects import plane, solid
+from uvms_pin.physics.world.touch import reach_spheres
 from uvms_pin.physics.world.world import FrictionMemory, World
 from uvms_pin.sim.integrators import RK4
 from uvms_pin.sim.plant import Plant
@@ -376,3 +377,48 @@ def test_a_shape_on_another_moving_body_is_pushed_back(reference_uvms, slide_m_s
     bare = Plant(uvms, free_surface=False).compiled  # without the pair
     expected = bare.acceleration(0.0, q, v, tau + (j1 - j2).T @ force, None)
     assert np.allclose(with_world, expected, rtol=TOL, atol=1e-10 * np.abs(expected).max())
+
+
+def test_the_core_broad_phase_turns_where_the_reference_does(reference_uvms):
+    """`Plant.world_clear` (world_bounds.hpp) and the reference's `World.clear`
+    (`touch.clear_of`) at random states, horizons and twists, the vehicle moved until the
+    lowest piece's reach sphere is 1e-7 m clear of a tilted seabed, then 1e-7 m into it, and
+    likewise for a boulder right below that piece (then no other piece's sphere is nearer):
+    both answer the same, clear and then not (each piece's reach r + 2 (|v_j| + |w_j|
+    (|c| + r)) h + clearance)."""
+    uvms = reference_uvms
+    normal = np.array([0.1, -0.05, 1.0]) / np.linalg.norm([0.1, -0.05, 1.0])
+    boulder, radius_m = np.array([0.3, -0.2, -10.7]), 0.7
+    rng = np.random.default_rng(8)
+    data = uvms.model.createData()
+    answers = []
+    for kind in ("plane", "sphere"):
+        if kind == "plane":
+            objects = [plane("floor", [0.0, 0.0, -10.0], normal, 0.6, 0.5)]
+        else:
+            shape = {"radius_m": radius_m}
+            objects = [solid("boulder", "sphere", shape, boulder, [0] * 3, 0.6, 0.5)]
+        world = World(uvms, objects)
+        core, _ = _pair(uvms, world)
+        for _ in range(8):
+            q = uvms.neutral_configuration()
+            q[3:7] = pin.Quaternion(pin.rpy.rpyToMatrix(rng.uniform(-0.4, 0.4, 3))).coeffs()
+            q[7:] = rng.uniform(-1.0, 1.0, uvms.nv - 6)
+            v = rng.normal(scale=rng.uniform(0.05, 1.5), size=uvms.nv)
+            horizon_s = rng.uniform(0.002, 0.3)
+            pin.forwardKinematics(uvms.model, data, q, v)
+            centres, radii = reach_spheres(data, world.pieces, horizon_s)
+            lowest = int(np.argmin(centres[:, 2] - radii))
+            for offset, expected in ((1e-7, True), (-1e-7, False)):
+                at = q.copy()
+                if kind == "plane":  # along z: the least height over the plane is offset
+                    height = np.min((centres - [0.0, 0.0, -10.0]) @ normal - radii)
+                    at[2] -= (height - offset) / normal[2]
+                else:  # the lowest sphere right above the boulder, offset from it
+                    above = boulder + np.array([0.0, 0.0, radius_m + radii[lowest] + offset])
+                    at[:3] += above - centres[lowest]
+                pin.forwardKinematics(uvms.model, data, at, v)
+                assert world.clear(data, horizon_s) is expected
+                assert core.compiled.world_clear(at, v, horizon_s) is expected
+                answers.append(expected)
+    assert answers.count(True) == answers.count(False) == 16
