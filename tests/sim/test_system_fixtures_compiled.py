@@ -152,15 +152,17 @@ def _compiled_as_reference(uvms, free: list, fixtures: list, seconds: float) -> 
     return compiled
 
 
-def _lever_and_ball(tmp_path, friction_Nm: float):
-    """A lever fixture (limits -0.05 and 0.3 rad) at z = -5 m and a steel ball (r = 5 cm)
-    2 mm above its fixed base."""
+def _lever_and_ball(
+    tmp_path, friction_Nm: float, *, name: str = "lever", x_m: float = 0.0, ball_at=(0.02, 0.077)
+):
+    """A lever fixture (limits -0.05 and 0.3 rad) at (``x_m``, 0, -5 m) and a steel ball
+    (r = 5 cm) at (x, z + 5 m) = ``ball_at``: by default 2 mm above the lever's fixed base."""
     lever = fixture(
-        "lever", lever_urdf(tmp_path, friction_Nm=friction_Nm, limits=(-0.05, 0.3)),
-        ([0.0, 0.0, -5.0], [0.0, 0.0, 0.0]), water_density_kg_m3=RHO,
+        name, lever_urdf(tmp_path, friction_Nm=friction_Nm, limits=(-0.05, 0.3)),
+        ([x_m, 0.0, -5.0], [0.0, 0.0, 0.0]), water_density_kg_m3=RHO,
     )  # fmt: skip
     ball = free_object(
-        "ball", "sphere", {"radius_m": 0.05}, ([0.02, 0.0, -5.0 + 0.025 + 0.052], [0, 0, 0]),
+        "ball", "sphere", {"radius_m": 0.05}, ([ball_at[0], 0.0, -5.0 + ball_at[1]], [0, 0, 0]),
         density_kg_m3=7800.0, water_density_kg_m3=RHO,
     )  # fmt: skip
     return lever, ball
@@ -186,6 +188,20 @@ def test_a_ball_on_a_fixtures_fixed_base_and_lever_as_the_reference(
     else:
         assert lever_rad.max() > 0.29  # turned to its 0.3 rad limit ...
         assert lever_rad.max() < 0.3 + 1e-6  # ... and held there
+
+
+def test_a_ball_on_the_second_of_two_fixtures_turns_it_as_the_reference(reference_uvms, tmp_path):
+    """Two levers held by 2 N m of friction against their own weight's 0.98 N m (the first
+    1 m away along x), a steel ball dropped 2 mm onto the second's arm: the ball's pairs
+    with each fixture are their own set (the second fixture's side after the free objects
+    and the first fixture), so its 35 N (3.5 N m) turns the second lever and not the first,
+    on both backends alike (to 1e-9 over 0.3 s)."""
+    far, _ = _lever_and_ball(tmp_path, friction_Nm=2.0, name="far_lever", x_m=1.0)
+    lever, ball = _lever_and_ball(tmp_path, friction_Nm=2.0, ball_at=(0.1, 0.01 + 0.052))
+    compiled = _compiled_as_reference(reference_uvms, [ball], [far, lever], 0.3)
+    far_rad, lever_rad = compiled[:, -2], compiled[:, -1]
+    assert lever_rad.max() > 0.05  # pushed down by the ball
+    np.testing.assert_allclose(far_rad, 0.0, atol=1e-9)  # held: nothing touches it
 
 
 @pytest.mark.parametrize("field", ["placements_a", "velocities_b"])
