@@ -198,28 +198,20 @@ class MovingContacts:
         """(each set's touching pairs, each free object's `ContactForces` against the fixed
         objects or None), after forward kinematics of every body with its velocity."""
         data = self._datas(uvms_data, object_datas)
-        sets = fixed = None  # the rigid ones: `solved`
-        if not self.rigid_pairs:
-            sets = [(s.search or s.pairs.forces)(data(s.a), data(s.b), s.memory) for s in self.sets]
-        if not self.rigid:
-            fixed = [
-                None if w is None else w.forces(object_datas[k], self.object_memory[k])
-                for k, w in enumerate(self.object_worlds)
-            ]
-        return self.solved(sets, fixed)
-
-    def solved(self, sets: list | None, fixed: list | None) -> tuple[list, list]:
-        """(``sets``, ``fixed``) as `contacts` gives them, the rigid ones replaced by what the
-        constraints solved over the last period (``rigid_pairs``: the sets'; ``rigid``: the
-        objects' against the fixed world): `rigid_source`'s when set (the core system that
-        solved the period), else the reference's (`rigid_pair_forces`, `rigid_forces`)."""
         rigid_sets, rigid_fixed = self.rigid_pair_forces, self.rigid_forces
         if self.rigid_source is not None and (self.rigid or self.rigid_pairs):
             rigid_sets, rigid_fixed = self.rigid_source()
-        return (
-            list(rigid_sets) if self.rigid_pairs else sets,
-            list(rigid_fixed) if self.rigid else fixed,
-        )
+        if self.rigid_pairs:
+            sets = list(rigid_sets)
+        else:
+            sets = [(s.search or s.pairs.forces)(data(s.a), data(s.b), s.memory) for s in self.sets]
+        if self.rigid:
+            return sets, list(rigid_fixed)
+        fixed = [
+            None if w is None else w.forces(object_datas[k], self.object_memory[k])
+            for k, w in enumerate(self.object_worlds)
+        ]
+        return sets, fixed
 
     def generalized(
         self, q: np.ndarray, uvms_data, states: list[State], object_datas, found

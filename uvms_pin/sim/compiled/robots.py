@@ -1,6 +1,6 @@
 """The compiled integration of several robots together (src/uvms_core/robots.hpp) of a
-`uvms_pin.sim.system.robots.Robots`: each robot's compiled system (`system_to_core`, a robot
-alone included) and the pair sets between the robots and with the first system's objects,
+`uvms_pin.sim.system.robots.Robots`: each robot's compiled system (its `System.compiled`, the
+one its own periods and logs use; for a robot alone, `system_to_core`) and the pair sets between the robots and with the first system's objects,
 built from their public attributes, with each side's reach for the bound test. One call
 crosses a control period while they touch (`Robots._together`: the integration, the anchors'
 move, each system's constraints); the bound test (`Robots.near`) and the force/torque
@@ -22,7 +22,7 @@ __all__ = ["RobotsParts", "robots_to_core"]
 class RobotsParts(Protocol):
     """What the compiled robots are built from: a `Robots`' public parts."""
 
-    systems: tuple
+    systems: tuple  # each with ``compiled``: its own core system, a Fallback or None
     contacts: Any  # `uvms_pin.physics.world.between_robots.RobotContacts`
 
 
@@ -32,7 +32,11 @@ def robots_to_core(robots: RobotsParts, core: ModuleType) -> tuple[Any, list] | 
     integrator steps them together instead."""
     systems = []
     for system in robots.systems:
-        built = system_to_core(system, core, alone=True)
+        # a system's own core system when it has one (one state: what its logs and its count
+        # of stalled solves read is what the robots' periods solved), else one of its own
+        built = system.compiled
+        if built is None:
+            built = system_to_core(system, core, alone=True)
         if isinstance(built, Fallback):
             return built
         systems.append(built)

@@ -379,9 +379,6 @@ class System:
                 robot_forces = forces_of_core(plant.compiled.world_forces(q_r, v_r, memories[0]))
                 fixed = plant.world.pair_wrenches(robot_forces).ravel()
             found = contacts_of_core(compiled.contacts(q, v, memories))
-            moving = self.moving.moving
-            if moving.rigid_source is not None:  # the core system that solved the period
-                found = moving.solved(*found)  # (several robots: theirs, not this one's)
         robot, between_objects = self.moving.moving.wrenches(found)
         out = {"world_contact": np.concatenate([fixed, robot])}
         if self.objects:
