@@ -142,3 +142,29 @@ def test_what_the_thrusters_cannot_produce_is_warned_alike():
         warned[compiled] = [str(w.message) for w in record if w.category is ActuationWarning]
         assert rollout.metadata["closed_loop"]["path"] == ("compiled" if compiled else "python")
     assert warned[True] == warned[False] and "roll moment" in warned[True][0]
+
+
+def test_after_either_loop_the_controller_holds_the_last_ticks_signals():
+    """The PPC given to a run ends with the signals of its last tick, whichever loop ran it:
+    the compiled loop hands its kernel's last call to the controller (its f_d and rpy_d,
+    `adopt_kernel_call`), the Python loop computed it; both the rollout's last logged row."""
+    scenario = load_scenario(REALISTIC, {"scenario.duration_s": 0.2})
+    held = []
+    for compiled in (True, False):
+        controller = scenario.controller_factory(scenario.uvms)
+        rollout = simulate(scenario, progress=False, controller=controller, compiled_loop=compiled)
+        assert rollout.metadata["closed_loop"]["path"] == ("compiled" if compiled else "python")
+        held.append(controller.last_signals)
+    core, python = held
+    assert core.time_s == python.time_s == pytest.approx(0.2, abs=1e-12)
+    for name in ("force_desired_world_N", "rpy_desired", "e_x", "xi_zeta", "eps_x", "tau"):
+        np.testing.assert_allclose(
+            getattr(core, name), getattr(python, name), rtol=0, atol=1e-9, err_msg=name
+        )
+    # a desired force and attitude that differ, so that swapping them shows
+    assert np.max(np.abs(core.force_desired_world_N[:3] - core.rpy_desired)) > 0.1
+    last = {k: v[-1] for k, v in rollout.signals.items()}
+    np.testing.assert_allclose(
+        core.force_desired_world_N, last["force_desired_world_N"], atol=1e-12
+    )
+    np.testing.assert_allclose(core.rpy_desired, last["rpy_desired"], atol=1e-12)
