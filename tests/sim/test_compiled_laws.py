@@ -12,6 +12,7 @@ from conftest import ROOT
 from test_compiled_loop import PAPER, PAPER_SAMPLED, REALISTIC, _assert_same
 
 from uvms_pin.apps.compare.runs import controller_scenarios
+from uvms_pin.control.base import ZeroController
 from uvms_pin.control.baselines.computed_torque import ComputedTorqueController
 from uvms_pin.control.baselines.pi_force import PIForceController
 from uvms_pin.control.ppc import PrescribedPerformanceController
@@ -42,6 +43,22 @@ def _both(scenario, **kwargs):
         except SimulationError as exc:
             out.append((exc.rollout, exc))
     return out
+
+
+def test_a_force_loop_held_at_its_anti_windup_bound_runs_compiled_as_in_python():
+    """pi_force's integral clipped at +-integral_limit_Ns (0.01 N s here, which the
+    realistic run's force error reaches within 0.5 s; the loop's gains are handed to the
+    core by the same code for computed_torque): the compiled law holds it at the same
+    bound as the Python controller, tick by tick."""
+    limit = [0.01, 0.01, 0.01]
+    overrides = {"baselines.pi_force.integral_limit_Ns": limit, "scenario.duration_s": 0.5}
+    (compiled, stop_c), (python, stop_p) = _both(_scenario(REALISTIC, "pi_force", overrides))
+    assert stop_c is None and stop_p is None
+    assert compiled.metadata["closed_loop"]["python_ticks"] == 0
+    integral = compiled.signals["force_integral_Ns"]
+    assert np.max(np.abs(integral)) == pytest.approx(0.01, abs=1e-15)  # held at the bound
+    assert np.mean(np.abs(integral[:, 0]) == 0.01) > 0.2  # for a good part of the run
+    _assert_same(compiled, python)
 
 
 @pytest.mark.parametrize("kind", BASELINES)
@@ -146,6 +163,21 @@ def test_law_to_core_says_why_a_controller_has_no_law():
     assert law_to_core(python, core).reason == "the controller's Python backend"
     motion = ComputedTorqueController(scenario.uvms, ee, reference=lambda t: (None, None, None))
     assert "motion reference" in law_to_core(motion, core).reason
+    nq, nv = model.nq, model.nv
+    assert not isinstance(law_to_core(ZeroController(nv, nq), core), Fallback)
+    assert "without nq" in law_to_core(ZeroController(nv), core).reason
+
+
+def test_a_passive_run_takes_the_compiled_loop_and_is_the_python_loops():
+    """scenarios/passive_still_water.toml (no input: the zero law) runs in the compiled
+    loop, every tick, and gives the Python loop's rollout."""
+    path = ROOT / "scenarios" / "passive_still_water.toml"
+    scenario = load_scenario(path, {"scenario.duration_s": 0.5})
+    rollouts = [simulate(scenario, progress=False, compiled_loop=c) for c in (True, False)]
+    compiled, python = (r.metadata["closed_loop"] for r in rollouts)
+    assert compiled["path"] == "compiled" and compiled["python_ticks"] == 0
+    assert python["path"] == "python"
+    _assert_same(*rollouts)
 
 
 @pytest.mark.parametrize(
