@@ -154,7 +154,9 @@ def _check_forces(plant: Plant, world: World, q, v, memory: FrictionMemory) -> i
 def test_compiled_contacts_and_rhs_are_the_reference(load_body, body, kind):
     collision, volume = BODIES[body]
     uvms = _body(load_body, collision, volume)
-    world = World(uvms, _objects(kind), ContactLaw(dissipation_s_m=0.5))
+    # every coefficient its own (a mapping that swaps two shows), none the default
+    law = ContactLaw(2.5e4, 0.5, tangential_stiffness_N_m=1.2e4, tangential_damping_N_s_m=150.0)
+    world = World(uvms, _objects(kind), law)
     core, python = _pair(uvms, world)
     rng = np.random.default_rng(11)
     points = 0
