@@ -112,6 +112,12 @@ def test_two_robots_holding_the_bar_at_rest_share_its_net_weight_as_their_coeffi
         robot = rollouts.robot(name)
         noise = robot.wrench_measured_world[:, :3] - robot.wrench_contact_world[:, :3]
         assert np.max(np.abs(noise)) <= 0.1 + 1e-9
+        # its moment is about the sensor (the end-effector frame's origin, in the jaws):
+        # at most the push times the jaws' reach (0.1 m), where about the world's origin
+        # it would be ~ 5 m x the push
+        force, moment = (np.linalg.norm(robot.wrench_contact_world[late, s], axis=1)
+                         for s in (slice(0, 3), slice(3, 6)))  # fmt: skip
+        assert np.all(moment <= 0.1 * force)
 
 
 @pytest.mark.slow
