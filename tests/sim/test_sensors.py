@@ -311,3 +311,33 @@ def test_noise_table_is_the_noise_measure_adds(reference_uvms):
         np.testing.assert_allclose(measured.q[7:] - q[7:], row[12 : 12 + n_arm], atol=1e-15)
         np.testing.assert_allclose(measured.v - v, row[12 + n_arm :], rtol=0, atol=1e-15)
     assert np.abs(table[:, 12 + n_arm :]).max() > 0.0  # the velocity noise is not silent
+
+
+def test_each_channel_draws_from_its_own_stream(reference_uvms):
+    """A channel's noise is the same whether the other channels are noisy or not (each has
+    its own generator spawned from the seed): with every channel on, and with that one
+    alone, its draws are equal, for force, torque, position, orientation, joints and
+    velocity."""
+    uvms = reference_uvms
+    q, v, wrench = _state(uvms)
+    rotation = pin.Quaternion(q[3:7]).toRotationMatrix()
+    channels = {
+        "force_noise": lambda m: m.wrench_world[:3] - wrench[:3],
+        "torque_noise": lambda m: m.wrench_world[3:] - wrench[3:],
+        "position_noise": lambda m: m.q[:3] - q[:3],
+        "orientation_noise": lambda m: pin.log3(
+            rotation.T @ pin.Quaternion(m.q[3:7]).toRotationMatrix()
+        ),
+        "joint_noise": lambda m: m.q[7:] - q[7:],
+        "velocity_noise": lambda m: m.v - v,
+    }
+    every = SensorSuite(uvms.model, _config(), DURATION, seed=9)
+    for name, noise in channels.items():
+        alone_config = SensorConfig(**{name: getattr(_config(), name)}, sample_period_s=PERIOD)
+        alone = SensorSuite(uvms.model, alone_config, DURATION, seed=9)
+        for t in _times(20):
+            drawn = noise(alone.measure(t, q, v, wrench))
+            assert np.max(np.abs(drawn)) > 0.0, name
+            np.testing.assert_allclose(
+                noise(every.measure(t, q, v, wrench)), drawn, rtol=0, atol=1e-12, err_msg=name
+            )
