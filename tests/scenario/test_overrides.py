@@ -184,6 +184,7 @@ def test_a_table_value_replaces_the_whole_table():
         ({"actuation.thruster[0]": {"name": "x"}}, "override 'actuation.thruster[0]': actuation.thruster[0].position_body_m: is required"),
         ({"actuation.thruster[0].max_forward_N": -1}, "override 'actuation.thruster[0].max_forward_N': must be >= 0"),
         ({"water[0].density_kg_m3": 1}, "'water' is not a list in the file"),
+        ({"actuation.thrustr[0].max_forward_N": 0}, "'actuation.thrustr' is not a list in the file, so it cannot be indexed (set the whole list); did you mean 'actuation.thruster'?"),
         ({"actuation.thruster[0].name[1]": "x"}, "'actuation.thruster[0].name' is not a list"),
     ],
 )  # fmt: skip
@@ -191,6 +192,17 @@ def test_bad_table_and_element_overrides_name_the_override(overrides, message):
     with pytest.raises(up.ScenarioError) as info:
         load_scenario(REALISTIC, overrides)
     assert message in str(info.value)
+
+
+def test_an_indexed_key_not_in_the_file_gets_a_hint_only_when_one_is_close():
+    """Indexing what the file does not hold as a list names the closest key of the file
+    (difflib), and no hint at all when none is close."""
+    with pytest.raises(up.ScenarioError) as info:
+        load_scenario(REALISTIC, {"water[0].density_kg_m3": 1})
+    assert str(info.value).endswith("(set the whole list); did you mean 'water.density_kg_m3'?")
+    with pytest.raises(up.ScenarioError) as info:
+        load_scenario(REALISTIC, {"zzz[0].q": 1})
+    assert str(info.value).endswith("so it cannot be indexed (set the whole list)")
 
 
 def test_a_study_varies_a_thrusters_limit(tmp_path):
