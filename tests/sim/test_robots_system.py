@@ -425,13 +425,16 @@ def test_the_core_solves_each_robots_joint_limits_as_the_reference():
         assert v[part][7] == pytest.approx(-0.002 / 0.01, abs=1e-6)  # what closes the gap
 
 
+@pytest.mark.parametrize("compiled", [True, False], ids=["compiled-systems", "python-loop"])
 def test_a_first_robots_object_resting_on_the_seabed_logs_its_weight_while_robots_touch(
-    load_body,
+    load_body, compiled
 ):
     """Robot a's world holds a seabed (rigid contacts with the fixed world, the default)
     and a ball resting on it; robots a and b touch, so each period is one core call for
     both (`RobotsSystem`). What a's run logs of the ball on the seabed is the core's rigid
-    contact of the period: the ball's weight in water, (rho_s - rho) V g, upwards."""
+    contact of the period: the ball's weight in water, (rho_s - rho) V g, upwards. Systems
+    built compiled log it from their core system; those of a run (the Python loop,
+    ``compiled=False``) by the reference's path, from the core system that solved it."""
     a, b = _sphere(load_body), _sphere(load_body, mass=6.0, radius=0.15)
     radius, density = 0.05, 2000.0
     seabed = plane("seabed", [0.0, 0.0, -6.0], [0.0, 0.0, 1.0], 0.6, 0.5)
@@ -441,8 +444,9 @@ def test_a_first_robots_object_resting_on_the_seabed_logs_its_weight_while_robot
     )  # fmt: skip
     world = World(a, [seabed], ContactLaw(), [ball])
     assert world.fixed_contact == "rigid"
-    first = System(Plant(a, world=world, free_surface=False))
-    robots = Robots([first, System(Plant(b, free_surface=False))], ["a", "b"])
+    first = System(Plant(a, world=world, free_surface=False), compiled=compiled)
+    second = System(Plant(b, free_surface=False), compiled=compiled)
+    robots = Robots([first, second], ["a", "b"])
     q_a, q_b = a.neutral_configuration(), b.neutral_configuration()
     q_a[:3], q_b[:3] = [-0.24, 0.0, -5.0], [0.0, 0.003, -5.0]  # 1 cm into each other
     state = robots.layout.join([first.initial_state(q_a, np.zeros(6)), (q_b, np.zeros(6))])
