@@ -197,3 +197,41 @@ def test_a_robot_started_inside_a_fixture_is_refused_naming_both_and_the_depth()
     ):
         simulate(load_scenario(panel, inside), progress=False)
     assert simulate(load_scenario(panel, {"scenario.duration_s": 0.1}), progress=False).status.ok
+
+
+@pytest.mark.parametrize(
+    ("q0", "v_free", "stops"),
+    [(0.2, 3.0, "limit"), (0.0, 0.01, "friction"), (0.0, 3.0, "slides")],
+)
+def test_a_fixtures_exact_step_reports_the_impulses_that_changed_its_velocity(
+    tmp_path, q0, v_free, stops
+):
+    """A lever's joint stepped apart (`with_fixtures`, its exact step): what the step
+    reports is what it did, as every constraint step's output must be: the generalized
+    impulse is M (v+ - v_free), and it is the joint rows' J^T of their (friction, limit)
+    impulses. Driven into its upper limit (0.2 rad) at 3 rad/s the limit stops it; at
+    0.01 rad/s from q = 0 its 0.5 N m of friction holds it; at 3 rad/s it slides on,
+    slowed by the friction's impulse c h."""
+    lever = _lever(tmp_path, friction_Nm=0.5, limits=(-0.1, 0.2))
+    model = fixtures.system_model(pin.Model(), [lever])
+    own, blocks, h = fixtures.constraints(1, [lever]), fixtures.blocks(1, 0, [lever]), PERIOD_S
+    mass = np.array([[lever.uvms.model.inertias[1].mass * LEVER_ARM_M**2 + LEVER_OWN_IYY]])
+    v = np.array([v_free])
+    out = fixtures.with_fixtures(
+        constrained_velocity, own, blocks, model, mass, v, np.array([q0]), own, h
+    )
+    np.testing.assert_allclose(out.generalized_impulse, mass @ (out.velocity - v), atol=1e-15)
+    (rows,) = [b for b in out.rows if b.name == fixtures.FIXTURE_JOINTS]
+    impulses = out.impulses[fixtures.FIXTURE_JOINTS].reshape(-1, 2)
+    np.testing.assert_allclose(
+        out.generalized_impulse, rows.jacobian.T @ impulses.sum(axis=1), atol=1e-15
+    )
+    friction, limit = impulses[0]
+    if stops == "limit":
+        assert out.velocity[0] <= 1e-12 and limit < -0.1 * mass[0, 0] * v_free
+    elif stops == "friction":
+        assert abs(out.velocity[0]) <= 1e-15 and limit == 0.0
+        assert friction == pytest.approx(-mass[0, 0] * v_free, rel=1e-12)
+    else:
+        assert abs(limit) <= 1e-15 and friction == pytest.approx(-0.5 * h, rel=1e-12)
+        assert out.velocity[0] == pytest.approx(v_free - 0.5 * h / mass[0, 0], rel=1e-12)
