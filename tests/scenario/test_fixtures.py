@@ -12,6 +12,7 @@ from uvms_pin.errors import ScenarioError
 from uvms_pin.scenario.load import load_scenario
 from uvms_pin.scenario.trust import check_no_code
 from uvms_pin.sim.run import simulate
+from uvms_pin.sim.system import System
 
 VALVE_PANEL = ROOT / "scenarios" / "valve_panel.toml"
 
@@ -113,3 +114,17 @@ def test_the_valve_panel_scenario_runs_stable_at_its_step():
     assert np.all(np.isfinite(rollout.q)) and np.max(np.abs(rollout.v)) < 1.0
     np.testing.assert_allclose(table["panel.valve_rad"], 0.0, atol=1e-9)
     assert "fixture" in rollout.metadata["world"]["world"]["integration"]
+
+
+def test_a_fixtures_friction_is_the_one_its_links_touch_with():
+    """The valve panel's ``friction_static`` and ``friction_kinetic`` (set apart here, 0.9
+    and 0.2) are the mu_s and mu_k of every pair against its links: the robot's pieces'
+    and (none here) the free objects'."""
+    path = ROOT / "scenarios" / "valve_turn.toml"
+    mu = {"world.objects[0].friction_static": 0.9, "world.objects[0].friction_kinetic": 0.2}
+    scenario = load_scenario(path, mu)
+    (panel,) = scenario.plant.world.fixtures
+    assert (panel.friction_static, panel.friction_kinetic) == (0.9, 0.2)
+    system = System(scenario.plant)
+    against = [s.pairs for s in system.moving.moving.sets if s.b == len(system.objects)]
+    assert against and all(np.array_equal(p.mu, [[0.9, 0.2]] * len(p.pairs)) for p in against)
