@@ -13,7 +13,7 @@ from conftest import body_urdf, hydro_xml
 from free_object_helpers import undamped
 
 from uvms_pin.errors import ParameterError
-from uvms_pin.physics.constraints.attachments import anchor_error
+from uvms_pin.physics.constraints.attachments import Attachments, anchor_error
 from uvms_pin.physics.world.attachment import Attachment
 from uvms_pin.physics.world.free_object import free_object
 from uvms_pin.physics.world.world import World
@@ -83,6 +83,7 @@ def test_the_anchor_rows_are_the_rate_of_its_pose_error(reference_uvms):
     data.q_in = q
     rows = held.rows(system.model, data, q, np.zeros(system.model.nv), PERIOD_S)
     assert rows.size == 6 and rows.bilateral.all()
+    assert rows.labels == tuple(f"ball@tool[{k}]" for k in range(6))  # one a row, named
     np.testing.assert_allclose(rows.gap, anchor_error(system.model, data, held.held[0]))
     assert 1e-6 < np.linalg.norm(rows.gap) < 1e-3
     v, eps = rng.standard_normal(system.model.nv), 1e-7
@@ -208,6 +209,10 @@ def test_bad_attachments_are_refused_naming_the_object_or_the_link(reference_uvm
         Attachment("ball", "tool", release_at_s=0.3, attach_at_s=0.5)
     with pytest.raises(ParameterError, match="attach_at_s must be finite and >= 0"):
         Attachment("ball", "tool", attach_at_s=float("nan"))
+    # the constraint's own check: both bodies are moving joints of the system's model
+    for joints in ((0, 7), (7, 0), (-1, 7)):
+        with pytest.raises(ParameterError, match="the attachment of 'ball': no such joint"):
+            Attachments([(Attachment("ball", "tool"), *joints)])
 
 
 def test_the_compiled_attachment_holds_as_the_reference(reference_uvms):
