@@ -463,4 +463,5 @@ def test_a_first_robots_object_resting_on_the_seabed_logs_its_weight_while_robot
     names = first.moving.moving.object_pair_names
     on_seabed = logged[[k for k, n in enumerate(names) if "seabed" in n]].sum(axis=0)
     weight_N = (density - RHO) * 4.0 / 3.0 * np.pi * radius**3 * 9.81
+    # 5.00733 N logged against 5.00809 N: the period's mean force, 10 ms after the start
     np.testing.assert_allclose(on_seabed[:3], [0.0, 0.0, weight_N], rtol=1e-3, atol=1e-6)

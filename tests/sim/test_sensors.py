@@ -331,9 +331,10 @@ def test_each_channel_draws_from_its_own_stream(reference_uvms):
         "joint_noise": lambda m: m.q[7:] - q[7:],
         "velocity_noise": lambda m: m.v - v,
     }
-    every = SensorSuite(uvms.model, _config(), DURATION, seed=9)
+    config = _config()
+    every = SensorSuite(uvms.model, config, DURATION, seed=9)
     for name, noise in channels.items():
-        alone_config = SensorConfig(**{name: getattr(_config(), name)}, sample_period_s=PERIOD)
+        alone_config = SensorConfig(**{name: getattr(config, name)}, sample_period_s=PERIOD)
         alone = SensorSuite(uvms.model, alone_config, DURATION, seed=9)
         for t in _times(20):
             drawn = noise(alone.measure(t, q, v, wrench))

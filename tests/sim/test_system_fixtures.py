@@ -215,7 +215,7 @@ def test_a_fixtures_exact_step_reports_the_impulses_that_changed_its_velocity(
     lever = _lever(tmp_path, friction_Nm=0.5, limits=(-0.1, 0.2))
     model = fixtures.system_model(pin.Model(), [lever])
     own, blocks, h = fixtures.constraints(1, [lever]), fixtures.blocks(1, 0, [lever]), PERIOD_S
-    mass = np.array([[lever.uvms.model.inertias[1].mass * LEVER_ARM_M**2 + LEVER_OWN_IYY]])
+    mass = np.array([[INERTIA]])
     v = np.array([v_free])
     out = fixtures.with_fixtures(
         constrained_velocity, own, blocks, model, mass, v, np.array([q0]), own, h

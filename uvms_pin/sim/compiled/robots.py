@@ -1,7 +1,8 @@
 """The compiled integration of several robots together (src/uvms_core/robots.hpp) of a
-`uvms_pin.sim.system.robots.Robots`: each robot's compiled system (its `System.compiled`, the
-one its own periods and logs use; for a robot alone, `system_to_core`) and the pair sets between the robots and with the first system's objects,
-built from their public attributes, with each side's reach for the bound test. One call
+`uvms_pin.sim.system.robots.Robots`: each robot's compiled system (its `System.compiled`,
+the one its own periods and logs use; for a robot alone, `system_to_core`) and the pair
+sets between the robots and with the first system's objects, built from their public
+attributes, with each side's reach for the bound test. One call
 crosses a control period while they touch (`Robots._together`: the integration, the anchors'
 move, each system's constraints); the bound test (`Robots.near`) and the force/torque
 sensors' wrenches on the objects (`Robots.object_wrenches`) are a call each."""
