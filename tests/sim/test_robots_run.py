@@ -12,7 +12,7 @@ import pytest
 from conftest import ROOT
 
 from uvms_pin.control.base import Controller
-from uvms_pin.errors import ControllerError, ParameterError, ScenarioError
+from uvms_pin.errors import ControllerError, ParameterError, ScenarioError, StiffModeError
 from uvms_pin.scenario.load import load_scenario, scenario_from_dict
 from uvms_pin.scenario.toml import read_toml
 from uvms_pin.sim.log import RolloutLog, run_metadata
@@ -193,6 +193,30 @@ def test_rigid_moving_contacts_with_several_robots_are_refused_by_name():
     refused = r'moving_contact = "rigid" is not simulated with several robots'
     with pytest.raises(ParameterError, match=refused):
         simulate_robots(scenario_from_dict(doc, transport))
+
+
+def test_a_stiff_pair_among_robots_is_refused_without_offering_what_robots_refuse():
+    """A ball against alpha's light jaw is unstable at two_robots' RK4 step of 2.5 ms: the
+    run is refused before it starts, naming the pair and the largest stable step, and its
+    ways out are a smaller step or a softer contact, not the rigid moving contact (which a
+    single robot is offered and several robots refuse)."""
+    doc = copy.deepcopy(read_toml(TWO, ScenarioError))
+    doc["scenario"]["duration_s"] = 0.05
+    ball = {"type": "sphere", "name": "ball", "radius_m": 0.25, "density_kg_m3": 2000.0,
+            "position_world_m": [-0.5, 0.0, -1.8]}  # fmt: skip
+    doc["world"] = {"objects": [ball]}
+    with pytest.raises(StiffModeError, match="against the free object 'ball'") as refused:
+        simulate_robots(scenario_from_dict(doc, TWO))
+    message = str(refused.value)
+    assert "the largest stable step is" in message and "soften the contact" in message
+    assert "moving_contact" not in message
+    # the same pair in the first robot's run alone is offered the rigid contact
+    alone = copy.deepcopy(doc)
+    first = alone.pop("robots")[0]
+    alone["scenario"]["model"] = first.pop("model")
+    alone.update({key: value for key, value in first.items() if key != "name"})
+    with pytest.raises(StiffModeError, match='moving_contact = "rigid"'):
+        simulate(scenario_from_dict(alone, TWO), progress=False)
 
 
 def test_progress_is_given_as_to_simulate(capsys):

@@ -21,7 +21,7 @@ from dataclasses import replace
 import numpy as np
 
 from uvms_pin.control.base import Controller
-from uvms_pin.errors import ActuationWarning, ParameterError, SimulationError
+from uvms_pin.errors import ActuationWarning, ParameterError, SimulationError, StiffModeError
 from uvms_pin.hydro.vector import cross3
 from uvms_pin.results.robots import RobotRollouts
 from uvms_pin.results.status import INTERRUPTED, OK, RunStatus
@@ -33,6 +33,7 @@ from uvms_pin.sim.pipeline import Pipeline, RunParts, why_not_compiled
 from uvms_pin.sim.plant import Plant
 from uvms_pin.sim.sensors import SensorSuite
 from uvms_pin.sim.settings import SimulationSettings
+from uvms_pin.sim.stiff_modes import without_rigid_pairs
 from uvms_pin.sim.system import SystemState
 from uvms_pin.sim.system.robots import Robots
 
@@ -75,7 +76,10 @@ class RobotsLoop:
         robots refused if they start inside each other, then the contacts between robots
         anchored."""
         for loop, (q0, v0), suite in zip(self.loops, starts, sensors, strict=True):
-            loop.start(q0, v0, suite)
+            try:
+                loop.start(q0, v0, suite)
+            except StiffModeError as error:  # `Robots` refuses rigid moving contacts
+                raise without_rigid_pairs(error) from None
         self.time_s = 0.0
         self.state = self.system.layout.join([loop.state for loop in self.loops])
         self.system.check_apart(self.state)  # no robot started inside another

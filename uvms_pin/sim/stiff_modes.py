@@ -41,11 +41,12 @@ little (the vehicle's mass dominates the arm's reflected inertia only near the b
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 import pinocchio as pin
 
+from uvms_pin.errors import StiffModeError
 from uvms_pin.physics.constraints.contacts import point_jacobian
 from uvms_pin.physics.contact import CompliantPlane, ContactModel, LinearSpring
 from uvms_pin.physics.joint_stops import JointStops
@@ -61,6 +62,7 @@ __all__ = [
     "contact_modes",
     "environment_mode",
     "stop_modes",
+    "without_rigid_pairs",
 ]
 
 LINEAR = ("N/m", "N s/m", "kg")
@@ -210,6 +212,13 @@ def contact_modes(
         StiffMode(f"{what}, at first touch", k, 0.0, mass, remedy=remedy),
         StiffMode(f"{what}, {depth * 1e3:.3g} mm deep", k, damping, mass, remedy=remedy),
     ]
+
+
+def without_rigid_pairs(error: StiffModeError) -> StiffModeError:
+    """``error`` again without the rigid moving contact among its remedies: for a run that
+    cannot take it (several robots: `uvms_pin.sim.system.robots.Robots` refuses it)."""
+    mode = replace(error.mode, remedy=error.mode.remedy.replace(_RIGID_PAIRS, ""))
+    return StiffModeError(mode, error.integrator, error.step_s, error.largest_stable_step_s)
 
 
 _NO_DRIVE = (
