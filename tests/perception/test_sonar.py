@@ -55,6 +55,29 @@ def test_the_altimeter_hears_the_seabed_at_its_altitude(reference_uvms):
     assert abs(spec.range_m[np.argmax(profile)] - 3.2) <= spec.range_m[1] - spec.range_m[0]
 
 
+def test_an_altimeter_by_its_type_alone_has_one_narrow_beam_and_hears_the_seabed(
+    reference_uvms,
+):
+    """``type = "altimeter"`` and nothing else: one beam, a 0.44 rad cone (the Ping's 25
+    degrees); a fan's type keeps its 256 beams over 2 rad. Under it a seabed sloping 20
+    degrees, 3 m down: the cone's rays meet it from 2.84 m (the ray 7.5 degrees off its
+    normal) to 3.34 m, and the echo is there. With the fan's 2 rad as its cone (the default
+    before), the altimeter on the vehicle's body heard the robot's own links at 0.16 m."""
+    spec = SonarSpec.from_dict(
+        {"name": "alt", "type": "altimeter", "rpy_rad": [0.0, np.pi / 2, 0.0]}, "alt"
+    )
+    assert (spec.beams, spec.horizontal_fov_rad) == (1, 0.44)
+    for kind in ("imaging", "multibeam"):
+        fan = SonarSpec("s", type=kind)
+        assert (fan.beams, fan.horizontal_fov_rad) == (256, 2.0)
+    slope = np.deg2rad(20.0)
+    seabed = plane("seabed", [0.0, 0.0, -23.0], [np.sin(slope), 0.0, np.cos(slope)], 0.5, 0.4)
+    sonar = Sonar(spec, _scene(reference_uvms, [seabed]), np.random.default_rng(0))
+    heard = spec.range_m[np.argmax(sonar.intensity()[:, 0])]
+    bin_m = spec.range_m[1] - spec.range_m[0]
+    assert 2.84 - bin_m <= heard <= 3.34 + bin_m
+
+
 def test_the_same_seed_gives_the_same_speckle(reference_uvms):
     wall = plane("wall", [5.0, 0.0, -20.0], [-1.0, 0.0, 0.0], 0.5, 0.4)
 
@@ -124,6 +147,7 @@ def test_a_multibeams_range_noise_is_seeded(reference_uvms):
         ({"type": "altimeter", "beams": 4}, "beams"),
         ({"max_range_m": 0.05}, "max_range_m"),
         ({"vertical_fov_rad": 0.0}, "vertical_fov_rad"),
+        ({"type": "altimeter", "horizontal_fov_rad": "wide"}, "horizontal_fov_rad"),
         ({"type": "multibeam", "range_noise_m": -0.1}, "range_noise_m"),
     ],
 )

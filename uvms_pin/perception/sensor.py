@@ -183,7 +183,9 @@ def check_fields_of_view(spec: Any, label: str, keys: tuple[str, ...]) -> None:
     (0, pi) [rad]."""
     for key in keys:
         value = getattr(spec, key)
-        if not (0.0 < value < math.pi):
+        if isinstance(value, bool) or not (
+            isinstance(value, int | float) and 0.0 < value < math.pi
+        ):
             raise ParameterError(f"{label}: {key} must be in (0, pi), got {value}")
 
 

@@ -42,16 +42,27 @@ __all__ = ["SONAR", "Sonar", "SonarSpec"]
 
 TYPES = ("imaging", "multibeam", "altimeter")
 
+#: The keys whose defaults depend on the type, and those defaults: a fan of 256 beams over
+#: 2 rad (about 115 degrees) for an imaging sonar or a multibeam; an altimeter's one beam a
+#: cone of 0.44 rad (25 degrees, the Blue Robotics Ping echosounder's beam width, the
+#: altimeter of the BlueROV2 this project starts from)
+DEFAULTS_BY_TYPE = {
+    "imaging": {"beams": 256, "horizontal_fov_rad": 2.0},
+    "multibeam": {"beams": 256, "horizontal_fov_rad": 2.0},
+    "altimeter": {"beams": 1, "horizontal_fov_rad": 0.44},
+}
+
 
 @dataclass(frozen=True)
 class SonarSpec:
-    """A sonar's table (``[[sensors.sonar]]``; the checks in `__post_init__`)."""
+    """A sonar's table (``[[sensors.sonar]]``; the checks in `__post_init__`). ``beams`` and
+    ``horizontal_fov_rad`` left None take their type's defaults (`DEFAULTS_BY_TYPE`)."""
 
     name: str
     type: str = "imaging"
-    beams: int = 256
+    beams: int | None = None
     bins: int = 512
-    horizontal_fov_rad: float = 2.0
+    horizontal_fov_rad: float | None = None
     vertical_fov_rad: float = 0.35
     max_range_m: float = 20.0
     min_range_m: float = 0.1
@@ -72,6 +83,9 @@ class SonarSpec:
             raise ParameterError(
                 f"{label}: type must be one of {', '.join(TYPES)}, got {self.type!r}"
             )
+        for key, default in DEFAULTS_BY_TYPE[self.type].items():
+            if getattr(self, key) is None:  # frozen: set once, here
+                object.__setattr__(self, key, default)
         sensor.check_counts(self, label, {"beams": 4096, "bins": 8192, "rays_per_beam": 1024})
         if self.type == "altimeter" and self.beams != 1:
             raise ParameterError(f"{label}: beams must be 1 for an altimeter, got {self.beams}")
