@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import math
 
 import pytest
 from conftest import ROOT
@@ -169,3 +170,34 @@ def test_a_metric_of_your_own_that_fails_does_not_make_the_arm_a_model_error(tmp
     assert "metric 'arm_metrics_broken:boom' raised ValueError: x" in row["reason"]
     saved = json.loads((tmp_path / "out" / "reference" / "metrics.json").read_text())
     assert "raised ValueError" in saved["extra_metrics_error"]
+
+
+def test_a_tracking_task_is_compared_by_its_tracking_errors(tmp_path):
+    """On a tracking task (the circle of scenarios/bluerov_alpha5_ee_circle.toml) a row has
+    the run's tracking errors (its metrics'), the Markdown table shows them and not the
+    force columns no arm has, the CSV keeps every column, the figure's first panels are
+    the tracking errors; a run that ends within the task's transient has no tracking error
+    (NaN, an empty cell)."""
+    from uvms_pin.apps.arms.figure import panels
+    from uvms_pin.apps.arms.row import COLUMNS
+
+    circle = ROOT / "scenarios" / "bluerov_alpha5_ee_circle.toml"
+    settings = CompareSettings(
+        duration_s=0.3, overrides=(("task.transient_s", 0.1),), keep_rollouts=True
+    )
+    (row,) = compare_arms(circle, ["reference"], tmp_path / "after", settings)
+    metrics = json.loads((tmp_path / "after" / "reference" / "metrics.json").read_text())
+    assert row["task_position_error_rms_m"] == metrics["task_position_error_rms_m"] > 0.0
+    assert row["task_orientation_error_rms_rad"] == metrics["task_orientation_error_rms_rad"]
+    assert math.isnan(row["force_error_rms_N"])
+    table = (tmp_path / "after" / "comparison.md").read_text()
+    assert "| tracking position error RMS [m] |" in table and "force error" not in table
+    header = (tmp_path / "after" / "comparison.csv").read_text().splitlines()[0]
+    assert header.split(",") == [key for key, _ in COLUMNS]
+    assert [key for key, _ in panels([row])[:2]] == [
+        "task_position_error_rms_m",
+        "task_orientation_error_rms_rad",
+    ]
+    within = CompareSettings(duration_s=0.1)  # the task's transient is 5 s
+    (short,) = compare_arms(circle, ["reference"], tmp_path / "within", within)
+    assert short["status"] == "ok" and math.isnan(short["task_position_error_rms_m"])

@@ -65,3 +65,19 @@ def test_the_mount_orientation_said_is_the_comparisons_or_each_arms_own(tmp_path
     ]:  # fmt: skip
         write_comparison(arms, tmp_path, scenario="s", settings=CompareSettings(mount_rpy=given))
         assert said in (tmp_path / "comparison.md").read_text().splitlines()[3]
+
+
+def test_the_markdown_shows_the_columns_of_the_task_some_arm_has(tmp_path):
+    """A contact task's rows (a force error) show the force columns and no tracking one;
+    a tracking task's the tracking columns and no force one; the CSV has both."""
+    write_comparison(_rows(), tmp_path)
+    header = (tmp_path / "comparison.md").read_text().splitlines()[4]
+    assert "| force error RMS [N] |" in header and "tracking" not in header
+    tracked = nan_row("reference")
+    tracked.update(status="ok", task_position_error_rms_m=7e-4, task_orientation_error_rms_rad=2e-4)
+    write_comparison([tracked, _rows()[1]], tmp_path)
+    header = (tmp_path / "comparison.md").read_text().splitlines()[4]
+    assert "| tracking position error RMS [m] | tracking orientation error RMS [rad] |" in header
+    assert "force error" not in header and "funnel" not in header
+    with open(tmp_path / "comparison.csv", newline="") as f:
+        assert list(next(csv.DictReader(f))) == [key for key, _ in COLUMNS]

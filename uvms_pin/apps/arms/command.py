@@ -57,8 +57,12 @@ def _cmd_compare_arms(args: argparse.Namespace) -> int:
         rows = compare_arms(args.scenario, arms, out, settings, jobs=args.jobs, progress=say)
     width = max(len(r["arm"]) for r in rows)
     for r in rows:
-        err = r["force_error_rms_N"]
-        err_text = "" if math.isnan(err) else f"force error RMS {err:.3f} N"
+        force, tracking = r["force_error_rms_N"], r["task_position_error_rms_m"]
+        err_text = ""
+        if not math.isnan(force):
+            err_text = f"force error RMS {force:.3f} N"
+        elif not math.isnan(tracking):
+            err_text = f"tracking position error RMS {tracking * 1e3:.2f} mm"
         print(f"{r['arm']:<{width}}  {r['status']:<16} {err_text}")
     print(f"wrote {args.out}/comparison.csv, comparison.md, comparison.png")
     if args.keep_rollouts:

@@ -1,9 +1,10 @@
 """``comparison.png``: six bar charts of the arms side by side.
 
-Force error RMS, minimum funnel margins (1st / 2nd level), peak vehicle force, peak joint
-torque, net buoyancy before / after trim, system mass. Bars are green for a completed
-task, gray for an unreachable contact point, red for a failure; the buoyancy panel's
-are blue (before trim) and orange (after).
+The task's two (a contact task's force error RMS and minimum funnel margins, 1st / 2nd
+level; a tracking task's position and orientation error RMS), peak vehicle force, peak
+joint torque, net buoyancy before / after trim, system mass. Bars are green for a completed
+task, gray for an unreachable start point, red for a failure; the buoyancy panel's are blue
+(before trim) and orange (after).
 """
 
 from __future__ import annotations
@@ -13,7 +14,9 @@ from pathlib import Path
 
 import numpy as np
 
-#: (row key, title) of the panels, row by row.
+from uvms_pin.apps.arms.row import has_values
+
+#: (row key, title) of the panels, row by row; a tracking task's first two `TRACKING_PANELS`
 PANELS = (
     ("force_error_rms_N", "force error RMS [N]"),
     ("funnel_margin_min_first", "min funnel margin (1st / 2nd level)"),
@@ -22,6 +25,19 @@ PANELS = (
     ("net_buoyancy_before_N", "net buoyancy before / after trim [N]"),
     ("system_mass_kg", "system mass [kg]"),
 )
+TRACKING_PANELS = (
+    ("task_position_error_rms_m", "tracking position error RMS [m]"),
+    ("task_orientation_error_rms_rad", "tracking orientation error RMS [rad]"),
+)
+
+
+def panels(rows: list[dict]) -> tuple[tuple[str, str], ...]:
+    """`PANELS`, the first two a tracking task's when no arm has a force error and some
+    has a tracking error."""
+    tracking = not has_values(rows, "force_error_rms_N") and any(
+        has_values(rows, key) for key, _ in TRACKING_PANELS
+    )
+    return (*TRACKING_PANELS, *PANELS[2:]) if tracking else PANELS
 
 
 def _status_color(status: str) -> str:
@@ -66,7 +82,7 @@ def comparison_figure(rows: list[dict], out: Path) -> Path:
     colors = [_status_color(r["status"]) for r in rows]
     x = np.arange(len(rows))
     fig, axes = plt.subplots(2, 3, figsize=(14, 7.5))
-    for ax, (key, title) in zip(axes.flat, PANELS, strict=True):
+    for ax, (key, title) in zip(axes.flat, panels(rows), strict=True):
         _bars(ax, rows, key, colors)
         ax.set_title(title, fontsize=10)
         ax.set_xticks(x, names, rotation=30, ha="right", fontsize=8)

@@ -240,7 +240,7 @@ def _add_notes(row: dict, orientation_error_rad: float, trim_notes: str) -> None
     if orientation_error_rad > 1e-3:
         note = (
             f"initial tool orientation {math.degrees(orientation_error_rad):.1f} deg "
-            "from the paper's (the arm cannot match it at the contact point)"
+            "from the reference arm's (the arm cannot match it at the task's start point)"
         )
         row["reason"] = f"{note}; {row['reason']}" if row["reason"] else note
     if trim_notes:

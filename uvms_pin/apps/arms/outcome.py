@@ -24,6 +24,8 @@ METRICS = (
     "force_error_rms_after_transient_N",
     "funnel_margin_min_first",
     "funnel_margin_min_second",
+    "task_position_error_rms_m",
+    "task_orientation_error_rms_rad",
     "vehicle_force_peak_N",
     "vehicle_torque_peak_Nm",
     "joint_torque_peak_Nm",

@@ -19,11 +19,13 @@ COLUMNS: tuple[tuple[str, str], ...] = (
     ("foam_volume_L", "foam [L]"),
     ("ballast_kg", "ballast [kg]"),
     ("bg_cm", "BG [cm]"),
-    ("initial_orientation_error_deg", "initial orientation vs paper [deg]"),
+    ("initial_orientation_error_deg", "initial orientation vs reference [deg]"),
     ("force_error_rms_N", "force error RMS [N]"),
     ("force_error_rms_after_transient_N", "force error RMS after transient [N]"),
     ("funnel_margin_min_first", "min funnel margin 1st"),
     ("funnel_margin_min_second", "min funnel margin 2nd"),
+    ("task_position_error_rms_m", "tracking position error RMS [m]"),
+    ("task_orientation_error_rms_rad", "tracking orientation error RMS [rad]"),
     ("vehicle_force_peak_N", "peak vehicle force [N]"),
     ("vehicle_torque_peak_Nm", "peak vehicle torque [N m]"),
     ("joint_torque_peak_Nm", "peak joint torque [N m]"),
@@ -32,6 +34,25 @@ COLUMNS: tuple[tuple[str, str], ...] = (
     ("dry_links", "dry links"),
     ("reason", "why"),
 )
+
+
+#: The columns of one kind of task: a contact task's force and funnels, a tracking task's
+#: errors (`uvms_pin.results.task_metrics`). The Markdown table and the figure show those
+#: some arm has a value of; the CSV has every column.
+TASK_COLUMNS = {
+    "force": (
+        "force_error_rms_N",
+        "force_error_rms_after_transient_N",
+        "funnel_margin_min_first",
+        "funnel_margin_min_second",
+    ),
+    "tracking": ("task_position_error_rms_m", "task_orientation_error_rms_rad"),
+}
+
+
+def has_values(rows: list[dict], key: str) -> bool:
+    """Whether some row has a number in column ``key`` (NaN: never got)."""
+    return any(math.isfinite(float(row.get(key, math.nan))) for row in rows)
 
 
 def nan_row(name: str) -> dict:

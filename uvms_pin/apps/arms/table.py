@@ -2,7 +2,8 @@
 
 Numbers are written with 4 significant digits; a number an arm never got (NaN) is an
 empty cell. The Markdown table leaves out the long columns (why, dry links): they follow
-as notes per arm.
+as notes per arm; and the columns of a kind of task no arm has a value of (a tracking
+task's table has no force column, `TASK_COLUMNS`).
 """
 
 from __future__ import annotations
@@ -12,7 +13,7 @@ import io
 from pathlib import Path
 
 from uvms_pin.apps.arms.figure import comparison_figure
-from uvms_pin.apps.arms.row import COLUMNS
+from uvms_pin.apps.arms.row import COLUMNS, TASK_COLUMNS, has_values
 from uvms_pin.apps.arms.settings import CompareSettings
 from uvms_pin.model.mount.catalog import UPSIDE_DOWN
 from uvms_pin.results.atomic import write_text_atomic
@@ -42,7 +43,8 @@ def _csv_text(rows: list[dict]) -> str:
 
 def _markdown(rows: list[dict], scenario: str, settings: CompareSettings | None) -> str:
     """The title, the settings, the table and the notes per arm."""
-    table_cols = [c for c in COLUMNS if c[0] not in ("reason", "dry_links")]
+    unused = {key for keys in TASK_COLUMNS.values() for key in keys if not has_values(rows, key)}
+    table_cols = [c for c in COLUMNS if c[0] not in ("reason", "dry_links", *unused)]
     lines = [
         f"# Arm comparison: {scenario}",
         "",
