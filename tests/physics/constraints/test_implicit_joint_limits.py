@@ -155,8 +155,9 @@ def test_refusals(alpha5):
         constrained_velocity(model, mass[:9], v, q, [limits], PERIOD_S)
     with pytest.raises(ParameterError, match="period_s"):
         constrained_velocity(model, mass, v, q, [limits], 0.0)
-    with pytest.raises(ParameterError, match="correction"):
-        constrained_velocity(model, mass, v, q, [limits], PERIOD_S, correction=1.5)
+    for beta in (1.5, 0.0):  # beta in (0, 1]: 0 would never remove a penetration
+        with pytest.raises(ParameterError, match="correction"):
+            constrained_velocity(model, mass, v, q, [limits], PERIOD_S, correction=beta)
     with pytest.raises(ParameterError, match="own name"):
         constrained_velocity(model, mass, v, q, [limits, limits], PERIOD_S)
     with pytest.raises(ParameterError, match="one coordinate"):
@@ -165,13 +166,18 @@ def test_refusals(alpha5):
         JointLimits((2,), margin=-1.0)
 
 
-def test_without_rows_the_velocity_is_the_free_one(alpha5):
+@pytest.mark.parametrize("period_s", [2e-3, 5e-4])  # a period under 1 ms too
+def test_without_rows_the_velocity_is_the_free_one(alpha5, period_s):
+    """Nothing within reach: no solve, v+ = v_free, no impulse, nothing stalled."""
     q, _ = _start(alpha5)
     v_free = np.r_[np.zeros(6), 0.1, 0.1, 0.1, 0.1]
     mass = up.mass_matrix(alpha5, q)
-    step = constrained_velocity(alpha5.model, mass, v_free, q, [JointLimits.of_uvms(alpha5)], 2e-3)
+    limits = JointLimits.of_uvms(alpha5)
+    step = constrained_velocity(alpha5.model, mass, v_free, q, [limits], period_s)
     assert step.rows == () and step.iterations == 0
+    assert (step.residual, step.converged, step.speed) == (0.0, True, 0.0)
     np.testing.assert_array_equal(step.velocity, v_free)
+    np.testing.assert_array_equal(step.generalized_impulse, np.zeros(alpha5.nv))
 
 
 def test_the_end_configuration_is_the_free_one_unless_rows_were_solved(alpha5):

@@ -5,6 +5,8 @@ accepted at once is not retried (every other period stays as it was)."""
 
 from __future__ import annotations
 
+import dataclasses
+
 import numpy as np
 import pytest
 
@@ -79,3 +81,19 @@ def test_a_runs_stalled_solves_are_counted_with_the_worst_residual():
     record = stalled.record()
     assert (record["stalled"], record["worst_stalled_residual_m_s"]) == (3, 8e-5)
     assert "m/s" in record["acceptable_residual"]
+
+
+def test_a_stalled_solve_may_keep_1e_4_of_its_rows_speed_and_at_least_1e_5_m_s():
+    """The bound a stalled solve is accepted under: 1e-4 of |g|_inf, at least 1e-5 m/s."""
+
+    def stalled(residual: float, speed_m_s: float) -> ConstrainedVelocity:
+        return ConstrainedVelocity(
+            np.zeros(2), {}, {}, np.zeros(2), (), 5000, residual, False, speed_m_s
+        )
+
+    assert stalled(0.0, 2.0).acceptable_residual == pytest.approx(2e-4, rel=1e-15)
+    assert stalled(1.9e-4, 2.0).accepted and not stalled(2.1e-4, 2.0).accepted
+    assert stalled(0.0, 0.01).acceptable_residual == 1e-5  # the floor
+    assert stalled(9e-6, 0.01).accepted and not stalled(1.1e-5, 0.01).accepted
+    converged = dataclasses.replace(stalled(1.0, 2.0), converged=True)
+    assert converged.accepted  # converged: whatever its residual
