@@ -121,6 +121,32 @@ def test_a_bounded_but_unphysical_motion_names_its_joint_and_time(reference_uvms
     assert implausible_motion(reference_uvms, time_s, v, np.full(n, 150.0)) is None
 
 
+def test_a_joint_driven_at_its_effort_limit_past_physics_is_said_to_be_so(reference_uvms):
+    """A joint past 100 rad/s whose applied torque reached its effort limit (0.9 of it and
+    more, up to that sample): its drive at the limit is said as a cause, with its peak
+    torque, its limit and its URDF velocity limit, after the unstable loop; below 0.9 of
+    it, or a torque reached only after that sample, not."""
+    uvms = reference_uvms
+    k = 6 + int(np.argmax(np.isfinite(uvms.model.effortLimit[6:])))
+    effort = float(uvms.model.effortLimit[k])
+    name = uvms.arm_joints.names[k - 6]
+    time_s = np.arange(5) * 0.01
+    v, tau = np.zeros((5, uvms.nv)), np.zeros((5, uvms.nv))
+    v[3, k] = 120.0
+    tau[1, k] = -0.95 * effort
+    when, why = implausible_motion(uvms, time_s, v, np.zeros(uvms.nv), tau)
+    assert when == pytest.approx(0.03) and f"{name} at 120 rad/s" in why
+    assert "control loop is unstable" in why
+    limit = (
+        f"its drive applied up to {0.95 * effort:.3g} N m, at its effort limit ({effort:.3g} N m)"
+    )
+    assert limit in why
+    assert f"URDF velocity limit: {uvms.model.velocityLimit[k]:g}" in why
+    for weaker in (np.where(tau != 0.0, -0.85 * effort, 0.0), np.roll(tau, 3, axis=0)):
+        _, why = implausible_motion(uvms, time_s, v, np.zeros(uvms.nv), weaker)
+        assert "control loop is unstable" in why and "its drive" not in why
+
+
 def test_a_control_loop_unstable_at_its_period_stops_the_run_with_the_reason(tmp_path):
     """The object push at a 10 ms control period on an Alpha 5 without its drives' armature:
     its joint PD (k_d = 1.5 N m s/rad on light links) is unstable sampled at 10 ms, and the

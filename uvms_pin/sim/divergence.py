@@ -51,8 +51,12 @@ def _labels(uvms) -> tuple[list[tuple[str, str]], list[tuple[str, str]]]:
     return velocity, force
 
 
+#: A joint torque at least this fraction of the joint's effort limit is "at its limit".
+AT_EFFORT_LIMIT = 0.9
+
+
 def implausible_motion(
-    uvms, time_s: np.ndarray, v: np.ndarray, v0: np.ndarray
+    uvms, time_s: np.ndarray, v: np.ndarray, v0: np.ndarray, tau: np.ndarray | None = None
 ) -> tuple[float, str] | None:
     """(when, why) a run that stayed finite is not physics, or None: the first logged sample (times
     ``time_s`` (T,) [s], velocities ``v`` (T, nv)) at which a velocity of the UVMS, the
@@ -60,7 +64,11 @@ def implausible_motion(
     that started below it (``v0``). Joint limits and damping keep such a motion bounded, so
     nothing diverges; most often it is a sampled control loop unstable at its control
     period (a derivative gain k_d with k_d T / I > 2 on a light link of inertia I sampled
-    every T), else a step too coarse for a stiff setting."""
+    every T), else a step too coarse for a stiff setting. With the applied generalized
+    forces ``tau`` (T, nv): of a joint whose torque reached its effort limit (the URDF's,
+    `AT_EFFORT_LIMIT` of it) up to that sample, that too is said: a torque held at the limit
+    drives a light joint there, the simulated drive keeping it at any speed (a real
+    drive's falls to zero at its no-load speed, about the URDF's velocity limit)."""
     bound = _IMPLAUSIBLE["speed"]
     if len(v) == 0 or np.max(np.abs(v0)) > bound:
         return None
@@ -70,19 +78,46 @@ def implausible_motion(
     row = int(np.argmax(past.any(axis=1)))
     k = int(np.argmax(np.abs(v[row])))
     name, unit = _labels(uvms)[0][k]
-    return float(time_s[row]), (
+    at = (
         f"the motion left physics at t = {time_s[row]:.6g} s: {name} at {v[row, k]:.3g} {unit}, "
         f"past the {bound:g} m/s or rad/s no UVMS reaches (bounded by its limits, not "
-        "diverged): most often the control loop is unstable at its control period (a "
+        "diverged)"
+    )
+    driven = None if tau is None or k < 6 else _driven_at_its_limit(uvms, tau[: row + 1], k)
+    return float(time_s[row]), (
+        f"{at}: most often the control loop is unstable at its control period (a "
         "derivative gain too large for a light link's inertia at this period: shorten "
         "control.period_s or lower the gains), else the step is too coarse"
+        + ("" if driven is None else f"; {driven}")
+    )
+
+
+def _driven_at_its_limit(uvms, tau: np.ndarray, k: int) -> str | None:
+    """What drove velocity ``k`` (an arm joint's) when its applied torques ``tau`` (T, nv)
+    reached its effort limit, or None."""
+    effort = float(uvms.model.effortLimit[k])
+    peak = float(np.max(np.abs(tau[:, k])))
+    if not (math.isfinite(effort) and effort > 0.0 and peak >= AT_EFFORT_LIMIT * effort):
+        return None
+    _, unit = _labels(uvms)[1][k]
+    speed = float(uvms.model.velocityLimit[k])
+    limit = (
+        f" (this joint's URDF velocity limit: {speed:g})"
+        if math.isfinite(speed) and speed > 0.0
+        else ""
+    )
+    return (
+        f"its drive applied up to {peak:.3g} {unit}, at its effort limit ({effort:.3g} "
+        f"{unit}): a torque held there (a saturated loop's, random actions at their bounds) "
+        "drives a light joint this fast too, the simulated drive keeping it at any speed "
+        f"where a real one's falls to zero at its no-load speed{limit}"
     )
 
 
 def stop_if_implausible(uvms, rollout, v0: np.ndarray) -> None:
     """Raise a SimulationError (``rollout`` attached, its status the stop and its reason)
     when the rollout's motion is `implausible_motion`."""
-    found = implausible_motion(uvms, rollout.time_s, rollout.v, v0)
+    found = implausible_motion(uvms, rollout.time_s, rollout.v, v0, rollout.tau)
     if found is not None:
         time_s, reason = found
         error = SimulationError(reason)
