@@ -88,6 +88,39 @@ def test_a_sphere_rolls_below_the_friction_limit_and_slides_above(ball, degrees)
     assert lowest >= -1e-8  # it never sinks into the plane
 
 
+def test_a_frictionless_sphere_slides_without_turning(ball):
+    """mu = 0 (a frictionless contact, allowed): on the 10 degree slope where mu = 0.2 rolls
+    it, the sphere slides at a = g sin(theta) and does not turn."""
+    normal, downhill = _slope(10.0)
+    contacts = PlaneContacts((ContactSphere(2, np.zeros(3), RADIUS_M),), np.zeros(3), normal, 0.0)
+    periods = 200
+    v, lowest = _roll(ball, contacts, periods)
+    acceleration = v[:3] @ downhill / (periods * PERIOD_S)
+    assert acceleration == pytest.approx(G * np.sin(np.radians(10.0)), rel=1e-6)
+    assert np.linalg.norm(v[3:]) < 1e-9
+    assert lowest >= -1e-8
+
+
+def test_the_planes_normal_is_made_unit_and_a_zero_margin_is_allowed(ball):
+    """A normal given at any length is the unit one (the same rows as the unit normal's);
+    a margin of 0 solves a sphere only within its reach."""
+    data = ball.createData()
+    q = pin.neutral(ball)
+    q[2] = RADIUS_M + 0.01
+    pin.computeJointJacobians(ball, data, q)
+    falling = np.abs(np.r_[0.0, 0.0, -6.0, 0.0, 0.0, 0.0])
+    sphere = (ContactSphere(2, np.zeros(3), RADIUS_M),)
+    unit = PlaneContacts(sphere, np.zeros(3), np.array([0.0, 0.0, 1.0]), MU)
+    long = PlaneContacts(sphere, np.zeros(3), np.array([0.0, 0.0, 2.5]), MU)
+    np.testing.assert_array_equal(long.normal_world, [0.0, 0.0, 1.0])
+    a, b = (c.rows(ball, data, q, falling, PERIOD_S) for c in (unit, long))
+    np.testing.assert_allclose(b.gap, a.gap, atol=1e-15)
+    np.testing.assert_allclose(b.jacobian, a.jacobian, atol=1e-15)
+    exact = PlaneContacts(sphere, np.zeros(3), np.array([0.0, 0.0, 1.0]), MU, margin=0.0)
+    assert exact.rows(ball, data, q, falling, PERIOD_S).size == 3  # 12 mm of reach
+    assert exact.rows(ball, data, q, falling * 0.5, PERIOD_S).size == 0  # 6 mm: not 10
+
+
 def test_a_sphere_above_the_plane_has_no_row(ball):
     contacts = PlaneContacts(
         (ContactSphere(2, np.zeros(3), RADIUS_M),), np.zeros(3), np.array([0.0, 0.0, 1.0]), MU
