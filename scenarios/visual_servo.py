@@ -52,6 +52,11 @@ class VisualServo(Controller):
         kp_Nm_rad: list[float] = (2.0, 10.0, 8.0, 0.5),
         kd_Nm_s_rad: list[float] = (0.3, 1.0, 0.8, 0.02),
     ):
+        if not 0.0 < horizontal_fov_rad < np.pi:  # its focal length from it: finite, > 0
+            raise ValueError(f"horizontal_fov_rad must be in (0, pi), got {horizontal_fov_rad}")
+        for name, pixels in (("width", width), ("height", height)):
+            if not (isinstance(pixels, int) and pixels >= 1):
+                raise ValueError(f"{name} must be a whole number of pixels >= 1, got {pixels}")
         self.uvms, self.nv = uvms, uvms.nv
         self.camera, self.target, self.radius = camera, target, float(target_radius_m)
         self.focal = 0.5 * width / np.tan(0.5 * horizontal_fov_rad)

@@ -346,6 +346,14 @@ void bind_derivatives(nb::module_& m) {
             for (int k = 0; k < 3; ++k) {
               Eigen::Map<RowMajor>(out.data() + std::ptrdiff_t(k) * nv * nv, nv, nv) = *parts[k];
             }
+            // finite inputs, a result that is not (a vehicle 1e300 m away: its lever arms'
+            // products overflow, inf - inf): SimulationError, never NaN (the reference's
+            // checks, uvms_pin.physics.dynamics._finite_result, say the same)
+            if (!Eigen::Map<const Eigen::ArrayXd>(out.data(), 3 * nv * nv).isFinite().all()) {
+              throw uvms::SimulationFailure(
+                  "da/dq, da/dv, da/dtau are not finite for finite inputs: a position or a speed "
+                  "beyond what their products hold in floating point");
+            }
           },
           "q"_a.none(), "v"_a.none(), "tau"_a.none(), "flow"_a.none(), "time_s"_a,
           "tau_ext"_a.none(), "free_surface"_a, "norm_tolerance"_a, "out"_a);

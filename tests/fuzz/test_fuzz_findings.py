@@ -14,6 +14,7 @@ from uvms_pin.model.urdf.loaded import loaded_uvms
 from uvms_pin.physics.dynamics import (
     bias_forces,
     forward_dynamics,
+    forward_dynamics_derivatives,
     frame_wrench_to_generalized,
     mass_matrix,
 )
@@ -51,6 +52,8 @@ def _import(tmp_path, source, old: str, new: str, count: int = 1):
         (LRAUV, "<lower>-0.261799</lower>", "<lower>nan</lower>", "<lower> must be 1 finite"),
         # was: KeyError: 'rexrov/thruster_0' (two thruster plugins naming one link)
         (REXROV, "<linkName>rexrov/thruster_1<", "<linkName>rexrov/thruster_0<", "two thruster"),
+        # was: OverflowError: (34, 'Numerical result out of range') (k_t rho d^4)
+        (LRAUV, "<propeller_diameter>0.2", "<propeller_diameter>1e300", r"\^4 .* not a finite"),
     ],
 )
 def test_an_import_error_names_the_file(tmp_path, source, old, new, match):
@@ -191,3 +194,29 @@ def test_a_camera_water_type_that_is_no_name_is_refused_by_key():
     doc["sensors"]["camera"][0]["water_type"] = ["IB"]
     with pytest.raises(ScenarioError, match=r"water_type must be a Jerlov type .* got \['IB'\]"):
         scenario_from_dict(doc, path)
+
+
+@pytest.mark.parametrize(
+    ("key", "value"),
+    [("horizontal_fov_rad", float("inf")), ("horizontal_fov_rad", 0.0), ("width", 0)],
+)
+def test_the_visual_servos_camera_of_no_focal_length_is_refused(key, value):
+    """Was: built through 'invalid value encountered in tan' (an infinite field of view: a
+    NaN focal length, every command of the run NaN)."""
+    import tomllib
+
+    doc = tomllib.loads((ROOT / "scenarios" / "visual_approach.toml").read_text())
+    doc["controller"][key] = value
+    with pytest.raises(ScenarioError, match=rf"v.toml: .*{key} must be"):
+        scenario_from_dict(doc, ROOT / "scenarios" / "v.toml")
+
+
+@pytest.mark.parametrize("backend", ["core", "python"])
+def test_derivatives_at_a_position_of_1e300_are_an_error_not_a_nan(backend):
+    """Was: da/dq, da/dv full of NaN (the core) for a vehicle 1e300 m up (its lever arms'
+    products overflow, inf - inf), where the dynamics themselves stay finite."""
+    q = pin.neutral(UVMS.model)
+    q[2] = 1e300
+    zero = np.zeros(UVMS.nv)
+    with pytest.raises(SimulationError, match="not finite for finite inputs"):
+        forward_dynamics_derivatives(UVMS, q, zero, zero, backend=backend)

@@ -89,9 +89,11 @@ def _finite_result(what: str, value: np.ndarray, uvms: UVMS, q, v=None) -> np.nd
         return value
     checked_configuration("q", q, uvms.model)
     fastest = 0.0 if v is None else float(np.max(np.abs(np.asarray(v, dtype=float))))
+    farthest = float(np.max(np.abs(np.asarray(q, dtype=float)[:3])))  # the vehicle's p
     raise SimulationError(
         f"{what} is not finite for finite inputs: the fastest entry of zeta, {fastest:.3g}, "
-        "is beyond what its square holds in floating point"
+        f"or the vehicle's position, {farthest:.3g} m from the origin, is beyond what its "
+        "products hold in floating point"
     )
 
 
@@ -237,8 +239,12 @@ def forward_dynamics_derivatives(
     # tau_ext are checked (shape, finite) by the reference and by the core
     q = checked_configuration("q", q, uvms.model)
     if isinstance(dynamics, ReferenceDynamics):
-        return reference_derivatives(uvms, q, v, tau, water, time_s, tau_ext, free_surface)
-    return dynamics.forward_dynamics_derivatives(q, v, tau, water, time_s, tau_ext, free_surface)
+        out = reference_derivatives(uvms, q, v, tau, water, time_s, tau_ext, free_surface)
+    else:
+        out = dynamics.forward_dynamics_derivatives(q, v, tau, water, time_s, tau_ext, free_surface)
+    for name, jacobian in zip(("da/dq", "da/dv", "da/dtau"), out, strict=True):
+        _finite_result(name, jacobian, uvms, q, v)
+    return out
 
 
 def water_of_call(

@@ -103,7 +103,16 @@ def gz_thruster(
     diameter = _number(plugin, "propeller_diameter", where, name)
     coefficient = None
     if k_t is not None and rho is not None and diameter is not None:
-        coefficient = k_t * rho * diameter**4
+        # in numpy: an overflow is inf (Python's ** raises), refused below by name
+        with np.errstate(over="ignore"):
+            coefficient = float(np.float64(k_t) * rho * np.float64(diameter) ** 4)
+        if not np.isfinite(coefficient):
+            raise ModelError(
+                f"thruster '{name}': <thrust_coefficient> x <fluid_density> x "
+                f"<propeller_diameter>^4 = {k_t:g} x {rho:g} x {diameter:g}^4 is not a finite "
+                "number",
+                path=where,
+            )
     upper = _number(plugin, "max_thrust_cmd", where, name)
     lower = _number(plugin, "min_thrust_cmd", where, name)
     for tag in (
