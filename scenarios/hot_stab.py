@@ -114,6 +114,11 @@ class HotStab(Controller):
         self.starts = np.concatenate([[0.0], np.cumsum(self.durations)])
         self._starts = self.starts.tolist()  # bisect's: np.searchsorted's index, cheaper
         axis = np.asarray(axis_world, dtype=float)
+        if axis.shape != (3,) or not np.all(np.isfinite(axis)) or not np.linalg.norm(axis) > 0:
+            raise ParameterError(
+                f"hot_stab: axis_world must be a direction [x, y, z] (finite, not zero), got "
+                f"{list(axis_world)}"
+            )
         self.axis = axis / np.linalg.norm(axis)
         aimed = np.asarray(mouth_world_m, dtype=float) + np.asarray(aim_error_m, dtype=float)
         self.standoff_world_m = aimed - standoff_m * self.axis

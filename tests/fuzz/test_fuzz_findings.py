@@ -52,6 +52,9 @@ def _import(tmp_path, source, old: str, new: str, count: int = 1):
         (LRAUV, "<lower>-0.261799</lower>", "<lower>nan</lower>", "<lower> must be 1 finite"),
         # was: KeyError: 'rexrov/thruster_0' (two thruster plugins naming one link)
         (REXROV, "<linkName>rexrov/thruster_1<", "<linkName>rexrov/thruster_0<", "two thruster"),
+        # was: built through a division by zero (the propeller joint's axis 0 0 0: a NaN
+        # thrust direction)
+        (LRAUV, "<xyz>1 0 0</xyz>", "<xyz>0 0 0</xyz>", r"'propeller_joint': its axis must be"),
         # was: OverflowError: (34, 'Numerical result out of range') (k_t rho d^4)
         (LRAUV, "<propeller_diameter>0.2", "<propeller_diameter>1e300", r"\^4 .* not a finite"),
     ],
@@ -220,3 +223,14 @@ def test_derivatives_at_a_position_of_1e300_are_an_error_not_a_nan(backend):
     zero = np.zeros(UVMS.nv)
     with pytest.raises(SimulationError, match="not finite for finite inputs"):
         forward_dynamics_derivatives(UVMS, q, zero, zero, backend=backend)
+
+
+def test_the_hot_stabs_axis_of_no_direction_is_refused():
+    """Was: built through 'invalid value encountered in divide' (axis_world = [0, 0, 0]: a
+    NaN standoff and insertion point)."""
+    import tomllib
+
+    doc = tomllib.loads((ROOT / "scenarios" / "hot_stab.toml").read_text())
+    doc["controller"]["axis_world"] = [0.0, 0.0, 0.0]
+    with pytest.raises(ScenarioError, match=r"h.toml: .*axis_world must be a direction"):
+        scenario_from_dict(doc, ROOT / "scenarios" / "h.toml")

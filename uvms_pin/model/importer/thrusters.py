@@ -128,7 +128,7 @@ def gz_thruster(
     return ImportedThruster(
         name=name,
         position_body_m=placement.translation.copy(),
-        direction_body=placement.rotation @ axis_of(joints[name]),
+        direction_body=placement.rotation @ axis_of(joints[name], where),
         time_constant_s=None,
         thrust_law="commanded thrust",
         thrust_coefficient=coefficient,

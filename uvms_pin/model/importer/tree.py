@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import math
 import xml.etree.ElementTree as ET
 
 import numpy as np
@@ -46,13 +47,23 @@ def link_placements(robot: ET.Element, where: str) -> dict[str, pin.SE3]:
     return placements
 
 
-def axis_of(joint: ET.Element) -> np.ndarray:
-    """A joint's unit axis in its (child link's) frame; URDF's default is x."""
+def axis_of(joint: ET.Element, where: str) -> np.ndarray:
+    """A joint's unit axis in its (child link's) frame; URDF's default is x. ModelError
+    naming the joint and the file ``where`` unless it is a direction."""
     axis = joint.find("axis")
-    values = np.array(
-        [float(v) for v in (axis.get("xyz", "1 0 0") if axis is not None else "1 0 0").split()]
-    )
-    return values / np.linalg.norm(values)
+    text = axis.get("xyz", "1 0 0") if axis is not None else "1 0 0"
+    try:
+        values = np.array([float(v) for v in text.split()])
+    except ValueError:
+        values = np.full(1, np.nan)
+    norm = float(np.linalg.norm(values)) if values.shape == (3,) else math.nan
+    if not (math.isfinite(norm) and norm > 0.0):
+        raise ModelError(
+            f"joint '{joint.get('name')}': its axis must be a direction (3 finite numbers, "
+            f"not zero), got '{text}'",
+            path=where,
+        )
+    return values / norm
 
 
 def fix_immobile_joints(robot: ET.Element, notes: list[str]) -> None:
