@@ -117,7 +117,7 @@ class HotStab(Controller):
         if axis.shape != (3,) or not np.all(np.isfinite(axis)) or not np.linalg.norm(axis) > 0:
             raise ParameterError(
                 f"hot_stab: axis_world must be a direction [x, y, z] (finite, not zero), got "
-                f"{list(axis_world)}"
+                f"{axis_world!r}"
             )
         self.axis = axis / np.linalg.norm(axis)
         aimed = np.asarray(mouth_world_m, dtype=float) + np.asarray(aim_error_m, dtype=float)
