@@ -234,3 +234,39 @@ def test_the_hot_stabs_axis_of_no_direction_is_refused():
     doc["controller"]["axis_world"] = [0.0, 0.0, 0.0]
     with pytest.raises(ScenarioError, match=r"h.toml: .*axis_world must be a direction"):
         scenario_from_dict(doc, ROOT / "scenarios" / "h.toml")
+
+
+def test_a_free_box_3_nm_thick_is_refused_not_a_crash():
+    """Was: a segmentation fault (qhull, inside coal's convex hull, on flat points): a free
+    box 0.3 x 0.3 m and 1e-9 m thick took the process down while the scenario was read."""
+    from uvms_pin.physics.world.kind import convex_hull
+    from uvms_pin.scenario.load import load_scenario
+
+    thin = {"world.objects[1].size_m": [0.3, 0.3, 1e-9]}
+    with pytest.raises(ScenarioError, match=r"\[world.objects\[1\]\]: .*span a volume"):
+        load_scenario(ROOT / "scenarios" / "push_object.toml", thin)
+    square = np.array([[x, y, 0.0] for x in (0.0, 1.0) for y in (0.0, 1.0)] * 2)
+    with pytest.raises(ParameterError, match="flat"):
+        convex_hull(square)
+    with pytest.raises(ParameterError, match="4 or more finite points"):
+        convex_hull(np.array([[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, np.nan, 1.0]]))
+    box = np.array([[x, y, z] for x in (0.0, 1.0) for y in (0.0, 1.0) for z in (0.0, 1e-3)])
+    assert convex_hull(box).num_points == 8  # 1 mm thick: a body
+
+
+def test_a_control_period_of_1e300_s_is_no_overflow_in_the_jaws_servo():
+    """Was: OverflowError: (34, 'Numerical result out of range') (the jaw servo's gain cap
+    I / (4 T^2) squared the period) while hot_stab.toml was read: the servo's gains are
+    capped to 0, and the scenario is refused by name (its log period is no multiple)."""
+    from uvms_pin.control.jaw_servo import JawSchedule, JawServo
+    from uvms_pin.errors import PlausibilityWarning
+    from uvms_pin.model.jaw import JawJoints
+    from uvms_pin.scenario.load import load_scenario
+
+    hot_stab = ROOT / "scenarios" / "hot_stab.toml"
+    with pytest.warns(PlausibilityWarning), pytest.raises(ScenarioError, match="integer multiple"):
+        load_scenario(hot_stab, {"control.period_s": 1e300})
+    jaws = ROOT / "models" / "uvms_bluerov2_alpha5_jaws.urdf"
+    model = loaded_uvms(jaws, water_density_kg_m3=1025.0).model
+    servo = JawServo.for_model(model, JawJoints.of(model), 10.0, JawSchedule(), period_s=1e300)
+    assert np.all(servo.stiffness == 0.0) and np.all(servo.damping == 0.0)

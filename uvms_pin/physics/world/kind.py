@@ -190,11 +190,34 @@ def solid_placement(params: Params) -> pin.SE3:
     return pin.SE3(pin.rpy.rpyToMatrix(rpy), np.asarray(params["position_world_m"], dtype=float))
 
 
+#: the least thickness of a convex hull's points, as a fraction of their extent (the ratio
+#: of their spread's smallest and largest singular values): flatter ones are refused, for
+#: qhull fails on them inside coal and takes the process down (a 0.3 m square 3 nm thick)
+LEAST_HULL_THICKNESS = 1e-6
+
+
 def convex_hull(points_m: np.ndarray) -> coal.Convex:
     """coal's convex hull (qhull) of the points (n, 3). The points it is built from stay
     with it (``hull.built_from_m``): the compiled core builds the same hull from the same
-    points (qhull's output depends on their order, not only on the polytope)."""
+    points (qhull's output depends on their order, not only on the polytope).
+
+    Raises:
+        ParameterError: fewer than 4 points, a non-finite one, or points that span no
+            volume (thinner than `LEAST_HULL_THICKNESS` of their extent: a plane, a line).
+    """
     source = np.array(points_m, dtype=float).reshape(-1, 3)
+    if len(source) < 4 or not np.all(np.isfinite(source)):
+        raise ParameterError(
+            f"a convex hull needs 4 or more finite points, got {len(source)} "
+            f"({'all' if np.all(np.isfinite(source)) else 'not all'} finite)"
+        )
+    spread = np.linalg.svd(source - source.mean(axis=0), compute_uv=False)
+    if not spread[2] > LEAST_HULL_THICKNESS * spread[0]:
+        raise ParameterError(
+            "a convex hull needs points that span a volume: these are flat (thickness "
+            f"{spread[2] / spread[0]:.2g} of their extent, below {LEAST_HULL_THICKNESS:g}); "
+            "give the body a thickness"
+        )
     points = coal.StdVec_Vec3s()
     for p in source:
         points.append(p)
