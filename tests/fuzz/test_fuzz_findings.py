@@ -225,14 +225,22 @@ def test_derivatives_at_a_position_of_1e300_are_an_error_not_a_nan(backend):
         forward_dynamics_derivatives(UVMS, q, zero, zero, backend=backend)
 
 
-def test_the_hot_stabs_axis_of_no_direction_is_refused():
-    """Was: built through 'invalid value encountered in divide' (axis_world = [0, 0, 0]: a
-    NaN standoff and insertion point)."""
+@pytest.mark.parametrize(
+    ("key", "value", "said"),
+    [
+        ("axis_world", [0.0, 0.0, 0.0], "axis_world must be a direction"),
+        ("depth_m", float("inf"), "depth_m must be finite"),  # (make fuzz, seed 16)
+        ("mouth_world_m", [0.75, float("nan"), -2.25], "mouth_world_m must be finite"),
+    ],
+)
+def test_the_hot_stabs_targets_of_no_place_are_refused(key, value, said):
+    """Was: built through 'invalid value encountered in divide' (axis_world = [0, 0, 0])
+    or '... in multiply' (depth_m = inf): NaN standoff and insertion points."""
     import tomllib
 
     doc = tomllib.loads((ROOT / "scenarios" / "hot_stab.toml").read_text())
-    doc["controller"]["axis_world"] = [0.0, 0.0, 0.0]
-    with pytest.raises(ScenarioError, match=r"h.toml: .*axis_world must be a direction"):
+    doc["controller"][key] = value
+    with pytest.raises(ScenarioError, match=rf"h.toml: .*{said}"):
         scenario_from_dict(doc, ROOT / "scenarios" / "h.toml")
 
 
