@@ -17,6 +17,7 @@ from uvms_pin.physics.dynamics import (
     forward_dynamics_derivatives,
     frame_wrench_to_generalized,
     mass_matrix,
+    potential_energy,
 )
 from uvms_pin.scenario.load import scenario_from_dict
 
@@ -103,11 +104,14 @@ def test_a_gym_scenario_that_is_no_path_is_refused():
 
 
 def test_a_quaternion_of_norm_1e300_is_named_not_a_nan_mass_matrix():
-    """Was: M(q) full of NaN for q with a quaternion entry of 1e300 (a list, not an array)."""
+    """Was: M(q) full of NaN for q with a quaternion entry of 1e300 (a list, not an array);
+    the potential energy NaN too (make fuzz, seed 22)."""
     q = [0.0] * UVMS.nq
     q[5] = 1e300
     with pytest.raises(ParameterError, match="'root_joint' has a quaternion of norm inf"):
         mass_matrix(UVMS, q)
+    with pytest.raises(ParameterError, match="'root_joint' has a quaternion of norm inf"):
+        potential_energy(UVMS, q)
 
 
 # ---- found by the campaign (make fuzz, seed 20261204) ------------------------------------

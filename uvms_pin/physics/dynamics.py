@@ -333,7 +333,8 @@ def potential_energy(
     model, data = uvms.model, uvms.data
     pin.forwardKinematics(model, data, q)
     wet = wet_state(uvms, data, _checked_flow(flow), check_time(time_s)) if free_surface else None
-    return potential_energy_placed(uvms, data, q, wet)
+    energy = potential_energy_placed(uvms, data, q, wet)
+    return float(_finite_result("U", np.array(energy), uvms, q))
 
 
 def potential_energy_placed(
