@@ -282,3 +282,15 @@ def test_a_control_period_of_1e300_s_is_no_overflow_in_the_jaws_servo():
     model = loaded_uvms(jaws, water_density_kg_m3=1025.0).model
     servo = JawServo.for_model(model, JawJoints.of(model), 10.0, JawSchedule(), period_s=1e300)
     assert np.all(servo.stiffness == 0.0) and np.all(servo.damping == 0.0)
+
+
+@pytest.mark.parametrize("backend", ["python", "core"])
+def test_a_velocity_of_none_is_refused_by_name_by_both_backends(backend):
+    """Was (the reference, make fuzz seed 23): Boost.Python.ArgumentError from
+    pin.forwardKinematics(model, data, q, None, ...) for bias_forces and forward_dynamics
+    given v = None with a q of zeros."""
+    q = np.zeros(UVMS.nq)
+    with pytest.raises(ParameterError, match="v must have shape"):
+        bias_forces(UVMS, q, None, backend=backend)
+    with pytest.raises(ParameterError, match="v must have shape"):
+        forward_dynamics(UVMS, q, None, None, backend=backend)

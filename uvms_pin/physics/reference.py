@@ -214,9 +214,11 @@ class ReferenceDynamics:
     def __init__(self, uvms: UVMS):
         self.uvms = uvms
 
-    def _state(self, q, v=None) -> tuple[np.ndarray, np.ndarray | None]:
+    def _state(self, q, *v) -> tuple[np.ndarray, np.ndarray | None]:
+        """(q, v) checked (v given, None included: a call that needs it gets it checked;
+        not given: None)."""
         q = finite_vector("q", q, self.uvms.nq)
-        return q, None if v is None else finite_vector("v", v, self.uvms.nv)
+        return q, finite_vector("v", v[0], self.uvms.nv) if v else None
 
     def mass_matrix(self, q: np.ndarray) -> np.ndarray:
         q, _ = self._state(q)
