@@ -214,20 +214,20 @@ class ReferenceDynamics:
     def __init__(self, uvms: UVMS):
         self.uvms = uvms
 
-    def _state(self, q, *v) -> tuple[np.ndarray, np.ndarray | None]:
-        """(q, v) checked (v given, None included: a call that needs it gets it checked;
-        not given: None)."""
-        q = finite_vector("q", q, self.uvms.nq)
-        return q, finite_vector("v", v[0], self.uvms.nv) if v else None
+    def _q(self, q) -> np.ndarray:
+        return finite_vector("q", q, self.uvms.nq)
+
+    def _state(self, q, v) -> tuple[np.ndarray, np.ndarray]:
+        """(q, v) checked: v too whenever a call takes one (None is refused by name)."""
+        return self._q(q), finite_vector("v", v, self.uvms.nv)
 
     def mass_matrix(self, q: np.ndarray) -> np.ndarray:
-        q, _ = self._state(q)
-        return _mass_matrix(self.uvms, q)
+        return _mass_matrix(self.uvms, self._q(q))
 
     def mass_matrix_in(
         self, q: np.ndarray, flow: FlowField | None, time_s: float, free_surface: bool = False
     ) -> np.ndarray:
-        q, _ = self._state(q)
+        q = self._q(q)
         pin.forwardKinematics(self.uvms.model, self.uvms.data, q)
         wet = _wet(self.uvms, flow, check_time(time_s), free_surface)
         return _mass_matrix(self.uvms, q, wet)

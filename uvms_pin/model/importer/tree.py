@@ -2,14 +2,13 @@
 
 from __future__ import annotations
 
-import math
 import xml.etree.ElementTree as ET
 
 import numpy as np
 import pinocchio as pin
 
 from uvms_pin.errors import ModelError
-from uvms_pin.model.urdf.read import read_origin
+from uvms_pin.model.urdf.read import read_numbers, read_origin
 
 __all__ = ["fix_immobile_joints", "hold_uuv_fins", "link_placements", "make_fixed", "root_link"]
 
@@ -49,19 +48,17 @@ def link_placements(robot: ET.Element, where: str) -> dict[str, pin.SE3]:
 
 def axis_of(joint: ET.Element, where: str) -> np.ndarray:
     """A joint's unit axis in its (child link's) frame; URDF's default is x. ModelError
-    naming the joint and the file ``where`` unless it is a direction."""
+    naming the joint, its link and the file ``where`` unless it is a direction."""
     axis = joint.find("axis")
     text = axis.get("xyz", "1 0 0") if axis is not None else "1 0 0"
-    try:
-        values = np.array([float(v) for v in text.split()])
-    except ValueError:
-        values = np.full(1, np.nan)
-    norm = float(np.linalg.norm(values)) if values.shape == (3,) else math.nan
-    if not (math.isfinite(norm) and norm > 0.0):
+    name, child = joint.get("name"), joint.find("child").get("link")
+    values = read_numbers(text, 3, f"joint '{name}' <axis xyz>", where, child)
+    norm = float(np.linalg.norm(values))
+    if not norm > 0.0:
         raise ModelError(
-            f"joint '{joint.get('name')}': its axis must be a direction (3 finite numbers, "
-            f"not zero), got '{text}'",
+            f"joint '{name}': its axis must be a direction, not zero ('{text}')",
             path=where,
+            link=child,
         )
     return values / norm
 
