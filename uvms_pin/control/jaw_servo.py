@@ -97,8 +97,9 @@ class JawServo:
         stiffness = max_force_N * lever / (SATURATION_TRAVEL_FRACTION * travel)
         inertia = _joint_inertias(model, jaw)
         if period_s is not None:
-            # k <= I / (4 T^2), written so that no period overflows its square
-            stiffness = np.minimum(stiffness, inertia / 4.0 / period_s / period_s)
+            # k <= I / (4 T^2): T * T, the same bits as T**2, is inf past the float range
+            # where ** raised OverflowError
+            stiffness = np.minimum(stiffness, inertia / (4.0 * period_s * period_s))
         return cls(
             jaw, float(max_force_N), lever, stiffness, 2.0 * np.sqrt(stiffness * inertia), schedule
         )
