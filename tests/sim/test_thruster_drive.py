@@ -44,6 +44,10 @@ def test_63_percent_of_a_step_at_the_time_constant(period_s):
         (0.0, 10.0, 0.05, 60.0),
         (5.0, -8.0, 0.02, 300.0),
         (0.0, 10.0, 0.0, 250.0),
+        # no lag and a rate too slow to reach the steady thrust in the period: it ramps the
+        # whole period (4 N of 10) and stays there
+        (0.0, 10.0, 0.0, 100.0),
+        (2.0, -10.0, 0.0, 100.0),
     ],
 )
 def test_one_period_matches_the_ode(f0, steady, tau, rate):
