@@ -23,18 +23,23 @@ def _thrusters(forward_N: float, reverse_N: float) -> list[Thruster]:
     return out
 
 
-@pytest.mark.parametrize(("forward_N", "reverse_N"), [(40.0, 30.0), (0.6, 0.25), (2.0, 0.0)])
+@pytest.mark.parametrize(
+    ("forward_N", "reverse_N"), [(40.0, 30.0), (0.6, 0.25), (2.0, 0.0), (0.0, 2.0)]
+)
 def test_a_saturated_thruster_is_commanded_full_scale_whatever_its_size(forward_N, reverse_N):
     """The command of a linear drive is u = f / f_full, so a thrust on its bound is u = +1
     forward and u = -1 in reverse, for large and small thrusters alike (a limit below 1 N
-    too); a thruster without reverse thrust (limit 0) is never commanded below 0."""
+    too); a thruster without reverse thrust (limit 0) is never commanded below 0, one without
+    forward thrust never above 0 (its command at zero thrust is 0, not 0 / 0)."""
     actuation = ThrustersAndJointLimits(_thrusters(forward_N, reverse_N), None)
     actuation.start(0.01)
     for sign in (1.0, -1.0):
         actuation.apply(np.r_[sign * 1e4 * np.ones(6), np.zeros(0)])
         thrust = actuation.signals()["thrust"]
         command = actuation.signals()["thruster_command"]
-        full = np.where(thrust >= 0.0, forward_N, reverse_N if reverse_N > 0.0 else np.inf)
+        assert np.all(np.isfinite(command))
+        full_forward = forward_N if forward_N > 0.0 else np.inf
+        full = np.where(thrust >= 0.0, full_forward, reverse_N if reverse_N > 0.0 else np.inf)
         np.testing.assert_allclose(command, thrust / full, rtol=1e-12)
         assert np.all(np.abs(command) <= 1.0 + 1e-12)
         on_bound = np.isclose(thrust, forward_N) | np.isclose(thrust, -reverse_N)
@@ -70,3 +75,27 @@ def test_saturated_only_past_a_bound_by_more_than_the_rounding_tolerance():
             assert actuation.saturated(allocation @ thrust)
             thrust[k] = bound - outward * 0.5 * PAST_LIMIT_N
             assert not actuation.saturated(allocation @ thrust)
+
+
+@pytest.mark.parametrize("components", [[], [6], [-1], [0, 0], [2, 7]])
+def test_allocated_components_must_be_distinct_indices_of_the_body_wrench(components):
+    """None, an index past 5 (the wrench has six components), a negative one or a repeated
+    one is refused by name."""
+    with pytest.raises(ParameterError, match="allocated_components must be distinct indices"):
+        ThrustersAndJointLimits(_thrusters(10.0, 10.0), None, allocated_components=components)
+
+
+@pytest.mark.parametrize("components", [[2], [0, 5], [5, 0, 3]])
+def test_any_distinct_components_are_allocated_and_the_others_ignored(components):
+    """One component alone (heave) or a few in any order: each allocated one is produced
+    (the thrusters span all six), and what the command asks of the others changes nothing
+    (f = B_s^+ tau_s reads the allocated rows only)."""
+    actuation = ThrustersAndJointLimits(_thrusters(100.0, 100.0), None, components)
+    actuation.start(0.01)
+    command = np.array([3.0, -2.0, 5.0, 1.0, -1.5, 0.5])
+    wrench = actuation.apply(command)
+    np.testing.assert_allclose(wrench[components], command[components], atol=1e-12)
+    others = np.setdiff1d(np.arange(6), components)
+    changed = command.copy()
+    changed[others] += 7.0
+    np.testing.assert_array_equal(actuation.apply(changed), wrench)
