@@ -228,3 +228,20 @@ def test_a_mass_matrix_singular_relative_to_its_largest_eigenvalue_is_named(refe
     assert 0.0 < eigenvalues[0] < 1e-12 * eigenvalues[-1]  # the case: tiny, not zero
     context = divergence_context(Plant(uvms), (0.0, 0.01), q, np.zeros(10), np.zeros(10))
     assert "the mass matrix is singular" in context and "along arm_joint4" in context
+
+
+def test_the_quantities_past_their_bounds_are_named_farthest_first(reference_uvms):
+    """Several quantities out of range are named by how far past its own bound each is, not
+    by their numbers: a velocity of 1e4 m/s (100 times the 100 m/s no UVMS reaches) before a
+    disturbance of 2e6 N (20 times the 1e5 N no vehicle meets), though 2e6 is the larger
+    number; at 1e3 m/s (10 times) the disturbance comes first."""
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        plant = Plant(reference_uvms, disturbance=lambda t: np.array([0, 2e6, 0, 0, 0, 0.0]))
+    q, v = reference_uvms.neutral_configuration(), np.zeros(10)
+    v[0] = 1e4
+    context = divergence_context(plant, (0.0, 0.01), q, v, None)
+    assert context.startswith("from t = 0 s: velocity vehicle u = 1e+04 m/s, disturbance ")
+    v[0] = 1e3
+    context = divergence_context(plant, (0.0, 0.01), q, v, None)
+    assert context.startswith("from t = 0 s: disturbance vehicle fy = 2e+06 N, velocity ")
