@@ -57,6 +57,11 @@ def test_quadratic_law():
     # half-way through the live range: a quarter of the thrust (T ~ n^2)
     assert curve.thrust_N(np.array([0.6]))[0] == pytest.approx(10.0, rel=1e-14)
     assert curve.thrust_N(np.array([-0.6]))[0] == pytest.approx(-6.25, rel=1e-14)
+    # a command past full scale gives the full thrust, no more
+    np.testing.assert_array_equal(curve.thrust_N(np.array([1.7, -1.3, -40.0])), [40, -25, -25])
+    # without a deadband (the default) the live range is the whole range: T = u^2 T_max
+    plain = QuadraticThrustCurve(40.0, 25.0)
+    np.testing.assert_allclose(plain.thrust_N(np.array([0.5, -0.5, 0.1])), [10, -6.25, 0.4])
 
 
 @pytest.mark.parametrize(
@@ -65,6 +70,9 @@ def test_quadratic_law():
         ([-1, 0, 1], [0, 0, -1], "non-decreasing"),
         ([-1, 0.5, 0], [-1, 0, 1], "increase strictly"),
         ([-1, 0, 1], [-1, 0.5, 1], "zero thrust at zero"),
+        ([-1, 0, 1], [-1, 0, np.nan], "finite command and thrust"),
+        ([-1, 0, np.inf], [-1, 0, 1], "finite command and thrust"),
+        ([-1, 0, 1], [-1, 0], "matching"),
     ],
 )
 def test_bad_tables_are_refused(command, thrust, match):
