@@ -286,3 +286,43 @@ def test_every_field_answers_each_point_with_a_vector_and_a_gradient(flow):
         assert f(1.3, np.zeros((0, 3))).shape == (0, 3)
     gradient = flow.velocity_gradient(1.3, points)
     assert gradient.shape == (4, 3, 3) and np.all(np.isfinite(gradient))
+
+
+def test_between_samples_the_gauss_markov_current_is_the_monotone_cubic_through_them():
+    """Between its samples (every 0.5 s) the current is the shape-preserving cubic through
+    them (Fritsch-Carlson slopes, the harmonic mean of the neighbouring secants on a uniform
+    grid): SciPy's PCHIP through the same samples, velocity and its time derivative, away
+    from the first interval (which starts at rest) and the last samples."""
+    from scipy.interpolate import PchipInterpolator
+
+    gm = GaussMarkovCurrent(
+        [0.3, 0.0, -0.1], std_m_s=0.2, time_constant_s=3.0, bound_m_s=0.5, seed=11
+    )
+    knots = 0.5 * np.arange(91)
+    samples = np.array([gm.velocity(t, [0, 0, 0])[0] for t in knots])
+    pchip = PchipInterpolator(knots, samples, axis=0)
+    times = np.linspace(0.5, 44.0, 871)
+    velocity = np.array([gm.velocity(t, [0, 0, 0])[0] for t in times])
+    acceleration = np.array([gm.local_acceleration(t, [0, 0, 0])[0] for t in times])
+    np.testing.assert_allclose(velocity, pchip(times), rtol=0.0, atol=1e-12)
+    np.testing.assert_allclose(acceleration, pchip(times, 1), rtol=0.0, atol=1e-10)
+
+
+W = np.array([0.5, 1.0])  # rad/s
+
+
+@pytest.mark.parametrize(
+    ("make", "match"),
+    [
+        (lambda: GaussMarkovCurrent([0, 0, 0], -0.1, 10.0, 1.0), "std_m_s must be >= 0"),
+        (lambda: GaussMarkovCurrent([0, 0, 0], math.inf, 10.0, 1.0), "std_m_s must be >= 0"),
+        (lambda: pierson_moskowitz_spectrum(W, -1.0, 8.0), "significant_height_m must be >= 0"),
+        (lambda: jonswap_spectrum(W, math.inf, 8.0), "significant_height_m must be >= 0"),
+        (lambda: jonswap_spectrum(W, 2.0, 0.0), "peak_period_s must be positive"),
+        (lambda: pierson_moskowitz_spectrum(W, 2.0, math.inf), "peak_period_s must be positive"),
+        (lambda: AiryWave(0.5, 8.0, water_depth_m=0.0), "water_depth_m must be positive"),
+    ],
+)
+def test_a_sea_or_current_without_a_physical_size_is_refused_by_name(make, match):
+    with pytest.raises(ParameterError, match=match):
+        make()
