@@ -190,6 +190,12 @@ def test_depth_profile_current():
     assert law.velocity(0.0, [[0, 0, -20.0]])[0, 0] == pytest.approx(0.0)
     with pytest.raises(ParameterError, match="increasing"):
         DepthProfileCurrent([1, 0, 0], [0.0, 0.0], [1, 1])
+    for depths, factors in (([0.0, 5.0, 10.0], [1.0, 0.5]), ([0.0], [1.0])):
+        with pytest.raises(ParameterError, match="equal-length lists of >= 2"):
+            DepthProfileCurrent([1, 0, 0], depths, factors)
+    # a table measured every centimetre (an ADCP's fine bins) is a table like any other
+    fine = DepthProfileCurrent([1.0, 0, 0], [0.0, 0.01, 0.02], [1.0, 0.9, 0.7])
+    assert fine.velocity(0.0, [[0, 0, -0.015]])[0, 0] == pytest.approx(0.8)
 
 
 def test_power_law_current_is_the_one_seventh_law_by_default():
