@@ -123,8 +123,28 @@ def test_servo_damping_opposes_the_fingers_velocity_critically(uvms, servo):
     q_closed = uvms.neutral_configuration()
     q_closed[jaw.q_index] = jaw.lower
     mass = pin.crba(uvms.model, uvms.model.createData(), q_closed)
-    inertia = np.array([mass[i, i] for i in jaw.v_index]) + uvms.model.armature[jaw.v_index]
+    inertia = np.array([mass[i, i] for i in jaw.v_index])
     np.testing.assert_allclose(servo.damping, 2.0 * np.sqrt(servo.stiffness * inertia), rtol=1e-12)
+
+
+def test_a_jaw_motors_armature_is_counted_once_in_the_fingers_inertia(uvms):
+    """A motor's reflected inertia (the joint's armature A) adds to the finger's own once:
+    I = M_ii(without A) + A, which sets the sampled servo's cap k = I / (4 T^2) and its
+    critical damping d = 2 sqrt(k I)."""
+    jaw = JawJoints.of(uvms.model)
+    bare = JawServo.for_model(uvms.model, jaw, 10.0, JawSchedule(), period_s=0.005)
+    bare_inertia = bare.damping**2 / (4.0 * bare.stiffness)
+    model = uvms.model.copy()
+    armature = np.array([3e-4, 5e-4])
+    model.armature[jaw.v_index] = armature
+    geared = JawServo.for_model(model, jaw, 10.0, JawSchedule(), period_s=0.005)
+    inertia = bare_inertia + armature
+    uncapped = 10.0 * geared.lever_m / (0.05 * (jaw.upper - jaw.lower))
+    assert np.all(geared.stiffness < uncapped)  # the cap binds
+    np.testing.assert_allclose(geared.stiffness, inertia / (4.0 * 0.005**2), rtol=1e-12)
+    np.testing.assert_allclose(
+        geared.damping, 2.0 * np.sqrt(geared.stiffness * inertia), rtol=1e-12
+    )
 
 
 def test_lever_ignores_the_centre_of_mass_offset_along_the_joint_axis(uvms):

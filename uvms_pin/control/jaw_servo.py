@@ -224,9 +224,11 @@ def _motion_axis(model: pin.Model, data: pin.Data, joint_id: int) -> pin.Motion:
 
 
 def _joint_inertias(model: pin.Model, jaw: JawJoints) -> np.ndarray:
-    """Each jaw joint's inertia about its own motion: M[i, i] + armature at the closed
-    position [kg m^2 or kg] (the water's added mass not included: a lower bound)."""
+    """Each jaw joint's inertia about its own motion: M[i, i] at the closed position [kg m^2
+    or kg], the joint's armature included (CRBA adds it to M's diagonal: added again, a jaw
+    with a motor's reflected inertia counted it twice); the water's added mass not included:
+    a lower bound."""
     q = pin.neutral(model)
     q[jaw.q_index] = jaw.lower
     mass = pin.crba(model, model.createData(), q)
-    return np.array([mass[i, i] for i in jaw.v_index]) + model.armature[jaw.v_index]
+    return np.array([mass[i, i] for i in jaw.v_index])
