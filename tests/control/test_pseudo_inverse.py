@@ -152,3 +152,15 @@ def test_the_weighted_reference_is_the_minimum_weighted_norm_least_squares_solut
 
 def test_the_zero_matrix_has_a_zero_pseudo_inverse():
     np.testing.assert_array_equal(pseudo_inverse(np.zeros((6, 10)), 1e-12), np.zeros((10, 6)))
+
+
+def test_a_single_row_or_column_has_its_pseudo_inverse():
+    """One singular value: J = (3, 4) gives J^+ = J^T / |J|^2, a column the same way; the
+    zero row gives zeros."""
+    np.testing.assert_allclose(
+        pseudo_inverse(np.array([[3.0, 4.0]]), 1e-12), [[0.12], [0.16]], rtol=1e-15
+    )
+    np.testing.assert_allclose(
+        pseudo_inverse(np.array([[3.0], [4.0]]), 1e-12), [[0.12, 0.16]], rtol=1e-15
+    )
+    np.testing.assert_array_equal(pseudo_inverse(np.zeros((1, 2)), 1e-12), np.zeros((2, 1)))
