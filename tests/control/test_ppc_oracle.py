@@ -507,3 +507,29 @@ def test_signals_are_those_of_the_last_successful_call(reference_uvms):
     assert fast.last_signals.time_s == 0.0
     fast.reset()
     assert fast.last_signals is None and fast.signals() == {}
+
+
+def test_the_svd_route_with_the_joint_limit_pull_is_the_exact_solution(
+    reference_uvms, monkeypatch, count_svd_fallbacks
+):
+    """Where the Cholesky solver declines (an ill-conditioned J), the exact SVD route gives
+    the same zeta_r = zeta_0 + J^# (xdot_r - J zeta_0), the joint-limit pull zeta_0 kept in
+    the null space: forced here on a well-conditioned pose, it is the exact rational
+    solution to 1e-12 of its size."""
+    monkeypatch.setattr(task_space.MinimumNormSolver, "solve", lambda self, jacobian, rhs: None)
+    model = reference_uvms.model
+    frame = model.frames[reference_uvms.ee_frame_id].name
+    q = reference_uvms.neutral_configuration()
+    q[7:] = [-0.2, 1.0, -0.8, 0.2]
+    params = PPCParams(velocity_weights=REALISTIC_WEIGHTS + [1.0] * 4, null_space_gain_per_s=3.0)
+    # the Python law (the compiled kernel has its own routes, checked against it elsewhere)
+    fast = PrescribedPerformanceController(
+        model, frame, params, (0.2, 0.0, 0.0), (0.05, -0.05, 0.1), backend="python"
+    )
+    measurement = Measurement(0.1, q, np.full(model.nv, 0.02), np.r_[0.3, -0.1, 0.1, 0, 0, 0])
+    assert not isinstance(outcome(fast, 0.1, measurement), Exception)
+    assert count_svd_fallbacks  # the SVD route was taken
+    assert np.abs(fast.null_space_velocity(q)).max() > 1e-3  # and the pull acts
+    exact = exact_reference_velocity(fast, q)
+    error = np.abs(fast.last_signals.zeta_r - exact).max() / np.abs(exact).max()
+    assert error <= 1e-12
