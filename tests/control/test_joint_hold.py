@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from conftest import ROOT
+from conftest import ROOT, continuous_joint_urdf
 
 import uvms_pin as up
 from uvms_pin.control.joint_hold import JointHoldController
@@ -66,3 +66,12 @@ def test_the_scenario_table_builds_it_and_names_a_bad_key():
     ):
         with pytest.raises(ScenarioError, match=key):
             up.load_scenario(path, {"controller": bad})
+
+
+def test_a_continuous_joint_is_refused_as_not_one_angle(tmp_path):
+    """A continuous joint's configuration is (cos, sin), two numbers for one velocity: the
+    hold, a PD on one angle, refuses it by name (a revolute one beside it is held)."""
+    uvms = up.load_uvms(continuous_joint_urdf(tmp_path, ("arm_joint2",)))
+    JointHoldController(uvms.model, {"arm_joint1": 0.1}, 1.0)
+    with pytest.raises(ParameterError, match="'arm_joint2' is not a one-angle joint"):
+        JointHoldController(uvms.model, {"arm_joint2": 0.1}, 1.0)
