@@ -3,6 +3,8 @@ documented error it now gets (before: the exception or crash named in each docst
 
 from __future__ import annotations
 
+import warnings
+
 import numpy as np
 import pinocchio as pin
 import pytest
@@ -260,6 +262,10 @@ def test_a_free_box_3_nm_thick_is_refused_not_a_crash():
     square = np.array([[x, y, 0.0] for x in (0.0, 1.0) for y in (0.0, 1.0)] * 2)
     with pytest.raises(ParameterError, match="flat"):
         convex_hull(square)
+    with warnings.catch_warnings():  # one point repeated: no 0 / 0 on the way to the refusal
+        warnings.simplefilter("error")
+        with pytest.raises(ParameterError, match=r"flat \(thickness 0 of"):
+            convex_hull(np.ones((5, 3)))
     with pytest.raises(ParameterError, match="4 or more finite points"):
         convex_hull(np.array([[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, np.nan, 1.0]]))
     box = np.array([[x, y, z] for x in (0.0, 1.0) for y in (0.0, 1.0) for z in (0.0, 1e-3)])

@@ -213,9 +213,11 @@ def convex_hull(points_m: np.ndarray) -> coal.Convex:
         )
     spread = np.linalg.svd(source - source.mean(axis=0), compute_uv=False)
     if not spread[2] > LEAST_HULL_THICKNESS * spread[0]:
+        # all points one point: no extent to divide by
+        thickness = spread[2] / spread[0] if spread[0] > 0.0 else 0.0
         raise ParameterError(
             "a convex hull needs points that span a volume: these are flat (thickness "
-            f"{spread[2] / spread[0]:.2g} of their extent, below {LEAST_HULL_THICKNESS:g}); "
+            f"{thickness:.2g} of their extent, below {LEAST_HULL_THICKNESS:g}); "
             "give the body a thickness"
         )
     points = coal.StdVec_Vec3s()
