@@ -1,8 +1,9 @@
 // The derivatives of the forward dynamics (derivatives.hpp) at n states at once, on T threads
 // (mirror of uvms_pin/physics/derivatives/batch.py, which calls the single derivatives state
-// by state): each thread differentiates its own contiguous share of the states with its own
-// Derivatives (its own copy of the dynamics and Pinocchio data), so a state's Jacobians do
-// not depend on the thread that computed them: the results equal n single calls for any T.
+// by state): the threads take the states one at a time in order, each differentiating
+// with its own Derivatives (its own copy of the dynamics and Pinocchio data), so a state's
+// Jacobians do not depend on the thread that computed them: the results equal n single calls
+// for any T.
 #pragma once
 
 #include <memory>
@@ -42,14 +43,15 @@ class BatchDerivatives {
   int nv() const { return derivatives_.front()->dynamics().nv(); }
   const Model& model() const { return derivatives_.front()->dynamics().model(); }
 
-  // Every state's Jacobians in `flow` (shared, read only), the first error of any thread
-  // rethrown after all have stopped.
+  // Every state's Jacobians in `flow` (shared, read only); after all threads have stopped,
+  // the error of the first state that failed rethrown.
   void compute(const BatchStates& states, const FlowField& flow, bool free_surface,
                const BatchJacobians& out);
 
  private:
-  void share(int thread, int begin, int end, const BatchStates& states, const FlowField& flow,
-             bool free_surface, const BatchJacobians& out);
+  // state k's Jacobians by thread `thread`'s Derivatives
+  void one(int thread, int k, const BatchStates& states, const FlowField& flow, bool free_surface,
+           const BatchJacobians& out);
 
   std::vector<std::unique_ptr<Derivatives>> derivatives_;  // one per thread
 };
