@@ -44,14 +44,19 @@ constexpr Eigen::Index kBlock = 256;
 // A block's arrays, by ray that met something (j < count) and channel.
 struct Block {
   explicit Block(Eigen::Index n_lights)
-      : ray(kBlock), pixel(kBlock), range_m(kBlock), direction(3 * kBlock), normal_z(kBlock),
-        sky(kBlock), depth_m(kBlock), power(kBlock * n_lights), rho(3 * kBlock),
-        day(3 * kBlock), back(3 * kBlock), lit(3 * kBlock * n_lights), signal(3 * kBlock) {}
-  std::vector<Eigen::Index> ray;    // its index in the cast
+      : pixel(kBlock), range_m(kBlock), direction(3 * kBlock), normal(3 * kBlock), sky(kBlock),
+        depth_m(kBlock), cosine(kBlock), facing(kBlock), falloff(kBlock),
+        power(kBlock * n_lights), rho(3 * kBlock), day(3 * kBlock), back(3 * kBlock),
+        lit(3 * kBlock * n_lights), signal(3 * kBlock) {}
   std::vector<std::int64_t> pixel;  // its pixel
   std::vector<double> range_m;
-  std::vector<double> direction;  // the ray's unit direction in the world, entry 3 j + axis
-  std::vector<double> normal_z, sky, depth_m, power;
+  // the ray's unit direction in the world and the normal of what it met, by axis: entry
+  // axis kBlock + j (so that the loops over the rays load them as vectors)
+  std::vector<double> direction, normal;
+  std::vector<double> sky, depth_m;
+  // a light's cone cosine, facing factor max(0, -n . l) and I_L / d^2, by ray (a light at a
+  // time); its power by light: entry l kBlock + j
+  std::vector<double> cosine, facing, falloff, power;
   // by channel c: entry c kBlock + j (lit: (l 3 + c) kBlock + j)
   std::vector<double> rho, day, back, lit, signal;
 };
@@ -145,11 +150,14 @@ template <class Sink>
   Block b(n_lights);
   // the block's arrays by their data (a store through the outputs' pointers may not reload
   // them)
-  Eigen::Index* const ray_of = b.ray.data();
   std::int64_t* const pixel_of_met = b.pixel.data();
   double* const range_of = b.range_m.data();
-  double* const direction = b.direction.data();
-  double* const normal_z = b.normal_z.data();
+  double* const dx = b.direction.data();
+  double* const dy = dx + kBlock;
+  double* const dz = dy + kBlock;
+  double* const nx = b.normal.data();
+  double* const ny = nx + kBlock;
+  double* const nz = ny + kBlock;
   double* const rho_of = b.rho.data();
   double* const depth_of = b.depth_m.data();
   double* const sky_of = b.sky.data();
@@ -174,12 +182,16 @@ template <class Sink>
       }
       sink.met(pixel, k, normal_world + 3 * i, r * ray_f.z());
       const Eigen::Index j = count++;
-      ray_of[j] = i;
       pixel_of_met[j] = pixel;
       range_of[j] = r;
       // the direction in the world, once a ray: its z for the depth, all of it for the lights
-      Eigen::Map<Vec3>(direction + 3 * j) = frame_rotation * ray_f;
-      normal_z[j] = normal_world[3 * i + 2];
+      const Vec3 d = frame_rotation * ray_f;
+      dx[j] = d.x();
+      dy[j] = d.y();
+      dz[j] = d.z();
+      nx[j] = normal_world[3 * i];
+      ny[j] = normal_world[3 * i + 1];
+      nz[j] = normal_world[3 * i + 2];
       for (int c = 0; c < 3; ++c) rho_of[c * kBlock + j] = reflectance[3 * k + c];
     }
     if (count == 0) {
@@ -189,8 +201,8 @@ template <class Sink>
     // daylight E0 exp(-K_d depth) (1 + n_z) / 2 and the direct path's exp(-beta_D r), and
     // the backscatter's exp(-beta_B r): their exponents
     for (Eigen::Index j = 0; j < count; ++j) {
-      depth_of[j] = std::max(-(origin_z + range_of[j] * direction[3 * j + 2]), 0.0);
-      sky_of[j] = half_sky * (1.0 + normal_z[j]);
+      depth_of[j] = std::max(-(origin_z + range_of[j] * dz[j]), 0.0);
+      sky_of[j] = half_sky * (1.0 + nz[j]);
     }
     for (int c = 0; c < 3; ++c) {
       const double kd = water.kd_per_m[c], beta_d = water.beta_d_per_m[c];
@@ -204,27 +216,54 @@ template <class Sink>
         back[j] = std::max(-beta_b * range_of[j], kExpLowest);
       }
     }
-    // each light: I_L cone max(0, n . l) / d^2, and the exponent of exp(-beta_D (d + r))
+    // each light: I_L cone max(0, n . l) / d^2, and the exponent of exp(-beta_D (d + r)).
+    // What has no branch first, in loops the compiler vectorizes (the products and sums as
+    // Eigen's Vec3 gave them: r d + (o - s), dot products (a0 b0 + a1 b1) + a2 b2; the arrays
+    // are the block's own, apart: ivdep), then the cone ray by ray (its branches: inside,
+    // outside, the edge's acos) and the power in the reference's order: cone, facing, falloff
+    double* const cosine = b.cosine.data();
+    double* const facing = b.facing.data();
+    double* const falloff = b.falloff.data();
     for (Eigen::Index l = 0; l < n_lights; ++l) {
       const SpotLight& light = lights[l];
+      const Vec3 offset = origin - light.source_world;
+      const double ox = offset.x(), oy = offset.y(), oz = offset.z();
+      const double ax = light.axis_world.x(), ay = light.axis_world.y();
+      const double az = light.axis_world.z();
+      const double intensity = light.intensity;
+      double* const lit = b.lit.data() + 3 * l * kBlock;
+      const double beta_0 = -water.beta_d_per_m[0], beta_1 = -water.beta_d_per_m[1];
+      const double beta_2 = -water.beta_d_per_m[2];
+#pragma GCC ivdep
       for (Eigen::Index j = 0; j < count; ++j) {
-        const Eigen::Index i = ray_of[j];
         const double r = range_of[j];
-        const Eigen::Map<const Vec3> d(direction + 3 * j);
-        const Eigen::Map<const Vec3> normal(normal_world + 3 * i);
-        const Vec3 to_point = r * d + (origin - light.source_world);
-        const double distance = std::sqrt(to_point.dot(to_point));
-        const double reach = std::max(distance, 1e-12);
-        double p = cones[l](to_point.dot(light.axis_world) / reach);
-        const double facing = normal.dot(to_point) / reach;
-        p *= std::max(0.0, -facing);
-        const double least = std::max(distance, 1e-6);
-        p *= light.intensity / (least * least);
-        b.power[l * kBlock + j] = p;
-        for (int c = 0; c < 3; ++c) {
-          b.lit[(3 * l + c) * kBlock + j] =
-              std::max((distance + r) * -water.beta_d_per_m[c], kExpLowest);
-        }
+        const double tx = r * dx[j] + ox, ty = r * dy[j] + oy, tz = r * dz[j] + oz;
+        const double distance = std::sqrt((tx * tx + ty * ty) + tz * tz);
+        // std::max(a, b) written out as a < b ? b : a (a NaN a kept), a select
+        const double reach = distance < 1e-12 ? 1e-12 : distance;
+        cosine[j] = ((tx * ax + ty * ay) + tz * az) / reach;
+        const double away = -(((nx[j] * tx + ny[j] * ty) + nz[j] * tz) / reach);
+        facing[j] = 0.0 < away ? away : 0.0;
+        // the distance kept from 0 here, squared below: squared here, GCC makes the select
+        // a branch between two squares, and the loop is not vectorized
+        falloff[j] = distance < 1e-6 ? 1e-6 : distance;
+        const double path = distance + r;
+        const double e0 = path * beta_0, e1 = path * beta_1, e2 = path * beta_2;
+        lit[j] = e0 < kExpLowest ? kExpLowest : e0;
+        lit[kBlock + j] = e1 < kExpLowest ? kExpLowest : e1;
+        lit[2 * kBlock + j] = e2 < kExpLowest ? kExpLowest : e2;
+      }
+#pragma GCC ivdep
+      for (Eigen::Index j = 0; j < count; ++j) {
+        falloff[j] = intensity / (falloff[j] * falloff[j]);
+      }
+      const SpotCone& cone = cones[l];
+      double* const power = b.power.data() + l * kBlock;
+      for (Eigen::Index j = 0; j < count; ++j) {
+        double p = cone(cosine[j]);
+        p *= facing[j];
+        p *= falloff[j];
+        power[j] = p;
       }
     }
     // the exponentials, vectorized over the rays that met something (vector_exp.hpp); the
