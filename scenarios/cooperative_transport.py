@@ -63,6 +63,7 @@ from __future__ import annotations
 import numpy as np
 import pinocchio as pin
 
+from uvms_pin.checks import finite_parameters
 from uvms_pin.control.base import Controller
 from uvms_pin.errors import ParameterError
 from uvms_pin.hydro.vector import cross3
@@ -133,6 +134,7 @@ class CooperativeTransport(Controller):
         kd_Nm_s_rad: list[float] = (0.8, 1.5, 1.0, 0.02),
         jaw_frame: str = "alpha_jaw_base_link",
     ):
+        finite_parameters("cooperative_transport", locals())  # inf or nan: refused now, by name
         if role not in ROLES:
             raise ParameterError(
                 f"cooperative_transport: role must be one of {ROLES}, got {role!r}"

@@ -51,6 +51,7 @@ import math
 import numpy as np
 import pinocchio as pin
 
+from uvms_pin.checks import finite_parameters
 from uvms_pin.control.base import Controller
 from uvms_pin.errors import ParameterError
 from uvms_pin.results.signal import Signal
@@ -98,16 +99,7 @@ class HotStab(Controller):
         attitude_gains: list[float] = (40.0, 20.0),
         jaw_frame: str = "alpha_jaw_base_link",
     ):
-        given = {
-            "mouth_world_m": mouth_world_m, "grasp_in_jaw_m": grasp_in_jaw_m,
-            "aim_error_m": aim_error_m, "stab_length_m": stab_length_m, "depth_m": depth_m,
-            "standoff_m": standoff_m, "overtravel_m": overtravel_m,
-            "lateral_gain": lateral_gain, "integral_limit_N": integral_limit_N,
-            "position_gains": position_gains, "attitude_gains": attitude_gains,
-        }  # fmt: skip
-        for key, value in given.items():  # a point or a length of inf: NaN targets
-            if not np.all(np.isfinite(np.asarray(value, dtype=float))):
-                raise ParameterError(f"hot_stab: {key} must be finite, got {value!r}")
+        finite_parameters("hot_stab", locals())  # inf or nan: refused now, by name
         self.model = uvms.model
         self.data = self.model.createData()
         if not self.model.existFrame(jaw_frame):

@@ -15,6 +15,7 @@ from __future__ import annotations
 import numpy as np
 import pinocchio as pin
 
+from uvms_pin.checks import finite_parameters
 from uvms_pin.control.base import Controller
 
 
@@ -54,6 +55,7 @@ class ObjectPush(Controller):
         depth_gains: list[float] = (200.0, 150.0),
         attitude_gains: list[float] = (40.0, 20.0),
     ):
+        finite_parameters("object_push", locals())  # inf or nan: refused now, by name
         self.nv = uvms.nv
         self.depth_m, self.surge_force_N = float(depth_m), float(surge_force_N)
         self.push_start_s, self.ramp_s = float(push_start_s), float(ramp_s)

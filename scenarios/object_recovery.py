@@ -42,6 +42,7 @@ from dataclasses import dataclass
 import numpy as np
 import pinocchio as pin
 
+from uvms_pin.checks import finite_parameters
 from uvms_pin.control.base import Controller
 from uvms_pin.control.jaw_servo import JawSchedule, JawServo
 from uvms_pin.errors import ParameterError
@@ -90,6 +91,9 @@ class ObjectRecovery(Controller):
         attitude_gains: list[float] = (40.0, 20.0),
         jaw_frame: str = "alpha_jaw_base_link",
     ):
+        finite_parameters(
+            "object_recovery", locals(), never=("jaw_open_at_s",)
+        )  # inf or nan: refused now, by name
         self.model = uvms.model
         self.data = self.model.createData()
         if not self.model.existFrame(jaw_frame):

@@ -13,6 +13,7 @@ from __future__ import annotations
 import numpy as np
 from object_push import arm_pd
 
+from uvms_pin.checks import finite_parameters
 from uvms_pin.control.base import Controller
 
 
@@ -28,6 +29,7 @@ class SeabedProbe(Controller):
         yaw_damping_Nm_s_rad: float = 2.0,
         start_s: float = 0.0,
     ):
+        finite_parameters("seabed_probe", locals())  # inf or nan: refused now, by name
         self.nv = uvms.nv
         self.heave_force_N = float(heave_force_N)
         self.target, self.kp, self.kd = arm_pd(self.nv, arm_target_rad, kp_Nm_rad, kd_Nm_s_rad)

@@ -45,6 +45,7 @@ from __future__ import annotations
 import numpy as np
 import pinocchio as pin
 
+from uvms_pin.checks import finite_parameters
 from uvms_pin.control.base import Controller
 from uvms_pin.errors import ParameterError
 from uvms_pin.results.signal import Signal
@@ -82,6 +83,7 @@ class ValveTurn(Controller):
         attitude_gains: list[float] = (40.0, 20.0),
         tip_frame: str = "alpha_jaw_link",
     ):
+        finite_parameters("valve_turn", locals())  # inf or nan: refused now, by name
         self.model = uvms.model
         self.data = self.model.createData()
         if not self.model.existFrame(tip_frame):

@@ -27,6 +27,7 @@ import numpy as np
 import pinocchio as pin
 from object_push import arm_pd
 
+from uvms_pin.checks import finite_parameters
 from uvms_pin.control.base import Controller
 from uvms_pin.physics.dynamics import bias_forces
 
@@ -52,6 +53,7 @@ class VisualServo(Controller):
         kp_Nm_rad: list[float] = (2.0, 10.0, 8.0, 0.5),
         kd_Nm_s_rad: list[float] = (0.3, 1.0, 0.8, 0.02),
     ):
+        finite_parameters("visual_servo", locals())  # inf or nan: refused now, by name
         if not 0.0 < horizontal_fov_rad < np.pi:  # its focal length from it: finite, > 0
             raise ValueError(f"horizontal_fov_rad must be in (0, pi), got {horizontal_fov_rad}")
         for name, pixels in (("width", width), ("height", height)):

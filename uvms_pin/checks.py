@@ -7,7 +7,7 @@ from __future__ import annotations
 import math
 import os
 import warnings
-from collections.abc import Callable
+from collections.abc import Callable, Iterable, Mapping
 from dataclasses import dataclass
 
 import numpy as np
@@ -36,6 +36,49 @@ def finite_vector(name: str, value, size: int) -> np.ndarray:
     if not np.all(np.isfinite(array)):
         raise ParameterError(f"{name} contains a non-finite value: {array}")
     return array
+
+
+def finite_parameters(
+    owner: str, parameters: Mapping[str, object], never: Iterable[str] = ()
+) -> None:
+    """Every number among ``parameters`` finite, or ParameterError naming ``owner`` and the
+    key: a controller's constructor calls it with ``locals()`` (what is not a number or
+    numbers, e.g. ``self``, the model, a frame's name, None, is passed over), so that a gain
+    of inf or nan in a scenario is refused before the run, not at its first tick.
+
+    Args:
+        owner: who is asking, for the message ("seabed_probe").
+        parameters: name -> value: a number, or a (nested) list, tuple or array of numbers.
+        never: the keys whose +inf means "never" or "none" (a time the jaw opens at):
+            accepted; their nan and -inf are not.
+    """
+    allowed = frozenset(never)
+    for key, value in parameters.items():
+        array = _numbers(value)
+        if array is None:
+            continue
+        finite = np.isfinite(array)
+        if key in allowed:
+            finite |= array == math.inf
+        if not finite.all():
+            also = " (or inf: never)" if key in allowed else ""
+            raise ParameterError(f"{owner}: {key} must be finite{also}, got {value!r}")
+
+
+def _numbers(value) -> np.ndarray | None:
+    """``value`` as a float array if it is a number or numbers (not a bool or a string),
+    else None."""
+    if isinstance(value, bool | str | bytes) or value is None:
+        return None
+    if isinstance(value, int | float | np.number):
+        return np.asarray(value, dtype=float)
+    if isinstance(value, list | tuple | np.ndarray):
+        try:
+            array = np.asarray(value, dtype=float)
+        except (TypeError, ValueError):
+            return None  # strings, ragged or mixed: not numbers
+        return array if array.size else None
+    return None
 
 
 def positive(name: str, value: float) -> float:

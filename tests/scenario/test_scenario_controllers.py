@@ -1,0 +1,71 @@
+"""The shipped scenarios' own controllers (``type = "module:Class"`` next to the scenario):
+a parameter that is not a finite number is refused by name before the run starts, as the
+built-in controllers' are (a gain of inf ran until its first tick, then stopped the run)."""
+
+from __future__ import annotations
+
+import math
+import tomllib
+from pathlib import Path
+
+import pytest
+
+import uvms_pin as up
+from uvms_pin.errors import ParameterError, ScenarioError
+
+SCENARIOS = Path(__file__).resolve().parents[2] / "scenarios"
+
+
+def _own_controllers() -> list[tuple[str, str, str]]:
+    """(scenario file, the controller table's override prefix, a numeric key) of every
+    shipped scenario whose controller is its own class."""
+    cases = []
+    for path in sorted(SCENARIOS.glob("*.toml")):
+        raw = tomllib.loads(path.read_text())
+        tables = [("controller", raw.get("controller", {}))]
+        tables += [(f"robots[{k}].controller", r.get("controller", {}))
+                   for k, r in enumerate(raw.get("robots", []))]  # fmt: skip
+        for prefix, table in tables:
+            if ":" not in str(table.get("type", "")):
+                continue
+            for key, value in table.items():
+                numbers = value if isinstance(value, list) else [value]
+                if numbers and all(
+                    isinstance(x, int | float) and not isinstance(x, bool) for x in numbers
+                ):
+                    cases.append((path.name, prefix, key))
+    return cases
+
+
+CASES = _own_controllers()
+#: the parameters whose inf means "never" (the jaw opens at inf: it stays closed)
+NEVER = {("object_recovery.toml", "jaw_open_at_s")}
+
+
+def test_every_scenario_controller_is_found():
+    assert {name for name, _, _ in CASES} >= {
+        "cooperative_transport.toml", "gripper_close.toml", "hot_stab.toml",
+        "object_recovery.toml", "push_object.toml", "seabed_landing.toml", "valve_turn.toml",
+        "visual_approach.toml",
+    }  # fmt: skip
+
+
+def _value_with(value, bad: float):
+    return [bad, *value[1:]] if isinstance(value, list) else bad
+
+
+@pytest.mark.parametrize("bad", [math.inf, -math.inf, math.nan])
+@pytest.mark.parametrize("name, prefix, key", CASES)
+def test_a_non_finite_parameter_is_refused_by_name_before_the_run(name, prefix, key, bad):
+    path = SCENARIOS / name
+    raw = tomllib.loads(path.read_text())
+    table = raw["controller"] if prefix == "controller" else raw["robots"][
+        int(prefix[len("robots[") : prefix.index("]")])
+    ]["controller"]  # fmt: skip
+    overrides = {f"{prefix}.{key}": _value_with(table[key], bad), "scenario.duration_s": 0.2}
+    if bad == math.inf and (name, key) in NEVER:
+        rollout = up.simulate(up.load_scenario(path, overrides=overrides), progress=False)
+        assert rollout.time_s[-1] == pytest.approx(0.2)  # it means never, and runs
+        return
+    with pytest.raises((ParameterError, ScenarioError), match=f"{key} must be"):
+        up.simulate(up.load_scenario(path, overrides=overrides), progress=False)
