@@ -106,3 +106,28 @@ def test_a_user_constructor_raising_names_its_parameters_with_the_traceback(tmp_
         load_scenario(tmp_path / "s.toml")
     assert "my_ctrl_raise.py" in info.value.user_traceback
     assert "self.gain = {}['missing']" in info.value.user_traceback
+
+
+def test_a_user_constructor_refusing_a_parameter_is_its_message_without_a_traceback(tmp_path):
+    """A ParameterError from the constructor is a refusal made on purpose (e.g.
+    `uvms_pin.checks.finite_parameters`): its message is the error, no frames shown."""
+    (tmp_path / "my_ctrl_refuse.py").write_text(
+        "from uvms_pin.checks import finite_parameters\n"
+        "from uvms_pin.control.base import Controller\n"
+        "class C(Controller):\n"
+        "    def __init__(self, uvms, gain=1.0):\n"
+        "        finite_parameters('mine', locals())\n"
+        "    def compute(self, t, m):\n"
+        "        return None\n"
+    )
+    text = PASSIVE.read_text().replace('"uvms_lbv150"', f'"{ROOT / "models" / "uvms_lbv150.urdf"}"')
+    (tmp_path / "s.toml").write_text(
+        text + '\n[controller]\ntype = "my_ctrl_refuse:C"\ngain = nan\n'
+    )
+    from uvms_pin.errors import ScenarioError
+
+    with pytest.raises(
+        ScenarioError, match=r"rejected its parameters: mine: gain must be finite, got nan"
+    ) as info:
+        load_scenario(tmp_path / "s.toml")
+    assert not getattr(info.value, "user_traceback", None)

@@ -61,7 +61,11 @@ def custom_controller(
                 controller = cls.from_params(uvms, dict(frozen))
             else:
                 controller = cls(uvms, **frozen)
-        except Exception as exc:  # the user's constructor: its traceback goes with it
+        except ParameterError as exc:  # a refusal the class made on purpose: its message
+            raise ParameterError(
+                f"controller '{type_path}' rejected its parameters: {exc}"
+            ) from exc
+        except Exception as exc:  # the user's constructor failed: its traceback goes with it
             raise users_code_failed(
                 f"controller '{type_path}' rejected its parameters "
                 f"({', '.join(sorted(frozen)) or 'none'}): {type(exc).__name__}: {exc}",
