@@ -136,6 +136,7 @@ def test_the_manipulability_task_climbs_its_gradient_in_the_pose_tasks_null_spac
     q = uvms.neutral_configuration()
     q[7:] = [0.3, 0.4, -0.6, 0.5]
     w = plain.manipulability(q)
+    gains_m = 2.5
     climbing = KinematicLevel(
         model,
         task,
@@ -143,7 +144,7 @@ def test_the_manipulability_task_climbs_its_gradient_in_the_pose_tasks_null_spac
             attitude_gain_per_s=0.0,
             damping=1e-9,
             manipulability_threshold=2.0 * w,  # active here
-            manipulability_gain=1.0,
+            manipulability_gain=gains_m,
         ),
     )
     zero = np.zeros(model.nv)
@@ -159,6 +160,13 @@ def test_the_manipulability_task_climbs_its_gradient_in_the_pose_tasks_null_spac
         for j in range(4)
     ])  # fmt: skip
     assert np.linalg.norm(change[6:]) > 1e-6 and change[6:] @ gradient > 0.0  # uphill
+    # and exactly the gradient k_m grad w projected off the pose task's rows (unit weights)
+    projector = np.eye(model.nv) - np.linalg.pinv(jac) @ jac
+    np.testing.assert_allclose(
+        change,
+        projector @ np.r_[np.zeros(6), gains_m * gradient],
+        atol=1e-6 * np.abs(gradient).max(),
+    )
     # above the threshold the set-based task is absent
     relaxed = KinematicLevel(
         model, task, KinematicGains(attitude_gain_per_s=0.0, damping=1e-9,
@@ -179,3 +187,25 @@ def test_a_vehicle_task_has_no_manipulability_task(uvms):
     for _ in range(3):
         q, v = _q(uvms, rng), rng.normal(size=model.nv)
         np.testing.assert_array_equal(asked.reference(0.0, q, v)[0], plain.reference(0.0, q, v)[0])
+
+
+@pytest.mark.parametrize("yaw", [0.0, 1.1])
+@pytest.mark.parametrize("roll, pitch", [(0.2, 0.0), (0.0, -0.15)])
+def test_the_attitude_task_levels_the_vehicle_at_its_rate_whatever_its_heading(
+    uvms, roll, pitch, yaw
+):
+    """Second task: the vehicle's body roll and pitch rates (p, q) are k_a times the rotation
+    from its attitude to the level one of the same heading: -k_a roll, -k_a pitch."""
+    model, k_a = uvms.model, 0.7
+    task = TrackingTask(
+        "hold", "end_effector", "world", uvms.model.frames[uvms.ee_frame_id].name,
+        Hold(np.zeros(3)), np.eye(3), track_orientation=False,
+    )  # fmt: skip
+    level = KinematicLevel(model, task, KinematicGains(attitude_gain_per_s=k_a, damping=1e-9))
+    q = uvms.neutral_configuration()
+    q[7:] = [0.3, 0.4, -0.6, 0.5]
+    rotation = pin.utils.rpyToMatrix(0.0, 0.0, yaw) @ pin.utils.rpyToMatrix(roll, pitch, 0.0)
+    q[3:7] = pin.Quaternion(rotation).coeffs()
+    zeta_r, info = level.reference(0.0, q, np.zeros(model.nv))
+    assert not info["active_limits"].any()
+    np.testing.assert_allclose(zeta_r[3:5], [-k_a * roll, -k_a * pitch], atol=1e-9)
