@@ -164,6 +164,15 @@ def test_refusals(alpha5):
         JointLimits((1,)).rows(model, model.createData(), q, np.abs(v), PERIOD_S)
     with pytest.raises(ParameterError, match="margin"):
         JointLimits((2,), margin=-1.0)
+    # a joint whose one limit is Pinocchio's "none" (the largest double), or infinite
+    for side, value in (("lower", -np.finfo(float).max), ("upper", np.inf), ("lower", -1e301)):
+        open_ended = pin.Model(model)
+        limits_of = getattr(open_ended, f"{side}PositionLimit").copy()
+        limits_of[open_ended.joints[2].idx_q] = value
+        setattr(open_ended, f"{side}PositionLimit", limits_of)
+        name = open_ended.names[2]
+        with pytest.raises(ParameterError, match=f"joint '{name}' has no finite position limits"):
+            JointLimits((2,)).rows(open_ended, open_ended.createData(), q, np.abs(v), PERIOD_S)
 
 
 @pytest.mark.parametrize("period_s", [2e-3, 5e-4])  # a period under 1 ms too
