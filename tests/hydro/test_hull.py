@@ -9,6 +9,7 @@ import numpy as np
 import pinocchio as pin
 import pytest
 
+from uvms_pin.errors import ParameterError
 from uvms_pin.hydro.hull import Hull, HullPiece, SurfaceAt
 from uvms_pin.hydro.submerged import Ellipsoid, Polyhedron, Sphere
 from uvms_pin.hydro.submerged_cylinder import Cylinder
@@ -115,3 +116,38 @@ def test_a_mesh_away_from_its_origin_is_fitted_by_its_own_centroid():
         ).fraction == pytest.approx(1.0, abs=1e-12)
         above = -(rotation @ hull.bound_center_m)[2] + hull.bound_radius_m
         assert hull.wet(rotation, np.array([0.0, 0.0, above]), SurfaceAt()).fraction == 0.0
+
+
+def test_a_piece_and_a_hull_placed_in_another_frame_move_by_that_pose():
+    """x' = R x + t: a placed piece's centroid and a placed hull's centroid and bounding centre
+    (the fits that follow in the loaders would hide a wrong translation: tested here alone)."""
+    rotation, translation = _random_rotation(), np.array([0.3, -0.7, 1.1])
+    piece = HullPiece(Ellipsoid((0.2, 0.1, 0.05)), _random_rotation(), np.array([0.1, 0.2, -0.3]))
+    moved = piece.placed(rotation, translation)
+    np.testing.assert_allclose(
+        moved.centroid_m, rotation @ piece.centroid_m + translation, atol=1e-12
+    )
+    np.testing.assert_allclose(moved.rotation, rotation @ piece.rotation, atol=1e-12)
+    hull = _hull()
+    placed = hull.placed(rotation, translation)
+    np.testing.assert_allclose(
+        placed.bound_center_m, rotation @ hull.bound_center_m + translation, atol=1e-12
+    )
+    for before, after in zip(hull.pieces, placed.pieces, strict=True):
+        np.testing.assert_allclose(
+            after.centroid_m, rotation @ before.centroid_m + translation, atol=1e-12
+        )
+
+
+@pytest.mark.parametrize(
+    "rotation, translation, needle",
+    [
+        (2.0 * np.eye(3), np.zeros(3), "rotation must be a 3x3 rotation"),
+        (np.eye(2), np.zeros(3), "rotation must be a 3x3 rotation"),
+        (np.eye(3), [0.0, math.nan, 0.0], "translation must be 3 finite numbers"),
+        (np.eye(3), [0.0, 1.0], "translation must be 3 finite numbers"),
+    ],
+)
+def test_a_piece_refuses_what_is_not_a_pose(rotation, translation, needle):
+    with pytest.raises(ParameterError, match=needle):
+        HullPiece(Sphere(0.1), rotation, translation)
