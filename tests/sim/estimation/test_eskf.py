@@ -178,6 +178,13 @@ def test_process_noise_is_the_imu_noise_integrated_over_a_period():
     assert Q[9, 9] == pytest.approx(IMU.gyro_bias_walk_rad_s2_rthz**2 * dt, rel=1e-12)
     assert Q[12, 12] == pytest.approx(IMU.accel_bias_walk_m_s3_rthz**2 * dt, rel=1e-12)
     assert np.linalg.eigvalsh(Q).min() >= -1e-20  # positive semi-definite (p, v rank one)
+    # the velocity's noise n reaches the position by dt/2 (dp+ = dp + dt dv + dt/2 (dv+ - dv)):
+    # (dp, dv) noise = [dt/2; 1] n, so its covariance is [dt^2/4, dt/2; dt/2, 1] N_a^2 dt
+    spread = np.kron(np.array([[dt * dt / 4.0, dt / 2.0], [dt / 2.0, 1.0]]), np.eye(3))
+    np.testing.assert_allclose(
+        Q[:6, :6], spread * IMU.accel_noise_m_s2_rthz**2 * dt, rtol=1e-12, atol=0.0
+    )
+    assert not Q[:6, 6:].any()  # no noise shared with the attitude or the biases
 
 
 def test_dvl_jacobian_matches_finite_differences():
