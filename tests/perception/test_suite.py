@@ -162,3 +162,25 @@ def test_an_image_stack_starts_on_a_huge_page_when_larger_than_one(shape, dtype)
         assert stack.ctypes.data % HUGE_PAGE == 0
     stack[...] = 7  # all of it is its own
     assert np.all(stack == 7)
+
+
+def test_the_memory_checked_before_a_run_is_what_its_images_take():
+    """Each kind's `bytes(spec)` (what `check_mounts` sums before the run) is what one firing
+    keeps: the camera's depth, colour and labels, a sonar's image, a multibeam's detections."""
+    from uvms_pin.perception.sensor import SENSORS
+
+    multibeam = {"name": "mb", "type": "multibeam", "beams": 16, "bins": 32, "rate_hz": 5.0,
+                 "rpy_rad": [0.0, 1.5708, 0.0]}  # fmt: skip
+    scenario = _scenario({"camera": [CAMERA], "sonar": [SONAR, multibeam]})
+    rollout = simulate(scenario, progress=False)
+    specs = {spec.name: (kind, spec) for kind, spec in scenario.sensor_config.perception.sensors}
+    for name, recorded in (("front", rollout.camera("front")), ("fls", rollout.sonar("fls")),
+                           ("mb", rollout.sonar("mb"))):  # fmt: skip
+        kind, spec = specs[name]
+        firings = len(recorded.time_s)
+        kept = sum(
+            value.nbytes
+            for key, value in vars(recorded).items()
+            if isinstance(value, np.ndarray) and value.ndim > 1 and len(value) == firings
+        )
+        assert kept == firings * SENSORS[kind].bytes(spec), name
