@@ -332,7 +332,9 @@ def test_funnel_margins_orientation_and_commanded_peaks():
     commanded = r.signal("tau_commanded", 6 + N_JOINTS)
     commanded[:] = 0.0
     commanded[10, :3] = [3.0, 4.0, 0.0]
+    commanded[10, 3] = 1.5  # a torque beside it: not part of the force
     commanded[20, 3:6] = [0.0, 0.0, -2.0]
+    commanded[20, 6] = 1.5  # a joint torque beside it: not part of the vehicle's torque
     commanded[30, 9] = -7.0
     m = force_tracking_metrics(r)
     assert m["funnel_margin_min_first"] == pytest.approx(0.3, rel=1e-12)
@@ -366,3 +368,7 @@ def test_world_contact_time_and_peak_force_from_the_logged_pairs():
     m = compute_metrics(r)
     assert m["time_in_world_contact_s"] == pytest.approx(300 * DT, rel=1e-12)
     assert m["world_contact_force_peak_N"] == pytest.approx(12.0, rel=1e-12)  # |(0, 0, 12)|
+    # touching at the last sample too: that sample holds for no time (a run ends there)
+    contacts[-1, 0, :3] = [0.0, 0.0, 1.0]
+    r.signal("world_contact", 18)[:] = contacts.reshape(N, 18)
+    assert compute_metrics(r)["time_in_world_contact_s"] == pytest.approx(300 * DT, rel=1e-12)
