@@ -44,6 +44,18 @@ def raising(rollout):
     raise RuntimeError("no data")
 
 
+def unnamed(rollout):
+    return {"": 1.0}
+
+
+def numbered(rollout):
+    return {3: 1.0}
+
+
+def flagged(rollout):
+    return {"touched": True}
+
+
 NOT_CALLABLE = 3
 '''
 
@@ -96,6 +108,9 @@ def test_bad_references_are_scenario_errors(scenario_dir, reference, match):
         ("not_a_mapping", "must return a mapping"),
         ("nan_valued", "'broken' is NaN"),
         ("raising", "raised RuntimeError: no data"),
+        ("unnamed", "a metric name must be text, got ''"),
+        ("numbered", "a metric name must be text, got 3"),
+        ("flagged", "'touched' must be a real number, got True"),
     ],
 )
 def test_bad_results_name_the_function(scenario_dir, reference, match):
