@@ -64,6 +64,10 @@ def test_mass_properties_of_the_solids():
     assert m == 10.0 and np.allclose(inertia, np.eye(3) * 0.4 * 10.0 * 0.25)
     m, _, inertia = solid_mass_properties("cylinder", {"radius_m": 0.1, "length_m": 1.0}, 3.0, None)
     assert np.allclose(np.diag(inertia), [3.0 * 1.03 / 12, 3.0 * 1.03 / 12, 0.015])
+    assert solid_mass_properties("sphere", {"radius_m": 0.01}, 0.004, None)[0] == 0.004  # 4 g
+    for mass, density in ((0.0, None), (-1.0, None), (None, 0.0), (math.nan, None)):
+        with pytest.raises(up.ParameterError, match="a free sphere needs a positive mass"):
+            solid_mass_properties("sphere", {"radius_m": 0.5}, mass, density)
 
 
 def test_a_free_object_has_the_hydrodynamics_of_its_shape():

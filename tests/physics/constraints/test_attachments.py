@@ -207,8 +207,11 @@ def test_bad_attachments_are_refused_naming_the_object_or_the_link(reference_uvm
         Attachment("ball", "tool", release_at_s=-1.0)
     with pytest.raises(ParameterError, match=r"after attach_at_s \(0.5 s\), got 0.3"):
         Attachment("ball", "tool", release_at_s=0.3, attach_at_s=0.5)
-    with pytest.raises(ParameterError, match="attach_at_s must be finite and >= 0"):
-        Attachment("ball", "tool", attach_at_s=float("nan"))
+    for start in (float("nan"), -0.5, float("inf")):
+        with pytest.raises(ParameterError, match="attach_at_s must be finite and >= 0"):
+            Attachment("ball", "tool", attach_at_s=start)
+    with pytest.raises(ParameterError, match=r"after attach_at_s \(0.5 s\), got 0.5"):
+        Attachment("ball", "tool", release_at_s=0.5, attach_at_s=0.5)  # released as it attaches
     # the constraint's own check: both bodies are moving joints of the system's model
     for joints in ((0, 7), (7, 0), (-1, 7)):
         with pytest.raises(ParameterError, match="the attachment of 'ball': no such joint"):

@@ -56,3 +56,12 @@ def test_what_a_kind_gives_the_views_and_the_core_is_its_own():
     assert object_kind("plane").drawing(floor.record()).unbounded
     assert object_kind("plane").free is None  # a plane cannot be free
     assert np.isinf(floor.bound_radius_m)
+    # meshcat's cylinder lies along its y: drawn turned onto the object's z, length first
+    pipe = solid("pipe", "cylinder", {"radius_m": 0.2, "length_m": 3.0}, [0, 0, 0], [0, 0, 0],
+                 0.6, 0.5)  # fmt: skip
+    drawn = object_kind("cylinder").drawing(pipe.record())
+    assert drawn.geometry == "Cylinder" and list(drawn.args) == [3.0, 0.2]
+    turn = np.asarray(drawn.rotation_in_object)
+    np.testing.assert_allclose(turn @ [0.0, 1.0, 0.0], [0.0, 0.0, 1.0], atol=1e-15)
+    np.testing.assert_allclose(turn.T @ turn, np.eye(3), atol=1e-15)
+    assert np.linalg.det(turn) == pytest.approx(1.0)
