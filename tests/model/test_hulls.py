@@ -66,3 +66,29 @@ def test_an_unreadable_collision_mesh_leaves_a_sphere_with_a_warning(load_body):
     with pytest.warns(up.ModelWarning, match="sphere of the link's volume"):
         uvms = load_body(text)
     assert uvms.surface_bodies.hulls[0].equivalent_sphere
+
+
+@pytest.mark.parametrize(
+    "collision, needle",
+    [
+        ("", "<collision> has no <geometry> shape"),  # an empty <geometry/>
+        ('<box size="12000 0.2 0.1"/>', "<box size> = 12000 0.2 0.1 m cannot be physical"),
+        ('<sphere radius="-20000"/>', "<sphere radius> = -20000 m cannot be physical"),
+    ],
+)
+def test_a_collision_without_a_shape_or_beyond_ten_kilometres_is_refused(
+    write_urdf, collision, needle
+):
+    """Refused where the body's water is derived from it; with <hydrodynamics>, said, and
+    the surface cuts an equivalent sphere instead."""
+    for hydro in (None, hydro_xml(0.01)):
+        text = body_urdf(mass=10.0, hydro=hydro, collision="<box/>")
+        text = text.replace("<geometry><box/></geometry>", f"<geometry>{collision}</geometry>")
+        path = write_urdf(text)
+        if hydro is None:
+            with pytest.raises(up.ModelError, match=needle):
+                up.load_uvms(path, ee_frame="body", sensor_frame="body")
+        else:
+            with pytest.warns(up.ModelWarning, match=needle):
+                uvms = up.load_uvms(path, ee_frame="body", sensor_frame="body")
+            assert uvms.surface_bodies.hulls[0].equivalent_sphere
