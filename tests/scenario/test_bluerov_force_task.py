@@ -30,3 +30,15 @@ def test_funnels_hold_through_the_transient_within_t200_and_joint_limits():
     assert np.all(thrusts <= 5.25 * 9.80665 + 1e-9) and np.all(thrusts >= -4.1 * 9.80665 - 1e-9)
     np.testing.assert_allclose(actuation.joint_effort_limits_Nm, [9, 9, 9, 5])
     assert np.all(np.abs(rollout.tau[:, 6:]) <= actuation.joint_effort_limits_Nm + 1e-12)
+
+
+def test_thrusters_allocate_all_six_components_unless_told_otherwise():
+    """[actuation] without ``allocated_components``: surge to yaw, 0 to 5, all of them."""
+    from uvms_pin.errors import ScenarioError
+    from uvms_pin.scenario.load import scenario_from_dict
+    from uvms_pin.scenario.toml import read_toml
+
+    raw = read_toml(SCENARIO, ScenarioError)
+    del raw["actuation"]["allocated_components"]
+    actuation = scenario_from_dict(raw, SCENARIO).plant.actuation
+    assert list(actuation.allocated_components) == [0, 1, 2, 3, 4, 5]
