@@ -91,9 +91,8 @@ class ObjectRecovery(Controller):
         attitude_gains: list[float] = (40.0, 20.0),
         jaw_frame: str = "alpha_jaw_base_link",
     ):
-        finite_parameters(
-            "object_recovery", locals(), never=("jaw_open_at_s",)
-        )  # inf or nan: refused now, by name
+        # inf or nan: refused now, by name (the jaw opening at inf: never)
+        finite_parameters("object_recovery", locals(), never=("jaw_open_at_s",))
         self.model = uvms.model
         self.data = self.model.createData()
         if not self.model.existFrame(jaw_frame):

@@ -28,13 +28,15 @@ def _own_controllers() -> list[tuple[str, str, str]]:
         for prefix, table in tables:
             if ":" not in str(table.get("type", "")):
                 continue
-            for key, value in table.items():
-                numbers = value if isinstance(value, list) else [value]
-                if numbers and all(
-                    isinstance(x, int | float) and not isinstance(x, bool) for x in numbers
-                ):
-                    cases.append((path.name, prefix, key))
+            cases += [(path.name, prefix, key) for key, v in table.items() if _numeric(v)]
     return cases
+
+
+def _numeric(value) -> bool:
+    """A number, or a non-empty (nested) list of numbers (waypoints: lists of points)."""
+    if isinstance(value, list):
+        return bool(value) and all(_numeric(x) for x in value)
+    return isinstance(value, int | float) and not isinstance(value, bool)
 
 
 CASES = _own_controllers()
@@ -51,7 +53,8 @@ def test_every_scenario_controller_is_found():
 
 
 def _value_with(value, bad: float):
-    return [bad, *value[1:]] if isinstance(value, list) else bad
+    """``value`` with its first number (the first of the first point's, when nested) bad."""
+    return [_value_with(value[0], bad), *value[1:]] if isinstance(value, list) else bad
 
 
 @pytest.mark.parametrize("bad", [math.inf, -math.inf, math.nan])
