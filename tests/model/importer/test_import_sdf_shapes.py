@@ -1,0 +1,99 @@
+"""An SDF model's sphere, cylinder and mesh collisions and a joint axis given in the model
+frame (``<use_parent_model_frame>``), imported: gz-sim's LRAUV with its fins' boxes made a
+sphere and a cylinder, its horizontal fins' link turned a quarter turn about z and a mesh
+beside the hull's box."""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from uvms_pin.model.importer.convert import import_model
+from uvms_pin.model.urdf.load import load_uvms
+
+LRAUV = Path(__file__).parent / "data" / "lrauv_hydrodynamics.sdf"
+FIN_BOX = "<box>\n            <size>0.1 0.1 0.02</size>\n          </box>"
+SPHERE_CENTRE_M = (0.01, -0.02, 0.03)
+
+
+def _replace_in_link(text: str, link: str, old: str, new: str) -> str:
+    start = text.index(old, text.index(f'<link name="{link}">'))
+    return text[:start] + new + text[start + len(old) :]
+
+
+@pytest.fixture(scope="module")
+def imported(tmp_path_factory):
+    text = LRAUV.read_text()
+    assert text.count(FIN_BOX) == 2
+    text = text.replace(
+        '<link name="horizontal_fins">\n      <pose>1.05 0 0 0 0 0</pose>',
+        '<link name="horizontal_fins">\n      <pose>1.05 0 0 0 0 1.5707963267948966</pose>',
+    )
+    text = _replace_in_link(
+        text, "horizontal_fins", FIN_BOX, "<sphere><radius>0.05</radius></sphere>"
+    )
+    text = _replace_in_link(
+        text,
+        "horizontal_fins",
+        '<collision name="collision">',
+        '<collision name="collision"><pose>{} {} {} 0 0 0</pose>'.format(*SPHERE_CENTRE_M),
+    )
+    text = _replace_in_link(
+        text,
+        "vertical_fins",
+        FIN_BOX,
+        "<cylinder><radius>0.04</radius><length>0.1</length></cylinder>",
+    )
+    # the horizontal fins' axis, y of the model frame: x of their link, turned about z
+    text = text.replace(
+        "<xyz>0 1 0</xyz>",
+        "<xyz>0 1 0</xyz><use_parent_model_frame>true</use_parent_model_frame>",
+    )
+    text = text.replace(
+        '<collision name="main_body_buoyancy">',
+        '<collision name="dome"><geometry><mesh><uri>dome.stl</uri><scale>2 2 2</scale>'
+        '</mesh></geometry></collision>\n      <collision name="main_body_buoyancy">',
+    )
+    folder = tmp_path_factory.mktemp("shapes")
+    source = folder / "shapes.sdf"
+    source.write_text(text)
+    return import_model(source, folder / "shapes.urdf"), folder / "shapes.urdf"
+
+
+def test_a_sphere_and_a_cylinder_displace_their_closed_form_volumes(imported):
+    result, _ = imported
+    sphere = result.hydro["horizontal_fins"]
+    assert sphere.volume_m3 == pytest.approx(4.0 / 3.0 * math.pi * 0.05**3, rel=1e-15)
+    np.testing.assert_allclose(sphere.center_of_buoyancy_m, SPHERE_CENTRE_M, atol=1e-15)
+    cylinder = result.hydro["vertical_fins"]
+    assert cylinder.volume_m3 == pytest.approx(math.pi * 0.04**2 * 0.1, rel=1e-15)
+
+
+def test_a_mesh_is_left_out_of_the_buoyancy_and_said_so(imported):
+    result, _ = imported
+    assert result.hydro["base_link"].volume_m3 == pytest.approx(2 * 0.3 * 0.2464451666666667)
+    assert any(
+        n == "link 'base_link': a collision shape without a primitive volume left out of its "
+        "buoyancy"
+        for n in result.not_mapped
+    )
+    # the mesh is kept as the link's collision, its scale with it
+    assert '<mesh filename="dome.stl" scale="2 2 2" />' in result.urdf_text
+
+
+def test_an_axis_in_the_model_frame_is_written_in_the_child_links(imported):
+    _, out = imported
+    with pytest.warns(UserWarning, match="dome.stl"):  # the mesh file is not there
+        uvms = load_uvms(out, water_density_kg_m3=1000.0)
+    joint = uvms.model.getJointId("horizontal_fins_joint")
+    placement = uvms.model.jointPlacements[joint]
+    np.testing.assert_allclose(placement.rotation[:, 0], [0.0, 1.0, 0.0], atol=1e-15)
+    # a revolute joint about its link's x: Pinocchio's RX (or a unit axis along x)
+    motion = uvms.model.joints[joint].shortname()
+    if motion == "JointModelRX":
+        return
+    assert motion == "JointModelRevoluteUnaligned"
+    np.testing.assert_allclose(uvms.model.joints[joint].extract().axis, [1.0, 0.0, 0.0], atol=1e-15)
