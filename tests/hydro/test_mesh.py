@@ -165,6 +165,32 @@ def test_a_wedge_is_buoyed_at_its_centroid_not_its_bounding_box_centre(load_body
     np.testing.assert_allclose(view["centre of buoyancy"], centroid, rtol=0, atol=1e-15)
 
 
+@pytest.mark.parametrize("scale", [(-1.0, 1.0, 1.0), (1.0, -2.0, 0.5), (-1.0, -1.0, -1.0)])
+def test_a_mesh_mirrored_by_its_scale_is_the_mirrored_mesh(load_body, tmp_path, scale):
+    """URDF's ``scale="-1 1 1"`` (a left part made from a right one's file): the wedge
+    scaled by a negative factor is the body of a file holding the scaled vertices, its
+    centroid (and every coefficient) on the mirrored side."""
+    a, b, length = 0.2, 0.1, 0.3
+    section = np.array([[0.0, 0.0], [a, 0.0], [0.0, b]])
+    wedge = trimesh.creation.extrude_triangulation(section, np.array([[0, 1, 2]]), length)
+    wedge.apply_transform(_pose(ROTATION, OFFSET_M))
+    given = _write(wedge, tmp_path / "wedge.obj").replace("/>", f' scale="{_numbers(scale)}"/>')
+    scaled = _body(load_body, given)
+    mirrored = wedge.copy()
+    mirrored.apply_transform(np.diag([*scale, 1.0]))  # trimesh turns its faces out again
+    expected = _in_link_frame(_body(load_body, _write(mirrored, tmp_path / "mirrored.obj")))
+    centroid = OFFSET_M + ROTATION @ np.array([a / 3.0, b / 3.0, length / 2.0])
+    np.testing.assert_allclose(
+        expected["centre of buoyancy"], np.asarray(scale) * centroid, rtol=0, atol=1e-15
+    )
+    assert scaled.params.volume_m3 == pytest.approx(
+        0.5 * a * b * length * abs(np.prod(scale)), rel=1e-12
+    )
+    for name, value in _in_link_frame(scaled).items():
+        size = float(np.max(np.abs(expected[name])))
+        np.testing.assert_allclose(value, expected[name], rtol=0, atol=1e-12 * size, err_msg=name)
+
+
 def test_the_surface_cuts_a_box_mesh_where_the_box_is(load_body, tmp_path):
     """The hull of a body derived from a mesh sits where the mesh is: a rotated, offset box
     mesh and the box primitive at that pose leave the same wet volume and moment, at random

@@ -138,7 +138,9 @@ def load_mesh_geometry(path: str | Path, scale=(1.0, 1.0, 1.0)) -> MeshGeometry:
     if not np.all(np.isfinite(s)) or np.any(s == 0.0):
         raise ParameterError(f"mesh scale must be finite and non-zero, got {scale!r}")
     check_mesh_fits(p)
-    return _load_cached(str(p.resolve()), p.stat().st_mtime_ns, tuple(float(x) for x in np.abs(s)))
+    # signed: a negative factor mirrors the mesh (URDF's scale="-1 1 1" for a left part made
+    # from a right one), its centroid and bounding box with it
+    return _load_cached(str(p.resolve()), p.stat().st_mtime_ns, tuple(float(x) for x in s))
 
 
 #: memory a mesh takes while it is read and reduced (its triangles, merged vertices,
