@@ -53,6 +53,8 @@ __all__ = ["TrimReport", "TrimSpec", "mass_properties", "plan_trim"]
 
 LEAD_DENSITY_KG_M3 = 11340.0
 _FIXED_POINT_PASSES = 8
+#: a net lift or weight below this fraction of the system's mass is none (rounding)
+_NEGLIGIBLE = 1e-12
 
 
 @dataclass(frozen=True)
@@ -211,9 +213,14 @@ def plan_trim(
         )
     moment, tilt = _residual_tilt(residual, mass_after * g, bg_after, g)
     if np.any(np.abs(residual) > 1e-9):
+        why = (
+            "foam/ballast offsets clipped to the hull footprint"
+            if lift > 0.0 or sink > 0.0
+            else "neutral without foam or ballast, none to level it"
+        )
         notes.append(
-            "foam/ballast offsets clipped to the hull footprint: the vehicle rests at roll "
-            f"{math.degrees(tilt[0]):.1f} deg, pitch {math.degrees(tilt[1]):.1f} deg"
+            f"{why}: the vehicle rests at roll {math.degrees(tilt[0]):.1f} deg, pitch "
+            f"{math.degrees(tilt[1]):.1f} deg"
         )
     return TrimReport(
         foam_volume_m3=foam_v,
@@ -310,7 +317,14 @@ def _foam_and_ballast(
                 foam_v, ballast_m = (mass - rho * volume) / (rho - rho_f), 0.0
             else:  # floats: ballast only
                 foam_v, ballast_m = 0.0, (mass - rho * volume) / (rho / rho_b - 1.0)
-    return float(max(foam_v, 0.0)), float(max(ballast_m, 0.0))
+    # a system neutral already (a model trimmed for this water) solves to amounts of the
+    # order of its mass's rounding (1e-18 m^3 of foam): none, not a slab to place
+    negligible_kg = _NEGLIGIBLE * mass
+    if foam_v * (rho - rho_f) < negligible_kg:
+        foam_v = 0.0
+    if ballast_m * (1.0 - rho / rho_b) < negligible_kg:
+        ballast_m = 0.0
+    return float(foam_v), float(ballast_m)
 
 
 def _heights(
