@@ -186,8 +186,10 @@ def test_a_passive_run_takes_the_compiled_loop_and_is_the_python_loops():
         ("lbv150_ee_circle", {}),
         ("lbv150_ee_circle", {"water.current_world_m_s": [0.1, 0.0, 0.0]}),
         ("bluerov_alpha5_ee_circle", {}),
+        # the vehicle's own path (its bias acceleration R (w x v), no arm frame)
+        ("lbv150_ee_circle", {"task.target": "vehicle"}),
     ],
-    ids=["lbv150", "lbv150-current", "bluerov-alpha5"],
+    ids=["lbv150", "lbv150-current", "bluerov-alpha5", "lbv150-vehicle"],
 )
 def test_resolved_acceleration_runs_compiled_as_in_python(stem, overrides):
     path = ROOT / "scenarios" / f"{stem}.toml"
