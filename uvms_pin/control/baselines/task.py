@@ -32,7 +32,6 @@ from uvms_pin.control.task_space import (
 )
 from uvms_pin.errors import ParameterError
 from uvms_pin.physics.kinematics import (
-    angular_velocity_world_from_euler_rates,
     check_euler_singularity,
     frame_rotation_and_jacobian,
 )
@@ -159,10 +158,6 @@ class EndEffectorTask:
     def reference_velocity(self, state: TaskState, xdot_r: np.ndarray) -> np.ndarray:
         """zeta_r (nv,) = J^# xdot_r + (I - J^# J) zeta_0 [m/s, rad/s], the PPC's eq. (9)."""
         return self.reference(state.q, state.rpy_ee, state.jacobian_lwa, [float(x) for x in xdot_r])
-
-    def world_rates(self, state: TaskState, euler_rates: np.ndarray) -> np.ndarray:
-        """omega_world (3,) [rad/s] of Euler rates at the end-effector's attitude."""
-        return np.array(angular_velocity_world_from_euler_rates(state.rpy_ee, euler_rates))
 
 
 class ForceOrientationLoop:
