@@ -35,10 +35,6 @@ __all__ = ["Convex", "Cylinder", "Ellipsoid", "Plane", "Sphere", "box", "convex_
 T_MIN_M = 1e-9
 
 
-def _misses(n: int) -> tuple[np.ndarray, np.ndarray]:
-    return np.full(n, np.inf), np.zeros((n, 3))
-
-
 def _quadratic_entry(b: np.ndarray, c: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """(entry, exit) of t^2 + 2 b t + c = 0 (inf, -inf where no real root)."""
     disc = b * b - c
