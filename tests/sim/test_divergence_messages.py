@@ -90,6 +90,28 @@ def test_a_mass_matrix_singular_along_a_joint_names_the_joint(reference_uvms):
     assert "the mass matrix is singular" in context and "along arm_joint4" in context
 
 
+@pytest.mark.parametrize("where", ["arm", "vehicle"])
+def test_a_mass_matrix_singular_at_the_start_is_refused_before_the_run(reference_uvms, where):
+    """A body without mass, added mass or armature about a motion: no step can be taken
+    (the run stopped at its first with exit 3); refused before it as a ModelError naming the
+    motion, nothing simulated."""
+    if where == "arm":
+        uvms, motion = _arm_joint4_link(reference_uvms, pin.Inertia.Zero()), "arm_joint4"
+    else:
+        model = reference_uvms.model.copy()
+        for j in range(1, model.njoints):
+            model.inertias[j] = pin.Inertia.Zero()
+        model.armature[:] = 0.0
+        dry = reference_uvms.with_model(model).with_hydro(lambda b: up.HydroParams.dry())
+        uvms, motion = dry, "vehicle"
+    scenario = load_scenario(ROOT / "scenarios" / "passive_still_water.toml")
+    plant = dataclasses.replace(scenario.plant, uvms=uvms)
+    with pytest.raises(
+        up.ModelError, match=f"at the start the mass matrix is singular.*along {motion}"
+    ):
+        simulate(dataclasses.replace(scenario, plant=plant), progress=False)
+
+
 def test_a_physical_state_says_so_with_its_largest_velocity(reference_uvms):
     v = np.zeros(10)
     v[4] = -0.3

@@ -167,7 +167,7 @@ def divergence_context(
     if found:
         found.sort(reverse=True)
         return f"from t = {t0:.6g} s: " + ", ".join(text for _, text in found[:3])
-    singular = _singular_mass(plant.uvms, q, velocity_labels)
+    singular = singular_mass(plant.uvms, q)
     if singular:
         return f"at t = {t0:.6g} s {singular}"
     k = int(np.argmax(np.abs(v)))
@@ -178,10 +178,12 @@ def divergence_context(
     )
 
 
-def _singular_mass(uvms, q: np.ndarray, labels) -> str:
-    """ "the mass matrix is singular ..." naming the least-massive degree of freedom, or ""."""
+def singular_mass(uvms, q: np.ndarray) -> str:
+    """ "the mass matrix is singular ..." naming the least-massive degree of freedom at
+    ``q`` (finite), or "" (positive definite)."""
     from uvms_pin.physics.dynamics import mass_matrix
 
+    labels = _labels(uvms)[0]  # by velocity
     mass = mass_matrix(uvms, q, backend="python")  # q: the last state reached, finite
     eigenvalues, vectors = np.linalg.eigh(mass)
     if eigenvalues[0] > 1e-12 * max(eigenvalues[-1], 1e-300):

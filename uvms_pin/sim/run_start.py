@@ -10,8 +10,9 @@ from typing import Any
 
 import numpy as np
 
-from uvms_pin.errors import ParameterError
+from uvms_pin.errors import ModelError, ParameterError
 from uvms_pin.physics.world.overlap import robot_started_apart
+from uvms_pin.sim.divergence import singular_mass
 from uvms_pin.sim.settings import SimulationSettings
 from uvms_pin.sim.stiffness import check_stiff_modes
 from uvms_pin.sim.system import System, SystemState
@@ -31,9 +32,14 @@ def checked_run_start(
             (a fixed object, a fixture's link: `uvms_pin.physics.world.overlap`).
         StiffModeError: a spring-damper integrated explicitly is unstable at the integrator's
             step (`uvms_pin.sim.stiffness`).
+        ModelError: the robot's mass matrix at the start is singular (a body without mass,
+            added mass or armature about some motion: no step could be taken).
     """
     state = system.initial_state(q0, v0)
     plant = system.plant
+    singular = singular_mass(plant.uvms, state.q[: plant.uvms.nq])
+    if singular:
+        raise ModelError(f"model '{plant.uvms.model.name}': at the start {singular}")
     robot_started_apart(plant.world, plant.uvms.model, state.q[: plant.uvms.nq])
     if system.fixtures:  # nor inside a fixture's link
         robot, *bodies = system.layout.split(state.q, state.v)
