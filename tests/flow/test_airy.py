@@ -129,6 +129,20 @@ def test_bad_parameters_are_refused():
         AiryWave(0.5, 5.0, water_depth_m=-3.0)
     with pytest.raises(ParameterError, match="points_world"):
         AiryWave(0.5, 5.0).velocity(0.0, np.zeros((2, 2)))
+    for name, value in [("amplitude_m", math.nan), ("amplitude_m", math.inf),
+                        ("heading_rad", math.inf), ("phase_rad", math.nan),
+                        ("period_s", math.inf)]:  # fmt: skip
+        given = {"amplitude_m": 0.5, "period_s": 5.0, name: value}
+        with pytest.raises(ParameterError, match=name):
+            AiryWave(**given)
+
+
+def test_a_wave_of_no_amplitude_is_still_water():
+    """A = 0 is accepted (a sea state switched off): the surface stays at 0, the water still."""
+    wave = AiryWave(0.0, 5.0)
+    points = np.array([[0.0, 0.0, 0.0], [3.0, -1.0, -2.0]])
+    assert np.all(wave.surface_elevation(1.3, points[:, :2]) == 0.0)
+    assert np.all(wave.velocity(1.3, points) == 0.0)
 
 
 @pytest.mark.parametrize("period_s", [4.0, 8.0, 12.0])

@@ -153,6 +153,41 @@ def test_gauss_markov_innovations_are_small_kicks_across_its_drawing_chunks():
     assert np.std(kicks) == pytest.approx(1.0, abs=0.05)
 
 
+def test_gauss_markov_samples_are_the_exact_ar1_of_its_seeded_draws():
+    """On its grid the current is V_mean + d_k with d_0 = 0 and d_k+1 = clip(rho d_k +
+    sigma sqrt(1 - rho^2) w_k, -b, b), w_k the seed's standard normals (n, 3) in order, the
+    same recursion across the process's chunks of 1024 draws (a sign lost where a chunk
+    starts from the last sample would flip the deviation there)."""
+    sigma, time_constant_s, dt, bound, n = 0.1, 2.0, 0.5, 0.25, 2500
+    mean = np.array([0.3, -0.2, 0.1])
+    gm = GaussMarkovCurrent(mean, sigma, time_constant_s, bound, seed=9, sample_period_s=dt)
+    got = np.array([gm.velocity(k * dt, [0, 0, 0])[0] for k in range(n)])
+    rho = math.exp(-dt / time_constant_s)
+    draws = np.random.default_rng(9).standard_normal((3 * 1024, 3))
+    expected = np.empty((n, 3))
+    deviation = np.zeros(3)
+    expected[0] = mean
+    for k in range(1, n):
+        deviation = np.clip(
+            rho * deviation + sigma * math.sqrt(1.0 - rho**2) * draws[k - 1], -bound, bound
+        )
+        expected[k] = mean + deviation
+    np.testing.assert_allclose(got, expected, rtol=0, atol=1e-15)
+    assert np.any(np.abs(got - mean) >= bound - 1e-15)  # the bound clipped some
+
+
+@pytest.mark.parametrize(
+    "name, value",
+    [("time_constant_s", 0.0), ("time_constant_s", -2.0), ("time_constant_s", math.inf),
+     ("bound_m_s", 0.0), ("bound_m_s", math.nan), ("sample_period_s", math.inf),
+     ("std_m_s", -0.1), ("std_m_s", math.inf)],
+)  # fmt: skip
+def test_gauss_markov_refuses_a_scale_that_is_not_positive_and_finite(name, value):
+    given = {"std_m_s": 0.1, "time_constant_s": 20.0, "bound_m_s": 0.2, name: value}
+    with pytest.raises(ParameterError, match=name):
+        GaussMarkovCurrent([0.2, 0.0, 0.0], **given)
+
+
 def test_gauss_markov_current_has_its_stationary_statistics():
     """Sampled on its grid (dt = 0.5 s) the process is AR(1): deviations of mean 0, standard
     deviation sigma, lag-one correlation rho = exp(-dt / T), per component. With the bound
@@ -266,8 +301,10 @@ def test_an_irregular_sea_draws_its_components_in_its_band_with_uniform_phases()
     assert np.all((phase >= 0.0) & (phase < 2.0 * math.pi)) and np.ptp(phase) > 6.0
     assert IrregularSea(1.0, 6.0, n_components=1).components.amplitude_m.size == 1
     IrregularSea(1.0, 6.0, frequency_range=(0.9, 1.2))
-    with pytest.raises(ParameterError, match="frequency_range"):
-        IrregularSea(1.0, 6.0, frequency_range=(1.2, 3.5))
+    # the band must hold the peak strictly inside, from above 0 to a finite multiple
+    for band in [(1.2, 3.5), (1.0, 3.5), (0.5, 1.0), (0.0, 3.5), (0.5, math.inf)]:
+        with pytest.raises(ParameterError, match="frequency_range"):
+            IrregularSea(1.0, 6.0, frequency_range=band)
 
 
 @pytest.mark.parametrize(
