@@ -55,6 +55,19 @@ def test_sphere_drag_is_half_rho_cd_area():
     )
 
 
+def test_sphere_spin_drag_is_the_skin_friction_moment_over_its_surface():
+    """Spinning at w about an axis, the surface at polar angle theta moves at w r sin(theta):
+    the shear 0.5 rho Cf (w r sin(theta))^2 at the arm r sin(theta), summed over the surface
+    (r^2 sin(theta) dtheta dphi) by quadrature, is D_rot w^2 about every axis."""
+    radius, cf, omega = 0.3, 0.004, 1.7
+    h = sphere_hydro(radius, RHO, skin_friction_coefficient=cf)
+    theta = np.linspace(0.0, math.pi, 20001)
+    ring = 0.5 * RHO * cf * (omega * radius * np.sin(theta)) ** 2 * radius * np.sin(theta)
+    ring *= 2.0 * math.pi * radius**2 * np.sin(theta)  # the band's area per dtheta
+    moment = float(np.sum(0.5 * (ring[1:] + ring[:-1]) * np.diff(theta)))
+    np.testing.assert_allclose(h.quadratic_damping[3:] * omega**2, moment, rtol=1e-7)
+
+
 # ----------------------------------------------------------------------------- ellipsoid
 
 
@@ -166,6 +179,13 @@ def test_cylinder_drag_matches_strip_integrals():
     ends, _ = quad(lambda x: 0.5 * RHO * cda * 2 * math.sqrt(r * r - x * x) * abs(x) ** 3, -r, r)
     assert q[3] == pytest.approx(side + ends, rel=1e-9)
     assert q[4] == pytest.approx(side + ends, rel=1e-9)
+    # roll: the skin friction 0.5 rho Cf (w s)^2 at the arm s, on the side (s = r, area
+    # 2 pi r L) and the two end discs (rings 2 pi s ds), per w^2
+    cf = 0.004
+    roll = cylinder_hydro(r, length, RHO, skin_friction_coefficient=cf).quadratic_damping[5]
+    wall = 0.5 * RHO * cf * r**2 * r * 2.0 * math.pi * r * length
+    disc, _ = quad(lambda s: 0.5 * RHO * cf * s**2 * s * 2.0 * math.pi * s, 0.0, r)
+    assert roll == pytest.approx(wall + 2.0 * disc, rel=1e-9)
 
 
 # ----------------------------------------------------------------------------- box
