@@ -235,3 +235,33 @@ def test_a_fixtures_exact_step_reports_the_impulses_that_changed_its_velocity(
     else:
         assert abs(limit) <= 1e-15 and friction == pytest.approx(-0.5 * h, rel=1e-12)
         assert out.velocity[0] == pytest.approx(v_free - 0.5 * h / mass[0, 0], rel=1e-12)
+
+
+def test_a_free_object_started_inside_a_fixture_is_refused_or_moved_out():
+    """A ball (r = 5 cm) centred in the valve panel's 2 cm board: 6 cm deep in it, refused
+    naming both; with initial_overlap = "separate" moved out by that depth along the board's
+    normal (x) before the run, which then runs."""
+    import tomllib
+
+    from uvms_pin.errors import InitialOverlapError
+    from uvms_pin.scenario.load import load_scenario
+    from uvms_pin.sim.run import simulate
+
+    panel = ROOT / "scenarios" / "valve_panel.toml"
+    ball = {"type": "sphere", "name": "ball", "radius_m": 0.05,
+            "position_world_m": [0.86, -0.156, -1.85], "density_kg_m3": 1100.0}  # fmt: skip
+    objects = [*tomllib.loads(panel.read_text())["world"]["objects"], ball]
+    inside = {"world.objects": objects, "scenario.duration_s": 0.1}
+    with pytest.raises(InitialOverlapError, match=r"'panel' and 'ball' overlap by 60 mm"):
+        simulate(load_scenario(panel, inside), progress=False)
+    moved = simulate(
+        load_scenario(panel, {**inside, "world.initial_overlap": "separate"}), progress=False
+    )
+    assert moved.status.ok
+    (move,) = moved.metadata["world"]["world"]["initial_overlap"]["moved"]
+    assert move["object"] == "ball" and move["bodies"] == ["panel", "ball"]
+    assert move["depth_m"] == pytest.approx(0.06, abs=1e-9)
+    start = moved.signals["free_objects"].reshape(len(moved), -1, 13)[0, 0, :3]
+    # out of the board (x 0.85 .. 0.87) on either side, touching it
+    assert abs(start[0] - 0.86) == pytest.approx(0.06, abs=1e-9)
+    np.testing.assert_allclose(start[1:], [-0.156, -1.85], atol=1e-12)
