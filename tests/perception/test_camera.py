@@ -195,3 +195,21 @@ def test_pixel_rays_are_unit_and_through_each_pixels_centre(width, height, fov):
     f = 0.5 * width / np.tan(0.5 * fov)
     np.testing.assert_allclose(rays[:, 0] / rays[:, 2], (u + 0.5 - 0.5 * width) / f, atol=1e-13)
     np.testing.assert_allclose(rays[:, 1] / rays[:, 2], (v + 0.5 - 0.5 * height) / f, atol=1e-13)
+
+
+@pytest.mark.parametrize(
+    "given, match",
+    [
+        ({"reflectance": [0.1, 0.2, 0.3]}, "reflectance must be a table"),
+        ({"reflectance": "red"}, "reflectance must be a table"),
+        ({"reflectance": {"box": "red"}}, r"reflectance must map label names to \(R, G, B\)"),
+        ({"reflectance": {"box": [0.1, 0.2]}}, r"reflectance\.box needs 3 numbers"),
+        ({"lights": {"intensity": 1.0}}, "lights must be tables"),
+        ({"lights": [{"intensity": 1.0}, 3]}, "lights must be tables"),
+    ],
+)
+def test_a_cameras_lights_and_reflectance_of_the_wrong_kind_are_named(given, match):
+    """A table's ``lights`` (a list of tables) and ``reflectance`` (a table of R, G, B)
+    of another kind: a ParameterError naming them, not an AttributeError of a list."""
+    with pytest.raises(ParameterError, match=rf"camera 'c': {match}"):
+        CameraSpec.from_dict({"name": "c", **given}, "camera 'c'")

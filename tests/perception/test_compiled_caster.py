@@ -310,10 +310,10 @@ def test_many_origins_are_cast_by_the_reference():
     _assert_same(reference.cast(origins, d), compiled.cast(origins, d))
 
 
-def _seen(uvms, backend: str) -> Scene:
+def _seen(uvms, backend: str, surface: bool = True) -> Scene:
     """The benchmark's scene (benchmarks/bench_perception.py: a seabed, five solids and the
-    rock mesh), the robot above."""
-    scene = Scene(uvms, bench_perception.objects(), backend=backend)
+    rock mesh), the robot above; the free surface over it or not (``surface``)."""
+    scene = Scene(uvms, bench_perception.objects(), surface=surface, backend=backend)
     q = uvms.neutral_configuration()
     q[2] = -9.0
     q[7:] += 0.3  # the arm bent into view
@@ -321,21 +321,30 @@ def _seen(uvms, backend: str) -> Scene:
     return scene
 
 
-@pytest.mark.parametrize("width, height", [(96, 64), (50, 37)])  # whole tiles, and not
-def test_the_compiled_camera_gives_the_references_images(reference_uvms, width, height):
+@pytest.mark.parametrize(
+    "width, height, pitch_rad",
+    [(96, 64, -1.9), (50, 37, -1.9), (64, 48, -1.45)],  # whole tiles, and not; above the
+)  # horizon too, no surface there (its upper rows meet nothing: the veiling light)
+def test_the_compiled_camera_gives_the_references_images(reference_uvms, width, height, pitch_rad):
     lights = (
         Light((0.1, 0.0, 0.0), intensity=2.0),
         Light((-0.1, 0.05, 0.0), (0.2, 0.1, 1.0), 1.5, half_angle_rad=0.3, edge_rad=0.2),
     )
-    spec = CameraSpec("front", width=width, height=height, rpy_rad=(-1.9, 0.0, -1.5708),
+    spec = CameraSpec("front", width=width, height=height, rpy_rad=(pitch_rad, 0.0, -1.5708),
                       lights=lights, noise_counts=2.0, water_type="3C")  # fmt: skip
-    python, core = _seen(reference_uvms, "python"), _seen(reference_uvms, "core")
+    surface = pitch_rad < -1.5708
+    python = _seen(reference_uvms, "python", surface)
+    core = _seen(reference_uvms, "core", surface)
     assert not python.compiled and core.compiled
     frames = [Camera(spec, s, np.random.default_rng(7)).render() for s in (python, core)]
     expected, got = frames
+    if not surface:
+        missed = np.isnan(expected.depth_m)
+        assert 0.1 < np.mean(missed) < 0.9  # both, in one image
     names = {python.names[k - 1] for k in np.unique(expected.label) if k > 0}
     assert {"seabed", "ball", "crate", "rock"} <= names  # the scene is in view
-    assert sum(n not in {"seabed", "ball", "crate", "pipe", "egg", "rock"} for n in names) > 0
+    robot = sum(n not in {"seabed", "ball", "crate", "pipe", "egg", "rock"} for n in names)
+    assert robot > 0 or not surface  # the arm too, looking down
     np.testing.assert_array_equal(got.label, expected.label)
     np.testing.assert_array_equal(np.isnan(got.depth_m), np.isnan(expected.depth_m))
     met = ~np.isnan(expected.depth_m)

@@ -107,8 +107,15 @@ class CameraSpec:
         lights = raw.pop("lights", [])
         reflectance = raw.pop("reflectance", {})
         tables = isinstance(lights, list) and all(isinstance(light, dict) for light in lights)
-        if not tables or not isinstance(reflectance, dict):
-            raise ParameterError(f"{label}: lights must be tables, reflectance a table")
+        if not tables:
+            raise ParameterError(
+                f"{label}: lights must be tables (of Light's keys), got {lights!r}"
+            )
+        if not isinstance(reflectance, dict):
+            raise ParameterError(
+                f"{label}: reflectance must be a table of label names to (R, G, B), "
+                f"got {reflectance!r}"
+            )
         built = tuple(
             sensor.spec_from_dict(Light, light, f"{label}: lights[{k}]")
             for k, light in enumerate(lights)
