@@ -25,6 +25,7 @@ from uvms_pin.physics.kinematics import (
     EULER_SINGULARITY_MIN_ABS_COS_PITCH,
     analytical_jacobian,
     angular_velocity_world_from_euler_rates,
+    check_frame_id,
     end_effector_pose,
     euler_rate_matrix_body,
     euler_rpy_from_rotation,
@@ -292,3 +293,16 @@ def test_one_pass_rotation_and_jacobian(model):
         np.testing.assert_allclose(
             analytical, analytical_jacobian(model, reference, q, frame_id), atol=1e-13
         )
+
+
+def test_a_frame_id_is_one_of_the_models_frames():
+    """0 (the universe) to nframes - 1: Pinocchio reads past its frames otherwise."""
+    model = pin.buildModelFromUrdf(str(REFERENCE_URDF), pin.JointModelFreeFlyer())
+    assert check_frame_id(model, 0) == 0
+    assert check_frame_id(model, np.int64(model.nframes - 1)) == model.nframes - 1
+    for bad in (model.nframes, -1):
+        with pytest.raises(ParameterError, match=rf"frame_id {bad} out of range"):
+            check_frame_id(model, bad)
+    for bad in (True, 1.0, "ee"):
+        with pytest.raises(ParameterError, match="frame_id must be an integer"):
+            check_frame_id(model, bad)
