@@ -135,3 +135,18 @@ def test_embree_meshes_agree_with_trimesh_in_single_precision():
     expected = np.linalg.norm(locations, axis=1)
     np.testing.assert_allclose(hits.range_m[rows], expected, rtol=0, atol=2e-5)
     assert np.isfinite(hits.range_m).sum() == pytest.approx(len(rows), abs=3)
+
+
+@pytest.mark.parametrize("shape", ["box", "cylinder", "sphere"])
+def test_rays_from_many_origins_meet_a_solid_each_from_its_own(shape):
+    """Parallel rays along +x from origins spread in y (one origin a ray, not one for all):
+    a box's face, a cylinder's side (its axis along z) and a sphere at their analytic
+    ranges, the ray passing beside it meeting nothing."""
+    solid = {"box": box([1.0, 1.0, 1.0]), "cylinder": Cylinder(1.0, 2.0), "sphere": Sphere(1.0)}
+    y = np.array([0.0, 0.5, -0.8, 2.0])
+    origins = np.column_stack([np.full(4, -5.0), y, np.zeros(4)])
+    directions = np.tile([1.0, 0.0, 0.0], (4, 1))
+    t, _normal = solid[shape].hit(origins, directions)
+    front = np.full(3, -1.0) if shape == "box" else -np.sqrt(1.0 - y[:3] ** 2)
+    np.testing.assert_allclose(t[:3], front + 5.0, rtol=0, atol=1e-12)
+    assert t[3] == np.inf
