@@ -212,3 +212,28 @@ def test_a_gym_camera_is_weighed_before_its_spaces_are_made(monkeypatch):
         ParameterError, match=r"a 8192 x 8192 camera observation would take 0\.938 GiB"
     ):
         CameraObservation(env, camera)
+
+
+def test_a_runs_log_estimate_holds_the_base_arrays_exactly_and_the_ppcs_signals():
+    """The estimate's base (time, q, v, tau, three wrenches, two energies) is what a run's
+    base arrays take, byte for byte; the PPC's signals, the most a shipped controller logs,
+    fit in its allowance of 10 (6 + nv) columns (with the thrusters' and the wet fractions)."""
+    import numpy as np
+
+    from uvms_pin.scenario.load import load_scenario
+    from uvms_pin.sim.run import simulate
+
+    scenario = load_scenario(ROOT / "scenarios" / "realistic_force_tracking.toml",
+                             {"scenario.duration_s": 0.2})  # fmt: skip
+    uvms, settings = scenario.uvms, scenario.settings
+    rollout = simulate(scenario, progress=False)
+    base = [rollout.time_s, rollout.q, rollout.v, rollout.tau, rollout.wrench_contact_world,
+            rollout.wrench_measured_world, rollout.wrench_disturbance_body,
+            rollout.kinetic_energy_J, rollout.potential_energy_J]  # fmt: skip
+    assert sum(a.nbytes for a in base) == settings.log_bytes(uvms.nq, uvms.nv) - (
+        settings.n_log * 8 * 10 * (6 + uvms.nv)
+    )
+    hulls = len(uvms.surface_bodies)
+    signals = sum(np.asarray(a).nbytes for a in rollout.signals.values())
+    assert signals > 0.5 * settings.n_log * 8 * 10 * (6 + uvms.nv)  # the allowance is used
+    assert sum(a.nbytes for a in base) + signals <= settings.log_bytes(uvms.nq, uvms.nv, hulls)
