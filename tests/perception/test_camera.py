@@ -88,6 +88,28 @@ def test_the_depth_of_a_sphere_and_a_box_ahead(reference_uvms):
     np.testing.assert_allclose(frame.depth_m[front], 5.5, rtol=0, atol=1e-9)
 
 
+def test_the_depth_of_a_cylinders_cap_facing_the_camera(reference_uvms):
+    """A cylinder (r = 0.4 m, L = 2 m) 5 m ahead, its axis turned onto the optical axis:
+    its near cap, a disc of 0.4 m at 4 m, is at z-depth 4 m on every pixel of it; the pixel
+    through the centre sees it, one 0.45 m off the axis at that range does not. Of the
+    planes, only the one facing up is a floor (the sand's colour)."""
+    pipe = solid("pipe", "cylinder", {"radius_m": 0.4, "length_m": 2.0},
+                 [5.0, 0.0, -DEPTH_M], [0.0, math.pi / 2, 0.0], 0.5, 0.4)  # fmt: skip
+    seabed = plane("seabed", [0.0, 0.0, -DEPTH_M - 3.0], [0.0, 0.0, 1.0], 0.5, 0.4)
+    camera = _camera(reference_uvms, [pipe, seabed, _wall(30.0)], width=101, height=81)
+    assert camera.scene.floor_names == {"seabed"}
+    frame = camera.render()
+    names = camera.scene.names
+    on_pipe = frame.label == names.index("pipe") + 1
+    assert names[frame.label[40, 50] - 1] == "pipe"
+    rays = camera.rays.reshape(81, 101, 3)
+    at_cap = rays * (4.0 / rays[..., 2:3])  # where each pixel's ray crosses z = 4 m
+    off_axis = np.hypot(at_cap[..., 0], at_cap[..., 1])
+    assert on_pipe[off_axis < 0.39].all() and on_pipe[off_axis < 0.39].sum() > 30
+    np.testing.assert_allclose(frame.depth_m[off_axis < 0.39], 4.0, rtol=0, atol=1e-9)
+    assert not on_pipe[off_axis > 0.45].any()
+
+
 @pytest.mark.parametrize("distance_m", [1.0, 3.0, 8.0])
 def test_a_flat_target_has_the_formation_models_colour(reference_uvms, distance_m):
     rho = (0.8, 0.6, 0.4)
