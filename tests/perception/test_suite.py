@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 from uvms_pin.errors import ParameterError, ScenarioError
-from uvms_pin.perception.suite import HUGE_PAGE, firing_rows, stack_of
+from uvms_pin.perception.suite import HUGE_PAGE, firing_rows, fixture_positions, stack_of
 from uvms_pin.results.rollout import Rollout
 from uvms_pin.scenario.load import scenario_from_dict
 from uvms_pin.scenario.toml import read_toml
@@ -34,6 +34,18 @@ def test_firing_rows_are_the_first_logged_samples_at_each_instant():
     np.testing.assert_array_equal(firing_rows(times, 10.0), [0, 5, 10])
     np.testing.assert_array_equal(firing_rows(times, 7.0), [0, 8])  # 1/7 s -> 0.16 s
     np.testing.assert_array_equal(firing_rows(times, 1000.0), np.arange(11))
+
+
+def test_fixtures_are_posed_from_their_logged_signals_or_stay_at_their_start():
+    """Each fixture's joint positions are the signal named after it; a run that logged
+    none of them (or not all) leaves every fixture where it started (None), not a KeyError."""
+    rollout = Rollout.allocate(3, 7, 6)
+    assert fixture_positions(rollout, []) is None
+    assert fixture_positions(rollout, ["panel"]) is None
+    rollout.signals["panel"] = np.array([[0.0], [0.1], [0.2]])
+    (panel,) = fixture_positions(rollout, ["panel"])
+    np.testing.assert_array_equal(panel, [[0.0], [0.1], [0.2]])
+    assert fixture_positions(rollout, ["panel", "valve"]) is None
 
 
 def test_a_run_records_its_cameras_and_sonars_beside_an_unchanged_rollout(tmp_path):
