@@ -6,6 +6,7 @@ beside the hull's box."""
 from __future__ import annotations
 
 import math
+import warnings
 from pathlib import Path
 
 import numpy as np
@@ -97,3 +98,31 @@ def test_an_axis_in_the_model_frame_is_written_in_the_child_links(imported):
         return
     assert motion == "JointModelRevoluteUnaligned"
     np.testing.assert_allclose(uvms.model.joints[joint].extract().axis, [1.0, 0.0, 0.0], atol=1e-15)
+
+
+def test_a_mesh_named_relative_to_the_source_is_found_from_the_urdf_written_elsewhere(tmp_path):
+    """``<uri>meshes/hull.stl</uri>`` beside the SDF: the URDF written in another folder
+    names it from there (it named it as the SDF did, and the loader, reading it from the
+    URDF's folder, did not find it: the link's hull fell back to a sphere); the URDF text
+    returned without writing names it by its absolute path."""
+    import trimesh
+
+    source_dir, out_dir = tmp_path / "models" / "lrauv", tmp_path / "out"
+    (source_dir / "meshes").mkdir(parents=True)
+    out_dir.mkdir()
+    trimesh.creation.box(extents=(0.4, 0.3, 0.2)).export(source_dir / "meshes" / "hull.stl")
+    text = LRAUV.read_text().replace(
+        '<collision name="main_body_buoyancy">',
+        '<collision name="dome"><geometry><mesh><uri>meshes/hull.stl</uri></mesh></geometry>'
+        '</collision>\n      <collision name="main_body_buoyancy">',
+    )
+    source = source_dir / "lrauv.sdf"
+    source.write_text(text)
+    result = import_model(source, out_dir / "lrauv.urdf")
+    assert '<mesh filename="../models/lrauv/meshes/hull.stl" />' in result.urdf_text
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")  # the file is found: no fallback warned of
+        load_uvms(out_dir / "lrauv.urdf", water_density_kg_m3=1000.0)
+    unwritten = import_model(source)
+    mesh = str((source_dir / "meshes" / "hull.stl").resolve())
+    assert f'<mesh filename="{mesh}" />' in unwritten.urdf_text

@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import copy
 import math
+import os
 import xml.etree.ElementTree as ET
 from contextlib import nullcontext
 from pathlib import Path
@@ -85,9 +86,10 @@ def import_model(
     _finish_links(robot, hydro, where, notes)
     add_fins(robot, plugins, where, notes)
     check_inertias(robot, where, notes, balance=balance_inertia)  # what the loader would refuse
+    out = None if out is None else Path(out)
+    _place_mesh_files(robot, path.parent, None if out is None else out.parent)
     result = ImportResult(urdf_text(robot, where, notes), hydro, thrusters, density, notes, fmt)
     if out is not None:
-        out = Path(out)
         table = None if not thrusters else Path(thrusters_out or out.with_suffix(".thrusters.toml"))
         # both files appear together or neither does
         with (
@@ -100,6 +102,21 @@ def import_model(
                     thruster_table_text(thrusters, where, density), encoding="utf-8"
                 )
     return result
+
+
+def _place_mesh_files(robot: ET.Element, source_dir: Path, out_dir: Path | None) -> None:
+    """A mesh file named relative to the source (``meshes/hull.stl``) named relative to the
+    URDF's own folder ``out_dir`` (the loader reads it from there), or absolute when the URDF
+    is not written (None); a URI (``package://``, ``model://``) or an absolute path stays."""
+    for mesh in robot.iter("mesh"):
+        filename = (mesh.get("filename") or "").strip()
+        if not filename or "://" in filename or Path(filename).is_absolute():
+            continue
+        found = (source_dir / filename).resolve()
+        if out_dir is None:
+            mesh.set("filename", str(found))
+        else:
+            mesh.set("filename", os.path.relpath(found, out_dir.resolve()))
 
 
 def _read_source(path: Path, notes: list[str]) -> tuple[ET.Element, list[ET.Element], str]:
