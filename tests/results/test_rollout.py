@@ -255,3 +255,13 @@ def test_load_without_rollout_raises_parameter_error(tmp_path):
     (tmp_path / "half" / META_FILE).unlink()
     with pytest.raises(up.ParameterError, match="holds no rollout"):
         Rollout.load(tmp_path / "half")
+
+
+@pytest.mark.parametrize("text", ["[1, 2]", "3", '"a rollout"', "{", "null"])
+def test_a_rollout_json_that_is_not_an_object_is_named(tmp_path, text):
+    """rollout.json edited into a list, a number, a string, broken or null: ParameterError
+    naming the file (or the damaged rollout), not a TypeError."""
+    _filled().save(tmp_path / "r")
+    (tmp_path / "r" / META_FILE).write_text(text)
+    with pytest.raises(up.ParameterError, match=r"(rollout\.json: a JSON object expected|damaged)"):
+        Rollout.load(tmp_path / "r")
