@@ -147,9 +147,10 @@ def _object(
 
 
 def _path(t: Table, key: Key, base_dir: Path) -> Path:
-    """A file, relative to the scenario's folder."""
+    """A file, relative to the scenario's folder, made absolute: the run records it, and a
+    replay from another working directory reads it again."""
     path = Path(t.string(key.name, key.default))
-    return path if path.is_absolute() else base_dir / path
+    return (path if path.is_absolute() else base_dir / path).resolve()
 
 
 #: what a kind's key holds -> how it is read from its table (its kind checks the values)

@@ -3,6 +3,8 @@ from the pair's contact point along the force, as long as the stated scale."""
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import numpy as np
 import pinocchio as pin
 import pytest
@@ -151,3 +153,35 @@ def test_the_live_feed_hands_the_fixtures_joint_rows_to_the_scene(reference_uvms
     poses = UvmsScene(reference_uvms, world=view).poses(pushed[0])
     rotation = pin.Quaternion(np.asarray(poses["world/fixtures/panel/valve"][1])).matrix()
     assert np.allclose(rotation, pin.rpy.rpyToMatrix(0.9, 0.0, 0.0))
+
+
+@pytest.mark.parametrize("stem", ["seabed_landing", "valve_panel"])
+def test_a_run_from_a_relative_scenario_path_replays_from_any_folder(tmp_path, monkeypatch, stem):
+    """A scenario loaded as ``scenarios/x.toml`` from the repository's folder: its mesh and
+    fixture files are recorded by absolute path (they were recorded relative to that folder,
+    and a replay from any other crashed in trimesh), so the replay is written from another
+    working directory; a mesh gone since is named, not a traceback."""
+    import json
+
+    from uvms_pin.apps.viz.replay import write_replay
+    from uvms_pin.errors import ParameterError
+    from uvms_pin.results.rollout import Rollout
+    from uvms_pin.scenario.load import load_scenario
+    from uvms_pin.sim.run import simulate
+
+    monkeypatch.chdir(ROOT)
+    scenario = load_scenario(f"scenarios/{stem}.toml", {"scenario.duration_s": 0.1})
+    simulate(scenario, progress=False).save(tmp_path / "run")
+    monkeypatch.chdir(tmp_path)
+    record = json.loads((tmp_path / "run" / "rollout.json").read_text())["world"]["world"]
+    listed = [*record.get("objects", ()), *record.get("fixtures", ())]
+    paths = [o["path"] for o in listed if "path" in o]
+    assert paths and all(Path(p).is_absolute() and Path(p).is_file() for p in paths)
+    write_replay(Rollout.load(tmp_path / "run"), tmp_path / "replay.html")
+    assert (tmp_path / "replay.html").stat().st_size > 10_000
+    if stem == "seabed_landing":
+        meta = tmp_path / "run" / "rollout.json"
+        meta.write_text(meta.read_text().replace(str(ROCK.resolve()), "/gone/rock.obj"))
+        with pytest.raises(ParameterError, match="world object 'rock': mesh file '/gone/rock"):
+            write_replay(Rollout.load(tmp_path / "run"), tmp_path / "replay2.html")
+        assert not (tmp_path / "replay2.html").exists()

@@ -149,7 +149,7 @@ def fixture_path(entry: str | Path, base_dir: Path) -> Path:
             pass
     for candidate in candidates:
         if candidate.is_file():
-            return candidate
+            return candidate.resolve()  # recorded by the run: read again from anywhere
     looked = " or ".join(str(c) for c in candidates)
     raise ParameterError(f"no URDF file at {looked}")
 

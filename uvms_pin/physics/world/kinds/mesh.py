@@ -16,6 +16,7 @@ from typing import Any
 import coal
 import numpy as np
 
+from uvms_pin.errors import ParameterError
 from uvms_pin.hydro.mesh import load_mesh_geometry
 from uvms_pin.physics.world import kind
 
@@ -62,7 +63,11 @@ def drawing(params: dict[str, Any]) -> kind.Drawing:
     """The file's triangles, scaled."""
     import trimesh  # only meshes need it
 
-    mesh = trimesh.load(params["path"], force="mesh")
+    path = Path(params["path"])
+    if not path.is_file():  # a run's record read elsewhere (a replay on another machine)
+        whose = f"world object '{params['name']}': " if "name" in params else ""
+        raise ParameterError(f"{whose}mesh file '{path}' not found: put it back there to draw it")
+    mesh = trimesh.load(path, force="mesh")
     vertices = np.asarray(mesh.vertices, dtype=float) * np.asarray(params["scale"], dtype=float)
     return kind.Drawing("TriangularMeshGeometry", (vertices, np.asarray(mesh.faces)))
 
