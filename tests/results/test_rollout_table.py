@@ -100,3 +100,41 @@ def test_simulated_rollout_names_the_models_joints():
         np.testing.assert_array_equal(df[f"v.{name}_rad_s"], rollout.v[:, 6 + k])
     assert df["q.vehicle.z_m"].iloc[0] == pytest.approx(-2.0)
     assert "tau_commanded.vehicle.fx_N" in df.columns
+
+
+@pytest.mark.parametrize(
+    "meta, expected",
+    [
+        # one name short: the joints numbered
+        ({"arm_joint_names": ["a", "b"]}, ["joint1_rad", "joint2_m", "joint3_rad"]),
+        # a kind it does not know, or one kind short: the names kept, revolute units
+        ({"arm_joint_kinds": ["revolute", "helical", "revolute"]},
+         ["shoulder_rad", "slide_rad", "wrist_rad"]),
+        ({"arm_joint_kinds": ["revolute", "prismatic"]},
+         ["shoulder_rad", "slide_rad", "wrist_rad"]),
+    ],
+)  # fmt: skip
+def test_metadata_that_does_not_fit_the_arrays_gives_plain_columns(meta, expected):
+    """A rollout whose joint names or kinds do not fit its q (a hand-edited rollout.json):
+    one column per entry still, named from what fits, nothing dropped or shifted."""
+    r = _rollout()
+    r.metadata.update(meta)
+    columns = [name for name, _, _ in column_layout(r) if name.startswith("q.")]
+    assert len(columns) == r.q.shape[1]
+    assert columns[7:] == [f"q.{c}" for c in expected]
+
+
+def test_a_signals_record_that_does_not_fit_its_width_gives_indexed_columns():
+    """A signal logged with component names and units (`signal_units`) whose record has
+    fewer names or units than the signal's columns: indexed columns, not a misaligned zip."""
+    r = _rollout()
+    r.metadata["signal_units"] = {
+        "my_signal": {"components": ["left"], "units": ["m", "m"]},
+    }
+    names = [name for name, _, _ in column_layout(r) if name.startswith("my_signal")]
+    assert names == ["my_signal.0", "my_signal.1"]
+    r.metadata["signal_units"] = {
+        "my_signal": {"components": ["left", "right"], "units": ["m", "m"]},
+    }
+    names = [name for name, _, _ in column_layout(r) if name.startswith("my_signal")]
+    assert names == ["my_signal.left_m", "my_signal.right_m"]
