@@ -31,10 +31,7 @@ from uvms_pin.control.task_space import (
     first_level_error,
 )
 from uvms_pin.errors import ParameterError
-from uvms_pin.physics.kinematics import (
-    check_euler_singularity,
-    frame_rotation_and_jacobian,
-)
+from uvms_pin.physics.kinematics import check_euler_singularity, frame_rotation_and_jacobian
 
 __all__ = [
     "EndEffectorTask",
