@@ -152,6 +152,7 @@ def test_root_not_robot(write_urdf):
     with pytest.raises(up.ModelError, match=r"root element is <sdf>, expected <robot>") as info:
         up.load_uvms(path)
     assert str(path) in str(info.value)
+    assert "uvms-pin import FILE --out model.urdf" in str(info.value)  # the way to load it
 
 
 LINK_CASES = {

@@ -70,7 +70,13 @@ def read_urdf_root(path: Path) -> ET.Element:
         raise ModelError("is a directory, not a URDF file", path=where)
     root = xml_root(path)
     if root.tag != "robot":
-        raise ModelError(f"root element is <{root.tag}>, expected <robot>", path=where)
+        hint = (
+            ": an SDF model, which `uvms-pin import FILE --out model.urdf` converts (with its "
+            "Gazebo plugins' hydrodynamics and thrusters)"
+            if root.tag == "sdf"
+            else ""
+        )
+        raise ModelError(f"root element is <{root.tag}>, expected <robot>{hint}", path=where)
     return root
 
 
