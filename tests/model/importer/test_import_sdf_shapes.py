@@ -126,3 +126,41 @@ def test_a_mesh_named_relative_to_the_source_is_found_from_the_urdf_written_else
     unwritten = import_model(source)
     mesh = str((source_dir / "meshes" / "hull.stl").resolve())
     assert f'<mesh filename="{mesh}" />' in unwritten.urdf_text
+
+
+def test_a_model_uri_mesh_is_found_beside_the_model_or_on_the_resource_path(tmp_path, monkeypatch):
+    """gz-sim's ``model://NAME/meshes/x.stl``: the model's own folder (models/NAME beside
+    the source's) or a folder of GZ_SIM_RESOURCE_PATH holds it; the URDF names it from its
+    own folder. One found nowhere is left as it was and noted."""
+    import trimesh
+
+    models, out_dir, shared = tmp_path / "models", tmp_path / "out", tmp_path / "shared"
+    for folder in (models / "lrauv" / "meshes", shared / "props" / "meshes", out_dir):
+        folder.mkdir(parents=True)
+    trimesh.creation.box(extents=(0.4, 0.3, 0.2)).export(models / "lrauv" / "meshes" / "h.stl")
+    trimesh.creation.box(extents=(0.1, 0.1, 0.1)).export(shared / "props" / "meshes" / "p.stl")
+
+    def meshes(*uris: str) -> str:
+        collisions = "".join(
+            f'<collision name="c{k}"><geometry><mesh><uri>{uri}</uri></mesh></geometry></collision>'
+            for k, uri in enumerate(uris)
+        )
+        return LRAUV.read_text().replace(
+            '<collision name="main_body_buoyancy">',
+            f'{collisions}\n      <collision name="main_body_buoyancy">',
+        )
+
+    source = models / "lrauv" / "model.sdf"
+    source.write_text(meshes("model://lrauv/meshes/h.stl", "model://props/meshes/p.stl"))
+    result = import_model(source, out_dir / "lrauv.urdf")
+    assert '<mesh filename="../models/lrauv/meshes/h.stl" />' in result.urdf_text
+    assert '<mesh filename="model://props/meshes/p.stl" />' in result.urdf_text
+    assert any(
+        n.startswith("mesh 'model://props/meshes/p.stl' not found") for n in result.not_mapped
+    )
+    monkeypatch.setenv("GZ_SIM_RESOURCE_PATH", str(shared))
+    result = import_model(source, out_dir / "lrauv.urdf", thrusters_out=out_dir / "t.toml")
+    assert '<mesh filename="../shared/props/meshes/p.stl" />' in result.urdf_text
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")  # both found from the URDF's folder
+        load_uvms(out_dir / "lrauv.urdf", water_density_kg_m3=1000.0)

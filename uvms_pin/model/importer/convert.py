@@ -26,7 +26,7 @@ from uvms_pin.hydro.params import HydroParams
 from uvms_pin.model.importer.collision_volume import collision_volume
 from uvms_pin.model.importer.fossen import fossen_hydro
 from uvms_pin.model.importer.gz_hydrodynamics import gz_hydrodynamics
-from uvms_pin.model.importer.includes import inline_includes
+from uvms_pin.model.importer.includes import inline_includes, resource_folders
 from uvms_pin.model.importer.inertia import check_inertias
 from uvms_pin.model.importer.lift_drag import add_fins
 from uvms_pin.model.importer.plugins import PluginKind, plugin_kind
@@ -87,7 +87,7 @@ def import_model(
     add_fins(robot, plugins, where, notes)
     check_inertias(robot, where, notes, balance=balance_inertia)  # what the loader would refuse
     out = None if out is None else Path(out)
-    _place_mesh_files(robot, path.parent, None if out is None else out.parent)
+    _place_mesh_files(robot, path, None if out is None else out.parent, notes)
     result = ImportResult(urdf_text(robot, where, notes), hydro, thrusters, density, notes, fmt)
     if out is not None:
         table = None if not thrusters else Path(thrusters_out or out.with_suffix(".thrusters.toml"))
@@ -104,19 +104,35 @@ def import_model(
     return result
 
 
-def _place_mesh_files(robot: ET.Element, source_dir: Path, out_dir: Path | None) -> None:
-    """A mesh file named relative to the source (``meshes/hull.stl``) named relative to the
-    URDF's own folder ``out_dir`` (the loader reads it from there), or absolute when the URDF
-    is not written (None); a URI (``package://``, ``model://``) or an absolute path stays."""
+def _place_mesh_files(
+    robot: ET.Element, source: Path, out_dir: Path | None, notes: list[str]
+) -> None:
+    """A mesh file the source names relative to its folder (``meshes/hull.stl``) or as a
+    ``model://NAME/...`` URI (gz-sim's, looked for beside the source, beside its folder and
+    in ``GZ_SIM_RESOURCE_PATH``) named relative to the URDF's own folder ``out_dir`` (the
+    loader reads it from there), or absolute when the URDF is not written (None). Another
+    URI (``package://``) or an absolute path stays; a ``model://`` mesh not found stays too,
+    and is noted."""
     for mesh in robot.iter("mesh"):
         filename = (mesh.get("filename") or "").strip()
-        if not filename or "://" in filename or Path(filename).is_absolute():
+        if filename.startswith("model://"):
+            rest = filename.removeprefix("model://")
+            folders = [source.parent.parent, *resource_folders(source)]
+            found = next((f / rest for f in folders if (f / rest).is_file()), None)
+            if found is None:
+                notes.append(
+                    f"mesh '{filename}' not found (looked in {', '.join(map(str, folders))}; "
+                    "set GZ_SIM_RESOURCE_PATH): left as is, the loader will not find it"
+                )
+                continue
+        elif not filename or "://" in filename or Path(filename).is_absolute():
             continue
-        found = (source_dir / filename).resolve()
-        if out_dir is None:
-            mesh.set("filename", str(found))
         else:
-            mesh.set("filename", os.path.relpath(found, out_dir.resolve()))
+            found = source.parent / filename
+        found = found.resolve()
+        mesh.set(
+            "filename", str(found) if out_dir is None else os.path.relpath(found, out_dir.resolve())
+        )
 
 
 def _read_source(path: Path, notes: list[str]) -> tuple[ET.Element, list[ET.Element], str]:

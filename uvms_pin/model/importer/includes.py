@@ -33,7 +33,7 @@ from uvms_pin.model.importer.sdf import sdf_pose
 from uvms_pin.model.urdf.read import xml_root
 from uvms_pin.results.format import numbers_text
 
-__all__ = ["inline_includes"]
+__all__ = ["inline_includes", "resource_folders"]
 
 #: includes within includes deeper than this are refused (a cycle or a runaway tree)
 MAX_INCLUDE_DEPTH = 16
@@ -103,12 +103,18 @@ def _included_model(
     return models[0], model_file
 
 
+def resource_folders(path: Path) -> list[Path]:
+    """Where a ``model://`` URI of the file ``path`` is looked for: its folder, then each
+    folder of ``GZ_SIM_RESOURCE_PATH``."""
+    return [path.parent] + [
+        Path(p) for p in os.environ.get("GZ_SIM_RESOURCE_PATH", "").split(os.pathsep) if p
+    ]
+
+
 def _model_file(uri: str, path: Path) -> Path:
     """The SDF file of an include URI, searched as the module docstring says."""
     name = uri.removeprefix("model://").removeprefix("file://")
-    folders = [path.parent] + [
-        Path(p) for p in os.environ.get("GZ_SIM_RESOURCE_PATH", "").split(os.pathsep) if p
-    ]
+    folders = resource_folders(path)
     tried = []
     for folder in folders:
         candidate = folder / name
