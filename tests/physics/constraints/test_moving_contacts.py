@@ -240,3 +240,39 @@ def test_a_ball_thrown_along_a_free_slab_slides_at_the_kinetic_friction_then_rol
     if rigid:
         np.testing.assert_allclose(slip[-20:], 0.0, atol=1e-8)
     assert max(slab_speed) < 1e-6
+
+
+@pytest.mark.parametrize("radius_m", [0.05, 0.5, 2.0])
+def test_a_pieces_reach_speed_bounds_every_point_of_its_bounding_sphere(reference_uvms, radius_m):
+    """The speed bound that chooses which pairs may close in a period: when each velocity
+    coordinate moves at most |v_i|, no point within the piece's bounding sphere (of any
+    radius, 5 cm to 2 m) moves faster than it (points on the sphere, random states)."""
+    import dataclasses
+
+    from uvms_pin.physics.constraints.moving_contacts import _reach_speed
+    from uvms_pin.physics.world.robot_geometry import robot_pieces
+
+    model = reference_uvms.model
+    data = model.createData()
+    rng = np.random.default_rng(4)
+    names = [f"hull{k}" for k in range(len(reference_uvms.surface_bodies.hulls))]
+    pieces = [
+        dataclasses.replace(p, bound_radius_m=radius_m) for p in robot_pieces(reference_uvms, names)
+    ]
+    for _ in range(5):
+        q = pin.randomConfiguration(model, -np.ones(model.nq), np.ones(model.nq))
+        q[3:7] /= np.linalg.norm(q[3:7])
+        v = rng.normal(size=model.nv)
+        pin.forwardKinematics(model, data, q, v)
+        pin.computeJointJacobians(model, data, q)
+        for piece in pieces:
+            bound = _reach_speed(model, data, piece, np.abs(v))
+            centre = data.oMi[piece.joint_id] * piece.placement_in_joint
+            twist = pin.getVelocity(model, data, piece.joint_id, pin.LOCAL_WORLD_ALIGNED)
+            directions = rng.normal(size=(50, 3))
+            directions /= np.linalg.norm(directions, axis=1, keepdims=True)
+            points = centre.translation + radius_m * directions
+            # v(p) = v(o_j) + w x (p - o_j), o_j the joint's origin, LOCAL_WORLD_ALIGNED
+            arms = points - data.oMi[piece.joint_id].translation
+            speeds = np.linalg.norm(twist.linear + np.cross(twist.angular, arms), axis=1)
+            assert speeds.max() <= bound * (1 + 1e-12)
