@@ -99,3 +99,19 @@ def test_the_estimator_takes_no_dvl_update_while_the_lock_is_lost():
     np.testing.assert_array_equal(a.errors, b.errors)
     np.testing.assert_array_equal(a.covariances, b.covariances)
     assert np.abs(c.errors - b.errors).max() > 1e-6
+
+
+@pytest.mark.parametrize("normal", [(0.0, 0.0, 1.0), (0.2, -0.1, 1.0)])
+def test_a_bottom_of_planes_alone_is_seen_as_the_worlds_plane_is(normal):
+    """A `PlaneSeabed` given by its planes alone (no world objects): the beams are cast at
+    its planes, the same reading as the world's plane of that pose gives."""
+    from uvms_pin.sim.navigation.seabed import PlaneSeabed
+
+    n = np.asarray(normal) / np.linalg.norm(normal)
+    alone = PlaneSeabed(((1.0, -2.0, -40.0),), (tuple(n),))
+    world = world_seabed([plane("seabed", [1.0, -2.0, -40.0], list(n), 0.5, 0.4)])
+    rotation = pin.rpy.rpyToMatrix(0.1, -0.2, 0.7)
+    position = np.array([3.0, 1.0, -31.0])
+    got = _dvl(alone).measure(position, VELOCITY, rotation)
+    assert got[4] == 1.0
+    np.testing.assert_allclose(got, _dvl(world).measure(position, VELOCITY, rotation), atol=1e-12)
