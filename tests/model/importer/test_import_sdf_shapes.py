@@ -134,11 +134,11 @@ def test_a_model_uri_mesh_is_found_beside_the_model_or_on_the_resource_path(tmp_
     own folder. One found nowhere is left as it was and noted."""
     import trimesh
 
-    models, out_dir, shared = tmp_path / "models", tmp_path / "out", tmp_path / "shared"
-    for folder in (models / "lrauv" / "meshes", shared / "props" / "meshes", out_dir):
+    models, out_dir, common = tmp_path / "models", tmp_path / "out", tmp_path / "common"
+    for folder in (models / "lrauv" / "meshes", common / "props" / "meshes", out_dir):
         folder.mkdir(parents=True)
     trimesh.creation.box(extents=(0.4, 0.3, 0.2)).export(models / "lrauv" / "meshes" / "h.stl")
-    trimesh.creation.box(extents=(0.1, 0.1, 0.1)).export(shared / "props" / "meshes" / "p.stl")
+    trimesh.creation.box(extents=(0.1, 0.1, 0.1)).export(common / "props" / "meshes" / "p.stl")
 
     def meshes(*uris: str) -> str:
         collisions = "".join(
@@ -158,9 +158,9 @@ def test_a_model_uri_mesh_is_found_beside_the_model_or_on_the_resource_path(tmp_
     assert any(
         n.startswith("mesh 'model://props/meshes/p.stl' not found") for n in result.not_mapped
     )
-    monkeypatch.setenv("GZ_SIM_RESOURCE_PATH", str(shared))
+    monkeypatch.setenv("GZ_SIM_RESOURCE_PATH", str(common))
     result = import_model(source, out_dir / "lrauv.urdf", thrusters_out=out_dir / "t.toml")
-    assert '<mesh filename="../shared/props/meshes/p.stl" />' in result.urdf_text
+    assert '<mesh filename="../common/props/meshes/p.stl" />' in result.urdf_text
     with warnings.catch_warnings():
         warnings.simplefilter("error")  # both found from the URDF's folder
         load_uvms(out_dir / "lrauv.urdf", water_density_kg_m3=1000.0)
