@@ -81,8 +81,11 @@ def test_a_mesh_is_left_out_of_the_buoyancy_and_said_so(imported):
         "buoyancy"
         for n in result.not_mapped
     )
-    # the mesh is kept as the link's collision, its scale with it
+    # the mesh is kept as the link's collision, its scale with it; its file is not there
     assert '<mesh filename="dome.stl" scale="2 2 2" />' in result.urdf_text
+    assert any(
+        n.startswith("mesh 'dome.stl' not found beside the source") for n in result.not_mapped
+    )
 
 
 def test_an_axis_in_the_model_frame_is_written_in_the_child_links(imported):

@@ -111,8 +111,8 @@ def _place_mesh_files(
     ``model://NAME/...`` URI (gz-sim's, looked for beside the source, beside its folder and
     in ``GZ_SIM_RESOURCE_PATH``) named relative to the URDF's own folder ``out_dir`` (the
     loader reads it from there), or absolute when the URDF is not written (None). Another
-    URI (``package://``) or an absolute path stays; a ``model://`` mesh not found stays too,
-    and is noted."""
+    URI (``package://``) or an absolute path stays; a ``model://`` mesh not found stays too;
+    a mesh not found is noted."""
     for mesh in robot.iter("mesh"):
         filename = (mesh.get("filename") or "").strip()
         if filename.startswith("model://"):
@@ -129,6 +129,8 @@ def _place_mesh_files(
             continue
         else:
             found = source.parent / filename
+            if not found.is_file():
+                notes.append(f"mesh '{filename}' not found beside the source ({found})")
         found = found.resolve()
         mesh.set(
             "filename", str(found) if out_dir is None else os.path.relpath(found, out_dir.resolve())
