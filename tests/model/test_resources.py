@@ -38,3 +38,37 @@ def test_package_urls_of_example_robot_data_resolve_without_arguments(tmp_path):
     url_mine = "package://example-robot-data/robots/x.stl"
     assert resolve_resource(url_mine, tmp_path, [tmp_path]) == mine
     assert resolve_resource(url_mine, tmp_path) is None
+
+
+def test_a_sourced_ros_workspace_resolves_its_packages(tmp_path, monkeypatch):
+    """``package://NAME/...`` in a sourced ROS workspace: ROS 1's ROS_PACKAGE_PATH (a folder
+    holding packages, or the package itself) and ROS 2's AMENT_PREFIX_PATH (prefix/share/
+    NAME); the caller's package_dirs first, example-robot-data last."""
+    import os
+
+    ros1 = tmp_path / "catkin_ws" / "src"
+    (ros1 / "bluerov2_description" / "meshes").mkdir(parents=True)
+    (ros1 / "bluerov2_description" / "meshes" / "hull.stl").write_text("solid\nendsolid\n")
+    ros2 = tmp_path / "install" / "alpha_description"
+    (ros2 / "share" / "alpha_description" / "meshes").mkdir(parents=True)
+    (ros2 / "share" / "alpha_description" / "meshes" / "link.stl").write_text("solid\nendsolid\n")
+    hull = "package://bluerov2_description/meshes/hull.stl"
+    link = "package://alpha_description/meshes/link.stl"
+    monkeypatch.delenv("ROS_PACKAGE_PATH", raising=False)
+    monkeypatch.delenv("AMENT_PREFIX_PATH", raising=False)
+    assert resolve_resource(hull, tmp_path) is None and resolve_resource(link, tmp_path) is None
+    package_dir = ros1 / "bluerov2_description"
+    monkeypatch.setenv(
+        "ROS_PACKAGE_PATH", os.pathsep.join([str(tmp_path / "none"), str(package_dir)])
+    )
+    assert resolve_resource(hull, tmp_path) == package_dir / "meshes" / "hull.stl"
+    monkeypatch.setenv("ROS_PACKAGE_PATH", str(ros1))
+    monkeypatch.setenv("AMENT_PREFIX_PATH", os.pathsep.join([str(tmp_path / "x"), str(ros2)]))
+    assert resolve_resource(hull, tmp_path) == package_dir / "meshes" / "hull.stl"
+    assert (
+        resolve_resource(link, tmp_path)
+        == ros2 / "share" / "alpha_description" / "meshes" / "link.stl"
+    )
+    search = package_search_path([tmp_path / "mine"])
+    assert search[:3] == [tmp_path / "mine", ros1, tmp_path / "x" / "share"]
+    assert search[-1] == example_robot_data_dir().parent

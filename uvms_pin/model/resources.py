@@ -2,9 +2,11 @@
 
 ``package://NAME/rest`` resolves to ``DIR/NAME/rest`` for the first directory DIR of the
 search path that has it (ROS and Pinocchio's ``package_dirs`` convention: a directory that
-*contains* packages). The search path is the caller's ``package_dirs`` followed by the
-``share`` directory of the installed ``example-robot-data`` distribution, so its robots load
-without arguments (its wheel ships URDFs and meshes under
+*contains* packages; a directory that *is* package NAME serves too). The search path is the
+caller's ``package_dirs``, then the folders of ``ROS_PACKAGE_PATH`` (ROS 1) and the
+``share`` folder of each prefix of ``AMENT_PREFIX_PATH`` (ROS 2), as a sourced ROS workspace
+sets them, then the ``share`` directory of the installed ``example-robot-data``
+distribution, so its robots load without arguments (its wheel ships URDFs and meshes under
 ``site-packages/cmeel.prefix/share/example-robot-data`` but no Python loader). ``file://``
 URLs and absolute paths are taken as they are; other paths are relative to the URDF's
 directory.
@@ -14,6 +16,7 @@ from __future__ import annotations
 
 import difflib
 import functools
+import os
 import sys
 from collections.abc import Iterable
 from importlib import metadata
@@ -52,8 +55,11 @@ def example_robot_data_dir() -> Path | None:
 
 
 def package_search_path(package_dirs: Iterable[str | Path] = ()) -> list[Path]:
-    """The directories searched for ``package://`` names, in order."""
+    """The directories searched for ``package://`` names, in order (the module docstring)."""
     dirs = [Path(d) for d in package_dirs]
+    dirs += [Path(d) for d in os.environ.get("ROS_PACKAGE_PATH", "").split(os.pathsep) if d]
+    prefixes = os.environ.get("AMENT_PREFIX_PATH", "").split(os.pathsep)
+    dirs += [Path(p) / "share" for p in prefixes if p]
     share = _example_robot_data_share()
     if share is not None:
         dirs.append(share)

@@ -189,7 +189,8 @@ def _mesh_geometry(
         raise ModelError(
             f"cannot derive hydrodynamics from collision <mesh>: file '{filename}' not "
             f"found (relative paths from {base_dir}; package:// searched in: "
-            f"{searched or 'none'}); fix the path, pass package_dirs, or add a "
+            f"{searched or 'none'}); fix the path, pass package_dirs (or source the ROS "
+            "workspace holding the package: ROS_PACKAGE_PATH, AMENT_PREFIX_PATH), or add a "
             "<hydrodynamics> element",
             path=where,
             link=link,
