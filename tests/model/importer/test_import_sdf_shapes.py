@@ -167,3 +167,22 @@ def test_a_model_uri_mesh_is_found_beside_the_model_or_on_the_resource_path(tmp_
     with warnings.catch_warnings():
         warnings.simplefilter("error")  # both found from the URDF's folder
         load_uvms(out_dir / "lrauv.urdf", water_density_kg_m3=1000.0)
+
+
+def test_a_limit_without_lower_or_upper_takes_minus_and_plus_pi(tmp_path):
+    """SDF's defaults for a revolute joint's limits not given: lower -pi, upper pi (their
+    absence is not 0)."""
+    text = LRAUV.read_text()
+    assert text.count("<lower>-0.261799</lower>") == 2
+    text = text.replace("<lower>-0.261799</lower>", "", 1).replace("<upper>0.261799</upper>", "", 2)
+    source = tmp_path / "limits.sdf"
+    source.write_text(text)
+    import_model(source, tmp_path / "limits.urdf")
+    uvms = load_uvms(tmp_path / "limits.urdf", water_density_kg_m3=1000.0)
+    joint = uvms.model.getJointId("horizontal_fins_joint")
+    q = uvms.model.joints[joint].idx_q
+    assert uvms.model.lowerPositionLimit[q] == pytest.approx(-math.pi, abs=1e-12)
+    assert uvms.model.upperPositionLimit[q] == pytest.approx(math.pi, abs=1e-12)
+    other = uvms.model.joints[uvms.model.getJointId("vertical_fins_joint")].idx_q
+    assert uvms.model.lowerPositionLimit[other] == pytest.approx(-0.261799, abs=1e-12)
+    assert uvms.model.upperPositionLimit[other] == pytest.approx(math.pi, abs=1e-12)
