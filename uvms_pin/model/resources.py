@@ -25,6 +25,7 @@ from pathlib import Path
 from uvms_pin.errors import ParameterError
 
 __all__ = [
+    "environment_folders",
     "example_robot_data_dir",
     "find_model",
     "package_search_path",
@@ -54,12 +55,17 @@ def example_robot_data_dir() -> Path | None:
     return None if share is None else share / _ERD_DISTRIBUTION
 
 
+def environment_folders(variable: str) -> list[Path]:
+    """The folders a search-path environment variable lists (``os.pathsep`` between them),
+    in order; none when it is unset or empty."""
+    return [Path(d) for d in os.environ.get(variable, "").split(os.pathsep) if d]
+
+
 def package_search_path(package_dirs: Iterable[str | Path] = ()) -> list[Path]:
     """The directories searched for ``package://`` names, in order (the module docstring)."""
     dirs = [Path(d) for d in package_dirs]
-    dirs += [Path(d) for d in os.environ.get("ROS_PACKAGE_PATH", "").split(os.pathsep) if d]
-    prefixes = os.environ.get("AMENT_PREFIX_PATH", "").split(os.pathsep)
-    dirs += [Path(p) / "share" for p in prefixes if p]
+    dirs += environment_folders("ROS_PACKAGE_PATH")
+    dirs += [prefix / "share" for prefix in environment_folders("AMENT_PREFIX_PATH")]
     share = _example_robot_data_share()
     if share is not None:
         dirs.append(share)

@@ -30,6 +30,7 @@ import pinocchio as pin
 
 from uvms_pin.errors import ModelError
 from uvms_pin.model.importer.sdf import sdf_pose
+from uvms_pin.model.resources import environment_folders
 from uvms_pin.model.urdf.read import xml_root
 from uvms_pin.results.format import numbers_text
 
@@ -106,9 +107,7 @@ def _included_model(
 def resource_folders(path: Path) -> list[Path]:
     """Where a ``model://`` URI of the file ``path`` is looked for: its folder, then each
     folder of ``GZ_SIM_RESOURCE_PATH``."""
-    return [path.parent] + [
-        Path(p) for p in os.environ.get("GZ_SIM_RESOURCE_PATH", "").split(os.pathsep) if p
-    ]
+    return [path.parent, *environment_folders("GZ_SIM_RESOURCE_PATH")]
 
 
 def _model_file(uri: str, path: Path) -> Path:
