@@ -214,6 +214,26 @@ def test_modules_and_functions_are_small(path):
             assert length <= MAX_FUNCTION_LINES, f"{node.name} (line {node.lineno}): {length}"
 
 
+#: the classes that hold what moves in a run, and the most methods each may have
+#: (properties counted, dunders not): what the system's logging took out of `System`
+#: (`SystemLog`) kept it a stepper
+SMALL_CLASSES = {"sim/plant.py": "Plant", "sim/system/system.py": "System"}
+MAX_METHODS = 15
+
+
+@pytest.mark.parametrize("path, name", SMALL_CLASSES.items())
+def test_the_plant_and_the_system_have_few_methods(path, name):
+    tree = ast.parse((PACKAGE / path).read_text())
+    (cls,) = [n for n in tree.body if isinstance(n, ast.ClassDef) and n.name == name]
+    methods = [
+        n.name
+        for n in cls.body
+        if isinstance(n, ast.FunctionDef)
+        and not (n.name.startswith("__") and n.name.endswith("__"))
+    ]
+    assert len(methods) <= MAX_METHODS, f"{name}: {len(methods)} methods: {methods}"
+
+
 def test_the_command_line_answers_without_loading_the_stack():
     code = "from uvms_pin.apps.cli.main import build_parser\nbuild_parser().format_help()"
     heavy = {"pinocchio", "scipy", "matplotlib", "meshcat", "pandas", "dask"}

@@ -115,8 +115,8 @@ def test_a_free_box_dropped_on_the_seafloor_rests_on_its_net_weight(load_body):
     # the UVMS did not move: nothing touched it
     assert np.allclose(q_end[:3], [20.0, 0.0, -5.0], atol=1e-9)
     # logged: the box's pair with the floor carries the same force
-    logged = system.logged_signals(np.r_[q_end, box_end[:7]], np.r_[v_end, box_end[7:]])
-    assert system.record()["world"]["object_pairs"] == ["box|seafloor"]
+    logged = system.log.signals(np.r_[q_end, box_end[:7]], np.r_[v_end, box_end[7:]])
+    assert system.log.record()["world"]["object_pairs"] == ["box|seafloor"]
     np.testing.assert_array_equal(logged["free_objects"], box_end)
     assert logged["free_object_contact"][:3] == pytest.approx(total, rel=1e-12)
 

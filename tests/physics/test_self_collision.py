@@ -86,7 +86,7 @@ def test_an_arm_folded_into_the_hull_is_pushed_out_only_on_request(tmp_path, sel
     for k in range(200):
         q, v = system.advance(RK4(1e-3), k * 0.01, q, v, tau, (k + 1) * 0.01)
     if self_collision:
-        names = system.contact_pair_names
+        names = system.log.contact_pair_names
         assert names == [
             "forearm/collision[0]|hull/collision[0]"
         ]  # the shoulder (jointed to the hull) is excepted

@@ -132,11 +132,11 @@ def test_a_free_object_scenario_builds_its_floating_body():
     assert np.allclose(box.q0[:3], [0.80, -0.11, -9.875])
     assert [o.name for o in world.objects] == ["seabed"]
     system = System(scenario.plant)
-    record = system.record()["world"]
+    record = system.log.record()["world"]
     assert record["free_objects"][0]["free"] is True
     assert "one compiled call" in record["integration"]
     assert record["object_pairs"] == ["box|seabed"]
-    assert system.contact_pair_names[-1].endswith("|box")
+    assert system.log.contact_pair_names[-1].endswith("|box")
     # rigid on the seabed by default; "compliant" is the compliant law
     assert record["fixed_contact"] == "rigid" and system.object_contacts is not None
     push = SCENARIOS / "push_object.toml"
@@ -149,7 +149,7 @@ def test_a_free_object_scenario_builds_its_floating_body():
 def test_self_collision_is_a_contact_key():
     scenario = load_scenario(SEABED, {"world.contact.self_collision": True})
     assert scenario.plant.world.self_collision
-    names = System(scenario.plant).contact_pair_names
+    names = System(scenario.plant).log.contact_pair_names
     # the arm's links beyond the first against the vehicle's shapes
     assert any(n.startswith("alpha_wrist_link") and "|base_link" in n for n in names)
     assert not any(n.startswith("alpha_shoulder_link") for n in names if "|base_link" in n)

@@ -202,7 +202,7 @@ def test_two_free_objects_collide_passively_in_the_core(load_body):
     q[:3] = [30.0, 0.0, -5.0]
     state = system.initial_state(q, np.zeros(6))
     system.start(state)
-    assert "one compiled call" in system.record(RK4(5e-4))["world"]["integration"]
+    assert "one compiled call" in system.log.record(RK4(5e-4))["world"]["integration"]
     q_s, v_s = state.q, state.v
     momentum, energy, touched = [], [], False
     for k in range(400):
@@ -232,12 +232,12 @@ def test_a_world_the_core_cannot_do_runs_in_python_with_its_reason(load_body):
         ("core", True, Adaptive(), "the integrator Adaptive"),
     ):
         system, state = _scene(load_body, backend, compiled)
-        record = system.record(integrator)["world"]
+        record = system.log.record(integrator)["world"]
         assert "Python integrator" in record["integration"] and reason in record["integration"]
         q, _ = _advance(system, state, 2)  # the integrated step, as before
         assert np.all(np.isfinite(q))
     system, _ = _scene(load_body)
-    assert "one compiled call" in system.record(RK4(5e-4))["world"]["integration"]
+    assert "one compiled call" in system.log.record(RK4(5e-4))["world"]["integration"]
 
 
 def test_push_object_compiled_follows_the_python_integration():
@@ -342,7 +342,7 @@ def test_self_collision_beside_a_free_object_is_compiled_alike():
         {"world.contact.self_collision": True, "world.fixed_contact": "compliant"}
     )
     assert any(s.a == -1 and s.b == -1 for s in system.moving.moving.sets)
-    assert "one compiled call" in system.record(RK4(5e-4))["world"]["integration"]
+    assert "one compiled call" in system.log.record(RK4(5e-4))["world"]["integration"]
     state = system.initial_state(scenario.q0, scenario.v0)
     system.start(state)
     tau = np.zeros(scenario.uvms.nv)

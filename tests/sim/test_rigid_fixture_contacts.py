@@ -50,7 +50,7 @@ def _dropped(uvms, body, contact: str, seconds: float, compiled: bool = True):
     ball = _steel_ball(body[1])
     world = World(uvms, [], free=[ball], fixtures=[body[0]], moving_contact=contact)
     system = System(Plant(uvms, free_surface=False, world=world), compiled=compiled)
-    integration = system.record(RK4(5e-4))["world"]["integration"]
+    integration = system.log.record(RK4(5e-4))["world"]["integration"]
     assert ("one compiled call" in integration) == compiled, integration
     q0 = uvms.neutral_configuration()
     q0[:3] = FAR

@@ -459,7 +459,7 @@ def test_a_first_robots_object_resting_on_the_seabed_logs_its_weight_while_robot
         assert robots.near(q, v, 2e-3)  # the robots' period, together
         q, v = robots.advance(integrator, 2e-3 * k, SystemState(q, v), taus, 2e-3 * (k + 1))
     q_first, v_first = robots.split(q, v)[0]
-    logged = first.logged_signals(q_first, v_first)["free_object_contact"].reshape(-1, 9)
+    logged = first.log.signals(q_first, v_first)["free_object_contact"].reshape(-1, 9)
     names = first.moving.moving.object_pair_names
     on_seabed = logged[[k for k, n in enumerate(names) if "seabed" in n]].sum(axis=0)
     weight_N = (density - RHO) * 4.0 / 3.0 * np.pi * radius**3 * 9.81

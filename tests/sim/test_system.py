@@ -102,22 +102,22 @@ def test_the_world_is_logged_per_pair_and_per_object(push):
     scenario, system = push
     state = system.initial_state(scenario.q0, scenario.v0)
     system.start(state)
-    logged = system.logged_signals(state.q, state.v)
-    assert logged["world_contact"].size == 9 * len(system.contact_pair_names)
+    logged = system.log.signals(state.q, state.v)
+    assert logged["world_contact"].size == 9 * len(system.log.contact_pair_names)
     assert logged["free_objects"].size == 13 * len(system.objects)
     np.testing.assert_array_equal(
         logged["free_objects"][:7], system.layout.split(state.q, state.v)[1][0]
     )
-    pairs = system.record()["world"]["object_pairs"]
+    pairs = system.log.record()["world"]["object_pairs"]
     assert logged["free_object_contact"].size == 9 * len(pairs)
-    assert system.n_logged_columns >= 9 * (len(system.contact_pair_names) + len(pairs)) + 13
+    assert system.log.n_columns >= 9 * (len(system.log.contact_pair_names) + len(pairs)) + 13
 
 
 def test_without_a_world_nothing_more_is_logged(reference_uvms):
     system = System(Plant(reference_uvms, free_surface=False))
     state = system.initial_state(reference_uvms.neutral_configuration(), np.zeros(10))
-    assert system.logged_signals(state.q, state.v) == {}
-    assert system.n_logged_columns == 0 and system.moving is None
+    assert system.log.signals(state.q, state.v) == {}
+    assert system.log.n_columns == 0 and system.moving is None
 
 
 def test_a_new_start_steps_with_the_plant_as_attached_anew(reference_uvms):
@@ -189,7 +189,7 @@ def test_joint_limits_are_either_stops_or_constraints(reference_uvms):
     "name", ["push_object", "valve_panel", "surfacing", "object_recovery", "hot_stab"]
 )
 def test_the_columns_a_run_is_sized_for_are_the_columns_it_logs(name):
-    """`System.n_logged_columns` (what the memory check before a run counts) is exactly the
+    """`SystemLog.n_columns` (what the memory check before a run counts) is exactly the
     width of the world's signals a short run logs: the wet fractions, the contact pairs'
     wrenches, the free objects' states and pairs, the fixtures' joints."""
     period = load_scenario(ROOT / "scenarios" / f"{name}.toml").settings.log_period_s
@@ -202,4 +202,4 @@ def test_the_columns_a_run_is_sized_for_are_the_columns_it_logs(name):
     world |= {fixture.name for fixture in system.fixtures}
     widths = {k: v.reshape(len(v), -1).shape[1] for k, v in rollout.signals.items() if k in world}
     assert widths, f"{name} logs nothing of its world"
-    assert system.n_logged_columns == sum(widths.values()), widths
+    assert system.log.n_columns == sum(widths.values()), widths

@@ -151,16 +151,16 @@ def test_the_fixtures_are_logged_and_said_how_they_are_stepped(reference_uvms):
     q0[:3] = FAR
     state = system.initial_state(q0, np.zeros(reference_uvms.nv))
     assert state.q.size == reference_uvms.nq + 1 and state.q[-1] == 0.3
-    logged = system.logged_signals(state.q, state.v)
+    logged = system.log.signals(state.q, state.v)
     assert logged["panel"].components == ("valve",) and logged["panel"].values[0] == 0.3
-    record = system.record(RK4(5e-4))
+    record = system.log.record(RK4(5e-4))
     assert record["world"]["integration"].startswith("fixtures: one compiled call")
     assert record["world"]["fixtures"][0]["joints"] == ["valve"]
-    assert system.n_logged_columns == 9 * len(system.contact_pair_names) + 1
+    assert system.log.n_columns == 9 * len(system.log.contact_pair_names) + 1
     world = World(reference_uvms, [], fixtures=[valve], moving_contact="rigid")
     rigid = System(Plant(reference_uvms, free_surface=False, world=world))
     # rigid moving contacts too: the fixture's joints join the compiled solve when touched
-    assert rigid.record(RK4(5e-4))["world"]["integration"].startswith("fixtures: one compiled")
+    assert rigid.log.record(RK4(5e-4))["world"]["integration"].startswith("fixtures: one compiled")
 
 
 def test_a_fixture_touched_by_another_sets_row_is_solved_with_it(tmp_path):

@@ -218,7 +218,7 @@ def _build(raw: dict[str, Any], path: Path, top: Table) -> Scenario:
         settings = SimulationSettings(
             head.duration_s, integrator, log_period, control_period, head.seed
         )
-        check_log_fits(settings, uvms.nq, uvms.nv, System(plant).n_logged_columns)
+        check_log_fits(settings, uvms.nq, uvms.nv, System(plant).log.n_columns)
     except ParameterError as exc:
         raise ScenarioError(f"{top.source}: {exc}") from exc
     return Scenario(

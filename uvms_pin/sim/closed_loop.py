@@ -208,7 +208,7 @@ class ClosedLoop:
         if controller is not None:
             with self._controller_code("signals"):
                 signals = {**controller.signals(), **signals}
-        signals.update(self.system.logged_signals(self.state.q, self.state.v))
+        signals.update(self.system.log.signals(self.state.q, self.state.v))
         return Sample(
             self.time_s,
             self.q,
@@ -259,7 +259,7 @@ class ClosedLoop:
         try:
             self.start(q0, v0, sensors)
             # as simulated: anchored, and how its period is stepped
-            log.rollout.metadata["world"] = self.system.record(self.settings.integrator)
+            log.rollout.metadata["world"] = self.system.log.record(self.settings.integrator)
             log.rollout.metadata["stiff_modes"] = self.stiff_modes
             # the pipeline, chosen once: why the loop is not compiled (continuous-time
             # control among the reasons), or the compiled loop
@@ -280,7 +280,7 @@ class ClosedLoop:
             raise
         finally:
             log.rollout.metadata["closed_loop"] = path.record()
-            log.rollout.metadata.update(self.system.solves_record())
+            log.rollout.metadata.update(self.system.log.solves_record())
             self.observers.remove(log)
             dropped = self.plant.actuation.dropped()
             if dropped is not None:
@@ -485,7 +485,7 @@ def simulate_closed_loop(
     from uvms_pin.sim.settings import check_log_fits
 
     loop = ClosedLoop(plant, settings, controller, observers, compiled=compiled)
-    check_log_fits(settings, plant.uvms.nq, plant.uvms.nv, loop.system.n_logged_columns)
+    check_log_fits(settings, plant.uvms.nq, plant.uvms.nv, loop.system.log.n_columns)
     meta = {**(metadata or {}), **run_metadata(plant, settings)}
     if sensors.navigation is not None:
         meta["signal_units"].update(described_columns(sensors.navigation.signal_columns()))

@@ -6,7 +6,7 @@ written, when the log is finished (they are functions of the state alone), and s
 free surface, is each hull's wet fraction (the signal ``wet_fraction``, one column per hull
 named in the metadata's ``hull_names``: 1 deep, 0 out of the water); the potential energy
 includes the joint stops' springs (`JointStops.energy_J`). With a world, each
-sample also logs (the system of bodies' `System.logged_signals`, among the sample's signals) the contact of every (body, object) pair (the signal ``world_contact``,
+sample also logs (the system of bodies' `SystemLog.signals`, among the sample's signals) the contact of every (body, object) pair (the signal ``world_contact``,
 9 columns per pair named in the metadata's ``world_contact_pairs``: the force on the body
 [N] (3), its point [m] (3) and the moment about that point [N m] (3), world axes; the
 UVMS against free objects and its own vehicle included). With free objects, the signal
@@ -62,7 +62,7 @@ class RolloutLog:
         # the joint stops' springs hold energy: a part of the potential energy logged
         self.stops = None if plant is None else plant.joint_stops
         if plant is not None and plant.world is not None:
-            metadata = {**metadata, "world_contact_pairs": system.contact_pair_names}
+            metadata = {**metadata, "world_contact_pairs": system.log.contact_pair_names}
         if system is not None and system.objects:
             names, units = system.moving.state_columns()
             units_meta = {

@@ -192,7 +192,7 @@ class RobotsLoop:
             together = self.system.integration(self.settings.integrator)
             together = TOGETHER_COMPILED if together is None else TOGETHER_PYTHON.format(together)
             for loop, log in zip(self.loops, logs, strict=True):
-                log.rollout.metadata["world"] = loop.system.record(self.settings.integrator)
+                log.rollout.metadata["world"] = loop.system.log.record(self.settings.integrator)
                 log.rollout.metadata["world"]["robots_together"] = together
                 log.rollout.metadata["stiff_modes"] = loop.stiff_modes
             self._run_ticks(path)

@@ -153,7 +153,7 @@ def _simulate_robots(
     for robot, (_, sensors, metadata), own in zip(robots, parts, loop.loops, strict=True):
         plant, settings = robot.plant, robot.settings
         pairs = loop.system.contact_pair_names(len(logs))
-        columns = own.system.n_logged_columns + 9 * len(pairs)
+        columns = own.system.log.n_columns + 9 * len(pairs)
         check_log_fits(settings, plant.uvms.nq, plant.uvms.nv, columns)
         meta = {**metadata, **run_metadata(plant, settings)}
         if pairs:  # the signal robot_contact's pairs (`Robots.contact_signals`)

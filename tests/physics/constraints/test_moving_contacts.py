@@ -143,7 +143,7 @@ def test_the_scenario_key_chooses_the_moving_contacts(load_body):
     assert _system(pusher, [ball]).moving_constraints is not None
     soft = _system(pusher, [ball], "compliant")
     assert soft.moving_constraints is None
-    assert soft.record()["world"]["moving_contact"] == "compliant"
+    assert soft.log.record()["world"]["moving_contact"] == "compliant"
     with pytest.raises(ParameterError, match="moving_contact must be one of compliant, rigid"):
         World(pusher, [], ContactLaw(), [ball], moving_contact="soft")
 

@@ -147,7 +147,7 @@ def test_the_world_says_how_free_objects_touch_it(load_body):
         Plant(pusher, world=World(pusher, [floor], ContactLaw(), [box]), free_surface=False)
     )
     assert rigid.object_contacts is not None
-    assert rigid.record()["world"]["fixed_contact"] == "rigid"
+    assert rigid.log.record()["world"]["fixed_contact"] == "rigid"
     soft = World(pusher, [floor], ContactLaw(), [box], fixed_contact="compliant")
     assert System(Plant(pusher, world=soft, free_surface=False)).object_contacts is None
     with pytest.raises(ParameterError, match="fixed_contact must be one of rigid"):

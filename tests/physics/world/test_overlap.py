@@ -131,7 +131,7 @@ def test_separate_moves_the_sphere_out_of_the_vehicle_and_the_run_has_no_kick(re
     assert move.direction_world[2] > 0.99  # out through the hull's top
     moved = state.q[uvms.nq : uvms.nq + 3] - ball.q0[:3]
     np.testing.assert_allclose(moved, move.depth_m * move.direction_world, atol=1e-12)
-    record = system.record()["world"]["initial_overlap"]
+    record = system.log.record()["world"]["initial_overlap"]
     assert record["mode"] == "separate"
     assert record["tolerance_m"] == {"ball": pytest.approx(2 * _net_weight(ball) / 2e4)}
     assert record["moved"][0]["object"] == "ball"
@@ -211,7 +211,7 @@ def test_a_scenario_s_separate_moves_the_box_out_of_the_seabed_and_says_so():
     state = system.initial_state(scenario.q0, scenario.v0)
     nq = scenario.plant.uvms.nq
     assert state.q[nq + 2] == pytest.approx(-10.0 + 0.125, abs=1e-9)  # on the seabed
-    (moved,) = system.record()["world"]["initial_overlap"]["moved"]
+    (moved,) = system.log.record()["world"]["initial_overlap"]["moved"]
     assert moved["object"] == "box" and moved["bodies"] == ["seabed", "box"]
     assert moved["depth_m"] == pytest.approx(0.075, abs=1e-9)
     assert moved["moved_world_m"] == pytest.approx([0.0, 0.0, 0.075], abs=1e-9)

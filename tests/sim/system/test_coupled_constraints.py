@@ -66,7 +66,7 @@ def _run(system: System, state, periods: int):
 def test_the_compiled_coupled_step_follows_the_reference(load_body):
     core, core_state = _scene(load_body, compiled=True)
     python, python_state = _scene(load_body, compiled=False)
-    assert "one compiled call" in core.record(RK4(5e-4))["world"]["integration"]
+    assert "one compiled call" in core.log.record(RK4(5e-4))["world"]["integration"]
     compiled_run, (q, v) = _run(core, core_state, 250)
     reference_run, (q_ref, v_ref) = _run(python, python_state, 250)
     np.testing.assert_allclose(compiled_run, reference_run, rtol=0, atol=AGREEMENT)

@@ -158,7 +158,7 @@ def test_rigid_contacts_with_joint_friction_are_compiled_as_the_reference(tmp_pa
     runs, systems = [], []
     for compiled in (True, False):
         system = System(plant, compiled=compiled)
-        integration = system.record(RK4(5e-4))["world"]["integration"]
+        integration = system.log.record(RK4(5e-4))["world"]["integration"]
         assert ("one compiled call" in integration) == compiled, integration
         state = system.initial_state(q, np.zeros(uvms.nv))
         system.start(state)

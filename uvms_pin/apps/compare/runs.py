@@ -55,7 +55,7 @@ def controller_scenarios(
     # every controller's rollout is kept until the figures are drawn: all of them must fit
     check_memory(
         sum(
-            s.settings.log_bytes(s.uvms.nq, s.uvms.nv, System(s.plant).n_logged_columns)
+            s.settings.log_bytes(s.uvms.nq, s.uvms.nv, System(s.plant).log.n_columns)
             for s in out.values()
         ),
         f"the logs of the {len(out)} runs ({next(iter(out.values())).settings.n_log} samples each)",

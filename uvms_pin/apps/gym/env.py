@@ -330,7 +330,7 @@ class UvmsEnv(gym.Env):
             **run_metadata(scenario.plant, settings),
             "seed": self.episode_seed,
             "log_period_s": settings.control_period_s,
-            "world": self._loop.system.record(),
+            "world": self._loop.system.log.record(),
         } | _shortened_record(scenario)
 
     # -- helpers -------------------------------------------------------------------------

@@ -26,53 +26,22 @@ import pinocchio as pin
 
 from uvms_pin.physics.compiled.backend import Fallback
 from uvms_pin.physics.compiled.extension import core_module
-from uvms_pin.physics.compiled.moving import (
-    contacts_of_core,
-    forces_of_core,
-    memories_of,
-    search_compiled,
-)
+from uvms_pin.physics.compiled.moving import memories_of, search_compiled
 from uvms_pin.physics.constraints.attachments import Attachments
 from uvms_pin.physics.constraints.moving_contacts import MovingPairContacts
 from uvms_pin.physics.constraints.object_contacts import ObjectWorldContacts
 from uvms_pin.physics.constraints.step import StalledSolves
 from uvms_pin.physics.dynamics import forward_dynamics, mass_matrix
-from uvms_pin.physics.world.overlap import tolerance_m
 from uvms_pin.sim.compiled.system import system_to_core
 from uvms_pin.sim.integrators import Integrator
 from uvms_pin.sim.plant import Plant, checked_start, has_moving_contacts
 from uvms_pin.sim.system import fixtures as fixture_joints
 from uvms_pin.sim.system.free_objects import FreeObjects
-from uvms_pin.sim.system.period import (
-    PeriodStep,
-    constraint_sets,
-    period_step,
-    why_not_compiled_system,
-)
+from uvms_pin.sim.system.period import PeriodStep, period_step
 from uvms_pin.sim.system.state import Layout, SystemState
+from uvms_pin.sim.system.system_log import SystemLog
 
 __all__ = ["System"]
-
-#: what a world record says of a run with free objects, its period compiled
-COMPILED_PATH = (
-    "{bodies}: one compiled call a control period steps the system (the UVMS, every "
-    "{each}, every contact between them and with the fixed world, the friction anchors)"
-)
-#: ... or integrated in Python, and why
-PYTHON_PATH = (
-    "{bodies}: the system (UVMS and {others}) is integrated by the Python integrator "
-    "around the compiled dynamics ({reason})"
-)
-
-
-def integration_path(reason: str | None, fixtures_only: bool = False) -> str:
-    """What a world record says of a run with free objects (or only fixtures:
-    ``fixtures_only``) whose compiled period is refused for ``reason`` (None: compiled)."""
-    bodies, others = ("fixtures", "fixtures") if fixtures_only else ("free objects", "objects")
-    if reason is None:
-        each = "fixture's joints" if fixtures_only else "free object and fixture's joints"
-        return COMPILED_PATH.format(bodies=bodies, each=each)
-    return PYTHON_PATH.format(bodies=bodies, others=others, reason=reason)
 
 
 def _system_model(robot: pin.Model, n_objects: int) -> pin.Model:
@@ -102,6 +71,7 @@ class System:
             (`uvms_pin.physics.constraints.object_contacts`), or None.
         moving_constraints: the rigid contacts between moving bodies, solved with them
             (`uvms_pin.physics.constraints.moving_contacts`), or None.
+        log: what a run records of it (`uvms_pin.sim.system.system_log.SystemLog`).
     """
 
     def __init__(self, plant: Plant, *, compiled: bool = True):
@@ -140,6 +110,7 @@ class System:
         self._data = uvms.model.createData()  # the bound test's kinematics
         self.separations: list = []  # the objects' moves out of an overlap at the start
         self.stalled = StalledSolves()  # the run's constraint solves accepted after stalling
+        self.log = SystemLog(self)
 
     def _object_contacts(self) -> ObjectWorldContacts | None:
         """The free objects' rigid contacts with the fixed world (`World.fixed_contact`
@@ -291,30 +262,6 @@ class System:
         if self.moving is not None:
             self.moving.settle(q_r, v_r, objects)
 
-    # ---- what a run records -----------------------------------------------------------------
-    def record(self, integrator: Integrator | None = None) -> dict[str, Any]:
-        """The world simulated, as plain data (`Plant.record`, with the moving pairs and,
-        with free objects, how a period of ``integrator`` steps them)."""
-        out = self.plant.record()
-        if self.moving is not None:
-            several = bool(self.objects or self.fixtures)
-            reason = why_not_compiled_system(self, integrator) if several else None
-            out["world"] = {
-                **out["world"],
-                "pairs": self.contact_pair_names,
-                "object_pairs": self.moving.moving.object_pair_names,
-                **({"integration": integration_path(reason, not self.objects)} if several else {}),
-            }
-            if self.objects:
-                out["world"]["initial_overlap"] = {
-                    "mode": self.plant.world.initial_overlap,
-                    "tolerance_m": {
-                        o.name: tolerance_m(o, self.plant.world.law) for o in self.objects
-                    },
-                    "moved": [o.record(self.objects[o.moved].name) for o in self.separations],
-                }
-        return out
-
     def stalled_solves(self) -> StalledSolves:
         """The run's constraint solves accepted after stalling (`StalledSolves`): the Python
         step's and the compiled system's (rebuilt, so counted afresh, when a run starts; read
@@ -323,70 +270,6 @@ class System:
         if held is None or held[0] is not self.plant.compiled or isinstance(held[1], Fallback):
             return self.stalled
         return self.stalled.merged(*held[1].stalled_solves)
-
-    def solves_record(self) -> dict[str, Any]:
-        """``{"constraint_solves": ...}`` (`StalledSolves.record`) for a run's metadata when
-        the system solves constraints at its periods' ends, else empty."""
-        solves = bool(constraint_sets(self))
-        return {"constraint_solves": self.stalled_solves().record()} if solves else {}
-
-    @property
-    def contact_pair_names(self) -> list[str]:
-        """``first|second`` of every logged contact pair of the robot (``world_contact``):
-        its bodies against the fixed objects, then against the free objects and its own
-        vehicle."""
-        world = self.plant.world
-        if world is None:
-            return []
-        extra = [] if self.moving is None else self.moving.moving.uvms_pair_names
-        return world.pair_names + extra
-
-    @property
-    def n_logged_columns(self) -> int:
-        """Values a run of this system logs per sample beyond the robot's arrays: the wet
-        fractions, 9 per contact pair (force [N], point [m], moment [N m]) and 13 per free
-        object (its state)."""
-        plant = self.plant
-        hulls = len(plant.uvms.surface_bodies) if plant.free_surface else 0
-        pairs = len(self.contact_pair_names)
-        if self.moving is not None:
-            pairs += len(self.moving.moving.object_pair_names)
-        joints = sum(len(f.joint_names) for f in self.fixtures)
-        return hulls + 9 * pairs + 13 * len(self.objects) + joints
-
-    def logged_signals(self, q: np.ndarray, v: np.ndarray) -> dict[str, np.ndarray]:
-        """What a run logs of the world at the system's (q, v): ``world_contact``, per
-        contact pair of the robot (`contact_pair_names`) the force on its body [N], the
-        point [m] and the moment about it [N m], world axes, flattened; with free objects,
-        ``free_objects`` (their states, `FreeObjects.state_columns`) and
-        ``free_object_contact`` (their pairs' wrenches). Empty without a world."""
-        plant = self.plant
-        if plant.world is None:
-            return {}
-        (q_r, v_r), *objects = self.layout.split(q, v)
-        n = len(self.objects)
-        compiled = self.compiled
-        # the Python integration's own contacts (its rigid contacts' forces are its own)
-        if compiled is None or isinstance(compiled, Fallback) or not self.compiled_allowed:
-            fixed = plant.world.pair_wrenches(plant.world_forces(q_r, v_r)).ravel()
-            if self.moving is None:
-                return {"world_contact": fixed}
-            found = self.moving.found(q_r, v_r, objects)
-        else:  # the compiled system's contacts (the same as the reference's, to rounding)
-            memories = self.friction_memories()
-            fixed = np.zeros(0)  # no fixed object: no pair of the robot's to search or log
-            if plant.world.objects:
-                robot_forces = forces_of_core(plant.compiled.world_forces(q_r, v_r, memories[0]))
-                fixed = plant.world.pair_wrenches(robot_forces).ravel()
-            found = contacts_of_core(compiled.contacts(q, v, memories))
-        robot, between_objects = self.moving.moving.wrenches(found)
-        out = {"world_contact": np.concatenate([fixed, robot])}
-        if self.objects:
-            out["free_objects"] = np.concatenate([np.concatenate(s) for s in objects[:n]])
-            out["free_object_contact"] = between_objects
-        for fixture, (q_f, _) in zip(self.fixtures, objects[n:], strict=True):
-            out[fixture.name] = fixture.signal(q_f)
-        return out
 
 
 def _attachments(world, objects: tuple, first_object_joint: int) -> Attachments | None:
