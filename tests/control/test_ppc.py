@@ -421,3 +421,29 @@ def test_null_space_task_keeps_the_end_effector_task(model):
     np.testing.assert_allclose(zeta_0[:6], 0.0)
     assert zeta_0[6] == pytest.approx(-0.5 * 2.0 / 2.5) and zeta_0[9] == pytest.approx(0.4)
     assert difference @ zeta_0 > 0.0
+
+
+@pytest.mark.parametrize("backend", ["core", "python"])
+@pytest.mark.parametrize("turns", [1, -1, 2])
+@pytest.mark.parametrize("axis", [0, 1, 2])
+def test_an_orientation_error_is_read_wrapped_to_within_pi(model, q_bent, axis, turns, backend):
+    """A desired angle a whole number of turns away from another is the same orientation:
+    the error, the reference velocity and the torque are those of the angle itself (a roll
+    or yaw crossing +-pi, where matrixToRpy jumps by 2 pi, is not a huge error), on the
+    compiled law as on the reference."""
+    rpy_now = ee_rpy(model, q_bent)
+    near = rpy_now.copy()
+    near[axis] -= 0.3
+    far = near.copy()
+    far[axis] += turns * 2.0 * np.pi
+    out = []
+    for desired in (near, far):
+        controller = PrescribedPerformanceController(
+            model, "ee", desired_rpy=desired, backend=backend
+        )
+        tau = controller.compute(0.0, make_measurement(model, q_bent))
+        out.append((tau, controller.last_signals))
+    (tau_near, near_signals), (tau_far, far_signals) = out
+    assert far_signals.e_x[3 + axis] == pytest.approx(0.3, abs=1e-12)
+    np.testing.assert_allclose(far_signals.e_x, near_signals.e_x, rtol=0, atol=1e-12)
+    np.testing.assert_allclose(tau_far, tau_near, rtol=1e-9, atol=1e-9)
