@@ -245,3 +245,48 @@ def test_a_mesh_enclosing_no_volume_is_refused_naming_the_file(load_body, tmp_pa
     text = body_urdf(mass=1.0, collision=f'<mesh filename="{path}"/>')
     with pytest.raises(ModelError, match=r"link 'body'.*encloses no volume"):
         load_body(text)
+
+
+def _binary_stl_headed_solid(mesh: trimesh.Trimesh) -> bytes:
+    """``mesh`` as a binary STL whose 80-byte header starts with ``solid``, as some CAD
+    tools write it."""
+    data = bytearray(trimesh.exchange.stl.export_stl(mesh))
+    data[:80] = b"solid exported by a CAD tool".ljust(80, b" ")
+    return bytes(data)
+
+
+@pytest.mark.parametrize(
+    "name, export",
+    [
+        ("sphere.stl", lambda m: trimesh.exchange.stl.export_stl(m)),
+        ("solid.stl", _binary_stl_headed_solid),
+        ("ascii.stl", lambda m: trimesh.exchange.stl.export_stl_ascii(m).encode()),
+        ("sphere.obj", lambda m: trimesh.exchange.obj.export_obj(m).encode()),
+        ("sphere.ply", lambda m: trimesh.exchange.ply.export_ply(m, encoding="binary")),
+        ("sphere.glb", lambda m: trimesh.exchange.gltf.export_glb(trimesh.Scene(m))),
+    ],
+)
+def test_the_memory_weighed_before_a_mesh_is_read_bounds_what_reading_it_takes(
+    tmp_path, name, export
+):
+    """`mesh_bytes` (what the check before a mesh is read weighs) is at least the peak of
+    the memory allocated while reading and reducing it (tracemalloc: Python's and numpy's
+    allocations), for a 5,120-triangle sphere in the compact formats (binary STL, PLY and
+    GLB: about 19 to 50 bytes a triangle) and the text ones; about 1,400 bytes a triangle,
+    whatever the format."""
+    import tracemalloc
+
+    from uvms_pin.hydro.mesh import load_mesh_geometry, mesh_bytes
+
+    path = tmp_path / name
+    path.write_bytes(export(trimesh.creation.icosphere(subdivisions=4)))
+    load_mesh_geometry(path, (2.0, 2.0, 2.0))  # the readers' imports (cached apart)
+    tracemalloc.start()
+    try:
+        geometry = load_mesh_geometry(path)
+        _, peak = tracemalloc.get_traced_memory()
+    finally:
+        tracemalloc.stop()
+    assert geometry.watertight and len(geometry.triangles) == 5120
+    assert peak > 1000 * 5120  # what the bound is weighed against: the triangles' memory
+    assert mesh_bytes(path) >= peak, f"{mesh_bytes(path)} bytes weighed, {peak} taken"

@@ -143,24 +143,35 @@ def load_mesh_geometry(path: str | Path, scale=(1.0, 1.0, 1.0)) -> MeshGeometry:
     return _load_cached(str(p.resolve()), p.stat().st_mtime_ns, tuple(float(x) for x in s))
 
 
-#: memory a mesh takes while it is read and reduced (its triangles, merged vertices,
-#: normals, convex hull and their temporaries), per byte of its file and per triangle a
-#: binary STL declares [bytes]: upper bounds (an OBJ's ~40 bytes of text per triangle, an
-#: STL's 50, become ~400 in memory)
-MESH_BYTES_PER_FILE_BYTE, MESH_BYTES_PER_TRIANGLE = 16, 800
+#: memory a mesh takes while it is read and reduced (its triangles, merged vertices, edges,
+#: normals, convex hull and their temporaries) [bytes], upper bounds of what was measured
+#: (peak resident memory above the start, and tracemalloc's peak, alike): 1,320 to 1,420
+#: bytes a triangle in every format (icospheres of 20,480 to 327,680 triangles as binary
+#: and ASCII STL, OBJ, OFF, binary and ASCII PLY, GLB, DAE). A binary STL declares its
+#: triangles; the others are weighed by their size: an ASCII STL, 7 bytes a byte of it
+#: (about 250 bytes of text a triangle); any other file, 75 (a binary PLY or GLB: about 19
+#: bytes a triangle; an OBJ, 33 to 43; an OFF, 33; a DAE, 21)
+MESH_BYTES_PER_TRIANGLE = 2000
+MESH_BYTES_PER_ASCII_STL_BYTE = 10
+MESH_BYTES_PER_FILE_BYTE = 100
 
 
 def mesh_bytes(path: Path) -> int:
-    """What reading the mesh file ``path`` takes [bytes], from its size and, for a binary
-    STL, from the triangle count its header declares (read from the 4 bytes after it)."""
+    """What reading the mesh file ``path`` takes [bytes]: a binary STL's triangles (the
+    count its header declares, the 4 bytes after its 80) times `MESH_BYTES_PER_TRIANGLE`;
+    an ASCII STL's size times `MESH_BYTES_PER_ASCII_STL_BYTE`; another file's size times
+    `MESH_BYTES_PER_FILE_BYTE`. An STL is ASCII when it starts with ``solid`` and its size
+    is not the 84 + 50 n bytes of n binary triangles (some CAD tools start a binary
+    header with ``solid`` too)."""
     size = path.stat().st_size
-    declared = 0
-    if path.suffix.lower() == ".stl" and size >= 84:
-        with open(path, "rb") as f:
-            head = f.read(84)
-        if not head.lstrip().startswith(b"solid"):
-            declared = int.from_bytes(head[80:84], "little")
-    return max(size * MESH_BYTES_PER_FILE_BYTE, declared * MESH_BYTES_PER_TRIANGLE)
+    if path.suffix.lower() != ".stl":
+        return size * MESH_BYTES_PER_FILE_BYTE
+    with open(path, "rb") as f:
+        head = f.read(84)
+    declared = int.from_bytes(head[80:84], "little") if len(head) == 84 else -1
+    if declared < 0 or (head.lstrip().startswith(b"solid") and size != 84 + 50 * declared):
+        return size * MESH_BYTES_PER_ASCII_STL_BYTE
+    return declared * MESH_BYTES_PER_TRIANGLE
 
 
 def check_mesh_fits(path: Path) -> None:
