@@ -107,3 +107,74 @@ def test_a_prismatic_joint_is_logged_in_metres(tmp_path):
     assert latch.joint_units == ("m",)
     signal = latch.signal(latch.q0)
     assert signal.components == ("hinge",) and signal.units == ("m",) and signal.values[0] == 0.05
+
+
+def _two_joint_urdf(folder, *, second_mass_kg: float = 0.5):
+    """A fixed ``base``, an ``arm`` on ``hinge`` (limits [-0.5, 1.0] rad) and a ``slider`` on
+    ``slide`` (prismatic, [0, 0.2] m), the slider's mass ``second_mass_kg``."""
+    inertia = 'ixx="1e-3" iyy="1e-3" izz="1e-3" ixy="0" ixz="0" iyz="0"'
+    slider = (
+        f'<inertial><mass value="{second_mass_kg!r}"/><inertia {inertia}/></inertial>'
+        if second_mass_kg > 0.0
+        else ""
+    )
+    path = folder / "two_joints.urdf"
+    path.write_text(f"""<robot name="two">
+  <link name="base"><inertial><mass value="1"/><inertia {inertia}/></inertial></link>
+  <joint name="hinge" type="revolute"><parent link="base"/><child link="arm"/>
+    <axis xyz="0 0 1"/><limit lower="-0.5" upper="1.0" effort="10" velocity="1"/></joint>
+  <link name="arm"><inertial><origin xyz="0.1 0 0"/><mass value="1"/><inertia {inertia}/></inertial></link>
+  <joint name="slide" type="prismatic"><parent link="arm"/><child link="slider"/>
+    <origin xyz="0.2 0 0"/><axis xyz="1 0 0"/>
+    <limit lower="0.0" upper="0.2" effort="10" velocity="1"/></joint>
+  <link name="slider">{slider}</link>
+</robot>""")
+    return path
+
+
+def test_joint_positions_at_their_limits_are_kept_and_beyond_them_refused_by_joint(tmp_path):
+    """Each joint's position is checked against its own limits: both joints at their lower
+    and at their upper limits are accepted; a position just beyond one limit is refused
+    naming that joint, its value and its limits."""
+    path = _two_joint_urdf(tmp_path)
+    for q0 in ([-0.5, 0.0], [1.0, 0.2]):
+        two = fixture("two", path, POSE, joint_positions=q0, water_density_kg_m3=RHO)
+        np.testing.assert_array_equal(two.q0, q0)
+    for q0, joint, text in (
+        ([-0.501, 0.1], "hinge", r"-0\.501, outside its limits \[-0\.5, 1\]"),
+        ([1.001, 0.1], "hinge", r"1\.001, outside its limits \[-0\.5, 1\]"),
+        ([0.3, -0.001], "slide", r"-0\.001, outside its limits \[0, 0\.2\]"),
+        ([0.3, 0.201], "slide", r"0\.201, outside its limits \[0, 0\.2\]"),
+    ):
+        with pytest.raises(ParameterError, match=f"joint '{joint}' of .* at {text}") as refused:
+            fixture("two", path, POSE, joint_positions=q0, water_density_kg_m3=RHO)
+        assert refused.value.key == "joint_positions_rad"
+
+
+def test_a_joint_the_fixture_lacks_is_refused_listing_its_moving_joints(tmp_path):
+    path = _two_joint_urdf(tmp_path)
+    with pytest.raises(ParameterError, match=r"names joint 'gate', .*\(hinge, slide\)"):
+        fixture("two", path, POSE, joint_positions={"gate": 0.1}, water_density_kg_m3=RHO)
+
+
+def test_a_moving_link_without_inertia_is_refused_naming_its_joint(tmp_path):
+    """A slider with no <inertial> makes the fixture's mass matrix singular: refused by the
+    joint that carries it (not the one before it), the key ``path``."""
+    path = _two_joint_urdf(tmp_path, second_mass_kg=0.0)
+    with pytest.raises(ParameterError, match=r"no inertia \(joint 'slide'\)") as refused:
+        fixture("two", path, POSE, water_density_kg_m3=RHO)
+    assert refused.value.key == "path"
+
+
+def test_a_shipped_fixture_is_found_from_a_scenario_anywhere(tmp_path):
+    """A fixture's ``path`` relative to the scenario's folder, else to the shipped models:
+    ``fixtures/subsea_panel_valve.urdf`` from a folder without it is the shipped valve; a
+    file beside the scenario wins over it; an absolute path is itself."""
+    from uvms_pin.physics.world.fixture import fixture_path
+
+    assert fixture_path("fixtures/subsea_panel_valve.urdf", tmp_path) == VALVE.resolve()
+    own = tmp_path / "fixtures" / "subsea_panel_valve.urdf"
+    own.parent.mkdir()
+    own.write_text(VALVE.read_text())
+    assert fixture_path("fixtures/subsea_panel_valve.urdf", tmp_path) == own.resolve()
+    assert fixture_path(VALVE, tmp_path / "elsewhere") == VALVE.resolve()
