@@ -85,6 +85,12 @@ class ActuationWarning(UvmsPinWarning):
     the components and the largest value dropped."""
 
 
+class PerceptionWarning(UvmsPinWarning):
+    """A camera or sonar cannot give what its table asks: it fires at logged samples, and
+    the log is slower than its ``rate_hz``. The message names the sensor, both rates and
+    the ``output.log_period_s`` that would give its own."""
+
+
 class ParameterError(UvmsPinError, ValueError):
     """An argument has the wrong shape, a non-finite value or is out of its valid range."""
 

@@ -9,7 +9,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from uvms_pin.errors import ParameterError, ScenarioError
+from uvms_pin.errors import ParameterError, PerceptionWarning, ScenarioError
 from uvms_pin.perception.suite import HUGE_PAGE, firing_rows, fixture_positions, stack_of
 from uvms_pin.results.rollout import Rollout
 from uvms_pin.scenario.load import scenario_from_dict
@@ -109,6 +109,23 @@ def test_a_misspelt_link_is_refused_with_the_frames_it_resembles():
         ParameterError, match=r"sonar 'fls': link 'base_lnk'.*did you mean 'base_link'"
     ):
         simulate(scenario, progress=False)
+
+
+def test_a_sensor_faster_than_the_log_is_warned_of_and_fires_on_its_grid(recwarn):
+    """A sensor fires at logged samples: a camera of 100 Hz over the scenario's log of 50 Hz gives 50
+    images a second, and says so before the run, naming it and the log period that would
+    give its rate; a sonar at the log's rate, and one slower, are not warned of."""
+    sonars = [{**SONAR, "rate_hz": 50.0}, {**SONAR, "name": "slow", "rate_hz": 30.0}]
+    scenario = _scenario({"camera": [{**CAMERA, "rate_hz": 100.0}], "sonar": sonars})
+    rollout = simulate(scenario, progress=False)
+    warned = [w for w in recwarn if issubclass(w.category, PerceptionWarning)]
+    assert len(warned) == 1, [str(w.message) for w in warned]
+    assert str(warned[0].message) == (
+        "camera 'front' fires at logged samples: at 50 Hz, not its rate_hz = 100 "
+        "(output.log_period_s = 0.02 s; 0.01 s or less gives its rate)"
+    )
+    np.testing.assert_allclose(rollout.camera("front").time_s, np.arange(11) * 0.02)
+    np.testing.assert_allclose(rollout.sonar("fls").time_s, np.arange(11) * 0.02)
 
 
 def test_images_that_would_not_fit_in_memory_are_refused_before_the_run():

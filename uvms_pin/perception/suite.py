@@ -13,6 +13,7 @@ in the order of the scenario.
 from __future__ import annotations
 
 import math
+import warnings
 from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import Any
@@ -20,6 +21,7 @@ from typing import Any
 import numpy as np
 
 from uvms_pin.checks import check_memory
+from uvms_pin.errors import PerceptionWarning
 
 # the sensor kinds, each registered by its module on import: the one list of them
 from uvms_pin.perception import camera, sonar  # noqa: F401
@@ -62,14 +64,25 @@ class PerceptionSpec:
         return [spec.name for _, spec in self.sensors]
 
 
-def check_mounts(spec: PerceptionSpec, model: Any, duration_s: float = 0.0) -> None:
+def check_mounts(
+    spec: PerceptionSpec, model: Any, duration_s: float = 0.0, log_period_s: float | None = None
+) -> None:
     """Before a run, not after it: ParameterError naming the sensor and its ``link`` when the
     robot's model has no such frame, or when the images of ``duration_s`` [s] would not fit
-    in memory."""
+    in memory; a `PerceptionWarning` for a sensor faster than the log of ``log_period_s``
+    [s] (it fires at logged samples: on the log's grid, `firing_rows`)."""
     total = 0.0
     for kind_name, own in spec.sensors:
         mount_frame(model, own.link, f"{kind_name} '{own.name}'")
         total += (math.floor(duration_s * own.rate_hz) + 1) * SENSORS[kind_name].bytes(own)
+        if log_period_s is not None and own.rate_hz * log_period_s > 1.0 + 1e-9:
+            warnings.warn(
+                f"{kind_name} '{own.name}' fires at logged samples: at {1.0 / log_period_s:g} "
+                f"Hz, not its rate_hz = {own.rate_hz:g} (output.log_period_s = "
+                f"{log_period_s:g} s; {1.0 / own.rate_hz:g} s or less gives its rate)",
+                PerceptionWarning,
+                stacklevel=2,
+            )
     check_memory(
         total,
         f"the images of {', '.join(spec.names)} over {duration_s:g} s",

@@ -123,7 +123,12 @@ def run_parts(
     """What a run of ``scenario`` starts from: (a fresh controller, or the instance
     ``given``; its sensors, seeded with the settings' seed; its rollout's metadata)."""
     settings = scenario.settings
-    check_mounts(scenario.sensor_config.perception, scenario.uvms.model, settings.duration_s)
+    check_mounts(
+        scenario.sensor_config.perception,
+        scenario.uvms.model,
+        settings.duration_s,
+        settings.log_period_s,
+    )
     sensors = SensorSuite(
         scenario.uvms.model, scenario.sensor_config, settings.duration_s, settings.seed
     )
