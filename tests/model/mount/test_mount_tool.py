@@ -37,7 +37,10 @@ def arm() -> URDFTree:
 
 
 def test_named_and_vector_tool_axes(arm):
-    assert tool_axis_in_link(arm, "-y", ["j1", "j2"], "wrist", PATH).tolist() == [0, -1, 0]
+    named = {"x": [1, 0, 0], "y": [0, 1, 0], "z": [0, 0, 1],
+             "-x": [-1, 0, 0], "-y": [0, -1, 0], "-z": [0, 0, -1]}  # fmt: skip
+    for name, axis in named.items():
+        assert tool_axis_in_link(arm, name, ["j1", "j2"], "wrist", PATH).tolist() == axis
     axis = tool_axis_in_link(arm, [0.0, 3.0, 4.0], ["j1", "j2"], "wrist", PATH)
     assert np.allclose(axis, [0.0, 0.6, 0.8])
     with pytest.raises(ParameterError, match="tool_axis must be 'auto', one of x"):
@@ -67,6 +70,11 @@ def test_probe_link_is_a_cylinder_along_x():
     assert float(inertia.get("ixx")) == pytest.approx(0.5 * 0.2 * 0.01**2)
     assert float(inertia.get("iyy")) == pytest.approx(0.2 * (3 * 0.01**2 + 0.1**2) / 12)
     assert link.find("collision/geometry/cylinder").get("length") == "0.1"
+    # a URDF cylinder lies along its z: turned onto the link's x, from the origin to the tip
+    for tag in ("collision", "visual"):
+        origin = origin_of(link.find(tag), PATH)
+        np.testing.assert_allclose(np.abs(origin.rotation @ [0.0, 0.0, 1.0]), [1, 0, 0], atol=1e-12)
+        np.testing.assert_allclose(origin.translation, [0.05, 0.0, 0.0], atol=1e-15)
 
 
 def test_the_sensor_tool_and_ee_frames():
