@@ -238,6 +238,44 @@ def test_missing_mesh_is_named(split, write_urdf):
     assert "l1" in str(info.value) and str(arm) in str(info.value)
 
 
+HYDRO = """<hydrodynamics><volume value="1e-4"/><added_mass diagonal="0.1 0.1 0.1 0 0 0"/>
+    <linear_damping diagonal="0 0 0 0 0 0"/><quadratic_damping diagonal="1 1 1 0 0 0"/>
+    </hydrodynamics>"""
+
+
+@pytest.mark.parametrize("where", ["in its link", "at the top level"])
+def test_a_link_with_hydrodynamics_needs_no_collision_mesh(split, write_urdf, where):
+    """Its coefficients are given: a collision mesh that cannot be found is dropped, not
+    refused (it would be read only to derive them), whether the <hydrodynamics> element is
+    in the link or at the top level naming it."""
+    text = _arm_text(collision='<mesh filename="meshes/nowhere.stl"/>')
+    if where == "in its link":
+        text = text.replace("</collision>\n  </link>", f"</collision>{HYDRO}</link>", 1)
+    else:
+        text = text.replace(
+            "</robot>", HYDRO.replace("<hydrodynamics>", '<hydrodynamics link="l1">') + "</robot>"
+        )
+    assert text.count("<hydrodynamics") == 1
+    uvms = mount_arm(split.vehicle_urdf, write_urdf(text, "arm.urdf"), split.mount_pose)
+    (l1,) = [b for b in uvms.hydro_bodies if b.name == "l1"]
+    assert l1.params.volume_m3 == pytest.approx(1e-4)
+
+
+def test_an_arm_bolted_by_a_link_below_its_root_leaves_what_is_above_behind(split, write_urdf):
+    """``arm_base_link`` below the arm file's root (a pedestal the arm stands on in its own
+    file): the pedestal and the joint holding the base to it are not mounted."""
+    pedestal = """<link name="pedestal">
+    <inertial><mass value="3.0"/><inertia ixx="1e-2" iyy="1e-2" izz="1e-2" ixy="0" ixz="0" iyz="0"/></inertial>
+    <collision><geometry><box size="0.2 0.2 0.2"/></geometry></collision></link>"""
+    stand = '<joint name="stand" type="fixed"><parent link="pedestal"/><child link="base"/></joint>'
+    arm = write_urdf(_arm_text(pedestal, stand), "arm.urdf")
+    alone = mount_arm(split.vehicle_urdf, write_urdf(_arm_text(), "alone.urdf"), split.mount_pose)
+    uvms = mount_arm(split.vehicle_urdf, arm, split.mount_pose, arm_base_link="base")
+    assert "stand" not in [f.name for f in uvms.model.frames]
+    assert "pedestal" not in [f.name for f in uvms.model.frames]
+    assert pin.computeTotalMass(uvms.model) == pytest.approx(pin.computeTotalMass(alone.model))
+
+
 def test_missing_package_mesh_is_named(split, write_urdf):
     arm = write_urdf(
         _arm_text(collision='<mesh filename="package://no_such_pkg/m.stl"/>'), "arm.urdf"
