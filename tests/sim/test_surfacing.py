@@ -33,6 +33,9 @@ def test_the_lbv150_rises_breaks_the_surface_and_floats_at_its_waterline(tmp_pat
     assert 10.0 < metrics["time_partly_out_of_water_s"] < 60.0
     assert metrics["time_wholly_out_of_water_s"] == 0.0
     assert 0.9 < metrics["wet_fraction_min"] < 1.0
+    fractions = rollout.signals["wet_fraction"][:, 0]
+    assert np.all((fractions >= 0.0) & (fractions <= 1.0))
+    assert np.all(fractions[rollout.q[:, 2] < -1.0] == 1.0)  # deep: wholly wet
     assert metrics["energy_max_increase_J"] < 1e-6
     assert rollout.metadata["hull_names"] == ["base_link"]
     assert rollout.metadata["world"]["free_surface"] is True
