@@ -258,3 +258,47 @@ def test_the_force_loop_integrates_its_error_by_rectangles_within_its_limit():
     # 100 s more of e1 would integrate to (-100, 300, 20) N s: clipped to (-5, 5, 0.4)
     loop.velocity(101.5, e1)
     np.testing.assert_allclose(loop.integral_Ns, [-5.0, 5.0, 0.4], rtol=1e-14)
+
+
+def test_the_impedance_law_is_its_formula_at_a_generic_state(reference_uvms):
+    """tau = J^T [f_d + K_p (p_a - p) - D_p p_dot; K_o log(R_d R^T) - D_o omega] - D_zeta
+    zeta - [0; K_q (q (-) q_a)], J the end effector's world-aligned Jacobian, p_a and q_a
+    the position and posture of the first call: recomputed from Pinocchio at a second,
+    moved state, each gain its own."""
+    uvms, ee = reference_uvms, _ee_name(reference_uvms)
+    model, data = uvms.model, uvms.model.createData()
+    frame = model.getFrameId(ee)
+    rng = np.random.default_rng(5)
+    gains = {
+        "stiffness_N_m": rng.uniform(2.0, 8.0, 3),
+        "damping_N_s_m": rng.uniform(5.0, 15.0, 3),
+        "stiffness_Nm_rad": rng.uniform(1.0, 3.0, 3),
+        "damping_Nm_s_rad": rng.uniform(0.2, 0.8, 3),
+        "velocity_damping": rng.uniform(2.0, 8.0, uvms.nv),
+        "posture_stiffness_Nm_rad": rng.uniform(0.2, 0.8, uvms.nv - 6),
+    }
+    f_d, rpy_d = np.array([0.3, -0.1, 0.5]), np.array([0.2, -0.3, 1.0])
+    controller = ImpedanceController(
+        model, ee, desired_force_world_N=f_d, desired_rpy=rpy_d, **gains
+    )
+    first = _measurement(uvms, rng)
+    controller.compute(0.2, first)
+    q = pin.integrate(model, first.q, rng.normal(0.0, 0.2, uvms.nv))
+    v = rng.normal(0.0, 0.3, uvms.nv)
+    tau = controller.compute(0.3, Measurement(0.3, q, v, np.zeros(6)))
+    pin.framesForwardKinematics(model, data, first.q)  # the anchor: the first position
+    anchor = data.oMf[frame].translation.copy()
+    pin.framesForwardKinematics(model, data, q)
+    placement = data.oMf[frame]
+    jacobian = pin.computeFrameJacobian(model, data, q, frame, pin.LOCAL_WORLD_ALIGNED)
+    twist = jacobian @ v
+    rotation_error = pin.log3(pin.rpy.rpyToMatrix(*rpy_d) @ placement.rotation.T)
+    wrench = np.r_[
+        f_d + gains["stiffness_N_m"] * (anchor - placement.translation)
+        - gains["damping_N_s_m"] * twist[:3],
+        gains["stiffness_Nm_rad"] * rotation_error - gains["damping_Nm_s_rad"] * twist[3:],
+    ]  # fmt: skip
+    expected = jacobian.T @ wrench - gains["velocity_damping"] * v
+    expected[6:] -= gains["posture_stiffness_Nm_rad"] * pin.difference(model, first.q, q)[6:]
+    np.testing.assert_allclose(tau, expected, rtol=1e-12, atol=1e-12)
+    assert np.linalg.norm(anchor - placement.translation) > 0.05  # the spring is stretched
