@@ -120,6 +120,22 @@ def test_a_joint_stops_at_its_limit_and_never_gains_energy(reference_uvms, tmp_p
     assert energy[-1] < energy[0] - 0.1  # what it fell by went into friction and the stop
 
 
+@pytest.mark.parametrize("compiled", [True, False])
+def test_a_frictionless_joint_stops_at_its_limit_on_either_path(reference_uvms, tmp_path, compiled):
+    """No friction, no damping: the limit alone stops the lever (its exact step's limit
+    impulse, the only row it has), on the compiled system and on the Python reference:
+    never past the limit, at rest on it after the fall, no energy gained."""
+    upper = 0.2
+    lever = _lever(tmp_path, friction_Nm=0.0, limits=(-0.1, upper))
+    world = World(reference_uvms, [], fixtures=[lever])
+    system = System(Plant(reference_uvms, free_surface=False, world=world), compiled=compiled)
+    q, v = _run(system, reference_uvms, 0.4)
+    assert q[:, 0].max() <= upper + 1e-9
+    assert q[-1, 0] == pytest.approx(upper, abs=1e-9) and abs(v[-1, 0]) < 1e-9
+    energy = np.array([_energy(lever, a, b) for a, b in zip(q, v, strict=True)])
+    assert np.max(np.diff(energy)) < 1e-9
+
+
 def test_a_free_object_falling_on_the_handle_turns_it(reference_uvms):
     # the panel faces +x, the handle's axis; its paddle lies along y at q = 0 and turns
     # towards +z for q > 0: a weight on its -y end turns it
