@@ -191,6 +191,15 @@ def _check_perception(rollout, bag: dict) -> None:
                 _close(pixel, np.column_stack([columns, rows]) + 0.0)
                 assert (info.width, info.height) == (spec.width, spec.height)
                 assert not np.any(info.d)
+        elif "beam_range_m" in arrays and about["spec"]["type"] == "altimeter":
+            readings = bag[f"/{name}/range"]
+            assert len(readings) == len(arrays["time_s"])
+            for k, (_, reading) in enumerate(readings):
+                assert reading.header.frame_id == frame and reading.radiation_type == 0
+                assert reading.field_of_view == np.float32(about["spec"]["horizontal_fov_rad"])
+                assert reading.max_range == np.float32(about["spec"]["max_range_m"])
+                expected = arrays["beam_range_m"][k][0]
+                assert reading.range == np.float32(np.inf if np.isnan(expected) else expected)
         elif "beam_range_m" in arrays:
             bearing = arrays["bearing_rad"]
             for k, (_, scan) in enumerate(bag[f"/{name}/scan"]):

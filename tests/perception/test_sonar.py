@@ -55,6 +55,29 @@ def test_the_altimeter_hears_the_seabed_at_its_altitude(reference_uvms):
     assert abs(spec.range_m[np.argmax(profile)] - 3.2) <= spec.range_m[1] - spec.range_m[0]
 
 
+@pytest.mark.parametrize("tilt_rad", [0.0, 0.15, -0.2])
+@pytest.mark.parametrize("altitude_m", [0.4, 3.0, 15.0])
+def test_the_altimeter_reads_its_distance_to_the_seabed(reference_uvms, altitude_m, tilt_rad):
+    """Its reading is the echo's first arrival: the seabed's distance along its normal
+    (flat, or sloping within the 25 degree cone), to the spacing of its rays about the axis
+    (5e-5 of it), whatever the altitude and with the speckle on; the centre of gravity of
+    its echo would read 1.3 % more. Nothing within its ranges: NaN, and the reading is what
+    its record keeps (`beam_range_m`, one beam)."""
+    normal = np.array([np.sin(tilt_rad), 0.0, np.cos(tilt_rad)])
+    seabed = plane("seabed", [0.0, 0.0, -20.0 - altitude_m], normal, 0.5, 0.4)
+    raw = {"name": "alt", "type": "altimeter", "rpy_rad": [0.0, np.pi / 2, 0.0],
+           "position_m": [0.1, 0.05, -0.1]}  # fmt: skip
+    spec = SonarSpec.from_dict(raw, "alt")
+    fired = Sonar(spec, _scene(reference_uvms, [seabed]), np.random.default_rng(0)).fire()
+    distance = (np.array([0.1, 0.05, -20.1]) - [0.0, 0.0, -20.0 - altitude_m]) @ normal
+    assert fired["beam_range_m"].shape == (1,) and fired["beam_intensity"][0] > 0.0
+    assert fired["beam_range_m"][0] == pytest.approx(distance, rel=5e-5)
+    assert fired["beam_range_m"][0] >= distance
+    deep = SonarSpec.from_dict({**raw, "max_range_m": 0.9 * distance}, "alt")
+    nothing = Sonar(deep, _scene(reference_uvms, [seabed]), np.random.default_rng(0)).fire()
+    assert np.isnan(nothing["beam_range_m"][0]) and nothing["beam_intensity"][0] == 0.0
+
+
 def test_an_altimeter_by_its_type_alone_has_one_narrow_beam_and_hears_the_seabed(
     reference_uvms,
 ):

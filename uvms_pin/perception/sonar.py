@@ -23,7 +23,12 @@ the track) and detects the bottom in each beam: its range is the echo-weighted m
 rays' ranges, sum_i e_i r_i / sum_i e_i (the centre of gravity of the beam's echo, amplitude
 detection: X. Lurton, An Introduction to Underwater Acoustics, 2nd ed. 2010, ch. 8), plus
 Gaussian noise of ``range_noise_m``; its intensity the sum of its echoes (speckled as a
-cell). A beam that hears nothing within its ranges reads NaN.
+cell). A beam that hears nothing within its ranges reads NaN. An ``altimeter`` detects the
+bottom in its one beam by the echo's first arrival, the distance an echosounder reports: the
+nearest range at which its rays hear a surface (the leading edge of the echo), plus the same
+noise; its intensity the sum of its echoes. Over a flat bottom at altitude h it reads h (to
+its rays' spacing about the axis), where the centre of gravity of its 25 degree cone's echo
+would read 1.3 % more.
 """
 
 from __future__ import annotations
@@ -41,6 +46,8 @@ from uvms_pin.perception.scene import Scene
 __all__ = ["SONAR", "Sonar", "SonarSpec"]
 
 TYPES = ("imaging", "multibeam", "altimeter")
+#: the types that detect the bottom in each beam (``beam_range_m``, ``beam_intensity``)
+DETECTING = ("multibeam", "altimeter")
 
 #: The keys whose defaults depend on the type, and those defaults: a fan of 256 beams over
 #: 2 rad (about 115 degrees) for an imaging sonar or a multibeam; an altimeter's one beam a
@@ -201,13 +208,20 @@ class Sonar(sensor.Mounted):
 
     def profile(self, beam, r, echo) -> tuple[np.ndarray, np.ndarray]:
         """Each beam's bottom detection from its heard rays: (range [m] (beams,), the
-        echo-weighted mean of its rays' ranges plus noise, NaN where it heard nothing;
-        intensity (beams,), its echoes' sum, speckled)."""
+        echo-weighted mean of its rays' ranges (an altimeter's: the nearest, its echo's first
+        arrival) plus noise, NaN where it heard nothing; intensity (beams,), its echoes'
+        sum, speckled)."""
         spec = self.spec
         energy = np.bincount(beam, echo, minlength=spec.beams)
-        moment = np.bincount(beam, echo * r, minlength=spec.beams)
         heard = energy > 0.0
-        range_m = np.where(heard, moment / np.where(heard, energy, 1.0), np.nan)
+        if spec.type == "altimeter":
+            echoing = echo > 0.0  # a ray grazing a surface returns nothing
+            nearest = np.full(spec.beams, np.inf)
+            np.minimum.at(nearest, beam[echoing], r[echoing])
+            range_m = np.where(heard, nearest, np.nan)
+        else:
+            moment = np.bincount(beam, echo * r, minlength=spec.beams)
+            range_m = np.where(heard, moment / np.where(heard, energy, 1.0), np.nan)
         if spec.range_noise_m > 0.0:
             range_m = range_m + spec.range_noise_m * self.rng.standard_normal(spec.beams)
         if spec.speckle:
@@ -215,12 +229,12 @@ class Sonar(sensor.Mounted):
         return range_m, energy
 
     def fire(self, out: dict[str, np.ndarray] | None = None) -> dict[str, np.ndarray]:
-        """What a firing records: its intensity (float32); a multibeam's detections too,
-        ``beam_range_m`` and ``beam_intensity`` (beams,); copied into ``out`` (the same
-        arrays) when given, else new arrays."""
+        """What a firing records: its intensity (float32); a multibeam's or an altimeter's
+        detections too, ``beam_range_m`` and ``beam_intensity`` (beams,); copied into
+        ``out`` (the same arrays) when given, else new arrays."""
         k, beam, r, echo = self.echoes()
         fired = {"intensity": self._image(k, beam, r, echo).astype(np.float32)}
-        if self.spec.type == "multibeam":
+        if self.spec.type in DETECTING:
             range_m, energy = self.profile(beam, r, echo)
             fired["beam_range_m"], fired["beam_intensity"] = range_m, energy.astype(np.float32)
         return sensor.written(fired, out, f"sonar '{self.spec.name}'")
@@ -233,8 +247,8 @@ SONAR = sensor.register(
         make=Sonar,
         bytes=lambda spec: (
             4 * spec.bins * spec.beams  # the image (float32)
-            # a multibeam's detections: range (float64) and intensity (float32) per beam
-            + ((8 + 4) * spec.beams if spec.type == "multibeam" else 0)
+            # the detections: range (float64) and intensity (float32) per beam
+            + ((8 + 4) * spec.beams if spec.type in DETECTING else 0)
         ),
         constants=lambda sonar: {
             "range_m": sonar.spec.range_m,

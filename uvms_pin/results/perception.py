@@ -3,8 +3,8 @@
 A rollout holds them in ``perception``: sensor name -> its arrays (``time_s`` (T,) and what
 each firing gave, stacked: a camera's ``depth_m`` (T, H, W) float32, ``rgb`` (T, H, W, 3)
 uint8 and ``label`` (T, H, W) int16; a sonar's ``intensity`` (T, bins, beams) with its
-``range_m`` (bins,) and ``bearing_rad`` (beams,), a multibeam's ``beam_range_m`` and
-``beam_intensity`` (T, beams) too); its metadata's ``perception`` says each
+``range_m`` (bins,) and ``bearing_rad`` (beams,), a multibeam's (and an altimeter's)
+``beam_range_m`` and ``beam_intensity`` (T, beams) too); its metadata's ``perception`` says each
 sensor's kind and, for a camera, its labels' names (label k is ``label_names[k - 1]``, 0:
 nothing met). Saved compressed as ``perception.npz`` beside ``rollout.npz``.
 """
@@ -49,9 +49,9 @@ class CameraRecord:
 @dataclass(frozen=True)
 class SonarRecord:
     """A sonar's images: ``time_s`` (T,), ``intensity`` (T, bins, beams), ``range_m``
-    (bins,) [m] and ``bearing_rad`` (beams,) [rad]; a multibeam's detections
-    ``beam_range_m`` (T, beams) [m] (NaN: none) and ``beam_intensity`` (T, beams) (None for
-    the other types)."""
+    (bins,) [m] and ``bearing_rad`` (beams,) [rad]; a multibeam's detections (an
+    altimeter's reading, one beam) ``beam_range_m`` (T, beams) [m] (NaN: none) and
+    ``beam_intensity`` (T, beams) (None for an imaging sonar)."""
 
     time_s: np.ndarray
     intensity: np.ndarray

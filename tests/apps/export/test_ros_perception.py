@@ -77,6 +77,12 @@ horizontal_fov_rad = 0.1
 max_range_m = 4.0
 rate_hz = 10.0
 rpy_rad = [0.0, 1.5708, 0.0]
+
+[[sensors.sonar]]
+name = "echosounder"        # on the vehicle, looking down at the seabed 1 m below
+type = "altimeter"
+rate_hz = 10.0
+rpy_rad = [0.0, 1.5707963267948966, 0.0]
 """
 
 
@@ -107,6 +113,11 @@ def test_a_camera_on_a_moving_link_and_sonars_export_as_their_images(saved, tmp_
     assert static["altimeter_frame"] == "alpha_wrist_link"
     assert len(bag["/wrist/image_raw"]) == 7  # 20 Hz over 0.3 s, t = 0 included
     assert len(bag["/altimeter/image"]) == 4 and "/altimeter/scan" not in bag
+    readings = [m.range for _, m in bag["/altimeter/range"]]  # sensor_msgs/Range
+    assert readings == [np.inf] * 4  # it looks into open water: +Inf (REP 117)
+    altitude = [m.range for _, m in bag["/echosounder/range"]]  # from its origin to z = -6 m
+    fired = np.searchsorted(rollout.time_s, rollout.sonar("echosounder").time_s)
+    np.testing.assert_allclose(altitude, rollout.q[fired, 2] + 6.0, rtol=1e-4)
     assert np.isinf(bag["/profiler/scan"][0][1].ranges).any()
 
 

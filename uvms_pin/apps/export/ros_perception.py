@@ -12,8 +12,10 @@ name made a ROS name (`ros_name`). At each firing:
   ``/<name>/labels`` (16UC1: the label of what each pixel sees, 0 nothing; the names in the
   run's metadata);
 - a sonar: ``/<name>/image`` (32FC1, one row per range bin from the nearest, one column per
-  beam from the first bearing), and a multibeam's detections ``/<name>/scan``
-  (``sensor_msgs/LaserScan`` in its frame, REP 117: +Inf where a beam heard nothing).
+  beam from the first bearing), a multibeam's detections ``/<name>/scan``
+  (``sensor_msgs/LaserScan`` in its frame, REP 117: +Inf where a beam heard nothing) and an
+  altimeter's reading ``/<name>/range`` (``sensor_msgs/Range``, ultrasound, its cone's
+  full angle as the field of view; +Inf when it heard nothing).
 
 The images are the rollout's (`uvms_pin.results.perception`), bit for bit; a run saved
 before its metadata kept the sensors' specs has none of these topics.
@@ -32,12 +34,15 @@ from uvms_pin.errors import VizError
 from uvms_pin.perception.camera import CameraSpec
 from uvms_pin.results.signal import component_label
 
-__all__ = ["PerceptionTopics", "camera_info", "laser_scan", "ros_name"]
+__all__ = ["PerceptionTopics", "altimeter_range", "camera_info", "laser_scan", "ros_name"]
 
 # (topic, message, time [ns])
 Message = tuple[str, dict, int]
 
 _IMAGE, _INFO, _SCAN = "sensor_msgs/Image", "sensor_msgs/CameraInfo", "sensor_msgs/LaserScan"
+_RANGE = "sensor_msgs/Range"
+#: sensor_msgs/Range's radiation type of a sonar
+_ULTRASOUND = 0
 
 
 def _image(time_ns: int, frame: str, pixels: np.ndarray, encoding: str) -> dict[str, Any]:
@@ -99,6 +104,19 @@ def laser_scan(
         "range_max": float(spec["max_range_m"]),
         "ranges": ranges.tolist(),
         "intensities": np.asarray(intensity, dtype=np.float32).tolist(),
+    }
+
+
+def altimeter_range(time_ns: int, frame: str, spec: dict[str, Any], range_m: float) -> dict:
+    """``sensor_msgs/Range`` of an altimeter's reading: ultrasound, the field of view its
+    cone's full angle, NaN (heard nothing) sent as +Inf (REP 117)."""
+    return {
+        "header": header(time_ns, frame),
+        "radiation_type": _ULTRASOUND,
+        "field_of_view": float(spec["horizontal_fov_rad"]),
+        "min_range": float(spec["min_range_m"]),
+        "max_range": float(spec["max_range_m"]),
+        "range": float(np.inf if np.isnan(range_m) else range_m),
     }
 
 
@@ -173,22 +191,22 @@ class PerceptionTopics:
             if len(shapes) != 1 or arrays["time_s"].shape[0] != next(iter(shapes))[0]:
                 raise ValueError("its images' shapes disagree")
         else:
-            for key in ("rate_hz", "min_range_m", "max_range_m"):  # what a scan reads
+            for key in ("rate_hz", "min_range_m", "max_range_m", "horizontal_fov_rad"):
                 float(spec[key])
             if arrays["intensity"].shape[0] != arrays["time_s"].shape[0]:
                 raise ValueError("its images and times disagree")
         self._frames[name] = (f"{ros_name(name)}{suffix}", parent, mount * in_link)
-        self.types.update(self._topic_types(name, about["kind"], arrays))
+        self.types.update(self._topic_types(name, about["kind"], spec, arrays))
 
     @staticmethod
-    def _topic_types(name: str, kind: str, arrays: dict) -> dict[str, str]:
+    def _topic_types(name: str, kind: str, spec: dict, arrays: dict) -> dict[str, str]:
         base = f"/{ros_name(name)}"
         if kind == "camera":
             topics = ("image_raw", "depth/image", "labels")
             return {f"{base}/{t}": _IMAGE for t in topics} | {f"{base}/camera_info": _INFO}
         out = {f"{base}/image": _IMAGE}
-        if "beam_range_m" in arrays:  # a multibeam's detections
-            out[f"{base}/scan"] = _SCAN
+        if "beam_range_m" in arrays:  # a multibeam's detections, an altimeter's reading
+            out |= {f"{base}/range": _RANGE} if _altimeter(spec) else {f"{base}/scan": _SCAN}
         return out
 
     def static_transforms(self, time_ns: int) -> list[dict]:
@@ -224,9 +242,17 @@ class PerceptionTopics:
             return
         intensity = np.asarray(arrays["intensity"][k], dtype="<f4")
         yield f"/{name}/image", _image(time_ns, frame, intensity, "32FC1"), time_ns
-        if "beam_range_m" in arrays:
+        if "beam_range_m" in arrays and _altimeter(about["spec"]):
+            reading = altimeter_range(time_ns, frame, about["spec"], arrays["beam_range_m"][k][0])
+            yield f"/{name}/range", reading, time_ns
+        elif "beam_range_m" in arrays:
             scan = laser_scan(
                 time_ns, frame, about["spec"], arrays["bearing_rad"],
                 arrays["beam_range_m"][k], arrays["beam_intensity"][k],
             )  # fmt: skip
             yield f"/{name}/scan", scan, time_ns
+
+
+def _altimeter(spec: dict[str, Any]) -> bool:
+    """The sonar of ``spec`` (its record) is an altimeter: one reading, not a scan."""
+    return spec.get("type") == "altimeter"

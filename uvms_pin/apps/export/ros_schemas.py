@@ -198,6 +198,16 @@ _FIELDS: dict[str, str] = {
         'string filename\n'
         'uint8[] data\n'
     ),
+    "sensor_msgs/Range": (
+        'std_msgs/Header header\n'
+        'uint8 ULTRASOUND=0\n'
+        'uint8 INFRARED=1\n'
+        'uint8 radiation_type\n'
+        'float32 field_of_view\n'
+        'float32 min_range\n'
+        'float32 max_range\n'
+        'float32 range\n'
+    ),
 }
 # fmt: on
 
@@ -252,6 +262,10 @@ _USES: dict[str, tuple[str, ...]] = {
         "sensor_msgs/RegionOfInterest",
     ),
     "sensor_msgs/LaserScan": (
+        "std_msgs/Header",
+        "builtin_interfaces/Time",
+    ),
+    "sensor_msgs/Range": (
         "std_msgs/Header",
         "builtin_interfaces/Time",
     ),

@@ -7,7 +7,8 @@
   (port to the left, as a sonar display), on one dB scale (50 dB below the brightest echo);
 - a multibeam: its swath over the run, each beam's detected range (white: heard nothing)
   against time and bearing;
-- an altimeter: its echogram, the echo at each range over time [dB].
+- an altimeter: its echogram, the echo at each range over time [dB], its reading drawn on it,
+  the range axis up to twice the farthest reading.
 """
 
 from __future__ import annotations
@@ -110,6 +111,8 @@ def _sonar(fig: Figure, grid, row: int, rollout: RolloutData, name: str) -> list
     times = edges(record.time_s, period_s)
     bearings = edges(np.degrees(record.bearing_rad), 1.0)
     ranges = edges(record.range_m, 1.0)
+    if record.intensity.shape[2] == 1:  # an altimeter: its echogram and its reading
+        return [_echogram(fig, grid, row, name, record, times, ranges)]
     if record.beam_range_m is not None:  # a multibeam: its swath over the run
         ax = fig.add_subplot(grid[row, :SNAPSHOTS])
         swath = np.ma.masked_invalid(record.beam_range_m.T)
@@ -120,14 +123,6 @@ def _sonar(fig: Figure, grid, row: int, rollout: RolloutData, name: str) -> list
         fig.colorbar(image, cax=fig.add_subplot(grid[row, SNAPSHOTS]), label="range [m]")
         return [ax]
     db, low, high = decibels(record.intensity)
-    if record.intensity.shape[2] == 1:  # an altimeter: its echogram
-        ax = fig.add_subplot(grid[row, :SNAPSHOTS])
-        extent = [*times, *ranges]
-        image = ax.imshow(db[:, :, 0].T, origin="lower", aspect="auto", extent=extent,
-                          vmin=low, vmax=high, cmap="copper", interpolation="nearest")  # fmt: skip
-        ax.set(xlabel="time [s]", ylabel="range [m]", title=f"altimeter '{name}': echogram")
-        fig.colorbar(image, cax=fig.add_subplot(grid[row, SNAPSHOTS]), label="echo [dB]")
-        return [ax]
     # port (positive bearing) on the left, as a sonar display shows it
     extent = [bearings[1], bearings[0], *ranges]
     for column, k in enumerate(snapshot_rows(len(record.time_s))):
@@ -138,6 +133,23 @@ def _sonar(fig: Figure, grid, row: int, rollout: RolloutData, name: str) -> list
         ax.set_title(f"sonar '{name}', t = {record.time_s[k]:.2f} s", fontsize=8)
     fig.colorbar(image, cax=fig.add_subplot(grid[row, SNAPSHOTS]), label="echo [dB]")
     return []
+
+
+def _echogram(fig: Figure, grid, row: int, name: str, record, times, ranges):
+    """An altimeter's echogram (echo [dB] by range over time) with its reading, the range
+    axis up to twice its farthest reading (the water column beyond is empty)."""
+    ax = fig.add_subplot(grid[row, :SNAPSHOTS])
+    db, low, high = decibels(record.intensity)
+    image = ax.imshow(db[:, :, 0].T, origin="lower", aspect="auto", extent=[*times, *ranges],
+                      vmin=low, vmax=high, cmap="copper", interpolation="nearest")  # fmt: skip
+    reading = None if record.beam_range_m is None else record.beam_range_m[:, 0]
+    if reading is not None and np.any(np.isfinite(reading)):
+        ax.plot(record.time_s, reading, color="tab:cyan", lw=1.0, label="reading")
+        ax.legend(loc="upper right", fontsize=8)
+        ax.set_ylim(ranges[0], min(ranges[1], 2.0 * float(np.nanmax(reading))))
+    ax.set(xlabel="time [s]", ylabel="range [m]", title=f"altimeter '{name}': echogram")
+    fig.colorbar(image, cax=fig.add_subplot(grid[row, SNAPSHOTS]), label="echo [dB]")
+    return ax
 
 
 def perception_figures(rollout: RolloutData, directory: Path) -> list[Path]:
