@@ -183,6 +183,37 @@ def test_the_python_backend_integrates_the_robots_in_python(load_body):
     np.testing.assert_allclose(v, v_c, rtol=0.0, atol=1e-9)
 
 
+def test_the_second_robot_meets_each_free_object_as_itself(load_body):
+    """Two free balls in the first robot's world: the second robot has a pair with each
+    ball, each pair's second side that ball (not another side), and resting against the
+    second ball (1 cm deep) it is pushed by it alone, along the line from the ball."""
+    balls = [
+        undamped(
+            free_object(
+                name, "sphere", {"radius_m": 0.2}, (position, [0, 0, 0]),
+                density_kg_m3=RHO, water_density_kg_m3=RHO,
+            )
+        )
+        for name, position in (("ball", [0.0, 3.0, -5.0]), ("ball2", [0.0, 0.0, -5.0]))
+    ]  # fmt: skip
+    a, b = _sphere(load_body), _sphere(load_body, mass=6.0, radius=0.15)
+    law = ContactLaw(stiffness_N_m=2e4, dissipation_s_m=2.0)
+    first = System(Plant(a, world=World(a, [], law, balls), free_surface=False))
+    second = System(Plant(b, world=World(b, [], law), free_surface=False))
+    robots = Robots([first, second], ["a", "b"])
+    assert robots.contact_pair_names(1) == ["a/body|b/body", "b/body|ball", "b/body|ball2"]
+    q_a, q_b = a.neutral_configuration(), b.neutral_configuration()
+    q_a[:3], q_b[:3] = [5.0, 0.0, -5.0], [0.34, 0.0, -5.0]  # b 1 cm into ball2
+    state = robots.layout.join([first.initial_state(q_a, np.zeros(6)), (q_b, np.zeros(6))])
+    for system, part in zip(robots.systems, robots.split(*state), strict=True):
+        system.start(SystemState(*part))
+    robots.start(state)
+    q, v = robots.advance(RK4(5e-4), 0.0, tuple(state), [np.zeros(6)] * 2, 0.01)
+    (_, v_b), (_, v_ball), (_, v_ball2) = robots.sides(q, v)[1:]
+    assert v_b[0] > 1e-3 and abs(v_b[1]) < 1e-9 * v_b[0]  # pushed off ball2, along x
+    assert v_ball2[0] < 0.0 and np.all(v_ball == 0.0)  # ball2 pushed back, ball untouched
+
+
 def test_a_robot_pushes_a_free_object_into_another_robot_and_momentum_stays(load_body):
     """Robot b runs into a free ball that the first robot's system holds; the ball runs on
     into robot a: b's pairs with the ball are the robots' own, a's its system's; the total
