@@ -92,6 +92,35 @@ def test_stops_and_friction_match_finite_differences(uvms):
         assert max(errors) < FD_REL, errors
 
 
+def test_a_stop_pulled_away_from_does_not_act_and_a_lower_one_pushes_up(reference_uvms):
+    """Each stop's four cases against the finite differences: the first joint 0.03 rad past
+    its upper limit moving back faster than its spring pushes (k e + c e_dot < 0: the stop
+    lets go, no derivative), the second past its lower limit moving further out (pushing
+    up), the third past its lower limit moving back fast (letting go), the fourth inside."""
+    uvms, rng = reference_uvms, np.random.default_rng(54)
+    plant = _plant(uvms)
+    stops = plant.joint_stops
+    q, v, tau = _past_the_limits(uvms, rng)
+    k, c = stops.stiffness_Nm_rad, stops.damping_Nm_s_rad
+    cases = [(stops.upper_rad, 0.03, -2.0), (stops.lower_rad, -0.03, -0.2),
+             (stops.lower_rad, -0.03, 2.0)]  # fmt: skip
+    for j, (limit, past, rate_scale) in enumerate(cases):
+        q[stops.q_index[j]] = limit[j] + past
+        v[stops.v_index[j]] = rate_scale * k * abs(past) / c
+    q[stops.q_index[3]] = 0.5 * (stops.lower_rad[3] + stops.upper_rad[3])
+    by_q, by_v = joint_stop_jacobians(stops, q, v)
+    diagonal = np.diag(by_q)[stops.v_index[:4]]
+    np.testing.assert_array_equal(diagonal, [0.0, -k, 0.0, 0.0])
+    np.testing.assert_array_equal(np.diag(by_v)[stops.v_index[:4]], [0.0, -c, 0.0, 0.0])
+    got = plant.acceleration_derivatives(0.2, q, v, tau)
+    expected = _finite_differences(plant, q, v, tau)
+    errors = [_relative_error(g, e) for g, e in zip(got, expected, strict=True)]
+    assert max(errors) < FD_REL, errors
+    core = _plant(uvms, "core").acceleration_derivatives(0.2, q, v, tau)  # the same cases
+    for a, b in zip(core, got, strict=True):
+        np.testing.assert_allclose(a, b, rtol=0, atol=1e-10 * np.abs(b).max())
+
+
 def test_without_the_terms_the_derivatives_miss(uvms):
     """The stops' and the friction's terms are needed: the water's alone differ."""
     rng = np.random.default_rng(52)
