@@ -153,3 +153,28 @@ def test_an_identification_is_known_by_the_files_identify_writes(tmp_path):
     assert [p.name for p in IDENTIFICATION.present(tmp_path)] == [
         "bluerov2_heavy_identified.urdf", "identified_alt_002-0.png",
     ]  # fmt: skip
+
+
+def test_a_pool_validation_owns_the_figure_of_each_trial_its_record_lists(tmp_path):
+    """A pool validation's figures are named after its trials: the ones its
+    pool_validation.json lists are its own (an overwrite removes them), a file it does not
+    list is not, and a listed name that is a path (``../x``, ``a/b``) names nothing."""
+    import json
+
+    from uvms_pin.results.outdir import POOL_VALIDATION
+
+    out = tmp_path / "validation"
+    out.mkdir()
+    trials = {"alt_002-0": {}, "../outside": {}, "sub/trial": {}, 7: {}}
+    (out / "pool_validation.json").write_text(json.dumps({"trials": trials}))
+    for name in ("alt_002-0.png", "mine.png", "pool_validation.csv"):
+        (out / name).write_bytes(b"x")
+    (tmp_path / "outside.png").write_bytes(b"x")
+    (out / "sub").mkdir()
+    (out / "sub" / "trial.png").write_bytes(b"x")
+    assert POOL_VALIDATION.holds(out)
+    present = [p.relative_to(out).as_posix() for p in POOL_VALIDATION.present(out)]
+    assert present == ["alt_002-0.png", "pool_validation.csv", "pool_validation.json"]
+    (out / "pool_validation.json").write_text("not json")  # unreadable: the patterns alone
+    present = [p.name for p in POOL_VALIDATION.present(out)]
+    assert present == ["pool_validation.csv", "pool_validation.json"]
