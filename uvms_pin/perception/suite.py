@@ -199,15 +199,20 @@ def stack_of(shape: tuple[int, ...], dtype: np.dtype) -> np.ndarray:
 
 def _fire(sensor: Any, scene: Scene, log: SceneLog, rows: Sequence[int]) -> dict[str, np.ndarray]:
     """The sensor's arrays at each of ``rows``, stacked (`stack_of`): the first firing's
-    arrays give the stack's, each later one is written into its place (no copy of an
-    image)."""
+    arrays give the stack's; each later firing is written into those same arrays, warm in
+    the cache, then copied into its place in order (a camera writes its pixels tile by
+    tile: straight into memory not yet touched, a 320 x 240 image's firing cost 2.5 ms,
+    2.2 ms with the copy)."""
     stacked: dict[str, np.ndarray] = {}
+    warm: dict[str, np.ndarray] = {}
     for k, row in enumerate(rows):
         log.pose(scene, row)
         if k == 0:
-            for key, value in sensor.fire().items():
+            warm = sensor.fire()
+            for key, value in warm.items():
                 stacked[key] = stack_of((len(rows), *value.shape), value.dtype)
-                stacked[key][0] = value
         else:
-            sensor.fire({key: values[k] for key, values in stacked.items()})
+            sensor.fire(warm)
+        for key, values in stacked.items():
+            np.copyto(values[k], warm[key])
     return stacked
