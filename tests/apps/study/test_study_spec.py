@@ -37,6 +37,48 @@ def test_runs_are_the_grid_times_the_samples_with_derived_seeds(tmp_path):
         )
 
 
+ADDED_AND_SCALED = """
+[study]
+name = "combined"
+base = "scenario.toml"
+seed = 3
+samples = 1
+
+[[parameter]]
+path = "disturbance.amplitude"
+apply = "add"
+values = [0.05]
+
+[[parameter]]
+path = "disturbance.period_s"
+apply = "scale"
+values = [3.0]
+
+[[parameter]]
+path = "control.period_s"
+apply = "add"
+values = [0.003]
+
+[[parameter]]
+path = "environment.stiffness_N_m[1]"
+apply = "scale"
+values = [2.5]
+"""
+
+
+def test_add_and_scale_apply_to_numbers_and_to_each_entry_of_a_list(tmp_path):
+    """``apply = "add"`` adds the value to the base (a number, or each entry of a list),
+    ``"scale"`` multiplies it (a number, or one indexed entry): the base scenario's
+    amplitude [0.15, 0.15, 0.15, 0, 0, 0], period 7 s, control period 2 ms, stiffness
+    [2, 2, 2]."""
+    (run,) = load_study(write_study(tmp_path, ADDED_AND_SCALED, "combined.toml")).runs()
+    overrides = run.overrides
+    np.testing.assert_allclose(overrides["disturbance.amplitude"], [0.2] * 3 + [0.05] * 3)
+    assert overrides["disturbance.period_s"] == pytest.approx(21.0)
+    assert overrides["control.period_s"] == pytest.approx(0.005)
+    np.testing.assert_allclose(overrides["environment.stiffness_N_m"], [2.0, 5.0, 2.0])
+
+
 def test_draws_do_not_depend_on_other_parameters_or_the_sample_count(tmp_path):
     base = load_study(write_study(tmp_path)).runs()
     more = STUDY.replace("samples = 3", "samples = 5") + (
