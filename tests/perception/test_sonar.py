@@ -248,6 +248,29 @@ def test_beam_patterns_are_half_power_at_the_fov_edge_and_sinc_squared_across_be
     assert np.argmax(sonar.weight) == np.argmin(off_axis)
 
 
+@pytest.mark.parametrize("kind", ["imaging", "altimeter"])
+def test_the_rays_fill_the_fan_symmetrically_about_the_acoustic_axis(reference_uvms, kind):
+    """A fan's rays sit at the centres of n equal slices of its vertical field of view
+    (+-(1 - 1/n) of its half, symmetric: their mean elevation 0); an altimeter's grid of n
+    x n at the centres of its cone's slices, symmetric in bearing and elevation: their mean
+    direction the acoustic axis x."""
+    n, half = 8, 0.2
+    fov = {"vertical_fov_rad": 2 * half} if kind == "imaging" else {"horizontal_fov_rad": 2 * half}
+    beams = 4 if kind == "imaging" else 1
+    spec = SonarSpec("s", type=kind, beams=beams, bins=16, rays_per_beam=n, **fov)
+    wall = plane("wall", [5.0, 0.0, -20.0], [-1.0, 0.0, 0.0], 0.5, 0.4)
+    sonar = Sonar(spec, _scene(reference_uvms, [wall]), np.random.default_rng(0))
+    elevation = np.arcsin(sonar.rays[:, 2])
+    centres = half * ((np.arange(n) + 0.5) / n * 2.0 - 1.0)
+    np.testing.assert_allclose(np.unique(elevation.round(12)), centres, rtol=0, atol=1e-12)
+    assert elevation.mean() == pytest.approx(0.0, abs=1e-15)
+    if kind == "altimeter":
+        bearing = np.arctan2(sonar.rays[:, 1], sonar.rays[:, 0])
+        np.testing.assert_allclose(np.unique(bearing.round(12)), centres, rtol=0, atol=1e-12)
+        mean = sonar.rays.mean(axis=0)
+        np.testing.assert_allclose(mean / np.linalg.norm(mean), [1.0, 0.0, 0.0], atol=1e-15)
+
+
 def test_a_firing_is_written_into_the_arrays_given(reference_uvms):
     """`Sonar.fire(out)`: the run's stack of images written into, the same values."""
     expected = _multibeam(reference_uvms, 3.0).fire()
