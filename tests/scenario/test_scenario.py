@@ -150,3 +150,28 @@ def test_the_recorded_settings_are_the_simulated_ones(tmp_path):
     np.testing.assert_allclose(rollout.time_s, np.arange(6) * 0.02, atol=1e-12)
     assert rollout.metadata["simulated_time_s"] == pytest.approx(0.1)
     assert rollout.metadata["integrator_settings"]["step_s"] == 0.005
+
+
+def test_the_environment_table_builds_its_contact_model_with_its_defaults():
+    """``[environment]``: a plane with every key (its normal normalised), a plane with its
+    defaults (the normal -x, no damping, the surface through the tip at t = 0), a spring
+    anchored where the table says or (by default) at the tip."""
+    from uvms_pin.physics.contact import CompliantPlane, LinearSpring
+
+    path = ROOT / "scenarios" / "realistic_force_tracking.toml"
+    plane = {"environment.type": "plane", "environment.stiffness_N_m": 400.0,
+             "environment.normal_world": [0.0, 3.0, 4.0], "environment.damping_N_s_m": 2.5,
+             "environment.anchor_world_m": [1.0, 2.0, -3.0]}  # fmt: skip
+    contact = load_scenario(path, plane).plant.contact
+    assert isinstance(contact, CompliantPlane)
+    np.testing.assert_allclose(contact.normal_world, [0.0, 0.6, 0.8], rtol=0, atol=1e-15)
+    assert (contact.stiffness_N_m, contact.damping_N_s_m) == (400.0, 2.5)
+    np.testing.assert_array_equal(contact.point_world_m, [1.0, 2.0, -3.0])
+    bare = {"environment.type": "plane", "environment.stiffness_N_m": 400.0}
+    contact = load_scenario(path, bare).plant.contact
+    np.testing.assert_array_equal(contact.normal_world, [-1.0, 0.0, 0.0])
+    assert contact.damping_N_s_m == 0.0 and contact.point_world_m is None  # set at t = 0
+    spring = {"environment.anchor_world_m": [0.5, -0.5, -2.0]}
+    contact = load_scenario(path, spring).plant.contact
+    assert isinstance(contact, LinearSpring)
+    np.testing.assert_array_equal(contact.anchor_world_m, [0.5, -0.5, -2.0])
