@@ -72,3 +72,22 @@ def test_a_non_finite_parameter_is_refused_by_name_before_the_run(name, prefix, 
         return
     with pytest.raises((ParameterError, ScenarioError), match=f"{key} must be"):
         up.simulate(up.load_scenario(path, overrides=overrides), progress=False)
+
+
+def test_a_baselines_table_must_name_another_built_in_baseline_or_give_its_type(tmp_path):
+    """[baselines.<name>] tunes a baseline compare-controllers runs beside the scenario's
+    controller: a misspelt name (``impedence``) and the scenario's own controller type
+    (``ppc``) are refused naming the table, before any run; a table with its own ``type``
+    is a named variant of any name."""
+    from uvms_pin.scenario.load import load_scenario
+
+    text = (SCENARIOS / "realistic_force_tracking.toml").read_text()
+    text = text.replace('"../models/', f'"{SCENARIOS.parent}/models/')
+    for name in ("impedence", "ppc"):
+        path = tmp_path / f"{name}.toml"
+        path.write_text(text + f"\n[baselines.{name}]\ndamping = 3.0\n")
+        with pytest.raises(ScenarioError, match=rf"\[baselines\.{name}\]: a baseline is one of"):
+            load_scenario(path)
+    variant = tmp_path / "variant.toml"
+    variant.write_text(text + '\n[baselines.soft_impedance]\ntype = "impedance"\n')
+    assert load_scenario(variant).controller_factory is not None
