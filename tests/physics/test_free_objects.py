@@ -243,3 +243,16 @@ def test_a_free_mesh_has_its_volume_mass_and_a_positive_inertia():
     inertia = rock.uvms.model.inertias[1].inertia
     assert np.all(np.linalg.eigvalsh(inertia) > 0.0)
     assert len(rock.pieces) == 1  # its hull collides
+    # without a scale the file's own size; scaled by 2 on every axis: 8 times the volume
+    # and mass, 32 times the inertia (m r^2)
+    import trimesh
+
+    path = ROOT / "scenarios" / "meshes" / "rock.obj"
+    assert body.params.volume_m3 == pytest.approx(abs(trimesh.load(path).volume), rel=1e-9)
+    big = free_object(
+        "rock", "mesh", {"path": path, "scale": [2.0, 2.0, 2.0]},
+        ([0, 0, -5], [0, 0, 0]), density_kg_m3=2600.0, water_density_kg_m3=RHO,
+    )  # fmt: skip
+    assert big.mass_kg == pytest.approx(8.0 * rock.mass_kg, rel=1e-9)
+    assert big.uvms.hydro_bodies[0].params.volume_m3 == pytest.approx(8.0 * body.params.volume_m3)
+    np.testing.assert_allclose(big.uvms.model.inertias[1].inertia, 32.0 * inertia, rtol=1e-9)
