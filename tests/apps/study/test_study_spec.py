@@ -37,33 +37,20 @@ def test_runs_are_the_grid_times_the_samples_with_derived_seeds(tmp_path):
         )
 
 
-ADDED_AND_SCALED = """
-[study]
-name = "combined"
-base = "scenario.toml"
-seed = 3
-samples = 1
-
-[[parameter]]
-path = "disturbance.amplitude"
-apply = "add"
-values = [0.05]
-
-[[parameter]]
-path = "disturbance.period_s"
-apply = "scale"
-values = [3.0]
-
-[[parameter]]
-path = "control.period_s"
-apply = "add"
-values = [0.003]
-
-[[parameter]]
-path = "environment.stiffness_N_m[1]"
-apply = "scale"
-values = [2.5]
-"""
+#: (path, apply, value) of each parameter of the study below
+COMBINED = (
+    ("disturbance.amplitude", "add", 0.05),
+    ("disturbance.period_s", "scale", 3.0),
+    ("control.period_s", "add", 0.003),
+    ("environment.stiffness_N_m[1]", "scale", 2.5),
+)
+ADDED_AND_SCALED = (
+    '[study]\nname = "combined"\nbase = "scenario.toml"\nseed = 3\nsamples = 1\n'
+    + "".join(
+        f'\n[[parameter]]\npath = "{path}"\napply = "{apply}"\nvalues = [{value!r}]\n'
+        for path, apply, value in COMBINED
+    )
+)
 
 
 def test_add_and_scale_apply_to_numbers_and_to_each_entry_of_a_list(tmp_path):
