@@ -201,8 +201,8 @@ def _fire(sensor: Any, scene: Scene, log: SceneLog, rows: Sequence[int]) -> dict
     """The sensor's arrays at each of ``rows``, stacked (`stack_of`): the first firing's
     arrays give the stack's; each later firing is written into those same arrays, warm in
     the cache, then copied into its place in order (a camera writes its pixels tile by
-    tile: straight into memory not yet touched, a 320 x 240 image's firing cost 2.5 ms,
-    2.2 ms with the copy)."""
+    tile, which straight into memory not yet touched cost more than the copy:
+    `benchmarks/bench_perception.py`'s camera run 1.82-1.84x -> 1.72-1.73x)."""
     stacked: dict[str, np.ndarray] = {}
     warm: dict[str, np.ndarray] = {}
     for k, row in enumerate(rows):
