@@ -355,10 +355,14 @@ def test_input_matrix_chains_the_thrusters_into_the_step(reference_uvms):
         up.input_matrix([], uvms.nv)
 
 
-def test_step_derivatives_refuse_a_bad_period(reference_uvms):
+@pytest.mark.parametrize("bad", [0.0, -0.1, math.inf, math.nan])
+@pytest.mark.parametrize("backend", ["core", "python"])
+def test_step_derivatives_refuse_a_bad_period(reference_uvms, bad, backend):
+    """A period or a step that is not positive and finite is named (a negative one would
+    otherwise run one substep backwards in time)."""
     q = reference_uvms.neutral_configuration()
     zero = np.zeros(reference_uvms.nv)
-    with pytest.raises(ParameterError, match="period_s"):
-        up.step_derivatives(reference_uvms, q, zero, zero, 0.0)
-    with pytest.raises(ParameterError, match="step_s"):
-        up.step_derivatives(reference_uvms, q, zero, zero, 0.1, step_s=-1.0)
+    with pytest.raises(ParameterError, match="period_s must be positive and finite"):
+        up.step_derivatives(reference_uvms, q, zero, zero, bad, backend=backend)
+    with pytest.raises(ParameterError, match="step_s must be positive and finite"):
+        up.step_derivatives(reference_uvms, q, zero, zero, 0.1, step_s=bad, backend=backend)
