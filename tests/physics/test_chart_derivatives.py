@@ -84,3 +84,34 @@ def test_a_joint_without_a_known_chart_is_refused():
     model.addJoint(0, pin.JointModelPlanar(), pin.SE3.Identity(), "sled")
     with pytest.raises(ParameterError, match="'sled' is JointModelPlanar"):
         ChartBlocks.of(model)
+
+
+def _bernoulli_even(count: int) -> list:
+    """B_2, B_4, ..., B_2count as exact fractions, from the Akiyama-Tanigawa algorithm (an
+    independent derivation of the numbers the chart's series is written in)."""
+    from fractions import Fraction
+
+    row, numbers = [], []
+    for m in range(2 * count + 1):
+        row.append(Fraction(1, m + 1))
+        for j in range(m, 0, -1):
+            row[j - 1] = j * (row[j - 1] - row[j])
+        numbers.append(row[0])
+    return [numbers[2 * k] for k in range(1, count + 1)]
+
+
+def test_the_series_coefficients_are_the_bernoulli_numbers():
+    """Each b_k of the series below 1 rad is |B_2k| / (2k)! (its last terms are far below
+    any rounding at 1 rad: only the table itself can show a wrong one)."""
+    expected = [abs(b) / math.factorial(2 * k) for k, b in enumerate(_bernoulli_even(10), 1)]
+    assert [abs(b) for b in chart._BERNOULLI_2K] == [abs(b) for b in _bernoulli_even(10)]
+    assert chart._B == tuple(float(b) for b in expected)
+
+
+@pytest.mark.parametrize("theta", [0.3, 0.999])
+def test_the_series_meets_the_closed_form_at_its_threshold(theta):
+    """beta = (1 - gamma) / theta^2 from the series (below 1 rad) and from the closed form
+    agree to rounding just below the threshold."""
+    (_, _, series), _ = chart.so3_coefficients(theta)
+    closed = chart._gamma_derivatives(theta)[0] / theta**2
+    assert series == pytest.approx(closed, rel=1e-14)
