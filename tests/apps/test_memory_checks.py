@@ -166,7 +166,8 @@ def test_a_batch_estimate_counts_environments_and_threads(monkeypatch):
     from uvms_pin.sim.batched_plant import THREAD_BYTES, batch_bytes, check_batch_fits
 
     one = batch_bytes(100, 11, 10, 1, 1)
-    assert batch_bytes(100, 11, 10, 4, 2) == 4 * (one - THREAD_BYTES) + 2 * THREAD_BYTES
+    per_env = batch_bytes(100, 11, 10, 2, 1) - one  # a reset's share counted once a batch
+    assert batch_bytes(100, 11, 10, 4, 2) == one + 3 * per_env + THREAD_BYTES
     assert batch_bytes(100, 11, 10, 2, 10**18) == batch_bytes(100, 11, 10, 2, 2)
     _available(monkeypatch, 2 * batch_bytes(100, 11, 10, 8, 2))
     check_batch_fits(100, 11, 10, 8, 2)

@@ -4,6 +4,11 @@ the number of threads."""
 
 from __future__ import annotations
 
+import json
+import subprocess
+import sys
+from pathlib import Path
+
 import numpy as np
 import pytest
 
@@ -159,3 +164,44 @@ def test_bad_arguments_are_clear_errors():
         batch.step(np.full((2, scenario.uvms.nv), np.inf))
     with pytest.raises(ParameterError, match="q0"):
         batch.reset(0, np.zeros(3), scenario.v0, 0)
+
+
+_PEAK_SCRIPT = """
+import json, sys
+from uvms_pin.apps.gym.env import scenario_path
+from uvms_pin.scenario.load import load_scenario
+from uvms_pin.sim.batched_plant import BatchedPlant, batch_bytes
+
+def status(key):
+    with open("/proc/self/status") as f:
+        return next(int(line.split()[1]) * 1024 for line in f if line.startswith(key))
+
+envs, seconds = int(sys.argv[1]), float(sys.argv[2])
+overrides = {**json.loads(sys.argv[3]), "scenario.duration_s": seconds}
+scenario = load_scenario(scenario_path("gym_station_keeping"), overrides)
+with open("/proc/self/clear_refs", "w") as f:
+    f.write("5")  # the peak resident memory starts again from what is resident now
+start = status("VmRSS")
+batch = BatchedPlant(scenario.plant, scenario.settings, scenario.sensor_config, envs, 1)
+for i in range(envs):
+    batch.reset(i, scenario.q0, scenario.v0, i)
+uvms = scenario.uvms
+print(status("VmHWM") - start, batch_bytes(batch._rows, uvms.nq, uvms.nv, envs, 1))
+"""
+
+
+@pytest.mark.skipif(not Path("/proc/self/clear_refs").exists(), reason="Linux's peak memory")
+@pytest.mark.parametrize(("envs", "seconds"), [(4, 500.0), (1, 200.0), (32, 50.0)])
+def test_the_memory_estimate_bounds_what_a_batch_takes_at_its_peak(envs, seconds):
+    """A batch with every noise channel drawn (its tables the most of its memory), built and
+    every environment reset in a fresh process: its peak resident memory grows by no more
+    than `batch_bytes` says, and by more than two thirds of it (an estimate far above
+    would refuse batches that fit)."""
+    noisy = {**NOISY_STATE, "sensors.force_noise_N": 0.1}
+    done = subprocess.run(
+        [sys.executable, "-c", _PEAK_SCRIPT, str(envs), str(seconds), json.dumps(noisy)],
+        capture_output=True, text=True, check=True,
+    )  # fmt: skip
+    grown, estimate = (int(x) for x in done.stdout.split())
+    assert grown <= estimate
+    assert grown > 2 / 3 * estimate
