@@ -113,18 +113,27 @@ def test_a_cylinder_on_a_plane_touches_by_its_rims_lowest_points_and_a_sphere_by
             np.testing.assert_allclose(c.point_world_m, obj.q0[:3] - [0, 0, 0.1], atol=1e-9)
 
 
-def test_a_box_on_rigid_contacts_rests_on_its_net_weight_without_sinking(load_body):
+@pytest.mark.parametrize("compiled", [False, True], ids=["python", "compiled"])
+def test_a_box_on_rigid_contacts_rests_on_its_net_weight_without_sinking(load_body, compiled):
+    """At rest on its four corners, on the Python reference and in the compiled system: it
+    neither sinks nor lifts, its contacts' mean forces (the solved impulses over the period,
+    world axes) add up to its net weight, straight up, each along its corner's normal."""
     floor = plane("seafloor", [0.0, 0.0, -10.0], [0.0, 0.0, 1.0], 0.6, 0.5)
     box = _object("box", {"size_m": [0.2, 0.3, 0.1]}, [0.0, 0.0, -9.95])
     world = World(_pusher(load_body), [floor], ContactLaw(), [box])
     system = System(Plant(world.uvms, world=world, free_surface=False))
-    states = _run(system, 250, compiled=False)
+    states = _run(system, 250, compiled=compiled)
     robot = system.plant.uvms
     z = states[:, robot.nq + 2]
     assert np.max(np.abs(z + 9.95)) < 1e-9  # neither sinks nor lifts
-    (forces,) = system.moving.moving.rigid_forces
+    q, v = states[-1][:14], states[-1][14:]  # the robot's and the box's (7 + 7, 6 + 6)
+    (forces,) = system.moving.found(q[:7], v[:6], [(q[7:], v[6:])])[1]
     weight = -box.uvms.net_buoyancy_N
+    assert len(forces.touch) == 4
     assert forces.normal_N.sum() == pytest.approx(weight, rel=1e-6)
+    total = forces.force_world_N.sum(axis=0)
+    np.testing.assert_allclose(total, [0.0, 0.0, weight], rtol=1e-6, atol=1e-6 * weight)
+    np.testing.assert_allclose(forces.force_world_N[:, 2], forces.normal_N, rtol=1e-9)
     assert np.all(forces.sticking)
 
 
