@@ -89,3 +89,16 @@ def test_jaw_joints_by_name_and_bad_names(uvms):
 def test_a_model_without_jaw_has_none():
     uvms = up.load_uvms(MODELS / "uvms_bluerov2_alpha5.urdf")
     assert JawJoints.of(uvms.model).count == 0
+
+
+def test_a_continuous_jaw_joint_is_refused():
+    """A continuous joint (one degree of freedom, but cos and sin in q: nq = 2) turns without
+    an open and a closed end: refused as a jaw joint by its kind, before its limits."""
+    text = JAWS.read_text().replace(
+        f'<joint name="{FINGERS[0]}" type="revolute">',
+        f'<joint name="{FINGERS[0]}" type="continuous">',
+    )
+    model = pin.buildModelFromXML(text, pin.JointModelFreeFlyer())
+    assert model.joints[model.getJointId(FINGERS[0])].nq == 2
+    with pytest.raises(ModelError, match=f"jaw joint '{FINGERS[0]}' .* must be revolute or"):
+        JawJoints.of(model, [FINGERS[0]])
