@@ -64,6 +64,12 @@ def test_batch_in_waves_at_one_time_per_state_under_the_surface(reference_uvms):
     for got, want in zip(batch, single, strict=True):
         np.testing.assert_array_equal(got, want)
 
+    # without a time, every state is taken at t = 0, as a single call's default
+    at_zero = up.forward_dynamics_derivatives_batch(uvms, q, v, tau, num_threads=2, **kw)
+    single = _single(uvms, q, v, tau, **kw)
+    for got, want in zip(at_zero, single, strict=True):
+        np.testing.assert_array_equal(got, want)
+
 
 def test_python_reference_batch_agrees_with_the_core(reference_uvms):
     uvms = reference_uvms
