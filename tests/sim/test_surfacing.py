@@ -4,6 +4,7 @@ water falls, the stop at the surface is an option, and the run reports time out 
 from __future__ import annotations
 
 import numpy as np
+import pinocchio as pin
 import pytest
 from conftest import ROOT
 
@@ -57,7 +58,19 @@ def test_stop_at_surface_ends_the_run_when_a_centre_of_buoyancy_reaches_it():
     assert not scenario.plant.free_surface  # the submerged model unless asked for
     with pytest.raises(up.SimulationError, match="reached the free surface") as info:
         simulate(scenario)
-    assert 5.0 < info.value.rollout.time_s[-1] < 30.0
+    rollout = info.value.rollout
+    assert 5.0 < rollout.time_s[-1] < 30.0
+    # it stops at the surface (z = 0), not beyond: the last logged sample (at most a log
+    # period before the stop, rising at a few cm/s) has every centre of buoyancy just below
+    model, data = scenario.uvms.model, scenario.uvms.model.createData()
+    pin.forwardKinematics(model, data, rollout.q[-1])
+    highest = max(
+        data.oMi[b.joint_id].act(b.placement_in_joint.act(b.params.center_of_buoyancy_m))[2]
+        for b in scenario.uvms.hydro_bodies
+        if b.params.volume_m3 > 0.0
+    )
+    assert -0.01 < highest <= 0.0
+    assert "m above the surface (eta = 0 m)" in str(info.value)
 
 
 def test_a_vehicle_above_the_water_falls_under_gravity_alone():

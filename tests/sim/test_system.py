@@ -203,3 +203,22 @@ def test_the_columns_a_run_is_sized_for_are_the_columns_it_logs(name):
     widths = {k: v.reshape(len(v), -1).shape[1] for k, v in rollout.signals.items() if k in world}
     assert widths, f"{name} logs nothing of its world"
     assert system.log.n_columns == sum(widths.values()), widths
+
+
+def test_the_initial_state_normalises_the_quaternion_alone_and_copies(reference_uvms):
+    """A start whose quaternion is not of unit norm is normalised; the position, the joints
+    and the velocity stay as given, and the caller's arrays are not changed."""
+    system = System(Plant(reference_uvms))
+    q0 = reference_uvms.neutral_configuration()
+    q0[:3] = [0.5, -0.2, -3.0]
+    q0[3:7] = 2.0 * np.array([0.0, 0.0, 0.6, 0.8])
+    q0[7:] = np.linspace(0.3, -0.2, reference_uvms.nq - 7)
+    v0 = np.linspace(-0.1, 0.1, reference_uvms.nv)
+    given = (q0.copy(), v0.copy())
+    state = system.initial_state(q0, v0)
+    np.testing.assert_allclose(state.q[3:7], [0.0, 0.0, 0.6, 0.8], rtol=1e-15)
+    np.testing.assert_array_equal(state.q[:3], given[0][:3])
+    np.testing.assert_array_equal(state.q[7:], given[0][7:])
+    np.testing.assert_array_equal(state.v, given[1])
+    np.testing.assert_array_equal(q0, given[0])
+    np.testing.assert_array_equal(v0, given[1])
