@@ -117,3 +117,24 @@ def test_a_stopped_runs_figure_says_where_it_stopped(survey):
         stops = [line for line in ax.get_lines() if np.all(np.asarray(line.get_xdata()) == 0.45)]
         over_time = ax.get_xlabel() == "time [s]"
         assert bool(stops) == over_time, ax.get_title()
+
+
+def test_a_camera_that_sees_only_water_says_so():
+    """Looking down in open water from 2 m ahead of the vehicle (no seabed, no object, the
+    arm behind), the depth panels would be blank: each says "nothing in view"."""
+    scenario = load_scenario(
+        ROOT / "scenarios" / "passive_still_water.toml",
+        {"scenario.duration_s": 0.3, "sensors.camera": [{"name": "up", "width": 32,
+         "height": 24, "rpy_rad": [3.1416, 0.0, 0.0], "position_m": [2.0, 0.0, 0.0], "horizontal_fov_rad": 0.3}]},
+    )  # fmt: skip
+    rollout = simulate(scenario, progress=False)
+    assert np.all(np.isnan(rollout.camera("up").depth_m))
+    fig = plot_perception(rollout)
+    depths = [ax for ax in fig.axes if ax.get_title() == "z-depth"]
+    assert depths and all([t.get_text() for t in ax.texts] == ["nothing in view"] for ax in depths)
+
+
+def test_a_depth_panel_with_something_in_view_has_no_note(survey):
+    fig = plot_perception(survey)
+    depths = [ax for ax in fig.axes if ax.get_title() == "z-depth"]
+    assert depths and not any(ax.texts for ax in depths)

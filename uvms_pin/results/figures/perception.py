@@ -101,6 +101,9 @@ def _camera(fig: Figure, grid, row: int, rollout: RolloutData, name: str) -> Non
         image = ax.imshow(np.ma.masked_invalid(depth[column]), vmin=low, vmax=high, cmap="viridis")
         ax.set_title("z-depth", fontsize=8)
         ax.axis("off")
+        if not np.any(np.isfinite(depth[column])):  # open water: not a blank to puzzle over
+            ax.text(0.5, 0.5, "nothing in view", ha="center", va="center",
+                    transform=ax.transAxes, fontsize=8, color="0.4")  # fmt: skip
     fig.colorbar(image, cax=fig.add_subplot(grid[row + 1, SNAPSHOTS]), label="z-depth [m]")
 
 
