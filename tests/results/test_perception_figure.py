@@ -122,19 +122,33 @@ def test_a_stopped_runs_figure_says_where_it_stopped(survey):
 def test_a_camera_that_sees_only_water_says_so():
     """Looking down in open water from 2 m ahead of the vehicle (no seabed, no object, the
     arm behind), the depth panels would be blank: each says "nothing in view"."""
-    scenario = load_scenario(
-        ROOT / "scenarios" / "passive_still_water.toml",
-        {"scenario.duration_s": 0.3, "sensors.camera": [{"name": "up", "width": 32,
-         "height": 24, "rpy_rad": [3.1416, 0.0, 0.0], "position_m": [2.0, 0.0, 0.0], "horizontal_fov_rad": 0.3}]},
-    )  # fmt: skip
-    rollout = simulate(scenario, progress=False)
-    assert np.all(np.isnan(rollout.camera("up").depth_m))
+    down = {"name": "down", "width": 32, "height": 24, "horizontal_fov_rad": 0.3,
+            "rpy_rad": [3.1416, 0.0, 0.0], "position_m": [2.0, 0.0, 0.0]}  # fmt: skip
+    rollout = _open_water({"sensors.camera": [down]})
+    assert np.all(np.isnan(rollout.camera("down").depth_m))
     fig = plot_perception(rollout)
     depths = [ax for ax in fig.axes if ax.get_title() == "z-depth"]
     assert depths and all([t.get_text() for t in ax.texts] == ["nothing in view"] for ax in depths)
 
 
-def test_a_depth_panel_with_something_in_view_has_no_note(survey):
+def test_an_altimeter_that_hears_nothing_says_so():
+    """An altimeter with nothing within its range (open water) draws an empty echogram and
+    says so."""
+    rollout = _open_water({"sensors.sonar": [ALTIMETER]})
+    assert not np.any(rollout.sonar("alt").intensity)
+    (ax,) = [a for a in plot_perception(rollout).axes if a.get_title().startswith("altimeter")]
+    assert len(ax.texts) == 1 and ax.texts[0].get_text().startswith("no echo within 12")
+
+
+def _open_water(sensors: dict):
+    """passive_still_water (no seabed, no object) for 0.3 s with ``sensors``."""
+    path = ROOT / "scenarios" / "passive_still_water.toml"
+    return simulate(load_scenario(path, {"scenario.duration_s": 0.3, **sensors}), progress=False)
+
+
+def test_panels_with_something_in_view_have_no_note(survey):
     fig = plot_perception(survey)
     depths = [ax for ax in fig.axes if ax.get_title() == "z-depth"]
     assert depths and not any(ax.texts for ax in depths)
+    (echogram,) = [ax for ax in fig.axes if ax.get_title().startswith("altimeter")]
+    assert not echogram.texts

@@ -150,6 +150,9 @@ def _echogram(fig: Figure, grid, row: int, name: str, record, times, ranges):
         ax.plot(record.time_s, reading, color="tab:cyan", lw=1.0, label="reading")
         ax.legend(loc="upper right", fontsize=8)
         ax.set_ylim(ranges[0], min(ranges[1], 2.0 * float(np.nanmax(reading))))
+    elif not np.any(record.intensity):  # nothing within its range: not a black puzzle
+        ax.text(0.5, 0.5, f"no echo within {ranges[1]:.3g} m", ha="center", va="center",
+                transform=ax.transAxes, fontsize=9, color="0.7")  # fmt: skip
     ax.set(xlabel="time [s]", ylabel="range [m]", title=f"altimeter '{name}': echogram")
     fig.colorbar(image, cax=fig.add_subplot(grid[row, SNAPSHOTS]), label="echo [dB]")
     return ax
