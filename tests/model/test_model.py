@@ -411,6 +411,27 @@ def test_a_buoyancy_link_fixed_to_a_mass_link_is_one_body_and_no_surprise(write_
         up.load_uvms(path, ee_frame="body", sensor_frame="body")
 
 
+def test_a_link_without_mass_or_volume_is_no_mismatch(write_urdf):
+    """A link that neither weighs nor displaces (a frame carrier with a zero-volume
+    <hydrodynamics>, say) has nothing to mismatch: no warning."""
+    empty = (
+        '<inertial><mass value="0"/>'
+        '<inertia ixx="0" iyy="0" izz="0" ixy="0" ixz="0" iyz="0"/></inertial>'
+        f"<hydrodynamics>{hydro_xml(0.0)}</hydrodynamics>"
+    )
+    path = write_urdf(
+        _robot(
+            _link("body", INERTIAL + f"<hydrodynamics>{GOOD_HYDRO}</hydrodynamics>"),
+            _link("fin", empty),
+            '<joint name="hinge" type="revolute"><parent link="body"/><child link="fin"/>'
+            '<axis xyz="0 0 1"/><limit lower="-1" upper="1" effort="1" velocity="1"/></joint>',
+        )
+    )
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", up.ModelWarning)
+        up.load_uvms(path, ee_frame="body", sensor_frame="body")
+
+
 def test_reference_model_loads_without_warnings(recwarn):
     up.load_uvms(REFERENCE_URDF)
     assert not [w for w in recwarn if issubclass(w.category, up.UvmsPinWarning)]
