@@ -135,3 +135,17 @@ def test_an_inertia_entry_that_is_no_number_is_refused_by_name(tmp_path, balance
     source = _source(tmp_path, REXROV.read_text().replace('ixz="33.41"', 'ixz="nan"', 1))
     with pytest.raises(ModelError, match="ixz"):
         import_model(source, balance_inertia=balance)
+
+
+@pytest.mark.parametrize(("origin", "cp"), [(None, (0.0, 0.0, 0.0)),
+                                             ('<origin xyz="0.05 0 -0.02"/>', (0.05, 0.0, -0.02)),
+                                             ("<origin/>", (0.0, 0.0, 0.0))])  # fmt: skip
+def test_a_uuv_fins_centre_of_pressure_is_its_links_centre_of_mass(tmp_path, origin, cp):
+    """uuv_simulator's fin plugin applies its lift at the link's centre of mass (its
+    inertial origin; the link's origin when there is none, or it has no xyz)."""
+    fin = FIN if origin is None else FIN.replace("<inertial>", f"<inertial>{origin}", 1)
+    source = _source(tmp_path, REXROV.read_text().replace("</robot>", fin, 1))
+    out = tmp_path / "out.urdf"
+    import_model(source, out)
+    (loaded,) = load_uvms(out, water_density_kg_m3=1028.0, allow_dry_links=True).fins
+    np.testing.assert_array_equal(loaded.params.cp_m, cp)

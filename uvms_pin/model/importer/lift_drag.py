@@ -43,15 +43,14 @@ _NUMBER_TAGS = {
 _CONTROL = {"control_joint_name", "control_joint_rad_to_cl", "cm_delta"}
 
 
-def add_fins(robot: ET.Element, plugins: list[ET.Element], where: str, notes: list[str]) -> int:
+def add_fins(robot: ET.Element, plugins: list[ET.Element], where: str, notes: list[str]) -> None:
     """A ``<lift_drag>`` in the link of each LiftDrag plugin and each uuv_simulator fin of
-    the TwoLines model; the number of fins added."""
+    the TwoLines model."""
     links = {link.get("name"): link for link in robot.findall("link")}
     moving = {j.get("name") for j in robot.findall("joint") if j.get("type") != "fixed"}
-    count = 0
     for plugin in plugins:
         if plugin_kind(plugin) is PluginKind.UUV_FIN:
-            count += _uuv_fin(plugin, links, where, notes)
+            _uuv_fin(plugin, links, where, notes)
             continue
         if plugin_kind(plugin) is not PluginKind.GZ_LIFT_DRAG:
             continue
@@ -63,8 +62,6 @@ def add_fins(robot: ET.Element, plugins: list[ET.Element], where: str, notes: li
                 path=where,
             )
         links[name].append(_element(plugin, moving, where, name, notes))
-        count += 1
-    return count
 
 
 def _element(
@@ -112,15 +109,15 @@ _UUV_NUMBERS = {
 }  # fmt: skip
 
 
-def _uuv_fin(plugin: ET.Element, links: dict[str, ET.Element], where: str, notes: list[str]) -> int:
-    """uuv_simulator's fin ``plugin`` as a ``<lift_drag>`` in its link (1), or a note (0)."""
+def _uuv_fin(plugin: ET.Element, links: dict[str, ET.Element], where: str, notes: list[str]) -> None:
+    """uuv_simulator's fin ``plugin`` as a ``<lift_drag>`` in its link, or a note."""
     name = child_text(plugin, "link_name")
     model = plugin.find("liftdrag")
     kind = None if model is None else child_text(model, "type")
     if name not in links or model is None or kind != "TwoLines":
         why = "no link of the model" if name not in links else f"<liftdrag> type {kind!r}"
         notes.append(f"fin plugin '{plugin.get('name')}': {why}; its lift and drag not mapped")
-        return 0
+        return
     out = ET.Element("lift_drag")
     for tag, ours in _UUV_NUMBERS.items():
         element = model.find(tag)
@@ -142,4 +139,3 @@ def _uuv_fin(plugin: ET.Element, links: dict[str, ET.Element], where: str, notes
         "model: coefficients scaled by cos^2 of the sweep, none below 0.01 m/s, beyond the "
         "negative stall the lift's slope and |c_D|, where uuv differs)"
     )
-    return 1
