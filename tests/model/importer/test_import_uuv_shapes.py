@@ -130,12 +130,15 @@ def test_a_cylinders_wrench_is_the_plugins_for_random_velocities(tmp_path, axis)
 @pytest.mark.parametrize(
     ("ratio", "circular", "lengthwise"),
     [(0.5, 0.91, 0.63), (1.5, 0.85, 0.68), (3.0, 0.87, 0.74), (4.5, 0.99, 0.74), (6.0, 0.99, 0.82),
-     (20.0, 0.99, 0.98), (50.0, 0.99, 0.98)],
+     (20.0, 0.99, 0.98), (50.0, 0.99, 0.98),
+     # each bound itself: the plugin's bands include their upper bound (dimRatio <= 2, ...)
+     (1.0, 0.91, 0.63), (2.0, 0.85, 0.68), (4.0, 0.87, 0.74), (5.0, 0.99, 0.74),
+     (10.0, 0.99, 0.82), (12.0, 0.99, 0.98)],
 )  # fmt: skip
 def test_the_cylinders_drag_coefficients_are_the_plugins_table(
     tmp_path, ratio, circular, lengthwise
 ):
-    r = 0.05
+    r = 0.5  # L = 2 r ratio = ratio exactly: a bound is met, not missed by a rounding
     length = 2 * r * ratio
     body = f"<type>cylinder</type><radius>{r}</radius><length>{length}</length><axis>k</axis>"
     result, _ = imported(tmp_path, vehicle(body))

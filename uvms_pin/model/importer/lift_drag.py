@@ -109,7 +109,9 @@ _UUV_NUMBERS = {
 }  # fmt: skip
 
 
-def _uuv_fin(plugin: ET.Element, links: dict[str, ET.Element], where: str, notes: list[str]) -> None:
+def _uuv_fin(
+    plugin: ET.Element, links: dict[str, ET.Element], where: str, notes: list[str]
+) -> None:
     """uuv_simulator's fin ``plugin`` as a ``<lift_drag>`` in its link, or a note."""
     name = child_text(plugin, "link_name")
     model = plugin.find("liftdrag")
