@@ -193,3 +193,15 @@ def test_a_fixtures_and_a_robots_meshes_are_judged_too(tmp_path):
     raw["robots"][1]["model"] = "model.urdf"
     with pytest.raises(ScenarioError, match=r"robots\[1\]\.model \(model\.urdf\) <mesh filename="):
         check_no_code(raw, ours / "two.toml")
+
+
+def test_a_malformed_world_object_is_passed_over_for_the_schema_to_name(tmp_path, capsys):
+    """world.objects entries that are no table (a string, a number) or of no known type
+    reach nothing: the trust check passes them over, and the run refuses them by key (exit
+    2), not with a traceback."""
+    path = _scenario(tmp_path, '[world]\nobjects = ["rock", 3, {type = "nonsense"}]\n')
+    raw = tomllib.loads(path.read_text())
+    assert [r.key for r in reaches(raw, tmp_path)] == ["scenario.model"]
+    check_no_code(raw, path)
+    assert main(["run", str(path), "--no-code", "--out", str(tmp_path / "out")]) == 2
+    assert "world.objects" in capsys.readouterr().err
