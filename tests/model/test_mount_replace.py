@@ -204,3 +204,34 @@ def test_split_finds_the_arms_first_joint_and_refuses_a_vehicle_alone(tmp_path):
     assert found.mount_pose.isApprox(named.mount_pose, 0.0)
     with pytest.raises(up.ModelError, match=r"give first_arm_joint.*a vehicle alone"):
         split_urdf(VEHICLE_URDF, tmp_path / "alone")
+
+
+def test_a_split_makes_relative_mesh_paths_absolute_and_keeps_the_others(tmp_path):
+    """The two files are written elsewhere than the source: a relative mesh path is made
+    absolute from the source's folder (vehicle and arm alike); an absolute path and a URI
+    (package://, file://) are kept as they are."""
+    import xml.etree.ElementTree as ET
+
+    def visual(filename: str) -> str:
+        return f'<visual><geometry><mesh filename="{filename}"/></geometry></visual>'
+
+    text = REFERENCE_URDF.read_text()
+    meshes = {"base_link": "meshes/hull.stl", "arm_link2": "../shared/link2.dae",
+              "arm_link3": "/opt/meshes/link3.stl", "arm_link4": "package://arm/link4.stl"}  # fmt: skip
+    for link, filename in meshes.items():
+        opening = f'<link name="{link}">'
+        assert text.count(opening) == 1
+        text = text.replace(opening, opening + visual(filename))
+    source = tmp_path / "src" / "uvms.urdf"
+    source.parent.mkdir()
+    source.write_text(text)
+    split = split_urdf(source, tmp_path / "out")
+    written = {}
+    for part in (split.vehicle_urdf, split.arm_urdf):
+        for link in ET.parse(part).getroot().iter("link"):
+            for mesh in link.iter("mesh"):
+                written.setdefault(link.get("name"), []).append(mesh.get("filename"))
+    assert written["base_link"][0] == str((source.parent / "meshes/hull.stl").resolve())
+    assert written["arm_link2"][0] == str((tmp_path / "shared" / "link2.dae").resolve())
+    assert written["arm_link3"][0] == "/opt/meshes/link3.stl"
+    assert written["arm_link4"][0] == "package://arm/link4.stl"
