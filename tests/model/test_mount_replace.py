@@ -216,7 +216,7 @@ def test_a_split_makes_relative_mesh_paths_absolute_and_keeps_the_others(tmp_pat
         return f'<visual><geometry><mesh filename="{filename}"/></geometry></visual>'
 
     text = REFERENCE_URDF.read_text()
-    meshes = {"base_link": "meshes/hull.stl", "arm_link2": "../shared/link2.dae",
+    meshes = {"base_link": "meshes/hull.stl", "arm_link2": "../common/link2.dae",
               "arm_link3": "/opt/meshes/link3.stl", "arm_link4": "package://arm/link4.stl"}  # fmt: skip
     for link, filename in meshes.items():
         opening = f'<link name="{link}">'
@@ -232,6 +232,6 @@ def test_a_split_makes_relative_mesh_paths_absolute_and_keeps_the_others(tmp_pat
             for mesh in link.iter("mesh"):
                 written.setdefault(link.get("name"), []).append(mesh.get("filename"))
     assert written["base_link"][0] == str((source.parent / "meshes/hull.stl").resolve())
-    assert written["arm_link2"][0] == str((tmp_path / "shared" / "link2.dae").resolve())
+    assert written["arm_link2"][0] == str((tmp_path / "common" / "link2.dae").resolve())
     assert written["arm_link3"][0] == "/opt/meshes/link3.stl"
     assert written["arm_link4"][0] == "package://arm/link4.stl"

@@ -281,3 +281,27 @@ def test_a_free_object_started_inside_a_fixture_is_refused_or_moved_out():
     # out of the board (x 0.85 .. 0.87) on either side, touching it
     assert abs(start[0] - 0.86) == pytest.approx(0.06, abs=1e-9)
     np.testing.assert_allclose(start[1:], [-0.156, -1.85], atol=1e-12)
+
+
+@pytest.mark.parametrize("period_s", [0.05, 0.3])
+def test_a_long_control_period_still_stops_the_lever_on_its_limit(
+    reference_uvms, tmp_path, period_s
+):
+    """The limit is solved at each period's end (docs/physics.md): a lever released 0.2 rad
+    from its limit (a pendulum of 0.75 s at that swing) reaches it within the first period
+    and rests on it, never past it at a period's end, with periods up to 0.3 s."""
+    upper = 0.2
+    lever = _lever(tmp_path, friction_Nm=0.0, limits=(-0.1, upper))
+    system = _system(reference_uvms, [lever])
+    q0 = reference_uvms.neutral_configuration()
+    q0[:3] = FAR
+    state = system.initial_state(q0, np.zeros(reference_uvms.nv))
+    system.start(state)
+    q, v, tau = state.q, state.v, np.zeros(reference_uvms.nv)
+    at = system.layout.q_slices[-1]
+    angles = []
+    for k in range(round(1.2 / period_s)):
+        q, v = system.advance(RK4(5e-4), k * period_s, q, v, tau, (k + 1) * period_s)
+        angles.append(q[at][0])
+    assert max(angles) <= upper + 1e-9
+    assert angles[-1] == pytest.approx(upper, abs=1e-9)
