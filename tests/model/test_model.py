@@ -373,19 +373,23 @@ MASS_VOLUME_WARNINGS = {
 }
 
 
+def _hinged_fin(fin: str) -> str:
+    """A body with mass and volume, and a link ``fin`` (its elements ``fin``) on the
+    revolute joint ``hinge``: a rigid body of its own."""
+    return _robot(
+        _link("body", INERTIAL + f"<hydrodynamics>{GOOD_HYDRO}</hydrodynamics>"),
+        _link("fin", fin),
+        '<joint name="hinge" type="revolute"><parent link="body"/><child link="fin"/>'
+        '<axis xyz="0 0 1"/><limit lower="-1" upper="1" effort="1" velocity="1"/></joint>',
+    )
+
+
 @pytest.mark.parametrize("case", list(MASS_VOLUME_WARNINGS), ids=list(MASS_VOLUME_WARNINGS))
 def test_mass_volume_mismatch_warns_naming_file_and_link(write_urdf, case):
     """A rigid body (here the fin, on its own revolute joint) with buoyancy but no weight,
     or the reverse."""
     body, expected = MASS_VOLUME_WARNINGS[case]
-    path = write_urdf(
-        _robot(
-            _link("body", INERTIAL + f"<hydrodynamics>{GOOD_HYDRO}</hydrodynamics>"),
-            _link("fin", body),
-            '<joint name="hinge" type="revolute"><parent link="body"/><child link="fin"/>'
-            '<axis xyz="0 0 1"/><limit lower="-1" upper="1" effort="1" velocity="1"/></joint>',
-        )
-    )
+    path = write_urdf(_hinged_fin(body))
     with pytest.warns(up.ModelWarning) as record:
         up.load_uvms(path, ee_frame="body", sensor_frame="body")
     messages = [str(w.message) for w in record]
@@ -419,14 +423,7 @@ def test_a_link_without_mass_or_volume_is_no_mismatch(write_urdf):
         '<inertia ixx="0" iyy="0" izz="0" ixy="0" ixz="0" iyz="0"/></inertial>'
         f"<hydrodynamics>{hydro_xml(0.0)}</hydrodynamics>"
     )
-    path = write_urdf(
-        _robot(
-            _link("body", INERTIAL + f"<hydrodynamics>{GOOD_HYDRO}</hydrodynamics>"),
-            _link("fin", empty),
-            '<joint name="hinge" type="revolute"><parent link="body"/><child link="fin"/>'
-            '<axis xyz="0 0 1"/><limit lower="-1" upper="1" effort="1" velocity="1"/></joint>',
-        )
-    )
+    path = write_urdf(_hinged_fin(empty))
     with warnings.catch_warnings():
         warnings.simplefilter("error", up.ModelWarning)
         up.load_uvms(path, ee_frame="body", sensor_frame="body")
