@@ -152,3 +152,24 @@ def test_panels_with_something_in_view_have_no_note(survey):
     assert depths and not any(ax.texts for ax in depths)
     (echogram,) = [ax for ax in fig.axes if ax.get_title().startswith("altimeter")]
     assert not echogram.texts
+
+
+def test_a_one_beam_imaging_sonar_is_drawn_as_an_echogram_under_its_own_type():
+    """An imaging sonar of one beam has no fan to draw: its echogram over time, titled as the
+    imaging sonar it is (not as an altimeter), without a reading (it detects nothing)."""
+    one_beam = {"name": "pencil", "type": "imaging", "beams": 1, "bins": 32,
+                "horizontal_fov_rad": 0.1, "max_range_m": 12.0,
+                "rpy_rad": [0.0, 1.5708, 0.0]}  # fmt: skip
+    scenario = load_scenario(
+        ROOT / "scenarios" / "seabed_survey.toml",
+        {"scenario.duration_s": 0.3, "sensors.sonar": [one_beam], "sensors.camera": []},
+    )
+    rollout = simulate(scenario, progress=False)
+    assert np.any(rollout.sonar("pencil").intensity)  # it hears the seabed below
+    fig = plot_perception(rollout)
+    (ax,) = [a for a in fig.axes if "pencil" in a.get_title()]
+    assert ax.get_title() == "imaging 'pencil': echogram"
+    np.testing.assert_allclose(
+        ax.images[0].get_array(), decibels(rollout.sonar("pencil").intensity)[0][:, :, 0].T
+    )
+    assert not ax.lines

@@ -7,8 +7,9 @@
   (port to the left, as a sonar display), on one dB scale (50 dB below the brightest echo);
 - a multibeam: its swath over the run, each beam's detected range (white: heard nothing)
   against time and bearing;
-- an altimeter: its echogram, the echo at each range over time [dB], its reading drawn on it,
-  the range axis up to twice the farthest reading.
+- an altimeter (any sonar of one beam): its echogram, the echo at each range over time [dB],
+  its reading drawn on it (an altimeter's, a multibeam's), the range axis up to twice the
+  farthest reading; titled with its type.
 """
 
 from __future__ import annotations
@@ -114,8 +115,9 @@ def _sonar(fig: Figure, grid, row: int, rollout: RolloutData, name: str) -> list
     times = edges(record.time_s, period_s)
     bearings = edges(np.degrees(record.bearing_rad), 1.0)
     ranges = edges(record.range_m, 1.0)
-    if record.intensity.shape[2] == 1:  # an altimeter: its echogram and its reading
-        return [_echogram(fig, grid, row, name, record, times, ranges)]
+    if record.intensity.shape[2] == 1:  # one beam (an altimeter's): its echogram over time
+        kind = rollout.metadata["perception"][name]["spec"]["type"]
+        return [_echogram(fig, grid, row, f"{kind} '{name}'", record, times, ranges)]
     if record.beam_range_m is not None:  # a multibeam: its swath over the run
         ax = fig.add_subplot(grid[row, :SNAPSHOTS])
         swath = np.ma.masked_invalid(record.beam_range_m.T)
@@ -138,9 +140,10 @@ def _sonar(fig: Figure, grid, row: int, rollout: RolloutData, name: str) -> list
     return []
 
 
-def _echogram(fig: Figure, grid, row: int, name: str, record, times, ranges):
-    """An altimeter's echogram (echo [dB] by range over time) with its reading, the range
-    axis up to twice its farthest reading (the water column beyond is empty)."""
+def _echogram(fig: Figure, grid, row: int, title: str, record, times, ranges):
+    """A one-beam sonar's echogram (echo [dB] by range over time) with its reading (an
+    altimeter's, a one-beam multibeam's), the range axis up to twice its farthest reading
+    (the water column beyond is empty); ``title``: its type and name."""
     ax = fig.add_subplot(grid[row, :SNAPSHOTS])
     db, low, high = decibels(record.intensity)
     image = ax.imshow(db[:, :, 0].T, origin="lower", aspect="auto", extent=[*times, *ranges],
@@ -153,7 +156,7 @@ def _echogram(fig: Figure, grid, row: int, name: str, record, times, ranges):
     elif not np.any(record.intensity):  # nothing within its range: not a black puzzle
         ax.text(0.5, 0.5, f"no echo within {ranges[1]:.3g} m", ha="center", va="center",
                 transform=ax.transAxes, fontsize=9, color="0.7")  # fmt: skip
-    ax.set(xlabel="time [s]", ylabel="range [m]", title=f"altimeter '{name}': echogram")
+    ax.set(xlabel="time [s]", ylabel="range [m]", title=f"{title}: echogram")
     fig.colorbar(image, cax=fig.add_subplot(grid[row, SNAPSHOTS]), label="echo [dB]")
     return ax
 
