@@ -207,3 +207,23 @@ def test_a_users_contact_model_is_refused_by_name_on_the_core(reference_uvms):
         pytest.raises(ParameterError, match="_Wall"),
     ):
         plant.acceleration_derivatives(0.2, q, v, tau)
+
+
+@pytest.mark.parametrize("what", ["free object", "self-collision"])
+def test_free_objects_or_self_collision_alone_are_refused(reference_uvms, what):
+    """Each of the two terms without derivatives is refused on its own, by name, before
+    anything is computed."""
+    from uvms_pin.physics.world.free_object import free_object
+    from uvms_pin.physics.world.world import World
+
+    uvms = reference_uvms
+    if what == "free object":
+        ball = free_object("ball", "sphere", {"radius_m": 0.1}, ([3.0, 0.0, -5.0], [0, 0, 0]),
+                           density_kg_m3=2000.0, water_density_kg_m3=1025.0)  # fmt: skip
+        world = World(uvms, [], free=[ball])
+    else:
+        world = World(uvms, [], self_collision=True)
+    plant = Plant(uvms, free_surface=False, world=world)
+    q, v, tau = _state(uvms, 86)
+    with pytest.raises(ParameterError, match="free objects and self-collision are not"):
+        plant.acceleration_derivatives(0.2, q, v, tau)
