@@ -97,3 +97,33 @@ def test_station_keeping_cost_is_its_docstrings(reference_uvms):
         moving[7] -= d
         model.calc(data, moving, np.zeros(model.nu))
         assert data.cost == pytest.approx(scale * 0.1 * 0.5 * 0.3**2, rel=1e-9)
+
+
+@pytest.mark.parametrize("iterations", [0, -3, True, 1.5, "10"])
+def test_solve_refuses_a_count_of_iterations_that_is_no_whole_number_from_one(
+    reference_uvms, iterations
+):
+    problem = _small_problem(reference_uvms)
+    with pytest.raises(up.ParameterError, match="ocp iterations must be"):
+        problems.solve(problem, iterations=iterations)
+
+
+def test_solve_refuses_a_warm_start_that_is_not_finite(reference_uvms):
+    """A NaN in the warm start's states or inputs is refused before the solver sees it; a
+    finite one is taken (and one iteration is enough to run)."""
+    problem = _small_problem(reference_uvms)
+    xs = [np.array(problem.x0) for _ in range(problem.T + 1)]
+    us = [np.zeros(m.nu) for m in problem.runningModels]
+    problems.solve(problem, iterations=1, warm_start=(xs, us))
+    for bad in ("xs", "us"):
+        held = ([x.copy() for x in xs], [u.copy() for u in us])
+        held[0 if bad == "xs" else 1][-1][0] = np.nan
+        with pytest.raises(up.ParameterError, match="warm_start: its xs and us must be finite"):
+            problems.solve(problem, iterations=1, warm_start=held)
+
+
+def _small_problem(uvms):
+    x0 = np.r_[uvms.neutral_configuration(), np.zeros(uvms.nv)]
+    x0[2] = -3.0
+    effort = lambda nu: [(costs.Effort(np.ones(nu)), 1.0)]  # noqa: E731
+    return problems.shooting_problem(uvms, x0, effort, effort, nodes=NODES, dt_s=DT_S)
