@@ -322,7 +322,7 @@ void System::constrain(double t0, const ConstVec& q0, const ConstVec& v0, double
     return;
   }
   const double h = t1 - t0;
-  constrain_fixtures(t0, q0, h, q1, v1);
+  constrain_fixtures(t0, q0, v0, h, q1, v1);
   // the robot's joint limits (and Coulomb friction): its plant's step (Plant::constrain_joints)
   Eigen::VectorXd q1_robot = q1.head(nq_robot_), v1_robot = v1.head(nv_robot_);
   if (plant_.constrain_joints(t0, q0.head(nq_robot_), v0.head(nv_robot_), h, q1_robot,
@@ -361,8 +361,8 @@ void System::constrain(double t0, const ConstVec& q0, const ConstVec& v0, double
   }
 }
 
-void System::constrain_fixtures(double t0, const ConstVec& q0, double h, Eigen::VectorXd& q1,
-                                Eigen::VectorXd& v1) {
+void System::constrain_fixtures(double t0, const ConstVec& q0, const ConstVec& v0, double h,
+                                Eigen::VectorXd& q1, Eigen::VectorXd& v1) {
   for (std::size_t k = 0; k < fixtures_.size(); ++k) {
     FixtureBody& f = fixtures_[k];
     const int n = f.body.nv();
@@ -372,12 +372,21 @@ void System::constrain_fixtures(double t0, const ConstVec& q0, double h, Eigen::
     const Eigen::MatrixXd& mass = f.body.mass_matrix_in(q0_f, plant_.flow, t0, plant_.free_surface);
     const Eigen::VectorXd gap_low = q0_f - f.lower, gap_high = f.upper - q0_f;
     const JointBoxStep step = joint_box_step(v_free, mass, f.coulomb, gap_low, gap_high, h);
-    // a joint with friction, or one its limit pushed, is a row: its rate is the step's, and
+    // the speeds a limit is reached at: the smooth step's end, start and mean (its joints
+    // are revolute or prismatic: q_free - q0 is the travel), as fixtures.with_fixtures
+    const Eigen::ArrayXd speed =
+        v_free.array().abs()
+            .max(v0.segment(fixture_v_[k], n).array().abs())
+            .max((q1.segment(fixture_q_[k], n) - q0_f).array().abs() / h);
+    // a joint with friction, one its limit pushed, or one whose limit the period can reach
+    // (a limit it may have swung through and back), is a row: its rate is the step's, and
     // the fixture moves from q0 with v+ (period.py's _end); the others keep v_free
     bool acting = false;
     Eigen::VectorXd v_plus = v_free;
     for (int j = 0; j < n; ++j) {
-      if (f.coulomb[j] > 0.0 || step.limit_impulse[j] != 0.0) {
+      const double reach = h * speed[j] + kFixtureLimitMargin;
+      const bool near = gap_low[j] <= reach || gap_high[j] <= reach;
+      if (f.coulomb[j] > 0.0 || step.limit_impulse[j] != 0.0 || near) {
         v_plus[j] = step.velocity[j];
         acting = true;
       }
@@ -474,7 +483,7 @@ void System::constrain_coupled(double t0, const ConstVec& q0, const ConstVec& v0
       q1.segment(fixture_q_[k], n) = q0.segment(fixture_q_[k], n) + h * v.segment(fixture_v_[k], n);
     }
   } else {
-    constrain_fixtures(t0, q0, h, q1, v1);
+    constrain_fixtures(t0, q0, v0, h, q1, v1);
   }
   if (solved && coupled_step_.acting(0)) {
     v1.head(nv_robot_) = v.head(nv_robot_);

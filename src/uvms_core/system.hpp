@@ -51,6 +51,10 @@
 
 namespace uvms {
 
+// A fixture joint's limit is a row once its gap is at most h |v| + this [rad or m] (the
+// margin of fixtures.constraints' JointLimits, as joint_limits.hpp's)
+constexpr double kFixtureLimitMargin = 1.0e-3;
+
 // A fixture of the system: its joints' dynamics (a fixed-base model, its links in the water)
 // and what acts along each joint: viscous damping D, Coulomb friction c, position limits.
 struct FixtureBody {
@@ -170,8 +174,8 @@ class System {
  private:
   void object_kinematics(const ConstVec& q, const ConstVec& v);
   // Each fixture's joints by their exact step (joint_box.hpp), after the smooth step.
-  void constrain_fixtures(double t0, const ConstVec& q0, double h, Eigen::VectorXd& q1,
-                          Eigen::VectorXd& v1);
+  void constrain_fixtures(double t0, const ConstVec& q0, const ConstVec& v0, double h,
+                          Eigen::VectorXd& q1, Eigen::VectorXd& v1);
   // ... with rigid_pairs: every row of the system in one solve (moving_constraints.hpp).
   void constrain_coupled(double t0, const ConstVec& q0, const ConstVec& v0, double t1,
                          Eigen::VectorXd& q1, Eigen::VectorXd& v1);

@@ -305,3 +305,29 @@ def test_a_long_control_period_still_stops_the_lever_on_its_limit(
         angles.append(q[at][0])
     assert max(angles) <= upper + 1e-9
     assert angles[-1] == pytest.approx(upper, abs=1e-9)
+
+
+@pytest.mark.parametrize("compiled", [True, False], ids=["compiled", "python"])
+@pytest.mark.parametrize("period_s", [0.375, 0.5])
+def test_a_period_longer_than_the_swing_never_ends_past_a_limit(
+    reference_uvms, tmp_path, period_s, compiled
+):
+    """A period as long as the lever's half swing (0.375 s): its smooth step swings it from
+    0 through its upper limit to pi and ends nearly at rest there, no impulse needed at that
+    end. The limit is a row all the same (the period's travel reaches it): the joint moves
+    from q0 with v+, inside its limits. Before, it kept the smooth step's end, 2.9 rad past
+    the limit, on the compiled system and the Python reference alike. (Within such a period
+    what reverses is lost: the lever then jumps between its limits, docs/physics.md.)"""
+    lower, upper = -0.1, 0.2
+    lever = _lever(tmp_path, friction_Nm=0.0, limits=(lower, upper))
+    world = World(reference_uvms, [], fixtures=[lever])
+    system = System(Plant(reference_uvms, free_surface=False, world=world), compiled=compiled)
+    q0 = reference_uvms.neutral_configuration()
+    q0[:3] = FAR
+    state = system.initial_state(q0, np.zeros(reference_uvms.nv))
+    system.start(state)
+    q, v, tau = state.q, state.v, np.zeros(reference_uvms.nv)
+    at = system.layout.q_slices[-1]
+    for k in range(6):
+        q, v = system.advance(RK4(5e-4), k * period_s, q, v, tau, (k + 1) * period_s)
+        assert lower - 1e-9 <= q[at][0] <= upper + 1e-9, (k, q[at][0])

@@ -166,6 +166,11 @@ def with_fixtures(
         {} if friction is None else dict(zip(friction.joint_ids, friction.coulomb_Nm, strict=True))
     )
     limited = () if limits is None else limits.joint_ids
+    # the speeds a limit is reached at, as the rows are selected (`step.constrained_velocity`):
+    # the smooth step's end, and its start and mean (``least_speed``)
+    least = kw.get("least_speed")
+    speed = np.abs(v_free) if least is None else np.maximum(np.abs(v_free), np.abs(least))
+    margin = 0.0 if limits is None else limits.margin
     steps = []
     for part, joints in blocks:
         if not joints:
@@ -180,11 +185,16 @@ def with_fixtures(
         coulomb = np.array([rubbing.get(j, 0.0) for j in joints])
         step = joint_box_step(v_free[part], mass_matrix[part, part], coulomb, (lower, upper),
                               period_s)  # fmt: skip
+        # a limit the period can reach is a row even when it pushes nothing at the end: the
+        # joint then moves from q0 with v+, inside its limits, not by the smooth step's end,
+        # which may have swung through the limit and back within a long period
+        reach = period_s * speed[part] + margin
+        near = (lower <= reach) | (upper <= reach)
         steps += [
             (joint, part.start + i, step.velocity[i], step.friction_impulse[i],
              step.limit_impulse[i])
             for i, joint in enumerate(joints)
-            if joint in rubbing or step.limit_impulse[i] != 0.0
+            if joint in rubbing or step.limit_impulse[i] != 0.0 or near[i]
         ]  # fmt: skip
     return _joined(out, steps)
 
