@@ -158,3 +158,36 @@ def test_the_integral_takes_up_the_current_the_model_does_not_know():
 
     with_integral, without = final_error(4.0), final_error(0.0)
     assert with_integral < 0.2 * without and without > 5e-3
+
+
+def _path(task: dict):
+    scenario = scenario_from_dict(_raw(1.0, task=task), CIRCLE)
+    return scenario.task.path, scenario.task.path.at(0.0)[0]
+
+
+def test_waypoints_are_offsets_from_the_start_reached_at_their_times():
+    offsets = [[0.0, 0.0, 0.0], [0.1, 0.0, 0.0], [0.1, 0.2, -0.05]]
+    path, start = _path({"type": "waypoints", "offsets_m": offsets, "times_s": [0.0, 1.0, 2.5]})
+    for offset, time_s in zip(offsets, [0.0, 1.0, 2.5], strict=True):
+        np.testing.assert_allclose(path.at(time_s)[0], start + offset, atol=1e-12)
+    np.testing.assert_allclose(path.at(9.0)[0], start + offsets[-1], atol=1e-12)
+
+
+def test_a_minimum_jerk_move_starts_at_zero_unless_told_and_ends_displaced():
+    move = {"type": "min_jerk", "displacement_m": [0.2, -0.1, 0.05], "duration_s": 2.0}
+    path, start = _path(move)
+    np.testing.assert_allclose(path.at(2.0)[0], start + np.array([0.2, -0.1, 0.05]), atol=1e-12)
+    assert path.at(1e-3)[0][0] > start[0]  # under way from t = 0
+    later, _ = _path({**move, "start_s": 1.0})
+    np.testing.assert_allclose(later.at(1.0)[0], start, atol=1e-12)
+    np.testing.assert_allclose(later.at(3.0)[0], start + np.array([0.2, -0.1, 0.05]), atol=1e-12)
+
+
+def test_a_circle_by_default_is_horizontal_and_at_full_speed_from_the_start():
+    """normal [0, 0, 1] and ramp_s 0 by default: half a period on, the point is across the
+    circle (2 r from its start) at the start's depth."""
+    path, start = _path({"type": "circle", "radius_m": 0.1, "period_s": 20.0})
+    across = path.at(10.0)[0]
+    assert np.linalg.norm(across - start) == pytest.approx(0.2, rel=1e-12)
+    for t in np.linspace(0.0, 20.0, 9):
+        assert path.at(t)[0][2] == pytest.approx(start[2], abs=1e-12)
