@@ -42,3 +42,25 @@ def test_a_model_entry_that_names_no_model_says_why(tmp_path):
         resolve_model(" ")
     with pytest.raises(up.ModelError, match="is a directory, not a URDF file"):
         up.load_uvms(ROOT / "models")
+
+
+@pytest.mark.parametrize("name", ["uvms_lbv150.urdf", "uvms_bluerov2_alpha5.urdf"])
+def test_the_bodies_table_is_each_joints_mass_volume_and_net_weight(name):
+    """Each body's row: its mass, the water it displaces and (m - rho V) g; the total row the
+    model's, its net weight the sum of the rows (to the table's digits) and -net_buoyancy."""
+    uvms = up.load_uvms(shipped_path(f"models/{name}"))
+    lines = model_summary(uvms).splitlines()
+    first = lines.index(next(line for line in lines if line.startswith("  joint "))) + 1
+    rows = [line.split() for line in lines[first : first + uvms.model.njoints]]
+    rho, g = uvms.water_density_kg_m3, -uvms.model.gravity.linear[2]
+    for j, (joint, mass, volume, net) in enumerate(rows[:-1], start=1):
+        assert joint == uvms.model.names[j]
+        assert float(mass) == pytest.approx(uvms.model.inertias[j].mass, abs=1e-4)
+        assert float(volume) == pytest.approx(uvms.volume_per_joint_m3[j], abs=1e-6)
+        expected = (uvms.model.inertias[j].mass - rho * uvms.volume_per_joint_m3[j]) * g
+        assert float(net) == pytest.approx(expected, abs=1e-4)
+    total = rows[-1]
+    assert total[0] == "total"
+    assert float(total[1]) == pytest.approx(uvms.mass_kg, abs=1e-4)
+    assert float(total[3]) == pytest.approx(-uvms.net_buoyancy_N, abs=1e-4)
+    assert float(total[3]) == pytest.approx(sum(float(r[3]) for r in rows[:-1]), abs=1e-3)
