@@ -141,3 +141,39 @@ def test_xml_that_is_not_well_formed_for_another_reason_is_still_refused(tmp_pat
     source.write_text('<sdf version="1.9"><model name="m"><gz:x></model></sdf>')
     with pytest.raises(ModelError, match="not well-formed XML"):
         import_model(source)
+
+
+def _notes_of(inner: str) -> list[str]:
+    import xml.etree.ElementTree as ET
+
+    notes: list[str] = []
+    plugin = ET.fromstring(f"<plugin><link_name>b</link_name>{inner}</plugin>")
+    gz_hydrodynamics(plugin, 0.0, np.zeros(3), "f.sdf", notes)
+    return notes
+
+
+def test_a_diagonal_added_mass_is_no_coriolis_difference():
+    """Diagonal added mass alone: gz-sim's Coriolis and uvms-pin's agree, nothing to say."""
+    notes = _notes_of("<xDotU>-2</xDotU><yDotV>-3</yDotV><nDotR>-1</nDotR><xU>-5</xU>")
+    assert not notes, notes
+
+
+@pytest.mark.parametrize(
+    ("flags", "said"),
+    [
+        ("<disable_coriolis>true</disable_coriolis>", ["disable_coriolis"]),
+        ("<disable_added_mass> 1 </disable_added_mass>", ["disable_added_mass"]),
+        (
+            "<disable_coriolis>false</disable_coriolis><disable_added_mass>0</disable_added_mass>",
+            [],
+        ),
+        ("<namespace>true</namespace>", []),
+    ],
+)
+def test_a_disabled_term_is_said_to_be_kept_and_other_flags_pass_quietly(flags, said):
+    """uvms-pin always has the added mass and its Coriolis term: a source that turns either off
+    is told so; the flags off, and the plugin's other settings, say nothing."""
+    notes = _notes_of(flags)
+    assert len(notes) == len(said), notes
+    for note, tag in zip(notes, said, strict=True):
+        assert f"<{tag}> is true in the source" in note
