@@ -101,3 +101,22 @@ def test_lines_in_a_log_after_the_delay_then_every_interval_and_at_the_end():
     assert quiet.getvalue() == ""  # shorter than the delay: nothing, not even the end
     with progress_printer("run", 10.0, stream=io.StringIO()) as printer:
         assert isinstance(printer, ProgressLines)  # a file: lines, not a bar
+
+
+def test_a_line_extrapolates_what_is_left_from_the_rate_so_far(monkeypatch):
+    """A quarter simulated in 3 s of wall time leaves 9 s at that rate, three quarters in 6 s
+    2 s; the bar is a quarter (7 of 30 marks) and three quarters (22) full."""
+    import io
+
+    from uvms_pin.results.progress import ProgressLines
+
+    clock = iter([100.0, 103.0, 106.0])
+    monkeypatch.setattr(progress_module.time, "perf_counter", lambda: next(clock))
+    log = io.StringIO()
+    lines = ProgressLines("run", 8.0, log, delay_s=0.0, interval_s=1.0)
+    lines(2.0, 8.0)
+    lines(6.0, 8.0)
+    first, second = log.getvalue().splitlines()
+    assert first.endswith("elapsed    3.0 s  left ~   9.0 s")
+    assert second.endswith("elapsed    6.0 s  left ~   2.0 s")
+    assert first.count("#") == 7 and second.count("#") == 22
