@@ -48,7 +48,26 @@ def test_read_urdf_root(tmp_path):
     with pytest.raises(ModelError, match="not well-formed XML"):
         read_urdf_root(bad)
     bad.write_text("<sdf/>")
-    with pytest.raises(ModelError, match="root element is <sdf>, expected <robot>"):
+    with pytest.raises(ModelError, match="root element is <sdf>, expected <robot>") as sdf:
         read_urdf_root(bad)
+    assert "uvms-pin import FILE --out model.urdf" in str(sdf.value)  # the way to convert it
+    bad.write_text("<launch/>")
+    with pytest.raises(ModelError, match="root element is <launch>, expected <robot>") as other:
+        read_urdf_root(bad)
+    assert "import" not in str(other.value)  # no conversion to offer
     bad.write_text('<robot name="r"/>')
     assert read_urdf_root(bad).get("name") == "r"
+
+
+@pytest.mark.parametrize("prefix", ["xacro", "gazebo_ext"])
+def test_a_prefix_used_without_its_declaration_is_read(tmp_path, prefix):
+    """Gazebo and xacro read elements of a prefix nobody declared; the URDF is read with the
+    prefix declared (xacro's own namespace, or one of uvms-pin's for an unknown prefix)."""
+    path = tmp_path / "prefixed.urdf"
+    path.write_text(
+        f'<robot name="r"><{prefix}:property name="x" value="1"/><link name="a"/></robot>'
+    )
+    root = read_urdf_root(path)
+    assert root.get("name") == "r" and root.find("link").get("name") == "a"
+    (element,) = [e for e in root if e.tag.endswith("}property")]
+    assert element.tag.startswith("{") and element.get("value") == "1"
