@@ -87,3 +87,25 @@ def test_a_neutral_vehicle_gets_nothing_and_is_told_why_it_tilts():
     assert report.foam_volume_m3 == 0.0 and report.ballast_mass_kg == 0.0
     assert not any("foam centroid" in n or "ballast raised" in n for n in report.notes)
     assert any(n.startswith("neutral without foam or ballast") for n in report.notes)
+
+
+def test_trim_links_take_the_prefix_while_their_name_or_joints_name_is_taken(tmp_path):
+    """A second trim beside the first (an arm's trim a vehicle file keeps) takes the prefix,
+    again while its name is taken; so does one whose joint's name alone is taken."""
+    vehicle = up.load_uvms(BLUEROV, water_density_kg_m3=SEA_KG_M3)
+    q = vehicle.neutral_configuration()
+    report = plan_trim(vehicle, q, TrimSpec(bg_m=0.005, **FOOTPRINT))
+    assert report.ballast_mass_kg > 0.0 and report.foam_volume_m3 == 0.0
+    root = ET.parse(BLUEROV).getroot()
+    for _ in range(3):
+        add_trim_links(root, "base_link", report, "old_")
+    names = [e.get("name") for e in root if e.tag == "link" and "ballast" in e.get("name")]
+    assert names == ["trim_ballast", "old_trim_ballast", "old_old_trim_ballast"]
+    joints = {e.get("name") for e in root if e.tag == "joint"}
+    assert {f"{n}_joint" for n in names} <= joints
+    lone = ET.parse(BLUEROV).getroot()
+    ET.SubElement(lone, "joint", {"name": "trim_ballast_joint", "type": "fixed"})
+    add_trim_links(lone, "base_link", report, "old_")
+    assert [e.get("name") for e in lone if e.tag == "link" and "ballast" in e.get("name")] == [
+        "old_trim_ballast"
+    ]
