@@ -11,7 +11,7 @@ from matplotlib.figure import Figure
 
 import uvms_pin as up
 from uvms_pin.results.figures.objects import objects_figures, plot_contacts, plot_objects
-from uvms_pin.results.free_objects import force_on_object_N
+from uvms_pin.results.free_objects import force_on_object_N, free_object_summary
 
 
 @pytest.fixture(scope="module")
@@ -87,6 +87,9 @@ def test_metrics_hold_each_free_objects_displacement(pushed):
     assert metrics["object_box_max_speed_m_s"] == pytest.approx(
         np.linalg.norm(box[:, 7:10], axis=1).max(), rel=1e-15
     )
+    summary = free_object_summary(pushed)["box"]  # where it ended: its last sample's x y z
+    assert [summary[f"final_{a}_m"] for a in "xyz"] == box[-1, :3].tolist()
+    assert len({round(v, 6) for v in box[-1, :3]}) == 3  # three different numbers: no mix-up
 
 
 def test_a_run_without_a_world_gets_none(tmp_path):
