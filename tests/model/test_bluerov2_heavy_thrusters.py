@@ -28,6 +28,22 @@ def test_geometry_matches_von_benzon_layout():
         np.testing.assert_allclose(t.direction_body, [0, 0, 1])
 
 
+def test_each_thruster_is_where_its_name_says_and_equal_thrusts_push_straight():
+    """front/rear: x > 0 / x < 0; right/left: y < 0 / y > 0 (FLU). Equal thrust on the four
+    horizontal thrusters is surge, with the pitch of their 8.5 cm below the origin and no
+    sway, roll or yaw; on the four vertical pure heave (a thruster on the wrong side, or
+    turned the wrong way, turns the vehicle)."""
+    ts = thrusters()
+    for t in ts:
+        x, y, _ = t.position_body_m
+        assert (x > 0) == ("front" in t.name) and (y < 0) == ("right" in t.name), t.name
+    surge = 4.0 * np.sqrt(0.5)
+    horizontal = sum(t.wrench_column for t in ts if "horizontal" in t.name)
+    np.testing.assert_allclose(horizontal, [surge, 0, 0, 0, -0.085 * surge, 0], atol=1e-12)
+    vertical = sum(t.wrench_column for t in ts if "vertical" in t.name)
+    np.testing.assert_allclose(vertical, [0, 0, 4.0, 0, 0, 0], atol=1e-12)
+
+
 def test_t200_limits_at_16_volts():
     assert T200_16V.max_forward_N == pytest.approx(5.25 * 9.80665)
     # the measured table's end at 1100 us (the technical details round it to 4.1 kgf)
