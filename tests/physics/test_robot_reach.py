@@ -37,9 +37,11 @@ def test_the_reach_holds_every_piece_and_bounds_its_speed():
                 np.linalg.norm(twist.linear + np.cross(twist.angular, local))
                 + np.linalg.norm(twist.angular) * piece.bound_radius_m
             )
-            centre, radius = reach_sphere(q, v, reach, 1.0)
-            assert np.array_equal(centre, q[:3])
-            assert fastest <= (radius - reach - CLEARANCE_M) / 2.0 + 1e-12
+            for horizon_s in (1.0, 0.01):  # what the points cover grows with the horizon
+                centre, radius = reach_sphere(q, v, reach, horizon_s)
+                assert np.array_equal(centre, q[:3])
+                assert fastest * horizon_s <= (radius - reach - CLEARANCE_M) / 2.0 + 1e-12
+            assert reach_sphere(q, v, reach, 0.01)[1] < reach_sphere(q, v, reach, 1.0)[1]
 
 
 def test_a_robot_without_pieces_reaches_nothing_and_a_prismatic_arm_everywhere():
