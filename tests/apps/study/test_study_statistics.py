@@ -62,6 +62,8 @@ def test_failure_rates_per_bin_and_over_the_grid():
     table = _table()
     order, rates, counts = bin_failure_rates(table, GRID_A)
     assert order == ["1", "2"] and rates == [0.0, 0.5] and counts == [4, 4]
+    # bins of unequal size: each its own count (six runs, four with a = 1)
+    assert bin_failure_rates(table.iloc[:6], GRID_A)[2] == [4, 2]
     frame, count = violation_rate_grid(table, GRID_A, GRID_B)
     assert list(frame.columns) == ["1", "2"] and list(frame.index) == ["10", "20"]
     np.testing.assert_array_equal(frame.to_numpy(), [[0.0, 0.0], [0.0, 1.0]])
