@@ -283,6 +283,28 @@ def test_a_free_object_started_inside_a_fixture_is_refused_or_moved_out():
     np.testing.assert_allclose(start[1:], [-0.156, -1.85], atol=1e-12)
 
 
+def _lever_at_period_ends(uvms, tmp_path, period_s, periods, compiled=True):
+    """The frictionless lever (limits -0.1 and 0.2 rad, released at 0) at each period's end
+    over ``periods`` periods of ``period_s``."""
+    lever = _lever(tmp_path, friction_Nm=0.0, limits=LONG_PERIOD_LIMITS)
+    world = World(uvms, [], fixtures=[lever])
+    system = System(Plant(uvms, free_surface=False, world=world), compiled=compiled)
+    q0 = uvms.neutral_configuration()
+    q0[:3] = FAR
+    state = system.initial_state(q0, np.zeros(uvms.nv))
+    system.start(state)
+    q, v, tau = state.q, state.v, np.zeros(uvms.nv)
+    at = system.layout.q_slices[-1]
+    angles = []
+    for k in range(periods):
+        q, v = system.advance(RK4(5e-4), k * period_s, q, v, tau, (k + 1) * period_s)
+        angles.append(float(q[at][0]))
+    return np.array(angles)
+
+
+LONG_PERIOD_LIMITS = (-0.1, 0.2)
+
+
 @pytest.mark.parametrize("period_s", [0.05, 0.3])
 def test_a_long_control_period_still_stops_the_lever_on_its_limit(
     reference_uvms, tmp_path, period_s
@@ -290,20 +312,9 @@ def test_a_long_control_period_still_stops_the_lever_on_its_limit(
     """The limit is solved at each period's end (docs/physics.md): a lever released 0.2 rad
     from its limit (a pendulum of 0.75 s at that swing) reaches it within the first period
     and rests on it, never past it at a period's end, with periods up to 0.3 s."""
-    upper = 0.2
-    lever = _lever(tmp_path, friction_Nm=0.0, limits=(-0.1, upper))
-    system = _system(reference_uvms, [lever])
-    q0 = reference_uvms.neutral_configuration()
-    q0[:3] = FAR
-    state = system.initial_state(q0, np.zeros(reference_uvms.nv))
-    system.start(state)
-    q, v, tau = state.q, state.v, np.zeros(reference_uvms.nv)
-    at = system.layout.q_slices[-1]
-    angles = []
-    for k in range(round(1.2 / period_s)):
-        q, v = system.advance(RK4(5e-4), k * period_s, q, v, tau, (k + 1) * period_s)
-        angles.append(q[at][0])
-    assert max(angles) <= upper + 1e-9
+    upper = LONG_PERIOD_LIMITS[1]
+    angles = _lever_at_period_ends(reference_uvms, tmp_path, period_s, round(1.2 / period_s))
+    assert angles.max() <= upper + 1e-9
     assert angles[-1] == pytest.approx(upper, abs=1e-9)
 
 
@@ -318,16 +329,6 @@ def test_a_period_longer_than_the_swing_never_ends_past_a_limit(
     from q0 with v+, inside its limits. Before, it kept the smooth step's end, 2.9 rad past
     the limit, on the compiled system and the Python reference alike. (Within such a period
     what reverses is lost: the lever then jumps between its limits, docs/physics.md.)"""
-    lower, upper = -0.1, 0.2
-    lever = _lever(tmp_path, friction_Nm=0.0, limits=(lower, upper))
-    world = World(reference_uvms, [], fixtures=[lever])
-    system = System(Plant(reference_uvms, free_surface=False, world=world), compiled=compiled)
-    q0 = reference_uvms.neutral_configuration()
-    q0[:3] = FAR
-    state = system.initial_state(q0, np.zeros(reference_uvms.nv))
-    system.start(state)
-    q, v, tau = state.q, state.v, np.zeros(reference_uvms.nv)
-    at = system.layout.q_slices[-1]
-    for k in range(6):
-        q, v = system.advance(RK4(5e-4), k * period_s, q, v, tau, (k + 1) * period_s)
-        assert lower - 1e-9 <= q[at][0] <= upper + 1e-9, (k, q[at][0])
+    lower, upper = LONG_PERIOD_LIMITS
+    angles = _lever_at_period_ends(reference_uvms, tmp_path, period_s, 6, compiled)
+    assert np.all((angles >= lower - 1e-9) & (angles <= upper + 1e-9)), angles
