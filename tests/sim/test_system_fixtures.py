@@ -283,6 +283,10 @@ def test_a_free_object_started_inside_a_fixture_is_refused_or_moved_out():
     np.testing.assert_allclose(start[1:], [-0.156, -1.85], atol=1e-12)
 
 
+#: the lever's limits in the long-period tests [rad]: released at 0, 0.2 rad from the upper
+LONG_PERIOD_LIMITS = (-0.1, 0.2)
+
+
 def _lever_at_period_ends(uvms, tmp_path, period_s, periods, compiled=True):
     """The frictionless lever (limits -0.1 and 0.2 rad, released at 0) at each period's end
     over ``periods`` periods of ``period_s``."""
@@ -300,9 +304,6 @@ def _lever_at_period_ends(uvms, tmp_path, period_s, periods, compiled=True):
         q, v = system.advance(RK4(5e-4), k * period_s, q, v, tau, (k + 1) * period_s)
         angles.append(float(q[at][0]))
     return np.array(angles)
-
-
-LONG_PERIOD_LIMITS = (-0.1, 0.2)
 
 
 @pytest.mark.parametrize("period_s", [0.05, 0.3])
