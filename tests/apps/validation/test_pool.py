@@ -135,3 +135,34 @@ def test_no_figures_says_so(tmp_path):
     assert result.returncode == 0, result.stderr
     assert result.stdout.strip().endswith(f"wrote {out}/pool_validation.json, pool_validation.csv")
     assert sorted(p.name for p in out.iterdir()) == ["pool_validation.csv", "pool_validation.json"]
+
+
+def test_an_arm_delay_moves_the_encoders_later_on_the_imu_clock():
+    """``arm_delay_s`` = d: the arm is at t where the encoders say it was at t + d."""
+    from uvms_pin.apps.validation.pool import trial_setup
+    from uvms_pin.apps.validation.trials import load_trial
+
+    trial = load_trial(DATA / f"{SHORT_TRIALS[0]}.npz")
+    plain, late = trial_setup(trial), trial_setup(trial, arm_delay_s=0.25)
+    np.testing.assert_allclose(np.subtract(plain.arm.span_s, late.arm.span_s), 0.25, atol=1e-9)
+    for t in np.linspace(2.0, 12.0, 6):
+        np.testing.assert_allclose(late.arm(t)[0], plain.arm(t + 0.25)[0], atol=1e-9)
+
+
+def test_the_csv_gives_each_trials_duration_and_rmse_of_its_samples():
+    """A trial's row: its name, its set, the span of its compared samples [s] and the RMSE
+    [deg] of each prediction; a missing published simulator reads nan."""
+    from uvms_pin.apps.validation.pool import TrialComparison, summary_csv
+
+    measured = np.zeros((3, 2))
+    simulated = np.radians([[1.0, 0.0], [1.0, 0.0], [1.0, 0.0]])  # roll 1 deg off, pitch right
+    held = np.radians([[0.0, 2.0], [0.0, 2.0], [0.0, 2.0]])
+    comparison = TrialComparison(
+        "_alt_011-1", np.array([1.5, 2.5, 4.0]), measured, simulated, held, None, np.zeros((3, 4))
+    )
+    (row,) = csv.DictReader(summary_csv([comparison]).splitlines())
+    assert row["trial"] == "_alt_011-1" and row["set"] == "validation"
+    assert row["duration_s"] == "2.500"
+    assert (row["roll_rmse_deg"], row["pitch_rmse_deg"]) == ("1.0000", "0.0000")
+    assert (row["held_roll_rmse_deg"], row["held_pitch_rmse_deg"]) == ("0.0000", "2.0000")
+    assert row["published_roll_rmse_deg"] == "nan"
