@@ -154,9 +154,9 @@ def test_the_csv_gives_each_trials_duration_and_rmse_of_its_samples():
     [deg] of each prediction; a missing published simulator reads nan."""
     from uvms_pin.apps.validation.pool import TrialComparison, summary_csv
 
-    measured = np.zeros((3, 2))
-    simulated = np.radians([[1.0, 0.0], [1.0, 0.0], [1.0, 0.0]])  # roll 1 deg off, pitch right
-    held = np.radians([[0.0, 2.0], [0.0, 2.0], [0.0, 2.0]])
+    measured = np.radians([[0.5, -3.0], [0.7, -2.0], [0.2, -1.0]])
+    simulated = measured + np.radians([1.0, 0.0])  # roll 1 deg off, pitch right
+    held = measured + np.radians([0.0, 2.0])
     comparison = TrialComparison(
         "_alt_011-1", np.array([1.5, 2.5, 4.0]), measured, simulated, held, None, np.zeros((3, 4))
     )
