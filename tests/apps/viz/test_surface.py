@@ -14,6 +14,11 @@ def test_tiles_follow_the_elevation_and_slope_of_the_wave():
     wave = AiryWave(0.5, 5.0, heading_rad=0.3)
     view = SurfaceView(wave, np.array([1.0, -2.0]), half_width_m=3.0, tiles_per_side=6)
     assert len(view.names) == 36
+    # 6 x 6 tiles of 1 m cover the 6 m square about (1, -2): centres 0.5 m in from its edges
+    assert view.cell_m == 1.0
+    for axis, centre in enumerate((1.0, -2.0)):
+        ticks = np.unique(view.centers_xy_m[:, axis])
+        np.testing.assert_allclose(ticks, centre + np.arange(-2.5, 3.0, 1.0), atol=1e-12)
     for t in (0.0, 1.7):
         poses = view.poses(t)
         positions = np.array([poses[n][0] for n in view.names])
