@@ -58,7 +58,11 @@ def test_with_no_finished_run_every_stopped_run_is_excluded():
 
 def test_report_states_the_exclusion_and_leaves_the_run_out_of_the_statistics(tmp_path):
     _table().to_parquet(tmp_path / RESULTS_FILE)
-    report = write_report(tmp_path)[0].read_text()
+    written = write_report(tmp_path)
+    report = written[0].read_text()
+    # the two funnel violations drawn (which funnel, when) and shown in the report
+    (violations,) = [p for p in written if p.name == "violations.png"]
+    assert violations.stat().st_size > 5_000 and "violations.png" in report
     assert "1 run(s) stopped before the force funnel's transient ended (t = 5.9 s" in report
     row = next(line for line in report.splitlines() if line.startswith(f"| {RMS} | all"))
     # all (5): the four finished runs and the one stopped at 7 s; max 0.35, not 1.9
@@ -139,3 +143,10 @@ def test_a_metric_no_run_has_is_drawn_saying_so_not_with_an_empty_legend(tmp_pat
         warnings.simplefilter("error")
         path = scatter_figure(table, params, "force_error_N", tmp_path / "s.png")
     assert path.stat().st_size > 1000
+
+
+def test_a_study_without_funnel_violations_has_no_violations_figure(tmp_path):
+    table = _table()
+    table["status"] = "ok"
+    table.to_parquet(tmp_path / RESULTS_FILE)
+    assert not [p for p in write_report(tmp_path) if p.name == "violations.png"]
