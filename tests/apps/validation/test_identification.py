@@ -27,7 +27,10 @@ class _Comparison:
         self.value = value
 
     def rmse_deg(self, kind: str):
-        return (self.value, -self.value) if kind == "simulated" else (np.nan, np.nan)
+        if kind == "simulated":
+            return self.value, -self.value
+        # the published simulator's: odd trials have none (nan), even ones roll 10x, pitch 100x
+        return (np.nan, np.nan) if self.value % 2 else (10.0 * self.value, 100.0 * self.value)
 
 
 def test_the_fit_sees_only_the_identification_trials_and_the_means_keep_them_apart(
@@ -64,6 +67,11 @@ def test_the_fit_sees_only_the_identification_trials_and_the_means_keep_them_apa
         assert result[group]["mean_start_roll_rmse_deg"] == mean
         assert result[group]["mean_identified_roll_rmse_deg"] == 2.0 * mean
     assert set(result["trials"]) == set(names)
+    for name, row in result["trials"].items():  # each trial's own numbers, roll and pitch
+        value = number[name]
+        assert (row["start_roll_rmse_deg"], row["start_pitch_rmse_deg"]) == (value, -value)
+        published = (row["published_roll_rmse_deg"], row["published_pitch_rmse_deg"])
+        assert published == ((None, None) if value % 2 else (10.0 * value, 100.0 * value))
 
 
 def test_a_directory_of_only_the_identification_trials_has_nothing_to_hold_out(tmp_path):
