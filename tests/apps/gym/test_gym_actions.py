@@ -60,3 +60,21 @@ def test_a_scale_of_some_entries_is_their_part_and_an_override_has_their_count()
     for bad in ([1.0] * 8, None):  # nv numbers, or none, for 7 driven entries
         with pytest.raises(ParameterError, match=r"must be 7 positive|<7 numbers"):
             action_scale(Unlimited(), 8, bad, driven)
+
+
+@pytest.mark.parametrize("seed", [1, 2, 3])
+def test_capacity_is_the_best_corner_for_any_layout(seed):
+    """Five thrusters at random places and directions, their forward and reverse limits
+    unequal either way: each axis's capacity is the largest |component| over the corners
+    of the thrust box (a linear function's maximum over a box is at a corner)."""
+    rng = np.random.default_rng(seed)
+    thrusters = [
+        Thruster(f"t{k}", rng.uniform(-0.4, 0.4, 3), rng.normal(size=3), *rng.uniform(2, 30, 2))
+        for k in range(5)
+    ]
+    actuation = ThrustersAndJointLimits(thrusters, np.array([1.0]))
+    lower = -np.array([t.max_reverse_N for t in thrusters])
+    upper = np.array([t.max_forward_N for t in thrusters])
+    corners = np.array(np.meshgrid(*zip(lower, upper, strict=True))).reshape(5, -1).T
+    best = np.abs(corners @ actuation.allocation.T).max(axis=0)
+    np.testing.assert_allclose(thruster_axis_capacity(actuation), best, rtol=1e-12)
