@@ -34,3 +34,18 @@ def test_joint_limit_violation(reference_uvms):
     text = joint_limit_violation(_rollout(uvms, limited, 0.01), uvms)
     assert text.startswith(f"joint '{uvms.arm_joint_names[limited]}' left its limits [")
     assert "at t = 0.200 s" in text
+
+
+def test_a_joint_within_the_tolerance_of_a_limit_is_not_past_it(reference_uvms):
+    """On a limit, or past it by less than the 1e-6 rad tolerance (the constraint solve's
+    rounding), is inside; 1.3e-6 rad past either limit is named."""
+    uvms = reference_uvms
+    limited = int(np.flatnonzero(np.isfinite(uvms.model.upperPositionLimit[7:]))[0])
+    for excess in (0.0, 5e-7):
+        assert joint_limit_violation(_rollout(uvms, limited, excess), uvms) == ""
+    assert "left its limits" in joint_limit_violation(_rollout(uvms, limited, 1.3e-6), uvms)
+    below = _rollout(uvms, limited, 0.0)
+    low = uvms.model.lowerPositionLimit[7 + limited]
+    for excess, named in ((0.0, False), (5e-7, False), (1.3e-6, True)):
+        below.q[2, 7 + limited] = low - excess
+        assert bool(joint_limit_violation(below, uvms)) is named, excess
