@@ -4,6 +4,7 @@
 #include "pinocchio_kinematics.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <string>
 
 #include <Eigen/Geometry>
@@ -372,19 +373,18 @@ void System::constrain_fixtures(double t0, const ConstVec& q0, const ConstVec& v
     const Eigen::MatrixXd& mass = f.body.mass_matrix_in(q0_f, plant_.flow, t0, plant_.free_surface);
     const Eigen::VectorXd gap_low = q0_f - f.lower, gap_high = f.upper - q0_f;
     const JointBoxStep step = joint_box_step(v_free, mass, f.coulomb, gap_low, gap_high, h);
-    // the speeds a limit is reached at: the smooth step's end, start and mean (its joints
-    // are revolute or prismatic: q_free - q0 is the travel), as fixtures.with_fixtures
-    const Eigen::ArrayXd speed =
-        v_free.array().abs()
-            .max(v0.segment(fixture_v_[k], n).array().abs())
-            .max((q1.segment(fixture_q_[k], n) - q0_f).array().abs() / h);
     // a joint with friction, one its limit pushed, or one whose limit the period can reach
     // (a limit it may have swung through and back), is a row: its rate is the step's, and
     // the fixture moves from q0 with v+ (period.py's _end); the others keep v_free
     bool acting = false;
     Eigen::VectorXd v_plus = v_free;
     for (int j = 0; j < n; ++j) {
-      const double reach = h * speed[j] + kFixtureLimitMargin;
+      // the speeds a limit is reached at: the smooth step's end, start and mean (its joints
+      // are revolute or prismatic: q_free - q0 is the travel), as fixtures.with_fixtures
+      const double travel = std::abs(q1[fixture_q_[k] + j] - q0_f[j]) / h;
+      const double speed =
+          std::max({std::abs(v_free[j]), std::abs(v0[fixture_v_[k] + j]), travel});
+      const double reach = h * speed + kFixtureLimitMargin;
       const bool near = gap_low[j] <= reach || gap_high[j] <= reach;
       if (f.coulomb[j] > 0.0 || step.limit_impulse[j] != 0.0 || near) {
         v_plus[j] = step.velocity[j];
