@@ -10,7 +10,10 @@ from conftest import ROOT
 from uvms_pin.control.base import Controller
 from uvms_pin.errors import ActuationWarning, FunnelViolation
 from uvms_pin.scenario.load import load_scenario
+from uvms_pin.sim.closed_loop import ClosedLoop
+from uvms_pin.sim.log import RolloutLog
 from uvms_pin.sim.run import simulate
+from uvms_pin.sim.sensors import SensorSuite
 
 REALISTIC = ROOT / "scenarios" / "realistic_force_tracking.toml"
 PAPER = ROOT / "scenarios" / "paper_force_tracking.toml"
@@ -168,3 +171,42 @@ def test_after_either_loop_the_controller_holds_the_last_ticks_signals():
         core.force_desired_world_N, last["force_desired_world_N"], atol=1e-12
     )
     np.testing.assert_allclose(core.rpy_desired, last["rpy_desired"], atol=1e-12)
+
+
+def _loop_after(path, overrides, compiled):
+    """The `ClosedLoop` after running ``path`` (compiled or in Python): (loop, rollout)."""
+    scenario = load_scenario(path, {"scenario.duration_s": 1.0, **overrides})
+    settings = scenario.settings
+    loop = ClosedLoop(
+        scenario.plant, settings, scenario.controller_factory(scenario.uvms), compiled=compiled
+    )
+    sensors = SensorSuite(
+        scenario.uvms.model, scenario.sensor_config, settings.duration_s, settings.seed
+    )
+    try:
+        rollout = loop.run(scenario.q0, scenario.v0, sensors, RolloutLog(scenario.uvms, 8, {}))
+    except FunnelViolation as exc:
+        rollout = exc.rollout
+    assert rollout.metadata["closed_loop"]["path"] == ("compiled" if compiled else "python")
+    return loop, rollout
+
+
+@pytest.mark.parametrize(
+    "path, overrides, time_s",
+    [(REALISTIC, {"scenario.duration_s": 0.3}, 0.3), (PAPER, PAPER_SAMPLED, 93 * 0.002)],
+    ids=["whole-run", "funnel-stop"],
+)
+def test_after_either_loop_its_time_and_state_are_the_last_ticks(path, overrides, time_s):
+    """The loop's clock and state after a run (what a script driving `ClosedLoop` reads
+    next): the last tick's, the compiled loop's as the Python loop's; after a whole run the
+    rollout's last row (no step after the last tick), after a stop the violating tick's."""
+    (core, core_rollout), (python, _) = (_loop_after(path, overrides, c) for c in (True, False))
+    assert core.time_s == python.time_s == pytest.approx(time_s, abs=1e-12)
+    for name in ("q", "v"):
+        scale = max(1.0, float(np.max(np.abs(getattr(python, name)))))
+        np.testing.assert_allclose(
+            getattr(core, name), getattr(python, name), rtol=0, atol=1e-12 * scale
+        )
+    if core_rollout.status.ok:
+        assert core_rollout.time_s[-1] == pytest.approx(core.time_s, abs=1e-12)
+        np.testing.assert_array_equal(core_rollout.q[-1], core.q)
