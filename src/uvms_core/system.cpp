@@ -384,7 +384,7 @@ void System::constrain_fixtures(double t0, const ConstVec& q0, const ConstVec& v
       const double travel = std::abs(q1[fixture_q_[k] + j] - q0_f[j]) / h;
       const double speed =
           std::max({std::abs(v_free[j]), std::abs(v0[fixture_v_[k] + j]), travel});
-      const double reach = h * speed + kFixtureLimitMargin;
+      const double reach = h * speed + fixture_limit_margin;
       const bool near = gap_low[j] <= reach || gap_high[j] <= reach;
       if (f.coulomb[j] > 0.0 || step.limit_impulse[j] != 0.0 || near) {
         v_plus[j] = step.velocity[j];

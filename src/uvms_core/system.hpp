@@ -51,10 +51,6 @@
 
 namespace uvms {
 
-// A fixture joint's limit is a row once its gap is at most h |v| + this [rad or m] (the
-// margin of fixtures.constraints' JointLimits, as joint_limits.hpp's)
-constexpr double kFixtureLimitMargin = 1.0e-3;
-
 // A fixture of the system: its joints' dynamics (a fixed-base model, its links in the water)
 // and what acts along each joint: viscous damping D, Coulomb friction c, position limits.
 struct FixtureBody {
@@ -101,6 +97,9 @@ class System {
   bool rigid_objects = false;
   // the moving bodies touch each other by rigid contacts (World.moving_contact)
   bool rigid_pairs = false;
+  // a fixture joint's limit is a row once its gap is at most h |v| + this [rad or m]: the
+  // margin of the fixtures' JointLimits (sim/system/fixtures.py), set by sim/compiled/system.py
+  double fixture_limit_margin = 1.0e-3;
 
   // Point forces from bodies outside the system (the other robots of a RobotsSystem): the
   // world force [N] at a world point [m] on a joint's body of the robot (side -1) or of an

@@ -334,6 +334,9 @@ void bind_system(nb::module_& m) {
       .def_rw("rigid_pairs", &System::rigid_pairs,
               "The moving bodies touch each other by rigid contacts, every row of the "
               "system solved in one problem at each period's end (moving_constraints.hpp).")
+      .def_rw("fixture_limit_margin", &System::fixture_limit_margin,
+              "A fixture joint's limit is a row of its exact step once its gap is at most "
+              "h |v| + this [rad or m] (the fixtures' JointLimits margin).")
       .def(
           "rigid_contacts",
           [](System& s) {

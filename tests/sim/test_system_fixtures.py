@@ -6,6 +6,8 @@ by the Python integrator (rigid ones), and says which."""
 
 from __future__ import annotations
 
+import dataclasses
+
 import numpy as np
 import pinocchio as pin
 import pytest
@@ -287,12 +289,18 @@ def test_a_free_object_started_inside_a_fixture_is_refused_or_moved_out():
 LONG_PERIOD_LIMITS = (-0.1, 0.2)
 
 
-def _lever_at_period_ends(uvms, tmp_path, period_s, periods, compiled=True):
+def _lever_at_period_ends(uvms, tmp_path, period_s, periods, compiled=True, margin=None):
     """The frictionless lever (limits -0.1 and 0.2 rad, released at 0) at each period's end
-    over ``periods`` periods of ``period_s``."""
+    over ``periods`` periods of ``period_s`` (``margin``: its limits' selection margin [rad]
+    instead of the fixtures' default)."""
     lever = _lever(tmp_path, friction_Nm=0.0, limits=LONG_PERIOD_LIMITS)
     world = World(uvms, [], fixtures=[lever])
     system = System(Plant(uvms, free_surface=False, world=world), compiled=compiled)
+    if margin is not None:
+        system.fixture_constraints = tuple(
+            dataclasses.replace(c, margin=margin) if isinstance(c, JointLimits) else c
+            for c in system.fixture_constraints
+        )
     q0 = uvms.neutral_configuration()
     q0[:3] = FAR
     state = system.initial_state(q0, np.zeros(uvms.nv))
@@ -333,3 +341,26 @@ def test_a_period_longer_than_the_swing_never_ends_past_a_limit(
     lower, upper = LONG_PERIOD_LIMITS
     angles = _lever_at_period_ends(reference_uvms, tmp_path, period_s, 6, compiled)
     assert np.all((angles >= lower - 1e-9) & (angles <= upper + 1e-9)), angles
+
+
+def test_the_compiled_system_selects_fixture_limits_with_the_python_margin(
+    reference_uvms, tmp_path
+):
+    """A fixture joint's limit is a row once its gap is at most h |v| + the margin of the
+    fixtures' `JointLimits`; the compiled system is given that margin, not a copy of its
+    default. With a margin of 0.5 rad the lever's limits (0.1 and 0.2 rad away) are rows from
+    the first period: each period then ends at q0 + h v+, not at the smooth step's end, and
+    the two paths agree; with the default, far from its limits, the lever swings by the
+    smooth step."""
+    lower, upper = LONG_PERIOD_LIMITS
+    runs = {
+        (compiled, margin): _lever_at_period_ends(
+            reference_uvms, tmp_path, 0.01, 5, compiled, margin
+        )
+        for compiled in (True, False)
+        for margin in (None, 0.5)
+    }
+    for margin in (None, 0.5):
+        np.testing.assert_allclose(runs[True, margin], runs[False, margin], rtol=0, atol=1e-9)
+    assert np.max(np.abs(runs[True, 0.5] - runs[True, None])) > 1e-4
+    assert np.all((runs[True, 0.5] > lower) & (runs[True, 0.5] < upper))

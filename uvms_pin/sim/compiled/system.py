@@ -14,6 +14,7 @@ from typing import Any, Protocol
 from uvms_pin.errors import ModelError
 from uvms_pin.physics.compiled.backend import Fallback
 from uvms_pin.physics.compiled.moving import moving_to_core
+from uvms_pin.physics.constraints.joint_limits import JointLimits
 from uvms_pin.physics.dynamics import dynamics_of
 
 __all__ = ["SystemParts", "system_to_core"]
@@ -25,6 +26,7 @@ class SystemParts(Protocol):
     plant: Any
     objects: tuple
     fixtures: tuple
+    fixture_constraints: tuple  # their joints' limits and friction (`sim.system.fixtures`)
     moving: Any
     attachments: Any  # `uvms_pin.physics.constraints.attachments.Attachments`, or None
 
@@ -45,6 +47,10 @@ def system_to_core(system: SystemParts, core: ModuleType, *, alone: bool = False
         [f.damping for f in fixtures], [f.coulomb for f in fixtures],
         *zip(*[f.limits for f in fixtures], strict=True) if fixtures else ([], []),
     )  # fmt: skip
+    # the fixture joints' rows are selected with the Python step's margin, not a copy of it
+    for limits in system.fixture_constraints:
+        if isinstance(limits, JointLimits):
+            out.fixture_limit_margin = limits.margin
     try:
         moving_to_core(system.moving.moving, out, core)
     except ModelError as exc:  # a piece without a compiled geometry
