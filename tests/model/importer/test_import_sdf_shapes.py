@@ -186,3 +186,36 @@ def test_a_limit_without_lower_or_upper_takes_minus_and_plus_pi(tmp_path):
     other = uvms.model.joints[uvms.model.getJointId("vertical_fins_joint")].idx_q
     assert uvms.model.lowerPositionLimit[other] == pytest.approx(-0.261799, abs=1e-12)
     assert uvms.model.upperPositionLimit[other] == pytest.approx(math.pi, abs=1e-12)
+
+
+def test_a_links_centre_of_buoyancy_is_its_primitives_volume_centroid():
+    """A box and a sphere: the centroid weighted by their closed-form volumes; a link with a
+    mesh alone displaces nothing, its centre the link's origin (3,), and is said so."""
+    import xml.etree.ElementTree as ET
+
+    from uvms_pin.model.importer.collision_volume import collision_volume
+
+    both = ET.fromstring(
+        '<link name="two"><collision><origin xyz="1 0 0"/><geometry><box size="0.2 0.1 0.5"/>'
+        '</geometry></collision><collision><origin xyz="0 2 -1"/><geometry>'
+        '<sphere radius="0.3"/></geometry></collision></link>'
+    )
+    notes: list[str] = []
+    volume, centre = collision_volume(both, "test.urdf", notes)
+    box, sphere = 0.2 * 0.1 * 0.5, 4.0 / 3.0 * math.pi * 0.3**3
+    assert volume == pytest.approx(box + sphere, rel=1e-15)
+    np.testing.assert_allclose(
+        centre, (box * np.array([1, 0, 0]) + sphere * np.array([0, 2, -1])) / (box + sphere),
+        rtol=0, atol=1e-15,
+    )  # fmt: skip
+    assert notes == []
+    mesh = ET.fromstring(
+        '<link name="hull"><collision><geometry><mesh filename="hull.stl"/></geometry>'
+        "</collision></link>"
+    )
+    volume, centre = collision_volume(mesh, "test.urdf", notes)
+    assert volume == 0.0
+    assert centre.shape == (3,) and not centre.any()
+    assert notes == [
+        "link 'hull': a collision shape without a primitive volume left out of its buoyancy"
+    ]

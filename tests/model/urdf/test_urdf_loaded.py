@@ -8,6 +8,7 @@ import warnings
 from pathlib import Path
 
 import numpy as np
+import pinocchio as pin
 import pytest
 
 import uvms_pin as up
@@ -117,3 +118,20 @@ def test_a_missing_file_is_the_loaders_error(tmp_path, bad):
 def test_a_path_that_is_not_one_is_a_parameter_error(bad):
     with pytest.raises(up.ParameterError, match="urdf_path must be a path"):
         up.load_uvms(bad)
+
+
+def test_a_mass_scale_scales_the_whole_rigid_body_mass_matrix_armature_included():
+    """M_rb (Pinocchio's CRBA: the bodies' inertias and the joints' armature) of a copy
+    with mass_scale s is s M_rb, on a model whose arm joints have a rotor's armature."""
+    uvms = loaded_uvms(MODEL, water_density_kg_m3=1025.0)
+    model = pin.Model(uvms.model)
+    model.armature[6:] = 0.02  # kg m^2 on each arm joint
+    geared = uvms.with_model(model)
+    q = uvms.neutral_configuration()
+    q[7:] = np.linspace(0.2, 0.8, model.nq - 7)  # the arm bent: M_rb couples its joints
+    heavier = scaled_uvms(geared, mass_scale=1.7)
+    np.testing.assert_array_equal(heavier.model.armature, 1.7 * model.armature)
+    m_rb = pin.crba(model, model.createData(), q)
+    np.testing.assert_allclose(
+        pin.crba(heavier.model, heavier.model.createData(), q), 1.7 * m_rb, rtol=1e-12, atol=1e-12
+    )
