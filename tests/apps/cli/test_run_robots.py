@@ -47,6 +47,8 @@ def test_the_progress_is_shown_unless_quiet(tmp_path, capsys):
     assert main(args) == 0
     shown = capsys.readouterr().err
     assert "two_robots" in shown and "0.10" in shown
+    # without --html, no replay page
+    assert not (tmp_path / "out" / "replay.html").exists()
 
 
 def test_the_replay_of_a_run_of_two_robots_draws_both_and_a_live_view_names_one(tmp_path, capsys):
