@@ -127,16 +127,11 @@ def test_the_compiled_step_is_the_references(tmp_path, force_N):
         assert qc[7] == pytest.approx(upper[0], abs=1e-6)
 
 
-def test_rigid_contacts_with_joint_friction_are_compiled_as_the_reference(tmp_path):
-    """The jaw's fingers, each with 0.3 N of Coulomb friction, close on a free ball (2 mm
-    off each pad, 0.5 mm off centre) and squeeze it by rigid contacts: the compiled system
-    solves the fingers' friction as box rows with the contact rows
-    (src/uvms_core/moving_constraints.hpp, projected Gauss-Seidel to 1e-10 m/s); the
-    reference solves the same rows by Pinocchio's ADMM (`period.constrained`, 1e-10 with
-    joint friction). Over 0.4 s the configurations agree to 1e-6 (measured 2.7e-7 m). The
-    velocities agree to 2e-4 m/s only: the reference's ADMM stalls on the squeezed ball (111
-    of 200 periods accepted as stalled, residual up to 5.4e-6 m/s), and in such a period its
-    fingers creep at up to 1.4e-4 m/s where the compiled solve holds them to 1e-10."""
+def _squeezed(tmp_path, finger_force_N: tuple[float, float]):
+    """The jaw's fingers (0.3 N of Coulomb friction each) pushed by ``finger_force_N`` (left,
+    right; negative closes) beside a free ball (2 mm off each pad, 0.5 mm off centre), every
+    contact rigid, 200 periods on the compiled system and on the reference: (uvms, [compiled
+    run, reference run] (periods, q and v), [their systems])."""
     uvms, q = _jaw(tmp_path)
     data = {
         "scenario": {"name": "squeeze", "model": str(parallel_jaw_urdf(tmp_path)),
@@ -163,7 +158,7 @@ def test_rigid_contacts_with_joint_friction_are_compiled_as_the_reference(tmp_pa
         state = system.initial_state(q, np.zeros(uvms.nv))
         system.start(state)
         tau = np.zeros(uvms.nv)
-        tau[6:8] = -1.5  # both fingers pushed closed, 1.2 N net of their friction
+        tau[6:8] = finger_force_N
         q_s, v_s, out = state.q, state.v, []
         for k in range(200):
             t0, t1 = k * PERIOD_S, (k + 1) * PERIOD_S
@@ -171,6 +166,21 @@ def test_rigid_contacts_with_joint_friction_are_compiled_as_the_reference(tmp_pa
             out.append(np.concatenate([q_s, v_s]))
         runs.append(np.array(out))
         systems.append(system)
+    return uvms, runs, systems
+
+
+def test_rigid_contacts_with_joint_friction_are_compiled_as_the_reference(tmp_path):
+    """The jaw's fingers, each with 0.3 N of Coulomb friction, close on a free ball (2 mm
+    off each pad, 0.5 mm off centre) and squeeze it by rigid contacts: the compiled system
+    solves the fingers' friction as box rows with the contact rows
+    (src/uvms_core/moving_constraints.hpp, projected Gauss-Seidel to 1e-10 m/s); the
+    reference solves the same rows by Pinocchio's ADMM (`period.constrained`, 1e-10 with
+    joint friction). Over 0.4 s the configurations agree to 1e-6 (measured 2.7e-7 m). The
+    velocities agree to 2e-4 m/s only: the reference's ADMM stalls on the squeezed ball (111
+    of 200 periods accepted as stalled, residual up to 5.4e-6 m/s), and in such a period its
+    fingers creep at up to 1.4e-4 m/s where the compiled solve holds them to 1e-10."""
+    # both fingers pushed closed, 1.2 N net of their friction
+    uvms, runs, systems = _squeezed(tmp_path, (-1.5, -1.5))
     (compiled_run, reference_run), nq = runs, uvms.nq + 7
     # they closed on the ball and hold it: the pads' inner faces (10 mm + q off the centre
     # line) one diameter apart, q_left + q_right = 40 - 20 mm, to the solve's gap
@@ -180,3 +190,22 @@ def test_rigid_contacts_with_joint_friction_are_compiled_as_the_reference(tmp_pa
     assert systems[0].stalled_solves().count == 0
     np.testing.assert_allclose(compiled_run[:, :nq], reference_run[:, :nq], rtol=0.0, atol=1e-6)
     np.testing.assert_allclose(compiled_run[:, nq:], reference_run[:, nq:], rtol=0.0, atol=2e-4)
+
+
+def test_a_finger_held_on_its_limit_beside_a_rigid_contact_is_compiled_as_the_reference(tmp_path):
+    """The left finger, closing, pushes the ball across against the right one, which is
+    driven open onto its limit; the left one ends on its closed limit. The robot's limit
+    rows join the contacts' in the coupled solve (a limit the period can reach:
+    gap <= h |v| + margin, src/uvms_core/moving_constraints.cpp); both fingers end on their
+    limits, never past them, on the compiled system as on the reference (measured: 7e-13
+    m, configurations agreeing to 6e-9 m, velocities 9e-8 m/s). The margin subtracted
+    there instead of added left the resting fingers without rows: 1 mm past the limit and a
+    run 0.3 m from the reference's."""
+    uvms, (compiled_run, reference_run), _ = _squeezed(tmp_path, (-1.5, 1.5))
+    lower, upper = uvms.model.lowerPositionLimit[7:9], uvms.model.upperPositionLimit[7:9]
+    for run in (compiled_run, reference_run):
+        assert np.all(run[:, 7:9] >= lower - 1e-9) and np.all(run[:, 7:9] <= upper + 1e-9)
+        np.testing.assert_allclose(run[-1, 7:9], [lower[0], upper[1]], rtol=0, atol=1e-9)
+    ball_y = uvms.nq + 1
+    assert compiled_run[-1, ball_y] < -0.015  # pushed along by the closing finger
+    np.testing.assert_allclose(compiled_run, reference_run, rtol=0.0, atol=1e-6)
