@@ -250,7 +250,7 @@ def test_robots_that_start_inside_each_other_or_another_robots_object_are_refuse
 ):
     """Two robots 5 cm apart (their hulls 25 cm into each other: 16 kN at once), or the
     first robot's free box placed inside bravo: refused before the run, naming both bodies
-    and the depth, as a robot inside a rock is; robots 1.5 m apart with the box clear run."""
+    and the depth, as a robot inside a rock is (and, for the box, that it may be moved); robots 1.5 m apart with the box clear run."""
     from uvms_pin.errors import InitialOverlapError
 
     doc = copy.deepcopy(read_toml(TWO, ScenarioError))
@@ -260,8 +260,12 @@ def test_robots_that_start_inside_each_other_or_another_robots_object_are_refuse
     box = {"type": "box", "name": "box", "size_m": [0.2, 0.2, 0.2], "density_kg_m3": 1025.0,
            "position_world_m": box_at or [0.0, 0.0, -4.0]}  # fmt: skip
     doc["world"] = {"objects": [box]}
-    with pytest.raises(InitialOverlapError, match=rf"{bodies} \d+ mm at the start.*start them"):
+    with pytest.raises(
+        InitialOverlapError, match=rf"{bodies} \d+ mm at the start.*start them"
+    ) as caught:
         simulate_robots(scenario_from_dict(doc, TWO))
+    # an object in the pair: it may be moved instead (the first object is side 2)
+    assert ("or move the object" in str(caught.value)) == (box_at is not None)
     doc["robots"][1]["initial"]["position_world_m"] = [0.0, 1.5, -2.0]
     box["position_world_m"] = [0.0, 0.0, -4.0]
     assert simulate_robots(scenario_from_dict(doc, TWO)).status.ok
