@@ -166,3 +166,15 @@ def test_a_wave_steeper_than_one_in_seven_is_refused_naming_its_height_and_lengt
         AiryWave(1.01 * length_m / 14.0, 8.0)
     with pytest.raises(ParameterError, match="water_depth_m"):
         AiryWave(0.5, 5.0, water_depth_m=0.0)
+
+
+def test_by_default_a_wave_travels_along_x_with_its_crest_at_the_origin():
+    """heading 0 and phase 0 unless given: eta = A cos(k x - w t), the orbital velocity in
+    the x-z plane (none along y), the crest over the origin at t = 0."""
+    wave = AiryWave(0.5, 5.0)
+    k = wave.wavenumber_rad_m
+    for t in (0.0, 1.3):
+        for x, y in ((0.0, 0.0), (2.0, 0.0), (2.0, 7.0), (-3.0, -4.0)):
+            eta = wave.surface_elevation(t, np.array([[x, y]]))[0]
+            assert eta == pytest.approx(0.5 * math.cos(k * x - 2 * math.pi / 5.0 * t), abs=1e-12)
+            assert abs(wave.velocity(t, [x, y, -1.0])[0, 1]) < 1e-15
