@@ -3,6 +3,7 @@ outside the repository."""
 
 from __future__ import annotations
 
+import dataclasses
 import inspect
 import re
 from functools import cache
@@ -428,20 +429,26 @@ def _controller_parameter_defaults() -> dict[str, set]:
         for value in vars(importlib.import_module(info.name)).values():
             if not isinstance(value, type) or value.__module__ != info.name:
                 continue  # a class the module imports is read where it is defined
+            factories = (
+                {f.name: f.default_factory for f in dataclasses.fields(value)}
+                if dataclasses.is_dataclass(value)
+                else {}
+            )
             for name, parameter in inspect.signature(value.__init__).parameters.items():
-                if parameter.default not in (inspect.Parameter.empty, None):
-                    out.setdefault(f"controller.{name}", set()).add(_hashable(parameter.default))
+                default = parameter.default
+                if factories.get(name, dataclasses.MISSING) is not dataclasses.MISSING:
+                    default = factories[name]()  # a field's default_factory: what it makes
+                if default is inspect.Parameter.empty or default is None:
+                    continue
+                if isinstance(default, dict):
+                    continue  # a table of values: no key's literal default
+                out.setdefault(f"controller.{name}", set()).add(_hashable(default))
     return out
 
 
-def test_every_default_docs_scenarios_gives_is_the_one_the_reader_takes():
-    """A key absent from the file takes the default its row says. Each literal default in
-    docs/scenarios.md is one the code gives the key (the reader's, or the controller's that
-    the ``[controller]`` table fills); each default the reader gives is one the key's rows
-    say (their default column, or "default N" in their meaning, as a key read by several
-    controllers is documented); a key said to be "required" is read without one."""
-    reads, records = scenario_reads(), _controller_parameter_defaults()
-    rows = [row[1:] for row in _table_rows((DOCS / "scenarios.md").read_text())]
+def _said_defaults(rows: list[tuple[str, str, str]]) -> dict[str, list]:
+    """Each key's documented defaults: its row's default column, and "default N" in its
+    meaning or "`key` default N" in another row's (a key read by several controllers)."""
     said: dict[str, list] = {}
     for key, text, meaning in rows:
         short = re.escape(key.rsplit(".", 1)[-1])
@@ -452,6 +459,18 @@ def test_every_default_docs_scenarios_gives_is_the_one_the_reader_takes():
         said.setdefault(key, []).extend(
             v for v in (_literal(text), *map(float, mentions)) if v is not None
         )
+    return said
+
+
+def test_every_default_docs_scenarios_gives_is_the_one_the_reader_takes():
+    """A key absent from the file takes the default its row says. Each literal default in
+    docs/scenarios.md is one the code gives the key (the reader's, or the controller's that
+    the ``[controller]`` table fills); each default the reader gives is one the key's rows
+    say (their default column, or "default N" in their meaning, as a key read by several
+    controllers is documented); a key said to be "required" is read without one."""
+    reads, records = scenario_reads(), _controller_parameter_defaults()
+    rows = [row[1:] for row in _table_rows((DOCS / "scenarios.md").read_text())]
+    said = _said_defaults(rows)
     checked, wrong = 0, []
     for key, text, _ in rows:
         read = {d for d in reads.get(key, ()) if d is not None}
@@ -489,6 +508,38 @@ def _same_default(documented, read) -> bool:
     documented, read = np.atleast_1d(documented), np.atleast_1d(read)
     # the table's digits: pi / 6 is documented as 0.5236
     return documented.shape == read.shape and np.allclose(documented, read, rtol=1e-4, atol=0)
+
+
+#: a controller's parameter named as a documented key that the key does not set (it is read
+#: for other controllers): (key, the parameter's default) -> whose it is
+_NAMED_AS_A_KEY = {
+    ("controller.damping", 0.001): "the task-priority law's damped pseudo-inverse "
+    "(`TaskPrioritySpec.damping`, the scenario's pinv_damping)",
+    ("controller.position_gain_per_s2", 25.0): "computed torque's motion task "
+    "(`InnerLoopGains`, built in Python only)",
+}
+
+
+def test_every_controllers_default_for_a_documented_key_is_a_documented_one():
+    """What a ``[controller]`` table without the key gives is the controller's own default:
+    each controller's (every class of uvms_pin.control, constructor keywords and record
+    fields) default for a documented key is one of the defaults the docs give it, not only
+    some controller's; the few parameters that share a key's name without being what it
+    sets are named (`_NAMED_AS_A_KEY`)."""
+    said = _said_defaults([row[1:] for row in _table_rows((DOCS / "scenarios.md").read_text())])
+    checked, wrong = 0, []
+    for key, defaults in _controller_parameter_defaults().items():
+        values = said.get(key)
+        if not values:
+            continue  # not a documented key, or its default said in words
+        for default in defaults:
+            if (key, default) in _NAMED_AS_A_KEY:
+                continue
+            checked += 1
+            if not any(_same_default(v, default) for v in values):
+                wrong.append(f"{key}: a controller's default {default}, documented {values}")
+    assert checked >= 40, f"only {checked} controller defaults compared"
+    assert not wrong, "docs/scenarios.md and the controllers disagree:\n" + "\n".join(wrong)
 
 
 def _agrees(default, text: str) -> bool | None:
