@@ -85,6 +85,15 @@ def test_the_compiled_coupled_step_follows_the_reference(load_body):
     for mine, theirs in zip([*core_sets, *core_fixed], [*ref_sets, *ref_fixed], strict=True):
         resultant = mine.force_world_N.sum(axis=0)
         np.testing.assert_allclose(resultant, theirs.force_world_N.sum(axis=0), atol=0.05)
+    # each point's normal force is its force along its normal (out of b, towards a), and
+    # pushes: both paths, the pairs and the objects on the floor
+    for found in [*core_sets, *core_fixed, *ref_sets, *ref_fixed]:
+        along = np.einsum("ki,ki->k", found.force_world_N, found.touch.normal_world)
+        np.testing.assert_allclose(found.normal_N, along, rtol=0, atol=1e-9)
+        assert np.all(found.normal_N >= -1e-9)
+        # rigid: the points end touching, not inside (their penetration, not their gap)
+        assert np.all(found.touch.depth_m <= 1e-6) and np.all(found.touch.depth_m >= 0.0)
+    assert max(float(np.max(f.normal_N)) for f in ref_sets if len(f)) > 1.0
 
 
 def _objects(system: System, q, v):
