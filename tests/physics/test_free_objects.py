@@ -256,3 +256,22 @@ def test_a_free_mesh_has_its_volume_mass_and_a_positive_inertia():
     assert big.mass_kg == pytest.approx(8.0 * rock.mass_kg, rel=1e-9)
     assert big.uvms.hydro_bodies[0].params.volume_m3 == pytest.approx(8.0 * body.params.volume_m3)
     np.testing.assert_allclose(big.uvms.model.inertias[1].inertia, 32.0 * inertia, rtol=1e-9)
+
+
+def test_a_free_objects_record_is_its_start():
+    """What the views draw and a rollout keeps of a free object: its start pose (position
+    (3,) and rotation), mass, friction and sizes."""
+    from uvms_pin.physics.world.free_object import free_object
+
+    box = free_object(
+        "box", "box", {"size_m": [0.2, 0.4, 0.6]}, ([1.0, -2.0, -3.0], [0.1, -0.2, 0.3]),
+        density_kg_m3=1500.0, water_density_kg_m3=1025.0, friction=(0.7, 0.4),
+    )  # fmt: skip
+    record = box.record()
+    assert record["position_world_m"] == [1.0, -2.0, -3.0]
+    np.testing.assert_allclose(
+        record["rotation_world"], pin.rpy.rpyToMatrix(0.1, -0.2, 0.3), rtol=0, atol=1e-15
+    )
+    assert record["mass_kg"] == pytest.approx(1500.0 * 0.2 * 0.4 * 0.6, rel=1e-12)
+    assert (record["friction_static"], record["friction_kinetic"]) == (0.7, 0.4)
+    assert record["size_m"] == [0.2, 0.4, 0.6] and record["free"] is True
