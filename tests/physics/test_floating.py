@@ -231,3 +231,28 @@ def test_energy_is_conserved_as_arm_links_cross_the_surface(reference_uvms):
     assert len(crossed) >= 4  # the hull and three arm links
     assert drift[1] < 2e-5 * kinetic0
     assert drift[1] < drift[0] / 3
+
+
+def test_the_net_hydrostatic_load_is_the_world_force_and_moments_on_the_body(load_body):
+    """`net_hydrostatic_load` (F_z, M_x, M_y), world axes at the vehicle's origin: the box
+    at its draft, heeled by 0.05 rad about x, then about y: F_z = 0 to first order and the
+    moment rights it, -rho g V GM phi on the heel's own axis (the sign of each, and which
+    axis, are what the equilibrium search does not see: it finds zeros)."""
+    from uvms_pin.physics.floating import net_hydrostatic_load
+
+    uvms = _box(load_body)
+    draft = BOX_MASS / (RHO * A * B)
+    z = C / 2 - draft
+    volume = BOX_MASS / RHO
+    np.testing.assert_allclose(net_hydrostatic_load(uvms, _at(uvms, z)), 0.0, atol=1e-9)
+    deep = net_hydrostatic_load(uvms, _at(uvms, -5.0))
+    assert deep[0] == pytest.approx((RHO * A * B * C - BOX_MASS) * G, rel=1e-9)  # buoyant
+    phi = 0.05
+    for axis, second_moment in ((0, A * B**3 / 12), (1, B * A**3 / 12)):
+        gm = draft / 2 + second_moment / volume - C / 2
+        rpy = [0.0, 0.0, 0.0]
+        rpy[axis] = phi
+        force_z, *moments = net_hydrostatic_load(uvms, _at(uvms, z, rpy))
+        assert moments[axis] == pytest.approx(-RHO * G * volume * gm * phi, rel=0.03)
+        assert abs(moments[1 - axis]) < 1e-6 * abs(moments[axis])
+        assert abs(force_z) < 0.01 * BOX_MASS * G
