@@ -39,6 +39,10 @@ def test_the_stop_torque_is_zero_inside_the_range_and_pushes_back_outside():
     v[6:] = [-50.0, 50.0]
     assert np.all(stops.torque(q, v) == 0.0)
     assert stops.at_stop(q).tolist() == [True, True]
+    # any penetration pushes, however small: 1 mm rad past either stop at rest
+    q[7:], v[6:] = [1.001, -0.001], 0.0
+    tau = stops.torque(q, v)
+    assert tau[6] == pytest.approx(-100.0 * 0.001) and tau[7] == pytest.approx(100.0 * 0.001)
 
 
 @pytest.mark.parametrize("joint", [0, 2])
