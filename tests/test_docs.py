@@ -435,9 +435,9 @@ def _controller_parameter_defaults() -> dict[str, set]:
                 else {}
             )
             for name, parameter in inspect.signature(value.__init__).parameters.items():
-                default = parameter.default
-                if factories.get(name, dataclasses.MISSING) is not dataclasses.MISSING:
-                    default = factories[name]()  # a field's default_factory: what it makes
+                factory = factories.get(name, dataclasses.MISSING)
+                # a field's default_factory: what it makes
+                default = parameter.default if factory is dataclasses.MISSING else factory()
                 if default is inspect.Parameter.empty or default is None:
                     continue
                 if isinstance(default, dict):

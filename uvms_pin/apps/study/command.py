@@ -61,11 +61,9 @@ def _cmd_sweep(args: argparse.Namespace) -> int:
 def _workers_text(workers: int | None) -> str:
     if workers == 0:
         return "this process (serial)"
-    return (
-        "1 local worker process"
-        if workers == 1
-        else f"{workers or 'cpu-count'} local worker processes"
-    )
+    if workers == 1:
+        return "1 local worker process"
+    return f"{workers or 'cpu-count'} local worker processes"
 
 
 def _cmd_report(args: argparse.Namespace) -> int:
