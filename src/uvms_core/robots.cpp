@@ -193,30 +193,34 @@ void RobotsSystem::side_state(std::size_t side, Eigen::Index& at_q, Eigen::Index
   nv = 6;
 }
 
-bool RobotsSystem::near(const ConstVec& q, const ConstVec& v, double horizon_s) {
+void RobotsSystem::root_spheres(const ConstVec& q, const ConstVec& v, double horizon_s) {
   const std::size_t n_sides = systems_.size() + systems_[0]->n_objects();
   if (reach_m.size() != n_sides) {
     throw InputError("robots: one reach per side (the robots, then the first's objects)");
   }
   if (q.size() != model_.nq || v.size() != model_.nv) throw InputError("robots: q, v sizes");
   // each side's sphere about its root (robot_reach.reach_sphere)
-  std::vector<Vec3>& centers = centers_;
-  std::vector<double>& radii = radii_;
-  centers.resize(n_sides);
-  radii.resize(n_sides);
+  centers_.resize(n_sides);
+  radii_.resize(n_sides);
   for (std::size_t side = 0; side < n_sides; ++side) {
     Eigen::Index at_q = 0, at_v = 0, nv = 0;
     side_state(side, at_q, at_v, nv);
-    centers[side] = q.segment<3>(at_q);
+    centers_[side] = q.segment<3>(at_q);
     const double reach = reach_m[side];
     if (std::isinf(reach)) {
-      radii[side] = reach;
+      radii_[side] = reach;
       continue;
     }
     const double speed = v.segment<3>(at_v).norm() + v.segment<3>(at_v + 3).norm() * reach +
                          2.0 * reach * v.segment(at_v + 6, nv - 6).cwiseAbs().sum();
-    radii[side] = reach + 2.0 * speed * horizon_s + clearance_m;
+    radii_[side] = reach + 2.0 * speed * horizon_s + clearance_m;
   }
+}
+
+bool RobotsSystem::near(const ConstVec& q, const ConstVec& v, double horizon_s) {
+  root_spheres(q, v, horizon_s);
+  const std::vector<Vec3>& centers = centers_;
+  const std::vector<double>& radii = radii_;
   std::vector<std::size_t>& close = close_;
   close.clear();
   for (std::size_t s = 0; s < sets.size(); ++s) {

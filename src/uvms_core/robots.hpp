@@ -61,6 +61,11 @@ class RobotsSystem {
   // (robot_reach.reach_sphere), then for two sides whose spheres meet every pair's pieces'
   // spheres, radius r + 2 (|v_j| + |w_j| (|c| + r)) h + clearance (touch.reach_spheres).
   bool near(const ConstVec& q, const ConstVec& v, double horizon_s);
+  // near()'s first test: each side's sphere about its root over horizon_s (centre, radius;
+  // inf: no bound), the robots then the first system's objects, kept until the next call.
+  void root_spheres(const ConstVec& q, const ConstVec& v, double horizon_s);
+  const std::vector<Vec3>& root_centers() const { return centers_; }
+  const std::vector<double>& root_radii() const { return radii_; }
   // Each robot's wrench on the free objects at (q, v) (n_robots x 6, world axes): the force
   // [N] its pieces exert on them, summed, and its moment about the world's origin [N m],
   // sum of x (-f) with f the force on the robot at x: the first robot's from its system's

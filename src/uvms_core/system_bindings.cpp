@@ -225,6 +225,22 @@ void bind_robots(nb::module_& m) {
           "q"_a, "v"_a, "horizon_s"_a,
           "Whether some pair of sides may touch within horizon_s (Robots.near).")
       .def(
+          "root_spheres",
+          [](RobotsSystem& r, const Eigen::VectorXd& q, const Eigen::VectorXd& v,
+             double horizon_s) {
+            check_robots_state(r, q, v);
+            r.root_spheres(q, v, horizon_s);
+            const auto n = static_cast<Eigen::Index>(r.root_radii().size());
+            Eigen::MatrixXd centers(n, 3);
+            for (Eigen::Index k = 0; k < n; ++k) centers.row(k) = r.root_centers()[k].transpose();
+            const Eigen::VectorXd radii =
+                Eigen::Map<const Eigen::VectorXd>(r.root_radii().data(), n);
+            return std::make_pair(centers, radii);
+          },
+          "q"_a, "v"_a, "horizon_s"_a,
+          "near's first test: (centres (sides, 3) [m], radii (sides,) [m]) of each side's "
+          "sphere about its root over horizon_s (robot_reach.reach_sphere; inf: no bound).")
+      .def(
           "object_wrenches",
           [](RobotsSystem& r, const Eigen::VectorXd& q, const Eigen::VectorXd& v,
              nb::handle systems, nb::handle memories) -> Eigen::MatrixXd {

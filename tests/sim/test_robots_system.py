@@ -16,6 +16,7 @@ from uvms_pin.physics.compiled.extension import core_module
 from uvms_pin.physics.world.contact_law import ContactLaw
 from uvms_pin.physics.world.free_object import free_object
 from uvms_pin.physics.world.objects import plane
+from uvms_pin.physics.world.robot_reach import reach_sphere
 from uvms_pin.physics.world.world import World
 from uvms_pin.scenario.load import load_scenario
 from uvms_pin.sim.compiled.integrator import integrator_to_core
@@ -496,3 +497,38 @@ def test_a_first_robots_object_resting_on_the_seabed_logs_its_weight_while_robot
     weight_N = (density - RHO) * 4.0 / 3.0 * np.pi * radius**3 * 9.81
     # 5.00733 N logged against 5.00809 N: the period's mean force, 10 ms after the start
     np.testing.assert_allclose(on_seabed[:3], [0.0, 0.0, weight_N], rtol=1e-3, atol=1e-6)
+
+
+def test_the_core_bound_spheres_are_the_references_at_any_reach_and_speed():
+    """The first test of the core's bound (`RobotsSystem.root_spheres`, what `near` reads)
+    gives each side, the two arms' robots then the carried pipe, the sphere of the reference
+    (`robot_reach.reach_sphere`: radius R + 2 s h + clearance, s = |v| + |w| R + 2 R
+    sum |qd|) at random states, reaches from 0.2 to 3 m and horizons up to 0.5 s, to
+    rounding: the arm joints' rates weigh with the reach on both sides of 1 m."""
+    scenario = load_scenario(ROOT / "scenarios" / "cooperative_transport.toml")
+    plants = [r.plant for r in scenario.robots]
+    plants[1:] = [Plant(p.uvms, world=None, free_surface=False) for p in plants[1:]]
+    robots = Robots([System(p) for p in plants], scenario.names)
+    core, _ = robots.compiled
+    rng = np.random.default_rng(5)
+    n_sides = len(robots.contacts.sides)
+    assert n_sides == 3  # two robots, one free object
+    starts = [
+        system.initial_state(r.q0, np.zeros(r.uvms.nv))
+        for system, r in zip(robots.systems, scenario.robots, strict=True)
+    ]
+    for _ in range(40):
+        q, v = robots.layout.join(starts)
+        for at in robots.layout.q_slices:  # each system's robot somewhere else
+            q[at.start : at.start + 3] += rng.uniform(-2.0, 2.0, size=3)
+        v = rng.normal(scale=2.0, size=robots.layout.nv)
+        reaches = rng.uniform(0.2, 3.0, size=n_sides)
+        horizon_s = float(rng.choice([0.0, 0.002, 0.05, 0.5]))
+        core.reach_m = list(reaches)
+        centers, radii = core.root_spheres(q, v, horizon_s)
+        for k, ((q_k, v_k), reach) in enumerate(zip(robots.sides(q, v), reaches, strict=True)):
+            center, radius = reach_sphere(q_k, v_k, reach, horizon_s)
+            np.testing.assert_allclose(centers[k], center, rtol=0.0, atol=1e-12)
+            assert radii[k] == pytest.approx(radius, rel=1e-12)
+    core.reach_m = [np.inf] * n_sides
+    assert np.all(np.isinf(core.root_spheres(q, v, 0.01)[1]))
