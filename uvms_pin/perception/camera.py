@@ -116,10 +116,13 @@ class CameraSpec:
                 f"{label}: reflectance must be a table of label names to (R, G, B), "
                 f"got {reflectance!r}"
             )
-        built = tuple(
-            sensor.spec_from_dict(Light, light, f"{label}: lights[{k}]")
-            for k, light in enumerate(lights)
-        )
+        built = []
+        for k, light in enumerate(lights):
+            try:
+                built.append(sensor.spec_from_dict(Light, light, f"{label}: lights[{k}]"))
+            except ParameterError as exc:  # Light's own checks say what, here where
+                where = f"{label}: lights[{k}]"
+                raise ParameterError(str(exc) if where in str(exc) else f"{where}: {exc}") from exc
         try:
             colours = {str(k): tuple(float(c) for c in v) for k, v in reflectance.items()}
         except (TypeError, ValueError) as exc:
@@ -127,7 +130,7 @@ class CameraSpec:
                 f"{label}: reflectance must map label names to (R, G, B) numbers, "
                 f"got {reflectance!r}"
             ) from exc
-        return sensor.spec_from_dict(cls, raw, label, lights=built, reflectance=colours)
+        return sensor.spec_from_dict(cls, raw, label, lights=tuple(built), reflectance=colours)
 
 
 @dataclass(frozen=True)

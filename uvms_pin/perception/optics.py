@@ -31,6 +31,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from uvms_pin.checks import finite_vector, nonnegative
 from uvms_pin.errors import ParameterError
 
 __all__ = ["JERLOV_KD_PER_M", "Light", "WaterOptics", "backscatter", "cone"]
@@ -79,8 +80,8 @@ class WaterOptics:
             )
         for name in ("attenuation_per_m", "backscatter_per_m"):
             value = getattr(self, name)
-            if value is not None and not (len(value) == 3 and all(v >= 0.0 for v in value)):
-                raise ParameterError(f"{name} needs 3 numbers >= 0 (R, G, B), got {value}")
+            if value is not None and not np.all(finite_vector(name, value, 3) >= 0.0):
+                raise ParameterError(f"{name} needs 3 finite numbers >= 0 (R, G, B), got {value}")
         if not (self.surface_irradiance >= 0.0 and np.isfinite(self.surface_irradiance)):
             raise ParameterError(f"surface_irradiance must be >= 0, got {self.surface_irradiance}")
         if not (0.0 <= self.backscatter_albedo <= 1.0):
@@ -125,14 +126,19 @@ class Light:
     edge_rad: float = 0.1
 
     def __post_init__(self) -> None:
-        norm = float(np.linalg.norm(self.direction))
+        # finite: an inf or nan here would make every lit pixel's radiance nan, read as 0
+        # counts, a black image and no error
+        finite_vector("a light's position_m", self.position_m, 3)
+        direction = finite_vector("a light's direction", self.direction, 3)
+        norm = float(np.linalg.norm(direction))
         if not norm > 0.0:
             raise ParameterError(f"a light's direction must not be zero, got {self.direction}")
-        object.__setattr__(self, "direction", tuple(np.asarray(self.direction) / norm))
-        if not (self.intensity >= 0.0 and 0.0 < self.half_angle_rad < np.pi and self.edge_rad >= 0):
+        object.__setattr__(self, "direction", tuple(direction / norm))
+        nonnegative("a light's intensity", self.intensity)
+        nonnegative("a light's edge_rad", self.edge_rad)
+        if not 0.0 < self.half_angle_rad < np.pi:
             raise ParameterError(
-                "a light needs intensity >= 0, 0 < half_angle_rad < pi and edge_rad >= 0, got "
-                f"{self.intensity}, {self.half_angle_rad}, {self.edge_rad}"
+                f"a light's half_angle_rad must be in (0, pi), got {self.half_angle_rad}"
             )
 
 
