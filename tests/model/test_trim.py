@@ -109,3 +109,23 @@ def test_trim_links_take_the_prefix_while_their_name_or_joints_name_is_taken(tmp
     assert [e.get("name") for e in lone if e.tag == "link" and "ballast" in e.get("name")] == [
         "old_trim_ballast"
     ]
+
+
+@pytest.mark.parametrize(
+    ("changes", "match"),
+    [
+        ({"top_z_m": np.nan}, "top_z_m"),
+        ({"bottom_z_m": -np.inf}, "bottom_z_m"),
+        ({"top_z_m": 0.1, "bottom_z_m": 0.2}, "top_z_m must be above bottom_z_m"),
+        ({"footprint_m": (0.3, np.nan)}, "footprint_m"),
+        ({"footprint_m": (0.3, 0.0)}, r"footprint_m\[1\]"),
+        ({"footprint_m": (0.3,)}, "footprint_m"),
+        ({"footprint_center_m": (np.inf, 0.0)}, "footprint_center_m"),
+    ],
+)
+def test_a_trim_spec_refuses_a_non_finite_or_impossible_slab_by_name(changes, match):
+    """The slabs' footprint, centre and heights, when given, are finite (a nan was accepted
+    and placed the foam and the ballast at nan), the footprint's sides > 0 and the top above
+    the bottom."""
+    with pytest.raises(up.ParameterError, match=match):
+        TrimSpec(**changes)

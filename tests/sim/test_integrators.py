@@ -159,10 +159,13 @@ def test_fixed_step_rejects_bad_step(integrator_class, step):
     [
         ({"method": "Euler"}, "adaptive method must be one of"),
         ({"method": "lsoda"}, "adaptive method must be one of"),
-        ({"rtol": 0.0}, "must be positive"),
-        ({"atol": -1e-8}, "must be positive"),
-        ({"rtol": math.nan}, "must be positive"),
-        ({"max_step_s": 0.0}, "must be positive"),
+        ({"rtol": 0.0}, "adaptive rtol must be finite and > 0"),
+        ({"atol": -1e-8}, "adaptive atol must be finite and > 0"),
+        ({"rtol": math.nan}, "adaptive rtol must be finite and > 0"),
+        ({"rtol": math.inf}, "adaptive rtol must be finite and > 0"),
+        ({"atol": math.inf}, "adaptive atol must be finite and > 0"),
+        ({"max_step_s": 0.0}, "max_step_s must be > 0"),
+        ({"max_step_s": math.nan}, "max_step_s must be > 0"),
     ],
 )
 def test_adaptive_rejects_bad_parameters(kwargs, message):

@@ -62,6 +62,17 @@ def test_bad_noise_spec_raises(kwargs):
         NoiseSpec(**kwargs)
 
 
+def test_a_sensor_config_noise_given_as_a_number_is_refused_with_the_spec_to_give():
+    """A bound given where a NoiseSpec goes was accepted and failed at the run's start
+    with an AttributeError."""
+    with pytest.raises(
+        up.ParameterError, match=r"force_noise must be a NoiseSpec \(NoiseSpec\(0.5\)"
+    ):
+        SensorConfig(force_noise=0.5)
+    with pytest.raises(up.ParameterError, match="velocity_noise must be a NoiseSpec, got dict"):
+        SensorConfig(velocity_noise={"bound": 0.1})
+
+
 def test_sampled_noise_rejects_bad_period():
     for period in (0.0, -1e-3, np.nan):
         with pytest.raises(up.ParameterError, match="period"):

@@ -45,7 +45,7 @@ from dataclasses import asdict, dataclass, field
 import numpy as np
 import pinocchio as pin
 
-from uvms_pin.checks import positive
+from uvms_pin.checks import finite_vector, positive
 from uvms_pin.errors import ParameterError
 from uvms_pin.model.uvms import UVMS
 
@@ -83,6 +83,20 @@ class TrimSpec:
     def __post_init__(self) -> None:
         for name in ("bg_m", "foam_density_kg_m3", "ballast_density_kg_m3"):
             positive(name, getattr(self, name))
+        # each given one finite: a nan here would place the foam or the ballast at nan
+        if self.footprint_m is not None:
+            for k, side in enumerate(finite_vector("footprint_m", self.footprint_m, 2)):
+                positive(f"footprint_m[{k}]", side)
+        if self.footprint_center_m is not None:
+            finite_vector("footprint_center_m", self.footprint_center_m, 2)
+        for name in ("top_z_m", "bottom_z_m"):
+            if getattr(self, name) is not None:
+                finite_vector(name, [getattr(self, name)], 1)
+        if self.top_z_m is not None and self.bottom_z_m is not None:
+            if not self.top_z_m > self.bottom_z_m:
+                raise ParameterError(
+                    f"top_z_m must be above bottom_z_m, got {self.top_z_m} and {self.bottom_z_m}"
+                )
 
 
 @dataclass

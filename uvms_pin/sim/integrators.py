@@ -20,6 +20,7 @@ from typing import ClassVar
 import numpy as np
 import pinocchio as pin
 
+from uvms_pin.checks import positive
 from uvms_pin.errors import ParameterError, SimulationError
 
 Rhs = Callable[[float, np.ndarray, np.ndarray], np.ndarray]
@@ -207,8 +208,10 @@ class Adaptive(Integrator):
             raise ParameterError(
                 f"adaptive method must be one of {self._METHODS}, got '{self.method}'"
             )
-        if not (self.rtol > 0.0 and self.atol > 0.0 and self.max_step_s > 0.0):
-            raise ParameterError("adaptive rtol, atol and max_step_s must be positive")
+        for name in ("rtol", "atol"):
+            positive(f"adaptive {name}", getattr(self, name))
+        if not self.max_step_s > 0.0:  # inf: no bound
+            raise ParameterError(f"adaptive max_step_s must be > 0, got {self.max_step_s}")
 
     def advance(self, model, rhs, t0, q0, v0, t1):
         _, q, v = self.advance_through(model, rhs, t0, q0, v0, np.array([t1]))[-1]

@@ -175,6 +175,31 @@ class SensorConfig:
     perception: PerceptionSpec = field(default_factory=PerceptionSpec)
     held_object_wrench: bool = False
 
+    def __post_init__(self) -> None:
+        for name in NOISES:
+            value = getattr(self, name)
+            if not isinstance(value, NoiseSpec):
+                hint = (
+                    f" (NoiseSpec({value!r}): uniform within +-{value!r})"
+                    if isinstance(value, int | float)
+                    else ""
+                )
+                raise ParameterError(
+                    f"SensorConfig {name} must be a NoiseSpec{hint}, got "
+                    f"{type(value).__name__} {value!r}"
+                )
+
+
+#: SensorConfig's noises, in the order of their streams
+NOISES = (
+    "force_noise",
+    "torque_noise",
+    "position_noise",
+    "orientation_noise",
+    "joint_noise",
+    "velocity_noise",
+)
+
 
 class SensorSuite:
     """Turns the true state and contact wrench into a noisy `Measurement`."""

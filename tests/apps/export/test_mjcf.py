@@ -223,6 +223,10 @@ def test_bad_input_raises_clear_errors():
         MjcfOptions(spring_stiffness_N_m=2.0)
     with pytest.raises(ParameterError, match="carrier_mass_fraction"):
         MjcfOptions(carrier_mass_fraction=1.0)
+    with pytest.raises(ParameterError, match="5 finite fluid_coefficients"):  # written as nan
+        MjcfOptions(fluid_coefficients=(np.nan, 0.25, 1.5, 1.0, 1.0))
+    with pytest.raises(ParameterError, match="spring_stiffness_N_m"):
+        MjcfOptions(spring_stiffness_N_m=np.inf, spring_anchor_world_m=(0.0, 0.0, -1.0))
     text = REFERENCE_URDF.read_text().replace(
         '<box size="0.53 0.245 0.254"/></geometry>\n    </collision>',
         '<capsule radius="0.1" length="0.2"/></geometry>\n    </collision>',

@@ -24,6 +24,14 @@ def test_an_initial_sigma_that_is_negative_or_infinite_is_refused(value):
         EstimatorSpec(initial_sigma=(0.1, value, 0.02, 1e-3, 0.01))
 
 
+@pytest.mark.parametrize("sigma", [(0.1, 0.05, 0.02, 1e-3), (0.1, 0.05, 0.02, 1e-3, 0.01, 0.1)])
+def test_an_initial_sigma_of_other_than_five_values_is_refused(sigma):
+    """Position, velocity, attitude, gyro and accelerometer bias: four or six values were
+    accepted, and the run failed at its start on numpy's broadcasting error."""
+    with pytest.raises(ParameterError, match="initial_sigma needs 5 values"):
+        EstimatorSpec(initial_sigma=sigma)
+
+
 def test_a_zero_noise_is_an_exact_sensor_and_a_zero_sigma_refused():
     assert EstimatorSpec(dvl_noise_m_s=0.0, depth_noise_m=0.0).dvl_noise_m_s == 0.0
     with pytest.raises(ParameterError, match="initial sigmas must be > 0"):

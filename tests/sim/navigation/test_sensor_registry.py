@@ -69,3 +69,19 @@ def test_each_signal_has_the_columns_its_kind_declares():
     assert set(signals) == set(columns) and len(signals) >= 5
     for name, values in signals.items():
         assert np.size(values) == len(columns[name]), name
+
+
+@pytest.mark.parametrize(
+    ("changes", "match"),
+    [
+        ({"water_density_kg_m3": np.nan}, "water_density_kg_m3"),
+        ({"water_density_kg_m3": 0.0}, "water_density_kg_m3"),
+        ({"depth_noise_Pa": np.inf}, "depth_noise_Pa"),
+        ({"seabed_depth_m": np.nan}, "seabed_depth_m"),
+    ],
+)
+def test_a_navigation_spec_refuses_a_non_finite_water_or_bottom_by_name(changes, match):
+    """The water's density (> 0), the pressure sensor's noise and the bottom's depth, when
+    given, finite: a nan density was accepted (the depth sensor then read nan)."""
+    with pytest.raises(ParameterError, match=match):
+        NavigationSpec(**changes)

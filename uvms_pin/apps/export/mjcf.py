@@ -92,9 +92,16 @@ class MjcfOptions:
             (self.timestep_s > 0.0 and math.isfinite(self.timestep_s), "timestep_s > 0"),
             (self.integrator in ("RK4", "Euler", "implicit", "implicitfast"), "a known integrator"),
             (self.viscosity_Pa_s >= 0.0 and math.isfinite(self.viscosity_Pa_s), "viscosity >= 0"),
-            (len(self.fluid_coefficients) == 5, "5 fluid_coefficients"),
+            (
+                len(self.fluid_coefficients) == 5
+                and all(math.isfinite(c) for c in self.fluid_coefficients),
+                "5 finite fluid_coefficients",
+            ),
             (0.0 < self.carrier_mass_fraction < 1.0, "0 < carrier_mass_fraction < 1"),
-            (self.spring_stiffness_N_m >= 0.0, "spring_stiffness_N_m >= 0"),
+            (
+                self.spring_stiffness_N_m >= 0.0 and math.isfinite(self.spring_stiffness_N_m),
+                "spring_stiffness_N_m >= 0",
+            ),
         )
         for ok, what in checks:
             if not ok:

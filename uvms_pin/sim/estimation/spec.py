@@ -66,6 +66,11 @@ class EstimatorSpec:
                 f"estimator controller_input must be one of {CONTROLLER_INPUTS}, "
                 f"got {self.controller_input!r}"
             )
+        if len(self.initial_sigma) != 5:
+            raise ParameterError(
+                "estimator initial_sigma needs 5 values (position, velocity, attitude, gyro "
+                f"bias, accelerometer bias), got {self.initial_sigma}"
+            )
         numbers = [*self.initial_sigma, self.dvl_noise_m_s, self.depth_noise_m, self.usbl_noise_m]
         if self.imu_noise is not None:
             numbers += list(vars(self.imu_noise).values())

@@ -21,7 +21,7 @@ from uvms_pin.sim.navigation import depth, dvl, imu, usbl  # noqa: F401
 from uvms_pin.sim.navigation.dvl import DvlSpec
 from uvms_pin.sim.navigation.imu import ImuSpec
 from uvms_pin.sim.navigation.seabed import Seabed
-from uvms_pin.sim.navigation.sensor import SENSORS, SensorKind, Tick
+from uvms_pin.sim.navigation.sensor import SENSORS, SensorKind, Tick, check_nonneg
 from uvms_pin.sim.navigation.usbl import UsblSpec
 
 __all__ = ["NAVIGATION_SEED_INDEX", "NavigationSpec", "NavigationSuite"]
@@ -51,6 +51,12 @@ class NavigationSpec:
     seabed: Seabed | None = None
 
     def __post_init__(self) -> None:
+        check_nonneg(
+            "the navigation's water_density_kg_m3", self.water_density_kg_m3, positive=True
+        )
+        for name in ("depth_noise_Pa", "seabed_depth_m"):
+            if getattr(self, name) is not None:
+                check_nonneg(name, getattr(self, name))
         if self.seabed is not None and self.seabed_depth_m is not None:
             raise ParameterError(
                 "the DVL's bottom is given twice: the world's seafloor and seabed_depth_m = "
