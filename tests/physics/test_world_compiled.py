@@ -421,3 +421,41 @@ def test_the_core_broad_phase_turns_where_the_reference_does(reference_uvms):
                 pin.forwardKinematics(uvms.model, data, at, v)
                 assert world.clear(data, horizon_s) is expected
                 assert core.compiled.world_clear(at, v, horizon_s) is expected
+
+
+def test_a_slide_by_a_bodys_second_piece_on_the_second_object_is_the_reference(load_body):
+    """The box of the slide above as the body's second collision piece (a small sphere above
+    it the first) on the second object of the world (a far buoy the first): each patch's
+    key, piece n_objects + object, is then neither the piece nor the object, and the slipping
+    patch (mu_k from its second period on) is the same one on both backends: their runs and
+    memories agree as the one-piece slide's do."""
+    collision, volume = BODIES["box"]
+    text = body_urdf(
+        mass=2.5 * RHO * volume,
+        inertia=(0.3, 0.4, 0.5),
+        hydro=hydro_xml(volume, added=(40.0, 50.0, 60.0, 2.0, 3.0, 4.0), lin=(5.0,) * 6),
+        collision=collision,
+    ).replace(
+        "<collision>",
+        '<collision><origin xyz="0 0 0.4"/><geometry><sphere radius="0.05"/></geometry>'
+        "</collision>\n    <collision>",
+        1,
+    )
+    uvms = load_body(text)
+    tilt = 0.75
+    normal = [-math.sin(tilt), 0.0, math.cos(tilt)]
+    buoy = solid("buoy", "sphere", {"radius_m": 0.5}, [50.0, 0.0, FLOOR_Z], [0, 0, 0], 0.6, 0.4)
+    slope = plane("slope", [0.0, 0.0, FLOOR_Z], normal, 0.6, 0.4)
+    world = World(uvms, [buoy, slope], ContactLaw(dissipation_s_m=0.3))
+    assert len(world.pieces) == 2
+    q = uvms.neutral_configuration()
+    q[3:7] = pin.Quaternion(pin.rpy.rpyToMatrix(0.0, -tilt, 0.0)).coeffs()
+    q[:3] = np.array([0.0, 0.0, FLOOR_Z]) + 0.137 * np.array(normal)
+    (core, core_memory), (python, python_memory) = _runs(uvms, world, q, np.zeros(uvms.nv), 300)
+    scale = np.abs(python).max(axis=0)
+    assert np.all(np.abs(core - python) <= TOL * 10 * np.maximum(scale, 1.0))
+    _same_memory(core_memory, python_memory, 10.0)
+    assert python_memory.slipping == {1 * 2 + 1}  # piece 1 on object 1
+    down_slope = np.array([-math.cos(tilt), 0.0, -math.sin(tilt)])
+    travel_m = (python[:, :3] - q[:3]) @ down_slope
+    assert travel_m[-1] > 2.0 * travel_m[len(travel_m) // 2] > 0.01
