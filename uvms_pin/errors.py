@@ -167,6 +167,11 @@ class DataError(UvmsPinError):
     """A measurement data set is missing, malformed or unusable; the message names the file."""
 
 
+class NotShippedError(UvmsPinError, FileNotFoundError):
+    """A file asked of `uvms_pin.shipped_path` is not shipped with this install (a
+    FileNotFoundError too, as it was)."""
+
+
 class CoreUnavailableError(UvmsPinError, ImportError):
     """The compiled core is missing, stale or built against another Pinocchio; the message
     says how to rebuild it."""

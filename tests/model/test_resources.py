@@ -6,6 +6,10 @@ other test that uses its arms runs them (and fails if they cannot be loaded), no
 
 from __future__ import annotations
 
+import pytest
+
+import uvms_pin as up
+from uvms_pin.errors import NotShippedError
 from uvms_pin.model.mount.catalog import CATALOG, available_arms
 from uvms_pin.model.resources import (
     example_robot_data_dir,
@@ -72,3 +76,12 @@ def test_a_sourced_ros_workspace_resolves_its_packages(tmp_path, monkeypatch):
     search = package_search_path([tmp_path / "mine"])
     assert search[:3] == [tmp_path / "mine", ros1, tmp_path / "x" / "share"]
     assert search[-1] == example_robot_data_dir().parent
+
+
+def test_a_file_not_shipped_is_the_projects_error_and_a_file_not_found():
+    """`shipped_path` of a name it does not ship raises `NotShippedError`, which a caller
+    catching uvms-pin's errors or FileNotFoundError (what it raised before) both catch."""
+    assert up.shipped_path("models/uvms_lbv150.urdf").is_file()
+    for caught in (NotShippedError, up.UvmsPinError, FileNotFoundError):
+        with pytest.raises(caught, match=r"models/nope\.urdf is not shipped"):
+            up.shipped_path("models/nope.urdf")

@@ -115,3 +115,13 @@ def test_a_seed_no_generator_takes_is_refused_where_it_is_given(seed):
         IrregularSea(0.5, 6.0, seed=seed)
     with pytest.raises(up.ParameterError, match="seed must be an integer in"):
         GaussMarkovCurrent([0.1, 0, 0], 0.05, 10.0, 0.2, seed=seed)
+
+
+@pytest.mark.parametrize("given", ["scenarios/passive_still_water.toml", ROOT, None, 3.0])
+def test_simulate_refuses_what_is_not_a_scenario_and_says_to_load_a_path(given):
+    """A path (the first thing a user passes) is refused with the call that loads it;
+    anything else that is not a scenario by its type: both ParameterErrors, not an
+    AttributeError on ``settings``."""
+    match = "load it first" if isinstance(given, str | type(ROOT)) else "takes a Scenario"
+    with pytest.raises(up.ParameterError, match=match):
+        simulate(given)

@@ -22,7 +22,7 @@ from collections.abc import Iterable
 from importlib import metadata
 from pathlib import Path
 
-from uvms_pin.errors import ParameterError
+from uvms_pin.errors import NotShippedError, ParameterError
 
 __all__ = [
     "environment_folders",
@@ -108,7 +108,7 @@ def shipped_path(relative: str | Path) -> Path:
     is the copy installed in ``<prefix>/share/uvms-pin/``.
 
     Raises:
-        FileNotFoundError: neither exists.
+        NotShippedError: neither exists (a FileNotFoundError).
     """
     relative = Path(relative)
     candidates = [
@@ -118,7 +118,9 @@ def shipped_path(relative: str | Path) -> Path:
     for candidate in candidates:
         if candidate.exists():
             return candidate
-    raise FileNotFoundError(f"{relative} is not shipped with this install (looked in {candidates})")
+    raise NotShippedError(
+        f"{relative} is not shipped with this install (looked in {', '.join(map(str, candidates))})"
+    )
 
 
 def shipped_models() -> list[str]:

@@ -106,6 +106,15 @@ def simulate(
     ``exc.rollout`` (see `uvms_pin.sim.closed_loop.ClosedLoop.run`). With
     ``UVMS_PIN_MAX_DURATION_S`` set, the run is shortened, and says so (`shortened`).
     """
+    if isinstance(scenario, str | Path):
+        raise ParameterError(
+            f"simulate takes a Scenario, got the path {str(scenario)!r}: load it first, "
+            "uvms_pin.simulate(uvms_pin.load_scenario(path))"
+        )
+    if not hasattr(scenario, "sensor_config"):  # a RobotsScenario says what to run instead
+        raise ParameterError(
+            f"simulate takes a Scenario (uvms_pin.load_scenario), got {type(scenario).__name__}"
+        )
     scenario = shortened(scenario)
     duration_s = scenario.settings.duration_s
     if progress is True:
