@@ -6,8 +6,8 @@
 #   make results - regenerate every table (docs/results/*.md) and figure the docs quote
 #                  (RESULTS="paper robustness" for some; the list is scripts/make_results.py)
 #   make docs    - build the documentation site into site/ (mkdocs.yml), --strict, offline
-#   make sanitize - after a C++ change: the core built with AddressSanitizer (.venv-asan) and
-#                   the tests that call it, every out-of-bounds or freed access reported
+#   make sanitize - after a C++ change: the core built with AddressSanitizer (build/venv-asan),
+#                   the tests that call it: every out-of-bounds or freed access reported
 PYTHON ?= python3
 VENV := .venv
 BIN := $(VENV)/bin
@@ -143,21 +143,23 @@ results: $(STAMP)
 docs: $(STAMP)
 	NO_MKDOCS_2_WARNING=1 $(BIN)/mkdocs build --strict --site-dir site
 
-# the compiled core with AddressSanitizer: a copy of .venv (.venv-asan) whose core is built
-# into build/asan with -fsanitize=address (with line numbers, not stripped), the tests of the
-# packages that call the core run there with the sanitizer's runtime loaded first (CPython is
-# not built with it; libstdc++ before it, or its interceptor of C++ exceptions finds none). A
-# read or write out of bounds or after free stops the test with the sanitizer's report (its
-# file in ASAN_LOG_DIR). EIGEN_MALLOC_ALREADY_ALIGNED=1: Eigen takes malloc as unaligned under
-# the sanitizer and frees with its own aligned scheme what libpinocchio (built without it)
-# allocated with malloc, a false report at the first pinocchio::Data the core destroys. The
-# instrumented core runs about twice as slowly; not part of `make test`. The batch's
-# memory-estimate tests skip themselves there (the sanitizer's shadow memory is not the batch's).
-ASAN_VENV := .venv-asan
+# the compiled core with AddressSanitizer: a copy of .venv (build/venv-asan: under build/, which
+# every tool here leaves alone) whose core is built into build/asan with -fsanitize=address
+# (with line numbers, not stripped); the tests of the packages that call the core run there
+# with the sanitizer's runtime loaded first (CPython is not built with it; libstdc++ before it,
+# or its interceptor of C++ exceptions finds none). A read or write out of bounds or after
+# free stops the test with the sanitizer's report (its file in ASAN_LOG_DIR).
+# EIGEN_MALLOC_ALREADY_ALIGNED=1: Eigen takes malloc as unaligned under the sanitizer and frees
+# with its own aligned scheme what libpinocchio (built without it) allocated with malloc, a
+# false report at the first pinocchio::Data the core destroys. The instrumented core runs
+# about twice as slowly; not part of `make test`. The batch's memory-estimate tests skip
+# themselves there (the sanitizer's shadow memory is not the batch's).
+ASAN_VENV := build/venv-asan
 ASAN_LOG_DIR ?= out/asan
 ASAN_TESTS ?= tests/physics tests/sim tests/perception tests/ocp tests/control tests/apps/gym
 sanitize: $(STAMP)
-	rm -rf $(ASAN_VENV) $(ASAN_LOG_DIR) && cp -a $(VENV) $(ASAN_VENV) && mkdir -p $(ASAN_LOG_DIR)
+	rm -rf $(ASAN_VENV) $(ASAN_LOG_DIR) && mkdir -p build $(ASAN_LOG_DIR)
+	cp -a $(VENV) $(ASAN_VENV)
 	SKBUILD_BUILD_DIR=build/asan SKBUILD_CMAKE_BUILD_TYPE=RelWithDebInfo \
 	  SKBUILD_INSTALL_STRIP=false SKBUILD_CMAKE_ARGS="-DCMAKE_CXX_FLAGS=-fsanitize=address \
 	  -fno-omit-frame-pointer -DEIGEN_MALLOC_ALREADY_ALIGNED=1;-DCMAKE_SHARED_LINKER_FLAGS=-fsanitize=address" \
@@ -170,4 +172,4 @@ sanitize: $(STAMP)
 	  exit $$status
 
 clean:
-	rm -rf $(VENV) $(ASAN_VENV) out build site *.egg-info
+	rm -rf $(VENV) out build site *.egg-info
