@@ -120,7 +120,7 @@ class CameraSpec:
         for k, light in enumerate(lights):
             try:
                 built.append(sensor.spec_from_dict(Light, light, f"{label}: lights[{k}]"))
-            except ParameterError as exc:  # Light's own checks say what, here where
+            except ParameterError as exc:  # Light's checks say what is wrong, this which light
                 where = f"{label}: lights[{k}]"
                 raise ParameterError(str(exc) if where in str(exc) else f"{where}: {exc}") from exc
         try:

@@ -126,7 +126,7 @@ class Light:
     edge_rad: float = 0.1
 
     def __post_init__(self) -> None:
-        # finite: an inf or nan here would make every lit pixel's radiance nan, read as 0
+        # finite: an inf or nan here would make the lit pixels' radiance nan, read as 0
         # counts, a black image and no error
         finite_vector("a light's position_m", self.position_m, 3)
         direction = finite_vector("a light's direction", self.direction, 3)
