@@ -8,7 +8,7 @@ import math
 import numpy as np
 import pytest
 
-from uvms_pin.checks import finite_parameters
+from uvms_pin.checks import finite_parameters, nonnegative, positive
 from uvms_pin.errors import ParameterError
 
 
@@ -48,3 +48,14 @@ def test_never_keys_accept_plus_infinity_only():
             finite_parameters("probe", {"open_at_s": bad}, never=("open_at_s",))
     with pytest.raises(ParameterError, match="close_at_s must be finite, got inf"):
         finite_parameters("probe", {"close_at_s": math.inf}, never=("open_at_s",))
+
+
+@pytest.mark.parametrize("value", ["0.1", None, True, [0.1], {"bound": 0.1}, "abc"])
+@pytest.mark.parametrize("check", [positive, nonnegative])
+def test_a_value_that_is_not_a_number_is_refused_by_name(check, value):
+    """A string (even one that reads as a number), None, a bool, a list or a table: a
+    ParameterError naming the value's owner (float() raised ValueError or TypeError, or
+    took "0.1" and True as numbers)."""
+    with pytest.raises(ParameterError, match="step_s must be a number"):
+        check("step_s", value)
+    assert check("step_s", np.float32(0.5)) == 0.5 and check("step_s", 2) == 2.0

@@ -81,9 +81,20 @@ def _numbers(value) -> np.ndarray | None:
     return None
 
 
+def _number(name: str, value) -> float:
+    """``value`` as a float, or ParameterError naming ``name``: a string ("0.1" too), None, a
+    bool or what float() refuses is not a number (float() raised ValueError or TypeError)."""
+    if isinstance(value, bool | str | bytes) or value is None:
+        raise ParameterError(f"{name} must be a number, got {value!r}")
+    try:
+        return float(value)
+    except (TypeError, ValueError) as exc:
+        raise ParameterError(f"{name} must be a number, got {value!r}") from exc
+
+
 def positive(name: str, value: float) -> float:
     """``value`` as a float, finite and > 0, or ParameterError naming ``name``."""
-    value = float(value)
+    value = _number(name, value)
     if not (math.isfinite(value) and value > 0.0):
         raise ParameterError(f"{name} must be finite and > 0, got {value}")
     return value
@@ -91,7 +102,7 @@ def positive(name: str, value: float) -> float:
 
 def nonnegative(name: str, value: float) -> float:
     """``value`` as a float, finite and >= 0, or ParameterError naming ``name``."""
-    value = float(value)
+    value = _number(name, value)
     if not (math.isfinite(value) and value >= 0.0):
         raise ParameterError(f"{name} must be finite and >= 0, got {value}")
     return value
