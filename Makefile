@@ -151,8 +151,8 @@ docs: $(STAMP)
 # free stops the test with the sanitizer's report (its file in ASAN_LOG_DIR).
 # EIGEN_MALLOC_ALREADY_ALIGNED=1: Eigen takes malloc as unaligned under the sanitizer and frees
 # with its own aligned scheme what libpinocchio (built without it) allocated with malloc, a
-# false report at the first pinocchio::Data the core destroys. The instrumented core runs
-# about twice as slowly; not part of `make test`. The batch's memory-estimate tests skip
+# false report at the first pinocchio::Data the core destroys. Not part of `make test` (about
+# 20 minutes on 2 cores: docs/compiled_core.md). The batch's memory-estimate tests skip
 # themselves there (the sanitizer's shadow memory is not the batch's).
 ASAN_VENV := build/venv-asan
 ASAN_LOG_DIR ?= out/asan

@@ -518,7 +518,7 @@ def test_the_core_bound_spheres_are_the_references_at_any_reach_and_speed():
         for system, r in zip(robots.systems, scenario.robots, strict=True)
     ]
     for _ in range(40):
-        q, v = robots.layout.join(starts)
+        q = robots.layout.join(starts)[0]
         for at in robots.layout.q_slices:  # each system's robot somewhere else
             q[at.start : at.start + 3] += rng.uniform(-2.0, 2.0, size=3)
         v = rng.normal(scale=2.0, size=robots.layout.nv)

@@ -14,7 +14,7 @@ from __future__ import annotations
 import dataclasses
 import math
 from collections.abc import Callable
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, fields
 
 import numpy as np
 import pinocchio as pin
@@ -176,7 +176,7 @@ class SensorConfig:
     held_object_wrench: bool = False
 
     def __post_init__(self) -> None:
-        for name in NOISES:
+        for name in (f.name for f in fields(self) if isinstance(f.default, NoiseSpec)):
             value = getattr(self, name)
             if not isinstance(value, NoiseSpec):
                 hint = (
@@ -188,17 +188,6 @@ class SensorConfig:
                     f"SensorConfig {name} must be a NoiseSpec{hint}, got "
                     f"{type(value).__name__} {value!r}"
                 )
-
-
-#: SensorConfig's noises, in the order of their streams
-NOISES = (
-    "force_noise",
-    "torque_noise",
-    "position_noise",
-    "orientation_noise",
-    "joint_noise",
-    "velocity_noise",
-)
 
 
 class SensorSuite:
