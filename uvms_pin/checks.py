@@ -8,7 +8,8 @@ import math
 import os
 import warnings
 from collections.abc import Callable, Iterable, Mapping
-from dataclasses import dataclass
+from dataclasses import dataclass, fields
+from typing import Any
 
 import numpy as np
 
@@ -35,6 +36,27 @@ def finite_vector(name: str, value, size: int) -> np.ndarray:
         raise ParameterError(f"{name} must have shape ({size},), got {array.shape}")
     if not np.all(np.isfinite(array)):
         raise ParameterError(f"{name} contains a non-finite value: {array}")
+    return array
+
+
+def sized_vector(name: str, value, size: int) -> np.ndarray:
+    """``value`` as a read-only (size,) float array: a scalar broadcast, else exactly
+    ``size`` finite entries (ParameterError naming ``name`` otherwise)."""
+    try:
+        array = np.asarray(value)
+    except (TypeError, ValueError):  # ragged lists
+        array = np.asarray(None)
+    if array.dtype.kind not in "iuf":  # no strings, booleans, objects
+        raise ParameterError(f"{name} must be a number or a list of numbers, got {value!r}")
+    array = array.astype(float)
+    if array.ndim == 0:
+        array = np.full(size, float(array))
+    if array.shape != (size,):
+        raise ParameterError(f"{name} must be a scalar or have {size} entries, got {array.shape}")
+    if not np.all(np.isfinite(array)):
+        raise ParameterError(f"{name} has non-finite entries: {array}")
+    array = array.copy()
+    array.flags.writeable = False
     return array
 
 
@@ -81,7 +103,7 @@ def _numbers(value) -> np.ndarray | None:
     return None
 
 
-def _number(name: str, value) -> float:
+def number(name: str, value) -> float:
     """``value`` as a float, or ParameterError naming ``name``: a string ("0.1" too), None, a
     bool or what float() refuses is not a number (float() raised ValueError or TypeError)."""
     if isinstance(value, bool | str | bytes) or value is None:
@@ -92,9 +114,29 @@ def _number(name: str, value) -> float:
         raise ParameterError(f"{name} must be a number, got {value!r}") from exc
 
 
+def number_fields(record: Any, owner: str | None = None) -> None:
+    """Every field of dataclass ``record`` annotated ``float`` (or ``float | None``: None
+    allowed) holds a number as `number` has it; else ParameterError naming ``owner`` (the
+    class's name by default) and the field: a string or None where a number belongs is
+    refused by name here, not by a comparison's TypeError further on."""
+    label = type(record).__name__ if owner is None else owner
+    for field in fields(record):
+        if field.type not in _FLOAT_TYPES:
+            continue
+        value = getattr(record, field.name)
+        if value is None and field.type in _OPTIONAL_FLOAT_TYPES:
+            continue
+        number(f"{label}: {field.name}", value)
+
+
+#: the annotations `number_fields` reads (as strings: the package's modules postpone them)
+_OPTIONAL_FLOAT_TYPES = frozenset({"float | None", "None | float", float | None})
+_FLOAT_TYPES = frozenset({"float", float}) | _OPTIONAL_FLOAT_TYPES
+
+
 def positive(name: str, value: float) -> float:
     """``value`` as a float, finite and > 0, or ParameterError naming ``name``."""
-    value = _number(name, value)
+    value = number(name, value)
     if not (math.isfinite(value) and value > 0.0):
         raise ParameterError(f"{name} must be finite and > 0, got {value}")
     return value
@@ -102,7 +144,7 @@ def positive(name: str, value: float) -> float:
 
 def nonnegative(name: str, value: float) -> float:
     """``value`` as a float, finite and >= 0, or ParameterError naming ``name``."""
-    value = _number(name, value)
+    value = number(name, value)
     if not (math.isfinite(value) and value >= 0.0):
         raise ParameterError(f"{name} must be finite and >= 0, got {value}")
     return value

@@ -164,6 +164,20 @@ def test_baseline_rejects_a_ppc_key_and_a_bad_gain():
         _with_controller({"type": "pi_force", "damping": -1.0})
 
 
+def test_a_gain_that_is_not_numbers_is_refused_by_name(reference_uvms):
+    """A string or None as a gain (Python API: the scenario reader refuses them first):
+    ParameterError naming it (was: numpy's ValueError or TypeError from float())."""
+    model = reference_uvms.model
+    ee = model.frames[reference_uvms.ee_frame_id].name
+    for given in ("20", None, ["a", "b"]):
+        with pytest.raises(ParameterError, match="damping must be a number or"):
+            PIForceController(model, ee, damping=given)
+        with pytest.raises(ParameterError, match="stiffness_N_m must be a number or"):
+            ImpedanceController(model, ee, stiffness_N_m=given)
+        with pytest.raises(ParameterError, match="velocity_gain_per_s must be a number or"):
+            ComputedTorqueController(reference_uvms, ee, velocity_gain_per_s=given)
+
+
 def test_model_error_table():
     table = {"type": "computed_torque", "model_error": {"mass_scale": 1.3}}
     scenario = _with_controller(table)

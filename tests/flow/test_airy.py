@@ -129,9 +129,14 @@ def test_bad_parameters_are_refused():
         AiryWave(0.5, 5.0, water_depth_m=-3.0)
     with pytest.raises(ParameterError, match="points_world"):
         AiryWave(0.5, 5.0).velocity(0.0, np.zeros((2, 2)))
+    # gravity 0 was a ZeroDivisionError, a negative or nan one a wave of nan; a string a
+    # ValueError of float()
     for name, value in [("amplitude_m", math.nan), ("amplitude_m", math.inf),
                         ("heading_rad", math.inf), ("phase_rad", math.nan),
-                        ("period_s", math.inf)]:  # fmt: skip
+                        ("period_s", math.inf), ("gravity_m_s2", 0.0),
+                        ("gravity_m_s2", -9.81), ("gravity_m_s2", math.nan),
+                        ("amplitude_m", "0.5"), ("period_s", None), ("water_depth_m", "deep"),
+                        ("heading_rad", [0.0])]:  # fmt: skip
         given = {"amplitude_m": 0.5, "period_s": 5.0, name: value}
         with pytest.raises(ParameterError, match=name):
             AiryWave(**given)

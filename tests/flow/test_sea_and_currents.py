@@ -180,7 +180,8 @@ def test_gauss_markov_samples_are_the_exact_ar1_of_its_seeded_draws():
     "name, value",
     [("time_constant_s", 0.0), ("time_constant_s", -2.0), ("time_constant_s", math.inf),
      ("bound_m_s", 0.0), ("bound_m_s", math.nan), ("sample_period_s", math.inf),
-     ("std_m_s", -0.1), ("std_m_s", math.inf)],
+     ("std_m_s", -0.1), ("std_m_s", math.inf), ("std_m_s", "0.1"), ("bound_m_s", None),
+     ("time_constant_s", [20.0])],
 )  # fmt: skip
 def test_gauss_markov_refuses_a_scale_that_is_not_positive_and_finite(name, value):
     given = {"std_m_s": 0.1, "time_constant_s": 20.0, "bound_m_s": 0.2, name: value}

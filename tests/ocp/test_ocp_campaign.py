@@ -152,6 +152,10 @@ def _at_rest(uvms):
         ({"pose_weights": (1.0, 2.0, 3.0)}, "pose_weights"),
         ({"effort_weight": -1e-4}, "effort"),
         ({"effort_weight": float("nan")}, "effort"),
+        ({"dt_s": "0.02"}, "dt_s must be a number"),  # was: a comparison's TypeError
+        ({"horizon_s": None}, "horizon_s must be a number"),
+        ({"pose_weights": "heavy"}, "pose_weights"),  # was: float()'s ValueError
+        ({"effort_weight": "1e-4"}, "effort"),
     ],
 )
 @pytest.mark.parametrize("builder", ["point_to_point", "station_hold"])

@@ -28,6 +28,7 @@ from dataclasses import dataclass
 import numpy as np
 import pinocchio as pin
 
+from uvms_pin.checks import number_fields
 from uvms_pin.control.base import Controller
 from uvms_pin.control.measurement import Measurement, read_only
 from uvms_pin.errors import ParameterError
@@ -49,6 +50,7 @@ class JawSchedule:
     open_at_s: float | None = None
 
     def __post_init__(self) -> None:
+        number_fields(self)
         opened = math.inf if self.open_at_s is None else self.open_at_s
         if not (math.isfinite(self.close_at_s) and self.close_at_s >= 0.0):
             raise ParameterError(f"close_at_s must be finite and >= 0, got {self.close_at_s}")

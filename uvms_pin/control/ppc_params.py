@@ -10,6 +10,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike
 
+from uvms_pin.checks import sized_vector
 from uvms_pin.control.performance import check_funnel_bounds
 from uvms_pin.errors import ParameterError
 from uvms_pin.results.components import FIRST_LEVEL_NAMES, VEHICLE_VELOCITY_NAMES
@@ -152,24 +153,3 @@ def _number(name: str, value: object) -> float:
     if isinstance(value, bool) or not isinstance(value, int | float | np.integer | np.floating):
         raise ParameterError(f"{name} must be a number, got {value!r}")
     return float(value)
-
-
-def sized_vector(name: str, value: ArrayLike, size: int) -> np.ndarray:
-    """``value`` as a read-only (size,) float array: a scalar broadcast, else exactly
-    ``size`` finite entries (ParameterError naming ``name`` otherwise)."""
-    try:
-        array = np.asarray(value)
-    except (TypeError, ValueError):  # ragged lists
-        array = np.asarray(None)
-    if array.dtype.kind not in "iuf":  # no strings, booleans, objects
-        raise ParameterError(f"{name} must be a number or a list of numbers, got {value!r}")
-    array = array.astype(float)
-    if array.ndim == 0:
-        array = np.full(size, float(array))
-    if array.shape != (size,):
-        raise ParameterError(f"{name} must be a scalar or have {size} entries, got {array.shape}")
-    if not np.all(np.isfinite(array)):
-        raise ParameterError(f"{name} has non-finite entries: {array}")
-    array = array.copy()
-    array.flags.writeable = False
-    return array

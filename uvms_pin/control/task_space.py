@@ -15,8 +15,9 @@ import numpy as np
 import pinocchio as pin
 from numpy.typing import ArrayLike
 
+from uvms_pin.checks import sized_vector
 from uvms_pin.control.measurement import Measurement
-from uvms_pin.control.ppc_params import N_VEHICLE, PPCParams, sized_vector
+from uvms_pin.control.ppc_params import N_VEHICLE, PPCParams
 from uvms_pin.control.pseudo_inverse import MinimumNormSolver, pseudo_inverse
 from uvms_pin.errors import ParameterError
 from uvms_pin.physics.kinematics import (

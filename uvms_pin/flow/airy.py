@@ -6,7 +6,7 @@ import math
 
 import numpy as np
 
-from uvms_pin.checks import Plausible
+from uvms_pin.checks import Plausible, number
 from uvms_pin.errors import ParameterError
 from uvms_pin.flow.components import (
     STANDARD_GRAVITY_M_S2,
@@ -19,7 +19,7 @@ __all__ = ["AiryWave", "wavenumber"]
 
 
 def _finite(value: float, name: str, *, positive: bool = False) -> float:
-    value = float(value)
+    value = number(name, value)
     if not math.isfinite(value) or (positive and value <= 0.0):
         raise ParameterError(
             f"{name} must be {'positive and ' if positive else ''}finite, got {value}"
@@ -69,7 +69,7 @@ class AiryWave(WaveField):
         period = _finite(period_s, "period_s", positive=True)
         heading = _finite(heading_rad, "heading_rad")
         phase = _finite(phase_rad, "phase_rad")
-        depth = float(water_depth_m)
+        depth = number("water_depth_m", water_depth_m)
         if not depth > 0.0:
             raise ParameterError(f"water_depth_m must be positive (or inf), got {water_depth_m}")
         refusal = WAVE_PERIOD.refusal(period)  # (a scenario warns of unusual ones)

@@ -22,6 +22,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from uvms_pin.checks import number, positive
 from uvms_pin.errors import ParameterError
 from uvms_pin.flow.base import FlowField, as_points
 
@@ -38,7 +39,8 @@ def wavenumber(
     Deep water (d = inf): k = w^2 / g. Converges to machine precision from Eckart's
     approximation.
     """
-    w, d, g = float(angular_frequency_rad_s), float(water_depth_m), float(gravity_m_s2)
+    w = number("angular frequency", angular_frequency_rad_s)
+    d, g = number("water_depth_m", water_depth_m), positive("gravity_m_s2", gravity_m_s2)
     if not (w > 0.0 and math.isfinite(w)):
         raise ParameterError(f"angular frequency must be positive and finite, got {w}")
     if not d > 0.0:

@@ -19,7 +19,7 @@ import math
 
 import numpy as np
 
-from uvms_pin.checks import finite_vector, seed_value
+from uvms_pin.checks import finite_vector, number, seed_value
 from uvms_pin.errors import ParameterError
 from uvms_pin.flow.base import FlowField, as_points, zero_gradient_kinematics
 
@@ -27,7 +27,7 @@ _CHUNK = 1024
 
 
 def _positive(value: float, name: str) -> float:
-    value = float(value)
+    value = number(name, value)
     if not (value > 0.0 and math.isfinite(value)):
         raise ParameterError(f"{name} must be positive and finite, got {value}")
     return value
@@ -69,7 +69,7 @@ class GaussMarkovCurrent(FlowField):
         self.mean_velocity_world_m_s = finite_vector(
             "mean_velocity_world_m_s", mean_velocity_world_m_s, 3
         )
-        self.std_m_s = float(std_m_s)
+        self.std_m_s = number("std_m_s", std_m_s)
         if not (self.std_m_s >= 0.0 and math.isfinite(self.std_m_s)):
             raise ParameterError(f"std_m_s must be >= 0, got {std_m_s}")
         self.time_constant_s = _positive(time_constant_s, "time_constant_s")

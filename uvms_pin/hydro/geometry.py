@@ -45,6 +45,7 @@ import math
 
 import numpy as np
 
+from uvms_pin.checks import nonnegative, positive
 from uvms_pin.errors import ParameterError
 from uvms_pin.hydro.elliptic import carlson_rd
 from uvms_pin.hydro.params import HydroParams
@@ -69,35 +70,11 @@ _DEFAULT_SKIN_FRICTION = 0.0047
 # --------------------------------------------------------------------------- validation
 
 
-def _number(name: str, value: float) -> float:
-    """``value`` as a float, else ParameterError naming ``name``."""
-    try:
-        return float(value)
-    except (TypeError, ValueError) as exc:
-        raise ParameterError(f"{name} must be a number, got {value!r}") from exc
-
-
-def _positive(name: str, value: float) -> float:
-    """Return ``value`` as a float if it is finite and > 0, else raise ParameterError."""
-    x = _number(name, value)
-    if not math.isfinite(x) or x <= 0.0:
-        raise ParameterError(f"{name} must be finite and > 0, got {value!r}")
-    return x
-
-
-def _non_negative(name: str, value: float) -> float:
-    """Return ``value`` as a float if it is finite and >= 0, else raise ParameterError."""
-    x = _number(name, value)
-    if not math.isfinite(x) or x < 0.0:
-        raise ParameterError(f"{name} must be finite and >= 0, got {value!r}")
-    return x
-
-
 def _linear_from_quadratic(quadratic: np.ndarray, reference: tuple[float, float]) -> np.ndarray:
     """Diagonal linear damping D_lin = D_quad * [u_ref]*3 + [omega_ref]*3 (see module doc),
     ``reference`` = (u_ref [m/s], omega_ref [rad/s]), each checked finite and >= 0."""
-    u = _non_negative("linear_damping_reference_speed_m_s", reference[0])
-    w = _non_negative("linear_damping_reference_rate_rad_s", reference[1])
+    u = nonnegative("linear_damping_reference_speed_m_s", reference[0])
+    w = nonnegative("linear_damping_reference_rate_rad_s", reference[1])
     return np.diag(quadratic * np.array([u, u, u, w, w, w]))
 
 
@@ -142,9 +119,9 @@ def ellipsoid_shape_integrals(a_m: float, b_m: float, c_m: float) -> tuple[float
     Returns:
         (alpha0, beta0, gamma0).
     """
-    a = _positive("a_m", a_m)
-    b = _positive("b_m", b_m)
-    c = _positive("c_m", c_m)
+    a = positive("a_m", a_m)
+    b = positive("b_m", b_m)
+    c = positive("c_m", c_m)
     scale = max(a, b, c)
     a2, b2, c2 = (a / scale) ** 2, (b / scale) ** 2, (c / scale) ** 2
     abc = math.sqrt(a2 * b2 * c2)
@@ -195,10 +172,10 @@ def ellipsoid_added_mass(a_m: float, b_m: float, c_m: float, rho_kg_m3: float) -
     Returns:
         (6,) [kg, kg, kg, kg m^2, kg m^2, kg m^2].
     """
-    a = _positive("a_m", a_m)
-    b = _positive("b_m", b_m)
-    c = _positive("c_m", c_m)
-    rho = _positive("rho_kg_m3", rho_kg_m3)
+    a = positive("a_m", a_m)
+    b = positive("b_m", b_m)
+    c = positive("c_m", c_m)
+    rho = positive("rho_kg_m3", rho_kg_m3)
     alpha0, beta0, gamma0 = ellipsoid_shape_integrals(a, b, c)
     mf = rho * 4.0 / 3.0 * math.pi * a * b * c
     return np.array(
@@ -241,10 +218,10 @@ def sphere_hydro(
         drag_coefficient: Cd of the sphere [-].
         the others: see the module docstring.
     """
-    r = _positive("radius_m", radius_m)
-    rho = _positive("water_density_kg_m3", water_density_kg_m3)
-    cd = _non_negative("drag_coefficient", drag_coefficient)
-    cf = _non_negative("skin_friction_coefficient", skin_friction_coefficient)
+    r = positive("radius_m", radius_m)
+    rho = positive("water_density_kg_m3", water_density_kg_m3)
+    cd = nonnegative("drag_coefficient", drag_coefficient)
+    cf = nonnegative("skin_friction_coefficient", skin_friction_coefficient)
     reference = (linear_damping_reference_speed_m_s, linear_damping_reference_rate_rad_s)
     volume = 4.0 / 3.0 * math.pi * r**3
     ma = 0.5 * rho * volume
@@ -306,12 +283,12 @@ def cylinder_hydro(
         drag_coefficient_cross, drag_coefficient_axial: Cd [-] >= 0.
         the others: see the module docstring.
     """
-    r = _positive("radius_m", radius_m)
-    length = _positive("length_m", length_m)
-    rho = _positive("water_density_kg_m3", water_density_kg_m3)
-    cd_x = _non_negative("drag_coefficient_cross", drag_coefficient_cross)
-    cd_a = _non_negative("drag_coefficient_axial", drag_coefficient_axial)
-    cf = _non_negative("skin_friction_coefficient", skin_friction_coefficient)
+    r = positive("radius_m", radius_m)
+    length = positive("length_m", length_m)
+    rho = positive("water_density_kg_m3", water_density_kg_m3)
+    cd_x = nonnegative("drag_coefficient_cross", drag_coefficient_cross)
+    cd_a = nonnegative("drag_coefficient_axial", drag_coefficient_axial)
+    cf = nonnegative("skin_friction_coefficient", skin_friction_coefficient)
     reference = (linear_damping_reference_speed_m_s, linear_damping_reference_rate_rad_s)
 
     volume = math.pi * r * r * length
@@ -369,9 +346,9 @@ def box_hydro(
     sides = np.asarray(size_m, dtype=object).reshape(-1)
     if sides.shape != (3,):
         raise ParameterError(f"size_m must be 3 numbers, got {size_m!r}")
-    lx, ly, lz = (_positive(f"size_m[{i}]", s) for i, s in enumerate(sides))
-    rho = _positive("water_density_kg_m3", water_density_kg_m3)
-    cd = _non_negative("drag_coefficient", drag_coefficient)
+    lx, ly, lz = (positive(f"size_m[{i}]", s) for i, s in enumerate(sides))
+    rho = positive("water_density_kg_m3", water_density_kg_m3)
+    cd = nonnegative("drag_coefficient", drag_coefficient)
     reference = (linear_damping_reference_speed_m_s, linear_damping_reference_rate_rad_s)
 
     volume = lx * ly * lz

@@ -25,6 +25,7 @@ from dataclasses import dataclass
 import numpy as np
 import pinocchio as pin
 
+from uvms_pin.checks import nonnegative, number
 from uvms_pin.errors import ParameterError
 from uvms_pin.flow import FlowField, UniformCurrent
 from uvms_pin.model.uvms import UVMS
@@ -178,10 +179,7 @@ def check_terms(terms: WeightedTerms, nu: int, has_contact: bool) -> None:
     NaN one every cost NaN), an effort term over the nu inputs, a term of the contact
     (``needs_contact``) only in a node with one; else ParameterError."""
     for term, scale in terms:
-        if not (scale >= 0.0 and np.isfinite(scale)):
-            raise ParameterError(
-                f"cost '{term.name}': its scale must be finite and >= 0, got {scale}"
-            )
+        nonnegative(f"cost '{term.name}': its scale", scale)
         if isinstance(term, costs.Effort) and term.nr != nu:
             raise ParameterError(
                 f"cost '{term.name}': {term.nr} weights for the node's {nu} inputs (nu)"
@@ -219,7 +217,7 @@ def _nodes(horizon_s: float, dt_s: float) -> int:
     """round(horizon_s / dt_s), the nodes of a horizon; ParameterError unless both are
     positive finite times [s] and the horizon holds at least one node."""
     for name, value in (("dt_s", dt_s), ("horizon_s", horizon_s)):
-        if not (value > 0.0 and math.isfinite(value)):
+        if not (number(f"ocp {name}", value) > 0.0 and math.isfinite(value)):
             raise ParameterError(f"ocp {name} must be a positive finite time [s], got {value}")
     nodes = round(horizon_s / dt_s)
     if nodes < 1:
@@ -231,7 +229,10 @@ def _nodes(horizon_s: float, dt_s: float) -> int:
 
 def _six_weights(name: str, weights) -> np.ndarray:
     """``weights``: one number or six, as a (6,) array; ParameterError naming ``name``."""
-    values = np.asarray(weights, float).reshape(-1)
+    try:
+        values = np.asarray(weights, float).reshape(-1)
+    except (TypeError, ValueError):
+        raise ParameterError(f"ocp {name}: one number or six needed, got {weights!r}") from None
     if values.size not in (1, 6):
         raise ParameterError(f"ocp {name}: one number or six needed, got {values.size}")
     return np.broadcast_to(values, (6,)).copy()
@@ -239,9 +240,7 @@ def _six_weights(name: str, weights) -> np.ndarray:
 
 def _scale(name: str, value: float) -> float:
     """A cost term's scale: finite and >= 0, else ParameterError naming it."""
-    if not (value >= 0.0 and math.isfinite(value)):
-        raise ParameterError(f"ocp {name} must be finite and >= 0, got {value}")
-    return float(value)
+    return nonnegative(f"ocp {name}", value)
 
 
 @dataclass(frozen=True)

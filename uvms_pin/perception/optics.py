@@ -31,7 +31,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from uvms_pin.checks import finite_vector, nonnegative
+from uvms_pin.checks import finite_vector, nonnegative, number_fields
 from uvms_pin.errors import ParameterError
 
 __all__ = ["JERLOV_KD_PER_M", "Light", "WaterOptics", "backscatter", "cone"]
@@ -73,6 +73,7 @@ class WaterOptics:
     backscatter_albedo: float = 0.2
 
     def __post_init__(self) -> None:
+        number_fields(self)
         if not isinstance(self.water_type, str) or self.water_type not in JERLOV_KD_PER_M:
             raise ParameterError(
                 f"water_type must be a Jerlov type ({', '.join(JERLOV_KD_PER_M)}), "
@@ -126,6 +127,7 @@ class Light:
     edge_rad: float = 0.1
 
     def __post_init__(self) -> None:
+        number_fields(self)
         # finite: an inf or nan here would make the lit pixels' radiance nan, read as 0
         # counts, a black image and no error
         finite_vector("a light's position_m", self.position_m, 3)

@@ -18,6 +18,7 @@ from typing import Any
 import numpy as np
 import pinocchio as pin
 
+from uvms_pin.checks import number_fields
 from uvms_pin.errors import ParameterError
 from uvms_pin.physics.kinematics import frame_id_from_name
 
@@ -153,14 +154,21 @@ def written(
 
 
 def check_mount(spec: Any, label: str) -> None:
-    """ParameterError unless ``spec``'s name is a non-empty string, its ``position_m`` and
-    ``rpy_rad`` finite 3-vectors and its ``rate_hz`` finite and > 0."""
+    """ParameterError unless ``spec``'s name is a non-empty string, its numbers numbers
+    (`number_fields`), its ``position_m`` and ``rpy_rad`` finite 3-vectors and its
+    ``rate_hz`` finite and > 0."""
     if not isinstance(spec.name, str) or not spec.name:
         raise ParameterError(f"{label}: name must be a non-empty string, got {spec.name!r}")
+    number_fields(spec, label)
     for key in ("position_m", "rpy_rad"):
-        value = np.asarray(getattr(spec, key), dtype=float)
+        try:
+            value = np.asarray(getattr(spec, key), dtype=float)
+        except (TypeError, ValueError):
+            value = np.asarray(None)  # not numbers: refused below, as a wrong shape
         if value.shape != (3,) or not np.all(np.isfinite(value)):
-            raise ParameterError(f"{label}: {key} must be 3 finite numbers, got {value.tolist()}")
+            raise ParameterError(
+                f"{label}: {key} must be 3 finite numbers, got {getattr(spec, key)!r}"
+            )
     if spec.link is not None and not isinstance(spec.link, str):
         raise ParameterError(f"{label}: link must be a frame's name, got {spec.link!r}")
     if not (math.isfinite(spec.rate_hz) and spec.rate_hz > 0.0):

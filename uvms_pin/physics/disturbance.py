@@ -8,7 +8,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from uvms_pin.checks import finite_vector
+from uvms_pin.checks import finite_vector, number_fields
 from uvms_pin.errors import ParameterError
 
 
@@ -24,6 +24,7 @@ class SinusoidalDisturbance:
     phase_rad: float = 0.0
 
     def __post_init__(self) -> None:
+        number_fields(self)
         object.__setattr__(
             self, "amplitude", finite_vector("disturbance amplitude", self.amplitude, 6)
         )

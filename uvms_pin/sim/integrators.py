@@ -20,7 +20,7 @@ from typing import ClassVar
 import numpy as np
 import pinocchio as pin
 
-from uvms_pin.checks import positive
+from uvms_pin.checks import number_fields, positive
 from uvms_pin.errors import ParameterError, SimulationError
 
 Rhs = Callable[[float, np.ndarray, np.ndarray], np.ndarray]
@@ -101,6 +101,7 @@ class FixedStep(Integrator):
     core_method: ClassVar[str] = ""
 
     def __post_init__(self) -> None:
+        number_fields(self)
         if not (self.step_s > 0.0 and math.isfinite(self.step_s)):
             raise ParameterError(
                 f"{type(self).__name__} step_s must be positive, got {self.step_s}"
@@ -204,6 +205,7 @@ class Adaptive(Integrator):
     _METHODS = ("LSODA", "Radau", "BDF", "RK45", "RK23", "DOP853")
 
     def __post_init__(self) -> None:
+        number_fields(self, "adaptive")
         if self.method not in self._METHODS:
             raise ParameterError(
                 f"adaptive method must be one of {self._METHODS}, got '{self.method}'"

@@ -19,6 +19,7 @@ from dataclasses import dataclass, field, fields
 import numpy as np
 import pinocchio as pin
 
+from uvms_pin.checks import number_fields
 from uvms_pin.control.measurement import Measurement, read_only
 from uvms_pin.errors import ParameterError
 from uvms_pin.perception.loop import LoopCameras
@@ -41,6 +42,7 @@ class NoiseSpec:
     distribution: str = "uniform"
 
     def __post_init__(self) -> None:
+        number_fields(self)
         if not (self.bound >= 0.0 and math.isfinite(self.bound)):
             raise ParameterError(f"noise bound must be >= 0, got {self.bound}")
         if self.distribution not in ("uniform", "gaussian"):
@@ -176,6 +178,7 @@ class SensorConfig:
     held_object_wrench: bool = False
 
     def __post_init__(self) -> None:
+        number_fields(self)
         for name in (f.name for f in fields(self) if isinstance(f.default, NoiseSpec)):
             value = getattr(self, name)
             if not isinstance(value, NoiseSpec):

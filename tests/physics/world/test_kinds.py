@@ -36,6 +36,10 @@ def test_the_one_check_names_the_key_it_refuses():
     with pytest.raises(ParameterError, match="size_m must be > 0") as refused:
         solid("crate", "box", {"size_m": [1, -1, 1]}, [0, 0, 0], [0, 0, 0], 0.6, 0.5)
     assert refused.value.key == "size_m"
+    for given in ("0.4", None, [0.4]):  # was: float()'s ValueError or TypeError
+        with pytest.raises(ParameterError, match="radius_m must be a number") as refused:
+            solid("ball", "sphere", {"radius_m": given}, [0, 0, 0], [0, 0, 0], 0.6, 0.5)
+        assert refused.value.key == "radius_m"
     with pytest.raises(ParameterError, match="normal_world must be non-zero") as refused:
         plane("floor", [0, 0, 0], [0, 0, 0], 0.6, 0.5)
     assert refused.value.key == "normal_world"

@@ -43,6 +43,7 @@ from pathlib import Path
 import numpy as np
 import pinocchio as pin
 
+from uvms_pin.checks import number_fields
 from uvms_pin.errors import ModelError, ModelWarning, ParameterError
 from uvms_pin.hydro.mesh import load_mesh_geometry
 from uvms_pin.model.resources import resolve_resource
@@ -88,6 +89,7 @@ class MjcfOptions:
     spring_anchor_world_m: tuple[float, float, float] | None = None
 
     def __post_init__(self) -> None:
+        number_fields(self)
         checks = (
             (self.timestep_s > 0.0 and math.isfinite(self.timestep_s), "timestep_s > 0"),
             (self.integrator in ("RK4", "Euler", "implicit", "implicitfast"), "a known integrator"),

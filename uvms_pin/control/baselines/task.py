@@ -23,6 +23,7 @@ import numpy as np
 import pinocchio as pin
 from numpy.typing import ArrayLike
 
+from uvms_pin.checks import sized_vector
 from uvms_pin.control.measurement import Measurement
 from uvms_pin.control.ppc_params import PPCParams
 from uvms_pin.control.task_space import (
@@ -48,15 +49,11 @@ def gain_vector(name: str, value: ArrayLike, size: int, *, positive: bool = Fals
     Raises:
         ParameterError: naming the gain: wrong size, non-finite, negative (or zero).
     """
-    array = np.asarray(value, dtype=float)
-    if array.ndim == 0:
-        array = np.full(size, float(array))
-    if array.shape != (size,):
-        raise ParameterError(f"{name} must be a scalar or have {size} entries, got {array.shape}")
-    bad = ~(array > 0.0) if positive else ~(array >= 0.0)
-    if not np.all(np.isfinite(array)) or np.any(bad):
-        sign = "> 0" if positive else ">= 0"
-        raise ParameterError(f"{name} must be finite and {sign}, got {array.tolist()}")
+    array = sized_vector(name, value, size)
+    if np.any(~(array > 0.0) if positive else ~(array >= 0.0)):
+        raise ParameterError(
+            f"{name} must be {'> 0' if positive else '>= 0'}, got {array.tolist()}"
+        )
     return array
 
 

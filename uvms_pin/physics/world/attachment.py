@@ -7,6 +7,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
+from uvms_pin.checks import number_fields
 from uvms_pin.errors import ParameterError
 
 __all__ = ["Attachment"]
@@ -30,6 +31,7 @@ class Attachment:
 
     def __post_init__(self) -> None:
         what = f"the attachment of '{self.object_name}' to '{self.link}'"
+        number_fields(self, what)
         if not (math.isfinite(self.attach_at_s) and self.attach_at_s >= 0.0):
             raise ParameterError(f"{what}: attach_at_s must be finite and >= 0 [s], got "
                                  f"{self.attach_at_s}")  # fmt: skip

@@ -31,7 +31,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from uvms_pin.checks import nonnegative, positive
+from uvms_pin.checks import nonnegative, number_fields, positive
 from uvms_pin.errors import ParameterError
 
 __all__ = ["ContactLaw", "friction_force_N", "normal_force_N"]
@@ -57,6 +57,7 @@ class ContactLaw:
     tangential_damping_N_s_m: float = 200.0
 
     def __post_init__(self) -> None:
+        number_fields(self)
         for name in ("stiffness_N_m", "tangential_stiffness_N_m"):
             positive(f"contact {name}", getattr(self, name))
         for name in ("dissipation_s_m", "tangential_damping_N_s_m"):

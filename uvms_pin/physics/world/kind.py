@@ -20,6 +20,7 @@ import coal
 import numpy as np
 import pinocchio as pin
 
+from uvms_pin import checks
 from uvms_pin.checks import finite_vector
 from uvms_pin.errors import ParameterError
 from uvms_pin.model.urdf.collision import collision_hydro, collision_piece
@@ -165,10 +166,13 @@ def invalid(name: str, key: str, what: str) -> ParameterError:
 
 def positive(name: str, key: str, value: Any) -> float:
     """``value`` as a float > 0 and finite, else `invalid`."""
-    number = float(value)
-    if not (np.isfinite(number) and number > 0.0):
-        raise invalid(name, key, f"must be > 0, got {number}")
-    return number
+    try:
+        checked = checks.number(key, value)
+    except ParameterError:
+        raise invalid(name, key, f"must be a number, got {value!r}") from None
+    if not (np.isfinite(checked) and checked > 0.0):
+        raise invalid(name, key, f"must be > 0, got {checked}")
+    return checked
 
 
 def positive_vector(name: str, key: str, value: Any) -> list[float]:

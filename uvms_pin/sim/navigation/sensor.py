@@ -9,13 +9,13 @@ what it reads at a tick (`Tick`). `uvms_pin.sim.navigation.suite` imports every 
 
 from __future__ import annotations
 
-import math
 from collections.abc import Callable
 from dataclasses import dataclass, fields
 from typing import Any
 
 import numpy as np
 
+from uvms_pin import checks
 from uvms_pin.errors import ParameterError
 
 __all__ = [
@@ -99,15 +99,13 @@ def register(kind: SensorKind) -> SensorKind:
 
 
 def check_nonneg(name: str, value: float, *, positive: bool = False) -> None:
-    """ParameterError unless ``value`` is finite and >= 0 (> 0 when ``positive``)."""
-    if not math.isfinite(value) or value < 0.0 or (positive and value == 0.0):
-        raise ParameterError(
-            f"{name} must be finite and {'> 0' if positive else '>= 0'}, got {value}"
-        )
+    """ParameterError unless ``value`` is a finite number >= 0 (> 0 when ``positive``)."""
+    (checks.positive if positive else checks.nonnegative)(name, value)
 
 
 def check_probability(name: str, value: float) -> None:
-    if not (0.0 <= value < 1.0):
+    """ParameterError unless ``value`` is a number in [0, 1)."""
+    if not (0.0 <= checks.number(name, value) < 1.0):
         raise ParameterError(f"{name} must be in [0, 1), got {value}")
 
 

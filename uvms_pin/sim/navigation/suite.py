@@ -13,6 +13,7 @@ from dataclasses import dataclass
 import numpy as np
 import pinocchio as pin
 
+from uvms_pin.checks import number_fields
 from uvms_pin.errors import ParameterError
 
 # the sensor kinds, each registered by its module on import: the one list of them (a new
@@ -51,6 +52,7 @@ class NavigationSpec:
     seabed: Seabed | None = None
 
     def __post_init__(self) -> None:
+        number_fields(self)
         check_nonneg(
             "the navigation's water_density_kg_m3", self.water_density_kg_m3, positive=True
         )
