@@ -73,8 +73,13 @@ def step_derivatives(
         method, step_s = integrator, 1e-3 if step_s is None else step_s
     elif step_s is not None:
         raise ParameterError("give step_s or an integrator object (with its step_s), not both")
-    else:
+    elif isinstance(getattr(integrator, "core_method", None), str):
         method, step_s = integrator.core_method, integrator.step_s
+    else:  # None, a number: not an integrator (the sim's FixedStep ones have these two)
+        raise ParameterError(
+            f"integrator must be one of {METHODS} or a fixed-step integrator (RK4, "
+            f"SemiImplicitEuler), got {integrator!r}"
+        )
     if method not in METHODS:
         raise ParameterError(f"integrator must be one of {METHODS}, got '{method}'")
     substeps(period_s, step_s)  # checks both

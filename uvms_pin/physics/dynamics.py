@@ -48,7 +48,8 @@ def dynamics_of(uvms: UVMS, backend: str = "core") -> CompiledDynamics | Referen
     """The dynamics of ``uvms`` in ``backend`` ("core": compiled, "python": the reference),
     built on first use and kept with it (``uvms.cache``)."""
     built = uvms.cache.get("dynamics")
-    dynamics = None if built is None else built.get(backend)
+    # a name, or refused by name in _build_dynamics (an array is not even a key)
+    dynamics = None if built is None or not isinstance(backend, str) else built.get(backend)
     return _build_dynamics(uvms, backend) if dynamics is None else dynamics
 
 
@@ -330,6 +331,7 @@ def potential_energy(
     rho g V_sub at r_sub; under waves the water does work and U is the same formula at
     ``time_s``)."""
     q = finite_vector("q", q, uvms.nq)
+    free_surface = flag("free_surface", free_surface)
     model, data = uvms.model, uvms.data
     pin.forwardKinematics(model, data, q)
     wet = wet_state(uvms, data, _checked_flow(flow), check_time(time_s)) if free_surface else None

@@ -192,6 +192,8 @@ def test_a_free_surface_flag_that_is_not_a_bool_is_named(reference, value):
             with pytest.raises(ParameterError, match="free_surface must be True or False"):
                 call(backend)
                 pytest.fail(f"{name} ({backend}) took free_surface={value!r}")
+    with pytest.raises(ParameterError, match="free_surface must be True or False"):
+        up.potential_energy(reference, q, free_surface=value)  # "yes" was read as True
     flag = np.bool_(True)  # numpy's bool is one
     up.forward_dynamics(reference, q, v, tau, free_surface=flag)
 
@@ -204,6 +206,24 @@ def test_a_time_that_is_not_a_finite_number_is_named(reference, time_s):
             up.forward_dynamics_derivatives(reference, q, v, tau, time_s=time_s, backend=backend)
         with pytest.raises(ParameterError, match="time_s"):
             up.step_derivatives(reference, q, v, tau, 0.02, time_s=time_s, backend=backend)
+
+
+@pytest.mark.parametrize("backend", [np.array(["core"]), ["core"], None])
+def test_a_backend_that_is_not_a_name_is_refused_by_name(reference, backend):
+    """(an array or a list was a TypeError of the cache's lookup: unhashable)"""
+    q, v, tau = _state(reference)
+    with pytest.raises(ParameterError, match="backend must be one of"):
+        up.forward_dynamics(reference, q, v, tau, backend=backend)
+    with pytest.raises(ParameterError, match="backend must be one of"):
+        up.mass_matrix(reference, q, backend=backend)
+
+
+@pytest.mark.parametrize("integrator", [None, 0.01, "euler"])
+def test_an_integrator_that_is_neither_a_name_nor_an_integrator_is_named(reference, integrator):
+    """(None or a number was an AttributeError on core_method)"""
+    q, v, tau = _state(reference)
+    with pytest.raises(ParameterError, match="integrator must be one of"):
+        up.step_derivatives(reference, q, v, tau, 0.02, integrator=integrator)
 
 
 @pytest.mark.parametrize("name", ["period_s", "step_s"])
