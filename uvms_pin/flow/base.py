@@ -168,8 +168,12 @@ class SumFlow(FlowField):
     gradients add; the material acceleration is formed from the sums, not summed)."""
 
     def __init__(self, fields: tuple[FlowField, ...]):
+        if not isinstance(fields, tuple | list):
+            raise ParameterError(f"SumFlow takes a tuple of FlowFields, got {fields!r}")
         flat: list[FlowField] = []
         for f in fields:
+            if not isinstance(f, FlowField):
+                raise ParameterError(f"SumFlow adds FlowFields, got {f!r}")
             flat.extend(f.fields if isinstance(f, SumFlow) else (f,))
         if not flat:
             raise ParameterError("SumFlow needs at least one field")

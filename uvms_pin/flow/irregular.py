@@ -15,7 +15,7 @@ import math
 
 import numpy as np
 
-from uvms_pin.checks import seed_value
+from uvms_pin.checks import finite_vector, number, seed_value
 from uvms_pin.errors import ParameterError
 from uvms_pin.flow.airy import WAVE_PERIOD
 from uvms_pin.flow.components import (
@@ -84,10 +84,17 @@ class IrregularSea(WaveField):
                 f"n_components must be an integer in 1..{MAX_COMPONENTS}, got {n_components!r}"
                 " (each component is summed at every body at every integrator stage)"
             )
-        refusal = WAVE_PERIOD.refusal(float(peak_period_s))  # a scenario warns of unusual
+        significant_height_m = number("significant_height_m", significant_height_m)
+        peak_period_s = number("peak_period_s", peak_period_s)
+        peak_enhancement = number("peak_enhancement", peak_enhancement)
+        heading_rad = number("heading_rad", heading_rad)
+        water_depth_m = number("water_depth_m", water_depth_m)
+        if spreading_exponent is not None:
+            spreading_exponent = number("spreading_exponent", spreading_exponent)
+        refusal = WAVE_PERIOD.refusal(peak_period_s)  # a scenario warns of unusual
         if refusal is not None:
             raise ParameterError(f"peak_period_s = {refusal}")
-        low, high = (float(x) for x in frequency_range)
+        low, high = finite_vector("frequency_range", frequency_range, 2)
         if not (0.0 < low < 1.0 < high and math.isfinite(high)):
             raise ParameterError(
                 f"frequency_range must be (low, high) multiples of the peak frequency with "

@@ -21,8 +21,11 @@ class DepthProfileCurrent(FlowField):
 
     def __init__(self, velocity_world_m_s, depths_m, factors):
         self.velocity_world_m_s = finite_vector("velocity_world_m_s", velocity_world_m_s, 3)
-        depths = np.asarray(depths_m, dtype=float).reshape(-1)
-        factors_ = np.asarray(factors, dtype=float).reshape(-1)
+        try:
+            depths = np.asarray(depths_m, dtype=float).reshape(-1)
+            factors_ = np.asarray(factors, dtype=float).reshape(-1)
+        except (TypeError, ValueError):  # strings, None, ragged lists
+            depths = factors_ = np.zeros(0)
         if depths.shape != factors_.shape or depths.size < 2:
             raise ParameterError("depths_m and factors must be equal-length lists of >= 2 numbers")
         if not (np.all(np.isfinite(depths)) and np.all(np.isfinite(factors_))):

@@ -93,6 +93,8 @@ def load_scenario(
     Raises:
         ScenarioError: naming the file and the key, or the override that set a bad value.
     """
+    if not isinstance(path, str | Path):
+        raise ParameterError(f"path must be a scenario file's path, got {path!r}")
     path = Path(path)
     return scenario_from_dict(read_toml(path, ScenarioError), path, overrides)
 

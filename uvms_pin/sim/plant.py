@@ -22,7 +22,7 @@ from typing import Any
 import numpy as np
 import pinocchio as pin
 
-from uvms_pin.checks import finite_vector
+from uvms_pin.checks import finite_vector, flag
 from uvms_pin.errors import ParameterError, SimulationError
 from uvms_pin.flow import FlowField, SumFlow, UniformCurrent
 from uvms_pin.model.uvms import UVMS
@@ -39,6 +39,17 @@ from uvms_pin.physics.surface import wet_state
 from uvms_pin.physics.world.world import ContactForces, FrictionMemory, World
 from uvms_pin.sim.actuation import Actuation, Unlimited
 from uvms_pin.sim.compiled.plant import plant_to_core
+
+#: a plant's optional parts and their kinds
+_PARTS = {
+    "contact": ContactModel,
+    "flow": FlowField,
+    "joint_friction": JointFriction,
+    "world": World,
+    "joint_stops": JointStops,
+    "joint_limits": JointLimits,
+    "joint_coulomb": JointCoulombFriction,
+}
 
 
 @dataclass
@@ -89,11 +100,23 @@ class Plant:
     joint_coulomb: JointCoulombFriction | None = None
 
     def __post_init__(self) -> None:
+        if not isinstance(self.uvms, UVMS):
+            raise ParameterError(f"uvms must be a UVMS (uvms_pin.load_uvms), got {self.uvms!r}")
+        for key, kind in _PARTS.items():
+            part = getattr(self, key)
+            if part is not None and not isinstance(part, kind):
+                raise ParameterError(f"{key} must be a {kind.__name__} (or None), got {part!r}")
+        if not isinstance(self.actuation, Actuation):
+            raise ParameterError(f"actuation must be an Actuation, got {self.actuation!r}")
+        if self.disturbance is not None and not callable(self.disturbance):
+            raise ParameterError(
+                f"disturbance must be a function of time [s] (or None), got {self.disturbance!r}"
+            )
+        self.free_surface = flag("free_surface", self.free_surface)
+        self.stop_at_surface = flag("stop_at_surface", self.stop_at_surface)
         self.current_world_m_s = finite_vector("current_world_m_s", self.current_world_m_s, 3)
         if self.contact is not None:
             self.uvms.require_ee_frame("a contact environment (at the end-effector)")
-        if self.flow is not None and not isinstance(self.flow, FlowField):
-            raise ParameterError(f"flow must be a FlowField, got {type(self.flow).__name__}")
         if (
             self.joint_friction is not None
             and self.joint_friction.viscous_Nms.size != self.uvms.nv - 6

@@ -6,7 +6,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-from uvms_pin.checks import check_memory, seed_value
+from uvms_pin.checks import check_memory, number_fields, seed_value
 from uvms_pin.errors import ParameterError
 from uvms_pin.sim.integrators import Integrator
 
@@ -33,6 +33,12 @@ class SimulationSettings:
     rebase_period_s: float = 0.5
 
     def __post_init__(self) -> None:
+        number_fields(self)
+        if not isinstance(self.integrator, Integrator):
+            raise ParameterError(
+                f"integrator must be an Integrator (RK4(), SemiImplicitEuler(), Adaptive()), "
+                f"got {self.integrator!r}"
+            )
         seed_value("seed", self.seed)
         if not (self.duration_s > 0.0 and math.isfinite(self.duration_s)):
             raise ParameterError(f"duration_s must be positive, got {self.duration_s}")

@@ -21,7 +21,7 @@ from pathlib import Path
 
 import numpy as np
 
-from uvms_pin.errors import ModelError
+from uvms_pin.errors import ModelError, ParameterError
 from uvms_pin.hydro.params import HydroParams
 from uvms_pin.model.importer.collision_volume import collision_volume
 from uvms_pin.model.importer.fossen import fossen_hydro
@@ -65,6 +65,8 @@ def import_model(
     Raises:
         ModelError: naming the file and what cannot be read or mapped; nothing is written.
     """
+    if not isinstance(path, str | Path):
+        raise ParameterError(f"path must be a model file's path, got {path!r}")
     path = Path(path)
     where = str(path)
     notes: list[str] = []

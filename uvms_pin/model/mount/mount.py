@@ -38,6 +38,7 @@ brackets):
 
 from __future__ import annotations
 
+import inspect
 import tempfile
 import warnings
 import xml.etree.ElementTree as ET
@@ -116,6 +117,10 @@ def mount_arm(
     return mount_arm_detailed(vehicle_urdf, arm_urdf, mount_pose, **options).uvms
 
 
+#: the keywords `merge_urdf` takes (what mount_arm passes it)
+_MERGE_OPTIONS = frozenset(inspect.signature(merge_urdf).parameters)
+
+
 def mount_arm_detailed(
     vehicle_urdf: str | Path,
     arm_urdf: str | Path | ArmEntry,
@@ -141,6 +146,17 @@ def mount_arm_detailed(
             ``tool_axis``, ``tool``, ``lock_positions``, ``package_dirs`` (also passed to
             ``load_uvms``), ``allow_dry_links``, ``keep_existing_arm``, ``moving_jaw``.
     """
+    known = _MERGE_OPTIONS - {"vehicle_urdf", "arm_urdf", "mount_pose"}
+    unknown = sorted(set(merge_options) - known)
+    if unknown:
+        raise ParameterError(
+            f"mount_arm: unknown option(s) {', '.join(unknown)}; the options are "
+            f"water_density_kg_m3, trim, trim_joint_positions, save_urdf, {', '.join(sorted(known))}"
+        )
+    if not (trim is None or isinstance(trim, bool | TrimSpec)):
+        raise ParameterError(
+            f"mount_arm: trim must be True, False, None or a TrimSpec, got {trim!r}"
+        )
     vehicle_urdf = find_model(vehicle_urdf) or vehicle_urdf
     entry = _catalog_entry(arm_urdf)
     if entry is not None:

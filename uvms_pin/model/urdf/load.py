@@ -12,6 +12,7 @@ from pathlib import Path
 import numpy as np
 import pinocchio as pin
 
+from uvms_pin.checks import flag, number
 from uvms_pin.errors import ModelError, ModelWarning, ParameterError
 from uvms_pin.model.native_stderr import captured_native_stderr
 from uvms_pin.model.urdf.bodies import hydro_bodies
@@ -49,8 +50,8 @@ def load_uvms(
             from their collision primitives (marked ``derived``).
         allow_dry_links: accept links with mass but neither hydrodynamics nor collision
             geometry (they get no hydrodynamic effect) instead of raising.
-        package_dirs: directories containing packages, searched first for the
-            ``package://`` mesh paths of collision meshes (then the installed
+        package_dirs: directories containing packages (or one, alone), searched first for
+            the ``package://`` mesh paths of collision meshes (then the installed
             example-robot-data; see `uvms_pin.model.resources`). Relative mesh paths are relative
             to the URDF's directory.
 
@@ -61,6 +62,14 @@ def load_uvms(
         raise ParameterError(f"urdf_path must be a path to a URDF file, got {urdf_path!r}")
     path = Path(urdf_path)
     where = str(path)
+    water_density_kg_m3 = number("water_density_kg_m3", water_density_kg_m3)
+    derive_missing = flag("derive_missing", derive_missing)
+    allow_dry_links = flag("allow_dry_links", allow_dry_links)
+    for name, frame in (("ee_frame", ee_frame), ("sensor_frame", sensor_frame)):
+        if frame is not None and not isinstance(frame, str):
+            raise ParameterError(f"{name} must be a frame's name (or None), got {frame!r}")
+    if isinstance(package_dirs, str | Path):
+        package_dirs = (package_dirs,)  # one folder, not its name's characters
     if not np.isfinite(water_density_kg_m3) or water_density_kg_m3 <= 0.0:
         raise ParameterError(f"water_density_kg_m3 must be positive, got {water_density_kg_m3}")
     WATER_DENSITY.check("water_density_kg_m3", water_density_kg_m3)

@@ -22,9 +22,13 @@ from typing import Any
 import numpy as np
 import pinocchio as pin
 
+from uvms_pin.checks import flag
 from uvms_pin.errors import ParameterError
 from uvms_pin.model.uvms import UVMS
+from uvms_pin.physics.world.attachment import Attachment
 from uvms_pin.physics.world.contact_law import ContactLaw, friction_force_N, normal_force_N
+from uvms_pin.physics.world.fixture import Fixture
+from uvms_pin.physics.world.free_object import FreeObject
 from uvms_pin.physics.world.objects import WorldObject
 from uvms_pin.physics.world.robot_geometry import RobotPiece, robot_pieces
 from uvms_pin.physics.world.touch import NO_TOUCH, Bounds, Touch, clear_of, cross, touch
@@ -125,6 +129,15 @@ class ContactForces:
         return cls(NO_TOUCH, np.zeros((0, 3)), np.zeros(0), np.zeros(0, dtype=bool))
 
 
+#: a world's lists and the kind of their members
+_MEMBERS = {
+    "objects": WorldObject,
+    "free": FreeObject,
+    "fixtures": Fixture,
+    "attachments": Attachment,
+}
+
+
 @dataclass
 class World:
     """Fixed objects and the contact law, for one UVMS.
@@ -159,6 +172,18 @@ class World:
     attachments: Sequence[Any] = ()
 
     def __post_init__(self) -> None:
+        if not isinstance(self.uvms, UVMS):
+            raise ParameterError(f"uvms must be a UVMS (uvms_pin.load_uvms), got {self.uvms!r}")
+        for key, kind in _MEMBERS.items():
+            members = getattr(self, key)
+            if not isinstance(members, Sequence) or isinstance(members, str):
+                raise ParameterError(f"{key} must be a list of {kind.__name__}, got {members!r}")
+            for k, member in enumerate(members):
+                if not isinstance(member, kind):
+                    raise ParameterError(f"{key}[{k}] must be a {kind.__name__}, got {member!r}")
+        if not isinstance(self.law, ContactLaw):
+            raise ParameterError(f"law must be a ContactLaw, got {self.law!r}")
+        self.self_collision = flag("self_collision", self.self_collision)
         for key, value, choices in (
             ("fixed_contact", self.fixed_contact, FIXED_CONTACT),
             ("moving_contact", self.moving_contact, MOVING_CONTACT),

@@ -24,6 +24,8 @@ from typing import Any
 import numpy as np
 import pinocchio as pin
 
+from uvms_pin.checks import flag
+from uvms_pin.errors import ParameterError
 from uvms_pin.physics.compiled.backend import Fallback
 from uvms_pin.physics.compiled.extension import core_module
 from uvms_pin.physics.compiled.moving import memories_of, search_compiled
@@ -75,8 +77,12 @@ class System:
     """
 
     def __init__(self, plant: Plant, *, compiled: bool = True):
+        if not isinstance(plant, Plant):
+            raise ParameterError(f"plant must be a Plant, got {plant!r}")
         self.plant = plant
-        self.compiled_allowed = compiled  # False: free objects integrated in Python
+        self.compiled_allowed = flag(
+            "compiled", compiled
+        )  # False: free objects integrated in Python
         world = plant.world
         self.moving = FreeObjects(plant.uvms, world) if has_moving_contacts(world) else None
         self.objects: tuple = () if self.moving is None else tuple(self.moving.objects)

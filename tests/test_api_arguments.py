@@ -1,0 +1,110 @@
+"""The flat API's entry points (``up.X``) given the wrong kind of argument (None, a number
+for a name, a string for a number, a stray keyword): each refuses it with uvms-pin's own
+error naming the argument. Before, each of these was a TypeError, a ValueError, an
+AttributeError or a Boost.Python ArgumentError from deeper down, or (a flag given as a
+string) was read by its truth."""
+
+from __future__ import annotations
+
+import pytest
+from conftest import REFERENCE_URDF, ROOT
+
+import uvms_pin as up
+from uvms_pin.errors import ParameterError, UvmsPinError
+
+VEHICLE = up.shipped_path("models/bluerov2_heavy.urdf")
+ARM = up.shipped_path("models/reach_alpha5.urdf")
+POSE = [0.1, 0.0, -0.1, 0.0, 0.0, 0.0]
+
+
+@pytest.fixture(scope="module")
+def uvms() -> up.UVMS:
+    return up.load_uvms(REFERENCE_URDF)
+
+
+CASES = {
+    "load_uvms: a density as a string": (
+        lambda u: up.load_uvms(REFERENCE_URDF, water_density_kg_m3="1025"),
+        "water_density_kg_m3 must be a number",
+    ),
+    "load_uvms: a frame's index for its name": (
+        lambda u: up.load_uvms(REFERENCE_URDF, ee_frame=3),
+        "ee_frame must be a frame's name",
+    ),
+    "load_uvms: a flag as a string": (
+        lambda u: up.load_uvms(REFERENCE_URDF, derive_missing="no"),
+        "derive_missing must be True or False",
+    ),
+    "import_model: no path": (lambda u: up.import_model(None), "path must be"),
+    "load_scenario: no path": (lambda u: up.load_scenario(None), "path must be"),
+    "mount_arm: an option it does not have": (
+        lambda u: up.mount_arm(VEHICLE, ARM, POSE, bogus=1),
+        "unknown option.*bogus.*arm_base_link",
+    ),
+    "mount_arm: a trim that is neither a flag nor a TrimSpec": (
+        lambda u: up.mount_arm(VEHICLE, ARM, POSE, trim="yes"),
+        "trim must be",
+    ),
+    "SimulationSettings: a duration as a string": (
+        lambda u: up.SimulationSettings("2", up.RK4()),
+        "duration_s must be a number",
+    ),
+    "SimulationSettings: no integrator": (
+        lambda u: up.SimulationSettings(1.0, None),
+        "integrator must be an Integrator",
+    ),
+    "Plant: no model": (lambda u: up.Plant(None), "uvms must be a UVMS"),
+    "Plant: a flag as a string": (
+        lambda u: up.Plant(u, free_surface="no"),
+        "free_surface must be True or False",
+    ),
+    "Plant: a world that is not one": (lambda u: up.Plant(u, world=1), "world must be a World"),
+    "Plant: a disturbance that is not a function": (
+        lambda u: up.Plant(u, disturbance=[0.0] * 6),
+        "disturbance must be a function",
+    ),
+    "System: no plant": (lambda u: up.System(None), "plant must be a Plant"),
+    "World: no list of objects": (
+        lambda u: up.World(u, None),
+        "objects must be a list of WorldObject",
+    ),
+    "World: an object that is not one": (
+        lambda u: up.World(u, [1]),
+        r"objects\[0\] must be a WorldObject",
+    ),
+    "SumFlow: a field that is not one": (
+        lambda u: up.SumFlow((up.UniformCurrent([0.1, 0, 0]), 1)),
+        "SumFlow adds FlowFields",
+    ),
+    "DepthProfileCurrent: depths as a string": (
+        lambda u: up.DepthProfileCurrent([0.1, 0, 0], "deep", [1.0, 0.5]),
+        "depths_m and factors",
+    ),
+    "IrregularSea: a height as a string": (
+        lambda u: up.IrregularSea("1", 8.0),
+        "significant_height_m must be a number",
+    ),
+    "IrregularSea: a frequency range of one number": (
+        lambda u: up.IrregularSea(1.0, 8.0, frequency_range=(0.5,)),
+        "frequency_range",
+    ),
+}
+
+
+@pytest.mark.parametrize("case", list(CASES))
+def test_an_entry_point_refuses_the_wrong_kind_of_argument_by_name(case, uvms):
+    call, message = CASES[case]
+    with pytest.raises(ParameterError, match=message):
+        call(uvms)
+
+
+def test_one_package_folder_may_be_given_alone(uvms):
+    """``package_dirs="models"`` was read as the folders "m", "o", "d", ...: one folder is
+    now taken as the list of it."""
+    alone = up.load_uvms(REFERENCE_URDF, package_dirs=str(ROOT / "models"))
+    listed = up.load_uvms(REFERENCE_URDF, package_dirs=[ROOT / "models"])
+    assert alone.nv == listed.nv == uvms.nv
+
+
+def test_the_refusals_are_uvms_pins_errors():
+    assert issubclass(ParameterError, UvmsPinError)
