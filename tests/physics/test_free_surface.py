@@ -3,6 +3,7 @@ deep bodies exactly as without a surface, bodies above the water under gravity a
 
 from __future__ import annotations
 
+import itertools
 import re
 import warnings
 
@@ -215,6 +216,46 @@ def test_every_shape_is_cut_alike_in_the_core():
             np.testing.assert_allclose(moment, part.moment_m4, atol=1e-12 * scale)
             assert area == pytest.approx(part.waterplane_area_m2, abs=1e-12 * scale)
             np.testing.assert_allclose(wet_moment, part.waterplane_moment_m3, atol=1e-12 * scale)
+
+
+def test_every_shape_upright_or_lying_is_cut_alike_in_the_core():
+    """The orientations random planes never draw, and the commonest in a run (a level vehicle
+    in still water): each shape's axes along or across the plane's normal exactly (the
+    cylinder's own branches: whole discs, or slices at one height), at heights from wholly
+    dry through cut to wholly wet; (V, M, A, M_A) as `test_every_shape_is_cut_alike_in_the_core`.
+    A whole wet or dry piece has no waterplane."""
+    from uvms_pin.hydro.hull import HullPiece
+    from uvms_pin.hydro.submerged import Ellipsoid, Polyhedron, Sphere
+    from uvms_pin.hydro.submerged_cylinder import Cylinder
+    from uvms_pin.physics.compiled.extension import core_module
+    from uvms_pin.physics.compiled.hull import piece_to_core
+
+    core = core_module()
+    shapes = [
+        Sphere(0.3),
+        Ellipsoid((0.4, 0.2, 0.1)),
+        Cylinder(0.15, 0.8),
+        Polyhedron.box((0.5, 0.3, 0.2)),
+    ]
+    turns = [np.eye(3), pin.rpy.rpyToMatrix(np.pi / 2, 0.0, 0.0)]  # upright, lying
+    normals = [np.array(n, dtype=float) for n in ([0, 0, 1], [0, 0, -1], [1, 0, 0], [0, -1, 0])]
+    depths = np.linspace(-1.1, 1.1, 23) + 0.013  # no height on a face
+    wholes = 0
+    for shape, turn in itertools.product(shapes, turns):
+        piece = HullPiece(shape, turn, np.array([0.05, -0.02, 0.0]))
+        compiled = piece_to_core(piece, core)
+        scale = shape.volume_m3
+        for normal, depth in itertools.product(normals, depths):
+            part = piece.below(normal, depth)
+            volume, moment, area, wet_moment = compiled.below(normal, depth)
+            assert volume == pytest.approx(part.volume_m3, abs=1e-12 * scale)
+            np.testing.assert_allclose(moment, part.moment_m4, atol=1e-12 * scale)
+            assert area == pytest.approx(part.waterplane_area_m2, abs=1e-12 * scale)
+            np.testing.assert_allclose(wet_moment, part.waterplane_moment_m3, atol=1e-12 * scale)
+            if part.volume_m3 in (0.0, pytest.approx(scale, rel=1e-12)):
+                wholes += 1
+                assert area == 0.0
+    assert wholes > 100  # the wholly wet and dry heights were reached
 
 
 def _arm_link4_variant(tmp_path, damping: bool) -> up.UVMS:
