@@ -238,6 +238,9 @@ def test_bad_actions_are_clear_errors():
         env.step(np.zeros(3))
     with pytest.raises(ParameterError, match="10 finite numbers"):
         env.step(np.full(10, np.nan))
+    for given in ("0.5", ["a"] * 10, [[0.0], [0.0, 1.0]]):  # was numpy's ValueError
+        with pytest.raises(ParameterError, match="10 finite numbers"):
+            env.step(given)
 
 
 def test_sea_state_is_drawn_from_the_episode_seed():

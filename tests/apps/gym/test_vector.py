@@ -189,6 +189,8 @@ def test_bad_steps_are_clear_errors():
         envs.step(np.zeros((3, 10)))
     with pytest.raises(ParameterError, match="actions"):
         envs.step(np.full((2, 10), np.nan))
+    with pytest.raises(ParameterError, match="actions"):  # was numpy's ValueError
+        envs.step([["a"] * 10] * 2)
 
 
 def test_unsupported_plants_are_refused():

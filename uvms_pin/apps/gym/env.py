@@ -236,7 +236,10 @@ class UvmsEnv(gym.Env):
         return self._observation(), {"seed": episode_seed, "time_s": 0.0}
 
     def step(self, action):
-        a = np.asarray(action, dtype=float)
+        try:
+            a = np.asarray(action, dtype=float)
+        except (TypeError, ValueError):  # strings, ragged lists: refused below by name
+            a = np.full(0, np.nan)
         if a.shape != self.action_space.shape or not np.all(np.isfinite(a)):
             raise ParameterError(
                 f"action must be {self.action_space.shape[0]} finite numbers, got {action!r}"

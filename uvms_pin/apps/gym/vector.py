@@ -141,7 +141,10 @@ class UvmsVectorEnv(VectorEnv):
         # the serial part of a step (this thread, between the threads' plant steps): numpy
         # over the batch, few calls (it bounds the speed-up of more threads)
         env = self.single_env
-        a = np.asarray(actions, dtype=float)
+        try:
+            a = np.asarray(actions, dtype=float)
+        except (TypeError, ValueError):  # strings, ragged lists: refused below by name
+            a = np.full(0, np.nan)
         if a.shape != self._action_shape or not np.isfinite(a).all():
             raise ParameterError(
                 f"actions must be {self._action_shape} finite numbers, got shape {a.shape}"
