@@ -64,3 +64,21 @@ def test_a_batch_of_a_scenario_object_and_its_errors():
         up.simulate_batch(REALISTIC, {"scenario.duration_s": 1.0})
     with pytest.raises(ScenarioError, match="nope"):
         up.simulate_batch(REALISTIC, [{"scenario.nope": 1}])
+
+
+def test_a_batch_too_large_for_memory_is_refused_before_any_run_is_built(monkeypatch):
+    """Every run keeps its own scenario and log until the batch returns: 100 runs of the
+    realistic scenario (a 1.7 MB log and about 1 MiB of its own each) in 64 MiB are refused
+    from the count, before the first is built (a batch of [{}] * 100000 used to deep-copy
+    its scenarios until the machine ran out of memory)."""
+    import uvms_pin.checks as checks
+    import uvms_pin.scenario.batch as batch
+
+    monkeypatch.setattr(checks, "available_memory_bytes", lambda: 64 * 2**20)
+    monkeypatch.setattr(batch, "scenario_for", lambda *a: pytest.fail("a run was built"))
+    with pytest.raises(ParameterError, match=r"a batch of 100 runs .*split overrides_list"):
+        up.simulate_batch(REALISTIC, [{}] * 100)
+    base = load_scenario(REALISTIC)
+    batch._check_batch_fits(base, 10)  # 27 MB: within half of the 64 MiB
+    with pytest.raises(ParameterError, match="a batch of 13 runs"):
+        batch._check_batch_fits(base, 13)  # 35 MB: beyond it

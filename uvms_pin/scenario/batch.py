@@ -13,7 +13,7 @@ from collections.abc import Mapping, Sequence
 from pathlib import Path
 from typing import Any
 
-from uvms_pin.checks import thread_count
+from uvms_pin.checks import check_memory, thread_count
 from uvms_pin.errors import ParameterError, SimulationError
 from uvms_pin.results.rollout import Rollout
 from uvms_pin.scenario.load import load_scenario, scenario_from_dict
@@ -28,6 +28,26 @@ def scenario_for(base: Scenario | str | Path, overrides: Mapping[str, Any]) -> S
     if not overrides:
         return copy.deepcopy(base)  # its own plant and sensors: runs never share state
     return scenario_from_dict(base.raw, base.path, dict(overrides))
+
+
+#: what a run of a batch holds besides its log [bytes]: its own scenario (plant, model data,
+#: controller, sensors), 0.5 MiB measured on the shipped ones (a deep copy), counted twice
+RUN_OVERHEAD_BYTES = 2**20
+
+
+def _check_batch_fits(base: Scenario, runs: int) -> None:
+    """ParameterError before any run is built if ``runs`` of ``base`` (their scenarios and
+    their logs, all kept until the batch returns) would take more than half of the memory
+    available. Runs whose overrides lengthen them are not in this estimate: each is checked
+    on its own when it is built."""
+    uvms, settings = base.uvms, base.settings
+    each = settings.log_bytes(uvms.nq, uvms.nv) + RUN_OVERHEAD_BYTES
+    check_memory(
+        runs * each,
+        f"a batch of {runs} runs (each its own scenario and a log of {settings.n_log} samples)",
+        "run fewer at once (split overrides_list), or shorten scenario.duration_s or lengthen "
+        "output.log_period_s",
+    )
 
 
 def simulate_batch(
@@ -57,6 +77,8 @@ def simulate_batch(
         raise ParameterError(
             f"overrides_list must be a list of dicts, got {type(overrides_list).__name__}"
         )
+    base = scenario if isinstance(scenario, Scenario) else load_scenario(scenario)
+    _check_batch_fits(base, len(overrides_list))
     for k, overrides in enumerate(overrides_list):
         if not isinstance(overrides, Mapping):
             raise ParameterError(
