@@ -10,6 +10,7 @@ import numpy as np
 import pytest
 
 import uvms_pin as up
+from uvms_pin.errors import OutputError
 from uvms_pin.results import rollout as rollout_module
 from uvms_pin.results.atomic import write_json_atomic
 from uvms_pin.results.rollout import ARRAY_FILE, META_FILE, Rollout
@@ -255,6 +256,22 @@ def test_load_without_rollout_raises_parameter_error(tmp_path):
     (tmp_path / "half" / META_FILE).unlink()
     with pytest.raises(up.ParameterError, match="holds no rollout"):
         Rollout.load(tmp_path / "half")
+
+
+def test_a_path_that_is_none_or_a_file_is_refused_by_name(tmp_path):
+    """save, load and to_mcap given None (a TypeError of pathlib's before), save given a
+    file (FileExistsError) or a folder it cannot write in: uvms-pin's errors naming it, and
+    nothing written."""
+    r = _filled()
+    for call in (r.save, Rollout.load, r.to_mcap):
+        with pytest.raises(up.ParameterError, match="must be a path, got None"):
+            call(None)
+    (tmp_path / "afile").write_text("x")
+    with pytest.raises(OutputError, match="afile: is a file; give a directory"):
+        r.save(tmp_path / "afile")
+    with pytest.raises(OutputError, match="is under a file"):
+        r.save(tmp_path / "afile" / "run")
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["afile"]
 
 
 @pytest.mark.parametrize("text", ["[1, 2]", "3", '"a rollout"', "{", "null"])
