@@ -6,6 +6,7 @@ string) was read by its truth."""
 
 from __future__ import annotations
 
+import numpy as np
 import pytest
 from conftest import REFERENCE_URDF, ROOT
 
@@ -96,6 +97,30 @@ def test_an_entry_point_refuses_the_wrong_kind_of_argument_by_name(case, uvms):
     call, message = CASES[case]
     with pytest.raises(ParameterError, match=message):
         call(uvms)
+
+
+@pytest.mark.parametrize("backend", ["core", "python"])
+def test_a_plants_acceleration_names_a_wrong_input(uvms, backend):
+    """`Plant.acceleration` (the right-hand side a Python loop integrates) and `ee_state`
+    given a state of the wrong kind or size: ParameterError naming it, checked only after
+    the core or Pinocchio refused the call (nanobind's TypeError, Boost.Python's
+    ArgumentError or Pinocchio's ValueError before)."""
+    import pinocchio as pin
+
+    plant = up.Plant(uvms, backend=backend)
+    q, v, tau = pin.neutral(uvms.model), np.zeros(uvms.nv), np.zeros(uvms.nv)
+    q[2] = -3.0
+    assert np.all(np.isfinite(plant.acceleration(0.0, q, v, tau)))
+    for args, name in (
+        (("0", q, v, tau), "time_s must be a number"),
+        ((0.0, None, v, tau), "q must"),
+        ((0.0, q, v[:3], tau), "v must have shape"),
+        ((0.0, q, v, "zero"), "tau must be"),
+    ):
+        with pytest.raises(ParameterError, match=name):
+            plant.acceleration(*args)
+    with pytest.raises(ParameterError, match="q must be"):
+        plant.ee_state("level", v)
 
 
 def test_one_package_folder_may_be_given_alone(uvms):

@@ -186,6 +186,9 @@ def test_the_rollout_records_the_world_as_simulated():
         (lambda q, v: (q[:-1], v), "q0 must have"),
         (lambda q, v: (q, np.append(v, 0.0)), "v0 "),
         (lambda q, v: (q, np.where(np.arange(v.size) == 2, np.nan, v)), "non-finite"),
+        # a quaternion of zeros was normalised into NaN; a string was numpy's ValueError
+        (lambda q, v: (np.concatenate([q[:3], np.zeros(4), q[7:]]), v), "not a rotation"),
+        (lambda q, v: ("level", v), "q0 must be"),
     ],
 )
 def test_a_bad_starting_state_is_refused_by_the_loop_and_the_batch(change, message):

@@ -22,7 +22,7 @@ from typing import Any
 import numpy as np
 import pinocchio as pin
 
-from uvms_pin.checks import finite_vector, flag
+from uvms_pin.checks import finite_vector, flag, number
 from uvms_pin.errors import ParameterError, SimulationError
 from uvms_pin.flow import FlowField, SumFlow, UniformCurrent
 from uvms_pin.model.uvms import UVMS
@@ -211,7 +211,11 @@ class Plant:
     def ee_state(self, q: np.ndarray, v: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """End-effector position, linear velocity (world) and its LOCAL_WORLD_ALIGNED Jacobian."""
         model, data, fid = self.uvms.model, self._ee_data, self.uvms.ee_frame_id
-        pin.forwardKinematics(model, data, q, v)
+        try:
+            pin.forwardKinematics(model, data, q, v)
+        except (TypeError, ValueError):  # Pinocchio's: the wrong input named first
+            _check_state(self.uvms, 0.0, q, v, np.zeros(model.nv))
+            raise
         position = pin.updateFramePlacement(model, data, fid).translation.copy()
         velocity = pin.getFrameVelocity(model, data, fid, pin.LOCAL_WORLD_ALIGNED).linear.copy()
         return position, velocity, data
@@ -290,44 +294,49 @@ class Plant:
         contact at the anchors of ``friction``, compiled with the rest on the core;
         ``extra_torque`` as in `external_torque` (given: the Python reference computes, as
         for the moving contacts of a system of bodies)."""
-        compiled = self.compiled
-        if compiled is not None and extra_torque is None:
-            if self.world is None:
-                return compiled.acceleration(time_s, q, v, tau, contact_world)
-            if contact_world is None:
-                return compiled.acceleration_in_world(time_s, q, v, tau, self.friction)
-        model = self.uvms.model
-        tau_ext = np.zeros(model.nv)
-        if self.joint_friction is not None:
-            tau_ext[6:] += self.joint_friction.torque_Nm(v[6:])
-        if self.contact is not None:
-            if contact_world is None:
-                contact_world = self.contact_wrench(q, v)
-            jac = pin.computeFrameJacobian(
-                model, self._ee_data, q, self.uvms.ee_frame_id, pin.LOCAL_WORLD_ALIGNED
+        try:
+            compiled = self.compiled
+            if compiled is not None and extra_torque is None:
+                if self.world is None:
+                    return compiled.acceleration(time_s, q, v, tau, contact_world)
+                if contact_world is None:
+                    return compiled.acceleration_in_world(time_s, q, v, tau, self.friction)
+            number("time_s", time_s)  # (the core's own check: its argument's type)
+            model = self.uvms.model
+            tau_ext = np.zeros(model.nv)
+            if self.joint_friction is not None:
+                tau_ext[6:] += self.joint_friction.torque_Nm(v[6:])
+            if self.contact is not None:
+                if contact_world is None:
+                    contact_world = self.contact_wrench(q, v)
+                jac = pin.computeFrameJacobian(
+                    model, self._ee_data, q, self.uvms.ee_frame_id, pin.LOCAL_WORLD_ALIGNED
+                )
+                tau_ext -= jac.T @ contact_world
+            if self.disturbance is not None:
+                # the free-flyer's LOCAL Jacobian is [I 0]: a body wrench maps to tau[:6] directly
+                tau_ext[:6] -= self.disturbance_wrench(time_s)
+            if self.world is not None or self.joint_stops is not None or extra_torque is not None:
+                tau_ext += self.external_torque(q, v, extra_torque)
+            if self.uvms.fins:  # lift and drag (the compiled plant's: src/uvms_core/fins.hpp)
+                wrenches = fin_wrenches_world(
+                    self.uvms, self._fin_data, q, v, self.water, time_s, bool(self.free_surface)
+                )
+                tau_ext += fin_generalized_force(self.uvms, self._fin_data, q, wrenches)
+            return forward_dynamics(
+                self.uvms,
+                q,
+                v,
+                tau,
+                tau_ext=tau_ext,
+                flow=self.water,
+                time_s=time_s,
+                backend=self.backend,
+                free_surface=self.free_surface,
             )
-            tau_ext -= jac.T @ contact_world
-        if self.disturbance is not None:
-            # the free-flyer's LOCAL Jacobian is [I 0]: a body wrench maps to tau[:6] directly
-            tau_ext[:6] -= self.disturbance_wrench(time_s)
-        if self.world is not None or self.joint_stops is not None or extra_torque is not None:
-            tau_ext += self.external_torque(q, v, extra_torque)
-        if self.uvms.fins:  # lift and drag (the compiled plant's: src/uvms_core/fins.hpp)
-            wrenches = fin_wrenches_world(
-                self.uvms, self._fin_data, q, v, self.water, time_s, bool(self.free_surface)
-            )
-            tau_ext += fin_generalized_force(self.uvms, self._fin_data, q, wrenches)
-        return forward_dynamics(
-            self.uvms,
-            q,
-            v,
-            tau,
-            tau_ext=tau_ext,
-            flow=self.water,
-            time_s=time_s,
-            backend=self.backend,
-            free_surface=self.free_surface,
-        )
+        except (TypeError, ValueError):  # the core's, Pinocchio's: a wrong input named first
+            _check_state(self.uvms, time_s, q, v, tau)
+            raise
 
     def acceleration_derivatives(
         self, time_s: float, q: np.ndarray, v: np.ndarray, tau: np.ndarray
@@ -338,6 +347,16 @@ class Plant:
         return acceleration_derivatives(
             self, time_s, q, v, tau, compiled=self.compiled, scratch=self._world_data
         )
+
+
+def _check_state(uvms: UVMS, time_s: float, q, v, tau) -> None:
+    """ParameterError naming the first of ``time_s``, ``q``, ``v``, ``tau`` that is not what
+    `Plant.acceleration` takes (called after the core or Pinocchio refused a call: nothing is
+    checked on the way of every call)."""
+    number("time_s", time_s)
+    finite_vector("q", q, uvms.nq)
+    finite_vector("v", v, uvms.nv)
+    finite_vector("tau", tau, uvms.nv)
 
 
 def water_of(current_world_m_s: np.ndarray, flow: FlowField | None) -> FlowField | None:
@@ -360,13 +379,10 @@ def checked_start(
 ) -> tuple[np.ndarray, np.ndarray]:
     """Copies of a starting state (q0 (nq,), v0 (nv,)) with the vehicle's quaternion
     normalised; a ParameterError for a wrong size or a non-finite value."""
-    q0 = np.array(q0, dtype=float)
-    v0 = np.array(v0, dtype=float)
-    if q0.shape != (model.nq,) or v0.shape != (model.nv,):
-        raise ParameterError(
-            f"q0 must have {model.nq} and v0 {model.nv} entries, got {q0.shape}, {v0.shape}"
-        )
-    if not (np.all(np.isfinite(q0)) and np.all(np.isfinite(v0))):
-        raise ParameterError("initial state has a non-finite value")
-    q0[3:7] /= np.linalg.norm(q0[3:7])
+    q0 = finite_vector("q0", q0, model.nq).copy()
+    v0 = finite_vector("v0", v0, model.nv).copy()
+    norm = np.linalg.norm(q0[3:7])
+    if not norm > 1e-6:  # no orientation to normalise (a quaternion of zeros: NaN)
+        raise ParameterError(f"q0's quaternion q0[3:7] = {q0[3:7].tolist()} is not a rotation")
+    q0[3:7] /= norm
     return q0, v0
