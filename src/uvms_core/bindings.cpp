@@ -93,6 +93,15 @@ Eigen::Map<const Eigen::VectorXd> vector(const char* name, nb::handle x, const V
   const VectorArg name##_arg(name##_obj); \
   const auto name = vector(#name, name##_obj, name##_arg, (n))
 
+// Declares the configuration `q` of `dynamics` (a Map) from `q_obj`: n finite numbers on
+// the configuration manifold (else InputError; the caller names the joint off it). A
+// quaternion of norm 0 or 2 would give a rotation that is none, and M, h of it, silently
+#define UVMS_CONFIGURATION(dynamics)                                               \
+  UVMS_VECTOR(q, (dynamics).nq());                                                 \
+  if (!uvms::pinlib::is_normalized((dynamics).model(), q, uvms::pinlib::kNormTolerance)) { \
+    throw InputError("q is not on the configuration manifold");                    \
+  }
+
 template <typename Struct>
 void check_finite(const char* name, const Struct& values) {
   if (!values.allFinite()) throw InputError(std::string(name) + " contains a non-finite value");
@@ -209,7 +218,7 @@ void bind_dynamics(nb::module_& m) {
       .def(
           "mass_matrix",
           [](Dynamics& d, nb::handle q_obj) -> Eigen::MatrixXd {
-            UVMS_VECTOR(q, d.nq());
+            UVMS_CONFIGURATION(d);
             return d.mass_matrix(q);
           },
           "q"_a.none())
@@ -217,7 +226,7 @@ void bind_dynamics(nb::module_& m) {
           "mass_matrix_in",
           [](Dynamics& d, nb::handle q_obj, const uvms::FlowField* flow,
              double time_s, bool free_surface) -> Eigen::MatrixXd {
-            UVMS_VECTOR(q, d.nq());
+            UVMS_CONFIGURATION(d);
             return d.mass_matrix_in(q, flow_or_still(flow), time_s, free_surface);
           },
           "q"_a.none(), "flow"_a.none(), "time_s"_a, "free_surface"_a = false)
@@ -225,7 +234,7 @@ void bind_dynamics(nb::module_& m) {
           "bias_forces",
           [](Dynamics& d, nb::handle q_obj, nb::handle v_obj,
              nb::handle current_world_obj) -> Eigen::VectorXd {
-            UVMS_VECTOR(q, d.nq());
+            UVMS_CONFIGURATION(d);
             UVMS_VECTOR(v, d.nv());
             return d.bias_forces(q, v, current_only(current_world_obj));
           },
@@ -235,7 +244,7 @@ void bind_dynamics(nb::module_& m) {
           [](Dynamics& d, nb::handle q_obj, nb::handle v_obj,
              const uvms::FlowField* flow, double time_s,
              bool free_surface) -> Eigen::VectorXd {
-            UVMS_VECTOR(q, d.nq());
+            UVMS_CONFIGURATION(d);
             UVMS_VECTOR(v, d.nv());
             return d.bias_forces(q, v, flow_or_still(flow), time_s, free_surface);
           },
@@ -244,7 +253,7 @@ void bind_dynamics(nb::module_& m) {
           "forward_dynamics",
           [](Dynamics& d, nb::handle q_obj, nb::handle v_obj, nb::handle tau_obj,
              nb::handle current_world_obj, nb::handle tau_ext_obj) -> Eigen::VectorXd {
-            UVMS_VECTOR(q, d.nq());
+            UVMS_CONFIGURATION(d);
             UVMS_VECTOR(v, d.nv());
             UVMS_VECTOR(tau, d.nv());
             const uvms::FlowField flow = current_only(current_world_obj);
@@ -259,7 +268,7 @@ void bind_dynamics(nb::module_& m) {
           [](Dynamics& d, nb::handle q_obj, nb::handle v_obj, nb::handle tau_obj,
              const uvms::FlowField* flow, double time_s,
              nb::handle tau_ext_obj, bool free_surface) -> Eigen::VectorXd {
-            UVMS_VECTOR(q, d.nq());
+            UVMS_CONFIGURATION(d);
             UVMS_VECTOR(v, d.nv());
             UVMS_VECTOR(tau, d.nv());
             if (tau_ext_obj.is_none()) {
@@ -524,7 +533,7 @@ void bind_plant(nb::module_& m) {
           "acceleration",
           [](Plant& p, double t, nb::handle q_obj, nb::handle v_obj, nb::handle tau_obj,
              nb::handle contact_world_obj) -> Eigen::VectorXd {
-            UVMS_VECTOR(q, p.dynamics().nq());
+            UVMS_CONFIGURATION(p.dynamics());
             UVMS_VECTOR(v, p.dynamics().nv());
             UVMS_VECTOR(tau, p.dynamics().nv());
             if (contact_world_obj.is_none()) return p.acceleration(t, q, v, tau);
@@ -605,6 +614,7 @@ void bind_batch_derivatives(nb::module_& m);  // batch_bindings.cpp
 
 NB_MODULE(_core, m) {
   m.doc() = "Compiled dynamics, plant and controller of uvms-pin (C++ on Pinocchio's C++ API).";
+  m.attr("NORM_TOLERANCE") = uvms::pinlib::kNormTolerance;
   m.attr("API_VERSION") = uvms::kApiVersion;
   m.attr("PINOCCHIO_VERSION") = PINOCCHIO_VERSION;
   m.attr("SOURCE_HASH") = uvms::core_source_hash();

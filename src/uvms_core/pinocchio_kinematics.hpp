@@ -132,4 +132,8 @@ inline bool is_normalized(const Model& model, const Eigen::VectorXd& q, double t
   return pinocchio::isNormalized(model, q, tolerance);
 }
 
+// The largest |norm - 1| of a configuration's unit parts (a quaternion, a (cos, sin) pair)
+// the bindings take: uvms_pin.physics.configuration.NORM_TOLERANCE (a test holds them equal)
+constexpr double kNormTolerance = 1e-9;
+
 }  // namespace uvms::pinlib

@@ -6,6 +6,8 @@
 // call, so that the state lives in one place for both backends.
 #include "world_bindings.hpp"
 
+#include "pinocchio_kinematics.hpp"
+
 #include <nanobind/eigen/dense.h>
 #include <nanobind/stl/optional.h>
 #include <nanobind/stl/pair.h>
@@ -170,6 +172,9 @@ void bind_plant_world(nb::class_<Plant>& plant) {
             const int nq = p.dynamics().nq(), nv = p.dynamics().nv();
             const auto qc = checked("q", q, nq), vc = checked("v", v, nv);
             const auto u = checked("tau", tau, nv);
+            if (!uvms::pinlib::is_normalized(p.dynamics().model(), q, uvms::pinlib::kNormTolerance)) {
+              throw InputError("q is not on the configuration manifold");
+            }
             read_memory(friction, p.friction);
             return p.acceleration(t, qc, vc, u);
           },

@@ -10,6 +10,7 @@ import pytest
 from conftest import REFERENCE_URDF, RHO, body_urdf, hydro_xml, random_configuration
 
 import uvms_pin as up
+from uvms_pin.errors import ParameterError
 from uvms_pin.hydro.params import HydroParams
 from uvms_pin.model.uvms import UVMS, HydroBody
 from uvms_pin.sim.integrators import RK4
@@ -400,3 +401,50 @@ def test_a_frame_wrench_does_the_virtual_power_of_its_frame_twist(reference_uvms
         pin.updateFramePlacements(model, data)
         twist = pin.getFrameVelocity(model, data, frame, pin.LOCAL_WORLD_ALIGNED).vector
         assert v @ tau_ext == pytest.approx(wrench @ twist, rel=1e-12, abs=1e-12)
+
+
+@pytest.mark.parametrize("backend", ["core", "python"])
+@pytest.mark.parametrize(
+    "quaternion", [[0.0, 0.0, 0.0, 0.0], [0.0, 0.0, 0.0, 2.0], [0.1, 0.2, 0.3, 0.9]]
+)
+def test_a_quaternion_off_the_unit_sphere_is_refused_by_every_dynamics_call(
+    reference_uvms, backend, quaternion
+):
+    """M, h, forward dynamics, the energies and the plant's right-hand side, in still water
+    and under the free surface, refuse a q whose quaternion is not a rotation, naming the
+    joint, as the derivatives do (a quaternion of zeros gave finite M, h of a rotation that
+    is none, returned silently; of norm 2 a rotation scaled by 4). The core checks it in its
+    call at no cost on the way (NORM_TOLERANCE, the same number on both sides)."""
+    from uvms_pin.physics.compiled.extension import core_module
+    from uvms_pin.physics.configuration import NORM_TOLERANCE, OFF_MANIFOLD
+
+    assert core_module().NORM_TOLERANCE == NORM_TOLERANCE
+    off = pin.neutral(reference_uvms.model)
+    off[3:7] = quaternion
+    with pytest.raises(ParameterError) as refused:  # the core's own words, named in Python
+        up.physics.dynamics.dynamics_of(reference_uvms, "core").mass_matrix(off)
+    assert str(refused.value) == OFF_MANIFOLD
+    uvms = reference_uvms
+    q = pin.neutral(uvms.model)
+    q[2] = -3.0
+    q[3:7] = quaternion
+    v = tau = np.zeros(uvms.nv)
+    calls = {
+        "M": lambda: up.mass_matrix(uvms, q, backend=backend),
+        "M wet": lambda: up.mass_matrix(uvms, q, backend=backend, free_surface=True),
+        "h": lambda: up.bias_forces(uvms, q, v, backend=backend),
+        "a": lambda: up.forward_dynamics(uvms, q, v, tau, backend=backend),
+        "a wet": lambda: up.forward_dynamics(uvms, q, v, tau, backend=backend, free_surface=True),
+        "T": lambda: up.kinetic_energy(uvms, q, v, backend=backend),
+        "U": lambda: up.potential_energy(uvms, q),
+        "plant": lambda: up.Plant(uvms, backend=backend).acceleration(0.0, q, v, tau),
+    }
+    for name, call in calls.items():
+        with pytest.raises(ParameterError, match=r"'root_joint' has a quaternion of norm"):
+            call()
+            pytest.fail(f"{name} took q[3:7] = {quaternion}")
+    q[3:7] = (
+        np.asarray(quaternion) / np.linalg.norm(quaternion) if any(quaternion) else [0, 0, 0, 1]
+    )
+    for call in calls.values():
+        call()  # normalised: taken

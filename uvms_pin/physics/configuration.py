@@ -22,6 +22,10 @@ from uvms_pin.errors import ParameterError
 #: 1e-9 moves the derivatives by ~5e-9 relative, below what they are held to)
 NORM_TOLERANCE = 1e-9
 
+#: the compiled core's refusal of a q off the manifold (src/uvms_core/bindings.cpp), which
+#: the Python side raises again naming the joint
+OFF_MANIFOLD = "q is not on the configuration manifold"
+
 #: where a joint's unit part is in its q (offset, size); the others: all of it
 _UNIT_PART = {"JointModelFreeFlyer": (3, 4), "JointModelPlanar": (2, 2)}
 

@@ -33,7 +33,7 @@ from uvms_pin.hydro.restoring import buoyancy_potential_energy
 from uvms_pin.model.uvms import UVMS
 from uvms_pin.physics.compiled.backend import backend_named
 from uvms_pin.physics.compiled.dynamics import CompiledDynamics
-from uvms_pin.physics.configuration import checked_configuration
+from uvms_pin.physics.configuration import OFF_MANIFOLD, checked_configuration
 from uvms_pin.physics.derivatives.reference import (
     forward_dynamics_derivatives as reference_derivatives,
 )
@@ -79,6 +79,25 @@ def _flow_of_call(current_world: np.ndarray, flow: FlowField | None) -> FlowFiel
     return flow
 
 
+def _on_manifold(
+    dynamics: CompiledDynamics | ReferenceDynamics, uvms: UVMS, q: np.ndarray
+) -> np.ndarray:
+    """``q`` as the call takes it: on the configuration manifold (a quaternion of norm 0 or 2
+    is a rotation that is none, and M, h of it would be returned silently). The reference's
+    q is checked here; the core checks its own in its call (its refusal, caught by the
+    caller, is checked again here to name the joint), at no cost on the way."""
+    if isinstance(dynamics, CompiledDynamics):
+        return q
+    return checked_configuration("q", q, uvms.model)
+
+
+def _name_the_joint(uvms: UVMS, q: np.ndarray, refusal: ParameterError) -> None:
+    """The core's refusal of a q off the configuration manifold raised again naming the
+    joint (the reference's check); any other refusal is the caller's to raise as it is."""
+    if str(refusal) == OFF_MANIFOLD:
+        checked_configuration("q", q, uvms.model)
+
+
 def _finite_result(what: str, value: np.ndarray, uvms: UVMS, q, v=None) -> np.ndarray:
     """``value``, or an error when finite inputs gave a non-finite result (checked after,
     at no cost on the way of every call): ParameterError for a q off the configuration
@@ -114,9 +133,14 @@ def mass_matrix(
     in still water) at ``time_s``."""
     dynamics = dynamics_of(uvms, backend)
     free_surface = flag("free_surface", free_surface)
-    if not free_surface:
-        return _finite_result("M(q)", dynamics.mass_matrix(q), uvms, q)
-    mass = dynamics.mass_matrix_in(q, _checked_flow(flow), check_time(time_s), True)
+    q = _on_manifold(dynamics, uvms, q)
+    try:
+        if not free_surface:
+            return _finite_result("M(q)", dynamics.mass_matrix(q), uvms, q)
+        mass = dynamics.mass_matrix_in(q, _checked_flow(flow), check_time(time_s), True)
+    except ParameterError as refusal:
+        _name_the_joint(uvms, q, refusal)
+        raise
     return _finite_result("M(q)", mass, uvms, q)
 
 
@@ -147,10 +171,16 @@ def bias_forces(
     """
     dynamics = dynamics_of(uvms, backend)
     free_surface = flag("free_surface", free_surface)
-    if flow is None and not free_surface:
-        return _finite_result("h(q, zeta)", dynamics.bias_forces(q, v, current_world), uvms, q, v)
-    flow = _flow_of_call(current_world, flow)
-    h = dynamics.bias_forces_in(q, v, flow, check_time(time_s), free_surface)
+    q = _on_manifold(dynamics, uvms, q)
+    try:
+        if flow is None and not free_surface:
+            h = dynamics.bias_forces(q, v, current_world)
+        else:
+            flow = _flow_of_call(current_world, flow)
+            h = dynamics.bias_forces_in(q, v, flow, check_time(time_s), free_surface)
+    except ParameterError as refusal:
+        _name_the_joint(uvms, q, refusal)
+        raise
     return _finite_result("h(q, zeta)", h, uvms, q, v)
 
 
@@ -184,13 +214,18 @@ def forward_dynamics(
     """
     dynamics = dynamics_of(uvms, backend)
     free_surface = flag("free_surface", free_surface)
-    if flow is None and not free_surface:
-        zeta_dot = dynamics.forward_dynamics(q, v, tau, current_world, tau_ext)
-    else:
-        flow = _flow_of_call(current_world, flow)
-        zeta_dot = dynamics.forward_dynamics_in(
-            q, v, tau, flow, check_time(time_s), tau_ext, free_surface
-        )
+    q = _on_manifold(dynamics, uvms, q)
+    try:
+        if flow is None and not free_surface:
+            zeta_dot = dynamics.forward_dynamics(q, v, tau, current_world, tau_ext)
+        else:
+            flow = _flow_of_call(current_world, flow)
+            zeta_dot = dynamics.forward_dynamics_in(
+                q, v, tau, flow, check_time(time_s), tau_ext, free_surface
+            )
+    except ParameterError as refusal:
+        _name_the_joint(uvms, q, refusal)
+        raise
     return _finite_result("zeta_dot", zeta_dot, uvms, q, v)
 
 
@@ -330,7 +365,7 @@ def potential_energy(
     still water, U is the potential of the exact hydrostatic load: its negative gradient is
     rho g V_sub at r_sub; under waves the water does work and U is the same formula at
     ``time_s``)."""
-    q = finite_vector("q", q, uvms.nq)
+    q = checked_configuration("q", q, uvms.model)
     free_surface = flag("free_surface", free_surface)
     model, data = uvms.model, uvms.data
     pin.forwardKinematics(model, data, q)

@@ -27,6 +27,7 @@ from uvms_pin.errors import ParameterError, SimulationError
 from uvms_pin.flow import FlowField, SumFlow, UniformCurrent
 from uvms_pin.model.uvms import UVMS
 from uvms_pin.physics.compiled.backend import Backend, Fallback, backend_named
+from uvms_pin.physics.configuration import checked_configuration
 from uvms_pin.physics.constraints.joint_friction import JointCoulombFriction
 from uvms_pin.physics.constraints.joint_limits import JointLimits
 from uvms_pin.physics.contact import ContactModel
@@ -354,7 +355,7 @@ def _check_state(uvms: UVMS, time_s: float, q, v, tau) -> None:
     `Plant.acceleration` takes (called after the core or Pinocchio refused a call: nothing is
     checked on the way of every call)."""
     number("time_s", time_s)
-    finite_vector("q", q, uvms.nq)
+    checked_configuration("q", q, uvms.model)  # (a quaternion off the unit sphere named)
     finite_vector("v", v, uvms.nv)
     finite_vector("tau", tau, uvms.nv)
 
