@@ -615,6 +615,7 @@ void bind_batch_derivatives(nb::module_& m);  // batch_bindings.cpp
 NB_MODULE(_core, m) {
   m.doc() = "Compiled dynamics, plant and controller of uvms-pin (C++ on Pinocchio's C++ API).";
   m.attr("NORM_TOLERANCE") = uvms::pinlib::kNormTolerance;
+  m.attr("MAX_SUBSTEPS") = uvms::kMaxSubsteps;
   m.attr("API_VERSION") = uvms::kApiVersion;
   m.attr("PINOCCHIO_VERSION") = PINOCCHIO_VERSION;
   m.attr("SOURCE_HASH") = uvms::core_source_hash();

@@ -26,9 +26,19 @@ struct FixedStep {
   double step_s = 1e-3;
 };
 
+// The most substeps one interval is split into (uvms_pin/physics/derivatives/step.py's
+// MAX_SUBSTEPS): beyond an int's range the count's conversion is undefined (it gave one step
+// of the whole interval), and far below it the call is already a hang.
+constexpr double kMaxSubsteps = 1e7;
+
 // n equal substeps no longer than max_step_s between t0 and t1, and their length.
 inline std::pair<int, double> substeps(double t0, double t1, double max_step_s) {
-  const int n = std::max(1, static_cast<int>(std::ceil((t1 - t0) / max_step_s - 1e-9)));
+  const double count = (t1 - t0) / max_step_s - 1e-9;
+  if (!(count <= kMaxSubsteps)) {
+    throw InputError(
+        "more than 1e7 substeps in one call: shorten the interval or lengthen the step");
+  }
+  const int n = std::max(1, static_cast<int>(std::ceil(count)));
   return {n, (t1 - t0) / n};
 }
 

@@ -190,6 +190,37 @@ def test_bad_integrators_are_refused(reference_uvms):
         up.step_derivatives(reference_uvms, q, zero, zero, 0.01, step_s=0.01, integrator=RK4())
 
 
+@pytest.mark.parametrize("backend", ["python", "core"])
+def test_a_period_of_more_substeps_than_one_call_takes_is_refused(reference_uvms, backend):
+    """1e4 s in steps of 1 us (1e10 substeps, beyond an int): the core's count was an
+    undefined conversion that gave one step of the whole period, returned at once as if
+    right; the reference's a hang. Both refuse more than MAX_SUBSTEPS by name, as the
+    plant's own advance does; MAX_SUBSTEPS of them are taken (the check is not the loop)."""
+    from uvms_pin.physics.compiled.extension import core_module
+    from uvms_pin.physics.derivatives.step import MAX_SUBSTEPS, substeps
+
+    assert core_module().MAX_SUBSTEPS == MAX_SUBSTEPS
+    q = reference_uvms.neutral_configuration()
+    zero = np.zeros(reference_uvms.nv)
+    for period_s, step_s in ((1e4, 1e-6), (1e9, 1e-3), (1.0, 1e-300)):
+        with pytest.raises(ParameterError, match=r"substeps, more than 1e\+07 in one call"):
+            up.step_derivatives(
+                reference_uvms, q, zero, zero, period_s, step_s=step_s, backend=backend
+            )
+    assert substeps(MAX_SUBSTEPS * 1e-3, 1e-3)[0] == MAX_SUBSTEPS
+    plant = Plant(reference_uvms, backend=backend)
+    with pytest.raises(ParameterError, match="substeps"):
+        RK4(step_s=1e-6).advance(
+            reference_uvms.model, plant.acceleration, 0.0, q, zero, 1e4
+        )  # the Python loop's advance, the same split
+    if backend == "core":  # the core's own split (its plant's advance)
+        core = core_module()
+        fixed = core.FixedStep()
+        fixed.method, fixed.step_s = core.Method.rk4, 1e-6
+        with pytest.raises(ParameterError, match="more than 1e7 substeps in one call"):
+            plant.compiled.advance(0.0, q, zero, zero, 1e4, fixed)
+
+
 @pytest.mark.parametrize("integrator", [RK4(step_s=STEP_S), SemiImplicitEuler(step_s=STEP_S)])
 @pytest.mark.parametrize("backend", ["python", "core"])
 def test_a_period_not_a_multiple_of_the_step_ends_where_the_plant_does(

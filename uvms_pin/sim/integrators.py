@@ -22,6 +22,7 @@ import pinocchio as pin
 
 from uvms_pin.checks import number_fields, positive
 from uvms_pin.errors import ParameterError, SimulationError
+from uvms_pin.physics.derivatives.step import check_substeps
 
 Rhs = Callable[[float, np.ndarray, np.ndarray], np.ndarray]
 Event = Callable[[float, np.ndarray, np.ndarray], float]
@@ -86,8 +87,12 @@ def python_chart(model: pin.Model) -> Chart:
     return chart
 
 
-def _substeps(t0: float, t1: float, max_step_s: float) -> tuple[int, float]:
-    n = max(1, math.ceil((t1 - t0) / max_step_s - 1e-9))
+def interval_substeps(t0: float, t1: float, max_step_s: float) -> tuple[int, float]:
+    """(n, h): the fewest equal substeps no longer than ``max_step_s`` [s] from t0 to t1
+    (one at least; more than `MAX_SUBSTEPS`: ParameterError), as the core splits it."""
+    count = (t1 - t0) / max_step_s - 1e-9
+    check_substeps(count, t1 - t0, max_step_s)
+    n = max(1, math.ceil(count))
     return n, (t1 - t0) / n
 
 
@@ -108,7 +113,7 @@ class FixedStep(Integrator):
             )
 
     def advance(self, model, rhs, t0, q0, v0, t1):
-        n, h = _substeps(t0, t1, self.step_s)
+        n, h = interval_substeps(t0, t1, self.step_s)
         q, v = q0, v0
         for k in range(n):
             q, v = self.step(model, rhs, t0 + k * h, q, v, h)

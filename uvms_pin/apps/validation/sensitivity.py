@@ -24,7 +24,6 @@ mounting yaw: then the caller gives S(t0)).
 from __future__ import annotations
 
 import itertools
-import math
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 
@@ -44,7 +43,7 @@ from uvms_pin.apps.validation.prescribed import JointTrajectory, free_flyer_mode
 from uvms_pin.errors import ParameterError
 from uvms_pin.model.uvms import UVMS
 from uvms_pin.physics.dynamics import bias_forces, forward_dynamics_derivatives, mass_matrix
-from uvms_pin.sim.integrators import python_chart
+from uvms_pin.sim.integrators import interval_substeps, python_chart
 
 __all__ = ["SensitiveModel", "Trajectory", "roll_pitch_tangent", "simulate_with_sensitivity"]
 
@@ -141,12 +140,6 @@ class SensitiveModel:
         return a_v, jac_state, jac_params
 
 
-def _substeps(t0: float, t1: float, max_step_s: float) -> tuple[int, float]:
-    # the same split as `uvms_pin.sim.integrators.FixedStep`
-    n = max(1, math.ceil((t1 - t0) / max_step_s - 1e-9))
-    return n, (t1 - t0) / n
-
-
 def _rk4_step(model, chart, rhs, t, q0, v0, s0, h):
     """One RKMK4 step of the state (as `uvms_pin.sim.integrators.RK4`) and RK4 of S."""
     a1, ds1 = rhs(t, q0, v0, s0)
@@ -203,7 +196,7 @@ def simulate_with_sensitivity(
     q, v = np.asarray(q_vehicle0, float), np.asarray(nu_vehicle0, float)
     qs, vs, ss = [q], [v], [s]
     for t0, t1 in itertools.pairwise(times_s):
-        n, h = _substeps(float(t0), float(t1), step_s)
+        n, h = interval_substeps(float(t0), float(t1), step_s)
         for i in range(n):
             q, v, s = _rk4_step(flyer, chart, rhs, t0 + i * h, q, v, s, h)
         qs.append(q)

@@ -90,6 +90,22 @@ Derivative = Callable[[float, np.ndarray, np.ndarray, np.ndarray], tuple[np.ndar
 """(t, q, v, tau) -> (a, da/dq, da/dv, da/dtau): the forward dynamics and their derivatives."""
 
 
+#: the most substeps one interval is split into (src/uvms_core/integrators.hpp's
+#: kMaxSubsteps): beyond, the core's count is no int (it took one step of the whole
+#: interval), and the call a hang
+MAX_SUBSTEPS = 10_000_000
+
+
+def check_substeps(count: float, interval_s: float, step_s: float) -> None:
+    """ParameterError if ``count`` substeps of ``step_s`` [s] over ``interval_s`` [s] are
+    more than `MAX_SUBSTEPS`."""
+    if not count <= MAX_SUBSTEPS:
+        raise ParameterError(
+            f"{interval_s:g} s in steps of {step_s:g} s is {count:.3g} substeps, more than "
+            f"{MAX_SUBSTEPS:.0e} in one call: shorten the interval or lengthen the step"
+        )
+
+
 def substeps(period_s: float, step_s: float) -> tuple[int, float]:
     """(n, h): the fewest equal substeps no longer than ``step_s`` covering the period."""
     for name, value in (("period_s", period_s), ("step_s", step_s)):
@@ -99,7 +115,9 @@ def substeps(period_s: float, step_s: float) -> tuple[int, float]:
         raise ParameterError(f"period_s must be positive and finite, got {period_s}")
     if not (step_s > 0.0 and math.isfinite(step_s)):
         raise ParameterError(f"step_s must be positive and finite, got {step_s}")
-    n = max(1, math.ceil(period_s / step_s - 1e-9))
+    count = period_s / step_s - 1e-9
+    check_substeps(count, period_s, step_s)
+    n = max(1, math.ceil(count))
     return n, period_s / n
 
 
