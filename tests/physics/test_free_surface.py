@@ -185,74 +185,63 @@ def test_above_the_water_a_body_feels_gravity_only(models):
         )
 
 
-def test_every_shape_is_cut_alike_in_the_core():
-    """Each piece's (V, M, A, M_A) under random planes: the core's hull.hpp against
-    uvms_pin.hydro, 1e-12 of the piece's scale, for every kind of shape."""
+def _hull_pieces(rotations_and_offsets) -> list:
+    """One hull piece of each kind of shape at each (rotation, offset), and the core's."""
     from uvms_pin.hydro.hull import HullPiece
     from uvms_pin.hydro.submerged import Ellipsoid, Polyhedron, Sphere
     from uvms_pin.hydro.submerged_cylinder import Cylinder
     from uvms_pin.physics.compiled.extension import core_module
     from uvms_pin.physics.compiled.hull import piece_to_core
 
-    core = core_module()
-    rng = np.random.default_rng(11)
-    shapes = [
-        Sphere(0.3),
-        Ellipsoid((0.4, 0.2, 0.1)),
-        Cylinder(0.15, 0.8),
-        Polyhedron.box((0.5, 0.3, 0.2)),
-    ]
+    shapes = [Sphere(0.3), Ellipsoid((0.4, 0.2, 0.1)), Cylinder(0.15, 0.8),
+              Polyhedron.box((0.5, 0.3, 0.2))]  # fmt: skip
+    pieces = []
     for shape in shapes:
-        piece = HullPiece(shape, pin.exp3(rng.normal(size=3)), rng.normal(scale=0.2, size=3))
-        compiled = piece_to_core(piece, core)
-        scale = shape.volume_m3
+        for rotation, offset in rotations_and_offsets():
+            piece = HullPiece(shape, rotation, offset)
+            pieces.append((piece, piece_to_core(piece, core_module())))
+    return pieces
+
+
+def _cut_alike(piece, compiled, normal: np.ndarray, depth: float):
+    """The core's (V, M, A, M_A) of ``piece`` below n . x = d held to the reference's, to
+    1e-12 of the piece's volume; the reference's part, and the core's waterplane area."""
+    scale = piece.shape.volume_m3
+    part = piece.below(normal, depth)
+    volume, moment, area, wet_moment = compiled.below(normal, depth)
+    assert volume == pytest.approx(part.volume_m3, abs=1e-12 * scale)
+    np.testing.assert_allclose(moment, part.moment_m4, atol=1e-12 * scale)
+    assert area == pytest.approx(part.waterplane_area_m2, abs=1e-12 * scale)
+    np.testing.assert_allclose(wet_moment, part.waterplane_moment_m3, atol=1e-12 * scale)
+    return part, area
+
+
+def test_every_shape_is_cut_alike_in_the_core():
+    """Each piece's (V, M, A, M_A) under random planes: the core's hull.hpp against
+    uvms_pin.hydro, 1e-12 of the piece's scale, for every kind of shape."""
+    rng = np.random.default_rng(11)
+    placed = lambda: [(pin.exp3(rng.normal(size=3)), rng.normal(scale=0.2, size=3))]  # noqa: E731
+    for piece, compiled in _hull_pieces(placed):
         for _ in range(60):
             normal = rng.normal(size=3)
-            normal /= np.linalg.norm(normal)
-            depth = rng.uniform(-0.8, 0.8)
-            part = piece.below(normal, depth)
-            volume, moment, area, wet_moment = compiled.below(normal, depth)
-            assert volume == pytest.approx(part.volume_m3, abs=1e-12 * scale)
-            np.testing.assert_allclose(moment, part.moment_m4, atol=1e-12 * scale)
-            assert area == pytest.approx(part.waterplane_area_m2, abs=1e-12 * scale)
-            np.testing.assert_allclose(wet_moment, part.waterplane_moment_m3, atol=1e-12 * scale)
+            _cut_alike(piece, compiled, normal / np.linalg.norm(normal), rng.uniform(-0.8, 0.8))
 
 
 def test_every_shape_upright_or_lying_is_cut_alike_in_the_core():
     """The orientations random planes never draw, and the commonest in a run (a level vehicle
     in still water): each shape's axes along or across the plane's normal exactly (the
     cylinder's own branches: whole discs, or slices at one height), at heights from wholly
-    dry through cut to wholly wet; (V, M, A, M_A) as `test_every_shape_is_cut_alike_in_the_core`.
-    A whole wet or dry piece has no waterplane."""
-    from uvms_pin.hydro.hull import HullPiece
-    from uvms_pin.hydro.submerged import Ellipsoid, Polyhedron, Sphere
-    from uvms_pin.hydro.submerged_cylinder import Cylinder
-    from uvms_pin.physics.compiled.extension import core_module
-    from uvms_pin.physics.compiled.hull import piece_to_core
-
-    core = core_module()
-    shapes = [
-        Sphere(0.3),
-        Ellipsoid((0.4, 0.2, 0.1)),
-        Cylinder(0.15, 0.8),
-        Polyhedron.box((0.5, 0.3, 0.2)),
-    ]
-    turns = [np.eye(3), pin.rpy.rpyToMatrix(np.pi / 2, 0.0, 0.0)]  # upright, lying
+    dry through cut to wholly wet, as `test_every_shape_is_cut_alike_in_the_core`. A whole
+    wet or dry piece has no waterplane."""
+    offset = np.array([0.05, -0.02, 0.0])
+    turns = lambda: [(np.eye(3), offset), (pin.rpy.rpyToMatrix(np.pi / 2, 0, 0), offset)]  # noqa: E731
     normals = [np.array(n, dtype=float) for n in ([0, 0, 1], [0, 0, -1], [1, 0, 0], [0, -1, 0])]
     depths = np.linspace(-1.1, 1.1, 23) + 0.013  # no height on a face
     wholes = 0
-    for shape, turn in itertools.product(shapes, turns):
-        piece = HullPiece(shape, turn, np.array([0.05, -0.02, 0.0]))
-        compiled = piece_to_core(piece, core)
-        scale = shape.volume_m3
+    for piece, compiled in _hull_pieces(turns):  # upright, lying
         for normal, depth in itertools.product(normals, depths):
-            part = piece.below(normal, depth)
-            volume, moment, area, wet_moment = compiled.below(normal, depth)
-            assert volume == pytest.approx(part.volume_m3, abs=1e-12 * scale)
-            np.testing.assert_allclose(moment, part.moment_m4, atol=1e-12 * scale)
-            assert area == pytest.approx(part.waterplane_area_m2, abs=1e-12 * scale)
-            np.testing.assert_allclose(wet_moment, part.waterplane_moment_m3, atol=1e-12 * scale)
-            if part.volume_m3 in (0.0, pytest.approx(scale, rel=1e-12)):
+            part, area = _cut_alike(piece, compiled, normal, depth)
+            if part.volume_m3 in (0.0, pytest.approx(piece.shape.volume_m3, rel=1e-12)):
                 wholes += 1
                 assert area == 0.0
     assert wholes > 100  # the wholly wet and dry heights were reached
