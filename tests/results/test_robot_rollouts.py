@@ -60,6 +60,9 @@ def test_metrics_have_a_block_per_robot_saved_and_read_back(rollouts, tmp_path):
     assert np.array_equal(back.robot("bravo").q, rollouts.robot("bravo").q)
     with pytest.raises(ParameterError, match="holds no run of several robots"):
         RobotRollouts.load(tmp_path / "alpha")
+    for call in (rollouts.save, RobotRollouts.load):  # was pathlib's TypeError
+        with pytest.raises(ParameterError, match="directory must be a path, got None"):
+            call(None)
 
 
 def test_each_robots_figures_by_name(rollouts):

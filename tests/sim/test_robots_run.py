@@ -172,6 +172,13 @@ def test_a_robot_grasps_the_first_robots_ball_as_a_single_robot_does():
     assert np.abs(gripped).max() > 1.0  # the jaws' force on b [N]
 
 
+def test_controllers_that_are_not_a_list_are_refused_by_name():
+    """(a number was a TypeError of list(); a string would be read letter by letter)"""
+    for given in (3, "ab"):
+        with pytest.raises(ParameterError, match="controllers must be a list"):
+            simulate_robots(_two(0.05), controllers=given)
+
+
 def test_a_fixture_with_several_robots_is_refused_by_name():
     doc = copy.deepcopy(read_toml(TWO, ScenarioError))
     doc["scenario"]["duration_s"] = 0.05

@@ -20,7 +20,7 @@ from contextlib import contextmanager
 from dataclasses import dataclass
 from pathlib import Path
 
-from uvms_pin.errors import OutputError
+from uvms_pin.errors import OutputError, ParameterError
 from uvms_pin.results.atomic import TEMP_SUFFIX
 
 try:  # POSIX; elsewhere directories are not locked
@@ -147,6 +147,14 @@ KINDS = (RUN, STUDY, COMPARISON, CONTROLLER_COMPARISON, IDENTIFICATION, POOL_VAL
 OVERWRITE_HELP = (
     "replace the results an earlier run left in --out (only files uvms-pin writes are removed)"
 )
+
+
+def given_path(name: str, value: str | Path) -> Path:
+    """``value`` as a Path, or ParameterError naming ``name`` (None, a number, an empty
+    string: Path("") would be the current directory)."""
+    if not isinstance(value, str | Path) or not str(value).strip():
+        raise ParameterError(f"{name} must be a path, got {value!r}")
+    return Path(value)
 
 
 def check_writable(path: str | Path, option: str = "--out", shown: str | None = None) -> Path:

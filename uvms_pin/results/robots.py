@@ -17,6 +17,7 @@ from typing import TYPE_CHECKING, Any
 from uvms_pin.errors import ParameterError
 from uvms_pin.results.atomic import write_json_atomic
 from uvms_pin.results.free_objects import free_object_summary
+from uvms_pin.results.outdir import given_path
 from uvms_pin.results.rollout import Rollout
 from uvms_pin.results.status import RunStatus
 
@@ -105,7 +106,7 @@ class RobotRollouts:
         """
         from uvms_pin.results.metrics import checked_metrics
 
-        out = Path(directory)
+        out = given_path("directory", directory)
         blocks, failures = {}, []
         for name, rollout in self.rollouts.items():
             metrics, failure = checked_metrics(rollout)
@@ -128,7 +129,7 @@ class RobotRollouts:
     @classmethod
     def load(cls, directory: str | Path) -> RobotRollouts:
         """The rollouts `save` wrote in ``directory``."""
-        src = Path(directory)
+        src = given_path("directory", directory)
         return cls({name: Rollout.load(src / name) for name in cls.names_in(src)})
 
     @staticmethod

@@ -12,7 +12,7 @@ import numpy as np
 from uvms_pin.errors import ParameterError
 from uvms_pin.results import perception as frames
 from uvms_pin.results.atomic import atomic_paths, json_text
-from uvms_pin.results.outdir import check_writable
+from uvms_pin.results.outdir import check_writable, given_path
 from uvms_pin.results.perception import (
     CameraRecord,
     SonarRecord,
@@ -82,13 +82,13 @@ class Rollout(RolloutData):
         ``ros`` extra (``pip install "uvms-pin[ros]"``)."""
         from uvms_pin.apps.export.ros_bag import write_mcap
 
-        return write_mcap(self, _path("path", path), urdf=urdf)
+        return write_mcap(self, given_path("path", path), urdf=urdf)
 
     # ---- persistence ------------------------------------------------------------------
     def save(self, directory: str | Path) -> Path:
         """Write ``rollout.npz`` and ``rollout.json`` into ``directory`` atomically (and the
         cameras' and sonars' images, when it has some, into ``perception.npz``)."""
-        out = check_writable(_path("directory", directory), "save")
+        out = check_writable(given_path("directory", directory), "save")
         out.mkdir(parents=True, exist_ok=True)
         # Fix: serialise the metadata before writing anything; it used to be serialised
         # after rollout.npz was replaced, so unserialisable metadata left a new .npz next
@@ -111,7 +111,7 @@ class Rollout(RolloutData):
 
     @classmethod
     def load(cls, directory: str | Path) -> Rollout:
-        src = _path("directory", directory)
+        src = given_path("directory", directory)
         if not (src / ARRAY_FILE).is_file() or not (src / META_FILE).is_file():
             raise ParameterError(f"{src} holds no rollout ({ARRAY_FILE} and {META_FILE} expected)")
         try:
@@ -129,10 +129,3 @@ class Rollout(RolloutData):
             raise ParameterError(f"{src / META_FILE}: a JSON object expected")
         perception = load_perception(src / frames.FILE) if "perception" in metadata else {}
         return cls(**base, signals=signals, metadata=metadata, perception=perception)
-
-
-def _path(name: str, value: str | Path) -> Path:
-    """``value`` as a Path, or ParameterError naming ``name`` (None, a number)."""
-    if not isinstance(value, str | Path) or not str(value).strip():
-        raise ParameterError(f"{name} must be a path, got {value!r}")
-    return Path(value)

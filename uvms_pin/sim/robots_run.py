@@ -129,6 +129,12 @@ def _simulate_robots(
     scenario: RobotsScenario, controllers: Sequence | None, progress: Progress | None
 ) -> RobotRollouts:
     robots = scenario.robots
+    if controllers is not None and (
+        not isinstance(controllers, Sequence) or isinstance(controllers, str)
+    ):
+        raise ParameterError(
+            f"controllers must be a list of one Controller (or None) per robot, got {controllers!r}"
+        )
     given = list(controllers) if controllers is not None else [None] * len(robots)
     if len(given) != len(robots):
         raise ParameterError(f"{len(given)} controllers for {len(robots)} robots")
