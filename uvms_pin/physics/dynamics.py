@@ -22,6 +22,7 @@ functions below are the public API on it.
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 
 import numpy as np
 import pinocchio as pin
@@ -91,11 +92,16 @@ def _on_manifold(
     return checked_configuration("q", q, uvms.model)
 
 
-def _name_the_joint(uvms: UVMS, q: np.ndarray, refusal: ParameterError) -> None:
-    """The core's refusal of a q off the configuration manifold raised again naming the
-    joint (the reference's check); any other refusal is the caller's to raise as it is."""
-    if str(refusal) == OFF_MANIFOLD:
-        checked_configuration("q", q, uvms.model)
+def _named(uvms: UVMS, q: np.ndarray, call: Callable, *args):
+    """``call(*args)``, a dynamics call on ``q``: the core's refusal of a q off the
+    configuration manifold is raised again naming the joint (the reference's check); any
+    other refusal as it is."""
+    try:
+        return call(*args)
+    except ParameterError as refusal:
+        if str(refusal) == OFF_MANIFOLD:
+            checked_configuration("q", q, uvms.model)
+        raise
 
 
 def _finite_result(what: str, value: np.ndarray, uvms: UVMS, q, v=None) -> np.ndarray:
@@ -134,14 +140,10 @@ def mass_matrix(
     dynamics = dynamics_of(uvms, backend)
     free_surface = flag("free_surface", free_surface)
     q = _on_manifold(dynamics, uvms, q)
-    try:
-        if not free_surface:
-            return _finite_result("M(q)", dynamics.mass_matrix(q), uvms, q)
-        mass = dynamics.mass_matrix_in(q, _checked_flow(flow), check_time(time_s), True)
-    except ParameterError as refusal:
-        _name_the_joint(uvms, q, refusal)
-        raise
-    return _finite_result("M(q)", mass, uvms, q)
+    if not free_surface:
+        return _finite_result("M(q)", _named(uvms, q, dynamics.mass_matrix, q), uvms, q)
+    at = (_checked_flow(flow), check_time(time_s), True)
+    return _finite_result("M(q)", _named(uvms, q, dynamics.mass_matrix_in, q, *at), uvms, q)
 
 
 def bias_forces(
@@ -172,15 +174,11 @@ def bias_forces(
     dynamics = dynamics_of(uvms, backend)
     free_surface = flag("free_surface", free_surface)
     q = _on_manifold(dynamics, uvms, q)
-    try:
-        if flow is None and not free_surface:
-            h = dynamics.bias_forces(q, v, current_world)
-        else:
-            flow = _flow_of_call(current_world, flow)
-            h = dynamics.bias_forces_in(q, v, flow, check_time(time_s), free_surface)
-    except ParameterError as refusal:
-        _name_the_joint(uvms, q, refusal)
-        raise
+    if flow is None and not free_surface:
+        h = _named(uvms, q, dynamics.bias_forces, q, v, current_world)
+    else:
+        at = (_flow_of_call(current_world, flow), check_time(time_s), free_surface)
+        h = _named(uvms, q, dynamics.bias_forces_in, q, v, *at)
     return _finite_result("h(q, zeta)", h, uvms, q, v)
 
 
@@ -215,17 +213,11 @@ def forward_dynamics(
     dynamics = dynamics_of(uvms, backend)
     free_surface = flag("free_surface", free_surface)
     q = _on_manifold(dynamics, uvms, q)
-    try:
-        if flow is None and not free_surface:
-            zeta_dot = dynamics.forward_dynamics(q, v, tau, current_world, tau_ext)
-        else:
-            flow = _flow_of_call(current_world, flow)
-            zeta_dot = dynamics.forward_dynamics_in(
-                q, v, tau, flow, check_time(time_s), tau_ext, free_surface
-            )
-    except ParameterError as refusal:
-        _name_the_joint(uvms, q, refusal)
-        raise
+    if flow is None and not free_surface:
+        zeta_dot = _named(uvms, q, dynamics.forward_dynamics, q, v, tau, current_world, tau_ext)
+    else:
+        at = (_flow_of_call(current_world, flow), check_time(time_s), tau_ext, free_surface)
+        zeta_dot = _named(uvms, q, dynamics.forward_dynamics_in, q, v, tau, *at)
     return _finite_result("zeta_dot", zeta_dot, uvms, q, v)
 
 
