@@ -15,7 +15,8 @@ from uvms_pin.errors import ParameterError, UvmsPinError
 
 VEHICLE = up.shipped_path("models/bluerov2_heavy.urdf")
 ARM = up.shipped_path("models/reach_alpha5.urdf")
-POSE = [0.1, 0.0, -0.1, 0.0, 0.0, 0.0]
+POSE = [0.1, 0.0, -0.1, 0.0, 0.0, 0.0]  # not a pose: the options are refused first
+MOUNT = ([0.1, 0.0, -0.1], [0.0, 0.0, 0.0])
 
 
 @pytest.fixture(scope="module")
@@ -45,6 +46,22 @@ CASES = {
     "mount_arm: a trim that is neither a flag nor a TrimSpec": (
         lambda u: up.mount_arm(VEHICLE, ARM, POSE, trim="yes"),
         "trim must be",
+    ),
+    "mount_arm: a flag as a string": (
+        lambda u: up.mount_arm(VEHICLE, ARM, MOUNT, moving_jaw="yes"),
+        "moving_jaw must be True or False",
+    ),
+    "mount_arm: a locked position as a string": (
+        lambda u: up.mount_arm(VEHICLE, ARM, MOUNT, lock_positions={"alpha_axis_e": "0.5"}),
+        r"lock_positions\['alpha_axis_e'\] must be a number",
+    ),
+    "mount_arm: locked positions that are no table": (
+        lambda u: up.mount_arm(VEHICLE, ARM, MOUNT, lock_positions="alpha_axis_e"),
+        "lock_positions must be a dict",
+    ),
+    "mount_arm: a file to save to that is no path": (
+        lambda u: up.mount_arm(VEHICLE, ARM, MOUNT, save_urdf=3),
+        "save_urdf must be a path",
     ),
     "SimulationSettings: a duration as a string": (
         lambda u: up.SimulationSettings("2", up.RK4()),

@@ -13,7 +13,8 @@ from pathlib import Path
 
 import numpy as np
 
-from uvms_pin.errors import ModelError
+from uvms_pin.checks import flag, number
+from uvms_pin.errors import ModelError, ParameterError
 from uvms_pin.model.jaw import is_jaw_name
 from uvms_pin.model.mount.existing_arm import existing_arm
 from uvms_pin.model.mount.hull import first_box
@@ -120,6 +121,11 @@ def merge_urdf(
             instead of locking them.
     """
     placement = parse_mount_pose(mount_pose)
+    allow_dry_links = flag("allow_dry_links", allow_dry_links)
+    keep_existing_arm = flag("keep_existing_arm", keep_existing_arm)
+    moving_jaw = flag("moving_jaw", moving_jaw)
+    if isinstance(package_dirs, str | Path):
+        package_dirs = (package_dirs,)  # one folder, not its name's characters
     vehicle = URDFTree.read(Path(vehicle_urdf))
     arm = URDFTree.read(Path(arm_urdf))
     removed_links, removed_joints = ([], []) if keep_existing_arm else existing_arm(vehicle)
@@ -188,8 +194,14 @@ def _vehicle_link(vehicle: URDFTree, vehicle_link: str | None, removed_links: li
 
 
 def _lock_positions(arm: URDFTree, lock_positions: Mapping[str, float] | None) -> dict:
-    """``lock_positions`` as a dict, every name a joint of the arm file."""
-    locks = dict(lock_positions or {})
+    """``lock_positions`` as a dict of numbers, every name a joint of the arm file."""
+    if lock_positions is not None and not isinstance(lock_positions, Mapping):
+        raise ParameterError(
+            f"lock_positions must be a dict of joint name -> position, got {lock_positions!r}"
+        )
+    locks = {
+        name: number(f"lock_positions[{name!r}]", x) for name, x in (lock_positions or {}).items()
+    }
     unknown = sorted(set(locks) - set(arm.joints))
     if unknown:
         raise ModelError(

@@ -153,6 +153,8 @@ def mount_arm_detailed(
             f"mount_arm: unknown option(s) {', '.join(unknown)}; the options are "
             f"water_density_kg_m3, trim, trim_joint_positions, save_urdf, {', '.join(sorted(known))}"
         )
+    if save_urdf is not None and not isinstance(save_urdf, str | Path):
+        raise ParameterError(f"mount_arm: save_urdf must be a path, got {save_urdf!r}")
     if not (trim is None or isinstance(trim, bool | TrimSpec)):
         raise ParameterError(
             f"mount_arm: trim must be True, False, None or a TrimSpec, got {trim!r}"
