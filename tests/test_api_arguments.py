@@ -90,6 +90,10 @@ CASES = {
         lambda u: up.World(u, [1]),
         r"objects\[0\] must be a WorldObject",
     ),
+    "Measurement: a configuration of strings": (
+        lambda u: up.Measurement(0.0, "level", [0.0] * u.nv, [0.0] * 6),
+        "measurement q must be numbers",
+    ),
     "SumFlow: a field that is not one": (
         lambda u: up.SumFlow((up.UniformCurrent([0.1, 0, 0]), 1)),
         "SumFlow adds FlowFields",

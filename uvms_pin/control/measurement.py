@@ -9,6 +9,8 @@ from typing import Any
 
 import numpy as np
 
+from uvms_pin.errors import ParameterError
+
 #: a measurement without images
 _NO_IMAGES: Mapping[str, Any] = MappingProxyType({})
 
@@ -61,7 +63,13 @@ class Measurement:
         for name in ("q", "v", "wrench_world"):
             value = getattr(self, name)
             if not _frozen(value):
-                object.__setattr__(self, name, read_only(np.array(value, dtype=float)))
+                try:
+                    array = np.array(value, dtype=float)
+                except (TypeError, ValueError):  # strings, ragged lists (the loop's: arrays)
+                    raise ParameterError(
+                        f"measurement {name} must be numbers, got {value!r}"
+                    ) from None
+                object.__setattr__(self, name, read_only(array))
 
     @property
     def force_world_N(self) -> np.ndarray:
