@@ -144,11 +144,24 @@ def test_a_plants_acceleration_names_a_wrong_input(uvms, backend):
         plant.ee_state("level", v)
 
 
-def test_one_package_folder_may_be_given_alone(uvms):
+def test_one_package_folder_may_be_given_alone(uvms, monkeypatch):
     """``package_dirs="models"`` was read as the folders "m", "o", "d", ...: one folder is
-    now taken as the list of it."""
-    alone = up.load_uvms(REFERENCE_URDF, package_dirs=str(ROOT / "models"))
-    listed = up.load_uvms(REFERENCE_URDF, package_dirs=[ROOT / "models"])
+    now taken as the list of it (what reaches the mesh search is looked at: the reference
+    model has no package:// mesh, so the loaded model alone could not tell)."""
+    import uvms_pin.model.urdf.load as load
+
+    searched = []
+    bodies = load.hydro_bodies
+
+    def recording(*args, **kwargs):
+        searched.append(tuple(kwargs["package_dirs"]))
+        return bodies(*args, **kwargs)
+
+    monkeypatch.setattr(load, "hydro_bodies", recording)
+    folder = str(ROOT / "models")
+    alone = up.load_uvms(REFERENCE_URDF, package_dirs=folder)
+    listed = up.load_uvms(REFERENCE_URDF, package_dirs=[folder])
+    assert searched == [(folder,), (folder,)]
     assert alone.nv == listed.nv == uvms.nv
 
 
