@@ -220,9 +220,15 @@ void Dynamics::articulated_body_pass(const ConstVec& tau) {
         bias_acc_[i];
     articulated_forward(i, a_parent);
   }
-  if (!acceleration_.allFinite()) {
-    throw SimulationFailure("articulated-body inertia is not positive definite");
+  if (acceleration_.allFinite()) return;
+  // bias forces that left the floating-point range (the squares of speeds of 1e200, in the
+  // damping and the Coriolis terms) make the acceleration non-finite with every inertia
+  // sound: returned as it is, for the caller to name (the public call names the fastest
+  // speed, a loop the divergence); otherwise an inertia could not be factored
+  for (int i = 1; i < nj; ++i) {
+    if (!bias_a_[i].allFinite()) return;
   }
+  throw SimulationFailure("articulated-body inertia is not positive definite");
 }
 
 }  // namespace uvms

@@ -96,11 +96,9 @@ Eigen::Map<const Eigen::VectorXd> vector(const char* name, nb::handle x, const V
 // Declares the configuration `q` of `dynamics` (a Map) from `q_obj`: n finite numbers on
 // the configuration manifold (else InputError; the caller names the joint off it). A
 // quaternion of norm 0 or 2 would give a rotation that is none, and M, h of it, silently
-#define UVMS_CONFIGURATION(dynamics)                                               \
-  UVMS_VECTOR(q, (dynamics).nq());                                                 \
-  if (!uvms::pinlib::is_normalized((dynamics).model(), q, uvms::pinlib::kNormTolerance)) { \
-    throw InputError("q is not on the configuration manifold");                    \
-  }
+#define UVMS_CONFIGURATION(dynamics) \
+  UVMS_VECTOR(q, (dynamics).nq());   \
+  uvms::pinlib::require_on_manifold((dynamics).model(), q)
 
 template <typename Struct>
 void check_finite(const char* name, const Struct& values) {
@@ -336,9 +334,7 @@ void bind_derivatives(nb::module_& m) {
                 out.shape(2) != std::size_t(nv)) {
               throw InputError("out must have shape (3, nv, nv)");
             }
-            if (!uvms::pinlib::is_normalized(d.dynamics().model(), q, norm_tolerance)) {
-              throw InputError("q is not on the configuration manifold");
-            }
+            uvms::pinlib::require_on_manifold(d.dynamics().model(), q, norm_tolerance);
             const ForwardDynamicsDerivatives* jacobians = nullptr;
             if (tau_ext_obj.is_none()) {
               jacobians = &d.forward_dynamics_derivatives(q, v, tau, flow_or_still(flow),

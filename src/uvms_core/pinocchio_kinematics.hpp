@@ -29,6 +29,8 @@
 #include <pinocchio/multibody/data.hpp>
 #include <pinocchio/multibody/model.hpp>
 
+#include "types.hpp"
+
 namespace uvms::pinlib {
 
 using Model = pinocchio::Model;
@@ -135,5 +137,16 @@ inline bool is_normalized(const Model& model, const Eigen::VectorXd& q, double t
 // The largest |norm - 1| of a configuration's unit parts (a quaternion, a (cos, sin) pair)
 // the bindings take: uvms_pin.physics.configuration.NORM_TOLERANCE (a test holds them equal)
 constexpr double kNormTolerance = 1e-9;
+
+// The bindings' check of a q they are given: on the configuration manifold (its unit parts'
+// norms within `tolerance` of 1), else InputError in the words the Python side recognises
+// (uvms_pin.physics.configuration.OFF_MANIFOLD) to name the joint. A quaternion of norm 0
+// or 2 would give a rotation that is none, and M, h of it, silently.
+inline void require_on_manifold(const Model& model, const Eigen::VectorXd& q,
+                                double tolerance = kNormTolerance) {
+  if (!is_normalized(model, q, tolerance)) {
+    throw InputError("q is not on the configuration manifold");
+  }
+}
 
 }  // namespace uvms::pinlib

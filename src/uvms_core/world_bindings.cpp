@@ -172,9 +172,7 @@ void bind_plant_world(nb::class_<Plant>& plant) {
             const int nq = p.dynamics().nq(), nv = p.dynamics().nv();
             const auto qc = checked("q", q, nq), vc = checked("v", v, nv);
             const auto u = checked("tau", tau, nv);
-            if (!uvms::pinlib::is_normalized(p.dynamics().model(), q, uvms::pinlib::kNormTolerance)) {
-              throw InputError("q is not on the configuration manifold");
-            }
+            uvms::pinlib::require_on_manifold(p.dynamics().model(), q);
             read_memory(friction, p.friction);
             return p.acceleration(t, qc, vc, u);
           },

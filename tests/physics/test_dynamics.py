@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import dataclasses
+import math
 
 import numpy as np
 import pinocchio as pin
@@ -10,7 +11,7 @@ import pytest
 from conftest import REFERENCE_URDF, RHO, body_urdf, hydro_xml, random_configuration
 
 import uvms_pin as up
-from uvms_pin.errors import ParameterError
+from uvms_pin.errors import ParameterError, SimulationError
 from uvms_pin.hydro.params import HydroParams
 from uvms_pin.model.uvms import UVMS, HydroBody
 from uvms_pin.sim.integrators import RK4
@@ -448,3 +449,32 @@ def test_a_quaternion_off_the_unit_sphere_is_refused_by_every_dynamics_call(
     )
     for call in calls.values():
         call()  # normalised: taken
+
+
+@pytest.mark.parametrize("backend", ["core", "python"])
+def test_speeds_whose_products_overflow_are_an_error_naming_them_not_an_inf(
+    reference_uvms, backend
+):
+    """Finite speeds of 1e200 (their squares, in the damping and the kinetic energy, leave
+    the floating-point range): h, the forward dynamics and T are a SimulationError naming
+    the fastest entry of zeta, on both backends. Was: T returned inf silently; the core's
+    forward dynamics blamed the articulated-body inertia (not positive definite)."""
+    uvms = reference_uvms
+    q = pin.neutral(uvms.model)
+    q[2] = -3.0
+    fast, tau = np.full(uvms.nv, 1e200), np.zeros(uvms.nv)
+    calls = {
+        "h": lambda: up.bias_forces(uvms, q, fast, backend=backend),
+        "a": lambda: up.forward_dynamics(uvms, q, fast, tau, backend=backend),
+        "T": lambda: up.kinetic_energy(uvms, q, fast, backend=backend),
+    }
+    for name, call in calls.items():
+        with (
+            np.errstate(all="ignore"),
+            pytest.raises(SimulationError, match=r"not finite for finite inputs: the fastest"),
+        ):
+            call()
+            pytest.fail(f"{name} returned for speeds of 1e200")
+    slow = np.full(uvms.nv, 0.1)  # the same calls at ordinary speeds: finite numbers
+    assert math.isfinite(up.kinetic_energy(uvms, q, slow, backend=backend))
+    assert np.all(np.isfinite(up.forward_dynamics(uvms, q, slow, tau, backend=backend)))

@@ -110,8 +110,9 @@ def _finite_result(what: str, value: np.ndarray, uvms: UVMS, q, v=None) -> np.nd
     manifold (a quaternion of norm 1e300), else SimulationError for a speed whose square
     (quadratic damping, Coriolis) leaves the floating-point range."""
     flat = value.reshape(-1)
-    # the product first: all finite unless it overflows (then the entries are looked at)
-    if math.isfinite(flat @ flat) or np.all(np.isfinite(flat)):
+    # the product first: all finite unless it overflows (then the entries are looked at);
+    # ndarray.dot, not @: 0.3 us for ten entries where the matmul ufunc takes 0.9
+    if math.isfinite(flat.dot(flat)) or np.all(np.isfinite(flat)):
         return value
     checked_configuration("q", q, uvms.model)
     fastest = 0.0 if v is None else float(np.max(np.abs(np.asarray(v, dtype=float))))
@@ -341,7 +342,8 @@ def kinetic_energy(
     mass = mass_matrix(
         uvms, q, backend=backend, free_surface=free_surface, flow=flow, time_s=time_s
     )
-    return float(0.5 * v @ mass @ v)
+    # the quadratic form of finite entries may still overflow (a speed of 1e200)
+    return float(_finite_result("T", np.array(0.5 * v @ mass @ v), uvms, q, v))
 
 
 def potential_energy(
