@@ -158,6 +158,24 @@ def test_a_damaged_sensor_record_is_refused_naming_the_sensor(saved, tmp_path, s
     assert list(tmp_path.iterdir()) == []
 
 
+def test_two_sensors_of_one_ros_name_are_refused_naming_both(saved, tmp_path):
+    """Sensor names the scenario keeps apart ("echo-sounder", "echo.sounder") but ROS does
+    not: one topic and one TF frame would carry both sensors' messages interleaved, so the
+    export refuses, naming both, and writes nothing (was: exit 0, one topic of both)."""
+    rollout = Rollout.load(saved)
+    described = rollout.metadata["perception"]
+    for old, new in (("altimeter", "echo-sounder"), ("echosounder", "echo.sounder")):
+        rollout.perception[new] = rollout.perception.pop(old)
+        described[new] = described.pop(old)
+    with pytest.raises(VizError, match=r"'echo-sounder' and 'echo.sounder' .* 'echo_sounder'"):
+        rollout.to_mcap(tmp_path / "run.mcap")
+    assert list(tmp_path.iterdir()) == []
+    for old, new in (("echo-sounder", "echo_a"), ("echo.sounder", "echo_b")):
+        rollout.perception[new] = rollout.perception.pop(old)
+        described[new] = described.pop(old)
+    check_bag(rollout, read_bag(rollout.to_mcap(tmp_path / "run.mcap")))  # apart: exported
+
+
 def test_a_sensor_name_becomes_a_ros_name():
     """ROS names are letters, digits and underscores, not starting with a digit."""
     assert ros_name("front") == "front"

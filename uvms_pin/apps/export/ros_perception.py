@@ -162,6 +162,15 @@ class PerceptionTopics:
             for name, about in described.items()
             if name in rollout.perception and "spec" in about and "frame" in about
         ]
+        tokens: dict[str, str] = {}  # ROS name -> the sensor's own
+        for name, _ in self.sensors:
+            other = tokens.setdefault(ros_name(name), name)
+            if other != name:  # one topic and one TF frame would carry both, interleaved
+                raise VizError(
+                    f"sensors '{other}' and '{name}' have the same ROS name "
+                    f"'{ros_name(name)}' (letters, digits and underscores): rename one in "
+                    "the scenario and run it again"
+                )
         self.arrays = rollout.perception
         self.types: dict[str, str] = {}
         self._frames: dict[str, tuple[str, str, pin.SE3]] = {}  # (its frame, parent, pose)
