@@ -101,20 +101,25 @@ void CoupledConstraintStep::add_pair_rows(const SystemAtStart& at, const Eigen::
       if (apart >= piece_a.bound_radius_m + piece_b.bound_radius_m + h * closing + margin) {
         continue;
       }
-      const ContactCandidate point = coal_candidate(piece_a, where_a, piece_b, where_b, ia, ib);
-      const Eigen::MatrixXd relative = side_jacobian(at, set.a, piece_a, point.point) -
-                                       side_jacobian(at, set.b, piece_b, point.point);
-      const Eigen::RowVectorXd normal_rate = point.normal.transpose() * relative;
-      if (point.gap_m > h * normal_rate.cwiseAbs().dot(speed) + margin) continue;
-      const Eigen::Matrix3d frame = contact_frame(point.normal);
-      const Eigen::MatrixXd rows = frame.transpose() * relative;
-      cone_rows_.push_back(static_cast<Eigen::Index>(rows_.size()));
-      for (int r = 0; r < 3; ++r) rows_.push_back(rows.row(r));
-      const double gap = point.gap_m;
-      drift_.insert(drift_.end(), {0.0, 0.0, (gap >= 0.0 ? gap : correction * gap) / h});
-      const bool sliding = set.memory.slipping.count(static_cast<int>(k)) > 0;
-      mu_.push_back(sliding ? set.pairs.friction_kinetic[k] : set.pairs.friction_static[k]);
-      pair_rows_.push_back({static_cast<int>(s), static_cast<int>(k), point, frame});
+      // the pair's candidates (moving_contacts.py's _candidates): a contact patch's vertices
+      // or coal's one point, each solved when its gap can close within the period
+      patch_.clear();
+      patch_candidates(piece_a, where_a, piece_b, where_b, ia, ib, h * closing + margin, patch_);
+      for (const ContactCandidate& point : patch_) {
+        const Eigen::MatrixXd relative = side_jacobian(at, set.a, piece_a, point.point) -
+                                         side_jacobian(at, set.b, piece_b, point.point);
+        const Eigen::RowVectorXd normal_rate = point.normal.transpose() * relative;
+        if (point.gap_m > h * normal_rate.cwiseAbs().dot(speed) + margin) continue;
+        const Eigen::Matrix3d frame = contact_frame(point.normal);
+        const Eigen::MatrixXd rows = frame.transpose() * relative;
+        cone_rows_.push_back(static_cast<Eigen::Index>(rows_.size()));
+        for (int r = 0; r < 3; ++r) rows_.push_back(rows.row(r));
+        const double gap = point.gap_m;
+        drift_.insert(drift_.end(), {0.0, 0.0, (gap >= 0.0 ? gap : correction * gap) / h});
+        const bool sliding = set.memory.slipping.count(static_cast<int>(k)) > 0;
+        mu_.push_back(sliding ? set.pairs.friction_kinetic[k] : set.pairs.friction_static[k]);
+        pair_rows_.push_back({static_cast<int>(s), static_cast<int>(k), point, frame});
+      }
     }
   }
 }

@@ -125,6 +125,7 @@ class CoupledConstraintStep {
     ContactCandidate point;
     Eigen::Matrix3d frame;
   };
+  std::vector<ContactCandidate> patch_;  // one pair's candidates (add_pair_rows' scratch)
   int select(const SystemAtStart& at, const Eigen::VectorXd& speed, double h);
   void add_pair_rows(const SystemAtStart& at, const Eigen::VectorXd& speed, double h);
   // The world velocity Jacobian (3 x nv) of side's material point at x, and a bound on the

@@ -6,6 +6,8 @@
 #include <limits>
 #include <string>
 
+#include <coal/collision.h>
+#include <coal/contact_patch.h>
 #include <coal/distance.h>
 #include <Eigen/Cholesky>
 #include <Eigen/Geometry>
@@ -77,6 +79,62 @@ ContactCandidate coal_candidate(const ContactShape& piece, const pinocchio::SE3&
   return {p, o, -1, result.nearest_points[0], -result.normal, gap};
 }
 
+namespace {
+
+// coal's contact patch of two shapes within reach_m [m] of each other, into `patches`: true
+// when it has two vertices or more (a face or an edge) (_patch of gaps.py)
+bool face_patch(const coal::CollisionGeometry* shape_1, const coal::Transform3s& transform_1,
+                const coal::CollisionGeometry* shape_2, const coal::Transform3s& transform_2,
+                double reach_m, coal::ContactPatchResult& patches) {
+  // one patch, curved rims sampled at 12 points, features within 1 mm (coal's defaults)
+  static const coal::ContactPatchRequest patch_request;
+  coal::CollisionRequest request;
+  request.security_margin = reach_m;  // a pair within the reach counts as touching
+  coal::CollisionResult result;
+  if (coal::collide(shape_1, transform_1, shape_2, transform_2, request, result) == 0) {
+    return false;
+  }
+  patches.set(patch_request);
+  coal::computeContactPatch(shape_1, transform_1, shape_2, transform_2, result, patch_request,
+                            patches);
+  return patches.numContactPatches() > 0 && patches.getContactPatch(0).size() >= 2;
+}
+
+}  // namespace
+
+void patch_candidates(const ContactShape& piece, const pinocchio::SE3& where,
+                      const ContactShape& object, const pinocchio::SE3& object_where, int p,
+                      int o, double reach_m, std::vector<ContactCandidate>& out) {
+  const ContactCandidate nearest = coal_candidate(piece, where, object, object_where, p, o);
+  if (!(nearest.gap_m <= reach_m)) {
+    out.push_back(nearest);
+    return;
+  }
+  const coal::Transform3s transform = transform_of(where);
+  const coal::Transform3s object_transform = transform_of(object_where);
+  // coal 3.0's patch of a cylinder is one point when the cylinder's supporting disc is the
+  // second shape's and the normal points away from it: the pair asked both ways
+  coal::ContactPatchResult patches;
+  bool first = true;
+  if (!face_patch(piece.geometry.get(), transform, object.geometry.get(), object_transform,
+                  reach_m, patches)) {
+    first = false;
+    if (!face_patch(object.geometry.get(), object_transform, piece.geometry.get(), transform,
+                    reach_m, patches)) {
+      out.push_back(nearest);
+      return;
+    }
+  }
+  const coal::ContactPatch& patch = patches.getContactPatch(0);
+  // coal's normal points from the first shape to the second; ours out of the object
+  const Vec3 normal = first ? Vec3(-patch.getNormal()) : Vec3(patch.getNormal());
+  for (std::size_t k = 0; k < patch.size(); ++k) {
+    const Vec3 on_piece = first ? patch.getPointShape1(k) : patch.getPointShape2(k);
+    out.push_back({p, o, kPatchCorner - static_cast<int>(k), on_piece, normal,
+                   patch.penetration_depth});
+  }
+}
+
 // C = (t1, t2, n) with n its third column (contact_frame of contacts.py).
 Eigen::Matrix3d contact_frame(const Vec3& normal) {
   const Vec3 helper = std::abs(normal.x()) < 0.9 ? Vec3::UnitX() : Vec3::UnitY();
@@ -122,7 +180,7 @@ void contact_candidates(const Data& data, const std::vector<ContactShape>& piece
         } else if ((center - at.translation()).norm() >= radius + object.bound_radius_m) {
           continue;
         }
-        out.push_back(coal_candidate(pieces[p], where[p], object, at, pi, oi));
+        patch_candidates(pieces[p], where[p], object, at, pi, oi, reach_m, out);
       }
     }
   }

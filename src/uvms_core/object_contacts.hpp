@@ -37,7 +37,7 @@ namespace uvms {
 constexpr double kSlipSpeed_m_s = 1.0e-6;
 
 // One candidate contact point (Candidate of gaps.py); corner: the piece's corner, a rim's
-// lowest point -2 - rim, -1 coal's point.
+// lowest point -2 - rim, -1 coal's point, kPatchCorner - k a contact patch's vertex k.
 struct ContactCandidate {
   int piece = 0, obj = 0, corner = -1;
   Vec3 point = Vec3::Zero();
@@ -56,6 +56,16 @@ void contact_candidates(const Data& data, const std::vector<ContactShape>& piece
 ContactCandidate coal_candidate(const ContactShape& piece, const pinocchio::SE3& where,
                                 const ContactShape& object, const pinocchio::SE3& object_where,
                                 int p, int o);
+
+// a patch's vertex k is candidate corner kPatchCorner - k (gaps.py's PATCH_CORNER)
+constexpr int kPatchCorner = -4;
+
+// The candidates of a piece on a solid object (patch_candidates of gaps.py): the vertices of
+// coal's contact patch when the two are within reach_m [m] and touch along a face or an edge
+// (two vertices or more), else coal_candidate's one point; appended to out.
+void patch_candidates(const ContactShape& piece, const pinocchio::SE3& where,
+                      const ContactShape& object, const pinocchio::SE3& object_where, int p,
+                      int o, double reach_m, std::vector<ContactCandidate>& out);
 
 // C = (t1, t2, n) with n its third column (contact_frame of contacts.py).
 Eigen::Matrix3d contact_frame(const Vec3& normal);

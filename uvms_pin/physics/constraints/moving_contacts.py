@@ -4,10 +4,12 @@ arm link and its own vehicle) as rigid point contacts with the Coulomb cone (Pin
 `step.constrained_velocity` with the joint limits and the objects' fixed-world contacts.
 
 Each pair (a, b) of pieces of a pair set (`uvms_pin.physics.world.moving`: the sets'
-pairs, their friction and their memories) that can touch within the period has one
-candidate: coal's signed distance between the two shapes (`gaps.coal_candidate`, b posed as
-an object), its nearest point x on a, the normal n out of b towards a and the gap r [m]
-(< 0 inside). Its three rows in the frame C = (t1, t2, n) are
+pairs, their friction and their memories) that can touch within the period has its
+candidates (`gaps.patch_candidates`, b posed as an object): coal's signed distance between
+the two shapes, its nearest point x on a, the normal n out of b towards a and the gap r [m]
+(< 0 inside); or, where two solids meet along a face or an edge, the vertices x of coal's
+contact patch, each with the patch's normal and gap. Each point's three rows in the frame
+C = (t1, t2, n) are
 
     J v = C^T (J_a(x) - J_b(x)) v      the velocity of a's material point at x relative to
                                        b's there [m/s]: tangential (two rows), normal,
@@ -43,7 +45,7 @@ from uvms_pin.physics.constraints.contacts import (
 )
 from uvms_pin.physics.constraints.object_contacts import SLIP_M_S
 from uvms_pin.physics.constraints.rows import ConstraintRows
-from uvms_pin.physics.world.gaps import Candidate, coal_candidate
+from uvms_pin.physics.world.gaps import Candidate, patch_candidates
 from uvms_pin.physics.world.objects import WorldObject
 from uvms_pin.physics.world.pairs import PairContacts, PiecePairs
 from uvms_pin.physics.world.robot_geometry import RobotPiece
@@ -142,23 +144,22 @@ class MovingPairContacts:
         for s, pair_set in enumerate(self.sets):
             pieces_a, pieces_b = self._pieces[s]
             for k, (ia, ib) in enumerate(pair_set.pairs.pairs):
-                point = self._candidate(model, data, speed, period_s, pieces_a[ia], pieces_b[ib])
-                if point is None:
-                    continue
-                point = dataclasses.replace(point, piece=ia, obj=ib)
-                joints = (pieces_a[ia].joint_id, pieces_b[ib].joint_id)
-                touching = (point.point_world_m, point.normal_world, point.gap_m)
-                mu_static, mu_kinetic = pair_set.pairs.mu[k]
-                mu = mu_kinetic if k in pair_set.memory.slipping else mu_static
-                evaluated_contacts.append(
-                    point_contact(model, data, joints[0], touching, mu, surface_joint=joints[1])
-                )
-                solved.append(_Solved(s, k, point, contact_frame(point.normal_world)))
+                found = self._candidates(model, data, speed, period_s, pieces_a[ia], pieces_b[ib])
+                for point in found:
+                    point = dataclasses.replace(point, piece=ia, obj=ib)
+                    joints = (pieces_a[ia].joint_id, pieces_b[ib].joint_id)
+                    touching = (point.point_world_m, point.normal_world, point.gap_m)
+                    mu_static, mu_kinetic = pair_set.pairs.mu[k]
+                    mu = mu_kinetic if k in pair_set.memory.slipping else mu_static
+                    evaluated_contacts.append(
+                        point_contact(model, data, joints[0], touching, mu, surface_joint=joints[1])
+                    )
+                    solved.append(_Solved(s, k, point, contact_frame(point.normal_world)))
         gaps = [c.point.gap_m for c in solved]
         labels = [self.sets[c.set].pairs.names[c.pair] for c in solved]
         return contact_rows(self.name, model.nv, evaluated_contacts, gaps, labels, solved)
 
-    def _candidate(
+    def _candidates(
         self,
         model: pin.Model,
         data: pin.Data,
@@ -166,25 +167,26 @@ class MovingPairContacts:
         period_s: float,
         piece_a: RobotPiece,
         piece_b: RobotPiece,
-    ) -> Candidate | None:
-        """The pair's candidate if its gap can close within the period, else None."""
+    ) -> list[Candidate]:
+        """The pair's candidates (`gaps.patch_candidates`: a contact patch's vertices, or
+        coal's one point) whose gaps can close within the period."""
         where_a = data.oMi[piece_a.joint_id] * piece_a.placement_in_joint
         where_b = data.oMi[piece_b.joint_id] * piece_b.placement_in_joint
         apart = np.linalg.norm(where_a.translation - where_b.translation)
         closing = _reach_speed(model, data, piece_a, speed)
         closing += _reach_speed(model, data, piece_b, speed)
-        if apart >= piece_a.bound_radius_m + piece_b.bound_radius_m + period_s * closing + (
-            self.margin
-        ):
-            return None
+        reach = period_s * closing + self.margin
+        if apart >= piece_a.bound_radius_m + piece_b.bound_radius_m + reach:
+            return []
         obstacle = WorldObject("b", "piece", piece_b.shape, where_b, 0.0, 0.0, 0.0)
-        point = coal_candidate(0, 0, piece_a, where_a, obstacle)
-        relative = point_jacobian(model, data, piece_a.joint_id, point.point_world_m)
-        relative -= point_jacobian(model, data, piece_b.joint_id, point.point_world_m)
-        normal_rate = point.normal_world @ relative
-        if point.gap_m > period_s * np.abs(normal_rate) @ speed + self.margin:
-            return None
-        return point
+        out = []
+        for point in patch_candidates(0, 0, piece_a, where_a, obstacle, reach):
+            relative = point_jacobian(model, data, piece_a.joint_id, point.point_world_m)
+            relative -= point_jacobian(model, data, piece_b.joint_id, point.point_world_m)
+            normal_rate = point.normal_world @ relative
+            if point.gap_m <= period_s * np.abs(normal_rate) @ speed + self.margin:
+                out.append(point)
+        return out
 
     def forces(
         self, rows: ConstraintRows, impulse: np.ndarray, velocity: np.ndarray, period_s: float
