@@ -235,3 +235,23 @@ def test_a_cameras_lights_and_reflectance_of_the_wrong_kind_are_named(given, mat
     of another kind: a ParameterError naming them, not an AttributeError of a list."""
     with pytest.raises(ParameterError, match=rf"camera 'c': {match}"):
         CameraSpec.from_dict({"name": "c", **given}, "camera 'c'")
+
+
+def test_a_reflectance_no_label_answers_to_is_named_and_a_link_answers_for_its_pieces():
+    """``reflectance`` keys are label names, or a link's name for its pieces (the Alpha 5's
+    label ``tool/collision[0]`` answers to ``tool``); a key no label answers to (a typo) is
+    a PerceptionWarning naming it and the labels (it was ignored silently)."""
+    from pathlib import Path
+
+    import uvms_pin as up
+    from uvms_pin.errors import PerceptionWarning
+
+    root = Path(__file__).resolve().parents[2]
+    scene = _scene(up.load_uvms(root / "models" / "uvms_bluerov2_alpha5.urdf"), [_wall(3.0)])
+    assert "tool/collision[0]" in scene.names
+    with pytest.warns(PerceptionWarning, match=r"'wal'.* no label .*its labels: wall"):
+        Camera(CameraSpec("c", reflectance={"wal": (1.0, 0.0, 0.0)}), scene, None)
+    colours = {"wall": (1.0, 0.0, 0.0), "tool": (0.0, 0.0, 1.0)}
+    camera = Camera(CameraSpec("c", reflectance=colours), scene, None)
+    rows = {name: tuple(camera.reflectance[k + 1]) for k, name in enumerate(scene.names)}
+    assert rows["wall"] == (1.0, 0.0, 0.0) and rows["tool/collision[0]"] == (0.0, 0.0, 1.0)

@@ -9,6 +9,7 @@ import pytest
 import trimesh
 from trimesh.ray.ray_triangle import RayMeshIntersector
 
+from uvms_pin.errors import ParameterError
 from uvms_pin.perception.caster import RayCaster
 from uvms_pin.perception.mesh import TriangleMesh
 from uvms_pin.perception.shapes import Cylinder, Ellipsoid, Plane, Sphere, box
@@ -108,6 +109,20 @@ def test_the_nearest_body_wins_and_a_moved_body_moves_its_hits():
     caster.set_pose(near, np.eye(3), np.array([10.0, 0, 0]))  # behind the far one now
     hits = caster.cast(np.zeros(3), axis)
     assert hits.range_m[0] == pytest.approx(7.0, abs=1e-12) and hits.label[0] == 1
+
+
+@pytest.mark.parametrize("where", ["rotation", "position"])
+def test_a_pose_that_is_not_finite_is_refused_as_the_core_refuses_it(where):
+    """A diverged state's NaN pose: the reference caster refuses it in the core's words
+    (it cast images of NaN depth, label 0 and black colour, silently)."""
+    caster = RayCaster()
+    ball = caster.add("ball", Sphere(1.0), np.eye(3), [3.0, 0.0, 0.0])
+    rotation, position = np.eye(3), np.array([3.0, 0.0, 0.0])
+    (rotation if where == "rotation" else position)[0, ...] = np.nan
+    with pytest.raises(ParameterError, match="a body's pose must be finite"):
+        caster.set_pose(ball, rotation, position)
+    axis = np.array([[1.0, 0.0, 0.0]])
+    assert caster.cast(np.zeros(3), axis).range_m[0] == pytest.approx(2.0)  # kept its pose
 
 
 def test_from_inside_a_solid_nothing_of_it_is_seen():

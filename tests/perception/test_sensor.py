@@ -26,6 +26,11 @@ from uvms_pin.physics.world.objects import plane
         ),
         (SonarSpec, {"bins": 8193}, "sonar 'c': bins must be an integer in [1, 8192], got 8193"),
         (
+            CameraSpec,
+            {"width": True},
+            "camera 'c': width must be an integer in [1, 8192], got True",
+        ),
+        (
             SonarSpec,
             {"rays_per_beam": 1025},
             "sonar 'c': rays_per_beam must be an integer in [1, 1024], got 1025",
@@ -45,6 +50,15 @@ from uvms_pin.physics.world.objects import plane
 def test_a_count_or_field_of_view_out_of_range_is_refused_in_full(spec, changes, message):
     with pytest.raises(ParameterError, match=f"^{re.escape(message)}$"):
         spec("c", **changes)
+
+
+def test_a_count_given_as_a_numpy_integer_is_taken_as_the_int_it_is():
+    """``width=np.int64(64)`` (a size computed with numpy): 64, stored as an int (it was
+    refused as "must be an integer ..., got 64")."""
+    camera = CameraSpec("c", width=np.int64(64), height=np.uint16(48))
+    sonar = SonarSpec("s", beams=np.int32(16))
+    assert (camera.width, camera.height, sonar.beams) == (64, 48, 16)
+    assert type(camera.width) is int and type(sonar.beams) is int
 
 
 def test_the_largest_counts_and_widest_fields_of_view_are_accepted():

@@ -135,6 +135,26 @@ def test_images_that_would_not_fit_in_memory_are_refused_before_the_run():
         simulate(scenario, progress=False)
 
 
+def test_a_camera_faster_than_the_log_is_counted_at_the_logs_rate_before_the_run(
+    monkeypatch,
+):
+    """A 320 x 240 camera asked for 5000 Hz over 12 s fires at the 50 Hz log: 601 images,
+    415 MB, not the 60,001 its rate would make (41 GB: a legal run was refused). A camera
+    without a log period given is counted at its rate."""
+    from uvms_pin.perception import suite
+    from uvms_pin.perception.camera import CameraSpec
+
+    counted = []
+    monkeypatch.setattr(suite, "check_memory", lambda size, what, how: counted.append(size))
+    spec = suite.PerceptionSpec((("camera", CameraSpec("front", rate_hz=5000.0)),))
+    model = _scenario().uvms.model
+    with pytest.warns(PerceptionWarning, match="fires at logged samples: at 50 Hz"):
+        suite.check_mounts(spec, model, 12.0, 0.02)
+    assert counted == [601 * 320 * 240 * 9]
+    suite.check_mounts(spec, model, 12.0, None)  # no log period given: the rate's count
+    assert counted[-1] == 60001 * 320 * 240 * 9
+
+
 def test_the_sensors_are_cast_on_the_plants_backend_with_the_same_images(monkeypatch):
     """`simulate` builds the sensors' scene once, on the plant's backend ([integrator]
     backend); the compiled caster's images are the Python reference's over the same log."""

@@ -14,13 +14,14 @@ seeded Gaussian noise of ``noise_counts`` (8-bit counts, the run's seed; drawn b
 from __future__ import annotations
 
 import math
+import warnings
 from dataclasses import dataclass, field
 from functools import cached_property
 from typing import Any
 
 import numpy as np
 
-from uvms_pin.errors import ParameterError
+from uvms_pin.errors import ParameterError, PerceptionWarning
 from uvms_pin.perception import sensor
 from uvms_pin.perception.caster import Bundles
 from uvms_pin.perception.compiled_camera import CompiledPixels
@@ -207,12 +208,20 @@ def tiles(spec: CameraSpec) -> tuple[np.ndarray, np.ndarray]:
     return blocks[kept], np.concatenate([[0], np.cumsum(np.count_nonzero(kept, axis=1))])
 
 
+def _keys_of(name: str) -> tuple[str, str]:
+    """The names a label answers to in a camera's ``reflectance``: its own (a free object's
+    pieces ``rock#2`` answering to ``rock``) and its link's (``tool/collision[0]``: a link's
+    piece named after its collision geometry answering to ``tool``)."""
+    base = name.split("#")[0]
+    return base, base.split("/")[0]
+
+
 def reflectance_of(names: list[str], given: dict[str, tuple], planes: set[str]) -> np.ndarray:
     """(labels + 1, 3): row k the reflectance of label k (row 0: nothing met)."""
     rows = [(0.0, 0.0, 0.0)]
     for name in names:
-        base = name.split("#")[0]
-        rows.append(given.get(base, SAND if base in planes else OTHER))
+        base, link = _keys_of(name)
+        rows.append(given.get(base, given.get(link, SAND if base in planes else OTHER)))
     return np.asarray(rows, dtype=float)
 
 
@@ -236,9 +245,19 @@ class Camera(sensor.Mounted):
         self._bundles = Bundles.of(self._tiled, starts)
         self.optics = spec.optics
         robot = {*scene.robot_names, *scene.other_robot_names}
+        answered = {key for name in scene.names for key in _keys_of(name)}
+        unknown = sorted(set(spec.reflectance) - answered - set(scene.fixture_names))
+        if unknown:  # a typo would leave its colour the default, silently
+            warnings.warn(
+                f"camera '{spec.name}': reflectance of {', '.join(map(repr, unknown))}, which "
+                f"no label of the scene answers to (its labels: {', '.join(scene.names)})",
+                PerceptionWarning,
+                stacklevel=2,
+            )
         given = dict(spec.reflectance)
-        for name in robot:
-            given.setdefault(name, ROBOT)
+        for name in robot:  # the robots' colour, unless given by the label or its link
+            if not any(key in given for key in _keys_of(name)):
+                given[name] = ROBOT
         for label, fixture in scene.fixture_of.items():  # a fixture's colour: all its links'
             if fixture in given:
                 given.setdefault(label, given[fixture])

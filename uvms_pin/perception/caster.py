@@ -16,6 +16,7 @@ from typing import Protocol
 
 import numpy as np
 
+from uvms_pin.errors import ParameterError
 from uvms_pin.perception.shapes import Plane
 
 __all__ = ["Bundles", "Hits", "RayCaster", "Shape"]
@@ -69,7 +70,10 @@ class RayCaster:
         return len(self.names) - 1
 
     def set_pose(self, index: int, rotation: np.ndarray, position_m: np.ndarray) -> None:
-        """Body ``index`` now at (R (3, 3), p (3,)) in the world."""
+        """Body ``index`` now at (R (3, 3), p (3,)) in the world (ParameterError for a
+        non-finite one: a state that diverged, which would give images of NaN silently)."""
+        if not (np.isfinite(rotation).all() and np.isfinite(position_m).all()):
+            raise ParameterError("a body's pose must be finite")
         self._rotations[index] = rotation
         self._positions[index] = position_m
 

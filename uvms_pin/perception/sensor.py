@@ -177,13 +177,16 @@ def check_mount(spec: Any, label: str) -> None:
 
 def check_counts(spec: Any, label: str, most: Mapping[str, int]) -> None:
     """ParameterError unless each field of ``spec`` named in ``most`` (pixels, beams, bins,
-    rays) is an integer from 1 to its entry there."""
+    rays) is an integer from 1 to its entry there (a numpy integer is taken as the int it
+    is, written back; a bool is not a count)."""
     for key, largest in most.items():
         value = getattr(spec, key)
-        if not (isinstance(value, int) and 1 <= value <= largest):
+        whole = isinstance(value, int | np.integer) and not isinstance(value, bool | np.bool_)
+        if not (whole and 1 <= value <= largest):
             raise ParameterError(
-                f"{label}: {key} must be an integer in [1, {largest}], got {value}"
+                f"{label}: {key} must be an integer in [1, {largest}], got {value!r}"
             )
+        object.__setattr__(spec, key, int(value))
 
 
 def check_fields_of_view(spec: Any, label: str, keys: tuple[str, ...]) -> None:

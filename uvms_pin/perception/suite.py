@@ -70,11 +70,15 @@ def check_mounts(
     """Before a run, not after it: ParameterError naming the sensor and its ``link`` when the
     robot's model has no such frame, or when the images of ``duration_s`` [s] would not fit
     in memory; a `PerceptionWarning` for a sensor faster than the log of ``log_period_s``
-    [s] (it fires at logged samples: on the log's grid, `firing_rows`)."""
+    [s] (it fires at logged samples: on the log's grid, `firing_rows`; its images counted
+    so, at most one a logged sample)."""
     total = 0.0
     for kind_name, own in spec.sensors:
         mount_frame(model, own.link, f"{kind_name} '{own.name}'")
-        total += (math.floor(duration_s * own.rate_hz) + 1) * SENSORS[kind_name].bytes(own)
+        firings = math.floor(duration_s * own.rate_hz) + 1
+        if log_period_s is not None:  # one firing a logged sample at the most
+            firings = min(firings, math.floor(duration_s / log_period_s + 1e-9) + 1)
+        total += firings * SENSORS[kind_name].bytes(own)
         if log_period_s is not None and own.rate_hz * log_period_s > 1.0 + 1e-9:
             warnings.warn(
                 f"{kind_name} '{own.name}' fires at logged samples: at {1.0 / log_period_s:g} "

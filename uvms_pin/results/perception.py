@@ -63,10 +63,15 @@ class SonarRecord:
 
 def _arrays(perception: dict, metadata: dict, name: str, kind: str) -> dict[str, np.ndarray]:
     described = metadata.get("perception", {}).get(name)
-    if name not in perception or described is None or described.get("kind") != kind:
+    if described is None or described.get("kind") != kind:
         known = [n for n, d in metadata.get("perception", {}).items() if d.get("kind") == kind]
         raise ParameterError(
             f"this rollout has no {kind} '{name}' (its {kind}s: {', '.join(known) or 'none'})"
+        )
+    if name not in perception:  # the run had it: its images were not saved or not found
+        raise ParameterError(
+            f"this rollout's {kind} '{name}' has no images: they are kept in {FILE} beside "
+            "rollout.npz, which was not found when it was loaded (copy it with the rollout)"
         )
     return perception[name]
 

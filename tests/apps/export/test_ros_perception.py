@@ -176,6 +176,26 @@ def test_two_sensors_of_one_ros_name_are_refused_naming_both(saved, tmp_path):
     check_bag(rollout, read_bag(rollout.to_mcap(tmp_path / "run.mcap")))  # apart: exported
 
 
+def test_a_run_whose_images_were_not_found_says_so_on_read_and_on_export(saved, tmp_path):
+    """Its perception.npz not copied with it: ``camera(name)`` says the images were not
+    found (it said the run had no such camera, naming it among its cameras), and the
+    export warns that it leaves them out (it was silent)."""
+    import shutil
+
+    from uvms_pin.errors import ParameterError, PerceptionWarning
+
+    copied = tmp_path / "copied"
+    shutil.copytree(saved, copied)
+    (copied / "perception.npz").unlink()
+    rollout = Rollout.load(copied)
+    with pytest.raises(ParameterError, match=r"camera 'wrist' has no images: .*perception.npz"):
+        rollout.camera("wrist")
+    with pytest.raises(ParameterError, match=r"has no camera 'lens' \(its cameras: wrist\)"):
+        rollout.camera("lens")
+    with pytest.warns(PerceptionWarning, match=r"'profiler', 'wrist' left out of the bag"):
+        rollout.to_mcap(tmp_path / "run.mcap")
+
+
 def test_a_sensor_name_becomes_a_ros_name():
     """ROS names are letters, digits and underscores, not starting with a digit."""
     assert ros_name("front") == "front"

@@ -23,6 +23,7 @@ before its metadata kept the sensors' specs has none of these topics.
 
 from __future__ import annotations
 
+import warnings
 from collections.abc import Iterator
 from typing import Any
 
@@ -30,8 +31,9 @@ import numpy as np
 import pinocchio as pin
 
 from uvms_pin.apps.export.ros_messages import header, stamp_ns, transform
-from uvms_pin.errors import VizError
+from uvms_pin.errors import PerceptionWarning, VizError
 from uvms_pin.perception.camera import CameraSpec
+from uvms_pin.results.perception import FILE
 from uvms_pin.results.signal import component_label
 
 __all__ = ["PerceptionTopics", "altimeter_range", "camera_info", "laser_scan", "ros_name"]
@@ -162,6 +164,14 @@ class PerceptionTopics:
             for name, about in described.items()
             if name in rollout.perception and "spec" in about and "frame" in about
         ]
+        unseen = [name for name in described if name not in rollout.perception]
+        if unseen:  # the bag is written without them: said, not silently
+            warnings.warn(
+                f"the run's {', '.join(map(repr, unseen))} left out of the bag: no images "
+                f"loaded ({FILE} was not found beside rollout.npz)",
+                PerceptionWarning,
+                stacklevel=2,
+            )
         tokens: dict[str, str] = {}  # ROS name -> the sensor's own
         for name, _ in self.sensors:
             other = tokens.setdefault(ros_name(name), name)
