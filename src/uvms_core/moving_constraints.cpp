@@ -54,6 +54,10 @@ const Data& CoupledConstraintStep::side_data(const SystemAtStart& at, int side) 
   return k < at.objects.size() ? *at.objects[k] : *at.fixtures[k - at.objects.size()].data;
 }
 
+bool CoupledConstraintStep::free_object(const SystemAtStart& at, int side) {
+  return side >= 0 && static_cast<std::size_t>(side) < at.objects.size();
+}
+
 Eigen::MatrixXd CoupledConstraintStep::side_jacobian(const SystemAtStart& at, int side,
                                                      const ContactShape& piece,
                                                      const Vec3& x) const {
@@ -101,10 +105,15 @@ void CoupledConstraintStep::add_pair_rows(const SystemAtStart& at, const Eigen::
       if (apart >= piece_a.bound_radius_m + piece_b.bound_radius_m + h * closing + margin) {
         continue;
       }
-      // the pair's candidates (moving_contacts.py's _candidates): a contact patch's vertices
-      // or coal's one point, each solved when its gap can close within the period
+      // the pair's candidates (moving_contacts.py's _candidates): between two free objects a
+      // contact patch's vertices (a crate resting on a crate), else coal's one point; each
+      // solved when its gap can close within the period
       patch_.clear();
-      patch_candidates(piece_a, where_a, piece_b, where_b, ia, ib, h * closing + margin, patch_);
+      if (free_object(at, set.a) && free_object(at, set.b)) {
+        patch_candidates(piece_a, where_a, piece_b, where_b, ia, ib, h * closing + margin, patch_);
+      } else {
+        patch_.push_back(coal_candidate(piece_a, where_a, piece_b, where_b, ia, ib));
+      }
       for (const ContactCandidate& point : patch_) {
         const Eigen::MatrixXd relative = side_jacobian(at, set.a, piece_a, point.point) -
                                          side_jacobian(at, set.b, piece_b, point.point);

@@ -126,6 +126,8 @@ class CoupledConstraintStep {
     Eigen::Matrix3d frame;
   };
   std::vector<ContactCandidate> patch_;  // one pair's candidates (add_pair_rows' scratch)
+  // whether side is a free object (not the robot, -1, nor a fixture, after the objects)
+  static bool free_object(const SystemAtStart& at, int side);
   int select(const SystemAtStart& at, const Eigen::VectorXd& speed, double h);
   void add_pair_rows(const SystemAtStart& at, const Eigen::VectorXd& speed, double h);
   // The world velocity Jacobian (3 x nv) of side's material point at x, and a bound on the

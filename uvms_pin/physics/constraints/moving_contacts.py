@@ -5,11 +5,14 @@ arm link and its own vehicle) as rigid point contacts with the Coulomb cone (Pin
 
 Each pair (a, b) of pieces of a pair set (`uvms_pin.physics.world.moving`: the sets'
 pairs, their friction and their memories) that can touch within the period has its
-candidates (`gaps.patch_candidates`, b posed as an object): coal's signed distance between
-the two shapes, its nearest point x on a, the normal n out of b towards a and the gap r [m]
-(< 0 inside); or, where two solids meet along a face or an edge, the vertices x of coal's
-contact patch, each with the patch's normal and gap. Each point's three rows in the frame
-C = (t1, t2, n) are
+candidates (b posed as an object): coal's signed distance between the two shapes, its
+nearest point x on a, the normal n out of b towards a and the gap r [m] (< 0 inside); or,
+between two free objects that meet along a face or an edge (a crate resting on a crate),
+the vertices x of coal's contact patch, each with the patch's normal and gap
+(`gaps.patch_candidates`). A robot's and a fixture's pairs keep the one point: with patches
+the shipped hot_stab's rigid grasp and insertion (a cylinder between two jaws, then in its
+receptacle) stalled its solves until one did not settle, and ran 2.3x slower. Each point's
+three rows in the frame C = (t1, t2, n) are
 
     J v = C^T (J_a(x) - J_b(x)) v      the velocity of a's material point at x relative to
                                        b's there [m/s]: tangential (two rows), normal,
@@ -45,7 +48,7 @@ from uvms_pin.physics.constraints.contacts import (
 )
 from uvms_pin.physics.constraints.object_contacts import SLIP_M_S
 from uvms_pin.physics.constraints.rows import ConstraintRows
-from uvms_pin.physics.world.gaps import Candidate, patch_candidates
+from uvms_pin.physics.world.gaps import Candidate, coal_candidate, patch_candidates
 from uvms_pin.physics.world.objects import WorldObject
 from uvms_pin.physics.world.pairs import PairContacts, PiecePairs
 from uvms_pin.physics.world.robot_geometry import RobotPiece
@@ -127,6 +130,7 @@ class MovingPairContacts:
         if not (math.isfinite(margin) and margin >= 0.0):
             raise ParameterError(f"the contacts' margin must be >= 0 [m], got {margin}")
         self.sets, self.margin, self.name = tuple(sets), float(margin), name
+        self._fixtures = fixtures
         self._pieces = [
             (
                 _on_joint(s.pairs.pieces_a, s.a, first_object_joint, fixtures),
@@ -141,10 +145,13 @@ class MovingPairContacts:
         """The contacts at q that can close within ``period_s`` at ``speed``
         (`ConstraintSet.rows`): three rows per contact (t1, t2, n)."""
         evaluated_contacts, solved = [], []
+        patches = [self._free(p.a) and self._free(p.b) for p in self.sets]
         for s, pair_set in enumerate(self.sets):
             pieces_a, pieces_b = self._pieces[s]
             for k, (ia, ib) in enumerate(pair_set.pairs.pairs):
-                found = self._candidates(model, data, speed, period_s, pieces_a[ia], pieces_b[ib])
+                found = self._candidates(
+                    model, data, speed, period_s, pieces_a[ia], pieces_b[ib], patches[s]
+                )
                 for point in found:
                     point = dataclasses.replace(point, piece=ia, obj=ib)
                     joints = (pieces_a[ia].joint_id, pieces_b[ib].joint_id)
@@ -159,6 +166,12 @@ class MovingPairContacts:
         labels = [self.sets[c.set].pairs.names[c.pair] for c in solved]
         return contact_rows(self.name, model.nv, evaluated_contacts, gaps, labels, solved)
 
+    def _free(self, side: int) -> bool:
+        """Whether ``side`` is a free object (not the robot, -1, nor a fixture, after the
+        free objects)."""
+        n_objects, fixture_joints = self._fixtures
+        return side >= 0 and (side < n_objects or not fixture_joints)
+
     def _candidates(
         self,
         model: pin.Model,
@@ -167,9 +180,11 @@ class MovingPairContacts:
         period_s: float,
         piece_a: RobotPiece,
         piece_b: RobotPiece,
+        patch: bool,
     ) -> list[Candidate]:
-        """The pair's candidates (`gaps.patch_candidates`: a contact patch's vertices, or
-        coal's one point) whose gaps can close within the period."""
+        """The pair's candidates whose gaps can close within the period: with ``patch``
+        (two free objects) `gaps.patch_candidates` (a contact patch's vertices, or coal's
+        one point), else coal's one point."""
         where_a = data.oMi[piece_a.joint_id] * piece_a.placement_in_joint
         where_b = data.oMi[piece_b.joint_id] * piece_b.placement_in_joint
         apart = np.linalg.norm(where_a.translation - where_b.translation)
@@ -180,7 +195,12 @@ class MovingPairContacts:
             return []
         obstacle = WorldObject("b", "piece", piece_b.shape, where_b, 0.0, 0.0, 0.0)
         out = []
-        for point in patch_candidates(0, 0, piece_a, where_a, obstacle, reach):
+        found = (
+            patch_candidates(0, 0, piece_a, where_a, obstacle, reach)
+            if patch
+            else [coal_candidate(0, 0, piece_a, where_a, obstacle)]
+        )
+        for point in found:
             relative = point_jacobian(model, data, piece_a.joint_id, point.point_world_m)
             relative -= point_jacobian(model, data, piece_b.joint_id, point.point_world_m)
             normal_rate = point.normal_world @ relative
