@@ -144,10 +144,12 @@ def test_a_planted_light_object_is_refused_before_the_run_naming_it():
     step_s = scenario.settings.integrator.step_s  # the scenario's own step
     assert error.step_s == step_s and error.largest_stable_step_s < step_s
     assert error.mode.stiffness == 2.0e4
-    # in water: its mass and its added mass (rho V / 2), against the heavy box (its
-    # mobility adds a little: the pair's 1/m_eff is the sum of both sides')
+    # in water: its mass and its added mass (rho V / 2); the stiffest of its modes is
+    # its friction's stick spring (c_t = 200 N s/m) against the lighter of what it
+    # touches (the pair's 1/m_eff is the sum of both sides': at most the pebble's)
     added = 0.5 * scenario.uvms.water_density_kg_m3 * 4.0 / 3.0 * math.pi * 0.01**3
-    assert 0.999 * (1e-3 + added) < error.mode.mass < 1e-3 + added
+    assert error.mode.what.endswith("its friction's stick spring")
+    assert 0.99 * (1e-3 + added) < error.mode.mass < 1e-3 + added
     for text in ("k = 2e+04 N/m", "m_eff =", f"{step_s:g} s", "largest stable step"):
         assert text in str(error)
     # a 1 kg stone there is accepted
@@ -215,18 +217,23 @@ def test_every_shipped_scenario_is_accepted_at_its_defaults(path):
 
 def test_the_rollout_records_the_stiffest_mode_and_its_margin():
     """seabed_landing's closest mode: the Alpha 5's jaw against the seabed and the rock,
-    at first touch (its most mobile corner: 0.82 kg with the drives' armature), 36.3x its
-    0.5 ms step."""
+    its friction's stick spring (k_t = 2e4 N/m, c_t = 200 N s/m; its most mobile corner:
+    0.82 kg with the drives' armature), 35.6x its 0.5 ms step (its normal mode at first
+    touch, 36.3x, is the next)."""
     scenario = load_scenario(SCENARIOS / "seabed_landing.toml", {"scenario.duration_s": 0.1})
     record = simulate(scenario, progress=False).metadata["stiff_modes"]
     assert record["checked"] and record["integrator"] == "RK4" and record["step_s"] == 5e-4
     stiffest = record["stiffest"]
     assert "link 'alpha_jaw_link' against the fixed world" in stiffest["what"]
-    assert stiffest["stiffness"] == 2.0e4 and stiffest["damping"] == 0.0
+    assert stiffest["what"].endswith("its friction's stick spring")
+    assert stiffest["stiffness"] == 2.0e4 and stiffest["damping"] == 200.0
     assert stiffest["effective_mass"] == pytest.approx(0.823, abs=0.001)
-    omega = math.sqrt(2.0e4 / stiffest["effective_mass"])
-    assert stiffest["largest_stable_step_s"] * omega == pytest.approx(2.0 * math.sqrt(2.0))
-    assert record["margin"] == pytest.approx(36.3, abs=0.1)
+    # its rates: -c / 2m +- i sqrt(k/m - (c / 2m)^2)
+    m = stiffest["effective_mass"]
+    decay, turn = 200.0 / (2.0 * m), math.sqrt(2.0e4 / m - (200.0 / (2.0 * m)) ** 2)
+    rates = sorted((re, abs(im)) for re, im in stiffest["rates_1_s"])
+    assert rates == [pytest.approx((-decay, turn))] * 2
+    assert record["margin"] == pytest.approx(35.6, abs=0.1)
 
 
 def test_the_environment_modes_take_the_end_effectors_mobility():
@@ -354,3 +361,15 @@ def test_a_stiff_fixture_contact_is_refused_naming_the_rigid_remedy():
     loop = ClosedLoop(rigid.plant, rigid.settings)
     modes = system_modes(loop.system, loop.system.initial_state(rigid.q0, rigid.v0))
     assert not any("fixture" in m.what for m in modes)
+
+
+def test_a_jaws_friction_stick_spring_beyond_the_step_is_refused_naming_it():
+    """gripper_close with the contact law's stick-spring damper (200 N s/m) in place of
+    its own 20: a finger of ~13 g gives the damper a rate of ~1.5e4 1/s, beyond RK4 at
+    the 0.5 ms step. Refused before the run (it rang at the step within the friction cone:
+    the held rod was logged spinning about its axis at 0.42 rad/s)."""
+    scenario = load_scenario(
+        SCENARIOS / "gripper_close.toml", {"world.contact.tangential_damping_N_s_m": 200.0}
+    )
+    with pytest.raises(StiffModeError, match=r"finger.*against the free object 'rod', its fr"):
+        simulate(scenario, progress=False)

@@ -25,8 +25,12 @@ rates lambda = -c / (2 m_eff) +- sqrt((c / (2 m_eff))^2 - k / m_eff) [1/s]. Whic
   undamped) and at the working depth delta_w = max(1 mm, 2 |W - B| / k) (c = k d delta_w:
   twice the depth at which one point carries the body's whole net weight, where a step load
   from rest reaches; the start's overlap tolerance, `uvms_pin.physics.world.overlap`). The
-  friction's stick spring (k_t, c_t) is not among them: it holds at most mu f_n, so it
-  cannot diverge on its own (beyond the cone the point slips).
+  friction's stick spring (k_t, c_t) is a third mode of the same m_eff (the tangent can be
+  along any direction too): it holds at most mu f_n, so it cannot diverge, but beyond the
+  step's limit it rings at the step within the cone, a wrong answer that stays bounded (a
+  rod held in the Alpha 5's jaw was logged spinning about its axis at 0.42 rad/s: a
+  finger's m_eff is 13 g, and h c_t / m_eff = 7.4 at the 0.5 ms step, where RK4 keeps
+  2.785).
 - a compliant joint stop (`uvms_pin.physics.joint_stops`) of k_s, c_s on joint j:
   I_eff = 1 / (M^-1)_jj [kg m^2].
 - the end-effector's environment (`uvms_pin.physics.contact`): the plane's k, c along its
@@ -75,6 +79,10 @@ _RIGID_PAIRS = (
     "solved implicitly, stable at any step)"
 )
 _SOFTER_ENV = ", or soften the environment ([environment] stiffness_N_m, damping_N_s_m)"
+_SOFTER_STICK = (
+    ", or soften the friction's stick spring ([world.contact] tangential_stiffness_N_m, "
+    "tangential_damping_N_s_m)"
+)
 ANGULAR = ("N m/rad", "N m s/rad", "kg m^2")
 
 
@@ -197,10 +205,10 @@ def body_mobility(
 def contact_modes(
     what: str, first: Body, second: Body | None, law: ContactLaw, moving: bool = False
 ) -> list[StiffMode]:
-    """The two normal modes of ``first`` against ``second`` (None: the fixed world): at first
-    touch and at the deeper of both bodies' working depth. ``moving``: a pair between moving
-    bodies whose second side is fixed all the same (a fixture's root link), whose remedy is
-    the rigid moving contact."""
+    """The modes of ``first`` against ``second`` (None: the fixed world): the normal ones at
+    first touch and at the deeper of both bodies' working depth, and the friction's stick
+    spring. ``moving``: a pair between moving bodies whose second side is fixed all the
+    same (a fixture's root link), whose remedy is the rigid moving contact."""
     mobility = first.mobility_1_kg + (0.0 if second is None else second.mobility_1_kg)
     if not mobility > 0.0:
         return []
@@ -208,9 +216,17 @@ def contact_modes(
     k, mass = law.stiffness_N_m, 1.0 / mobility
     damping = k * law.dissipation_s_m * depth
     remedy = _SOFTER_CONTACT if second is None and not moving else _RIGID_PAIRS + _SOFTER_CONTACT
+    stick = remedy + _SOFTER_STICK
     return [
         StiffMode(f"{what}, at first touch", k, 0.0, mass, remedy=remedy),
         StiffMode(f"{what}, {depth * 1e3:.3g} mm deep", k, damping, mass, remedy=remedy),
+        StiffMode(
+            f"{what}, its friction's stick spring",
+            law.tangential_stiffness_N_m,
+            law.tangential_damping_N_s_m,
+            mass,
+            remedy=stick,
+        ),
     ]
 
 
