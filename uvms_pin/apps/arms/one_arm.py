@@ -74,7 +74,9 @@ def run_one_arm(
     )
     try:
         _fill_row(row, job)
-    except (UvmsPinError, ScenarioError) as exc:
+    except ScenarioError as exc:  # the scenario's task does not fit this arm
+        row.update(status="scenario error", reason=f"{type(exc).__name__}: {exc}")
+    except UvmsPinError as exc:
         row.update(status="model error", reason=f"{type(exc).__name__}: {exc}")
     except Exception as exc:  # a per-arm bug must not lose the other rows
         row.update(
