@@ -155,6 +155,30 @@ def test_a_camera_faster_than_the_log_is_counted_at_the_logs_rate_before_the_run
     assert counted[-1] == 60001 * 320 * 240 * 9
 
 
+def test_an_in_loop_camera_faster_than_the_control_ticks_is_said_before_the_run(monkeypatch):
+    """Its controller reads it at a tick at the most: 250 Hz asked, 100 Hz read at a 10 ms
+    period, said in a PerceptionWarning (it was silent); a camera not in the loop, or at
+    the ticks' rate, is not."""
+    from uvms_pin.perception import suite
+    from uvms_pin.perception.camera import CameraSpec
+
+    monkeypatch.setattr(suite, "check_memory", lambda size, what, how: None)
+    model = _scenario().uvms.model
+    fast = CameraSpec("eye", rate_hz=250.0, in_loop=True)
+    with pytest.warns(PerceptionWarning, match=r"'eye' is read by the controller at its ticks: "
+                      r"at 100 Hz at the most, not its rate_hz = 250"):  # fmt: skip
+        suite.check_mounts(suite.PerceptionSpec((("camera", fast),)), model, 1.0, None, 0.01)
+    import warnings
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        for spec in (
+            CameraSpec("eye", rate_hz=250.0),
+            CameraSpec("eye", rate_hz=100.0, in_loop=True),
+        ):
+            suite.check_mounts(suite.PerceptionSpec((("camera", spec),)), model, 1.0, None, 0.01)
+
+
 def test_the_sensors_are_cast_on_the_plants_backend_with_the_same_images(monkeypatch):
     """`simulate` builds the sensors' scene once, on the plant's backend ([integrator]
     backend); the compiled caster's images are the Python reference's over the same log."""

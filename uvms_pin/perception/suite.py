@@ -65,13 +65,18 @@ class PerceptionSpec:
 
 
 def check_mounts(
-    spec: PerceptionSpec, model: Any, duration_s: float = 0.0, log_period_s: float | None = None
+    spec: PerceptionSpec,
+    model: Any,
+    duration_s: float = 0.0,
+    log_period_s: float | None = None,
+    control_period_s: float | None = None,
 ) -> None:
     """Before a run, not after it: ParameterError naming the sensor and its ``link`` when the
     robot's model has no such frame, or when the images of ``duration_s`` [s] would not fit
     in memory; a `PerceptionWarning` for a sensor faster than the log of ``log_period_s``
     [s] (it fires at logged samples: on the log's grid, `firing_rows`; its images counted
-    so, at most one a logged sample)."""
+    so, at most one a logged sample), and for an ``in_loop`` sensor faster than the control
+    ticks of ``control_period_s`` [s] (its controller reads it at a tick at the most)."""
     total = 0.0
     for kind_name, own in spec.sensors:
         mount_frame(model, own.link, f"{kind_name} '{own.name}'")
@@ -79,6 +84,15 @@ def check_mounts(
         if log_period_s is not None:  # one firing a logged sample at the most
             firings = min(firings, math.floor(duration_s / log_period_s + 1e-9) + 1)
         total += firings * SENSORS[kind_name].bytes(own)
+        ticks = control_period_s
+        if getattr(own, "in_loop", False) and ticks and own.rate_hz * ticks > 1.0 + 1e-9:
+            warnings.warn(
+                f"{kind_name} '{own.name}' is read by the controller at its ticks: at "
+                f"{1.0 / ticks:g} Hz at the most, not its rate_hz = {own.rate_hz:g} "
+                f"(control.period_s = {ticks:g} s)",
+                PerceptionWarning,
+                stacklevel=2,
+            )
         if log_period_s is not None and own.rate_hz * log_period_s > 1.0 + 1e-9:
             warnings.warn(
                 f"{kind_name} '{own.name}' fires at logged samples: at {1.0 / log_period_s:g} "

@@ -137,6 +137,7 @@ def run_parts(
         scenario.uvms.model,
         settings.duration_s,
         settings.log_period_s,
+        settings.control_period_s,
     )
     sensors = SensorSuite(
         scenario.uvms.model, scenario.sensor_config, settings.duration_s, settings.seed
