@@ -78,6 +78,30 @@ def test_the_altimeter_reads_its_distance_to_the_seabed(reference_uvms, altitude
     assert np.isnan(nothing["beam_range_m"][0]) and nothing["beam_intensity"][0] == 0.0
 
 
+def test_the_altimeters_cone_is_round_over_a_slope_steeper_than_it(reference_uvms):
+    """Its rays all within the cone's half-angle, so a slope steeper than the cone (0.3 rad
+    against 0.22) reads alike whichever way it faces: the nearest the cone hears,
+    d / cos(slope - half), to the rays' spacing. Its rays were a square grid of bearings and
+    elevations, its corners 17 degrees off the axis of a 12.6 degree cone: facing the
+    diagonal the slope read its perpendicular distance, 0.4 % nearer."""
+    slope = 0.3
+    readings = []
+    for azimuth in (0.0, np.pi / 4, np.pi / 2, 3 * np.pi / 4):
+        normal = [np.sin(slope) * np.cos(azimuth), np.sin(slope) * np.sin(azimuth), np.cos(slope)]
+        seabed = plane("seabed", [0.0, 0.0, -24.0], normal, 0.5, 0.4)
+        spec = SonarSpec("alt", type="altimeter", rpy_rad=(0.0, np.pi / 2, 0.0), speckle=False,
+                         range_noise_m=0.0)  # fmt: skip
+        sonar = Sonar(spec, _scene(reference_uvms, [seabed]), np.random.default_rng(0))
+        off_axis = np.arccos(np.clip(sonar.rays[:, 0], -1.0, 1.0))
+        assert off_axis.max() <= 0.5 * spec.horizontal_fov_rad + 1e-12
+        readings.append(sonar.fire()["beam_range_m"][0])
+    distance = 4.0 * np.cos(slope)  # from the sonar's origin to the plane, along its normal
+    nearest = distance / np.cos(slope - 0.5 * spec.horizontal_fov_rad)
+    assert np.ptp(readings) < 2e-4
+    np.testing.assert_allclose(readings, nearest, rtol=1e-3)
+    assert min(readings) >= nearest
+
+
 def test_an_altimeter_by_its_type_alone_has_one_narrow_beam_and_hears_the_seabed(
     reference_uvms,
 ):

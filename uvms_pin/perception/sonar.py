@@ -5,7 +5,8 @@ The sonar's frame sits at ``position_m``, ``rpy_rad`` in its ``link`` (default: 
 body), x along its acoustic axis, y to port, z up. An ``imaging`` sonar has ``beams`` beams at
 bearings spread evenly over ``horizontal_fov_rad`` (about z, positive to port); each beam is
 sampled by ``rays_per_beam`` rays over its ``vertical_fov_rad`` fan. An ``altimeter`` has one
-beam, a cone of ``horizontal_fov_rad`` sampled by ``rays_per_beam``^2 rays. A ray that meets a
+beam, a cone of ``horizontal_fov_rad`` sampled by the rays of a ``rays_per_beam`` x
+``rays_per_beam`` grid of bearings and elevations that lie within it (about pi / 4 of them). A ray that meets a
 surface at range r with incidence theta (to its normal) returns, into the range bin of r,
 
     mu cos^2(theta) w(e) 10^(-2 alpha r / 10) / r^2
@@ -133,6 +134,10 @@ def _fan(spec: SonarSpec) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     if spec.type == "altimeter":
         half = 0.5 * spec.horizontal_fov_rad
         bearing, elevation = (g.ravel() for g in np.meshgrid(half * across, half * across))
+        # the cone: the grid's rays within half of the axis (its corners, up to sqrt(2) half
+        # off, heard a slope facing the diagonal nearer than the cone can)
+        inside = np.cos(bearing) * np.cos(elevation) >= math.cos(half) * (1.0 - 1e-12)
+        bearing, elevation = bearing[inside], elevation[inside]
         beam = np.zeros(bearing.size, dtype=np.int64)
         weight = np.exp(-((bearing**2 + elevation**2) / half**2) * math.log(2.0))
     else:
