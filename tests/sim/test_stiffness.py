@@ -373,3 +373,24 @@ def test_a_jaws_friction_stick_spring_beyond_the_step_is_refused_naming_it():
     )
     with pytest.raises(StiffModeError, match=r"finger.*against the free object 'rod', its fr"):
         simulate(scenario, progress=False)
+
+
+def test_a_contacts_modes_are_named_as_what_the_check_assumes_not_as_found():
+    """Two objects 2 m apart are checked as if they touched: the damped mode says the depth
+    is an assumption ("should it press ... (its working depth)"; it read "167 mm deep", as if
+    they overlapped); the third mode is the friction's stick spring, its k_t and c_t."""
+    from uvms_pin.physics.world.contact_law import ContactLaw
+    from uvms_pin.sim.stiff_modes import Body, contact_modes
+
+    law = ContactLaw()
+    first, second = Body("a", 1.0 / 3.0, 0.167), Body("b", 0.5, 0.001)
+    touch, pressed, stick = contact_modes("a against b", first, second, law, moving=True)
+    assert touch.what == "a against b, at first touch" and touch.damping == 0.0
+    assert pressed.what == "a against b, should it press 167 mm deep (its working depth)"
+    assert pressed.damping == pytest.approx(law.stiffness_N_m * law.dissipation_s_m * 0.167)
+    assert stick.what == "a against b, its friction's stick spring"
+    assert (stick.stiffness, stick.damping) == (
+        law.tangential_stiffness_N_m,
+        law.tangential_damping_N_s_m,
+    )
+    assert touch.mass == pressed.mass == stick.mass == pytest.approx(1.0 / (1 / 3 + 0.5))

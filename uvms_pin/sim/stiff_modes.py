@@ -219,7 +219,14 @@ def contact_modes(
     stick = remedy + _SOFTER_STICK
     return [
         StiffMode(f"{what}, at first touch", k, 0.0, mass, remedy=remedy),
-        StiffMode(f"{what}, {depth * 1e3:.3g} mm deep", k, damping, mass, remedy=remedy),
+        # a depth the check assumes, not one found: the pair may be far apart at the start
+        StiffMode(
+            f"{what}, should it press {depth * 1e3:.3g} mm deep (its working depth)",
+            k,
+            damping,
+            mass,
+            remedy=remedy,
+        ),
         StiffMode(
             f"{what}, its friction's stick spring",
             law.tangential_stiffness_N_m,
