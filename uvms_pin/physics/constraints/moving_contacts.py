@@ -10,9 +10,10 @@ nearest point x on a, the normal n out of b towards a and the gap r [m] (< 0 ins
 between two free objects that meet along a face or an edge (a crate resting on a crate),
 the vertices x of coal's contact patch, each with the patch's normal and gap
 (`gaps.patch_candidates`). A robot's and a fixture's pairs keep the one point: with patches
-the shipped hot_stab's rigid grasp and insertion (a cylinder between two jaws, then in its
-receptacle) stalled its solves until one did not settle, and ran 2.3x slower. Each point's
-three rows in the frame C = (t1, t2, n) are
+on every pair the shipped hot_stab's rigid grasp and insertion (a cylinder between two jaws,
+then in its receptacle) stalled its solves until one did not settle, and with the fixture's
+pairs alone patched it ran 2.3x slower. Each point's three rows in the frame C = (t1, t2, n)
+are
 
     J v = C^T (J_a(x) - J_b(x)) v      the velocity of a's material point at x relative to
                                        b's there [m/s]: tangential (two rows), normal,
