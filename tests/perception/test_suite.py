@@ -179,6 +179,29 @@ def test_an_in_loop_camera_faster_than_the_control_ticks_is_said_before_the_run(
             suite.check_mounts(suite.PerceptionSpec((("camera", spec),)), model, 1.0, None, 0.01)
 
 
+def test_a_sensor_above_the_free_surface_is_said_after_the_run():
+    """A camera on a 12 m mast above the vehicle 9.5 m down: in the air at every firing. Its
+    images are formed as under water (the model has no air), which a PerceptionWarning now
+    says, with how many firings and the first's time (it was silent); the same camera below
+    the surface, or a sonar there, says nothing."""
+    import warnings
+
+    def with_surface(sensors):
+        raw = read_toml(SEABED, ScenarioError)
+        raw["scenario"].update(duration_s=0.2, seed=7)
+        raw["water"]["free_surface"] = True  # seabed_landing's is off (10 m down)
+        raw["sensors"] = copy.deepcopy(sensors)
+        return scenario_from_dict(raw, SEABED)
+
+    mast = {**CAMERA, "position_m": [0.0, 0.0, 12.0]}
+    with pytest.warns(PerceptionWarning, match=r"camera 'front' was above the free surface at "
+                      r"3 of its 3 firings \(the first at t = 0 s\)"):  # fmt: skip
+        simulate(with_surface({"camera": [mast]}), progress=False)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", PerceptionWarning)
+        simulate(with_surface({"camera": [CAMERA], "sonar": [SONAR]}), progress=False)
+
+
 def test_the_sensors_are_cast_on_the_plants_backend_with_the_same_images(monkeypatch):
     """`simulate` builds the sensors' scene once, on the plant's backend ([integrator]
     backend); the compiled caster's images are the Python reference's over the same log."""

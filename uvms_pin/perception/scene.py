@@ -123,6 +123,8 @@ class Scene:
         self.caster: RayCaster = caster_for(backend)
         self.data = uvms.model.createData()
         add_objects(self.caster, objects)
+        #: whether the free surface z = 0 is in the scene (a sensor above it is in the air)
+        self.has_surface = bool(surface)
         if surface:
             self.caster.add(SURFACE, Plane(), _FACING_DOWN, np.zeros(3))
         names = _link_names(uvms)

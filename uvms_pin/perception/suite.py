@@ -181,7 +181,15 @@ def perceive(
         kind = SENSORS[kind_name]
         sensor = kind.make(own, scene, np.random.default_rng(stream))
         rows = firing_rows(rollout.time_s, own.rate_hz)
-        fired = _fire(sensor, scene, log, rows)
+        fired, above = _fire(sensor, scene, log, rows)
+        if above:  # its images and echoes are formed as in water: said, not silently
+            warnings.warn(
+                f"{kind_name} '{own.name}' was above the free surface at {len(above)} of its "
+                f"{len(rows)} firings (the first at t = {rollout.time_s[above[0]]:g} s): what "
+                "it recorded there is formed as if under water",
+                PerceptionWarning,
+                stacklevel=2,
+            )
         rollout.perception[own.name] = {
             "time_s": rollout.time_s[rows].copy(),
             **fired,
@@ -215,16 +223,22 @@ def stack_of(shape: tuple[int, ...], dtype: np.dtype) -> np.ndarray:
     return raw[skip : skip + size].view(dtype).reshape(shape)
 
 
-def _fire(sensor: Any, scene: Scene, log: SceneLog, rows: Sequence[int]) -> dict[str, np.ndarray]:
-    """The sensor's arrays at each of ``rows``, stacked (`stack_of`): the first firing's
+def _fire(
+    sensor: Any, scene: Scene, log: SceneLog, rows: Sequence[int]
+) -> tuple[dict[str, np.ndarray], list[int]]:
+    """The sensor's arrays at each of ``rows``, stacked (`stack_of`), and the rows it fired
+    at from above the free surface (in the air): the first firing's
     arrays give the stack's; each later firing is written into those same arrays, warm in
     the cache, then copied into its place in order (a camera writes its pixels tile by
     tile, which straight into memory not yet touched cost more than the copy:
     `benchmarks/bench_perception.py`'s camera run 1.82-1.84x -> 1.72-1.73x)."""
     stacked: dict[str, np.ndarray] = {}
     warm: dict[str, np.ndarray] = {}
+    above = []  # the firings from above the free surface (in the air)
     for k, row in enumerate(rows):
         log.pose(scene, row)
+        if scene.has_surface and sensor.placement().translation[2] > 0.0:
+            above.append(row)
         if k == 0:
             warm = sensor.fire()
             for key, value in warm.items():
@@ -233,4 +247,4 @@ def _fire(sensor: Any, scene: Scene, log: SceneLog, rows: Sequence[int]) -> dict
             sensor.fire(warm)
         for key, values in stacked.items():
             np.copyto(values[k], warm[key])
-    return stacked
+    return stacked, above
