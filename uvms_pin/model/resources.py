@@ -28,6 +28,7 @@ __all__ = [
     "environment_folders",
     "example_robot_data_dir",
     "find_model",
+    "package_folders",
     "package_search_path",
     "resolve_model",
     "resolve_resource",
@@ -59,6 +60,12 @@ def environment_folders(variable: str) -> list[Path]:
     """The folders a search-path environment variable lists (``os.pathsep`` between them),
     in order; none when it is unset or empty."""
     return [Path(d) for d in os.environ.get(variable, "").split(os.pathsep) if d]
+
+
+def package_folders(package_dirs: str | Path | Iterable[str | Path]) -> Iterable[str | Path]:
+    """``package_dirs`` as a list of folders: one folder given alone is the list of it (a
+    string is not read as its characters); a list as it is."""
+    return (package_dirs,) if isinstance(package_dirs, str | Path) else package_dirs
 
 
 def package_search_path(package_dirs: Iterable[str | Path] = ()) -> list[Path]:

@@ -6,8 +6,9 @@ body), x along its acoustic axis, y to port, z up. An ``imaging`` sonar has ``be
 bearings spread evenly over ``horizontal_fov_rad`` (about z, positive to port); each beam is
 sampled by ``rays_per_beam`` rays over its ``vertical_fov_rad`` fan. An ``altimeter`` has one
 beam, a cone of ``horizontal_fov_rad`` sampled by the rays of a ``rays_per_beam`` x
-``rays_per_beam`` grid of bearings and elevations that lie within it (about pi / 4 of them). A ray that meets a
-surface at range r with incidence theta (to its normal) returns, into the range bin of r,
+``rays_per_beam`` grid of bearings and elevations that lie within it (about pi / 4 of
+them). A ray that meets a surface at range r with incidence theta (to its normal) returns,
+into the range bin of r,
 
     mu cos^2(theta) w(e) 10^(-2 alpha r / 10) / r^2
 

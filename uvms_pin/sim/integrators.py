@@ -22,7 +22,7 @@ import pinocchio as pin
 
 from uvms_pin.checks import number_fields, positive
 from uvms_pin.errors import ParameterError, SimulationError
-from uvms_pin.physics.derivatives.step import check_substeps
+from uvms_pin.physics.derivatives.step import split_interval
 
 Rhs = Callable[[float, np.ndarray, np.ndarray], np.ndarray]
 Event = Callable[[float, np.ndarray, np.ndarray], float]
@@ -90,10 +90,7 @@ def python_chart(model: pin.Model) -> Chart:
 def interval_substeps(t0: float, t1: float, max_step_s: float) -> tuple[int, float]:
     """(n, h): the fewest equal substeps no longer than ``max_step_s`` [s] from t0 to t1
     (one at least; more than `MAX_SUBSTEPS`: ParameterError), as the core splits it."""
-    count = (t1 - t0) / max_step_s - 1e-9
-    check_substeps(count, t1 - t0, max_step_s)
-    n = max(1, math.ceil(count))
-    return n, (t1 - t0) / n
+    return split_interval(t1 - t0, max_step_s)
 
 
 @dataclass(frozen=True)

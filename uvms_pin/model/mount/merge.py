@@ -36,6 +36,7 @@ from uvms_pin.model.mount.tool import (
     tool_axis_in_link,
 )
 from uvms_pin.model.mount.tree import URDFTree
+from uvms_pin.model.resources import package_folders
 
 __all__ = ["ArmMerge", "MergedURDF", "merge_urdf"]
 
@@ -124,8 +125,7 @@ def merge_urdf(
     allow_dry_links = flag("allow_dry_links", allow_dry_links)
     keep_existing_arm = flag("keep_existing_arm", keep_existing_arm)
     moving_jaw = flag("moving_jaw", moving_jaw)
-    if isinstance(package_dirs, str | Path):
-        package_dirs = (package_dirs,)  # one folder, not its name's characters
+    package_dirs = package_folders(package_dirs)
     vehicle = URDFTree.read(Path(vehicle_urdf))
     arm = URDFTree.read(Path(arm_urdf))
     removed_links, removed_joints = ([], []) if keep_existing_arm else existing_arm(vehicle)

@@ -15,6 +15,7 @@ import pinocchio as pin
 from uvms_pin.checks import flag, number
 from uvms_pin.errors import ModelError, ModelWarning, ParameterError
 from uvms_pin.model.native_stderr import captured_native_stderr
+from uvms_pin.model.resources import package_folders
 from uvms_pin.model.urdf.bodies import hydro_bodies
 from uvms_pin.model.urdf.hydrodynamics import hydro_elements_by_link
 from uvms_pin.model.urdf.lift_drag import read_fins
@@ -68,8 +69,7 @@ def load_uvms(
     for name, frame in (("ee_frame", ee_frame), ("sensor_frame", sensor_frame)):
         if frame is not None and not isinstance(frame, str):
             raise ParameterError(f"{name} must be a frame's name (or None), got {frame!r}")
-    if isinstance(package_dirs, str | Path):
-        package_dirs = (package_dirs,)  # one folder, not its name's characters
+    package_dirs = package_folders(package_dirs)
     if not np.isfinite(water_density_kg_m3) or water_density_kg_m3 <= 0.0:
         raise ParameterError(f"water_density_kg_m3 must be positive, got {water_density_kg_m3}")
     WATER_DENSITY.check("water_density_kg_m3", water_density_kg_m3)

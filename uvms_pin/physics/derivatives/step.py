@@ -96,14 +96,18 @@ Derivative = Callable[[float, np.ndarray, np.ndarray, np.ndarray], tuple[np.ndar
 MAX_SUBSTEPS = 10_000_000
 
 
-def check_substeps(count: float, interval_s: float, step_s: float) -> None:
-    """ParameterError if ``count`` substeps of ``step_s`` [s] over ``interval_s`` [s] are
-    more than `MAX_SUBSTEPS`."""
+def split_interval(interval_s: float, step_s: float) -> tuple[int, float]:
+    """(n, h): the fewest equal substeps no longer than ``step_s`` [s] over ``interval_s``
+    [s], one at least, as the core splits it (1e-9 of a step's slack against rounding);
+    ParameterError for more than `MAX_SUBSTEPS`. Unchecked numbers: the callers' own."""
+    count = interval_s / step_s - 1e-9
     if not count <= MAX_SUBSTEPS:
         raise ParameterError(
             f"{interval_s:g} s in steps of {step_s:g} s is {count:.3g} substeps, more than "
             f"{MAX_SUBSTEPS:.0e} in one call: shorten the interval or lengthen the step"
         )
+    n = max(1, math.ceil(count))
+    return n, interval_s / n
 
 
 def substeps(period_s: float, step_s: float) -> tuple[int, float]:
@@ -115,10 +119,7 @@ def substeps(period_s: float, step_s: float) -> tuple[int, float]:
         raise ParameterError(f"period_s must be positive and finite, got {period_s}")
     if not (step_s > 0.0 and math.isfinite(step_s)):
         raise ParameterError(f"step_s must be positive and finite, got {step_s}")
-    count = period_s / step_s - 1e-9
-    check_substeps(count, period_s, step_s)
-    n = max(1, math.ceil(count))
-    return n, period_s / n
+    return split_interval(period_s, step_s)
 
 
 def euler_substep(
